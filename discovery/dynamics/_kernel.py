@@ -1,0 +1,370 @@
+"""Compiled event-driven Dormand–Prince 5(4) integrator for the two-body system.
+
+The right-hand side is smooth inside each *contact mode*; the mode changes only
+at located events, and no step straddles an event: a step in which a switching
+function changes sign is re-taken with its length cut to the root (found on the
+dense output), so every step integrates one smooth vector field.
+
+Modes
+    FREE     no force (``zeta <= 0``)
+    LOAD     ``F = P(zeta, dzeta)``       (``zeta > 0``, ``dzeta > 0``)
+    UNLOAD   ``F = P(zeta, 0)``           (``zeta > 0``, ``dzeta <= 0``)
+    CLIPPED  ``F = 0`` with ``zeta > 0``  (``P`` would be adhesive, < 0)
+
+Switching functions ``h`` are written so that an event fires when ``h`` goes from
+``>= 0`` to ``< 0`` over a step (direction built in):
+
+    FREE:    onset       h = -zeta
+    LOAD:    loss        h = zeta,  unload  h = dzeta,   release h = P(zeta, dzeta)
+    UNLOAD:  loss        h = zeta,  reload  h = -dzeta,  release h = P(zeta, 0)
+    CLIPPED: loss        h = zeta,  resume  h = -P(zeta, max(dzeta, 0))
+
+Inside a mode the force is extended smoothly past the switching surface (odd
+extension of fractional powers) because Runge–Kutta stages may sample slightly
+beyond it.
+"""
+
+import numpy as np
+from numba import njit
+
+from ._tableau import A as _A
+from ._tableau import B as _B
+from ._tableau import C as _C
+from ._tableau import E as _E
+from ._tableau import P as _P
+
+FREE, LOAD, UNLOAD, CLIPPED = 0, 1, 2, 3
+EV_ONSET, EV_LOSS, EV_UNLOAD, EV_RELOAD, EV_RELEASE, EV_RESUME = 1, 2, 3, 4, 5, 6
+OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW, CHATTER = 0, 1, 2, 3, 4
+
+_SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
+
+
+@njit(cache=True, inline="always")
+def _pw(x, p):
+    if p == 0.0:
+        return 1.0
+    if p == 1.0:
+        return x
+    if p == 2.0:
+        return x * x
+    if p == 3.0:
+        return x * x * x
+    if x >= 0.0:
+        return x**p
+    return -((-x) ** p)
+
+
+@njit(cache=True)
+def poly(z, zd, coef, ea, eb):
+    """``P(z, zd) = sum c_i z^a_i zd^b_i`` (odd extension for negative arguments)."""
+    s = 0.0
+    for i in range(coef.shape[0]):
+        s += coef[i] * _pw(z, ea[i]) * _pw(zd, eb[i])
+    return s
+
+
+@njit(cache=True)
+def mode_force(mode, z, v, coef, ea, eb):
+    """Contact force [N] in a given mode at penetration ``z`` and its rate ``v``."""
+    if mode == LOAD:
+        return poly(z, v, coef, ea, eb)
+    if mode == UNLOAD:
+        return poly(z, 0.0, coef, ea, eb)
+    return 0.0
+
+
+@njit(cache=True)
+def resolve_mode(y, coef, ea, eb):
+    """The mode a state belongs to (used at the start of an integration)."""
+    z = y[0] - y[2]
+    v = y[1] - y[3]
+    if z < 0.0 or (z == 0.0 and v <= 0.0):
+        return FREE
+    if v > 0.0:
+        return LOAD if poly(max(z, 0.0), v, coef, ea, eb) >= 0.0 else CLIPPED
+    return UNLOAD if poly(z, 0.0, coef, ea, eb) > 0.0 else CLIPPED
+
+
+@njit(cache=True)
+def _rhs(t, y, mode, p, coef, ea, eb, out):
+    z = y[0] - y[2]
+    v = y[1] - y[3]
+    f = mode_force(mode, z, v, coef, ea, eb)
+    out[0] = y[1]
+    out[1] = -(p[3] * y[1] + p[2] * y[0] + p[4] * np.sin(p[5] * t) + p[0] * p[6] + f) / p[0]
+    out[2] = y[3]
+    out[3] = f / p[1] - p[6]
+
+
+@njit(cache=True)
+def _switching(mode, y, coef, ea, eb, h):
+    """Fill ``h`` with the mode's switching functions; return how many."""
+    z = y[0] - y[2]
+    v = y[1] - y[3]
+    if mode == FREE:
+        h[0] = -z
+        return 1
+    h[0] = z
+    if mode == LOAD:
+        h[1] = v
+        h[2] = poly(z, v, coef, ea, eb)
+        return 3
+    if mode == UNLOAD:
+        h[1] = -v
+        h[2] = poly(z, 0.0, coef, ea, eb)
+        return 3
+    h[1] = -poly(max(z, 0.0), max(v, 0.0), coef, ea, eb)
+    return 2
+
+
+@njit(cache=True)
+def _event_kind(mode, index):
+    if mode == FREE:
+        return EV_ONSET
+    if index == 0:
+        return EV_LOSS
+    if mode == LOAD:
+        return EV_UNLOAD if index == 1 else EV_RELEASE
+    if mode == UNLOAD:
+        return EV_RELOAD if index == 1 else EV_RELEASE
+    return EV_RESUME
+
+
+@njit(cache=True)
+def _mode_after(kind, y, coef, ea, eb):
+    z = max(y[0] - y[2], 0.0)
+    v = y[1] - y[3]
+    if kind == EV_LOSS:
+        return FREE
+    if kind == EV_RELEASE:
+        return CLIPPED
+    if kind == EV_UNLOAD or ((kind == EV_ONSET or kind == EV_RESUME) and v <= 0.0):
+        return UNLOAD if poly(z, 0.0, coef, ea, eb) >= 0.0 else CLIPPED
+    # onset / resume with dzeta > 0, or reload
+    return LOAD if poly(z, max(v, 0.0), coef, ea, eb) >= 0.0 else CLIPPED
+
+
+@njit(cache=True)
+def _dense(y, K, h, theta, out):
+    t2 = theta * theta
+    t3 = t2 * theta
+    t4 = t3 * theta
+    for j in range(4):
+        acc = 0.0
+        for i in range(7):
+            acc += K[i, j] * (_P[i, 0] * theta + _P[i, 1] * t2 + _P[i, 2] * t3 + _P[i, 3] * t4)
+        out[j] = y[j] + h * acc
+
+
+@njit(cache=True)
+def _rk_step(t, y, h, mode, p, coef, ea, eb, K, ytmp, ynew):
+    """One DP5 step from (t, y) with K[0] = f(t, y) already set; fills K[1:7], ynew."""
+    for s in range(1, 6):
+        for j in range(4):
+            acc = 0.0
+            for i in range(s):
+                acc += _A[s, i] * K[i, j]
+            ytmp[j] = y[j] + h * acc
+        _rhs(t + _C[s] * h, ytmp, mode, p, coef, ea, eb, K[s])
+    for j in range(4):
+        acc = 0.0
+        for i in range(6):
+            acc += _B[i] * K[i, j]
+        ynew[j] = y[j] + h * acc
+    _rhs(t + h, ynew, mode, p, coef, ea, eb, K[6])
+
+
+@njit(cache=True)
+def _error_norm(y, ynew, K, h, rtol, atol):
+    s = 0.0
+    for j in range(4):
+        e = 0.0
+        for i in range(7):
+            e += _E[i] * K[i, j]
+        sc = atol[j] + rtol * max(abs(y[j]), abs(ynew[j]))
+        r = h * e / sc
+        s += r * r
+    return np.sqrt(s / 4.0)
+
+
+@njit(cache=True)
+def _locate(y, K, h, mode, coef, ea, eb, index, th_lo, th_hi, h_lo, h_hi, ybuf, hbuf):
+    """Root in ``theta`` of switching function ``index`` on the dense output (Illinois)."""
+    a, b, fa, fb = th_lo, th_hi, h_lo, h_hi
+    side = 0
+    for _ in range(100):
+        c = (a * fb - b * fa) / (fb - fa)
+        if not (a < c < b):
+            c = 0.5 * (a + b)
+        _dense(y, K, h, c, ybuf)
+        _switching(mode, ybuf, coef, ea, eb, hbuf)
+        fc = hbuf[index]
+        if fc < 0.0:
+            b, fb = c, fc
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:
+            a, fa = c, fc
+            if side == 1:
+                fb *= 0.5
+            side = 1
+        if b - a <= 1e-15 * max(1.0, b):
+            break
+    return b
+
+
+@njit(cache=True)
+def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_steps,
+              t_eval, out_y, out_f, out_mode, ev_t, ev_kind, ev_y, ev_modes):
+    """Integrate from ``t0`` to ``t1``; see :func:`discovery.dynamics.simulate`.
+
+    Writes the state, force and mode at each ``t_eval`` (sorted, within
+    ``[t0, t1]``) and up to ``len(ev_t)`` events.  Returns
+    ``(status, t, y, mode, n_steps, n_events, h)``; ``mode0 < 0`` resolves the mode
+    from ``y0``.
+    """
+    y = y0.copy()
+    ynew = np.empty(4)
+    ytmp = np.empty(4)
+    ybuf = np.empty(4)
+    K = np.empty((7, 4))
+    hs0 = np.empty(3)
+    hs1 = np.empty(3)
+    hsm = np.empty(3)
+    t = t0
+    mode = mode0 if mode0 >= 0 else resolve_mode(y, coef, ea, eb)
+    h = min(h0, hmax, t1 - t0)
+    n_eval = t_eval.shape[0]
+    k_eval = 0
+    while k_eval < n_eval and t_eval[k_eval] <= t0:
+        for j in range(4):
+            out_y[j, k_eval] = y[j]
+        out_f[k_eval] = mode_force(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb)
+        out_mode[k_eval] = mode
+        k_eval += 1
+    n_ev = 0
+    n_steps = 0
+    zero_len = 0
+    status = OK
+    need_f = True
+    while t < t1:
+        if n_steps >= max_steps:
+            status = STEP_BUDGET
+            break
+        if need_f:
+            _rhs(t, y, mode, p, coef, ea, eb, K[0])
+            need_f = False
+        h = min(h, hmax, t1 - t)
+        if h < 1e-14 * max(1.0, abs(t)) and t1 - t > h:
+            status = STEP_UNDERFLOW
+            break
+        _rk_step(t, y, h, mode, p, coef, ea, eb, K, ytmp, ynew)
+        n_steps += 1
+        err = _error_norm(y, ynew, K, h, rtol, atol)
+        if not np.isfinite(err):
+            h *= _MIN_FACTOR
+            if h < 1e-14 * max(1.0, abs(t)):
+                status = BLOW_UP
+                break
+            continue
+        if err > 1.0:
+            h *= max(_MIN_FACTOR, _SAFETY * err**-0.2)
+            continue
+        # ---- accepted step: look for the earliest event in (t, t + h]
+        ns = _switching(mode, y, coef, ea, eb, hs0)
+        _switching(mode, ynew, coef, ea, eb, hs1)
+        best_theta = 2.0
+        best_index = -1
+        for i in range(ns):
+            if hs0[i] == 0.0 and hs1[i] < 0.0:
+                # already on the surface and moving across: transition at t
+                best_theta, best_index = 0.0, i
+                break
+            if hs0[i] < 0.0:
+                continue
+            # check interior points too, so a brief excursion inside a step is seen
+            lo, flo = 0.0, hs0[i]
+            found = False
+            th = 2.0
+            for q in (1.0 / 3.0, 2.0 / 3.0, 1.0):
+                if q < 1.0:
+                    _dense(y, K, h, q, ybuf)
+                    _switching(mode, ybuf, coef, ea, eb, hsm)
+                    fq = hsm[i]
+                else:
+                    fq = hs1[i]
+                if fq < 0.0:
+                    th = _locate(y, K, h, mode, coef, ea, eb, i, lo, q, flo, fq, ybuf, hsm)
+                    found = True
+                    break
+                lo, flo = q, fq
+            # near-ties go to the lower index: contact loss (index 0) wins over the
+            # force reaching zero at the same instant (e.g. P(zeta, 0) = k * zeta)
+            if found and th < best_theta - 1e-9:
+                best_theta, best_index = th, i
+        if best_index >= 0:
+            if best_theta == 0.0:
+                zero_len += 1
+                if zero_len > 4:
+                    status = CHATTER
+                    break
+                kind = _event_kind(mode, best_index)
+                new_mode = _mode_after(kind, y, coef, ea, eb)
+                if n_ev < ev_t.shape[0]:
+                    ev_t[n_ev] = t
+                    ev_kind[n_ev] = kind
+                    ev_modes[n_ev, 0] = mode
+                    ev_modes[n_ev, 1] = new_mode
+                    for j in range(4):
+                        ev_y[n_ev, j] = y[j]
+                n_ev += 1
+                mode = new_mode
+                need_f = True
+                continue
+            # re-take the step so that it ends on the event
+            h_ev = best_theta * h
+            _rk_step(t, y, h_ev, mode, p, coef, ea, eb, K, ytmp, ynew)
+            h_used = h_ev
+        else:
+            h_used = h
+        zero_len = 0
+        t_new = t + h_used if best_index >= 0 or h_used < t1 - t else t1
+        # dense output at requested times inside (t, t_new]
+        while k_eval < n_eval and t_eval[k_eval] <= t_new:
+            theta = (t_eval[k_eval] - t) / h_used
+            _dense(y, K, h_used, min(theta, 1.0), ybuf)
+            for j in range(4):
+                out_y[j, k_eval] = ybuf[j]
+            out_f[k_eval] = mode_force(mode, ybuf[0] - ybuf[2], ybuf[1] - ybuf[3], coef, ea, eb)
+            out_mode[k_eval] = mode
+            k_eval += 1
+        for j in range(4):
+            y[j] = ynew[j]
+            K[0, j] = K[6, j]
+        t = t_new
+        bad = False
+        for j in range(4):
+            if not np.isfinite(y[j]):
+                bad = True
+        if bad:
+            status = BLOW_UP
+            break
+        if best_index >= 0:
+            kind = _event_kind(mode, best_index)
+            new_mode = _mode_after(kind, y, coef, ea, eb)
+            if n_ev < ev_t.shape[0]:
+                ev_t[n_ev] = t
+                ev_kind[n_ev] = kind
+                ev_modes[n_ev, 0] = mode
+                ev_modes[n_ev, 1] = new_mode
+                for j in range(4):
+                    ev_y[n_ev, j] = y[j]
+            n_ev += 1
+            mode = new_mode
+            need_f = True
+            # keep the step size that worked before the cut
+        else:
+            h = h * min(_MAX_FACTOR, max(_MIN_FACTOR, _SAFETY * max(err, 1e-10) ** -0.2))
+    return status, t, y, mode, n_steps, n_ev, h

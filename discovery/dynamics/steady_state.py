@@ -1,0 +1,255 @@
+"""Periodic steady states: stroboscopic map, shooting, Floquet multipliers.
+
+The stroboscopic map ``Phi`` advances a state by one drive period ``T`` (the drive
+phase is fixed, so states are sampled at ``t = kT``).  After a short transient the
+recurrence of the strobe points suggests a period ``n``; a damped Newton method
+on ``Phi^n(y) - y = 0`` (finite-difference Jacobian, which includes the event
+saltation automatically) then converges to the periodic orbit, whose Floquet
+multipliers are the eigenvalues of that Jacobian.  An orbit is accepted only when
+it converged and is stable; otherwise a long transient is integrated and the
+search repeated, and if that fails too the result says "nonperiodic" with the
+evidence.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import IntegrationError
+from . import _kernel as K
+from .simulate import Tolerances, _atol
+
+__all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
+
+
+class StroboscopicMap:
+    """The period map of one scenario and law (a thin, fast wrapper on the kernel).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    law : ForceLaw
+    tolerances : Tolerances, optional
+    """
+
+    def __init__(self, scenario, law, tolerances=None):
+        self.scenario = scenario
+        self.law = law
+        self.tol = tolerances or Tolerances()
+        self._p = scenario.params()
+        self._coef, self._ea, self._eb = law.kernel_arrays()
+        self._atol = _atol(scenario, self.tol)
+        self._T = scenario.period
+        self._hmax = self._T * self.tol.hmax_fraction
+        self._empty = np.zeros(0)
+        self._ey = np.empty((4, 0))
+        self._ef = np.empty(0)
+        self._em = np.empty(0, dtype=np.int64)
+        self._evt = np.empty(0)
+        self._evk = np.empty(0, dtype=np.int64)
+        self._evy = np.empty((0, 4))
+        self._evm = np.empty((0, 2), dtype=np.int64)
+        x, v = scenario.scales()
+        self.scale = np.array([x, v, x, v])
+        self.n_calls = 0
+        self.n_steps = 0
+
+    def advance(self, y, n=1, t0=0.0):
+        """State after ``n`` periods from ``y`` at time ``t0`` (a multiple of ``T``)."""
+        status, tf, yf, _, steps, _, _ = K.integrate(
+            t0, t0 + n * self._T, np.asarray(y, dtype=float), -1, self._p, self._coef, self._ea,
+            self._eb, self.tol.rtol, self._atol, self._T / 100.0, self._hmax,
+            self.tol.max_steps, self._empty, self._ey, self._ef, self._em, self._evt,
+            self._evk, self._evy, self._evm)
+        self.n_calls += 1
+        self.n_steps += steps
+        if status != K.OK or not np.all(np.abs(yf) < 1e6 * self.scale.max() + 1e3):
+            raise IntegrationError(
+                f"simulation of law '{self.law}' failed at t = {tf:.6g} s "
+                f"(status {status}); the law may be unphysical (negative or huge coefficients)")
+        return yf
+
+    def jacobian(self, y, n=1, fy=None):
+        """Finite-difference Jacobian of ``Phi^n`` at ``y``, ndarray of shape (4, 4)."""
+        fy = self.advance(y, n) if fy is None else fy
+        J = np.empty((4, 4))
+        for j in range(4):
+            d = 1e-6 * self.scale[j]
+            yp = np.array(y, dtype=float)
+            yp[j] += d
+            J[:, j] = (self.advance(yp, n) - fy) / d
+        return J
+
+
+@dataclass(frozen=True)
+class SteadyState:
+    """A periodic steady state of the two-body system (or the evidence that none was found).
+
+    Attributes
+    ----------
+    regime : str
+        ``"P1"``, ``"P2"``, ... (period in drive periods) or ``"nonperiodic"``.
+    n_periods : int
+        Period ``n`` of the orbit in drive periods (0 when nonperiodic).
+    y0 : ndarray of shape (4,)
+        State on the orbit at ``t0`` (a multiple of the drive period).
+    t0 : float
+        Time [s] at which ``y0`` holds.
+    impacts : int
+        Contact onsets per orbit (``n`` periods).
+    multipliers : ndarray of shape (4,), complex
+        Floquet multipliers (eigenvalues of the Jacobian of ``Phi^n``).
+    residual : float
+        ``max |Phi^n(y0) - y0| / scale`` at the solution.
+    n_simulations : int
+        Period-map evaluations used.
+    evidence : dict
+        How the decision was reached (recurrence distances, Newton history).
+    """
+
+    regime: str
+    n_periods: int
+    y0: np.ndarray
+    t0: float
+    impacts: int
+    multipliers: np.ndarray
+    residual: float
+    n_simulations: int
+    evidence: dict = field(default_factory=dict)
+
+    @property
+    def periodic(self):
+        return self.n_periods > 0
+
+    @property
+    def impacts_per_period(self):
+        return self.impacts / self.n_periods if self.n_periods else float("nan")
+
+    def as_dict(self):
+        return {"regime": self.regime, "n_periods": self.n_periods,
+                "impacts": self.impacts, "impacts_per_period": self.impacts_per_period,
+                "multipliers_abs": [float(abs(m)) for m in self.multipliers],
+                "residual": self.residual, "n_simulations": self.n_simulations}
+
+
+def _recurrence(strobe, scale, max_period):
+    """Smallest relative distance ``|y_{k+n} - y_k|`` over the last strobe points, per n."""
+    d = {}
+    last = len(strobe) - 1
+    for n in range(1, max_period + 1):
+        ks = range(max(0, last - n - 2), last - n + 1)
+        d[n] = float(max(np.max(np.abs(strobe[k + n] - strobe[k]) / scale) for k in ks))
+    return d
+
+
+def _newton(pm, y, n, tol, max_iter, history):
+    """Damped Newton on ``G(y) = Phi^n(y) - y``; returns (y, residual, J, converged)."""
+    s = pm.scale
+    fy = pm.advance(y, n)
+    res = np.max(np.abs(fy - y) / s)
+    J = None
+    for _ in range(max_iter):
+        history.append(res)
+        if res < tol:
+            break
+        J = pm.jacobian(y, n, fy)
+        try:
+            step = np.linalg.solve(J - np.eye(4), -(fy - y))
+        except np.linalg.LinAlgError:
+            return y, res, J, False
+        lam = 1.0
+        while lam > 1e-3:
+            y_try = y + lam * step
+            try:
+                f_try = pm.advance(y_try, n)
+            except IntegrationError:
+                lam *= 0.5
+                continue
+            r_try = np.max(np.abs(f_try - y_try) / s)
+            if r_try < res:
+                y, fy, res = y_try, f_try, r_try
+                break
+            lam *= 0.5
+        else:
+            return y, res, J, False
+    converged = res < tol
+    if converged:
+        J = pm.jacobian(y, n, fy)
+    return y, res, J, converged
+
+
+def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_newton=12,
+                 long_transient=300, tolerances=None, y_start=None):
+    """Find the periodic steady state reached from the scenario's initial state.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    law : ForceLaw
+    transient : int
+        Drive periods integrated before the period search.
+    max_period : int
+        Largest orbit period (in drive periods) looked for.
+    tol : float
+        Newton tolerance on ``max |Phi^n(y) - y| / scale``.
+    max_newton : int
+        Newton iterations per attempt.
+    long_transient : int
+        Periods of the fallback transient when the first search fails.
+    tolerances : Tolerances, optional
+        Integrator settings.
+    y_start : array_like of shape (4,), optional
+        Initial state (default the scenario's).
+
+    Returns
+    -------
+    SteadyState
+        ``regime == "nonperiodic"`` when no stable periodic orbit was found.
+    """
+    pm = StroboscopicMap(scenario, law, tolerances)
+    y = scenario.initial_state() if y_start is None else np.asarray(y_start, dtype=float)
+    evidence = {"attempts": []}
+    t_done = 0
+    for phase, n_trans in (("transient", transient), ("long-transient", long_transient)):
+        y = pm.advance(y, n_trans)
+        t_done += n_trans
+        strobe = [y]
+        for _ in range(2 * max_period + 2):
+            strobe.append(pm.advance(strobe[-1], 1))
+        y = strobe[-1]
+        t_done += 2 * max_period + 2
+        dist = _recurrence(strobe, pm.scale, max_period)
+        order = sorted(dist, key=lambda n: (dist[n] > 1e-2, n if dist[n] <= 1e-2 else dist[n]))
+        attempt = {"phase": phase, "recurrence": dist, "tried": []}
+        evidence["attempts"].append(attempt)
+        for n in order[:3]:
+            hist = []
+            y_orb, res, J, ok = _newton(pm, y, n, tol, max_newton, hist)
+            mult = np.linalg.eigvals(J) if J is not None else np.full(4, np.nan + 0j)
+            stable = bool(ok and np.all(np.abs(mult) < 1.0))
+            attempt["tried"].append({"n": n, "newton_residuals": hist, "converged": ok,
+                                     "max_multiplier": float(np.max(np.abs(mult))),
+                                     "stable": stable})
+            if not stable:
+                continue
+            # the smallest divisor period that also closes the orbit
+            for m in range(1, n):
+                if n % m == 0 and np.max(np.abs(pm.advance(y_orb, m) - y_orb) / pm.scale) < 10 * tol:
+                    n = m
+                    mult = np.linalg.eigvals(pm.jacobian(y_orb, n))
+                    break
+            t0 = t_done * scenario.period
+            impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n)
+            return SteadyState(regime=f"P{n}", n_periods=n, y0=y_orb, t0=t0, impacts=impacts,
+                               multipliers=mult, residual=float(res),
+                               n_simulations=pm.n_calls, evidence=evidence)
+    return SteadyState(regime="nonperiodic", n_periods=0, y0=y, t0=t_done * scenario.period,
+                       impacts=0, multipliers=np.full(4, np.nan + 0j), residual=float("nan"),
+                       n_simulations=pm.n_calls, evidence=evidence)
+
+
+def _count_onsets(scenario, law, tol, y0, t0, n):
+    from .simulate import simulate
+
+    tr = simulate(scenario, law, (t0, t0 + n * scenario.period), y0=y0, tolerances=tol)
+    return int(np.sum(tr.event_kind == K.EV_ONSET))
