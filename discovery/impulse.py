@@ -1,0 +1,351 @@
+"""Steady-state impact-force histories aligned at the impact onset.
+
+An :class:`Impulse` is the force over one steady-state cycle (``n`` drive periods)
+starting at the main impact onset ``t* = 0``.  It is piecewise linear between its
+points; a time that appears twice marks a jump (left limit, then right limit), so
+the force jump of a viscous contact at onset is represented exactly: the first
+point is the right limit ``F(0+)``.
+
+Two constructors:
+
+* :func:`impulse_from_steady_state`: from a simulated periodic orbit, with the
+  onset and every switching event located exactly by the integrator;
+* :func:`impulse_from_samples`: from a sampled (measured) record, with a noise
+  level estimated from the data, a threshold from it, a sub-sample onset time,
+  and averaging over all complete cycles in the record.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .dynamics import _kernel as K
+from .dynamics.simulate import simulate
+from .errors import InputError
+
+__all__ = ["Impulse", "impulse_from_steady_state", "impulse_from_samples", "estimate_noise"]
+
+
+@dataclass(frozen=True)
+class Impulse:
+    """Force over one cycle from the impact onset.
+
+    Attributes
+    ----------
+    t : ndarray of shape (n,)
+        Times since the onset [s], non-decreasing, from 0 to ``duration``; a
+        repeated time is a jump (left then right limit).
+    F : ndarray of shape (n,)
+        Force [N].
+    duration : float
+        Cycle length ``n_periods * T`` [s].
+    support : ndarray of shape (k, 2)
+        Intervals ``[start, end)`` [s] where the force is positive.
+    n_periods : int
+        Drive periods per cycle.
+    onset : float
+        Absolute time of the onset [s] in the source record or simulation.
+    threshold : float
+        Force level [N] that defined the support (0 for an exact simulation).
+    noise : float
+        Estimated noise standard deviation [N] (0 for a simulation).
+    n_cycles : int
+        Cycles averaged.
+    """
+
+    t: np.ndarray
+    F: np.ndarray
+    duration: float
+    support: np.ndarray
+    n_periods: int
+    onset: float
+    threshold: float = 0.0
+    noise: float = 0.0
+    n_cycles: int = 1
+
+    @property
+    def contact_time(self):
+        """Total time with positive force per cycle [s]."""
+        return float(np.sum(self.support[:, 1] - self.support[:, 0])) if len(self.support) else 0.0
+
+    @property
+    def peak(self):
+        """Largest force [N]."""
+        return float(np.max(self.F))
+
+    def evaluate(self, tq, side="right"):
+        """Force at times ``tq`` (periodic in ``duration``), one-sided at jumps.
+
+        Parameters
+        ----------
+        tq : array_like
+            Query times since the onset [s].
+        side : {"right", "left"}
+            Which limit to take where the force jumps.
+        """
+        tq = np.asarray(tq, dtype=float)
+        q = np.mod(tq, self.duration)
+        if side == "left":
+            q = np.where((q == 0) & (tq > 0), self.duration, q)
+        t, F = self.t, self.F
+        if side == "right":
+            i = np.clip(np.searchsorted(t, q, "right") - 1, 0, len(t) - 2)
+        else:
+            i = np.clip(np.searchsorted(t, q, "left") - 1, 0, len(t) - 2)
+        t0, t1 = t[i], t[i + 1]
+        w = np.where(t1 > t0, (q - t0) / np.where(t1 > t0, t1 - t0, 1.0), 1.0 if side == "left" else 0.0)
+        return F[i] + np.clip(w, 0.0, 1.0) * (F[i + 1] - F[i])
+
+    def periodic_support(self, length):
+        """Support intervals repeated over ``[0, length]``, ndarray of shape (m, 2)."""
+        reps = int(round(length / self.duration))
+        if not np.isclose(reps * self.duration, length, rtol=1e-9) or reps < 1:
+            raise ValueError("length must be a whole number of cycles")
+        return np.concatenate([self.support + k * self.duration for k in range(reps)]) \
+            if len(self.support) else np.zeros((0, 2))
+
+
+# ----------------------------------------------------------------- simulation
+def _orbit_events(scenario, law, ss, tolerances):
+    T = scenario.period
+    t0 = ss.t0
+    n = ss.n_periods
+    tr = simulate(scenario, law, (t0, t0 + n * T), y0=ss.y0, tolerances=tolerances,
+                  t_eval=np.linspace(t0, t0 + n * T, 400 * n + 1))
+    return tr
+
+
+def _main_onset(tr, law, scenario, n):
+    """Index (into tr events) of the onset followed by the largest impulse."""
+    onsets = np.flatnonzero(tr.event_kind == K.EV_ONSET)
+    if len(onsets) == 0:
+        return None
+    if len(onsets) == 1:
+        return onsets[0]
+    best, best_j = -1.0, onsets[0]
+    times = tr.event_t[onsets]
+    for j, t_on in zip(onsets, times, strict=True):
+        later = times[times > t_on]
+        t_end = later[0] if len(later) else t_on + n * scenario.period
+        m = (tr.t >= t_on) & (tr.t < t_end)
+        imp = np.trapezoid(tr.force[m], tr.t[m]) if m.sum() > 1 else 0.0
+        if imp > best:
+            best, best_j = imp, j
+    return best_j
+
+
+def impulse_from_steady_state(scenario, law, ss, points_per_period=2000, tolerances=None):
+    """The exact steady-state impulse of a periodic orbit.
+
+    The cycle is integrated again from the located onset, so ``F(0+)`` and every
+    later event are exact (to integrator tolerance), with one-sided limits at jumps.
+
+    Parameters
+    ----------
+    scenario, law
+        As used for ``ss``.
+    ss : SteadyState
+        A periodic steady state (``ss.periodic`` must be true).
+    points_per_period : int
+        Uniform output points per drive period (events are added to them).
+    tolerances : Tolerances, optional
+
+    Returns
+    -------
+    Impulse
+        ``None`` when the orbit has no contact onset (the moulding never leaves the
+        grid, or never touches it).
+    """
+    if not ss.periodic:
+        raise InputError(f"no periodic steady state ({ss.regime}); an impulse needs one")
+    n, T = ss.n_periods, scenario.period
+    tr = _orbit_events(scenario, law, ss, tolerances)
+    j = _main_onset(tr, law, scenario, n)
+    if j is None:
+        return None
+    t_on, y_on, mode_on = tr.event_t[j], tr.event_y[j], tr.event_modes[j, 1]
+    W = n * T
+    grid = np.linspace(0.0, W, points_per_period * n + 1)
+    tr2 = simulate(scenario, law, (t_on, t_on + W), y0=y_on, mode0=mode_on,
+                   t_eval=t_on + grid, tolerances=tolerances)
+    F = tr2.force  # at t_on the kernel reports the mode after the onset: F(0+)
+    # periodicity: F(W-) = F(0-), the force just before the onset (the kernel may have
+    # crossed the next onset a whisker before W)
+    F[-1] = tr.event_forces(law)[j, 0]
+    # insert events (left and right limits) into the grid
+    ev_rel = tr2.event_t - t_on
+    lim = tr2.event_forces(law)
+    # events within a whisker of W belong to the next cycle (orbit closes to ~1e-9 T)
+    keep = (ev_rel > 0) & (ev_rel < W * (1.0 - 1e-6))
+    t_all = np.concatenate([grid, ev_rel[keep], ev_rel[keep]])
+    f_all = np.concatenate([F, lim[keep, 0], lim[keep, 1]])
+    rank = np.concatenate([np.full(grid.size, 1), np.zeros(keep.sum()), np.full(keep.sum(), 2)])
+    order = np.lexsort((rank, t_all))
+    t_all, f_all, rank = t_all[order], f_all[order], rank[order]
+    # a grid point that coincides with an event time is replaced by its limits
+    drop = (rank == 1) & np.isin(t_all, ev_rel[keep])
+    t_all, f_all = t_all[~drop], f_all[~drop]
+    # the last point closes the cycle with the left limit at W
+    support = _support_from_events(ev_rel[keep], tr2.event_modes[keep], W)
+    return Impulse(t=t_all, F=f_all, duration=W, support=support, n_periods=n, onset=t_on)
+
+
+def _support_from_events(ev_rel, modes, W):
+    """Intervals where the contact force is on: mode LOAD/UNLOAD."""
+    on = True
+    start = 0.0
+    out = []
+    for t, (m0, m1) in zip(ev_rel, modes, strict=True):
+        was = m0 in (K.LOAD, K.UNLOAD)
+        now = m1 in (K.LOAD, K.UNLOAD)
+        if was and not now and on:
+            out.append((start, t))
+            on = False
+        elif now and not was and not on:
+            start, on = t, True
+    if on:
+        out.append((start, W))
+    return np.array(out, dtype=float).reshape(-1, 2)
+
+
+# -------------------------------------------------------------------- samples
+def estimate_noise(F):
+    """Robust noise standard deviation [N] from first differences (MAD)."""
+    d = np.diff(np.asarray(F, dtype=float))
+    if d.size < 2:
+        return 0.0
+    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
+
+
+def _edges(t, F, thr, min_len):
+    """Sub-sample start/end times of the runs where F > thr (runs shorter than
+    ``min_len`` samples dropped, gaps shorter than ``min_len`` closed)."""
+    above = F > thr
+    idx = np.flatnonzero(np.diff(above.astype(np.int8)))
+    starts = list(idx[~above[idx]] + 1)
+    ends = list(idx[above[idx]] + 1)
+    if above[0]:
+        starts.insert(0, 0)
+    if above[-1]:
+        ends.append(len(F))
+    runs = [[s, e] for s, e in zip(starts, ends, strict=True)]
+    merged = []
+    for r in runs:
+        if merged and r[0] - merged[-1][1] < min_len:
+            merged[-1][1] = r[1]
+        else:
+            merged.append(r)
+    runs = [r for r in merged if r[1] - r[0] >= min_len]
+    out = []
+    for s, e in runs:
+        if s == 0 or e >= len(F):
+            continue  # incomplete at the record's ends
+        # onset: the rising edge extrapolated to zero force, inside (t[s-1], t[s]]
+        f0, f1 = F[s - 1], F[s]
+        frac = np.clip((0.0 - f0) / (f1 - f0), 0.0, 1.0) if f1 != f0 else 1.0
+        t_on = t[s - 1] + frac * (t[s] - t[s - 1])
+        g0, g1 = F[e - 1], F[e]
+        frac = np.clip((0.0 - g0) / (g1 - g0), 0.0, 1.0) if g1 != g0 else 0.0
+        t_off = t[e - 1] + frac * (t[e] - t[e - 1])
+        out.append((t_on, t_off, s))
+    return out
+
+
+def impulse_from_samples(t, F, period, *, n_periods=None, threshold=None, max_period=4,
+                         min_samples=3):
+    """Steady-state impulse from a sampled force record (measured or simulated).
+
+    Parameters
+    ----------
+    t : ndarray of shape (n,)
+        Sample times [s], strictly increasing, uniform.
+    F : ndarray of shape (n,)
+        Force samples [N].
+    period : float
+        Drive period ``T`` [s].
+    n_periods : int, optional
+        Cycle length in periods; by default the smallest ``n <= max_period`` for
+        which consecutive cycles agree within the noise.
+    threshold : float, optional
+        Contact threshold [N]; default ``max(5 sigma, 1e-3 * max F)`` with sigma
+        from :func:`estimate_noise`.
+    max_period : int
+    min_samples : int
+        Shortest contact (and shortest gap) in samples; shorter runs are noise.
+
+    Returns
+    -------
+    Impulse
+        Averaged over every complete cycle; ``F(0+)`` estimated by extrapolating
+        the first two samples after the onset back to it.
+    """
+    t = np.asarray(t, dtype=float)
+    F = np.asarray(F, dtype=float)
+    dt = float(np.median(np.diff(t)))
+    sigma = estimate_noise(F)
+    thr = max(5.0 * sigma, 1e-3 * float(np.max(F))) if threshold is None else float(threshold)
+    runs = _edges(t, F, thr, min_samples)
+    if not runs:
+        raise InputError("no contact found in the force record (no run of samples above "
+                         f"the threshold {thr:.3g} N); check the F column and its units")
+    # peak force per run to find the main impact and the cycle length
+    peaks = np.array([np.max(F[s:int(np.searchsorted(t, off)) + 1]) for _, off, s in runs])
+    onsets = np.array([r[0] for r in runs])
+    n = n_periods or _cycle_length(onsets, peaks, period, max_period, sigma)
+    W = n * period
+    first = int(np.argmax(peaks[onsets < onsets[0] + W]))
+    ref = onsets[first]
+    # main onsets: one per cycle, the run starting nearest ref + k W
+    mains = []
+    k = 0
+    while ref + (k + 1) * W <= t[-1]:
+        target = ref + k * W
+        j = int(np.argmin(np.abs(onsets - target)))
+        if abs(onsets[j] - target) < 0.25 * period:
+            mains.append(j)
+        k += 1
+    if not mains:
+        raise InputError(f"the record is shorter than one cycle ({W:.4g} s) after the first "
+                         "impact; record more periods")
+    m = int(np.floor(W / dt + 1e-9))
+    tau = np.arange(m + 1) * dt
+    tau[-1] = min(tau[-1], W)
+    stack = []
+    for j in mains:
+        t_on, _, s = runs[j]
+        vals = np.interp(t_on + tau, t, F)
+        # right limit at the onset: extrapolate the first two samples after it
+        slope = (F[s + 1] - F[s]) / (t[s + 1] - t[s])
+        vals[0] = F[s] - slope * (t[s] - t_on)
+        stack.append(vals)
+    Fm = np.mean(stack, axis=0)
+    sup = []
+    for t_on, t_off, _ in runs:
+        for j in mains[:1]:
+            r0 = t_on - onsets[j]
+            if -1e-12 <= r0 < W:
+                sup.append((max(r0, 0.0), min(t_off - onsets[j], W)))
+    return Impulse(t=tau, F=Fm, duration=W, support=np.array(sup).reshape(-1, 2),
+                   n_periods=n, onset=float(onsets[mains[0]]), threshold=thr,
+                   noise=sigma, n_cycles=len(mains))
+
+
+def _cycle_length(onsets, peaks, period, max_period, sigma):
+    """Smallest n whose cycles repeat: onset phases and peaks agree cycle to cycle."""
+    for n in range(1, max_period + 1):
+        W = n * period
+        ok = True
+        for i, t_on in enumerate(onsets):
+            later = np.flatnonzero(np.abs(onsets - (t_on + W)) < 0.05 * period)
+            if len(later) == 0:
+                if t_on + W < onsets[-1]:
+                    ok = False
+                    break
+                continue
+            j = later[0]
+            if abs(peaks[j] - peaks[i]) > 0.05 * max(peaks[i], 1e-300) + 5 * sigma:
+                ok = False
+                break
+        if ok:
+            return n
+    return max_period
