@@ -11,8 +11,12 @@ the unit square ``[0, 1]**2`` bijectively onto ``D`` and turns each term into a 
 The polynomial is written in the tensor-product Bernstein basis of degree
 ``(n_s, n_u) = (deg_s + elevation, deg_u + elevation)``; the monomial ``s**i`` has Bernstein
 coefficients ``C(k, i) / C(n, i)`` for ``k >= i`` and 0 otherwise. If every Bernstein coefficient
-is ``>= 0`` the polynomial is ``>= 0`` on the square, hence on ``D`` (a sufficient condition;
-it becomes necessary for strictly positive polynomials as the elevation grows).
+is ``>= 0`` the polynomial is ``>= 0`` on the square, hence on ``D``. This is a sufficient
+condition; it becomes necessary as the elevation grows only for polynomials *strictly* positive
+on the closed square. Every law vanishes at ``zeta = zd = 0``, and the coefficients next to that
+corner are governed by the lowest-order monomials, so non-negativity that relies on a
+cancellation between lowest-order terms (e.g. ``s**2 - s*u + u**2``) is never certified at any
+elevation: the certificate (and the fit constrained by it) is conservative there.
 
 Scaling convention
 ------------------

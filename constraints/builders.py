@@ -150,7 +150,12 @@ def dissipativity(
     """
     check_margin(library, margin)
     return _bernstein_constraints(
-        x, library, box, "dissipativity", elevation=elevation, margin=margin,
+        x,
+        library,
+        box,
+        "dissipativity",
+        elevation=elevation,
+        margin=margin,
         force_unit=force_unit,
     )
 

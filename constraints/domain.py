@@ -79,9 +79,7 @@ class Box:
                 raise ValueError(f"{name} contains non-finite values; cannot build a Box")
             top = float(np.max(values, initial=0.0))
             if top <= 0.0:
-                raise ValueError(
-                    f"{name} has no strictly positive sample; cannot infer {field}"
-                )
+                raise ValueError(f"{name} has no strictly positive sample; cannot infer {field}")
             bounds[field] = top * (1.0 + margin_value)
         return cls(**bounds)
 

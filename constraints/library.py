@@ -75,9 +75,7 @@ def exponents(library: Library | np.ndarray) -> np.ndarray:
                 "a contact force must vanish at zeta = 0, zd = 0"
             )
         if (a, b) in seen:
-            raise ValueError(
-                f"library entry {index} = ({a}, {b}) repeats entry {seen[(a, b)]}"
-            )
+            raise ValueError(f"library entry {index} = ({a}, {b}) repeats entry {seen[(a, b)]}")
         seen[(a, b)] = index
         out[index] = (a, b)
     out.setflags(write=False)

@@ -103,9 +103,7 @@ class Certificate:
 
 def _grid_shape(grid: int | Sequence[int]) -> tuple[int, int]:
     sizes = (grid, grid) if np.ndim(grid) == 0 else tuple(grid)
-    if len(sizes) != 2 or any(
-        isinstance(n, bool) or int(n) != n or int(n) < 2 for n in sizes
-    ):
+    if len(sizes) != 2 or any(isinstance(n, bool) or int(n) != n or int(n) < 2 for n in sizes):
         raise ValueError(f"grid must be an integer >= 2 or a pair of them, got {grid!r}")
     return int(sizes[0]), int(sizes[1])
 
@@ -158,7 +156,7 @@ def _scaled(coef: ArrayLike, library: Library, box: Box) -> tuple[np.ndarray, np
     return to_scaled(coef, exps, box), exps
 
 
-def _axes(box: Box, shape: tuple[int, int], condition: str) -> tuple[np.ndarray, np.ndarray]:
+def _axes(shape: tuple[int, int], condition: str) -> tuple[np.ndarray, np.ndarray]:
     s = np.linspace(0.0, 1.0, shape[0])
     u = np.zeros(1) if condition == "monotone_elastic" else np.linspace(0.0, 1.0, shape[1])
     return s, u
@@ -203,7 +201,7 @@ def grid_minimum(
     margin = check_margin(library, margin) if condition == "dissipativity" else 0.0
     shape = _grid_shape(grid)
     x, exps = _scaled(coef, library, box)
-    s, u = _axes(box, shape, condition)
+    s, u = _axes(shape, condition)
     value, (i, j), _ = _scan(*_terms(x, exps, box, condition, margin), s, u, chunk_rows)
     return value, (float(s[i] * box.zeta_max), float(u[j] * box.zd_max))
 
@@ -218,7 +216,7 @@ def force_scale(
 ) -> float:
     """Force scale ``max |P|`` over the grid [N]."""
     x, exps = _scaled(coef, library, box)
-    s, u = _axes(box, _grid_shape(grid), "non_adhesion")
+    s, u = _axes(_grid_shape(grid), "non_adhesion")
     return _scan(x, exps[:, 0], exps[:, 1], s, u, chunk_rows)[2]
 
 
