@@ -96,6 +96,30 @@ class Impulse:
         w = np.where(t1 > t0, (q - t0) / np.where(t1 > t0, t1 - t0, 1.0), 1.0 if side == "left" else 0.0)
         return F[i] + np.clip(w, 0.0, 1.0) * (F[i + 1] - F[i])
 
+    def resampled_like(self, other):
+        """This impulse seen through ``other``'s sampling: values at ``other.t`` and
+        the support where the force exceeds ``other.threshold`` (the simulated
+        impulse "sampled like the measurement")."""
+        reps = max(1, int(round(other.duration / self.duration)))
+        fine_t = np.concatenate([self.t[:-1] + k * self.duration for k in range(reps)]
+                                + [[reps * self.duration]])
+        fine_f = np.concatenate([self.F[:-1]] * reps + [self.F[-1:]])
+        vals = self.evaluate(other.t, "left")
+        vals[0] = self.evaluate(0.0, "right")
+        runs = _edges(fine_t, fine_f, other.threshold, 1) if other.threshold > 0 else []
+        if other.threshold > 0:
+            sup = [(a, b) for a, b, _ in runs]
+            if fine_f[0] > other.threshold:  # the run starting at the onset
+                first_off = np.flatnonzero(fine_f <= other.threshold)
+                end = fine_t[first_off[0]] if first_off.size else fine_t[-1]
+                sup.insert(0, (0.0, end))
+            support = np.array(sup, dtype=float).reshape(-1, 2)
+        else:
+            support = np.concatenate([self.support + k * self.duration for k in range(reps)])
+        return Impulse(t=other.t.copy(), F=vals, duration=reps * self.duration,
+                       support=support, n_periods=reps * self.n_periods, onset=self.onset,
+                       threshold=other.threshold)
+
     def periodic_support(self, length):
         """Support intervals repeated over ``[0, length]``, ndarray of shape (m, 2)."""
         reps = int(round(length / self.duration))
@@ -217,6 +241,15 @@ def estimate_noise(F):
     return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
 
 
+def _refine_onset(t, zeta, s, t_on):
+    """Onset as the interpolated up-crossing of zeta = 0 near sample ``s``."""
+    lo = max(s - 3, 0)
+    for k in range(min(s + 1, len(t) - 1), lo, -1):
+        if zeta[k - 1] <= 0.0 < zeta[k]:
+            return t[k - 1] + (0.0 - zeta[k - 1]) / (zeta[k] - zeta[k - 1]) * (t[k] - t[k - 1])
+    return t_on
+
+
 def _edges(t, F, thr, min_len):
     """Sub-sample start/end times of the runs where F > thr (runs shorter than
     ``min_len`` samples dropped, gaps shorter than ``min_len`` closed)."""
@@ -251,8 +284,8 @@ def _edges(t, F, thr, min_len):
     return out
 
 
-def impulse_from_samples(t, F, period, *, n_periods=None, threshold=None, max_period=4,
-                         min_samples=3):
+def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=None,
+                         max_period=4, min_samples=3):
     """Steady-state impulse from a sampled force record (measured or simulated).
 
     Parameters
@@ -261,6 +294,10 @@ def impulse_from_samples(t, F, period, *, n_periods=None, threshold=None, max_pe
         Sample times [s], strictly increasing, uniform.
     F : ndarray of shape (n,)
         Force samples [N].
+    zeta : ndarray of shape (n,), optional
+        Interpenetration ``w1 - w2`` [m].  When given, each onset is the
+        interpolated zero up-crossing of ``zeta`` (exact to O(dt^2)); from the
+        force alone the onset of a force *jump* is only known to within a sample.
     period : float
         Drive period ``T`` [s].
     n_periods : int, optional
@@ -284,7 +321,15 @@ def impulse_from_samples(t, F, period, *, n_periods=None, threshold=None, max_pe
     dt = float(np.median(np.diff(t)))
     sigma = estimate_noise(F)
     thr = max(5.0 * sigma, 1e-3 * float(np.max(F))) if threshold is None else float(threshold)
-    runs = _edges(t, F, thr, min_samples)
+    # gaps shorter than 1 % of a period are noise flicker inside one contact
+    runs = _edges(t, F, thr, max(min_samples, int(0.01 * period / dt)))
+    if runs:
+        # a contact whose peak barely clears the threshold is noise, not an impact
+        pk = np.array([np.max(F[s:int(np.searchsorted(t, off)) + 1]) for _, off, s in runs])
+        runs = [r for r, p in zip(runs, pk, strict=True) if p >= max(3 * thr, 0.02 * pk.max())]
+    if zeta is not None:
+        zeta = np.asarray(zeta, dtype=float)
+        runs = [(_refine_onset(t, zeta, s, t_on), t_off, s) for t_on, t_off, s in runs]
     if not runs:
         raise InputError("no contact found in the force record (no run of samples above "
                          f"the threshold {thr:.3g} N); check the F column and its units")
@@ -314,16 +359,24 @@ def impulse_from_samples(t, F, period, *, n_periods=None, threshold=None, max_pe
     for j in mains:
         t_on, _, s = runs[j]
         vals = np.interp(t_on + tau, t, F)
-        # right limit at the onset: extrapolate the first two samples after it
-        slope = (F[s + 1] - F[s]) / (t[s + 1] - t[s])
-        vals[0] = F[s] - slope * (t[s] - t_on)
+        # right limit at the onset: extrapolate the first two samples after it, and
+        # do not interpolate across the jump between the onset and sample s
+        # (quadratic through samples s, s+1, s+2; a force is never negative)
+        coef = np.polyfit(t[s:s + 3] - t_on, F[s:s + 3], 2)
+        head = tau < t[s] - t_on
+        vals[head] = np.maximum(np.polyval(coef, tau[head]), 0.0)
+        # at the cycle's end hold the last sample before the next onset (left limit)
+        last = int(np.searchsorted(t, t_on + W - (t[s] - t_on), "right")) - 1
+        last = min(last, len(t) - 1)
+        tail = t_on + tau > t[last]
+        vals[tail] = F[last]
         stack.append(vals)
     Fm = np.mean(stack, axis=0)
     sup = []
     for t_on, t_off, _ in runs:
         for j in mains[:1]:
             r0 = t_on - onsets[j]
-            if -1e-12 <= r0 < W:
+            if -1e-12 <= r0 < W - 0.5 * dt:
                 sup.append((max(r0, 0.0), min(t_off - onsets[j], W)))
     return Impulse(t=tau, F=Fm, duration=W, support=np.array(sup).reshape(-1, 2),
                    n_periods=n, onset=float(onsets[mains[0]]), threshold=thr,

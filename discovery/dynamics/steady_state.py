@@ -213,15 +213,25 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
     for phase, n_trans in (("transient", transient), ("long-transient", long_transient)):
         y = pm.advance(y, n_trans)
         t_done += n_trans
-        strobe = [y]
-        for _ in range(2 * max_period + 2):
-            strobe.append(pm.advance(strobe[-1], 1))
-        y = strobe[-1]
-        t_done += 2 * max_period + 2
-        dist = _recurrence(strobe, pm.scale, max_period)
+        strobe = [y, pm.advance(y, 1), None]
+        strobe[2] = pm.advance(strobe[1], 1)
+        quick = max(np.max(np.abs(strobe[k + 1] - strobe[k]) / pm.scale) for k in (0, 1))
+        if quick < 1e-2:
+            # fast path: the strobe points already recur after one period
+            y = strobe[-1]
+            t_done += 2
+            dist = {1: float(quick)}
+        else:
+            for _ in range(2 * max_period):
+                strobe.append(pm.advance(strobe[-1], 1))
+            y = strobe[-1]
+            t_done += 2 * max_period + 2
+            dist = _recurrence(strobe, pm.scale, max_period)
         order = sorted(dist, key=lambda n: (dist[n] > 1e-2, n if dist[n] <= 1e-2 else dist[n]))
         attempt = {"phase": phase, "recurrence": dist, "tried": []}
         evidence["attempts"].append(attempt)
+        if quick < 1e-2:
+            order = [1] + [n for n in range(2, max_period + 1)][:2]
         for n in order[:3]:
             hist = []
             y_orb, res, J, ok = _newton(pm, y, n, tol, max_newton, hist)
