@@ -27,7 +27,8 @@ def provenance(settings=None):
             versions[name] = None
     return {"versions": versions, "platform": platform.platform(),
             "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
-            "settings": to_jsonable(settings or {})}
+            "settings": to_jsonable({k: v for k, v in (settings or {}).items()
+                                     if not callable(v)})}
 
 
 def to_jsonable(obj):

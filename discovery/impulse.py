@@ -242,11 +242,19 @@ def estimate_noise(F):
 
 
 def _refine_onset(t, zeta, s, t_on):
-    """Onset as the interpolated up-crossing of zeta = 0 near sample ``s``."""
-    lo = max(s - 3, 0)
-    for k in range(min(s + 1, len(t) - 1), lo, -1):
+    """Onset as the zero up-crossing of zeta near sample ``s``: a quadratic through the
+    three samples before the crossing (free flight, smooth) extrapolated into the
+    crossing interval, error O(dt^3)."""
+    lo = max(s - 3, 3)
+    for k in range(min(s + 1, len(t) - 1), lo - 1, -1):
         if zeta[k - 1] <= 0.0 < zeta[k]:
-            return t[k - 1] + (0.0 - zeta[k - 1]) / (zeta[k] - zeta[k - 1]) * (t[k] - t[k - 1])
+            a, b, c = np.polyfit(t[k - 3:k] - t[k - 1], zeta[k - 3:k], 2)
+            roots = np.roots([a, b, c]) if a != 0 else np.array([-c / b])
+            h = t[k] - t[k - 1]
+            ok = [r.real for r in roots if abs(r.imag) < 1e-12 and -1e-9 * h <= r.real <= h]
+            if ok:
+                return t[k - 1] + min(ok)
+            return t[k - 1] + (0.0 - zeta[k - 1]) / (zeta[k] - zeta[k - 1]) * h
     return t_on
 
 
@@ -352,9 +360,11 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     if not mains:
         raise InputError(f"the record is shorter than one cycle ({W:.4g} s) after the first "
                          "impact; record more periods")
-    m = int(np.floor(W / dt + 1e-9))
-    tau = np.arange(m + 1) * dt
-    tau[-1] = min(tau[-1], W)
+    # time axis: the first cycle's own sample offsets from its onset (no re-interpolation
+    # of that cycle; the others are interpolated onto it, exactly when fs*T is whole)
+    t_on0, _, s0 = runs[mains[0]]
+    inside = t[s0:] - t_on0
+    tau = np.concatenate([[0.0], inside[inside < W], [W]])
     stack = []
     for j in mains:
         t_on, _, s = runs[j]

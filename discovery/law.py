@@ -212,11 +212,12 @@ class ForceLaw:
     def sympy(self):
         """``P`` as a sympy expression in ``ZETA`` (zeta) and ``ZD`` (max(dzeta, 0))."""
         return sympy.Add(
-            *[sympy.Float(c, 15) * t.sympy() for c, t in zip(self.coefficients, self.terms, strict=True)]
+            *[sympy.Float(c, 15) * t.sympy()
+              for c, t in zip(self.coefficients, self.terms, strict=True)]
         )
 
     def latex(self, digits=4):
-        """LaTeX of ``F`` for ``zeta > 0``, terms in law order, ``\\dot\\zeta_+ = max(\\dot\\zeta, 0)``."""
+        """LaTeX of ``F`` for ``zeta > 0`` in law order (``\\dot\\zeta_+ = max(\\dot\\zeta, 0)``)."""
         out = []
         for c, t in zip(self.coefficients, self.terms, strict=True):
             mant, _, exp = f"{abs(c):.{digits - 1}e}".partition("e")

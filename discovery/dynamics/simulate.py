@@ -4,7 +4,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import IntegrationError, InputError
+from ..errors import InputError, IntegrationError
 from . import _kernel as K
 
 __all__ = ["Trajectory", "simulate", "Tolerances", "MODE_NAMES", "EVENT_NAMES"]

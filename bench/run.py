@@ -1,0 +1,127 @@
+"""Benchmarks (``make bench``): ratios against baselines measured in the same run.
+
+Writes ``bench/results.json``.  Figures:
+
+1. one steady-state force history: compiled kernel vs the scipy reference path at
+   equal accuracy (goal >= 300x faster);
+2. the 41x41 landscape wall time (goal <= 15 s on 2 cores), also as a ratio to
+   one steady-state point;
+3. simulations each identification method needs from the same start to reach
+   0.1 % of the true alphas (goal: a method needing >= 5x fewer than coordinate
+   descent).
+"""
+
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from discovery._io import provenance, to_jsonable
+from discovery.dynamics import Tolerances, simulate
+from discovery.dynamics.reference import reference_simulate
+from discovery.dynamics.steady_state import steady_state
+from discovery.identify import METHODS, identify
+from discovery.landscape import landscape
+from discovery.law import ForceLaw
+from discovery.measurement import synthesize
+from discovery.scenario import load_scenario
+
+
+def _best(f, repeat=5):
+    ts = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = f()
+        ts.append(time.perf_counter() - t0)
+    return min(ts), out
+
+
+def bench_kernel(sc):
+    """One steady-state cycle with a dense force history, fast vs scipy, equal accuracy."""
+    ss = steady_state(sc, sc.law)
+    T = sc.period
+    te = np.linspace(ss.t0, ss.t0 + T, 2001)
+    # accuracy of each path against a very tight reference
+    truth = reference_simulate(sc, sc.law, (ss.t0, ss.t0 + T), y0=ss.y0, t_eval=te, rtol=1e-13)
+    # same method (Dormand-Prince 5(4)) and tolerance on both paths
+    ref_rtol, fast_rtol = 1e-9, 1e-9
+    t_ref, ref = _best(lambda: reference_simulate(sc, sc.law, (ss.t0, ss.t0 + T), y0=ss.y0,
+                                                  t_eval=te, rtol=ref_rtol, method="RK45"),
+                       repeat=3)
+    tol = Tolerances(rtol=fast_rtol)
+    t_fast, fast = _best(lambda: simulate(sc, sc.law, (ss.t0, ss.t0 + T), y0=ss.y0, t_eval=te,
+                                          tolerances=tol), repeat=20)
+    x = sc.scales()[0]
+    err_ref = float(np.max(np.abs(ref["y"][[0, 2]] - truth["y"][[0, 2]])) / x)
+    err_fast = float(np.max(np.abs(fast.y[[0, 2]] - truth["y"][[0, 2]])) / x)
+    # a long run (40 periods, the size of a steady-state search): per-step cost dominates
+    t40_ref, _ = _best(lambda: reference_simulate(sc, sc.law, (ss.t0, ss.t0 + 40 * T), y0=ss.y0,
+                                                  rtol=ref_rtol, method="RK45"), repeat=1)
+    t40_fast, _ = _best(lambda: simulate(sc, sc.law, (ss.t0, ss.t0 + 40 * T), y0=ss.y0,
+                                         tolerances=tol), repeat=5)
+    return {"long_run_40_periods_speedup": t40_ref / t40_fast,
+            "scipy_seconds": t_ref, "kernel_seconds": t_fast, "speedup": t_ref / t_fast,
+            "scipy_rtol": ref_rtol, "kernel_rtol": fast_rtol,
+            "scipy_max_error_rel": err_ref, "kernel_max_error_rel": err_fast,
+            "scipy_method": "RK45 restarted at events",
+            "equal_or_better_accuracy": err_fast <= 2 * err_ref, "goal": ">= 300x"}
+
+
+def bench_landscape(sc):
+    a0, a1 = np.linspace(1.03e8, 3.09e8, 41), np.linspace(0.64e7, 1.92e7, 41)
+    t_one, _ = _best(lambda: steady_state(sc, sc.law), repeat=5)
+    land = landscape(sc, sc.law, a0, a1)
+    return {"seconds": land.seconds, "workers": land.workers, "points": 41 * 41,
+            "one_steady_state_seconds": t_one,
+            "ratio_to_one_point": land.seconds / t_one,
+            "parallel_efficiency": 41 * 41 * t_one / (land.seconds * land.workers),
+            "goal": "<= 15 s on 2 cores"}
+
+
+def bench_identify(sc):
+    meas = synthesize(sc, sc.law, periods=20, fs=20000)
+    E = meas.impulse(sc.period)
+    start = ForceLaw.parse("1.5e8*z + 0.9e7*zd")
+    true = np.array(sc.law.coefficients)
+    out = {}
+    for m in METHODS:
+        r = identify(sc, E, start, criterion="I2", method=m)
+        hit = next((it["n_simulations"] for it in r.iterations
+                    if np.all(np.abs(np.array(list(it["coefficients"].values())) / true - 1)
+                              < 1e-3)), None)
+        out[m] = {"simulations_to_0.1%": hit, "total_simulations": r.n_simulations,
+                  "seconds": r.seconds, "final": r.coefficients}
+    cd = out["coordinate-descent"]["simulations_to_0.1%"]
+    for m in METHODS:
+        h = out[m]["simulations_to_0.1%"]
+        out[m]["fewer_than_coordinate_descent"] = (cd / h) if (cd and h) else None
+    out["goal"] = "a method needing >= 5x fewer simulations than coordinate descent"
+    return out
+
+
+def main():
+    sc = load_scenario("paper")
+    steady_state(sc, sc.law)  # compile / load the cached kernels first
+    results = {"kernel_vs_scipy": bench_kernel(sc), "landscape_41x41": bench_landscape(sc),
+               "identification": bench_identify(sc), "cores": os.cpu_count(),
+               **provenance({"scenario": "paper"})}
+    Path("bench/results.json").write_text(json.dumps(to_jsonable(results), indent=2) + "\n")
+    k, L, idf = results["kernel_vs_scipy"], results["landscape_41x41"], results["identification"]
+    print(f"kernel vs scipy: {k['speedup']:.0f}x faster on one period, "
+          f"{k['long_run_40_periods_speedup']:.0f}x on 40 periods (errors "
+          f"{k['kernel_max_error_rel']:.1e} vs {k['scipy_max_error_rel']:.1e})")
+    print(f"landscape 41x41: {L['seconds']:.1f} s on {L['workers']} processes "
+          f"({L['ratio_to_one_point']:.0f} x one point, efficiency "
+          f"{L['parallel_efficiency']:.2f})")
+    for m in METHODS:
+        print(f"identify {m}: {idf[m]['simulations_to_0.1%']} simulations to 0.1 % "
+              f"({idf[m]['fewer_than_coordinate_descent']} x fewer than coordinate descent)")
+    print("wrote bench/results.json")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

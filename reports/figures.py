@@ -1,0 +1,113 @@
+"""Figures as pure functions of result objects (matplotlib, Agg backend).
+
+Each function writes the same figure as PNG and PDF and returns the paths.
+"""
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+__all__ = ["landscape_figure", "identification_figure"]
+
+_ORDER = ("I1", "I2", "I3", "I4", "I0")
+
+
+def _save(fig, stem):
+    paths = [f"{stem}.png", f"{stem}.pdf"]
+    fig.savefig(paths[0], dpi=130, bbox_inches="tight")
+    fig.savefig(paths[1], bbox_inches="tight")
+    plt.close(fig)
+    return paths
+
+
+def _contour(ax, land, name, truth=None):
+    a0, a1 = land.axes
+    v = land.values[name]
+    cs = ax.contourf(a0, a1, v.T, levels=20, cmap="viridis")
+    ax.contour(a0, a1, v.T, levels=10, colors="k", linewidths=0.4)
+    bad = np.argwhere(land.regime != "P1")
+    if bad.size:
+        ax.plot(a0[bad[:, 0]], a1[bad[:, 1]], "rx", ms=4, label="not P1")
+        ax.legend(loc="upper right", fontsize=7)
+    i, j = land.argmin(name)
+    ax.plot(a0[i], a1[j], "w*", ms=10, mec="k", label="minimum")
+    if truth is not None:
+        ax.plot(*truth, "o", mfc="none", mec="r", ms=10)
+    ax.set_xlabel(f"coefficient of {land.terms[0]}")
+    ax.set_ylabel(f"coefficient of {land.terms[1]}")
+    ax.set_title(name)
+    plt.colorbar(cs, ax=ax)
+
+
+def landscape_figure(land, stem, truth=None):
+    """Contours of I1..I4 and I0 (the paper's Figs. 4-5); non-P1 points marked.
+
+    Parameters
+    ----------
+    land : Landscape
+    stem : str
+        Output path without extension.
+    truth : (float, float), optional
+        Reference coefficients, circled.
+    """
+    fig, axes = plt.subplots(2, 3, figsize=(14, 8.5))
+    for ax, name in zip(axes.flat, _ORDER, strict=False):
+        _contour(ax, land, name, truth)
+    ax = axes.flat[5]
+    ax.axis("off")
+    ax.text(0.0, 0.9, "Criteria landscape\n"
+            f"{land.axes[0].size} x {land.axes[1].size} points, {land.seconds:.1f} s "
+            f"on {land.workers} processes\nwhite star: minimum; red circle: reference law\n"
+            "red x: regime other than P1", va="top", fontsize=10)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def identification_figure(result, measured, impulses, stem, land=None):
+    """Identification path (Fig. 6) and F_N converging to F_E (Fig. 7).
+
+    Parameters
+    ----------
+    result : IdentificationResult
+    measured : Impulse
+        ``F_E``.
+    impulses : list of (label, Impulse)
+        Simulated impulses of selected iterates.
+    stem : str
+    land : Landscape, optional
+        Background contours of the identified criterion (two-term laws).
+    """
+    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(13, 5))
+    names = list(result.law.names)
+    path = np.array([[it["coefficients"][n] for n in names] for it in result.iterations])
+    if len(names) >= 2 and path.size:
+        if land is not None and result.criterion in land.values:
+            a0, a1 = land.axes
+            cs = ax0.contourf(a0, a1, land.values[result.criterion].T, levels=20, cmap="viridis")
+            plt.colorbar(cs, ax=ax0, label=result.criterion)
+        ax0.plot(path[:, 0], path[:, 1], "o-", color="w" if land is not None else "C0",
+                 mec="k", ms=4, lw=1)
+        ax0.plot(path[-1, 0], path[-1, 1], "r*", ms=12)
+        ax0.set_xlabel(f"coefficient of {names[0]}")
+        ax0.set_ylabel(f"coefficient of {names[1]}")
+        ax0.set_title(f"{result.method}: {len(path)} improvements, "
+                      f"{result.n_simulations} simulations")
+    else:
+        ax0.semilogy([it["value"] for it in result.iterations], "o-")
+        ax0.set_xlabel("improvement")
+        ax0.set_ylabel(result.criterion)
+    ax1.plot(measured.t * 1e3, measured.F / 1e6, "k-", lw=2.5, label="F_E (measured)")
+    for k, (label, imp) in enumerate(impulses):
+        if imp is not None:
+            ax1.plot(imp.t * 1e3, imp.F / 1e6, "-", lw=1, color=plt.cm.plasma(k / max(
+                1, len(impulses))), label=label)
+    end = measured.support[:, 1].max() if len(measured.support) else measured.duration
+    ax1.set_xlim(-0.05 * end * 1e3, min(measured.duration, 1.4 * end) * 1e3)
+    ax1.set_xlabel("time since onset t - t* [ms]")
+    ax1.set_ylabel("contact force [MN]")
+    ax1.set_title(f"F_N converging to F_E ({result.criterion} = {result.value:.3g})")
+    ax1.legend(fontsize=8)
+    fig.tight_layout()
+    return _save(fig, stem)

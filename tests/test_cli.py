@@ -1,0 +1,90 @@
+"""End-to-end tests of the vidi command line (each command calls the API only)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from discovery.cli import main
+
+
+@pytest.fixture(scope="module")
+def record(tmp_path_factory):
+    d = tmp_path_factory.mktemp("rec")
+    path = d / "d.csv"
+    assert main(["simulate", "--periods", "8", "--out", str(path)]) == 0
+    return path
+
+
+def test_simulate_writes_csv_and_summary(record):
+    header = record.read_text().splitlines()[0]
+    assert header == "t,F,w1,v1,w2,v2"
+    s = json.loads(record.with_suffix(".summary.json").read_text())
+    assert s["samples"] == 8 * 800
+    assert s["versions"]["numpy"] and s["settings"]["seed"] == 0
+
+
+def test_landscape_small_grid(tmp_path):
+    out = tmp_path / "land"
+    assert main(["landscape", "--grid", "3x3", "--workers", "1", "--out", str(out)]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert len(s["alpha1"]) == 3 and s["alpha1"][0] == 1.03e8 and s["alpha1"][-1] == 3.09e8
+    assert np.array(s["I2"]).shape == (3, 3)
+    # the centre of the paper's box is the true law: every criterion vanishes there
+    # (exact impulses on both sides; 1e-9 covers the integrator tolerance)
+    for name in ("I0", "I1", "I2", "I3", "I4"):
+        assert s[name][1][1] < 1e-6
+    assert s["regime"][1][1] == "P1"
+    for f in ("landscape.csv", "landscape.png", "landscape.pdf"):
+        assert (out / f).stat().st_size > 0
+
+
+def test_identify_recovers_true_law(record, tmp_path):
+    out = tmp_path / "id"
+    rc = main(["identify", "--data", str(record), "--start", "1.5e8*z + 0.9e7*zd",
+               "--method", "least-squares", "--out", str(out)])
+    assert rc == 0
+    s = json.loads((out / "summary.json").read_text())
+    c = s["coefficients"]
+    # noise-free data sampled at 20 kHz: the onset is known to O(dt^3), 0.3 % is ample
+    assert abs(c["z"] / 2.06e8 - 1) < 3e-3 and abs(c["zd"] / 1.28e7 - 1) < 3e-3
+    assert s["iterations"] and s["n_simulations"] >= s["iterations"][-1]["n_simulations"]
+    assert set(s["criteria"]) == {"I0", "I1", "I2", "I3", "I4"}
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["simulate", "--law", "2*q", "--out", "x.csv"], "cannot read force law"),
+    (["simulate", "--scenario", "nope.toml", "--out", "x.csv"], "does not exist"),
+    (["identify", "--data", "missing.csv", "--start", "z", "--out", "o"], "does not exist"),
+    (["landscape", "--grid", "4by4", "--out", "o"], "must look like 41x41"),
+])
+def test_bad_input_one_line_exit_2(argv, needle, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert needle in err and "\n" not in err and "Traceback" not in err
+
+
+def test_bad_csv_does_not_destroy_earlier_results(record, tmp_path, capsys):
+    out = tmp_path / "id"
+    out.mkdir()
+    (out / "summary.json").write_text('{"earlier": true}')
+    bad = tmp_path / "bad.csv"
+    bad.write_text("t,F\n0,0\n1e-4,1\n1e-4,2\n3e-4,0\n4e-4,0\n")
+    assert main(["identify", "--data", str(bad), "--start", "z", "--out", str(out)]) == 2
+    assert "duplicate time" in capsys.readouterr().err
+    assert json.loads((out / "summary.json").read_text()) == {"earlier": True}
+    assert list(tmp_path.glob(".id.*")) == []
+
+
+@pytest.mark.parametrize("body, needle", [
+    ("t,F\n0,0\n1,nan\n2,0\n3,0\n", "non-finite"),
+    ("t,F\n0,0\n2,1\n1,0\n3,0\n", "not increasing"),
+    ("time,F\n0,0\n", "no column t"),
+    ("t,F\n0,0\n1,0\n2,0\n3,0\n4,0\n", "no contact"),
+])
+def test_bad_csv_messages(body, needle, tmp_path, capsys):
+    p = tmp_path / "d.csv"
+    p.write_text(body)
+    assert main(["identify", "--data", str(p), "--start", "z", "--out", str(tmp_path / "o")]) == 2
+    assert needle in capsys.readouterr().err
