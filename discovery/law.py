@@ -162,7 +162,9 @@ class ForceLaw:
         out = []
         for c, t in zip(self.coefficients, self.terms, strict=True):
             sign = "-" if c < 0 else "+"
-            out.append(f"{sign} {abs(c):.12g}*{t.name}")
+            num = repr(abs(c))  # shortest text that reads back exactly
+            num = num[:-2] if num.endswith(".0") else num
+            out.append(f"{sign} {num}*{t.name}")
         text = " ".join(out)
         return text[2:] if text.startswith("+ ") else "-" + text[2:]
 

@@ -86,7 +86,11 @@ class Scenario:
                 )
             object.__setattr__(self, key, value)
         if self.initial is not None:
-            init = tuple(float(v) for v in self.initial)
+            try:
+                init = tuple(float(v) for v in self.initial)
+            except (TypeError, ValueError):
+                raise InputError("scenario initial must be 4 numbers (w1, v1, w2, v2) in m, "
+                                 f"m/s; got {self.initial!r}") from None
             if len(init) != 4 or not all(math.isfinite(v) for v in init):
                 raise InputError("scenario initial must be 4 finite numbers (w1, v1, w2, v2)")
             object.__setattr__(self, "initial", init)
@@ -169,7 +173,11 @@ class Scenario:
         if missing:
             raise InputError(f"scenario {source!r}: [machine] is missing {', '.join(missing)}; "
                              "add them in SI units (kg, N/m, N s/m, N, Hz)")
-        law_text = (data.get("law") or {}).get("text")
+        law_table = data.get("law") or {}
+        if not isinstance(law_table, dict):
+            raise InputError(f"scenario {source!r}: law must be a table, write [law] then "
+                             "text = \"2.06e8*z + 1.28e7*zd\"")
+        law_text = law_table.get("text")
         law = ForceLaw.parse(law_text) if law_text else None
         init = data.get("initial")
         initial = None

@@ -139,6 +139,10 @@ def _mode_after(kind, y, coef, ea, eb):
         return FREE
     if kind == EV_RELEASE:
         return CLIPPED
+    if kind == EV_RESUME:
+        # P crossed to positive at the located root: the force is on again, even if the
+        # re-taken step ended a whisker on the adhesive side
+        return LOAD if v > 0.0 else UNLOAD
     if kind == EV_UNLOAD or ((kind == EV_ONSET or kind == EV_RESUME) and v <= 0.0):
         return UNLOAD if poly(z, 0.0, coef, ea, eb) >= 0.0 else CLIPPED
     # onset / resume with dzeta > 0, or reload

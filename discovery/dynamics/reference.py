@@ -61,6 +61,8 @@ def _after(law, kind, y):
         return "free"
     if kind == "release":
         return "clipped"
+    if kind == "resume":  # P crossed to positive: the force is on again
+        return "load" if v > 0 else "unload"
     if kind == "unload" or (kind in ("onset", "resume") and v <= 0):
         return "unload" if _poly(law, z, 0.0) >= 0 else "clipped"
     return "load" if _poly(law, z, max(v, 0.0)) >= 0 else "clipped"
@@ -110,7 +112,7 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
         if mask.any():
             ys = sol.sol(te[mask])
             out_y[:, mask] = ys
-            out_f[mask] = [_force(law, mode, a - b, c - d) for a, c, b, d in ys.T[:, [0, 2, 1, 3]]]
+            out_f[mask] = [_force(law, mode, w1 - w2, v1 - v2) for w1, v1, w2, v2 in ys.T]
         y = sol.y[:, -1].copy()
         if sol.status == 1:
             fired = [i for i, tev in enumerate(sol.t_events) if len(tev)]
