@@ -8,7 +8,7 @@ from discovery.dynamics import _kernel as K
 from discovery.dynamics import _tableau
 from discovery.dynamics.reference import reference_simulate
 from discovery.dynamics.simulate import EVENT_NAMES, Tolerances, simulate
-from discovery.errors import IntegrationError, InputError
+from discovery.errors import InputError, IntegrationError
 from discovery.law import ForceLaw
 from discovery.scenario import Scenario
 
