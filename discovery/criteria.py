@@ -55,7 +55,14 @@ class Comparison:
 def _grid_points(imp, length):
     """(times, is_right_limit) of one impulse's nodes repeated over ``length``."""
     reps = int(round(length / imp.duration))
-    ts = np.concatenate([imp.t[:-1] + k * imp.duration for k in range(reps)] + [[length]])
+    # a force jump at the onset (F(0-) != F(0+)) recurs at every cycle boundary k*duration
+    jump = imp.F[-1] != imp.F[0]
+    parts = []
+    for k in range(reps):
+        if k and jump:
+            parts.append([k * imp.duration])
+        parts.append(imp.t[:-1] + k * imp.duration)
+    ts = np.concatenate(parts + [[length]])
     dup = np.zeros(ts.size, dtype=bool)
     dup[1:] = ts[1:] == ts[:-1]
     return ts, dup

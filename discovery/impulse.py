@@ -97,25 +97,17 @@ class Impulse:
         return F[i] + np.clip(w, 0.0, 1.0) * (F[i + 1] - F[i])
 
     def resampled_like(self, other):
-        """This impulse seen through ``other``'s sampling: values at ``other.t`` and
-        the support where the force exceeds ``other.threshold`` (the simulated
-        impulse "sampled like the measurement")."""
+        """This impulse seen through ``other``'s sampling (the simulated impulse
+        "sampled like the measurement"): its values at ``other.t``, and its support
+        found from those values by the same threshold and edge rules as ``other``'s."""
         reps = max(1, int(round(other.duration / self.duration)))
-        fine_t = np.concatenate([self.t[:-1] + k * self.duration for k in range(reps)]
-                                + [[reps * self.duration]])
-        fine_f = np.concatenate([self.F[:-1]] * reps + [self.F[-1:]])
         vals = self.evaluate(other.t, "left")
         vals[0] = self.evaluate(0.0, "right")
-        runs = _edges(fine_t, fine_f, other.threshold, 1) if other.threshold > 0 else []
         if other.threshold > 0:
-            sup = [(a, b) for a, b, _ in runs]
-            if fine_f[0] > other.threshold:  # the run starting at the onset
-                first_off = np.flatnonzero(fine_f <= other.threshold)
-                end = fine_t[first_off[0]] if first_off.size else fine_t[-1]
-                sup.insert(0, (0.0, end))
-            support = np.array(sup, dtype=float).reshape(-1, 2)
+            support = _sampled_support(other.t, vals, other.threshold,
+                                       other.duration / other.n_periods)
         else:
-            support = np.concatenate([self.support + k * self.duration for k in range(reps)])
+            support = self.periodic_support(reps * self.duration)
         return Impulse(t=other.t.copy(), F=vals, duration=reps * self.duration,
                        support=support, n_periods=reps * self.n_periods, onset=self.onset,
                        threshold=other.threshold)
@@ -241,24 +233,43 @@ def estimate_noise(F):
     return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
 
 
-def _refine_onset(t, zeta, s, t_on):
-    """Onset as the zero up-crossing of zeta near sample ``s``: a quadratic through the
-    three samples before the crossing (free flight, smooth) extrapolated into the
-    crossing interval, error O(dt^3)."""
-    lo = max(s - 3, 3)
-    for k in range(min(s + 1, len(t) - 1), lo - 1, -1):
-        if zeta[k - 1] <= 0.0 < zeta[k]:
-            a, b, c = np.polyfit(t[k - 3:k] - t[k - 1], zeta[k - 3:k], 2)
-            roots = np.roots([a, b, c]) if a != 0 else np.array([-c / b])
-            h = t[k] - t[k - 1]
-            ok = [r.real for r in roots if abs(r.imag) < 1e-12 and -1e-9 * h <= r.real <= h]
-            if ok:
-                return t[k - 1] + min(ok)
-            return t[k - 1] + (0.0 - zeta[k - 1]) / (zeta[k] - zeta[k - 1]) * h
-    return t_on
+def _refine_onset(t, zeta, s, t_on, max_back):
+    """Onset as the zero up-crossing of zeta at or before sample ``s`` (searched back
+    at most ``max_back`` samples): a quadratic through the three samples before the
+    crossing (free flight, smooth) extrapolated into the crossing interval, O(dt^3)."""
+    k = min(s, len(t) - 1)
+    stop = max(3, k - int(max_back))
+    while k > stop and zeta[k - 1] > 0.0:
+        k -= 1
+    if not (k >= 3 and zeta[k - 1] <= 0.0 < zeta[k]):
+        return t_on
+    a, b, c = np.polyfit(t[k - 3:k] - t[k - 1], zeta[k - 3:k], 2)
+    roots = np.roots([a, b, c]) if a != 0 else np.array([-c / b])
+    h = t[k] - t[k - 1]
+    ok = [r.real for r in roots if abs(r.imag) < 1e-12 and -1e-9 * h <= r.real <= h]
+    if ok:
+        return t[k - 1] + min(ok)
+    return t[k - 1] + (0.0 - zeta[k - 1]) / (zeta[k] - zeta[k - 1]) * h
 
 
-def _edges(t, F, thr, min_len):
+def _edge_params(t, period, min_samples=3):
+    """Debounce length and edge extrapolation bound [samples] for a sampling."""
+    dt = float(np.median(np.diff(t)))
+    return max(min_samples, int(0.01 * period / dt)), max(4.0, 0.02 * period / dt)
+
+
+def _sampled_support(tau, F, thr, period):
+    """Support of a cycle sampled at ``tau`` (starting at the onset, ``tau[0] = 0``)."""
+    min_len, max_extrap = _edge_params(tau, period)
+    dt = tau[1] - tau[0]
+    t_ext = np.concatenate([[-dt], tau, [tau[-1] + dt]])
+    f_ext = np.concatenate([[0.0], F, [0.0]])
+    runs = _edges(t_ext, f_ext, thr, min_len, max_extrap)
+    sup = [(max(a, 0.0), min(b, tau[-1])) for a, b, _ in runs]
+    return np.array(sup, dtype=float).reshape(-1, 2)
+
+
+def _edges(t, F, thr, min_len, max_extrap=4.0):
     """Sub-sample start/end times of the runs where F > thr (runs shorter than
     ``min_len`` samples dropped, gaps shorter than ``min_len`` closed)."""
     above = F > thr
@@ -282,11 +293,14 @@ def _edges(t, F, thr, min_len):
         if s == 0 or e >= len(F):
             continue  # incomplete at the record's ends
         # onset: the rising edge extrapolated to zero force, inside (t[s-1], t[s]]
+        # the edges are extrapolated along the local slope to zero force, so the part
+        # of a smooth rise or fall that lies below the threshold is not cut off (by at
+        # most ``max_extrap`` samples)
         f0, f1 = F[s - 1], F[s]
-        frac = np.clip((0.0 - f0) / (f1 - f0), 0.0, 1.0) if f1 != f0 else 1.0
+        frac = np.clip((0.0 - f0) / (f1 - f0), -max_extrap, 1.0) if f1 > f0 else 1.0
         t_on = t[s - 1] + frac * (t[s] - t[s - 1])
         g0, g1 = F[e - 1], F[e]
-        frac = np.clip((0.0 - g0) / (g1 - g0), 0.0, 1.0) if g1 != g0 else 0.0
+        frac = np.clip((0.0 - g0) / (g1 - g0), 0.0, 1.0 + max_extrap) if g1 < g0 else 0.0
         t_off = t[e - 1] + frac * (t[e] - t[e - 1])
         out.append((t_on, t_off, s))
     return out
@@ -330,14 +344,15 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     sigma = estimate_noise(F)
     thr = max(5.0 * sigma, 1e-3 * float(np.max(F))) if threshold is None else float(threshold)
     # gaps shorter than 1 % of a period are noise flicker inside one contact
-    runs = _edges(t, F, thr, max(min_samples, int(0.01 * period / dt)))
+    runs = _edges(t, F, thr, *_edge_params(t, period, min_samples))
     if runs:
         # a contact whose peak barely clears the threshold is noise, not an impact
         pk = np.array([np.max(F[s:int(np.searchsorted(t, off)) + 1]) for _, off, s in runs])
         runs = [r for r, p in zip(runs, pk, strict=True) if p >= max(3 * thr, 0.02 * pk.max())]
     if zeta is not None:
         zeta = np.asarray(zeta, dtype=float)
-        runs = [(_refine_onset(t, zeta, s, t_on), t_off, s) for t_on, t_off, s in runs]
+        back = 0.25 * period / dt
+        runs = [(_refine_onset(t, zeta, s, t_on, back), t_off, s) for t_on, t_off, s in runs]
     if not runs:
         raise InputError("no contact found in the force record (no run of samples above "
                          f"the threshold {thr:.3g} N); check the F column and its units")
@@ -346,7 +361,7 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     onsets = np.array([r[0] for r in runs])
     n = n_periods or _cycle_length(onsets, peaks, period, max_period, sigma)
     W = n * period
-    first = int(np.argmax(peaks[onsets < onsets[0] + W]))
+    first = int(np.argmax(peaks[onsets < onsets[0] + W - 0.25 * period]))
     ref = onsets[first]
     # main onsets: one per cycle, the run starting nearest ref + k W
     mains = []
@@ -362,15 +377,16 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
                          "impact; record more periods")
     # time axis: the first cycle's own sample offsets from its onset (no re-interpolation
     # of that cycle; the others are interpolated onto it, exactly when fs*T is whole)
-    t_on0, _, s0 = runs[mains[0]]
-    inside = t[s0:] - t_on0
+    t_on0 = runs[mains[0]][0]
+    inside = t[_first_after(t, F, t_on0, thr, zeta is not None):] - t_on0
     tau = np.concatenate([[0.0], inside[inside < W], [W]])
     stack = []
     for j in mains:
-        t_on, _, s = runs[j]
+        t_on = runs[j][0]
+        s = _first_after(t, F, t_on, thr, zeta is not None)
         vals = np.interp(t_on + tau, t, F)
-        # right limit at the onset: extrapolate the first two samples after it, and
-        # do not interpolate across the jump between the onset and sample s
+        # right limit at the onset: extrapolate the first samples after it, and do not
+        # interpolate across a jump between the onset and sample s
         # (quadratic through samples s, s+1, s+2; a force is never negative)
         coef = np.polyfit(t[s:s + 3] - t_on, F[s:s + 3], 2)
         head = tau < t[s] - t_on
@@ -382,15 +398,24 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
         vals[tail] = F[last]
         stack.append(vals)
     Fm = np.mean(stack, axis=0)
-    sup = []
-    for t_on, t_off, _ in runs:
-        for j in mains[:1]:
-            r0 = t_on - onsets[j]
-            if -1e-12 <= r0 < W - 0.5 * dt:
-                sup.append((max(r0, 0.0), min(t_off - onsets[j], W)))
-    return Impulse(t=tau, F=Fm, duration=W, support=np.array(sup).reshape(-1, 2),
-                   n_periods=n, onset=float(onsets[mains[0]]), threshold=thr,
+    # the support of the averaged cycle, whose noise is sigma / sqrt(cycles)
+    thr_avg = thr if threshold is not None else max(
+        5.0 * sigma / np.sqrt(len(mains)), 1e-3 * float(np.max(F)))
+    support = _sampled_support(tau, Fm, thr_avg, period)
+    return Impulse(t=tau, F=Fm, duration=W, support=support,
+                   n_periods=n, onset=float(onsets[mains[0]]), threshold=thr_avg,
                    noise=sigma, n_cycles=len(mains))
+
+
+def _first_after(t, F, t_on, thr, exact_onset):
+    """Index of the first sample inside the contact: just after an exact (zeta) onset;
+    after an onset estimated from the force, the first one above half the threshold
+    (a sample before a force jump is still pre-contact)."""
+    k = int(np.searchsorted(t, t_on, "right"))
+    if not exact_onset:
+        while k < len(F) - 3 and F[k] <= 0.5 * thr:
+            k += 1
+    return k
 
 
 def _cycle_length(onsets, peaks, period, max_period, sigma):

@@ -174,10 +174,6 @@ def test_p1_against_p2_without_jump_at_cycle_start():
     assert v["I4"] == 0.0
 
 
-@pytest.mark.xfail(strict=True, reason="criteria._grid_points does not mark the cycle "
-                   "boundary k*duration as a jump, so in the periodic extension the onset jump "
-                   "F(0-) -> F(0+) of the P1 impulse is lost at t = T (evaluated as the left "
-                   "limit 0 and interpolated linearly): I2 = 1/3, I3 = 0.5 instead of 0.5, 0.707")
 def test_p1_with_onset_jump_against_p2():
     # E (P1): 1 on [0, 0.5) every period; N (P2): 1 on [0, 0.5) once every two periods
     e = imp([0, 0.5, 0.5, 1], [1, 1, 0, 0], 1, [[0, 0.5]])

@@ -45,11 +45,6 @@ def test_paper_orbit_closes_after_one_period(paper, paper_ss):
     assert np.sum(tr.event_kind == K.EV_ONSET) == 1
 
 
-@pytest.mark.xfail(strict=True, reason="steady_state reports the residual of the Newton "
-                   "solve for the period it tried (n=5 for the paper scenario), not for the "
-                   "reduced period n_periods=1 it returns: 2.4e-9 reported vs 1.45e-8 actual "
-                   "(steady_state.py, 'residual=float(res)' not recomputed after the divisor "
-                   "reduction)")
 def test_reported_residual_is_that_of_the_reported_period(paper, paper_ss):
     pm = StroboscopicMap(paper, paper.law)
     actual = _rel(pm, pm.advance(paper_ss.y0, paper_ss.n_periods), paper_ss.y0)

@@ -245,8 +245,10 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
             # the smallest divisor period that also closes the orbit
             for m in range(1, n):
                 if n % m == 0 and np.max(np.abs(pm.advance(y_orb, m) - y_orb) / pm.scale) < 10 * tol:
-                    n = m
-                    mult = np.linalg.eigvals(pm.jacobian(y_orb, n))
+                    # polish at the reduced period: its own residual and Jacobian
+                    y_m, res_m, J_m, ok_m = _newton(pm, y_orb, m, tol, max_newton, [])
+                    if ok_m:
+                        n, y_orb, res, mult = m, y_m, res_m, np.linalg.eigvals(J_m)
                     break
             t0 = t_done * scenario.period
             impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n)
