@@ -55,7 +55,7 @@ def _pw(x, p):
     return -((-x) ** p)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def poly(z, zd, coef, ea, eb):
     """``P(z, zd) = sum c_i z^a_i zd^b_i`` (odd extension for negative arguments)."""
     s = 0.0
@@ -64,7 +64,7 @@ def poly(z, zd, coef, ea, eb):
     return s
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def mode_force(mode, z, v, coef, ea, eb):
     """Contact force [N] in a given mode at penetration ``z`` and its rate ``v``."""
     if mode == LOAD:
@@ -86,7 +86,7 @@ def resolve_mode(y, coef, ea, eb):
     return UNLOAD if poly(z, 0.0, coef, ea, eb) > 0.0 else CLIPPED
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rhs(t, y, mode, p, coef, ea, eb, out):
     z = y[0] - y[2]
     v = y[1] - y[3]
@@ -97,7 +97,7 @@ def _rhs(t, y, mode, p, coef, ea, eb, out):
     out[3] = f / p[1] - p[6]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _switching(mode, y, coef, ea, eb, h):
     """Fill ``h`` with the mode's switching functions; return how many."""
     z = y[0] - y[2]
@@ -149,19 +149,23 @@ def _mode_after(kind, y, coef, ea, eb):
     return LOAD if poly(z, max(v, 0.0), coef, ea, eb) >= 0.0 else CLIPPED
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _dense(y, K, h, theta, out):
     t2 = theta * theta
     t3 = t2 * theta
     t4 = t3 * theta
+    w0 = _P[0, 0] * theta + _P[0, 1] * t2 + _P[0, 2] * t3 + _P[0, 3] * t4
+    w2 = _P[2, 1] * t2 + _P[2, 2] * t3 + _P[2, 3] * t4
+    w3 = _P[3, 1] * t2 + _P[3, 2] * t3 + _P[3, 3] * t4
+    w4 = _P[4, 1] * t2 + _P[4, 2] * t3 + _P[4, 3] * t4
+    w5 = _P[5, 1] * t2 + _P[5, 2] * t3 + _P[5, 3] * t4
+    w6 = _P[6, 1] * t2 + _P[6, 2] * t3 + _P[6, 3] * t4
     for j in range(4):
-        acc = 0.0
-        for i in range(7):
-            acc += K[i, j] * (_P[i, 0] * theta + _P[i, 1] * t2 + _P[i, 2] * t3 + _P[i, 3] * t4)
-        out[j] = y[j] + h * acc
+        out[j] = y[j] + h * (w0 * K[0, j] + w2 * K[2, j] + w3 * K[3, j] + w4 * K[4, j]
+                             + w5 * K[5, j] + w6 * K[6, j])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rk_step(t, y, h, mode, p, coef, ea, eb, K, ytmp, ynew):
     """One DP5 step from (t, y) with K[0] = f(t, y) already set; fills K[1:7], ynew."""
     for s in range(1, 6):
@@ -179,7 +183,7 @@ def _rk_step(t, y, h, mode, p, coef, ea, eb, K, ytmp, ynew):
     _rhs(t + h, ynew, mode, p, coef, ea, eb, K[6])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _error_norm(y, ynew, K, h, rtol, atol):
     s = 0.0
     for j in range(4):
@@ -236,7 +240,11 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
     K = np.empty((7, 4))
     hs0 = np.empty(3)
     hs1 = np.empty(3)
+    hsa = np.empty(3)
+    hsb = np.empty(3)
     hsm = np.empty(3)
+    need_h0 = True
+    ns = 0
     t = t0
     mode = mode0 if mode0 >= 0 else resolve_mode(y, coef, ea, eb)
     h = min(h0, hmax, t1 - t0)
@@ -277,10 +285,15 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
             h *= max(_MIN_FACTOR, _SAFETY * err**-0.2)
             continue
         # ---- accepted step: look for the earliest event in (t, t + h]
-        ns = _switching(mode, y, coef, ea, eb, hs0)
+        if need_h0:
+            ns = _switching(mode, y, coef, ea, eb, hs0)
+            need_h0 = False
         _switching(mode, ynew, coef, ea, eb, hs1)
         best_theta = 2.0
         best_index = -1
+        # probe the dense output at 1/3 and 2/3 too, so a brief excursion across a
+        # switching surface inside one step is seen (once per step, for all functions)
+        probed = False
         for i in range(ns):
             if hs0[i] == 0.0 and hs1[i] < 0.0:
                 # already on the surface and moving across: transition at t
@@ -288,25 +301,26 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
                 break
             if hs0[i] < 0.0:
                 continue
-            # check interior points too, so a brief excursion inside a step is seen
-            lo, flo = 0.0, hs0[i]
-            found = False
-            th = 2.0
-            for q in (1.0 / 3.0, 2.0 / 3.0, 1.0):
-                if q < 1.0:
-                    _dense(y, K, h, q, ybuf)
-                    _switching(mode, ybuf, coef, ea, eb, hsm)
-                    fq = hsm[i]
-                else:
-                    fq = hs1[i]
-                if fq < 0.0:
-                    th = _locate(y, K, h, mode, coef, ea, eb, i, lo, q, flo, fq, ybuf, hsm)
-                    found = True
-                    break
-                lo, flo = q, fq
+            if not probed:
+                _dense(y, K, h, 1.0 / 3.0, ybuf)
+                _switching(mode, ybuf, coef, ea, eb, hsa)
+                _dense(y, K, h, 2.0 / 3.0, ybuf)
+                _switching(mode, ybuf, coef, ea, eb, hsb)
+                probed = True
+            if hsa[i] < 0.0:
+                th = _locate(y, K, h, mode, coef, ea, eb, i, 0.0, 1.0 / 3.0, hs0[i], hsa[i],
+                             ybuf, hsm)
+            elif hsb[i] < 0.0:
+                th = _locate(y, K, h, mode, coef, ea, eb, i, 1.0 / 3.0, 2.0 / 3.0, hsa[i],
+                             hsb[i], ybuf, hsm)
+            elif hs1[i] < 0.0:
+                th = _locate(y, K, h, mode, coef, ea, eb, i, 2.0 / 3.0, 1.0, hsb[i], hs1[i],
+                             ybuf, hsm)
+            else:
+                continue
             # near-ties go to the lower index: contact loss (index 0) wins over the
             # force reaching zero at the same instant (e.g. P(zeta, 0) = k * zeta)
-            if found and th < best_theta - 1e-9:
+            if th < best_theta - 1e-9:
                 best_theta, best_index = th, i
         if best_index >= 0:
             if best_theta == 0.0:
@@ -326,6 +340,7 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
                 n_ev += 1
                 mode = new_mode
                 need_f = True
+                need_h0 = True
                 continue
             # re-take the step so that it ends on the event
             h_ev = best_theta * h
@@ -368,7 +383,10 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
             n_ev += 1
             mode = new_mode
             need_f = True
+            need_h0 = True
             # keep the step size that worked before the cut
         else:
+            for i in range(ns):
+                hs0[i] = hs1[i]
             h = h * min(_MAX_FACTOR, max(_MIN_FACTOR, _SAFETY * max(err, 1e-10) ** -0.2))
     return status, t, y, mode, n_steps, n_ev, h
