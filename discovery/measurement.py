@@ -1,7 +1,9 @@
 """Measured (or synthetic) records: validated loading and writing of CSV files.
 
 CSV format: a header row; ``t`` [s] and ``F`` [N] required; ``w1``, ``w2`` [m],
-``v1``, ``v2`` [m/s] optional; other columns are ignored (with a note).  The time
+``v1``, ``v2`` [m/s] and ``a2`` [m/s^2] optional; other columns are ignored (with a
+note).  Without ``F``, the force is taken from the moulding's acceleration,
+``F = m2 (a2 + g)`` (its equation of motion), which needs the scenario.  The time
 ``t`` is the drive's clock: the drive is ``A sin(2 pi f t)``.
 """
 
@@ -17,7 +19,8 @@ from .impulse import impulse_from_samples
 
 __all__ = ["Measurement", "synthesize"]
 
-_OPTIONAL = ("w1", "v1", "w2", "v2")
+_OPTIONAL = ("w1", "v1", "w2", "v2", "a2")
+_STATE = ("w1", "v1", "w2", "v2")
 
 
 @dataclass(frozen=True)
@@ -73,8 +76,15 @@ class Measurement:
         return 1.0 / float(np.median(np.diff(self.t)))
 
     @classmethod
-    def from_csv(cls, path):
-        """Load and validate a CSV file (see module docstring)."""
+    def from_csv(cls, path, scenario=None):
+        """Load and validate a CSV file (see module docstring).
+
+        Parameters
+        ----------
+        path : str or Path
+        scenario : Scenario, optional
+            Needed only when the file has ``a2`` but no ``F``.
+        """
         try:
             text = open(path, newline="").read()
         except FileNotFoundError:
@@ -83,7 +93,11 @@ class Measurement:
         if not rows:
             raise InputError(f"data file {str(path)!r} is empty; it needs a header with t and F")
         header = [h.strip() for h in rows[0]]
-        missing = [c for c in ("t", "F") if c not in header]
+        from_a2 = "F" not in header and "a2" in header
+        if from_a2 and scenario is None:
+            raise InputError(f"data file {str(path)!r} has a2 but no F; give the scenario so "
+                             "that F = m2 (a2 + g) can be formed")
+        missing = [c for c in ("t", "F") if c not in header and not (c == "F" and from_a2)]
         if missing:
             raise InputError(f"data file {str(path)!r} has no column {' or '.join(missing)}; "
                              f"the header must name t [s] and F [N] (found {header})")
@@ -101,6 +115,9 @@ class Measurement:
         ignored = [h for h in header if h not in ("t", "F", *_OPTIONAL)]
         notes = (f"ignored column(s): {', '.join(ignored)}",) if ignored else ()
         channels = {k: cols[k] for k in _OPTIONAL if k in cols}
+        if from_a2:
+            cols["F"] = scenario.m2 * (cols["a2"] + scenario.g)
+            notes += ("F formed from the moulding's acceleration: F = m2 (a2 + g)",)
         return cls(cols["t"], cols["F"], channels, str(path), notes)
 
     def to_csv(self, path):
@@ -165,5 +182,5 @@ def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None
     if noise > 0:
         rng = np.random.default_rng(seed)
         F = F + rng.normal(0.0, noise * float(np.max(F)), size=F.shape)
-    ch = dict(zip(_OPTIONAL, tr.y, strict=True))
+    ch = dict(zip(_STATE, tr.y, strict=True))
     return Measurement(t, F, ch, source=f"synthetic:{scenario.name}")

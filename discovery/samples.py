@@ -1,0 +1,135 @@
+"""Data preparation for regression: contact samples ``(zeta, dzeta, F)`` from a record.
+
+``zeta = w1 - w2`` from the positions; ``dzeta`` from the velocities when recorded,
+otherwise by Savitzky-Golay differentiation of ``zeta`` (a local cubic fit, robust
+to noise) or pysindy's smoothed finite differences.  A sample is a *contact
+sample* when ``zeta`` is clearly positive, so no sample of free flight enters the fit.  Contact is decided on ``zeta`` (above its own noise level), never on
+the force: selecting on the dependent variable would bias the fit (samples whose
+noise happens to push them over a force threshold would be kept, the others not).
+Each sample carries the index of its impact, so cross-validation
+and bootstrap resample whole impacts.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.signal import savgol_filter
+
+from .errors import InputError
+from .impulse import estimate_noise
+
+__all__ = ["ContactSamples", "contact_samples"]
+
+DERIVATIVES = ("velocities", "savgol", "pysindy")
+
+
+@dataclass(frozen=True)
+class ContactSamples:
+    """Samples in contact.
+
+    Attributes
+    ----------
+    zeta : ndarray of shape (n,)
+        Interpenetration [m].
+    dzeta : ndarray of shape (n,)
+        Penetration velocity [m/s].
+    F : ndarray of shape (n,)
+        Contact force [N].
+    impact : ndarray of shape (n,), int
+        Index of the impact each sample belongs to.
+    weight : ndarray of shape (n,)
+        Regression weights (mean 1).
+    noise : float
+        Estimated force noise standard deviation [N].
+    derivative : str
+        How ``dzeta`` was obtained.
+    """
+
+    zeta: np.ndarray
+    dzeta: np.ndarray
+    F: np.ndarray
+    impact: np.ndarray
+    weight: np.ndarray
+    noise: float
+    derivative: str
+
+    @property
+    def X(self):
+        """ndarray of shape (n, 2): ``zeta``, ``dzeta`` (the estimators' input)."""
+        return np.column_stack([self.zeta, self.dzeta])
+
+    @property
+    def n_impacts(self):
+        return int(np.unique(self.impact).size)
+
+    def __len__(self):
+        return self.zeta.size
+
+
+def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weights="uniform"):
+    """Contact samples of a :class:`~discovery.measurement.Measurement`.
+
+    Parameters
+    ----------
+    measurement : Measurement
+        Needs ``w1`` and ``w2``; ``v1`` and ``v2`` are used when present.
+    derivative : {"velocities", "savgol", "pysindy"}, optional
+        Source of ``dzeta``; default the velocities when recorded, else ``"savgol"``.
+    window : int
+        Samples in the differentiation window (odd, >= 5).
+    k_sigma : float
+        A sample counts as in contact when ``zeta > k_sigma * sigma_zeta`` (noise level
+        of ``zeta`` from :func:`~discovery.impulse.estimate_noise`; a tiny floor for
+        noise-free data).
+    weights : {"uniform", "per-impact"}
+        ``"per-impact"`` gives every impact the same total weight.
+
+    Returns
+    -------
+    ContactSamples
+    """
+    ch = measurement.channels
+    if "w1" not in ch or "w2" not in ch:
+        raise InputError("discovery needs the positions w1 and w2 in the data (zeta = w1 - w2); "
+                         "add those columns")
+    t = measurement.t
+    zeta = ch["w1"] - ch["w2"]
+    have_v = "v1" in ch and "v2" in ch
+    derivative = derivative or ("velocities" if have_v else "savgol")
+    if derivative not in DERIVATIVES:
+        raise InputError(f"unknown derivative {derivative!r}; valid: {', '.join(DERIVATIVES)}")
+    if not (isinstance(window, int) and window >= 5 and window % 2 == 1):
+        raise InputError(f"window must be an odd integer >= 5, got {window!r}")
+    dt = float(np.median(np.diff(t)))
+    if derivative == "velocities":
+        if not have_v:
+            raise InputError("derivative 'velocities' needs the v1 and v2 columns")
+        dzeta = ch["v1"] - ch["v2"]
+    elif derivative == "savgol":
+        dzeta = savgol_filter(zeta, window, 3, deriv=1, delta=dt)
+    else:
+        from pysindy.differentiation import SmoothedFiniteDifference
+
+        sfd = SmoothedFiniteDifference(smoother_kws={"window_length": window, "polyorder": 3})
+        dzeta = np.asarray(sfd._differentiate(zeta.reshape(-1, 1), t)).ravel()
+    F = measurement.F
+    sigma = estimate_noise(F)
+    floor = max(k_sigma * estimate_noise(zeta), 1e-9 * float(np.max(np.abs(zeta))))
+    contact = zeta > floor
+    if contact.sum() < 10:
+        raise InputError("fewer than 10 contact samples (zeta = w1 - w2 > 0 above its noise); "
+                         "check the w1 and w2 columns and their sign (positions upward)")
+    starts = np.flatnonzero(np.diff(np.concatenate([[0], contact.astype(np.int8)])) == 1)
+    impact_all = np.cumsum(np.isin(np.arange(t.size), starts)) - 1
+    idx = np.flatnonzero(contact)
+    impact = impact_all[idx]
+    if weights == "uniform":
+        w = np.ones(idx.size)
+    elif weights == "per-impact":
+        counts = np.bincount(impact)
+        w = 1.0 / counts[impact]
+        w *= idx.size / w.sum()
+    else:
+        raise InputError(f"weights must be 'uniform' or 'per-impact', got {weights!r}")
+    return ContactSamples(zeta=zeta[idx], dzeta=dzeta[idx], F=F[idx], impact=impact, weight=w,
+                          noise=sigma, derivative=derivative)
