@@ -105,7 +105,8 @@ class Impulse:
         vals[0] = self.evaluate(0.0, "right")
         if other.threshold > 0:
             support = _sampled_support(other.t, vals, other.threshold,
-                                       other.duration / other.n_periods)
+                                       other.duration / other.n_periods,
+                                       other.noise / np.sqrt(max(other.n_cycles, 1)))
         else:
             support = self.periodic_support(reps * self.duration)
         return Impulse(t=other.t.copy(), F=vals, duration=reps * self.duration,
@@ -258,20 +259,35 @@ def _edge_params(t, period, min_samples=3):
     return max(min_samples, int(0.01 * period / dt)), max(4.0, 0.02 * period / dt)
 
 
-def _sampled_support(tau, F, thr, period):
-    """Support of a cycle sampled at ``tau`` (starting at the onset, ``tau[0] = 0``)."""
+def _sampled_support(tau, F, thr, period, noise=0.0):
+    """Support of a cycle sampled at ``tau`` (starting at the onset, ``tau[0] = 0``).
+
+    When its noise is not negligible (``noise > thr / 100``) the cycle is first smoothed
+    by a moving average over 1 % of a period, so noise near a flat tail does not stretch
+    the support by chance crossings of the threshold (the measured and the simulated
+    cycle go through the same operator; a smoothed edge moves by up to half a window)."""
+    from scipy.ndimage import uniform_filter1d
+
     min_len, max_extrap = _edge_params(tau, period)
-    dt = tau[1] - tau[0]
+    dt = tau[2] - tau[1]
+    width = max(1, int(0.01 * period / dt)) | 1 if noise > thr / 100.0 else 1
+    Fs = uniform_filter1d(np.asarray(F, dtype=float), width, mode="nearest")
+    Fs[0] = F[0]
     t_ext = np.concatenate([[-dt], tau, [tau[-1] + dt]])
-    f_ext = np.concatenate([[0.0], F, [0.0]])
-    runs = _edges(t_ext, f_ext, thr, min_len, max_extrap)
+    f_ext = np.concatenate([[0.0], Fs, [0.0]])
+    runs = _edges(t_ext, f_ext, thr, min_len, max_extrap, noise / np.sqrt(width))
     sup = [(max(a, 0.0), min(b, tau[-1])) for a, b, _ in runs]
     return np.array(sup, dtype=float).reshape(-1, 2)
 
 
-def _edges(t, F, thr, min_len, max_extrap=4.0):
+def _edges(t, F, thr, min_len, max_extrap=4.0, noise=0.0):
     """Sub-sample start/end times of the runs where F > thr (runs shorter than
-    ``min_len`` samples dropped, gaps shorter than ``min_len`` closed)."""
+    ``min_len`` samples dropped, gaps shorter than ``min_len`` closed).
+
+    An edge whose step between samples clearly exceeds the noise (``> 3 noise``) is
+    extrapolated along its slope to zero force, by at most ``max_extrap`` samples, so
+    the part of a smooth rise or fall below the threshold is not cut off; a flat,
+    noisy edge has no meaningful slope and ends at its threshold crossing."""
     above = F > thr
     idx = np.flatnonzero(np.diff(above.astype(np.int8)))
     starts = list(idx[~above[idx]] + 1)
@@ -292,17 +308,21 @@ def _edges(t, F, thr, min_len, max_extrap=4.0):
     for s, e in runs:
         if s == 0 or e >= len(F):
             continue  # incomplete at the record's ends
-        # onset: the rising edge extrapolated to zero force, inside (t[s-1], t[s]]
-        # the edges are extrapolated along the local slope to zero force, so the part
-        # of a smooth rise or fall that lies below the threshold is not cut off (by at
-        # most ``max_extrap`` samples)
         f0, f1 = F[s - 1], F[s]
-        frac = np.clip((0.0 - f0) / (f1 - f0), -max_extrap, 1.0) if f1 > f0 else 1.0
-        t_on = t[s - 1] + frac * (t[s] - t[s - 1])
+        steep = f1 - f0 > 3.0 * noise
+        lo = -max_extrap if steep else 0.0
+        frac = np.clip((thr if not steep else 0.0) - f0, None, None) / (f1 - f0) \
+            if f1 > f0 else 1.0
+        t_on = t[s - 1] + float(np.clip(frac, lo, 1.0)) * (t[s] - t[s - 1])
         g0, g1 = F[e - 1], F[e]
-        frac = np.clip((0.0 - g0) / (g1 - g0), 0.0, 1.0 + max_extrap) if g1 < g0 else 0.0
-        t_off = t[e - 1] + frac * (t[e] - t[e - 1])
-        out.append((t_on, t_off, s))
+        steep = g0 - g1 > 3.0 * noise
+        hi = 1.0 + max_extrap if steep else 1.0
+        frac = ((0.0 if steep else thr) - g0) / (g1 - g0) if g1 < g0 else 0.0
+        t_off = t[e - 1] + float(np.clip(frac, 0.0, hi)) * (t[e] - t[e - 1])
+        if out and t_on <= out[-1][1]:  # extrapolated edges met: one contact
+            out[-1] = (out[-1][0], max(out[-1][1], t_off), out[-1][2])
+        else:
+            out.append((t_on, t_off, s))
     return out
 
 
@@ -344,7 +364,7 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     sigma = estimate_noise(F)
     thr = max(5.0 * sigma, 1e-3 * float(np.max(F))) if threshold is None else float(threshold)
     # gaps shorter than 1 % of a period are noise flicker inside one contact
-    runs = _edges(t, F, thr, *_edge_params(t, period, min_samples))
+    runs = _edges(t, F, thr, *_edge_params(t, period, min_samples), noise=sigma)
     if runs:
         # a contact whose peak barely clears the threshold is noise, not an impact
         pk = np.array([np.max(F[s:int(np.searchsorted(t, off)) + 1]) for _, off, s in runs])
@@ -357,24 +377,37 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
         raise InputError("no contact found in the force record (no run of samples above "
                          f"the threshold {thr:.3g} N); check the F column and its units")
     # peak force per run to find the main impact and the cycle length
-    peaks = np.array([np.max(F[s:int(np.searchsorted(t, off)) + 1]) for _, off, s in runs])
+    # each contact's impulse (integral of F): unlike the sampled peak it does not depend
+    # on where the samples fall after a force jump; its noise is sigma dt sqrt(samples)
+    spans = [(s, int(np.searchsorted(t, off)) + 1) for _, off, s in runs]
+    peaks = np.array([np.sum(F[a:b]) * dt for a, b in spans])
+    peak_noise = np.array([sigma * dt * np.sqrt(max(b - a, 1)) for a, b in spans])
     onsets = np.array([r[0] for r in runs])
-    n = n_periods or _cycle_length(onsets, peaks, period, max_period, sigma)
+    # the steady state is at the end of a record (which may start with a run-up): the
+    # cycle length and the reference impact come from its second half
+    late = onsets >= t[0] + 0.5 * (t[-1] - t[0])
+    if late.sum() < 2:
+        late = np.ones(onsets.size, dtype=bool)
+    n = n_periods or _cycle_length(onsets[late], peaks[late], period, max_period,
+                                   peak_noise[late])
     W = n * period
-    first = int(np.argmax(peaks[onsets < onsets[0] + W - 0.25 * period]))
-    ref = onsets[first]
-    # main onsets: one per cycle, the run starting nearest ref + k W
-    mains = []
-    k = 0
-    while ref + (k + 1) * W <= t[-1]:
-        target = ref + k * W
-        j = int(np.argmin(np.abs(onsets - target)))
-        if abs(onsets[j] - target) < 0.25 * period:
-            mains.append(j)
-        k += 1
-    if not mains:
+    complete = np.flatnonzero(onsets + W <= t[-1] + 0.5 * dt)
+    if complete.size == 0:
         raise InputError(f"the record is shorter than one cycle ({W:.4g} s) after the first "
                          "impact; record more periods")
+    last = complete[onsets[complete] >= onsets[complete[-1]] - W + 0.25 * period]
+    ref_j = int(last[np.argmax(peaks[last])])
+    # walk back one cycle at a time while the cycles repeat the last one (steady state)
+    mains = [ref_j]
+    tol_peak = 0.05 * peaks[ref_j] + 5 * peak_noise[ref_j]
+    k = 1
+    while True:
+        target = onsets[ref_j] - k * W
+        j = int(np.argmin(np.abs(onsets - target)))
+        if abs(onsets[j] - target) > 0.02 * period or abs(peaks[j] - peaks[ref_j]) > tol_peak:
+            break
+        mains.insert(0, j)
+        k += 1
     # time axis: the first cycle's own sample offsets from its onset (no re-interpolation
     # of that cycle; the others are interpolated onto it, exactly when fs*T is whole)
     t_on0 = runs[mains[0]][0]
@@ -401,7 +434,7 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     # the support of the averaged cycle, whose noise is sigma / sqrt(cycles)
     thr_avg = thr if threshold is not None else max(
         5.0 * sigma / np.sqrt(len(mains)), 1e-3 * float(np.max(F)))
-    support = _sampled_support(tau, Fm, thr_avg, period)
+    support = _sampled_support(tau, Fm, thr_avg, period, sigma / np.sqrt(len(mains)))
     return Impulse(t=tau, F=Fm, duration=W, support=support,
                    n_periods=n, onset=float(onsets[mains[0]]), threshold=thr_avg,
                    noise=sigma, n_cycles=len(mains))
@@ -418,8 +451,9 @@ def _first_after(t, F, t_on, thr, exact_onset):
     return k
 
 
-def _cycle_length(onsets, peaks, period, max_period, sigma):
-    """Smallest n whose cycles repeat: onset phases and peaks agree cycle to cycle."""
+def _cycle_length(onsets, impulses, period, max_period, noise):
+    """Smallest n whose cycles repeat: onset phases and contact impulses agree from one
+    cycle to the next (within 5 % and 5 noise standard deviations)."""
     for n in range(1, max_period + 1):
         W = n * period
         ok = True
@@ -431,9 +465,11 @@ def _cycle_length(onsets, peaks, period, max_period, sigma):
                     break
                 continue
             j = later[0]
-            if abs(peaks[j] - peaks[i]) > 0.05 * max(peaks[i], 1e-300) + 5 * sigma:
+            if abs(impulses[j] - impulses[i]) > 0.05 * abs(impulses[i]) + 5 * noise[i]:
                 ok = False
                 break
         if ok:
             return n
-    return max_period
+    raise InputError(f"the second half of the record is not periodic with up to {max_period} "
+                     "drive periods (its impacts differ by more than 5 %); record longer so "
+                     "that it reaches a steady state, or give n_periods")

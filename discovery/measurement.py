@@ -142,45 +142,63 @@ class Measurement:
         return impulse_from_samples(self.t, self.F, period, zeta=self.zeta, **kwargs)
 
 
-def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None):
-    """A synthetic measurement: the steady state of ``law`` sampled at ``fs``.
+def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None, *,
+               from_rest=False, position_noise=0.0, velocities=True):
+    """A synthetic measurement of ``law`` sampled at ``fs``.
 
     Parameters
     ----------
     scenario : Scenario
     law : ForceLaw
     periods : int
-        Drive periods recorded (from a time on the periodic orbit, so the drive
-        phase at ``t = 0`` is zero).
+        Drive periods recorded.
     fs : float
         Sampling rate [Hz].
     noise : float
         Gaussian noise on ``F`` with standard deviation ``noise * max F``.
     seed : int
-        Seed of ``numpy.random.default_rng`` for the noise.
+        Seed of ``numpy.random.default_rng`` for all noise.
     ss : SteadyState, optional
         Precomputed steady state.
+    from_rest : bool
+        Record from the scenario's initial state (the run-up, with impacts at many
+        velocities, then the steady state) instead of from a time on the periodic
+        orbit.  Either way the drive phase at ``t = 0`` is zero.
+    position_noise : float
+        Gaussian noise on ``w1`` and ``w2`` with standard deviation
+        ``position_noise * max |w1 - w2|``.
+    velocities : bool
+        Include the ``v1``, ``v2`` channels.
 
     Returns
     -------
     Measurement
-        With the exact ``w1, v1, w2, v2`` channels (noise only on ``F``).
     """
     from .dynamics import simulate
     from .dynamics.steady_state import steady_state
 
-    if not (periods >= 1 and fs > 0 and noise >= 0):
-        raise InputError("periods must be >= 1, fs > 0 and noise >= 0")
-    ss = ss or steady_state(scenario, law)
-    if not ss.periodic:
-        raise InputError(f"law '{law}' has no periodic steady state in scenario "
-                         f"{scenario.name!r} ({ss.regime}); choose another law or scenario")
+    if not (periods >= 1 and fs > 0 and noise >= 0 and position_noise >= 0):
+        raise InputError("periods must be >= 1, fs > 0 and the noise levels >= 0")
     n = int(round(periods * scenario.period * fs))
     t = np.arange(n) / fs
-    tr = simulate(scenario, law, (ss.t0, ss.t0 + t[-1]), y0=ss.y0, t_eval=ss.t0 + t)
+    if from_rest:
+        tr = simulate(scenario, law, (0.0, t[-1]), t_eval=t)
+    else:
+        ss = ss or steady_state(scenario, law)
+        if not ss.periodic:
+            raise InputError(f"law '{law}' has no periodic steady state in scenario "
+                             f"{scenario.name!r} ({ss.regime}); choose another law or scenario, "
+                             "or record from rest")
+        tr = simulate(scenario, law, (ss.t0, ss.t0 + t[-1]), y0=ss.y0, t_eval=ss.t0 + t)
+    rng = np.random.default_rng(seed)
     F = tr.force.copy()
     if noise > 0:
-        rng = np.random.default_rng(seed)
         F = F + rng.normal(0.0, noise * float(np.max(F)), size=F.shape)
-    ch = dict(zip(_STATE, tr.y, strict=True))
+    ch = dict(zip(_STATE, (v.copy() for v in tr.y), strict=True))
+    if position_noise > 0:
+        sd = position_noise * float(np.max(np.abs(ch["w1"] - ch["w2"])))
+        ch["w1"] += rng.normal(0.0, sd, n)
+        ch["w2"] += rng.normal(0.0, sd, n)
+    if not velocities:
+        del ch["v1"], ch["v2"]
     return Measurement(t, F, ch, source=f"synthetic:{scenario.name}")
