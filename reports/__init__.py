@@ -1,5 +1,13 @@
-"""Reports: figures (and, later, LaTeX documents) as pure functions of results."""
+"""Reports: figures and LaTeX documents as pure functions of results."""
 
-from .figures import identification_figure, landscape_figure
+from .figures import (
+    fit_impulse_figure,
+    fit_loop_figure,
+    fit_surface_figure,
+    identification_figure,
+    landscape_figure,
+)
+from .latex import model_tex
 
-__all__ = ["landscape_figure", "identification_figure"]
+__all__ = ["landscape_figure", "identification_figure", "fit_impulse_figure",
+           "fit_surface_figure", "fit_loop_figure", "model_tex"]

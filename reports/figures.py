@@ -111,3 +111,69 @@ def identification_figure(result, measured, impulses, stem, land=None):
     ax1.legend(fontsize=8)
     fig.tight_layout()
     return _save(fig, stem)
+
+
+def fit_impulse_figure(result, impulses, stem):
+    """Measured impulse against the simulated impulses of the best-ranked models.
+
+    Parameters
+    ----------
+    result : DiscoveryResult
+    impulses : list of (label, Impulse)
+    stem : str
+    """
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    E = result.measured
+    ax.plot(E.t * 1e3, E.F / 1e3, "k-", lw=2.5, label=f"measured ({E.n_cycles} cycles)")
+    for k, (label, imp) in enumerate(impulses):
+        if imp is not None:
+            ax.plot(imp.t * 1e3, imp.F / 1e3, "-", lw=1.2, color=f"C{k}", label=label)
+    visible = np.flatnonzero(E.F > 0.02 * E.peak)
+    end = E.t[visible[-1]] if visible.size else E.duration
+    ax.set_xlim(-0.03 * end * 1e3, min(E.duration, 1.5 * end) * 1e3)
+    ax.set_xlabel("time since onset [ms]")
+    ax.set_ylabel("contact force [kN]")
+    ax.set_title("Measured impulse and the simulated steady states of the best models")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def fit_surface_figure(result, stem):
+    """The selected law over the box in (zeta, zd), with the contact samples."""
+    est, s = result.estimator, result.samples
+    Z, V = est.box_.zeta_max, est.box_.zd_max
+    zz, vv = np.meshgrid(np.linspace(0, Z, 200), np.linspace(0, V, 200))
+    F = result.selected.law(zz, vv)
+    fig, ax = plt.subplots(figsize=(7, 5))
+    cs = ax.contourf(zz * 1e3, vv, F / 1e3, levels=25, cmap="magma")
+    plt.colorbar(cs, ax=ax, label="F [kN]")
+    step = max(1, len(s) // 4000)
+    ax.plot(s.zeta[::step] * 1e3, np.maximum(s.dzeta[::step], 0), ".", ms=1.5, color="c",
+            alpha=0.6, label="contact samples")
+    ax.set_xlabel("penetration zeta [mm]")
+    ax.set_ylabel("loading velocity max(dzeta, 0) [m/s]")
+    ax.set_title(f"F = {result.selected.law}", fontsize=8)
+    ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def fit_loop_figure(result, stem, max_impacts=3):
+    """Loading / unloading loops F(zeta) of a few impacts (the paper's Fig. 2a)."""
+    s = result.samples
+    fig, ax = plt.subplots(figsize=(7, 5))
+    impacts = np.unique(s.impact)
+    pick = impacts[np.linspace(0, impacts.size - 1, min(max_impacts, impacts.size)).astype(int)]
+    for k, imp in enumerate(pick):
+        m = s.impact == imp
+        ax.plot(s.zeta[m] * 1e3, s.F[m] / 1e3, ".", ms=3, color=f"C{k}", alpha=0.5,
+                label=f"measured, impact {imp}")
+        ax.plot(s.zeta[m] * 1e3, result.selected.law(s.zeta[m], s.dzeta[m]) / 1e3, "-",
+                color=f"C{k}", lw=1.5, label=f"model, impact {imp}")
+    ax.set_xlabel("penetration zeta [mm]")
+    ax.set_ylabel("contact force [kN]")
+    ax.set_title("Loading (upper) and elastic unloading (lower) branches")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return _save(fig, stem)
