@@ -32,7 +32,7 @@ test-fast: install
 	$(BIN)/python -m pytest -q -m "not slow"
 
 bench: install
-	$(BIN)/python bench/run.py
+	cd bench && ../$(BIN)/python run.py
 
 lint: install
 	$(BIN)/ruff check discovery constraints reports tests bench
