@@ -223,6 +223,21 @@ def _locate(y, K, h, mode, coef, ea, eb, index, th_lo, th_hi, h_lo, h_hi, ybuf, 
     return b
 
 
+@njit(cache=True, inline="always")
+def _record_event(t, y, mode, index, coef, ea, eb, n_ev, ev_t, ev_kind, ev_y, ev_modes):
+    """Store event ``n_ev`` (if there is room) and return the mode after it."""
+    kind = _event_kind(mode, index)
+    new_mode = _mode_after(kind, y, coef, ea, eb)
+    if n_ev < ev_t.shape[0]:
+        ev_t[n_ev] = t
+        ev_kind[n_ev] = kind
+        ev_modes[n_ev, 0] = mode
+        ev_modes[n_ev, 1] = new_mode
+        for j in range(4):
+            ev_y[n_ev, j] = y[j]
+    return new_mode
+
+
 @njit(cache=True)
 def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_steps,
               t_eval, out_y, out_f, out_mode, ev_t, ev_kind, ev_y, ev_modes):
@@ -328,17 +343,9 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
                 if zero_len > 4:
                     status = CHATTER
                     break
-                kind = _event_kind(mode, best_index)
-                new_mode = _mode_after(kind, y, coef, ea, eb)
-                if n_ev < ev_t.shape[0]:
-                    ev_t[n_ev] = t
-                    ev_kind[n_ev] = kind
-                    ev_modes[n_ev, 0] = mode
-                    ev_modes[n_ev, 1] = new_mode
-                    for j in range(4):
-                        ev_y[n_ev, j] = y[j]
+                mode = _record_event(t, y, mode, best_index, coef, ea, eb, n_ev, ev_t,
+                                     ev_kind, ev_y, ev_modes)
                 n_ev += 1
-                mode = new_mode
                 need_f = True
                 need_h0 = True
                 continue
@@ -371,17 +378,9 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
             status = BLOW_UP
             break
         if best_index >= 0:
-            kind = _event_kind(mode, best_index)
-            new_mode = _mode_after(kind, y, coef, ea, eb)
-            if n_ev < ev_t.shape[0]:
-                ev_t[n_ev] = t
-                ev_kind[n_ev] = kind
-                ev_modes[n_ev, 0] = mode
-                ev_modes[n_ev, 1] = new_mode
-                for j in range(4):
-                    ev_y[n_ev, j] = y[j]
+            mode = _record_event(t, y, mode, best_index, coef, ea, eb, n_ev, ev_t, ev_kind,
+                                 ev_y, ev_modes)
             n_ev += 1
-            mode = new_mode
             need_f = True
             need_h0 = True
             # keep the step size that worked before the cut
