@@ -3,15 +3,27 @@
 __all__ = ["model_tex"]
 
 
+_SPECIAL = {"\\": r"\textbackslash{}", "_": r"\_", "%": r"\%", "&": r"\&", "#": r"\#",
+            "$": r"\$", "{": r"\{", "}": r"\}", "^": r"\textasciicircum{}",
+            "~": r"\textasciitilde{}"}
+
+
 def _esc(text):
-    return str(text).replace("_", r"\_").replace("%", r"\%").replace("&", r"\&")
+    """Text safe for LaTeX (special characters escaped)."""
+    return "".join(_SPECIAL.get(ch, ch) for ch in str(text))
+
+
+def _math(v, digits=4):
+    """A number as LaTeX math (no dollars)."""
+    mant, _, exp = f"{v:.{digits - 1}e}".partition("e")
+    return mant if int(exp) == 0 else rf"{mant}\cdot 10^{{{int(exp)}}}"
 
 
 def _num(v, digits=4):
+    """A number for text or tables (in dollars; '--' when missing)."""
     if v is None or v != v:
         return "--"
-    mant, _, exp = f"{v:.{digits - 1}e}".partition("e")
-    return f"${mant}$" if int(exp) == 0 else rf"${mant}\cdot 10^{{{int(exp)}}}$"
+    return f"${_math(v, digits)}$"
 
 
 def model_tex(result, scenario):
@@ -55,8 +67,8 @@ term & coefficient (SI) \\
 \bottomrule
 \end{{tabular}}
 \end{{center}}
-\paragraph{{Certificate.}} {_esc(cert.method)} on $\zeta\in[0,{_num(dom['zeta_max'])}]$ m,
-$\dot\zeta_+\in[0,{_num(dom['zd_max'])}]$ m/s:
+\paragraph{{Certificate.}} {_esc(cert.method)} on $\zeta\in[0,{_math(dom['zeta_max'])}]$ m,
+$\dot\zeta_+\in[0,{_math(dom['zd_max'])}]$ m/s:
 conditions {'hold' if cert.holds else 'DO NOT hold'}, worst relative violation
 {_num(cert.worst_violation)}.
 
