@@ -393,6 +393,9 @@ def main(argv=None):
     except ValueError as exc:  # certificate/validation errors from the packages
         print(f"vidi: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # output piped into e.g. `head`: stop quietly
+        sys.stderr.close()
+        return 0
 
 
 if __name__ == "__main__":

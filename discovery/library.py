@@ -74,7 +74,15 @@ class Library:
             elif part == "hc":
                 lib = cls.hunt_crossley()
             else:
-                lib = cls(tuple(Term.parse(name.strip()) for name in part.split(",")))
+                terms = []
+                for name in part.split(","):
+                    try:
+                        terms.append(Term.parse(name.strip()))
+                    except InputError:
+                        raise InputError(
+                            f"library {spec!r}: {name.strip()!r} is not a term; use poly:N, hc "
+                            "or names like z, zd, z*zd, z^1.5, z^2*zd") from None
+                lib = cls(tuple(terms))
             out = lib if out is None else out + lib
         return out
 
