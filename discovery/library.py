@@ -61,6 +61,8 @@ class Library:
         """Library from a specification (see the module docstring)."""
         if isinstance(spec, Library):
             return spec
+        if hasattr(spec, "powers_") or type(spec).__module__.startswith("pysindy"):
+            return cls.from_pysindy(spec)
         if not isinstance(spec, str) or not spec.strip():
             raise InputError("library must be text like 'poly:3', 'hc' or 'z,zd,z*zd'")
         out = None
@@ -88,18 +90,25 @@ class Library:
 
     @classmethod
     def from_pysindy(cls, feature_library, feature_names=("z", "zd")):
-        """Terms of a *fitted* pysindy polynomial library on the inputs ``(z, zd)``.
+        """Terms of a pysindy polynomial library on the inputs ``(z, zd)``.
 
         Parameters
         ----------
         feature_library : pysindy.PolynomialLibrary
-            Fitted on an array with two columns (``zeta`` and ``zd``).
+            On two inputs (``zeta``, ``zd``); fitted here if it is not yet.
         feature_names : (str, str)
             Names pysindy should use for the two inputs.
         """
         powers = getattr(feature_library, "powers_", None)
         if powers is None:
-            raise InputError("fit the pysindy library on (zeta, zd) samples before converting it")
+            try:  # not fitted yet: only the number of inputs matters for the terms
+                feature_library.fit(np.ones((4, 2)))
+            except Exception as exc:  # noqa: BLE001 - any pysindy failure is a user error here
+                raise InputError(f"cannot use pysindy library {feature_library!r}: {exc}") \
+                    from None
+            powers = getattr(feature_library, "powers_", None)
+        if powers is None:
+            raise InputError("only pysindy polynomial libraries (with powers_) can be converted")
         powers = np.asarray(powers)
         if powers.ndim != 2 or powers.shape[1] != 2:
             raise InputError("the pysindy library must be fitted on exactly two inputs (z, zd)")
