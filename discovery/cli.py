@@ -206,7 +206,8 @@ def _cmd_fit(args):
     res = discover(sc, meas, library=args.library, selection=args.select, score=args.score,
                    max_terms=args.max_terms, criterion=args.criterion,
                    shortlist=args.shortlist, refine=args.refine, stability=args.stability,
-                   derivative=args.derivative, random_state=args.seed, margin=args.margin,
+                   derivative=args.derivative, average_cycles=args.average_cycles,
+                   random_state=args.seed, margin=args.margin,
                    monotone=args.monotone)
     imps = []
     for k, m in enumerate(res.ranking[:3]):
@@ -339,6 +340,8 @@ def _parser():
                    help="bootstrap resamples of impacts for stability selection (0)")
     s.add_argument("--derivative", choices=["velocities", "savgol", "pysindy"],
                    help="source of dzeta (default: velocities if recorded, else savgol)")
+    s.add_argument("--average-cycles", action="store_true",
+                   help="average the steady cycles sample by sample before the regression")
     s.add_argument("--seed", type=int, default=0, help="seed of the stability selection")
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=_cmd_fit)

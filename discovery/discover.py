@@ -120,8 +120,8 @@ def rank(models, criterion="I2", sim_rtol=0.1, sim_atol=0.005):
 
 def discover(scenario, measurement, *, library="poly:2", selection="best-subset", score="bic",
              max_terms=4, criterion="I2", shortlist=8, refine=False, stability=0,
-             derivative=None, sim_rtol=0.1, sim_atol=0.005, tolerances=None, random_state=0,
-             **estimator_kwargs):
+             derivative=None, average_cycles=False, sim_rtol=0.1, sim_atol=0.005,
+             tolerances=None, random_state=0, **estimator_kwargs):
     """Discover a contact law from a measurement and check the candidates by simulation.
 
     Parameters
@@ -143,6 +143,8 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         Bootstrap resamples of impacts for stability selection (0 = skip).
     derivative : str, optional
         How ``dzeta`` is obtained (see :func:`~discovery.samples.contact_samples`).
+    average_cycles : bool
+        Average the steady cycles sample by sample before the regression.
     sim_rtol, sim_atol : float
         Tolerances of the ranking rule.
     tolerances : Tolerances, optional
@@ -158,7 +160,8 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     """
     t0 = time.perf_counter()
     _criterion(criterion)
-    samples = contact_samples(measurement, derivative=derivative)
+    samples = contact_samples(measurement, derivative=derivative,
+                              average_cycles=average_cycles, period=scenario.period)
     measured = measurement.impulse(scenario.period)
     est = ConstrainedSparseRegressor(library=library, selection=selection, score=score,
                                      max_terms=max_terms, **estimator_kwargs)
@@ -182,6 +185,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     settings = {"library": str(library), "selection": selection, "score": score,
                 "max_terms": max_terms, "criterion": criterion, "shortlist": shortlist,
                 "refine": refine, "stability": stability, "derivative": samples.derivative,
+                "average_cycles": average_cycles,
                 "random_state": random_state, "ranking_rule": {"sim_rtol": sim_rtol,
                                                                "sim_atol": sim_atol},
                 "estimator": est.get_params()}

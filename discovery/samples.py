@@ -66,7 +66,35 @@ class ContactSamples:
         return self.zeta.size
 
 
-def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weights="uniform"):
+def _average_steady(t, zeta, dzeta, F, period):
+    """Replace the steady cycles at the end of a record by their sample-wise average.
+
+    Returns ``(t, zeta, dzeta, F, count)`` where ``count`` is how many samples each
+    value stands for (the number of averaged cycles, 1 elsewhere)."""
+    from .impulse import impulse_from_samples
+
+    imp = impulse_from_samples(t, F, period, zeta=zeta)
+    dt = float(np.median(np.diff(t)))
+    m = imp.duration / dt
+    if abs(m - round(m)) > 1e-6 * m:
+        raise InputError("average_cycles needs a whole number of samples per cycle (fs * T "
+                         f"= {m:.6g}); resample the record or do not average")
+    m = int(round(m))
+    i0 = int(np.searchsorted(t, imp.onset - dt))  # one sample before the first steady onset
+    k = min(imp.n_cycles, (t.size - i0) // m)
+    if k < 2:
+        return t, zeta, dzeta, F, np.ones(t.size)
+    sl = slice(i0, i0 + k * m)
+    avg = [a[sl].reshape(k, m).mean(axis=0) for a in (zeta, dzeta, F)]
+    keep = np.arange(t.size) < i0
+    cat = [np.concatenate([a[keep], b]) for a, b in zip((t, zeta, dzeta, F),
+                                                          (t[i0:i0 + m], *avg), strict=True)]
+    count = np.concatenate([np.ones(keep.sum()), np.full(m, float(k))])
+    return (*cat, count)
+
+
+def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weights="uniform",
+                    average_cycles=False, period=None):
     """Contact samples of a :class:`~discovery.measurement.Measurement`.
 
     Parameters
@@ -83,6 +111,13 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
         noise-free data).
     weights : {"uniform", "per-impact"}
         ``"per-impact"`` gives every impact the same total weight.
+    average_cycles : bool
+        Average the steady cycles at the end of the record sample by sample (noise
+        down by the square root of their number) and weight each averaged sample by
+        the number of cycles; run-up impacts are kept as they are.  Needs ``period``
+        and a whole number of samples per cycle.
+    period : float, optional
+        Drive period [s] (for ``average_cycles``).
 
     Returns
     -------
@@ -114,6 +149,11 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
         dzeta = np.asarray(sfd._differentiate(zeta.reshape(-1, 1), t)).ravel()
     F = measurement.F
     sigma = estimate_noise(F)
+    count = np.ones(t.size)
+    if average_cycles:
+        if period is None:
+            raise InputError("average_cycles needs the drive period")
+        t, zeta, dzeta, F, count = _average_steady(t, zeta, dzeta, F, period)
     floor = max(k_sigma * estimate_noise(zeta), 1e-9 * float(np.max(np.abs(zeta))))
     contact = zeta > floor
     if contact.sum() < 10:
@@ -124,10 +164,10 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
     idx = np.flatnonzero(contact)
     impact = impact_all[idx]
     if weights == "uniform":
-        w = np.ones(idx.size)
+        w = count[idx].copy()
     elif weights == "per-impact":
         counts = np.bincount(impact)
-        w = 1.0 / counts[impact]
+        w = count[idx] / counts[impact]
         w *= idx.size / w.sum()
     else:
         raise InputError(f"weights must be 'uniform' or 'per-impact', got {weights!r}")
