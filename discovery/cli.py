@@ -203,7 +203,7 @@ def _cmd_fit(args):
     meas = Measurement.from_csv(args.data, scenario=sc)
     for note in meas.notes:
         print(f"note: {note}")
-    res = discover(sc, meas, library=args.library, selection=args.select, score=args.score,
+    res = discover(sc, meas, library=args.library, selection=args.select, scoring=args.score,
                    max_terms=args.max_terms, criterion=args.criterion,
                    shortlist=args.shortlist, refine=args.refine, stability=args.stability,
                    derivative=args.derivative, average_cycles=args.average_cycles,

@@ -118,7 +118,7 @@ def rank(models, criterion="I2", sim_rtol=0.1, sim_atol=0.005):
     return tier + rest + bad
 
 
-def discover(scenario, measurement, *, library="poly:2", selection="best-subset", score="bic",
+def discover(scenario, measurement, *, library="poly:2", selection="best-subset", scoring="bic",
              max_terms=4, criterion="I2", shortlist=8, refine=False, stability=0,
              derivative=None, average_cycles=False, sim_rtol=0.1, sim_atol=0.005,
              tolerances=None, random_state=0, **estimator_kwargs):
@@ -130,12 +130,12 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         The known part of the machine (masses, supports, drive).
     measurement : Measurement
         Needs ``t``, ``F``, ``w1``, ``w2`` (``v1``, ``v2`` optional).
-    library, selection, score, max_terms
+    library, selection, scoring, max_terms
         Passed to :class:`~discovery.regression.ConstrainedSparseRegressor`.
     criterion : str
         Simulation criterion for the ranking (``I0``..``I4``).
     shortlist : int
-        How many candidates (best by ``score``) are simulated.
+        How many candidates (best by ``scoring``) are simulated.
     refine : bool
         Refine the chosen model's coefficients by identification through simulation
         (least squares on the impulse, starting from the regression).
@@ -163,7 +163,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     samples = contact_samples(measurement, derivative=derivative,
                               average_cycles=average_cycles, period=scenario.period)
     measured = measurement.impulse(scenario.period)
-    est = ConstrainedSparseRegressor(library=library, selection=selection, score=score,
+    est = ConstrainedSparseRegressor(library=library, selection=selection, scoring=scoring,
                                      max_terms=max_terms, **estimator_kwargs)
     est.fit(samples.X, samples.F, groups=samples.impact, sample_weight=samples.weight)
     models = [_check(scenario, est.library_.law(
@@ -182,7 +182,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     cert = est.certify(coef)
     stab = est.stability(samples.X, samples.F, samples.impact, stability, random_state) \
         if stability else {}
-    settings = {"library": str(library), "selection": selection, "score": score,
+    settings = {"library": str(library), "selection": selection, "scoring": scoring,
                 "max_terms": max_terms, "criterion": criterion, "shortlist": shortlist,
                 "refine": refine, "stability": stability, "derivative": samples.derivative,
                 "average_cycles": average_cycles,

@@ -15,6 +15,7 @@ Two constructors:
   and averaging over all complete cycles in the record.
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -226,12 +227,20 @@ def _support_from_events(ev_rel, modes, W):
 
 
 # -------------------------------------------------------------------- samples
-def estimate_noise(F):
-    """Robust noise standard deviation [N] from first differences (MAD)."""
-    d = np.diff(np.asarray(F, dtype=float))
+def estimate_noise(x, order=1):
+    """Robust noise standard deviation of a sampled signal (MAD of differences).
+
+    Differences of order ``k`` cancel a smooth trend (a polynomial of degree < k)
+    while white noise of variance ``s^2`` gives them variance ``C(2k, k) s^2``; the
+    median absolute deviation makes the estimate robust to the few differences that
+    straddle a jump.  Order 1 suits mostly-flat signals (a force record), order 3
+    smooth ones (positions).
+    """
+    d = np.diff(np.asarray(x, dtype=float), n=order)
     if d.size < 2:
         return 0.0
-    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
+    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(math.comb(2 * order,
+                                                                                 order)))
 
 
 def _refine_onset(t, zeta, s, t_on, max_back):
@@ -430,6 +439,9 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
         tail = t_on + tau > t[last]
         vals[tail] = F[last]
         stack.append(vals)
+    steady = _steady_tail(np.array(stack), sigma)
+    stack = [stack[i] for i in steady]
+    mains = [mains[i] for i in steady]
     Fm = np.mean(stack, axis=0)
     # the support of the averaged cycle, whose noise is sigma / sqrt(cycles)
     thr_avg = thr if threshold is not None else max(
@@ -438,6 +450,34 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     return Impulse(t=tau, F=Fm, duration=W, support=support,
                    n_periods=n, onset=float(onsets[mains[0]]), threshold=thr_avg,
                    noise=sigma, n_cycles=len(mains))
+
+
+def _steady_tail(stack, sigma):
+    """Indices of the steady cycles of ``stack`` (n_cycles, m), from the end of the record.
+
+    A cycle is steady when its mean square deviation from the median of the last five
+    cycles is what the noise explains (with a six-sigma allowance for the estimate and
+    0.5 % of the peak for sampling effects), or at most four times the typical
+    deviation of those last cycles (onset jitter at a force jump misaligns every cycle
+    a little).  Walking back from the end, an isolated deviating cycle is left out of
+    the average; three deviating cycles in a row mark the end of the run-up."""
+    n, m = stack.shape
+    last = min(5, n)
+    ref = np.median(stack[-last:], axis=0)
+    peak = float(np.max(np.abs(ref))) or 1.0
+    dev = np.mean((stack - ref) ** 2, axis=1)
+    expected = 2.0 * sigma**2 * (1.0 + 6.0 * np.sqrt(2.0 / m)) + (0.005 * peak) ** 2
+    limit = max(expected, 4.0 * float(np.median(dev[-last:])))
+    keep, misses = [], 0
+    for k in range(n - 1, -1, -1):
+        if dev[k] <= limit:
+            keep.append(k)
+            misses = 0
+        else:
+            misses += 1
+            if misses == 3:
+                break
+    return sorted(keep) or [n - 1]
 
 
 def _first_after(t, F, t_on, thr, exact_onset):

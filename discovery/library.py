@@ -86,6 +86,9 @@ class Library:
                             "or names like z, zd, z*zd, z^1.5, z^2*zd") from None
                 lib = cls(tuple(terms))
             out = lib if out is None else out + lib
+        if out is None:
+            raise InputError(f"library {spec!r} names no terms; write e.g. 'poly:2', 'hc' or "
+                             "'z,zd,z*zd'")
         return out
 
     @classmethod

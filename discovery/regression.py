@@ -143,10 +143,22 @@ class _Problem:
         support's columns, so the cvxpy problem has k x k data whatever n is."""
         Q, R = np.linalg.qr(self.A[:, idx])
         qb = Q.T @ self.b
+        M = self.M[:, idx]
+        rows = np.abs(M).max(axis=1) > 0  # rows that vanish on this support: offset only
+        if np.any(self.off[~rows] < -1e-12):
+            raise SolverError("a constraint cannot hold with these terms (a margin needs a "
+                              "term it acts on)", status="infeasible", solver=self.solver)
+        norms = np.abs(M[rows]).max(axis=1)
+        M, off = M[rows] / norms[:, None], self.off[rows] / norms
         x = cp.Variable(len(idx))
-        prob = cp.Problem(cp.Minimize(cp.sum_squares(R @ x - qb)),
-                          [self.M[:, idx] @ x + self.off >= 0])
-        solve(prob, self.solver)
+        prob = cp.Problem(cp.Minimize(cp.sum_squares(R @ x - qb)), [M @ x + off >= 0])
+        try:
+            solve(prob, self.solver)
+        except SolverError:
+            # one more interior/first-order solver before giving up (then it raises)
+            solve(prob, "OSQP" if self.solver != "OSQP" else "CLARABEL",
+                  **({"eps_abs": 1e-10, "eps_rel": 1e-10, "max_iter": 200000}
+                     if self.solver != "OSQP" else {}))
         self.n_solves += 1
         xv = np.asarray(x.value, dtype=float)
         r = self.A[:, idx] @ xv - self.b
@@ -180,7 +192,7 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         Candidate terms, e.g. ``"poly:2"``, ``"poly:3+hc"``, ``"z,zd,z*zd"``.
     selection : str
         One of :data:`SELECTIONS`.
-    score : {"bic", "aic", "cv"}
+    scoring : {"bic", "aic", "cv"}
         How the final support is chosen among the candidates.
     max_terms : int
         Largest support considered by ``best-subset``.
@@ -214,7 +226,7 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
     support_ : ndarray of shape (n_terms,), bool
     law_ : ForceLaw
     candidates_ : list of Candidate
-        One per proposed support, best first by ``score``.
+        One per proposed support, best first by ``scoring``.
     certificate_ : constraints.Certificate
     n_features_in_ : int
         2 (``zeta``, ``dzeta``).
@@ -223,12 +235,12 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
     fit_seconds_ : float
     """
 
-    def __init__(self, library="poly:2", selection="best-subset", score="bic", max_terms=4, cv=5,
+    def __init__(self, library="poly:2", selection="best-subset", scoring="bic", max_terms=4, cv=5,
                  margin=0.0, monotone=False, signs=None, box_margin=0.1, elevation=2,
                  threshold=0.05, n_lambdas=30, solver="CLARABEL", grid=1001):
         self.library = library
         self.selection = selection
-        self.score = score
+        self.scoring = scoring
         self.max_terms = max_terms
         self.cv = cv
         self.margin = margin
@@ -270,6 +282,11 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         w = np.ones(y.size) if sample_weight is None else np.asarray(sample_weight, float)
         groups = np.arange(y.size) if groups is None else np.asarray(groups)
         self.library_ = Library.parse(self.library)
+        if self.signs is not None:
+            sg = np.atleast_1d(np.asarray(self.signs))
+            if sg.size not in (1, len(self.library_)) or not np.all(np.isin(sg, (-1, 0, 1))):
+                raise InputError(f"signs must be one of -1, 0, +1 or one per library term "
+                                 f"({len(self.library_)}); got {self.signs!r}")
         zp = np.maximum(X[:, 0], 0.0)
         vp = np.maximum(X[:, 1], 0.0)
         if not (zp.max() > 0 and vp.max() > 0):
@@ -294,7 +311,7 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
                 rss=float(rss), bic=float(bic), aic=float(aic), cv_error=float(e),
                 constrained=bool(active)))
         key = {"bic": lambda c: c.bic, "aic": lambda c: c.aic, "cv": lambda c: c.cv_error}
-        self.candidates_.sort(key=key[self.score])
+        self.candidates_.sort(key=key[self.scoring])
         best = self.candidates_[0]
         self.coef_ = np.array([best.coefficients.get(t.name, 0.0) for t in self.library_.terms])
         self.support_ = self.coef_ != 0
@@ -317,14 +334,19 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         if self.selection not in SELECTIONS:
             raise InputError(f"selection must be one of {', '.join(SELECTIONS)}; got "
                              f"{self.selection!r}")
-        if self.score not in SCORES:
-            raise InputError(f"score must be one of {', '.join(SCORES)}; got {self.score!r}")
+        if self.scoring not in SCORES:
+            raise InputError(f"scoring must be one of {', '.join(SCORES)}; got {self.scoring!r}")
         if not (isinstance(self.max_terms, int | np.integer) and self.max_terms >= 1):
             raise InputError(f"max_terms must be a positive integer; got {self.max_terms!r}")
         if not (isinstance(self.cv, int | np.integer) and self.cv >= 2):
             raise InputError(f"cv must be an integer >= 2; got {self.cv!r}")
-        if not self.margin >= 0:
-            raise InputError(f"margin must be >= 0 (N s/m); got {self.margin!r}")
+        if not (isinstance(self.margin, int | float | np.number) and self.margin >= 0):
+            raise InputError(f"margin must be a number >= 0 (N s/m); got {self.margin!r}")
+        if not (isinstance(self.box_margin, int | float | np.number) and self.box_margin >= 0):
+            raise InputError(f"box_margin must be a number >= 0 (the box must contain the "
+                             f"data); got {self.box_margin!r}")
+        if not (isinstance(self.elevation, int | np.integer) and self.elevation >= 0):
+            raise InputError(f"elevation must be an integer >= 0; got {self.elevation!r}")
 
     def _problem(self, X, y, w):
         return _Problem(self.library_, self.box_, X, y, w, margin=self.margin,
@@ -361,10 +383,7 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
                     if rss < best_rss:
                         best_rss, best_idx = rss, idx
                     break  # feasible and smallest remaining unconstrained RSS
-                try:
-                    _, crss = prob.constrained(idx)
-                except SolverError:
-                    continue
+                _, crss = prob.constrained(idx)  # a solver failure raises: never skipped
                 if crss < best_rss:
                     best_rss, best_idx = crss, idx
             if best_idx is not None:

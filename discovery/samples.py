@@ -38,7 +38,8 @@ class ContactSamples:
     impact : ndarray of shape (n,), int
         Index of the impact each sample belongs to.
     weight : ndarray of shape (n,)
-        Regression weights (mean 1).
+        Regression weights: how many recorded samples each sample stands for (1, or the
+        number of averaged cycles with ``average_cycles``), or equal totals per impact.
     noise : float
         Estimated force noise standard deviation [N].
     derivative : str
@@ -107,8 +108,8 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
         Samples in the differentiation window (odd, >= 5).
     k_sigma : float
         A sample counts as in contact when ``zeta > k_sigma * sigma_zeta`` (noise level
-        of ``zeta`` from :func:`~discovery.impulse.estimate_noise`; a tiny floor for
-        noise-free data).
+        of ``zeta`` from third differences, :func:`~discovery.impulse.estimate_noise`;
+        a tiny floor for noise-free data).
     weights : {"uniform", "per-impact"}
         ``"per-impact"`` gives every impact the same total weight.
     average_cycles : bool
@@ -154,7 +155,8 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
         if period is None:
             raise InputError("average_cycles needs the drive period")
         t, zeta, dzeta, F, count = _average_steady(t, zeta, dzeta, F, period)
-    floor = max(k_sigma * estimate_noise(zeta), 1e-9 * float(np.max(np.abs(zeta))))
+    # third differences: the smooth motion cancels, only the measurement noise remains
+    floor = max(k_sigma * estimate_noise(zeta, order=3), 1e-9 * float(np.max(np.abs(zeta))))
     contact = zeta > floor
     if contact.sum() < 10:
         raise InputError("fewer than 10 contact samples (zeta = w1 - w2 > 0 above its noise); "

@@ -1,0 +1,119 @@
+"""End-to-end tests of ``vidi fit`` (discovery from a CSV record)."""
+
+import csv
+import json
+
+import pytest
+
+from discovery.cli import main
+
+FIGURES = ("fit_impulse", "fit_surface", "fit_loop")
+
+
+@pytest.fixture(scope="module")
+def record(tmp_path_factory):
+    path = tmp_path_factory.mktemp("fitrec") / "runup.csv"
+    assert main(["simulate", "--from-rest", "--periods", "150", "--noise", "0.01",
+                 "--out", str(path)]) == 0
+    return path
+
+
+@pytest.fixture(scope="module")
+def fitted(record, tmp_path_factory):
+    out = tmp_path_factory.mktemp("fitout") / "fit"
+    rc = main(["fit", "--data", str(record), "--library", "poly:2", "--out", str(out)])
+    return rc, out
+
+
+def test_fit_exit_code_and_files(fitted):
+    rc, out = fitted
+    assert rc == 0
+    for name in ("summary.json", "ranking.csv", "model.tex",
+                 *(f"{f}.{ext}" for f in FIGURES for ext in ("png", "pdf"))):
+        assert (out / name).stat().st_size > 0, name
+    assert (out / "fit_impulse.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (out / "fit_surface.pdf").read_bytes()[:5] == b"%PDF-"
+
+
+def test_fit_summary_contents(fitted):
+    _, out = fitted
+    s = json.loads((out / "summary.json").read_text())
+    sel = s["selected"]
+    for key in ("terms", "coefficients", "latex", "criteria"):
+        assert key in sel
+    assert sel["terms"] == ["z", "zd"]  # the run-up record identifies law (11)
+    # 150 periods from rest, 1 % noise: coefficients within 3 % (measured 0.2 %)
+    assert abs(sel["coefficients"]["z"] / 2.06e8 - 1) < 0.03
+    assert abs(sel["coefficients"]["zd"] / 1.28e7 - 1) < 0.03
+    assert set(sel["criteria"]) == {"I0", "I1", "I2", "I3", "I4"}
+    assert isinstance(s["ranking"], list) and s["ranking"]
+    assert s["ranking"][0]["terms"] == sel["terms"]
+    for m in s["ranking"]:
+        assert "bic" in m and "cv_error" in m
+        assert 0 <= m["cv_error"] < 1  # relative RMS of held-out impacts
+    cert = s["certificate"]
+    for key in ("method", "holds", "worst_violation", "domain"):
+        assert key in cert
+    assert cert["holds"] is True and cert["worst_violation"] <= 1e-7
+    assert cert["domain"]["zeta_max"] > 0 and cert["domain"]["zd_max"] > 0
+    assert s["seconds"] > 0
+    assert s["command"] == "fit"
+
+
+def test_fit_ranking_csv_matches_summary(fitted):
+    _, out = fitted
+    s = json.loads((out / "summary.json").read_text())
+    rows = list(csv.DictReader((out / "ranking.csv").read_text().splitlines()))
+    assert len(rows) == len(s["ranking"])
+    assert [int(r["rank"]) for r in rows] == list(range(1, len(rows) + 1))
+    assert rows[0]["terms"] == " + ".join(s["selected"]["terms"])
+    # bic written with 8 significant digits
+    for r, m in zip(rows, s["ranking"], strict=True):
+        assert float(r["bic"]) == pytest.approx(m["bic"], rel=1e-7)
+
+
+def test_model_tex_names_the_law(fitted):
+    tex = (fitted[1] / "model.tex").read_text()
+    assert "zeta" in tex
+
+
+def _assert_clean_failure(argv, out, capsys, needle=None):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err and "\n" not in err and "Traceback" not in err
+    if needle:
+        assert needle in err, err
+    assert not out.exists()
+    assert not list(out.parent.glob(f".{out.name}*"))  # no staged leftovers
+
+
+@pytest.mark.parametrize("library, needle", [("poly:2+q", "'q'"), ("z,zd,w", "'w'"),
+                                             ("poly:0", "poly:N")])
+def test_bad_library_exit_2_without_output(record, tmp_path, capsys, library, needle):
+    out = tmp_path / "o"
+    _assert_clean_failure(["fit", "--data", str(record), "--library", library,
+                           "--out", str(out)], out, capsys, needle)
+
+
+def test_data_without_positions_exit_2_without_output(record, tmp_path, capsys):
+    lines = record.read_text().splitlines()
+    header = lines[0].split(",")
+    keep = [header.index("t"), header.index("F")]
+    bad = tmp_path / "tF.csv"
+    bad.write_text("\n".join(",".join(line.split(",")[j] for j in keep)
+                             for line in lines[:4001]) + "\n")
+    out = tmp_path / "o"
+    _assert_clean_failure(["fit", "--data", str(bad), "--out", str(out)], out, capsys,
+                          "w1 and w2")
+
+
+def test_bad_max_terms_exit_2(record, tmp_path, capsys):
+    out = tmp_path / "o"
+    _assert_clean_failure(["fit", "--data", str(record), "--max-terms", "0",
+                           "--out", str(out)], out, capsys, "max_terms")
+
+
+def test_library_of_only_plus_exit_2(record, tmp_path, capsys):
+    out = tmp_path / "o"
+    _assert_clean_failure(["fit", "--data", str(record), "--library", "+",
+                           "--out", str(out)], out, capsys)

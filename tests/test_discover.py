@@ -1,0 +1,144 @@
+"""Discovery pipeline (discovery.discover): regression, simulation check, ranking."""
+
+import math
+
+import pytest
+
+from discovery.discover import RankedModel, discover, rank
+from discovery.errors import InputError
+from discovery.law import ForceLaw
+from discovery.measurement import synthesize
+from discovery.regression import Candidate
+
+RTOL, ATOL = 0.1, 0.005  # discover()'s default ranking rule
+
+
+@pytest.fixture(scope="module")
+def runup(paper):
+    """300 periods of law (11) from rest, 1 % force noise."""
+    return synthesize(paper, paper.law, periods=300, fs=20000, noise=0.01, seed=0,
+                      from_rest=True)
+
+
+@pytest.fixture(scope="module")
+def result(paper, runup):
+    return discover(paper, runup, library="poly:3")
+
+
+@pytest.fixture(scope="module")
+def refined(paper, runup):
+    return discover(paper, runup, library="poly:3", refine=True)
+
+
+def test_selects_true_support_p1_and_certified(result, paper):
+    sel = result.selected
+    assert sel.law.names == ["z", "zd"]
+    # run-up records with 1 % noise: coefficients within 2 % (measured 1.0 %)
+    for name, true in paper.law.as_dict().items():
+        assert abs(sel.law.as_dict()[name] / true - 1) < 0.02
+    assert sel.regime == "P1"
+    assert set(sel.criteria) == {"I0", "I1", "I2", "I3", "I4"}
+    assert result.certificate.holds and result.certificate.worst_violation <= 1e-7
+    # the certificate is on the data's box
+    assert result.certificate.domain["zeta_max"] >= result.samples.zeta.max()
+    assert result.certificate.domain["zd_max"] >= result.samples.dzeta.max()
+
+
+def test_selected_follows_the_ranking_rule(result):
+    ranked = [m for m in result.ranking if m.criteria]
+    assert len(ranked) >= 2
+    best = min(m.criteria["I2"] for m in ranked)
+    limit = max(best * (1 + RTOL), best + ATOL)
+    sel = result.selected
+    assert sel is result.ranking[0]
+    assert sel.criteria["I2"] <= limit
+    # among the models equivalent by simulation, the smallest BIC
+    tier = [m for m in ranked if m.criteria["I2"] <= limit]
+    assert sel.candidate.bic == min(m.candidate.bic for m in tier)
+    # the whole ranking: tier by BIC, then the others by I2, then models without criteria
+    n = len(tier)
+    assert [m.candidate.bic for m in result.ranking[:n]] == sorted(m.candidate.bic for m in tier)
+    rest = result.ranking[n:len(ranked)]
+    assert [m.criteria["I2"] for m in rest] == sorted(m.criteria["I2"] for m in rest)
+    assert all(not m.criteria for m in result.ranking[len(ranked):])
+
+
+def test_result_bookkeeping(result):
+    assert result.seconds > 0
+    assert result.settings["library"] == "poly:3"
+    assert result.settings["estimator"]["library"] == "poly:3"
+    assert result.refinement is None and result.stability == {}
+    # every ranked model comes from a regression candidate
+    terms = {c.terms for c in result.estimator.candidates_}
+    assert all(tuple(m.law.names) in terms for m in result.ranking)
+
+
+def test_refine_never_makes_the_criterion_worse(result, refined):
+    assert refined.refinement is not None
+    before = result.selected.criteria["I2"]
+    after = refined.selected.criteria["I2"]
+    assert after <= before
+    # same support, and the refinement stays physical here
+    assert refined.selected.law.names == result.selected.law.names
+    assert refined.certificate.holds
+
+
+def test_bad_criterion_raises(paper, runup):
+    with pytest.raises(InputError):
+        discover(paper, runup, criterion="I9")
+
+
+# ---------------------------------------------------------------- rank()
+
+
+def _model(name, bic, i2=None, regime="P1"):
+    cand = Candidate(terms=(name,), coefficients={name: 1.0}, rss=1.0, bic=bic, aic=bic)
+    crit = {} if i2 is None else {"I0": i2, "I1": i2, "I2": i2, "I3": i2, "I4": i2}
+    return RankedModel(ForceLaw.parse(f"1*{name}"), cand, regime, crit)
+
+
+def _names(models):
+    return [m.law.names[0] for m in models]
+
+
+def test_rank_nonperiodic_last_even_with_best_bic():
+    models = [_model("z", -100.0, None, "nonperiodic"),
+              _model("zd", 10.0, 0.5),
+              _model("z*zd", 0.0, 0.05)]
+    assert _names(rank(models)) == ["z*zd", "zd", "z"]
+
+
+def test_rank_tier_by_bic_then_criterion():
+    models = [_model("z", 5.0, 0.100),      # best I2
+              _model("zd", 1.0, 0.109),     # within 10 %: equivalent, lower BIC wins
+              _model("z*zd", -50.0, 0.200),  # outside: after the tier despite best BIC
+              _model("zd^2", -60.0, 0.150),  # outside, smaller I2 than z*zd
+              _model("z^2", -70.0, None, "no-contact")]
+    assert _names(rank(models)) == ["zd", "z", "zd^2", "z*zd", "z^2"]
+
+
+def test_rank_absolute_tolerance_for_small_criteria():
+    # best 1e-3: 10 % would be 1.1e-3, but the absolute 5e-3 makes 5.5e-3 equivalent
+    models = [_model("z", 3.0, 0.001), _model("zd", 2.0, 0.0055), _model("z*zd", 1.0, 0.0061)]
+    assert _names(rank(models)) == ["zd", "z", "z*zd"]
+    assert _names(rank(models, sim_atol=0.0)) == ["z", "zd", "z*zd"]
+
+
+def test_rank_without_any_periodic_model_orders_by_bic():
+    models = [_model("z", 2.0, None, "nonperiodic"), _model("zd", 1.0, None, "P2-no-contact")]
+    assert _names(rank(models)) == ["zd", "z"]
+
+
+def test_rank_uses_the_requested_criterion():
+    a, b = _model("z", 1.0, 0.1), _model("zd", 2.0, 0.1)
+    a = RankedModel(a.law, a.candidate, "P1", {**a.criteria, "I3": 0.9})
+    assert _names(rank([a, b], criterion="I3")) == ["zd", "z"]
+    assert _names(rank([a, b], criterion="I2")) == ["z", "zd"]
+
+
+def test_rank_keeps_every_model():
+    models = [_model(n, float(i), None if i % 3 == 0 else 0.1 * i)
+              for i, n in enumerate(["z", "zd", "z^2", "z*zd", "zd^2", "z^3"])]
+    out = rank(models)
+    assert sorted(_names(out)) == sorted(_names(models)) and len(out) == len(models)
+    assert all(not math.isnan(m.candidate.bic) for m in out)

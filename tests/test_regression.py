@@ -1,0 +1,337 @@
+"""Sparse certified regression (discovery.regression.ConstrainedSparseRegressor)."""
+
+import itertools
+import warnings
+
+import numpy as np
+import pytest
+
+from constraints import certify
+from constraints.errors import SolverError
+from discovery.errors import InputError
+from discovery.law import ForceLaw
+from discovery.library import Library
+from discovery.measurement import synthesize
+from discovery.regression import SELECTIONS, ConstrainedSparseRegressor
+from discovery.samples import contact_samples
+
+LAW11 = "2.06e8*z + 1.28e7*zd"
+LAW11_ZZD = "2.06e8*z + 1.28e7*zd + 2e10*z*zd"
+HC = "2e10*z^1.5 + 5e11*z^1.5*zd"
+LIB = "poly:3+hc"
+
+CASES = [("paper", LAW11), ("paper", LAW11_ZZD), ("light", HC)]
+
+
+@pytest.fixture(scope="module")
+def clean(paper, light):
+    """Noise-free steady-state records (20 periods) of the three laws: contact samples."""
+    sc = {"paper": paper, "light": light}
+    return {(s, law): contact_samples(synthesize(sc[s], ForceLaw.parse(law), periods=20))
+            for s, law in CASES}
+
+
+@pytest.fixture(scope="module")
+def clean_fits(clean):
+    return {k: ConstrainedSparseRegressor(library=LIB).fit(cs.X, cs.F, groups=cs.impact)
+            for k, cs in clean.items()}
+
+
+def _rel_errors(law_text, est):
+    true = ForceLaw.parse(law_text).as_dict()
+    got = est.law_.as_dict()
+    assert set(got) == set(true), (got, true)
+    return {k: abs(got[k] / v - 1) for k, v in true.items()}
+
+
+# ------------------------------------------------------------------ noise-free
+
+
+@pytest.mark.parametrize("case", CASES, ids=["paper-11", "paper-11+zzd", "light-hc"])
+def test_noise_free_exact_support_and_coefficients(case, clean_fits):
+    est = clean_fits[case]
+    err = _rel_errors(case[1], est)
+    # the data are the law to integrator/rounding precision (measured ~1e-12): 1e-6 relative
+    assert max(err.values()) < 1e-6, err
+    assert est.certificate_.holds
+    assert est.support_.sum() == len(err)
+    np.testing.assert_array_equal(est.coef_ != 0, est.support_)
+
+
+@pytest.mark.parametrize("case", CASES, ids=["paper-11", "paper-11+zzd", "light-hc"])
+def test_every_candidate_is_certified(case, clean_fits):
+    est = clean_fits[case]
+    assert len(est.candidates_) >= 2
+    for c in est.candidates_:
+        coef = np.array([c.coefficients.get(n, 0.0) for n in est.library_.names])
+        cert = est.certify(coef)
+        assert cert.holds and cert.worst_violation <= 1e-7, (c.terms, cert.worst_violation)
+    # candidates are sorted by the score (bic)
+    bics = [c.bic for c in est.candidates_]
+    assert bics == sorted(bics)
+
+
+@pytest.mark.parametrize("selection", SELECTIONS)
+@pytest.mark.parametrize("case", CASES, ids=["paper-11", "paper-11+zzd", "light-hc"])
+def test_every_selection_method_returns_a_certified_law(case, selection, clean):
+    cs = clean[case]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        est = ConstrainedSparseRegressor(library=LIB, selection=selection, grid=201)
+        est.fit(cs.X, cs.F, groups=cs.impact)
+    assert est.certificate_.holds
+    # on noise-free data every method fits the force to ~1e-6 of its scale (measured
+    # <= 1e-9 relative RMS; spurious tiny terms of pysindy methods change nothing)
+    r = est.predict(cs.X) - cs.F
+    assert np.sqrt(np.mean(r**2)) < 1e-6 * np.sqrt(np.mean(cs.F**2))
+    # the exact support and coefficients by best-subset and, on the paper, by the l1 path
+    if selection == "best-subset" or (selection == "l1-path" and case[0] == "paper"):
+        assert max(_rel_errors(case[1], est).values()) < 1e-6
+
+
+# --------------------------------------------------------------- noisy run-up
+
+
+def _runup(sc, law, periods, noise, seed):
+    m = synthesize(sc, ForceLaw.parse(law), periods=periods, fs=20000, noise=noise, seed=seed,
+                   from_rest=True)
+    return contact_samples(m)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case, periods", [(CASES[0], 300), (CASES[1], 300), (CASES[2], 30)],
+                         ids=["paper-11", "paper-11+zzd", "light-hc"])
+def test_one_percent_noise_over_20_seeds(case, periods, paper, light):
+    sc = {"paper": paper, "light": light}[case[0]]
+    true = ForceLaw.parse(case[1]).as_dict()
+    exact, worst = 0, 0.0
+    for seed in range(20):
+        cs = _runup(sc, case[1], periods, 0.01, seed)
+        est = ConstrainedSparseRegressor(library=LIB, grid=201).fit(cs.X, cs.F, groups=cs.impact)
+        assert est.certificate_.holds
+        got = est.law_.as_dict()
+        if set(got) == set(true):
+            exact += 1
+            worst = max(worst, max(abs(got[k] / v - 1) for k, v in true.items()))
+    # run-up records identify the terms: measured 20/20, 20/20, 19/20 exact supports and
+    # worst errors 1.7 %, 1.94 %, 0.26 %; the specification is >= 95 % and <= 2 %
+    assert exact >= 19, exact
+    assert worst <= 0.02, worst
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_five_percent_noise_fit_is_certified(seed, paper, light):
+    for sc, law, periods in ((paper, LAW11_ZZD, 300), (light, HC, 30)):
+        cs = _runup(sc, law, periods, 0.05, seed)
+        est = ConstrainedSparseRegressor(library=LIB).fit(cs.X, cs.F, groups=cs.impact)
+        cert = est.certificate_
+        # support may be wrong at 5 %; the conditions never break (tolerance: the
+        # certificate's own 1e-7 of the force scale)
+        assert cert.holds and cert.worst_violation <= 1e-7, (law, seed, cert.worst_violation)
+        # certificate covers the data: the box contains every sample
+        assert cs.zeta.max() <= est.box_.zeta_max and cs.dzeta.max() <= est.box_.zd_max
+
+
+def test_noise_on_second_scenario_recovers_hunt_crossley(light):
+    cs = _runup(light, HC, 30, 0.01, 1)
+    est = ConstrainedSparseRegressor(library=LIB).fit(cs.X, cs.F, groups=cs.impact)
+    # measured 0.26 % worst over 19 exact seeds; 1 % allows for platform differences
+    assert max(_rel_errors(HC, est).values()) < 0.01
+
+
+# ------------------------------------------------------- constraints are needed
+
+
+@pytest.fixture(scope="module")
+def hc_wrong_library(light, light_ss):
+    """Hunt-Crossley data fitted with a library that lacks z^1.5: the unconstrained
+    least squares on the full support goes non-dissipative / adhesive."""
+    cs = contact_samples(synthesize(light, light.law, periods=20, ss=light_ss))
+    est = ConstrainedSparseRegressor(library="z,z^2,zd,z*zd").fit(cs.X, cs.F, groups=cs.impact)
+    return cs, est
+
+
+def test_constrained_fit_certified_where_unconstrained_lstsq_is_not(hc_wrong_library):
+    cs, est = hc_wrong_library
+    full = [c for c in est.candidates_ if c.size == 4]
+    assert len(full) == 1
+    cand = full[0]
+    assert cand.constrained  # a constraint was active at the solution
+    lib = Library.parse(",".join(cand.terms))
+    coef = np.array([cand.coefficients[n] for n in lib.names])
+    conditions = ["non_adhesion", "dissipativity"]
+    ok = certify(coef, lib.exponents, est.box_, conditions)
+    assert ok.holds and ok.worst_violation <= 1e-7
+    # plain numpy least squares on the same support breaks a condition by far more than
+    # the 1e-7 tolerance (measured 7 % of the force scale)
+    x = np.linalg.lstsq(lib.transform(cs.X), cs.F, rcond=None)[0]
+    bad = certify(x, lib.exponents, est.box_, conditions)
+    assert not bad.holds and bad.worst_violation > 1e-3
+    # the price of the constraints: a larger residual, never a smaller one
+    r_unc = float(np.sum((lib.transform(cs.X) @ x - cs.F) ** 2))
+    assert cand.rss >= r_unc * (1 - 1e-9)
+
+
+def test_selected_law_of_wrong_library_is_certified(hc_wrong_library):
+    _, est = hc_wrong_library
+    assert est.certificate_.holds and est.certificate_.worst_violation <= 1e-7
+
+
+# ------------------------------------------------------------ best-subset exact
+
+
+def _unphysical_data(seed=0, n=400):
+    """Data from a non-dissipative polynomial (negative zd term): many supports need the
+    constraints, so the branch and bound has real work."""
+    rng = np.random.default_rng(seed)
+    z = rng.uniform(0, 1e-3, n)
+    v = rng.uniform(-0.5, 0.5, n)
+    zd = np.maximum(v, 0)
+    y = 2e8 * z - 4e6 * zd + 3e10 * z * zd + 1e11 * z**2 + rng.normal(0, 2e3, n)
+    return np.column_stack([z, v]), y
+
+
+def _reference_constrained_rss(prob, idx):
+    """Certified least squares on a support, solved independently of the estimator:
+    cvxpy + Clarabel with the same rows (rows that vanish on the support removed)."""
+    import cvxpy as cp
+
+    from constraints import solve
+
+    x, rss = prob.precise(idx)
+    if prob.feasible(idx, x):
+        return rss
+    Q, R = np.linalg.qr(prob.A[:, idx])
+    keep = np.abs(prob.M[:, idx]).max(axis=1) > 0
+    xv = cp.Variable(len(idx))
+    pr = cp.Problem(cp.Minimize(cp.sum_squares(R @ xv - Q.T @ prob.b)),
+                    [prob.M[keep][:, idx] @ xv + prob.off[keep] >= 0])
+    solve(pr, "CLARABEL")
+    r = prob.A[:, idx] @ xv.value - prob.b
+    return float(r @ r)
+
+
+@pytest.mark.parametrize("source", ["unphysical", "hc-on-poly2"])
+def test_best_subset_is_exact_against_brute_force(source, light):
+    if source == "unphysical":
+        X, y = _unphysical_data(1)
+        groups = None
+    else:
+        cs = _runup(light, HC, 30, 0.01, 3)
+        X, y, groups = cs.X, cs.F, cs.impact
+    est = ConstrainedSparseRegressor(library="poly:2", max_terms=3).fit(X, y, groups=groups)
+    prob = est._problem(X, y, np.ones(len(y)))
+    n = len(est.library_)
+    n_active = 0
+    for k in (1, 2, 3):
+        rss = {}
+        for s in itertools.combinations(range(n), k):
+            rss[s] = _reference_constrained_rss(prob, list(s))
+            n_active += not prob.feasible(list(s), prob.precise(list(s))[0])
+        best = min(rss.values())
+        cand = [c for c in est.candidates_ if c.size == k]
+        assert len(cand) == 1
+        # same objective to the interior-point accuracy (~1e-8 relative): 1e-6
+        assert cand[0].rss / prob.fscale**2 <= best * (1 + 1e-6), (k, cand[0].terms)
+    assert n_active > 0  # the constraints mattered for some subsets
+
+
+def test_constrained_solve_on_support_with_vanishing_rows():
+    X, y = _unphysical_data(0)
+    est = ConstrainedSparseRegressor(library="poly:2", max_terms=3).fit(X, y)
+    prob = est._problem(X, y, np.ones(len(y)))
+    idx = [est.library_.names.index(n) for n in ("z", "z^2", "zd^2")]
+    x, rss, active = prob.fit_support(idx)
+    assert active
+    assert rss == pytest.approx(_reference_constrained_rss(prob, idx), rel=1e-6)
+
+
+# ---------------------------------------------------------- predict, score, ...
+
+
+def test_predict_is_the_law_and_the_library_model(clean_fits, clean):
+    key = ("paper", LAW11_ZZD)
+    est, cs = clean_fits[key], clean[key]
+    rng = np.random.default_rng(0)
+    X = np.column_stack([rng.uniform(-1e-4, 3e-4, 500), rng.uniform(-1, 1, 500)])
+    p = est.predict(X)
+    # contact conditions: no force without contact, never adhesive
+    assert np.all(p[X[:, 0] <= 0] == 0) and np.all(p >= 0)
+    np.testing.assert_array_equal(p, est.law_(X[:, 0], X[:, 1]))
+    # in contact (and where P >= 0) predict is Theta @ coef_: the law and the library
+    # agree term by term; relative 1e-12 covers summation order
+    inside = X[:, 0] > 0
+    lin = est.library_.transform(X) @ est.coef_
+    np.testing.assert_allclose(p[inside], np.maximum(lin[inside], 0), rtol=1e-12,
+                               atol=1e-12 * np.abs(lin).max())
+    # on the training samples predict reproduces F (noise-free) to 1e-9 of peak force
+    assert np.abs(est.predict(cs.X) - cs.F).max() < 1e-9 * cs.F.max()
+
+
+def test_score_is_r2(light):
+    cs = _runup(light, HC, 30, 0.05, 0)
+    est = ConstrainedSparseRegressor(library="poly:2").fit(cs.X, cs.F, groups=cs.impact)
+    r = cs.F - est.predict(cs.X)
+    r2 = 1 - np.sum(r**2) / np.sum((cs.F - cs.F.mean()) ** 2)
+    assert est.score(cs.X, cs.F) == pytest.approx(r2, rel=1e-12)
+    assert 0.5 < r2 < 1.0  # wrong library + 5 % noise: a meaningful, imperfect fit
+
+
+def test_stability_frequencies(paper):
+    cs = _runup(paper, LAW11, 60, 0.01, 0)
+    est = ConstrainedSparseRegressor(library="poly:2")
+    freq = est.stability(cs.X, cs.F, cs.impact, n_resamples=10, random_state=0)
+    assert list(freq) == Library.parse("poly:2").names
+    assert all(0.0 <= f <= 1.0 for f in freq.values())
+    # easy data: the true terms are in every resample's support
+    assert freq["z"] == 1.0 and freq["zd"] == 1.0
+    # ... and the spurious ones are not always selected
+    assert max(freq[k] for k in ("z^2", "z*zd", "zd^2")) < 1.0
+    # deterministic for a fixed random_state
+    assert est.stability(cs.X, cs.F, cs.impact, n_resamples=10, random_state=0) == freq
+
+
+# --------------------------------------------------------------- bad input
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(selection="foo"), "selection"),
+    (dict(scoring="x"), "scoring"),
+    (dict(max_terms=0), "max_terms"),
+    (dict(max_terms=2.5), "max_terms"),
+    (dict(cv=1), "cv"),
+    (dict(margin=-1), "margin"),
+    (dict(library="poly:0"), "poly"),
+])
+def test_bad_parameters_raise_input_error_naming_them(kwargs, name):
+    X, y = _unphysical_data(0, 50)
+    with pytest.raises(InputError, match=name):
+        ConstrainedSparseRegressor(**kwargs).fit(X, y)
+
+
+@pytest.mark.parametrize("kwargs, name", [(dict(signs=[1, 1]), "signs"),
+                                          (dict(margin="x"), "margin")])
+def test_more_bad_parameters_raise_input_error(kwargs, name):
+    X, y = _unphysical_data(0, 50)
+    with pytest.raises(InputError, match=name):
+        ConstrainedSparseRegressor(**kwargs).fit(X, y)
+
+
+def test_certificate_box_always_contains_the_data():
+    X, y = _unphysical_data(0, 200)
+    try:
+        est = ConstrainedSparseRegressor(library="poly:1", box_margin=-0.5).fit(X, y)
+    except InputError:
+        return
+    assert X[:, 0].max() <= est.box_.zeta_max and X[:, 1].max() <= est.box_.zd_max
+
+
+@pytest.mark.parametrize("X, y", [
+    (np.zeros((5, 3)), np.zeros(5)),
+    (np.zeros((5, 2)), np.zeros(4)),
+    (np.array([[1e-4, 0.1], [2e-4, np.nan], [3e-4, 0.2]]), np.ones(3)),
+    (np.column_stack([-np.ones(5), np.ones(5)]), np.ones(5)),   # never in contact
+])
+def test_bad_data_raise_input_error(X, y):
+    with pytest.raises(InputError):
+        ConstrainedSparseRegressor().fit(X, y)
