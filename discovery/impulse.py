@@ -94,7 +94,8 @@ class Impulse:
         else:
             i = np.clip(np.searchsorted(t, q, "left") - 1, 0, len(t) - 2)
         t0, t1 = t[i], t[i + 1]
-        w = np.where(t1 > t0, (q - t0) / np.where(t1 > t0, t1 - t0, 1.0), 1.0 if side == "left" else 0.0)
+        at_jump = 1.0 if side == "left" else 0.0
+        w = np.where(t1 > t0, (q - t0) / np.where(t1 > t0, t1 - t0, 1.0), at_jump)
         return F[i] + np.clip(w, 0.0, 1.0) * (F[i + 1] - F[i])
 
     def resampled_like(self, other):

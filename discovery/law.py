@@ -219,7 +219,10 @@ class ForceLaw:
         )
 
     def latex(self, digits=4):
-        """LaTeX of ``F`` for ``zeta > 0`` in law order (``\\dot\\zeta_+ = max(\\dot\\zeta, 0)``)."""
+        """LaTeX of ``F`` for ``zeta > 0``, in law order.
+
+        ``\\dot\\zeta_+`` stands for ``max(dzeta, 0)``.
+        """
         out = []
         for c, t in zip(self.coefficients, self.terms, strict=True):
             mant, _, exp = f"{abs(c):.{digits - 1}e}".partition("e")

@@ -3,11 +3,12 @@
 ``zeta = w1 - w2`` from the positions; ``dzeta`` from the velocities when recorded,
 otherwise by Savitzky-Golay differentiation of ``zeta`` (a local cubic fit, robust
 to noise) or pysindy's smoothed finite differences.  A sample is a *contact
-sample* when ``zeta`` is clearly positive, so no sample of free flight enters the fit.  Contact is decided on ``zeta`` (above its own noise level), never on
-the force: selecting on the dependent variable would bias the fit (samples whose
-noise happens to push them over a force threshold would be kept, the others not).
-Each sample carries the index of its impact, so cross-validation
-and bootstrap resample whole impacts.
+sample* when ``zeta`` is clearly positive, so no sample of free flight enters the
+fit.  Contact is decided on ``zeta`` (above its own noise level), never on the
+force: selecting on the dependent variable would bias the fit (samples whose noise
+happens to push them over a force threshold would be kept, the others not).  Each
+sample carries the index of its impact, so cross-validation and bootstrap resample
+whole impacts.
 """
 
 from dataclasses import dataclass

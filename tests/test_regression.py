@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 from constraints import certify
-from constraints.errors import SolverError
 from discovery.errors import InputError
 from discovery.law import ForceLaw
 from discovery.library import Library

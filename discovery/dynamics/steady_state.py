@@ -244,7 +244,8 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
                 continue
             # the smallest divisor period that also closes the orbit
             for m in range(1, n):
-                if n % m == 0 and np.max(np.abs(pm.advance(y_orb, m) - y_orb) / pm.scale) < 10 * tol:
+                closes = np.max(np.abs(pm.advance(y_orb, m) - y_orb) / pm.scale) < 10 * tol
+                if n % m == 0 and closes:
                     # polish at the reduced period: its own residual and Jacobian
                     y_m, res_m, J_m, ok_m = _newton(pm, y_orb, m, tol, max_newton, [])
                     if ok_m:
