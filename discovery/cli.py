@@ -309,7 +309,7 @@ def _parser():
                    help="record from the initial state (run-up with impacts at many "
                    "velocities, then the steady state) instead of on the periodic orbit")
     s.add_argument("--position-noise", type=float, default=0.0,
-                   help="Gaussian noise on w1, w2 as a fraction of max |w1 - w2| (0)")
+                   help="Gaussian noise on w1, w2 as a fraction of the largest penetration (0)")
     s.add_argument("--no-velocities", action="store_true",
                    help="leave out the v1, v2 columns (discovery then differentiates w1 - w2)")
     s.add_argument("--out", required=True, help="output CSV (t, F, w1, v1, w2, v2)")

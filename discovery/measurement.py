@@ -166,7 +166,7 @@ def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None
         orbit.  Either way the drive phase at ``t = 0`` is zero.
     position_noise : float
         Gaussian noise on ``w1`` and ``w2`` with standard deviation
-        ``position_noise * max |w1 - w2|``.
+        ``position_noise * max(w1 - w2)`` (a fraction of the largest penetration).
     velocities : bool
         Include the ``v1``, ``v2`` channels.
 
@@ -196,7 +196,7 @@ def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None
         F = F + rng.normal(0.0, noise * float(np.max(F)), size=F.shape)
     ch = dict(zip(_STATE, (v.copy() for v in tr.y), strict=True))
     if position_noise > 0:
-        sd = position_noise * float(np.max(np.abs(ch["w1"] - ch["w2"])))
+        sd = position_noise * float(np.max(ch["w1"] - ch["w2"]))  # of the largest penetration
         ch["w1"] += rng.normal(0.0, sd, n)
         ch["w2"] += rng.normal(0.0, sd, n)
     if not velocities:
