@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from constraints import require
+
 from .criteria import criterion as _criterion
 from .criteria import evaluate_criteria
 from .errors import IntegrationError
@@ -104,6 +106,12 @@ def _check(scenario, law, candidate, measured, tolerances):
     return RankedModel(law, candidate, r.regime, evaluate_criteria(measured, r.like(measured)))
 
 
+def _coefficients(law, library):
+    """Coefficient vector of ``law`` over ``library`` (zeros for absent terms)."""
+    d = law.as_dict()
+    return np.array([d.get(t.name, 0.0) for t in library.terms])
+
+
 def rank(models, criterion="I2", sim_rtol=0.1, sim_atol=0.005):
     """Order checked models by the ranking rule of the module docstring."""
     ok = [m for m in models if m.criteria]
@@ -138,7 +146,8 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         How many candidates (best by ``scoring``) are simulated.
     refine : bool
         Refine the chosen model's coefficients by identification through simulation
-        (least squares on the impulse, starting from the regression).
+        (least squares on the impulse, starting from the regression); the refined law
+        is kept only if it is better by simulation and still certified.
     stability : int
         Bootstrap resamples of impacts for stability selection (0 = skip).
     derivative : str, optional
@@ -172,14 +181,20 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     ranking = rank(models, criterion, sim_rtol, sim_atol)
     selected = ranking[0]
     refinement = None
+    # the certificate of the law actually selected (the ranking may prefer another
+    # candidate than the estimator's best by BIC); a failure is an error
+    cert = require(est.certify(_coefficients(selected.law, est.library_)))
     if refine and selected.criteria:
         refinement = identify(scenario, measured, selected.law, criterion=criterion,
                               method="least-squares")
-        if refinement.criteria and refinement.value < selected.criteria[criterion]:
+        refined_cert = est.certify(_coefficients(refinement.law, est.library_))
+        # the refined law replaces the fit only if it is better by simulation AND still
+        # satisfies the physical conditions on the whole box
+        if (refinement.criteria and refinement.value < selected.criteria[criterion]
+                and refined_cert.holds):
             selected = RankedModel(refinement.law, selected.candidate, selected.regime,
                                    refinement.criteria)
-    coef = np.array([selected.law.as_dict().get(t.name, 0.0) for t in est.library_.terms])
-    cert = est.certify(coef)
+            cert = refined_cert
     stab = est.stability(samples.X, samples.F, samples.impact, stability, random_state) \
         if stability else {}
     settings = {"library": str(library), "selection": selection, "scoring": scoring,

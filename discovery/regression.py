@@ -31,7 +31,7 @@ import cvxpy as cp
 import numpy as np
 from sklearn.base import BaseEstimator, RegressorMixin
 
-from constraints import Box, bernstein_map, certify, solve
+from constraints import Box, bernstein_map, certify, require, solve
 from constraints.errors import SolverError
 
 from .errors import InputError
@@ -316,7 +316,8 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         self.coef_ = np.array([best.coefficients.get(t.name, 0.0) for t in self.library_.terms])
         self.support_ = self.coef_ != 0
         self.law_ = self.library_.law(self.coef_)
-        self.certificate_ = self.certify(self.coef_)
+        # a law that breaks a condition anywhere in the box is an error, never a warning
+        self.certificate_ = require(self.certify(self.coef_))
         self.n_solves_ = prob.n_solves
         self.fit_seconds_ = time.perf_counter() - t0
         return self
