@@ -31,7 +31,7 @@ import cvxpy as cp
 import numpy as np
 from sklearn.base import BaseEstimator, RegressorMixin
 
-from constraints import Box, bernstein_map, certify, require, solve
+from constraints import Box, bernstein_map, certify, require, scale_factors, solve
 from constraints.errors import SolverError
 
 from .errors import InputError
@@ -87,7 +87,7 @@ class _Problem:
     def __init__(self, library, box, X, y, w, *, margin, monotone, signs, elevation, solver):
         self.library, self.box = library, box
         exps = library.exponents
-        self.scale = box.zeta_max ** exps[:, 0] * box.zd_max ** exps[:, 1]
+        self.scale = scale_factors(exps, box)  # Z^a V^b: each term's value at the far corner
         theta = library.transform(X)
         self.fscale = float(np.sqrt(np.average(y**2, weights=w))) or 1.0
         sw = np.sqrt(w)
