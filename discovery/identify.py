@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares, minimize
 
-from .criteria import criterion, evaluate_criteria
+from .criteria import compare, criterion, evaluate_criteria
 from .errors import InputError, IntegrationError
 from .response import response
 
@@ -83,6 +83,10 @@ class _Objective:
         self.cache = {}
         self.best = (np.inf, None)
         self.path = []
+        # residual weights: trapezoid-like sample spacing, normalised so that the sum
+        # of squared residuals is I3^2
+        E = measured
+        self.w = np.sqrt(np.gradient(E.t) / max(np.trapezoid(E.F**2, E.t), 1e-300))
 
     def law(self, x):
         return self.start.with_coefficients(self.c0 * np.asarray(x))
@@ -105,8 +109,6 @@ class _Objective:
         imp = self.impulse(x)
         if imp is None:
             return _PENALTY
-        from .criteria import compare
-
         v = float(self.func(compare(self.measured, imp)))
         if v < self.best[0]:
             self.best = (v, np.array(x, dtype=float))
@@ -116,8 +118,7 @@ class _Objective:
 
     def residuals(self, x):
         imp = self.impulse(x)
-        E = self.measured
-        w = np.sqrt(np.gradient(E.t) / max(np.trapezoid(E.F**2, E.t), 1e-300))
+        E, w = self.measured, self.w
         if imp is None:
             return (np.full(E.t.size, _PENALTY) * w * max(np.max(np.abs(E.F)), 1.0))[1:]
         self(x)  # records the path with the requested criterion

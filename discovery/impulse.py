@@ -19,6 +19,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.ndimage import uniform_filter1d
 
 from .dynamics import _kernel as K
 from .dynamics.simulate import simulate
@@ -276,8 +277,6 @@ def _sampled_support(tau, F, thr, period, noise=0.0):
     by a moving average over 1 % of a period, so noise near a flat tail does not stretch
     the support by chance crossings of the threshold (the measured and the simulated
     cycle go through the same operator; a smoothed edge moves by up to half a window)."""
-    from scipy.ndimage import uniform_filter1d
-
     min_len, max_extrap = _edge_params(tau, period)
     dt = tau[2] - tau[1]
     width = max(1, int(0.01 * period / dt)) | 1 if noise > thr / 100.0 else 1
@@ -321,8 +320,7 @@ def _edges(t, F, thr, min_len, max_extrap=4.0, noise=0.0):
         f0, f1 = F[s - 1], F[s]
         steep = f1 - f0 > 3.0 * noise
         lo = -max_extrap if steep else 0.0
-        frac = np.clip((thr if not steep else 0.0) - f0, None, None) / (f1 - f0) \
-            if f1 > f0 else 1.0
+        frac = ((0.0 if steep else thr) - f0) / (f1 - f0) if f1 > f0 else 1.0
         t_on = t[s - 1] + float(np.clip(frac, lo, 1.0)) * (t[s] - t[s - 1])
         g0, g1 = F[e - 1], F[e]
         steep = g0 - g1 > 3.0 * noise

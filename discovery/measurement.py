@@ -14,6 +14,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ._io import atomic_write_text
+from .dynamics import simulate
+from .dynamics.steady_state import steady_state
 from .errors import InputError
 from .impulse import impulse_from_samples
 
@@ -174,9 +176,6 @@ def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None
     -------
     Measurement
     """
-    from .dynamics import simulate
-    from .dynamics.steady_state import steady_state
-
     if not (periods >= 1 and fs > 0 and noise >= 0 and position_noise >= 0):
         raise InputError("periods must be >= 1, fs > 0 and the noise levels >= 0")
     n = int(round(periods * scenario.period * fs))

@@ -17,7 +17,7 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from .errors import InputError
-from .impulse import estimate_noise
+from .impulse import estimate_noise, impulse_from_samples
 
 __all__ = ["ContactSamples", "contact_samples"]
 
@@ -73,8 +73,6 @@ def _average_steady(t, zeta, dzeta, F, period):
 
     Returns ``(t, zeta, dzeta, F, count)`` where ``count`` is how many samples each
     value stands for (the number of averaged cycles, 1 elsewhere)."""
-    from .impulse import impulse_from_samples
-
     imp = impulse_from_samples(t, F, period, zeta=zeta)
     dt = float(np.median(np.diff(t)))
     m = imp.duration / dt

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import IntegrationError
 from . import _kernel as K
-from .simulate import Tolerances, _atol
+from .simulate import Tolerances, _atol, simulate
 
 __all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
 
@@ -262,7 +262,5 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
 
 
 def _count_onsets(scenario, law, tol, y0, t0, n):
-    from .simulate import simulate
-
     tr = simulate(scenario, law, (t0, t0 + n * scenario.period), y0=y0, tolerances=tol)
     return int(np.sum(tr.event_kind == K.EV_ONSET))
