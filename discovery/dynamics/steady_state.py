@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import IntegrationError
 from . import _kernel as K
-from .simulate import Tolerances, _atol, simulate
+from .simulate import _STATUS, Tolerances, _atol, simulate
 
 __all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
 
@@ -63,10 +63,14 @@ class StroboscopicMap:
             self._evk, self._evy, self._evm)
         self.n_calls += 1
         self.n_steps += steps
-        if status != K.OK or not np.all(np.abs(yf) < 1e6 * self.scale.max() + 1e3):
+        if status != K.OK:
+            raise IntegrationError(f"simulation of law '{self.law}' stopped at t = {tf:.6g} s: "
+                                   f"{_STATUS[status]}")
+        if not np.all(np.abs(yf) < 1e6 * self.scale.max() + 1e3):
             raise IntegrationError(
-                f"simulation of law '{self.law}' failed at t = {tf:.6g} s "
-                f"(status {status}); the law may be unphysical (negative or huge coefficients)")
+                f"simulation of law '{self.law}' left the physical range at t = {tf:.6g} s "
+                "(a displacement over 1e6 times the drive's scale); the law or the scenario "
+                "may be unphysical (negative or huge coefficients, a moulding thrown away)")
         return yf
 
     def jacobian(self, y, n=1, fy=None):
@@ -178,9 +182,37 @@ def _newton(pm, y, n, tol, max_iter, history):
     return y, res, J, converged
 
 
+def _reduce_period(pm, y_orb, n, tol, max_newton):
+    """The smallest period ``m | n`` of a stable period-``n`` orbit through ``y_orb``.
+
+    Each divisor ``m`` is tested by polishing: damped Newton on ``Phi^m(y) = y`` from
+    ``y_orb``.  The orbit has period ``m`` when that converges to a *stable* fixed point
+    of ``Phi^m`` close to ``y_orb`` (two attracting fixed points of ``Phi^n`` cannot be
+    arbitrarily close).  The decision therefore rests on the accuracy Newton reaches at
+    each divisor, never on a fixed closure threshold: a period-1 orbit with a Floquet
+    multiplier near +1 or -1 closes after one period only to the accuracy that shooting
+    at ``n`` reached, which can be far above ``tol``.  Near a period doubling the nearby
+    period-``m`` orbit is unstable (a multiplier below -1), so it is not taken.
+
+    Returns ``(m, y, residual, J)`` or ``None`` when no divisor closes the orbit.
+    """
+    for m in range(1, n):
+        if n % m:
+            continue
+        hist = []
+        y_m, res_m, J_m, ok_m = _newton(pm, y_orb, m, tol, max_newton, hist)
+        if not ok_m:
+            continue
+        mult = np.linalg.eigvals(J_m)
+        close = np.max(np.abs(y_m - y_orb) / pm.scale) < 1e-3
+        if close and np.all(np.abs(mult) < 1.0):
+            return m, y_m, res_m, J_m, hist
+    return None
+
+
 def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_newton=12,
-                 long_transient=300, tolerances=None, y_start=None):
-    """Find the periodic steady state reached from the scenario's initial state.
+                 long_transient=300, tolerances=None, y_start=None, t_start=0.0):
+    """Find the periodic steady state reached from a given (or the scenario's) state.
 
     Parameters
     ----------
@@ -199,17 +231,34 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
     tolerances : Tolerances, optional
         Integrator settings.
     y_start : array_like of shape (4,), optional
-        Initial state (default the scenario's).
+        Initial state ``(w1, v1, w2, v2)`` (default the scenario's).  To follow the
+        attractor a machine is on, pass its measured state (see
+        :meth:`~discovery.measurement.Measurement.state_at`).
+    t_start : float
+        Time [s] at which ``y_start`` holds, on the drive's clock (the drive is
+        ``A sin(2 pi f t)``, phase 0 at ``t = 0``); it need not be a multiple of ``T``.
 
     Returns
     -------
     SteadyState
         ``regime == "nonperiodic"`` when no stable periodic orbit was found.
+
+    Raises
+    ------
+    IntegrationError
+        When a simulation fails (blow-up, step budget): a failure is never reported
+        as the physical regime "nonperiodic".
     """
     pm = StroboscopicMap(scenario, law, tolerances)
     y = scenario.initial_state() if y_start is None else np.asarray(y_start, dtype=float)
-    evidence = {"attempts": []}
-    t_done = 0
+    T = scenario.period
+    evidence = {"attempts": [], "t_start": float(t_start)}
+    k0 = int(np.ceil(t_start / T - 1e-9))
+    if abs(t_start - k0 * T) > 1e-12 * T:
+        # integrate to the next strobe time (drive phase 0)
+        tr = simulate(scenario, law, (t_start, k0 * T), y0=y, tolerances=pm.tol)
+        y = tr.y_final
+    t_done = k0
     for phase, n_trans in (("transient", transient), ("long-transient", long_transient)):
         y = pm.advance(y, n_trans)
         t_done += n_trans
@@ -242,21 +291,18 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
                                      "stable": stable})
             if not stable:
                 continue
-            # the smallest divisor period that also closes the orbit
-            for m in range(1, n):
-                closes = np.max(np.abs(pm.advance(y_orb, m) - y_orb) / pm.scale) < 10 * tol
-                if n % m == 0 and closes:
-                    # polish at the reduced period: its own residual and Jacobian
-                    y_m, res_m, J_m, ok_m = _newton(pm, y_orb, m, tol, max_newton, [])
-                    if ok_m:
-                        n, y_orb, res, mult = m, y_m, res_m, np.linalg.eigvals(J_m)
-                    break
-            t0 = t_done * scenario.period
+            reduced = _reduce_period(pm, y_orb, n, tol, max_newton) if n > 1 else None
+            if reduced is not None:
+                m, y_orb, res, J, hist_m = reduced
+                attempt["tried"].append({"n": m, "reduced_from": n, "newton_residuals": hist_m,
+                                         "converged": True, "stable": True})
+                n, mult = m, np.linalg.eigvals(J)
+            t0 = t_done * T
             impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n)
             return SteadyState(regime=f"P{n}", n_periods=n, y0=y_orb, t0=t0, impacts=impacts,
                                multipliers=mult, residual=float(res),
                                n_simulations=pm.n_calls, evidence=evidence)
-    return SteadyState(regime="nonperiodic", n_periods=0, y0=y, t0=t_done * scenario.period,
+    return SteadyState(regime="nonperiodic", n_periods=0, y0=y, t0=t_done * T,
                        impacts=0, multipliers=np.full(4, np.nan + 0j), residual=float("nan"),
                        n_simulations=pm.n_calls, evidence=evidence)
 
