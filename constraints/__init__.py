@@ -23,6 +23,7 @@ verify
 solver
     :func:`solve`, a cvxpy wrapper that raises on any non-optimal status.
 errors
+    :class:`VidiError` (root of the project's one error hierarchy), :class:`InputError`,
     :class:`CertificateError`, :class:`SolverError`.
 """
 
@@ -36,13 +37,16 @@ from .bernstein import (
 )
 from .builders import (
     coefficient_signs,
+    constraint_rows,
     dissipativity,
     monotone_elastic,
     non_adhesion,
+    normalized_rows,
     physical,
+    sign_rows,
 )
 from .domain import Box
-from .errors import CertificateError, SolverError
+from .errors import CertificateError, InputError, SolverError, VidiError
 from .library import evaluate, exponents, features, scale_factors, to_physical, to_scaled
 from .solver import solve
 from .verify import (
@@ -63,11 +67,14 @@ __all__ = [
     "Box",
     "Certificate",
     "CertificateError",
+    "InputError",
     "SolverError",
+    "VidiError",
     "bernstein_coefficients",
     "bernstein_map",
     "certify",
     "coefficient_signs",
+    "constraint_rows",
     "dissipativity",
     "evaluate",
     "evaluate_bernstein",
@@ -78,9 +85,11 @@ __all__ = [
     "lattice_factor",
     "monotone_elastic",
     "non_adhesion",
+    "normalized_rows",
     "physical",
     "require",
     "scale_factors",
+    "sign_rows",
     "solve",
     "to_physical",
     "to_scaled",

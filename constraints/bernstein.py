@@ -51,6 +51,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .domain import Box
+from .errors import InputError
 from .library import Library, exponents, to_scaled
 
 __all__ = [
@@ -104,7 +105,7 @@ def lattice_factor(values: Sequence[float] | np.ndarray, max_factor: int = MAX_L
         for v in vals
         if all(abs(q * v - round(q * v)) > _LATTICE_TOL for q in range(1, max_factor + 1))
     ]
-    raise ValueError(
+    raise InputError(
         f"exponents {bad or list(vals)} are not rationals with denominator <= {max_factor} "
         "(jointly); the Bernstein certificate needs q * exponent integer for some q <= "
         f"{max_factor}"
@@ -127,7 +128,7 @@ def monomial_bernstein(power: int, degree: int) -> np.ndarray:
         ``C(k, i) / C(n, i)`` for ``k >= i``, else 0 (exact binomials, rounded once).
     """
     if power < 0 or degree < power:
-        raise ValueError(f"need 0 <= power <= degree, got power={power}, degree={degree}")
+        raise InputError(f"need 0 <= power <= degree, got power={power}, degree={degree}")
     denominator = math.comb(degree, power)
     return np.array(
         [math.comb(k, power) / denominator if k >= power else 0.0 for k in range(degree + 1)]
@@ -175,7 +176,7 @@ def evaluate_bernstein(coefficients: ArrayLike, s: ArrayLike, u: ArrayLike | Non
     if coef.ndim == 1:
         return bs @ coef
     if u is None:
-        raise ValueError("a bivariate Bernstein form needs both s and u")
+        raise InputError("a bivariate Bernstein form needs both s and u")
     bu = bernstein_basis(coef.shape[1] - 1, u)
     return np.einsum("pk,kl,pl->p", bs, coef, bu)
 
@@ -263,11 +264,11 @@ def check_margin(library: Library | np.ndarray, margin: float) -> float:
     """
     value = float(margin)
     if not math.isfinite(value) or value < 0.0:
-        raise ValueError(f"margin must be a finite number >= 0 [N s/m], got {margin!r}")
+        raise InputError(f"margin must be a finite number >= 0 [N s/m], got {margin!r}")
     if value > 0.0:
         exps = exponents(library)
         if not np.any((exps[:, 0] == 0.0) & (exps[:, 1] > 0.0) & (exps[:, 1] <= 1.0)):
-            raise ValueError(
+            raise InputError(
                 f"dissipativity margin {value:g} N s/m is impossible for library "
                 f"{[tuple(map(float, e)) for e in exps]}: Q(zeta, zd) = sum_(b>0) c zeta^a "
                 "zd^(b-1) vanishes at zeta = 0 (zd -> 0) unless a term has a = 0 and "
@@ -278,12 +279,12 @@ def check_margin(library: Library | np.ndarray, margin: float) -> float:
 
 def _check_condition(condition: str) -> None:
     if condition not in CONDITIONS:
-        raise ValueError(f"unknown condition {condition!r}; expected one of {CONDITIONS}")
+        raise InputError(f"unknown condition {condition!r}; expected one of {CONDITIONS}")
 
 
 def _check_elevation(elevation: int) -> int:
     if isinstance(elevation, bool) or int(elevation) != elevation or elevation < 0:
-        raise ValueError(f"elevation must be an integer >= 0, got {elevation!r}")
+        raise InputError(f"elevation must be an integer >= 0, got {elevation!r}")
     return int(elevation)
 
 
@@ -326,7 +327,7 @@ def bernstein_map(
     a, b = exps[:, 0], exps[:, 1]
     margin = check_margin(exps, margin) if condition == "dissipativity" else float(margin)
     if condition != "dissipativity" and margin != 0.0:
-        raise ValueError(f"margin applies to dissipativity only, got margin={margin!r}")
+        raise InputError(f"margin applies to dissipativity only, got margin={margin!r}")
 
     if condition == "monotone_elastic":
         active = b == 0.0

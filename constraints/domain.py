@@ -8,6 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .errors import InputError
+
 __all__ = ["Box"]
 
 
@@ -15,9 +17,9 @@ def _check_positive(name: str, value: object) -> float:
     try:
         number = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a positive finite number, got {value!r}") from None
+        raise InputError(f"{name} must be a positive finite number, got {value!r}") from None
     if not math.isfinite(number) or number <= 0.0:
-        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+        raise InputError(f"{name} must be a positive finite number, got {value!r}")
     return number
 
 
@@ -71,15 +73,15 @@ class Box:
         """
         margin_value = float(margin)
         if not math.isfinite(margin_value) or margin_value < 0.0:
-            raise ValueError(f"margin must be a finite number >= 0, got {margin!r}")
+            raise InputError(f"margin must be a finite number >= 0, got {margin!r}")
         bounds = {}
         for name, field, data in (("zeta", "zeta_max", zeta), ("zd", "zd_max", zd)):
             values = np.asarray(data, dtype=float).ravel()
             if not np.all(np.isfinite(values)):
-                raise ValueError(f"{name} contains non-finite values; cannot build a Box")
+                raise InputError(f"{name} contains non-finite values; cannot build a Box")
             top = float(np.max(values, initial=0.0))
             if top <= 0.0:
-                raise ValueError(f"{name} has no strictly positive sample; cannot infer {field}")
+                raise InputError(f"{name} has no strictly positive sample; cannot infer {field}")
             bounds[field] = top * (1.0 + margin_value)
         return cls(**bounds)
 

@@ -3,14 +3,29 @@
 A law that breaks a physical condition anywhere on the domain, or a solver run that does not
 end in an optimal status, is always an error: nothing is downgraded to a warning and no
 coefficient is silently zeroed.
+
+:class:`VidiError` is the root of the one error hierarchy of the project: it is defined
+here, in the lower-level package, and :mod:`discovery.errors` re-exports it (``constraints``
+never imports ``discovery``). Every error of both packages is therefore catchable as
+``VidiError`` (the CLI turns it into a one-line message and exit code 2), and as the
+builtin it specialises (``ValueError`` for bad input and failed certificates,
+``RuntimeError`` for failed solves).
 """
 
 from __future__ import annotations
 
-__all__ = ["CertificateError", "SolverError"]
+__all__ = ["VidiError", "InputError", "CertificateError", "SolverError"]
 
 
-class CertificateError(ValueError):
+class VidiError(Exception):
+    """Base class of the errors the CLI reports as a one-line message (exit code 2)."""
+
+
+class InputError(VidiError, ValueError):
+    """A user-supplied value, file or option is invalid."""
+
+
+class CertificateError(VidiError, ValueError):
     """A fitted law violates (or could not be certified for) a physical condition.
 
     Parameters
@@ -40,7 +55,7 @@ class CertificateError(ValueError):
         self.violation = violation
 
 
-class SolverError(RuntimeError):
+class SolverError(VidiError, RuntimeError):
     """A cvxpy problem did not end with an accepted status.
 
     Parameters

@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .domain import Box
+from .errors import InputError
 
 __all__ = [
     "Library",
@@ -55,27 +56,27 @@ def exponents(library: Library | np.ndarray) -> np.ndarray:
     """
     entries = list(library)
     if not entries:
-        raise ValueError("library is empty; it needs at least one (a, b) term")
+        raise InputError("library is empty; it needs at least one (a, b) term")
     out = np.empty((len(entries), 2))
     seen: dict[tuple[float, float], int] = {}
     for index, entry in enumerate(entries):
         try:
             a, b = (float(v) for v in entry)
         except (TypeError, ValueError):
-            raise ValueError(
+            raise InputError(
                 f"library entry {index} = {entry!r} is not a pair of numbers (a, b)"
             ) from None
         if not (math.isfinite(a) and math.isfinite(b)) or a < 0.0 or b < 0.0:
-            raise ValueError(
+            raise InputError(
                 f"library entry {index} = ({a}, {b}): exponents must be finite and >= 0"
             )
         if a == 0.0 and b == 0.0:
-            raise ValueError(
+            raise InputError(
                 f"library entry {index} = (0, 0) is a constant term, which is never allowed: "
                 "a contact force must vanish at zeta = 0, zd = 0"
             )
         if (a, b) in seen:
-            raise ValueError(f"library entry {index} = ({a}, {b}) repeats entry {seen[(a, b)]}")
+            raise InputError(f"library entry {index} = ({a}, {b}) repeats entry {seen[(a, b)]}")
         seen[(a, b)] = index
         out[index] = (a, b)
     out.setflags(write=False)
@@ -104,11 +105,11 @@ def scale_factors(library: Library | np.ndarray, box: Box) -> np.ndarray:
 def _coefficients(coef: ArrayLike, n_terms: int, name: str = "coef") -> np.ndarray:
     values = np.asarray(coef, dtype=float)
     if values.shape != (n_terms,):
-        raise ValueError(
+        raise InputError(
             f"{name} must have shape ({n_terms},) to match the library, got {values.shape}"
         )
     if not np.all(np.isfinite(values)):
-        raise ValueError(f"{name} contains non-finite values: {values}")
+        raise InputError(f"{name} contains non-finite values: {values}")
     return values
 
 
@@ -153,9 +154,9 @@ def _state(zeta: ArrayLike, zd: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     v = np.asarray(zd, dtype=float)
     for name, values in (("zeta", z), ("zd", v)):
         if not np.all(np.isfinite(values)):
-            raise ValueError(f"{name} contains non-finite values")
+            raise InputError(f"{name} contains non-finite values")
         if np.any(values < 0.0):
-            raise ValueError(
+            raise InputError(
                 f"{name} has negative values (min {values.min():.3g}); the law is defined "
                 "on zeta >= 0, zd = max(dzeta/dt, 0) >= 0"
             )

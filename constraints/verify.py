@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike
 
 from .bernstein import CONDITIONS, bernstein_map, check_margin
 from .domain import Box
-from .errors import CertificateError
+from .errors import CertificateError, InputError
 from .library import Library, exponents, to_scaled
 
 __all__ = [
@@ -104,7 +104,7 @@ class Certificate:
 def _grid_shape(grid: int | Sequence[int]) -> tuple[int, int]:
     sizes = (grid, grid) if np.ndim(grid) == 0 else tuple(grid)
     if len(sizes) != 2 or any(isinstance(n, bool) or int(n) != n or int(n) < 2 for n in sizes):
-        raise ValueError(f"grid must be an integer >= 2 or a pair of them, got {grid!r}")
+        raise InputError(f"grid must be an integer >= 2 or a pair of them, got {grid!r}")
     return int(sizes[0]), int(sizes[1])
 
 
@@ -197,7 +197,7 @@ def grid_minimum(
         ``(zeta [m], zd [m/s])`` where it is reached.
     """
     if condition not in CONDITIONS:
-        raise ValueError(f"unknown condition {condition!r}; expected one of {CONDITIONS}")
+        raise InputError(f"unknown condition {condition!r}; expected one of {CONDITIONS}")
     margin = check_margin(library, margin) if condition == "dissipativity" else 0.0
     shape = _grid_shape(grid)
     x, exps = _scaled(coef, library, box)
@@ -261,13 +261,13 @@ def certify(
     """
     names = (conditions,) if isinstance(conditions, str) else tuple(conditions)
     if not names:
-        raise ValueError("conditions is empty; name at least one of " + ", ".join(CONDITIONS))
+        raise InputError("conditions is empty; name at least one of " + ", ".join(CONDITIONS))
     for name in names:
         if name not in CONDITIONS:
-            raise ValueError(f"unknown condition {name!r}; expected one of {CONDITIONS}")
+            raise InputError(f"unknown condition {name!r}; expected one of {CONDITIONS}")
     tol = float(tol)
     if not math.isfinite(tol) or tol < 0.0:
-        raise ValueError(f"tol must be a finite number >= 0, got {tol!r}")
+        raise InputError(f"tol must be a finite number >= 0, got {tol!r}")
     shape = _grid_shape(grid)
     x, exps = _scaled(coef, library, box)
     scale = force_scale(coef, exps, box, grid=shape, chunk_rows=chunk_rows)

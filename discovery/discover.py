@@ -195,7 +195,8 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
             selected = RankedModel(refinement.law, selected.candidate, selected.regime,
                                    refinement.criteria)
             cert = refined_cert
-    stab = est.stability(samples.X, samples.F, samples.impact, stability, random_state) \
+    stab = est.stability(samples.X, samples.F, samples.impact, stability, random_state,
+                         sample_weight=samples.weight) \
         if stability else {}
     settings = {"library": str(library), "selection": selection, "scoring": scoring,
                 "max_terms": max_terms, "criterion": criterion, "shortlist": shortlist,

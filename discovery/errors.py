@@ -2,17 +2,17 @@
 
 Every error message is one line naming the problem and the fix; the CLI turns
 :class:`VidiError` subclasses into exit code 2 without a traceback.
+
+One hierarchy: :class:`VidiError` and :class:`InputError` are defined in
+:mod:`constraints.errors` (the lower-level package, which never imports ``discovery``) and
+re-exported here, so the constraints package's :class:`~constraints.errors.SolverError` and
+:class:`~constraints.errors.CertificateError` are ``VidiError`` subclasses too.
 """
 
-__all__ = ["VidiError", "InputError", "LawSyntaxError", "IntegrationError"]
+from constraints.errors import CertificateError, InputError, SolverError, VidiError
 
-
-class VidiError(Exception):
-    """Base class of the errors the CLI reports as a one-line message (exit code 2)."""
-
-
-class InputError(VidiError, ValueError):
-    """A user-supplied value, file or option is invalid."""
+__all__ = ["VidiError", "InputError", "LawSyntaxError", "IntegrationError", "CertificateError",
+           "SolverError"]
 
 
 class LawSyntaxError(InputError):

@@ -10,6 +10,11 @@ and dissipativity (6), optionally a monotone elastic branch and coefficient sign
 They are imposed through Bernstein certificates (:mod:`constraints`) as linear
 constraints of a cvxpy problem, and every selected law is verified independently on
 a dense grid.  A solver failure raises with the solver's status; nothing is zeroed.
+A support on which the constraints cannot hold at all (e.g. a dissipativity margin with no
+``zd`` term to meet it) is infeasible: it is skipped and recorded in ``infeasible_``; only when
+no proposed support is feasible does the fit raise.  When the requested solver fails on a
+support, the other of CLARABEL/OSQP is tried once; every such fallback is recorded in
+``fallbacks_`` and in the candidate's ``extra["solver"]``.
 
 Selection methods
     ``best-subset``  exact best subset of each size under the constraints
@@ -19,7 +24,8 @@ Selection methods
     ``stlsq``, ``sr3``  pysindy's optimizers propose supports;
     ``constrained-sr3`` pysindy's ConstrainedSR3 with the conditions at the samples.
 Every support a method proposes is re-fitted under the certified constraints and
-scored by BIC, AIC and K-fold cross-validation over whole impacts.
+scored by BIC and AIC; K-fold cross-validation over whole impacts is computed when
+``scoring="cv"`` or ``cv_report=True`` (``cv_error`` is ``nan`` otherwise).
 """
 
 import itertools
@@ -30,8 +36,17 @@ from dataclasses import dataclass, field
 import cvxpy as cp
 import numpy as np
 from sklearn.base import BaseEstimator, RegressorMixin
+from sklearn.utils.validation import check_is_fitted
 
-from constraints import Box, bernstein_map, certify, require, scale_factors, solve
+from constraints import (
+    Box,
+    certify,
+    constraint_rows,
+    normalized_rows,
+    require,
+    scale_factors,
+    solve,
+)
 from constraints.errors import SolverError
 
 from .errors import InputError
@@ -42,6 +57,14 @@ __all__ = ["ConstrainedSparseRegressor", "Candidate", "SELECTIONS", "SCORES"]
 SELECTIONS = ("best-subset", "l1-path", "stlsq", "sr3", "constrained-sr3")
 SCORES = ("bic", "aic", "cv")
 _RSS_FLOOR = 1e-14  # relative to mean square force: data are never more exact than this
+_INFEASIBLE = ("infeasible", "infeasible_inaccurate")
+
+
+class _InfeasibleSupport(SolverError):
+    """No coefficients on this support satisfy the constraints (not a solver failure)."""
+
+    def __init__(self, message):
+        super().__init__(message, status="infeasible")
 
 
 @dataclass(frozen=True)
@@ -60,6 +83,10 @@ class Candidate:
         Cross-validated relative RMS error (``nan`` when not computed).
     constrained : bool
         Whether any physical constraint was active at the solution.
+    extra : dict
+        ``"solver"``: what produced the coefficients (``"lstsq"`` when no constraint is
+        active, else the cvxpy solver that succeeded, the fallback one if the requested
+        solver failed).
     """
 
     terms: tuple
@@ -97,28 +124,18 @@ class _Problem:
         self.G = self.A.T @ self.A
         self.h = self.A.T @ self.b
         self.yy = float(self.b @ self.b)
-        maps = [bernstein_map(exps, box, "non_adhesion", elevation=elevation)]
-        maps.append(bernstein_map(exps, box, "dissipativity", elevation=elevation, margin=margin))
-        if monotone:
-            maps.append(bernstein_map(exps, box, "monotone_elastic", elevation=elevation))
-        rows = [m.matrix for m in maps]
-        offs = [m.offset / self.fscale for m in maps]
         if signs is not None:
-            s = np.broadcast_to(np.asarray(signs, dtype=float), (len(library),))
-            for i, si in enumerate(s):
-                if si != 0:
-                    r = np.zeros((1, len(library)))
-                    r[0, i] = si
-                    rows.append(r)
-                    offs.append(np.zeros(1))
-        self.M = np.vstack(rows)
-        self.off = np.concatenate(offs)
-        norms = np.abs(self.M).max(axis=1)
-        keep = norms > 0
-        self.M = self.M[keep] / norms[keep, None]
-        self.off = self.off[keep] / norms[keep]
+            signs = np.broadcast_to(np.asarray(signs, dtype=float), (len(library),))
+        # the rows of the cvxpy builders (constraints.builders), as one system M x + off >= 0
+        # in units of fscale newtons (offsets come from the dissipativity margin)
+        self.M, self.off = constraint_rows(exps, box, margin=margin, monotone=monotone,
+                                           signs=signs, elevation=elevation,
+                                           force_unit=self.fscale)
         self.solver = solver
         self.n_solves = 0
+        self.fallbacks = []   # (support, failed solver, its status, solver that succeeded)
+        self.infeasible = {}  # support -> reason
+        self._solved = {}     # support -> (x, rss, solver)
 
     def feasible(self, idx, x, tol=1e-10):
         return bool(np.all(self.M[:, idx] @ x + self.off >= -tol))
@@ -139,38 +156,62 @@ class _Problem:
         return x, float(r @ r)
 
     def constrained(self, idx):
-        """Certified least squares on a support; the data enter through a QR of the
-        support's columns, so the cvxpy problem has k x k data whatever n is."""
+        """Certified least squares on a support: ``(x, rss, solver)``.
+
+        The data enter through a QR of the support's columns, so the cvxpy problem has
+        k x k data whatever n is.  Raises :class:`_InfeasibleSupport` when no coefficients
+        on the support satisfy the constraints, :class:`SolverError` when both solvers fail.
+        """
+        key = tuple(idx)
+        if key in self._solved:
+            return self._solved[key]
+        if key in self.infeasible:
+            raise _InfeasibleSupport(self.infeasible[key])
+        # rows that vanish on this support are dropped; one with a negative offset (a margin
+        # and no term it acts on) cannot hold for any coefficients
+        M, off, impossible = normalized_rows(self.M[:, idx], self.off)
+        if impossible.size:
+            self._infeasible(key, "a constraint has no term on this support to act on (a "
+                             "dissipativity margin needs a term zd^b, 0 < b <= 1, without zeta)")
         Q, R = np.linalg.qr(self.A[:, idx])
         qb = Q.T @ self.b
-        M = self.M[:, idx]
-        rows = np.abs(M).max(axis=1) > 0  # rows that vanish on this support: offset only
-        if np.any(self.off[~rows] < -1e-12):
-            raise SolverError("a constraint cannot hold with these terms (a margin needs a "
-                              "term it acts on)", status="infeasible", solver=self.solver)
-        norms = np.abs(M[rows]).max(axis=1)
-        M, off = M[rows] / norms[:, None], self.off[rows] / norms
         x = cp.Variable(len(idx))
-        prob = cp.Problem(cp.Minimize(cp.sum_squares(R @ x - qb)), [M @ x + off >= 0])
+        cons = [M @ x + off >= 0] if M.shape[0] else []
+        prob = cp.Problem(cp.Minimize(cp.sum_squares(R @ x - qb)), cons)
+        used = self.solver
         try:
             solve(prob, self.solver)
-        except SolverError:
+        except SolverError as first:
             # one more interior/first-order solver before giving up (then it raises)
-            solve(prob, "OSQP" if self.solver != "OSQP" else "CLARABEL",
-                  **({"eps_abs": 1e-10, "eps_rel": 1e-10, "max_iter": 200000}
-                     if self.solver != "OSQP" else {}))
+            used = "OSQP" if self.solver != "OSQP" else "CLARABEL"
+            opts = {"eps_abs": 1e-10, "eps_rel": 1e-10, "max_iter": 200000} \
+                if used == "OSQP" else {}
+            try:
+                solve(prob, used, **opts)
+            except SolverError as second:
+                if first.status in _INFEASIBLE and second.status in _INFEASIBLE:
+                    self._infeasible(key, f"{self.solver} and {used} report the constraints "
+                                     "infeasible on this support")
+                raise SolverError(f"{first}; fallback: {second}", status=second.status,
+                                  solver=used) from second
+            self.fallbacks.append((key, self.solver, first.status, used))
         self.n_solves += 1
         xv = np.asarray(x.value, dtype=float)
         r = self.A[:, idx] @ xv - self.b
-        return xv, float(r @ r)
+        self._solved[key] = (xv, float(r @ r), used)
+        return self._solved[key]
+
+    def _infeasible(self, key, reason):
+        self.infeasible[key] = reason
+        raise _InfeasibleSupport(reason)
 
     def fit_support(self, idx):
-        """(x, rss, constrained?) of the best certified fit on a support."""
+        """(x, rss, constrained?, solver) of the best certified fit on a support."""
         x, rss = self.precise(idx)
         if self.feasible(idx, x):
-            return x, rss, False
-        x, rss = self.constrained(idx)
-        return x, rss, True
+            return x, rss, False, "lstsq"
+        x, rss, used = self.constrained(idx)
+        return x, rss, True, used
 
     def physical(self, idx, x):
         c = np.zeros(len(self.library))
@@ -213,9 +254,12 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
     n_lambdas : int
         Points on the ``l1-path``.
     solver : str
-        cvxpy solver.
+        cvxpy solver (when it fails on a support, the other of CLARABEL/OSQP is tried).
     grid : int
         Points per axis of the independent verification grid.
+    cv_report : bool
+        Compute the cross-validation error of every candidate even when ``scoring`` is not
+        ``"cv"`` (it costs ``cv`` refits of every candidate).
 
     Attributes
     ----------
@@ -226,7 +270,14 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
     support_ : ndarray of shape (n_terms,), bool
     law_ : ForceLaw
     candidates_ : list of Candidate
-        One per proposed support, best first by ``scoring``.
+        One per feasible proposed support, best first by ``scoring``.
+    infeasible_ : list of dict
+        Proposed supports skipped because no coefficients on them satisfy the constraints:
+        ``{"support": terms, "reason": str}``.
+    fallbacks_ : list of dict
+        Solves where ``solver`` failed and the fallback succeeded: ``{"support": terms,
+        "solver": fallback solver, "failed": requested solver, "status": its status,
+        "stage": "fit" or "cv"}``.
     certificate_ : constraints.Certificate
     n_features_in_ : int
         2 (``zeta``, ``dzeta``).
@@ -237,7 +288,7 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
 
     def __init__(self, library="poly:2", selection="best-subset", scoring="bic", max_terms=4, cv=5,
                  margin=0.0, monotone=False, signs=None, box_margin=0.1, elevation=2,
-                 threshold=0.05, n_lambdas=30, solver="CLARABEL", grid=1001):
+                 threshold=0.05, n_lambdas=30, solver="CLARABEL", grid=1001, cv_report=False):
         self.library = library
         self.selection = selection
         self.scoring = scoring
@@ -252,6 +303,7 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         self.n_lambdas = n_lambdas
         self.solver = solver
         self.grid = grid
+        self.cv_report = cv_report
 
     # ------------------------------------------------------------------ fit
     def fit(self, X, y, groups=None, sample_weight=None):
@@ -279,8 +331,7 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
                              f"{X.shape} and {y.shape}")
         if not (np.all(np.isfinite(X)) and np.all(np.isfinite(y))):
             raise InputError("X and y must be finite")
-        w = np.ones(y.size) if sample_weight is None else np.asarray(sample_weight, float)
-        groups = np.arange(y.size) if groups is None else np.asarray(groups)
+        w, groups = _weights_and_groups(y.size, sample_weight, groups)
         self.library_ = Library.parse(self.library)
         if self.signs is not None:
             sg = np.atleast_1d(np.asarray(self.signs))
@@ -297,19 +348,32 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         supports = self._propose(prob, X, y, w)
         cands = []
         for idx in supports:
-            x, rss, active = prob.fit_support(list(idx))
+            try:
+                x, rss, active, used = prob.fit_support(list(idx))
+            except _InfeasibleSupport:
+                continue  # recorded in prob.infeasible
             bic, aic = prob.scores(rss, len(idx))
             c = prob.physical(list(idx), x)
-            cands.append((idx, c, rss * prob.fscale**2, bic, aic, active))
-        # cross-validation over impacts for every candidate support
-        cv_err = self._cross_validate(X, y, w, groups, [c[0] for c in cands])
+            cands.append((idx, c, rss * prob.fscale**2, bic, aic, active, used))
+        self.infeasible_ = [{"support": self._names(k), "reason": r}
+                            for k, r in prob.infeasible.items()]
+        self.fallbacks_ = [{"support": self._names(k), "solver": alt, "failed": failed,
+                            "status": status, "stage": "fit"}
+                           for k, failed, status, alt in prob.fallbacks]
+        if not cands:
+            self._no_feasible_support()
+        # cross-validation over impacts (only when it is used or asked for)
+        if self.scoring == "cv" or self.cv_report:
+            cv_err = self._cross_validate(X, y, w, groups, [c[0] for c in cands])
+        else:
+            cv_err = [float("nan")] * len(cands)
         self.candidates_ = []
-        for (idx, c, rss, bic, aic, active), e in zip(cands, cv_err, strict=True):
-            names = tuple(self.library_.terms[i].name for i in idx)
+        for (idx, c, rss, bic, aic, active, used), e in zip(cands, cv_err, strict=True):
+            names = self._names(idx)
             self.candidates_.append(Candidate(
                 terms=names, coefficients={n: float(c[i]) for n, i in zip(names, idx, strict=True)},
                 rss=float(rss), bic=float(bic), aic=float(aic), cv_error=float(e),
-                constrained=bool(active)))
+                constrained=bool(active), extra={"solver": used}))
         key = {"bic": lambda c: c.bic, "aic": lambda c: c.aic, "cv": lambda c: c.cv_error}
         self.candidates_.sort(key=key[self.scoring])
         best = self.candidates_[0]
@@ -321,6 +385,21 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         self.n_solves_ = prob.n_solves
         self.fit_seconds_ = time.perf_counter() - t0
         return self
+
+    def _names(self, idx):
+        return tuple(self.library_.terms[i].name for i in idx)
+
+    def _no_feasible_support(self):
+        by_reason = {}
+        for rec in self.infeasible_:
+            by_reason.setdefault(rec["reason"], []).append(" + ".join(rec["support"]))
+        why = "; ".join(f"{', '.join(sup)}: {r}" for r, sup in by_reason.items()) \
+            or "no support was proposed"
+        opts = f"margin {self.margin:g} N s/m" + (", monotone" if self.monotone else "") \
+            + ("" if self.signs is None else f", signs {self.signs!r}")
+        raise InputError(f"no proposed support of library {self.library!r} can satisfy the "
+                         f"physical constraints ({opts}): {why}; add a term they act on, raise "
+                         "max_terms or relax the margin/signs")
 
     def certify(self, coef):
         """Independent certificate of physical coefficients on ``box_`` (Bernstein + grid)."""
@@ -384,13 +463,18 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
                     if rss < best_rss:
                         best_rss, best_idx = rss, idx
                     break  # feasible and smallest remaining unconstrained RSS
-                _, crss = prob.constrained(idx)  # a solver failure raises: never skipped
+                try:
+                    _, crss, _ = prob.constrained(idx)  # a solver failure raises
+                except _InfeasibleSupport:
+                    continue  # no coefficients on this subset are physical: recorded, skipped
                 if crss < best_rss:
                     best_rss, best_idx = crss, idx
             if best_idx is not None:
                 out.append(tuple(best_idx))
         if not out:
-            raise InputError("no subset could be fitted under the constraints")
+            self.infeasible_ = [{"support": self._names(k), "reason": r}
+                                for k, r in prob.infeasible.items()]
+            self._no_feasible_support()
         return out
 
     def _l1_path(self, prob):
@@ -460,21 +544,41 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
             sub = self._problem(X[tr], y[tr], w[tr])
             theta = self.library_.transform(X[te])
             for j, idx in enumerate(supports):
-                x, _, _ = sub.fit_support(list(idx))
+                x, _, _, _ = sub.fit_support(list(idx))
                 c = sub.physical(list(idx), x)
                 r = theta @ c - y[te]
                 errs[j] += float(np.sum(w[te] * r * r))
             den += float(np.sum(w[te] * y[te] ** 2))
+            self.fallbacks_ += [{"support": self._names(key), "solver": alt, "failed": failed,
+                                 "status": status, "stage": "cv"}
+                                for key, failed, status, alt in sub.fallbacks]
         return list(np.sqrt(errs / den))
 
     # --------------------------------------------------------------- predict
     def predict(self, X):
         """Contact force [N] at ``X`` (conditions (3)-(5) applied)."""
+        check_is_fitted(self)
         X = np.asarray(X, dtype=float)
+        if X.ndim != 2 or X.shape[1] != self.n_features_in_:
+            raise InputError(f"X has shape {X.shape}; the estimator is expecting "
+                             f"{self.n_features_in_} features (zeta, dzeta)")
         return self.law_(X[:, 0], X[:, 1])
 
-    def stability(self, X, y, groups, n_resamples=50, random_state=0):
+    def stability(self, X, y, groups, n_resamples=50, random_state=0, sample_weight=None):
         """How often each term is selected over bootstrap resamples of whole impacts.
+
+        Each resample draws impacts (those of non-zero total weight) with replacement and
+        refits with their samples' weights; an impact drawn twice enters as two distinct
+        impacts (its own group id each time), so the refit's cross-validation never splits
+        or merges them.
+
+        Parameters
+        ----------
+        X, y, groups
+            As for :meth:`fit` (``groups`` required: impacts are what is resampled).
+        n_resamples : int
+        random_state : int
+        sample_weight : array_like of shape (n_samples,), optional
 
         Returns
         -------
@@ -482,19 +586,38 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
             ``{term: frequency in [0, 1]}`` for every library term.
         """
         X = np.asarray(X, dtype=float)
-        y = np.asarray(y, dtype=float)
-        groups = np.asarray(groups)
+        y = np.asarray(y, dtype=float).ravel()
+        if groups is None:
+            raise InputError("stability needs the impact of every sample (groups)")
+        w, groups = _weights_and_groups(y.size, sample_weight, groups)
         rng = np.random.default_rng(random_state)
-        ug = np.unique(groups)
-        counts = np.zeros(len(Library.parse(self.library)))
-        for _ in range(n_resamples):
-            pick = rng.choice(ug, size=ug.size, replace=True)
-            rows = np.concatenate([np.flatnonzero(groups == g) for g in pick])
-            est = ConstrainedSparseRegressor(**{**self.get_params(), "cv": 2, "grid": 101})
-            est.fit(X[rows], y[rows], groups=None)
-            counts += est.support_
+        ug = np.unique(groups[w > 0])  # an impact of zero weight is no data: never drawn
+        members = [np.flatnonzero(groups == g) for g in ug]
         lib = Library.parse(self.library)
+        counts = np.zeros(len(lib))
+        for _ in range(n_resamples):
+            pick = rng.choice(ug.size, size=ug.size, replace=True)
+            rows = np.concatenate([members[g] for g in pick])
+            # a duplicated impact is a new impact: group id = its position in the draw
+            new_groups = np.repeat(np.arange(pick.size), [members[g].size for g in pick])
+            est = ConstrainedSparseRegressor(**{**self.get_params(), "cv": 2, "grid": 101,
+                                                "cv_report": False})
+            est.fit(X[rows], y[rows], groups=new_groups, sample_weight=w[rows])
+            counts += est.support_
         return {t.name: float(c / n_resamples) for t, c in zip(lib.terms, counts, strict=True)}
+
+
+def _weights_and_groups(n, sample_weight, groups):
+    """Validated ``(weights, groups)`` for ``n`` samples (defaults: ones, one group each)."""
+    w = np.ones(n) if sample_weight is None else np.asarray(sample_weight, dtype=float)
+    if w.shape != (n,) or not np.all(np.isfinite(w)) or np.any(w < 0) or not w.sum() > 0:
+        raise InputError(f"sample_weight must be {n} finite values >= 0, not all zero; got "
+                         f"shape {w.shape}")
+    groups = np.arange(n) if groups is None else np.asarray(groups)
+    if groups.shape != (n,):
+        raise InputError(f"groups must give the impact of each of the {n} samples; got shape "
+                         f"{groups.shape}")
+    return w, groups
 
 
 def _pysindy_constrained(prob, thr):

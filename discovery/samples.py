@@ -68,8 +68,34 @@ class ContactSamples:
         return self.zeta.size
 
 
+def _steady_cycles(*stacks):
+    """Indices of the cycles that repeat: rows of every ``(stack, sigma)`` pair (``stack`` of
+    shape (n_cycles, m)) within what the noise explains of the sample-wise median cycle.
+
+    A cycle is steady when, for every signal, its mean square deviation from the median of
+    all the cycles is at most ``2 sigma^2 (1 + 6 sqrt(2/m))`` plus ``(0.5 % of the peak)^2``
+    (the allowance of :func:`discovery.impulse.impulse_from_samples`), or four times the
+    median deviation of the cycles (the median is robust to isolated outliers)."""
+    ok = None
+    for stack, sigma in stacks:
+        m = stack.shape[1]
+        ref = np.median(stack, axis=0)
+        peak = float(np.max(np.abs(ref))) or 1.0
+        dev = np.mean((stack - ref) ** 2, axis=1)
+        expected = 2.0 * sigma**2 * (1.0 + 6.0 * np.sqrt(2.0 / m)) + (0.005 * peak) ** 2
+        good = dev <= max(expected, 4.0 * float(np.median(dev)))
+        ok = good if ok is None else ok & good
+    return np.flatnonzero(ok)
+
+
 def _average_steady(t, zeta, dzeta, F, period):
     """Replace the steady cycles at the end of a record by their sample-wise average.
+
+    The steady part starts at the first cycle :func:`~discovery.impulse.impulse_from_samples`
+    averages (``imp.onset``); every whole cycle from there to the end of the record is
+    checked again (force and ``zeta`` against their median cycle, :func:`_steady_cycles`),
+    because the impulse leaves out isolated deviating cycles: those, like the run-up before
+    the steady part and the incomplete cycle at the end, stay as they are (count 1).
 
     Returns ``(t, zeta, dzeta, F, count)`` where ``count`` is how many samples each
     value stands for (the number of averaged cycles, 1 elsewhere)."""
@@ -81,15 +107,28 @@ def _average_steady(t, zeta, dzeta, F, period):
                          f"= {m:.6g}); resample the record or do not average")
     m = int(round(m))
     i0 = int(np.searchsorted(t, imp.onset - dt))  # one sample before the first steady onset
-    k = min(imp.n_cycles, (t.size - i0) // m)
+    k = (t.size - i0) // m  # whole cycles from there to the end of the record
     if k < 2:
         return t, zeta, dzeta, F, np.ones(t.size)
-    sl = slice(i0, i0 + k * m)
-    avg = [a[sl].reshape(k, m).mean(axis=0) for a in (zeta, dzeta, F)]
-    keep = np.arange(t.size) < i0
-    cat = [np.concatenate([a[keep], b]) for a, b in zip((t, zeta, dzeta, F),
-                                                          (t[i0:i0 + m], *avg), strict=True)]
-    count = np.concatenate([np.ones(keep.sum()), np.full(m, float(k))])
+    block = slice(i0, i0 + k * m)
+    steady = _steady_cycles((F[block].reshape(k, m), estimate_noise(F)),
+                            (zeta[block].reshape(k, m), estimate_noise(zeta, order=3)))
+    if steady.size < 2:
+        return t, zeta, dzeta, F, np.ones(t.size)
+    avg = [a[block].reshape(k, m)[steady].mean(axis=0) for a in (zeta, dzeta, F)]
+    # the average takes the first steady cycle's place; the run-up, the deviating cycles
+    # and the incomplete last cycle stay as recorded, in time order (every cycle starts
+    # one sample before its onset, so no contact is joined to another one)
+    idx = np.arange(t.size)
+    cycle = np.full(t.size, -1)
+    cycle[block] = np.repeat(np.arange(k), m)
+    raw = ~np.isin(cycle, steady)
+    at = i0 + int(steady[0]) * m
+    before, after = raw & (idx < at), raw & (idx >= at)
+    cat = [np.concatenate([a[before], b, a[after]])
+           for a, b in zip((t, zeta, dzeta, F), (t[at:at + m], *avg), strict=True)]
+    count = np.concatenate([np.ones(before.sum()), np.full(m, float(steady.size)),
+                            np.ones(after.sum())])
     return (*cat, count)
 
 
@@ -114,8 +153,9 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
     average_cycles : bool
         Average the steady cycles at the end of the record sample by sample (noise
         down by the square root of their number) and weight each averaged sample by
-        the number of cycles; run-up impacts are kept as they are.  Needs ``period``
-        and a whole number of samples per cycle.
+        the number of cycles; run-up impacts, isolated deviating cycles and the
+        incomplete last cycle are kept as they are.  Needs ``period`` and a whole
+        number of samples per cycle.
     period : float, optional
         Drive period [s] (for ``average_cycles``).
 
@@ -146,7 +186,7 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
         from pysindy.differentiation import SmoothedFiniteDifference
 
         sfd = SmoothedFiniteDifference(smoother_kws={"window_length": window, "polyorder": 3})
-        dzeta = np.asarray(sfd._differentiate(zeta.reshape(-1, 1), t)).ravel()
+        dzeta = np.asarray(sfd(zeta.reshape(-1, 1), t)).ravel()  # the public __call__
     F = measurement.F
     sigma = estimate_noise(F)
     count = np.ones(t.size)

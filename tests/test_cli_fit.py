@@ -1,10 +1,12 @@
 """End-to-end tests of ``vidi fit`` (discovery from a CSV record)."""
 
 import csv
+import importlib
 import json
 
 import pytest
 
+from constraints.errors import SolverError
 from discovery.cli import main
 
 FIGURES = ("fit_impulse", "fit_surface", "fit_loop")
@@ -50,7 +52,7 @@ def test_fit_summary_contents(fitted):
     assert s["ranking"][0]["terms"] == sel["terms"]
     for m in s["ranking"]:
         assert "bic" in m and "cv_error" in m
-        assert 0 <= m["cv_error"] < 1  # relative RMS of held-out impacts
+        assert m["cv_error"] is None  # scored by BIC: no cross-validation run (JSON null)
     cert = s["certificate"]
     for key in ("method", "holds", "worst_violation", "domain"):
         assert key in cert
@@ -73,8 +75,26 @@ def test_fit_ranking_csv_matches_summary(fitted):
 
 
 def test_model_tex_names_the_law(fitted):
-    tex = (fitted[1] / "model.tex").read_text()
-    assert "zeta" in tex
+    _, out = fitted
+    tex = (out / "model.tex").read_text()
+    sel = json.loads((out / "summary.json").read_text())["selected"]
+    assert sel["latex"] in tex  # the fitted law's formula
+    for name, value in sel["coefficients"].items():  # one table row per fitted term
+        mant, exp = f"{value:.3e}".split("e")
+        assert rf"\texttt{{{name}}} & ${mant}\cdot 10^{{{int(exp)}}}$" in tex, name
+
+
+def test_fit_scored_by_cross_validation_reports_it(record, tmp_path):
+    out = tmp_path / "cv"
+    assert main(["fit", "--data", str(record), "--library", "poly:2", "--score", "cv",
+                 "--out", str(out)]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["ranking"]
+    for m in s["ranking"]:
+        assert 0 <= m["cv_error"] < 1  # relative RMS of held-out impacts
+    rows = list(csv.DictReader((out / "ranking.csv").read_text().splitlines()))
+    assert [float(r["cv_error"]) for r in rows] == pytest.approx(
+        [m["cv_error"] for m in s["ranking"]], rel=1e-5)
 
 
 def _assert_clean_failure(argv, out, capsys, needle=None):
@@ -111,6 +131,19 @@ def test_bad_max_terms_exit_2(record, tmp_path, capsys):
     out = tmp_path / "o"
     _assert_clean_failure(["fit", "--data", str(record), "--max-terms", "0",
                            "--out", str(out)], out, capsys, "max_terms")
+
+
+def test_solver_error_exit_2_one_line(record, tmp_path, capsys, monkeypatch):
+    # errors of the constraints package are VidiErrors: a clean exit, never a traceback
+    def fail(*args, **kwargs):
+        raise SolverError("cvxpy problem ended with status 'infeasible' (solver CLARABEL); "
+                          "no solution is returned", status="infeasible", solver="CLARABEL")
+
+    # the module (the package attribute of the same name is the function)
+    monkeypatch.setattr(importlib.import_module("discovery.discover"), "discover", fail)
+    out = tmp_path / "o"
+    _assert_clean_failure(["fit", "--data", str(record), "--out", str(out)], out, capsys,
+                          "status 'infeasible'")
 
 
 def test_library_of_only_plus_exit_2(record, tmp_path, capsys):

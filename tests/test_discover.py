@@ -26,8 +26,13 @@ def result(paper, runup):
 
 
 @pytest.fixture(scope="module")
-def refined(paper, runup):
-    return discover(paper, runup, library="poly:3", refine=True)
+def biased(paper):
+    """Positions with 1 % noise and no velocities: dzeta differentiated from the noisy zeta
+    biases the regression; the refinement by simulation never uses dzeta.  Discovered
+    without and with refinement."""
+    m = synthesize(paper, paper.law, periods=300, fs=20000, noise=0.01, seed=0,
+                   from_rest=True, position_noise=0.01, velocities=False)
+    return discover(paper, m, library="z,zd"), discover(paper, m, library="z,zd", refine=True)
 
 
 def test_selects_true_support_p1_and_certified(result, paper):
@@ -73,13 +78,17 @@ def test_result_bookkeeping(result):
     assert all(tuple(m.law.names) in terms for m in result.ranking)
 
 
-def test_refine_never_makes_the_criterion_worse(result, refined):
-    assert refined.refinement is not None
-    before = result.selected.criteria["I2"]
+def test_refinement_reduces_the_criterion_of_a_biased_regression(biased):
+    plain, refined = biased
+    assert plain.refinement is None and refined.refinement is not None
+    before = plain.selected.criteria["I2"]
     after = refined.selected.criteria["I2"]
-    assert after <= before
-    # same support, and the refinement stays physical here
-    assert refined.selected.law.names == result.selected.law.names
+    # measured I2 0.150 for the regression's law, 0.087 after refinement
+    assert after < 0.8 * before, (before, after)
+    # the refined coefficients replaced the regression's, on the same support
+    assert refined.selected.law.as_dict() == refined.refinement.law.as_dict()
+    assert refined.selected.law.names == plain.selected.law.names
+    assert refined.selected.law.as_dict() != plain.selected.law.as_dict()
     assert refined.certificate.holds
 
 

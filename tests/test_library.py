@@ -153,7 +153,7 @@ def test_get_params_are_the_constructor_arguments():
     names = [p for p in sig.parameters if p != "self"]
     args = dict(library="z,zd,z*zd", selection="l1-path", scoring="aic", max_terms=2, cv=3,
                 margin=1.5, monotone=True, signs=[1, 1, 0], box_margin=0.2, elevation=3,
-                threshold=0.1, n_lambdas=7, solver="CLARABEL", grid=51)
+                threshold=0.1, n_lambdas=7, solver="CLARABEL", grid=51, cv_report=True)
     assert set(args) == set(names)  # the test covers every parameter
     est = ConstrainedSparseRegressor(**args)
     params = est.get_params()

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from discovery.errors import InputError
+from discovery.impulse import impulse_from_samples
 from discovery.measurement import Measurement, synthesize
 from discovery.samples import contact_samples
 
@@ -129,6 +130,86 @@ def test_per_impact_weights_equal_total_per_impact(paper):
     np.testing.assert_allclose(totals, totals[0], rtol=1e-12)
     # weights have mean 1 (scale of the residual sum of squares unchanged)
     assert cs.weight.mean() == pytest.approx(1.0, rel=1e-12)
+
+
+def test_pysindy_derivative_goes_through_the_public_call(rec, monkeypatch):
+    # pysindy 2.x's public differentiation API is calling the object, sfd(x, t)
+    from pysindy.differentiation import SmoothedFiniteDifference
+
+    calls = []
+    public = SmoothedFiniteDifference.__call__
+
+    def spy(self, x, t=1):
+        calls.append(np.shape(x))
+        return public(self, x, t)
+
+    monkeypatch.setattr(SmoothedFiniteDifference, "__call__", spy)
+    cs = contact_samples(_positions_only(rec), derivative="pysindy")
+    assert calls == [(rec.t.size, 1)]
+    assert cs.derivative == "pysindy"
+
+
+# ------------------------------------------------------------ average_cycles
+
+
+def _cycle_start_and_length(m, period):
+    imp = impulse_from_samples(m.t, m.F, period, zeta=m.zeta)
+    dt = m.t[1] - m.t[0]
+    return int(np.searchsorted(m.t, imp.onset - dt)), int(round(imp.duration / dt)), imp
+
+
+def _reshape_like_law(F, a, n, e):
+    """``F`` with a zero-sum wiggle of ``e`` max F inside the contact of samples a..a+n: the
+    impulse (integral) is unchanged, the shape is not."""
+    F = F.copy()
+    seg = F[a:a + n]
+    on = np.flatnonzero(seg > 1e-3 * F.max())[1:-1]
+    d = e * F.max() * np.sin(4 * np.pi * np.arange(on.size) / on.size)
+    seg[on] += d - d.mean()
+    return F
+
+
+def test_average_cycles_of_a_steady_record(rec, paper):
+    i0, n, imp = _cycle_start_and_length(rec, paper.period)
+    cs = contact_samples(rec, average_cycles=True, period=paper.period)
+    k = (rec.t.size - i0) // n
+    assert imp.n_cycles == k == 19
+    avg = cs.weight > 1
+    assert set(np.unique(cs.weight)) == {1.0, float(k)}
+    # the averaged samples are the sample-wise mean of the k whole cycles
+    mean = {name: a[i0:i0 + k * n].reshape(k, n).mean(axis=0)
+            for name, a in (("zeta", rec.zeta), ("F", rec.F))}
+    sel = np.isin(mean["zeta"], cs.zeta[avg])
+    assert sel.sum() == avg.sum()
+    np.testing.assert_array_equal(cs.F[avg], mean["F"][sel])
+    # every recorded contact sample counted once
+    assert cs.weight.sum() == len(contact_samples(rec))
+
+
+def test_average_cycles_leaves_out_a_deviating_cycle(rec, paper):
+    i0, n, _ = _cycle_start_and_length(rec, paper.period)
+    clean = contact_samples(rec, average_cycles=True, period=paper.period)
+    bad = 7
+    F = _reshape_like_law(rec.F, i0 + bad * n, n, 0.02)
+    m = Measurement(rec.t, F, rec.channels)
+    imp = impulse_from_samples(m.t, F, paper.period, zeta=m.zeta)
+    # the premise: the impulse averages 18 cycles, not contiguous (cycle 7 is left out)
+    assert imp.n_cycles == 18 and imp.onset == pytest.approx(rec.t[i0 + 1], abs=rec.t[1])
+    cs = contact_samples(m, average_cycles=True, period=paper.period)
+    assert set(np.unique(cs.weight)) == {1.0, 18.0}
+    # the average is that of the 18 steady cycles: the clean cycle to rounding (with the
+    # deviating cycle in it, it would be off by 0.02 / 18 ~ 1e-3 of the peak)
+    np.testing.assert_allclose(cs.F[cs.weight > 1], clean.F[clean.weight > 1], rtol=0,
+                               atol=1e-9 * rec.F.max())
+    # the deviating cycle stays in as recorded (weight 1), its wiggle included
+    sl = slice(i0 + bad * n, i0 + (bad + 1) * n)
+    raw = cs.weight == 1
+    in_bad = np.isin(cs.zeta[raw], m.zeta[sl])
+    assert in_bad.sum() > 10
+    np.testing.assert_array_equal(cs.F[raw][in_bad],
+                                  F[sl][np.isin(m.zeta[sl], cs.zeta[raw][in_bad])])
+    # total weight: every recorded contact sample counted once
+    assert cs.weight.sum() == pytest.approx(clean.weight.sum(), rel=1e-12)
 
 
 # ------------------------------------------------------------------ CSV with a2

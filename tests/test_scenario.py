@@ -173,13 +173,6 @@ def test_law_not_a_table_is_input_error(tmp_path):
         load_scenario(_write(tmp_path, text))
 
 
-def test_frozen():
-    sc = load_scenario("paper")
-    with pytest.raises(dataclasses.FrozenInstanceError):
-        sc.m1 = 2.0
-    with pytest.raises(dataclasses.FrozenInstanceError):
-        sc.law = None
-
 
 def test_with_law_and_as_dict():
     sc = load_scenario("paper")

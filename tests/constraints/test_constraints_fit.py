@@ -9,10 +9,12 @@ from constraints import (
     SolverError,
     certify,
     coefficient_signs,
+    constraint_rows,
     dissipativity,
     evaluate,
     features,
     non_adhesion,
+    normalized_rows,
     physical,
     require,
     solve,
@@ -128,3 +130,49 @@ def test_physical_constraints_are_infeasible_for_contradicting_signs():
     cons = physical(x, LIBRARY, BOX, margin=1.0, signs=-1) + [cp.sum(cp.abs(x)) <= 1e3]
     with pytest.raises(SolverError, match="infeasible"):
         solve(cp.Problem(cp.Minimize(0), cons))
+
+
+# ------------------------------------------------------------- shared rows
+
+
+def _affine(constraints, x):
+    """``(rows, rhs)`` of cvxpy constraints ``g(x) >= 0`` with affine ``g``, by evaluation."""
+    def g(v):
+        x.value = v
+        # cvxpy stores ``a >= b`` as ``b <= a``, whose ``expr`` is ``b - a``
+        return np.concatenate([-np.ravel(c.expr.value) for c in constraints])
+
+    n = x.shape[0]
+    rhs = g(np.zeros(n))
+    rows = np.column_stack([g(np.eye(n)[i]) - rhs for i in range(n)])
+    return rows, rhs
+
+
+@pytest.mark.parametrize("kwargs", [
+    dict(),
+    dict(margin=50.0, force_unit=1e3),
+    dict(monotone=True, signs=[1, -1, 0, 1, 0], elevation=3),
+])
+def test_constraint_rows_are_the_builders_constraints(kwargs):
+    x = cp.Variable(len(LIBRARY))
+    rows, rhs = constraint_rows(LIBRARY, BOX, **kwargs)
+    ref_rows, ref_rhs = _affine(physical(x, LIBRARY, BOX, **kwargs), x)
+    np.testing.assert_allclose(rows, ref_rows, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(rhs, ref_rhs, rtol=0, atol=1e-15)
+    # normalised: every row has max-norm 1
+    np.testing.assert_allclose(np.abs(rows).max(axis=1), 1.0, rtol=1e-15)
+    assert np.any(rhs < 0) == ("margin" in kwargs)
+
+
+def test_normalized_rows_drop_vanishing_rows_and_flag_impossible_ones():
+    matrix = np.array([[2.0, -4.0], [0.0, 0.0], [0.0, 0.0], [0.0, 0.5]])
+    offset = np.array([1.0, 0.0, -3.0, -1.0])
+    rows, rhs, impossible = normalized_rows(matrix, offset)
+    np.testing.assert_array_equal(rows, [[0.5, -1.0], [0.0, 1.0]])
+    np.testing.assert_array_equal(rhs, [0.25, -2.0])
+    np.testing.assert_array_equal(impossible, [2])  # 0 x - 3 >= 0 never holds
+
+
+def test_constraint_rows_impossible_margin_raises():
+    with pytest.raises(ValueError, match="impossible"):
+        constraint_rows([(1, 0), (1.5, 1)], BOX, margin=1.0)
