@@ -17,7 +17,7 @@ from ._io import atomic_write_text
 from .dynamics import simulate
 from .dynamics.steady_state import steady_state
 from .errors import InputError
-from .impulse import impulse_from_samples
+from .impulse import estimate_noise, impulse_from_samples
 
 __all__ = ["Measurement", "synthesize"]
 
@@ -137,6 +137,55 @@ class Measurement:
         if "w1" in self.channels and "w2" in self.channels:
             return self.channels["w1"] - self.channels["w2"]
         return None
+
+    def state_at_strobe(self, period, time_offset=0.0):
+        """The bodies' state at a late strobe time of the record (drive phase 0).
+
+        The latest time ``t + time_offset = k T`` with a window of samples on both sides
+        and, preferably, no contact force in it; positions (and velocities, when
+        recorded; otherwise the slope of the position fit) from a local quadratic fit
+        over +-1 % of a period, which averages the sensor noise down.
+
+        Returns
+        -------
+        state : ndarray of shape (4,)
+            ``w1, v1, w2, v2``.
+        t_drive : float
+            The strobe time on the drive's clock [s].
+        """
+        ch = self.channels
+        if "w1" not in ch or "w2" not in ch:
+            raise InputError("the state needs the positions w1 and w2 in the data")
+        t = self.t
+        dt = float(np.median(np.diff(t)))
+        m = max(3, int(0.01 * period / dt))
+        k_hi = int(np.floor((t[-1 - m] + time_offset) / period))
+        k_lo = int(np.ceil((t[m] + time_offset) / period))
+        if k_hi < k_lo:
+            raise InputError("the record is shorter than one drive period")
+        thr = 5.0 * estimate_noise(self.F)
+        best = None
+        for k in range(k_hi, max(k_lo, k_hi - 8) - 1, -1):
+            i = int(np.searchsorted(t, k * period - time_offset))
+            free = bool(np.all(self.F[max(i - m, 0):i + m + 1] <= max(thr, 0.0)))
+            if best is None or free:
+                best = (k, i)
+            if free:
+                break
+        k, i = best
+        tk = k * period - time_offset
+        sl = slice(max(i - m, 0), min(i + m + 1, t.size))
+        x = t[sl] - tk
+
+        def fit(y):
+            return np.polyfit(x, y[sl], 2)
+
+        state = []
+        for w, v in (("w1", "v1"), ("w2", "v2")):
+            cw = fit(ch[w])
+            state.append(np.polyval(cw, 0.0))
+            state.append(np.polyval(fit(ch[v]), 0.0) if v in ch else cw[1])
+        return np.array(state, dtype=float), float(k * period)
 
     def impulse(self, period, **kwargs):
         """Period-averaged steady-state impulse (see :func:`impulse_from_samples`);

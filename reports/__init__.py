@@ -6,8 +6,9 @@ from .figures import (
     fit_surface_figure,
     identification_figure,
     landscape_figure,
+    verify_figure,
 )
 from .latex import model_tex
 
 __all__ = ["landscape_figure", "identification_figure", "fit_impulse_figure",
-           "fit_surface_figure", "fit_loop_figure", "model_tex"]
+           "fit_surface_figure", "fit_loop_figure", "model_tex", "verify_figure"]

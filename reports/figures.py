@@ -9,7 +9,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-__all__ = ["landscape_figure", "identification_figure"]
+__all__ = ["landscape_figure", "identification_figure", "verify_figure"]
 
 _ORDER = ("I1", "I2", "I3", "I4", "I0")
 
@@ -175,5 +175,45 @@ def fit_loop_figure(result, stem, max_impacts=3):
     ax.set_ylabel("contact force [kN]")
     ax.set_title("Loading (upper) and elastic unloading (lower) branches")
     ax.legend(fontsize=7)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def verify_figure(result, stem):
+    """Measured and simulated force over the whole orbit, the noise band, the residual.
+
+    Parameters
+    ----------
+    result : discovery.verify.VerifyResult
+    stem : str
+        Output path without extension (PNG and PDF are written).
+    """
+    from discovery.criteria import compare
+
+    ev = result.evaluation
+    E = result.reference.impulse
+    fig, (ax, axr) = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True,
+                                  gridspec_kw={"height_ratios": [3, 1.3]})
+    band = 2.0 * result.reference.noise.get("F", 0.0) / np.sqrt(max(E.n_cycles, 1))
+    ms = 1e3
+    if ev.simulated is not None:
+        c = compare(E, ev.simulated)
+        ax.fill_between(c.t * ms, c.fe - band, c.fe + band, color="0.85",
+                        label=f"measured +-2 sigma/sqrt({E.n_cycles}) noise band")
+        ax.plot(c.t * ms, c.fe, "k-", lw=1.0, label=f"measured F_E ({E.n_cycles} cycles)")
+        ax.plot(c.t * ms, c.fn, "C3-", lw=1.0, label=f"simulated F_N ({ev.regime['simulated']})")
+        axr.fill_between(c.t * ms, -band, band, color="0.85")
+        axr.plot(c.t * ms, c.fn - c.fe, "C0-", lw=0.8)
+    else:
+        ax.plot(E.t * ms, E.F, "k-", lw=1.0, label="measured F_E")
+    crit = ", ".join(f"{k} {v:.3g} (floor {ev.noise_floor.get(k, float('nan')):.2g})"
+                     for k, v in ev.criteria.items() if k in ("I2", "I3", "I0"))
+    ax.set_title(f"{result.law}\n{'consistent' if ev.consistent else 'INCONSISTENT'}: "
+                 f"{crit or ev.status}", fontsize=9)
+    ax.set_ylabel("contact force F [N]")
+    ax.legend(fontsize=7, loc="upper right")
+    axr.set_ylabel("F_N - F_E [N]")
+    axr.set_xlabel("time since the impact onset t* [ms]")
+    axr.axhline(0.0, color="k", lw=0.5)
     fig.tight_layout()
     return _save(fig, stem)

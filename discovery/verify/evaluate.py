@@ -1,0 +1,187 @@
+"""The one evaluation of a law against a reference: simulate, align, score, decide.
+
+Used by ``verify``, ``discover`` (every shortlisted model), ``identify`` (every
+objective evaluation) and ``landscape`` (every grid point), so all of them compare
+in the same way:
+
+1. the law is simulated to its periodic steady state, from the machine's measured
+   state when the record carries it (the attractor the machine is on), else from the
+   scenario's initial state;
+2. a failed simulation is a failure with its message (``status="failed"``), never
+   the physical regime "nonperiodic";
+3. the simulated orbit is aligned with the measured cycle: every impact of the orbit
+   is tried as ``t*`` (the cyclic sequence of impacts is matched) and the one whose
+   whole-orbit force history is closest (L2) to the measured cycle is kept;
+4. the simulated force is sampled like the measurement and scored by I0..I4 over the
+   whole orbit;
+5. **consistency rule**: the model is consistent with the record when the regimes
+   agree (same period and the same number of contacts per orbit) and
+   ``I2 <= CONSISTENCY_FACTOR x (noise floor of I2) + CONSISTENCY_SLACK``.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..criteria import compare, evaluate_criteria
+from ..dynamics.steady_state import steady_state
+from ..errors import IntegrationError
+from ..impulse import impulse_from_steady_state
+
+__all__ = ["Evaluation", "evaluate", "CONSISTENCY_FACTOR", "CONSISTENCY_SLACK"]
+
+CONSISTENCY_FACTOR = 2.0
+CONSISTENCY_SLACK = 0.005  # I2: numerical agreement of two simulators, sampling effects
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """A law scored against a reference.
+
+    Attributes
+    ----------
+    status : str
+        ``"ok"``, ``"nonperiodic"`` (no stable periodic orbit: physical), ``"no-contact"``
+        or ``"failed"`` (the simulation failed: see ``message``).
+    regime : dict
+        ``{"measured": "P1", "simulated": "P1" or None}``.
+    impacts : dict
+        Contacts per orbit, ``{"measured": k, "simulated": k or None}``.
+    criteria : dict
+        ``I0..I4`` (empty unless ``status == "ok"``).
+    noise_floor : dict
+        The reference's floor of every criterion (mean over replicates).
+    consistent : bool
+    verdict : str
+        One sentence.
+    steady : SteadyState or None
+    simulated : Impulse or None
+        The aligned simulated impulse sampled like the measurement.
+    message : str
+    """
+
+    status: str
+    regime: dict
+    impacts: dict
+    criteria: dict
+    noise_floor: dict
+    consistent: bool
+    verdict: str
+    steady: object = None
+    simulated: object = None
+    message: str = ""
+    extra: dict = field(default_factory=dict)
+
+    def value(self, name):
+        """Criterion ``name``, ``inf`` when there is none (for ranking and optimisers)."""
+        return self.criteria.get(name, float("inf"))
+
+    def as_dict(self):
+        ss = self.steady
+        return {"status": self.status, "regime": self.regime, "impacts": self.impacts,
+                "criteria": self.criteria, "noise_floor": self.noise_floor,
+                "consistent": self.consistent, "verdict": self.verdict,
+                "message": self.message,
+                "max_multiplier": None if ss is None or not ss.periodic
+                else float(np.max(np.abs(ss.multipliers)))}
+
+
+def align(measured, exact):
+    """The rotation of ``exact`` (one of its impacts at ``t* = 0``) whose force history,
+    sampled like ``measured``, is closest to the measured one (L2).
+
+    Returns
+    -------
+    rotated : Impulse
+        ``exact`` with the matched impact at ``t* = 0`` (exact, not sampled).
+    sampled : Impulse
+        ``rotated`` sampled like ``measured``.
+    """
+    best, best_d = None, np.inf
+    for o in exact.onsets:
+        rot = exact.rotated(o)
+        cand = rot.resampled_like(measured)
+        c = compare(measured, cand)
+        r = c.fn - c.fe
+        d = float(np.sum(np.diff(c.t) * (r[1:] ** 2 + r[:-1] ** 2)))
+        if d < best_d:
+            best, best_d = (rot, cand), d
+    return best
+
+
+def _verdict(consistent, reg, imp, crit, floor):
+    if not crit:
+        return None
+    if reg["simulated"] != reg["measured"] or imp["simulated"] != imp["measured"]:
+        return (f"inconsistent: regime mismatch (measured {reg['measured']} with "
+                f"{imp['measured']} contact(s), simulated {reg['simulated']} with "
+                f"{imp['simulated']})")
+    limit = CONSISTENCY_FACTOR * floor["I2"] + CONSISTENCY_SLACK
+    if consistent:
+        return (f"consistent: I2 = {crit['I2']:.3g} is within {limit:.3g} ("
+                f"{CONSISTENCY_FACTOR:g} x noise floor {floor['I2']:.3g} + "
+                f"{CONSISTENCY_SLACK:g}), same regime {reg['measured']}")
+    return (f"inconsistent: I2 = {crit['I2']:.3g} exceeds {limit:.3g} ("
+            f"{CONSISTENCY_FACTOR:g} x noise floor {floor['I2']:.3g} + {CONSISTENCY_SLACK:g})")
+
+
+def evaluate(scenario, law, reference, *, tolerances=None, from_state=True, floor=True,
+             **steady_kwargs):
+    """Simulate ``law`` and score it against ``reference`` (see the module docstring).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    law : ForceLaw
+    reference : Reference
+    tolerances : Tolerances, optional
+    from_state : bool
+        Start from the reference's measured state when it has one (default), else from
+        the scenario's initial state.
+    floor : bool
+        Compute the noise floor under the hypothesis that ``law`` is true (a parametric
+        bootstrap, ~0.1 s) and decide consistency.  Optimisers that only need the
+        criteria pass ``False`` (then ``noise_floor`` is empty and ``consistent`` False).
+    **steady_kwargs
+        Passed to :func:`~discovery.dynamics.steady_state.steady_state`.
+
+    Returns
+    -------
+    Evaluation
+    """
+    E = reference.impulse
+    reg = {"measured": reference.regime, "simulated": None}
+    imp = {"measured": reference.impacts, "simulated": None}
+    if from_state and reference.start is not None:
+        steady_kwargs = {"y_start": reference.start, "t_start": reference.start_time,
+                         **steady_kwargs}
+    try:
+        ss = steady_state(scenario, law, tolerances=tolerances, **steady_kwargs)
+        if not ss.periodic:
+            return Evaluation("nonperiodic", reg, imp, {}, {}, False,
+                              "inconsistent: the law has no stable periodic steady state "
+                              f"(measured {reg['measured']})", steady=ss)
+        reg["simulated"] = ss.regime
+        exact = impulse_from_steady_state(scenario, law, ss, tolerances=tolerances)
+    except IntegrationError as exc:
+        return Evaluation("failed", reg, imp, {}, {}, False,
+                          f"the simulation failed: {exc}", message=str(exc))
+    if exact is None:
+        imp["simulated"] = 0
+        return Evaluation("no-contact", reg, imp, {}, {}, False,
+                          "inconsistent: the simulated bodies never come into contact",
+                          steady=ss)
+    rot, sim = align(E, exact)
+    # contacts per simulated orbit, seen through the measurement's threshold rules
+    imp["simulated"] = int(round(len(sim.support) * ss.n_periods / sim.n_periods))
+    crit = evaluate_criteria(E, sim)
+    if not floor:
+        return Evaluation("ok", reg, imp, crit, {}, False, "", steady=ss, simulated=sim,
+                          extra={"aligned": rot})
+    fl = reference.floor_for(rot)
+    same = reg["simulated"] == reg["measured"] and imp["simulated"] == imp["measured"]
+    consistent = bool(same and crit["I2"] <= CONSISTENCY_FACTOR * fl["mean"]["I2"]
+                      + CONSISTENCY_SLACK)
+    return Evaluation("ok", reg, imp, crit, fl["mean"], consistent,
+                      _verdict(consistent, reg, imp, crit, fl["mean"]), steady=ss,
+                      simulated=sim, extra={"aligned": rot, "noise_floor_q95": fl["q95"]})

@@ -1,0 +1,129 @@
+"""Verification against records made by the independent scipy path with realistic noise.
+
+Every record here comes from :func:`discovery.dynamics.reference.reference_simulate`
+(not the compiled kernel), from rest, through a transient, with noise relative to
+each channel's own range: so the penetration ``w1 - w2`` is noisy.
+"""
+
+import numpy as np
+import pytest
+
+from discovery import ForceLaw, Measurement, Scenario, load_scenario
+from discovery.dynamics.reference import reference_simulate
+from discovery.response import response
+from discovery.verify import Reference, evaluate, verify
+
+
+def _record(sc, law, *, periods=15, transient=60, fs=20000.0, force_noise=0.01,
+            motion_noise=0.002, seed=0, velocities=True):
+    T = sc.period
+    t = transient * T + np.arange(int(periods * T * fs)) / fs
+    r = reference_simulate(sc, law, (0.0, t[-1]), t_eval=t, rtol=1e-9)
+    rng = np.random.default_rng(seed)
+    F = r["force"] + rng.normal(0.0, force_noise * np.max(np.abs(r["force"])), t.size)
+    ch = {}
+    for k, name in enumerate(("w1", "v1", "w2", "v2")):
+        ch[name] = r["y"][k] + rng.normal(0.0, motion_noise * np.ptp(r["y"][k]), t.size)
+    if not velocities:
+        del ch["v1"], ch["v2"]
+    return Measurement(t, F, ch, source="reference")
+
+
+@pytest.fixture(scope="module")
+def light():
+    return load_scenario("light")
+
+
+@pytest.fixture(scope="module")
+def light_record(light):
+    return _record(light, light.law, seed=3)
+
+
+def test_true_law_consistent_wrong_law_not(light, light_record):
+    ok = verify(light, light_record, light.law, check_default_start=False)
+    assert ok.consistent, ok.verdict
+    assert ok.evaluation.regime == {"measured": "P1", "simulated": "P1"}
+    # stiffness 30 % off, damping 30 % off: both far outside the noise
+    for coefs in ([2.6e10, 5e11], [2e10, 3.5e11]):
+        bad = verify(light, light_record, light.law.with_coefficients(coefs),
+                     check_default_start=False)
+        assert not bad.consistent
+        assert bad.criteria["I2"] > 5 * bad.noise_floor["I2"]
+
+
+def test_noise_floor_is_the_spread_of_the_true_law(light):
+    # over independent noise draws the true law's I2 scatters around its floor
+    rows = []
+    for seed in range(4):
+        v = verify(light, _record(light, light.law, seed=10 + seed), light.law,
+                   check_default_start=False)
+        rows.append((v.criteria["I2"], v.noise_floor["I2"]))
+    i2, fl = np.array(rows).T
+    assert np.all(i2 < 2 * fl + 0.005)
+    assert 0.3 < np.mean(i2) / np.mean(fl) < 2.0
+
+
+def test_verify_starts_from_the_measured_state(light, light_record):
+    ref = Reference.from_measurement(light_record, light)
+    assert ref.start is not None
+    k = ref.start_time / light.period
+    assert k == pytest.approx(round(k), abs=1e-9)
+    # the measured state is on the orbit: a short transient suffices
+    ev = evaluate(light, light.law, ref, transient=2)
+    assert ev.status == "ok" and ev.consistent
+
+
+def test_time_offset_shifts_the_drive_clock(light, light_record):
+    # the same record with t shifted by 0.3 T is verified with --time-offset 0.3 T
+    off = 0.3 * light.period
+    shifted = Measurement(light_record.t - off, light_record.F, light_record.channels)
+    good = verify(light, shifted, light.law, time_offset=off, check_default_start=False)
+    assert good.consistent
+    assert good.reference.start_time == pytest.approx(
+        Reference.from_measurement(light_record, light).start_time)
+
+
+_SUB = Scenario(m1=7240.8062456432735, m2=5459.453320705147, k1=170863194.34024045,
+                c1=69692.89930199806, A=256308.8049041235, frequency=33.232564136106916)
+_SUB_LAW = ForceLaw.parse("1318000000*z + 23170000*zd")
+
+
+@pytest.mark.slow
+def test_subharmonic_with_several_impacts_is_aligned():
+    # a P4 orbit with 3 impacts: t* must be the same impact in both (issue case 2)
+    ss = response(_SUB, _SUB_LAW).steady
+    assert ss.regime == "P4" and ss.impacts == 3
+    rec = _record(_SUB, _SUB_LAW, periods=16, seed=1)
+    v = verify(_SUB, rec, _SUB_LAW, check_default_start=False)
+    assert v.evaluation.regime == {"measured": "P4", "simulated": "P4"}
+    assert v.consistent, v.verdict
+    # each other impact taken as t* matches far worse than the one chosen
+    from discovery.criteria import evaluate_criteria
+
+    exact = v.evaluation.extra["aligned"]
+    E = v.reference.impulse
+    others = [evaluate_criteria(E, exact.rotated(o).resampled_like(E))["I2"]
+              for o in exact.onsets[1:]]
+    assert len(others) == 2 and min(others) > 2 * v.criteria["I2"]
+
+
+_PD = Scenario(m1=4770.989046559852, m2=5430.940884957566, k1=161209836.32495606,
+               c1=343759.5619373554, A=231045.9099917681 * 1.01, frequency=37.287324033370695)
+_PD_LAW = ForceLaw.parse("1448000000*z + 9927000*zd")
+
+
+@pytest.mark.slow
+def test_slow_p1_record_is_read_as_p1():
+    # Floquet multiplier -0.985: after a short transient the record still alternates a
+    # little from period to period; it is P1 and the true law is consistent with it
+    rec = _record(_PD, _PD_LAW, periods=15, transient=600, seed=2)
+    v = verify(_PD, rec, _PD_LAW, check_default_start=False)
+    assert v.evaluation.regime == {"measured": "P1", "simulated": "P1"}
+    assert v.consistent, v.verdict
+
+
+def test_regime_mismatch_is_inconsistent(light, light_record):
+    # the P4 machine's law against a P1 record of another machine: never consistent
+    ref = Reference.from_measurement(light_record, light)
+    ev = evaluate(light, ForceLaw.parse("2e10*z^1.5"), ref)
+    assert not ev.consistent
