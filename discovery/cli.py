@@ -252,7 +252,10 @@ def _cmd_fit(args):
     sel = res.selected
     print(f"selected {sel.law}   [{sel.regime}]")
     if sel.criteria:
-        print("  criteria: " + ", ".join(f"{k} {v:.3g}" for k, v in sel.criteria.items()))
+        print("  criteria (noise floor): " + ", ".join(
+            f"{k} {v:.3g} ({sel.evaluation.noise_floor.get(k, float('nan')):.2g})"
+            for k, v in sel.criteria.items()))
+    print(f"  {sel.evaluation.verdict}")
     print(f"  certificate: {'holds' if cert.holds else 'FAILS'} on zeta <= "
           f"{cert.domain['zeta_max']:.3g} m, zd <= {cert.domain['zd_max']:.3g} m/s "
           f"(worst violation {cert.worst_violation:.2g})")

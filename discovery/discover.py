@@ -7,10 +7,12 @@ Pipeline (:func:`discover`)::
     criteria I0..I4 against the measured impulse -> ranking -> (optional) refinement
     of the chosen model's coefficients by identification through simulation.
 
-Ranking rule (regression fit and simulation together): the candidates whose
-simulation criterion (default I2) is within ``sim_rtol`` (relative) or ``sim_atol``
-(absolute) of the best are equivalent by simulation and ordered by BIC; the others
-follow in order of the criterion; models without a periodic steady state come last.
+Ranking rule (regression fit and simulation together): the candidates consistent
+with the record (:mod:`discovery.verify`: same regime, I2 within its noise floor) come
+first, the simplest by BIC; then those whose simulation criterion (default I2) is
+within ``sim_rtol`` (relative) or ``sim_atol`` (absolute) of the best, by BIC; the
+others follow in order of the criterion; models without a periodic steady state come
+last.
 """
 
 import time
@@ -21,12 +23,10 @@ import numpy as np
 from constraints import require
 
 from .criteria import criterion as _criterion
-from .criteria import evaluate_criteria
-from .errors import IntegrationError
 from .identify import identify
 from .regression import ConstrainedSparseRegressor
-from .response import response
 from .samples import contact_samples
+from .verify import Reference, evaluate
 
 __all__ = ["RankedModel", "DiscoveryResult", "discover"]
 
@@ -40,20 +40,34 @@ class RankedModel:
     law : ForceLaw
     candidate : Candidate
         Regression statistics (rss, bic, aic, cv_error).
-    regime : str
-        Steady-state regime of the simulation (``"P1"``, ... or ``"nonperiodic"``).
-    criteria : dict
-        ``I0..I4`` against the measured impulse (empty when not periodic with contact).
+    evaluation : Evaluation
+        The law simulated and scored against the record (:func:`discovery.verify.evaluate`):
+        regime, criteria, noise floor, consistency.
     """
 
     law: object
     candidate: object
-    regime: str
-    criteria: dict
+    evaluation: object
+
+    @property
+    def regime(self):
+        ev = self.evaluation
+        return ev.regime["simulated"] or ev.status
+
+    @property
+    def criteria(self):
+        return self.evaluation.criteria
+
+    @property
+    def consistent(self):
+        return self.evaluation.consistent
 
     def as_dict(self):
+        ev = self.evaluation
         return {"terms": list(self.law.names), "coefficients": self.law.as_dict(),
-                "latex": self.law.latex(), "regime": self.regime, "criteria": self.criteria,
+                "latex": self.law.latex(), "regime": self.regime, "status": ev.status,
+                "criteria": ev.criteria, "noise_floor": ev.noise_floor,
+                "consistent": ev.consistent, "verdict": ev.verdict,
                 "bic": self.candidate.bic, "aic": self.candidate.aic,
                 "cv_error": self.candidate.cv_error, "rss": self.candidate.rss,
                 "constrained": self.candidate.constrained}
@@ -95,15 +109,8 @@ class DiscoveryResult:
     settings: dict = field(default_factory=dict)
 
 
-def _check(scenario, law, candidate, measured, tolerances):
-    try:
-        r = response(scenario, law, tolerances=tolerances)
-    except IntegrationError:
-        return RankedModel(law, candidate, "nonperiodic", {})
-    if r.impulse is None:
-        regime = r.regime if not r.steady.periodic else "no-contact"
-        return RankedModel(law, candidate, regime, {})
-    return RankedModel(law, candidate, r.regime, evaluate_criteria(measured, r.like(measured)))
+def _check(scenario, law, candidate, reference, tolerances):
+    return RankedModel(law, candidate, evaluate(scenario, law, reference, tolerances=tolerances))
 
 
 def _coefficients(law, library):
@@ -113,23 +120,31 @@ def _coefficients(law, library):
 
 
 def rank(models, criterion="I2", sim_rtol=0.1, sim_atol=0.005):
-    """Order checked models by the ranking rule of the module docstring."""
+    """Order checked models: the models consistent with the record first, simplest by BIC
+    (the record cannot tell them apart); then the others whose criterion is within
+    ``sim_rtol`` (relative) or ``sim_atol`` of the best, by BIC; then the rest by the
+    criterion; models without a periodic steady state with contact last."""
     ok = [m for m in models if m.criteria]
     bad = sorted((m for m in models if not m.criteria), key=lambda m: m.candidate.bic)
     if not ok:
         return bad
-    best = min(m.criteria[criterion] for m in ok)
+    good = sorted((m for m in ok if m.consistent), key=lambda m: m.candidate.bic)
+    rest = [m for m in ok if not m.consistent]
+    if not rest:
+        return good + bad
+    best = min(m.criteria[criterion] for m in rest)
     limit = max(best * (1 + sim_rtol), best + sim_atol)
-    tier = sorted((m for m in ok if m.criteria[criterion] <= limit), key=lambda m: m.candidate.bic)
-    rest = sorted((m for m in ok if m.criteria[criterion] > limit),
+    tier = sorted((m for m in rest if m.criteria[criterion] <= limit),
+                  key=lambda m: m.candidate.bic)
+    tail = sorted((m for m in rest if m.criteria[criterion] > limit),
                   key=lambda m: m.criteria[criterion])
-    return tier + rest + bad
+    return good + tier + tail + bad
 
 
 def discover(scenario, measurement, *, library="poly:2", selection="best-subset", scoring="bic",
              max_terms=4, criterion="I2", shortlist=8, refine=False, stability=0,
              derivative=None, average_cycles=False, sim_rtol=0.1, sim_atol=0.005,
-             tolerances=None, random_state=0, **estimator_kwargs):
+             tolerances=None, random_state=0, n_boot=16, **estimator_kwargs):
     """Discover a contact law from a measurement and check the candidates by simulation.
 
     Parameters
@@ -159,7 +174,9 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     tolerances : Tolerances, optional
         Integrator settings.
     random_state : int
-        Seed of the stability selection.
+        Seed of the stability selection and of the noise-floor bootstrap.
+    n_boot : int
+        Bootstrap replicates of each candidate's noise floor.
     **estimator_kwargs
         Further estimator parameters (``margin``, ``monotone``, ``signs``, ...).
 
@@ -171,12 +188,14 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     _criterion(criterion)
     samples = contact_samples(measurement, derivative=derivative,
                               average_cycles=average_cycles, period=scenario.period)
-    measured = measurement.impulse(scenario.period)
+    reference = Reference.from_measurement(measurement, scenario, n_boot=n_boot,
+                                           seed=random_state)
+    measured = reference.impulse
     est = ConstrainedSparseRegressor(library=library, selection=selection, scoring=scoring,
                                      max_terms=max_terms, **estimator_kwargs)
     est.fit(samples.X, samples.F, groups=samples.impact, sample_weight=samples.weight)
     models = [_check(scenario, est.library_.law(
-        [c.coefficients.get(t.name, 0.0) for t in est.library_.terms]), c, measured, tolerances)
+        [c.coefficients.get(t.name, 0.0) for t in est.library_.terms]), c, reference, tolerances)
         for c in est.candidates_[:shortlist]]
     ranking = rank(models, criterion, sim_rtol, sim_atol)
     selected = ranking[0]
@@ -192,8 +211,9 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         # satisfies the physical conditions on the whole box
         if (refinement.criteria and refinement.value < selected.criteria[criterion]
                 and refined_cert.holds):
-            selected = RankedModel(refinement.law, selected.candidate, selected.regime,
-                                   refinement.criteria)
+            selected = RankedModel(refinement.law, selected.candidate,
+                                   evaluate(scenario, refinement.law, reference,
+                                            tolerances=tolerances))
             cert = refined_cert
     stab = est.stability(samples.X, samples.F, samples.impact, stability, random_state,
                          sample_weight=samples.weight) \
@@ -202,8 +222,8 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
                 "max_terms": max_terms, "criterion": criterion, "shortlist": shortlist,
                 "refine": refine, "stability": stability, "derivative": samples.derivative,
                 "average_cycles": average_cycles,
-                "random_state": random_state, "ranking_rule": {"sim_rtol": sim_rtol,
-                                                               "sim_atol": sim_atol},
+                "random_state": random_state, "n_boot": n_boot,
+                "ranking_rule": {"sim_rtol": sim_rtol, "sim_atol": sim_atol},
                 "estimator": est.get_params()}
     return DiscoveryResult(selected=selected, ranking=ranking, certificate=cert, estimator=est,
                            samples=samples, measured=measured, stability=stab,

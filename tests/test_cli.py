@@ -88,3 +88,36 @@ def test_bad_csv_messages(body, needle, tmp_path, capsys):
     p.write_text(body)
     assert main(["identify", "--data", str(p), "--start", "z", "--out", str(tmp_path / "o")]) == 2
     assert needle in capsys.readouterr().err
+
+
+def test_verify_command_writes_summary_and_figure(tmp_path):
+
+    from discovery import load_scenario
+    from discovery.dynamics.reference import reference_simulate
+    from discovery.measurement import Measurement
+
+    sc = load_scenario("light")
+    T = sc.period
+    t = 60 * T + np.arange(int(12 * T * 20000)) / 20000.0
+    r = reference_simulate(sc, sc.law, (0.0, t[-1]), t_eval=t, rtol=1e-9)
+    rng = np.random.default_rng(5)
+    ch = {n: r["y"][k] + rng.normal(0, 0.002 * np.ptp(r["y"][k]), t.size)
+          for k, n in enumerate(("w1", "v1", "w2", "v2"))}
+    F = r["force"] + rng.normal(0, 0.01 * r["force"].max(), t.size)
+    Measurement(t, F, ch).to_csv(tmp_path / "rec.csv")
+    out = tmp_path / "v"
+    assert main(["verify", "--scenario", "light", "--data", str(tmp_path / "rec.csv"),
+                 "--out", str(out), "--n-boot", "8"]) == 0
+    d = json.loads((out / "summary.json").read_text())
+    assert d["consistent"] is True and d["regime"] == {"measured": "P1", "simulated": "P1"}
+    assert set(d["noise_floor"]) == {"I0", "I1", "I2", "I3", "I4"}
+    assert d["criteria"]["I2"] <= 2 * d["noise_floor"]["I2"] + 0.005
+    assert (out / "verify.png").stat().st_size > 0
+    # a wrong law is inconsistent; an empty law is one clear line, exit 2
+    assert main(["verify", "--scenario", "light", "--data", str(tmp_path / "rec.csv"),
+                 "--law", "3e10*z^1.5 + 5e11*z^1.5*zd", "--out", str(tmp_path / "w"),
+                 "--n-boot", "8"]) == 0
+    assert json.loads((tmp_path / "w" / "summary.json").read_text())["consistent"] is False
+    assert main(["verify", "--scenario", "light", "--data", str(tmp_path / "rec.csv"),
+                 "--law", " ", "--out", str(tmp_path / "e")]) == 2
+    assert not (tmp_path / "e").exists()

@@ -1,5 +1,6 @@
 """Discovery pipeline (discovery.discover): regression, simulation check, ranking."""
 
+import dataclasses
 import math
 
 import pytest
@@ -9,6 +10,7 @@ from discovery.errors import InputError
 from discovery.law import ForceLaw
 from discovery.measurement import synthesize
 from discovery.regression import Candidate
+from discovery.verify import Evaluation
 
 RTOL, ATOL = 0.1, 0.005  # discover()'s default ranking rule
 
@@ -100,10 +102,13 @@ def test_bad_criterion_raises(paper, runup):
 # ---------------------------------------------------------------- rank()
 
 
-def _model(name, bic, i2=None, regime="P1"):
+def _model(name, bic, i2=None, regime="P1", consistent=False):
     cand = Candidate(terms=(name,), coefficients={name: 1.0}, rss=1.0, bic=bic, aic=bic)
     crit = {} if i2 is None else {"I0": i2, "I1": i2, "I2": i2, "I3": i2, "I4": i2}
-    return RankedModel(ForceLaw.parse(f"1*{name}"), cand, regime, crit)
+    status = "ok" if crit else regime
+    ev = Evaluation(status, {"measured": "P1", "simulated": regime if crit else None},
+                    {"measured": 1, "simulated": 1}, crit, {}, consistent, "")
+    return RankedModel(ForceLaw.parse(f"1*{name}"), cand, ev)
 
 
 def _names(models):
@@ -126,6 +131,14 @@ def test_rank_tier_by_bic_then_criterion():
     assert _names(rank(models)) == ["zd", "z", "zd^2", "z*zd", "z^2"]
 
 
+def test_rank_consistent_models_first_simplest_by_bic():
+    models = [_model("z", 5.0, 0.010),                       # best I2, not consistent
+              _model("zd", 9.0, 0.030, consistent=True),
+              _model("z*zd", 2.0, 0.020, consistent=True),  # consistent, lowest BIC
+              _model("zd^2", -60.0, 0.5)]
+    assert _names(rank(models)) == ["z*zd", "zd", "z", "zd^2"]
+
+
 def test_rank_absolute_tolerance_for_small_criteria():
     # best 1e-3: 10 % would be 1.1e-3, but the absolute 5e-3 makes 5.5e-3 equivalent
     models = [_model("z", 3.0, 0.001), _model("zd", 2.0, 0.0055), _model("z*zd", 1.0, 0.0061)]
@@ -140,7 +153,8 @@ def test_rank_without_any_periodic_model_orders_by_bic():
 
 def test_rank_uses_the_requested_criterion():
     a, b = _model("z", 1.0, 0.1), _model("zd", 2.0, 0.1)
-    a = RankedModel(a.law, a.candidate, "P1", {**a.criteria, "I3": 0.9})
+    a = RankedModel(a.law, a.candidate, dataclasses.replace(
+        a.evaluation, criteria={**a.criteria, "I3": 0.9}))
     assert _names(rank([a, b], criterion="I3")) == ["zd", "z"]
     assert _names(rank([a, b], criterion="I2")) == ["z", "zd"]
 
