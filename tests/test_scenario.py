@@ -1,6 +1,5 @@
 """Scenario loading and validation."""
 
-import dataclasses
 import math
 
 import numpy as np
