@@ -3,39 +3,49 @@
 Not a test module: a generator used by tests (and by ``tests/realistic_survey.py``).
 
 :func:`draw_case` draws a random, physically sensible machine (a heavily loaded
-shake-out grid: tens of tonnes, 12-40 Hz, drive 1.1-3 times the weight) and a
-random contact law of one of three kinds
+shake-out grid: 3-30 t, 12-40 Hz, drive 1.1-3 times the weight; the ranges are in
+``_BASE``/``_RANGES``) and a random contact law of one of three kinds, set from a
+contact frequency ``wc`` and damping ratio ``xi`` on the reduced mass ``mu``
+(``k = mu wc^2``, ``c = 2 xi sqrt(k mu)``) and a typical penetration
+``z0 = (typical velocity) / wc``:
 
-* ``linear``  ``k*z + c*zd``                (Kelvin-Voigt, force jump at onset)
-* ``zzd``     ``k*z + c*zd + d*z*zd``        (damping split between zd and z*zd)
-* ``hertz``   ``k*z^1.5 + l*z^1.5*zd``       (Hunt-Crossley type, no jump)
+* ``linear``  ``k*z + c*zd``                  (Kelvin-Voigt, force jump at onset)
+* ``zzd``     ``k*z + (1-s) c*zd + s c/z0*z*zd``  (damping split, ``s`` in 0.2-0.8)
+* ``hertz``   ``k/sqrt(z0)*z^1.5 + c/z0^1.5*z^1.5*zd``  (Hunt-Crossley type; secant
+  stiffness and damping match ``k``, ``c`` at ``z0``)
 
 and rejects draws until the periodic steady state reached from rest (found with the
 compiled kernel through :func:`~discovery.dynamics.steady_state.steady_state`; fast,
 and only used to *classify* the draw) has the property of the requested category:
 
-===============  =========================================================
-``p1``           P1, exactly one impact per period, max |multiplier| < 0.9
-``p1-slow``      P1, >= 1 impact per period, 0.95 < max |multiplier| < 0.985
-                 (slow transient; the upper bound keeps the default transient,
-                 capped at 600 periods, long enough to decay to 1e-4)
-``subharmonic``  P2, P3 or P4 with >= 2 impacts per orbit
-``short-contact`` P1 or P2 with >= 1 impact, contact time < 6 % of the orbit
-===============  =========================================================
+=================  =======================================================
+``p1``             P1, exactly one impact per period, max |multiplier| < 0.9
+``p1-slow``        P1, >= 1 impact per period, 0.95 < max |multiplier| < 0.985
+                   (slow transient; the upper bound keeps the default transient,
+                   capped at 600 periods, long enough to decay to 1e-4)
+``subharmonic``    P2, P3 or P4 with >= 2 impacts per orbit
+``short-contact``  P1 or P2 with >= 1 impact, contact time < 6 % of the orbit
+=================  =======================================================
 
-Draws that are nonperiodic (chaotic, many are), fail to integrate, or never
-separate are simply rejected.
+Draws that are nonperiodic (chaotic: many are), fail to integrate or never separate
+are rejected, and so (by default) is an accepted draw whose reference record cannot
+be trusted: the reference path has known failure modes (see
+:func:`_reference_problem`), so the record must start on the compiled kernel's orbit
+and agree with the kernel over the recorded span.
 
-:func:`reference_record` then simulates the case with
+:func:`reference_record` simulates a case with
 :func:`discovery.dynamics.reference.reference_simulate` (scipy DOP853 restarted at
 every contact event, written independently of the compiled kernel) **from rest**,
-through a transient, and samples the next ``periods`` periods with relative noise on
-every channel.  Integrator tolerances: the transient is integrated at
-``rtol = 1e-8`` (only its end state matters, and the orbit is attracting), the
-recorded part at ``rtol = 1e-10`` (the reference's default).  The cost is dominated
-by the ``max_step = T/50`` cap, about 10 ms per drive period, so a 600-period
-transient takes a few seconds.  Noise-free simulations are cached (``lru_cache``)
-so tests that ask for several noise realisations pay once.
+through a transient, and samples the next ``periods`` periods with noise on every
+channel relative to that channel's range.  Tolerances: the transient is integrated
+at ``rtol = 1e-8`` in 50-period pieces (only its end state matters and the orbit
+attracts), the recorded part at ``rtol = 1e-10`` (the reference's default); with
+``record_transient`` the whole span is at 1e-10.  The cost is set by the reference's
+``max_step = T/50``, about 10 ms per drive period whatever the rtol (1e-8 saves
+~10 %), so the default record takes 0.4-1 s (30-70-period transients) and up to
+~6 s for a 400-600-period transient.  Noise-free simulations are cached
+(``lru_cache``): further noise realisations of the same record are free, and the
+default record of a drawn case was already made by its check.
 """
 
 import math
@@ -185,8 +195,9 @@ def _reference_problem(scenario, law, ss, mult):
     attractor from rest), and (3) agree with the compiled kernel run from its first
     state over the recorded span (states within 1e-5 of each channel's range).
 
-    Known reference-path failures this catches (seen in about 1 in 4 accepted draws
-    of p1-slow, rarer elsewhere): (a) when ``P(zeta, 0)`` vanishes at ``zeta = 0``
+    Known reference-path failures this catches (in a 3-seed survey: 3 of 6 accepted
+    p1-slow draws, whose drive is just above lift-off so contacts graze, 1 of 4
+    short-contact, none of 6 p1 and 3 subharmonic): (a) when ``P(zeta, 0)`` vanishes at ``zeta = 0``
     (``k*z``, ``k*z^1.5``) the "release" event can be located a hair before "loss";
     the clipped mode then "resumes" at once into *unload* with ``zeta < 0``, where the
     odd extension ``sign(z)|z|^a`` of ``P`` makes the contact adhesive; (b) a loss
@@ -235,9 +246,8 @@ def draw_case(category, seed, max_tries=400, check_reference=True):
     Draws come from ``numpy.random.default_rng(seed)`` one after another until one
     is accepted; raises ``RuntimeError`` after ``max_tries`` draws.  With
     ``check_reference`` a draw is also rejected when its default reference record
-    cannot be trusted (see :func:`_reference_problem`; the reference path has a
-    failure mode on contact losses followed at once by a re-contact); the reasons
-    are kept in ``Case.reference_rejects``.
+    cannot be trusted (see :func:`_reference_problem`: the reference path has known
+    failures at contact losses); the reasons are kept in ``Case.reference_rejects``.
     """
     if category not in CATEGORIES:
         raise ValueError(f"unknown category {category!r}; choose one of {CATEGORIES}")
