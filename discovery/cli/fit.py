@@ -1,0 +1,119 @@
+"""``vidi fit``: discover a law (certified sparse regression, every candidate simulated)."""
+
+import csv
+import io
+
+from .._io import OutputDir, provenance
+from ..criteria import CRITERIA
+from ..scenario import load_scenario
+from ._common import SCENARIO_HELP
+
+
+def run(args):
+    from reports import fit_impulse_figure, fit_loop_figure, fit_surface_figure, model_tex
+
+    from ..discover import discover
+    from ..measurement import Measurement
+    from ..response import response
+
+    sc = load_scenario(args.scenario)
+    meas = Measurement.from_csv(args.data, scenario=sc)
+    for note in meas.notes:
+        print(f"note: {note}")
+    res = discover(sc, meas, library=args.library, selection=args.select, scoring=args.score,
+                   max_terms=args.max_terms, criterion=args.criterion,
+                   shortlist=args.shortlist, refine=args.refine, stability=args.stability,
+                   derivative=args.derivative, average_cycles=args.average_cycles,
+                   random_state=args.seed, margin=args.margin,
+                   monotone=args.monotone)
+    imps = []
+    for k, m in enumerate(res.ranking[:3]):
+        if m.criteria:
+            imps.append((f"#{k + 1}: {', '.join(m.law.names)} "
+                         f"({args.criterion} {m.criteria[args.criterion]:.3g})",
+                         response(sc, m.law).like(res.measured)))
+    cert = res.certificate
+    summary = {
+        "command": "fit", "scenario": sc.as_dict(), "data": str(args.data),
+        "selected": res.selected.as_dict(),
+        "ranking": [m.as_dict() for m in res.ranking],
+        "certificate": {"method": cert.method, "holds": cert.holds,
+                        "worst_violation": cert.worst_violation, "domain": cert.domain,
+                        "conditions": cert.conditions},
+        "stability": res.stability,
+        "refinement": None if res.refinement is None else {
+            "coefficients": res.refinement.coefficients, "criteria": res.refinement.criteria,
+            "n_simulations": res.refinement.n_simulations},
+        "samples": {"n": len(res.samples), "impacts": res.samples.n_impacts,
+                    "derivative": res.samples.derivative, "noise": res.samples.noise},
+        "measured": {"n_cycles": res.measured.n_cycles, "n_periods": res.measured.n_periods,
+                     "noise": res.measured.noise, "threshold": res.measured.threshold},
+        "n_solves": res.estimator.n_solves_, "seconds": res.seconds,
+        "fit_settings": res.settings, **provenance(vars(args))}
+    with OutputDir(args.out) as out:
+        out.write_json("summary.json", summary)
+        buf = io.StringIO()
+        w = csv.writer(buf)
+        w.writerow(["rank", "terms", "regime", "bic", "aic", "cv_error", *CRITERIA,
+                    "coefficients"])
+        for i, m in enumerate(res.ranking):
+            w.writerow([i + 1, " + ".join(m.law.names), m.regime, f"{m.candidate.bic:.8g}",
+                        f"{m.candidate.aic:.8g}", f"{m.candidate.cv_error:.6g}",
+                        *[f"{m.criteria[n]:.6g}" if m.criteria else "" for n in CRITERIA],
+                        m.law.to_text()])
+        out.path("ranking.csv").write_text(buf.getvalue())
+        out.path("model.tex").write_text(model_tex(res, sc))
+        fit_impulse_figure(res, imps, str(out.path("fit_impulse")))
+        fit_surface_figure(res, str(out.path("fit_surface")))
+        fit_loop_figure(res, str(out.path("fit_loop")))
+    sel = res.selected
+    print(f"selected {sel.law}   [{sel.regime}]")
+    if sel.criteria:
+        print("  criteria (noise floor): " + ", ".join(
+            f"{k} {v:.3g} ({sel.evaluation.noise_floor.get(k, float('nan')):.2g})"
+            for k, v in sel.criteria.items()))
+    print(f"  {sel.evaluation.verdict}")
+    print(f"  certificate: {'holds' if cert.holds else 'FAILS'} on zeta <= "
+          f"{cert.domain['zeta_max']:.3g} m, zd <= {cert.domain['zd_max']:.3g} m/s "
+          f"(worst violation {cert.worst_violation:.2g})")
+    print(f"  {len(res.ranking)} candidates ranked ({res.samples.n_impacts} impacts, "
+          f"{len(res.samples)} contact samples, {res.seconds:.1f} s)")
+    if res.stability:
+        print("  stability: " + ", ".join(f"{k} {v:.2f}" for k, v in res.stability.items()
+                                          if v > 0))
+    print(f"outputs in {args.out}/: summary.json, ranking.csv, model.tex, fit_impulse.png/.pdf, "
+          "fit_surface.png/.pdf, fit_loop.png/.pdf")
+    return 0
+
+
+def register(sub):
+    s = sub.add_parser("fit", help="discover a law: sparse certified regression, every "
+                       "candidate checked by simulation")
+    s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
+    s.add_argument("--data", required=True, help="CSV with t, F, w1, w2 (v1, v2 optional)")
+    s.add_argument("--library", default="poly:2",
+                   help="candidate terms: poly:N, hc, a list 'z,zd,z*zd', or sums (poly:2)")
+    s.add_argument("--select", default="best-subset",
+                   choices=["best-subset", "l1-path", "stlsq", "sr3", "constrained-sr3"],
+                   help="how supports are proposed (best-subset)")
+    s.add_argument("--score", default="bic", choices=["bic", "aic", "cv"],
+                   help="regression score that orders the candidates (bic)")
+    s.add_argument("--max-terms", type=int, default=4, help="largest support (4)")
+    s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
+                   help="simulation criterion of the ranking (I2)")
+    s.add_argument("--shortlist", type=int, default=8, help="candidates simulated (8)")
+    s.add_argument("--margin", type=float, default=0.0,
+                   help="dissipativity strictness margin in N s/m (0)")
+    s.add_argument("--monotone", action="store_true",
+                   help="also require a monotone elastic branch")
+    s.add_argument("--refine", action="store_true",
+                   help="refine the chosen model's coefficients by simulation")
+    s.add_argument("--stability", type=int, default=0,
+                   help="bootstrap resamples of impacts for stability selection (0)")
+    s.add_argument("--derivative", choices=["velocities", "savgol", "pysindy"],
+                   help="source of dzeta (default: velocities if recorded, else savgol)")
+    s.add_argument("--average-cycles", action="store_true",
+                   help="average the steady cycles sample by sample before the regression")
+    s.add_argument("--seed", type=int, default=0, help="seed of the stability selection")
+    s.add_argument("--out", required=True, help="output directory")
+    s.set_defaults(func=run)
