@@ -1,76 +1,149 @@
-"""Discovery: sparse certified regression, then every shortlisted model checked by simulation.
+"""Discovery: sparse certified regression, then every shortlisted model refined and checked
+by simulation.
 
 Pipeline (:func:`discover`)::
 
-    Measurement -> contact samples -> ConstrainedSparseRegressor (one candidate per
-    proposed support) -> each candidate simulated to its periodic steady state ->
-    criteria I0..I4 against the measured impulse -> ranking -> (optional) refinement
-    of the chosen model's coefficients by identification through simulation.
+    record(s) -> contact samples (joined over records) -> ConstrainedSparseRegressor
+    (one candidate per proposed support) -> each shortlisted support refined by
+    output-error identification through simulation (all records jointly, starting from
+    its regression coefficients; the certificate is checked again) -> each law
+    simulated from every record's measured state and scored against its noise floor
+    (:func:`discovery.verify.evaluate`) -> ranking -> warnings and equivalent models.
 
-Ranking rule (regression fit and simulation together): the candidates consistent
-with the record (:mod:`discovery.verify`: same regime, I2 within its noise floor) come
-first, the simplest by BIC; then those whose simulation criterion (default I2) is
-within ``sim_rtol`` (relative) or ``sim_atol`` (absolute) of the best, by BIC; the
-others follow in order of the criterion; models without a periodic steady state come
-last.
+Why refine: the regression sees the penetration ``zeta = w1 - w2`` and its rate,
+which are noisy (a small difference of two large motions); its coefficients are then
+biased (errors in variables).  The output-error refinement fits the force history by
+simulation, where the penetration is computed, not measured.
+
+Then up to ``stepwise`` output-error moves around the best model: when it is not
+consistent, a forward step extends it by each library term it lacks (refined by
+simulation from its coefficients), so a support the biased regression never proposed can
+still be found; when it is consistent but has terms whose coefficient is within two
+standard errors of zero, a backward step drops each such term and refines the rest.
+
+Ranking rule: the models consistent with every record (same regime; I2 and I4 within
+their noise floors, see :mod:`discovery.verify`) come first, the fewest terms first, then
+by the criterion; then
+those whose simulation criterion (default I2) is within ``sim_rtol`` (relative) or
+``sim_atol`` (absolute) of the best, by BIC; the others follow in order of the
+criterion; models without a periodic steady state come last.
 """
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from constraints import require
 
 from .criteria import criterion as _criterion
+from .errors import InputError, IntegrationError
 from .identify import identify
 from .regression import ConstrainedSparseRegressor
-from .samples import contact_samples
+from .samples import contact_samples, join_samples
 from .verify import Reference, evaluate
 
-__all__ = ["RankedModel", "DiscoveryResult", "discover"]
+__all__ = ["RankedModel", "DiscoveryResult", "discover", "rank"]
+
+_REFINE_BUDGET = 120   # simulations per shortlisted support (every record counts)
+_FORWARD_STARTS = (0.01, 0.001)  # a new term's start force at the box corner / peak force
+_SIGNIFICANT = 2.0  # a term whose |coefficient| is below this many standard errors may go
 
 
 @dataclass(frozen=True)
 class RankedModel:
-    """A candidate with its simulation check.
+    """A candidate law with its simulation check against every record.
 
     Attributes
     ----------
     law : ForceLaw
+        The law (refined by simulation when refinement ran and kept the certificate).
     candidate : Candidate
-        Regression statistics (rss, bic, aic, cv_error).
-    evaluation : Evaluation
-        The law simulated and scored against the record (:func:`discovery.verify.evaluate`):
-        regime, criteria, noise floor, consistency.
+        Regression statistics of ``law`` on the contact samples (rss, bic, aic; for a
+        refined law recomputed for the refined coefficients; the regression's own
+        coefficients are in ``candidate.extra["regression_coefficients"]``).
+    evaluations : tuple of Evaluation
+        The law simulated and scored against each record
+        (:func:`discovery.verify.evaluate`): regime, criteria, noise floor, consistency.
+    refinement : IdentificationResult or None
+        The output-error refinement (standard errors, simulations used).
+    note : str
+        What happened to the refinement (kept, or why not).
+    certificate : constraints.Certificate or None
+        Of ``law`` on the box of the samples it was fitted to.
     """
 
     law: object
     candidate: object
-    evaluation: object
+    evaluations: tuple
+    refinement: object = None
+    note: str = ""
+    certificate: object = None
+
+    @property
+    def evaluation(self):
+        """The evaluation against the first record."""
+        return self.evaluations[0]
 
     @property
     def regime(self):
-        ev = self.evaluation
-        return ev.regime["simulated"] or ev.status
+        return ", ".join(ev.regime["simulated"] or ev.status for ev in self.evaluations)
 
     @property
     def criteria(self):
-        return self.evaluation.criteria
+        """Criteria I0..I4, the mean over records (empty unless every record is ``ok``)."""
+        if not all(ev.criteria for ev in self.evaluations):
+            return {}
+        return {k: float(np.mean([ev.criteria[k] for ev in self.evaluations]))
+                for k in self.evaluations[0].criteria}
+
+    @property
+    def noise_floor(self):
+        """Noise floor of every criterion, the mean over records."""
+        if not all(ev.noise_floor for ev in self.evaluations):
+            return {}
+        return {k: float(np.mean([ev.noise_floor[k] for ev in self.evaluations]))
+                for k in self.evaluations[0].noise_floor}
 
     @property
     def consistent(self):
-        return self.evaluation.consistent
+        """Consistent with every record."""
+        return all(ev.consistent for ev in self.evaluations)
+
+    @property
+    def verdict(self):
+        if len(self.evaluations) == 1:
+            return self.evaluation.verdict
+        bad = [(i, ev) for i, ev in enumerate(self.evaluations) if not ev.consistent]
+        if not bad:
+            return f"consistent with all {len(self.evaluations)} records"
+        i, ev = bad[0]
+        return f"inconsistent with record {i + 1}: {ev.verdict}" + (
+            f" (and {len(bad) - 1} more)" if len(bad) > 1 else "")
+
+    @property
+    def standard_errors(self):
+        """``{term: standard error}`` from the refinement (empty without it)."""
+        return dict(self.refinement.standard_errors) if self.refinement is not None \
+            and self.note.startswith("refined") else {}
 
     def as_dict(self):
         ev = self.evaluation
-        return {"terms": list(self.law.names), "coefficients": self.law.as_dict(),
-                "latex": self.law.latex(), "regime": self.regime, "status": ev.status,
-                "criteria": ev.criteria, "noise_floor": ev.noise_floor,
-                "consistent": ev.consistent, "verdict": ev.verdict,
-                "bic": self.candidate.bic, "aic": self.candidate.aic,
-                "cv_error": self.candidate.cv_error, "rss": self.candidate.rss,
-                "constrained": self.candidate.constrained}
+        d = {"terms": list(self.law.names), "coefficients": self.law.as_dict(),
+             "standard_errors": self.standard_errors,
+             "regression_coefficients": self.candidate.extra.get(
+                 "regression_coefficients", self.candidate.coefficients),
+             "latex": self.law.latex(), "regime": self.regime, "status": ev.status,
+             "criteria": self.criteria, "noise_floor": self.noise_floor,
+             "consistent": self.consistent, "verdict": self.verdict,
+             "bic": self.candidate.bic, "aic": self.candidate.aic,
+             "cv_error": self.candidate.cv_error, "rss": self.candidate.rss,
+             "constrained": self.candidate.constrained, "refinement": self.note}
+        if self.refinement is not None:
+            d["n_simulations"] = self.refinement.n_simulations
+        if len(self.evaluations) > 1:
+            d["records"] = [e.as_dict() for e in self.evaluations]
+        return d
 
 
 @dataclass(frozen=True)
@@ -80,20 +153,29 @@ class DiscoveryResult:
     Attributes
     ----------
     selected : RankedModel
-        The chosen model (after refinement when requested).
+        The chosen model.
     ranking : list of RankedModel
-        Every candidate, best first.
+        Every shortlisted candidate, best first.
     certificate : constraints.Certificate
         Of the selected law on the data's box.
     estimator : ConstrainedSparseRegressor
         The fitted estimator.
     samples : ContactSamples
+        The contact samples of all records, joined.
     measured : Impulse
+        The first record's measured cycle.
+    references : tuple of (Scenario, Reference)
+        Every record with its scenario.
     stability : dict
         ``{term: selection frequency}`` over bootstrap resamples of impacts (empty if
         not requested).
-    refinement : IdentificationResult or None
+    warnings : list of str
+        Why the record(s) may not identify the law (see :func:`discover`).
+    equivalent : list of dict
+        Models the records cannot tell apart from the selected one, with the reason and
+        what data would separate them.
     seconds : float
+        Wall time of the whole discovery.
     settings : dict
     """
 
@@ -103,14 +185,17 @@ class DiscoveryResult:
     estimator: object
     samples: object
     measured: object
+    references: tuple = ()
     stability: dict = field(default_factory=dict)
-    refinement: object = None
+    warnings: list = field(default_factory=list)
+    equivalent: list = field(default_factory=list)
     seconds: float = 0.0
     settings: dict = field(default_factory=dict)
 
-
-def _check(scenario, law, candidate, reference, tolerances):
-    return RankedModel(law, candidate, evaluate(scenario, law, reference, tolerances=tolerances))
+    @property
+    def refinement(self):
+        """The selected model's refinement (or None)."""
+        return self.selected.refinement
 
 
 def _coefficients(law, library):
@@ -120,15 +205,16 @@ def _coefficients(law, library):
 
 
 def rank(models, criterion="I2", sim_rtol=0.1, sim_atol=0.005):
-    """Order checked models: the models consistent with the record first, simplest by BIC
-    (the record cannot tell them apart); then the others whose criterion is within
-    ``sim_rtol`` (relative) or ``sim_atol`` of the best, by BIC; then the rest by the
-    criterion; models without a periodic steady state with contact last."""
+    """Order checked models: the models consistent with the records first, the fewest terms
+    first, then by the criterion (the records cannot tell them apart); then the others
+    whose criterion is within ``sim_rtol`` (relative) or ``sim_atol`` of the best, by BIC;
+    then the rest by the criterion; models without a periodic steady state with contact last."""
     ok = [m for m in models if m.criteria]
     bad = sorted((m for m in models if not m.criteria), key=lambda m: m.candidate.bic)
     if not ok:
         return bad
-    good = sorted((m for m in ok if m.consistent), key=lambda m: m.candidate.bic)
+    good = sorted((m for m in ok if m.consistent),
+                  key=lambda m: (len(m.law.names), m.criteria[criterion]))
     rest = [m for m in ok if not m.consistent]
     if not rest:
         return good + bad
@@ -141,28 +227,291 @@ def rank(models, criterion="I2", sim_rtol=0.1, sim_atol=0.005):
     return good + tier + tail + bad
 
 
+def _steady_from(ref):
+    """Record time from which a record is steady: its first averaged cycle's onset."""
+    return float(ref.impulse.onset)
+
+
+def _pairs(scenario, measurement):
+    scs = list(scenario) if isinstance(scenario, list | tuple) else [scenario]
+    ms = list(measurement) if isinstance(measurement, list | tuple) else [measurement]
+    if len(scs) == 1 and len(ms) > 1:
+        scs = scs * len(ms)
+    if not ms or len(scs) != len(ms):
+        raise InputError(f"{len(ms)} record(s) but {len(scs)} scenario(s): give one scenario "
+                         "per record (or one for all)")
+    return list(zip(scs, ms, strict=True))
+
+
+class _Checker:
+    """Refines (optionally) and evaluates one regression candidate against all records."""
+
+    def __init__(self, est, samples, refs, criterion, refine, tolerances, budget):
+        self.est, self.samples, self.refs = est, samples, refs
+        self.criterion, self.refine, self.tol, self.budget = criterion, refine, tolerances, budget
+
+    def evaluate(self, law):
+        return tuple(evaluate(sc, law, ref, tolerances=self.tol) for sc, ref in self.refs)
+
+    def __call__(self, cand):
+        """Refine and check a regression candidate."""
+        est = self.est
+        law = est.library_.law([cand.coefficients.get(t.name, 0.0) for t in est.library_.terms])
+        return self.refined(law, cand, "regression")
+
+    def refined(self, law, cand, origin):
+        """Refine ``law`` (from ``origin``: "regression" or a forward step) and check it."""
+        est = self.est
+        extra = {"regression_coefficients": dict(cand.coefficients), "origin": origin}
+        cert0 = est.certify(_coefficients(law, est.library_))
+        if not self.refine:
+            return RankedModel(law, cand, self.evaluate(law), note="not refined",
+                               certificate=cert0)
+        try:
+            ref = identify([sc for sc, _ in self.refs], [r for _, r in self.refs], law,
+                           criterion=self.criterion, method="least-squares",
+                           max_simulations=self.budget, tolerances=self.tol)
+        except IntegrationError as exc:
+            return RankedModel(law, cand, self.evaluate(law),
+                               note=f"not refined: the {origin} law fails ({exc})",
+                               certificate=cert0)
+        coef = _coefficients(ref.law, est.library_)
+        cert = est.certify(coef)
+        if not cert.holds:
+            return RankedModel(law, cand, self.evaluate(law), refinement=ref,
+                               note="not refined: the refined coefficients break a physical "
+                               f"condition (worst violation {cert.worst_violation:.2g})",
+                               certificate=cert0)
+        s = self.samples
+        rescored = est.rescore(coef, s.X, s.F, s.weight, constrained=cand.constrained,
+                               extra={**cand.extra, **extra})
+        rescored = replace(rescored, cv_error=cand.cv_error)
+        return RankedModel(ref.law, rescored, self.evaluate(ref.law), refinement=ref,
+                           note=f"refined by simulation from the {origin} "
+                           f"({ref.n_simulations} simulations, {self.criterion} "
+                           f"{ref.value:.3g})", certificate=cert)
+
+    def backward(self, base):
+        """Output-error backward step: ``base`` without each of its insignificant terms
+        (``|c| < 2 x standard error``), refined by simulation from the other coefficients."""
+        se = base.standard_errors
+        names = base.law.names
+        if len(names) < 2 or not se:
+            return []
+        lib = self.est.library_
+        out = []
+        for term, c in base.law.as_dict().items():
+            if not abs(c) < _SIGNIFICANT * se.get(term, 0.0):
+                continue
+            coef = _coefficients(base.law, lib)
+            coef[[t.name for t in lib.terms].index(term)] = 0.0
+            cand = self.est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight)
+            out.append(self.refined(lib.law(coef), cand,
+                                    f"backward step from {' + '.join(names)}"))
+        return out
+
+    def forward(self, base, max_terms):
+        """Output-error forward step: ``base`` plus each library term it lacks, every trial
+        refined by simulation from ``base``'s coefficients and a small start value of the
+        new term (its force at the far corner of the data's box 1 % of the peak force, or
+        0.1 % when that start has no periodic orbit)."""
+        est = self.est
+        lib = est.library_
+        peak = float(np.max(np.abs(self.samples.F)))
+        corner = lib.transform(np.array([[est.box_.zeta_max, est.box_.zd_max]]))[0]
+        have = set(base.law.names)
+        if len(have) >= max_terms:
+            return []
+        out = []
+        for i, term in enumerate(lib.terms):
+            if term.name in have or corner[i] <= 0:
+                continue
+            origin = f"forward step from {' + '.join(base.law.names)}"
+            for frac in _FORWARD_STARTS:
+                coef = _coefficients(base.law, lib)
+                coef[i] = frac * peak / corner[i]
+                cand = est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight)
+                trial = self.refined(lib.law(coef), cand, origin)
+                if trial.criteria:
+                    break
+            out.append(trial)
+        return out
+
+
+def _stability_warning(stab, selected):
+    if not stab:
+        return None
+    names = set(selected.law.names)
+    weak = [t for t in names if stab.get(t, 0.0) < 0.5]
+    strong = [t for t, f in stab.items() if f >= 0.5 and t not in names]
+    if not weak and not strong:
+        return None
+    parts = []
+    if weak:
+        parts.append("selected but chosen in < 50 % of resamples: " + ", ".join(
+            f"{t} ({stab.get(t, 0.0):.2f})" for t in sorted(weak)))
+    if strong:
+        parts.append("chosen in >= 50 % of resamples but not selected: " + ", ".join(
+            f"{t} ({stab[t]:.2f})" for t in sorted(strong)))
+    return ("stability selection disagrees with the selected support (" + "; ".join(parts)
+            + "): the record may not identify these terms")
+
+
+def _impact_warnings(pairs, parts, refs):
+    out = []
+    for k, ((sc, meas), s, (_, ref)) in enumerate(zip(pairs, parts, refs, strict=True)):
+        E = ref.impulse
+        span = float(meas.t[-1] - meas.t[0])
+        expected = span / (E.n_periods * sc.period) * ref.impacts
+        n = s.n_impacts
+        if expected >= 2 and not (0.6 * expected - 1 <= n <= 1.15 * expected + 1):
+            label = f"record {k + 1}" if len(pairs) > 1 else "the record"
+            out.append(f"{label} gives {n} impacts for the contact samples, but its "
+                       f"{span / sc.period:.0f} periods of a {ref.regime} cycle with "
+                       f"{ref.impacts} contact(s) hold about {expected:.0f}: contacts are "
+                       "split or merged (noisy positions?); check the record, record the "
+                       "velocities, or lower the position noise")
+    return out
+
+
+def _warnings(selected, by_bic, stab, pairs, parts, refs, samples, refine):
+    out = []
+    w = _stability_warning(stab, selected)
+    if w:
+        out.append(w)
+    failing = [m for m in by_bic[:3] if not m.criteria]
+    if failing:
+        out.append(f"{len(failing)} of the 3 best candidates by the regression score have no "
+                   "periodic steady state with contact (" + "; ".join(
+                       f"{' + '.join(m.law.names)}: {m.evaluation.status}" for m in failing)
+                   + "): the regression alone would mislead here")
+    out.extend(_impact_warnings(pairs, parts, refs))
+    if not selected.consistent:
+        out.append("no shortlisted model is consistent with the record(s) within the noise "
+                   "floor: try a larger library (e.g. poly:3+hc), a longer shortlist, or check "
+                   "the scenario (masses, supports, drive)")
+    if samples.derivative != "velocities" and not refine:
+        out.append(f"dzeta was obtained by {samples.derivative} from noisy positions: the "
+                   "regression coefficients are biased (errors in variables); use the "
+                   "refinement by simulation")
+    ref = selected.refinement
+    if ref is not None and selected.standard_errors:
+        reg = selected.candidate.extra.get("regression_coefficients", {})
+        moved = []
+        for t, c in selected.law.as_dict().items():
+            se = selected.standard_errors.get(t, 0.0)
+            c0 = reg.get(t)
+            if c0 is not None and se > 0 and abs(c - c0) > max(3 * se, 0.1 * abs(c)):
+                moved.append(f"{t} {c0:.3g} -> {c:.3g} ({abs(c - c0) / se:.0f} standard "
+                             "errors)")
+        if moved:
+            out.append("the refinement by simulation moved regression coefficients far beyond "
+                       "their uncertainty (" + "; ".join(moved) + "): the regression is biased "
+                       "by noisy penetration or velocity; the refined values are reported")
+    return out
+
+
+def _collinearity(est, samples, terms, others):
+    """R^2 of each of ``terms``' columns regressed on ``others``' along the samples."""
+    lib = est.library_
+    idx = {t.name: i for i, t in enumerate(lib.terms)}
+    theta = lib.transform(samples.X) * np.sqrt(samples.weight)[:, None]
+    B = theta[:, [idx[t] for t in others]] if others else np.zeros((theta.shape[0], 0))
+    r2 = {}
+    for t in terms:
+        y = theta[:, idx[t]]
+        if B.shape[1]:
+            res = y - B @ np.linalg.lstsq(B, y, rcond=None)[0]
+        else:
+            res = y
+        tot = float(y @ y)
+        r2[t] = 1.0 - float(res @ res) / tot if tot > 0 else 0.0
+    return r2
+
+
+def _separation(est, a, b):
+    """How much two checked models' simulated force histories differ on the recorded
+    orbits, and where their laws differ most beyond the recorded range (up to 2x the
+    recorded penetration and impact velocity); both relative to the peak force."""
+    d_in, peak = 0.0, 1e-300
+    for ea, eb in zip(a.evaluations, b.evaluations, strict=True):
+        fa, fb = ea.simulated.F, eb.simulated.F
+        peak = max(peak, float(np.max(np.abs(fa))))
+        d_in = max(d_in, float(np.max(np.abs(fa - fb))))
+    box = est.box_
+    zz, vv = np.meshgrid(np.linspace(0, 2 * box.zeta_max, 41),
+                         np.linspace(0, 2 * box.zd_max, 41))
+    d = np.abs(a.law(zz, vv) - b.law(zz, vv)) / peak
+    i = np.unravel_index(int(np.argmax(d)), d.shape)
+    return d_in / peak, float(d[i]), float(zz[i]), float(vv[i])
+
+
+def _equivalent(ranking, selected, est, samples, criterion):
+    """Consistent models whose criterion is within the noise floor of the selected one's."""
+    if not selected.consistent or not selected.criteria:
+        return []
+    best = selected.criteria[criterion]
+    tol = selected.noise_floor.get(criterion, 0.0)
+    out = []
+    for m in ranking:
+        if m is selected or not m.consistent or m.criteria[criterion] > best + tol:
+            continue
+        sel_t, m_t = set(selected.law.names), set(m.law.names)
+        extra = sorted(m_t - sel_t) or sorted(sel_t - m_t)
+        base = sorted(sel_t & m_t)
+        r2 = _collinearity(est, samples, extra, base) if extra else {}
+        near = {t: v for t, v in r2.items() if v > 0.95}
+        d_in, d_out, z, v = _separation(est, selected, m)
+        differ = (" vs ".join(" + ".join(sorted(x)) for x in (sel_t - m_t, m_t - sel_t) if x)
+                  or "the coefficients")
+        if near:
+            reason = ("near-collinear along the recorded orbit(s): " + ", ".join(
+                f"{t} is explained by {' + '.join(base) or 'nothing'} to R^2 = {v:.3f}"
+                for t, v in near.items()))
+        else:
+            reason = (f"{differ}: their simulated force histories differ by at most "
+                      f"{100 * d_in:.1f} % of the peak on the recorded orbit(s), within the "
+                      "noise floor")
+        separate = (f"their forces differ by {100 * d_out:.0f} % of the recorded peak at "
+                    f"zeta = {z:.3g} m, zd = {v:.3g} m/s (recorded up to "
+                    f"{est.box_.zeta_max:.3g} m, {est.box_.zd_max:.3g} m/s): a record with "
+                    "faster or deeper impacts (larger drive amplitude, another frequency) "
+                    "would separate them" if d_out > 2 * d_in else
+                    "they differ little anywhere near the recorded range: the data cannot "
+                    "separate them; prefer the simpler one")
+        out.append({"terms": list(m.law.names), "coefficients": m.law.as_dict(),
+                    "criteria": m.criteria, "consistent": True, "reason": reason,
+                    "separate": separate})
+    return out
+
+
 def discover(scenario, measurement, *, library="poly:2", selection="best-subset", scoring="bic",
-             max_terms=4, criterion="I2", shortlist=8, refine=False, stability=0,
+             max_terms=4, criterion="I2", shortlist=8, refine=True, stability=0,
              derivative=None, average_cycles=False, sim_rtol=0.1, sim_atol=0.005,
-             tolerances=None, random_state=0, n_boot=16, **estimator_kwargs):
-    """Discover a contact law from a measurement and check the candidates by simulation.
+             tolerances=None, random_state=0, n_boot=16, max_simulations=_REFINE_BUDGET,
+             stepwise=3, **estimator_kwargs):
+    """Discover a contact law from one or several records and check it by simulation.
 
     Parameters
     ----------
-    scenario : Scenario
-        The known part of the machine (masses, supports, drive).
-    measurement : Measurement
-        Needs ``t``, ``F``, ``w1``, ``w2`` (``v1``, ``v2`` optional).
+    scenario : Scenario or sequence of Scenario
+        The known part of the machine (masses, supports, drive): one per record, or one
+        for all (a machine tested at several drive frequencies or amplitudes has one
+        scenario per operating point).
+    measurement : Measurement or sequence of Measurement
+        Each needs ``t``, ``F``, ``w1``, ``w2`` (``v1``, ``v2`` optional).  All records
+        are fitted jointly: several operating points separate terms one orbit cannot.
     library, selection, scoring, max_terms
         Passed to :class:`~discovery.regression.ConstrainedSparseRegressor`.
     criterion : str
-        Simulation criterion for the ranking (``I0``..``I4``).
+        Simulation criterion of the refinement and of the ranking (``I0``..``I4``).
     shortlist : int
-        How many candidates (best by ``scoring``) are simulated.
+        How many candidates (best by ``scoring``) are refined and simulated (>= 1).
     refine : bool
-        Refine the chosen model's coefficients by identification through simulation
-        (least squares on the impulse, starting from the regression); the refined law
-        is kept only if it is better by simulation and still certified.
+        Refine every shortlisted support by output-error identification through
+        simulation (least squares on the force histories of all records, from the
+        regression coefficients); the certificate is checked again, and a refined law that
+        breaks it is not used.  Gives the coefficients' standard errors.
     stability : int
         Bootstrap resamples of impacts for stability selection (0 = skip).
     derivative : str, optional
@@ -172,60 +521,79 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     sim_rtol, sim_atol : float
         Tolerances of the ranking rule.
     tolerances : Tolerances, optional
-        Integrator settings.
+        Integrator settings (the same for refinement and checks).
     random_state : int
         Seed of the stability selection and of the noise-floor bootstrap.
     n_boot : int
         Bootstrap replicates of each candidate's noise floor.
+    max_simulations : int
+        Simulation budget of each support's refinement.
+    stepwise : int
+        Output-error stepwise moves around the best model (see the module docstring).
     **estimator_kwargs
         Further estimator parameters (``margin``, ``monotone``, ``signs``, ...).
 
     Returns
     -------
     DiscoveryResult
+        With ``warnings`` when the record(s) may not identify the law: stability selection
+        disagreeing with the selected support, the best candidates by BIC without a
+        periodic steady state, impact counts that do not fit the measured regime, no
+        consistent model, a refinement that moved coefficients far beyond their
+        uncertainty (regression bias).
     """
     t0 = time.perf_counter()
     _criterion(criterion)
-    samples = contact_samples(measurement, derivative=derivative,
-                              average_cycles=average_cycles, period=scenario.period)
-    reference = Reference.from_measurement(measurement, scenario, n_boot=n_boot,
-                                           seed=random_state)
-    measured = reference.impulse
+    if not (isinstance(shortlist, int | np.integer) and shortlist >= 1):
+        raise InputError(f"shortlist must be a positive integer (candidates simulated); got "
+                         f"{shortlist!r}")
+    pairs = _pairs(scenario, measurement)
+    parts = [contact_samples(m, derivative=derivative, average_cycles=average_cycles,
+                             period=sc.period) for sc, m in pairs]
+    samples = join_samples(parts)
+    refs = [(sc, Reference.from_measurement(m, sc, n_boot=n_boot, seed=random_state))
+            for sc, m in pairs]
     est = ConstrainedSparseRegressor(library=library, selection=selection, scoring=scoring,
                                      max_terms=max_terms, **estimator_kwargs)
     est.fit(samples.X, samples.F, groups=samples.impact, sample_weight=samples.weight)
-    models = [_check(scenario, est.library_.law(
-        [c.coefficients.get(t.name, 0.0) for t in est.library_.terms]), c, reference, tolerances)
-        for c in est.candidates_[:shortlist]]
+    check = _Checker(est, samples, refs, criterion, refine, tolerances, max_simulations)
+    models = [check(c) for c in est.candidates_[:shortlist]]
+    by_score = list(models)  # the estimator's order (its scoring)
     ranking = rank(models, criterion, sim_rtol, sim_atol)
+    steps = []
+    while refine and ranking[0].criteria and len(steps) < stepwise:
+        # output-error stepwise search around the best model: a consistent model with
+        # insignificant terms loses one (backward), an inconsistent one gains one (forward:
+        # the regression may have been misled, e.g. by noisy penetration)
+        top = ranking[0]
+        if top.consistent:
+            trials, kind = check.backward(top), "backward"
+        else:
+            trials, kind = check.forward(top, max_terms), "forward"
+        if not trials:
+            break
+        steps.append({"kind": kind, "from": list(top.law.names), "trials": len(trials)})
+        models = models + trials
+        ranking = rank(models, criterion, sim_rtol, sim_atol)
+        if ranking[0] is top:
+            break
     selected = ranking[0]
-    refinement = None
     # the certificate of the law actually selected (the ranking may prefer another
     # candidate than the estimator's best by BIC); a failure is an error
-    cert = require(est.certify(_coefficients(selected.law, est.library_)))
-    if refine and selected.criteria:
-        refinement = identify(scenario, measured, selected.law, criterion=criterion,
-                              method="least-squares")
-        refined_cert = est.certify(_coefficients(refinement.law, est.library_))
-        # the refined law replaces the fit only if it is better by simulation AND still
-        # satisfies the physical conditions on the whole box
-        if (refinement.criteria and refinement.value < selected.criteria[criterion]
-                and refined_cert.holds):
-            selected = RankedModel(refinement.law, selected.candidate,
-                                   evaluate(scenario, refinement.law, reference,
-                                            tolerances=tolerances))
-            cert = refined_cert
+    cert = require(selected.certificate)
     stab = est.stability(samples.X, samples.F, samples.impact, stability, random_state,
-                         sample_weight=samples.weight) \
-        if stability else {}
+                         sample_weight=samples.weight) if stability else {}
+    warnings = _warnings(selected, by_score, stab, pairs, parts, refs, samples, refine)
+    equivalent = _equivalent(ranking, selected, est, samples, criterion)
     settings = {"library": str(library), "selection": selection, "scoring": scoring,
                 "max_terms": max_terms, "criterion": criterion, "shortlist": shortlist,
-                "refine": refine, "stability": stability, "derivative": samples.derivative,
-                "average_cycles": average_cycles,
-                "random_state": random_state, "n_boot": n_boot,
+                "refine": refine, "max_simulations": max_simulations, "stability": stability,
+                "derivative": samples.derivative, "average_cycles": average_cycles,
+                "random_state": random_state, "n_boot": n_boot, "records": len(pairs),
+                "stepwise": stepwise, "steps": steps,
                 "ranking_rule": {"sim_rtol": sim_rtol, "sim_atol": sim_atol},
                 "estimator": est.get_params()}
     return DiscoveryResult(selected=selected, ranking=ranking, certificate=cert, estimator=est,
-                           samples=samples, measured=measured, stability=stab,
-                           refinement=refinement, seconds=time.perf_counter() - t0,
-                           settings=settings)
+                           samples=samples, measured=refs[0][1].impulse, references=tuple(refs),
+                           stability=stab, warnings=warnings, equivalent=equivalent,
+                           seconds=time.perf_counter() - t0, settings=settings)

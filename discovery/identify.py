@@ -1,7 +1,9 @@
-"""Identification by simulation: minimise a criterion over a law's coefficients.
+"""Identification by simulation (output error): minimise a criterion over a law's coefficients.
 
-Every objective evaluation is a full simulation to the periodic steady state and a
-comparison of its impulse with the measured one.  Coefficients are optimised in
+Every objective evaluation is :func:`discovery.verify.evaluate` (the one evaluation
+function: simulate to the periodic steady state from the record's measured state,
+align the impacts, sample like the record, score I0..I4).  Several records, each with
+its own scenario (operating point), are fitted jointly.  Coefficients are optimised in
 units of the start values (``x_i = c_i / c_i^start``) so all methods see a
 well-scaled problem.  Methods:
 
@@ -12,9 +14,18 @@ well-scaled problem.  Methods:
 ``nelder-mead``
     scipy's Nelder–Mead simplex (derivative-free).
 ``least-squares``
-    scipy's trust-region least squares on the residual vector
-    ``(F_N - F_E)`` weighted so that its squared norm is ``I3^2`` (a smooth
+    scipy's trust-region least squares on the residual vector ``(F_N - F_E)`` of every
+    record, weighted so that each record's squared norm is its ``I3^2`` (a smooth
     surrogate, Gauss–Newton fast); the chosen criterion is reported.
+
+The simulation budget counts every simulation, the finite-difference Jacobians
+included.  A simulation that fails or has no periodic orbit with contact is recorded
+in ``failures`` (the optimiser sees a penalty); a start law that fails is an error.
+
+Coefficient uncertainty: the Jacobian ``J`` of the weighted residuals at the optimum
+(forward differences, one simulation per coefficient and record) gives the
+covariance ``s^2 (J^T J)^-1`` with ``s^2 = RSS / (m - p)`` (as lmfit scales it: the
+residual variance estimated from the fit), hence a standard error per coefficient.
 """
 
 import time
@@ -23,14 +34,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares, minimize
 
-from .criteria import compare, criterion, evaluate_criteria
+from .criteria import criterion as _criterion
 from .errors import InputError, IntegrationError
-from .response import response
+from .impulse import Impulse
+from .verify import Reference, evaluate
 
-__all__ = ["IdentificationResult", "identify", "METHODS"]
+__all__ = ["IdentificationResult", "identify", "METHODS", "as_records"]
 
 METHODS = ("coordinate-descent", "nelder-mead", "least-squares")
-_PENALTY = 10.0
+_PENALTY = 10.0          # criterion value of a failed simulation (criteria are O(1))
+_JAC_STEP = 1e-5         # relative step of the standard-error Jacobian
 
 
 @dataclass(frozen=True)
@@ -42,16 +55,25 @@ class IdentificationResult:
     law : ForceLaw
         Identified law.
     criterion : str
-        The criterion minimised (reported for every method).
+        The criterion minimised (reported for every method; the mean over records).
     value : float
         Its final value.
     criteria : dict
-        All criteria ``I0..I4`` at the identified law.
+        All criteria ``I0..I4`` at the identified law (the mean over records).
+    evaluations : tuple of Evaluation
+        The identified law against each record (without noise floor).
     method : str
     n_simulations : int
-        Steady-state simulations used.
+        Steady-state simulations used (every record counts, Jacobians included).
     iterations : list of dict
-        Every iterate: ``coefficients`` {term: value}, ``value``, ``n_simulations``.
+        Every improving iterate: ``coefficients`` {term: value}, ``value``,
+        ``n_simulations``.
+    standard_errors : dict
+        ``{term: standard error}`` (empty when not computed or not estimable).
+    correlation : ndarray or None
+        Correlation matrix of the coefficients (order of ``law.names``).
+    failures : list of dict
+        Simulations that failed: ``coefficients``, ``status``, ``message``.
     seconds : float
     message : str
     """
@@ -62,7 +84,11 @@ class IdentificationResult:
     criteria: dict
     method: str
     n_simulations: int
+    evaluations: tuple = ()
     iterations: list = field(default_factory=list)
+    standard_errors: dict = field(default_factory=dict)
+    correlation: object = None
+    failures: list = field(default_factory=list)
     seconds: float = 0.0
     message: str = ""
 
@@ -71,45 +97,79 @@ class IdentificationResult:
         return self.law.as_dict()
 
 
-class _Objective:
-    """Counts simulations, caches them, and records the best-so-far path."""
+class _Budget(Exception):
+    """The simulation budget is used up."""
 
-    def __init__(self, scenario, start, measured, name, sampled, tolerances):
-        self.scenario, self.start, self.measured = scenario, start, measured
-        self.name, self.sampled, self.tol = name, sampled, tolerances
-        self.func = criterion(name)
+
+def as_records(scenario, reference):
+    """``[(scenario, Reference), ...]`` from one pair or from two equal-length sequences.
+
+    ``reference`` may be a :class:`~discovery.verify.Reference`, a
+    :class:`~discovery.measurement.Measurement` (prepared with
+    :meth:`Reference.from_measurement`) or an exact :class:`~discovery.impulse.Impulse`.
+    """
+    scs = list(scenario) if isinstance(scenario, list | tuple) else [scenario]
+    refs = list(reference) if isinstance(reference, list | tuple) else [reference]
+    if len(scs) == 1 and len(refs) > 1:
+        scs = scs * len(refs)
+    if len(scs) != len(refs) or not refs:
+        raise InputError(f"{len(refs)} record(s) but {len(scs)} scenario(s): give one scenario "
+                         "per record (or one for all)")
+    out = []
+    for sc, ref in zip(scs, refs, strict=True):
+        if isinstance(ref, Impulse):
+            ref = Reference.exact(ref, source="impulse")
+        elif not isinstance(ref, Reference):
+            ref = Reference.from_measurement(ref, sc)
+        out.append((sc, ref))
+    return out
+
+
+class _Objective:
+    """Counts and caches simulations, enforces the budget, records the best-so-far path."""
+
+    def __init__(self, records, start, name, tolerances, max_sim):
+        self.records, self.start, self.name = records, start, name
+        self.tol, self.max_sim = tolerances, max_sim
+        _criterion(name)
         self.c0 = np.array(start.coefficients)
         self.n = 0
         self.cache = {}
         self.best = (np.inf, None)
-        self.path = []
+        self.path, self.failures = [], []
         # residual weights: trapezoid-like sample spacing, normalised so that the sum
-        # of squared residuals is I3^2
-        E = measured
-        self.w = np.sqrt(np.gradient(E.t) / max(np.trapezoid(E.F**2, E.t), 1e-300))
+        # of squared residuals of a record is its I3^2
+        self.w = []
+        for _, ref in records:
+            E = ref.impulse
+            self.w.append(np.sqrt(np.gradient(E.t) / max(np.trapezoid(E.F**2, E.t), 1e-300)))
 
     def law(self, x):
         return self.start.with_coefficients(self.c0 * np.asarray(x))
 
-    def impulse(self, x):
+    def evaluations(self, x):
         key = tuple(np.round(np.asarray(x, dtype=float), 14))
         if key not in self.cache:
-            self.n += 1
-            try:
-                r = response(self.scenario, self.law(x), tolerances=self.tol)
-                imp = r.impulse
-                if imp is not None and self.sampled:
-                    imp = imp.resampled_like(self.measured)
-            except IntegrationError:
-                imp = None
-            self.cache[key] = imp
+            if self.n + len(self.records) > self.max_sim:
+                raise _Budget
+            law = self.law(x)
+            evs = []
+            for sc, ref in self.records:
+                self.n += 1
+                ev = evaluate(sc, law, ref, tolerances=self.tol, floor=False)
+                evs.append(ev)
+                if ev.status != "ok":
+                    self.failures.append({"coefficients": law.as_dict(), "status": ev.status,
+                                          "message": ev.message or ev.verdict})
+                    break
+            self.cache[key] = evs if all(e.status == "ok" for e in evs) else None
         return self.cache[key]
 
     def __call__(self, x):
-        imp = self.impulse(x)
-        if imp is None:
+        evs = self.evaluations(x)
+        if evs is None:
             return _PENALTY
-        v = float(self.func(compare(self.measured, imp)))
+        v = float(np.mean([e.criteria[self.name] for e in evs]))
         if v < self.best[0]:
             self.best = (v, np.array(x, dtype=float))
             self.path.append({"coefficients": self.law(x).as_dict(), "value": v,
@@ -117,24 +177,26 @@ class _Objective:
         return v
 
     def residuals(self, x):
-        imp = self.impulse(x)
-        E, w = self.measured, self.w
-        if imp is None:
-            return (np.full(E.t.size, _PENALTY) * w * max(np.max(np.abs(E.F)), 1.0))[1:]
+        evs = self.evaluations(x)
+        if evs is None:
+            # a failed point: residuals as large as an all-wrong force history
+            return np.concatenate([_PENALTY * w[1:] * np.max(np.abs(ref.impulse.F))
+                                   for (_, ref), w in zip(self.records, self.w, strict=True)])
         self(x)  # records the path with the requested criterion
-        fn = imp.evaluate(E.t, "left")
         # the onset value F_E(0+) is extrapolated from samples: it is left out so the
         # fit is not biased by the extrapolation error at the jump
-        return ((fn - E.F) * w)[1:]
+        return np.concatenate([((ev.simulated.F - ref.impulse.F) * w)[1:]
+                               for ev, (_, ref), w in zip(evs, self.records, self.w,
+                                                          strict=True)])
 
 
-def _coordinate_descent(obj, x0, xtol, max_sim, step0=0.1):
+def _coordinate_descent(obj, x0, xtol, step0=0.1):
     x = np.array(x0, dtype=float)
     fx = obj(x)
     steps = np.full(x.size, step0)
-    while np.any(steps > xtol) and obj.n < max_sim:
+    while np.any(steps > xtol):
         for i in range(x.size):
-            if steps[i] <= xtol or obj.n >= max_sim:
+            if steps[i] <= xtol:
                 continue
             improved = False
             for direction in (1.0, -1.0):
@@ -144,7 +206,7 @@ def _coordinate_descent(obj, x0, xtol, max_sim, step0=0.1):
                 if ft < fx:
                     x, fx, improved = trial, ft, True
                     # accelerate: keep going and double the step while it pays
-                    while obj.n < max_sim:
+                    while True:
                         steps[i] *= 2.0
                         trial = x.copy()
                         trial[i] += direction * steps[i]
@@ -159,60 +221,121 @@ def _coordinate_descent(obj, x0, xtol, max_sim, step0=0.1):
     return x
 
 
-def identify(scenario, measured, start, *, criterion="I2", method="coordinate-descent",
-             xtol=1e-5, max_simulations=600, sampled=True, tolerances=None):
-    """Identify the coefficients of ``start`` from a measured impulse by simulation.
+def _uncertainty(obj, x, names):
+    """Standard errors and correlations from the residual Jacobian at ``x``."""
+    r0 = obj.residuals(x)
+    J = np.empty((r0.size, x.size))
+    for i in range(x.size):
+        xi = x.copy()
+        h = _JAC_STEP * max(abs(x[i]), 1e-3)
+        xi[i] += h
+        if obj.evaluations(xi) is None:
+            return {}, None
+        J[:, i] = (obj.residuals(xi) - r0) / h
+    m, p = J.shape
+    if m <= p:
+        return {}, None
+    s2 = float(r0 @ r0) / (m - p)
+    try:
+        cov = s2 * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        return {}, None
+    d = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    se = {n: float(abs(c) * s) for n, c, s in zip(names, obj.c0, d, strict=True)}
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(d, d)
+    return se, corr
+
+
+def identify(scenario, reference, start, *, criterion="I2", method="coordinate-descent",
+             xtol=1e-5, max_simulations=600, tolerances=None, uncertainty=True):
+    """Identify the coefficients of ``start`` from one or several records by simulation.
 
     Parameters
     ----------
-    scenario : Scenario
-        The known part of the machine.
-    measured : Impulse
-        ``F_E`` (e.g. :meth:`Measurement.impulse`).
+    scenario : Scenario or sequence of Scenario
+        The known part of the machine; one per record (or one for all).
+    reference : Reference, Measurement or Impulse, or a sequence of them
+        The record(s) (see :func:`as_records`).  A :class:`Reference` built with
+        :meth:`~discovery.verify.Reference.from_measurement` starts every simulation from
+        the machine's measured state.
     start : ForceLaw
         Terms to identify and their start values (all non-zero).
     criterion : str
-        Criterion to minimise (``I0``..``I4``).
+        Criterion to minimise (``I0``..``I4``; the mean over records).
     method : str
         One of :data:`METHODS`.
     xtol : float
-        Relative coefficient tolerance.
+        Relative coefficient tolerance (> 0).
     max_simulations : int
-        Simulation budget.
-    sampled : bool
-        Compare ``F_N`` sampled like the measurement (default) or exact.
+        Simulation budget (every record and every Jacobian evaluation counts).
     tolerances : Tolerances, optional
+        Integrator settings (the same for every evaluation).
+    uncertainty : bool
+        Estimate standard errors (one more simulation per coefficient and record).
 
     Returns
     -------
     IdentificationResult
+
+    Raises
+    ------
+    InputError
+        Bad settings.
+    IntegrationError
+        The start law has no periodic steady state with contact.
     """
     if method not in METHODS:
         raise InputError(f"unknown method {method!r}; valid methods: {', '.join(METHODS)}")
     if any(c == 0 for c in start.coefficients):
         raise InputError("every start coefficient must be non-zero (they set the scale)")
+    if not (np.isfinite(xtol) and xtol > 0):
+        raise InputError(f"xtol must be a positive number, got {xtol!r}")
+    records = as_records(scenario, reference)
+    if not (isinstance(max_simulations, int | np.integer)
+            and max_simulations >= 2 * len(records)):
+        raise InputError(f"the simulation budget must be an integer of at least "
+                         f"{2 * len(records)} (two per record); got {max_simulations!r}")
     t0 = time.perf_counter()
-    obj = _Objective(scenario, start, measured, criterion, sampled, tolerances)
+    obj = _Objective(records, start, criterion, tolerances, int(max_simulations))
     x0 = np.ones(len(start.coefficients))
-    if method == "coordinate-descent":
-        _coordinate_descent(obj, x0, xtol, max_simulations)
-        message = "steps below xtol" if obj.n < max_simulations else "simulation budget used"
-    elif method == "nelder-mead":
-        simplex = np.vstack([x0] + [x0 + 0.1 * np.eye(x0.size)[i] for i in range(x0.size)])
-        res = minimize(obj, x0, method="Nelder-Mead",
-                       options={"xatol": xtol, "fatol": 1e-12, "maxfev": max_simulations,
-                                "initial_simplex": simplex})
-        message = res.message
-    else:
-        res = least_squares(obj.residuals, x0, method="trf", x_scale=1.0, diff_step=1e-6,
-                            xtol=xtol * 1e-2, ftol=1e-12, gtol=1e-12,
-                            max_nfev=max_simulations)
-        message = res.message
-    x_best = obj.best[1] if obj.best[1] is not None else x0
+    if obj.evaluations(x0) is None:
+        f = obj.failures[-1]
+        raise IntegrationError(f"the start law {start} cannot be compared with the record: "
+                               f"{f['status']} ({f['message']}); give start values closer to "
+                               "the record (e.g. from vidi fit)")
+    message = ""
+    try:
+        if method == "coordinate-descent":
+            _coordinate_descent(obj, x0, xtol)
+            message = "steps below xtol"
+        elif method == "nelder-mead":
+            simplex = np.vstack([x0] + [x0 + 0.1 * np.eye(x0.size)[i] for i in range(x0.size)])
+            res = minimize(obj, x0, method="Nelder-Mead",
+                           options={"xatol": xtol, "fatol": 1e-12, "maxfev": max_simulations,
+                                    "initial_simplex": simplex})
+            message = str(res.message)
+        else:
+            res = least_squares(obj.residuals, x0, method="trf", x_scale=1.0, diff_step=1e-6,
+                                xtol=xtol * 1e-2, ftol=1e-12, gtol=1e-12)
+            message = str(res.message)
+    except _Budget:
+        message = f"simulation budget of {max_simulations} used"
+    if obj.best[1] is None:  # least squares evaluates residuals, which record the path
+        obj(x0)
+    x_best = obj.best[1]
     law = obj.law(x_best)
-    imp = obj.impulse(x_best)
-    crit = evaluate_criteria(measured, imp) if imp is not None else {}
+    evs = obj.evaluations(x_best)
+    se, corr = {}, None
+    if uncertainty:
+        obj.max_sim += len(x_best) * len(records)  # the error estimate has its own budget
+        se, corr = _uncertainty(obj, x_best, law.names)
+    crit = {k: float(np.mean([e.criteria[k] for e in evs])) for k in evs[0].criteria}
+    if obj.failures:
+        message += (f"; {len(obj.failures)} trial law(s) had no periodic steady state with "
+                    "contact (see failures)")
     return IdentificationResult(
         law=law, criterion=criterion, value=float(obj.best[0]), criteria=crit, method=method,
-        n_simulations=obj.n, iterations=obj.path, seconds=time.perf_counter() - t0,
-        message=str(message))
+        n_simulations=obj.n, evaluations=tuple(evs), iterations=obj.path,
+        standard_errors=se, correlation=corr, failures=obj.failures,
+        seconds=time.perf_counter() - t0, message=message)

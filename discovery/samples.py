@@ -19,7 +19,7 @@ from scipy.signal import savgol_filter
 from .errors import InputError
 from .impulse import estimate_noise, impulse_from_samples
 
-__all__ = ["ContactSamples", "contact_samples"]
+__all__ = ["ContactSamples", "contact_samples", "join_samples"]
 
 DERIVATIVES = ("velocities", "savgol", "pysindy")
 
@@ -66,6 +66,26 @@ class ContactSamples:
 
     def __len__(self):
         return self.zeta.size
+
+
+def join_samples(parts):
+    """The contact samples of several records as one set (impacts renumbered so each
+    record's impacts stay distinct groups; the noise is the RMS of the records')."""
+    parts = list(parts)
+    if len(parts) == 1:
+        return parts[0]
+    impact, offset = [], 0
+    for p in parts:
+        impact.append(p.impact + offset)
+        offset += int(p.impact.max()) + 1 if p.impact.size else 0
+    derivs = sorted({p.derivative for p in parts})
+    return ContactSamples(zeta=np.concatenate([p.zeta for p in parts]),
+                          dzeta=np.concatenate([p.dzeta for p in parts]),
+                          F=np.concatenate([p.F for p in parts]),
+                          impact=np.concatenate(impact),
+                          weight=np.concatenate([p.weight for p in parts]),
+                          noise=float(np.sqrt(np.mean([p.noise**2 for p in parts]))),
+                          derivative=derivs[0] if len(derivs) == 1 else "+".join(derivs))
 
 
 def _steady_cycles(*stacks):
@@ -200,8 +220,14 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
     if contact.sum() < 10:
         raise InputError("fewer than 10 contact samples (zeta = w1 - w2 > 0 above its noise); "
                          "check the w1 and w2 columns and their sign (positions upward)")
+    # impacts: runs of contact samples; two runs are one impact unless zeta falls clearly
+    # below zero (< -floor) between them (noise dips near onset and loss do not split it)
     starts = np.flatnonzero(np.diff(np.concatenate([[0], contact.astype(np.int8)])) == 1)
-    impact_all = np.cumsum(np.isin(np.arange(t.size), starts)) - 1
+    ends = np.flatnonzero(np.diff(np.concatenate([contact.astype(np.int8), [0]])) == -1)
+    new = np.ones(starts.size, dtype=bool)
+    for j in range(1, starts.size):
+        new[j] = bool(np.min(zeta[ends[j - 1] + 1:starts[j]]) < -floor)
+    impact_all = np.cumsum(np.isin(np.arange(t.size), starts[new])) - 1
     idx = np.flatnonzero(contact)
     impact = impact_all[idx]
     if weights == "uniform":
@@ -214,3 +240,4 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
         raise InputError(f"weights must be 'uniform' or 'per-impact', got {weights!r}")
     return ContactSamples(zeta=zeta[idx], dzeta=dzeta[idx], F=F[idx], impact=impact, weight=w,
                           noise=sigma, derivative=derivative)
+

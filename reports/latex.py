@@ -26,6 +26,14 @@ def _num(v, digits=4):
     return f"${_math(v, digits)}$"
 
 
+def _law_tex(entry):
+    """LaTeX of an ``equivalent`` entry's law."""
+    from discovery.law import ForceLaw, Term
+
+    d = entry["coefficients"]
+    return ForceLaw(tuple(Term.parse(k) for k in d), tuple(d.values())).latex()
+
+
 def model_tex(result, scenario):
     """A standalone LaTeX document describing a discovered law.
 
@@ -40,8 +48,20 @@ def model_tex(result, scenario):
     """
     sel = result.selected
     cert = result.certificate
-    rows = "\n".join(rf"  \texttt{{{_esc(k)}}} & {_num(v)} \\" for k, v in
-                     sel.law.as_dict().items())
+    se = sel.standard_errors
+    rows = "\n".join(rf"  \texttt{{{_esc(k)}}} & {_num(v)} & {_num(se.get(k))} \\"
+                     for k, v in sel.law.as_dict().items())
+    floor = sel.noise_floor
+    floors = " & ".join(_num(floor.get(k), 2) for k in ("I0", "I1", "I2", "I3", "I4"))
+    warn = "".join(rf"\item {_esc(w)}" + "\n" for w in result.warnings)
+    warn = (r"\paragraph{Warnings.}" + "\n" + r"\begin{itemize}" + "\n" + warn
+            + r"\end{itemize}" + "\n") if warn else ""
+    equiv = "".join(rf"\item ${e_law}$: {_esc(e['reason'])}; {_esc(e['separate'])}" + "\n"
+                    for e, e_law in ((e, _law_tex(e)) for e in result.equivalent))
+    equiv = (r"\paragraph{Models the record cannot tell apart}" + " (consistent, within the "
+             "noise of the selected one):\n" + r"\begin{itemize}" + "\n" + equiv
+             + r"\end{itemize}" + "\n") if equiv else ""
+    nrec = len(result.references) or 1
     crit = " & ".join(_num(sel.criteria.get(k)) for k in ("I0", "I1", "I2", "I3", "I4"))
     ranking = "\n".join(
         rf"  {i + 1} & \texttt{{{_esc(', '.join(m.law.names))}}} & {m.regime} & "
@@ -59,9 +79,9 @@ For $\zeta>0$, with $\dot\zeta_+=\max(\dot\zeta,0)$ (and $F=0$ for $\zeta\le 0$)
 F(\zeta,\dot\zeta) = \max\Bigl(0,\; {sel.law.latex()}\Bigr)
 \end{{equation}}
 \begin{{center}}
-\begin{{tabular}}{{lr}}
+\begin{{tabular}}{{lrr}}
 \toprule
-term & coefficient (SI) \\
+term & coefficient (SI) & standard error \\
 \midrule
 {rows}
 \bottomrule
@@ -72,18 +92,25 @@ $\dot\zeta_+\in[0,{_math(dom['zd_max'])}]$ m/s:
 conditions {'hold' if cert.holds else 'DO NOT hold'}, worst relative violation
 {_num(cert.worst_violation)}.
 
-\paragraph{{Simulation check.}} Steady state {sel.regime};
-criteria against the measured impulse:
+Standard errors from the output-error Jacobian at the refined coefficients
+(residual variance estimated from the fit{'' if se else '; not computed: no refinement'}).
+
+\paragraph{{Simulation check.}} Steady state {sel.regime}; criteria against the
+measured impulse ({'mean over ' + str(nrec) + ' records' if nrec > 1 else 'one record'}),
+with the noise floor (what the true law would score on records this noisy):
 \begin{{center}}
-\begin{{tabular}}{{ccccc}}
+\begin{{tabular}}{{lccccc}}
 \toprule
-$I_0$ & $I_1$ & $I_2$ & $I_3$ & $I_4$ \\
+ & $I_0$ & $I_1$ & $I_2$ & $I_3$ & $I_4$ \\
 \midrule
-{crit} \\
+criteria & {crit} \\
+noise floor & {floors} \\
 \bottomrule
 \end{{tabular}}
 \end{{center}}
+Verdict: {_esc(sel.verdict)}.
 
+{warn}{equiv}
 \paragraph{{Ranking}} (selection \texttt{{{_esc(result.settings['selection'])}}},
 library \texttt{{{_esc(result.settings['library'])}}}):
 \begin{{center}}

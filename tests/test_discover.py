@@ -34,15 +34,22 @@ def biased(paper):
     without and with refinement."""
     m = synthesize(paper, paper.law, periods=300, fs=20000, noise=0.01, seed=0,
                    from_rest=True, position_noise=0.01, velocities=False)
-    return discover(paper, m, library="z,zd"), discover(paper, m, library="z,zd", refine=True)
+    return (discover(paper, m, library="z,zd", refine=False),
+            discover(paper, m, library="z,zd"))
 
 
 def test_selects_true_support_p1_and_certified(result, paper):
     sel = result.selected
     assert sel.law.names == ["z", "zd"]
-    # run-up records with 1 % noise: coefficients within 2 % (measured 1.0 %)
+    assert sel.consistent, sel.verdict
+    # refined by simulation: every coefficient within 3 standard errors of the truth or
+    # 0.5 % (the standard errors cover the noise, not the ~0.2 % bias of averaging 150
+    # sampled cycles; measured: z 2.015e8 +- 4.2e6, zd 1.2822e7 +- 5.1e3)
+    se = sel.standard_errors
     for name, true in paper.law.as_dict().items():
-        assert abs(sel.law.as_dict()[name] / true - 1) < 0.02
+        c = sel.law.as_dict()[name]
+        assert abs(c - true) < max(3 * se[name], 0.005 * abs(true)), (name, c, se[name])
+        assert 0 < se[name] < 0.05 * abs(true)
     assert sel.regime == "P1"
     assert set(sel.criteria) == {"I0", "I1", "I2", "I3", "I4"}
     assert result.certificate.holds and result.certificate.worst_violation <= 1e-7
@@ -54,19 +61,23 @@ def test_selects_true_support_p1_and_certified(result, paper):
 def test_selected_follows_the_ranking_rule(result):
     ranked = [m for m in result.ranking if m.criteria]
     assert len(ranked) >= 2
-    best = min(m.criteria["I2"] for m in ranked)
-    limit = max(best * (1 + RTOL), best + ATOL)
     sel = result.selected
     assert sel is result.ranking[0]
-    assert sel.criteria["I2"] <= limit
-    # among the models equivalent by simulation, the smallest BIC
-    tier = [m for m in ranked if m.criteria["I2"] <= limit]
-    assert sel.candidate.bic == min(m.candidate.bic for m in tier)
-    # the whole ranking: tier by BIC, then the others by I2, then models without criteria
-    n = len(tier)
-    assert [m.candidate.bic for m in result.ranking[:n]] == sorted(m.candidate.bic for m in tier)
-    rest = result.ranking[n:len(ranked)]
-    assert [m.criteria["I2"] for m in rest] == sorted(m.criteria["I2"] for m in rest)
+    # consistent models first: the fewest terms, then the criterion
+    good = [m for m in ranked if m.consistent]
+    assert good and result.ranking[:len(good)] == good
+    keys = [(len(m.law.names), m.criteria["I2"]) for m in good]
+    assert keys == sorted(keys)
+    # then the others: the tier within the tolerance by BIC, then by I2
+    rest = ranked[len(good):]
+    if rest:
+        best = min(m.criteria["I2"] for m in rest)
+        limit = max(best * (1 + RTOL), best + ATOL)
+        tier = [m for m in rest if m.criteria["I2"] <= limit]
+        assert [m.candidate.bic for m in rest[:len(tier)]] == sorted(m.candidate.bic
+                                                                     for m in tier)
+        tail = rest[len(tier):]
+        assert [m.criteria["I2"] for m in tail] == sorted(m.criteria["I2"] for m in tail)
     assert all(not m.criteria for m in result.ranking[len(ranked):])
 
 
@@ -74,10 +85,13 @@ def test_result_bookkeeping(result):
     assert result.seconds > 0
     assert result.settings["library"] == "poly:3"
     assert result.settings["estimator"]["library"] == "poly:3"
-    assert result.refinement is None and result.stability == {}
-    # every ranked model comes from a regression candidate
+    assert result.refinement is result.selected.refinement is not None
+    assert result.stability == {}
+    # every ranked model comes from a regression candidate or a stepwise move from one
     terms = {c.terms for c in result.estimator.candidates_}
-    assert all(tuple(m.law.names) in terms for m in result.ranking)
+    for m in result.ranking:
+        origin = m.candidate.extra["origin"]
+        assert (origin == "regression" and tuple(m.law.names) in terms) or "step" in origin
 
 
 def test_refinement_reduces_the_criterion_of_a_biased_regression(biased):
@@ -85,12 +99,13 @@ def test_refinement_reduces_the_criterion_of_a_biased_regression(biased):
     assert plain.refinement is None and refined.refinement is not None
     before = plain.selected.criteria["I2"]
     after = refined.selected.criteria["I2"]
-    # measured I2 0.150 for the regression's law, 0.087 after refinement
     assert after < 0.8 * before, (before, after)
-    # the refined coefficients replaced the regression's, on the same support
+    # the biased regression drops the small elastic term; the output-error forward step
+    # finds it again, and the refined law is consistent with the record
+    assert plain.selected.law.names == ["zd"] and not plain.selected.consistent
+    assert refined.selected.law.names == ["z", "zd"] and refined.selected.consistent
     assert refined.selected.law.as_dict() == refined.refinement.law.as_dict()
-    assert refined.selected.law.names == plain.selected.law.names
-    assert refined.selected.law.as_dict() != plain.selected.law.as_dict()
+    assert "forward step" in refined.selected.candidate.extra["origin"]
     assert refined.certificate.holds
 
 
@@ -108,7 +123,7 @@ def _model(name, bic, i2=None, regime="P1", consistent=False):
     status = "ok" if crit else regime
     ev = Evaluation(status, {"measured": "P1", "simulated": regime if crit else None},
                     {"measured": 1, "simulated": 1}, crit, {}, consistent, "")
-    return RankedModel(ForceLaw.parse(f"1*{name}"), cand, ev)
+    return RankedModel(ForceLaw.parse(f"1*{name}"), cand, (ev,))
 
 
 def _names(models):
@@ -131,12 +146,16 @@ def test_rank_tier_by_bic_then_criterion():
     assert _names(rank(models)) == ["zd", "z", "zd^2", "z*zd", "z^2"]
 
 
-def test_rank_consistent_models_first_simplest_by_bic():
+def test_rank_consistent_models_first_fewest_terms_then_criterion():
+    two = _model("z", -99.0, 0.005, consistent=True)  # consistent, best BIC, but two terms
+    two = RankedModel(ForceLaw.parse("1*z + 1*zd"), two.candidate, two.evaluations)
     models = [_model("z", 5.0, 0.010),                       # best I2, not consistent
               _model("zd", 9.0, 0.030, consistent=True),
-              _model("z*zd", 2.0, 0.020, consistent=True),  # consistent, lowest BIC
+              _model("z*zd", 2.0, 0.020, consistent=True),  # consistent, smaller I2
+              two,
               _model("zd^2", -60.0, 0.5)]
-    assert _names(rank(models)) == ["z*zd", "zd", "z", "zd^2"]
+    assert _names(rank(models)) == ["z*zd", "zd", "z", "z", "zd^2"]
+    assert rank(models)[2] is two
 
 
 def test_rank_absolute_tolerance_for_small_criteria():
@@ -153,8 +172,8 @@ def test_rank_without_any_periodic_model_orders_by_bic():
 
 def test_rank_uses_the_requested_criterion():
     a, b = _model("z", 1.0, 0.1), _model("zd", 2.0, 0.1)
-    a = RankedModel(a.law, a.candidate, dataclasses.replace(
-        a.evaluation, criteria={**a.criteria, "I3": 0.9}))
+    a = RankedModel(a.law, a.candidate, (dataclasses.replace(
+        a.evaluation, criteria={**a.criteria, "I3": 0.9}),))
     assert _names(rank([a, b], criterion="I3")) == ["zd", "z"]
     assert _names(rank([a, b], criterion="I2")) == ["z", "zd"]
 

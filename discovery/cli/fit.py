@@ -5,6 +5,7 @@ import io
 
 from .._io import OutputDir, provenance
 from ..criteria import CRITERIA
+from ..errors import InputError
 from ..scenario import load_scenario
 from ._common import SCENARIO_HELP
 
@@ -16,13 +17,23 @@ def run(args):
     from ..measurement import Measurement
     from ..response import response
 
-    sc = load_scenario(args.scenario)
-    meas = Measurement.from_csv(args.data, scenario=sc)
-    for note in meas.notes:
-        print(f"note: {note}")
-    res = discover(sc, meas, library=args.library, selection=args.select, scoring=args.score,
+    data = args.data
+    names = args.scenario or ["paper"]
+    if len(names) not in (1, len(data)):
+        raise InputError(f"{len(data)} --data record(s) but {len(names)} --scenario: give one "
+                         "--scenario per --data, in the same order, or one for all")
+    scs = [load_scenario(n) for n in names] * (len(data) if len(names) == 1 else 1)
+    meas = []
+    for path, sc_k in zip(data, scs, strict=True):
+        m = Measurement.from_csv(path, scenario=sc_k)
+        for note in m.notes:
+            print(f"note: {path}: {note}" if len(data) > 1 else f"note: {note}")
+        meas.append(m)
+    sc = scs[0]
+    res = discover(scs, meas, library=args.library, selection=args.select, scoring=args.score,
                    max_terms=args.max_terms, criterion=args.criterion,
-                   shortlist=args.shortlist, refine=args.refine, stability=args.stability,
+                   shortlist=args.shortlist, refine=not args.no_refine,
+                   max_simulations=args.max_simulations, stability=args.stability,
                    derivative=args.derivative, average_cycles=args.average_cycles,
                    random_state=args.seed, margin=args.margin,
                    monotone=args.monotone)
@@ -34,8 +45,14 @@ def run(args):
                          response(sc, m.law).like(res.measured)))
     cert = res.certificate
     summary = {
-        "command": "fit", "scenario": sc.as_dict(), "data": str(args.data),
+        "command": "fit", "scenario": sc.as_dict(),
+        "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
+        "records": [{"data": str(p), "scenario": s_k.name, "regime": ref.regime,
+                     "impacts": ref.impacts, "noise": ref.noise}
+                    for p, s_k, (_, ref) in zip(data, scs, res.references, strict=True)],
         "selected": res.selected.as_dict(),
+        "warnings": res.warnings,
+        "equivalent": res.equivalent,
         "ranking": [m.as_dict() for m in res.ranking],
         "certificate": {"method": cert.method, "holds": cert.holds,
                         "worst_violation": cert.worst_violation, "domain": cert.domain,
@@ -43,7 +60,9 @@ def run(args):
         "stability": res.stability,
         "refinement": None if res.refinement is None else {
             "coefficients": res.refinement.coefficients, "criteria": res.refinement.criteria,
-            "n_simulations": res.refinement.n_simulations},
+            "standard_errors": res.refinement.standard_errors,
+            "n_simulations": res.refinement.n_simulations, "message": res.refinement.message,
+            "failures": len(res.refinement.failures)},
         "samples": {"n": len(res.samples), "impacts": res.samples.n_impacts,
                     "derivative": res.samples.derivative, "noise": res.samples.noise},
         "measured": {"n_cycles": res.measured.n_cycles, "n_periods": res.measured.n_periods,
@@ -68,11 +87,14 @@ def run(args):
         fit_loop_figure(res, str(out.path("fit_loop")))
     sel = res.selected
     print(f"selected {sel.law}   [{sel.regime}]")
+    if sel.standard_errors:
+        print("  coefficients (standard error): " + ", ".join(
+            f"{t} {c:.4g} ({sel.standard_errors[t]:.2g})" for t, c in sel.law.as_dict().items()))
     if sel.criteria:
         print("  criteria (noise floor): " + ", ".join(
-            f"{k} {v:.3g} ({sel.evaluation.noise_floor.get(k, float('nan')):.2g})"
+            f"{k} {v:.3g} ({sel.noise_floor.get(k, float('nan')):.2g})"
             for k, v in sel.criteria.items()))
-    print(f"  {sel.evaluation.verdict}")
+    print(f"  {sel.verdict}")
     print(f"  certificate: {'holds' if cert.holds else 'FAILS'} on zeta <= "
           f"{cert.domain['zeta_max']:.3g} m, zd <= {cert.domain['zd_max']:.3g} m/s "
           f"(worst violation {cert.worst_violation:.2g})")
@@ -81,6 +103,10 @@ def run(args):
     if res.stability:
         print("  stability: " + ", ".join(f"{k} {v:.2f}" for k, v in res.stability.items()
                                           if v > 0))
+    for e in res.equivalent:
+        print(f"  equivalent: {' + '.join(e['terms'])} ({e['reason']})")
+    for w in res.warnings:
+        print(f"  warning: {w}")
     print(f"outputs in {args.out}/: summary.json, ranking.csv, model.tex, fit_impulse.png/.pdf, "
           "fit_surface.png/.pdf, fit_loop.png/.pdf")
     return 0
@@ -89,8 +115,12 @@ def run(args):
 def register(sub):
     s = sub.add_parser("fit", help="discover a law: sparse certified regression, every "
                        "candidate checked by simulation")
-    s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
-    s.add_argument("--data", required=True, help="CSV with t, F, w1, w2 (v1, v2 optional)")
+    s.add_argument("--scenario", action="append",
+                   help=SCENARIO_HELP + "; repeat it, once per --data in the same order, when "
+                   "the records come from different operating points")
+    s.add_argument("--data", required=True, action="append",
+                   help="CSV with t, F, w1, w2 (v1, v2 optional); repeat it to fit several "
+                   "records jointly")
     s.add_argument("--library", default="poly:2",
                    help="candidate terms: poly:N, hc, a list 'z,zd,z*zd', or sums (poly:2)")
     s.add_argument("--select", default="best-subset",
@@ -106,8 +136,11 @@ def register(sub):
                    help="dissipativity strictness margin in N s/m (0)")
     s.add_argument("--monotone", action="store_true",
                    help="also require a monotone elastic branch")
-    s.add_argument("--refine", action="store_true",
-                   help="refine the chosen model's coefficients by simulation")
+    s.add_argument("--no-refine", action="store_true",
+                   help="skip the refinement of every shortlisted support by simulation "
+                   "(output error: unbiased coefficients and their standard errors)")
+    s.add_argument("--max-simulations", type=int, default=120,
+                   help="simulation budget of each support's refinement (120)")
     s.add_argument("--stability", type=int, default=0,
                    help="bootstrap resamples of impacts for stability selection (0)")
     s.add_argument("--derivative", choices=["velocities", "savgol", "pysindy"],

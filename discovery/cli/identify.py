@@ -29,10 +29,14 @@ def _load_landscape(path, cls):
         d = json.loads(p.read_text())
     except (OSError, ValueError):
         raise InputError(f"--landscape {path!r}: no readable landscape summary.json") from None
-    vals = {n: np.array(d[n], dtype=float) for n in CRITERIA}
-    return cls(terms=tuple(d["terms"]), axes=(np.array(d["alpha1"]), np.array(d["alpha2"])),
-               values=vals, regime=np.array(d["regime"], dtype=object),
-               seconds=d["seconds"], workers=d["workers"])
+    try:
+        vals = {n: np.array(d[n], dtype=float) for n in CRITERIA}
+        return cls(terms=tuple(d["terms"]), axes=(np.array(d["alpha1"]), np.array(d["alpha2"])),
+                   values=vals, regime=np.array(d["regime"], dtype=object),
+                   seconds=d["seconds"], workers=d["workers"])
+    except (KeyError, TypeError, ValueError):
+        raise InputError(f"--landscape {path!r} is not a landscape result (made by vidi "
+                         "landscape); give its output directory or summary.json") from None
 
 
 def run(args):
@@ -41,26 +45,25 @@ def run(args):
     from ..identify import identify
     from ..landscape import Landscape
     from ..measurement import Measurement
-    from ..response import response
+    from ..verify import Reference, evaluate
 
     sc = load_scenario(args.scenario)
+    start = ForceLaw.parse(args.start)
+    land = _load_landscape(args.landscape, Landscape) if args.landscape else None
     meas = Measurement.from_csv(args.data, scenario=sc)
     for note in meas.notes:
         print(f"note: {note}")
-    E = meas.impulse(sc.period)
-    start = ForceLaw.parse(args.start)
-    res = identify(sc, E, start, criterion=args.criterion, method=args.method,
+    ref = Reference.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
+    E = ref.impulse
+    res = identify(sc, ref, start, criterion=args.criterion, method=args.method,
                    max_simulations=args.max_simulations, xtol=args.xtol)
-    land = None
-    if args.landscape:
-        land = _load_landscape(args.landscape, Landscape)
+    final = evaluate(sc, res.law, ref)
     picks = _pick_iterates(res.iterations, 5)
     imps = []
     for k in picks:
         law = start.with_coefficients(list(res.iterations[k]["coefficients"].values()))
-        r = response(sc, law)
-        imps.append((f"iterate {k} ({res.iterations[k]['n_simulations']} sims)",
-                     r.like(E) if r.impulse is not None else None))
+        ev = evaluate(sc, law, ref, floor=False)
+        imps.append((f"iterate {k} ({res.iterations[k]['n_simulations']} sims)", ev.simulated))
     with OutputDir(args.out) as out:
         summary = {"command": "identify", "scenario": sc.as_dict(), "data": str(args.data),
                    "measured": {"n_cycles": E.n_cycles, "n_periods": E.n_periods,
@@ -69,7 +72,12 @@ def run(args):
                    "criterion": res.criterion, "method": res.method,
                    "start": start.as_dict(), "coefficients": res.coefficients,
                    "law": res.law.to_text(), "latex": res.law.latex(),
-                   "criteria": res.criteria, "n_simulations": res.n_simulations,
+                   "standard_errors": res.standard_errors,
+                   "correlation": res.correlation,
+                   "criteria": final.criteria, "noise_floor": final.noise_floor,
+                   "consistent": final.consistent, "verdict": final.verdict,
+                   "regime": final.regime, "n_simulations": res.n_simulations,
+                   "failures": res.failures,
                    "iterations": res.iterations, "message": res.message,
                    "seconds": res.seconds, **provenance(vars(args))}
         out.write_json("summary.json", summary)
@@ -84,7 +92,17 @@ def run(args):
     print(f"identified {res.law}")
     print(f"  {res.criterion} = {res.value:.4g} after {res.n_simulations} simulations "
           f"({res.method}, {res.seconds:.1f} s)")
-    print("  criteria: " + ", ".join(f"{k} {v:.3g}" for k, v in res.criteria.items()))
+    if res.standard_errors:
+        print("  coefficients (standard error): " + ", ".join(
+            f"{t} {c:.4g} ({res.standard_errors[t]:.2g})" for t, c in res.coefficients.items()))
+    if final.criteria:
+        print("  criteria (noise floor): " + ", ".join(
+            f"{k} {v:.3g} ({final.noise_floor.get(k, float('nan')):.2g})"
+            for k, v in final.criteria.items()))
+    print(f"  {final.verdict}")
+    if res.failures:
+        print(f"  note: {len(res.failures)} trial law(s) had no periodic steady state with "
+              "contact (listed in summary.json)")
     print(f"outputs in {args.out}/: summary.json, iterations.csv, identification.png, "
           "identification.pdf")
     return 0
@@ -94,7 +112,9 @@ def register(sub):
     s = sub.add_parser("identify", help="identify a law's coefficients from a measured CSV by "
                        "simulation (paper Figs. 6-7)")
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
-    s.add_argument("--data", required=True, help="CSV with t [s], F [N] (w1, w2 optional)")
+    s.add_argument("--data", required=True,
+                   help="CSV with t [s], F [N] (w1, v1, w2, v2 recommended: exact onsets and "
+                   "the machine's state)")
     s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
                    help="criterion to minimise (I2)")
     s.add_argument("--method", default="least-squares",
@@ -106,5 +126,8 @@ def register(sub):
     s.add_argument("--xtol", type=float, default=1e-5, help="relative coefficient tolerance")
     s.add_argument("--landscape", help="a landscape output (directory or summary.json) to draw "
                    "the path on")
+    s.add_argument("--n-boot", type=int, default=16,
+                   help="bootstrap replicates of the noise floor (16)")
+    s.add_argument("--seed", type=int, default=0, help="seed of the noise-floor bootstrap (0)")
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)
