@@ -18,8 +18,8 @@ simulation, where the penetration is computed, not measured.
 Then up to ``stepwise`` output-error moves around the best model: when it is not
 consistent, a forward step extends it by each library term it lacks (refined by
 simulation from its coefficients), so a support the biased regression never proposed can
-still be found; when it is consistent but has terms whose coefficient is within two
-standard errors of zero, a backward step drops each such term and refines the rest.
+still be found; when it is consistent, a backward step drops each of its terms in turn and
+refines the rest, so the simplest consistent model is found.
 
 Ranking rule: the models consistent with every record (same regime; I2 and I4 within
 their noise floors, see :mod:`discovery.verify`) come first, the fewest terms first, then
@@ -47,7 +47,6 @@ __all__ = ["RankedModel", "DiscoveryResult", "discover", "rank"]
 
 _REFINE_BUDGET = 120   # simulations per shortlisted support (every record counts)
 _FORWARD_STARTS = (0.01, 0.001)  # a new term's start force at the box corner / peak force
-_SIGNIFICANT = 2.0  # a term whose |coefficient| is below this many standard errors may go
 
 
 @dataclass(frozen=True)
@@ -263,6 +262,7 @@ class _Checker:
         """Refine ``law`` (from ``origin``: "regression" or a forward step) and check it."""
         est = self.est
         extra = {"regression_coefficients": dict(cand.coefficients), "origin": origin}
+        cand = replace(cand, extra={**cand.extra, **extra})
         cert0 = est.certify(_coefficients(law, est.library_))
         if not self.refine:
             return RankedModel(law, cand, self.evaluate(law), note="not refined",
@@ -284,7 +284,7 @@ class _Checker:
                                certificate=cert0)
         s = self.samples
         rescored = est.rescore(coef, s.X, s.F, s.weight, constrained=cand.constrained,
-                               extra={**cand.extra, **extra})
+                               extra=cand.extra)
         rescored = replace(rescored, cv_error=cand.cv_error)
         return RankedModel(ref.law, rescored, self.evaluate(ref.law), refinement=ref,
                            note=f"refined by simulation from the {origin} "
@@ -292,17 +292,14 @@ class _Checker:
                            f"{ref.value:.3g})", certificate=cert)
 
     def backward(self, base):
-        """Output-error backward step: ``base`` without each of its insignificant terms
-        (``|c| < 2 x standard error``), refined by simulation from the other coefficients."""
-        se = base.standard_errors
+        """Output-error backward step: ``base`` without each of its terms in turn, refined
+        by simulation from the other coefficients (the simplest consistent model wins)."""
         names = base.law.names
-        if len(names) < 2 or not se:
+        if len(names) < 2:
             return []
         lib = self.est.library_
         out = []
-        for term, c in base.law.as_dict().items():
-            if not abs(c) < _SIGNIFICANT * se.get(term, 0.0):
-                continue
+        for term in names:
             coef = _coefficients(base.law, lib)
             coef[[t.name for t in lib.terms].index(term)] = 0.0
             cand = self.est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight)
@@ -562,9 +559,9 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     ranking = rank(models, criterion, sim_rtol, sim_atol)
     steps = []
     while refine and ranking[0].criteria and len(steps) < stepwise:
-        # output-error stepwise search around the best model: a consistent model with
-        # insignificant terms loses one (backward), an inconsistent one gains one (forward:
-        # the regression may have been misled, e.g. by noisy penetration)
+        # output-error stepwise search around the best model: a consistent model loses a
+        # term (backward), an inconsistent one gains one (forward: the regression may have
+        # been misled, e.g. by noisy penetration)
         top = ranking[0]
         if top.consistent:
             trials, kind = check.backward(top), "backward"

@@ -42,7 +42,9 @@ def _contour(ax, land, name, truth=None):
 
 
 def landscape_figure(land, stem, truth=None):
-    """Contours of I1..I4 and I0 (the paper's Figs. 4-5); non-P1 points marked.
+    """Contours of I1..I4 and I0 (the paper's Figs. 4-5), with the points that have no
+    criteria or another regime marked, the consistent region outlined and the
+    reference's noise floor.
 
     Parameters
     ----------
@@ -50,17 +52,95 @@ def landscape_figure(land, stem, truth=None):
     stem : str
         Output path without extension.
     truth : (float, float), optional
-        Reference coefficients, circled.
+        Reference coefficients, circled (when inside the grid).
     """
+    import textwrap
+
+    from matplotlib.lines import Line2D
+    from matplotlib.ticker import MaxNLocator
+
+    a0, a1 = land.axes
+    reg = np.asarray(land.regime, dtype=str)
+    ref_reg = (getattr(land, "reference", None) or {}).get("regime", "P1")
+    exact = (getattr(land, "reference", None) or {}).get("exact", True)
+    floor = getattr(land, "noise_floor", None)
+    cons = getattr(land, "consistent", None)
+    physical = ("no-contact", "nonperiodic", "failed")
+    marks = [  # (mask, marker style, legend label)
+        ((reg != ref_reg) & ~np.isin(reg, physical),
+         dict(ls="none", marker="x", color="r", ms=4), f"periodic, not {ref_reg}"),
+        (reg == "nonperiodic", dict(ls="none", marker="+", color="orange", ms=5),
+         "nonperiodic"),
+        (reg == "no-contact", dict(ls="none", marker=".", color="0.6", ms=4), "no contact"),
+        (reg == "failed", dict(ls="none", marker="s", mfc="none", mec="k", ms=4),
+         "simulation failed"),
+    ]
+    marks = [m for m in marks if m[0].any()]
+    inside = truth is not None and a0[0] <= truth[0] <= a0[-1] and a1[0] <= truth[1] <= a1[-1]
+    show_cons = cons is not None and cons.sum() >= 2  # one point: hidden by the star
     fig, axes = plt.subplots(2, 3, figsize=(14, 8.5))
     for ax, name in zip(axes.flat, _ORDER, strict=False):
-        _contour(ax, land, name, truth)
+        v = land.values[name]
+        ok = np.isfinite(v)
+        if ok.any():
+            lo, hi = float(v[ok].min()), float(v[ok].max())
+            levels = MaxNLocator(20).tick_values(lo, hi if hi > lo else lo + 1e-12)
+            cs = ax.contourf(a0, a1, v.T, levels=levels, cmap="viridis")
+            if hi > lo:
+                ax.contour(a0, a1, v.T, levels=levels[::2], colors="k", linewidths=0.4)
+            plt.colorbar(cs, ax=ax)
+            i, j = land.argmin(name)
+            ax.plot(a0[i], a1[j], "w*", ms=10, mec="k")
+        else:
+            ax.text(0.5, 0.5, "no periodic contact\nanywhere in this range",
+                    transform=ax.transAxes, ha="center", va="center")
+        if show_cons:
+            ax.contour(a0, a1, cons.T.astype(float), levels=[0.5], colors="w",
+                       linestyles="--", linewidths=1.2)
+        for mask, style, _ in marks:
+            ij = np.argwhere(mask)
+            ax.plot(a0[ij[:, 0]], a1[ij[:, 1]], **style)
+        if inside:
+            ax.plot(*truth, "o", mfc="none", mec="r", ms=10, mew=1.5)
+        ax.set_xlim(a0[0], a0[-1])
+        ax.set_ylim(a1[0], a1[-1])
+        ax.set_xlabel(f"coefficient of {land.terms[0]}")
+        ax.set_ylabel(f"coefficient of {land.terms[1]}")
+        title = name if exact or not floor else f"{name} (noise floor {floor[name]:.3g})"
+        ax.set_title(title)
     ax = axes.flat[5]
     ax.axis("off")
-    ax.text(0.0, 0.9, "Criteria landscape\n"
-            f"{land.axes[0].size} x {land.axes[1].size} points, {land.seconds:.1f} s "
-            f"on {land.workers} processes\nwhite star: minimum; red circle: reference law\n"
-            "red x: regime other than P1", va="top", fontsize=10)
+    info = getattr(land, "reference", None) or {}
+    src = info.get("source", "")
+    src = "the scenario's law (exact)" if src in ("law", "") else src
+    lines = ["Criteria landscape",
+             f"{a0.size} x {a1.size} points, {land.seconds:.1f} s on {land.workers} processes",
+             f"reference: {src}"[:70], f"reference regime: {ref_reg}"]
+    if not exact and floor:
+        lines.append("noise floor: " + ", ".join(f"{n} {floor[n]:.2g}" for n in _ORDER))
+    counts = land.regime_counts() if hasattr(land, "regime_counts") else {}
+    if counts:
+        lines.append("regimes: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
+    if cons is not None:
+        lines.append(f"consistent with the reference at {int(cons.sum())} point(s)")
+    fails = getattr(land, "failures", (0, "", None))
+    if fails[0]:
+        lines.append(f"{fails[0]} simulation(s) failed, the first:")
+        lines += ["  " + w for w in textwrap.wrap(fails[1], 62)[:4]]
+    if truth is not None and not inside:
+        lines.append("the reference law lies outside this range")
+    ax.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, transform=ax.transAxes)
+    handles = [Line2D([], [], ls="none", marker="*", mfc="w", mec="k", ms=10,
+                      label="minimum")]
+    if inside:
+        handles.append(Line2D([], [], ls="none", marker="o", mfc="none", mec="r", ms=10,
+                              label="reference law"))
+    if show_cons:
+        handles.append(Line2D([], [], color="w", ls="--", lw=1.2,
+                              label="consistent region (boundary)"))
+    handles += [Line2D([], [], label=label, **style) for _, style, label in marks]
+    leg = ax.legend(handles=handles, loc="lower left", fontsize=8, facecolor="0.85")
+    leg.get_frame().set_edgecolor("0.5")
     fig.tight_layout()
     return _save(fig, stem)
 

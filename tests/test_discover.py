@@ -3,6 +3,7 @@
 import dataclasses
 import math
 
+import numpy as np
 import pytest
 
 from discovery.discover import RankedModel, discover, rank
@@ -184,3 +185,72 @@ def test_rank_keeps_every_model():
     out = rank(models)
     assert sorted(_names(out)) == sorted(_names(models)) and len(out) == len(models)
     assert all(not math.isnan(m.candidate.bic) for m in out)
+
+
+# ------------------------------------- noisy positions, no velocities: poly:2 library
+
+
+@pytest.fixture(scope="module")
+def noisy_positions(paper):
+    """Positions with 1 % noise and no velocities, the poly:2 library, stability selection:
+    the regression proposes four-term supports; the output-error backward steps find the
+    simplest consistent law."""
+    m = synthesize(paper, paper.law, periods=300, fs=20000, noise=0.01, seed=0,
+                   from_rest=True, position_noise=0.01, velocities=False)
+    return discover(paper, m, library="poly:2", stability=10)
+
+
+def test_backward_steps_reach_the_simplest_consistent_law(noisy_positions):
+    res = noisy_positions
+    sel = res.selected
+    assert sel.law.names == ["z", "zd"] and sel.consistent
+    assert "backward step" in sel.candidate.extra["origin"]
+    assert [s["kind"] for s in res.settings["steps"]][0] == "backward"
+    # no consistent model is simpler than the selected one
+    assert all(len(m.law.names) >= 2 for m in res.ranking if m.consistent)
+
+
+def test_equivalent_models_say_why_and_what_would_separate_them(noisy_positions):
+    res = noisy_positions
+    sel = res.selected
+    assert res.equivalent, "the poly:2 extensions of z + zd fit this record as well"
+    for e in res.equivalent:
+        assert set(e) >= {"terms", "coefficients", "criteria", "reason", "separate"}
+        assert e["consistent"] and set(e["terms"]) != set(sel.law.names)
+        assert e["criteria"]["I2"] <= sel.criteria["I2"] + sel.noise_floor["I2"]
+        assert "recorded orbit" in e["reason"] or "collinear" in e["reason"]
+        assert e["separate"]
+
+
+def test_stability_disagreement_is_a_warning(noisy_positions):
+    res = noisy_positions
+    strong = [t for t, f in res.stability.items()
+              if f >= 0.5 and t not in res.selected.law.names]
+    assert strong  # the biased regression keeps choosing extra terms
+    assert any("stability selection disagrees" in w and all(t in w for t in strong)
+               for w in res.warnings)
+
+
+def test_contact_samples_do_not_split_impacts_at_noise_dips(paper):
+    """Position noise of 5 % of the penetration: zeta dips below its threshold near onset
+    and loss; one impact per period is still one impact."""
+    from discovery.samples import contact_samples
+
+    m = synthesize(paper, paper.law, periods=30, fs=20000, noise=0.01, seed=0,
+                   position_noise=0.05)
+    s = contact_samples(m)
+    assert s.n_impacts in (30, 31)  # a contact cut by the record's end may count too
+
+
+def test_impact_count_that_does_not_fit_the_regime_is_a_warning(paper):
+    from discovery.discover import _impact_warnings
+    from discovery.samples import contact_samples
+    from discovery.verify import Reference
+
+    m = synthesize(paper, paper.law, periods=30, fs=20000, noise=0.01, seed=0)
+    s = contact_samples(m)
+    ref = Reference.from_measurement(m, paper, n_boot=2)
+    assert _impact_warnings([(paper, m)], [s], [(paper, ref)]) == []
+    split = dataclasses.replace(s, impact=np.arange(len(s)) // 20)  # contacts split apart
+    (w,) = _impact_warnings([(paper, m)], [split], [(paper, ref)])
+    assert f"gives {split.n_impacts} impacts" in w and "hold about 30" in w

@@ -1,12 +1,14 @@
 """``vidi landscape``: criteria over a grid of two coefficients."""
 
 import csv
+import hashlib
 import io
 
 import numpy as np
 
 from .._io import OutputDir, provenance
 from ..criteria import CRITERIA
+from ..errors import InputError
 from ..scenario import load_scenario
 from ._common import SCENARIO_HELP, law_or_default, parse_range
 
@@ -14,12 +16,59 @@ from ._common import SCENARIO_HELP, law_or_default, parse_range
 def _grid_csv(land):
     buf = io.StringIO()
     w = csv.writer(buf)
-    w.writerow([land.terms[0], land.terms[1], "regime", *CRITERIA])
+    w.writerow([land.terms[0], land.terms[1], "regime", *CRITERIA, "impacts", "consistent"])
     for i, a in enumerate(land.axes[0]):
         for j, b in enumerate(land.axes[1]):
             w.writerow([f"{a:.10g}", f"{b:.10g}", land.regime[i, j],
-                        *[f"{land.values[n][i, j]:.10g}" for n in CRITERIA]])
+                        *[f"{land.values[n][i, j]:.10g}" for n in CRITERIA],
+                        int(land.impacts[i, j]), int(land.consistent[i, j])])
     return buf.getvalue()
+
+
+def _sha256(path):
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _ranges(args, law):
+    """The two coefficient ranges and where they came from."""
+    from ..landscape import DEFAULT_SPREAD, default_range
+
+    out, origin = [], []
+    for k, (text, opt) in enumerate(((args.range0, "--range0"), (args.range1, "--range1"))):
+        if text is None:
+            out.append(default_range(law.coefficients[k], law.names[k], opt))
+            origin.append(f"default: {1 - DEFAULT_SPREAD:g}x..{1 + DEFAULT_SPREAD:g}x the "
+                          f"template's coefficient {law.coefficients[k]:.6g}")
+        else:
+            out.append(parse_range(text, None, opt))
+            origin.append(f"{opt} {text}")
+    return out, origin
+
+
+def _reference(args, sc):
+    """``(Reference or None, description for summary.json, notes)``."""
+    from ..measurement import Measurement
+    from ..verify import Reference
+
+    if args.data is None:
+        if sc.law is None:
+            raise InputError(f"scenario {sc.name!r} has no reference law; pass --data D.csv "
+                             "(a measured record) or add [law] text to the scenario")
+        return None, {"source": "law", "law": sc.law.to_text()}, ()
+    meas = Measurement.from_csv(args.data, scenario=sc)
+    ref = Reference.from_measurement(meas, sc, time_offset=args.time_offset,
+                                     n_boot=args.n_boot, seed=args.seed)
+    E = ref.impulse
+    info = {"source": str(args.data), "sha256": _sha256(args.data),
+            "n_periods": E.n_periods, "n_cycles": E.n_cycles, "impacts": ref.impacts,
+            "noise": dict(ref.noise), "threshold": E.threshold, "peak": E.peak,
+            "contact_time": E.contact_time, "time_offset": ref.time_offset,
+            "n_boot": ref.n_boot, "seed": ref.seed, "notes": list(meas.notes)}
+    return ref, info, meas.notes
 
 
 def run(args):
@@ -27,32 +76,77 @@ def run(args):
 
     from ..landscape import landscape, parse_grid
 
+    if args.workers is not None and args.workers < 1:
+        raise InputError(f"--workers must be at least 1, got {args.workers}")
+    if args.n_boot < 1:
+        raise InputError(f"--n-boot must be at least 1, got {args.n_boot}")
     sc = load_scenario(args.scenario)
     law = law_or_default(args.law, sc)
+    if len(law.terms) < 2:
+        raise InputError(f"the template law '{law}' has {len(law.terms)} term(s); a landscape "
+                         "varies two coefficients, give --law with at least two terms, e.g. "
+                         "'2.06e8*z + 1.28e7*zd'")
     n0, n1 = parse_grid(args.grid)
-    r0 = parse_range(args.range0, (1.03e8, 3.09e8), "--range0")
-    r1 = parse_range(args.range1, (0.64e7, 1.92e7), "--range1")
+    (r0, r1), origin = _ranges(args, law)
+    ref, ref_info, notes = _reference(args, sc)
+    for note in notes:
+        print(f"note: {note}")
     a0, a1 = np.linspace(*r0, n0), np.linspace(*r1, n1)
-    land = landscape(sc, law, a0, a1, workers=args.workers)
+    land = landscape(sc, law, a0, a1, ref, workers=args.workers)
+    ref_info.update(regime=land.reference["regime"], start=land.reference["start"])
+    if ref is None:
+        ref_info["impacts"] = land.reference["impacts"]
+    count, first, at = land.failures
+    minima = {}
+    for n in CRITERIA:
+        ij = land.argmin(n)
+        minima[n] = None if ij is None else {
+            "alpha1": a0[ij[0]], "alpha2": a1[ij[1]], "value": land.values[n][ij],
+            "regime": land.regime[ij], "consistent": bool(land.consistent[ij]),
+            "noise_floor": land.noise_floor[n]}
     with OutputDir(args.out) as out:
-        summary = {"command": "landscape", "scenario": sc.as_dict(), "terms": land.terms,
-                   "alpha1": a0, "alpha2": a1,
+        summary = {"command": "landscape", "scenario": sc.as_dict(), "law": law.to_text(),
+                   "terms": land.terms, "alpha1": a0, "alpha2": a1,
                    **{n: land.values[n] for n in CRITERIA},
-                   "regime": land.regime.tolist(), "seconds": land.seconds,
-                   "workers": land.workers,
-                   "minima": {n: {"alpha1": a0[land.argmin(n)[0]], "alpha2": a1[land.argmin(n)[1]]}
-                              for n in CRITERIA},
+                   "regime": land.regime.tolist(), "impacts": land.impacts,
+                   "consistent": land.consistent, "n_consistent": int(land.consistent.sum()),
+                   "regimes": land.regime_counts(),
+                   "failed": {"count": count, "first_message": first,
+                              "first_at": None if at is None
+                              else {"alpha1": a0[at[0]], "alpha2": a1[at[1]]}},
+                   "reference": ref_info, "noise_floor": land.noise_floor,
+                   "noise_floor_q95": land.noise_floor_q95,
+                   "noise_floor_under": land.noise_floor_under,
+                   "grid": [n0, n1],
+                   "ranges": {"alpha1": list(r0), "alpha2": list(r1), "from": origin},
+                   "minima": minima, "seconds": land.seconds, "workers": land.workers,
                    **provenance(vars(args))}
         out.write_json("summary.json", summary)
         out.path("landscape.csv").write_text(_grid_csv(land))
-        truth = tuple(sc.law.coefficients[:2]) if sc.law is not None else None
+        truth = None
+        if ref is None and sc.law.names[:2] == law.names[:2]:
+            truth = tuple(sc.law.coefficients[:2])
         landscape_figure(land, str(out.path("landscape")), truth=truth)
-    regimes = {r: int(np.sum(land.regime == r)) for r in set(land.regime.ravel())}
-    print(f"landscape {n0}x{n1} in {land.seconds:.1f} s on {land.workers} processes; "
-          f"regimes {regimes}")
+    src = "the scenario's law" if ref is None else f"{args.data}"
+    print(f"landscape {n0}x{n1} of {law.names[0]} in [{r0[0]:.4g}, {r0[1]:.4g}] x "
+          f"{law.names[1]} in [{r1[0]:.4g}, {r1[1]:.4g}] against {src} "
+          f"({land.reference['regime']}): {land.seconds:.1f} s on {land.workers} processes")
+    print(f"  regimes {land.regime_counts()}; consistent at {int(land.consistent.sum())} "
+          "point(s)")
+    if count:
+        print(f"  {count} simulation(s) failed, first at ({a0[at[0]]:.4g}, {a1[at[1]]:.4g}): "
+              f"{first}")
+    exact = land.reference["exact"]
     for n in CRITERIA:
-        i, j = land.argmin(n)
-        print(f"  {n}: minimum {np.nanmin(land.values[n]):.3g} at ({a0[i]:.4g}, {a1[j]:.4g})")
+        m = minima[n]
+        if m is None:
+            print(f"  {n}: no point with a periodic steady state with contact")
+            continue
+        beside = "" if exact else f" (noise floor {land.noise_floor[n]:.3g})"
+        print(f"  {n}: minimum {m['value']:.3g}{beside} at ({m['alpha1']:.4g}, "
+              f"{m['alpha2']:.4g})")
+    if not exact:
+        print(f"  noise floor under {land.noise_floor_under}")
     print(f"outputs in {args.out}/: summary.json, landscape.csv, landscape.png, landscape.pdf")
     return 0
 
@@ -63,9 +157,18 @@ def register(sub):
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
     s.add_argument("--law", help="template law whose first two coefficients vary "
                    "(default: the scenario's law)")
+    s.add_argument("--data", help="CSV record (t, F [, w1, v1, w2, v2]) to compare with "
+                   "(default: the exact impulse of the scenario's law)")
     s.add_argument("--grid", default="41x41", help="points per axis, e.g. 41x41")
-    s.add_argument("--range0", help="LOW:HIGH of the first coefficient (1.03e8:3.09e8)")
-    s.add_argument("--range1", help="LOW:HIGH of the second coefficient (0.64e7:1.92e7)")
+    s.add_argument("--range0", help="LOW:HIGH of the first coefficient (default 0.5x..1.5x "
+                   "the template's coefficient)")
+    s.add_argument("--range1", help="LOW:HIGH of the second coefficient (default 0.5x..1.5x "
+                   "the template's coefficient)")
+    s.add_argument("--time-offset", type=float, default=0.0,
+                   help="with --data: drive-clock time [s] of the record's t = 0 (0)")
+    s.add_argument("--n-boot", type=int, default=16,
+                   help="with --data: bootstrap replicates of the noise floor (16)")
+    s.add_argument("--seed", type=int, default=0, help="with --data: seed of the bootstrap (0)")
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

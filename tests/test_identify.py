@@ -1,0 +1,172 @@
+"""Identification by simulation (discovery.identify) and discovery from several records."""
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from discovery.cli import main
+from discovery.discover import discover
+from discovery.errors import InputError, IntegrationError
+from discovery.identify import as_records, identify
+from discovery.law import ForceLaw
+from discovery.measurement import synthesize
+from discovery.verify import Reference
+
+START = ForceLaw.parse("1.5e8*z + 0.9e7*zd")
+
+
+@pytest.fixture(scope="module")
+def record(paper):
+    """20 periods on the orbit, 1 % force noise, positions and velocities."""
+    return synthesize(paper, paper.law, periods=20, fs=20000, noise=0.01, seed=3)
+
+
+@pytest.fixture(scope="module")
+def reference(paper, record):
+    return Reference.from_measurement(record, paper, n_boot=8, seed=0)
+
+
+@pytest.fixture(scope="module")
+def fitted(paper, reference):
+    return identify(paper, reference, START, method="least-squares")
+
+
+def test_least_squares_recovers_the_law_within_its_standard_errors(paper, fitted):
+    assert fitted.law.names == ["z", "zd"]
+    se = fitted.standard_errors
+    for name, true in paper.law.as_dict().items():
+        c = fitted.coefficients[name]
+        # measured: z 2.07e8 +- 9.5e6 (4.6 %), zd 1.280e7 +- 2.2e4
+        assert abs(c - true) < max(3 * se[name], 0.005 * abs(true)), (name, c, se[name])
+        assert 0 < se[name] < 0.1 * abs(true)
+    assert fitted.correlation.shape == (2, 2)
+    assert np.allclose(np.diag(fitted.correlation), 1.0)
+    assert fitted.value == pytest.approx(fitted.criteria["I2"])
+    assert len(fitted.evaluations) == 1 and fitted.evaluations[0].status == "ok"
+    assert fitted.failures == []
+
+
+def test_budget_counts_every_simulation(paper, reference):
+    """The budget bounds all simulations (finite-difference Jacobians included); the
+    uncertainty estimate adds one simulation per coefficient and record."""
+    res = identify(paper, reference, START, method="least-squares", max_simulations=7)
+    assert res.n_simulations <= 7 + 2
+    assert "budget" in res.message
+    # a budget-limited result is still the best law seen, not the start
+    assert res.value <= identify(paper, reference, START, max_simulations=2,
+                                 uncertainty=False).value
+
+
+@pytest.mark.parametrize("method", ["nelder-mead", "coordinate-descent"])
+def test_derivative_free_methods_agree(paper, reference, fitted, method):
+    res = identify(paper, reference, START, method=method, max_simulations=300,
+                   uncertainty=False)
+    # they minimise I2 itself, least squares its L2 surrogate: the same law within the
+    # uncertainty of the data (measured: z 2.25e8 by coordinate descent vs 2.08e8 +- 9e6)
+    for name, c in fitted.coefficients.items():
+        assert abs(res.coefficients[name] - c) < 3 * fitted.standard_errors[name]
+    assert res.standard_errors == {}
+
+
+def test_failed_trial_laws_are_recorded_not_silent(paper, reference):
+    """A start far from the record makes the optimiser try laws with no periodic orbit;
+    each is recorded with its status and message."""
+    start = ForceLaw.parse("2.06e8*z + 1.28e7*zd + 1e4*zd^2")
+    res = identify(paper, reference, start, method="coordinate-descent", max_simulations=60,
+                   uncertainty=False)
+    for f in res.failures:
+        assert f["status"] in ("nonperiodic", "no-contact", "failed") and f["message"]
+    if res.failures:
+        assert "no periodic steady state" in res.message
+
+
+def test_start_law_that_fails_is_an_error(paper, reference):
+    with pytest.raises(IntegrationError, match="start law"):
+        identify(paper, reference, ForceLaw.parse("1e3*zd"), max_simulations=20)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"method": "simplex"}, "unknown method"),
+    ({"xtol": -1.0}, "xtol"),
+    ({"max_simulations": 1}, "budget"),
+    ({"max_simulations": 2.5}, "budget"),
+])
+def test_bad_settings(paper, reference, kwargs, match):
+    with pytest.raises(InputError, match=match):
+        identify(paper, reference, START, **kwargs)
+
+
+def test_as_records_accepts_impulses_references_and_lists(paper, record, reference):
+    E = record.impulse(paper.period)
+    (sc, ref), = as_records(paper, E)
+    assert ref.noise == {} and ref.impulse is E
+    pairs = as_records(paper, [reference, record])
+    assert len(pairs) == 2 and all(isinstance(r, Reference) for _, r in pairs)
+    with pytest.raises(InputError, match="one scenario per record"):
+        as_records([paper, paper], [reference, reference, reference])
+
+
+# ------------------------------------------------------------- several records
+
+
+@pytest.fixture(scope="module")
+def two_points(paper):
+    """The same machine at two drive amplitudes (two operating points), 1 % force noise."""
+    high = dataclasses.replace(paper, A=1.4 * paper.A, name="paper-high")
+    recs = [synthesize(sc, paper.law, periods=15, fs=20000, noise=0.01, seed=k)
+            for k, sc in enumerate((paper, high))]
+    return (paper, high), recs
+
+
+def test_discover_fits_several_records_jointly(two_points, paper):
+    scs, recs = two_points
+    res = discover(list(scs), recs, library="poly:2", n_boot=8)
+    sel = res.selected
+    assert sel.law.names == ["z", "zd"] and sel.consistent, sel.verdict
+    assert len(sel.evaluations) == 2 and len(res.references) == 2
+    assert "all 2 records" in sel.verdict
+    d = sel.as_dict()
+    assert len(d["records"]) == 2 and all(r["consistent"] for r in d["records"])
+    # the joined samples keep each record's impacts apart
+    one = discover(scs[0], recs[0], library="poly:2", n_boot=8, refine=False)
+    assert res.samples.n_impacts > one.samples.n_impacts
+    for name, true in paper.law.as_dict().items():
+        assert sel.law.as_dict()[name] == pytest.approx(true, rel=0.05)
+    assert res.settings["records"] == 2
+
+
+def test_discover_needs_one_scenario_per_record(two_points):
+    scs, recs = two_points
+    with pytest.raises(InputError, match="one scenario per record"):
+        discover([scs[0], scs[1], scs[0]], recs)
+
+
+def test_fit_cli_with_two_records_and_their_scenarios(two_points, tmp_path, capsys):
+    scs, recs = two_points
+    paths = []
+    for k, (sc, rec) in enumerate(zip(scs, recs, strict=True)):
+        p = tmp_path / f"r{k}.csv"
+        rec.to_csv(p)
+        paths.append(p)
+    toml = tmp_path / "high.toml"
+    m = scs[1]
+    toml.write_text(f'name = "paper-high"\n[machine]\nm1 = {m.m1!r}\nm2 = {m.m2!r}\n'
+                    f'k1 = {m.k1!r}\nc1 = {m.c1!r}\nA = {m.A!r}\nfrequency = {m.frequency!r}\n')
+    out = tmp_path / "fit"
+    rc = main(["fit", "--scenario", "paper", "--data", str(paths[0]), "--scenario", str(toml),
+               "--data", str(paths[1]), "--library", "z,zd", "--out", str(out)])
+    assert rc == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert [r["scenario"] for r in s["records"]] == ["paper", "paper-high"]
+    assert s["selected"]["consistent"] and set(s["selected"]["standard_errors"]) == {"z", "zd"}
+    assert isinstance(s["warnings"], list) and isinstance(s["equivalent"], list)
+    text = capsys.readouterr().out
+    assert "standard error" in text and "consistent with all 2 records" in text
+    # two --data with three --scenario: one line, exit 2, nothing written
+    out2 = tmp_path / "bad"
+    assert main(["fit", "--scenario", "paper", "--scenario", "paper", "--scenario", "paper",
+                 "--data", str(paths[0]), "--data", str(paths[1]), "--out", str(out2)]) == 2
+    assert "one --scenario per --data" in capsys.readouterr().err
+    assert not out2.exists()
