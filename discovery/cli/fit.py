@@ -15,7 +15,6 @@ def run(args):
 
     from ..discover import discover
     from ..measurement import Measurement
-    from ..response import response
 
     data = args.data
     names = args.scenario or ["paper"]
@@ -39,10 +38,10 @@ def run(args):
                    monotone=args.monotone)
     imps = []
     for k, m in enumerate(res.ranking[:3]):
-        if m.criteria:
+        if m.criteria:  # aligned with the first record and sampled like it
             imps.append((f"#{k + 1}: {', '.join(m.law.names)} "
                          f"({args.criterion} {m.criteria[args.criterion]:.3g})",
-                         response(sc, m.law).like(res.measured)))
+                         m.evaluation.simulated))
     cert = res.certificate
     summary = {
         "command": "fit", "scenario": sc.as_dict(),
