@@ -283,9 +283,10 @@ class _Checker:
                                f"condition (worst violation {cert.worst_violation:.2g})",
                                certificate=cert0)
         s = self.samples
-        rescored = est.rescore(coef, s.X, s.F, s.weight, constrained=cand.constrained,
+        rescored = est.rescore(coef, s.X, s.F, s.weight, s.impact, constrained=cand.constrained,
                                extra=cand.extra)
-        rescored = replace(rescored, cv_error=cand.cv_error)
+        if origin == "regression":  # the support's cross-validated error is the candidate's
+            rescored = replace(rescored, cv_error=cand.cv_error)
         return RankedModel(ref.law, rescored, self.evaluate(ref.law), refinement=ref,
                            note=f"refined by simulation from the {origin} "
                            f"({ref.n_simulations} simulations, {self.criterion} "
@@ -302,7 +303,8 @@ class _Checker:
         for term in names:
             coef = _coefficients(base.law, lib)
             coef[[t.name for t in lib.terms].index(term)] = 0.0
-            cand = self.est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight)
+            cand = self.est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight,
+                                    self.samples.impact)
             out.append(self.refined(lib.law(coef), cand,
                                     f"backward step from {' + '.join(names)}"))
         return out
@@ -327,7 +329,8 @@ class _Checker:
             for frac in _FORWARD_STARTS:
                 coef = _coefficients(base.law, lib)
                 coef[i] = frac * peak / corner[i]
-                cand = est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight)
+                cand = est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight,
+                                   self.samples.impact)
                 trial = self.refined(lib.law(coef), cand, origin)
                 if trial.criteria:
                     break

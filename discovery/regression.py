@@ -401,22 +401,27 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
                          f"physical constraints ({opts}): {why}; add a term they act on, raise "
                          "max_terms or relax the margin/signs")
 
-    def rescore(self, coef, X, y, sample_weight=None, *, constrained=False, extra=None):
+    def rescore(self, coef, X, y, sample_weight=None, groups=None, *, constrained=False,
+                extra=None):
         """A :class:`Candidate` for given physical coefficients (e.g. refined by simulation):
-        its rss, BIC and AIC on ``(X, y)`` computed exactly as for the fitted candidates."""
+        its rss, BIC and AIC on ``(X, y)`` computed exactly as for the fitted candidates, and
+        the cross-validated error of its support when the estimator computes one."""
         coef = np.asarray(coef, dtype=float)
         X, y = np.asarray(X, dtype=float), np.asarray(y, dtype=float)
-        w, _ = _weights_and_groups(y.size, sample_weight, None)
+        w, groups = _weights_and_groups(y.size, sample_weight, groups)
         prob = self._problem(X, y, w)
         r = self.library_.transform(X) @ coef - y
         rss = float(np.sum(w * r**2))
         idx = np.flatnonzero(coef != 0)
         bic, aic = prob.scores(rss / prob.fscale**2, idx.size)
         names = self._names(idx)
+        cv = float("nan")
+        if self.scoring == "cv" or self.cv_report:
+            cv = float(self._cross_validate(X, y, w, groups, [tuple(idx)])[0])
         return Candidate(terms=names, coefficients={n: float(coef[i]) for n, i in
                                                     zip(names, idx, strict=True)},
-                         rss=rss, bic=float(bic), aic=float(aic), constrained=constrained,
-                         extra=dict(extra or {}))
+                         rss=rss, bic=float(bic), aic=float(aic), cv_error=cv,
+                         constrained=constrained, extra=dict(extra or {}))
 
     def certify(self, coef):
         """Independent certificate of physical coefficients on ``box_`` (Bernstein + grid)."""
