@@ -292,7 +292,7 @@ class _Checker:
                            f"({ref.n_simulations} simulations, {self.criterion} "
                            f"{ref.value:.3g})", certificate=cert)
 
-    def backward(self, base):
+    def backward(self, base, skip=frozenset()):
         """Output-error backward step: ``base`` without each of its terms in turn, refined
         by simulation from the other coefficients (the simplest consistent model wins)."""
         names = base.law.names
@@ -301,6 +301,8 @@ class _Checker:
         lib = self.est.library_
         out = []
         for term in names:
+            if frozenset(names) - {term} in skip:
+                continue
             coef = _coefficients(base.law, lib)
             coef[[t.name for t in lib.terms].index(term)] = 0.0
             cand = self.est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight,
@@ -309,7 +311,7 @@ class _Checker:
                                     f"backward step from {' + '.join(names)}"))
         return out
 
-    def forward(self, base, max_terms):
+    def forward(self, base, max_terms, skip=frozenset()):
         """Output-error forward step: ``base`` plus each library term it lacks, every trial
         refined by simulation from ``base``'s coefficients and a small start value of the
         new term (its force at the far corner of the data's box 1 % of the peak force, or
@@ -323,7 +325,7 @@ class _Checker:
             return []
         out = []
         for i, term in enumerate(lib.terms):
-            if term.name in have or corner[i] <= 0:
+            if term.name in have or corner[i] <= 0 or frozenset(have | {term.name}) in skip:
                 continue
             origin = f"forward step from {' + '.join(base.law.names)}"
             for frac in _FORWARD_STARTS:
@@ -566,10 +568,12 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         # term (backward), an inconsistent one gains one (forward: the regression may have
         # been misled, e.g. by noisy penetration)
         top = ranking[0]
+        # supports already simulated successfully are not tried again
+        done = frozenset(frozenset(m.law.names) for m in models if m.criteria)
         if top.consistent:
-            trials, kind = check.backward(top), "backward"
+            trials, kind = check.backward(top, done), "backward"
         else:
-            trials, kind = check.forward(top, max_terms), "forward"
+            trials, kind = check.forward(top, max_terms, done), "forward"
         if not trials:
             break
         steps.append({"kind": kind, "from": list(top.law.names), "trials": len(trials)})

@@ -8,7 +8,7 @@ from .figures import (
     landscape_figure,
     verify_figure,
 )
-from .latex import model_tex
+from .latex import compile_pdf, model_tex
 
 __all__ = ["landscape_figure", "identification_figure", "fit_impulse_figure",
-           "fit_surface_figure", "fit_loop_figure", "model_tex", "verify_figure"]
+           "fit_surface_figure", "fit_loop_figure", "model_tex", "compile_pdf", "verify_figure"]

@@ -1,11 +1,15 @@
-"""LaTeX documents as pure functions of results."""
+"""LaTeX documents as pure functions of results, and their compilation to PDF."""
 
-__all__ = ["model_tex"]
+import shutil
+import subprocess
+from pathlib import Path
+
+__all__ = ["model_tex", "compile_pdf"]
 
 
 _SPECIAL = {"\\": r"\textbackslash{}", "_": r"\_", "%": r"\%", "&": r"\&", "#": r"\#",
             "$": r"\$", "{": r"\{", "}": r"\}", "^": r"\textasciicircum{}",
-            "~": r"\textasciitilde{}"}
+            "~": r"\textasciitilde{}", "<": r"$<$", ">": r"$>$"}
 
 
 def _esc(text):
@@ -124,3 +128,38 @@ library \texttt{{{_esc(result.settings['library'])}}}):
 \end{{center}}
 \end{{document}}
 """
+
+
+def compile_pdf(tex_path, timeout=180):
+    """Compile a standalone LaTeX file beside itself with latexmk (pdflatex).
+
+    Returns ``(pdf_path, None)`` on success, ``(None, reason)`` when TeX Live is not
+    installed or the compilation fails (the ``.tex`` file is kept either way).  Auxiliary
+    files are removed.
+    """
+    tex = Path(tex_path)
+    if shutil.which("latexmk") is None:
+        return None, ("no PDF: latexmk not found (install TeX Live: apt-get install latexmk "
+                      "texlive-latex-recommended texlive-latex-extra)")
+    cmd = ["latexmk", "-pdf", "-interaction=nonstopmode", "-halt-on-error", "-quiet", tex.name]
+    try:
+        run = subprocess.run(cmd, cwd=tex.parent, capture_output=True, text=True,
+                             timeout=timeout)
+    except subprocess.TimeoutExpired:
+        _clean(tex)
+        return None, f"no PDF: latexmk took more than {timeout} s"
+    reason = None
+    pdf = tex.with_suffix(".pdf")
+    if run.returncode != 0 or not pdf.exists():
+        log = tex.with_suffix(".log")
+        text = log.read_text(errors="replace") if log.exists() else run.stdout
+        first = [ln for ln in text.splitlines() if ln.startswith("!")][:1]
+        reason = "no PDF: LaTeX failed" + (f" ({first[0][1:].strip()})" if first else "")
+    _clean(tex)
+    return (None, reason) if reason else (pdf, None)
+
+
+def _clean(tex):
+    """Remove latexmk's auxiliary files (and a failed run's partial PDF)."""
+    subprocess.run(["latexmk", "-C" if not tex.with_suffix(".pdf").exists() else "-c",
+                    tex.name], cwd=tex.parent, capture_output=True, timeout=60)

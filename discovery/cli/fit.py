@@ -11,7 +11,13 @@ from ._common import SCENARIO_HELP
 
 
 def run(args):
-    from reports import fit_impulse_figure, fit_loop_figure, fit_surface_figure, model_tex
+    from reports import (
+        compile_pdf,
+        fit_impulse_figure,
+        fit_loop_figure,
+        fit_surface_figure,
+        model_tex,
+    )
 
     from ..discover import discover
     from ..measurement import Measurement
@@ -81,6 +87,7 @@ def run(args):
                         m.law.to_text()])
         out.path("ranking.csv").write_text(buf.getvalue())
         out.path("model.tex").write_text(model_tex(res, sc))
+        pdf, why = compile_pdf(out.path("model.tex")) if not args.no_pdf else (None, None)
         fit_impulse_figure(res, imps, str(out.path("fit_impulse")))
         fit_surface_figure(res, str(out.path("fit_surface")))
         fit_loop_figure(res, str(out.path("fit_loop")))
@@ -106,8 +113,11 @@ def run(args):
         print(f"  equivalent: {' + '.join(e['terms'])} ({e['reason']})")
     for w in res.warnings:
         print(f"  warning: {w}")
-    print(f"outputs in {args.out}/: summary.json, ranking.csv, model.tex, fit_impulse.png/.pdf, "
-          "fit_surface.png/.pdf, fit_loop.png/.pdf")
+    if why:
+        print(f"  note: {why}")
+    print(f"outputs in {args.out}/: summary.json, ranking.csv, model.tex"
+          f"{', model.pdf' if pdf else ''}, fit_impulse.png/.pdf, fit_surface.png/.pdf, "
+          "fit_loop.png/.pdf")
     return 0
 
 
@@ -147,5 +157,8 @@ def register(sub):
     s.add_argument("--average-cycles", action="store_true",
                    help="average the steady cycles sample by sample before the regression")
     s.add_argument("--seed", type=int, default=0, help="seed of the stability selection")
+    s.add_argument("--no-pdf", action="store_true",
+                   help="do not compile model.tex to model.pdf (compiled when latexmk is "
+                   "installed)")
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)
