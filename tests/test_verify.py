@@ -127,3 +127,20 @@ def test_regime_mismatch_is_inconsistent(light, light_record):
     ref = Reference.from_measurement(light_record, light)
     ev = evaluate(light, ForceLaw.parse("2e10*z^1.5"), ref)
     assert not ev.consistent
+
+
+def test_an_undefined_noise_floor_never_makes_a_law_consistent(light, light_record):
+    """When no bootstrap replicate finds the contacts the floor is infinite; the rule must
+    not then accept any criterion value."""
+    import dataclasses
+
+    class _NoFloor(Reference):
+        def floor_for(self, stand_in):
+            inf = {n: float("inf") for n in ("I0", "I1", "I2", "I3", "I4")}
+            return {"mean": inf, "q95": dict(inf), "n_boot": 0, "seed": 0}
+
+    ref = Reference.from_measurement(light_record, light, n_boot=4)
+    ev = evaluate(light, light.law, _NoFloor(**{f.name: getattr(ref, f.name)
+                                                for f in dataclasses.fields(ref)}))
+    assert ev.status == "ok" and ev.criteria
+    assert not ev.consistent and "could not be estimated" in ev.verdict

@@ -130,6 +130,9 @@ def _verdict(consistent, reg, imp, crit, floor):
                 f"{imp['measured']} contact(s), simulated {reg['simulated']} with "
                 f"{imp['simulated']})")
     lim = consistency_limits(floor)
+    if not all(np.isfinite(v) for v in lim.values()):
+        return ("inconsistent: the noise floor under this law could not be estimated (no "
+                "bootstrap replicate of its force history found the contacts)")
     rule = f"{CONSISTENCY_FACTOR:g} x noise floor + {CONSISTENCY_SLACK:g}"
     if consistent:
         within = ", ".join(f"{k} = {crit[k]:.3g} <= {lim[k]:.3g}" for k in lim)
@@ -195,7 +198,8 @@ def evaluate(scenario, law, reference, *, tolerances=None, from_state=True, floo
     fl = reference.floor_for(rot)
     same = reg["simulated"] == reg["measured"] and imp["simulated"] == imp["measured"]
     lim = consistency_limits(fl["mean"])
-    consistent = bool(same and all(crit[k] <= lim[k] for k in lim))
+    # an undefined floor (no bootstrap replicate found the contacts) decides nothing
+    consistent = bool(same and all(np.isfinite(lim[k]) and crit[k] <= lim[k] for k in lim))
     return Evaluation("ok", reg, imp, crit, fl["mean"], consistent,
                       _verdict(consistent, reg, imp, crit, fl["mean"]), steady=ss,
                       simulated=sim, extra={"aligned": rot, "noise_floor_q95": fl["q95"]})
