@@ -15,8 +15,10 @@ which are noisy (a small difference of two large motions); its coefficients are 
 biased (errors in variables).  The output-error refinement fits the force history by
 simulation, where the penetration is computed, not measured.
 
-Then up to ``stepwise`` output-error moves around the best model: when it is not
-consistent, a forward step extends it by each library term it lacks (refined by
+When no regression law has a periodic orbit with contact, a spring-dashpot start made
+from the record alone (contact time, force jump at onset, reduced mass) is refined.  Then
+up to ``stepwise`` output-error moves around the best model: when it is not consistent,
+each library term it lacks is added and each of its terms dropped in turn (refined by
 simulation from its coefficients), so a support the biased regression never proposed can
 still be found; when it is consistent, a backward step drops each of its terms in turn and
 refines the rest, so the simplest consistent model is found.
@@ -267,6 +269,7 @@ class _Checker:
         if not self.refine:
             return RankedModel(law, cand, self.evaluate(law), note="not refined",
                                certificate=cert0)
+        law = self._scaled_start(law)
         try:
             ref = identify([sc for sc, _ in self.refs], [r for _, r in self.refs], law,
                            criterion=self.criterion, method="least-squares",
@@ -291,6 +294,55 @@ class _Checker:
                            note=f"refined by simulation from the {origin} "
                            f"({ref.n_simulations} simulations, {self.criterion} "
                            f"{ref.value:.3g})", certificate=cert)
+
+    def _scaled_start(self, law):
+        """The refinement works in units of the start coefficients: a term whose start is
+        negligible (its force at the box's far corner below 0.1 % of the peak force) could
+        never grow, so it starts at 1 % of the peak instead (with its sign)."""
+        lib, est = self.est.library_, self.est
+        corner = lib.transform(np.array([[est.box_.zeta_max, est.box_.zd_max]]))[0]
+        peak = float(np.max(np.abs(self.samples.F)))
+        coef = _coefficients(law, lib)
+        small = (coef != 0) & (np.abs(coef) * corner < 1e-3 * peak) & (corner > 0)
+        if not small.any():
+            return law
+        coef[small] = np.sign(coef[small]) * _FORWARD_STARTS[0] * peak / corner[small]
+        return lib.law(coef)
+
+    def physical_start(self, scenario, ref):
+        """A spring-dashpot start from the record alone, refined by simulation: stiffness from
+        the measured contact time (``k = mu (pi / tau)^2``, ``mu`` the reduced mass), damping
+        from the force jump at onset (``c = F(0+) / v``, ``v`` the impact velocity; 5 % of
+        critical when there is no jump), put on the library's lowest elastic and damping
+        terms at the typical penetration ``v tau / pi``.  ``None`` when the library has
+        neither kind of term or the record gives no contact time."""
+        est, E = self.est, ref.impulse
+        lib = est.library_
+        if not len(E.support):
+            return None
+        tau = float(np.median(E.support[:, 1] - E.support[:, 0]))
+        v = ref.noise.get("impact_velocity") or float(np.max(self.samples.dzeta))
+        if not (tau > 0 and v and v > 0):
+            return None
+        mu = scenario.m1 * scenario.m2 / (scenario.m1 + scenario.m2)
+        k = mu * (np.pi / tau) ** 2
+        jump = float(E.evaluate(0.0, "right"))
+        c = jump / v if jump > 0.05 * E.peak else 0.1 * np.sqrt(k * mu)
+        z0 = v * tau / np.pi
+        coef = np.zeros(len(lib))
+        elastic = [i for i, t in enumerate(lib.terms) if t.b == 0]
+        damping = [i for i, t in enumerate(lib.terms) if t.b == 1]
+        if elastic:
+            i = min(elastic, key=lambda j: lib.terms[j].a)
+            coef[i] = k * z0 / z0 ** lib.terms[i].a
+        if damping:
+            i = min(damping, key=lambda j: lib.terms[j].a)
+            coef[i] = c / z0 ** lib.terms[i].a
+        if not coef.any():
+            return None
+        s = self.samples
+        cand = est.rescore(coef, s.X, s.F, s.weight, s.impact)
+        return self.refined(lib.law(coef), cand, "physical start (contact time, onset jump)")
 
     def backward(self, base, skip=frozenset()):
         """Output-error backward step: ``base`` without each of its terms in turn, refined
@@ -563,6 +615,13 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     by_score = list(models)  # the estimator's order (its scoring)
     ranking = rank(models, criterion, sim_rtol, sim_atol)
     steps = []
+    if refine and not ranking[0].criteria:
+        # no regression law has a periodic orbit with contact: start from the record alone
+        start = check.physical_start(*refs[0])
+        if start is not None:
+            steps.append({"kind": "physical start", "from": [], "trials": 1})
+            models = models + [start]
+            ranking = rank(models, criterion, sim_rtol, sim_atol)
     while refine and ranking[0].criteria and len(steps) < stepwise:
         # output-error stepwise search around the best model: a consistent model loses a
         # term (backward), an inconsistent one gains one (forward: the regression may have
@@ -572,8 +631,9 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         done = frozenset(frozenset(m.law.names) for m in models if m.criteria)
         if top.consistent:
             trials, kind = check.backward(top, done), "backward"
-        else:
-            trials, kind = check.forward(top, max_terms, done), "forward"
+        else:  # both directions: a wrong term may have to go while a missing one comes in
+            trials = check.forward(top, max_terms, done) + check.backward(top, done)
+            kind = "forward+backward"
         if not trials:
             break
         steps.append({"kind": kind, "from": list(top.law.names), "trials": len(trials)})
