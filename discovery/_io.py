@@ -1,34 +1,170 @@
-"""Atomic output directories and provenance records."""
+"""Atomic output directories, output checks and provenance records.
 
+Atomicity scheme (:class:`OutputDir`): a command writes its whole result set into a
+hidden *staging* directory beside the target, ``.NAME.vidi-staging.PID-START.TOKEN``
+(``PID`` and ``START``, the process start time, identify the run that owns it).  Only
+after the command succeeded is the staging directory put in place of the target as a
+whole:
+
+* no target yet: one ``rename(staging, target)``;
+* a target holding an earlier result: on Linux ``renameat2(RENAME_EXCHANGE)`` swaps
+  the two directories in one atomic step; the earlier set is then at the staging name
+  and is removed.  Elsewhere (or on a file system without the exchange), the target
+  is first renamed aside to ``.NAME.vidi-old.PID-START.TOKEN``, the staging directory
+  is renamed to the target, and the aside copy is removed.
+
+A reader therefore sees the complete earlier set or the complete new set, never a
+mix (in the fallback there is a window of two renames in which the target is
+absent).  On an exception (including Ctrl-C) the staging directory is removed and
+the target is untouched.  A run killed by SIGKILL leaves its staging (or aside)
+directory behind: the next run for the same target removes it once the process
+that made it is gone, and puts an aside copy back when the target is missing (a
+kill between the two renames of the fallback).
+
+Results are atomic *as a directory*: the target is replaced as a whole, so it must
+hold one command's results only.  :func:`check_output` (called by the commands before
+any work) refuses a target that is a file, not writable, the current directory, an
+input file or a directory holding one, or a non-empty directory that does not look
+like an earlier result (``summary.json`` beside output files only, no subdirectories).
+"""
+
+import contextlib
+import ctypes
+import ctypes.util
 import datetime
+import errno
+import hashlib
 import json
 import os
 import platform
+import re
+import secrets
 import shutil
+import subprocess
+import sys
 import tempfile
-from importlib import metadata
+from importlib import metadata, resources
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["OutputDir", "provenance", "to_jsonable"]
+from .errors import InputError
 
-_PACKAGES = ("vibroimpact-discovery", "numpy", "scipy", "numba", "sympy", "cvxpy", "pysindy",
-             "matplotlib")
+__all__ = ["OutputDir", "provenance", "to_jsonable", "check_output", "atomic_write_text",
+           "file_sha256", "git_state", "clean_stale"]
+
+# the solvers cvxpy uses here: CLARABEL (default), OSQP (fallback in the regression)
+_PACKAGES = ("vibroimpact-discovery", "numpy", "scipy", "numba", "sympy", "cvxpy", "clarabel",
+             "osqp", "scikit-learn", "pysindy", "matplotlib")
+
+# names of the files a result directory may hold (an earlier result that may be replaced)
+_RESULT_FILE = re.compile(r"^[^/]+\.(json|csv|png|pdf|tex|txt|svg)$", re.IGNORECASE)
+_STAGING, _ASIDE, _TMP = "vidi-staging", "vidi-old", "vidi-tmp"
+_OWNED = re.compile(r"^\.(?P<name>.+)\.(?P<kind>vidi-staging|vidi-old|vidi-tmp)\.(?P<pid>\d+)-"
+                    r"(?P<start>\d+)\.[0-9a-f]+$")
 
 
-def provenance(settings=None):
-    """Versions, platform and settings: recorded in every ``summary.json``."""
+# ---------------------------------------------------------------------------- provenance
+def _project_root():
+    return Path(__file__).resolve().parent.parent
+
+
+def git_state(root=None, timeout=2.0):
+    """``(commit, dirty)`` of the git checkout the package runs from, else ``(None, None)``.
+
+    Only a checkout whose top level holds the package counts (``root/.git`` exists): an
+    installed copy inside some other repository is not attributed to that repository.
+    ``dirty`` is True when tracked files differ from the commit (None if unknown).
+    """
+    root = Path(root) if root is not None else _project_root()
+    if not (root / ".git").exists():
+        return None, None
+    env = {**os.environ, "GIT_OPTIONAL_LOCKS": "0", "LC_ALL": "C"}
+
+    def git(*args):
+        return subprocess.run(["git", "-C", str(root), *args], capture_output=True, text=True,
+                              timeout=timeout, env=env, stdin=subprocess.DEVNULL)
+
+    try:
+        head = git("rev-parse", "HEAD")
+        if head.returncode != 0:
+            return None, None
+        commit = head.stdout.strip() or None
+    except (OSError, subprocess.SubprocessError):
+        return None, None
+    try:
+        st = git("status", "--porcelain", "--untracked-files=no")
+        dirty = bool(st.stdout.strip()) if st.returncode == 0 else None
+    except (OSError, subprocess.SubprocessError):
+        dirty = None
+    return commit, dirty
+
+
+def file_sha256(path):
+    """Hex sha256 of a file's bytes (read in chunks), or None if it cannot be read."""
+    h = hashlib.sha256()
+    try:
+        if not isinstance(path, str | os.PathLike):  # an importlib resource
+            h.update(path.read_bytes())
+            return h.hexdigest()
+        with open(path, "rb") as fh:
+            for chunk in iter(lambda: fh.read(1 << 20), b""):
+                h.update(chunk)
+    except (OSError, AttributeError):
+        return None
+    return h.hexdigest()
+
+
+def _input_record(value):
+    if value is None:
+        return None
+    text = str(value)
+    path = value
+    if isinstance(value, str) and not os.path.exists(value):
+        # a built-in scenario name: checksum of the packaged file
+        res = resources.files("discovery") / "scenarios" / f"{value}.toml"
+        if res.is_file():
+            return {"path": f"builtin:{value}", "sha256": file_sha256(res)}
+    if not isinstance(path, str | os.PathLike) or not os.path.isfile(path):
+        return {"path": text, "sha256": None}
+    return {"path": str(Path(path).resolve()), "sha256": file_sha256(path),
+            "bytes": os.path.getsize(path)}
+
+
+def provenance(settings=None, inputs=None):
+    """Versions, platform, git commit, input checksums and settings: recorded in every
+    ``summary.json``.
+
+    Parameters
+    ----------
+    settings : dict, optional
+        The run's options (callables are left out).
+    inputs : dict, optional
+        ``{"data": path, "scenario": path or built-in name, ...}``; each becomes
+        ``{"path", "sha256", "bytes"}`` (``sha256`` None when it is not a readable file).
+
+    Returns
+    -------
+    dict
+        ``versions`` (python and the packages, None when not installed), ``git``
+        (``commit``, ``dirty``: None outside a git checkout), ``platform``, ``created``
+        (UTC), ``inputs``, ``settings``.
+    """
     versions = {"python": platform.python_version()}
     for name in _PACKAGES:
         try:
             versions[name] = metadata.version(name)
         except metadata.PackageNotFoundError:
             versions[name] = None
-    return {"versions": versions, "platform": platform.platform(),
-            "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
-            "settings": to_jsonable({k: v for k, v in (settings or {}).items()
-                                     if not callable(v)})}
+    commit, dirty = git_state()
+    out = {"versions": versions, "git": {"commit": commit, "dirty": dirty},
+           "platform": platform.platform(),
+           "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+           "settings": to_jsonable({k: v for k, v in (settings or {}).items()
+                                    if not callable(v)})}
+    if inputs is not None:
+        out["inputs"] = {k: _input_record(v) for k, v in inputs.items()}
+    return out
 
 
 def to_jsonable(obj):
@@ -49,12 +185,281 @@ def to_jsonable(obj):
     return obj
 
 
-class OutputDir:
-    """Stage outputs in a hidden sibling directory and move them in only on success.
+# ------------------------------------------------------------------------ file modes
+def _umask():
+    """The process umask, read without changing it where /proc allows."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
-    Earlier results in the target directory are never destroyed or half-written:
-    each file is moved with ``os.replace`` (atomic) after the whole job succeeded;
-    on an exception the staging directory is removed and the target is untouched.
+
+def _chmod_default(path, directory=False):
+    """Give ``path`` the mode ``open``/``mkdir`` would (0666/0777 minus the umask);
+    mkstemp and mkdtemp create 0600/0700."""
+    with contextlib.suppress(OSError):
+        os.chmod(path, (0o777 if directory else 0o666) & ~_umask())
+
+
+def _fsync_dir(path):
+    with contextlib.suppress(OSError):
+        fd = os.open(path, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def atomic_write_text(path, text):
+    """Write a text file atomically (temporary file + rename), mode 0666 minus umask.
+
+    The temporary file ``.NAME.vidi-tmp.PID-START.TOKEN`` is removed on any exception;
+    one left by a killed run is removed by the next write of the same file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    clean_stale(path)
+    tmp = path.parent / _owned_name(path, _TMP)
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # the umask applies
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+# --------------------------------------------------------------------- output checks
+def _same_file(a, b):
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return os.path.abspath(a) == os.path.abspath(b)
+
+
+def _inside(child, parent):
+    """True when ``child`` is ``parent`` or lies below it (both resolved)."""
+    try:
+        Path(child).resolve().relative_to(Path(parent).resolve())
+        return True
+    except ValueError:
+        return False
+
+
+def _nearest_existing(path):
+    p = Path(os.path.abspath(path))
+    while not p.exists() and p != p.parent:
+        p = p.parent
+    return p
+
+
+def _writable_dir(d):
+    """Can entries be created in directory ``d``?  ``os.access`` for ordinary users; for
+    root (whom it always answers yes, e.g. in /proc) by creating and removing a probe."""
+    if not os.access(d, os.W_OK | os.X_OK):
+        return False
+    if not hasattr(os, "geteuid") or os.geteuid() != 0:
+        return True
+    try:
+        probe = tempfile.mkdtemp(prefix=".vidi-probe.", dir=d)
+    except OSError:
+        return False
+    with contextlib.suppress(OSError):
+        os.rmdir(probe)
+    return True
+
+
+def check_output(path, inputs=(), *, kind="dir", option="--out"):
+    """Refuse an output path before any work starts; returns it as a :class:`Path`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output directory (``kind="dir"``) or file (``kind="file"``).
+    inputs : iterable of paths
+        Input files (data, scenario): the output may neither be one nor, for a
+        directory, contain one (the directory is replaced as a whole).
+    kind : {"dir", "file"}
+    option : str
+        Option name used in the messages.
+
+    Raises
+    ------
+    InputError
+        ``path`` is empty, an existing file where a directory is expected (or a
+        directory where a file is), an input file, not writable, the current directory
+        (or above it), a directory holding an input, or a non-empty directory that is
+        not an earlier result.
+    """
+    text = "" if path is None else str(path)
+    if not text.strip():
+        what = "a directory such as results/run1" if kind == "dir" else "a file such as D.csv"
+        raise InputError(f"{option} is empty; give {what}")
+    p = Path(text)
+    for inp in inputs:
+        if inp is not None and os.path.isfile(inp) and _same_file(p, inp):
+            raise InputError(f"{option} {text!r} is the input file {str(inp)!r}; write the "
+                             "results elsewhere")
+    if kind == "file":
+        if p.is_dir():
+            raise InputError(f"{option} {text!r} is a directory; give a file name inside it, "
+                             f"e.g. {str(p / 'D.csv')!r}")
+    else:
+        if p.exists() and not p.is_dir():
+            raise InputError(f"{option} {text!r} is an existing file; give a directory (it is "
+                             "created) or remove the file")
+        if p.is_dir():
+            if _inside(Path.cwd(), p):
+                raise InputError(f"{option} {text!r} is the current directory or above it; the "
+                                 "result directory is replaced as a whole, so give a new "
+                                 "subdirectory such as results/run1")
+            for inp in inputs:
+                if inp is not None and os.path.isfile(inp) and _inside(inp, p):
+                    raise InputError(f"{option} {text!r} holds the input file {str(inp)!r}; "
+                                     "the result directory is replaced as a whole, so give "
+                                     "another directory")
+            _check_replaceable(p, text, option)
+    parent = _nearest_existing(Path(os.path.abspath(p)).parent)
+    if not parent.is_dir():
+        raise InputError(f"{option} {text!r}: {str(parent)!r} is a file, not a directory; "
+                         "choose another location")
+    if not _writable_dir(parent):
+        raise InputError(f"{option} {text!r}: cannot write in {str(parent)!r} (permission "
+                         "denied or read-only); choose a writable location")
+    return p
+
+
+def _check_replaceable(p, text, option):
+    """An existing directory may be replaced only when it is empty or looks like an
+    earlier result (a summary.json beside output files, no subdirectories)."""
+    entries = [e for e in os.scandir(p) if not _OWNED.match(e.name)]
+    if not entries:
+        return
+    names = {e.name for e in entries}
+    subdirs = sorted(e.name for e in entries if e.is_dir(follow_symlinks=False))
+    odd = sorted(e.name for e in entries if not e.is_dir(follow_symlinks=False)
+                 and not (e.is_file(follow_symlinks=False) and _RESULT_FILE.match(e.name)))
+    if subdirs or odd or "summary.json" not in names:
+        shown = ", ".join((subdirs + odd)[:3] or sorted(names)[:3])
+        raise InputError(f"{option} {text!r} is a non-empty directory that is not an earlier "
+                         f"vidi result (it holds {shown}); results replace the directory as a "
+                         "whole, so give a new or empty directory such as "
+                         f"{str(p / 'run1')!r}")
+
+
+# ---------------------------------------------------------------- staging directories
+def _proc_start(pid):
+    """Start time of process ``pid`` (clock ticks since boot) on Linux, else 0."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            stat = fh.read().decode("ascii", "replace")
+        return int(stat.rsplit(")", 1)[1].split()[19])
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
+def _alive(pid, start):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True  # another user's live process
+    except OSError:
+        return True
+    if start and os.path.exists("/proc/self/stat"):
+        now = _proc_start(pid)
+        return now == 0 or now == start  # the pid was reused by another process otherwise
+    return True
+
+
+def _owned_name(target, kind):
+    return (f".{target.name}.{kind}.{os.getpid()}-{_proc_start(os.getpid())}."
+            f"{secrets.token_hex(4)}")
+
+
+def clean_stale(target):
+    """Remove the staging/aside directories (and temporary files) of ``target`` left by
+    runs that were killed (their process is gone).  When the target itself is missing,
+    the newest aside copy (the earlier result, renamed aside just before a kill) is put
+    back first.
+
+    Returns
+    -------
+    list of Path
+        What was removed or restored.
+    """
+    target = Path(os.path.abspath(target))
+    parent = target.parent
+    if not parent.is_dir():
+        return []
+    stale = []
+    try:
+        for e in os.scandir(parent):
+            m = _OWNED.match(e.name)
+            if m and m["name"] == target.name and not _alive(int(m["pid"]), int(m["start"])) \
+                    and e.is_dir(follow_symlinks=False) == (m["kind"] != _TMP):
+                stale.append((m["kind"], Path(e.path)))
+    except OSError:
+        return []
+    done = []
+    asides = sorted((p for k, p in stale if k == _ASIDE), key=lambda p: p.stat().st_mtime)
+    if asides and not os.path.lexists(target):
+        with contextlib.suppress(OSError):
+            os.rename(asides[-1], target)
+            done.append(target)
+    for kind, p in stale:
+        if kind == _TMP:
+            with contextlib.suppress(OSError):
+                p.unlink()
+                done.append(p)
+        elif p.exists():
+            shutil.rmtree(p, ignore_errors=True)
+            done.append(p)
+    return done
+
+
+_libc = None
+
+
+def _exchange(a, b):
+    """Atomically swap directories ``a`` and ``b`` (Linux renameat2 RENAME_EXCHANGE);
+    False when the platform or file system does not support it."""
+    global _libc
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        if _libc is None:
+            _libc = ctypes.CDLL(ctypes.util.find_library("c") or None, use_errno=True)
+        fn = _libc.renameat2
+    except (OSError, AttributeError):
+        return False
+    fn.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
+    fn.restype = ctypes.c_int
+    at_fdcwd, rename_exchange = -100, 2
+    if fn(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EPERM):
+        return False
+    raise OSError(err, os.strerror(err), str(b))
+
+
+class OutputDir:
+    """Build a result set in a staging directory and put it in place as a whole.
+
+    See the module docstring for the scheme.  ``with OutputDir(p) as out:`` gives
+    ``out.path(name)`` (where to write ``name`` now) and ``out.write_json(name, data)``;
+    on leaving the block without an exception the staging directory replaces ``p``
+    atomically, otherwise it is removed and ``p`` is untouched.
 
     Examples
     --------
@@ -62,13 +467,35 @@ class OutputDir:
     ...     out.write_json("summary.json", {...})
     """
 
-    def __init__(self, target):
-        self.target = Path(target)
+    def __init__(self, target, inputs=()):
+        self._raw = "" if target is None else str(target)  # Path("") would read as "."
+        self.target = Path(self._raw)
+        self.inputs = tuple(inputs)
+        self.stage = None
 
     def __enter__(self):
-        parent = self.target.resolve().parent
-        parent.mkdir(parents=True, exist_ok=True)
-        self.stage = Path(tempfile.mkdtemp(prefix=f".{self.target.name}.", dir=parent))
+        check_output(self._raw, self.inputs)
+        target = Path(os.path.abspath(self.target))
+        if target.is_symlink() and target.is_dir():  # replace the directory it points to
+            target = Path(os.path.realpath(target))
+        clean_stale(target)
+        self._made = []
+        p = target.parent
+        while not p.exists():
+            self._made.append(p)
+            p = p.parent
+        try:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            self.stage = target.parent / _owned_name(target, _STAGING)
+            os.mkdir(self.stage)
+        except OSError as exc:
+            for d in self._made:
+                with contextlib.suppress(OSError):
+                    d.rmdir()
+            raise InputError(f"--out {str(self.target)!r}: cannot create {exc.filename!r} "
+                             f"({exc.strerror}); choose a writable location") from None
+        _chmod_default(self.stage, directory=True)
+        self._abs = target
         return self
 
     def path(self, name):
@@ -76,30 +503,46 @@ class OutputDir:
         return self.stage / name
 
     def write_json(self, name, data):
-        with open(self.path(name), "w") as fh:
+        with open(self.path(name), "w", encoding="utf-8") as fh:
             json.dump(to_jsonable(data), fh, indent=2)
             fh.write("\n")
+
+    def _commit(self):
+        for f in self.stage.iterdir():
+            if f.is_file():
+                with contextlib.suppress(OSError), open(f, "rb") as fh:
+                    os.fsync(fh.fileno())
+        _fsync_dir(self.stage)
+        target = self._abs
+        if not os.path.lexists(target):
+            os.rename(self.stage, target)
+            _fsync_dir(target.parent)
+            return
+        if not target.is_dir():
+            raise InputError(f"--out {str(self.target)!r} became a file during the run; the "
+                             "results were not written")
+        if _exchange(self.stage, target):
+            old = self.stage  # now holds the earlier result
+        else:
+            old = target.parent / _owned_name(target, _ASIDE)
+            os.rename(target, old)
+            try:
+                os.rename(self.stage, target)
+            except BaseException:
+                os.rename(old, target)
+                raise
+        _fsync_dir(target.parent)
+        shutil.rmtree(old, ignore_errors=True)
 
     def __exit__(self, exc_type, exc, tb):
         try:
             if exc_type is None:
-                self.target.mkdir(parents=True, exist_ok=True)
-                for f in sorted(self.stage.iterdir()):
-                    os.replace(f, self.target / f.name)
+                self._commit()
         finally:
-            shutil.rmtree(self.stage, ignore_errors=True)
+            if self.stage is not None and self.stage.exists():
+                shutil.rmtree(self.stage, ignore_errors=True)
+            if exc_type is not None or not self._abs.exists():
+                for d in self._made:  # parents created for a run that failed
+                    with contextlib.suppress(OSError):
+                        d.rmdir()
         return False
-
-
-def atomic_write_text(path, text):
-    """Write a text file atomically (temporary file + rename)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise

@@ -601,6 +601,10 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     if not (isinstance(shortlist, int | np.integer) and shortlist >= 1):
         raise InputError(f"shortlist must be a positive integer (candidates simulated); got "
                          f"{shortlist!r}")
+    for name, v, low in (("stability", stability, 0), ("n_boot", n_boot, 1),
+                         ("max_simulations", max_simulations, 2), ("stepwise", stepwise, 0)):
+        if not (isinstance(v, int | np.integer) and not isinstance(v, bool) and v >= low):
+            raise InputError(f"{name} must be an integer >= {low}; got {v!r}")
     pairs = _pairs(scenario, measurement)
     parts = [contact_samples(m, derivative=derivative, average_cycles=average_cycles,
                              period=sc.period) for sc, m in pairs]

@@ -24,6 +24,7 @@ from multiprocessing import get_context
 
 import numpy as np
 
+from ._workers import terminate_pool, worker_initializer
 from .criteria import CRITERIA
 from .errors import InputError, VidiError
 from .response import response
@@ -283,8 +284,9 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
         results = map(_row, jobs)
         pool = None
     else:
+        # workers die with this process (Ctrl-C, kill) and ignore SIGINT themselves
         pool = ProcessPoolExecutor(workers, mp_context=get_context("fork"),
-                                   initializer=_init, initargs=init)
+                                   **worker_initializer(_init, init))
         results = pool.map(_row, jobs)
     try:
         for i, row in results:
@@ -293,6 +295,11 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
                 if crit is not None:
                     for n, v in crit.items():
                         values[n][i, j] = v
+    except BaseException:
+        if pool is not None:
+            terminate_pool(pool)  # interrupted or failed: no waiting for queued rows
+            pool = None
+        raise
     finally:
         if pool is not None:
             pool.shutdown()

@@ -5,10 +5,30 @@ CSV format: a header row; ``t`` [s] and ``F`` [N] required; ``w1``, ``w2`` [m],
 note).  Without ``F``, the force is taken from the moulding's acceleration,
 ``F = m2 (a2 + g)`` (its equation of motion), which needs the scenario.  The time
 ``t`` is the drive's clock: the drive is ``A sin(2 pi f t)``.
+
+Files from real instruments (:meth:`Measurement.from_csv`):
+
+* **Encoding.** UTF-8, with or without a byte-order mark (spreadsheet exports); a
+  UTF-16 file with its byte-order mark is read too.  Anything else is refused with a
+  line asking to re-save the file as UTF-8.
+* **Separators.** ``,``, ``;`` or tab, sniffed from the header line.  With ``;`` or tab
+  a decimal comma (``0,25``) is read as a decimal point (noted).  Lines starting with
+  ``#`` and blank lines are skipped.
+* **Other header names.** ``columns={"t": "time_s", "F": "force_N"}`` (CLI:
+  ``--columns t=time_s,F=force_N``) maps our names to the file's.
+* **Sampling.** The record must be uniformly sampled.  With ``med`` the median step,
+  the jitter is ``max |dt - med| / med``: up to 0.1 % (rounding of written times) the
+  record is used as it is; up to :data:`JITTER_LIMIT` (10 %) every column is resampled
+  by linear interpolation onto the uniform grid ``t0 + k (t_end - t0) / (n - 1)`` (same
+  number of samples, same ends) and a note says so; beyond it (gaps, dropped samples,
+  irregular logging) the file is refused with a line saying what to do.
+* **Values.** Every cell must be a finite number within :data:`LIMITS` (SI units: a
+  value beyond them is a unit or column mix-up and would overflow the processing).
 """
 
 import csv
 import io
+import os
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,12 +37,31 @@ from ._io import atomic_write_text
 from .dynamics import simulate
 from .dynamics.steady_state import steady_state
 from .errors import InputError
-from .impulse import estimate_noise, impulse_from_samples
+from .impulse import _edge_params, estimate_noise, impulse_from_samples
 
-__all__ = ["Measurement", "synthesize"]
+__all__ = ["Measurement", "synthesize", "COLUMNS", "LIMITS", "JITTER_LIMIT"]
 
 _OPTIONAL = ("w1", "v1", "w2", "v2", "a2")
 _STATE = ("w1", "v1", "w2", "v2")
+COLUMNS = ("t", "F", *_OPTIONAL)
+#: largest accepted magnitude and unit of each column (SI)
+LIMITS = {"t": (1e7, "s"), "F": (1e12, "N"), "w1": (1e3, "m"), "w2": (1e3, "m"),
+          "v1": (1e3, "m/s"), "v2": (1e3, "m/s"), "a2": (1e7, "m/s^2")}
+#: relative sampling jitter below which a record is uniform as it is
+UNIFORM_TOL = 1e-3
+#: relative sampling jitter up to which a record is resampled onto a uniform grid
+JITTER_LIMIT = 0.10
+
+
+def _jitter(t):
+    """``(max |dt - med| / med, med, min dt, max dt)`` of increasing times."""
+    d = np.diff(t)
+    med = float(np.median(d))
+    return float(np.max(np.abs(d - med)) / med), med, float(d.min()), float(d.max())
+
+
+def _fmt(x):
+    return f"{float(x):.10g}"
 
 
 @dataclass(frozen=True)
@@ -32,7 +71,8 @@ class Measurement:
     Attributes
     ----------
     t : ndarray of shape (n,)
-        Strictly increasing sample times [s].
+        Strictly increasing, uniformly spaced sample times [s] (jitter up to
+        :data:`JITTER_LIMIT` of a step is tolerated; :meth:`from_csv` resamples it).
     F : ndarray of shape (n,)
         Contact force [N].
     channels : dict
@@ -54,23 +94,39 @@ class Measurement:
         F = np.asarray(self.F, dtype=float)
         where = f" in {self.source}" if self.source else ""
         if t.ndim != 1 or t.shape != F.shape or t.size < 4:
-            raise InputError(f"t and F must be 1-D of equal length >= 4{where}")
+            raise InputError(f"t and F must be 1-D of equal length >= 4{where}; a record needs "
+                             "at least 4 samples")
         for name, arr in (("t", t), ("F", F), *self.channels.items()):
-            bad = np.flatnonzero(~np.isfinite(np.asarray(arr, dtype=float)))
+            arr = np.asarray(arr, dtype=float)
+            if arr.shape != t.shape:
+                raise InputError(f"channel {name}{where} has {arr.size} samples but t has "
+                                 f"{t.size}; give every channel at every time")
+            bad = np.flatnonzero(~np.isfinite(arr))
             if bad.size:
                 raise InputError(f"column {name}{where} has a missing or non-finite value at "
                                  f"data row {bad[0] + 1}; remove or fill it")
+            lim, unit = LIMITS.get(name, (np.inf, ""))
+            big = np.flatnonzero(np.abs(arr) > lim)
+            if big.size:
+                raise InputError(f"column {name}{where} has the value {_fmt(arr[big[0]])} at "
+                                 f"data row {big[0] + 1}, beyond the accepted |{name}| <= "
+                                 f"{lim:g} {unit}; check the column and its units (SI)")
         d = np.diff(t)
         if np.any(d == 0):
             k = int(np.flatnonzero(d == 0)[0])
-            raise InputError(f"duplicate time t = {t[k]!r}{where} (data rows {k + 1}, {k + 2}); "
-                             "each sample needs its own time")
+            raise InputError(f"duplicate time t = {_fmt(t[k])}{where} (data rows {k + 1}, "
+                             f"{k + 2}); each sample needs its own time")
         if np.any(d < 0):
             k = int(np.flatnonzero(d < 0)[0])
             raise InputError(f"times are not increasing{where} at data row {k + 2}; sort the "
                              "file by t")
+        jit, med, lo, hi = _jitter(t)
+        if jit > JITTER_LIMIT:
+            raise InputError(_nonuniform_message(where, jit, med, lo, hi))
         object.__setattr__(self, "t", t)
         object.__setattr__(self, "F", F)
+        object.__setattr__(self, "channels",
+                           {k: np.asarray(v, dtype=float) for k, v in self.channels.items()})
 
     @property
     def fs(self):
@@ -78,58 +134,88 @@ class Measurement:
         return 1.0 / float(np.median(np.diff(self.t)))
 
     @classmethod
-    def from_csv(cls, path, scenario=None):
-        """Load and validate a CSV file (see module docstring).
+    def from_csv(cls, path, scenario=None, columns=None):
+        """Load and validate a CSV file (see the module docstring for the dialects).
 
         Parameters
         ----------
         path : str or Path
         scenario : Scenario, optional
             Needed only when the file has ``a2`` but no ``F``.
+        columns : dict, optional
+            ``{our name: the file's header}``, e.g. ``{"t": "time_s", "F": "force_N"}``;
+            our names are ``t, F, w1, v1, w2, v2, a2``.  Unmapped names are looked up as
+            they are.
+
+        Raises
+        ------
+        InputError
+            One line naming the problem (file, column, line) and the fix.
         """
-        try:
-            text = open(path, newline="").read()
-        except FileNotFoundError:
-            raise InputError(f"data file {str(path)!r} does not exist") from None
-        rows = list(csv.reader(io.StringIO(text)))
-        if not rows:
-            raise InputError(f"data file {str(path)!r} is empty; it needs a header with t and F")
+        name = str(path)
+        text, notes = _read_text(path, name)
+        lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
+                 if ln.strip() and not ln.lstrip().startswith("#")]
+        if not lines:
+            raise InputError(f"data file {name!r} is empty; it needs a header with t and F")
+        delim = _sniff(lines[0][1])
+        rows = []
+        for ln, line in lines:  # one record per line (no quoted line breaks in numbers)
+            try:
+                rows.append(next(csv.reader([line], delimiter=delim), []))
+            except csv.Error as exc:
+                raise InputError(f"data file {name!r}: line {ln} is not a readable CSV row "
+                                 f"({exc}); save the file as CSV with a header row") from None
         header = [h.strip() for h in rows[0]]
-        from_a2 = "F" not in header and "a2" in header
-        if from_a2 and scenario is None:
-            raise InputError(f"data file {str(path)!r} has a2 but no F; give the scenario so "
-                             "that F = m2 (a2 + g) can be formed")
-        missing = [c for c in ("t", "F") if c not in header and not (c == "F" and from_a2)]
-        if missing:
-            raise InputError(f"data file {str(path)!r} has no column {' or '.join(missing)}; "
-                             f"the header must name t [s] and F [N] (found {header})")
-        cols = {}
-        body = [r for r in rows[1:] if any(c.strip() for c in r)]
-        for name in ("t", "F", *_OPTIONAL):
-            if name in header:
-                j = header.index(name)
-                try:
-                    cols[name] = np.array([float(r[j]) if r[j].strip() else np.nan
-                                           for r in body])
-                except (ValueError, IndexError):
-                    raise InputError(f"column {name} in {str(path)!r} has a non-numeric or "
-                                     "missing entry; every row needs a number") from None
-        ignored = [h for h in header if h not in ("t", "F", *_OPTIONAL)]
-        notes = (f"ignored column(s): {', '.join(ignored)}",) if ignored else ()
+        src, from_a2, extra_notes = _column_sources(header, columns, name, scenario)
+        notes += extra_notes
+        body = list(zip((ln for ln, _ in lines[1:]), rows[1:], strict=True))
+        if not body:
+            raise InputError(f"data file {name!r} has a header but no data rows")
+        decimal_comma = delim != "," and any("," in c for _, r in body[:50] for c in r)
+        if decimal_comma:
+            notes += ("decimal commas read as decimal points",)
+        cols = {key: _parse_column(key, header[j], j, body, name, decimal_comma)
+                for key, j in src.items()}
+        t = cols["t"]
+        d = np.diff(t)
+        if np.any(d == 0):
+            k = int(np.flatnonzero(d == 0)[0])
+            raise InputError(f"data file {name!r}: duplicate time t = {_fmt(t[k])} at lines "
+                             f"{body[k][0]} and {body[k + 1][0]}; each sample needs its own time")
+        if np.any(d < 0):
+            k = int(np.flatnonzero(d < 0)[0])
+            raise InputError(f"data file {name!r}: times are not increasing at line "
+                             f"{body[k + 1][0]}; sort the file by t")
+        if t.size >= 3:
+            jit, med, lo, hi = _jitter(t)
+            if jit > JITTER_LIMIT:
+                raise InputError(_nonuniform_message(f" in {name!r}", jit, med, lo, hi))
+            if jit > UNIFORM_TOL:
+                grid = np.linspace(t[0], t[-1], t.size)
+                cols = {k: (grid if k == "t" else np.interp(grid, t, v)) for k, v in cols.items()}
+                notes += (f"resampled onto a uniform grid (step {_fmt(grid[1] - grid[0])} s) by "
+                          f"linear interpolation: the sampling jitter was {100 * jit:.3g} % of "
+                          "a step",)
         channels = {k: cols[k] for k in _OPTIONAL if k in cols}
         if from_a2:
             cols["F"] = scenario.m2 * (cols["a2"] + scenario.g)
             notes += ("F formed from the moulding's acceleration: F = m2 (a2 + g)",)
-        return cls(cols["t"], cols["F"], channels, str(path), notes)
+        return cls(cols["t"], cols["F"], channels, name, notes)
 
-    def to_csv(self, path):
-        """Write atomically as CSV (``t, F`` then the optional channels)."""
+    def to_csv_text(self):
+        """The record as CSV text (``t, F`` then the optional channels, ``%.12g``)."""
         names = ["t", "F", *[k for k in _OPTIONAL if k in self.channels]]
         data = np.column_stack([self.t, self.F, *[self.channels[k] for k in names[2:]]])
         buf = io.StringIO()
         buf.write(",".join(names) + "\n")
         np.savetxt(buf, data, delimiter=",", fmt="%.12g")
-        atomic_write_text(path, buf.getvalue())
+        return buf.getvalue()
+
+    def to_csv(self, path):
+        """Write atomically as CSV (``t, F`` then the optional channels); mode 0666 minus
+        the umask."""
+        atomic_write_text(path, self.to_csv_text())
 
     @property
     def zeta(self):
@@ -190,7 +276,198 @@ class Measurement:
     def impulse(self, period, **kwargs):
         """Period-averaged steady-state impulse (see :func:`impulse_from_samples`);
         the onset comes from ``zeta`` when positions were recorded."""
-        return impulse_from_samples(self.t, self.F, period, zeta=self.zeta, **kwargs)
+        try:
+            return impulse_from_samples(self.t, self.F, period, zeta=self.zeta, **kwargs)
+        except InputError as exc:
+            if not str(exc).startswith("no contact found"):
+                raise
+            raise InputError(no_contact_message(self.t, self.F, period, self.source,
+                                                kwargs.get("threshold"))) from None
+
+
+def _nonuniform_message(where, jit, med, lo, hi):
+    return (f"the record{where} is not uniformly sampled: time steps from {_fmt(lo)} to "
+            f"{_fmt(hi)} s around the median {_fmt(med)} s ({100 * jit:.3g} % off; up to "
+            f"{100 * JITTER_LIMIT:g} % is resampled); resample it onto a uniform time grid "
+            "(e.g. numpy.interp) or cut it at the gap, then load it again")
+
+
+def no_contact_message(t, F, period, source="", threshold=None):
+    """Why a record yields no complete contact: no sample above the threshold, samples
+    above it only in runs cut off at the record's start or end, or only noise spikes."""
+    t = np.asarray(t, dtype=float)
+    F = np.asarray(F, dtype=float)
+    where = f" in {source}" if source else ""
+    sigma = estimate_noise(F)
+    thr = max(5.0 * sigma, 1e-3 * float(np.max(F))) if threshold is None else float(threshold)
+    above = F > thr
+    n_above = int(above.sum())
+    if n_above == 0:
+        return (f"no contact found in the force record{where}: no sample exceeds the threshold "
+                f"{thr:.3g} N (5 x the noise {sigma:.3g} N, at least 1e-3 of max F); check the "
+                "F column and its units")
+    min_len = _edge_params(t, period)[0]
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], above.astype(np.int8), [0]])))
+    runs = []
+    for a, b in zip(edges[::2], edges[1::2], strict=True):
+        if runs and a - runs[-1][1] < min_len:
+            runs[-1][1] = b
+        else:
+            runs.append([a, b])
+    long_runs = [(a, b) for a, b in runs if b - a >= min_len]
+    if long_runs and all(a == 0 or b == F.size for a, b in long_runs):
+        at = [("start" if a == 0 else "end") for a, b in long_runs]
+        n_cut = sum(b - a for a, b in long_runs)
+        side = " and ".join(dict.fromkeys(at))
+        return (f"the only contact{where} ({n_cut} samples above the threshold {thr:.3g} N) is "
+                f"cut off at the record's {side}: a contact must begin and end inside the "
+                "record; record a few drive periods more (whole contacts)")
+    if not long_runs:
+        return (f"no contact found in the force record{where}: {n_above} samples exceed the "
+                f"threshold {thr:.3g} N but no run lasts {min_len} samples (1 % of a drive "
+                "period): they look like noise spikes; check the F column, its units and the "
+                "sampling rate")
+    return (f"no contact found in the force record{where}: the runs above the threshold "
+            f"{thr:.3g} N peak below 3 x the threshold, which is read as noise; check the F "
+            "column and its units, or record with less noise")
+
+
+def _read_text(path, name):
+    """The file's text (UTF-8 with or without BOM, or UTF-16 with BOM) and notes."""
+    if not name.strip():
+        raise InputError("the data file name is empty; give a CSV file such as D.csv")
+    try:
+        with open(path, "rb") as fh:
+            raw = fh.read()
+    except FileNotFoundError:
+        raise InputError(f"data file {name!r} does not exist; check the path") from None
+    except IsADirectoryError:
+        raise InputError(f"data file {name!r} is a directory; give the CSV file itself, e.g. "
+                         f"{os.path.join(name, 'D.csv')!r}") from None
+    except PermissionError:
+        raise InputError(f"data file {name!r} cannot be read (permission denied); fix its "
+                         "permissions or copy it somewhere readable") from None
+    except OSError as exc:
+        raise InputError(f"cannot read data file {name!r} ({exc.strerror or exc}); check the "
+                         "path") from None
+    notes = ()
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        try:
+            text = raw.decode("utf-16")
+        except UnicodeDecodeError:
+            raise InputError(f"data file {name!r} starts with a UTF-16 byte-order mark but is "
+                             "not valid UTF-16; re-save it as UTF-8 CSV") from None
+        notes = ("read as UTF-16 (byte-order mark)",)
+    else:
+        try:
+            text = raw.decode("utf-8-sig")
+        except UnicodeDecodeError as exc:
+            raise InputError(f"data file {name!r} is not UTF-8 text (byte 0x{raw[exc.start]:02x} "
+                             f"at offset {exc.start}); re-save it as UTF-8 (spreadsheets: "
+                             "'CSV UTF-8'; or iconv -f latin1 -t utf-8)") from None
+    if "\x00" in text:
+        raise InputError(f"data file {name!r} contains NUL bytes: it is binary (or UTF-16 "
+                         "without a byte-order mark), not CSV text; export it as CSV (UTF-8)")
+    return text, notes
+
+
+def _sniff(header_line):
+    """The separator of the header line: the most frequent of tab, ';' and ','."""
+    counts = [(header_line.count(c), -k, c) for k, c in enumerate(("\t", ";", ","))]
+    n, _, c = max(counts)
+    return c if n else ","
+
+
+def _column_sources(header, columns, name, scenario):
+    """``{our name: column index}``, whether F comes from a2, and notes."""
+    named = [h for h in header if h]
+    dups = sorted({h for h in named if named.count(h) > 1})
+    if dups:
+        raise InputError(f"data file {name!r}: column name(s) {', '.join(dups)} appear more "
+                         "than once in the header; rename them")
+    src, notes = {}, ()
+    if columns:
+        if not isinstance(columns, dict):
+            raise InputError("columns must map our names to the file's headers, e.g. "
+                             "{'t': 'time_s', 'F': 'force_N'}")
+        for key, col in columns.items():
+            if key not in COLUMNS:
+                raise InputError(f"column mapping: unknown name {key!r}; map the names "
+                                 f"{', '.join(COLUMNS)} to the file's headers, e.g. "
+                                 "t=time_s,F=force_N")
+            col = col.strip() if isinstance(col, str) else col
+            if not isinstance(col, str) or not col:
+                raise InputError(f"column mapping {key}=: give the header of the file's "
+                                 f"column for {key}, e.g. {key}=time_s")
+            if col not in header:
+                raise InputError(f"column mapping {key}={col}: data file {name!r} has no column "
+                                 f"{col!r} (found {', '.join(named) or 'no names'})")
+            src[key] = header.index(col)
+        if len(set(src.values())) != len(src):
+            raise InputError("column mapping: two names are mapped to the same column; map "
+                             "each of the file's columns once")
+        notes += ("columns mapped: " + ", ".join(f"{k} <- {header[j]}" for k, j in src.items()),)
+    used = set(src.values())
+    for key in COLUMNS:
+        if key not in src and key in header and header.index(key) not in used:
+            src[key] = header.index(key)
+    from_a2 = "F" not in src and "a2" in src
+    if from_a2 and scenario is None:
+        raise InputError(f"data file {name!r} has a2 but no F; give the scenario so that "
+                         "F = m2 (a2 + g) can be formed")
+    missing = [c for c in ("t", "F") if c not in src and not (c == "F" and from_a2)]
+    for c in missing:
+        if c in header:  # its column was mapped to another name
+            other = next(k for k, j in src.items() if j == header.index(c))
+            raise InputError(f"column mapping {other}={c} takes the file's column {c}, so "
+                             f"nothing is left for {c}; map {c} to another column as well, "
+                             f"e.g. {c}=NAME")
+    if missing:
+        raise InputError(f"data file {name!r} has no column {' or '.join(missing)} (found "
+                         f"{', '.join(named) or 'no names'}); name them t [s] and F [N] in the "
+                         "header, or map yours: --columns t=NAME,F=NAME (API: columns=)")
+    ignored = [h for j, h in enumerate(header) if h and j not in src.values()]
+    if ignored:
+        notes += (f"ignored column(s): {', '.join(ignored)}",)
+    return src, from_a2, notes
+
+
+def _parse_column(key, hname, j, body, name, decimal_comma):
+    """Column ``j`` of the data rows as floats, with a line-numbered error for a missing,
+    non-numeric, non-finite or out-of-range cell."""
+    cells = []
+    for ln, row in body:
+        if j >= len(row):
+            raise InputError(f"data file {name!r}: line {ln} has {len(row)} field(s), no value "
+                             f"for column {hname}; every row needs a value in every column")
+        cells.append(row[j].strip())
+    arr = np.array(cells, dtype=str)
+    if decimal_comma:
+        arr = np.char.replace(arr, ",", ".")
+    try:
+        v = arr.astype(float)
+    except (ValueError, OverflowError):
+        for (ln, _), c in zip(body, arr, strict=True):
+            try:
+                float(c)
+            except ValueError:
+                what = "is empty" if not c else f"has a non-numeric value {c[:20]!r}"
+                raise InputError(f"data file {name!r}: column {hname} {what} at line {ln}; "
+                                 "every row needs a number (remove the row or fill it)") from None
+        raise InputError(f"data file {name!r}: column {hname} cannot be read as numbers; "
+                         "every row needs a number") from None
+    bad = np.flatnonzero(~np.isfinite(v))
+    if bad.size:
+        raise InputError(f"data file {name!r}: column {hname} has the non-finite value "
+                         f"{cells[bad[0]][:20]!r} at line {body[bad[0]][0]}; remove the row or "
+                         "fill it with a measured number")
+    lim, unit = LIMITS[key]
+    big = np.flatnonzero(np.abs(v) > lim)
+    if big.size:
+        raise InputError(f"data file {name!r}: column {hname} has the value {cells[big[0]][:20]} "
+                         f"at line {body[big[0]][0]}, beyond the accepted |{key}| <= {lim:g} "
+                         f"{unit}; check the column and its units (SI)")
+    return v
 
 
 def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None, *,

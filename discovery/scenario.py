@@ -28,6 +28,28 @@ _FIELDS = {
     "m1": ("kg", True), "m2": ("kg", True), "k1": ("N/m", False), "c1": ("N s/m", False),
     "A": ("N", False), "frequency": ("Hz", True), "g": ("m/s^2", False),
 }
+#: largest accepted value of each parameter: far beyond any vibro-impact machine, and
+#: small enough that the simulation's scales (A / (m1 omega^2), k1 / m1, ...) stay finite
+LIMITS = {"m1": 1e9, "m2": 1e9, "k1": 1e15, "c1": 1e12, "A": 1e12, "frequency": 1e5,
+          "g": 1e3}
+#: largest accepted |position| [m] and |velocity| [m/s] of the initial state
+INITIAL_LIMITS = (1e3, 1e3)
+#: the tables and keys a scenario file may have
+_TABLES = {"name": None, "machine": tuple(_FIELDS), "law": ("text",),
+           "initial": ("w1", "v1", "w2", "v2")}
+
+
+def _number(value, what, unit):
+    """A float from a number (not a boolean, not text) or raise naming ``what``."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.number):
+        got = "a boolean" if isinstance(value, bool | np.bool_) else (
+            f"text {value!r}" if isinstance(value, str) else type(value).__name__)
+        raise InputError(f"{what} must be a number in {unit}, got {got}; write a number such "
+                         "as 1.0e4 (no quotes)")
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf
 
 
 @dataclass(frozen=True)
@@ -72,28 +94,32 @@ class Scenario:
 
     def __post_init__(self):
         for key, (unit, strict) in _FIELDS.items():
-            value = getattr(self, key)
-            try:
-                value = float(value)
-            except (TypeError, ValueError):
-                raise InputError(
-                    f"scenario {key} must be a number in {unit}, got {value!r}"
-                ) from None
-            if not math.isfinite(value) or value < 0 or (strict and value == 0):
+            value = _number(getattr(self, key), f"scenario {key}", unit)
+            lim = LIMITS[key]
+            if not (math.isfinite(value) and 0 <= value <= lim) or (strict and value == 0):
                 need = "> 0" if strict else ">= 0"
                 raise InputError(
-                    f"scenario {key} = {value!r} {unit} is invalid; it must be finite and {need}"
+                    f"scenario {key} = {value:g} {unit} is invalid; it must be finite, {need} "
+                    f"and <= {lim:g} {unit}"
                 )
             object.__setattr__(self, key, value)
         if self.initial is not None:
-            try:
-                init = tuple(float(v) for v in self.initial)
-            except (TypeError, ValueError):
+            if isinstance(self.initial, str | bytes) or not hasattr(self.initial, "__len__") \
+                    or len(self.initial) != 4:
                 raise InputError("scenario initial must be 4 numbers (w1, v1, w2, v2) in m, "
-                                 f"m/s; got {self.initial!r}") from None
-            if len(init) != 4 or not all(math.isfinite(v) for v in init):
-                raise InputError("scenario initial must be 4 finite numbers (w1, v1, w2, v2)")
+                                 f"m/s; got {self.initial!r}")
+            init = tuple(_number(v, f"scenario initial {k}", u) for v, k, u in
+                         zip(self.initial, ("w1", "v1", "w2", "v2"), ("m", "m/s", "m", "m/s"),
+                             strict=True))
+            wmax, vmax = INITIAL_LIMITS
+            if not all(math.isfinite(v) for v in init) or max(abs(init[0]), abs(init[2])) > wmax \
+                    or max(abs(init[1]), abs(init[3])) > vmax:
+                raise InputError("scenario initial must be 4 finite numbers (w1, v1, w2, v2) "
+                                 f"with |w| <= {wmax:g} m and |v| <= {vmax:g} m/s")
             object.__setattr__(self, "initial", init)
+        if self.law is not None and not isinstance(self.law, ForceLaw):
+            raise InputError(f"scenario law must be a ForceLaw, got {type(self.law).__name__}; "
+                             "use ForceLaw.parse(text)")
 
     # ------------------------------------------------------------------ derived
     @property
@@ -146,48 +172,82 @@ class Scenario:
     # ------------------------------------------------------------------ loading
     @classmethod
     def from_toml(cls, path):
-        """Read a scenario file (``[machine]`` table, optional ``[law] text``)."""
+        """Read a scenario file (``[machine]`` table, optional ``[law] text``, optional
+        ``[initial]``, optional top-level ``name``); every table and key is checked (see
+        :meth:`_from_mapping`)."""
         path = Path(path)
+        hint = f"give a TOML file or one of {', '.join(builtin_scenarios())}"
         try:
-            data = tomllib.loads(path.read_text())
+            raw = path.read_bytes()
         except FileNotFoundError:
-            raise InputError(
-                f"scenario file {str(path)!r} does not exist; give a TOML file or one of "
-                f"{', '.join(builtin_scenarios())}"
-            ) from None
+            raise InputError(f"scenario file {str(path)!r} does not exist; {hint}") from None
+        except IsADirectoryError:
+            raise InputError(f"scenario {str(path)!r} is a directory; {hint}") from None
+        except PermissionError:
+            raise InputError(f"scenario file {str(path)!r} cannot be read (permission denied); "
+                             "fix its permissions") from None
+        except OSError as exc:
+            raise InputError(f"cannot read scenario file {str(path)!r} ({exc.strerror or exc}); "
+                             f"{hint}") from None
+        try:
+            text = raw.decode("utf-8-sig")
+        except UnicodeDecodeError as exc:
+            raise InputError(f"scenario file {str(path)!r} is not UTF-8 text (byte "
+                             f"0x{raw[exc.start]:02x} at offset {exc.start}); re-save it as "
+                             "UTF-8") from None
+        try:
+            data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
             raise InputError(f"scenario file {str(path)!r} is not valid TOML: {exc}") from None
         return cls._from_mapping(data, str(path), default_name=path.stem)
 
     @classmethod
     def _from_mapping(cls, data, source, default_name):
+        """Validate a parsed scenario file: unknown tables and keys are refused (a typo
+        would otherwise silently fall back to a default), every value is type-checked
+        (a boolean or a quoted number is not a number) and range-checked."""
+        unknown = sorted(set(data) - set(_TABLES))
+        if unknown:
+            raise InputError(f"scenario {source!r}: unknown table(s) or key(s) "
+                             f"{', '.join(unknown)}; valid are name, [machine], [law], [initial]")
+        for table in ("machine", "law", "initial"):
+            if table in data and not isinstance(data[table], dict):
+                raise InputError(f"scenario {source!r}: {table} must be a table; write "
+                                 f"[{table}] on its own line followed by its keys")
+            extra = sorted(set(data.get(table, {})) - set(_TABLES[table]))
+            if extra:
+                raise InputError(f"scenario {source!r}: unknown [{table}] key(s) "
+                                 f"{', '.join(extra)}; valid keys are "
+                                 f"{', '.join(_TABLES[table])}")
         machine = data.get("machine")
-        if not isinstance(machine, dict):
+        if machine is None:
             raise InputError(f"scenario {source!r} needs a [machine] table with m1, m2, k1, c1, A, "
                              "frequency")
-        unknown = set(machine) - set(_FIELDS)
-        if unknown:
-            raise InputError(f"scenario {source!r}: unknown [machine] key(s) {sorted(unknown)}; "
-                             f"valid keys are {sorted(_FIELDS)}")
         missing = [k for k in _FIELDS if k != "g" and k not in machine]
         if missing:
             raise InputError(f"scenario {source!r}: [machine] is missing {', '.join(missing)}; "
                              "add them in SI units (kg, N/m, N s/m, N, Hz)")
-        law_table = data.get("law") or {}
-        if not isinstance(law_table, dict):
-            raise InputError(f"scenario {source!r}: law must be a table, write [law] then "
-                             "text = \"2.06e8*z + 1.28e7*zd\"")
-        law_text = law_table.get("text")
-        law = ForceLaw.parse(law_text) if law_text else None
-        init = data.get("initial")
+        values = {k: _number(v, f"scenario {k}", _FIELDS[k][0]) for k, v in machine.items()}
+        law = None
+        if "law" in data:
+            law_text = data["law"].get("text")
+            if not isinstance(law_text, str) or not law_text.strip():
+                raise InputError(f"scenario {source!r}: [law] needs text = \"2.06e8*z + "
+                                 "1.28e7*zd\" (a quoted, non-empty law), or remove the table")
+            law = ForceLaw.parse(law_text)
         initial = None
-        if init is not None:
-            try:
-                initial = tuple(init[k] for k in ("w1", "v1", "w2", "v2"))
-            except (KeyError, TypeError):
-                raise InputError(f"scenario {source!r}: [initial] needs w1, v1, w2, v2") from None
-        return cls(**machine, law=law, initial=initial,
-                   name=str(data.get("name", default_name)), source=source)
+        if "initial" in data:
+            init = data["initial"]
+            if set(init) != set(_TABLES["initial"]):
+                raise InputError(f"scenario {source!r}: [initial] needs w1, v1, w2, v2")
+            initial = tuple(_number(init[k], f"scenario initial {k}", u)
+                            for k, u in zip(_TABLES["initial"], ("m", "m/s", "m", "m/s"),
+                                            strict=True))
+        name = data.get("name", default_name)
+        if not isinstance(name, str) or not name.strip():
+            raise InputError(f"scenario {source!r}: name must be non-empty text, e.g. "
+                             "name = \"my-grid\"")
+        return cls(**values, law=law, initial=initial, name=name, source=source)
 
 
 def builtin_scenarios():
@@ -201,6 +261,9 @@ def load_scenario(name_or_path):
     if isinstance(name_or_path, Scenario):
         return name_or_path
     text = str(name_or_path)
+    if not text.strip():
+        raise InputError("the scenario is empty; give a built-in name "
+                         f"({', '.join(builtin_scenarios())}) or a TOML file")
     if text in builtin_scenarios():
         res = resources.files("discovery") / "scenarios" / f"{text}.toml"
         data = tomllib.loads(res.read_text())

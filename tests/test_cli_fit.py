@@ -130,7 +130,7 @@ def test_data_without_positions_exit_2_without_output(record, tmp_path, capsys):
 def test_bad_max_terms_exit_2(record, tmp_path, capsys):
     out = tmp_path / "o"
     _assert_clean_failure(["fit", "--data", str(record), "--max-terms", "0",
-                           "--out", str(out)], out, capsys, "max_terms")
+                           "--out", str(out)], out, capsys, "--max-terms")
 
 
 def test_solver_error_exit_2_one_line(record, tmp_path, capsys, monkeypatch):

@@ -121,7 +121,7 @@ def test_default_ranges_are_centred_on_the_template(tmp_path):
     (["--range1", "1e7:1e7"], "--range1 needs LOW < HIGH"),
     (["--law", "0*z + 1e7*zd"], "give --range0 LOW:HIGH"),
     (["--law", "2e8*z + 0*zd"], "give --range1 LOW:HIGH"),
-    (["--workers", "0"], "--workers must be at least 1"),
+    (["--workers", "0"], "--workers: '0' is out of range"),
     (["--grid", "1x5"], "at least 2 points per axis"),
     (["--data", "missing.csv"], "does not exist"),
 ])

@@ -186,5 +186,73 @@ def test_with_law_and_as_dict():
 
 
 def test_numbers_are_coerced_to_float():
-    sc = Scenario(m1=1, m2="2", k1=3, c1=0, A=0, frequency=np.float32(4))
+    sc = Scenario(m1=1, m2=np.int64(2), k1=3, c1=0, A=0, frequency=np.float32(4))
     assert all(type(getattr(sc, k)) is float for k in ("m1", "m2", "k1", "frequency"))
+
+
+@pytest.mark.parametrize("value", [True, False, np.bool_(True), "2", None, [1.0]])
+def test_booleans_and_text_are_not_numbers(value):
+    with pytest.raises(InputError, match="scenario m2 must be a number in kg"):
+        Scenario(m1=1, m2=value, k1=3, c1=0, A=0, frequency=4)
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "needle"),
+    [("m1", "true", "got a boolean"), ("m2", "false", "got a boolean"),
+     ("k1", '"2.0e7"', "got text '2.0e7'"), ("A", "[1, 2]", "got list"),
+     ("frequency", "{ a = 1 }", "got dict"), ("c1", "1979-05-27", "got date"),
+     ("A", "1e300", "<= 1e+12 N"), ("m1", "1e30", "<= 1e+09 kg"),
+     ("frequency", "1e9", "<= 100000 Hz"), ("g", "inf", "must be finite"),
+     ("m1", "-inf", "must be finite")],
+)
+def test_toml_types_and_ranges(tmp_path, key, value, needle):
+    lines = [f"{key} = {value}" if line.startswith(f"{key} =") else line
+             for line in GOOD.splitlines()]
+    with pytest.raises(InputError, match=f"scenario {key} ") as exc:
+        load_scenario(_write(tmp_path, "\n".join(lines)))
+    assert needle in str(exc.value) and "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize(
+    ("extra", "needle"),
+    [("\n[machnie]\nm1 = 1.0\n", "unknown table(s) or key(s) machnie"),
+     ("\n[solver]\nrtol = 1e-9\n", "valid are name, [machine], [law], [initial]"),
+     ("\n[initial]\nw1 = 0\nv1 = 0\nw2 = 0\nv2 = 0\nw3 = 0\n", "unknown [initial] key(s) w3"),
+    ])
+def test_unknown_tables_and_keys_are_refused(tmp_path, extra, needle):
+    with pytest.raises(InputError) as exc:
+        load_scenario(_write(tmp_path, GOOD + extra))
+    assert needle in str(exc.value)
+
+
+def test_unknown_law_key_and_bad_law_text(tmp_path):
+    with pytest.raises(InputError, match=r"unknown \[law\] key\(s\) txt; valid keys are text"):
+        load_scenario(_write(tmp_path, GOOD.replace("text =", "txt =")))
+    for bad in ('text = ""', "text = 5", "text = true"):
+        with pytest.raises(InputError, match=r"\[law\] needs text"):
+            load_scenario(_write(tmp_path, GOOD.replace('text = "1e8*z + 2e6*zd"', bad)))
+
+
+def test_bad_name_and_initial_types(tmp_path):
+    with pytest.raises(InputError, match="name must be non-empty text"):
+        load_scenario(_write(tmp_path, GOOD.replace('name = "bench"', "name = 3")))
+    text = GOOD + "\n[initial]\nw1 = true\nv1 = 0.0\nw2 = 0.0\nv2 = 0.0\n"
+    with pytest.raises(InputError, match="scenario initial w1 must be a number"):
+        load_scenario(_write(tmp_path, text))
+    with pytest.raises(InputError, match="<= 1000 m"):
+        Scenario(m1=1, m2=1, k1=0, c1=0, A=0, frequency=1, initial=(1e6, 0, 0, 0))
+
+
+def test_directory_non_utf8_empty_and_bom(tmp_path):
+    with pytest.raises(InputError, match="is a directory") as exc:
+        load_scenario(tmp_path)
+    assert "paper" in str(exc.value)
+    p = tmp_path / "latin.toml"
+    p.write_bytes(GOOD.replace('"bench"', '"b\u00e9nch"').encode("latin-1"))
+    with pytest.raises(InputError, match="not UTF-8 text .*re-save it as UTF-8"):
+        load_scenario(p)
+    with pytest.raises(InputError, match="scenario is empty"):
+        load_scenario("")
+    p = tmp_path / "bom.toml"
+    p.write_bytes(b"\xef\xbb\xbf" + GOOD.encode())
+    assert load_scenario(p).name == "bench"

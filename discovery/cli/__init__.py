@@ -3,46 +3,194 @@
 One module per command (``simulate``, ``fit``, ``verify``, ``steady``, ``landscape``,
 ``identify``), each with ``register(subparsers)`` and ``run(args)``.  Every command
 writes ``summary.json`` (results, versions, settings) beside its other outputs;
-outputs are staged and moved in only when the command succeeds.  Bad input gives one
-line on stderr and exit code 2.
+outputs are staged and put in place as a whole only when the command succeeds
+(:class:`discovery._io.OutputDir`).
+
+Exit codes: 0 success; 2 bad input, failed numerics or an OS error such as a full disk
+(one line on stderr, ``vidi: error: ...``, naming the problem and the fix; also for
+option errors, which argparse would print as a usage block); 130 interrupted by Ctrl-C
+(SIGINT), 143 terminated (SIGTERM), one line each, earlier results untouched; 1 an
+internal error (one line, the traceback with ``VIDI_TRACEBACK=1``).
+
+A value that starts with ``-`` (``--law -1e8*z``) is taken as the option's value when
+it is not itself an option; ``--law=-1e8*z`` always works.
 """
 
 import argparse
+import contextlib
+import os
+import re
+import signal
 import sys
+import threading
+import traceback
 
 from ..errors import VidiError
 from . import fit, identify, landscape, simulate, steady, verify
 
-__all__ = ["main"]
+__all__ = ["main", "UsageError", "VidiArgumentParser"]
 
 _COMMANDS = (simulate, fit, verify, steady, landscape, identify)
 
 
+class UsageError(VidiError):
+    """A command-line option is missing, unknown or has an invalid value."""
+
+
+class Terminated(BaseException):  # noqa: N818  (like KeyboardInterrupt)
+    """SIGTERM received: unwinds like Ctrl-C, so staging directories are removed."""
+
+
+def _one_line(message, prog, command=None):
+    """argparse's message rewritten as one line naming the option, the valid values and
+    the fix."""
+    command = prog.split()[-1] if prog and prog != "vidi" else command
+    see = f"see vidi {command} --help" if command else "see vidi --help"
+    m = re.match(r"argument (\S+?)(?:/\S+)?: invalid choice: '(.*)' \(choose from (.*)\)$",
+                 message, re.S)
+    if m:
+        opt, value, choices = m.groups()
+        choices = choices.replace("'", "")
+        if opt in ("COMMAND", "command"):
+            return f"unknown command {value!r}; choose one of {choices} ({see})"
+        return f"{opt}: invalid choice {value!r}; choose one of {choices}"
+    m = re.match(r"argument (\S+?)(?:/\S+)?: invalid (\w+) value: '(.*)'$", message, re.S)
+    if m:
+        opt, kind, value = m.groups()
+        what = {"int": "an integer", "float": "a number"}.get(kind, f"a valid {kind}")
+        return f"{opt}: {value!r} is not {what}; give e.g. {opt} {'20' if kind == 'int' else '0.5'}"
+    m = re.match(r"argument (\S+?)(?:/\S+)?: expected one argument$", message)
+    if m:
+        opt = m.group(1)
+        return (f"{opt} needs a value; write {opt} VALUE, and a value that starts with '-' as "
+                f"{opt}=-VALUE (e.g. {opt}=-1e8*z)")
+    m = re.match(r"the following arguments are required: (.*)$", message)
+    if m:
+        names = m.group(1)
+        if names in ("COMMAND", "command"):
+            cmds = ", ".join(c.__name__.rsplit(".", 1)[-1] for c in _COMMANDS)
+            return f"missing the command; choose one of {cmds} (see vidi --help)"
+        return f"missing required option(s) {names}; {see}"
+    m = re.match(r"unrecognized arguments: (.*)$", message)
+    if m:
+        return f"unrecognized option(s) or value(s) {m.group(1)}; {see}"
+    m = re.match(r"argument (\S+?)(?:/\S+)?: (.*)$", message, re.S)
+    if m:  # an ArgumentTypeError from a type function: its message names the fix
+        return f"{m.group(1)}: {m.group(2)}"
+    return f"{' '.join(message.split())}; {see}"
+
+
+class VidiArgumentParser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors are one line (raised as :class:`UsageError`)."""
+
+    command_hint = None  # the command named on the line (for the top-level parser)
+
+    def error(self, message):
+        raise UsageError(_one_line(message, self.prog, self.command_hint))
+
+
 def _parser():
-    p = argparse.ArgumentParser(
+    p = VidiArgumentParser(
         prog="vidi",
         description="Discover and verify contact-force laws F(zeta, dzeta) of vibro-impact "
-                    "machines by simulation.")
-    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+                    "machines by simulation.",
+        epilog="exit codes: 0 ok, 2 bad input or failed numerics, 130 interrupted, 1 internal "
+               "error")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND",
+                           parser_class=VidiArgumentParser)
     for cmd in _COMMANDS:
         cmd.register(sub)
     return p
 
 
+def _attach_dash_values(parser, argv):
+    """``--law -1e8*z`` -> ``--law=-1e8*z``: a token starting with a single '-' after an
+    option that takes one value is that option's value unless it is an option itself."""
+    sub = next((a for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
+    command = next((t for t in argv if not t.startswith("-")), None)
+    if sub is None or command not in sub.choices:
+        return argv
+    parser.command_hint = command
+    sp = sub.choices[command]
+    takes_value = {s for a in sp._actions if a.nargs is None and a.option_strings
+                   and not isinstance(a, argparse._StoreConstAction) for s in a.option_strings}
+    known = set(sp._option_string_actions)
+    out, i = [], 0
+    while i < len(argv):
+        tok = argv[i]
+        if tok == "--":
+            out.extend(argv[i:])
+            break
+        nxt = argv[i + 1] if i + 1 < len(argv) else None
+        if tok in takes_value and nxt is not None and nxt.startswith("-") \
+                and not nxt.startswith("--") and nxt not in known and len(nxt) > 1:
+            out.append(f"{tok}={nxt}")
+            i += 2
+            continue
+        out.append(tok)
+        i += 1
+    return out
+
+
+def _error(message):
+    print(f"vidi: error: {' '.join(str(message).split())}", file=sys.stderr)
+
+
 def main(argv=None):
-    """Run ``vidi``; returns the exit code (0 ok, 2 bad input or failed numerics)."""
-    args = _parser().parse_args(argv)
+    """Run ``vidi``; returns the exit code (0 ok, 2 bad input or failed numerics, 130
+    interrupted, 143 terminated, 1 internal error)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    old_term = None
+    if threading.current_thread() is threading.main_thread():
+        def _terminate(signum, frame):
+            raise Terminated()
+        try:
+            old_term = signal.signal(signal.SIGTERM, _terminate)
+        except (ValueError, OSError):
+            old_term = None
     try:
+        parser = _parser()
+        try:
+            args = parser.parse_args(_attach_dash_values(parser, argv))
+        except SystemExit as exc:  # --help, --version
+            return exc.code if isinstance(exc.code, int) else 0
         return args.func(args)
     except VidiError as exc:
-        print(f"vidi: error: {exc}", file=sys.stderr)
+        _error(exc)
         return 2
-    except ValueError as exc:  # certificate/validation errors from the packages
-        print(f"vidi: error: {exc}", file=sys.stderr)
+    except ValueError as exc:  # validation errors raised as ValueError by the packages
+        _error(exc)
         return 2
+    except MemoryError:
+        _error("not enough memory for this run; reduce its size (--fs, --periods, --grid) and "
+               "try again")
+        return 2
+    except KeyboardInterrupt:
+        _error("interrupted (Ctrl-C); partial outputs were removed, earlier results are "
+               "unchanged")
+        return 130
+    except Terminated:
+        _error("terminated (SIGTERM); partial outputs were removed, earlier results are "
+               "unchanged")
+        return 143
     except BrokenPipeError:  # output piped into e.g. `head`: stop quietly
-        sys.stderr.close()
+        with contextlib.suppress(OSError, ValueError):
+            sys.stderr.close()
         return 0
+    except OSError as exc:  # the environment: disk full, permissions, a vanished file
+        where = f" ({exc.filename})" if exc.filename else ""
+        _error(f"{exc.strerror or exc}{where}; check the path, its permissions and the free "
+               "space")
+        return 2
+    except Exception as exc:  # a bug: one line, the traceback on request
+        if os.environ.get("VIDI_TRACEBACK"):
+            traceback.print_exc()
+        _error(f"internal error {type(exc).__name__}: {exc}; please report it (set "
+               "VIDI_TRACEBACK=1 for the traceback)")
+        return 1
+    finally:
+        if old_term is not None:
+            signal.signal(signal.SIGTERM, old_term)
 
 
 if __name__ == "__main__":

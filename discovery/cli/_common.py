@@ -1,18 +1,89 @@
-"""Shared pieces of the command modules: option help texts and small parsers."""
+"""Shared pieces of the command modules: option help texts, option types that check
+values at parse time (before any work), and the record/output helpers every command
+calls first.
+
+For the command modules:
+
+* ``add_record_options(parser)`` adds ``--columns t=NAME,F=NAME,...`` (the file's
+  header names for our columns); ``read_record(args, scenario)`` then loads
+  ``args.data`` with that mapping (:meth:`discovery.Measurement.from_csv`).
+* ``check_out(args, kind="dir")`` refuses a bad ``--out`` before any work
+  (:func:`discovery._io.check_output` with the command's input files).
+* ``inputs_of(args)`` gives the input files for ``provenance(..., inputs=...)``.
+* ``number(...)`` and ``integer(...)`` are argparse ``type=`` functions with ranges.
+"""
+
+import argparse
+import math
+import os
 
 import numpy as np
 
+from .._io import check_output
 from ..errors import InputError
 from ..law import ForceLaw
 from ..scenario import builtin_scenarios
 
 SCENARIO_HELP = (f"built-in scenario ({', '.join(builtin_scenarios())}) or a TOML file "
                  "(default: paper)")
-LAW_HELP = "force law, e.g. '2.06e8*z + 1.28e7*zd' (default: the scenario's law)"
+LAW_HELP = ("force law, e.g. '2.06e8*z + 1.28e7*zd' (default: the scenario's law); a law "
+            "starting with '-' as --law=-1e8*z")
+COLUMNS_HELP = ("the file's header names for our columns when they differ, e.g. "
+                "t=time_s,F=force_N (names: t, F, w1, v1, w2, v2, a2)")
+
+
+def _fmt(x):
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def number(lo=None, hi=None, *, lo_open=False, unit=""):
+    """argparse ``type=``: a finite float in ``[lo, hi]`` (``(lo, hi]`` with ``lo_open``)."""
+    lo_txt = "" if lo is None else (f"> {_fmt(lo)}" if lo_open else f">= {_fmt(lo)}")
+    hi_txt = "" if hi is None else f"<= {_fmt(hi)}"
+    rng = " and ".join(x for x in (lo_txt, hi_txt) if x)
+    need = f"a finite number{' ' + rng if rng else ''}{' ' + unit if unit else ''}"
+
+    def parse(text):
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a number; give {need}") from None
+        if not math.isfinite(v) or (lo is not None and (v <= lo if lo_open else v < lo)) \
+                or (hi is not None and v > hi):
+            raise argparse.ArgumentTypeError(f"{text!r} is out of range; give {need}")
+        return v
+
+    parse.__name__ = "number"
+    return parse
+
+
+def integer(lo=None, hi=None):
+    """argparse ``type=``: an integer in ``[lo, hi]``."""
+    rng = " and ".join(x for x in ((f">= {lo}" if lo is not None else ""),
+                                   (f"<= {hi}" if hi is not None else "")) if x)
+    need = f"an integer{' ' + rng if rng else ''}"
+
+    def parse(text):
+        try:
+            v = int(text, 10)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer; give {need}") \
+                from None
+        if (lo is not None and v < lo) or (hi is not None and v > hi):
+            raise argparse.ArgumentTypeError(f"{text!r} is out of range; give {need}")
+        return v
+
+    parse.__name__ = "integer"
+    return parse
 
 
 def law_or_default(text, scenario, what="--law"):
-    if text:
+    """The law given as text, or the scenario's law when the option was left out; an
+    empty text is an error (not silently the scenario's law)."""
+    if text is not None:
+        if not text.strip():
+            raise InputError(f"{what} is empty; give a law such as '2.06e8*z + 1.28e7*zd' or "
+                             "leave the option out to use the scenario's law")
         return ForceLaw.parse(text)
     if scenario.law is None:
         raise InputError(f"scenario {scenario.name!r} has no reference law; pass {what}")
@@ -29,3 +100,72 @@ def parse_range(text, default, name):
     if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
         raise InputError(f"{name} needs LOW < HIGH, got {text!r}")
     return lo, hi
+
+
+# ------------------------------------------------------------------ records and outputs
+def parse_columns(text, option="--columns"):
+    """``"t=time_s,F=force_N"`` -> ``{"t": "time_s", "F": "force_N"}`` (None for None)."""
+    from ..measurement import COLUMNS
+
+    if text is None:
+        return None
+    mapping = {}
+    for part in text.split(","):
+        key, sep, col = part.partition("=")
+        key, col = key.strip(), col.strip()
+        if not sep or not key or not col:
+            raise InputError(f"{option} {text!r}: write OURS=THEIRS pairs separated by commas, "
+                             "e.g. t=time_s,F=force_N")
+        if key not in COLUMNS:
+            raise InputError(f"{option}: unknown name {key!r}; map the names "
+                             f"{', '.join(COLUMNS)} to the file's headers, e.g. t=time_s")
+        if key in mapping:
+            raise InputError(f"{option}: {key} is mapped twice; map each name once")
+        mapping[key] = col
+    return mapping
+
+
+def add_record_options(parser):
+    """Add the options of reading a record (``--columns``)."""
+    parser.add_argument("--columns", metavar="MAP", help=COLUMNS_HELP)
+
+
+def read_record(args, scenario, path=None):
+    """The record ``path`` (default ``args.data``) read with ``args.columns``."""
+    from ..measurement import Measurement
+
+    columns = parse_columns(getattr(args, "columns", None))
+    return Measurement.from_csv(args.data if path is None else path, scenario=scenario,
+                                columns=columns)
+
+
+def scenario_file(text):
+    """The scenario option as a file path when it names an existing file, else None (a
+    built-in name)."""
+    if text and text not in builtin_scenarios() and os.path.isfile(text):
+        return text
+    return None
+
+
+def _listed(value):
+    if value is None:
+        return []
+    return list(value) if isinstance(value, list | tuple) else [value]
+
+
+def inputs_of(args):
+    """``{"data": ..., "scenario": ...}`` of a command's arguments, for provenance (a
+    repeated option gives ``data``, ``data_2``, ...)."""
+    out = {}
+    for key in ("data", "scenario"):
+        for k, v in enumerate(_listed(getattr(args, key, None))):
+            if v:
+                out[key if k == 0 else f"{key}_{k + 1}"] = v
+    return out
+
+
+def check_out(args, kind="dir", option="--out"):
+    """Refuse a bad ``--out`` before any work (see :func:`discovery._io.check_output`)."""
+    inputs = [p for p in _listed(getattr(args, "data", None)) if p]
+    inputs += [p for p in map(scenario_file, _listed(getattr(args, "scenario", None))) if p]
+    return check_output(getattr(args, "out", None), inputs, kind=kind, option=option)

@@ -7,7 +7,15 @@ from .._io import OutputDir, provenance
 from ..criteria import CRITERIA
 from ..errors import InputError
 from ..scenario import load_scenario
-from ._common import SCENARIO_HELP
+from ._common import (
+    SCENARIO_HELP,
+    add_record_options,
+    check_out,
+    inputs_of,
+    integer,
+    number,
+    read_record,
+)
 
 
 def run(args):
@@ -20,8 +28,8 @@ def run(args):
     )
 
     from ..discover import discover
-    from ..measurement import Measurement
 
+    check_out(args)
     data = args.data
     names = args.scenario or ["paper"]
     if len(names) not in (1, len(data)):
@@ -30,7 +38,7 @@ def run(args):
     scs = [load_scenario(n) for n in names] * (len(data) if len(names) == 1 else 1)
     meas = []
     for path, sc_k in zip(data, scs, strict=True):
-        m = Measurement.from_csv(path, scenario=sc_k)
+        m = read_record(args, sc_k, path)
         for note in m.notes:
             print(f"note: {path}: {note}" if len(data) > 1 else f"note: {note}")
         meas.append(m)
@@ -73,7 +81,7 @@ def run(args):
         "measured": {"n_cycles": res.measured.n_cycles, "n_periods": res.measured.n_periods,
                      "noise": res.measured.noise, "threshold": res.measured.threshold},
         "n_solves": res.estimator.n_solves_, "seconds": res.seconds,
-        "fit_settings": res.settings, **provenance(vars(args))}
+        "fit_settings": res.settings, **provenance(vars(args), inputs=inputs_of(args))}
     with OutputDir(args.out) as out:
         out.write_json("summary.json", summary)
         buf = io.StringIO()
@@ -130,6 +138,7 @@ def register(sub):
     s.add_argument("--data", required=True, action="append",
                    help="CSV with t, F, w1, w2 (v1, v2 optional); repeat it to fit several "
                    "records jointly")
+    add_record_options(s)
     s.add_argument("--library", default="poly:2",
                    help="candidate terms: poly:N, hc, a list 'z,zd,z*zd', or sums (poly:2)")
     s.add_argument("--select", default="best-subset",
@@ -137,26 +146,27 @@ def register(sub):
                    help="how supports are proposed (best-subset)")
     s.add_argument("--score", default="bic", choices=["bic", "aic", "cv"],
                    help="regression score that orders the candidates (bic)")
-    s.add_argument("--max-terms", type=int, default=4, help="largest support (4)")
+    s.add_argument("--max-terms", type=integer(1, 12), default=4, help="largest support (4)")
     s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
                    help="simulation criterion of the ranking (I2)")
-    s.add_argument("--shortlist", type=int, default=8, help="candidates simulated (8)")
-    s.add_argument("--margin", type=float, default=0.0,
+    s.add_argument("--shortlist", type=integer(1, 200), default=8, help="candidates simulated (8)")
+    s.add_argument("--margin", type=number(0.0, unit="N s/m"), default=0.0,
                    help="dissipativity strictness margin in N s/m (0)")
     s.add_argument("--monotone", action="store_true",
                    help="also require a monotone elastic branch")
     s.add_argument("--no-refine", action="store_true",
                    help="skip the refinement of every shortlisted support by simulation "
                    "(output error: unbiased coefficients and their standard errors)")
-    s.add_argument("--max-simulations", type=int, default=120,
+    s.add_argument("--max-simulations", type=integer(2, 100_000), default=120,
                    help="simulation budget of each support's refinement (120)")
-    s.add_argument("--stability", type=int, default=0,
+    s.add_argument("--stability", type=integer(0, 10_000), default=0,
                    help="bootstrap resamples of impacts for stability selection (0)")
     s.add_argument("--derivative", choices=["velocities", "savgol", "pysindy"],
                    help="source of dzeta (default: velocities if recorded, else savgol)")
     s.add_argument("--average-cycles", action="store_true",
                    help="average the steady cycles sample by sample before the regression")
-    s.add_argument("--seed", type=int, default=0, help="seed of the stability selection")
+    s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
+                   help="seed of the stability selection")
     s.add_argument("--no-pdf", action="store_true",
                    help="do not compile model.tex to model.pdf (compiled when latexmk is "
                    "installed)")

@@ -12,7 +12,15 @@ from ..criteria import CRITERIA
 from ..errors import InputError
 from ..law import ForceLaw
 from ..scenario import load_scenario
-from ._common import SCENARIO_HELP
+from ._common import (
+    SCENARIO_HELP,
+    add_record_options,
+    check_out,
+    inputs_of,
+    integer,
+    number,
+    read_record,
+)
 
 
 def _pick_iterates(iterations, k):
@@ -44,13 +52,16 @@ def run(args):
 
     from ..identify import identify
     from ..landscape import Landscape
-    from ..measurement import Measurement
     from ..verify import Reference, evaluate
 
+    check_out(args)
     sc = load_scenario(args.scenario)
+    if not args.start.strip():
+        raise InputError("--start is empty; give the terms and start values, e.g. "
+                         "'1.5e8*z + 0.9e7*zd'")
     start = ForceLaw.parse(args.start)
     land = _load_landscape(args.landscape, Landscape) if args.landscape else None
-    meas = Measurement.from_csv(args.data, scenario=sc)
+    meas = read_record(args, sc)
     for note in meas.notes:
         print(f"note: {note}")
     ref = Reference.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
@@ -79,7 +90,7 @@ def run(args):
                    "regime": final.regime, "n_simulations": res.n_simulations,
                    "failures": res.failures,
                    "iterations": res.iterations, "message": res.message,
-                   "seconds": res.seconds, **provenance(vars(args))}
+                   "seconds": res.seconds, **provenance(vars(args), inputs=inputs_of(args))}
         out.write_json("summary.json", summary)
         buf = io.StringIO()
         w = csv.writer(buf)
@@ -115,6 +126,7 @@ def register(sub):
     s.add_argument("--data", required=True,
                    help="CSV with t [s], F [N] (w1, v1, w2, v2 recommended: exact onsets and "
                    "the machine's state)")
+    add_record_options(s)
     s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
                    help="criterion to minimise (I2)")
     s.add_argument("--method", default="least-squares",
@@ -122,12 +134,15 @@ def register(sub):
                    help="optimiser (least-squares)")
     s.add_argument("--start", required=True, help="terms and start values, e.g. "
                    "'1.5e8*z + 0.9e7*zd'")
-    s.add_argument("--max-simulations", type=int, default=600, help="simulation budget (600)")
-    s.add_argument("--xtol", type=float, default=1e-5, help="relative coefficient tolerance")
+    s.add_argument("--max-simulations", type=integer(2, 1_000_000), default=600,
+                   help="simulation budget (600)")
+    s.add_argument("--xtol", type=number(0.0, 1.0, lo_open=True), default=1e-5,
+                   help="relative coefficient tolerance")
     s.add_argument("--landscape", help="a landscape output (directory or summary.json) to draw "
                    "the path on")
-    s.add_argument("--n-boot", type=int, default=16,
+    s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
                    help="bootstrap replicates of the noise floor (16)")
-    s.add_argument("--seed", type=int, default=0, help="seed of the noise-floor bootstrap (0)")
+    s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
+                   help="seed of the noise-floor bootstrap (0)")
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

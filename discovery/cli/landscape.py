@@ -10,7 +10,17 @@ from .._io import OutputDir, provenance
 from ..criteria import CRITERIA
 from ..errors import InputError
 from ..scenario import load_scenario
-from ._common import SCENARIO_HELP, law_or_default, parse_range
+from ._common import (
+    SCENARIO_HELP,
+    add_record_options,
+    check_out,
+    inputs_of,
+    integer,
+    law_or_default,
+    number,
+    parse_range,
+    read_record,
+)
 
 
 def _grid_csv(land):
@@ -44,14 +54,20 @@ def _ranges(args, law):
             origin.append(f"default: {1 - DEFAULT_SPREAD:g}x..{1 + DEFAULT_SPREAD:g}x the "
                           f"template's coefficient {law.coefficients[k]:.6g}")
         else:
-            out.append(parse_range(text, None, opt))
+            lo, hi = parse_range(text, None, opt)
+            if lo <= 0 <= hi:
+                raise InputError(f"{opt} {text!r} reaches zero: the coefficient of "
+                                 f"{law.names[k]} would vanish or change sign inside the grid; "
+                                 "give a range on one side of zero, e.g. "
+                                 f"{0.5 * abs(law.coefficients[k]):.3g}:"
+                                 f"{1.5 * abs(law.coefficients[k]):.3g}")
+            out.append((lo, hi))
             origin.append(f"{opt} {text}")
     return out, origin
 
 
 def _reference(args, sc):
     """``(Reference or None, description for summary.json, notes)``."""
-    from ..measurement import Measurement
     from ..verify import Reference
 
     if args.data is None:
@@ -59,7 +75,7 @@ def _reference(args, sc):
             raise InputError(f"scenario {sc.name!r} has no reference law; pass --data D.csv "
                              "(a measured record) or add [law] text to the scenario")
         return None, {"source": "law", "law": sc.law.to_text()}, ()
-    meas = Measurement.from_csv(args.data, scenario=sc)
+    meas = read_record(args, sc)
     ref = Reference.from_measurement(meas, sc, time_offset=args.time_offset,
                                      n_boot=args.n_boot, seed=args.seed)
     E = ref.impulse
@@ -76,10 +92,7 @@ def run(args):
 
     from ..landscape import landscape, parse_grid
 
-    if args.workers is not None and args.workers < 1:
-        raise InputError(f"--workers must be at least 1, got {args.workers}")
-    if args.n_boot < 1:
-        raise InputError(f"--n-boot must be at least 1, got {args.n_boot}")
+    check_out(args)
     sc = load_scenario(args.scenario)
     law = law_or_default(args.law, sc)
     if len(law.terms) < 2:
@@ -120,7 +133,7 @@ def run(args):
                    "grid": [n0, n1],
                    "ranges": {"alpha1": list(r0), "alpha2": list(r1), "from": origin},
                    "minima": minima, "seconds": land.seconds, "workers": land.workers,
-                   **provenance(vars(args))}
+                   **provenance(vars(args), inputs=inputs_of(args))}
         out.write_json("summary.json", summary)
         out.path("landscape.csv").write_text(_grid_csv(land))
         truth = None
@@ -159,16 +172,18 @@ def register(sub):
                    "(default: the scenario's law)")
     s.add_argument("--data", help="CSV record (t, F [, w1, v1, w2, v2]) to compare with "
                    "(default: the exact impulse of the scenario's law)")
+    add_record_options(s)
     s.add_argument("--grid", default="41x41", help="points per axis, e.g. 41x41")
     s.add_argument("--range0", help="LOW:HIGH of the first coefficient (default 0.5x..1.5x "
                    "the template's coefficient)")
     s.add_argument("--range1", help="LOW:HIGH of the second coefficient (default 0.5x..1.5x "
                    "the template's coefficient)")
-    s.add_argument("--time-offset", type=float, default=0.0,
+    s.add_argument("--time-offset", type=number(-1e7, 1e7, unit="s"), default=0.0,
                    help="with --data: drive-clock time [s] of the record's t = 0 (0)")
-    s.add_argument("--n-boot", type=int, default=16,
+    s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
                    help="with --data: bootstrap replicates of the noise floor (16)")
-    s.add_argument("--seed", type=int, default=0, help="with --data: seed of the bootstrap (0)")
-    s.add_argument("--workers", type=int, help="processes (default: all cores)")
+    s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
+                   help="with --data: seed of the bootstrap (0)")
+    s.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

@@ -1,32 +1,60 @@
-"""``vidi simulate``: a synthetic measurement CSV of a law's steady state."""
+"""``vidi simulate``: a synthetic measurement CSV of a law's steady state.
 
+Writes ``D.csv`` and ``D.summary.json`` (each atomically: temporary file + rename); the
+summary records the sha256 of the CSV it describes (``outputs``), so a pair from two
+different runs (a kill between the two renames) is detectable.
+"""
+
+import hashlib
 import json
 import time
-from pathlib import Path
 
-from .._io import atomic_write_text, provenance, to_jsonable
+from .._io import atomic_write_text, check_output, provenance, to_jsonable
 from ..errors import InputError
 from ..scenario import load_scenario
-from ._common import LAW_HELP, SCENARIO_HELP, law_or_default
+from ._common import (
+    LAW_HELP,
+    SCENARIO_HELP,
+    check_out,
+    inputs_of,
+    integer,
+    law_or_default,
+    number,
+    scenario_file,
+)
+
+#: largest record written (samples): 1e7 rows of 6 columns is ~1 GB of text
+MAX_SAMPLES = 10_000_000
 
 
 def run(args):
     from ..measurement import synthesize
 
+    out = check_out(args, kind="file")
+    if out.suffix.lower() != ".csv":
+        raise InputError(f"--out {args.out!r} must name a .csv file, e.g. D.csv")
+    check_output(out.with_suffix(".summary.json"), [scenario_file(args.scenario)],
+                 kind="file", option="--out's summary")
     sc = load_scenario(args.scenario)
     law = law_or_default(args.law, sc)
-    out = Path(args.out)
-    if out.suffix.lower() != ".csv":
-        raise InputError(f"--out {args.out!r} must name a .csv file")
+    n = args.periods * sc.period * args.fs
+    if n > MAX_SAMPLES:
+        raise InputError(f"--periods {args.periods} at --fs {args.fs:g} Hz is {n:.3g} samples; "
+                         f"the limit is {MAX_SAMPLES:.0e}: lower --fs or --periods")
+    if n < 8:
+        raise InputError(f"--periods {args.periods} at --fs {args.fs:g} Hz is only {n:.3g} "
+                         "samples; raise --fs or --periods")
     t0 = time.perf_counter()
     meas = synthesize(sc, law, periods=args.periods, fs=args.fs, noise=args.noise,
                       seed=args.seed, from_rest=args.from_rest,
                       position_noise=args.position_noise, velocities=not args.no_velocities)
+    csv_text = meas.to_csv_text()
     summary = {"command": "simulate", "scenario": sc.as_dict(), "law": law.to_text(),
                "samples": int(meas.t.size), "seconds": time.perf_counter() - t0,
-               **provenance(vars(args))}
+               "outputs": {out.name: {"sha256": hashlib.sha256(csv_text.encode()).hexdigest()}},
+               **provenance(vars(args), inputs=inputs_of(args))}
     text = json.dumps(to_jsonable(summary), indent=2) + "\n"
-    meas.to_csv(out)
+    atomic_write_text(out, csv_text)
     atomic_write_text(out.with_suffix(".summary.json"), text)
     print(f"wrote {out} ({meas.t.size} samples, {args.periods} periods at {args.fs:g} Hz, "
           f"noise {args.noise:g}) and {out.with_suffix('.summary.json')}")
@@ -38,16 +66,19 @@ def register(sub):
                        "steady state")
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
     s.add_argument("--law", help=LAW_HELP)
-    s.add_argument("--periods", type=int, default=20, help="drive periods recorded (20)")
-    s.add_argument("--fs", type=float, default=20000.0, help="sampling rate in Hz (20000)")
-    s.add_argument("--noise", type=float, default=0.0,
-                   help="Gaussian noise on F as a fraction of the peak force (0)")
-    s.add_argument("--seed", type=int, default=0, help="noise seed (0)")
+    s.add_argument("--periods", type=integer(1, 100_000), default=20,
+                   help="drive periods recorded (20)")
+    s.add_argument("--fs", type=number(0, 1e8, lo_open=True, unit="Hz"), default=20000.0,
+                   help="sampling rate in Hz (20000)")
+    s.add_argument("--noise", type=number(0, 1), default=0.0,
+                   help="Gaussian noise on F as a fraction of the peak force, 0..1 (0)")
+    s.add_argument("--seed", type=integer(0), default=0, help="noise seed, >= 0 (0)")
     s.add_argument("--from-rest", action="store_true",
                    help="record from the initial state (run-up with impacts at many "
                    "velocities, then the steady state) instead of on the periodic orbit")
-    s.add_argument("--position-noise", type=float, default=0.0,
-                   help="Gaussian noise on w1, w2 as a fraction of the largest penetration (0)")
+    s.add_argument("--position-noise", type=number(0, 1), default=0.0,
+                   help="Gaussian noise on w1, w2 as a fraction of the largest penetration, "
+                   "0..1 (0)")
     s.add_argument("--no-velocities", action="store_true",
                    help="leave out the v1, v2 columns (discovery then differentiates w1 - w2)")
     s.add_argument("--out", required=True, help="output CSV (t, F, w1, v1, w2, v2)")

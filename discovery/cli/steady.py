@@ -6,12 +6,14 @@ import numpy as np
 
 from .._io import OutputDir, provenance
 from ..scenario import load_scenario
-from ._common import LAW_HELP, SCENARIO_HELP, law_or_default
+from ._common import LAW_HELP, SCENARIO_HELP, check_out, inputs_of, law_or_default
 
 
 def run(args):
     from ..response import response
 
+    if args.out is not None:
+        check_out(args)
     sc = load_scenario(args.scenario)
     law = law_or_default(args.law, sc)
     r = response(sc, law)
@@ -28,7 +30,8 @@ def run(args):
         with OutputDir(args.out) as out:
             out.write_json("summary.json", {"command": "steady", "law": law.to_text(),
                                             "scenario": sc.as_dict(), **info,
-                                            **provenance(vars(args))})
+                                            **provenance(vars(args),
+                                                          inputs=inputs_of(args))})
         print(f"wrote {Path(args.out) / 'summary.json'}")
     return 0
 

@@ -1,0 +1,98 @@
+"""Interruptions of a command: Ctrl-C (SIGINT) exits 130 and SIGTERM 143 with one line,
+no traceback, earlier results intact and no staging left; after SIGKILL the next run
+removes the staging directory the killed one left."""
+
+import json
+import signal
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from discovery.cli import main
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# `vidi steady --out DIR`, held inside the output stage (the staging directory exists)
+_CHILD = textwrap.dedent("""
+    import sys, time
+    import discovery.cli.steady as st
+    real = st.provenance
+    def slow(*a, **k):
+        print("staged", flush=True)
+        time.sleep(120)
+        return real(*a, **k)
+    st.provenance = slow
+    from discovery.cli import main
+    sys.exit(main(["steady", "--out", sys.argv[1]]))
+""")
+
+
+def _wait_staged(p):
+    for line in p.stdout:  # steady prints its result, then enters the output stage
+        if line.strip() == "staged":
+            return
+    raise AssertionError("the child ended before staging its output")
+
+
+@pytest.fixture
+def earlier(tmp_path):
+    out = tmp_path / "res"
+    out.mkdir()
+    (out / "summary.json").write_text('{"earlier": true}\n')
+    (out / "figure.png").write_bytes(b"old figure")
+    return out
+
+
+def _intact(out):
+    assert json.loads((out / "summary.json").read_text()) == {"earlier": True}
+    assert (out / "figure.png").read_bytes() == b"old figure"
+    assert sorted(p.name for p in out.parent.iterdir()) == ["res"]
+
+
+def test_keyboard_interrupt_in_process(earlier, monkeypatch, capsys):
+    import discovery.cli.steady as st
+
+    def interrupt(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(st, "provenance", interrupt)
+    assert main(["steady", "--out", str(earlier)]) == 130
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("vidi: error: interrupted (Ctrl-C)")
+    _intact(earlier)
+
+
+@pytest.mark.parametrize(("sig", "code", "word"), [(signal.SIGINT, 130, "interrupted"),
+                                                   (signal.SIGTERM, 143, "terminated")])
+def test_signal_exits_with_one_line(earlier, sig, code, word):
+    p = subprocess.Popen([sys.executable, "-c", _CHILD, str(earlier)], cwd=ROOT,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _wait_staged(p)
+    assert any(".vidi-staging." in q.name for q in earlier.parent.iterdir())
+    p.send_signal(sig)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == code, err
+    lines = err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"vidi: error: {word}"), err
+    assert "Traceback" not in err
+    _intact(earlier)
+
+
+def test_sigkill_then_next_run_cleans_up(earlier, capsys):
+    p = subprocess.Popen([sys.executable, "-c", _CHILD, str(earlier)], cwd=ROOT,
+                         stdout=subprocess.PIPE, text=True)
+    _wait_staged(p)
+    p.kill()
+    p.wait()
+    p.stdout.close()
+    left = [q for q in earlier.parent.iterdir() if ".vidi-staging." in q.name]
+    assert len(left) == 1
+    assert json.loads((earlier / "summary.json").read_text()) == {"earlier": True}
+    assert main(["steady", "--out", str(earlier)]) == 0
+    capsys.readouterr()
+    assert sorted(q.name for q in earlier.parent.iterdir()) == ["res"]
+    assert sorted(q.name for q in earlier.iterdir()) == ["summary.json"]
+    assert json.loads((earlier / "summary.json").read_text())["command"] == "steady"
