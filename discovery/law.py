@@ -186,6 +186,36 @@ class ForceLaw:
             out = out + c * t(zeta, zd)
         return out
 
+    def check_physical(self, scenario, what="law"):
+        """Refuse a law no machine could have (one clear line, :class:`InputError`).
+
+        On the box ``0 < zeta <= x``, ``0 <= zd <= 4 v`` (``x, v`` the scenario's motion
+        scales, :meth:`Scenario.scales`): the law must push the bodies apart somewhere
+        (else the moulding falls through the grid and no steady state exists), and satisfy
+        the paper's condition (6), dissipativity ``P(zeta, zd) >= P(zeta, 0)`` (damping
+        never feeds energy into an impact).  Conditions (3)-(5) hold by construction.
+        """
+        if not any(self.coefficients):
+            raise InputError(f"{what} '{self}' has no non-zero coefficient; give a law such "
+                             "as '2.06e8*z + 1.28e7*zd'")
+        x, v = scenario.scales()
+        Z, V = x, 4.0 * v
+        zz, vv = np.meshgrid(np.linspace(Z / 64, Z, 64), np.linspace(0.0, V, 65))
+        P = self.polynomial(zz, vv)
+        if not np.max(P) > 0:
+            raise InputError(
+                f"{what} '{self}' never pushes the bodies apart (P <= 0 for every "
+                f"penetration up to {Z:.3g} m and velocity up to {V:.3g} m/s): the moulding "
+                "would fall through the grid; a contact law needs a positive stiffness term "
+                "such as 2e8*z")
+        D = P - self.polynomial(zz, np.zeros_like(vv))
+        worst = np.unravel_index(int(np.argmin(D)), D.shape)
+        if D[worst] < -1e-9 * float(np.max(np.abs(P))):
+            raise InputError(
+                f"{what} '{self}' breaks the paper's condition (6), dissipativity: F(zeta, zd) "
+                f"< F(zeta, 0) at zeta = {zz[worst]:.3g} m, zd = {vv[worst]:.3g} m/s (damping "
+                "that feeds energy into the impact); make the velocity terms non-negative")
+
     def __call__(self, zeta, dzeta):
         """Contact force ``F(zeta, dzeta)`` [N] with conditions (3)-(5) applied.
 

@@ -261,3 +261,19 @@ def test_property_round_trip_through_text(law):
 def test_round_trip_full_precision_coefficient(c):
     law = ForceLaw((Term(1, 0), Term(0, 1)), (c, 1.28e7))
     assert ForceLaw.parse(law.to_text()) == law
+
+
+def test_check_physical_accepts_real_laws_and_names_what_is_wrong(paper, light):
+    from discovery.errors import InputError
+
+    paper.law.check_physical(paper)
+    light.law.check_physical(light)
+    # a law that turns adhesive at depth is clipped, not refused (conditions (3)-(5) hold
+    # by construction)
+    ForceLaw.parse("2e8*z - 1e12*z^2 + 1e7*zd").check_physical(paper)
+    with pytest.raises(InputError, match="never pushes"):
+        ForceLaw.parse("-1e8*z - 1e6*zd").check_physical(paper)
+    with pytest.raises(InputError, match="no non-zero coefficient"):
+        ForceLaw.parse("0*z").check_physical(paper)
+    with pytest.raises(InputError, match=r"condition \(6\)"):
+        ForceLaw.parse("2e8*z + 1e7*zd - 1e10*z*zd").check_physical(paper)  # z > 1 mm

@@ -84,9 +84,12 @@ def law_or_default(text, scenario, what="--law"):
         if not text.strip():
             raise InputError(f"{what} is empty; give a law such as '2.06e8*z + 1.28e7*zd' or "
                              "leave the option out to use the scenario's law")
-        return ForceLaw.parse(text)
+        law = ForceLaw.parse(text)
+        law.check_physical(scenario, what)
+        return law
     if scenario.law is None:
         raise InputError(f"scenario {scenario.name!r} has no reference law; pass {what}")
+    scenario.law.check_physical(scenario, f"the scenario's law ({scenario.name})")
     return scenario.law
 
 

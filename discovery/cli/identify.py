@@ -60,6 +60,7 @@ def run(args):
         raise InputError("--start is empty; give the terms and start values, e.g. "
                          "'1.5e8*z + 0.9e7*zd'")
     start = ForceLaw.parse(args.start)
+    start.check_physical(sc, "--start")
     land = _load_landscape(args.landscape, Landscape) if args.landscape else None
     meas = read_record(args, sc)
     for note in meas.notes:

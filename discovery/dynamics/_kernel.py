@@ -22,6 +22,18 @@ Switching functions ``h`` are written so that an event fires when ``h`` goes fro
 Inside a mode the force is extended smoothly past the switching surface (odd
 extension of fractional powers) because Runge–Kutta stages may sample slightly
 beyond it.
+
+Detection (per accepted step, see :func:`_first_crossing`): each function is
+sampled on the dense output at ``theta = 0, 1/3, 2/3, 1``; an event needs a value
+``> 0`` before one ``< 0``.  Right after an event a function may start a hair on
+the wrong side (the re-taken step ends within rounding of the surface, not on its
+side): it is then neither skipped nor fired at once, but the point where the flow
+leaves the surface is searched for, so a contact loss followed by a re-contact
+inside the next step is seen (and a function that starts across but comes back is
+not fired).  In the free and clipped modes the contact surface is also checked at
+the interior extremum of ``zeta`` (a graze between samples).  Mode switches that
+hardly advance time (zero-length ones, or over a thousand events in a row each
+within ``1e-3 hmax`` of the last) stop the run as chattering.
 """
 
 import numpy as np
@@ -38,6 +50,9 @@ EV_ONSET, EV_LOSS, EV_UNLOAD, EV_RELOAD, EV_RELEASE, EV_RESUME = 1, 2, 3, 4, 5, 
 OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW, CHATTER = 0, 1, 2, 3, 4
 
 _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
+# chattering: more than _ZENO_EVENTS located events in a row, each within
+# _ZENO_GAP * hmax of the previous one (mode switches that hardly advance time)
+_ZENO_EVENTS, _ZENO_GAP = 1000, 1e-3
 
 
 @njit(cache=True, inline="always")
@@ -224,6 +239,118 @@ def _locate(y, K, h, mode, coef, ea, eb, index, th_lo, th_hi, h_lo, h_hi, ybuf, 
 
 
 @njit(cache=True, inline="always")
+def _h_at(y, K, h, mode, coef, ea, eb, index, theta, ybuf, hbuf):
+    """Switching function ``index`` on the dense output at ``theta``."""
+    _dense(y, K, h, theta, ybuf)
+    _switching(mode, ybuf, coef, ea, eb, hbuf)
+    return hbuf[index]
+
+
+@njit(cache=True)
+def _rate_root(y, K, h, s, d0, d1, ybuf):
+    """``theta`` where ``s * dzeta`` on the dense output goes from ``d0 < 0`` to ``d1 > 0``:
+    the interior minimum of the switching function ``s * zeta`` (Illinois)."""
+    a, b, fa, fb = 0.0, 1.0, d0, d1
+    side = 0
+    for _ in range(60):
+        c = (a * fb - b * fa) / (fb - fa)
+        if not (a < c < b):
+            c = 0.5 * (a + b)
+        _dense(y, K, h, c, ybuf)
+        fc = s * (ybuf[1] - ybuf[3])
+        if fc < 0.0:
+            a, fa = c, fc
+            if side == -1:
+                fb *= 0.5
+            side = -1
+        else:
+            b, fb = c, fc
+            if side == 1:
+                fa *= 0.5
+            side = 1
+        if b - a <= 1e-12:
+            break
+    return 0.5 * (a + b)
+
+
+@njit(cache=True)
+def _first_crossing(t, y, ynew, K, h, mode, coef, ea, eb, i, h0, ha, hb, h1, ybuf, hbuf):
+    """``theta`` in ``[0, 1]`` of the first crossing of switching function ``i`` over the
+    step (``0``: at once), or ``2`` if it stays on its side.
+
+    ``h0, ha, hb, h1`` are its values at ``theta = 0, 1/3, 2/3, 1``.  A crossing needs a
+    value strictly on the function's side (``> 0``) before one across it (``< 0``):
+
+    * the start does not count as on its side unless ``h0 > 0``: right after an event
+      the state sits on the surface just crossed (and on any coinciding one) with a
+      value that is zero only to within rounding, of either sign.  Such a function
+      is never skipped (a state a hair across the surface, e.g. ``zeta = +1e-13``
+      right after a contact loss, would otherwise hide a re-contact in the same step
+      and then every later one: the mode would stay wrong for good); instead the
+      point where the flow leaves the surface is searched for by halving towards
+      the start; if there is none, the crossing is at once if the function moves
+      further across (the first probe across is below ``h0``), and there is no event
+      yet if it is coming back (a step cut to an event ends within its local error
+      of the surface; at loose tolerances that can be well beyond rounding);
+    * the contact surface ``zeta = 0`` in modes without a ``dzeta = 0`` surface
+      (free, clipped) is also checked at the interior minimum of its function (where
+      ``dzeta`` changes sign), so a graze that touches and leaves the surface between
+      the probes is seen.
+    """
+    third = 1.0 / 3.0
+    pos_t, pos_f = -1.0, 0.0
+    if h0 > 0.0:
+        pos_t, pos_f = 0.0, h0
+    neg_t, neg_f = -1.0, 0.0
+    if ha < 0.0:
+        neg_t, neg_f = third, ha
+    else:
+        if ha > 0.0:
+            pos_t, pos_f = third, ha
+        if hb < 0.0:
+            neg_t, neg_f = 2.0 * third, hb
+        else:
+            if hb > 0.0:
+                pos_t, pos_f = 2.0 * third, hb
+            if h1 < 0.0:
+                neg_t, neg_f = 1.0, h1
+    if neg_t < 0.0 and i == 0 and (mode == FREE or mode == CLIPPED):
+        s = -1.0 if mode == FREE else 1.0
+        d0 = s * (y[1] - y[3])
+        d1 = s * (ynew[1] - ynew[3])
+        if d0 < 0.0 and d1 > 0.0:
+            th = _rate_root(y, K, h, s, d0, d1, ybuf)
+            fm = _h_at(y, K, h, mode, coef, ea, eb, 0, th, ybuf, hbuf)
+            if fm < 0.0:
+                neg_t, neg_f = th, fm
+                pos_t = -1.0
+                if h0 > 0.0:
+                    pos_t, pos_f = 0.0, h0
+                if ha > 0.0 and third < th:
+                    pos_t, pos_f = third, ha
+                if hb > 0.0 and 2.0 * third < th:
+                    pos_t, pos_f = 2.0 * third, hb
+    if neg_t < 0.0:
+        return 2.0
+    if pos_t < 0.0:
+        th, f_first = neg_t, neg_f
+        while True:
+            th *= 0.5
+            if th * h <= 1e-15 * max(1.0, abs(t)):
+                # across the surface from the start and nowhere on its side before the
+                # probe: moving further across, it crosses now; coming back (a step cut
+                # to an event ends within its error of the surface, not on it), not yet
+                return 0.0 if f_first <= h0 else 2.0
+            f = _h_at(y, K, h, mode, coef, ea, eb, i, th, ybuf, hbuf)
+            if f > 0.0:
+                pos_t, pos_f = th, f
+                break
+            if f < 0.0:
+                neg_t, neg_f = th, f
+    return _locate(y, K, h, mode, coef, ea, eb, i, pos_t, neg_t, pos_f, neg_f, ybuf, hbuf)
+
+
+@njit(cache=True, inline="always")
 def _record_event(t, y, mode, index, coef, ea, eb, n_ev, ev_t, ev_kind, ev_y, ev_modes):
     """Store event ``n_ev`` (if there is room) and return the mode after it."""
     kind = _event_kind(mode, index)
@@ -274,6 +401,8 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
     n_ev = 0
     n_steps = 0
     zero_len = 0
+    short_run = 0
+    t_last_ev = -np.inf
     status = OK
     need_f = True
     while t < t1:
@@ -308,31 +437,21 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
         best_index = -1
         # probe the dense output at 1/3 and 2/3 too, so a brief excursion across a
         # switching surface inside one step is seen (once per step, for all functions)
-        probed = False
+        _dense(y, K, h, 1.0 / 3.0, ybuf)
+        _switching(mode, ybuf, coef, ea, eb, hsa)
+        _dense(y, K, h, 2.0 / 3.0, ybuf)
+        _switching(mode, ybuf, coef, ea, eb, hsb)
         for i in range(ns):
-            if hs0[i] == 0.0 and hs1[i] < 0.0:
-                # already on the surface and moving across: transition at t
-                best_theta, best_index = 0.0, i
-                break
-            if hs0[i] < 0.0:
-                continue
-            if not probed:
-                _dense(y, K, h, 1.0 / 3.0, ybuf)
-                _switching(mode, ybuf, coef, ea, eb, hsa)
-                _dense(y, K, h, 2.0 / 3.0, ybuf)
-                _switching(mode, ybuf, coef, ea, eb, hsb)
-                probed = True
-            if hsa[i] < 0.0:
-                th = _locate(y, K, h, mode, coef, ea, eb, i, 0.0, 1.0 / 3.0, hs0[i], hsa[i],
-                             ybuf, hsm)
-            elif hsb[i] < 0.0:
-                th = _locate(y, K, h, mode, coef, ea, eb, i, 1.0 / 3.0, 2.0 / 3.0, hsa[i],
-                             hsb[i], ybuf, hsm)
-            elif hs1[i] < 0.0:
-                th = _locate(y, K, h, mode, coef, ea, eb, i, 2.0 / 3.0, 1.0, hsb[i], hs1[i],
-                             ybuf, hsm)
-            else:
-                continue
+            if hsa[i] >= 0.0 and hsb[i] >= 0.0 and hs1[i] >= 0.0:
+                # fast path: no probe across the surface; only a graze of zeta = 0
+                # between them is left to check (free and clipped modes only)
+                if i != 0 or mode == LOAD or mode == UNLOAD:
+                    continue
+                s = -1.0 if mode == FREE else 1.0
+                if not (s * (y[1] - y[3]) < 0.0 and s * (ynew[1] - ynew[3]) > 0.0):
+                    continue
+            th = _first_crossing(t, y, ynew, K, h, mode, coef, ea, eb, i, hs0[i], hsa[i],
+                                 hsb[i], hs1[i], ybuf, hsm)
             # near-ties go to the lower index: contact loss (index 0) wins over the
             # force reaching zero at the same instant (e.g. P(zeta, 0) = k * zeta)
             if th < best_theta - 1e-9:
@@ -378,6 +497,14 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
             status = BLOW_UP
             break
         if best_index >= 0:
+            if t - t_last_ev < _ZENO_GAP * hmax:
+                short_run += 1
+                if short_run > _ZENO_EVENTS:
+                    status = CHATTER
+                    break
+            else:
+                short_run = 0
+            t_last_ev = t
             mode = _record_event(t, y, mode, best_index, coef, ea, eb, n_ev, ev_t, ev_kind,
                                  ev_y, ev_modes)
             n_ev += 1
