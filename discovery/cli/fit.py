@@ -2,6 +2,7 @@
 
 import csv
 import io
+import time
 
 from .._io import OutputDir, provenance
 from ..criteria import CRITERIA
@@ -19,6 +20,7 @@ from ._common import (
 
 
 def run(args):
+    t_start = time.perf_counter()
     from reports import (
         compile_pdf,
         fit_impulse_figure,
@@ -80,10 +82,9 @@ def run(args):
                     "derivative": res.samples.derivative, "noise": res.samples.noise},
         "measured": {"n_cycles": res.measured.n_cycles, "n_periods": res.measured.n_periods,
                      "noise": res.measured.noise, "threshold": res.measured.threshold},
-        "n_solves": res.estimator.n_solves_, "seconds": res.seconds,
+        "n_solves": res.estimator.n_solves_, "discovery_seconds": res.seconds,
         "fit_settings": res.settings, **provenance(vars(args), inputs=inputs_of(args))}
     with OutputDir(args.out) as out:
-        out.write_json("summary.json", summary)
         buf = io.StringIO()
         w = csv.writer(buf)
         w.writerow(["rank", "terms", "regime", "bic", "aic", "cv_error", *CRITERIA,
@@ -99,6 +100,9 @@ def run(args):
         fit_impulse_figure(res, imps, str(out.path("fit_impulse")))
         fit_surface_figure(res, str(out.path("fit_surface")))
         fit_loop_figure(res, str(out.path("fit_loop")))
+        summary["pdf"] = None if pdf is None else "model.pdf"
+        summary["seconds"] = time.perf_counter() - t_start  # the whole command
+        out.write_json("summary.json", summary)
     sel = res.selected
     print(f"selected {sel.law}   [{sel.regime}]")
     if sel.standard_errors:
