@@ -11,6 +11,7 @@ from .discover import DiscoveryResult, RankedModel, discover
 from .dynamics import Tolerances, simulate
 from .dynamics.steady_state import SteadyState, steady_state
 from .errors import InputError, IntegrationError, LawSyntaxError, VidiError
+from .explain import ExplainResult, explain
 from .identify import IdentificationResult, identify
 from .impulse import Impulse, impulse_from_samples, impulse_from_steady_state
 from .landscape import Landscape, landscape
@@ -29,5 +30,5 @@ __all__ = [
     "landscape", "ForceLaw", "Term", "Measurement", "synthesize", "Response", "response",
     "Scenario", "builtin_scenarios", "load_scenario", "discover", "DiscoveryResult",
     "RankedModel", "Library", "ConstrainedSparseRegressor", "Candidate", "ContactSamples",
-    "contact_samples",
+    "contact_samples", "explain", "ExplainResult",
 ]

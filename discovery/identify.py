@@ -128,8 +128,9 @@ def as_records(scenario, reference):
 class _Objective:
     """Counts and caches simulations, enforces the budget, records the best-so-far path."""
 
-    def __init__(self, records, start, name, tolerances, max_sim):
+    def __init__(self, records, start, name, tolerances, max_sim, observe=None):
         self.records, self.start, self.name = records, start, name
+        self.observe = observe
         self.tol, self.max_sim = tolerances, max_sim
         _criterion(name)
         self.c0 = np.array(start.coefficients)
@@ -156,7 +157,8 @@ class _Objective:
             evs = []
             for sc, ref in self.records:
                 self.n += 1
-                ev = evaluate(sc, law, ref, tolerances=self.tol, floor=False)
+                ev = evaluate(sc, law, ref, tolerances=self.tol, floor=False,
+                              observe=self.observe)
                 evs.append(ev)
                 if ev.status != "ok":
                     self.failures.append({"coefficients": law.as_dict(), "status": ev.status,
@@ -248,7 +250,8 @@ def _uncertainty(obj, x, names):
 
 
 def identify(scenario, reference, start, *, criterion="I2", method="coordinate-descent",
-             xtol=1e-5, max_simulations=600, tolerances=None, uncertainty=True):
+             xtol=1e-5, max_simulations=600, tolerances=None, uncertainty=True,
+             observe=None):
     """Identify the coefficients of ``start`` from one or several records by simulation.
 
     Parameters
@@ -273,6 +276,8 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
         Integrator settings (the same for every evaluation).
     uncertainty : bool
         Estimate standard errors (one more simulation per coefficient and record).
+    observe : callable, optional
+        Observation model of the simulated force (see :func:`discovery.verify.evaluate`).
 
     Returns
     -------
@@ -297,7 +302,7 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
         raise InputError(f"the simulation budget must be an integer of at least "
                          f"{2 * len(records)} (two per record); got {max_simulations!r}")
     t0 = time.perf_counter()
-    obj = _Objective(records, start, criterion, tolerances, int(max_simulations))
+    obj = _Objective(records, start, criterion, tolerances, int(max_simulations), observe)
     x0 = np.ones(len(start.coefficients))
     if obj.evaluations(x0) is None:
         f = obj.failures[-1]

@@ -1,6 +1,7 @@
 """Reports: figures and LaTeX documents as pure functions of results."""
 
 from .figures import (
+    explain_figure,
     fit_impulse_figure,
     fit_loop_figure,
     fit_surface_figure,
@@ -11,4 +12,5 @@ from .figures import (
 from .latex import compile_pdf, model_tex
 
 __all__ = ["landscape_figure", "identification_figure", "fit_impulse_figure",
-           "fit_surface_figure", "fit_loop_figure", "model_tex", "compile_pdf", "verify_figure"]
+           "fit_surface_figure", "fit_loop_figure", "model_tex", "compile_pdf", "verify_figure",
+           "explain_figure"]

@@ -9,7 +9,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-__all__ = ["landscape_figure", "identification_figure", "verify_figure"]
+__all__ = ["landscape_figure", "identification_figure", "verify_figure", "explain_figure"]
 
 _ORDER = ("I1", "I2", "I3", "I4", "I0")
 
@@ -20,25 +20,6 @@ def _save(fig, stem):
     fig.savefig(paths[1], bbox_inches="tight")
     plt.close(fig)
     return paths
-
-
-def _contour(ax, land, name, truth=None):
-    a0, a1 = land.axes
-    v = land.values[name]
-    cs = ax.contourf(a0, a1, v.T, levels=20, cmap="viridis")
-    ax.contour(a0, a1, v.T, levels=10, colors="k", linewidths=0.4)
-    bad = np.argwhere(land.regime != "P1")
-    if bad.size:
-        ax.plot(a0[bad[:, 0]], a1[bad[:, 1]], "rx", ms=4, label="not P1")
-        ax.legend(loc="upper right", fontsize=7)
-    i, j = land.argmin(name)
-    ax.plot(a0[i], a1[j], "w*", ms=10, mec="k", label="minimum")
-    if truth is not None:
-        ax.plot(*truth, "o", mfc="none", mec="r", ms=10)
-    ax.set_xlabel(f"coefficient of {land.terms[0]}")
-    ax.set_ylabel(f"coefficient of {land.terms[1]}")
-    ax.set_title(name)
-    plt.colorbar(cs, ax=ax)
 
 
 def landscape_figure(land, stem, truth=None):
@@ -295,5 +276,72 @@ def verify_figure(result, stem):
     axr.set_ylabel("F_N - F_E [N]")
     axr.set_xlabel("time since the impact onset t* [ms]")
     axr.axhline(0.0, color="k", lw=0.5)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def explain_figure(iteration, measured, stem, k=1):
+    """One iteration of the missing-effect loop: the force before and after adding the
+    named effect against the record, the residual's share by impact phase (and its ratio
+    to the noise), the mean residual over the simulated (zeta, dzeta) plane, and every
+    candidate effect's score test."""
+    fig, axes = plt.subplots(2, 2, figsize=(12, 8))
+    ax = axes[0, 0]
+    E = measured
+    ax.plot(E.t * 1e3, E.F / 1e3, "k-", lw=2, label="measured")
+    if iteration.simulated_before is not None:
+        ax.plot(E.t * 1e3, iteration.simulated_before.F / 1e3, "-", color="tab:red",
+                label=f"before ({' + '.join(iteration.model_before.law.names)})")
+    if iteration.effect and iteration.simulated_after is not None:
+        ax.plot(E.t * 1e3, iteration.simulated_after.F / 1e3, "-", color="tab:blue",
+                label=f"after (+ {iteration.effect})")
+    if len(E.support):
+        a, b = E.support[0]
+        ax.set_xlim(max(a - 0.1 * (b - a), 0) * 1e3, (b + 0.3 * (b - a)) * 1e3)
+    ax.set_xlabel("time since onset [ms]")
+    ax.set_ylabel("contact force [kN]")
+    i2b = iteration.criteria_before.get("I2", float("nan"))
+    i2a = iteration.criteria_after.get("I2", float("nan"))
+    ax.set_title(f"iteration {k}: I2 {i2b:.3g} -> {i2a:.3g} (noise floor "
+                 f"{iteration.noise_floor.get('I2', float('nan')):.2g})", fontsize=9)
+    ax.legend(fontsize=7)
+    ax = axes[0, 1]
+    ph = iteration.localisation["phases"]
+    names = list(ph)
+    shares = [ph[n]["share"] for n in names]
+    bars = ax.bar(names, shares, color=["tab:red" if ph[n]["exceeds_noise"] else "tab:gray"
+                                        for n in names])
+    for bar, n in zip(bars, names, strict=True):
+        r = ph[n]["ratio_to_noise"]
+        if r is not None:
+            ax.text(bar.get_x() + bar.get_width() / 2, bar.get_height(), f"{r:.1f}x",
+                    ha="center", va="bottom", fontsize=7)
+    ax.set_ylabel("share of the residual energy above the noise")
+    ax.set_title("where the model disagrees (red: above the noise; label: energy / noise)",
+                 fontsize=9)
+    ax = axes[1, 0]
+    plane = iteration.localisation.get("plane")
+    if plane is not None:
+        ze, ve = plane["zeta_edges"], plane["dzeta_edges"]
+        m = plane["mean_residual"]
+        lim = np.nanmax(np.abs(m)) if np.isfinite(m).any() else 1.0
+        im = ax.pcolormesh(ze * 1e3, ve, (m / 1e3).T, cmap="RdBu_r", vmin=-lim / 1e3,
+                           vmax=lim / 1e3, shading="flat")
+        fig.colorbar(im, ax=ax, label="mean residual F_N - F_E [kN]")
+        ax.set_xlabel("zeta [mm] (simulated)")
+        ax.set_ylabel("dzeta [m/s] (simulated)")
+    else:
+        ax.text(0.5, 0.5, "no positions in the record", ha="center", transform=ax.transAxes)
+    ax.set_title("residual over the (zeta, dzeta) plane", fontsize=9)
+    ax = axes[1, 1]
+    sc = [x for x in iteration.scores if x.get("lm") is not None]
+    if sc:
+        lm = [max(x["lm"], 1e-3) for x in sc]
+        ax.barh([x["effect"] for x in sc], lm,
+                color=["tab:green" if x["effect"] == iteration.effect else
+                       ("tab:orange" if x["significant"] else "tab:gray") for x in sc])
+        ax.set_xscale("log")
+        ax.set_xlabel("score (LM) statistic; green: named, orange: significant")
+    ax.set_title("candidate effects", fontsize=9)
     fig.tight_layout()
     return _save(fig, stem)

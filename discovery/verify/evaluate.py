@@ -143,7 +143,7 @@ def _verdict(consistent, reg, imp, crit, floor):
 
 
 def evaluate(scenario, law, reference, *, tolerances=None, from_state=True, floor=True,
-             **steady_kwargs):
+             observe=None, **steady_kwargs):
     """Simulate ``law`` and score it against ``reference`` (see the module docstring).
 
     Parameters
@@ -159,6 +159,10 @@ def evaluate(scenario, law, reference, *, tolerances=None, from_state=True, floo
         Compute the noise floor under the hypothesis that ``law`` is true (a parametric
         bootstrap, ~0.1 s) and decide consistency.  Optimisers that only need the
         criteria pass ``False`` (then ``noise_floor`` is empty and ``consistent`` False).
+    observe : callable, optional
+        An observation model ``Impulse -> Impulse`` applied to the exact simulated force
+        history before it is aligned and sampled (e.g. the force sensor's own dynamics,
+        :mod:`discovery.explain.effects`).
     **steady_kwargs
         Passed to :func:`~discovery.dynamics.steady_state.steady_state`.
 
@@ -183,6 +187,8 @@ def evaluate(scenario, law, reference, *, tolerances=None, from_state=True, floo
     except IntegrationError as exc:
         return Evaluation("failed", reg, imp, {}, {}, False,
                           f"the simulation failed: {exc}", message=str(exc))
+    if exact is not None and observe is not None:
+        exact = observe(exact)
     if exact is None:
         imp["simulated"] = 0
         return Evaluation("no-contact", reg, imp, {}, {}, False,

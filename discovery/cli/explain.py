@@ -1,0 +1,111 @@
+"""``vidi explain``: name the physical effect a model misses, add it, show the gap shrink."""
+
+import time
+
+from .._io import OutputDir, provenance
+from ..criteria import CRITERIA
+from ..errors import InputError
+from ..scenario import load_scenario
+from ._common import (
+    SCENARIO_HELP,
+    add_record_options,
+    check_out,
+    inputs_of,
+    integer,
+    number,
+    read_record,
+)
+
+
+def run(args):
+    from reports import explain_figure
+
+    from ..explain import EFFECTS, explain
+
+    t_start = time.perf_counter()
+    check_out(args)
+    data = args.data
+    names = args.scenario or ["paper"]
+    if len(names) not in (1, len(data)):
+        raise InputError(f"{len(data)} --data record(s) but {len(names)} --scenario: give one "
+                         "--scenario per --data, in the same order, or one for all")
+    known = {e.id for e in EFFECTS}
+    effects = None
+    if args.effects:
+        effects = [e.strip() for e in args.effects.split(",") if e.strip()]
+        bad = sorted(set(effects) - known)
+        if bad or not effects:
+            raise InputError(f"--effects: unknown effect(s) {', '.join(bad) or '(none)'}; "
+                             f"choose from {', '.join(sorted(known))}")
+    scs = [load_scenario(n) for n in names] * (len(data) if len(names) == 1 else 1)
+    meas = []
+    for path, sc_k in zip(data, scs, strict=True):
+        m = read_record(args, sc_k, path)
+        for note in m.notes:
+            print(f"note: {path}: {note}" if len(data) > 1 else f"note: {note}")
+        meas.append(m)
+    res = explain(scs, meas, args.start, criterion=args.criterion, alpha=args.alpha,
+                  max_iterations=args.max_iterations, budget=args.max_simulations,
+                  n_boot=args.n_boot, seed=args.seed, effects=effects)
+    summary = {"command": "explain", "scenario": scs[0].as_dict(),
+               "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
+               **res.as_dict(), "catalogue": [e.as_dict() for e in EFFECTS],
+               "explain_settings": res.settings}
+    with OutputDir(args.out) as out:
+        files = []
+        for k, it in enumerate(res.iterations, start=1):
+            explain_figure(it, it.measured, str(out.path(f"explain_{k}")), k)
+            files.append(f"explain_{k}.png/.pdf")
+        summary["seconds"] = time.perf_counter() - t_start
+        out.write_json("summary.json", {**summary,
+                                        **provenance(vars(args), inputs=inputs_of(args))})
+    for k, it in enumerate(res.iterations, start=1):
+        name = it.effect or "nothing named"
+        print(f"iteration {k}: {name}: {it.evidence}")
+        if it.equivalent:
+            print(f"  equally good: {', '.join(it.equivalent)}")
+    fm = res.final_model
+    print(f"final model: {fm.law}" + (f"  observed through {fm.observation}"
+                                      if fm.observation else ""))
+    if res.uncertainties:
+        print("  coefficients (standard error): " + ", ".join(
+            f"{t} {c:.4g} ({res.uncertainties.get(t, float('nan')):.2g})"
+            for t, c in fm.law.as_dict().items()))
+    if res.criteria:
+        print("  criteria (noise floor): " + ", ".join(
+            f"{n} {res.criteria[n]:.3g} ({res.noise_floor.get(n, float('nan')):.2g})"
+            for n in CRITERIA))
+    print(f"  {'consistent' if res.consistent else 'not consistent'} with the record(s); "
+          f"stopped because {res.stopped_because}")
+    print(f"outputs in {args.out}/: summary.json" + "".join(f", {f}" for f in files))
+    return 0
+
+
+def register(sub):
+    s = sub.add_parser("explain", help="find where a model and a record disagree, name the "
+                       "missing physical effect, add it, refit, show the gap shrink")
+    s.add_argument("--scenario", action="append",
+                   help=SCENARIO_HELP + "; repeat it, once per --data in the same order")
+    s.add_argument("--data", required=True, action="append",
+                   help="CSV with t, F, w1, w2 (v1, v2 recommended); repeat it to explain "
+                   "several records jointly")
+    add_record_options(s)
+    s.add_argument("--start", default="linear",
+                   help="start model: 'linear' (z, zd), a term list 'z,zd,z^1.5' (start values "
+                   "from the regression and the record) or a law with coefficients (linear)")
+    s.add_argument("--effects", help="comma-separated catalogue ids to consider (default all: "
+                   "penetration_velocity_coupling, hertzian_stiffening, sensor_lag)")
+    s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
+                   help="criterion of the refits (I2)")
+    s.add_argument("--alpha", type=number(0.0, 0.5, lo_open=True), default=0.01,
+                   help="family-wise significance level of the score tests (0.01)")
+    s.add_argument("--max-iterations", type=integer(0, 10), default=3,
+                   help="effects added at most (3)")
+    s.add_argument("--max-simulations", type=integer(10, 100_000), default=150,
+                   help="simulation budget of each refit (150)")
+    s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
+                   help="bootstrap replicates of the noise floor (16)")
+    s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
+                   help="seed of the noise-floor bootstrap (0)")
+    s.add_argument("--out", required=True, help="output directory")
+    s.set_defaults(func=run)

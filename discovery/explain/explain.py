@@ -1,0 +1,511 @@
+"""The missing-effect loop: find where the model and the record disagree, name the missing
+effect, add it, refit, show the gap shrink.
+
+One iteration (:func:`explain`):
+
+1. **Verify** the current model against every record (:func:`discovery.verify.evaluate`):
+   if it is consistent (same regime; I2 and I4 within their noise floors) there is
+   nothing to explain, and the loop stops: no false discoveries.
+2. **Localise** the disagreement (:func:`~discovery.explain.localise.localise`).
+3. **Score** every applicable catalogue effect by a Lagrange-multiplier (score) test for
+   an omitted variable: with the residual ``r = F_N - F_E`` of all records, the output
+   Jacobian ``J`` of the model's own coefficients and the output sensitivity ``s`` to the
+   effect's parameter (finite differences through full simulations),
+   ``LM = (s^T M r)^2 / (sigma^2 s^T M s)``, ``M = I - J (J^T J)^-1 J^T`` (``r`` and ``s``
+   are made orthogonal to what a refit of the current coefficients can absorb), ``sigma``
+   the noise of the averaged cycles.  Under "the effect is absent" ``LM ~ chi^2(1)``; an
+   effect is significant when its p-value is below ``alpha`` divided by the number of
+   effects scored (Bonferroni).
+4. **Refit** the significant effects (the best two by LM): output-error identification of
+   the extended model (:func:`discovery.identify`), re-verified.  The effect is named when
+   its refit lowers the mean I2 by at least 10 %; two refits within the noise floor of each
+   other are reported as equivalent.  Its signature (the phases where it acts) is
+   checked against the localisation and reported.
+5. Repeat until nothing significant remains or ``max_iterations`` is reached.
+"""
+
+import re
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+from scipy.stats import chi2
+
+from ..errors import InputError, IntegrationError
+from ..identify import as_records, identify
+from ..law import ForceLaw
+from ..verify import evaluate
+from .effects import EFFECTS, Model
+from .localise import localise
+
+__all__ = ["ExplainResult", "Iteration", "explain", "start_law"]
+
+_ALTERNATIONS = 4  # observation parameter / law refits
+
+# a number multiplying a factor: the start is a law with coefficients, not a term list
+_HAS_COEFFICIENT = re.compile(r"(^|[+\-])\s*[0-9.]+([eE][+\-]?[0-9]+)?\s*\*")
+
+
+@dataclass(frozen=True)
+class Iteration:
+    """One pass of the loop.
+
+    Attributes
+    ----------
+    model_before, model_after : Model
+    criteria_before, criteria_after : dict
+        Mean criteria over records.
+    noise_floor : dict
+    localisation : dict
+        Of the model before (first record).
+    scores : list of dict
+        Every scored effect: ``effect``, ``lm``, ``p``, ``significant``,
+        ``signature_agrees``, and for refitted ones ``criteria_after`` and ``parameters``.
+    effect : str or None
+        The effect named (None when the iteration stopped the loop).
+    evidence : str
+    equivalent : list of str
+        Effects whose refit explains the record as well (within the noise floor).
+    simulated_before, simulated_after : Impulse or None
+        The aligned simulated force histories (first record), for figures.
+    measured : Impulse or None
+        The first record's measured cycle.
+    """
+
+    model_before: Model
+    model_after: Model
+    criteria_before: dict
+    criteria_after: dict
+    noise_floor: dict
+    localisation: dict
+    scores: list
+    effect: str | None
+    evidence: str
+    equivalent: list = field(default_factory=list)
+    simulated_before: object = None
+    simulated_after: object = None
+    measured: object = None
+
+    def as_dict(self):
+        return {"effect": self.effect, "evidence": self.evidence,
+                "criteria_before": self.criteria_before, "criteria_after": self.criteria_after,
+                "noise_floor": self.noise_floor, "parameters": _parameters(self),
+                "model_before": self.model_before.as_dict(),
+                "model_after": self.model_after.as_dict(), "scores": self.scores,
+                "equivalent": self.equivalent,
+                "localisation": {"phases": self.localisation["phases"],
+                                 "grid": self.localisation.get("grid"),
+                                 "drift": self.localisation.get("drift"),
+                                 "sigma": self.localisation["sigma"],
+                                 "rms": self.localisation["rms"]}}
+
+
+def _parameters(it):
+    if it.effect is None:
+        return {}
+    for s in it.scores:
+        if s["effect"] == it.effect:
+            return s.get("parameters", {})
+    return {}
+
+
+@dataclass(frozen=True)
+class ExplainResult:
+    """Outcome of :func:`explain`.
+
+    Attributes
+    ----------
+    iterations : tuple of Iteration
+    final_model : Model
+    uncertainties : dict
+        Standard errors of the final law's coefficients (output error).
+    criteria : dict
+        Of the final model (mean over records).
+    noise_floor : dict
+    consistent : bool
+        The final model is consistent with every record.
+    stopped_because : str
+    seconds : float
+    settings : dict
+    """
+
+    iterations: tuple
+    final_model: Model
+    uncertainties: dict
+    criteria: dict
+    noise_floor: dict
+    consistent: bool
+    stopped_because: str
+    seconds: float = 0.0
+    settings: dict = field(default_factory=dict)
+
+    def as_dict(self):
+        return {"iterations": [it.as_dict() for it in self.iterations],
+                "final_model": {**self.final_model.as_dict(),
+                                "uncertainties": self.uncertainties},
+                "criteria": self.criteria, "noise_floor": self.noise_floor,
+                "consistent": self.consistent, "stopped_because": self.stopped_because,
+                "seconds": self.seconds}
+
+
+def _physical(names, records):
+    """Start values from the record alone: stiffness from the contact time and the reduced
+    mass, damping from the force jump at onset."""
+    sc, ref = records[0]
+    E = ref.impulse
+    tau, v, z0 = _scales(records)
+    mu = sc.m1 * sc.m2 / (sc.m1 + sc.m2)
+    k = mu * (np.pi / tau) ** 2
+    jump = float(E.evaluate(0.0, "right"))
+    c = jump / v if jump > 0.05 * E.peak else 0.1 * np.sqrt(k * mu)
+    parts = []
+    for n in names:
+        term = ForceLaw.parse(f"1*{n}").terms[0]
+        base = c if term.b >= 1 else k * z0
+        parts.append(f"{base / z0 ** term.a:.6g}*{n}")
+    return ForceLaw.parse(" + ".join(parts))
+
+
+def _regression(names, scenarios, measurements):
+    """The certified regression of the force on exactly these terms (None without
+    positions in every record, or when the regression fails)."""
+    from ..regression import ConstrainedSparseRegressor
+    from ..samples import contact_samples, join_samples
+
+    try:
+        samples = join_samples([contact_samples(m, period=sc.period)
+                                for sc, m in zip(scenarios, measurements, strict=True)])
+        est = ConstrainedSparseRegressor(library=",".join(names), max_terms=len(names))
+        est.fit(samples.X, samples.F, groups=samples.impact, sample_weight=samples.weight)
+    except (InputError, ValueError):
+        return None
+    full = [c for c in est.candidates_ if len(c.terms) == len(names)]
+    if not full:
+        return None
+    coef = full[0].coefficients
+    if not all(coef.get(ForceLaw.parse(f"1*{n}").names[0], 0.0) for n in names):
+        return None
+    return ForceLaw.parse(" + ".join(f"{coef[ForceLaw.parse(f'1*{n}').names[0]]!r}*{n}"
+                                     for n in names))
+
+
+def start_law(text, records, measurements=None):
+    """Candidate start laws, best first: ``linear`` (z, zd) or a term list (``z,zd``) gets
+    its coefficients from the certified regression on the contact samples (when the records
+    have positions) and from the record alone (contact time, reduced mass, force jump);
+    a law with coefficients (``2e8*z + 1e7*zd``) is used as given."""
+    text = str(text).strip()
+    if not text:
+        raise InputError("--start is empty; give 'linear', a term list such as 'z,zd' or a "
+                         "law such as '2e8*z + 1e7*zd'")
+    if text != "linear" and "," not in text and _HAS_COEFFICIENT.search(text):
+        return [ForceLaw.parse(text)]
+    names = ["z", "zd"] if text == "linear" else [n.strip() for n in text.split(",") if n.strip()]
+    for n in names:
+        ForceLaw.parse(f"1*{n}")  # a clear error for a bad term name
+    E = records[0][1].impulse
+    if not len(E.support):
+        raise InputError("the record has no contact to start from")
+    out = []
+    if measurements is not None:
+        reg = _regression(names, [sc for sc, _ in records], measurements)
+        if reg is not None:
+            out.append(reg)
+    out.append(_physical(names, records))
+    return out
+
+
+class _Problem:
+    """Residuals of a model against all records, and their sensitivities."""
+
+    def __init__(self, records, tolerances):
+        self.records, self.tol = records, tolerances
+        self.n_sim = 0
+
+    def evaluations(self, model, floor=False):
+        evs = []
+        for sc, ref in self.records:
+            self.n_sim += 1
+            evs.append(evaluate(sc, model.law, ref, tolerances=self.tol, floor=floor,
+                                observe=model.observe()))
+        return evs
+
+    def residual(self, model):
+        evs = self.evaluations(model)
+        if not all(e.status == "ok" for e in evs):
+            return None
+        return np.concatenate([e.simulated.F - ref.impulse.F
+                               for e, (_, ref) in zip(evs, self.records, strict=True)])
+
+    def sigma(self):
+        s = [ref.noise["F"] / np.sqrt(max(ref.noise["n_cycles"], 1))
+             for _, ref in self.records if ref.noise]
+        return float(np.sqrt(np.mean(np.square(s)))) if s else 0.0
+
+
+def _mean(evs, key):
+    if not all(getattr(e, key) for e in evs):
+        return {}
+    return {k: float(np.mean([getattr(e, key)[k] for e in evs])) for k in getattr(evs[0], key)}
+
+
+def _scales(records):
+    """Typical contact time [s], impact velocity [m/s] and penetration [m] of the record."""
+    sc, ref = records[0]
+    E = ref.impulse
+    tau = float(np.median(E.support[:, 1] - E.support[:, 0])) if len(E.support) else sc.period
+    v = (ref.noise.get("impact_velocity") if ref.noise else None) or sc.scales()[1]
+    return tau, v, v * tau / np.pi
+
+
+def _small_step(eff, records):
+    """A small value of the effect's parameter (1 % of the peak force at the typical
+    penetration and impact velocity; 1 % of the contact time for a time constant)."""
+    tau, v, z0 = _scales(records)
+    if eff.terms:
+        term = ForceLaw.parse(f"1*{eff.terms[0]}").terms[0]
+        return 0.01 * records[0][1].impulse.peak / max(float(term(z0, v)), 1e-300)
+    return 0.01 * tau
+
+
+def _extend(model, eff, value):
+    if eff.terms:
+        return model.with_term(eff.terms[0], value, eff.id)
+    return model.with_observation(eff.observation, value, eff.id)
+
+
+def _score(problem, model, r0, J, eff, records, sigma):
+    h = _small_step(eff, records)
+    r1 = problem.residual(_extend(model, eff, h))
+    if r1 is None or sigma <= 0:
+        return {"effect": eff.id, "lm": None, "p": None, "significant": False,
+                "note": "its sensitivity could not be simulated"}
+    s = (r1 - r0) / h
+    if J.shape[1]:
+        Q, _ = np.linalg.qr(J)
+        s_perp = s - Q @ (Q.T @ s)
+        r_perp = r0 - Q @ (Q.T @ r0)
+    else:
+        s_perp, r_perp = s, r0
+    den = float(s_perp @ s_perp)
+    lm = float((s_perp @ r_perp) ** 2 / (sigma**2 * den)) if den > 0 else 0.0
+    return {"effect": eff.id, "lm": lm, "p": float(chi2.sf(lm, 1)), "significant": False,
+            "direction": float(-(s_perp @ r_perp) / den) if den > 0 else 0.0}
+
+
+def _jacobian(problem, model, r0):
+    law = model.law
+    cols = []
+    for i, c in enumerate(law.coefficients):
+        h = 1e-4 * abs(c)
+        coefs = list(law.coefficients)
+        coefs[i] = c + h
+        r1 = problem.residual(Model(law.with_coefficients(coefs), model.observation,
+                                    model.effects))
+        if r1 is None:
+            continue
+        cols.append((r1 - r0) / h)
+    return np.column_stack(cols) if cols else np.zeros((r0.size, 0))
+
+
+def _refit(problem, model, eff, direction, records, criterion, budget, tol):
+    """Add ``eff`` (start: the LM direction when it is usable, else a small value) and refit
+    by output error; returns ``(model, identification or None)``."""
+    h = _small_step(eff, records)
+    start = direction if direction and direction > 0 else h
+    if eff.terms:
+        trial = _extend(model, eff, start)
+        try:
+            res = identify([s for s, _ in records], [r for _, r in records], trial.law,
+                           criterion=criterion, method="least-squares",
+                           max_simulations=budget, tolerances=tol)
+        except IntegrationError:
+            trial = _extend(model, eff, h)
+            res = identify([s for s, _ in records], [r for _, r in records], trial.law,
+                           criterion=criterion, method="least-squares",
+                           max_simulations=budget, tolerances=tol)
+        return Model(res.law, dict(model.observation), trial.effects), res
+    # an observation parameter: alternate a bounded 1-D fit of it (law fixed) and an
+    # output-error refit of the law (parameter fixed); the law first absorbed what the
+    # missing effect did, so one pass is not enough
+    lo, hi = eff.parameters[0].bounds
+    hi = min(hi, 20 * h)
+    law, res, value = model.law, None, h
+    for _ in range(_ALTERNATIONS):
+        base = Model(law, dict(model.observation), model.effects)
+
+        def cost(v, base=base):
+            r = problem.residual(_extend(base, eff, v))
+            return float(r @ r) if r is not None else np.inf
+
+        opt = minimize_scalar(cost, bounds=(max(lo, 1e-3 * h), hi), method="bounded",
+                              options={"xatol": 1e-3 * h, "maxiter": 40})
+        moved = abs(float(opt.x) - value) / max(value, 1e-300)
+        value = float(opt.x)
+        trial = _extend(base, eff, value)
+        res = identify([s for s, _ in records], [r for _, r in records], trial.law,
+                       criterion=criterion, method="least-squares", max_simulations=budget,
+                       tolerances=tol, observe=trial.observe())
+        law = res.law
+        if moved < 0.01:
+            break
+    return Model(law, {**model.observation, eff.observation: value},
+                 model.effects + (eff.id,)), res
+
+
+def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01,
+            max_iterations=3, budget=150, n_boot=16, seed=0, tolerances=None, effects=None):
+    """Explain the disagreement of a start model with one or several records by named
+    physical effects (see the module docstring).
+
+    Parameters
+    ----------
+    scenario : Scenario or sequence of Scenario
+        One per record (or one for all).
+    measurement : Measurement, Reference, or a sequence of them
+    start : str or ForceLaw
+        ``"linear"`` (z, zd), a term list (``"z,zd"``) or a law with coefficients; the
+        start is first refined by simulation.
+    criterion : str
+        Criterion of the refits (the mean over records).
+    alpha : float
+        Family-wise significance level of the score tests.
+    max_iterations : int
+        Effects added at most.
+    budget : int
+        Simulations of each refit.
+    n_boot, seed : int
+        Noise-floor bootstrap.
+    tolerances : Tolerances, optional
+    effects : sequence of str, optional
+        Catalogue ids to consider (default all).
+
+    Returns
+    -------
+    ExplainResult
+    """
+    t0 = time.perf_counter()
+    if not (0 < alpha < 1):
+        raise InputError(f"alpha must be in (0, 1); got {alpha!r}")
+    if not (isinstance(max_iterations, int) and max_iterations >= 0):
+        raise InputError(f"max_iterations must be an integer >= 0; got {max_iterations!r}")
+    from ..verify import Reference
+
+    scs = list(scenario) if isinstance(scenario, list | tuple) else [scenario]
+    ms = list(measurement) if isinstance(measurement, list | tuple) else [measurement]
+    if len(scs) == 1:
+        scs = scs * len(ms)
+    refs = [m if isinstance(m, Reference) else
+            Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)
+            for sc, m in zip(scs, ms, strict=True)]
+    records = as_records(scs, refs)
+    catalogue = [e for e in EFFECTS if effects is None or e.id in effects]
+    if effects is not None and len(catalogue) != len(set(effects)):
+        known = {e.id for e in EFFECTS}
+        raise InputError(f"unknown effect(s) {sorted(set(effects) - known)}; the catalogue "
+                         f"has {', '.join(sorted(known))}")
+    problem = _Problem(records, tolerances)
+    plain = [m for m in ms if not isinstance(m, Reference)]
+    starts = [start] if isinstance(start, ForceLaw) else \
+        start_law(start, records, plain if len(plain) == len(ms) else None)
+    fit, why = None, ""
+    for law in starts:
+        try:
+            fit = identify([s for s, _ in records], [r for _, r in records], law,
+                           criterion=criterion, method="least-squares",
+                           max_simulations=budget, tolerances=tolerances)
+            break
+        except IntegrationError as exc:
+            why = str(exc)
+    if fit is None:
+        raise IntegrationError(f"no start law for {start!r} has a periodic steady state with "
+                               f"contact for the record ({why}); give --start as a law with "
+                               "coefficients closer to the record")
+    model = Model(fit.law)
+    uncertainties = dict(fit.standard_errors)
+    iterations = []
+    stopped = f"the budget of {max_iterations} added effect(s) is used"
+    meas_first = ms[0] if not isinstance(ms[0], Reference) else None
+    for _ in range(max_iterations + 1):
+        evs = problem.evaluations(model, floor=True)
+        before, floor = _mean(evs, "criteria"), _mean(evs, "noise_floor")
+        if all(e.consistent for e in evs):
+            stopped = ("the model is consistent with the record(s): I2 and I4 within their "
+                       "noise floors, nothing left to explain")
+            break
+        if len(iterations) >= max_iterations:
+            break
+        loc = localise(records[0][0], model, records[0][1], evs[0], meas_first,
+                       tolerances=tolerances)
+        r0 = problem.residual(model)
+        J = _jacobian(problem, model, r0)
+        sigma = problem.sigma()
+        cands = [e for e in catalogue if e.applicable(model)]
+        scores = [_score(problem, model, r0, J, e, records, sigma) for e in cands]
+        level = alpha / max(len(scores), 1)
+        top_phases = sorted(loc["phases"], key=lambda p: -loc["phases"][p]["share"])[:2]
+        for s, e in zip(scores, cands, strict=True):
+            s["significant"] = bool(s["p"] is not None and s["p"] < level)
+            s["signature_agrees"] = bool(set(e.phases) & set(top_phases))
+        ranked = sorted((s for s in scores if s["significant"]), key=lambda s: -s["lm"])
+        if not ranked:
+            iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
+                                        "no catalogue effect is significant (score tests at "
+                                        f"family-wise level {alpha:g})", [], evs[0].simulated,
+                                        evs[0].simulated, records[0][1].impulse))
+            stopped = "no catalogue effect explains the remaining disagreement significantly"
+            break
+        trials = []
+        for s in ranked[:2]:
+            eff = next(e for e in cands if e.id == s["effect"])
+            try:
+                m2, res = _refit(problem, model, eff, s.get("direction"), records, criterion,
+                                 budget, tolerances)
+                evs2 = problem.evaluations(m2, floor=True)
+            except IntegrationError as exc:
+                s["note"] = f"refit failed: {exc}"
+                continue
+            after = _mean(evs2, "criteria")
+            if not after:
+                s["note"] = "the refitted model has no periodic steady state with contact"
+                continue
+            s["criteria_after"] = after
+            s["consistent_after"] = all(e.consistent for e in evs2)
+            s["parameters"] = ({eff.terms[0]: m2.law.as_dict()[eff.terms[0]]} if eff.terms
+                               else {eff.parameters[0].name: m2.observation[eff.observation]})
+            trials.append((after[criterion], s, m2, res, evs2))
+        good = [x for x in trials if x[0] <= 0.9 * before[criterion]]
+        if not good:
+            iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
+                                        "significant by the score test, but no refit lowers "
+                                        f"{criterion} by 10 %", [], evs[0].simulated,
+                                        evs[0].simulated, records[0][1].impulse))
+            stopped = "the significant effects do not shrink the gap when refitted"
+            break
+        good.sort(key=lambda x: x[0])
+        value, s, m2, res, evs2 = good[0]
+        tol_eq = floor.get(criterion, 0.0)
+        equivalent = [x[1]["effect"] for x in good[1:] if x[0] <= value + tol_eq]
+        evidence = (f"score test LM = {s['lm']:.3g} (p = {s['p']:.2g} < {level:.2g}); refitted, "
+                    f"{criterion} {before[criterion]:.3g} -> {value:.3g} (noise floor "
+                    f"{floor.get(criterion, float('nan')):.3g}); signature "
+                    f"{'agrees' if s['signature_agrees'] else 'does not agree'} with the "
+                    f"localisation (largest shares: {', '.join(top_phases)})")
+        iterations.append(Iteration(model, m2, before, _mean(evs2, "criteria"), floor, loc,
+                                    scores, s["effect"], evidence, equivalent,
+                                    evs[0].simulated, evs2[0].simulated,
+                                    records[0][1].impulse))
+        model = m2
+        if res is not None:
+            uncertainties = dict(res.standard_errors)
+    evs = problem.evaluations(model, floor=True)
+    return ExplainResult(
+        iterations=tuple(iterations), final_model=model, uncertainties=uncertainties,
+        criteria=_mean(evs, "criteria"), noise_floor=_mean(evs, "noise_floor"),
+        consistent=all(e.consistent for e in evs), stopped_because=stopped,
+        seconds=time.perf_counter() - t0,
+        settings={"start": str(start), "criterion": criterion, "alpha": alpha,
+                  "max_iterations": max_iterations, "budget": budget, "n_boot": n_boot,
+                  "seed": seed, "effects": [e.id for e in catalogue],
+                  "records": len(records), "simulations": problem.n_sim})
