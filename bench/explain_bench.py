@@ -1,0 +1,54 @@
+"""Benchmark of the missing-effect workflow: ``explain`` on a 20-period record with the full
+catalogue, as a ratio to one steady state measured in the same run."""
+
+import importlib.util
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def _realistic():
+    """tests/realistic.py, loaded by path (tests/ on sys.path would shadow the constraints
+    package with tests/constraints)."""
+    path = Path(__file__).resolve().parent.parent / "tests" / "realistic.py"
+    spec = importlib.util.spec_from_file_location("realistic", path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules["realistic"] = mod
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def bench_explain(repeat=2):
+    R = _realistic()
+
+    from discovery import ForceLaw, load_scenario
+    from discovery.dynamics.steady_state import steady_state
+    from discovery.explain import EFFECTS, explain
+
+    sc = load_scenario("paper")
+    law = ForceLaw.parse("2.06e8*z + 0.9e7*zd + 2e10*z*zd")  # a hidden coupling
+    rec = R.reference_record((sc.with_law(law), law), periods=20, seed=0, check=False)
+    steady_state(sc, sc.law)  # compiled kernels loaded
+    t_ss = min(_time(lambda: steady_state(sc, sc.law)) for _ in range(5))
+    times, res = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        res = explain(sc, rec, "linear")
+        times.append(time.perf_counter() - t0)
+    t = float(np.min(times))
+    return {"seconds": t, "one_steady_state_seconds": t_ss,
+            "ratio_to_one_steady_state": t / t_ss, "catalogue": [e.id for e in EFFECTS],
+            "named": [it.effect for it in res.iterations if it.effect],
+            "simulations": res.settings["simulations"]}
+
+
+def _time(f):
+    t0 = time.perf_counter()
+    f()
+    return time.perf_counter() - t0
+
+
+if __name__ == "__main__":
+    print(bench_explain())
