@@ -26,11 +26,11 @@ import threading
 import traceback
 
 from ..errors import VidiError
-from . import explain, fit, identify, landscape, simulate, steady, verify
+from . import explain, fit, identify, landscape, simulate, steady, ueda, verify
 
 __all__ = ["main", "UsageError", "VidiArgumentParser"]
 
-_COMMANDS = (simulate, fit, verify, explain, steady, landscape, identify)
+_COMMANDS = (simulate, fit, verify, explain, steady, landscape, identify, ueda)
 
 
 class UsageError(VidiError):

@@ -1,4 +1,6 @@
-"""Compiled event-driven Dormand–Prince 5(4) integrator for the two-body system.
+"""Compiled event-driven Dormand–Prince 5(4) integrator for the two-body system (the
+method's stages, error norm, dense output and step control are shared with every system:
+:mod:`discovery.dynamics._dopri`).
 
 The right-hand side is smooth inside each *contact mode*; the mode changes only
 at located events, and no step straddles an event: a step in which a switching
@@ -39,17 +41,19 @@ within ``1e-3 hmax`` of the last) stop the run as chattering.
 import numpy as np
 from numba import njit
 
-from ._tableau import A as _A
-from ._tableau import B as _B
-from ._tableau import C as _C
-from ._tableau import E as _E
-from ._tableau import P as _P
+from ._dopri import MIN_FACTOR as _MIN_FACTOR
+from ._dopri import C as _C
+from ._dopri import blocks
+from ._dopri import step_factor as _step_factor
+
+# the shared Dormand-Prince blocks for this system's four states (w1, v1, w2, v2)
+_D = blocks(4)
+_stage, _combine, _dense, _error_norm = _D.stage, _D.combine, _D.dense, _D.error_norm
 
 FREE, LOAD, UNLOAD, CLIPPED = 0, 1, 2, 3
 EV_ONSET, EV_LOSS, EV_UNLOAD, EV_RELOAD, EV_RELEASE, EV_RESUME = 1, 2, 3, 4, 5, 6
 OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW, CHATTER = 0, 1, 2, 3, 4
 
-_SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 # chattering: more than _ZENO_EVENTS located events in a row, each within
 # _ZENO_GAP * hmax of the previous one (mode switches that hardly advance time)
 _ZENO_EVENTS, _ZENO_GAP = 1000, 1e-3
@@ -165,50 +169,14 @@ def _mode_after(kind, y, coef, ea, eb):
 
 
 @njit(cache=True, inline="always")
-def _dense(y, K, h, theta, out):
-    t2 = theta * theta
-    t3 = t2 * theta
-    t4 = t3 * theta
-    w0 = _P[0, 0] * theta + _P[0, 1] * t2 + _P[0, 2] * t3 + _P[0, 3] * t4
-    w2 = _P[2, 1] * t2 + _P[2, 2] * t3 + _P[2, 3] * t4
-    w3 = _P[3, 1] * t2 + _P[3, 2] * t3 + _P[3, 3] * t4
-    w4 = _P[4, 1] * t2 + _P[4, 2] * t3 + _P[4, 3] * t4
-    w5 = _P[5, 1] * t2 + _P[5, 2] * t3 + _P[5, 3] * t4
-    w6 = _P[6, 1] * t2 + _P[6, 2] * t3 + _P[6, 3] * t4
-    for j in range(4):
-        out[j] = y[j] + h * (w0 * K[0, j] + w2 * K[2, j] + w3 * K[3, j] + w4 * K[4, j]
-                             + w5 * K[5, j] + w6 * K[6, j])
-
-
-@njit(cache=True, inline="always")
 def _rk_step(t, y, h, mode, p, coef, ea, eb, K, ytmp, ynew):
-    """One DP5 step from (t, y) with K[0] = f(t, y) already set; fills K[1:7], ynew."""
+    """One DP5 step from (t, y) with K[0] = f(t, y) already set; fills K[1:7], ynew
+    (the method's stages from :mod:`._dopri`, this system's right-hand side)."""
     for s in range(1, 6):
-        for j in range(4):
-            acc = 0.0
-            for i in range(s):
-                acc += _A[s, i] * K[i, j]
-            ytmp[j] = y[j] + h * acc
+        _stage(s, y, h, K, ytmp)
         _rhs(t + _C[s] * h, ytmp, mode, p, coef, ea, eb, K[s])
-    for j in range(4):
-        acc = 0.0
-        for i in range(6):
-            acc += _B[i] * K[i, j]
-        ynew[j] = y[j] + h * acc
+    _combine(y, h, K, ynew)
     _rhs(t + h, ynew, mode, p, coef, ea, eb, K[6])
-
-
-@njit(cache=True, inline="always")
-def _error_norm(y, ynew, K, h, rtol, atol):
-    s = 0.0
-    for j in range(4):
-        e = 0.0
-        for i in range(7):
-            e += _E[i] * K[i, j]
-        sc = atol[j] + rtol * max(abs(y[j]), abs(ynew[j]))
-        r = h * e / sc
-        s += r * r
-    return np.sqrt(s / 4.0)
 
 
 @njit(cache=True)
@@ -426,7 +394,7 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
                 break
             continue
         if err > 1.0:
-            h *= max(_MIN_FACTOR, _SAFETY * err**-0.2)
+            h *= _step_factor(err)
             continue
         # ---- accepted step: look for the earliest event in (t, t + h]
         if need_h0:
@@ -514,5 +482,5 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
         else:
             for i in range(ns):
                 hs0[i] = hs1[i]
-            h = h * min(_MAX_FACTOR, max(_MIN_FACTOR, _SAFETY * max(err, 1e-10) ** -0.2))
+            h = h * _step_factor(err)
     return status, t, y, mode, n_steps, n_ev, h

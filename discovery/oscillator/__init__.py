@@ -1,0 +1,33 @@
+"""The second system: Ueda's periodically forced oscillators.
+
+``x'' - (mu (1 - gamma x^2) - k) x' + x^3 = B cos(nu t)`` - the negative-resistance
+oscillator of the "broken egg" (``negres``) and Ueda's classical Duffing-type oscillator
+(``duffing``).  Integrated by the Dormand-Prince machinery shared with the vibro-impact
+system (:mod:`discovery.dynamics._dopri`).
+
+* :class:`UedaSystem` - the system description (parameters, rhs, Jacobian, period);
+* :func:`attractor`, :func:`lyapunov`, :func:`lyapunov_two_trajectory`,
+  :func:`classify`, :func:`basins`, :func:`strobe_points`, :func:`trajectory`;
+* :func:`chart` - the regime chart over ``(nu, B)`` in parallel processes.
+"""
+
+from .attractor import (
+    Attractor,
+    Basins,
+    Lyapunov,
+    Regime,
+    attractor,
+    basins,
+    classify,
+    classify_points,
+    lyapunov,
+    lyapunov_two_trajectory,
+    rotation_number,
+    strobe_points,
+    trajectory,
+)
+from .system import MODELS, UedaSystem
+
+__all__ = ["UedaSystem", "MODELS", "Attractor", "Basins", "Lyapunov", "Regime", "attractor",
+           "basins", "classify", "classify_points", "lyapunov", "lyapunov_two_trajectory",
+           "rotation_number", "strobe_points", "trajectory"]
