@@ -172,3 +172,23 @@ def check_out(args, kind="dir", option="--out"):
     inputs = [p for p in _listed(getattr(args, "data", None)) if p]
     inputs += [p for p in map(scenario_file, _listed(getattr(args, "scenario", None))) if p]
     return check_output(getattr(args, "out", None), inputs, kind=kind, option=option)
+
+
+def read_records(args):
+    """Every ``--data`` record with its scenario (``--scenario`` once per ``--data`` in the
+    same order, or once for all): ``(scenarios, measurements)``; notes are printed."""
+    from ..scenario import load_scenario
+
+    data = _listed(args.data)
+    names = _listed(args.scenario) or ["paper"]
+    if len(names) not in (1, len(data)):
+        raise InputError(f"{len(data)} --data record(s) but {len(names)} --scenario: give one "
+                         "--scenario per --data, in the same order, or one for all")
+    scs = [load_scenario(n) for n in names] * (len(data) if len(names) == 1 else 1)
+    meas = []
+    for path, sc in zip(data, scs, strict=True):
+        m = read_record(args, sc, path)
+        for note in m.notes:
+            print(f"note: {path}: {note}" if len(data) > 1 else f"note: {note}")
+        meas.append(m)
+    return scs, meas

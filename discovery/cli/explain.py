@@ -5,7 +5,6 @@ import time
 from .._io import OutputDir, provenance
 from ..criteria import CRITERIA
 from ..errors import InputError
-from ..scenario import load_scenario
 from ._common import (
     SCENARIO_HELP,
     add_record_options,
@@ -13,7 +12,7 @@ from ._common import (
     inputs_of,
     integer,
     number,
-    read_record,
+    read_records,
 )
 
 
@@ -25,10 +24,6 @@ def run(args):
     t_start = time.perf_counter()
     check_out(args)
     data = args.data
-    names = args.scenario or ["paper"]
-    if len(names) not in (1, len(data)):
-        raise InputError(f"{len(data)} --data record(s) but {len(names)} --scenario: give one "
-                         "--scenario per --data, in the same order, or one for all")
     known = {e.id for e in EFFECTS}
     effects = None
     if args.effects:
@@ -37,13 +32,7 @@ def run(args):
         if bad or not effects:
             raise InputError(f"--effects: unknown effect(s) {', '.join(bad) or '(none)'}; "
                              f"choose from {', '.join(sorted(known))}")
-    scs = [load_scenario(n) for n in names] * (len(data) if len(names) == 1 else 1)
-    meas = []
-    for path, sc_k in zip(data, scs, strict=True):
-        m = read_record(args, sc_k, path)
-        for note in m.notes:
-            print(f"note: {path}: {note}" if len(data) > 1 else f"note: {note}")
-        meas.append(m)
+    scs, meas = read_records(args)
     res = explain(scs, meas, args.start, criterion=args.criterion, alpha=args.alpha,
                   max_iterations=args.max_iterations, budget=args.max_simulations,
                   n_boot=args.n_boot, seed=args.seed, effects=effects)

@@ -6,8 +6,6 @@ import time
 
 from .._io import OutputDir, provenance
 from ..criteria import CRITERIA
-from ..errors import InputError
-from ..scenario import load_scenario
 from ._common import (
     SCENARIO_HELP,
     add_record_options,
@@ -15,7 +13,7 @@ from ._common import (
     inputs_of,
     integer,
     number,
-    read_record,
+    read_records,
 )
 
 
@@ -33,17 +31,7 @@ def run(args):
 
     check_out(args)
     data = args.data
-    names = args.scenario or ["paper"]
-    if len(names) not in (1, len(data)):
-        raise InputError(f"{len(data)} --data record(s) but {len(names)} --scenario: give one "
-                         "--scenario per --data, in the same order, or one for all")
-    scs = [load_scenario(n) for n in names] * (len(data) if len(names) == 1 else 1)
-    meas = []
-    for path, sc_k in zip(data, scs, strict=True):
-        m = read_record(args, sc_k, path)
-        for note in m.notes:
-            print(f"note: {path}: {note}" if len(data) > 1 else f"note: {note}")
-        meas.append(m)
+    scs, meas = read_records(args)
     sc = scs[0]
     res = discover(scs, meas, library=args.library, selection=args.select, scoring=args.score,
                    max_terms=args.max_terms, criterion=args.criterion,
