@@ -1,5 +1,6 @@
 """Figures of Ueda's oscillators (matplotlib, Agg): the attractor (the paper's Figs. 1-2:
-stroboscopic points, and a trajectory in the (x, x') plane) and the regime chart.
+stroboscopic points, and a trajectory in the (x, x') plane), the regime chart, the basins
+and the verification of a discovered equation (record's strobe points vs the model's).
 
 Each function writes PNG and PDF and returns the paths.
 """
@@ -11,7 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 
-__all__ = ["attractor_figure", "chart_figure", "basins_figure"]
+__all__ = ["attractor_figure", "chart_figure", "basins_figure", "discover_figure"]
 
 _KIND_COLORS = ("#9ecae1", "#a1d99b", "#fdd0a2", "#e6550d")  # P1, Pn, beat, chaotic
 _KIND_LABELS = ("synchronisation (P1)", "subharmonic (Pn)", "beat (quasi-periodic)", "chaos")
@@ -128,4 +129,69 @@ def basins_figure(bas, stem):
     ax.set_xlabel("x")
     ax.set_ylabel("x'")
     ax.set_title("(b) the attractors' strobe points", fontsize=9)
+    return _save(fig, stem)
+
+
+def discover_figure(disc, ver, stem):
+    """(a) the record's stroboscopic points over the discovered model's; (b) the
+    coefficients with their standard errors (bars: 2 SE); (c) the energy distance
+    against its noise floor (random halves of the record)."""
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8),
+                             gridspec_kw={"width_ratios": [1.3, 1, 1]})
+    ax = axes[0]
+    ms, rs = ver.model_strobe, ver.record_strobe
+    if len(ms):
+        ax.plot(ms[:, 0], ms[:, 1], ".", ms=1.5, color="tab:orange", alpha=0.6,
+                label=f"discovered model ({len(ms)}, {ver.regime_model})")
+    ax.plot(rs[:, 0], rs[:, 1], ".", ms=4, color="k",
+            label=f"record ({len(rs)}, {ver.regime_record})")
+    ax.set_xlabel("x")
+    ax.set_ylabel("x'")
+    ax.legend(loc="upper right", fontsize=8)
+    L = ver.lyapunov
+    lyap = f"model lambda1 = {L['value']:.4f} +- {L['stderr']:.4f}" if L else \
+        f"model diverged: {ver.diverged}"
+    ax.set_title(f"(a) stroboscopic points at t = 2 pi k / nu\n{lyap}", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax = axes[1]
+    names = list(disc.coefficients)
+    c = np.array([disc.coefficients[k] for k in names])
+    se = np.array([disc.standard_errors[k] for k in names])
+    y = np.arange(len(names))
+    ax.barh(y, c, xerr=2 * se, color="tab:blue", alpha=0.7, capsize=3)
+    ax.set_yticks(y, [f"{k}\n{ci:.4f} +- {si:.4f}" for k, ci, si in zip(names, c, se,
+                                                                          strict=True)],
+                  fontsize=8)
+    ax.axvline(0, color="k", lw=0.5)
+    ax.set_title("(b) coefficients of x'' = ...\n(error bars: 2 SE, block bootstrap)",
+                 fontsize=9)
+    ax.grid(alpha=0.3, axis="x")
+    ax = axes[2]
+    hi = max(ver.floor_q95 * 1.5, ver.energy_distance * 1.1 if np.isfinite(
+        ver.energy_distance) else 0.0)
+    hi = hi if np.isfinite(hi) and hi > 0 else 1.0
+    if ver.floor_samples is not None and len(ver.floor_samples):
+        ax.hist(ver.floor_samples, bins=30, range=(0, hi), color="tab:green", alpha=0.4,
+                label="floor: record half vs half")
+        ax.hist(ver.test_samples, bins=30, range=(0, hi), color="tab:red", alpha=0.4,
+                label="record half vs model")
+    ax.axvline(ver.floor_q95, color="tab:green", ls="--",
+               label=f"noise floor q95 {ver.floor_q95:.3g}")
+    ax.axvline(ver.floor_median, color="tab:green", lw=0.8,
+               label=f"noise floor median {ver.floor_median:.3g}")
+    if np.isfinite(ver.energy_distance):
+        ax.axvline(ver.energy_distance, color="tab:red", lw=2,
+                   label=f"record vs model {ver.energy_distance:.3g}")
+    ax.set_xlim(0, hi)
+    ax.set_ylabel("resamples")
+    ax.legend(fontsize=8, loc="upper right")
+    ax.set_xlabel("energy distance of strobe points (scaled by the record's sd)", fontsize=8)
+    verdict = "consistent" if ver.consistent else "INCONSISTENT"
+    ax.set_title(f"(c) {verdict}\n(rule: median distance <= floor q95, and the same regime)",
+                 fontsize=9)
+    eq = "x'' = " + " ".join(f"{v:+.4g} {k}" if k != "1" else f"{v:+.4g}"
+                             for k, v in disc.model.terms.items())
+    eq += f" {disc.model.forcing:+.4g} B cos(nu t)"
+    fig.suptitle(f"discovered: {eq};  B = {disc.model.B:g}, nu = {disc.model.nu:g}",
+                 fontsize=10)
     return _save(fig, stem)

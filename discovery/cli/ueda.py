@@ -3,12 +3,17 @@
 ``vidi ueda attractor`` - one attractor: strobe points, the two Lyapunov exponents with
 standard errors, the regime with its evidence, figures (optionally the coexisting
 attractors from a grid of initial states).  ``vidi ueda chart`` - the regime chart over
-``(nu, B)`` in parallel processes.
+``(nu, B)`` in parallel processes.  ``vidi ueda simulate`` - a noisy record ``t, x`` (CSV)
+of a model.  ``vidi ueda discover`` - the equation recovered from a record with known
+forcing (weak-form sparse regression, bootstrap standard errors), verified by simulation
+against the record's attractor (energy distance of strobe points against a noise floor,
+Lyapunov exponent, regime).
 """
 
 import argparse
 import csv
 import sys
+from dataclasses import replace
 
 import numpy as np
 
@@ -124,6 +129,102 @@ def run_chart(args):
     return 0
 
 
+def run_simulate(args):
+    import hashlib
+    import json
+    import time
+
+    from .._io import atomic_write_text, check_output, to_jsonable
+    from ..oscillator.discover import simulate_record
+
+    out = check_out(args, kind="file")
+    if out.suffix.lower() != ".csv":
+        raise InputError(f"--out {args.out!r} must name a .csv file, e.g. D.csv")
+    summary_path = out.with_suffix(".summary.json")
+    check_output(summary_path, [], kind="file", option="--out's summary")
+    n = args.periods * args.samples_per_period
+    if n > 10_000_000:
+        raise InputError(f"--periods {args.periods} x --samples-per-period "
+                         f"{args.samples_per_period} is {n} samples; the limit is 1e7")
+    system = _system(args)
+    t0 = time.perf_counter()
+    t, x, xc, _ = simulate_record(system, args.periods, args.samples_per_period, args.noise,
+                                  args.seed, transient=args.transient,
+                                  y0=(args.x0, args.v0), integrator=args.integrator,
+                                  rtol=args.rtol)
+    if not np.all(np.isfinite(x)):
+        raise InputError("the simulation produced non-finite values; check the parameters")
+    lines = ["t,x"] + [f"{a:.12g},{b:.12g}" for a, b in zip(t, x, strict=True)]
+    csv_text = "\n".join(lines) + "\n"
+    summary = {"command": "ueda simulate", "system": system.as_dict(),
+               "samples": int(t.size), "periods": args.periods,
+               "samples_per_period": args.samples_per_period,
+               "noise": {"fraction_of_range": args.noise,
+                         "sd": float(args.noise * np.ptp(xc)),
+                         "x_range": [float(xc.min()), float(xc.max())]},
+               "integrator": args.integrator, "seconds": time.perf_counter() - t0,
+               "outputs": {out.name: {"sha256": hashlib.sha256(csv_text.encode()).hexdigest()}},
+               **provenance(vars(args))}
+    atomic_write_text(out, csv_text)
+    atomic_write_text(summary_path, json.dumps(to_jsonable(summary), indent=2) + "\n")
+    print(f"wrote {out} ({t.size} samples, {args.periods} periods of {system.model}, "
+          f"{args.samples_per_period} samples per period, noise {args.noise:g} of the range) "
+          f"and {summary_path}")
+    return 0
+
+
+def _forcing(args):
+    from ..oscillator import MODELS
+
+    if args.model is None and (args.B is None or args.nu is None):
+        raise InputError("give the forcing: --B and --nu (e.g. --B 0.35 --nu 1.02), or --model "
+                         "negres|duffing for its forcing")
+    base = MODELS[args.model] if args.model else {}
+    B = args.B if args.B is not None else base["B"]
+    nu = args.nu if args.nu is not None else base["nu"]
+    return B, nu
+
+
+def run_discover(args):
+    from reports.ueda_figures import discover_figure
+
+    from ..oscillator.discover import discover, read_record_csv, verify
+
+    check_out(args)
+    B, nu = _forcing(args)
+    t, x = read_record_csv(args.data)
+    d = discover(t, x, B, nu, threshold=args.threshold, half_width=args.half_width,
+                 fit_forcing=not args.fix_forcing, bootstrap=args.bootstrap,
+                 block_periods=args.block_periods, seed=args.seed)
+    sm = d.smoothed
+    if args.noise is not None:
+        sm = replace(sm, noise_sd=float(args.noise * np.ptp(x)))
+    ver = verify(d.model, t, x, smoothed=sm, transient=args.transient,
+                 periods=args.model_periods, resamples=args.resamples, seed=args.seed)
+    summary = {"command": "ueda discover", "forcing": {"B": B, "nu": nu},
+               **d.as_dict(), "verification": ver.as_dict(),
+               **provenance(vars(args), inputs={"data": args.data})}
+    with OutputDir(args.out, inputs=[args.data]) as out:
+        discover_figure(d, ver, str(out.path("discover")))
+        np.savetxt(out.path("strobe_record.csv"), ver.record_strobe, delimiter=",",
+                   header="x,v", comments="")
+        np.savetxt(out.path("strobe_model.csv"), ver.model_strobe, delimiter=",",
+                   header="x,v", comments="")
+        out.write_json("summary.json", summary)
+    print(f"discovered: {d.model.sympy()}")
+    for k, c in d.coefficients.items():
+        print(f"  {k:>12}: {c: .5f} +- {d.standard_errors[k]:.5f}")
+    L = ver.lyapunov
+    lyap = f"{L['value']:.4f} +- {L['stderr']:.4f}" if L else "n/a"
+    print(f"verification: energy distance {ver.energy_distance:.4g} vs floor q95 "
+          f"{ver.floor_q95:.4g}; regime record {ver.regime_record}, model "
+          f"{ver.regime_model}; model lyapunov {lyap}: "
+          f"{'consistent' if ver.consistent else 'INCONSISTENT'}")
+    print(f"outputs in {args.out}/: summary.json, discover.png, discover.pdf, "
+          "strobe_record.csv, strobe_model.csv")
+    return 0
+
+
 def _add_system_options(s, chart=False):
     s.add_argument("--model", choices=("negres", "duffing"), default="negres",
                    help="negres: x'' - mu (1 - gamma x^2) x' + x^3 = B cos(nu t) (mu 0.2, "
@@ -143,7 +244,7 @@ def _add_system_options(s, chart=False):
 
 def register(sub):
     u = sub.add_parser("ueda", help="Ueda's forced oscillators: attractors, Lyapunov "
-                       "exponents, regime charts")
+                       "exponents, regime charts, equation discovery")
     usub = u.add_subparsers(dest="ueda_command", required=True, metavar="SUBCOMMAND",
                             parser_class=type(u))
     a = usub.add_parser("attractor", help="one attractor: strobe points, exponents, regime, "
@@ -180,3 +281,53 @@ def register(sub):
                    "is not a terminal")
     c.add_argument("--out", required=True, help="output directory")
     c.set_defaults(func=run_chart)
+    m = usub.add_parser("simulate", help="a noisy record t, x (CSV) of a model, for discover")
+    _add_system_options(m)
+    m.set_defaults(rtol=1e-10)
+    m.add_argument("--periods", type=integer(2, 10**6), default=200,
+                   help="forcing periods recorded (200)")
+    m.add_argument("--samples-per-period", type=integer(8, 10**4), default=40,
+                   help="samples per forcing period (40)")
+    m.add_argument("--noise", type=number(0, 1), default=0.0,
+                   help="Gaussian noise on x, standard deviation as a fraction of x's range, "
+                   "0..1 (0)")
+    m.add_argument("--seed", type=integer(0), default=0, help="noise seed (0)")
+    m.add_argument("--transient", type=integer(0, 10**6), default=200,
+                   help="periods discarded before the record (200)")
+    m.add_argument("--x0", type=number(-1e3, 1e3), default=0.1, help="initial x (0.1)")
+    m.add_argument("--v0", type=number(-1e3, 1e3), default=0.0, help="initial x' (0)")
+    m.add_argument("--integrator", choices=("compiled", "scipy"), default="compiled",
+                   help="compiled (Dormand-Prince kernel) or scipy (solve_ivp DOP853, the "
+                   "independent path) (compiled)")
+    m.add_argument("--out", required=True, help="output CSV (columns t, x); the summary "
+                   "goes to OUT.summary.json")
+    m.set_defaults(func=run_simulate)
+    d = usub.add_parser("discover", help="recover the equation from a record t, x with "
+                        "known forcing, and verify it by simulation")
+    d.add_argument("--data", required=True, help="CSV with columns t (uniform) and x")
+    d.add_argument("--model", choices=("negres", "duffing"),
+                   help="take the forcing B, nu from this model (override with --B, --nu)")
+    d.add_argument("--B", type=number(-1e3, 1e3), help="forcing amplitude")
+    d.add_argument("--nu", type=number(0, 100, lo_open=True), help="forcing angular "
+                   "frequency, > 0")
+    d.add_argument("--noise", type=number(0, 1), help="known noise sd as a fraction of x's "
+                   "range (default: estimated from the smoothing residual)")
+    d.add_argument("--threshold", type=number(0, 1), default=0.02,
+                   help="STLSQ threshold on scaled coefficients (0.02)")
+    d.add_argument("--half-width", type=integer(2, 10**4), help="test-window half width in "
+                   "samples (a quarter period, at least 7)")
+    d.add_argument("--fix-forcing", action="store_true", help="fix the forcing's "
+                   "coefficient at 1 instead of fitting it")
+    d.add_argument("--bootstrap", type=integer(0, 10**5), default=200,
+                   help="block-bootstrap resamples for the standard errors (200)")
+    d.add_argument("--block-periods", type=integer(1, 10**4), default=4,
+                   help="bootstrap block length in forcing periods (4)")
+    d.add_argument("--model-periods", type=integer(50, 10**6), default=2000,
+                   help="periods of the discovered model simulated (2000)")
+    d.add_argument("--transient", type=integer(0, 10**6), default=200,
+                   help="periods of the discovered model discarded first (200)")
+    d.add_argument("--resamples", type=integer(10, 10**5), default=200,
+                   help="random halves for the energy-distance noise floor (200)")
+    d.add_argument("--seed", type=integer(0), default=0, help="seed of the resampling (0)")
+    d.add_argument("--out", required=True, help="output directory")
+    d.set_defaults(func=run_discover)

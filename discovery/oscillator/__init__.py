@@ -8,7 +8,10 @@ system (:mod:`discovery.dynamics._dopri`).
 * :class:`UedaSystem` - the system description (parameters, rhs, Jacobian, period);
 * :func:`attractor`, :func:`lyapunov`, :func:`lyapunov_two_trajectory`,
   :func:`classify`, :func:`basins`, :func:`strobe_points`, :func:`trajectory`;
-* :func:`chart` - the regime chart over ``(nu, B)`` in parallel processes.
+* :func:`chart` - the regime chart over ``(nu, B)`` in parallel processes;
+* :func:`discover` (equation discovery from a record ``t, x`` with known forcing) and
+  :func:`verify` (the discovered equation's attractor against the record's),
+  :class:`ForcedPolynomial`, :func:`simulate_record` - :mod:`.discover`.
 """
 
 from .attractor import (
@@ -26,8 +29,10 @@ from .attractor import (
     strobe_points,
     trajectory,
 )
+from .discover import Discovery, ForcedPolynomial, Verification, discover, simulate_record, verify
 from .system import MODELS, UedaSystem
 
 __all__ = ["UedaSystem", "MODELS", "Attractor", "Basins", "Lyapunov", "Regime", "attractor",
            "basins", "classify", "classify_points", "lyapunov", "lyapunov_two_trajectory",
-           "rotation_number", "strobe_points", "trajectory"]
+           "rotation_number", "strobe_points", "trajectory", "Discovery", "ForcedPolynomial",
+           "Verification", "discover", "simulate_record", "verify"]

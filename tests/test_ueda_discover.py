@@ -1,0 +1,195 @@
+"""Equation discovery for Ueda's oscillators (issue 9, section 3): recovery from noisy
+records made by scipy's solve_ivp (the independent path) and by the compiled kernel,
+verification by simulation (consistent for the true equation, inconsistent for a wrong
+one), the CLI end to end and its bad inputs."""
+
+import json
+
+import numpy as np
+import pytest
+
+from discovery.errors import InputError
+from discovery.oscillator import UedaSystem
+from discovery.oscillator.discover import (
+    FORCING,
+    ForcedPolynomial,
+    classify_record,
+    discover,
+    energy_distance,
+    simulate_record,
+    stlsq,
+    verify,
+)
+
+NEGRES = UedaSystem.from_model("negres")
+DUFFING = UedaSystem.from_model("duffing")
+TRUTH = {"negres": {"x'": 0.2, "x^2 x'": -1.6, "x^3": -1.0, FORCING: 1.0},
+         "duffing": {"x'": -0.05, "x^3": -1.0, FORCING: 1.0}}
+
+
+@pytest.fixture(scope="module")
+def records():
+    """200 periods, 40 samples per period, noise 0.2 % of x's range, scipy DOP853."""
+    out = {}
+    for name, s in (("negres", NEGRES), ("duffing", DUFFING)):
+        t, x, _, _ = simulate_record(s, 200, 40, 0.002, seed=1, transient=100,
+                                     integrator="scipy")
+        out[name] = (s, t, x)
+    return out
+
+
+@pytest.mark.parametrize("name", ["negres", "duffing"])
+def test_recovers_the_equation_from_a_scipy_record(records, name):
+    s, t, x = records[name]
+    d = discover(t, x, s.B, s.nu)
+    truth = TRUTH[name]
+    assert set(d.coefficients) == set(truth)
+    for k, v in truth.items():
+        se = d.standard_errors[k]
+        assert 0 < se < 0.02 * max(abs(v), 0.1)
+        assert abs(d.coefficients[k] - v) < 4 * se + 1e-3, (k, d.coefficients[k], se)
+    # the noise estimate (filter residual) is an upper bound where the filter window is
+    # wide against the fast oscillation (duffing: 0.0047 for 0.002)
+    assert 0.0015 < d.settings["noise_fraction_of_range"] < (0.003 if name == "negres" else 0.006)
+    assert "\\cos" in d.latex and "B" in d.latex
+
+
+def test_recovers_from_the_compiled_integrator_with_fixed_forcing():
+    t, x, _, _ = simulate_record(NEGRES, 150, 30, 0.005, seed=2, transient=100)
+    d = discover(t, x, NEGRES.B, NEGRES.nu, fit_forcing=False)
+    assert d.coefficients[FORCING] == 1.0 and d.standard_errors[FORCING] == 0.0
+    assert set(d.terms) == {"x'", "x^2 x'", "x^3"}
+    for k in d.terms:
+        assert abs(d.coefficients[k] - TRUTH["negres"][k]) < 4 * d.standard_errors[k] + 2e-3
+
+
+def test_stlsq_drops_small_terms():
+    rng = np.random.default_rng(0)
+    G = rng.standard_normal((500, 5))
+    b = G @ np.array([1.0, 0.0, -0.5, 0.0, 0.0]) + 1e-3 * rng.standard_normal(500)
+    c, sup = stlsq(G, b, 0.05)
+    assert list(sup) == [True, False, True, False, False]
+    assert np.allclose(c, [1.0, 0, -0.5, 0, 0], atol=1e-3)
+
+
+def test_equation_as_sympy_and_latex():
+    m = ForcedPolynomial.from_system(NEGRES)
+    assert m.terms == {"x'": 0.2, "x^3": -1.0, "x^2 x'": pytest.approx(-1.6)}
+    assert "Derivative" in str(m.sympy()) and "cos" in m.latex()
+    y = np.array([0.3, -0.2])
+    assert np.allclose(m.rhs(1.3, y), NEGRES.rhs(1.3, y))
+
+
+def test_energy_distance():
+    rng = np.random.default_rng(0)
+    a = rng.standard_normal((300, 2))
+    assert energy_distance(a, a) == pytest.approx(0.0, abs=1e-12)
+    assert energy_distance(a, a + 1.0) > 0.5
+
+
+def test_verification_accepts_the_truth_and_rejects_gamma_halved(records):
+    s, t, x = records["negres"]
+    d = discover(t, x, s.B, s.nu)
+    good = verify(d.model, t, x, periods=1500)
+    assert good.consistent and good.energy_consistent
+    assert good.regime_record == "chaotic" and good.regime_model == "chaotic"
+    assert good.lyapunov["value"] > 3 * good.lyapunov["stderr"]
+    assert 0.08 < good.lyapunov["value"] < 0.11  # the broken egg: 0.097
+    bad = verify(ForcedPolynomial.from_system(s.with_params(gamma=4.0)), t, x, periods=1500)
+    assert not bad.consistent and not bad.energy_consistent
+    assert bad.energy_distance > 10 * bad.floor_q95
+    assert bad.regime_model != "chaotic"
+
+
+def test_verification_of_duffing_and_a_wrong_damping(records):
+    s, t, x = records["duffing"]
+    v = verify(ForcedPolynomial.from_system(s), t, x, periods=1500)
+    assert v.consistent and v.regime_record == "chaotic"
+    bad = verify(ForcedPolynomial.from_system(s.with_params(k=0.1)), t, x, periods=1500)
+    assert not bad.consistent
+
+
+def test_a_diverging_model_is_inconsistent(records):
+    s, t, x = records["negres"]
+    m = ForcedPolynomial.from_terms({"x'": 0.2, "x^3": 1.0}, s.B, s.nu)  # x'' = +x^3 ...
+    v = verify(m, t, x, periods=200)
+    assert not v.consistent and v.diverged and v.regime_model == "diverged"
+
+
+def test_record_classification_of_a_periodic_record():
+    s = UedaSystem.from_model("negres", B=0.55, nu=1.1)  # entrained (P1) on the chart
+    t, x, _, _ = simulate_record(s, 60, 40, 0.002, seed=0, transient=300)
+    d = discover(t, x, s.B, s.nu)
+    v = verify(d.model, t, x, periods=300, resamples=50)
+    assert v.regime_record == "P1" and v.regime_model == "P1"
+    reg = classify_record(np.random.default_rng(0).standard_normal((100, 2)), 1e-3)
+    assert reg.regime == "chaotic"
+
+
+def test_bad_inputs():
+    t = np.linspace(0, 100, 1000)
+    with pytest.raises(InputError):
+        discover(t[:10], np.sin(t[:10]), 0.35, 1.02)
+    with pytest.raises(InputError):
+        discover(t, np.zeros_like(t), 0.35, 1.02)
+    with pytest.raises(InputError):
+        discover(np.r_[t[:500], t[500:] + 0.05], np.sin(t), 0.35, 1.02)
+    with pytest.raises(InputError):
+        discover(t, np.sin(t), 0.35, -1.0)
+    with pytest.raises(InputError):
+        discover(t, np.sin(t), 0.35, 100.0)  # 0.6 samples per period
+
+
+# ------------------------------------------------------------------ CLI
+@pytest.fixture
+def vidi():
+    from discovery.cli import main
+
+    return main
+
+
+def test_cli_simulate_and_discover(vidi, tmp_path):
+    data = tmp_path / "D.csv"
+    assert vidi(["ueda", "simulate", "--model", "negres", "--periods", "150",
+                 "--samples-per-period", "40", "--noise", "0.002", "--seed", "0",
+                 "--transient", "100", "--out", str(data)]) == 0
+    meta = json.loads((tmp_path / "D.summary.json").read_text())
+    assert meta["samples"] == 6001 and meta["noise"]["fraction_of_range"] == 0.002
+    assert data.read_text().splitlines()[0] == "t,x"
+    out = tmp_path / "res"
+    assert vidi(["ueda", "discover", "--data", str(data), "--nu", "1.02", "--B", "0.35",
+                 "--model-periods", "1000", "--resamples", "100", "--out", str(out)]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert set(s["terms"]) == {"x'", "x^2 x'", "x^3"}
+    assert set(s["coefficients"]) == set(s["standard_errors"]) == set(TRUTH["negres"])
+    assert abs(s["coefficients"]["x^2 x'"] + 1.6) < 4 * s["standard_errors"]["x^2 x'"] + 1e-3
+    v = s["verification"]
+    assert {"energy_distance", "floor_q95", "consistent", "regime_record", "regime_model",
+            "lyapunov"} <= set(v)
+    assert v["consistent"] and v["regime_record"] == v["regime_model"] == "chaotic"
+    assert "\\cos" in s["latex"] and "versions" in s and s["inputs"]["data"]["sha256"]
+    assert (out / "discover.png").exists() and (out / "strobe_model.csv").exists()
+
+
+def test_cli_bad_inputs_exit_2(vidi, tmp_path, capsys):
+    out = str(tmp_path / "o")
+    missing = str(tmp_path / "nope.csv")
+    assert vidi(["ueda", "discover", "--data", missing, "--model", "negres", "--out", out]) == 2
+    bad = tmp_path / "bad.csv"
+    bad.write_text("time,pos\n0,1\n1,2\n")
+    assert vidi(["ueda", "discover", "--data", str(bad), "--model", "negres",
+                 "--out", out]) == 2
+    txt = tmp_path / "txt.csv"
+    txt.write_text("t,x\n" + "".join(f"{k},{np.sin(k)}\n" for k in range(100)) + "5,abc\n")
+    assert vidi(["ueda", "discover", "--data", str(txt), "--model", "negres",
+                 "--out", out]) == 2
+    good = tmp_path / "g.csv"
+    good.write_text("t,x\n" + "".join(f"{0.15 * k},{np.sin(0.15 * k)}\n" for k in range(400)))
+    assert vidi(["ueda", "discover", "--data", str(good), "--out", out]) == 2  # no forcing
+    assert vidi(["ueda", "discover", "--data", str(good), "--nu", "0", "--B", "1",
+                 "--out", out]) == 2
+    assert vidi(["ueda", "simulate", "--out", str(tmp_path / "D.txt")]) == 2
+    assert vidi(["ueda", "simulate", "--noise", "2", "--out", str(tmp_path / "D.csv")]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and "internal error" not in err
+    assert not (tmp_path / "o").exists()
