@@ -146,7 +146,7 @@ def test_discover_needs_one_scenario_per_record(two_points):
 def test_fit_cli_with_two_records_and_their_scenarios(two_points, tmp_path, capsys):
     scs, recs = two_points
     paths = []
-    for k, (sc, rec) in enumerate(zip(scs, recs, strict=True)):
+    for k, rec in enumerate(recs):
         p = tmp_path / f"r{k}.csv"
         rec.to_csv(p)
         paths.append(p)
