@@ -1,4 +1,5 @@
-"""Discovery benchmarks: certified fit time, and pysindy's ConstrainedSR3 side by side.
+"""Discovery benchmarks: certified fit time, pysindy's ConstrainedSR3 side by side, and
+the wall time of ``verify`` and ``discover`` (:func:`bench_pipeline`).
 
 Same data for both: 10^4 contact samples of a run-up record (paper scenario, law
 (11) + 2e10 z zd, 1 % noise), a 10-term library (poly:3 + z^1.5).  ConstrainedSR3
@@ -93,7 +94,51 @@ def bench_discovery():
     return out
 
 
+def bench_pipeline(repeat=3):
+    """Wall time of the public entry points, as ratios to one steady state of the same
+    scenario and law measured in the same run (the unit of every simulation they make):
+
+    * ``discovery.verify.verify`` on a 20-period steady record (paper scenario, law
+      (11), 1 % force noise, positions and velocities; best of ``repeat``): one
+      steady state from the measured state, the alignment, a 16-replicate noise floor
+      and the check from the scenario's default start;
+    * ``discovery.discover(scenario, record, library=..., refine=True)`` with
+      ``poly:2`` and ``poly:3`` on a 100-period run-up from rest (law (11) + 2e10 z zd,
+      1 % noise; one run each: regression, shortlist, refinement by simulation,
+      verification of every shortlisted model).
+    """
+    from discovery import discover
+    from discovery.dynamics.steady_state import steady_state
+    from discovery.verify import verify
+
+    sc = load_scenario("paper")
+    steady_state(sc, sc.law)  # compiled kernels loaded
+    t_one, _ = _best(lambda: steady_state(sc, sc.law), repeat=5)
+    rec = synthesize(sc, sc.law, periods=20, fs=20000, noise=0.01, seed=1)
+    t_ver, res = _best(lambda: verify(sc, rec, sc.law), repeat=repeat)
+    out = {"one_steady_state_seconds": t_one,
+           "verify_20_periods": {"seconds": t_ver, "ratio_to_one_steady_state": t_ver / t_one,
+                                 "consistent": res.consistent}}
+    law = ForceLaw.parse(TRUE)
+    t_ss, _ = _best(lambda: steady_state(sc, law), repeat=5)
+    run_up = synthesize(sc, law, periods=100, noise=0.01, seed=1, from_rest=True)
+    out["discover_one_steady_state_seconds"] = t_ss
+    for lib in ("poly:2", "poly:3"):
+        t0 = time.perf_counter()
+        try:
+            r = discover(sc, run_up, library=lib, refine=True)
+        except Exception as exc:  # noqa: BLE001 - a benchmark reports, it does not stop
+            out[f"discover_{lib}"] = {"error": f"{type(exc).__name__}: {exc}"}
+            continue
+        t = time.perf_counter() - t0
+        out[f"discover_{lib}"] = {"seconds": t, "ratio_to_one_steady_state": t / t_ss,
+                                  "law": r.selected.law.to_text(),
+                                  "consistent": getattr(r.selected, "consistent", None)}
+    return out
+
+
 if __name__ == "__main__":
     import json
 
-    print(json.dumps(bench_discovery(), indent=2, default=str))
+    print(json.dumps({"discovery": bench_discovery(), "pipeline": bench_pipeline()}, indent=2,
+                     default=str))

@@ -10,7 +10,10 @@ Writes ``bench/results.json``.  Figures:
    0.1 % of the true alphas (goal: a method needing >= 5x fewer than coordinate
    descent);
 4. discovery (``bench/discovery_bench.py``): certified fit of a 10-term library on
-   10^4 samples (goal <= 1 s), and pysindy's ConstrainedSR3 side by side.
+   10^4 samples (goal <= 1 s), and pysindy's ConstrainedSR3 side by side;
+5. the public pipeline (``bench/discovery_bench.py``): ``verify`` on a 20-period record
+   and ``discover(..., library="poly:2" / "poly:3", refine=True)`` on a run-up record,
+   as ratios to one steady state measured in the same run.
 """
 
 import json
@@ -105,12 +108,13 @@ def bench_identify(sc):
 
 
 def main():
-    from discovery_bench import bench_discovery
+    from discovery_bench import bench_discovery, bench_pipeline
 
     sc = load_scenario("paper")
     steady_state(sc, sc.law)  # compile / load the cached kernels first
     results = {"kernel_vs_scipy": bench_kernel(sc), "landscape_41x41": bench_landscape(sc),
                "identification": bench_identify(sc), "discovery": bench_discovery(),
+               "pipeline": bench_pipeline(),
                "cores": os.cpu_count(),
                **provenance({"scenario": "paper"})}
     text = json.dumps(to_jsonable(results), indent=2) + "\n"
@@ -132,6 +136,17 @@ def main():
           f"ConstrainedSR3 {d['time_ratio_pysindy_over_ours']:.0f}x slower, exact zeros "
           f"{ps_['exact_zeros']} vs {ours['exact_zeros']}, support recovered "
           f"{ps_['support_recovered_1e-3_cutoff']} vs {ours['support_recovered']}")
+    p = results["pipeline"]
+    v = p["verify_20_periods"]
+    print(f"verify, 20-period record: {v['seconds']:.2f} s ({v['ratio_to_one_steady_state']:.0f}"
+          f" x one steady state of {p['one_steady_state_seconds'] * 1e3:.1f} ms)")
+    for lib in ("poly:2", "poly:3"):
+        d_ = p[f"discover_{lib}"]
+        if "error" in d_:
+            print(f"discover {lib}: failed: {d_['error']}")
+        else:
+            print(f"discover {lib}, refine: {d_['seconds']:.1f} s "
+                  f"({d_['ratio_to_one_steady_state']:.0f} x one steady state)")
     print("wrote bench/results.json")
     return 0
 

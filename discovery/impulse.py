@@ -321,6 +321,42 @@ def _refine_onset(t, zeta, s, t_on, max_back):
     return t[k - 1] + (0.0 - zeta[k - 1]) / (zeta[k] - zeta[k - 1]) * h
 
 
+def _merge_unseparated(t, zeta, runs):
+    """Runs of force whose gap has no separation are one contact: when ``zeta`` never
+    goes clearly below zero between them (by three times its noise), the force only
+    dipped below the threshold within a contact (a near-loss), and the second run is
+    neither a new impact nor, however large, the main one (its "onset" would be a
+    point inside the contact)."""
+    if len(runs) < 2:
+        return runs
+    sz = estimate_noise(zeta, order=3)
+    out = [runs[0]]
+    for r in runs[1:]:
+        t_on, t_off, s = out[-1]
+        a, b = int(np.searchsorted(t, t_off)), r[2]
+        if b > a and np.min(zeta[a:b]) > -3.0 * sz:
+            out[-1] = (t_on, r[1], s)
+        else:
+            out.append(r)
+    return out
+
+
+def _bracket_onset(t, F, s, t_off, thr, t_on):
+    """A ``zeta`` onset kept where the force allows it: not after sample ``s``, the first
+    one above the threshold (the contact has begun there), and, when the force *jumps*
+    at ``s`` (from at most half the threshold to a quarter of the contact's peak or
+    more: a viscous contact's ``F(0+)``), not before sample ``s - 1`` either (the force
+    was still zero there).  A noisy ``zeta`` can be a sample or two off; a force jump
+    brackets the onset within one sample."""
+    hi = t[s]
+    lo = -np.inf
+    if s >= 1:
+        e = max(int(np.searchsorted(t, t_off)), s + 1)
+        if F[s - 1] <= 0.5 * thr and F[s] >= 0.25 * float(np.max(F[s:e])):
+            lo = t[s - 1]
+    return float(min(max(t_on, lo), hi))
+
+
 def _edge_params(t, period, min_samples=3):
     """Debounce length and edge extrapolation bound [samples] for a sampling."""
     dt = float(np.median(np.diff(t)))
@@ -348,7 +384,8 @@ def _sampled_support(tau, F, thr, period, noise=0.0):
 
 def _edges(t, F, thr, min_len, max_extrap=4.0, noise=0.0):
     """Sub-sample start/end times of the runs where F > thr (runs shorter than
-    ``min_len`` samples dropped, gaps shorter than ``min_len`` closed).
+    ``min_len`` samples dropped unless they last 3 samples and peak above ``3 thr``;
+    gaps shorter than ``min_len``, or not going below ``thr - 3 noise``, closed).
 
     An edge whose step between samples clearly exceeds the noise (``> 3 noise``) is
     extrapolated along its slope to zero force, by at most ``max_extrap`` samples, so
@@ -365,11 +402,18 @@ def _edges(t, F, thr, min_len, max_extrap=4.0, noise=0.0):
     runs = [[s, e] for s, e in zip(starts, ends, strict=True)]
     merged = []
     for r in runs:
-        if merged and r[0] - merged[-1][1] < min_len:
+        # a gap is closed when it is short, or when it never goes clearly below the
+        # threshold (a dip of the force within the noise of it: noise must not decide
+        # whether a contact is one or two)
+        if merged and (r[0] - merged[-1][1] < min_len or (
+                noise > 0 and np.min(F[merged[-1][1]:r[0]]) > thr - 3.0 * noise)):
             merged[-1][1] = r[1]
         else:
             merged.append(r)
-    runs = [r for r in merged if r[1] - r[0] >= min_len]
+    # short runs are threshold flicker, unless the force clearly stands out: a contact
+    # shorter than the debounce length (< 1 % of a period) is still a contact
+    runs = [r for r in merged if r[1] - r[0] >= min_len
+            or (r[1] - r[0] >= 3 and np.max(F[r[0]:r[1]]) >= 3.0 * thr)]
     out = []
     for s, e in runs:
         if s == 0 or e >= len(F):
@@ -436,8 +480,10 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
         runs = [r for r, p in zip(runs, pk, strict=True) if p >= max(3 * thr, 0.02 * pk.max())]
     if zeta is not None:
         zeta = np.asarray(zeta, dtype=float)
+        runs = _merge_unseparated(t, zeta, runs)
         back = 0.25 * period / dt
-        runs = [(_refine_onset(t, zeta, s, t_on, back), t_off, s) for t_on, t_off, s in runs]
+        runs = [(_bracket_onset(t, F, s, t_off, thr, _refine_onset(t, zeta, s, t_on, back)),
+                 t_off, s) for t_on, t_off, s in runs]
     if not runs:
         raise InputError("no contact found in the force record (no run of samples above "
                          f"the threshold {thr:.3g} N); check the F column and its units")
@@ -486,8 +532,13 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
         coef = np.polyfit(t[s:s + 3] - t_on, F[s:s + 3], 2)
         head = tau < t[s] - t_on
         vals[head] = np.maximum(np.polyval(coef, tau[head]), 0.0)
-        # at the cycle's end hold the last sample before the next onset (left limit)
+        # at the cycle's end hold the last sample before the next onset (left limit): the
+        # next cycle's own onset when it was recorded (the cycles' onsets differ by up to
+        # a sample or two: noise, sampling), else one cycle after this one
         last = int(np.searchsorted(t, t_on + W - (t[s] - t_on), "right")) - 1
+        nxt = onsets[(onsets > t_on + W - 0.02 * period) & (onsets < t_on + W + 0.02 * period)]
+        if nxt.size:
+            last = min(last, int(np.searchsorted(t, nxt.min(), "left")) - 1)
         last = min(last, len(t) - 1)
         tail = t_on + tau > t[last]
         vals[tail] = F[last]
@@ -538,13 +589,22 @@ def _steady_tail(stack, sigma):
 
 
 def _first_after(t, F, t_on, thr, exact_onset):
-    """Index of the first sample inside the contact: just after an exact (zeta) onset;
-    after an onset estimated from the force, the first one above half the threshold
-    (a sample before a force jump is still pre-contact)."""
+    """Index of the first sample inside the contact.
+
+    After an onset estimated from the force, the first one above half the threshold
+    (a sample before a force jump is still pre-contact).  After a ``zeta`` onset, the
+    first sample after it, unless the force *jumps* from below half the threshold to
+    above it within the next three samples: a noisy ``zeta`` can put the onset a sample
+    or two early, and the zero force before the jump must not be taken for ``F(0+)``
+    (a smooth rise keeps its small first samples)."""
     k = int(np.searchsorted(t, t_on, "right"))
     if not exact_onset:
         while k < len(F) - 3 and F[k] <= 0.5 * thr:
             k += 1
+        return k
+    for j in range(k, min(k + 3, len(F) - 3)):
+        if F[j] > thr:
+            return j if j > k and F[j - 1] <= 0.5 * thr else k
     return k
 
 

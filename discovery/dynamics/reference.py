@@ -3,6 +3,29 @@
 Written separately from the compiled kernel (its own right-hand side, force
 evaluation and mode logic in plain numpy) so that agreement between the two is
 evidence, not tautology.  Used by the tests and the benchmarks only.
+
+Modes and switching surfaces are those of the kernel (``free``, ``load``,
+``unload``, ``clipped``; onset/loss ``zeta = 0``, unload/reload ``dzeta = 0``,
+release/resume ``P = 0``).  Restarting at events needs care where a segment starts
+*on* a switching surface (it always does: the event that ended the previous segment
+put it there, and coinciding surfaces, e.g. ``P(zeta, 0) = k zeta`` and ``zeta``,
+put it on several):
+
+* a surface function whose value at the start is within rounding of zero (less than
+  its rate of change times ``1e-12`` of the time scale) takes the sign of where the
+  flow goes next (a short Heun step of the mode's vector field), not its rounded
+  value: if that is across the surface the event happens at once (a zero-length
+  segment); otherwise the function is held on its side for an instant, so scipy
+  neither fires it at the start (an exact 0 counts as a crossing) nor misses a
+  crossing back within the first step (a contact loss followed by a re-contact);
+* of several events at the same instant the lowest index wins (the kernel's rule:
+  contact loss before the force reaching zero);
+* a contact mode is never entered with ``zeta <= 0`` (after a release or resume
+  that ends a hair past the loss), and the reported force is evaluated at
+  ``max(zeta, 0)``, so the contact is never adhesive.
+
+A run of more than ``_MAX_ZERO_LENGTH`` zero-length segments at one instant raises
+:class:`~discovery.errors.IntegrationError` (chattering between modes).
 """
 
 import numpy as np
@@ -12,13 +35,25 @@ from ..errors import IntegrationError
 
 __all__ = ["reference_simulate"]
 
+_TREND_STEP = 1e-8     # Heun step for the trend of a surface function [periods]
+_ON_SURFACE = 1e-12    # "on the surface": within this time [max(t, T)] of it at its rate
+_HOLD = 10.0           # a held function keeps its start value for _HOLD x that time
+_MAX_ZERO_LENGTH = 8   # zero-length segments in a row before raising
+
 
 def _poly(law, z, zd):
     return float(sum(c * np.sign(z) ** (t.a > 0) * abs(z) ** t.a * np.sign(zd) ** (t.b > 0)
                      * abs(zd) ** t.b for c, t in zip(law.coefficients, law.terms, strict=True)))
 
 
-def _force(law, mode, z, v):
+def _force(law, mode, z, v, clamp=False):
+    """Contact force of a mode.  Inside the integration the vector field is extended
+    smoothly past the loss surface (odd extension of ``P``: a Runge-Kutta step that
+    straddles the loss samples it there, and a kink would spoil the step's accuracy,
+    ~1e-5 of the ranges after a run-up instead of ~1e-8); the force *reported*
+    (``clamp``) is that at ``max(zeta, 0)``, never adhesive."""
+    if clamp:
+        z = max(z, 0.0)
     if mode == "load":
         return _poly(law, z, v)
     if mode == "unload":
@@ -56,16 +91,44 @@ def _events(law, mode):
 
 
 def _after(law, kind, y):
-    z, v = max(y[0] - y[2], 0.0), y[1] - y[3]
+    z, v = y[0] - y[2], y[1] - y[3]
     if kind == "loss":
         return "free"
+    if kind in ("release", "resume") and z <= 0:
+        return "free"  # the force reached 0 at (or a hair past) the contact loss
+    z = max(z, 0.0)
     if kind == "release":
         return "clipped"
     if kind == "resume":  # P crossed to positive: the force is on again
         return "load" if v > 0 else "unload"
-    if kind == "unload" or (kind in ("onset", "resume") and v <= 0):
+    if kind == "unload" or (kind == "onset" and v <= 0):
         return "unload" if _poly(law, z, 0.0) >= 0 else "clipped"
     return "load" if _poly(law, z, max(v, 0.0)) >= 0 else "clipped"
+
+
+def _surface_start(evs, rhs, t, y, dt_trend, tau_on):
+    """Each surface function's value at the start of a segment and where it goes.
+
+    Returns ``(g0, on, trend)``: values, whether each is on its surface (within
+    rounding: ``|g0| <= |rate| tau_on``), and the sign of its change along the flow
+    over ``dt_trend`` (a Heun step, so a grazing start with zero rate sees the
+    curvature)."""
+    f0 = np.asarray(rhs(t, y), dtype=float)
+    yp = y + dt_trend * f0
+    y1 = y + 0.5 * dt_trend * (f0 + np.asarray(rhs(t + dt_trend, yp), dtype=float))
+    g0 = np.array([fn(t, y) for fn, _, _ in evs])
+    dg = np.array([fn(t + dt_trend, y1) for fn, _, _ in evs]) - g0
+    on = np.abs(g0) <= np.abs(dg) * (tau_on / dt_trend)
+    on |= g0 == 0.0
+    return g0, on, np.sign(dg)
+
+
+def _crossing_now(evs, on, trend):
+    """Index of the lowest surface function on its surface and moving across it now."""
+    for i, (_, direction, _) in enumerate(evs):
+        if on[i] and trend[i] == direction:
+            return i
+    return None
 
 
 def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, atol=None,
@@ -79,6 +142,7 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
         ``(t, kind, y)``; ``y_final``; ``nfev``.
     """
     m1, m2, k1, c1, A, om, g = scenario.params()
+    T = scenario.period
     y = scenario.initial_state() if y0 is None else np.array(y0, dtype=float)
     if atol is None:
         x, v = scenario.scales()
@@ -88,39 +152,76 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
     out_y = np.full((4, te.size), np.nan)
     out_f = np.full(te.size, np.nan)
     mode = _mode_of(law, y)
-    events, nfev = [], 0
-    while t < t1:
-        def rhs(tt, yy, mode=mode):
+    events, nfev, zero_length = [], 0, 0
+
+    def record(kind, yy):
+        events.append((t, kind, yy.copy()))
+        if len(events) > max_events:
+            raise IntegrationError("reference integration: too many events")
+
+    def make_rhs(mode):
+        def rhs(tt, yy):
             f = _force(law, mode, yy[0] - yy[2], yy[1] - yy[3])
             return [yy[1], -(c1 * yy[1] + k1 * yy[0] + A * np.sin(om * tt) + m1 * g + f) / m1,
                     yy[3], f / m2 - g]
+        return rhs
 
+    while t < t1:
+        rhs = make_rhs(mode)
         evs = _events(law, mode)
+        tau_on = _ON_SURFACE * max(abs(t), T)
+        g0, on, trend = _surface_start(evs, rhs, t, y, _TREND_STEP * T, tau_on)
+        i_now = _crossing_now(evs, on, trend)
+        if i_now is not None:  # an event at the segment's start: a zero-length segment
+            zero_length += 1
+            if zero_length > _MAX_ZERO_LENGTH:
+                raise IntegrationError(f"reference integration: the contact mode chatters at "
+                                       f"t = {t!r} ({zero_length} switches at one instant)")
+            kind = evs[i_now][2]
+            record(kind, y)
+            mode = _after(law, kind, y)
+            continue
         fns = []
-        for fn, direction, _ in evs:
-            def ev(tt, yy, fn=fn):
-                return fn(tt, yy)
+        for i, (fn, direction, _) in enumerate(evs):
+            if on[i]:
+                # held on its side (where the flow takes it) for an instant: an exact 0
+                # would count as a crossing at the start, a rounded value of the wrong
+                # sign would hide a crossing back within the first step
+                hold = -direction * max(abs(g0[i]), 1e-300)
+
+                def ev(tt, yy, fn=fn, hold=hold, t_hold=t + _HOLD * tau_on):
+                    return hold if tt <= t_hold else fn(tt, yy)
+            else:
+                def ev(tt, yy, fn=fn):
+                    return fn(tt, yy)
             ev.terminal, ev.direction = True, direction
             fns.append(ev)
+        t_start = t
         sol = solve_ivp(rhs, (t, t1), y, method=method, rtol=rtol, atol=atol, events=fns,
-                        dense_output=True, max_step=scenario.period * 0.02)
+                        dense_output=True, max_step=T * 0.02)
         nfev += sol.nfev
         if sol.status == -1:
             raise IntegrationError(f"reference integration failed: {sol.message}")
         t_end = sol.t[-1]
-        mask = (te >= t) & (te <= t_end)
+        mask = (te >= t_start) & (te <= t_end)
         if mask.any():
             ys = sol.sol(te[mask])
             out_y[:, mask] = ys
-            out_f[mask] = [_force(law, mode, w1 - w2, v1 - v2) for w1, v1, w2, v2 in ys.T]
+            out_f[mask] = [_force(law, mode, w1 - w2, v1 - v2, clamp=True)
+                           for w1, v1, w2, v2 in ys.T]
         y = sol.y[:, -1].copy()
+        t = t_end
+        if t_end - t_start > _HOLD * tau_on:
+            zero_length = 0
         if sol.status == 1:
             fired = [i for i, tev in enumerate(sol.t_events) if len(tev)]
             i = min(fired, key=lambda i: (sol.t_events[i][0], i))
-            kind = evs[i][2]
-            events.append((t_end, kind, y.copy()))
+            # a lower-index surface reached at the same instant wins the tie (contact
+            # loss before the force reaching zero, as in the kernel)
+            _, on_end, trend_end = _surface_start(evs, rhs, t, y, _TREND_STEP * T,
+                                                  _ON_SURFACE * max(abs(t), T))
+            j = _crossing_now(evs[:i], on_end[:i], trend_end[:i])
+            kind = evs[i if j is None else j][2]
+            record(kind, y)
             mode = _after(law, kind, y)
-            if len(events) > max_events:
-                raise IntegrationError("reference integration: too many events")
-        t = t_end
     return {"t": te, "y": out_y, "force": out_f, "events": events, "y_final": y, "nfev": nfev}

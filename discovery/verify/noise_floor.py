@@ -7,7 +7,8 @@ force noise of the record's estimated level and, when the onsets came from the
 penetration, a penetration signal crossing zero at every onset with the record's
 impact velocity and penetration noise.  The replicate goes through the *same*
 processing as the record (:func:`~discovery.impulse.impulse_from_samples`: onsets,
-averaging, thresholds, supports) and is compared with the stand-in by the same
+averaging, thresholds, supports), is aligned with the stand-in in the same way
+(:func:`~discovery.verify.evaluate.align`) and compared with it by the same
 criteria.  The mean over replicates is the floor; a model whose criteria are within
 a small factor of it agrees with the record as well as the truth could.
 """
@@ -16,6 +17,7 @@ import numpy as np
 
 from ..criteria import CRITERIA, evaluate_criteria
 from ..impulse import impulse_from_samples
+from .evaluate import align
 
 __all__ = ["noise_floor"]
 
@@ -77,7 +79,9 @@ def noise_floor(reference_impulse, period, dt, *, sigma_f, n_cycles, sigma_zeta=
             rep = impulse_from_samples(t, F, period, zeta=zeta, n_periods=E.n_periods)
         except ValueError:
             continue  # a replicate too noisy to find its contacts: the floor is high anyway
-        crit = evaluate_criteria(rep, E.resampled_like(rep))
+        # aligned like a record (every impact of the stand-in tried as t*): with several
+        # impacts of similar size the replicate's main impact is either one
+        crit = evaluate_criteria(rep, align(rep, E)[1])
         for n, v in crit.items():
             samples[n].append(v)
     if not samples["I2"]:
