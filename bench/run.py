@@ -13,7 +13,10 @@ Writes ``bench/results.json``.  Figures:
    10^4 samples (goal <= 1 s), and pysindy's ConstrainedSR3 side by side;
 5. the public pipeline (``bench/discovery_bench.py``): ``verify`` on a 20-period record
    and ``discover(..., library="poly:2" / "poly:3", refine=True)`` on a run-up record,
-   as ratios to one steady state measured in the same run.
+   as ratios to one steady state measured in the same run;
+6. ``explain`` on a 20-period record with the full catalogue (``bench/explain_bench.py``);
+7. Ueda's oscillator (``bench/ueda_bench.py``): one chart point against scipy, a chart's
+   wall time (and the 200x200 extrapolation), the duffing exponent per period against scipy.
 """
 
 import json
@@ -109,12 +112,14 @@ def bench_identify(sc):
 
 def main():
     from discovery_bench import bench_discovery, bench_pipeline
+    from explain_bench import bench_explain
+    from ueda_bench import bench_ueda
 
     sc = load_scenario("paper")
     steady_state(sc, sc.law)  # compile / load the cached kernels first
     results = {"kernel_vs_scipy": bench_kernel(sc), "landscape_41x41": bench_landscape(sc),
                "identification": bench_identify(sc), "discovery": bench_discovery(),
-               "pipeline": bench_pipeline(),
+               "pipeline": bench_pipeline(), "explain": bench_explain(), "ueda": bench_ueda(),
                "cores": os.cpu_count(),
                **provenance({"scenario": "paper"})}
     text = json.dumps(to_jsonable(results), indent=2) + "\n"
@@ -147,6 +152,14 @@ def main():
         else:
             print(f"discover {lib}, refine: {d_['seconds']:.1f} s "
                   f"({d_['ratio_to_one_steady_state']:.0f} x one steady state)")
+    e = results["explain"]
+    print(f"explain, 20-period record, full catalogue: {e['seconds']:.1f} s "
+          f"({e['ratio_to_one_steady_state']:.0f} x one steady state), named {e['named']}")
+    u = results["ueda"]
+    print(f"ueda chart point: {u['chart_point']['speedup']:.0f}x faster than scipy; chart "
+          f"{u['chart']['grid'][0]}x{u['chart']['grid'][1]} in {u['chart']['seconds']:.1f} s "
+          f"(200x200 extrapolated {u['chart']['extrapolated_200x200_seconds']:.0f} s); duffing "
+          f"exponent {u['lyapunov_duffing']['value']:.4f} +- {u['lyapunov_duffing']['stderr']:.4f}")
     print("wrote bench/results.json")
     return 0
 
