@@ -42,7 +42,6 @@ import secrets
 import shutil
 import subprocess
 import sys
-import tempfile
 from importlib import metadata, resources
 from pathlib import Path
 
@@ -62,6 +61,7 @@ _RESULT_FILE = re.compile(r"^[^/]+\.(json|csv|png|pdf|tex|txt|svg)$", re.IGNOREC
 _STAGING, _ASIDE, _TMP = "vidi-staging", "vidi-old", "vidi-tmp"
 _OWNED = re.compile(r"^\.(?P<name>.+)\.(?P<kind>vidi-staging|vidi-old|vidi-tmp)\.(?P<pid>\d+)-"
                     r"(?P<start>\d+)\.[0-9a-f]+$")
+_PROBE = re.compile(r"^\.vidi-probe\.(?P<pid>\d+)-(?P<start>\d+)\.[0-9a-f]+$")
 
 
 # ---------------------------------------------------------------------------- provenance
@@ -268,8 +268,10 @@ def _writable_dir(d):
         return False
     if not hasattr(os, "geteuid") or os.geteuid() != 0:
         return True
+    probe = os.path.join(d, f".vidi-probe.{os.getpid()}-{_proc_start(os.getpid())}."
+                            f"{secrets.token_hex(4)}")  # owned: clean_stale removes it
     try:
-        probe = tempfile.mkdtemp(prefix=".vidi-probe.", dir=d)
+        os.mkdir(probe)
     except OSError:
         return False
     with contextlib.suppress(OSError):
@@ -408,6 +410,10 @@ def clean_stale(target):
             if m and m["name"] == target.name and not _alive(int(m["pid"]), int(m["start"])) \
                     and e.is_dir(follow_symlinks=False) == (m["kind"] != _TMP):
                 stale.append((m["kind"], Path(e.path)))
+            m = _PROBE.match(e.name)  # a writability probe of a killed run
+            if m and not _alive(int(m["pid"]), int(m["start"])) \
+                    and e.is_dir(follow_symlinks=False):
+                stale.append(("probe", Path(e.path)))
     except OSError:
         return []
     done = []

@@ -440,7 +440,13 @@ def _warnings(selected, by_bic, stab, pairs, parts, refs, samples, refine):
                        f"{' + '.join(m.law.names)}: {m.evaluation.status}" for m in failing)
                    + "): the regression alone would mislead here")
     out.extend(_impact_warnings(pairs, parts, refs))
-    if not selected.consistent:
+    if not selected.consistent and selected.criteria and all(
+            ev.consistent or ev.extra.get("only_I4") for ev in selected.evaluations):
+        out.append("the selected model fails the consistency rule by I4 alone (the contact "
+                   "supports; I2 is within its noise floor): I4 is noise-sensitive on flat "
+                   "force tails and short contacts, so this may be the right law; compare the "
+                   "contact ends in fit_impulse before trying a larger library")
+    elif not selected.consistent:
         out.append("no shortlisted model is consistent with the record(s) within the noise "
                    "floor: try a larger library (e.g. poly:3+hc), a longer shortlist, or check "
                    "the scenario (masses, supports, drive)")
@@ -524,7 +530,7 @@ def _equivalent(ranking, selected, est, samples, criterion):
                 for t, v in near.items()))
         else:
             reason = (f"{differ}: their simulated force histories differ by at most "
-                      f"{100 * d_in:.1f} % of the peak on the recorded orbit(s), within the "
+                      f"{100 * d_in:.2g} % of the peak on the recorded orbit(s), within the "
                       "noise floor")
         separate = (f"their forces differ by {100 * d_out:.0f} % of the recorded peak at "
                     f"zeta = {z:.3g} m, zd = {v:.3g} m/s (recorded up to "

@@ -168,8 +168,17 @@ class ForceLaw:
         text = " ".join(out)
         return text[2:] if text.startswith("+ ") else "-" + text[2:]
 
+    def format(self, digits=6):
+        """Readable text with ``digits`` significant digits (``to_text`` is exact)."""
+        out = []
+        for c, t in zip(self.coefficients, self.terms, strict=True):
+            sign = "-" if c < 0 else "+"
+            out.append(f"{sign} {abs(c):.{digits}g}*{t.name}")
+        text = " ".join(out)
+        return text[2:] if text.startswith("+ ") else "-" + text[2:]
+
     def __str__(self):
-        return self.to_text()
+        return self.format()
 
     @property
     def has_jump(self):

@@ -268,7 +268,7 @@ def verify_figure(result, stem):
     else:
         ax.plot(E.t * ms, E.F, "k-", lw=1.0, label="measured F_E")
     crit = ", ".join(f"{k} {v:.3g} (floor {ev.noise_floor.get(k, float('nan')):.2g})"
-                     for k, v in ev.criteria.items() if k in ("I2", "I3", "I0"))
+                     for k, v in ev.criteria.items() if k in ("I2", "I4", "I3", "I0"))
     ax.set_title(f"{result.law}\n{'consistent' if ev.consistent else 'INCONSISTENT'}: "
                  f"{crit or ev.status}", fontsize=9)
     ax.set_ylabel("contact force F [N]")
