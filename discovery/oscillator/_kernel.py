@@ -104,6 +104,28 @@ def strobe_run(t0, y0, p, T, n_trans, n_strobe, rtol, atol, hmax, max_steps, t_e
     return status, t, y, n_steps, k_eval
 
 
+@njit(cache=True, inline="always")
+def renormalise(y, k, out_logs, out_trace, out_strobe):
+    """Benettin's step at strobe ``k`` on the variational state ``y`` (x, v, two tangent
+    vectors, the trace integral): Gram-Schmidt (QR) of the tangent vectors, their log
+    growths, the trace integral and the strobe point stored; the integral restarts."""
+    r11 = np.sqrt(y[2] * y[2] + y[3] * y[3])
+    y[2] /= r11
+    y[3] /= r11
+    r12 = y[2] * y[4] + y[3] * y[5]
+    y[4] -= r12 * y[2]
+    y[5] -= r12 * y[3]
+    r22 = np.sqrt(y[4] * y[4] + y[5] * y[5])
+    y[4] /= r22
+    y[5] /= r22
+    out_logs[k, 0] = np.log(r11)
+    out_logs[k, 1] = np.log(r22)
+    out_trace[k] = y[6]
+    y[6] = 0.0
+    out_strobe[k, 0] = y[0]
+    out_strobe[k, 1] = y[1]
+
+
 @njit(cache=True)
 def variational_run(t0, y0, p, T, n_seg, rtol, atol_state, atol_tangent, hmax, max_steps,
                     out_logs, out_trace, out_strobe):
@@ -140,21 +162,7 @@ def variational_run(t0, y0, p, T, n_seg, rtol, atol_state, atol_tangent, hmax, m
         n_steps += ns
         if status != OK:
             break
-        r11 = np.sqrt(y[2] * y[2] + y[3] * y[3])
-        y[2] /= r11
-        y[3] /= r11
-        r12 = y[2] * y[4] + y[3] * y[5]
-        y[4] -= r12 * y[2]
-        y[5] -= r12 * y[3]
-        r22 = np.sqrt(y[4] * y[4] + y[5] * y[5])
-        y[4] /= r22
-        y[5] /= r22
-        out_logs[k, 0] = np.log(r11)
-        out_logs[k, 1] = np.log(r22)
-        out_trace[k] = y[6]
-        y[6] = 0.0
-        out_strobe[k, 0] = y[0]
-        out_strobe[k, 1] = y[1]
+        renormalise(y, k, out_logs, out_trace, out_strobe)
         _rhs7(t, y, p, K[0])  # the tangent vectors changed
     return status, t, y[:2].copy(), n_steps
 

@@ -42,6 +42,7 @@ from numba import njit
 from ..dynamics import Tolerances
 from ..dynamics._dopri import OK, make_smooth_advance
 from ..errors import InputError, IntegrationError
+from ._kernel import renormalise
 from .attractor import classify_points, rotation_number
 from .system import UedaSystem
 
@@ -261,21 +262,7 @@ def _variational_run(t0, y0, p, T, n_seg, rtol, atol_state, atol_tangent, hmax, 
         if abs(y[0]) > 1e6 or abs(y[1]) > 1e6:
             status = 2
             break
-        r11 = np.sqrt(y[2] * y[2] + y[3] * y[3])
-        y[2] /= r11
-        y[3] /= r11
-        r12 = y[2] * y[4] + y[3] * y[5]
-        y[4] -= r12 * y[2]
-        y[5] -= r12 * y[3]
-        r22 = np.sqrt(y[4] * y[4] + y[5] * y[5])
-        y[4] /= r22
-        y[5] /= r22
-        out_logs[k, 0] = np.log(r11)
-        out_logs[k, 1] = np.log(r22)
-        out_trace[k] = y[6]
-        y[6] = 0.0
-        out_strobe[k, 0] = y[0]
-        out_strobe[k, 1] = y[1]
+        renormalise(y, k, out_logs, out_trace, out_strobe)
         _rhs7(t, y, p, K[0])
     return status, t, y[:2].copy(), n_steps
 
