@@ -40,7 +40,7 @@ from constraints import require
 
 from .criteria import criterion as _criterion
 from .errors import InputError, IntegrationError
-from .identify import identify
+from .identify import identify, pair_records, record_start
 from .regression import ConstrainedSparseRegressor
 from .samples import contact_samples, join_samples
 from .verify import Reference, evaluate
@@ -233,17 +233,6 @@ def _steady_from(ref):
     return float(ref.impulse.onset)
 
 
-def _pairs(scenario, measurement):
-    scs = list(scenario) if isinstance(scenario, list | tuple) else [scenario]
-    ms = list(measurement) if isinstance(measurement, list | tuple) else [measurement]
-    if len(scs) == 1 and len(ms) > 1:
-        scs = scs * len(ms)
-    if not ms or len(scs) != len(ms):
-        raise InputError(f"{len(ms)} record(s) but {len(scs)} scenario(s): give one scenario "
-                         "per record (or one for all)")
-    return list(zip(scs, ms, strict=True))
-
-
 class _Checker:
     """Refines (optionally) and evaluates one regression candidate against all records."""
 
@@ -316,30 +305,18 @@ class _Checker:
         critical when there is no jump), put on the library's lowest elastic and damping
         terms at the typical penetration ``v tau / pi``.  ``None`` when the library has
         neither kind of term or the record gives no contact time."""
-        est, E = self.est, ref.impulse
+        est = self.est
         lib = est.library_
-        if not len(E.support):
+        if not len(ref.impulse.support):
             return None
-        tau = float(np.median(E.support[:, 1] - E.support[:, 0]))
-        v = ref.noise.get("impact_velocity") or float(np.max(self.samples.dzeta))
-        if not (tau > 0 and v and v > 0):
-            return None
-        mu = scenario.m1 * scenario.m2 / (scenario.m1 + scenario.m2)
-        k = mu * (np.pi / tau) ** 2
-        jump = float(E.evaluate(0.0, "right"))
-        c = jump / v if jump > 0.05 * E.peak else 0.1 * np.sqrt(k * mu)
-        z0 = v * tau / np.pi
         coef = np.zeros(len(lib))
         elastic = [i for i, t in enumerate(lib.terms) if t.b == 0]
         damping = [i for i, t in enumerate(lib.terms) if t.b == 1]
-        if elastic:
-            i = min(elastic, key=lambda j: lib.terms[j].a)
-            coef[i] = k * z0 / z0 ** lib.terms[i].a
-        if damping:
-            i = min(damping, key=lambda j: lib.terms[j].a)
-            coef[i] = c / z0 ** lib.terms[i].a
-        if not coef.any():
+        chosen = [min(group, key=lambda j: lib.terms[j].a) for group in (elastic, damping)
+                  if group]
+        if not chosen:
             return None
+        coef[chosen] = record_start(scenario, ref, [lib.terms[i] for i in chosen])
         s = self.samples
         cand = est.rescore(coef, s.X, s.F, s.weight, s.impact)
         return self.refined(lib.law(coef), cand, "physical start (contact time, onset jump)")
@@ -611,7 +588,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
                          ("max_simulations", max_simulations, 2), ("stepwise", stepwise, 0)):
         if not (isinstance(v, int | np.integer) and not isinstance(v, bool) and v >= low):
             raise InputError(f"{name} must be an integer >= {low}; got {v!r}")
-    pairs = _pairs(scenario, measurement)
+    pairs = pair_records(scenario, measurement)
     parts = [contact_samples(m, derivative=derivative, average_cycles=average_cycles,
                              period=sc.period) for sc, m in pairs]
     samples = join_samples(parts)

@@ -39,7 +39,8 @@ from .errors import InputError, IntegrationError
 from .impulse import Impulse
 from .verify import Reference, evaluate
 
-__all__ = ["IdentificationResult", "identify", "METHODS", "as_records"]
+__all__ = ["IdentificationResult", "identify", "METHODS", "as_records", "pair_records",
+           "contact_scales", "record_start"]
 
 METHODS = ("coordinate-descent", "nelder-mead", "least-squares")
 _PENALTY = 10.0          # criterion value of a failed simulation (criteria are O(1))
@@ -101,6 +102,19 @@ class _Budget(Exception):
     """The simulation budget is used up."""
 
 
+def pair_records(scenario, records):
+    """``[(scenario, record), ...]``: one scenario per record, or one for all; a single
+    scenario or record may be given bare."""
+    scs = list(scenario) if isinstance(scenario, list | tuple) else [scenario]
+    recs = list(records) if isinstance(records, list | tuple) else [records]
+    if len(scs) == 1 and len(recs) > 1:
+        scs = scs * len(recs)
+    if not recs or len(scs) != len(recs):
+        raise InputError(f"{len(recs)} record(s) but {len(scs)} scenario(s): give one scenario "
+                         "per record (or one for all)")
+    return list(zip(scs, recs, strict=True))
+
+
 def as_records(scenario, reference):
     """``[(scenario, Reference), ...]`` from one pair or from two equal-length sequences.
 
@@ -108,21 +122,46 @@ def as_records(scenario, reference):
     :class:`~discovery.measurement.Measurement` (prepared with
     :meth:`Reference.from_measurement`) or an exact :class:`~discovery.impulse.Impulse`.
     """
-    scs = list(scenario) if isinstance(scenario, list | tuple) else [scenario]
-    refs = list(reference) if isinstance(reference, list | tuple) else [reference]
-    if len(scs) == 1 and len(refs) > 1:
-        scs = scs * len(refs)
-    if len(scs) != len(refs) or not refs:
-        raise InputError(f"{len(refs)} record(s) but {len(scs)} scenario(s): give one scenario "
-                         "per record (or one for all)")
     out = []
-    for sc, ref in zip(scs, refs, strict=True):
+    for sc, ref in pair_records(scenario, reference):
         if isinstance(ref, Impulse):
             ref = Reference.exact(ref, source="impulse")
         elif not isinstance(ref, Reference):
             ref = Reference.from_measurement(ref, sc)
         out.append((sc, ref))
     return out
+
+
+def contact_scales(scenario, reference):
+    """Typical contact time [s], impact velocity [m/s] and penetration ``v tau / pi`` [m] of
+    a record (the scenario's period and motion scale when the record lacks them)."""
+    E = reference.impulse
+    tau = float(np.median(E.support[:, 1] - E.support[:, 0])) if len(E.support) \
+        else scenario.period
+    v = (reference.noise.get("impact_velocity") if reference.noise else None) \
+        or scenario.scales()[1]
+    return tau, v, v * tau / np.pi
+
+
+def record_start(scenario, reference, terms):
+    """Start coefficients for ``terms`` from the record alone (a spring-dashpot estimate, to
+    be refined by simulation): stiffness ``k = mu (pi / tau)^2`` from the contact time and
+    the reduced mass, damping ``c = F(0+) / v`` from the force jump at onset (5 % of
+    critical without a jump), each term scaled to give that force at the typical
+    penetration ``z0``: elastic terms (``b = 0``) ``k z0 / z0^a``, the others ``c / z0^a``.
+
+    Returns
+    -------
+    ndarray
+        One coefficient per term.
+    """
+    E = reference.impulse
+    tau, v, z0 = contact_scales(scenario, reference)
+    mu = scenario.m1 * scenario.m2 / (scenario.m1 + scenario.m2)
+    k = mu * (np.pi / tau) ** 2
+    jump = float(E.evaluate(0.0, "right"))
+    c = jump / v if jump > 0.05 * E.peak else 0.1 * np.sqrt(k * mu)
+    return np.array([(k * z0 if t.b == 0 else c) / z0**t.a for t in terms])
 
 
 class _Objective:

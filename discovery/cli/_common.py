@@ -192,3 +192,15 @@ def read_records(args):
             print(f"note: {path}: {note}" if len(data) > 1 else f"note: {note}")
         meas.append(m)
     return scs, meas
+
+
+def criteria_line(criteria, floor):
+    """``  criteria (noise floor): I0 x (f), ...`` for the command's printout."""
+    return "  criteria (noise floor): " + ", ".join(
+        f"{k} {v:.3g} ({floor.get(k, float('nan')):.2g})" for k, v in criteria.items())
+
+
+def coefficients_line(coefficients, errors):
+    """``  coefficients (standard error): z c (se), ...`` for the command's printout."""
+    return "  coefficients (standard error): " + ", ".join(
+        f"{t} {c:.4g} ({errors.get(t, float('nan')):.2g})" for t, c in coefficients.items())

@@ -9,6 +9,8 @@ from ._common import (
     SCENARIO_HELP,
     add_record_options,
     check_out,
+    coefficients_line,
+    criteria_line,
     inputs_of,
     integer,
     number,
@@ -57,13 +59,9 @@ def run(args):
     print(f"final model: {fm.law}" + (f"  observed through {fm.observation}"
                                       if fm.observation else ""))
     if res.uncertainties:
-        print("  coefficients (standard error): " + ", ".join(
-            f"{t} {c:.4g} ({res.uncertainties.get(t, float('nan')):.2g})"
-            for t, c in fm.law.as_dict().items()))
+        print(coefficients_line(fm.law.as_dict(), res.uncertainties))
     if res.criteria:
-        print("  criteria (noise floor): " + ", ".join(
-            f"{n} {res.criteria[n]:.3g} ({res.noise_floor.get(n, float('nan')):.2g})"
-            for n in CRITERIA))
+        print(criteria_line(res.criteria, res.noise_floor))
     print(f"  {'consistent' if res.consistent else 'not consistent'} with the record(s); "
           f"stopped because {res.stopped_because}")
     print(f"outputs in {args.out}/: summary.json" + "".join(f", {f}" for f in files))

@@ -10,6 +10,8 @@ from ._common import (
     SCENARIO_HELP,
     add_record_options,
     check_out,
+    coefficients_line,
+    criteria_line,
     inputs_of,
     integer,
     number,
@@ -94,12 +96,9 @@ def run(args):
     sel = res.selected
     print(f"selected {sel.law}   [{sel.regime}]")
     if sel.standard_errors:
-        print("  coefficients (standard error): " + ", ".join(
-            f"{t} {c:.4g} ({sel.standard_errors[t]:.2g})" for t, c in sel.law.as_dict().items()))
+        print(coefficients_line(sel.law.as_dict(), sel.standard_errors))
     if sel.criteria:
-        print("  criteria (noise floor): " + ", ".join(
-            f"{k} {v:.3g} ({sel.noise_floor.get(k, float('nan')):.2g})"
-            for k, v in sel.criteria.items()))
+        print(criteria_line(sel.criteria, sel.noise_floor))
     print(f"  {sel.verdict}")
     print(f"  certificate: {'holds' if cert.holds else 'FAILS'} on zeta <= "
           f"{cert.domain['zeta_max']:.3g} m, zd <= {cert.domain['zd_max']:.3g} m/s "

@@ -16,6 +16,8 @@ from ._common import (
     SCENARIO_HELP,
     add_record_options,
     check_out,
+    coefficients_line,
+    criteria_line,
     inputs_of,
     integer,
     number,
@@ -105,12 +107,9 @@ def run(args):
     print(f"  {res.criterion} = {res.value:.4g} after {res.n_simulations} simulations "
           f"({res.method}, {res.seconds:.1f} s)")
     if res.standard_errors:
-        print("  coefficients (standard error): " + ", ".join(
-            f"{t} {c:.4g} ({res.standard_errors[t]:.2g})" for t, c in res.coefficients.items()))
+        print(coefficients_line(res.coefficients, res.standard_errors))
     if final.criteria:
-        print("  criteria (noise floor): " + ", ".join(
-            f"{k} {v:.3g} ({final.noise_floor.get(k, float('nan')):.2g})"
-            for k, v in final.criteria.items()))
+        print(criteria_line(final.criteria, final.noise_floor))
     print(f"  {final.verdict}")
     if res.failures:
         print(f"  note: {len(res.failures)} trial law(s) had no periodic steady state with "

@@ -7,6 +7,7 @@ from ._common import (
     SCENARIO_HELP,
     add_record_options,
     check_out,
+    criteria_line,
     inputs_of,
     integer,
     law_or_default,
@@ -40,8 +41,7 @@ def run(args):
           f"simulated {ev.regime['simulated'] or ev.status} "
           f"({ev.impacts['simulated']} contact(s))")
     if ev.criteria:
-        print("  criteria (noise floor): " + ", ".join(
-            f"{k} {v:.3g} ({ev.noise_floor[k]:.2g})" for k, v in ev.criteria.items()))
+        print(criteria_line(ev.criteria, ev.noise_floor))
     for note in res.notes:
         print(f"  note: {note}")
     print(f"outputs in {args.out}/: summary.json, verify.png, verify.pdf")

@@ -33,7 +33,7 @@ from scipy.optimize import minimize_scalar
 from scipy.stats import chi2
 
 from ..errors import InputError, IntegrationError
-from ..identify import as_records, identify
+from ..identify import as_records, contact_scales, identify, pair_records, record_start
 from ..law import ForceLaw
 from ..verify import evaluate
 from .effects import EFFECTS, Model
@@ -150,21 +150,9 @@ class ExplainResult:
 
 
 def _physical(names, records):
-    """Start values from the record alone: stiffness from the contact time and the reduced
-    mass, damping from the force jump at onset."""
-    sc, ref = records[0]
-    E = ref.impulse
-    tau, v, z0 = _scales(records)
-    mu = sc.m1 * sc.m2 / (sc.m1 + sc.m2)
-    k = mu * (np.pi / tau) ** 2
-    jump = float(E.evaluate(0.0, "right"))
-    c = jump / v if jump > 0.05 * E.peak else 0.1 * np.sqrt(k * mu)
-    parts = []
-    for n in names:
-        term = ForceLaw.parse(f"1*{n}").terms[0]
-        base = c if term.b >= 1 else k * z0
-        parts.append(f"{base / z0 ** term.a:.6g}*{n}")
-    return ForceLaw.parse(" + ".join(parts))
+    """Start values from the record alone (:func:`discovery.identify.record_start`)."""
+    terms = [ForceLaw.parse(f"1*{n}").terms[0] for n in names]
+    return ForceLaw(tuple(terms), tuple(record_start(*records[0], terms)))
 
 
 def _regression(names, scenarios, measurements):
@@ -250,19 +238,10 @@ def _mean(evs, key):
     return {k: float(np.mean([getattr(e, key)[k] for e in evs])) for k in getattr(evs[0], key)}
 
 
-def _scales(records):
-    """Typical contact time [s], impact velocity [m/s] and penetration [m] of the record."""
-    sc, ref = records[0]
-    E = ref.impulse
-    tau = float(np.median(E.support[:, 1] - E.support[:, 0])) if len(E.support) else sc.period
-    v = (ref.noise.get("impact_velocity") if ref.noise else None) or sc.scales()[1]
-    return tau, v, v * tau / np.pi
-
-
 def _small_step(eff, records):
     """A small value of the effect's parameter (1 % of the peak force at the typical
     penetration and impact velocity; 1 % of the contact time for a time constant)."""
-    tau, v, z0 = _scales(records)
+    tau, v, z0 = contact_scales(*records[0])
     if eff.terms:
         term = ForceLaw.parse(f"1*{eff.terms[0]}").terms[0]
         return 0.01 * records[0][1].impulse.peak / max(float(term(z0, v)), 1e-300)
@@ -392,14 +371,12 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         raise InputError(f"max_iterations must be an integer >= 0; got {max_iterations!r}")
     from ..verify import Reference
 
-    scs = list(scenario) if isinstance(scenario, list | tuple) else [scenario]
-    ms = list(measurement) if isinstance(measurement, list | tuple) else [measurement]
-    if len(scs) == 1:
-        scs = scs * len(ms)
-    refs = [m if isinstance(m, Reference) else
-            Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)
-            for sc, m in zip(scs, ms, strict=True)]
-    records = as_records(scs, refs)
+    pairs = pair_records(scenario, measurement)
+    ms = [m for _, m in pairs]
+    records = as_records([sc for sc, _ in pairs],
+                         [m if isinstance(m, Reference) else
+                          Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)
+                          for sc, m in pairs])
     catalogue = [e for e in EFFECTS if effects is None or e.id in effects]
     if effects is not None and len(catalogue) != len(set(effects)):
         known = {e.id for e in EFFECTS}
