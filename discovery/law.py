@@ -8,12 +8,28 @@ A :class:`ForceLaw` is a sum ``P(zeta, zd) = sum_i c_i * zeta^a_i * zd^b_i`` wit
 
 so the paper's conditions (3) (no force without contact) and (5) (negative
 penetration velocity has no effect) hold by construction, and the force is never
-adhesive (4): where ``P`` would be negative the bodies exert no force.  Units are
+adhesive (4): where ``P`` would be negative the bodies exert no force.
+
+Two optional extensions give the law an unloading branch of its own (``dzeta <= 0``),
+for machines the paper's model does not describe:
+
+* *unloading terms* ``d_j zeta^a_j dzeta^b_j`` (``b_j > 0``) act only while the bodies
+  separate, at the signed velocity, so they lower the force (damping that also acts
+  while unloading, as in a Kelvin-Voigt contact).  This departs from the paper's
+  condition (5) on purpose: a real contact (wet sand, a rubber pad) can dissipate energy
+  in restitution too, and then the force reaches zero before the penetration does;
+* a *permanent set* ``s`` in [0, 0.95]: plastic indentation (Walton-Braun).  Unloading
+  follows ``P(u, 0)`` at ``u = (zeta - s zeta_max) / (1 - s)``, ``zeta_max`` the contact's
+  largest penetration: continuous at ``zeta_max`` and zero at the residual penetration
+  ``s zeta_max`` (for a linear law: unloading stiffness ``k / (1 - s)``).  The set is
+  recovered between impacts (each contact starts from the undeformed surface).
+
+Text form: ``"2e8*z + 1e7*zd; unloading: 4e6*zd; set: 0.2"``.  Units are
 SI: ``zeta`` [m], ``dzeta`` [m/s], ``F`` [N]; a coefficient of ``z^a*zd^b`` has
 units N m^-a (m/s)^-b.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import sympy
@@ -24,6 +40,7 @@ from .errors import InputError
 __all__ = ["Term", "ForceLaw", "ZETA", "ZD"]
 
 ZETA, ZD = sympy.symbols("zeta zd", nonnegative=True)
+_MAX_SET = 0.95  # largest permanent-set fraction (1 would be a rigid-plastic contact)
 _LATEX_NAMES = {ZETA: r"\zeta", ZD: r"\dot{\zeta}_{+}"}
 
 
@@ -112,6 +129,9 @@ class ForceLaw:
 
     terms: tuple
     coefficients: tuple
+    unloading: tuple = ()
+    unloading_coefficients: tuple = ()
+    permanent_set: float = 0.0
 
     def __post_init__(self):
         terms = tuple(self.terms)
@@ -126,16 +146,61 @@ class ForceLaw:
             raise InputError("force-law coefficients must be finite numbers")
         object.__setattr__(self, "terms", terms)
         object.__setattr__(self, "coefficients", coefs)
+        uterms = tuple(self.unloading)
+        ucoefs = tuple(float(c) for c in self.unloading_coefficients)
+        if len(uterms) != len(ucoefs):
+            raise InputError(f"{len(uterms)} unloading terms but {len(ucoefs)} coefficients")
+        if len(set(uterms)) != len(uterms):
+            raise InputError("a force law lists the same unloading term twice; merge them")
+        if any(t.b == 0 for t in uterms):
+            raise InputError("an unloading term must depend on the velocity (e.g. 'zd' or "
+                             "'z*zd'), so the force is continuous when the motion reverses")
+        if not all(np.isfinite(ucoefs)):
+            raise InputError("unloading coefficients must be finite numbers")
+        rho = self.permanent_set
+        if isinstance(rho, bool) or not isinstance(rho, int | float | np.number) \
+                or not (0.0 <= float(rho) <= _MAX_SET):
+            raise InputError(f"the permanent set must be a number in [0, {_MAX_SET}] (the "
+                             f"residual share of the largest penetration); got {rho!r}")
+        object.__setattr__(self, "unloading", uterms)
+        object.__setattr__(self, "unloading_coefficients", ucoefs)
+        object.__setattr__(self, "permanent_set", float(rho))
 
     # ----------------------------------------------------------- construction
     @classmethod
     def parse(cls, text):
-        """Law from text like ``"2.06e8*z + 1.28e7*zd"`` (like terms are summed)."""
+        """Law from text like ``"2.06e8*z + 1.28e7*zd"`` (like terms are summed), with
+        optional parts ``"; unloading: 4e6*zd"`` and ``"; set: 0.2"``."""
+        if not isinstance(text, str):
+            return cls(*cls._merged(text))  # the grammar's own "must be text" error
+        main, *parts = text.split(";")
+        extra = {}
+        for part in parts:
+            key, sep, value = part.partition(":")
+            key = key.strip().lower()
+            if not sep or key not in ("unloading", "set") or key in extra:
+                raise InputError(f"force law {text!r}: after ';' give 'unloading: <terms>' or "
+                                 "'set: <fraction>' once each, e.g. '2e8*z + 1e7*zd; "
+                                 "unloading: 4e6*zd; set: 0.2'")
+            extra[key] = value.strip()
+        terms, coefs = cls._merged(main)
+        uterms, ucoefs = cls._merged(extra["unloading"]) if "unloading" in extra else ((), ())
+        rho = 0.0
+        if "set" in extra:
+            try:
+                rho = float(extra["set"])
+            except ValueError:
+                raise InputError(f"force law {text!r}: 'set:' needs a number in [0, "
+                                 f"{_MAX_SET}], got {extra['set']!r}") from None
+        return cls(terms, coefs, uterms, ucoefs, rho)
+
+    @staticmethod
+    def _merged(text):
         merged = {}
         for c, a, b in parse_law_terms(text):
             t = Term(a, b)
             merged[t] = merged.get(t, 0.0) + c
-        return cls(tuple(merged), tuple(merged.values()))
+        return tuple(merged), tuple(merged.values())
 
     @classmethod
     def from_dict(cls, coefficients):
@@ -144,8 +209,23 @@ class ForceLaw:
         return cls(terms, tuple(float(v) for v in coefficients.values()))
 
     def with_coefficients(self, values):
-        """The same terms with new coefficients (sequence of floats)."""
-        return ForceLaw(self.terms, tuple(float(v) for v in values))
+        """The same terms with new coefficients (sequence of floats); the unloading branch
+        is kept."""
+        return replace(self, coefficients=tuple(float(v) for v in values))
+
+    def with_unloading(self, terms=None, coefficients=None, permanent_set=None):
+        """The same loading branch with another unloading branch (None keeps a part)."""
+        return replace(self,
+                       unloading=self.unloading if terms is None else tuple(terms),
+                       unloading_coefficients=self.unloading_coefficients
+                       if coefficients is None else tuple(coefficients),
+                       permanent_set=self.permanent_set if permanent_set is None
+                       else permanent_set)
+
+    @property
+    def has_unloading_branch(self):
+        """True when unloading is not the paper's ``P(zeta, 0)`` (unloading terms or a set)."""
+        return bool(self.unloading) or self.permanent_set > 0
 
     # ------------------------------------------------------------- properties
     @property
@@ -159,23 +239,29 @@ class ForceLaw:
 
     def to_text(self):
         """Text that :meth:`parse` reads back to the same law."""
-        out = []
-        for c, t in zip(self.coefficients, self.terms, strict=True):
-            sign = "-" if c < 0 else "+"
+        def exact(c):
             num = repr(abs(c))  # shortest text that reads back exactly
-            num = num[:-2] if num.endswith(".0") else num
-            out.append(f"{sign} {num}*{t.name}")
-        text = " ".join(out)
-        return text[2:] if text.startswith("+ ") else "-" + text[2:]
+            return num[:-2] if num.endswith(".0") else num
+
+        return self._text(exact, repr)
 
     def format(self, digits=6):
         """Readable text with ``digits`` significant digits (``to_text`` is exact)."""
-        out = []
-        for c, t in zip(self.coefficients, self.terms, strict=True):
-            sign = "-" if c < 0 else "+"
-            out.append(f"{sign} {abs(c):.{digits}g}*{t.name}")
-        text = " ".join(out)
-        return text[2:] if text.startswith("+ ") else "-" + text[2:]
+        return self._text(lambda c: f"{abs(c):.{digits}g}", lambda r: f"{r:.{digits}g}")
+
+    def _text(self, number, fraction):
+        def poly(terms, coefs):
+            out = [f"{'-' if c < 0 else '+'} {number(c)}*{t.name}"
+                   for c, t in zip(coefs, terms, strict=True)]
+            text = " ".join(out)
+            return text[2:] if text.startswith("+ ") else "-" + text[2:]
+
+        text = poly(self.terms, self.coefficients)
+        if self.unloading:
+            text += "; unloading: " + poly(self.unloading, self.unloading_coefficients)
+        if self.permanent_set:
+            text += f"; set: {fraction(self.permanent_set)}"
+        return text
 
     def __str__(self):
         return self.format()
@@ -217,6 +303,10 @@ class ForceLaw:
                 f"penetration up to {Z:.3g} m and velocity up to {V:.3g} m/s): the moulding "
                 "would fall through the grid; a contact law needs a positive stiffness term "
                 "such as 2e8*z")
+        if any(c < 0 for c in self.unloading_coefficients):
+            raise InputError(f"{what} '{self}' has a negative unloading coefficient: it would "
+                             "push the bodies apart harder while they separate (energy fed "
+                             "into the rebound); make the unloading terms non-negative")
         D = P - self.polynomial(zz, np.zeros_like(vv))
         worst = np.unravel_index(int(np.argmin(D)), D.shape)
         if D[worst] < -1e-9 * float(np.max(np.abs(P))):
@@ -225,8 +315,10 @@ class ForceLaw:
                 f"< F(zeta, 0) at zeta = {zz[worst]:.3g} m, zd = {vv[worst]:.3g} m/s (damping "
                 "that feeds energy into the impact); make the velocity terms non-negative")
 
-    def __call__(self, zeta, dzeta):
-        """Contact force ``F(zeta, dzeta)`` [N] with conditions (3)-(5) applied.
+    def __call__(self, zeta, dzeta, zeta_max=None):
+        """Contact force ``F(zeta, dzeta)`` [N] with conditions (3)-(5) applied (and the
+        law's unloading branch, if it has one: ``zeta_max`` is then the contact's largest
+        penetration, default ``zeta`` itself).
 
         Parameters
         ----------
@@ -239,14 +331,33 @@ class ForceLaw:
         dzeta = np.asarray(dzeta, dtype=float)
         zp = np.maximum(zeta, 0.0)
         p = self.polynomial(zp, np.maximum(dzeta, 0.0))
+        if self.has_unloading_branch:
+            zm = zp if zeta_max is None else np.maximum(np.asarray(zeta_max, float), zp)
+            p = np.where(dzeta > 0, p, self.unloading_force(zp, dzeta, zm))
         return np.where(zeta > 0, np.maximum(p, 0.0), 0.0)
 
+    def unloading_force(self, zeta, dzeta, zeta_max):
+        """Raw unloading branch (``dzeta <= 0``, before clipping at 0): ``P(u, 0)`` at
+        ``u = (zeta - s zeta_max) / (1 - s)`` (negative below the residual penetration)
+        plus the unloading terms at the signed velocity (see the module docstring)."""
+        zeta = np.asarray(zeta, dtype=float)
+        dzeta = np.minimum(np.asarray(dzeta, dtype=float), 0.0)
+        s = self.permanent_set
+        u = (zeta - s * np.asarray(zeta_max, dtype=float)) / (1.0 - s)
+        out = np.where(u > 0, self.polynomial(np.maximum(u, 0.0), np.zeros_like(u)), -1.0)
+        for c, t in zip(self.unloading_coefficients, self.unloading, strict=True):
+            out = out - c * t(zeta, -dzeta)
+        return out
+
     def kernel_arrays(self):
-        """``(coef, a, b)`` float arrays for the compiled integrator."""
+        """``(coef, a, b, branch)`` float arrays for the compiled integrator: the loading
+        terms (branch 0), then the unloading terms (branch 1)."""
+        terms = self.terms + self.unloading
         return (
-            np.array(self.coefficients, dtype=np.float64),
-            np.array([t.a for t in self.terms], dtype=np.float64),
-            np.array([t.b for t in self.terms], dtype=np.float64),
+            np.array(self.coefficients + self.unloading_coefficients, dtype=np.float64),
+            np.array([t.a for t in terms], dtype=np.float64),
+            np.array([t.b for t in terms], dtype=np.float64),
+            np.array([0.0] * len(self.terms) + [1.0] * len(self.unloading), dtype=np.float64),
         )
 
     # --------------------------------------------------------------- export
@@ -262,11 +373,23 @@ class ForceLaw:
 
         ``\\dot\\zeta_+`` stands for ``max(dzeta, 0)``.
         """
-        out = []
-        for c, t in zip(self.coefficients, self.terms, strict=True):
-            mant, _, exp = f"{abs(c):.{digits - 1}e}".partition("e")
-            num = mant if int(exp) == 0 else rf"{mant} \cdot 10^{{{int(exp)}}}"
-            sym = sympy.latex(t.sympy(), symbol_names=_LATEX_NAMES)
-            out.append(("-" if c < 0 else "+") + rf" {num}\,{sym}")
-        text = " ".join(out)
-        return text[2:] if text.startswith("+ ") else text
+        text = _latex_sum(self.coefficients, self.terms, digits, _LATEX_NAMES)
+        if self.unloading:
+            text += (r"\quad\text{unloading: } P(\zeta, 0) - "
+                     + _latex_sum(self.unloading_coefficients, self.unloading, digits,
+                                  {ZETA: r"\zeta", ZD: r"|\dot{\zeta}|"}, paren=True))
+        if self.permanent_set:
+            text += rf"\quad\text{{set }} s = {self.permanent_set:.{digits}g}"
+        return text
+
+
+def _latex_sum(coefficients, terms, digits, names, paren=False):
+    out = []
+    for c, t in zip(coefficients, terms, strict=True):
+        mant, _, exp = f"{abs(c):.{digits - 1}e}".partition("e")
+        num = mant if int(exp) == 0 else rf"{mant} \cdot 10^{{{int(exp)}}}"
+        sym = sympy.latex(t.sympy(), symbol_names=names)
+        out.append(("-" if c < 0 else "+") + rf" {num}\,{sym}")
+    text = " ".join(out)
+    text = text[2:] if text.startswith("+ ") else text
+    return rf"\left({text}\right)" if paren and len(out) > 1 else text

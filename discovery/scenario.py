@@ -27,11 +27,14 @@ __all__ = ["Scenario", "builtin_scenarios", "load_scenario"]
 _FIELDS = {
     "m1": ("kg", True), "m2": ("kg", True), "k1": ("N/m", False), "c1": ("N s/m", False),
     "A": ("N", False), "frequency": ("Hz", True), "g": ("m/s^2", False),
+    "k3": ("N/m^3", False), "mass_loss": ("per impact", False),
 }
+#: parameters a scenario file may leave out (their defaults: the paper's machine)
+_OPTIONAL = {"g": 9.81, "k3": 0.0, "mass_loss": 0.0}
 #: largest accepted value of each parameter: far beyond any vibro-impact machine, and
 #: small enough that the simulation's scales (A / (m1 omega^2), k1 / m1, ...) stay finite
 LIMITS = {"m1": 1e9, "m2": 1e9, "k1": 1e15, "c1": 1e12, "A": 1e12, "frequency": 1e5,
-          "g": 1e3}
+          "g": 1e3, "k3": 1e24, "mass_loss": 0.5}
 #: largest accepted |position| [m] and |velocity| [m/s] of the initial state
 INITIAL_LIMITS = (1e3, 1e3)
 #: the tables and keys a scenario file may have
@@ -70,6 +73,13 @@ class Scenario:
         Drive frequency ``f`` [Hz], > 0.
     g : float
         Gravitational acceleration [m/s^2], >= 0.
+    k3 : float
+        Cubic stiffness of the supports [N/m^3], >= 0: their force is ``k1 w1 + k3 w1^3``
+        (stiffening supports; 0 for the paper's linear springs).
+    mass_loss : float
+        Fraction of the moulding's mass shed at each impact, in [0, 0.5] (sand falling
+        out of the flask); 0 for the paper's constant mass.  With a loss the motion
+        drifts and has no periodic steady state: it is simulated over a record's span.
     law : ForceLaw or None
         The reference ("true") contact law, if the scenario has one.
     initial : tuple of 4 floats or None
@@ -91,6 +101,8 @@ class Scenario:
     initial: tuple | None = None
     name: str = "custom"
     source: str = field(default="", compare=False)
+    k3: float = 0.0
+    mass_loss: float = 0.0
 
     def __post_init__(self):
         for key, (unit, strict) in _FIELDS.items():
@@ -142,6 +154,10 @@ class Scenario:
         if self.initial is not None:
             return np.array(self.initial, dtype=float)
         w1 = -self.m1 * self.g / self.k1 if self.k1 > 0 else 0.0
+        if self.k3 > 0:
+            # the real root of k1 w + k3 w^3 + m1 g = 0 (stiffening supports sag less)
+            roots = np.roots([self.k3, 0.0, self.k1, self.m1 * self.g])
+            w1 = float(np.real(roots[np.argmin(np.abs(np.imag(roots)))]))
         return np.array([w1, 0.0, w1, 0.0])
 
     def scales(self):
@@ -151,8 +167,14 @@ class Scenario:
         return x, x * self.omega
 
     def params(self):
-        """Parameter vector for the compiled kernel: m1, m2, k1, c1, A, omega, g."""
-        return np.array([self.m1, self.m2, self.k1, self.c1, self.A, self.omega, self.g])
+        """Parameter vector for the compiled kernel: m1, m2, k1, c1, A, omega, g, k3,
+        mass_loss."""
+        return np.array([self.m1, self.m2, self.k1, self.c1, self.A, self.omega, self.g,
+                         self.k3, self.mass_loss])
+
+    def replace(self, **changes):
+        """A copy with some parameters changed (validated like the original)."""
+        return Scenario(**{**self._fields(), **changes})
 
     def with_law(self, law):
         """A copy with another reference law."""
@@ -160,7 +182,8 @@ class Scenario:
 
     def _fields(self):
         return {k: getattr(self, k) for k in
-                ("m1", "m2", "k1", "c1", "A", "frequency", "g", "law", "initial", "name", "source")}
+                ("m1", "m2", "k1", "c1", "A", "frequency", "g", "law", "initial", "name", "source",
+                 "k3", "mass_loss")}
 
     def as_dict(self):
         """JSON-ready description (provenance for outputs)."""
@@ -223,7 +246,7 @@ class Scenario:
         if machine is None:
             raise InputError(f"scenario {source!r} needs a [machine] table with m1, m2, k1, c1, A, "
                              "frequency")
-        missing = [k for k in _FIELDS if k != "g" and k not in machine]
+        missing = [k for k in _FIELDS if k not in _OPTIONAL and k not in machine]
         if missing:
             raise InputError(f"scenario {source!r}: [machine] is missing {', '.join(missing)}; "
                              "add them in SI units (kg, N/m, N s/m, N, Hz)")

@@ -145,10 +145,11 @@ def test_from_dict_with_coefficients_and_has_jump():
     assert not ForceLaw.parse("2e10*z^1.5 + 5e11*z^1.5*zd").has_jump
     law2 = law.with_coefficients([1.0, 2.0])
     assert law2.terms == law.terms and law2.coefficients == (1.0, 2.0)
-    coef, a, b = law.kernel_arrays()
+    coef, a, b, branch = law.kernel_arrays()
     np.testing.assert_array_equal(coef, [2.06e8, 1.28e7])
     np.testing.assert_array_equal(a, [1.0, 0.0])
     np.testing.assert_array_equal(b, [0.0, 1.0])
+    np.testing.assert_array_equal(branch, [0.0, 0.0])  # loading terms only
 
 
 # ----------------------------------------------------------------------- evaluation

@@ -110,18 +110,19 @@ def test_release_or_resume_at_or_past_the_loss_goes_free():
     past = np.array([0.0, 0.0, 1e-17, 0.01])   # zeta = -1e-17, separating
     on = np.array([0.0, 0.0, 0.0, 0.01])
     inside = np.array([1e-6, 0.0, 0.0, 0.01])  # zeta > 0: still in contact
+    st = {"m2": 1.0, "zmax": 0.0}
     for kind in ("release", "resume"):
-        assert R._after(law, kind, past) == "free"
-        assert R._after(law, kind, on) == "free"
-    assert R._after(law, "release", inside) == "clipped"
-    assert R._after(law, "resume", inside) == "unload"
+        assert R._after(law, kind, past, st, 0.0) == "free"
+        assert R._after(law, kind, on, st, 0.0) == "free"
+    assert R._after(law, "release", inside, st, 0.0) == "clipped"
+    assert R._after(law, "resume", inside, st, 0.0) == "unload"
 
 
 def test_reported_force_is_never_adhesive():
     law = ForceLaw.parse("1e8*z + 1e10*z^1.5")
-    assert R._force(law, "unload", -1e-9, 0.0, clamp=True) == 0.0
-    assert R._force(law, "unload", -1e-9, 0.0) < 0.0  # the smooth extension inside steps
-    assert R._force(law, "load", 1e-6, 0.1, clamp=True) == pytest.approx(law(1e-6, 0.1))
+    assert R._force(law, "unload", -1e-9, 0.0, 0.0, clamp=True) == 0.0
+    assert R._force(law, "unload", -1e-9, 0.0, 0.0) < 0.0  # the smooth extension inside steps
+    assert R._force(law, "load", 1e-6, 0.1, 0.0, clamp=True) == pytest.approx(law(1e-6, 0.1))
 
 
 # -------------------------------------------------------------- (2) endless loop
@@ -167,14 +168,14 @@ def test_start_on_the_surface_while_separating_flies_then_recontacts(v, phase):
     flight = 2 * v / a_rel
     assert t_on - t0 == pytest.approx(flight, rel=0.02 + sc.omega * flight)
     assert y_on[1] - y_on[3] == pytest.approx(v, rel=5e-2)
-    assert R._mode_of(law, y0) == "free"
+    assert R._mode_of(law, y0, {"m2": 1.0, "zmax": 0.0}) == "free"
 
 
 def test_a_surface_function_at_the_start_follows_the_flow():
     """On its surface at a segment's start, a switching function takes the sign of
     where the flow goes: across (the event happens now) or away (held, not fired)."""
     law = ForceLaw.parse("1e8*z")
-    evs = R._events(law, "free")
+    evs = R._events(law, "free", {"m2": 1.0, "zmax": 0.0})
     # on the surface and moving across: the onset happens now (a zero-length segment)
     g0, on, trend = R._surface_start(evs, lambda t, y: [y[1], 0.0, y[3], 0.0], 0.0,
                                      np.array([0.0, 1.0, 0.0, 0.0]), 1e-8, 1e-12)

@@ -54,6 +54,12 @@ FREE, LOAD, UNLOAD, CLIPPED = 0, 1, 2, 3
 EV_ONSET, EV_LOSS, EV_UNLOAD, EV_RELOAD, EV_RELEASE, EV_RESUME = 1, 2, 3, 4, 5, 6
 OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW, CHATTER = 0, 1, 2, 3, 4
 
+# the parameter vector ``p``: the scenario's m1, m2, k1, c1, A, omega, g (0-6), the
+# supports' cubic stiffness, the mass fraction shed per impact, the law's permanent-set
+# fraction, and one contact state: the current contact's largest penetration.  The kernel
+# updates m2 and z_max in place (callers pass a copy: :func:`kernel_params`).
+P_K3, P_LOSS, P_SET, P_ZMAX, N_PARAMS = 7, 8, 9, 10, 11
+
 # chattering: more than _ZENO_EVENTS located events in a row, each within
 # _ZENO_GAP * hmax of the previous one (mode switches that hardly advance time)
 _ZENO_EVENTS, _ZENO_GAP = 1000, 1e-3
@@ -75,49 +81,82 @@ def _pw(x, p):
 
 
 @njit(cache=True, inline="always")
-def poly(z, zd, coef, ea, eb):
-    """``P(z, zd) = sum c_i z^a_i zd^b_i`` (odd extension for negative arguments)."""
+def poly(z, zd, coef, ea, eb, br):
+    """Loading branch ``P(z, zd) = sum c_i z^a_i zd^b_i`` over the loading terms
+    (``br_i = 0``; odd extension for negative arguments)."""
     s = 0.0
     for i in range(coef.shape[0]):
-        s += coef[i] * _pw(z, ea[i]) * _pw(zd, eb[i])
+        if br[i] == 0.0:
+            s += coef[i] * _pw(z, ea[i]) * _pw(zd, eb[i])
     return s
 
 
 @njit(cache=True, inline="always")
-def mode_force(mode, z, v, coef, ea, eb):
+def unload_force(z, v, p, coef, ea, eb, br):
+    """Unloading branch (``dzeta <= 0``): the elastic part ``P(u, 0)`` at the unloading
+    penetration ``u = (z - s z_max) / (1 - s)`` (``s`` the permanent-set fraction, ``z_max``
+    the contact's largest penetration: ``u = z`` without a set), plus the unloading terms
+    (``br_i = 1``) ``c_i z^a_i dzeta^b_i`` at the signed velocity (odd extension: they
+    lower the force while the bodies separate).  With neither it is the paper's
+    ``P(z, 0)``, term for term."""
+    rho = p[P_SET]
+    u = z if rho == 0.0 else (z - rho * p[P_ZMAX]) / (1.0 - rho)
+    s = 0.0
+    for i in range(coef.shape[0]):
+        if br[i] == 0.0:
+            s += coef[i] * _pw(u, ea[i]) * _pw(0.0, eb[i])
+        else:
+            s += coef[i] * _pw(z, ea[i]) * _pw(v, eb[i])
+    return s
+
+
+@njit(cache=True, inline="always")
+def branch_force(z, v, p, coef, ea, eb, br):
+    """The branch force at ``(z, v)``: loading for ``v > 0``, unloading otherwise (the
+    clipped mode's resume function)."""
+    if v > 0.0:
+        return poly(z, v, coef, ea, eb, br)
+    return unload_force(z, v, p, coef, ea, eb, br)
+
+
+@njit(cache=True, inline="always")
+def mode_force(mode, z, v, p, coef, ea, eb, br):
     """Contact force [N] in a given mode at penetration ``z`` and its rate ``v``."""
     if mode == LOAD:
-        return poly(z, v, coef, ea, eb)
+        return poly(z, v, coef, ea, eb, br)
     if mode == UNLOAD:
-        return poly(z, 0.0, coef, ea, eb)
+        return unload_force(z, v, p, coef, ea, eb, br)
     return 0.0
 
 
 @njit(cache=True)
-def resolve_mode(y, coef, ea, eb):
-    """The mode a state belongs to (used at the start of an integration)."""
+def resolve_mode(y, p, coef, ea, eb, br):
+    """The mode a state belongs to (used at the start of an integration; a start inside
+    an unloading phase takes its own penetration as the contact's largest)."""
     z = y[0] - y[2]
     v = y[1] - y[3]
     if z < 0.0 or (z == 0.0 and v <= 0.0):
         return FREE
     if v > 0.0:
-        return LOAD if poly(max(z, 0.0), v, coef, ea, eb) >= 0.0 else CLIPPED
-    return UNLOAD if poly(z, 0.0, coef, ea, eb) > 0.0 else CLIPPED
+        return LOAD if poly(max(z, 0.0), v, coef, ea, eb, br) >= 0.0 else CLIPPED
+    p[P_ZMAX] = max(p[P_ZMAX], z)
+    return UNLOAD if unload_force(z, v, p, coef, ea, eb, br) > 0.0 else CLIPPED
 
 
 @njit(cache=True, inline="always")
-def _rhs(t, y, mode, p, coef, ea, eb, out):
+def _rhs(t, y, mode, p, coef, ea, eb, br, out):
     z = y[0] - y[2]
     v = y[1] - y[3]
-    f = mode_force(mode, z, v, coef, ea, eb)
+    f = mode_force(mode, z, v, p, coef, ea, eb, br)
     out[0] = y[1]
-    out[1] = -(p[3] * y[1] + p[2] * y[0] + p[4] * np.sin(p[5] * t) + p[0] * p[6] + f) / p[0]
+    out[1] = -(p[3] * y[1] + p[2] * y[0] + p[P_K3] * y[0] * y[0] * y[0]
+               + p[4] * np.sin(p[5] * t) + p[0] * p[6] + f) / p[0]
     out[2] = y[3]
     out[3] = f / p[1] - p[6]
 
 
 @njit(cache=True, inline="always")
-def _switching(mode, y, coef, ea, eb, h):
+def _switching(mode, y, p, coef, ea, eb, br, h):
     """Fill ``h`` with the mode's switching functions; return how many."""
     z = y[0] - y[2]
     v = y[1] - y[3]
@@ -127,13 +166,13 @@ def _switching(mode, y, coef, ea, eb, h):
     h[0] = z
     if mode == LOAD:
         h[1] = v
-        h[2] = poly(z, v, coef, ea, eb)
+        h[2] = poly(z, v, coef, ea, eb, br)
         return 3
     if mode == UNLOAD:
         h[1] = -v
-        h[2] = poly(z, 0.0, coef, ea, eb)
+        h[2] = unload_force(z, v, p, coef, ea, eb, br)
         return 3
-    h[1] = -poly(max(z, 0.0), max(v, 0.0), coef, ea, eb)
+    h[1] = -branch_force(max(z, 0.0), v, p, coef, ea, eb, br)
     return 2
 
 
@@ -151,36 +190,46 @@ def _event_kind(mode, index):
 
 
 @njit(cache=True)
-def _mode_after(kind, y, coef, ea, eb):
+def _mode_after(kind, y, p, coef, ea, eb, br):
+    """The mode after an event, and the contact's state updates it brings (in ``p``): an
+    onset starts a new contact (``z_max = 0``) and sheds the moulding's mass fraction
+    ``p[P_LOSS]``; entering the unloading branch records the largest penetration."""
     z = max(y[0] - y[2], 0.0)
     v = y[1] - y[3]
     if kind == EV_LOSS:
         return FREE
+    if kind == EV_ONSET:
+        p[P_ZMAX] = 0.0
+        p[1] *= 1.0 - p[P_LOSS]
     if kind == EV_RELEASE:
         return CLIPPED
     if kind == EV_RESUME:
-        # P crossed to positive at the located root: the force is on again, even if the
+        # the force crossed to positive at the located root: it is on again, even if the
         # re-taken step ended a whisker on the adhesive side
-        return LOAD if v > 0.0 else UNLOAD
-    if kind == EV_UNLOAD or ((kind == EV_ONSET or kind == EV_RESUME) and v <= 0.0):
-        return UNLOAD if poly(z, 0.0, coef, ea, eb) >= 0.0 else CLIPPED
-    # onset / resume with dzeta > 0, or reload
-    return LOAD if poly(z, max(v, 0.0), coef, ea, eb) >= 0.0 else CLIPPED
+        if v > 0.0:
+            return LOAD
+        p[P_ZMAX] = max(p[P_ZMAX], z)
+        return UNLOAD
+    if kind == EV_UNLOAD or (kind == EV_ONSET and v <= 0.0):
+        p[P_ZMAX] = max(p[P_ZMAX], z)
+        return UNLOAD if unload_force(z, v, p, coef, ea, eb, br) >= 0.0 else CLIPPED
+    # onset with dzeta > 0, or reload
+    return LOAD if poly(z, max(v, 0.0), coef, ea, eb, br) >= 0.0 else CLIPPED
 
 
 @njit(cache=True, inline="always")
-def _rk_step(t, y, h, mode, p, coef, ea, eb, K, ytmp, ynew):
+def _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew):
     """One DP5 step from (t, y) with K[0] = f(t, y) already set; fills K[1:7], ynew
     (the method's stages from :mod:`._dopri`, this system's right-hand side)."""
     for s in range(1, 6):
         _stage(s, y, h, K, ytmp)
-        _rhs(t + _C[s] * h, ytmp, mode, p, coef, ea, eb, K[s])
+        _rhs(t + _C[s] * h, ytmp, mode, p, coef, ea, eb, br, K[s])
     _combine(y, h, K, ynew)
-    _rhs(t + h, ynew, mode, p, coef, ea, eb, K[6])
+    _rhs(t + h, ynew, mode, p, coef, ea, eb, br, K[6])
 
 
 @njit(cache=True)
-def _locate(y, K, h, mode, coef, ea, eb, index, th_lo, th_hi, h_lo, h_hi, ybuf, hbuf):
+def _locate(y, K, h, mode, p, coef, ea, eb, br, index, th_lo, th_hi, h_lo, h_hi, ybuf, hbuf):
     """Root in ``theta`` of switching function ``index`` on the dense output (Illinois)."""
     a, b, fa, fb = th_lo, th_hi, h_lo, h_hi
     side = 0
@@ -189,7 +238,7 @@ def _locate(y, K, h, mode, coef, ea, eb, index, th_lo, th_hi, h_lo, h_hi, ybuf, 
         if not (a < c < b):
             c = 0.5 * (a + b)
         _dense(y, K, h, c, ybuf)
-        _switching(mode, ybuf, coef, ea, eb, hbuf)
+        _switching(mode, ybuf, p, coef, ea, eb, br, hbuf)
         fc = hbuf[index]
         if fc < 0.0:
             b, fb = c, fc
@@ -207,10 +256,10 @@ def _locate(y, K, h, mode, coef, ea, eb, index, th_lo, th_hi, h_lo, h_hi, ybuf, 
 
 
 @njit(cache=True, inline="always")
-def _h_at(y, K, h, mode, coef, ea, eb, index, theta, ybuf, hbuf):
+def _h_at(y, K, h, mode, p, coef, ea, eb, br, index, theta, ybuf, hbuf):
     """Switching function ``index`` on the dense output at ``theta``."""
     _dense(y, K, h, theta, ybuf)
-    _switching(mode, ybuf, coef, ea, eb, hbuf)
+    _switching(mode, ybuf, p, coef, ea, eb, br, hbuf)
     return hbuf[index]
 
 
@@ -242,7 +291,7 @@ def _rate_root(y, K, h, s, d0, d1, ybuf):
 
 
 @njit(cache=True)
-def _first_crossing(t, y, ynew, K, h, mode, coef, ea, eb, i, h0, ha, hb, h1, ybuf, hbuf):
+def _first_crossing(t, y, ynew, K, h, mode, p, coef, ea, eb, br, i, h0, ha, hb, h1, ybuf, hbuf):
     """``theta`` in ``[0, 1]`` of the first crossing of switching function ``i`` over the
     step (``0``: at once), or ``2`` if it stays on its side.
 
@@ -288,7 +337,7 @@ def _first_crossing(t, y, ynew, K, h, mode, coef, ea, eb, i, h0, ha, hb, h1, ybu
         d1 = s * (ynew[1] - ynew[3])
         if d0 < 0.0 and d1 > 0.0:
             th = _rate_root(y, K, h, s, d0, d1, ybuf)
-            fm = _h_at(y, K, h, mode, coef, ea, eb, 0, th, ybuf, hbuf)
+            fm = _h_at(y, K, h, mode, p, coef, ea, eb, br, 0, th, ybuf, hbuf)
             if fm < 0.0:
                 neg_t, neg_f = th, fm
                 pos_t = -1.0
@@ -309,20 +358,20 @@ def _first_crossing(t, y, ynew, K, h, mode, coef, ea, eb, i, h0, ha, hb, h1, ybu
                 # probe: moving further across, it crosses now; coming back (a step cut
                 # to an event ends within its error of the surface, not on it), not yet
                 return 0.0 if f_first <= h0 else 2.0
-            f = _h_at(y, K, h, mode, coef, ea, eb, i, th, ybuf, hbuf)
+            f = _h_at(y, K, h, mode, p, coef, ea, eb, br, i, th, ybuf, hbuf)
             if f > 0.0:
                 pos_t, pos_f = th, f
                 break
             if f < 0.0:
                 neg_t, neg_f = th, f
-    return _locate(y, K, h, mode, coef, ea, eb, i, pos_t, neg_t, pos_f, neg_f, ybuf, hbuf)
+    return _locate(y, K, h, mode, p, coef, ea, eb, br, i, pos_t, neg_t, pos_f, neg_f, ybuf, hbuf)
 
 
 @njit(cache=True, inline="always")
-def _record_event(t, y, mode, index, coef, ea, eb, n_ev, ev_t, ev_kind, ev_y, ev_modes):
+def _record_event(t, y, mode, index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes):
     """Store event ``n_ev`` (if there is room) and return the mode after it."""
     kind = _event_kind(mode, index)
-    new_mode = _mode_after(kind, y, coef, ea, eb)
+    new_mode = _mode_after(kind, y, p, coef, ea, eb, br)
     if n_ev < ev_t.shape[0]:
         ev_t[n_ev] = t
         ev_kind[n_ev] = kind
@@ -334,7 +383,7 @@ def _record_event(t, y, mode, index, coef, ea, eb, n_ev, ev_t, ev_kind, ev_y, ev
 
 
 @njit(cache=True)
-def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_steps,
+def integrate(t0, t1, y0, mode0, p, coef, ea, eb, br, rtol, atol, h0, hmax, max_steps,
               t_eval, out_y, out_f, out_mode, ev_t, ev_kind, ev_y, ev_modes):
     """Integrate from ``t0`` to ``t1``; see :func:`discovery.dynamics.simulate`.
 
@@ -356,14 +405,14 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
     need_h0 = True
     ns = 0
     t = t0
-    mode = mode0 if mode0 >= 0 else resolve_mode(y, coef, ea, eb)
+    mode = mode0 if mode0 >= 0 else resolve_mode(y, p, coef, ea, eb, br)
     h = min(h0, hmax, t1 - t0)
     n_eval = t_eval.shape[0]
     k_eval = 0
     while k_eval < n_eval and t_eval[k_eval] <= t0:
         for j in range(4):
             out_y[j, k_eval] = y[j]
-        out_f[k_eval] = mode_force(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb)
+        out_f[k_eval] = mode_force(mode, y[0] - y[2], y[1] - y[3], p, coef, ea, eb, br)
         out_mode[k_eval] = mode
         k_eval += 1
     n_ev = 0
@@ -378,13 +427,13 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
             status = STEP_BUDGET
             break
         if need_f:
-            _rhs(t, y, mode, p, coef, ea, eb, K[0])
+            _rhs(t, y, mode, p, coef, ea, eb, br, K[0])
             need_f = False
         h = min(h, hmax, t1 - t)
         if h < 1e-14 * max(1.0, abs(t)) and t1 - t > h:
             status = STEP_UNDERFLOW
             break
-        _rk_step(t, y, h, mode, p, coef, ea, eb, K, ytmp, ynew)
+        _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew)
         n_steps += 1
         err = _error_norm(y, ynew, K, h, rtol, atol)
         if not np.isfinite(err):
@@ -398,17 +447,17 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
             continue
         # ---- accepted step: look for the earliest event in (t, t + h]
         if need_h0:
-            ns = _switching(mode, y, coef, ea, eb, hs0)
+            ns = _switching(mode, y, p, coef, ea, eb, br, hs0)
             need_h0 = False
-        _switching(mode, ynew, coef, ea, eb, hs1)
+        _switching(mode, ynew, p, coef, ea, eb, br, hs1)
         best_theta = 2.0
         best_index = -1
         # probe the dense output at 1/3 and 2/3 too, so a brief excursion across a
         # switching surface inside one step is seen (once per step, for all functions)
         _dense(y, K, h, 1.0 / 3.0, ybuf)
-        _switching(mode, ybuf, coef, ea, eb, hsa)
+        _switching(mode, ybuf, p, coef, ea, eb, br, hsa)
         _dense(y, K, h, 2.0 / 3.0, ybuf)
-        _switching(mode, ybuf, coef, ea, eb, hsb)
+        _switching(mode, ybuf, p, coef, ea, eb, br, hsb)
         for i in range(ns):
             if hsa[i] >= 0.0 and hsb[i] >= 0.0 and hs1[i] >= 0.0:
                 # fast path: no probe across the surface; only a graze of zeta = 0
@@ -418,7 +467,7 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
                 s = -1.0 if mode == FREE else 1.0
                 if not (s * (y[1] - y[3]) < 0.0 and s * (ynew[1] - ynew[3]) > 0.0):
                     continue
-            th = _first_crossing(t, y, ynew, K, h, mode, coef, ea, eb, i, hs0[i], hsa[i],
+            th = _first_crossing(t, y, ynew, K, h, mode, p, coef, ea, eb, br, i, hs0[i], hsa[i],
                                  hsb[i], hs1[i], ybuf, hsm)
             # near-ties go to the lower index: contact loss (index 0) wins over the
             # force reaching zero at the same instant (e.g. P(zeta, 0) = k * zeta)
@@ -430,7 +479,7 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
                 if zero_len > 4:
                     status = CHATTER
                     break
-                mode = _record_event(t, y, mode, best_index, coef, ea, eb, n_ev, ev_t,
+                mode = _record_event(t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t,
                                      ev_kind, ev_y, ev_modes)
                 n_ev += 1
                 need_f = True
@@ -438,7 +487,7 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
                 continue
             # re-take the step so that it ends on the event
             h_ev = best_theta * h
-            _rk_step(t, y, h_ev, mode, p, coef, ea, eb, K, ytmp, ynew)
+            _rk_step(t, y, h_ev, mode, p, coef, ea, eb, br, K, ytmp, ynew)
             h_used = h_ev
         else:
             h_used = h
@@ -450,7 +499,7 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
             _dense(y, K, h_used, min(theta, 1.0), ybuf)
             for j in range(4):
                 out_y[j, k_eval] = ybuf[j]
-            out_f[k_eval] = mode_force(mode, ybuf[0] - ybuf[2], ybuf[1] - ybuf[3], coef, ea, eb)
+            out_f[k_eval] = mode_force(mode, ybuf[0] - ybuf[2], ybuf[1] - ybuf[3], p, coef, ea, eb, br)
             out_mode[k_eval] = mode
             k_eval += 1
         for j in range(4):
@@ -473,7 +522,7 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, rtol, atol, h0, hmax, max_step
             else:
                 short_run = 0
             t_last_ev = t
-            mode = _record_event(t, y, mode, best_index, coef, ea, eb, n_ev, ev_t, ev_kind,
+            mode = _record_event(t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind,
                                  ev_y, ev_modes)
             n_ev += 1
             need_f = True

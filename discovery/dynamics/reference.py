@@ -41,12 +41,27 @@ _HOLD = 10.0           # a held function keeps its start value for _HOLD x that 
 _MAX_ZERO_LENGTH = 8   # zero-length segments in a row before raising
 
 
+def _signed_pow(x, a):
+    return np.sign(x) ** (a > 0) * abs(x) ** a
+
+
 def _poly(law, z, zd):
-    return float(sum(c * np.sign(z) ** (t.a > 0) * abs(z) ** t.a * np.sign(zd) ** (t.b > 0)
-                     * abs(zd) ** t.b for c, t in zip(law.coefficients, law.terms, strict=True)))
+    """The loading branch ``P`` (odd extension past the surfaces)."""
+    return float(sum(c * _signed_pow(z, t.a) * _signed_pow(zd, t.b)
+                     for c, t in zip(law.coefficients, law.terms, strict=True)))
 
 
-def _force(law, mode, z, v, clamp=False):
+def _unload(law, z, v, zmax):
+    """The unloading branch: ``P(u, 0)`` at the unloading penetration ``u`` (the permanent
+    set) plus the unloading terms at the signed velocity."""
+    s = law.permanent_set
+    u = (z - s * zmax) / (1.0 - s) if s else z
+    return _poly(law, u, 0.0) + float(sum(
+        c * _signed_pow(z, t.a) * _signed_pow(v, t.b)
+        for c, t in zip(law.unloading_coefficients, law.unloading, strict=True)))
+
+
+def _force(law, mode, z, v, zmax, clamp=False):
     """Contact force of a mode.  Inside the integration the vector field is extended
     smoothly past the loss surface (odd extension of ``P``: a Runge-Kutta step that
     straddles the loss samples it there, and a kink would spoil the step's accuracy,
@@ -57,20 +72,21 @@ def _force(law, mode, z, v, clamp=False):
     if mode == "load":
         return _poly(law, z, v)
     if mode == "unload":
-        return _poly(law, z, 0.0)
+        return _unload(law, z, v, zmax)
     return 0.0
 
 
-def _mode_of(law, y):
+def _mode_of(law, y, state):
     z, v = y[0] - y[2], y[1] - y[3]
     if z < 0 or (z == 0 and v <= 0):
         return "free"
     if v > 0:
         return "load" if _poly(law, max(z, 0.0), v) >= 0 else "clipped"
-    return "unload" if _poly(law, z, 0.0) > 0 else "clipped"
+    state["zmax"] = max(state["zmax"], z)
+    return "unload" if _unload(law, z, v, state["zmax"]) > 0 else "clipped"
 
 
-def _events(law, mode):
+def _events(law, mode, state):
     """(function, direction, next-mode rule) for each switching surface of a mode."""
     zeta = lambda t, y: y[0] - y[2]  # noqa: E731
     dz = lambda t, y: y[1] - y[3]  # noqa: E731
@@ -79,19 +95,28 @@ def _events(law, mode):
         out.append((zeta, 1.0, "onset"))
     else:
         out.append((zeta, -1.0, "loss"))
+    zmax = state["zmax"]
     if mode == "load":
         out += [(dz, -1.0, "unload"),
                 (lambda t, y: _poly(law, y[0] - y[2], y[1] - y[3]), -1.0, "release")]
     elif mode == "unload":
-        out += [(dz, 1.0, "reload"), (lambda t, y: _poly(law, y[0] - y[2], 0.0), -1.0, "release")]
+        out += [(dz, 1.0, "reload"),
+                (lambda t, y: _unload(law, y[0] - y[2], y[1] - y[3], zmax), -1.0, "release")]
     elif mode == "clipped":
-        out.append((lambda t, y: _poly(law, max(y[0] - y[2], 0.0), max(y[1] - y[3], 0.0)), 1.0,
-                    "resume"))
+        def resume(t, y):
+            z, v = max(y[0] - y[2], 0.0), y[1] - y[3]
+            return _poly(law, z, v) if v > 0 else _unload(law, z, v, zmax)
+        out.append((resume, 1.0, "resume"))
     return out
 
 
-def _after(law, kind, y):
+def _after(law, kind, y, state, loss):
+    """The mode after an event; an onset starts a new contact (and sheds mass), entering
+    the unloading branch records the contact's largest penetration."""
     z, v = y[0] - y[2], y[1] - y[3]
+    if kind == "onset":
+        state["zmax"] = 0.0
+        state["m2"] *= 1.0 - loss
     if kind == "loss":
         return "free"
     if kind in ("release", "resume") and z <= 0:
@@ -99,10 +124,14 @@ def _after(law, kind, y):
     z = max(z, 0.0)
     if kind == "release":
         return "clipped"
-    if kind == "resume":  # P crossed to positive: the force is on again
-        return "load" if v > 0 else "unload"
+    if kind == "resume":  # the branch force crossed to positive: the force is on again
+        if v > 0:
+            return "load"
+        state["zmax"] = max(state["zmax"], z)
+        return "unload"
     if kind == "unload" or (kind == "onset" and v <= 0):
-        return "unload" if _poly(law, z, 0.0) >= 0 else "clipped"
+        state["zmax"] = max(state["zmax"], z)
+        return "unload" if _unload(law, z, v, state["zmax"]) >= 0 else "clipped"
     return "load" if _poly(law, z, max(v, 0.0)) >= 0 else "clipped"
 
 
@@ -141,7 +170,10 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
         ``t``, ``y`` (4, n), ``force`` at ``t_eval``; ``events`` list of
         ``(t, kind, y)``; ``y_final``; ``nfev``.
     """
-    m1, m2, k1, c1, A, om, g = scenario.params()
+    m1, m2, k1, c1, A, om, g = (scenario.m1, scenario.m2, scenario.k1, scenario.c1,
+                                scenario.A, scenario.omega, scenario.g)
+    k3, loss = scenario.k3, scenario.mass_loss
+    state = {"m2": m2, "zmax": 0.0}
     T = scenario.period
     y = scenario.initial_state() if y0 is None else np.array(y0, dtype=float)
     if atol is None:
@@ -151,7 +183,7 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
     te = np.zeros(0) if t_eval is None else np.asarray(t_eval, dtype=float)
     out_y = np.full((4, te.size), np.nan)
     out_f = np.full(te.size, np.nan)
-    mode = _mode_of(law, y)
+    mode = _mode_of(law, y, state)
     events, nfev, zero_length = [], 0, 0
 
     def record(kind, yy):
@@ -160,15 +192,18 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
             raise IntegrationError("reference integration: too many events")
 
     def make_rhs(mode):
+        zmax, m2 = state["zmax"], state["m2"]
+
         def rhs(tt, yy):
-            f = _force(law, mode, yy[0] - yy[2], yy[1] - yy[3])
-            return [yy[1], -(c1 * yy[1] + k1 * yy[0] + A * np.sin(om * tt) + m1 * g + f) / m1,
+            f = _force(law, mode, yy[0] - yy[2], yy[1] - yy[3], zmax)
+            return [yy[1], -(c1 * yy[1] + (k1 + k3 * yy[0] ** 2) * yy[0] + A * np.sin(om * tt)
+                             + m1 * g + f) / m1,
                     yy[3], f / m2 - g]
         return rhs
 
     while t < t1:
         rhs = make_rhs(mode)
-        evs = _events(law, mode)
+        evs = _events(law, mode, state)
         tau_on = _ON_SURFACE * max(abs(t), T)
         g0, on, trend = _surface_start(evs, rhs, t, y, _TREND_STEP * T, tau_on)
         i_now = _crossing_now(evs, on, trend)
@@ -179,7 +214,7 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
                                        f"t = {t!r} ({zero_length} switches at one instant)")
             kind = evs[i_now][2]
             record(kind, y)
-            mode = _after(law, kind, y)
+            mode = _after(law, kind, y, state, loss)
             continue
         fns = []
         for i, (fn, direction, _) in enumerate(evs):
@@ -207,7 +242,7 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
         if mask.any():
             ys = sol.sol(te[mask])
             out_y[:, mask] = ys
-            out_f[mask] = [_force(law, mode, w1 - w2, v1 - v2, clamp=True)
+            out_f[mask] = [_force(law, mode, w1 - w2, v1 - v2, state["zmax"], clamp=True)
                            for w1, v1, w2, v2 in ys.T]
         y = sol.y[:, -1].copy()
         t = t_end
@@ -223,5 +258,5 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
             j = _crossing_now(evs[:i], on_end[:i], trend_end[:i])
             kind = evs[i if j is None else j][2]
             record(kind, y)
-            mode = _after(law, kind, y)
+            mode = _after(law, kind, y, state, loss)
     return {"t": te, "y": out_y, "force": out_f, "events": events, "y_final": y, "nfev": nfev}

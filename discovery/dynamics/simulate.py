@@ -120,13 +120,29 @@ class Trajectory:
 
     def event_forces(self, law):
         """Left and right limits of the force at each event, ndarray of shape (n_events, 2)."""
-        coef, ea, eb = law.kernel_arrays()
+        coef, ea, eb, br = law.kernel_arrays()
         out = np.empty((len(self.event_t), 2))
+        p = np.zeros(K.N_PARAMS)
+        p[K.P_SET] = law.permanent_set
         for k, (yk, (m0, m1)) in enumerate(zip(self.event_y, self.event_modes, strict=True)):
             z, v = yk[0] - yk[2], yk[1] - yk[3]
-            out[k, 0] = K.mode_force(m0, z, v, coef, ea, eb)
-            out[k, 1] = K.mode_force(m1, z, v, coef, ea, eb)
+            if m0 == K.FREE:
+                p[K.P_ZMAX] = 0.0
+            p[K.P_ZMAX] = max(p[K.P_ZMAX], z)  # the largest penetration so far (events only)
+            out[k, 0] = K.mode_force(m0, z, v, p, coef, ea, eb, br)
+            out[k, 1] = K.mode_force(m1, z, v, p, coef, ea, eb, br)
         return out
+
+
+def kernel_params(scenario, law):
+    """The compiled kernel's parameter vector (:data:`~discovery.dynamics._kernel.P_K3` ...):
+    the scenario's parameters, the law's permanent set and a fresh contact state.  The
+    kernel updates the state slots in place: pass each integration its own copy."""
+    p = np.zeros(K.N_PARAMS)
+    base = scenario.params()
+    p[:base.size] = base
+    p[K.P_SET] = law.permanent_set
+    return p
 
 
 def _atol(scenario, tol):
@@ -171,7 +187,7 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, tolerances=None,
     te = np.zeros(0) if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
     if te.size and (np.any(np.diff(te) < 0) or te[0] < t0 - 1e-12 or te[-1] > t1 + 1e-12):
         raise InputError("t_eval must be sorted and inside t_span")
-    coef, ea, eb = law.kernel_arrays()
+    coef, ea, eb, br = law.kernel_arrays()
     out_y = np.empty((4, te.size))
     out_f = np.empty(te.size)
     out_m = np.empty(te.size, dtype=np.int64)
@@ -181,8 +197,8 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, tolerances=None,
     ev_m = np.empty((max_events, 2), dtype=np.int64)
     period = scenario.period
     status, tf, yf, mf, n_steps, n_ev, _ = K.integrate(
-        t0, t1, y0, -1 if mode0 is None else int(mode0), scenario.params(), coef, ea, eb,
-        tol.rtol, _atol(scenario, tol), period / 100.0, period * tol.hmax_fraction,
+        t0, t1, y0, -1 if mode0 is None else int(mode0), kernel_params(scenario, law), coef,
+        ea, eb, br, tol.rtol, _atol(scenario, tol), period / 100.0, period * tol.hmax_fraction,
         tol.max_steps, te, out_y, out_f, out_m, ev_t, ev_k, ev_y, ev_m)
     message = "ok" if status == 0 else (
         f"integration stopped at t = {tf:.6g} s: {_STATUS[status]}")
