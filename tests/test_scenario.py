@@ -59,7 +59,8 @@ def test_paper_values():
     # default start: grid at its static deflection -m1 g / k1, moulding touching it
     w = -1.0e4 * 9.81 / 2.75e7
     np.testing.assert_allclose(sc.initial_state(), [w, 0.0, w, 0.0], rtol=1e-15, atol=0)
-    np.testing.assert_allclose(sc.params(), [1e4, 1e4, 2.75e7, 1e5, 5e5, 50 * math.pi, 9.81, 0.0, 0.0],
+    np.testing.assert_allclose(sc.params(),
+                               [1e4, 1e4, 2.75e7, 1e5, 5e5, 50 * math.pi, 9.81, 0.0, 0.0],
                                rtol=1e-15, atol=0)
 
 

@@ -499,7 +499,8 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, br, rtol, atol, h0, hmax, max_
             _dense(y, K, h_used, min(theta, 1.0), ybuf)
             for j in range(4):
                 out_y[j, k_eval] = ybuf[j]
-            out_f[k_eval] = mode_force(mode, ybuf[0] - ybuf[2], ybuf[1] - ybuf[3], p, coef, ea, eb, br)
+            out_f[k_eval] = mode_force(mode, ybuf[0] - ybuf[2], ybuf[1] - ybuf[3], p, coef, ea,
+                                       eb, br)
             out_mode[k_eval] = mode
             k_eval += 1
         for j in range(4):

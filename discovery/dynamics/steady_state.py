@@ -9,6 +9,10 @@ multipliers are the eigenvalues of that Jacobian.  An orbit is accepted only whe
 it converged and is stable; otherwise a long transient is integrated and the
 search repeated, and if that fails too the result says "nonperiodic" with the
 evidence.
+
+The recurrence, the Newton shooting, the period reduction and the Floquet multipliers
+are :mod:`discovery.dynamics.shooting` (shared with Ueda's oscillators);
+:class:`StroboscopicMap` is this system's period map for it.
 """
 
 from dataclasses import dataclass, field
@@ -17,7 +21,14 @@ import numpy as np
 
 from ..errors import IntegrationError
 from . import _kernel as K
-from .simulate import _STATUS, Tolerances, _atol, simulate
+from .shooting import (
+    floquet_multipliers,
+    is_stable,
+    newton_orbit,
+    recurrence,
+    smallest_period,
+)
+from .simulate import _STATUS, Tolerances, _atol, kernel_params, simulate
 
 __all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
 
@@ -36,8 +47,8 @@ class StroboscopicMap:
         self.scenario = scenario
         self.law = law
         self.tol = tolerances or Tolerances()
-        self._p = scenario.params()
-        self._coef, self._ea, self._eb = law.kernel_arrays()
+        self._p = kernel_params(scenario, law)
+        self._coef, self._ea, self._eb, self._br = law.kernel_arrays()
         self._atol = _atol(scenario, self.tol)
         self._T = scenario.period
         self._hmax = self._T * self.tol.hmax_fraction
@@ -57,8 +68,8 @@ class StroboscopicMap:
     def advance(self, y, n=1, t0=0.0):
         """State after ``n`` periods from ``y`` at time ``t0`` (a multiple of ``T``)."""
         status, tf, yf, _, steps, _, _ = K.integrate(
-            t0, t0 + n * self._T, np.asarray(y, dtype=float), -1, self._p, self._coef, self._ea,
-            self._eb, self.tol.rtol, self._atol, self._T / 100.0, self._hmax,
+            t0, t0 + n * self._T, np.asarray(y, dtype=float), -1, self._p.copy(), self._coef,
+            self._ea, self._eb, self._br, self.tol.rtol, self._atol, self._T / 100.0, self._hmax,
             self.tol.max_steps, self._empty, self._ey, self._ef, self._em, self._evt,
             self._evk, self._evy, self._evm)
         self.n_calls += 1
@@ -136,80 +147,6 @@ class SteadyState:
                 "residual": self.residual, "n_simulations": self.n_simulations}
 
 
-def _recurrence(strobe, scale, max_period):
-    """Smallest relative distance ``|y_{k+n} - y_k|`` over the last strobe points, per n."""
-    d = {}
-    last = len(strobe) - 1
-    for n in range(1, max_period + 1):
-        ks = range(max(0, last - n - 2), last - n + 1)
-        d[n] = float(max(np.max(np.abs(strobe[k + n] - strobe[k]) / scale) for k in ks))
-    return d
-
-
-def _newton(pm, y, n, tol, max_iter, history):
-    """Damped Newton on ``G(y) = Phi^n(y) - y``; returns (y, residual, J, converged)."""
-    s = pm.scale
-    fy = pm.advance(y, n)
-    res = np.max(np.abs(fy - y) / s)
-    J = None
-    for _ in range(max_iter):
-        history.append(res)
-        if res < tol:
-            break
-        J = pm.jacobian(y, n, fy)
-        try:
-            step = np.linalg.solve(J - np.eye(4), -(fy - y))
-        except np.linalg.LinAlgError:
-            return y, res, J, False
-        lam = 1.0
-        while lam > 1e-3:
-            y_try = y + lam * step
-            try:
-                f_try = pm.advance(y_try, n)
-            except IntegrationError:
-                lam *= 0.5
-                continue
-            r_try = np.max(np.abs(f_try - y_try) / s)
-            if r_try < res:
-                y, fy, res = y_try, f_try, r_try
-                break
-            lam *= 0.5
-        else:
-            return y, res, J, False
-    converged = res < tol
-    if converged:
-        J = pm.jacobian(y, n, fy)
-    return y, res, J, converged
-
-
-def _reduce_period(pm, y_orb, n, tol, max_newton):
-    """The smallest period ``m | n`` of a stable period-``n`` orbit through ``y_orb``.
-
-    Each divisor ``m`` is tested by polishing: damped Newton on ``Phi^m(y) = y`` from
-    ``y_orb``.  The orbit has period ``m`` when that converges to a *stable* fixed point
-    of ``Phi^m`` close to ``y_orb`` (two attracting fixed points of ``Phi^n`` cannot be
-    arbitrarily close).  The decision therefore rests on the accuracy Newton reaches at
-    each divisor, never on a fixed closure threshold: a period-1 orbit with a Floquet
-    multiplier near +1 or -1 closes after one period only to the accuracy that shooting
-    at ``n`` reached, which can be far above ``tol``.  Near a period doubling the nearby
-    period-``m`` orbit is unstable (a multiplier below -1), so it is not taken.
-
-    Returns ``(m, y, residual, J)`` or ``None`` when no divisor closes the orbit.
-    """
-    for m in range(1, n):
-        if n % m:
-            continue
-        hist = []
-        y_m, res_m, J_m, ok_m = _newton(pm, y_orb, m, tol, max_newton, hist)
-        if not ok_m:
-            continue
-        mult = np.linalg.eigvals(J_m)
-        close = np.max(np.abs(y_m - y_orb) / pm.scale) < 1e-3
-        if close and np.all(np.abs(mult) < 1.0):
-            return m, y_m, res_m, J_m, hist
-    return None
-
-
 def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_newton=12,
                  long_transient=300, tolerances=None, y_start=None, t_start=0.0):
     """Find the periodic steady state reached from a given (or the scenario's) state.
@@ -275,7 +212,7 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
                 strobe.append(pm.advance(strobe[-1], 1))
             y = strobe[-1]
             t_done += 2 * max_period + 2
-            dist = _recurrence(strobe, pm.scale, max_period)
+            dist = recurrence(strobe, pm.scale, max_period)
         order = sorted(dist, key=lambda n: (dist[n] > 1e-2, n if dist[n] <= 1e-2 else dist[n]))
         attempt = {"phase": phase, "recurrence": dist, "tried": []}
         evidence["attempts"].append(attempt)
@@ -283,20 +220,20 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
             order = [1] + [n for n in range(2, max_period + 1)][:2]
         for n in order[:3]:
             hist = []
-            y_orb, res, J, ok = _newton(pm, y, n, tol, max_newton, hist)
-            mult = np.linalg.eigvals(J) if J is not None else np.full(4, np.nan + 0j)
-            stable = bool(ok and np.all(np.abs(mult) < 1.0))
+            y_orb, res, J, ok = newton_orbit(pm, y, n, tol, max_newton, hist)
+            mult = floquet_multipliers(J, len(y))
+            stable = bool(ok and is_stable(mult))
             attempt["tried"].append({"n": n, "newton_residuals": hist, "converged": ok,
                                      "max_multiplier": float(np.max(np.abs(mult))),
                                      "stable": stable})
             if not stable:
                 continue
-            reduced = _reduce_period(pm, y_orb, n, tol, max_newton) if n > 1 else None
+            reduced = smallest_period(pm, y_orb, n, tol, max_newton) if n > 1 else None
             if reduced is not None:
                 m, y_orb, res, J, hist_m = reduced
                 attempt["tried"].append({"n": m, "reduced_from": n, "newton_residuals": hist_m,
                                          "converged": True, "stable": True})
-                n, mult = m, np.linalg.eigvals(J)
+                n, mult = m, floquet_multipliers(J)
             t0 = t_done * T
             impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n)
             return SteadyState(regime=f"P{n}", n_periods=n, y0=y_orb, t0=t0, impacts=impacts,

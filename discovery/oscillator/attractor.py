@@ -252,7 +252,10 @@ class Regime:
     evidence : dict
         ``recurrence`` (max distance ``|S_{k+n} - S_k|`` / scale over the last points,
         per ``n``), ``lyapunov``, ``lyapunov_threshold``, ``rotation_number`` and
-        ``monotone_fraction`` (beat), ``rule`` (the sentence that decided).
+        ``monotone_fraction`` (beat), ``rule`` (the sentence that decided).  When the
+        orbit was polished by shooting (:func:`classify`, or :func:`classify_points`
+        with a ``period_map``): ``floquet_multipliers_abs``, ``newton_residual`` and
+        ``shooting`` (:meth:`~discovery.oscillator.periodic.PeriodicOrbit.as_dict`).
     """
 
     regime: str
@@ -266,13 +269,21 @@ class Regime:
 
 
 def classify_points(strobe, scale, lam, lam_stderr=0.0, *, max_period=8, closure=1e-5,
-                    chaos_threshold=0.01):
+                    chaos_threshold=0.01, period_map=None, shooting_tol=1e-8):
     """Classify from stroboscopic points and the largest exponent (see :class:`Regime`).
 
     Rules, in order: the smallest ``n <= max_period`` whose recurrence distance is below
     ``closure`` gives ``P<n>``; else a largest exponent above ``max(chaos_threshold,
     3 stderr)`` gives ``chaotic``; else ``beat`` (exponent near 0), with the rotation
     number of the points around their centre.
+
+    With a ``period_map`` (a :class:`~discovery.oscillator.periodic.UedaMap` of the
+    system the points came from) a recurring orbit is polished by shooting from the last
+    point (:func:`~discovery.oscillator.periodic.periodic_orbit`, Newton tolerance
+    ``shooting_tol``) and is periodic only if Newton converges to a stable orbit (all
+    Floquet multipliers inside the unit circle); its period is then the smallest one
+    shooting finds.  Otherwise the exponent rules decide.  Without one (the default, as
+    in the chart), the recurrence alone decides.
     """
     s = np.asarray(strobe, dtype=float)
     m = min(len(s) - 1, 3 * max_period)
@@ -285,9 +296,24 @@ def classify_points(strobe, scale, lam, lam_stderr=0.0, *, max_period=8, closure
           "closure": closure}
     for n, d in rec.items():
         if d < closure:
-            ev["rule"] = (f"the strobe points repeat after {n} period(s) to {d:.1e} of the "
-                          f"scale (< {closure:g})")
-            return Regime(f"P{n}", "P1" if n == 1 else "Pn", n, ev)
+            rule = (f"the strobe points repeat after {n} period(s) to {d:.1e} of the "
+                    f"scale (< {closure:g})")
+            if period_map is None:
+                ev["rule"] = rule
+                return Regime(f"P{n}", "P1" if n == 1 else "Pn", n, ev)
+            orb = _shoot(period_map, s[-1], n, shooting_tol, ev)
+            if orb is not None and orb.converged and orb.stable:
+                n = orb.n_periods
+                big = float(np.max(np.abs(orb.multipliers)))
+                ev["rule"] = (f"{rule}; shooting converged (residual {orb.residual:.1e}) to a "
+                              f"stable period-{n} orbit, largest |Floquet multiplier| "
+                              f"{big:.4g} < 1")
+                return Regime(f"P{n}", "P1" if n == 1 else "Pn", n, ev)
+            why = ("shooting failed" if orb is None else
+                   "shooting did not converge" if not orb.converged else
+                   "the orbit shooting converged to is unstable")
+            ev["periodic_rejected"] = f"{rule}, but {why}"
+            break
     thr = max(chaos_threshold, 3.0 * lam_stderr)
     ev["lyapunov_threshold"] = thr
     rho, mono = rotation_number(s)
@@ -301,13 +327,38 @@ def classify_points(strobe, scale, lam, lam_stderr=0.0, *, max_period=8, closure
     return Regime("beat", "beat", 0, ev)
 
 
-def classify(system, y0=None, *, transient=300, periods=400, tolerances=None, **rules):
-    """The regime reached from ``y0``: ``(Regime, Lyapunov, strobe points)``."""
+def _shoot(period_map, y, n, tol, ev):
+    """Shooting for the period-``n`` orbit near ``y``; its evidence into ``ev``."""
+    from .periodic import periodic_orbit
+
+    try:
+        orb = periodic_orbit(period_map.system, y, n, tol=tol, period_map=period_map)
+    except IntegrationError as exc:
+        ev["shooting"] = {"n_periods": int(n), "error": str(exc)}
+        return None
+    ev["shooting"] = orb.as_dict()
+    ev["floquet_multipliers_abs"] = [float(abs(m)) for m in orb.multipliers]
+    ev["newton_residual"] = float(orb.residual)
+    return orb
+
+
+def classify(system, y0=None, *, transient=300, periods=400, tolerances=None, shoot=True,
+             **rules):
+    """The regime reached from ``y0``: ``(Regime, Lyapunov, strobe points)``.
+
+    ``shoot`` (default): a recurring orbit is polished by shooting and called periodic
+    only if it converges to a stable orbit; its Floquet multipliers and Newton residual
+    are in the evidence (see :func:`classify_points`).  ``rules`` are passed on to it.
+    """
     tol, T, atol, hmax = _setup(system, tolerances)
     y = _after(system, y0, transient, tol)
     logs, trace, strobe, _ = _variational(system, y, 0.0, periods, tol, T, atol, hmax)
     lyap = lyapunov(system, tolerances=tol, batches=min(20, max(2, int(periods) // 20)),
                     _run=(logs, trace))
+    if shoot and rules.get("period_map") is None:
+        from .periodic import UedaMap
+
+        rules["period_map"] = UedaMap(system, tol)
     reg = classify_points(strobe, system.scales(), lyap.value, lyap.stderr, **rules)
     return reg, lyap, strobe
 
@@ -372,7 +423,11 @@ def attractor(system, y0=None, *, transient=500, periods=5000, batches=20,
     y = _after(system, y_init, transient, tol)
     logs, trace, strobe, yf = _variational(system, y, 0.0, periods, tol, T, atol, hmax)
     lyap = lyapunov(system, tolerances=tol, batches=batches, _run=(logs, trace))
-    reg = classify_points(strobe, system.scales(), lyap.value, lyap.stderr)
+    from .periodic import UedaMap
+
+    # a recurring orbit is polished by shooting: its Floquet multipliers are the evidence
+    reg = classify_points(strobe, system.scales(), lyap.value, lyap.stderr,
+                          period_map=UedaMap(system, tol))
     n_tr = int(trajectory_periods)
     t, x, v = trajectory(system, yf, (0.0, n_tr * T), n_samples=200 * n_tr, tolerances=tol)
     return Attractor(system=system, regime=reg, lyapunov=lyap, strobe=strobe, t=t, x=x, v=v,
