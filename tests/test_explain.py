@@ -15,6 +15,7 @@ from discovery import ForceLaw, load_scenario
 from discovery.cli import main
 from discovery.errors import InputError
 from discovery.explain import EFFECTS, effect, explain, first_order_lag
+from discovery.explain.effects import TARGETS
 from discovery.measurement import Measurement
 from discovery.response import response
 
@@ -126,9 +127,14 @@ def test_first_order_lag_is_exact_for_a_step():
 def test_catalogue_entries_are_complete():
     for e in EFFECTS:
         assert e.id and e.explanation and e.enters and e.signature and e.parameters
-        assert bool(e.terms) != bool(e.observation)
+        assert e.target in TARGETS and e.key
         d = e.as_dict()
         assert d["parameters"][0]["bounds"][0] >= 0
+    # the effects the paper's model cannot have say which of its conditions they leave
+    assert "condition (5)" in effect("unloading_damping").departs
+    assert {e.id for e in EFFECTS} >= {"penetration_velocity_coupling", "hertzian_stiffening",
+                                       "unloading_damping", "permanent_set",
+                                       "support_nonlinearity", "sensor_lag"}
     with pytest.raises(InputError, match="unknown effect"):
         effect("gremlins")
 
@@ -143,7 +149,7 @@ def test_explain_cli_end_to_end(hidden_coupling, tmp_path, capsys):
     assert [it["effect"] for it in s["iterations"]] == ["penetration_velocity_coupling"]
     it = s["iterations"][0]
     assert set(it) >= {"effect", "evidence", "criteria_before", "criteria_after", "parameters"}
-    assert "z*zd" in it["parameters"]
+    assert "c_z_zd" in it["parameters"]  # the catalogue parameter name
     fm = s["final_model"]
     assert set(fm) >= {"terms", "coefficients", "uncertainties", "latex", "effects"}
     assert fm["effects"] == ["penetration_velocity_coupling"]

@@ -56,8 +56,7 @@ def run(args):
         if it.equivalent:
             print(f"  equally good: {', '.join(it.equivalent)}")
     fm = res.final_model
-    print(f"final model: {fm.law}" + (f"  observed through {fm.observation}"
-                                      if fm.observation else ""))
+    print(f"final model: {fm}")
     if res.uncertainties:
         print(coefficients_line(fm.law.as_dict(), res.uncertainties))
     if res.criteria:

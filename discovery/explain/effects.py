@@ -1,24 +1,32 @@
 """The catalogue of named physical effects: each a candidate "omitted variable".
 
-An effect extends a :class:`Model` through one general mechanism: it adds terms to the
-force law (``terms``), or an observation model applied to the simulated force before it
-is compared with the record (``observation``).  Nothing effect-specific enters the
-simulator's hot loop.
+An effect extends a :class:`Model` through one general mechanism, :meth:`Model.with_effect`:
+its ``target`` says where its one parameter enters,
 
-Effects that need a law with a separate unloading branch, a hysteresis state, a
-drifting mass or a support term (unloading damping, permanent set, mass loss, support
-nonlinearity) need those extensions of the simulator first; they are not in the
-catalogue yet, so no claim is ever made about them.
+``term``         a loading term of the force law (the paper's polynomial);
+``unloading``    a term of the law's own unloading branch (:class:`~discovery.law.ForceLaw`);
+``set``          the law's permanent-set fraction;
+``scenario``     a machine parameter (``k3``, ``mass_loss``: :class:`~discovery.scenario.Scenario`);
+``observation``  an observation model applied to the simulated force before it is compared
+                 with the record (a sensor's dynamics).
+
+The simulator reads all of them from its parameter vector and law arrays; nothing
+effect-specific enters its hot loop.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..errors import InputError
 from ..impulse import Impulse
 from ..law import ForceLaw, Term
 
-__all__ = ["Parameter", "Effect", "Model", "EFFECTS", "effect", "first_order_lag"]
+__all__ = ["Parameter", "Effect", "Model", "EFFECTS", "TARGETS", "effect", "first_order_lag",
+           "small_step"]
+
+#: where an effect's parameter can enter a model
+TARGETS = ("term", "unloading", "set", "scenario", "observation")
 
 
 @dataclass(frozen=True)
@@ -41,13 +49,20 @@ class Effect:
     title, explanation, enters, signature : str
         What it is, the physics, how it enters the model, how it shows in a record.
     parameters : tuple of Parameter
+        Its one parameter, with physical bounds.
     phases : tuple of str
         The impact phases where its signature concentrates (checked against the
-        localisation, :func:`discovery.explain.localise`).
+        localisation, :func:`discovery.explain.localise`); ``"grid"`` for the grid's free
+        motion, ``"drift"`` for a trend across the impacts of a record.
+    target : str
+        Where the parameter enters (:data:`TARGETS`).
+    key : str
+        The term, scenario field or observation model it sets.
+    departs : str
+        The paper's condition it departs from, and why a user may still need it.
     terms : tuple of str
-        Force-law terms it adds (law effects).
-    observation : str or None
-        Name of the observation model it adds (observation effects).
+        For a system whose effects are terms of its own model (the Ueda oscillator's
+        catalogue): the terms it adds; ``target`` is then ``"term"`` and ``key`` the first.
     """
 
     id: str
@@ -57,21 +72,29 @@ class Effect:
     signature: str
     parameters: tuple
     phases: tuple
+    target: str = ""
+    key: str = ""
+    departs: str = ""
     terms: tuple = ()
-    observation: str | None = None
+
+    def __post_init__(self):
+        if not self.target and self.terms:
+            object.__setattr__(self, "target", "term")
+            object.__setattr__(self, "key", self.terms[0])
+        if self.target not in TARGETS or not self.key:
+            raise ValueError(f"effect {self.id}: target must be one of {TARGETS}, with a key")
 
     def applicable(self, model):
-        """Whether the effect can still be added to ``model``."""
-        if self.terms:
-            return not set(self.terms) & set(model.law.names)
-        return self.observation not in model.observation
+        """Whether the effect can still be added to ``model`` (its parameter is zero)."""
+        return model.value(self) == 0.0
 
     def as_dict(self):
         return {"id": self.id, "title": self.title, "explanation": self.explanation,
                 "enters": self.enters, "signature": self.signature,
                 "parameters": [{"name": p.name, "unit": p.unit, "bounds": list(p.bounds)}
                                for p in self.parameters],
-                "phases": list(self.phases)}
+                "phases": list(self.phases), "target": self.target, "key": self.key,
+                "departs_from_paper": self.departs}
 
 
 def first_order_lag(impulse, tau):
@@ -104,15 +127,31 @@ def first_order_lag(impulse, tau):
 _OBSERVATIONS = {"sensor_lag": first_order_lag}
 
 
+def _term(name):
+    return Term.parse(name)
+
+
+def _set_term(terms, coefs, name, value):
+    t = _term(name)
+    if t in terms:
+        i = terms.index(t)
+        coefs = coefs[:i] + (float(value),) + coefs[i + 1:]
+        return terms, coefs
+    return terms + (t,), coefs + (float(value),)
+
+
 @dataclass(frozen=True)
 class Model:
-    """A force law with the observation models added to it.
+    """A force law with the machine changes and observation models added to it.
 
     Attributes
     ----------
     law : ForceLaw
+        With its unloading branch, if an effect gave it one.
     observation : dict
         ``{name: parameter}``, e.g. ``{"sensor_lag": 2e-5}`` (a time constant [s]).
+    scenario : dict
+        Machine parameters changed from the record's scenario, e.g. ``{"k3": 3e12}``.
     effects : tuple of str
         Ids of the effects added so far.
     """
@@ -120,6 +159,49 @@ class Model:
     law: ForceLaw
     observation: dict = field(default_factory=dict)
     effects: tuple = ()
+    scenario: dict = field(default_factory=dict)
+
+    # ------------------------------------------------------------- one mechanism
+    def value(self, eff):
+        """The current value of an effect's parameter (0 when it is absent)."""
+        law, key = self.law, eff.key
+        if eff.target == "term":
+            return law.as_dict().get(_term(key).name, 0.0)
+        if eff.target == "unloading":
+            d = dict(zip([t.name for t in law.unloading], law.unloading_coefficients,
+                         strict=True))
+            return d.get(_term(key).name, 0.0)
+        if eff.target == "set":
+            return law.permanent_set
+        if eff.target == "scenario":
+            return float(self.scenario.get(key, 0.0))
+        return float(self.observation.get(key, 0.0))
+
+    def with_effect(self, eff, value, add=True):
+        """The model with the effect's parameter set to ``value`` (and, with ``add``, the
+        effect's id recorded)."""
+        law, obs, scen = self.law, dict(self.observation), dict(self.scenario)
+        if eff.target == "term":
+            law = ForceLaw(*_set_term(law.terms, law.coefficients, eff.key, value),
+                           law.unloading, law.unloading_coefficients, law.permanent_set)
+        elif eff.target == "unloading":
+            terms, coefs = _set_term(law.unloading, law.unloading_coefficients, eff.key, value)
+            law = law.with_unloading(terms, coefs)
+        elif eff.target == "set":
+            law = law.with_unloading(permanent_set=float(value))
+        elif eff.target == "scenario":
+            scen[eff.key] = float(value)
+        else:
+            obs[eff.key] = float(value)
+        ids = self.effects + ((eff.id,) if add and eff.id not in self.effects else ())
+        return Model(law, obs, ids, scen)
+
+    def with_law(self, law):
+        return replace(self, law=law)
+
+    def apply(self, scenario):
+        """The record's scenario with this model's machine changes."""
+        return scenario.replace(**self.scenario) if self.scenario else scenario
 
     def observe(self):
         """The observation model ``Impulse -> Impulse`` (None when there is none)."""
@@ -134,19 +216,36 @@ class Model:
 
         return apply
 
-    def with_term(self, term, coefficient, effect_id):
-        law = ForceLaw(self.law.terms + (Term.parse(term),),
-                       self.law.coefficients + (float(coefficient),))
-        return Model(law, dict(self.observation), self.effects + (effect_id,))
-
-    def with_observation(self, name, value, effect_id):
-        return Model(self.law, {**self.observation, name: float(value)},
-                     self.effects + (effect_id,))
-
     def as_dict(self):
-        return {"terms": list(self.law.names), "coefficients": self.law.as_dict(),
+        law = self.law
+        return {"terms": list(law.names), "coefficients": law.as_dict(),
+                "unloading": dict(zip([t.name for t in law.unloading],
+                                      law.unloading_coefficients, strict=True)),
+                "permanent_set": law.permanent_set, "scenario": dict(self.scenario),
                 "observation": dict(self.observation), "effects": list(self.effects),
-                "latex": self.law.latex(), "text": self.law.to_text()}
+                "latex": law.latex(), "text": law.to_text()}
+
+    def __str__(self):
+        extra = [f"{k} = {v:.4g}" for k, v in sorted(self.scenario.items())]
+        extra += [f"observed through {k} = {v:.4g}" for k, v in sorted(self.observation.items())]
+        return str(self.law) + (f"  ({'; '.join(extra)})" if extra else "")
+
+
+def small_step(eff, scenario, peak, tau, v, z0):
+    """A small value of an effect's parameter: one that changes the force by about 1 % of
+    its peak (``peak`` [N], at the typical penetration ``z0`` and impact velocity ``v``),
+    1 % of the contact time ``tau`` for a time constant, a 2 % set, supports 1 % stiffer at
+    the grid's excursion, or 0.2 % of the mass shed per impact."""
+    if eff.target in ("term", "unloading"):
+        return 0.01 * peak / max(float(_term(eff.key)(z0, v)), 1e-300)
+    if eff.target == "set":
+        return 0.02
+    if eff.target == "observation":
+        return 0.01 * tau
+    if eff.key == "k3":
+        x = abs(float(scenario.initial_state()[0])) + scenario.scales()[0]
+        return 0.01 * max(scenario.k1, 1e-300) / x**2
+    return 0.002
 
 
 EFFECTS = (
@@ -161,8 +260,7 @@ EFFECTS = (
         signature="onset jump and early loading smaller than a linear damper's; the peak "
                   "later in the impact",
         parameters=(Parameter("c_z_zd", "N s/m^2", (0.0, np.inf)),),
-        phases=("onset", "loading", "peak"),
-        terms=("z*zd",)),
+        phases=("onset", "loading", "peak"), target="term", key="z*zd"),
     Effect(
         id="hertzian_stiffening",
         title="Hertzian stiffening",
@@ -172,8 +270,50 @@ EFFECTS = (
         enters="a force-law term k*z^1.5, k >= 0",
         signature="the force grows faster than linearly late in loading; a shorter contact",
         parameters=(Parameter("k_z1.5", "N/m^1.5", (0.0, np.inf)),),
-        phases=("loading", "peak", "unloading"),
-        terms=("z^1.5",)),
+        phases=("loading", "peak", "unloading"), target="term", key="z^1.5"),
+    Effect(
+        id="unloading_damping",
+        title="Damping while unloading",
+        explanation="The contact dissipates energy in restitution too (wet sand, a rubber "
+                    "pad): a damper that keeps acting while the bodies separate, so the "
+                    "force falls below the elastic branch and reaches zero before the "
+                    "penetration does; the bodies then part with the surface still "
+                    "indented.",
+        enters="a term d*zd of the law's unloading branch (acting at the signed velocity, "
+               "lowering the force while the bodies separate), d >= 0",
+        signature="the force reaches zero before zeta does; a weaker unloading and an "
+                  "earlier end of the force",
+        parameters=(Parameter("d_zd", "N s/m", (0.0, np.inf)),),
+        phases=("unloading", "separation"), target="unloading", key="zd",
+        departs="the paper's condition (5) (a negative penetration velocity has no effect "
+                "on the force): a real contact can dissipate energy while unloading, and "
+                "its restitution is then lower than any law obeying (5) with the same "
+                "loading can give"),
+    Effect(
+        id="permanent_set",
+        title="Permanent set (plastic indentation, Walton-Braun)",
+        explanation="The moulding's sand (or the grid's pad) yields under load: unloading "
+                    "is stiffer than loading and ends at a residual penetration, a share s "
+                    "of the impact's largest one (linear law: loading k*z, unloading "
+                    "k/(1-s)*(z - s*z_max)). The set is recovered between impacts.",
+        enters="the law's permanent-set fraction s in [0, 0.95]",
+        signature="unloading ends at a residual penetration: the force drops to zero "
+                  "before the bodies separate, faster than the loading rose",
+        parameters=(Parameter("set", "1", (0.0, 0.95)),),
+        phases=("unloading", "separation"), target="set", key="permanent_set",
+        departs="the paper's elastic unloading P(zeta, 0): a plastic contact does not give "
+                "back its loading energy, whatever the velocity"),
+    Effect(
+        id="support_nonlinearity",
+        title="Stiffening grid supports",
+        explanation="The grid's springs stiffen with the deflection (rubber buffers, coil "
+                    "springs closing up): their force is k1*w1 + k3*w1^3. The grid's free "
+                    "motion, and with it the impact velocity, depart from a linear "
+                    "suspension's.",
+        enters="the supports' cubic stiffness k3 >= 0 (a machine parameter)",
+        signature="the disagreement lies in the grid's free motion; the impacts shift with it",
+        parameters=(Parameter("k3", "N/m^3", (0.0, np.inf)),),
+        phases=("grid", "free", "onset"), target="scenario", key="k3"),
     Effect(
         id="sensor_lag",
         title="Force-sensor lag",
@@ -183,8 +323,7 @@ EFFECTS = (
         enters="an observation model on the simulated force (the simulation is unchanged)",
         signature="a smeared onset, a phase lag, force after the separation",
         parameters=(Parameter("tau", "s", (0.0, 5e-3)),),
-        phases=("onset", "separation"),
-        observation="sensor_lag"),
+        phases=("onset", "separation"), target="observation", key="sensor_lag"),
 )
 
 
@@ -193,7 +332,5 @@ def effect(effect_id):
     for e in EFFECTS:
         if e.id == effect_id:
             return e
-    from ..errors import InputError
-
     raise InputError(f"unknown effect {effect_id!r}; the catalogue has "
                      f"{', '.join(e.id for e in EFFECTS)}")

@@ -36,7 +36,7 @@ from ..errors import InputError, IntegrationError
 from ..identify import as_records, contact_scales, identify, pair_records, record_start
 from ..law import ForceLaw
 from ..verify import evaluate
-from .effects import EFFECTS, Model
+from .effects import EFFECTS, Model, small_step
 from .localise import localise
 
 __all__ = ["ExplainResult", "Iteration", "explain", "start_law"]
@@ -215,8 +215,8 @@ class _Problem:
         evs = []
         for sc, ref in self.records:
             self.n_sim += 1
-            evs.append(evaluate(sc, model.law, ref, tolerances=self.tol, floor=floor,
-                                observe=model.observe()))
+            evs.append(evaluate(model.apply(sc), model.law, ref, tolerances=self.tol,
+                                floor=floor, observe=model.observe()))
         return evs
 
     def residual(self, model):
@@ -239,19 +239,25 @@ def _mean(evs, key):
 
 
 def _small_step(eff, records):
-    """A small value of the effect's parameter (1 % of the peak force at the typical
-    penetration and impact velocity; 1 % of the contact time for a time constant)."""
+    """A small value of the effect's parameter (:func:`~discovery.explain.effects.small_step`
+    at the first record's scales)."""
     tau, v, z0 = contact_scales(*records[0])
-    if eff.terms:
-        term = ForceLaw.parse(f"1*{eff.terms[0]}").terms[0]
-        return 0.01 * records[0][1].impulse.peak / max(float(term(z0, v)), 1e-300)
-    return 0.01 * tau
+    return small_step(eff, records[0][0], records[0][1].impulse.peak, tau, v, z0)
+
+
+def _signature_agrees(eff, loc, top_phases):
+    """Whether the localisation shows the effect's signature: its phases among the two
+    with the largest shares, the grid's motion off beyond its noise (``"grid"``), or a
+    significant trend across the impacts (``"drift"``)."""
+    if set(eff.phases) & set(top_phases):
+        return True
+    if "grid" in eff.phases and (loc.get("grid") or {}).get("exceeds_noise"):
+        return True
+    return bool("drift" in eff.phases and (loc.get("drift") or {}).get("significant"))
 
 
 def _extend(model, eff, value):
-    if eff.terms:
-        return model.with_term(eff.terms[0], value, eff.id)
-    return model.with_observation(eff.observation, value, eff.id)
+    return model.with_effect(eff, value)
 
 
 def _score(problem, model, r0, J, eff, records, sigma):
@@ -280,8 +286,7 @@ def _jacobian(problem, model, r0):
         h = 1e-4 * abs(c)
         coefs = list(law.coefficients)
         coefs[i] = c + h
-        r1 = problem.residual(Model(law.with_coefficients(coefs), model.observation,
-                                    model.effects))
+        r1 = problem.residual(model.with_law(law.with_coefficients(coefs)))
         if r1 is None:
             continue
         cols.append((r1 - r0) / h)
@@ -293,26 +298,30 @@ def _refit(problem, model, eff, direction, records, criterion, budget, tol):
     by output error; returns ``(model, identification or None)``."""
     h = _small_step(eff, records)
     start = direction if direction and direction > 0 else h
-    if eff.terms:
+
+    def fit_law(trial):
+        return identify([trial.apply(s) for s, _ in records], [r for _, r in records],
+                        trial.law, criterion=criterion, method="least-squares",
+                        max_simulations=budget, tolerances=tol, observe=trial.observe())
+
+    if eff.target == "term":
+        # a loading term: its coefficient joins the law's, refitted together
         trial = _extend(model, eff, start)
         try:
-            res = identify([s for s, _ in records], [r for _, r in records], trial.law,
-                           criterion=criterion, method="least-squares",
-                           max_simulations=budget, tolerances=tol)
+            res = fit_law(trial)
         except IntegrationError:
             trial = _extend(model, eff, h)
-            res = identify([s for s, _ in records], [r for _, r in records], trial.law,
-                           criterion=criterion, method="least-squares",
-                           max_simulations=budget, tolerances=tol)
-        return Model(res.law, dict(model.observation), trial.effects), res
-    # an observation parameter: alternate a bounded 1-D fit of it (law fixed) and an
-    # output-error refit of the law (parameter fixed); the law first absorbed what the
-    # missing effect did, so one pass is not enough
+            res = fit_law(trial)
+        return trial.with_law(res.law), res
+    # any other parameter (an unloading term, a set, a machine parameter, an observation
+    # model): alternate a bounded 1-D fit of it (law fixed) and an output-error refit of
+    # the law (parameter fixed); the law first absorbed what the missing effect did, so
+    # one pass is not enough
     lo, hi = eff.parameters[0].bounds
     hi = min(hi, 20 * h)
     law, res, value = model.law, None, h
     for _ in range(_ALTERNATIONS):
-        base = Model(law, dict(model.observation), model.effects)
+        base = model.with_law(law)
 
         def cost(v, base=base):
             r = problem.residual(_extend(base, eff, v))
@@ -322,15 +331,11 @@ def _refit(problem, model, eff, direction, records, criterion, budget, tol):
                               options={"xatol": 1e-3 * h, "maxiter": 40})
         moved = abs(float(opt.x) - value) / max(value, 1e-300)
         value = float(opt.x)
-        trial = _extend(base, eff, value)
-        res = identify([s for s, _ in records], [r for _, r in records], trial.law,
-                       criterion=criterion, method="least-squares", max_simulations=budget,
-                       tolerances=tol, observe=trial.observe())
+        res = fit_law(_extend(base, eff, value))
         law = res.law
         if moved < 0.01:
             break
-    return Model(law, {**model.observation, eff.observation: value},
-                 model.effects + (eff.id,)), res
+    return _extend(model.with_law(law), eff, value), res
 
 
 def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01,
@@ -413,7 +418,7 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             break
         if len(iterations) >= max_iterations:
             break
-        loc = localise(records[0][0], model, records[0][1], evs[0], meas_first,
+        loc = localise(model.apply(records[0][0]), model, records[0][1], evs[0], meas_first,
                        tolerances=tolerances)
         r0 = problem.residual(model)
         J = _jacobian(problem, model, r0)
@@ -424,7 +429,7 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         top_phases = sorted(loc["phases"], key=lambda p: -loc["phases"][p]["share"])[:2]
         for s, e in zip(scores, cands, strict=True):
             s["significant"] = bool(s["p"] is not None and s["p"] < level)
-            s["signature_agrees"] = bool(set(e.phases) & set(top_phases))
+            s["signature_agrees"] = _signature_agrees(e, loc, top_phases)
         ranked = sorted((s for s in scores if s["significant"]), key=lambda s: -s["lm"])
         if not ranked:
             iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
@@ -449,8 +454,7 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
                 continue
             s["criteria_after"] = after
             s["consistent_after"] = all(e.consistent for e in evs2)
-            s["parameters"] = ({eff.terms[0]: m2.law.as_dict()[eff.terms[0]]} if eff.terms
-                               else {eff.parameters[0].name: m2.observation[eff.observation]})
+            s["parameters"] = {eff.parameters[0].name: m2.value(eff)}
             trials.append((after[criterion], s, m2, res, evs2))
         good = [x for x in trials if x[0] <= 0.9 * before[criterion]]
         if not good:
