@@ -59,7 +59,10 @@ def attractor_figure(att, stem):
 
 def chart_figure(ch, stem):
     """Regions over ``(nu, B)`` (synchronisation, subharmonic, beat, chaos) with the
-    boundaries between regions drawn (the bifurcation sets, to the grid's resolution)."""
+    boundaries between regions drawn (the bifurcation sets, to the grid's resolution),
+    the periods of the larger subharmonic regions written in them, and, for a chart swept
+    in both directions, the points where the two sweeps ended on different attractors
+    (coexisting attractors: hysteresis) marked ``x``."""
     kind = np.where(ch.kind < 0, np.nan, ch.kind.astype(float))
     fig, ax = plt.subplots(figsize=(8, 6.4))
     nu, B = ch.nu, ch.B
@@ -88,20 +91,42 @@ def chart_figure(ch, stem):
         from matplotlib.collections import LineCollection
 
         ax.add_collection(LineCollection(segs, colors="k", linewidths=0.4))
+    # the period of each larger subharmonic region, at its cell nearest its median
+    least = max(3, int(0.002 * ch.kind.size))
+    for n in np.unique(ch.period[ch.period > 1]):
+        cells = np.argwhere(ch.period == n)
+        if len(cells) < least:
+            continue
+        med = np.median(cells, axis=0)
+        i, j = cells[np.argmin(((cells - med) ** 2).sum(axis=1))]
+        ax.text(nu[j], B[i], str(int(n)), fontsize=6, ha="center", va="center",
+                color="#08306b")
+    from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
     fr = ch.fractions()
     handles = [Patch(color=c, label=f"{lbl} {100 * fr[k]:.0f} %")
                for c, lbl, k in zip(_KIND_COLORS, _KIND_LABELS, ("P1", "Pn", "beat", "chaotic"),
                                     strict=True)]
+    coex = getattr(ch, "coexisting", None)
+    if coex is not None:
+        ii, jj = np.nonzero(coex)
+        size = float(np.clip(2500.0 / max(nu.size, B.size) ** 1.5, 1.0, 30.0))
+        ax.scatter(nu[jj], B[ii], s=size, marker="x", c="k", linewidths=0.5)
+        handles.append(Line2D([], [], ls="", marker="x", color="k",
+                              label=f"coexisting: the sweeps up and down in nu differ "
+                              f"({100 * coex.mean():.1f} %)"))
     ax.legend(handles=handles, loc="upper left", fontsize=8, framealpha=0.9)
     ax.set_xlabel("nu (forcing frequency)")
     ax.set_ylabel("B (forcing amplitude)")
     s = ch.system
-    ax.set_title(f"{s.model}: regimes over (nu, B), {nu.size}x{B.size}, "
+    sweep = ("sweeps up and down in nu (colours: up)" if coex is not None
+             else "sweep up in nu")
+    maxp = ch.settings.get("max_period", 8)
+    ax.set_title(f"{s.model}: regimes over (nu, B), {nu.size}x{B.size}, {sweep}, "
                  f"{ch.seconds:.0f} s on {ch.workers} processes\n"
-                 "black lines: boundaries between regimes (or periods), to the grid's "
-                 "resolution", fontsize=9)
+                 f"black lines: boundaries between regimes (or periods), to the grid's "
+                 f"resolution; numbers: periods (up to {maxp})", fontsize=9)
     ax.set_xlim(en[0], en[-1])
     ax.set_ylim(eb[0], eb[-1])
     return _save(fig, stem)

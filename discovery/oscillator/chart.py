@@ -1,15 +1,36 @@
 """Regime charts over the forcing plane ``(nu, B)``, in parallel processes.
 
 Each row of the chart (one ``B``) is swept in increasing ``nu``, every point starting
-from the last state of the previous one (continuation, as an analog-computer sweep:
-the chart follows one branch where attractors coexist; the first point of a row starts
-from ``y0``).  Each point: ``transient`` periods, then ``periods`` periods with the
-variational equations; the regime by :func:`~discovery.oscillator.classify_points`
-(``P1`` synchronised, ``Pn`` subharmonic, ``beat`` quasi-periodic, ``chaotic``).
+from the last state of the previous one (continuation, as an analog-computer sweep; the
+first point of a row starts from ``y0``).  With ``sweeps=2`` the row is swept back in
+decreasing ``nu`` as well, starting from the state the first sweep ended in (the
+up-and-down sweep of a hysteresis experiment): both regimes are recorded, and a point
+where one sweep ends on a stable periodic orbit and the other does not (another orbit,
+or a non-periodic regime), also after ``recheck`` times the transient more from both
+final states, is marked ``coexisting`` (the jump phenomenon near a resonance, two
+coexisting subharmonics).  Two non-periodic results are not compared.
+
+Each point: up to ``transient`` forcing periods of the stroboscopic map (compiled), with
+an early exit as soon as the strobe points repeat after ``n <= max_period`` periods to
+``closure`` (of the scale) over ``max(3 n, min_pairs)`` consecutive pairs, unless the run
+may still be converging to an orbit of a divisor of ``n`` (a P1 orbit with a multiplier
+near -1 repeats after 2 periods long before it repeats after 1).  The orbit's monodromy
+matrix over ``n`` periods then gives its Floquet multipliers: a stable orbit (``|m| <
+1``) is ``P<n>`` with the exponent ``log|m_1| / (n T)``; an unstable one repeated by
+chance and the transient goes on.  Without an early exit, ``periods`` more periods with
+the variational equations (Benettin): ``P<n>`` by the same recurrence test on their
+strobe points (and a stable monodromy), else ``chaotic`` if the largest exponent exceeds
+``chaos_threshold``, else ``beat`` (:func:`~discovery.oscillator.classify_points`).
+With ``early_exit=False`` every point takes the second path after the full transient.
+The early exit halves the cost of a chart; the classes of chaotic and quasi-periodic
+points are computed exactly as without it.
+
 Rows are distributed over worker processes (they die with the parent; Ctrl-C stops
 them); the result does not depend on the number of workers.
 """
 
+import cmath
+import math
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -17,16 +38,128 @@ from dataclasses import dataclass, field
 from multiprocessing import get_context
 
 import numpy as np
+from numba import njit
 
 from .._workers import terminate_pool, worker_initializer
 from ..dynamics import Tolerances
+from ..dynamics._dopri import OK
 from ..errors import InputError, IntegrationError
-from .attractor import _after, _setup, _variational, _y0, classify_points, lyapunov
+from . import _kernel as UK
+from .attractor import _budget, _check, _y0, classify_points
 from .system import UedaSystem
 
 __all__ = ["Chart", "chart", "KINDS"]
 
 KINDS = ("P1", "Pn", "beat", "chaotic")  # codes 0..3; -1 failed
+
+
+@njit(cache=True)
+def _scan(y0, p, T, n_max, max_period, min_pairs, closure, inv_scale, rtol, atol, hmax,
+          max_steps, out_strobe, run):
+    """Up to ``n_max`` periods of the stroboscopic map from ``(0, y0)`` (the same steps
+    as :func:`~discovery.oscillator._kernel.strobe_run`), stopping early when the strobe
+    points repeat: ``run[n]`` counts the consecutive latest pairs ``|S_k - S_{k-n}| /
+    scale < closure`` (max norm); the smallest ``n`` with ``run[n] >= max(3 n,
+    min_pairs)`` ends the run unless the run may still be converging to an orbit of a
+    divisor ``d`` of ``n``: ``d`` is closing too (``run[d] > 0``), or its differences
+    ``|S_k - S_{k-d}|`` shrank by more than 10 % over the last ``max(3 n, min_pairs)``
+    periods (e.g. a P1 orbit with a multiplier near -1 repeats after 2 periods long
+    before it repeats after 1).  Returns ``(status, t, y, periods done, n or 0)``."""
+    y = y0.copy()
+    K = np.empty((7, 2))
+    ytmp = np.empty(2)
+    ynew = np.empty(2)
+    empty_t = np.empty(0)
+    empty_o = np.empty((2, 0))
+    for n in range(max_period + 1):
+        run[n] = 0
+    UK._rhs2(0.0, y, p, K[0])
+    t = 0.0
+    h = T / 50.0
+    n_steps = 0
+    status = OK
+    found = 0
+    k = 0
+    while k < n_max:
+        status, t, h, _, ns = UK._adv2(t, y, (k + 1) * T, h, p, rtol, atol, hmax,
+                                       max_steps - n_steps, K, ytmp, ynew, empty_t, 0, empty_o)
+        n_steps += ns
+        if status != OK:
+            break
+        out_strobe[k, 0] = y[0]
+        out_strobe[k, 1] = y[1]
+        for n in range(1, min(k, max_period) + 1):
+            if _gap(out_strobe, k, n, inv_scale) < closure:
+                run[n] += 1
+            else:
+                run[n] = 0
+        for n in range(1, max_period + 1):
+            need = max(3 * n, min_pairs)
+            if run[n] >= need:
+                found = n
+                for d in range(1, n):
+                    if n % d == 0 and (run[d] > 0 or _gap(out_strobe, k, d, inv_scale)
+                                       < 0.9 * _gap(out_strobe, k - need, d, inv_scale)):
+                        found = 0
+                break
+        k += 1
+        if found > 0:
+            break
+    return status, t, y, k, found
+
+
+@njit(cache=True, inline="always")
+def _gap(s, k, n, inv_scale):
+    """``max |S_k - S_{k-n}| / scale``."""
+    return max(abs(s[k, 0] - s[k - n, 0]) * inv_scale[0],
+               abs(s[k, 1] - s[k - n, 1]) * inv_scale[1])
+
+
+@njit(cache=True)
+def _monodromy(y0, p, T, n, rtol, atol_state, atol_tangent, hmax, max_steps):
+    """The variational equations over ``n`` periods from ``(0, y0)`` without
+    orthonormalisation (the tangent matrix only rescaled by its largest entry every
+    period).  Returns ``(status, t, M, log of the scale factors, trace integral)``: the
+    monodromy matrix is ``exp(log) M``."""
+    y = np.zeros(7)
+    y[0] = y0[0]
+    y[1] = y0[1]
+    y[2] = 1.0
+    y[5] = 1.0
+    atol = np.empty(7)
+    atol[0] = atol_state[0]
+    atol[1] = atol_state[1]
+    for j in range(2, 7):
+        atol[j] = atol_tangent
+    K = np.empty((7, 7))
+    ytmp = np.empty(7)
+    ynew = np.empty(7)
+    empty_t = np.empty(0)
+    empty_o = np.empty((2, 0))
+    t = 0.0
+    h = T / 50.0
+    n_steps = 0
+    status = OK
+    logs = 0.0
+    UK._rhs7(t, y, p, K[0])
+    for k in range(n):
+        status, t, h, _, ns = UK._adv7(t, y, (k + 1) * T, h, p, rtol, atol, hmax,
+                                       max_steps - n_steps, K, ytmp, ynew, empty_t, 0, empty_o)
+        n_steps += ns
+        if status != OK:
+            break
+        m = max(max(abs(y[2]), abs(y[3])), max(abs(y[4]), abs(y[5])))
+        if m > 0.0:
+            for j in range(2, 6):
+                y[j] /= m
+            logs += np.log(m)
+        UK._rhs7(t, y, p, K[0])  # the tangent vectors changed
+    M = np.empty((2, 2))
+    M[0, 0] = y[2]
+    M[1, 0] = y[3]
+    M[0, 1] = y[4]
+    M[1, 1] = y[5]
+    return status, t, M, logs, y[6]
 
 
 @dataclass(frozen=True)
@@ -40,16 +173,32 @@ class Chart:
     nu, B : ndarray
         The axes.
     kind : ndarray of int, shape (len(B), len(nu))
-        Index into :data:`KINDS` (``-1``: the integration failed).
+        Index into :data:`KINDS` (``-1``: the integration failed); the sweep in
+        increasing ``nu``.
     period : ndarray of int
         ``n`` of periodic points, else 0.
     lyapunov : ndarray
-        Largest exponent at each point (short run: ``periods`` periods).
+        Largest exponent at each point: ``log|m_1| / (n T)`` of the largest Floquet
+        multiplier for an orbit found by the early exit, else the Benettin estimate over
+        ``periods`` periods.
     rotation : ndarray
         Rotation number of the strobe points (beat and chaos; NaN for periodic points).
+    periods_integrated : ndarray of int
+        Forcing periods integrated at each point, both sweeps (the cost; the early exit
+        shortens it; the rechecks of ``sweeps=2`` are not counted).
     seconds : float
+        Wall time.
+    cpu_seconds : float
+        CPU time of the rows summed over the processes (the work, whatever the load).
     workers : int
     settings : dict
+    kind_down, period_down, lyapunov_down, rotation_down : ndarray or None
+        The same for the sweep in decreasing ``nu`` (``sweeps=2``).
+    coexisting : ndarray of bool or None
+        ``sweeps=2``: the two sweeps ended on different attractors - at least one on a
+        stable periodic orbit, the other on another orbit or a non-periodic regime, also
+        after ``recheck`` times the transient more from both (two non-periodic results
+        are not compared).
     """
 
     system: UedaSystem
@@ -62,32 +211,81 @@ class Chart:
     seconds: float
     workers: int
     settings: dict
+    periods_integrated: np.ndarray | None = field(default=None, repr=False)
+    cpu_seconds: float = float("nan")
+    kind_down: np.ndarray | None = field(default=None, repr=False)
+    period_down: np.ndarray | None = field(default=None, repr=False)
+    lyapunov_down: np.ndarray | None = field(default=None, repr=False)
+    rotation_down: np.ndarray | None = field(default=None, repr=False)
+    coexisting: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def sweeps(self):
+        return 1 if self.kind_down is None else 2
 
     def fractions(self):
+        """Fraction of the points in each class (the sweep in increasing ``nu``)."""
         n = self.kind.size
         out = {k: float(np.sum(self.kind == i) / n) for i, k in enumerate(KINDS)}
         out["failed"] = float(np.sum(self.kind < 0) / n)
         return out
 
+    def period_counts(self):
+        """``{n: number of points}`` of the periodic points (increasing ``nu``)."""
+        n, c = np.unique(self.period[self.period > 0], return_counts=True)
+        return {int(a): int(b) for a, b in zip(n, c, strict=True)}
+
+    @property
+    def columns(self):
+        """The CSV header (:meth:`rows`)."""
+        cols = ["nu", "B", "regime", "period", "lyapunov", "rotation_number"]
+        if self.sweeps == 2:
+            cols += ["regime_down", "period_down", "lyapunov_down", "rotation_number_down",
+                     "coexisting"]
+        return cols
+
     def rows(self):
-        """CSV rows ``nu, B, regime, period, lyapunov, rotation``."""
+        """CSV rows (:attr:`columns`): ``nu, B, regime, period, lyapunov, rotation``
+        and, with two sweeps, the same for the sweep in decreasing ``nu`` and
+        ``coexisting`` (0/1)."""
+        def name(k):
+            return KINDS[k] if k >= 0 else "failed"
+
         for i, b in enumerate(self.B):
             for j, nu in enumerate(self.nu):
-                k = int(self.kind[i, j])
-                yield (float(nu), float(b), KINDS[k] if k >= 0 else "failed",
+                row = (float(nu), float(b), name(int(self.kind[i, j])),
                        int(self.period[i, j]), float(self.lyapunov[i, j]),
                        float(self.rotation[i, j]))
+                if self.sweeps == 2:
+                    row += (name(int(self.kind_down[i, j])), int(self.period_down[i, j]),
+                            float(self.lyapunov_down[i, j]), float(self.rotation_down[i, j]),
+                            int(self.coexisting[i, j]))
+                yield row
 
     def as_dict(self):
-        return {"system": self.system.as_dict(), "grid": [int(self.nu.size), int(self.B.size)],
-                "nu_range": [float(self.nu[0]), float(self.nu[-1])],
-                "B_range": [float(self.B[0]), float(self.B[-1])],
-                "fractions": self.fractions(), "seconds": self.seconds,
-                "workers": self.workers, "points": int(self.kind.size),
-                "seconds_per_point_per_worker": self.seconds * self.workers / self.kind.size,
-                "settings": self.settings}
+        n = int(self.kind.size)
+        out = {"system": self.system.as_dict(), "grid": [int(self.nu.size), int(self.B.size)],
+               "nu_range": [float(self.nu[0]), float(self.nu[-1])],
+               "B_range": [float(self.B[0]), float(self.B[-1])],
+               "fractions": self.fractions(),
+               "periods_found": {f"P{k}": v for k, v in self.period_counts().items()},
+               "seconds": self.seconds, "cpu_seconds": self.cpu_seconds,
+               "workers": self.workers, "points": n, "sweeps": self.sweeps,
+               "seconds_per_point_per_worker": self.seconds * self.workers / n,
+               "cpu_seconds_per_point": self.cpu_seconds / (n * self.sweeps),
+               "settings": self.settings}
+        if self.periods_integrated is not None:
+            out["mean_periods_integrated"] = float(np.mean(self.periods_integrated))
+        if self.sweeps == 2:
+            down = {k: float(np.sum(self.kind_down == i) / n) for i, k in enumerate(KINDS)}
+            down["failed"] = float(np.sum(self.kind_down < 0) / n)
+            out["fractions_down"] = down
+            out["coexisting_fraction"] = float(np.mean(self.coexisting))
+            out["coexisting_points"] = int(np.sum(self.coexisting))
+        return out
 
 
+# ------------------------------------------------------------------ one point
 _CTX = {}
 
 
@@ -95,35 +293,183 @@ def _init(system, settings):
     _CTX.update(system=system, settings=settings)
 
 
-def _point(system, y, s, tol):
+def _floquet(M, logs):
+    """Moduli of the two multipliers (largest first) of ``exp(logs) M``, as logs."""
+    tr, det = M[0, 0] + M[1, 1], M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
+    r = cmath.sqrt(tr * tr - 4.0 * det)
+    a, b = abs(0.5 * (tr + r)), abs(0.5 * (tr - r))
+    big, small = max(a, b), min(a, b)
+    return (math.log(big) + logs if big > 0 else -math.inf,
+            math.log(small) + logs if small > 0 else -math.inf)
+
+
+class _Point:
+    """Result of one point: ``kind`` code, ``period``, ``lam``, ``rot``, the final state
+    ``y``, the periods integrated (``cost``) and ``points`` (the periodic orbit's strobe
+    points, or the observed strobe points)."""
+
+    __slots__ = ("kind", "period", "lam", "rot", "y", "cost", "points")
+
+    def __init__(self, kind, period, lam, rot, y, cost, points):
+        self.kind, self.period, self.lam, self.rot = kind, period, lam, rot
+        self.y, self.cost, self.points = y, cost, points
+
+
+def _recurrence(strobe, inv_scale, max_period, closure, min_pairs):
+    """The smallest ``n <= max_period`` whose last ``max(3 n, min_pairs)`` pairs
+    ``|S_k - S_{k-n}| / scale`` are all below ``closure`` (0: none)."""
+    s = strobe * inv_scale
+    for n in range(1, max_period + 1):
+        need = max(3 * n, min_pairs)
+        if need + n > len(s):
+            break
+        tail = s[-(need + n):]
+        if np.max(np.abs(tail[n:] - tail[:-n])) < closure:
+            return n
+    return 0
+
+
+def _stable_orbit(y, p, T, n, tol, atol, hmax):
+    """``log|m_1| / (n T)`` of the period-``n`` orbit through ``y`` (its monodromy over
+    ``n`` periods); NaN when it is not stable (``|m_1| >= 1``)."""
+    status, t, M, logs, _ = _monodromy(y, p, T, n, tol.rtol, atol, tol.rtol * tol.atol_scale,
+                                       hmax, _budget(tol, n))
+    _check(status, t, "the variational equations")
+    log1, _ = _floquet(M, logs)
+    return log1 / (n * T) if log1 < 0.0 else np.nan
+
+
+def _point(system, y, s, tol, buffers=None):
+    """The regime at one ``(nu, B)`` from the state ``y`` at the forcing's phase 0."""
     T = system.period
-    y = _after(system, y, s["transient"], tol)
-    _, _, atol, hmax = _setup(system, tol)
-    logs, trace, strobe, yf = _variational(system, y, 0.0, s["periods"], tol, T, atol, hmax)
-    lyap = lyapunov(system, tolerances=tol, batches=4, _run=(logs, trace))
-    reg = classify_points(strobe, system.scales(), lyap.value, 0.0,
-                          max_period=s["max_period"], closure=s["closure"],
+    p = system.params()
+    scale = system.scales()
+    inv = 1.0 / scale
+    atol = tol.rtol * tol.atol_scale * scale
+    hmax = T * tol.hmax_fraction
+    n_tr, n_obs, P, closure = s["transient"], s["periods"], s["max_period"], s["closure"]
+    if buffers is None:
+        buffers = (np.empty((max(n_tr, 1), 2)), np.zeros(P + 1, dtype=np.int64))
+    strobe, run = buffers
+    y = np.asarray(y, dtype=float)
+    cost = 0
+    if n_tr > 0:
+        status, t, y, done, n = _scan(y, p, T, n_tr, P if s["early_exit"] else 0,
+                                      s["min_pairs"], closure, inv, tol.rtol, atol, hmax,
+                                      _budget(tol, n_tr), strobe, run)
+        _check(status, t, "the stroboscopic map")
+        cost += done
+        if n > 0:
+            lam = _stable_orbit(y, p, T, n, tol, atol, hmax)
+            cost += n
+            if np.isfinite(lam):  # a stable orbit: P<n>
+                return _Point(0 if n == 1 else 1, n, lam, np.nan, y, cost,
+                              strobe[done - n:done].copy())
+            # an unstable orbit repeating by chance: the rest of the transient
+            status, t, y, more, _ = _scan(y, p, T, n_tr - done, 0, 1, closure, inv, tol.rtol,
+                                          atol, hmax, _budget(tol, n_tr), strobe, run)
+            _check(status, t, "the stroboscopic map")
+            cost += more
+    logs = np.empty((n_obs, 2))
+    trace = np.empty(n_obs)
+    obs = np.empty((n_obs, 2))
+    status, t, yf, _ = UK.variational_run(0.0, y, p, T, n_obs, tol.rtol, atol,
+                                          tol.rtol * tol.atol_scale, hmax,
+                                          _budget(tol, n_obs), logs, trace, obs)
+    _check(status, t, "the variational equations")
+    cost += n_obs
+    n = _recurrence(obs, inv, P, closure, s["min_pairs"])
+    if n > 0:
+        lam = _stable_orbit(yf, p, T, n, tol, atol, hmax)
+        cost += n
+        if np.isfinite(lam):
+            return _Point(0 if n == 1 else 1, n, lam, np.nan, yf, cost, obs[-n:])
+    lam = float(logs[:, 0].sum() / (n_obs * T))
+    reg = classify_points(obs, scale, lam, 0.0, max_period=0,
                           chaos_threshold=s["chaos_threshold"])
-    return reg, lyap.value, yf
+    return _Point(KINDS.index(reg.kind), 0, lam, reg.evidence["rotation_number"], yf, cost,
+                  obs)
 
 
-def _row(args):
-    i, b, nus = args
-    base, s = _CTX["system"], _CTX["settings"]
-    tol = Tolerances(rtol=s["rtol"], hmax_fraction=s["hmax_fraction"])
-    y = np.array(s["y0"], dtype=float)
+# ------------------------------------------------------------------ same attractor?
+def _same_orbit(a, b, T, scale, closure):
+    """Whether two points' results are the same periodic orbit (``False`` when either is
+    not periodic): the same period, and every strobe point of one orbit within ``tol``
+    of the other's (in any phase), ``tol = max(10 closure, 3 (e_a + e_b))`` where ``e =
+    closure / (1 - |m_1|)`` bounds how far a run whose points repeat to ``closure`` can be
+    from its orbit (slow convergence near a bifurcation widens it)."""
+    if not a.period or a.kind != b.kind or a.period != b.period:
+        return False
+
+    def err(r):
+        m = math.exp(min(r.lam * r.period * T, 0.0))
+        return closure / max(1.0 - m, 1e-12)
+
+    A, Bp = a.points / scale, b.points / scale
+    tol = max(10.0 * closure, 3.0 * (err(a) + err(b)))
+    return max(float(np.min(np.max(np.abs(Bp - q), axis=1))) for q in A) <= tol
+
+
+_FAILED = _Point(-1, 0, np.nan, np.nan, None, 0, None)
+
+
+def _sweep(base, b, nus, s, tol, y, buffers):
     out = []
     for nu in nus:
         system = base.with_params(nu=float(nu), B=float(b))
         try:
-            reg, lam, y = _point(system, y, s, tol)
+            r = _point(system, y, s, tol, buffers)
         except IntegrationError:
-            out.append((-1, 0, np.nan, np.nan))
+            out.append(_FAILED)
             y = np.array(s["y0"], dtype=float)
             continue
-        out.append((KINDS.index(reg.kind), reg.period, lam,
-                    reg.evidence.get("rotation_number", np.nan)))
-    return i, out
+        out.append(r)
+        y = r.y
+    return out, y
+
+
+def _row(args):
+    i, b, nus = args
+    c0 = time.process_time()
+    base, s = _CTX["system"], _CTX["settings"]
+    tol = Tolerances(rtol=s["rtol"], hmax_fraction=s["hmax_fraction"])
+    buffers = (np.empty((max(s["transient"], 1), 2)),
+               np.zeros(s["max_period"] + 1, dtype=np.int64))
+    up, y = _sweep(base, b, nus, s, tol, np.array(s["y0"], dtype=float), buffers)
+
+    def pack(r):
+        return (r.kind, r.period, r.lam, r.rot, r.cost)
+
+    down = coex = None
+    if s["sweeps"] == 2:
+        dn, _ = _sweep(base, b, nus[::-1], s, tol, y, buffers)
+        dn = dn[::-1]
+        coex = [_coexisting(base, b, nu, u, d, s, tol) for nu, u, d in zip(nus, up, dn,
+                                                                             strict=True)]
+        down = [pack(r) for r in dn]
+    return i, [pack(r) for r in up], down, coex, time.process_time() - c0
+
+
+def _coexisting(base, b, nu, u, d, s, tol):
+    """Whether the two sweeps ended on different attractors at ``(nu, b)``: at least one
+    on a stable periodic orbit and the other not on it - as recorded and again after
+    ``recheck`` times the transient more from both final states (a slow transient is not
+    coexistence).  Two non-periodic results are not compared (a few dozen strobe points
+    do not tell two quasi-periodic or chaotic sets apart reliably)."""
+    if u.kind < 0 or d.kind < 0 or not (u.period or d.period):
+        return False
+    system = base.with_params(nu=float(nu), B=float(b))
+    T, scale = system.period, system.scales()
+    if _same_orbit(u, d, T, scale, s["closure"]):
+        return False
+    if s["recheck"] <= 0 or s["transient"] <= 0:
+        return True
+    longer = dict(s, transient=s["transient"] * s["recheck"])
+    try:
+        u2, d2 = (_point(system, r.y, longer, tol) for r in (u, d))
+    except IntegrationError:
+        return True
+    return bool(u2.period or d2.period) and not _same_orbit(u2, d2, T, scale, s["closure"])
 
 
 def _axis(values, name):
@@ -134,7 +480,8 @@ def _axis(values, name):
 
 
 def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_fraction=0.1,
-          max_period=8, closure=1e-4, chaos_threshold=0.015, workers=None, progress=None):
+          max_period=16, closure=1e-4, chaos_threshold=0.015, sweeps=1, early_exit=True,
+          min_pairs=12, recheck=5, workers=None, progress=None):
     """The regime at every ``(nu, B)`` of a grid (see the module docstring).
 
     Parameters
@@ -145,13 +492,30 @@ def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_f
         Strictly increasing axes (``nu > 0``).
     y0 : (x, v), optional
         Start of every row.
-    transient, periods : int
-        Periods discarded, then observed, at each point.
+    transient : int
+        Periods discarded at most (the early exit stops sooner at periodic points).
+    periods : int
+        Periods observed with the variational equations where no stable orbit was found
+        in the transient; at least ``4 max_period`` (the recurrence test of period ``n``
+        compares three cycles of strobe points with the cycle before).
     rtol, hmax_fraction : float
         Integrator tolerance and largest step (fraction of a period); charts favour
         speed (``attractor`` uses 1e-9 and 0.02).
-    max_period, closure, chaos_threshold
+    max_period : int
+        The longest period recognised (longer locked orbits appear as beat).
+    closure, chaos_threshold
         The classification rules (:func:`classify_points`).
+    sweeps : {1, 2}
+        2: each row swept in increasing ``nu`` and back; both regimes and
+        ``coexisting`` recorded (twice the work, and the rechecks).
+    recheck : int
+        ``sweeps=2``: where the two sweeps' attractors differ, both are run again from
+        their final states with ``recheck`` times the transient; ``coexisting`` only if
+        they still differ (0: no recheck).
+    early_exit : bool
+        Stop the transient once a period-``n`` orbit repeats (see the module docstring).
+    min_pairs : int
+        Consecutive repeating pairs the early exit needs at least (and ``3 n``).
     workers : int, optional
         Processes (default all cores, at most one per row).
     progress : callable, optional
@@ -168,18 +532,44 @@ def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_f
         raise InputError("nu must be > 0")
     if workers is not None and int(workers) < 1:
         raise InputError(f"workers must be at least 1, got {workers!r}")
+    if int(max_period) < 1:
+        raise InputError(f"max_period must be at least 1, got {max_period!r}")
+    if int(transient) < 0:
+        raise InputError(f"transient must be >= 0, got {transient!r}")
+    if int(periods) < 4 * int(max_period):
+        raise InputError(f"periods ({int(periods)}) must be at least 4 x max_period = "
+                         f"{4 * int(max_period)}: the recurrence test of period n compares "
+                         "three cycles of strobe points with the cycle before")
+    if int(sweeps) not in (1, 2):
+        raise InputError(f"sweeps must be 1 or 2, got {sweeps!r}")
+    if int(recheck) < 0:
+        raise InputError(f"recheck must be >= 0, got {recheck!r}")
+    if int(min_pairs) < 1:
+        raise InputError(f"min_pairs must be at least 1, got {min_pairs!r}")
     settings = {"transient": int(transient), "periods": int(periods), "rtol": float(rtol),
                 "hmax_fraction": float(hmax_fraction),
                 "max_period": int(max_period), "closure": float(closure),
-                "chaos_threshold": float(chaos_threshold),
-                "y0": [float(v) for v in _y0(y0)], "continuation": "rows swept in increasing nu"}
+                "chaos_threshold": float(chaos_threshold), "sweeps": int(sweeps),
+                "early_exit": bool(early_exit), "min_pairs": int(min_pairs),
+                "recheck": int(recheck),
+                "y0": [float(v) for v in _y0(y0)],
+                "continuation": "rows swept in increasing nu" + (
+                    ", then back in decreasing nu from the state the first sweep ended in"
+                    if int(sweeps) == 2 else "")}
     workers = min(int(workers or os.cpu_count() or 1), B.size)
     shape = (B.size, nu.size)
     kind = np.full(shape, -1, dtype=int)
     period = np.zeros(shape, dtype=int)
     lam = np.full(shape, np.nan)
     rot = np.full(shape, np.nan)
+    cost = np.zeros(shape, dtype=int)
+    two = int(sweeps) == 2
+    if two:
+        kind2, period2 = kind.copy(), period.copy()
+        lam2, rot2 = lam.copy(), rot.copy()
+        coex = np.zeros(shape, dtype=bool)
     jobs = [(i, b, nu) for i, b in enumerate(B)]
+    cpu = 0.0
     t_start = time.perf_counter()
     if workers == 1:
         _init(system, settings)
@@ -189,9 +579,15 @@ def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_f
                                    **worker_initializer(_init, (system, settings)))
         results = pool.map(_row, jobs)
     try:
-        for done, (i, row) in enumerate(results, start=1):
-            for j, (k, n, lv, r) in enumerate(row):
-                kind[i, j], period[i, j], lam[i, j], rot[i, j] = k, n, lv, r
+        for done, (i, up, down, cx, sec) in enumerate(results, start=1):
+            cpu += sec
+            for j, (k, n, lv, r, c) in enumerate(up):
+                kind[i, j], period[i, j], lam[i, j], rot[i, j], cost[i, j] = k, n, lv, r, c
+            if two:
+                for j, (k, n, lv, r, c) in enumerate(down):
+                    kind2[i, j], period2[i, j], lam2[i, j], rot2[i, j] = k, n, lv, r
+                    cost[i, j] += c
+                coex[i] = cx
             if progress is not None:
                 progress(done, len(jobs))
     except BaseException:
@@ -202,6 +598,10 @@ def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_f
     finally:
         if pool is not None:
             pool.shutdown()
+    extra = {}
+    if two:
+        extra = {"kind_down": kind2, "period_down": period2, "lyapunov_down": lam2,
+                 "rotation_down": rot2, "coexisting": coex}
     return Chart(system=system, nu=nu, B=B, kind=kind, period=period, lyapunov=lam,
                  rotation=rot, seconds=time.perf_counter() - t_start, workers=workers,
-                 settings=settings)
+                 settings=settings, periods_integrated=cost, cpu_seconds=cpu, **extra)
