@@ -14,6 +14,32 @@ __all__ = ["landscape_figure", "identification_figure", "verify_figure", "explai
 _ORDER = ("I1", "I2", "I3", "I4", "I0")
 
 
+def _exp(p):
+    return str(int(p)) if float(p).is_integer() else f"{float(p):g}"
+
+
+def term_unit(name):
+    """SI unit of the coefficient of the term ``name`` (``z^a*zd^b``): N m^-a (m/s)^-b,
+    as matplotlib mathtext, e.g. ``'z*zd'`` -> ``N m$^{-1}$ (m/s)$^{-1}$``."""
+    from discovery.law import Term
+
+    try:
+        t = Term.parse(name)
+    except Exception:  # not a single term: say what the coefficient multiplies
+        return f"N per unit of {name}"
+    unit = "N"
+    if t.a:
+        unit += f" m$^{{-{_exp(t.a)}}}$"
+    if t.b:
+        unit += f" (m/s)$^{{-{_exp(t.b)}}}$"
+    return unit
+
+
+def coefficient_label(name):
+    """Axis label of a coefficient with its unit, e.g. ``coefficient of z [N m^-1]``."""
+    return f"coefficient of {name} [{term_unit(name)}]"
+
+
 def _save(fig, stem):
     paths = [f"{stem}.png", f"{stem}.pdf"]
     fig.savefig(paths[0], dpi=130, bbox_inches="tight")
@@ -69,7 +95,7 @@ def landscape_figure(land, stem, truth=None):
             cs = ax.contourf(a0, a1, v.T, levels=levels, cmap="viridis")
             if hi > lo:
                 ax.contour(a0, a1, v.T, levels=levels[::2], colors="k", linewidths=0.4)
-            plt.colorbar(cs, ax=ax)
+            plt.colorbar(cs, ax=ax, label=f"{name} (dimensionless)")
             i, j = land.argmin(name)
             ax.plot(a0[i], a1[j], "w*", ms=10, mec="k")
         else:
@@ -85,8 +111,9 @@ def landscape_figure(land, stem, truth=None):
             ax.plot(*truth, "o", mfc="none", mec="r", ms=10, mew=1.5)
         ax.set_xlim(a0[0], a0[-1])
         ax.set_ylim(a1[0], a1[-1])
-        ax.set_xlabel(f"coefficient of {land.terms[0]}")
-        ax.set_ylabel(f"coefficient of {land.terms[1]}")
+        ax.set_xlabel(coefficient_label(land.terms[0]))
+        ax.set_ylabel(coefficient_label(land.terms[1]))
+        ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
         title = name if exact or not floor else f"{name} (noise floor {floor[name]:.3g})"
         ax.set_title(title)
     ax = axes.flat[5]
@@ -127,7 +154,14 @@ def landscape_figure(land, stem, truth=None):
 
 
 def identification_figure(result, measured, impulses, stem, land=None):
-    """Identification path (Fig. 6) and F_N converging to F_E (Fig. 7).
+    """Identification path (Fig. 6), the criterion against the simulations spent, and F_N
+    converging to F_E (Fig. 7).
+
+    ``result.iterations`` lists every simulated law that was the best so far when it was
+    simulated.  Those are not all optimiser steps: with ``least-squares`` most are
+    finite-difference probes of the Jacobian (and the standard-error Jacobian can add one
+    after the search).  So the history is drawn against the simulations spent, each new
+    best marked, and nothing is counted as an iteration or an improvement.
 
     Parameters
     ----------
@@ -135,30 +169,56 @@ def identification_figure(result, measured, impulses, stem, land=None):
     measured : Impulse
         ``F_E``.
     impulses : list of (label, Impulse)
-        Simulated impulses of selected iterates.
+        Simulated impulses of selected laws (e.g. the start, some of the best-so-far laws,
+        the identified law).
     stem : str
     land : Landscape, optional
         Background contours of the identified criterion (two-term laws).
     """
-    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(13, 5))
     names = list(result.law.names)
-    path = np.array([[it["coefficients"][n] for n in names] for it in result.iterations])
-    if len(names) >= 2 and path.size:
-        if land is not None and result.criterion in land.values:
+    its = list(result.iterations)
+    path = np.array([[it["coefficients"][n] for n in names] for it in its])
+    two = len(names) >= 2 and path.size > 0
+    fig, axes = plt.subplots(1, 3 if two else 2, figsize=(17 if two else 12, 5.2),
+                             layout="constrained")
+    crit = result.criterion
+    # the identified law's value (result.value can belong to a standard-error probe)
+    value = result.criteria.get(crit, result.value)
+    if two:
+        ax = axes[0]
+        if land is not None and crit in land.values:
             a0, a1 = land.axes
-            cs = ax0.contourf(a0, a1, land.values[result.criterion].T, levels=20, cmap="viridis")
-            plt.colorbar(cs, ax=ax0, label=result.criterion)
-        ax0.plot(path[:, 0], path[:, 1], "o-", color="w" if land is not None else "C0",
-                 mec="k", ms=4, lw=1)
-        ax0.plot(path[-1, 0], path[-1, 1], "r*", ms=12)
-        ax0.set_xlabel(f"coefficient of {names[0]}")
-        ax0.set_ylabel(f"coefficient of {names[1]}")
-        ax0.set_title(f"{result.method}: {len(path)} improvements, "
-                      f"{result.n_simulations} simulations")
-    else:
-        ax0.semilogy([it["value"] for it in result.iterations], "o-")
-        ax0.set_xlabel("improvement")
-        ax0.set_ylabel(result.criterion)
+            cs = ax.contourf(a0, a1, land.values[crit].T, levels=20, cmap="viridis")
+            fig.colorbar(cs, ax=ax, label=f"{crit} (dimensionless)")
+        ax.plot(path[:, 0], path[:, 1], "o-", color="w" if land is not None else "C0",
+                mec="k", ms=3.5, lw=1, label="best law so far")
+        ax.plot(path[0, 0], path[0, 1], "s", mfc="none", mec="r", ms=9, mew=1.5,
+                label="start")
+        final = result.law.as_dict()
+        ax.plot(final[names[0]], final[names[1]], "r*", ms=13, mec="k", label="identified")
+        ax.set_xlabel(coefficient_label(names[0]))
+        ax.set_ylabel(coefficient_label(names[1]))
+        ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
+        more = f" (first two of {len(names)} terms)" if len(names) > 2 else ""
+        ax.set_title(f"{result.method}: path of the best law so far{more}", fontsize=10)
+        ax.legend(fontsize=8, loc="best")
+    ax = axes[1] if two else axes[0]
+    if its:
+        sims = np.array([it["n_simulations"] for it in its], dtype=float)
+        vals = np.array([it["value"] for it in its], dtype=float)
+        xs = np.append(sims, max(result.n_simulations, sims[-1]))
+        ax.step(xs, np.append(vals, vals[-1]), where="post", color="C0", lw=1.2,
+                label=f"best {crit} so far")
+        ax.plot(sims, vals, "o", color="C0", ms=3.5,
+                label="new best (an optimiser step or a finite-difference probe)")
+        if np.all(vals > 0):
+            ax.set_yscale("log")
+        ax.legend(fontsize=8)
+    ax.set_xlabel("simulations spent (steady states computed)")
+    ax.set_ylabel(f"best {crit} so far (dimensionless)")
+    ax.set_title(f"identified: {crit} = {value:.3g}, {result.n_simulations} simulations in all",
+                 fontsize=10)
+    ax1 = axes[-1]
     ax1.plot(measured.t * 1e3, measured.F / 1e6, "k-", lw=2.5, label="F_E (measured)")
     for k, (label, imp) in enumerate(impulses):
         if imp is not None:
@@ -168,9 +228,8 @@ def identification_figure(result, measured, impulses, stem, land=None):
     ax1.set_xlim(-0.05 * end * 1e3, min(measured.duration, 1.4 * end) * 1e3)
     ax1.set_xlabel("time since onset t - t* [ms]")
     ax1.set_ylabel("contact force [MN]")
-    ax1.set_title(f"F_N converging to F_E ({result.criterion} = {result.value:.3g})")
+    ax1.set_title(f"F_N converging to F_E ({crit} = {value:.3g})", fontsize=10)
     ax1.legend(fontsize=8)
-    fig.tight_layout()
     return _save(fig, stem)
 
 
@@ -285,7 +344,7 @@ def explain_figure(iteration, measured, stem, k=1):
     named effect against the record, the residual's share by impact phase (and its ratio
     to the noise), the mean residual over the simulated (zeta, dzeta) plane, and every
     candidate effect's score test."""
-    fig, axes = plt.subplots(2, 2, figsize=(12, 8))
+    fig, axes = plt.subplots(2, 2, figsize=(13, 8.5), layout="constrained")
     ax = axes[0, 0]
     E = measured
     ax.plot(E.t * 1e3, E.F / 1e3, "k-", lw=2, label="measured")
@@ -309,16 +368,22 @@ def explain_figure(iteration, measured, stem, k=1):
     ph = iteration.localisation["phases"]
     names = list(ph)
     shares = [ph[n]["share"] for n in names]
-    bars = ax.bar(names, shares, color=["tab:red" if ph[n]["exceeds_noise"] else "tab:gray"
-                                        for n in names])
+    x = np.arange(len(names))
+    bars = ax.bar(x, shares, color=["tab:red" if ph[n]["exceeds_noise"] else "tab:gray"
+                                    for n in names])
+    # phase names are long next to each other: rotated, anchored at their tick
+    ax.set_xticks(x, names, rotation=30, ha="right", rotation_mode="anchor")
     for bar, n in zip(bars, names, strict=True):
         r = ph[n]["ratio_to_noise"]
         if r is not None:
-            ax.text(bar.get_x() + bar.get_width() / 2, bar.get_height(), f"{r:.1f}x",
+            ax.text(bar.get_x() + bar.get_width() / 2, bar.get_height(),
+                    f"{r:.0f}x" if r >= 10 else f"{r:.1f}x",
                     ha="center", va="bottom", fontsize=7)
-    ax.set_ylabel("share of the residual energy above the noise")
-    ax.set_title("where the model disagrees (red: above the noise; label: energy / noise)",
-                 fontsize=9)
+    ax.margins(y=0.12)  # room for the numbers above the tallest bar
+    ax.set_xlabel("impact phase")
+    ax.set_ylabel("share of the residual energy\nin excess of the noise (dimensionless)")
+    ax.set_title("where the model disagrees, by impact phase\n(red: above the noise; "
+                 "number: residual energy / noise energy)", fontsize=9)
     ax = axes[1, 0]
     plane = iteration.localisation.get("plane")
     if plane is not None:
@@ -341,7 +406,7 @@ def explain_figure(iteration, measured, stem, k=1):
                 color=["tab:green" if x["effect"] == iteration.effect else
                        ("tab:orange" if x["significant"] else "tab:gray") for x in sc])
         ax.set_xscale("log")
-        ax.set_xlabel("score (LM) statistic; green: named, orange: significant")
-    ax.set_title("candidate effects", fontsize=9)
-    fig.tight_layout()
+    ax.set_xlabel("score-test (LM) statistic (dimensionless)")
+    ax.set_title("candidate effects (green: named; orange: significant; gray: not "
+                 "significant)", fontsize=9)
     return _save(fig, stem)

@@ -78,20 +78,23 @@ def register(sub):
     add_record_options(s)
     s.add_argument("--start", default="linear",
                    help="start model: 'linear' (z, zd), a term list 'z,zd,z^1.5' (start values "
-                   "from the regression and the record) or a law with coefficients (linear)")
-    s.add_argument("--effects", help="comma-separated catalogue ids to consider (default all: "
-                   "penetration_velocity_coupling, hertzian_stiffening, sensor_lag)")
+                   "from the regression and the record) or a law with coefficients "
+                   "(default: %(default)s)")
+    s.add_argument("--effects", help="comma-separated catalogue ids to consider (default: all of "
+                   "penetration_velocity_coupling, hertzian_stiffening, unloading_damping, "
+                   "permanent_set, support_nonlinearity, sensor_lag)")
     s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
-                   help="criterion of the refits (I2)")
+                   help="criterion of the refits (default: %(default)s)")
     s.add_argument("--alpha", type=number(0.0, 0.5, lo_open=True), default=0.01,
-                   help="family-wise significance level of the score tests (0.01)")
+                   help="family-wise significance level of the score tests "
+                   "(default: %(default)g)")
     s.add_argument("--max-iterations", type=integer(0, 10), default=3,
-                   help="effects added at most (3)")
+                   help="effects added at most (default: %(default)s)")
     s.add_argument("--max-simulations", type=integer(10, 100_000), default=150,
-                   help="simulation budget of each refit (150)")
+                   help="simulation budget of each refit (default: %(default)s)")
     s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
-                   help="bootstrap replicates of the noise floor (16)")
+                   help="bootstrap replicates of the noise floor (default: %(default)s)")
     s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
-                   help="seed of the noise-floor bootstrap (0)")
+                   help="seed of the noise-floor bootstrap (default: %(default)s)")
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

@@ -72,7 +72,7 @@ def run(args):
                     "derivative": res.samples.derivative, "noise": res.samples.noise},
         "measured": {"n_cycles": res.measured.n_cycles, "n_periods": res.measured.n_periods,
                      "noise": res.measured.noise, "threshold": res.measured.threshold},
-        "n_solves": res.estimator.n_solves_, "discovery_seconds": res.seconds,
+        "discovery_seconds": res.seconds,
         "fit_settings": res.settings, **provenance(vars(args), inputs=inputs_of(args))}
     with OutputDir(args.out) as out:
         buf = io.StringIO()
@@ -131,33 +131,39 @@ def register(sub):
                    "records jointly")
     add_record_options(s)
     s.add_argument("--library", default="poly:2",
-                   help="candidate terms: poly:N, hc, a list 'z,zd,z*zd', or sums (poly:2)")
+                   help="candidate terms: poly:N, hc, a list 'z,zd,z*zd', or sums "
+                   "(default: %(default)s)")
     s.add_argument("--select", default="best-subset",
                    choices=["best-subset", "l1-path", "stlsq", "sr3", "constrained-sr3"],
-                   help="how supports are proposed (best-subset)")
+                   help="how supports are proposed (default: %(default)s)")
     s.add_argument("--score", default="bic", choices=["bic", "aic", "cv"],
-                   help="regression score that orders the candidates (bic)")
-    s.add_argument("--max-terms", type=integer(1, 12), default=4, help="largest support (4)")
+                   help="regression score that orders the candidates "
+                   "(default: %(default)s)")
+    s.add_argument("--max-terms", type=integer(1, 12), default=4,
+                   help="largest support (default: %(default)s)")
     s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
-                   help="simulation criterion of the ranking (I2)")
-    s.add_argument("--shortlist", type=integer(1, 200), default=8, help="candidates simulated (8)")
+                   help="simulation criterion of the ranking (default: %(default)s)")
+    s.add_argument("--shortlist", type=integer(1, 200), default=8,
+                   help="candidates simulated (default: %(default)s)")
     s.add_argument("--margin", type=number(0.0, unit="N s/m"), default=0.0,
-                   help="dissipativity strictness margin in N s/m (0)")
+                   help="dissipativity strictness margin in N s/m (default: %(default)g)")
     s.add_argument("--monotone", action="store_true",
                    help="also require a monotone elastic branch")
     s.add_argument("--no-refine", action="store_true",
                    help="skip the refinement of every shortlisted support by simulation "
                    "(output error: unbiased coefficients and their standard errors)")
     s.add_argument("--max-simulations", type=integer(2, 100_000), default=120,
-                   help="simulation budget of each support's refinement (120)")
+                   help="simulation budget of each support's refinement "
+                   "(default: %(default)s)")
     s.add_argument("--stability", type=integer(0, 10_000), default=0,
-                   help="bootstrap resamples of impacts for stability selection (0)")
+                   help="bootstrap resamples of impacts for stability selection "
+                   "(default: %(default)s, no stability selection)")
     s.add_argument("--derivative", choices=["velocities", "savgol", "pysindy"],
                    help="source of dzeta (default: velocities if recorded, else savgol)")
     s.add_argument("--average-cycles", action="store_true",
                    help="average the steady cycles sample by sample before the regression")
     s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
-                   help="seed of the stability selection")
+                   help="seed of the stability selection (default: %(default)s)")
     s.add_argument("--no-pdf", action="store_true",
                    help="do not compile model.tex to model.pdf (compiled when latexmk is "
                    "installed)")

@@ -72,12 +72,21 @@ def run(args):
     res = identify(sc, ref, start, criterion=args.criterion, method=args.method,
                    max_simulations=args.max_simulations, xtol=args.xtol)
     final = evaluate(sc, res.law, ref)
-    picks = _pick_iterates(res.iterations, 5)
+    # res.iterations lists every new best-so-far law (finite-difference probes included),
+    # so the impulses are labelled by the simulations spent, not as iterations: a few of
+    # those found before the identified law, then the identified law itself
+    its = res.iterations
+    found = next((k for k, it in enumerate(its) if it["coefficients"] == res.coefficients),
+                 len(its))
     imps = []
-    for k in picks:
-        law = start.with_coefficients(list(res.iterations[k]["coefficients"].values()))
+    for k in _pick_iterates(its[:found], 4):
+        it = its[k]
+        law = start.with_coefficients(list(it["coefficients"].values()))
         ev = evaluate(sc, law, ref, floor=False)
-        imps.append((f"iterate {k} ({res.iterations[k]['n_simulations']} sims)", ev.simulated))
+        n = it["n_simulations"]
+        imps.append(("start" if it["coefficients"] == start.as_dict() else
+                     f"best after {n} simulation{'s' if n != 1 else ''}", ev.simulated))
+    imps.append(("identified law", final.simulated))
     with OutputDir(args.out) as out:
         summary = {"command": "identify", "scenario": sc.as_dict(), "data": str(args.data),
                    "measured": {"n_cycles": E.n_cycles, "n_periods": E.n_periods,
@@ -97,14 +106,17 @@ def run(args):
         out.write_json("summary.json", summary)
         buf = io.StringIO()
         w = csv.writer(buf)
-        w.writerow(["iterate", "n_simulations", res.criterion, *res.law.names])
+        # one row per new best-so-far law (optimiser steps and finite-difference probes)
+        w.writerow(["best_so_far", "n_simulations", res.criterion, *res.law.names])
         for k, it in enumerate(res.iterations):
             w.writerow([k, it["n_simulations"], f"{it['value']:.10g}",
                         *[f"{v:.10g}" for v in it["coefficients"].values()]])
         out.path("iterations.csv").write_text(buf.getvalue())
         identification_figure(res, E, imps, str(out.path("identification")), land)
     print(f"identified {res.law}")
-    print(f"  {res.criterion} = {res.value:.4g} after {res.n_simulations} simulations "
+    # the criterion of the identified law (res.value can be that of a standard-error probe)
+    value = res.criteria.get(res.criterion, res.value)
+    print(f"  {res.criterion} = {value:.4g} after {res.n_simulations} simulations "
           f"({res.method}, {res.seconds:.1f} s)")
     if res.standard_errors:
         print(coefficients_line(res.coefficients, res.standard_errors))
@@ -128,21 +140,21 @@ def register(sub):
                    "the machine's state)")
     add_record_options(s)
     s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
-                   help="criterion to minimise (I2)")
+                   help="criterion to minimise (default: %(default)s)")
     s.add_argument("--method", default="least-squares",
                    choices=["coordinate-descent", "nelder-mead", "least-squares"],
-                   help="optimiser (least-squares)")
+                   help="optimiser (default: %(default)s)")
     s.add_argument("--start", required=True, help="terms and start values, e.g. "
                    "'1.5e8*z + 0.9e7*zd'")
     s.add_argument("--max-simulations", type=integer(2, 1_000_000), default=600,
-                   help="simulation budget (600)")
+                   help="simulation budget (default: %(default)s)")
     s.add_argument("--xtol", type=number(0.0, 1.0, lo_open=True), default=1e-5,
-                   help="relative coefficient tolerance")
+                   help="relative coefficient tolerance (default: %(default)g)")
     s.add_argument("--landscape", help="a landscape output (directory or summary.json) to draw "
-                   "the path on")
+                   "the path on (default: none)")
     s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
-                   help="bootstrap replicates of the noise floor (16)")
+                   help="bootstrap replicates of the noise floor (default: %(default)s)")
     s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
-                   help="seed of the noise-floor bootstrap (0)")
+                   help="seed of the noise-floor bootstrap (default: %(default)s)")
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

@@ -67,18 +67,20 @@ def register(sub):
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
     s.add_argument("--law", help=LAW_HELP)
     s.add_argument("--periods", type=integer(1, 100_000), default=20,
-                   help="drive periods recorded (20)")
+                   help="drive periods recorded (default: %(default)s)")
     s.add_argument("--fs", type=number(0, 1e8, lo_open=True, unit="Hz"), default=20000.0,
-                   help="sampling rate in Hz (20000)")
+                   help="sampling rate in Hz (default: %(default)g)")
     s.add_argument("--noise", type=number(0, 1), default=0.0,
-                   help="Gaussian noise on F as a fraction of the peak force, 0..1 (0)")
-    s.add_argument("--seed", type=integer(0), default=0, help="noise seed, >= 0 (0)")
+                   help="Gaussian noise on F as a fraction of the peak force, 0..1 "
+                   "(default: %(default)g)")
+    s.add_argument("--seed", type=integer(0), default=0,
+                   help="noise seed, >= 0 (default: %(default)s)")
     s.add_argument("--from-rest", action="store_true",
                    help="record from the initial state (run-up with impacts at many "
                    "velocities, then the steady state) instead of on the periodic orbit")
     s.add_argument("--position-noise", type=number(0, 1), default=0.0,
                    help="Gaussian noise on w1, w2 as a fraction of the largest penetration, "
-                   "0..1 (0)")
+                   "0..1 (default: %(default)g)")
     s.add_argument("--no-velocities", action="store_true",
                    help="leave out the v1, v2 columns (discovery then differentiates w1 - w2)")
     s.add_argument("--out", required=True, help="output CSV (t, F, w1, v1, w2, v2)")

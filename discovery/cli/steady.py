@@ -41,5 +41,6 @@ def register(sub):
                        "Floquet multipliers")
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
     s.add_argument("--law", help=LAW_HELP)
-    s.add_argument("--out", help="optional output directory for summary.json")
+    s.add_argument("--out", help="optional output directory for summary.json "
+                   "(default: none, print only)")
     s.set_defaults(func=run)

@@ -112,21 +112,39 @@ def run_chart(args):
             if done == total:
                 print(file=sys.stderr)
 
+    if args.periods < 4 * args.max_period:
+        raise InputError(f"--periods {args.periods} is too short for --max-period "
+                         f"{args.max_period}: give --periods {4 * args.max_period} or more "
+                         "(the recurrence test compares three cycles with the cycle before)")
     ch = chart(system, args.nu, args.B, transient=args.transient, periods=args.periods,
-               rtol=args.rtol, workers=args.workers, progress=progress)
+               rtol=args.rtol, max_period=args.max_period,
+               sweeps=2 if args.both_directions else 1, workers=args.workers,
+               progress=progress)
     summary = {"command": "ueda chart", **ch.as_dict(), **provenance(vars(args))}
+
+    def cell(value, column):
+        if isinstance(value, float):
+            return f"{value:.10g}" if column in ("nu", "B") else f"{value:.6g}"
+        return value
+
     with OutputDir(args.out) as out:
         with open(out.path("chart.csv"), "w", newline="", encoding="utf-8") as fh:
             w = csv.writer(fh)
-            w.writerow(["nu", "B", "regime", "period", "lyapunov", "rotation_number"])
+            w.writerow(ch.columns)
             for r in ch.rows():
-                w.writerow([f"{r[0]:.10g}", f"{r[1]:.10g}", r[2], r[3], f"{r[4]:.6g}",
-                            f"{r[5]:.6g}"])
+                w.writerow([cell(v, c) for v, c in zip(r, ch.columns, strict=True)])
         chart_figure(ch, str(out.path("chart")))
         out.write_json("summary.json", summary)
     fr = ch.fractions()
     print(f"{system.model} chart {ch.nu.size}x{ch.B.size}: {ch.seconds:.1f} s on {ch.workers} "
-          f"processes; " + ", ".join(f"{k} {100 * v:.0f} %" for k, v in fr.items()))
+          f"processes ({ch.cpu_seconds:.1f} CPU s); "
+          + ", ".join(f"{k} {100 * v:.0f} %" for k, v in fr.items()))
+    found = ch.period_counts()
+    if found:
+        print("  periods found (points): " + ", ".join(f"P{n} {c}" for n, c in found.items()))
+    if ch.coexisting is not None:
+        print(f"  coexisting attractors (the sweeps up and down in nu differ) at "
+              f"{int(ch.coexisting.sum())} point(s), {100 * ch.coexisting.mean():.1f} %")
     print(f"outputs in {args.out}/: summary.json, chart.csv, chart.png, chart.pdf")
     return 0
 
@@ -278,8 +296,8 @@ def _add_system_options(s, chart=False):
     s.add_argument("--model", choices=("negres", "duffing"), default="negres",
                    help="negres: x'' - mu (1 - gamma x^2) x' + x^3 = B cos(nu t) (mu 0.2, "
                    "gamma 8, B 0.35, nu 1.02: the broken egg); duffing: x'' + k x' + x^3 = "
-                   "B cos(nu t) (k 0.05, B 7.5, nu 1)")
-    s.add_argument("--mu", type=number(-10, 10), help="negative resistance (model's default)")
+                   "B cos(nu t) (k 0.05, B 7.5, nu 1) (default: %(default)s)")
+    s.add_argument("--mu", type=number(-10, 10), help="negative resistance (default: the model's)")
     s.add_argument("--gamma", type=number(0, 1e3), help="amplitude dependence of the "
                    "resistance, >= 0")
     s.add_argument("--k", type=number(-10, 10), help="linear damping")
@@ -288,7 +306,7 @@ def _add_system_options(s, chart=False):
         s.add_argument("--nu", type=number(0, 100, lo_open=True), help="forcing angular "
                        "frequency, > 0")
     s.add_argument("--rtol", type=number(1e-13, 1e-3), default=1e-9 if not chart else 1e-6,
-                   help="integrator tolerance (%(default)g)")
+                   help="integrator tolerance (default: %(default)g)")
 
 
 def register(sub):
@@ -299,33 +317,44 @@ def register(sub):
     a = usub.add_parser("attractor", help="one attractor: strobe points, exponents, regime, "
                         "figures")
     _add_system_options(a)
-    a.add_argument("--x0", type=number(-1e3, 1e3), default=0.1, help="initial x (0.1)")
-    a.add_argument("--v0", type=number(-1e3, 1e3), default=0.0, help="initial x' (0)")
+    a.add_argument("--x0", type=number(-1e3, 1e3), default=0.1,
+                   help="initial x (default: %(default)g)")
+    a.add_argument("--v0", type=number(-1e3, 1e3), default=0.0,
+                   help="initial x' (default: %(default)g)")
     a.add_argument("--transient", type=integer(0, 10**6), default=500,
-                   help="periods discarded (500)")
+                   help="periods discarded (default: %(default)s)")
     a.add_argument("--periods", type=integer(20, 10**7), default=5000,
-                   help="periods averaged (strobe points) (5000)")
+                   help="periods averaged (strobe points) (default: %(default)s)")
     a.add_argument("--batches", type=integer(2, 1000), default=20,
-                   help="batches for the standard error (20)")
+                   help="batches for the standard error (default: %(default)s)")
     a.add_argument("--basins", type=integer(0, 100), default=0,
                    help="also find coexisting attractors from an NxN grid of initial states "
-                   "(0: skip)")
+                   "(default: %(default)s, skip)")
     a.add_argument("--grid-extent", type=number(0, 1e3, lo_open=True), default=1.0,
-                   help="the grid of initial states covers [-E, E]^2 (1)")
+                   help="the grid of initial states covers [-E, E]^2 (default: %(default)g)")
     a.add_argument("--out", required=True, help="output directory")
     a.set_defaults(func=run_attractor)
     c = usub.add_parser("chart", help="regime chart over (nu, B) in parallel processes")
     _add_system_options(c, chart=True)
     c.add_argument("--nu", type=lambda t: _grid(t, "--nu"), default=_grid("0.8:1.2:200", "--nu"),
-                   metavar="LOW:HIGH:N", help="forcing frequencies (0.8:1.2:200)")
+                   metavar="LOW:HIGH:N", help="forcing frequencies (default: 0.8:1.2:200)")
     c.add_argument("--B", type=lambda t: _grid(t, "--B"), default=_grid("0:0.6:200", "--B"),
-                   metavar="LOW:HIGH:N", help="forcing amplitudes (0:0.6:200)")
+                   metavar="LOW:HIGH:N", help="forcing amplitudes (default: 0:0.6:200)")
     c.add_argument("--transient", type=integer(0, 10**5), default=60,
-                   help="periods discarded at each point, after continuation from the "
-                   "previous nu (60)")
+                   help="periods discarded at most at each point, after continuation from "
+                   "the previous nu; a point stops sooner once its strobe points repeat "
+                   "(a stable periodic orbit) (default: %(default)s)")
     c.add_argument("--periods", type=integer(20, 10**5), default=80,
-                   help="periods observed at each point (80)")
-    c.add_argument("--workers", type=integer(1, 1024), help="processes (all cores)")
+                   help="periods observed with the variational equations where no stable "
+                   "orbit was found; at least 4 x --max-period (default: %(default)s)")
+    c.add_argument("--max-period", type=integer(1, 1000), default=16,
+                   help="longest period recognised, in forcing periods; longer locked "
+                   "orbits appear as beat (default: %(default)s)")
+    c.add_argument("--both-directions", action="store_true",
+                   help="sweep every row up and back down in nu, and mark the points where "
+                   "the two sweeps end on different attractors (coexisting attractors, "
+                   "hysteresis); about twice the time (default: off)")
+    c.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
     c.add_argument("--progress", action="store_true", help="progress bar even when stderr "
                    "is not a terminal")
     c.add_argument("--out", required=True, help="output directory")
@@ -334,20 +363,23 @@ def register(sub):
     _add_system_options(m)
     m.set_defaults(rtol=1e-10)
     m.add_argument("--periods", type=integer(2, 10**6), default=200,
-                   help="forcing periods recorded (200)")
+                   help="forcing periods recorded (default: %(default)s)")
     m.add_argument("--samples-per-period", type=integer(8, 10**4), default=40,
-                   help="samples per forcing period (40)")
+                   help="samples per forcing period (default: %(default)s)")
     m.add_argument("--noise", type=number(0, 1), default=0.0,
                    help="Gaussian noise on x, standard deviation as a fraction of x's range, "
-                   "0..1 (0)")
-    m.add_argument("--seed", type=integer(0), default=0, help="noise seed (0)")
+                   "0..1 (default: %(default)g)")
+    m.add_argument("--seed", type=integer(0), default=0,
+                   help="noise seed (default: %(default)s)")
     m.add_argument("--transient", type=integer(0, 10**6), default=200,
-                   help="periods discarded before the record (200)")
-    m.add_argument("--x0", type=number(-1e3, 1e3), default=0.1, help="initial x (0.1)")
-    m.add_argument("--v0", type=number(-1e3, 1e3), default=0.0, help="initial x' (0)")
+                   help="periods discarded before the record (default: %(default)s)")
+    m.add_argument("--x0", type=number(-1e3, 1e3), default=0.1,
+                   help="initial x (default: %(default)g)")
+    m.add_argument("--v0", type=number(-1e3, 1e3), default=0.0,
+                   help="initial x' (default: %(default)g)")
     m.add_argument("--integrator", choices=("compiled", "scipy"), default="compiled",
                    help="compiled (Dormand-Prince kernel) or scipy (solve_ivp DOP853, the "
-                   "independent path) (compiled)")
+                   "independent path) (default: %(default)s)")
     m.add_argument("--out", required=True, help="output CSV (columns t, x); the summary "
                    "goes to OUT.summary.json")
     m.set_defaults(func=run_simulate)
@@ -362,22 +394,26 @@ def register(sub):
     d.add_argument("--noise", type=number(0, 1), help="known noise sd as a fraction of x's "
                    "range (default: estimated from the smoothing residual)")
     d.add_argument("--threshold", type=number(0, 1), default=0.02,
-                   help="STLSQ threshold on scaled coefficients (0.02)")
+                   help="STLSQ threshold on scaled coefficients (default: %(default)g)")
     d.add_argument("--half-width", type=integer(2, 10**4), help="test-window half width in "
-                   "samples (a quarter period, at least 7)")
+                   "samples (default: a quarter period, at least 7)")
     d.add_argument("--fix-forcing", action="store_true", help="fix the forcing's "
                    "coefficient at 1 instead of fitting it")
     d.add_argument("--bootstrap", type=integer(0, 10**5), default=200,
-                   help="block-bootstrap resamples for the standard errors (200)")
+                   help="block-bootstrap resamples for the standard errors "
+                   "(default: %(default)s)")
     d.add_argument("--block-periods", type=integer(1, 10**4), default=4,
-                   help="bootstrap block length in forcing periods (4)")
+                   help="bootstrap block length in forcing periods (default: %(default)s)")
     d.add_argument("--model-periods", type=integer(50, 10**6), default=2000,
-                   help="periods of the discovered model simulated (2000)")
+                   help="periods of the discovered model simulated (default: %(default)s)")
     d.add_argument("--transient", type=integer(0, 10**6), default=200,
-                   help="periods of the discovered model discarded first (200)")
+                   help="periods of the discovered model discarded first "
+                   "(default: %(default)s)")
     d.add_argument("--resamples", type=integer(10, 10**5), default=200,
-                   help="random halves for the energy-distance noise floor (200)")
-    d.add_argument("--seed", type=integer(0), default=0, help="seed of the resampling (0)")
+                   help="random halves for the energy-distance noise floor "
+                   "(default: %(default)s)")
+    d.add_argument("--seed", type=integer(0), default=0,
+                   help="seed of the resampling (default: %(default)s)")
     d.add_argument("--out", required=True, help="output directory")
     d.set_defaults(func=run_discover)
     e = usub.add_parser("explain", help="name the effect missing from a start model "
@@ -386,31 +422,35 @@ def register(sub):
     e.add_argument("--data", required=True, help="CSV with columns t (uniform) and x")
     e.add_argument("--start", default="x',x^3", help="library terms of the start model, "
                    "separated by commas (x^2*x' or x^2 x'; v for x'; none: the forcing "
-                   "alone) (x',x^3: negres without its van der Pol damping x^2 x')")
+                   "alone); x',x^3 is negres without its van der Pol damping x^2 x' "
+                   "(default: %(default)s)")
     e.add_argument("--model", choices=("negres", "duffing"),
                    help="take the forcing B, nu from this model (override with --B, --nu)")
     e.add_argument("--B", type=number(-1e3, 1e3), help="forcing amplitude")
     e.add_argument("--nu", type=number(0, 100, lo_open=True), help="forcing angular "
                    "frequency, > 0")
     e.add_argument("--effects", help="catalogue ids to consider, separated by commas "
-                   "(default all: van_der_pol_damping, linear_damping, cubic_stiffness, "
+                   "(default: all of van_der_pol_damping, linear_damping, cubic_stiffness, "
                    "quadratic_stiffness, velocity_cubic_damping)")
     e.add_argument("--alpha", type=number(0, 1, lo_open=True), default=0.01,
-                   help="family-wise level of the score tests, Bonferroni (0.01)")
+                   help="family-wise level of the score tests, Bonferroni "
+                   "(default: %(default)g)")
     e.add_argument("--max-iterations", type=integer(0, 20), default=3,
-                   help="effects added at most (3)")
+                   help="effects added at most (default: %(default)s)")
     e.add_argument("--noise", type=number(0, 1), help="known noise sd as a fraction of x's "
                    "range (default: estimated from the smoothing residual)")
     e.add_argument("--half-width", type=integer(2, 10**4), help="test-window half width in "
-                   "samples (a quarter period, at least 7)")
+                   "samples (default: a quarter period, at least 7)")
     e.add_argument("--fix-forcing", action="store_true", help="fix the forcing's "
                    "coefficient at 1 instead of fitting it")
     e.add_argument("--model-periods", type=integer(50, 10**6), default=2000,
-                   help="periods of each model simulated (2000)")
+                   help="periods of each model simulated (default: %(default)s)")
     e.add_argument("--transient", type=integer(0, 10**6), default=200,
-                   help="periods of each model discarded first (200)")
+                   help="periods of each model discarded first (default: %(default)s)")
     e.add_argument("--resamples", type=integer(10, 10**5), default=200,
-                   help="random halves for the energy-distance noise floor (200)")
-    e.add_argument("--seed", type=integer(0), default=0, help="seed of the resampling (0)")
+                   help="random halves for the energy-distance noise floor "
+                   "(default: %(default)s)")
+    e.add_argument("--seed", type=integer(0), default=0,
+                   help="seed of the resampling (default: %(default)s)")
     e.add_argument("--out", required=True, help="output directory")
     e.set_defaults(func=run_explain)

@@ -58,10 +58,12 @@ def register(sub):
     add_record_options(s)
     s.add_argument("--time-offset", type=number(-1e7, 1e7, unit="s"), default=0.0,
                    help="drive-clock time [s] of the record's t = 0, when the record does not "
-                   "start at drive phase 0 (0)")
+                   "start at drive phase 0 (default: %(default)g)")
     s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
-                   help="bootstrap replicates of the noise floor, 1..10000 (16)")
-    s.add_argument("--seed", type=integer(0), default=0, help="seed of the bootstrap, >= 0 (0)")
+                   help="bootstrap replicates of the noise floor, 1..10000 "
+                   "(default: %(default)s)")
+    s.add_argument("--seed", type=integer(0), default=0,
+                   help="seed of the bootstrap, >= 0 (default: %(default)s)")
     s.add_argument("--no-default-start", action="store_true",
                    help="skip the check of the attractor reached from the scenario's "
                    "initial state")

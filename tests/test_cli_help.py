@@ -1,0 +1,104 @@
+"""Every ``vidi ... --help`` works and shows the default of every option that has one.
+
+The parsers are walked as ``discovery.cli`` builds them (each command's ``register``),
+nested subcommands (``vidi ueda attractor``) included, so a new option is checked
+without touching this file.  The convention: an option with a default says
+``(default: VALUE)`` in its help, written ``(default: %(default)s)`` (or ``%(default)g``)
+so the text follows the code; a default argparse cannot print (an array of grid points)
+is written out and must parse, with the option's own type, to that default.
+"""
+
+import argparse
+import re
+
+import numpy as np
+import pytest
+
+from discovery.cli import _parser, main
+
+
+def _walk(parser, path=()):
+    """``(command words, parser)`` of ``parser`` and of every subcommand below it."""
+    yield path, parser
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                yield from _walk(sub, (*path, name))
+
+
+PARSERS = list(_walk(_parser()))
+IDS = [" ".join(p) or "vidi" for p, _ in PARSERS]
+
+
+def _expanded_help(parser, action):
+    """The action's help as ``--help`` prints it (``%(default)s`` etc. filled in)."""
+    return parser._get_formatter()._expand_help(action)
+
+
+def _has_default(action):
+    return (action.option_strings and action.help is not argparse.SUPPRESS
+            and action.default is not None and action.default is not False
+            and action.default is not argparse.SUPPRESS)
+
+
+def _same(shown, action):
+    """Does the text ``shown`` (after "default: ") give the action's default?"""
+    default = action.default
+    if isinstance(default, str):
+        return shown == default
+    try:
+        value = action.type(shown) if callable(action.type) else type(default)(shown)
+    except (ValueError, TypeError, argparse.ArgumentTypeError):
+        return False
+    if isinstance(default, np.ndarray):
+        return np.array_equal(np.asarray(value), default)
+    return value == default
+
+
+def test_every_command_is_walked():
+    commands = {p[0] for p, _ in PARSERS if p}
+    assert {"simulate", "fit", "verify", "explain", "steady", "landscape", "identify",
+            "ueda"} <= commands
+    assert {p[1] for p, _ in PARSERS if len(p) == 2 and p[0] == "ueda"} >= {
+        "attractor", "chart", "simulate", "discover", "explain"}
+
+
+@pytest.mark.parametrize(("path", "parser"), PARSERS, ids=IDS)
+def test_help_exits_0(path, parser, capsys):
+    assert main([*path, "--help"]) == 0
+    out = capsys.readouterr()
+    assert out.out.startswith("usage: vidi")
+    assert out.err == ""
+
+
+@pytest.mark.parametrize(("path", "parser"), PARSERS, ids=IDS)
+def test_every_default_is_shown(path, parser):
+    missing = []
+    for action in parser._actions:
+        if not _has_default(action):
+            continue
+        text = " ".join(_expanded_help(parser, action).split())
+        # "(default: 0)", "(default: 0, skip)", "(default: x',x^3)"
+        shown = [c for m in re.findall(r"\(default: ([^()]*)\)", text)
+                 for c in (m, re.split(r"[,;] ", m)[0])]
+        if not any(_same(s.strip(), action) for s in shown):
+            missing.append(f"{'/'.join(action.option_strings)} (default {action.default!r}): "
+                           f"{text!r}")
+    assert not missing, (f"vidi {' '.join(path)}: help without its default:\n  "
+                         + "\n  ".join(missing))
+
+
+@pytest.mark.parametrize(("path", "parser"), PARSERS, ids=IDS)
+def test_help_uses_one_convention(path, parser):
+    """``(default: ...)``, not the old ``(20)`` suffix nor argparse's formatter class
+    (which would print ``(default: None)`` for options without a default)."""
+    assert parser.formatter_class is argparse.HelpFormatter
+    for action in parser._actions:
+        if action.help in (None, argparse.SUPPRESS) or not action.option_strings:
+            continue
+        text = _expanded_help(parser, action)
+        assert "(default: None)" not in text and "(default: False)" not in text
+        if _has_default(action):
+            assert not re.search(r"\(\s*[-+]?[\d.e+-]+\s*\)\s*$", text), (
+                f"vidi {' '.join(path)} {action.option_strings[0]}: write the default as "
+                f"'(default: %(default)s)', not {text!r}")
