@@ -37,6 +37,7 @@ from scipy.optimize import least_squares, minimize
 from .criteria import criterion as _criterion
 from .errors import InputError, IntegrationError
 from .impulse import Impulse
+from .law import ForceLaw
 from .verify import Reference, evaluate
 
 __all__ = ["IdentificationResult", "identify", "METHODS", "as_records", "pair_records",
@@ -53,8 +54,9 @@ class IdentificationResult:
 
     Attributes
     ----------
-    law : ForceLaw
-        Identified law.
+    law : ForceLaw or Model
+        Identified law (of the kind ``start`` was: a model when more than a law was
+        fitted).
     criterion : str
         The criterion minimised (reported for every method; the mean over records).
     value : float
@@ -95,7 +97,7 @@ class IdentificationResult:
 
     @property
     def coefficients(self):
-        return self.law.as_dict()
+        return _named(self.law)
 
 
 class _Budget(Exception):
@@ -164,6 +166,20 @@ def record_start(scenario, reference, terms):
     return np.array([(k * z0 if t.b == 0 else c) / z0**t.a for t in terms])
 
 
+def _named(model):
+    return dict(zip(model.names, model.coefficients, strict=True))
+
+
+def model_parts(model, observe=None):
+    """``(law, scenario -> scenario, observation)`` of what :func:`identify` fits: a
+    :class:`ForceLaw`, or a model with more parameters than a law's coefficients (the
+    missing-effect workflow's :class:`~discovery.explain.Model`: ``coefficients``,
+    ``names``, ``with_coefficients``, ``law``, ``apply(scenario)``, ``observe()``)."""
+    if isinstance(model, ForceLaw):
+        return model, (lambda sc: sc), observe
+    return model.law, model.apply, model.observe()
+
+
 class _Objective:
     """Counts and caches simulations, enforces the budget, records the best-so-far path."""
 
@@ -192,15 +208,16 @@ class _Objective:
         if key not in self.cache:
             if self.n + len(self.records) > self.max_sim:
                 raise _Budget
-            law = self.law(x)
+            law, machine, observe = model_parts(self.law(x), self.observe)
             evs = []
             for sc, ref in self.records:
                 self.n += 1
-                ev = evaluate(sc, law, ref, tolerances=self.tol, floor=False,
-                              observe=self.observe)
+                ev = evaluate(machine(sc), law, ref, tolerances=self.tol, floor=False,
+                              observe=observe)
                 evs.append(ev)
                 if ev.status != "ok":
-                    self.failures.append({"coefficients": law.as_dict(), "status": ev.status,
+                    self.failures.append({"coefficients": _named(self.law(x)),
+                                          "status": ev.status,
                                           "message": ev.message or ev.verdict})
                     break
             self.cache[key] = evs if all(e.status == "ok" for e in evs) else None
@@ -213,7 +230,7 @@ class _Objective:
         v = float(np.mean([e.criteria[self.name] for e in evs]))
         if v < self.best[0]:
             self.best = (v, np.array(x, dtype=float))
-            self.path.append({"coefficients": self.law(x).as_dict(), "value": v,
+            self.path.append({"coefficients": _named(self.law(x)), "value": v,
                               "n_simulations": self.n})
         return v
 
@@ -301,8 +318,10 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
         The record(s) (see :func:`as_records`).  A :class:`Reference` built with
         :meth:`~discovery.verify.Reference.from_measurement` starts every simulation from
         the machine's measured state.
-    start : ForceLaw
-        Terms to identify and their start values (all non-zero).
+    start : ForceLaw or Model
+        Terms to identify and their start values (all non-zero); or a model whose
+        parameters go beyond a law's coefficients (:func:`model_parts`: an unloading
+        branch, a machine parameter, an observation model, fitted jointly).
     criterion : str
         Criterion to minimise (``I0``..``I4``; the mean over records).
     method : str

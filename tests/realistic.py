@@ -378,17 +378,20 @@ def default_transient(case_or_pair):
     (``Case.transient``: the slowest multiplier decays to 1e-4, lengthened by the draw's
     reference check when its record did not start on the orbit), or for a ``(scenario,
     law)`` pair :func:`transient_periods` of the compiled steady state's largest
-    multiplier (600 when it is nonperiodic)."""
+    multiplier times the orbit's period (600 when it is nonperiodic)."""
     if isinstance(case_or_pair, Case) and case_or_pair.transient > 0:
         return int(case_or_pair.transient)
     scenario, law, mult = _unpack(case_or_pair)
+    n = 1
     if mult is None:
         try:
             ss = steady_state(scenario, law)
             mult = float(np.max(np.abs(ss.multipliers))) if ss.periodic else float("nan")
+            n = max(ss.n_periods, 1)
         except VidiError:
             mult = float("nan")
-    return transient_periods(mult)
+    # the multipliers are per orbit: a period-n orbit decays once every n drive periods
+    return min(TRANSIENT_MAX, n * transient_periods(mult))
 
 
 def reference_record(case_or_pair, *, periods=15, fs=20000.0, transient=None,

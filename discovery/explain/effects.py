@@ -199,6 +199,31 @@ class Model:
     def with_law(self, law):
         return replace(self, law=law)
 
+    # ------------------------------------------- the parameters identify() fits
+    def _free(self):
+        """Added effects whose parameter is not a coefficient of the loading law."""
+        return [e for e in (effect(i) for i in self.effects) if e.target != "term"]
+
+    @property
+    def coefficients(self):
+        """The law's coefficients, then the added effects' other parameters."""
+        return self.law.coefficients + tuple(self.value(e) for e in self._free())
+
+    @property
+    def names(self):
+        return list(self.law.names) + [e.parameters[0].name for e in self._free()]
+
+    def with_coefficients(self, values):
+        """The model with new :attr:`coefficients` (each effect parameter clipped to its
+        physical bounds), so :func:`discovery.identify` fits them jointly."""
+        values = [float(v) for v in values]
+        n = len(self.law.coefficients)
+        m = self.with_law(self.law.with_coefficients(values[:n]))
+        for e, v in zip(self._free(), values[n:], strict=True):
+            lo, hi = e.parameters[0].bounds
+            m = m.with_effect(e, min(max(v, lo), hi), add=False)
+        return m
+
     def apply(self, scenario):
         """The record's scenario with this model's machine changes."""
         return scenario.replace(**self.scenario) if self.scenario else scenario
