@@ -386,7 +386,7 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
         message = f"simulation budget of {max_simulations} used"
     if obj.best[1] is None:  # least squares evaluates residuals, which record the path
         obj(x0)
-    x_best = obj.best[1]
+    x_best, value = obj.best[1], float(obj.best[0])  # before the error probes run
     law = obj.law(x_best)
     evs = obj.evaluations(x_best)
     se, corr = {}, None
@@ -398,7 +398,7 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
         message += (f"; {len(obj.failures)} trial law(s) had no periodic steady state with "
                     "contact (see failures)")
     return IdentificationResult(
-        law=law, criterion=criterion, value=float(obj.best[0]), criteria=crit, method=method,
+        law=law, criterion=criterion, value=value, criteria=crit, method=method,
         n_simulations=obj.n, evaluations=tuple(evs), iterations=obj.path,
         standard_errors=se, correlation=corr, failures=obj.failures,
         seconds=time.perf_counter() - t0, message=message)
