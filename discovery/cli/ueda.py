@@ -221,8 +221,11 @@ def run_discover(args):
         sm = replace(sm, noise_sd=float(args.noise * np.ptp(x)))
     ver = verify(d.model, t, x, smoothed=sm, transient=args.transient,
                  periods=args.model_periods, resamples=args.resamples, seed=args.seed)
+    result = d.as_dict()
+    # "settings" is provenance's (the command-line options); keep the discovery's own
+    result["discovery_settings"] = result.pop("settings")
     summary = {"command": "ueda discover", "forcing": {"B": B, "nu": nu},
-               **d.as_dict(), "verification": ver.as_dict(),
+               **result, "verification": ver.as_dict(),
                **provenance(vars(args), inputs={"data": args.data})}
     with OutputDir(args.out, inputs=[args.data]) as out:
         discover_figure(d, ver, str(out.path("discover")))
@@ -237,7 +240,8 @@ def run_discover(args):
     L = ver.lyapunov
     lyap = f"{L['value']:.4f} +- {L['stderr']:.4f}" if L else "n/a"
     print(f"verification: energy distance {ver.energy_distance:.4g} vs floor q95 "
-          f"{ver.floor_q95:.4g}; regime record {ver.regime_record}, model "
+          f"{ver.floor_q95:.4g} ({ver.floor_block_periods}-period blocks); regime record "
+          f"{ver.regime_record}, model "
           f"{ver.regime_model}; model lyapunov {lyap}: "
           f"{'consistent' if ver.consistent else 'INCONSISTENT'}")
     print(f"outputs in {args.out}/: summary.json, discover.png, discover.pdf, "
