@@ -21,7 +21,8 @@ for machines the paper's model does not describe:
 * a *permanent set* ``s`` in [0, 0.95]: plastic indentation (Walton-Braun).  Unloading
   follows ``P(u, 0)`` at ``u = (zeta - s zeta_max) / (1 - s)``, ``zeta_max`` the contact's
   largest penetration: continuous at ``zeta_max`` and zero at the residual penetration
-  ``s zeta_max`` (for a linear law: unloading stiffness ``k / (1 - s)``).  The set is
+  ``s zeta_max`` (for a linear law: unloading stiffness ``k / (1 - s)``).  A contact that
+  reloads before it ends climbs back along that line up to ``zeta_max``.  The set is
   recovered between impacts (each contact starts from the undeformed surface).
 
 Text form: ``"2e8*z + 1e7*zd; unloading: 4e6*zd; set: 0.2"``.  Units are
@@ -333,6 +334,11 @@ class ForceLaw:
         p = self.polynomial(zp, np.maximum(dzeta, 0.0))
         if self.has_unloading_branch:
             zm = zp if zeta_max is None else np.maximum(np.asarray(zeta_max, float), zp)
+            if self.permanent_set:
+                # reloading below z_max follows the elastic unloading line (Walton-Braun)
+                p = p - self.polynomial(zp, np.zeros_like(zp)) \
+                    + self.unloading_force(zp, np.zeros_like(zp), zm) \
+                    * (zp < zm) + self.polynomial(zp, np.zeros_like(zp)) * (zp >= zm)
             p = np.where(dzeta > 0, p, self.unloading_force(zp, dzeta, zm))
         return np.where(zeta > 0, np.maximum(p, 0.0), 0.0)
 

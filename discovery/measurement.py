@@ -259,9 +259,20 @@ class Measurement:
             if free:
                 break
         k, i = best
-        tk = k * period - time_offset
+        return self.state_near(k * period - time_offset, period), float(k * period)
+
+    def state_near(self, t_k, period):
+        """The bodies' state ``w1, v1, w2, v2`` at record time ``t_k`` from a local
+        quadratic fit of each channel over +-1 % of a period (velocities from the fit's
+        slope when they were not recorded)."""
+        ch, t = self.channels, self.t
+        if "w1" not in ch or "w2" not in ch:
+            raise InputError("the state needs the positions w1 and w2 in the data")
+        dt = float(np.median(np.diff(t)))
+        m = max(3, int(0.01 * period / dt))
+        i = int(np.searchsorted(t, t_k))
         sl = slice(max(i - m, 0), min(i + m + 1, t.size))
-        x = t[sl] - tk
+        x = t[sl] - t_k
 
         def fit(y):
             return np.polyfit(x, y[sl], 2)
@@ -271,7 +282,7 @@ class Measurement:
             cw = fit(ch[w])
             state.append(np.polyval(cw, 0.0))
             state.append(np.polyval(fit(ch[v]), 0.0) if v in ch else cw[1])
-        return np.array(state, dtype=float), float(k * period)
+        return np.array(state, dtype=float)
 
     def impulse(self, period, **kwargs):
         """Period-averaged steady-state impulse (see :func:`impulse_from_samples`);

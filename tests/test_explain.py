@@ -153,7 +153,8 @@ def test_explain_cli_end_to_end(hidden_coupling, tmp_path, capsys):
     fm = s["final_model"]
     assert set(fm) >= {"terms", "coefficients", "uncertainties", "latex", "effects"}
     assert fm["effects"] == ["penetration_velocity_coupling"]
-    assert set(s["noise_floor"]) == {"I0", "I1", "I2", "I3", "I4"} and s["stopped_because"]
+    # I0..I4 of the averaged cycle, and D of the drift channel (orbit by orbit)
+    assert set(s["noise_floor"]) == {"I0", "I1", "I2", "I3", "I4", "D"} and s["stopped_because"]
     assert (out / "explain_1.png").stat().st_size > 10_000
     assert "penetration_velocity_coupling" in capsys.readouterr().out
     bad = tmp_path / "bad"

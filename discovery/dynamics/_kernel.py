@@ -92,6 +92,29 @@ def poly(z, zd, coef, ea, eb, br):
 
 
 @njit(cache=True, inline="always")
+def _elastic_set(z, p, coef, ea, eb, br):
+    """``P(u, 0)`` at the unloading penetration ``u = (z - s z_max) / (1 - s)``."""
+    rho = p[P_SET]
+    u = (z - rho * p[P_ZMAX]) / (1.0 - rho)
+    s = 0.0
+    for i in range(coef.shape[0]):
+        if br[i] == 0.0:
+            s += coef[i] * _pw(u, ea[i]) * _pw(0.0, eb[i])
+    return s
+
+
+@njit(cache=True, inline="always")
+def load_force(z, v, p, coef, ea, eb, br):
+    """Loading branch: ``P(z, v)``; with a permanent set, a contact that reloads below its
+    largest penetration so far follows its elastic unloading line ``P(u, 0)`` (plus the
+    velocity terms) back up to ``z_max`` (Walton-Braun), continuous there."""
+    if p[P_SET] == 0.0 or z >= p[P_ZMAX]:
+        return poly(z, v, coef, ea, eb, br)
+    return poly(z, v, coef, ea, eb, br) - poly(z, 0.0, coef, ea, eb, br) \
+        + _elastic_set(z, p, coef, ea, eb, br)
+
+
+@njit(cache=True, inline="always")
 def unload_force(z, v, p, coef, ea, eb, br):
     """Unloading branch (``dzeta <= 0``): the elastic part ``P(u, 0)`` at the unloading
     penetration ``u = (z - s z_max) / (1 - s)`` (``s`` the permanent-set fraction, ``z_max``
@@ -115,7 +138,7 @@ def branch_force(z, v, p, coef, ea, eb, br):
     """The branch force at ``(z, v)``: loading for ``v > 0``, unloading otherwise (the
     clipped mode's resume function)."""
     if v > 0.0:
-        return poly(z, v, coef, ea, eb, br)
+        return load_force(z, v, p, coef, ea, eb, br)
     return unload_force(z, v, p, coef, ea, eb, br)
 
 
@@ -123,7 +146,7 @@ def branch_force(z, v, p, coef, ea, eb, br):
 def mode_force(mode, z, v, p, coef, ea, eb, br):
     """Contact force [N] in a given mode at penetration ``z`` and its rate ``v``."""
     if mode == LOAD:
-        return poly(z, v, coef, ea, eb, br)
+        return load_force(z, v, p, coef, ea, eb, br)
     if mode == UNLOAD:
         return unload_force(z, v, p, coef, ea, eb, br)
     return 0.0
@@ -138,7 +161,7 @@ def resolve_mode(y, p, coef, ea, eb, br):
     if z < 0.0 or (z == 0.0 and v <= 0.0):
         return FREE
     if v > 0.0:
-        return LOAD if poly(max(z, 0.0), v, coef, ea, eb, br) >= 0.0 else CLIPPED
+        return LOAD if load_force(max(z, 0.0), v, p, coef, ea, eb, br) >= 0.0 else CLIPPED
     p[P_ZMAX] = max(p[P_ZMAX], z)
     return UNLOAD if unload_force(z, v, p, coef, ea, eb, br) > 0.0 else CLIPPED
 
@@ -166,7 +189,7 @@ def _switching(mode, y, p, coef, ea, eb, br, h):
     h[0] = z
     if mode == LOAD:
         h[1] = v
-        h[2] = poly(z, v, coef, ea, eb, br)
+        h[2] = load_force(z, v, p, coef, ea, eb, br)
         return 3
     if mode == UNLOAD:
         h[1] = -v
@@ -214,7 +237,7 @@ def _mode_after(kind, y, p, coef, ea, eb, br):
         p[P_ZMAX] = max(p[P_ZMAX], z)
         return UNLOAD if unload_force(z, v, p, coef, ea, eb, br) >= 0.0 else CLIPPED
     # onset with dzeta > 0, or reload
-    return LOAD if poly(z, max(v, 0.0), coef, ea, eb, br) >= 0.0 else CLIPPED
+    return LOAD if load_force(z, max(v, 0.0), p, coef, ea, eb, br) >= 0.0 else CLIPPED
 
 
 @njit(cache=True, inline="always")

@@ -51,6 +51,15 @@ def _poly(law, z, zd):
                      for c, t in zip(law.coefficients, law.terms, strict=True)))
 
 
+def _load(law, z, v, zmax):
+    """The loading branch: ``P``, or below the contact's largest penetration with a set,
+    the elastic unloading line plus ``P``'s velocity part (Walton-Braun reloading)."""
+    s = law.permanent_set
+    if not s or z >= zmax:
+        return _poly(law, z, v)
+    return _poly(law, z, v) - _poly(law, z, 0.0) + _poly(law, (z - s * zmax) / (1.0 - s), 0.0)
+
+
 def _unload(law, z, v, zmax):
     """The unloading branch: ``P(u, 0)`` at the unloading penetration ``u`` (the permanent
     set) plus the unloading terms at the signed velocity."""
@@ -70,7 +79,7 @@ def _force(law, mode, z, v, zmax, clamp=False):
     if clamp:
         z = max(z, 0.0)
     if mode == "load":
-        return _poly(law, z, v)
+        return _load(law, z, v, zmax)
     if mode == "unload":
         return _unload(law, z, v, zmax)
     return 0.0
@@ -81,7 +90,7 @@ def _mode_of(law, y, state):
     if z < 0 or (z == 0 and v <= 0):
         return "free"
     if v > 0:
-        return "load" if _poly(law, max(z, 0.0), v) >= 0 else "clipped"
+        return "load" if _load(law, max(z, 0.0), v, state["zmax"]) >= 0 else "clipped"
     state["zmax"] = max(state["zmax"], z)
     return "unload" if _unload(law, z, v, state["zmax"]) > 0 else "clipped"
 
@@ -98,14 +107,14 @@ def _events(law, mode, state):
     zmax = state["zmax"]
     if mode == "load":
         out += [(dz, -1.0, "unload"),
-                (lambda t, y: _poly(law, y[0] - y[2], y[1] - y[3]), -1.0, "release")]
+                (lambda t, y: _load(law, y[0] - y[2], y[1] - y[3], zmax), -1.0, "release")]
     elif mode == "unload":
         out += [(dz, 1.0, "reload"),
                 (lambda t, y: _unload(law, y[0] - y[2], y[1] - y[3], zmax), -1.0, "release")]
     elif mode == "clipped":
         def resume(t, y):
             z, v = max(y[0] - y[2], 0.0), y[1] - y[3]
-            return _poly(law, z, v) if v > 0 else _unload(law, z, v, zmax)
+            return _load(law, z, v, zmax) if v > 0 else _unload(law, z, v, zmax)
         out.append((resume, 1.0, "resume"))
     return out
 
@@ -132,7 +141,7 @@ def _after(law, kind, y, state, loss):
     if kind == "unload" or (kind == "onset" and v <= 0):
         state["zmax"] = max(state["zmax"], z)
         return "unload" if _unload(law, z, v, state["zmax"]) >= 0 else "clipped"
-    return "load" if _poly(law, z, max(v, 0.0)) >= 0 else "clipped"
+    return "load" if _load(law, z, max(v, 0.0), state["zmax"]) >= 0 else "clipped"
 
 
 def _surface_start(evs, rhs, t, y, dt_trend, tau_on):

@@ -16,7 +16,8 @@ One iteration (:func:`explain`):
    the noise of the averaged cycles.  Under "the effect is absent" ``LM ~ chi^2(1)``; an
    effect is significant when its p-value is below ``alpha`` divided by the number of
    effects scored (Bonferroni).
-4. **Refit** every significant effect (at most ``max_refits``, by LM): output-error
+4. **Refit** every significant effect (at most ``max_refits``, by LM; a third of the
+   simulation budget each, the chosen one polished with the whole): output-error
    identification of the extended model, the law's coefficients and the effect's
    parameter jointly (:func:`discovery.identify` on the :class:`Model`), re-verified.  The
    LM statistic is local: an effect whose output is far from linear in its parameter (a
@@ -42,6 +43,7 @@ from ..errors import InputError, IntegrationError
 from ..identify import as_records, contact_scales, identify, pair_records, record_start
 from ..law import ForceLaw
 from ..verify import evaluate
+from . import drift as D
 from .effects import EFFECTS, Model, small_step
 from .localise import localise
 
@@ -238,6 +240,56 @@ class _Problem:
         return float(np.sqrt(np.mean(np.square(s)))) if s else 0.0
 
 
+class _Drift:
+    """The drift channel of every record (:mod:`discovery.explain.drift`)."""
+
+    def __init__(self, pairs, records):
+        self.recs = []
+        for (sc, m), (_, ref) in zip(pairs, records, strict=True):
+            self.recs.append((sc, D.DriftRecord.from_measurement(m, ref.impulse)))
+
+    def _pairs(self, model):
+        return [(model.apply(sc), rec) for sc, rec in self.recs]
+
+    @staticmethod
+    def _loss(model):
+        return float(model.scenario.get("mass_loss", 0.0))
+
+    def criterion(self, model):
+        """Mean ``D`` over records and its noise floor."""
+        out = [D.drift_criterion(D.drift_residual(sc, rec, self._loss(model)), rec)
+               for sc, rec in self._pairs(model)]
+        return float(np.mean([d for d, _ in out])), float(np.mean([f for _, f in out]))
+
+    def score(self, model, eff, h):
+        lm, p, direction = D.drift_score(self._pairs(model), self._loss(model), h)
+        return {"effect": eff.id, "lm": lm, "p": p, "significant": False,
+                "direction": direction, "channel": "drift"}
+
+    def refit(self, model, eff, h):
+        """The model with the loss that fits the drift (the law is not refitted: the
+        drift channel does not depend on it)."""
+        return model.with_effect(eff, D.fit_drift(self._pairs(model), h,
+                                                  hi=eff.parameters[0].bounds[1]))
+
+
+def _with_drift(crit, floor, drift, model):
+    """Add the drift criterion ``D`` (and its floor) to the cycle's criteria."""
+    if drift is None or not crit:
+        return crit, floor
+    d = drift.criterion(model)
+    return {**crit, "D": d[0]}, {**floor, "D": d[1]}
+
+
+def _drift_free(drift, model, records, alpha):
+    """No significant trend across the impacts: the drift channel's score test of a mass
+    loss per impact (beyond the model's own) at level ``alpha``."""
+    if drift is None:
+        return True
+    eff = next(e for e in EFFECTS if "drift" in e.phases)
+    return drift.score(model, eff, _small_step(eff, records))["p"] >= alpha
+
+
 def _mean(evs, key):
     if not all(getattr(e, key) for e in evs):
         return {}
@@ -254,7 +306,8 @@ def _small_step(eff, records):
 def _repulsive(law, records):
     """Whether the law's elastic branch pushes the bodies apart at the records' typical
     penetration (a refit that turns the contact spring into a pull has explained the
-    residual by undoing the contact, not by the effect)."""
+    residual by undoing the contact, not by the effect; a start that already pulls is
+    not held against the effect)."""
     for sc, ref in records:
         _, _, z0 = contact_scales(sc, ref)
         if not float(law.polynomial(z0, 0.0)) > 0:
@@ -408,12 +461,14 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     iterations = []
     stopped = f"the budget of {max_iterations} added effect(s) is used"
     meas_first = ms[0] if not isinstance(ms[0], Reference) else None
+    drift = _Drift(pairs, records) if not any(isinstance(m, Reference) for m in ms) else None
     for _ in range(max_iterations + 1):
         evs = problem.evaluations(model, floor=True)
-        before, floor = _mean(evs, "criteria"), _mean(evs, "noise_floor")
-        if all(e.consistent for e in evs):
+        before, floor = _with_drift(_mean(evs, "criteria"), _mean(evs, "noise_floor"), drift,
+                                    model)
+        if all(e.consistent for e in evs) and _drift_free(drift, model, records, alpha):
             stopped = ("the model is consistent with the record(s): I2 and I4 within their "
-                       "noise floors, nothing left to explain")
+                       "noise floors, no drift across the impacts, nothing left to explain")
             break
         if len(iterations) >= max_iterations:
             break
@@ -422,14 +477,19 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         r0 = problem.residual(model)
         J = _jacobian(problem, model, r0)
         sigma = problem.sigma()
-        cands = [e for e in catalogue if e.applicable(model)]
-        scores = [_score(problem, model, r0, J, e, records, sigma) for e in cands]
+        cands = [e for e in catalogue if e.applicable(model)
+                 and (drift is not None or "drift" not in e.phases)]
+        scores = [drift.score(model, e, _small_step(e, records)) if "drift" in e.phases
+                  else _score(problem, model, r0, J, e, records, sigma) for e in cands]
         level = alpha / max(len(scores), 1)
         top_phases = sorted(loc["phases"], key=lambda p: -loc["phases"][p]["share"])[:2]
         for s, e in zip(scores, cands, strict=True):
             s["significant"] = bool(s["p"] is not None and s["p"] < level)
             s["signature_agrees"] = _signature_agrees(e, loc, top_phases)
         ranked = sorted((s for s in scores if s["significant"]), key=lambda s: -s["lm"])
+        if any(s.get("channel") == "drift" for s in ranked):
+            # a record that drifts has no steady cycle to compare: the drift comes first
+            ranked = [s for s in ranked if s.get("channel") == "drift"]
         if not ranked:
             iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
                                         "no catalogue effect is significant (score tests at "
@@ -438,28 +498,38 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             stopped = "no catalogue effect explains the remaining disagreement significantly"
             break
         trials = []
+        # every candidate is refitted with a third of the budget; the winner gets the rest
+        screen = max(budget // 3, 4 * len(records))
+        eff_by_id = {e.id: e for e in cands}
         for s in ranked[:max_refits]:
             eff = next(e for e in cands if e.id == s["effect"])
+            key = "D" if "drift" in eff.phases else criterion
             try:
-                m2, res = _refit(model, eff, s.get("direction"), records, criterion, budget,
-                                 tolerances)
+                if key == "D":
+                    m2, res = drift.refit(model, eff, _small_step(eff, records)), None
+                else:
+                    m2, res = _refit(model, eff, s.get("direction"), records, criterion,
+                                     screen, tolerances)
                 evs2 = problem.evaluations(m2, floor=True)
             except IntegrationError as exc:
                 s["note"] = f"refit failed: {exc}"
                 continue
-            after = _mean(evs2, "criteria")
-            if not after:
+            after, _ = _with_drift(_mean(evs2, "criteria"), {}, drift, m2)
+            if not after or key not in after or key not in before:
                 s["note"] = "the refitted model has no periodic steady state with contact"
                 continue
             s["criteria_after"] = after
             s["consistent_after"] = all(e.consistent for e in evs2)
             s["parameters"] = {eff.parameters[0].name: m2.value(eff)}
-            s["repulsive"] = _repulsive(m2.law, records)
+            # (the drift channel does not depend on the law: no compensation to guard)
+            s["repulsive"] = (key == "D" or _repulsive(m2.law, records)
+                              or not _repulsive(model.law, records))
             if not s["repulsive"]:
                 s["note"] = ("the refit's elastic branch P(zeta, 0) pulls at the record's "
                              "penetration: the effect only fits by undoing the contact spring")
-            trials.append((after[criterion], s, m2, res, evs2))
-        good = [x for x in trials if x[0] <= 0.9 * before[criterion] and x[1]["repulsive"]]
+            s["gap"] = key
+            trials.append((after[key] / max(before[key], 1e-300), s, m2, res, evs2, key))
+        good = [x for x in trials if x[0] <= 0.9 and x[1]["repulsive"]]
         if not good:
             iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
                                         "significant by the score test, but no refit lowers "
@@ -468,15 +538,32 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             stopped = "the significant effects do not shrink the gap when refitted"
             break
         good.sort(key=lambda x: x[0])
-        value, s, m2, res, evs2 = good[0]
-        tol_eq = floor.get(criterion, 0.0)
-        equivalent = [x[1]["effect"] for x in good[1:] if x[0] <= value + tol_eq]
+        _, s, m2, res, evs2, key = good[0]
+        if res is not None and res.n_simulations >= screen - len(records) and budget > screen:
+            # the screening refit ran out: polish the winner with the full budget
+            try:
+                res2 = identify([sc for sc, _ in records], [r for _, r in records], m2,
+                                criterion=criterion, method="least-squares",
+                                max_simulations=budget, tolerances=tolerances)
+                evs3 = problem.evaluations(res2.law, floor=True)
+                after3, _ = _with_drift(_mean(evs3, "criteria"), {}, drift, res2.law)
+                if after3 and after3[key] <= s["criteria_after"][key]:
+                    m2, res, evs2 = res2.law, res2, evs3
+                    s["criteria_after"] = after3
+                    s["parameters"] = {p.name: m2.value(eff_by_id[s["effect"]])
+                                       for p in eff_by_id[s["effect"]].parameters}
+            except IntegrationError:
+                pass
+        value = s["criteria_after"][key]
+        tol_eq = floor.get(key, 0.0)
+        equivalent = [x[1]["effect"] for x in good[1:]
+                      if x[5] == key and x[1]["criteria_after"][key] <= value + tol_eq]
         evidence = (f"score test LM = {s['lm']:.3g} (p = {s['p']:.2g} < {level:.2g}); refitted, "
-                    f"{criterion} {before[criterion]:.3g} -> {value:.3g} (noise floor "
-                    f"{floor.get(criterion, float('nan')):.3g}); signature "
+                    f"{key} {before[key]:.3g} -> {value:.3g} (noise floor "
+                    f"{floor.get(key, float('nan')):.3g}); signature "
                     f"{'agrees' if s['signature_agrees'] else 'does not agree'} with the "
                     f"localisation (largest shares: {', '.join(top_phases)})")
-        iterations.append(Iteration(model, m2, before, _mean(evs2, "criteria"), floor, loc,
+        iterations.append(Iteration(model, m2, before, s["criteria_after"], floor, loc,
                                     scores, s["effect"], evidence, equivalent,
                                     evs[0].simulated, evs2[0].simulated,
                                     records[0][1].impulse))
@@ -484,10 +571,13 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         if res is not None:
             uncertainties = dict(res.standard_errors)
     evs = problem.evaluations(model, floor=True)
+    crit, floor = _with_drift(_mean(evs, "criteria"), _mean(evs, "noise_floor"), drift, model)
     return ExplainResult(
         iterations=tuple(iterations), final_model=model, uncertainties=uncertainties,
-        criteria=_mean(evs, "criteria"), noise_floor=_mean(evs, "noise_floor"),
-        consistent=all(e.consistent for e in evs), stopped_because=stopped,
+        criteria=crit, noise_floor=floor,
+        consistent=all(e.consistent for e in evs) and _drift_free(drift, model, records,
+                                                                   alpha),
+        stopped_because=stopped,
         seconds=time.perf_counter() - t0,
         settings={"start": str(start), "criterion": criterion, "alpha": alpha,
                   "max_iterations": max_iterations, "budget": budget, "n_boot": n_boot,
