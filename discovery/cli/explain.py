@@ -58,7 +58,8 @@ def run(args):
     fm = res.final_model
     print(f"final model: {fm}")
     if res.uncertainties:
-        print(coefficients_line(fm.law.as_dict(), res.uncertainties))
+        print(coefficients_line(dict(zip(fm.names, fm.coefficients, strict=True)),
+                                res.uncertainties))
     if res.criteria:
         print(criteria_line(res.criteria, res.noise_floor))
     print(f"  {'consistent' if res.consistent else 'not consistent'} with the record(s); "
