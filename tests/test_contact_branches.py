@@ -157,3 +157,19 @@ def test_kernel_matches_reference_extended(name, text, changes):
         assert np.sum(tr.event_kind == K.EV_RELEASE) >= 8
     far = np.min(np.abs(tr.t[:, None] - tr.event_t[None, :]), axis=1) > 1e-6 * sc.period
     assert np.max(np.abs(tr.force[far] - ref["force"][far])) < 1e-5 * np.max(tr.force)
+
+
+def test_a_moulding_that_sheds_mass_has_no_steady_state(tmp_path, capsys):
+    from discovery.cli import main
+    from discovery.dynamics.steady_state import steady_state
+
+    sc = load_scenario("paper").replace(mass_loss=0.01)
+    with pytest.raises(InputError, match="no periodic steady state"):
+        steady_state(sc, sc.law)
+    f = tmp_path / "lossy.toml"
+    f.write_text('name = "lossy"\n[machine]\nm1 = 1.0e4\nm2 = 1.0e4\nk1 = 2.75e7\n'
+                 'c1 = 1.0e5\nA = 5.0e5\nfrequency = 25.0\nmass_loss = 0.01\n[law]\n'
+                 'text = "2.06e8*z + 1.28e7*zd"\n')
+    assert main(["steady", "--scenario", str(f)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "mass_loss = 0" in err[0]

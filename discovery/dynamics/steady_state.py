@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import IntegrationError
+from ..errors import InputError, IntegrationError
 from . import _kernel as K
 from .shooting import (
     floquet_multipliers,
@@ -186,6 +186,10 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
         When a simulation fails (blow-up, step budget): a failure is never reported
         as the physical regime "nonperiodic".
     """
+    if scenario.mass_loss > 0:
+        raise InputError(f"scenario {scenario.name!r} sheds {scenario.mass_loss:g} of the "
+                         "moulding's mass per impact, so it has no periodic steady state; "
+                         "simulate it over a span (vidi simulate) or set mass_loss = 0")
     pm = StroboscopicMap(scenario, law, tolerances)
     y = scenario.initial_state() if y_start is None else np.asarray(y_start, dtype=float)
     T = scenario.period
