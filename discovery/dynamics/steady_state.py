@@ -189,7 +189,8 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
     if scenario.mass_loss > 0:
         raise InputError(f"scenario {scenario.name!r} sheds {scenario.mass_loss:g} of the "
                          "moulding's mass per impact, so it has no periodic steady state; "
-                         "simulate it over a span (vidi simulate) or set mass_loss = 0")
+                         "simulate it from rest (vidi simulate --from-rest) or set "
+                         "mass_loss = 0")
     pm = StroboscopicMap(scenario, law, tolerances)
     y = scenario.initial_state() if y_start is None else np.asarray(y_start, dtype=float)
     T = scenario.period
