@@ -336,9 +336,9 @@ class ForceLaw:
             zm = zp if zeta_max is None else np.maximum(np.asarray(zeta_max, float), zp)
             if self.permanent_set:
                 # reloading below z_max follows the elastic unloading line (Walton-Braun)
-                p = p - self.polynomial(zp, np.zeros_like(zp)) \
-                    + self.unloading_force(zp, np.zeros_like(zp), zm) \
-                    * (zp < zm) + self.polynomial(zp, np.zeros_like(zp)) * (zp >= zm)
+                elastic = self.polynomial(zp, np.zeros_like(zp))
+                p = p - elastic + np.where(
+                    zp < zm, self.unloading_force(zp, np.zeros_like(zp), zm), elastic)
             p = np.where(dzeta > 0, p, self.unloading_force(zp, dzeta, zm))
         return np.where(zeta > 0, np.maximum(p, 0.0), 0.0)
 

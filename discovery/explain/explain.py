@@ -376,16 +376,19 @@ def _refit(model, eff, guess, records, criterion, budget, tol):
     hi = eff.parameters[0].bounds[1]
     start = min(guess if guess and guess > 0 else h, 0.5 * hi)
 
-    def fit(trial):
-        return identify([s for s, _ in records], [r for _, r in records], trial,
-                        criterion=criterion, method="least-squares", max_simulations=budget,
-                        tolerances=tol)
-
     try:
-        res = fit(_extend(model, eff, start))
+        res = _output_error(records, _extend(model, eff, start), criterion, budget, tol)
     except IntegrationError:
-        res = fit(_extend(model, eff, min(h, 0.5 * hi)))
+        res = _output_error(records, _extend(model, eff, min(h, 0.5 * hi)), criterion, budget,
+                            tol)
     return res.law, res
+
+
+def _output_error(records, start, criterion, budget, tol):
+    """Output-error identification of a law or model on every record (least squares)."""
+    return identify([s for s, _ in records], [r for _, r in records], start,
+                    criterion=criterion, method="least-squares", max_simulations=budget,
+                    tolerances=tol)
 
 
 def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01,
@@ -447,9 +450,7 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     fit, why = None, ""
     for law in starts:
         try:
-            fit = identify([s for s, _ in records], [r for _, r in records], law,
-                           criterion=criterion, method="least-squares",
-                           max_simulations=budget, tolerances=tolerances)
+            fit = _output_error(records, law, criterion, budget, tolerances)
             break
         except IntegrationError as exc:
             why = str(exc)
@@ -546,9 +547,7 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         if res is not None and res.n_simulations >= screen - len(records) and budget > screen:
             # the screening refit ran out: polish the winner with the full budget
             try:
-                res2 = identify([sc for sc, _ in records], [r for _, r in records], m2,
-                                criterion=criterion, method="least-squares",
-                                max_simulations=budget, tolerances=tolerances)
+                res2 = _output_error(records, m2, criterion, budget, tolerances)
                 evs3 = problem.evaluations(res2.law, floor=True)
                 after3, _ = _with_drift(_mean(evs3, "criteria"), {}, drift, res2.law)
                 if after3 and after3[key] <= s["criteria_after"][key]:
