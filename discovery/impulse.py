@@ -185,7 +185,7 @@ def _orbit_events(scenario, law, ss, tolerances):
     t0 = ss.t0
     n = ss.n_periods
     tr = simulate(scenario, law, (t0, t0 + n * T), y0=ss.y0, tolerances=tolerances,
-                  t_eval=np.linspace(t0, t0 + n * T, 400 * n + 1))
+                  t_eval=np.linspace(t0, t0 + n * T, 400 * n + 1), zeta_max0=ss.zeta_max0)
     return tr
 
 

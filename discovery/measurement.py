@@ -525,7 +525,8 @@ def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None
             raise InputError(f"law '{law}' has no periodic steady state in scenario "
                              f"{scenario.name!r} ({ss.regime}); choose another law or scenario, "
                              "or record from rest")
-        tr = simulate(scenario, law, (ss.t0, ss.t0 + t[-1]), y0=ss.y0, t_eval=ss.t0 + t)
+        tr = simulate(scenario, law, (ss.t0, ss.t0 + t[-1]), y0=ss.y0, t_eval=ss.t0 + t,
+                      zeta_max0=ss.zeta_max0)
     rng = np.random.default_rng(seed)
     F = tr.force.copy()
     if noise > 0:

@@ -173,3 +173,28 @@ def test_a_moulding_that_sheds_mass_has_no_steady_state(tmp_path, capsys):
     assert main(["steady", "--scenario", str(f)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "mass_loss = 0" in err[0]
+
+
+def test_a_set_orbit_strobed_inside_its_contact_keeps_its_unloading_memory():
+    # the drive's phase 0 falls in this orbit's unloading: the four states do not say from
+    # which penetration the set contact unloads, so the steady state carries it.  The orbit
+    # and its force must be the independent scipy path's (without the memory the true law
+    # failed its own noise-free record with I2 = 0.11)
+    from tests.realistic import reference_record
+
+    from discovery.dynamics.steady_state import steady_state
+    from discovery.verify import Reference, evaluate
+
+    law = ForceLaw.parse("1.4e8*z + 8.24e6*zd; set: 0.44")
+    sc = Scenario(m1=25200.0, m2=8750.0, k1=2.73e8, c1=9.28e5, A=5.19e5, frequency=21.1,
+                  law=law)
+    ss = steady_state(sc, law)
+    z, v = ss.y0[0] - ss.y0[2], ss.y0[1] - ss.y0[3]
+    assert ss.regime == "P1" and z > 0 and v < 0  # strobed while unloading
+    assert ss.zeta_max0 > z
+    # the orbit closes with its memory: one period from (y0, zeta_max0) returns to y0
+    tr = simulate(sc, law, (ss.t0, ss.t0 + sc.period), y0=ss.y0, zeta_max0=ss.zeta_max0)
+    assert np.max(np.abs(tr.y_final - ss.y0) / np.array(sc.scales() * 2)) < 1e-6
+    rec = reference_record((sc, law), periods=10, force_noise=0.0, motion_noise=0.0)
+    ev = evaluate(sc, law, Reference.from_measurement(rec, sc, n_boot=4, seed=0))
+    assert ev.criteria["I2"] < 2e-3, ev.criteria

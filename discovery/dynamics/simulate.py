@@ -103,6 +103,7 @@ class Trajectory:
     n_steps: int
     status: int
     message: str
+    zeta_max0: float = 0.0
 
     @property
     def success(self):
@@ -124,6 +125,7 @@ class Trajectory:
         out = np.empty((len(self.event_t), 2))
         p = np.zeros(K.N_PARAMS)
         p[K.P_SET] = law.permanent_set
+        p[K.P_ZMAX] = self.zeta_max0
         for k, (yk, (m0, m1)) in enumerate(zip(self.event_y, self.event_modes, strict=True)):
             z, v = yk[0] - yk[2], yk[1] - yk[3]
             if m0 == K.FREE:
@@ -151,7 +153,7 @@ def _atol(scenario, tol):
 
 
 def simulate(scenario, law, t_span, y0=None, t_eval=None, *, tolerances=None,
-             max_events=10_000, mode0=None, throw=True):
+             max_events=10_000, mode0=None, throw=True, zeta_max0=0.0):
     """Integrate the two-body vibro-impact system with a given contact law.
 
     Parameters
@@ -171,6 +173,10 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, tolerances=None,
         How many events to record (all are located regardless).
     mode0 : int, optional
         Contact mode at ``t0``; default resolves it from ``y0``.
+    zeta_max0 : float
+        The current contact's largest penetration so far at ``t0`` (its memory, which a
+        law with a permanent set unloads from; :attr:`SteadyState.zeta_max0` for an orbit
+        strobed inside a contact).  The default takes the start's own penetration.
     throw : bool
         Raise :class:`IntegrationError` on failure (default) or return a
         trajectory whose ``status``/``message`` say what happened.
@@ -196,8 +202,10 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, tolerances=None,
     ev_y = np.empty((max_events, 4))
     ev_m = np.empty((max_events, 2), dtype=np.int64)
     period = scenario.period
+    p = kernel_params(scenario, law)
+    p[K.P_ZMAX] = float(zeta_max0)
     status, tf, yf, mf, n_steps, n_ev, _ = K.integrate(
-        t0, t1, y0, -1 if mode0 is None else int(mode0), kernel_params(scenario, law), coef,
+        t0, t1, y0, -1 if mode0 is None else int(mode0), p, coef,
         ea, eb, br, tol.rtol, _atol(scenario, tol), period / 100.0, period * tol.hmax_fraction,
         tol.max_steps, te, out_y, out_f, out_m, ev_t, ev_k, ev_y, ev_m)
     message = "ok" if status == 0 else (
@@ -211,4 +219,4 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, tolerances=None,
         event_t=ev_t[:n_keep].copy(), event_kind=ev_k[:n_keep].copy(),
         event_y=ev_y[:n_keep].copy(), event_modes=ev_m[:n_keep].copy(),
         t_final=float(tf), y_final=yf, mode_final=int(mf), n_steps=int(n_steps),
-        status=int(status), message=message)
+        status=int(status), message=message, zeta_max0=float(zeta_max0))

@@ -64,16 +64,30 @@ class StroboscopicMap:
         self.scale = np.array([x, v, x, v])
         self.n_calls = 0
         self.n_steps = 0
+        # a law with a permanent set unloads from the contact's largest penetration, which
+        # the four states do not hold: the map carries it from one call's end to the next
+        # start (exact at a fixed point; Jacobian probes hold it fixed)
+        self._memory = law.permanent_set > 0
+        self.zeta_max = 0.0
 
-    def advance(self, y, n=1, t0=0.0):
-        """State after ``n`` periods from ``y`` at time ``t0`` (a multiple of ``T``)."""
+    def advance(self, y, n=1, t0=0.0, remember=True):
+        """State after ``n`` periods from ``y`` at time ``t0`` (a multiple of ``T``).
+
+        For a law with a permanent set, a start inside a contact unloads from
+        :attr:`zeta_max`, the largest penetration the previous call ended with; with
+        ``remember`` this call's own end value replaces it."""
+        p = self._p.copy()
+        if self._memory:
+            p[K.P_ZMAX] = self.zeta_max
         status, tf, yf, _, steps, _, _ = K.integrate(
-            t0, t0 + n * self._T, np.asarray(y, dtype=float), -1, self._p.copy(), self._coef,
+            t0, t0 + n * self._T, np.asarray(y, dtype=float), -1, p, self._coef,
             self._ea, self._eb, self._br, self.tol.rtol, self._atol, self._T / 100.0, self._hmax,
             self.tol.max_steps, self._empty, self._ey, self._ef, self._em, self._evt,
             self._evk, self._evy, self._evm)
         self.n_calls += 1
         self.n_steps += steps
+        if self._memory and remember:
+            self.zeta_max = float(p[K.P_ZMAX])
         if status != K.OK:
             raise IntegrationError(f"simulation of law '{self.law}' stopped at t = {tf:.6g} s: "
                                    f"{_STATUS[status]}")
@@ -92,7 +106,7 @@ class StroboscopicMap:
             d = 1e-6 * self.scale[j]
             yp = np.array(y, dtype=float)
             yp[j] += d
-            J[:, j] = (self.advance(yp, n) - fy) / d
+            J[:, j] = (self.advance(yp, n, remember=False) - fy) / d
         return J
 
 
@@ -120,6 +134,9 @@ class SteadyState:
         Period-map evaluations used.
     evidence : dict
         How the decision was reached (recurrence distances, Newton history).
+    zeta_max0 : float
+        For a law with a permanent set: the largest penetration of the contact under way
+        at ``y0`` (its unloading memory; pass it to :func:`simulate` as ``zeta_max0``).
     """
 
     regime: str
@@ -131,6 +148,7 @@ class SteadyState:
     residual: float
     n_simulations: int
     evidence: dict = field(default_factory=dict)
+    zeta_max0: float = 0.0
 
     @property
     def periodic(self):
@@ -240,15 +258,21 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
                                          "converged": True, "stable": True})
                 n, mult = m, floquet_multipliers(J)
             t0 = t_done * T
-            impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n)
+            zmax = 0.0
+            if pm._memory:
+                # one more orbit from y0 leaves the memory y0 holds (the orbit is periodic)
+                pm.advance(y_orb, n)
+                zmax = pm.zeta_max
+            impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n, zmax)
             return SteadyState(regime=f"P{n}", n_periods=n, y0=y_orb, t0=t0, impacts=impacts,
                                multipliers=mult, residual=float(res),
-                               n_simulations=pm.n_calls, evidence=evidence)
+                               n_simulations=pm.n_calls, evidence=evidence, zeta_max0=zmax)
     return SteadyState(regime="nonperiodic", n_periods=0, y0=y, t0=t_done * T,
                        impacts=0, multipliers=np.full(4, np.nan + 0j), residual=float("nan"),
                        n_simulations=pm.n_calls, evidence=evidence)
 
 
-def _count_onsets(scenario, law, tol, y0, t0, n):
-    tr = simulate(scenario, law, (t0, t0 + n * scenario.period), y0=y0, tolerances=tol)
+def _count_onsets(scenario, law, tol, y0, t0, n, zeta_max0=0.0):
+    tr = simulate(scenario, law, (t0, t0 + n * scenario.period), y0=y0, tolerances=tol,
+                  zeta_max0=zeta_max0)
     return int(np.sum(tr.event_kind == K.EV_ONSET))

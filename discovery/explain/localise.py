@@ -54,7 +54,8 @@ def simulated_at(scenario, law, steady, t_record, F_record, *, time_offset=0.0,
         tau = np.mod(t_record + time_offset - steady.t0 + k * scenario.period, P)
         order = np.argsort(tau)
         tr = simulate(scenario, law, (steady.t0, steady.t0 + P), y0=steady.y0,
-                      t_eval=steady.t0 + tau[order], tolerances=tolerances)
+                      t_eval=steady.t0 + tau[order], tolerances=tolerances,
+                      zeta_max0=steady.zeta_max0)
         inv = np.empty_like(order)
         inv[order] = np.arange(order.size)
         d = float(np.sum((tr.force[inv] - F_record) ** 2))
