@@ -17,9 +17,13 @@ One iteration (:func:`explain`):
    effect is significant when its p-value is below ``alpha`` divided by the number of
    effects scored (Bonferroni).
 4. **Refit** every significant effect (at most ``max_refits``, by LM; a third of the
-   simulation budget each, the chosen one polished with the whole): output-error
-   identification of the extended model, the law's coefficients and the effect's
-   parameter jointly (:func:`discovery.identify` on the :class:`Model`), re-verified.  The
+   simulation budget each, the chosen one polished with the whole, least squares then
+   Nelder-Mead): output-error identification of the extended model, the law's
+   coefficients and the effect's parameter jointly (:func:`discovery.identify` on the
+   :class:`Model`), re-verified.  A term effect's refit starts from the certified
+   regression on the extended term set when that simulates closer to the record than the
+   current law with the term at its LM step (a start that has compensated for a missing
+   Hertz term with a stiffer spring otherwise holds the refit in its basin).  The
    LM statistic is local: an effect whose output is far from linear in its parameter (a
    set, an unloading damper the start law has compensated) can score below one that
    merely correlates with the residual, so the refits, not the scores, decide.  The
@@ -32,6 +36,7 @@ One iteration (:func:`explain`):
 5. Repeat until nothing significant remains or ``max_iterations`` is reached.
 """
 
+import itertools
 import re
 import time
 from dataclasses import dataclass, field
@@ -41,7 +46,7 @@ from scipy.stats import chi2
 
 from ..errors import InputError, IntegrationError
 from ..identify import as_records, contact_scales, identify, pair_records, record_start
-from ..law import ForceLaw
+from ..law import ForceLaw, Term
 from ..verify import evaluate
 from . import drift as D
 from .effects import EFFECTS, Model, small_step
@@ -180,36 +185,58 @@ def _regression(names, scenarios, measurements):
     if not full:
         return None
     coef = full[0].coefficients
-    if not all(coef.get(ForceLaw.parse(f"1*{n}").names[0], 0.0) for n in names):
+    terms = [Term.parse(n) for n in names]
+    if not all(coef.get(t.name, 0.0) for t in terms):
         return None
-    return ForceLaw.parse(" + ".join(f"{coef[ForceLaw.parse(f'1*{n}').names[0]]!r}*{n}"
-                                     for n in names))
+    return ForceLaw(tuple(terms), tuple(float(coef[t.name]) for t in terms))
 
 
 def start_law(text, records, measurements=None):
-    """Candidate start laws, best first: ``linear`` (z, zd) or a term list (``z,zd``) gets
-    its coefficients from the certified regression on the contact samples (when the records
-    have positions) and from the record alone (contact time, reduced mass, force jump);
-    a law with coefficients (``2e8*z + 1e7*zd``) is used as given."""
+    """Candidate start laws: ``linear`` (z, zd) or a term list (``z,zd``) gets its
+    coefficients from the certified regression on the contact samples (when the records
+    have positions: first), then from the record alone (contact time, reduced mass, force
+    jump), term-wise mixtures of the two and softer springs; a law with coefficients
+    (``2e8*z + 1e7*zd``) is used as given."""
+    preferred, others = _start_candidates(text, records, measurements)
+    return preferred + others
+
+
+def _start_candidates(text, records, measurements):
+    """``(preferred, others)`` of :func:`start_law`: the given law or the regression (a
+    fit to the force itself), and the fallbacks :func:`explain` ranks by one simulation
+    each."""
     text = str(text).strip()
     if not text:
         raise InputError("--start is empty; give 'linear', a term list such as 'z,zd' or a "
                          "law such as '2e8*z + 1e7*zd'")
     if text != "linear" and "," not in text and _HAS_COEFFICIENT.search(text):
-        return [ForceLaw.parse(text)]
+        return [ForceLaw.parse(text)], []
     names = ["z", "zd"] if text == "linear" else [n.strip() for n in text.split(",") if n.strip()]
     for n in names:
         ForceLaw.parse(f"1*{n}")  # a clear error for a bad term name
     E = records[0][1].impulse
     if not len(E.support):
         raise InputError("the record has no contact to start from")
-    out = []
+    reg = None
     if measurements is not None:
         reg = _regression(names, [sc for sc, _ in records], measurements)
-        if reg is not None:
-            out.append(reg)
-    out.append(_physical(names, records))
-    return out
+    phys = _physical(names, records)
+    others = [phys]
+    if reg is not None and len(names) <= 4 and reg.terms == phys.terms:
+        # term-wise mixtures: the regression's damping with the contact time's stiffness
+        # (a short contact's few noisy penetration samples can bias one coefficient only)
+        for mask in itertools.product((0, 1), repeat=len(names)):
+            if 0 < sum(mask) < len(names):
+                others.append(reg.with_coefficients([(phys if m else reg).coefficients[i]
+                                                     for i, m in enumerate(mask)]))
+    # softer springs: a contact that damping ends early (the paper's law unloads
+    # elastically, so the contact lasts at least a quarter of the spring's period) is far
+    # shorter than the half period the contact-time stiffness assumes
+    for f in (0.25, 0.25**2, 0.25**3):
+        others.append(phys.with_coefficients([c * f if t.b == 0 else c
+                                              for t, c in zip(phys.terms, phys.coefficients,
+                                                              strict=True)]))
+    return ([reg] if reg is not None else []), others
 
 
 class _Problem:
@@ -233,6 +260,13 @@ class _Problem:
             return None
         return np.concatenate([e.simulated.F - ref.impulse.F
                                for e, (_, ref) in zip(evs, self.records, strict=True)])
+
+    def value(self, model, criterion):
+        """The mean ``criterion`` over records (inf when a record has no steady cycle)."""
+        evs = self.evaluations(model)
+        if not all(e.status == "ok" and criterion in (e.criteria or {}) for e in evs):
+            return np.inf
+        return float(np.mean([e.criteria[criterion] for e in evs]))
 
     def sigma(self):
         s = [ref.noise["F"] / np.sqrt(max(ref.noise["n_cycles"], 1))
@@ -367,28 +401,82 @@ def _jacobian(problem, model, r0):
     return np.column_stack(cols) if cols else np.zeros((r0.size, 0))
 
 
-def _refit(model, eff, guess, records, criterion, budget, tol):
-    """Add ``eff`` (start: the LM direction when it is usable, else a small value) and refit
-    the extended model by output error: the law's coefficients and every added effect's
-    parameter jointly (:func:`discovery.identify` on the :class:`Model`); returns
-    ``(model, identification)``."""
+def _regressed(model, names, regress):
+    """``model`` with every loading coefficient from the certified regression of the
+    measured force on the terms ``names`` (its unloading branch and added effects kept);
+    None when the records have no positions or the regression fails.  The regression sees
+    the force against the measured penetration alone, so a start law that has compensated
+    for a missing effect with its coefficients (a stiffer spring for a Hertz term or for
+    stiffening supports) does not hold the refit in its basin."""
+    if regress is None:
+        return None
+    fit = regress(list(names))
+    if fit is None:
+        return None
+    law = model.law
+    return model.with_law(ForceLaw(fit.terms, fit.coefficients, law.unloading,
+                                   law.unloading_coefficients, law.permanent_set))
+
+
+#: the effect's value on the regressed law: its small step times these
+_LADDER = tuple(4.0**k for k in range(7))
+
+
+def _refit(problem, model, eff, guess, records, criterion, budget, tol, regress=None):
+    """Add ``eff`` and refit the extended model by output error: the law's coefficients and
+    every added effect's parameter jointly (:func:`discovery.identify` on the
+    :class:`Model`); returns ``(model, identification)``.
+
+    The start is the best (by ``criterion``, one simulation each) of the current law with
+    the effect at its LM direction (a small value when that is unusable) and the law from
+    the certified regression (:func:`_regressed`) with the effect: for a term effect the
+    regression on the extended term set; for any other, the regression on the current
+    terms with the effect's value from a ladder (its small step times 1, 4, ... 4096,
+    within its bounds)."""
     h = _small_step(eff, records)
     hi = eff.parameters[0].bounds[1]
-    start = min(guess if guess and guess > 0 else h, 0.5 * hi)
+    cands = [_extend(model, eff, min(guess if guess and guess > 0 else h, 0.5 * hi))]
+    if eff.target == "term":
+        reg = _regressed(model.with_effect(eff, 0.0), list(model.law.names)
+                         + [Term.parse(eff.key).name], regress)
+        if reg is not None:
+            cands.append(reg)
+    else:
+        reg = _regressed(model, model.law.names, regress)
+        if reg is not None:
+            values = sorted({min(h * f, 0.9 * hi) for f in _LADDER})
+            cands += [_extend(reg, eff, v) for v in values]
+    ranked = [cands[0]] if len(cands) == 1 else \
+        [m for _, _, m in sorted((problem.value(m, criterion), i, m)
+                                 for i, m in enumerate(cands))]
+    starts = ranked[:2] + [_extend(model, eff, min(h, 0.5 * hi))]
+    for i, start in enumerate(starts):
+        try:
+            res = _output_error(records, start, criterion, budget, tol)
+            return res.law, res
+        except IntegrationError:
+            if i == len(starts) - 1:
+                raise
 
+
+def _output_error(records, start, criterion, budget, tol, polish=False):
+    """Output-error identification of a law or model on every record: least squares, and
+    with ``polish`` Nelder-Mead on the budget least squares left.  Least squares can stop
+    early, its step rejected, where the residual is not smooth in the coefficients (a force
+    jump at the onset moving across the samples); the simplex, which only compares
+    criterion values, goes on from there."""
+    scs, refs = [s for s, _ in records], [r for _, r in records]
+    res = identify(scs, refs, start, criterion=criterion, method="least-squares",
+                   max_simulations=budget, tolerances=tol)
+    left = budget - res.n_simulations
+    if not polish or left < 4 * (len(res.law.coefficients) + 1) * len(records):
+        return res
     try:
-        res = _output_error(records, _extend(model, eff, start), criterion, budget, tol)
+        res2 = identify(scs, refs, res.law, criterion=criterion, method="nelder-mead",
+                        max_simulations=left, tolerances=tol)
     except IntegrationError:
-        res = _output_error(records, _extend(model, eff, min(h, 0.5 * hi)), criterion, budget,
-                            tol)
-    return res.law, res
-
-
-def _output_error(records, start, criterion, budget, tol):
-    """Output-error identification of a law or model on every record (least squares)."""
-    return identify([s for s, _ in records], [r for _, r in records], start,
-                    criterion=criterion, method="least-squares", max_simulations=budget,
-                    tolerances=tol)
+        return res
+    return res2 if res2.value < res.value else res
 
 
 def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01,
@@ -445,12 +533,18 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
                          f"has {', '.join(sorted(known))}")
     problem = _Problem(records, tolerances)
     plain = [m for m in ms if not isinstance(m, Reference)]
-    starts = [start] if isinstance(start, ForceLaw) else \
-        start_law(start, records, plain if len(plain) == len(ms) else None)
+    preferred, others = ([start], []) if isinstance(start, ForceLaw) else \
+        _start_candidates(start, records, plain if len(plain) == len(ms) else None)
+    scen_list = [sc for sc, _ in records]
+    regress = (lambda names: _regression(names, scen_list, plain)) \
+        if len(plain) == len(ms) else None
+    # the fallbacks best first, by one simulation each (a start can land in another
+    # regime's basin); the three closest are tried
+    others.sort(key=lambda law: problem.value(Model(law), criterion))
     fit, why = None, ""
-    for law in starts:
+    for law in preferred + others[:3]:
         try:
-            fit = _output_error(records, law, criterion, budget, tolerances)
+            fit = _output_error(records, law, criterion, budget, tolerances, polish=True)
             break
         except IntegrationError as exc:
             why = str(exc)
@@ -495,6 +589,10 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         if any(s.get("channel") == "drift" for s in ranked):
             # a record that drifts has no steady cycle to compare: the drift comes first
             ranked = [s for s in ranked if s.get("channel") == "drift"]
+        else:
+            # an effect whose small step already changes the regime has no local score;
+            # its refit (from the regression, over a ladder of values) still decides
+            ranked += [s for s in scores if s["lm"] is None]
         if not ranked:
             iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
                                         "no catalogue effect is significant (score tests at "
@@ -513,8 +611,8 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
                 if key == "D":
                     m2, res = drift.refit(model, eff, _small_step(eff, records)), None
                 else:
-                    m2, res = _refit(model, eff, s.get("direction"), records, criterion,
-                                     screen, tolerances)
+                    m2, res = _refit(problem, model, eff, s.get("direction"), records,
+                                     criterion, screen, tolerances, regress)
                 evs2 = problem.evaluations(m2, floor=True)
             except IntegrationError as exc:
                 s["note"] = f"refit failed: {exc}"
@@ -532,25 +630,36 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             if not s["repulsive"]:
                 s["note"] = ("the refit's elastic branch P(zeta, 0) pulls at the record's "
                              "penetration: the effect only fits by undoing the contact spring")
+            lo, hi = eff.parameters[0].bounds
+            s["in_bounds"] = bool(lo <= m2.value(eff) <= hi)
+            if not s["in_bounds"]:
+                s["note"] = (f"the refit puts {eff.parameters[0].name} = {m2.value(eff):.4g} "
+                             f"outside its physical bounds [{lo:g}, {hi:g}]")
             s["gap"] = key
             trials.append((after[key] / max(before[key], 1e-300), s, m2, res, evs2, key))
-        good = [x for x in trials if x[0] <= 0.9 and x[1]["repulsive"]]
+        good = [x for x in trials if x[0] <= 0.9 and x[1]["repulsive"] and x[1]["in_bounds"]]
         if not good:
             iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
-                                        "significant by the score test, but no refit lowers "
-                                        f"{criterion} by 10 %", [], evs[0].simulated,
+                                        "no refit of a significant effect (or of one without a "
+                                        f"score) lowers {criterion} by 10 %", [],
+                                        evs[0].simulated,
                                         evs[0].simulated, records[0][1].impulse))
-            stopped = "the significant effects do not shrink the gap when refitted"
+            stopped = "the candidate effects do not shrink the gap when refitted"
             break
         good.sort(key=lambda x: x[0])
         _, s, m2, res, evs2, key = good[0]
-        if res is not None and res.n_simulations >= screen - len(records) and budget > screen:
-            # the screening refit ran out: polish the winner with the full budget
+        if res is not None and budget > screen:
+            # polish the winner with the full budget
             try:
-                res2 = _output_error(records, m2, criterion, budget, tolerances)
+                res2 = _output_error(records, m2, criterion, budget, tolerances, polish=True)
                 evs3 = problem.evaluations(res2.law, floor=True)
                 after3, _ = _with_drift(_mean(evs3, "criteria"), {}, drift, res2.law)
-                if after3 and after3[key] <= s["criteria_after"][key]:
+                e = eff_by_id[s["effect"]]
+                lo, hi = e.parameters[0].bounds
+                if after3 and after3[key] <= s["criteria_after"][key] \
+                        and lo <= res2.law.value(e) <= hi \
+                        and (_repulsive(res2.law.law, records)
+                             or not _repulsive(model.law, records)):
                     m2, res, evs2 = res2.law, res2, evs3
                     s["criteria_after"] = after3
                     s["parameters"] = {p.name: m2.value(eff_by_id[s["effect"]])
@@ -561,7 +670,10 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         tol_eq = floor.get(key, 0.0)
         equivalent = [x[1]["effect"] for x in good[1:]
                       if x[5] == key and x[1]["criteria_after"][key] <= value + tol_eq]
-        evidence = (f"score test LM = {s['lm']:.3g} (p = {s['p']:.2g} < {level:.2g}); refitted, "
+        score = (f"score test LM = {s['lm']:.3g} (p = {s['p']:.2g} < {level:.2g})"
+                 if s["lm"] is not None else
+                 "no score test (a small step of it changes the regime)")
+        evidence = (f"{score}; refitted, "
                     f"{key} {before[key]:.3g} -> {value:.3g} (noise floor "
                     f"{floor.get(key, float('nan')):.3g}); signature "
                     f"{'agrees' if s['signature_agrees'] else 'does not agree'} with the "
