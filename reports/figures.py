@@ -400,13 +400,19 @@ def explain_figure(iteration, measured, stem, k=1):
     ax.set_title("residual over the (zeta, dzeta) plane", fontsize=9)
     ax = axes[1, 1]
     sc = [x for x in iteration.scores if x.get("lm") is not None]
-    if sc:
+    unscored = [x for x in iteration.scores if x.get("lm") is None and "criteria_after" in x]
+    if sc or unscored:
         lm = [max(x["lm"], 1e-3) for x in sc]
         ax.barh([x["effect"] for x in sc], lm,
                 color=["tab:green" if x["effect"] == iteration.effect else
                        ("tab:orange" if x["significant"] else "tab:gray") for x in sc])
+        # an effect whose small step changes the regime has no score, only its refit
+        for x in unscored:
+            ax.barh([x["effect"]], [max(lm, default=1.0)], fill=False, hatch="//",
+                    edgecolor="tab:green" if x["effect"] == iteration.effect else "tab:gray")
         ax.set_xscale("log")
-    ax.set_xlabel("score-test (LM) statistic (dimensionless)")
+    ax.set_xlabel("score-test (LM) statistic (dimensionless; hatched: no local score, "
+                  "refitted)", fontsize=8)
     ax.set_title("candidate effects (green: named; orange: significant; gray: not "
                  "significant)", fontsize=9)
     return _save(fig, stem)
