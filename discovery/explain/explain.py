@@ -47,7 +47,7 @@ from scipy.stats import chi2
 from ..errors import InputError, IntegrationError
 from ..identify import as_records, contact_scales, identify, pair_records, record_start
 from ..law import ForceLaw, Term
-from ..verify import evaluate
+from ..verify import consistency_limits, evaluate
 from . import drift as D
 from .effects import EFFECTS, Model, small_step
 from .localise import localise
@@ -325,6 +325,28 @@ def _drift_free(drift, model, records, alpha):
     return drift.score(model, eff, _small_step(eff, records))["p"] >= alpha
 
 
+def _within_noise(evs, criterion):
+    """Every record in the measured regime with ``criterion`` within its consistency limit
+    (:func:`discovery.verify.consistency_limits`)."""
+    for e in evs:
+        if e.status != "ok" or e.regime["simulated"] != e.regime["measured"] \
+                or e.impacts["simulated"] != e.impacts["measured"] or not e.noise_floor:
+            return False
+        lim = consistency_limits(e.noise_floor)
+        if criterion not in lim or not e.criteria[criterion] <= lim[criterion]:
+            return False
+    return True
+
+
+def _failing(evs):
+    """The criteria beyond their consistency limit in any record."""
+    out = []
+    for e in evs:
+        lim = consistency_limits(e.noise_floor) if e.noise_floor else {}
+        out += [k for k in lim if e.criteria.get(k, 0.0) > lim[k] and k not in out]
+    return out or ["the comparison"]
+
+
 def _mean(evs, key):
     if not all(getattr(e, key) for e in evs):
         return {}
@@ -574,10 +596,13 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         r0 = problem.residual(model)
         J = _jacobian(problem, model, r0)
         sigma = problem.sigma()
-        # a consistent cycle leaves only the drift to explain
+        # a cycle within its noise leaves only the drift to explain: consistent, or failing
+        # I4 alone (the supports of a noisy record) while the criterion the refits lower is
+        # within its limit (lowering it further would fit the noise)
+        quiet = cycle_ok or _within_noise(evs, criterion)
         cands = [e for e in catalogue if e.applicable(model)
                  and (drift is not None or "drift" not in e.phases)
-                 and (not cycle_ok or "drift" in e.phases)]
+                 and (not quiet or "drift" in e.phases)]
         scores = [drift.score(model, e, _small_step(e, records)) if "drift" in e.phases
                   else _score(problem, model, r0, J, e, records, sigma) for e in cands]
         level = alpha / max(len(scores), 1)
@@ -594,11 +619,19 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             # its refit (from the regression, over a ladder of values) still decides
             ranked += [s for s in scores if s["lm"] is None]
         if not ranked:
-            iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
-                                        "no catalogue effect is significant (score tests at "
-                                        f"family-wise level {alpha:g})", [], evs[0].simulated,
-                                        evs[0].simulated, records[0][1].impulse))
+            why = ("no catalogue effect is significant (score tests at family-wise level "
+                   f"{alpha:g})")
             stopped = "no catalogue effect explains the remaining disagreement significantly"
+            if quiet and not cycle_ok:
+                why = (f"{criterion} is within its noise limit and the model fails "
+                       f"{', '.join(_failing(evs))} alone, which no effect is fitted to (the "
+                       "contact supports of a noisy record); " + why)
+                stopped = (f"{criterion} is within its noise limit; the model fails "
+                           f"{', '.join(_failing(evs))} alone, which is not explained by an "
+                           "effect")
+            iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
+                                        why, [], evs[0].simulated, evs[0].simulated,
+                                        records[0][1].impulse))
             break
         trials = []
         # every candidate is refitted with a third of the budget; the winner gets the rest
