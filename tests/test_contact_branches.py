@@ -180,10 +180,9 @@ def test_a_set_orbit_strobed_inside_its_contact_keeps_its_unloading_memory():
     # which penetration the set contact unloads, so the steady state carries it.  The orbit
     # and its force must be the independent scipy path's (without the memory the true law
     # failed its own noise-free record with I2 = 0.11)
-    from tests.realistic import reference_record
-
     from discovery.dynamics.steady_state import steady_state
     from discovery.verify import Reference, evaluate
+    from tests.realistic import reference_record
 
     law = ForceLaw.parse("1.4e8*z + 8.24e6*zd; set: 0.44")
     sc = Scenario(m1=25200.0, m2=8750.0, k1=2.73e8, c1=9.28e5, A=5.19e5, frequency=21.1,

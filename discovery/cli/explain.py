@@ -37,7 +37,7 @@ def run(args):
     scs, meas = read_records(args)
     res = explain(scs, meas, args.start, criterion=args.criterion, alpha=args.alpha,
                   max_iterations=args.max_iterations, budget=args.max_simulations,
-                  n_boot=args.n_boot, seed=args.seed, effects=effects)
+                  n_boot=args.n_boot, seed=args.seed, effects=effects, workers=args.workers)
     summary = {"command": "explain", "scenario": scs[0].as_dict(),
                "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
                **res.as_dict(), "catalogue": [e.as_dict() for e in EFFECTS],
@@ -97,5 +97,8 @@ def register(sub):
                    help="bootstrap replicates of the noise floor (default: %(default)s)")
     s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
                    help="seed of the noise-floor bootstrap (default: %(default)s)")
+    s.add_argument("--workers", type=integer(1, 1024),
+                   help="processes for the screening refits (default: all cores; the result "
+                        "does not depend on it)")
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

@@ -37,19 +37,23 @@ One iteration (:func:`explain`):
 """
 
 import itertools
+import os
 import re
 import time
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
+from multiprocessing import get_context
 
 import numpy as np
 from scipy.stats import chi2
 
+from .._workers import terminate_pool, worker_initializer
 from ..errors import InputError, IntegrationError
 from ..identify import as_records, contact_scales, identify, pair_records, record_start
 from ..law import ForceLaw, Term
 from ..verify import consistency_limits, evaluate
 from . import drift as D
-from .effects import EFFECTS, Model, small_step
+from .effects import EFFECTS, Model, effect, small_step
 from .localise import localise
 
 __all__ = ["ExplainResult", "Iteration", "explain", "start_law"]
@@ -481,6 +485,52 @@ def _refit(problem, model, eff, guess, records, criterion, budget, tol, regress=
                 raise
 
 
+_SCREEN = {}
+
+
+def _screen_init(problem, records, criterion, budget, tol, regress):
+    _SCREEN.update(problem=problem, records=records, criterion=criterion, budget=budget,
+                   tol=tol, regress=regress)
+
+
+def _screen_one(job):
+    """One screening refit (:func:`_refit`) in a worker: ``(model, evaluations, error,
+    simulations)``."""
+    model, eff_id, direction = job
+    c = _SCREEN
+    n0 = c["problem"].n_sim
+    try:
+        m2, res = _refit(c["problem"], model, effect(eff_id), direction, c["records"],
+                         c["criterion"], c["budget"], c["tol"], c["regress"])
+        evs = c["problem"].evaluations(m2, floor=True)
+    except IntegrationError as exc:
+        return None, None, None, str(exc), c["problem"].n_sim - n0
+    return m2, res, evs, None, c["problem"].n_sim - n0
+
+
+def _screen(jobs, context, workers):
+    """The screening refits ``[(model, identification, evaluations, error)]`` in the order of
+    ``jobs``, on ``workers`` processes (forked: the records are not copied)."""
+    problem = context[0]
+    workers = min(int(workers or os.cpu_count() or 1), len(jobs))
+    if workers <= 1:
+        _screen_init(*context)
+        try:
+            return [r[:4] for r in map(_screen_one, jobs)]
+        finally:
+            _SCREEN.clear()
+    pool = ProcessPoolExecutor(workers, mp_context=get_context("fork"),
+                               **worker_initializer(_screen_init, context))
+    try:
+        out = list(pool.map(_screen_one, jobs))
+    except BaseException:
+        terminate_pool(pool)  # interrupted or failed: no waiting for queued refits
+        raise
+    pool.shutdown()
+    problem.n_sim += sum(r[4] for r in out)
+    return [r[:4] for r in out]
+
+
 def _output_error(records, start, criterion, budget, tol, polish=False):
     """Output-error identification of a law or model on every record: least squares, and
     with ``polish`` Nelder-Mead on the budget least squares left.  Least squares can stop
@@ -503,7 +553,7 @@ def _output_error(records, start, criterion, budget, tol, polish=False):
 
 def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01,
             max_iterations=3, budget=150, n_boot=16, seed=0, tolerances=None, effects=None,
-            max_refits=6):
+            max_refits=6, workers=None):
     """Explain the disagreement of a start model with one or several records by named
     physical effects (see the module docstring).
 
@@ -530,6 +580,9 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         Catalogue ids to consider (default all).
     max_refits : int
         Significant effects refitted per iteration (the largest scores first).
+    workers : int, optional
+        Processes for the screening refits (default: all cores; the result does not
+        depend on it).
 
     Returns
     -------
@@ -538,6 +591,8 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     t0 = time.perf_counter()
     if not (0 < alpha < 1):
         raise InputError(f"alpha must be in (0, 1); got {alpha!r}")
+    if workers is not None and not (isinstance(workers, int) and workers >= 1):
+        raise InputError(f"workers must be an integer >= 1; got {workers!r}")
     if not (isinstance(max_iterations, int) and max_iterations >= 0):
         raise InputError(f"max_iterations must be an integer >= 0; got {max_iterations!r}")
     from ..verify import Reference
@@ -637,16 +692,23 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         # every candidate is refitted with a third of the budget; the winner gets the rest
         screen = max(budget // 3, 4 * len(records))
         eff_by_id = {e.id: e for e in cands}
-        for s in ranked[:max_refits]:
-            eff = next(e for e in cands if e.id == s["effect"])
+        chosen = ranked[:max_refits]
+        # the screening refits of the force history are independent: one process each
+        refits = iter(_screen([(model, s["effect"], s.get("direction")) for s in chosen
+                               if "drift" not in eff_by_id[s["effect"]].phases],
+                              (problem, records, criterion, screen, tolerances, regress),
+                              workers))
+        for s in chosen:
+            eff = eff_by_id[s["effect"]]
             key = "D" if "drift" in eff.phases else criterion
             try:
                 if key == "D":
                     m2, res = drift.refit(model, eff, _small_step(eff, records)), None
+                    evs2 = problem.evaluations(m2, floor=True)
                 else:
-                    m2, res = _refit(problem, model, eff, s.get("direction"), records,
-                                     criterion, screen, tolerances, regress)
-                evs2 = problem.evaluations(m2, floor=True)
+                    m2, res, evs2, error = next(refits)
+                    if error is not None:
+                        raise IntegrationError(error)
             except IntegrationError as exc:
                 s["note"] = f"refit failed: {exc}"
                 continue
@@ -730,4 +792,5 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         settings={"start": str(start), "criterion": criterion, "alpha": alpha,
                   "max_iterations": max_iterations, "budget": budget, "n_boot": n_boot,
                   "seed": seed, "effects": [e.id for e in catalogue], "max_refits": max_refits,
+                  "workers": workers,
                   "records": len(records), "simulations": problem.n_sim})
