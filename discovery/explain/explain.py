@@ -172,17 +172,23 @@ def _physical(names, records):
     return ForceLaw(tuple(terms), tuple(record_start(*records[0], terms)))
 
 
-def _regression(names, scenarios, measurements):
+def _regression(names, scenarios, measurements, loading=False):
     """The certified regression of the force on exactly these terms (None without
-    positions in every record, or when the regression fails)."""
+    positions in every record, or when the regression fails); with ``loading``, on the
+    loading samples (``dzeta > 0``) alone, which an unloading branch or a set leaves as
+    they are."""
     from ..regression import ConstrainedSparseRegressor
     from ..samples import contact_samples, join_samples
 
     try:
         samples = join_samples([contact_samples(m, period=sc.period)
                                 for sc, m in zip(scenarios, measurements, strict=True)])
+        keep = samples.dzeta > 0 if loading else np.ones(len(samples), dtype=bool)
+        if np.count_nonzero(keep) < 10 * len(names):
+            return None
         est = ConstrainedSparseRegressor(library=",".join(names), max_terms=len(names))
-        est.fit(samples.X, samples.F, groups=samples.impact, sample_weight=samples.weight)
+        est.fit(samples.X[keep], samples.F[keep], groups=samples.impact[keep],
+                sample_weight=samples.weight[keep])
     except (InputError, ValueError):
         return None
     full = [c for c in est.candidates_ if len(c.terms) == len(names)]
@@ -427,7 +433,7 @@ def _jacobian(problem, model, r0):
     return np.column_stack(cols) if cols else np.zeros((r0.size, 0))
 
 
-def _regressed(model, names, regress):
+def _regressed(model, names, regress, loading=False):
     """``model`` with every loading coefficient from the certified regression of the
     measured force on the terms ``names`` (its unloading branch and added effects kept);
     None when the records have no positions or the regression fails.  The regression sees
@@ -436,7 +442,7 @@ def _regressed(model, names, regress):
     stiffening supports) does not hold the refit in its basin."""
     if regress is None:
         return None
-    fit = regress(list(names))
+    fit = regress(list(names), loading)
     if fit is None:
         return None
     law = model.law
@@ -457,8 +463,9 @@ def _refit(problem, model, eff, guess, records, criterion, budget, tol, regress=
     the effect at its LM direction (a small value when that is unusable) and the law from
     the certified regression (:func:`_regressed`) with the effect: for a term effect the
     regression on the extended term set; for any other, the regression on the current
-    terms with the effect's value from a ladder (its small step times 1, 4, ... 4096,
-    within its bounds)."""
+    terms (on the loading samples alone for an effect on the unloading branch) with the
+    effect's value from a ladder (its small step times 1, 4, ... 4096, within its
+    bounds)."""
     h = _small_step(eff, records)
     hi = eff.parameters[0].bounds[1]
     cands = [_extend(model, eff, min(guess if guess and guess > 0 else h, 0.5 * hi))]
@@ -468,7 +475,9 @@ def _refit(problem, model, eff, guess, records, criterion, budget, tol, regress=
         if reg is not None:
             cands.append(reg)
     else:
-        reg = _regressed(model, model.law.names, regress)
+        # an effect on the unloading branch leaves the loading samples as they are
+        reg = _regressed(model, model.law.names, regress,
+                         loading=eff.target in ("unloading", "set"))
         if reg is not None:
             values = sorted({min(h * f, 0.9 * hi) for f in _LADDER})
             cands += [_extend(reg, eff, v) for v in values]
@@ -494,8 +503,8 @@ def _screen_init(problem, records, criterion, budget, tol, regress):
 
 
 def _screen_one(job):
-    """One screening refit (:func:`_refit`) in a worker: ``(model, evaluations, error,
-    simulations)``."""
+    """One screening refit (:func:`_refit`) in a worker: ``(model, identification,
+    evaluations, error, simulations)``."""
     model, eff_id, direction = job
     c = _SCREEN
     n0 = c["problem"].n_sim
@@ -613,7 +622,7 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     preferred, others = ([start], []) if isinstance(start, ForceLaw) else \
         _start_candidates(start, records, plain if len(plain) == len(ms) else None)
     scen_list = [sc for sc, _ in records]
-    regress = (lambda names: _regression(names, scen_list, plain)) \
+    regress = (lambda names, loading=False: _regression(names, scen_list, plain, loading)) \
         if len(plain) == len(ms) else None
     # the fallbacks best first, by one simulation each (a start can land in another
     # regime's basin); the three closest are tried
