@@ -154,7 +154,8 @@ def main():
                   f"({d_['ratio_to_one_steady_state']:.0f} x one steady state)")
     e = results["explain"]
     print(f"explain, 20-period record, full catalogue: {e['seconds']:.1f} s "
-          f"({e['ratio_to_one_steady_state']:.0f} x one steady state), named {e['named']}")
+          f"({e['ratio_to_one_steady_state']:.0f} x one steady state), named {e['named']}; "
+          f"{e['parallel_speedup']:.2f}x faster than one process on {e['cores']} cores")
     u = results["ueda"]
     print(f"ueda chart point: {u['chart_point']['speedup']:.0f}x faster than scipy; chart "
           f"{u['chart']['grid'][0]}x{u['chart']['grid'][1]} in {u['chart']['seconds']:.1f} s "
