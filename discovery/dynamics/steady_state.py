@@ -259,7 +259,7 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
                 n, mult = m, floquet_multipliers(J)
             t0 = t_done * T
             zmax = 0.0
-            if pm._memory:
+            if law.permanent_set > 0:
                 # one more orbit from y0 leaves the memory y0 holds (the orbit is periodic)
                 pm.advance(y_orb, n)
                 zmax = pm.zeta_max

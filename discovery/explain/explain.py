@@ -249,6 +249,14 @@ def _start_candidates(text, records, measurements):
     return ([reg] if reg is not None else []), others
 
 
+def _fallbacks(preferred, others, problem, criterion):
+    """The start laws in the order they are tried: the preferred ones, then (only when
+    those fail) the three closest fallbacks, ranked by one simulation each (a start can
+    land in another regime's basin)."""
+    yield from preferred
+    yield from sorted(others, key=lambda law: problem.value(Model(law), criterion))[:3]
+
+
 class _Problem:
     """Residuals of a model against all records, and their sensitivities."""
 
@@ -380,6 +388,18 @@ def _repulsive(law, records):
         if not float(law.polynomial(z0, 0.0)) > 0:
             return False
     return True
+
+
+def _keeps_repulsive(refit, model, records):
+    """Whether a refit keeps the contact spring pushing (:func:`_repulsive`); a start that
+    already pulls is not held against it."""
+    return _repulsive(refit.law, records) or not _repulsive(model.law, records)
+
+
+def _in_bounds(eff, model):
+    """Whether the effect's parameter in ``model`` is within its physical bounds."""
+    lo, hi = eff.parameters[0].bounds
+    return bool(lo <= model.value(eff) <= hi)
 
 
 def _signature_agrees(eff, loc, top_phases):
@@ -624,11 +644,8 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     scen_list = [sc for sc, _ in records]
     regress = (lambda names, loading=False: _regression(names, scen_list, plain, loading)) \
         if len(plain) == len(ms) else None
-    # the fallbacks best first, by one simulation each (a start can land in another
-    # regime's basin); the three closest are tried
-    others.sort(key=lambda law: problem.value(Model(law), criterion))
     fit, why = None, ""
-    for law in preferred + others[:3]:
+    for law in _fallbacks(preferred, others, problem, criterion):
         try:
             fit = _output_error(records, law, criterion, budget, tolerances, polish=True)
             break
@@ -729,14 +746,13 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             s["consistent_after"] = all(e.consistent for e in evs2)
             s["parameters"] = {eff.parameters[0].name: m2.value(eff)}
             # (the drift channel does not depend on the law: no compensation to guard)
-            s["repulsive"] = (key == "D" or _repulsive(m2.law, records)
-                              or not _repulsive(model.law, records))
+            s["repulsive"] = key == "D" or _keeps_repulsive(m2, model, records)
             if not s["repulsive"]:
                 s["note"] = ("the refit's elastic branch P(zeta, 0) pulls at the record's "
                              "penetration: the effect only fits by undoing the contact spring")
-            lo, hi = eff.parameters[0].bounds
-            s["in_bounds"] = bool(lo <= m2.value(eff) <= hi)
+            s["in_bounds"] = _in_bounds(eff, m2)
             if not s["in_bounds"]:
+                lo, hi = eff.parameters[0].bounds
                 s["note"] = (f"the refit puts {eff.parameters[0].name} = {m2.value(eff):.4g} "
                              f"outside its physical bounds [{lo:g}, {hi:g}]")
             s["gap"] = key
@@ -758,12 +774,9 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
                 res2 = _output_error(records, m2, criterion, budget, tolerances, polish=True)
                 evs3 = problem.evaluations(res2.law, floor=True)
                 after3, _ = _with_drift(_mean(evs3, "criteria"), {}, drift, res2.law)
-                e = eff_by_id[s["effect"]]
-                lo, hi = e.parameters[0].bounds
                 if after3 and after3[key] <= s["criteria_after"][key] \
-                        and lo <= res2.law.value(e) <= hi \
-                        and (_repulsive(res2.law.law, records)
-                             or not _repulsive(model.law, records)):
+                        and _in_bounds(eff_by_id[s["effect"]], res2.law) \
+                        and _keeps_repulsive(res2.law, model, records):
                     m2, res, evs2 = res2.law, res2, evs3
                     s["criteria_after"] = after3
                     s["parameters"] = {p.name: m2.value(eff_by_id[s["effect"]])
