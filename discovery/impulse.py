@@ -363,7 +363,7 @@ def _edge_params(t, period, min_samples=3):
     return max(min_samples, int(0.01 * period / dt)), max(4.0, 0.02 * period / dt)
 
 
-def _sampled_support(tau, F, thr, period, noise=0.0):
+def _sampled_support(tau, F, thr, period, noise=0.0, extrapolate=True):
     """Support of a cycle sampled at ``tau`` (starting at the onset, ``tau[0] = 0``).
 
     When its noise is not negligible (``noise > thr / 100``) the cycle is first smoothed
@@ -377,7 +377,8 @@ def _sampled_support(tau, F, thr, period, noise=0.0):
     Fs[0] = F[0]
     t_ext = np.concatenate([[-dt], tau, [tau[-1] + dt]])
     f_ext = np.concatenate([[0.0], Fs, [0.0]])
-    runs = _edges(t_ext, f_ext, thr, min_len, max_extrap, noise / np.sqrt(width))
+    runs = _edges(t_ext, f_ext, thr, min_len, max_extrap if extrapolate else None,
+                  noise / np.sqrt(width))
     sup = [(max(a, 0.0), min(b, tau[-1])) for a, b, _ in runs]
     return np.array(sup, dtype=float).reshape(-1, 2)
 
@@ -419,12 +420,12 @@ def _edges(t, F, thr, min_len, max_extrap=4.0, noise=0.0):
         if s == 0 or e >= len(F):
             continue  # incomplete at the record's ends
         f0, f1 = F[s - 1], F[s]
-        steep = f1 - f0 > 3.0 * noise
+        steep = max_extrap is not None and f1 - f0 > 3.0 * noise
         lo = -max_extrap if steep else 0.0
         frac = ((0.0 if steep else thr) - f0) / (f1 - f0) if f1 > f0 else 1.0
         t_on = t[s - 1] + float(np.clip(frac, lo, 1.0)) * (t[s] - t[s - 1])
         g0, g1 = F[e - 1], F[e]
-        steep = g0 - g1 > 3.0 * noise
+        steep = max_extrap is not None and g0 - g1 > 3.0 * noise
         hi = 1.0 + max_extrap if steep else 1.0
         frac = ((0.0 if steep else thr) - g0) / (g1 - g0) if g1 < g0 else 0.0
         t_off = t[e - 1] + float(np.clip(frac, 0.0, hi)) * (t[e] - t[e - 1])

@@ -10,6 +10,7 @@ from ..criteria import CRITERIA
 from ..errors import InputError
 from ..impulse import estimate_noise
 from .noise_floor import noise_floor
+from .trajectory import record_span
 
 __all__ = ["Reference"]
 
@@ -37,6 +38,15 @@ class Reference:
     n_boot, seed : int
         Bootstrap replicates and seed of the noise floor.
     source : str
+    span : RecordSpan or None
+        With positions recorded: the record's span on the drive's phase and the machine's
+        state before it (:mod:`~discovery.verify.trajectory`); laws are then simulated from
+        that state across the span and compared cycle by cycle.  ``impulse`` is then the
+        span's folded cycle.
+    cycle : Impulse or None
+        The record's cycle aligned at each cycle's own onset
+        (:func:`~discovery.impulse.impulse_from_samples`), which sets the cycle length and
+        the main onset; the comparison itself uses it only without positions.
     """
 
     impulse: object
@@ -47,6 +57,8 @@ class Reference:
     n_boot: int = 16
     seed: int = 0
     source: str = ""
+    span: object = None
+    cycle: object = None
 
     @property
     def regime(self):
@@ -104,12 +116,18 @@ class Reference:
         if zeta is not None:
             noise["zeta"] = estimate_noise(zeta, order=3)
             noise["impact_velocity"] = _impact_velocity(t, zeta, E, T, dt)
-        start, t_start = None, 0.0
+        start, t_start, span, cycle = None, 0.0, None, E
         if use_state and zeta is not None:
-            start, t_start = measurement.state_at_strobe(T, time_offset)
+            span = record_span(measurement, scenario, E, time_offset=time_offset)
+            if span is None:
+                start, t_start = measurement.state_at_strobe(T, time_offset)
+            else:
+                start, t_start = span.state.y, span.state.t
+                E = span.impulse(span.F, onset_record_time=span.fold.origin - time_offset)
+                noise["n_cycles"] = span.fold.n_cycles
         return cls(impulse=E, noise=noise, start=start, start_time=t_start,
                    time_offset=float(time_offset), n_boot=int(n_boot), seed=int(seed),
-                   source=measurement.source)
+                   source=measurement.source, span=span, cycle=cycle)
 
 
 def _impact_velocity(t, zeta, E, period, dt):
