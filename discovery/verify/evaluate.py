@@ -29,8 +29,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..criteria import compare, evaluate_criteria
-from ..dynamics.steady_state import steady_state
 from ..dynamics.simulate import simulate
+from ..dynamics.steady_state import steady_state
 from ..errors import InputError, IntegrationError
 from ..impulse import impulse_from_steady_state
 from .trajectory import simulated_history, span_floor
