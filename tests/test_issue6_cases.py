@@ -130,8 +130,9 @@ def test_case4_short_contact_true_law_consistent_missing_term_not(short_contact_
     assert ev.consistent, ev.verdict
     for b in bad:
         assert not b.consistent, b.verdict
-        # far outside the noise, not by a whisker: I2 0.28-1.26 against floors <= 0.09
-        if b.status == "ok":
+        # far outside the noise, not by a whisker: I2 0.28-1.26 against floors <= 0.09 (a
+        # dropped term that makes the moulding chatter has a wide floor of its own)
+        if b.status == "ok" and b.impacts["simulated"] == b.impacts["measured"]:
             assert b.criteria["I2"] > 2 * _limit(b)
 
 

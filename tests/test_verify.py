@@ -8,8 +8,9 @@ each channel's own range: so the penetration ``w1 - w2`` is noisy.
 import numpy as np
 import pytest
 
-from discovery import ForceLaw, Measurement, Scenario, load_scenario
+from discovery import ForceLaw, Measurement, Scenario, load_scenario, simulate
 from discovery.dynamics.reference import reference_simulate
+from discovery.impulse import estimate_noise
 from discovery.response import response
 from discovery.verify import Reference, evaluate, verify
 
@@ -66,8 +67,19 @@ def test_noise_floor_is_the_spread_of_the_true_law(light):
 def test_verify_starts_from_the_measured_state(light, light_record):
     ref = Reference.from_measurement(light_record, light)
     assert ref.start is not None
-    k = ref.start_time / light.period
-    assert k == pytest.approx(round(k), abs=1e-9)
+    # the state comes from the record's first free flight, fitted by the exact free motion:
+    # it predicts the recorded positions to their noise level
+    assert ref.span is not None and ref.span.state.method == "free-flight fit"
+    t = light_record.t
+    assert t[0] <= ref.start_time <= t[0] + light.period
+    tr = simulate(light, light.law, (ref.start_time, ref.start_time + 0.5 * light.period),
+                  y0=ref.start, t_eval=t[(t >= ref.start_time)
+                                         & (t <= ref.start_time + 0.5 * light.period)])
+    sel = (t >= ref.start_time) & (t <= ref.start_time + 0.5 * light.period)
+    for k, name in ((0, "w1"), (2, "w2")):
+        ch = light_record.channels[name]
+        rms = float(np.sqrt(np.mean((tr.y[k] - ch[sel]) ** 2)))
+        assert rms < 1.3 * estimate_noise(ch, order=3)  # the sensor noise, no model error
     # the measured state is on the orbit: a short transient suffices
     ev = evaluate(light, light.law, ref, transient=2)
     assert ev.status == "ok" and ev.consistent
@@ -97,9 +109,13 @@ def test_subharmonic_with_several_impacts_is_aligned():
     v = verify(_SUB, rec, _SUB_LAW, check_default_start=False)
     assert v.evaluation.regime == {"measured": "P4", "simulated": "P4"}
     assert v.consistent, v.verdict
-    # each other impact taken as t* matches far worse than the one chosen
+    # without positions (the force alone) the impacts are aligned: each other impact taken
+    # as t* matches far worse than the one chosen
     from discovery.criteria import evaluate_criteria
 
+    v = verify(_SUB, Reference.from_measurement(rec, _SUB, use_state=False), _SUB_LAW,
+               check_default_start=False)
+    assert v.consistent, v.verdict
     exact = v.evaluation.extra["aligned"]
     E = v.reference.impulse
     others = [evaluate_criteria(E, exact.rotated(o).resampled_like(E))["I2"]
@@ -135,7 +151,7 @@ def test_an_undefined_noise_floor_never_makes_a_law_consistent(light, light_reco
     import dataclasses
 
     class _NoFloor(Reference):
-        def floor_for(self, stand_in):
+        def floor_for(self, stand_in, **kwargs):
             inf = {n: float("inf") for n in ("I0", "I1", "I2", "I3", "I4")}
             return {"mean": inf, "q95": dict(inf), "n_boot": 0, "seed": 0}
 

@@ -33,7 +33,7 @@ from ..dynamics.simulate import simulate
 from ..dynamics.steady_state import steady_state
 from ..errors import InputError, IntegrationError
 from ..impulse import impulse_from_steady_state
-from .trajectory import simulated_history, span_floor
+from .trajectory import simulated_history
 
 __all__ = ["Evaluation", "evaluate", "consistency_limits", "CONSISTENCY_CRITERIA",
            "CONSISTENCY_FACTOR",
@@ -282,8 +282,8 @@ def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_
         reg["simulated"] = f"failed ({exc})"
     extra["transient_I2"] = transient
     settled = transient is not None and transient <= TRANSIENT_GAP
-    fl = span_floor(scenario, law, span, sim, n_boot=reference.n_boot, seed=reference.seed,
-                    tolerances=tolerances, observe=observe)
+    fl = reference.floor_for(sim, scenario=scenario, law=law, tolerances=tolerances,
+                             observe=observe)
     lim = consistency_limits(fl["mean"])
     same_impacts = imp["simulated"] == imp["measured"]
     regime_ok = reg["simulated"] == reg["measured"] or not settled

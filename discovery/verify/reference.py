@@ -10,7 +10,7 @@ from ..criteria import CRITERIA
 from ..errors import InputError
 from ..impulse import estimate_noise
 from .noise_floor import noise_floor
-from .trajectory import record_span
+from .trajectory import record_span, span_floor
 
 __all__ = ["Reference"]
 
@@ -69,9 +69,14 @@ class Reference:
         """Contacts per measured cycle (above the noise threshold)."""
         return int(len(self.impulse.support))
 
-    def floor_for(self, stand_in):
+    def floor_for(self, stand_in, *, scenario=None, law=None, tolerances=None, observe=None):
         """Noise floor of every criterion if ``stand_in`` (an exact impulse aligned with
-        the measured cycle) were the truth: see :func:`~discovery.verify.noise_floor`."""
+        the measured cycle) were the truth: see :func:`~discovery.verify.noise_floor`; with
+        a record span (and ``scenario``, ``law``), through the span's own processing
+        (:func:`~discovery.verify.trajectory.span_floor`)."""
+        if self.span is not None and law is not None:
+            return span_floor(scenario, law, self.span, stand_in, n_boot=self.n_boot,
+                              seed=self.seed, tolerances=tolerances, observe=observe)
         if not self.noise:
             zero = {n: 0.0 for n in CRITERIA}
             return {"mean": zero, "q95": dict(zero), "n_boot": 0, "seed": self.seed}
