@@ -36,11 +36,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from constraints import require
+from constraints import require as require_certificate
 
 from .criteria import criterion as _criterion
-from .errors import InputError, IntegrationError
+from .errors import InputError, IntegrationError, VidiError
 from .identify import identify, pair_records, record_start
+from .law import Term
+from .library import Library
 from .regression import ConstrainedSparseRegressor
 from .samples import contact_samples, join_samples
 from .verify import Reference, evaluate
@@ -123,6 +125,11 @@ class RankedModel:
             f" (and {len(bad) - 1} more)" if len(bad) > 1 else "")
 
     @property
+    def defects(self):
+        """Why the law is not a contact law (:meth:`ForceLaw.contact_defects`)."""
+        return self.law.contact_defects()
+
+    @property
     def standard_errors(self):
         """``{term: standard error}`` from the refinement (empty without it)."""
         return dict(self.refinement.standard_errors) if self.refinement is not None \
@@ -139,7 +146,8 @@ class RankedModel:
              "consistent": self.consistent, "verdict": self.verdict,
              "bic": self.candidate.bic, "aic": self.candidate.aic,
              "cv_error": self.candidate.cv_error, "rss": self.candidate.rss,
-             "constrained": self.candidate.constrained, "refinement": self.note}
+             "constrained": self.candidate.constrained, "refinement": self.note,
+             "contact_defects": self.defects}
         if self.refinement is not None:
             d["n_simulations"] = self.refinement.n_simulations
         if len(self.evaluations) > 1:
@@ -205,11 +213,25 @@ def _coefficients(law, library):
     return np.array([d.get(t.name, 0.0) for t in library.terms])
 
 
-def rank(models, criterion="I2", sim_rtol=0.1, sim_atol=0.005):
+def rank(models, criterion="I2", sim_rtol=0.1, sim_atol=0.005, physics=True):
     """Order checked models: the models consistent with the records first, the fewest terms
     first, then by the criterion (the records cannot tell them apart); then the others
     whose criterion is within ``sim_rtol`` (relative) or ``sim_atol`` of the best, by BIC;
-    then the rest by the criterion; models without a periodic steady state with contact last."""
+    then the rest by the criterion; models without a periodic steady state with contact last.
+
+    With ``physics`` (default) laws that are no contact laws
+    (:meth:`ForceLaw.contact_defects`: no spring, a negative damper) come after every
+    contact law, ranked among themselves by the same rule."""
+    if physics:
+        sound = [m for m in models if not m.defects]
+        if len(sound) < len(models):
+            unsound = [m for m in models if m.defects]
+            head = rank(sound, criterion, sim_rtol, sim_atol, physics=False)
+            tail = rank(unsound, criterion, sim_rtol, sim_atol, physics=False)
+            # models without a periodic steady state stay last of all
+            return ([m for m in head if m.criteria] + [m for m in tail if m.criteria]
+                    + [m for m in head if not m.criteria]
+                    + [m for m in tail if not m.criteria])
     ok = [m for m in models if m.criteria]
     bad = sorted((m for m in models if not m.criteria), key=lambda m: m.candidate.bic)
     if not ok:
@@ -228,6 +250,42 @@ def rank(models, criterion="I2", sim_rtol=0.1, sim_atol=0.005):
     return good + tier + tail + bad
 
 
+def _sign_vector(signs, library):
+    """``{term: +1 | -1 | 0}`` as the estimator's per-term sign vector."""
+    lib = library if isinstance(library, Library) else Library.parse(library)
+    names = [t.name for t in lib.terms]
+    out = np.zeros(len(names))
+    for key, sign in signs.items():
+        try:
+            name = Term.parse(str(key).strip()).name
+        except VidiError:
+            name = None
+        if name not in names:
+            raise InputError(f"signs: term {key!r} is not in the library ({', '.join(names)})")
+        if sign not in (-1, 0, 1):
+            raise InputError(f"signs: the sign of {key} must be +1, -1 or 0; got {sign!r}")
+        out[names.index(name)] = sign
+    return out
+
+
+def _required_terms(require, library):
+    """The set of required term names, each checked against the library."""
+    if isinstance(require, str):
+        require = [r for r in require.split(",") if r.strip()]
+    names = [t.name for t in library.terms]
+    out = set()
+    for r in require:
+        try:
+            name = Term.parse(str(r).strip()).name
+        except VidiError:
+            name = None
+        if name not in names:
+            raise InputError(f"required term {r!r} is not in the library ({', '.join(names)})"
+                             "; give library terms to --require, e.g. --require z")
+        out.add(name)
+    return frozenset(out)
+
+
 def _steady_from(ref):
     """Record time from which a record is steady: its first averaged cycle's onset."""
     return float(ref.impulse.onset)
@@ -236,8 +294,10 @@ def _steady_from(ref):
 class _Checker:
     """Refines (optionally) and evaluates one regression candidate against all records."""
 
-    def __init__(self, est, samples, refs, criterion, refine, tolerances, budget):
+    def __init__(self, est, samples, refs, criterion, refine, tolerances, budget,
+                 required=frozenset()):
         self.est, self.samples, self.refs = est, samples, refs
+        self.required = frozenset(required)
         self.criterion, self.refine, self.tol, self.budget = criterion, refine, tolerances, budget
 
     def evaluate(self, law):
@@ -330,7 +390,7 @@ class _Checker:
         lib = self.est.library_
         out = []
         for term in names:
-            if frozenset(names) - {term} in skip:
+            if term in self.required or frozenset(names) - {term} in skip:
                 continue
             coef = _coefficients(base.law, lib)
             coef[[t.name for t in lib.terms].index(term)] = 0.0
@@ -526,7 +586,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
              max_terms=4, criterion="I2", shortlist=8, refine=True, stability=0,
              derivative=None, average_cycles=False, sim_rtol=0.1, sim_atol=0.005,
              tolerances=None, random_state=0, n_boot=16, max_simulations=_REFINE_BUDGET,
-             stepwise=3, **estimator_kwargs):
+             stepwise=3, physics=True, require=(), **estimator_kwargs):
     """Discover a contact law from one or several records and check it by simulation.
 
     Parameters
@@ -567,6 +627,13 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         Simulation budget of each support's refinement.
     stepwise : int
         Output-error stepwise moves around the best model (see the module docstring).
+    physics : bool
+        Rank laws that are no contact laws (no spring, a negative damper:
+        :meth:`ForceLaw.contact_defects`) after every contact law (default); ``False``
+        ranks them by the records alone.
+    require : sequence of str
+        Library terms every candidate must contain (e.g. ``("z",)``: a spring): supports
+        without them are not simulated, and the backward step never drops them.
     **estimator_kwargs
         Further estimator parameters (``margin``, ``monotone``, ``signs``, ...).
 
@@ -594,13 +661,25 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     samples = join_samples(parts)
     refs = [(sc, Reference.from_measurement(m, sc, n_boot=n_boot, seed=random_state))
             for sc, m in pairs]
+    if isinstance(estimator_kwargs.get("signs"), dict):
+        estimator_kwargs["signs"] = _sign_vector(estimator_kwargs["signs"], library)
     est = ConstrainedSparseRegressor(library=library, selection=selection, scoring=scoring,
                                      max_terms=max_terms, **estimator_kwargs)
     est.fit(samples.X, samples.F, groups=samples.impact, sample_weight=samples.weight)
-    check = _Checker(est, samples, refs, criterion, refine, tolerances, max_simulations)
-    models = [check(c) for c in est.candidates_[:shortlist]]
+    required = _required_terms(require, est.library_)
+    check = _Checker(est, samples, refs, criterion, refine, tolerances, max_simulations,
+                     required)
+    pool = [c for c in est.candidates_ if required <= set(c.coefficients)]
+    if not pool:
+        raise InputError(f"no candidate support of the library holds the required terms "
+                         f"{', '.join(sorted(required))}; raise --max-terms or drop --require")
+    models = [check(c) for c in pool[:shortlist]]
     by_score = list(models)  # the estimator's order (its scoring)
-    ranking = rank(models, criterion, sim_rtol, sim_atol)
+
+    def rank_all(ms):
+        return rank(ms, criterion, sim_rtol, sim_atol, physics=physics)
+
+    ranking = rank_all(models)
     steps = []
     if refine and not ranking[0].criteria:
         # no regression law has a periodic orbit with contact: start from the record alone
@@ -608,7 +687,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         if start is not None:
             steps.append({"kind": "physical start", "from": [], "trials": 1})
             models = models + [start]
-            ranking = rank(models, criterion, sim_rtol, sim_atol)
+            ranking = rank_all(models)
     while refine and ranking[0].criteria and len(steps) < stepwise:
         # output-error stepwise search around the best model: a consistent model loses a
         # term (backward), an inconsistent one gains one (forward: the regression may have
@@ -616,7 +695,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         top = ranking[0]
         # supports already simulated successfully are not tried again
         done = frozenset(frozenset(m.law.names) for m in models if m.criteria)
-        if top.consistent:
+        if top.consistent and not (physics and top.defects):
             trials, kind = check.backward(top, done), "backward"
         else:  # both directions: a wrong term may have to go while a missing one comes in
             trials = check.forward(top, max_terms, done) + check.backward(top, done)
@@ -625,23 +704,29 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
             break
         steps.append({"kind": kind, "from": list(top.law.names), "trials": len(trials)})
         models = models + trials
-        ranking = rank(models, criterion, sim_rtol, sim_atol)
+        ranking = rank_all(models)
         if ranking[0] is top:
             break
     selected = ranking[0]
     # the certificate of the law actually selected (the ranking may prefer another
     # candidate than the estimator's best by BIC); a failure is an error
-    cert = require(selected.certificate)
+    cert = require_certificate(selected.certificate)
     stab = est.stability(samples.X, samples.F, samples.impact, stability, random_state,
                          sample_weight=samples.weight) if stability else {}
     warnings = _warnings(selected, by_score, stab, pairs, parts, refs, samples, refine)
+    if selected.defects:
+        warnings.insert(0, "the selected law is no contact law (" + "; ".join(selected.defects)
+                        + "): " + ("no candidate was one; widen the library or --require z"
+                                   if physics else "ranked by the records alone "
+                                   "(--allow-unphysical)"))
     equivalent = _equivalent(ranking, selected, est, samples, criterion)
     settings = {"library": str(library), "selection": selection, "scoring": scoring,
                 "max_terms": max_terms, "criterion": criterion, "shortlist": shortlist,
                 "refine": refine, "max_simulations": max_simulations, "stability": stability,
                 "derivative": samples.derivative, "average_cycles": average_cycles,
                 "random_state": random_state, "n_boot": n_boot, "records": len(pairs),
-                "stepwise": stepwise, "steps": steps,
+                "stepwise": stepwise, "steps": steps, "physics": physics,
+                "require": sorted(required),
                 "ranking_rule": {"sim_rtol": sim_rtol, "sim_atol": sim_atol},
                 "estimator": est.get_params()}
     return DiscoveryResult(selected=selected, ranking=ranking, certificate=cert, estimator=est,

@@ -180,6 +180,28 @@ def model_parts(model, observe=None):
     return model.law, model.apply, model.observe()
 
 
+def _measured_cycles(ref):
+    """The measured cycles a record is compared on: every block of a record span, else
+    the one aligned cycle."""
+    return list(ref.blocks) if getattr(ref, "blocks", ()) else [ref.impulse]
+
+
+def _cycle_pairs(ev, ref):
+    """``[(measured, simulated), ...]`` of an evaluation, one per compared cycle."""
+    return ev.extra.get("blocks") or [(ref.impulse, ev.simulated)]
+
+
+def _residual_weights(ref):
+    """Per measured cycle: trapezoid-like sample spacing, normalised so that the sum of
+    squared residuals of a cycle is its I3^2, times the square root of its share of the
+    record's cycles."""
+    cycles = _measured_cycles(ref)
+    n = np.array([max(E.n_cycles, 1) for E in cycles], dtype=float)
+    share = np.sqrt(n / n.sum())
+    return [s * np.sqrt(np.gradient(E.t) / max(np.trapezoid(E.F**2, E.t), 1e-300))
+            for E, s in zip(cycles, share, strict=True)]
+
+
 class _Objective:
     """Counts and caches simulations, enforces the budget, records the best-so-far path."""
 
@@ -195,10 +217,7 @@ class _Objective:
         self.path, self.failures = [], []
         # residual weights: trapezoid-like sample spacing, normalised so that the sum
         # of squared residuals of a record is its I3^2
-        self.w = []
-        for _, ref in records:
-            E = ref.impulse
-            self.w.append(np.sqrt(np.gradient(E.t) / max(np.trapezoid(E.F**2, E.t), 1e-300)))
+        self.w = [_residual_weights(ref) for _, ref in records]
 
     def law(self, x):
         return self.start.with_coefficients(self.c0 * np.asarray(x))
@@ -238,14 +257,16 @@ class _Objective:
         evs = self.evaluations(x)
         if evs is None:
             # a failed point: residuals as large as an all-wrong force history
-            return np.concatenate([_PENALTY * w[1:] * np.max(np.abs(ref.impulse.F))
-                                   for (_, ref), w in zip(self.records, self.w, strict=True)])
+            return np.concatenate([_PENALTY * w[1:] * np.max(np.abs(E.F))
+                                   for (_, ref), ws in zip(self.records, self.w, strict=True)
+                                   for E, w in zip(_measured_cycles(ref), ws, strict=True)])
         self(x)  # records the path with the requested criterion
-        # the onset value F_E(0+) is extrapolated from samples: it is left out so the
-        # fit is not biased by the extrapolation error at the jump
-        return np.concatenate([((ev.simulated.F - ref.impulse.F) * w)[1:]
-                               for ev, (_, ref), w in zip(evs, self.records, self.w,
-                                                          strict=True)])
+        # the first point (F_E(0+), extrapolated from samples for an aligned cycle) is left
+        # out so the fit is not biased by the extrapolation error at the jump
+        return np.concatenate([((S.F - E.F) * w)[1:]
+                               for ev, (_, ref), ws in zip(evs, self.records, self.w,
+                                                           strict=True)
+                               for (E, S), w in zip(_cycle_pairs(ev, ref), ws, strict=True)])
 
 
 def _coordinate_descent(obj, x0, xtol, step0=0.1):

@@ -272,6 +272,29 @@ class ForceLaw:
         """True when the force jumps at contact onset (a term ``zd^b`` with ``a = 0``)."""
         return any(t.a == 0 for t in self.terms)
 
+    def contact_defects(self):
+        """Why this law is not a contact law, as short reasons (empty when it is one).
+
+        A contact pushes the bodies apart by its elastic branch ``F(zeta, 0)``: a law
+        without an elastic term with a positive coefficient (``F(zeta, 0) = 0``: no spring)
+        only damps, and its unloading never returns the stored energy.  Its dissipative
+        terms (``zd^b``, ``b > 0``) must not have negative coefficients: a damper that
+        pulls harder the faster the bodies meet is not dissipation.  A record's noise can
+        make such a law fit as well as the truth; the ranking puts it last, with these
+        reasons, unless the user asks for it.
+        """
+        out = []
+        if not any(t.b == 0 and c > 0 for t, c in zip(self.terms, self.coefficients,
+                                                        strict=True)):
+            out.append("no spring: F(zeta, 0) = 0 (no elastic term with a positive "
+                       "coefficient)")
+        neg = [t.name for t, c in zip(self.terms, self.coefficients, strict=True)
+               if t.b > 0 and c < 0]
+        if neg:
+            out.append(f"dissipative term{'s' if len(neg) > 1 else ''} {', '.join(neg)} with "
+                       "a negative coefficient")
+        return out
+
     # ------------------------------------------------------------ evaluation
     def polynomial(self, zeta, zd):
         """Raw ``P(zeta, zd)`` without the contact conditions (inputs >= 0)."""

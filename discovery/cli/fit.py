@@ -1,5 +1,6 @@
 """``vidi fit``: discover a law (certified sparse regression, every candidate simulated)."""
 
+import argparse
 import csv
 import io
 import time
@@ -41,7 +42,8 @@ def run(args):
                    max_simulations=args.max_simulations, stability=args.stability,
                    derivative=args.derivative, average_cycles=args.average_cycles,
                    random_state=args.seed, margin=args.margin,
-                   monotone=args.monotone)
+                   monotone=args.monotone, physics=not args.allow_unphysical,
+                   require=args.require or (), **({"signs": args.signs} if args.signs else {}))
     imps = []
     for k, m in enumerate(res.ranking[:3]):
         if m.criteria:  # aligned with the first record and sampled like it
@@ -120,6 +122,31 @@ def run(args):
     return 0
 
 
+def _signs(text):
+    """``'z:+,zd:-'`` -> ``{"z": 1, "zd": -1}`` (argparse type)."""
+    out = {}
+    for part in text.split(","):
+        if not part.strip():
+            continue
+        term, _, sign = part.rpartition(":")
+        value = {"+": 1, "+1": 1, "1": 1, "-": -1, "-1": -1, "0": 0}.get(sign.strip())
+        if not term.strip() or value is None:
+            raise argparse.ArgumentTypeError(
+                f"{part.strip()!r} is not TERM:SIGN; write e.g. --signs 'z:+,zd:+' (signs + - 0)")
+        out[term.strip()] = value
+    if not out:
+        raise argparse.ArgumentTypeError("no TERM:SIGN given; write e.g. --signs 'z:+,zd:+'")
+    return out
+
+
+def _terms(text):
+    """``'z,zd'`` -> ``["z", "zd"]`` (argparse type)."""
+    out = [t.strip() for t in text.split(",") if t.strip()]
+    if not out:
+        raise argparse.ArgumentTypeError("no term given; write e.g. --require z")
+    return out
+
+
 def register(sub):
     s = sub.add_parser("fit", help="discover a law: sparse certified regression, every "
                        "candidate checked by simulation")
@@ -147,6 +174,15 @@ def register(sub):
                    help="candidates simulated (default: %(default)s)")
     s.add_argument("--margin", type=number(0.0, unit="N s/m"), default=0.0,
                    help="dissipativity strictness margin in N s/m (default: %(default)g)")
+    s.add_argument("--signs", type=_signs, default=None,
+                   help="coefficient signs of library terms, e.g. 'z:+,zd:+,zd^2:-' (a term "
+                   "not named is free; default: none)")
+    s.add_argument("--require", type=_terms, default=None,
+                   help="terms every candidate must contain, e.g. 'z' (a spring) or 'z,zd' "
+                   "(default: none)")
+    s.add_argument("--allow-unphysical", action="store_true",
+                   help="rank laws that are no contact laws (no spring: F(zeta, 0) = 0; a "
+                   "negative damper) by the records alone; by default they come last")
     s.add_argument("--monotone", action="store_true",
                    help="also require a monotone elastic branch")
     s.add_argument("--no-refine", action="store_true",

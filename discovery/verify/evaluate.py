@@ -33,7 +33,7 @@ from ..dynamics.simulate import simulate
 from ..dynamics.steady_state import steady_state
 from ..errors import InputError, IntegrationError
 from ..impulse import impulse_from_steady_state
-from .trajectory import simulated_history
+from .trajectory import block_criteria, simulated_history
 
 __all__ = ["Evaluation", "evaluate", "consistency_limits", "CONSISTENCY_CRITERIA",
            "CONSISTENCY_FACTOR",
@@ -229,12 +229,12 @@ TRANSIENT_GAP = CONSISTENCY_SLACK
 the same times above which the record is taken to be still in a transient under that law."""
 
 
-def _orbit_history(scenario, law, ss, span, tolerances):
-    """The steady orbit's force at the span's sample times (the orbit is periodic in
+def _orbit_history(scenario, law, ss, block, tolerances):
+    """The steady orbit's force at a block's sample times (the orbit is periodic in
     ``n T`` from ``ss.t0``)."""
     W = ss.n_periods * scenario.period
-    fold = span.fold
-    t0 = ss.t0 + np.floor((span.state.t - ss.t0) / W) * W
+    fold = block.fold
+    t0 = ss.t0 + np.floor((block.state.t - ss.t0) / W) * W
     tr = simulate(scenario, law, (t0, fold.end), y0=ss.y0, t_eval=fold.td,
                   tolerances=tolerances, zeta_max0=ss.zeta_max0)
     return np.asarray(tr.force, dtype=float)
@@ -242,9 +242,10 @@ def _orbit_history(scenario, law, ss, span, tolerances):
 
 def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_kwargs):
     """:func:`evaluate` for a record with positions: the law simulated from the machine's
-    state across the record's span, both histories folded by the same operator
-    (:mod:`~discovery.verify.trajectory`); the steady state is found only to report the
-    law's regime and to tell a transient from a regime mismatch."""
+    states across the record's span, block by block, both histories folded by the same
+    operator (:mod:`~discovery.verify.trajectory`); the criteria are the blocks' mean
+    (weighted by cycles); the steady state is found only to report the law's regime and to
+    tell a transient from a regime mismatch."""
     span = reference.span
     E = reference.impulse
     reg = {"measured": reference.regime, "simulated": None}
@@ -254,17 +255,22 @@ def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_
     except IntegrationError as exc:
         return Evaluation("failed", reg, imp, {}, {}, False,
                           f"the simulation failed: {exc}", message=str(exc))
-    if not np.any(hist > 0):
+    if not any(np.any(h > 0) for h in hist):
         imp["simulated"] = 0
         return Evaluation("no-contact", reg, imp, {}, {}, False,
                           "inconsistent: the simulated bodies never come into contact "
                           "over the record's span")
-    sim = span.impulse(hist, onset_record_time=E.onset)
+    sims = span.impulses(hist, onset_record_time=E.onset)
+    sim = sims[-1]
     imp["simulated"] = int(len(sim.support))
-    crit = evaluate_criteria(E, sim)
-    extra = {"comparison": "record span", "span": {
-        "start_time": span.state.t, "cycles": span.fold.n_cycles,
-        "state": span.state.method, "state_samples": span.state.n_samples}}
+    crit, per_block = block_criteria(reference.blocks, sims, span)
+    last = span.blocks[-1]
+    extra = {"comparison": "record span", "blocks": list(zip(reference.blocks, sims,
+                                                             strict=True)),
+             "span": {"start_time": span.state.t, "cycles": span.n_cycles,
+                      "blocks": len(span.blocks), "state": last.state.method,
+                      "state_samples": last.state.n_samples,
+                      "block_I2": [p["I2"] for p in per_block]}}
     if not floor:
         return Evaluation("ok", reg, imp, crit, {}, False, "", simulated=sim, extra=extra)
     steady_kwargs = {"y_start": reference.start, "t_start": reference.start_time,
@@ -274,7 +280,8 @@ def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_
         ss = steady_state(scenario, law, tolerances=tolerances, **steady_kwargs)
         if ss.periodic:
             reg["simulated"] = ss.regime
-            orbit = span.impulse(_orbit_history(scenario, law, ss, span, tolerances))
+            orbit = last.fold.impulse(_orbit_history(scenario, law, ss, last, tolerances),
+                                      threshold=last.threshold, noise=span.sigma_f)
             transient = evaluate_criteria(orbit, sim, ["I2"])["I2"]
         else:
             reg["simulated"] = "nonperiodic"
@@ -282,7 +289,7 @@ def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_
         reg["simulated"] = f"failed ({exc})"
     extra["transient_I2"] = transient
     settled = transient is not None and transient <= TRANSIENT_GAP
-    fl = reference.floor_for(sim, scenario=scenario, law=law, tolerances=tolerances,
+    fl = reference.floor_for(sims, scenario=scenario, law=law, tolerances=tolerances,
                              observe=observe)
     lim = consistency_limits(fl["mean"])
     same_impacts = imp["simulated"] == imp["measured"]
@@ -290,7 +297,7 @@ def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_
     within = all(np.isfinite(lim[k]) and crit[k] <= lim[k] for k in lim)
     consistent = bool(same_impacts and regime_ok and within)
     # a regime "mismatch" while the law's own trajectory over the span has not settled is a
-    # transient, judged by the cycle-by-cycle comparison alone
+    # transient, judged by the block-by-block comparison alone
     reg_for_verdict = dict(reg) if settled or reg["simulated"] == reg["measured"] else \
         {**reg, "simulated": reg["measured"]}
     verdict = _verdict(consistent, reg_for_verdict, imp, crit, fl["mean"])
@@ -301,12 +308,12 @@ def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_
         gap = "" if transient is None else f" (I2 {transient:.3g} from its steady orbit)"
         notes.append(f"the record reads {reg['measured']} but is still in a transient under "
                      f"this law: from the measured state its trajectory{gap} {what}; the law "
-                     "is judged against the record's own span, cycle by cycle")
+                     "is judged against the record's own span")
     elif not settled and transient is not None:
         notes.append(f"the record is still in a transient under this law (I2 {transient:.3g} "
-                     "between its trajectory over the span and its steady orbit); judged "
-                     "against the record's own span")
-    if notes:
+                     "between its trajectory over the last cycles and its steady orbit); "
+                     "judged against the record's own span")
+    if notes and verdict is not None:
         verdict = f"{verdict}; {notes[0]}"
     extra.update({"noise_floor_q95": fl["q95"], "notes": notes,
                   "only_I4": bool(same_impacts and regime_ok and not consistent

@@ -40,13 +40,16 @@ class Reference:
     source : str
     span : RecordSpan or None
         With positions recorded: the record's span on the drive's phase and the machine's
-        state before it (:mod:`~discovery.verify.trajectory`); laws are then simulated from
-        that state across the span and compared cycle by cycle.  ``impulse`` is then the
-        span's folded cycle.
+        states (:mod:`~discovery.verify.trajectory`); laws are then simulated from those
+        states across the span and compared block by block.  ``impulse`` is then the last
+        block's folded cycle.
     cycle : Impulse or None
         The record's cycle aligned at each cycle's own onset
         (:func:`~discovery.impulse.impulse_from_samples`), which sets the cycle length and
         the main onset; the comparison itself uses it only without positions.
+    blocks : tuple of Impulse
+        With a span: the measured folded cycle of each of its blocks (the last is
+        ``impulse``).
     """
 
     impulse: object
@@ -59,6 +62,7 @@ class Reference:
     source: str = ""
     span: object = None
     cycle: object = None
+    blocks: tuple = ()
 
     @property
     def regime(self):
@@ -121,18 +125,20 @@ class Reference:
         if zeta is not None:
             noise["zeta"] = estimate_noise(zeta, order=3)
             noise["impact_velocity"] = _impact_velocity(t, zeta, E, T, dt)
-        start, t_start, span, cycle = None, 0.0, None, E
+        start, t_start, span, cycle, blocks = None, 0.0, None, E, ()
         if use_state and zeta is not None:
             span = record_span(measurement, scenario, E, time_offset=time_offset)
             if span is None:
                 start, t_start = measurement.state_at_strobe(T, time_offset)
             else:
-                start, t_start = span.state.y, span.state.t
-                E = span.impulse(span.F, onset_record_time=span.fold.origin - time_offset)
-                noise["n_cycles"] = span.fold.n_cycles
+                last = span.blocks[-1]
+                start, t_start = last.state.y, last.state.t
+                blocks = tuple(span.measured(onset_record_time=E.onset))
+                E = blocks[-1]
+                noise["n_cycles"] = span.n_cycles
         return cls(impulse=E, noise=noise, start=start, start_time=t_start,
                    time_offset=float(time_offset), n_boot=int(n_boot), seed=int(seed),
-                   source=measurement.source, span=span, cycle=cycle)
+                   source=measurement.source, span=span, cycle=cycle, blocks=blocks)
 
 
 def _impact_velocity(t, zeta, E, period, dt):

@@ -26,25 +26,29 @@ from ..impulse import Impulse, estimate_noise
 from .fold import make_fold
 from .state import free_flight_runs, free_flight_state
 
-__all__ = ["RecordSpan", "record_span", "simulated_history", "span_floor"]
+__all__ = ["Block", "RecordSpan", "record_span", "simulated_history", "block_criteria",
+           "span_floor", "BLOCK_CYCLES"]
 
 _MIN_FLIGHT = 0.08  # shortest free flight that gives a state, in drive periods
 
 
+BLOCK_CYCLES = 20
+"""Cycles per block: a long record (a run-up, a drift) is compared block by block, each
+block folded on its own and simulated from the machine's state just before it."""
+
+
 @dataclass(frozen=True)
-class RecordSpan:
-    """The part of a record a simulation is compared with, cycle by cycle.
+class Block:
+    """Consecutive cycles of a record, folded together, with the state before them.
 
     Attributes
     ----------
     fold : Fold
-        The span's samples on one cycle (origin: the record's main onset).
     state : StateEstimate
-        The machine's state where the simulation starts (before the span).
+        The machine's state in the free flight just before the block (the simulation of
+        the block starts there).
     F : ndarray of shape (m,)
         The measured force at the folded samples [N].
-    sigma_f : float
-        Force noise of one sample [N].
     threshold : float
         Contact threshold of the folded cycle [N].
     """
@@ -52,16 +56,70 @@ class RecordSpan:
     fold: object
     state: object
     F: np.ndarray
-    sigma_f: float
     threshold: float
 
-    def impulse(self, values, onset_record_time=None):
-        """A history at the folded samples as a folded :class:`Impulse`."""
-        return self.fold.impulse(values, threshold=self.threshold, noise=self.sigma_f,
-                                 onset_record_time=onset_record_time)
+
+@dataclass(frozen=True)
+class RecordSpan:
+    """The part of a record a simulation is compared with, block by block.
+
+    Attributes
+    ----------
+    blocks : tuple of Block
+        In time order; the last one ends with the record.
+    sigma_f : float
+        Force noise of one sample [N].
+    """
+
+    blocks: tuple
+    sigma_f: float
+
+    @property
+    def state(self):
+        """The state where the first block's simulation starts."""
+        return self.blocks[0].state
+
+    @property
+    def fold(self):
+        """The last block's fold (the record's latest cycles)."""
+        return self.blocks[-1].fold
+
+    @property
+    def n_cycles(self):
+        return int(sum(b.fold.n_cycles for b in self.blocks))
+
+    @property
+    def size(self):
+        return int(sum(b.F.size for b in self.blocks))
+
+    def impulses(self, histories, onset_record_time=None):
+        """Each block's history (a list of arrays, one per block) as its folded
+        :class:`~discovery.impulse.Impulse`."""
+        return [b.fold.impulse(h, threshold=b.threshold, noise=self.sigma_f,
+                               onset_record_time=onset_record_time)
+                for b, h in zip(self.blocks, histories, strict=True)]
+
+    def measured(self, onset_record_time=None):
+        """The measured folded cycle of every block."""
+        return self.impulses([b.F for b in self.blocks], onset_record_time)
 
 
-def record_span(measurement, scenario, cycle, *, time_offset=0.0):
+def _block_ranges(M, size):
+    """``[(first, count), ...]`` of cycles, blocks of ``size`` counted from the end; a first
+    block shorter than half a block joins the next."""
+    out = []
+    hi = M
+    while hi > 0:
+        lo = max(0, hi - size)
+        out.insert(0, (lo, hi - lo))
+        hi = lo
+    if len(out) > 1 and out[0][1] < size / 2:
+        (a, n0), (_, n1) = out[0], out[1]
+        out[:2] = [(a, n0 + n1)]
+    return out
+
+
+def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=BLOCK_CYCLES):
     """The span of a record with positions: from its first usable free flight to its end.
 
     Parameters
@@ -72,6 +130,8 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0):
         The record's cycle from :func:`~discovery.impulse.impulse_from_samples` (its
         length in periods and its main onset give the fold).
     time_offset : float
+    block_cycles : int
+        Cycles per block.
 
     Returns
     -------
@@ -86,58 +146,106 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0):
     T = scenario.period
     zeta = ch["w1"] - ch["w2"]
     runs = free_flight_runs(t, F, zeta, T, min_fraction=_MIN_FLIGHT)
+    if not runs:
+        return None
     td_all = t + time_offset
     W = cycle.duration
-    origin = cycle.onset + time_offset
-    for run in runs:
-        a, b = run
-        t_a = 0.5 * (td_all[a] + td_all[b - 1])
-        fold = make_fold(td_all, origin, cycle.n_periods, T, t_a, td_all[-1])
-        if fold is None:
+    mids = np.array([0.5 * (td_all[a] + td_all[b - 1]) for a, b in runs])
+    whole = make_fold(td_all, cycle.onset + time_offset, cycle.n_periods, T, mids[0],
+                      td_all[-1])
+    if whole is None or whole.n_cycles < max(1, int(0.5 * (td_all[-1] - td_all[0]) / W)):
+        return None  # the first flights are too late to use most of the record
+    sigma = float(estimate_noise(F))
+    blocks = []
+    for first, count in _block_ranges(whole.n_cycles, max(1, int(block_cycles))):
+        o = whole.origin + first * W
+        # the latest free flight that ends before the block starts
+        ok = np.flatnonzero(np.array([td_all[b - 1] for _, b in runs]) <= o)
+        if not ok.size:
             return None
-        if fold.n_cycles < max(1, int(0.5 * (td_all[-1] - td_all[0]) / W)):
-            return None  # the first flights are too late to use most of the record
-        state = free_flight_state(measurement, scenario, run, t_a, time_offset=time_offset)
-        sigma = estimate_noise(F)
+        j = int(ok[-1])
+        fold = make_fold(td_all, o, cycle.n_periods, T, o, o + count * W + 0.5 * (
+            td_all[1] - td_all[0]))
+        state = free_flight_state(measurement, scenario, runs[j], mids[j],
+                                  time_offset=time_offset)
         Fi = F[fold.idx]
         peak = float(np.max(fold.average(Fi)))
         thr = max(5.0 * sigma / np.sqrt(fold.n_cycles), 1e-3 * peak)
-        return RecordSpan(fold=fold, state=state, F=Fi, sigma_f=float(sigma), threshold=thr)
-    return None
+        blocks.append(Block(fold=fold, state=state, F=Fi, threshold=thr))
+    return RecordSpan(blocks=tuple(blocks), sigma_f=sigma)
 
 
-def simulated_history(scenario, law, span, *, tolerances=None, y0=None, observe=None):
-    """The law's force at the span's sample times, simulated from the span's state.
+def simulated_history(scenario, law, span, *, tolerances=None, starts=None, observe=None,
+                      window=True):
+    """The law's force at the span's sample times, each block simulated from its state.
 
     Parameters
     ----------
     scenario, law
     span : RecordSpan
     tolerances : Tolerances, optional
-    y0 : ndarray of shape (4,), optional
-        Another start state (a bootstrap draw); default the measured one.
+    starts : sequence of ndarray of shape (4,), optional
+        Other start states, one per block (a bootstrap draw); default the measured ones.
     observe : callable, optional
-        Observation model ``Impulse -> Impulse`` applied to the simulated history (the span
-        taken as one periodic signal).
+        Observation model ``Impulse -> Impulse`` applied to each block's simulated history
+        (the block taken as one periodic signal).
+    window : bool
+        Each sample is the force averaged over its sample interval (exactly, from the
+        moulding's momentum ``m2 (v2(b) - v2(a)) + m2 g (b - a)``; a scenario that sheds
+        mass uses point values); ``False``: the value at the sample time.  A force jump at
+        the onset then moves through a sample continuously as the law's coefficients
+        change, instead of switching a whole sample from 0 to ``F(0+)`` (which made the
+        output error a staircase in the coefficients); over cycles with different
+        sub-sample phases the mean equals the point samples' mean.
 
     Returns
     -------
-    ndarray of shape (m,)
-        Raises :class:`~discovery.errors.IntegrationError` when the simulation fails.
+    list of ndarray
+        One history per block.  Raises :class:`~discovery.errors.IntegrationError` when a
+        simulation fails.
     """
-    fold, st = span.fold, span.state
-    y0 = st.y if y0 is None else y0
-    tr = simulate(scenario, law, (st.t, fold.end), y0=y0, t_eval=fold.td,
-                  tolerances=tolerances)
-    Fs = np.asarray(tr.force, dtype=float)
-    if observe is not None:
-        L = fold.end - fold.origin
-        tt = np.concatenate([[0.0], fold.td - fold.origin, [L]])
-        FF = np.concatenate([[Fs[-1]], Fs, [Fs[-1]]])
-        imp = Impulse(t=tt, F=FF, duration=L, support=np.zeros((0, 2)),
-                      n_periods=fold.n_periods * fold.n_cycles, onset=fold.origin)
-        Fs = observe(imp).evaluate(fold.td - fold.origin)
-    return Fs
+    out = []
+    for k, blk in enumerate(span.blocks):
+        fold, st = blk.fold, blk.state
+        y0 = st.y if starts is None else starts[k]
+        if window and not getattr(scenario, "mass_loss", 0.0) and fold.td.size > 1:
+            # the force averaged over each sample's interval, exactly, from the moulding's
+            # momentum: int F dt = m2 (v2(b) - v2(a) + g (b - a))
+            td = fold.td
+            mid = 0.5 * (td[1:] + td[:-1])
+            edges = np.concatenate([[td[0] - (mid[0] - td[0])], mid,
+                                    [td[-1] + (td[-1] - mid[-1])]])
+            tr = simulate(scenario, law, (min(st.t, edges[0]), edges[-1]), y0=y0,
+                          t_eval=edges, tolerances=tolerances)
+            v2 = np.asarray(tr.y[3], dtype=float)
+            Fs = scenario.m2 * (np.diff(v2) / np.diff(edges) + scenario.g)
+        else:
+            tr = simulate(scenario, law, (min(st.t, fold.td[0]), fold.end), y0=y0,
+                          t_eval=fold.td, tolerances=tolerances)
+            Fs = np.asarray(tr.force, dtype=float)
+        if observe is not None:
+            L = fold.end - fold.origin
+            tt = np.concatenate([[0.0], fold.td - fold.origin, [L]])
+            FF = np.concatenate([[Fs[-1]], Fs, [Fs[-1]]])
+            imp = Impulse(t=tt, F=FF, duration=L, support=np.zeros((0, 2)),
+                          n_periods=fold.n_periods * fold.n_cycles, onset=fold.origin)
+            Fs = observe(imp).evaluate(fold.td - fold.origin)
+        out.append(Fs)
+    return out
+
+
+def block_criteria(measured, simulated, span, names=None):
+    """Criteria of every block, and their mean weighted by the blocks' cycles.
+
+    Returns
+    -------
+    mean : dict
+    per_block : list of dict
+    """
+    per = [evaluate_criteria(m, s, names) for m, s in zip(measured, simulated, strict=True)]
+    w = np.array([b.fold.n_cycles for b in span.blocks], dtype=float)
+    w = w / w.sum()
+    return {k: float(np.dot(w, [p[k] for p in per])) for k in per[0]}, per
 
 
 def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=None,
@@ -145,9 +253,10 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
     """Noise floor of every criterion if ``law`` were the truth, through the span's own
     processing.
 
-    Each replicate starts the law from a state drawn from the state fit's covariance,
-    adds the record's force noise at the record's sample times, folds, and is compared
-    with ``simulated`` (the folded noise-free history from the measured state).
+    Each replicate starts every block from a state drawn from that block's state-fit
+    covariance, adds the record's force noise at the record's sample times, folds, and is
+    compared block by block with ``simulated`` (the folded noise-free histories from the
+    measured states).
 
     Returns
     -------
@@ -155,27 +264,30 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
         ``{"mean": {I0..I4}, "q95": {I0..I4}, "n_boot": n, "seed": seed}``.
     """
     rng = np.random.default_rng(seed)
-    st = span.state
-    try:
-        L = np.linalg.cholesky(st.cov + 1e-30 * np.eye(4))
-    except np.linalg.LinAlgError:
-        L = np.diag(np.sqrt(np.clip(np.diag(st.cov), 0.0, None)))
+    chol = []
+    for blk in span.blocks:
+        try:
+            chol.append(np.linalg.cholesky(blk.state.cov + 1e-30 * np.eye(4)))
+        except np.linalg.LinAlgError:
+            chol.append(np.diag(np.sqrt(np.clip(np.diag(blk.state.cov), 0.0, None))))
     samples = {n: [] for n in CRITERIA}
     base = None
     for _ in range(n_boot):
-        y0 = st.y + L @ rng.standard_normal(4)
-        noise = rng.normal(0.0, span.sigma_f, span.F.size)
+        starts = [b.state.y + L @ rng.standard_normal(4) for b, L in zip(span.blocks, chol,
+                                                                          strict=True)]
+        noise = [rng.normal(0.0, span.sigma_f, b.F.size) for b in span.blocks]
         try:
-            Fr = simulated_history(scenario, law, span, tolerances=tolerances, y0=y0,
-                                   observe=observe)
-        except IntegrationError:  # a failed draw: the measured state's history instead
+            # the truth as a record holds it: point samples
+            hist = simulated_history(scenario, law, span, tolerances=tolerances,
+                                     starts=starts, observe=observe, window=False)
+        except IntegrationError:  # a failed draw: the measured states' histories instead
             if base is None:
                 base = simulated_history(scenario, law, span, tolerances=tolerances,
-                                         observe=observe)
-            Fr = base
+                                         observe=observe, window=False)
+            hist = base
         try:
-            rep = span.impulse(Fr + noise)
-            crit = evaluate_criteria(rep, simulated)
+            reps = span.impulses([h + e for h, e in zip(hist, noise, strict=True)])
+            crit, _ = block_criteria(reps, simulated, span)
         except InputError:
             continue
         for n, v in crit.items():
