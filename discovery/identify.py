@@ -232,7 +232,7 @@ class _Objective:
             for sc, ref in self.records:
                 self.n += 1
                 ev = evaluate(machine(sc), law, ref, tolerances=self.tol, floor=False,
-                              observe=observe)
+                              observe=observe, smooth_onset=True)
                 evs.append(ev)
                 if ev.status != "ok":
                     self.failures.append({"coefficients": _named(self.law(x)),

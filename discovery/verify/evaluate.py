@@ -150,7 +150,7 @@ def _verdict(consistent, reg, imp, crit, floor):
 
 
 def evaluate(scenario, law, reference, *, tolerances=None, from_state=True, floor=True,
-             observe=None, **steady_kwargs):
+             observe=None, smooth_onset=False, **steady_kwargs):
     """Simulate ``law`` and score it against ``reference`` (see the module docstring).
 
     Parameters
@@ -170,6 +170,12 @@ def evaluate(scenario, law, reference, *, tolerances=None, from_state=True, floo
         An observation model ``Impulse -> Impulse`` applied to the exact simulated force
         history before it is aligned and sampled (e.g. the force sensor's own dynamics,
         :mod:`discovery.explain.effects`).
+    smooth_onset : bool
+        For a record span: the simulated sample whose interval holds a contact onset is
+        the force averaged over that interval (see
+        :func:`~discovery.verify.trajectory.simulated_history`), so the criteria are
+        continuous in the law's coefficients (optimisers: ``identify``); the default
+        compares point samples with the record's point samples (the verdict).
     **steady_kwargs
         Passed to :func:`~discovery.dynamics.steady_state.steady_state`.
 
@@ -179,7 +185,7 @@ def evaluate(scenario, law, reference, *, tolerances=None, from_state=True, floo
     """
     if from_state and getattr(reference, "span", None) is not None:
         return _evaluate_span(scenario, law, reference, tolerances, floor, observe,
-                              steady_kwargs)
+                              steady_kwargs, smooth_onset)
     E = reference.impulse
     reg = {"measured": reference.regime, "simulated": None}
     imp = {"measured": reference.impacts, "simulated": None}
@@ -240,7 +246,8 @@ def _orbit_history(scenario, law, ss, block, tolerances):
     return np.asarray(tr.force, dtype=float)
 
 
-def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_kwargs):
+def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_kwargs,
+                   smooth_onset=False):
     """:func:`evaluate` for a record with positions: the law simulated from the machine's
     states across the record's span, block by block, both histories folded by the same
     operator (:mod:`~discovery.verify.trajectory`); the criteria are the blocks' mean
@@ -251,7 +258,8 @@ def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_
     reg = {"measured": reference.regime, "simulated": None}
     imp = {"measured": reference.impacts, "simulated": None}
     try:
-        hist = simulated_history(scenario, law, span, tolerances=tolerances, observe=observe)
+        hist = simulated_history(scenario, law, span, tolerances=tolerances, observe=observe,
+                                 window=smooth_onset)
     except IntegrationError as exc:
         return Evaluation("failed", reg, imp, {}, {}, False,
                           f"the simulation failed: {exc}", message=str(exc))

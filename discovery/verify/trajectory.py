@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..criteria import CRITERIA, evaluate_criteria
+from ..dynamics import _kernel as _K
 from ..dynamics.simulate import simulate
 from ..errors import InputError, IntegrationError
 from ..impulse import Impulse, estimate_noise
@@ -176,7 +177,7 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
 
 
 def simulated_history(scenario, law, span, *, tolerances=None, starts=None, observe=None,
-                      window=True):
+                      window=False):
     """The law's force at the span's sample times, each block simulated from its state.
 
     Parameters
@@ -190,13 +191,15 @@ def simulated_history(scenario, law, span, *, tolerances=None, starts=None, obse
         Observation model ``Impulse -> Impulse`` applied to each block's simulated history
         (the block taken as one periodic signal).
     window : bool
-        Each sample is the force averaged over its sample interval (exactly, from the
-        moulding's momentum ``m2 (v2(b) - v2(a)) + m2 g (b - a)``; a scenario that sheds
-        mass uses point values); ``False``: the value at the sample time.  A force jump at
-        the onset then moves through a sample continuously as the law's coefficients
-        change, instead of switching a whole sample from 0 to ``F(0+)`` (which made the
-        output error a staircase in the coefficients); over cycles with different
-        sub-sample phases the mean equals the point samples' mean.
+        A sample whose interval holds a contact onset is the force averaged over that
+        interval (exactly, from the moulding's momentum ``m2 (v2(b) - v2(a)) + m2 g (b -
+        a)``; a scenario that sheds mass uses point values), every other sample the
+        force at its time (for optimisers); ``False`` (default): point values, like the
+        record's.  A force jump at the onset
+        then moves through its sample continuously as the law's coefficients change,
+        instead of switching a whole sample from 0 to ``F(0+)`` (which made the output
+        error a staircase in the coefficients); over cycles with different sub-sample
+        phases the mean equals the point samples' mean.
 
     Returns
     -------
@@ -208,20 +211,29 @@ def simulated_history(scenario, law, span, *, tolerances=None, starts=None, obse
     for k, blk in enumerate(span.blocks):
         fold, st = blk.fold, blk.state
         y0 = st.y if starts is None else starts[k]
-        if window and not getattr(scenario, "mass_loss", 0.0) and fold.td.size > 1:
-            # the force averaged over each sample's interval, exactly, from the moulding's
-            # momentum: int F dt = m2 (v2(b) - v2(a) + g (b - a))
-            td = fold.td
+        td = fold.td
+        if window and not getattr(scenario, "mass_loss", 0.0) and td.size > 1:
+            # each sample's interval; the samples whose interval holds a contact onset get
+            # the force averaged over it, exactly, from the moulding's momentum
+            # (int F dt = m2 (v2(b) - v2(a) + g (b - a))), the others their point value
             mid = 0.5 * (td[1:] + td[:-1])
             edges = np.concatenate([[td[0] - (mid[0] - td[0])], mid,
                                     [td[-1] + (td[-1] - mid[-1])]])
+            te = np.empty(2 * td.size + 1)
+            te[0::2], te[1::2] = edges, td
             tr = simulate(scenario, law, (min(st.t, edges[0]), edges[-1]), y0=y0,
-                          t_eval=edges, tolerances=tolerances)
-            v2 = np.asarray(tr.y[3], dtype=float)
-            Fs = scenario.m2 * (np.diff(v2) / np.diff(edges) + scenario.g)
+                          t_eval=te, tolerances=tolerances)
+            Fs = np.asarray(tr.force[1::2], dtype=float)
+            on = tr.event_t[tr.event_kind == _K.EV_ONSET]
+            k = np.unique(np.searchsorted(edges, on, "right") - 1)
+            k = k[(k >= 0) & (k < td.size)]
+            if k.size:
+                v2 = np.asarray(tr.y[3][0::2], dtype=float)
+                Fs[k] = scenario.m2 * ((v2[k + 1] - v2[k]) / (edges[k + 1] - edges[k])
+                                       + scenario.g)
         else:
-            tr = simulate(scenario, law, (min(st.t, fold.td[0]), fold.end), y0=y0,
-                          t_eval=fold.td, tolerances=tolerances)
+            tr = simulate(scenario, law, (min(st.t, td[0]), fold.end), y0=y0, t_eval=td,
+                          tolerances=tolerances)
             Fs = np.asarray(tr.force, dtype=float)
         if observe is not None:
             L = fold.end - fold.origin
@@ -279,11 +291,11 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
         try:
             # the truth as a record holds it: point samples
             hist = simulated_history(scenario, law, span, tolerances=tolerances,
-                                     starts=starts, observe=observe, window=False)
+                                     starts=starts, observe=observe)
         except IntegrationError:  # a failed draw: the measured states' histories instead
             if base is None:
                 base = simulated_history(scenario, law, span, tolerances=tolerances,
-                                         observe=observe, window=False)
+                                         observe=observe)
             hist = base
         try:
             reps = span.impulses([h + e for h, e in zip(hist, noise, strict=True)])
