@@ -191,15 +191,14 @@ def simulated_history(scenario, law, span, *, tolerances=None, starts=None, obse
         Observation model ``Impulse -> Impulse`` applied to each block's simulated history
         (the block taken as one periodic signal).
     window : bool
-        A sample whose interval holds a contact onset is the force averaged over that
-        interval (exactly, from the moulding's momentum ``m2 (v2(b) - v2(a)) + m2 g (b -
-        a)``; a scenario that sheds mass uses point values), every other sample the
-        force at its time (for optimisers); ``False`` (default): point values, like the
-        record's.  A force jump at the onset
-        then moves through its sample continuously as the law's coefficients change,
-        instead of switching a whole sample from 0 to ``F(0+)`` (which made the output
-        error a staircase in the coefficients); over cycles with different sub-sample
-        phases the mean equals the point samples' mean.
+        For optimisers: a sample whose interval holds a contact onset at fraction ``u`` is
+        blended towards the record's value with weight ``|2u - 1|`` (whole at the
+        interval's ends, nothing where the onset crosses the sample time).  With point
+        values (``False``, the default, like the record's) a force jump at the onset
+        switches a whole sample from 0 to ``F(0+)`` as the law's coefficients change, and
+        the output error is a staircase in the coefficients; blended, it is continuous,
+        and at the truth the blended residual is still the record's noise (no bias, also
+        when the sampling is a multiple of the drive frequency).
 
     Returns
     -------
@@ -212,29 +211,26 @@ def simulated_history(scenario, law, span, *, tolerances=None, starts=None, obse
         fold, st = blk.fold, blk.state
         y0 = st.y if starts is None else starts[k]
         td = fold.td
-        if window and not getattr(scenario, "mass_loss", 0.0) and td.size > 1:
-            # each sample's interval; the samples whose interval holds a contact onset get
-            # the force averaged over it, exactly, from the moulding's momentum
-            # (int F dt = m2 (v2(b) - v2(a) + g (b - a))), the others their point value
+        tr = simulate(scenario, law, (min(st.t, td[0]), fold.end), y0=y0, t_eval=td,
+                      tolerances=tolerances)
+        Fs = np.asarray(tr.force, dtype=float)
+        if window and td.size > 1:
+            # the sample whose interval [e_i, e_i+1) holds a contact onset at fraction u is
+            # blended towards the record's value with weight |2u - 1|: its residual is 0
+            # when the onset crosses the sample time (where the point value jumps) and
+            # whole at the interval's ends, so the residual is continuous in the law's
+            # coefficients and unbiased (at the truth it is the record's noise, weighted)
             mid = 0.5 * (td[1:] + td[:-1])
             edges = np.concatenate([[td[0] - (mid[0] - td[0])], mid,
                                     [td[-1] + (td[-1] - mid[-1])]])
-            te = np.empty(2 * td.size + 1)
-            te[0::2], te[1::2] = edges, td
-            tr = simulate(scenario, law, (min(st.t, edges[0]), edges[-1]), y0=y0,
-                          t_eval=te, tolerances=tolerances)
-            Fs = np.asarray(tr.force[1::2], dtype=float)
             on = tr.event_t[tr.event_kind == _K.EV_ONSET]
-            k = np.unique(np.searchsorted(edges, on, "right") - 1)
-            k = k[(k >= 0) & (k < td.size)]
+            k = np.searchsorted(edges, on, "right") - 1
+            keep = (k >= 0) & (k < td.size)
+            k, on = k[keep], on[keep]
             if k.size:
-                v2 = np.asarray(tr.y[3][0::2], dtype=float)
-                Fs[k] = scenario.m2 * ((v2[k + 1] - v2[k]) / (edges[k + 1] - edges[k])
-                                       + scenario.g)
-        else:
-            tr = simulate(scenario, law, (min(st.t, td[0]), fold.end), y0=y0, t_eval=td,
-                          tolerances=tolerances)
-            Fs = np.asarray(tr.force, dtype=float)
+                u = (on - edges[k]) / (edges[k + 1] - edges[k])
+                w = np.abs(2.0 * u - 1.0)
+                Fs[k] = blk.F[k] + w * (Fs[k] - blk.F[k])
         if observe is not None:
             L = fold.end - fold.origin
             tt = np.concatenate([[0.0], fold.td - fold.origin, [L]])
