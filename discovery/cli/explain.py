@@ -64,6 +64,11 @@ def run(args):
         print(criteria_line(res.criteria, res.noise_floor))
     print(f"  {'consistent' if res.consistent else 'not consistent'} with the record(s); "
           f"stopped because {res.stopped_because}")
+    for s in res.separability:
+        how = s.get("note") or (f"{s['criterion']} {s['before']:.3g} -> {s['after']:.3g} "
+                                f"refitted with it, noise floor {s['floor']:.3g}")
+        print(f"  {s['effect']}: {'separable' if s['separable'] else 'not separable'} by this "
+              f"record ({how})")
     print(f"outputs in {args.out}/: summary.json" + "".join(f", {f}" for f in files))
     return 0
 
