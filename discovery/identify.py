@@ -328,7 +328,7 @@ def _uncertainty(obj, x, names):
 
 def identify(scenario, reference, start, *, criterion="I2", method="coordinate-descent",
              xtol=1e-5, max_simulations=600, tolerances=None, uncertainty=True,
-             observe=None):
+             observe=None, short_first=True):
     """Identify the coefficients of ``start`` from one or several records by simulation.
 
     Parameters
@@ -357,6 +357,11 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
         Estimate standard errors (one more simulation per coefficient and record).
     observe : callable, optional
         Observation model of the simulated force (see :func:`discovery.verify.evaluate`).
+    short_first : bool
+        With record spans compared in blocks of several cycles: first fit the records
+        cycle by cycle (:meth:`~discovery.verify.Reference.shortened`, up to half the
+        budget), where a law's timing error cannot accumulate and the basin is wider, then
+        go on from there on the blocks (continuation in block length).
 
     Returns
     -------
@@ -381,7 +386,31 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
         raise InputError(f"the simulation budget must be an integer of at least "
                          f"{2 * len(records)} (two per record); got {max_simulations!r}")
     t0 = time.perf_counter()
-    obj = _Objective(records, start, criterion, tolerances, int(max_simulations), observe)
+    spent = 0
+    short = [r.shortened() if isinstance(r, Reference) else None for _, r in records]
+    if short_first and method == "least-squares" and all(r is not None for r in short) \
+            and max_simulations >= 8 * len(records):
+        try:
+            first = identify([sc for sc, _ in records], short, start, criterion=criterion,
+                             method=method, xtol=xtol, max_simulations=max_simulations // 2,
+                             tolerances=tolerances, uncertainty=False, observe=observe,
+                             short_first=False)
+            spent = first.n_simulations
+            if not any(c == 0 for c in first.law.coefficients):
+                start0, start = start, first.law
+                # keep the caller's start when it already matches the blocks better
+                probe = _Objective(records, start0, criterion, tolerances, 10**9, observe)
+                alt = _Objective(records, start, criterion, tolerances, 10**9, observe)
+                x1 = np.ones(len(start.coefficients))
+                v0, v1 = probe(x1), alt(x1)
+                spent += probe.n + alt.n
+                if not v1 <= v0:
+                    start = start0
+        except IntegrationError:
+            pass
+    obj = _Objective(records, start, criterion, tolerances,
+                     max(int(max_simulations) - spent, 2 * len(records)), observe)
+    obj.n = 0
     x0 = np.ones(len(start.coefficients))
     if obj.evaluations(x0) is None:
         f = obj.failures[-1]
@@ -420,6 +449,6 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
                     "contact (see failures)")
     return IdentificationResult(
         law=law, criterion=criterion, value=value, criteria=crit, method=method,
-        n_simulations=obj.n, evaluations=tuple(evs), iterations=obj.path,
+        n_simulations=obj.n + spent, evaluations=tuple(evs), iterations=obj.path,
         standard_errors=se, correlation=corr, failures=obj.failures,
         seconds=time.perf_counter() - t0, message=message)

@@ -10,7 +10,7 @@ from ..criteria import CRITERIA
 from ..errors import InputError
 from ..impulse import estimate_noise
 from .noise_floor import noise_floor
-from .trajectory import record_span, span_floor
+from .trajectory import BLOCK_CYCLES, record_span, span_floor
 
 __all__ = ["Reference"]
 
@@ -63,6 +63,7 @@ class Reference:
     span: object = None
     cycle: object = None
     blocks: tuple = ()
+    _source: object = field(default=None, repr=False, compare=False)
 
     @property
     def regime(self):
@@ -72,6 +73,23 @@ class Reference:
     def impacts(self):
         """Contacts per measured cycle (above the noise threshold)."""
         return int(len(self.impulse.support))
+
+    def shortened(self):
+        """The same record compared cycle by cycle: blocks of one cycle, each simulated
+        from the state just before it (``None`` without a record span, or when the blocks
+        are one cycle already).  An optimiser far from the answer starts here: a law's
+        timing error cannot accumulate over a block, so the output error's basin is wider
+        (multiple shooting)."""
+        if self.span is None or self._source is None or all(
+                b.fold.n_cycles == 1 for b in self.span.blocks):
+            return None
+        cache = self.__dict__.setdefault("_shortened", {})
+        if "ref" not in cache:
+            m, sc = self._source
+            cache["ref"] = Reference.from_measurement(
+                m, sc, time_offset=self.time_offset, n_boot=self.n_boot, seed=self.seed,
+                block_cycles=1)
+        return cache["ref"]
 
     def floor_for(self, stand_in, *, scenario=None, law=None, tolerances=None, observe=None):
         """Noise floor of every criterion if ``stand_in`` (an exact impulse aligned with
@@ -97,7 +115,7 @@ class Reference:
 
     @classmethod
     def from_measurement(cls, measurement, scenario, *, time_offset=0.0, n_boot=16, seed=0,
-                         use_state=True):
+                         use_state=True, block_cycles=BLOCK_CYCLES):
         """Prepare a record: steady cycle, noise model, measured state.
 
         Parameters
@@ -112,6 +130,8 @@ class Reference:
             Seed of the bootstrap.
         use_state : bool
             Start simulations from the measured state when ``w1, w2`` are recorded.
+        block_cycles : int
+            Cycles per compared block of a record span.
         """
         if not np.isfinite(time_offset):
             raise InputError(f"time offset must be finite, got {time_offset!r}")
@@ -127,7 +147,8 @@ class Reference:
             noise["impact_velocity"] = _impact_velocity(t, zeta, E, T, dt)
         start, t_start, span, cycle, blocks = None, 0.0, None, E, ()
         if use_state and zeta is not None:
-            span = record_span(measurement, scenario, E, time_offset=time_offset)
+            span = record_span(measurement, scenario, E, time_offset=time_offset,
+                               block_cycles=block_cycles)
             if span is None:
                 start, t_start = measurement.state_at_strobe(T, time_offset)
             else:
@@ -138,7 +159,8 @@ class Reference:
                 noise["n_cycles"] = span.n_cycles
         return cls(impulse=E, noise=noise, start=start, start_time=t_start,
                    time_offset=float(time_offset), n_boot=int(n_boot), seed=int(seed),
-                   source=measurement.source, span=span, cycle=cycle, blocks=blocks)
+                   source=measurement.source, span=span, cycle=cycle, blocks=blocks,
+                   _source=(measurement, scenario))
 
 
 def _impact_velocity(t, zeta, E, period, dt):
