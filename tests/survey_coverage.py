@@ -6,8 +6,8 @@ machine and seed a record is made by the independent scipy path from rest
 frequency, force noise 2 % of the peak, motion noise 0.2 % of each channel's range), the
 true support is identified by output error (:func:`discovery.identify`) from a start
 20 % off the truth (each coefficient up or down at random), verified
-(:func:`discovery.verify.evaluate`), and every coefficient's interval (``identify``'s standard errors,
-+-1.96 SE) is checked against the truth.  One JSON line per record; ``--summary`` prints
+(:func:`discovery.verify.evaluate`), and every coefficient's interval (``identify``'s
+standard errors, +-1.96 SE) is checked against the truth.  One JSON line per record; ``--summary`` prints
 the coverage per machine and term.
 """
 
