@@ -7,7 +7,8 @@ frequency, force noise 2 % of the peak, motion noise 0.2 % of each channel's ran
 true support is identified by output error (:func:`discovery.identify`) from a start
 20 % off the truth (each coefficient up or down at random), verified
 (:func:`discovery.verify.evaluate`), and every coefficient's interval (``identify``'s
-standard errors, +-1.96 SE) is checked against the truth.  One JSON line per record; ``--summary`` prints
+standard errors, +-1.96 SE) is checked against the truth.  One JSON line per record;
+``--summary`` prints
 the coverage per machine and term.
 """
 
