@@ -135,7 +135,7 @@ def test_rank_nonperiodic_last_even_with_best_bic():
     models = [_model("z", -100.0, None, "nonperiodic"),
               _model("zd", 10.0, 0.5),
               _model("z*zd", 0.0, 0.05)]
-    assert _names(rank(models)) == ["z*zd", "zd", "z"]
+    assert _names(rank(models, physics=False)) == ["z*zd", "zd", "z"]
 
 
 def test_rank_tier_by_bic_then_criterion():
@@ -144,7 +144,7 @@ def test_rank_tier_by_bic_then_criterion():
               _model("z*zd", -50.0, 0.200),  # outside: after the tier despite best BIC
               _model("zd^2", -60.0, 0.150),  # outside, smaller I2 than z*zd
               _model("z^2", -70.0, None, "no-contact")]
-    assert _names(rank(models)) == ["zd", "z", "zd^2", "z*zd", "z^2"]
+    assert _names(rank(models, physics=False)) == ["zd", "z", "zd^2", "z*zd", "z^2"]
 
 
 def test_rank_consistent_models_first_fewest_terms_then_criterion():
@@ -155,34 +155,34 @@ def test_rank_consistent_models_first_fewest_terms_then_criterion():
               _model("z*zd", 2.0, 0.020, consistent=True),  # consistent, smaller I2
               two,
               _model("zd^2", -60.0, 0.5)]
-    assert _names(rank(models)) == ["z*zd", "zd", "z", "z", "zd^2"]
-    assert rank(models)[2] is two
+    assert _names(rank(models, physics=False)) == ["z*zd", "zd", "z", "z", "zd^2"]
+    assert rank(models, physics=False)[2] is two
 
 
 def test_rank_absolute_tolerance_for_small_criteria():
     # best 1e-3: 10 % would be 1.1e-3, but the absolute 5e-3 makes 5.5e-3 equivalent
     models = [_model("z", 3.0, 0.001), _model("zd", 2.0, 0.0055), _model("z*zd", 1.0, 0.0061)]
-    assert _names(rank(models)) == ["zd", "z", "z*zd"]
+    assert _names(rank(models, physics=False)) == ["zd", "z", "z*zd"]
     assert _names(rank(models, sim_atol=0.0)) == ["z", "zd", "z*zd"]
 
 
 def test_rank_without_any_periodic_model_orders_by_bic():
     models = [_model("z", 2.0, None, "nonperiodic"), _model("zd", 1.0, None, "P2-no-contact")]
-    assert _names(rank(models)) == ["zd", "z"]
+    assert _names(rank(models, physics=False)) == ["zd", "z"]
 
 
 def test_rank_uses_the_requested_criterion():
     a, b = _model("z", 1.0, 0.1), _model("zd", 2.0, 0.1)
     a = RankedModel(a.law, a.candidate, (dataclasses.replace(
         a.evaluation, criteria={**a.criteria, "I3": 0.9}),))
-    assert _names(rank([a, b], criterion="I3")) == ["zd", "z"]
-    assert _names(rank([a, b], criterion="I2")) == ["z", "zd"]
+    assert _names(rank([a, b], criterion="I3", physics=False)) == ["zd", "z"]
+    assert _names(rank([a, b], criterion="I2", physics=False)) == ["z", "zd"]
 
 
 def test_rank_keeps_every_model():
     models = [_model(n, float(i), None if i % 3 == 0 else 0.1 * i)
               for i, n in enumerate(["z", "zd", "z^2", "z*zd", "zd^2", "z^3"])]
-    out = rank(models)
+    out = rank(models, physics=False)
     assert sorted(_names(out)) == sorted(_names(models)) and len(out) == len(models)
     assert all(not math.isnan(m.candidate.bic) for m in out)
 
@@ -255,3 +255,20 @@ def test_impact_count_that_does_not_fit_the_regime_is_a_warning(paper):
     split = dataclasses.replace(s, impact=np.arange(len(s)) // 20)  # contacts split apart
     (w,) = _impact_warnings([(paper, m)], [split], [(paper, ref)])
     assert f"gives {split.n_impacts} impacts" in w and "hold about 30" in w
+
+
+def test_rank_puts_laws_that_are_no_contact_laws_last():
+    """A law without a spring (F(zeta, 0) = 0) or with a negative damper can match a noisy
+    record as well as the truth; it is ranked after every contact law, with its reasons."""
+    spring = _model("z", 5.0, 0.030)
+    spring = RankedModel(ForceLaw.parse("1*z + 1*zd"), spring.candidate, spring.evaluations)
+    damper = _model("zd", -9.0, 0.010, consistent=True)             # consistent, no spring
+    neg = RankedModel(ForceLaw.parse("1*z - 1*zd^2"), damper.candidate, damper.evaluations)
+    ranked = rank([damper, neg, spring])
+    assert ranked[0] is spring
+    assert set(map(id, ranked[1:])) == {id(damper), id(neg)}
+    assert damper.defects and "no spring" in damper.defects[0]
+    assert any("zd^2" in d for d in neg.defects)
+    assert not spring.defects
+    # asked for, the records alone decide
+    assert rank([damper, neg, spring], physics=False)[0] is damper

@@ -172,7 +172,12 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
         Fi = F[fold.idx]
         peak = float(np.max(fold.average(Fi)))
         thr = max(5.0 * sigma / np.sqrt(fold.n_cycles), 1e-3 * peak)
-        blocks.append(Block(fold=fold, state=state, F=Fi, threshold=thr))
+        blk = Block(fold=fold, state=state, F=Fi, threshold=thr)
+        if not len(fold.impulse(Fi, threshold=thr, noise=sigma).support):
+            continue  # no contact in these cycles (a run-up's start): nothing to compare
+        blocks.append(blk)
+    if not blocks:
+        return None
     return RecordSpan(blocks=tuple(blocks), sigma_f=sigma)
 
 
