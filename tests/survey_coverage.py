@@ -87,7 +87,7 @@ def main(argv=None):
     a = p.parse_args(argv)
     if a.summary:
         with open(a.summary) as fh:
-            summary([json.loads(line) for line in fh if line.strip()])
+            summary([json.loads(line) for line in fh if line.startswith("{")])
         return 0
     rows = []
     for m in a.machines.split(","):

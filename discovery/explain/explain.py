@@ -58,7 +58,7 @@ from ..identify import (
     record_start,
 )
 from ..law import ForceLaw, Term
-from ..verify import consistency_limits, evaluate
+from ..verify import evaluate
 from . import drift as D
 from .effects import EFFECTS, Model, effect, small_step
 from .localise import localise
@@ -393,7 +393,7 @@ def _within_noise(evs, criterion):
         if e.status != "ok" or e.regime["simulated"] != e.regime["measured"] \
                 or e.impacts["simulated"] != e.impacts["measured"] or not e.noise_floor:
             return False
-        lim = consistency_limits(e.noise_floor)
+        lim = e.limits
         if criterion not in lim or not e.criteria[criterion] <= lim[criterion]:
             return False
     return True
@@ -403,7 +403,7 @@ def _failing(evs):
     """The criteria beyond their consistency limit in any record."""
     out = []
     for e in evs:
-        lim = consistency_limits(e.noise_floor) if e.noise_floor else {}
+        lim = e.limits
         out += [k for k in lim if e.criteria.get(k, 0.0) > lim[k] and k not in out]
     return out or ["the comparison"]
 

@@ -89,4 +89,6 @@ def noise_floor(reference_impulse, period, dt, *, sigma_f, n_cycles, sigma_zeta=
                 "q95": {n: float("inf") for n in CRITERIA}, "n_boot": 0, "seed": seed}
     return {"mean": {n: float(np.mean(v)) for n, v in samples.items()},
             "q95": {n: float(np.quantile(v, 0.95)) for n, v in samples.items()},
+            "sd": {n: float(np.std(v, ddof=1)) if len(v) > 1 else 0.0
+                   for n, v in samples.items()},
             "n_boot": len(samples["I2"]), "seed": seed}

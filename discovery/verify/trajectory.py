@@ -307,7 +307,9 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
             samples[n].append(v)
     if not samples["I2"]:
         inf = {n: float("inf") for n in CRITERIA}
-        return {"mean": inf, "q95": dict(inf), "n_boot": 0, "seed": seed}
+        return {"mean": inf, "q95": dict(inf), "sd": dict(inf), "n_boot": 0, "seed": seed}
     return {"mean": {n: float(np.mean(v)) for n, v in samples.items()},
             "q95": {n: float(np.quantile(v, 0.95)) for n, v in samples.items()},
+            "sd": {n: float(np.std(v, ddof=1)) if len(v) > 1 else 0.0
+                   for n, v in samples.items()},
             "n_boot": len(samples["I2"]), "seed": seed}
