@@ -154,7 +154,7 @@ class _FixedFloor(Reference):
 
     fixed_floor: dict | None = None
 
-    def floor_for(self, stand_in):
+    def floor_for(self, stand_in, **kwargs):
         return self.fixed_floor
 
 

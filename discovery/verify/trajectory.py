@@ -33,6 +33,10 @@ __all__ = ["Block", "RecordSpan", "record_span", "simulated_history", "block_cri
 _MIN_FLIGHT = 0.08  # shortest free flight that gives a state, in drive periods
 
 
+SINK_FACTOR = 10.0
+"""A simulated penetration beyond this many motion scales (:meth:`Scenario.scales`) is no
+contact any more: the law lets the moulding sink into the frame."""
+
 BLOCK_CYCLES = 20
 """Cycles per block: a long record (a run-up, a drift) is compared block by block, each
 block folded on its own and simulated from the machine's state just before it."""
@@ -218,6 +222,12 @@ def simulated_history(scenario, law, span, *, tolerances=None, starts=None, obse
         td = fold.td
         tr = simulate(scenario, law, (min(st.t, td[0]), fold.end), y0=y0, t_eval=td,
                       tolerances=tolerances)
+        zmax = float(np.max(tr.y[0] - tr.y[2]))
+        if zmax > SINK_FACTOR * scenario.scales()[0]:
+            raise IntegrationError(
+                f"under law '{law}' the moulding sinks into the frame (penetration "
+                f"{zmax:.3g} m, over {SINK_FACTOR:g} times the drive's motion scale): the law "
+                "is far too soft for the record")
         Fs = np.asarray(tr.force, dtype=float)
         if window and td.size > 1:
             # the sample whose interval [e_i, e_i+1) holds a contact onset at fraction u is
