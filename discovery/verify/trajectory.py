@@ -37,7 +37,7 @@ SINK_FACTOR = 10.0
 """A simulated penetration beyond this many motion scales (:meth:`Scenario.scales`) is no
 contact any more: the law lets the moulding sink into the frame."""
 
-BLOCK_CYCLES = 20
+BLOCK_CYCLES = 4
 """Cycles per block: a long record (a run-up, a drift) is compared block by block, each
 block folded on its own and simulated from the machine's state just before it."""
 
