@@ -181,9 +181,10 @@ class ExplainResult:
 
 
 def _polish_start(records, fit, criterion, budget, tol):
-    """The cycle-by-cycle start refined on the records' blocks, kept only when it keeps
-    the measured number of contacts in every record (a refit that reaches another contact
-    pattern has left the start's basin) and lowers the criterion."""
+    """The cycle-by-cycle start refined on the records' blocks, kept only as a local
+    refinement: every coefficient within 3 standard errors of the cycle-by-cycle fit, the
+    measured number of contacts kept in every record, and the criterion lowered (a refit
+    that trades the spring for the restitution has left the start's basin)."""
     scs, refs = [s for s, _ in records], [r for _, r in records]
     try:
         res = identify(scs, refs, fit.law, criterion=criterion, method="least-squares",
@@ -193,7 +194,10 @@ def _polish_start(records, fit, criterion, budget, tol):
     same = all(e.impacts["simulated"] == e.impacts["measured"] for e in res.evaluations)
     base = [evaluate(sc, fit.law, ref, tolerances=tol, floor=False) for sc, ref in records]
     v0 = float(np.mean([e.criteria.get(criterion, np.inf) for e in base]))
-    return res if same and res.value <= v0 else fit
+    se = fit.standard_errors
+    near = all(abs(b - a) <= 3.0 * se.get(n, 0.0) for n, a, b in
+               zip(fit.law.names, fit.law.coefficients, res.law.coefficients, strict=True))
+    return res if same and near and res.value <= v0 else fit
 
 
 def _separability(problem, records, model, catalogue, criterion, before, floor, budget, tol):
@@ -735,7 +739,7 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         if cycle_ok and _drift_free(drift, model, records, alpha / max(len(catalogue), 1)):
             stopped = ("the model is consistent with the record(s): I2 and I4 within their "
                        "noise floors, no drift across the impacts, nothing left to explain")
-            if not iterations:
+            if not any(it.effect for it in iterations):
                 separability = _separability(problem, records, model, catalogue, criterion,
                                              before,
                                              floor, max(budget // 3, 12), tolerances)
@@ -832,7 +836,35 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
                              f"outside its physical bounds [{lo:g}, {hi:g}]")
             s["gap"] = key
             trials.append((after[key] / max(before[key], 1e-300), s, m2, res, evs2, key))
-        good = [x for x in trials if x[0] <= 0.9 and x[1]["repulsive"] and x[1]["in_bounds"]]
+        # the baseline: the law refitted alone, with the same budget; an effect is named
+        # only when its refit beats that by the noise floor (else the gap was the start's
+        # own misfit, and the effect only carried a refit of the law)
+        null_after, null = None, None
+        try:
+            null = _output_error(records, model, criterion, screen, tolerances)
+            null_evs = problem.evaluations(null.law, floor=True)
+            null_after, _ = _with_drift(_mean(null_evs, "criteria"), {}, drift, null.law)
+        except IntegrationError:
+            null = None
+        for x in trials:
+            k = x[5]
+            x[1]["beats_law_refit"] = bool(not null_after or k not in null_after or
+                                           x[1]["criteria_after"][k]
+                                           <= null_after[k] - floor.get(k, 0.0))
+        good = [x for x in trials if x[0] <= 0.9 and x[1]["repulsive"] and x[1]["in_bounds"]
+                and x[1]["beats_law_refit"]]
+        if not good and null_after and criterion in null_after \
+                and null_after[criterion] <= 0.9 * before[criterion]:
+            iterations.append(Iteration(model, null.law, before, null_after, floor, loc, scores,
+                                        None, f"no effect beats the law refitted alone ("
+                                        f"{criterion} {before[criterion]:.3g} -> "
+                                        f"{null_after[criterion]:.3g}) by its noise floor: the "
+                                        "law is refitted, nothing is named", [],
+                                        evs[0].simulated, null_evs[0].simulated,
+                                        records[0][1].impulse))
+            model = null.law
+            uncertainties = dict(null.standard_errors)
+            continue
         if not good:
             iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
                                         "no refit of a significant effect (or of one without a "
