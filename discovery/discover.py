@@ -41,6 +41,7 @@ from constraints import require as require_certificate
 from .criteria import criterion as _criterion
 from .errors import InputError, IntegrationError, VidiError
 from .identify import identify, pair_records, record_start
+from .intervals import bootstrap_intervals
 from .law import Term
 from .library import Library
 from .regression import ConstrainedSparseRegressor
@@ -74,6 +75,9 @@ class RankedModel:
         What happened to the refinement (kept, or why not).
     certificate : constraints.Certificate or None
         Of ``law`` on the box of the samples it was fitted to.
+    intervals : Intervals or None
+        Bootstrap intervals of the coefficients through the full processing
+        (:func:`discovery.intervals.bootstrap_intervals`; the selected model only).
     """
 
     law: object
@@ -82,6 +86,7 @@ class RankedModel:
     refinement: object = None
     note: str = ""
     certificate: object = None
+    intervals: object = None
 
     @property
     def evaluation(self):
@@ -137,8 +142,12 @@ class RankedModel:
 
     def as_dict(self):
         ev = self.evaluation
+        iv = self.intervals
         d = {"terms": list(self.law.names), "coefficients": self.law.as_dict(),
              "standard_errors": self.standard_errors,
+             "intervals": {} if iv is None else {k: list(v) for k, v in iv.bounds.items()},
+             "interval_method": None if iv is None else iv.method,
+             "interval_level": None if iv is None else iv.level,
              "regression_coefficients": self.candidate.extra.get(
                  "regression_coefficients", self.candidate.coefficients),
              "latex": self.law.latex(), "regime": self.regime, "status": ev.status,
@@ -586,7 +595,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
              max_terms=4, criterion="I2", shortlist=8, refine=True, stability=0,
              derivative=None, average_cycles=False, sim_rtol=0.1, sim_atol=0.005,
              tolerances=None, random_state=0, n_boot=16, max_simulations=_REFINE_BUDGET,
-             stepwise=3, physics=True, require=(), **estimator_kwargs):
+             stepwise=3, physics=True, require=(), n_boot_intervals=30, **estimator_kwargs):
     """Discover a contact law from one or several records and check it by simulation.
 
     Parameters
@@ -634,6 +643,11 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     require : sequence of str
         Library terms every candidate must contain (e.g. ``("z",)``: a spring): supports
         without them are not simulated, and the backward step never drops them.
+    n_boot_intervals : int
+        Bootstrap replicates of the selected model's 95 % coefficient intervals through the
+        full processing (:func:`discovery.intervals.bootstrap_intervals`; records with
+        positions, refined models; 0 = none).  The Jacobian standard errors assume white
+        residuals and miss the noise of the estimated machine states.
     **estimator_kwargs
         Further estimator parameters (``margin``, ``monotone``, ``signs``, ...).
 
@@ -708,6 +722,15 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         if ranking[0] is top:
             break
     selected = ranking[0]
+    if n_boot_intervals and refine and selected.refinement is not None \
+            and selected.note.startswith("refined"):
+        iv = bootstrap_intervals([sc for sc, _ in refs], [r for _, r in refs], selected.law,
+                                 n_boot=int(n_boot_intervals), seed=random_state,
+                                 criterion=criterion, tolerances=tolerances)
+        if iv is not None:
+            chosen = replace(selected, intervals=iv)
+            ranking = [chosen if m is selected else m for m in ranking]
+            selected = chosen
     # the certificate of the law actually selected (the ranking may prefer another
     # candidate than the estimator's best by BIC); a failure is an error
     cert = require_certificate(selected.certificate)
@@ -726,6 +749,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
                 "derivative": samples.derivative, "average_cycles": average_cycles,
                 "random_state": random_state, "n_boot": n_boot, "records": len(pairs),
                 "stepwise": stepwise, "steps": steps, "physics": physics,
+                "n_boot_intervals": n_boot_intervals,
                 "require": sorted(required),
                 "ranking_rule": {"sim_rtol": sim_rtol, "sim_atol": sim_atol},
                 "estimator": est.get_params()}

@@ -201,7 +201,18 @@ def criteria_line(criteria, floor):
         f"{k} {v:.3g} ({floor.get(k, float('nan')):.2g})" for k, v in criteria.items())
 
 
-def coefficients_line(coefficients, errors):
-    """``  coefficients (standard error): z c (se), ...`` for the command's printout."""
-    return "  coefficients (standard error): " + ", ".join(
+def coefficients_line(coefficients, errors, intervals=None):
+    """``  coefficients (standard error): z c (se), ...`` for the command's printout, and
+    with ``intervals`` (:class:`discovery.intervals.Intervals`) a second line with them and
+    what the standard errors do not cover."""
+    line = "  coefficients (standard error): " + ", ".join(
         f"{t} {c:.4g} ({errors.get(t, float('nan')):.2g})" for t, c in coefficients.items())
+    if intervals is None:
+        if errors:
+            line += ("\n  (Jacobian standard errors: they assume white residuals and miss the "
+                     "noise of the estimated machine states)")
+        return line
+    b = intervals.bounds
+    return line + (f"\n  {intervals.level:.0%} intervals ({intervals.method}, "
+                   f"{intervals.n_boot} replicates): " + ", ".join(
+                       f"{t} [{b[t][0]:.4g}, {b[t][1]:.4g}]" for t in coefficients if t in b))

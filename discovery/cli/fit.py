@@ -98,7 +98,7 @@ def run(args):
     sel = res.selected
     print(f"selected {sel.law}   [{sel.regime}]")
     if sel.standard_errors:
-        print(coefficients_line(sel.law.as_dict(), sel.standard_errors))
+        print(coefficients_line(sel.law.as_dict(), sel.standard_errors, sel.intervals))
     if sel.criteria:
         print(criteria_line(sel.criteria, sel.noise_floor))
     print(f"  {sel.verdict}")
