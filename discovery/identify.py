@@ -94,6 +94,7 @@ class IdentificationResult:
     failures: list = field(default_factory=list)
     seconds: float = 0.0
     message: str = ""
+    intervals: object = None
 
     @property
     def coefficients(self):
@@ -328,7 +329,7 @@ def _uncertainty(obj, x, names):
 
 def identify(scenario, reference, start, *, criterion="I2", method="coordinate-descent",
              xtol=1e-5, max_simulations=600, tolerances=None, uncertainty=True,
-             observe=None, short_first=True):
+             observe=None, short_first=True, n_boot_intervals=0, seed=0):
     """Identify the coefficients of ``start`` from one or several records by simulation.
 
     Parameters
@@ -357,6 +358,11 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
         Estimate standard errors (one more simulation per coefficient and record).
     observe : callable, optional
         Observation model of the simulated force (see :func:`discovery.verify.evaluate`).
+    n_boot_intervals : int
+        Bootstrap replicates of 95 % coefficient intervals through the full processing
+        (:func:`discovery.intervals.bootstrap_intervals`; records with positions; 0 = none).
+    seed : int
+        Seed of that bootstrap.
     short_first : bool
         With record spans compared in blocks of several cycles: first fit the records
         cycle by cycle (:meth:`~discovery.verify.Reference.shortened`, up to half the
@@ -447,7 +453,15 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
     if obj.failures:
         message += (f"; {len(obj.failures)} trial law(s) had no periodic steady state with "
                     "contact (see failures)")
+    intervals = None
+    if n_boot_intervals:
+        from .intervals import bootstrap_intervals
+
+        intervals = bootstrap_intervals([sc for sc, _ in records], [r for _, r in records],
+                                        law, n_boot=int(n_boot_intervals), seed=seed,
+                                        criterion=criterion, tolerances=tolerances)
     return IdentificationResult(
+        intervals=intervals,
         law=law, criterion=criterion, value=value, criteria=crit, method=method,
         n_simulations=obj.n + spent, evaluations=tuple(evs), iterations=obj.path,
         standard_errors=se, correlation=corr, failures=obj.failures,

@@ -78,6 +78,15 @@ def integer(lo=None, hi=None):
     return parse
 
 
+def interval_count(text):
+    """0 or an integer >= 5: bootstrap replicates of coefficient intervals (argparse type)."""
+    n = integer(0, 10_000)(text)
+    if 0 < n < 5:
+        raise argparse.ArgumentTypeError(f"{n} replicates cannot give an interval; give 0 "
+                                         "(none) or at least 5, e.g. --intervals 30")
+    return n
+
+
 def law_or_default(text, scenario, what="--law"):
     """The law given as text, or the scenario's law when the option was left out; an
     empty text is an error (not silently the scenario's law)."""

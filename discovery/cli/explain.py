@@ -13,6 +13,7 @@ from ._common import (
     criteria_line,
     inputs_of,
     integer,
+    interval_count,
     number,
     read_records,
 )
@@ -37,7 +38,8 @@ def run(args):
     scs, meas = read_records(args)
     res = explain(scs, meas, args.start, criterion=args.criterion, alpha=args.alpha,
                   max_iterations=args.max_iterations, budget=args.max_simulations,
-                  n_boot=args.n_boot, seed=args.seed, effects=effects, workers=args.workers)
+                  n_boot=args.n_boot, seed=args.seed, effects=effects, workers=args.workers,
+                  n_boot_intervals=args.intervals)
     summary = {"command": "explain", "scenario": scs[0].as_dict(),
                "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
                **res.as_dict(), "catalogue": [e.as_dict() for e in EFFECTS],
@@ -59,7 +61,7 @@ def run(args):
     print(f"final model: {fm}")
     if res.uncertainties:
         print(coefficients_line(dict(zip(fm.names, fm.coefficients, strict=True)),
-                                res.uncertainties))
+                                res.uncertainties, res.intervals))
     if res.criteria:
         print(criteria_line(res.criteria, res.noise_floor))
     print(f"  {'consistent' if res.consistent else 'not consistent'} with the record(s); "
@@ -100,6 +102,9 @@ def register(sub):
                    help="simulation budget of each refit (default: %(default)s)")
     s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
                    help="bootstrap replicates of the noise floor (default: %(default)s)")
+    s.add_argument("--intervals", type=interval_count, default=30,
+                   help="bootstrap replicates of the final model's 95 %% parameter intervals "
+                   "through the full processing (0 = none; default: %(default)s)")
     s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
                    help="seed of the noise-floor bootstrap (default: %(default)s)")
     s.add_argument("--workers", type=integer(1, 1024),

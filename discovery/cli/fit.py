@@ -15,6 +15,7 @@ from ._common import (
     criteria_line,
     inputs_of,
     integer,
+    interval_count,
     number,
     read_records,
 )
@@ -43,7 +44,8 @@ def run(args):
                    derivative=args.derivative, average_cycles=args.average_cycles,
                    random_state=args.seed, margin=args.margin,
                    monotone=args.monotone, physics=not args.allow_unphysical,
-                   require=args.require or (), **({"signs": args.signs} if args.signs else {}))
+                   require=args.require or (), n_boot_intervals=args.intervals,
+                   **({"signs": args.signs} if args.signs else {}))
     imps = []
     for k, m in enumerate(res.ranking[:3]):
         if m.criteria:  # aligned with the first record and sampled like it
@@ -180,6 +182,9 @@ def register(sub):
     s.add_argument("--require", type=_terms, default=None,
                    help="terms every candidate must contain, e.g. 'z' (a spring) or 'z,zd' "
                    "(default: none)")
+    s.add_argument("--intervals", type=interval_count, default=30,
+                   help="bootstrap replicates of the selected law's 95 %% coefficient intervals "
+                   "through the full processing (0 = none; default: %(default)s)")
     s.add_argument("--allow-unphysical", action="store_true",
                    help="rank laws that are no contact laws (no spring: F(zeta, 0) = 0; a "
                    "negative damper) by the records alone; by default they come last")

@@ -20,6 +20,7 @@ from ._common import (
     criteria_line,
     inputs_of,
     integer,
+    interval_count,
     number,
     read_record,
 )
@@ -70,7 +71,8 @@ def run(args):
     ref = Reference.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
     E = ref.impulse
     res = identify(sc, ref, start, criterion=args.criterion, method=args.method,
-                   max_simulations=args.max_simulations, xtol=args.xtol)
+                   max_simulations=args.max_simulations, xtol=args.xtol,
+                   n_boot_intervals=args.intervals, seed=args.seed)
     final = evaluate(sc, res.law, ref)
     # res.iterations lists every new best-so-far law (finite-difference probes included),
     # so the impulses are labelled by the simulations spent, not as iterations: a few of
@@ -96,6 +98,7 @@ def run(args):
                    "start": start.as_dict(), "coefficients": res.coefficients,
                    "law": res.law.to_text(), "latex": res.law.latex(),
                    "standard_errors": res.standard_errors,
+                   "intervals": None if res.intervals is None else res.intervals.as_dict(),
                    "correlation": res.correlation,
                    "criteria": final.criteria, "noise_floor": final.noise_floor,
                    "consistent": final.consistent, "verdict": final.verdict,
@@ -119,7 +122,7 @@ def run(args):
     print(f"  {res.criterion} = {value:.4g} after {res.n_simulations} simulations "
           f"({res.method}, {res.seconds:.1f} s)")
     if res.standard_errors:
-        print(coefficients_line(res.coefficients, res.standard_errors))
+        print(coefficients_line(res.coefficients, res.standard_errors, res.intervals))
     if final.criteria:
         print(criteria_line(final.criteria, final.noise_floor))
     print(f"  {final.verdict}")
@@ -154,7 +157,11 @@ def register(sub):
                    "the path on (default: none)")
     s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
                    help="bootstrap replicates of the noise floor (default: %(default)s)")
+    s.add_argument("--intervals", type=interval_count, default=30,
+                   help="bootstrap replicates of the 95 %% coefficient intervals through the "
+                   "full processing (records with positions; 0 = none; default: %(default)s)")
     s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
-                   help="seed of the noise-floor bootstrap (default: %(default)s)")
+                   help="seed of the noise-floor and interval bootstraps (default: "
+                   "%(default)s)")
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

@@ -57,6 +57,7 @@ from ..identify import (
     pair_records,
     record_start,
 )
+from ..intervals import bootstrap_intervals
 from ..law import ForceLaw, Term
 from ..verify import evaluate
 from . import drift as D
@@ -158,6 +159,8 @@ class ExplainResult:
         ``floor``, ``parameter``, ``separable``: the refit lowers the criterion by more
         than its noise floor), so a report can say, with numbers, which effects this record
         cannot tell from the model (e.g. a Hertz term on a record a linear law matches).
+    intervals : Intervals or None
+        Bootstrap intervals of the final model's parameters through the full processing.
     """
 
     iterations: tuple
@@ -170,11 +173,14 @@ class ExplainResult:
     seconds: float = 0.0
     settings: dict = field(default_factory=dict)
     separability: tuple = ()
+    intervals: object = None
 
     def as_dict(self):
         return {"iterations": [it.as_dict() for it in self.iterations],
                 "final_model": {**self.final_model.as_dict(),
-                                "uncertainties": self.uncertainties},
+                                "uncertainties": self.uncertainties,
+                                "intervals": None if self.intervals is None
+                                else self.intervals.as_dict()},
                 "criteria": self.criteria, "noise_floor": self.noise_floor,
                 "consistent": self.consistent, "stopped_because": self.stopped_because,
                 "separability": list(self.separability), "seconds": self.seconds}
@@ -645,7 +651,7 @@ def _output_error(records, start, criterion, budget, tol, polish=False):
 
 def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01,
             max_iterations=3, budget=150, n_boot=16, seed=0, tolerances=None, effects=None,
-            max_refits=6, workers=None):
+            max_refits=6, workers=None, n_boot_intervals=30):
     """Explain the disagreement of a start model with one or several records by named
     physical effects (see the module docstring).
 
@@ -675,6 +681,9 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     workers : int, optional
         Processes for the screening refits (default: all cores; the result does not
         depend on it).
+    n_boot_intervals : int
+        Bootstrap replicates of the final model's 95 % parameter intervals through the full
+        processing (:func:`discovery.intervals.bootstrap_intervals`; 0 = none).
 
     Returns
     -------
@@ -911,7 +920,16 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             uncertainties = dict(res.standard_errors)
     evs = problem.evaluations(model, floor=True)
     crit, floor = _with_drift(_mean(evs, "criteria"), _mean(evs, "noise_floor"), drift, model)
+    intervals = None
+    if n_boot_intervals:
+        try:
+            intervals = bootstrap_intervals([sc for sc, _ in records], [r for _, r in records],
+                                            model, n_boot=int(n_boot_intervals), seed=seed,
+                                            criterion=criterion, tolerances=tolerances)
+        except IntegrationError:
+            intervals = None
     return ExplainResult(
+        intervals=intervals,
         iterations=tuple(iterations), final_model=model, uncertainties=uncertainties,
         criteria=crit, noise_floor=floor,
         consistent=all(e.consistent for e in evs) and _drift_free(
