@@ -195,7 +195,7 @@ def _polish_start(records, fit, criterion, budget, tol):
     try:
         res = identify(scs, refs, fit.law, criterion=criterion, method="least-squares",
                        max_simulations=budget, tolerances=tol, short_first=False)
-    except IntegrationError:
+    except (IntegrationError, InputError):
         return fit
     same = all(e.impacts["simulated"] == e.impacts["measured"] for e in res.evaluations)
     base = [evaluate(sc, fit.law, ref, tolerances=tol, floor=False) for sc, ref in records]
@@ -853,8 +853,8 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             null = _output_error(records, model, criterion, screen, tolerances)
             null_evs = problem.evaluations(null.law, floor=True)
             null_after, _ = _with_drift(_mean(null_evs, "criteria"), {}, drift, null.law)
-        except IntegrationError:
-            null = None
+        except (IntegrationError, InputError):  # no refit (e.g. a parameter at 0)
+            null, null_after = None, None
         for x in trials:
             k = x[5]
             x[1]["beats_law_refit"] = bool(not null_after or k not in null_after or
