@@ -61,16 +61,18 @@ def test_hidden_coupling_is_named_and_the_gap_shrinks(hidden_coupling):
 
 
 def test_clean_records_add_nothing(paper):
-    """No hidden effect, 20 noise seeds: no false discovery (the README's count).  Two of
-    the records fail I4 alone (the contact supports of a noisy record) with I2 within its
-    noise; nothing is fitted to that, and the stop says so."""
+    """No hidden effect, 20 noise seeds: no false discovery (the README's count).  A few
+    records end inconsistent without naming anything: failing I4 alone (the contact
+    supports of a noisy record) with I2 within its noise, or with a drift score no effect's
+    refit lowers; nothing is fitted to that, and the stop says so."""
     false, i4_alone = [], 0
     for seed in range(100, 120):
         res = explain(paper, _record(paper, paper.law, seed=seed), "linear")
         if any(it.effect for it in res.iterations):
             false.append(seed)
         if not res.consistent:
-            assert "I4 alone" in res.stopped_because, (seed, res.stopped_because)
+            assert "I4 alone" in res.stopped_because or "do not shrink the gap" in \
+                res.stopped_because, (seed, res.stopped_because)
             i4_alone += 1
     assert false == []
     assert i4_alone <= 3

@@ -897,7 +897,7 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
                     s["criteria_after"] = after3
                     s["parameters"] = {p.name: m2.value(eff_by_id[s["effect"]])
                                        for p in eff_by_id[s["effect"]].parameters}
-            except IntegrationError:
+            except (IntegrationError, InputError):
                 pass
         value = s["criteria_after"][key]
         tol_eq = floor.get(key, 0.0)
