@@ -33,7 +33,8 @@ MACHINES = {
 }
 
 
-def run(machine, seed, *, fs=20000.0, periods=12, force_noise=0.02, motion_noise=0.002):
+def run(machine, seed, *, fs=20000.0, periods=12, force_noise=0.02, motion_noise=0.002,
+        n_boot=0):
     from discovery import load_scenario
 
     sc, text = MACHINES[machine]
@@ -47,7 +48,7 @@ def run(machine, seed, *, fs=20000.0, periods=12, force_noise=0.02, motion_noise
                                    for c in law.coefficients])
     ref = Reference.from_measurement(rec, sc)
     res = identify(sc, ref, start, criterion="I2", method="least-squares",
-                   max_simulations=200)
+                   max_simulations=200, n_boot_intervals=n_boot, seed=seed)
     ev = evaluate(sc, res.law, ref)
     row = {"machine": machine, "seed": seed, "law": text, "fs": fs, "periods": periods,
            "force_noise": force_noise, "motion_noise": motion_noise,
@@ -59,6 +60,9 @@ def run(machine, seed, *, fs=20000.0, periods=12, force_noise=0.02, motion_noise
         c, se = res.law.as_dict()[name], res.standard_errors.get(name, float("nan"))
         row["z_scores"][name] = (c - true) / se if se > 0 else float("inf")
         row["covered"][name] = bool(abs(c - true) <= 1.96 * se)
+        if res.intervals is not None:
+            lo, hi = res.intervals.bounds[name]
+            row.setdefault("covered_bootstrap", {})[name] = bool(lo <= true <= hi)
     return row
 
 
@@ -72,8 +76,11 @@ def summary(rows):
     for r in rows:
         for name, ok in r["covered"].items():
             by.setdefault((r["machine"], name), []).append(ok)
+    boot = [ok for r in rows for ok in r.get("covered_bootstrap", {}).values()]
+    if boot:
+        print(f"bootstrap intervals: {sum(boot)}/{len(boot)} = {sum(boot) / len(boot):.1%}")
     allv = [ok for v in by.values() for ok in v]
-    print(f"coverage of the 95 % intervals: {sum(allv)}/{len(allv)} = "
+    print(f"Jacobian 95 % intervals: {sum(allv)}/{len(allv)} = "
           f"{sum(allv) / max(len(allv), 1):.1%} ({len(rows)} records)")
     for (m, name), v in sorted(by.items()):
         print(f"  {m:18s} {name:6s} {sum(v)}/{len(v)}")
@@ -83,6 +90,8 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--records", type=int, default=25, help="seeds per machine")
     p.add_argument("--machines", default=",".join(MACHINES))
+    p.add_argument("--bootstrap", type=int, default=0,
+                   help="replicates of the bootstrap intervals (0 = Jacobian only)")
     p.add_argument("--summary", metavar="JSONL", help="summarise an earlier run's output")
     a = p.parse_args(argv)
     if a.summary:
@@ -92,7 +101,7 @@ def main(argv=None):
     rows = []
     for m in a.machines.split(","):
         for seed in range(a.records):
-            row = run(m, seed)
+            row = run(m, seed, n_boot=a.bootstrap)
             rows.append(row)
             print(json.dumps(row), flush=True)
     summary(rows)
