@@ -96,8 +96,8 @@ def bootstrap_intervals(scenario, reference, model, *, n_boot=30, seed=0, level=
     Returns
     -------
     Intervals or None
-        ``None`` when a record has no span (no state to draw) or fewer than 5 refits
-        succeeded.
+        ``None`` when a record has no span (no state to draw), a parameter is 0, or fewer
+        than 5 refits succeeded.
     """
     from scipy.stats import norm
 
@@ -110,6 +110,8 @@ def bootstrap_intervals(scenario, reference, model, *, n_boot=30, seed=0, level=
     records = as_records(scenario, reference)
     if any(getattr(ref, "span", None) is None for _, ref in records):
         return None
+    if any(c == 0 for c in model.coefficients):
+        return None  # a parameter at 0 sets no scale for the refits
     law, machine, observe = model_parts(model)
     rng = np.random.default_rng(seed)
     draws = []
