@@ -857,8 +857,9 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             null, null_after = None, None
         for x in trials:
             k = x[5]
-            x[1]["beats_law_refit"] = bool(not null_after or k not in null_after or
-                                           x[1]["criteria_after"][k]
+            # (the drift channel does not depend on the law: a law refit is no baseline)
+            x[1]["beats_law_refit"] = bool(k == "D" or not null_after or k not in null_after
+                                           or x[1]["criteria_after"][k]
                                            <= null_after[k] - floor.get(k, 0.0))
         good = [x for x in trials if x[0] <= 0.9 and x[1]["repulsive"] and x[1]["in_bounds"]
                 and x[1]["beats_law_refit"]]
