@@ -187,10 +187,11 @@ class ExplainResult:
 
 
 def _polish_start(records, fit, criterion, budget, tol):
-    """The cycle-by-cycle start refined on the records' blocks, kept only as a local
-    refinement: every coefficient within 3 standard errors of the cycle-by-cycle fit, the
-    measured number of contacts kept in every record, and the criterion lowered (a refit
-    that trades the spring for the restitution has left the start's basin)."""
+    """The cycle-by-cycle start refined on the records' blocks, kept when it keeps the
+    measured number of contacts in every record and lowers the criterion, and either stays
+    local (every coefficient within 3 standard errors of the cycle-by-cycle fit) or is
+    consistent with every record (a far refit that trades the spring for the restitution
+    has left the start's basin without explaining the record)."""
     scs, refs = [s for s, _ in records], [r for _, r in records]
     try:
         res = identify(scs, refs, fit.law, criterion=criterion, method="least-squares",
@@ -200,10 +201,14 @@ def _polish_start(records, fit, criterion, budget, tol):
     same = all(e.impacts["simulated"] == e.impacts["measured"] for e in res.evaluations)
     base = [evaluate(sc, fit.law, ref, tolerances=tol, floor=False) for sc, ref in records]
     v0 = float(np.mean([e.criteria.get(criterion, np.inf) for e in base]))
+    if not (same and res.value <= v0):
+        return fit
     se = fit.standard_errors
     near = all(abs(b - a) <= 3.0 * se.get(n, 0.0) for n, a, b in
                zip(fit.law.names, fit.law.coefficients, res.law.coefficients, strict=True))
-    return res if same and near and res.value <= v0 else fit
+    # a far move is kept only when it reaches a law consistent with every record
+    return res if near or all(evaluate(sc, res.law, ref, tolerances=tol).consistent
+                              for sc, ref in records) else fit
 
 
 def _separability(problem, records, model, catalogue, criterion, before, floor, budget, tol):
@@ -850,7 +855,14 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         # own misfit, and the effect only carried a refit of the law)
         null_after, null = None, None
         try:
-            null = _output_error(records, model, criterion, screen, tolerances)
+            # from the better of the current model and the regression on its terms (the
+            # effects' refits may start from the regression too)
+            null_starts = [model]
+            reg0 = _regressed(model, model.law.names, regress)
+            if reg0 is not None:
+                null_starts.append(reg0)
+            null_start = min(null_starts, key=lambda m: problem.value(m, criterion))
+            null = _output_error(records, null_start, criterion, screen, tolerances)
             null_evs = problem.evaluations(null.law, floor=True)
             null_after, _ = _with_drift(_mean(null_evs, "criteria"), {}, drift, null.law)
         except (IntegrationError, InputError):  # no refit (e.g. a parameter at 0)
@@ -861,8 +873,17 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             x[1]["beats_law_refit"] = bool(k == "D" or not null_after or k not in null_after
                                            or x[1]["criteria_after"][k]
                                            <= null_after[k] - floor.get(k, 0.0))
+        for x in trials:
+            # an effect refitted to 0, or to a value within 2 standard errors of 0, only
+            # carried a refit of the law
+            e_ = eff_by_id[x[1]["effect"]]
+            v_ = x[2].value(e_)
+            se_ = (x[3].standard_errors.get(e_.parameters[0].name) if x[3] is not None
+                   else None)
+            x[1]["present"] = bool(v_ != 0.0 and (se_ is None or not np.isfinite(se_)
+                                                  or abs(v_) > 2.0 * se_))
         good = [x for x in trials if x[0] <= 0.9 and x[1]["repulsive"] and x[1]["in_bounds"]
-                and x[1]["beats_law_refit"]]
+                and x[1]["beats_law_refit"] and x[1]["present"]]
         if not good and null_after and criterion in null_after \
                 and null_after[criterion] <= 0.9 * before[criterion]:
             iterations.append(Iteration(model, null.law, before, null_after, floor, loc, scores,
