@@ -21,11 +21,18 @@ directory behind: the next run for the same target removes it once the process
 that made it is gone, and puts an aside copy back when the target is missing (a
 kill between the two renames of the fallback).
 
-Results are atomic *as a directory*: the target is replaced as a whole, so it must
-hold one command's results only.  :func:`check_output` (called by the commands before
-any work) refuses a target that is a file, not writable, the current directory, an
-input file or a directory holding one, or a non-empty directory that does not look
-like an earlier result (``summary.json`` beside output files only, no subdirectories).
+Results are atomic *as a directory* and never take what is not theirs.  Every result
+directory holds ``.vidi-manifest.json``: the command that wrote it and the files it wrote.
+After the swap, every entry of the earlier directory that is not in its manifest (a user's
+notes, another record, a file dropped in while the run went on) is moved back into the new
+one (as ``NAME.kept`` when the new result uses its name), and only then is the earlier set
+removed.  :func:`check_output` (called by the commands before any work) refuses a target
+that is a symbolic link (results never replace through a link), a file where a directory
+is expected or anything but a regular file where a file is, not writable, the current
+directory, an input file or a directory holding one, a directory holding another command's
+results (unless ``--overwrite``: :func:`set_run`), a file that vidi did not write (no
+``X.summary.json`` sidecar naming the command) or another command's file, and a non-empty
+directory that is no vidi result at all.
 """
 
 import contextlib
@@ -50,7 +57,7 @@ import numpy as np
 from .errors import InputError
 
 __all__ = ["OutputDir", "provenance", "to_jsonable", "check_output", "atomic_write_text",
-           "file_sha256", "git_state", "clean_stale"]
+           "file_sha256", "git_state", "clean_stale", "set_run", "MANIFEST"]
 
 # the solvers cvxpy uses here: CLARABEL (default), OSQP (fallback in the regression)
 _PACKAGES = ("vibroimpact-discovery", "numpy", "scipy", "numba", "sympy", "cvxpy", "clarabel",
@@ -62,6 +69,44 @@ _STAGING, _ASIDE, _TMP = "vidi-staging", "vidi-old", "vidi-tmp"
 _OWNED = re.compile(r"^\.(?P<name>.+)\.(?P<kind>vidi-staging|vidi-old|vidi-tmp)\.(?P<pid>\d+)-"
                     r"(?P<start>\d+)\.[0-9a-f]+$")
 _PROBE = re.compile(r"^\.vidi-probe\.(?P<pid>\d+)-(?P<start>\d+)\.[0-9a-f]+$")
+
+MANIFEST = ".vidi-manifest.json"
+"""The file in every result directory that lists what the run wrote (and which command):
+a later run may replace those files only; anything else in the directory is the user's."""
+
+_RUN = {"command": None, "overwrite": False}
+
+
+def set_run(command, overwrite=False):
+    """The command this process runs (``"verify"``, ``"ueda simulate"``, ...) and whether
+    the user allowed replacing another command's results (``--overwrite``)."""
+    _RUN.update(command=command, overwrite=bool(overwrite))
+
+
+def _owner(directory):
+    """``(command, files)`` of an earlier result directory: from its manifest, else from a
+    legacy ``summary.json`` (command only, files unknown), else ``(None, None)``."""
+    d = Path(directory)
+    for name, legacy in ((MANIFEST, False), ("summary.json", True)):
+        try:
+            with open(d / name, encoding="utf-8") as fh:
+                data = json.load(fh)
+        except (OSError, ValueError):
+            continue
+        if not isinstance(data, dict):
+            continue
+        cmd = data.get("command")
+        files = None if legacy else [f for f in data.get("files", []) if isinstance(f, str)]
+        return (cmd if isinstance(cmd, str) else None), files
+    return None, None
+
+
+def _refuse_other_command(owner, text, option):
+    here = _RUN["command"]
+    if owner and here and owner != here and not _RUN["overwrite"]:
+        raise InputError(f"{option} {text!r} holds the results of `vidi {owner}`; give this "
+                         f"`vidi {here}` run its own output, or add --overwrite to replace "
+                         "them (files you added there are kept)")
 
 
 # ---------------------------------------------------------------------------- provenance
@@ -310,10 +355,24 @@ def check_output(path, inputs=(), *, kind="dir", option="--out"):
         if inp is not None and os.path.isfile(inp) and _same_file(p, inp):
             raise InputError(f"{option} {text!r} is the input file {str(inp)!r}; write the "
                              "results elsewhere")
+    if p.is_symlink():
+        raise InputError(f"{option} {text!r} is a symbolic link; results never replace "
+                         "through a link: give the real path or a new name")
     if kind == "file":
         if p.is_dir():
             raise InputError(f"{option} {text!r} is a directory; give a file name inside it, "
                              f"e.g. {str(p / 'D.csv')!r}")
+        if p.exists() and not p.is_file():
+            raise InputError(f"{option} {text!r} exists and is not a regular file (a pipe, a "
+                             "device or a socket); it is never replaced: give a new file name")
+        if p.is_file():
+            sidecar = p if p.name.endswith(".summary.json") else p.with_suffix(".summary.json")
+            owner, _ = _owner_file(sidecar)
+            if owner is None and not _RUN["overwrite"] and _RUN["command"]:
+                raise InputError(f"{option} {text!r} exists and was not written by vidi (no "
+                                 f"{sidecar.name} beside it); give a new file name, or add "
+                                 "--overwrite to replace it")
+            _refuse_other_command(owner, text, option)
     else:
         if p.exists() and not p.is_dir():
             raise InputError(f"{option} {text!r} is an existing file; give a directory (it is "
@@ -339,11 +398,27 @@ def check_output(path, inputs=(), *, kind="dir", option="--out"):
     return p
 
 
+def _owner_file(sidecar):
+    """``(command, None)`` from a single-file output's ``X.summary.json`` sidecar."""
+    try:
+        with open(sidecar, encoding="utf-8") as fh:
+            data = json.load(fh)
+    except (OSError, ValueError):
+        return None, None
+    cmd = data.get("command") if isinstance(data, dict) else None
+    return (cmd if isinstance(cmd, str) else None), None
+
+
 def _check_replaceable(p, text, option):
-    """An existing directory may be replaced only when it is empty or looks like an
-    earlier result (a summary.json beside output files, no subdirectories)."""
+    """An existing directory may receive a new result only when it is empty or holds an
+    earlier result (a manifest, or a legacy summary.json beside output files) of the same
+    command (or with ``--overwrite``); the files a user added are kept by the commit."""
     entries = [e for e in os.scandir(p) if not _OWNED.match(e.name)]
     if not entries:
+        return
+    owner, files = _owner(p)
+    if owner is not None or files is not None:
+        _refuse_other_command(owner, text, option)
         return
     names = {e.name for e in entries}
     subdirs = sorted(e.name for e in entries if e.is_dir(follow_symlinks=False))
@@ -482,8 +557,6 @@ class OutputDir:
     def __enter__(self):
         check_output(self._raw, self.inputs)
         target = Path(os.path.abspath(self.target))
-        if target.is_symlink() and target.is_dir():  # replace the directory it points to
-            target = Path(os.path.realpath(target))
         clean_stale(target)
         self._made = []
         p = target.parent
@@ -513,7 +586,37 @@ class OutputDir:
             json.dump(to_jsonable(data), fh, indent=2)
             fh.write("\n")
 
+    def _write_manifest(self):
+        files = sorted(f.name for f in self.stage.iterdir() if f.name != MANIFEST)
+        try:
+            version = metadata.version("vibroimpact-discovery")
+        except metadata.PackageNotFoundError:
+            version = None
+        with open(self.stage / MANIFEST, "w", encoding="utf-8") as fh:
+            json.dump({"command": _RUN["command"], "files": files, "vidi": version}, fh,
+                      indent=2)
+            fh.write("\n")
+
+    def _keep_user_files(self, old, target):
+        """Move every entry of the earlier directory ``old`` that the earlier run did not
+        write (not in its manifest; for a legacy result without one, not a name of the new
+        result) back into ``target``: a user's notes, a file dropped in during the run.  A
+        name the new result also uses is kept as ``NAME.kept``."""
+        _, files = _owner(old)
+        ours = set(files) | {MANIFEST} if files is not None else \
+            {f.name for f in target.iterdir()} | {"summary.json"}
+        for e in list(os.scandir(old)):
+            if e.name in ours or _OWNED.match(e.name):
+                continue
+            dest = target / e.name
+            k = 0
+            while os.path.lexists(dest):
+                k += 1
+                dest = target / (f"{e.name}.kept" if k == 1 else f"{e.name}.kept{k}")
+            os.rename(e.path, dest)
+
     def _commit(self):
+        self._write_manifest()
         for f in self.stage.iterdir():
             if f.is_file():
                 with contextlib.suppress(OSError), open(f, "rb") as fh:
@@ -524,9 +627,9 @@ class OutputDir:
             os.rename(self.stage, target)
             _fsync_dir(target.parent)
             return
-        if not target.is_dir():
-            raise InputError(f"--out {str(self.target)!r} became a file during the run; the "
-                             "results were not written")
+        if target.is_symlink() or not target.is_dir():
+            raise InputError(f"--out {str(self.target)!r} became a file or a link during the "
+                             "run; the results were not written")
         if _exchange(self.stage, target):
             old = self.stage  # now holds the earlier result
         else:
@@ -537,6 +640,7 @@ class OutputDir:
             except BaseException:
                 os.rename(old, target)
                 raise
+        self._keep_user_files(old, target)
         _fsync_dir(target.parent)
         shutil.rmtree(old, ignore_errors=True)
 

@@ -114,12 +114,12 @@ def workspace(tmp_path_factory, paper):
     (w / "datadir").mkdir()
     (w / "datadir" / "in.csv").write_text(text)
     (w / "datadir" / "summary.json").write_text("{}")
-    # earlier results: a steady output directory and a simulate record with its summary
+    # earlier results: a simulate record with its summary and a verify output directory
     cwd = os.getcwd()
     os.chdir(w)
     try:
-        assert main(["steady", "--out", "res"]) == 0
         assert main(["simulate", "--periods", "3", "--out", "rec.csv"]) == 0
+        assert main(["verify", "--data", "rec.csv", "--out", "res"]) == 0
     finally:
         os.chdir(cwd)
     return w

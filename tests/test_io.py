@@ -37,7 +37,8 @@ def _write_set(target, run_id, names=("summary.json", "a.csv", "b.png")):
 
 
 def _snapshot(d):
-    return {p.name: p.read_text() for p in sorted(Path(d).iterdir())}
+    """The result files (the manifest aside: it is checked on its own)."""
+    return {p.name: p.read_text() for p in sorted(Path(d).iterdir()) if p.name != _io.MANIFEST}
 
 
 # ----------------------------------------------------------------------------- OutputDir
@@ -78,13 +79,19 @@ def test_failure_keeps_earlier_result_and_leaves_nothing(tmp_path):
     assert sorted(p.name for p in target.parent.iterdir()) == ["res"]
 
 
-def test_symlinked_target_replaces_the_directory_it_points_to(tmp_path):
+def test_a_symlinked_target_is_refused_and_left_alone(tmp_path):
+    """Results never replace through a link: the directory it points to may hold the
+    user's files."""
     real = tmp_path / "real"
     _write_set(real, 1)
+    (real / "lab_notes.txt").write_text("mine")
     link = tmp_path / "latest"
     link.symlink_to(real)
-    _write_set(link, 2)
-    assert link.is_symlink() and set(_snapshot(real).values()) == {"2\n"}
+    with pytest.raises(InputError, match="symbolic link"):
+        _write_set(link, 2)
+    assert link.is_symlink() and _snapshot(real) == {"a.csv": "1\n", "b.png": "1\n",
+                                                     "lab_notes.txt": "mine",
+                                                     "summary.json": "1\n"}
 
 
 @pytest.mark.skipif(not LINUX, reason="readers by directory fd")
@@ -106,7 +113,7 @@ def test_reader_never_sees_a_mixed_set(tmp_path):
             except FileNotFoundError:
                 continue  # the fallback's window: absent, never mixed
             try:
-                listing = sorted(os.listdir(fd))
+                listing = sorted(n for n in os.listdir(fd) if n != _io.MANIFEST)
                 vals = set()
                 for n in listing:
                     try:
@@ -382,3 +389,70 @@ def test_die_with_parent_in_this_process_is_harmless():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          cwd=ROOT, check=True).stdout.split()
     assert out == ["prctl", "True"]
+
+
+# ------------------------------------------------- ownership: nothing a user owns is lost
+def test_user_files_in_an_earlier_result_are_kept(tmp_path):
+    target = tmp_path / "res"
+    _write_set(target, 1, ("summary.json", "old_only.csv"))
+    (target / "lab_notes.txt").write_text("mine")
+    (target / "record2.csv").write_text("t,F\n")
+    _write_set(target, 2)
+    assert _snapshot(target) == {"a.csv": "2\n", "b.png": "2\n", "summary.json": "2\n",
+                                 "lab_notes.txt": "mine", "record2.csv": "t,F\n"}
+    manifest = json.loads((target / _io.MANIFEST).read_text())
+    assert manifest["files"] == ["a.csv", "b.png", "summary.json"]
+
+
+def test_a_file_dropped_in_during_the_run_is_kept(tmp_path):
+    target = tmp_path / "res"
+    _write_set(target, 1)
+    with OutputDir(target) as out:
+        for n in ("summary.json", "a.csv", "notes.txt"):
+            out.path(n).write_text("2\n")
+        (target / "dropped.txt").write_text("during")  # the user, while the run goes on
+        (target / "notes.txt").write_text("user's")    # a name the new result also uses
+    snap = _snapshot(target)
+    assert snap["dropped.txt"] == "during" and snap["notes.txt"] == "2\n"
+    assert snap["notes.txt.kept"] == "user's"
+
+
+def test_another_commands_result_is_refused_unless_overwrite(tmp_path):
+    target = tmp_path / "res"
+    _io.set_run("verify")
+    try:
+        _write_set(target, 1)
+        (target / "notes.txt").write_text("mine")
+        _io.set_run("explain")
+        with pytest.raises(InputError, match="holds the results of `vidi verify`"):
+            check_output(target)
+        _io.set_run("explain", overwrite=True)
+        check_output(target)
+        _write_set(target, 2)
+        assert json.loads((target / _io.MANIFEST).read_text())["command"] == "explain"
+        assert (target / "notes.txt").read_text() == "mine"
+    finally:
+        _io.set_run(None)
+
+
+@pytest.mark.skipif(not LINUX, reason="mkfifo and /dev/null")
+@pytest.mark.parametrize("kind", ["fifo", "device", "symlink", "foreign"])
+def test_file_targets_that_are_not_ours_are_refused(tmp_path, kind):
+    target = tmp_path / "D.csv"
+    if kind == "fifo":
+        os.mkfifo(target)
+    elif kind == "device":
+        target = Path("/dev/null")
+    elif kind == "symlink":
+        (tmp_path / "real.csv").write_text("x")
+        target.symlink_to(tmp_path / "real.csv")
+    else:
+        target.write_text("a user's file")
+    _io.set_run("simulate")
+    try:
+        with pytest.raises(InputError):
+            check_output(target, kind="file")
+    finally:
+        _io.set_run(None)
+    if kind == "foreign":
+        assert target.read_text() == "a user's file"

@@ -94,5 +94,8 @@ def test_sigkill_then_next_run_cleans_up(earlier, capsys):
     assert main(["steady", "--out", str(earlier)]) == 0
     capsys.readouterr()
     assert sorted(q.name for q in earlier.parent.iterdir()) == ["res"]
-    assert sorted(q.name for q in earlier.iterdir()) == ["summary.json"]
+    # an earlier result without a manifest (older vidi): what the new result does not
+    # replace is kept, since nothing says it was vidi's
+    assert sorted(q.name for q in earlier.iterdir()) == [".vidi-manifest.json", "figure.png",
+                                                         "summary.json"]
     assert json.loads((earlier / "summary.json").read_text())["command"] == "steady"

@@ -25,6 +25,7 @@ import sys
 import threading
 import traceback
 
+from .._io import set_run
 from ..errors import VidiError
 from . import explain, fit, identify, landscape, simulate, steady, ueda, verify
 
@@ -100,7 +101,22 @@ def _parser():
                            parser_class=VidiArgumentParser)
     for cmd in _COMMANDS:
         cmd.register(sub)
+    _add_overwrite(p)
     return p
+
+
+def _add_overwrite(parser):
+    """``--overwrite`` on every (sub)command that writes ``--out``: replace the results of
+    another command (or a file vidi did not write); files the user added are kept."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sp in action.choices.values():
+                _add_overwrite(sp)
+    if "--out" in parser._option_string_actions and \
+            "--overwrite" not in parser._option_string_actions:
+        parser.add_argument("--overwrite", action="store_true",
+                            help="replace the results of another command in --out (or a "
+                            "file vidi did not write); files you added are kept")
 
 
 def _attach_dash_values(parser, argv):
@@ -154,6 +170,9 @@ def main(argv=None):
             args = parser.parse_args(_attach_dash_values(parser, argv))
         except SystemExit as exc:  # --help, --version
             return exc.code if isinstance(exc.code, int) else 0
+        command = " ".join(x for x in (getattr(args, "command", None),
+                                       getattr(args, "ueda_command", None)) if x)
+        set_run(command or None, getattr(args, "overwrite", False))
         return args.func(args)
     except VidiError as exc:
         _error(exc)
