@@ -4,6 +4,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._compile import announce_compile
 from ..errors import InputError, IntegrationError
 from . import _kernel as K
 
@@ -204,6 +205,7 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, tolerances=None,
     period = scenario.period
     p = kernel_params(scenario, law)
     p[K.P_ZMAX] = float(zeta_max0)
+    announce_compile("vibro-impact")
     status, tf, yf, mf, n_steps, n_ev, _ = K.integrate(
         t0, t1, y0, -1 if mode0 is None else int(mode0), p, coef,
         ea, eb, br, tol.rtol, _atol(scenario, tol), period / 100.0, period * tol.hmax_fraction,

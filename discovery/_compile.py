@@ -1,0 +1,35 @@
+"""Whether the compiled kernels are in numba's cache, and one line when a run must compile
+them (see :mod:`discovery.warm`)."""
+
+import sys
+from pathlib import Path
+
+__all__ = ["KERNELS", "cached", "announce_compile"]
+
+KERNELS = {"vibro-impact": (Path(__file__).parent / "dynamics", "_kernel.integrate-"),
+           "oscillator": (Path(__file__).parent / "oscillator", "_kernel.")}
+_ANNOUNCED = set()
+
+
+def cached(kernel="vibro-impact"):
+    """Whether numba's cache holds the compiled ``kernel`` (``"vibro-impact"`` or
+    ``"oscillator"``)."""
+    folder, prefix = KERNELS[kernel]
+    cache = folder / "__pycache__"
+    return cache.is_dir() and any(p.name.startswith(prefix) and p.suffix == ".nbi"
+                                  for p in cache.iterdir())
+
+
+def announce_compile(kernel="vibro-impact", stream=None):
+    """One line on stderr before a run that must compile ``kernel`` (checked once per
+    process)."""
+    if kernel in _ANNOUNCED:
+        return
+    _ANNOUNCED.add(kernel)  # checked once per process
+    if cached(kernel):
+        return
+    print(f"vidi: compiling the {kernel} simulator once (a few minutes on a small machine; "
+          "cached for every later run; `make install` does it ahead)",
+          file=stream or sys.stderr, flush=True)
+
+

@@ -1,0 +1,52 @@
+"""Compile the simulators once and keep them in numba's cache (``python -m discovery.warm``).
+
+The compiled kernels (the vibro-impact integrator with its event location, and Ueda's
+oscillator) are cached by numba beside their sources (``__pycache__``).  Without a cache
+the first simulation compiles them, which takes minutes on a small machine; ``make
+install`` runs this module once so that the first command after it starts in seconds, and
+`discovery._compile.announce_compile` says so in one line when a command has to compile anyway.
+"""
+
+import sys
+import time
+
+from ._compile import KERNELS, cached
+
+__all__ = ["warm", "main"]
+
+def warm():
+    """Compile (or load) every kernel: ``{kernel: seconds}``."""
+    out = {}
+    t0 = time.perf_counter()
+    from .dynamics.steady_state import steady_state
+    from .scenario import load_scenario
+
+    sc = load_scenario("paper")
+    steady_state(sc, sc.law)
+    out["vibro-impact"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    from .oscillator.attractor import lyapunov, strobe_points
+    from .oscillator.discover import simulate_record
+    from .oscillator.system import UedaSystem
+
+    system = UedaSystem.from_model("negres")
+    simulate_record(system, 2, 50, 0.0, 0, transient=2)
+    strobe_points(system, n=2, transient=2)
+    lyapunov(system, transient=2, periods=4, batches=2)
+    out["oscillator"] = time.perf_counter() - t0
+    return out
+
+
+def main():
+    todo = [k for k in KERNELS if not cached(k)]
+    if todo:
+        print(f"compiling the simulators once ({', '.join(todo)}; a few minutes on two cores) "
+              "...", flush=True)
+    seconds = warm()
+    print("simulators ready (" + ", ".join(f"{k} {v:.1f} s" for k, v in seconds.items())
+          + "); later runs load them from the cache")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
