@@ -102,3 +102,12 @@ def test_help_uses_one_convention(path, parser):
             assert not re.search(r"\(\s*[-+]?[\d.e+-]+\s*\)\s*$", text), (
                 f"vidi {' '.join(path)} {action.option_strings[0]}: write the default as "
                 f"'(default: %(default)s)', not {text!r}")
+
+
+def test_version_and_plain_vidi(capsys):
+    from discovery.cli import main
+
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.startswith("vidi ")
+    assert main([]) == 0  # the overview, not an error
+    assert "COMMAND" in capsys.readouterr().out

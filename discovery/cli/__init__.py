@@ -97,6 +97,8 @@ def _parser():
                     "machines by simulation.",
         epilog="exit codes: 0 ok, 2 bad input or failed numerics, 130 interrupted, 1 internal "
                "error")
+    p.add_argument("--version", action="version", version=f"vidi {_version()}",
+                   help="print the version and exit")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND",
                            parser_class=VidiArgumentParser)
     for cmd in _COMMANDS:
@@ -117,6 +119,15 @@ def _add_overwrite(parser):
         parser.add_argument("--overwrite", action="store_true",
                             help="replace the results of another command in --out (or a "
                             "file vidi did not write); files you added are kept")
+
+
+def _version():
+    from importlib import metadata
+
+    try:
+        return metadata.version("vibroimpact-discovery")
+    except metadata.PackageNotFoundError:
+        return "unknown (not installed)"
 
 
 def _attach_dash_values(parser, argv):
@@ -166,6 +177,9 @@ def main(argv=None):
             old_term = None
     try:
         parser = _parser()
+        if not argv:  # plain `vidi`: the overview, not an error
+            parser.print_help()
+            return 0
         try:
             args = parser.parse_args(_attach_dash_values(parser, argv))
         except SystemExit as exc:  # --help, --version

@@ -104,7 +104,7 @@ def register(sub):
                    help="bootstrap replicates of the noise floor (default: %(default)s)")
     s.add_argument("--intervals", type=interval_count, default=30,
                    help="bootstrap replicates of the final model's 95 %% parameter intervals "
-                   "through the full processing (0 = none; default: %(default)s)")
+                   "through the full processing (0 = none) (default: %(default)s)")
     s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
                    help="seed of the noise-floor bootstrap (default: %(default)s)")
     s.add_argument("--workers", type=integer(1, 1024),

@@ -184,7 +184,7 @@ def register(sub):
                    "(default: none)")
     s.add_argument("--intervals", type=interval_count, default=30,
                    help="bootstrap replicates of the selected law's 95 %% coefficient intervals "
-                   "through the full processing (0 = none; default: %(default)s)")
+                   "through the full processing (0 = none) (default: %(default)s)")
     s.add_argument("--allow-unphysical", action="store_true",
                    help="rank laws that are no contact laws (no spring: F(zeta, 0) = 0; a "
                    "negative damper) by the records alone; by default they come last")

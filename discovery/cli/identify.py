@@ -159,7 +159,7 @@ def register(sub):
                    help="bootstrap replicates of the noise floor (default: %(default)s)")
     s.add_argument("--intervals", type=interval_count, default=30,
                    help="bootstrap replicates of the 95 %% coefficient intervals through the "
-                   "full processing (records with positions; 0 = none; default: %(default)s)")
+                   "full processing (records with positions; 0 = none) (default: %(default)s)")
     s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
                    help="seed of the noise-floor and interval bootstraps (default: "
                    "%(default)s)")
