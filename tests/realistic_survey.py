@@ -116,7 +116,8 @@ def _properties(args):
             for ns in range(args.noise_seeds):
                 t1 = time.perf_counter()
                 try:
-                    trials = R.verification_trials(case, ns)
+                    kw = R.field_record_kw(case) if args.field else {}
+                    trials = R.verification_trials(case, ns, **kw)
                 except RuntimeError as exc:  # the record disagrees with the kernel
                     print(f"{cat:<14} {seed:>4} noise {ns}: {exc}", flush=True)
                     continue
@@ -166,7 +167,12 @@ def main(argv=None):
     ap.add_argument("--noise-seeds", type=int, default=1,
                     help="noisy records per case (with --properties)")
     ap.add_argument("--verbose", action="store_true", help="every trial on its own line")
+    ap.add_argument("--field", action="store_true",
+                    help="the field-like setting (realistic.FIELD): slow P1 up to multiplier "
+                    "0.995, records after at most 250 periods from rest, 5 or 20 kHz")
     args = ap.parse_args(argv)
+    if args.field:
+        R.MAX_MULTIPLIER = R.FIELD["multiplier"]
     if args.properties:
         _properties(args)
     else:
