@@ -60,6 +60,13 @@ def test_fit_summary_contents(fitted):
     assert cert["domain"]["zeta_max"] > 0 and cert["domain"]["zd_max"] > 0
     assert s["seconds"] > 0
     assert s["command"] == "fit"
+    # the selected law's bootstrap intervals, beside the Jacobian standard errors
+    sel = s["selected"]
+    assert set(sel["intervals"]) == set(sel["terms"]) and sel["interval_level"] == 0.95
+    for t in sel["terms"]:
+        lo, hi = sel["intervals"][t]
+        assert lo < sel["coefficients"][t] < hi
+    assert "bootstrap" in sel["interval_method"]
 
 
 def test_fit_ranking_csv_matches_summary(fitted):

@@ -86,7 +86,7 @@ def test_fit_recovers_the_coupling_support(records):
 
 def test_fit_on_the_hertz_record_selects_a_consistent_contact_law(records):
     sc, m, _, _ = records["c03-hertz"]
-    res = discover(sc, m, library="poly:2")
+    res = discover(sc, m, library="poly:2", n_boot_intervals=0)
     sel = res.selected
     assert sel.consistent and not sel.defects, sel.verdict
     assert "z" in sel.law.names
@@ -100,7 +100,7 @@ def _named(res):
                                           ("c06-unloading-damping", "unloading_damping")])
 def test_explain_names_the_hidden_effect_and_shrinks_the_gap(records, name, effect):
     sc, m, _, _ = records[name]
-    res = explain(sc, m, "linear", workers=1)
+    res = explain(sc, m, "linear", workers=1, n_boot_intervals=0)
     assert _named(res)[:1] == [effect], [it.evidence for it in res.iterations]
     it = next(it for it in res.iterations if it.effect)
     before, after = it.criteria_before["I2"], it.criteria_after["I2"]
@@ -110,7 +110,7 @@ def test_explain_names_the_hidden_effect_and_shrinks_the_gap(records, name, effe
 
 def test_explain_on_the_hertz_record_names_it_or_says_it_cannot_tell(records):
     sc, m, _, _ = records["c03-hertz"]
-    res = explain(sc, m, "linear", workers=1)
+    res = explain(sc, m, "linear", workers=1, n_boot_intervals=0)
     named = _named(res)
     if named:
         assert named[0] == "hertzian_stiffening"
@@ -125,6 +125,6 @@ def test_explain_on_the_hertz_record_names_it_or_says_it_cannot_tell(records):
                                   "c07-noisy"])
 def test_explain_names_nothing_on_clean_records(records, name):
     sc, m, _, _ = records[name]
-    res = explain(sc, m, "linear", workers=1)
+    res = explain(sc, m, "linear", workers=1, n_boot_intervals=0)
     assert _named(res) == [], [it.evidence for it in res.iterations]
     assert res.consistent, res.stopped_because

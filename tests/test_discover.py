@@ -25,7 +25,7 @@ def runup(paper):
 
 @pytest.fixture(scope="module")
 def result(paper, runup):
-    return discover(paper, runup, library="poly:3")
+    return discover(paper, runup, library="poly:3", n_boot_intervals=0)
 
 
 @pytest.fixture(scope="module")
@@ -36,7 +36,7 @@ def biased(paper):
     m = synthesize(paper, paper.law, periods=300, fs=20000, noise=0.01, seed=0,
                    from_rest=True, position_noise=0.01, velocities=False)
     return (discover(paper, m, library="z,zd", refine=False),
-            discover(paper, m, library="z,zd"))
+            discover(paper, m, library="z,zd", n_boot_intervals=0))
 
 
 def test_selects_true_support_p1_and_certified(result, paper):
@@ -197,7 +197,7 @@ def noisy_positions(paper):
     simplest consistent law."""
     m = synthesize(paper, paper.law, periods=300, fs=20000, noise=0.01, seed=0,
                    from_rest=True, position_noise=0.01, velocities=False)
-    return discover(paper, m, library="poly:2", stability=10)
+    return discover(paper, m, library="poly:2", stability=10, n_boot_intervals=0)
 
 
 def test_backward_steps_reach_the_simplest_consistent_law(noisy_positions):

@@ -34,7 +34,7 @@ def paper():
 @pytest.fixture(scope="module")
 def hidden_coupling(paper):
     rec = _record(paper, HC, seed=0)
-    return rec, explain(paper, rec, "linear")
+    return rec, explain(paper, rec, "linear", n_boot_intervals=0)
 
 
 def test_hidden_coupling_is_named_and_the_gap_shrinks(hidden_coupling):
@@ -67,7 +67,8 @@ def test_clean_records_add_nothing(paper):
     refit lowers; nothing is fitted to that, and the stop says so."""
     false, i4_alone = [], 0
     for seed in range(100, 120):
-        res = explain(paper, _record(paper, paper.law, seed=seed), "linear")
+        res = explain(paper, _record(paper, paper.law, seed=seed), "linear",
+                      n_boot_intervals=0)
         if any(it.effect for it in res.iterations):
             false.append(seed)
         if not res.consistent:
@@ -80,7 +81,7 @@ def test_clean_records_add_nothing(paper):
 
 def test_an_effect_too_weak_to_matter_is_not_named(paper):
     weak = ForceLaw.parse("2.06e8*z + 1.28e7*zd + 2e7*z*zd")  # 0.1 % of the peak force
-    res = explain(paper, _record(paper, weak, seed=3), "linear")
+    res = explain(paper, _record(paper, weak, seed=3), "linear", n_boot_intervals=0)
     assert [it.effect for it in res.iterations if it.effect] == []
 
 
@@ -96,7 +97,7 @@ def test_hidden_sensor_lag_is_named(paper):
     F = F + np.random.default_rng(4).normal(0.0, 0.01 * F.max(), F.size)
     rec = Measurement(rec.t, F, rec.channels, source="lagged")
     pick = ["sensor_lag", "penetration_velocity_coupling"]
-    res = explain(paper, rec, "linear", effects=pick, workers=2)
+    res = explain(paper, rec, "linear", effects=pick, workers=2, n_boot_intervals=0)
     named = [it.effect for it in res.iterations if it.effect]
     assert named and named[0] == "sensor_lag", [it.evidence for it in res.iterations]
     tau = res.final_model.observation["sensor_lag"]
@@ -105,7 +106,7 @@ def test_hidden_sensor_lag_is_named(paper):
     assert it.criteria_after["I2"] <= it.criteria_before["I2"] / 3 \
         or it.criteria_after["I2"] <= 1.5 * it.noise_floor["I2"]
     # the screening refits run in two processes; one process gives the same result
-    one = explain(paper, rec, "linear", effects=pick, workers=1)
+    one = explain(paper, rec, "linear", effects=pick, workers=1, n_boot_intervals=0)
     assert one.final_model == res.final_model
     assert [x.as_dict()["scores"] for x in one.iterations] == \
         [x.as_dict()["scores"] for x in res.iterations]

@@ -24,7 +24,7 @@ BASE = "2.06e8*z + 4e6*zd"  # the paper's machine, a lighter damper (no dominant
 def _explain(sc, law, seed=0, periods=15, **changes):
     rec = R.reference_record((sc.replace(**changes).with_law(law), law), periods=periods,
                              seed=seed, check=False)
-    return rec, explain(sc.with_law(ForceLaw.parse(BASE)), rec, "linear")
+    return rec, explain(sc.with_law(ForceLaw.parse(BASE)), rec, "linear", n_boot_intervals=0)
 
 
 def _named(res):
@@ -71,7 +71,7 @@ def test_hidden_support_nonlinearity_is_named_in_a_subharmonic_regime(paper):
     sc = paper.replace(k3=5e10)
     law = ForceLaw.parse(BASE)
     rec = R.reference_record((sc.with_law(law), law), periods=16, seed=0, check=False)
-    res = explain(paper.with_law(law), rec, "linear")
+    res = explain(paper.with_law(law), rec, "linear", n_boot_intervals=0)
     it = res.iterations[0]
     assert _named(res)[0] == "support_nonlinearity", [it.evidence for it in res.iterations]
     assert _shrinks(it)
@@ -96,7 +96,7 @@ def test_hidden_mass_loss_is_named_on_the_drift_channel(paper):
     true = lossy.replace(m2=paper.m2 / (1 - delta) ** n)
     rec = R.reference_record((true, paper.law), periods=40, transient=trans, seed=0,
                              check=False)
-    res = explain(paper, rec, "linear")
+    res = explain(paper, rec, "linear", n_boot_intervals=0)
     assert _named(res)[0] == "mass_loss", [it.evidence for it in res.iterations]
     it = res.iterations[0]
     assert _shrinks(it, "D")
@@ -105,7 +105,7 @@ def test_hidden_mass_loss_is_named_on_the_drift_channel(paper):
 
 def test_a_clean_record_shows_no_drift(paper):
     rec = R.reference_record((paper, paper.law), periods=40, seed=5, check=False)
-    res = explain(paper, rec, "linear")
+    res = explain(paper, rec, "linear", n_boot_intervals=0)
     assert _named(res) == []
     assert res.consistent and "no drift" in res.stopped_because
     assert res.criteria["D"] <= 2 * res.noise_floor["D"] + 0.005
@@ -127,7 +127,7 @@ def test_two_hidden_effects_are_both_found(paper):
     n = int(np.sum(simulate(lossy, law, (0, trans * paper.period)).event_kind == K.EV_ONSET))
     true = lossy.replace(m2=paper.m2 / (1 - delta) ** n)
     rec = R.reference_record((true, law), periods=40, transient=trans, seed=0, check=False)
-    res = explain(paper, rec, "linear")
+    res = explain(paper, rec, "linear", n_boot_intervals=0)
     named = _named(res)
     assert named[:2] == ["mass_loss", "penetration_velocity_coupling"], \
         [it.evidence for it in res.iterations]

@@ -124,7 +124,7 @@ def two_points(paper):
 
 def test_discover_fits_several_records_jointly(two_points, paper):
     scs, recs = two_points
-    res = discover(list(scs), recs, library="poly:2", n_boot=8)
+    res = discover(list(scs), recs, library="poly:2", n_boot=8, n_boot_intervals=0)
     sel = res.selected
     assert sel.law.names == ["z", "zd"] and sel.consistent, sel.verdict
     assert len(sel.evaluations) == 2 and len(res.references) == 2
