@@ -17,9 +17,13 @@ import re
 
 from .errors import LawSyntaxError
 
-_TOKEN = re.compile(
-    r"\s*(?:(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|(?P<sym>zd|z)|(?P<op>\*\*|[-+*^]))"
+_TOKEN = re.compile(  # ASCII digits only: "\d" would also take full-width and other digits
+    r"\s*(?:(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|(?P<sym>zd|z)|(?P<op>\*\*|[-+*^]))",
+    re.ASCII,
 )
+
+MAX_LAW_CHARS = 10_000
+MAX_LAW_TERMS = 100
 
 
 def _tokenize(text):
@@ -127,4 +131,11 @@ def parse_law_terms(text):
     """Parse force-law text into ``[(coefficient, a, b), ...]`` (``c * z^a * zd^b``)."""
     if not isinstance(text, str):
         raise LawSyntaxError(f"force law must be text, got {type(text).__name__}")
-    return _Parser(text).parse()
+    if len(text) > MAX_LAW_CHARS:
+        raise LawSyntaxError(f"force law text of {len(text)} characters; a contact law has a "
+                             f"few terms (at most {MAX_LAW_TERMS}, {MAX_LAW_CHARS} characters)")
+    terms = _Parser(text).parse()
+    if len(terms) > MAX_LAW_TERMS:
+        raise LawSyntaxError(f"force law of {len(terms)} terms; a contact law has a few (at "
+                             f"most {MAX_LAW_TERMS}): simplify it")
+    return terms

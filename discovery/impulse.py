@@ -470,6 +470,16 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     """
     t = np.asarray(t, dtype=float)
     F = np.asarray(F, dtype=float)
+    if not (isinstance(period, int | float | np.floating | np.integer)
+            and np.isfinite(period) and period > 0):
+        raise InputError(f"period must be a positive number of seconds; got {period!r}")
+    if t.ndim != 1 or F.shape != t.shape or t.size < 8:
+        raise InputError(f"t and F must be 1-D arrays of the same length (at least 8 samples); "
+                         f"got shapes {t.shape} and {F.shape}")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(F)) and np.all(np.diff(t) > 0)):
+        raise InputError("t must be finite and strictly increasing, and F finite")
+    if n_periods is not None and not (isinstance(n_periods, int | np.integer) and n_periods >= 1):
+        raise InputError(f"n_periods must be a positive integer; got {n_periods!r}")
     dt = float(np.median(np.diff(t)))
     sigma = estimate_noise(F)
     thr = max(5.0 * sigma, 1e-3 * float(np.max(F))) if threshold is None else float(threshold)

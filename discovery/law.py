@@ -145,6 +145,11 @@ class ForceLaw:
             raise InputError("a force law lists the same term twice; merge them")
         if not all(np.isfinite(coefs)):
             raise InputError("force-law coefficients must be finite numbers")
+        tiny = [c for c in coefs if c != 0.0 and abs(c) < np.finfo(float).tiny]
+        if tiny:
+            raise InputError(f"force-law coefficient {tiny[0]:.3g} is below the smallest normal "
+                             f"number ({np.finfo(float).tiny:.3g}): no arithmetic on it is exact;"
+                             " give the coefficient in N, m and s (e.g. 2.06e8*z)")
         object.__setattr__(self, "terms", terms)
         object.__setattr__(self, "coefficients", coefs)
         uterms = tuple(self.unloading)

@@ -150,7 +150,6 @@ def _verify_data(name, *extra):
 
 CASES = [
     # ---------------------------------------------------------------- the command line
-    ("no-command", [], "missing the command; choose one of simulate"),
     ("unknown-command", ["simulat"], "unknown command 'simulat'; choose one of"),
     ("unknown-option", ["steady", "--bogus"], "unrecognized option(s) or value(s) --bogus; "
                                               "see vidi steady --help"),
@@ -230,6 +229,21 @@ CASES = [
     ("position-noise-negative", [*S, "--position-noise", "-1"], "--position-noise"),
     ("seed-negative", [*S, "--seed", "-1"], "--seed: '-1' is out of range; give an integer >= 0"),
     ("seed-fraction", [*S, "--seed", "1.5"], "--seed: '1.5' is not an integer"),
+    # ------------------------------------------------ silently accepted before (issue 16)
+    ("repeated-law", ["steady", "--law", "1e8*z", "--law", "2e8*z", "--out", "res2"],
+     "--law is given twice"),
+    ("repeated-data", ["verify", "--data", "good.csv", "--data", "good.csv", "--out", "res"],
+     "--data is given twice"),
+    ("repeated-scenario", ["steady", "--scenario", "paper", "--scenario=light", "--out", "r3"],
+     "--scenario is given twice"),
+    ("denormal-spring", ["steady", "--law", "1e-320*z", "--out", "r4"],
+     "below the smallest normal number"),
+    ("fullwidth-digit-law", ["steady", "--law", "\uff12e8*z", "--out", "r5"],
+     "cannot read force law"),
+    ("fullwidth-digit-option", ["simulate", "--periods", "\uff13", "--out", "r6.csv"],
+     "is not an integer"),
+    ("huge-law", ["steady", "--law", " + ".join(f"{k + 1}*z^{k + 1}" for k in range(150)),
+                  "--out", "r7"], "a contact law has a few"),
     # -------------------------------------------------------------- simulate --out
     ("simulate-out-empty", ["simulate", "--out", ""], "--out is empty"),
     ("simulate-out-directory", ["simulate", "--out", "adir"], "is a directory; give a file"),
@@ -352,9 +366,12 @@ CASES += [
     ("landscape-range-crosses-zero", [*L, "--range0=-1e8:1e8"], 'reaches zero'),
     ("landscape-range-reversed", [*L, "--range0", "3e8:1e8"], 'needs LOW < HIGH'),
     ("landscape-range-text", [*L, "--range1", "abc"], 'must look like LOW:HIGH'),
-    ("landscape-grid-syntax", [*L, "--grid", "4by4"], 'must look like 41x41'),
-    ("landscape-grid-too-small", [*L, "--grid", "1x1"], 'at least 2 points per axis'),
-    ("landscape-workers-zero", [*L, "--workers", "0"], "--workers: '0' is out of range"),
+    ("landscape-grid-syntax", ["landscape", "--grid", "4by4", "--out", "landres"],
+     'must look like 41x41'),
+    ("landscape-grid-too-small", ["landscape", "--grid", "1x1", "--out", "landres"],
+     'at least 2 points per axis'),
+    ("landscape-workers-zero", ["landscape", "--grid", "3x3", "--workers", "0", "--out",
+                                "landres"], "--workers: '0' is out of range"),
     ("landscape-law-one-term", [*L, "--law", "2e8*z"], 'has 1 term(s)'),
     ("landscape-law-empty", [*L, "--law", ""], '--law is empty'),
     ("landscape-data-no-contact", [*L, "--data", "zeros.csv"], 'no contact found'),

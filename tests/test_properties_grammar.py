@@ -23,7 +23,7 @@ exponents = st.one_of(
 )
 terms = st.tuples(exponents, exponents).filter(lambda ab: ab != (0.0, 0.0)).map(
     lambda ab: Term(*ab))
-coefficients = st.floats(allow_nan=False, allow_infinity=False)
+coefficients = st.floats(allow_nan=False, allow_infinity=False, allow_subnormal=False)
 laws = st.lists(st.tuples(terms, coefficients), min_size=1, max_size=6,
                 unique_by=lambda tc: tc[0]).map(
     lambda tcs: ForceLaw(tuple(t for t, _ in tcs), tuple(c for _, c in tcs)))

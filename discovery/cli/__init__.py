@@ -159,6 +159,33 @@ def _attach_dash_values(parser, argv):
     return out
 
 
+def _refuse_repeats(parser, argv):
+    """A value option given twice (``--law A --law B``) is refused: argparse would keep the
+    last one silently.  Options that collect values (``--data`` of ``fit``) may repeat."""
+    sp, rest = parser, list(argv)
+    while True:  # descend into the (sub)command named on the line
+        sub = next((a for a in sp._actions if isinstance(a, argparse._SubParsersAction)), None)
+        name = next((t for t in rest if not t.startswith("-")), None)
+        if sub is None or name not in sub.choices:
+            break
+        sp, rest = sub.choices[name], rest[rest.index(name) + 1:]
+    seen = {}
+    for tok in rest:
+        if tok == "--":
+            break
+        if not tok.startswith("--"):
+            continue
+        opt = tok.split("=", 1)[0]
+        action = sp._option_string_actions.get(opt)
+        if action is None or action.nargs is not None or isinstance(
+                action, argparse._AppendAction | argparse._StoreConstAction):
+            continue
+        if action.dest in seen:
+            raise UsageError(f"{opt} is given twice; give it once (the last would silently "
+                             "win)")
+        seen[action.dest] = tok
+
+
 def _error(message):
     print(f"vidi: error: {' '.join(str(message).split())}", file=sys.stderr)
 
@@ -181,7 +208,9 @@ def main(argv=None):
             parser.print_help()
             return 0
         try:
-            args = parser.parse_args(_attach_dash_values(parser, argv))
+            line = _attach_dash_values(parser, argv)
+            _refuse_repeats(parser, line)
+            args = parser.parse_args(line)
         except SystemExit as exc:  # --help, --version
             return exc.code if isinstance(exc.code, int) else 0
         command = " ".join(x for x in (getattr(args, "command", None),

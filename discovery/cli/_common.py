@@ -46,6 +46,8 @@ def number(lo=None, hi=None, *, lo_open=False, unit=""):
 
     def parse(text):
         try:
+            if not text.isascii():  # float() would take full-width and other digits
+                raise ValueError(text)
             v = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not a number; give {need}") from None
@@ -66,6 +68,8 @@ def integer(lo=None, hi=None):
 
     def parse(text):
         try:
+            if not text.isascii():
+                raise ValueError(text)
             v = int(text, 10)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not an integer; give {need}") \
