@@ -284,7 +284,8 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
     Returns
     -------
     dict
-        ``{"mean": {I0..I4}, "q95": {I0..I4}, "n_boot": n, "seed": seed}``.
+        ``{"mean": {I0..I4}, "q95": {I0..I4}, "sd": {I0..I4}, "n_boot": n, "seed": seed,
+        "impacts": [contacts per cycle of each replicate's last block]}``.
     """
     rng = np.random.default_rng(seed)
     chol = []
@@ -294,6 +295,7 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
         except np.linalg.LinAlgError:
             chol.append(np.diag(np.sqrt(np.clip(np.diag(blk.state.cov), 0.0, None))))
     samples = {n: [] for n in CRITERIA}
+    impacts = []  # contacts per cycle each replicate shows (noise can split a contact)
     base = None
     for _ in range(n_boot):
         starts = [b.state.y + L @ rng.standard_normal(4) for b, L in zip(span.blocks, chol,
@@ -315,10 +317,13 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
             continue
         for n, v in crit.items():
             samples[n].append(v)
+        impacts.append(int(len(reps[-1].support)))
     if not samples["I2"]:
         inf = {n: float("inf") for n in CRITERIA}
-        return {"mean": inf, "q95": dict(inf), "sd": dict(inf), "n_boot": 0, "seed": seed}
-    return {"mean": {n: float(np.mean(v)) for n, v in samples.items()},
+        return {"mean": inf, "q95": dict(inf), "sd": dict(inf), "n_boot": 0, "seed": seed,
+                "impacts": []}
+    return {"impacts": impacts,
+            "mean": {n: float(np.mean(v)) for n, v in samples.items()},
             "q95": {n: float(np.quantile(v, 0.95)) for n, v in samples.items()},
             "sd": {n: float(np.std(v, ddof=1)) if len(v) > 1 else 0.0
                    for n, v in samples.items()},
