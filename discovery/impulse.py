@@ -25,7 +25,8 @@ from .dynamics import _kernel as K
 from .dynamics.simulate import simulate
 from .errors import InputError
 
-__all__ = ["Impulse", "impulse_from_steady_state", "impulse_from_samples", "estimate_noise"]
+__all__ = ["Impulse", "impulse_from_steady_state", "impulse_from_samples", "estimate_noise",
+           "own_period", "check_drive_period"]
 
 
 @dataclass(frozen=True)
@@ -617,6 +618,49 @@ def _first_after(t, F, t_on, thr, exact_onset):
         if F[j] > thr:
             return j if j > k and F[j - 1] <= 0.5 * thr else k
     return k
+
+
+def own_period(t, F, period, max_periods=4.5):
+    """The record's own period from its force history: the lag of the autocorrelation's
+    highest peak between half a drive period and ``max_periods`` periods.
+
+    Returns
+    -------
+    (lag, strength) : (float, float)
+        Lag [s] and the normalised autocorrelation there (1: exactly periodic).
+    """
+    t = np.asarray(t, dtype=float)
+    x = np.asarray(F, dtype=float)
+    x = x - x.mean()
+    dt = float(np.median(np.diff(t)))
+    n = x.size
+    lo, hi = int(0.5 * period / dt), min(int(max_periods * period / dt), n // 2)
+    if hi <= lo + 2 or not np.any(x):
+        return float("nan"), 0.0
+    m = 1 << int(np.ceil(np.log2(2 * n)))
+    X = np.fft.rfft(x, m)
+    ac = np.fft.irfft(X * np.conj(X), m)[:n]
+    ac = ac / ac[0]
+    k = lo + int(np.argmax(ac[lo:hi]))
+    return k * dt, float(ac[k])
+
+
+def check_drive_period(t, F, period, source=""):
+    """Refuse a record whose force repeats at a period that is no whole number of the
+    scenario's drive periods (a record of another machine or drive frequency, or a time
+    column in other units): everything downstream would be meaningless.  A record without a
+    clear period (strength below 0.3: chaos, too short) passes."""
+    lag, strength = own_period(t, F, period)
+    if not (np.isfinite(lag) and strength >= 0.3):
+        return
+    r = lag / period
+    if abs(r - round(r)) > 0.03:
+        where = f" of {source}" if source else ""
+        raise InputError(
+            f"the force{where} repeats every {lag:.4g} s ({r:.3g} of the scenario's drive "
+            f"period {period:.4g} s, i.e. a drive of {round(r) / lag if round(r) else 1 / lag:.4g}"
+            f" Hz rather than {1 / period:.4g} Hz); give the scenario of the machine that made "
+            "the record (its frequency), or check the t column's units")
 
 
 def _cycle_periods(t, F, period, max_period):

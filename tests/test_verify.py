@@ -160,3 +160,12 @@ def test_an_undefined_noise_floor_never_makes_a_law_consistent(light, light_reco
                                                 for f in dataclasses.fields(ref)}))
     assert ev.status == "ok" and ev.criteria
     assert not ev.consistent and "could not be estimated" in ev.verdict
+
+
+def test_a_record_of_another_drive_frequency_is_refused_up_front(light_record):
+    """A 20 Hz record against the 25 Hz paper scenario: its force repeats every 1.25 drive
+    periods, which no machine at 25 Hz does; refused before any simulation."""
+    from discovery.errors import InputError
+
+    with pytest.raises(InputError, match=r"repeats every .* 20 Hz rather than 25 Hz"):
+        Reference.from_measurement(light_record, load_scenario("paper"))

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..criteria import CRITERIA
 from ..errors import InputError
-from ..impulse import estimate_noise
+from ..impulse import check_drive_period, estimate_noise
 from .noise_floor import noise_floor
 from .trajectory import BLOCK_CYCLES, record_span, span_floor
 
@@ -136,6 +136,7 @@ class Reference:
         if not np.isfinite(time_offset):
             raise InputError(f"time offset must be finite, got {time_offset!r}")
         T = scenario.period
+        check_drive_period(measurement.t, measurement.F, T, measurement.source)
         E = measurement.impulse(T)
         t = measurement.t
         dt = float(np.median(np.diff(t)))
