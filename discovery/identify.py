@@ -394,7 +394,7 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
     t0 = time.perf_counter()
     spent = 0
     short = [r.shortened() if isinstance(r, Reference) else None for _, r in records]
-    if short_first and method == "least-squares" and all(r is not None for r in short) \
+    if short_first and all(r is not None for r in short) \
             and max_simulations >= 8 * len(records):
         try:
             first = identify([sc for sc, _ in records], short, start, criterion=criterion,
