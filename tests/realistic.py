@@ -553,7 +553,8 @@ def _trial(label, scenario, law, ref, ref_clean, true):
     i2c = evc.criteria.get("I2", nan)
     if true or "failed" in (ev.status, evc.status):
         detectable = None
-    elif evc.status != "ok" or evc.regime["simulated"] != evc.regime["measured"]:
+    elif evc.status != "ok" or (evc.regime["simulated"] is not None  # None: not computed
+                                and evc.regime["simulated"] != evc.regime["measured"]):
         detectable = True
     else:
         limit = CONSISTENCY_FACTOR * floor + CONSISTENCY_SLACK if ev.status == "ok" else 0.0

@@ -71,7 +71,11 @@ class Reference:
 
     @property
     def impacts(self):
-        """Contacts per measured cycle (above the noise threshold)."""
+        """Contacts per measured cycle (above the noise threshold); with a record span,
+        those of the cycles aligned at their onsets, whose near-losses are merged on the
+        penetration (a dip of the force within its noise is no new impact)."""
+        if self.span is not None and self.cycle is not None:
+            return int(len(self.cycle.support))
         return int(len(self.impulse.support))
 
     def shortened(self):
