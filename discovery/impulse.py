@@ -474,8 +474,8 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     if not (isinstance(period, int | float | np.floating | np.integer)
             and np.isfinite(period) and period > 0):
         raise InputError(f"period must be a positive number of seconds; got {period!r}")
-    if t.ndim != 1 or F.shape != t.shape or t.size < 8:
-        raise InputError(f"t and F must be 1-D arrays of the same length (at least 8 samples); "
+    if t.ndim != 1 or F.shape != t.shape or t.size < 2:
+        raise InputError(f"t and F must be 1-D arrays of the same length (at least 2 samples); "
                          f"got shapes {t.shape} and {F.shape}")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(F)) and np.all(np.diff(t) > 0)):
         raise InputError("t must be finite and strictly increasing, and F finite")
