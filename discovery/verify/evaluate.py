@@ -339,6 +339,8 @@ def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_
                      "they agree (a contact split or hidden near the threshold)")
         imp = {**imp, "simulated": imp["measured"]}
     verdict = _verdict(consistent, reg_for_verdict, imp, crit, fl["mean"], lim)
+    if verdict and reg_for_verdict is not reg and reg_for_verdict != reg:
+        verdict = verdict.replace(f", same regime {reg['measured']}", ", over the record's span")
     if not settled and reg["simulated"] != reg["measured"]:
         what = (f"settles to {reg['simulated']}" if ss is not None and ss.periodic
                 else f"reaches no stable periodic orbit ({reg['simulated']})")
