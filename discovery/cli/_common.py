@@ -26,7 +26,8 @@ from ..scenario import builtin_scenarios
 
 SCENARIO_HELP = (f"built-in scenario ({', '.join(builtin_scenarios())}) or a TOML file "
                  "(default: paper)")
-LAW_HELP = ("force law, e.g. '2.06e8*z + 1.28e7*zd' (default: the scenario's law); a law "
+LAW_HELP = ("force law in z = zeta (penetration w1 - w2, m) and zd = dzeta (its rate while "
+            "loading, m/s), e.g. '2.06e8*z + 1.28e7*zd' (default: the scenario's law); a law "
             "starting with '-' as --law=-1e8*z")
 COLUMNS_HELP = ("the file's header names for our columns when they differ, e.g. "
                 "t=time_s,F=force_N (names: t, F, w1, v1, w2, v2, a2; default: the headers are "

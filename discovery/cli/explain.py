@@ -75,6 +75,12 @@ def run(args):
     return 0
 
 
+def _catalogue():
+    from ..explain.effects import EFFECTS
+
+    return EFFECTS
+
+
 def register(sub):
     s = sub.add_parser("explain", help="find where a model and a record disagree, name the "
                        "missing physical effect, add it, refit, show the gap shrink")
@@ -88,9 +94,8 @@ def register(sub):
                    help="start model: 'linear' (z, zd), a term list 'z,zd,z^1.5' (start values "
                    "from the regression and the record) or a law with coefficients "
                    "(default: %(default)s)")
-    s.add_argument("--effects", help="comma-separated catalogue ids to consider (default: all of "
-                   "penetration_velocity_coupling, hertzian_stiffening, unloading_damping, "
-                   "permanent_set, support_nonlinearity, sensor_lag)")
+    s.add_argument("--effects", help="comma-separated catalogue ids to consider (default: all "
+                   "of " + ", ".join(e.id for e in _catalogue()) + ")")
     s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
                    help="criterion of the refits (default: %(default)s)")
     s.add_argument("--alpha", type=number(0.0, 0.5, lo_open=True), default=0.01,
