@@ -41,7 +41,7 @@ from .law import ForceLaw
 from .verify import Reference, evaluate
 
 __all__ = ["IdentificationResult", "identify", "METHODS", "as_records", "pair_records",
-           "contact_scales", "record_start"]
+           "contact_scales", "record_start", "cycle_pairs"]
 
 METHODS = ("coordinate-descent", "nelder-mead", "least-squares")
 _PENALTY = 10.0          # criterion value of a failed simulation (criteria are O(1))
@@ -187,7 +187,7 @@ def _measured_cycles(ref):
     return list(ref.blocks) if getattr(ref, "blocks", ()) else [ref.impulse]
 
 
-def _cycle_pairs(ev, ref):
+def cycle_pairs(ev, ref):
     """``[(measured, simulated), ...]`` of an evaluation, one per compared cycle."""
     return ev.extra.get("blocks") or [(ref.impulse, ev.simulated)]
 
@@ -267,7 +267,7 @@ class _Objective:
         return np.concatenate([((S.F - E.F) * w)[1:]
                                for ev, (_, ref), ws in zip(evs, self.records, self.w,
                                                            strict=True)
-                               for (E, S), w in zip(_cycle_pairs(ev, ref), ws, strict=True)])
+                               for (E, S), w in zip(cycle_pairs(ev, ref), ws, strict=True)])
 
 
 def _coordinate_descent(obj, x0, xtol, step0=0.1):

@@ -55,13 +55,7 @@ def _replicate(scenario, law, observe, ref, rng, tolerances):
     from .verify.trajectory import simulated_history
 
     span = ref.span
-    starts = []
-    for b in span.blocks:
-        try:
-            L = np.linalg.cholesky(b.state.cov + 1e-30 * np.eye(4))
-        except np.linalg.LinAlgError:
-            L = np.diag(np.sqrt(np.clip(np.diag(b.state.cov), 0.0, None)))
-        starts.append(b.state.y + L @ rng.standard_normal(4))
+    starts = [b.state.draw(rng) for b in span.blocks]
     hist = simulated_history(scenario, law, span, tolerances=tolerances, starts=starts,
                              observe=observe)
     blocks = tuple(replace(b, F=h + rng.normal(0.0, span.sigma_f, h.size))

@@ -50,9 +50,9 @@ from scipy.stats import chi2
 from .._workers import terminate_pool, worker_initializer
 from ..errors import InputError, IntegrationError
 from ..identify import (
-    _cycle_pairs,
     as_records,
     contact_scales,
+    cycle_pairs,
     identify,
     pair_records,
     record_start,
@@ -351,7 +351,7 @@ class _Problem:
         if not all(e.status == "ok" for e in evs):
             return None
         return np.concatenate([S.F - E.F for e, (_, ref) in zip(evs, self.records, strict=True)
-                               for E, S in _cycle_pairs(e, ref)])
+                               for E, S in cycle_pairs(e, ref)])
 
     def value(self, model, criterion):
         """The mean ``criterion`` over records (inf when a record has no steady cycle)."""

@@ -18,6 +18,7 @@ a local quadratic for the frame.
 """
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -49,6 +50,19 @@ class StateEstimate:
     t: float
     n_samples: int
     method: str
+
+    @cached_property
+    def factor(self):
+        """``L`` with ``L L^T = cov`` (the square roots of the variances where the
+        covariance is not positive definite)."""
+        try:
+            return np.linalg.cholesky(self.cov + 1e-30 * np.eye(4))
+        except np.linalg.LinAlgError:
+            return np.diag(np.sqrt(np.clip(np.diag(self.cov), 0.0, None)))
+
+    def draw(self, rng):
+        """A state drawn from the fit's distribution (four standard normals from ``rng``)."""
+        return self.y + self.factor @ rng.standard_normal(4)
 
 
 def free_flight_runs(t, F, zeta, period, *, min_fraction=0.08):

@@ -288,18 +288,11 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
         "impacts": [contacts per cycle of each replicate's last block]}``.
     """
     rng = np.random.default_rng(seed)
-    chol = []
-    for blk in span.blocks:
-        try:
-            chol.append(np.linalg.cholesky(blk.state.cov + 1e-30 * np.eye(4)))
-        except np.linalg.LinAlgError:
-            chol.append(np.diag(np.sqrt(np.clip(np.diag(blk.state.cov), 0.0, None))))
     samples = {n: [] for n in CRITERIA}
     impacts = []  # contacts per cycle each replicate shows (noise can split a contact)
     base = None
     for _ in range(n_boot):
-        starts = [b.state.y + L @ rng.standard_normal(4) for b, L in zip(span.blocks, chol,
-                                                                          strict=True)]
+        starts = [b.state.draw(rng) for b in span.blocks]
         noise = [rng.normal(0.0, span.sigma_f, b.F.size) for b in span.blocks]
         try:
             # the truth as a record holds it: point samples
