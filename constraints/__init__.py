@@ -27,37 +27,60 @@ errors
     :class:`CertificateError`, :class:`SolverError`.
 """
 
-from .bernstein import (
-    CONDITIONS,
-    BernsteinMap,
-    bernstein_coefficients,
-    bernstein_map,
-    evaluate_bernstein,
-    lattice_factor,
-)
-from .builders import (
-    coefficient_signs,
-    constraint_rows,
-    dissipativity,
-    monotone_elastic,
-    non_adhesion,
-    normalized_rows,
-    physical,
-    sign_rows,
-)
-from .domain import Box
-from .errors import CertificateError, InputError, SolverError, VidiError
-from .library import evaluate, exponents, features, scale_factors, to_physical, to_scaled
-from .solver import solve
-from .verify import (
-    DEFAULT_GRID,
-    DEFAULT_TOLERANCE,
-    Certificate,
-    certify,
-    force_scale,
-    grid_minimum,
-    require,
-)
+import importlib
+
+# Imported on first use (PEP 562): ``import constraints`` costs nothing until a name is
+# needed, so the errors module can be reached without loading cvxpy.
+_EXPORTS = {
+    'CONDITIONS': 'bernstein',
+    'BernsteinMap': 'bernstein',
+    'bernstein_coefficients': 'bernstein',
+    'bernstein_map': 'bernstein',
+    'evaluate_bernstein': 'bernstein',
+    'lattice_factor': 'bernstein',
+    'coefficient_signs': 'builders',
+    'constraint_rows': 'builders',
+    'dissipativity': 'builders',
+    'monotone_elastic': 'builders',
+    'non_adhesion': 'builders',
+    'normalized_rows': 'builders',
+    'physical': 'builders',
+    'sign_rows': 'builders',
+    'Box': 'domain',
+    'CertificateError': 'errors',
+    'InputError': 'errors',
+    'SolverError': 'errors',
+    'VidiError': 'errors',
+    'evaluate': 'library',
+    'exponents': 'library',
+    'features': 'library',
+    'scale_factors': 'library',
+    'to_physical': 'library',
+    'to_scaled': 'library',
+    'solve': 'solver',
+    'DEFAULT_GRID': 'verify',
+    'DEFAULT_TOLERANCE': 'verify',
+    'Certificate': 'verify',
+    'certify': 'verify',
+    'force_scale': 'verify',
+    'grid_minimum': 'verify',
+    'require': 'verify',
+}
+
+
+
+def __getattr__(name):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'constraints' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))
+
 
 __all__ = [
     "CONDITIONS",

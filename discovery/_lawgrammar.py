@@ -23,6 +23,7 @@ _TOKEN = re.compile(  # ASCII digits only: "\d" would also take full-width and o
 )
 
 MAX_LAW_CHARS = 10_000
+MAX_EXPONENT = 10.0  # largest exponent of a term: z^10 already spans 40 decades of force
 MAX_LAW_TERMS = 100
 
 
@@ -112,6 +113,11 @@ class _Parser:
                     raise LawSyntaxError(
                         f"force law {self.text!r}: negative exponent on {sym}; "
                         "exponents must be >= 0 (the force must stay finite at contact onset)"
+                    )
+                if power > MAX_EXPONENT:
+                    raise LawSyntaxError(
+                        f"force law {self.text!r}: exponent {power:.6g} on {sym} is above "
+                        f"{MAX_EXPONENT:g}; a contact law's powers are small (1, 1.5, 2, ...)"
                     )
             if sym == "z":
                 a += power

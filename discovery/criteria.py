@@ -26,7 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._validate import params
 from .errors import InputError
+from .impulse import Impulse
 
 __all__ = ["CRITERIA", "Comparison", "compare", "evaluate_criteria", "criterion"]
 
@@ -195,6 +197,7 @@ def criterion(name):
             from None
 
 
+@params(measured=Impulse, simulated=Impulse, names=(None, list, tuple))
 def evaluate_criteria(measured, simulated, names=None):
     """``{name: value}`` for the requested criteria (default all), measured vs simulated."""
     names = list(CRITERIA) if names is None else list(names)

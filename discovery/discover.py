@@ -38,14 +38,18 @@ import numpy as np
 
 from constraints import require as require_certificate
 
+from ._validate import Real, Text, params
 from .criteria import criterion as _criterion
+from .dynamics import Tolerances
 from .errors import InputError, IntegrationError, VidiError
 from .identify import identify, pair_records, record_start
 from .intervals import bootstrap_intervals
 from .law import Term
 from .library import Library
+from .measurement import Measurement
 from .regression import ConstrainedSparseRegressor
 from .samples import contact_samples, join_samples
+from .scenario import Scenario
 from .verify import Reference, evaluate
 
 __all__ = ["RankedModel", "DiscoveryResult", "discover", "rank"]
@@ -591,6 +595,15 @@ def _equivalent(ranking, selected, est, samples, criterion):
     return out
 
 
+@params(
+    scenario=(Scenario, list, tuple), measurement=(Measurement, list, tuple),
+    library=(Text(), Library, list, tuple), selection=Text(), scoring=Text(),
+    max_terms=Real(1, 64, integer=True), criterion=Text(), shortlist=Real(1, integer=True),
+    stability=Real(0, integer=True), derivative=(None, Text()), sim_rtol=Real(0, open_low=True),
+    sim_atol=Real(0), tolerances=(Tolerances, None), random_state=Real(0, integer=True),
+    n_boot=Real(0, integer=True), max_simulations=Real(0, integer=True),
+    stepwise=Real(0, integer=True), require=(tuple, list), n_boot_intervals=Real(0, integer=True),
+)
 def discover(scenario, measurement, *, library="poly:2", selection="best-subset", scoring="bic",
              max_terms=4, criterion="I2", shortlist=8, refine=True, stability=0,
              derivative=None, average_cycles=False, sim_rtol=0.1, sim_atol=0.005,

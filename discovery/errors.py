@@ -11,7 +11,8 @@ re-exported here, so the constraints package's :class:`~constraints.errors.Solve
 
 from constraints.errors import CertificateError, InputError, SolverError, VidiError
 
-__all__ = ["VidiError", "InputError", "LawSyntaxError", "IntegrationError", "CertificateError",
+__all__ = ["VidiError", "InputError", "VidiTypeError", "LawSyntaxError", "IntegrationError",
+           "CertificateError",
            "SolverError"]
 
 
@@ -21,3 +22,7 @@ class LawSyntaxError(InputError):
 
 class IntegrationError(VidiError, RuntimeError):
     """A simulation failed (blow-up, step budget exhausted, step size underflow)."""
+
+
+class VidiTypeError(VidiError, TypeError):
+    """An argument of a public function has the wrong type."""

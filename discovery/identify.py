@@ -34,10 +34,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares, minimize
 
+from ._validate import Real, Text, params
 from .criteria import criterion as _criterion
+from .dynamics import Tolerances
 from .errors import InputError, IntegrationError
 from .impulse import Impulse
 from .law import ForceLaw
+from .measurement import Measurement
+from .scenario import Scenario
 from .verify import Reference, evaluate
 
 __all__ = ["IdentificationResult", "identify", "METHODS", "as_records", "pair_records",
@@ -327,6 +331,12 @@ def _uncertainty(obj, x, names):
     return se, corr
 
 
+@params(
+    scenario=(Scenario, list, tuple), reference=(Measurement, Reference, Impulse, list, tuple),
+    criterion=Text(), method=Text(), xtol=Real(0, open_low=True),
+    max_simulations=Real(1, integer=True), tolerances=(Tolerances, None),
+    n_boot_intervals=Real(0, integer=True), seed=Real(0, integer=True),
+)
 def identify(scenario, reference, start, *, criterion="I2", method="coordinate-descent",
              xtol=1e-5, max_simulations=600, tolerances=None, uncertainty=True,
              observe=None, short_first=True, n_boot_intervals=0, seed=0):

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
+from ._validate import Array, Real, params
 from .dynamics import _kernel as K
 from .dynamics.simulate import simulate
 from .errors import InputError
@@ -437,6 +438,11 @@ def _edges(t, F, thr, min_len, max_extrap=4.0, noise=0.0):
     return out
 
 
+@params(
+    t=Array(1), F=Array(1), period=Real(0, open_low=True), zeta=(None, Array(1)),
+    n_periods=(None, Real(1, integer=True)), threshold=(None, Real(0)),
+    max_period=Real(1, 64, integer=True), min_samples=Real(1, integer=True),
+)
 def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=None,
                          max_period=4, min_samples=3):
     """Steady-state impulse from a sampled force record (measured or simulated).

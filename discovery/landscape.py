@@ -24,10 +24,14 @@ from multiprocessing import get_context
 
 import numpy as np
 
+from ._validate import Array, Real, params
 from ._workers import terminate_pool, worker_initializer
 from .criteria import CRITERIA
+from .dynamics import Tolerances
 from .errors import InputError, VidiError
+from .law import ForceLaw
 from .response import response
+from .scenario import Scenario
 from .verify import Reference, evaluate
 
 __all__ = ["Landscape", "landscape", "parse_grid", "default_range", "DEFAULT_SPREAD"]
@@ -217,6 +221,10 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
     return fl["mean"], fl["q95"], f"the measured cycle ({why})"
 
 
+@params(
+    scenario=Scenario, law=ForceLaw, axis0=Array(1), axis1=Array(1), reference=(None, Reference),
+    workers=(None, Real(1, integer=True)), tolerances=(Tolerances, None),
+)
 def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tolerances=None,
               from_state=True):
     """Compute all criteria over a grid of the first two coefficients of ``law``.

@@ -35,7 +35,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 import sympy
 
-from ._lawgrammar import parse_law_terms
+from ._lawgrammar import MAX_EXPONENT, parse_law_terms
+from ._validate import Real, check
 from .errors import InputError
 
 __all__ = ["Term", "ForceLaw", "ZETA", "ZD"]
@@ -65,6 +66,8 @@ class Term:
     b: float
 
     def __post_init__(self):
+        check("Term: a", self.a, Real(0, MAX_EXPONENT))
+        check("Term: b", self.b, Real(0, MAX_EXPONENT))
         a, b = float(self.a), float(self.b)
         if not (np.isfinite(a) and np.isfinite(b)) or a < 0 or b < 0 or (a == 0 and b == 0):
             raise InputError(
@@ -135,6 +138,13 @@ class ForceLaw:
     permanent_set: float = 0.0
 
     def __post_init__(self):
+        for name in ("terms", "coefficients", "unloading", "unloading_coefficients"):
+            check(f"ForceLaw: {name}", getattr(self, name), (tuple, list))
+        for term in (*self.terms, *self.unloading):
+            check("ForceLaw: each term", term, Term)
+        for c in (*self.coefficients, *self.unloading_coefficients):
+            check("ForceLaw: each coefficient", c, Real())
+        check("ForceLaw: permanent_set", self.permanent_set, Real(0, _MAX_SET))
         terms = tuple(self.terms)
         coefs = tuple(float(c) for c in self.coefficients)
         if len(terms) != len(coefs):

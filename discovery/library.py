@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._validate import check
 from .errors import InputError
 from .law import ForceLaw, Term
 
@@ -36,6 +37,9 @@ class Library:
     terms: tuple
 
     def __post_init__(self):
+        check("Library: terms", self.terms, (tuple, list))
+        for term in self.terms:
+            check("Library: each term", term, Term)
         terms = tuple(self.terms)
         if not terms:
             raise InputError("a library needs at least one term")

@@ -34,10 +34,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ._io import atomic_write_text
+from ._validate import Array, Real, Text, check, params
 from .dynamics import simulate
 from .dynamics.steady_state import steady_state
 from .errors import InputError
 from .impulse import _edge_params, estimate_noise, impulse_from_samples
+from .law import ForceLaw
+from .scenario import Scenario
 
 __all__ = ["Measurement", "synthesize", "COLUMNS", "LIMITS", "JITTER_LIMIT"]
 
@@ -90,6 +93,13 @@ class Measurement:
     notes: tuple = ()
 
     def __post_init__(self):
+        check("Measurement: t", self.t, Array(1))
+        check("Measurement: F", self.F, Array(1))
+        check("Measurement: channels", self.channels, dict)
+        for name, arr in self.channels.items():
+            check("Measurement: a channel name", name, Text(100))
+            check(f"Measurement: channel {name}", arr, Array(1))
+        check("Measurement: source", self.source, Text(4096, empty=True))
         t = np.asarray(self.t, dtype=float)
         F = np.asarray(self.F, dtype=float)
         where = f" in {self.source}" if self.source else ""
@@ -481,6 +491,10 @@ def _parse_column(key, hname, j, body, name, decimal_comma):
     return v
 
 
+@params(
+    scenario=Scenario, law=ForceLaw, periods=Real(1, integer=True), fs=Real(0, open_low=True),
+    noise=Real(0, 1), seed=Real(0, integer=True), position_noise=Real(0, 1),
+)
 def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None, *,
                from_rest=False, position_noise=0.0, velocities=True):
     """A synthetic measurement of ``law`` sampled at ``fs``.

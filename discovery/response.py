@@ -8,8 +8,12 @@ measurement's contact threshold.
 
 from dataclasses import dataclass
 
+from ._validate import Real, params
+from .dynamics import Tolerances
 from .dynamics.steady_state import steady_state
 from .impulse import Impulse, impulse_from_steady_state
+from .law import ForceLaw
+from .scenario import Scenario
 
 __all__ = ["Response", "response"]
 
@@ -32,6 +36,10 @@ class Response:
         return self.impulse.resampled_like(measured)
 
 
+@params(
+    scenario=Scenario, law=ForceLaw, tolerances=(Tolerances, None),
+    points_per_period=Real(16, integer=True),
+)
 def response(scenario, law, *, tolerances=None, points_per_period=2000, **steady_kwargs):
     """Steady state of ``law`` in ``scenario`` and its exact impulse.
 

@@ -16,8 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import savgol_filter
 
+from ._validate import Real, Text, params
 from .errors import InputError
 from .impulse import estimate_noise, impulse_from_samples
+from .measurement import Measurement
 
 __all__ = ["ContactSamples", "contact_samples", "join_samples"]
 
@@ -152,6 +154,10 @@ def _average_steady(t, zeta, dzeta, F, period):
     return (*cat, count)
 
 
+@params(
+    measurement=Measurement, derivative=(None, Text()), window=Real(3, integer=True),
+    k_sigma=Real(0, open_low=True), weights=Text(), period=(None, Real(0, open_low=True)),
+)
 def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weights="uniform",
                     average_cycles=False, period=None):
     """Contact samples of a :class:`~discovery.measurement.Measurement`.

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ._validate import Text, check
 from .errors import InputError
 from .law import ForceLaw
 
@@ -105,6 +106,9 @@ class Scenario:
     mass_loss: float = 0.0
 
     def __post_init__(self):
+        check("Scenario: name", self.name, Text(200))
+        check("Scenario: source", self.source, Text(4096, empty=True))
+        check("Scenario: law", self.law, (ForceLaw, None))
         for key, (unit, strict) in _FIELDS.items():
             value = _number(getattr(self, key), f"scenario {key}", unit)
             lim = LIMITS[key]

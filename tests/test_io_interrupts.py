@@ -2,11 +2,14 @@
 no traceback, earlier results intact and no staging left; after SIGKILL the next run
 removes the staging directory the killed one left."""
 
+import contextlib
 import json
+import os
 import signal
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import pytest
@@ -99,3 +102,54 @@ def test_sigkill_then_next_run_cleans_up(earlier, capsys):
     assert sorted(q.name for q in earlier.iterdir()) == [".vidi-manifest.json", "figure.png",
                                                          "summary.json"]
     assert json.loads((earlier / "summary.json").read_text())["command"] == "steady"
+
+
+def test_interrupt_reraised_by_compiled_code_is_an_interrupt(earlier, monkeypatch, capsys):
+    """numba re-raises a Ctrl-C inside compiled code as ``SystemError`` with the interrupt
+    as its cause: still 130 and the interrupt line, not an internal error."""
+    import discovery.cli.steady as st
+
+    def compiled(*a, **k):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as exc:
+            raise SystemError("CPUDispatcher returned a result with an exception set") from exc
+
+    monkeypatch.setattr(st, "provenance", compiled)
+    assert main(["steady", "--out", str(earlier)]) == 130
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("vidi: error: interrupted (Ctrl-C)")
+    _intact(earlier)
+
+
+def _restore_sigint():
+    signal.signal(signal.SIGINT, signal.SIG_DFL)  # as in a terminal, not a background job
+
+
+@pytest.mark.parametrize("delay", [0.3, 2.0, 4.0, 7.0])
+def test_ctrl_c_to_the_process_group_during_identify(tmp_path, delay):
+    """Ctrl-C in a terminal reaches the whole process group, at any moment of a run:
+    during the imports, the simulations, the bootstrap; the exit is 130 with one line (or 0
+    when the run had already finished), never an internal error or a traceback."""
+    from discovery import ForceLaw, load_scenario, synthesize
+
+    rec = synthesize(load_scenario("paper"), ForceLaw.parse("2e8*z + 1e7*zd"), periods=8,
+                     noise=0.01, seed=1)
+    rec.to_csv(tmp_path / "R.csv")
+    entry = "import sys; from discovery.cli import main; sys.exit(main())"
+    p = subprocess.Popen([sys.executable, "-c", entry, "identify", "--scenario",
+                          "paper", "--data", "R.csv", "--start", "1.5e8*z + 8e6*zd",
+                          "--intervals", "10", "--out", "I"], cwd=tmp_path,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True, preexec_fn=_restore_sigint)
+    time.sleep(delay)
+    with contextlib.suppress(ProcessLookupError):
+        os.killpg(p.pid, signal.SIGINT)
+    out, err = p.communicate(timeout=300)
+    assert p.returncode in (130, 0), (p.returncode, err)
+    assert "Traceback" not in err and "internal error" not in err, err
+    if p.returncode == 130:
+        assert err.splitlines() == ["vidi: error: interrupted (Ctrl-C); partial outputs were "
+                                    "removed, earlier results are unchanged"], err
+        assert not (tmp_path / "I").exists()
+        assert not [q for q in tmp_path.iterdir() if ".vidi-staging." in q.name]

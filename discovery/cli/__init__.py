@@ -25,13 +25,10 @@ import sys
 import threading
 import traceback
 
-from .._io import set_run
 from ..errors import VidiError
-from . import explain, fit, identify, landscape, simulate, steady, ueda, verify
 
 __all__ = ["main", "UsageError", "VidiArgumentParser"]
 
-_COMMANDS = (simulate, fit, verify, explain, steady, landscape, identify, ueda)
 
 
 class UsageError(VidiError):
@@ -69,7 +66,7 @@ def _one_line(message, prog, command=None):
     if m:
         names = m.group(1)
         if names in ("COMMAND", "command"):
-            cmds = ", ".join(c.__name__.rsplit(".", 1)[-1] for c in _COMMANDS)
+            cmds = ", ".join(COMMANDS)
             return f"missing the command; choose one of {cmds} (see vidi --help)"
         return f"missing required option(s) {names}; {see}"
     m = re.match(r"unrecognized arguments: (.*)$", message)
@@ -90,6 +87,9 @@ class VidiArgumentParser(argparse.ArgumentParser):
         raise UsageError(_one_line(message, self.prog, self.command_hint))
 
 
+COMMANDS = ("simulate", "fit", "verify", "explain", "steady", "landscape", "identify", "ueda")
+
+
 def _parser():
     p = VidiArgumentParser(
         prog="vidi",
@@ -101,8 +101,12 @@ def _parser():
                    help="print the version and exit")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND",
                            parser_class=VidiArgumentParser)
-    for cmd in _COMMANDS:
-        cmd.register(sub)
+    # imported here, inside main()'s handlers: a Ctrl-C while they load is an interrupt too
+    from . import explain, fit, identify, landscape, simulate, steady, ueda, verify
+    modules = {"simulate": simulate, "fit": fit, "verify": verify, "explain": explain,
+               "steady": steady, "landscape": landscape, "identify": identify, "ueda": ueda}
+    for name in COMMANDS:
+        modules[name].register(sub)
     _add_overwrite(p)
     return p
 
@@ -190,12 +194,39 @@ def _error(message):
     print(f"vidi: error: {' '.join(str(message).split())}", file=sys.stderr)
 
 
+_OUT_OF_MEMORY = (b"vidi: error: not enough memory for this run; reduce its size (--fs, --periods, "
+                  b"--grid) and try again\n")
+
+
+def _interruption(exc):
+    """The Ctrl-C or SIGTERM behind ``exc``: compiled code and solvers re-raise an interrupt
+    as another error (numba's ``SystemError``), with the interrupt as its cause."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt | Terminated):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
+
+
+def _stopped(exc):
+    if isinstance(exc, Terminated):
+        _error("terminated (SIGTERM); partial outputs were removed, earlier results are "
+               "unchanged")
+        return 143
+    _error("interrupted (Ctrl-C); partial outputs were removed, earlier results are unchanged")
+    return 130
+
+
 def main(argv=None):
     """Run ``vidi``; returns the exit code (0 ok, 2 bad input or failed numerics, 130
     interrupted, 143 terminated, 1 internal error)."""
+    entry = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
     old_term = None
-    if threading.current_thread() is threading.main_thread():
+    in_main_thread = threading.current_thread() is threading.main_thread()
+    if in_main_thread:
         def _terminate(signum, frame):
             raise Terminated()
         try:
@@ -203,6 +234,27 @@ def main(argv=None):
         except (ValueError, OSError):
             old_term = None
     try:
+        code = _run(argv)
+    except MemoryError:  # handled out here, once the frames holding the memory are gone
+        code = None
+    finally:
+        if entry and in_main_thread:  # the run is over: a late signal must not change its exit
+            with contextlib.suppress(ValueError, OSError):
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+                signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        elif old_term is not None:
+            signal.signal(signal.SIGTERM, old_term)
+    if code is None:
+        with contextlib.suppress(OSError):
+            os.write(2, _OUT_OF_MEMORY)
+        return 2
+    return code
+
+
+def _run(argv):
+    try:
+        from .._io import set_run
+
         parser = _parser()
         if not argv:  # plain `vidi`: the overview, not an error
             parser.print_help()
@@ -217,42 +269,31 @@ def main(argv=None):
                                        getattr(args, "ueda_command", None)) if x)
         set_run(command or None, getattr(args, "overwrite", False))
         return args.func(args)
-    except VidiError as exc:
-        _error(exc)
-        return 2
-    except ValueError as exc:  # validation errors raised as ValueError by the packages
-        _error(exc)
-        return 2
+    except (KeyboardInterrupt, Terminated) as exc:
+        return _stopped(exc)
     except MemoryError:
-        _error("not enough memory for this run; reduce its size (--fs, --periods, --grid) and "
-               "try again")
-        return 2
-    except KeyboardInterrupt:
-        _error("interrupted (Ctrl-C); partial outputs were removed, earlier results are "
-               "unchanged")
-        return 130
-    except Terminated:
-        _error("terminated (SIGTERM); partial outputs were removed, earlier results are "
-               "unchanged")
-        return 143
+        raise
     except BrokenPipeError:  # output piped into e.g. `head`: stop quietly
         with contextlib.suppress(OSError, ValueError):
             sys.stderr.close()
         return 0
-    except OSError as exc:  # the environment: disk full, permissions, a vanished file
-        where = f" ({exc.filename})" if exc.filename else ""
-        _error(f"{exc.strerror or exc}{where}; check the path, its permissions and the free "
-               "space")
-        return 2
-    except Exception as exc:  # a bug: one line, the traceback on request
-        if os.environ.get("VIDI_TRACEBACK"):
+    except Exception as exc:
+        stop = _interruption(exc)  # an interrupt re-raised by compiled code or a solver
+        if stop is not None:
+            return _stopped(stop)
+        if isinstance(exc, VidiError | ValueError):  # ValueError: the packages' validation
+            _error(exc)
+            return 2
+        if isinstance(exc, OSError):  # the environment: disk full, permissions, a vanished file
+            where = f" ({exc.filename})" if exc.filename else ""
+            _error(f"{exc.strerror or exc}{where}; check the path, its permissions and the "
+                   "free space")
+            return 2
+        if os.environ.get("VIDI_TRACEBACK"):  # a bug: one line, the traceback on request
             traceback.print_exc()
         _error(f"internal error {type(exc).__name__}: {exc}; please report it (set "
                "VIDI_TRACEBACK=1 for the traceback)")
         return 1
-    finally:
-        if old_term is not None:
-            signal.signal(signal.SIGTERM, old_term)
 
 
 if __name__ == "__main__":

@@ -5,7 +5,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._compile import announce_compile
+from .._validate import Array, Real, check, params
 from ..errors import InputError, IntegrationError
+from ..law import ForceLaw
+from ..scenario import Scenario
 from . import _kernel as K
 
 __all__ = ["Trajectory", "simulate", "Tolerances", "MODE_NAMES", "EVENT_NAMES"]
@@ -45,6 +48,11 @@ class Tolerances:
     hmax_fraction: float = 0.02
 
     def __post_init__(self):
+        for name, spec in (("rtol", Real(0, 1, open_low=True)),
+                           ("atol_scale", Real(0, open_low=True)),
+                           ("max_steps", Real(1, integer=True)),
+                           ("hmax_fraction", Real(0, 1, open_low=True))):
+            check(f"Tolerances: {name}", getattr(self, name), spec)
         if not (0 < self.rtol < 1):
             raise InputError(f"rtol must be in (0, 1), got {self.rtol!r}")
         if not self.atol_scale > 0:
@@ -153,6 +161,10 @@ def _atol(scenario, tol):
     return tol.rtol * tol.atol_scale * np.array([x, v, x, v])
 
 
+@params(
+    scenario=Scenario, law=ForceLaw, t_span=Array(1), y0=(None, Array(1)), t_eval=(None, Array(1)),
+    tolerances=(Tolerances, None), max_events=Real(1, integer=True), zeta_max0=Real(0),
+)
 def simulate(scenario, law, t_span, y0=None, t_eval=None, *, tolerances=None,
              max_events=10_000, mode0=None, throw=True, zeta_max0=0.0):
     """Integrate the two-body vibro-impact system with a given contact law.

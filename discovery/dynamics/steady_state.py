@@ -19,7 +19,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._validate import Array, Real, params
 from ..errors import InputError, IntegrationError
+from ..law import ForceLaw
+from ..scenario import Scenario
 from . import _kernel as K
 from .shooting import (
     floquet_multipliers,
@@ -165,6 +168,12 @@ class SteadyState:
                 "residual": self.residual, "n_simulations": self.n_simulations}
 
 
+@params(
+    scenario=Scenario, law=ForceLaw, transient=Real(0, integer=True),
+    max_period=Real(1, 64, integer=True), tol=Real(0, 1, open_low=True),
+    max_newton=Real(1, integer=True), long_transient=Real(0, integer=True),
+    tolerances=(Tolerances, None), y_start=(None, Array(1)), t_start=Real(),
+)
 def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_newton=12,
                  long_transient=300, tolerances=None, y_start=None, t_start=0.0):
     """Find the periodic steady state reached from a given (or the scenario's) state.

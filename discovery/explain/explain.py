@@ -47,7 +47,9 @@ from multiprocessing import get_context
 import numpy as np
 from scipy.stats import chi2
 
+from .._validate import Real, Text, params
 from .._workers import terminate_pool, worker_initializer
+from ..dynamics import Tolerances
 from ..errors import InputError, IntegrationError
 from ..identify import (
     as_records,
@@ -59,7 +61,9 @@ from ..identify import (
 )
 from ..intervals import bootstrap_intervals
 from ..law import ForceLaw, Term
-from ..verify import evaluate
+from ..measurement import Measurement
+from ..scenario import Scenario
+from ..verify import Reference, evaluate
 from . import drift as D
 from .effects import EFFECTS, Model, effect, small_step
 from .localise import localise
@@ -654,6 +658,14 @@ def _output_error(records, start, criterion, budget, tol, polish=False):
     return res2 if res2.value < res.value else res
 
 
+@params(
+    scenario=(Scenario, list, tuple), measurement=(Measurement, Reference, list, tuple),
+    start=(Text(), ForceLaw), criterion=Text(), alpha=Real(0, 1, open_low=True),
+    max_iterations=Real(1, integer=True), budget=Real(1, integer=True),
+    n_boot=Real(0, integer=True), seed=Real(0, integer=True), tolerances=(Tolerances, None),
+    effects=(None, list, tuple), max_refits=Real(1, integer=True),
+    workers=(None, Real(1, integer=True)), n_boot_intervals=Real(0, integer=True),
+)
 def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01,
             max_iterations=3, budget=150, n_boot=16, seed=0, tolerances=None, effects=None,
             max_refits=6, workers=None, n_boot_intervals=30):

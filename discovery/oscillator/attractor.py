@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._validate import Array, Real, params
 from ..dynamics import Tolerances
 from ..errors import InputError, IntegrationError
 from . import _kernel as UK
@@ -52,6 +53,12 @@ def _y0(y0):
     return y
 
 
+@params(
+    system=UedaSystem, y0=(None, Array(1)), n=Real(1, integer=True),
+    transient=Real(0, integer=True), t0=Real(), tolerances=(Tolerances, None),
+)
+
+
 def strobe_points(system, y0=None, n=200, *, transient=200, t0=0.0, tolerances=None):
     """The stroboscopic points after a transient.
 
@@ -88,6 +95,12 @@ def _after(system, y0, transient, tol):
     if int(transient) <= 0:
         return _y0(y0)
     return strobe_points(system, y0, 1, transient=int(transient) - 1, tolerances=tol)[1]
+
+
+@params(
+    system=UedaSystem, y0=Array(1), t_span=Array(1), n_samples=Real(2, integer=True),
+    tolerances=(Tolerances, None),
+)
 
 
 def trajectory(system, y0, t_span, n_samples=4000, *, tolerances=None):
@@ -164,6 +177,12 @@ def _variational(system, y, t0, periods, tol, T, atol, hmax):
                                           _budget(tol, n), logs, trace, strobe)
     _check(status, t, "the variational equations")
     return logs, trace, strobe, yf
+
+
+@params(
+    system=UedaSystem, y0=(None, Array(1)), transient=Real(0, integer=True),
+    periods=Real(1, integer=True), batches=Real(1, integer=True), tolerances=(Tolerances, None),
+)
 
 
 def lyapunov(system, y0=None, *, transient=200, periods=4000, batches=20, tolerances=None,
@@ -408,6 +427,13 @@ class Attractor:
                 "transient_periods": self.transient, "seconds": self.seconds}
 
 
+@params(
+    system=UedaSystem, y0=(None, Array(1)), transient=Real(0, integer=True),
+    periods=Real(1, integer=True), batches=Real(1, integer=True),
+    trajectory_periods=Real(0, integer=True), tolerances=(Tolerances, None),
+)
+
+
 def attractor(system, y0=None, *, transient=500, periods=5000, batches=20,
               trajectory_periods=30, tolerances=None):
     """The attractor reached from ``y0``: strobe points, exponents, regime, a trajectory.
@@ -484,6 +510,12 @@ def _same_attractor(a, b, reg_a, reg_b, scale, tol=1e-3):
 
     own = max(nn(a, a, True), nn(b, b, True), tol)
     return bool(max(nn(a, b), nn(b, a)) < 3.0 * own)
+
+
+@params(
+    system=UedaSystem, x_range=Array(1), v_range=Array(1), n=Real(1, integer=True),
+    transient=Real(0, integer=True), periods=Real(1, integer=True), tolerances=(Tolerances, None),
+)
 
 
 def basins(system, x_range=(-1.0, 1.0), v_range=(-1.0, 1.0), n=10, *, transient=300,

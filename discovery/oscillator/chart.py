@@ -40,6 +40,7 @@ from multiprocessing import get_context
 import numpy as np
 from numba import njit
 
+from .._validate import Array, Real, params
 from .._workers import terminate_pool, worker_initializer
 from ..dynamics import Tolerances
 from ..dynamics._dopri import OK
@@ -477,6 +478,14 @@ def _axis(values, name):
     if a.size < 1 or not np.all(np.isfinite(a)) or np.any(np.diff(a) <= 0):
         raise InputError(f"the {name} axis must be finite and strictly increasing")
     return a
+
+
+@params(
+    system=UedaSystem, nu=Array(1), B=Array(1), y0=(None, Array(1)),
+    transient=Real(0, integer=True), periods=Real(1, integer=True), rtol=Real(0, 1, open_low=True),
+    hmax_fraction=Real(0, 1, open_low=True), max_period=Real(1, integer=True),
+    workers=(None, Real(1, integer=True)),
+)
 
 
 def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_fraction=0.1,

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from .._validate import Array, Real, Text, params
 from ..dynamics import Tolerances
 from ..dynamics._dopri import OK, make_smooth_advance
 from ..errors import InputError, IntegrationError
@@ -372,6 +373,14 @@ def check_record(t, x, what="the record"):
     return t, x
 
 
+@params(
+    system=(UedaSystem, ForcedPolynomial), periods=Real(1, integer=True),
+    samples_per_period=Real(4, integer=True), noise=Real(0), seed=Real(0, integer=True),
+    transient=Real(0, integer=True), y0=(None, Array(1)), integrator=Text(),
+    rtol=Real(0, 1, open_low=True),
+)
+
+
 def simulate_record(system, periods=200, samples_per_period=40, noise=0.0, seed=0, *,
                     transient=200, y0=None, integrator="compiled", rtol=1e-10):
     """A synthetic record of ``system`` (a :class:`UedaSystem` or
@@ -599,6 +608,14 @@ def _record_forcing(t, x, B, nu):
         raise InputError(f"{spp:.3g} samples per forcing period; need at least 8 (20-50 is "
                          "typical)")
     return t, x, spp
+
+
+@params(
+    t=Array(1), x=Array(1), B=Real(), nu=Real(0, open_low=True), threshold=Real(0),
+    half_width=(None, Real(1, integer=True)), order=Real(1, integer=True),
+    bootstrap=Real(0, integer=True), block_periods=Real(1, integer=True),
+    seed=Real(0, integer=True),
+)
 
 
 def discover(t, x, B, nu, *, threshold=0.02, half_width=None, order=4, fit_forcing=True,
@@ -909,6 +926,13 @@ def _block_sample(N, size, L, rng):
     nb = -(-size // L)
     starts = rng.choice(N - L + 1, nb, replace=nb > N - L + 1)
     return (starts[:, None] + np.arange(L)).ravel()[:size]
+
+
+@params(
+    model=ForcedPolynomial, t=Array(1), x=Array(1), smoothed=(None, Array(1)),
+    transient=Real(0, integer=True), periods=Real(1, integer=True),
+    resamples=Real(0, integer=True), seed=Real(0, integer=True), tolerances=(Tolerances, None),
+)
 
 
 def verify(model, t, x, *, smoothed=None, transient=200, periods=2000,

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.stats import chi2
 
+from .._validate import Array, Real, params
 from ..errors import InputError
 from .discover import (
     FORCING,
@@ -321,6 +322,12 @@ class Explanation:
 
 def _model_dict(m):
     return {**m.as_dict(), "equation": str(m.sympy())}
+
+
+@params(
+    t=Array(1), x=Array(1), B=Real(), nu=Real(0, open_low=True), alpha=Real(0, 1, open_low=True),
+    max_iterations=Real(1, integer=True), effects=(None, list, tuple), seed=Real(0, integer=True),
+)
 
 
 def explain(t, x, B, nu, start_terms=DEFAULT_START, *, alpha=0.01, max_iterations=3,

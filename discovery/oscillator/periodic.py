@@ -24,9 +24,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._validate import Array, Real, params
+from ..dynamics import Tolerances
 from ..dynamics.shooting import floquet_multipliers, is_stable, newton_orbit, smallest_period
 from . import _kernel as UK
 from .attractor import _budget, _check, _setup, _y0
+from .system import UedaSystem
 
 __all__ = ["UedaMap", "PeriodicOrbit", "periodic_orbit"]
 
@@ -154,6 +157,12 @@ class PeriodicOrbit:
                 "stable": self.stable,
                 "newton_residuals": [float(r) for r in self.newton_residuals],
                 "reduced_from": self.reduced_from, "n_calls": self.n_calls}
+
+
+@params(
+    system=UedaSystem, y0=Array(1), n=Real(1, integer=True), tol=Real(0, open_low=True),
+    max_newton=Real(1, integer=True), tolerances=(Tolerances, None),
+)
 
 
 def periodic_orbit(system, y0, n=1, *, tol=1e-8, max_newton=12, reduce=True, tolerances=None,

@@ -3,6 +3,11 @@
 import time
 from dataclasses import dataclass, field
 
+from .._validate import Real, params
+from ..dynamics import Tolerances
+from ..law import ForceLaw
+from ..measurement import Measurement
+from ..scenario import Scenario
 from .evaluate import evaluate
 from .reference import Reference
 
@@ -72,6 +77,10 @@ class VerifyResult:
                 "notes": list(self.notes), "seconds": self.seconds}
 
 
+@params(
+    scenario=Scenario, measurement=(Measurement, Reference), law=ForceLaw, time_offset=Real(),
+    n_boot=Real(0, integer=True), seed=Real(0, integer=True), tolerances=(Tolerances, None),
+)
 def verify(scenario, measurement, law, *, time_offset=0.0, n_boot=16, seed=0,
            check_default_start=True, tolerances=None):
     """Verify ``law`` against a record by full simulation.

@@ -1,0 +1,181 @@
+"""One validation layer for the public API: wrong types and values stop at the boundary.
+
+A public function declares what each argument must be with :func:`params`; a public dataclass
+calls :func:`check` from its ``__post_init__``. Either way a wrong argument raises, before any
+work, an error of the one hierarchy that is also the builtin a Python user expects (the
+scikit-learn way): :class:`VidiTypeError` (a ``VidiError`` and a ``TypeError``) for a wrong
+type, :class:`~discovery.errors.InputError` (a ``VidiError`` and a ``ValueError``) for a value
+out of range. The message is one line naming the function, the parameter, what is allowed and
+what was received.
+
+A spec is a class (or a tuple of classes), a :class:`Real`, :class:`Choice`, :class:`Text`
+or :class:`Array`, or ``None`` inside a tuple to allow ``None``.
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+import numbers
+
+import numpy as np
+
+from .errors import InputError, VidiTypeError
+
+__all__ = ["Real", "Choice", "Text", "Array", "check", "params"]
+
+
+def _received(value):
+    text = repr(value)
+    if len(text) > 40:
+        text = text[:37] + "..."
+    return f"{type(value).__name__} {text}"
+
+
+class Real:
+    """A real number (not a bool, not text) within ``[low, high]``, optionally an integer."""
+
+    def __init__(self, low=None, high=None, *, integer=False, open_low=False, unit=""):
+        self.low, self.high, self.integer, self.open_low = low, high, integer, open_low
+        self.unit = f" {unit}" if unit else ""
+
+    def describe(self):
+        kind = "an integer" if self.integer else "a number"
+        if self.low is not None and self.high is not None:
+            lo = "(" if self.open_low else "["
+            return f"{kind} in {lo}{self.low:g}, {self.high:g}]{self.unit}"
+        if self.low is not None:
+            return f"{kind} {'>' if self.open_low else '>='} {self.low:g}{self.unit}"
+        return f"a finite {kind[2:] if kind.startswith('a ') else kind[3:]}"
+
+    def __call__(self, where, value):
+        ok_type = (isinstance(value, numbers.Integral) if self.integer
+                   else isinstance(value, numbers.Real))
+        if isinstance(value, (bool, np.bool_)) or not ok_type:
+            raise VidiTypeError(f"{where} must be {self.describe()}; got {_received(value)}")
+        v = float(value)
+        bad = (not np.isfinite(v)
+               or (self.low is not None and (v <= self.low if self.open_low else v < self.low))
+               or (self.high is not None and v > self.high))
+        if bad:
+            raise InputError(f"{where} must be {self.describe()}; got {value!r}")
+
+
+class Choice:
+    """One of a fixed set of values."""
+
+    def __init__(self, *values):
+        self.values = values
+
+    def describe(self):
+        return "one of " + ", ".join(repr(v) for v in self.values)
+
+    def __call__(self, where, value):
+        if not isinstance(value, (str, numbers.Number)) or value not in self.values:
+            raise InputError(f"{where} must be {self.describe()}; got {_received(value)}")
+
+
+class Text:
+    """A non-empty string of at most ``max_chars`` characters."""
+
+    def __init__(self, max_chars=10_000, empty=False):
+        self.max_chars, self.empty = max_chars, empty
+
+    def describe(self):
+        return "text"
+
+    def __call__(self, where, value):
+        if not isinstance(value, str):
+            raise VidiTypeError(f"{where} must be text; got {_received(value)}")
+        if (not value and not self.empty) or len(value) > self.max_chars:
+            raise InputError(f"{where} must be {'' if self.empty else 'non-empty '}text of at "
+                             f"most {self.max_chars} characters; got {len(value)} characters")
+
+
+class Array:
+    """Numbers convertible to a float array (a list, a tuple or an array), optionally 1-D."""
+
+    def __init__(self, ndim=None):
+        self.ndim = ndim
+
+    def describe(self):
+        return "a 1-D array of numbers" if self.ndim == 1 else "an array of numbers"
+
+    def __call__(self, where, value):
+        if isinstance(value, (str, bytes, dict)) or value is None:
+            raise VidiTypeError(f"{where} must be {self.describe()}; got {_received(value)}")
+        try:
+            arr = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise VidiTypeError(
+                f"{where} must be {self.describe()}; got {_received(value)}") from None
+        if self.ndim is not None and arr.ndim != self.ndim:
+            raise InputError(f"{where} must be {self.describe()}; got {arr.ndim}-D of shape "
+                             f"{arr.shape}")
+
+
+def _describe(spec):
+    if isinstance(spec, tuple):
+        return " or ".join("None" if s is None else _describe(s) for s in spec)
+    if isinstance(spec, type):
+        return _a(spec.__name__)
+    return spec.describe()
+
+
+def _a(name):
+    return f"{'an' if name[0] in 'AEIOUaeiou' else 'a'} {name}"
+
+
+def check(where, value, spec):
+    """Check ``value`` against ``spec``; ``where`` names it (``'simulate: law'``)."""
+    if isinstance(spec, tuple):
+        if value is None and None in spec:
+            return
+        classes = tuple(s for s in spec if isinstance(s, type))
+        if classes and isinstance(value, classes):
+            return
+        others = [s for s in spec if s is not None and not isinstance(s, type)]
+        for s in others:
+            try:
+                s(where, value)
+                return
+            except VidiTypeError:
+                continue
+        raise VidiTypeError(f"{where} must be {_describe(spec)}; got {_received(value)}")
+    if isinstance(spec, type):
+        if not isinstance(value, spec):
+            hint = ""
+            if spec.__name__ == "ForceLaw" and isinstance(value, str):
+                hint = f" (parse text with ForceLaw.parse({value[:30]!r}))"
+            elif spec.__name__ == "Scenario" and isinstance(value, str):
+                hint = f" (load one with load_scenario({value[:30]!r}))"
+            raise VidiTypeError(
+                f"{where} must be {_a(spec.__name__)}{hint}; got {_received(value)}")
+        return
+    spec(where, value)
+
+
+def params(**specs):
+    """Decorator: check the named arguments of every call against their specs."""
+
+    def wrap(func):
+        signature = inspect.signature(func)
+        unknown = set(specs) - set(signature.parameters)
+        if unknown:  # a programming error in this package, caught at import
+            raise AssertionError(f"{func.__qualname__}: no parameters {sorted(unknown)}")
+        owner = func.__qualname__.replace(".__init__", "")
+
+        @functools.wraps(func)
+        def checked(*args, **kwargs):
+            try:
+                bound = signature.bind(*args, **kwargs)
+            except TypeError as exc:
+                raise VidiTypeError(f"{owner}: {exc}") from None
+            for name, spec in specs.items():
+                if name in bound.arguments:
+                    check(f"{owner}: {name}", bound.arguments[name], spec)
+            return func(*args, **kwargs)
+
+        return checked
+
+    return wrap

@@ -1,0 +1,131 @@
+"""Every public API entry refuses wrong types and values at its boundary.
+
+Table-driven: each row calls one public function or constructor with one wrong argument
+and names the parameter the message must mention. The error must be a ``VidiError`` and
+the builtin a Python user expects (``TypeError`` for a wrong type, ``ValueError`` for a
+value out of range), with one line naming the parameter, and raised before any work.
+"""
+
+import numpy as np
+import pytest
+
+import discovery as d
+import discovery.oscillator as osc
+from discovery.errors import InputError, VidiError, VidiTypeError
+from discovery.oscillator.chart import chart as ueda_chart
+from discovery.verify import verify
+
+SC = d.load_scenario("paper")
+LAW = d.ForceLaw.parse("2.06e8*z + 1.28e7*zd")
+T = np.linspace(0.0, 0.1, 50)
+F = np.zeros(50)
+REC = d.Measurement(t=T, F=F, channels={"w1": np.zeros(50), "w2": np.zeros(50)})
+UEDA = osc.UedaSystem("negres", mu=0.2, gamma=8.0, k=0.0, B=0.9, nu=1.0)
+
+TYPE, VALUE = VidiTypeError, InputError
+
+CASES = [
+    # (id, call, error, parameter named in the message)
+    ("Term a text", lambda: d.Term("x", 1), TYPE, "a"),
+    ("Term b None", lambda: d.Term(1, None), TYPE, "b"),
+    ("Term exponent 1e4", lambda: d.Term(1e4, 0), VALUE, "a"),
+    ("Term bool", lambda: d.Term(True, 0), TYPE, "a"),
+    ("ForceLaw terms text", lambda: d.ForceLaw("z", (1.0,)), TYPE, "terms"),
+    ("ForceLaw term not Term", lambda: d.ForceLaw((5,), (1.0,)), TYPE, "term"),
+    ("ForceLaw coefficient text", lambda: d.ForceLaw((d.Term(1, 0),), ("a",)), TYPE,
+     "coefficient"),
+    ("ForceLaw set 2", lambda: d.ForceLaw((d.Term(1, 0),), (1.0,), permanent_set=2.0), VALUE,
+     "permanent_set"),
+    ("ForceLaw.parse int", lambda: d.ForceLaw.parse(5), VALUE, "text"),
+    ("law exponent 1e300", lambda: d.ForceLaw.parse("2e8*z^1e300"), VALUE, "exponent"),
+    ("Scenario name int", lambda: d.Scenario(1, 1, 1, 1, 1, 1, name=5), TYPE, "name"),
+    ("Scenario m1 text", lambda: d.Scenario("a", 1, 1, 1, 1, 1), VALUE, "m1"),
+    ("Scenario law text", lambda: d.Scenario(1, 1, 1, 1, 1, 1, law="2e8*z"), TYPE, "law"),
+    ("Measurement t text", lambda: d.Measurement(t="abc", F=F), TYPE, "t"),
+    ("Measurement F 2-D", lambda: d.Measurement(t=T, F=np.zeros((50, 2))), VALUE, "F"),
+    ("Measurement channels list", lambda: d.Measurement(t=T, F=F, channels=[1]), TYPE,
+     "channels"),
+    ("Measurement channel text", lambda: d.Measurement(t=T, F=F, channels={"w1": "x"}), TYPE,
+     "w1"),
+    ("Tolerances rtol text", lambda: d.Tolerances(rtol="a"), TYPE, "rtol"),
+    ("Tolerances max_steps float", lambda: d.Tolerances(max_steps=1.5), TYPE, "max_steps"),
+    ("simulate scenario text", lambda: d.simulate("paper", LAW, (0, 0.1)), TYPE, "scenario"),
+    ("simulate law text", lambda: d.simulate(SC, "2e8*z", (0, 0.1)), TYPE, "law"),
+    ("simulate t_span text", lambda: d.simulate(SC, LAW, "0,1"), TYPE, "t_span"),
+    ("simulate unknown keyword", lambda: d.simulate(SC, LAW, (0, 1), t_end=1), TYPE, "t_end"),
+    ("steady_state law int", lambda: d.steady_state(SC, 5), TYPE, "law"),
+    ("steady_state max_period 0", lambda: d.steady_state(SC, LAW, max_period=0), VALUE,
+     "max_period"),
+    ("steady_state tolerances dict", lambda: d.steady_state(SC, LAW, tolerances={}), TYPE,
+     "tolerances"),
+    ("Library text", lambda: d.Library("z"), TYPE, "terms"),
+    ("Library of ints", lambda: d.Library([5]), TYPE, "term"),
+    ("regressor threshold text", lambda: d.ConstrainedSparseRegressor(threshold="a"), TYPE,
+     "threshold"),
+    ("regressor max_terms 0", lambda: d.ConstrainedSparseRegressor(max_terms=0), VALUE,
+     "max_terms"),
+    ("discover scenario int", lambda: d.discover(5, REC), TYPE, "scenario"),
+    ("discover measurement text", lambda: d.discover(SC, "D.csv"), TYPE, "measurement"),
+    ("discover max_terms text", lambda: d.discover(SC, REC, max_terms="4"), TYPE, "max_terms"),
+    ("identify reference text", lambda: d.identify(SC, "D.csv", LAW), TYPE, "reference"),
+    ("identify seed -1", lambda: d.identify(SC, REC, LAW, seed=-1), VALUE, "seed"),
+    ("verify law text", lambda: verify(SC, REC, "2e8*z"), TYPE, "law"),
+    ("verify n_boot float", lambda: verify(SC, REC, LAW, n_boot=2.5), TYPE, "n_boot"),
+    ("landscape axis text", lambda: d.landscape(SC, LAW, "1,2", [1, 2]), TYPE, "axis0"),
+    ("landscape workers 0", lambda: d.landscape(SC, LAW, [1, 2], [1, 2], workers=0), VALUE,
+     "workers"),
+    ("explain alpha 2", lambda: d.explain(SC, REC, alpha=2.0), VALUE, "alpha"),
+    ("explain start int", lambda: d.explain(SC, REC, start=5), TYPE, "start"),
+    ("impulse period 0", lambda: d.impulse_from_samples(T, F, 0.0), VALUE, "period"),
+    ("impulse F text", lambda: d.impulse_from_samples(T, "F", 0.04), TYPE, "F"),
+    ("synthesize periods text", lambda: d.synthesize(SC, LAW, periods="a"), TYPE, "periods"),
+    ("synthesize noise 5", lambda: d.synthesize(SC, LAW, noise=5.0), VALUE, "noise"),
+    ("response law int", lambda: d.response(SC, 5), TYPE, "law"),
+    ("contact_samples int", lambda: d.contact_samples(5), TYPE, "measurement"),
+    ("evaluate_criteria int", lambda: d.evaluate_criteria(5, 5), TYPE, "measured"),
+    ("ueda strobe system text", lambda: osc.strobe_points("negres"), TYPE, "system"),
+    ("ueda lyapunov periods 0", lambda: osc.lyapunov(UEDA, periods=0), VALUE, "periods"),
+    ("ueda attractor y0 text", lambda: osc.attractor(UEDA, y0="0,0"), TYPE, "y0"),
+    ("ueda chart nu text", lambda: ueda_chart(UEDA, "1", [0.9]), TYPE, "nu"),
+    ("ueda discover x None", lambda: osc.discover(T, None, 0.9, 1.0), TYPE, "x"),
+    ("ueda discover nu 0", lambda: osc.discover(T, F, 0.9, 0.0), VALUE, "nu"),
+    ("ueda explain alpha text", lambda: osc.explain(T, F, 0.9, 1.0, alpha="a"), TYPE, "alpha"),
+    ("ueda periodic n 0", lambda: osc.periodic_orbit(UEDA, [0.0, 0.0], n=0), VALUE, "n"),
+    ("ueda record periods text", lambda: osc.simulate_record(UEDA, periods="a"), TYPE,
+     "periods"),
+]
+
+
+@pytest.mark.parametrize("call, error, name", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+def test_wrong_argument_is_refused_at_the_boundary(call, error, name):
+    with pytest.raises(VidiError) as info:
+        call()
+    exc = info.value
+    assert isinstance(exc, error), f"{type(exc).__name__}: {exc}"
+    assert isinstance(exc, TypeError if error is TYPE else ValueError)
+    message = str(exc)
+    assert "\n" not in message and len(message) < 300, message
+    assert name in message, message
+
+
+def test_the_cases_cover_every_public_entry():
+    """A new public function or class must get a row here."""
+    covered = " ".join(c[0] for c in CASES).lower()
+    entries = ["term", "forcelaw", "scenario", "measurement", "tolerances", "simulate",
+               "steady_state", "library", "regressor", "discover", "identify", "verify",
+               "landscape", "explain", "impulse", "synthesize", "response", "contact_samples",
+               "evaluate_criteria", "ueda strobe", "ueda lyapunov", "ueda attractor",
+               "ueda chart", "ueda discover", "ueda explain", "ueda periodic", "ueda record"]
+    missing = [e for e in entries if e not in covered]
+    assert not missing, missing
+    public = {n for n in d.__all__ if callable(getattr(d, n)) and not n.endswith("Error")}
+    data_only = {"SteadyState", "Landscape", "DiscoveryResult", "RankedModel", "Impulse",
+                 "Response", "ContactSamples", "Candidate", "IdentificationResult",
+                 "ExplainResult", "builtin_scenarios", "load_scenario",
+                 "impulse_from_steady_state"}
+    unlisted = public - data_only - {
+        "Term", "ForceLaw", "Scenario", "Measurement", "Tolerances", "simulate", "steady_state",
+        "Library", "ConstrainedSparseRegressor", "discover", "identify", "landscape",
+        "explain", "impulse_from_samples", "synthesize", "response", "contact_samples",
+        "evaluate_criteria"}
+    assert not unlisted, f"public entries without a row: {sorted(unlisted)}"
