@@ -42,6 +42,7 @@ from .errors import InputError
 __all__ = ["Term", "ForceLaw", "ZETA", "ZD"]
 
 ZETA, ZD = sympy.symbols("zeta zd", nonnegative=True)
+FASTEST_CONTACT = 2 * np.pi * 1e7  # contact rate x drive period: a contact of 1e-7 periods
 _MAX_SET = 0.95  # largest permanent-set fraction (1 would be a rigid-plastic contact)
 _LATEX_NAMES = {ZETA: r"\zeta", ZD: r"\dot{\zeta}_{+}"}
 
@@ -66,8 +67,8 @@ class Term:
     b: float
 
     def __post_init__(self):
-        check("Term: a", self.a, Real(0, MAX_EXPONENT))
-        check("Term: b", self.b, Real(0, MAX_EXPONENT))
+        check("Term: exponent a", self.a, Real(0, MAX_EXPONENT))
+        check("Term: exponent b", self.b, Real(0, MAX_EXPONENT))
         a, b = float(self.a), float(self.b)
         if not (np.isfinite(a) and np.isfinite(b)) or a < 0 or b < 0 or (a == 0 and b == 0):
             raise InputError(
@@ -353,6 +354,16 @@ class ForceLaw:
                 f"{what} '{self}' breaks the paper's condition (6), dissipativity: F(zeta, zd) "
                 f"< F(zeta, 0) at zeta = {zz[worst]:.3g} m, zd = {vv[worst]:.3g} m/s (damping "
                 "that feeds energy into the impact); make the velocity terms non-negative")
+        # a contact far shorter than any step the drive period allows cannot be simulated
+        m = scenario.m1 * scenario.m2 / (scenario.m1 + scenario.m2)
+        rate = max(float(np.sqrt(np.max(self.polynomial(zz, np.zeros_like(vv)) / zz) / m)),
+                   float(np.max(D / np.maximum(vv, 1e-300)) / m))
+        if rate * scenario.period > FASTEST_CONTACT:
+            raise InputError(
+                f"{what} '{self}' is too stiff for this machine: a contact would last about "
+                f"{scenario.period * 2 * np.pi / min(rate * scenario.period, 1e300):.2g} s, "
+                f"under 1e-7 of the drive period {scenario.period:.3g} s, which no simulation "
+                "resolves; check the coefficients' units (N/m, N s/m) and the scenario's masses")
 
     def __call__(self, zeta, dzeta, zeta_max=None):
         """Contact force ``F(zeta, dzeta)`` [N] with conditions (3)-(5) applied (and the

@@ -24,6 +24,15 @@ from .law import ForceLaw, Term
 __all__ = ["Library"]
 
 
+def _reason(exc):
+    """The part of a term error after the quoted law text: the reason alone."""
+    text = str(exc)
+    if "cannot read" in text:  # a syntax error: the hint after it says what a term looks like
+        return ""
+    text = text.split(": ", 1)[1] if text.startswith("force law ") and ": " in text else text
+    return f" ({text.split(';')[0]})"
+
+
 @dataclass(frozen=True)
 class Library:
     """An ordered set of candidate terms.
@@ -84,10 +93,10 @@ class Library:
                 for name in part.split(","):
                     try:
                         terms.append(Term.parse(name.strip()))
-                    except InputError:
+                    except InputError as exc:
                         raise InputError(
-                            f"library {spec!r}: {name.strip()!r} is not a term; use poly:N, hc "
-                            "or names like z, zd, z*zd, z^1.5, z^2*zd") from None
+                            f"library {spec!r}: {name.strip()!r} is not a term{_reason(exc)}; "
+                            "use poly:N, hc or names like z, zd, z*zd, z^1.5, z^2*zd") from None
                 lib = cls(tuple(terms))
             out = lib if out is None else out + lib
         if out is None:

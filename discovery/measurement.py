@@ -163,28 +163,9 @@ class Measurement:
             One line naming the problem (file, column, line) and the fix.
         """
         name = str(path)
-        text, notes = _read_text(path, name)
-        lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
-                 if ln.strip() and not ln.lstrip().startswith("#")]
-        if not lines:
-            raise InputError(f"data file {name!r} is empty; it needs a header with t and F")
-        delim = _sniff(lines[0][1])
-        rows = []
-        for ln, line in lines:  # one record per line (no quoted line breaks in numbers)
-            try:
-                rows.append(next(csv.reader([line], delimiter=delim), []))
-            except csv.Error as exc:
-                raise InputError(f"data file {name!r}: line {ln} is not a readable CSV row "
-                                 f"({exc}); save the file as CSV with a header row") from None
-        header = [h.strip() for h in rows[0]]
+        header, body, decimal_comma, notes = read_csv_rows(path, "t and F")
         src, from_a2, extra_notes = _column_sources(header, columns, name, scenario)
         notes += extra_notes
-        body = list(zip((ln for ln, _ in lines[1:]), rows[1:], strict=True))
-        if not body:
-            raise InputError(f"data file {name!r} has a header but no data rows")
-        decimal_comma = delim != "," and any("," in c for _, r in body[:50] for c in r)
-        if decimal_comma:
-            notes += ("decimal commas read as decimal points",)
         cols = {key: _parse_column(key, header[j], j, body, name, decimal_comma)
                 for key, j in src.items()}
         t = cols["t"]
@@ -353,6 +334,38 @@ def no_contact_message(t, F, period, source="", threshold=None):
             "column and its units, or record with less noise")
 
 
+def read_csv_rows(path, needs):
+    """The one CSV reader of both systems: ``(header, body, decimal_comma, notes)``.
+
+    UTF-8 (with or without a byte-order mark) or UTF-16 with one; ``,``, ``;`` or tab as
+    the separator (from the header); ``#`` comment lines and blank lines skipped; decimal
+    commas with ``;`` or tab.  ``body`` is ``[(line number, fields), ...]``.  ``needs``
+    names the columns for the messages (``"t and F"``).
+    """
+    name = str(path)
+    text, notes = _read_text(path, name)
+    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
+             if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise InputError(f"data file {name!r} is empty; it needs a header with {needs}")
+    delim = _sniff(lines[0][1])
+    rows = []
+    for ln, line in lines:  # one record per line (no quoted line breaks in numbers)
+        try:
+            rows.append(next(csv.reader([line], delimiter=delim), []))
+        except csv.Error as exc:
+            raise InputError(f"data file {name!r}: line {ln} is not a readable CSV row "
+                             f"({exc}); save the file as CSV with a header row") from None
+    header = [h.strip() for h in rows[0]]
+    body = list(zip((ln for ln, _ in lines[1:]), rows[1:], strict=True))
+    if not body:
+        raise InputError(f"data file {name!r} has a header but no data rows")
+    decimal_comma = delim != "," and any("," in c for _, r in body[:50] for c in r)
+    if decimal_comma:
+        notes += ("decimal commas read as decimal points",)
+    return header, body, decimal_comma, notes
+
+
 def _read_text(path, name):
     """The file's text (UTF-8 with or without BOM, or UTF-16 with BOM) and notes."""
     if not name.strip():
@@ -453,9 +466,10 @@ def _column_sources(header, columns, name, scenario):
     return src, from_a2, notes
 
 
-def _parse_column(key, hname, j, body, name, decimal_comma):
+def _parse_column(key, hname, j, body, name, decimal_comma, limits=None):
     """Column ``j`` of the data rows as floats, with a line-numbered error for a missing,
-    non-numeric, non-finite or out-of-range cell."""
+    non-numeric, non-finite or out-of-range cell (``limits``: ``{key: (bound, unit)}``,
+    default the vibro-impact channels')."""
     cells = []
     for ln, row in body:
         if j >= len(row):
@@ -482,7 +496,7 @@ def _parse_column(key, hname, j, body, name, decimal_comma):
         raise InputError(f"data file {name!r}: column {hname} has the non-finite value "
                          f"{cells[bad[0]][:20]!r} at line {body[bad[0]][0]}; remove the row or "
                          "fill it with a measured number")
-    lim, unit = LIMITS[key]
+    lim, unit = (LIMITS if limits is None else limits)[key]
     big = np.flatnonzero(np.abs(v) > lim)
     if big.size:
         raise InputError(f"data file {name!r}: column {hname} has the value {cells[big[0]][:20]} "

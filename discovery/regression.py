@@ -291,7 +291,8 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
     @params(
         library=(Text(), Library), selection=Text(), scoring=Text(),
         max_terms=Real(1, 64, integer=True), cv=Real(2, integer=True), margin=Real(0),
-        signs=(None, dict), box_margin=Real(0), elevation=Real(0, 8, integer=True),
+        signs=(None, Real(-1, 1, integer=True), list, tuple, np.ndarray), box_margin=Real(0),
+        elevation=Real(0, 8, integer=True),
         threshold=Real(0), n_lambdas=Real(2, integer=True), solver=Text(),
         grid=Real(3, integer=True),
     )

@@ -153,3 +153,21 @@ def test_ctrl_c_to_the_process_group_during_identify(tmp_path, delay):
                                     "removed, earlier results are unchanged"], err
         assert not (tmp_path / "I").exists()
         assert not [q for q in tmp_path.iterdir() if ".vidi-staging." in q.name]
+
+
+def test_out_of_memory_is_one_line_once_the_memory_is_freed(earlier, monkeypatch, capfd):
+    """A MemoryError is reported after the handlers have left the frames that hold the
+    memory (formatting a message inside them raised a second MemoryError), from a line
+    built in advance; earlier results stay."""
+    import discovery.cli.steady as st
+
+    def exhaust(*a, **k):
+        hog = [bytearray(1 << 20)]  # noqa: F841  (a frame holding memory)
+        raise MemoryError
+
+    monkeypatch.setattr(st, "provenance", exhaust)
+    assert main(["steady", "--out", str(earlier)]) == 2
+    err = capfd.readouterr().err
+    assert err.splitlines() == ["vidi: error: not enough memory for this run; reduce its size "
+                                "(--fs, --periods, --grid) and try again"], err
+    _intact(earlier)

@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 
+from discovery import ForceLaw, load_scenario
 from discovery.cli import main
 from discovery.criteria import CRITERIA
 from discovery.dynamics import Tolerances
@@ -94,8 +95,26 @@ def test_landscape_against_a_record(noisy_record, tmp_path, capsys):
     csv_head = (out / "landscape.csv").read_text().splitlines()[0]
     assert csv_head == "z,zd,regime,I0,I1,I2,I3,I4,impacts,consistent"
     # `vidi identify --landscape` still reads it
-    land = _load_landscape(out, Landscape)
+    sc = load_scenario("paper")
+    land = _load_landscape(out, Landscape, ForceLaw.parse("1e8*z + 1e7*zd"), sc)
     assert land.terms == ("z", "zd") and land.values["I2"].shape == (5, 5)
+    # ... and refuses one for other terms, another scenario or of the wrong shape, before
+    # any simulation
+    base = ["identify", "--data", str(noisy_record), "--out", str(tmp_path / "id")]
+    cases = [(["--start", "1e8*z^1.5 + 1e7*zd", "--landscape", str(out)], "not the start's"),
+             (["--scenario", "light", "--start", "1e10*z + 1e11*zd", "--landscape", str(out)],
+              "made for scenario 'paper'")]
+    broken = tmp_path / "broken.json"
+    s["I2"] = s["I2"][:3]
+    broken.write_text(json.dumps(s))
+    cases.append((["--start", "1e8*z + 1e7*zd", "--landscape", str(broken)],
+                   "do not match its axes"))
+    for extra, needle in cases:
+        capsys.readouterr()
+        assert main(base + extra) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and needle in err, err
+        assert not (tmp_path / "id").exists()
 
 
 def test_default_ranges_are_centred_on_the_template(tmp_path):

@@ -116,7 +116,7 @@ def test_law_syntax_error_is_input_error():
 
 @pytest.mark.parametrize(("a", "b"), [(0, 0), (-1, 1), (1, -0.5), (np.nan, 1), (np.inf, 0)])
 def test_bad_term_exponents(a, b):
-    with pytest.raises(InputError, match="exponents"):
+    with pytest.raises(InputError, match="exponent"):
         Term(a, b)
 
 

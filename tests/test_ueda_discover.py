@@ -259,3 +259,31 @@ def test_cli_bad_inputs_exit_2(vidi, tmp_path, capsys):
     err = capsys.readouterr().err
     assert "Traceback" not in err and "internal error" not in err
     assert not (tmp_path / "o").exists()
+
+
+def test_one_csv_reader_for_both_systems(tmp_path):
+    """The Ueda records go through the vibro-impact reader: a byte-order mark, ';' with
+    decimal commas, comments are read; a huge field, a missing column and text in a number
+    are one line each."""
+    from discovery.oscillator.discover import read_record_csv
+
+    t = 0.15 * np.arange(400)
+    x = np.sin(t)
+    plain = tmp_path / "plain.csv"
+    plain.write_text("t,x\n" + "".join(f"{a:.17g},{b:.17g}\n" for a, b in zip(t, x, strict=True)))
+    excel = tmp_path / "excel.csv"
+    excel.write_bytes(b"\xef\xbb\xbf# exported\r\nt;x\r\n" + "".join(
+        f"{a:.17g};{b:.17g}\r\n".replace(".", ",") for a, b in zip(t, x, strict=True)).encode())
+    t1, x1 = read_record_csv(plain)
+    t2, x2 = read_record_csv(excel)
+    assert np.array_equal(t1, t2) and np.array_equal(x1, x2) and np.array_equal(x1, x)
+    cases = [("t,x\n0," + "1" * 300_000 + "\n", "field larger than field limit"),
+             ("time,x\n0,1\n", "no column(s) t"),
+             ("t,x\n" + "".join(f"{a:.17g},{b:.17g}\n" for a, b in zip(t, x, strict=True))
+              + "61,abc\n", "non-numeric value 'abc' at line 402")]
+    for k, (text, needle) in enumerate(cases):
+        bad = tmp_path / f"bad{k}.csv"
+        bad.write_text(text)
+        with pytest.raises(InputError) as info:
+            read_record_csv(bad)
+        assert needle in str(info.value) and "\n" not in str(info.value), str(info.value)

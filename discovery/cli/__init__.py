@@ -86,6 +86,13 @@ class VidiArgumentParser(argparse.ArgumentParser):
     def error(self, message):
         raise UsageError(_one_line(message, self.prog, self.command_hint))
 
+    def add_argument(self, *args, needs=None, excludes=None, **kwargs):
+        """``needs``/``excludes``: the option acts only with / not with another option
+        (checked by :func:`_refuse_orphans`)."""
+        action = super().add_argument(*args, **kwargs)
+        action.needs, action.excludes = needs, excludes
+        return action
+
 
 COMMANDS = ("simulate", "fit", "verify", "explain", "steady", "landscape", "identify", "ueda")
 
@@ -190,6 +197,43 @@ def _refuse_repeats(parser, argv):
         seen[action.dest] = tok
 
 
+def _given(parser, argv):
+    """The subparser named on the line and the option strings given on it."""
+    sp, rest = parser, list(argv)
+    while True:
+        sub = next((a for a in sp._actions if isinstance(a, argparse._SubParsersAction)), None)
+        name = next((t for t in rest if not t.startswith("-")), None)
+        if sub is None or name not in sub.choices:
+            break
+        sp, rest = sub.choices[name], rest[rest.index(name) + 1:]
+    given = set()
+    for tok in rest:
+        if tok == "--":
+            break
+        action = sp._option_string_actions.get(tok.split("=", 1)[0]) if tok.startswith("--") \
+            else None
+        if action is not None:
+            given.add(action.option_strings[-1])
+    return sp, given
+
+
+def _refuse_orphans(parser, argv):
+    """An option that only acts with another one (``needs``) or not with another one
+    (``excludes``) is refused when given alone: it would be silently ignored."""
+    sp, given = _given(parser, argv)
+    for action in sp._actions:
+        opt = action.option_strings[-1] if action.option_strings else None
+        if opt not in given:
+            continue
+        need = getattr(action, "needs", None)
+        if need and need not in given:
+            raise UsageError(f"{opt} acts only with {need}, which is not given; add {need} "
+                             f"or leave out {opt}")
+        excl = getattr(action, "excludes", None)
+        if excl and excl in given:
+            raise UsageError(f"{opt} has no effect with {excl}; leave out one of them")
+
+
 def _error(message):
     print(f"vidi: error: {' '.join(str(message).split())}", file=sys.stderr)
 
@@ -263,6 +307,7 @@ def _run(argv):
             line = _attach_dash_values(parser, argv)
             _refuse_repeats(parser, line)
             args = parser.parse_args(line)
+            _refuse_orphans(parser, line)
         except SystemExit as exc:  # --help, --version
             return exc.code if isinstance(exc.code, int) else 0
         command = " ".join(x for x in (getattr(args, "command", None),

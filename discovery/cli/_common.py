@@ -144,8 +144,8 @@ def parse_columns(text, option="--columns"):
 
 
 def add_record_options(parser):
-    """Add the options of reading a record (``--columns``)."""
-    parser.add_argument("--columns", metavar="MAP", help=COLUMNS_HELP)
+    """Add the options of reading a record (``--columns``); returns the action."""
+    return parser.add_argument("--columns", metavar="MAP", help=COLUMNS_HELP)
 
 
 def read_record(args, scenario, path=None):

@@ -194,6 +194,7 @@ def register(sub):
                    help="skip the refinement of every shortlisted support by simulation "
                    "(output error: unbiased coefficients and their standard errors)")
     s.add_argument("--max-simulations", type=integer(2, 100_000), default=120,
+                   excludes="--no-refine",
                    help="simulation budget of each support's refinement "
                    "(default: %(default)s)")
     s.add_argument("--stability", type=integer(0, 10_000), default=0,

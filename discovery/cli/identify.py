@@ -33,7 +33,29 @@ def _pick_iterates(iterations, k):
     return sorted(set(np.unique(np.round(np.geomspace(1, n, k)).astype(int) - 1)))
 
 
-def _load_landscape(path, cls):
+def _load_landscape(path, cls, start, scenario):
+    """The landscape to draw the path on: made by ``vidi landscape`` for the start's first
+    two terms and the same scenario, every criterion a grid of its two axes."""
+    land, d = _read_landscape(path, cls)
+    terms = tuple(t.name for t in start.terms[:2])
+    if tuple(land.terms) != terms:
+        raise InputError(f"--landscape {path!r} varies {', '.join(land.terms)}, not the start's "
+                         f"{', '.join(terms)}; make one with vidi landscape --law "
+                         "(the start law) or leave out --landscape")
+    shape = (land.axes[0].size, land.axes[1].size)
+    bad = [n for n, v in land.values.items() if v.shape != shape]
+    if bad or land.regime.shape != shape or min(shape) < 2:
+        raise InputError(f"--landscape {path!r}: its grids do not match its axes "
+                         f"({shape[0]} x {shape[1]}); make it again with vidi landscape")
+    made_for = (d.get("scenario") or {}).get("name")
+    if made_for is not None and made_for != scenario.name:
+        raise InputError(f"--landscape {path!r} was made for scenario {made_for!r}, not "
+                         f"{scenario.name!r}; make one for this scenario or leave out "
+                         "--landscape")
+    return land
+
+
+def _read_landscape(path, cls):
     p = Path(path)
     p = p / "summary.json" if p.is_dir() else p
     try:
@@ -42,9 +64,11 @@ def _load_landscape(path, cls):
         raise InputError(f"--landscape {path!r}: no readable landscape summary.json") from None
     try:
         vals = {n: np.array(d[n], dtype=float) for n in CRITERIA}
-        return cls(terms=tuple(d["terms"]), axes=(np.array(d["alpha1"]), np.array(d["alpha2"])),
+        land = cls(terms=tuple(d["terms"]),
+                   axes=(np.array(d["alpha1"], dtype=float), np.array(d["alpha2"], dtype=float)),
                    values=vals, regime=np.array(d["regime"], dtype=object),
                    seconds=d["seconds"], workers=d["workers"])
+        return land, d
     except (KeyError, TypeError, ValueError):
         raise InputError(f"--landscape {path!r} is not a landscape result (made by vidi "
                          "landscape); give its output directory or summary.json") from None
@@ -64,7 +88,7 @@ def run(args):
                          "'1.5e8*z + 0.9e7*zd'")
     start = ForceLaw.parse(args.start)
     start.check_physical(sc, "--start")
-    land = _load_landscape(args.landscape, Landscape) if args.landscape else None
+    land = _load_landscape(args.landscape, Landscape, start, sc) if args.landscape else None
     meas = read_record(args, sc)
     for note in meas.notes:
         print(f"note: {note}")

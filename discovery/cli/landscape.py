@@ -172,7 +172,7 @@ def register(sub):
                    "(default: the scenario's law)")
     s.add_argument("--data", help="CSV record (t, F [, w1, v1, w2, v2]) to compare with "
                    "(default: the exact impulse of the scenario's law)")
-    add_record_options(s)
+    add_record_options(s).needs = "--data"
     s.add_argument("--grid", default="41x41",
                    help="points per axis, e.g. 41x41 (default: %(default)s)")
     s.add_argument("--range0", help="LOW:HIGH of the first coefficient (default: 0.5x..1.5x "
@@ -180,12 +180,15 @@ def register(sub):
     s.add_argument("--range1", help="LOW:HIGH of the second coefficient (default: 0.5x..1.5x "
                    "the template's coefficient)")
     s.add_argument("--time-offset", type=number(-1e7, 1e7, unit="s"), default=0.0,
+                   needs="--data",
                    help="with --data: drive-clock time [s] of the record's t = 0 "
                    "(default: %(default)g)")
     s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
+                   needs="--data",
                    help="with --data: bootstrap replicates of the noise floor "
                    "(default: %(default)s)")
     s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
+                   needs="--data",
                    help="with --data: seed of the bootstrap (default: %(default)s)")
     s.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
     s.add_argument("--out", required=True, help="output directory")

@@ -17,7 +17,8 @@ MODE_NAMES = {K.FREE: "free", K.LOAD: "load", K.UNLOAD: "unload", K.CLIPPED: "cl
 EVENT_NAMES = {K.EV_ONSET: "onset", K.EV_LOSS: "loss", K.EV_UNLOAD: "unload",
                K.EV_RELOAD: "reload", K.EV_RELEASE: "release", K.EV_RESUME: "resume"}
 _STATUS = {
-    K.STEP_BUDGET: "the step budget was exhausted; raise max_steps or loosen rtol",
+    K.STEP_BUDGET: ("the step budget was exhausted (a law too stiff or too fast for the "
+                    "machine: check the coefficients' units; API: Tolerances(max_steps=...))"),
     K.BLOW_UP: "the solution blew up (non-finite state); check the law's coefficients and signs",
     K.STEP_UNDERFLOW: "the step size underflowed; the law may be too stiff for this tolerance",
     K.CHATTER: "the contact mode switched back and forth without progress (chattering)",

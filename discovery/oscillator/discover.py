@@ -319,34 +319,17 @@ def read_record_csv(path):
     """``(t, x)`` from a CSV with a header naming columns ``t`` and ``x`` (other columns
     ignored); checked: finite, at least 64 rows, strictly increasing and uniform ``t``
     (to 1e-6 of the step)."""
-    import csv
+    from ..measurement import _parse_column, read_csv_rows
 
-    try:
-        with open(path, newline="", encoding="utf-8") as fh:
-            rows = list(csv.reader(fh))
-    except FileNotFoundError:
-        raise InputError(f"--data {path}: no such file") from None
-    except UnicodeDecodeError:
-        raise InputError(f"--data {path}: not a text CSV file") from None
-    if not rows:
-        raise InputError(f"--data {path}: the file is empty; need a header t,x and rows")
-    header = [h.strip() for h in rows[0]]
+    header, body, decimal_comma, _ = read_csv_rows(path, "t and x")
     missing = [c for c in ("t", "x") if c not in header]
     if missing:
-        raise InputError(f"--data {path}: no column(s) {', '.join(missing)} in the header "
-                         f"{','.join(header)!r}; need columns t and x")
-    it, ix = header.index("t"), header.index("x")
-    t, x = [], []
-    for n, r in enumerate(rows[1:], start=2):
-        if not r or all(not c.strip() for c in r):
-            continue
-        try:
-            t.append(float(r[it]))
-            x.append(float(r[ix]))
-        except (ValueError, IndexError):
-            raise InputError(f"--data {path}: line {n}: t and x must be numbers, got "
-                             f"{','.join(r)!r}") from None
-    return check_record(np.array(t), np.array(x), what=f"--data {path}")
+        raise InputError(f"data file {str(path)!r}: no column(s) {', '.join(missing)} in the "
+                         f"header {','.join(header)[:80]!r}; name the columns t and x")
+    limits = {"t": (1e7, "s"), "x": (1e6, "")}
+    t, x = (_parse_column(c, c, header.index(c), body, str(path), decimal_comma, limits)
+            for c in ("t", "x"))
+    return check_record(t, x, what=f"--data {path}")
 
 
 def check_record(t, x, what="the record"):
@@ -929,7 +912,7 @@ def _block_sample(N, size, L, rng):
 
 
 @params(
-    model=ForcedPolynomial, t=Array(1), x=Array(1), smoothed=(None, Array(1)),
+    model=ForcedPolynomial, t=Array(1), x=Array(1), smoothed=(None, Smoothed),
     transient=Real(0, integer=True), periods=Real(1, integer=True),
     resamples=Real(0, integer=True), seed=Real(0, integer=True), tolerances=(Tolerances, None),
 )
