@@ -6,7 +6,10 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: install demo test test-fast bench lint clean
+TEX_PACKAGES := latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended \
+	lmodern poppler-utils
+
+.PHONY: install demo test test-fast bench lint clean tex
 
 install: $(STAMP)
 
@@ -25,6 +28,16 @@ demo: install
 		--out out/identify
 	@echo "demo outputs: out/landscape/ (landscape.png/.pdf, landscape.csv, summary.json)," \
 		"out/identify/ (identification.png/.pdf, iterations.csv, summary.json)"
+
+# TeX Live for `vidi report` PDFs (optional: without it the reports are .tex files)
+tex:
+	@if command -v latexmk >/dev/null && command -v pdftotext >/dev/null; then \
+		echo "TeX Live is installed"; \
+	else \
+		SUDO=$$([ "$$(id -u)" = 0 ] || echo sudo); \
+		$$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install \
+			-y -qq --no-install-recommends $(TEX_PACKAGES); \
+	fi
 
 test: install
 	$(BIN)/python -m pytest -q

@@ -53,8 +53,10 @@ _EXPORTS = {
     'Scenario': 'scenario',
     'builtin_scenarios': 'scenario',
     'load_scenario': 'scenario',
+    'Report': 'report',
+    'report': 'report',
 }
-_SHADOWED = ("discover", "explain", "identify", "landscape", "response")
+_SHADOWED = ("discover", "explain", "identify", "landscape", "report", "response")
 
 
 def _export(name):
@@ -99,5 +101,5 @@ __all__ = [
     "landscape", "ForceLaw", "Term", "Measurement", "synthesize", "Response", "response",
     "Scenario", "builtin_scenarios", "load_scenario", "discover", "DiscoveryResult",
     "RankedModel", "Library", "ConstrainedSparseRegressor", "Candidate", "ContactSamples",
-    "contact_samples", "explain", "ExplainResult",
+    "contact_samples", "explain", "ExplainResult", "report", "Report",
 ]

@@ -9,8 +9,6 @@ from .figures import (
     landscape_figure,
     verify_figure,
 )
-from .latex import compile_pdf, model_tex
 
 __all__ = ["landscape_figure", "identification_figure", "fit_impulse_figure",
-           "fit_surface_figure", "fit_loop_figure", "model_tex", "compile_pdf", "verify_figure",
-           "explain_figure"]
+           "fit_surface_figure", "fit_loop_figure", "verify_figure", "explain_figure"]

@@ -92,7 +92,10 @@ def test_every_default_is_shown(path, parser):
 def test_help_uses_one_convention(path, parser):
     """``(default: ...)``, not the old ``(20)`` suffix nor argparse's formatter class
     (which would print ``(default: None)`` for options without a default)."""
-    assert parser.formatter_class is argparse.HelpFormatter
+    from discovery.cli import HelpFormatter
+
+    assert parser.formatter_class is HelpFormatter  # argparse's, with examples as written
+    assert parser.epilog is None or parser.epilog.startswith("examples:\n  vidi ")
     for action in parser._actions:
         if action.help in (None, argparse.SUPPRESS) or not action.option_strings:
             continue
@@ -111,3 +114,18 @@ def test_version_and_plain_vidi(capsys):
     assert capsys.readouterr().out.startswith("vidi ")
     assert main([]) == 0  # the overview, not an error
     assert "COMMAND" in capsys.readouterr().out
+
+
+def test_every_example_in_the_help_parses():
+    """The examples printed under each command's help are valid command lines."""
+    import shlex
+
+    from discovery.cli import EXAMPLES, _parser
+
+    parser = _parser()
+    for path, lines in EXAMPLES.items():
+        for line in lines:
+            argv = shlex.split(re.split(r"\s{2,}", line)[0])
+            assert argv[0] == "vidi" and argv[1:1 + len(path.split())] == path.split(), line
+            if "COMMAND" not in argv:
+                parser.parse_args(argv[1:])  # raises UsageError on a wrong example

@@ -94,7 +94,62 @@ class VidiArgumentParser(argparse.ArgumentParser):
         return action
 
 
-COMMANDS = ("simulate", "fit", "verify", "explain", "steady", "landscape", "identify", "ueda")
+EXAMPLES = {
+    "": ["vidi simulate --noise 0.01 --out D.csv     a record of the paper's machine",
+         "vidi fit --data D.csv --out out/fit       discover its law, check it by simulation",
+         "vidi report out/fit                       the LaTeX report, compiled to PDF",
+         "vidi COMMAND --help                       each command's options and examples"],
+    "simulate": ["vidi simulate --scenario paper --periods 20 --noise 0.01 --out D.csv",
+                 "vidi simulate --law '2e8*z + 1e7*zd; unloading: 4e6*zd' --from-rest "
+                 "--integrator scipy --out R.csv"],
+    "fit": ["vidi fit --data D.csv --out out/fit",
+            "vidi fit --scenario a.toml --scenario b.toml --data a.csv --data b.csv "
+            "--library poly:3+hc --out out/fit2"],
+    "verify": ["vidi verify --data D.csv --law '2.06e8*z + 1.28e7*zd' --out out/verify"],
+    "explain": ["vidi explain --data D.csv --out out/explain",
+                "vidi explain --data D.csv --start '2e8*z + 1e7*zd' --effects "
+                "unloading_damping,permanent_set --out out/explain2"],
+    "steady": ["vidi steady --scenario paper --law '2e8*z + 1e7*zd'"],
+    "landscape": ["vidi landscape --grid 21x21 --out out/landscape",
+                  "vidi landscape --data D.csv --range0 1e8:3e8 --out out/landscape2"],
+    "identify": ["vidi identify --data D.csv --start '1.5e8*z + 0.9e7*zd' --out out/identify"],
+    "report": ["vidi report out/fit                 report.tex and report.pdf in out/fit",
+               "vidi report out/verify --snippet criteria",
+               "vidi report out/fit --no-pdf        the LaTeX source only"],
+    "ueda attractor": ["vidi ueda attractor --model negres --out out/attractor"],
+    "ueda chart": ["vidi ueda chart --model negres --nu 0.8:1.2:21 --B 0.2:1.2:21 "
+                   "--out out/chart"],
+    "ueda simulate": ["vidi ueda simulate --model negres --noise 0.002 --out U.csv"],
+    "ueda discover": ["vidi ueda discover --data U.csv --model negres --out out/ueda"],
+    "ueda explain": ["vidi ueda explain --data U.csv --model negres --out out/ueda-explain"],
+}
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """argparse's formatter, but an epilog of examples is printed as written."""
+
+    def _fill_text(self, text, width, indent):
+        if text.startswith("examples:"):
+            return "".join(indent + line for line in text.splitlines(keepends=True))
+        return super()._fill_text(text, width, indent)
+
+
+def _add_examples(parser, path=()):
+    """Every (sub)command's help ends with its examples (``EXAMPLES``)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sp in action.choices.items():
+                _add_examples(sp, (*path, name))
+    parser.formatter_class = HelpFormatter
+    lines = EXAMPLES.get(" ".join(path))
+    if lines:
+        parser.epilog = "examples:\n" + "\n".join(f"  {ln}" for ln in lines) + (
+            "" if path else "\n\nexit codes: 0 ok, 2 bad input or failed numerics, 130 "
+            "interrupted (Ctrl-C),\n            143 terminated, 1 internal error")
+
+
+COMMANDS = ("simulate", "fit", "verify", "explain", "steady", "landscape", "identify", "report",
+            "ueda")
 
 
 def _parser():
@@ -102,19 +157,20 @@ def _parser():
         prog="vidi",
         description="Discover and verify contact-force laws F(zeta, dzeta) of vibro-impact "
                     "machines by simulation.",
-        epilog="exit codes: 0 ok, 2 bad input or failed numerics, 130 interrupted, 1 internal "
-               "error")
+)
     p.add_argument("--version", action="version", version=f"vidi {_version()}",
                    help="print the version and exit")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND",
                            parser_class=VidiArgumentParser)
     # imported here, inside main()'s handlers: a Ctrl-C while they load is an interrupt too
-    from . import explain, fit, identify, landscape, simulate, steady, ueda, verify
+    from . import explain, fit, identify, landscape, report, simulate, steady, ueda, verify
     modules = {"simulate": simulate, "fit": fit, "verify": verify, "explain": explain,
-               "steady": steady, "landscape": landscape, "identify": identify, "ueda": ueda}
+               "steady": steady, "landscape": landscape, "identify": identify,
+               "report": report, "ueda": ueda}
     for name in COMMANDS:
         modules[name].register(sub)
     _add_overwrite(p)
+    _add_examples(p)
     return p
 
 

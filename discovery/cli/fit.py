@@ -3,9 +3,10 @@
 import argparse
 import csv
 import io
+import json
 import time
 
-from .._io import OutputDir, provenance
+from .._io import OutputDir, provenance, to_jsonable
 from ..criteria import CRITERIA
 from ._common import (
     SCENARIO_HELP,
@@ -23,13 +24,8 @@ from ._common import (
 
 def run(args):
     t_start = time.perf_counter()
-    from reports import (
-        compile_pdf,
-        fit_impulse_figure,
-        fit_loop_figure,
-        fit_surface_figure,
-        model_tex,
-    )
+    from reports import fit_impulse_figure, fit_loop_figure, fit_surface_figure
+    from reports.document import compile_tex, render
 
     from ..discover import discover
 
@@ -89,11 +85,15 @@ def run(args):
                         *[f"{m.criteria[n]:.6g}" if m.criteria else "" for n in CRITERIA],
                         m.law.to_text()])
         out.path("ranking.csv").write_text(buf.getvalue())
-        out.path("model.tex").write_text(model_tex(res, sc))
-        pdf, why = compile_pdf(out.path("model.tex")) if not args.no_pdf else (None, None)
         fit_impulse_figure(res, imps, str(out.path("fit_impulse")))
         fit_surface_figure(res, str(out.path("fit_surface")))
         fit_loop_figure(res, str(out.path("fit_loop")))
+        # model.tex is a template of the report system, rendered from the summary itself
+        as_json = json.loads(json.dumps(to_jsonable(summary)))
+        out.path("model.tex").write_text(render(as_json, out.stage, template="model"))
+        pdf, why = (compile_tex(out.path("model.tex"), ["fit_impulse.pdf"])
+                    if not args.no_pdf else (None, None))
+        why = None if pdf is not None else why
         summary["pdf"] = None if pdf is None else "model.pdf"
         summary["seconds"] = time.perf_counter() - t_start  # the whole command
         out.write_json("summary.json", summary)

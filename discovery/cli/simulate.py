@@ -47,7 +47,8 @@ def run(args):
     t0 = time.perf_counter()
     meas = synthesize(sc, law, periods=args.periods, fs=args.fs, noise=args.noise,
                       seed=args.seed, from_rest=args.from_rest,
-                      position_noise=args.position_noise, velocities=not args.no_velocities)
+                      position_noise=args.position_noise, velocities=not args.no_velocities,
+                      integrator=args.integrator)
     csv_text = meas.to_csv_text()
     summary = {"command": "simulate", "scenario": sc.as_dict(), "law": law.to_text(),
                "samples": int(meas.t.size), "seconds": time.perf_counter() - t0,
@@ -81,6 +82,10 @@ def register(sub):
     s.add_argument("--position-noise", type=number(0, 1), default=0.0,
                    help="Gaussian noise on w1, w2 as a fraction of the largest penetration, "
                    "0..1 (default: %(default)g)")
+    s.add_argument("--integrator", choices=("compiled", "scipy"), default="compiled",
+                   help="compiled: the kernel every fit uses; scipy: the independent slow "
+                   "path (scipy DOP853 restarted at every contact event), for records the "
+                   "fitting kernel did not make (default: %(default)s)")
     s.add_argument("--no-velocities", action="store_true",
                    help="leave out the v1, v2 columns (discovery then differentiates w1 - w2)")
     s.add_argument("--out", required=True, help="output CSV (t, F, w1, v1, w2, v2)")

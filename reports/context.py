@@ -1,0 +1,400 @@
+"""What a report says, computed from a run's ``summary.json`` alone.
+
+One function per run kind turns the summary into the template's context: tables (rows of
+cells), the model as LaTeX, the figures the run wrote, and conclusions written from the
+numbers (which terms the data support, what is inconsistent and where, what would separate
+models the record cannot tell apart). Nothing here reads a result object: the report of a
+run made last year reads the same as today's.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .texenv import Tex, escape, num
+
+__all__ = ["context", "KINDS"]
+
+CRITERIA = ("I0", "I1", "I2", "I3", "I4")
+CRITERION_MEANING = {
+    "I0": "relative L2 distance of the impulses",
+    "I1": "relative distance of the peak forces",
+    "I2": "relative L2 distance over the contact (the paper's main criterion)",
+    "I3": "relative distance of the contact times",
+    "I4": "relative distance of the transmitted momenta",
+}
+FIGURE_CAPTIONS = {
+    "verify": "Measured force (black) and the law's simulated force (red), folded on the "
+              "drive phase over the record's span.",
+    "fit_impulse": "Measured impulse and the simulated steady states of the best models.",
+    "fit_surface": "The selected law over the (zeta, dzeta) plane with the contact samples.",
+    "fit_loop": "Loading and unloading branches, measured and modelled, for a few impacts.",
+    "identification": "Identification: the path of the best law so far and the simulated "
+                      "force converging to the measured one.",
+    "landscape": "Criteria over the two coefficients; the noise floor and the consistent "
+                 "region are marked.",
+    "discover": "Recovered equation: strobe points, coefficients with error bars and the "
+                "verification by simulation.",
+    "attractor": "Stroboscopic points and a trajectory of the attractor.",
+    "basins": "Basins of the coexisting attractors.",
+    "chart": "Regime chart over the forcing frequency and amplitude.",
+    "explain": "The missing effect: where the model disagrees before and after it is added.",
+}
+
+
+def _model_tex(latex):
+    return Tex(latex) if latex else Tex("--")
+
+
+def _rows_from(d, keys=None, fmt=num):
+    keys = list(d) if keys is None else [k for k in keys if k in d]
+    return [[Tex(r"\texttt{" + escape(k) + "}"), fmt(d[k])] for k in keys]
+
+
+def _provenance(s, run_dir):
+    v = s.get("versions") or {}
+    git = s.get("git") or {}
+    rows = [["command", Tex(r"\texttt{vidi " + escape(s.get("command", "?")) + "}")],
+            ["created", s.get("created", "--")],
+            ["vidi", v.get("vibroimpact-discovery", "--")],
+            ["git commit", (git.get("commit") or "--")[:12]
+             + (" (uncommitted changes)" if git.get("dirty") else "")],
+            ["platform", s.get("platform", "--")],
+            ["libraries", ", ".join(f"{k} {val}" for k, val in v.items()
+                                    if k != "vibroimpact-discovery")]]
+    for name, inp in (s.get("inputs") or {}).items():
+        if isinstance(inp, dict):
+            rows.append([f"input {name}", f"{inp.get('path', '')} (sha256 "
+                         f"{str(inp.get('sha256', ''))[:16]}...)"])
+    settings = s.get("settings") or {}
+    shown = {k: val for k, val in settings.items()
+             if k not in ("command", "func", "out", "ueda_command") and val not in (None, False)}
+    rows.append(["settings", "; ".join(f"{k}={val}" for k, val in shown.items()) or "--"])
+    return rows
+
+
+def _scenario_rows(sc):
+    if not sc:
+        return []
+    units = {"m1": "kg", "m2": "kg", "k1": "N/m", "c1": "N s/m", "A": "N", "frequency": "Hz",
+             "g": "m/s^2", "k3": "N/m^3", "mass_loss": "per impact"}
+    rows = [["name", sc.get("name", "--")]]
+    for k, unit in units.items():
+        if k in sc and not (k in ("k3", "mass_loss") and not sc[k]):
+            rows.append([k, Tex(num(sc[k]) + r"\ " + escape(unit))])
+    if sc.get("law"):
+        rows.append(["reference law", Tex(r"\texttt{" + escape(sc["law"]) + "}")])
+    return rows
+
+
+def _criteria_table(criteria, floor, limits=None):
+    """Rows: criterion, value, noise floor, limit (when judged), its meaning."""
+    rows = []
+    for k in CRITERIA:
+        if k not in (criteria or {}):
+            continue
+        lim = (limits or {}).get(k)
+        rows.append([Tex(f"$I_{k[1]}$"), num(criteria[k]), num((floor or {}).get(k)),
+                     num(lim) if lim is not None else Tex("--"), CRITERION_MEANING[k]])
+    return rows
+
+
+def _measured_rows(m, records=None):
+    if not m:
+        return []
+    noise = m.get("noise")
+    noise_f = noise.get("F") if isinstance(noise, dict) else noise
+    rows = [["drive periods per cycle", m.get("n_periods", "--")],
+            ["cycles in the record", m.get("n_cycles", "--")],
+            ["contacts per cycle", m.get("impacts", "--")],
+            ["force noise (sd)", Tex(num(noise_f) + r"\,N")],
+            ["peak force", Tex(num(m.get("peak")) + r"\,N")],
+            ["contact time", Tex(num(m.get("contact_time")) + r"\,s")]]
+    if isinstance(noise, dict) and "dt" in noise:
+        rows.insert(0, ["sampling step", Tex(num(noise["dt"]) + r"\,s")])
+    return rows
+
+
+def _figures(run_dir, order):
+    figs = []
+    for stem in order:
+        for p in sorted(Path(run_dir).glob(f"{stem}*.pdf")):
+            if p.stem in ("report", "model"):
+                continue
+            base = p.stem.split("_")[0] if p.stem not in FIGURE_CAPTIONS else p.stem
+            figs.append({"file": p.name,
+                         "caption": FIGURE_CAPTIONS.get(p.stem,
+                                                        FIGURE_CAPTIONS.get(base, p.stem))})
+    seen, out = set(), []
+    for f in figs:
+        if f["file"] not in seen:
+            seen.add(f["file"])
+            out.append(f)
+    return out
+
+
+def _transient(verdict):
+    return "transient" in (verdict or "")
+
+
+def _intervals(entry):
+    iv = entry.get("intervals") or {}
+    return iv.get("bounds", iv) if isinstance(iv, dict) else {}
+
+
+def _coef_rows(coefs, errors=None, intervals=None, start=None):
+    rows = []
+    for k, v in coefs.items():
+        lo_hi = (intervals or {}).get(k)
+        rows.append([Tex(r"\texttt{" + escape(k) + "}"), num(v, 4),
+                     num((errors or {}).get(k), 2),
+                     Tex(f"[{num(lo_hi[0], 4)}, {num(lo_hi[1], 4)}]") if lo_hi else Tex("--")]
+                    + ([num((start or {}).get(k), 3)] if start is not None else []))
+    return rows
+
+
+# ----------------------------------------------------------------------------- kinds
+def _verify(s, run_dir):
+    c = {"title": "Verification of a contact law against a record",
+         "law": Tex(r"\texttt{" + escape(s.get("law", "")) + "}"),
+         "data": s.get("data"),
+         "measured": _measured_rows(s.get("measured")),
+         "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
+         "verdict": s.get("verdict") or s.get("message") or "--",
+         "consistent": bool(s.get("consistent")),
+         "regime": s.get("regime") or {}, "impacts": s.get("impacts") or {},
+         "start": s.get("start") or {},
+         "default_start": s.get("default_start")}
+    lim = s.get("limits") or {}
+    crit = s.get("criteria") or {}
+    concl = []
+    if c["consistent"]:
+        concl.append(f"The law is consistent with the record: every judged criterion is within "
+                     f"its limit (I2 {crit.get('I2', float('nan')):.3g} against "
+                     f"{lim.get('I2', float('nan')):.3g}), the limit being what the true law "
+                     "scores on records this noisy (twice the noise floor, or the floor plus "
+                     "three of its standard deviations, plus 0.005).")
+    else:
+        over = [k for k in lim if crit.get(k, 0) > lim[k]]
+        concl.append("The law is inconsistent with the record"
+                     + (f": {', '.join(over)} exceed{'s' if len(over) == 1 else ''} the noise "
+                        "limit" if over else "") + ". The figure shows where the simulated force "
+                     "departs from the measured one; `vidi explain` names the effect most "
+                     "likely missing.")
+    reg = c["regime"]
+    if reg and reg.get("measured") != reg.get("simulated"):
+        concl.append(f"The measured regime is {reg.get('measured')}, the simulated one "
+                     f"{reg.get('simulated')}.")
+    if _transient(s.get("verdict")):
+        concl.append("The record is not yet steady under this law: it was compared with the "
+                     "law's own trajectory from the measured state, block by block, not with "
+                     "its steady orbit.")
+    c["conclusions"] = concl
+    c["figures"] = _figures(run_dir, ["verify"])
+    return c
+
+
+def _selected_conclusions(s):
+    sel = s.get("selected") or {}
+    concl = []
+    terms = sel.get("terms") or list((sel.get("coefficients") or {}).keys())
+    lib = (s.get("fit_settings") or {}).get("library", "?")
+    state = "consistent" if sel.get("consistent") else "NOT consistent"
+    concl.append(f"From the library {lib}, the data support the terms {', '.join(terms)}: "
+                 f"the selected law is {state}"
+                 " with the record by full simulation.")
+    eq = s.get("equivalent") or []
+    if eq:
+        names = "; ".join(", ".join(e.get("terms") or e.get("coefficients", {}).keys())
+                          for e in eq)
+        concl.append(f"{len(eq)} other model(s) fit the record as well within its noise "
+                     f"({names}). They cannot be told apart from this record; a second "
+                     "operating point (another drive amplitude or frequency) or lower noise "
+                     "would separate them (see each model's reason below).")
+    for w in s.get("warnings") or []:
+        concl.append(f"Warning: {w}")
+    if sel.get("contact_defects"):
+        concl.append("The selected law has contact defects: " + "; ".join(sel["contact_defects"]))
+    return concl
+
+
+def _fit(s, run_dir):
+    sel = s.get("selected") or {}
+    fs = s.get("fit_settings") or {}
+    cert = s.get("certificate") or {}
+    c = {"title": "Discovery of a contact law",
+         "model": _model_tex(sel.get("latex")),
+         "coefficients": _coef_rows(sel.get("coefficients") or {}, sel.get("standard_errors"),
+                                    _intervals(sel)),
+         "interval_method": sel.get("interval_method") or "no bootstrap intervals",
+         "criteria": _criteria_table(sel.get("criteria"), sel.get("noise_floor")),
+         "verdict": sel.get("verdict") or "--",
+         "regime": sel.get("regime", "--"),
+         "refinement": sel.get("refinement", "--"),
+         "library": fs.get("library", "--"), "selection": fs.get("selection", "--"),
+         "scoring": fs.get("scoring", "--"), "criterion": fs.get("criterion", "I2"),
+         "records": [[r.get("data", "--"), r.get("scenario", "--"), r.get("regime", "--"),
+                      r.get("impacts", "--"),
+                      num((r.get("noise") or {}).get("F")),
+                      (r.get("noise") or {}).get("n_cycles", "--")]
+                     for r in s.get("records") or []],
+         "certificate": {"method": cert.get("method", "--"),
+                         "holds": bool(cert.get("holds")),
+                         "worst": num(cert.get("worst_violation")),
+                         "domain": {k: num(v) for k, v in (cert.get("domain") or {}).items()
+                                    if isinstance(v, int | float)},
+                         "conditions": [[k.replace("_", " "), v.get("quantity", ""),
+                                         "holds" if v.get("holds") else "FAILS",
+                                         num(v.get("grid_min_rel"))]
+                                        for k, v in (cert.get("conditions") or {}).items()]},
+         "ranking": [[str(i + 1), ", ".join(m.get("terms") or []), m.get("regime", "--"),
+                      num(m.get("bic"), 6), num((m.get("criteria") or {}).get(
+                          fs.get("criterion", "I2"))),
+                      "yes" if m.get("consistent") else "no"]
+                     for i, m in enumerate(s.get("ranking") or [])],
+         "equivalent": [{"model": _model_tex(e.get("latex")),
+                         "reason": e.get("reason", ""), "separate": e.get("separate", "")}
+                        for e in s.get("equivalent") or []],
+         "warnings": list(s.get("warnings") or [])}
+    c["conclusions"] = _selected_conclusions(s)
+    c["figures"] = _figures(run_dir, ["fit_impulse", "fit_surface", "fit_loop"])
+    return c
+
+
+def _identify(s, run_dir):
+    c = {"title": "Identification of a contact law by simulation",
+         "model": _model_tex(s.get("latex")),
+         "coefficients": _coef_rows(s.get("coefficients") or {}, s.get("standard_errors"),
+                                    _intervals(s), start=s.get("start") or {}),
+         "measured": _measured_rows(s.get("measured")),
+         "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor")),
+         "verdict": s.get("verdict") or "--",
+         "method": s.get("method", "--"), "criterion": s.get("criterion", "I2"),
+         "n_simulations": s.get("n_simulations", "--"), "message": s.get("message", "")}
+    concl = [f"{s.get('method', '?')} spent {s.get('n_simulations', '?')} simulations; the "
+             f"identified law is {'consistent' if s.get('consistent') else 'NOT consistent'} "
+             "with the record."]
+    if not s.get("consistent"):
+        concl.append("An inconsistent result after identification means either a missing "
+                     "effect (run `vidi explain`) or a local minimum: start nearer (the "
+                     "coefficients of `vidi fit`), or look at the landscape.")
+    c["conclusions"] = concl
+    c["figures"] = _figures(run_dir, ["identification"])
+    return c
+
+
+def _landscape(s, run_dir):
+    terms = s.get("terms") or ["?", "?"]
+    mins = s.get("minima") or {}
+    c = {"title": "Criteria landscape over two coefficients",
+         "terms": terms, "law": s.get("law", "--"),
+         "grid": "x".join(str(g) for g in s.get("grid") or []),
+         "minima": [[Tex(f"$I_{k[1]}$"), num(m.get("alpha1")), num(m.get("alpha2")),
+                     num(m.get("value")), m.get("regime", "--"),
+                     "yes" if m.get("consistent") else "no"]
+                    for k, m in mins.items()],
+         "noise_floor": _rows_from(s.get("noise_floor") or {}),
+         "n_consistent": s.get("n_consistent", 0),
+         "regimes": ", ".join(f"{k}: {v}" for k, v in (s.get("regimes") or {}).items()),
+         "reference": (s.get("reference") or {}).get("source", "--")}
+    n = s.get("n_consistent", 0)
+    c["conclusions"] = [
+        f"{n} grid point(s) are consistent with the reference within the noise limit"
+        + ("; the consistent region's size is the coefficients' uncertainty from this record."
+           if n else "; no pair of these coefficients explains the record on this grid.")]
+    c["figures"] = _figures(run_dir, ["landscape"])
+    return c
+
+
+def _explain(s, run_dir):
+    fm = s.get("final_model") or {}
+    its = s.get("iterations") or []
+    c = {"title": "The missing physical effect",
+         "model": _model_tex(fm.get("latex")),
+         "coefficients": _coef_rows(fm.get("coefficients") or {}, fm.get("uncertainties"),
+                                    _intervals(fm)),
+         "effects": list(fm.get("effects") or []),
+         "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor")),
+         "stopped": s.get("stopped_because", "--"),
+         "iterations": [[str(k + 1), it.get("effect", "--"),
+                         num((it.get("before") or {}).get("I2")),
+                         num((it.get("after") or {}).get("I2")),
+                         it.get("reason", "") or it.get("why", "")]
+                        for k, it in enumerate(its)],
+         "separability": [[r.get("effect", "--"), num(r.get("before")), num(r.get("after")),
+                           num(r.get("floor")),
+                           "yes" if r.get("separable") else "no"]
+                          for r in s.get("separability") or []]}
+    if its:
+        named = ", ".join(it.get("effect", "?") for it in its)
+        state = "consistent" if s.get("consistent") else "still NOT consistent"
+        concl = [f"Named and added: {named}. The gap to the record shrank as the table shows; "
+                 f"the final model is {state} with the record."]
+    else:
+        concl = ["No effect was added: " + str(s.get("stopped_because", "the start model already "
+                                                 "agrees with the record"))]
+    c["conclusions"] = concl
+    c["figures"] = _figures(run_dir, ["explain", "localise", "screen", "drift"])
+    return c
+
+
+def _ueda(s, run_dir):
+    cmd = s.get("command", "ueda")
+    c = {"title": f"Ueda's forced oscillator: {cmd.replace('ueda ', '')}"}
+    rows = []
+    for key in ("model", "regime", "terms", "forcing", "residual_rms", "n_windows"):
+        if key in s:
+            val = s[key]
+            rows.append([key.replace("_", " "),
+                         ", ".join(map(str, val)) if isinstance(val, list)
+                         else ("; ".join(f"{k}={v}" for k, v in val.items())
+                               if isinstance(val, dict)
+                         else (num(val) if isinstance(val, float) else val))])
+    c["facts"] = rows
+    c["model"] = _model_tex(s.get("latex") or (s.get("final") or {}).get("latex"))
+    c["coefficients"] = _coef_rows(s.get("coefficients") or {}, s.get("standard_errors"))
+    ver = s.get("verification") or {}
+    c["verification"] = [[k.replace("_", " "), num(v) if isinstance(v, int | float) else v]
+                         for k, v in ver.items()
+                         if isinstance(v, int | float | str) and not isinstance(v, bool)]
+    concl = []
+    if ver:
+        state = "consistent" if ver.get("consistent") else "NOT consistent"
+        concl.append(f"Verification by simulation: {state}"
+                     f" (energy distance {ver.get('energy_distance', float('nan')):.3g} against "
+                     f"the record's own floor {ver.get('floor_q95', float('nan')):.3g}; regime of "
+                     f"the record {ver.get('regime_record', '?')}, of the model "
+                     f"{ver.get('regime_model', '?')}).")
+    if "lyapunov" in s and isinstance(s["lyapunov"], dict):
+        L = s["lyapunov"]
+        concl.append(f"Largest Lyapunov exponent {L.get('value', float('nan')):.4g} per unit "
+                     "time: " + ("chaotic." if L.get("value", 0) > 0.01 else "not chaotic."))
+    c["conclusions"] = concl or ["See the tables and figures."]
+    c["figures"] = _figures(run_dir, ["discover", "explain", "attractor", "basins", "chart"])
+    return c
+
+
+KINDS = {"verify": _verify, "fit": _fit, "identify": _identify, "landscape": _landscape,
+         "explain": _explain, "ueda attractor": _ueda, "ueda chart": _ueda,
+         "ueda discover": _ueda, "ueda explain": _ueda}
+TEMPLATES = {"verify": "verify", "fit": "fit", "identify": "identify",
+             "landscape": "landscape", "explain": "explain"}
+
+
+def context(summary, run_dir):
+    """The template context of a run: the kind's own part plus provenance and scenario."""
+    kind = summary.get("command")
+    build = KINDS.get(kind)
+    if build is None:
+        from discovery.errors import InputError
+
+        raise InputError(f"no report for a {kind!r} run; reports cover "
+                         f"{', '.join(KINDS)} runs")
+    c = build(summary, run_dir)
+    c["kind"] = kind
+    c["template"] = TEMPLATES.get(kind, "ueda") + ".tex.j2"
+    c["provenance"] = _provenance(summary, run_dir)
+    c["scenario"] = _scenario_rows(summary.get("scenario"))
+    c["data"] = summary.get("data") or (summary.get("settings") or {}).get("data")
+    c["seconds"] = summary.get("seconds")
+    return c
