@@ -38,6 +38,7 @@ import numpy as np
 
 from constraints import require as require_certificate
 
+from ._printing import coefficient_lines, criteria_lines, fmt, readable
 from ._validate import Real, Text, params
 from .criteria import criterion as _criterion
 from .dynamics import Tolerances
@@ -168,6 +169,7 @@ class RankedModel:
         return d
 
 
+@readable
 @dataclass(frozen=True)
 class DiscoveryResult:
     """Outcome of :func:`discover`.
@@ -218,6 +220,31 @@ class DiscoveryResult:
     def refinement(self):
         """The selected model's refinement (or None)."""
         return self.selected.refinement
+
+    def _lines(self):
+        sel = self.selected
+        crit = self.settings.get("criterion", "I2")
+        head = (f"selected {sel.law}  [{sel.regime}]: "
+                f"{'consistent' if sel.consistent else 'NOT consistent'} with the record(s)")
+        out = [head, *coefficient_lines(sel.law.as_dict(), sel.standard_errors, sel.intervals)]
+        out += criteria_lines(sel.criteria, sel.noise_floor)
+        out.append(f"  verdict: {sel.verdict}")
+        out.append(f"ranking ({len(self.ranking)} candidates, criterion {crit}):")
+        for i, m in enumerate(self.ranking[:8]):
+            out.append(f"  {i + 1:>2}. {' + '.join(m.law.names):<28} {m.regime:<6} "
+                       f"{crit} {fmt((m.criteria or {}).get(crit), 3):>8}  "
+                       f"{'consistent' if m.consistent else ''}")
+        if len(self.ranking) > 8:
+            out.append(f"  ... {len(self.ranking) - 8} more")
+        for e in self.equivalent:
+            out.append(f"equivalent: {e.get('law', e.get('terms'))}: {e.get('reason', '')}")
+        cert = self.certificate
+        if cert is not None:
+            out.append(f"certificate: conditions {'hold' if cert.holds else 'DO NOT hold'} "
+                       f"({cert.method})")
+        out += [f"warning: {w}" for w in self.warnings]
+        out.append(f"{self.seconds:.1f} s")
+        return out
 
 
 def _coefficients(law, library):

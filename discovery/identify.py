@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares, minimize
 
+from ._printing import coefficient_lines, criteria_lines, fmt, readable
 from ._validate import Real, Text, params
 from .criteria import criterion as _criterion
 from .dynamics import Tolerances
@@ -52,6 +53,7 @@ _PENALTY = 10.0          # criterion value of a failed simulation (criteria are 
 _JAC_STEP = 1e-5         # relative step of the standard-error Jacobian
 
 
+@readable
 @dataclass(frozen=True)
 class IdentificationResult:
     """Outcome of :func:`identify`.
@@ -103,6 +105,17 @@ class IdentificationResult:
     @property
     def coefficients(self):
         return _named(self.law)
+
+    def _lines(self):
+        out = [f"identified {self.law}: {self.criterion} = {fmt(self.value, 3)} "
+               f"({self.method}, {self.n_simulations} simulations, {self.seconds:.1f} s)"]
+        out += coefficient_lines(self.coefficients, self.standard_errors, self.intervals)
+        out += criteria_lines(self.criteria)
+        if self.message:
+            out.append(f"  optimiser: {self.message}")
+        if self.failures:
+            out.append(f"  {len(self.failures)} simulation(s) failed on the way")
+        return out
 
 
 class _Budget(Exception):

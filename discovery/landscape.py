@@ -24,6 +24,7 @@ from multiprocessing import get_context
 
 import numpy as np
 
+from ._printing import fmt, readable
 from ._validate import Array, Real, params
 from ._workers import terminate_pool, worker_initializer
 from .criteria import CRITERIA
@@ -40,6 +41,7 @@ DEFAULT_SPREAD = 0.5
 """Default ranges: ``(1 - s) c .. (1 + s) c`` around each template coefficient ``c``."""
 
 
+@readable
 @dataclass(frozen=True)
 class Landscape:
     """Criteria over ``axes[0] x axes[1]`` coefficient values.
@@ -117,6 +119,21 @@ class Landscape:
         i, j = (int(k) for k in bad[0])
         msg = "" if self.messages is None else str(self.messages[i, j])
         return int(len(bad)), msg, (i, j)
+
+    def _lines(self):
+        n0, n1 = (len(a) for a in self.axes)
+        out = [f"landscape of {self.terms[0]}, {self.terms[1]} on {n0}x{n1} points "
+               f"({self.seconds:.1f} s, {self.workers} worker(s))"]
+        for k, v in self.values.items():
+            arr = np.asarray(v, dtype=float)
+            if np.isfinite(arr).any():
+                i, j = np.unravel_index(int(np.nanargmin(arr)), arr.shape)
+                out.append(f"  min {k} = {fmt(arr[i, j], 3)} at {self.terms[0]} = "
+                           f"{fmt(self.axes[0][i])}, {self.terms[1]} = {fmt(self.axes[1][j])}")
+        if self.consistent is not None:
+            out.append(f"  {int(np.sum(self.consistent))} point(s) consistent with the "
+                       "reference")
+        return out
 
 
 def parse_grid(text):

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._printing import fmt, readable
 from .._validate import Array, Real, params
 from ..errors import InputError, IntegrationError
 from ..law import ForceLaw
@@ -113,6 +114,7 @@ class StroboscopicMap:
         return J
 
 
+@readable
 @dataclass(frozen=True)
 class SteadyState:
     """A periodic steady state of the two-body system (or the evidence that none was found).
@@ -166,6 +168,13 @@ class SteadyState:
                 "impacts": self.impacts, "impacts_per_period": self.impacts_per_period,
                 "multipliers_abs": [float(abs(m)) for m in self.multipliers],
                 "residual": self.residual, "n_simulations": self.n_simulations}
+
+    def _lines(self):
+        d = self.as_dict()
+        mult = np.abs(np.asarray(self.multipliers)) if self.multipliers is not None else []
+        return [f"steady state {d.get('regime')}: {d.get('impacts')} impact(s) per orbit, "
+                f"max |Floquet multiplier| {fmt(np.max(mult) if len(mult) else None)}, "
+                f"residual {fmt(d.get('residual'), 2)}"]
 
 
 @params(

@@ -47,6 +47,7 @@ from multiprocessing import get_context
 import numpy as np
 from scipy.stats import chi2
 
+from .._printing import criteria_lines, fmt, readable
 from .._validate import Real, Text, params
 from .._workers import terminate_pool, worker_initializer
 from ..dynamics import Tolerances
@@ -70,6 +71,26 @@ from .localise import localise
 
 __all__ = ["ExplainResult", "Iteration", "explain", "start_law"]
 
+
+
+def _present(eff, model, res):
+    """The effect's parameter is away from 0 by more than 2 standard errors."""
+    name = eff.parameters[0].name
+    v = model.value(eff)
+    se = res.standard_errors.get(name)
+    return bool(v != 0.0 and (se is None or not np.isfinite(se) or abs(v) > 2.0 * se))
+
+
+def _polished_law(records, model, criterion, budget, tolerances, problem, drift):
+    """``(law, criteria, evaluations)`` of the model refitted alone with the full budget,
+    or None when the refit fails."""
+    try:
+        res = _output_error(records, model, criterion, budget, tolerances, polish=True)
+        evs = problem.evaluations(res.law, floor=True)
+        after, _ = _with_drift(_mean(evs, "criteria"), {}, drift, res.law)
+    except (IntegrationError, InputError):
+        return None
+    return res.law, after, evs
 
 
 # a number multiplying a factor: the start is a law with coefficients, not a term list
@@ -139,6 +160,7 @@ def _parameters(it):
     return {}
 
 
+@readable
 @dataclass(frozen=True)
 class ExplainResult:
     """Outcome of :func:`explain`.
@@ -188,6 +210,21 @@ class ExplainResult:
                 "criteria": self.criteria, "noise_floor": self.noise_floor,
                 "consistent": self.consistent, "stopped_because": self.stopped_because,
                 "separability": list(self.separability), "seconds": self.seconds}
+
+    def _lines(self):
+        named = [it.effect for it in self.iterations if it.effect]
+        out = [f"final model {self.final_model.law}"
+               + (f" with {', '.join(named)}" if named else " (nothing named)") + ": "
+               f"{'consistent' if self.consistent else 'NOT consistent'} with the record(s)"]
+        for k, it in enumerate(self.iterations):
+            key = next((c for c in ("I2", "D") if c in it.criteria_after), None)
+            gap = (f"{key} {fmt(it.criteria_before.get(key), 3)} -> "
+                   f"{fmt(it.criteria_after.get(key), 3)}" if key else "")
+            out.append(f"  iteration {k + 1}: {it.effect or 'nothing named'}  {gap}")
+        out += criteria_lines(self.criteria, self.noise_floor)
+        out.append(f"  stopped because {self.stopped_because}")
+        out.append(f"{self.seconds:.1f} s")
+        return out
 
 
 def _polish_start(records, fit, criterion, budget, tol):
@@ -889,11 +926,8 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             # an effect refitted to 0, or to a value within 2 standard errors of 0, only
             # carried a refit of the law
             e_ = eff_by_id[x[1]["effect"]]
-            v_ = x[2].value(e_)
-            se_ = (x[3].standard_errors.get(e_.parameters[0].name) if x[3] is not None
-                   else None)
-            x[1]["present"] = bool(v_ != 0.0 and (se_ is None or not np.isfinite(se_)
-                                                  or abs(v_) > 2.0 * se_))
+            x[1]["present"] = (_present(e_, x[2], x[3]) if x[3] is not None
+                               else bool(x[2].value(e_) != 0.0))
         good = [x for x in trials if x[0] <= 0.9 and x[1]["repulsive"] and x[1]["in_bounds"]
                 and x[1]["beats_law_refit"] and x[1]["present"]]
         if not good and null_after and criterion in null_after \
@@ -933,6 +967,22 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
                                        for p in eff_by_id[s["effect"]].parameters}
             except (IntegrationError, InputError):
                 pass
+        if res is not None and not _present(eff_by_id[s["effect"]], m2, res):
+            # polished with the full budget, the effect's parameter is within 2 standard
+            # errors of 0: the gain was the law's own refit. Nothing is named; the model is
+            # the polished refit without the effect (the loop then screens again)
+            refit = _polished_law(records, model, criterion, budget, tolerances, problem,
+                                  drift)
+            if refit is not None and refit[1] and refit[1][key] < before[key]:
+                law_refit, after_law, evs_law = refit
+                iterations.append(Iteration(
+                    model, law_refit, before, after_law, floor, loc, scores, None,
+                    f"{s['effect']} refitted with the full budget has its parameter within 2 "
+                    "standard errors of 0: the gain was the law's own refit "
+                    f"({key} {before[key]:.3g} -> {after_law[key]:.3g}); nothing is named",
+                    [], evs[0].simulated, evs_law[0].simulated, records[0][1].impulse))
+                model = law_refit
+                continue
         value = s["criteria_after"][key]
         tol_eq = floor.get(key, 0.0)
         equivalent = [x[1]["effect"] for x in good[1:]

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._printing import generic_lines, readable
 from .._validate import Array, Real, params
 from ..dynamics import Tolerances
 from ..errors import InputError, IntegrationError
@@ -383,6 +384,7 @@ def classify(system, y0=None, *, transient=300, periods=400, tolerances=None, sh
 
 
 # ------------------------------------------------------------------ one attractor
+@readable
 @dataclass(frozen=True)
 class Attractor:
     """An attractor reached from one initial state.
@@ -425,6 +427,9 @@ class Attractor:
                 "strobe_y_range": [float(s[:, 1].min()), float(s[:, 1].max())],
                 "n_points": self.n_points, "y0": [float(v) for v in self.y0],
                 "transient_periods": self.transient, "seconds": self.seconds}
+
+    def _lines(self):
+        return generic_lines(self)
 
 
 @params(

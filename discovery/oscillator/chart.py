@@ -40,6 +40,7 @@ from multiprocessing import get_context
 import numpy as np
 from numba import njit
 
+from .._printing import readable
 from .._validate import Array, Real, params
 from .._workers import terminate_pool, worker_initializer
 from ..dynamics import Tolerances
@@ -163,6 +164,7 @@ def _monodromy(y0, p, T, n, rtol, atol_state, atol_tangent, hmax, max_steps):
     return status, t, M, logs, y[6]
 
 
+@readable
 @dataclass(frozen=True)
 class Chart:
     """A regime chart.
@@ -287,6 +289,15 @@ class Chart:
 
 
 # ------------------------------------------------------------------ one point
+
+    def _lines(self):
+        kinds, counts = np.unique(np.asarray(self.kind).astype(str), return_counts=True)
+        share = ", ".join(f"{k} {c}" for k, c in zip(kinds, counts, strict=True))
+        return [f"regime chart of {self.system.model} on {np.size(self.nu)} x "
+                f"{np.size(self.B)} points ({self.seconds:.1f} s, {self.workers} worker(s))",
+                f"  regimes: {share}"]
+
+
 _CTX = {}
 
 

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from .._printing import generic_lines, readable
 from .._validate import Array, Real, Text, params
 from ..dynamics import Tolerances
 from ..dynamics._dopri import OK, make_smooth_advance
@@ -489,6 +490,7 @@ def stlsq(G, b, threshold, keep=None, max_iter=25):
     return x * sb, sup
 
 
+@readable
 @dataclass(frozen=True)
 class Discovery:
     """A discovered equation with its uncertainty.
@@ -544,6 +546,9 @@ class Discovery:
                 "residual_rms": self.residual_rms, "n_windows": self.n_windows,
                 "n_blocks": self.n_blocks, "bootstrap_support": self.bootstrap_support,
                 "settings": self.settings, "seconds": self.seconds}
+
+    def _lines(self):
+        return generic_lines(self)
 
 
 @dataclass(frozen=True)
@@ -764,6 +769,7 @@ def classify_record(strobe, noise_sd, *, max_period=8, monotone=0.98):
     return Regime("chaotic", "chaotic", 0, ev)
 
 
+@readable
 @dataclass(frozen=True)
 class Verification:
     """The discovered equation's attractor against the record's.
@@ -847,6 +853,9 @@ class Verification:
                          "many model points) <= the 95 % quantile of the distance between "
                          "the record's own random halves, and the same regime"),
                 "seconds": self.seconds}
+
+    def _lines(self):
+        return generic_lines(self)
 
 
 def _regime_match(rec, mod, lyap):

@@ -42,6 +42,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.stats import chi2
 
+from .._printing import generic_lines, readable
 from .._validate import Array, Real, params
 from ..errors import InputError
 from .discover import (
@@ -246,6 +247,7 @@ class Iteration:
                 "model_after": _model_dict(self.model_after)}
 
 
+@readable
 @dataclass(frozen=True)
 class Explanation:
     """Outcome of :func:`explain`.
@@ -318,6 +320,9 @@ class Explanation:
                 "catalogue": [effect_dict(e) for e in EFFECTS
                               if e.id in self.settings.get("effects", ())],
                 "settings": self.settings, "seconds": self.seconds}
+
+    def _lines(self):
+        return generic_lines(self)
 
 
 def _model_dict(m):

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._printing import criteria_lines, readable
 from ..criteria import compare, evaluate_criteria
 from ..dynamics.simulate import simulate
 from ..dynamics.steady_state import steady_state
@@ -61,6 +62,7 @@ def consistency_limits(floor, sd=None):
             for k in CONSISTENCY_CRITERIA}
 
 
+@readable
 @dataclass(frozen=True)
 class Evaluation:
     """A law scored against a reference.
@@ -117,6 +119,11 @@ class Evaluation:
                 "message": self.message,
                 "max_multiplier": None if ss is None or not ss.periodic
                 else float(np.max(np.abs(ss.multipliers)))}
+
+    def _lines(self):
+        out = [f"{self.status}: {self.verdict or self.message}"]
+        out += criteria_lines(self.criteria, self.noise_floor, self.limits)
+        return out
 
 
 def align(measured, exact):

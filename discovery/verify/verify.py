@@ -3,6 +3,7 @@
 import time
 from dataclasses import dataclass, field
 
+from .._printing import criteria_lines, readable
 from .._validate import Real, params
 from ..dynamics import Tolerances
 from ..law import ForceLaw
@@ -14,6 +15,7 @@ from .reference import Reference
 __all__ = ["VerifyResult", "verify"]
 
 
+@readable
 @dataclass(frozen=True)
 class VerifyResult:
     """Outcome of :func:`verify`.
@@ -75,6 +77,15 @@ class VerifyResult:
                 "default_start": None if self.default_start is None
                 else self.default_start.as_dict(),
                 "notes": list(self.notes), "seconds": self.seconds}
+
+    def _lines(self):
+        ev = self.evaluation
+        out = [f"{self.law}: {ev.verdict or ev.message}"]
+        out += criteria_lines(ev.criteria, ev.noise_floor, ev.limits)
+        out.append(f"  regime measured {ev.regime.get('measured')}, simulated "
+                   f"{ev.regime.get('simulated')}")
+        out += [f"  note: {n}" for n in self.notes]
+        return out
 
 
 @params(
