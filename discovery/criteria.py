@@ -197,7 +197,7 @@ def criterion(name):
             from None
 
 
-@params(measured=Impulse, simulated=Impulse, names=(None, list, tuple))
+@params(measured=(Impulse, None), simulated=(Impulse, None), names=(None, list, tuple))
 def evaluate_criteria(measured, simulated, names=None):
     """``{name: value}`` for the requested criteria (default all), measured vs simulated."""
     names = list(CRITERIA) if names is None else list(names)

@@ -30,6 +30,7 @@ from ._workers import terminate_pool, worker_initializer
 from .criteria import CRITERIA
 from .dynamics import Tolerances
 from .errors import InputError, VidiError
+from .impulse import Impulse
 from .law import ForceLaw
 from .response import response
 from .scenario import Scenario
@@ -239,7 +240,8 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
 
 
 @params(
-    scenario=Scenario, law=ForceLaw, axis0=Array(1), axis1=Array(1), reference=(None, Reference),
+    scenario=Scenario, law=ForceLaw, axis0=Array(1), axis1=Array(1),
+    reference=(None, Reference, Impulse),
     workers=(None, Real(1, integer=True)), tolerances=(Tolerances, None),
 )
 def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tolerances=None,

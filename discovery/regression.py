@@ -49,7 +49,6 @@ from constraints import (
 )
 from constraints.errors import SolverError
 
-from ._validate import Real, Text, params
 from .errors import InputError
 from .library import Library
 
@@ -288,14 +287,6 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
     fit_seconds_ : float
     """
 
-    @params(
-        library=(Text(), Library), selection=Text(), scoring=Text(),
-        max_terms=Real(1, 64, integer=True), cv=Real(2, integer=True), margin=Real(0),
-        signs=(None, Real(-1, 1, integer=True), list, tuple, np.ndarray), box_margin=Real(0),
-        elevation=Real(0, 8, integer=True),
-        threshold=Real(0), n_lambdas=Real(2, integer=True), solver=Text(),
-        grid=Real(3, integer=True),
-    )
     def __init__(self, library="poly:2", selection="best-subset", scoring="bic", max_terms=4, cv=5,
                  margin=0.0, monotone=False, signs=None, box_margin=0.1, elevation=2,
                  threshold=0.05, n_lambdas=30, solver="CLARABEL", grid=1001, cv_report=False):

@@ -8,7 +8,7 @@ import pytest
 
 from discovery.cli import main
 from discovery.discover import discover
-from discovery.errors import InputError, IntegrationError
+from discovery.errors import InputError, IntegrationError, VidiError
 from discovery.identify import as_records, identify
 from discovery.law import ForceLaw
 from discovery.measurement import synthesize
@@ -100,10 +100,10 @@ def test_start_law_that_fails_is_an_error(paper, reference):
     ({"method": "simplex"}, "unknown method"),
     ({"xtol": -1.0}, "xtol"),
     ({"max_simulations": 1}, "budget"),
-    ({"max_simulations": 2.5}, "budget"),
+    ({"max_simulations": 2.5}, "max_simulations must be an integer"),
 ])
 def test_bad_settings(paper, reference, kwargs, match):
-    with pytest.raises(InputError, match=match):
+    with pytest.raises(VidiError, match=match):  # InputError, or VidiTypeError for a type
         identify(paper, reference, START, **kwargs)
 
 

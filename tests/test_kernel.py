@@ -8,7 +8,7 @@ from discovery.dynamics import _kernel as K
 from discovery.dynamics import _tableau
 from discovery.dynamics.reference import reference_simulate
 from discovery.dynamics.simulate import EVENT_NAMES, Tolerances, simulate
-from discovery.errors import InputError, IntegrationError
+from discovery.errors import InputError, IntegrationError, VidiError, VidiTypeError
 from discovery.law import ForceLaw
 from discovery.scenario import Scenario
 
@@ -283,5 +283,8 @@ def test_invalid_t_eval(paper, te):
                                 dict(max_steps=0), dict(max_steps=2.5),
                                 dict(hmax_fraction=0), dict(hmax_fraction=1.5)])
 def test_invalid_tolerances(kw):
-    with pytest.raises(InputError):
+    with pytest.raises(VidiError) as info:  # a wrong value, or a float for an integer
+        Tolerances(**kw)
+    assert isinstance(info.value, InputError | VidiTypeError)
+    with pytest.raises(VidiError):
         Tolerances(**kw)

@@ -160,7 +160,7 @@ class PeriodicOrbit:
 
 
 @params(
-    system=UedaSystem, y0=Array(1), n=Real(1, integer=True), tol=Real(0, open_low=True),
+    system=(UedaSystem, None), y0=Array(1), n=Real(1, integer=True), tol=Real(0, open_low=True),
     max_newton=Real(1, integer=True), tolerances=(Tolerances, None),
 )
 
