@@ -311,22 +311,26 @@ def _explain(s, run_dir):
     its = s.get("iterations") or []
     c = {"title": "The missing physical effect",
          "model": _model_tex(fm.get("latex")),
-         "coefficients": _coef_rows(fm.get("coefficients") or {}, fm.get("uncertainties"),
-                                    _intervals(fm)),
+         "coefficients": _coef_rows({**(fm.get("coefficients") or {}),
+                                     **{f"d_{k}": v for k, v in
+                                        (fm.get("unloading") or {}).items()}},
+                                    fm.get("uncertainties"), _intervals(fm)),
          "effects": list(fm.get("effects") or []),
          "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor")),
          "stopped": s.get("stopped_because", "--"),
-         "iterations": [[str(k + 1), it.get("effect", "--"),
-                         num((it.get("before") or {}).get("I2")),
-                         num((it.get("after") or {}).get("I2")),
-                         it.get("reason", "") or it.get("why", "")]
+         "iterations": [[str(k + 1), it.get("effect") or "nothing named",
+                         num((it.get("criteria_before") or {}).get("I2")),
+                         num((it.get("criteria_after") or {}).get("I2")),
+                         num((it.get("noise_floor") or {}).get("I2")),
+                         it.get("evidence", "")]
                         for k, it in enumerate(its)],
          "separability": [[r.get("effect", "--"), num(r.get("before")), num(r.get("after")),
                            num(r.get("floor")),
                            "yes" if r.get("separable") else "no"]
                           for r in s.get("separability") or []]}
-    if its:
-        named = ", ".join(it.get("effect", "?") for it in its)
+    named_its = [it for it in its if it.get("effect")]
+    if named_its:
+        named = ", ".join(it["effect"] for it in named_its)
         state = "consistent" if s.get("consistent") else "still NOT consistent"
         concl = [f"Named and added: {named}. The gap to the record shrank as the table shows; "
                  f"the final model is {state} with the record."]

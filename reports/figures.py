@@ -233,28 +233,48 @@ def identification_figure(result, measured, impulses, stem, land=None):
     return _save(fig, stem)
 
 
-def fit_impulse_figure(result, impulses, stem):
-    """Measured impulse against the simulated impulses of the best-ranked models.
+def fit_impulse_figure(result, impulses, stem, n_models=3):
+    """Each record's measured impulse against the simulated ones of the best-ranked models,
+    one panel per record, each re-based on its contact.
 
     Parameters
     ----------
     result : DiscoveryResult
     impulses : list of (label, Impulse)
+        Labels of the models to draw (their simulated impulses against the first record);
+        the other records' come from each model's evaluations.
     stem : str
     """
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    E = result.measured
-    ax.plot(E.t * 1e3, E.F / 1e3, "k-", lw=2.5, label=f"measured ({E.n_cycles} cycles)")
-    for k, (label, imp) in enumerate(impulses):
-        if imp is not None:
-            ax.plot(imp.t * 1e3, imp.F / 1e3, "-", lw=1.2, color=f"C{k}", label=label)
-    visible = np.flatnonzero(E.F > 0.02 * E.peak)
-    end = E.t[visible[-1]] if visible.size else E.duration
-    ax.set_xlim(-0.03 * end * 1e3, min(E.duration, 1.5 * end) * 1e3)
-    ax.set_xlabel("time since onset [ms]")
-    ax.set_ylabel("contact force [kN]")
-    ax.set_title("Measured impulse and the simulated steady states of the best models")
-    ax.legend(fontsize=8)
+    refs = [ref for _, ref in result.references] or [None]  # (scenario, Reference) pairs
+    measured = [r.impulse if r is not None else result.measured for r in refs]
+    models = [m for m in result.ranking if m.evaluations][:n_models]
+    labels = [lab for lab, _ in impulses][:len(models)]
+    fig, axes = plt.subplots(len(measured), 1, figsize=(8, 3.0 + 2.2 * len(measured)),
+                             squeeze=False)
+    sc, unit = _force_unit(max(E.peak for E in measured))
+    for r, (E, ax) in enumerate(zip(measured, axes[:, 0], strict=True)):
+        sims = [(labels[k] if k < len(labels) else ", ".join(m.law.names),
+                 m.evaluations[r].simulated if r < len(m.evaluations) else None)
+                for k, m in enumerate(models)]
+        forces = [E.F] + [np.interp(E.t, imp.t, imp.F) for _, imp in sims if imp is not None]
+        tr, o, (lo, hi) = _contact_view(E.t, E.duration, *forces,
+                                        threshold=max(0.02 * E.peak, 5.0 * E.noise))
+        ax.plot(tr[o] * 1e3, E.F[o] * sc, "k-", lw=2.5, alpha=0.6,
+                label=f"measured ({E.n_cycles} cycles)")
+        styles = ["-", "--", ":"]
+        for k, (label, imp) in enumerate(sims):
+            if imp is None:
+                continue
+            f = np.interp(E.t, imp.t, imp.F)
+            ax.plot(tr[o] * 1e3, f[o] * sc, styles[k % 3], lw=1.4, color=f"C{k}", label=label)
+        ax.set_xlim(lo * 1e3, hi * 1e3)
+        ax.set_ylabel(f"contact force [{unit}]")
+        name = getattr(refs[r], "source", None) or f"record {r + 1}"
+        ax.set_title(f"record {r + 1}: {name}" if len(measured) > 1 else
+                     "Measured impulse and the simulated steady states of the best models",
+                     fontsize=9)
+        ax.legend(fontsize=7, loc="upper right")
+    axes[-1, 0].set_xlabel("time since the start of the contact [ms]")
     fig.tight_layout()
     return _save(fig, stem)
 
@@ -299,6 +319,49 @@ def fit_loop_figure(result, stem, max_impacts=3):
     return _save(fig, stem)
 
 
+def _force_unit(peak):
+    """``(scale, unit)`` to draw forces without an offset label: N, kN or MN."""
+    peak = abs(float(peak)) if np.isfinite(peak) else 0.0
+    if peak >= 1e6:
+        return 1e-6, "MN"
+    if peak >= 1e3:
+        return 1e-3, "kN"
+    return 1.0, "N"
+
+
+def _contact_view(t, period, *forces, threshold=0.0):
+    """Times of a folded cycle re-based on the contact: ``(t', order, (lo, hi))`` with
+    ``t'`` the time since the first sample of the contact (the end of the longest stretch
+    where every force is at most ``threshold``), wrapped so the contact is not cut by the
+    fold, and the x-range around it (the whole cycle when contact fills most of it)."""
+    t = np.asarray(t, dtype=float)
+    active = np.zeros(t.size, dtype=bool)
+    for f in forces:
+        active |= np.abs(np.asarray(f, dtype=float)) > threshold
+    # a noise spike is not a contact: keep only runs of at least 3 samples
+    active &= (np.roll(active, 1) & np.roll(active, -1)) | (np.roll(active, 1) & np.roll(
+        active, 2)) | (np.roll(active, -1) & np.roll(active, -2))
+    n = t.size
+    if not active.any() or active.all():
+        return t - t[0], np.arange(n), (0.0, float(period))
+    # the longest run of inactive samples on the circle
+    doubled = np.concatenate([~active, ~active])
+    best_len, best_end, run = 0, 0, 0
+    for i, free in enumerate(doubled):
+        run = run + 1 if free else 0
+        if run > best_len and run <= n:
+            best_len, best_end = run, i
+    start = (best_end + 1) % n  # first active sample after the longest gap
+    tr = np.mod(t - t[start], period)
+    span = float(period) * (n - best_len) / n
+    margin = 0.15 * span
+    tr = np.where(tr > period - margin, tr - period, tr)
+    order = np.argsort(tr)
+    if span > 0.6 * period:
+        return tr, order, (float(tr.min()), float(tr.max()))
+    return tr, order, (-margin, span + 2.0 * margin)
+
+
 def verify_figure(result, stem):
     """Measured and simulated force over the whole orbit, the noise band, the residual.
 
@@ -316,24 +379,32 @@ def verify_figure(result, stem):
                                   gridspec_kw={"height_ratios": [3, 1.3]})
     band = 2.0 * result.reference.noise.get("F", 0.0) / np.sqrt(max(E.n_cycles, 1))
     ms = 1e3
+    sc, unit = _force_unit(E.peak)
     if ev.simulated is not None:
         c = compare(E, ev.simulated)
-        ax.fill_between(c.t * ms, c.fe - band, c.fe + band, color="0.85",
+        # the contact, not the whole cycle: re-based on its start, not cut by the fold
+        tr, o, (lo, hi) = _contact_view(c.t, E.duration, c.fe, c.fn,
+                                        threshold=max(2.0 * band, 0.02 * E.peak,
+                                                      5.0 * E.noise))
+        x = tr[o] * ms
+        ax.fill_between(x, (c.fe[o] - band) * sc, (c.fe[o] + band) * sc, color="0.85",
                         label=f"measured +-2 sigma/sqrt({E.n_cycles}) noise band")
-        ax.plot(c.t * ms, c.fe, "k-", lw=1.0, label=f"measured F_E ({E.n_cycles} cycles)")
-        ax.plot(c.t * ms, c.fn, "C3-", lw=1.0, label=f"simulated F_N ({ev.regime['simulated']})")
-        axr.fill_between(c.t * ms, -band, band, color="0.85")
-        axr.plot(c.t * ms, c.fn - c.fe, "C0-", lw=0.8)
+        ax.plot(x, c.fe[o] * sc, "k-", lw=1.0, label=f"measured F_E ({E.n_cycles} cycles)")
+        ax.plot(x, c.fn[o] * sc, "C3-", lw=1.0,
+                label=f"simulated F_N ({ev.regime['simulated']})")
+        axr.fill_between(x, -band * sc, band * sc, color="0.85")
+        axr.plot(x, (c.fn[o] - c.fe[o]) * sc, "C0-", lw=0.8)
+        ax.set_xlim(lo * ms, hi * ms)
     else:
-        ax.plot(E.t * ms, E.F, "k-", lw=1.0, label="measured F_E")
+        ax.plot(E.t * ms, E.F * sc, "k-", lw=1.0, label="measured F_E")
     crit = ", ".join(f"{k} {v:.3g} (floor {ev.noise_floor.get(k, float('nan')):.2g})"
                      for k, v in ev.criteria.items() if k in ("I2", "I4", "I3", "I0"))
     ax.set_title(f"{result.law}\n{'consistent' if ev.consistent else 'INCONSISTENT'}: "
                  f"{crit or ev.status}", fontsize=9)
-    ax.set_ylabel("contact force F [N]")
+    ax.set_ylabel(f"contact force F [{unit}]")
     ax.legend(fontsize=7, loc="upper right")
-    axr.set_ylabel("F_N - F_E [N]")
-    axr.set_xlabel("time since the impact onset t* [ms]")
+    axr.set_ylabel(f"F_N - F_E [{unit}]")
+    axr.set_xlabel("time since the start of the contact [ms] (folded on the drive period)")
     axr.axhline(0.0, color="k", lw=0.5)
     fig.tight_layout()
     return _save(fig, stem)
@@ -390,14 +461,16 @@ def explain_figure(iteration, measured, stem, k=1):
         ze, ve = plane["zeta_edges"], plane["dzeta_edges"]
         m = plane["mean_residual"]
         lim = np.nanmax(np.abs(m)) if np.isfinite(m).any() else 1.0
-        im = ax.pcolormesh(ze * 1e3, ve, (m / 1e3).T, cmap="RdBu_r", vmin=-lim / 1e3,
-                           vmax=lim / 1e3, shading="flat")
+        # an empty bin (NaN: no sample fell in it) is gray, a zero residual white
+        ax.set_facecolor("0.8")
+        im = ax.pcolormesh(ze * 1e3, ve, np.ma.masked_invalid(m / 1e3).T, cmap="RdBu_r",
+                           vmin=-lim / 1e3, vmax=lim / 1e3, shading="flat")
         fig.colorbar(im, ax=ax, label="mean residual F_N - F_E [kN]")
         ax.set_xlabel("zeta [mm] (simulated)")
         ax.set_ylabel("dzeta [m/s] (simulated)")
     else:
         ax.text(0.5, 0.5, "no positions in the record", ha="center", transform=ax.transAxes)
-    ax.set_title("residual over the (zeta, dzeta) plane", fontsize=9)
+    ax.set_title("residual over the (zeta, dzeta) plane (gray: no samples)", fontsize=9)
     ax = axes[1, 1]
     sc = [x for x in iteration.scores if x.get("lm") is not None]
     unscored = [x for x in iteration.scores if x.get("lm") is None and "criteria_after" in x]
