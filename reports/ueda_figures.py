@@ -91,16 +91,24 @@ def chart_figure(ch, stem):
         from matplotlib.collections import LineCollection
 
         ax.add_collection(LineCollection(segs, colors="k", linewidths=0.4))
-    # the period of each larger subharmonic region, at its cell nearest its median
-    least = max(3, int(0.002 * ch.kind.size))
+    # periods: in every subharmonic cell on a coarse grid, else once per larger region (at
+    # its cell nearest the median); bold, outlined in white, to read on any colour
+    from matplotlib import patheffects
+
+    outline = [patheffects.withStroke(linewidth=2.2, foreground="white")]
+    coarse = ch.kind.size <= 31 * 31
+    least = 1 if coarse else max(3, int(0.002 * ch.kind.size))
+    size = 9 if ch.kind.size <= 15 * 15 else (7 if coarse else 8)
     for n in np.unique(ch.period[ch.period > 1]):
         cells = np.argwhere(ch.period == n)
         if len(cells) < least:
             continue
-        med = np.median(cells, axis=0)
-        i, j = cells[np.argmin(((cells - med) ** 2).sum(axis=1))]
-        ax.text(nu[j], B[i], str(int(n)), fontsize=6, ha="center", va="center",
-                color="#08306b")
+        if not coarse:
+            med = np.median(cells, axis=0)
+            cells = cells[[np.argmin(((cells - med) ** 2).sum(axis=1))]]
+        for i, j in cells:
+            ax.text(nu[j], B[i], f"P{int(n)}", fontsize=size, fontweight="bold",
+                    ha="center", va="center", color="#08306b", path_effects=outline)
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -161,7 +169,7 @@ def discover_figure(disc, ver, stem):
     """(a) the record's stroboscopic points over the discovered model's; (b) the
     coefficients with their standard errors (bars: 2 SE); (c) the energy distance
     against its noise floor (random halves of the record)."""
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8),
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8), layout="constrained",
                              gridspec_kw={"width_ratios": [1.3, 1, 1]})
     ax = axes[0]
     ms, rs = ver.model_strobe, ver.record_strobe
@@ -184,9 +192,13 @@ def discover_figure(disc, ver, stem):
     se = np.array([disc.standard_errors[k] for k in names])
     y = np.arange(len(names))
     ax.barh(y, c, xerr=2 * se, color="tab:blue", alpha=0.7, capsize=3)
-    ax.set_yticks(y, [f"{k}\n{ci:.4f} +- {si:.4f}" for k, ci, si in zip(names, c, se,
-                                                                          strict=True)],
-                  fontsize=8)
+    ax.set_yticks(y, names, fontsize=8)
+    span = float(np.max(np.abs(c))) if len(c) else 1.0
+    for yi, ci, si in zip(y, c, se, strict=True):  # the value beside its bar, inside the axes
+        ax.text(0.02 * span if ci < 0 else -0.02 * span, yi, f"{ci:.4g} +- {si:.2g}",
+                ha="left" if ci < 0 else "right", va="center", fontsize=7)
+    ax.set_xlim(-1.15 * span if np.any(c < 0) else -0.6 * span,
+                1.15 * span if np.any(c > 0) else 0.6 * span)
     ax.axvline(0, color="k", lw=0.5)
     ax.set_title("(b) coefficients of x'' = ...\n(error bars: 2 SE, block bootstrap)",
                  fontsize=9)
