@@ -221,6 +221,39 @@ class DiscoveryResult:
         """The selected model's refinement (or None)."""
         return self.selected.refinement
 
+    def as_dict(self, names=None):
+        """The result as JSON-ready data (``summary.json`` of ``vidi fit``); ``names``
+        labels the records (default: their sources)."""
+        cert = self.certificate
+        refs = [ref for _, ref in self.references]
+        names = list(names) if names is not None else [getattr(r, "source", "") for r in refs]
+        ref_out = self.refinement
+        return {
+            "records": [{"data": n, "scenario": s_k.name, "regime": ref.regime,
+                         "impacts": ref.impacts, "noise": ref.noise}
+                        for n, (s_k, ref) in zip(names, self.references, strict=True)],
+            "selected": self.selected.as_dict(),
+            "warnings": self.warnings,
+            "equivalent": self.equivalent,
+            "ranking": [m.as_dict() for m in self.ranking],
+            "certificate": None if cert is None else {
+                "method": cert.method, "holds": cert.holds,
+                "worst_violation": cert.worst_violation, "domain": cert.domain,
+                "conditions": cert.conditions},
+            "stability": self.stability,
+            "refinement": None if ref_out is None else {
+                "coefficients": ref_out.coefficients, "criteria": ref_out.criteria,
+                "standard_errors": ref_out.standard_errors,
+                "n_simulations": ref_out.n_simulations, "message": ref_out.message,
+                "failures": len(ref_out.failures)},
+            "samples": {"n": len(self.samples), "impacts": self.samples.n_impacts,
+                        "derivative": self.samples.derivative, "noise": self.samples.noise},
+            "measured": {"n_cycles": self.measured.n_cycles,
+                         "n_periods": self.measured.n_periods,
+                         "noise": self.measured.noise, "threshold": self.measured.threshold},
+            "discovery_seconds": self.seconds,
+            "fit_settings": self.settings}
+
     def _lines(self):
         sel = self.selected
         crit = self.settings.get("criterion", "I2")

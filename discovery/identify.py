@@ -106,6 +106,17 @@ class IdentificationResult:
     def coefficients(self):
         return _named(self.law)
 
+    def as_dict(self):
+        """The result as JSON-ready data (the identification part of ``summary.json``)."""
+        return {"criterion": self.criterion, "method": self.method,
+                "coefficients": self.coefficients, "law": self.law.to_text(),
+                "latex": self.law.latex(), "standard_errors": self.standard_errors,
+                "intervals": None if self.intervals is None else self.intervals.as_dict(),
+                "correlation": self.correlation, "value": self.value,
+                "criteria_found": self.criteria, "n_simulations": self.n_simulations,
+                "failures": self.failures, "iterations": self.iterations,
+                "message": self.message, "seconds": self.seconds}
+
     def _lines(self):
         out = [f"identified {self.law}: {self.criterion} = {fmt(self.value, 3)} "
                f"({self.method}, {self.n_simulations} simulations, {self.seconds:.1f} s)"]

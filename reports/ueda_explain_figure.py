@@ -31,7 +31,20 @@ def _strobe_panel(ax, ver, label, color, title):
     ax.plot(rs[:, 0], rs[:, 1], ".", ms=4, color="k",
             label=f"record ({len(rs)}, {ver.regime_record})")
     lo, hi = rs.min(axis=0), rs.max(axis=0)
-    pad = 0.5 * (hi - lo) + 1e-9
+    span = hi - lo + 1e-9
+    finite = ms[np.all(np.isfinite(ms), axis=1)] if len(ms) else ms
+    far = False
+    if len(finite):  # the model's points in view, unless it went far (diverged)
+        mlo, mhi = finite.min(axis=0), finite.max(axis=0)
+        if np.all(mlo > lo - 10 * span) and np.all(mhi < hi + 10 * span):
+            lo, hi = np.minimum(lo, mlo), np.maximum(hi, mhi)
+        else:
+            far = True
+    pad = 0.15 * (hi - lo) + 1e-9
+    if far:
+        ax.text(0.02, 0.02, f"{label}: points far outside this view (e.g. x = "
+                f"{finite[0, 0]:.3g}, x' = {finite[0, 1]:.3g})", transform=ax.transAxes,
+                fontsize=7, color=color)
     ax.set_xlim(lo[0] - pad[0], hi[0] + pad[0])  # a diverged or far model stays readable
     ax.set_ylim(lo[1] - pad[1], hi[1] + pad[1])
     ax.set_xlabel("x")
@@ -83,5 +96,8 @@ def explain_figure(ex, stem):
     eq = "x'' = " + " ".join(f"{v:+.4g} {k}" if k != "1" else f"{v:+.4g}"
                              for k, v in ex.final_model.terms.items())
     eq += f" {ex.final_model.forcing:+.4g} B cos(nu t)"
-    fig.suptitle(f"final: {eq}\nstopped: {ex.stopped_because}", fontsize=9, y=1.04)
+    import textwrap
+
+    stopped = textwrap.fill(f"stopped: {ex.stopped_because}", 170)
+    fig.suptitle(f"final: {eq}\n{stopped}", fontsize=9, y=1.04 + 0.03 * stopped.count("\n"))
     return _save(fig, stem)

@@ -48,32 +48,10 @@ def run(args):
             imps.append((f"#{k + 1}: {', '.join(m.law.names)} "
                          f"({args.criterion} {m.criteria[args.criterion]:.3g})",
                          m.evaluation.simulated))
-    cert = res.certificate
-    summary = {
-        "command": "fit", "scenario": sc.as_dict(),
-        "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
-        "records": [{"data": str(p), "scenario": s_k.name, "regime": ref.regime,
-                     "impacts": ref.impacts, "noise": ref.noise}
-                    for p, s_k, (_, ref) in zip(data, scs, res.references, strict=True)],
-        "selected": res.selected.as_dict(),
-        "warnings": res.warnings,
-        "equivalent": res.equivalent,
-        "ranking": [m.as_dict() for m in res.ranking],
-        "certificate": {"method": cert.method, "holds": cert.holds,
-                        "worst_violation": cert.worst_violation, "domain": cert.domain,
-                        "conditions": cert.conditions},
-        "stability": res.stability,
-        "refinement": None if res.refinement is None else {
-            "coefficients": res.refinement.coefficients, "criteria": res.refinement.criteria,
-            "standard_errors": res.refinement.standard_errors,
-            "n_simulations": res.refinement.n_simulations, "message": res.refinement.message,
-            "failures": len(res.refinement.failures)},
-        "samples": {"n": len(res.samples), "impacts": res.samples.n_impacts,
-                    "derivative": res.samples.derivative, "noise": res.samples.noise},
-        "measured": {"n_cycles": res.measured.n_cycles, "n_periods": res.measured.n_periods,
-                     "noise": res.measured.noise, "threshold": res.measured.threshold},
-        "discovery_seconds": res.seconds,
-        "fit_settings": res.settings, **provenance(vars(args), inputs=inputs_of(args))}
+    summary = {"command": "fit", "scenario": sc.as_dict(),
+               "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
+               **res.as_dict(names=[str(p) for p in data]),
+               **provenance(vars(args), inputs=inputs_of(args))}
     with OutputDir(args.out) as out:
         buf = io.StringIO()
         w = csv.writer(buf)

@@ -118,18 +118,10 @@ def run(args):
                    "measured": {"n_cycles": E.n_cycles, "n_periods": E.n_periods,
                                 "noise": E.noise, "threshold": E.threshold,
                                 "peak": E.peak, "contact_time": E.contact_time},
-                   "criterion": res.criterion, "method": res.method,
-                   "start": start.as_dict(), "coefficients": res.coefficients,
-                   "law": res.law.to_text(), "latex": res.law.latex(),
-                   "standard_errors": res.standard_errors,
-                   "intervals": None if res.intervals is None else res.intervals.as_dict(),
-                   "correlation": res.correlation,
+                   "start": start.as_dict(), **res.as_dict(),
                    "criteria": final.criteria, "noise_floor": final.noise_floor,
                    "consistent": final.consistent, "verdict": final.verdict,
-                   "regime": final.regime, "n_simulations": res.n_simulations,
-                   "failures": res.failures,
-                   "iterations": res.iterations, "message": res.message,
-                   "seconds": res.seconds, **provenance(vars(args), inputs=inputs_of(args))}
+                   "regime": final.regime, **provenance(vars(args), inputs=inputs_of(args))}
         out.write_json("summary.json", summary)
         buf = io.StringIO()
         w = csv.writer(buf)
