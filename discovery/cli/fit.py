@@ -82,6 +82,7 @@ def run(args):
     if sel.criteria:
         print(criteria_line(sel.criteria, sel.noise_floor))
     print(f"  {sel.verdict}")
+    cert = res.certificate
     print(f"  certificate: {'holds' if cert.holds else 'FAILS'} on zeta <= "
           f"{cert.domain['zeta_max']:.3g} m, zd <= {cert.domain['zd_max']:.3g} m/s "
           f"(worst violation {cert.worst_violation:.2g})")
