@@ -121,6 +121,29 @@ class Landscape:
         msg = "" if self.messages is None else str(self.messages[i, j])
         return int(len(bad)), msg, (i, j)
 
+    def as_dict(self):
+        """The landscape as JSON-ready data (``summary.json`` of ``vidi landscape``)."""
+        a0, a1 = self.axes
+        count, first, at = self.failures
+        minima = {}
+        for n in CRITERIA:
+            ij = self.argmin(n)
+            minima[n] = None if ij is None else {
+                "alpha1": a0[ij[0]], "alpha2": a1[ij[1]], "value": self.values[n][ij],
+                "regime": self.regime[ij], "consistent": bool(self.consistent[ij]),
+                "noise_floor": self.noise_floor[n]}
+        return {"terms": self.terms, "alpha1": a0, "alpha2": a1,
+                **{n: self.values[n] for n in CRITERIA},
+                "regime": self.regime.tolist(), "impacts": self.impacts,
+                "consistent": self.consistent, "n_consistent": int(self.consistent.sum()),
+                "regimes": self.regime_counts(),
+                "failed": {"count": count, "first_message": first,
+                           "first_at": None if at is None
+                           else {"alpha1": a0[at[0]], "alpha2": a1[at[1]]}},
+                "noise_floor": self.noise_floor, "noise_floor_q95": self.noise_floor_q95,
+                "noise_floor_under": self.noise_floor_under, "minima": minima,
+                "seconds": self.seconds, "workers": self.workers}
+
     def _lines(self):
         n0, n1 = (len(a) for a in self.axes)
         out = [f"landscape of {self.terms[0]}, {self.terms[1]} on {n0}x{n1} points "

@@ -270,7 +270,7 @@ def fit_impulse_figure(result, impulses, stem, n_models=3):
         ax.set_xlim(lo * 1e3, hi * 1e3)
         ax.set_ylabel(f"contact force [{unit}]")
         name = getattr(refs[r], "source", None) or f"record {r + 1}"
-        ax.set_title(f"record {r + 1}: {name}" if len(measured) > 1 else
+        ax.set_title(f"record {r + 1}: {plain(name)}" if len(measured) > 1 else
                      "Measured impulse and the simulated steady states of the best models",
                      fontsize=9)
         ax.legend(fontsize=7, loc="upper right")
@@ -317,6 +317,12 @@ def fit_loop_figure(result, stem, max_impacts=3):
     ax.legend(fontsize=7)
     fig.tight_layout()
     return _save(fig, stem)
+
+
+def plain(text):
+    """User text (a file or scenario name) for a figure: matplotlib would read ``$...$`` as
+    mathtext (and fail on a broken one)."""
+    return str(text).replace("$", r"\$")
 
 
 def _force_unit(peak):

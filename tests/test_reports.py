@@ -187,3 +187,25 @@ def test_fit_writes_model_tex_from_the_template(runs):
     tex = (runs / "fit" / "model.tex").read_text()
     assert "\\documentclass" in tex and "Records." in tex
     assert "r\\_\\textbackslash{}input\\{etc-passwd\\}\\_\\$x\\$.csv" in tex
+
+
+def test_user_text_in_figures_is_not_read_as_mathtext(tmp_path):
+    """A record name holding '$...$' is drawn as it is: matplotlib's mathtext would fail on
+    a broken formula and end the run."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from reports.figures import plain
+
+    name = r"r$\frac{1}{0$_x.csv"
+    fig, ax = plt.subplots()
+    ax.set_title(plain(name))
+    fig.savefig(tmp_path / "ok.png")
+    plt.close(fig)
+    fig, ax = plt.subplots()
+    ax.set_title(name)
+    with pytest.raises(ValueError):
+        fig.savefig(tmp_path / "broken.png")
+    plt.close(fig)

@@ -109,30 +109,10 @@ def run(args):
     ref_info.update(regime=land.reference["regime"], start=land.reference["start"])
     if ref is None:
         ref_info["impacts"] = land.reference["impacts"]
-    count, first, at = land.failures
-    minima = {}
-    for n in CRITERIA:
-        ij = land.argmin(n)
-        minima[n] = None if ij is None else {
-            "alpha1": a0[ij[0]], "alpha2": a1[ij[1]], "value": land.values[n][ij],
-            "regime": land.regime[ij], "consistent": bool(land.consistent[ij]),
-            "noise_floor": land.noise_floor[n]}
     with OutputDir(args.out) as out:
         summary = {"command": "landscape", "scenario": sc.as_dict(), "law": law.to_text(),
-                   "terms": land.terms, "alpha1": a0, "alpha2": a1,
-                   **{n: land.values[n] for n in CRITERIA},
-                   "regime": land.regime.tolist(), "impacts": land.impacts,
-                   "consistent": land.consistent, "n_consistent": int(land.consistent.sum()),
-                   "regimes": land.regime_counts(),
-                   "failed": {"count": count, "first_message": first,
-                              "first_at": None if at is None
-                              else {"alpha1": a0[at[0]], "alpha2": a1[at[1]]}},
-                   "reference": ref_info, "noise_floor": land.noise_floor,
-                   "noise_floor_q95": land.noise_floor_q95,
-                   "noise_floor_under": land.noise_floor_under,
-                   "grid": [n0, n1],
+                   **land.as_dict(), "reference": ref_info, "grid": [n0, n1],
                    "ranges": {"alpha1": list(r0), "alpha2": list(r1), "from": origin},
-                   "minima": minima, "seconds": land.seconds, "workers": land.workers,
                    **provenance(vars(args), inputs=inputs_of(args))}
         out.write_json("summary.json", summary)
         out.path("landscape.csv").write_text(_grid_csv(land))
@@ -141,6 +121,8 @@ def run(args):
             truth = tuple(sc.law.coefficients[:2])
         landscape_figure(land, str(out.path("landscape")), truth=truth)
     src = "the scenario's law" if ref is None else f"{args.data}"
+    count, first, at = land.failures
+    minima = summary["minima"]
     print(f"landscape {n0}x{n1} of {law.names[0]} in [{r0[0]:.4g}, {r0[1]:.4g}] x "
           f"{law.names[1]} in [{r1[0]:.4g}, {r1[1]:.4g}] against {src} "
           f"({land.reference['regime']}): {land.seconds:.1f} s on {land.workers} processes")
