@@ -369,6 +369,25 @@ def _ueda(s, run_dir):
                      f"the record's own floor {ver.get('floor_q95', float('nan')):.3g}; regime of "
                      f"the record {ver.get('regime_record', '?')}, of the model "
                      f"{ver.get('regime_model', '?')}).")
+    fr = s.get("fractions")
+    if isinstance(fr, dict):
+        grid = "x".join(str(g) for g in s.get("grid") or [])
+        share = ", ".join(f"{k} {100 * v:.0f} %" for k, v in fr.items() if v)
+        periods = ", ".join(f"{k} ({v} points)" for k, v in (s.get("periods_found") or {}).items())
+        concl.append(f"Over nu in {s.get('nu_range')} and B in {s.get('B_range')} on a {grid} "
+                     f"grid the regimes are: {share}." + (f" Periods found: {periods}."
+                                                          if periods else ""))
+    if "effects_added" in s:
+        gaps = "; ".join(f"{k.replace('_', ' ')} {v['before']:.3g} -> {v['after']:.3g} "
+                         f"({v['ratio']:.0f}x)" for k, v in (s.get("gap") or {}).items()
+                         if isinstance(v, dict))
+        added = ", ".join(s["effects_added"]) or "none"
+        concl.append(f"Effects named and added: {added}; the gap: {gaps}. The final model is "
+                     f"{'consistent' if s.get('consistent') else 'NOT consistent'} with the "
+                     f"record. Stopped because {s.get('stopped_because', '--')}.")
+        final = s.get("final_model") or {}
+        if final.get("coefficients"):
+            c["coefficients"] = _coef_rows(final["coefficients"], final.get("standard_errors"))
     if "lyapunov" in s and isinstance(s["lyapunov"], dict):
         L = s["lyapunov"]
         concl.append(f"Largest Lyapunov exponent {L.get('value', float('nan')):.4g} per unit "
