@@ -2,6 +2,8 @@
 
 Writes ``bench/results.json``.  Figures:
 
+0. start-up: ``vidi --help`` and ``import discovery`` against a bare Python start
+   (goal: help <= 0.3 s);
 1. one steady-state force history: compiled kernel vs the scipy reference path at
    equal accuracy (goal >= 300x faster);
 2. the 41x41 landscape wall time (goal <= 15 s on 2 cores), also as a ratio to
@@ -89,6 +91,30 @@ def bench_landscape(sc):
             "goal": "<= 15 s on 2 cores"}
 
 
+def bench_start_up(repeat=5):
+    """``vidi --help`` and ``import discovery`` against a bare interpreter start, measured
+    in the same run (best of ``repeat``), as ratios and extra seconds."""
+    import subprocess
+
+    def best(argv):
+        times = []
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            subprocess.run(argv, capture_output=True, check=True)
+            times.append(time.perf_counter() - t0)
+        return min(times)
+
+    py = sys.executable
+    vidi = str(Path(py).with_name("vidi"))
+    base = best([py, "-c", "pass"])
+    help_ = best([vidi, "--help"])
+    imp = best([py, "-c", "import discovery"])
+    return {"python_start_seconds": base, "vidi_help_seconds": help_,
+            "import_discovery_seconds": imp, "vidi_help_over_python_start": help_ / base,
+            "vidi_help_extra_seconds": help_ - base,
+            "goal": "vidi --help <= 0.3 s"}
+
+
 def bench_identify(sc):
     meas = synthesize(sc, sc.law, periods=20, fs=20000)
     E = meas.impulse(sc.period)
@@ -117,7 +143,8 @@ def main():
 
     sc = load_scenario("paper")
     steady_state(sc, sc.law)  # compile / load the cached kernels first
-    results = {"kernel_vs_scipy": bench_kernel(sc), "landscape_41x41": bench_landscape(sc),
+    results = {"start_up": bench_start_up(), "kernel_vs_scipy": bench_kernel(sc),
+               "landscape_41x41": bench_landscape(sc),
                "identification": bench_identify(sc), "discovery": bench_discovery(),
                "pipeline": bench_pipeline(), "explain": bench_explain(), "ueda": bench_ueda(),
                "cores": os.cpu_count(),
@@ -125,6 +152,10 @@ def main():
     text = json.dumps(to_jsonable(results), indent=2) + "\n"
     Path(__file__).with_name("results.json").write_text(text)
     k, L, idf = results["kernel_vs_scipy"], results["landscape_41x41"], results["identification"]
+    s = results["start_up"]
+    print(f"vidi --help: {s['vidi_help_seconds']:.2f} s ({s['vidi_help_over_python_start']:.1f}"
+          f" x a bare python start of {s['python_start_seconds']:.3f} s); import discovery "
+          f"{s['import_discovery_seconds']:.2f} s")
     print(f"kernel vs scipy: {k['speedup']:.0f}x faster on one period, "
           f"{k['long_run_40_periods_speedup']:.0f}x on 40 periods (errors "
           f"{k['kernel_max_error_rel']:.1e} vs {k['scipy_max_error_rel']:.1e})")

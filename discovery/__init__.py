@@ -6,15 +6,10 @@ candidate :class:`Library` -> certified sparse fit (:class:`ConstrainedSparseReg
 (:func:`discover`), identification, landscapes -> figures, LaTeX and ``summary.json``.
 """
 
-import importlib
-import sys
-import types
+from ._lazy import lazy_package
 
-# Names are imported on first use (PEP 562), so ``import discovery`` and ``vidi --help`` do not
-# load numba, cvxpy, sympy and matplotlib.  Five functions share their name with the
-# submodule that defines them (``discovery.explain`` ...): importing that submodule binds
-# the package attribute to the module, so those five are properties of the package's
-# class and always give the function.
+# Names are imported on first use (:mod:`discovery._lazy`): ``import discovery`` and
+# ``vidi --help`` do not load numba, cvxpy, sympy and matplotlib.
 _EXPORTS = {
     'CRITERIA': 'criteria',
     'evaluate_criteria': 'criteria',
@@ -56,42 +51,8 @@ _EXPORTS = {
     'Report': 'report',
     'report': 'report',
 }
-_SHADOWED = ("discover", "explain", "identify", "landscape", "report", "response")
 
 
-def _export(name):
-    return getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
-
-
-def __getattr__(name):
-    if name not in _EXPORTS:
-        raise AttributeError(f"module 'discovery' has no attribute {name!r}")
-    value = _export(name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_EXPORTS))
-
-
-class _Package(types.ModuleType):
-    pass
-
-
-def _function_property(name):
-    def get(module):
-        return _export(name)
-
-    def set_(module, value):  # the import system binds the submodule here: keep the function
-        pass
-
-    return property(get, set_)
-
-
-for _name in _SHADOWED:
-    setattr(_Package, _name, _function_property(_name))
-sys.modules[__name__].__class__ = _Package
 
 __all__ = [
     "CRITERIA", "evaluate_criteria", "simulate", "Tolerances", "SteadyState", "steady_state",
@@ -103,3 +64,5 @@ __all__ = [
     "RankedModel", "Library", "ConstrainedSparseRegressor", "Candidate", "ContactSamples",
     "contact_samples", "explain", "ExplainResult", "report", "Report",
 ]
+
+lazy_package(__name__, _EXPORTS)

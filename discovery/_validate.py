@@ -22,7 +22,7 @@ import numpy as np
 
 from .errors import InputError, VidiTypeError
 
-__all__ = ["Real", "Choice", "Text", "Array", "check", "params"]
+__all__ = ["Real", "Choice", "Text", "Array", "Instance", "check", "params"]
 
 
 def _received(value):
@@ -59,6 +59,24 @@ class Real:
                or (self.high is not None and v > self.high))
         if bad:
             raise InputError(f"{where} must be {self.describe()}; got {value!r}")
+
+
+class Instance:
+    """An instance of a class named by its module, imported at the first check (so that a
+    light module need not import a heavy one for its signature)."""
+
+    def __init__(self, module, name):
+        self.module, self.name = module, name
+
+    def describe(self):
+        return _a(self.name)
+
+    def __call__(self, where, value):
+        import importlib
+
+        cls = getattr(importlib.import_module(self.module), self.name)
+        if not isinstance(value, cls):
+            raise VidiTypeError(f"{where} must be {self.describe()}; got {_received(value)}")
 
 
 class Choice:

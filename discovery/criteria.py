@@ -26,9 +26,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validate import params
+from ._validate import Instance, params
 from .errors import InputError
-from .impulse import Impulse
+
+_IMPULSE = Instance("discovery.impulse", "Impulse")
 
 __all__ = ["CRITERIA", "Comparison", "compare", "evaluate_criteria", "criterion"]
 
@@ -197,7 +198,7 @@ def criterion(name):
             from None
 
 
-@params(measured=(Impulse, None), simulated=(Impulse, None), names=(None, list, tuple))
+@params(measured=(_IMPULSE, None), simulated=(_IMPULSE, None), names=(None, list, tuple))
 def evaluate_criteria(measured, simulated, names=None):
     """``{name: value}`` for the requested criteria (default all), measured vs simulated."""
     names = list(CRITERIA) if names is None else list(names)

@@ -31,20 +31,35 @@ units N m^-a (m/s)^-b.
 """
 
 from dataclasses import dataclass, replace
+from functools import lru_cache
 
 import numpy as np
-import sympy
 
 from ._lawgrammar import MAX_EXPONENT, parse_law_terms
 from ._validate import Real, check
 from .errors import InputError
 
-__all__ = ["Term", "ForceLaw", "ZETA", "ZD"]
+__all__ = ["Term", "ForceLaw"]  # and ZETA, ZD, the sympy symbols (made on first use)
 
-ZETA, ZD = sympy.symbols("zeta zd", nonnegative=True)
+
+
+@lru_cache(maxsize=1)
+def _symbols():
+    """``(ZETA, ZD)``, the sympy symbols (sympy is imported on first use: ``vidi --help``
+    and reading a law do not need it)."""
+    import sympy
+
+    return sympy.symbols("zeta zd", nonnegative=True)
+
+
+def __getattr__(name):
+    if name in ("ZETA", "ZD"):
+        return _symbols()[name == "ZD"]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 FASTEST_CONTACT = 2 * np.pi * 1e7  # contact rate x drive period: a contact of 1e-7 periods
 _MAX_SET = 0.95  # largest permanent-set fraction (1 would be a rigid-plastic contact)
-_LATEX_NAMES = {ZETA: r"\zeta", ZD: r"\dot{\zeta}_{+}"}
+_LATEX = (r"\zeta", r"\dot{\zeta}_{+}")  # names of (ZETA, ZD) in LaTeX
+_LATEX_UNLOADING = (r"\zeta", r"|\dot{\zeta}|")
 
 
 def _fmt_exp(p):
@@ -108,7 +123,10 @@ class Term:
 
     def sympy(self):
         """The term as a sympy expression in ``ZETA`` and ``ZD``."""
-        return ZETA ** sympy.nsimplify(self.a) * ZD ** sympy.nsimplify(self.b)
+        import sympy
+
+        zeta, zd = _symbols()
+        return zeta ** sympy.nsimplify(self.a) * zd ** sympy.nsimplify(self.b)
 
     def __str__(self):
         return self.name
@@ -418,6 +436,8 @@ class ForceLaw:
     # --------------------------------------------------------------- export
     def sympy(self):
         """``P`` as a sympy expression in ``ZETA`` (zeta) and ``ZD`` (max(dzeta, 0))."""
+        import sympy
+
         return sympy.Add(
             *[sympy.Float(c, 15) * t.sympy()
               for c, t in zip(self.coefficients, self.terms, strict=True)]
@@ -428,17 +448,20 @@ class ForceLaw:
 
         ``\\dot\\zeta_+`` stands for ``max(dzeta, 0)``.
         """
-        text = _latex_sum(self.coefficients, self.terms, digits, _LATEX_NAMES)
+        text = _latex_sum(self.coefficients, self.terms, digits, _LATEX)
         if self.unloading:
             text += (r"\quad\text{unloading: } P(\zeta, 0) - "
                      + _latex_sum(self.unloading_coefficients, self.unloading, digits,
-                                  {ZETA: r"\zeta", ZD: r"|\dot{\zeta}|"}, paren=True))
+                                  _LATEX_UNLOADING, paren=True))
         if self.permanent_set:
             text += rf"\quad\text{{set }} s = {self.permanent_set:.{digits}g}"
         return text
 
 
-def _latex_sum(coefficients, terms, digits, names, paren=False):
+def _latex_sum(coefficients, terms, digits, latex_names, paren=False):
+    import sympy
+
+    names = dict(zip(_symbols(), latex_names, strict=True))
     out = []
     for c, t in zip(coefficients, terms, strict=True):
         mant, _, exp = f"{abs(c):.{digits - 1}e}".partition("e")

@@ -129,3 +129,17 @@ def test_every_example_in_the_help_parses():
             assert argv[0] == "vidi" and argv[1:1 + len(path.split())] == path.split(), line
             if "COMMAND" not in argv:
                 parser.parse_args(argv[1:])  # raises UsageError on a wrong example
+
+
+def test_help_loads_no_heavy_library():
+    """``vidi --help`` builds every parser without numba, cvxpy, sympy, scipy, matplotlib,
+    pysindy or jinja2 (their import took 2-3 s; the timing itself is in make bench)."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from discovery.cli import _parser; _parser(); "
+            "print(','.join(m for m in ('numba', 'cvxpy', 'sympy', 'scipy', 'matplotlib', "
+            "'pysindy', 'jinja2', 'sklearn') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=120).stdout.strip()
+    assert out == "", f"vidi --help imports {out}"

@@ -5,9 +5,14 @@ record + model -> :func:`localise` (phases, (zeta, dzeta) plane, grid motion, dr
 score tests of the catalogue's effects (:data:`EFFECTS`) -> refit -> :func:`explain`.
 """
 
-from .effects import EFFECTS, Effect, Model, effect, first_order_lag
-from .explain import ExplainResult, Iteration, explain, start_law
-from .localise import PHASES, localise
+from .._lazy import lazy_package
+
+_EXPORTS = {"EFFECTS": "effects", "Effect": "effects", "Model": "effects", "effect": "effects",
+            "first_order_lag": "effects", "ExplainResult": "explain", "Iteration": "explain",
+            "explain": "explain", "start_law": "explain", "PHASES": "localise",
+            "localise": "localise"}
 
 __all__ = ["explain", "ExplainResult", "Iteration", "EFFECTS", "Effect", "Model", "effect",
            "first_order_lag", "localise", "PHASES", "start_law"]
+
+lazy_package(__name__, _EXPORTS)

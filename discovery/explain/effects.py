@@ -19,7 +19,6 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import InputError
-from ..impulse import Impulse
 from ..law import ForceLaw, Term
 
 __all__ = ["Parameter", "Effect", "Model", "EFFECTS", "TARGETS", "effect", "first_order_lag",
@@ -120,6 +119,8 @@ def first_order_lag(impulse, tau):
         else np.zeros((0, 2))
     tt = np.concatenate([t, [W]])
     GG = np.concatenate([G, G[:1]])
+    from ..impulse import Impulse
+
     return Impulse(t=tt, F=GG, duration=W, support=support, n_periods=impulse.n_periods,
                    onset=impulse.onset, onsets=impulse.onsets)
 
