@@ -39,6 +39,7 @@ import numpy as np
 from constraints import require as require_certificate
 
 from ._printing import coefficient_lines, criteria_lines, fmt, readable
+from ._progress import tick
 from ._validate import Real, Text, params
 from .criteria import criterion as _criterion
 from .dynamics import Tolerances
@@ -668,7 +669,8 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
              max_terms=4, criterion="I2", shortlist=8, refine=True, stability=0,
              derivative=None, average_cycles=False, sim_rtol=0.1, sim_atol=0.005,
              tolerances=None, random_state=0, n_boot=16, max_simulations=_REFINE_BUDGET,
-             stepwise=3, physics=True, require=(), n_boot_intervals=30, **estimator_kwargs):
+             stepwise=3, physics=True, require=(), n_boot_intervals=30, progress=None,
+             **estimator_kwargs):
     """Discover a contact law from one or several records and check it by simulation.
 
     Parameters
@@ -721,6 +723,9 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         full processing (:func:`discovery.intervals.bootstrap_intervals`; records with
         positions, refined models; 0 = none).  The Jacobian standard errors assume white
         residuals and miss the noise of the estimated machine states.
+    progress : callable, optional
+        ``progress(stage, done, total)`` as the shortlist is simulated and the stepwise
+        search and the bootstrap go on (:mod:`discovery._progress`).
     **estimator_kwargs
         Further estimator parameters (``margin``, ``monotone``, ``signs``, ...).
 
@@ -760,7 +765,11 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     if not pool:
         raise InputError(f"no candidate support of the library holds the required terms "
                          f"{', '.join(sorted(required))}; raise --max-terms or drop --require")
-    models = [check(c) for c in pool[:shortlist]]
+    models = []
+    for k, c in enumerate(pool[:shortlist]):
+        tick(progress, "fit: shortlisted supports checked by simulation", k, min(len(pool),
+                                                                                 shortlist))
+        models.append(check(c))
     by_score = list(models)  # the estimator's order (its scoring)
 
     def rank_all(ms):
@@ -790,6 +799,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         if not trials:
             break
         steps.append({"kind": kind, "from": list(top.law.names), "trials": len(trials)})
+        tick(progress, "fit: stepwise search around the best support", len(steps), stepwise)
         models = models + trials
         ranking = rank_all(models)
         if ranking[0] is top:
@@ -797,6 +807,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     selected = ranking[0]
     if n_boot_intervals and refine and selected.refinement is not None \
             and selected.note.startswith("refined"):
+        tick(progress, "fit: bootstrap intervals", 0, n_boot_intervals)
         iv = bootstrap_intervals([sc for sc, _ in refs], [r for _, r in refs], selected.law,
                                  n_boot=int(n_boot_intervals), seed=random_state,
                                  criterion=criterion, tolerances=tolerances)

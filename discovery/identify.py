@@ -35,6 +35,7 @@ import numpy as np
 from scipy.optimize import least_squares, minimize
 
 from ._printing import coefficient_lines, criteria_lines, fmt, readable
+from ._progress import tick
 from ._validate import Real, Text, params
 from .criteria import criterion as _criterion
 from .dynamics import Tolerances
@@ -234,7 +235,8 @@ def _residual_weights(ref):
 class _Objective:
     """Counts and caches simulations, enforces the budget, records the best-so-far path."""
 
-    def __init__(self, records, start, name, tolerances, max_sim, observe=None):
+    def __init__(self, records, start, name, tolerances, max_sim, observe=None, progress=None):
+        self.progress = progress
         self.records, self.start, self.name = records, start, name
         self.observe = observe
         self.tol, self.max_sim = tolerances, max_sim
@@ -260,6 +262,7 @@ class _Objective:
             evs = []
             for sc, ref in self.records:
                 self.n += 1
+                tick(self.progress, "identify: simulations", self.n, self.max_sim)
                 ev = evaluate(machine(sc), law, ref, tolerances=self.tol, floor=False,
                               observe=observe, smooth_onset=True)
                 evs.append(ev)
@@ -363,7 +366,7 @@ def _uncertainty(obj, x, names):
 )
 def identify(scenario, reference, start, *, criterion="I2", method="coordinate-descent",
              xtol=1e-5, max_simulations=600, tolerances=None, uncertainty=True,
-             observe=None, short_first=True, n_boot_intervals=0, seed=0):
+             observe=None, short_first=True, n_boot_intervals=0, seed=0, progress=None):
     """Identify the coefficients of ``start`` from one or several records by simulation.
 
     Parameters
@@ -397,6 +400,8 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
         (:func:`discovery.intervals.bootstrap_intervals`; records with positions; 0 = none).
     seed : int
         Seed of that bootstrap.
+    progress : callable, optional
+        ``progress(stage, done, total)`` after each simulation (:mod:`discovery._progress`).
     short_first : bool
         With record spans compared in blocks of several cycles: first fit the records
         cycle by cycle (:meth:`~discovery.verify.Reference.shortened`, up to half the
@@ -434,7 +439,9 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
             first = identify([sc for sc, _ in records], short, start, criterion=criterion,
                              method=method, xtol=xtol, max_simulations=max_simulations // 2,
                              tolerances=tolerances, uncertainty=False, observe=observe,
-                             short_first=False)
+                             short_first=False,
+                             progress=None if progress is None else
+                             (lambda s, d, t: progress("identify: cycle by cycle", d, t)))
             spent = first.n_simulations
             if not any(c == 0 for c in first.law.coefficients):
                 start0, start = start, first.law
@@ -449,7 +456,7 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
         except IntegrationError:
             pass
     obj = _Objective(records, start, criterion, tolerances,
-                     max(int(max_simulations) - spent, 2 * len(records)), observe)
+                     max(int(max_simulations) - spent, 2 * len(records)), observe, progress)
     obj.n = 0
     x0 = np.ones(len(start.coefficients))
     if obj.evaluations(x0) is None:

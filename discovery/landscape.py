@@ -25,6 +25,7 @@ from multiprocessing import get_context
 import numpy as np
 
 from ._printing import fmt, readable
+from ._progress import tick
 from ._validate import Array, Real, params
 from ._workers import terminate_pool, worker_initializer
 from .criteria import CRITERIA
@@ -268,7 +269,7 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
     workers=(None, Real(1, integer=True)), tolerances=(Tolerances, None),
 )
 def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tolerances=None,
-              from_state=True):
+              from_state=True, progress=None):
     """Compute all criteria over a grid of the first two coefficients of ``law``.
 
     Parameters
@@ -289,6 +290,8 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
     from_state : bool
         Start each simulation from the reference's measured state when it has one
         (default), else from the scenario's initial state.
+    progress : callable, optional
+        ``progress(stage, done, total)`` after each row of the grid.
 
     Returns
     -------
@@ -339,7 +342,8 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
                                    **worker_initializer(_init, init))
         results = pool.map(_row, jobs)
     try:
-        for i, row in results:
+        for done, (i, row) in enumerate(results, start=1):
+            tick(progress, "landscape: rows of the grid", done, len(jobs))
             for j, (reg, k, crit, ok, msg) in enumerate(row):
                 regime[i, j], impacts[i, j], consistent[i, j], messages[i, j] = reg, k, ok, msg
                 if crit is not None:

@@ -170,8 +170,24 @@ def _parser():
     for name in COMMANDS:
         modules[name].register(sub)
     _add_overwrite(p)
+    _add_quiet(p)
     _add_examples(p)
     return p
+
+
+LONG = ("fit", "identify", "landscape", "explain", "ueda chart")  # they report progress
+
+
+def _add_quiet(parser, path=()):
+    """``--quiet`` on every command that reports progress (``LONG``)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sp in action.choices.items():
+                _add_quiet(sp, (*path, name))
+    if " ".join(path) in LONG:
+        parser.add_argument("--quiet", action="store_true",
+                            help="no progress on stderr (by default a bar with an ETA on a "
+                            "terminal, one line per stage otherwise)")
 
 
 def _add_overwrite(parser):

@@ -143,6 +143,15 @@ def parse_columns(text, option="--columns"):
     return mapping
 
 
+def reporter(args):
+    """The progress reporter of a long command (``--quiet`` silences it; ``--progress``, where
+    a command has it, draws the bar even when stderr is not a terminal)."""
+    from .._progress import Reporter
+
+    return Reporter(quiet=getattr(args, "quiet", False),
+                    bar=True if getattr(args, "progress", False) else None)
+
+
 def add_record_options(parser):
     """Add the options of reading a record (``--columns``); returns the action."""
     return parser.add_argument("--columns", metavar="MAP", help=COLUMNS_HELP)

@@ -16,6 +16,7 @@ from ._common import (
     interval_count,
     number,
     read_records,
+    reporter,
 )
 
 
@@ -36,10 +37,11 @@ def run(args):
             raise InputError(f"--effects: unknown effect(s) {', '.join(bad) or '(none)'}; "
                              f"choose from {', '.join(sorted(known))}")
     scs, meas = read_records(args)
-    res = explain(scs, meas, args.start, criterion=args.criterion, alpha=args.alpha,
-                  max_iterations=args.max_iterations, budget=args.max_simulations,
-                  n_boot=args.n_boot, seed=args.seed, effects=effects, workers=args.workers,
-                  n_boot_intervals=args.intervals)
+    with reporter(args) as rep:
+        res = explain(scs, meas, args.start, criterion=args.criterion, alpha=args.alpha,
+                      max_iterations=args.max_iterations, budget=args.max_simulations,
+                      n_boot=args.n_boot, seed=args.seed, effects=effects,
+                      workers=args.workers, n_boot_intervals=args.intervals, progress=rep)
     summary = {"command": "explain", "scenario": scs[0].as_dict(),
                "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
                **res.as_dict(), "catalogue": [e.as_dict() for e in EFFECTS],

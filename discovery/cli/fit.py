@@ -19,6 +19,7 @@ from ._common import (
     interval_count,
     number,
     read_records,
+    reporter,
 )
 
 
@@ -33,15 +34,16 @@ def run(args):
     data = args.data
     scs, meas = read_records(args)
     sc = scs[0]
-    res = discover(scs, meas, library=args.library, selection=args.select, scoring=args.score,
-                   max_terms=args.max_terms, criterion=args.criterion,
-                   shortlist=args.shortlist, refine=not args.no_refine,
-                   max_simulations=args.max_simulations, stability=args.stability,
-                   derivative=args.derivative, average_cycles=args.average_cycles,
-                   random_state=args.seed, margin=args.margin,
-                   monotone=args.monotone, physics=not args.allow_unphysical,
-                   require=args.require or (), n_boot_intervals=args.intervals,
-                   **({"signs": args.signs} if args.signs else {}))
+    with reporter(args) as rep:
+        res = discover(scs, meas, library=args.library, selection=args.select,
+                       scoring=args.score, max_terms=args.max_terms, criterion=args.criterion,
+                       shortlist=args.shortlist, refine=not args.no_refine,
+                       max_simulations=args.max_simulations, stability=args.stability,
+                       derivative=args.derivative, average_cycles=args.average_cycles,
+                       random_state=args.seed, margin=args.margin,
+                       monotone=args.monotone, physics=not args.allow_unphysical,
+                       require=args.require or (), n_boot_intervals=args.intervals,
+                       progress=rep, **({"signs": args.signs} if args.signs else {}))
     imps = []
     for k, m in enumerate(res.ranking[:3]):
         if m.criteria:  # aligned with the first record and sampled like it

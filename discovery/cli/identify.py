@@ -23,6 +23,7 @@ from ._common import (
     interval_count,
     number,
     read_record,
+    reporter,
 )
 
 
@@ -94,9 +95,10 @@ def run(args):
         print(f"note: {note}")
     ref = Reference.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
     E = ref.impulse
-    res = identify(sc, ref, start, criterion=args.criterion, method=args.method,
-                   max_simulations=args.max_simulations, xtol=args.xtol,
-                   n_boot_intervals=args.intervals, seed=args.seed)
+    with reporter(args) as rep:
+        res = identify(sc, ref, start, criterion=args.criterion, method=args.method,
+                       max_simulations=args.max_simulations, xtol=args.xtol,
+                       n_boot_intervals=args.intervals, seed=args.seed, progress=rep)
     final = evaluate(sc, res.law, ref)
     # res.iterations lists every new best-so-far law (finite-difference probes included),
     # so the impulses are labelled by the simulations spent, not as iterations: a few of

@@ -20,6 +20,7 @@ from ._common import (
     number,
     parse_range,
     read_record,
+    reporter,
 )
 
 
@@ -105,7 +106,8 @@ def run(args):
     for note in notes:
         print(f"note: {note}")
     a0, a1 = np.linspace(*r0, n0), np.linspace(*r1, n1)
-    land = landscape(sc, law, a0, a1, ref, workers=args.workers)
+    with reporter(args) as rep:
+        land = landscape(sc, law, a0, a1, ref, workers=args.workers, progress=rep)
     ref_info.update(regime=land.reference["regime"], start=land.reference["start"])
     if ref is None:
         ref_info["impacts"] = land.reference["impacts"]

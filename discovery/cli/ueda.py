@@ -14,14 +14,13 @@ this system's catalogue by score tests, add it, refit, and show the gap shrink.
 
 import argparse
 import csv
-import sys
 from dataclasses import replace
 
 import numpy as np
 
 from .._io import OutputDir, provenance
 from ..errors import InputError
-from ._common import check_out, integer, number
+from ._common import check_out, integer, number, reporter
 
 _PARAMS = ("mu", "gamma", "k", "B", "nu")
 
@@ -103,23 +102,15 @@ def run_chart(args):
         raise InputError("--nu: the frequencies must be > 0, e.g. --nu 0.8:1.2:200")
     system = _system(args, nu=None, B=None)
 
-    def progress(done, total):
-        if sys.stderr.isatty() or args.progress:
-            w = 30
-            f = done / total
-            print(f"\r  [{'#' * int(w * f):<{w}}] {done}/{total} rows", end="",
-                  file=sys.stderr, flush=True)
-            if done == total:
-                print(file=sys.stderr)
-
     if args.periods < 4 * args.max_period:
         raise InputError(f"--periods {args.periods} is too short for --max-period "
                          f"{args.max_period}: give --periods {4 * args.max_period} or more "
                          "(the recurrence test compares three cycles with the cycle before)")
-    ch = chart(system, args.nu, args.B, transient=args.transient, periods=args.periods,
-               rtol=args.rtol, max_period=args.max_period,
-               sweeps=2 if args.both_directions else 1, workers=args.workers,
-               progress=progress)
+    with reporter(args) as rep:
+        ch = chart(system, args.nu, args.B, transient=args.transient, periods=args.periods,
+                   rtol=args.rtol, max_period=args.max_period,
+                   sweeps=2 if args.both_directions else 1, workers=args.workers,
+                   progress=lambda done, total: rep("chart: rows", done, total))
     summary = {"command": "ueda chart", **ch.as_dict(), **provenance(vars(args))}
 
     def cell(value, column):

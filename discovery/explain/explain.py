@@ -48,6 +48,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from .._printing import criteria_lines, fmt, readable
+from .._progress import tick
 from .._validate import Real, Text, params
 from .._workers import terminate_pool, worker_initializer
 from ..dynamics import Tolerances
@@ -705,7 +706,7 @@ def _output_error(records, start, criterion, budget, tol, polish=False):
 )
 def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01,
             max_iterations=3, budget=150, n_boot=16, seed=0, tolerances=None, effects=None,
-            max_refits=6, workers=None, n_boot_intervals=30):
+            max_refits=6, workers=None, n_boot_intervals=30, progress=None):
     """Explain the disagreement of a start model with one or several records by named
     physical effects (see the module docstring).
 
@@ -738,6 +739,8 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     n_boot_intervals : int
         Bootstrap replicates of the final model's 95 % parameter intervals through the full
         processing (:func:`discovery.intervals.bootstrap_intervals`; 0 = none).
+    progress : callable, optional
+        ``progress(stage, done, total)`` at each stage and iteration (:mod:`discovery._progress`).
 
     Returns
     -------
@@ -778,6 +781,7 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             # effect through the restitution (a soft spring mimics damping while
             # unloading), and the effect would then look absent
             short = [(sc, ref.shortened() or ref) for sc, ref in records]
+            tick(progress, "explain: fitting the start cycle by cycle", 0, None)
             fit = _output_error(short, law, criterion, budget, tolerances, polish=True)
             fit = _polish_start(records, fit, criterion, max(budget // 3, 8), tolerances)
             break
@@ -795,6 +799,8 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     meas_first = ms[0] if not isinstance(ms[0], Reference) else None
     drift = _Drift(pairs, records) if not any(isinstance(m, Reference) for m in ms) else None
     for _ in range(max_iterations + 1):
+        tick(progress, "explain: iterations (localise, score, refit)", len(iterations),
+             max_iterations)
         evs = problem.evaluations(model, floor=True)
         before, floor = _with_drift(_mean(evs, "criteria"), _mean(evs, "noise_floor"), drift,
                                     model)
@@ -1007,6 +1013,7 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     intervals = None
     if n_boot_intervals:
         try:
+            tick(progress, "explain: bootstrap intervals", 0, n_boot_intervals)
             intervals = bootstrap_intervals([sc for sc, _ in records], [r for _, r in records],
                                             model, n_boot=int(n_boot_intervals), seed=seed,
                                             criterion=criterion, tolerances=tolerances)
