@@ -242,9 +242,9 @@ def _attach_dash_values(parser, argv):
     return out
 
 
-def _refuse_repeats(parser, argv):
-    """A value option given twice (``--law A --law B``) is refused: argparse would keep the
-    last one silently.  Options that collect values (``--data`` of ``fit``) may repeat."""
+def _options_on_line(parser, argv):
+    """The (sub)command's parser named on the line, and ``(option, action)`` of every long
+    option given on it (up to ``--``)."""
     sp, rest = parser, list(argv)
     while True:  # descend into the (sub)command named on the line
         sub = next((a for a in sp._actions if isinstance(a, argparse._SubParsersAction)), None)
@@ -252,47 +252,37 @@ def _refuse_repeats(parser, argv):
         if sub is None or name not in sub.choices:
             break
         sp, rest = sub.choices[name], rest[rest.index(name) + 1:]
-    seen = {}
+    found = []
     for tok in rest:
         if tok == "--":
             break
-        if not tok.startswith("--"):
-            continue
-        opt = tok.split("=", 1)[0]
-        action = sp._option_string_actions.get(opt)
-        if action is None or action.nargs is not None or isinstance(
+        if tok.startswith("--"):
+            opt = tok.split("=", 1)[0]
+            action = sp._option_string_actions.get(opt)
+            if action is not None:
+                found.append((opt, action))
+    return sp, found
+
+
+def _refuse_repeats(parser, argv):
+    """A value option given twice (``--law A --law B``) is refused: argparse would keep the
+    last one silently.  Options that collect values (``--data`` of ``fit``) may repeat."""
+    seen = set()
+    for opt, action in _options_on_line(parser, argv)[1]:
+        if action.nargs is not None or isinstance(
                 action, argparse._AppendAction | argparse._StoreConstAction):
             continue
         if action.dest in seen:
             raise UsageError(f"{opt} is given twice; give it once (the last would silently "
                              "win)")
-        seen[action.dest] = tok
-
-
-def _given(parser, argv):
-    """The subparser named on the line and the option strings given on it."""
-    sp, rest = parser, list(argv)
-    while True:
-        sub = next((a for a in sp._actions if isinstance(a, argparse._SubParsersAction)), None)
-        name = next((t for t in rest if not t.startswith("-")), None)
-        if sub is None or name not in sub.choices:
-            break
-        sp, rest = sub.choices[name], rest[rest.index(name) + 1:]
-    given = set()
-    for tok in rest:
-        if tok == "--":
-            break
-        action = sp._option_string_actions.get(tok.split("=", 1)[0]) if tok.startswith("--") \
-            else None
-        if action is not None:
-            given.add(action.option_strings[-1])
-    return sp, given
+        seen.add(action.dest)
 
 
 def _refuse_orphans(parser, argv):
     """An option that only acts with another one (``needs``) or not with another one
     (``excludes``) is refused when given alone: it would be silently ignored."""
-    sp, given = _given(parser, argv)
+    sp, found = _options_on_line(parser, argv)
+    given = {action.option_strings[-1] for _, action in found}
     for action in sp._actions:
         opt = action.option_strings[-1] if action.option_strings else None
         if opt not in given:

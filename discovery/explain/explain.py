@@ -82,16 +82,16 @@ def _present(eff, model, res):
     return bool(v != 0.0 and (se is None or not np.isfinite(se) or abs(v) > 2.0 * se))
 
 
-def _polished_law(records, model, criterion, budget, tolerances, problem, drift):
-    """``(law, criteria, evaluations)`` of the model refitted alone with the full budget,
-    or None when the refit fails."""
+def _law_refit(records, model, criterion, budget, tolerances, problem, drift, polish=False):
+    """``(result, criteria, evaluations)`` of the model refitted alone (no effect added),
+    or None when the refit fails (e.g. a parameter at 0)."""
     try:
-        res = _output_error(records, model, criterion, budget, tolerances, polish=True)
+        res = _output_error(records, model, criterion, budget, tolerances, polish=polish)
         evs = problem.evaluations(res.law, floor=True)
         after, _ = _with_drift(_mean(evs, "criteria"), {}, drift, res.law)
     except (IntegrationError, InputError):
         return None
-    return res.law, after, evs
+    return res, after, evs
 
 
 # a number multiplying a factor: the start is a law with coefficients, not a term list
@@ -917,11 +917,12 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             if reg0 is not None:
                 null_starts.append(reg0)
             null_start = min(null_starts, key=lambda m: problem.value(m, criterion))
-            null = _output_error(records, null_start, criterion, screen, tolerances)
-            null_evs = problem.evaluations(null.law, floor=True)
-            null_after, _ = _with_drift(_mean(null_evs, "criteria"), {}, drift, null.law)
-        except (IntegrationError, InputError):  # no refit (e.g. a parameter at 0)
-            null, null_after = None, None
+        except (IntegrationError, InputError):
+            null_start = None
+        refit0 = None if null_start is None else _law_refit(
+            records, null_start, criterion, screen, tolerances, problem, drift)
+        if refit0 is not None:
+            null, null_after, null_evs = refit0
         for x in trials:
             k = x[5]
             # (the drift channel does not depend on the law: a law refit is no baseline)
@@ -977,10 +978,10 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             # polished with the full budget, the effect's parameter is within 2 standard
             # errors of 0: the gain was the law's own refit. Nothing is named; the model is
             # the polished refit without the effect (the loop then screens again)
-            refit = _polished_law(records, model, criterion, budget, tolerances, problem,
-                                  drift)
+            refit = _law_refit(records, model, criterion, budget, tolerances, problem, drift,
+                               polish=True)
             if refit is not None and refit[1] and refit[1][key] < before[key]:
-                law_refit, after_law, evs_law = refit
+                law_refit, after_law, evs_law = refit[0].law, refit[1], refit[2]
                 iterations.append(Iteration(
                     model, law_refit, before, after_law, floor, loc, scores, None,
                     f"{s['effect']} refitted with the full budget has its parameter within 2 "
