@@ -49,6 +49,12 @@ _EXPORTS = {
     'builtin_scenarios': 'scenario',
     'load_scenario': 'scenario',
     'Report': 'report',
+    'StudyResult': 'studies.driver',
+    'study': 'studies.driver',
+    'load_study': 'studies.config',
+    'field_record': 'studies.records',
+    'Executor': 'executor',
+    'make_executor': 'executor',
     'report': 'report',
 }
 
@@ -62,7 +68,8 @@ __all__ = [
     "landscape", "ForceLaw", "Term", "Measurement", "synthesize", "Response", "response",
     "Scenario", "builtin_scenarios", "load_scenario", "discover", "DiscoveryResult",
     "RankedModel", "Library", "ConstrainedSparseRegressor", "Candidate", "ContactSamples",
-    "contact_samples", "explain", "ExplainResult", "report", "Report",
+    "contact_samples", "explain", "ExplainResult", "report", "Report", "study", "StudyResult",
+    "load_study", "field_record", "Executor", "make_executor",
 ]
 
 lazy_package(__name__, _EXPORTS)

@@ -61,7 +61,8 @@ __all__ = ["OutputDir", "provenance", "to_jsonable", "check_output", "atomic_wri
 
 # the solvers cvxpy uses here: CLARABEL (default), OSQP (fallback in the regression)
 _PACKAGES = ("vibroimpact-discovery", "numpy", "scipy", "numba", "sympy", "cvxpy", "clarabel",
-             "osqp", "scikit-learn", "pysindy", "matplotlib")
+             "osqp", "scikit-learn", "pysindy", "matplotlib", "jinja2", "tqdm", "pandas",
+             "distributed")
 
 # names of the files a result directory may hold (an earlier result that may be replaced)
 _RESULT_FILE = re.compile(r"^[^/]+\.(json|csv|png|pdf|tex|txt|svg)$", re.IGNORECASE)

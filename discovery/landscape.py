@@ -18,19 +18,17 @@ differed at 2 of 441 points, both on the boundary of the consistent region.  So
 
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, fields
-from multiprocessing import get_context
 
 import numpy as np
 
 from ._printing import fmt, readable
 from ._progress import tick
-from ._validate import Array, Real, params
-from ._workers import terminate_pool, worker_initializer
+from ._validate import Array, Instance, Real, params
 from .criteria import CRITERIA
 from .dynamics import Tolerances
 from .errors import InputError, VidiError
+from .executor import make_executor
 from .impulse import Impulse
 from .law import ForceLaw
 from .response import response
@@ -204,19 +202,13 @@ class _FixedFloor(Reference):
         return self.fixed_floor
 
 
-_CTX = {}
-
-
-def _init(scenario, law, reference, tolerances, from_state):
-    _CTX.update(scenario=scenario, law=law, reference=reference, tolerances=tolerances,
-                from_state=from_state)
-
-
-def _point(law):
-    """``(regime, impacts, criteria or None, consistent, message)`` of one law."""
+def _point(ctx, law):
+    """``(regime, impacts, criteria or None, consistent, message)`` of one law; ``ctx`` is
+    ``(scenario, law, reference, tolerances, from_state)``."""
+    scenario, _, reference, tolerances, from_state = ctx
     try:
-        ev = evaluate(_CTX["scenario"], law, _CTX["reference"], tolerances=_CTX["tolerances"],
-                      from_state=_CTX["from_state"], floor=True)
+        ev = evaluate(scenario, law, reference, tolerances=tolerances, from_state=from_state,
+                      floor=True)
     except VidiError:
         raise  # bad input (e.g. a zero reference impulse) concerns every point: stop
     except (ValueError, ArithmeticError) as exc:  # numerics at this point only
@@ -230,15 +222,17 @@ def _point(law):
     return "nonperiodic", -1, None, False, ""
 
 
-def _row(args):
-    i, v0, axis1 = args
-    law = _CTX["law"]
+def _row(ctx, job):
+    """One row of the grid (a task of the executor: a row, not a point, lasts long enough
+    to amortise a task's overhead)."""
+    v0, axis1 = job
+    law = ctx[1]
     out = []
     for v1 in axis1:
         coefs = list(law.coefficients)
         coefs[0], coefs[1] = v0, v1
-        out.append(_point(law.with_coefficients(coefs)))
-    return i, out
+        out.append(_point(ctx, law.with_coefficients(coefs)))
+    return out
 
 
 def _floor_once(scenario, law, reference, tolerances, from_state):
@@ -267,9 +261,10 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
     scenario=Scenario, law=ForceLaw, axis0=Array(1), axis1=Array(1),
     reference=(None, Reference, Impulse),
     workers=(None, Real(1, integer=True)), tolerances=(Tolerances, None),
+    executor=(None, Instance("discovery.executor", "Executor")),
 )
 def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tolerances=None,
-              from_state=True, progress=None):
+              from_state=True, progress=None, executor=None):
     """Compute all criteria over a grid of the first two coefficients of ``law``.
 
     Parameters
@@ -292,6 +287,9 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
         (default), else from the scenario's initial state.
     progress : callable, optional
         ``progress(stage, done, total)`` after each row of the grid.
+    executor : Executor, optional
+        Where the rows run (:mod:`discovery.executor`: serial, a process pool, a Dask
+        cluster); overrides ``workers`` and is not closed here.  One task per row.
 
     Returns
     -------
@@ -330,33 +328,22 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
     consistent = np.zeros(shape, dtype=bool)
     messages = np.full(shape, "", dtype=object)
     values = {n: np.full(shape, np.nan) for n in CRITERIA}
-    jobs = [(i, v0, axis1) for i, v0 in enumerate(axis0)]
-    init = (scenario, law, ref, tolerances, from_state)
-    if workers == 1:
-        _init(*init)
-        results = map(_row, jobs)
-        pool = None
-    else:
-        # workers die with this process (Ctrl-C, kill) and ignore SIGINT themselves
-        pool = ProcessPoolExecutor(workers, mp_context=get_context("fork"),
-                                   **worker_initializer(_init, init))
-        results = pool.map(_row, jobs)
+    jobs = [(v0, axis1) for v0 in axis0]
+    context = (scenario, law, ref, tolerances, from_state)
+    own = executor is None
+    ex = make_executor(workers) if own else executor
     try:
-        for done, (i, row) in enumerate(results, start=1):
+        for done, (i, row) in enumerate(ex.run(_row, jobs, context), start=1):
             tick(progress, "landscape: rows of the grid", done, len(jobs))
             for j, (reg, k, crit, ok, msg) in enumerate(row):
                 regime[i, j], impacts[i, j], consistent[i, j], messages[i, j] = reg, k, ok, msg
                 if crit is not None:
                     for n, v in crit.items():
                         values[n][i, j] = v
-    except BaseException:
-        if pool is not None:
-            terminate_pool(pool)  # interrupted or failed: no waiting for queued rows
-            pool = None
-        raise
     finally:
-        if pool is not None:
-            pool.shutdown()
+        if own:
+            ex.close()
+    workers = min(ex.workers, len(jobs))
     info = {"source": reference.source, "exact": not reference.noise,
             "regime": reference.regime, "impacts": reference.impacts,
             "start": "measured state" if from_state and reference.start is not None

@@ -60,18 +60,26 @@ for each wrong law whether its difference is detectable (:class:`Trial`); used b
 import math
 import time
 from dataclasses import dataclass
-from functools import cache, lru_cache
+from functools import cache
 
 import numpy as np
 
-from discovery.dynamics.reference import reference_simulate
 from discovery.dynamics.simulate import Tolerances, simulate
 from discovery.dynamics.steady_state import steady_state
 from discovery.errors import VidiError
 from discovery.impulse import impulse_from_steady_state
 from discovery.law import ForceLaw
-from discovery.measurement import Measurement
 from discovery.scenario import Scenario
+from discovery.studies.records import (
+    RTOL_RECORD,
+    RTOL_TRANSIENT,
+    TRANSIENT_DECAY,  # noqa: F401 (used by the tests as R.TRANSIENT_DECAY)
+    TRANSIENT_MAX,
+    TRANSIENT_MIN,  # noqa: F401
+    clean_record,
+    noisy_measurement,
+    transient_periods,
+)
 
 __all__ = ["CATEGORIES", "Case", "Trial", "draw_case", "default_transient", "reference_events",
            "reference_record", "transient_periods", "verification_trials", "wrong_laws"]
@@ -328,57 +336,9 @@ def draw_case(category, seed, max_tries=400, check_reference=True):
 
 
 # ------------------------------------------------------------------- records
-TRANSIENT_DECAY = 1e-4
-TRANSIENT_MIN, TRANSIENT_MAX = 30, 600
-RTOL_TRANSIENT, RTOL_RECORD = 1e-8, 1e-10
-
-
-def transient_periods(max_multiplier):
-    """Periods for the slowest Floquet mode to decay to ``1e-4``: ``ceil(log(1e-4) /
-    log|mu|max)``, at least 30, at most 600 (600 for ``|mu| >= 1`` or unknown)."""
-    mu = float(max_multiplier)
-    if not (0.0 <= mu < 1.0):
-        return TRANSIENT_MAX
-    if mu == 0.0:
-        return TRANSIENT_MIN
-    n = math.ceil(math.log(TRANSIENT_DECAY) / math.log(mu))
-    return int(min(TRANSIENT_MAX, max(TRANSIENT_MIN, n)))
-
-
-TRANSIENT_CHUNK = 50  # periods per reference call in the transient
-
-
-def _reference(scenario, law, t_span, y0, t_eval, rtol):
-    """``reference_simulate`` of one piece of a record."""
-    return reference_simulate(scenario, law, t_span, y0=y0, t_eval=t_eval, rtol=rtol)
-
-
-@lru_cache(maxsize=32)
-def _clean(scenario, law, periods, fs, transient, record_transient):
-    """Noise-free reference record ``(t, y (4, n), F, events)`` (read-only arrays)."""
-    T = scenario.period
-    t_rec = transient * T
-    t_end = (transient + periods) * T
-    y0 = scenario.initial_state()
-    if record_transient:
-        n = int(round(t_end * fs))
-        t = np.arange(n) / fs
-        out = _reference(scenario, law, (0.0, t_end), y0, t, RTOL_RECORD)
-    else:
-        for k in range(0, transient, TRANSIENT_CHUNK):
-            k1 = min(transient, k + TRANSIENT_CHUNK)
-            y0 = _reference(scenario, law, (k * T, k1 * T), y0, None,
-                            RTOL_TRANSIENT)["y_final"]
-        n = int(round(periods * T * fs))
-        t = t_rec + np.arange(n) / fs
-        out = _reference(scenario, law, (t_rec, t_end), y0, t, RTOL_RECORD)
-    y, F = out["y"], out["force"]
-    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(F))):
-        raise RuntimeError("reference simulation left samples unset")
-    for a in (t, y, F):
-        a.setflags(write=False)
-    events = tuple((float(te), kind) for te, kind, _ in out["events"])
-    return t, y, F, events
+# the record maker itself lives in the package (studies use it too): the transient, the
+# scipy-path record from rest (cached) and the noise relative to each channel's range
+_clean = clean_record
 
 
 def _unpack(case_or_pair):
@@ -465,21 +425,13 @@ def reference_record(case_or_pair, *, periods=15, fs=20000.0, transient=None,
                 f"reference record of {scenario.name} disagrees with the compiled kernel by "
                 f"{err:.1e} of the channel ranges (see _reference_problem); use another "
                 "case or check=False")
-    rng = np.random.default_rng(seed)
-    n = t.size
-    F = F + rng.normal(0.0, force_noise * float(np.max(np.abs(F))), n)
-    ch = {}
-    for name, row in (("w1", 0), ("w2", 2), ("v1", 1), ("v2", 3)):
-        x = y[row]
-        ch[name] = x + rng.normal(0.0, motion_noise * float(np.ptp(x)), n)
-    if not velocities:
-        del ch["v1"], ch["v2"]
-    channels = {k: ch[k] for k in ("w1", "v1", "w2", "v2") if k in ch}
     notes = (f"reference_simulate from rest; transient {transient} periods "
              f"(rtol {RTOL_TRANSIENT:g}), recorded at rtol {RTOL_RECORD:g}",
              f"noise: force {force_noise:g} of max|F|, motion {motion_noise:g} of each "
              f"channel's range, seed {seed}")
-    return Measurement(t.copy(), F, channels, source=f"reference:{scenario.name}", notes=notes)
+    return noisy_measurement(t, y, F, force_noise=force_noise, motion_noise=motion_noise,
+                             seed=seed, velocities=velocities,
+                             source=f"reference:{scenario.name}", notes=notes)
 
 
 def reference_events(case_or_pair, *, periods=15, fs=20000.0, transient=None,

@@ -67,6 +67,14 @@ CASES = [
     ("identify seed -1", lambda: d.identify(SC, REC, LAW, seed=-1), VALUE, "seed"),
     ("verify law text", lambda: verify(SC, REC, "2e8*z"), TYPE, "law"),
     ("verify n_boot float", lambda: verify(SC, REC, LAW, n_boot=2.5), TYPE, "n_boot"),
+    ("study config int", lambda: d.study(5, "out"), TYPE, "config"),
+    ("study workers 0", lambda: d.study({}, "out", workers=0), VALUE, "workers"),
+    ("study executor text", lambda: d.study({}, "out", executor="pool"), TYPE, "executor"),
+    ("load_study list", lambda: d.load_study([1]), TYPE, "path_or_mapping"),
+    ("field_record law text", lambda: d.field_record(SC, "2e8*z"), TYPE, "law"),
+    ("field_record noise 2", lambda: d.field_record(SC, LAW, force_noise=2.0), VALUE,
+     "force_noise"),
+    ("make_executor workers text", lambda: d.make_executor("2"), TYPE, "workers"),
     ("landscape axis text", lambda: d.landscape(SC, LAW, "1,2", [1, 2]), TYPE, "axis0"),
     ("landscape workers 0", lambda: d.landscape(SC, LAW, [1, 2], [1, 2], workers=0), VALUE,
      "workers"),
@@ -118,7 +126,8 @@ def test_the_cases_cover_every_public_entry():
     data_only = {"SteadyState", "Landscape", "DiscoveryResult", "RankedModel", "Impulse",
                  "Response", "ContactSamples", "Candidate", "IdentificationResult",
                  "ExplainResult", "builtin_scenarios", "load_scenario",
-                 "impulse_from_steady_state", "Report", "report",
+                 "impulse_from_steady_state", "Report", "report", "StudyResult",
+                 "Executor",
                  # a scikit-learn estimator checks its parameters in fit, not in __init__
                  # (tests/test_regression.py)
                  "ConstrainedSparseRegressor"}
@@ -126,5 +135,5 @@ def test_the_cases_cover_every_public_entry():
         "Term", "ForceLaw", "Scenario", "Measurement", "Tolerances", "simulate", "steady_state",
         "Library", "discover", "identify", "landscape",
         "explain", "impulse_from_samples", "synthesize", "response", "contact_samples",
-        "evaluate_criteria"}
+        "evaluate_criteria", "study", "load_study", "field_record", "make_executor"}
     assert not unlisted, f"public entries without a row: {sorted(unlisted)}"

@@ -209,3 +209,27 @@ def test_user_text_in_figures_is_not_read_as_mathtext(tmp_path):
     with pytest.raises(ValueError):
         fig.savefig(tmp_path / "broken.png")
     plt.close(fig)
+
+
+def test_study_report_states_recovery_coverage_and_figures(tmp_path):
+    """A study's report: the design, the pooled table per method, the per-cell table and the
+    four figures, compiled to a PDF."""
+    _need_tex()
+    from discovery import study
+    from discovery.report import report
+
+    cfg = {"name": "tiny & 100%", "seeds": 1,
+           "factors": {"force_noise": [0.01, 0.02], "periods": [4],
+                       "library": ["z, zd, z^2"], "selection": ["best-subset", "l1-path"],
+                       "refine": [False]}}
+    out = tmp_path / "s"
+    study(cfg, out, workers=1)
+    r = report(out)
+    text = _text(r.pdf)
+    assert "Model-term selection study: tiny & 100%" in text
+    for words in ("Per selection method", "best-subset", "l1-path", "force_noise",
+                  "recovered", "Records were made by the independent scipy path"):
+        assert words in text, words
+    tex = r.tex.read_text()
+    for fig in ("recovery_noise.pdf", "recovery_map.pdf", "coverage.pdf", "inclusion.pdf"):
+        assert fig in tex

@@ -113,6 +113,9 @@ EXAMPLES = {
     "landscape": ["vidi landscape --grid 21x21 --out out/landscape",
                   "vidi landscape --data D.csv --range0 1e8:3e8 --out out/landscape2"],
     "identify": ["vidi identify --data D.csv --start '1.5e8*z + 0.9e7*zd' --out out/identify"],
+    "study": ["vidi study --config examples/study_paper.toml --out out/study",
+              "vidi study --config examples/study_paper.toml --out out/study --scheduler local",
+              "vidi study --config S.toml --out out/s --max-runs 20   a slice; rerun to go on"],
     "report": ["vidi report out/fit                 report.tex and report.pdf in out/fit",
                "vidi report out/verify --snippet criteria",
                "vidi report out/fit --no-pdf        the LaTeX source only"],
@@ -148,8 +151,8 @@ def _add_examples(parser, path=()):
             "interrupted (Ctrl-C),\n            143 terminated, 1 internal error")
 
 
-COMMANDS = ("simulate", "fit", "verify", "explain", "steady", "landscape", "identify", "report",
-            "ueda")
+COMMANDS = ("simulate", "fit", "verify", "explain", "steady", "landscape", "identify", "study",
+            "report", "ueda")
 
 
 def _parser():
@@ -163,10 +166,10 @@ def _parser():
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND",
                            parser_class=VidiArgumentParser)
     # imported here, inside main()'s handlers: a Ctrl-C while they load is an interrupt too
-    from . import explain, fit, identify, landscape, report, simulate, steady, ueda, verify
+    from . import explain, fit, identify, landscape, report, simulate, steady, study, ueda, verify
     modules = {"simulate": simulate, "fit": fit, "verify": verify, "explain": explain,
                "steady": steady, "landscape": landscape, "identify": identify,
-               "report": report, "ueda": ueda}
+               "study": study, "report": report, "ueda": ueda}
     for name in COMMANDS:
         modules[name].register(sub)
     _add_overwrite(p)
@@ -175,7 +178,7 @@ def _parser():
     return p
 
 
-LONG = ("fit", "identify", "landscape", "explain", "ueda chart")  # they report progress
+LONG = ("fit", "identify", "landscape", "explain", "study", "ueda chart")  # they report progress
 
 
 def _add_quiet(parser, path=()):

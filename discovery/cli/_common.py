@@ -152,6 +152,23 @@ def reporter(args):
                     bar=True if getattr(args, "progress", False) else None)
 
 
+SCHEDULER_HELP = ("run on Dask: 'local' starts a LocalCluster of single-threaded workers, "
+                  "tcp://host:port joins a running scheduler (its workers started with "
+                  "--nthreads 1); needs pip install 'vibroimpact-discovery[dask]'")
+
+
+def executor_of(args):
+    """The executor of ``--scheduler`` (a context manager that closes it), or a null
+    context giving ``None`` (the API's default: ``--workers`` local processes)."""
+    import contextlib
+
+    if not getattr(args, "scheduler", None):
+        return contextlib.nullcontext(None)
+    from ..executor import make_executor
+
+    return make_executor(getattr(args, "workers", None), args.scheduler)
+
+
 def add_record_options(parser):
     """Add the options of reading a record (``--columns``); returns the action."""
     return parser.add_argument("--columns", metavar="MAP", help=COLUMNS_HELP)

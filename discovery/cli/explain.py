@@ -7,10 +7,12 @@ from ..criteria import CRITERIA
 from ..errors import InputError
 from ._common import (
     SCENARIO_HELP,
+    SCHEDULER_HELP,
     add_record_options,
     check_out,
     coefficients_line,
     criteria_line,
+    executor_of,
     inputs_of,
     integer,
     interval_count,
@@ -37,11 +39,12 @@ def run(args):
             raise InputError(f"--effects: unknown effect(s) {', '.join(bad) or '(none)'}; "
                              f"choose from {', '.join(sorted(known))}")
     scs, meas = read_records(args)
-    with reporter(args) as rep:
+    with reporter(args) as rep, executor_of(args) as ex:
         res = explain(scs, meas, args.start, criterion=args.criterion, alpha=args.alpha,
                       max_iterations=args.max_iterations, budget=args.max_simulations,
                       n_boot=args.n_boot, seed=args.seed, effects=effects,
-                      workers=args.workers, n_boot_intervals=args.intervals, progress=rep)
+                      workers=args.workers, n_boot_intervals=args.intervals, progress=rep,
+                      executor=ex)
     summary = {"command": "explain", "scenario": scs[0].as_dict(),
                "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
                **res.as_dict(), "catalogue": [e.as_dict() for e in EFFECTS],
@@ -117,5 +120,6 @@ def register(sub):
     s.add_argument("--workers", type=integer(1, 1024),
                    help="processes for the screening refits (default: all cores; the result "
                         "does not depend on it)")
+    s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

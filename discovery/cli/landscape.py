@@ -12,8 +12,10 @@ from ..errors import InputError
 from ..scenario import load_scenario
 from ._common import (
     SCENARIO_HELP,
+    SCHEDULER_HELP,
     add_record_options,
     check_out,
+    executor_of,
     inputs_of,
     integer,
     law_or_default,
@@ -106,8 +108,8 @@ def run(args):
     for note in notes:
         print(f"note: {note}")
     a0, a1 = np.linspace(*r0, n0), np.linspace(*r1, n1)
-    with reporter(args) as rep:
-        land = landscape(sc, law, a0, a1, ref, workers=args.workers, progress=rep)
+    with reporter(args) as rep, executor_of(args) as ex:
+        land = landscape(sc, law, a0, a1, ref, workers=args.workers, progress=rep, executor=ex)
     ref_info.update(regime=land.reference["regime"], start=land.reference["start"])
     if ref is None:
         ref_info["impacts"] = land.reference["impacts"]
@@ -175,5 +177,6 @@ def register(sub):
                    needs="--data",
                    help="with --data: seed of the bootstrap (default: %(default)s)")
     s.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
+    s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

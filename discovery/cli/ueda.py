@@ -20,7 +20,7 @@ import numpy as np
 
 from .._io import OutputDir, provenance
 from ..errors import InputError
-from ._common import check_out, integer, number, reporter
+from ._common import SCHEDULER_HELP, check_out, executor_of, integer, number, reporter
 
 _PARAMS = ("mu", "gamma", "k", "B", "nu")
 
@@ -106,11 +106,11 @@ def run_chart(args):
         raise InputError(f"--periods {args.periods} is too short for --max-period "
                          f"{args.max_period}: give --periods {4 * args.max_period} or more "
                          "(the recurrence test compares three cycles with the cycle before)")
-    with reporter(args) as rep:
+    with reporter(args) as rep, executor_of(args) as ex:
         ch = chart(system, args.nu, args.B, transient=args.transient, periods=args.periods,
                    rtol=args.rtol, max_period=args.max_period,
                    sweeps=2 if args.both_directions else 1, workers=args.workers,
-                   progress=lambda done, total: rep("chart: rows", done, total))
+                   progress=lambda done, total: rep("chart: rows", done, total), executor=ex)
     summary = {"command": "ueda chart", **ch.as_dict(), **provenance(vars(args))}
 
     def cell(value, column):
@@ -350,6 +350,7 @@ def register(sub):
                    "the two sweeps end on different attractors (coexisting attractors, "
                    "hysteresis); about twice the time (default: off)")
     c.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
+    c.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
     c.add_argument("--progress", action="store_true", help="progress bar even when stderr "
                    "is not a terminal")
     c.add_argument("--out", required=True, help="output directory")

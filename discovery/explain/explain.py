@@ -40,19 +40,17 @@ import itertools
 import os
 import re
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from multiprocessing import get_context
 
 import numpy as np
 from scipy.stats import chi2
 
 from .._printing import criteria_lines, fmt, readable
 from .._progress import tick
-from .._validate import Real, Text, params
-from .._workers import terminate_pool, worker_initializer
+from .._validate import Instance, Real, Text, params
 from ..dynamics import Tolerances
 from ..errors import InputError, IntegrationError
+from ..executor import make_executor
 from ..identify import (
     as_records,
     contact_scales,
@@ -630,49 +628,38 @@ def _refit(problem, model, eff, guess, records, criterion, budget, tol, regress=
                 raise
 
 
-_SCREEN = {}
-
-
-def _screen_init(problem, records, criterion, budget, tol, regress):
-    _SCREEN.update(problem=problem, records=records, criterion=criterion, budget=budget,
-                   tol=tol, regress=regress)
-
-
-def _screen_one(job):
-    """One screening refit (:func:`_refit`) in a worker: ``(model, identification,
-    evaluations, error, simulations)``."""
+def _screen_one(ctx, job):
+    """One screening refit (:func:`_refit`, a task of the executor): ``(model,
+    identification, evaluations, error, simulations)``; ``ctx`` is ``(problem, records,
+    criterion, budget, tol, regress)``."""
+    problem, records, criterion, budget, tol, regress = ctx
     model, eff_id, direction = job
-    c = _SCREEN
-    n0 = c["problem"].n_sim
+    n0 = problem.n_sim
     try:
-        m2, res = _refit(c["problem"], model, effect(eff_id), direction, c["records"],
-                         c["criterion"], c["budget"], c["tol"], c["regress"])
-        evs = c["problem"].evaluations(m2, floor=True)
+        m2, res = _refit(problem, model, effect(eff_id), direction, records, criterion, budget,
+                         tol, regress)
+        evs = problem.evaluations(m2, floor=True)
     except IntegrationError as exc:
-        return None, None, None, str(exc), c["problem"].n_sim - n0
-    return m2, res, evs, None, c["problem"].n_sim - n0
+        return None, None, None, str(exc), problem.n_sim - n0
+    return m2, res, evs, None, problem.n_sim - n0
 
 
-def _screen(jobs, context, workers):
+def _screen(jobs, context, workers, executor=None):
     """The screening refits ``[(model, identification, evaluations, error)]`` in the order of
-    ``jobs``, on ``workers`` processes (forked: the records are not copied)."""
+    ``jobs``, on ``executor`` (default: ``workers`` forked processes, so the records are not
+    copied; in this process for one worker).  The simulations of every refit are added to the
+    problem's count whichever process ran it."""
     problem = context[0]
-    workers = min(int(workers or os.cpu_count() or 1), len(jobs))
-    if workers <= 1:
-        _screen_init(*context)
-        try:
-            return [r[:4] for r in map(_screen_one, jobs)]
-        finally:
-            _SCREEN.clear()
-    pool = ProcessPoolExecutor(workers, mp_context=get_context("fork"),
-                               **worker_initializer(_screen_init, context))
+    n0 = problem.n_sim
+    own = executor is None
+    ex = make_executor(min(int(workers or os.cpu_count() or 1), max(len(jobs), 1))) if own \
+        else executor
     try:
-        out = list(pool.map(_screen_one, jobs))
-    except BaseException:
-        terminate_pool(pool)  # interrupted or failed: no waiting for queued refits
-        raise
-    pool.shutdown()
-    problem.n_sim += sum(r[4] for r in out)
+        out = ex.map(_screen_one, jobs, context)
+    finally:
+        if own:
+            ex.close()
+    problem.n_sim = n0 + sum(r[4] for r in out)
     return [r[:4] for r in out]
 
 
@@ -703,10 +690,12 @@ def _output_error(records, start, criterion, budget, tol, polish=False):
     n_boot=Real(0, integer=True), seed=Real(0, integer=True), tolerances=(Tolerances, None),
     effects=(None, list, tuple), max_refits=Real(1, integer=True),
     workers=(None, Real(1, integer=True)), n_boot_intervals=Real(0, integer=True),
+    executor=(None, Instance("discovery.executor", "Executor")),
 )
 def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01,
             max_iterations=3, budget=150, n_boot=16, seed=0, tolerances=None, effects=None,
-            max_refits=6, workers=None, n_boot_intervals=30, progress=None):
+            max_refits=6, workers=None, n_boot_intervals=30, progress=None,
+            executor=None):
     """Explain the disagreement of a start model with one or several records by named
     physical effects (see the module docstring).
 
@@ -736,6 +725,9 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     workers : int, optional
         Processes for the screening refits (default: all cores; the result does not
         depend on it).
+    executor : Executor, optional
+        Where the screening refits run (:mod:`discovery.executor`); overrides ``workers``
+        and is not closed here.
     n_boot_intervals : int
         Bootstrap replicates of the final model's 95 % parameter intervals through the full
         processing (:func:`discovery.intervals.bootstrap_intervals`; 0 = none).
@@ -871,7 +863,7 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         refits = iter(_screen([(model, s["effect"], s.get("direction")) for s in chosen
                                if "drift" not in eff_by_id[s["effect"]].phases],
                               (problem, records, criterion, screen, tolerances, regress),
-                              workers))
+                              workers, executor))
         for s in chosen:
             eff = eff_by_id[s["effect"]]
             key = "D" if "drift" in eff.phases else criterion

@@ -33,19 +33,17 @@ import cmath
 import math
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
-from multiprocessing import get_context
 
 import numpy as np
 from numba import njit
 
 from .._printing import readable
-from .._validate import Array, Real, params
-from .._workers import terminate_pool, worker_initializer
+from .._validate import Array, Instance, Real, params
 from ..dynamics import Tolerances
 from ..dynamics._dopri import OK
 from ..errors import InputError, IntegrationError
+from ..executor import make_executor
 from . import _kernel as UK
 from .attractor import _budget, _check, _y0, classify_points
 from .system import UedaSystem
@@ -298,13 +296,6 @@ class Chart:
                 f"  regimes: {share}"]
 
 
-_CTX = {}
-
-
-def _init(system, settings):
-    _CTX.update(system=system, settings=settings)
-
-
 def _floquet(M, logs):
     """Moduli of the two multipliers (largest first) of ``exp(logs) M``, as logs."""
     tr, det = M[0, 0] + M[1, 1], M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
@@ -440,10 +431,11 @@ def _sweep(base, b, nus, s, tol, y, buffers):
     return out, y
 
 
-def _row(args):
-    i, b, nus = args
+def _row(ctx, job):
+    """One row of the chart (a task of the executor); ``ctx`` is ``(system, settings)``."""
+    b, nus = job
     c0 = time.process_time()
-    base, s = _CTX["system"], _CTX["settings"]
+    base, s = ctx
     tol = Tolerances(rtol=s["rtol"], hmax_fraction=s["hmax_fraction"])
     buffers = (np.empty((max(s["transient"], 1), 2)),
                np.zeros(s["max_period"] + 1, dtype=np.int64))
@@ -459,7 +451,7 @@ def _row(args):
         coex = [_coexisting(base, b, nu, u, d, s, tol) for nu, u, d in zip(nus, up, dn,
                                                                              strict=True)]
         down = [pack(r) for r in dn]
-    return i, [pack(r) for r in up], down, coex, time.process_time() - c0
+    return [pack(r) for r in up], down, coex, time.process_time() - c0
 
 
 def _coexisting(base, b, nu, u, d, s, tol):
@@ -496,12 +488,11 @@ def _axis(values, name):
     transient=Real(0, integer=True), periods=Real(1, integer=True), rtol=Real(0, 1, open_low=True),
     hmax_fraction=Real(0, 1, open_low=True), max_period=Real(1, integer=True),
     workers=(None, Real(1, integer=True)),
+    executor=(None, Instance("discovery.executor", "Executor")),
 )
-
-
 def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_fraction=0.1,
           max_period=16, closure=1e-4, chaos_threshold=0.015, sweeps=1, early_exit=True,
-          min_pairs=12, recheck=5, workers=None, progress=None):
+          min_pairs=12, recheck=5, workers=None, progress=None, executor=None):
     """The regime at every ``(nu, B)`` of a grid (see the module docstring).
 
     Parameters
@@ -540,6 +531,9 @@ def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_f
         Processes (default all cores, at most one per row).
     progress : callable, optional
         ``progress(done_rows, total_rows)`` after each row.
+    executor : Executor, optional
+        Where the rows run (:mod:`discovery.executor`); overrides ``workers`` and is not
+        closed here.  One task per row of ``B``.
 
     Returns
     -------
@@ -588,18 +582,14 @@ def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_f
         kind2, period2 = kind.copy(), period.copy()
         lam2, rot2 = lam.copy(), rot.copy()
         coex = np.zeros(shape, dtype=bool)
-    jobs = [(i, b, nu) for i, b in enumerate(B)]
+    jobs = [(b, nu) for b in B]
     cpu = 0.0
     t_start = time.perf_counter()
-    if workers == 1:
-        _init(system, settings)
-        results, pool = map(_row, jobs), None
-    else:
-        pool = ProcessPoolExecutor(workers, mp_context=get_context("fork"),
-                                   **worker_initializer(_init, (system, settings)))
-        results = pool.map(_row, jobs)
+    own = executor is None
+    ex = make_executor(workers) if own else executor
     try:
-        for done, (i, up, down, cx, sec) in enumerate(results, start=1):
+        for done, (i, (up, down, cx, sec)) in enumerate(ex.run(_row, jobs, (system, settings)),
+                                                        start=1):
             cpu += sec
             for j, (k, n, lv, r, c) in enumerate(up):
                 kind[i, j], period[i, j], lam[i, j], rot[i, j], cost[i, j] = k, n, lv, r, c
@@ -610,14 +600,10 @@ def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_f
                 coex[i] = cx
             if progress is not None:
                 progress(done, len(jobs))
-    except BaseException:
-        if pool is not None:
-            terminate_pool(pool)
-            pool = None
-        raise
     finally:
-        if pool is not None:
-            pool.shutdown()
+        if own:
+            ex.close()
+    workers = min(ex.workers, len(jobs))
     extra = {}
     if two:
         extra = {"kind_down": kind2, "period_down": period2, "lyapunov_down": lam2,
