@@ -93,6 +93,7 @@ class Landscape:
     noise_floor_q95: dict | None = None
     noise_floor_under: str = ""
     reference: dict = field(default_factory=dict)
+    continuation: bool = False
 
     def argmin(self, name):
         """Index ``(i, j)`` of the smallest value of criterion ``name``; ``None`` when no
@@ -141,7 +142,8 @@ class Landscape:
                            else {"alpha1": a0[at[0]], "alpha2": a1[at[1]]}},
                 "noise_floor": self.noise_floor, "noise_floor_q95": self.noise_floor_q95,
                 "noise_floor_under": self.noise_floor_under, "minima": minima,
-                "seconds": self.seconds, "workers": self.workers}
+                "seconds": self.seconds, "workers": self.workers,
+                "continuation": self.continuation}
 
     def _lines(self):
         n0, n1 = (len(a) for a in self.axes)
@@ -202,36 +204,43 @@ class _FixedFloor(Reference):
         return self.fixed_floor
 
 
-def _point(ctx, law):
-    """``(regime, impacts, criteria or None, consistent, message)`` of one law; ``ctx`` is
-    ``(scenario, law, reference, tolerances, from_state)``."""
-    scenario, _, reference, tolerances, from_state = ctx
+def _point(ctx, law, guess=None):
+    """``((regime, impacts, criteria or None, consistent, message), steady state or None)``
+    of one law; ``ctx`` is ``(scenario, law, reference, tolerances, from_state,
+    continuation)``; ``guess`` the previous point's steady state (continuation)."""
+    scenario, _, reference, tolerances, from_state, _ = ctx
     try:
         ev = evaluate(scenario, law, reference, tolerances=tolerances, from_state=from_state,
-                      floor=True)
+                      floor=True, guess=guess)
     except VidiError:
         raise  # bad input (e.g. a zero reference impulse) concerns every point: stop
     except (ValueError, ArithmeticError) as exc:  # numerics at this point only
-        return "failed", -1, None, False, f"{type(exc).__name__}: {exc}"
+        return ("failed", -1, None, False, f"{type(exc).__name__}: {exc}"), None
+    ss = ev.steady
     if ev.status == "ok":
-        return ev.regime["simulated"], ev.impacts["simulated"], ev.criteria, ev.consistent, ""
+        return (ev.regime["simulated"], ev.impacts["simulated"], ev.criteria, ev.consistent,
+                ""), ss
     if ev.status == "failed":
-        return "failed", -1, None, False, ev.message or ev.verdict
+        return ("failed", -1, None, False, ev.message or ev.verdict), None
     if ev.status == "no-contact":
-        return "no-contact", 0, None, False, ""
-    return "nonperiodic", -1, None, False, ""
+        return ("no-contact", 0, None, False, ""), ss
+    return ("nonperiodic", -1, None, False, ""), None
 
 
 def _row(ctx, job):
     """One row of the grid (a task of the executor: a row, not a point, lasts long enough
-    to amortise a task's overhead)."""
+    to amortise a task's overhead).  With continuation each point's steady state starts
+    from its neighbour's orbit (:func:`~discovery.dynamics.steady_state.steady_state`'s
+    ``guess``), and from the cold search when that fails."""
     v0, axis1 = job
-    law = ctx[1]
-    out = []
+    law, continuation = ctx[1], ctx[5]
+    out, guess = [], None
     for v1 in axis1:
         coefs = list(law.coefficients)
         coefs[0], coefs[1] = v0, v1
-        out.append(_point(ctx, law.with_coefficients(coefs)))
+        res, ss = _point(ctx, law.with_coefficients(coefs), guess)
+        out.append(res)
+        guess = ss if continuation and ss is not None and ss.periodic else None
     return out
 
 
@@ -264,7 +273,7 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
     executor=(None, Instance("discovery.executor", "Executor")),
 )
 def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tolerances=None,
-              from_state=True, progress=None, executor=None):
+              from_state=True, progress=None, executor=None, continuation=True):
     """Compute all criteria over a grid of the first two coefficients of ``law``.
 
     Parameters
@@ -329,7 +338,7 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
     messages = np.full(shape, "", dtype=object)
     values = {n: np.full(shape, np.nan) for n in CRITERIA}
     jobs = [(v0, axis1) for v0 in axis0]
-    context = (scenario, law, ref, tolerances, from_state)
+    context = (scenario, law, ref, tolerances, from_state, bool(continuation))
     own = executor is None
     ex = make_executor(workers) if own else executor
     try:
@@ -352,4 +361,5 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
                      regime=regime, seconds=time.perf_counter() - t_start, workers=workers,
                      consistent=consistent, impacts=impacts, messages=messages,
                      noise_floor=dict(floor), noise_floor_q95=dict(q95),
-                     noise_floor_under=under, reference=info)
+                     noise_floor_under=under, reference=info,
+                     continuation=bool(continuation))

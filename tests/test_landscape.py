@@ -159,3 +159,27 @@ def test_api_input_checks(paper):
         landscape(paper, paper.law, [1e8, 2e8], [1e7, 2e7], ref, workers=1)
     with pytest.raises(InputError, match="strictly increasing"):
         landscape(paper, paper.law, [2e8, 1e8], [1e7, 2e7], Reference.exact(ref), workers=1)
+
+
+def test_continuation_gives_the_cold_search_result(paper):
+    """Each point started from its neighbour's orbit (the default) lands on the orbit the
+    cold search from the start state finds: same regimes, impacts and consistency, criteria
+    within the shooting tolerance; and a continued steady state agrees with a cold one."""
+    from discovery.dynamics.steady_state import steady_state
+
+    a0, a1 = np.linspace(1.2e8, 3.0e8, 5), np.linspace(0.7e7, 1.9e7, 7)
+    cold = landscape(paper, paper.law, a0, a1, workers=1, continuation=False)
+    cont = landscape(paper, paper.law, a0, a1, workers=1)
+    assert cont.continuation and not cold.continuation
+    assert np.array_equal(cold.regime, cont.regime)
+    assert np.array_equal(cold.impacts, cont.impacts)
+    assert np.array_equal(cold.consistent, cont.consistent)
+    for n in CRITERIA:
+        assert np.allclose(cold.values[n], cont.values[n], rtol=0, atol=1e-7, equal_nan=True), n
+    near = paper.law.with_coefficients([2.2e8, 1.3e7])
+    ss0 = steady_state(paper, paper.law)
+    a, b = steady_state(paper, near), steady_state(paper, near, guess=ss0)
+    assert "continued_from" in b.evidence and "continued_from" not in a.evidence
+    assert a.regime == b.regime and a.impacts == b.impacts
+    assert np.max(np.abs(a.y0 - b.y0) / np.abs(a.y0).max()) < 1e-6
+    assert np.allclose(a.multipliers, b.multipliers, atol=1e-5)

@@ -109,7 +109,8 @@ def run(args):
         print(f"note: {note}")
     a0, a1 = np.linspace(*r0, n0), np.linspace(*r1, n1)
     with reporter(args) as rep, executor_of(args) as ex:
-        land = landscape(sc, law, a0, a1, ref, workers=args.workers, progress=rep, executor=ex)
+        land = landscape(sc, law, a0, a1, ref, workers=args.workers, progress=rep, executor=ex,
+                         continuation=not args.no_continuation)
     ref_info.update(regime=land.reference["regime"], start=land.reference["start"])
     if ref is None:
         ref_info["impacts"] = land.reference["impacts"]
@@ -176,6 +177,10 @@ def register(sub):
     s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
                    needs="--data",
                    help="with --data: seed of the bootstrap (default: %(default)s)")
+    s.add_argument("--no-continuation", action="store_true",
+                   help="search every point's steady state from the start state (by default "
+                   "each point starts from its neighbour's orbit along the row, several "
+                   "times faster; the search from the start state when that fails)")
     s.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
     s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
     s.add_argument("--out", required=True, help="output directory")

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._printing import fmt, readable
-from .._validate import Array, Real, params
+from .._validate import Array, Instance, Real, params
 from ..errors import InputError, IntegrationError
 from ..law import ForceLaw
 from ..scenario import Scenario
@@ -182,9 +182,10 @@ class SteadyState:
     max_period=Real(1, 64, integer=True), tol=Real(0, 1, open_low=True),
     max_newton=Real(1, integer=True), long_transient=Real(0, integer=True),
     tolerances=(Tolerances, None), y_start=(None, Array(1)), t_start=Real(),
+    guess=(None, Instance("discovery.dynamics.steady_state", "SteadyState")),
 )
 def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_newton=12,
-                 long_transient=300, tolerances=None, y_start=None, t_start=0.0):
+                 long_transient=300, tolerances=None, y_start=None, t_start=0.0, guess=None):
     """Find the periodic steady state reached from a given (or the scenario's) state.
 
     Parameters
@@ -207,6 +208,12 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
         Initial state ``(w1, v1, w2, v2)`` (default the scenario's).  To follow the
         attractor a machine is on, pass its measured state (see
         :meth:`~discovery.measurement.Measurement.state_at`).
+    guess : SteadyState, optional
+        Continuation: the periodic orbit of a nearby law (a neighbouring landscape point).
+        Newton starts from its orbit with its period; the orbit is taken when Newton
+        converges within ``CONTINUATION_NEWTON`` iterations to a stable orbit whose period
+        does not reduce; otherwise the search from ``y_start`` runs as without a guess.
+        Where attractors coexist, the continued orbit is the one on the guess's branch.
     t_start : float
         Time [s] at which ``y_start`` holds, on the drive's clock (the drive is
         ``A sin(2 pi f t)``, phase 0 at ``t = 0``); it need not be a multiple of ``T``.
@@ -228,6 +235,10 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
                          "simulate it from rest (vidi simulate --from-rest) or set "
                          "mass_loss = 0")
     pm = StroboscopicMap(scenario, law, tolerances)
+    if guess is not None and guess.periodic and law.permanent_set == 0:
+        cont = _continued(scenario, law, pm, guess, tol)
+        if cont is not None:
+            return cont
     y = scenario.initial_state() if y_start is None else np.asarray(y_start, dtype=float)
     T = scenario.period
     evidence = {"attempts": [], "t_start": float(t_start)}
@@ -288,6 +299,32 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
     return SteadyState(regime="nonperiodic", n_periods=0, y0=y, t0=t_done * T,
                        impacts=0, multipliers=np.full(4, np.nan + 0j), residual=float("nan"),
                        n_simulations=pm.n_calls, evidence=evidence)
+
+
+CONTINUATION_NEWTON = 4
+"""Newton iterations a continuation may take before the cold search runs instead."""
+
+
+def _continued(scenario, law, pm, guess, tol):
+    """The orbit continued from ``guess`` (see :func:`steady_state`), or None."""
+    n = guess.n_periods
+    hist = []
+    try:
+        y_orb, res, J, ok = newton_orbit(pm, np.asarray(guess.y0, dtype=float), n, tol,
+                                         CONTINUATION_NEWTON, hist)
+    except IntegrationError:
+        return None
+    mult = floquet_multipliers(J, len(y_orb))
+    if not (ok and is_stable(mult)):
+        return None
+    if n > 1 and smallest_period(pm, y_orb, n, tol, CONTINUATION_NEWTON) is not None:
+        return None  # the period reduces here: let the cold search decide
+    evidence = {"attempts": [], "t_start": float(guess.t0),
+                "continued_from": {"regime": guess.regime, "newton_residuals": hist}}
+    impacts = _count_onsets(scenario, law, pm.tol, y_orb, guess.t0, n, 0.0)
+    return SteadyState(regime=f"P{n}", n_periods=n, y0=y_orb, t0=guess.t0, impacts=impacts,
+                       multipliers=mult, residual=float(res), n_simulations=pm.n_calls,
+                       evidence=evidence, zeta_max0=0.0)
 
 
 def _count_onsets(scenario, law, tol, y0, t0, n, zeta_max0=0.0):
