@@ -44,8 +44,7 @@ from ._validate import Real, Text, params
 from .criteria import criterion as _criterion
 from .dynamics import Tolerances
 from .errors import InputError, IntegrationError, VidiError
-from .identify import identify, pair_records, record_start
-from .intervals import bootstrap_intervals
+from .identify import bootstrap_intervals, identify, pair_records, record_start
 from .law import Term
 from .library import Library
 from .measurement import Measurement
@@ -58,6 +57,7 @@ __all__ = ["RankedModel", "DiscoveryResult", "discover", "rank"]
 
 _REFINE_BUDGET = 120   # simulations per shortlisted support (every record counts)
 _FORWARD_STARTS = (0.01, 0.001)  # a new term's start force at the box corner / peak force
+_RESTARTS = 2  # stalled smaller supports restarted from a consistent model, per step
 
 
 @dataclass(frozen=True)
@@ -324,6 +324,19 @@ def rank(models, criterion="I2", sim_rtol=0.1, sim_atol=0.005, physics=True):
     return good + tier + tail + bad
 
 
+def _best_per_support(models, criterion):
+    """One model per support: the consistent one, else the lowest criterion (a support
+    refined again from another start keeps its better refinement)."""
+    best = {}
+    for m in models:
+        key = frozenset(m.law.names)
+        score = (not m.consistent, m.criteria.get(criterion, np.inf) if m.criteria else np.inf)
+        if key not in best or score < best[key][0]:
+            best[key] = (score, m)
+    keep = {id(m) for _, m in best.values()}
+    return [m for m in models if id(m) in keep]
+
+
 def _sign_vector(signs, library):
     """``{term: +1 | -1 | 0}`` as the estimator's per-term sign vector."""
     lib = library if isinstance(library, Library) else Library.parse(library)
@@ -473,6 +486,25 @@ class _Checker:
             out.append(self.refined(lib.law(coef), cand,
                                     f"backward step from {' + '.join(names)}"))
         return out
+
+    def restart(self, base, support):
+        """``support`` refined again from ``base``'s coefficients (its other terms started
+        like a forward step's new term): a smaller support whose refinement from the
+        biased regression stalled, retried from a consistent model's start."""
+        est = self.est
+        lib = est.library_
+        peak = float(np.max(np.abs(self.samples.F)))
+        corner = lib.transform(np.array([[est.box_.zeta_max, est.box_.zd_max]]))[0]
+        coef = np.zeros(len(lib))
+        base_c = _coefficients(base.law, lib)
+        for i, term in enumerate(lib.terms):
+            if term.name in support:
+                coef[i] = base_c[i] if base_c[i] else _FORWARD_STARTS[0] * peak / max(
+                    corner[i], 1e-300)
+        cand = est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight,
+                           self.samples.impact)
+        return self.refined(lib.law(coef), cand,
+                            f"restart from {' + '.join(base.law.names)}")
 
     def forward(self, base, max_terms, skip=frozenset()):
         """Output-error forward step: ``base`` plus each library term it lacks, every trial
@@ -784,15 +816,40 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
             steps.append({"kind": "physical start", "from": [], "trials": 1})
             models = models + [start]
             ranking = rank_all(models)
-    while refine and ranking[0].criteria and len(steps) < stepwise:
+    retried = set()
+    def more(steps):
+        # up to `stepwise` moves, and one simplifying move more when the last move made the
+        # best model consistent (its backward step and restarts would be cut off otherwise)
+        if len(steps) < stepwise:
+            return True
+        return (len(steps) == stepwise and stepwise > 0 and ranking[0].consistent
+                and steps[-1]["kind"] != "backward")
+
+    while refine and ranking[0].criteria and more(steps):
         # output-error stepwise search around the best model: a consistent model loses a
         # term (backward), an inconsistent one gains one (forward: the regression may have
         # been misled, e.g. by noisy penetration)
         top = ranking[0]
-        # supports already simulated successfully are not tried again
+        # supports already simulated successfully are not tried again, except that a
+        # consistent model's backward step retries a smaller support that was inconsistent
+        # from its own (biased regression) start, once, from the consistent coefficients:
+        # a refinement that stalled far from the truth must not hide the simplest model
         done = frozenset(frozenset(m.law.names) for m in models if m.criteria)
         if top.consistent and not (physics and top.defects):
-            trials, kind = check.backward(top, done), "backward"
+            good = frozenset(frozenset(m.law.names) for m in models
+                             if m.criteria and m.consistent)
+            trials, kind = check.backward(top, good | retried), "backward"
+            retried |= {frozenset(m.law.names) for m in trials} & done
+            # smaller supports that stalled and no backward step reaches: the two best,
+            # restarted from the consistent model's coefficients
+            stalled = sorted((m for m in models if m.criteria and not m.consistent
+                              and len(m.law.names) <= len(top.law.names)
+                              and frozenset(m.law.names) not in retried
+                              and not (physics and m.defects)),
+                             key=lambda m: m.criteria[criterion])[:_RESTARTS]
+            for m in stalled:
+                retried.add(frozenset(m.law.names))
+                trials.append(check.restart(top, set(m.law.names)))
         else:  # both directions: a wrong term may have to go while a missing one comes in
             trials = check.forward(top, max_terms, done) + check.backward(top, done)
             kind = "forward+backward"
@@ -800,7 +857,7 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
             break
         steps.append({"kind": kind, "from": list(top.law.names), "trials": len(trials)})
         tick(progress, "fit: stepwise search around the best support", len(steps), stepwise)
-        models = models + trials
+        models = _best_per_support(models + trials, criterion)
         ranking = rank_all(models)
         if ranking[0] is top:
             break

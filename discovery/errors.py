@@ -12,8 +12,7 @@ re-exported here, so the constraints package's :class:`~constraints.errors.Solve
 from constraints.errors import CertificateError, InputError, SolverError, VidiError
 
 __all__ = ["VidiError", "InputError", "VidiTypeError", "LawSyntaxError", "IntegrationError",
-           "CertificateError",
-           "SolverError"]
+           "NoContactError", "CertificateError", "SolverError"]
 
 
 class LawSyntaxError(InputError):
@@ -22,6 +21,10 @@ class LawSyntaxError(InputError):
 
 class IntegrationError(VidiError, RuntimeError):
     """A simulation failed (blow-up, step budget exhausted, step size underflow)."""
+
+
+class NoContactError(InputError):
+    """A force record (or a noisy replicate of one) has no contact above its threshold."""
 
 
 class VidiTypeError(VidiError, TypeError):

@@ -24,7 +24,7 @@ from scipy.ndimage import uniform_filter1d
 from ._validate import Array, Real, params
 from .dynamics import _kernel as K
 from .dynamics.simulate import simulate
-from .errors import InputError
+from .errors import InputError, NoContactError
 
 __all__ = ["Impulse", "impulse_from_steady_state", "impulse_from_samples", "estimate_noise",
            "own_period", "check_drive_period"]
@@ -176,7 +176,8 @@ class Impulse:
         """Support intervals repeated over ``[0, length]``, ndarray of shape (m, 2)."""
         reps = int(round(length / self.duration))
         if not np.isclose(reps * self.duration, length, rtol=1e-9) or reps < 1:
-            raise ValueError("length must be a whole number of cycles")
+            raise InputError(f"length {length!r} must be a whole number of cycles of "
+                             f"{self.duration!r} s")
         return np.concatenate([self.support + k * self.duration for k in range(reps)]) \
             if len(self.support) else np.zeros((0, 2))
 
@@ -503,7 +504,7 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
         runs = [(_bracket_onset(t, F, s, t_off, thr, _refine_onset(t, zeta, s, t_on, back)),
                  t_off, s) for t_on, t_off, s in runs]
     if not runs:
-        raise InputError("no contact found in the force record (no run of samples above "
+        raise NoContactError("no contact found in the force record (no run of samples above "
                          f"the threshold {thr:.3g} N); check the F column and its units")
     # peak force per run to find the main impact and the cycle length
     # each contact's impulse (integral of F): unlike the sampled peak it does not depend

@@ -27,7 +27,7 @@ from ._progress import tick
 from ._validate import Array, Instance, Real, params
 from .criteria import CRITERIA
 from .dynamics import Tolerances
-from .errors import InputError, VidiError
+from .errors import InputError, VidiError, VidiTypeError
 from .executor import make_executor
 from .impulse import Impulse
 from .law import ForceLaw
@@ -323,7 +323,7 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
                              "with contact")
         reference = Reference.exact(imp, source="law")
     elif not isinstance(reference, Reference):
-        raise TypeError("reference must be a discovery.verify.Reference; wrap an exact impulse "
+        raise VidiTypeError("reference must be a discovery.verify.Reference; wrap an exact impulse "
                         "with Reference.exact(impulse) or prepare a record with "
                         "Reference.from_measurement(measurement, scenario)")
     floor, q95, under = _floor_once(scenario, law, reference, tolerances, from_state)

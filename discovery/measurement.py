@@ -37,7 +37,7 @@ from ._io import atomic_write_text
 from ._validate import Array, Choice, Real, Text, check, params
 from .dynamics import simulate
 from .dynamics.steady_state import steady_state
-from .errors import InputError
+from .errors import InputError, NoContactError
 from .impulse import _edge_params, estimate_noise, impulse_from_samples
 from .law import ForceLaw
 from .scenario import Scenario
@@ -280,10 +280,8 @@ class Measurement:
         the onset comes from ``zeta`` when positions were recorded."""
         try:
             return impulse_from_samples(self.t, self.F, period, zeta=self.zeta, **kwargs)
-        except InputError as exc:
-            if not str(exc).startswith("no contact found"):
-                raise
-            raise InputError(no_contact_message(self.t, self.F, period, self.source,
+        except NoContactError:
+            raise NoContactError(no_contact_message(self.t, self.F, period, self.source,
                                                 kwargs.get("threshold"))) from None
 
 

@@ -416,7 +416,7 @@ def _frac(k, n, ci=None):
 
 def _study(s, run_dir):
     d = s.get("design") or {}
-    varied = list((d.get("varied") or {}))
+    varied = list(d.get("varied") or {})
     pooled = s.get("pooled") or {}
     cells = s.get("cells") or []
     c = {"title": "Model-term selection study" + (f": {s['name']}" if s.get("name") else ""),

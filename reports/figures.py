@@ -1,13 +1,11 @@
-"""Figures as pure functions of result objects (matplotlib, Agg backend).
+"""Figures as pure functions of result objects (matplotlib Figures, no pyplot).
 
 Each function writes the same figure as PNG and PDF and returns the paths.
 """
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+from ._mpl import colormap, save, subplots
 
 __all__ = ["landscape_figure", "identification_figure", "verify_figure", "explain_figure"]
 
@@ -40,12 +38,7 @@ def coefficient_label(name):
     return f"coefficient of {name} [{term_unit(name)}]"
 
 
-def _save(fig, stem):
-    paths = [f"{stem}.png", f"{stem}.pdf"]
-    fig.savefig(paths[0], dpi=130, bbox_inches="tight")
-    fig.savefig(paths[1], bbox_inches="tight")
-    plt.close(fig)
-    return paths
+_save = save
 
 
 def landscape_figure(land, stem, truth=None):
@@ -85,7 +78,7 @@ def landscape_figure(land, stem, truth=None):
     marks = [m for m in marks if m[0].any()]
     inside = truth is not None and a0[0] <= truth[0] <= a0[-1] and a1[0] <= truth[1] <= a1[-1]
     show_cons = cons is not None and cons.sum() >= 2  # one point: hidden by the star
-    fig, axes = plt.subplots(2, 3, figsize=(14, 8.5))
+    fig, axes = subplots(2, 3, figsize=(14, 8.5))
     for ax, name in zip(axes.flat, _ORDER, strict=False):
         v = land.values[name]
         ok = np.isfinite(v)
@@ -95,7 +88,7 @@ def landscape_figure(land, stem, truth=None):
             cs = ax.contourf(a0, a1, v.T, levels=levels, cmap="viridis")
             if hi > lo:
                 ax.contour(a0, a1, v.T, levels=levels[::2], colors="k", linewidths=0.4)
-            plt.colorbar(cs, ax=ax, label=f"{name} (dimensionless)")
+            fig.colorbar(cs, ax=ax, label=f"{name} (dimensionless)")
             i, j = land.argmin(name)
             ax.plot(a0[i], a1[j], "w*", ms=10, mec="k")
         else:
@@ -179,7 +172,7 @@ def identification_figure(result, measured, impulses, stem, land=None):
     its = list(result.iterations)
     path = np.array([[it["coefficients"][n] for n in names] for it in its])
     two = len(names) >= 2 and path.size > 0
-    fig, axes = plt.subplots(1, 3 if two else 2, figsize=(17 if two else 12, 5.2),
+    fig, axes = subplots(1, 3 if two else 2, figsize=(17 if two else 12, 5.2),
                              layout="constrained")
     crit = result.criterion
     # the identified law's value (result.value can belong to a standard-error probe)
@@ -222,7 +215,7 @@ def identification_figure(result, measured, impulses, stem, land=None):
     ax1.plot(measured.t * 1e3, measured.F / 1e6, "k-", lw=2.5, label="F_E (measured)")
     for k, (label, imp) in enumerate(impulses):
         if imp is not None:
-            ax1.plot(imp.t * 1e3, imp.F / 1e6, "-", lw=1, color=plt.cm.plasma(k / max(
+            ax1.plot(imp.t * 1e3, imp.F / 1e6, "-", lw=1, color=colormap("plasma")(k / max(
                 1, len(impulses))), label=label)
     end = measured.support[:, 1].max() if len(measured.support) else measured.duration
     ax1.set_xlim(-0.05 * end * 1e3, min(measured.duration, 1.4 * end) * 1e3)
@@ -249,7 +242,7 @@ def fit_impulse_figure(result, impulses, stem, n_models=3):
     measured = [r.impulse if r is not None else result.measured for r in refs]
     models = [m for m in result.ranking if m.evaluations][:n_models]
     labels = [lab for lab, _ in impulses][:len(models)]
-    fig, axes = plt.subplots(len(measured), 1, figsize=(8, 3.0 + 2.2 * len(measured)),
+    fig, axes = subplots(len(measured), 1, figsize=(8, 3.0 + 2.2 * len(measured)),
                              squeeze=False)
     sc, unit = _force_unit(max(E.peak for E in measured))
     for r, (E, ax) in enumerate(zip(measured, axes[:, 0], strict=True)):
@@ -285,9 +278,9 @@ def fit_surface_figure(result, stem):
     Z, V = est.box_.zeta_max, est.box_.zd_max
     zz, vv = np.meshgrid(np.linspace(0, Z, 200), np.linspace(0, V, 200))
     F = result.selected.law(zz, vv)
-    fig, ax = plt.subplots(figsize=(7, 5))
+    fig, ax = subplots(figsize=(7, 5))
     cs = ax.contourf(zz * 1e3, vv, F / 1e3, levels=25, cmap="magma")
-    plt.colorbar(cs, ax=ax, label="F [kN]")
+    fig.colorbar(cs, ax=ax, label="F [kN]")
     step = max(1, len(s) // 4000)
     ax.plot(s.zeta[::step] * 1e3, np.maximum(s.dzeta[::step], 0), ".", ms=1.5, color="c",
             alpha=0.6, label="contact samples")
@@ -302,7 +295,7 @@ def fit_surface_figure(result, stem):
 def fit_loop_figure(result, stem, max_impacts=3):
     """Loading / unloading loops F(zeta) of a few impacts (the paper's Fig. 2a)."""
     s = result.samples
-    fig, ax = plt.subplots(figsize=(7, 5))
+    fig, ax = subplots(figsize=(7, 5))
     impacts = np.unique(s.impact)
     pick = impacts[np.linspace(0, impacts.size - 1, min(max_impacts, impacts.size)).astype(int)]
     for k, imp in enumerate(pick):
@@ -381,7 +374,7 @@ def verify_figure(result, stem):
 
     ev = result.evaluation
     E = result.reference.impulse
-    fig, (ax, axr) = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True,
+    fig, (ax, axr) = subplots(2, 1, figsize=(8, 5.5), sharex=True,
                                   gridspec_kw={"height_ratios": [3, 1.3]})
     band = 2.0 * result.reference.noise.get("F", 0.0) / np.sqrt(max(E.n_cycles, 1))
     ms = 1e3
@@ -421,7 +414,7 @@ def explain_figure(iteration, measured, stem, k=1):
     named effect against the record, the residual's share by impact phase (and its ratio
     to the noise), the mean residual over the simulated (zeta, dzeta) plane, and every
     candidate effect's score test."""
-    fig, axes = plt.subplots(2, 2, figsize=(13, 8.5), layout="constrained")
+    fig, axes = subplots(2, 2, figsize=(13, 8.5), layout="constrained")
     ax = axes[0, 0]
     E = measured
     ax.plot(E.t * 1e3, E.F / 1e3, "k-", lw=2, label="measured")

@@ -17,18 +17,21 @@ Runs are pooled over every factor a figure does not show (laws, scenarios, motio
 from __future__ import annotations
 
 import numpy as np
-from matplotlib.figure import Figure
 
 from discovery.studies.aggregate import wilson
+
+from ._mpl import save
 
 __all__ = ["study_figures"]
 
 
-def _save(fig, stem):
-    paths = [f"{stem}.png", f"{stem}.pdf"]
-    fig.savefig(paths[0], dpi=130, bbox_inches="tight")
-    fig.savefig(paths[1], bbox_inches="tight")
-    return paths
+_save = save
+
+
+def _figure(**kw):
+    from matplotlib.figure import Figure
+
+    return Figure(**kw)
 
 
 def _levels(runs, cells, name):
@@ -45,6 +48,11 @@ def _rate(rs):
     return (k / n if n else np.nan), lo, hi
 
 
+def _yerr(p, lo, hi):
+    """Error bar lengths below and above ``p`` (never negative; 0 where undefined)."""
+    return np.nan_to_num(np.clip([p - lo, hi - p], 0.0, None))
+
+
 def _pct(x):
     return f"{100 * x:g} %"
 
@@ -53,7 +61,7 @@ def recovery_noise_figure(runs, cells, stem):
     methods = _levels(runs, cells, "selection")
     noises = _levels(runs, cells, "force_noise")
     lengths = _levels(runs, cells, "periods")
-    fig = Figure(figsize=(4.2 * len(lengths), 3.6))
+    fig = _figure(figsize=(4.2 * len(lengths), 3.6))
     axes = fig.subplots(1, len(lengths), squeeze=False, sharey=True)[0]
     x = np.arange(len(noises))
     for ax, n_per in zip(axes, lengths, strict=True):
@@ -62,7 +70,7 @@ def recovery_noise_figure(runs, cells, stem):
                     for s in noises]
             p, lo, hi = (np.array(v) for v in zip(*vals, strict=True))
             dx = (j - (len(methods) - 1) / 2) * 0.06
-            ax.errorbar(x + dx, p, yerr=[p - lo, hi - p], marker="o", ms=4, capsize=2,
+            ax.errorbar(x + dx, p, yerr=_yerr(p, lo, hi), marker="o", ms=4, capsize=2,
                         label=m)
         ax.set_xticks(x, [_pct(s) for s in noises])
         ax.set_xlabel("force noise (of the peak force)")
@@ -79,7 +87,7 @@ def recovery_map_figure(runs, cells, stem):
     methods = _levels(runs, cells, "selection")
     noises = _levels(runs, cells, "force_noise")
     lengths = _levels(runs, cells, "periods")
-    fig = Figure(figsize=(2.9 * len(methods) + 0.8, 3.0))
+    fig = _figure(figsize=(2.9 * len(methods) + 0.8, 3.0))
     axes = fig.subplots(1, len(methods), squeeze=False)[0]
     im = None
     for ax, m in zip(axes, methods, strict=True):
@@ -105,7 +113,7 @@ def recovery_map_figure(runs, cells, stem):
 def coverage_figure(runs, cells, stem):
     methods = _levels(runs, cells, "selection")
     noises = _levels(runs, cells, "force_noise")
-    fig = Figure(figsize=(6.4, 3.6))
+    fig = _figure(figsize=(6.4, 3.6))
     ax = fig.subplots()
     width = 0.8 / max(len(noises), 1)
     for j, s in enumerate(noises):
@@ -121,7 +129,7 @@ def coverage_figure(runs, cells, stem):
             lab.append(n)
         p, lo, hi = np.array(p), np.array(lo), np.array(hi)
         xs = np.arange(len(methods)) + (j - (len(noises) - 1) / 2) * width
-        ax.bar(xs, p, width * 0.9, yerr=[p - lo, hi - p], capsize=2,
+        ax.bar(xs, p, width * 0.9, yerr=_yerr(p, lo, hi), capsize=2,
                label=f"noise {_pct(s)}")
         for xx, n in zip(xs, lab, strict=True):
             if n:
@@ -146,7 +154,7 @@ def inclusion_figure(runs, cells, stem, truth_terms):
     noises = _levels(runs, cells, "force_noise")
     ok = [r for r in runs if r["status"] == "ok"]
     terms = sorted({t for r in ok for t in r["selected"]} | set(truth_terms))
-    fig = Figure(figsize=(2.6 * len(methods) + 0.8, 0.45 * len(terms) + 1.6))
+    fig = _figure(figsize=(2.6 * len(methods) + 0.8, 0.45 * len(terms) + 1.6))
     axes = fig.subplots(1, len(methods), squeeze=False, sharey=True)[0]
     im = None
     for ax, m in zip(axes, methods, strict=True):

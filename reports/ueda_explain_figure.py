@@ -4,15 +4,13 @@ Bonferroni gate, (b) the record's stroboscopic points over the start model's, (c
 final model's.  Writes PNG and PDF and returns the paths.
 """
 
-import matplotlib
+import numpy as np
+from matplotlib.patches import Patch
+from scipy.stats import chi2
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.patches import Patch  # noqa: E402
-from scipy.stats import chi2  # noqa: E402
+from ._mpl import colormap, save, subplots
 
-from .ueda_figures import _save  # noqa: E402
+_save = save
 
 __all__ = ["explain_figure"]
 
@@ -61,14 +59,14 @@ def _strobe_panel(ax, ver, label, color, title):
 
 def explain_figure(ex, stem):
     """The figure of an :class:`~discovery.oscillator.explain.Explanation`."""
-    fig, axes = plt.subplots(1, 3, figsize=(16, 4.8), gridspec_kw={"width_ratios": [1.3, 1, 1]})
+    fig, axes = subplots(1, 3, figsize=(16, 4.8), gridspec_kw={"width_ratios": [1.3, 1, 1]})
     ax = axes[0]
     its = ex.iterations
     ids = [s["effect"] for s in its[0].scores] if its else []
     for it in its[1:]:
         ids += [s["effect"] for s in it.scores if s["effect"] not in ids]
     width = 0.8 / max(len(ids), 1)
-    colors = plt.get_cmap("tab10")
+    colors = colormap("tab10")
     for k, it in enumerate(its):
         for s in it.scores:
             j = ids.index(s["effect"])

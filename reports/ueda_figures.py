@@ -1,16 +1,15 @@
-"""Figures of Ueda's oscillators (matplotlib, Agg): the attractor (the paper's Figs. 1-2:
-stroboscopic points, and a trajectory in the (x, x') plane), the regime chart, the basins
-and the verification of a discovered equation (record's strobe points vs the model's).
+"""Figures of Ueda's oscillators (matplotlib Figures, no pyplot): the attractor (the
+paper's Figs. 1-2: stroboscopic points, and a trajectory in the (x, x') plane), the regime
+chart, the basins and the verification of a discovered equation (record's strobe points vs
+the model's).
 
 Each function writes PNG and PDF and returns the paths.
 """
 
-import matplotlib
+import numpy as np
+from matplotlib.colors import ListedColormap
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.colors import ListedColormap  # noqa: E402
+from ._mpl import colormap, save, subplots
 
 __all__ = ["attractor_figure", "chart_figure", "basins_figure", "discover_figure"]
 
@@ -18,19 +17,14 @@ _KIND_COLORS = ("#9ecae1", "#a1d99b", "#fdd0a2", "#e6550d")  # P1, Pn, beat, cha
 _KIND_LABELS = ("synchronisation (P1)", "subharmonic (Pn)", "beat (quasi-periodic)", "chaos")
 
 
-def _save(fig, stem):
-    paths = [f"{stem}.png", f"{stem}.pdf"]
-    fig.savefig(paths[0], dpi=130, bbox_inches="tight")
-    fig.savefig(paths[1], bbox_inches="tight")
-    plt.close(fig)
-    return paths
+_save = save
 
 
 def attractor_figure(att, stem):
     """(a) the stroboscopic points ``(x, x')`` at ``t = 2 pi k / nu``; (b) a stretch of
     trajectory in the ``(x, x')`` plane with the strobe points on it."""
     s = att.system
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.8))
+    fig, axes = subplots(1, 2, figsize=(11, 4.8))
     ax = axes[0]
     ax.plot(att.strobe[:, 0], att.strobe[:, 1], ".", ms=1.2, color="k")
     ax.set_xlabel("x")
@@ -64,7 +58,7 @@ def chart_figure(ch, stem):
     in both directions, the points where the two sweeps ended on different attractors
     (coexisting attractors: hysteresis) marked ``x``."""
     kind = np.where(ch.kind < 0, np.nan, ch.kind.astype(float))
-    fig, ax = plt.subplots(figsize=(8, 6.4))
+    fig, ax = subplots(figsize=(8, 6.4))
     nu, B = ch.nu, ch.B
 
     def edges(a):
@@ -143,9 +137,9 @@ def chart_figure(ch, stem):
 def basins_figure(bas, stem):
     """The grid of initial states coloured by the attractor each reaches, beside the
     attractors' strobe points."""
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.8))
+    fig, axes = subplots(1, 2, figsize=(11, 4.8))
     n = len(bas.attractors)
-    cmap = plt.get_cmap("tab10")
+    cmap = colormap("tab10")
     ax = axes[0]
     ax.pcolormesh(bas.x0, bas.v0, bas.label, cmap=ListedColormap([cmap(k) for k in range(n)]),
                   vmin=-0.5, vmax=n - 0.5, shading="nearest")
@@ -169,7 +163,7 @@ def discover_figure(disc, ver, stem):
     """(a) the record's stroboscopic points over the discovered model's; (b) the
     coefficients with their standard errors (bars: 2 SE); (c) the energy distance
     against its noise floor (random halves of the record)."""
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8), layout="constrained",
+    fig, axes = subplots(1, 3, figsize=(15, 4.8), layout="constrained",
                              gridspec_kw={"width_ratios": [1.3, 1, 1]})
     ax = axes[0]
     ms, rs = ver.model_strobe, ver.record_strobe

@@ -454,3 +454,23 @@ def test_api_bad_input(workspace, case):
     msg = str(exc.value)
     assert needle in msg and "\n" not in msg, (name, msg)
     assert _snapshot(workspace) == before
+
+
+@pytest.mark.parametrize("exc", [ValueError("operands could not be broadcast together"),
+                                 TypeError("unsupported operand"), IndexError("index 5")])
+def test_a_bug_is_exit_1_not_bad_input(monkeypatch, capsys, exc):
+    """Only the package's own errors (VidiError) are bad input (exit 2); a numpy shape error
+    or any other exception from a bug is exit 1 with one line asking for a report."""
+    import importlib
+
+    R = importlib.import_module("discovery.response")  # the module (its function shadows it)
+
+    def broken(*args, **kwargs):
+        raise exc
+
+    monkeypatch.setattr(R, "response", broken)
+    from discovery.cli import main
+
+    assert main(["steady", "--scenario", "paper"]) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("vidi: error: internal error") and len(err.splitlines()) == 1, err

@@ -391,7 +391,7 @@ def _run(argv):
         stop = _interruption(exc)  # an interrupt re-raised by compiled code or a solver
         if stop is not None:
             return _stopped(stop)
-        if isinstance(exc, VidiError | ValueError):  # ValueError: the packages' validation
+        if isinstance(exc, VidiError):  # bad input or failed numerics, by type
             _error(exc)
             return 2
         if isinstance(exc, OSError):  # the environment: disk full, permissions, a vanished file

@@ -10,18 +10,19 @@ from ..errors import InputError, IntegrationError
 from ..law import ForceLaw
 from ..scenario import Scenario
 from . import _kernel as K
+from .status import message as status_message
 
 __all__ = ["Trajectory", "simulate", "Tolerances", "MODE_NAMES", "EVENT_NAMES"]
 
 MODE_NAMES = {K.FREE: "free", K.LOAD: "load", K.UNLOAD: "unload", K.CLIPPED: "clipped"}
 EVENT_NAMES = {K.EV_ONSET: "onset", K.EV_LOSS: "loss", K.EV_UNLOAD: "unload",
                K.EV_RELOAD: "reload", K.EV_RELEASE: "release", K.EV_RESUME: "resume"}
-_STATUS = {
-    K.STEP_BUDGET: ("the step budget was exhausted (a law too stiff or too fast for the "
-                    "machine: check the coefficients' units; API: Tolerances(max_steps=...))"),
-    K.BLOW_UP: "the solution blew up (non-finite state); check the law's coefficients and signs",
-    K.STEP_UNDERFLOW: "the step size underflowed; the law may be too stiff for this tolerance",
-    K.CHATTER: "the contact mode switched back and forth without progress (chattering)",
+# what to check when the vibro-impact kernel fails (after the meaning from .status)
+_HINTS = {
+    K.STEP_BUDGET: (" (a law too stiff or too fast for the machine: check the coefficients' "
+                    "units; API: Tolerances(max_steps=...))"),
+    K.BLOW_UP: "; check the law's coefficients and signs",
+    K.STEP_UNDERFLOW: "; the law may be too stiff for this tolerance",
 }
 
 
@@ -62,6 +63,16 @@ class Tolerances:
             raise InputError(f"max_steps must be a positive integer, got {self.max_steps!r}")
         if not (0 < self.hmax_fraction <= 1):
             raise InputError(f"hmax_fraction must be in (0, 1], got {self.hmax_fraction!r}")
+
+    def atol(self, scale):
+        """Absolute tolerances ``rtol * atol_scale * scale`` for states of size ``scale``."""
+        return self.rtol * self.atol_scale * np.asarray(scale, dtype=float)
+
+    @property
+    def atol_variational(self):
+        """Absolute tolerance of the variational (tangent) equations: ``rtol * atol_scale``
+        (tangent vectors are normalised)."""
+        return self.rtol * self.atol_scale
 
     def as_dict(self):
         return {"rtol": self.rtol, "atol_scale": self.atol_scale, "max_steps": self.max_steps,
@@ -159,7 +170,7 @@ def kernel_params(scenario, law):
 
 def _atol(scenario, tol):
     x, v = scenario.scales()
-    return tol.rtol * tol.atol_scale * np.array([x, v, x, v])
+    return tol.atol([x, v, x, v])
 
 
 @params(
@@ -224,7 +235,7 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, tolerances=None,
         ea, eb, br, tol.rtol, _atol(scenario, tol), period / 100.0, period * tol.hmax_fraction,
         tol.max_steps, te, out_y, out_f, out_m, ev_t, ev_k, ev_y, ev_m)
     message = "ok" if status == 0 else (
-        f"integration stopped at t = {tf:.6g} s: {_STATUS[status]}")
+        f"integration stopped at t = {tf:.6g} s: {status_message(status, _HINTS)}")
     if status and throw:
         raise IntegrationError(message)
     n_keep = min(n_ev, max_events)

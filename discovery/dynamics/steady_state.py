@@ -32,7 +32,8 @@ from .shooting import (
     recurrence,
     smallest_period,
 )
-from .simulate import _STATUS, Tolerances, _atol, kernel_params, simulate
+from .simulate import _HINTS, Tolerances, _atol, kernel_params, simulate
+from .status import message as status_message
 
 __all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
 
@@ -94,7 +95,7 @@ class StroboscopicMap:
             self.zeta_max = float(p[K.P_ZMAX])
         if status != K.OK:
             raise IntegrationError(f"simulation of law '{self.law}' stopped at t = {tf:.6g} s: "
-                                   f"{_STATUS[status]}")
+                                   f"{status_message(status, _HINTS)}")
         if not np.all(np.abs(yf) < 1e6 * self.scale.max() + 1e3):
             raise IntegrationError(
                 f"simulation of law '{self.law}' left the physical range at t = {tf:.6g} s "

@@ -81,7 +81,7 @@ class Effect:
             object.__setattr__(self, "target", "term")
             object.__setattr__(self, "key", self.terms[0])
         if self.target not in TARGETS or not self.key:
-            raise ValueError(f"effect {self.id}: target must be one of {TARGETS}, with a key")
+            raise InputError(f"effect {self.id}: target must be one of {TARGETS}, with a key")
 
     def applicable(self, model):
         """Whether the effect can still be added to ``model`` (its parameter is zero)."""

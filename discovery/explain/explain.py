@@ -53,13 +53,13 @@ from ..errors import InputError, IntegrationError
 from ..executor import make_executor
 from ..identify import (
     as_records,
+    bootstrap_intervals,
     contact_scales,
     cycle_pairs,
     identify,
     pair_records,
     record_start,
 )
-from ..intervals import bootstrap_intervals
 from ..law import ForceLaw, Term
 from ..measurement import Measurement
 from ..scenario import Scenario

@@ -14,44 +14,20 @@ import numpy as np
 from .._printing import generic_lines, readable
 from .._validate import Array, Real, params
 from ..dynamics import Tolerances
-from ..errors import InputError, IntegrationError
+from ..errors import IntegrationError
 from . import _kernel as UK
+from ._runs import budget as _budget
+from ._runs import check as _check
+from ._runs import initial_state as _y0
+from ._runs import setup as _setup
+from .periodic import periodic_orbit
 from .system import UedaSystem
 
 __all__ = ["Lyapunov", "Regime", "Attractor", "Basins", "strobe_points", "trajectory",
            "lyapunov", "lyapunov_two_trajectory", "classify", "attractor", "basins",
            "rotation_number", "REGIMES"]
 
-_STATUS = {1: "the step budget was exhausted", 2: "the solution blew up (non-finite state)",
-           3: "the step size underflowed"}
 REGIMES = ("P1", "Pn", "beat", "chaotic")
-DEFAULT_Y0 = (0.1, 0.0)
-
-
-def _budget(tol, n_periods):
-    """Step budget of a run: ``max_steps`` per 100 periods."""
-    return tol.max_steps * (1 + int(n_periods) // 100)
-
-
-def _check(status, t, what):
-    if status != UK.OK:
-        raise IntegrationError(f"{what} stopped at t = {t:.6g}: {_STATUS.get(status, status)}")
-
-
-def _setup(system, tolerances):
-    if not isinstance(system, UedaSystem):
-        raise TypeError("system must be a discovery.oscillator.UedaSystem")
-    tol = tolerances or Tolerances()
-    T = system.period
-    atol = tol.rtol * tol.atol_scale * system.scales()
-    return tol, T, atol, T * tol.hmax_fraction
-
-
-def _y0(y0):
-    y = np.array(DEFAULT_Y0 if y0 is None else y0, dtype=float).reshape(-1)
-    if y.shape != (2,) or not np.all(np.isfinite(y)):
-        raise InputError(f"the initial state must be two finite numbers (x, x'), got {y0!r}")
-    return y
 
 
 @params(
@@ -174,7 +150,7 @@ def _variational(system, y, t0, periods, tol, T, atol, hmax):
     n = int(periods)
     logs, trace, strobe = np.empty((n, 2)), np.empty(n), np.empty((n, 2))
     status, t, yf, _ = UK.variational_run(float(t0), y, system.params(), T, n, tol.rtol, atol,
-                                          tol.rtol * tol.atol_scale, hmax,
+                                          tol.atol_variational, hmax,
                                           _budget(tol, n), logs, trace, strobe)
     _check(status, t, "the variational equations")
     return logs, trace, strobe, yf
@@ -346,10 +322,8 @@ def classify_points(strobe, scale, lam, lam_stderr=0.0, *, max_period=8, closure
                   f"0): an invariant closed curve, rotation number {rho:.4f}")
     return Regime("beat", "beat", 0, ev)
 
-
 def _shoot(period_map, y, n, tol, ev):
     """Shooting for the period-``n`` orbit near ``y``; its evidence into ``ev``."""
-    from .periodic import periodic_orbit
 
     try:
         orb = periodic_orbit(period_map.system, y, n, tol=tol, period_map=period_map)

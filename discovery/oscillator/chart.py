@@ -42,10 +42,13 @@ from .._printing import readable
 from .._validate import Array, Instance, Real, params
 from ..dynamics import Tolerances
 from ..dynamics._dopri import OK
-from ..errors import InputError, IntegrationError
+from ..errors import InputError, IntegrationError, VidiTypeError
 from ..executor import make_executor
 from . import _kernel as UK
-from .attractor import _budget, _check, _y0, classify_points
+from ._runs import budget as _budget
+from ._runs import check as _check
+from ._runs import initial_state as _y0
+from .attractor import classify_points
 from .system import UedaSystem
 
 __all__ = ["Chart", "chart", "KINDS"]
@@ -335,7 +338,7 @@ def _recurrence(strobe, inv_scale, max_period, closure, min_pairs):
 def _stable_orbit(y, p, T, n, tol, atol, hmax):
     """``log|m_1| / (n T)`` of the period-``n`` orbit through ``y`` (its monodromy over
     ``n`` periods); NaN when it is not stable (``|m_1| >= 1``)."""
-    status, t, M, logs, _ = _monodromy(y, p, T, n, tol.rtol, atol, tol.rtol * tol.atol_scale,
+    status, t, M, logs, _ = _monodromy(y, p, T, n, tol.rtol, atol, tol.atol_variational,
                                        hmax, _budget(tol, n))
     _check(status, t, "the variational equations")
     log1, _ = _floquet(M, logs)
@@ -348,7 +351,7 @@ def _point(system, y, s, tol, buffers=None):
     p = system.params()
     scale = system.scales()
     inv = 1.0 / scale
-    atol = tol.rtol * tol.atol_scale * scale
+    atol = tol.atol(scale)
     hmax = T * tol.hmax_fraction
     n_tr, n_obs, P, closure = s["transient"], s["periods"], s["max_period"], s["closure"]
     if buffers is None:
@@ -377,7 +380,7 @@ def _point(system, y, s, tol, buffers=None):
     trace = np.empty(n_obs)
     obs = np.empty((n_obs, 2))
     status, t, yf, _ = UK.variational_run(0.0, y, p, T, n_obs, tol.rtol, atol,
-                                          tol.rtol * tol.atol_scale, hmax,
+                                          tol.atol_variational, hmax,
                                           _budget(tol, n_obs), logs, trace, obs)
     _check(status, t, "the variational equations")
     cost += n_obs
@@ -540,7 +543,7 @@ def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_f
     Chart
     """
     if not isinstance(system, UedaSystem):
-        raise TypeError("system must be a discovery.oscillator.UedaSystem")
+        raise VidiTypeError("system must be a discovery.oscillator.UedaSystem")
     nu, B = _axis(nu, "nu"), _axis(B, "B")
     if nu[0] <= 0:
         raise InputError("nu must be > 0")

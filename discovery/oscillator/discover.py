@@ -58,8 +58,6 @@ __all__ = ["TERMS", "MONOMIALS", "FORCING", "ForcedPolynomial", "Discovery", "Ve
 MONOMIALS = ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2), (3, 0), (2, 1), (1, 2), (0, 3))
 TERMS = ("1", "x", "x'", "x^2", "x x'", "x'^2", "x^3", "x^2 x'", "x x'^2", "x'^3")
 FORCING = "B cos(nu t)"
-_STATUS = {1: "the step budget was exhausted", 2: "the solution blew up (non-finite state)",
-           3: "the step size underflowed"}
 
 
 # ------------------------------------------------------------------ the equation
@@ -280,30 +278,28 @@ def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20
     Returns ``(strobe, Lyapunov)``; raises :class:`IntegrationError` when the solution
     blows up (``|x|`` or ``|x'|`` above 1e6).
     """
+    from ._runs import budget as _budget
+    from ._runs import check
     from .attractor import Lyapunov as _Lyap
-    from .attractor import _batch_stats, _budget
+    from .attractor import _batch_stats
 
     tol = tolerances or Tolerances()
     T = model.period
-    atol = tol.rtol * tol.atol_scale * model.scales()
+    atol = tol.atol(model.scales())
     hmax = T * tol.hmax_fraction
     p = model.params()
     y = np.asarray(y0, dtype=float).copy()
     if transient > 0:
         status, t, y = _strobe_run(float(t0), y, p, T, int(transient), tol.rtol, atol, hmax,
                                    _budget(tol, transient))
-        if status != OK:
-            raise IntegrationError(f"the discovered equation stopped at t = {t:.6g}: "
-                                   f"{_STATUS.get(status, status)}")
+        check(status, t, "the discovered equation")
     n = int(periods)
     logs, trace, strobe = np.empty((n, 2)), np.empty(n), np.empty((n, 2))
     t_start = float(t0) + int(transient) * T
     status, t, _, _ = _variational_run(t_start, y, p, T, n, tol.rtol, atol,
-                                       tol.rtol * tol.atol_scale, hmax, _budget(tol, n),
+                                       tol.atol_variational, hmax, _budget(tol, n),
                                        logs, trace, strobe)
-    if status != OK:
-        raise IntegrationError(f"the discovered equation stopped at t = {t:.6g}: "
-                               f"{_STATUS.get(status, status)}")
+    check(status, t, "the discovered equation")
     bv, se = _batch_stats(logs, T, batches)
     lam = logs.sum(axis=0) / (n * T)
     lyap = _Lyap(value=float(lam[0]), stderr=float(se[0]), second=float(lam[1]),

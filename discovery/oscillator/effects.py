@@ -91,7 +91,8 @@ EFFECTS = (
 
 for _e in EFFECTS:
     if not set(_e.terms) <= set(TERMS):  # a catalogue error, caught on import
-        raise RuntimeError(f"effect {_e.id}: terms {_e.terms} not in the library {TERMS}")
+        raise AssertionError(f"catalogue: effect {_e.id}: terms {_e.terms} not in the "
+                             f"library {TERMS}")
 
 
 def effect(effect_id):

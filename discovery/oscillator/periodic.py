@@ -27,8 +27,12 @@ import numpy as np
 from .._validate import Array, Real, params
 from ..dynamics import Tolerances
 from ..dynamics.shooting import floquet_multipliers, is_stable, newton_orbit, smallest_period
+from ..errors import InputError
 from . import _kernel as UK
-from .attractor import _budget, _check, _setup, _y0
+from ._runs import budget as _budget
+from ._runs import check as _check
+from ._runs import initial_state as _y0
+from ._runs import setup as _setup
 from .system import UedaSystem
 
 __all__ = ["UedaMap", "PeriodicOrbit", "periodic_orbit"]
@@ -61,7 +65,7 @@ class UedaMap:
 
     def __init__(self, system, tolerances=None, difference="central", fd_step=None):
         if difference not in ("central", "forward"):
-            raise ValueError(f"difference must be 'central' or 'forward', got {difference!r}")
+            raise InputError(f"difference must be 'central' or 'forward', got {difference!r}")
         self.system = system
         self.difference = difference
         self.tol, self._T, self._atol, self._hmax = _setup(system, tolerances)
@@ -83,7 +87,7 @@ class UedaMap:
         """``Phi^n(y)``: the state ``n`` forcing periods after ``y`` (taken at phase 0)."""
         n = int(n)
         if n < 1:
-            raise ValueError(f"n must be >= 1, got {n}")
+            raise InputError(f"n must be >= 1, got {n}")
         status, t, yf, steps, _ = UK.strobe_run(
             0.0, np.asarray(y, dtype=float), self._p, self._T, n - 1, 1, self.tol.rtol,
             self._atol, self._hmax, _budget(self.tol, n), self._te, self._oe, self._out)

@@ -36,7 +36,9 @@ def wilson(k, n, z=Z95):
     den = 1 + z * z / n
     mid = (p + z * z / (2 * n)) / den
     half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / den
-    return (max(0.0, mid - half), min(1.0, mid + half))
+    lo, hi = max(0.0, mid - half), min(1.0, mid + half)
+    # exact at the ends (rounding would put the bound a hair inside)
+    return (0.0 if k == 0 else min(lo, p), 1.0 if k == n else max(hi, p))
 
 
 def _factor_text(name, value):

@@ -28,7 +28,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .._io import MANIFEST, atomic_write_text, check_output, git_state, provenance, to_jsonable
+from .._io import MANIFEST, atomic_write_text, check_output, provenance, to_jsonable
 from .._printing import readable
 from .._progress import tick
 from .._validate import Instance, Real, Text, params
@@ -44,15 +44,28 @@ _FIT_DEFAULTS = {"n_boot_intervals": 0}
 
 
 def code_version():
-    """The package version and, in a git checkout, its commit: part of every run's key."""
+    """The package version and a hash of its source (every ``.py`` file of ``discovery`` and
+    ``constraints``): part of every run's key, so a change of the code that computes a run
+    gives new runs, and a change of anything else (documentation, tests) keeps them."""
     from importlib import metadata
 
     try:
         version = metadata.version("vibroimpact-discovery")
     except metadata.PackageNotFoundError:
         version = "unknown"
-    commit, _ = git_state()
-    return f"{version}+{commit[:12]}" if commit else version
+    return f"{version}+src.{_source_hash()}"
+
+
+def _source_hash():
+    import hashlib
+
+    root = Path(__file__).resolve().parents[2]
+    h = hashlib.sha256()
+    for pkg in ("discovery", "constraints"):
+        for path in sorted((root / pkg).rglob("*.py")):
+            h.update(str(path.relative_to(root)).encode())
+            h.update(path.read_bytes())
+    return h.hexdigest()[:12]
 
 
 def _read_run(path):

@@ -16,6 +16,7 @@ a small factor of it agrees with the record as well as the truth could.
 import numpy as np
 
 from ..criteria import CRITERIA, evaluate_criteria
+from ..errors import InputError
 from ..impulse import impulse_from_samples
 from .evaluate import align
 
@@ -77,7 +78,7 @@ def noise_floor(reference_impulse, period, dt, *, sigma_f, n_cycles, sigma_zeta=
             zeta = zeta + rng.normal(0.0, sigma_zeta, t.size)
         try:
             rep = impulse_from_samples(t, F, period, zeta=zeta, n_periods=E.n_periods)
-        except ValueError:
+        except InputError:
             continue  # a replicate too noisy to find its contacts: the floor is high anyway
         # aligned like a record (every impact of the stand-in tried as t*): with several
         # impacts of similar size the replicate's main impact is either one

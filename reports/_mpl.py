@@ -1,0 +1,28 @@
+"""Figures drawn on ``matplotlib.figure.Figure`` objects: no pyplot, so drawing a report
+never switches the backend of a notebook or a GUI session that imported ``discovery``."""
+
+from matplotlib import colormaps
+from matplotlib.figure import Figure
+
+__all__ = ["subplots", "save", "colormap"]
+
+_FIGURE_KEYS = ("figsize", "dpi", "layout")
+
+
+def subplots(nrows=1, ncols=1, **kwargs):
+    """``(figure, axes)`` like ``pyplot.subplots``, on a standalone Figure."""
+    fig = Figure(**{k: kwargs.pop(k) for k in _FIGURE_KEYS if k in kwargs})
+    return fig, fig.subplots(nrows, ncols, **kwargs)
+
+
+def save(fig, stem, dpi=130):
+    """The figure as ``stem.png`` and ``stem.pdf``; returns both paths."""
+    paths = [f"{stem}.png", f"{stem}.pdf"]
+    fig.savefig(paths[0], dpi=dpi, bbox_inches="tight")
+    fig.savefig(paths[1], bbox_inches="tight")
+    return paths
+
+
+def colormap(name):
+    """A registered colormap by name."""
+    return colormaps[name]
