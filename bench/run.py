@@ -103,6 +103,41 @@ def bench_landscape(sc):
             "goal": "<= 4 s on 2 cores; <= 0.3 steady-state equivalents per point"}
 
 
+def bench_study():
+    """A small study (the paper's law, 2 noise levels x 2 methods x 4 seeds, regression only:
+    16 runs) serially, on the local process pool and on a Dask LocalCluster, each from
+    scratch, in the same run: the executors' speed-ups and whether their tables agree."""
+    import tempfile
+
+    from discovery.studies import study
+
+    cfg = {"name": "bench", "seeds": 4,
+           "factors": {"force_noise": [0.01, 0.05], "periods": [6],
+                       "library": ["z, zd, z^2, z*zd"], "selection": ["best-subset", "stlsq"],
+                       "refine": [False]}}
+    out, tables = {}, {}
+    runs = [("serial", {"workers": 1}), ("pool_2", {"workers": 2})]
+    try:
+        import distributed  # noqa: F401
+
+        runs.append(("dask_local_2", {"scheduler": "local", "workers": 2}))
+    except ImportError:
+        pass
+    with tempfile.TemporaryDirectory() as d:
+        for name, kw in runs:
+            t0 = time.perf_counter()
+            res = study(cfg, Path(d) / name, figures=False, **kw)
+            out[name + "_seconds"] = time.perf_counter() - t0
+            tables[name] = [{k: v for k, v in row.items() if "seconds" not in k}
+                            for row in res.cells]
+    for name, _ in runs[1:]:
+        out[name + "_speedup"] = out["serial_seconds"] / out[name + "_seconds"]
+        out[name + "_same_table"] = tables[name] == tables["serial"]
+    out["runs"] = 16
+    out["note"] = "each executor's time includes its start-up (a LocalCluster takes seconds)"
+    return out
+
+
 def bench_start_up(repeat=5):
     """``vidi --help`` and ``import discovery`` against a bare interpreter start, measured
     in the same run (best of ``repeat``), as ratios and extra seconds."""
@@ -157,7 +192,8 @@ def main():
     steady_state(sc, sc.law)  # compile / load the cached kernels first
     results = {"start_up": bench_start_up(), "kernel_vs_scipy": bench_kernel(sc),
                "landscape_41x41": bench_landscape(sc),
-               "identification": bench_identify(sc), "discovery": bench_discovery(),
+               "identification": bench_identify(sc), "study": bench_study(),
+               "discovery": bench_discovery(),
                "pipeline": bench_pipeline(), "explain": bench_explain(), "ueda": bench_ueda(),
                "cores": os.cpu_count(),
                **provenance({"scenario": "paper"})}
@@ -177,6 +213,10 @@ def main():
           f"({L['cold_steady_state_equivalents_per_point']:.2f}): "
           f"{L['continuation_speedup']:.1f}x; same regimes {L['same_regimes']}, criteria "
           f"within {L['max_criterion_difference']:.1e}")
+    st = results["study"]
+    print("study (16 runs): serial {:.1f} s; ".format(st["serial_seconds"]) + "; ".join(
+        f"{k[:-8]} {st[k]:.1f}x (same table {st[k[:-8] + '_same_table']})"
+        for k in st if k.endswith("_speedup")))
     for m in METHODS:
         print(f"identify {m}: {idf[m]['simulations_to_0.1%']} simulations to 0.1 % "
               f"({idf[m]['fewer_than_coordinate_descent']} x fewer than coordinate descent)")
