@@ -39,6 +39,7 @@ from .errors import InputError
 __all__ = ["Executor", "Serial", "Pool", "Dask", "make_executor"]
 
 _CONTEXT = {}  # the context of the sweep running in this (worker) process
+_THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
 
 
 def _set_context(context):
@@ -149,8 +150,18 @@ class Dask(Executor):
             # compile (or load) the kernels here first: the workers then only read the cache
             _warm_worker()
             n = max(1, int(workers or os.cpu_count() or 1))
-            self._cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                         dashboard_address=None, silence_logs=50)
+            import dask
+
+            # the workers get this process's BLAS/OpenMP thread settings, like the pool's
+            # forked workers (Dask sets them to 1 by default; a BLAS initialised with
+            # another thread count can sum in another order and move an optimiser's path)
+            environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ",
+                                                        {}).items() if k not in _THREAD_VARS}
+            environ.update({k: os.environ[k] for k in _THREAD_VARS if k in os.environ})
+            with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
+                self._cluster = LocalCluster(n_workers=n, threads_per_worker=1,
+                                             processes=True, dashboard_address=None,
+                                             silence_logs=50)
             self.client = Client(self._cluster)
         else:
             try:
