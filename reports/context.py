@@ -445,10 +445,12 @@ def _study(s, run_dir):
                     num(row.get("coef_error_median"), 2)] for row in cells]}
     concl = []
     if pooled:
-        best = max(pooled.items(), key=lambda kv: (kv[1]["recovered"] / max(kv[1]["runs"], 1)))
-        m, p = best
-        concl.append(f"Across the study, {m} recovered the exact true support most often: "
-                     f"{p['recovered']} of {p['runs']} runs.")
+        rate = {m: p["recovered"] / max(p["runs"], 1) for m, p in pooled.items()}
+        top = [m for m in pooled if rate[m] == max(rate.values())]
+        p = pooled[top[0]]
+        concl.append(f"Across the study, {' and '.join(top)} recovered the exact true support "
+                     f"most often: {p['recovered']} of {p['runs']} runs"
+                     + (" each." if len(top) > 1 else "."))
         for m, p in pooled.items():
             if p["intervals"]:
                 share = p["covered"] / p["intervals"]
