@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed
 TEX_PACKAGES := latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended \
 	lmodern poppler-utils
 
-.PHONY: install demo test test-fast bench lint clean tex
+.PHONY: install demo study test test-fast bench lint clean tex
 
 install: $(STAMP)
 
@@ -49,6 +49,12 @@ demo: install
 	$(BIN)/vidi report $(DEMO)/fit
 	$(BIN)/vidi report $(DEMO)/explain
 	@echo "demo done: read $(DEMO)/explain/report.pdf (or report.tex without TeX: make tex)"
+
+# The shipped model-term selection study (120 runs, ~18 min on two cores; resumable: run it
+# again after an interruption), then its report
+study: install
+	$(BIN)/vidi study --config examples/study_paper.toml --out out/study
+	$(BIN)/vidi report out/study
 
 # TeX Live for `vidi report` PDFs (optional: without it the reports are .tex files)
 tex:
