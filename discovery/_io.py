@@ -57,7 +57,7 @@ import numpy as np
 from .errors import InputError
 
 __all__ = ["OutputDir", "provenance", "to_jsonable", "check_output", "atomic_write_text",
-           "file_sha256", "git_state", "clean_stale", "set_run", "MANIFEST"]
+           "file_sha256", "git_state", "clean_stale", "set_run", "running", "MANIFEST"]
 
 # the solvers cvxpy uses here: CLARABEL (default), OSQP (fallback in the regression)
 _PACKAGES = ("vibroimpact-discovery", "numpy", "scipy", "numba", "sympy", "cvxpy", "clarabel",
@@ -82,6 +82,19 @@ def set_run(command, overwrite=False):
     """The command this process runs (``"verify"``, ``"ueda simulate"``, ...) and whether
     the user allowed replacing another command's results (``--overwrite``)."""
     _RUN.update(command=command, overwrite=bool(overwrite))
+
+
+@contextlib.contextmanager
+def running(command):
+    """Within the block this process runs ``command`` (an API call such as ``study`` that
+    owns its output directory like the CLI command of that name); ``--overwrite`` carries
+    over only from the same command."""
+    prev = dict(_RUN)
+    set_run(command, prev["overwrite"] and prev["command"] == command)
+    try:
+        yield
+    finally:
+        _RUN.update(prev)
 
 
 def _owner(directory):

@@ -254,3 +254,24 @@ def test_study_refuses_a_directory_that_is_not_a_study(tmp_path):
     with pytest.raises(InputError):
         study(QUICK, tmp_path, workers=1)
     assert (tmp_path / "mine.txt").read_text() == "notes"
+
+
+def test_study_owns_its_directory_whatever_ran_before(tmp_path):
+    """An earlier CLI command in the same process (here `vidi report`) does not make the API
+    refuse a study directory as another command's results."""
+    from discovery._io import _RUN, set_run
+
+    out = tmp_path / "s"
+    study({**QUICK, "seeds": 1, "factors": {**QUICK["factors"], "force_noise": [0.01],
+                                            "selection": ["best-subset"]}}, out, workers=1,
+          figures=False)
+    prev = dict(_RUN)
+    set_run("report")
+    try:
+        again = study({**QUICK, "seeds": 1, "factors": {**QUICK["factors"],
+                                                        "force_noise": [0.01],
+                                                        "selection": ["best-subset"]}},
+                      out, workers=1, figures=False)
+    finally:
+        _RUN.update(prev)
+    assert again.reused == 1 and again.executed == 0

@@ -28,7 +28,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .._io import MANIFEST, atomic_write_text, check_output, provenance, to_jsonable
+from .._io import MANIFEST, atomic_write_text, check_output, provenance, running, to_jsonable
 from .._printing import readable
 from .._progress import tick
 from .._validate import Instance, Real, Text, params
@@ -222,7 +222,8 @@ def study(config, out, *, workers=None, scheduler=None, executor=None, progress=
     t0 = time.perf_counter()
     cfg = load_study(config)
     cfg = StudyConfig(**{**cfg.__dict__, "fit": {**_FIT_DEFAULTS, **cfg.fit}})
-    out = check_output(out, [cfg.source] if cfg.source else [])
+    with running("study"):  # the directory is a study's, whatever ran before in this process
+        out = check_output(out, [cfg.source] if cfg.source else [])
     version = code_version()
     runs = cfg.runs(version)
     rundir = out / "runs"
