@@ -26,8 +26,7 @@ def _data(n=10_000, seed=1):
     sc = load_scenario("paper")
     m = synthesize(sc, ForceLaw.parse(TRUE), periods=300, noise=0.01, seed=seed, from_rest=True)
     cs = contact_samples(m)
-    rows = np.sort(np.random.default_rng(seed).choice(len(cs), size=min(n, len(cs)),
-                                                      replace=False))
+    rows = np.sort(np.random.default_rng(seed).choice(len(cs), size=min(n, len(cs)), replace=False))
     return cs.X[rows], cs.F[rows], cs.impact[rows]
 
 
@@ -44,8 +43,18 @@ def _pysindy_grid(est_template, X, y, grid=30, thr=0.05):
     import pysindy as ps
 
     est = est_template
-    prob = _Problem(est.library_, est.box_, X, y, np.ones(y.size), margin=0.0, monotone=False,
-                    signs=None, elevation=2, solver="CLARABEL")
+    prob = _Problem(
+        est.library_,
+        est.box_,
+        X,
+        y,
+        np.ones(y.size),
+        margin=0.0,
+        monotone=False,
+        signs=None,
+        elevation=2,
+        solver="CLARABEL",
+    )
     lib = est.library_
     Z, V = est.box_.zeta_max, est.box_.zd_max
     zz, vv = np.meshgrid(np.linspace(0, Z, grid), np.linspace(0, V, grid))
@@ -54,9 +63,14 @@ def _pysindy_grid(est_template, X, y, grid=30, thr=0.05):
     P0 = lib.transform(np.column_stack([pts[:, 0], np.zeros(len(pts))])) / prob.scale
     lhs = -np.vstack([P, P - P0])  # pysindy: lhs @ x <= rhs  <=>  P x >= 0, (P - P0) x >= 0
     rhs = np.zeros(lhs.shape[0])
-    opt = ps.ConstrainedSR3(reg_weight_lam=thr, regularizer="L1", constraint_lhs=lhs,
-                            constraint_rhs=rhs, constraint_order="feature",
-                            inequality_constraints=True)
+    opt = ps.ConstrainedSR3(
+        reg_weight_lam=thr,
+        regularizer="L1",
+        constraint_lhs=lhs,
+        constraint_rhs=rhs,
+        constraint_order="feature",
+        inequality_constraints=True,
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         opt.fit(prob.A, prob.b)
@@ -69,13 +83,21 @@ def bench_discovery():
     true = ForceLaw.parse(TRUE).as_dict()
     out = {"samples": int(y.size), "library": LIBRARY}
     for max_terms in (4, 10):
-        t, est = _best(lambda mt=max_terms: ConstrainedSparseRegressor(
-            library=LIBRARY, max_terms=mt).fit(X, y, groups=g))
+        t, est = _best(
+            lambda mt=max_terms: ConstrainedSparseRegressor(library=LIBRARY, max_terms=mt).fit(
+                X, y, groups=g
+            )
+        )
         out[f"ours_max_terms_{max_terms}"] = {
-            "seconds": t, "law": est.law_.to_text(), "holds": est.certificate_.holds,
+            "seconds": t,
+            "law": est.law_.to_text(),
+            "holds": est.certificate_.holds,
             "worst_violation": est.certificate_.worst_violation,
-            "exact_zeros": int(np.sum(est.coef_ == 0)), "n_terms": len(est.library_),
-            "support_recovered": set(est.law_.names) == set(true), "cvxpy_solves": est.n_solves_}
+            "exact_zeros": int(np.sum(est.coef_ == 0)),
+            "n_terms": len(est.library_),
+            "support_recovered": set(est.law_.names) == set(true),
+            "cvxpy_solves": est.n_solves_,
+        }
     est = ConstrainedSparseRegressor(library=LIBRARY).fit(X, y, groups=g)
     t_ps, c_ps = _best(lambda: _pysindy_grid(est, X, y), repeat=1)
     lib = est.library_
@@ -83,12 +105,18 @@ def bench_discovery():
     big = np.abs(c_ps) > 1e-3 * np.max(np.abs(c_ps * 1.0))
     names = {t.name for t, b in zip(lib.terms, big, strict=True) if b}
     out["pysindy_constrained_sr3_grid30"] = {
-        "seconds": t_ps, "holds": cert.holds, "worst_violation": cert.worst_violation,
-        "exact_zeros": int(np.sum(c_ps == 0)), "n_terms": len(lib),
-        "support_recovered_exact_zeros": {t.name for t, c in zip(lib.terms, c_ps, strict=True)
-                                          if c != 0} == set(true),
+        "seconds": t_ps,
+        "holds": cert.holds,
+        "worst_violation": cert.worst_violation,
+        "exact_zeros": int(np.sum(c_ps == 0)),
+        "n_terms": len(lib),
+        "support_recovered_exact_zeros": {
+            t.name for t, c in zip(lib.terms, c_ps, strict=True) if c != 0
+        }
+        == set(true),
         "support_recovered_1e-3_cutoff": names == set(true),
-        "coefficients": {t.name: float(c) for t, c in zip(lib.terms, c_ps, strict=True)}}
+        "coefficients": {t.name: float(c) for t, c in zip(lib.terms, c_ps, strict=True)},
+    }
     out["time_ratio_pysindy_over_ours"] = t_ps / out["ours_max_terms_4"]["seconds"]
     out["goal"] = "certified fit of a 10-term library on 1e4 samples in <= 1 s"
     return out
@@ -116,9 +144,14 @@ def bench_pipeline(repeat=3):
     t_one, _ = _best(lambda: steady_state(sc, sc.law), repeat=5)
     rec = synthesize(sc, sc.law, periods=20, fs=20000, noise=0.01, seed=1)
     t_ver, res = _best(lambda: verify(sc, rec, sc.law), repeat=repeat)
-    out = {"one_steady_state_seconds": t_one,
-           "verify_20_periods": {"seconds": t_ver, "ratio_to_one_steady_state": t_ver / t_one,
-                                 "consistent": res.consistent}}
+    out = {
+        "one_steady_state_seconds": t_one,
+        "verify_20_periods": {
+            "seconds": t_ver,
+            "ratio_to_one_steady_state": t_ver / t_one,
+            "consistent": res.consistent,
+        },
+    }
     law = ForceLaw.parse(TRUE)
     t_ss, _ = _best(lambda: steady_state(sc, law), repeat=5)
     run_up = synthesize(sc, law, periods=100, noise=0.01, seed=1, from_rest=True)
@@ -131,14 +164,20 @@ def bench_pipeline(repeat=3):
             out[f"discover_{lib}"] = {"error": f"{type(exc).__name__}: {exc}"}
             continue
         t = time.perf_counter() - t0
-        out[f"discover_{lib}"] = {"seconds": t, "ratio_to_one_steady_state": t / t_ss,
-                                  "law": r.selected.law.to_text(),
-                                  "consistent": getattr(r.selected, "consistent", None)}
+        out[f"discover_{lib}"] = {
+            "seconds": t,
+            "ratio_to_one_steady_state": t / t_ss,
+            "law": r.selected.law.to_text(),
+            "consistent": getattr(r.selected, "consistent", None),
+        }
     return out
 
 
 if __name__ == "__main__":
     import json
 
-    print(json.dumps({"discovery": bench_discovery(), "pipeline": bench_pipeline()}, indent=2,
-                     default=str))
+    print(
+        json.dumps(
+            {"discovery": bench_discovery(), "pipeline": bench_pipeline()}, indent=2, default=str
+        )
+    )

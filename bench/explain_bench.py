@@ -43,12 +43,17 @@ def bench_explain(repeat=2):
         explain(sc, rec, "linear", workers=1)
         serial.append(time.perf_counter() - t0)
     t, t1 = float(np.min(times)), float(np.min(serial))
-    return {"seconds": t, "one_steady_state_seconds": t_ss,
-            "ratio_to_one_steady_state": t / t_ss, "seconds_one_worker": t1,
-            "parallel_speedup": t1 / t, "cores": os.cpu_count(),
-            "catalogue": [e.id for e in EFFECTS],
-            "named": [it.effect for it in res.iterations if it.effect],
-            "simulations": res.settings["simulations"]}
+    return {
+        "seconds": t,
+        "one_steady_state_seconds": t_ss,
+        "ratio_to_one_steady_state": t / t_ss,
+        "seconds_one_worker": t1,
+        "parallel_speedup": t1 / t,
+        "cores": os.cpu_count(),
+        "catalogue": [e.id for e in EFFECTS],
+        "named": [it.effect for it in res.iterations if it.effect],
+        "simulations": res.settings["simulations"],
+    }
 
 
 def _time(f):

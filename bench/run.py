@@ -58,26 +58,43 @@ def bench_kernel(sc):
     truth = reference_simulate(sc, sc.law, (ss.t0, ss.t0 + T), y0=ss.y0, t_eval=te, rtol=1e-13)
     # same method (Dormand-Prince 5(4)) and tolerance on both paths
     ref_rtol, fast_rtol = 1e-9, 1e-9
-    t_ref, ref = _best(lambda: reference_simulate(sc, sc.law, (ss.t0, ss.t0 + T), y0=ss.y0,
-                                                  t_eval=te, rtol=ref_rtol, method="RK45"),
-                       repeat=3)
+    t_ref, ref = _best(
+        lambda: reference_simulate(
+            sc, sc.law, (ss.t0, ss.t0 + T), y0=ss.y0, t_eval=te, rtol=ref_rtol, method="RK45"
+        ),
+        repeat=3,
+    )
     tol = Tolerances(rtol=fast_rtol)
-    t_fast, fast = _best(lambda: simulate(sc, sc.law, (ss.t0, ss.t0 + T), y0=ss.y0, t_eval=te,
-                                          tolerances=tol), repeat=20)
+    t_fast, fast = _best(
+        lambda: simulate(sc, sc.law, (ss.t0, ss.t0 + T), y0=ss.y0, t_eval=te, tolerances=tol),
+        repeat=20,
+    )
     x = sc.scales()[0]
     err_ref = float(np.max(np.abs(ref["y"][[0, 2]] - truth["y"][[0, 2]])) / x)
     err_fast = float(np.max(np.abs(fast.y[[0, 2]] - truth["y"][[0, 2]])) / x)
     # a long run (40 periods, the size of a steady-state search): per-step cost dominates
-    t40_ref, _ = _best(lambda: reference_simulate(sc, sc.law, (ss.t0, ss.t0 + 40 * T), y0=ss.y0,
-                                                  rtol=ref_rtol, method="RK45"), repeat=1)
-    t40_fast, _ = _best(lambda: simulate(sc, sc.law, (ss.t0, ss.t0 + 40 * T), y0=ss.y0,
-                                         tolerances=tol), repeat=5)
-    return {"long_run_40_periods_speedup": t40_ref / t40_fast,
-            "scipy_seconds": t_ref, "kernel_seconds": t_fast, "speedup": t_ref / t_fast,
-            "scipy_rtol": ref_rtol, "kernel_rtol": fast_rtol,
-            "scipy_max_error_rel": err_ref, "kernel_max_error_rel": err_fast,
-            "scipy_method": "RK45 restarted at events",
-            "equal_or_better_accuracy": err_fast <= 2 * err_ref, "goal": ">= 300x"}
+    t40_ref, _ = _best(
+        lambda: reference_simulate(
+            sc, sc.law, (ss.t0, ss.t0 + 40 * T), y0=ss.y0, rtol=ref_rtol, method="RK45"
+        ),
+        repeat=1,
+    )
+    t40_fast, _ = _best(
+        lambda: simulate(sc, sc.law, (ss.t0, ss.t0 + 40 * T), y0=ss.y0, tolerances=tol), repeat=5
+    )
+    return {
+        "long_run_40_periods_speedup": t40_ref / t40_fast,
+        "scipy_seconds": t_ref,
+        "kernel_seconds": t_fast,
+        "speedup": t_ref / t_fast,
+        "scipy_rtol": ref_rtol,
+        "kernel_rtol": fast_rtol,
+        "scipy_max_error_rel": err_ref,
+        "kernel_max_error_rel": err_fast,
+        "scipy_method": "RK45 restarted at events",
+        "equal_or_better_accuracy": err_fast <= 2 * err_ref,
+        "goal": ">= 300x",
+    }
 
 
 def bench_landscape(sc):
@@ -88,19 +105,23 @@ def bench_landscape(sc):
     land = landscape(sc, sc.law, a0, a1)
     cold = landscape(sc, sc.law, a0, a1, continuation=False)
     pts = 41 * 41
-    return {"seconds": land.seconds, "workers": land.workers, "points": pts,
-            "one_steady_state_seconds": t_one,
-            "ratio_to_one_point": land.seconds / t_one,
-            "steady_state_equivalents_per_point": land.seconds * land.workers / (pts * t_one),
-            "cold_seconds": cold.seconds,
-            "cold_steady_state_equivalents_per_point":
-                cold.seconds * cold.workers / (pts * t_one),
-            "continuation_speedup": cold.seconds / land.seconds,
-            "same_regimes": bool(np.array_equal(land.regime, cold.regime)),
-            "max_criterion_difference": float(max(
-                np.nanmax(np.abs(land.values[n] - cold.values[n])) for n in land.values)),
-            "parallel_efficiency": pts * t_one / (cold.seconds * cold.workers),
-            "goal": "<= 4 s on 2 cores; <= 0.3 steady-state equivalents per point"}
+    return {
+        "seconds": land.seconds,
+        "workers": land.workers,
+        "points": pts,
+        "one_steady_state_seconds": t_one,
+        "ratio_to_one_point": land.seconds / t_one,
+        "steady_state_equivalents_per_point": land.seconds * land.workers / (pts * t_one),
+        "cold_seconds": cold.seconds,
+        "cold_steady_state_equivalents_per_point": cold.seconds * cold.workers / (pts * t_one),
+        "continuation_speedup": cold.seconds / land.seconds,
+        "same_regimes": bool(np.array_equal(land.regime, cold.regime)),
+        "max_criterion_difference": float(
+            max(np.nanmax(np.abs(land.values[n] - cold.values[n])) for n in land.values)
+        ),
+        "parallel_efficiency": pts * t_one / (cold.seconds * cold.workers),
+        "goal": "<= 4 s on 2 cores; <= 0.3 steady-state equivalents per point",
+    }
 
 
 def bench_study():
@@ -111,10 +132,17 @@ def bench_study():
 
     from discovery.studies import study
 
-    cfg = {"name": "bench", "seeds": 4,
-           "factors": {"force_noise": [0.01, 0.05], "periods": [6],
-                       "library": ["z, zd, z^2, z*zd"], "selection": ["best-subset", "stlsq"],
-                       "refine": [False]}}
+    cfg = {
+        "name": "bench",
+        "seeds": 4,
+        "factors": {
+            "force_noise": [0.01, 0.05],
+            "periods": [6],
+            "library": ["z, zd, z^2, z*zd"],
+            "selection": ["best-subset", "stlsq"],
+            "refine": [False],
+        },
+    }
     out, tables = {}, {}
     runs = [("serial", {"workers": 1}), ("pool_2", {"workers": 2})]
     try:
@@ -128,8 +156,9 @@ def bench_study():
             t0 = time.perf_counter()
             res = study(cfg, Path(d) / name, figures=False, **kw)
             out[name + "_seconds"] = time.perf_counter() - t0
-            tables[name] = [{k: v for k, v in row.items() if "seconds" not in k}
-                            for row in res.cells]
+            tables[name] = [
+                {k: v for k, v in row.items() if "seconds" not in k} for row in res.cells
+            ]
     for name, _ in runs[1:]:
         out[name + "_speedup"] = out["serial_seconds"] / out[name + "_seconds"]
         out[name + "_same_table"] = tables[name] == tables["serial"]
@@ -156,10 +185,14 @@ def bench_start_up(repeat=5):
     base = best([py, "-c", "pass"])
     help_ = best([vidi, "--help"])
     imp = best([py, "-c", "import discovery"])
-    return {"python_start_seconds": base, "vidi_help_seconds": help_,
-            "import_discovery_seconds": imp, "vidi_help_over_python_start": help_ / base,
-            "vidi_help_extra_seconds": help_ - base,
-            "goal": "vidi --help <= 0.3 s"}
+    return {
+        "python_start_seconds": base,
+        "vidi_help_seconds": help_,
+        "import_discovery_seconds": imp,
+        "vidi_help_over_python_start": help_ / base,
+        "vidi_help_extra_seconds": help_ - base,
+        "goal": "vidi --help <= 0.3 s",
+    }
 
 
 def bench_identify(sc):
@@ -170,11 +203,20 @@ def bench_identify(sc):
     out = {}
     for m in METHODS:
         r = identify(sc, E, start, criterion="I2", method=m)
-        hit = next((it["n_simulations"] for it in r.iterations
-                    if np.all(np.abs(np.array(list(it["coefficients"].values())) / true - 1)
-                              < 1e-3)), None)
-        out[m] = {"simulations_to_0.1%": hit, "total_simulations": r.n_simulations,
-                  "seconds": r.seconds, "final": r.coefficients}
+        hit = next(
+            (
+                it["n_simulations"]
+                for it in r.iterations
+                if np.all(np.abs(np.array(list(it["coefficients"].values())) / true - 1) < 1e-3)
+            ),
+            None,
+        )
+        out[m] = {
+            "simulations_to_0.1%": hit,
+            "total_simulations": r.n_simulations,
+            "seconds": r.seconds,
+            "final": r.coefficients,
+        }
     cd = out["coordinate-descent"]["simulations_to_0.1%"]
     for m in METHODS:
         h = out[m]["simulations_to_0.1%"]
@@ -190,63 +232,92 @@ def main():
 
     sc = load_scenario("paper")
     steady_state(sc, sc.law)  # compile / load the cached kernels first
-    results = {"start_up": bench_start_up(), "kernel_vs_scipy": bench_kernel(sc),
-               "landscape_41x41": bench_landscape(sc),
-               "identification": bench_identify(sc), "study": bench_study(),
-               "discovery": bench_discovery(),
-               "pipeline": bench_pipeline(), "explain": bench_explain(), "ueda": bench_ueda(),
-               "cores": os.cpu_count(),
-               **provenance({"scenario": "paper"})}
+    results = {
+        "start_up": bench_start_up(),
+        "kernel_vs_scipy": bench_kernel(sc),
+        "landscape_41x41": bench_landscape(sc),
+        "identification": bench_identify(sc),
+        "study": bench_study(),
+        "discovery": bench_discovery(),
+        "pipeline": bench_pipeline(),
+        "explain": bench_explain(),
+        "ueda": bench_ueda(),
+        "cores": os.cpu_count(),
+        **provenance({"scenario": "paper"}),
+    }
     text = json.dumps(to_jsonable(results), indent=2) + "\n"
     Path(__file__).with_name("results.json").write_text(text)
     k, L, idf = results["kernel_vs_scipy"], results["landscape_41x41"], results["identification"]
     s = results["start_up"]
-    print(f"vidi --help: {s['vidi_help_seconds']:.2f} s ({s['vidi_help_over_python_start']:.1f}"
-          f" x a bare python start of {s['python_start_seconds']:.3f} s); import discovery "
-          f"{s['import_discovery_seconds']:.2f} s")
-    print(f"kernel vs scipy: {k['speedup']:.0f}x faster on one period, "
-          f"{k['long_run_40_periods_speedup']:.0f}x on 40 periods (errors "
-          f"{k['kernel_max_error_rel']:.1e} vs {k['scipy_max_error_rel']:.1e})")
-    print(f"landscape 41x41: {L['seconds']:.1f} s on {L['workers']} processes with "
-          f"continuation ({L['steady_state_equivalents_per_point']:.2f} steady-state "
-          f"equivalents per point), {L['cold_seconds']:.1f} s cold "
-          f"({L['cold_steady_state_equivalents_per_point']:.2f}): "
-          f"{L['continuation_speedup']:.1f}x; same regimes {L['same_regimes']}, criteria "
-          f"within {L['max_criterion_difference']:.1e}")
+    print(
+        f"vidi --help: {s['vidi_help_seconds']:.2f} s ({s['vidi_help_over_python_start']:.1f}"
+        f" x a bare python start of {s['python_start_seconds']:.3f} s); import discovery "
+        f"{s['import_discovery_seconds']:.2f} s"
+    )
+    print(
+        f"kernel vs scipy: {k['speedup']:.0f}x faster on one period, "
+        f"{k['long_run_40_periods_speedup']:.0f}x on 40 periods (errors "
+        f"{k['kernel_max_error_rel']:.1e} vs {k['scipy_max_error_rel']:.1e})"
+    )
+    print(
+        f"landscape 41x41: {L['seconds']:.1f} s on {L['workers']} processes with "
+        f"continuation ({L['steady_state_equivalents_per_point']:.2f} steady-state "
+        f"equivalents per point), {L['cold_seconds']:.1f} s cold "
+        f"({L['cold_steady_state_equivalents_per_point']:.2f}): "
+        f"{L['continuation_speedup']:.1f}x; same regimes {L['same_regimes']}, criteria "
+        f"within {L['max_criterion_difference']:.1e}"
+    )
     st = results["study"]
-    print("study (16 runs): serial {:.1f} s; ".format(st["serial_seconds"]) + "; ".join(
-        f"{k[:-8]} {st[k]:.1f}x (same table {st[k[:-8] + '_same_table']})"
-        for k in st if k.endswith("_speedup")))
+    print(
+        "study (16 runs): serial {:.1f} s; ".format(st["serial_seconds"])
+        + "; ".join(
+            f"{k[:-8]} {st[k]:.1f}x (same table {st[k[:-8] + '_same_table']})"
+            for k in st
+            if k.endswith("_speedup")
+        )
+    )
     for m in METHODS:
-        print(f"identify {m}: {idf[m]['simulations_to_0.1%']} simulations to 0.1 % "
-              f"({idf[m]['fewer_than_coordinate_descent']} x fewer than coordinate descent)")
+        print(
+            f"identify {m}: {idf[m]['simulations_to_0.1%']} simulations to 0.1 % "
+            f"({idf[m]['fewer_than_coordinate_descent']} x fewer than coordinate descent)"
+        )
     d = results["discovery"]
     ours, ps_ = d["ours_max_terms_4"], d["pysindy_constrained_sr3_grid30"]
-    print(f"discovery fit, {d['library']} on {d['samples']} samples: {ours['seconds']:.3f} s "
-          f"certified (all sizes: {d['ours_max_terms_10']['seconds']:.3f} s); pysindy "
-          f"ConstrainedSR3 {d['time_ratio_pysindy_over_ours']:.0f}x slower, exact zeros "
-          f"{ps_['exact_zeros']} vs {ours['exact_zeros']}, support recovered "
-          f"{ps_['support_recovered_1e-3_cutoff']} vs {ours['support_recovered']}")
+    print(
+        f"discovery fit, {d['library']} on {d['samples']} samples: {ours['seconds']:.3f} s "
+        f"certified (all sizes: {d['ours_max_terms_10']['seconds']:.3f} s); pysindy "
+        f"ConstrainedSR3 {d['time_ratio_pysindy_over_ours']:.0f}x slower, exact zeros "
+        f"{ps_['exact_zeros']} vs {ours['exact_zeros']}, support recovered "
+        f"{ps_['support_recovered_1e-3_cutoff']} vs {ours['support_recovered']}"
+    )
     p = results["pipeline"]
     v = p["verify_20_periods"]
-    print(f"verify, 20-period record: {v['seconds']:.2f} s ({v['ratio_to_one_steady_state']:.0f}"
-          f" x one steady state of {p['one_steady_state_seconds'] * 1e3:.1f} ms)")
+    print(
+        f"verify, 20-period record: {v['seconds']:.2f} s ({v['ratio_to_one_steady_state']:.0f}"
+        f" x one steady state of {p['one_steady_state_seconds'] * 1e3:.1f} ms)"
+    )
     for lib in ("poly:2", "poly:3"):
         d_ = p[f"discover_{lib}"]
         if "error" in d_:
             print(f"discover {lib}: failed: {d_['error']}")
         else:
-            print(f"discover {lib}, refine: {d_['seconds']:.1f} s "
-                  f"({d_['ratio_to_one_steady_state']:.0f} x one steady state)")
+            print(
+                f"discover {lib}, refine: {d_['seconds']:.1f} s "
+                f"({d_['ratio_to_one_steady_state']:.0f} x one steady state)"
+            )
     e = results["explain"]
-    print(f"explain, 20-period record, full catalogue: {e['seconds']:.1f} s "
-          f"({e['ratio_to_one_steady_state']:.0f} x one steady state), named {e['named']}; "
-          f"{e['parallel_speedup']:.2f}x faster than one process on {e['cores']} cores")
+    print(
+        f"explain, 20-period record, full catalogue: {e['seconds']:.1f} s "
+        f"({e['ratio_to_one_steady_state']:.0f} x one steady state), named {e['named']}; "
+        f"{e['parallel_speedup']:.2f}x faster than one process on {e['cores']} cores"
+    )
     u = results["ueda"]
-    print(f"ueda chart point: {u['chart_point']['speedup']:.0f}x faster than scipy; chart "
-          f"{u['chart']['grid'][0]}x{u['chart']['grid'][1]} in {u['chart']['seconds']:.1f} s "
-          f"(200x200 extrapolated {u['chart']['extrapolated_200x200_seconds']:.0f} s); duffing "
-          f"exponent {u['lyapunov_duffing']['value']:.4f} +- {u['lyapunov_duffing']['stderr']:.4f}")
+    print(
+        f"ueda chart point: {u['chart_point']['speedup']:.0f}x faster than scipy; chart "
+        f"{u['chart']['grid'][0]}x{u['chart']['grid'][1]} in {u['chart']['seconds']:.1f} s "
+        f"(200x200 extrapolated {u['chart']['extrapolated_200x200_seconds']:.0f} s); duffing "
+        f"exponent {u['lyapunov_duffing']['value']:.4f} +- {u['lyapunov_duffing']['stderr']:.4f}"
+    )
     print("wrote bench/results.json")
     return 0
 

@@ -48,8 +48,13 @@ def _scipy_point(system, y0, transient, periods, rtol, hmax_fraction):
     T = system.period
     atol = rtol * 1e-3 * system.scales()
     hmax = hmax_fraction * T
-    y = solve_ivp(system.rhs, (0, transient * T), y0, method="RK45", rtol=rtol, atol=atol,
-                  max_step=hmax).y[:, -1] if transient else np.asarray(y0, dtype=float)
+    y = (
+        solve_ivp(
+            system.rhs, (0, transient * T), y0, method="RK45", rtol=rtol, atol=atol, max_step=hmax
+        ).y[:, -1]
+        if transient
+        else np.asarray(y0, dtype=float)
+    )
 
     def f(t, z):
         J = system.jacobian(t, z[:2])
@@ -59,8 +64,9 @@ def _scipy_point(system, y0, transient, periods, rtol, hmax_fraction):
     at = np.concatenate([atol, np.full(4, rtol * 1e-3)])
     logs = np.zeros(2)
     for k in range(periods):
-        z = solve_ivp(f, (k * T, (k + 1) * T), z, method="RK45", rtol=rtol, atol=at,
-                      max_step=hmax).y[:, -1]
+        z = solve_ivp(
+            f, (k * T, (k + 1) * T), z, method="RK45", rtol=rtol, atol=at, max_step=hmax
+        ).y[:, -1]
         q, r = np.linalg.qr(np.column_stack([z[2:4], z[4:6]]))
         logs += np.log(np.abs(np.diag(r)))
         q = q * np.sign(np.diag(r))
@@ -74,8 +80,15 @@ def _load():
 
 def bench_ueda(grid=60):
     system = UedaSystem.from_model("negres")  # the broken egg: a chaotic (full) point
-    s = {"transient": 60, "periods": 80, "max_period": 16, "closure": 1e-4,
-         "chaos_threshold": 0.015, "early_exit": True, "min_pairs": 12}
+    s = {
+        "transient": 60,
+        "periods": 80,
+        "max_period": 16,
+        "closure": 1e-4,
+        "chaos_threshold": 0.015,
+        "early_exit": True,
+        "min_pairs": 12,
+    }
     tol = Tolerances(rtol=1e-6, hmax_fraction=0.1)
     y0 = np.array([0.1, 0.0])
     _point(system, y0, s, tol)  # compile / load the cache
@@ -94,45 +107,64 @@ def bench_ueda(grid=60):
     old, ob, oa = runs["old"]
     n = grid * grid
     per_point, cpu_point = ch.seconds / n, ch.cpu_seconds / n
-    same = np.mean((np.where(ch.period > 8, 2, ch.kind) == old.kind)
-                   & (np.where(ch.period > 8, 0, ch.period) == old.period))
+    same = np.mean(
+        (np.where(ch.period > 8, 2, ch.kind) == old.kind)
+        & (np.where(ch.period > 8, 0, ch.period) == old.period)
+    )
     duff = UedaSystem.from_model("duffing")
     lyapunov(duff, periods=10)
     t_lyap, L = _best(lambda: lyapunov(duff, periods=20000, batches=40), 1)
-    t_lyap_scipy, _ = _best(lambda: _scipy_point(duff, np.array([0.1, 0.0]), 0, 200, 1e-9,
-                                                 0.02), 1)
+    t_lyap_scipy, _ = _best(lambda: _scipy_point(duff, np.array([0.1, 0.0]), 0, 200, 1e-9, 0.02), 1)
     return {
-        "chart_point": {"kernel_seconds": t_fast, "scipy_seconds": t_scipy,
-                        "speedup": t_scipy / t_fast, "goal": ">= 100x per point",
-                        "work": "60 transient + 80 variational periods, rtol 1e-6 (a chaotic "
-                                "point: the full path)",
-                        "chart_cpu_seconds_per_point": cpu_point,
-                        "chart_speedup": t_scipy / cpu_point,
-                        "chart_speedup_note": "the chart's mean CPU time per point (early "
-                                              "exit at periodic points) vs scipy's full "
-                                              "point"},
-        "chart": {"grid": [grid, grid], "seconds": ch.seconds, "cpu_seconds": ch.cpu_seconds,
-                  "workers": ch.workers, "seconds_per_point": per_point,
-                  "cpu_seconds_per_point": cpu_point,
-                  "mean_periods_integrated": float(ch.periods_integrated.mean()),
-                  "extrapolated_200x200_seconds": per_point * 40000,
-                  "extrapolated_200x200_seconds_idle_cores": cpu_point * 40000 / min(
-                      cores, 200),
-                  "cores": cores, "load_average_before": before, "load_average_after": after,
-                  "max_period": ch.settings["max_period"],
-                  "goal": "200x200 <= 60 s on 2 cores"},
+        "chart_point": {
+            "kernel_seconds": t_fast,
+            "scipy_seconds": t_scipy,
+            "speedup": t_scipy / t_fast,
+            "goal": ">= 100x per point",
+            "work": "60 transient + 80 variational periods, rtol 1e-6 (a chaotic "
+            "point: the full path)",
+            "chart_cpu_seconds_per_point": cpu_point,
+            "chart_speedup": t_scipy / cpu_point,
+            "chart_speedup_note": "the chart's mean CPU time per point (early "
+            "exit at periodic points) vs scipy's full "
+            "point",
+        },
+        "chart": {
+            "grid": [grid, grid],
+            "seconds": ch.seconds,
+            "cpu_seconds": ch.cpu_seconds,
+            "workers": ch.workers,
+            "seconds_per_point": per_point,
+            "cpu_seconds_per_point": cpu_point,
+            "mean_periods_integrated": float(ch.periods_integrated.mean()),
+            "extrapolated_200x200_seconds": per_point * 40000,
+            "extrapolated_200x200_seconds_idle_cores": cpu_point * 40000 / min(cores, 200),
+            "cores": cores,
+            "load_average_before": before,
+            "load_average_after": after,
+            "max_period": ch.settings["max_period"],
+            "goal": "200x200 <= 60 s on 2 cores",
+        },
         "chart_without_early_exit": {
-            "seconds": old.seconds, "cpu_seconds": old.cpu_seconds,
+            "seconds": old.seconds,
+            "cpu_seconds": old.cpu_seconds,
             "cpu_seconds_per_point": old.cpu_seconds / n,
             "mean_periods_integrated": float(old.periods_integrated.mean()),
-            "load_average_before": ob, "load_average_after": oa,
+            "load_average_before": ob,
+            "load_average_after": oa,
             "cpu_ratio_old_over_new": old.cpu_seconds / ch.cpu_seconds,
             "same_class_fraction": float(same),
             "note": "max_period 8, no early exit (the earlier charts); classes compared "
-                    "with periods > 8 of the new chart counted as beat"},
-        "lyapunov_duffing": {"value": L.value, "stderr": L.stderr, "periods": 20000,
-                             "seconds": t_lyap, "scipy_seconds_200_periods": t_lyap_scipy,
-                             "speedup_per_period": (t_lyap_scipy / 200) / (t_lyap / 20000)},
+            "with periods > 8 of the new chart counted as beat",
+        },
+        "lyapunov_duffing": {
+            "value": L.value,
+            "stderr": L.stderr,
+            "periods": 20000,
+            "seconds": t_lyap,
+            "scipy_seconds_200_periods": t_lyap_scipy,
+            "speedup_per_period": (t_lyap_scipy / 200) / (t_lyap / 20000),
+        },
     }
 
 

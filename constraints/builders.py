@@ -204,7 +204,11 @@ def constraint_rows(
     parts = [
         _condition_rows(library, box, "non_adhesion", elevation=elevation),
         _condition_rows(
-            library, box, "dissipativity", elevation=elevation, margin=margin,
+            library,
+            box,
+            "dissipativity",
+            elevation=elevation,
+            margin=margin,
             force_unit=force_unit,
         ),
     ]

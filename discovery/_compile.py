@@ -6,8 +6,10 @@ from pathlib import Path
 
 __all__ = ["KERNELS", "cached", "announce_compile"]
 
-KERNELS = {"vibro-impact": (Path(__file__).parent / "dynamics", "_kernel.integrate-"),
-           "oscillator": (Path(__file__).parent / "oscillator", "_kernel.")}
+KERNELS = {
+    "vibro-impact": (Path(__file__).parent / "dynamics", "_kernel.integrate-"),
+    "oscillator": (Path(__file__).parent / "oscillator", "_kernel."),
+}
 _ANNOUNCED = set()
 
 
@@ -16,8 +18,9 @@ def cached(kernel="vibro-impact"):
     ``"oscillator"``)."""
     folder, prefix = KERNELS[kernel]
     cache = folder / "__pycache__"
-    return cache.is_dir() and any(p.name.startswith(prefix) and p.suffix == ".nbi"
-                                  for p in cache.iterdir())
+    return cache.is_dir() and any(
+        p.name.startswith(prefix) and p.suffix == ".nbi" for p in cache.iterdir()
+    )
 
 
 def announce_compile(kernel="vibro-impact", stream=None):
@@ -28,8 +31,9 @@ def announce_compile(kernel="vibro-impact", stream=None):
     _ANNOUNCED.add(kernel)  # checked once per process
     if cached(kernel):
         return
-    print(f"vidi: compiling the {kernel} simulator once (a few minutes on a small machine; "
-          "cached for every later run; `make install` does it ahead)",
-          file=stream or sys.stderr, flush=True)
-
-
+    print(
+        f"vidi: compiling the {kernel} simulator once (a few minutes on a small machine; "
+        "cached for every later run; `make install` does it ahead)",
+        file=stream or sys.stderr,
+        flush=True,
+    )

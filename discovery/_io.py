@@ -56,19 +56,46 @@ import numpy as np
 
 from .errors import InputError
 
-__all__ = ["OutputDir", "provenance", "to_jsonable", "check_output", "atomic_write_text",
-           "file_sha256", "git_state", "clean_stale", "set_run", "running", "MANIFEST"]
+__all__ = [
+    "OutputDir",
+    "provenance",
+    "to_jsonable",
+    "check_output",
+    "atomic_write_text",
+    "file_sha256",
+    "git_state",
+    "clean_stale",
+    "set_run",
+    "running",
+    "MANIFEST",
+]
 
 # the solvers cvxpy uses here: CLARABEL (default), OSQP (fallback in the regression)
-_PACKAGES = ("vibroimpact-discovery", "numpy", "scipy", "numba", "sympy", "cvxpy", "clarabel",
-             "osqp", "scikit-learn", "pysindy", "matplotlib", "jinja2", "tqdm", "pandas",
-             "distributed")
+_PACKAGES = (
+    "vibroimpact-discovery",
+    "numpy",
+    "scipy",
+    "numba",
+    "sympy",
+    "cvxpy",
+    "clarabel",
+    "osqp",
+    "scikit-learn",
+    "pysindy",
+    "matplotlib",
+    "jinja2",
+    "tqdm",
+    "pandas",
+    "distributed",
+)
 
 # names of the files a result directory may hold (an earlier result that may be replaced)
 _RESULT_FILE = re.compile(r"^[^/]+\.(json|csv|png|pdf|tex|txt|svg)$", re.IGNORECASE)
 _STAGING, _ASIDE, _TMP = "vidi-staging", "vidi-old", "vidi-tmp"
-_OWNED = re.compile(r"^\.(?P<name>.+)\.(?P<kind>vidi-staging|vidi-old|vidi-tmp)\.(?P<pid>\d+)-"
-                    r"(?P<start>\d+)\.[0-9a-f]+$")
+_OWNED = re.compile(
+    r"^\.(?P<name>.+)\.(?P<kind>vidi-staging|vidi-old|vidi-tmp)\.(?P<pid>\d+)-"
+    r"(?P<start>\d+)\.[0-9a-f]+$"
+)
 _PROBE = re.compile(r"^\.vidi-probe\.(?P<pid>\d+)-(?P<start>\d+)\.[0-9a-f]+$")
 
 MANIFEST = ".vidi-manifest.json"
@@ -118,9 +145,11 @@ def _owner(directory):
 def _refuse_other_command(owner, text, option):
     here = _RUN["command"]
     if owner and here and owner != here and not _RUN["overwrite"]:
-        raise InputError(f"{option} {text!r} holds the results of `vidi {owner}`; give this "
-                         f"`vidi {here}` run its own output, or add --overwrite to replace "
-                         "them (files you added there are kept)")
+        raise InputError(
+            f"{option} {text!r} holds the results of `vidi {owner}`; give this "
+            f"`vidi {here}` run its own output, or add --overwrite to replace "
+            "them (files you added there are kept)"
+        )
 
 
 # ---------------------------------------------------------------------------- provenance
@@ -141,8 +170,14 @@ def git_state(root=None, timeout=2.0):
     env = {**os.environ, "GIT_OPTIONAL_LOCKS": "0", "LC_ALL": "C"}
 
     def git(*args):
-        return subprocess.run(["git", "-C", str(root), *args], capture_output=True, text=True,
-                              timeout=timeout, env=env, stdin=subprocess.DEVNULL)
+        return subprocess.run(
+            ["git", "-C", str(root), *args],
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            env=env,
+            stdin=subprocess.DEVNULL,
+        )
 
     try:
         head = git("rev-parse", "HEAD")
@@ -186,8 +221,11 @@ def _input_record(value):
             return {"path": f"builtin:{value}", "sha256": file_sha256(res)}
     if not isinstance(path, str | os.PathLike) or not os.path.isfile(path):
         return {"path": text, "sha256": None}
-    return {"path": str(Path(path).resolve()), "sha256": file_sha256(path),
-            "bytes": os.path.getsize(path)}
+    return {
+        "path": str(Path(path).resolve()),
+        "sha256": file_sha256(path),
+        "bytes": os.path.getsize(path),
+    }
 
 
 def provenance(settings=None, inputs=None):
@@ -216,11 +254,13 @@ def provenance(settings=None, inputs=None):
         except metadata.PackageNotFoundError:
             versions[name] = None
     commit, dirty = git_state()
-    out = {"versions": versions, "git": {"commit": commit, "dirty": dirty},
-           "platform": platform.platform(),
-           "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
-           "settings": to_jsonable({k: v for k, v in (settings or {}).items()
-                                    if not callable(v)})}
+    out = {
+        "versions": versions,
+        "git": {"commit": commit, "dirty": dirty},
+        "platform": platform.platform(),
+        "created": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+        "settings": to_jsonable({k: v for k, v in (settings or {}).items() if not callable(v)}),
+    }
     if inputs is not None:
         out["inputs"] = {k: _input_record(v) for k, v in inputs.items()}
     return out
@@ -327,8 +367,9 @@ def _writable_dir(d):
         return False
     if not hasattr(os, "geteuid") or os.geteuid() != 0:
         return True
-    probe = os.path.join(d, f".vidi-probe.{os.getpid()}-{_proc_start(os.getpid())}."
-                            f"{secrets.token_hex(4)}")  # owned: clean_stale removes it
+    probe = os.path.join(
+        d, f".vidi-probe.{os.getpid()}-{_proc_start(os.getpid())}.{secrets.token_hex(4)}"
+    )  # owned: clean_stale removes it
     try:
         os.mkdir(probe)
     except OSError:
@@ -367,48 +408,67 @@ def check_output(path, inputs=(), *, kind="dir", option="--out"):
     p = Path(text)
     for inp in inputs:
         if inp is not None and os.path.isfile(inp) and _same_file(p, inp):
-            raise InputError(f"{option} {text!r} is the input file {str(inp)!r}; write the "
-                             "results elsewhere")
+            raise InputError(
+                f"{option} {text!r} is the input file {str(inp)!r}; write the results elsewhere"
+            )
     if p.is_symlink():
-        raise InputError(f"{option} {text!r} is a symbolic link; results never replace "
-                         "through a link: give the real path or a new name")
+        raise InputError(
+            f"{option} {text!r} is a symbolic link; results never replace "
+            "through a link: give the real path or a new name"
+        )
     if kind == "file":
         if p.is_dir():
-            raise InputError(f"{option} {text!r} is a directory; give a file name inside it, "
-                             f"e.g. {str(p / 'D.csv')!r}")
+            raise InputError(
+                f"{option} {text!r} is a directory; give a file name inside it, "
+                f"e.g. {str(p / 'D.csv')!r}"
+            )
         if p.exists() and not p.is_file():
-            raise InputError(f"{option} {text!r} exists and is not a regular file (a pipe, a "
-                             "device or a socket); it is never replaced: give a new file name")
+            raise InputError(
+                f"{option} {text!r} exists and is not a regular file (a pipe, a "
+                "device or a socket); it is never replaced: give a new file name"
+            )
         if p.is_file():
             sidecar = p if p.name.endswith(".summary.json") else p.with_suffix(".summary.json")
             owner, _ = _owner_file(sidecar)
             if owner is None and not _RUN["overwrite"] and _RUN["command"]:
-                raise InputError(f"{option} {text!r} exists and was not written by vidi (no "
-                                 f"{sidecar.name} beside it); give a new file name, or add "
-                                 "--overwrite to replace it")
+                raise InputError(
+                    f"{option} {text!r} exists and was not written by vidi (no "
+                    f"{sidecar.name} beside it); give a new file name, or add "
+                    "--overwrite to replace it"
+                )
             _refuse_other_command(owner, text, option)
     else:
         if p.exists() and not p.is_dir():
-            raise InputError(f"{option} {text!r} is an existing file; give a directory (it is "
-                             "created) or remove the file")
+            raise InputError(
+                f"{option} {text!r} is an existing file; give a directory (it is "
+                "created) or remove the file"
+            )
         if p.is_dir():
             if _inside(Path.cwd(), p):
-                raise InputError(f"{option} {text!r} is the current directory or above it; the "
-                                 "result directory is replaced as a whole, so give a new "
-                                 "subdirectory such as results/run1")
+                raise InputError(
+                    f"{option} {text!r} is the current directory or above it; the "
+                    "result directory is replaced as a whole, so give a new "
+                    "subdirectory such as results/run1"
+                )
             for inp in inputs:
                 if inp is not None and os.path.isfile(inp) and _inside(inp, p):
-                    raise InputError(f"{option} {text!r} holds the input file {str(inp)!r}; "
-                                     "the result directory is replaced as a whole, so give "
-                                     "another directory")
+                    raise InputError(
+                        f"{option} {text!r} holds the input file {str(inp)!r}; "
+                        "the result directory is replaced as a whole, so give "
+                        "another directory"
+                    )
             _check_replaceable(p, text, option)
     parent = _nearest_existing(Path(os.path.abspath(p)).parent)
     if not parent.is_dir():
-        raise InputError(f"{option} {text!r}: {str(parent)!r} is a file, not a directory; "
-                         "choose another location")
+        raise InputError(
+            f"{option} {text!r}: {str(parent)!r} is a file, not a directory; "
+            "choose another location"
+        )
     if not _writable_dir(parent):
-        raise InputError(f"{option} {text!r}: cannot write in {str(parent)!r} (permission "
-                         "denied or read-only); choose a writable location")
+        raise InputError(
+            f"{option} {text!r}: cannot write in {str(parent)!r} (permission "
+            "denied or read-only); choose a writable location"
+        )
     return p
 
 
@@ -436,14 +496,20 @@ def _check_replaceable(p, text, option):
         return
     names = {e.name for e in entries}
     subdirs = sorted(e.name for e in entries if e.is_dir(follow_symlinks=False))
-    odd = sorted(e.name for e in entries if not e.is_dir(follow_symlinks=False)
-                 and not (e.is_file(follow_symlinks=False) and _RESULT_FILE.match(e.name)))
+    odd = sorted(
+        e.name
+        for e in entries
+        if not e.is_dir(follow_symlinks=False)
+        and not (e.is_file(follow_symlinks=False) and _RESULT_FILE.match(e.name))
+    )
     if subdirs or odd or "summary.json" not in names:
         shown = ", ".join((subdirs + odd)[:3] or sorted(names)[:3])
-        raise InputError(f"{option} {text!r} is a non-empty directory that is not an earlier "
-                         f"vidi result (it holds {shown}); results replace the directory as a "
-                         "whole, so give a new or empty directory such as "
-                         f"{str(p / 'run1')!r}")
+        raise InputError(
+            f"{option} {text!r} is a non-empty directory that is not an earlier "
+            f"vidi result (it holds {shown}); results replace the directory as a "
+            "whole, so give a new or empty directory such as "
+            f"{str(p / 'run1')!r}"
+        )
 
 
 # ---------------------------------------------------------------- staging directories
@@ -473,8 +539,7 @@ def _alive(pid, start):
 
 
 def _owned_name(target, kind):
-    return (f".{target.name}.{kind}.{os.getpid()}-{_proc_start(os.getpid())}."
-            f"{secrets.token_hex(4)}")
+    return f".{target.name}.{kind}.{os.getpid()}-{_proc_start(os.getpid())}.{secrets.token_hex(4)}"
 
 
 def clean_stale(target):
@@ -496,12 +561,15 @@ def clean_stale(target):
     try:
         for e in os.scandir(parent):
             m = _OWNED.match(e.name)
-            if m and m["name"] == target.name and not _alive(int(m["pid"]), int(m["start"])) \
-                    and e.is_dir(follow_symlinks=False) == (m["kind"] != _TMP):
+            if (
+                m
+                and m["name"] == target.name
+                and not _alive(int(m["pid"]), int(m["start"]))
+                and e.is_dir(follow_symlinks=False) == (m["kind"] != _TMP)
+            ):
                 stale.append((m["kind"], Path(e.path)))
             m = _PROBE.match(e.name)  # a writability probe of a killed run
-            if m and not _alive(int(m["pid"]), int(m["start"])) \
-                    and e.is_dir(follow_symlinks=False):
+            if m and not _alive(int(m["pid"]), int(m["start"])) and e.is_dir(follow_symlinks=False):
                 stale.append(("probe", Path(e.path)))
     except OSError:
         return []
@@ -585,8 +653,10 @@ class OutputDir:
             for d in self._made:
                 with contextlib.suppress(OSError):
                     d.rmdir()
-            raise InputError(f"--out {str(self.target)!r}: cannot create {exc.filename!r} "
-                             f"({exc.strerror}); choose a writable location") from None
+            raise InputError(
+                f"--out {str(self.target)!r}: cannot create {exc.filename!r} "
+                f"({exc.strerror}); choose a writable location"
+            ) from None
         _chmod_default(self.stage, directory=True)
         self._abs = target
         return self
@@ -607,8 +677,7 @@ class OutputDir:
         except metadata.PackageNotFoundError:
             version = None
         with open(self.stage / MANIFEST, "w", encoding="utf-8") as fh:
-            json.dump({"command": _RUN["command"], "files": files, "vidi": version}, fh,
-                      indent=2)
+            json.dump({"command": _RUN["command"], "files": files, "vidi": version}, fh, indent=2)
             fh.write("\n")
 
     def _keep_user_files(self, old, target):
@@ -617,8 +686,11 @@ class OutputDir:
         result) back into ``target``: a user's notes, a file dropped in during the run.  A
         name the new result also uses is kept as ``NAME.kept``."""
         _, files = _owner(old)
-        ours = set(files) | {MANIFEST} if files is not None else \
-            {f.name for f in target.iterdir()} | {"summary.json"}
+        ours = (
+            set(files) | {MANIFEST}
+            if files is not None
+            else {f.name for f in target.iterdir()} | {"summary.json"}
+        )
         for e in list(os.scandir(old)):
             if e.name in ours or _OWNED.match(e.name):
                 continue
@@ -642,8 +714,10 @@ class OutputDir:
             _fsync_dir(target.parent)
             return
         if target.is_symlink() or not target.is_dir():
-            raise InputError(f"--out {str(self.target)!r} became a file or a link during the "
-                             "run; the results were not written")
+            raise InputError(
+                f"--out {str(self.target)!r} became a file or a link during the "
+                "run; the results were not written"
+            )
         if _exchange(self.stage, target):
             old = self.stage  # now holds the earlier result
         else:

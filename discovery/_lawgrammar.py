@@ -34,7 +34,7 @@ def _tokenize(text):
         m = _TOKEN.match(text, pos)
         if m is None or m.end() == pos:
             raise LawSyntaxError(
-                f"cannot read force law {text!r} at position {pos} ({text[pos:pos + 8]!r}); "
+                f"cannot read force law {text!r} at position {pos} ({text[pos : pos + 8]!r}); "
                 "write terms like '2.06e8*z + 1.28e7*zd' using z, zd, numbers, * and ^"
             )
         kind = m.lastgroup
@@ -138,10 +138,14 @@ def parse_law_terms(text):
     if not isinstance(text, str):
         raise LawSyntaxError(f"force law must be text, got {type(text).__name__}")
     if len(text) > MAX_LAW_CHARS:
-        raise LawSyntaxError(f"force law text of {len(text)} characters; a contact law has a "
-                             f"few terms (at most {MAX_LAW_TERMS}, {MAX_LAW_CHARS} characters)")
+        raise LawSyntaxError(
+            f"force law text of {len(text)} characters; a contact law has a "
+            f"few terms (at most {MAX_LAW_TERMS}, {MAX_LAW_CHARS} characters)"
+        )
     terms = _Parser(text).parse()
     if len(terms) > MAX_LAW_TERMS:
-        raise LawSyntaxError(f"force law of {len(terms)} terms; a contact law has a few (at "
-                             f"most {MAX_LAW_TERMS}): simplify it")
+        raise LawSyntaxError(
+            f"force law of {len(terms)} terms; a contact law has a few (at "
+            f"most {MAX_LAW_TERMS}): simplify it"
+        )
     return terms

@@ -40,6 +40,7 @@ def lazy_package(name, exports):
     module.__getattr__, module.__dir__ = __getattr__, __dir__
     shadowed = [a for a, sub in exports.items() if sub.split(".")[-1] == a]
     if shadowed:
+
         def prop(attr):
             def get(_):
                 return load(attr)
@@ -49,6 +50,9 @@ def lazy_package(name, exports):
 
             return property(get, set_)
 
-        cls = type(f"_{name.replace('.', '_')}_package", (types.ModuleType,),
-                   {a: prop(a) for a in shadowed})
+        cls = type(
+            f"_{name.replace('.', '_')}_package",
+            (types.ModuleType,),
+            {a: prop(a) for a in shadowed},
+        )
         module.__class__ = cls

@@ -34,9 +34,11 @@ def criteria_lines(criteria, floor=None, limits=None, indent="  "):
     for k in (*CRITERIA, *(k for k in criteria if k not in CRITERIA)):
         if k in criteria:
             lim = (limits or {}).get(k)
-            out.append(f"{indent}{k:<10}{fmt(criteria[k], 3):>10}"
-                       f"{fmt((floor or {}).get(k), 3):>10}"
-                       f"{fmt(lim, 3) if lim is not None else '':>10}")
+            out.append(
+                f"{indent}{k:<10}{fmt(criteria[k], 3):>10}"
+                f"{fmt((floor or {}).get(k), 3):>10}"
+                f"{fmt(lim, 3) if lim is not None else '':>10}"
+            )
     return out
 
 
@@ -65,7 +67,7 @@ def readable(cls):
         return f"<{cls.__name__}: {lines[0] if lines else ''}>"
 
     def _repr_html_(self):
-        return ("<pre style='white-space: pre-wrap'>" + html.escape(str(self)) + "</pre>")
+        return "<pre style='white-space: pre-wrap'>" + html.escape(str(self)) + "</pre>"
 
     cls.__str__, cls.__repr__, cls._repr_html_ = __str__, __repr__, _repr_html_
     return cls
@@ -78,10 +80,15 @@ def generic_lines(result, limit=12):
     for k, v in d.items():
         if isinstance(v, bool | int | float | str) and len(str(v)) < 120:
             out.append(f"  {k}: {fmt(v) if isinstance(v, float) else v}")
-        elif isinstance(v, dict) and 0 < len(v) <= 6 and all(
-                isinstance(x, bool | int | float | str) for x in v.values()):
-            out.append(f"  {k}: " + ", ".join(f"{a} {fmt(b) if isinstance(b, float) else b}"
-                                               for a, b in v.items()))
+        elif (
+            isinstance(v, dict)
+            and 0 < len(v) <= 6
+            and all(isinstance(x, bool | int | float | str) for x in v.values())
+        ):
+            out.append(
+                f"  {k}: "
+                + ", ".join(f"{a} {fmt(b) if isinstance(b, float) else b}" for a, b in v.items())
+            )
         if len(out) > limit:
             break
     return out

@@ -39,8 +39,14 @@ class Reporter:
             if self.bar:
                 from tqdm import tqdm
 
-                self._bar = tqdm(total=total, desc=stage, file=self.stream, leave=False,
-                                 dynamic_ncols=True, mininterval=0.2)
+                self._bar = tqdm(
+                    total=total,
+                    desc=stage,
+                    file=self.stream,
+                    leave=False,
+                    dynamic_ncols=True,
+                    mininterval=0.2,
+                )
             else:
                 print(f"{stage} ...", file=self.stream, flush=True)
         if self._bar is not None:

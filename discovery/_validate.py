@@ -49,14 +49,17 @@ class Real:
         return f"a finite {kind[2:] if kind.startswith('a ') else kind[3:]}"
 
     def __call__(self, where, value):
-        ok_type = (isinstance(value, numbers.Integral) if self.integer
-                   else isinstance(value, numbers.Real))
+        ok_type = (
+            isinstance(value, numbers.Integral) if self.integer else isinstance(value, numbers.Real)
+        )
         if isinstance(value, (bool, np.bool_)) or not ok_type:
             raise VidiTypeError(f"{where} must be {self.describe()}; got {_received(value)}")
         v = float(value)
-        bad = (not np.isfinite(v)
-               or (self.low is not None and (v <= self.low if self.open_low else v < self.low))
-               or (self.high is not None and v > self.high))
+        bad = (
+            not np.isfinite(v)
+            or (self.low is not None and (v <= self.low if self.open_low else v < self.low))
+            or (self.high is not None and v > self.high)
+        )
         if bad:
             raise InputError(f"{where} must be {self.describe()}; got {value!r}")
 
@@ -106,8 +109,10 @@ class Text:
         if not isinstance(value, str):
             raise VidiTypeError(f"{where} must be text; got {_received(value)}")
         if (not value and not self.empty) or len(value) > self.max_chars:
-            raise InputError(f"{where} must be {'' if self.empty else 'non-empty '}text of at "
-                             f"most {self.max_chars} characters; got {len(value)} characters")
+            raise InputError(
+                f"{where} must be {'' if self.empty else 'non-empty '}text of at "
+                f"most {self.max_chars} characters; got {len(value)} characters"
+            )
 
 
 class Array:
@@ -126,10 +131,12 @@ class Array:
             arr = np.asarray(value, dtype=float)
         except (TypeError, ValueError):
             raise VidiTypeError(
-                f"{where} must be {self.describe()}; got {_received(value)}") from None
+                f"{where} must be {self.describe()}; got {_received(value)}"
+            ) from None
         if self.ndim is not None and arr.ndim != self.ndim:
-            raise InputError(f"{where} must be {self.describe()}; got {arr.ndim}-D of shape "
-                             f"{arr.shape}")
+            raise InputError(
+                f"{where} must be {self.describe()}; got {arr.ndim}-D of shape {arr.shape}"
+            )
 
 
 def _describe(spec):
@@ -168,7 +175,8 @@ def check(where, value, spec):
             elif spec.__name__ == "Scenario" and isinstance(value, str):
                 hint = f" (load one with load_scenario({value[:30]!r}))"
             raise VidiTypeError(
-                f"{where} must be {_a(spec.__name__)}{hint}; got {_received(value)}")
+                f"{where} must be {_a(spec.__name__)}{hint}; got {_received(value)}"
+            )
         return
     spec(where, value)
 

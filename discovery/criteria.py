@@ -127,8 +127,11 @@ def _int_abs(t, d):
     h = np.diff(t)
     a, b = d[:-1], d[1:]
     same = a * b >= 0
-    area = np.where(same, 0.5 * (np.abs(a) + np.abs(b)),
-                    0.5 * (a * a + b * b) / np.where(same, 1.0, np.abs(a) + np.abs(b)))
+    area = np.where(
+        same,
+        0.5 * (np.abs(a) + np.abs(b)),
+        0.5 * (a * a + b * b) / np.where(same, 1.0, np.abs(a) + np.abs(b)),
+    )
     return float(np.sum(h * area))
 
 
@@ -184,7 +187,11 @@ def _i0(c):
 
 
 CRITERIA = {
-    "I0": _i0, "I1": _i1, "I2": _i2, "I3": _i3, "I4": _i4,
+    "I0": _i0,
+    "I1": _i1,
+    "I2": _i2,
+    "I3": _i3,
+    "I4": _i4,
 }
 """Registry: name -> function of a :class:`Comparison` returning a float >= 0."""
 
@@ -194,8 +201,9 @@ def criterion(name):
     try:
         return CRITERIA[name]
     except KeyError:
-        raise InputError(f"unknown criterion {name!r}; valid names: {', '.join(CRITERIA)}") \
-            from None
+        raise InputError(
+            f"unknown criterion {name!r}; valid names: {', '.join(CRITERIA)}"
+        ) from None
 
 
 @params(measured=(_IMPULSE, None), simulated=(_IMPULSE, None), names=(None, list, tuple))

@@ -55,7 +55,7 @@ from .verify import Reference, evaluate
 
 __all__ = ["RankedModel", "DiscoveryResult", "discover", "rank"]
 
-_REFINE_BUDGET = 120   # simulations per shortlisted support (every record counts)
+_REFINE_BUDGET = 120  # simulations per shortlisted support (every record counts)
 _FORWARD_STARTS = (0.01, 0.001)  # a new term's start force at the box corner / peak force
 _RESTARTS = 2  # stalled smaller supports restarted from a consistent model, per step
 
@@ -108,16 +108,20 @@ class RankedModel:
         """Criteria I0..I4, the mean over records (empty unless every record is ``ok``)."""
         if not all(ev.criteria for ev in self.evaluations):
             return {}
-        return {k: float(np.mean([ev.criteria[k] for ev in self.evaluations]))
-                for k in self.evaluations[0].criteria}
+        return {
+            k: float(np.mean([ev.criteria[k] for ev in self.evaluations]))
+            for k in self.evaluations[0].criteria
+        }
 
     @property
     def noise_floor(self):
         """Noise floor of every criterion, the mean over records."""
         if not all(ev.noise_floor for ev in self.evaluations):
             return {}
-        return {k: float(np.mean([ev.noise_floor[k] for ev in self.evaluations]))
-                for k in self.evaluations[0].noise_floor}
+        return {
+            k: float(np.mean([ev.noise_floor[k] for ev in self.evaluations]))
+            for k in self.evaluations[0].noise_floor
+        }
 
     @property
     def consistent(self):
@@ -133,7 +137,8 @@ class RankedModel:
             return f"consistent with all {len(self.evaluations)} records"
         i, ev = bad[0]
         return f"inconsistent with record {i + 1}: {ev.verdict}" + (
-            f" (and {len(bad) - 1} more)" if len(bad) > 1 else "")
+            f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
+        )
 
     @property
     def defects(self):
@@ -143,26 +148,40 @@ class RankedModel:
     @property
     def standard_errors(self):
         """``{term: standard error}`` from the refinement (empty without it)."""
-        return dict(self.refinement.standard_errors) if self.refinement is not None \
-            and self.note.startswith("refined") else {}
+        return (
+            dict(self.refinement.standard_errors)
+            if self.refinement is not None and self.note.startswith("refined")
+            else {}
+        )
 
     def as_dict(self):
         ev = self.evaluation
         iv = self.intervals
-        d = {"terms": list(self.law.names), "coefficients": self.law.as_dict(),
-             "standard_errors": self.standard_errors,
-             "intervals": {} if iv is None else {k: list(v) for k, v in iv.bounds.items()},
-             "interval_method": None if iv is None else iv.method,
-             "interval_level": None if iv is None else iv.level,
-             "regression_coefficients": self.candidate.extra.get(
-                 "regression_coefficients", self.candidate.coefficients),
-             "latex": self.law.latex(), "regime": self.regime, "status": ev.status,
-             "criteria": self.criteria, "noise_floor": self.noise_floor,
-             "consistent": self.consistent, "verdict": self.verdict,
-             "bic": self.candidate.bic, "aic": self.candidate.aic,
-             "cv_error": self.candidate.cv_error, "rss": self.candidate.rss,
-             "constrained": self.candidate.constrained, "refinement": self.note,
-             "contact_defects": self.defects}
+        d = {
+            "terms": list(self.law.names),
+            "coefficients": self.law.as_dict(),
+            "standard_errors": self.standard_errors,
+            "intervals": {} if iv is None else {k: list(v) for k, v in iv.bounds.items()},
+            "interval_method": None if iv is None else iv.method,
+            "interval_level": None if iv is None else iv.level,
+            "regression_coefficients": self.candidate.extra.get(
+                "regression_coefficients", self.candidate.coefficients
+            ),
+            "latex": self.law.latex(),
+            "regime": self.regime,
+            "status": ev.status,
+            "criteria": self.criteria,
+            "noise_floor": self.noise_floor,
+            "consistent": self.consistent,
+            "verdict": self.verdict,
+            "bic": self.candidate.bic,
+            "aic": self.candidate.aic,
+            "cv_error": self.candidate.cv_error,
+            "rss": self.candidate.rss,
+            "constrained": self.candidate.constrained,
+            "refinement": self.note,
+            "contact_defects": self.defects,
+        }
         if self.refinement is not None:
             d["n_simulations"] = self.refinement.n_simulations
         if len(self.evaluations) > 1:
@@ -230,52 +249,82 @@ class DiscoveryResult:
         names = list(names) if names is not None else [getattr(r, "source", "") for r in refs]
         ref_out = self.refinement
         return {
-            "records": [{"data": n, "scenario": s_k.name, "regime": ref.regime,
-                         "impacts": ref.impacts, "noise": ref.noise}
-                        for n, (s_k, ref) in zip(names, self.references, strict=True)],
+            "records": [
+                {
+                    "data": n,
+                    "scenario": s_k.name,
+                    "regime": ref.regime,
+                    "impacts": ref.impacts,
+                    "noise": ref.noise,
+                }
+                for n, (s_k, ref) in zip(names, self.references, strict=True)
+            ],
             "selected": self.selected.as_dict(),
             "warnings": self.warnings,
             "equivalent": self.equivalent,
             "ranking": [m.as_dict() for m in self.ranking],
-            "certificate": None if cert is None else {
-                "method": cert.method, "holds": cert.holds,
-                "worst_violation": cert.worst_violation, "domain": cert.domain,
-                "conditions": cert.conditions},
+            "certificate": None
+            if cert is None
+            else {
+                "method": cert.method,
+                "holds": cert.holds,
+                "worst_violation": cert.worst_violation,
+                "domain": cert.domain,
+                "conditions": cert.conditions,
+            },
             "stability": self.stability,
-            "refinement": None if ref_out is None else {
-                "coefficients": ref_out.coefficients, "criteria": ref_out.criteria,
+            "refinement": None
+            if ref_out is None
+            else {
+                "coefficients": ref_out.coefficients,
+                "criteria": ref_out.criteria,
                 "standard_errors": ref_out.standard_errors,
-                "n_simulations": ref_out.n_simulations, "message": ref_out.message,
-                "failures": len(ref_out.failures)},
-            "samples": {"n": len(self.samples), "impacts": self.samples.n_impacts,
-                        "derivative": self.samples.derivative, "noise": self.samples.noise},
-            "measured": {"n_cycles": self.measured.n_cycles,
-                         "n_periods": self.measured.n_periods,
-                         "noise": self.measured.noise, "threshold": self.measured.threshold},
+                "n_simulations": ref_out.n_simulations,
+                "message": ref_out.message,
+                "failures": len(ref_out.failures),
+            },
+            "samples": {
+                "n": len(self.samples),
+                "impacts": self.samples.n_impacts,
+                "derivative": self.samples.derivative,
+                "noise": self.samples.noise,
+            },
+            "measured": {
+                "n_cycles": self.measured.n_cycles,
+                "n_periods": self.measured.n_periods,
+                "noise": self.measured.noise,
+                "threshold": self.measured.threshold,
+            },
             "discovery_seconds": self.seconds,
-            "fit_settings": self.settings}
+            "fit_settings": self.settings,
+        }
 
     def _lines(self):
         sel = self.selected
         crit = self.settings.get("criterion", "I2")
-        head = (f"selected {sel.law}  [{sel.regime}]: "
-                f"{'consistent' if sel.consistent else 'NOT consistent'} with the record(s)")
+        head = (
+            f"selected {sel.law}  [{sel.regime}]: "
+            f"{'consistent' if sel.consistent else 'NOT consistent'} with the record(s)"
+        )
         out = [head, *coefficient_lines(sel.law.as_dict(), sel.standard_errors, sel.intervals)]
         out += criteria_lines(sel.criteria, sel.noise_floor)
         out.append(f"  verdict: {sel.verdict}")
         out.append(f"ranking ({len(self.ranking)} candidates, criterion {crit}):")
         for i, m in enumerate(self.ranking[:8]):
-            out.append(f"  {i + 1:>2}. {' + '.join(m.law.names):<28} {m.regime:<6} "
-                       f"{crit} {fmt((m.criteria or {}).get(crit), 3):>8}  "
-                       f"{'consistent' if m.consistent else ''}")
+            out.append(
+                f"  {i + 1:>2}. {' + '.join(m.law.names):<28} {m.regime:<6} "
+                f"{crit} {fmt((m.criteria or {}).get(crit), 3):>8}  "
+                f"{'consistent' if m.consistent else ''}"
+            )
         if len(self.ranking) > 8:
             out.append(f"  ... {len(self.ranking) - 8} more")
         for e in self.equivalent:
             out.append(f"equivalent: {e.get('law', e.get('terms'))}: {e.get('reason', '')}")
         cert = self.certificate
         if cert is not None:
-            out.append(f"certificate: conditions {'hold' if cert.holds else 'DO NOT hold'} "
-                       f"({cert.method})")
+            out.append(
+                f"certificate: conditions {'hold' if cert.holds else 'DO NOT hold'} ({cert.method})"
+            )
         out += [f"warning: {w}" for w in self.warnings]
         out.append(f"{self.seconds:.1f} s")
         return out
@@ -303,24 +352,30 @@ def rank(models, criterion="I2", sim_rtol=0.1, sim_atol=0.005, physics=True):
             head = rank(sound, criterion, sim_rtol, sim_atol, physics=False)
             tail = rank(unsound, criterion, sim_rtol, sim_atol, physics=False)
             # models without a periodic steady state stay last of all
-            return ([m for m in head if m.criteria] + [m for m in tail if m.criteria]
-                    + [m for m in head if not m.criteria]
-                    + [m for m in tail if not m.criteria])
+            return (
+                [m for m in head if m.criteria]
+                + [m for m in tail if m.criteria]
+                + [m for m in head if not m.criteria]
+                + [m for m in tail if not m.criteria]
+            )
     ok = [m for m in models if m.criteria]
     bad = sorted((m for m in models if not m.criteria), key=lambda m: m.candidate.bic)
     if not ok:
         return bad
-    good = sorted((m for m in ok if m.consistent),
-                  key=lambda m: (len(m.law.names), m.criteria[criterion]))
+    good = sorted(
+        (m for m in ok if m.consistent), key=lambda m: (len(m.law.names), m.criteria[criterion])
+    )
     rest = [m for m in ok if not m.consistent]
     if not rest:
         return good + bad
     best = min(m.criteria[criterion] for m in rest)
     limit = max(best * (1 + sim_rtol), best + sim_atol)
-    tier = sorted((m for m in rest if m.criteria[criterion] <= limit),
-                  key=lambda m: m.candidate.bic)
-    tail = sorted((m for m in rest if m.criteria[criterion] > limit),
-                  key=lambda m: m.criteria[criterion])
+    tier = sorted(
+        (m for m in rest if m.criteria[criterion] <= limit), key=lambda m: m.candidate.bic
+    )
+    tail = sorted(
+        (m for m in rest if m.criteria[criterion] > limit), key=lambda m: m.criteria[criterion]
+    )
     return good + tier + tail + bad
 
 
@@ -367,8 +422,10 @@ def _required_terms(require, library):
         except VidiError:
             name = None
         if name not in names:
-            raise InputError(f"required term {r!r} is not in the library ({', '.join(names)})"
-                             "; give library terms to --require, e.g. --require z")
+            raise InputError(
+                f"required term {r!r} is not in the library ({', '.join(names)})"
+                "; give library terms to --require, e.g. --require z"
+            )
         out.add(name)
     return frozenset(out)
 
@@ -381,8 +438,9 @@ def _steady_from(ref):
 class _Checker:
     """Refines (optionally) and evaluates one regression candidate against all records."""
 
-    def __init__(self, est, samples, refs, criterion, refine, tolerances, budget,
-                 required=frozenset()):
+    def __init__(
+        self, est, samples, refs, criterion, refine, tolerances, budget, required=frozenset()
+    ):
         self.est, self.samples, self.refs = est, samples, refs
         self.required = frozenset(required)
         self.criterion, self.refine, self.tol, self.budget = criterion, refine, tolerances, budget
@@ -403,33 +461,54 @@ class _Checker:
         cand = replace(cand, extra={**cand.extra, **extra})
         cert0 = est.certify(_coefficients(law, est.library_))
         if not self.refine:
-            return RankedModel(law, cand, self.evaluate(law), note="not refined",
-                               certificate=cert0)
+            return RankedModel(law, cand, self.evaluate(law), note="not refined", certificate=cert0)
         law = self._scaled_start(law)
         try:
-            ref = identify([sc for sc, _ in self.refs], [r for _, r in self.refs], law,
-                           criterion=self.criterion, method="least-squares",
-                           max_simulations=self.budget, tolerances=self.tol)
+            ref = identify(
+                [sc for sc, _ in self.refs],
+                [r for _, r in self.refs],
+                law,
+                criterion=self.criterion,
+                method="least-squares",
+                max_simulations=self.budget,
+                tolerances=self.tol,
+            )
         except IntegrationError as exc:
-            return RankedModel(law, cand, self.evaluate(law),
-                               note=f"not refined: the {origin} law fails ({exc})",
-                               certificate=cert0)
+            return RankedModel(
+                law,
+                cand,
+                self.evaluate(law),
+                note=f"not refined: the {origin} law fails ({exc})",
+                certificate=cert0,
+            )
         coef = _coefficients(ref.law, est.library_)
         cert = est.certify(coef)
         if not cert.holds:
-            return RankedModel(law, cand, self.evaluate(law), refinement=ref,
-                               note="not refined: the refined coefficients break a physical "
-                               f"condition (worst violation {cert.worst_violation:.2g})",
-                               certificate=cert0)
+            return RankedModel(
+                law,
+                cand,
+                self.evaluate(law),
+                refinement=ref,
+                note="not refined: the refined coefficients break a physical "
+                f"condition (worst violation {cert.worst_violation:.2g})",
+                certificate=cert0,
+            )
         s = self.samples
-        rescored = est.rescore(coef, s.X, s.F, s.weight, s.impact, constrained=cand.constrained,
-                               extra=cand.extra)
+        rescored = est.rescore(
+            coef, s.X, s.F, s.weight, s.impact, constrained=cand.constrained, extra=cand.extra
+        )
         if origin == "regression":  # the support's cross-validated error is the candidate's
             rescored = replace(rescored, cv_error=cand.cv_error)
-        return RankedModel(ref.law, rescored, self.evaluate(ref.law), refinement=ref,
-                           note=f"refined by simulation from the {origin} "
-                           f"({ref.n_simulations} simulations, {self.criterion} "
-                           f"{ref.value:.3g})", certificate=cert)
+        return RankedModel(
+            ref.law,
+            rescored,
+            self.evaluate(ref.law),
+            refinement=ref,
+            note=f"refined by simulation from the {origin} "
+            f"({ref.n_simulations} simulations, {self.criterion} "
+            f"{ref.value:.3g})",
+            certificate=cert,
+        )
 
     def _scaled_start(self, law):
         """The refinement works in units of the start coefficients: a term whose start is
@@ -459,8 +538,7 @@ class _Checker:
         coef = np.zeros(len(lib))
         elastic = [i for i, t in enumerate(lib.terms) if t.b == 0]
         damping = [i for i, t in enumerate(lib.terms) if t.b == 1]
-        chosen = [min(group, key=lambda j: lib.terms[j].a) for group in (elastic, damping)
-                  if group]
+        chosen = [min(group, key=lambda j: lib.terms[j].a) for group in (elastic, damping) if group]
         if not chosen:
             return None
         coef[chosen] = record_start(scenario, ref, [lib.terms[i] for i in chosen])
@@ -481,10 +559,10 @@ class _Checker:
                 continue
             coef = _coefficients(base.law, lib)
             coef[[t.name for t in lib.terms].index(term)] = 0.0
-            cand = self.est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight,
-                                    self.samples.impact)
-            out.append(self.refined(lib.law(coef), cand,
-                                    f"backward step from {' + '.join(names)}"))
+            cand = self.est.rescore(
+                coef, self.samples.X, self.samples.F, self.samples.weight, self.samples.impact
+            )
+            out.append(self.refined(lib.law(coef), cand, f"backward step from {' + '.join(names)}"))
         return out
 
     def restart(self, base, support):
@@ -499,12 +577,13 @@ class _Checker:
         base_c = _coefficients(base.law, lib)
         for i, term in enumerate(lib.terms):
             if term.name in support:
-                coef[i] = base_c[i] if base_c[i] else _FORWARD_STARTS[0] * peak / max(
-                    corner[i], 1e-300)
-        cand = est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight,
-                           self.samples.impact)
-        return self.refined(lib.law(coef), cand,
-                            f"restart from {' + '.join(base.law.names)}")
+                coef[i] = (
+                    base_c[i] if base_c[i] else _FORWARD_STARTS[0] * peak / max(corner[i], 1e-300)
+                )
+        cand = est.rescore(
+            coef, self.samples.X, self.samples.F, self.samples.weight, self.samples.impact
+        )
+        return self.refined(lib.law(coef), cand, f"restart from {' + '.join(base.law.names)}")
 
     def forward(self, base, max_terms, skip=frozenset()):
         """Output-error forward step: ``base`` plus each library term it lacks, every trial
@@ -526,8 +605,9 @@ class _Checker:
             for frac in _FORWARD_STARTS:
                 coef = _coefficients(base.law, lib)
                 coef[i] = frac * peak / corner[i]
-                cand = est.rescore(coef, self.samples.X, self.samples.F, self.samples.weight,
-                                   self.samples.impact)
+                cand = est.rescore(
+                    coef, self.samples.X, self.samples.F, self.samples.weight, self.samples.impact
+                )
                 trial = self.refined(lib.law(coef), cand, origin)
                 if trial.criteria:
                     break
@@ -545,13 +625,20 @@ def _stability_warning(stab, selected):
         return None
     parts = []
     if weak:
-        parts.append("selected but chosen in < 50 % of resamples: " + ", ".join(
-            f"{t} ({stab.get(t, 0.0):.2f})" for t in sorted(weak)))
+        parts.append(
+            "selected but chosen in < 50 % of resamples: "
+            + ", ".join(f"{t} ({stab.get(t, 0.0):.2f})" for t in sorted(weak))
+        )
     if strong:
-        parts.append("chosen in >= 50 % of resamples but not selected: " + ", ".join(
-            f"{t} ({stab[t]:.2f})" for t in sorted(strong)))
-    return ("stability selection disagrees with the selected support (" + "; ".join(parts)
-            + "): the record may not identify these terms")
+        parts.append(
+            "chosen in >= 50 % of resamples but not selected: "
+            + ", ".join(f"{t} ({stab[t]:.2f})" for t in sorted(strong))
+        )
+    return (
+        "stability selection disagrees with the selected support ("
+        + "; ".join(parts)
+        + "): the record may not identify these terms"
+    )
 
 
 def _impact_warnings(pairs, parts, refs):
@@ -563,11 +650,13 @@ def _impact_warnings(pairs, parts, refs):
         n = s.n_impacts
         if expected >= 2 and not (0.6 * expected - 1 <= n <= 1.15 * expected + 1):
             label = f"record {k + 1}" if len(pairs) > 1 else "the record"
-            out.append(f"{label} gives {n} impacts for the contact samples, but its "
-                       f"{span / sc.period:.0f} periods of a {ref.regime} cycle with "
-                       f"{ref.impacts} contact(s) hold about {expected:.0f}: contacts are "
-                       "split or merged (noisy positions?); check the record, record the "
-                       "velocities, or lower the position noise")
+            out.append(
+                f"{label} gives {n} impacts for the contact samples, but its "
+                f"{span / sc.period:.0f} periods of a {ref.regime} cycle with "
+                f"{ref.impacts} contact(s) hold about {expected:.0f}: contacts are "
+                "split or merged (noisy positions?); check the record, record the "
+                "velocities, or lower the position noise"
+            )
     return out
 
 
@@ -578,25 +667,36 @@ def _warnings(selected, by_bic, stab, pairs, parts, refs, samples, refine):
         out.append(w)
     failing = [m for m in by_bic[:3] if not m.criteria]
     if failing:
-        out.append(f"{len(failing)} of the 3 best candidates by the regression score have no "
-                   "periodic steady state with contact (" + "; ".join(
-                       f"{' + '.join(m.law.names)}: {m.evaluation.status}" for m in failing)
-                   + "): the regression alone would mislead here")
+        out.append(
+            f"{len(failing)} of the 3 best candidates by the regression score have no "
+            "periodic steady state with contact ("
+            + "; ".join(f"{' + '.join(m.law.names)}: {m.evaluation.status}" for m in failing)
+            + "): the regression alone would mislead here"
+        )
     out.extend(_impact_warnings(pairs, parts, refs))
-    if not selected.consistent and selected.criteria and all(
-            ev.consistent or ev.extra.get("only_I4") for ev in selected.evaluations):
-        out.append("the selected model fails the consistency rule by I4 alone (the contact "
-                   "supports; I2 is within its noise floor): I4 is noise-sensitive on flat "
-                   "force tails and short contacts, so this may be the right law; compare the "
-                   "contact ends in fit_impulse before trying a larger library")
+    if (
+        not selected.consistent
+        and selected.criteria
+        and all(ev.consistent or ev.extra.get("only_I4") for ev in selected.evaluations)
+    ):
+        out.append(
+            "the selected model fails the consistency rule by I4 alone (the contact "
+            "supports; I2 is within its noise floor): I4 is noise-sensitive on flat "
+            "force tails and short contacts, so this may be the right law; compare the "
+            "contact ends in fit_impulse before trying a larger library"
+        )
     elif not selected.consistent:
-        out.append("no shortlisted model is consistent with the record(s) within the noise "
-                   "floor: try a larger library (e.g. poly:3+hc), a longer shortlist, or check "
-                   "the scenario (masses, supports, drive)")
+        out.append(
+            "no shortlisted model is consistent with the record(s) within the noise "
+            "floor: try a larger library (e.g. poly:3+hc), a longer shortlist, or check "
+            "the scenario (masses, supports, drive)"
+        )
     if samples.derivative != "velocities" and not refine:
-        out.append(f"dzeta was obtained by {samples.derivative} from noisy positions: the "
-                   "regression coefficients are biased (errors in variables); use the "
-                   "refinement by simulation")
+        out.append(
+            f"dzeta was obtained by {samples.derivative} from noisy positions: the "
+            "regression coefficients are biased (errors in variables); use the "
+            "refinement by simulation"
+        )
     ref = selected.refinement
     if ref is not None and selected.standard_errors:
         reg = selected.candidate.extra.get("regression_coefficients", {})
@@ -605,12 +705,13 @@ def _warnings(selected, by_bic, stab, pairs, parts, refs, samples, refine):
             se = selected.standard_errors.get(t, 0.0)
             c0 = reg.get(t)
             if c0 is not None and se > 0 and abs(c - c0) > max(3 * se, 0.1 * abs(c)):
-                moved.append(f"{t} {c0:.3g} -> {c:.3g} ({abs(c - c0) / se:.0f} standard "
-                             "errors)")
+                moved.append(f"{t} {c0:.3g} -> {c:.3g} ({abs(c - c0) / se:.0f} standard errors)")
         if moved:
-            out.append("the refinement by simulation moved regression coefficients far beyond "
-                       "their uncertainty (" + "; ".join(moved) + "): the regression is biased "
-                       "by noisy penetration or velocity; the refined values are reported")
+            out.append(
+                "the refinement by simulation moved regression coefficients far beyond "
+                "their uncertainty (" + "; ".join(moved) + "): the regression is biased "
+                "by noisy penetration or velocity; the refined values are reported"
+            )
     return out
 
 
@@ -642,8 +743,7 @@ def _separation(est, a, b):
         peak = max(peak, float(np.max(np.abs(fa))))
         d_in = max(d_in, float(np.max(np.abs(fa - fb))))
     box = est.box_
-    zz, vv = np.meshgrid(np.linspace(0, 2 * box.zeta_max, 41),
-                         np.linspace(0, 2 * box.zd_max, 41))
+    zz, vv = np.meshgrid(np.linspace(0, 2 * box.zeta_max, 41), np.linspace(0, 2 * box.zd_max, 41))
     d = np.abs(a.law(zz, vv) - b.law(zz, vv)) / peak
     i = np.unravel_index(int(np.argmax(d)), d.shape)
     return d_in / peak, float(d[i]), float(zz[i]), float(vv[i])
@@ -665,44 +765,92 @@ def _equivalent(ranking, selected, est, samples, criterion):
         r2 = _collinearity(est, samples, extra, base) if extra else {}
         near = {t: v for t, v in r2.items() if v > 0.95}
         d_in, d_out, z, v = _separation(est, selected, m)
-        differ = (" vs ".join(" + ".join(sorted(x)) for x in (sel_t - m_t, m_t - sel_t) if x)
-                  or "the coefficients")
+        differ = (
+            " vs ".join(" + ".join(sorted(x)) for x in (sel_t - m_t, m_t - sel_t) if x)
+            or "the coefficients"
+        )
         if near:
-            reason = ("near-collinear along the recorded orbit(s): " + ", ".join(
+            reason = "near-collinear along the recorded orbit(s): " + ", ".join(
                 f"{t} is explained by {' + '.join(base) or 'nothing'} to R^2 = {v:.3f}"
-                for t, v in near.items()))
+                for t, v in near.items()
+            )
         else:
-            reason = (f"{differ}: their simulated force histories differ by at most "
-                      f"{100 * d_in:.2g} % of the peak on the recorded orbit(s), within the "
-                      "noise floor")
-        separate = (f"their forces differ by {100 * d_out:.0f} % of the recorded peak at "
-                    f"zeta = {z:.3g} m, zd = {v:.3g} m/s (recorded up to "
-                    f"{est.box_.zeta_max:.3g} m, {est.box_.zd_max:.3g} m/s): a record with "
-                    "faster or deeper impacts (larger drive amplitude, another frequency) "
-                    "would separate them" if d_out > 2 * d_in else
-                    "they differ little anywhere near the recorded range: the data cannot "
-                    "separate them; prefer the simpler one")
-        out.append({"terms": list(m.law.names), "coefficients": m.law.as_dict(),
-                    "criteria": m.criteria, "consistent": True, "reason": reason,
-                    "separate": separate})
+            reason = (
+                f"{differ}: their simulated force histories differ by at most "
+                f"{100 * d_in:.2g} % of the peak on the recorded orbit(s), within the "
+                "noise floor"
+            )
+        separate = (
+            f"their forces differ by {100 * d_out:.0f} % of the recorded peak at "
+            f"zeta = {z:.3g} m, zd = {v:.3g} m/s (recorded up to "
+            f"{est.box_.zeta_max:.3g} m, {est.box_.zd_max:.3g} m/s): a record with "
+            "faster or deeper impacts (larger drive amplitude, another frequency) "
+            "would separate them"
+            if d_out > 2 * d_in
+            else "they differ little anywhere near the recorded range: the data cannot "
+            "separate them; prefer the simpler one"
+        )
+        out.append(
+            {
+                "terms": list(m.law.names),
+                "coefficients": m.law.as_dict(),
+                "criteria": m.criteria,
+                "consistent": True,
+                "reason": reason,
+                "separate": separate,
+            }
+        )
     return out
 
 
 @params(
-    scenario=(Scenario, list, tuple), measurement=(Measurement, list, tuple),
-    library=(Text(), Library, list, tuple), selection=Text(), scoring=Text(),
-    max_terms=Real(1, 64, integer=True), criterion=Text(), shortlist=Real(1, integer=True),
-    stability=Real(0, integer=True), derivative=(None, Text()), sim_rtol=Real(0, open_low=True),
-    sim_atol=Real(0), tolerances=(Tolerances, None), random_state=Real(0, integer=True),
-    n_boot=Real(0, integer=True), max_simulations=Real(0, integer=True),
-    stepwise=Real(0, integer=True), require=(tuple, list), n_boot_intervals=Real(0, integer=True),
+    scenario=(Scenario, list, tuple),
+    measurement=(Measurement, list, tuple),
+    library=(Text(), Library, list, tuple),
+    selection=Text(),
+    scoring=Text(),
+    max_terms=Real(1, 64, integer=True),
+    criterion=Text(),
+    shortlist=Real(1, integer=True),
+    stability=Real(0, integer=True),
+    derivative=(None, Text()),
+    sim_rtol=Real(0, open_low=True),
+    sim_atol=Real(0),
+    tolerances=(Tolerances, None),
+    random_state=Real(0, integer=True),
+    n_boot=Real(0, integer=True),
+    max_simulations=Real(0, integer=True),
+    stepwise=Real(0, integer=True),
+    require=(tuple, list),
+    n_boot_intervals=Real(0, integer=True),
 )
-def discover(scenario, measurement, *, library="poly:2", selection="best-subset", scoring="bic",
-             max_terms=4, criterion="I2", shortlist=8, refine=True, stability=0,
-             derivative=None, average_cycles=False, sim_rtol=0.1, sim_atol=0.005,
-             tolerances=None, random_state=0, n_boot=16, max_simulations=_REFINE_BUDGET,
-             stepwise=3, physics=True, require=(), n_boot_intervals=30, progress=None,
-             **estimator_kwargs):
+def discover(
+    scenario,
+    measurement,
+    *,
+    library="poly:2",
+    selection="best-subset",
+    scoring="bic",
+    max_terms=4,
+    criterion="I2",
+    shortlist=8,
+    refine=True,
+    stability=0,
+    derivative=None,
+    average_cycles=False,
+    sim_rtol=0.1,
+    sim_atol=0.005,
+    tolerances=None,
+    random_state=0,
+    n_boot=16,
+    max_simulations=_REFINE_BUDGET,
+    stepwise=3,
+    physics=True,
+    require=(),
+    n_boot_intervals=30,
+    progress=None,
+    **estimator_kwargs,
+):
     """Discover a contact law from one or several records and check it by simulation.
 
     Parameters
@@ -773,34 +921,52 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     t0 = time.perf_counter()
     _criterion(criterion)
     if not (isinstance(shortlist, int | np.integer) and shortlist >= 1):
-        raise InputError(f"shortlist must be a positive integer (candidates simulated); got "
-                         f"{shortlist!r}")
-    for name, v, low in (("stability", stability, 0), ("n_boot", n_boot, 1),
-                         ("max_simulations", max_simulations, 2), ("stepwise", stepwise, 0)):
+        raise InputError(
+            f"shortlist must be a positive integer (candidates simulated); got {shortlist!r}"
+        )
+    for name, v, low in (
+        ("stability", stability, 0),
+        ("n_boot", n_boot, 1),
+        ("max_simulations", max_simulations, 2),
+        ("stepwise", stepwise, 0),
+    ):
         if not (isinstance(v, int | np.integer) and not isinstance(v, bool) and v >= low):
             raise InputError(f"{name} must be an integer >= {low}; got {v!r}")
     pairs = pair_records(scenario, measurement)
-    parts = [contact_samples(m, derivative=derivative, average_cycles=average_cycles,
-                             period=sc.period) for sc, m in pairs]
+    parts = [
+        contact_samples(m, derivative=derivative, average_cycles=average_cycles, period=sc.period)
+        for sc, m in pairs
+    ]
     samples = join_samples(parts)
-    refs = [(sc, Reference.from_measurement(m, sc, n_boot=n_boot, seed=random_state))
-            for sc, m in pairs]
+    refs = [
+        (sc, Reference.from_measurement(m, sc, n_boot=n_boot, seed=random_state)) for sc, m in pairs
+    ]
     if isinstance(estimator_kwargs.get("signs"), dict):
         estimator_kwargs["signs"] = _sign_vector(estimator_kwargs["signs"], library)
-    est = ConstrainedSparseRegressor(library=library, selection=selection, scoring=scoring,
-                                     max_terms=max_terms, **estimator_kwargs)
+    est = ConstrainedSparseRegressor(
+        library=library,
+        selection=selection,
+        scoring=scoring,
+        max_terms=max_terms,
+        **estimator_kwargs,
+    )
     est.fit(samples.X, samples.F, groups=samples.impact, sample_weight=samples.weight)
     required = _required_terms(require, est.library_)
-    check = _Checker(est, samples, refs, criterion, refine, tolerances, max_simulations,
-                     required)
+    check = _Checker(est, samples, refs, criterion, refine, tolerances, max_simulations, required)
     pool = [c for c in est.candidates_ if required <= set(c.coefficients)]
     if not pool:
-        raise InputError(f"no candidate support of the library holds the required terms "
-                         f"{', '.join(sorted(required))}; raise --max-terms or drop --require")
+        raise InputError(
+            f"no candidate support of the library holds the required terms "
+            f"{', '.join(sorted(required))}; raise --max-terms or drop --require"
+        )
     models = []
     for k, c in enumerate(pool[:shortlist]):
-        tick(progress, "fit: shortlisted supports checked by simulation", k, min(len(pool),
-                                                                                 shortlist))
+        tick(
+            progress,
+            "fit: shortlisted supports checked by simulation",
+            k,
+            min(len(pool), shortlist),
+        )
         models.append(check(c))
     by_score = list(models)  # the estimator's order (its scoring)
 
@@ -817,13 +983,18 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
             models = models + [start]
             ranking = rank_all(models)
     retried = set()
+
     def more(steps):
         # up to `stepwise` moves, and one simplifying move more when the last move made the
         # best model consistent (its backward step and restarts would be cut off otherwise)
         if len(steps) < stepwise:
             return True
-        return (len(steps) == stepwise and stepwise > 0 and ranking[0].consistent
-                and steps[-1]["kind"] != "backward")
+        return (
+            len(steps) == stepwise
+            and stepwise > 0
+            and ranking[0].consistent
+            and steps[-1]["kind"] != "backward"
+        )
 
     while refine and ranking[0].criteria and more(steps):
         # output-error stepwise search around the best model: a consistent model loses a
@@ -836,17 +1007,23 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         # a refinement that stalled far from the truth must not hide the simplest model
         done = frozenset(frozenset(m.law.names) for m in models if m.criteria)
         if top.consistent and not (physics and top.defects):
-            good = frozenset(frozenset(m.law.names) for m in models
-                             if m.criteria and m.consistent)
+            good = frozenset(frozenset(m.law.names) for m in models if m.criteria and m.consistent)
             trials, kind = check.backward(top, good | retried), "backward"
             retried |= {frozenset(m.law.names) for m in trials} & done
             # smaller supports that stalled and no backward step reaches: the two best,
             # restarted from the consistent model's coefficients
-            stalled = sorted((m for m in models if m.criteria and not m.consistent
-                              and len(m.law.names) <= len(top.law.names)
-                              and frozenset(m.law.names) not in retried
-                              and not (physics and m.defects)),
-                             key=lambda m: m.criteria[criterion])[:_RESTARTS]
+            stalled = sorted(
+                (
+                    m
+                    for m in models
+                    if m.criteria
+                    and not m.consistent
+                    and len(m.law.names) <= len(top.law.names)
+                    and frozenset(m.law.names) not in retried
+                    and not (physics and m.defects)
+                ),
+                key=lambda m: m.criteria[criterion],
+            )[:_RESTARTS]
             for m in stalled:
                 retried.add(frozenset(m.law.names))
                 trials.append(check.restart(top, set(m.law.names)))
@@ -862,12 +1039,22 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
         if ranking[0] is top:
             break
     selected = ranking[0]
-    if n_boot_intervals and refine and selected.refinement is not None \
-            and selected.note.startswith("refined"):
+    if (
+        n_boot_intervals
+        and refine
+        and selected.refinement is not None
+        and selected.note.startswith("refined")
+    ):
         tick(progress, "fit: bootstrap intervals", 0, n_boot_intervals)
-        iv = bootstrap_intervals([sc for sc, _ in refs], [r for _, r in refs], selected.law,
-                                 n_boot=int(n_boot_intervals), seed=random_state,
-                                 criterion=criterion, tolerances=tolerances)
+        iv = bootstrap_intervals(
+            [sc for sc, _ in refs],
+            [r for _, r in refs],
+            selected.law,
+            n_boot=int(n_boot_intervals),
+            seed=random_state,
+            criterion=criterion,
+            tolerances=tolerances,
+        )
         if iv is not None:
             chosen = replace(selected, intervals=iv)
             ranking = [chosen if m is selected else m for m in ranking]
@@ -875,26 +1062,66 @@ def discover(scenario, measurement, *, library="poly:2", selection="best-subset"
     # the certificate of the law actually selected (the ranking may prefer another
     # candidate than the estimator's best by BIC); a failure is an error
     cert = require_certificate(selected.certificate)
-    stab = est.stability(samples.X, samples.F, samples.impact, stability, random_state,
-                         sample_weight=samples.weight) if stability else {}
+    stab = (
+        est.stability(
+            samples.X,
+            samples.F,
+            samples.impact,
+            stability,
+            random_state,
+            sample_weight=samples.weight,
+        )
+        if stability
+        else {}
+    )
     warnings = _warnings(selected, by_score, stab, pairs, parts, refs, samples, refine)
     if selected.defects:
-        warnings.insert(0, "the selected law is no contact law (" + "; ".join(selected.defects)
-                        + "): " + ("no candidate was one; widen the library or --require z"
-                                   if physics else "ranked by the records alone "
-                                   "(--allow-unphysical)"))
+        warnings.insert(
+            0,
+            "the selected law is no contact law ("
+            + "; ".join(selected.defects)
+            + "): "
+            + (
+                "no candidate was one; widen the library or --require z"
+                if physics
+                else "ranked by the records alone (--allow-unphysical)"
+            ),
+        )
     equivalent = _equivalent(ranking, selected, est, samples, criterion)
-    settings = {"library": str(library), "selection": selection, "scoring": scoring,
-                "max_terms": max_terms, "criterion": criterion, "shortlist": shortlist,
-                "refine": refine, "max_simulations": max_simulations, "stability": stability,
-                "derivative": samples.derivative, "average_cycles": average_cycles,
-                "random_state": random_state, "n_boot": n_boot, "records": len(pairs),
-                "stepwise": stepwise, "steps": steps, "physics": physics,
-                "n_boot_intervals": n_boot_intervals,
-                "require": sorted(required),
-                "ranking_rule": {"sim_rtol": sim_rtol, "sim_atol": sim_atol},
-                "estimator": est.get_params()}
-    return DiscoveryResult(selected=selected, ranking=ranking, certificate=cert, estimator=est,
-                           samples=samples, measured=refs[0][1].impulse, references=tuple(refs),
-                           stability=stab, warnings=warnings, equivalent=equivalent,
-                           seconds=time.perf_counter() - t0, settings=settings)
+    settings = {
+        "library": str(library),
+        "selection": selection,
+        "scoring": scoring,
+        "max_terms": max_terms,
+        "criterion": criterion,
+        "shortlist": shortlist,
+        "refine": refine,
+        "max_simulations": max_simulations,
+        "stability": stability,
+        "derivative": samples.derivative,
+        "average_cycles": average_cycles,
+        "random_state": random_state,
+        "n_boot": n_boot,
+        "records": len(pairs),
+        "stepwise": stepwise,
+        "steps": steps,
+        "physics": physics,
+        "n_boot_intervals": n_boot_intervals,
+        "require": sorted(required),
+        "ranking_rule": {"sim_rtol": sim_rtol, "sim_atol": sim_atol},
+        "estimator": est.get_params(),
+    }
+    return DiscoveryResult(
+        selected=selected,
+        ranking=ranking,
+        certificate=cert,
+        estimator=est,
+        samples=samples,
+        measured=refs[0][1].impulse,
+        references=tuple(refs),
+        stability=stab,
+        warnings=warnings,
+        equivalent=equivalent,
+        seconds=time.perf_counter() - t0,
+        settings=settings,
+    )

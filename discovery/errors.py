@@ -11,8 +11,16 @@ re-exported here, so the constraints package's :class:`~constraints.errors.Solve
 
 from constraints.errors import CertificateError, InputError, SolverError, VidiError
 
-__all__ = ["VidiError", "InputError", "VidiTypeError", "LawSyntaxError", "IntegrationError",
-           "NoContactError", "CertificateError", "SolverError"]
+__all__ = [
+    "VidiError",
+    "InputError",
+    "VidiTypeError",
+    "LawSyntaxError",
+    "IntegrationError",
+    "NoContactError",
+    "CertificateError",
+    "SolverError",
+]
 
 
 class LawSyntaxError(InputError):

@@ -110,8 +110,9 @@ class Pool(Executor):
         if n <= 1:
             yield from Serial().run(fn, jobs, context)
             return
-        pool = ProcessPoolExecutor(n, mp_context=get_context("fork"),
-                                   **worker_initializer(_set_context, (context,)))
+        pool = ProcessPoolExecutor(
+            n, mp_context=get_context("fork"), **worker_initializer(_set_context, (context,))
+        )
         try:
             pending = {pool.submit(_call, fn, job): i for i, job in enumerate(jobs)}
             while pending:
@@ -142,8 +143,10 @@ class Dask(Executor):
         try:
             from distributed import Client, LocalCluster
         except ImportError:
-            raise InputError("--scheduler needs Dask's distributed scheduler; install it with "
-                             "pip install 'vibroimpact-discovery[dask]'") from None
+            raise InputError(
+                "--scheduler needs Dask's distributed scheduler; install it with "
+                "pip install 'vibroimpact-discovery[dask]'"
+            ) from None
         self.address = str(address)
         self._cluster = None
         if self.address == "local":
@@ -155,20 +158,29 @@ class Dask(Executor):
             # the workers get this process's BLAS/OpenMP thread settings, like the pool's
             # forked workers (Dask sets them to 1 by default; a BLAS initialised with
             # another thread count can sum in another order and move an optimiser's path)
-            environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ",
-                                                        {}).items() if k not in _THREAD_VARS}
+            environ = {
+                k: v
+                for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
+                if k not in _THREAD_VARS
+            }
             environ.update({k: os.environ[k] for k in _THREAD_VARS if k in os.environ})
             with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
-                self._cluster = LocalCluster(n_workers=n, threads_per_worker=1,
-                                             processes=True, dashboard_address=None,
-                                             silence_logs=50)
+                self._cluster = LocalCluster(
+                    n_workers=n,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    silence_logs=50,
+                )
             self.client = Client(self._cluster)
         else:
             try:
                 self.client = Client(self.address, timeout="5s")
             except (OSError, TimeoutError, ValueError) as exc:
-                raise InputError(f"cannot reach the Dask scheduler at {self.address} ({exc}); "
-                                 "start one (dask scheduler) or use --scheduler local") from None
+                raise InputError(
+                    f"cannot reach the Dask scheduler at {self.address} ({exc}); "
+                    "start one (dask scheduler) or use --scheduler local"
+                ) from None
             workers = sorted(self.client.scheduler_info()["workers"])
             if workers:  # one worker builds the cache, then the others load it
                 self.client.run(_warm_worker, workers=workers[:1])
@@ -182,8 +194,7 @@ class Dask(Executor):
         if not jobs:
             return
         ctx = self.client.scatter(context, broadcast=True, hash=False)
-        futures = self.client.map(_call_with, [fn] * len(jobs), [ctx] * len(jobs), jobs,
-                                  pure=False)
+        futures = self.client.map(_call_with, [fn] * len(jobs), [ctx] * len(jobs), jobs, pure=False)
         index = {f.key: i for i, f in enumerate(futures)}
         try:
             for fut in as_completed(futures):

@@ -46,12 +46,22 @@ from .measurement import Measurement
 from .scenario import Scenario
 from .verify import Reference, evaluate
 
-__all__ = ["IdentificationResult", "identify", "METHODS", "as_records", "pair_records",
-           "contact_scales", "record_start", "cycle_pairs", "Intervals", "bootstrap_intervals"]
+__all__ = [
+    "IdentificationResult",
+    "identify",
+    "METHODS",
+    "as_records",
+    "pair_records",
+    "contact_scales",
+    "record_start",
+    "cycle_pairs",
+    "Intervals",
+    "bootstrap_intervals",
+]
 
 METHODS = ("coordinate-descent", "nelder-mead", "least-squares")
-_PENALTY = 10.0          # criterion value of a failed simulation (criteria are O(1))
-_JAC_STEP = 1e-5         # relative step of the standard-error Jacobian
+_PENALTY = 10.0  # criterion value of a failed simulation (criteria are O(1))
+_JAC_STEP = 1e-5  # relative step of the standard-error Jacobian
 
 
 @readable
@@ -109,18 +119,29 @@ class IdentificationResult:
 
     def as_dict(self):
         """The result as JSON-ready data (the identification part of ``summary.json``)."""
-        return {"criterion": self.criterion, "method": self.method,
-                "coefficients": self.coefficients, "law": self.law.to_text(),
-                "latex": self.law.latex(), "standard_errors": self.standard_errors,
-                "intervals": None if self.intervals is None else self.intervals.as_dict(),
-                "correlation": self.correlation, "value": self.value,
-                "criteria_found": self.criteria, "n_simulations": self.n_simulations,
-                "failures": self.failures, "iterations": self.iterations,
-                "message": self.message, "seconds": self.seconds}
+        return {
+            "criterion": self.criterion,
+            "method": self.method,
+            "coefficients": self.coefficients,
+            "law": self.law.to_text(),
+            "latex": self.law.latex(),
+            "standard_errors": self.standard_errors,
+            "intervals": None if self.intervals is None else self.intervals.as_dict(),
+            "correlation": self.correlation,
+            "value": self.value,
+            "criteria_found": self.criteria,
+            "n_simulations": self.n_simulations,
+            "failures": self.failures,
+            "iterations": self.iterations,
+            "message": self.message,
+            "seconds": self.seconds,
+        }
 
     def _lines(self):
-        out = [f"identified {self.law}: {self.criterion} = {fmt(self.value, 3)} "
-               f"({self.method}, {self.n_simulations} simulations, {self.seconds:.1f} s)"]
+        out = [
+            f"identified {self.law}: {self.criterion} = {fmt(self.value, 3)} "
+            f"({self.method}, {self.n_simulations} simulations, {self.seconds:.1f} s)"
+        ]
         out += coefficient_lines(self.coefficients, self.standard_errors, self.intervals)
         out += criteria_lines(self.criteria)
         if self.message:
@@ -142,8 +163,10 @@ def pair_records(scenario, records):
     if len(scs) == 1 and len(recs) > 1:
         scs = scs * len(recs)
     if not recs or len(scs) != len(recs):
-        raise InputError(f"{len(recs)} record(s) but {len(scs)} scenario(s): give one scenario "
-                         "per record (or one for all)")
+        raise InputError(
+            f"{len(recs)} record(s) but {len(scs)} scenario(s): give one scenario "
+            "per record (or one for all)"
+        )
     return list(zip(scs, recs, strict=True))
 
 
@@ -168,10 +191,10 @@ def contact_scales(scenario, reference):
     """Typical contact time [s], impact velocity [m/s] and penetration ``v tau / pi`` [m] of
     a record (the scenario's period and motion scale when the record lacks them)."""
     E = reference.impulse
-    tau = float(np.median(E.support[:, 1] - E.support[:, 0])) if len(E.support) \
-        else scenario.period
-    v = (reference.noise.get("impact_velocity") if reference.noise else None) \
-        or scenario.scales()[1]
+    tau = float(np.median(E.support[:, 1] - E.support[:, 0])) if len(E.support) else scenario.period
+    v = (reference.noise.get("impact_velocity") if reference.noise else None) or scenario.scales()[
+        1
+    ]
     return tau, v, v * tau / np.pi
 
 
@@ -228,8 +251,10 @@ def _residual_weights(ref):
     cycles = _measured_cycles(ref)
     n = np.array([max(E.n_cycles, 1) for E in cycles], dtype=float)
     share = np.sqrt(n / n.sum())
-    return [s * np.sqrt(np.gradient(E.t) / max(np.trapezoid(E.F**2, E.t), 1e-300))
-            for E, s in zip(cycles, share, strict=True)]
+    return [
+        s * np.sqrt(np.gradient(E.t) / max(np.trapezoid(E.F**2, E.t), 1e-300))
+        for E, s in zip(cycles, share, strict=True)
+    ]
 
 
 class _Objective:
@@ -263,13 +288,24 @@ class _Objective:
             for sc, ref in self.records:
                 self.n += 1
                 tick(self.progress, "identify: simulations", self.n, self.max_sim)
-                ev = evaluate(machine(sc), law, ref, tolerances=self.tol, floor=False,
-                              observe=observe, smooth_onset=True)
+                ev = evaluate(
+                    machine(sc),
+                    law,
+                    ref,
+                    tolerances=self.tol,
+                    floor=False,
+                    observe=observe,
+                    smooth_onset=True,
+                )
                 evs.append(ev)
                 if ev.status != "ok":
-                    self.failures.append({"coefficients": _named(self.law(x)),
-                                          "status": ev.status,
-                                          "message": ev.message or ev.verdict})
+                    self.failures.append(
+                        {
+                            "coefficients": _named(self.law(x)),
+                            "status": ev.status,
+                            "message": ev.message or ev.verdict,
+                        }
+                    )
                     break
             self.cache[key] = evs if all(e.status == "ok" for e in evs) else None
         return self.cache[key]
@@ -281,24 +317,32 @@ class _Objective:
         v = float(np.mean([e.criteria[self.name] for e in evs]))
         if v < self.best[0]:
             self.best = (v, np.array(x, dtype=float))
-            self.path.append({"coefficients": _named(self.law(x)), "value": v,
-                              "n_simulations": self.n})
+            self.path.append(
+                {"coefficients": _named(self.law(x)), "value": v, "n_simulations": self.n}
+            )
         return v
 
     def residuals(self, x):
         evs = self.evaluations(x)
         if evs is None:
             # a failed point: residuals as large as an all-wrong force history
-            return np.concatenate([_PENALTY * w[1:] * np.max(np.abs(E.F))
-                                   for (_, ref), ws in zip(self.records, self.w, strict=True)
-                                   for E, w in zip(_measured_cycles(ref), ws, strict=True)])
+            return np.concatenate(
+                [
+                    _PENALTY * w[1:] * np.max(np.abs(E.F))
+                    for (_, ref), ws in zip(self.records, self.w, strict=True)
+                    for E, w in zip(_measured_cycles(ref), ws, strict=True)
+                ]
+            )
         self(x)  # records the path with the requested criterion
         # the first point (F_E(0+), extrapolated from samples for an aligned cycle) is left
         # out so the fit is not biased by the extrapolation error at the jump
-        return np.concatenate([((S.F - E.F) * w)[1:]
-                               for ev, (_, ref), ws in zip(evs, self.records, self.w,
-                                                           strict=True)
-                               for (E, S), w in zip(cycle_pairs(ev, ref), ws, strict=True)])
+        return np.concatenate(
+            [
+                ((S.F - E.F) * w)[1:]
+                for ev, (_, ref), ws in zip(evs, self.records, self.w, strict=True)
+                for (E, S), w in zip(cycle_pairs(ev, ref), ws, strict=True)
+            ]
+        )
 
 
 def _coordinate_descent(obj, x0, xtol, step0=0.1):
@@ -359,14 +403,33 @@ def _uncertainty(obj, x, names):
 
 
 @params(
-    scenario=(Scenario, list, tuple), reference=(Measurement, Reference, Impulse, list, tuple),
-    criterion=Text(), method=Text(), xtol=Real(0, open_low=True),
-    max_simulations=Real(1, integer=True), tolerances=(Tolerances, None),
-    n_boot_intervals=Real(0, integer=True), seed=Real(0, integer=True),
+    scenario=(Scenario, list, tuple),
+    reference=(Measurement, Reference, Impulse, list, tuple),
+    criterion=Text(),
+    method=Text(),
+    xtol=Real(0, open_low=True),
+    max_simulations=Real(1, integer=True),
+    tolerances=(Tolerances, None),
+    n_boot_intervals=Real(0, integer=True),
+    seed=Real(0, integer=True),
 )
-def identify(scenario, reference, start, *, criterion="I2", method="coordinate-descent",
-             xtol=1e-5, max_simulations=600, tolerances=None, uncertainty=True,
-             observe=None, short_first=True, n_boot_intervals=0, seed=0, progress=None):
+def identify(
+    scenario,
+    reference,
+    start,
+    *,
+    criterion="I2",
+    method="coordinate-descent",
+    xtol=1e-5,
+    max_simulations=600,
+    tolerances=None,
+    uncertainty=True,
+    observe=None,
+    short_first=True,
+    n_boot_intervals=0,
+    seed=0,
+    progress=None,
+):
     """Identify the coefficients of ``start`` from one or several records by simulation.
 
     Parameters
@@ -426,22 +489,32 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
     if not (np.isfinite(xtol) and xtol > 0):
         raise InputError(f"xtol must be a positive number, got {xtol!r}")
     records = as_records(scenario, reference)
-    if not (isinstance(max_simulations, int | np.integer)
-            and max_simulations >= 2 * len(records)):
-        raise InputError(f"the simulation budget must be an integer of at least "
-                         f"{2 * len(records)} (two per record); got {max_simulations!r}")
+    if not (isinstance(max_simulations, int | np.integer) and max_simulations >= 2 * len(records)):
+        raise InputError(
+            f"the simulation budget must be an integer of at least "
+            f"{2 * len(records)} (two per record); got {max_simulations!r}"
+        )
     t0 = time.perf_counter()
     spent = 0
     short = [r.shortened() if isinstance(r, Reference) else None for _, r in records]
-    if short_first and all(r is not None for r in short) \
-            and max_simulations >= 8 * len(records):
+    if short_first and all(r is not None for r in short) and max_simulations >= 8 * len(records):
         try:
-            first = identify([sc for sc, _ in records], short, start, criterion=criterion,
-                             method=method, xtol=xtol, max_simulations=max_simulations // 2,
-                             tolerances=tolerances, uncertainty=False, observe=observe,
-                             short_first=False,
-                             progress=None if progress is None else
-                             (lambda s, d, t: progress("identify: cycle by cycle", d, t)))
+            first = identify(
+                [sc for sc, _ in records],
+                short,
+                start,
+                criterion=criterion,
+                method=method,
+                xtol=xtol,
+                max_simulations=max_simulations // 2,
+                tolerances=tolerances,
+                uncertainty=False,
+                observe=observe,
+                short_first=False,
+                progress=None
+                if progress is None
+                else (lambda s, d, t: progress("identify: cycle by cycle", d, t)),
+            )
             spent = first.n_simulations
             if not any(c == 0 for c in first.law.coefficients):
                 start0, start = start, first.law
@@ -455,15 +528,24 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
                     start = start0
         except IntegrationError:
             pass
-    obj = _Objective(records, start, criterion, tolerances,
-                     max(int(max_simulations) - spent, 2 * len(records)), observe, progress)
+    obj = _Objective(
+        records,
+        start,
+        criterion,
+        tolerances,
+        max(int(max_simulations) - spent, 2 * len(records)),
+        observe,
+        progress,
+    )
     obj.n = 0
     x0 = np.ones(len(start.coefficients))
     if obj.evaluations(x0) is None:
         f = obj.failures[-1]
-        raise IntegrationError(f"the start law {start} cannot be compared with the record: "
-                               f"{f['status']} ({f['message']}); give start values closer to "
-                               "the record (e.g. from vidi fit)")
+        raise IntegrationError(
+            f"the start law {start} cannot be compared with the record: "
+            f"{f['status']} ({f['message']}); give start values closer to "
+            "the record (e.g. from vidi fit)"
+        )
     message = ""
     try:
         if method == "coordinate-descent":
@@ -471,13 +553,29 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
             message = "steps below xtol"
         elif method == "nelder-mead":
             simplex = np.vstack([x0] + [x0 + 0.1 * np.eye(x0.size)[i] for i in range(x0.size)])
-            res = minimize(obj, x0, method="Nelder-Mead",
-                           options={"xatol": xtol, "fatol": 1e-12, "maxfev": max_simulations,
-                                    "initial_simplex": simplex})
+            res = minimize(
+                obj,
+                x0,
+                method="Nelder-Mead",
+                options={
+                    "xatol": xtol,
+                    "fatol": 1e-12,
+                    "maxfev": max_simulations,
+                    "initial_simplex": simplex,
+                },
+            )
             message = str(res.message)
         else:
-            res = least_squares(obj.residuals, x0, method="trf", x_scale=1.0, diff_step=1e-6,
-                                xtol=xtol * 1e-2, ftol=1e-12, gtol=1e-12)
+            res = least_squares(
+                obj.residuals,
+                x0,
+                method="trf",
+                x_scale=1.0,
+                diff_step=1e-6,
+                xtol=xtol * 1e-2,
+                ftol=1e-12,
+                gtol=1e-12,
+            )
             message = str(res.message)
     except _Budget:
         message = f"simulation budget of {max_simulations} used"
@@ -492,19 +590,37 @@ def identify(scenario, reference, start, *, criterion="I2", method="coordinate-d
         se, corr = _uncertainty(obj, x_best, law.names)
     crit = {k: float(np.mean([e.criteria[k] for e in evs])) for k in evs[0].criteria}
     if obj.failures:
-        message += (f"; {len(obj.failures)} trial law(s) had no periodic steady state with "
-                    "contact (see failures)")
+        message += (
+            f"; {len(obj.failures)} trial law(s) had no periodic steady state with "
+            "contact (see failures)"
+        )
     intervals = None
     if n_boot_intervals:
-        intervals = bootstrap_intervals([sc for sc, _ in records], [r for _, r in records],
-                                        law, n_boot=int(n_boot_intervals), seed=seed,
-                                        criterion=criterion, tolerances=tolerances)
+        intervals = bootstrap_intervals(
+            [sc for sc, _ in records],
+            [r for _, r in records],
+            law,
+            n_boot=int(n_boot_intervals),
+            seed=seed,
+            criterion=criterion,
+            tolerances=tolerances,
+        )
     return IdentificationResult(
         intervals=intervals,
-        law=law, criterion=criterion, value=value, criteria=crit, method=method,
-        n_simulations=obj.n + spent, evaluations=tuple(evs), iterations=obj.path,
-        standard_errors=se, correlation=corr, failures=obj.failures,
-        seconds=time.perf_counter() - t0, message=message)
+        law=law,
+        criterion=criterion,
+        value=value,
+        criteria=crit,
+        method=method,
+        n_simulations=obj.n + spent,
+        evaluations=tuple(evs),
+        iterations=obj.path,
+        standard_errors=se,
+        correlation=corr,
+        failures=obj.failures,
+        seconds=time.perf_counter() - t0,
+        message=message,
+    )
 
 
 # ------------------------------------------------------------------ bootstrap intervals
@@ -549,9 +665,14 @@ class Intervals:
     method: str = "parametric bootstrap through the record-span processing"
 
     def as_dict(self):
-        return {"bounds": {k: list(v) for k, v in self.bounds.items()}, "sd": dict(self.sd),
-                "level": self.level, "n_boot": self.n_boot, "seed": self.seed,
-                "method": self.method}
+        return {
+            "bounds": {k: list(v) for k, v in self.bounds.items()},
+            "sd": dict(self.sd),
+            "level": self.level,
+            "n_boot": self.n_boot,
+            "seed": self.seed,
+            "method": self.method,
+        }
 
 
 def _replicate(scenario, law, observe, ref, rng, tolerances):
@@ -560,17 +681,30 @@ def _replicate(scenario, law, observe, ref, rng, tolerances):
 
     span = ref.span
     starts = [b.state.draw(rng) for b in span.blocks]
-    hist = simulated_history(scenario, law, span, tolerances=tolerances, starts=starts,
-                             observe=observe)
-    blocks = tuple(replace(b, F=h + rng.normal(0.0, span.sigma_f, h.size))
-                   for b, h in zip(span.blocks, hist, strict=True))
+    hist = simulated_history(
+        scenario, law, span, tolerances=tolerances, starts=starts, observe=observe
+    )
+    blocks = tuple(
+        replace(b, F=h + rng.normal(0.0, span.sigma_f, h.size))
+        for b, h in zip(span.blocks, hist, strict=True)
+    )
     span2 = replace(span, blocks=blocks)
     imps = tuple(span2.measured(onset_record_time=ref.impulse.onset))
     return replace(ref, span=span2, blocks=imps, impulse=imps[-1], _source=None)
 
 
-def bootstrap_intervals(scenario, reference, model, *, n_boot=30, seed=0, level=0.95,
-                        max_simulations=60, criterion="I2", tolerances=None):
+def bootstrap_intervals(
+    scenario,
+    reference,
+    model,
+    *,
+    n_boot=30,
+    seed=0,
+    level=0.95,
+    max_simulations=60,
+    criterion="I2",
+    tolerances=None,
+):
     """Intervals of ``model``'s coefficients by a parametric bootstrap (module docstring).
 
     Parameters
@@ -613,11 +747,20 @@ def bootstrap_intervals(scenario, reference, model, *, n_boot=30, seed=0, level=
     draws = []
     for _ in range(n_boot):
         try:
-            reps = [_replicate(machine(sc), law, observe, ref, rng, tolerances)
-                    for sc, ref in records]
-            res = identify([sc for sc, _ in records], reps, model, criterion=criterion,
-                           method="least-squares", max_simulations=max_simulations,
-                           tolerances=tolerances, uncertainty=False, short_first=False)
+            reps = [
+                _replicate(machine(sc), law, observe, ref, rng, tolerances) for sc, ref in records
+            ]
+            res = identify(
+                [sc for sc, _ in records],
+                reps,
+                model,
+                criterion=criterion,
+                method="least-squares",
+                max_simulations=max_simulations,
+                tolerances=tolerances,
+                uncertainty=False,
+                short_first=False,
+            )
         except IntegrationError:
             continue
         draws.append(np.array(res.law.coefficients, dtype=float))
@@ -628,7 +771,12 @@ def bootstrap_intervals(scenario, reference, model, *, n_boot=30, seed=0, level=
     est = np.array(model.coefficients, dtype=float)
     sd = D.std(axis=0, ddof=1)
     z = float(norm.ppf(0.5 + level / 2))
-    return Intervals(bounds={n: (float(e - z * s), float(e + z * s))
-                             for n, e, s in zip(names, est, sd, strict=True)},
-                     sd={n: float(s) for n, s in zip(names, sd, strict=True)},
-                     level=float(level), n_boot=len(draws), seed=int(seed))
+    return Intervals(
+        bounds={
+            n: (float(e - z * s), float(e + z * s)) for n, e, s in zip(names, est, sd, strict=True)
+        },
+        sd={n: float(s) for n, s in zip(names, sd, strict=True)},
+        level=float(level),
+        n_boot=len(draws),
+        seed=int(seed),
+    )

@@ -26,8 +26,14 @@ from .dynamics import _kernel as K
 from .dynamics.simulate import simulate
 from .errors import InputError, NoContactError
 
-__all__ = ["Impulse", "impulse_from_steady_state", "impulse_from_samples", "estimate_noise",
-           "own_period", "check_drive_period"]
+__all__ = [
+    "Impulse",
+    "impulse_from_steady_state",
+    "impulse_from_samples",
+    "estimate_noise",
+    "own_period",
+    "check_drive_period",
+]
 
 
 @dataclass(frozen=True)
@@ -123,15 +129,26 @@ class Impulse:
         vals = self.evaluate(other.t, "left")
         vals[0] = self.evaluate(0.0, "right")
         if other.threshold > 0:
-            support = _sampled_support(other.t, vals, other.threshold,
-                                       other.duration / other.n_periods,
-                                       other.noise / np.sqrt(max(other.n_cycles, 1)))
+            support = _sampled_support(
+                other.t,
+                vals,
+                other.threshold,
+                other.duration / other.n_periods,
+                other.noise / np.sqrt(max(other.n_cycles, 1)),
+            )
         else:
             support = self.periodic_support(reps * self.duration)
         onsets = np.concatenate([self.onsets + k * self.duration for k in range(reps)])
-        return Impulse(t=other.t.copy(), F=vals, duration=reps * self.duration,
-                       support=support, n_periods=reps * self.n_periods, onset=self.onset,
-                       threshold=other.threshold, onsets=onsets)
+        return Impulse(
+            t=other.t.copy(),
+            F=vals,
+            duration=reps * self.duration,
+            support=support,
+            n_periods=reps * self.n_periods,
+            onset=self.onset,
+            threshold=other.threshold,
+            onsets=onsets,
+        )
 
     def rotated(self, delta):
         """The same periodic force seen from ``delta`` [s] later: ``t* = delta``.
@@ -145,11 +162,11 @@ class Impulse:
         if delta == 0.0:
             return self
         t, F = self.t, self.F
-        i_l = int(np.searchsorted(t, delta, "left"))   # first point at or after delta
+        i_l = int(np.searchsorted(t, delta, "left"))  # first point at or after delta
         i_r = int(np.searchsorted(t, delta, "right"))  # first point after delta
         if i_r - i_l >= 2:  # a jump: left limit at i_l, right limit at i_r - 1
-            head_t, head_F = t[i_r - 1:] - delta, F[i_r - 1:]
-            tail_t, tail_F = t[:i_l + 1] + (W - delta), F[:i_l + 1]
+            head_t, head_F = t[i_r - 1 :] - delta, F[i_r - 1 :]
+            tail_t, tail_F = t[: i_l + 1] + (W - delta), F[: i_l + 1]
         else:
             f_d = self.evaluate(delta)
             head_t = np.concatenate([[0.0], t[i_r:] - delta])
@@ -166,20 +183,31 @@ class Impulse:
             else:
                 sup.append((a, b))
         sup = np.array(sorted(sup), dtype=float).reshape(-1, 2)
-        return Impulse(t=np.concatenate([head_t, tail_t]), F=np.concatenate([head_F, tail_F]),
-                       duration=W, support=sup, n_periods=self.n_periods,
-                       onset=self.onset + delta, threshold=self.threshold, noise=self.noise,
-                       n_cycles=self.n_cycles,
-                       onsets=np.sort(np.mod(self.onsets - delta, W)))
+        return Impulse(
+            t=np.concatenate([head_t, tail_t]),
+            F=np.concatenate([head_F, tail_F]),
+            duration=W,
+            support=sup,
+            n_periods=self.n_periods,
+            onset=self.onset + delta,
+            threshold=self.threshold,
+            noise=self.noise,
+            n_cycles=self.n_cycles,
+            onsets=np.sort(np.mod(self.onsets - delta, W)),
+        )
 
     def periodic_support(self, length):
         """Support intervals repeated over ``[0, length]``, ndarray of shape (m, 2)."""
         reps = int(round(length / self.duration))
         if not np.isclose(reps * self.duration, length, rtol=1e-9) or reps < 1:
-            raise InputError(f"length {length!r} must be a whole number of cycles of "
-                             f"{self.duration!r} s")
-        return np.concatenate([self.support + k * self.duration for k in range(reps)]) \
-            if len(self.support) else np.zeros((0, 2))
+            raise InputError(
+                f"length {length!r} must be a whole number of cycles of {self.duration!r} s"
+            )
+        return (
+            np.concatenate([self.support + k * self.duration for k in range(reps)])
+            if len(self.support)
+            else np.zeros((0, 2))
+        )
 
 
 # ----------------------------------------------------------------- simulation
@@ -187,8 +215,15 @@ def _orbit_events(scenario, law, ss, tolerances):
     T = scenario.period
     t0 = ss.t0
     n = ss.n_periods
-    tr = simulate(scenario, law, (t0, t0 + n * T), y0=ss.y0, tolerances=tolerances,
-                  t_eval=np.linspace(t0, t0 + n * T, 400 * n + 1), zeta_max0=ss.zeta_max0)
+    tr = simulate(
+        scenario,
+        law,
+        (t0, t0 + n * T),
+        y0=ss.y0,
+        tolerances=tolerances,
+        t_eval=np.linspace(t0, t0 + n * T, 400 * n + 1),
+        zeta_max0=ss.zeta_max0,
+    )
     return tr
 
 
@@ -243,8 +278,15 @@ def impulse_from_steady_state(scenario, law, ss, points_per_period=2000, toleran
     t_on, y_on, mode_on = tr.event_t[j], tr.event_y[j], tr.event_modes[j, 1]
     W = n * T
     grid = np.linspace(0.0, W, points_per_period * n + 1)
-    tr2 = simulate(scenario, law, (t_on, t_on + W), y0=y_on, mode0=mode_on,
-                   t_eval=t_on + grid, tolerances=tolerances)
+    tr2 = simulate(
+        scenario,
+        law,
+        (t_on, t_on + W),
+        y0=y_on,
+        mode0=mode_on,
+        t_eval=t_on + grid,
+        tolerances=tolerances,
+    )
     F = tr2.force  # at t_on the kernel reports the mode after the onset: F(0+)
     # periodicity: F(W-) = F(0-), the force just before the onset (the kernel may have
     # crossed the next onset a whisker before W)
@@ -266,8 +308,9 @@ def impulse_from_steady_state(scenario, law, ss, points_per_period=2000, toleran
     support = _support_from_events(ev_rel[keep], tr2.event_modes[keep], W)
     on = tr2.event_kind == K.EV_ONSET
     onsets = np.concatenate([[0.0], ev_rel[on & keep]])
-    return Impulse(t=t_all, F=f_all, duration=W, support=support, n_periods=n, onset=t_on,
-                   onsets=onsets)
+    return Impulse(
+        t=t_all, F=f_all, duration=W, support=support, n_periods=n, onset=t_on, onsets=onsets
+    )
 
 
 def _support_from_events(ev_rel, modes, W):
@@ -301,8 +344,9 @@ def estimate_noise(x, order=1):
     d = np.diff(np.asarray(x, dtype=float), n=order)
     if d.size < 2:
         return 0.0
-    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(math.comb(2 * order,
-                                                                                 order)))
+    return float(
+        1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(math.comb(2 * order, order))
+    )
 
 
 def _refine_onset(t, zeta, s, t_on, max_back):
@@ -315,7 +359,7 @@ def _refine_onset(t, zeta, s, t_on, max_back):
         k -= 1
     if not (k >= 3 and zeta[k - 1] <= 0.0 < zeta[k]):
         return t_on
-    a, b, c = np.polyfit(t[k - 3:k] - t[k - 1], zeta[k - 3:k], 2)
+    a, b, c = np.polyfit(t[k - 3 : k] - t[k - 1], zeta[k - 3 : k], 2)
     roots = np.roots([a, b, c]) if a != 0 else np.array([-c / b])
     h = t[k] - t[k - 1]
     ok = [r.real for r in roots if abs(r.imag) < 1e-12 and -1e-9 * h <= r.real <= h]
@@ -380,8 +424,9 @@ def _sampled_support(tau, F, thr, period, noise=0.0, extrapolate=True):
     Fs[0] = F[0]
     t_ext = np.concatenate([[-dt], tau, [tau[-1] + dt]])
     f_ext = np.concatenate([[0.0], Fs, [0.0]])
-    runs = _edges(t_ext, f_ext, thr, min_len, max_extrap if extrapolate else None,
-                  noise / np.sqrt(width))
+    runs = _edges(
+        t_ext, f_ext, thr, min_len, max_extrap if extrapolate else None, noise / np.sqrt(width)
+    )
     sup = [(max(a, 0.0), min(b, tau[-1])) for a, b, _ in runs]
     return np.array(sup, dtype=float).reshape(-1, 2)
 
@@ -409,15 +454,20 @@ def _edges(t, F, thr, min_len, max_extrap=4.0, noise=0.0):
         # a gap is closed when it is short, or when it never goes clearly below the
         # threshold (a dip of the force within the noise of it: noise must not decide
         # whether a contact is one or two)
-        if merged and (r[0] - merged[-1][1] < min_len or (
-                noise > 0 and np.min(F[merged[-1][1]:r[0]]) > thr - 3.0 * noise)):
+        if merged and (
+            r[0] - merged[-1][1] < min_len
+            or (noise > 0 and np.min(F[merged[-1][1] : r[0]]) > thr - 3.0 * noise)
+        ):
             merged[-1][1] = r[1]
         else:
             merged.append(r)
     # short runs are threshold flicker, unless the force clearly stands out: a contact
     # shorter than the debounce length (< 1 % of a period) is still a contact
-    runs = [r for r in merged if r[1] - r[0] >= min_len
-            or (r[1] - r[0] >= 3 and np.max(F[r[0]:r[1]]) >= 3.0 * thr)]
+    runs = [
+        r
+        for r in merged
+        if r[1] - r[0] >= min_len or (r[1] - r[0] >= 3 and np.max(F[r[0] : r[1]]) >= 3.0 * thr)
+    ]
     out = []
     for s, e in runs:
         if s == 0 or e >= len(F):
@@ -440,12 +490,18 @@ def _edges(t, F, thr, min_len, max_extrap=4.0, noise=0.0):
 
 
 @params(
-    t=Array(1), F=Array(1), period=Real(0, open_low=True), zeta=(None, Array(1)),
-    n_periods=(None, Real(1, integer=True)), threshold=(None, Real(0)),
-    max_period=Real(1, 64, integer=True), min_samples=Real(1, integer=True),
+    t=Array(1),
+    F=Array(1),
+    period=Real(0, open_low=True),
+    zeta=(None, Array(1)),
+    n_periods=(None, Real(1, integer=True)),
+    threshold=(None, Real(0)),
+    max_period=Real(1, 64, integer=True),
+    min_samples=Real(1, integer=True),
 )
-def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=None,
-                         max_period=4, min_samples=3):
+def impulse_from_samples(
+    t, F, period, *, zeta=None, n_periods=None, threshold=None, max_period=4, min_samples=3
+):
     """Steady-state impulse from a sampled force record (measured or simulated).
 
     Parameters
@@ -478,12 +534,17 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     """
     t = np.asarray(t, dtype=float)
     F = np.asarray(F, dtype=float)
-    if not (isinstance(period, int | float | np.floating | np.integer)
-            and np.isfinite(period) and period > 0):
+    if not (
+        isinstance(period, int | float | np.floating | np.integer)
+        and np.isfinite(period)
+        and period > 0
+    ):
         raise InputError(f"period must be a positive number of seconds; got {period!r}")
     if t.ndim != 1 or F.shape != t.shape or t.size < 2:
-        raise InputError(f"t and F must be 1-D arrays of the same length (at least 2 samples); "
-                         f"got shapes {t.shape} and {F.shape}")
+        raise InputError(
+            f"t and F must be 1-D arrays of the same length (at least 2 samples); "
+            f"got shapes {t.shape} and {F.shape}"
+        )
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(F)) and np.all(np.diff(t) > 0)):
         raise InputError("t must be finite and strictly increasing, and F finite")
     if n_periods is not None and not (isinstance(n_periods, int | np.integer) and n_periods >= 1):
@@ -495,17 +556,21 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     runs = _edges(t, F, thr, *_edge_params(t, period, min_samples), noise=sigma)
     if runs:
         # a contact whose peak barely clears the threshold is noise, not an impact
-        pk = np.array([np.max(F[s:int(np.searchsorted(t, off)) + 1]) for _, off, s in runs])
+        pk = np.array([np.max(F[s : int(np.searchsorted(t, off)) + 1]) for _, off, s in runs])
         runs = [r for r, p in zip(runs, pk, strict=True) if p >= max(3 * thr, 0.02 * pk.max())]
     if zeta is not None:
         zeta = np.asarray(zeta, dtype=float)
         runs = _merge_unseparated(t, zeta, runs)
         back = 0.25 * period / dt
-        runs = [(_bracket_onset(t, F, s, t_off, thr, _refine_onset(t, zeta, s, t_on, back)),
-                 t_off, s) for t_on, t_off, s in runs]
+        runs = [
+            (_bracket_onset(t, F, s, t_off, thr, _refine_onset(t, zeta, s, t_on, back)), t_off, s)
+            for t_on, t_off, s in runs
+        ]
     if not runs:
-        raise NoContactError("no contact found in the force record (no run of samples above "
-                         f"the threshold {thr:.3g} N); check the F column and its units")
+        raise NoContactError(
+            "no contact found in the force record (no run of samples above "
+            f"the threshold {thr:.3g} N); check the F column and its units"
+        )
     # peak force per run to find the main impact and the cycle length
     # each contact's impulse (integral of F): unlike the sampled peak it does not depend
     # on where the samples fall after a force jump; its noise is sigma dt sqrt(samples)
@@ -518,8 +583,10 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     W = n * period
     complete = np.flatnonzero(onsets + W <= t[-1] + 0.5 * dt)
     if complete.size == 0:
-        raise InputError(f"the record is shorter than one cycle ({W:.4g} s) after the first "
-                         "impact; record more periods")
+        raise InputError(
+            f"the record is shorter than one cycle ({W:.4g} s) after the first "
+            "impact; record more periods"
+        )
     last = complete[onsets[complete] >= onsets[complete[-1]] - W + 0.25 * period]
     ref_j = int(last[np.argmax(peaks[last])])
     # walk back one cycle at a time while an impact recurs at the same drive phase; which
@@ -538,7 +605,7 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     # time axis: the first cycle's own sample offsets from its onset (no re-interpolation
     # of that cycle; the others are interpolated onto it, exactly when fs*T is whole)
     t_on0 = runs[mains[0]][0]
-    inside = t[_first_after(t, F, t_on0, thr, zeta is not None):] - t_on0
+    inside = t[_first_after(t, F, t_on0, thr, zeta is not None) :] - t_on0
     tau = np.concatenate([[0.0], inside[inside < W], [W]])
     stack = []
     for j in mains:
@@ -548,7 +615,7 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
         # right limit at the onset: extrapolate the first samples after it, and do not
         # interpolate across a jump between the onset and sample s
         # (quadratic through samples s, s+1, s+2; a force is never negative)
-        coef = np.polyfit(t[s:s + 3] - t_on, F[s:s + 3], 2)
+        coef = np.polyfit(t[s : s + 3] - t_on, F[s : s + 3], 2)
         head = tau < t[s] - t_on
         vals[head] = np.maximum(np.polyval(coef, tau[head]), 0.0)
         # at the cycle's end hold the last sample before the next onset (left limit): the
@@ -567,16 +634,28 @@ def impulse_from_samples(t, F, period, *, zeta=None, n_periods=None, threshold=N
     mains = [mains[i] for i in steady]
     Fm = np.mean(stack, axis=0)
     # the support of the averaged cycle, whose noise is sigma / sqrt(cycles)
-    thr_avg = thr if threshold is not None else max(
-        5.0 * sigma / np.sqrt(len(mains)), 1e-3 * float(np.max(F)))
+    thr_avg = (
+        thr
+        if threshold is not None
+        else max(5.0 * sigma / np.sqrt(len(mains)), 1e-3 * float(np.max(F)))
+    )
     support = _sampled_support(tau, Fm, thr_avg, period, sigma / np.sqrt(len(mains)))
     # the cyclic sequence of impacts, from the last steady cycle
     j_last = mains[-1]
     rel = onsets - onsets[j_last]
     cyc = np.sort(rel[(rel >= 0) & (rel < W - 0.02 * period)])
-    return Impulse(t=tau, F=Fm, duration=W, support=support,
-                   n_periods=n, onset=float(onsets[mains[0]]), threshold=thr_avg,
-                   noise=sigma, n_cycles=len(mains), onsets=cyc)
+    return Impulse(
+        t=tau,
+        F=Fm,
+        duration=W,
+        support=support,
+        n_periods=n,
+        onset=float(onsets[mains[0]]),
+        threshold=thr_avg,
+        noise=sigma,
+        n_cycles=len(mains),
+        onsets=cyc,
+    )
 
 
 def _steady_tail(stack, sigma):
@@ -667,7 +746,8 @@ def check_drive_period(t, F, period, source=""):
             f"the force{where} repeats every {lag:.4g} s ({r:.3g} of the scenario's drive "
             f"period {period:.4g} s, i.e. a drive of {round(r) / lag if round(r) else 1 / lag:.4g}"
             f" Hz rather than {1 / period:.4g} Hz); give the scenario of the machine that made "
-            "the record (its frequency), or check the t column's units")
+            "the record (its frequency), or check the t column's units"
+        )
 
 
 def _cycle_periods(t, F, period, max_period):
@@ -693,8 +773,10 @@ def _cycle_periods(t, F, period, max_period):
         d = np.interp(t[sel] + n * period, t, F) - F[sel]
         D[n] = float(np.mean(d * d))
     if not D:
-        raise InputError("the record is shorter than one cycle in its second half (it needs "
-                         f"at least 3 drive periods, {3 * period:.4g} s); record more periods")
+        raise InputError(
+            "the record is shorter than one cycle in its second half (it needs "
+            f"at least 3 drive periods, {3 * period:.4g} s); record more periods"
+        )
     R = float(np.mean(np.diff(F[half]) ** 2))
     limit = 1.5 * min(D.values()) + 0.5 * R
     return min(n for n, v in D.items() if v <= limit)

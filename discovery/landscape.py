@@ -128,36 +128,58 @@ class Landscape:
         minima = {}
         for n in CRITERIA:
             ij = self.argmin(n)
-            minima[n] = None if ij is None else {
-                "alpha1": a0[ij[0]], "alpha2": a1[ij[1]], "value": self.values[n][ij],
-                "regime": self.regime[ij], "consistent": bool(self.consistent[ij]),
-                "noise_floor": self.noise_floor[n]}
-        return {"terms": self.terms, "alpha1": a0, "alpha2": a1,
-                **{n: self.values[n] for n in CRITERIA},
-                "regime": self.regime.tolist(), "impacts": self.impacts,
-                "consistent": self.consistent, "n_consistent": int(self.consistent.sum()),
-                "regimes": self.regime_counts(),
-                "failed": {"count": count, "first_message": first,
-                           "first_at": None if at is None
-                           else {"alpha1": a0[at[0]], "alpha2": a1[at[1]]}},
-                "noise_floor": self.noise_floor, "noise_floor_q95": self.noise_floor_q95,
-                "noise_floor_under": self.noise_floor_under, "minima": minima,
-                "seconds": self.seconds, "workers": self.workers,
-                "continuation": self.continuation}
+            minima[n] = (
+                None
+                if ij is None
+                else {
+                    "alpha1": a0[ij[0]],
+                    "alpha2": a1[ij[1]],
+                    "value": self.values[n][ij],
+                    "regime": self.regime[ij],
+                    "consistent": bool(self.consistent[ij]),
+                    "noise_floor": self.noise_floor[n],
+                }
+            )
+        return {
+            "terms": self.terms,
+            "alpha1": a0,
+            "alpha2": a1,
+            **{n: self.values[n] for n in CRITERIA},
+            "regime": self.regime.tolist(),
+            "impacts": self.impacts,
+            "consistent": self.consistent,
+            "n_consistent": int(self.consistent.sum()),
+            "regimes": self.regime_counts(),
+            "failed": {
+                "count": count,
+                "first_message": first,
+                "first_at": None if at is None else {"alpha1": a0[at[0]], "alpha2": a1[at[1]]},
+            },
+            "noise_floor": self.noise_floor,
+            "noise_floor_q95": self.noise_floor_q95,
+            "noise_floor_under": self.noise_floor_under,
+            "minima": minima,
+            "seconds": self.seconds,
+            "workers": self.workers,
+            "continuation": self.continuation,
+        }
 
     def _lines(self):
         n0, n1 = (len(a) for a in self.axes)
-        out = [f"landscape of {self.terms[0]}, {self.terms[1]} on {n0}x{n1} points "
-               f"({self.seconds:.1f} s, {self.workers} worker(s))"]
+        out = [
+            f"landscape of {self.terms[0]}, {self.terms[1]} on {n0}x{n1} points "
+            f"({self.seconds:.1f} s, {self.workers} worker(s))"
+        ]
         for k, v in self.values.items():
             arr = np.asarray(v, dtype=float)
             if np.isfinite(arr).any():
                 i, j = np.unravel_index(int(np.nanargmin(arr)), arr.shape)
-                out.append(f"  min {k} = {fmt(arr[i, j], 3)} at {self.terms[0]} = "
-                           f"{fmt(self.axes[0][i])}, {self.terms[1]} = {fmt(self.axes[1][j])}")
+                out.append(
+                    f"  min {k} = {fmt(arr[i, j], 3)} at {self.terms[0]} = "
+                    f"{fmt(self.axes[0][i])}, {self.terms[1]} = {fmt(self.axes[1][j])}"
+                )
         if self.consistent is not None:
-            out.append(f"  {int(np.sum(self.consistent))} point(s) consistent with the "
-                       "reference")
+            out.append(f"  {int(np.sum(self.consistent))} point(s) consistent with the reference")
         return out
 
 
@@ -168,8 +190,9 @@ def parse_grid(text):
     except ValueError:
         raise InputError(f"grid {text!r} must look like 41x41") from None
     if a < 2 or b < 2 or a * b > 250_000:
-        raise InputError(f"grid {text!r} needs at least 2 points per axis and at most 250000 "
-                         "points in all")
+        raise InputError(
+            f"grid {text!r} needs at least 2 points per axis and at most 250000 points in all"
+        )
     return a, b
 
 
@@ -178,8 +201,10 @@ def default_range(value, name, option, spread=DEFAULT_SPREAD):
     option that replaces it (in the error for a zero coefficient)."""
     value = float(value)
     if value == 0.0 or not np.isfinite(value):
-        raise InputError(f"the coefficient of {name} in the template law is {value!r}, so no "
-                         f"range can be centred on it; give {option} LOW:HIGH")
+        raise InputError(
+            f"the coefficient of {name} in the template law is {value!r}, so no "
+            f"range can be centred on it; give {option} LOW:HIGH"
+        )
     lo, hi = sorted(((1.0 - spread) * value, (1.0 + spread) * value))
     return lo, hi
 
@@ -210,16 +235,22 @@ def _point(ctx, law, guess=None):
     continuation)``; ``guess`` the previous point's steady state (continuation)."""
     scenario, _, reference, tolerances, from_state, _ = ctx
     try:
-        ev = evaluate(scenario, law, reference, tolerances=tolerances, from_state=from_state,
-                      floor=True, guess=guess)
+        ev = evaluate(
+            scenario,
+            law,
+            reference,
+            tolerances=tolerances,
+            from_state=from_state,
+            floor=True,
+            guess=guess,
+        )
     except VidiError:
         raise  # bad input (e.g. a zero reference impulse) concerns every point: stop
     except (ValueError, ArithmeticError) as exc:  # numerics at this point only
         return ("failed", -1, None, False, f"{type(exc).__name__}: {exc}"), None
     ss = ev.steady
     if ev.status == "ok":
-        return (ev.regime["simulated"], ev.impacts["simulated"], ev.criteria, ev.consistent,
-                ""), ss
+        return (ev.regime["simulated"], ev.impacts["simulated"], ev.criteria, ev.consistent, ""), ss
     if ev.status == "failed":
         return ("failed", -1, None, False, ev.message or ev.verdict), None
     if ev.status == "no-contact":
@@ -258,8 +289,11 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
             continue
         ev = evaluate(scenario, cand, reference, tolerances=tolerances, from_state=from_state)
         if ev.status == "ok":
-            return (dict(ev.noise_floor), dict(ev.extra.get("noise_floor_q95") or {}),
-                    cand.to_text())
+            return (
+                dict(ev.noise_floor),
+                dict(ev.extra.get("noise_floor_q95") or {}),
+                cand.to_text(),
+            )
         tried.append((cand.to_text(), ev.status))
     fl = reference.floor_for(reference.impulse)
     why = "; ".join(f"'{t}' gives {st}" for t, st in tried)
@@ -267,13 +301,29 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
 
 
 @params(
-    scenario=Scenario, law=ForceLaw, axis0=Array(1), axis1=Array(1),
+    scenario=Scenario,
+    law=ForceLaw,
+    axis0=Array(1),
+    axis1=Array(1),
     reference=(None, Reference, Impulse),
-    workers=(None, Real(1, integer=True)), tolerances=(Tolerances, None),
+    workers=(None, Real(1, integer=True)),
+    tolerances=(Tolerances, None),
     executor=(None, Instance("discovery.executor", "Executor")),
 )
-def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tolerances=None,
-              from_state=True, progress=None, executor=None, continuation=True):
+def landscape(
+    scenario,
+    law,
+    axis0,
+    axis1,
+    reference=None,
+    *,
+    workers=None,
+    tolerances=None,
+    from_state=True,
+    progress=None,
+    executor=None,
+    continuation=True,
+):
     """Compute all criteria over a grid of the first two coefficients of ``law``.
 
     Parameters
@@ -305,9 +355,11 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
     Landscape
     """
     if len(law.terms) < 2:
-        raise InputError(f"a landscape varies two coefficients but the law '{law}' has "
-                         f"{len(law.terms)} term(s); give a law with at least two terms, e.g. "
-                         "'2.06e8*z + 1.28e7*zd'")
+        raise InputError(
+            f"a landscape varies two coefficients but the law '{law}' has "
+            f"{len(law.terms)} term(s); give a law with at least two terms, e.g. "
+            "'2.06e8*z + 1.28e7*zd'"
+        )
     axis0 = _axis(axis0, "axis0")
     axis1 = _axis(axis1, "axis1")
     if workers is not None and int(workers) < 1:
@@ -315,21 +367,27 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
     t_start = time.perf_counter()
     if reference is None:
         if scenario.law is None:
-            raise InputError(f"scenario {scenario.name!r} has no reference law; add [law] text "
-                             "or compare with a measured record")
+            raise InputError(
+                f"scenario {scenario.name!r} has no reference law; add [law] text "
+                "or compare with a measured record"
+            )
         imp = response(scenario, scenario.law, tolerances=tolerances).impulse
         if imp is None:
-            raise InputError(f"the reference law '{scenario.law}' has no periodic steady state "
-                             "with contact")
+            raise InputError(
+                f"the reference law '{scenario.law}' has no periodic steady state with contact"
+            )
         reference = Reference.exact(imp, source="law")
     elif not isinstance(reference, Reference):
-        raise VidiTypeError("reference must be a discovery.verify.Reference; wrap an exact impulse "
-                        "with Reference.exact(impulse) or prepare a record with "
-                        "Reference.from_measurement(measurement, scenario)")
+        raise VidiTypeError(
+            "reference must be a discovery.verify.Reference; wrap an exact impulse "
+            "with Reference.exact(impulse) or prepare a record with "
+            "Reference.from_measurement(measurement, scenario)"
+        )
     floor, q95, under = _floor_once(scenario, law, reference, tolerances, from_state)
-    ref = _FixedFloor(**{f.name: getattr(reference, f.name) for f in fields(Reference)},
-                      fixed_floor={"mean": floor, "q95": q95, "n_boot": reference.n_boot,
-                                   "seed": reference.seed})
+    ref = _FixedFloor(
+        **{f.name: getattr(reference, f.name) for f in fields(Reference)},
+        fixed_floor={"mean": floor, "q95": q95, "n_boot": reference.n_boot, "seed": reference.seed},
+    )
     workers = min(int(workers or os.cpu_count() or 1), axis0.size)
     shape = (axis0.size, axis1.size)
     regime = np.empty(shape, dtype=object)
@@ -353,13 +411,28 @@ def landscape(scenario, law, axis0, axis1, reference=None, *, workers=None, tole
         if own:
             ex.close()
     workers = min(ex.workers, len(jobs))
-    info = {"source": reference.source, "exact": not reference.noise,
-            "regime": reference.regime, "impacts": reference.impacts,
-            "start": "measured state" if from_state and reference.start is not None
-            else "scenario initial state"}
-    return Landscape(terms=tuple(law.names[:2]), axes=(axis0, axis1), values=values,
-                     regime=regime, seconds=time.perf_counter() - t_start, workers=workers,
-                     consistent=consistent, impacts=impacts, messages=messages,
-                     noise_floor=dict(floor), noise_floor_q95=dict(q95),
-                     noise_floor_under=under, reference=info,
-                     continuation=bool(continuation))
+    info = {
+        "source": reference.source,
+        "exact": not reference.noise,
+        "regime": reference.regime,
+        "impacts": reference.impacts,
+        "start": "measured state"
+        if from_state and reference.start is not None
+        else "scenario initial state",
+    }
+    return Landscape(
+        terms=tuple(law.names[:2]),
+        axes=(axis0, axis1),
+        values=values,
+        regime=regime,
+        seconds=time.perf_counter() - t_start,
+        workers=workers,
+        consistent=consistent,
+        impacts=impacts,
+        messages=messages,
+        noise_floor=dict(floor),
+        noise_floor_q95=dict(q95),
+        noise_floor_under=under,
+        reference=info,
+        continuation=bool(continuation),
+    )

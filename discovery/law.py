@@ -42,7 +42,6 @@ from .errors import InputError
 __all__ = ["Term", "ForceLaw"]  # and ZETA, ZD, the sympy symbols (made on first use)
 
 
-
 @lru_cache(maxsize=1)
 def _symbols():
     """``(ZETA, ZD)``, the sympy symbols (sympy is imported on first use: ``vidi --help``
@@ -56,6 +55,8 @@ def __getattr__(name):
     if name in ("ZETA", "ZD"):
         return _symbols()[name == "ZD"]
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 FASTEST_CONTACT = 2 * np.pi * 1e7  # contact rate x drive period: a contact of 1e-7 periods
 _MAX_SET = 0.95  # largest permanent-set fraction (1 would be a rigid-plastic contact)
 _LATEX = (r"\zeta", r"\dot{\zeta}_{+}")  # names of (ZETA, ZD) in LaTeX
@@ -176,9 +177,11 @@ class ForceLaw:
             raise InputError("force-law coefficients must be finite numbers")
         tiny = [c for c in coefs if c != 0.0 and abs(c) < np.finfo(float).tiny]
         if tiny:
-            raise InputError(f"force-law coefficient {tiny[0]:.3g} is below the smallest normal "
-                             f"number ({np.finfo(float).tiny:.3g}): no arithmetic on it is exact;"
-                             " give the coefficient in N, m and s (e.g. 2.06e8*z)")
+            raise InputError(
+                f"force-law coefficient {tiny[0]:.3g} is below the smallest normal "
+                f"number ({np.finfo(float).tiny:.3g}): no arithmetic on it is exact;"
+                " give the coefficient in N, m and s (e.g. 2.06e8*z)"
+            )
         object.__setattr__(self, "terms", terms)
         object.__setattr__(self, "coefficients", coefs)
         uterms = tuple(self.unloading)
@@ -188,15 +191,22 @@ class ForceLaw:
         if len(set(uterms)) != len(uterms):
             raise InputError("a force law lists the same unloading term twice; merge them")
         if any(t.b == 0 for t in uterms):
-            raise InputError("an unloading term must depend on the velocity (e.g. 'zd' or "
-                             "'z*zd'), so the force is continuous when the motion reverses")
+            raise InputError(
+                "an unloading term must depend on the velocity (e.g. 'zd' or "
+                "'z*zd'), so the force is continuous when the motion reverses"
+            )
         if not all(np.isfinite(ucoefs)):
             raise InputError("unloading coefficients must be finite numbers")
         rho = self.permanent_set
-        if isinstance(rho, bool) or not isinstance(rho, int | float | np.number) \
-                or not (0.0 <= float(rho) <= _MAX_SET):
-            raise InputError(f"the permanent set must be a number in [0, {_MAX_SET}] (the "
-                             f"residual share of the largest penetration); got {rho!r}")
+        if (
+            isinstance(rho, bool)
+            or not isinstance(rho, int | float | np.number)
+            or not (0.0 <= float(rho) <= _MAX_SET)
+        ):
+            raise InputError(
+                f"the permanent set must be a number in [0, {_MAX_SET}] (the "
+                f"residual share of the largest penetration); got {rho!r}"
+            )
         object.__setattr__(self, "unloading", uterms)
         object.__setattr__(self, "unloading_coefficients", ucoefs)
         object.__setattr__(self, "permanent_set", float(rho))
@@ -214,9 +224,11 @@ class ForceLaw:
             key, sep, value = part.partition(":")
             key = key.strip().lower()
             if not sep or key not in ("unloading", "set") or key in extra:
-                raise InputError(f"force law {text!r}: after ';' give 'unloading: <terms>' or "
-                                 "'set: <fraction>' once each, e.g. '2e8*z + 1e7*zd; "
-                                 "unloading: 4e6*zd; set: 0.2'")
+                raise InputError(
+                    f"force law {text!r}: after ';' give 'unloading: <terms>' or "
+                    "'set: <fraction>' once each, e.g. '2e8*z + 1e7*zd; "
+                    "unloading: 4e6*zd; set: 0.2'"
+                )
             extra[key] = value.strip()
         terms, coefs = cls._merged(main)
         uterms, ucoefs = cls._merged(extra["unloading"]) if "unloading" in extra else ((), ())
@@ -225,8 +237,10 @@ class ForceLaw:
             try:
                 rho = float(extra["set"])
             except ValueError:
-                raise InputError(f"force law {text!r}: 'set:' needs a number in [0, "
-                                 f"{_MAX_SET}], got {extra['set']!r}") from None
+                raise InputError(
+                    f"force law {text!r}: 'set:' needs a number in [0, "
+                    f"{_MAX_SET}], got {extra['set']!r}"
+                ) from None
         return cls(terms, coefs, uterms, ucoefs, rho)
 
     @staticmethod
@@ -250,12 +264,14 @@ class ForceLaw:
 
     def with_unloading(self, terms=None, coefficients=None, permanent_set=None):
         """The same loading branch with another unloading branch (None keeps a part)."""
-        return replace(self,
-                       unloading=self.unloading if terms is None else tuple(terms),
-                       unloading_coefficients=self.unloading_coefficients
-                       if coefficients is None else tuple(coefficients),
-                       permanent_set=self.permanent_set if permanent_set is None
-                       else permanent_set)
+        return replace(
+            self,
+            unloading=self.unloading if terms is None else tuple(terms),
+            unloading_coefficients=self.unloading_coefficients
+            if coefficients is None
+            else tuple(coefficients),
+            permanent_set=self.permanent_set if permanent_set is None else permanent_set,
+        )
 
     @property
     def has_unloading_branch(self):
@@ -274,6 +290,7 @@ class ForceLaw:
 
     def to_text(self):
         """Text that :meth:`parse` reads back to the same law."""
+
         def exact(c):
             num = repr(abs(c))  # shortest text that reads back exactly
             return num[:-2] if num.endswith(".0") else num
@@ -286,8 +303,10 @@ class ForceLaw:
 
     def _text(self, number, fraction):
         def poly(terms, coefs):
-            out = [f"{'-' if c < 0 else '+'} {number(c)}*{t.name}"
-                   for c, t in zip(coefs, terms, strict=True)]
+            out = [
+                f"{'-' if c < 0 else '+'} {number(c)}*{t.name}"
+                for c, t in zip(coefs, terms, strict=True)
+            ]
             text = " ".join(out)
             return text[2:] if text.startswith("+ ") else "-" + text[2:]
 
@@ -318,15 +337,16 @@ class ForceLaw:
         reasons, unless the user asks for it.
         """
         out = []
-        if not any(t.b == 0 and c > 0 for t, c in zip(self.terms, self.coefficients,
-                                                        strict=True)):
-            out.append("no spring: F(zeta, 0) = 0 (no elastic term with a positive "
-                       "coefficient)")
-        neg = [t.name for t, c in zip(self.terms, self.coefficients, strict=True)
-               if t.b > 0 and c < 0]
+        if not any(t.b == 0 and c > 0 for t, c in zip(self.terms, self.coefficients, strict=True)):
+            out.append("no spring: F(zeta, 0) = 0 (no elastic term with a positive coefficient)")
+        neg = [
+            t.name for t, c in zip(self.terms, self.coefficients, strict=True) if t.b > 0 and c < 0
+        ]
         if neg:
-            out.append(f"dissipative term{'s' if len(neg) > 1 else ''} {', '.join(neg)} with "
-                       "a negative coefficient")
+            out.append(
+                f"dissipative term{'s' if len(neg) > 1 else ''} {', '.join(neg)} with "
+                "a negative coefficient"
+            )
         return out
 
     # ------------------------------------------------------------ evaluation
@@ -349,8 +369,10 @@ class ForceLaw:
         never feeds energy into an impact).  Conditions (3)-(5) hold by construction.
         """
         if not any(self.coefficients):
-            raise InputError(f"{what} '{self}' has no non-zero coefficient; give a law such "
-                             "as '2.06e8*z + 1.28e7*zd'")
+            raise InputError(
+                f"{what} '{self}' has no non-zero coefficient; give a law such "
+                "as '2.06e8*z + 1.28e7*zd'"
+            )
         x, v = scenario.scales()
         Z, V = x, 4.0 * v
         zz, vv = np.meshgrid(np.linspace(Z / 64, Z, 64), np.linspace(0.0, V, 65))
@@ -360,28 +382,35 @@ class ForceLaw:
                 f"{what} '{self}' never pushes the bodies apart (P <= 0 for every "
                 f"penetration up to {Z:.3g} m and velocity up to {V:.3g} m/s): the moulding "
                 "would fall through the grid; a contact law needs a positive stiffness term "
-                "such as 2e8*z")
+                "such as 2e8*z"
+            )
         if any(c < 0 for c in self.unloading_coefficients):
-            raise InputError(f"{what} '{self}' has a negative unloading coefficient: it would "
-                             "push the bodies apart harder while they separate (energy fed "
-                             "into the rebound); make the unloading terms non-negative")
+            raise InputError(
+                f"{what} '{self}' has a negative unloading coefficient: it would "
+                "push the bodies apart harder while they separate (energy fed "
+                "into the rebound); make the unloading terms non-negative"
+            )
         D = P - self.polynomial(zz, np.zeros_like(vv))
         worst = np.unravel_index(int(np.argmin(D)), D.shape)
         if D[worst] < -1e-9 * float(np.max(np.abs(P))):
             raise InputError(
                 f"{what} '{self}' breaks the paper's condition (6), dissipativity: F(zeta, zd) "
                 f"< F(zeta, 0) at zeta = {zz[worst]:.3g} m, zd = {vv[worst]:.3g} m/s (damping "
-                "that feeds energy into the impact); make the velocity terms non-negative")
+                "that feeds energy into the impact); make the velocity terms non-negative"
+            )
         # a contact far shorter than any step the drive period allows cannot be simulated
         m = scenario.m1 * scenario.m2 / (scenario.m1 + scenario.m2)
-        rate = max(float(np.sqrt(np.max(self.polynomial(zz, np.zeros_like(vv)) / zz) / m)),
-                   float(np.max(D / np.maximum(vv, 1e-300)) / m))
+        rate = max(
+            float(np.sqrt(np.max(self.polynomial(zz, np.zeros_like(vv)) / zz) / m)),
+            float(np.max(D / np.maximum(vv, 1e-300)) / m),
+        )
         if rate * scenario.period > FASTEST_CONTACT:
             raise InputError(
                 f"{what} '{self}' is too stiff for this machine: a contact would last about "
                 f"{scenario.period * 2 * np.pi / min(rate * scenario.period, 1e300):.2g} s, "
                 f"under 1e-7 of the drive period {scenario.period:.3g} s, which no simulation "
-                "resolves; check the coefficients' units (N/m, N s/m) and the scenario's masses")
+                "resolves; check the coefficients' units (N/m, N s/m) and the scenario's masses"
+            )
 
     def __call__(self, zeta, dzeta, zeta_max=None):
         """Contact force ``F(zeta, dzeta)`` [N] with conditions (3)-(5) applied (and the
@@ -404,8 +433,11 @@ class ForceLaw:
             if self.permanent_set:
                 # reloading below z_max follows the elastic unloading line (Walton-Braun)
                 elastic = self.polynomial(zp, np.zeros_like(zp))
-                p = p - elastic + np.where(
-                    zp < zm, self.unloading_force(zp, np.zeros_like(zp), zm), elastic)
+                p = (
+                    p
+                    - elastic
+                    + np.where(zp < zm, self.unloading_force(zp, np.zeros_like(zp), zm), elastic)
+                )
             p = np.where(dzeta > 0, p, self.unloading_force(zp, dzeta, zm))
         return np.where(zeta > 0, np.maximum(p, 0.0), 0.0)
 
@@ -439,8 +471,10 @@ class ForceLaw:
         import sympy
 
         return sympy.Add(
-            *[sympy.Float(c, 15) * t.sympy()
-              for c, t in zip(self.coefficients, self.terms, strict=True)]
+            *[
+                sympy.Float(c, 15) * t.sympy()
+                for c, t in zip(self.coefficients, self.terms, strict=True)
+            ]
         )
 
     def latex(self, digits=4):
@@ -450,9 +484,9 @@ class ForceLaw:
         """
         text = _latex_sum(self.coefficients, self.terms, digits, _LATEX)
         if self.unloading:
-            text += (r"\quad\text{unloading: } P(\zeta, 0) - "
-                     + _latex_sum(self.unloading_coefficients, self.unloading, digits,
-                                  _LATEX_UNLOADING, paren=True))
+            text += r"\quad\text{unloading: } P(\zeta, 0) - " + _latex_sum(
+                self.unloading_coefficients, self.unloading, digits, _LATEX_UNLOADING, paren=True
+            )
         if self.permanent_set:
             text += rf"\quad\text{{set }} s = {self.permanent_set:.{digits}g}"
         return text

@@ -96,12 +96,14 @@ class Library:
                     except InputError as exc:
                         raise InputError(
                             f"library {spec!r}: {name.strip()!r} is not a term{_reason(exc)}; "
-                            "use poly:N, hc or names like z, zd, z*zd, z^1.5, z^2*zd") from None
+                            "use poly:N, hc or names like z, zd, z*zd, z^1.5, z^2*zd"
+                        ) from None
                 lib = cls(tuple(terms))
             out = lib if out is None else out + lib
         if out is None:
-            raise InputError(f"library {spec!r} names no terms; write e.g. 'poly:2', 'hc' or "
-                             "'z,zd,z*zd'")
+            raise InputError(
+                f"library {spec!r} names no terms; write e.g. 'poly:2', 'hc' or 'z,zd,z*zd'"
+            )
         return out
 
     @classmethod
@@ -120,8 +122,7 @@ class Library:
             try:  # not fitted yet: only the number of inputs matters for the terms
                 feature_library.fit(np.ones((4, 2)))
             except Exception as exc:  # noqa: BLE001 - any pysindy failure is a user error here
-                raise InputError(f"cannot use pysindy library {feature_library!r}: {exc}") \
-                    from None
+                raise InputError(f"cannot use pysindy library {feature_library!r}: {exc}") from None
             powers = getattr(feature_library, "powers_", None)
         if powers is None:
             raise InputError("only pysindy polynomial libraries (with powers_) can be converted")

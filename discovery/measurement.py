@@ -48,8 +48,15 @@ _OPTIONAL = ("w1", "v1", "w2", "v2", "a2")
 _STATE = ("w1", "v1", "w2", "v2")
 COLUMNS = ("t", "F", *_OPTIONAL)
 #: largest accepted magnitude and unit of each column (SI)
-LIMITS = {"t": (1e7, "s"), "F": (1e12, "N"), "w1": (1e3, "m"), "w2": (1e3, "m"),
-          "v1": (1e3, "m/s"), "v2": (1e3, "m/s"), "a2": (1e7, "m/s^2")}
+LIMITS = {
+    "t": (1e7, "s"),
+    "F": (1e12, "N"),
+    "w1": (1e3, "m"),
+    "w2": (1e3, "m"),
+    "v1": (1e3, "m/s"),
+    "v2": (1e3, "m/s"),
+    "a2": (1e7, "m/s^2"),
+}
 #: relative sampling jitter below which a record is uniform as it is
 UNIFORM_TOL = 1e-3
 #: relative sampling jitter up to which a record is resampled onto a uniform grid
@@ -104,39 +111,51 @@ class Measurement:
         F = np.asarray(self.F, dtype=float)
         where = f" in {self.source}" if self.source else ""
         if t.ndim != 1 or t.shape != F.shape or t.size < 4:
-            raise InputError(f"t and F must be 1-D of equal length >= 4{where}; a record needs "
-                             "at least 4 samples")
+            raise InputError(
+                f"t and F must be 1-D of equal length >= 4{where}; a record needs "
+                "at least 4 samples"
+            )
         for name, arr in (("t", t), ("F", F), *self.channels.items()):
             arr = np.asarray(arr, dtype=float)
             if arr.shape != t.shape:
-                raise InputError(f"channel {name}{where} has {arr.size} samples but t has "
-                                 f"{t.size}; give every channel at every time")
+                raise InputError(
+                    f"channel {name}{where} has {arr.size} samples but t has "
+                    f"{t.size}; give every channel at every time"
+                )
             bad = np.flatnonzero(~np.isfinite(arr))
             if bad.size:
-                raise InputError(f"column {name}{where} has a missing or non-finite value at "
-                                 f"data row {bad[0] + 1}; remove or fill it")
+                raise InputError(
+                    f"column {name}{where} has a missing or non-finite value at "
+                    f"data row {bad[0] + 1}; remove or fill it"
+                )
             lim, unit = LIMITS.get(name, (np.inf, ""))
             big = np.flatnonzero(np.abs(arr) > lim)
             if big.size:
-                raise InputError(f"column {name}{where} has the value {_fmt(arr[big[0]])} at "
-                                 f"data row {big[0] + 1}, beyond the accepted |{name}| <= "
-                                 f"{lim:g} {unit}; check the column and its units (SI)")
+                raise InputError(
+                    f"column {name}{where} has the value {_fmt(arr[big[0]])} at "
+                    f"data row {big[0] + 1}, beyond the accepted |{name}| <= "
+                    f"{lim:g} {unit}; check the column and its units (SI)"
+                )
         d = np.diff(t)
         if np.any(d == 0):
             k = int(np.flatnonzero(d == 0)[0])
-            raise InputError(f"duplicate time t = {_fmt(t[k])}{where} (data rows {k + 1}, "
-                             f"{k + 2}); each sample needs its own time")
+            raise InputError(
+                f"duplicate time t = {_fmt(t[k])}{where} (data rows {k + 1}, "
+                f"{k + 2}); each sample needs its own time"
+            )
         if np.any(d < 0):
             k = int(np.flatnonzero(d < 0)[0])
-            raise InputError(f"times are not increasing{where} at data row {k + 2}; sort the "
-                             "file by t")
+            raise InputError(
+                f"times are not increasing{where} at data row {k + 2}; sort the file by t"
+            )
         jit, med, lo, hi = _jitter(t)
         if jit > JITTER_LIMIT:
             raise InputError(_nonuniform_message(where, jit, med, lo, hi))
         object.__setattr__(self, "t", t)
         object.__setattr__(self, "F", F)
-        object.__setattr__(self, "channels",
-                           {k: np.asarray(v, dtype=float) for k, v in self.channels.items()})
+        object.__setattr__(
+            self, "channels", {k: np.asarray(v, dtype=float) for k, v in self.channels.items()}
+        )
 
     @property
     def fs(self):
@@ -166,18 +185,24 @@ class Measurement:
         header, body, decimal_comma, notes = read_csv_rows(path, "t and F")
         src, from_a2, extra_notes = _column_sources(header, columns, name, scenario)
         notes += extra_notes
-        cols = {key: _parse_column(key, header[j], j, body, name, decimal_comma)
-                for key, j in src.items()}
+        cols = {
+            key: _parse_column(key, header[j], j, body, name, decimal_comma)
+            for key, j in src.items()
+        }
         t = cols["t"]
         d = np.diff(t)
         if np.any(d == 0):
             k = int(np.flatnonzero(d == 0)[0])
-            raise InputError(f"data file {name!r}: duplicate time t = {_fmt(t[k])} at lines "
-                             f"{body[k][0]} and {body[k + 1][0]}; each sample needs its own time")
+            raise InputError(
+                f"data file {name!r}: duplicate time t = {_fmt(t[k])} at lines "
+                f"{body[k][0]} and {body[k + 1][0]}; each sample needs its own time"
+            )
         if np.any(d < 0):
             k = int(np.flatnonzero(d < 0)[0])
-            raise InputError(f"data file {name!r}: times are not increasing at line "
-                             f"{body[k + 1][0]}; sort the file by t")
+            raise InputError(
+                f"data file {name!r}: times are not increasing at line "
+                f"{body[k + 1][0]}; sort the file by t"
+            )
         if t.size >= 3:
             jit, med, lo, hi = _jitter(t)
             if jit > JITTER_LIMIT:
@@ -185,9 +210,11 @@ class Measurement:
             if jit > UNIFORM_TOL:
                 grid = np.linspace(t[0], t[-1], t.size)
                 cols = {k: (grid if k == "t" else np.interp(grid, t, v)) for k, v in cols.items()}
-                notes += (f"resampled onto a uniform grid (step {_fmt(grid[1] - grid[0])} s) by "
-                          f"linear interpolation: the sampling jitter was {100 * jit:.3g} % of "
-                          "a step",)
+                notes += (
+                    f"resampled onto a uniform grid (step {_fmt(grid[1] - grid[0])} s) by "
+                    f"linear interpolation: the sampling jitter was {100 * jit:.3g} % of "
+                    "a step",
+                )
         channels = {k: cols[k] for k in _OPTIONAL if k in cols}
         if from_a2:
             cols["F"] = scenario.m2 * (cols["a2"] + scenario.g)
@@ -244,7 +271,7 @@ class Measurement:
         best = None
         for k in range(k_hi, max(k_lo, k_hi - 8) - 1, -1):
             i = int(np.searchsorted(t, k * period - time_offset))
-            free = bool(np.all(self.F[max(i - m, 0):i + m + 1] <= max(thr, 0.0)))
+            free = bool(np.all(self.F[max(i - m, 0) : i + m + 1] <= max(thr, 0.0)))
             if best is None or free:
                 best = (k, i)
             if free:
@@ -281,15 +308,18 @@ class Measurement:
         try:
             return impulse_from_samples(self.t, self.F, period, zeta=self.zeta, **kwargs)
         except NoContactError:
-            raise NoContactError(no_contact_message(self.t, self.F, period, self.source,
-                                                kwargs.get("threshold"))) from None
+            raise NoContactError(
+                no_contact_message(self.t, self.F, period, self.source, kwargs.get("threshold"))
+            ) from None
 
 
 def _nonuniform_message(where, jit, med, lo, hi):
-    return (f"the record{where} is not uniformly sampled: time steps from {_fmt(lo)} to "
-            f"{_fmt(hi)} s around the median {_fmt(med)} s ({100 * jit:.3g} % off; up to "
-            f"{100 * JITTER_LIMIT:g} % is resampled); resample it onto a uniform time grid "
-            "(e.g. numpy.interp) or cut it at the gap, then load it again")
+    return (
+        f"the record{where} is not uniformly sampled: time steps from {_fmt(lo)} to "
+        f"{_fmt(hi)} s around the median {_fmt(med)} s ({100 * jit:.3g} % off; up to "
+        f"{100 * JITTER_LIMIT:g} % is resampled); resample it onto a uniform time grid "
+        "(e.g. numpy.interp) or cut it at the gap, then load it again"
+    )
 
 
 def no_contact_message(t, F, period, source="", threshold=None):
@@ -303,9 +333,11 @@ def no_contact_message(t, F, period, source="", threshold=None):
     above = F > thr
     n_above = int(above.sum())
     if n_above == 0:
-        return (f"no contact found in the force record{where}: no sample exceeds the threshold "
-                f"{thr:.3g} N (5 x the noise {sigma:.3g} N, at least 1e-3 of max F); check the "
-                "F column and its units")
+        return (
+            f"no contact found in the force record{where}: no sample exceeds the threshold "
+            f"{thr:.3g} N (5 x the noise {sigma:.3g} N, at least 1e-3 of max F); check the "
+            "F column and its units"
+        )
     min_len = _edge_params(t, period)[0]
     edges = np.flatnonzero(np.diff(np.concatenate([[0], above.astype(np.int8), [0]])))
     runs = []
@@ -319,17 +351,23 @@ def no_contact_message(t, F, period, source="", threshold=None):
         at = [("start" if a == 0 else "end") for a, b in long_runs]
         n_cut = sum(b - a for a, b in long_runs)
         side = " and ".join(dict.fromkeys(at))
-        return (f"the only contact{where} ({n_cut} samples above the threshold {thr:.3g} N) is "
-                f"cut off at the record's {side}: a contact must begin and end inside the "
-                "record; record a few drive periods more (whole contacts)")
+        return (
+            f"the only contact{where} ({n_cut} samples above the threshold {thr:.3g} N) is "
+            f"cut off at the record's {side}: a contact must begin and end inside the "
+            "record; record a few drive periods more (whole contacts)"
+        )
     if not long_runs:
-        return (f"no contact found in the force record{where}: {n_above} samples exceed the "
-                f"threshold {thr:.3g} N but no run lasts {min_len} samples (1 % of a drive "
-                "period): they look like noise spikes; check the F column, its units and the "
-                "sampling rate")
-    return (f"no contact found in the force record{where}: the runs above the threshold "
-            f"{thr:.3g} N peak below 3 x the threshold, which is read as noise; check the F "
-            "column and its units, or record with less noise")
+        return (
+            f"no contact found in the force record{where}: {n_above} samples exceed the "
+            f"threshold {thr:.3g} N but no run lasts {min_len} samples (1 % of a drive "
+            "period): they look like noise spikes; check the F column, its units and the "
+            "sampling rate"
+        )
+    return (
+        f"no contact found in the force record{where}: the runs above the threshold "
+        f"{thr:.3g} N peak below 3 x the threshold, which is read as noise; check the F "
+        "column and its units, or record with less noise"
+    )
 
 
 def read_csv_rows(path, needs):
@@ -342,8 +380,11 @@ def read_csv_rows(path, needs):
     """
     name = str(path)
     text, notes = _read_text(path, name)
-    lines = [(i + 1, ln) for i, ln in enumerate(text.splitlines())
-             if ln.strip() and not ln.lstrip().startswith("#")]
+    lines = [
+        (i + 1, ln)
+        for i, ln in enumerate(text.splitlines())
+        if ln.strip() and not ln.lstrip().startswith("#")
+    ]
     if not lines:
         raise InputError(f"data file {name!r} is empty; it needs a header with {needs}")
     delim = _sniff(lines[0][1])
@@ -352,8 +393,10 @@ def read_csv_rows(path, needs):
         try:
             rows.append(next(csv.reader([line], delimiter=delim), []))
         except csv.Error as exc:
-            raise InputError(f"data file {name!r}: line {ln} is not a readable CSV row "
-                             f"({exc}); save the file as CSV with a header row") from None
+            raise InputError(
+                f"data file {name!r}: line {ln} is not a readable CSV row "
+                f"({exc}); save the file as CSV with a header row"
+            ) from None
     header = [h.strip() for h in rows[0]]
     body = list(zip((ln for ln, _ in lines[1:]), rows[1:], strict=True))
     if not body:
@@ -374,32 +417,43 @@ def _read_text(path, name):
     except FileNotFoundError:
         raise InputError(f"data file {name!r} does not exist; check the path") from None
     except IsADirectoryError:
-        raise InputError(f"data file {name!r} is a directory; give the CSV file itself, e.g. "
-                         f"{os.path.join(name, 'D.csv')!r}") from None
+        raise InputError(
+            f"data file {name!r} is a directory; give the CSV file itself, e.g. "
+            f"{os.path.join(name, 'D.csv')!r}"
+        ) from None
     except PermissionError:
-        raise InputError(f"data file {name!r} cannot be read (permission denied); fix its "
-                         "permissions or copy it somewhere readable") from None
+        raise InputError(
+            f"data file {name!r} cannot be read (permission denied); fix its "
+            "permissions or copy it somewhere readable"
+        ) from None
     except OSError as exc:
-        raise InputError(f"cannot read data file {name!r} ({exc.strerror or exc}); check the "
-                         "path") from None
+        raise InputError(
+            f"cannot read data file {name!r} ({exc.strerror or exc}); check the path"
+        ) from None
     notes = ()
     if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
         try:
             text = raw.decode("utf-16")
         except UnicodeDecodeError:
-            raise InputError(f"data file {name!r} starts with a UTF-16 byte-order mark but is "
-                             "not valid UTF-16; re-save it as UTF-8 CSV") from None
+            raise InputError(
+                f"data file {name!r} starts with a UTF-16 byte-order mark but is "
+                "not valid UTF-16; re-save it as UTF-8 CSV"
+            ) from None
         notes = ("read as UTF-16 (byte-order mark)",)
     else:
         try:
             text = raw.decode("utf-8-sig")
         except UnicodeDecodeError as exc:
-            raise InputError(f"data file {name!r} is not UTF-8 text (byte 0x{raw[exc.start]:02x} "
-                             f"at offset {exc.start}); re-save it as UTF-8 (spreadsheets: "
-                             "'CSV UTF-8'; or iconv -f latin1 -t utf-8)") from None
+            raise InputError(
+                f"data file {name!r} is not UTF-8 text (byte 0x{raw[exc.start]:02x} "
+                f"at offset {exc.start}); re-save it as UTF-8 (spreadsheets: "
+                "'CSV UTF-8'; or iconv -f latin1 -t utf-8)"
+            ) from None
     if "\x00" in text:
-        raise InputError(f"data file {name!r} contains NUL bytes: it is binary (or UTF-16 "
-                         "without a byte-order mark), not CSV text; export it as CSV (UTF-8)")
+        raise InputError(
+            f"data file {name!r} contains NUL bytes: it is binary (or UTF-16 "
+            "without a byte-order mark), not CSV text; export it as CSV (UTF-8)"
+        )
     return text, notes
 
 
@@ -415,29 +469,41 @@ def _column_sources(header, columns, name, scenario):
     named = [h for h in header if h]
     dups = sorted({h for h in named if named.count(h) > 1})
     if dups:
-        raise InputError(f"data file {name!r}: column name(s) {', '.join(dups)} appear more "
-                         "than once in the header; rename them")
+        raise InputError(
+            f"data file {name!r}: column name(s) {', '.join(dups)} appear more "
+            "than once in the header; rename them"
+        )
     src, notes = {}, ()
     if columns:
         if not isinstance(columns, dict):
-            raise InputError("columns must map our names to the file's headers, e.g. "
-                             "{'t': 'time_s', 'F': 'force_N'}")
+            raise InputError(
+                "columns must map our names to the file's headers, e.g. "
+                "{'t': 'time_s', 'F': 'force_N'}"
+            )
         for key, col in columns.items():
             if key not in COLUMNS:
-                raise InputError(f"column mapping: unknown name {key!r}; map the names "
-                                 f"{', '.join(COLUMNS)} to the file's headers, e.g. "
-                                 "t=time_s,F=force_N")
+                raise InputError(
+                    f"column mapping: unknown name {key!r}; map the names "
+                    f"{', '.join(COLUMNS)} to the file's headers, e.g. "
+                    "t=time_s,F=force_N"
+                )
             col = col.strip() if isinstance(col, str) else col
             if not isinstance(col, str) or not col:
-                raise InputError(f"column mapping {key}=: give the header of the file's "
-                                 f"column for {key}, e.g. {key}=time_s")
+                raise InputError(
+                    f"column mapping {key}=: give the header of the file's "
+                    f"column for {key}, e.g. {key}=time_s"
+                )
             if col not in header:
-                raise InputError(f"column mapping {key}={col}: data file {name!r} has no column "
-                                 f"{col!r} (found {', '.join(named) or 'no names'})")
+                raise InputError(
+                    f"column mapping {key}={col}: data file {name!r} has no column "
+                    f"{col!r} (found {', '.join(named) or 'no names'})"
+                )
             src[key] = header.index(col)
         if len(set(src.values())) != len(src):
-            raise InputError("column mapping: two names are mapped to the same column; map "
-                             "each of the file's columns once")
+            raise InputError(
+                "column mapping: two names are mapped to the same column; map "
+                "each of the file's columns once"
+            )
         notes += ("columns mapped: " + ", ".join(f"{k} <- {header[j]}" for k, j in src.items()),)
     used = set(src.values())
     for key in COLUMNS:
@@ -445,19 +511,25 @@ def _column_sources(header, columns, name, scenario):
             src[key] = header.index(key)
     from_a2 = "F" not in src and "a2" in src
     if from_a2 and scenario is None:
-        raise InputError(f"data file {name!r} has a2 but no F; give the scenario so that "
-                         "F = m2 (a2 + g) can be formed")
+        raise InputError(
+            f"data file {name!r} has a2 but no F; give the scenario so that "
+            "F = m2 (a2 + g) can be formed"
+        )
     missing = [c for c in ("t", "F") if c not in src and not (c == "F" and from_a2)]
     for c in missing:
         if c in header:  # its column was mapped to another name
             other = next(k for k, j in src.items() if j == header.index(c))
-            raise InputError(f"column mapping {other}={c} takes the file's column {c}, so "
-                             f"nothing is left for {c}; map {c} to another column as well, "
-                             f"e.g. {c}=NAME")
+            raise InputError(
+                f"column mapping {other}={c} takes the file's column {c}, so "
+                f"nothing is left for {c}; map {c} to another column as well, "
+                f"e.g. {c}=NAME"
+            )
     if missing:
-        raise InputError(f"data file {name!r} has no column {' or '.join(missing)} (found "
-                         f"{', '.join(named) or 'no names'}); name them t [s] and F [N] in the "
-                         "header, or map yours: --columns t=NAME,F=NAME (API: columns=)")
+        raise InputError(
+            f"data file {name!r} has no column {' or '.join(missing)} (found "
+            f"{', '.join(named) or 'no names'}); name them t [s] and F [N] in the "
+            "header, or map yours: --columns t=NAME,F=NAME (API: columns=)"
+        )
     ignored = [h for j, h in enumerate(header) if h and j not in src.values()]
     if ignored:
         notes += (f"ignored column(s): {', '.join(ignored)}",)
@@ -471,8 +543,10 @@ def _parse_column(key, hname, j, body, name, decimal_comma, limits=None):
     cells = []
     for ln, row in body:
         if j >= len(row):
-            raise InputError(f"data file {name!r}: line {ln} has {len(row)} field(s), no value "
-                             f"for column {hname}; every row needs a value in every column")
+            raise InputError(
+                f"data file {name!r}: line {ln} has {len(row)} field(s), no value "
+                f"for column {hname}; every row needs a value in every column"
+            )
         cells.append(row[j].strip())
     arr = np.array(cells, dtype=str)
     if decimal_comma:
@@ -485,31 +559,56 @@ def _parse_column(key, hname, j, body, name, decimal_comma, limits=None):
                 float(c)
             except ValueError:
                 what = "is empty" if not c else f"has a non-numeric value {c[:20]!r}"
-                raise InputError(f"data file {name!r}: column {hname} {what} at line {ln}; "
-                                 "every row needs a number (remove the row or fill it)") from None
-        raise InputError(f"data file {name!r}: column {hname} cannot be read as numbers; "
-                         "every row needs a number") from None
+                raise InputError(
+                    f"data file {name!r}: column {hname} {what} at line {ln}; "
+                    "every row needs a number (remove the row or fill it)"
+                ) from None
+        raise InputError(
+            f"data file {name!r}: column {hname} cannot be read as numbers; "
+            "every row needs a number"
+        ) from None
     bad = np.flatnonzero(~np.isfinite(v))
     if bad.size:
-        raise InputError(f"data file {name!r}: column {hname} has the non-finite value "
-                         f"{cells[bad[0]][:20]!r} at line {body[bad[0]][0]}; remove the row or "
-                         "fill it with a measured number")
+        raise InputError(
+            f"data file {name!r}: column {hname} has the non-finite value "
+            f"{cells[bad[0]][:20]!r} at line {body[bad[0]][0]}; remove the row or "
+            "fill it with a measured number"
+        )
     lim, unit = (LIMITS if limits is None else limits)[key]
     big = np.flatnonzero(np.abs(v) > lim)
     if big.size:
-        raise InputError(f"data file {name!r}: column {hname} has the value {cells[big[0]][:20]} "
-                         f"at line {body[big[0]][0]}, beyond the accepted |{key}| <= {lim:g} "
-                         f"{unit}; check the column and its units (SI)")
+        raise InputError(
+            f"data file {name!r}: column {hname} has the value {cells[big[0]][:20]} "
+            f"at line {body[big[0]][0]}, beyond the accepted |{key}| <= {lim:g} "
+            f"{unit}; check the column and its units (SI)"
+        )
     return v
 
 
 @params(
-    scenario=Scenario, law=ForceLaw, periods=Real(1, integer=True), fs=Real(0, open_low=True),
-    noise=Real(0, 1), seed=Real(0, integer=True), position_noise=Real(0, 1),
+    scenario=Scenario,
+    law=ForceLaw,
+    periods=Real(1, integer=True),
+    fs=Real(0, open_low=True),
+    noise=Real(0, 1),
+    seed=Real(0, integer=True),
+    position_noise=Real(0, 1),
     integrator=Choice("compiled", "scipy"),
 )
-def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None, *,
-               from_rest=False, position_noise=0.0, velocities=True, integrator="compiled"):
+def synthesize(
+    scenario,
+    law,
+    periods=20,
+    fs=20000.0,
+    noise=0.0,
+    seed=0,
+    ss=None,
+    *,
+    from_rest=False,
+    position_noise=0.0,
+    velocities=True,
+    integrator="compiled",
+):
     """A synthetic measurement of ``law`` sampled at ``fs``.
 
     Parameters
@@ -553,14 +652,18 @@ def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None
     else:
         ss = ss or steady_state(scenario, law)
         if not ss.periodic:
-            raise InputError(f"law '{law}' has no periodic steady state in scenario "
-                             f"{scenario.name!r} ({ss.regime}); choose another law or scenario, "
-                             "or record from rest")
+            raise InputError(
+                f"law '{law}' has no periodic steady state in scenario "
+                f"{scenario.name!r} ({ss.regime}); choose another law or scenario, "
+                "or record from rest"
+            )
         span, y0, t_eval, zmax0 = (ss.t0, ss.t0 + t[-1]), ss.y0, ss.t0 + t, ss.zeta_max0
     if integrator == "scipy":
         if zmax0 and law.permanent_set:
-            raise InputError("the scipy path records a law with a permanent set from rest "
-                             "only; add from_rest=True (--from-rest)")
+            raise InputError(
+                "the scipy path records a law with a permanent set from rest "
+                "only; add from_rest=True (--from-rest)"
+            )
         from .dynamics.reference import reference_simulate
 
         out = reference_simulate(scenario, law, span, y0=y0, t_eval=t_eval, rtol=1e-9)
@@ -579,5 +682,9 @@ def synthesize(scenario, law, periods=20, fs=20000.0, noise=0.0, seed=0, ss=None
         ch["w2"] += rng.normal(0.0, sd, n)
     if not velocities:
         del ch["v1"], ch["v2"]
-    return Measurement(t, F, ch, source=f"synthetic:{scenario.name}"
-                       + (" (scipy path)" if integrator == "scipy" else ""))
+    return Measurement(
+        t,
+        F,
+        ch,
+        source=f"synthetic:{scenario.name}" + (" (scipy path)" if integrator == "scipy" else ""),
+    )

@@ -63,7 +63,6 @@ _INFEASIBLE = ("infeasible", "infeasible_inaccurate")
 class _InfeasibleSupport(SolverError):
     """No coefficients on this support satisfy the constraints (not a solver failure)."""
 
-
     def __init__(self, message):
         super().__init__(message, status="infeasible")
 
@@ -104,9 +103,16 @@ class Candidate:
         return len(self.terms)
 
     def as_dict(self):
-        return {"terms": list(self.terms), "coefficients": self.coefficients, "rss": self.rss,
-                "bic": self.bic, "aic": self.aic, "cv_error": self.cv_error,
-                "constrained": self.constrained, **self.extra}
+        return {
+            "terms": list(self.terms),
+            "coefficients": self.coefficients,
+            "rss": self.rss,
+            "bic": self.bic,
+            "aic": self.aic,
+            "cv_error": self.cv_error,
+            "constrained": self.constrained,
+            **self.extra,
+        }
 
 
 class _Problem:
@@ -129,14 +135,20 @@ class _Problem:
             signs = np.broadcast_to(np.asarray(signs, dtype=float), (len(library),))
         # the rows of the cvxpy builders (constraints.builders), as one system M x + off >= 0
         # in units of fscale newtons (offsets come from the dissipativity margin)
-        self.M, self.off = constraint_rows(exps, box, margin=margin, monotone=monotone,
-                                           signs=signs, elevation=elevation,
-                                           force_unit=self.fscale)
+        self.M, self.off = constraint_rows(
+            exps,
+            box,
+            margin=margin,
+            monotone=monotone,
+            signs=signs,
+            elevation=elevation,
+            force_unit=self.fscale,
+        )
         self.solver = solver
         self.n_solves = 0
-        self.fallbacks = []   # (support, failed solver, its status, solver that succeeded)
+        self.fallbacks = []  # (support, failed solver, its status, solver that succeeded)
         self.infeasible = {}  # support -> reason
-        self._solved = {}     # support -> (x, rss, solver)
+        self._solved = {}  # support -> (x, rss, solver)
 
     def feasible(self, idx, x, tol=1e-10):
         return bool(np.all(self.M[:, idx] @ x + self.off >= -tol))
@@ -172,8 +184,11 @@ class _Problem:
         # and no term it acts on) cannot hold for any coefficients
         M, off, impossible = normalized_rows(self.M[:, idx], self.off)
         if impossible.size:
-            self._infeasible(key, "a constraint has no term on this support to act on (a "
-                             "dissipativity margin needs a term zd^b, 0 < b <= 1, without zeta)")
+            self._infeasible(
+                key,
+                "a constraint has no term on this support to act on (a "
+                "dissipativity margin needs a term zd^b, 0 < b <= 1, without zeta)",
+            )
         Q, R = np.linalg.qr(self.A[:, idx])
         qb = Q.T @ self.b
         x = cp.Variable(len(idx))
@@ -185,16 +200,21 @@ class _Problem:
         except SolverError as first:
             # one more interior/first-order solver before giving up (then it raises)
             used = "OSQP" if self.solver != "OSQP" else "CLARABEL"
-            opts = {"eps_abs": 1e-10, "eps_rel": 1e-10, "max_iter": 200000} \
-                if used == "OSQP" else {}
+            opts = (
+                {"eps_abs": 1e-10, "eps_rel": 1e-10, "max_iter": 200000} if used == "OSQP" else {}
+            )
             try:
                 solve(prob, used, **opts)
             except SolverError as second:
                 if first.status in _INFEASIBLE and second.status in _INFEASIBLE:
-                    self._infeasible(key, f"{self.solver} and {used} report the constraints "
-                                     "infeasible on this support")
-                raise SolverError(f"{first}; fallback: {second}", status=second.status,
-                                  solver=used) from second
+                    self._infeasible(
+                        key,
+                        f"{self.solver} and {used} report the constraints "
+                        "infeasible on this support",
+                    )
+                raise SolverError(
+                    f"{first}; fallback: {second}", status=second.status, solver=used
+                ) from second
             self.fallbacks.append((key, self.solver, first.status, used))
         self.n_solves += 1
         xv = np.asarray(x.value, dtype=float)
@@ -287,9 +307,24 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
     fit_seconds_ : float
     """
 
-    def __init__(self, library="poly:2", selection="best-subset", scoring="bic", max_terms=4, cv=5,
-                 margin=0.0, monotone=False, signs=None, box_margin=0.1, elevation=2,
-                 threshold=0.05, n_lambdas=30, solver="CLARABEL", grid=1001, cv_report=False):
+    def __init__(
+        self,
+        library="poly:2",
+        selection="best-subset",
+        scoring="bic",
+        max_terms=4,
+        cv=5,
+        margin=0.0,
+        monotone=False,
+        signs=None,
+        box_margin=0.1,
+        elevation=2,
+        threshold=0.05,
+        n_lambdas=30,
+        solver="CLARABEL",
+        grid=1001,
+        cv_report=False,
+    ):
         self.library = library
         self.selection = selection
         self.scoring = scoring
@@ -328,8 +363,10 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         X = np.asarray(X, dtype=float)
         y = np.asarray(y, dtype=float).ravel()
         if X.ndim != 2 or X.shape[1] != 2 or X.shape[0] != y.size or y.size < 3:
-            raise InputError(f"X must be (n_samples, 2) = (zeta, dzeta) and y (n_samples,); got "
-                             f"{X.shape} and {y.shape}")
+            raise InputError(
+                f"X must be (n_samples, 2) = (zeta, dzeta) and y (n_samples,); got "
+                f"{X.shape} and {y.shape}"
+            )
         if not (np.all(np.isfinite(X)) and np.all(np.isfinite(y))):
             raise InputError("X and y must be finite")
         w, groups = _weights_and_groups(y.size, sample_weight, groups)
@@ -337,8 +374,10 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         if self.signs is not None:
             sg = np.atleast_1d(np.asarray(self.signs))
             if sg.size not in (1, len(self.library_)) or not np.all(np.isin(sg, (-1, 0, 1))):
-                raise InputError(f"signs must be one of -1, 0, +1 or one per library term "
-                                 f"({len(self.library_)}); got {self.signs!r}")
+                raise InputError(
+                    f"signs must be one of -1, 0, +1 or one per library term "
+                    f"({len(self.library_)}); got {self.signs!r}"
+                )
         zp = np.maximum(X[:, 0], 0.0)
         vp = np.maximum(X[:, 1], 0.0)
         if not (zp.max() > 0 and vp.max() > 0):
@@ -356,11 +395,19 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
             bic, aic = prob.scores(rss, len(idx))
             c = prob.physical(list(idx), x)
             cands.append((idx, c, rss * prob.fscale**2, bic, aic, active, used))
-        self.infeasible_ = [{"support": self._names(k), "reason": r}
-                            for k, r in prob.infeasible.items()]
-        self.fallbacks_ = [{"support": self._names(k), "solver": alt, "failed": failed,
-                            "status": status, "stage": "fit"}
-                           for k, failed, status, alt in prob.fallbacks]
+        self.infeasible_ = [
+            {"support": self._names(k), "reason": r} for k, r in prob.infeasible.items()
+        ]
+        self.fallbacks_ = [
+            {
+                "support": self._names(k),
+                "solver": alt,
+                "failed": failed,
+                "status": status,
+                "stage": "fit",
+            }
+            for k, failed, status, alt in prob.fallbacks
+        ]
         if not cands:
             self._no_feasible_support()
         # cross-validation over impacts (only when it is used or asked for)
@@ -371,10 +418,18 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         self.candidates_ = []
         for (idx, c, rss, bic, aic, active, used), e in zip(cands, cv_err, strict=True):
             names = self._names(idx)
-            self.candidates_.append(Candidate(
-                terms=names, coefficients={n: float(c[i]) for n, i in zip(names, idx, strict=True)},
-                rss=float(rss), bic=float(bic), aic=float(aic), cv_error=float(e),
-                constrained=bool(active), extra={"solver": used}))
+            self.candidates_.append(
+                Candidate(
+                    terms=names,
+                    coefficients={n: float(c[i]) for n, i in zip(names, idx, strict=True)},
+                    rss=float(rss),
+                    bic=float(bic),
+                    aic=float(aic),
+                    cv_error=float(e),
+                    constrained=bool(active),
+                    extra={"solver": used},
+                )
+            )
         key = {"bic": lambda c: c.bic, "aic": lambda c: c.aic, "cv": lambda c: c.cv_error}
         self.candidates_.sort(key=key[self.scoring])
         best = self.candidates_[0]
@@ -394,16 +449,24 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         by_reason = {}
         for rec in self.infeasible_:
             by_reason.setdefault(rec["reason"], []).append(" + ".join(rec["support"]))
-        why = "; ".join(f"{', '.join(sup)}: {r}" for r, sup in by_reason.items()) \
+        why = (
+            "; ".join(f"{', '.join(sup)}: {r}" for r, sup in by_reason.items())
             or "no support was proposed"
-        opts = f"margin {self.margin:g} N s/m" + (", monotone" if self.monotone else "") \
+        )
+        opts = (
+            f"margin {self.margin:g} N s/m"
+            + (", monotone" if self.monotone else "")
             + ("" if self.signs is None else f", signs {self.signs!r}")
-        raise InputError(f"no proposed support of library {self.library!r} can satisfy the "
-                         f"physical constraints ({opts}): {why}; add a term they act on, raise "
-                         "max_terms or relax the margin/signs")
+        )
+        raise InputError(
+            f"no proposed support of library {self.library!r} can satisfy the "
+            f"physical constraints ({opts}): {why}; add a term they act on, raise "
+            "max_terms or relax the margin/signs"
+        )
 
-    def rescore(self, coef, X, y, sample_weight=None, groups=None, *, constrained=False,
-                extra=None):
+    def rescore(
+        self, coef, X, y, sample_weight=None, groups=None, *, constrained=False, extra=None
+    ):
         """A :class:`Candidate` for given physical coefficients (e.g. refined by simulation):
         its rss, BIC and AIC on ``(X, y)`` computed exactly as for the fitted candidates, and
         the cross-validated error of its support when the estimator computes one."""
@@ -419,24 +482,39 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         cv = float("nan")
         if self.scoring == "cv" or self.cv_report:
             cv = float(self._cross_validate(X, y, w, groups, [tuple(idx)])[0])
-        return Candidate(terms=names, coefficients={n: float(coef[i]) for n, i in
-                                                    zip(names, idx, strict=True)},
-                         rss=rss, bic=float(bic), aic=float(aic), cv_error=cv,
-                         constrained=constrained, extra=dict(extra or {}))
+        return Candidate(
+            terms=names,
+            coefficients={n: float(coef[i]) for n, i in zip(names, idx, strict=True)},
+            rss=rss,
+            bic=float(bic),
+            aic=float(aic),
+            cv_error=cv,
+            constrained=constrained,
+            extra=dict(extra or {}),
+        )
 
     def certify(self, coef):
         """Independent certificate of physical coefficients on ``box_`` (Bernstein + grid)."""
-        conditions = ["non_adhesion", "dissipativity"] + (["monotone_elastic"] if self.monotone
-                                                          else [])
+        conditions = ["non_adhesion", "dissipativity"] + (
+            ["monotone_elastic"] if self.monotone else []
+        )
         sup = np.asarray(coef) != 0
         lib = self.library_.subset(sup)
-        return certify(np.asarray(coef)[sup], lib.exponents, self.box_, conditions,
-                       elevation=self.elevation, grid=self.grid, margin=self.margin)
+        return certify(
+            np.asarray(coef)[sup],
+            lib.exponents,
+            self.box_,
+            conditions,
+            elevation=self.elevation,
+            grid=self.grid,
+            margin=self.margin,
+        )
 
     def _validate(self):
         if self.selection not in SELECTIONS:
-            raise InputError(f"selection must be one of {', '.join(SELECTIONS)}; got "
-                             f"{self.selection!r}")
+            raise InputError(
+                f"selection must be one of {', '.join(SELECTIONS)}; got {self.selection!r}"
+            )
         if self.scoring not in SCORES:
             raise InputError(f"scoring must be one of {', '.join(SCORES)}; got {self.scoring!r}")
         if not (isinstance(self.max_terms, int | np.integer) and self.max_terms >= 1):
@@ -446,15 +524,26 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         if not (isinstance(self.margin, int | float | np.number) and self.margin >= 0):
             raise InputError(f"margin must be a number >= 0 (N s/m); got {self.margin!r}")
         if not (isinstance(self.box_margin, int | float | np.number) and self.box_margin >= 0):
-            raise InputError(f"box_margin must be a number >= 0 (the box must contain the "
-                             f"data); got {self.box_margin!r}")
+            raise InputError(
+                f"box_margin must be a number >= 0 (the box must contain the "
+                f"data); got {self.box_margin!r}"
+            )
         if not (isinstance(self.elevation, int | np.integer) and self.elevation >= 0):
             raise InputError(f"elevation must be an integer >= 0; got {self.elevation!r}")
 
     def _problem(self, X, y, w):
-        return _Problem(self.library_, self.box_, X, y, w, margin=self.margin,
-                        monotone=self.monotone, signs=self.signs, elevation=self.elevation,
-                        solver=self.solver)
+        return _Problem(
+            self.library_,
+            self.box_,
+            X,
+            y,
+            w,
+            margin=self.margin,
+            monotone=self.monotone,
+            signs=self.signs,
+            elevation=self.elevation,
+            solver=self.solver,
+        )
 
     # ------------------------------------------------------- support proposal
     def _propose(self, prob, X, y, w):
@@ -468,8 +557,9 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         """Exact best certified subset of each size (branch and bound on the RSS)."""
         n = len(self.library_)
         if n > 16:
-            raise InputError(f"best-subset handles libraries up to 16 terms (got {n}); "
-                             "use l1-path or stlsq")
+            raise InputError(
+                f"best-subset handles libraries up to 16 terms (got {n}); use l1-path or stlsq"
+            )
         out = []
         for k in range(1, min(self.max_terms, n) + 1):
             subsets = [list(s) for s in itertools.combinations(range(n), k)]
@@ -495,8 +585,9 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
             if best_idx is not None:
                 out.append(tuple(best_idx))
         if not out:
-            self.infeasible_ = [{"support": self._names(k), "reason": r}
-                                for k, r in prob.infeasible.items()]
+            self.infeasible_ = [
+                {"support": self._names(k), "reason": r} for k, r in prob.infeasible.items()
+            ]
             self._no_feasible_support()
         return out
 
@@ -548,8 +639,10 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
             if idx and idx not in supports:
                 supports.append(idx)
         if not supports:
-            raise InputError(f"pysindy's {self.selection} selected no term at any threshold "
-                             f"around {self.threshold}; change threshold")
+            raise InputError(
+                f"pysindy's {self.selection} selected no term at any threshold "
+                f"around {self.threshold}; change threshold"
+            )
         return supports
 
     def _cross_validate(self, X, y, w, groups, supports):
@@ -572,9 +665,16 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
                 r = theta @ c - y[te]
                 errs[j] += float(np.sum(w[te] * r * r))
             den += float(np.sum(w[te] * y[te] ** 2))
-            self.fallbacks_ += [{"support": self._names(key), "solver": alt, "failed": failed,
-                                 "status": status, "stage": "cv"}
-                                for key, failed, status, alt in sub.fallbacks]
+            self.fallbacks_ += [
+                {
+                    "support": self._names(key),
+                    "solver": alt,
+                    "failed": failed,
+                    "status": status,
+                    "stage": "cv",
+                }
+                for key, failed, status, alt in sub.fallbacks
+            ]
         return list(np.sqrt(errs / den))
 
     # --------------------------------------------------------------- predict
@@ -583,8 +683,10 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         check_is_fitted(self)
         X = np.asarray(X, dtype=float)
         if X.ndim != 2 or X.shape[1] != self.n_features_in_:
-            raise InputError(f"X has shape {X.shape}; the estimator is expecting "
-                             f"{self.n_features_in_} features (zeta, dzeta)")
+            raise InputError(
+                f"X has shape {X.shape}; the estimator is expecting "
+                f"{self.n_features_in_} features (zeta, dzeta)"
+            )
         return self.law_(X[:, 0], X[:, 1])
 
     def stability(self, X, y, groups, n_resamples=50, random_state=0, sample_weight=None):
@@ -623,8 +725,9 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
             rows = np.concatenate([members[g] for g in pick])
             # a duplicated impact is a new impact: group id = its position in the draw
             new_groups = np.repeat(np.arange(pick.size), [members[g].size for g in pick])
-            est = ConstrainedSparseRegressor(**{**self.get_params(), "cv": 2, "grid": 101,
-                                                "cv_report": False})
+            est = ConstrainedSparseRegressor(
+                **{**self.get_params(), "cv": 2, "grid": 101, "cv_report": False}
+            )
             est.fit(X[rows], y[rows], groups=new_groups, sample_weight=w[rows])
             counts += est.support_
         return {t.name: float(c / n_resamples) for t, c in zip(lib.terms, counts, strict=True)}
@@ -634,12 +737,14 @@ def _weights_and_groups(n, sample_weight, groups):
     """Validated ``(weights, groups)`` for ``n`` samples (defaults: ones, one group each)."""
     w = np.ones(n) if sample_weight is None else np.asarray(sample_weight, dtype=float)
     if w.shape != (n,) or not np.all(np.isfinite(w)) or np.any(w < 0) or not w.sum() > 0:
-        raise InputError(f"sample_weight must be {n} finite values >= 0, not all zero; got "
-                         f"shape {w.shape}")
+        raise InputError(
+            f"sample_weight must be {n} finite values >= 0, not all zero; got shape {w.shape}"
+        )
     groups = np.arange(n) if groups is None else np.asarray(groups)
     if groups.shape != (n,):
-        raise InputError(f"groups must give the impact of each of the {n} samples; got shape "
-                         f"{groups.shape}")
+        raise InputError(
+            f"groups must give the impact of each of the {n} samples; got shape {groups.shape}"
+        )
     return w, groups
 
 
@@ -647,6 +752,11 @@ def _pysindy_constrained(prob, thr):
     """pysindy ConstrainedSR3 with the Bernstein rows as (sample-free) inequalities."""
     import pysindy as ps
 
-    return ps.ConstrainedSR3(reg_weight_lam=thr, regularizer="L1",
-                             constraint_lhs=-prob.M, constraint_rhs=prob.off,
-                             constraint_order="feature", inequality_constraints=True)
+    return ps.ConstrainedSR3(
+        reg_weight_lam=thr,
+        regularizer="L1",
+        constraint_lhs=-prob.M,
+        constraint_rhs=prob.off,
+        constraint_order="feature",
+        inequality_constraints=True,
+    )

@@ -37,7 +37,9 @@ class Response:
 
 
 @params(
-    scenario=Scenario, law=ForceLaw, tolerances=(Tolerances, None),
+    scenario=Scenario,
+    law=ForceLaw,
+    tolerances=(Tolerances, None),
     points_per_period=Real(16, integer=True),
 )
 def response(scenario, law, *, tolerances=None, points_per_period=2000, **steady_kwargs):
@@ -60,5 +62,4 @@ def response(scenario, law, *, tolerances=None, points_per_period=2000, **steady
     ss = steady_state(scenario, law, tolerances=tolerances, **steady_kwargs)
     if not ss.periodic:
         return Response(ss, None)
-    return Response(ss, impulse_from_steady_state(scenario, law, ss, points_per_period,
-                                                  tolerances))
+    return Response(ss, impulse_from_steady_state(scenario, law, ss, points_per_period, tolerances))

@@ -81,13 +81,15 @@ def join_samples(parts):
         impact.append(p.impact + offset)
         offset += int(p.impact.max()) + 1 if p.impact.size else 0
     derivs = sorted({p.derivative for p in parts})
-    return ContactSamples(zeta=np.concatenate([p.zeta for p in parts]),
-                          dzeta=np.concatenate([p.dzeta for p in parts]),
-                          F=np.concatenate([p.F for p in parts]),
-                          impact=np.concatenate(impact),
-                          weight=np.concatenate([p.weight for p in parts]),
-                          noise=float(np.sqrt(np.mean([p.noise**2 for p in parts]))),
-                          derivative=derivs[0] if len(derivs) == 1 else "+".join(derivs))
+    return ContactSamples(
+        zeta=np.concatenate([p.zeta for p in parts]),
+        dzeta=np.concatenate([p.dzeta for p in parts]),
+        F=np.concatenate([p.F for p in parts]),
+        impact=np.concatenate(impact),
+        weight=np.concatenate([p.weight for p in parts]),
+        noise=float(np.sqrt(np.mean([p.noise**2 for p in parts]))),
+        derivative=derivs[0] if len(derivs) == 1 else "+".join(derivs),
+    )
 
 
 def _steady_cycles(*stacks):
@@ -125,16 +127,20 @@ def _average_steady(t, zeta, dzeta, F, period):
     dt = float(np.median(np.diff(t)))
     m = imp.duration / dt
     if abs(m - round(m)) > 1e-6 * m:
-        raise InputError("average_cycles needs a whole number of samples per cycle (fs * T "
-                         f"= {m:.6g}); resample the record or do not average")
+        raise InputError(
+            "average_cycles needs a whole number of samples per cycle (fs * T "
+            f"= {m:.6g}); resample the record or do not average"
+        )
     m = int(round(m))
     i0 = int(np.searchsorted(t, imp.onset - dt))  # one sample before the first steady onset
     k = (t.size - i0) // m  # whole cycles from there to the end of the record
     if k < 2:
         return t, zeta, dzeta, F, np.ones(t.size)
     block = slice(i0, i0 + k * m)
-    steady = _steady_cycles((F[block].reshape(k, m), estimate_noise(F)),
-                            (zeta[block].reshape(k, m), estimate_noise(zeta, order=3)))
+    steady = _steady_cycles(
+        (F[block].reshape(k, m), estimate_noise(F)),
+        (zeta[block].reshape(k, m), estimate_noise(zeta, order=3)),
+    )
     if steady.size < 2:
         return t, zeta, dzeta, F, np.ones(t.size)
     avg = [a[block].reshape(k, m)[steady].mean(axis=0) for a in (zeta, dzeta, F)]
@@ -147,19 +153,34 @@ def _average_steady(t, zeta, dzeta, F, period):
     raw = ~np.isin(cycle, steady)
     at = i0 + int(steady[0]) * m
     before, after = raw & (idx < at), raw & (idx >= at)
-    cat = [np.concatenate([a[before], b, a[after]])
-           for a, b in zip((t, zeta, dzeta, F), (t[at:at + m], *avg), strict=True)]
-    count = np.concatenate([np.ones(before.sum()), np.full(m, float(steady.size)),
-                            np.ones(after.sum())])
+    cat = [
+        np.concatenate([a[before], b, a[after]])
+        for a, b in zip((t, zeta, dzeta, F), (t[at : at + m], *avg), strict=True)
+    ]
+    count = np.concatenate(
+        [np.ones(before.sum()), np.full(m, float(steady.size)), np.ones(after.sum())]
+    )
     return (*cat, count)
 
 
 @params(
-    measurement=Measurement, derivative=(None, Text()), window=Real(3, integer=True),
-    k_sigma=Real(0, open_low=True), weights=Text(), period=(None, Real(0, open_low=True)),
+    measurement=Measurement,
+    derivative=(None, Text()),
+    window=Real(3, integer=True),
+    k_sigma=Real(0, open_low=True),
+    weights=Text(),
+    period=(None, Real(0, open_low=True)),
 )
-def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weights="uniform",
-                    average_cycles=False, period=None):
+def contact_samples(
+    measurement,
+    *,
+    derivative=None,
+    window=7,
+    k_sigma=5.0,
+    weights="uniform",
+    average_cycles=False,
+    period=None,
+):
     """Contact samples of a :class:`~discovery.measurement.Measurement`.
 
     Parameters
@@ -191,8 +212,10 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
     """
     ch = measurement.channels
     if "w1" not in ch or "w2" not in ch:
-        raise InputError("discovery needs the positions w1 and w2 in the data (zeta = w1 - w2); "
-                         "add those columns")
+        raise InputError(
+            "discovery needs the positions w1 and w2 in the data (zeta = w1 - w2); "
+            "add those columns"
+        )
     t = measurement.t
     zeta = ch["w1"] - ch["w2"]
     have_v = "v1" in ch and "v2" in ch
@@ -224,15 +247,17 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
     floor = max(k_sigma * estimate_noise(zeta, order=3), 1e-9 * float(np.max(np.abs(zeta))))
     contact = zeta > floor
     if contact.sum() < 10:
-        raise InputError("fewer than 10 contact samples (zeta = w1 - w2 > 0 above its noise); "
-                         "check the w1 and w2 columns and their sign (positions upward)")
+        raise InputError(
+            "fewer than 10 contact samples (zeta = w1 - w2 > 0 above its noise); "
+            "check the w1 and w2 columns and their sign (positions upward)"
+        )
     # impacts: runs of contact samples; two runs are one impact unless zeta falls clearly
     # below zero (< -floor) between them (noise dips near onset and loss do not split it)
     starts = np.flatnonzero(np.diff(np.concatenate([[0], contact.astype(np.int8)])) == 1)
     ends = np.flatnonzero(np.diff(np.concatenate([contact.astype(np.int8), [0]])) == -1)
     new = np.ones(starts.size, dtype=bool)
     for j in range(1, starts.size):
-        new[j] = bool(np.min(zeta[ends[j - 1] + 1:starts[j]]) < -floor)
+        new[j] = bool(np.min(zeta[ends[j - 1] + 1 : starts[j]]) < -floor)
     impact_all = np.cumsum(np.isin(np.arange(t.size), starts[new])) - 1
     idx = np.flatnonzero(contact)
     impact = impact_all[idx]
@@ -244,6 +269,12 @@ def contact_samples(measurement, *, derivative=None, window=7, k_sigma=5.0, weig
         w *= idx.size / w.sum()
     else:
         raise InputError(f"weights must be 'uniform' or 'per-impact', got {weights!r}")
-    return ContactSamples(zeta=zeta[idx], dzeta=dzeta[idx], F=F[idx], impact=impact, weight=w,
-                          noise=sigma, derivative=derivative)
-
+    return ContactSamples(
+        zeta=zeta[idx],
+        dzeta=dzeta[idx],
+        F=F[idx],
+        impact=impact,
+        weight=w,
+        noise=sigma,
+        derivative=derivative,
+    )

@@ -26,30 +26,54 @@ from .law import ForceLaw
 __all__ = ["Scenario", "builtin_scenarios", "load_scenario"]
 
 _FIELDS = {
-    "m1": ("kg", True), "m2": ("kg", True), "k1": ("N/m", False), "c1": ("N s/m", False),
-    "A": ("N", False), "frequency": ("Hz", True), "g": ("m/s^2", False),
-    "k3": ("N/m^3", False), "mass_loss": ("per impact", False),
+    "m1": ("kg", True),
+    "m2": ("kg", True),
+    "k1": ("N/m", False),
+    "c1": ("N s/m", False),
+    "A": ("N", False),
+    "frequency": ("Hz", True),
+    "g": ("m/s^2", False),
+    "k3": ("N/m^3", False),
+    "mass_loss": ("per impact", False),
 }
 #: parameters a scenario file may leave out (their defaults: the paper's machine)
 _OPTIONAL = {"g": 9.81, "k3": 0.0, "mass_loss": 0.0}
 #: largest accepted value of each parameter: far beyond any vibro-impact machine, and
 #: small enough that the simulation's scales (A / (m1 omega^2), k1 / m1, ...) stay finite
-LIMITS = {"m1": 1e9, "m2": 1e9, "k1": 1e15, "c1": 1e12, "A": 1e12, "frequency": 1e5,
-          "g": 1e3, "k3": 1e24, "mass_loss": 0.5}
+LIMITS = {
+    "m1": 1e9,
+    "m2": 1e9,
+    "k1": 1e15,
+    "c1": 1e12,
+    "A": 1e12,
+    "frequency": 1e5,
+    "g": 1e3,
+    "k3": 1e24,
+    "mass_loss": 0.5,
+}
 #: largest accepted |position| [m] and |velocity| [m/s] of the initial state
 INITIAL_LIMITS = (1e3, 1e3)
 #: the tables and keys a scenario file may have
-_TABLES = {"name": None, "machine": tuple(_FIELDS), "law": ("text",),
-           "initial": ("w1", "v1", "w2", "v2")}
+_TABLES = {
+    "name": None,
+    "machine": tuple(_FIELDS),
+    "law": ("text",),
+    "initial": ("w1", "v1", "w2", "v2"),
+}
 
 
 def _number(value, what, unit):
     """A float from a number (not a boolean, not text) or raise naming ``what``."""
     if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.number):
-        got = "a boolean" if isinstance(value, bool | np.bool_) else (
-            f"text {value!r}" if isinstance(value, str) else type(value).__name__)
-        raise InputError(f"{what} must be a number in {unit}, got {got}; write a number such "
-                         "as 1.0e4 (no quotes)")
+        got = (
+            "a boolean"
+            if isinstance(value, bool | np.bool_)
+            else (f"text {value!r}" if isinstance(value, str) else type(value).__name__)
+        )
+        raise InputError(
+            f"{what} must be a number in {unit}, got {got}; write a number such "
+            "as 1.0e4 (no quotes)"
+        )
     try:
         return float(value)
     except OverflowError:
@@ -120,22 +144,37 @@ class Scenario:
                 )
             object.__setattr__(self, key, value)
         if self.initial is not None:
-            if isinstance(self.initial, str | bytes) or not hasattr(self.initial, "__len__") \
-                    or len(self.initial) != 4:
-                raise InputError("scenario initial must be 4 numbers (w1, v1, w2, v2) in m, "
-                                 f"m/s; got {self.initial!r}")
-            init = tuple(_number(v, f"scenario initial {k}", u) for v, k, u in
-                         zip(self.initial, ("w1", "v1", "w2", "v2"), ("m", "m/s", "m", "m/s"),
-                             strict=True))
+            if (
+                isinstance(self.initial, str | bytes)
+                or not hasattr(self.initial, "__len__")
+                or len(self.initial) != 4
+            ):
+                raise InputError(
+                    "scenario initial must be 4 numbers (w1, v1, w2, v2) in m, "
+                    f"m/s; got {self.initial!r}"
+                )
+            init = tuple(
+                _number(v, f"scenario initial {k}", u)
+                for v, k, u in zip(
+                    self.initial, ("w1", "v1", "w2", "v2"), ("m", "m/s", "m", "m/s"), strict=True
+                )
+            )
             wmax, vmax = INITIAL_LIMITS
-            if not all(math.isfinite(v) for v in init) or max(abs(init[0]), abs(init[2])) > wmax \
-                    or max(abs(init[1]), abs(init[3])) > vmax:
-                raise InputError("scenario initial must be 4 finite numbers (w1, v1, w2, v2) "
-                                 f"with |w| <= {wmax:g} m and |v| <= {vmax:g} m/s")
+            if (
+                not all(math.isfinite(v) for v in init)
+                or max(abs(init[0]), abs(init[2])) > wmax
+                or max(abs(init[1]), abs(init[3])) > vmax
+            ):
+                raise InputError(
+                    "scenario initial must be 4 finite numbers (w1, v1, w2, v2) "
+                    f"with |w| <= {wmax:g} m and |v| <= {vmax:g} m/s"
+                )
             object.__setattr__(self, "initial", init)
         if self.law is not None and not isinstance(self.law, ForceLaw):
-            raise InputError(f"scenario law must be a ForceLaw, got {type(self.law).__name__}; "
-                             "use ForceLaw.parse(text)")
+            raise InputError(
+                f"scenario law must be a ForceLaw, got {type(self.law).__name__}; "
+                "use ForceLaw.parse(text)"
+            )
 
     # ------------------------------------------------------------------ derived
     @property
@@ -173,8 +212,19 @@ class Scenario:
     def params(self):
         """Parameter vector for the compiled kernel: m1, m2, k1, c1, A, omega, g, k3,
         mass_loss."""
-        return np.array([self.m1, self.m2, self.k1, self.c1, self.A, self.omega, self.g,
-                         self.k3, self.mass_loss])
+        return np.array(
+            [
+                self.m1,
+                self.m2,
+                self.k1,
+                self.c1,
+                self.A,
+                self.omega,
+                self.g,
+                self.k3,
+                self.mass_loss,
+            ]
+        )
 
     def replace(self, **changes):
         """A copy with some parameters changed (validated like the original)."""
@@ -185,9 +235,24 @@ class Scenario:
         return Scenario(**{**self._fields(), "law": law})
 
     def _fields(self):
-        return {k: getattr(self, k) for k in
-                ("m1", "m2", "k1", "c1", "A", "frequency", "g", "law", "initial", "name", "source",
-                 "k3", "mass_loss")}
+        return {
+            k: getattr(self, k)
+            for k in (
+                "m1",
+                "m2",
+                "k1",
+                "c1",
+                "A",
+                "frequency",
+                "g",
+                "law",
+                "initial",
+                "name",
+                "source",
+                "k3",
+                "mass_loss",
+            )
+        }
 
     def as_dict(self):
         """JSON-ready description (provenance for outputs)."""
@@ -211,17 +276,22 @@ class Scenario:
         except IsADirectoryError:
             raise InputError(f"scenario {str(path)!r} is a directory; {hint}") from None
         except PermissionError:
-            raise InputError(f"scenario file {str(path)!r} cannot be read (permission denied); "
-                             "fix its permissions") from None
+            raise InputError(
+                f"scenario file {str(path)!r} cannot be read (permission denied); "
+                "fix its permissions"
+            ) from None
         except OSError as exc:
-            raise InputError(f"cannot read scenario file {str(path)!r} ({exc.strerror or exc}); "
-                             f"{hint}") from None
+            raise InputError(
+                f"cannot read scenario file {str(path)!r} ({exc.strerror or exc}); {hint}"
+            ) from None
         try:
             text = raw.decode("utf-8-sig")
         except UnicodeDecodeError as exc:
-            raise InputError(f"scenario file {str(path)!r} is not UTF-8 text (byte "
-                             f"0x{raw[exc.start]:02x} at offset {exc.start}); re-save it as "
-                             "UTF-8") from None
+            raise InputError(
+                f"scenario file {str(path)!r} is not UTF-8 text (byte "
+                f"0x{raw[exc.start]:02x} at offset {exc.start}); re-save it as "
+                "UTF-8"
+            ) from None
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as exc:
@@ -235,45 +305,58 @@ class Scenario:
         (a boolean or a quoted number is not a number) and range-checked."""
         unknown = sorted(set(data) - set(_TABLES))
         if unknown:
-            raise InputError(f"scenario {source!r}: unknown table(s) or key(s) "
-                             f"{', '.join(unknown)}; valid are name, [machine], [law], [initial]")
+            raise InputError(
+                f"scenario {source!r}: unknown table(s) or key(s) "
+                f"{', '.join(unknown)}; valid are name, [machine], [law], [initial]"
+            )
         for table in ("machine", "law", "initial"):
             if table in data and not isinstance(data[table], dict):
-                raise InputError(f"scenario {source!r}: {table} must be a table; write "
-                                 f"[{table}] on its own line followed by its keys")
+                raise InputError(
+                    f"scenario {source!r}: {table} must be a table; write "
+                    f"[{table}] on its own line followed by its keys"
+                )
             extra = sorted(set(data.get(table, {})) - set(_TABLES[table]))
             if extra:
-                raise InputError(f"scenario {source!r}: unknown [{table}] key(s) "
-                                 f"{', '.join(extra)}; valid keys are "
-                                 f"{', '.join(_TABLES[table])}")
+                raise InputError(
+                    f"scenario {source!r}: unknown [{table}] key(s) "
+                    f"{', '.join(extra)}; valid keys are "
+                    f"{', '.join(_TABLES[table])}"
+                )
         machine = data.get("machine")
         if machine is None:
-            raise InputError(f"scenario {source!r} needs a [machine] table with m1, m2, k1, c1, A, "
-                             "frequency")
+            raise InputError(
+                f"scenario {source!r} needs a [machine] table with m1, m2, k1, c1, A, frequency"
+            )
         missing = [k for k in _FIELDS if k not in _OPTIONAL and k not in machine]
         if missing:
-            raise InputError(f"scenario {source!r}: [machine] is missing {', '.join(missing)}; "
-                             "add them in SI units (kg, N/m, N s/m, N, Hz)")
+            raise InputError(
+                f"scenario {source!r}: [machine] is missing {', '.join(missing)}; "
+                "add them in SI units (kg, N/m, N s/m, N, Hz)"
+            )
         values = {k: _number(v, f"scenario {k}", _FIELDS[k][0]) for k, v in machine.items()}
         law = None
         if "law" in data:
             law_text = data["law"].get("text")
             if not isinstance(law_text, str) or not law_text.strip():
-                raise InputError(f"scenario {source!r}: [law] needs text = \"2.06e8*z + "
-                                 "1.28e7*zd\" (a quoted, non-empty law), or remove the table")
+                raise InputError(
+                    f'scenario {source!r}: [law] needs text = "2.06e8*z + '
+                    '1.28e7*zd" (a quoted, non-empty law), or remove the table'
+                )
             law = ForceLaw.parse(law_text)
         initial = None
         if "initial" in data:
             init = data["initial"]
             if set(init) != set(_TABLES["initial"]):
                 raise InputError(f"scenario {source!r}: [initial] needs w1, v1, w2, v2")
-            initial = tuple(_number(init[k], f"scenario initial {k}", u)
-                            for k, u in zip(_TABLES["initial"], ("m", "m/s", "m", "m/s"),
-                                            strict=True))
+            initial = tuple(
+                _number(init[k], f"scenario initial {k}", u)
+                for k, u in zip(_TABLES["initial"], ("m", "m/s", "m", "m/s"), strict=True)
+            )
         name = data.get("name", default_name)
         if not isinstance(name, str) or not name.strip():
-            raise InputError(f"scenario {source!r}: name must be non-empty text, e.g. "
-                             "name = \"my-grid\"")
+            raise InputError(
+                f'scenario {source!r}: name must be non-empty text, e.g. name = "my-grid"'
+            )
         return cls(**values, law=law, initial=initial, name=name, source=source)
 
 
@@ -289,8 +372,10 @@ def load_scenario(name_or_path):
         return name_or_path
     text = str(name_or_path)
     if not text.strip():
-        raise InputError("the scenario is empty; give a built-in name "
-                         f"({', '.join(builtin_scenarios())}) or a TOML file")
+        raise InputError(
+            "the scenario is empty; give a built-in name "
+            f"({', '.join(builtin_scenarios())}) or a TOML file"
+        )
     if text in builtin_scenarios():
         res = resources.files("discovery") / "scenarios" / f"{text}.toml"
         data = tomllib.loads(res.read_text())

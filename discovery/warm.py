@@ -14,6 +14,7 @@ from ._compile import KERNELS, cached
 
 __all__ = ["warm", "main"]
 
+
 def warm():
     """Compile (or load) every kernel: ``{kernel: seconds}``."""
     out = {}
@@ -40,11 +41,16 @@ def warm():
 def main():
     todo = [k for k in KERNELS if not cached(k)]
     if todo:
-        print(f"compiling the simulators once ({', '.join(todo)}; a few minutes on two cores) "
-              "...", flush=True)
+        print(
+            f"compiling the simulators once ({', '.join(todo)}; a few minutes on two cores) ...",
+            flush=True,
+        )
     seconds = warm()
-    print("simulators ready (" + ", ".join(f"{k} {v:.1f} s" for k, v in seconds.items())
-          + "); later runs load them from the cache")
+    print(
+        "simulators ready ("
+        + ", ".join(f"{k} {v:.1f} s" for k, v in seconds.items())
+        + "); later runs load them from the cache"
+    )
     return 0
 
 

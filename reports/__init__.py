@@ -5,11 +5,27 @@ Names are imported on first use (matplotlib only when a figure is drawn).
 
 from discovery._lazy import lazy_package
 
-_EXPORTS = {name: "figures" for name in (
-    "explain_figure", "fit_impulse_figure", "fit_loop_figure", "fit_surface_figure",
-    "identification_figure", "landscape_figure", "verify_figure")}
+_EXPORTS = {
+    name: "figures"
+    for name in (
+        "explain_figure",
+        "fit_impulse_figure",
+        "fit_loop_figure",
+        "fit_surface_figure",
+        "identification_figure",
+        "landscape_figure",
+        "verify_figure",
+    )
+}
 
-__all__ = ["landscape_figure", "identification_figure", "fit_impulse_figure",
-           "fit_surface_figure", "fit_loop_figure", "verify_figure", "explain_figure"]
+__all__ = [
+    "landscape_figure",
+    "identification_figure",
+    "fit_impulse_figure",
+    "fit_surface_figure",
+    "fit_loop_figure",
+    "verify_figure",
+    "explain_figure",
+]
 
 lazy_package(__name__, _EXPORTS)

@@ -25,26 +25,26 @@ CRITERION_MEANING = {
 }
 FIGURE_CAPTIONS = {
     "verify": "Measured force (black) and the law's simulated force (red), folded on the "
-              "drive phase over the record's span.",
+    "drive phase over the record's span.",
     "fit_impulse": "Measured impulse and the simulated steady states of the best models.",
     "fit_surface": "The selected law over the (zeta, dzeta) plane with the contact samples.",
     "fit_loop": "Loading and unloading branches, measured and modelled, for a few impacts.",
     "identification": "Identification: the path of the best law so far and the simulated "
-                      "force converging to the measured one.",
+    "force converging to the measured one.",
     "landscape": "Criteria over the two coefficients; the noise floor and the consistent "
-                 "region are marked.",
+    "region are marked.",
     "discover": "Recovered equation: strobe points, coefficients with error bars and the "
-                "verification by simulation.",
+    "verification by simulation.",
     "attractor": "Stroboscopic points and a trajectory of the attractor.",
     "basins": "Basins of the coexisting attractors.",
     "chart": "Regime chart over the forcing frequency and amplitude.",
     "explain": "The missing effect: where the model disagrees before and after it is added.",
     "recovery_noise": "Exact-support recovery against the force noise, per selection method "
-                      "and record length (Wilson 95 % intervals).",
+    "and record length (Wilson 95 % intervals).",
     "recovery_map": "Recovery over force noise and record length, per selection method "
-                    "(recovered/runs in each cell).",
+    "(recovered/runs in each cell).",
     "coverage": "Share of true coefficients inside their 95 % intervals (exact supports), "
-                "against the nominal 95 %.",
+    "against the nominal 95 %.",
     "inclusion": "How often each term was selected, per method and noise level.",
 }
 
@@ -61,21 +61,35 @@ def _rows_from(d, keys=None, fmt=num):
 def _provenance(s, run_dir):
     v = s.get("versions") or {}
     git = s.get("git") or {}
-    rows = [["command", Tex(r"\texttt{vidi " + escape(s.get("command", "?")) + "}")],
-            ["created", s.get("created", "--")],
-            ["vidi", v.get("vibroimpact-discovery", "--")],
-            ["git commit", (git.get("commit") or "--")[:12]
-             + (" (uncommitted changes)" if git.get("dirty") else "")],
-            ["platform", s.get("platform", "--")],
-            ["libraries", ", ".join(f"{k} {val}" for k, val in v.items()
-                                    if k != "vibroimpact-discovery")]]
+    rows = [
+        ["command", Tex(r"\texttt{vidi " + escape(s.get("command", "?")) + "}")],
+        ["created", s.get("created", "--")],
+        ["vidi", v.get("vibroimpact-discovery", "--")],
+        [
+            "git commit",
+            (git.get("commit") or "--")[:12]
+            + (" (uncommitted changes)" if git.get("dirty") else ""),
+        ],
+        ["platform", s.get("platform", "--")],
+        [
+            "libraries",
+            ", ".join(f"{k} {val}" for k, val in v.items() if k != "vibroimpact-discovery"),
+        ],
+    ]
     for name, inp in (s.get("inputs") or {}).items():
         if isinstance(inp, dict):
-            rows.append([f"input {name}", f"{inp.get('path', '')} (sha256 "
-                         f"{str(inp.get('sha256', ''))[:16]}...)"])
+            rows.append(
+                [
+                    f"input {name}",
+                    f"{inp.get('path', '')} (sha256 {str(inp.get('sha256', ''))[:16]}...)",
+                ]
+            )
     settings = s.get("settings") or {}
-    shown = {k: val for k, val in settings.items()
-             if k not in ("command", "func", "out", "ueda_command") and val not in (None, False)}
+    shown = {
+        k: val
+        for k, val in settings.items()
+        if k not in ("command", "func", "out", "ueda_command") and val not in (None, False)
+    }
     rows.append(["settings", "; ".join(f"{k}={val}" for k, val in shown.items()) or "--"])
     return rows
 
@@ -83,8 +97,17 @@ def _provenance(s, run_dir):
 def _scenario_rows(sc):
     if not sc:
         return []
-    units = {"m1": "kg", "m2": "kg", "k1": "N/m", "c1": "N s/m", "A": "N", "frequency": "Hz",
-             "g": "m/s^2", "k3": "N/m^3", "mass_loss": "per impact"}
+    units = {
+        "m1": "kg",
+        "m2": "kg",
+        "k1": "N/m",
+        "c1": "N s/m",
+        "A": "N",
+        "frequency": "Hz",
+        "g": "m/s^2",
+        "k3": "N/m^3",
+        "mass_loss": "per impact",
+    }
     rows = [["name", sc.get("name", "--")]]
     for k, unit in units.items():
         if k in sc and not (k in ("k3", "mass_loss") and not sc[k]):
@@ -101,8 +124,15 @@ def _criteria_table(criteria, floor, limits=None):
         if k not in (criteria or {}):
             continue
         lim = (limits or {}).get(k)
-        rows.append([Tex(f"$I_{k[1]}$"), num(criteria[k]), num((floor or {}).get(k)),
-                     num(lim) if lim is not None else Tex("--"), CRITERION_MEANING[k]])
+        rows.append(
+            [
+                Tex(f"$I_{k[1]}$"),
+                num(criteria[k]),
+                num((floor or {}).get(k)),
+                num(lim) if lim is not None else Tex("--"),
+                CRITERION_MEANING[k],
+            ]
+        )
     return rows
 
 
@@ -111,12 +141,14 @@ def _measured_rows(m, records=None):
         return []
     noise = m.get("noise")
     noise_f = noise.get("F") if isinstance(noise, dict) else noise
-    rows = [["drive periods per cycle", m.get("n_periods", "--")],
-            ["cycles in the record", m.get("n_cycles", "--")],
-            ["contacts per cycle", m.get("impacts", "--")],
-            ["force noise (sd)", Tex(num(noise_f) + r"\,N")],
-            ["peak force", Tex(num(m.get("peak")) + r"\,N")],
-            ["contact time", Tex(num(m.get("contact_time")) + r"\,s")]]
+    rows = [
+        ["drive periods per cycle", m.get("n_periods", "--")],
+        ["cycles in the record", m.get("n_cycles", "--")],
+        ["contacts per cycle", m.get("impacts", "--")],
+        ["force noise (sd)", Tex(num(noise_f) + r"\,N")],
+        ["peak force", Tex(num(m.get("peak")) + r"\,N")],
+        ["contact time", Tex(num(m.get("contact_time")) + r"\,s")],
+    ]
     if isinstance(noise, dict) and "dt" in noise:
         rows.insert(0, ["sampling step", Tex(num(noise["dt"]) + r"\,s")])
     return rows
@@ -129,9 +161,12 @@ def _figures(run_dir, order):
             if p.stem in ("report", "model"):
                 continue
             base = p.stem.split("_")[0] if p.stem not in FIGURE_CAPTIONS else p.stem
-            figs.append({"file": p.name,
-                         "caption": FIGURE_CAPTIONS.get(p.stem,
-                                                        FIGURE_CAPTIONS.get(base, p.stem))})
+            figs.append(
+                {
+                    "file": p.name,
+                    "caption": FIGURE_CAPTIONS.get(p.stem, FIGURE_CAPTIONS.get(base, p.stem)),
+                }
+            )
     seen, out = set(), []
     for f in figs:
         if f["file"] not in seen:
@@ -153,49 +188,69 @@ def _coef_rows(coefs, errors=None, intervals=None, start=None):
     rows = []
     for k, v in coefs.items():
         lo_hi = (intervals or {}).get(k)
-        rows.append([Tex(r"\texttt{" + escape(k) + "}"), num(v, 4),
-                     num((errors or {}).get(k), 2),
-                     Tex(f"[{num(lo_hi[0], 4)}, {num(lo_hi[1], 4)}]") if lo_hi else Tex("--")]
-                    + ([num((start or {}).get(k), 3)] if start is not None else []))
+        rows.append(
+            [
+                Tex(r"\texttt{" + escape(k) + "}"),
+                num(v, 4),
+                num((errors or {}).get(k), 2),
+                Tex(f"[{num(lo_hi[0], 4)}, {num(lo_hi[1], 4)}]") if lo_hi else Tex("--"),
+            ]
+            + ([num((start or {}).get(k), 3)] if start is not None else [])
+        )
     return rows
 
 
 # ----------------------------------------------------------------------------- kinds
 def _verify(s, run_dir):
-    c = {"title": "Verification of a contact law against a record",
-         "law": Tex(r"\texttt{" + escape(s.get("law", "")) + "}"),
-         "data": s.get("data"),
-         "measured": _measured_rows(s.get("measured")),
-         "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
-         "verdict": s.get("verdict") or s.get("message") or "--",
-         "consistent": bool(s.get("consistent")),
-         "regime": s.get("regime") or {}, "impacts": s.get("impacts") or {},
-         "start": s.get("start") or {},
-         "default_start": s.get("default_start")}
+    c = {
+        "title": "Verification of a contact law against a record",
+        "law": Tex(r"\texttt{" + escape(s.get("law", "")) + "}"),
+        "data": s.get("data"),
+        "measured": _measured_rows(s.get("measured")),
+        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
+        "verdict": s.get("verdict") or s.get("message") or "--",
+        "consistent": bool(s.get("consistent")),
+        "regime": s.get("regime") or {},
+        "impacts": s.get("impacts") or {},
+        "start": s.get("start") or {},
+        "default_start": s.get("default_start"),
+    }
     lim = s.get("limits") or {}
     crit = s.get("criteria") or {}
     concl = []
     if c["consistent"]:
-        concl.append(f"The law is consistent with the record: every judged criterion is within "
-                     f"its limit (I2 {crit.get('I2', float('nan')):.3g} against "
-                     f"{lim.get('I2', float('nan')):.3g}), the limit being what the true law "
-                     "scores on records this noisy (twice the noise floor, or the floor plus "
-                     "three of its standard deviations, plus 0.005).")
+        concl.append(
+            f"The law is consistent with the record: every judged criterion is within "
+            f"its limit (I2 {crit.get('I2', float('nan')):.3g} against "
+            f"{lim.get('I2', float('nan')):.3g}), the limit being what the true law "
+            "scores on records this noisy (twice the noise floor, or the floor plus "
+            "three of its standard deviations, plus 0.005)."
+        )
     else:
         over = [k for k in lim if crit.get(k, 0) > lim[k]]
-        concl.append("The law is inconsistent with the record"
-                     + (f": {', '.join(over)} exceed{'s' if len(over) == 1 else ''} the noise "
-                        "limit" if over else "") + ". The figure shows where the simulated force "
-                     "departs from the measured one; `vidi explain` names the effect most "
-                     "likely missing.")
+        concl.append(
+            "The law is inconsistent with the record"
+            + (
+                f": {', '.join(over)} exceed{'s' if len(over) == 1 else ''} the noise limit"
+                if over
+                else ""
+            )
+            + ". The figure shows where the simulated force "
+            "departs from the measured one; `vidi explain` names the effect most "
+            "likely missing."
+        )
     reg = c["regime"]
     if reg and reg.get("measured") != reg.get("simulated"):
-        concl.append(f"The measured regime is {reg.get('measured')}, the simulated one "
-                     f"{reg.get('simulated')}.")
+        concl.append(
+            f"The measured regime is {reg.get('measured')}, the simulated one "
+            f"{reg.get('simulated')}."
+        )
     if _transient(s.get("verdict")):
-        concl.append("The record is not yet steady under this law: it was compared with the "
-                     "law's own trajectory from the measured state, block by block, not with "
-                     "its steady orbit.")
+        concl.append(
+            "The record is not yet steady under this law: it was compared with the "
+            "law's own trajectory from the measured state, block by block, not with "
+            "its steady orbit."
+        )
     c["conclusions"] = concl
     c["figures"] = _figures(run_dir, ["verify"])
     return c
@@ -207,17 +262,20 @@ def _selected_conclusions(s):
     terms = sel.get("terms") or list((sel.get("coefficients") or {}).keys())
     lib = (s.get("fit_settings") or {}).get("library", "?")
     state = "consistent" if sel.get("consistent") else "NOT consistent"
-    concl.append(f"From the library {lib}, the data support the terms {', '.join(terms)}: "
-                 f"the selected law is {state}"
-                 " with the record by full simulation.")
+    concl.append(
+        f"From the library {lib}, the data support the terms {', '.join(terms)}: "
+        f"the selected law is {state}"
+        " with the record by full simulation."
+    )
     eq = s.get("equivalent") or []
     if eq:
-        names = "; ".join(", ".join(e.get("terms") or e.get("coefficients", {}).keys())
-                          for e in eq)
-        concl.append(f"{len(eq)} other model(s) fit the record as well within its noise "
-                     f"({names}). They cannot be told apart from this record; a second "
-                     "operating point (another drive amplitude or frequency) or lower noise "
-                     "would separate them (see each model's reason below).")
+        names = "; ".join(", ".join(e.get("terms") or e.get("coefficients", {}).keys()) for e in eq)
+        concl.append(
+            f"{len(eq)} other model(s) fit the record as well within its noise "
+            f"({names}). They cannot be told apart from this record; a second "
+            "operating point (another drive amplitude or frequency) or lower noise "
+            "would separate them (see each model's reason below)."
+        )
     for w in s.get("warnings") or []:
         concl.append(f"Warning: {w}")
     if sel.get("contact_defects"):
@@ -229,62 +287,106 @@ def _fit(s, run_dir):
     sel = s.get("selected") or {}
     fs = s.get("fit_settings") or {}
     cert = s.get("certificate") or {}
-    c = {"title": "Discovery of a contact law",
-         "model": _model_tex(sel.get("latex")),
-         "coefficients": _coef_rows(sel.get("coefficients") or {}, sel.get("standard_errors"),
-                                    _intervals(sel)),
-         "interval_method": sel.get("interval_method") or "no bootstrap intervals",
-         "criteria": _criteria_table(sel.get("criteria"), sel.get("noise_floor")),
-         "verdict": sel.get("verdict") or "--",
-         "regime": sel.get("regime", "--"),
-         "refinement": sel.get("refinement", "--"),
-         "library": fs.get("library", "--"), "selection": fs.get("selection", "--"),
-         "scoring": fs.get("scoring", "--"), "criterion": fs.get("criterion", "I2"),
-         "records": [[r.get("data", "--"), r.get("scenario", "--"), r.get("regime", "--"),
-                      r.get("impacts", "--"),
-                      num((r.get("noise") or {}).get("F")),
-                      (r.get("noise") or {}).get("n_cycles", "--")]
-                     for r in s.get("records") or []],
-         "certificate": {"method": cert.get("method", "--"),
-                         "holds": bool(cert.get("holds")),
-                         "worst": num(cert.get("worst_violation")),
-                         "domain": {k: num(v) for k, v in (cert.get("domain") or {}).items()
-                                    if isinstance(v, int | float)},
-                         "conditions": [[k.replace("_", " "), v.get("quantity", ""),
-                                         "holds" if v.get("holds") else "FAILS",
-                                         num(v.get("grid_min_rel"))]
-                                        for k, v in (cert.get("conditions") or {}).items()]},
-         "ranking": [[str(i + 1), ", ".join(m.get("terms") or []), m.get("regime", "--"),
-                      num(m.get("bic"), 6), num((m.get("criteria") or {}).get(
-                          fs.get("criterion", "I2"))),
-                      "yes" if m.get("consistent") else "no"]
-                     for i, m in enumerate(s.get("ranking") or [])],
-         "equivalent": [{"model": _model_tex(e.get("latex")),
-                         "reason": e.get("reason", ""), "separate": e.get("separate", "")}
-                        for e in s.get("equivalent") or []],
-         "warnings": list(s.get("warnings") or [])}
+    c = {
+        "title": "Discovery of a contact law",
+        "model": _model_tex(sel.get("latex")),
+        "coefficients": _coef_rows(
+            sel.get("coefficients") or {}, sel.get("standard_errors"), _intervals(sel)
+        ),
+        "interval_method": sel.get("interval_method") or "no bootstrap intervals",
+        "criteria": _criteria_table(sel.get("criteria"), sel.get("noise_floor")),
+        "verdict": sel.get("verdict") or "--",
+        "regime": sel.get("regime", "--"),
+        "refinement": sel.get("refinement", "--"),
+        "library": fs.get("library", "--"),
+        "selection": fs.get("selection", "--"),
+        "scoring": fs.get("scoring", "--"),
+        "criterion": fs.get("criterion", "I2"),
+        "records": [
+            [
+                r.get("data", "--"),
+                r.get("scenario", "--"),
+                r.get("regime", "--"),
+                r.get("impacts", "--"),
+                num((r.get("noise") or {}).get("F")),
+                (r.get("noise") or {}).get("n_cycles", "--"),
+            ]
+            for r in s.get("records") or []
+        ],
+        "certificate": {
+            "method": cert.get("method", "--"),
+            "holds": bool(cert.get("holds")),
+            "worst": num(cert.get("worst_violation")),
+            "domain": {
+                k: num(v)
+                for k, v in (cert.get("domain") or {}).items()
+                if isinstance(v, int | float)
+            },
+            "conditions": [
+                [
+                    k.replace("_", " "),
+                    v.get("quantity", ""),
+                    "holds" if v.get("holds") else "FAILS",
+                    num(v.get("grid_min_rel")),
+                ]
+                for k, v in (cert.get("conditions") or {}).items()
+            ],
+        },
+        "ranking": [
+            [
+                str(i + 1),
+                ", ".join(m.get("terms") or []),
+                m.get("regime", "--"),
+                num(m.get("bic"), 6),
+                num((m.get("criteria") or {}).get(fs.get("criterion", "I2"))),
+                "yes" if m.get("consistent") else "no",
+            ]
+            for i, m in enumerate(s.get("ranking") or [])
+        ],
+        "equivalent": [
+            {
+                "model": _model_tex(e.get("latex")),
+                "reason": e.get("reason", ""),
+                "separate": e.get("separate", ""),
+            }
+            for e in s.get("equivalent") or []
+        ],
+        "warnings": list(s.get("warnings") or []),
+    }
     c["conclusions"] = _selected_conclusions(s)
     c["figures"] = _figures(run_dir, ["fit_impulse", "fit_surface", "fit_loop"])
     return c
 
 
 def _identify(s, run_dir):
-    c = {"title": "Identification of a contact law by simulation",
-         "model": _model_tex(s.get("latex")),
-         "coefficients": _coef_rows(s.get("coefficients") or {}, s.get("standard_errors"),
-                                    _intervals(s), start=s.get("start") or {}),
-         "measured": _measured_rows(s.get("measured")),
-         "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor")),
-         "verdict": s.get("verdict") or "--",
-         "method": s.get("method", "--"), "criterion": s.get("criterion", "I2"),
-         "n_simulations": s.get("n_simulations", "--"), "message": s.get("message", "")}
-    concl = [f"{s.get('method', '?')} spent {s.get('n_simulations', '?')} simulations; the "
-             f"identified law is {'consistent' if s.get('consistent') else 'NOT consistent'} "
-             "with the record."]
+    c = {
+        "title": "Identification of a contact law by simulation",
+        "model": _model_tex(s.get("latex")),
+        "coefficients": _coef_rows(
+            s.get("coefficients") or {},
+            s.get("standard_errors"),
+            _intervals(s),
+            start=s.get("start") or {},
+        ),
+        "measured": _measured_rows(s.get("measured")),
+        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor")),
+        "verdict": s.get("verdict") or "--",
+        "method": s.get("method", "--"),
+        "criterion": s.get("criterion", "I2"),
+        "n_simulations": s.get("n_simulations", "--"),
+        "message": s.get("message", ""),
+    }
+    concl = [
+        f"{s.get('method', '?')} spent {s.get('n_simulations', '?')} simulations; the "
+        f"identified law is {'consistent' if s.get('consistent') else 'NOT consistent'} "
+        "with the record."
+    ]
     if not s.get("consistent"):
-        concl.append("An inconsistent result after identification means either a missing "
-                     "effect (run `vidi explain`) or a local minimum: start nearer (the "
-                     "coefficients of `vidi fit`), or look at the landscape.")
+        concl.append(
+            "An inconsistent result after identification means either a missing "
+            "effect (run `vidi explain`) or a local minimum: start nearer (the "
+            "coefficients of `vidi fit`), or look at the landscape."
+        )
     c["conclusions"] = concl
     c["figures"] = _figures(run_dir, ["identification"])
     return c
@@ -293,22 +395,36 @@ def _identify(s, run_dir):
 def _landscape(s, run_dir):
     terms = s.get("terms") or ["?", "?"]
     mins = s.get("minima") or {}
-    c = {"title": "Criteria landscape over two coefficients",
-         "terms": terms, "law": s.get("law", "--"),
-         "grid": "x".join(str(g) for g in s.get("grid") or []),
-         "minima": [[Tex(f"$I_{k[1]}$"), num(m.get("alpha1")), num(m.get("alpha2")),
-                     num(m.get("value")), m.get("regime", "--"),
-                     "yes" if m.get("consistent") else "no"]
-                    for k, m in mins.items()],
-         "noise_floor": _rows_from(s.get("noise_floor") or {}),
-         "n_consistent": s.get("n_consistent", 0),
-         "regimes": ", ".join(f"{k}: {v}" for k, v in (s.get("regimes") or {}).items()),
-         "reference": (s.get("reference") or {}).get("source", "--")}
+    c = {
+        "title": "Criteria landscape over two coefficients",
+        "terms": terms,
+        "law": s.get("law", "--"),
+        "grid": "x".join(str(g) for g in s.get("grid") or []),
+        "minima": [
+            [
+                Tex(f"$I_{k[1]}$"),
+                num(m.get("alpha1")),
+                num(m.get("alpha2")),
+                num(m.get("value")),
+                m.get("regime", "--"),
+                "yes" if m.get("consistent") else "no",
+            ]
+            for k, m in mins.items()
+        ],
+        "noise_floor": _rows_from(s.get("noise_floor") or {}),
+        "n_consistent": s.get("n_consistent", 0),
+        "regimes": ", ".join(f"{k}: {v}" for k, v in (s.get("regimes") or {}).items()),
+        "reference": (s.get("reference") or {}).get("source", "--"),
+    }
     n = s.get("n_consistent", 0)
     c["conclusions"] = [
         f"{n} grid point(s) are consistent with the reference within the noise limit"
-        + ("; the consistent region's size is the coefficients' uncertainty from this record."
-           if n else "; no pair of these coefficients explains the record on this grid.")]
+        + (
+            "; the consistent region's size is the coefficients' uncertainty from this record."
+            if n
+            else "; no pair of these coefficients explains the record on this grid."
+        )
+    ]
     c["figures"] = _figures(run_dir, ["landscape"])
     return c
 
@@ -316,34 +432,55 @@ def _landscape(s, run_dir):
 def _explain(s, run_dir):
     fm = s.get("final_model") or {}
     its = s.get("iterations") or []
-    c = {"title": "The missing physical effect",
-         "model": _model_tex(fm.get("latex")),
-         "coefficients": _coef_rows({**(fm.get("coefficients") or {}),
-                                     **{f"d_{k}": v for k, v in
-                                        (fm.get("unloading") or {}).items()}},
-                                    fm.get("uncertainties"), _intervals(fm)),
-         "effects": list(fm.get("effects") or []),
-         "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor")),
-         "stopped": s.get("stopped_because", "--"),
-         "iterations": [[str(k + 1), it.get("effect") or "nothing named",
-                         num((it.get("criteria_before") or {}).get("I2")),
-                         num((it.get("criteria_after") or {}).get("I2")),
-                         num((it.get("noise_floor") or {}).get("I2")),
-                         it.get("evidence", "")]
-                        for k, it in enumerate(its)],
-         "separability": [[r.get("effect", "--"), num(r.get("before")), num(r.get("after")),
-                           num(r.get("floor")),
-                           "yes" if r.get("separable") else "no"]
-                          for r in s.get("separability") or []]}
+    c = {
+        "title": "The missing physical effect",
+        "model": _model_tex(fm.get("latex")),
+        "coefficients": _coef_rows(
+            {
+                **(fm.get("coefficients") or {}),
+                **{f"d_{k}": v for k, v in (fm.get("unloading") or {}).items()},
+            },
+            fm.get("uncertainties"),
+            _intervals(fm),
+        ),
+        "effects": list(fm.get("effects") or []),
+        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor")),
+        "stopped": s.get("stopped_because", "--"),
+        "iterations": [
+            [
+                str(k + 1),
+                it.get("effect") or "nothing named",
+                num((it.get("criteria_before") or {}).get("I2")),
+                num((it.get("criteria_after") or {}).get("I2")),
+                num((it.get("noise_floor") or {}).get("I2")),
+                it.get("evidence", ""),
+            ]
+            for k, it in enumerate(its)
+        ],
+        "separability": [
+            [
+                r.get("effect", "--"),
+                num(r.get("before")),
+                num(r.get("after")),
+                num(r.get("floor")),
+                "yes" if r.get("separable") else "no",
+            ]
+            for r in s.get("separability") or []
+        ],
+    }
     named_its = [it for it in its if it.get("effect")]
     if named_its:
         named = ", ".join(it["effect"] for it in named_its)
         state = "consistent" if s.get("consistent") else "still NOT consistent"
-        concl = [f"Named and added: {named}. The gap to the record shrank as the table shows; "
-                 f"the final model is {state} with the record."]
+        concl = [
+            f"Named and added: {named}. The gap to the record shrank as the table shows; "
+            f"the final model is {state} with the record."
+        ]
     else:
-        concl = ["No effect was added: " + str(s.get("stopped_because", "the start model already "
-                                                 "agrees with the record"))]
+        concl = [
+            "No effect was added: "
+            + str(s.get("stopped_because", "the start model already agrees with the record"))
+        ]
     c["conclusions"] = concl
     c["figures"] = _figures(run_dir, ["explain", "localise", "screen", "drift"])
     return c
@@ -356,49 +493,67 @@ def _ueda(s, run_dir):
     for key in ("model", "regime", "terms", "forcing", "residual_rms", "n_windows"):
         if key in s:
             val = s[key]
-            rows.append([key.replace("_", " "),
-                         ", ".join(map(str, val)) if isinstance(val, list)
-                         else ("; ".join(f"{k}={v}" for k, v in val.items())
-                               if isinstance(val, dict)
-                         else (num(val) if isinstance(val, float) else val))])
+            rows.append(
+                [
+                    key.replace("_", " "),
+                    ", ".join(map(str, val))
+                    if isinstance(val, list)
+                    else (
+                        "; ".join(f"{k}={v}" for k, v in val.items())
+                        if isinstance(val, dict)
+                        else (num(val) if isinstance(val, float) else val)
+                    ),
+                ]
+            )
     c["facts"] = rows
     c["model"] = _model_tex(s.get("latex") or (s.get("final") or {}).get("latex"))
     c["coefficients"] = _coef_rows(s.get("coefficients") or {}, s.get("standard_errors"))
     ver = s.get("verification") or {}
-    c["verification"] = [[k.replace("_", " "), num(v) if isinstance(v, int | float) else v]
-                         for k, v in ver.items()
-                         if isinstance(v, int | float | str) and not isinstance(v, bool)]
+    c["verification"] = [
+        [k.replace("_", " "), num(v) if isinstance(v, int | float) else v]
+        for k, v in ver.items()
+        if isinstance(v, int | float | str) and not isinstance(v, bool)
+    ]
     concl = []
     if ver:
         state = "consistent" if ver.get("consistent") else "NOT consistent"
-        concl.append(f"Verification by simulation: {state}"
-                     f" (energy distance {ver.get('energy_distance', float('nan')):.3g} against "
-                     f"the record's own floor {ver.get('floor_q95', float('nan')):.3g}; regime of "
-                     f"the record {ver.get('regime_record', '?')}, of the model "
-                     f"{ver.get('regime_model', '?')}).")
+        concl.append(
+            f"Verification by simulation: {state}"
+            f" (energy distance {ver.get('energy_distance', float('nan')):.3g} against "
+            f"the record's own floor {ver.get('floor_q95', float('nan')):.3g}; regime of "
+            f"the record {ver.get('regime_record', '?')}, of the model "
+            f"{ver.get('regime_model', '?')})."
+        )
     fr = s.get("fractions")
     if isinstance(fr, dict):
         grid = "x".join(str(g) for g in s.get("grid") or [])
         share = ", ".join(f"{k} {100 * v:.0f} %" for k, v in fr.items() if v)
         periods = ", ".join(f"{k} ({v} points)" for k, v in (s.get("periods_found") or {}).items())
-        concl.append(f"Over nu in {s.get('nu_range')} and B in {s.get('B_range')} on a {grid} "
-                     f"grid the regimes are: {share}." + (f" Periods found: {periods}."
-                                                          if periods else ""))
+        concl.append(
+            f"Over nu in {s.get('nu_range')} and B in {s.get('B_range')} on a {grid} "
+            f"grid the regimes are: {share}." + (f" Periods found: {periods}." if periods else "")
+        )
     if "effects_added" in s:
-        gaps = "; ".join(f"{k.replace('_', ' ')} {v['before']:.3g} -> {v['after']:.3g} "
-                         f"({v['ratio']:.0f}x)" for k, v in (s.get("gap") or {}).items()
-                         if isinstance(v, dict))
+        gaps = "; ".join(
+            f"{k.replace('_', ' ')} {v['before']:.3g} -> {v['after']:.3g} ({v['ratio']:.0f}x)"
+            for k, v in (s.get("gap") or {}).items()
+            if isinstance(v, dict)
+        )
         added = ", ".join(s["effects_added"]) or "none"
-        concl.append(f"Effects named and added: {added}; the gap: {gaps}. The final model is "
-                     f"{'consistent' if s.get('consistent') else 'NOT consistent'} with the "
-                     f"record. Stopped because {s.get('stopped_because', '--')}.")
+        concl.append(
+            f"Effects named and added: {added}; the gap: {gaps}. The final model is "
+            f"{'consistent' if s.get('consistent') else 'NOT consistent'} with the "
+            f"record. Stopped because {s.get('stopped_because', '--')}."
+        )
         final = s.get("final_model") or {}
         if final.get("coefficients"):
             c["coefficients"] = _coef_rows(final["coefficients"], final.get("standard_errors"))
     if "lyapunov" in s and isinstance(s["lyapunov"], dict):
         L = s["lyapunov"]
-        concl.append(f"Largest Lyapunov exponent {L.get('value', float('nan')):.4g} per unit "
-                     "time: " + ("chaotic." if L.get("value", 0) > 0.01 else "not chaotic."))
+        concl.append(
+            f"Largest Lyapunov exponent {L.get('value', float('nan')):.4g} per unit "
+            "time: " + ("chaotic." if L.get("value", 0) > 0.01 else "not chaotic.")
+        )
     c["conclusions"] = concl or ["See the tables and figures."]
     c["figures"] = _figures(run_dir, ["discover", "explain", "attractor", "basins", "chart"])
     return c
@@ -419,60 +574,109 @@ def _study(s, run_dir):
     varied = list(d.get("varied") or {})
     pooled = s.get("pooled") or {}
     cells = s.get("cells") or []
-    c = {"title": "Model-term selection study" + (f": {s['name']}" if s.get("name") else ""),
-         "design": [[Tex(r"\texttt{" + escape(k) + "}"), ", ".join(map(str, v))]
-                    for k, v in (d.get("varied") or {}).items()]
-         + [[Tex(r"\texttt{" + escape(k) + "}"), f"{v} (fixed)"]
-            for k, v in (d.get("fixed") or {}).items()]
-         + [["fit options", "; ".join(f"{k}={v}" for k, v in (d.get("fit") or {}).items())
-             or "--"],
-            ["record options", "; ".join(f"{k}={v}" for k, v in
-                                         (d.get("record") or {}).items()) or "--"],
+    c = {
+        "title": "Model-term selection study" + (f": {s['name']}" if s.get("name") else ""),
+        "design": [
+            [Tex(r"\texttt{" + escape(k) + "}"), ", ".join(map(str, v))]
+            for k, v in (d.get("varied") or {}).items()
+        ]
+        + [
+            [Tex(r"\texttt{" + escape(k) + "}"), f"{v} (fixed)"]
+            for k, v in (d.get("fixed") or {}).items()
+        ]
+        + [
+            ["fit options", "; ".join(f"{k}={v}" for k, v in (d.get("fit") or {}).items()) or "--"],
+            [
+                "record options",
+                "; ".join(f"{k}={v}" for k, v in (d.get("record") or {}).items()) or "--",
+            ],
             ["seeds", ", ".join(map(str, d.get("seeds") or []))],
-            ["runs", f"{s.get('complete', 0)} of {s.get('runs', 0)} done "
-                     f"({d.get('cells', '?')} cells)"]],
-         "varied": varied,
-         "pooled": [[m, _frac(p["recovered"], p["runs"], p.get("recovery_ci")),
-                     f"{p['equivalent']}/{p['runs']}",
-                     num(p.get("fp_per_run"), 2),
-                     _frac(p["covered"], p["intervals"], p.get("coverage_ci")),
-                     p.get("failed", 0)] for m, p in pooled.items()],
-         "cells": [[*(str(row.get(f, "")) for f in varied),
-                    _frac(row["recovered"], row["runs"],
-                          (row.get("recovery_low"), row.get("recovery_high"))),
-                    num(row.get("fp_per_run"), 2),
-                    _frac(row.get("covered", 0), row.get("intervals", 0)),
-                    num(row.get("coef_error_median"), 2)] for row in cells]}
+            [
+                "runs",
+                f"{s.get('complete', 0)} of {s.get('runs', 0)} done ({d.get('cells', '?')} cells)",
+            ],
+        ],
+        "varied": varied,
+        "pooled": [
+            [
+                m,
+                _frac(p["recovered"], p["runs"], p.get("recovery_ci")),
+                f"{p['equivalent']}/{p['runs']}",
+                num(p.get("fp_per_run"), 2),
+                _frac(p["covered"], p["intervals"], p.get("coverage_ci")),
+                p.get("failed", 0),
+            ]
+            for m, p in pooled.items()
+        ],
+        "cells": [
+            [
+                *(str(row.get(f, "")) for f in varied),
+                _frac(
+                    row["recovered"],
+                    row["runs"],
+                    (row.get("recovery_low"), row.get("recovery_high")),
+                ),
+                num(row.get("fp_per_run"), 2),
+                _frac(row.get("covered", 0), row.get("intervals", 0)),
+                num(row.get("coef_error_median"), 2),
+            ]
+            for row in cells
+        ],
+    }
     concl = []
     if pooled:
         rate = {m: p["recovered"] / max(p["runs"], 1) for m, p in pooled.items()}
         top = [m for m in pooled if rate[m] == max(rate.values())]
         p = pooled[top[0]]
-        concl.append(f"Across the study, {' and '.join(top)} recovered the exact true support "
-                     f"most often: {p['recovered']} of {p['runs']} runs"
-                     + (" each." if len(top) > 1 else "."))
+        concl.append(
+            f"Across the study, {' and '.join(top)} recovered the exact true support "
+            f"most often: {p['recovered']} of {p['runs']} runs"
+            + (" each." if len(top) > 1 else ".")
+        )
         for m, p in pooled.items():
             if p["intervals"]:
                 share = p["covered"] / p["intervals"]
                 lo, hi = p["coverage_ci"]
-                verdict = ("consistent with the nominal 95 %" if lo <= 0.95 <= hi else
-                           "below the nominal 95 %: the intervals are too narrow"
-                           if hi < 0.95 else "above the nominal 95 %")
-                concl.append(f"{m}: the 95 % intervals held the truth in {share:.0%} of "
-                             f"{p['intervals']} cases ({lo:.2f}--{hi:.2f}), {verdict}.")
-    concl.append("Records were made by the independent scipy path from rest; no selection "
-                 "used the truth (no oracle settings).")
+                verdict = (
+                    "consistent with the nominal 95 %"
+                    if lo <= 0.95 <= hi
+                    else "below the nominal 95 %: the intervals are too narrow"
+                    if hi < 0.95
+                    else "above the nominal 95 %"
+                )
+                concl.append(
+                    f"{m}: the 95 % intervals held the truth in {share:.0%} of "
+                    f"{p['intervals']} cases ({lo:.2f}--{hi:.2f}), {verdict}."
+                )
+    concl.append(
+        "Records were made by the independent scipy path from rest; no selection "
+        "used the truth (no oracle settings)."
+    )
     c["conclusions"] = concl
-    c["figures"] = _figures(run_dir, ["recovery_noise", "recovery_map", "coverage",
-                                      "inclusion"])
+    c["figures"] = _figures(run_dir, ["recovery_noise", "recovery_map", "coverage", "inclusion"])
     return c
 
 
-KINDS = {"verify": _verify, "fit": _fit, "identify": _identify, "landscape": _landscape,
-         "explain": _explain, "ueda attractor": _ueda, "ueda chart": _ueda,
-         "ueda discover": _ueda, "ueda explain": _ueda, "study": _study}
-TEMPLATES = {"verify": "verify", "fit": "fit", "identify": "identify",
-             "landscape": "landscape", "explain": "explain", "study": "study"}
+KINDS = {
+    "verify": _verify,
+    "fit": _fit,
+    "identify": _identify,
+    "landscape": _landscape,
+    "explain": _explain,
+    "ueda attractor": _ueda,
+    "ueda chart": _ueda,
+    "ueda discover": _ueda,
+    "ueda explain": _ueda,
+    "study": _study,
+}
+TEMPLATES = {
+    "verify": "verify",
+    "fit": "fit",
+    "identify": "identify",
+    "landscape": "landscape",
+    "explain": "explain",
+    "study": "study",
+}
 
 
 def context(summary, run_dir):
@@ -482,8 +686,7 @@ def context(summary, run_dir):
     if build is None:
         from discovery.errors import InputError
 
-        raise InputError(f"no report for a {kind!r} run; reports cover "
-                         f"{', '.join(KINDS)} runs")
+        raise InputError(f"no report for a {kind!r} run; reports cover {', '.join(KINDS)} runs")
     c = build(summary, run_dir)
     c["kind"] = kind
     c["template"] = TEMPLATES.get(kind, "ueda") + ".tex.j2"

@@ -25,8 +25,9 @@ from .texenv import Tex, environment
 
 __all__ = ["Report", "report", "render", "SNIPPETS", "TEX_PACKAGES", "compile_tex"]
 
-TEX_PACKAGES = ("latexmk texlive-latex-recommended texlive-latex-extra "
-                "texlive-fonts-recommended lmodern")
+TEX_PACKAGES = (
+    "latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended lmodern"
+)
 SNIPPETS = ("model", "table", "criteria", "figure")
 _SAFE_FILE = re.compile(r"^[A-Za-z0-9_.-]+\.pdf$")
 
@@ -70,20 +71,27 @@ def _load(run_dir):
 
     d = Path(run_dir)
     if not d.is_dir():
-        raise InputError(f"{str(run_dir)!r} is not a run directory; give the --out directory "
-                         "of a vidi command (it holds summary.json)")
+        raise InputError(
+            f"{str(run_dir)!r} is not a run directory; give the --out directory "
+            "of a vidi command (it holds summary.json)"
+        )
     p = d / "summary.json"
     try:
         summary = json.loads(p.read_text(encoding="utf-8"))
     except FileNotFoundError:
-        raise InputError(f"{str(run_dir)!r} has no summary.json: not a vidi run directory; "
-                         "give the --out directory of a vidi command") from None
+        raise InputError(
+            f"{str(run_dir)!r} has no summary.json: not a vidi run directory; "
+            "give the --out directory of a vidi command"
+        ) from None
     except (OSError, ValueError, UnicodeDecodeError):
-        raise InputError(f"{str(p)!r} is not readable JSON; run the command again to "
-                         "rewrite it") from None
+        raise InputError(
+            f"{str(p)!r} is not readable JSON; run the command again to rewrite it"
+        ) from None
     if not isinstance(summary, dict) or "command" not in summary:
-        raise InputError(f"{str(p)!r} is not a vidi summary (no 'command'); give the --out "
-                         "directory of a vidi command")
+        raise InputError(
+            f"{str(p)!r} is not a vidi summary (no 'command'); give the --out "
+            "directory of a vidi command"
+        )
     return summary
 
 
@@ -93,8 +101,9 @@ def render(summary, run_dir, snippet=None, template=None):
     from discovery.errors import InputError
 
     ctx = context(summary, run_dir)
-    ctx["figures"] = [dict(f, file=Tex(f["file"])) for f in ctx["figures"]
-                      if _SAFE_FILE.match(f["file"])]
+    ctx["figures"] = [
+        dict(f, file=Tex(f["file"])) for f in ctx["figures"] if _SAFE_FILE.match(f["file"])
+    ]
     ctx["created"] = summary.get("created", "")
     env = environment()
     if template is not None:
@@ -104,8 +113,9 @@ def render(summary, run_dir, snippet=None, template=None):
     if snippet not in SNIPPETS:
         raise InputError(f"unknown snippet {snippet!r}; choose one of {', '.join(SNIPPETS)}")
     if snippet == "model" and ctx.get("model") in (None, "--"):
-        raise InputError(f"a {ctx['kind']} run has no model to paste; use --snippet criteria, "
-                         "table or figure")
+        raise InputError(
+            f"a {ctx['kind']} run has no model to paste; use --snippet criteria, table or figure"
+        )
     if snippet == "figure" and not ctx["figures"]:
         raise InputError(f"the {ctx['kind']} run wrote no PDF figure to paste")
     return env.get_template("snippets.tex.j2").render(snippet=snippet, **ctx)
@@ -115,7 +125,7 @@ def _first_error(log_text):
     lines = log_text.splitlines()
     for k, ln in enumerate(lines):
         if ln.startswith("!"):
-            more = next((x.strip() for x in lines[k + 1:k + 3] if x.strip().startswith("l.")), "")
+            more = next((x.strip() for x in lines[k + 1 : k + 3] if x.strip().startswith("l.")), "")
             return (ln[1:].strip() + (f" ({more})" if more else ""))[:200]
     return "see the log"
 
@@ -138,10 +148,11 @@ def compile_tex(tex_path, figures=(), timeout=300):
     """
     tex = Path(tex_path)
     if shutil.which("latexmk") is None or shutil.which("pdflatex") is None:
-        return None, (f"no PDF: TeX is not installed; wrote {tex}; to compile it, install "
-                      f"TeX Live: apt-get install {TEX_PACKAGES}")
-    env = dict(os.environ, openin_any="p", openout_any="p", shell_escape="f",
-               TEXMFOUTPUT="")
+        return None, (
+            f"no PDF: TeX is not installed; wrote {tex}; to compile it, install "
+            f"TeX Live: apt-get install {TEX_PACKAGES}"
+        )
+    env = dict(os.environ, openin_any="p", openout_any="p", shell_escape="f", TEXMFOUTPUT="")
     with tempfile.TemporaryDirectory(prefix=".vidi-tex-", dir=tex.parent) as work:
         w = Path(work)
         shutil.copy2(tex, w / tex.name)
@@ -149,11 +160,19 @@ def compile_tex(tex_path, figures=(), timeout=300):
             src = tex.parent / f
             if src.is_file():
                 shutil.copy2(src, w / f)
-        cmd = ["latexmk", "-pdf", "-interaction=nonstopmode", "-halt-on-error",
-               "-no-shell-escape", "-quiet", tex.name]
+        cmd = [
+            "latexmk",
+            "-pdf",
+            "-interaction=nonstopmode",
+            "-halt-on-error",
+            "-no-shell-escape",
+            "-quiet",
+            tex.name,
+        ]
         try:
-            run = subprocess.run(cmd, cwd=w, capture_output=True, text=True, timeout=timeout,
-                                 env=env)
+            run = subprocess.run(
+                cmd, cwd=w, capture_output=True, text=True, timeout=timeout, env=env
+            )
         except subprocess.TimeoutExpired:
             return None, f"no PDF: latexmk took more than {timeout} s; the source is {tex}"
         pdf = w / tex.with_suffix(".pdf").name
@@ -187,8 +206,10 @@ def _check_ours(run_dir, names):
     for name in names:
         p = d / name
         if os.path.lexists(p) and (name not in listed or p.is_symlink() or not p.is_file()):
-            raise InputError(f"{str(p)!r} exists and was not written by vidi; move it away "
-                             "(the report would replace it)")
+            raise InputError(
+                f"{str(p)!r} exists and was not written by vidi; move it away "
+                "(the report would replace it)"
+            )
 
 
 def _record_in_manifest(run_dir, names):
@@ -232,8 +253,9 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300):
     text = render(summary, run_dir, snippet)
     d = Path(run_dir)
     name = "report.tex" if snippet is None else f"snippet-{snippet}.tex"
-    _check_ours(d, [name] if snippet is not None or not compile else
-                [name, "report.pdf", "report.log"])
+    _check_ours(
+        d, [name] if snippet is not None or not compile else [name, "report.pdf", "report.log"]
+    )
     tex = d / name
     atomic_write_text(tex, text)
     ctx_figs = re.findall(r"\\includegraphics(?:\[[^\]]*\])?\{([^}]+)\}", text)
@@ -245,5 +267,6 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300):
     if pdf is not None:
         written.append(pdf.name)
     _record_in_manifest(d, written)
-    return Report(tex, pdf, message, summary["command"],
-                  _pages(pdf) if pdf is not None else None, ctx_figs)
+    return Report(
+        tex, pdf, message, summary["command"], _pages(pdf) if pdf is not None else None, ctx_figs
+    )

@@ -67,13 +67,18 @@ def landscape_figure(land, stem, truth=None):
     cons = getattr(land, "consistent", None)
     physical = ("no-contact", "nonperiodic", "failed")
     marks = [  # (mask, marker style, legend label)
-        ((reg != ref_reg) & ~np.isin(reg, physical),
-         dict(ls="none", marker="x", color="r", ms=4), f"periodic, not {ref_reg}"),
-        (reg == "nonperiodic", dict(ls="none", marker="+", color="orange", ms=5),
-         "nonperiodic"),
+        (
+            (reg != ref_reg) & ~np.isin(reg, physical),
+            dict(ls="none", marker="x", color="r", ms=4),
+            f"periodic, not {ref_reg}",
+        ),
+        (reg == "nonperiodic", dict(ls="none", marker="+", color="orange", ms=5), "nonperiodic"),
         (reg == "no-contact", dict(ls="none", marker=".", color="0.6", ms=4), "no contact"),
-        (reg == "failed", dict(ls="none", marker="s", mfc="none", mec="k", ms=4),
-         "simulation failed"),
+        (
+            reg == "failed",
+            dict(ls="none", marker="s", mfc="none", mec="k", ms=4),
+            "simulation failed",
+        ),
     ]
     marks = [m for m in marks if m[0].any()]
     inside = truth is not None and a0[0] <= truth[0] <= a0[-1] and a1[0] <= truth[1] <= a1[-1]
@@ -92,11 +97,24 @@ def landscape_figure(land, stem, truth=None):
             i, j = land.argmin(name)
             ax.plot(a0[i], a1[j], "w*", ms=10, mec="k")
         else:
-            ax.text(0.5, 0.5, "no periodic contact\nanywhere in this range",
-                    transform=ax.transAxes, ha="center", va="center")
+            ax.text(
+                0.5,
+                0.5,
+                "no periodic contact\nanywhere in this range",
+                transform=ax.transAxes,
+                ha="center",
+                va="center",
+            )
         if show_cons:
-            ax.contour(a0, a1, cons.T.astype(float), levels=[0.5], colors="w",
-                       linestyles="--", linewidths=1.2)
+            ax.contour(
+                a0,
+                a1,
+                cons.T.astype(float),
+                levels=[0.5],
+                colors="w",
+                linestyles="--",
+                linewidths=1.2,
+            )
         for mask, style, _ in marks:
             ij = np.argwhere(mask)
             ax.plot(a0[ij[:, 0]], a1[ij[:, 1]], **style)
@@ -114,9 +132,12 @@ def landscape_figure(land, stem, truth=None):
     info = getattr(land, "reference", None) or {}
     src = info.get("source", "")
     src = "the scenario's law (exact)" if src in ("law", "") else src
-    lines = ["Criteria landscape",
-             f"{a0.size} x {a1.size} points, {land.seconds:.1f} s on {land.workers} processes",
-             f"reference: {src}"[:70], f"reference regime: {ref_reg}"]
+    lines = [
+        "Criteria landscape",
+        f"{a0.size} x {a1.size} points, {land.seconds:.1f} s on {land.workers} processes",
+        f"reference: {src}"[:70],
+        f"reference regime: {ref_reg}",
+    ]
     if not exact and floor:
         lines.append("noise floor: " + ", ".join(f"{n} {floor[n]:.2g}" for n in _ORDER))
     counts = land.regime_counts() if hasattr(land, "regime_counts") else {}
@@ -131,14 +152,15 @@ def landscape_figure(land, stem, truth=None):
     if truth is not None and not inside:
         lines.append("the reference law lies outside this range")
     ax.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, transform=ax.transAxes)
-    handles = [Line2D([], [], ls="none", marker="*", mfc="w", mec="k", ms=10,
-                      label="minimum")]
+    handles = [Line2D([], [], ls="none", marker="*", mfc="w", mec="k", ms=10, label="minimum")]
     if inside:
-        handles.append(Line2D([], [], ls="none", marker="o", mfc="none", mec="r", ms=10,
-                              label="reference law"))
+        handles.append(
+            Line2D([], [], ls="none", marker="o", mfc="none", mec="r", ms=10, label="reference law")
+        )
     if show_cons:
-        handles.append(Line2D([], [], color="w", ls="--", lw=1.2,
-                              label="consistent region (boundary)"))
+        handles.append(
+            Line2D([], [], color="w", ls="--", lw=1.2, label="consistent region (boundary)")
+        )
     handles += [Line2D([], [], label=label, **style) for _, style, label in marks]
     leg = ax.legend(handles=handles, loc="lower left", fontsize=8, facecolor="0.85")
     leg.get_frame().set_edgecolor("0.5")
@@ -172,8 +194,7 @@ def identification_figure(result, measured, impulses, stem, land=None):
     its = list(result.iterations)
     path = np.array([[it["coefficients"][n] for n in names] for it in its])
     two = len(names) >= 2 and path.size > 0
-    fig, axes = subplots(1, 3 if two else 2, figsize=(17 if two else 12, 5.2),
-                             layout="constrained")
+    fig, axes = subplots(1, 3 if two else 2, figsize=(17 if two else 12, 5.2), layout="constrained")
     crit = result.criterion
     # the identified law's value (result.value can belong to a standard-error probe)
     value = result.criteria.get(crit, result.value)
@@ -183,10 +204,17 @@ def identification_figure(result, measured, impulses, stem, land=None):
             a0, a1 = land.axes
             cs = ax.contourf(a0, a1, land.values[crit].T, levels=20, cmap="viridis")
             fig.colorbar(cs, ax=ax, label=f"{crit} (dimensionless)")
-        ax.plot(path[:, 0], path[:, 1], "o-", color="w" if land is not None else "C0",
-                mec="k", ms=3.5, lw=1, label="best law so far")
-        ax.plot(path[0, 0], path[0, 1], "s", mfc="none", mec="r", ms=9, mew=1.5,
-                label="start")
+        ax.plot(
+            path[:, 0],
+            path[:, 1],
+            "o-",
+            color="w" if land is not None else "C0",
+            mec="k",
+            ms=3.5,
+            lw=1,
+            label="best law so far",
+        )
+        ax.plot(path[0, 0], path[0, 1], "s", mfc="none", mec="r", ms=9, mew=1.5, label="start")
         final = result.law.as_dict()
         ax.plot(final[names[0]], final[names[1]], "r*", ms=13, mec="k", label="identified")
         ax.set_xlabel(coefficient_label(names[0]))
@@ -200,23 +228,42 @@ def identification_figure(result, measured, impulses, stem, land=None):
         sims = np.array([it["n_simulations"] for it in its], dtype=float)
         vals = np.array([it["value"] for it in its], dtype=float)
         xs = np.append(sims, max(result.n_simulations, sims[-1]))
-        ax.step(xs, np.append(vals, vals[-1]), where="post", color="C0", lw=1.2,
-                label=f"best {crit} so far")
-        ax.plot(sims, vals, "o", color="C0", ms=3.5,
-                label="new best (an optimiser step or a finite-difference probe)")
+        ax.step(
+            xs,
+            np.append(vals, vals[-1]),
+            where="post",
+            color="C0",
+            lw=1.2,
+            label=f"best {crit} so far",
+        )
+        ax.plot(
+            sims,
+            vals,
+            "o",
+            color="C0",
+            ms=3.5,
+            label="new best (an optimiser step or a finite-difference probe)",
+        )
         if np.all(vals > 0):
             ax.set_yscale("log")
         ax.legend(fontsize=8)
     ax.set_xlabel("simulations spent (steady states computed)")
     ax.set_ylabel(f"best {crit} so far (dimensionless)")
-    ax.set_title(f"identified: {crit} = {value:.3g}, {result.n_simulations} simulations in all",
-                 fontsize=10)
+    ax.set_title(
+        f"identified: {crit} = {value:.3g}, {result.n_simulations} simulations in all", fontsize=10
+    )
     ax1 = axes[-1]
     ax1.plot(measured.t * 1e3, measured.F / 1e6, "k-", lw=2.5, label="F_E (measured)")
     for k, (label, imp) in enumerate(impulses):
         if imp is not None:
-            ax1.plot(imp.t * 1e3, imp.F / 1e6, "-", lw=1, color=colormap("plasma")(k / max(
-                1, len(impulses))), label=label)
+            ax1.plot(
+                imp.t * 1e3,
+                imp.F / 1e6,
+                "-",
+                lw=1,
+                color=colormap("plasma")(k / max(1, len(impulses))),
+                label=label,
+            )
     end = measured.support[:, 1].max() if len(measured.support) else measured.duration
     ax1.set_xlim(-0.05 * end * 1e3, min(measured.duration, 1.4 * end) * 1e3)
     ax1.set_xlabel("time since onset t - t* [ms]")
@@ -241,19 +288,29 @@ def fit_impulse_figure(result, impulses, stem, n_models=3):
     refs = [ref for _, ref in result.references] or [None]  # (scenario, Reference) pairs
     measured = [r.impulse if r is not None else result.measured for r in refs]
     models = [m for m in result.ranking if m.evaluations][:n_models]
-    labels = [lab for lab, _ in impulses][:len(models)]
-    fig, axes = subplots(len(measured), 1, figsize=(8, 3.0 + 2.2 * len(measured)),
-                             squeeze=False)
+    labels = [lab for lab, _ in impulses][: len(models)]
+    fig, axes = subplots(len(measured), 1, figsize=(8, 3.0 + 2.2 * len(measured)), squeeze=False)
     sc, unit = _force_unit(max(E.peak for E in measured))
     for r, (E, ax) in enumerate(zip(measured, axes[:, 0], strict=True)):
-        sims = [(labels[k] if k < len(labels) else ", ".join(m.law.names),
-                 m.evaluations[r].simulated if r < len(m.evaluations) else None)
-                for k, m in enumerate(models)]
+        sims = [
+            (
+                labels[k] if k < len(labels) else ", ".join(m.law.names),
+                m.evaluations[r].simulated if r < len(m.evaluations) else None,
+            )
+            for k, m in enumerate(models)
+        ]
         forces = [E.F] + [np.interp(E.t, imp.t, imp.F) for _, imp in sims if imp is not None]
-        tr, o, (lo, hi) = _contact_view(E.t, E.duration, *forces,
-                                        threshold=max(0.02 * E.peak, 5.0 * E.noise))
-        ax.plot(tr[o] * 1e3, E.F[o] * sc, "k-", lw=2.5, alpha=0.6,
-                label=f"measured ({E.n_cycles} cycles)")
+        tr, o, (lo, hi) = _contact_view(
+            E.t, E.duration, *forces, threshold=max(0.02 * E.peak, 5.0 * E.noise)
+        )
+        ax.plot(
+            tr[o] * 1e3,
+            E.F[o] * sc,
+            "k-",
+            lw=2.5,
+            alpha=0.6,
+            label=f"measured ({E.n_cycles} cycles)",
+        )
         styles = ["-", "--", ":"]
         for k, (label, imp) in enumerate(sims):
             if imp is None:
@@ -263,9 +320,12 @@ def fit_impulse_figure(result, impulses, stem, n_models=3):
         ax.set_xlim(lo * 1e3, hi * 1e3)
         ax.set_ylabel(f"contact force [{unit}]")
         name = getattr(refs[r], "source", None) or f"record {r + 1}"
-        ax.set_title(f"record {r + 1}: {plain(name)}" if len(measured) > 1 else
-                     "Measured impulse and the simulated steady states of the best models",
-                     fontsize=9)
+        ax.set_title(
+            f"record {r + 1}: {plain(name)}"
+            if len(measured) > 1
+            else "Measured impulse and the simulated steady states of the best models",
+            fontsize=9,
+        )
         ax.legend(fontsize=7, loc="upper right")
     axes[-1, 0].set_xlabel("time since the start of the contact [ms]")
     fig.tight_layout()
@@ -282,8 +342,15 @@ def fit_surface_figure(result, stem):
     cs = ax.contourf(zz * 1e3, vv, F / 1e3, levels=25, cmap="magma")
     fig.colorbar(cs, ax=ax, label="F [kN]")
     step = max(1, len(s) // 4000)
-    ax.plot(s.zeta[::step] * 1e3, np.maximum(s.dzeta[::step], 0), ".", ms=1.5, color="c",
-            alpha=0.6, label="contact samples")
+    ax.plot(
+        s.zeta[::step] * 1e3,
+        np.maximum(s.dzeta[::step], 0),
+        ".",
+        ms=1.5,
+        color="c",
+        alpha=0.6,
+        label="contact samples",
+    )
     ax.set_xlabel("penetration zeta [mm]")
     ax.set_ylabel("loading velocity max(dzeta, 0) [m/s]")
     ax.set_title(f"F = {result.selected.law}", fontsize=8)
@@ -300,10 +367,23 @@ def fit_loop_figure(result, stem, max_impacts=3):
     pick = impacts[np.linspace(0, impacts.size - 1, min(max_impacts, impacts.size)).astype(int)]
     for k, imp in enumerate(pick):
         m = s.impact == imp
-        ax.plot(s.zeta[m] * 1e3, s.F[m] / 1e3, ".", ms=3, color=f"C{k}", alpha=0.5,
-                label=f"measured, impact {imp}")
-        ax.plot(s.zeta[m] * 1e3, result.selected.law(s.zeta[m], s.dzeta[m]) / 1e3, "-",
-                color=f"C{k}", lw=1.5, label=f"model, impact {imp}")
+        ax.plot(
+            s.zeta[m] * 1e3,
+            s.F[m] / 1e3,
+            ".",
+            ms=3,
+            color=f"C{k}",
+            alpha=0.5,
+            label=f"measured, impact {imp}",
+        )
+        ax.plot(
+            s.zeta[m] * 1e3,
+            result.selected.law(s.zeta[m], s.dzeta[m]) / 1e3,
+            "-",
+            color=f"C{k}",
+            lw=1.5,
+            label=f"model, impact {imp}",
+        )
     ax.set_xlabel("penetration zeta [mm]")
     ax.set_ylabel("contact force [kN]")
     ax.set_title("Loading (upper) and elastic unloading (lower) branches")
@@ -338,8 +418,11 @@ def _contact_view(t, period, *forces, threshold=0.0):
     for f in forces:
         active |= np.abs(np.asarray(f, dtype=float)) > threshold
     # a noise spike is not a contact: keep only runs of at least 3 samples
-    active &= (np.roll(active, 1) & np.roll(active, -1)) | (np.roll(active, 1) & np.roll(
-        active, 2)) | (np.roll(active, -1) & np.roll(active, -2))
+    active &= (
+        (np.roll(active, 1) & np.roll(active, -1))
+        | (np.roll(active, 1) & np.roll(active, 2))
+        | (np.roll(active, -1) & np.roll(active, -2))
+    )
     n = t.size
     if not active.any() or active.all():
         return t - t[0], np.arange(n), (0.0, float(period))
@@ -374,32 +457,42 @@ def verify_figure(result, stem):
 
     ev = result.evaluation
     E = result.reference.impulse
-    fig, (ax, axr) = subplots(2, 1, figsize=(8, 5.5), sharex=True,
-                                  gridspec_kw={"height_ratios": [3, 1.3]})
+    fig, (ax, axr) = subplots(
+        2, 1, figsize=(8, 5.5), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
+    )
     band = 2.0 * result.reference.noise.get("F", 0.0) / np.sqrt(max(E.n_cycles, 1))
     ms = 1e3
     sc, unit = _force_unit(E.peak)
     if ev.simulated is not None:
         c = compare(E, ev.simulated)
         # the contact, not the whole cycle: re-based on its start, not cut by the fold
-        tr, o, (lo, hi) = _contact_view(c.t, E.duration, c.fe, c.fn,
-                                        threshold=max(2.0 * band, 0.02 * E.peak,
-                                                      5.0 * E.noise))
+        tr, o, (lo, hi) = _contact_view(
+            c.t, E.duration, c.fe, c.fn, threshold=max(2.0 * band, 0.02 * E.peak, 5.0 * E.noise)
+        )
         x = tr[o] * ms
-        ax.fill_between(x, (c.fe[o] - band) * sc, (c.fe[o] + band) * sc, color="0.85",
-                        label=f"measured +-2 sigma/sqrt({E.n_cycles}) noise band")
+        ax.fill_between(
+            x,
+            (c.fe[o] - band) * sc,
+            (c.fe[o] + band) * sc,
+            color="0.85",
+            label=f"measured +-2 sigma/sqrt({E.n_cycles}) noise band",
+        )
         ax.plot(x, c.fe[o] * sc, "k-", lw=1.0, label=f"measured F_E ({E.n_cycles} cycles)")
-        ax.plot(x, c.fn[o] * sc, "C3-", lw=1.0,
-                label=f"simulated F_N ({ev.regime['simulated']})")
+        ax.plot(x, c.fn[o] * sc, "C3-", lw=1.0, label=f"simulated F_N ({ev.regime['simulated']})")
         axr.fill_between(x, -band * sc, band * sc, color="0.85")
         axr.plot(x, (c.fn[o] - c.fe[o]) * sc, "C0-", lw=0.8)
         ax.set_xlim(lo * ms, hi * ms)
     else:
         ax.plot(E.t * ms, E.F * sc, "k-", lw=1.0, label="measured F_E")
-    crit = ", ".join(f"{k} {v:.3g} (floor {ev.noise_floor.get(k, float('nan')):.2g})"
-                     for k, v in ev.criteria.items() if k in ("I2", "I4", "I3", "I0"))
-    ax.set_title(f"{result.law}\n{'consistent' if ev.consistent else 'INCONSISTENT'}: "
-                 f"{crit or ev.status}", fontsize=9)
+    crit = ", ".join(
+        f"{k} {v:.3g} (floor {ev.noise_floor.get(k, float('nan')):.2g})"
+        for k, v in ev.criteria.items()
+        if k in ("I2", "I4", "I3", "I0")
+    )
+    ax.set_title(
+        f"{result.law}\n{'consistent' if ev.consistent else 'INCONSISTENT'}: {crit or ev.status}",
+        fontsize=9,
+    )
     ax.set_ylabel(f"contact force F [{unit}]")
     ax.legend(fontsize=7, loc="upper right")
     axr.set_ylabel(f"F_N - F_E [{unit}]")
@@ -419,11 +512,21 @@ def explain_figure(iteration, measured, stem, k=1):
     E = measured
     ax.plot(E.t * 1e3, E.F / 1e3, "k-", lw=2, label="measured")
     if iteration.simulated_before is not None:
-        ax.plot(E.t * 1e3, iteration.simulated_before.F / 1e3, "-", color="tab:red",
-                label=f"before ({' + '.join(iteration.model_before.law.names)})")
+        ax.plot(
+            E.t * 1e3,
+            iteration.simulated_before.F / 1e3,
+            "-",
+            color="tab:red",
+            label=f"before ({' + '.join(iteration.model_before.law.names)})",
+        )
     if iteration.effect and iteration.simulated_after is not None:
-        ax.plot(E.t * 1e3, iteration.simulated_after.F / 1e3, "-", color="tab:blue",
-                label=f"after (+ {iteration.effect})")
+        ax.plot(
+            E.t * 1e3,
+            iteration.simulated_after.F / 1e3,
+            "-",
+            color="tab:blue",
+            label=f"after (+ {iteration.effect})",
+        )
     if len(E.support):
         a, b = E.support[0]
         ax.set_xlim(max(a - 0.1 * (b - a), 0) * 1e3, (b + 0.3 * (b - a)) * 1e3)
@@ -431,29 +534,41 @@ def explain_figure(iteration, measured, stem, k=1):
     ax.set_ylabel("contact force [kN]")
     i2b = iteration.criteria_before.get("I2", float("nan"))
     i2a = iteration.criteria_after.get("I2", float("nan"))
-    ax.set_title(f"iteration {k}: I2 {i2b:.3g} -> {i2a:.3g} (noise floor "
-                 f"{iteration.noise_floor.get('I2', float('nan')):.2g})", fontsize=9)
+    ax.set_title(
+        f"iteration {k}: I2 {i2b:.3g} -> {i2a:.3g} (noise floor "
+        f"{iteration.noise_floor.get('I2', float('nan')):.2g})",
+        fontsize=9,
+    )
     ax.legend(fontsize=7)
     ax = axes[0, 1]
     ph = iteration.localisation["phases"]
     names = list(ph)
     shares = [ph[n]["share"] for n in names]
     x = np.arange(len(names))
-    bars = ax.bar(x, shares, color=["tab:red" if ph[n]["exceeds_noise"] else "tab:gray"
-                                    for n in names])
+    bars = ax.bar(
+        x, shares, color=["tab:red" if ph[n]["exceeds_noise"] else "tab:gray" for n in names]
+    )
     # phase names are long next to each other: rotated, anchored at their tick
     ax.set_xticks(x, names, rotation=30, ha="right", rotation_mode="anchor")
     for bar, n in zip(bars, names, strict=True):
         r = ph[n]["ratio_to_noise"]
         if r is not None:
-            ax.text(bar.get_x() + bar.get_width() / 2, bar.get_height(),
-                    f"{r:.0f}x" if r >= 10 else f"{r:.1f}x",
-                    ha="center", va="bottom", fontsize=7)
+            ax.text(
+                bar.get_x() + bar.get_width() / 2,
+                bar.get_height(),
+                f"{r:.0f}x" if r >= 10 else f"{r:.1f}x",
+                ha="center",
+                va="bottom",
+                fontsize=7,
+            )
     ax.margins(y=0.12)  # room for the numbers above the tallest bar
     ax.set_xlabel("impact phase")
     ax.set_ylabel("share of the residual energy\nin excess of the noise (dimensionless)")
-    ax.set_title("where the model disagrees, by impact phase\n(red: above the noise; "
-                 "number: residual energy / noise energy)", fontsize=9)
+    ax.set_title(
+        "where the model disagrees, by impact phase\n(red: above the noise; "
+        "number: residual energy / noise energy)",
+        fontsize=9,
+    )
     ax = axes[1, 0]
     plane = iteration.localisation.get("plane")
     if plane is not None:
@@ -462,8 +577,15 @@ def explain_figure(iteration, measured, stem, k=1):
         lim = np.nanmax(np.abs(m)) if np.isfinite(m).any() else 1.0
         # an empty bin (NaN: no sample fell in it) is gray, a zero residual white
         ax.set_facecolor("0.8")
-        im = ax.pcolormesh(ze * 1e3, ve, np.ma.masked_invalid(m / 1e3).T, cmap="RdBu_r",
-                           vmin=-lim / 1e3, vmax=lim / 1e3, shading="flat")
+        im = ax.pcolormesh(
+            ze * 1e3,
+            ve,
+            np.ma.masked_invalid(m / 1e3).T,
+            cmap="RdBu_r",
+            vmin=-lim / 1e3,
+            vmax=lim / 1e3,
+            shading="flat",
+        )
         fig.colorbar(im, ax=ax, label="mean residual F_N - F_E [kN]")
         ax.set_xlabel("zeta [mm] (simulated)")
         ax.set_ylabel("dzeta [m/s] (simulated)")
@@ -475,16 +597,30 @@ def explain_figure(iteration, measured, stem, k=1):
     unscored = [x for x in iteration.scores if x.get("lm") is None and "criteria_after" in x]
     if sc or unscored:
         lm = [max(x["lm"], 1e-3) for x in sc]
-        ax.barh([x["effect"] for x in sc], lm,
-                color=["tab:green" if x["effect"] == iteration.effect else
-                       ("tab:orange" if x["significant"] else "tab:gray") for x in sc])
+        ax.barh(
+            [x["effect"] for x in sc],
+            lm,
+            color=[
+                "tab:green"
+                if x["effect"] == iteration.effect
+                else ("tab:orange" if x["significant"] else "tab:gray")
+                for x in sc
+            ],
+        )
         # an effect whose small step changes the regime has no score, only its refit
         for x in unscored:
-            ax.barh([x["effect"]], [max(lm, default=1.0)], fill=False, hatch="//",
-                    edgecolor="tab:green" if x["effect"] == iteration.effect else "tab:gray")
+            ax.barh(
+                [x["effect"]],
+                [max(lm, default=1.0)],
+                fill=False,
+                hatch="//",
+                edgecolor="tab:green" if x["effect"] == iteration.effect else "tab:gray",
+            )
         ax.set_xscale("log")
-    ax.set_xlabel("score-test (LM) statistic (dimensionless; hatched: no local score, "
-                  "refitted)", fontsize=8)
-    ax.set_title("candidate effects (green: named; orange: significant; gray: not "
-                 "significant)", fontsize=9)
+    ax.set_xlabel(
+        "score-test (LM) statistic (dimensionless; hatched: no local score, refitted)", fontsize=8
+    )
+    ax.set_title(
+        "candidate effects (green: named; orange: significant; gray: not significant)", fontsize=9
+    )
     return _save(fig, stem)

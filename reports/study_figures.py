@@ -66,12 +66,13 @@ def recovery_noise_figure(runs, cells, stem):
     x = np.arange(len(noises))
     for ax, n_per in zip(axes, lengths, strict=True):
         for j, m in enumerate(methods):
-            vals = [_rate(_group(runs, cells, selection=m, force_noise=s, periods=n_per))
-                    for s in noises]
+            vals = [
+                _rate(_group(runs, cells, selection=m, force_noise=s, periods=n_per))
+                for s in noises
+            ]
             p, lo, hi = (np.array(v) for v in zip(*vals, strict=True))
             dx = (j - (len(methods) - 1) / 2) * 0.06
-            ax.errorbar(x + dx, p, yerr=_yerr(p, lo, hi), marker="o", ms=4, capsize=2,
-                        label=m)
+            ax.errorbar(x + dx, p, yerr=_yerr(p, lo, hi), marker="o", ms=4, capsize=2, label=m)
         ax.set_xticks(x, [_pct(s) for s in noises])
         ax.set_xlabel("force noise (of the peak force)")
         ax.set_title(f"{n_per} periods recorded", fontsize=10)
@@ -97,9 +98,15 @@ def recovery_map_figure(runs, cells, stem):
                 rs = _group(runs, cells, selection=m, force_noise=s, periods=n_per)
                 if rs:
                     grid[i, j] = _rate(rs)[0]
-                    ax.text(j, i, f"{sum(bool(r['exact']) for r in rs)}/{len(rs)}",
-                            ha="center", va="center", fontsize=8,
-                            color="white" if grid[i, j] < 0.5 else "black")
+                    ax.text(
+                        j,
+                        i,
+                        f"{sum(bool(r['exact']) for r in rs)}/{len(rs)}",
+                        ha="center",
+                        va="center",
+                        fontsize=8,
+                        color="white" if grid[i, j] < 0.5 else "black",
+                    )
         im = ax.imshow(grid, origin="lower", vmin=0, vmax=1, cmap="viridis", aspect="auto")
         ax.set_xticks(range(len(noises)), [_pct(s) for s in noises], fontsize=8)
         ax.set_yticks(range(len(lengths)), [str(n) for n in lengths], fontsize=8)
@@ -119,8 +126,11 @@ def coverage_figure(runs, cells, stem):
     for j, s in enumerate(noises):
         p, lo, hi, lab = [], [], [], []
         for m in methods:
-            cov = [c for r in _group(runs, cells, selection=m, force_noise=s)
-                   for c in (r.get("coverage") or {}).values()]
+            cov = [
+                c
+                for r in _group(runs, cells, selection=m, force_noise=s)
+                for c in (r.get("coverage") or {}).values()
+            ]
             k, n = sum(cov), len(cov)
             a, b = wilson(k, n)
             p.append(k / n if n else np.nan)
@@ -129,22 +139,29 @@ def coverage_figure(runs, cells, stem):
             lab.append(n)
         p, lo, hi = np.array(p), np.array(lo), np.array(hi)
         xs = np.arange(len(methods)) + (j - (len(noises) - 1) / 2) * width
-        ax.bar(xs, p, width * 0.9, yerr=_yerr(p, lo, hi), capsize=2,
-               label=f"noise {_pct(s)}")
+        ax.bar(xs, p, width * 0.9, yerr=_yerr(p, lo, hi), capsize=2, label=f"noise {_pct(s)}")
         for xx, n in zip(xs, lab, strict=True):
             if n:
                 ax.text(xx, 0.02, str(n), ha="center", va="bottom", fontsize=6, rotation=90)
     if not any((r.get("coverage") or {}) for r in runs):
-        ax.text(0.5, 0.5, "no coefficient intervals in these runs\n(they come from the "
-                "refinement: refine = [true])", ha="center", va="center",
-                transform=ax.transAxes, fontsize=9)
+        ax.text(
+            0.5,
+            0.5,
+            "no coefficient intervals in these runs\n(they come from the "
+            "refinement: refine = [true])",
+            ha="center",
+            va="center",
+            transform=ax.transAxes,
+            fontsize=9,
+        )
     ax.set_xlim(-0.6, len(methods) - 0.4)
     ax.axhline(0.95, color="k", ls="--", lw=1, label="nominal 95 %")
     ax.set_xticks(range(len(methods)), methods, fontsize=8)
     ax.set_ylim(0, 1.05)
     ax.set_ylabel("true coefficient inside its 95 % interval")
-    ax.set_title("Coverage of the coefficient intervals (exact supports; n at the foot)",
-                 fontsize=10)
+    ax.set_title(
+        "Coverage of the coefficient intervals (exact supports; n at the foot)", fontsize=10
+    )
     ax.legend(fontsize=7, loc="lower right")
     return _save(fig, stem)
 
@@ -166,8 +183,9 @@ def inclusion_figure(runs, cells, stem, truth_terms):
                     grid[i, j] = np.mean([t in r["selected"] for r in rs])
         im = ax.imshow(grid, origin="upper", vmin=0, vmax=1, cmap="Blues", aspect="auto")
         ax.set_xticks(range(len(noises)), [_pct(s) for s in noises], fontsize=8)
-        ax.set_yticks(range(len(terms)),
-                      [f"{t} (true)" if t in truth_terms else t for t in terms], fontsize=8)
+        ax.set_yticks(
+            range(len(terms)), [f"{t} (true)" if t in truth_terms else t for t in terms], fontsize=8
+        )
         ax.set_xlabel("force noise")
         ax.set_title(m, fontsize=10)
     fig.colorbar(im, ax=list(axes), shrink=0.85, label="selected in this share of runs")

@@ -19,10 +19,24 @@ from pathlib import Path
 
 __all__ = ["Tex", "escape", "num", "environment"]
 
-_SPECIAL = {"\\": r"\textbackslash{}", "_": r"\_", "%": r"\%", "&": r"\&", "#": r"\#",
-            "$": r"\$", "{": r"\{", "}": r"\}", "^": r"\textasciicircum{}",
-            "~": r"\textasciitilde{}", "<": r"\textless{}", ">": r"\textgreater{}",
-            "\n": " ", "\r": " ", "\t": " ", "\x0c": " "}
+_SPECIAL = {
+    "\\": r"\textbackslash{}",
+    "_": r"\_",
+    "%": r"\%",
+    "&": r"\&",
+    "#": r"\#",
+    "$": r"\$",
+    "{": r"\{",
+    "}": r"\}",
+    "^": r"\textasciicircum{}",
+    "~": r"\textasciitilde{}",
+    "<": r"\textless{}",
+    ">": r"\textgreater{}",
+    "\n": " ",
+    "\r": " ",
+    "\t": " ",
+    "\x0c": " ",
+}
 
 
 class Tex(str):
@@ -41,8 +55,10 @@ def escape(value):
     # control characters other than the whitespace above could confuse TeX's reader
     # control characters, and characters beyond Latin-1 that pdflatex's T1 fonts lack,
     # become '?'
-    return "".join(_SPECIAL.get(ch, ch) if (ch.isprintable() and ord(ch) < 0x100)
-                   or ch in _SPECIAL else "?" for ch in text)
+    return "".join(
+        _SPECIAL.get(ch, ch) if (ch.isprintable() and ord(ch) < 0x100) or ch in _SPECIAL else "?"
+        for ch in text
+    )
 
 
 def num(value, digits=3, unit=None):
@@ -96,11 +112,19 @@ def environment():
 
     env = jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(Path(__file__).with_name("templates"))),
-        block_start_string="((*", block_end_string="*))",
-        variable_start_string="(((", variable_end_string=")))",
-        comment_start_string="((=", comment_end_string="=))",
-        undefined=jinja2.StrictUndefined, finalize=_final, autoescape=True,
-        trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True)
+        block_start_string="((*",
+        block_end_string="*))",
+        variable_start_string="(((",
+        variable_end_string=")))",
+        comment_start_string="((=",
+        comment_end_string="=))",
+        undefined=jinja2.StrictUndefined,
+        finalize=_final,
+        autoescape=True,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        keep_trailing_newline=True,
+    )
     env.filters["num"] = num
     env.filters["spec"] = _spec
     env.filters["tex"] = lambda v: v if isinstance(v, Tex) else Tex(escape(v))

@@ -81,22 +81,32 @@ from discovery.studies.records import (
     transient_periods,
 )
 
-__all__ = ["CATEGORIES", "Case", "Trial", "draw_case", "default_transient", "reference_events",
-           "reference_record", "transient_periods", "verification_trials", "wrong_laws"]
+__all__ = [
+    "CATEGORIES",
+    "Case",
+    "Trial",
+    "draw_case",
+    "default_transient",
+    "reference_events",
+    "reference_record",
+    "transient_periods",
+    "verification_trials",
+    "wrong_laws",
+]
 
 CATEGORIES = ("p1", "p1-slow", "subharmonic", "short-contact")
 KINDS = ("linear", "zzd", "hertz")
 
 # sampling ranges: uniform on the range, or on the log10 for the *_exp / *_log entries
 _BASE = {
-    "f": (12.0, 40.0),                  # drive frequency [Hz]
+    "f": (12.0, 40.0),  # drive frequency [Hz]
     "m1_log": (math.log10(3e3), math.log10(3e4)),
-    "mass_ratio": (0.2, 1.5),           # m2 / m1
-    "fn_exp": (-0.4, 0.3),              # support natural frequency fn = f 10**U
-    "zeta1": (0.02, 0.2),               # support damping ratio
-    "gamma": (1.1, 3.0),                # A / ((m1 + m2) g)
-    "wc_exp": (0.0, 1.0),               # contact angular frequency wc = 2 pi f 10**U
-    "xi_exp": (-0.7, 0.8),              # contact damping ratio xi = 10**U
+    "mass_ratio": (0.2, 1.5),  # m2 / m1
+    "fn_exp": (-0.4, 0.3),  # support natural frequency fn = f 10**U
+    "zeta1": (0.02, 0.2),  # support damping ratio
+    "gamma": (1.1, 3.0),  # A / ((m1 + m2) g)
+    "wc_exp": (0.0, 1.0),  # contact angular frequency wc = 2 pi f 10**U
+    "xi_exp": (-0.7, 0.8),  # contact damping ratio xi = 10**U
 }
 # per category: ranges moved to where the property is common (measured acceptance in
 # 120-150 draws; the rest are mostly nonperiodic).  p1 and subharmonic use the base
@@ -124,12 +134,12 @@ class Case:
     max_multiplier: float
     contact_fraction: float
     seed: int
-    kind: str = ""                 # 'linear', 'zzd' or 'hertz'
-    tries: int = 0                 # draws made
-    seconds: float = 0.0           # time to draw (and check) the case
+    kind: str = ""  # 'linear', 'zzd' or 'hertz'
+    tries: int = 0  # draws made
+    seconds: float = 0.0  # time to draw (and check) the case
     reference_rejects: tuple = ()  # why accepted draws were dropped by the reference check
     reference_seconds: float = float("nan")  # time to make (and check) its default record
-    transient: int = 0             # default transient of its records [periods]
+    transient: int = 0  # default transient of its records [periods]
 
 
 def _sig(x, digits=3):
@@ -156,8 +166,9 @@ def _draw(rng, category):
     k = mu * wc**2
     c = 2 * xi * math.sqrt(k * mu)
     split = float(rng.uniform(0.2, 0.8))  # share of the damping on z*zd (zzd laws)
-    machine = dict(m1=_sig(m1), m2=_sig(m2), k1=_sig(k1), c1=_sig(c1), A=_sig(A),
-                   frequency=_sig(f), g=g)
+    machine = dict(
+        m1=_sig(m1), m2=_sig(m2), k1=_sig(k1), c1=_sig(c1), A=_sig(A), frequency=_sig(f), g=g
+    )
     # typical penetration: a typical relative impact velocity over the contact frequency
     z0 = Scenario(**machine).scales()[1] / wc
     if kind == "linear":
@@ -207,9 +218,11 @@ multiple of the drive frequency for a drawn machine)."""
 
 def field_record_kw(case):
     """Record settings of the field-like setting for ``case`` (its seed picks the rate)."""
-    return {"fs": FIELD["rates"][case.seed % 2],
-            "transient": min(FIELD["transient"], default_transient(case)),
-            "check": False}
+    return {
+        "fs": FIELD["rates"][case.seed % 2],
+        "transient": min(FIELD["transient"], default_transient(case)),
+        "check": False,
+    }
 
 
 def _accepts(category, ss, mult):
@@ -257,12 +270,15 @@ def _reference_problem(scenario, law, ss, transient):
         return f"reference path failed: {exc}"
     T, n = scenario.period, ss.n_periods
     span = np.maximum(np.ptp(y, axis=1), 1e-12)
-    orbit = simulate(scenario, law, (ss.t0, ss.t0 + n * T), y0=ss.y0,
-                     t_eval=ss.t0 + np.arange(n) * T).y
+    orbit = simulate(
+        scenario, law, (ss.t0, ss.t0 + n * T), y0=ss.y0, t_eval=ss.t0 + np.arange(n) * T
+    ).y
     off = min(float(np.max(np.abs(orbit[:, j] - y[:, 0]) / span)) for j in range(n))
     if not off < START_TOL:
-        return (f"reference record starts {off:.1e} of the ranges off the compiled orbit "
-                f"(found after {ss.t0 / T:.0f} periods; transient {transient})")
+        return (
+            f"reference record starts {off:.1e} of the ranges off the compiled orbit "
+            f"(found after {ss.t0 / T:.0f} periods; transient {transient})"
+        )
     err = _kernel_mismatch(scenario, law, t, y)
     if not err < CHECK_TOL:
         return f"reference and compiled kernel differ by {err:.1e} of the ranges"
@@ -280,8 +296,9 @@ def _kernel_mismatch(scenario, law, t, y):
     span = np.maximum(np.ptp(y, axis=1), 1e-12)
     # tight kernel tolerance: a run-up from rest amplifies integration errors ~1e4-fold
     # for a while (at the kernel's default rtol 1e-9 that alone reaches ~4e-5)
-    tr = simulate(scenario, law, (t[0], t[-1]), y0=y[:, 0], t_eval=t, throw=False,
-                  tolerances=CHECK_KERNEL_TOL)
+    tr = simulate(
+        scenario, law, (t[0], t[-1]), y0=y[:, 0], t_eval=t, throw=False, tolerances=CHECK_KERNEL_TOL
+    )
     if not tr.success:
         return float("inf")
     return float(np.max(np.abs(tr.y - y) / span[:, None]))
@@ -326,12 +343,22 @@ def draw_case(category, seed, max_tries=400, check_reference=True):
                 rejects.append(problem)
                 continue
         t_ref = time.perf_counter() - t_ref
-        return Case(scenario=sc, law=law, category=category, regime=ss.regime,
-                    impacts=int(ss.impacts), max_multiplier=mult, contact_fraction=frac,
-                    seed=seed, kind=kind, tries=tries,
-                    seconds=time.perf_counter() - t_start, reference_rejects=tuple(rejects),
-                    reference_seconds=t_ref if check_reference else float("nan"),
-                    transient=transient)
+        return Case(
+            scenario=sc,
+            law=law,
+            category=category,
+            regime=ss.regime,
+            impacts=int(ss.impacts),
+            max_multiplier=mult,
+            contact_fraction=frac,
+            seed=seed,
+            kind=kind,
+            tries=tries,
+            seconds=time.perf_counter() - t_start,
+            reference_rejects=tuple(rejects),
+            reference_seconds=t_ref if check_reference else float("nan"),
+            transient=transient,
+        )
     raise RuntimeError(f"no {category!r} case in {max_tries} draws from seed {seed}")
 
 
@@ -369,9 +396,19 @@ def default_transient(case_or_pair):
     return min(TRANSIENT_MAX, n * transient_periods(mult))
 
 
-def reference_record(case_or_pair, *, periods=15, fs=20000.0, transient=None,
-                     force_noise=0.01, motion_noise=0.002, seed=0, record_transient=False,
-                     velocities=True, check=True):
+def reference_record(
+    case_or_pair,
+    *,
+    periods=15,
+    fs=20000.0,
+    transient=None,
+    force_noise=0.01,
+    motion_noise=0.002,
+    seed=0,
+    record_transient=False,
+    velocities=True,
+    check=True,
+):
     """A noisy record of a case, simulated with the independent scipy reference path.
 
     Parameters
@@ -424,25 +461,36 @@ def reference_record(case_or_pair, *, periods=15, fs=20000.0, transient=None,
             raise RuntimeError(
                 f"reference record of {scenario.name} disagrees with the compiled kernel by "
                 f"{err:.1e} of the channel ranges (see _reference_problem); use another "
-                "case or check=False")
-    notes = (f"reference_simulate from rest; transient {transient} periods "
-             f"(rtol {RTOL_TRANSIENT:g}), recorded at rtol {RTOL_RECORD:g}",
-             f"noise: force {force_noise:g} of max|F|, motion {motion_noise:g} of each "
-             f"channel's range, seed {seed}")
-    return noisy_measurement(t, y, F, force_noise=force_noise, motion_noise=motion_noise,
-                             seed=seed, velocities=velocities,
-                             source=f"reference:{scenario.name}", notes=notes)
+                "case or check=False"
+            )
+    notes = (
+        f"reference_simulate from rest; transient {transient} periods "
+        f"(rtol {RTOL_TRANSIENT:g}), recorded at rtol {RTOL_RECORD:g}",
+        f"noise: force {force_noise:g} of max|F|, motion {motion_noise:g} of each "
+        f"channel's range, seed {seed}",
+    )
+    return noisy_measurement(
+        t,
+        y,
+        F,
+        force_noise=force_noise,
+        motion_noise=motion_noise,
+        seed=seed,
+        velocities=velocities,
+        source=f"reference:{scenario.name}",
+        notes=notes,
+    )
 
 
-def reference_events(case_or_pair, *, periods=15, fs=20000.0, transient=None,
-                     record_transient=False):
+def reference_events(
+    case_or_pair, *, periods=15, fs=20000.0, transient=None, record_transient=False
+):
     """``(time, kind)`` of the contact events of the recorded span (same cache as
     :func:`reference_record`)."""
     scenario, law, _ = _unpack(case_or_pair)
     if transient is None:
         transient = default_transient(case_or_pair)
-    return _clean(scenario, law, int(periods), float(fs), int(transient),
-                  bool(record_transient))[3]
+    return _clean(scenario, law, int(periods), float(fs), int(transient), bool(record_transient))[3]
 
 
 # ------------------------------------------------------ verification properties
@@ -481,17 +529,17 @@ class Trial:
     bounce can count on one record and not on the other.)
     """
 
-    label: str               # "true", "drop zd", "z x1.3", ...
+    label: str  # "true", "drop zd", "z x1.3", ...
     law: ForceLaw
-    status: str              # Evaluation.status on the noisy record
+    status: str  # Evaluation.status on the noisy record
     consistent: bool
-    detectable: object       # True / False / None
-    i2: float                # on the noisy record (nan when not "ok")
-    floor_i2: float          # noise floor of I2 (nan when not "ok")
-    i2_clean: float          # against the noise-free record (nan when not "ok")
-    regime: str              # simulated regime on the noisy record
+    detectable: object  # True / False / None
+    i2: float  # on the noisy record (nan when not "ok")
+    floor_i2: float  # noise floor of I2 (nan when not "ok")
+    i2_clean: float  # against the noise-free record (nan when not "ok")
+    regime: str  # simulated regime on the noisy record
     verdict: str
-    i2_rule: bool = False    # same regime and I2 within its limit (the rule on I2 alone)
+    i2_rule: bool = False  # same regime and I2 within its limit (the rule on I2 alone)
 
 
 def _trial(label, scenario, law, ref, ref_clean, true):
@@ -505,19 +553,33 @@ def _trial(label, scenario, law, ref, ref_clean, true):
     i2c = evc.criteria.get("I2", nan)
     if true or "failed" in (ev.status, evc.status):
         detectable = None
-    elif evc.status != "ok" or (evc.regime["simulated"] is not None  # None: not computed
-                                and evc.regime["simulated"] != evc.regime["measured"]):
+    elif evc.status != "ok" or (
+        evc.regime["simulated"] is not None  # None: not computed
+        and evc.regime["simulated"] != evc.regime["measured"]
+    ):
         detectable = True
     else:
         limit = CONSISTENCY_FACTOR * floor + CONSISTENCY_SLACK if ev.status == "ok" else 0.0
         detectable = bool(i2c > limit)
-    same = ev.status == "ok" and ev.regime["simulated"] == ev.regime["measured"] \
+    same = (
+        ev.status == "ok"
+        and ev.regime["simulated"] == ev.regime["measured"]
         and ev.impacts["simulated"] == ev.impacts["measured"]
+    )
     i2_rule = bool(same and i2 <= CONSISTENCY_FACTOR * floor + CONSISTENCY_SLACK)
-    return Trial(label=label, law=law, status=ev.status, consistent=bool(ev.consistent),
-                 detectable=detectable, i2=i2, floor_i2=floor, i2_clean=i2c,
-                 regime=str(ev.regime["simulated"]), verdict=ev.verdict or ev.message,
-                 i2_rule=i2_rule)
+    return Trial(
+        label=label,
+        law=law,
+        status=ev.status,
+        consistent=bool(ev.consistent),
+        detectable=detectable,
+        i2=i2,
+        floor_i2=floor,
+        i2_clean=i2c,
+        regime=str(ev.regime["simulated"]),
+        verdict=ev.verdict or ev.message,
+        i2_rule=i2_rule,
+    )
 
 
 def verification_trials(case, noise_seed=0, *, wrong=True, **record_kw):

@@ -44,8 +44,10 @@ import realistic as R  # noqa: E402
 
 
 def _draw_table(args):
-    head = (f"{'category':<14} {'seed':>4} {'regime':<6} {'imp':>3} {'max|mu|':>7} "
-            f"{'contact':>7} {'tries':>5} {'draw s':>6} {'trans':>5} {'ref s':>6}  law")
+    head = (
+        f"{'category':<14} {'seed':>4} {'regime':<6} {'imp':>3} {'max|mu|':>7} "
+        f"{'contact':>7} {'tries':>5} {'draw s':>6} {'trans':>5} {'ref s':>6}  law"
+    )
     print(head)
     print("-" * len(head))
     for cat in args.categories.split(","):
@@ -60,19 +62,31 @@ def _draw_table(args):
             trans = R.default_transient(case)
             # the draw made (and checked) the noise-free default record: its time
             rec = f"{case.reference_seconds:6.1f}"
-            print(f"{cat:<14} {seed:>4} {case.regime:<6} {case.impacts:>3} "
-                  f"{case.max_multiplier:7.3f} {case.contact_fraction:7.3f} {case.tries:>5} "
-                  f"{t_draw:6.1f} {trans:>5} {rec:>6}  [{case.kind}] {case.law}"
-                  + (f"  (reference check dropped {len(case.reference_rejects)})"
-                     if case.reference_rejects else ""), flush=True)
+            print(
+                f"{cat:<14} {seed:>4} {case.regime:<6} {case.impacts:>3} "
+                f"{case.max_multiplier:7.3f} {case.contact_fraction:7.3f} {case.tries:>5} "
+                f"{t_draw:6.1f} {trans:>5} {rec:>6}  [{case.kind}] {case.law}"
+                + (
+                    f"  (reference check dropped {len(case.reference_rejects)})"
+                    if case.reference_rejects
+                    else ""
+                ),
+                flush=True,
+            )
 
 
 def rates(trials):
     """``{"true": (consistent, n), "wrong": (inconsistent, detectable n),
     "undetectable": n, "failed": n}`` over ``(category, seed, noise_seed, Trial)``; and
     ``"true_i2"``, ``"wrong_i2"``: the same by the rule on I2 alone."""
-    out = {"true": [0, 0], "wrong": [0, 0], "undetectable": 0, "failed": 0,
-           "true_i2": [0, 0], "wrong_i2": [0, 0]}
+    out = {
+        "true": [0, 0],
+        "wrong": [0, 0],
+        "undetectable": 0,
+        "failed": 0,
+        "true_i2": [0, 0],
+        "wrong_i2": [0, 0],
+    }
     for *_, tr in trials:
         if tr.label == "true":
             out["true"][0] += tr.consistent
@@ -100,8 +114,10 @@ def _properties(args):
     from discovery.verify import evaluate as ev_mod
 
     crit = getattr(sys.modules[ev_mod.__module__], "CONSISTENCY_CRITERIA", ("I2",))
-    print(f"consistency rule: {', '.join(crit)} <= {CONSISTENCY_FACTOR:g} x noise floor + "
-          f"{CONSISTENCY_SLACK:g}, same regime; noise seeds per case {args.noise_seeds}")
+    print(
+        f"consistency rule: {', '.join(crit)} <= {CONSISTENCY_FACTOR:g} x noise floor + "
+        f"{CONSISTENCY_SLACK:g}, same regime; noise seeds per case {args.noise_seeds}"
+    )
     all_trials = []
     t_start = time.perf_counter()
     for cat in args.categories.split(","):
@@ -123,32 +139,41 @@ def _properties(args):
                     continue
                 all_trials += [(cat, seed, ns, tr) for tr in trials]
                 r = rates([(cat, seed, ns, tr) for tr in trials])
-                print(f"{cat:<14} {seed:>4} n{ns} {case.regime:<3} imp {case.impacts} "
-                      f"contact {case.contact_fraction:.3f} [{case.kind}] true "
-                      f"{'ok ' if trials[0].consistent else 'BAD'} I2 {trials[0].i2:.3f} "
-                      f"(floor {trials[0].floor_i2:.3f}, clean {trials[0].i2_clean:.4f}); "
-                      f"wrong inconsistent {r['wrong'][0]}/{r['wrong'][1]} detectable "
-                      f"(+{r['undetectable']} undetectable, {r['failed']} failed)  "
-                      f"draw {t_draw:.1f} s, verify {time.perf_counter() - t1:.1f} s",
-                      flush=True)
+                print(
+                    f"{cat:<14} {seed:>4} n{ns} {case.regime:<3} imp {case.impacts} "
+                    f"contact {case.contact_fraction:.3f} [{case.kind}] true "
+                    f"{'ok ' if trials[0].consistent else 'BAD'} I2 {trials[0].i2:.3f} "
+                    f"(floor {trials[0].floor_i2:.3f}, clean {trials[0].i2_clean:.4f}); "
+                    f"wrong inconsistent {r['wrong'][0]}/{r['wrong'][1]} detectable "
+                    f"(+{r['undetectable']} undetectable, {r['failed']} failed)  "
+                    f"draw {t_draw:.1f} s, verify {time.perf_counter() - t1:.1f} s",
+                    flush=True,
+                )
                 for tr in trials:
                     bad = (tr.label == "true" and not tr.consistent) or (
-                        tr.label != "true" and tr.detectable and tr.consistent)
+                        tr.label != "true" and tr.detectable and tr.consistent
+                    )
                     if bad or args.verbose:
-                        print(f"    {'FAIL' if bad else '    '} {tr.label:<14} {tr.status:<11} "
-                              f"{tr.regime:<5} I2 {tr.i2:.4f} floor {tr.floor_i2:.4f} clean "
-                              f"{tr.i2_clean:.4f} detectable {tr.detectable}: {tr.verdict}",
-                              flush=True)
+                        print(
+                            f"    {'FAIL' if bad else '    '} {tr.label:<14} {tr.status:<11} "
+                            f"{tr.regime:<5} I2 {tr.i2:.4f} floor {tr.floor_i2:.4f} clean "
+                            f"{tr.i2_clean:.4f} detectable {tr.detectable}: {tr.verdict}",
+                            flush=True,
+                        )
     print()
-    print(f"{'category':<14} {'true law consistent':>24} {'wrong law inconsistent':>26} "
-          f"{'undetectable':>12} {'failed':>6}")
+    print(
+        f"{'category':<14} {'true law consistent':>24} {'wrong law inconsistent':>26} "
+        f"{'undetectable':>12} {'failed':>6}"
+    )
     by_cat = defaultdict(list)
     for row in all_trials:
         by_cat[row[0]].append(row)
     for cat, rows in [*by_cat.items(), ("all", all_trials)]:
         r = rates(rows)
-        print(f"{cat:<14} {_fmt_rate(*r['true']):>24} {_fmt_rate(*r['wrong']):>26} "
-              f"{r['undetectable']:>12} {r['failed']:>6}")
+        print(
+            f"{cat:<14} {_fmt_rate(*r['true']):>24} {_fmt_rate(*r['wrong']):>26} "
+            f"{r['undetectable']:>12} {r['failed']:>6}"
+        )
     if "I4" in crit:
         print("with the rule on I2 alone (same regime, I2 <= 2 x floor + 0.005):")
         for cat, rows in [*by_cat.items(), ("all", all_trials)]:
@@ -162,14 +187,21 @@ def main(argv=None):
     ap.add_argument("--n", type=int, default=5, help="cases per category")
     ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--categories", default=",".join(R.CATEGORIES))
-    ap.add_argument("--properties", action="store_true",
-                    help="verify the true and wrong laws on noisy records (rates)")
-    ap.add_argument("--noise-seeds", type=int, default=1,
-                    help="noisy records per case (with --properties)")
+    ap.add_argument(
+        "--properties",
+        action="store_true",
+        help="verify the true and wrong laws on noisy records (rates)",
+    )
+    ap.add_argument(
+        "--noise-seeds", type=int, default=1, help="noisy records per case (with --properties)"
+    )
     ap.add_argument("--verbose", action="store_true", help="every trial on its own line")
-    ap.add_argument("--field", action="store_true",
-                    help="the field-like setting (realistic.FIELD): slow P1 up to multiplier "
-                    "0.995, records after at most 250 periods from rest, 5 or 20 kHz")
+    ap.add_argument(
+        "--field",
+        action="store_true",
+        help="the field-like setting (realistic.FIELD): slow P1 up to multiplier "
+        "0.995, records after at most 250 periods from rest, 5 or 20 kHz",
+    )
     args = ap.parse_args(argv)
     if args.field:
         R.MAX_MULTIPLIER = R.FIELD["multiplier"]

@@ -33,29 +33,54 @@ MACHINES = {
 }
 
 
-def run(machine, seed, *, fs=20000.0, periods=12, force_noise=0.02, motion_noise=0.002,
-        n_boot=0):
+def run(machine, seed, *, fs=20000.0, periods=12, force_noise=0.02, motion_noise=0.002, n_boot=0):
     from discovery import load_scenario
 
     sc, text = MACHINES[machine]
     sc = sc or load_scenario("paper")
     law = ForceLaw.parse(text)
     t0 = time.perf_counter()
-    rec = R.reference_record((sc, law), periods=periods, fs=fs, force_noise=force_noise,
-                             motion_noise=motion_noise, seed=seed, check=False)
+    rec = R.reference_record(
+        (sc, law),
+        periods=periods,
+        fs=fs,
+        force_noise=force_noise,
+        motion_noise=motion_noise,
+        seed=seed,
+        check=False,
+    )
     rng = np.random.default_rng(1000 + seed)
-    start = law.with_coefficients([c * (1 + 0.2 * rng.choice([-1, 1]))
-                                   for c in law.coefficients])
+    start = law.with_coefficients([c * (1 + 0.2 * rng.choice([-1, 1])) for c in law.coefficients])
     ref = Reference.from_measurement(rec, sc)
-    res = identify(sc, ref, start, criterion="I2", method="least-squares",
-                   max_simulations=200, n_boot_intervals=n_boot, seed=seed)
+    res = identify(
+        sc,
+        ref,
+        start,
+        criterion="I2",
+        method="least-squares",
+        max_simulations=200,
+        n_boot_intervals=n_boot,
+        seed=seed,
+    )
     ev = evaluate(sc, res.law, ref)
-    row = {"machine": machine, "seed": seed, "law": text, "fs": fs, "periods": periods,
-           "force_noise": force_noise, "motion_noise": motion_noise,
-           "identified": res.law.as_dict(), "standard_errors": res.standard_errors,
-           "n_simulations": res.n_simulations, "seconds": time.perf_counter() - t0,
-           "covered": {}, "z_scores": {}, "consistent": bool(ev.consistent),
-           "I2": ev.criteria.get("I2"), "I2_floor": ev.noise_floor.get("I2")}
+    row = {
+        "machine": machine,
+        "seed": seed,
+        "law": text,
+        "fs": fs,
+        "periods": periods,
+        "force_noise": force_noise,
+        "motion_noise": motion_noise,
+        "identified": res.law.as_dict(),
+        "standard_errors": res.standard_errors,
+        "n_simulations": res.n_simulations,
+        "seconds": time.perf_counter() - t0,
+        "covered": {},
+        "z_scores": {},
+        "consistent": bool(ev.consistent),
+        "I2": ev.criteria.get("I2"),
+        "I2_floor": ev.noise_floor.get("I2"),
+    }
     for name, true in law.as_dict().items():
         c, se = res.law.as_dict()[name], res.standard_errors.get(name, float("nan"))
         row["z_scores"][name] = (c - true) / se if se > 0 else float("inf")
@@ -80,8 +105,10 @@ def summary(rows):
     if boot:
         print(f"bootstrap intervals: {sum(boot)}/{len(boot)} = {sum(boot) / len(boot):.1%}")
     allv = [ok for v in by.values() for ok in v]
-    print(f"Jacobian 95 % intervals: {sum(allv)}/{len(allv)} = "
-          f"{sum(allv) / max(len(allv), 1):.1%} ({len(rows)} records)")
+    print(
+        f"Jacobian 95 % intervals: {sum(allv)}/{len(allv)} = "
+        f"{sum(allv) / max(len(allv), 1):.1%} ({len(rows)} records)"
+    )
     for (m, name), v in sorted(by.items()):
         print(f"  {m:18s} {name:6s} {sum(v)}/{len(v)}")
 
@@ -90,8 +117,12 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--records", type=int, default=25, help="seeds per machine")
     p.add_argument("--machines", default=",".join(MACHINES))
-    p.add_argument("--bootstrap", type=int, default=0,
-                   help="replicates of the bootstrap intervals (0 = Jacobian only)")
+    p.add_argument(
+        "--bootstrap",
+        type=int,
+        default=0,
+        help="replicates of the bootstrap intervals (0 = Jacobian only)",
+    )
     p.add_argument("--summary", metavar="JSONL", help="summarise an earlier run's output")
     a = p.parse_args(argv)
     if a.summary:

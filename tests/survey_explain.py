@@ -42,8 +42,9 @@ def _hide(case, rng):
     draw."""
     law, sc = case.law, case.scenario
     if case.kind == "zzd":
-        base = ForceLaw.parse(" + ".join(f"{c!r}*{n}" for n, c in law.as_dict().items()
-                                         if n != "z*zd"))
+        base = ForceLaw.parse(
+            " + ".join(f"{c!r}*{n}" for n, c in law.as_dict().items() if n != "z*zd")
+        )
         return "penetration_velocity_coupling", sc, law, base
     if case.kind != "linear":
         return None
@@ -53,8 +54,7 @@ def _hide(case, rng):
         true = law.with_unloading(permanent_set=float(np.round(rng.uniform(0.2, 0.5), 2)))
     elif hidden == "unloading_damping":
         c = law.as_dict()["zd"]
-        true = law.with_unloading((law.terms[1],),
-                                  (float(np.round(rng.uniform(0.3, 0.8), 2)) * c,))
+        true = law.with_unloading((law.terms[1],), (float(np.round(rng.uniform(0.3, 0.8), 2)) * c,))
     elif hidden == "support_nonlinearity":
         x = abs(float(sc.initial_state()[0])) + sc.scales()[0]
         true_sc = sc.replace(k3=float(f"{rng.uniform(0.1, 0.5) * sc.k1 / x**2:.2e}"))
@@ -66,8 +66,7 @@ def draw(i):
     cat = CATEGORIES[i % len(CATEGORIES)]
     seed = 1000 + i
     prov = provenance()
-    row = {"i": i, "category": cat, "seed": seed, "versions": prov["versions"],
-           "git": prov["git"]}
+    row = {"i": i, "category": cat, "seed": seed, "versions": prov["versions"], "git": prov["git"]}
     try:
         case = R.draw_case(cat, seed)
     except RuntimeError as exc:
@@ -76,23 +75,34 @@ def draw(i):
     if got is None:
         return {**row, "skip": f"{case.kind} law (no linear start)"}
     hidden, true_sc, true, base = got
-    row.update(regime=case.regime, impacts=case.impacts, hidden=hidden, true=true.to_text(),
-               k3=true_sc.k3, start=base.to_text())
+    row.update(
+        regime=case.regime,
+        impacts=case.impacts,
+        hidden=hidden,
+        true=true.to_text(),
+        k3=true_sc.k3,
+        start=base.to_text(),
+    )
     sc = case.scenario.with_law(base)
     try:
-        rec = R.reference_record((true_sc.with_law(true), true), periods=15, seed=seed,
-                                 check=False)
+        rec = R.reference_record((true_sc.with_law(true), true), periods=15, seed=seed, check=False)
         ev = evaluate(true_sc, true, Reference.from_measurement(rec, sc, n_boot=16, seed=0))
         row.update(true_consistent=ev.consistent, true_verdict=ev.verdict)
         t0 = time.perf_counter()
         res = explain(sc, rec, "linear")
-        row.update(seconds=time.perf_counter() - t0,
-                   named=[it.effect for it in res.iterations if it.effect],
-                   I2_start=(res.iterations[0].criteria_before if res.iterations
-                             else res.criteria).get("I2"),
-                   I2_final=res.criteria.get("I2"), floor=res.noise_floor.get("I2"),
-                   start_consistent=not res.iterations, consistent=res.consistent,
-                   stopped=res.stopped_because, final=str(res.final_model))
+        row.update(
+            seconds=time.perf_counter() - t0,
+            named=[it.effect for it in res.iterations if it.effect],
+            I2_start=(res.iterations[0].criteria_before if res.iterations else res.criteria).get(
+                "I2"
+            ),
+            I2_final=res.criteria.get("I2"),
+            floor=res.noise_floor.get("I2"),
+            start_consistent=not res.iterations,
+            consistent=res.consistent,
+            stopped=res.stopped_because,
+            final=str(res.final_model),
+        )
     except Exception as exc:  # noqa: BLE001 (a survey row records any failure)
         row["error"] = f"{type(exc).__name__}: {exc}"
     return row
@@ -121,8 +131,9 @@ def outcome(r):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--draws", nargs=2, type=int, metavar=("FIRST", "STOP"),
-                    help="draw indices FIRST .. STOP-1")
+    ap.add_argument(
+        "--draws", nargs=2, type=int, metavar=("FIRST", "STOP"), help="draw indices FIRST .. STOP-1"
+    )
     ap.add_argument("--out", help="JSON-lines file the rows are appended to")
     ap.add_argument("--summary", help="count the outcomes of a JSON-lines file")
     args = ap.parse_args(argv)
@@ -130,8 +141,10 @@ def main(argv=None):
         with open(args.summary) as f:
             rows = [json.loads(line) for line in f]
         for r in rows:
-            print(f"{r['i']:3d} {r['category']:14s} {r.get('regime', '-'):4s} "
-                  f"{r.get('hidden', '-'):30s} {outcome(r)}")
+            print(
+                f"{r['i']:3d} {r['category']:14s} {r.get('regime', '-'):4s} "
+                f"{r.get('hidden', '-'):30s} {outcome(r)}"
+            )
         print(dict(collections.Counter(outcome(r) for r in rows)))
         return 0
     if not (args.draws and args.out):

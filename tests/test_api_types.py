@@ -32,10 +32,13 @@ CASES = [
     ("Term bool", lambda: d.Term(True, 0), TYPE, "a"),
     ("ForceLaw terms text", lambda: d.ForceLaw("z", (1.0,)), TYPE, "terms"),
     ("ForceLaw term not Term", lambda: d.ForceLaw((5,), (1.0,)), TYPE, "term"),
-    ("ForceLaw coefficient text", lambda: d.ForceLaw((d.Term(1, 0),), ("a",)), TYPE,
-     "coefficient"),
-    ("ForceLaw set 2", lambda: d.ForceLaw((d.Term(1, 0),), (1.0,), permanent_set=2.0), VALUE,
-     "permanent_set"),
+    ("ForceLaw coefficient text", lambda: d.ForceLaw((d.Term(1, 0),), ("a",)), TYPE, "coefficient"),
+    (
+        "ForceLaw set 2",
+        lambda: d.ForceLaw((d.Term(1, 0),), (1.0,), permanent_set=2.0),
+        VALUE,
+        "permanent_set",
+    ),
     ("ForceLaw.parse int", lambda: d.ForceLaw.parse(5), VALUE, "text"),
     ("law exponent 1e300", lambda: d.ForceLaw.parse("2e8*z^1e300"), VALUE, "exponent"),
     ("Scenario name int", lambda: d.Scenario(1, 1, 1, 1, 1, 1, name=5), TYPE, "name"),
@@ -43,10 +46,8 @@ CASES = [
     ("Scenario law text", lambda: d.Scenario(1, 1, 1, 1, 1, 1, law="2e8*z"), TYPE, "law"),
     ("Measurement t text", lambda: d.Measurement(t="abc", F=F), TYPE, "t"),
     ("Measurement F 2-D", lambda: d.Measurement(t=T, F=np.zeros((50, 2))), VALUE, "F"),
-    ("Measurement channels list", lambda: d.Measurement(t=T, F=F, channels=[1]), TYPE,
-     "channels"),
-    ("Measurement channel text", lambda: d.Measurement(t=T, F=F, channels={"w1": "x"}), TYPE,
-     "w1"),
+    ("Measurement channels list", lambda: d.Measurement(t=T, F=F, channels=[1]), TYPE, "channels"),
+    ("Measurement channel text", lambda: d.Measurement(t=T, F=F, channels={"w1": "x"}), TYPE, "w1"),
     ("Tolerances rtol text", lambda: d.Tolerances(rtol="a"), TYPE, "rtol"),
     ("Tolerances max_steps float", lambda: d.Tolerances(max_steps=1.5), TYPE, "max_steps"),
     ("simulate scenario text", lambda: d.simulate("paper", LAW, (0, 0.1)), TYPE, "scenario"),
@@ -54,10 +55,18 @@ CASES = [
     ("simulate t_span text", lambda: d.simulate(SC, LAW, "0,1"), TYPE, "t_span"),
     ("simulate unknown keyword", lambda: d.simulate(SC, LAW, (0, 1), t_end=1), TYPE, "t_end"),
     ("steady_state law int", lambda: d.steady_state(SC, 5), TYPE, "law"),
-    ("steady_state max_period 0", lambda: d.steady_state(SC, LAW, max_period=0), VALUE,
-     "max_period"),
-    ("steady_state tolerances dict", lambda: d.steady_state(SC, LAW, tolerances={}), TYPE,
-     "tolerances"),
+    (
+        "steady_state max_period 0",
+        lambda: d.steady_state(SC, LAW, max_period=0),
+        VALUE,
+        "max_period",
+    ),
+    (
+        "steady_state tolerances dict",
+        lambda: d.steady_state(SC, LAW, tolerances={}),
+        TYPE,
+        "tolerances",
+    ),
     ("Library text", lambda: d.Library("z"), TYPE, "terms"),
     ("Library of ints", lambda: d.Library([5]), TYPE, "term"),
     ("discover scenario int", lambda: d.discover(5, REC), TYPE, "scenario"),
@@ -72,12 +81,20 @@ CASES = [
     ("study executor text", lambda: d.study({}, "out", executor="pool"), TYPE, "executor"),
     ("load_study list", lambda: d.load_study([1]), TYPE, "path_or_mapping"),
     ("field_record law text", lambda: d.field_record(SC, "2e8*z"), TYPE, "law"),
-    ("field_record noise 2", lambda: d.field_record(SC, LAW, force_noise=2.0), VALUE,
-     "force_noise"),
+    (
+        "field_record noise 2",
+        lambda: d.field_record(SC, LAW, force_noise=2.0),
+        VALUE,
+        "force_noise",
+    ),
     ("make_executor workers text", lambda: d.make_executor("2"), TYPE, "workers"),
     ("landscape axis text", lambda: d.landscape(SC, LAW, "1,2", [1, 2]), TYPE, "axis0"),
-    ("landscape workers 0", lambda: d.landscape(SC, LAW, [1, 2], [1, 2], workers=0), VALUE,
-     "workers"),
+    (
+        "landscape workers 0",
+        lambda: d.landscape(SC, LAW, [1, 2], [1, 2], workers=0),
+        VALUE,
+        "workers",
+    ),
     ("explain alpha 2", lambda: d.explain(SC, REC, alpha=2.0), VALUE, "alpha"),
     ("explain start int", lambda: d.explain(SC, REC, start=5), TYPE, "start"),
     ("impulse period 0", lambda: d.impulse_from_samples(T, F, 0.0), VALUE, "period"),
@@ -95,8 +112,7 @@ CASES = [
     ("ueda discover nu 0", lambda: osc.discover(T, F, 0.9, 0.0), VALUE, "nu"),
     ("ueda explain alpha text", lambda: osc.explain(T, F, 0.9, 1.0, alpha="a"), TYPE, "alpha"),
     ("ueda periodic n 0", lambda: osc.periodic_orbit(UEDA, [0.0, 0.0], n=0), VALUE, "n"),
-    ("ueda record periods text", lambda: osc.simulate_record(UEDA, periods="a"), TYPE,
-     "periods"),
+    ("ueda record periods text", lambda: osc.simulate_record(UEDA, periods="a"), TYPE, "periods"),
 ]
 
 
@@ -115,25 +131,84 @@ def test_wrong_argument_is_refused_at_the_boundary(call, error, name):
 def test_the_cases_cover_every_public_entry():
     """A new public function or class must get a row here."""
     covered = " ".join(c[0] for c in CASES).lower()
-    entries = ["term", "forcelaw", "scenario", "measurement", "tolerances", "simulate",
-               "steady_state", "library", "discover", "identify", "verify",
-               "landscape", "explain", "impulse", "synthesize", "response", "contact_samples",
-               "evaluate_criteria", "ueda strobe", "ueda lyapunov", "ueda attractor",
-               "ueda chart", "ueda discover", "ueda explain", "ueda periodic", "ueda record"]
+    entries = [
+        "term",
+        "forcelaw",
+        "scenario",
+        "measurement",
+        "tolerances",
+        "simulate",
+        "steady_state",
+        "library",
+        "discover",
+        "identify",
+        "verify",
+        "landscape",
+        "explain",
+        "impulse",
+        "synthesize",
+        "response",
+        "contact_samples",
+        "evaluate_criteria",
+        "ueda strobe",
+        "ueda lyapunov",
+        "ueda attractor",
+        "ueda chart",
+        "ueda discover",
+        "ueda explain",
+        "ueda periodic",
+        "ueda record",
+    ]
     missing = [e for e in entries if e not in covered]
     assert not missing, missing
     public = {n for n in d.__all__ if callable(getattr(d, n)) and not n.endswith("Error")}
-    data_only = {"SteadyState", "Landscape", "DiscoveryResult", "RankedModel", "Impulse",
-                 "Response", "ContactSamples", "Candidate", "IdentificationResult",
-                 "ExplainResult", "builtin_scenarios", "load_scenario",
-                 "impulse_from_steady_state", "Report", "report", "StudyResult",
-                 "Executor",
-                 # a scikit-learn estimator checks its parameters in fit, not in __init__
-                 # (tests/test_regression.py)
-                 "ConstrainedSparseRegressor"}
-    unlisted = public - data_only - {
-        "Term", "ForceLaw", "Scenario", "Measurement", "Tolerances", "simulate", "steady_state",
-        "Library", "discover", "identify", "landscape",
-        "explain", "impulse_from_samples", "synthesize", "response", "contact_samples",
-        "evaluate_criteria", "study", "load_study", "field_record", "make_executor"}
+    data_only = {
+        "SteadyState",
+        "Landscape",
+        "DiscoveryResult",
+        "RankedModel",
+        "Impulse",
+        "Response",
+        "ContactSamples",
+        "Candidate",
+        "IdentificationResult",
+        "ExplainResult",
+        "builtin_scenarios",
+        "load_scenario",
+        "impulse_from_steady_state",
+        "Report",
+        "report",
+        "StudyResult",
+        "Executor",
+        # a scikit-learn estimator checks its parameters in fit, not in __init__
+        # (tests/test_regression.py)
+        "ConstrainedSparseRegressor",
+    }
+    unlisted = (
+        public
+        - data_only
+        - {
+            "Term",
+            "ForceLaw",
+            "Scenario",
+            "Measurement",
+            "Tolerances",
+            "simulate",
+            "steady_state",
+            "Library",
+            "discover",
+            "identify",
+            "landscape",
+            "explain",
+            "impulse_from_samples",
+            "synthesize",
+            "response",
+            "contact_samples",
+            "evaluate_criteria",
+            "study",
+            "load_study",
+            "field_record",
+            "make_executor",
+        }
+    )
     assert not unlisted, f"public entries without a row: {sorted(unlisted)}"

@@ -61,8 +61,7 @@ SCENARIOS = {
 
 
 def _table(t, F):
-    return "t,F\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), F.tolist(),
-                                                             strict=True))
+    return "t,F\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), F.tolist(), strict=True))
 
 
 @pytest.fixture(scope="module")
@@ -84,9 +83,12 @@ def workspace(tmp_path_factory, paper):
         "emptycell.csv": "t,F\n0,0\n1e-4,\n2e-4,0\n3e-4,0\n",
         "textcell.csv": "t,F\n0,0\n1e-4,12 kN\n2e-4,0\n3e-4,0\n",
         "shortrow.csv": "t,F,w1\n0,0,0\n1e-4,0\n2e-4,0,0\n3e-4,0,0\n",
-        "hugeF.csv": text.replace("\n", "\n", 1).splitlines()[0] + "\n" + "\n".join(
-            ln if i != 5 else "0.00025,1e300,0,0,0,0"
-            for i, ln in enumerate(text.splitlines()[1:])) + "\n",
+        "hugeF.csv": text.replace("\n", "\n", 1).splitlines()[0]
+        + "\n"
+        + "\n".join(
+            ln if i != 5 else "0.00025,1e300,0,0,0,0" for i, ln in enumerate(text.splitlines()[1:])
+        )
+        + "\n",
         "hugew.csv": "t,F,w1\n0,0,0\n1e-4,0,2e4\n2e-4,0,0\n3e-4,0,0\n",
         "dup.csv": "t,F\n0,0\n1e-4,1\n1e-4,2\n3e-4,0\n4e-4,0\n",
         "decreasing.csv": "t,F\n0,0\n2e-4,1\n1e-4,2\n3e-4,0\n",
@@ -135,8 +137,13 @@ def _snapshot(root):
             if stat.S_ISREG(st.st_mode):
                 with open(p, "rb") as fh:
                     digest = hashlib.sha256(fh.read()).hexdigest()
-            snap[os.path.relpath(p, root)] = (stat.S_IFMT(st.st_mode), st.st_mode & 0o7777,
-                                              st.st_size, st.st_mtime_ns, digest)
+            snap[os.path.relpath(p, root)] = (
+                stat.S_IFMT(st.st_mode),
+                st.st_mode & 0o7777,
+                st.st_size,
+                st.st_mtime_ns,
+                digest,
+            )
     return snap
 
 
@@ -151,8 +158,11 @@ def _verify_data(name, *extra):
 CASES = [
     # ---------------------------------------------------------------- the command line
     ("unknown-command", ["simulat"], "unknown command 'simulat'; choose one of"),
-    ("unknown-option", ["steady", "--bogus"], "unrecognized option(s) or value(s) --bogus; "
-                                              "see vidi steady --help"),
+    (
+        "unknown-option",
+        ["steady", "--bogus"],
+        "unrecognized option(s) or value(s) --bogus; see vidi steady --help",
+    ),
     ("stray-value", ["steady", "paper"], "unrecognized option(s) or value(s) paper"),
     ("missing-required", ["verify", "--data", "good.csv"], "missing required option(s) --out"),
     ("missing-all-required", ["verify"], "missing required option(s) --data, --out"),
@@ -168,19 +178,34 @@ CASES = [
     ("law-negative-exponent", ["steady", "--law", "1e8*z^-1"], "negative exponent"),
     ("law-overflow", ["steady", "--law", "1e999*z"], "must be a finite number"),
     ("too-stiff", ["steady", "--law", "1e308*z + 1e7*zd"], "too stiff for this machine"),
-    ("orphan-time-offset", ["landscape", "--time-offset", "0.1", "--grid", "3x3", "--out",
-                            "r9"], "--time-offset acts only with --data"),
-    ("orphan-columns", ["landscape", "--columns", "F=force", "--out", "r9"],
-     "--columns acts only with --data"),
-    ("orphan-budget", ["fit", "--data", "rec.csv", "--no-refine", "--max-simulations", "5",
-                       "--out", "r9"], "has no effect with --no-refine"),
-    ("exponent-too-large", ["fit", "--data", "rec.csv", "--library", "z,zd,z^1e4", "--out",
-                            "r9"], "exponent 10000 on z is above 10"),
+    (
+        "orphan-time-offset",
+        ["landscape", "--time-offset", "0.1", "--grid", "3x3", "--out", "r9"],
+        "--time-offset acts only with --data",
+    ),
+    (
+        "orphan-columns",
+        ["landscape", "--columns", "F=force", "--out", "r9"],
+        "--columns acts only with --data",
+    ),
+    (
+        "orphan-budget",
+        ["fit", "--data", "rec.csv", "--no-refine", "--max-simulations", "5", "--out", "r9"],
+        "has no effect with --no-refine",
+    ),
+    (
+        "exponent-too-large",
+        ["fit", "--data", "rec.csv", "--library", "z,zd,z^1e4", "--out", "r9"],
+        "exponent 10000 on z is above 10",
+    ),
     ("law-code", ["steady", "--law", "__import__('os')"], "cannot read force law"),
     ("law-never-pushes", ["steady", "--law=-1e8*z"], "never pushes the bodies apart"),
     ("law-all-zero", ["steady", "--law", "0*z"], "has no non-zero coefficient"),
-    ("law-not-dissipative", ["steady", "--law", "2.06e8*z - 1e9*zd"],
-     "condition (6), dissipativity"),
+    (
+        "law-not-dissipative",
+        ["steady", "--law", "2.06e8*z - 1e9*zd"],
+        "condition (6), dissipativity",
+    ),
     ("verify-law-never-pushes", [*V, "--law=-2e8*z - 1e7*zd"], "never pushes"),
     ("law-dangling-op", ["steady", "--law", "1e8*z +"], "expected a number, 'z' or 'zd'"),
     ("law-missing-star", ["steady", "--law", "1e8 z"], "expected '*' between factors"),
@@ -191,8 +216,11 @@ CASES = [
     ("scenario-missing", ["steady", "--scenario", "nope.toml"], "does not exist"),
     ("scenario-directory", ["steady", "--scenario", "adir"], "is a directory"),
     ("scenario-empty", ["steady", "--scenario", ""], "the scenario is empty"),
-    ("scenario-bool", ["steady", "--scenario", "bool.toml"], "m1 must be a number in kg, got a "
-                                                             "boolean"),
+    (
+        "scenario-bool",
+        ["steady", "--scenario", "bool.toml"],
+        "m1 must be a number in kg, got a boolean",
+    ),
     ("scenario-text", ["steady", "--scenario", "text.toml"], "got text '1.0e4'"),
     ("scenario-nan", ["steady", "--scenario", "nan.toml"], "scenario c1 = nan N s/m is invalid"),
     ("scenario-inf", ["steady", "--scenario", "infk.toml"], "scenario k1 = inf"),
@@ -200,11 +228,17 @@ CASES = [
     ("scenario-huge-m", ["steady", "--scenario", "hugem.toml"], "<= 1e+09 kg"),
     ("scenario-negative-m", ["steady", "--scenario", "negm.toml"], "must be finite, > 0"),
     ("scenario-zero-f", ["steady", "--scenario", "zerof.toml"], "frequency = 0 Hz is invalid"),
-    ("scenario-unknown-table", ["steady", "--scenario", "table.toml"],
-     "unknown table(s) or key(s) solver; valid are name, [machine], [law], [initial]"),
+    (
+        "scenario-unknown-table",
+        ["steady", "--scenario", "table.toml"],
+        "unknown table(s) or key(s) solver; valid are name, [machine], [law], [initial]",
+    ),
     ("scenario-table-typo", ["steady", "--scenario", "typo.toml"], "machnie"),
-    ("scenario-unknown-key", ["steady", "--scenario", "key.toml"],
-     "unknown [machine] key(s) mass3; valid keys are m1, m2"),
+    (
+        "scenario-unknown-key",
+        ["steady", "--scenario", "key.toml"],
+        "unknown [machine] key(s) mass3; valid keys are m1, m2",
+    ),
     ("scenario-law-key", ["steady", "--scenario", "lawkey.toml"], "unknown [law] key(s) txt"),
     ("scenario-law-empty", ["steady", "--scenario", "emptylaw.toml"], "[law] needs text"),
     ("scenario-law-syntax", ["steady", "--scenario", "badlaw.toml"], "cannot read force law"),
@@ -217,8 +251,11 @@ CASES = [
     ("simulate-scenario-bool", [*S, "--scenario", "bool.toml"], "got a boolean"),
     ("verify-scenario-table", [*V, "--scenario", "table.toml"], "unknown table(s)"),
     # ------------------------------------------------------------- simulate options
-    ("periods-zero", [*S, "--periods", "0"], "--periods: '0' is out of range; give an integer "
-                                             ">= 1"),
+    (
+        "periods-zero",
+        [*S, "--periods", "0"],
+        "--periods: '0' is out of range; give an integer >= 1",
+    ),
     ("periods-negative", [*S, "--periods", "-3"], "--periods: '-3' is out of range"),
     ("periods-fraction", [*S, "--periods", "2.5"], "'2.5' is not an integer"),
     ("periods-text", [*S, "--periods", "ten"], "'ten' is not an integer"),
@@ -229,8 +266,11 @@ CASES = [
     ("fs-inf", [*S, "--fs", "inf"], "--fs: 'inf' is out of range"),
     ("fs-text", [*S, "--fs", "20kHz"], "--fs: '20kHz' is not a number"),
     ("fs-1e9", [*S, "--fs", "1e9"], "<= 1e+08 Hz"),
-    ("samples-too-many", [*S, "--fs", "5e7", "--periods", "100"],
-     "is 2e+08 samples; the limit is 1e+07: lower --fs or --periods"),
+    (
+        "samples-too-many",
+        [*S, "--fs", "5e7", "--periods", "100"],
+        "is 2e+08 samples; the limit is 1e+07: lower --fs or --periods",
+    ),
     ("samples-too-few", [*S, "--fs", "10", "--periods", "1"], "only 0.4 samples"),
     ("noise-negative", [*S, "--noise", "-0.1"], "--noise: '-0.1' is out of range"),
     ("noise-nan", [*S, "--noise", "nan"], "--noise: 'nan' is out of range"),
@@ -239,51 +279,98 @@ CASES = [
     ("seed-negative", [*S, "--seed", "-1"], "--seed: '-1' is out of range; give an integer >= 0"),
     ("seed-fraction", [*S, "--seed", "1.5"], "--seed: '1.5' is not an integer"),
     # ------------------------------------------------ silently accepted before (issue 16)
-    ("repeated-law", ["steady", "--law", "1e8*z", "--law", "2e8*z", "--out", "res2"],
-     "--law is given twice"),
-    ("repeated-data", ["verify", "--data", "good.csv", "--data", "good.csv", "--out", "res"],
-     "--data is given twice"),
-    ("repeated-scenario", ["steady", "--scenario", "paper", "--scenario=light", "--out", "r3"],
-     "--scenario is given twice"),
-    ("denormal-spring", ["steady", "--law", "1e-320*z", "--out", "r4"],
-     "below the smallest normal number"),
-    ("fullwidth-digit-law", ["steady", "--law", "\uff12e8*z", "--out", "r5"],
-     "cannot read force law"),
-    ("fullwidth-digit-option", ["simulate", "--periods", "\uff13", "--out", "r6.csv"],
-     "is not an integer"),
-    ("huge-law", ["steady", "--law", " + ".join(f"{k + 1}*z^{1 + k / 20:g}" for k in range(150)),
-                  "--out", "r7"], "a contact law has a few"),
+    (
+        "repeated-law",
+        ["steady", "--law", "1e8*z", "--law", "2e8*z", "--out", "res2"],
+        "--law is given twice",
+    ),
+    (
+        "repeated-data",
+        ["verify", "--data", "good.csv", "--data", "good.csv", "--out", "res"],
+        "--data is given twice",
+    ),
+    (
+        "repeated-scenario",
+        ["steady", "--scenario", "paper", "--scenario=light", "--out", "r3"],
+        "--scenario is given twice",
+    ),
+    (
+        "denormal-spring",
+        ["steady", "--law", "1e-320*z", "--out", "r4"],
+        "below the smallest normal number",
+    ),
+    (
+        "fullwidth-digit-law",
+        ["steady", "--law", "\uff12e8*z", "--out", "r5"],
+        "cannot read force law",
+    ),
+    (
+        "fullwidth-digit-option",
+        ["simulate", "--periods", "\uff13", "--out", "r6.csv"],
+        "is not an integer",
+    ),
+    (
+        "huge-law",
+        [
+            "steady",
+            "--law",
+            " + ".join(f"{k + 1}*z^{1 + k / 20:g}" for k in range(150)),
+            "--out",
+            "r7",
+        ],
+        "a contact law has a few",
+    ),
     # -------------------------------------------------------------- simulate --out
     ("simulate-out-empty", ["simulate", "--out", ""], "--out is empty"),
     ("simulate-out-directory", ["simulate", "--out", "adir"], "is a directory; give a file"),
     ("simulate-out-not-csv", ["simulate", "--out", "rec.txt"], "must name a .csv file"),
-    ("simulate-out-is-scenario", ["simulate", "--scenario", "good.toml", "--out", "good.toml"],
-     "is the input file"),
-    ("simulate-out-parent-file", ["simulate", "--out", "afile/x.csv"],
-     "is a file, not a directory"),
+    (
+        "simulate-out-is-scenario",
+        ["simulate", "--scenario", "good.toml", "--out", "good.toml"],
+        "is the input file",
+    ),
+    (
+        "simulate-out-parent-file",
+        ["simulate", "--out", "afile/x.csv"],
+        "is a file, not a directory",
+    ),
     ("simulate-out-unwritable", ["simulate", "--out", "/proc/self/x.csv"], "cannot write in"),
     ("simulate-summary-is-dir", ["simulate", "--out", "summ.csv"], "summary"),
     # ---------------------------------------------------------------- output dirs
     ("steady-out-empty", ["steady", "--out", ""], "--out is empty"),
     ("steady-out-file", ["steady", "--out", "afile"], "is an existing file"),
-    ("steady-out-input", ["steady", "--scenario", "good.toml", "--out", "good.toml"],
-     "is the input file"),
+    (
+        "steady-out-input",
+        ["steady", "--scenario", "good.toml", "--out", "good.toml"],
+        "is the input file",
+    ),
     ("steady-out-cwd", ["steady", "--out", "."], "is the current directory"),
     ("steady-out-parent", ["steady", "--out", ".."], "is the current directory or above it"),
     ("steady-out-not-result", ["steady", "--out", "adir"], "not an earlier vidi result"),
     ("steady-out-unwritable", ["steady", "--out", "/proc/self/out"], "cannot write in"),
     ("steady-out-parent-file", ["steady", "--out", "afile/out"], "is a file, not a directory"),
     ("verify-out-empty", ["verify", "--data", "good.csv", "--out", ""], "--out is empty"),
-    ("verify-out-is-data", ["verify", "--data", "good.csv", "--out", "good.csv"],
-     "is the input file"),
-    ("verify-out-holds-data", ["verify", "--data", "datadir/in.csv", "--out", "datadir"],
-     "holds the input file"),
-    ("verify-out-file", ["verify", "--data", "good.csv", "--out", "afile"],
-     "is an existing file"),
-    ("verify-out-not-result", ["verify", "--data", "good.csv", "--out", "adir"],
-     "not an earlier vidi result"),
-    ("verify-out-unwritable", ["verify", "--data", "good.csv", "--out", "/proc/self/v"],
-     "cannot write in"),
+    (
+        "verify-out-is-data",
+        ["verify", "--data", "good.csv", "--out", "good.csv"],
+        "is the input file",
+    ),
+    (
+        "verify-out-holds-data",
+        ["verify", "--data", "datadir/in.csv", "--out", "datadir"],
+        "holds the input file",
+    ),
+    ("verify-out-file", ["verify", "--data", "good.csv", "--out", "afile"], "is an existing file"),
+    (
+        "verify-out-not-result",
+        ["verify", "--data", "good.csv", "--out", "adir"],
+        "not an earlier vidi result",
+    ),
+    (
+        "verify-out-unwritable",
+        ["verify", "--data", "good.csv", "--out", "/proc/self/v"],
+        "cannot write in",
+    ),
     # -------------------------------------------------------------- verify options
     ("n-boot-zero", [*V, "--n-boot", "0"], "--n-boot: '0' is out of range"),
     ("n-boot-negative", [*V, "--n-boot", "-4"], "--n-boot: '-4' is out of range"),
@@ -335,58 +422,94 @@ CASES += [
     ("fit-margin-negative", [*F, "--margin", "-1"], "--margin: '-1' is out of range"),
     ("fit-seed-negative", [*F, "--seed", "-1"], "--seed: '-1' is out of range"),
     ("fit-budget-one", [*F, "--max-simulations", "1"], "--max-simulations: '1' is out of range"),
-    ("fit-out-is-input", ["fit", "--data", "good.csv", "--out", "good.csv"],
-     "is the input file 'good.csv'"),
-    ("fit-out-is-file", ["fit", "--data", "good.csv", "--out", "afile"], 'is an existing file'),
-    ("fit-out-empty", ["fit", "--data", "good.csv", "--out", ""], '--out is empty'),
-    ("fit-out-foreign-dir", ["fit", "--data", "good.csv", "--out", "adir"],
-     'not an earlier vidi result'),
+    (
+        "fit-out-is-input",
+        ["fit", "--data", "good.csv", "--out", "good.csv"],
+        "is the input file 'good.csv'",
+    ),
+    ("fit-out-is-file", ["fit", "--data", "good.csv", "--out", "afile"], "is an existing file"),
+    ("fit-out-empty", ["fit", "--data", "good.csv", "--out", ""], "--out is empty"),
+    (
+        "fit-out-foreign-dir",
+        ["fit", "--data", "good.csv", "--out", "adir"],
+        "not an earlier vidi result",
+    ),
     ("fit-select-unknown", [*F, "--select", "nope"], "--select: invalid choice 'nope'"),
     ("fit-score-unknown", [*F, "--score", "r2"], "--score: invalid choice 'r2'"),
     ("fit-criterion-unknown", [*F, "--criterion", "I9"], "--criterion: invalid choice 'I9'"),
     ("fit-library-bad", [*F, "--library", "+"], "library '+' names no terms"),
-    ("fit-data-missing", ["fit", "--data", "missing.csv", "--out", "fitres"],
-     "'missing.csv' does not exist"),
+    (
+        "fit-data-missing",
+        ["fit", "--data", "missing.csv", "--out", "fitres"],
+        "'missing.csv' does not exist",
+    ),
     ("fit-data-dir", ["fit", "--data", "adir", "--out", "fitres"], "'adir' is a directory"),
     ("fit-columns-absent", [*F, "--columns", "t=time"], "has no column 'time'"),
-    ("fit-scenarios-mismatch", [*F, "--data", "good.csv", *["--scenario", "paper"] * 3],
-     'one --scenario per --data'),
-    ("fit-scenario-bool", [*F, "--scenario", "bool.toml"], 'got a boolean'),
-    ("fit-data-nan", ["fit", "--data", "nan.csv", "--out", "fitres"],
-     "non-finite value 'nan' at line 3"),
-    ("fit-data-no-positions", ["fit", "--data", "cutoff.csv", "--out", "fitres"],
-     'needs the positions w1 and w2'),
-    ("identify-start-empty", ["identify", "--data", "good.csv", "--start", "", "--out", "idres"],
-     '--start is empty'),
-    ("identify-start-missing", ["identify", "--data", "good.csv", "--out", "idres"],
-     'missing required option(s) --start'),
+    (
+        "fit-scenarios-mismatch",
+        [*F, "--data", "good.csv", *["--scenario", "paper"] * 3],
+        "one --scenario per --data",
+    ),
+    ("fit-scenario-bool", [*F, "--scenario", "bool.toml"], "got a boolean"),
+    (
+        "fit-data-nan",
+        ["fit", "--data", "nan.csv", "--out", "fitres"],
+        "non-finite value 'nan' at line 3",
+    ),
+    (
+        "fit-data-no-positions",
+        ["fit", "--data", "cutoff.csv", "--out", "fitres"],
+        "needs the positions w1 and w2",
+    ),
+    (
+        "identify-start-empty",
+        ["identify", "--data", "good.csv", "--start", "", "--out", "idres"],
+        "--start is empty",
+    ),
+    (
+        "identify-start-missing",
+        ["identify", "--data", "good.csv", "--out", "idres"],
+        "missing required option(s) --start",
+    ),
     ("identify-xtol-negative", [*I, "--xtol", "-1"], "--xtol: '-1' is out of range"),
     ("identify-xtol-nan", [*I, "--xtol", "nan"], "--xtol: 'nan' is out of range"),
-    ("identify-budget-one", [*I, "--max-simulations", "1"],
-     "--max-simulations: '1' is out of range"),
+    (
+        "identify-budget-one",
+        [*I, "--max-simulations", "1"],
+        "--max-simulations: '1' is out of range",
+    ),
     ("identify-method-unknown", [*I, "--method", "simplex"], "--method: invalid choice 'simplex'"),
     ("identify-landscape-dir", [*I, "--landscape", "adir"], "--landscape 'adir'"),
     ("identify-landscape-file", [*I, "--landscape", "afile"], "--landscape 'afile'"),
-    ("identify-out-is-input", [*I[:-1], "good.csv"],
-     "is the input file 'good.csv'"),
-    ("identify-start-zero", [*I[:4], "0*z + 1e7*zd", *I[5:]], 'must be non-zero'),
+    ("identify-out-is-input", [*I[:-1], "good.csv"], "is the input file 'good.csv'"),
+    ("identify-start-zero", [*I[:4], "0*z + 1e7*zd", *I[5:]], "must be non-zero"),
     ("identify-start-not-dissipative", [*I[:4], "2e8*z - 1e7*zd", *I[5:]], "condition (6)"),
     ("identify-n-boot-zero", [*I, "--n-boot", "0"], "--n-boot: '0' is out of range"),
-    ("landscape-range-crosses-zero", [*L, "--range0=-1e8:1e8"], 'reaches zero'),
-    ("landscape-range-reversed", [*L, "--range0", "3e8:1e8"], 'needs LOW < HIGH'),
-    ("landscape-range-text", [*L, "--range1", "abc"], 'must look like LOW:HIGH'),
-    ("landscape-grid-syntax", ["landscape", "--grid", "4by4", "--out", "landres"],
-     'must look like 41x41'),
-    ("landscape-grid-too-small", ["landscape", "--grid", "1x1", "--out", "landres"],
-     'at least 2 points per axis'),
-    ("landscape-workers-zero", ["landscape", "--grid", "3x3", "--workers", "0", "--out",
-                                "landres"], "--workers: '0' is out of range"),
-    ("landscape-law-one-term", [*L, "--law", "2e8*z"], 'has 1 term(s)'),
-    ("landscape-law-empty", [*L, "--law", ""], '--law is empty'),
-    ("landscape-data-no-contact", [*L, "--data", "zeros.csv"], 'no contact found'),
+    ("landscape-range-crosses-zero", [*L, "--range0=-1e8:1e8"], "reaches zero"),
+    ("landscape-range-reversed", [*L, "--range0", "3e8:1e8"], "needs LOW < HIGH"),
+    ("landscape-range-text", [*L, "--range1", "abc"], "must look like LOW:HIGH"),
+    (
+        "landscape-grid-syntax",
+        ["landscape", "--grid", "4by4", "--out", "landres"],
+        "must look like 41x41",
+    ),
+    (
+        "landscape-grid-too-small",
+        ["landscape", "--grid", "1x1", "--out", "landres"],
+        "at least 2 points per axis",
+    ),
+    (
+        "landscape-workers-zero",
+        ["landscape", "--grid", "3x3", "--workers", "0", "--out", "landres"],
+        "--workers: '0' is out of range",
+    ),
+    ("landscape-law-one-term", [*L, "--law", "2e8*z"], "has 1 term(s)"),
+    ("landscape-law-empty", [*L, "--law", ""], "--law is empty"),
+    ("landscape-data-no-contact", [*L, "--data", "zeros.csv"], "no contact found"),
     ("landscape-n-boot-zero", [*L, "--n-boot", "0"], "--n-boot: '0' is out of range"),
-    ("landscape-out-is-file", [*L[:-1], "afile"], 'is an existing file'),
+    ("landscape-out-is-file", [*L[:-1], "afile"], "is an existing file"),
 ]
+
 
 def test_enough_cases():
     assert len(CASES) >= 100
@@ -422,22 +545,39 @@ def _api_cases():
     return [
         ("law-none", lambda w: ForceLaw.parse(None), "must be text"),
         ("law-bytes", lambda w: ForceLaw.parse(b"z"), "must be text"),
-        ("scenario-bool", lambda w: Scenario(m1=True, m2=1, k1=0, c1=0, A=0, frequency=1),
-         "got a boolean"),
-        ("scenario-text", lambda w: Scenario(m1=1, m2="1", k1=0, c1=0, A=0, frequency=1),
-         "got text"),
-        ("scenario-law-text", lambda w: Scenario(m1=1, m2=1, k1=0, c1=0, A=0, frequency=1,
-                                                 law="z"), "must be a ForceLaw"),
+        (
+            "scenario-bool",
+            lambda w: Scenario(m1=True, m2=1, k1=0, c1=0, A=0, frequency=1),
+            "got a boolean",
+        ),
+        (
+            "scenario-text",
+            lambda w: Scenario(m1=1, m2="1", k1=0, c1=0, A=0, frequency=1),
+            "got text",
+        ),
+        (
+            "scenario-law-text",
+            lambda w: Scenario(m1=1, m2=1, k1=0, c1=0, A=0, frequency=1, law="z"),
+            "must be a ForceLaw",
+        ),
         ("scenario-dir", lambda w: load_scenario(w), "is a directory"),
-        ("columns-not-dict", lambda w: Measurement.from_csv(w / "good.csv", columns=["t"]),
-         "columns must map"),
-        ("columns-unknown", lambda w: Measurement.from_csv(w / "good.csv",
-                                                           columns={"x": "t"}),
-         "unknown name 'x'"),
+        (
+            "columns-not-dict",
+            lambda w: Measurement.from_csv(w / "good.csv", columns=["t"]),
+            "columns must map",
+        ),
+        (
+            "columns-unknown",
+            lambda w: Measurement.from_csv(w / "good.csv", columns={"x": "t"}),
+            "unknown name 'x'",
+        ),
         ("measurement-shape", lambda w: Measurement(t, t[:5]), "equal length"),
         ("measurement-channel", lambda w: Measurement(t, t, {"w1": t[:3]}), "has 3 samples"),
-        ("measurement-gap", lambda w: Measurement(np.r_[t, 1.0], np.r_[t, 0.0]),
-         "not uniformly sampled"),
+        (
+            "measurement-gap",
+            lambda w: Measurement(np.r_[t, 1.0], np.r_[t, 0.0]),
+            "not uniformly sampled",
+        ),
         ("measurement-huge", lambda w: Measurement(t, t * 1e20), "|F| <= 1e+12 N"),
         ("check-output-empty", lambda w: check_output(""), "--out is empty"),
         ("check-output-file", lambda w: check_output(w / "afile"), "is an existing file"),
@@ -456,8 +596,14 @@ def test_api_bad_input(workspace, case):
     assert _snapshot(workspace) == before
 
 
-@pytest.mark.parametrize("exc", [ValueError("operands could not be broadcast together"),
-                                 TypeError("unsupported operand"), IndexError("index 5")])
+@pytest.mark.parametrize(
+    "exc",
+    [
+        ValueError("operands could not be broadcast together"),
+        TypeError("unsupported operand"),
+        IndexError("index 5"),
+    ],
+)
 def test_a_bug_is_exit_1_not_bad_input(monkeypatch, capsys, exc):
     """Only the package's own errors (VidiError) are bad input (exit 2); a numpy shape error
     or any other exception from a bug is exit 1 with one line asking for a report."""

@@ -41,8 +41,19 @@ def test_landscape_small_grid(tmp_path):
 
 def test_identify_recovers_true_law(record, tmp_path):
     out = tmp_path / "id"
-    rc = main(["identify", "--data", str(record), "--start", "1.5e8*z + 0.9e7*zd",
-               "--method", "least-squares", "--out", str(out)])
+    rc = main(
+        [
+            "identify",
+            "--data",
+            str(record),
+            "--start",
+            "1.5e8*z + 0.9e7*zd",
+            "--method",
+            "least-squares",
+            "--out",
+            str(out),
+        ]
+    )
     assert rc == 0
     s = json.loads((out / "summary.json").read_text())
     c = s["coefficients"]
@@ -52,12 +63,15 @@ def test_identify_recovers_true_law(record, tmp_path):
     assert set(s["criteria"]) == {"I0", "I1", "I2", "I3", "I4"}
 
 
-@pytest.mark.parametrize("argv, needle", [
-    (["simulate", "--law", "2*q", "--out", "x.csv"], "cannot read force law"),
-    (["simulate", "--scenario", "nope.toml", "--out", "x.csv"], "does not exist"),
-    (["identify", "--data", "missing.csv", "--start", "z", "--out", "o"], "does not exist"),
-    (["landscape", "--grid", "4by4", "--out", "o"], "must look like 41x41"),
-])
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["simulate", "--law", "2*q", "--out", "x.csv"], "cannot read force law"),
+        (["simulate", "--scenario", "nope.toml", "--out", "x.csv"], "does not exist"),
+        (["identify", "--data", "missing.csv", "--start", "z", "--out", "o"], "does not exist"),
+        (["landscape", "--grid", "4by4", "--out", "o"], "must look like 41x41"),
+    ],
+)
 def test_bad_input_one_line_exit_2(argv, needle, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert main(argv) == 2
@@ -77,12 +91,15 @@ def test_bad_csv_does_not_destroy_earlier_results(record, tmp_path, capsys):
     assert list(tmp_path.glob(".id.*")) == []
 
 
-@pytest.mark.parametrize("body, needle", [
-    ("t,F\n0,0\n1,nan\n2,0\n3,0\n", "non-finite"),
-    ("t,F\n0,0\n2,1\n1,0\n3,0\n", "not increasing"),
-    ("time,F\n0,0\n", "no column t"),
-    ("t,F\n0,0\n1,0\n2,0\n3,0\n4,0\n", "no contact"),
-])
+@pytest.mark.parametrize(
+    "body, needle",
+    [
+        ("t,F\n0,0\n1,nan\n2,0\n3,0\n", "non-finite"),
+        ("t,F\n0,0\n2,1\n1,0\n3,0\n", "not increasing"),
+        ("time,F\n0,0\n", "no column t"),
+        ("t,F\n0,0\n1,0\n2,0\n3,0\n4,0\n", "no contact"),
+    ],
+)
 def test_bad_csv_messages(body, needle, tmp_path, capsys):
     p = tmp_path / "d.csv"
     p.write_text(body)
@@ -101,23 +118,68 @@ def test_verify_command_writes_summary_and_figure(tmp_path):
     t = 60 * T + np.arange(int(12 * T * 20000)) / 20000.0
     r = reference_simulate(sc, sc.law, (0.0, t[-1]), t_eval=t, rtol=1e-9)
     rng = np.random.default_rng(5)
-    ch = {n: r["y"][k] + rng.normal(0, 0.002 * np.ptp(r["y"][k]), t.size)
-          for k, n in enumerate(("w1", "v1", "w2", "v2"))}
+    ch = {
+        n: r["y"][k] + rng.normal(0, 0.002 * np.ptp(r["y"][k]), t.size)
+        for k, n in enumerate(("w1", "v1", "w2", "v2"))
+    }
     F = r["force"] + rng.normal(0, 0.01 * r["force"].max(), t.size)
     Measurement(t, F, ch).to_csv(tmp_path / "rec.csv")
     out = tmp_path / "v"
-    assert main(["verify", "--scenario", "light", "--data", str(tmp_path / "rec.csv"),
-                 "--out", str(out), "--n-boot", "8"]) == 0
+    assert (
+        main(
+            [
+                "verify",
+                "--scenario",
+                "light",
+                "--data",
+                str(tmp_path / "rec.csv"),
+                "--out",
+                str(out),
+                "--n-boot",
+                "8",
+            ]
+        )
+        == 0
+    )
     d = json.loads((out / "summary.json").read_text())
     assert d["consistent"] is True and d["regime"] == {"measured": "P1", "simulated": "P1"}
     assert set(d["noise_floor"]) == {"I0", "I1", "I2", "I3", "I4"}
     assert d["criteria"]["I2"] <= 2 * d["noise_floor"]["I2"] + 0.005
     assert (out / "verify.png").stat().st_size > 0
     # a wrong law is inconsistent; an empty law is one clear line, exit 2
-    assert main(["verify", "--scenario", "light", "--data", str(tmp_path / "rec.csv"),
-                 "--law", "3e10*z^1.5 + 5e11*z^1.5*zd", "--out", str(tmp_path / "w"),
-                 "--n-boot", "8"]) == 0
+    assert (
+        main(
+            [
+                "verify",
+                "--scenario",
+                "light",
+                "--data",
+                str(tmp_path / "rec.csv"),
+                "--law",
+                "3e10*z^1.5 + 5e11*z^1.5*zd",
+                "--out",
+                str(tmp_path / "w"),
+                "--n-boot",
+                "8",
+            ]
+        )
+        == 0
+    )
     assert json.loads((tmp_path / "w" / "summary.json").read_text())["consistent"] is False
-    assert main(["verify", "--scenario", "light", "--data", str(tmp_path / "rec.csv"),
-                 "--law", " ", "--out", str(tmp_path / "e")]) == 2
+    assert (
+        main(
+            [
+                "verify",
+                "--scenario",
+                "light",
+                "--data",
+                str(tmp_path / "rec.csv"),
+                "--law",
+                " ",
+                "--out",
+                str(tmp_path / "e"),
+            ]
+        )
+        == 2
+    )
     assert not (tmp_path / "e").exists()

@@ -15,8 +15,10 @@ FIGURES = ("fit_impulse", "fit_surface", "fit_loop")
 @pytest.fixture(scope="module")
 def record(tmp_path_factory):
     path = tmp_path_factory.mktemp("fitrec") / "runup.csv"
-    assert main(["simulate", "--from-rest", "--periods", "150", "--noise", "0.01",
-                 "--out", str(path)]) == 0
+    assert (
+        main(["simulate", "--from-rest", "--periods", "150", "--noise", "0.01", "--out", str(path)])
+        == 0
+    )
     return path
 
 
@@ -30,8 +32,12 @@ def fitted(record, tmp_path_factory):
 def test_fit_exit_code_and_files(fitted):
     rc, out = fitted
     assert rc == 0
-    for name in ("summary.json", "ranking.csv", "model.tex",
-                 *(f"{f}.{ext}" for f in FIGURES for ext in ("png", "pdf"))):
+    for name in (
+        "summary.json",
+        "ranking.csv",
+        "model.tex",
+        *(f"{f}.{ext}" for f in FIGURES for ext in ("png", "pdf")),
+    ):
         assert (out / name).stat().st_size > 0, name
     assert (out / "fit_impulse.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert (out / "fit_surface.pdf").read_bytes()[:5] == b"%PDF-"
@@ -93,15 +99,30 @@ def test_model_tex_names_the_law(fitted):
 
 def test_fit_scored_by_cross_validation_reports_it(record, tmp_path):
     out = tmp_path / "cv"
-    assert main(["fit", "--data", str(record), "--library", "poly:2", "--score", "cv",
-                 "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "fit",
+                "--data",
+                str(record),
+                "--library",
+                "poly:2",
+                "--score",
+                "cv",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     s = json.loads((out / "summary.json").read_text())
     assert s["ranking"]
     for m in s["ranking"]:
         assert 0 <= m["cv_error"] < 1  # relative RMS of held-out impacts
     rows = list(csv.DictReader((out / "ranking.csv").read_text().splitlines()))
     assert [float(r["cv_error"]) for r in rows] == pytest.approx(
-        [m["cv_error"] for m in s["ranking"]], rel=1e-5)
+        [m["cv_error"] for m in s["ranking"]], rel=1e-5
+    )
 
 
 def _assert_clean_failure(argv, out, capsys, needle=None):
@@ -114,12 +135,14 @@ def _assert_clean_failure(argv, out, capsys, needle=None):
     assert not list(out.parent.glob(f".{out.name}*"))  # no staged leftovers
 
 
-@pytest.mark.parametrize("library, needle", [("poly:2+q", "'q'"), ("z,zd,w", "'w'"),
-                                             ("poly:0", "poly:N")])
+@pytest.mark.parametrize(
+    "library, needle", [("poly:2+q", "'q'"), ("z,zd,w", "'w'"), ("poly:0", "poly:N")]
+)
 def test_bad_library_exit_2_without_output(record, tmp_path, capsys, library, needle):
     out = tmp_path / "o"
-    _assert_clean_failure(["fit", "--data", str(record), "--library", library,
-                           "--out", str(out)], out, capsys, needle)
+    _assert_clean_failure(
+        ["fit", "--data", str(record), "--library", library, "--out", str(out)], out, capsys, needle
+    )
 
 
 def test_data_without_positions_exit_2_without_output(record, tmp_path, capsys):
@@ -127,33 +150,43 @@ def test_data_without_positions_exit_2_without_output(record, tmp_path, capsys):
     header = lines[0].split(",")
     keep = [header.index("t"), header.index("F")]
     bad = tmp_path / "tF.csv"
-    bad.write_text("\n".join(",".join(line.split(",")[j] for j in keep)
-                             for line in lines[:4001]) + "\n")
+    bad.write_text(
+        "\n".join(",".join(line.split(",")[j] for j in keep) for line in lines[:4001]) + "\n"
+    )
     out = tmp_path / "o"
-    _assert_clean_failure(["fit", "--data", str(bad), "--out", str(out)], out, capsys,
-                          "w1 and w2")
+    _assert_clean_failure(["fit", "--data", str(bad), "--out", str(out)], out, capsys, "w1 and w2")
 
 
 def test_bad_max_terms_exit_2(record, tmp_path, capsys):
     out = tmp_path / "o"
-    _assert_clean_failure(["fit", "--data", str(record), "--max-terms", "0",
-                           "--out", str(out)], out, capsys, "--max-terms")
+    _assert_clean_failure(
+        ["fit", "--data", str(record), "--max-terms", "0", "--out", str(out)],
+        out,
+        capsys,
+        "--max-terms",
+    )
 
 
 def test_solver_error_exit_2_one_line(record, tmp_path, capsys, monkeypatch):
     # errors of the constraints package are VidiErrors: a clean exit, never a traceback
     def fail(*args, **kwargs):
-        raise SolverError("cvxpy problem ended with status 'infeasible' (solver CLARABEL); "
-                          "no solution is returned", status="infeasible", solver="CLARABEL")
+        raise SolverError(
+            "cvxpy problem ended with status 'infeasible' (solver CLARABEL); "
+            "no solution is returned",
+            status="infeasible",
+            solver="CLARABEL",
+        )
 
     # the module (the package attribute of the same name is the function)
     monkeypatch.setattr(importlib.import_module("discovery.discover"), "discover", fail)
     out = tmp_path / "o"
-    _assert_clean_failure(["fit", "--data", str(record), "--out", str(out)], out, capsys,
-                          "status 'infeasible'")
+    _assert_clean_failure(
+        ["fit", "--data", str(record), "--out", str(out)], out, capsys, "status 'infeasible'"
+    )
 
 
 def test_library_of_only_plus_exit_2(record, tmp_path, capsys):
     out = tmp_path / "o"
-    _assert_clean_failure(["fit", "--data", str(record), "--library", "+",
-                           "--out", str(out)], out, capsys)
+    _assert_clean_failure(
+        ["fit", "--data", str(record), "--library", "+", "--out", str(out)], out, capsys
+    )

@@ -36,9 +36,13 @@ def _expanded_help(parser, action):
 
 
 def _has_default(action):
-    return (action.option_strings and action.help is not argparse.SUPPRESS
-            and action.default is not None and action.default is not False
-            and action.default is not argparse.SUPPRESS)
+    return (
+        action.option_strings
+        and action.help is not argparse.SUPPRESS
+        and action.default is not None
+        and action.default is not False
+        and action.default is not argparse.SUPPRESS
+    )
 
 
 def _same(shown, action):
@@ -57,10 +61,23 @@ def _same(shown, action):
 
 def test_every_command_is_walked():
     commands = {p[0] for p, _ in PARSERS if p}
-    assert {"simulate", "fit", "verify", "explain", "steady", "landscape", "identify",
-            "ueda"} <= commands
+    assert {
+        "simulate",
+        "fit",
+        "verify",
+        "explain",
+        "steady",
+        "landscape",
+        "identify",
+        "ueda",
+    } <= commands
     assert {p[1] for p, _ in PARSERS if len(p) == 2 and p[0] == "ueda"} >= {
-        "attractor", "chart", "simulate", "discover", "explain"}
+        "attractor",
+        "chart",
+        "simulate",
+        "discover",
+        "explain",
+    }
 
 
 @pytest.mark.parametrize(("path", "parser"), PARSERS, ids=IDS)
@@ -79,13 +96,18 @@ def test_every_default_is_shown(path, parser):
             continue
         text = " ".join(_expanded_help(parser, action).split())
         # "(default: 0)", "(default: 0, skip)", "(default: x',x^3)"
-        shown = [c for m in re.findall(r"\(default: ([^()]*)\)", text)
-                 for c in (m, re.split(r"[,;] ", m)[0])]
+        shown = [
+            c
+            for m in re.findall(r"\(default: ([^()]*)\)", text)
+            for c in (m, re.split(r"[,;] ", m)[0])
+        ]
         if not any(_same(s.strip(), action) for s in shown):
-            missing.append(f"{'/'.join(action.option_strings)} (default {action.default!r}): "
-                           f"{text!r}")
-    assert not missing, (f"vidi {' '.join(path)}: help without its default:\n  "
-                         + "\n  ".join(missing))
+            missing.append(
+                f"{'/'.join(action.option_strings)} (default {action.default!r}): {text!r}"
+            )
+    assert not missing, f"vidi {' '.join(path)}: help without its default:\n  " + "\n  ".join(
+        missing
+    )
 
 
 @pytest.mark.parametrize(("path", "parser"), PARSERS, ids=IDS)
@@ -104,7 +126,8 @@ def test_help_uses_one_convention(path, parser):
         if _has_default(action):
             assert not re.search(r"\(\s*[-+]?[\d.e+-]+\s*\)\s*$", text), (
                 f"vidi {' '.join(path)} {action.option_strings[0]}: write the default as "
-                f"'(default: %(default)s)', not {text!r}")
+                f"'(default: %(default)s)', not {text!r}"
+            )
 
 
 def test_version_and_plain_vidi(capsys):
@@ -126,7 +149,7 @@ def test_every_example_in_the_help_parses():
     for path, lines in EXAMPLES.items():
         for line in lines:
             argv = shlex.split(re.split(r"\s{2,}", line)[0])
-            assert argv[0] == "vidi" and argv[1:1 + len(path.split())] == path.split(), line
+            assert argv[0] == "vidi" and argv[1 : 1 + len(path.split())] == path.split(), line
             if "COMMAND" not in argv:
                 parser.parse_args(argv[1:])  # raises UsageError on a wrong example
 
@@ -137,9 +160,12 @@ def test_help_loads_no_heavy_library():
     import subprocess
     import sys
 
-    code = ("import sys; from discovery.cli import _parser; _parser(); "
-            "print(','.join(m for m in ('numba', 'cvxpy', 'sympy', 'scipy', 'matplotlib', "
-            "'pysindy', 'jinja2', 'sklearn') if m in sys.modules))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True, timeout=120).stdout.strip()
+    code = (
+        "import sys; from discovery.cli import _parser; _parser(); "
+        "print(','.join(m for m in ('numba', 'cvxpy', 'sympy', 'scipy', 'matplotlib', "
+        "'pysindy', 'jinja2', 'sklearn') if m in sys.modules))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
+    ).stdout.strip()
     assert out == "", f"vidi --help imports {out}"

@@ -35,8 +35,13 @@ def test_law_text_round_trip_and_validation():
     # keeping the branch when the loading coefficients change (the regression's refits)
     assert law.with_coefficients([3e8, 2e7]).unloading == law.unloading
     assert not ForceLaw.parse("2e8*z").has_unloading_branch
-    for bad in ("2e8*z; unloading: 4e6*z", "2e8*z; set: 1.5", "2e8*z; set: x",
-                "2e8*z; spring: 3", "2e8*z; set: 0.1; set: 0.2"):
+    for bad in (
+        "2e8*z; unloading: 4e6*z",
+        "2e8*z; set: 1.5",
+        "2e8*z; set: x",
+        "2e8*z; spring: 3",
+        "2e8*z; set: 0.1; set: 0.2",
+    ):
         with pytest.raises(InputError):
             ForceLaw.parse(bad)
     with pytest.raises(InputError, match="unloading coefficient"):
@@ -63,8 +68,11 @@ def test_permanent_set_restitution_closed_form(s):
     law = ForceLaw.parse(f"{KW!r}*z; set: {s!r}")
     tr = _wall(law)
     kinds = tr.event_kind
-    expect = [K.EV_ONSET, K.EV_UNLOAD, K.EV_LOSS] if s == 0 else \
-        [K.EV_ONSET, K.EV_UNLOAD, K.EV_RELEASE, K.EV_LOSS]
+    expect = (
+        [K.EV_ONSET, K.EV_UNLOAD, K.EV_LOSS]
+        if s == 0
+        else [K.EV_ONSET, K.EV_UNLOAD, K.EV_RELEASE, K.EV_LOSS]
+    )
     assert list(kinds) == expect
     dz = tr.event_y[:, 1] - tr.event_y[:, 3]
     zeta = tr.event_y[:, 0] - tr.event_y[:, 2]
@@ -105,8 +113,9 @@ def test_stiffening_supports_static_equilibrium():
     w = sc.initial_state()[0]
     assert sc.k1 * w + sc.k3 * w**3 == pytest.approx(-sc.m1 * sc.g, rel=1e-12)
     assert abs(w) < sc.m1 * sc.g / sc.k1  # stiffer: sags less
-    tr = simulate(sc.replace(m2=1.0), ForceLaw.parse("1e3*z"), (0.0, 0.04),
-                  tolerances=Tolerances(rtol=1e-10))
+    tr = simulate(
+        sc.replace(m2=1.0), ForceLaw.parse("1e3*z"), (0.0, 0.04), tolerances=Tolerances(rtol=1e-10)
+    )
     # the 1 kg moulding's weight and its bounce move the 10 t grid by micrometres at most
     assert abs(tr.y_final[0] - w) < 1e-3 * abs(w)
 
@@ -126,8 +135,13 @@ def test_mass_loss_sheds_a_fraction_at_each_onset():
     part = simulate(lossy, sc.law, (0.0, t_cut), tolerances=Tolerances(rtol=1e-10))
     t_end = onsets[2] - 1e-3 * T  # before the third onset sheds once more
     ok = simulate(lossy, sc.law, (0.0, t_end), tolerances=Tolerances(rtol=1e-10))
-    ok2 = simulate(sc.replace(m2=sc.m2 * 0.98**2), sc.law, (t_cut, t_end), y0=part.y_final,
-                   tolerances=Tolerances(rtol=1e-10))
+    ok2 = simulate(
+        sc.replace(m2=sc.m2 * 0.98**2),
+        sc.law,
+        (t_cut, t_end),
+        y0=part.y_final,
+        tolerances=Tolerances(rtol=1e-10),
+    )
     x, v = sc.scales()
     assert np.max(np.abs(ok.y_final - ok2.y_final) / np.array([x, v, x, v])) < 1e-7
     # and the shed mass matters: without the loss the states differ
@@ -167,9 +181,11 @@ def test_a_moulding_that_sheds_mass_has_no_steady_state(tmp_path, capsys):
     with pytest.raises(InputError, match="no periodic steady state"):
         steady_state(sc, sc.law)
     f = tmp_path / "lossy.toml"
-    f.write_text('name = "lossy"\n[machine]\nm1 = 1.0e4\nm2 = 1.0e4\nk1 = 2.75e7\n'
-                 'c1 = 1.0e5\nA = 5.0e5\nfrequency = 25.0\nmass_loss = 0.01\n[law]\n'
-                 'text = "2.06e8*z + 1.28e7*zd"\n')
+    f.write_text(
+        'name = "lossy"\n[machine]\nm1 = 1.0e4\nm2 = 1.0e4\nk1 = 2.75e7\n'
+        "c1 = 1.0e5\nA = 5.0e5\nfrequency = 25.0\nmass_loss = 0.01\n[law]\n"
+        'text = "2.06e8*z + 1.28e7*zd"\n'
+    )
     assert main(["steady", "--scenario", str(f)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "mass_loss = 0" in err[0]
@@ -185,8 +201,7 @@ def test_a_set_orbit_strobed_inside_its_contact_keeps_its_unloading_memory():
     from tests.realistic import reference_record
 
     law = ForceLaw.parse("1.4e8*z + 8.24e6*zd; set: 0.44")
-    sc = Scenario(m1=25200.0, m2=8750.0, k1=2.73e8, c1=9.28e5, A=5.19e5, frequency=21.1,
-                  law=law)
+    sc = Scenario(m1=25200.0, m2=8750.0, k1=2.73e8, c1=9.28e5, A=5.19e5, frequency=21.1, law=law)
     ss = steady_state(sc, law)
     z, v = ss.y0[0] - ss.y0[2], ss.y0[1] - ss.y0[3]
     assert ss.regime == "P1" and z > 0 and v < 0  # strobed while unloading

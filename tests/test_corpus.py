@@ -24,8 +24,11 @@ from discovery.explain import explain
 from discovery.verify import Reference, verify
 
 CORPUS = Path(__file__).resolve().parents[2] / "shared" / "corpus"
-NAMES = sorted(p.name for p in CORPUS.iterdir() if (p / "truth.json").exists()) \
-    if CORPUS.is_dir() else []
+NAMES = (
+    sorted(p.name for p in CORPUS.iterdir() if (p / "truth.json").exists())
+    if CORPUS.is_dir()
+    else []
+)
 
 pytestmark = pytest.mark.skipif(not NAMES, reason=f"the corpus is not at {CORPUS}")
 
@@ -33,8 +36,12 @@ pytestmark = pytest.mark.skipif(not NAMES, reason=f"the corpus is not at {CORPUS
 def _load(name):
     d = CORPUS / name
     truth = json.loads((d / "truth.json").read_text())
-    return (load_scenario(str(d / "scenario.toml")), Measurement.from_csv(str(d / "measured.csv")),
-            ForceLaw.parse(truth["law"]), truth)
+    return (
+        load_scenario(str(d / "scenario.toml")),
+        Measurement.from_csv(str(d / "measured.csv")),
+        ForceLaw.parse(truth["law"]),
+        truth,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -96,8 +103,13 @@ def _named(res):
     return [it.effect for it in res.iterations if it.effect]
 
 
-@pytest.mark.parametrize("name, effect", [("c02-steep-onset", "penetration_velocity_coupling"),
-                                          ("c06-unloading-damping", "unloading_damping")])
+@pytest.mark.parametrize(
+    "name, effect",
+    [
+        ("c02-steep-onset", "penetration_velocity_coupling"),
+        ("c06-unloading-damping", "unloading_damping"),
+    ],
+)
 def test_explain_names_the_hidden_effect_and_shrinks_the_gap(records, name, effect):
     sc, m, _, _ = records[name]
     res = explain(sc, m, "linear", workers=1, n_boot_intervals=0)
@@ -117,12 +129,12 @@ def test_explain_on_the_hertz_record_names_it_or_says_it_cannot_tell(records):
     else:
         row = next(s for s in res.separability if s["effect"] == "hertzian_stiffening")
         assert row["separable"] is False and row["after"] is not None
-        assert "cannot tell" in res.stopped_because and "hertzian_stiffening" in \
-            res.stopped_because
+        assert "cannot tell" in res.stopped_because and "hertzian_stiffening" in res.stopped_because
 
 
-@pytest.mark.parametrize("name", ["c01-slow-transient", "c04-period-two", "c05-low-rate",
-                                  "c07-noisy"])
+@pytest.mark.parametrize(
+    "name", ["c01-slow-transient", "c04-period-two", "c05-low-rate", "c07-noisy"]
+)
 def test_explain_names_nothing_on_clean_records(records, name):
     sc, m, _, _ = records[name]
     res = explain(sc, m, "linear", workers=1, n_boot_intervals=0)

@@ -16,9 +16,14 @@ NAMES = ["I0", "I1", "I2", "I3", "I4"]
 
 
 def imp(t, F, duration, support, n_periods=1, onset=0.0):
-    return Impulse(t=np.asarray(t, float), F=np.asarray(F, float), duration=float(duration),
-                   support=np.asarray(support, float).reshape(-1, 2), n_periods=n_periods,
-                   onset=onset)
+    return Impulse(
+        t=np.asarray(t, float),
+        F=np.asarray(F, float),
+        duration=float(duration),
+        support=np.asarray(support, float).reshape(-1, 2),
+        n_periods=n_periods,
+        onset=onset,
+    )
 
 
 # ------------------------------------------------------- simulated impulses (paper)
@@ -62,8 +67,9 @@ def test_shift_invariance_with_simulation(paper, paper_impulse):
     """The same orbit sampled 3 and 1000 periods later: same impulse, other onset."""
     ss = steady_state(paper, paper.law)
     for k in (3, 1000):
-        later = impulse_from_steady_state(paper, paper.law,
-                                          dataclasses.replace(ss, t0=ss.t0 + k * paper.period))
+        later = impulse_from_steady_state(
+            paper, paper.law, dataclasses.replace(ss, t0=ss.t0 + k * paper.period)
+        )
         # onset moves by exactly k periods (abs 1e-12 s: roundoff of times ~40 s)
         assert later.onset - paper_impulse.onset == pytest.approx(k * paper.period, abs=1e-12)
         vals = evaluate_criteria(paper_impulse, later)
@@ -76,8 +82,9 @@ def test_shift_invariance_by_hand():
     n = imp([0, 0.2, 0.2, 1], [3, 3, 0, 0], 1, [[0, 0.2]], onset=5.0)
     base = evaluate_criteria(e, n)
     for onset_e, onset_n in ((17.0, 5.0), (1e6, -3.0)):
-        shifted = evaluate_criteria(dataclasses.replace(e, onset=onset_e),
-                                    dataclasses.replace(n, onset=onset_n))
+        shifted = evaluate_criteria(
+            dataclasses.replace(e, onset=onset_e), dataclasses.replace(n, onset=onset_n)
+        )
         assert shifted == base  # exact: the onsets only label the records
 
 
@@ -138,10 +145,12 @@ def test_triangles_closed_form():
 
 @pytest.mark.parametrize(
     ("sup_e", "sup_n", "expected"),
-    [([[0, 0.3]], [[0, 0.2]], 0.1 / 0.3),          # N inside E
-     ([[0, 0.2]], [[0, 0.3]], 0.1 / 0.2),          # E inside N
-     ([[0, 0.3]], [[0, 0.1], [0.2, 0.5]], 1.0),    # not nested: symmetric difference
-     ([[0, 0.3]], [[0, 0.3]], 0.0)],
+    [
+        ([[0, 0.3]], [[0, 0.2]], 0.1 / 0.3),  # N inside E
+        ([[0, 0.2]], [[0, 0.3]], 0.1 / 0.2),  # E inside N
+        ([[0, 0.3]], [[0, 0.1], [0.2, 0.5]], 1.0),  # not nested: symmetric difference
+        ([[0, 0.3]], [[0, 0.3]], 0.0),
+    ],
 )
 def test_i4_support_measure(sup_e, sup_n, expected):
     e = imp([0, 1], [1, 0], 1, sup_e)
@@ -154,8 +163,13 @@ def test_i4_support_measure(sup_e, sup_n, expected):
 
 def test_p1_against_itself_written_as_p2_is_zero():
     e1 = imp([0, 0.5, 0.5, 1], [1, 1, 0, 0], 1, [[0, 0.5]])
-    e2 = imp([0, 0.5, 0.5, 1, 1, 1.5, 1.5, 2], [1, 1, 0, 0, 1, 1, 0, 0], 2,
-             [[0, 0.5], [1, 1.5]], n_periods=2)
+    e2 = imp(
+        [0, 0.5, 0.5, 1, 1, 1.5, 1.5, 2],
+        [1, 1, 0, 0, 1, 1, 0, 0],
+        2,
+        [[0, 0.5], [1, 1.5]],
+        n_periods=2,
+    )
     for a, b in ((e1, e2), (e2, e1)):
         c = compare(a, b)
         assert c.length == 2.0
@@ -165,8 +179,13 @@ def test_p1_against_itself_written_as_p2_is_zero():
 def test_p1_against_p2_without_jump_at_cycle_start():
     # E (P1): triangle 0 -> 1 -> 0 on [0, 0.5]; N (P2): the same, then one half as high
     e = imp([0, 0.25, 0.5, 1], [0, 1, 0, 0], 1, [[0, 0.5]])
-    n = imp([0, 0.25, 0.5, 1, 1.25, 1.5, 2], [0, 1, 0, 0, 0.5, 0, 0], 2,
-            [[0, 0.5], [1, 1.5]], n_periods=2)
+    n = imp(
+        [0, 0.25, 0.5, 1, 1.25, 1.5, 2],
+        [0, 1, 0, 0, 0.5, 0, 0],
+        2,
+        [[0, 0.5], [1, 1.5]],
+        n_periods=2,
+    )
     v = evaluate_criteria(e, n)
     assert v["I1"] == pytest.approx(0.5, rel=1e-14)
     assert v["I2"] == pytest.approx((0.5 * 0.5 * 0.5) / (2 * 0.5 * 0.5 * 1), rel=1e-14)

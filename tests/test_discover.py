@@ -19,8 +19,7 @@ RTOL, ATOL = 0.1, 0.005  # discover()'s default ranking rule
 @pytest.fixture(scope="module")
 def runup(paper):
     """300 periods of law (11) from rest, 1 % force noise."""
-    return synthesize(paper, paper.law, periods=300, fs=20000, noise=0.01, seed=0,
-                      from_rest=True)
+    return synthesize(paper, paper.law, periods=300, fs=20000, noise=0.01, seed=0, from_rest=True)
 
 
 @pytest.fixture(scope="module")
@@ -33,10 +32,21 @@ def biased(paper):
     """Positions with 1 % noise and no velocities: dzeta differentiated from the noisy zeta
     biases the regression; the refinement by simulation never uses dzeta.  Discovered
     without and with refinement."""
-    m = synthesize(paper, paper.law, periods=300, fs=20000, noise=0.01, seed=0,
-                   from_rest=True, position_noise=0.01, velocities=False)
-    return (discover(paper, m, library="z,zd", refine=False),
-            discover(paper, m, library="z,zd", n_boot_intervals=0))
+    m = synthesize(
+        paper,
+        paper.law,
+        periods=300,
+        fs=20000,
+        noise=0.01,
+        seed=0,
+        from_rest=True,
+        position_noise=0.01,
+        velocities=False,
+    )
+    return (
+        discover(paper, m, library="z,zd", refine=False),
+        discover(paper, m, library="z,zd", n_boot_intervals=0),
+    )
 
 
 def test_selects_true_support_p1_and_certified(result, paper):
@@ -63,27 +73,26 @@ def test_selected_follows_the_ranking_rule(result):
     ranked = [m for m in result.ranking if m.criteria]
     # contact laws first (physics), each group by the rule below
     sound = [m for m in ranked if not m.defects]
-    assert ranked[:len(sound)] == sound
+    assert ranked[: len(sound)] == sound
     ranked = sound
     assert len(ranked) >= 2
     sel = result.selected
     assert sel is result.ranking[0]
     # consistent models first: the fewest terms, then the criterion
     good = [m for m in ranked if m.consistent]
-    assert good and result.ranking[:len(good)] == good
+    assert good and result.ranking[: len(good)] == good
     keys = [(len(m.law.names), m.criteria["I2"]) for m in good]
     assert keys == sorted(keys)
     # then the others: the tier within the tolerance by BIC, then by I2
-    rest = ranked[len(good):]
+    rest = ranked[len(good) :]
     if rest:
         best = min(m.criteria["I2"] for m in rest)
         limit = max(best * (1 + RTOL), best + ATOL)
         tier = [m for m in rest if m.criteria["I2"] <= limit]
-        assert [m.candidate.bic for m in rest[:len(tier)]] == sorted(m.candidate.bic
-                                                                     for m in tier)
-        tail = rest[len(tier):]
+        assert [m.candidate.bic for m in rest[: len(tier)]] == sorted(m.candidate.bic for m in tier)
+        tail = rest[len(tier) :]
         assert [m.criteria["I2"] for m in tail] == sorted(m.criteria["I2"] for m in tail)
-    assert all(not m.criteria or m.defects for m in result.ranking[len(ranked):])
+    assert all(not m.criteria or m.defects for m in result.ranking[len(ranked) :])
 
 
 def test_result_bookkeeping(result):
@@ -127,8 +136,15 @@ def _model(name, bic, i2=None, regime="P1", consistent=False):
     cand = Candidate(terms=(name,), coefficients={name: 1.0}, rss=1.0, bic=bic, aic=bic)
     crit = {} if i2 is None else {"I0": i2, "I1": i2, "I2": i2, "I3": i2, "I4": i2}
     status = "ok" if crit else regime
-    ev = Evaluation(status, {"measured": "P1", "simulated": regime if crit else None},
-                    {"measured": 1, "simulated": 1}, crit, {}, consistent, "")
+    ev = Evaluation(
+        status,
+        {"measured": "P1", "simulated": regime if crit else None},
+        {"measured": 1, "simulated": 1},
+        crit,
+        {},
+        consistent,
+        "",
+    )
     return RankedModel(ForceLaw.parse(f"1*{name}"), cand, (ev,))
 
 
@@ -137,29 +153,35 @@ def _names(models):
 
 
 def test_rank_nonperiodic_last_even_with_best_bic():
-    models = [_model("z", -100.0, None, "nonperiodic"),
-              _model("zd", 10.0, 0.5),
-              _model("z*zd", 0.0, 0.05)]
+    models = [
+        _model("z", -100.0, None, "nonperiodic"),
+        _model("zd", 10.0, 0.5),
+        _model("z*zd", 0.0, 0.05),
+    ]
     assert _names(rank(models, physics=False)) == ["z*zd", "zd", "z"]
 
 
 def test_rank_tier_by_bic_then_criterion():
-    models = [_model("z", 5.0, 0.100),      # best I2
-              _model("zd", 1.0, 0.109),     # within 10 %: equivalent, lower BIC wins
-              _model("z*zd", -50.0, 0.200),  # outside: after the tier despite best BIC
-              _model("zd^2", -60.0, 0.150),  # outside, smaller I2 than z*zd
-              _model("z^2", -70.0, None, "no-contact")]
+    models = [
+        _model("z", 5.0, 0.100),  # best I2
+        _model("zd", 1.0, 0.109),  # within 10 %: equivalent, lower BIC wins
+        _model("z*zd", -50.0, 0.200),  # outside: after the tier despite best BIC
+        _model("zd^2", -60.0, 0.150),  # outside, smaller I2 than z*zd
+        _model("z^2", -70.0, None, "no-contact"),
+    ]
     assert _names(rank(models, physics=False)) == ["zd", "z", "zd^2", "z*zd", "z^2"]
 
 
 def test_rank_consistent_models_first_fewest_terms_then_criterion():
     two = _model("z", -99.0, 0.005, consistent=True)  # consistent, best BIC, but two terms
     two = RankedModel(ForceLaw.parse("1*z + 1*zd"), two.candidate, two.evaluations)
-    models = [_model("z", 5.0, 0.010),                       # best I2, not consistent
-              _model("zd", 9.0, 0.030, consistent=True),
-              _model("z*zd", 2.0, 0.020, consistent=True),  # consistent, smaller I2
-              two,
-              _model("zd^2", -60.0, 0.5)]
+    models = [
+        _model("z", 5.0, 0.010),  # best I2, not consistent
+        _model("zd", 9.0, 0.030, consistent=True),
+        _model("z*zd", 2.0, 0.020, consistent=True),  # consistent, smaller I2
+        two,
+        _model("zd^2", -60.0, 0.5),
+    ]
     assert _names(rank(models, physics=False)) == ["z*zd", "zd", "z", "z", "zd^2"]
     assert rank(models, physics=False)[2] is two
 
@@ -178,15 +200,18 @@ def test_rank_without_any_periodic_model_orders_by_bic():
 
 def test_rank_uses_the_requested_criterion():
     a, b = _model("z", 1.0, 0.1), _model("zd", 2.0, 0.1)
-    a = RankedModel(a.law, a.candidate, (dataclasses.replace(
-        a.evaluation, criteria={**a.criteria, "I3": 0.9}),))
+    a = RankedModel(
+        a.law, a.candidate, (dataclasses.replace(a.evaluation, criteria={**a.criteria, "I3": 0.9}),)
+    )
     assert _names(rank([a, b], criterion="I3", physics=False)) == ["zd", "z"]
     assert _names(rank([a, b], criterion="I2", physics=False)) == ["z", "zd"]
 
 
 def test_rank_keeps_every_model():
-    models = [_model(n, float(i), None if i % 3 == 0 else 0.1 * i)
-              for i, n in enumerate(["z", "zd", "z^2", "z*zd", "zd^2", "z^3"])]
+    models = [
+        _model(n, float(i), None if i % 3 == 0 else 0.1 * i)
+        for i, n in enumerate(["z", "zd", "z^2", "z*zd", "zd^2", "z^3"])
+    ]
     out = rank(models, physics=False)
     assert sorted(_names(out)) == sorted(_names(models)) and len(out) == len(models)
     assert all(not math.isnan(m.candidate.bic) for m in out)
@@ -200,15 +225,27 @@ def noisy_positions(paper):
     """Positions with 1 % noise and no velocities, the poly:2 library, stability selection:
     the regression proposes four-term supports; the output-error backward steps find the
     simplest consistent law."""
-    m = synthesize(paper, paper.law, periods=300, fs=20000, noise=0.01, seed=0,
-                   from_rest=True, position_noise=0.01, velocities=False)
+    m = synthesize(
+        paper,
+        paper.law,
+        periods=300,
+        fs=20000,
+        noise=0.01,
+        seed=0,
+        from_rest=True,
+        position_noise=0.01,
+        velocities=False,
+    )
     return discover(paper, m, library="poly:2", stability=10, n_boot_intervals=0)
 
 
-@pytest.mark.xfail(reason="records judged over their span: with 1 % position noise and no "
-                   "velocities the biased regression starts the z + zd refinement outside the "
-                   "basin (it ends at 3.9e7*z, I2 1.39; the true law is consistent at 0.023), "
-                   "and z + z*zd + zd^2 is selected (README, limits)", strict=False)
+@pytest.mark.xfail(
+    reason="records judged over their span: with 1 % position noise and no "
+    "velocities the biased regression starts the z + zd refinement outside the "
+    "basin (it ends at 3.9e7*z, I2 1.39; the true law is consistent at 0.023), "
+    "and z + z*zd + zd^2 is selected (README, limits)",
+    strict=False,
+)
 def test_backward_steps_reach_the_simplest_consistent_law(noisy_positions):
     res = noisy_positions
     sel = res.selected
@@ -220,10 +257,13 @@ def test_backward_steps_reach_the_simplest_consistent_law(noisy_positions):
     assert all(len(m.law.names) >= 2 for m in res.ranking if m.consistent)
 
 
-@pytest.mark.xfail(reason="records judged over their span: with 1 % position noise and no "
-                   "velocities the biased regression starts the z + zd refinement outside the "
-                   "basin (it ends at 3.9e7*z, I2 1.39; the true law is consistent at 0.023), "
-                   "and z + z*zd + zd^2 is selected (README, limits)", strict=False)
+@pytest.mark.xfail(
+    reason="records judged over their span: with 1 % position noise and no "
+    "velocities the biased regression starts the z + zd refinement outside the "
+    "basin (it ends at 3.9e7*z, I2 1.39; the true law is consistent at 0.023), "
+    "and z + z*zd + zd^2 is selected (README, limits)",
+    strict=False,
+)
 def test_equivalent_models_say_why_and_what_would_separate_them(noisy_positions):
     res = noisy_positions
     sel = res.selected
@@ -238,11 +278,11 @@ def test_equivalent_models_say_why_and_what_would_separate_them(noisy_positions)
 
 def test_stability_disagreement_is_a_warning(noisy_positions):
     res = noisy_positions
-    strong = [t for t, f in res.stability.items()
-              if f >= 0.5 and t not in res.selected.law.names]
+    strong = [t for t, f in res.stability.items() if f >= 0.5 and t not in res.selected.law.names]
     assert strong  # the biased regression keeps choosing extra terms
-    assert any("stability selection disagrees" in w and all(t in w for t in strong)
-               for w in res.warnings)
+    assert any(
+        "stability selection disagrees" in w and all(t in w for t in strong) for w in res.warnings
+    )
 
 
 def test_contact_samples_do_not_split_impacts_at_noise_dips(paper):
@@ -250,8 +290,7 @@ def test_contact_samples_do_not_split_impacts_at_noise_dips(paper):
     and loss; one impact per period is still one impact."""
     from discovery.samples import contact_samples
 
-    m = synthesize(paper, paper.law, periods=30, fs=20000, noise=0.01, seed=0,
-                   position_noise=0.05)
+    m = synthesize(paper, paper.law, periods=30, fs=20000, noise=0.01, seed=0, position_noise=0.05)
     s = contact_samples(m)
     assert s.n_impacts in (30, 31)  # a contact cut by the record's end may count too
 
@@ -275,7 +314,7 @@ def test_rank_puts_laws_that_are_no_contact_laws_last():
     record as well as the truth; it is ranked after every contact law, with its reasons."""
     spring = _model("z", 5.0, 0.030)
     spring = RankedModel(ForceLaw.parse("1*z + 1*zd"), spring.candidate, spring.evaluations)
-    damper = _model("zd", -9.0, 0.010, consistent=True)             # consistent, no spring
+    damper = _model("zd", -9.0, 0.010, consistent=True)  # consistent, no spring
     neg = RankedModel(ForceLaw.parse("1*z - 1*zd^2"), damper.candidate, damper.evaluations)
     ranked = rank([damper, neg, spring])
     assert ranked[0] is spring

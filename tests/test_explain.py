@@ -55,8 +55,12 @@ def test_hidden_coupling_is_named_and_the_gap_shrinks(hidden_coupling):
     s = next(x for x in it.scores if x["effect"] == "penetration_velocity_coupling")
     assert s["significant"] and s["lm"] == max(x["lm"] for x in it.scores if x["lm"])
     phases = it.localisation["phases"]
-    assert max(phases, key=lambda p: phases[p]["share"]) in ("onset", "loading", "peak",
-                                                             "unloading")
+    assert max(phases, key=lambda p: phases[p]["share"]) in (
+        "onset",
+        "loading",
+        "peak",
+        "unloading",
+    )
     assert phases["onset"]["exceeds_noise"]
 
 
@@ -67,13 +71,13 @@ def test_clean_records_add_nothing(paper):
     refit lowers; nothing is fitted to that, and the stop says so."""
     false, i4_alone = [], 0
     for seed in range(100, 120):
-        res = explain(paper, _record(paper, paper.law, seed=seed), "linear",
-                      n_boot_intervals=0)
+        res = explain(paper, _record(paper, paper.law, seed=seed), "linear", n_boot_intervals=0)
         if any(it.effect for it in res.iterations):
             false.append(seed)
         if not res.consistent:
-            assert "I4 alone" in res.stopped_because or "do not shrink the gap" in \
-                res.stopped_because, (seed, res.stopped_because)
+            assert (
+                "I4 alone" in res.stopped_because or "do not shrink the gap" in res.stopped_because
+            ), (seed, res.stopped_because)
             i4_alone += 1
     assert false == []
     assert i4_alone <= 3
@@ -103,13 +107,16 @@ def test_hidden_sensor_lag_is_named(paper):
     tau = res.final_model.observation["sensor_lag"]
     assert 0.5e-4 < tau < 2e-4
     it = res.iterations[0]
-    assert it.criteria_after["I2"] <= it.criteria_before["I2"] / 3 \
+    assert (
+        it.criteria_after["I2"] <= it.criteria_before["I2"] / 3
         or it.criteria_after["I2"] <= 1.5 * it.noise_floor["I2"]
+    )
     # the screening refits run in two processes; one process gives the same result
     one = explain(paper, rec, "linear", effects=pick, workers=1, n_boot_intervals=0)
     assert one.final_model == res.final_model
-    assert [x.as_dict()["scores"] for x in one.iterations] == \
-        [x.as_dict()["scores"] for x in res.iterations]
+    assert [x.as_dict()["scores"] for x in one.iterations] == [
+        x.as_dict()["scores"] for x in res.iterations
+    ]
 
 
 def test_the_papers_claim_coupling_moves_the_force_maximum_into_the_impact(paper):
@@ -119,7 +126,7 @@ def test_the_papers_claim_coupling_moves_the_force_maximum_into_the_impact(paper
     hc = response(paper, ForceLaw.parse("2.06e8*z + 1e5*zd + 5e9*z*zd + 1e5*zd^2")).impulse
 
     def where(imp):
-        (a, b), = imp.support[:1]
+        ((a, b),) = imp.support[:1]
         m = (imp.t >= a) & (imp.t < b)
         return (imp.t[m][np.argmax(imp.F[m])] - a) / (b - a)
 
@@ -133,8 +140,14 @@ def test_first_order_lag_is_exact_for_a_step():
 
     W, tau = 1.0, 0.01
     t = np.array([0.0, 0.5, 0.5, 1.0])
-    imp = Impulse(t=t, F=np.array([1.0, 1.0, 0.0, 0.0]), duration=W,
-                  support=np.array([[0.0, 0.5]]), n_periods=1, onset=0.0)
+    imp = Impulse(
+        t=t,
+        F=np.array([1.0, 1.0, 0.0, 0.0]),
+        duration=W,
+        support=np.array([[0.0, 0.5]]),
+        n_periods=1,
+        onset=0.0,
+    )
     out = first_order_lag(imp, tau)
     for s in (0.01, 0.03, 0.1):
         # periodic steady state of the filter: the step starts from the decayed tail
@@ -150,9 +163,14 @@ def test_catalogue_entries_are_complete():
         assert d["parameters"][0]["bounds"][0] >= 0
     # the effects the paper's model cannot have say which of its conditions they leave
     assert "condition (5)" in effect("unloading_damping").departs
-    assert {e.id for e in EFFECTS} >= {"penetration_velocity_coupling", "hertzian_stiffening",
-                                       "unloading_damping", "permanent_set",
-                                       "support_nonlinearity", "sensor_lag"}
+    assert {e.id for e in EFFECTS} >= {
+        "penetration_velocity_coupling",
+        "hertzian_stiffening",
+        "unloading_damping",
+        "permanent_set",
+        "support_nonlinearity",
+        "sensor_lag",
+    }
     with pytest.raises(InputError, match="unknown effect"):
         effect("gremlins")
 
@@ -176,6 +194,5 @@ def test_explain_cli_end_to_end(hidden_coupling, tmp_path, capsys):
     assert (out / "explain_1.png").stat().st_size > 10_000
     assert "penetration_velocity_coupling" in capsys.readouterr().out
     bad = tmp_path / "bad"
-    assert main(["explain", "--data", str(data), "--effects", "gremlins",
-                 "--out", str(bad)]) == 2
+    assert main(["explain", "--data", str(data), "--effects", "gremlins", "--out", str(bad)]) == 2
     assert "unknown effect" in capsys.readouterr().err and not bad.exists()

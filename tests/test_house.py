@@ -27,7 +27,7 @@ def _imports(path, name):
         if isinstance(node, ast.ImportFrom):
             if node.level:
                 parts = base.split(".")
-                parent = ".".join(parts[:len(parts) - node.level + 1])
+                parent = ".".join(parts[: len(parts) - node.level + 1])
                 mod = f"{parent}.{node.module}" if node.module else parent
             else:
                 mod = node.module or ""
@@ -56,8 +56,11 @@ def test_no_import_cycle_between_modules():
             name = _module_name(path)
             if path.name == "__init__.py":
                 continue
-            graph[name] = {m for m in _imports(path, name) if not (ROOT.joinpath(
-                *m.split(".")) / "__init__.py").is_file()}
+            graph[name] = {
+                m
+                for m in _imports(path, name)
+                if not (ROOT.joinpath(*m.split(".")) / "__init__.py").is_file()
+            }
     state, stack, cycles = {}, [], []
 
     def visit(n):
@@ -65,7 +68,7 @@ def test_no_import_cycle_between_modules():
         stack.append(n)
         for m in sorted(graph.get(n, ())):
             if state.get(m) == 1:
-                cycles.append(stack[stack.index(m):] + [m])
+                cycles.append(stack[stack.index(m) :] + [m])
             elif m not in state:
                 visit(m)
         stack.pop()
@@ -92,8 +95,9 @@ def _resolve(path):
 
 def test_every_path_the_readme_documents_imports():
     text = (ROOT / "README.md").read_text()
-    paths = sorted(set(re.findall(r"`((?:discovery|reports|constraints)(?:\.[A-Za-z_]\w*)+)",
-                                  text)))
+    paths = sorted(
+        set(re.findall(r"`((?:discovery|reports|constraints)(?:\.[A-Za-z_]\w*)+)", text))
+    )
     assert len(paths) >= 15
     bad = []
     for p in paths:
@@ -123,14 +127,17 @@ def test_figures_leave_the_users_backend_alone():
     import subprocess
     import sys
 
-    code = ("import sys, matplotlib; matplotlib.use('svg'); "
-            "import reports.figures, reports.ueda_figures, reports.ueda_explain_figure, "
-            "reports.study_figures; "
-            "from reports._mpl import subplots, save; import tempfile, os; "
-            "fig, ax = subplots(figsize=(2, 2)); ax.plot([0, 1]); "
-            "d = tempfile.mkdtemp(); save(fig, os.path.join(d, 'x')); "
-            "assert matplotlib.get_backend() == 'svg', matplotlib.get_backend(); "
-            "assert 'matplotlib.pyplot' not in sys.modules; print('ok')")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         cwd=ROOT, timeout=120)
+    code = (
+        "import sys, matplotlib; matplotlib.use('svg'); "
+        "import reports.figures, reports.ueda_figures, reports.ueda_explain_figure, "
+        "reports.study_figures; "
+        "from reports._mpl import subplots, save; import tempfile, os; "
+        "fig, ax = subplots(figsize=(2, 2)); ax.plot([0, 1]); "
+        "d = tempfile.mkdtemp(); save(fig, os.path.join(d, 'x')); "
+        "assert matplotlib.get_backend() == 'svg', matplotlib.get_backend(); "
+        "assert 'matplotlib.pyplot' not in sys.modules; print('ok')"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=120
+    )
     assert out.stdout.strip() == "ok", out.stderr

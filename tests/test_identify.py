@@ -55,14 +55,14 @@ def test_budget_counts_every_simulation(paper, reference):
     assert res.n_simulations <= 7 + 2
     assert "budget" in res.message
     # a budget-limited result is still the best law seen, not the start
-    assert res.value <= identify(paper, reference, START, max_simulations=2,
-                                 uncertainty=False).value
+    assert (
+        res.value <= identify(paper, reference, START, max_simulations=2, uncertainty=False).value
+    )
 
 
 @pytest.mark.parametrize("method", ["nelder-mead", "coordinate-descent"])
 def test_derivative_free_methods_agree(paper, reference, fitted, method):
-    res = identify(paper, reference, START, method=method, max_simulations=300,
-                   uncertainty=False)
+    res = identify(paper, reference, START, method=method, max_simulations=300, uncertainty=False)
     assert res.standard_errors == {}
     start = identify(paper, reference, START, max_simulations=2, uncertainty=False).value
     assert res.value < start
@@ -75,16 +75,18 @@ def test_derivative_free_methods_agree(paper, reference, fitted, method):
     # estimators of the same law, a few standard errors apart (measured: z 2.0586e8 by the
     # simplex vs 2.0593e8 +- 4e5 by least squares)
     for name, c in fitted.coefficients.items():
-        assert abs(res.coefficients[name] - c) < max(3 * fitted.standard_errors[name],
-                                                     0.03 * abs(c))
+        assert abs(res.coefficients[name] - c) < max(
+            3 * fitted.standard_errors[name], 0.03 * abs(c)
+        )
 
 
 def test_failed_trial_laws_are_recorded_not_silent(paper, reference):
     """A start far from the record makes the optimiser try laws with no periodic orbit;
     each is recorded with its status and message."""
     start = ForceLaw.parse("2.06e8*z + 1.28e7*zd + 1e4*zd^2")
-    res = identify(paper, reference, start, method="coordinate-descent", max_simulations=60,
-                   uncertainty=False)
+    res = identify(
+        paper, reference, start, method="coordinate-descent", max_simulations=60, uncertainty=False
+    )
     for f in res.failures:
         assert f["status"] in ("nonperiodic", "no-contact", "failed") and f["message"]
     if res.failures:
@@ -96,12 +98,15 @@ def test_start_law_that_fails_is_an_error(paper, reference):
         identify(paper, reference, ForceLaw.parse("1e3*zd"), max_simulations=20)
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    ({"method": "simplex"}, "unknown method"),
-    ({"xtol": -1.0}, "xtol"),
-    ({"max_simulations": 1}, "budget"),
-    ({"max_simulations": 2.5}, "max_simulations must be an integer"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"method": "simplex"}, "unknown method"),
+        ({"xtol": -1.0}, "xtol"),
+        ({"max_simulations": 1}, "budget"),
+        ({"max_simulations": 2.5}, "max_simulations must be an integer"),
+    ],
+)
 def test_bad_settings(paper, reference, kwargs, match):
     with pytest.raises(VidiError, match=match):  # InputError, or VidiTypeError for a type
         identify(paper, reference, START, **kwargs)
@@ -109,7 +114,7 @@ def test_bad_settings(paper, reference, kwargs, match):
 
 def test_as_records_accepts_impulses_references_and_lists(paper, record, reference):
     E = record.impulse(paper.period)
-    (sc, ref), = as_records(paper, E)
+    ((sc, ref),) = as_records(paper, E)
     assert ref.noise == {} and ref.impulse is E
     pairs = as_records(paper, [reference, record])
     assert len(pairs) == 2 and all(isinstance(r, Reference) for _, r in pairs)
@@ -124,8 +129,10 @@ def test_as_records_accepts_impulses_references_and_lists(paper, record, referen
 def two_points(paper):
     """The same machine at two drive amplitudes (two operating points), 1 % force noise."""
     high = dataclasses.replace(paper, A=1.4 * paper.A, name="paper-high")
-    recs = [synthesize(sc, paper.law, periods=15, fs=20000, noise=0.01, seed=k)
-            for k, sc in enumerate((paper, high))]
+    recs = [
+        synthesize(sc, paper.law, periods=15, fs=20000, noise=0.01, seed=k)
+        for k, sc in enumerate((paper, high))
+    ]
     return (paper, high), recs
 
 
@@ -161,11 +168,28 @@ def test_fit_cli_with_two_records_and_their_scenarios(two_points, tmp_path, caps
         paths.append(p)
     toml = tmp_path / "high.toml"
     m = scs[1]
-    toml.write_text(f'name = "paper-high"\n[machine]\nm1 = {m.m1!r}\nm2 = {m.m2!r}\n'
-                    f'k1 = {m.k1!r}\nc1 = {m.c1!r}\nA = {m.A!r}\nfrequency = {m.frequency!r}\n')
+    toml.write_text(
+        f'name = "paper-high"\n[machine]\nm1 = {m.m1!r}\nm2 = {m.m2!r}\n'
+        f"k1 = {m.k1!r}\nc1 = {m.c1!r}\nA = {m.A!r}\nfrequency = {m.frequency!r}\n"
+    )
     out = tmp_path / "fit"
-    rc = main(["fit", "--scenario", "paper", "--data", str(paths[0]), "--scenario", str(toml),
-               "--data", str(paths[1]), "--library", "z,zd", "--out", str(out)])
+    rc = main(
+        [
+            "fit",
+            "--scenario",
+            "paper",
+            "--data",
+            str(paths[0]),
+            "--scenario",
+            str(toml),
+            "--data",
+            str(paths[1]),
+            "--library",
+            "z,zd",
+            "--out",
+            str(out),
+        ]
+    )
     assert rc == 0
     s = json.loads((out / "summary.json").read_text())
     assert [r["scenario"] for r in s["records"]] == ["paper", "paper-high"]
@@ -175,7 +199,25 @@ def test_fit_cli_with_two_records_and_their_scenarios(two_points, tmp_path, caps
     assert "standard error" in text and "consistent with all 2 records" in text
     # two --data with three --scenario: one line, exit 2, nothing written
     out2 = tmp_path / "bad"
-    assert main(["fit", "--scenario", "paper", "--scenario", "paper", "--scenario", "paper",
-                 "--data", str(paths[0]), "--data", str(paths[1]), "--out", str(out2)]) == 2
+    assert (
+        main(
+            [
+                "fit",
+                "--scenario",
+                "paper",
+                "--scenario",
+                "paper",
+                "--scenario",
+                "paper",
+                "--data",
+                str(paths[0]),
+                "--data",
+                str(paths[1]),
+                "--out",
+                str(out2),
+            ]
+        )
+        == 2
+    )
     assert "one --scenario per --data" in capsys.readouterr().err
     assert not out2.exists()

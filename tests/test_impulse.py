@@ -56,8 +56,7 @@ def test_exact_impulse_structure(paper, paper_ss, paper_impulse):
     assert imp.evaluate(T) == imp.F[0]  # periodic
     # inside the support the force is the law on the orbit: compare at a few times
     te = imp.onset + np.array([0.1, 0.3, 0.6]) * imp.contact_time
-    tr2 = simulate(paper, paper.law, (paper_ss.t0, paper_ss.t0 + 2 * T), y0=paper_ss.y0,
-                   t_eval=te)
+    tr2 = simulate(paper, paper.law, (paper_ss.t0, paper_ss.t0 + 2 * T), y0=paper_ss.y0, t_eval=te)
     # rel 1e-3: linear interpolation on h = T/2000 = 2e-5 s of a force decaying with a
     # time constant ~0.45 ms errs by up to h^2 |F''| / 8 ~ 2.5e-4 F (measured 8.4e-5)
     np.testing.assert_allclose(imp.evaluate(te - imp.onset), tr2.force, rtol=1e-3)
@@ -77,12 +76,17 @@ def test_exact_impulse_needs_periodic_state(paper, paper_ss):
 
 
 def test_impulse_evaluate_limits_and_periodic_support():
-    imp = Impulse(t=np.array([0, 0.3, 0.3, 1.0]), F=np.array([2.0, 2.0, 0.0, 0.0]),
-                  duration=1.0, support=np.array([[0.0, 0.3]]), n_periods=1, onset=0.0)
+    imp = Impulse(
+        t=np.array([0, 0.3, 0.3, 1.0]),
+        F=np.array([2.0, 2.0, 0.0, 0.0]),
+        duration=1.0,
+        support=np.array([[0.0, 0.3]]),
+        n_periods=1,
+        onset=0.0,
+    )
     assert imp.evaluate(0.3) == 0.0 and imp.evaluate(0.3, side="left") == 2.0
     np.testing.assert_array_equal(imp.evaluate([0.1, 1.1, 2.35, 5.0]), [2.0, 2.0, 0.0, 2.0])
-    np.testing.assert_array_equal(imp.periodic_support(3.0),
-                                  [[0, 0.3], [1, 1.3], [2, 2.3]])
+    np.testing.assert_array_equal(imp.periodic_support(3.0), [[0, 0.3], [1, 1.3], [2, 2.3]])
     with pytest.raises(ValueError):
         imp.periodic_support(2.5)
 
@@ -125,8 +129,14 @@ def _shifted(imp, d):
     t = np.concatenate([[0.0], imp.t + d])
     F = np.concatenate([[0.0], imp.F])
     keep = t < imp.duration
-    return Impulse(t=np.append(t[keep], imp.duration), F=np.append(F[keep], 0.0),
-                   duration=imp.duration, support=imp.support + d, n_periods=1, onset=0.0)
+    return Impulse(
+        t=np.append(t[keep], imp.duration),
+        F=np.append(F[keep], 0.0),
+        duration=imp.duration,
+        support=imp.support + d,
+        n_periods=1,
+        onset=0.0,
+    )
 
 
 def test_samples_close_to_exact_impulse(paper, paper_record, paper_impulse):

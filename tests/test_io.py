@@ -89,9 +89,12 @@ def test_a_symlinked_target_is_refused_and_left_alone(tmp_path):
     link.symlink_to(real)
     with pytest.raises(InputError, match="symbolic link"):
         _write_set(link, 2)
-    assert link.is_symlink() and _snapshot(real) == {"a.csv": "1\n", "b.png": "1\n",
-                                                     "lab_notes.txt": "mine",
-                                                     "summary.json": "1\n"}
+    assert link.is_symlink() and _snapshot(real) == {
+        "a.csv": "1\n",
+        "b.png": "1\n",
+        "lab_notes.txt": "mine",
+        "summary.json": "1\n",
+    }
 
 
 @pytest.mark.skipif(not LINUX, reason="readers by directory fd")
@@ -186,7 +189,14 @@ def test_check_output_refusals(tmp_path, monkeypatch):
     for ok in ("new/deeper/res", "empty", "prev"):
         assert check_output(ok, [data]) == Path(ok)
     assert sorted(p.name for p in tmp_path.iterdir()) == [
-        "afile", "d.csv", "empty", "holder", "mine", "prev", "withsub"]
+        "afile",
+        "d.csv",
+        "empty",
+        "holder",
+        "mine",
+        "prev",
+        "withsub",
+    ]
     assert (notours / "notes.txt").read_text() == "keep me"
 
 
@@ -250,8 +260,12 @@ _WRITER = textwrap.dedent("""
 def test_sigkill_leaves_staging_that_the_next_run_removes(tmp_path):
     target = tmp_path / "res"
     _write_set(target, "earlier")
-    p = subprocess.Popen([sys.executable, "-c", _WRITER, str(target), "hang"],
-                         stdout=subprocess.PIPE, text=True, cwd=ROOT)
+    p = subprocess.Popen(
+        [sys.executable, "-c", _WRITER, str(target), "hang"],
+        stdout=subprocess.PIPE,
+        text=True,
+        cwd=ROOT,
+    )
     assert p.stdout.readline().strip() == "ready"
     assert p.stdout.readline().strip() == "staged"
     p.kill()
@@ -270,13 +284,20 @@ def test_sigkill_at_random_moments_never_mixes(tmp_path, exchange):
     """A writer replacing the set in a loop is killed at random moments: the target is
     always one complete set, and the next run leaves no staging behind."""
     target = tmp_path / "res"
-    script = _WRITER if exchange else (
-        "import discovery._io as m; m._exchange = lambda a, b: False\n" + _WRITER)
+    script = (
+        _WRITER
+        if exchange
+        else ("import discovery._io as m; m._exchange = lambda a, b: False\n" + _WRITER)
+    )
     _write_set(target, "earlier", ("summary.json", "a.csv", "b.png", "c.pdf"))
     rng = __import__("random").Random(7)
     for _ in range(3):
-        p = subprocess.Popen([sys.executable, "-c", script, str(target), "loop"],
-                             stdout=subprocess.PIPE, text=True, cwd=ROOT)
+        p = subprocess.Popen(
+            [sys.executable, "-c", script, str(target), "loop"],
+            stdout=subprocess.PIPE,
+            text=True,
+            cwd=ROOT,
+        )
         assert p.stdout.readline().strip() == "ready"
         time.sleep(0.05 + rng.random() * 0.3)  # hundreds of commits
         p.send_signal(signal.SIGKILL)
@@ -294,8 +315,10 @@ def test_sigkill_at_random_moments_never_mixes(tmp_path, exchange):
 def test_provenance_versions_git_and_inputs(tmp_path):
     data = tmp_path / "d.csv"
     data.write_bytes(b"t,F\n0,1\n")
-    p = provenance({"seed": 1, "f": print}, inputs={"data": data, "scenario": "paper",
-                                                   "missing": tmp_path / "nope"})
+    p = provenance(
+        {"seed": 1, "f": print},
+        inputs={"data": data, "scenario": "paper", "missing": tmp_path / "nope"},
+    )
     for name in ("scikit-learn", "clarabel", "osqp", "cvxpy", "numpy"):
         assert p["versions"][name], name
     assert p["settings"] == {"seed": 1}
@@ -368,8 +391,9 @@ def _running(pid):
 
 @pytest.mark.skipif(not LINUX, reason="PR_SET_PDEATHSIG is Linux")
 def test_workers_die_with_their_parent():
-    p = subprocess.Popen([sys.executable, "-c", _POOL, "guarded"], stdout=subprocess.PIPE,
-                         text=True, cwd=ROOT)
+    p = subprocess.Popen(
+        [sys.executable, "-c", _POOL, "guarded"], stdout=subprocess.PIPE, text=True, cwd=ROOT
+    )
     workers = [int(w) for w in p.stdout.readline().split()]
     p.stdout.close()
     assert len(workers) == 2 and all(_running(w) for w in workers)
@@ -384,10 +408,13 @@ def test_workers_die_with_their_parent():
 @pytest.mark.skipif(not LINUX, reason="/proc")
 def test_die_with_parent_in_this_process_is_harmless():
     # run in a child so the signal dispositions of the test process are untouched
-    code = ("import os, signal\nfrom discovery._workers import die_with_parent\n"
-            "print(die_with_parent(), signal.getsignal(signal.SIGINT) is signal.SIG_IGN)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         cwd=ROOT, check=True).stdout.split()
+    code = (
+        "import os, signal\nfrom discovery._workers import die_with_parent\n"
+        "print(die_with_parent(), signal.getsignal(signal.SIGINT) is signal.SIG_IGN)"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True
+    ).stdout.split()
     assert out == ["prctl", "True"]
 
 
@@ -398,8 +425,13 @@ def test_user_files_in_an_earlier_result_are_kept(tmp_path):
     (target / "lab_notes.txt").write_text("mine")
     (target / "record2.csv").write_text("t,F\n")
     _write_set(target, 2)
-    assert _snapshot(target) == {"a.csv": "2\n", "b.png": "2\n", "summary.json": "2\n",
-                                 "lab_notes.txt": "mine", "record2.csv": "t,F\n"}
+    assert _snapshot(target) == {
+        "a.csv": "2\n",
+        "b.png": "2\n",
+        "summary.json": "2\n",
+        "lab_notes.txt": "mine",
+        "record2.csv": "t,F\n",
+    }
     manifest = json.loads((target / _io.MANIFEST).read_text())
     assert manifest["files"] == ["a.csv", "b.png", "summary.json"]
 
@@ -411,7 +443,7 @@ def test_a_file_dropped_in_during_the_run_is_kept(tmp_path):
         for n in ("summary.json", "a.csv", "notes.txt"):
             out.path(n).write_text("2\n")
         (target / "dropped.txt").write_text("during")  # the user, while the run goes on
-        (target / "notes.txt").write_text("user's")    # a name the new result also uses
+        (target / "notes.txt").write_text("user's")  # a name the new result also uses
     snap = _snapshot(target)
     assert snap["dropped.txt"] == "during" and snap["notes.txt"] == "2\n"
     assert snap["notes.txt.kept"] == "user's"

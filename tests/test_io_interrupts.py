@@ -68,11 +68,18 @@ def test_keyboard_interrupt_in_process(earlier, monkeypatch, capsys):
     _intact(earlier)
 
 
-@pytest.mark.parametrize(("sig", "code", "word"), [(signal.SIGINT, 130, "interrupted"),
-                                                   (signal.SIGTERM, 143, "terminated")])
+@pytest.mark.parametrize(
+    ("sig", "code", "word"),
+    [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "terminated")],
+)
 def test_signal_exits_with_one_line(earlier, sig, code, word):
-    p = subprocess.Popen([sys.executable, "-c", _CHILD, str(earlier)], cwd=ROOT,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(
+        [sys.executable, "-c", _CHILD, str(earlier)],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     _wait_staged(p)
     assert any(".vidi-staging." in q.name for q in earlier.parent.iterdir())
     p.send_signal(sig)
@@ -85,8 +92,9 @@ def test_signal_exits_with_one_line(earlier, sig, code, word):
 
 
 def test_sigkill_then_next_run_cleans_up(earlier, capsys):
-    p = subprocess.Popen([sys.executable, "-c", _CHILD, str(earlier)], cwd=ROOT,
-                         stdout=subprocess.PIPE, text=True)
+    p = subprocess.Popen(
+        [sys.executable, "-c", _CHILD, str(earlier)], cwd=ROOT, stdout=subprocess.PIPE, text=True
+    )
     _wait_staged(p)
     p.kill()
     p.wait()
@@ -99,8 +107,11 @@ def test_sigkill_then_next_run_cleans_up(earlier, capsys):
     assert sorted(q.name for q in earlier.parent.iterdir()) == ["res"]
     # an earlier result without a manifest (older vidi): what the new result does not
     # replace is kept, since nothing says it was vidi's
-    assert sorted(q.name for q in earlier.iterdir()) == [".vidi-manifest.json", "figure.png",
-                                                         "summary.json"]
+    assert sorted(q.name for q in earlier.iterdir()) == [
+        ".vidi-manifest.json",
+        "figure.png",
+        "summary.json",
+    ]
     assert json.loads((earlier / "summary.json").read_text())["command"] == "steady"
 
 
@@ -133,15 +144,35 @@ def test_ctrl_c_to_the_process_group_during_identify(tmp_path, delay):
     when the run had already finished), never an internal error or a traceback."""
     from discovery import ForceLaw, load_scenario, synthesize
 
-    rec = synthesize(load_scenario("paper"), ForceLaw.parse("2e8*z + 1e7*zd"), periods=8,
-                     noise=0.01, seed=1)
+    rec = synthesize(
+        load_scenario("paper"), ForceLaw.parse("2e8*z + 1e7*zd"), periods=8, noise=0.01, seed=1
+    )
     rec.to_csv(tmp_path / "R.csv")
     entry = "import sys; from discovery.cli import main; sys.exit(main())"
-    p = subprocess.Popen([sys.executable, "-c", entry, "identify", "--scenario",
-                          "paper", "--data", "R.csv", "--start", "1.5e8*z + 8e6*zd",
-                          "--intervals", "10", "--out", "I"], cwd=tmp_path,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         start_new_session=True, preexec_fn=_restore_sigint)
+    p = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            entry,
+            "identify",
+            "--scenario",
+            "paper",
+            "--data",
+            "R.csv",
+            "--start",
+            "1.5e8*z + 8e6*zd",
+            "--intervals",
+            "10",
+            "--out",
+            "I",
+        ],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        preexec_fn=_restore_sigint,
+    )
     time.sleep(delay)
     with contextlib.suppress(ProcessLookupError):
         os.killpg(p.pid, signal.SIGINT)
@@ -150,8 +181,10 @@ def test_ctrl_c_to_the_process_group_during_identify(tmp_path, delay):
     assert "Traceback" not in err and "internal error" not in err, err
     if p.returncode == 130:
         lines = [ln for ln in err.splitlines() if not ln.endswith(" ...")]  # progress lines
-        assert lines == ["vidi: error: interrupted (Ctrl-C); partial outputs were "
-                                    "removed, earlier results are unchanged"], err
+        assert lines == [
+            "vidi: error: interrupted (Ctrl-C); partial outputs were "
+            "removed, earlier results are unchanged"
+        ], err
         assert not (tmp_path / "I").exists()
         assert not [q for q in tmp_path.iterdir() if ".vidi-staging." in q.name]
 
@@ -169,6 +202,8 @@ def test_out_of_memory_is_one_line_once_the_memory_is_freed(earlier, monkeypatch
     monkeypatch.setattr(st, "provenance", exhaust)
     assert main(["steady", "--out", str(earlier)]) == 2
     err = capfd.readouterr().err
-    assert err.splitlines() == ["vidi: error: not enough memory for this run; reduce its size "
-                                "(--fs, --periods, --grid) and try again"], err
+    assert err.splitlines() == [
+        "vidi: error: not enough memory for this run; reduce its size "
+        "(--fs, --periods, --grid) and try again"
+    ], err
     _intact(earlier)

@@ -46,16 +46,14 @@ def _limit(ev, name="I2"):
 
 
 # ------------------------------------------------------------ case 2: noise floor
-_P4 = Scenario(m1=10800.0, m2=5960.0, k1=216000000.0, c1=96300.0, A=393000.0,
-               frequency=13.7)
+_P4 = Scenario(m1=10800.0, m2=5960.0, k1=216000000.0, c1=96300.0, A=393000.0, frequency=13.7)
 _P4_LAW = ForceLaw.parse("81100000*z + 4910000*zd")  # P4, 2 impacts ("subharmonic" seed 5)
 
 
 @pytest.mark.parametrize("seed", [0, 1])
 def test_case2_noise_floor_of_a_multi_impact_orbit_is_aligned(seed):
     rec = R.reference_record((_P4, _P4_LAW), transient=30, seed=seed)
-    ref, ev, (no_k,) = _verify(_P4, _P4_LAW, rec,
-                               wrong=[ForceLaw.parse("4910000*zd")])
+    ref, ev, (no_k,) = _verify(_P4, _P4_LAW, rec, wrong=[ForceLaw.parse("4910000*zd")])
     assert ref.regime == "P4"
     assert ev.consistent, ev.verdict
     # floor of the true law: 0.235 and 0.61 before (misaligned replicates); now ~0.06,
@@ -69,8 +67,7 @@ def test_case2_noise_floor_of_a_multi_impact_orbit_is_aligned(seed):
 
 
 # --------------------------------------------------------------- case 3: P1 as P2
-_SHORT_P1 = Scenario(m1=4390.0, m2=3270.0, k1=21900000.0, c1=73600.0, A=142000.0,
-                     frequency=16.6)
+_SHORT_P1 = Scenario(m1=4390.0, m2=3270.0, k1=21900000.0, c1=73600.0, A=142000.0, frequency=16.6)
 _SHORT_P1_LAW = ForceLaw.parse("3370000000*z + 8150000*zd + 78700000000*z*zd")
 
 
@@ -98,15 +95,13 @@ def test_case3_p1_record_with_varying_sampled_impulses_is_p1(seed):
 
 
 # --------------------------------------------------------- case 4: short contact
-_SHORT = Scenario(m1=10000.0, m2=5000.0, k1=322000000.0, c1=718000.0, A=235000.0,
-                  frequency=23.8)
+_SHORT = Scenario(m1=10000.0, m2=5000.0, k1=322000000.0, c1=718000.0, A=235000.0, frequency=23.8)
 _SHORT_LAW = ForceLaw.parse("11400000000*z + 3700000*zd + 43500000000*z*zd")
 
 
 @pytest.fixture(scope="module")
 def short_contact_records():
-    return [R.reference_record((_SHORT, _SHORT_LAW), force_noise=0.02, seed=s)
-            for s in (0, 1)]
+    return [R.reference_record((_SHORT, _SHORT_LAW), force_noise=0.02, seed=s) for s in (0, 1)]
 
 
 def test_case4_machine_is_a_short_contact():
@@ -120,8 +115,7 @@ def test_case4_machine_is_a_short_contact():
 
 
 @pytest.mark.parametrize("index", [0, 1])
-def test_case4_short_contact_true_law_consistent_missing_term_not(short_contact_records,
-                                                                    index):
+def test_case4_short_contact_true_law_consistent_missing_term_not(short_contact_records, index):
     rec = short_contact_records[index]
     wrong = [law for label, law in R.wrong_laws(_SHORT_LAW) if label.startswith("drop")]
     assert len(wrong) == 3
@@ -137,16 +131,15 @@ def test_case4_short_contact_true_law_consistent_missing_term_not(short_contact_
 
 
 # ------------------------------------------------------ case 5: noisy penetration
-_HERTZ = Scenario(m1=4960.0, m2=6350.0, k1=269000000.0, c1=330000.0, A=295000.0,
-                  frequency=32.2)
+_HERTZ = Scenario(m1=4960.0, m2=6350.0, k1=269000000.0, c1=330000.0, A=295000.0, frequency=32.2)
 _HERTZ_LAW = ForceLaw.parse("236000000000*z^1.5 + 6660000000000*z^1.5*zd")  # "p1" seed 3
-_JUMP = Scenario(m1=4240.0, m2=3230.0, k1=177000000.0, c1=166000.0, A=169000.0,
-                 frequency=27.7)
+_JUMP = Scenario(m1=4240.0, m2=3230.0, k1=177000000.0, c1=166000.0, A=169000.0, frequency=27.7)
 _JUMP_LAW = ForceLaw.parse("4800000000*z + 12500000*zd")  # "p1" seed 2
 
 
-@pytest.mark.parametrize("sc, law, share", [(_HERTZ, _HERTZ_LAW, 0.04),
-                                            (_JUMP, _JUMP_LAW, 0.12)], ids=["hertz", "jump"])
+@pytest.mark.parametrize(
+    "sc, law, share", [(_HERTZ, _HERTZ_LAW, 0.04), (_JUMP, _JUMP_LAW, 0.12)], ids=["hertz", "jump"]
+)
 @pytest.mark.parametrize("seed", [0, 1])
 def test_case5_noisy_penetration_true_law_consistent(sc, law, share, seed):
     rec = R.reference_record((sc, law), transient=30, seed=seed)
@@ -159,8 +152,18 @@ def test_case5_noisy_penetration_true_law_consistent(sc, law, share, seed):
     assert ev.consistent, ev.verdict
 
 
-def _jump_train(seed, *, T=0.04, fs=20000.0, F0=1.0e6, width=1.5e-3, v=0.5, sigma_z=1.5e-5,
-                sigma_f=1.0e4, periods=12):
+def _jump_train(
+    seed,
+    *,
+    T=0.04,
+    fs=20000.0,
+    F0=1.0e6,
+    width=1.5e-3,
+    v=0.5,
+    sigma_z=1.5e-5,
+    sigma_f=1.0e4,
+    periods=12,
+):
     """Force jumps to F0 at each onset and decays linearly to 0 over ``width``; the
     penetration crosses zero at the onset with slope ``v`` (noise ``sigma_z``: about 0.6
     of its change per sample)."""

@@ -108,8 +108,9 @@ def _compare_with_reference(sc, law, n_periods=10, max_events=100_000):
     T = sc.period
     te = np.linspace(0.0, n_periods * T, 200 * n_periods + 1)
     tr = simulate(sc, law, (0.0, n_periods * T), t_eval=te, tolerances=Tolerances(rtol=1e-10))
-    ref = reference_simulate(sc, law, (0.0, n_periods * T), t_eval=te, rtol=1e-10,
-                             max_events=max_events)
+    ref = reference_simulate(
+        sc, law, (0.0, n_periods * T), t_eval=te, rtol=1e-10, max_events=max_events
+    )
     ours = [EVENT_NAMES[k] for k in tr.event_kind]
     theirs = _normalised_reference_events(ref["events"], T)
     assert ours == [k for _, k in theirs]
@@ -238,8 +239,7 @@ def test_split_integration_matches_single_run(paper):
     tol = Tolerances(rtol=1e-10)
     whole = simulate(paper, paper.law, (0.0, 4 * T), tolerances=tol)
     a = simulate(paper, paper.law, (0.0, 2 * T), tolerances=tol)
-    b = simulate(paper, paper.law, (2 * T, 4 * T), y0=a.y_final, mode0=a.mode_final,
-                 tolerances=tol)
+    b = simulate(paper, paper.law, (2 * T, 4 * T), y0=a.y_final, mode0=a.mode_final, tolerances=tol)
     x, v = paper.scales()
     scale = np.array([x, v, x, v])
     # different step sequences: agreement to ~rtol-level global error (1e-7 of scale)
@@ -261,8 +261,14 @@ def test_step_budget_exhausted(paper):
 
 def test_failed_run_keeps_only_reached_outputs(paper):
     te = np.linspace(0.0, paper.period, 11)
-    tr = simulate(paper, paper.law, (0.0, paper.period), t_eval=te,
-                  tolerances=Tolerances(max_steps=5), throw=False)
+    tr = simulate(
+        paper,
+        paper.law,
+        (0.0, paper.period),
+        t_eval=te,
+        tolerances=Tolerances(max_steps=5),
+        throw=False,
+    )
     assert np.all(tr.t <= tr.t_final) and tr.t.size < te.size
     assert tr.y.shape == (4, tr.t.size)
 
@@ -279,9 +285,18 @@ def test_invalid_t_eval(paper, te):
         simulate(paper, paper.law, (0.0, 0.04), t_eval=te)
 
 
-@pytest.mark.parametrize("kw", [dict(rtol=0), dict(rtol=1), dict(atol_scale=0),
-                                dict(max_steps=0), dict(max_steps=2.5),
-                                dict(hmax_fraction=0), dict(hmax_fraction=1.5)])
+@pytest.mark.parametrize(
+    "kw",
+    [
+        dict(rtol=0),
+        dict(rtol=1),
+        dict(atol_scale=0),
+        dict(max_steps=0),
+        dict(max_steps=2.5),
+        dict(hmax_fraction=0),
+        dict(hmax_fraction=1.5),
+    ],
+)
 def test_invalid_tolerances(kw):
     with pytest.raises(VidiError) as info:  # a wrong value, or a float for an integer
         Tolerances(**kw)

@@ -62,8 +62,7 @@ def test_recontact_run_stays_bounded_and_consistent(light, recontact_law):
 def test_recontact_agrees_with_reference(light, recontact_law):
     T = light.period
     te = np.union1d(np.linspace(0.0, 10 * T, 2001), np.linspace(0.1436, 0.1440, 81))
-    tr = simulate(light, recontact_law, (0.0, 10 * T), t_eval=te,
-                  tolerances=Tolerances(rtol=1e-10))
+    tr = simulate(light, recontact_law, (0.0, 10 * T), t_eval=te, tolerances=Tolerances(rtol=1e-10))
     ref = reference_simulate(light, recontact_law, (0.0, 10 * T), t_eval=te, rtol=1e-10)
     x, v = light.scales()
     scale = np.array([x, v, x, v])[:, None]
@@ -107,8 +106,9 @@ def test_free_flight_starting_on_the_surface(light, recontact_law, offset):
     y0 = tr.event_y[k].copy()
     y0[2] = y0[0] - offset  # zeta = offset
     # a long first step (the one that works before the cut), as after a located event
-    out = simulate(light, recontact_law, (tr.event_t[k], tr.event_t[k] + 0.005), y0=y0,
-                   mode0=K.FREE)
+    out = simulate(
+        light, recontact_law, (tr.event_t[k], tr.event_t[k] + 0.005), y0=y0, mode0=K.FREE
+    )
     assert out.event_kind[0] == K.EV_ONSET
     assert out.event_t[0] == pytest.approx(ONSET_T, abs=1e-7)
 
@@ -126,8 +126,9 @@ def test_start_across_the_surface_coming_back_is_not_an_event(light, recontact_l
     step cut to a contact loss may end, at loose tolerances, a little inside): still
     inside at the first probes, yet no contact is invented; the flight goes on."""
     y0 = np.array([0.0, -1e-5, -1e-7, 0.0])  # zeta = 1e-7 m, separating at 1e-5 m/s
-    tr = simulate(light, recontact_law, (0.0, 0.02), y0=y0, mode0=K.FREE,
-                  t_eval=np.linspace(0.0, 0.02, 201))
+    tr = simulate(
+        light, recontact_law, (0.0, 0.02), y0=y0, mode0=K.FREE, t_eval=np.linspace(0.0, 0.02, 201)
+    )
     assert tr.success and tr.event_t.size == 0
     assert tr.zeta[0] > 0 and tr.zeta[-1] < 0
 
@@ -151,9 +152,21 @@ def _graze(depth, shift):
     """No gravity, no drive: the frame oscillates, the moulding floats at AMP - depth,
     so zeta peaks at +depth at t = pi / OMEGA - shift: a contact of ~2 sqrt(2 depth /
     (AMP OMEGA^2)) s (0.9 us at depth 1e-13 m), far shorter than the steps (1 ms)."""
-    sc = Scenario(m1=1.0, m2=1.0, k1=OMEGA**2, c1=0.0, A=0.0, frequency=20.0, g=0.0,
-                  initial=(-AMP * np.cos(OMEGA * shift), AMP * OMEGA * np.sin(OMEGA * shift),
-                           AMP - depth, 0.0))
+    sc = Scenario(
+        m1=1.0,
+        m2=1.0,
+        k1=OMEGA**2,
+        c1=0.0,
+        A=0.0,
+        frequency=20.0,
+        g=0.0,
+        initial=(
+            -AMP * np.cos(OMEGA * shift),
+            AMP * OMEGA * np.sin(OMEGA * shift),
+            AMP - depth,
+            0.0,
+        ),
+    )
     t_on = (np.pi - np.arccos(1.0 - depth / AMP)) / OMEGA - shift
     return sc, t_on
 

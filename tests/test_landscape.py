@@ -42,8 +42,7 @@ def test_a_failed_simulation_is_failed_not_nonperiodic(paper, tmp_path):
     from reports import landscape_figure
 
     tol = Tolerances(max_steps=10_000)  # enough for the paper's stiffness, not for 1e2 x it
-    land = landscape(paper, paper.law, [2.06e8, 2e10], [1.28e7, 1.5e7], workers=1,
-                     tolerances=tol)
+    land = landscape(paper, paper.law, [2.06e8, 2e10], [1.28e7, 1.5e7], workers=1, tolerances=tol)
     assert list(land.regime[0]) == ["P1", "P1"]
     assert list(land.regime[1]) == ["failed", "failed"]
     assert np.isnan(land.values["I2"][1]).all() and np.isfinite(land.values["I2"][0]).all()
@@ -58,12 +57,29 @@ def test_a_failed_simulation_is_failed_not_nonperiodic(paper, tmp_path):
 def noisy_record(tmp_path_factory):
     d = tmp_path_factory.mktemp("rec")
     path = d / "noisy.csv"
-    assert main(["simulate", "--periods", "12", "--noise", "0.01", "--position-noise", "0.01",
-                 "--seed", "1", "--out", str(path)]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                "--periods",
+                "12",
+                "--noise",
+                "0.01",
+                "--position-noise",
+                "0.01",
+                "--seed",
+                "1",
+                "--out",
+                str(path),
+            ]
+        )
+        == 0
+    )
     # an extra column: the record's loading notes must be printed
     lines = path.read_text().splitlines()
-    path.write_text("\n".join([lines[0] + ",temperature"] + [ln + ",20" for ln in lines[1:]])
-                    + "\n")
+    path.write_text(
+        "\n".join([lines[0] + ",temperature"] + [ln + ",20" for ln in lines[1:]]) + "\n"
+    )
     return path
 
 
@@ -71,8 +87,24 @@ def test_landscape_against_a_record(noisy_record, tmp_path, capsys):
     from discovery.cli.identify import _load_landscape
 
     out = tmp_path / "land"
-    assert main(["landscape", "--data", str(noisy_record), "--grid", "5x5", "--workers", "2",
-                 "--n-boot", "8", "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "landscape",
+                "--data",
+                str(noisy_record),
+                "--grid",
+                "5x5",
+                "--workers",
+                "2",
+                "--n-boot",
+                "8",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     printed = capsys.readouterr().out
     assert "note: ignored column(s): temperature" in printed
     assert "I2: minimum" in printed and "(noise floor " in printed
@@ -101,14 +133,19 @@ def test_landscape_against_a_record(noisy_record, tmp_path, capsys):
     # ... and refuses one for other terms, another scenario or of the wrong shape, before
     # any simulation
     base = ["identify", "--data", str(noisy_record), "--out", str(tmp_path / "id")]
-    cases = [(["--start", "1e8*z^1.5 + 1e7*zd", "--landscape", str(out)], "not the start's"),
-             (["--scenario", "light", "--start", "1e10*z + 1e11*zd", "--landscape", str(out)],
-              "made for scenario 'paper'")]
+    cases = [
+        (["--start", "1e8*z^1.5 + 1e7*zd", "--landscape", str(out)], "not the start's"),
+        (
+            ["--scenario", "light", "--start", "1e10*z + 1e11*zd", "--landscape", str(out)],
+            "made for scenario 'paper'",
+        ),
+    ]
     broken = tmp_path / "broken.json"
     s["I2"] = s["I2"][:3]
     broken.write_text(json.dumps(s))
-    cases.append((["--start", "1e8*z + 1e7*zd", "--landscape", str(broken)],
-                   "do not match its axes"))
+    cases.append(
+        (["--start", "1e8*z + 1e7*zd", "--landscape", str(broken)], "do not match its axes")
+    )
     for extra, needle in cases:
         capsys.readouterr()
         assert main(base + extra) == 2
@@ -119,31 +156,64 @@ def test_landscape_against_a_record(noisy_record, tmp_path, capsys):
 
 def test_default_ranges_are_centred_on_the_template(tmp_path):
     out = tmp_path / "light"
-    assert main(["landscape", "--scenario", "light", "--grid", "3x3", "--workers", "1",
-                 "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "landscape",
+                "--scenario",
+                "light",
+                "--grid",
+                "3x3",
+                "--workers",
+                "1",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     s = json.loads((out / "summary.json").read_text())
     assert s["alpha1"] == [1e10, 2e10, 3e10] and s["alpha2"] == [2.5e11, 5e11, 7.5e11]
     assert s["regime"][1][1] == "P1" and s["I2"][1][1] < 1e-6
     assert s["ranges"]["alpha1"] == [1e10, 3e10] and s["reference"]["source"] == "law"
     out = tmp_path / "tmpl"
-    assert main(["landscape", "--law", "1.5e8*z + 1e7*zd", "--range1", "1.2e7:1.4e7",
-                 "--grid", "3x3", "--workers", "1", "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "landscape",
+                "--law",
+                "1.5e8*z + 1e7*zd",
+                "--range1",
+                "1.2e7:1.4e7",
+                "--grid",
+                "3x3",
+                "--workers",
+                "1",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     s = json.loads((out / "summary.json").read_text())
     assert s["alpha1"] == [0.75e8, 1.5e8, 2.25e8] and s["alpha2"] == [1.2e7, 1.3e7, 1.4e7]
     assert s["ranges"]["from"][1] == "--range1 1.2e7:1.4e7"
     assert default_range(-4.0, "z", "--range0") == (-6.0, -2.0)
 
 
-@pytest.mark.parametrize("argv, needle", [
-    (["--law", "2e8*z"], "at least two terms"),
-    (["--range0", "3e8:1e8"], "--range0 needs LOW < HIGH"),
-    (["--range1", "1e7:1e7"], "--range1 needs LOW < HIGH"),
-    (["--law", "0*z + 1e7*zd"], "give --range0 LOW:HIGH"),
-    (["--law", "2e8*z + 0*zd"], "give --range1 LOW:HIGH"),
-    (["--workers", "0"], "--workers: '0' is out of range"),
-    (["--grid", "1x5"], "at least 2 points per axis"),
-    (["--data", "missing.csv"], "does not exist"),
-])
+@pytest.mark.parametrize(
+    "argv, needle",
+    [
+        (["--law", "2e8*z"], "at least two terms"),
+        (["--range0", "3e8:1e8"], "--range0 needs LOW < HIGH"),
+        (["--range1", "1e7:1e7"], "--range1 needs LOW < HIGH"),
+        (["--law", "0*z + 1e7*zd"], "give --range0 LOW:HIGH"),
+        (["--law", "2e8*z + 0*zd"], "give --range1 LOW:HIGH"),
+        (["--workers", "0"], "--workers: '0' is out of range"),
+        (["--grid", "1x5"], "at least 2 points per axis"),
+        (["--data", "missing.csv"], "does not exist"),
+    ],
+)
 def test_bad_input_one_line_exit_2(argv, needle, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     grid = [] if "--grid" in argv else ["--grid", "3x3"]

@@ -41,8 +41,15 @@ def test_parse_values_and_signs():
 
 @pytest.mark.parametrize(
     ("name", "a", "b"),
-    [("z", 1, 0), ("zd", 0, 1), ("z*zd", 1, 1), ("z^1.5", 1.5, 0), ("z^2*zd", 2, 1),
-     ("zd^0.5", 0, 0.5), ("z^0.25*zd^3", 0.25, 3)],
+    [
+        ("z", 1, 0),
+        ("zd", 0, 1),
+        ("z*zd", 1, 1),
+        ("z^1.5", 1.5, 0),
+        ("z^2*zd", 2, 1),
+        ("zd^0.5", 0, 0.5),
+        ("z^0.25*zd^3", 0.25, 3),
+    ],
 )
 def test_term_names(name, a, b):
     t = Term(a, b)
@@ -53,8 +60,13 @@ def test_term_names(name, a, b):
 
 @pytest.mark.parametrize(
     ("text", "canonical"),
-    [("zd*z", "z*zd"), ("z**2*zd", "z^2*zd"), ("z*z*zd", "z^2*zd"), ("zd^1*z^1.0", "z*zd"),
-     ("z^0*zd", "zd")],
+    [
+        ("zd*z", "z*zd"),
+        ("z**2*zd", "z^2*zd"),
+        ("z*z*zd", "z^2*zd"),
+        ("zd^1*z^1.0", "z*zd"),
+        ("z^0*zd", "zd"),
+    ],
 )
 def test_equivalent_spellings_give_canonical_name(text, canonical):
     assert Term.parse(text).name == canonical
@@ -240,10 +252,16 @@ EXPONENTS = [0.0, 0.5, 1.0, 1.5, 2.0, 3.0]
 
 @st.composite
 def laws(draw):
-    pairs = draw(st.lists(
-        st.tuples(st.sampled_from(EXPONENTS), st.sampled_from(EXPONENTS))
-        .filter(lambda p: p != (0.0, 0.0)),
-        min_size=1, max_size=5, unique=True))
+    pairs = draw(
+        st.lists(
+            st.tuples(st.sampled_from(EXPONENTS), st.sampled_from(EXPONENTS)).filter(
+                lambda p: p != (0.0, 0.0)
+            ),
+            min_size=1,
+            max_size=5,
+            unique=True,
+        )
+    )
     # coefficients with <= 12 significant digits (what to_text promises to keep)
     mant = draw(st.lists(st.integers(1, 10**12 - 1), min_size=len(pairs), max_size=len(pairs)))
     expo = draw(st.lists(st.integers(-12, 12), min_size=len(pairs), max_size=len(pairs)))

@@ -36,12 +36,15 @@ def test_explicit_list_keeps_order():
     assert lib.names == ["z^1.5", "zd", "z*zd", "z"]
 
 
-@pytest.mark.parametrize("spec, names", [
-    ("poly:1+hc", ["z", "zd", "z^1.5", "z^1.5*zd"]),
-    ("poly:2+z,zd", ["z", "zd", "z^2", "z*zd", "zd^2"]),   # z, zd already in poly:2
-    ("hc+hc", ["z^1.5", "z^1.5*zd"]),
-    ("poly:1 + poly:2", ["z", "zd", "z^2", "z*zd", "zd^2"]),
-])
+@pytest.mark.parametrize(
+    "spec, names",
+    [
+        ("poly:1+hc", ["z", "zd", "z^1.5", "z^1.5*zd"]),
+        ("poly:2+z,zd", ["z", "zd", "z^2", "z*zd", "zd^2"]),  # z, zd already in poly:2
+        ("hc+hc", ["z^1.5", "z^1.5*zd"]),
+        ("poly:1 + poly:2", ["z", "zd", "z^2", "z*zd", "zd^2"]),
+    ],
+)
 def test_sums_deduplicate_and_keep_first_order(spec, names):
     assert Library.parse(spec).names == names
 
@@ -55,8 +58,24 @@ def test_parse_returns_library_unchanged():
     assert Library.parse(lib) is lib
 
 
-@pytest.mark.parametrize("spec", ["", "   ", "poly:0", "poly:x", "poly:", "poly:2.5", "poly:9",
-                                  "q", "z,q", "z,z", "2*z", None, 3])
+@pytest.mark.parametrize(
+    "spec",
+    [
+        "",
+        "   ",
+        "poly:0",
+        "poly:x",
+        "poly:",
+        "poly:2.5",
+        "poly:9",
+        "q",
+        "z,q",
+        "z,z",
+        "2*z",
+        None,
+        3,
+    ],
+)
 def test_bad_specs_raise_input_error(spec):
     with pytest.raises(InputError):
         Library.parse(spec)
@@ -73,10 +92,14 @@ def test_only_plus_signs_raise_input_error(spec):
 
 def test_transform_shape_and_values():
     lib = Library.parse("poly:2+hc")
-    X = np.array([[2e-4, 0.3],     # loading
-                  [2e-4, -0.3],    # unloading: zd = 0
-                  [-1e-4, 0.5],    # no contact: zeta clipped to 0
-                  [0.0, 0.0]])
+    X = np.array(
+        [
+            [2e-4, 0.3],  # loading
+            [2e-4, -0.3],  # unloading: zd = 0
+            [-1e-4, 0.5],  # no contact: zeta clipped to 0
+            [0.0, 0.0],
+        ]
+    )
     T = lib.transform(X)
     assert T.shape == (4, len(lib))
     z = np.array([2e-4, 2e-4, 0.0, 0.0])
@@ -151,9 +174,23 @@ def _toy(n=300, seed=0):
 def test_get_params_are_the_constructor_arguments():
     sig = inspect.signature(ConstrainedSparseRegressor.__init__)
     names = [p for p in sig.parameters if p != "self"]
-    args = dict(library="z,zd,z*zd", selection="l1-path", scoring="aic", max_terms=2, cv=3,
-                margin=1.5, monotone=True, signs=[1, 1, 0], box_margin=0.2, elevation=3,
-                threshold=0.1, n_lambdas=7, solver="CLARABEL", grid=51, cv_report=True)
+    args = dict(
+        library="z,zd,z*zd",
+        selection="l1-path",
+        scoring="aic",
+        max_terms=2,
+        cv=3,
+        margin=1.5,
+        monotone=True,
+        signs=[1, 1, 0],
+        box_margin=0.2,
+        elevation=3,
+        threshold=0.1,
+        n_lambdas=7,
+        solver="CLARABEL",
+        grid=51,
+        cv_report=True,
+    )
     assert set(args) == set(names)  # the test covers every parameter
     est = ConstrainedSparseRegressor(**args)
     params = est.get_params()
@@ -189,8 +226,16 @@ def test_fit_returns_self_learns_underscored_attributes_and_keeps_params():
     assert est.get_params() == params  # fit never overwrites a parameter
     learned = [a for a in vars(est) if a not in before]
     assert learned and all(a.endswith("_") for a in learned), learned
-    for a in ("library_", "box_", "coef_", "support_", "law_", "candidates_", "certificate_",
-              "n_features_in_"):
+    for a in (
+        "library_",
+        "box_",
+        "coef_",
+        "support_",
+        "law_",
+        "candidates_",
+        "certificate_",
+        "n_features_in_",
+    ):
         assert hasattr(est, a)
     assert est.coef_.shape == (5,) and est.support_.dtype == bool
     # clone of a fitted estimator is unfitted

@@ -79,21 +79,23 @@ def test_column_mapping(rec, text, tmp_path):
     np.testing.assert_allclose(m2.channels["w1"], rec.channels["w1"], rtol=1e-11, atol=1e-15)
 
 
-@pytest.mark.parametrize(("columns", "needle"), [
-    ({"time": "t"}, "unknown name 'time'"),
-    ({"F": "force_N"}, "has no column 'force_N'"),
-    ({"t": "t", "F": "t"}, "same column"),
-    ({"F": ""}, "give the header"),
-    (["t"], "columns must map"),
-])
+@pytest.mark.parametrize(
+    ("columns", "needle"),
+    [
+        ({"time": "t"}, "unknown name 'time'"),
+        ({"F": "force_N"}, "has no column 'force_N'"),
+        ({"t": "t", "F": "t"}, "same column"),
+        ({"F": ""}, "give the header"),
+        (["t"], "columns must map"),
+    ],
+)
 def test_bad_column_mapping(text, tmp_path, columns, needle):
     with pytest.raises(InputError, match=needle):
         Measurement.from_csv(_write(tmp_path, text), columns=columns)
 
 
 def _table(t, F):
-    return "t,F\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), F.tolist(),
-                                                             strict=True))
+    return "t,F\n" + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), F.tolist(), strict=True))
 
 
 def test_small_jitter_is_resampled_with_a_note(rec, tmp_path):
@@ -131,24 +133,27 @@ def test_gap_or_large_jitter_is_refused(rec, tmp_path):
         Measurement(t, rec.F)
 
 
-@pytest.mark.parametrize(("body", "needle"), [
-    ("t,F\n0,0\n1,nan\n2,0\n3,0\n", "non-finite value 'nan' at line 3"),
-    ("t,F\n0,0\n1,inf\n2,0\n3,0\n", "non-finite value 'inf' at line 3"),
-    ("t,F\n0,0\n1,\n2,0\n3,0\n", "column F is empty at line 3"),
-    ("t,F\n0,0\n1,abc\n2,0\n3,0\n", "non-numeric value 'abc' at line 3"),
-    ("t,F\n0,0\n1\n2,0\n3,0\n", "line 3 has 1 field(s)"),
-    ("t,F\n0,0\n1,1e300\n2,0\n3,0\n", "beyond the accepted |F| <= 1e+12 N"),
-    ("t,F,w1\n0,0,0\n1,0,5e6\n2,0,0\n3,0,0\n", "beyond the accepted |w1| <= 1000 m"),
-    ("t,F\n0,0\n1,0\n1,0\n3,0\n", "duplicate time t = 1 at lines 3 and 4"),
-    ("t,F\n0,0\n2,0\n1,0\n3,0\n", "not increasing at line 4"),
-    ("t,F,F\n0,0,0\n", "F appear more than once"),
-    ("t,F\n", "has a header but no data rows"),
-    ("", "is empty"),
-    ("# only a comment\n", "is empty"),
-    ("time,F\n0,0\n", "no column t"),
-    ("t,F\n0,0\n1,0\n", "at least 4 samples"),
-    ("t,F\n0\x00,0\n", "NUL bytes"),
-])
+@pytest.mark.parametrize(
+    ("body", "needle"),
+    [
+        ("t,F\n0,0\n1,nan\n2,0\n3,0\n", "non-finite value 'nan' at line 3"),
+        ("t,F\n0,0\n1,inf\n2,0\n3,0\n", "non-finite value 'inf' at line 3"),
+        ("t,F\n0,0\n1,\n2,0\n3,0\n", "column F is empty at line 3"),
+        ("t,F\n0,0\n1,abc\n2,0\n3,0\n", "non-numeric value 'abc' at line 3"),
+        ("t,F\n0,0\n1\n2,0\n3,0\n", "line 3 has 1 field(s)"),
+        ("t,F\n0,0\n1,1e300\n2,0\n3,0\n", "beyond the accepted |F| <= 1e+12 N"),
+        ("t,F,w1\n0,0,0\n1,0,5e6\n2,0,0\n3,0,0\n", "beyond the accepted |w1| <= 1000 m"),
+        ("t,F\n0,0\n1,0\n1,0\n3,0\n", "duplicate time t = 1 at lines 3 and 4"),
+        ("t,F\n0,0\n2,0\n1,0\n3,0\n", "not increasing at line 4"),
+        ("t,F,F\n0,0,0\n", "F appear more than once"),
+        ("t,F\n", "has a header but no data rows"),
+        ("", "is empty"),
+        ("# only a comment\n", "is empty"),
+        ("time,F\n0,0\n", "no column t"),
+        ("t,F\n0,0\n1,0\n", "at least 4 samples"),
+        ("t,F\n0\x00,0\n", "NUL bytes"),
+    ],
+)
 def test_malformed_tables_one_line(tmp_path, body, needle):
     with pytest.raises(InputError) as exc:
         Measurement.from_csv(_write(tmp_path, body))
@@ -172,8 +177,11 @@ def test_contact_cut_off_at_the_start_is_named(rec):
     end = int(k[np.flatnonzero(np.diff(k) > 1)[0]]) + 200  # after the first contact
     m = Measurement(rec.t[:end], rec.F[:end], source="cut.csv")
     assert np.sum(m.F > 1e-3 * m.F.max()) >= 16
-    with pytest.raises(InputError, match=r"the only contact in cut\.csv \(\d+ samples above "
-                                         r"the threshold .*cut off at the record's start"):
+    with pytest.raises(
+        InputError,
+        match=r"the only contact in cut\.csv \(\d+ samples above "
+        r"the threshold .*cut off at the record's start",
+    ):
         m.impulse(0.04)
     with pytest.raises(InputError, match="no sample exceeds the threshold"):
         Measurement(rec.t[:100], np.zeros(100)).impulse(0.04)
@@ -181,8 +189,10 @@ def test_contact_cut_off_at_the_start_is_named(rec):
 
 def test_a2_forms_force_after_mapping(paper, rec, tmp_path):
     a2 = rec.F / paper.m2 - paper.g
-    body = "time;acc\n" + "".join(f"{a!r};{b!r}\n" for a, b in zip(rec.t.tolist(), a2.tolist(),
-                                                                   strict=True))
-    m = Measurement.from_csv(_write(tmp_path, body), scenario=paper,
-                             columns={"t": "time", "a2": "acc"})
+    body = "time;acc\n" + "".join(
+        f"{a!r};{b!r}\n" for a, b in zip(rec.t.tolist(), a2.tolist(), strict=True)
+    )
+    m = Measurement.from_csv(
+        _write(tmp_path, body), scenario=paper, columns={"t": "time", "a2": "acc"}
+    )
     np.testing.assert_allclose(m.F, rec.F, rtol=0, atol=1e-9 * rec.F.max())

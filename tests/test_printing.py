@@ -15,13 +15,13 @@ LAW = d.ForceLaw.parse("2.06e8*z + 1.28e7*zd")
 def results():
     sc = d.load_scenario("paper")
     rec = d.synthesize(sc, LAW, periods=10, noise=0.01, seed=3)
-    out = {"verify": verify(sc, rec, LAW),
-           "discover": d.discover(sc, rec, refine=False, n_boot_intervals=0),
-           "identify": d.identify(sc, rec, d.ForceLaw.parse("1.9e8*z + 1.2e7*zd"),
-                                  max_simulations=30),
-           "landscape": d.landscape(sc, LAW, [1.5e8, 2.06e8, 2.5e8], [1e7, 1.28e7],
-                                    workers=1),
-           "steady": d.steady_state(sc, LAW)}
+    out = {
+        "verify": verify(sc, rec, LAW),
+        "discover": d.discover(sc, rec, refine=False, n_boot_intervals=0),
+        "identify": d.identify(sc, rec, d.ForceLaw.parse("1.9e8*z + 1.2e7*zd"), max_simulations=30),
+        "landscape": d.landscape(sc, LAW, [1.5e8, 2.06e8, 2.5e8], [1e7, 1.28e7], workers=1),
+        "steady": d.steady_state(sc, LAW),
+    }
     system = osc.UedaSystem("negres", mu=0.2, gamma=8.0, k=0.0, B=0.35, nu=1.02)
     t, x, _, _ = osc.simulate_record(system, periods=120, noise=0.002, seed=0)
     disc = osc.discover(t, x, 0.35, 1.02)
@@ -30,15 +30,18 @@ def results():
     return out
 
 
-@pytest.mark.parametrize("name, needles", [
-    ("verify", ["consistent", "criterion", "I2", "regime measured"]),
-    ("discover", ["selected", "term", "std error", "ranking", "certificate"]),
-    ("identify", ["identified", "simulations", "z ", "zd"]),
-    ("landscape", ["landscape of z, zd on 3x2 points", "min I2"]),
-    ("steady", ["steady state P1", "Floquet"]),
-    ("ueda discover", ["Discovery", "residual_rms"]),
-    ("ueda verify", ["Verification", "energy_distance", "consistent"]),
-])
+@pytest.mark.parametrize(
+    "name, needles",
+    [
+        ("verify", ["consistent", "criterion", "I2", "regime measured"]),
+        ("discover", ["selected", "term", "std error", "ranking", "certificate"]),
+        ("identify", ["identified", "simulations", "z ", "zd"]),
+        ("landscape", ["landscape of z, zd on 3x2 points", "min I2"]),
+        ("steady", ["steady state P1", "Floquet"]),
+        ("ueda discover", ["Discovery", "residual_rms"]),
+        ("ueda verify", ["Verification", "energy_distance", "consistent"]),
+    ],
+)
 def test_print_of_a_result_is_a_short_report(results, name, needles):
     r = results[name]
     text = str(r)

@@ -29,8 +29,14 @@ def test_reporter_modes():
 def test_the_api_reports_every_row():
     calls = []
     sc = load_scenario("paper")
-    landscape(sc, ForceLaw.parse("2.06e8*z + 1.28e7*zd"), [1.5e8, 2.06e8, 2.5e8],
-              [1e7, 1.28e7], workers=1, progress=lambda *a: calls.append(a))
+    landscape(
+        sc,
+        ForceLaw.parse("2.06e8*z + 1.28e7*zd"),
+        [1.5e8, 2.06e8, 2.5e8],
+        [1e7, 1.28e7],
+        workers=1,
+        progress=lambda *a: calls.append(a),
+    )
     assert calls == [("landscape: rows of the grid", k, 3) for k in (1, 2, 3)]
 
 

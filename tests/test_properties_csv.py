@@ -13,8 +13,7 @@ from hypothesis import strategies as st
 from discovery.errors import InputError
 from discovery.measurement import LIMITS, Measurement
 
-SETTINGS = settings(max_examples=150, deadline=None,
-                    suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 OPTIONAL = ("w1", "v1", "w2", "v2")
 
 
@@ -25,8 +24,11 @@ def path(tmp_path_factory):
 
 def _values(name, n):
     lim = LIMITS[name][0]
-    return st.lists(st.floats(min_value=-lim, max_value=lim, allow_nan=False,
-                              allow_subnormal=False), min_size=n, max_size=n)
+    return st.lists(
+        st.floats(min_value=-lim, max_value=lim, allow_nan=False, allow_subnormal=False),
+        min_size=n,
+        max_size=n,
+    )
 
 
 @st.composite
@@ -101,8 +103,10 @@ def test_random_bytes_load_or_raise_input_error(path, data):
 
 
 @SETTINGS
-@given(st.lists(st.lists(st.text(max_size=8), max_size=5), max_size=8),
-       st.sampled_from([",", ";", "\t"]))
+@given(
+    st.lists(st.lists(st.text(max_size=8), max_size=5), max_size=8),
+    st.sampled_from([",", ";", "\t"]),
+)
 @example([['"', "\x1e0"]], ",")  # a quote left open: csv would read on into the next line
 def test_random_text_tables(path, rows, sep):
     data = "\n".join(sep.join(r) for r in [["t", "F"], *rows]).encode("utf-8", "surrogatepass")
@@ -110,11 +114,15 @@ def test_random_text_tables(path, rows, sep):
 
 
 @SETTINGS
-@given(tables(), st.lists(st.tuples(st.integers(0, 10_000), st.binary(min_size=0, max_size=3)),
-                          min_size=1, max_size=4))
+@given(
+    tables(),
+    st.lists(
+        st.tuples(st.integers(0, 10_000), st.binary(min_size=0, max_size=3)), min_size=1, max_size=4
+    ),
+)
 def test_mutated_tables(path, table, edits):
     data = bytearray(_render(*table))
     for pos, repl in edits:
         pos = pos % (len(data) + 1)
-        data[pos:pos + 1] = repl
+        data[pos : pos + 1] = repl
     _load_or_input_error(path, bytes(data))

@@ -14,24 +14,27 @@ from discovery._lawgrammar import parse_law_terms
 from discovery.errors import InputError
 from discovery.law import ForceLaw, Term
 
-SETTINGS = settings(max_examples=300, deadline=None,
-                    suppress_health_check=[HealthCheck.too_slow])
+SETTINGS = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 
 exponents = st.one_of(
     st.sampled_from([0.0, 0.5, 1.0, 1.5, 2.0, 3.0]),
     st.floats(min_value=0.0, max_value=10.0, allow_nan=False, allow_infinity=False),
 )
-terms = st.tuples(exponents, exponents).filter(lambda ab: ab != (0.0, 0.0)).map(
-    lambda ab: Term(*ab))
+terms = (
+    st.tuples(exponents, exponents).filter(lambda ab: ab != (0.0, 0.0)).map(lambda ab: Term(*ab))
+)
 coefficients = st.floats(allow_nan=False, allow_infinity=False, allow_subnormal=False)
-laws = st.lists(st.tuples(terms, coefficients), min_size=1, max_size=6,
-                unique_by=lambda tc: tc[0]).map(
-    lambda tcs: ForceLaw(tuple(t for t, _ in tcs), tuple(c for _, c in tcs)))
+laws = st.lists(
+    st.tuples(terms, coefficients), min_size=1, max_size=6, unique_by=lambda tc: tc[0]
+).map(lambda tcs: ForceLaw(tuple(t for t, _ in tcs), tuple(c for _, c in tcs)))
 
 # text near the grammar: its tokens, spaces and a few foreign characters
-grammar_text = st.lists(st.sampled_from(list("zd0123456789.eE+-*^ \t()x_\u0663")
-                                        + ["**", "zd", "1e308", "2.06e8", "z^1.5"]),
-                        max_size=30).map("".join)
+grammar_text = st.lists(
+    st.sampled_from(
+        list("zd0123456789.eE+-*^ \t()x_\u0663") + ["**", "zd", "1e308", "2.06e8", "z^1.5"]
+    ),
+    max_size=30,
+).map("".join)
 
 
 def _forbidden(*args, **kwargs):
@@ -60,9 +63,11 @@ def test_round_trip(law):
 @example("z" * 10000)
 @example("+".join(["z"] * 3000))
 def test_any_text_parses_or_raises_input_error(text):
-    with mock.patch.object(builtins, "eval", _forbidden), \
-            mock.patch.object(builtins, "exec", _forbidden), \
-            mock.patch.object(sympy, "sympify", _forbidden):
+    with (
+        mock.patch.object(builtins, "eval", _forbidden),
+        mock.patch.object(builtins, "exec", _forbidden),
+        mock.patch.object(sympy, "sympify", _forbidden),
+    ):
         try:
             law = ForceLaw.parse(text)
         except InputError as exc:
@@ -75,8 +80,15 @@ def test_any_text_parses_or_raises_input_error(text):
 
 
 @SETTINGS
-@given(st.one_of(st.none(), st.integers(), st.floats(), st.binary(max_size=10),
-                 st.lists(st.text(max_size=5), max_size=3)))
+@given(
+    st.one_of(
+        st.none(),
+        st.integers(),
+        st.floats(),
+        st.binary(max_size=10),
+        st.lists(st.text(max_size=5), max_size=3),
+    )
+)
 def test_non_text_raises_input_error(value):
     try:
         parse_law_terms(value)

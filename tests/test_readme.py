@@ -15,8 +15,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def _quickstart():
     text = (ROOT / "README.md").read_text()
-    block = re.search(r"<!-- quickstart -->\s*```bash\n(.*?)```\s*<!-- /quickstart -->", text,
-                      re.S)
+    block = re.search(r"<!-- quickstart -->\s*```bash\n(.*?)```\s*<!-- /quickstart -->", text, re.S)
     assert block, "the README has no quickstart block"
     return [ln for ln in block.group(1).splitlines() if ln.strip()]
 
@@ -30,8 +29,14 @@ def test_the_quickstart_runs_as_written(tmp_path):
     for line in _quickstart():
         argv = shlex.split(line)
         assert argv[0] == "vidi", line
-        run = subprocess.run([str(vidi), *argv[1:]], cwd=tmp_path, capture_output=True,
-                             text=True, timeout=600, env=env)
+        run = subprocess.run(
+            [str(vidi), *argv[1:]],
+            cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=600,
+            env=env,
+        )
         assert run.returncode == 0, (line, run.stderr[-2000:])
         assert "Traceback" not in run.stderr
     assert (tmp_path / "D.csv").exists() and (tmp_path / "out" / "fit" / "report.pdf").exists()

@@ -90,8 +90,9 @@ def test_run_up_from_rest_agrees_with_compiled_kernel(case):
     y = _states(rec)
     assert rec.t[0] == 0.0
     np.testing.assert_array_equal(y[:, 0], case.scenario.initial_state())
-    tr = simulate(case.scenario, case.law, (0.0, rec.t[-1]), t_eval=rec.t,
-                  tolerances=Tolerances(rtol=1e-11))
+    tr = simulate(
+        case.scenario, case.law, (0.0, rec.t[-1]), t_eval=rec.t, tolerances=Tolerances(rtol=1e-11)
+    )
     assert np.max(np.abs(tr.y - y) / np.ptp(y, axis=1)[:, None]) < 1e-5
 
 
@@ -120,8 +121,9 @@ def test_noise_is_relative_to_each_channels_range(case):
         assert abs(np.mean(e)) < 5 * sd / math.sqrt(n), name
         # blind: the noise seen in the noisy channel alone (MAD of 3rd differences; the
         # smooth motion sampled at 20 kHz contributes < 1e-6 of the noise there)
-        assert estimate_noise(noisy.channels[name] if name != "F" else noisy.F, order=3) \
-            == pytest.approx(sd, rel=0.1), name
+        assert estimate_noise(
+            noisy.channels[name] if name != "F" else noisy.F, order=3
+        ) == pytest.approx(sd, rel=0.1), name
     # independent channels: the noise on w1 and w2 is uncorrelated
     r = np.corrcoef(added["w1"], added["w2"])[0, 1]
     assert abs(r) < 5 / math.sqrt(n)
@@ -212,8 +214,13 @@ def test_draw_is_reproducible_and_checked(case):
 
 
 def test_bad_arguments(case):
-    for kw in ({"periods": 0}, {"force_noise": -1.0}, {"motion_noise": -0.1}, {"fs": 0.0},
-               {"transient": -1}):
+    for kw in (
+        {"periods": 0},
+        {"force_noise": -1.0},
+        {"motion_noise": -0.1},
+        {"fs": 0.0},
+        {"transient": -1},
+    ):
         with pytest.raises(ValueError):
             R.reference_record(case, **kw)
 
@@ -227,8 +234,9 @@ def test_scenario_and_law_pair_is_accepted(case):
 # ------------------------------------------------------------ (c) categories
 def _reference_strobe(sc, law, y0, t0, periods):
     T = sc.period
-    out = reference_simulate(sc, law, (t0, t0 + periods * T), y0=y0,
-                             t_eval=t0 + np.arange(periods + 1) * T)
+    out = reference_simulate(
+        sc, law, (t0, t0 + periods * T), y0=y0, t_eval=t0 + np.arange(periods + 1) * T
+    )
     return out["y"], out["events"]
 
 
@@ -242,8 +250,7 @@ def _reference_max_multiplier(sc, law, y0, t0, n):
         yp = np.array(y0, dtype=float)
         d = 1e-6 * scale[j]
         yp[j] += d
-        J[:, j] = (reference_simulate(sc, law, (t0, t0 + n * sc.period), y0=yp)["y_final"]
-                   - f0) / d
+        J[:, j] = (reference_simulate(sc, law, (t0, t0 + n * sc.period), y0=yp)["y_final"] - f0) / d
     return float(np.max(np.abs(np.linalg.eigvals(J))))
 
 

@@ -31,8 +31,12 @@ from discovery.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK, Reference, e
 RATE = 0.95
 NOISE_SEEDS = (0, 1)
 # fixed cases: the quickest to draw in the 25-seed survey (0.5-3.3 s each), all kinds
-SEEDS = {"p1": (2, 4, 12, 13), "p1-slow": (0, 10, 14, 17), "subharmonic": (0, 5, 8, 21),
-         "short-contact": (4, 9, 15, 18)}
+SEEDS = {
+    "p1": (2, 4, 12, 13),
+    "p1-slow": (0, 10, 14, 17),
+    "subharmonic": (0, 5, 8, 21),
+    "short-contact": (4, 9, 15, 18),
+}
 
 
 def _trials(category):
@@ -47,14 +51,21 @@ def _trials(category):
 def _rates(rows):
     true = [tr for *_, tr in rows if tr.label == "true"]
     det = [tr for *_, tr in rows if tr.label != "true" and tr.detectable]
-    return (sum(tr.consistent for tr in true), len(true),
-            sum(not tr.consistent for tr in det), len(det))
+    return (
+        sum(tr.consistent for tr in true),
+        len(true),
+        sum(not tr.consistent for tr in det),
+        len(det),
+    )
 
 
 def _failures(rows):
-    return [f"seed {s} noise {n} {tr.label}: {tr.verdict}" for s, n, tr in rows
-            if (tr.label == "true" and not tr.consistent)
-            or (tr.label != "true" and tr.detectable and tr.consistent)]
+    return [
+        f"seed {s} noise {n} {tr.label}: {tr.verdict}"
+        for s, n, tr in rows
+        if (tr.label == "true" and not tr.consistent)
+        or (tr.label != "true" and tr.detectable and tr.consistent)
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -67,8 +78,10 @@ def all_trials():
 def test_rates_per_category(all_trials, category):
     rows = all_trials[category]
     ok, n, caught, n_det = _rates(rows)
-    msg = (f"{category}: true law consistent {ok}/{n}, wrong law inconsistent {caught}/{n_det}"
-           f" detectable; failures: {_failures(rows)}")
+    msg = (
+        f"{category}: true law consistent {ok}/{n}, wrong law inconsistent {caught}/{n_det}"
+        f" detectable; failures: {_failures(rows)}"
+    )
     assert n == len(SEEDS[category]) * len(NOISE_SEEDS)
     # per category the sets are small: at most one miss of each property
     assert n - ok <= 1, msg
@@ -79,9 +92,11 @@ def test_rates_per_category(all_trials, category):
 def test_rates_overall(all_trials):
     rows = [r for cat in SEEDS for r in all_trials[cat]]
     ok, n, caught, n_det = _rates(rows)
-    msg = (f"true law consistent {ok}/{n} = {ok / n:.3f}, wrong law inconsistent "
-           f"{caught}/{n_det} = {caught / n_det:.3f} of the detectable; failures: "
-           f"{_failures(rows)}")
+    msg = (
+        f"true law consistent {ok}/{n} = {ok / n:.3f}, wrong law inconsistent "
+        f"{caught}/{n_det} = {caught / n_det:.3f} of the detectable; failures: "
+        f"{_failures(rows)}"
+    )
     assert ok / n >= RATE, msg
     assert caught / n_det >= RATE, msg
 
@@ -90,8 +105,17 @@ def test_rates_overall(all_trials):
 def test_wrong_laws():
     law = ForceLaw.parse("1e8*z + 2e6*zd + 3e9*z*zd")
     wrong = dict(R.wrong_laws(law))
-    assert list(wrong) == ["drop z", "drop zd", "drop z*zd", "z x1.3", "z x0.7", "zd x1.3",
-                           "zd x0.7", "z*zd x1.3", "z*zd x0.7"]
+    assert list(wrong) == [
+        "drop z",
+        "drop zd",
+        "drop z*zd",
+        "z x1.3",
+        "z x0.7",
+        "zd x1.3",
+        "zd x0.7",
+        "z*zd x1.3",
+        "z*zd x0.7",
+    ]
     assert wrong["drop zd"].as_dict() == {"z": 1e8, "z*zd": 3e9}
     assert wrong["zd x0.7"].as_dict()["zd"] == pytest.approx(1.4e6)
     # a one-term law has no term to drop
@@ -129,12 +153,11 @@ def test_generator_rejects_orbits_that_do_not_settle():
         assert not R._accepts(cat, SS, 0.99)
     assert R._accepts("p1-slow", SS, 0.97)
     assert R.transient_periods(R.MAX_MULTIPLIER - 1e-6) <= R.TRANSIENT_MAX
-    assert R.MAX_MULTIPLIER ** R.TRANSIENT_MAX < 1.5 * R.TRANSIENT_DECAY
+    assert R.MAX_MULTIPLIER**R.TRANSIENT_MAX < 1.5 * R.TRANSIENT_DECAY
 
 
 # ------------------------------------------- regressions found by the survey
-_DIP = Scenario(m1=12800.0, m2=2700.0, k1=120000000.0, c1=74500.0, A=209000.0,
-                frequency=35.0)
+_DIP = Scenario(m1=12800.0, m2=2700.0, k1=120000000.0, c1=74500.0, A=209000.0, frequency=35.0)
 _DIP_LAW = ForceLaw.parse("140000000000*z^1.5 + 14100000000000*z^1.5*zd")  # p1-slow seed 4
 
 
@@ -186,8 +209,7 @@ def test_contact_shorter_than_the_debounce_length_is_found():
     assert 4e-4 - 2 / fs < imp.contact_time < 4e-4 + 0.01 * T + 2 / fs
 
 
-_NEAR_LOSS = Scenario(m1=3640.0, m2=1900.0, k1=7730000.0, c1=8670.0, A=65900.0,
-                      frequency=18.4)
+_NEAR_LOSS = Scenario(m1=3640.0, m2=1900.0, k1=7730000.0, c1=8670.0, A=65900.0, frequency=18.4)
 _NEAR_LOSS_LAW = ForceLaw.parse("812000000*z + 1690000*zd")  # p1-slow seed 17
 
 
@@ -212,8 +234,8 @@ def test_runs_merge_only_without_separation():
     t = np.arange(100) * 1e-4
     runs = [(t[10], t[30], 10), (t[40], t[60], 40), (t[80], t[90], 80)]
     zeta = np.full(t.size, 1e-5)
-    zeta[30:40] = 2e-7       # a near-loss: zeta stays >= 0
-    zeta[60:80] = -5e-5      # a flight: clearly separated
+    zeta[30:40] = 2e-7  # a near-loss: zeta stays >= 0
+    zeta[60:80] = -5e-5  # a flight: clearly separated
     rng = np.random.default_rng(0)
     noisy = zeta + rng.normal(0, 1e-6, t.size)
     for z in (zeta, noisy):

@@ -63,13 +63,18 @@ def _never_adhesive(law, ref):
 
 
 # ------------------------------------------------------------- (1) sticky contact
-_HERTZ_SLOW = Scenario(m1=22100.0, m2=27200.0, k1=199000000.0, c1=166000.0, A=621000.0,
-                       frequency=37.3)
+_HERTZ_SLOW = Scenario(
+    m1=22100.0, m2=27200.0, k1=199000000.0, c1=166000.0, A=621000.0, frequency=37.3
+)
 _HERTZ_SLOW_LAW = ForceLaw.parse("128000000000*z^1.5 + 3650000000000*z^1.5*zd")
 # the reference's state at the onset before the former sticky release (t = 34.98 T)
 _HERTZ_T0 = 0.9378147636874227
-_HERTZ_Y0 = (-0.0019478847629913346, 0.279630622751982, -0.0019478847629913394,
-             -0.12322995692326541)
+_HERTZ_Y0 = (
+    -0.0019478847629913346,
+    0.279630622751982,
+    -0.0019478847629913394,
+    -0.12322995692326541,
+)
 
 
 def test_release_at_the_contact_loss_does_not_stick():
@@ -107,7 +112,7 @@ def test_reference_matches_kernel_without_normalising_events(text):
 
 def test_release_or_resume_at_or_past_the_loss_goes_free():
     law = ForceLaw.parse("1e8*z")
-    past = np.array([0.0, 0.0, 1e-17, 0.01])   # zeta = -1e-17, separating
+    past = np.array([0.0, 0.0, 1e-17, 0.01])  # zeta = -1e-17, separating
     on = np.array([0.0, 0.0, 0.0, 0.01])
     inside = np.array([1e-6, 0.0, 0.0, 0.01])  # zeta > 0: still in contact
     st = {"m2": 1.0, "zmax": 0.0}
@@ -126,13 +131,18 @@ def test_reported_force_is_never_adhesive():
 
 
 # -------------------------------------------------------------- (2) endless loop
-_LINEAR_SLOW = Scenario(m1=13100.0, m2=9140.0, k1=52100000.0, c1=49800.0, A=241000.0,
-                        frequency=22.1)
+_LINEAR_SLOW = Scenario(
+    m1=13100.0, m2=9140.0, k1=52100000.0, c1=49800.0, A=241000.0, frequency=22.1
+)
 _LINEAR_SLOW_LAW = ForceLaw.parse("9100000000*z + 7490000*zd")
 # the reference's state at the unload event before the former loop (t = 15.55 T)
 _LINEAR_T0 = 0.7037955084625734
-_LINEAR_Y0 = (-0.0048474333051092035, -0.09811216099738396, -0.004883761753036823,
-              -0.09811216099738339)
+_LINEAR_Y0 = (
+    -0.0048474333051092035,
+    -0.09811216099738396,
+    -0.004883761753036823,
+    -0.09811216099738339,
+)
 
 
 def test_loss_then_recontact_within_a_step_does_not_loop():
@@ -177,10 +187,12 @@ def test_a_surface_function_at_the_start_follows_the_flow():
     law = ForceLaw.parse("1e8*z")
     evs = R._events(law, "free", {"m2": 1.0, "zmax": 0.0})
     # on the surface and moving across: the onset happens now (a zero-length segment)
-    g0, on, trend = R._surface_start(evs, lambda t, y: [y[1], 0.0, y[3], 0.0], 0.0,
-                                     np.array([0.0, 1.0, 0.0, 0.0]), 1e-8, 1e-12)
+    g0, on, trend = R._surface_start(
+        evs, lambda t, y: [y[1], 0.0, y[3], 0.0], 0.0, np.array([0.0, 1.0, 0.0, 0.0]), 1e-8, 1e-12
+    )
     assert on[0] and trend[0] == 1.0 and R._crossing_now(evs, on, trend) == 0
     # moving away: held, not fired
-    g0, on, trend = R._surface_start(evs, lambda t, y: [y[1], 0.0, y[3], 0.0], 0.0,
-                                     np.array([0.0, -1.0, 0.0, 0.0]), 1e-8, 1e-12)
+    g0, on, trend = R._surface_start(
+        evs, lambda t, y: [y[1], 0.0, y[3], 0.0], 0.0, np.array([0.0, -1.0, 0.0, 0.0]), 1e-8, 1e-12
+    )
     assert on[0] and trend[0] == -1.0 and R._crossing_now(evs, on, trend) is None

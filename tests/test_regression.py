@@ -34,14 +34,18 @@ CASES = [("paper", LAW11), ("paper", LAW11_ZZD), ("light", HC)]
 def clean(paper, light):
     """Noise-free steady-state records (20 periods) of the three laws: contact samples."""
     sc = {"paper": paper, "light": light}
-    return {(s, law): contact_samples(synthesize(sc[s], ForceLaw.parse(law), periods=20))
-            for s, law in CASES}
+    return {
+        (s, law): contact_samples(synthesize(sc[s], ForceLaw.parse(law), periods=20))
+        for s, law in CASES
+    }
 
 
 @pytest.fixture(scope="module")
 def clean_fits(clean):
-    return {k: ConstrainedSparseRegressor(library=LIB).fit(cs.X, cs.F, groups=cs.impact)
-            for k, cs in clean.items()}
+    return {
+        k: ConstrainedSparseRegressor(library=LIB).fit(cs.X, cs.F, groups=cs.impact)
+        for k, cs in clean.items()
+    }
 
 
 def _rel_errors(law_text, est):
@@ -100,14 +104,18 @@ def test_every_selection_method_returns_a_certified_law(case, selection, clean):
 
 
 def _runup(sc, law, periods, noise, seed):
-    m = synthesize(sc, ForceLaw.parse(law), periods=periods, fs=20000, noise=noise, seed=seed,
-                   from_rest=True)
+    m = synthesize(
+        sc, ForceLaw.parse(law), periods=periods, fs=20000, noise=noise, seed=seed, from_rest=True
+    )
     return contact_samples(m)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("case, periods", [(CASES[0], 300), (CASES[1], 300), (CASES[2], 30)],
-                         ids=["paper-11", "paper-11+zzd", "light-hc"])
+@pytest.mark.parametrize(
+    "case, periods",
+    [(CASES[0], 300), (CASES[1], 300), (CASES[2], 30)],
+    ids=["paper-11", "paper-11+zzd", "light-hc"],
+)
 def test_one_percent_noise_over_20_seeds(case, periods, paper, light):
     sc = {"paper": paper, "light": light}[case[0]]
     true = ForceLaw.parse(case[1]).as_dict()
@@ -211,8 +219,10 @@ def _reference_constrained_rss(prob, idx):
     Q, R = np.linalg.qr(prob.A[:, idx])
     keep = np.abs(prob.M[:, idx]).max(axis=1) > 0
     xv = cp.Variable(len(idx))
-    pr = cp.Problem(cp.Minimize(cp.sum_squares(R @ xv - Q.T @ prob.b)),
-                    [prob.M[keep][:, idx] @ xv + prob.off[keep] >= 0])
+    pr = cp.Problem(
+        cp.Minimize(cp.sum_squares(R @ xv - Q.T @ prob.b)),
+        [prob.M[keep][:, idx] @ xv + prob.off[keep] >= 0],
+    )
     solve(pr, "CLARABEL")
     r = prob.A[:, idx] @ xv.value - prob.b
     return float(r @ r)
@@ -269,8 +279,9 @@ def test_predict_is_the_law_and_the_library_model(clean_fits, clean):
     # agree term by term; relative 1e-12 covers summation order
     inside = X[:, 0] > 0
     lin = est.library_.transform(X) @ est.coef_
-    np.testing.assert_allclose(p[inside], np.maximum(lin[inside], 0), rtol=1e-12,
-                               atol=1e-12 * np.abs(lin).max())
+    np.testing.assert_allclose(
+        p[inside], np.maximum(lin[inside], 0), rtol=1e-12, atol=1e-12 * np.abs(lin).max()
+    )
     # on the training samples predict reproduces F (noise-free) to 1e-9 of peak force
     assert np.abs(est.predict(cs.X) - cs.F).max() < 1e-9 * cs.F.max()
 
@@ -292,24 +303,28 @@ def test_stability_frequencies(paper):
 # --------------------------------------------------------------- bad input
 
 
-@pytest.mark.parametrize("kwargs, name", [
-    (dict(selection="foo"), "selection"),
-    (dict(scoring="x"), "scoring"),
-    (dict(max_terms=0), "max_terms"),
-    (dict(max_terms=2.5), "max_terms"),
-    (dict(cv=1), "cv"),
-    (dict(margin=-1), "margin"),
-    (dict(box_margin=-0.5), "box_margin"),
-    (dict(library="poly:0"), "poly"),
-])
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        (dict(selection="foo"), "selection"),
+        (dict(scoring="x"), "scoring"),
+        (dict(max_terms=0), "max_terms"),
+        (dict(max_terms=2.5), "max_terms"),
+        (dict(cv=1), "cv"),
+        (dict(margin=-1), "margin"),
+        (dict(box_margin=-0.5), "box_margin"),
+        (dict(library="poly:0"), "poly"),
+    ],
+)
 def test_bad_parameters_raise_input_error_naming_them(kwargs, name):
     X, y = _unphysical_data(0, 50)
     with pytest.raises(InputError, match=name):
         ConstrainedSparseRegressor(**kwargs).fit(X, y)
 
 
-@pytest.mark.parametrize("kwargs, name", [(dict(signs=[1, 1]), "signs"),
-                                          (dict(margin="x"), "margin")])
+@pytest.mark.parametrize(
+    "kwargs, name", [(dict(signs=[1, 1]), "signs"), (dict(margin="x"), "margin")]
+)
 def test_more_bad_parameters_raise_input_error(kwargs, name):
     X, y = _unphysical_data(0, 50)
     with pytest.raises(InputError, match=name):
@@ -325,12 +340,15 @@ def test_certificate_box_always_contains_the_data(box_margin):
     assert est.certificate_.domain == est.box_.as_dict()
 
 
-@pytest.mark.parametrize("X, y", [
-    (np.zeros((5, 3)), np.zeros(5)),
-    (np.zeros((5, 2)), np.zeros(4)),
-    (np.array([[1e-4, 0.1], [2e-4, np.nan], [3e-4, 0.2]]), np.ones(3)),
-    (np.column_stack([-np.ones(5), np.ones(5)]), np.ones(5)),   # never in contact
-])
+@pytest.mark.parametrize(
+    "X, y",
+    [
+        (np.zeros((5, 3)), np.zeros(5)),
+        (np.zeros((5, 2)), np.zeros(4)),
+        (np.array([[1e-4, 0.1], [2e-4, np.nan], [3e-4, 0.2]]), np.ones(3)),
+        (np.column_stack([-np.ones(5), np.ones(5)]), np.ones(5)),  # never in contact
+    ],
+)
 def test_bad_data_raise_input_error(X, y):
     with pytest.raises(InputError):
         ConstrainedSparseRegressor().fit(X, y)
@@ -362,12 +380,15 @@ def test_margin_skips_a_support_without_a_zd_term():
     assert est.coef_[est.library_.names.index("zd")] >= 1e4 * (1 - 1e-6)
 
 
-@pytest.mark.parametrize("kwargs, needle", [
-    # every support is infeasible: {z} has no zd term, {zd} and {z, zd} need c_zd <= 0
-    (dict(library="z,zd", signs=[1, -1]), "no proposed support"),
-    # no term of the library can meet a margin at all
-    (dict(library="z,z^2"), "impossible"),
-])
+@pytest.mark.parametrize(
+    "kwargs, needle",
+    [
+        # every support is infeasible: {z} has no zd term, {zd} and {z, zd} need c_zd <= 0
+        (dict(library="z,zd", signs=[1, -1]), "no proposed support"),
+        # no term of the library can meet a margin at all
+        (dict(library="z,z^2"), "impossible"),
+    ],
+)
 def test_no_feasible_support_is_a_one_line_input_error(kwargs, needle):
     X, y, g = _law11_data()
     with pytest.raises(InputError, match=needle) as info:
@@ -383,8 +404,11 @@ def _failing(monkeypatch, failing):
 
     def solve(problem, solver=None, **options):
         if solver in failing:
-            raise SolverError(f"solver {solver} failed (status 'solver_error')",
-                              status="solver_error", solver=solver)
+            raise SolverError(
+                f"solver {solver} failed (status 'solver_error')",
+                status="solver_error",
+                solver=solver,
+            )
         return real(problem, solver, **options)
 
     monkeypatch.setattr(regression, "solve", solve)
@@ -396,8 +420,12 @@ def test_solver_fallback_is_recorded(monkeypatch):
     est = ConstrainedSparseRegressor(library="poly:2", max_terms=3).fit(X, y)
     assert est.fallbacks_
     for f in est.fallbacks_:
-        assert (f["solver"], f["failed"], f["status"], f["stage"]) == \
-            ("OSQP", "CLARABEL", "solver_error", "fit")
+        assert (f["solver"], f["failed"], f["status"], f["stage"]) == (
+            "OSQP",
+            "CLARABEL",
+            "solver_error",
+            "fit",
+        )
     constrained = [c for c in est.candidates_ if c.constrained]
     assert constrained  # the data need the constraints on some selected supports
     assert all(c.extra["solver"] == "OSQP" for c in constrained)
@@ -426,11 +454,18 @@ def test_failure_of_both_solvers_raises_and_is_never_skipped(monkeypatch):
 
 def test_problem_rows_are_the_constraints_package_rows():
     X, y, _ = _law11_data()
-    est = ConstrainedSparseRegressor(library="poly:2", margin=1e3, monotone=True,
-                                     signs=[1, 1, 0, 0, 0]).fit(X, y)
+    est = ConstrainedSparseRegressor(
+        library="poly:2", margin=1e3, monotone=True, signs=[1, 1, 0, 0, 0]
+    ).fit(X, y)
     prob = est._problem(X, y, np.ones(len(y)))
-    rows, rhs = constraint_rows(est.library_.exponents, est.box_, margin=1e3, monotone=True,
-                                signs=[1, 1, 0, 0, 0], force_unit=prob.fscale)
+    rows, rhs = constraint_rows(
+        est.library_.exponents,
+        est.box_,
+        margin=1e3,
+        monotone=True,
+        signs=[1, 1, 0, 0, 0],
+        force_unit=prob.fscale,
+    )
     np.testing.assert_array_equal(prob.M, rows)
     np.testing.assert_array_equal(prob.off, rhs)
     assert np.any(rhs < 0)  # the margin is in the offsets, in units of the force scale
@@ -458,13 +493,15 @@ def test_cross_validation_only_when_scored_by_it_or_asked(monkeypatch):
     assert len(made) == 1 + 4 and all(n < len(y) for n in made[1:])
     assert all(0 <= c.cv_error < 1 for c in rep.candidates_)
     # reporting changes nothing else
-    assert [(c.terms, c.bic) for c in rep.candidates_] == \
-        [(c.terms, c.bic) for c in bic.candidates_]
+    assert [(c.terms, c.bic) for c in rep.candidates_] == [
+        (c.terms, c.bic) for c in bic.candidates_
+    ]
     cv = ConstrainedSparseRegressor(**{**kw, "scoring": "cv"}).fit(X, y, groups=g)
     errs = [c.cv_error for c in cv.candidates_]
     assert errs == sorted(errs) and not any(math.isnan(e) for e in errs)
-    assert {c.terms: c.cv_error for c in cv.candidates_} == \
-        {c.terms: c.cv_error for c in rep.candidates_}
+    assert {c.terms: c.cv_error for c in cv.candidates_} == {
+        c.terms: c.cv_error for c in rep.candidates_
+    }
 
 
 # ------------------------------------------------------------------ stability
@@ -521,14 +558,25 @@ def test_stability_follows_the_weights():
 _SKLEARN_CHECKS = [
     # the checks of sklearn.utils.estimator_checks that apply to a 2-column (zeta, dzeta)
     # estimator; the others fit on 3+ random columns, which this estimator refuses
-    "check_estimator_cloneable", "check_estimator_repr", "check_no_attributes_set_in_init",
-    "check_estimators_overwrite_params", "check_estimators_fit_returns_self",
-    "check_do_not_raise_errors_in_init_or_set_params", "check_mixin_order",
-    "check_parameters_default_constructible", "check_get_params_invariance",
-    "check_set_params", "check_fit_idempotent", "check_fit_check_is_fitted",
-    "check_n_features_in", "check_estimators_unfitted", "check_fit1d",
-    "check_sample_weights_not_an_array", "check_sample_weights_not_overwritten",
-    "check_sample_weights_shape", "check_supervised_y_no_nan",
+    "check_estimator_cloneable",
+    "check_estimator_repr",
+    "check_no_attributes_set_in_init",
+    "check_estimators_overwrite_params",
+    "check_estimators_fit_returns_self",
+    "check_do_not_raise_errors_in_init_or_set_params",
+    "check_mixin_order",
+    "check_parameters_default_constructible",
+    "check_get_params_invariance",
+    "check_set_params",
+    "check_fit_idempotent",
+    "check_fit_check_is_fitted",
+    "check_n_features_in",
+    "check_estimators_unfitted",
+    "check_fit1d",
+    "check_sample_weights_not_an_array",
+    "check_sample_weights_not_overwritten",
+    "check_sample_weights_shape",
+    "check_supervised_y_no_nan",
 ]
 
 
@@ -537,7 +585,8 @@ def test_sklearn_estimator_checks(check):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         getattr(estimator_checks, check)(
-            check, ConstrainedSparseRegressor(library="z,zd", max_terms=2, grid=51))
+            check, ConstrainedSparseRegressor(library="z,zd", max_terms=2, grid=51)
+        )
 
 
 def test_estimator_contract_on_contact_data():

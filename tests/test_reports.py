@@ -23,20 +23,27 @@ HAVE_TEX = shutil.which("latexmk") is not None and shutil.which("pdftotext") is 
 def _need_tex():
     if not HAVE_TEX:
         if os.environ.get("VIDI_REQUIRE_TEX"):
-            pytest.fail("TeX Live is required here (VIDI_REQUIRE_TEX=1) but latexmk or "
-                        "pdftotext is missing")
+            pytest.fail(
+                "TeX Live is required here (VIDI_REQUIRE_TEX=1) but latexmk or pdftotext is missing"
+            )
         pytest.skip("needs TeX Live (latexmk) and poppler-utils (pdftotext)")
 
 
 def _text(pdf):
-    return subprocess.run(["pdftotext", "-layout", str(pdf), "-"], capture_output=True,
-                          text=True, timeout=60, check=True).stdout
+    return subprocess.run(
+        ["pdftotext", "-layout", str(pdf), "-"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    ).stdout
 
 
 def test_escape_every_special_character():
     assert escape("z^1.5*zd_2 & 5% #x $ {a} ~ \\") == (
         r"z\textasciicircum{}1.5*zd\_2 \& 5\% \#x \$ \{a\} \textasciitilde{} "
-        r"\textbackslash{}")
+        r"\textbackslash{}"
+    )
     assert escape("a\nb\x07c\u4e2d") == "a b?c?"  # no line breaks, controls or CJK reach TeX
     assert escape(Tex(r"\zeta")) == r"\zeta" and escape(None) == "--"
 
@@ -73,8 +80,10 @@ def test_tex_cannot_read_outside_or_run_commands(tmp_path):
     directory is read (openin_any=p) and no shell command runs (-no-shell-escape)."""
     _need_tex()
     tex = tmp_path / "evil.tex"
-    tex.write_text("\\documentclass{article}\\begin{document}\\immediate\\write18{touch "
-                   f"{tmp_path}/pwned}}\\input{{/etc/passwd}}\\end{{document}}\n")
+    tex.write_text(
+        "\\documentclass{article}\\begin{document}\\immediate\\write18{touch "
+        f"{tmp_path}/pwned}}\\input{{/etc/passwd}}\\end{{document}}\n"
+    )
     pdf, why = compile_tex(tex, timeout=120)
     assert not (tmp_path / "pwned").exists()
     if pdf is not None:
@@ -91,39 +100,88 @@ def runs(tmp_path_factory):
     os.chdir(d)
     try:
         rec = "r_\\input{etc-passwd}_$x$.csv"
-        assert main(["simulate", "--periods", "12", "--noise", "0.01", "--seed", "2",
-                     "--out", rec]) == 0
+        assert (
+            main(["simulate", "--periods", "12", "--noise", "0.01", "--seed", "2", "--out", rec])
+            == 0
+        )
         scen = d / "evil.toml"
-        scen.write_text('name = "\\\\write18{touch pwned} & 100% #1"\n[machine]\nm1 = 1.0e4\n'
-                        "m2 = 1.0e4\nk1 = 2.75e7\nc1 = 1.0e5\nA = 5.0e5\nfrequency = 25.0\n"
-                        "[law]\ntext = \"2.06e8*z + 1.28e7*zd\"\n")
+        scen.write_text(
+            'name = "\\\\write18{touch pwned} & 100% #1"\n[machine]\nm1 = 1.0e4\n'
+            "m2 = 1.0e4\nk1 = 2.75e7\nc1 = 1.0e5\nA = 5.0e5\nfrequency = 25.0\n"
+            '[law]\ntext = "2.06e8*z + 1.28e7*zd"\n'
+        )
         law = "2.06e8*z + 1.28e7*zd"
         cmds = {
             "verify": ["verify", "--scenario", str(scen), "--data", rec, "--law", law],
             "fit": ["fit", "--data", rec, "--no-refine", "--intervals", "0"],
-            "identify": ["identify", "--data", rec, "--start", "1.8e8*z + 1.1e7*zd",
-                         "--max-simulations", "40"],
+            "identify": [
+                "identify",
+                "--data",
+                rec,
+                "--start",
+                "1.8e8*z + 1.1e7*zd",
+                "--max-simulations",
+                "40",
+            ],
             "landscape": ["landscape", "--grid", "3x3", "--workers", "1"],
         }
         for kind, argv in cmds.items():
             assert main([*argv, "--out", kind]) == 0, kind
         assert main(["ueda", "simulate", "--periods", "120", "--out", "U.csv"]) == 0
-        assert main(["ueda", "discover", "--data", "U.csv", "--model", "negres",
-                     "--model-periods", "400", "--resamples", "40", "--out", "ueda"]) == 0
+        assert (
+            main(
+                [
+                    "ueda",
+                    "discover",
+                    "--data",
+                    "U.csv",
+                    "--model",
+                    "negres",
+                    "--model-periods",
+                    "400",
+                    "--resamples",
+                    "40",
+                    "--out",
+                    "ueda",
+                ]
+            )
+            == 0
+        )
     finally:
         os.chdir(cwd)
     return d
 
 
-@pytest.mark.parametrize("kind, needles", [
-    ("verify", ["Verification of a contact law", "Verdict", "consistent", "noise floor",
-                "write18", "100% #1"]),
-    ("fit", ["Discovery of a contact law", "The discovered law", "Selection", "certified",
-             "Verdict", "r_\\input{etc-passwd}_$x$.csv"]),
-    ("identify", ["Identification of a contact law", "simulations", "Verdict"]),
-    ("landscape", ["Criteria landscape", "Minima", "Noise floor"]),
-    ("ueda", ["Ueda", "Verification by simulation", "energy distance"]),
-])
+@pytest.mark.parametrize(
+    "kind, needles",
+    [
+        (
+            "verify",
+            [
+                "Verification of a contact law",
+                "Verdict",
+                "consistent",
+                "noise floor",
+                "write18",
+                "100% #1",
+            ],
+        ),
+        (
+            "fit",
+            [
+                "Discovery of a contact law",
+                "The discovered law",
+                "Selection",
+                "certified",
+                "Verdict",
+                "r_\\input{etc-passwd}_$x$.csv",
+            ],
+        ),
+        ("identify", ["Identification of a contact law", "simulations", "Verdict"]),
+        ("landscape", ["Criteria landscape", "Minima", "Noise floor"]),
+        ("ueda", ["Ueda", "Verification by simulation", "energy distance"]),
+    ],
+)
 def test_a_report_of_every_kind_reads_right(runs, kind, needles, capsys):
     _need_tex()
     run = runs / kind
@@ -134,8 +192,11 @@ def test_a_report_of_every_kind_reads_right(runs, kind, needles, capsys):
     text = _text(pdf)
     for needle in needles:
         assert needle in text, (kind, needle)
-    pages = int(subprocess.run(["pdfinfo", str(pdf)], capture_output=True, text=True,
-                               check=True).stdout.split("Pages:")[1].split()[0])
+    pages = int(
+        subprocess.run(["pdfinfo", str(pdf)], capture_output=True, text=True, check=True)
+        .stdout.split("Pages:")[1]
+        .split()[0]
+    )
     assert pages >= (3 if kind in ("fit", "verify") else 2), pages
     assert "Provenance" in text and "sha256" in text
     # the figures are embedded: their own axis text is in the PDF's text
@@ -152,8 +213,14 @@ def test_the_fit_report_is_at_least_three_pages_with_model_criteria_figures(runs
     r = report(runs / "fit")
     assert r.pages >= 3 and len(r.figures) == 3
     text = _text(r.pdf)
-    for needle in ("Conclusions", "data support the terms", "criterion", "I2",
-                   "Library, constraints and certificate", "Figures"):
+    for needle in (
+        "Conclusions",
+        "data support the terms",
+        "criterion",
+        "I2",
+        "Library, constraints and certificate",
+        "Figures",
+    ):
         assert needle in text, needle
     s = json.loads((runs / "fit" / "summary.json").read_text())
     assert s["selected"]["latex"] in (runs / "fit" / "report.tex").read_text()
@@ -218,17 +285,30 @@ def test_study_report_states_recovery_coverage_and_figures(tmp_path):
     from discovery import study
     from discovery.report import report
 
-    cfg = {"name": "tiny & 100%", "seeds": 1,
-           "factors": {"force_noise": [0.01, 0.02], "periods": [4],
-                       "library": ["z, zd, z^2"], "selection": ["best-subset", "l1-path"],
-                       "refine": [False]}}
+    cfg = {
+        "name": "tiny & 100%",
+        "seeds": 1,
+        "factors": {
+            "force_noise": [0.01, 0.02],
+            "periods": [4],
+            "library": ["z, zd, z^2"],
+            "selection": ["best-subset", "l1-path"],
+            "refine": [False],
+        },
+    }
     out = tmp_path / "s"
     study(cfg, out, workers=1)
     r = report(out)
     text = _text(r.pdf)
     assert "Model-term selection study: tiny & 100%" in text
-    for words in ("Per selection method", "best-subset", "l1-path", "force_noise",
-                  "recovered", "Records were made by the independent scipy path"):
+    for words in (
+        "Per selection method",
+        "best-subset",
+        "l1-path",
+        "force_noise",
+        "recovered",
+        "Records were made by the independent scipy path",
+    ):
         assert words in text, words
     tex = r.tex.read_text()
     for fig in ("recovery_noise.pdf", "recovery_map.pdf", "coverage.pdf", "inclusion.pdf"):

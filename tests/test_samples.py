@@ -62,14 +62,17 @@ def _positions_only(m):
     return Measurement(m.t, m.F, {k: v for k, v in m.channels.items() if k in ("w1", "w2")})
 
 
-@pytest.mark.parametrize("which, tol_savgol, tol_sindy", [
-    # paper: law (11) has a force jump at onset, so the acceleration jumps and a local cubic
-    # over 7 samples is off near the onset by ~ dt * jump; measured max 0.28 % (savgol) and
-    # 1.2 % (pysindy) of max dzeta; tolerances ~3x the measured values.
-    ("rec", 0.01, 0.035),
-    # light: Hunt-Crossley, no force jump, smooth zeta; measured 3e-5 and 2e-4.
-    ("rec_light", 1e-4, 1e-3),
-])
+@pytest.mark.parametrize(
+    "which, tol_savgol, tol_sindy",
+    [
+        # paper: law (11) has a force jump at onset, so the acceleration jumps and a local cubic
+        # over 7 samples is off near the onset by ~ dt * jump; measured max 0.28 % (savgol) and
+        # 1.2 % (pysindy) of max dzeta; tolerances ~3x the measured values.
+        ("rec", 0.01, 0.035),
+        # light: Hunt-Crossley, no force jump, smooth zeta; measured 3e-5 and 2e-4.
+        ("rec_light", 1e-4, 1e-3),
+    ],
+)
 def test_dzeta_from_positions_agrees_with_velocities(which, tol_savgol, tol_sindy, request):
     m = request.getfixturevalue(which)
     ref = contact_samples(m)
@@ -100,8 +103,9 @@ def test_missing_positions_raise(rec, keep):
         contact_samples(m)
 
 
-@pytest.mark.parametrize("kwargs", [dict(derivative="spline"), dict(window=6), dict(window=3),
-                                    dict(weights="equal")])
+@pytest.mark.parametrize(
+    "kwargs", [dict(derivative="spline"), dict(window=6), dict(window=3), dict(weights="equal")]
+)
 def test_bad_options_raise(rec, kwargs):
     with pytest.raises(InputError):
         contact_samples(rec, **kwargs)
@@ -162,7 +166,7 @@ def _reshape_like_law(F, a, n, e):
     """``F`` with a zero-sum wiggle of ``e`` max F inside the contact of samples a..a+n: the
     impulse (integral) is unchanged, the shape is not."""
     F = F.copy()
-    seg = F[a:a + n]
+    seg = F[a : a + n]
     on = np.flatnonzero(seg > 1e-3 * F.max())[1:-1]
     d = e * F.max() * np.sin(4 * np.pi * np.arange(on.size) / on.size)
     seg[on] += d - d.mean()
@@ -177,8 +181,10 @@ def test_average_cycles_of_a_steady_record(rec, paper):
     avg = cs.weight > 1
     assert set(np.unique(cs.weight)) == {1.0, float(k)}
     # the averaged samples are the sample-wise mean of the k whole cycles
-    mean = {name: a[i0:i0 + k * n].reshape(k, n).mean(axis=0)
-            for name, a in (("zeta", rec.zeta), ("F", rec.F))}
+    mean = {
+        name: a[i0 : i0 + k * n].reshape(k, n).mean(axis=0)
+        for name, a in (("zeta", rec.zeta), ("F", rec.F))
+    }
     sel = np.isin(mean["zeta"], cs.zeta[avg])
     assert sel.sum() == avg.sum()
     np.testing.assert_array_equal(cs.F[avg], mean["F"][sel])
@@ -199,15 +205,17 @@ def test_average_cycles_leaves_out_a_deviating_cycle(rec, paper):
     assert set(np.unique(cs.weight)) == {1.0, 18.0}
     # the average is that of the 18 steady cycles: the clean cycle to rounding (with the
     # deviating cycle in it, it would be off by 0.02 / 18 ~ 1e-3 of the peak)
-    np.testing.assert_allclose(cs.F[cs.weight > 1], clean.F[clean.weight > 1], rtol=0,
-                               atol=1e-9 * rec.F.max())
+    np.testing.assert_allclose(
+        cs.F[cs.weight > 1], clean.F[clean.weight > 1], rtol=0, atol=1e-9 * rec.F.max()
+    )
     # the deviating cycle stays in as recorded (weight 1), its wiggle included
     sl = slice(i0 + bad * n, i0 + (bad + 1) * n)
     raw = cs.weight == 1
     in_bad = np.isin(cs.zeta[raw], m.zeta[sl])
     assert in_bad.sum() > 10
-    np.testing.assert_array_equal(cs.F[raw][in_bad],
-                                  F[sl][np.isin(m.zeta[sl], cs.zeta[raw][in_bad])])
+    np.testing.assert_array_equal(
+        cs.F[raw][in_bad], F[sl][np.isin(m.zeta[sl], cs.zeta[raw][in_bad])]
+    )
     # total weight: every recorded contact sample counted once
     assert cs.weight.sum() == pytest.approx(clean.weight.sum(), rel=1e-12)
 
@@ -249,7 +257,7 @@ def test_csv_a2_sign_convention_matches_simulated_motion(paper, rec, tmp_path):
     smooth = np.ones(rec.t.size, bool)
     jumps = np.flatnonzero(np.abs(np.diff(rec.F)) > 0.05 * rec.F.max())
     for j in jumps:
-        smooth[max(j - 2, 0): j + 3] = False
+        smooth[max(j - 2, 0) : j + 3] = False
     smooth[[0, -1]] = False
     err = np.abs(m.F - rec.F)[smooth].max() / rec.F.max()
     assert err < 0.01, err

@@ -50,7 +50,14 @@ def test_builtins_listed_and_load():
 def test_paper_values():
     sc = load_scenario("paper")
     assert (sc.m1, sc.m2, sc.k1, sc.c1, sc.A, sc.frequency, sc.g) == (
-        1.0e4, 1.0e4, 2.75e7, 1.0e5, 5.0e5, 25.0, 9.81)
+        1.0e4,
+        1.0e4,
+        2.75e7,
+        1.0e5,
+        5.0e5,
+        25.0,
+        9.81,
+    )
     assert sc.law == ForceLaw.parse("2.06e8*z + 1.28e7*zd")
     assert sc.period == 0.04
     # rel 1e-15: one multiplication by 2 pi
@@ -59,9 +66,9 @@ def test_paper_values():
     # default start: grid at its static deflection -m1 g / k1, moulding touching it
     w = -1.0e4 * 9.81 / 2.75e7
     np.testing.assert_allclose(sc.initial_state(), [w, 0.0, w, 0.0], rtol=1e-15, atol=0)
-    np.testing.assert_allclose(sc.params(),
-                               [1e4, 1e4, 2.75e7, 1e5, 5e5, 50 * math.pi, 9.81, 0.0, 0.0],
-                               rtol=1e-15, atol=0)
+    np.testing.assert_allclose(
+        sc.params(), [1e4, 1e4, 2.75e7, 1e5, 5e5, 50 * math.pi, 9.81, 0.0, 0.0], rtol=1e-15, atol=0
+    )
 
 
 def test_light_values():
@@ -80,14 +87,22 @@ def test_toml_from_file(tmp_path):
     for sc in (load_scenario(p), load_scenario(str(p)), Scenario.from_toml(p)):
         assert sc.name == "bench"
         assert (sc.m1, sc.m2, sc.k1, sc.c1, sc.A, sc.frequency, sc.g) == (
-            1.0e4, 2.0e3, 2.0e7, 5.0e4, 3.0e5, 30.0, 9.81)
+            1.0e4,
+            2.0e3,
+            2.0e7,
+            5.0e4,
+            3.0e5,
+            30.0,
+            9.81,
+        )
         assert sc.law == ForceLaw.parse("1e8*z + 2e6*zd")
         assert sc.source == str(p)
 
 
 def test_toml_defaults_and_initial(tmp_path):
     text = _machine_without("g").replace('name = "bench"\n', "") + (
-        "\n[initial]\nw1 = 0.001\nv1 = -0.5\nw2 = 0.002\nv2 = 0.25\n")
+        "\n[initial]\nw1 = 0.001\nv1 = -0.5\nw2 = 0.002\nv2 = 0.25\n"
+    )
     p = _write(tmp_path, text, "mine.toml")
     sc = load_scenario(p)
     assert sc.g == 9.81
@@ -109,12 +124,22 @@ def test_missing_key_is_named(tmp_path, key):
 
 @pytest.mark.parametrize(
     ("key", "value"),
-    [("m1", "0.0"), ("m2", "-2.0e3"), ("frequency", "0"), ("k1", "-1.0"), ("c1", "nan"),
-     ("A", "inf"), ("g", "-9.81"), ("m1", "nan"), ("m2", '"heavy"')],
+    [
+        ("m1", "0.0"),
+        ("m2", "-2.0e3"),
+        ("frequency", "0"),
+        ("k1", "-1.0"),
+        ("c1", "nan"),
+        ("A", "inf"),
+        ("g", "-9.81"),
+        ("m1", "nan"),
+        ("m2", '"heavy"'),
+    ],
 )
 def test_bad_value_is_named(tmp_path, key, value):
-    lines = [f"{key} = {value}" if line.startswith(f"{key} =") else line
-             for line in GOOD.splitlines()]
+    lines = [
+        f"{key} = {value}" if line.startswith(f"{key} =") else line for line in GOOD.splitlines()
+    ]
     p = _write(tmp_path, "\n".join(lines))
     with pytest.raises(InputError, match=f"scenario {key} "):
         load_scenario(p)
@@ -173,7 +198,6 @@ def test_law_not_a_table_is_input_error(tmp_path):
         load_scenario(_write(tmp_path, text))
 
 
-
 def test_with_law_and_as_dict():
     sc = load_scenario("paper")
     law = ForceLaw.parse("1e8*z")
@@ -199,16 +223,24 @@ def test_booleans_and_text_are_not_numbers(value):
 
 @pytest.mark.parametrize(
     ("key", "value", "needle"),
-    [("m1", "true", "got a boolean"), ("m2", "false", "got a boolean"),
-     ("k1", '"2.0e7"', "got text '2.0e7'"), ("A", "[1, 2]", "got list"),
-     ("frequency", "{ a = 1 }", "got dict"), ("c1", "1979-05-27", "got date"),
-     ("A", "1e300", "<= 1e+12 N"), ("m1", "1e30", "<= 1e+09 kg"),
-     ("frequency", "1e9", "<= 100000 Hz"), ("g", "inf", "must be finite"),
-     ("m1", "-inf", "must be finite")],
+    [
+        ("m1", "true", "got a boolean"),
+        ("m2", "false", "got a boolean"),
+        ("k1", '"2.0e7"', "got text '2.0e7'"),
+        ("A", "[1, 2]", "got list"),
+        ("frequency", "{ a = 1 }", "got dict"),
+        ("c1", "1979-05-27", "got date"),
+        ("A", "1e300", "<= 1e+12 N"),
+        ("m1", "1e30", "<= 1e+09 kg"),
+        ("frequency", "1e9", "<= 100000 Hz"),
+        ("g", "inf", "must be finite"),
+        ("m1", "-inf", "must be finite"),
+    ],
 )
 def test_toml_types_and_ranges(tmp_path, key, value, needle):
-    lines = [f"{key} = {value}" if line.startswith(f"{key} =") else line
-             for line in GOOD.splitlines()]
+    lines = [
+        f"{key} = {value}" if line.startswith(f"{key} =") else line for line in GOOD.splitlines()
+    ]
     with pytest.raises(InputError, match=f"scenario {key} ") as exc:
         load_scenario(_write(tmp_path, "\n".join(lines)))
     assert needle in str(exc.value) and "\n" not in str(exc.value)
@@ -216,10 +248,12 @@ def test_toml_types_and_ranges(tmp_path, key, value, needle):
 
 @pytest.mark.parametrize(
     ("extra", "needle"),
-    [("\n[machnie]\nm1 = 1.0\n", "unknown table(s) or key(s) machnie"),
-     ("\n[solver]\nrtol = 1e-9\n", "valid are name, [machine], [law], [initial]"),
-     ("\n[initial]\nw1 = 0\nv1 = 0\nw2 = 0\nv2 = 0\nw3 = 0\n", "unknown [initial] key(s) w3"),
-    ])
+    [
+        ("\n[machnie]\nm1 = 1.0\n", "unknown table(s) or key(s) machnie"),
+        ("\n[solver]\nrtol = 1e-9\n", "valid are name, [machine], [law], [initial]"),
+        ("\n[initial]\nw1 = 0\nv1 = 0\nw2 = 0\nv2 = 0\nw3 = 0\n", "unknown [initial] key(s) w3"),
+    ],
+)
 def test_unknown_tables_and_keys_are_refused(tmp_path, extra, needle):
     with pytest.raises(InputError) as exc:
         load_scenario(_write(tmp_path, GOOD + extra))

@@ -70,10 +70,11 @@ class LinearForcedMap:
 
     def exact(self):
         """Orbit state at t = 0 and multipliers, in closed form."""
-        X = self.F / (self.w ** 2 - self.W ** 2 + 2j * self.zeta * self.w * self.W)
-        lam = -self.zeta * self.w + 1j * self.w * np.sqrt(1.0 - self.zeta ** 2)
-        return np.array([X.real, -self.W * X.imag]), np.exp(np.array([lam, lam.conjugate()])
-                                                            * self.T)
+        X = self.F / (self.w**2 - self.W**2 + 2j * self.zeta * self.w * self.W)
+        lam = -self.zeta * self.w + 1j * self.w * np.sqrt(1.0 - self.zeta**2)
+        return np.array([X.real, -self.W * X.imag]), np.exp(
+            np.array([lam, lam.conjugate()]) * self.T
+        )
 
 
 class LogisticMap:
@@ -138,17 +139,30 @@ def test_logistic_period_two_is_not_reduced_to_the_unstable_fixed_point():
 # ------------------------------------------------------------------ vibro-impact unchanged
 # recorded with the implementation before the move (steady_state.py's own _newton,
 # _reduce_period, _recurrence), identical bit for bit after it
-PAPER = {"y0": [-0.005653106861707833, 0.28098294771776317, -0.0058524706348867615,
-                0.06132476750837263],
-         "mult": [-0.15144515095886793, -0.0241409887620794,
-                  0.23372419095798397 + 0.8657576918859299j,
-                  0.23372419095798397 - 0.8657576918859299j],
-         "residual": 2.589742359771409e-13, "t0": 1.92, "n_simulations": 44}
-PD = {"y0": [0.0012036689521576082, 0.06697651816161, 0.0010927289183266834,
-             0.10318728497831268],
-      "mult": [-0.9852111011544376, 0.13685111081128576 + 0.21725786314819234j,
-               0.13685111081128576 - 0.21725786314819234j, -0.1060874616175707],
-      "residual": 3.3199423404977085e-10, "t0": 1.2873007448065161, "n_simulations": 50}
+PAPER = {
+    "y0": [-0.005653106861707833, 0.28098294771776317, -0.0058524706348867615, 0.06132476750837263],
+    "mult": [
+        -0.15144515095886793,
+        -0.0241409887620794,
+        0.23372419095798397 + 0.8657576918859299j,
+        0.23372419095798397 - 0.8657576918859299j,
+    ],
+    "residual": 2.589742359771409e-13,
+    "t0": 1.92,
+    "n_simulations": 44,
+}
+PD = {
+    "y0": [0.0012036689521576082, 0.06697651816161, 0.0010927289183266834, 0.10318728497831268],
+    "mult": [
+        -0.9852111011544376,
+        0.13685111081128576 + 0.21725786314819234j,
+        0.13685111081128576 - 0.21725786314819234j,
+        -0.1060874616175707,
+    ],
+    "residual": 3.3199423404977085e-10,
+    "t0": 1.2873007448065161,
+    "n_simulations": 50,
+}
 
 
 def _same(ss, ref):
@@ -171,9 +185,14 @@ def test_vibro_impact_period_reduction_unchanged():
     path through smallest_period)."""
     from discovery.dynamics.steady_state import steady_state
 
-    sc = Scenario(m1=4770.989046559852, m2=5430.940884957566, k1=161209836.32495606,
-                  c1=343759.5619373554, A=231045.9099917681 * 1.01,
-                  frequency=37.287324033370695)
+    sc = Scenario(
+        m1=4770.989046559852,
+        m2=5430.940884957566,
+        k1=161209836.32495606,
+        c1=343759.5619373554,
+        A=231045.9099917681 * 1.01,
+        frequency=37.287324033370695,
+    )
     ss = steady_state(sc, ForceLaw.parse("1448000000*z + 9927000*zd"), tol=1e-6)
     _same(ss, PD)
     tried = ss.evidence["attempts"][-1]["tried"]
@@ -195,8 +214,9 @@ def test_ueda_entrained_orbit_is_stable_and_satisfies_liouville(entrained):
     # Liouville: det of the monodromy = exp(integral over the period of the trace
     # mu (1 - gamma x^2) - k); the periodic trapezoid rule is spectrally accurate
     T = ENTRAINED.period
-    t, x, _ = trajectory(ENTRAINED, orb.y0, (0.0, T), n_samples=2001,
-                         tolerances=Tolerances(rtol=1e-11))
+    t, x, _ = trajectory(
+        ENTRAINED, orb.y0, (0.0, T), n_samples=2001, tolerances=Tolerances(rtol=1e-11)
+    )
     integral = (t[1] - t[0]) * np.sum(ENTRAINED.trace(x[:-1]))
     # central differences: det to ~1e-9 (measured 4e-10 on the entries)
     assert np.prod(orb.multipliers).real == pytest.approx(np.exp(integral), rel=1e-7)
@@ -208,14 +228,20 @@ def test_ueda_multipliers_match_scipy_monodromy_and_variational_run(entrained):
     s, orb = ENTRAINED, entrained
 
     def f(t, z):
-        return np.concatenate([s.rhs(t, z[:2]), (s.jacobian(t, z[:2]) @ z[2:].reshape(2, 2))
-                               .ravel()])
+        return np.concatenate(
+            [s.rhs(t, z[:2]), (s.jacobian(t, z[:2]) @ z[2:].reshape(2, 2)).ravel()]
+        )
 
-    z = solve_ivp(f, (0.0, s.period), np.concatenate([orb.y0, np.eye(2).ravel()]),
-                  method="DOP853", rtol=1e-12, atol=1e-13).y[:, -1]
+    z = solve_ivp(
+        f,
+        (0.0, s.period),
+        np.concatenate([orb.y0, np.eye(2).ravel()]),
+        method="DOP853",
+        rtol=1e-12,
+        atol=1e-13,
+    ).y[:, -1]
     ref = np.linalg.eigvals(z[2:].reshape(2, 2))
-    np.testing.assert_allclose(np.sort_complex(orb.multipliers), np.sort_complex(ref),
-                               atol=1e-8)
+    np.testing.assert_allclose(np.sort_complex(orb.multipliers), np.sort_complex(ref), atol=1e-8)
     # forward differences (the vibro-impact choice) are ~1e-7 off (truncation error)
     fwd = np.linalg.eigvals(UedaMap(s, difference="forward").jacobian(orb.y0))
     np.testing.assert_allclose(np.sort_complex(fwd), np.sort_complex(ref), atol=2e-6)
@@ -225,8 +251,7 @@ def test_ueda_multipliers_match_scipy_monodromy_and_variational_run(entrained):
     tol, T, atol, hmax = _setup(s, None)
     logs, trace, strobe, _ = _variational(s, orb.y0, 0.0, 12, tol, T, atol, hmax)
     assert np.max(np.abs(strobe - orb.y0) / s.scales()) < 1e-7  # stays on the orbit
-    np.testing.assert_allclose(np.exp(logs[-1]), np.sort(np.abs(orb.multipliers))[::-1],
-                               rtol=1e-6)
+    np.testing.assert_allclose(np.exp(logs[-1]), np.sort(np.abs(orb.multipliers))[::-1], rtol=1e-6)
     assert np.exp(trace[-1]) == pytest.approx(abs(np.prod(orb.multipliers)), rel=1e-7)
 
 
@@ -252,6 +277,7 @@ def test_unstable_recurring_orbit_is_not_called_periodic():
     assert min(reg.evidence["floquet_multipliers_abs"]) > 1.0
     assert "unstable" in reg.evidence["periodic_rejected"]
     stable = LinearForcedMap()
-    reg = classify_points(np.tile(stable.exact()[0], (30, 1)), stable.scale, -0.1,
-                          period_map=stable)
+    reg = classify_points(
+        np.tile(stable.exact()[0], (30, 1)), stable.scale, -0.1, period_map=stable
+    )
     assert reg.regime == "P1" and max(reg.evidence["floquet_multipliers_abs"]) < 1.0

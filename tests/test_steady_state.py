@@ -37,8 +37,10 @@ def test_paper_orbit_closes_after_one_period(paper, paper_ss):
     assert _rel(pm, pm.advance(paper_ss.y0, 1), paper_ss.y0) < 1e-7
     # the drive phase only depends on t mod T: starting at t0 = k T gives the same map
     # (differences only from roundoff of sin(omega t) at larger t: 1e-9 of scale)
-    assert _rel(pm, pm.advance(paper_ss.y0, 1, t0=paper_ss.t0),
-                pm.advance(paper_ss.y0, 1, t0=0.0)) < 1e-9
+    assert (
+        _rel(pm, pm.advance(paper_ss.y0, 1, t0=paper_ss.t0), pm.advance(paper_ss.y0, 1, t0=0.0))
+        < 1e-9
+    )
     # and through simulate(): the public path gives the same point (same kernel, same steps)
     tr = simulate(paper, paper.law, (paper_ss.t0, paper_ss.t0 + paper.period), y0=paper_ss.y0)
     assert _rel(pm, tr.y_final, paper_ss.y0) < 1e-7
@@ -102,7 +104,7 @@ def test_floquet_multipliers_match_perturbation_decay(which, request):
     assert rate == pytest.approx(rho, abs=0.03)
     # bound: after k periods the perturbation is within a constant times rho^k
     ks = np.arange(len(d))
-    assert np.all(np.array(d) <= 20 * d[0] * rho ** ks + 1e-10)
+    assert np.all(np.array(d) <= 20 * d[0] * rho**ks + 1e-10)
 
 
 @pytest.mark.parametrize("which", ["paper", "light"])
@@ -129,8 +131,12 @@ def test_stroboscopic_map_jacobian_shape_and_counters(paper, paper_ss):
     assert pm.n_calls == 5 and pm.n_steps > 0
     # P1 orbit: Phi^2 has the squared multipliers (rel 1e-3: FD noise as above)
     J2 = pm.jacobian(paper_ss.y0, n=2)
-    np.testing.assert_allclose(np.sort(np.abs(np.linalg.eigvals(J2))),
-                               np.sort(np.abs(paper_ss.multipliers) ** 2), rtol=0, atol=2e-3)
+    np.testing.assert_allclose(
+        np.sort(np.abs(np.linalg.eigvals(J2))),
+        np.sort(np.abs(paper_ss.multipliers) ** 2),
+        rtol=0,
+        atol=2e-3,
+    )
 
 
 def test_t0_shift_gives_same_orbit(paper, paper_ss):
@@ -152,8 +158,14 @@ def test_advance_raises_on_runaway(paper):
 
 
 # --- period detection near multipliers -1 (issue: a slow P1 orbit read as P2) -------------
-_PD = Scenario(m1=4770.989046559852, m2=5430.940884957566, k1=161209836.32495606,
-               c1=343759.5619373554, A=231045.9099917681 * 1.01, frequency=37.287324033370695)
+_PD = Scenario(
+    m1=4770.989046559852,
+    m2=5430.940884957566,
+    k1=161209836.32495606,
+    c1=343759.5619373554,
+    A=231045.9099917681 * 1.01,
+    frequency=37.287324033370695,
+)
 _PD_LAW = ForceLaw.parse("1448000000*z + 9927000*zd")
 
 
@@ -169,8 +181,14 @@ def test_p1_with_multiplier_near_minus_one_is_not_read_as_p2():
 
 def test_p1_at_the_edge_of_period_doubling_is_p1():
     # multiplier -0.9999 (the period doubling is a whisker away): still one orbit, 2 impacts
-    sc = Scenario(m1=13548.873878973951, m2=10237.086997075849, k1=201079328.34759715,
-                  c1=107030.21999360243, A=300137.0, frequency=12.074213096216956)
+    sc = Scenario(
+        m1=13548.873878973951,
+        m2=10237.086997075849,
+        k1=201079328.34759715,
+        c1=107030.21999360243,
+        A=300137.0,
+        frequency=12.074213096216956,
+    )
     ss = steady_state(sc, ForceLaw.parse("182300000*z + 383000*zd + 893800000*z*zd"))
     assert ss.regime == "P1" and ss.impacts == 2
     assert np.max(np.abs(ss.multipliers)) > 0.999

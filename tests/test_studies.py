@@ -22,10 +22,16 @@ VIDI = [sys.executable, "-c", "import sys; from discovery.cli import main; sys.e
 
 # the paper's law, two noise levels and two methods, regression only: 8 runs in seconds
 QUICK = {
-    "name": "quick", "seeds": 2,
-    "factors": {"law": ["2.06e8*z + 1.28e7*zd"], "force_noise": [0.01, 0.05],
-                "periods": [6], "library": ["z, zd, z^2, z*zd"],
-                "selection": ["best-subset", "stlsq"], "refine": [False]},
+    "name": "quick",
+    "seeds": 2,
+    "factors": {
+        "law": ["2.06e8*z + 1.28e7*zd"],
+        "force_noise": [0.01, 0.05],
+        "periods": [6],
+        "library": ["z, zd, z^2, z*zd"],
+        "selection": ["best-subset", "stlsq"],
+        "refine": [False],
+    },
 }
 TIMING = {"seconds", "seconds_median", "code_version"}
 
@@ -48,6 +54,7 @@ def _cells(d):
     keep = [i for i, c in enumerate(cols) if c not in TIMING]
     # the library text holds commas inside quotes: compare whole lines minus timing columns
     import csv
+
     rows = list(csv.reader(lines))
     return [[r[i] for i in keep] for r in rows]
 
@@ -69,29 +76,38 @@ def test_config_product_seeds_and_keys():
 
 
 def test_config_rows_and_scenario_tables():
-    cfg = load_study({"seeds": [3], "rows": [
-        {"scenario": [{"base": "paper", "A": 3.5e5}, "paper"], "periods": 4},
-        {"selection": "stlsq"}]})
+    cfg = load_study(
+        {
+            "seeds": [3],
+            "rows": [
+                {"scenario": [{"base": "paper", "A": 3.5e5}, "paper"], "periods": 4},
+                {"selection": "stlsq"},
+            ],
+        }
+    )
     assert cfg.seeds == (3,) and len(cfg.cells) == 2
     runs = cfg.runs()
     assert [s["A"] for s in runs[0]["scenarios"]] == [3.5e5, 5.0e5]
     assert runs[1]["selection"] == "stlsq" and runs[1]["periods"] == FACTORS["periods"]
 
 
-@pytest.mark.parametrize("bad, words", [
-    ({"factors": {"noise": [0.1]}}, "unknown factor"),
-    ({"factors": {"force_noise": 0.1}}, "must be a non-empty list"),
-    ({"factors": {"force_noise": [1.5]}}, "fractions in [0, 1)"),
-    ({"factors": {"selection": ["lasso"]}}, "selection 'lasso' is unknown"),
-    ({"factors": {"periods": [2.5]}}, "whole numbers"),
-    ({"seeds": 0}, "seeds = 0"),
-    ({"seeds": [1, 1]}, "repeats a seed"),
-    ({"fit": {"max_term": 3}}, "unknown [fit] key"),
-    ({"record": {"transient": "long"}}, "transient is \"auto\""),
-    ({"factors": {"refine": [True]}, "rows": [{}]}, "not both"),
-    ({"factors": {"scenario": [{"base": "paper", "mass": 3}]}}, "unknown scenario key"),
-    ({"factors": {"law": ["2e8*z +"]}}, ""),
-])
+@pytest.mark.parametrize(
+    "bad, words",
+    [
+        ({"factors": {"noise": [0.1]}}, "unknown factor"),
+        ({"factors": {"force_noise": 0.1}}, "must be a non-empty list"),
+        ({"factors": {"force_noise": [1.5]}}, "fractions in [0, 1)"),
+        ({"factors": {"selection": ["lasso"]}}, "selection 'lasso' is unknown"),
+        ({"factors": {"periods": [2.5]}}, "whole numbers"),
+        ({"seeds": 0}, "seeds = 0"),
+        ({"seeds": [1, 1]}, "repeats a seed"),
+        ({"fit": {"max_term": 3}}, "unknown [fit] key"),
+        ({"record": {"transient": "long"}}, 'transient is "auto"'),
+        ({"factors": {"refine": [True]}, "rows": [{}]}, "not both"),
+        ({"factors": {"scenario": [{"base": "paper", "mass": 3}]}}, "unknown scenario key"),
+        ({"factors": {"law": ["2e8*z +"]}}, ""),
+    ],
+)
 def test_config_refuses_bad_studies_in_one_line(bad, words):
     with pytest.raises(InputError) as err:
         load_study(bad)
@@ -109,16 +125,17 @@ def test_wilson_interval_closed_form():
 def test_field_record_noise_is_relative_to_each_channel(paper):
     law = paper.law
     clean = clean_record(paper, law, 4, 10000.0, 30)
-    m = field_record(paper, law, periods=4, fs=10000.0, transient=30, force_noise=0.02,
-                     motion_noise=0.01, seed=5)
+    m = field_record(
+        paper, law, periods=4, fs=10000.0, transient=30, force_noise=0.02, motion_noise=0.01, seed=5
+    )
     t, y, F, _ = clean
     assert np.array_equal(m.t, t) and m.t[0] == pytest.approx(30 * paper.period)
     assert np.std(m.F - F) == pytest.approx(0.02 * np.max(np.abs(F)), rel=0.1)
     for name, row in (("w1", 0), ("v1", 1), ("w2", 2), ("v2", 3)):
-        assert np.std(m.channels[name] - y[row]) == pytest.approx(0.01 * np.ptp(y[row]),
-                                                                  rel=0.1)
-    again = field_record(paper, law, periods=4, fs=10000.0, transient=30, force_noise=0.02,
-                         motion_noise=0.01, seed=5)
+        assert np.std(m.channels[name] - y[row]) == pytest.approx(0.01 * np.ptp(y[row]), rel=0.1)
+    again = field_record(
+        paper, law, periods=4, fs=10000.0, transient=30, force_noise=0.02, motion_noise=0.01, seed=5
+    )
     assert np.array_equal(again.F, m.F)  # seeds are explicit
 
 
@@ -133,8 +150,17 @@ def test_study_runs_scores_and_writes_tables(quick_serial):
     res, out = quick_serial
     assert res.executed == 8 and res.reused == 0 and len(res.runs) == 8
     assert len(_files(out)) == 8
-    for f in ("cells.csv", "runs.csv", "inclusion.csv", "summary.json", "config.json",
-              "recovery_noise.png", "recovery_map.pdf", "coverage.png", "inclusion.png"):
+    for f in (
+        "cells.csv",
+        "runs.csv",
+        "inclusion.csv",
+        "summary.json",
+        "config.json",
+        "recovery_noise.png",
+        "recovery_map.pdf",
+        "coverage.png",
+        "inclusion.png",
+    ):
         assert (out / f).stat().st_size > 0, f
     for r in res.runs:
         assert r["status"] == "ok", r.get("error")
@@ -146,8 +172,9 @@ def test_study_runs_scores_and_writes_tables(quick_serial):
         rs = [r for r in res.runs if r["cell"] == ci]
         assert row["recovered"] == sum(r["exact"] for r in rs) and row["runs"] == 2
     # at 1 % noise best-subset finds the paper's law on both seeds
-    best = next(c for c in res.cells if c["selection"] == "best-subset"
-                and c["force_noise"] == 0.01)
+    best = next(
+        c for c in res.cells if c["selection"] == "best-subset" and c["force_noise"] == 0.01
+    )
     assert best["recovered"] == 2
     summary = json.loads((out / "summary.json").read_text())
     assert summary["versions"]["numpy"] and summary["runs"] == 8
@@ -214,8 +241,18 @@ def test_study_killed_with_sigkill_resumes_with_every_run_once(quick_serial, tmp
     cfg = tmp_path / "quick.toml"
     cfg.write_text((ROOT / "examples" / "study_quick.toml").read_text())
     out = tmp_path / "killed"
-    cmd = [*VIDI, "study", "--config", str(cfg), "--out",
-           str(out), "--workers", "1", "--no-figures", "--quiet"]
+    cmd = [
+        *VIDI,
+        "study",
+        "--config",
+        str(cfg),
+        "--out",
+        str(out),
+        "--workers",
+        "1",
+        "--no-figures",
+        "--quiet",
+    ]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 300
     while len(_files(out)) < 3 and time.monotonic() < deadline and proc.poll() is None:
@@ -231,20 +268,33 @@ def test_study_killed_with_sigkill_resumes_with_every_run_once(quick_serial, tmp
     assert all(f.stem == json.loads(f.read_text())["key"] for f in _files(out))
     assert f"{8 - before} run now, {before} from earlier files" in again.stdout
     assert runs == _runs(full) and _cells(out) == _cells(full)
-    assert not [p for p in (out / "runs").iterdir() if p.name.startswith(".")] or \
-        all("vidi-tmp" in p.name for p in (out / "runs").iterdir() if p.name.startswith("."))
+    assert not [p for p in (out / "runs").iterdir() if p.name.startswith(".")] or all(
+        "vidi-tmp" in p.name for p in (out / "runs").iterdir() if p.name.startswith(".")
+    )
 
 
 def test_cli_study_bad_inputs_are_one_line(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text('[factors]\nselection = ["lasso"]\n')
     for args, words in (
-            (["--config", str(bad)], "selection 'lasso' is unknown"),
-            (["--config", str(tmp_path / "none.toml")], "does not exist"),
-            (["--config", str(ROOT / "examples" / "study_quick.toml"), "--scheduler",
-              "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler")):
-        p = subprocess.run([*VIDI, "study", *args, "--out",
-                            str(tmp_path / "o")], capture_output=True, text=True, timeout=120)
+        (["--config", str(bad)], "selection 'lasso' is unknown"),
+        (["--config", str(tmp_path / "none.toml")], "does not exist"),
+        (
+            [
+                "--config",
+                str(ROOT / "examples" / "study_quick.toml"),
+                "--scheduler",
+                "tcp://127.0.0.1:9",
+            ],
+            "cannot reach the Dask scheduler",
+        ),
+    ):
+        p = subprocess.run(
+            [*VIDI, "study", *args, "--out", str(tmp_path / "o")],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         assert p.returncode == 2, p.stderr
         assert words in p.stderr and len(p.stderr.strip().splitlines()) == 1, p.stderr
 
@@ -262,16 +312,33 @@ def test_study_owns_its_directory_whatever_ran_before(tmp_path):
     from discovery._io import _RUN, set_run
 
     out = tmp_path / "s"
-    study({**QUICK, "seeds": 1, "factors": {**QUICK["factors"], "force_noise": [0.01],
-                                            "selection": ["best-subset"]}}, out, workers=1,
-          figures=False)
+    study(
+        {
+            **QUICK,
+            "seeds": 1,
+            "factors": {**QUICK["factors"], "force_noise": [0.01], "selection": ["best-subset"]},
+        },
+        out,
+        workers=1,
+        figures=False,
+    )
     prev = dict(_RUN)
     set_run("report")
     try:
-        again = study({**QUICK, "seeds": 1, "factors": {**QUICK["factors"],
-                                                        "force_noise": [0.01],
-                                                        "selection": ["best-subset"]}},
-                      out, workers=1, figures=False)
+        again = study(
+            {
+                **QUICK,
+                "seeds": 1,
+                "factors": {
+                    **QUICK["factors"],
+                    "force_noise": [0.01],
+                    "selection": ["best-subset"],
+                },
+            },
+            out,
+            workers=1,
+            figures=False,
+        )
     finally:
         _RUN.update(prev)
     assert again.reused == 1 and again.executed == 0

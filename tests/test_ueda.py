@@ -33,17 +33,30 @@ def test_strobe_points_match_scipy(system):
     n = 6
     pts, _ = strobe_points(system, y0, n, transient=0, tolerances=Tolerances(rtol=1e-11))
     T = system.period
-    ref = solve_ivp(system.rhs, (0, n * T), y0, method="DOP853", rtol=1e-13, atol=1e-14,
-                    t_eval=T * np.arange(1, n + 1)).y.T
+    ref = solve_ivp(
+        system.rhs,
+        (0, n * T),
+        y0,
+        method="DOP853",
+        rtol=1e-13,
+        atol=1e-14,
+        t_eval=T * np.arange(1, n + 1),
+    ).y.T
     # chaotic divergence over 6 periods amplifies ~1e-11 local errors to ~1e-8 at most
     assert np.max(np.abs(pts - ref)) < 1e-7
 
 
 def test_dense_trajectory_matches_scipy():
-    t, x, v = trajectory(NEGRES, (0.1, 0.0), (0.0, 3 * NEGRES.period), n_samples=301,
-                         tolerances=Tolerances(rtol=1e-11))
-    ref = solve_ivp(NEGRES.rhs, (0, t[-1]), [0.1, 0.0], method="DOP853", rtol=1e-13,
-                    atol=1e-14, t_eval=t).y
+    t, x, v = trajectory(
+        NEGRES,
+        (0.1, 0.0),
+        (0.0, 3 * NEGRES.period),
+        n_samples=301,
+        tolerances=Tolerances(rtol=1e-11),
+    )
+    ref = solve_ivp(
+        NEGRES.rhs, (0, t[-1]), [0.1, 0.0], method="DOP853", rtol=1e-13, atol=1e-14, t_eval=t
+    ).y
     # dense output is 4th order between steps: ~1e-9 at rtol 1e-11
     assert np.max(np.abs(x - ref[0])) < 1e-7 and np.max(np.abs(v - ref[1])) < 1e-7
 
@@ -63,8 +76,7 @@ def test_variational_equations_match_scipy_finite_time_exponents():
     logs = np.zeros(2)
     T = s.period
     for k in range(8):
-        z = solve_ivp(f, (k * T, (k + 1) * T), z, method="DOP853", rtol=1e-13,
-                      atol=1e-14).y[:, -1]
+        z = solve_ivp(f, (k * T, (k + 1) * T), z, method="DOP853", rtol=1e-13, atol=1e-14).y[:, -1]
         Q, R = np.linalg.qr(np.column_stack([z[2:4], z[4:6]]))
         sg = np.sign(np.diag(R))
         logs += np.log(np.abs(np.diag(R)))
@@ -130,8 +142,14 @@ def test_exponent_converges_as_the_tolerance_tightens():
     _, y = strobe_points(DUFFING, None, 1, transient=300, tolerances=Tolerances(rtol=1e-12))
 
     def lam(rtol):
-        return lyapunov(DUFFING, y, transient=0, periods=10, batches=2,
-                        tolerances=Tolerances(rtol=rtol, hmax_fraction=1.0)).value
+        return lyapunov(
+            DUFFING,
+            y,
+            transient=0,
+            periods=10,
+            batches=2,
+            tolerances=Tolerances(rtol=rtol, hmax_fraction=1.0),
+        ).value
 
     ref = lam(1e-12)
     errs = [abs(lam(r) - ref) for r in (1e-5, 1e-6, 1e-7, 1e-8, 1e-9)]
@@ -207,16 +225,46 @@ def vidi(monkeypatch):
 
 def test_cli_attractor_and_chart(vidi, tmp_path):
     out = tmp_path / "att"
-    assert vidi(["ueda", "attractor", "--model", "duffing", "--periods", "300",
-                 "--transient", "100", "--out", str(out)]) == 0
+    assert (
+        vidi(
+            [
+                "ueda",
+                "attractor",
+                "--model",
+                "duffing",
+                "--periods",
+                "300",
+                "--transient",
+                "100",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     s = json.loads((out / "summary.json").read_text())
     assert set(s["lyapunov"]) >= {"value", "stderr", "second"}
     assert s["n_points"] == 300 and len(s["strobe_x_range"]) == 2
     assert s["regime"] == "chaotic" and "versions" in s and "settings" in s
     assert (out / "attractor.png").exists()
     ch = tmp_path / "chart"
-    assert vidi(["ueda", "chart", "--nu", "0.9:1.1:4", "--B", "0.1:0.5:3", "--workers", "1",
-                 "--out", str(ch)]) == 0
+    assert (
+        vidi(
+            [
+                "ueda",
+                "chart",
+                "--nu",
+                "0.9:1.1:4",
+                "--B",
+                "0.1:0.5:3",
+                "--workers",
+                "1",
+                "--out",
+                str(ch),
+            ]
+        )
+        == 0
+    )
     s = json.loads((ch / "summary.json").read_text())
     assert s["points"] == 12 and abs(sum(s["fractions"].values()) - 1) < 1e-12
     assert len((ch / "chart.csv").read_text().splitlines()) == 13

@@ -61,9 +61,11 @@ def test_the_p9_orbit_is_confirmed_by_shooting(small_chart):
     big = float(np.max(np.abs(orb.multipliers)))
     assert big < 0.1
     assert abs(small_chart.lyapunov[0, 2] - np.log(big) / (9 * s.period)) < 2e-3
-    orb13 = periodic_orbit(NEGRES.with_params(B=0.09, nu=1.05),
-                           strobe_points(NEGRES.with_params(B=0.09, nu=1.05), None, 20,
-                                         transient=1000)[0][-1], 13)
+    orb13 = periodic_orbit(
+        NEGRES.with_params(B=0.09, nu=1.05),
+        strobe_points(NEGRES.with_params(B=0.09, nu=1.05), None, 20, transient=1000)[0][-1],
+        13,
+    )
     assert orb13.converged and orb13.stable and orb13.n_periods == 13
 
 
@@ -120,8 +122,14 @@ def test_negres_resonance_hysteresis_at_large_forcing():
         assert KINDS[ch.kind[i, j]] == KINDS[ch.kind_down[i, j]] == "P1"
         assert abs(ch.lyapunov[i, j] - ch.lyapunov_down[i, j]) > 0.02
     assert not ch.coexisting[:, :3].any()  # nu <= 1.04: one P1
-    bas = basins(NEGRES.with_params(B=0.55, nu=1.08), (-1.5, 1.5), (-1.5, 1.5), n=5,
-                 transient=300, periods=100)
+    bas = basins(
+        NEGRES.with_params(B=0.55, nu=1.08),
+        (-1.5, 1.5),
+        (-1.5, 1.5),
+        n=5,
+        transient=300,
+        periods=100,
+    )
     p1 = [a for a in bas.attractors if a["regime"] == "P1"]
     assert len(p1) >= 2
     assert np.max(np.abs(np.subtract(p1[0]["centre"], p1[1]["centre"]))) > 0.1
@@ -146,16 +154,38 @@ def vidi(monkeypatch):
 
 def test_cli_chart_both_directions_and_bad_input(vidi, tmp_path, capsys):
     out = tmp_path / "ch"
-    assert vidi(["ueda", "chart", "--model", "duffing", "--nu", "0.6:1.5:10", "--B",
-                 "0.1:0.15:2", "--both-directions", "--workers", "1", "--out",
-                 str(out)]) == 0
+    assert (
+        vidi(
+            [
+                "ueda",
+                "chart",
+                "--model",
+                "duffing",
+                "--nu",
+                "0.6:1.5:10",
+                "--B",
+                "0.1:0.15:2",
+                "--both-directions",
+                "--workers",
+                "1",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     s = json.loads((out / "summary.json").read_text())
     assert s["sweeps"] == 2 and s["coexisting_points"] >= 3
     assert s["settings"]["max_period"] == 16 and "P1" in s["periods_found"]
     with open(out / "chart.csv", newline="") as fh:
         rows = list(csv.reader(fh))
-    assert rows[0][-5:] == ["regime_down", "period_down", "lyapunov_down",
-                            "rotation_number_down", "coexisting"]
+    assert rows[0][-5:] == [
+        "regime_down",
+        "period_down",
+        "lyapunov_down",
+        "rotation_number_down",
+        "coexisting",
+    ]
     assert len(rows) == 21 and (out / "chart.png").exists()
     capsys.readouterr()
     for bad in (["--max-period", "0"], ["--max-period", "30"], ["--max-period", "x"]):

@@ -24,8 +24,10 @@ from discovery.oscillator.discover import (
 
 NEGRES = UedaSystem.from_model("negres")
 DUFFING = UedaSystem.from_model("duffing")
-TRUTH = {"negres": {"x'": 0.2, "x^2 x'": -1.6, "x^3": -1.0, FORCING: 1.0},
-         "duffing": {"x'": -0.05, "x^3": -1.0, FORCING: 1.0}}
+TRUTH = {
+    "negres": {"x'": 0.2, "x^2 x'": -1.6, "x^3": -1.0, FORCING: 1.0},
+    "duffing": {"x'": -0.05, "x^3": -1.0, FORCING: 1.0},
+}
 
 
 @pytest.fixture(scope="module")
@@ -33,8 +35,7 @@ def records():
     """200 periods, 40 samples per period, noise 0.2 % of x's range, scipy DOP853."""
     out = {}
     for name, s in (("negres", NEGRES), ("duffing", DUFFING)):
-        t, x, _, _ = simulate_record(s, 200, 40, 0.002, seed=1, transient=100,
-                                     integrator="scipy")
+        t, x, _, _ = simulate_record(s, 200, 40, 0.002, seed=1, transient=100, integrator="scipy")
         out[name] = (s, t, x)
     return out
 
@@ -94,8 +95,10 @@ def test_verification_accepts_the_truth_and_rejects_gamma_halved(records):
     good = verify(d.model, t, x, periods=1500)
     assert good.consistent and good.energy_consistent
     # block halves (the default floor); measured 0.23 here, 0.26-0.62 over 10 records
-    assert good.floor_method == "blocks" and 4 <= good.floor_block_periods <= len(
-        good.record_strobe) // 8
+    assert (
+        good.floor_method == "blocks"
+        and 4 <= good.floor_block_periods <= len(good.record_strobe) // 8
+    )
     assert good.energy_distance < 0.8 * good.floor_q95
     assert good.regime_record == "chaotic" and good.regime_model == "chaotic"
     assert good.lyapunov["value"] > 3 * good.lyapunov["stderr"]
@@ -147,20 +150,23 @@ def test_verification_rates_over_records():
     for name, wrong in (("negres", {"gamma": 7.2}), ("duffing", None)):
         s = UedaSystem.from_model(name)
         for r in range(3):
-            t, x, _, _ = simulate_record(s, 200, 40, 0.002, seed=10 + r,
-                                         transient=150 + 97 * r)
+            t, x, _, _ = simulate_record(s, 200, 40, 0.002, seed=10 + r, transient=150 + 97 * r)
             v = verify(ForcedPolynomial.from_system(s), t, x, periods=1000, resamples=100)
             assert v.consistent and v.energy_distance < 0.8 * v.floor_q95, (name, r)
             if wrong:
-                w = verify(ForcedPolynomial.from_system(s.with_params(**wrong)), t, x,
-                           periods=1000, resamples=100)
+                w = verify(
+                    ForcedPolynomial.from_system(s.with_params(**wrong)),
+                    t,
+                    x,
+                    periods=1000,
+                    resamples=100,
+                )
                 assert not w.consistent and w.energy_distance > 1.5 * w.floor_q95, (name, r)
 
 
 def test_the_former_random_halves_floor_is_available(records):
     s, t, x = records["negres"]
-    v = verify(ForcedPolynomial.from_system(s), t, x, periods=300, resamples=50,
-               floor="halves")
+    v = verify(ForcedPolynomial.from_system(s), t, x, periods=300, resamples=50, floor="halves")
     assert v.floor_method == "halves" and v.floor_block_periods == 1
     assert v.floor_correlation_lag is None and v.energy_consistent
     with pytest.raises(InputError):
@@ -210,22 +216,67 @@ def vidi():
 
 def test_cli_simulate_and_discover(vidi, tmp_path):
     data = tmp_path / "D.csv"
-    assert vidi(["ueda", "simulate", "--model", "negres", "--periods", "150",
-                 "--samples-per-period", "40", "--noise", "0.002", "--seed", "0",
-                 "--transient", "100", "--out", str(data)]) == 0
+    assert (
+        vidi(
+            [
+                "ueda",
+                "simulate",
+                "--model",
+                "negres",
+                "--periods",
+                "150",
+                "--samples-per-period",
+                "40",
+                "--noise",
+                "0.002",
+                "--seed",
+                "0",
+                "--transient",
+                "100",
+                "--out",
+                str(data),
+            ]
+        )
+        == 0
+    )
     meta = json.loads((tmp_path / "D.summary.json").read_text())
     assert meta["samples"] == 6001 and meta["noise"]["fraction_of_range"] == 0.002
     assert data.read_text().splitlines()[0] == "t,x"
     out = tmp_path / "res"
-    assert vidi(["ueda", "discover", "--data", str(data), "--nu", "1.02", "--B", "0.35",
-                 "--model-periods", "1000", "--resamples", "100", "--out", str(out)]) == 0
+    assert (
+        vidi(
+            [
+                "ueda",
+                "discover",
+                "--data",
+                str(data),
+                "--nu",
+                "1.02",
+                "--B",
+                "0.35",
+                "--model-periods",
+                "1000",
+                "--resamples",
+                "100",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     s = json.loads((out / "summary.json").read_text())
     assert set(s["terms"]) == {"x'", "x^2 x'", "x^3"}
     assert set(s["coefficients"]) == set(s["standard_errors"]) == set(TRUTH["negres"])
     assert abs(s["coefficients"]["x^2 x'"] + 1.6) < 4 * s["standard_errors"]["x^2 x'"] + 1e-3
     v = s["verification"]
-    assert {"energy_distance", "floor_q95", "consistent", "regime_record", "regime_model",
-            "lyapunov"} <= set(v)
+    assert {
+        "energy_distance",
+        "floor_q95",
+        "consistent",
+        "regime_record",
+        "regime_model",
+        "lyapunov",
+    } <= set(v)
     assert v["consistent"] and v["regime_record"] == v["regime_model"] == "chaotic"
     assert "\\cos" in s["latex"] and "versions" in s and s["inputs"]["data"]["sha256"]
     # both settings kept: the command line's (provenance) and the discovery's own
@@ -243,17 +294,16 @@ def test_cli_bad_inputs_exit_2(vidi, tmp_path, capsys):
     assert vidi(["ueda", "discover", "--data", missing, "--model", "negres", "--out", out]) == 2
     bad = tmp_path / "bad.csv"
     bad.write_text("time,pos\n0,1\n1,2\n")
-    assert vidi(["ueda", "discover", "--data", str(bad), "--model", "negres",
-                 "--out", out]) == 2
+    assert vidi(["ueda", "discover", "--data", str(bad), "--model", "negres", "--out", out]) == 2
     txt = tmp_path / "txt.csv"
     txt.write_text("t,x\n" + "".join(f"{k},{np.sin(k)}\n" for k in range(100)) + "5,abc\n")
-    assert vidi(["ueda", "discover", "--data", str(txt), "--model", "negres",
-                 "--out", out]) == 2
+    assert vidi(["ueda", "discover", "--data", str(txt), "--model", "negres", "--out", out]) == 2
     good = tmp_path / "g.csv"
     good.write_text("t,x\n" + "".join(f"{0.15 * k},{np.sin(0.15 * k)}\n" for k in range(400)))
     assert vidi(["ueda", "discover", "--data", str(good), "--out", out]) == 2  # no forcing
-    assert vidi(["ueda", "discover", "--data", str(good), "--nu", "0", "--B", "1",
-                 "--out", out]) == 2
+    assert (
+        vidi(["ueda", "discover", "--data", str(good), "--nu", "0", "--B", "1", "--out", out]) == 2
+    )
     assert vidi(["ueda", "simulate", "--out", str(tmp_path / "D.txt")]) == 2
     assert vidi(["ueda", "simulate", "--noise", "2", "--out", str(tmp_path / "D.csv")]) == 2
     err = capsys.readouterr().err
@@ -272,15 +322,25 @@ def test_one_csv_reader_for_both_systems(tmp_path):
     plain = tmp_path / "plain.csv"
     plain.write_text("t,x\n" + "".join(f"{a:.17g},{b:.17g}\n" for a, b in zip(t, x, strict=True)))
     excel = tmp_path / "excel.csv"
-    excel.write_bytes(b"\xef\xbb\xbf# exported\r\nt;x\r\n" + "".join(
-        f"{a:.17g};{b:.17g}\r\n".replace(".", ",") for a, b in zip(t, x, strict=True)).encode())
+    excel.write_bytes(
+        b"\xef\xbb\xbf# exported\r\nt;x\r\n"
+        + "".join(
+            f"{a:.17g};{b:.17g}\r\n".replace(".", ",") for a, b in zip(t, x, strict=True)
+        ).encode()
+    )
     t1, x1 = read_record_csv(plain)
     t2, x2 = read_record_csv(excel)
     assert np.array_equal(t1, t2) and np.array_equal(x1, x2) and np.array_equal(x1, x)
-    cases = [("t,x\n0," + "1" * 300_000 + "\n", "field larger than field limit"),
-             ("time,x\n0,1\n", "no column(s) t"),
-             ("t,x\n" + "".join(f"{a:.17g},{b:.17g}\n" for a, b in zip(t, x, strict=True))
-              + "61,abc\n", "non-numeric value 'abc' at line 402")]
+    cases = [
+        ("t,x\n0," + "1" * 300_000 + "\n", "field larger than field limit"),
+        ("time,x\n0,1\n", "no column(s) t"),
+        (
+            "t,x\n"
+            + "".join(f"{a:.17g},{b:.17g}\n" for a, b in zip(t, x, strict=True))
+            + "61,abc\n",
+            "non-numeric value 'abc' at line 402",
+        ),
+    ]
     for k, (text, needle) in enumerate(cases):
         bad = tmp_path / f"bad{k}.csv"
         bad.write_text(text)

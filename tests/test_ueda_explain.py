@@ -35,8 +35,13 @@ def missing_vdp():
 
 def test_the_catalogue():
     ids = {e.id for e in EFFECTS}
-    assert {"van_der_pol_damping", "linear_damping", "cubic_stiffness", "quadratic_stiffness",
-            "velocity_cubic_damping"} <= ids
+    assert {
+        "van_der_pol_damping",
+        "linear_damping",
+        "cubic_stiffness",
+        "quadratic_stiffness",
+        "velocity_cubic_damping",
+    } <= ids
     for e in EFFECTS:  # the vibro-impact catalogue's dataclasses, this system's terms
         assert isinstance(e, Effect) and all(isinstance(p, Parameter) for p in e.parameters)
         assert set(e.terms) <= set(TERMS) and len(e.parameters) == len(e.terms)
@@ -82,8 +87,10 @@ def test_missing_van_der_pol_damping_is_named_and_the_gap_shrinks(missing_vdp):
     g = ex.gap
     assert g["energy_distance"]["ratio"] >= 3
     assert g["energy_distance"]["after"] <= ex.noise_floor["energy_distance_q95"]
-    assert g["residual_rms"]["ratio"] >= 3 or \
-        g["residual_rms"]["after"] <= 1.2 * ex.noise_floor["residual_rms"]
+    assert (
+        g["residual_rms"]["ratio"] >= 3
+        or g["residual_rms"]["after"] <= 1.2 * ex.noise_floor["residual_rms"]
+    )
     assert ex.consistent and ex.criteria["regime_model"] == ex.criteria["regime_record"]
     assert "consistent" in ex.stopped_because and "no catalogue effect" in ex.stopped_because
     for k, v in {"x'": 0.2, "x^3": -1.0, FORCING: 1.0}.items():
@@ -117,8 +124,7 @@ def test_no_false_discoveries_from_the_true_terms():
         false += len(ex.effects_added)
         assert ex.final_terms == TRUE_TERMS
         assert len(ex.iterations) == 1 and ex.iterations[0].effect is None
-        assert ("is consistent" if ex.consistent else "still inconsistent") \
-            in ex.stopped_because
+        assert ("is consistent" if ex.consistent else "still inconsistent") in ex.stopped_because
     assert false == 0
 
 
@@ -170,30 +176,74 @@ def vidi():
 
 def _write_record(path, seed=0, periods=150):
     t, x = _record(seed, periods=periods)
-    path.write_text("t,x\n" + "".join(f"{a:.12g},{b:.12g}\n" for a, b in zip(t, x,
-                                                                           strict=True)))
+    path.write_text("t,x\n" + "".join(f"{a:.12g},{b:.12g}\n" for a, b in zip(t, x, strict=True)))
 
 
 def test_cli_explain(vidi, tmp_path, capsys):
     data = tmp_path / "D.csv"
     _write_record(data)
     out = tmp_path / "res"
-    assert vidi(["ueda", "explain", "--data", str(data), "--model", "negres",
-                 "--model-periods", "400", "--resamples", "50", "--out", str(out)]) == 0
+    assert (
+        vidi(
+            [
+                "ueda",
+                "explain",
+                "--data",
+                str(data),
+                "--model",
+                "negres",
+                "--model-periods",
+                "400",
+                "--resamples",
+                "50",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     s = json.loads((out / "summary.json").read_text())
-    assert {"command", "forcing", "start_terms", "final_terms", "effects_added",
-            "iterations", "start_model", "final_model", "criteria_start", "criteria", "gap",
-            "noise_floor", "consistent", "stopped_because", "catalogue", "method",
-            "versions", "settings", "inputs"} <= set(s)
+    assert {
+        "command",
+        "forcing",
+        "start_terms",
+        "final_terms",
+        "effects_added",
+        "iterations",
+        "start_model",
+        "final_model",
+        "criteria_start",
+        "criteria",
+        "gap",
+        "noise_floor",
+        "consistent",
+        "stopped_because",
+        "catalogue",
+        "method",
+        "versions",
+        "settings",
+        "inputs",
+    } <= set(s)
     assert s["command"] == "ueda explain" and s["start_terms"] == ["x'", "x^3"]
     assert s["effects_added"] == ["van_der_pol_damping"] and s["consistent"]
     assert s["forcing"] == {"B": 0.35, "nu": 1.02}
     it = s["iterations"][0]
-    assert {"effect", "evidence", "scores", "criteria_before", "criteria_after",
-            "parameters"} <= set(it)
+    assert {
+        "effect",
+        "evidence",
+        "scores",
+        "criteria_before",
+        "criteria_after",
+        "parameters",
+    } <= set(it)
     assert s["inputs"]["data"]["sha256"] and s["settings"]["start"] == "x',x^3"
-    for f in ("explain.png", "explain.pdf", "strobe_record.csv", "strobe_start.csv",
-              "strobe_final.csv"):
+    for f in (
+        "explain.png",
+        "explain.pdf",
+        "strobe_record.csv",
+        "strobe_start.csv",
+        "strobe_final.csv",
+    ):
         assert (out / f).exists(), f
     assert "named van_der_pol_damping" in capsys.readouterr().out
 
@@ -202,16 +252,31 @@ def test_cli_explain_bad_inputs_exit_2(vidi, tmp_path, capsys):
     data = tmp_path / "D.csv"
     _write_record(data, periods=30)
     out = str(tmp_path / "o")
-    cases = [["--start", "y^2", "--model", "negres"],
-             ["--start", "x'", "--effects", "friction", "--model", "negres"],
-             ["--alpha", "0", "--model", "negres"],
-             []]  # no forcing
+    cases = [
+        ["--start", "y^2", "--model", "negres"],
+        ["--start", "x'", "--effects", "friction", "--model", "negres"],
+        ["--alpha", "0", "--model", "negres"],
+        [],
+    ]  # no forcing
     for extra in cases:
         capsys.readouterr()
         assert vidi(["ueda", "explain", "--data", str(data), *extra, "--out", out]) == 2, extra
         err = capsys.readouterr().err
         assert len(err.strip().splitlines()) == 1 and err.startswith("vidi: error:"), err
         assert "Traceback" not in err
-    assert vidi(["ueda", "explain", "--data", str(tmp_path / "nope.csv"), "--model", "negres",
-                 "--out", out]) == 2
+    assert (
+        vidi(
+            [
+                "ueda",
+                "explain",
+                "--data",
+                str(tmp_path / "nope.csv"),
+                "--model",
+                "negres",
+                "--out",
+                out,
+            ]
+        )
+        == 2
+    )
     assert not (tmp_path / "o").exists()

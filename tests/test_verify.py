@@ -15,8 +15,18 @@ from discovery.response import response
 from discovery.verify import Reference, evaluate, verify
 
 
-def _record(sc, law, *, periods=15, transient=60, fs=20000.0, force_noise=0.01,
-            motion_noise=0.002, seed=0, velocities=True):
+def _record(
+    sc,
+    law,
+    *,
+    periods=15,
+    transient=60,
+    fs=20000.0,
+    force_noise=0.01,
+    motion_noise=0.002,
+    seed=0,
+    velocities=True,
+):
     T = sc.period
     t = transient * T + np.arange(int(periods * T * fs)) / fs
     r = reference_simulate(sc, law, (0.0, t[-1]), t_eval=t, rtol=1e-9)
@@ -46,8 +56,9 @@ def test_true_law_consistent_wrong_law_not(light, light_record):
     assert ok.evaluation.regime == {"measured": "P1", "simulated": "P1"}
     # stiffness 30 % off, damping 30 % off: both far outside the noise
     for coefs in ([2.6e10, 5e11], [2e10, 3.5e11]):
-        bad = verify(light, light_record, light.law.with_coefficients(coefs),
-                     check_default_start=False)
+        bad = verify(
+            light, light_record, light.law.with_coefficients(coefs), check_default_start=False
+        )
         assert not bad.consistent
         assert bad.criteria["I2"] > 5 * bad.noise_floor["I2"]
 
@@ -56,8 +67,9 @@ def test_noise_floor_is_the_spread_of_the_true_law(light):
     # over independent noise draws the true law's I2 scatters around its floor
     rows = []
     for seed in range(4):
-        v = verify(light, _record(light, light.law, seed=10 + seed), light.law,
-                   check_default_start=False)
+        v = verify(
+            light, _record(light, light.law, seed=10 + seed), light.law, check_default_start=False
+        )
         rows.append((v.criteria["I2"], v.noise_floor["I2"]))
     i2, fl = np.array(rows).T
     assert np.all(i2 < 2 * fl + 0.005)
@@ -72,9 +84,13 @@ def test_verify_starts_from_the_measured_state(light, light_record):
     assert ref.span is not None and ref.span.state.method == "free-flight fit"
     t = light_record.t
     assert t[0] <= ref.start_time <= t[-1]  # the last block's start (the latest cycles)
-    tr = simulate(light, light.law, (ref.start_time, ref.start_time + 0.5 * light.period),
-                  y0=ref.start, t_eval=t[(t >= ref.start_time)
-                                         & (t <= ref.start_time + 0.5 * light.period)])
+    tr = simulate(
+        light,
+        light.law,
+        (ref.start_time, ref.start_time + 0.5 * light.period),
+        y0=ref.start,
+        t_eval=t[(t >= ref.start_time) & (t <= ref.start_time + 0.5 * light.period)],
+    )
     sel = (t >= ref.start_time) & (t <= ref.start_time + 0.5 * light.period)
     for k, name in ((0, "w1"), (2, "w2")):
         ch = light_record.channels[name]
@@ -92,11 +108,18 @@ def test_time_offset_shifts_the_drive_clock(light, light_record):
     good = verify(light, shifted, light.law, time_offset=off, check_default_start=False)
     assert good.consistent
     assert good.reference.start_time == pytest.approx(
-        Reference.from_measurement(light_record, light).start_time)
+        Reference.from_measurement(light_record, light).start_time
+    )
 
 
-_SUB = Scenario(m1=7240.8062456432735, m2=5459.453320705147, k1=170863194.34024045,
-                c1=69692.89930199806, A=256308.8049041235, frequency=33.232564136106916)
+_SUB = Scenario(
+    m1=7240.8062456432735,
+    m2=5459.453320705147,
+    k1=170863194.34024045,
+    c1=69692.89930199806,
+    A=256308.8049041235,
+    frequency=33.232564136106916,
+)
 _SUB_LAW = ForceLaw.parse("1318000000*z + 23170000*zd")
 
 
@@ -113,18 +136,29 @@ def test_subharmonic_with_several_impacts_is_aligned():
     # as t* matches far worse than the one chosen
     from discovery.criteria import evaluate_criteria
 
-    v = verify(_SUB, Reference.from_measurement(rec, _SUB, use_state=False), _SUB_LAW,
-               check_default_start=False)
+    v = verify(
+        _SUB,
+        Reference.from_measurement(rec, _SUB, use_state=False),
+        _SUB_LAW,
+        check_default_start=False,
+    )
     assert v.consistent, v.verdict
     exact = v.evaluation.extra["aligned"]
     E = v.reference.impulse
-    others = [evaluate_criteria(E, exact.rotated(o).resampled_like(E))["I2"]
-              for o in exact.onsets[1:]]
+    others = [
+        evaluate_criteria(E, exact.rotated(o).resampled_like(E))["I2"] for o in exact.onsets[1:]
+    ]
     assert len(others) == 2 and min(others) > 2 * v.criteria["I2"]
 
 
-_PD = Scenario(m1=4770.989046559852, m2=5430.940884957566, k1=161209836.32495606,
-               c1=343759.5619373554, A=231045.9099917681 * 1.01, frequency=37.287324033370695)
+_PD = Scenario(
+    m1=4770.989046559852,
+    m2=5430.940884957566,
+    k1=161209836.32495606,
+    c1=343759.5619373554,
+    A=231045.9099917681 * 1.01,
+    frequency=37.287324033370695,
+)
 _PD_LAW = ForceLaw.parse("1448000000*z + 9927000*zd")
 
 
@@ -156,8 +190,11 @@ def test_an_undefined_noise_floor_never_makes_a_law_consistent(light, light_reco
             return {"mean": inf, "q95": dict(inf), "n_boot": 0, "seed": 0}
 
     ref = Reference.from_measurement(light_record, light, n_boot=4)
-    ev = evaluate(light, light.law, _NoFloor(**{f.name: getattr(ref, f.name)
-                                                for f in dataclasses.fields(ref)}))
+    ev = evaluate(
+        light,
+        light.law,
+        _NoFloor(**{f.name: getattr(ref, f.name) for f in dataclasses.fields(ref)}),
+    )
     assert ev.status == "ok" and ev.criteria
     assert not ev.consistent and "could not be estimated" in ev.verdict
 

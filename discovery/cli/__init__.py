@@ -30,7 +30,6 @@ from ..errors import VidiError
 __all__ = ["main", "UsageError", "VidiArgumentParser"]
 
 
-
 class UsageError(VidiError):
     """A command-line option is missing, unknown or has an invalid value."""
 
@@ -44,8 +43,9 @@ def _one_line(message, prog, command=None):
     the fix."""
     command = prog.split()[-1] if prog and prog != "vidi" else command
     see = f"see vidi {command} --help" if command else "see vidi --help"
-    m = re.match(r"argument (\S+?)(?:/\S+)?: invalid choice: '(.*)' \(choose from (.*)\)$",
-                 message, re.S)
+    m = re.match(
+        r"argument (\S+?)(?:/\S+)?: invalid choice: '(.*)' \(choose from (.*)\)$", message, re.S
+    )
     if m:
         opt, value, choices = m.groups()
         choices = choices.replace("'", "")
@@ -60,8 +60,10 @@ def _one_line(message, prog, command=None):
     m = re.match(r"argument (\S+?)(?:/\S+)?: expected one argument$", message)
     if m:
         opt = m.group(1)
-        return (f"{opt} needs a value; write {opt} VALUE, and a value that starts with '-' as "
-                f"{opt}=-VALUE (e.g. {opt}=-1e8*z)")
+        return (
+            f"{opt} needs a value; write {opt} VALUE, and a value that starts with '-' as "
+            f"{opt}=-VALUE (e.g. {opt}=-1e8*z)"
+        )
     m = re.match(r"the following arguments are required: (.*)$", message)
     if m:
         names = m.group(1)
@@ -95,33 +97,46 @@ class VidiArgumentParser(argparse.ArgumentParser):
 
 
 EXAMPLES = {
-    "": ["vidi simulate --noise 0.01 --out D.csv     a record of the paper's machine",
-         "vidi fit --data D.csv --out out/fit       discover its law, check it by simulation",
-         "vidi report out/fit                       the LaTeX report, compiled to PDF",
-         "vidi COMMAND --help                       each command's options and examples"],
-    "simulate": ["vidi simulate --scenario paper --periods 20 --noise 0.01 --out D.csv",
-                 "vidi simulate --law '2e8*z + 1e7*zd; unloading: 4e6*zd' --from-rest "
-                 "--integrator scipy --out R.csv"],
-    "fit": ["vidi fit --data D.csv --out out/fit",
-            "vidi fit --scenario a.toml --scenario b.toml --data a.csv --data b.csv "
-            "--library poly:3+hc --out out/fit2"],
+    "": [
+        "vidi simulate --noise 0.01 --out D.csv     a record of the paper's machine",
+        "vidi fit --data D.csv --out out/fit       discover its law, check it by simulation",
+        "vidi report out/fit                       the LaTeX report, compiled to PDF",
+        "vidi COMMAND --help                       each command's options and examples",
+    ],
+    "simulate": [
+        "vidi simulate --scenario paper --periods 20 --noise 0.01 --out D.csv",
+        "vidi simulate --law '2e8*z + 1e7*zd; unloading: 4e6*zd' --from-rest "
+        "--integrator scipy --out R.csv",
+    ],
+    "fit": [
+        "vidi fit --data D.csv --out out/fit",
+        "vidi fit --scenario a.toml --scenario b.toml --data a.csv --data b.csv "
+        "--library poly:3+hc --out out/fit2",
+    ],
     "verify": ["vidi verify --data D.csv --law '2.06e8*z + 1.28e7*zd' --out out/verify"],
-    "explain": ["vidi explain --data D.csv --out out/explain",
-                "vidi explain --data D.csv --start '2e8*z + 1e7*zd' --effects "
-                "unloading_damping,permanent_set --out out/explain2"],
+    "explain": [
+        "vidi explain --data D.csv --out out/explain",
+        "vidi explain --data D.csv --start '2e8*z + 1e7*zd' --effects "
+        "unloading_damping,permanent_set --out out/explain2",
+    ],
     "steady": ["vidi steady --scenario paper --law '2e8*z + 1e7*zd'"],
-    "landscape": ["vidi landscape --grid 21x21 --out out/landscape",
-                  "vidi landscape --data D.csv --range0 1e8:3e8 --out out/landscape2"],
+    "landscape": [
+        "vidi landscape --grid 21x21 --out out/landscape",
+        "vidi landscape --data D.csv --range0 1e8:3e8 --out out/landscape2",
+    ],
     "identify": ["vidi identify --data D.csv --start '1.5e8*z + 0.9e7*zd' --out out/identify"],
-    "study": ["vidi study --config examples/study_paper.toml --out out/study",
-              "vidi study --config examples/study_paper.toml --out out/study --scheduler local",
-              "vidi study --config S.toml --out out/s --max-runs 20   a slice; rerun to go on"],
-    "report": ["vidi report out/fit                 report.tex and report.pdf in out/fit",
-               "vidi report out/verify --snippet criteria",
-               "vidi report out/fit --no-pdf        the LaTeX source only"],
+    "study": [
+        "vidi study --config examples/study_paper.toml --out out/study",
+        "vidi study --config examples/study_paper.toml --out out/study --scheduler local",
+        "vidi study --config S.toml --out out/s --max-runs 20   a slice; rerun to go on",
+    ],
+    "report": [
+        "vidi report out/fit                 report.tex and report.pdf in out/fit",
+        "vidi report out/verify --snippet criteria",
+        "vidi report out/fit --no-pdf        the LaTeX source only",
+    ],
     "ueda attractor": ["vidi ueda attractor --model negres --out out/attractor"],
-    "ueda chart": ["vidi ueda chart --model negres --nu 0.8:1.2:21 --B 0.2:1.2:21 "
-                   "--out out/chart"],
+    "ueda chart": ["vidi ueda chart --model negres --nu 0.8:1.2:21 --B 0.2:1.2:21 --out out/chart"],
     "ueda simulate": ["vidi ueda simulate --model negres --noise 0.002 --out U.csv"],
     "ueda discover": ["vidi ueda discover --data U.csv --model negres --out out/ueda"],
     "ueda explain": ["vidi ueda explain --data U.csv --model negres --out out/ueda-explain"],
@@ -146,30 +161,62 @@ def _add_examples(parser, path=()):
     parser.formatter_class = HelpFormatter
     lines = EXAMPLES.get(" ".join(path))
     if lines:
-        parser.epilog = "examples:\n" + "\n".join(f"  {ln}" for ln in lines) + (
-            "" if path else "\n\nexit codes: 0 ok, 2 bad input or failed numerics, 130 "
-            "interrupted (Ctrl-C),\n            143 terminated, 1 internal error")
+        parser.epilog = (
+            "examples:\n"
+            + "\n".join(f"  {ln}" for ln in lines)
+            + (
+                ""
+                if path
+                else "\n\nexit codes: 0 ok, 2 bad input or failed numerics, 130 "
+                "interrupted (Ctrl-C),\n            143 terminated, 1 internal error"
+            )
+        )
 
 
-COMMANDS = ("simulate", "fit", "verify", "explain", "steady", "landscape", "identify", "study",
-            "report", "ueda")
+COMMANDS = (
+    "simulate",
+    "fit",
+    "verify",
+    "explain",
+    "steady",
+    "landscape",
+    "identify",
+    "study",
+    "report",
+    "ueda",
+)
 
 
 def _parser():
     p = VidiArgumentParser(
         prog="vidi",
         description="Discover and verify contact-force laws F(zeta, dzeta) of vibro-impact "
-                    "machines by simulation.",
-)
-    p.add_argument("--version", action="version", version=f"vidi {_version()}",
-                   help="print the version and exit")
-    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND",
-                           parser_class=VidiArgumentParser)
+        "machines by simulation.",
+    )
+    p.add_argument(
+        "--version",
+        action="version",
+        version=f"vidi {_version()}",
+        help="print the version and exit",
+    )
+    sub = p.add_subparsers(
+        dest="command", required=True, metavar="COMMAND", parser_class=VidiArgumentParser
+    )
     # imported here, inside main()'s handlers: a Ctrl-C while they load is an interrupt too
     from . import explain, fit, identify, landscape, report, simulate, steady, study, ueda, verify
-    modules = {"simulate": simulate, "fit": fit, "verify": verify, "explain": explain,
-               "steady": steady, "landscape": landscape, "identify": identify,
-               "study": study, "report": report, "ueda": ueda}
+
+    modules = {
+        "simulate": simulate,
+        "fit": fit,
+        "verify": verify,
+        "explain": explain,
+        "steady": steady,
+        "landscape": landscape,
+        "identify": identify,
+        "study": study,
+        "report": report,
+        "ueda": ueda,
+    }
     for name in COMMANDS:
         modules[name].register(sub)
     _add_overwrite(p)
@@ -188,9 +235,12 @@ def _add_quiet(parser, path=()):
             for name, sp in action.choices.items():
                 _add_quiet(sp, (*path, name))
     if " ".join(path) in LONG:
-        parser.add_argument("--quiet", action="store_true",
-                            help="no progress on stderr (by default a bar with an ETA on a "
-                            "terminal, one line per stage otherwise)")
+        parser.add_argument(
+            "--quiet",
+            action="store_true",
+            help="no progress on stderr (by default a bar with an ETA on a "
+            "terminal, one line per stage otherwise)",
+        )
 
 
 def _add_overwrite(parser):
@@ -200,11 +250,16 @@ def _add_overwrite(parser):
         if isinstance(action, argparse._SubParsersAction):
             for sp in action.choices.values():
                 _add_overwrite(sp)
-    if "--out" in parser._option_string_actions and \
-            "--overwrite" not in parser._option_string_actions:
-        parser.add_argument("--overwrite", action="store_true",
-                            help="replace the results of another command in --out (or a "
-                            "file vidi did not write); files you added are kept")
+    if (
+        "--out" in parser._option_string_actions
+        and "--overwrite" not in parser._option_string_actions
+    ):
+        parser.add_argument(
+            "--overwrite",
+            action="store_true",
+            help="replace the results of another command in --out (or a "
+            "file vidi did not write); files you added are kept",
+        )
 
 
 def _version():
@@ -225,8 +280,12 @@ def _attach_dash_values(parser, argv):
         return argv
     parser.command_hint = command
     sp = sub.choices[command]
-    takes_value = {s for a in sp._actions if a.nargs is None and a.option_strings
-                   and not isinstance(a, argparse._StoreConstAction) for s in a.option_strings}
+    takes_value = {
+        s
+        for a in sp._actions
+        if a.nargs is None and a.option_strings and not isinstance(a, argparse._StoreConstAction)
+        for s in a.option_strings
+    }
     known = set(sp._option_string_actions)
     out, i = [], 0
     while i < len(argv):
@@ -235,8 +294,14 @@ def _attach_dash_values(parser, argv):
             out.extend(argv[i:])
             break
         nxt = argv[i + 1] if i + 1 < len(argv) else None
-        if tok in takes_value and nxt is not None and nxt.startswith("-") \
-                and not nxt.startswith("--") and nxt not in known and len(nxt) > 1:
+        if (
+            tok in takes_value
+            and nxt is not None
+            and nxt.startswith("-")
+            and not nxt.startswith("--")
+            and nxt not in known
+            and len(nxt) > 1
+        ):
             out.append(f"{tok}={nxt}")
             i += 2
             continue
@@ -254,7 +319,7 @@ def _options_on_line(parser, argv):
         name = next((t for t in rest if not t.startswith("-")), None)
         if sub is None or name not in sub.choices:
             break
-        sp, rest = sub.choices[name], rest[rest.index(name) + 1:]
+        sp, rest = sub.choices[name], rest[rest.index(name) + 1 :]
     found = []
     for tok in rest:
         if tok == "--":
@@ -273,11 +338,11 @@ def _refuse_repeats(parser, argv):
     seen = set()
     for opt, action in _options_on_line(parser, argv)[1]:
         if action.nargs is not None or isinstance(
-                action, argparse._AppendAction | argparse._StoreConstAction):
+            action, argparse._AppendAction | argparse._StoreConstAction
+        ):
             continue
         if action.dest in seen:
-            raise UsageError(f"{opt} is given twice; give it once (the last would silently "
-                             "win)")
+            raise UsageError(f"{opt} is given twice; give it once (the last would silently win)")
         seen.add(action.dest)
 
 
@@ -292,8 +357,9 @@ def _refuse_orphans(parser, argv):
             continue
         need = getattr(action, "needs", None)
         if need and need not in given:
-            raise UsageError(f"{opt} acts only with {need}, which is not given; add {need} "
-                             f"or leave out {opt}")
+            raise UsageError(
+                f"{opt} acts only with {need}, which is not given; add {need} or leave out {opt}"
+            )
         excl = getattr(action, "excludes", None)
         if excl and excl in given:
             raise UsageError(f"{opt} has no effect with {excl}; leave out one of them")
@@ -303,8 +369,10 @@ def _error(message):
     print(f"vidi: error: {' '.join(str(message).split())}", file=sys.stderr)
 
 
-_OUT_OF_MEMORY = (b"vidi: error: not enough memory for this run; reduce its size (--fs, --periods, "
-                  b"--grid) and try again\n")
+_OUT_OF_MEMORY = (
+    b"vidi: error: not enough memory for this run; reduce its size (--fs, --periods, "
+    b"--grid) and try again\n"
+)
 
 
 def _interruption(exc):
@@ -321,8 +389,7 @@ def _interruption(exc):
 
 def _stopped(exc):
     if isinstance(exc, Terminated):
-        _error("terminated (SIGTERM); partial outputs were removed, earlier results are "
-               "unchanged")
+        _error("terminated (SIGTERM); partial outputs were removed, earlier results are unchanged")
         return 143
     _error("interrupted (Ctrl-C); partial outputs were removed, earlier results are unchanged")
     return 130
@@ -336,8 +403,10 @@ def main(argv=None):
     old_term = None
     in_main_thread = threading.current_thread() is threading.main_thread()
     if in_main_thread:
+
         def _terminate(signum, frame):
             raise Terminated()
+
         try:
             old_term = signal.signal(signal.SIGTERM, _terminate)
         except (ValueError, OSError):
@@ -375,8 +444,9 @@ def _run(argv):
             _refuse_orphans(parser, line)
         except SystemExit as exc:  # --help, --version
             return exc.code if isinstance(exc.code, int) else 0
-        command = " ".join(x for x in (getattr(args, "command", None),
-                                       getattr(args, "ueda_command", None)) if x)
+        command = " ".join(
+            x for x in (getattr(args, "command", None), getattr(args, "ueda_command", None)) if x
+        )
         set_run(command or None, getattr(args, "overwrite", False))
         return args.func(args)
     except (KeyboardInterrupt, Terminated) as exc:
@@ -396,13 +466,16 @@ def _run(argv):
             return 2
         if isinstance(exc, OSError):  # the environment: disk full, permissions, a vanished file
             where = f" ({exc.filename})" if exc.filename else ""
-            _error(f"{exc.strerror or exc}{where}; check the path, its permissions and the "
-                   "free space")
+            _error(
+                f"{exc.strerror or exc}{where}; check the path, its permissions and the free space"
+            )
             return 2
         if os.environ.get("VIDI_TRACEBACK"):  # a bug: one line, the traceback on request
             traceback.print_exc()
-        _error(f"internal error {type(exc).__name__}: {exc}; please report it (set "
-               "VIDI_TRACEBACK=1 for the traceback)")
+        _error(
+            f"internal error {type(exc).__name__}: {exc}; please report it (set "
+            "VIDI_TRACEBACK=1 for the traceback)"
+        )
         return 1
 
 

@@ -24,14 +24,19 @@ from ..errors import InputError
 from ..law import ForceLaw
 from ..scenario import builtin_scenarios
 
-SCENARIO_HELP = (f"built-in scenario ({', '.join(builtin_scenarios())}) or a TOML file "
-                 "(default: paper)")
-LAW_HELP = ("force law in z = zeta (penetration w1 - w2, m) and zd = dzeta (its rate while "
-            "loading, m/s), e.g. '2.06e8*z + 1.28e7*zd' (default: the scenario's law); a law "
-            "starting with '-' as --law=-1e8*z")
-COLUMNS_HELP = ("the file's header names for our columns when they differ, e.g. "
-                "t=time_s,F=force_N (names: t, F, w1, v1, w2, v2, a2; default: the headers are "
-                "these names)")
+SCENARIO_HELP = (
+    f"built-in scenario ({', '.join(builtin_scenarios())}) or a TOML file (default: paper)"
+)
+LAW_HELP = (
+    "force law in z = zeta (penetration w1 - w2, m) and zd = dzeta (its rate while "
+    "loading, m/s), e.g. '2.06e8*z + 1.28e7*zd' (default: the scenario's law); a law "
+    "starting with '-' as --law=-1e8*z"
+)
+COLUMNS_HELP = (
+    "the file's header names for our columns when they differ, e.g. "
+    "t=time_s,F=force_N (names: t, F, w1, v1, w2, v2, a2; default: the headers are "
+    "these names)"
+)
 
 
 def _fmt(x):
@@ -52,8 +57,11 @@ def number(lo=None, hi=None, *, lo_open=False, unit=""):
             v = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"{text!r} is not a number; give {need}") from None
-        if not math.isfinite(v) or (lo is not None and (v <= lo if lo_open else v < lo)) \
-                or (hi is not None and v > hi):
+        if (
+            not math.isfinite(v)
+            or (lo is not None and (v <= lo if lo_open else v < lo))
+            or (hi is not None and v > hi)
+        ):
             raise argparse.ArgumentTypeError(f"{text!r} is out of range; give {need}")
         return v
 
@@ -63,8 +71,11 @@ def number(lo=None, hi=None, *, lo_open=False, unit=""):
 
 def integer(lo=None, hi=None):
     """argparse ``type=``: an integer in ``[lo, hi]``."""
-    rng = " and ".join(x for x in ((f">= {lo}" if lo is not None else ""),
-                                   (f"<= {hi}" if hi is not None else "")) if x)
+    rng = " and ".join(
+        x
+        for x in ((f">= {lo}" if lo is not None else ""), (f"<= {hi}" if hi is not None else ""))
+        if x
+    )
     need = f"an integer{' ' + rng if rng else ''}"
 
     def parse(text):
@@ -73,8 +84,7 @@ def integer(lo=None, hi=None):
                 raise ValueError(text)
             v = int(text, 10)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{text!r} is not an integer; give {need}") \
-                from None
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer; give {need}") from None
         if (lo is not None and v < lo) or (hi is not None and v > hi):
             raise argparse.ArgumentTypeError(f"{text!r} is out of range; give {need}")
         return v
@@ -87,8 +97,10 @@ def interval_count(text):
     """0 or an integer >= 5: bootstrap replicates of coefficient intervals (argparse type)."""
     n = integer(0, 10_000)(text)
     if 0 < n < 5:
-        raise argparse.ArgumentTypeError(f"{n} replicates cannot give an interval; give 0 "
-                                         "(none) or at least 5, e.g. --intervals 30")
+        raise argparse.ArgumentTypeError(
+            f"{n} replicates cannot give an interval; give 0 "
+            "(none) or at least 5, e.g. --intervals 30"
+        )
     return n
 
 
@@ -97,8 +109,10 @@ def law_or_default(text, scenario, what="--law"):
     empty text is an error (not silently the scenario's law)."""
     if text is not None:
         if not text.strip():
-            raise InputError(f"{what} is empty; give a law such as '2.06e8*z + 1.28e7*zd' or "
-                             "leave the option out to use the scenario's law")
+            raise InputError(
+                f"{what} is empty; give a law such as '2.06e8*z + 1.28e7*zd' or "
+                "leave the option out to use the scenario's law"
+            )
         law = ForceLaw.parse(text)
         law.check_physical(scenario, what)
         return law
@@ -132,11 +146,15 @@ def parse_columns(text, option="--columns"):
         key, sep, col = part.partition("=")
         key, col = key.strip(), col.strip()
         if not sep or not key or not col:
-            raise InputError(f"{option} {text!r}: write OURS=THEIRS pairs separated by commas, "
-                             "e.g. t=time_s,F=force_N")
+            raise InputError(
+                f"{option} {text!r}: write OURS=THEIRS pairs separated by commas, "
+                "e.g. t=time_s,F=force_N"
+            )
         if key not in COLUMNS:
-            raise InputError(f"{option}: unknown name {key!r}; map the names "
-                             f"{', '.join(COLUMNS)} to the file's headers, e.g. t=time_s")
+            raise InputError(
+                f"{option}: unknown name {key!r}; map the names "
+                f"{', '.join(COLUMNS)} to the file's headers, e.g. t=time_s"
+            )
         if key in mapping:
             raise InputError(f"{option}: {key} is mapped twice; map each name once")
         mapping[key] = col
@@ -148,13 +166,16 @@ def reporter(args):
     a command has it, draws the bar even when stderr is not a terminal)."""
     from .._progress import Reporter
 
-    return Reporter(quiet=getattr(args, "quiet", False),
-                    bar=True if getattr(args, "progress", False) else None)
+    return Reporter(
+        quiet=getattr(args, "quiet", False), bar=True if getattr(args, "progress", False) else None
+    )
 
 
-SCHEDULER_HELP = ("run on Dask: 'local' starts a LocalCluster of single-threaded workers, "
-                  "tcp://host:port joins a running scheduler (its workers started with "
-                  "--nthreads 1); needs pip install 'vibroimpact-discovery[dask]'")
+SCHEDULER_HELP = (
+    "run on Dask: 'local' starts a LocalCluster of single-threaded workers, "
+    "tcp://host:port joins a running scheduler (its workers started with "
+    "--nthreads 1); needs pip install 'vibroimpact-discovery[dask]'"
+)
 
 
 def executor_of(args):
@@ -179,8 +200,9 @@ def read_record(args, scenario, path=None):
     from ..measurement import Measurement
 
     columns = parse_columns(getattr(args, "columns", None))
-    return Measurement.from_csv(args.data if path is None else path, scenario=scenario,
-                                columns=columns)
+    return Measurement.from_csv(
+        args.data if path is None else path, scenario=scenario, columns=columns
+    )
 
 
 def scenario_file(text):
@@ -223,8 +245,10 @@ def read_records(args):
     data = _listed(args.data)
     names = _listed(args.scenario) or ["paper"]
     if len(names) not in (1, len(data)):
-        raise InputError(f"{len(data)} --data record(s) but {len(names)} --scenario: give one "
-                         "--scenario per --data, in the same order, or one for all")
+        raise InputError(
+            f"{len(data)} --data record(s) but {len(names)} --scenario: give one "
+            "--scenario per --data, in the same order, or one for all"
+        )
     scs = [load_scenario(n) for n in names] * (len(data) if len(names) == 1 else 1)
     meas = []
     for path, sc in zip(data, scs, strict=True):
@@ -238,7 +262,8 @@ def read_records(args):
 def criteria_line(criteria, floor):
     """``  criteria (noise floor): I0 x (f), ...`` for the command's printout."""
     return "  criteria (noise floor): " + ", ".join(
-        f"{k} {v:.3g} ({floor.get(k, float('nan')):.2g})" for k, v in criteria.items())
+        f"{k} {v:.3g} ({floor.get(k, float('nan')):.2g})" for k, v in criteria.items()
+    )
 
 
 def coefficients_line(coefficients, errors, intervals=None):
@@ -246,13 +271,18 @@ def coefficients_line(coefficients, errors, intervals=None):
     with ``intervals`` (:class:`discovery.intervals.Intervals`) a second line with them and
     what the standard errors do not cover."""
     line = "  coefficients (standard error): " + ", ".join(
-        f"{t} {c:.4g} ({errors.get(t, float('nan')):.2g})" for t, c in coefficients.items())
+        f"{t} {c:.4g} ({errors.get(t, float('nan')):.2g})" for t, c in coefficients.items()
+    )
     if intervals is None:
         if errors:
-            line += ("\n  (Jacobian standard errors: they assume white residuals and miss the "
-                     "noise of the estimated machine states)")
+            line += (
+                "\n  (Jacobian standard errors: they assume white residuals and miss the "
+                "noise of the estimated machine states)"
+            )
         return line
     b = intervals.bounds
-    return line + (f"\n  {intervals.level:.0%} intervals ({intervals.method}, "
-                   f"{intervals.n_boot} replicates): " + ", ".join(
-                       f"{t} [{b[t][0]:.4g}, {b[t][1]:.4g}]" for t in coefficients if t in b))
+    return line + (
+        f"\n  {intervals.level:.0%} intervals ({intervals.method}, "
+        f"{intervals.n_boot} replicates): "
+        + ", ".join(f"{t} [{b[t][0]:.4g}, {b[t][1]:.4g}]" for t in coefficients if t in b)
+    )

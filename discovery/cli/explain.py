@@ -36,27 +36,45 @@ def run(args):
         effects = [e.strip() for e in args.effects.split(",") if e.strip()]
         bad = sorted(set(effects) - known)
         if bad or not effects:
-            raise InputError(f"--effects: unknown effect(s) {', '.join(bad) or '(none)'}; "
-                             f"choose from {', '.join(sorted(known))}")
+            raise InputError(
+                f"--effects: unknown effect(s) {', '.join(bad) or '(none)'}; "
+                f"choose from {', '.join(sorted(known))}"
+            )
     scs, meas = read_records(args)
     with reporter(args) as rep, executor_of(args) as ex:
-        res = explain(scs, meas, args.start, criterion=args.criterion, alpha=args.alpha,
-                      max_iterations=args.max_iterations, budget=args.max_simulations,
-                      n_boot=args.n_boot, seed=args.seed, effects=effects,
-                      workers=args.workers, n_boot_intervals=args.intervals, progress=rep,
-                      executor=ex)
-    summary = {"command": "explain", "scenario": scs[0].as_dict(),
-               "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
-               **res.as_dict(), "catalogue": [e.as_dict() for e in EFFECTS],
-               "explain_settings": res.settings}
+        res = explain(
+            scs,
+            meas,
+            args.start,
+            criterion=args.criterion,
+            alpha=args.alpha,
+            max_iterations=args.max_iterations,
+            budget=args.max_simulations,
+            n_boot=args.n_boot,
+            seed=args.seed,
+            effects=effects,
+            workers=args.workers,
+            n_boot_intervals=args.intervals,
+            progress=rep,
+            executor=ex,
+        )
+    summary = {
+        "command": "explain",
+        "scenario": scs[0].as_dict(),
+        "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
+        **res.as_dict(),
+        "catalogue": [e.as_dict() for e in EFFECTS],
+        "explain_settings": res.settings,
+    }
     with OutputDir(args.out) as out:
         files = []
         for k, it in enumerate(res.iterations, start=1):
             explain_figure(it, it.measured, str(out.path(f"explain_{k}")), k)
             files.append(f"explain_{k}.png/.pdf")
         summary["seconds"] = time.perf_counter() - t_start
-        out.write_json("summary.json", {**summary,
-                                        **provenance(vars(args), inputs=inputs_of(args))})
+        out.write_json(
+            "summary.json", {**summary, **provenance(vars(args), inputs=inputs_of(args))}
+        )
     for k, it in enumerate(res.iterations, start=1):
         name = it.effect or "nothing named"
         print(f"iteration {k}: {name}: {it.evidence}")
@@ -65,17 +83,26 @@ def run(args):
     fm = res.final_model
     print(f"final model: {fm}")
     if res.uncertainties:
-        print(coefficients_line(dict(zip(fm.names, fm.coefficients, strict=True)),
-                                res.uncertainties, res.intervals))
+        print(
+            coefficients_line(
+                dict(zip(fm.names, fm.coefficients, strict=True)), res.uncertainties, res.intervals
+            )
+        )
     if res.criteria:
         print(criteria_line(res.criteria, res.noise_floor))
-    print(f"  {'consistent' if res.consistent else 'not consistent'} with the record(s); "
-          f"stopped because {res.stopped_because}")
+    print(
+        f"  {'consistent' if res.consistent else 'not consistent'} with the record(s); "
+        f"stopped because {res.stopped_because}"
+    )
     for s in res.separability:
-        how = s.get("note") or (f"{s['criterion']} {s['before']:.3g} -> {s['after']:.3g} "
-                                f"refitted with it, noise floor {s['floor']:.3g}")
-        print(f"  {s['effect']}: {'separable' if s['separable'] else 'not separable'} by this "
-              f"record ({how})")
+        how = s.get("note") or (
+            f"{s['criterion']} {s['before']:.3g} -> {s['after']:.3g} "
+            f"refitted with it, noise floor {s['floor']:.3g}"
+        )
+        print(
+            f"  {s['effect']}: {'separable' if s['separable'] else 'not separable'} by this "
+            f"record ({how})"
+        )
     print(f"outputs in {args.out}/: summary.json" + "".join(f", {f}" for f in files))
     return 0
 
@@ -87,39 +114,85 @@ def _catalogue():
 
 
 def register(sub):
-    s = sub.add_parser("explain", help="find where a model and a record disagree, name the "
-                       "missing physical effect, add it, refit, show the gap shrink")
-    s.add_argument("--scenario", action="append",
-                   help=SCENARIO_HELP + "; repeat it, once per --data in the same order")
-    s.add_argument("--data", required=True, action="append",
-                   help="CSV with t, F, w1, w2 (v1, v2 recommended); repeat it to explain "
-                   "several records jointly")
+    s = sub.add_parser(
+        "explain",
+        help="find where a model and a record disagree, name the "
+        "missing physical effect, add it, refit, show the gap shrink",
+    )
+    s.add_argument(
+        "--scenario",
+        action="append",
+        help=SCENARIO_HELP + "; repeat it, once per --data in the same order",
+    )
+    s.add_argument(
+        "--data",
+        required=True,
+        action="append",
+        help="CSV with t, F, w1, w2 (v1, v2 recommended); repeat it to explain "
+        "several records jointly",
+    )
     add_record_options(s)
-    s.add_argument("--start", default="linear",
-                   help="start model: 'linear' (z, zd), a term list 'z,zd,z^1.5' (start values "
-                   "from the regression and the record) or a law with coefficients "
-                   "(default: %(default)s)")
-    s.add_argument("--effects", help="comma-separated catalogue ids to consider (default: all "
-                   "of " + ", ".join(e.id for e in _catalogue()) + ")")
-    s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
-                   help="criterion of the refits (default: %(default)s)")
-    s.add_argument("--alpha", type=number(0.0, 0.5, lo_open=True), default=0.01,
-                   help="family-wise significance level of the score tests "
-                   "(default: %(default)g)")
-    s.add_argument("--max-iterations", type=integer(0, 10), default=3,
-                   help="effects added at most (default: %(default)s)")
-    s.add_argument("--max-simulations", type=integer(10, 100_000), default=150,
-                   help="simulation budget of each refit (default: %(default)s)")
-    s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
-                   help="bootstrap replicates of the noise floor (default: %(default)s)")
-    s.add_argument("--intervals", type=interval_count, default=30,
-                   help="bootstrap replicates of the final model's 95 %% parameter intervals "
-                   "through the full processing (0 = none) (default: %(default)s)")
-    s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
-                   help="seed of the noise-floor bootstrap (default: %(default)s)")
-    s.add_argument("--workers", type=integer(1, 1024),
-                   help="processes for the screening refits (default: all cores; the result "
-                        "does not depend on it)")
+    s.add_argument(
+        "--start",
+        default="linear",
+        help="start model: 'linear' (z, zd), a term list 'z,zd,z^1.5' (start values "
+        "from the regression and the record) or a law with coefficients "
+        "(default: %(default)s)",
+    )
+    s.add_argument(
+        "--effects",
+        help="comma-separated catalogue ids to consider (default: all "
+        "of " + ", ".join(e.id for e in _catalogue()) + ")",
+    )
+    s.add_argument(
+        "--criterion",
+        default="I2",
+        choices=list(CRITERIA),
+        help="criterion of the refits (default: %(default)s)",
+    )
+    s.add_argument(
+        "--alpha",
+        type=number(0.0, 0.5, lo_open=True),
+        default=0.01,
+        help="family-wise significance level of the score tests (default: %(default)g)",
+    )
+    s.add_argument(
+        "--max-iterations",
+        type=integer(0, 10),
+        default=3,
+        help="effects added at most (default: %(default)s)",
+    )
+    s.add_argument(
+        "--max-simulations",
+        type=integer(10, 100_000),
+        default=150,
+        help="simulation budget of each refit (default: %(default)s)",
+    )
+    s.add_argument(
+        "--n-boot",
+        type=integer(1, 10_000),
+        default=16,
+        help="bootstrap replicates of the noise floor (default: %(default)s)",
+    )
+    s.add_argument(
+        "--intervals",
+        type=interval_count,
+        default=30,
+        help="bootstrap replicates of the final model's 95 %% parameter intervals "
+        "through the full processing (0 = none) (default: %(default)s)",
+    )
+    s.add_argument(
+        "--seed",
+        type=integer(0, 2**32 - 1),
+        default=0,
+        help="seed of the noise-floor bootstrap (default: %(default)s)",
+    )
+    s.add_argument(
+        "--workers",
+        type=integer(1, 1024),
+        help="processes for the screening refits (default: all cores; the result "
+        "does not depend on it)",
+    )
     s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

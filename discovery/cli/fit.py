@@ -35,35 +35,63 @@ def run(args):
     scs, meas = read_records(args)
     sc = scs[0]
     with reporter(args) as rep:
-        res = discover(scs, meas, library=args.library, selection=args.select,
-                       scoring=args.score, max_terms=args.max_terms, criterion=args.criterion,
-                       shortlist=args.shortlist, refine=not args.no_refine,
-                       max_simulations=args.max_simulations, stability=args.stability,
-                       derivative=args.derivative, average_cycles=args.average_cycles,
-                       random_state=args.seed, margin=args.margin,
-                       monotone=args.monotone, physics=not args.allow_unphysical,
-                       require=args.require or (), n_boot_intervals=args.intervals,
-                       progress=rep, **({"signs": args.signs} if args.signs else {}))
+        res = discover(
+            scs,
+            meas,
+            library=args.library,
+            selection=args.select,
+            scoring=args.score,
+            max_terms=args.max_terms,
+            criterion=args.criterion,
+            shortlist=args.shortlist,
+            refine=not args.no_refine,
+            max_simulations=args.max_simulations,
+            stability=args.stability,
+            derivative=args.derivative,
+            average_cycles=args.average_cycles,
+            random_state=args.seed,
+            margin=args.margin,
+            monotone=args.monotone,
+            physics=not args.allow_unphysical,
+            require=args.require or (),
+            n_boot_intervals=args.intervals,
+            progress=rep,
+            **({"signs": args.signs} if args.signs else {}),
+        )
     imps = []
     for k, m in enumerate(res.ranking[:3]):
         if m.criteria:  # aligned with the first record and sampled like it
-            imps.append((f"#{k + 1}: {', '.join(m.law.names)} "
-                         f"({args.criterion} {m.criteria[args.criterion]:.3g})",
-                         m.evaluation.simulated))
-    summary = {"command": "fit", "scenario": sc.as_dict(),
-               "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
-               **res.as_dict(names=[str(p) for p in data]),
-               **provenance(vars(args), inputs=inputs_of(args))}
+            imps.append(
+                (
+                    f"#{k + 1}: {', '.join(m.law.names)} "
+                    f"({args.criterion} {m.criteria[args.criterion]:.3g})",
+                    m.evaluation.simulated,
+                )
+            )
+    summary = {
+        "command": "fit",
+        "scenario": sc.as_dict(),
+        "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
+        **res.as_dict(names=[str(p) for p in data]),
+        **provenance(vars(args), inputs=inputs_of(args)),
+    }
     with OutputDir(args.out) as out:
         buf = io.StringIO()
         w = csv.writer(buf)
-        w.writerow(["rank", "terms", "regime", "bic", "aic", "cv_error", *CRITERIA,
-                    "coefficients"])
+        w.writerow(["rank", "terms", "regime", "bic", "aic", "cv_error", *CRITERIA, "coefficients"])
         for i, m in enumerate(res.ranking):
-            w.writerow([i + 1, " + ".join(m.law.names), m.regime, f"{m.candidate.bic:.8g}",
-                        f"{m.candidate.aic:.8g}", f"{m.candidate.cv_error:.6g}",
-                        *[f"{m.criteria[n]:.6g}" if m.criteria else "" for n in CRITERIA],
-                        m.law.to_text()])
+            w.writerow(
+                [
+                    i + 1,
+                    " + ".join(m.law.names),
+                    m.regime,
+                    f"{m.candidate.bic:.8g}",
+                    f"{m.candidate.aic:.8g}",
+                    f"{m.candidate.cv_error:.6g}",
+                    *[f"{m.criteria[n]:.6g}" if m.criteria else "" for n in CRITERIA],
+                    m.law.to_text(),
+                ]
+            )
         out.path("ranking.csv").write_text(buf.getvalue())
         fit_impulse_figure(res, imps, str(out.path("fit_impulse")))
         fit_surface_figure(res, str(out.path("fit_surface")))
@@ -71,8 +99,11 @@ def run(args):
         # model.tex is a template of the report system, rendered from the summary itself
         as_json = json.loads(json.dumps(to_jsonable(summary)))
         out.path("model.tex").write_text(render(as_json, out.stage, template="model"))
-        pdf, why = (compile_tex(out.path("model.tex"), ["fit_impulse.pdf"])
-                    if not args.no_pdf else (None, None))
+        pdf, why = (
+            compile_tex(out.path("model.tex"), ["fit_impulse.pdf"])
+            if not args.no_pdf
+            else (None, None)
+        )
         why = None if pdf is not None else why
         summary["pdf"] = None if pdf is None else "model.pdf"
         summary["seconds"] = time.perf_counter() - t_start  # the whole command
@@ -85,23 +116,30 @@ def run(args):
         print(criteria_line(sel.criteria, sel.noise_floor))
     print(f"  {sel.verdict}")
     cert = res.certificate
-    print(f"  certificate: {'holds' if cert.holds else 'FAILS'} on zeta <= "
-          f"{cert.domain['zeta_max']:.3g} m, zd <= {cert.domain['zd_max']:.3g} m/s "
-          f"(worst violation {cert.worst_violation:.2g})")
-    print(f"  {len(res.ranking)} candidates ranked ({res.samples.n_impacts} impacts, "
-          f"{len(res.samples)} contact samples, {res.seconds:.1f} s)")
+    print(
+        f"  certificate: {'holds' if cert.holds else 'FAILS'} on zeta <= "
+        f"{cert.domain['zeta_max']:.3g} m, zd <= {cert.domain['zd_max']:.3g} m/s "
+        f"(worst violation {cert.worst_violation:.2g})"
+    )
+    print(
+        f"  {len(res.ranking)} candidates ranked ({res.samples.n_impacts} impacts, "
+        f"{len(res.samples)} contact samples, {res.seconds:.1f} s)"
+    )
     if res.stability:
-        print("  stability: " + ", ".join(f"{k} {v:.2f}" for k, v in res.stability.items()
-                                          if v > 0))
+        print(
+            "  stability: " + ", ".join(f"{k} {v:.2f}" for k, v in res.stability.items() if v > 0)
+        )
     for e in res.equivalent:
         print(f"  equivalent: {' + '.join(e['terms'])} ({e['reason']})")
     for w in res.warnings:
         print(f"  warning: {w}")
     if why:
         print(f"  note: {why}")
-    print(f"outputs in {args.out}/: summary.json, ranking.csv, model.tex"
-          f"{', model.pdf' if pdf else ''}, fit_impulse.png/.pdf, fit_surface.png/.pdf, "
-          "fit_loop.png/.pdf")
+    print(
+        f"outputs in {args.out}/: summary.json, ranking.csv, model.tex"
+        f"{', model.pdf' if pdf else ''}, fit_impulse.png/.pdf, fit_surface.png/.pdf, "
+        "fit_loop.png/.pdf"
+    )
     return 0
 
 
@@ -115,7 +153,8 @@ def _signs(text):
         value = {"+": 1, "+1": 1, "1": 1, "-": -1, "-1": -1, "0": 0}.get(sign.strip())
         if not term.strip() or value is None:
             raise argparse.ArgumentTypeError(
-                f"{part.strip()!r} is not TERM:SIGN; write e.g. --signs 'z:+,zd:+' (signs + - 0)")
+                f"{part.strip()!r} is not TERM:SIGN; write e.g. --signs 'z:+,zd:+' (signs + - 0)"
+            )
         out[term.strip()] = value
     if not out:
         raise argparse.ArgumentTypeError("no TERM:SIGN given; write e.g. --signs 'z:+,zd:+'")
@@ -131,64 +170,128 @@ def _terms(text):
 
 
 def register(sub):
-    s = sub.add_parser("fit", help="discover a law: sparse certified regression, every "
-                       "candidate checked by simulation")
-    s.add_argument("--scenario", action="append",
-                   help=SCENARIO_HELP + "; repeat it, once per --data in the same order, when "
-                   "the records come from different operating points")
-    s.add_argument("--data", required=True, action="append",
-                   help="CSV with t, F, w1, w2 (v1, v2 optional); repeat it to fit several "
-                   "records jointly")
+    s = sub.add_parser(
+        "fit",
+        help="discover a law: sparse certified regression, every candidate checked by simulation",
+    )
+    s.add_argument(
+        "--scenario",
+        action="append",
+        help=SCENARIO_HELP + "; repeat it, once per --data in the same order, when "
+        "the records come from different operating points",
+    )
+    s.add_argument(
+        "--data",
+        required=True,
+        action="append",
+        help="CSV with t, F, w1, w2 (v1, v2 optional); repeat it to fit several records jointly",
+    )
     add_record_options(s)
-    s.add_argument("--library", default="poly:2",
-                   help="candidate terms: poly:N, hc, a list 'z,zd,z*zd', or sums "
-                   "(default: %(default)s)")
-    s.add_argument("--select", default="best-subset",
-                   choices=["best-subset", "l1-path", "stlsq", "sr3", "constrained-sr3"],
-                   help="how supports are proposed (default: %(default)s)")
-    s.add_argument("--score", default="bic", choices=["bic", "aic", "cv"],
-                   help="regression score that orders the candidates "
-                   "(default: %(default)s)")
-    s.add_argument("--max-terms", type=integer(1, 12), default=4,
-                   help="largest support (default: %(default)s)")
-    s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
-                   help="simulation criterion of the ranking (default: %(default)s)")
-    s.add_argument("--shortlist", type=integer(1, 200), default=8,
-                   help="candidates simulated (default: %(default)s)")
-    s.add_argument("--margin", type=number(0.0, unit="N s/m"), default=0.0,
-                   help="dissipativity strictness margin in N s/m (default: %(default)g)")
-    s.add_argument("--signs", type=_signs, default=None,
-                   help="coefficient signs of library terms, e.g. 'z:+,zd:+,zd^2:-' (a term "
-                   "not named is free; default: none)")
-    s.add_argument("--require", type=_terms, default=None,
-                   help="terms every candidate must contain, e.g. 'z' (a spring) or 'z,zd' "
-                   "(default: none)")
-    s.add_argument("--intervals", type=interval_count, default=30,
-                   help="bootstrap replicates of the selected law's 95 %% coefficient intervals "
-                   "through the full processing (0 = none) (default: %(default)s)")
-    s.add_argument("--allow-unphysical", action="store_true",
-                   help="rank laws that are no contact laws (no spring: F(zeta, 0) = 0; a "
-                   "negative damper) by the records alone; by default they come last")
-    s.add_argument("--monotone", action="store_true",
-                   help="also require a monotone elastic branch")
-    s.add_argument("--no-refine", action="store_true",
-                   help="skip the refinement of every shortlisted support by simulation "
-                   "(output error: unbiased coefficients and their standard errors)")
-    s.add_argument("--max-simulations", type=integer(2, 100_000), default=120,
-                   excludes="--no-refine",
-                   help="simulation budget of each support's refinement "
-                   "(default: %(default)s)")
-    s.add_argument("--stability", type=integer(0, 10_000), default=0,
-                   help="bootstrap resamples of impacts for stability selection "
-                   "(default: %(default)s, no stability selection)")
-    s.add_argument("--derivative", choices=["velocities", "savgol", "pysindy"],
-                   help="source of dzeta (default: velocities if recorded, else savgol)")
-    s.add_argument("--average-cycles", action="store_true",
-                   help="average the steady cycles sample by sample before the regression")
-    s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
-                   help="seed of the stability selection (default: %(default)s)")
-    s.add_argument("--no-pdf", action="store_true",
-                   help="do not compile model.tex to model.pdf (compiled when latexmk is "
-                   "installed)")
+    s.add_argument(
+        "--library",
+        default="poly:2",
+        help="candidate terms: poly:N, hc, a list 'z,zd,z*zd', or sums (default: %(default)s)",
+    )
+    s.add_argument(
+        "--select",
+        default="best-subset",
+        choices=["best-subset", "l1-path", "stlsq", "sr3", "constrained-sr3"],
+        help="how supports are proposed (default: %(default)s)",
+    )
+    s.add_argument(
+        "--score",
+        default="bic",
+        choices=["bic", "aic", "cv"],
+        help="regression score that orders the candidates (default: %(default)s)",
+    )
+    s.add_argument(
+        "--max-terms", type=integer(1, 12), default=4, help="largest support (default: %(default)s)"
+    )
+    s.add_argument(
+        "--criterion",
+        default="I2",
+        choices=list(CRITERIA),
+        help="simulation criterion of the ranking (default: %(default)s)",
+    )
+    s.add_argument(
+        "--shortlist",
+        type=integer(1, 200),
+        default=8,
+        help="candidates simulated (default: %(default)s)",
+    )
+    s.add_argument(
+        "--margin",
+        type=number(0.0, unit="N s/m"),
+        default=0.0,
+        help="dissipativity strictness margin in N s/m (default: %(default)g)",
+    )
+    s.add_argument(
+        "--signs",
+        type=_signs,
+        default=None,
+        help="coefficient signs of library terms, e.g. 'z:+,zd:+,zd^2:-' (a term "
+        "not named is free; default: none)",
+    )
+    s.add_argument(
+        "--require",
+        type=_terms,
+        default=None,
+        help="terms every candidate must contain, e.g. 'z' (a spring) or 'z,zd' (default: none)",
+    )
+    s.add_argument(
+        "--intervals",
+        type=interval_count,
+        default=30,
+        help="bootstrap replicates of the selected law's 95 %% coefficient intervals "
+        "through the full processing (0 = none) (default: %(default)s)",
+    )
+    s.add_argument(
+        "--allow-unphysical",
+        action="store_true",
+        help="rank laws that are no contact laws (no spring: F(zeta, 0) = 0; a "
+        "negative damper) by the records alone; by default they come last",
+    )
+    s.add_argument("--monotone", action="store_true", help="also require a monotone elastic branch")
+    s.add_argument(
+        "--no-refine",
+        action="store_true",
+        help="skip the refinement of every shortlisted support by simulation "
+        "(output error: unbiased coefficients and their standard errors)",
+    )
+    s.add_argument(
+        "--max-simulations",
+        type=integer(2, 100_000),
+        default=120,
+        excludes="--no-refine",
+        help="simulation budget of each support's refinement (default: %(default)s)",
+    )
+    s.add_argument(
+        "--stability",
+        type=integer(0, 10_000),
+        default=0,
+        help="bootstrap resamples of impacts for stability selection "
+        "(default: %(default)s, no stability selection)",
+    )
+    s.add_argument(
+        "--derivative",
+        choices=["velocities", "savgol", "pysindy"],
+        help="source of dzeta (default: velocities if recorded, else savgol)",
+    )
+    s.add_argument(
+        "--average-cycles",
+        action="store_true",
+        help="average the steady cycles sample by sample before the regression",
+    )
+    s.add_argument(
+        "--seed",
+        type=integer(0, 2**32 - 1),
+        default=0,
+        help="seed of the stability selection (default: %(default)s)",
+    )
+    s.add_argument(
+        "--no-pdf",
+        action="store_true",
+        help="do not compile model.tex to model.pdf (compiled when latexmk is installed)",
+    )
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

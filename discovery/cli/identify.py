@@ -40,19 +40,25 @@ def _load_landscape(path, cls, start, scenario):
     land, d = _read_landscape(path, cls)
     terms = tuple(t.name for t in start.terms[:2])
     if tuple(land.terms) != terms:
-        raise InputError(f"--landscape {path!r} varies {', '.join(land.terms)}, not the start's "
-                         f"{', '.join(terms)}; make one with vidi landscape --law "
-                         "(the start law) or leave out --landscape")
+        raise InputError(
+            f"--landscape {path!r} varies {', '.join(land.terms)}, not the start's "
+            f"{', '.join(terms)}; make one with vidi landscape --law "
+            "(the start law) or leave out --landscape"
+        )
     shape = (land.axes[0].size, land.axes[1].size)
     bad = [n for n, v in land.values.items() if v.shape != shape]
     if bad or land.regime.shape != shape or min(shape) < 2:
-        raise InputError(f"--landscape {path!r}: its grids do not match its axes "
-                         f"({shape[0]} x {shape[1]}); make it again with vidi landscape")
+        raise InputError(
+            f"--landscape {path!r}: its grids do not match its axes "
+            f"({shape[0]} x {shape[1]}); make it again with vidi landscape"
+        )
     made_for = (d.get("scenario") or {}).get("name")
     if made_for is not None and made_for != scenario.name:
-        raise InputError(f"--landscape {path!r} was made for scenario {made_for!r}, not "
-                         f"{scenario.name!r}; make one for this scenario or leave out "
-                         "--landscape")
+        raise InputError(
+            f"--landscape {path!r} was made for scenario {made_for!r}, not "
+            f"{scenario.name!r}; make one for this scenario or leave out "
+            "--landscape"
+        )
     return land
 
 
@@ -65,14 +71,20 @@ def _read_landscape(path, cls):
         raise InputError(f"--landscape {path!r}: no readable landscape summary.json") from None
     try:
         vals = {n: np.array(d[n], dtype=float) for n in CRITERIA}
-        land = cls(terms=tuple(d["terms"]),
-                   axes=(np.array(d["alpha1"], dtype=float), np.array(d["alpha2"], dtype=float)),
-                   values=vals, regime=np.array(d["regime"], dtype=object),
-                   seconds=d["seconds"], workers=d["workers"])
+        land = cls(
+            terms=tuple(d["terms"]),
+            axes=(np.array(d["alpha1"], dtype=float), np.array(d["alpha2"], dtype=float)),
+            values=vals,
+            regime=np.array(d["regime"], dtype=object),
+            seconds=d["seconds"],
+            workers=d["workers"],
+        )
         return land, d
     except (KeyError, TypeError, ValueError):
-        raise InputError(f"--landscape {path!r} is not a landscape result (made by vidi "
-                         "landscape); give its output directory or summary.json") from None
+        raise InputError(
+            f"--landscape {path!r} is not a landscape result (made by vidi "
+            "landscape); give its output directory or summary.json"
+        ) from None
 
 
 def run(args):
@@ -85,8 +97,9 @@ def run(args):
     check_out(args)
     sc = load_scenario(args.scenario)
     if not args.start.strip():
-        raise InputError("--start is empty; give the terms and start values, e.g. "
-                         "'1.5e8*z + 0.9e7*zd'")
+        raise InputError(
+            "--start is empty; give the terms and start values, e.g. '1.5e8*z + 0.9e7*zd'"
+        )
     start = ForceLaw.parse(args.start)
     start.check_physical(sc, "--start")
     land = _load_landscape(args.landscape, Landscape, start, sc) if args.landscape else None
@@ -96,90 +109,165 @@ def run(args):
     ref = Reference.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
     E = ref.impulse
     with reporter(args) as rep:
-        res = identify(sc, ref, start, criterion=args.criterion, method=args.method,
-                       max_simulations=args.max_simulations, xtol=args.xtol,
-                       n_boot_intervals=args.intervals, seed=args.seed, progress=rep)
+        res = identify(
+            sc,
+            ref,
+            start,
+            criterion=args.criterion,
+            method=args.method,
+            max_simulations=args.max_simulations,
+            xtol=args.xtol,
+            n_boot_intervals=args.intervals,
+            seed=args.seed,
+            progress=rep,
+        )
     final = evaluate(sc, res.law, ref)
     # res.iterations lists every new best-so-far law (finite-difference probes included),
     # so the impulses are labelled by the simulations spent, not as iterations: a few of
     # those found before the identified law, then the identified law itself
     its = res.iterations
-    found = next((k for k, it in enumerate(its) if it["coefficients"] == res.coefficients),
-                 len(its))
+    found = next(
+        (k for k, it in enumerate(its) if it["coefficients"] == res.coefficients), len(its)
+    )
     imps = []
     for k in _pick_iterates(its[:found], 4):
         it = its[k]
         law = start.with_coefficients(list(it["coefficients"].values()))
         ev = evaluate(sc, law, ref, floor=False)
         n = it["n_simulations"]
-        imps.append(("start" if it["coefficients"] == start.as_dict() else
-                     f"best after {n} simulation{'s' if n != 1 else ''}", ev.simulated))
+        imps.append(
+            (
+                "start"
+                if it["coefficients"] == start.as_dict()
+                else f"best after {n} simulation{'s' if n != 1 else ''}",
+                ev.simulated,
+            )
+        )
     imps.append(("identified law", final.simulated))
     with OutputDir(args.out) as out:
-        summary = {"command": "identify", "scenario": sc.as_dict(), "data": str(args.data),
-                   "measured": {"n_cycles": E.n_cycles, "n_periods": E.n_periods,
-                                "noise": E.noise, "threshold": E.threshold,
-                                "peak": E.peak, "contact_time": E.contact_time},
-                   "start": start.as_dict(), **res.as_dict(),
-                   "criteria": final.criteria, "noise_floor": final.noise_floor,
-                   "consistent": final.consistent, "verdict": final.verdict,
-                   "regime": final.regime, **provenance(vars(args), inputs=inputs_of(args))}
+        summary = {
+            "command": "identify",
+            "scenario": sc.as_dict(),
+            "data": str(args.data),
+            "measured": {
+                "n_cycles": E.n_cycles,
+                "n_periods": E.n_periods,
+                "noise": E.noise,
+                "threshold": E.threshold,
+                "peak": E.peak,
+                "contact_time": E.contact_time,
+            },
+            "start": start.as_dict(),
+            **res.as_dict(),
+            "criteria": final.criteria,
+            "noise_floor": final.noise_floor,
+            "consistent": final.consistent,
+            "verdict": final.verdict,
+            "regime": final.regime,
+            **provenance(vars(args), inputs=inputs_of(args)),
+        }
         out.write_json("summary.json", summary)
         buf = io.StringIO()
         w = csv.writer(buf)
         # one row per new best-so-far law (optimiser steps and finite-difference probes)
         w.writerow(["best_so_far", "n_simulations", res.criterion, *res.law.names])
         for k, it in enumerate(res.iterations):
-            w.writerow([k, it["n_simulations"], f"{it['value']:.10g}",
-                        *[f"{v:.10g}" for v in it["coefficients"].values()]])
+            w.writerow(
+                [
+                    k,
+                    it["n_simulations"],
+                    f"{it['value']:.10g}",
+                    *[f"{v:.10g}" for v in it["coefficients"].values()],
+                ]
+            )
         out.path("iterations.csv").write_text(buf.getvalue())
         identification_figure(res, E, imps, str(out.path("identification")), land)
     print(f"identified {res.law}")
     # the criterion of the identified law (res.value can be that of a standard-error probe)
     value = res.criteria.get(res.criterion, res.value)
-    print(f"  {res.criterion} = {value:.4g} after {res.n_simulations} simulations "
-          f"({res.method}, {res.seconds:.1f} s)")
+    print(
+        f"  {res.criterion} = {value:.4g} after {res.n_simulations} simulations "
+        f"({res.method}, {res.seconds:.1f} s)"
+    )
     if res.standard_errors:
         print(coefficients_line(res.coefficients, res.standard_errors, res.intervals))
     if final.criteria:
         print(criteria_line(final.criteria, final.noise_floor))
     print(f"  {final.verdict}")
     if res.failures:
-        print(f"  note: {len(res.failures)} trial law(s) had no periodic steady state with "
-              "contact (listed in summary.json)")
-    print(f"outputs in {args.out}/: summary.json, iterations.csv, identification.png, "
-          "identification.pdf")
+        print(
+            f"  note: {len(res.failures)} trial law(s) had no periodic steady state with "
+            "contact (listed in summary.json)"
+        )
+    print(
+        f"outputs in {args.out}/: summary.json, iterations.csv, identification.png, "
+        "identification.pdf"
+    )
     return 0
 
 
 def register(sub):
-    s = sub.add_parser("identify", help="identify a law's coefficients from a measured CSV by "
-                       "simulation (paper Figs. 6-7)")
+    s = sub.add_parser(
+        "identify",
+        help="identify a law's coefficients from a measured CSV by simulation (paper Figs. 6-7)",
+    )
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
-    s.add_argument("--data", required=True,
-                   help="CSV with t [s], F [N] (w1, v1, w2, v2 recommended: exact onsets and "
-                   "the machine's state)")
+    s.add_argument(
+        "--data",
+        required=True,
+        help="CSV with t [s], F [N] (w1, v1, w2, v2 recommended: exact onsets and "
+        "the machine's state)",
+    )
     add_record_options(s)
-    s.add_argument("--criterion", default="I2", choices=list(CRITERIA),
-                   help="criterion to minimise (default: %(default)s)")
-    s.add_argument("--method", default="least-squares",
-                   choices=["coordinate-descent", "nelder-mead", "least-squares"],
-                   help="optimiser (default: %(default)s)")
-    s.add_argument("--start", required=True, help="terms and start values, e.g. "
-                   "'1.5e8*z + 0.9e7*zd'")
-    s.add_argument("--max-simulations", type=integer(2, 1_000_000), default=600,
-                   help="simulation budget (default: %(default)s)")
-    s.add_argument("--xtol", type=number(0.0, 1.0, lo_open=True), default=1e-5,
-                   help="relative coefficient tolerance (default: %(default)g)")
-    s.add_argument("--landscape", help="a landscape output (directory or summary.json) to draw "
-                   "the path on (default: none)")
-    s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
-                   help="bootstrap replicates of the noise floor (default: %(default)s)")
-    s.add_argument("--intervals", type=interval_count, default=30,
-                   help="bootstrap replicates of the 95 %% coefficient intervals through the "
-                   "full processing (records with positions; 0 = none) (default: %(default)s)")
-    s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
-                   help="seed of the noise-floor and interval bootstraps (default: "
-                   "%(default)s)")
+    s.add_argument(
+        "--criterion",
+        default="I2",
+        choices=list(CRITERIA),
+        help="criterion to minimise (default: %(default)s)",
+    )
+    s.add_argument(
+        "--method",
+        default="least-squares",
+        choices=["coordinate-descent", "nelder-mead", "least-squares"],
+        help="optimiser (default: %(default)s)",
+    )
+    s.add_argument(
+        "--start", required=True, help="terms and start values, e.g. '1.5e8*z + 0.9e7*zd'"
+    )
+    s.add_argument(
+        "--max-simulations",
+        type=integer(2, 1_000_000),
+        default=600,
+        help="simulation budget (default: %(default)s)",
+    )
+    s.add_argument(
+        "--xtol",
+        type=number(0.0, 1.0, lo_open=True),
+        default=1e-5,
+        help="relative coefficient tolerance (default: %(default)g)",
+    )
+    s.add_argument(
+        "--landscape",
+        help="a landscape output (directory or summary.json) to draw the path on (default: none)",
+    )
+    s.add_argument(
+        "--n-boot",
+        type=integer(1, 10_000),
+        default=16,
+        help="bootstrap replicates of the noise floor (default: %(default)s)",
+    )
+    s.add_argument(
+        "--intervals",
+        type=interval_count,
+        default=30,
+        help="bootstrap replicates of the 95 %% coefficient intervals through the "
+        "full processing (records with positions; 0 = none) (default: %(default)s)",
+    )
+    s.add_argument(
+        "--seed",
+        type=integer(0, 2**32 - 1),
+        default=0,
+        help="seed of the noise-floor and interval bootstraps (default: %(default)s)",
+    )
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

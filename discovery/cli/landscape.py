@@ -32,9 +32,16 @@ def _grid_csv(land):
     w.writerow([land.terms[0], land.terms[1], "regime", *CRITERIA, "impacts", "consistent"])
     for i, a in enumerate(land.axes[0]):
         for j, b in enumerate(land.axes[1]):
-            w.writerow([f"{a:.10g}", f"{b:.10g}", land.regime[i, j],
-                        *[f"{land.values[n][i, j]:.10g}" for n in CRITERIA],
-                        int(land.impacts[i, j]), int(land.consistent[i, j])])
+            w.writerow(
+                [
+                    f"{a:.10g}",
+                    f"{b:.10g}",
+                    land.regime[i, j],
+                    *[f"{land.values[n][i, j]:.10g}" for n in CRITERIA],
+                    int(land.impacts[i, j]),
+                    int(land.consistent[i, j]),
+                ]
+            )
     return buf.getvalue()
 
 
@@ -54,16 +61,20 @@ def _ranges(args, law):
     for k, (text, opt) in enumerate(((args.range0, "--range0"), (args.range1, "--range1"))):
         if text is None:
             out.append(default_range(law.coefficients[k], law.names[k], opt))
-            origin.append(f"default: {1 - DEFAULT_SPREAD:g}x..{1 + DEFAULT_SPREAD:g}x the "
-                          f"template's coefficient {law.coefficients[k]:.6g}")
+            origin.append(
+                f"default: {1 - DEFAULT_SPREAD:g}x..{1 + DEFAULT_SPREAD:g}x the "
+                f"template's coefficient {law.coefficients[k]:.6g}"
+            )
         else:
             lo, hi = parse_range(text, None, opt)
             if lo <= 0 <= hi:
-                raise InputError(f"{opt} {text!r} reaches zero: the coefficient of "
-                                 f"{law.names[k]} would vanish or change sign inside the grid; "
-                                 "give a range on one side of zero, e.g. "
-                                 f"{0.5 * abs(law.coefficients[k]):.3g}:"
-                                 f"{1.5 * abs(law.coefficients[k]):.3g}")
+                raise InputError(
+                    f"{opt} {text!r} reaches zero: the coefficient of "
+                    f"{law.names[k]} would vanish or change sign inside the grid; "
+                    "give a range on one side of zero, e.g. "
+                    f"{0.5 * abs(law.coefficients[k]):.3g}:"
+                    f"{1.5 * abs(law.coefficients[k]):.3g}"
+                )
             out.append((lo, hi))
             origin.append(f"{opt} {text}")
     return out, origin
@@ -75,18 +86,31 @@ def _reference(args, sc):
 
     if args.data is None:
         if sc.law is None:
-            raise InputError(f"scenario {sc.name!r} has no reference law; pass --data D.csv "
-                             "(a measured record) or add [law] text to the scenario")
+            raise InputError(
+                f"scenario {sc.name!r} has no reference law; pass --data D.csv "
+                "(a measured record) or add [law] text to the scenario"
+            )
         return None, {"source": "law", "law": sc.law.to_text()}, ()
     meas = read_record(args, sc)
-    ref = Reference.from_measurement(meas, sc, time_offset=args.time_offset,
-                                     n_boot=args.n_boot, seed=args.seed)
+    ref = Reference.from_measurement(
+        meas, sc, time_offset=args.time_offset, n_boot=args.n_boot, seed=args.seed
+    )
     E = ref.impulse
-    info = {"source": str(args.data), "sha256": _sha256(args.data),
-            "n_periods": E.n_periods, "n_cycles": E.n_cycles, "impacts": ref.impacts,
-            "noise": dict(ref.noise), "threshold": E.threshold, "peak": E.peak,
-            "contact_time": E.contact_time, "time_offset": ref.time_offset,
-            "n_boot": ref.n_boot, "seed": ref.seed, "notes": list(meas.notes)}
+    info = {
+        "source": str(args.data),
+        "sha256": _sha256(args.data),
+        "n_periods": E.n_periods,
+        "n_cycles": E.n_cycles,
+        "impacts": ref.impacts,
+        "noise": dict(ref.noise),
+        "threshold": E.threshold,
+        "peak": E.peak,
+        "contact_time": E.contact_time,
+        "time_offset": ref.time_offset,
+        "n_boot": ref.n_boot,
+        "seed": ref.seed,
+        "notes": list(meas.notes),
+    }
     return ref, info, meas.notes
 
 
@@ -99,9 +123,11 @@ def run(args):
     sc = load_scenario(args.scenario)
     law = law_or_default(args.law, sc)
     if len(law.terms) < 2:
-        raise InputError(f"the template law '{law}' has {len(law.terms)} term(s); a landscape "
-                         "varies two coefficients, give --law with at least two terms, e.g. "
-                         "'2.06e8*z + 1.28e7*zd'")
+        raise InputError(
+            f"the template law '{law}' has {len(law.terms)} term(s); a landscape "
+            "varies two coefficients, give --law with at least two terms, e.g. "
+            "'2.06e8*z + 1.28e7*zd'"
+        )
     n0, n1 = parse_grid(args.grid)
     (r0, r1), origin = _ranges(args, law)
     ref, ref_info, notes = _reference(args, sc)
@@ -109,16 +135,31 @@ def run(args):
         print(f"note: {note}")
     a0, a1 = np.linspace(*r0, n0), np.linspace(*r1, n1)
     with reporter(args) as rep, executor_of(args) as ex:
-        land = landscape(sc, law, a0, a1, ref, workers=args.workers, progress=rep, executor=ex,
-                         continuation=not args.no_continuation)
+        land = landscape(
+            sc,
+            law,
+            a0,
+            a1,
+            ref,
+            workers=args.workers,
+            progress=rep,
+            executor=ex,
+            continuation=not args.no_continuation,
+        )
     ref_info.update(regime=land.reference["regime"], start=land.reference["start"])
     if ref is None:
         ref_info["impacts"] = land.reference["impacts"]
     with OutputDir(args.out) as out:
-        summary = {"command": "landscape", "scenario": sc.as_dict(), "law": law.to_text(),
-                   **land.as_dict(), "reference": ref_info, "grid": [n0, n1],
-                   "ranges": {"alpha1": list(r0), "alpha2": list(r1), "from": origin},
-                   **provenance(vars(args), inputs=inputs_of(args))}
+        summary = {
+            "command": "landscape",
+            "scenario": sc.as_dict(),
+            "law": law.to_text(),
+            **land.as_dict(),
+            "reference": ref_info,
+            "grid": [n0, n1],
+            "ranges": {"alpha1": list(r0), "alpha2": list(r1), "from": origin},
+            **provenance(vars(args), inputs=inputs_of(args)),
+        }
         out.write_json("summary.json", summary)
         out.path("landscape.csv").write_text(_grid_csv(land))
         truth = None
@@ -128,14 +169,16 @@ def run(args):
     src = "the scenario's law" if ref is None else f"{args.data}"
     count, first, at = land.failures
     minima = summary["minima"]
-    print(f"landscape {n0}x{n1} of {law.names[0]} in [{r0[0]:.4g}, {r0[1]:.4g}] x "
-          f"{law.names[1]} in [{r1[0]:.4g}, {r1[1]:.4g}] against {src} "
-          f"({land.reference['regime']}): {land.seconds:.1f} s on {land.workers} processes")
-    print(f"  regimes {land.regime_counts()}; consistent at {int(land.consistent.sum())} "
-          "point(s)")
+    print(
+        f"landscape {n0}x{n1} of {law.names[0]} in [{r0[0]:.4g}, {r0[1]:.4g}] x "
+        f"{law.names[1]} in [{r1[0]:.4g}, {r1[1]:.4g}] against {src} "
+        f"({land.reference['regime']}): {land.seconds:.1f} s on {land.workers} processes"
+    )
+    print(f"  regimes {land.regime_counts()}; consistent at {int(land.consistent.sum())} point(s)")
     if count:
-        print(f"  {count} simulation(s) failed, first at ({a0[at[0]]:.4g}, {a1[at[1]]:.4g}): "
-              f"{first}")
+        print(
+            f"  {count} simulation(s) failed, first at ({a0[at[0]]:.4g}, {a1[at[1]]:.4g}): {first}"
+        )
     exact = land.reference["exact"]
     for n in CRITERIA:
         m = minima[n]
@@ -143,8 +186,7 @@ def run(args):
             print(f"  {n}: no point with a periodic steady state with contact")
             continue
         beside = "" if exact else f" (noise floor {land.noise_floor[n]:.3g})"
-        print(f"  {n}: minimum {m['value']:.3g}{beside} at ({m['alpha1']:.4g}, "
-              f"{m['alpha2']:.4g})")
+        print(f"  {n}: minimum {m['value']:.3g}{beside} at ({m['alpha1']:.4g}, {m['alpha2']:.4g})")
     if not exact:
         print(f"  noise floor under {land.noise_floor_under}")
     print(f"outputs in {args.out}/: summary.json, landscape.csv, landscape.png, landscape.pdf")
@@ -152,35 +194,59 @@ def run(args):
 
 
 def register(sub):
-    s = sub.add_parser("landscape", help="criteria I0..I4 over a grid of the first two "
-                       "coefficients (paper Figs. 4-5)")
+    s = sub.add_parser(
+        "landscape",
+        help="criteria I0..I4 over a grid of the first two coefficients (paper Figs. 4-5)",
+    )
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
-    s.add_argument("--law", help="template law whose first two coefficients vary "
-                   "(default: the scenario's law)")
-    s.add_argument("--data", help="CSV record (t, F [, w1, v1, w2, v2]) to compare with "
-                   "(default: the exact impulse of the scenario's law)")
+    s.add_argument(
+        "--law", help="template law whose first two coefficients vary (default: the scenario's law)"
+    )
+    s.add_argument(
+        "--data",
+        help="CSV record (t, F [, w1, v1, w2, v2]) to compare with "
+        "(default: the exact impulse of the scenario's law)",
+    )
     add_record_options(s).needs = "--data"
-    s.add_argument("--grid", default="41x41",
-                   help="points per axis, e.g. 41x41 (default: %(default)s)")
-    s.add_argument("--range0", help="LOW:HIGH of the first coefficient (default: 0.5x..1.5x "
-                   "the template's coefficient)")
-    s.add_argument("--range1", help="LOW:HIGH of the second coefficient (default: 0.5x..1.5x "
-                   "the template's coefficient)")
-    s.add_argument("--time-offset", type=number(-1e7, 1e7, unit="s"), default=0.0,
-                   needs="--data",
-                   help="with --data: drive-clock time [s] of the record's t = 0 "
-                   "(default: %(default)g)")
-    s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
-                   needs="--data",
-                   help="with --data: bootstrap replicates of the noise floor "
-                   "(default: %(default)s)")
-    s.add_argument("--seed", type=integer(0, 2**32 - 1), default=0,
-                   needs="--data",
-                   help="with --data: seed of the bootstrap (default: %(default)s)")
-    s.add_argument("--no-continuation", action="store_true",
-                   help="search every point's steady state from the start state (by default "
-                   "each point starts from its neighbour's orbit along the row, several "
-                   "times faster; the search from the start state when that fails)")
+    s.add_argument(
+        "--grid", default="41x41", help="points per axis, e.g. 41x41 (default: %(default)s)"
+    )
+    s.add_argument(
+        "--range0",
+        help="LOW:HIGH of the first coefficient (default: 0.5x..1.5x the template's coefficient)",
+    )
+    s.add_argument(
+        "--range1",
+        help="LOW:HIGH of the second coefficient (default: 0.5x..1.5x the template's coefficient)",
+    )
+    s.add_argument(
+        "--time-offset",
+        type=number(-1e7, 1e7, unit="s"),
+        default=0.0,
+        needs="--data",
+        help="with --data: drive-clock time [s] of the record's t = 0 (default: %(default)g)",
+    )
+    s.add_argument(
+        "--n-boot",
+        type=integer(1, 10_000),
+        default=16,
+        needs="--data",
+        help="with --data: bootstrap replicates of the noise floor (default: %(default)s)",
+    )
+    s.add_argument(
+        "--seed",
+        type=integer(0, 2**32 - 1),
+        default=0,
+        needs="--data",
+        help="with --data: seed of the bootstrap (default: %(default)s)",
+    )
+    s.add_argument(
+        "--no-continuation",
+        action="store_true",
+        help="search every point's steady state from the start state (by default "
+        "each point starts from its neighbour's orbit along the row, several "
+        "times faster; the search from the start state when that fails)",
+    )
     s.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
     s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
     s.add_argument("--out", required=True, help="output directory")

@@ -33,60 +33,108 @@ def run(args):
     out = check_out(args, kind="file")
     if out.suffix.lower() != ".csv":
         raise InputError(f"--out {args.out!r} must name a .csv file, e.g. D.csv")
-    check_output(out.with_suffix(".summary.json"), [scenario_file(args.scenario)],
-                 kind="file", option="--out's summary")
+    check_output(
+        out.with_suffix(".summary.json"),
+        [scenario_file(args.scenario)],
+        kind="file",
+        option="--out's summary",
+    )
     sc = load_scenario(args.scenario)
     law = law_or_default(args.law, sc)
     n = args.periods * sc.period * args.fs
     if n > MAX_SAMPLES:
-        raise InputError(f"--periods {args.periods} at --fs {args.fs:g} Hz is {n:.3g} samples; "
-                         f"the limit is {MAX_SAMPLES:.0e}: lower --fs or --periods")
+        raise InputError(
+            f"--periods {args.periods} at --fs {args.fs:g} Hz is {n:.3g} samples; "
+            f"the limit is {MAX_SAMPLES:.0e}: lower --fs or --periods"
+        )
     if n < 8:
-        raise InputError(f"--periods {args.periods} at --fs {args.fs:g} Hz is only {n:.3g} "
-                         "samples; raise --fs or --periods")
+        raise InputError(
+            f"--periods {args.periods} at --fs {args.fs:g} Hz is only {n:.3g} "
+            "samples; raise --fs or --periods"
+        )
     t0 = time.perf_counter()
-    meas = synthesize(sc, law, periods=args.periods, fs=args.fs, noise=args.noise,
-                      seed=args.seed, from_rest=args.from_rest,
-                      position_noise=args.position_noise, velocities=not args.no_velocities,
-                      integrator=args.integrator)
+    meas = synthesize(
+        sc,
+        law,
+        periods=args.periods,
+        fs=args.fs,
+        noise=args.noise,
+        seed=args.seed,
+        from_rest=args.from_rest,
+        position_noise=args.position_noise,
+        velocities=not args.no_velocities,
+        integrator=args.integrator,
+    )
     csv_text = meas.to_csv_text()
-    summary = {"command": "simulate", "scenario": sc.as_dict(), "law": law.to_text(),
-               "samples": int(meas.t.size), "seconds": time.perf_counter() - t0,
-               "outputs": {out.name: {"sha256": hashlib.sha256(csv_text.encode()).hexdigest()}},
-               **provenance(vars(args), inputs=inputs_of(args))}
+    summary = {
+        "command": "simulate",
+        "scenario": sc.as_dict(),
+        "law": law.to_text(),
+        "samples": int(meas.t.size),
+        "seconds": time.perf_counter() - t0,
+        "outputs": {out.name: {"sha256": hashlib.sha256(csv_text.encode()).hexdigest()}},
+        **provenance(vars(args), inputs=inputs_of(args)),
+    }
     text = json.dumps(to_jsonable(summary), indent=2) + "\n"
     atomic_write_text(out, csv_text)
     atomic_write_text(out.with_suffix(".summary.json"), text)
-    print(f"wrote {out} ({meas.t.size} samples, {args.periods} periods at {args.fs:g} Hz, "
-          f"noise {args.noise:g}) and {out.with_suffix('.summary.json')}")
+    print(
+        f"wrote {out} ({meas.t.size} samples, {args.periods} periods at {args.fs:g} Hz, "
+        f"noise {args.noise:g}) and {out.with_suffix('.summary.json')}"
+    )
     return 0
 
 
 def register(sub):
-    s = sub.add_parser("simulate", help="write a synthetic measurement CSV of a law's "
-                       "steady state")
+    s = sub.add_parser("simulate", help="write a synthetic measurement CSV of a law's steady state")
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
     s.add_argument("--law", help=LAW_HELP)
-    s.add_argument("--periods", type=integer(1, 100_000), default=20,
-                   help="drive periods recorded (default: %(default)s)")
-    s.add_argument("--fs", type=number(0, 1e8, lo_open=True, unit="Hz"), default=20000.0,
-                   help="sampling rate in Hz (default: %(default)g)")
-    s.add_argument("--noise", type=number(0, 1), default=0.0,
-                   help="Gaussian noise on F as a fraction of the peak force, 0..1 "
-                   "(default: %(default)g)")
-    s.add_argument("--seed", type=integer(0), default=0,
-                   help="noise seed, >= 0 (default: %(default)s)")
-    s.add_argument("--from-rest", action="store_true",
-                   help="record from the initial state (run-up with impacts at many "
-                   "velocities, then the steady state) instead of on the periodic orbit")
-    s.add_argument("--position-noise", type=number(0, 1), default=0.0,
-                   help="Gaussian noise on w1, w2 as a fraction of the largest penetration, "
-                   "0..1 (default: %(default)g)")
-    s.add_argument("--integrator", choices=("compiled", "scipy"), default="compiled",
-                   help="compiled: the kernel every fit uses; scipy: the independent slow "
-                   "path (scipy DOP853 restarted at every contact event), for records the "
-                   "fitting kernel did not make (default: %(default)s)")
-    s.add_argument("--no-velocities", action="store_true",
-                   help="leave out the v1, v2 columns (discovery then differentiates w1 - w2)")
+    s.add_argument(
+        "--periods",
+        type=integer(1, 100_000),
+        default=20,
+        help="drive periods recorded (default: %(default)s)",
+    )
+    s.add_argument(
+        "--fs",
+        type=number(0, 1e8, lo_open=True, unit="Hz"),
+        default=20000.0,
+        help="sampling rate in Hz (default: %(default)g)",
+    )
+    s.add_argument(
+        "--noise",
+        type=number(0, 1),
+        default=0.0,
+        help="Gaussian noise on F as a fraction of the peak force, 0..1 (default: %(default)g)",
+    )
+    s.add_argument(
+        "--seed", type=integer(0), default=0, help="noise seed, >= 0 (default: %(default)s)"
+    )
+    s.add_argument(
+        "--from-rest",
+        action="store_true",
+        help="record from the initial state (run-up with impacts at many "
+        "velocities, then the steady state) instead of on the periodic orbit",
+    )
+    s.add_argument(
+        "--position-noise",
+        type=number(0, 1),
+        default=0.0,
+        help="Gaussian noise on w1, w2 as a fraction of the largest penetration, "
+        "0..1 (default: %(default)g)",
+    )
+    s.add_argument(
+        "--integrator",
+        choices=("compiled", "scipy"),
+        default="compiled",
+        help="compiled: the kernel every fit uses; scipy: the independent slow "
+        "path (scipy DOP853 restarted at every contact event), for records the "
+        "fitting kernel did not make (default: %(default)s)",
+    )
+    s.add_argument(
+        "--no-velocities",
+        action="store_true",
+        help="leave out the v1, v2 columns (discovery then differentiates w1 - w2)",
+    )
     s.add_argument("--out", required=True, help="output CSV (t, F, w1, v1, w2, v2)")
     s.set_defaults(func=run)

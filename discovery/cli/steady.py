@@ -21,26 +21,36 @@ def run(args):
     info = ss.as_dict()
     if r.impulse is not None:
         info.update(peak_force=r.impulse.peak, contact_time=r.impulse.contact_time)
-    print(f"{law}: {ss.regime}, {ss.impacts} impact(s) per orbit, "
-          f"max |Floquet multiplier| {np.max(np.abs(ss.multipliers)):.4g}, "
-          f"residual {ss.residual:.2g}")
+    print(
+        f"{law}: {ss.regime}, {ss.impacts} impact(s) per orbit, "
+        f"max |Floquet multiplier| {np.max(np.abs(ss.multipliers)):.4g}, "
+        f"residual {ss.residual:.2g}"
+    )
     if r.impulse is not None:
         print(f"peak force {r.impulse.peak:.4g} N, contact time {r.impulse.contact_time:.4g} s")
     if args.out:
         with OutputDir(args.out) as out:
-            out.write_json("summary.json", {"command": "steady", "law": law.to_text(),
-                                            "scenario": sc.as_dict(), **info,
-                                            **provenance(vars(args),
-                                                          inputs=inputs_of(args))})
+            out.write_json(
+                "summary.json",
+                {
+                    "command": "steady",
+                    "law": law.to_text(),
+                    "scenario": sc.as_dict(),
+                    **info,
+                    **provenance(vars(args), inputs=inputs_of(args)),
+                },
+            )
         print(f"wrote {Path(args.out) / 'summary.json'}")
     return 0
 
 
 def register(sub):
-    s = sub.add_parser("steady", help="periodic steady state of a law: regime, impacts, "
-                       "Floquet multipliers")
+    s = sub.add_parser(
+        "steady", help="periodic steady state of a law: regime, impacts, Floquet multipliers"
+    )
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
     s.add_argument("--law", help=LAW_HELP)
-    s.add_argument("--out", help="optional output directory for summary.json "
-                   "(default: none, print only)")
+    s.add_argument(
+        "--out", help="optional output directory for summary.json (default: none, print only)"
+    )
     s.set_defaults(func=run)

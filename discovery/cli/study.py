@@ -8,8 +8,15 @@ def run(args):
 
     set_run("study", getattr(args, "overwrite", False))
     with reporter(args) as rep:
-        r = study(args.config, args.out, workers=args.workers, scheduler=args.scheduler,
-                  progress=rep, max_runs=args.max_runs, figures=not args.no_figures)
+        r = study(
+            args.config,
+            args.out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            progress=rep,
+            max_runs=args.max_runs,
+            figures=not args.no_figures,
+        )
     print(r)
     left = r.config.n_runs - len(r.runs)
     if left:
@@ -21,7 +28,8 @@ def register(sub):
     from ._common import SCHEDULER_HELP, integer
 
     s = sub.add_parser(
-        "study", help="model-term selection study: which terms a record like yours supports",
+        "study",
+        help="model-term selection study: which terms a record like yours supports",
         description="Run a study described in a TOML file: every combination of its factors "
         "(true law, scenario(s), noise, record length, sample rate, library, selection "
         "method, refinement) and seeds. Each run makes its record(s) with the independent "
@@ -30,15 +38,31 @@ def register(sub):
         "configuration: an interrupted study (Ctrl-C, kill -9) continues where it stopped "
         "when the same command is run again. Writes cells.csv (recovery with its 95 %% "
         "interval, false positives, interval coverage, coefficient error per cell), "
-        "runs.csv, inclusion.csv, figures and summary.json.")
-    s.add_argument("--config", required=True, metavar="FILE",
-                   help="the study file (see examples/study_paper.toml)")
-    s.add_argument("--out", required=True, metavar="DIR",
-                   help="the study directory (runs already there are reused)")
-    s.add_argument("--workers", type=integer(1, 4096),
-                   help="worker processes (default: one per core; 1 runs in this process)")
+        "runs.csv, inclusion.csv, figures and summary.json.",
+    )
+    s.add_argument(
+        "--config",
+        required=True,
+        metavar="FILE",
+        help="the study file (see examples/study_paper.toml)",
+    )
+    s.add_argument(
+        "--out",
+        required=True,
+        metavar="DIR",
+        help="the study directory (runs already there are reused)",
+    )
+    s.add_argument(
+        "--workers",
+        type=integer(1, 4096),
+        help="worker processes (default: one per core; 1 runs in this process)",
+    )
     s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
-    s.add_argument("--max-runs", type=integer(0, 10**9), metavar="N",
-                   help="do at most N missing runs now (the rest on the next call)")
+    s.add_argument(
+        "--max-runs",
+        type=integer(0, 10**9),
+        metavar="N",
+        help="do at most N missing runs now (the rest on the next call)",
+    )
     s.add_argument("--no-figures", action="store_true", help="tables only")
     s.set_defaults(func=run)

@@ -27,19 +27,33 @@ def run(args):
     meas = read_record(args, sc)
     for note in meas.notes:
         print(f"note: {note}")
-    res = verify(sc, meas, law, time_offset=args.time_offset, n_boot=args.n_boot,
-                 seed=args.seed, check_default_start=not args.no_default_start)
-    summary = {"command": "verify", "scenario": sc.as_dict(), "data": str(args.data),
-               **res.as_dict(), "verify_settings": res.settings,
-               **provenance(vars(args), inputs=inputs_of(args))}
+    res = verify(
+        sc,
+        meas,
+        law,
+        time_offset=args.time_offset,
+        n_boot=args.n_boot,
+        seed=args.seed,
+        check_default_start=not args.no_default_start,
+    )
+    summary = {
+        "command": "verify",
+        "scenario": sc.as_dict(),
+        "data": str(args.data),
+        **res.as_dict(),
+        "verify_settings": res.settings,
+        **provenance(vars(args), inputs=inputs_of(args)),
+    }
     with OutputDir(args.out) as out:
         out.write_json("summary.json", summary)
         verify_figure(res, str(out.path("verify")))
     ev = res.evaluation
     print(f"{law}: {res.verdict}")
-    print(f"  regime measured {ev.regime['measured']} ({ev.impacts['measured']} contact(s)), "
-          f"simulated {ev.regime['simulated'] or ev.status} "
-          f"({ev.impacts['simulated']} contact(s))")
+    print(
+        f"  regime measured {ev.regime['measured']} ({ev.impacts['measured']} contact(s)), "
+        f"simulated {ev.regime['simulated'] or ev.status} "
+        f"({ev.impacts['simulated']} contact(s))"
+    )
     if ev.criteria:
         print(criteria_line(ev.criteria, ev.noise_floor))
     for note in res.notes:
@@ -49,23 +63,43 @@ def run(args):
 
 
 def register(sub):
-    s = sub.add_parser("verify", help="is a law consistent with a record? full simulation, "
-                       "criteria I0..I4 against their noise floor")
+    s = sub.add_parser(
+        "verify",
+        help="is a law consistent with a record? full simulation, "
+        "criteria I0..I4 against their noise floor",
+    )
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
-    s.add_argument("--data", required=True, help="CSV with t [s], F [N] (w1, v1, w2, v2 "
-                   "recommended: exact onsets and the machine's state)")
+    s.add_argument(
+        "--data",
+        required=True,
+        help="CSV with t [s], F [N] (w1, v1, w2, v2 "
+        "recommended: exact onsets and the machine's state)",
+    )
     s.add_argument("--law", help=LAW_HELP)
     add_record_options(s)
-    s.add_argument("--time-offset", type=number(-1e7, 1e7, unit="s"), default=0.0,
-                   help="drive-clock time [s] of the record's t = 0, when the record does not "
-                   "start at drive phase 0 (default: %(default)g)")
-    s.add_argument("--n-boot", type=integer(1, 10_000), default=16,
-                   help="bootstrap replicates of the noise floor, 1..10000 "
-                   "(default: %(default)s)")
-    s.add_argument("--seed", type=integer(0), default=0,
-                   help="seed of the bootstrap, >= 0 (default: %(default)s)")
-    s.add_argument("--no-default-start", action="store_true",
-                   help="skip the check of the attractor reached from the scenario's "
-                   "initial state")
+    s.add_argument(
+        "--time-offset",
+        type=number(-1e7, 1e7, unit="s"),
+        default=0.0,
+        help="drive-clock time [s] of the record's t = 0, when the record does not "
+        "start at drive phase 0 (default: %(default)g)",
+    )
+    s.add_argument(
+        "--n-boot",
+        type=integer(1, 10_000),
+        default=16,
+        help="bootstrap replicates of the noise floor, 1..10000 (default: %(default)s)",
+    )
+    s.add_argument(
+        "--seed",
+        type=integer(0),
+        default=0,
+        help="seed of the bootstrap, >= 0 (default: %(default)s)",
+    )
+    s.add_argument(
+        "--no-default-start",
+        action="store_true",
+        help="skip the check of the attractor reached from the scenario's initial state",
+    )
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

@@ -45,8 +45,7 @@ from ._tableau import C as C
 from ._tableau import E as _E
 from ._tableau import P as _P
 
-__all__ = ["C", "SAFETY", "MIN_FACTOR", "MAX_FACTOR", "Blocks", "blocks", "step_factor",
-           "ORDER"]
+__all__ = ["C", "SAFETY", "MIN_FACTOR", "MAX_FACTOR", "Blocks", "blocks", "step_factor", "ORDER"]
 
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 ORDER = 5  # the error estimate is of order 4: factors use err^(-1/5)
@@ -100,8 +99,14 @@ def _build(n):
         w5 = _P[5, 1] * t2 + _P[5, 2] * t3 + _P[5, 3] * t4
         w6 = _P[6, 1] * t2 + _P[6, 2] * t3 + _P[6, 3] * t4
         for j in range(n):
-            out[j] = y[j] + h * (w0 * K[0, j] + w2 * K[2, j] + w3 * K[3, j] + w4 * K[4, j]
-                                 + w5 * K[5, j] + w6 * K[6, j])
+            out[j] = y[j] + h * (
+                w0 * K[0, j]
+                + w2 * K[2, j]
+                + w3 * K[3, j]
+                + w4 * K[4, j]
+                + w5 * K[5, j]
+                + w6 * K[6, j]
+            )
 
     @njit(inline="always")
     def error_norm(y, ynew, K, h, rtol, atol):
@@ -178,8 +183,9 @@ def make_smooth_advance(rhs, n, n_out):
     stage, combine, dense, error_norm = D.stage, D.combine, D.dense, D.error_norm
 
     @njit(inline="always")
-    def advance(t, y, t_end, h, p, rtol, atol, hmax, max_steps, K, ytmp, ynew, t_eval,
-                k_eval, out_eval):
+    def advance(
+        t, y, t_end, h, p, rtol, atol, hmax, max_steps, K, ytmp, ynew, t_eval, k_eval, out_eval
+    ):
         n_steps = 0
         status = OK
         n_eval = t_eval.shape[0]

@@ -110,8 +110,11 @@ def load_force(z, v, p, coef, ea, eb, br):
     velocity terms) back up to ``z_max`` (Walton-Braun), continuous there."""
     if p[P_SET] == 0.0 or z >= p[P_ZMAX]:
         return poly(z, v, coef, ea, eb, br)
-    return poly(z, v, coef, ea, eb, br) - poly(z, 0.0, coef, ea, eb, br) \
+    return (
+        poly(z, v, coef, ea, eb, br)
+        - poly(z, 0.0, coef, ea, eb, br)
         + _elastic_set(z, p, coef, ea, eb, br)
+    )
 
 
 @njit(cache=True, inline="always")
@@ -172,8 +175,17 @@ def _rhs(t, y, mode, p, coef, ea, eb, br, out):
     v = y[1] - y[3]
     f = mode_force(mode, z, v, p, coef, ea, eb, br)
     out[0] = y[1]
-    out[1] = -(p[3] * y[1] + p[2] * y[0] + p[P_K3] * y[0] * y[0] * y[0]
-               + p[4] * np.sin(p[5] * t) + p[0] * p[6] + f) / p[0]
+    out[1] = (
+        -(
+            p[3] * y[1]
+            + p[2] * y[0]
+            + p[P_K3] * y[0] * y[0] * y[0]
+            + p[4] * np.sin(p[5] * t)
+            + p[0] * p[6]
+            + f
+        )
+        / p[0]
+    )
     out[2] = y[3]
     out[3] = f / p[1] - p[6]
 
@@ -406,8 +418,30 @@ def _record_event(t, y, mode, index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, e
 
 
 @njit(cache=True)
-def integrate(t0, t1, y0, mode0, p, coef, ea, eb, br, rtol, atol, h0, hmax, max_steps,
-              t_eval, out_y, out_f, out_mode, ev_t, ev_kind, ev_y, ev_modes):
+def integrate(
+    t0,
+    t1,
+    y0,
+    mode0,
+    p,
+    coef,
+    ea,
+    eb,
+    br,
+    rtol,
+    atol,
+    h0,
+    hmax,
+    max_steps,
+    t_eval,
+    out_y,
+    out_f,
+    out_mode,
+    ev_t,
+    ev_kind,
+    ev_y,
+    ev_modes,
+):
     """Integrate from ``t0`` to ``t1``; see :func:`discovery.dynamics.simulate`.
 
     Writes the state, force and mode at each ``t_eval`` (sorted, within
@@ -490,8 +524,26 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, br, rtol, atol, h0, hmax, max_
                 s = -1.0 if mode == FREE else 1.0
                 if not (s * (y[1] - y[3]) < 0.0 and s * (ynew[1] - ynew[3]) > 0.0):
                     continue
-            th = _first_crossing(t, y, ynew, K, h, mode, p, coef, ea, eb, br, i, hs0[i], hsa[i],
-                                 hsb[i], hs1[i], ybuf, hsm)
+            th = _first_crossing(
+                t,
+                y,
+                ynew,
+                K,
+                h,
+                mode,
+                p,
+                coef,
+                ea,
+                eb,
+                br,
+                i,
+                hs0[i],
+                hsa[i],
+                hsb[i],
+                hs1[i],
+                ybuf,
+                hsm,
+            )
             # near-ties go to the lower index: contact loss (index 0) wins over the
             # force reaching zero at the same instant (e.g. P(zeta, 0) = k * zeta)
             if th < best_theta - 1e-9:
@@ -502,8 +554,9 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, br, rtol, atol, h0, hmax, max_
                 if zero_len > 4:
                     status = CHATTER
                     break
-                mode = _record_event(t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t,
-                                     ev_kind, ev_y, ev_modes)
+                mode = _record_event(
+                    t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
+                )
                 n_ev += 1
                 need_f = True
                 need_h0 = True
@@ -522,8 +575,9 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, br, rtol, atol, h0, hmax, max_
             _dense(y, K, h_used, min(theta, 1.0), ybuf)
             for j in range(4):
                 out_y[j, k_eval] = ybuf[j]
-            out_f[k_eval] = mode_force(mode, ybuf[0] - ybuf[2], ybuf[1] - ybuf[3], p, coef, ea,
-                                       eb, br)
+            out_f[k_eval] = mode_force(
+                mode, ybuf[0] - ybuf[2], ybuf[1] - ybuf[3], p, coef, ea, eb, br
+            )
             out_mode[k_eval] = mode
             k_eval += 1
         for j in range(4):
@@ -546,8 +600,9 @@ def integrate(t0, t1, y0, mode0, p, coef, ea, eb, br, rtol, atol, h0, hmax, max_
             else:
                 short_run = 0
             t_last_ev = t
-            mode = _record_event(t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind,
-                                 ev_y, ev_modes)
+            mode = _record_event(
+                t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
+            )
             n_ev += 1
             need_f = True
             need_h0 = True

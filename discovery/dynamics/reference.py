@@ -35,10 +35,10 @@ from ..errors import IntegrationError
 
 __all__ = ["reference_simulate"]
 
-_TREND_STEP = 1e-8     # Heun step for the trend of a surface function [periods]
-_ON_SURFACE = 1e-12    # "on the surface": within this time [max(t, T)] of it at its rate
-_HOLD = 10.0           # a held function keeps its start value for _HOLD x that time
-_MAX_ZERO_LENGTH = 8   # zero-length segments in a row before raising
+_TREND_STEP = 1e-8  # Heun step for the trend of a surface function [periods]
+_ON_SURFACE = 1e-12  # "on the surface": within this time [max(t, T)] of it at its rate
+_HOLD = 10.0  # a held function keeps its start value for _HOLD x that time
+_MAX_ZERO_LENGTH = 8  # zero-length segments in a row before raising
 
 
 def _signed_pow(x, a):
@@ -47,8 +47,12 @@ def _signed_pow(x, a):
 
 def _poly(law, z, zd):
     """The loading branch ``P`` (odd extension past the surfaces)."""
-    return float(sum(c * _signed_pow(z, t.a) * _signed_pow(zd, t.b)
-                     for c, t in zip(law.coefficients, law.terms, strict=True)))
+    return float(
+        sum(
+            c * _signed_pow(z, t.a) * _signed_pow(zd, t.b)
+            for c, t in zip(law.coefficients, law.terms, strict=True)
+        )
+    )
 
 
 def _load(law, z, v, zmax):
@@ -65,9 +69,12 @@ def _unload(law, z, v, zmax):
     set) plus the unloading terms at the signed velocity."""
     s = law.permanent_set
     u = (z - s * zmax) / (1.0 - s) if s else z
-    return _poly(law, u, 0.0) + float(sum(
-        c * _signed_pow(z, t.a) * _signed_pow(v, t.b)
-        for c, t in zip(law.unloading_coefficients, law.unloading, strict=True)))
+    return _poly(law, u, 0.0) + float(
+        sum(
+            c * _signed_pow(z, t.a) * _signed_pow(v, t.b)
+            for c, t in zip(law.unloading_coefficients, law.unloading, strict=True)
+        )
+    )
 
 
 def _force(law, mode, z, v, zmax, clamp=False):
@@ -106,15 +113,21 @@ def _events(law, mode, state):
         out.append((zeta, -1.0, "loss"))
     zmax = state["zmax"]
     if mode == "load":
-        out += [(dz, -1.0, "unload"),
-                (lambda t, y: _load(law, y[0] - y[2], y[1] - y[3], zmax), -1.0, "release")]
+        out += [
+            (dz, -1.0, "unload"),
+            (lambda t, y: _load(law, y[0] - y[2], y[1] - y[3], zmax), -1.0, "release"),
+        ]
     elif mode == "unload":
-        out += [(dz, 1.0, "reload"),
-                (lambda t, y: _unload(law, y[0] - y[2], y[1] - y[3], zmax), -1.0, "release")]
+        out += [
+            (dz, 1.0, "reload"),
+            (lambda t, y: _unload(law, y[0] - y[2], y[1] - y[3], zmax), -1.0, "release"),
+        ]
     elif mode == "clipped":
+
         def resume(t, y):
             z, v = max(y[0] - y[2], 0.0), y[1] - y[3]
             return _load(law, z, v, zmax) if v > 0 else _unload(law, z, v, zmax)
+
         out.append((resume, 1.0, "resume"))
     return out
 
@@ -169,8 +182,17 @@ def _crossing_now(evs, on, trend):
     return None
 
 
-def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, atol=None,
-                       method="DOP853", max_events=100_000):
+def reference_simulate(
+    scenario,
+    law,
+    t_span,
+    y0=None,
+    t_eval=None,
+    rtol=1e-10,
+    atol=None,
+    method="DOP853",
+    max_events=100_000,
+):
     """Simulate with scipy, restarting at events.
 
     Returns
@@ -179,8 +201,15 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
         ``t``, ``y`` (4, n), ``force`` at ``t_eval``; ``events`` list of
         ``(t, kind, y)``; ``y_final``; ``nfev``.
     """
-    m1, m2, k1, c1, A, om, g = (scenario.m1, scenario.m2, scenario.k1, scenario.c1,
-                                scenario.A, scenario.omega, scenario.g)
+    m1, m2, k1, c1, A, om, g = (
+        scenario.m1,
+        scenario.m2,
+        scenario.k1,
+        scenario.c1,
+        scenario.A,
+        scenario.omega,
+        scenario.g,
+    )
     k3, loss = scenario.k3, scenario.mass_loss
     state = {"m2": m2, "zmax": 0.0}
     T = scenario.period
@@ -205,9 +234,14 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
 
         def rhs(tt, yy):
             f = _force(law, mode, yy[0] - yy[2], yy[1] - yy[3], zmax)
-            return [yy[1], -(c1 * yy[1] + (k1 + k3 * yy[0] ** 2) * yy[0] + A * np.sin(om * tt)
-                             + m1 * g + f) / m1,
-                    yy[3], f / m2 - g]
+            return [
+                yy[1],
+                -(c1 * yy[1] + (k1 + k3 * yy[0] ** 2) * yy[0] + A * np.sin(om * tt) + m1 * g + f)
+                / m1,
+                yy[3],
+                f / m2 - g,
+            ]
+
         return rhs
 
     while t < t1:
@@ -219,8 +253,10 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
         if i_now is not None:  # an event at the segment's start: a zero-length segment
             zero_length += 1
             if zero_length > _MAX_ZERO_LENGTH:
-                raise IntegrationError(f"reference integration: the contact mode chatters at "
-                                       f"t = {t!r} ({zero_length} switches at one instant)")
+                raise IntegrationError(
+                    f"reference integration: the contact mode chatters at "
+                    f"t = {t!r} ({zero_length} switches at one instant)"
+                )
             kind = evs[i_now][2]
             record(kind, y)
             mode = _after(law, kind, y, state, loss)
@@ -236,13 +272,24 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
                 def ev(tt, yy, fn=fn, hold=hold, t_hold=t + _HOLD * tau_on):
                     return hold if tt <= t_hold else fn(tt, yy)
             else:
+
                 def ev(tt, yy, fn=fn):
                     return fn(tt, yy)
+
             ev.terminal, ev.direction = True, direction
             fns.append(ev)
         t_start = t
-        sol = solve_ivp(rhs, (t, t1), y, method=method, rtol=rtol, atol=atol, events=fns,
-                        dense_output=True, max_step=T * 0.02)
+        sol = solve_ivp(
+            rhs,
+            (t, t1),
+            y,
+            method=method,
+            rtol=rtol,
+            atol=atol,
+            events=fns,
+            dense_output=True,
+            max_step=T * 0.02,
+        )
         nfev += sol.nfev
         if sol.status == -1:
             raise IntegrationError(f"reference integration failed: {sol.message}")
@@ -251,8 +298,10 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
         if mask.any():
             ys = sol.sol(te[mask])
             out_y[:, mask] = ys
-            out_f[mask] = [_force(law, mode, w1 - w2, v1 - v2, state["zmax"], clamp=True)
-                           for w1, v1, w2, v2 in ys.T]
+            out_f[mask] = [
+                _force(law, mode, w1 - w2, v1 - v2, state["zmax"], clamp=True)
+                for w1, v1, w2, v2 in ys.T
+            ]
         y = sol.y[:, -1].copy()
         t = t_end
         if t_end - t_start > _HOLD * tau_on:
@@ -262,8 +311,9 @@ def reference_simulate(scenario, law, t_span, y0=None, t_eval=None, rtol=1e-10, 
             i = min(fired, key=lambda i: (sol.t_events[i][0], i))
             # a lower-index surface reached at the same instant wins the tie (contact
             # loss before the force reaching zero, as in the kernel)
-            _, on_end, trend_end = _surface_start(evs, rhs, t, y, _TREND_STEP * T,
-                                                  _ON_SURFACE * max(abs(t), T))
+            _, on_end, trend_end = _surface_start(
+                evs, rhs, t, y, _TREND_STEP * T, _ON_SURFACE * max(abs(t), T)
+            )
             j = _crossing_now(evs[:i], on_end[:i], trend_end[:i])
             kind = evs[i if j is None else j][2]
             record(kind, y)

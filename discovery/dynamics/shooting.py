@@ -22,8 +22,14 @@ import numpy as np
 
 from ..errors import IntegrationError
 
-__all__ = ["PeriodMap", "recurrence", "newton_orbit", "floquet_multipliers", "is_stable",
-           "smallest_period"]
+__all__ = [
+    "PeriodMap",
+    "recurrence",
+    "newton_orbit",
+    "floquet_multipliers",
+    "is_stable",
+    "smallest_period",
+]
 
 
 @runtime_checkable

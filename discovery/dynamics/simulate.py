@@ -15,12 +15,20 @@ from .status import message as status_message
 __all__ = ["Trajectory", "simulate", "Tolerances", "MODE_NAMES", "EVENT_NAMES"]
 
 MODE_NAMES = {K.FREE: "free", K.LOAD: "load", K.UNLOAD: "unload", K.CLIPPED: "clipped"}
-EVENT_NAMES = {K.EV_ONSET: "onset", K.EV_LOSS: "loss", K.EV_UNLOAD: "unload",
-               K.EV_RELOAD: "reload", K.EV_RELEASE: "release", K.EV_RESUME: "resume"}
+EVENT_NAMES = {
+    K.EV_ONSET: "onset",
+    K.EV_LOSS: "loss",
+    K.EV_UNLOAD: "unload",
+    K.EV_RELOAD: "reload",
+    K.EV_RELEASE: "release",
+    K.EV_RESUME: "resume",
+}
 # what to check when the vibro-impact kernel fails (after the meaning from .status)
 _HINTS = {
-    K.STEP_BUDGET: (" (a law too stiff or too fast for the machine: check the coefficients' "
-                    "units; API: Tolerances(max_steps=...))"),
+    K.STEP_BUDGET: (
+        " (a law too stiff or too fast for the machine: check the coefficients' "
+        "units; API: Tolerances(max_steps=...))"
+    ),
     K.BLOW_UP: "; check the law's coefficients and signs",
     K.STEP_UNDERFLOW: "; the law may be too stiff for this tolerance",
 }
@@ -50,10 +58,12 @@ class Tolerances:
     hmax_fraction: float = 0.02
 
     def __post_init__(self):
-        for name, spec in (("rtol", Real(0, 1, open_low=True)),
-                           ("atol_scale", Real(0, open_low=True)),
-                           ("max_steps", Real(1, integer=True)),
-                           ("hmax_fraction", Real(0, 1, open_low=True))):
+        for name, spec in (
+            ("rtol", Real(0, 1, open_low=True)),
+            ("atol_scale", Real(0, open_low=True)),
+            ("max_steps", Real(1, integer=True)),
+            ("hmax_fraction", Real(0, 1, open_low=True)),
+        ):
             check(f"Tolerances: {name}", getattr(self, name), spec)
         if not (0 < self.rtol < 1):
             raise InputError(f"rtol must be in (0, 1), got {self.rtol!r}")
@@ -75,8 +85,13 @@ class Tolerances:
         return self.rtol * self.atol_scale
 
     def as_dict(self):
-        return {"rtol": self.rtol, "atol_scale": self.atol_scale, "max_steps": self.max_steps,
-                "hmax_fraction": self.hmax_fraction, "method": "dopri5+events"}
+        return {
+            "rtol": self.rtol,
+            "atol_scale": self.atol_scale,
+            "max_steps": self.max_steps,
+            "hmax_fraction": self.hmax_fraction,
+            "method": "dopri5+events",
+        }
 
 
 @dataclass(frozen=True)
@@ -163,7 +178,7 @@ def kernel_params(scenario, law):
     kernel updates the state slots in place: pass each integration its own copy."""
     p = np.zeros(K.N_PARAMS)
     base = scenario.params()
-    p[:base.size] = base
+    p[: base.size] = base
     p[K.P_SET] = law.permanent_set
     return p
 
@@ -174,11 +189,28 @@ def _atol(scenario, tol):
 
 
 @params(
-    scenario=Scenario, law=ForceLaw, t_span=Array(1), y0=(None, Array(1)), t_eval=(None, Array(1)),
-    tolerances=(Tolerances, None), max_events=Real(1, integer=True), zeta_max0=Real(0),
+    scenario=Scenario,
+    law=ForceLaw,
+    t_span=Array(1),
+    y0=(None, Array(1)),
+    t_eval=(None, Array(1)),
+    tolerances=(Tolerances, None),
+    max_events=Real(1, integer=True),
+    zeta_max0=Real(0),
 )
-def simulate(scenario, law, t_span, y0=None, t_eval=None, *, tolerances=None,
-             max_events=10_000, mode0=None, throw=True, zeta_max0=0.0):
+def simulate(
+    scenario,
+    law,
+    t_span,
+    y0=None,
+    t_eval=None,
+    *,
+    tolerances=None,
+    max_events=10_000,
+    mode0=None,
+    throw=True,
+    zeta_max0=0.0,
+):
     """Integrate the two-body vibro-impact system with a given contact law.
 
     Parameters
@@ -231,18 +263,52 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, tolerances=None,
     p[K.P_ZMAX] = float(zeta_max0)
     announce_compile("vibro-impact")
     status, tf, yf, mf, n_steps, n_ev, _ = K.integrate(
-        t0, t1, y0, -1 if mode0 is None else int(mode0), p, coef,
-        ea, eb, br, tol.rtol, _atol(scenario, tol), period / 100.0, period * tol.hmax_fraction,
-        tol.max_steps, te, out_y, out_f, out_m, ev_t, ev_k, ev_y, ev_m)
-    message = "ok" if status == 0 else (
-        f"integration stopped at t = {tf:.6g} s: {status_message(status, _HINTS)}")
+        t0,
+        t1,
+        y0,
+        -1 if mode0 is None else int(mode0),
+        p,
+        coef,
+        ea,
+        eb,
+        br,
+        tol.rtol,
+        _atol(scenario, tol),
+        period / 100.0,
+        period * tol.hmax_fraction,
+        tol.max_steps,
+        te,
+        out_y,
+        out_f,
+        out_m,
+        ev_t,
+        ev_k,
+        ev_y,
+        ev_m,
+    )
+    message = (
+        "ok"
+        if status == 0
+        else (f"integration stopped at t = {tf:.6g} s: {status_message(status, _HINTS)}")
+    )
     if status and throw:
         raise IntegrationError(message)
     n_keep = min(n_ev, max_events)
     ok_out = te <= tf if status else slice(None)
     return Trajectory(
-        t=te[ok_out], y=out_y[:, ok_out], force=out_f[ok_out], mode=out_m[ok_out],
-        event_t=ev_t[:n_keep].copy(), event_kind=ev_k[:n_keep].copy(),
-        event_y=ev_y[:n_keep].copy(), event_modes=ev_m[:n_keep].copy(),
-        t_final=float(tf), y_final=yf, mode_final=int(mf), n_steps=int(n_steps),
-        status=int(status), message=message, zeta_max0=float(zeta_max0))
+        t=te[ok_out],
+        y=out_y[:, ok_out],
+        force=out_f[ok_out],
+        mode=out_m[ok_out],
+        event_t=ev_t[:n_keep].copy(),
+        event_kind=ev_k[:n_keep].copy(),
+        event_y=ev_y[:n_keep].copy(),
+        event_modes=ev_m[:n_keep].copy(),
+        t_final=float(tf),
+        y_final=yf,
+        mode_final=int(mf),
+        n_steps=int(n_steps),
+        status=int(status),
+        message=message,
+        zeta_max0=float(zeta_max0),
+    )

@@ -7,8 +7,16 @@ Every compiled run returns a status (:data:`OK` or one of the failures below, th
 
 from ..errors import IntegrationError
 
-__all__ = ["OK", "STEP_BUDGET", "BLOW_UP", "STEP_UNDERFLOW", "CHATTER", "MESSAGES", "message",
-           "check"]
+__all__ = [
+    "OK",
+    "STEP_BUDGET",
+    "BLOW_UP",
+    "STEP_UNDERFLOW",
+    "CHATTER",
+    "MESSAGES",
+    "message",
+    "check",
+]
 
 OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW, CHATTER = 0, 1, 2, 3, 4
 

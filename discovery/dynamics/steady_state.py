@@ -85,22 +85,44 @@ class StroboscopicMap:
         if self._memory:
             p[K.P_ZMAX] = self.zeta_max
         status, tf, yf, _, steps, _, _ = K.integrate(
-            t0, t0 + n * self._T, np.asarray(y, dtype=float), -1, p, self._coef,
-            self._ea, self._eb, self._br, self.tol.rtol, self._atol, self._T / 100.0, self._hmax,
-            self.tol.max_steps, self._empty, self._ey, self._ef, self._em, self._evt,
-            self._evk, self._evy, self._evm)
+            t0,
+            t0 + n * self._T,
+            np.asarray(y, dtype=float),
+            -1,
+            p,
+            self._coef,
+            self._ea,
+            self._eb,
+            self._br,
+            self.tol.rtol,
+            self._atol,
+            self._T / 100.0,
+            self._hmax,
+            self.tol.max_steps,
+            self._empty,
+            self._ey,
+            self._ef,
+            self._em,
+            self._evt,
+            self._evk,
+            self._evy,
+            self._evm,
+        )
         self.n_calls += 1
         self.n_steps += steps
         if self._memory and remember:
             self.zeta_max = float(p[K.P_ZMAX])
         if status != K.OK:
-            raise IntegrationError(f"simulation of law '{self.law}' stopped at t = {tf:.6g} s: "
-                                   f"{status_message(status, _HINTS)}")
+            raise IntegrationError(
+                f"simulation of law '{self.law}' stopped at t = {tf:.6g} s: "
+                f"{status_message(status, _HINTS)}"
+            )
         if not np.all(np.abs(yf) < 1e6 * self.scale.max() + 1e3):
             raise IntegrationError(
                 f"simulation of law '{self.law}' left the physical range at t = {tf:.6g} s "
                 "(a displacement over 1e6 times the drive's scale); the law or the scenario "
-                "may be unphysical (negative or huge coefficients, a moulding thrown away)")
+                "may be unphysical (negative or huge coefficients, a moulding thrown away)"
+            )
         return yf
 
     def jacobian(self, y, n=1, fy=None):
@@ -165,28 +187,53 @@ class SteadyState:
         return self.impacts / self.n_periods if self.n_periods else float("nan")
 
     def as_dict(self):
-        return {"regime": self.regime, "n_periods": self.n_periods,
-                "impacts": self.impacts, "impacts_per_period": self.impacts_per_period,
-                "multipliers_abs": [float(abs(m)) for m in self.multipliers],
-                "residual": self.residual, "n_simulations": self.n_simulations}
+        return {
+            "regime": self.regime,
+            "n_periods": self.n_periods,
+            "impacts": self.impacts,
+            "impacts_per_period": self.impacts_per_period,
+            "multipliers_abs": [float(abs(m)) for m in self.multipliers],
+            "residual": self.residual,
+            "n_simulations": self.n_simulations,
+        }
 
     def _lines(self):
         d = self.as_dict()
         mult = np.abs(np.asarray(self.multipliers)) if self.multipliers is not None else []
-        return [f"steady state {d.get('regime')}: {d.get('impacts')} impact(s) per orbit, "
-                f"max |Floquet multiplier| {fmt(np.max(mult) if len(mult) else None)}, "
-                f"residual {fmt(d.get('residual'), 2)}"]
+        return [
+            f"steady state {d.get('regime')}: {d.get('impacts')} impact(s) per orbit, "
+            f"max |Floquet multiplier| {fmt(np.max(mult) if len(mult) else None)}, "
+            f"residual {fmt(d.get('residual'), 2)}"
+        ]
 
 
 @params(
-    scenario=Scenario, law=ForceLaw, transient=Real(0, integer=True),
-    max_period=Real(1, 64, integer=True), tol=Real(0, 1, open_low=True),
-    max_newton=Real(1, integer=True), long_transient=Real(0, integer=True),
-    tolerances=(Tolerances, None), y_start=(None, Array(1)), t_start=Real(),
+    scenario=Scenario,
+    law=ForceLaw,
+    transient=Real(0, integer=True),
+    max_period=Real(1, 64, integer=True),
+    tol=Real(0, 1, open_low=True),
+    max_newton=Real(1, integer=True),
+    long_transient=Real(0, integer=True),
+    tolerances=(Tolerances, None),
+    y_start=(None, Array(1)),
+    t_start=Real(),
     guess=(None, Instance("discovery.dynamics.steady_state", "SteadyState")),
 )
-def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_newton=12,
-                 long_transient=300, tolerances=None, y_start=None, t_start=0.0, guess=None):
+def steady_state(
+    scenario,
+    law,
+    *,
+    transient=30,
+    max_period=8,
+    tol=1e-8,
+    max_newton=12,
+    long_transient=300,
+    tolerances=None,
+    y_start=None,
+    t_start=0.0,
+    guess=None,
+):
     """Find the periodic steady state reached from a given (or the scenario's) state.
 
     Parameters
@@ -231,10 +278,12 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
         as the physical regime "nonperiodic".
     """
     if scenario.mass_loss > 0:
-        raise InputError(f"scenario {scenario.name!r} sheds {scenario.mass_loss:g} of the "
-                         "moulding's mass per impact, so it has no periodic steady state; "
-                         "simulate it from rest (vidi simulate --from-rest) or set "
-                         "mass_loss = 0")
+        raise InputError(
+            f"scenario {scenario.name!r} sheds {scenario.mass_loss:g} of the "
+            "moulding's mass per impact, so it has no periodic steady state; "
+            "simulate it from rest (vidi simulate --from-rest) or set "
+            "mass_loss = 0"
+        )
     pm = StroboscopicMap(scenario, law, tolerances)
     if guess is not None and guess.periodic and law.permanent_set == 0:
         cont = _continued(scenario, law, pm, guess, tol)
@@ -276,16 +325,29 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
             y_orb, res, J, ok = newton_orbit(pm, y, n, tol, max_newton, hist)
             mult = floquet_multipliers(J, len(y))
             stable = bool(ok and is_stable(mult))
-            attempt["tried"].append({"n": n, "newton_residuals": hist, "converged": ok,
-                                     "max_multiplier": float(np.max(np.abs(mult))),
-                                     "stable": stable})
+            attempt["tried"].append(
+                {
+                    "n": n,
+                    "newton_residuals": hist,
+                    "converged": ok,
+                    "max_multiplier": float(np.max(np.abs(mult))),
+                    "stable": stable,
+                }
+            )
             if not stable:
                 continue
             reduced = smallest_period(pm, y_orb, n, tol, max_newton) if n > 1 else None
             if reduced is not None:
                 m, y_orb, res, J, hist_m = reduced
-                attempt["tried"].append({"n": m, "reduced_from": n, "newton_residuals": hist_m,
-                                         "converged": True, "stable": True})
+                attempt["tried"].append(
+                    {
+                        "n": m,
+                        "reduced_from": n,
+                        "newton_residuals": hist_m,
+                        "converged": True,
+                        "stable": True,
+                    }
+                )
                 n, mult = m, floquet_multipliers(J)
             t0 = t_done * T
             zmax = 0.0
@@ -294,12 +356,29 @@ def steady_state(scenario, law, *, transient=30, max_period=8, tol=1e-8, max_new
                 pm.advance(y_orb, n)
                 zmax = pm.zeta_max
             impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n, zmax)
-            return SteadyState(regime=f"P{n}", n_periods=n, y0=y_orb, t0=t0, impacts=impacts,
-                               multipliers=mult, residual=float(res),
-                               n_simulations=pm.n_calls, evidence=evidence, zeta_max0=zmax)
-    return SteadyState(regime="nonperiodic", n_periods=0, y0=y, t0=t_done * T,
-                       impacts=0, multipliers=np.full(4, np.nan + 0j), residual=float("nan"),
-                       n_simulations=pm.n_calls, evidence=evidence)
+            return SteadyState(
+                regime=f"P{n}",
+                n_periods=n,
+                y0=y_orb,
+                t0=t0,
+                impacts=impacts,
+                multipliers=mult,
+                residual=float(res),
+                n_simulations=pm.n_calls,
+                evidence=evidence,
+                zeta_max0=zmax,
+            )
+    return SteadyState(
+        regime="nonperiodic",
+        n_periods=0,
+        y0=y,
+        t0=t_done * T,
+        impacts=0,
+        multipliers=np.full(4, np.nan + 0j),
+        residual=float("nan"),
+        n_simulations=pm.n_calls,
+        evidence=evidence,
+    )
 
 
 CONTINUATION_NEWTON = 4
@@ -311,8 +390,9 @@ def _continued(scenario, law, pm, guess, tol):
     n = guess.n_periods
     hist = []
     try:
-        y_orb, res, J, ok = newton_orbit(pm, np.asarray(guess.y0, dtype=float), n, tol,
-                                         CONTINUATION_NEWTON, hist)
+        y_orb, res, J, ok = newton_orbit(
+            pm, np.asarray(guess.y0, dtype=float), n, tol, CONTINUATION_NEWTON, hist
+        )
     except IntegrationError:
         return None
     mult = floquet_multipliers(J, len(y_orb))
@@ -320,15 +400,28 @@ def _continued(scenario, law, pm, guess, tol):
         return None
     if n > 1 and smallest_period(pm, y_orb, n, tol, CONTINUATION_NEWTON) is not None:
         return None  # the period reduces here: let the cold search decide
-    evidence = {"attempts": [], "t_start": float(guess.t0),
-                "continued_from": {"regime": guess.regime, "newton_residuals": hist}}
+    evidence = {
+        "attempts": [],
+        "t_start": float(guess.t0),
+        "continued_from": {"regime": guess.regime, "newton_residuals": hist},
+    }
     impacts = _count_onsets(scenario, law, pm.tol, y_orb, guess.t0, n, 0.0)
-    return SteadyState(regime=f"P{n}", n_periods=n, y0=y_orb, t0=guess.t0, impacts=impacts,
-                       multipliers=mult, residual=float(res), n_simulations=pm.n_calls,
-                       evidence=evidence, zeta_max0=0.0)
+    return SteadyState(
+        regime=f"P{n}",
+        n_periods=n,
+        y0=y_orb,
+        t0=guess.t0,
+        impacts=impacts,
+        multipliers=mult,
+        residual=float(res),
+        n_simulations=pm.n_calls,
+        evidence=evidence,
+        zeta_max0=0.0,
+    )
 
 
 def _count_onsets(scenario, law, tol, y0, t0, n, zeta_max0=0.0):
-    tr = simulate(scenario, law, (t0, t0 + n * scenario.period), y0=y0, tolerances=tol,
-                  zeta_max0=zeta_max0)
+    tr = simulate(
+        scenario, law, (t0, t0 + n * scenario.period), y0=y0, tolerances=tol, zeta_max0=zeta_max0
+    )
     return int(np.sum(tr.event_kind == K.EV_ONSET))

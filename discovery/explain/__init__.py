@@ -7,12 +7,32 @@ score tests of the catalogue's effects (:data:`EFFECTS`) -> refit -> :func:`expl
 
 from .._lazy import lazy_package
 
-_EXPORTS = {"EFFECTS": "effects", "Effect": "effects", "Model": "effects", "effect": "effects",
-            "first_order_lag": "effects", "ExplainResult": "explain", "Iteration": "explain",
-            "explain": "explain", "start_law": "explain", "PHASES": "localise",
-            "localise": "localise"}
+_EXPORTS = {
+    "EFFECTS": "effects",
+    "Effect": "effects",
+    "Model": "effects",
+    "effect": "effects",
+    "first_order_lag": "effects",
+    "ExplainResult": "explain",
+    "Iteration": "explain",
+    "explain": "explain",
+    "start_law": "explain",
+    "PHASES": "localise",
+    "localise": "localise",
+}
 
-__all__ = ["explain", "ExplainResult", "Iteration", "EFFECTS", "Effect", "Model", "effect",
-           "first_order_lag", "localise", "PHASES", "start_law"]
+__all__ = [
+    "explain",
+    "ExplainResult",
+    "Iteration",
+    "EFFECTS",
+    "Effect",
+    "Model",
+    "effect",
+    "first_order_lag",
+    "localise",
+    "PHASES",
+    "start_law",
+]
 
 lazy_package(__name__, _EXPORTS)

@@ -27,8 +27,14 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.stats import chi2
 
-__all__ = ["DriftRecord", "drift_residual", "drift_criterion", "drift_score", "fit_drift",
-           "noise_of"]
+__all__ = [
+    "DriftRecord",
+    "drift_residual",
+    "drift_criterion",
+    "drift_score",
+    "fit_drift",
+    "noise_of",
+]
 
 
 @dataclass(frozen=True)
@@ -66,8 +72,7 @@ class DriftRecord:
                 continue
             J.append(float(np.sum(F[m]) * dt))
             before.append((k - k0) * impacts_per_orbit)
-        return cls(impulses=np.array(J), impacts_before=np.array(before, dtype=float),
-                   window=W)
+        return cls(impulses=np.array(J), impacts_before=np.array(before, dtype=float), window=W)
 
     @property
     def n_impacts(self):
@@ -124,14 +129,17 @@ def fit_drift(pairs, h, hi=0.5):
     w = [1.0 / noise_of(drift_residual(sc, rec, 0.0)) ** 2 for sc, rec in pairs]
 
     def cost(loss):
-        return sum(wi * float(np.sum(drift_residual(sc, rec, loss) ** 2))
-                   for wi, (sc, rec) in zip(w, pairs, strict=True))
+        return sum(
+            wi * float(np.sum(drift_residual(sc, rec, loss) ** 2))
+            for wi, (sc, rec) in zip(w, pairs, strict=True)
+        )
 
     # the cost is cheap (no simulation) but flat for large losses (the prediction decays
     # to nothing): a grid finds the basin, a bounded search polishes it
     grid = np.linspace(0.0, min(hi, 100 * h), 401)
     k = int(np.argmin([cost(x) for x in grid]))
     lo, up = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
-    opt = minimize_scalar(cost, bounds=(lo, up), method="bounded",
-                          options={"xatol": 1e-4 * h, "maxiter": 60})
+    opt = minimize_scalar(
+        cost, bounds=(lo, up), method="bounded", options={"xatol": 1e-4 * h, "maxiter": 60}
+    )
     return float(opt.x) if opt.fun <= cost(grid[k]) else float(grid[k])

@@ -21,8 +21,16 @@ import numpy as np
 from ..errors import InputError
 from ..law import ForceLaw, Term
 
-__all__ = ["Parameter", "Effect", "Model", "EFFECTS", "TARGETS", "effect", "first_order_lag",
-           "small_step"]
+__all__ = [
+    "Parameter",
+    "Effect",
+    "Model",
+    "EFFECTS",
+    "TARGETS",
+    "effect",
+    "first_order_lag",
+    "small_step",
+]
 
 #: where an effect's parameter can enter a model
 TARGETS = ("term", "unloading", "set", "scenario", "observation")
@@ -88,12 +96,20 @@ class Effect:
         return model.value(self) == 0.0
 
     def as_dict(self):
-        return {"id": self.id, "title": self.title, "explanation": self.explanation,
-                "enters": self.enters, "signature": self.signature,
-                "parameters": [{"name": p.name, "unit": p.unit, "bounds": list(p.bounds)}
-                               for p in self.parameters],
-                "phases": list(self.phases), "target": self.target, "key": self.key,
-                "departs_from_paper": self.departs}
+        return {
+            "id": self.id,
+            "title": self.title,
+            "explanation": self.explanation,
+            "enters": self.enters,
+            "signature": self.signature,
+            "parameters": [
+                {"name": p.name, "unit": p.unit, "bounds": list(p.bounds)} for p in self.parameters
+            ],
+            "phases": list(self.phases),
+            "target": self.target,
+            "key": self.key,
+            "departs_from_paper": self.departs,
+        }
 
 
 def first_order_lag(impulse, tau):
@@ -115,14 +131,24 @@ def first_order_lag(impulse, tau):
     on = G > 1e-9 * max(float(np.max(G)), 1e-300)
     starts = np.flatnonzero(np.diff(np.concatenate([[False], on]).astype(np.int8)) == 1)
     ends = np.flatnonzero(np.diff(np.concatenate([on, [False]]).astype(np.int8)) == -1)
-    support = np.column_stack([t[starts], np.minimum(t[ends] + W / n, W)]) if starts.size \
+    support = (
+        np.column_stack([t[starts], np.minimum(t[ends] + W / n, W)])
+        if starts.size
         else np.zeros((0, 2))
+    )
     tt = np.concatenate([t, [W]])
     GG = np.concatenate([G, G[:1]])
     from ..impulse import Impulse
 
-    return Impulse(t=tt, F=GG, duration=W, support=support, n_periods=impulse.n_periods,
-                   onset=impulse.onset, onsets=impulse.onsets)
+    return Impulse(
+        t=tt,
+        F=GG,
+        duration=W,
+        support=support,
+        n_periods=impulse.n_periods,
+        onset=impulse.onset,
+        onsets=impulse.onsets,
+    )
 
 
 _OBSERVATIONS = {"sensor_lag": first_order_lag}
@@ -136,7 +162,7 @@ def _set_term(terms, coefs, name, value):
     t = _term(name)
     if t in terms:
         i = terms.index(t)
-        coefs = coefs[:i] + (float(value),) + coefs[i + 1:]
+        coefs = coefs[:i] + (float(value),) + coefs[i + 1 :]
         return terms, coefs
     return terms + (t,), coefs + (float(value),)
 
@@ -169,8 +195,7 @@ class Model:
         if eff.target == "term":
             return law.as_dict().get(_term(key).name, 0.0)
         if eff.target == "unloading":
-            d = dict(zip([t.name for t in law.unloading], law.unloading_coefficients,
-                         strict=True))
+            d = dict(zip([t.name for t in law.unloading], law.unloading_coefficients, strict=True))
             return d.get(_term(key).name, 0.0)
         if eff.target == "set":
             return law.permanent_set
@@ -183,8 +208,12 @@ class Model:
         effect's id recorded)."""
         law, obs, scen = self.law, dict(self.observation), dict(self.scenario)
         if eff.target == "term":
-            law = ForceLaw(*_set_term(law.terms, law.coefficients, eff.key, value),
-                           law.unloading, law.unloading_coefficients, law.permanent_set)
+            law = ForceLaw(
+                *_set_term(law.terms, law.coefficients, eff.key, value),
+                law.unloading,
+                law.unloading_coefficients,
+                law.permanent_set,
+            )
         elif eff.target == "unloading":
             terms, coefs = _set_term(law.unloading, law.unloading_coefficients, eff.key, value)
             law = law.with_unloading(terms, coefs)
@@ -203,8 +232,11 @@ class Model:
     # ------------------------------------------- the parameters identify() fits
     def _free(self):
         """Added effects whose parameter is not a coefficient of the loading law."""
-        return [e for e in (effect(i) for i in self.effects)
-                if e.target != "term" and "drift" not in e.phases]
+        return [
+            e
+            for e in (effect(i) for i in self.effects)
+            if e.target != "term" and "drift" not in e.phases
+        ]
 
     @property
     def coefficients(self):
@@ -249,12 +281,19 @@ class Model:
 
     def as_dict(self):
         law = self.law
-        return {"terms": list(law.names), "coefficients": law.as_dict(),
-                "unloading": dict(zip([t.name for t in law.unloading],
-                                      law.unloading_coefficients, strict=True)),
-                "permanent_set": law.permanent_set, "scenario": dict(self.scenario),
-                "observation": dict(self.observation), "effects": list(self.effects),
-                "latex": law.latex(), "text": law.to_text()}
+        return {
+            "terms": list(law.names),
+            "coefficients": law.as_dict(),
+            "unloading": dict(
+                zip([t.name for t in law.unloading], law.unloading_coefficients, strict=True)
+            ),
+            "permanent_set": law.permanent_set,
+            "scenario": dict(self.scenario),
+            "observation": dict(self.observation),
+            "effects": list(self.effects),
+            "latex": law.latex(),
+            "text": law.to_text(),
+        }
 
     def __str__(self):
         extra = [f"{k} = {v:.4g}" for k, v in sorted(self.scenario.items())]
@@ -285,90 +324,111 @@ EFFECTS = (
         id="penetration_velocity_coupling",
         title="Penetration-velocity coupling (Hunt-Crossley type damping)",
         explanation="The contact's damping grows with the penetration: a damping term "
-                    "z*zd. The force then starts near zero instead of jumping at the onset, "
-                    "its maximum moves from the onset toward the middle of the impact (the "
-                    "paper's Fig. 8), and the restitution falls as the impact velocity rises.",
+        "z*zd. The force then starts near zero instead of jumping at the onset, "
+        "its maximum moves from the onset toward the middle of the impact (the "
+        "paper's Fig. 8), and the restitution falls as the impact velocity rises.",
         enters="a force-law term c*z*zd, c >= 0",
         signature="onset jump and early loading smaller than a linear damper's; the peak "
-                  "later in the impact",
+        "later in the impact",
         parameters=(Parameter("c_z_zd", "N s/m^2", (0.0, np.inf)),),
-        phases=("onset", "loading", "peak"), target="term", key="z*zd"),
+        phases=("onset", "loading", "peak"),
+        target="term",
+        key="z*zd",
+    ),
     Effect(
         id="hertzian_stiffening",
         title="Hertzian stiffening",
         explanation="Contact stiffness that rises with the penetration, as for curved "
-                    "elastic bodies (Hertz: F ~ z^1.5). The contact time then shortens as the "
-                    "impact velocity rises.",
+        "elastic bodies (Hertz: F ~ z^1.5). The contact time then shortens as the "
+        "impact velocity rises.",
         enters="a force-law term k*z^1.5, k >= 0",
         signature="the force grows faster than linearly late in loading; a shorter contact",
         parameters=(Parameter("k_z1.5", "N/m^1.5", (0.0, np.inf)),),
-        phases=("loading", "peak", "unloading"), target="term", key="z^1.5"),
+        phases=("loading", "peak", "unloading"),
+        target="term",
+        key="z^1.5",
+    ),
     Effect(
         id="unloading_damping",
         title="Damping while unloading",
         explanation="The contact dissipates energy in restitution too (wet sand, a rubber "
-                    "pad): a damper that keeps acting while the bodies separate, so the "
-                    "force falls below the elastic branch and reaches zero before the "
-                    "penetration does; the bodies then part with the surface still "
-                    "indented.",
+        "pad): a damper that keeps acting while the bodies separate, so the "
+        "force falls below the elastic branch and reaches zero before the "
+        "penetration does; the bodies then part with the surface still "
+        "indented.",
         enters="a term d*zd of the law's unloading branch (acting at the signed velocity, "
-               "lowering the force while the bodies separate), d >= 0",
+        "lowering the force while the bodies separate), d >= 0",
         signature="the force reaches zero before zeta does; a weaker unloading and an "
-                  "earlier end of the force",
+        "earlier end of the force",
         parameters=(Parameter("d_zd", "N s/m", (0.0, np.inf)),),
-        phases=("unloading", "separation"), target="unloading", key="zd",
+        phases=("unloading", "separation"),
+        target="unloading",
+        key="zd",
         departs="the paper's condition (5) (a negative penetration velocity has no effect "
-                "on the force): a real contact can dissipate energy while unloading, and "
-                "its restitution is then lower than any law obeying (5) with the same "
-                "loading can give"),
+        "on the force): a real contact can dissipate energy while unloading, and "
+        "its restitution is then lower than any law obeying (5) with the same "
+        "loading can give",
+    ),
     Effect(
         id="permanent_set",
         title="Permanent set (plastic indentation, Walton-Braun)",
         explanation="The moulding's sand (or the grid's pad) yields under load: unloading "
-                    "is stiffer than loading and ends at a residual penetration, a share s "
-                    "of the impact's largest one (linear law: loading k*z, unloading "
-                    "k/(1-s)*(z - s*z_max)). The set is recovered between impacts.",
+        "is stiffer than loading and ends at a residual penetration, a share s "
+        "of the impact's largest one (linear law: loading k*z, unloading "
+        "k/(1-s)*(z - s*z_max)). The set is recovered between impacts.",
         enters="the law's permanent-set fraction s in [0, 0.95]",
         signature="unloading ends at a residual penetration: the force drops to zero "
-                  "before the bodies separate, faster than the loading rose",
+        "before the bodies separate, faster than the loading rose",
         parameters=(Parameter("set", "1", (0.0, 0.95)),),
-        phases=("unloading", "separation"), target="set", key="permanent_set",
+        phases=("unloading", "separation"),
+        target="set",
+        key="permanent_set",
         departs="the paper's elastic unloading P(zeta, 0): a plastic contact does not give "
-                "back its loading energy, whatever the velocity"),
+        "back its loading energy, whatever the velocity",
+    ),
     Effect(
         id="support_nonlinearity",
         title="Stiffening grid supports",
         explanation="The grid's springs stiffen with the deflection (rubber buffers, coil "
-                    "springs closing up): their force is k1*w1 + k3*w1^3. The grid's free "
-                    "motion, and with it the impact velocity, depart from a linear "
-                    "suspension's.",
+        "springs closing up): their force is k1*w1 + k3*w1^3. The grid's free "
+        "motion, and with it the impact velocity, depart from a linear "
+        "suspension's.",
         enters="the supports' cubic stiffness k3 >= 0 (a machine parameter)",
         signature="the disagreement lies in the grid's free motion; the impacts shift with it",
         parameters=(Parameter("k3", "N/m^3", (0.0, np.inf)),),
-        phases=("grid", "free", "onset"), target="scenario", key="k3"),
+        phases=("grid", "free", "onset"),
+        target="scenario",
+        key="k3",
+    ),
     Effect(
         id="mass_loss",
         title="Mass shed at every impact",
         explanation="The moulding loses sand at each impact, so its mass falls through the "
-                    "record: the impacts drift (the peak force and the contact change "
-                    "impact by impact) and the record has no steady state. It shows only "
-                    "across the impacts of a record, not in its averaged cycle.",
+        "record: the impacts drift (the peak force and the contact change "
+        "impact by impact) and the record has no steady state. It shows only "
+        "across the impacts of a record, not in its averaged cycle.",
         enters="the share of the moulding's mass shed per impact, in [0, 0.5] (a machine "
-               "parameter); fitted on the one-period-ahead predictions of every period",
+        "parameter); fitted on the one-period-ahead predictions of every period",
         signature="a trend of the peak force across the impacts that the model's "
-                  "predictions from the record's own states do not follow",
+        "predictions from the record's own states do not follow",
         parameters=(Parameter("loss", "1/impact", (0.0, 0.5)),),
-        phases=("drift",), target="scenario", key="mass_loss"),
+        phases=("drift",),
+        target="scenario",
+        key="mass_loss",
+    ),
     Effect(
         id="sensor_lag",
         title="Force-sensor lag",
         explanation="The force sensor (or its amplifier and filter) has its own dynamics: a "
-                    "first-order low-pass tau F' + F = F_true. The recorded onset is smeared "
-                    "and the whole impulse lags.",
+        "first-order low-pass tau F' + F = F_true. The recorded onset is smeared "
+        "and the whole impulse lags.",
         enters="an observation model on the simulated force (the simulation is unchanged)",
         signature="a smeared onset, a phase lag, force after the separation",
         parameters=(Parameter("tau", "s", (0.0, 5e-3)),),
-        phases=("onset", "separation"), target="observation", key="sensor_lag"),
+        phases=("onset", "separation"),
+        target="observation",
+        key="sensor_lag",
+    ),
 )
 
 
@@ -377,5 +437,6 @@ def effect(effect_id):
     for e in EFFECTS:
         if e.id == effect_id:
             return e
-    raise InputError(f"unknown effect {effect_id!r}; the catalogue has "
-                     f"{', '.join(e.id for e in EFFECTS)}")
+    raise InputError(
+        f"unknown effect {effect_id!r}; the catalogue has {', '.join(e.id for e in EFFECTS)}"
+    )

@@ -71,7 +71,6 @@ from .localise import localise
 __all__ = ["ExplainResult", "Iteration", "explain", "start_law"]
 
 
-
 def _present(eff, model, res):
     """The effect's parameter is away from 0 by more than 2 standard errors."""
     name = eff.parameters[0].name
@@ -137,17 +136,25 @@ class Iteration:
     measured: object = None
 
     def as_dict(self):
-        return {"effect": self.effect, "evidence": self.evidence,
-                "criteria_before": self.criteria_before, "criteria_after": self.criteria_after,
-                "noise_floor": self.noise_floor, "parameters": _parameters(self),
-                "model_before": self.model_before.as_dict(),
-                "model_after": self.model_after.as_dict(), "scores": self.scores,
-                "equivalent": self.equivalent,
-                "localisation": {"phases": self.localisation["phases"],
-                                 "grid": self.localisation.get("grid"),
-                                 "drift": self.localisation.get("drift"),
-                                 "sigma": self.localisation["sigma"],
-                                 "rms": self.localisation["rms"]}}
+        return {
+            "effect": self.effect,
+            "evidence": self.evidence,
+            "criteria_before": self.criteria_before,
+            "criteria_after": self.criteria_after,
+            "noise_floor": self.noise_floor,
+            "parameters": _parameters(self),
+            "model_before": self.model_before.as_dict(),
+            "model_after": self.model_after.as_dict(),
+            "scores": self.scores,
+            "equivalent": self.equivalent,
+            "localisation": {
+                "phases": self.localisation["phases"],
+                "grid": self.localisation.get("grid"),
+                "drift": self.localisation.get("drift"),
+                "sigma": self.localisation["sigma"],
+                "rms": self.localisation["rms"],
+            },
+        }
 
 
 def _parameters(it):
@@ -201,24 +208,37 @@ class ExplainResult:
     intervals: object = None
 
     def as_dict(self):
-        return {"iterations": [it.as_dict() for it in self.iterations],
-                "final_model": {**self.final_model.as_dict(),
-                                "uncertainties": self.uncertainties,
-                                "intervals": None if self.intervals is None
-                                else self.intervals.as_dict()},
-                "criteria": self.criteria, "noise_floor": self.noise_floor,
-                "consistent": self.consistent, "stopped_because": self.stopped_because,
-                "separability": list(self.separability), "seconds": self.seconds}
+        return {
+            "iterations": [it.as_dict() for it in self.iterations],
+            "final_model": {
+                **self.final_model.as_dict(),
+                "uncertainties": self.uncertainties,
+                "intervals": None if self.intervals is None else self.intervals.as_dict(),
+            },
+            "criteria": self.criteria,
+            "noise_floor": self.noise_floor,
+            "consistent": self.consistent,
+            "stopped_because": self.stopped_because,
+            "separability": list(self.separability),
+            "seconds": self.seconds,
+        }
 
     def _lines(self):
         named = [it.effect for it in self.iterations if it.effect]
-        out = [f"final model {self.final_model.law}"
-               + (f" with {', '.join(named)}" if named else " (nothing named)") + ": "
-               f"{'consistent' if self.consistent else 'NOT consistent'} with the record(s)"]
+        out = [
+            f"final model {self.final_model.law}"
+            + (f" with {', '.join(named)}" if named else " (nothing named)")
+            + ": "
+            f"{'consistent' if self.consistent else 'NOT consistent'} with the record(s)"
+        ]
         for k, it in enumerate(self.iterations):
             key = next((c for c in ("I2", "D") if c in it.criteria_after), None)
-            gap = (f"{key} {fmt(it.criteria_before.get(key), 3)} -> "
-                   f"{fmt(it.criteria_after.get(key), 3)}" if key else "")
+            gap = (
+                f"{key} {fmt(it.criteria_before.get(key), 3)} -> "
+                f"{fmt(it.criteria_after.get(key), 3)}"
+                if key
+                else ""
+            )
             out.append(f"  iteration {k + 1}: {it.effect or 'nothing named'}  {gap}")
         out += criteria_lines(self.criteria, self.noise_floor)
         out.append(f"  stopped because {self.stopped_because}")
@@ -234,8 +254,16 @@ def _polish_start(records, fit, criterion, budget, tol):
     has left the start's basin without explaining the record)."""
     scs, refs = [s for s, _ in records], [r for _, r in records]
     try:
-        res = identify(scs, refs, fit.law, criterion=criterion, method="least-squares",
-                       max_simulations=budget, tolerances=tol, short_first=False)
+        res = identify(
+            scs,
+            refs,
+            fit.law,
+            criterion=criterion,
+            method="least-squares",
+            max_simulations=budget,
+            tolerances=tol,
+            short_first=False,
+        )
     except (IntegrationError, InputError):
         return fit
     same = all(e.impacts["simulated"] == e.impacts["measured"] for e in res.evaluations)
@@ -244,11 +272,16 @@ def _polish_start(records, fit, criterion, budget, tol):
     if not (same and res.value <= v0):
         return fit
     se = fit.standard_errors
-    near = all(abs(b - a) <= 3.0 * se.get(n, 0.0) for n, a, b in
-               zip(fit.law.names, fit.law.coefficients, res.law.coefficients, strict=True))
+    near = all(
+        abs(b - a) <= 3.0 * se.get(n, 0.0)
+        for n, a, b in zip(fit.law.names, fit.law.coefficients, res.law.coefficients, strict=True)
+    )
     # a far move is kept only when it reaches a law consistent with every record
-    return res if near or all(evaluate(sc, res.law, ref, tolerances=tol).consistent
-                              for sc, ref in records) else fit
+    return (
+        res
+        if near or all(evaluate(sc, res.law, ref, tolerances=tol).consistent for sc, ref in records)
+        else fit
+    )
 
 
 def _separability(problem, records, model, catalogue, criterion, before, floor, budget, tol):
@@ -261,19 +294,26 @@ def _separability(problem, records, model, catalogue, criterion, before, floor, 
     for e in catalogue:
         if not e.applicable(model) or "drift" in e.phases:
             continue
-        row = {"effect": e.id, "criterion": criterion, "before": before.get(criterion),
-               "floor": floor.get(criterion)}
+        row = {
+            "effect": e.id,
+            "criterion": criterion,
+            "before": before.get(criterion),
+            "floor": floor.get(criterion),
+        }
         try:
-            res = _output_error(records, _extend(model, e, _small_step(e, records)),
-                                criterion, budget, tol)
+            res = _output_error(
+                records, _extend(model, e, _small_step(e, records)), criterion, budget, tol
+            )
             row["after"] = float(problem.value(res.law, criterion))  # as ``before``
             row["parameter"] = float(res.law.value(e)) if hasattr(res.law, "value") else None
         except IntegrationError as exc:
             row["after"], row["note"] = None, f"refit failed: {exc}"
-        gain = None if row["after"] is None or row["before"] is None else \
-            row["before"] - row["after"]
-        row["separable"] = bool(gain is not None and row["floor"] is not None
-                                and gain > row["floor"])
+        gain = (
+            None if row["after"] is None or row["before"] is None else row["before"] - row["after"]
+        )
+        row["separable"] = bool(
+            gain is not None and row["floor"] is not None and gain > row["floor"]
+        )
         out.append(row)
     return out
 
@@ -293,14 +333,22 @@ def _regression(names, scenarios, measurements, loading=False):
     from ..samples import contact_samples, join_samples
 
     try:
-        samples = join_samples([contact_samples(m, period=sc.period)
-                                for sc, m in zip(scenarios, measurements, strict=True)])
+        samples = join_samples(
+            [
+                contact_samples(m, period=sc.period)
+                for sc, m in zip(scenarios, measurements, strict=True)
+            ]
+        )
         keep = samples.dzeta > 0 if loading else np.ones(len(samples), dtype=bool)
         if np.count_nonzero(keep) < 10 * len(names):
             return None
         est = ConstrainedSparseRegressor(library=",".join(names), max_terms=len(names))
-        est.fit(samples.X[keep], samples.F[keep], groups=samples.impact[keep],
-                sample_weight=samples.weight[keep])
+        est.fit(
+            samples.X[keep],
+            samples.F[keep],
+            groups=samples.impact[keep],
+            sample_weight=samples.weight[keep],
+        )
     except (InputError, ValueError):
         return None
     full = [c for c in est.candidates_ if len(c.terms) == len(names)]
@@ -329,8 +377,10 @@ def _start_candidates(text, records, measurements):
     each."""
     text = str(text).strip()
     if not text:
-        raise InputError("--start is empty; give 'linear', a term list such as 'z,zd' or a "
-                         "law such as '2e8*z + 1e7*zd'")
+        raise InputError(
+            "--start is empty; give 'linear', a term list such as 'z,zd' or a "
+            "law such as '2e8*z + 1e7*zd'"
+        )
     if text != "linear" and "," not in text and _HAS_COEFFICIENT.search(text):
         return [ForceLaw.parse(text)], []
     names = ["z", "zd"] if text == "linear" else [n.strip() for n in text.split(",") if n.strip()]
@@ -349,15 +399,23 @@ def _start_candidates(text, records, measurements):
         # (a short contact's few noisy penetration samples can bias one coefficient only)
         for mask in itertools.product((0, 1), repeat=len(names)):
             if 0 < sum(mask) < len(names):
-                others.append(reg.with_coefficients([(phys if m else reg).coefficients[i]
-                                                     for i, m in enumerate(mask)]))
+                others.append(
+                    reg.with_coefficients(
+                        [(phys if m else reg).coefficients[i] for i, m in enumerate(mask)]
+                    )
+                )
     # softer springs: a contact that damping ends early (the paper's law unloads
     # elastically, so the contact lasts at least a quarter of the spring's period) is far
     # shorter than the half period the contact-time stiffness assumes
     for f in (0.25, 0.25**2, 0.25**3):
-        others.append(phys.with_coefficients([c * f if t.b == 0 else c
-                                              for t, c in zip(phys.terms, phys.coefficients,
-                                                              strict=True)]))
+        others.append(
+            phys.with_coefficients(
+                [
+                    c * f if t.b == 0 else c
+                    for t, c in zip(phys.terms, phys.coefficients, strict=True)
+                ]
+            )
+        )
     return ([reg] if reg is not None else []), others
 
 
@@ -380,9 +438,17 @@ class _Problem:
         evs = []
         for sc, ref in self.records:
             self.n_sim += 1
-            evs.append(evaluate(model.apply(sc), model.law, ref, tolerances=self.tol,
-                                floor=floor, observe=model.observe(),
-                                smooth_onset=smooth_onset))
+            evs.append(
+                evaluate(
+                    model.apply(sc),
+                    model.law,
+                    ref,
+                    tolerances=self.tol,
+                    floor=floor,
+                    observe=model.observe(),
+                    smooth_onset=smooth_onset,
+                )
+            )
         return evs
 
     def residual(self, model):
@@ -390,8 +456,13 @@ class _Problem:
         evs = self.evaluations(model, smooth_onset=True)
         if not all(e.status == "ok" for e in evs):
             return None
-        return np.concatenate([S.F - E.F for e, (_, ref) in zip(evs, self.records, strict=True)
-                               for E, S in cycle_pairs(e, ref)])
+        return np.concatenate(
+            [
+                S.F - E.F
+                for e, (_, ref) in zip(evs, self.records, strict=True)
+                for E, S in cycle_pairs(e, ref)
+            ]
+        )
 
     def value(self, model, criterion):
         """The mean ``criterion`` over records (inf when a record has no steady cycle)."""
@@ -401,8 +472,11 @@ class _Problem:
         return float(np.mean([e.criteria[criterion] for e in evs]))
 
     def sigma(self):
-        s = [ref.noise["F"] / np.sqrt(max(ref.noise["n_cycles"], 1))
-             for _, ref in self.records if ref.noise]
+        s = [
+            ref.noise["F"] / np.sqrt(max(ref.noise["n_cycles"], 1))
+            for _, ref in self.records
+            if ref.noise
+        ]
         return float(np.sqrt(np.mean(np.square(s)))) if s else 0.0
 
 
@@ -423,20 +497,29 @@ class _Drift:
 
     def criterion(self, model):
         """Mean ``D`` over records and its noise floor."""
-        out = [D.drift_criterion(D.drift_residual(sc, rec, self._loss(model)), rec)
-               for sc, rec in self._pairs(model)]
+        out = [
+            D.drift_criterion(D.drift_residual(sc, rec, self._loss(model)), rec)
+            for sc, rec in self._pairs(model)
+        ]
         return float(np.mean([d for d, _ in out])), float(np.mean([f for _, f in out]))
 
     def score(self, model, eff, h):
         lm, p, direction = D.drift_score(self._pairs(model), self._loss(model), h)
-        return {"effect": eff.id, "lm": lm, "p": p, "significant": False,
-                "direction": direction, "channel": "drift"}
+        return {
+            "effect": eff.id,
+            "lm": lm,
+            "p": p,
+            "significant": False,
+            "direction": direction,
+            "channel": "drift",
+        }
 
     def refit(self, model, eff, h):
         """The model with the loss that fits the drift (the law is not refitted: the
         drift channel does not depend on it)."""
-        return model.with_effect(eff, D.fit_drift(self._pairs(model), h,
-                                                  hi=eff.parameters[0].bounds[1]))
+        return model.with_effect(
+            eff, D.fit_drift(self._pairs(model), h, hi=eff.parameters[0].bounds[1])
+        )
 
 
 def _with_drift(crit, floor, drift, model):
@@ -461,8 +544,12 @@ def _within_noise(evs, criterion):
     """Every record in the measured regime with ``criterion`` within its consistency limit
     (:func:`discovery.verify.consistency_limits`)."""
     for e in evs:
-        if e.status != "ok" or e.regime["simulated"] != e.regime["measured"] \
-                or e.impacts["simulated"] != e.impacts["measured"] or not e.noise_floor:
+        if (
+            e.status != "ok"
+            or e.regime["simulated"] != e.regime["measured"]
+            or e.impacts["simulated"] != e.impacts["measured"]
+            or not e.noise_floor
+        ):
             return False
         lim = e.limits
         if criterion not in lim or not e.criteria[criterion] <= lim[criterion]:
@@ -538,8 +625,13 @@ def _score(problem, model, r0, J, eff, records, sigma):
     r1 = problem.residual(_extend(model, eff, h))
     r2 = problem.residual(_extend(model, eff, 2 * h)) if r1 is not None else None
     if r2 is None or sigma <= 0:
-        return {"effect": eff.id, "lm": None, "p": None, "significant": False,
-                "note": "its sensitivity could not be simulated"}
+        return {
+            "effect": eff.id,
+            "lm": None,
+            "p": None,
+            "significant": False,
+            "note": "its sensitivity could not be simulated",
+        }
     s = (r2 - r1) / h
     if J.shape[1]:
         Q, _ = np.linalg.qr(J)
@@ -549,8 +641,13 @@ def _score(problem, model, r0, J, eff, records, sigma):
         s_perp, r_perp = s, r0
     den = float(s_perp @ s_perp)
     lm = float((s_perp @ r_perp) ** 2 / (sigma**2 * den)) if den > 0 else 0.0
-    return {"effect": eff.id, "lm": lm, "p": float(chi2.sf(lm, 1)), "significant": False,
-            "direction": float(-(s_perp @ r_perp) / den) if den > 0 else 0.0}
+    return {
+        "effect": eff.id,
+        "lm": lm,
+        "p": float(chi2.sf(lm, 1)),
+        "significant": False,
+        "direction": float(-(s_perp @ r_perp) / den) if den > 0 else 0.0,
+    }
 
 
 def _jacobian(problem, model, r0):
@@ -580,8 +677,15 @@ def _regressed(model, names, regress, loading=False):
     if fit is None:
         return None
     law = model.law
-    return model.with_law(ForceLaw(fit.terms, fit.coefficients, law.unloading,
-                                   law.unloading_coefficients, law.permanent_set))
+    return model.with_law(
+        ForceLaw(
+            fit.terms,
+            fit.coefficients,
+            law.unloading,
+            law.unloading_coefficients,
+            law.permanent_set,
+        )
+    )
 
 
 #: the effect's value on the regressed law: its small step times these
@@ -604,20 +708,27 @@ def _refit(problem, model, eff, guess, records, criterion, budget, tol, regress=
     hi = eff.parameters[0].bounds[1]
     cands = [_extend(model, eff, min(guess if guess and guess > 0 else h, 0.5 * hi))]
     if eff.target == "term":
-        reg = _regressed(model.with_effect(eff, 0.0), list(model.law.names)
-                         + [Term.parse(eff.key).name], regress)
+        reg = _regressed(
+            model.with_effect(eff, 0.0), list(model.law.names) + [Term.parse(eff.key).name], regress
+        )
         if reg is not None:
             cands.append(reg)
     else:
         # an effect on the unloading branch leaves the loading samples as they are
-        reg = _regressed(model, model.law.names, regress,
-                         loading=eff.target in ("unloading", "set"))
+        reg = _regressed(
+            model, model.law.names, regress, loading=eff.target in ("unloading", "set")
+        )
         if reg is not None:
             values = sorted({min(h * f, 0.9 * hi) for f in _LADDER})
             cands += [_extend(reg, eff, v) for v in values]
-    ranked = [cands[0]] if len(cands) == 1 else \
-        [m for _, _, m in sorted((problem.value(m, criterion), i, m)
-                                 for i, m in enumerate(cands))]
+    ranked = (
+        [cands[0]]
+        if len(cands) == 1
+        else [
+            m
+            for _, _, m in sorted((problem.value(m, criterion), i, m) for i, m in enumerate(cands))
+        ]
+    )
     starts = ranked[:2] + [_extend(model, eff, min(h, 0.5 * hi))]
     for i, start in enumerate(starts):
         try:
@@ -636,8 +747,9 @@ def _screen_one(ctx, job):
     model, eff_id, direction = job
     n0 = problem.n_sim
     try:
-        m2, res = _refit(problem, model, effect(eff_id), direction, records, criterion, budget,
-                         tol, regress)
+        m2, res = _refit(
+            problem, model, effect(eff_id), direction, records, criterion, budget, tol, regress
+        )
         evs = problem.evaluations(m2, floor=True)
     except IntegrationError as exc:
         return None, None, None, str(exc), problem.n_sim - n0
@@ -652,8 +764,11 @@ def _screen(jobs, context, workers, executor=None):
     problem = context[0]
     n0 = problem.n_sim
     own = executor is None
-    ex = make_executor(min(int(workers or os.cpu_count() or 1), max(len(jobs), 1))) if own \
+    ex = (
+        make_executor(min(int(workers or os.cpu_count() or 1), max(len(jobs), 1)))
+        if own
         else executor
+    )
     try:
         out = ex.map(_screen_one, jobs, context)
     finally:
@@ -670,32 +785,69 @@ def _output_error(records, start, criterion, budget, tol, polish=False):
     jump at the onset moving across the samples); the simplex, which only compares
     criterion values, goes on from there."""
     scs, refs = [s for s, _ in records], [r for _, r in records]
-    res = identify(scs, refs, start, criterion=criterion, method="least-squares",
-                   max_simulations=budget, tolerances=tol)
+    res = identify(
+        scs,
+        refs,
+        start,
+        criterion=criterion,
+        method="least-squares",
+        max_simulations=budget,
+        tolerances=tol,
+    )
     left = budget - res.n_simulations
     if not polish or left < 4 * (len(res.law.coefficients) + 1) * len(records):
         return res
     try:
-        res2 = identify(scs, refs, res.law, criterion=criterion, method="nelder-mead",
-                        max_simulations=left, tolerances=tol)
+        res2 = identify(
+            scs,
+            refs,
+            res.law,
+            criterion=criterion,
+            method="nelder-mead",
+            max_simulations=left,
+            tolerances=tol,
+        )
     except IntegrationError:
         return res
     return res2 if res2.value < res.value else res
 
 
 @params(
-    scenario=(Scenario, list, tuple), measurement=(Measurement, Reference, list, tuple),
-    start=(Text(), ForceLaw), criterion=Text(), alpha=Real(0, 1, open_low=True),
-    max_iterations=Real(1, integer=True), budget=Real(1, integer=True),
-    n_boot=Real(0, integer=True), seed=Real(0, integer=True), tolerances=(Tolerances, None),
-    effects=(None, list, tuple), max_refits=Real(1, integer=True),
-    workers=(None, Real(1, integer=True)), n_boot_intervals=Real(0, integer=True),
+    scenario=(Scenario, list, tuple),
+    measurement=(Measurement, Reference, list, tuple),
+    start=(Text(), ForceLaw),
+    criterion=Text(),
+    alpha=Real(0, 1, open_low=True),
+    max_iterations=Real(1, integer=True),
+    budget=Real(1, integer=True),
+    n_boot=Real(0, integer=True),
+    seed=Real(0, integer=True),
+    tolerances=(Tolerances, None),
+    effects=(None, list, tuple),
+    max_refits=Real(1, integer=True),
+    workers=(None, Real(1, integer=True)),
+    n_boot_intervals=Real(0, integer=True),
     executor=(None, Instance("discovery.executor", "Executor")),
 )
-def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01,
-            max_iterations=3, budget=150, n_boot=16, seed=0, tolerances=None, effects=None,
-            max_refits=6, workers=None, n_boot_intervals=30, progress=None,
-            executor=None):
+def explain(
+    scenario,
+    measurement,
+    start="linear",
+    *,
+    criterion="I2",
+    alpha=0.01,
+    max_iterations=3,
+    budget=150,
+    n_boot=16,
+    seed=0,
+    tolerances=None,
+    effects=None,
+    max_refits=6,
+    workers=None,
+    n_boot_intervals=30,
+    progress=None,
+    executor=None,
+):
     """Explain the disagreement of a start model with one or several records by named
     physical effects (see the module docstring).
 
@@ -749,22 +901,35 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
 
     pairs = pair_records(scenario, measurement)
     ms = [m for _, m in pairs]
-    records = as_records([sc for sc, _ in pairs],
-                         [m if isinstance(m, Reference) else
-                          Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)
-                          for sc, m in pairs])
+    records = as_records(
+        [sc for sc, _ in pairs],
+        [
+            m
+            if isinstance(m, Reference)
+            else Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)
+            for sc, m in pairs
+        ],
+    )
     catalogue = [e for e in EFFECTS if effects is None or e.id in effects]
     if effects is not None and len(catalogue) != len(set(effects)):
         known = {e.id for e in EFFECTS}
-        raise InputError(f"unknown effect(s) {sorted(set(effects) - known)}; the catalogue "
-                         f"has {', '.join(sorted(known))}")
+        raise InputError(
+            f"unknown effect(s) {sorted(set(effects) - known)}; the catalogue "
+            f"has {', '.join(sorted(known))}"
+        )
     problem = _Problem(records, tolerances)
     plain = [m for m in ms if not isinstance(m, Reference)]
-    preferred, others = ([start], []) if isinstance(start, ForceLaw) else \
-        _start_candidates(start, records, plain if len(plain) == len(ms) else None)
+    preferred, others = (
+        ([start], [])
+        if isinstance(start, ForceLaw)
+        else _start_candidates(start, records, plain if len(plain) == len(ms) else None)
+    )
     scen_list = [sc for sc, _ in records]
-    regress = (lambda names, loading=False: _regression(names, scen_list, plain, loading)) \
-        if len(plain) == len(ms) else None
+    regress = (
+        (lambda names, loading=False: _regression(names, scen_list, plain, loading))
+        if len(plain) == len(ms)
+        else None
+    )
     fit, why = None, ""
     for law in _fallbacks(preferred, others, problem, criterion):
         try:
@@ -780,9 +945,11 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         except IntegrationError as exc:
             why = str(exc)
     if fit is None:
-        raise IntegrationError(f"no start law for {start!r} has a periodic steady state with "
-                               f"contact for the record ({why}); give --start as a law with "
-                               "coefficients closer to the record")
+        raise IntegrationError(
+            f"no start law for {start!r} has a periodic steady state with "
+            f"contact for the record ({why}); give --start as a law with "
+            "coefficients closer to the record"
+        )
     model = Model(fit.law)
     uncertainties = dict(fit.standard_errors)
     iterations = []
@@ -791,29 +958,50 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     meas_first = ms[0] if not isinstance(ms[0], Reference) else None
     drift = _Drift(pairs, records) if not any(isinstance(m, Reference) for m in ms) else None
     for _ in range(max_iterations + 1):
-        tick(progress, "explain: iterations (localise, score, refit)", len(iterations),
-             max_iterations)
+        tick(
+            progress,
+            "explain: iterations (localise, score, refit)",
+            len(iterations),
+            max_iterations,
+        )
         evs = problem.evaluations(model, floor=True)
-        before, floor = _with_drift(_mean(evs, "criteria"), _mean(evs, "noise_floor"), drift,
-                                    model)
+        before, floor = _with_drift(_mean(evs, "criteria"), _mean(evs, "noise_floor"), drift, model)
         cycle_ok = all(e.consistent for e in evs)
         if cycle_ok and _drift_free(drift, model, records, alpha / max(len(catalogue), 1)):
-            stopped = ("the model is consistent with the record(s): I2 and I4 within their "
-                       "noise floors, no drift across the impacts, nothing left to explain")
+            stopped = (
+                "the model is consistent with the record(s): I2 and I4 within their "
+                "noise floors, no drift across the impacts, nothing left to explain"
+            )
             if not any(it.effect for it in iterations):
-                separability = _separability(problem, records, model, catalogue, criterion,
-                                             before,
-                                             floor, max(budget // 3, 12), tolerances)
+                separability = _separability(
+                    problem,
+                    records,
+                    model,
+                    catalogue,
+                    criterion,
+                    before,
+                    floor,
+                    max(budget // 3, 12),
+                    tolerances,
+                )
                 hidden = [s["effect"] for s in separability if not s["separable"]]
                 if hidden:
-                    stopped += ("; this record cannot tell " + ", ".join(hidden) + " from the "
-                                f"model (each refitted with the model lowers {criterion} by "
-                                "less than its noise floor: see separability)")
+                    stopped += (
+                        "; this record cannot tell " + ", ".join(hidden) + " from the "
+                        f"model (each refitted with the model lowers {criterion} by "
+                        "less than its noise floor: see separability)"
+                    )
             break
         if len(iterations) >= max_iterations:
             break
-        loc = localise(model.apply(records[0][0]), model, records[0][1], evs[0], meas_first,
-                       tolerances=tolerances)
+        loc = localise(
+            model.apply(records[0][0]),
+            model,
+            records[0][1],
+            evs[0],
+            meas_first,
+            tolerances=tolerances,
+        )
         r0 = problem.residual(model)
         J = _jacobian(problem, model, r0)
         sigma = problem.sigma()
@@ -821,11 +1009,19 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         # I4 alone (the supports of a noisy record) while the criterion the refits lower is
         # within its limit (lowering it further would fit the noise)
         quiet = cycle_ok or _within_noise(evs, criterion)
-        cands = [e for e in catalogue if e.applicable(model)
-                 and (drift is not None or "drift" not in e.phases)
-                 and (not quiet or "drift" in e.phases)]
-        scores = [drift.score(model, e, _small_step(e, records)) if "drift" in e.phases
-                  else _score(problem, model, r0, J, e, records, sigma) for e in cands]
+        cands = [
+            e
+            for e in catalogue
+            if e.applicable(model)
+            and (drift is not None or "drift" not in e.phases)
+            and (not quiet or "drift" in e.phases)
+        ]
+        scores = [
+            drift.score(model, e, _small_step(e, records))
+            if "drift" in e.phases
+            else _score(problem, model, r0, J, e, records, sigma)
+            for e in cands
+        ]
         level = alpha / max(len(scores), 1)
         top_phases = sorted(loc["phases"], key=lambda p: -loc["phases"][p]["share"])[:2]
         for s, e in zip(scores, cands, strict=True):
@@ -840,19 +1036,36 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             # its refit (from the regression, over a ladder of values) still decides
             ranked += [s for s in scores if s["lm"] is None]
         if not ranked:
-            why = ("no catalogue effect is significant (score tests at family-wise level "
-                   f"{alpha:g})")
+            why = f"no catalogue effect is significant (score tests at family-wise level {alpha:g})"
             stopped = "no catalogue effect explains the remaining disagreement significantly"
             if quiet and not cycle_ok:
-                why = (f"{criterion} is within its noise limit and the model fails "
-                       f"{', '.join(_failing(evs))} alone, which no effect is fitted to (the "
-                       "contact supports of a noisy record); " + why)
-                stopped = (f"{criterion} is within its noise limit; the model fails "
-                           f"{', '.join(_failing(evs))} alone, which is not explained by an "
-                           "effect")
-            iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
-                                        why, [], evs[0].simulated, evs[0].simulated,
-                                        records[0][1].impulse))
+                why = (
+                    f"{criterion} is within its noise limit and the model fails "
+                    f"{', '.join(_failing(evs))} alone, which no effect is fitted to (the "
+                    "contact supports of a noisy record); " + why
+                )
+                stopped = (
+                    f"{criterion} is within its noise limit; the model fails "
+                    f"{', '.join(_failing(evs))} alone, which is not explained by an "
+                    "effect"
+                )
+            iterations.append(
+                Iteration(
+                    model,
+                    model,
+                    before,
+                    before,
+                    floor,
+                    loc,
+                    scores,
+                    None,
+                    why,
+                    [],
+                    evs[0].simulated,
+                    evs[0].simulated,
+                    records[0][1].impulse,
+                )
+            )
             break
         trials = []
         # every candidate is refitted with a third of the budget; the winner gets the rest
@@ -860,10 +1073,18 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
         eff_by_id = {e.id: e for e in cands}
         chosen = ranked[:max_refits]
         # the screening refits of the force history are independent: one process each
-        refits = iter(_screen([(model, s["effect"], s.get("direction")) for s in chosen
-                               if "drift" not in eff_by_id[s["effect"]].phases],
-                              (problem, records, criterion, screen, tolerances, regress),
-                              workers, executor))
+        refits = iter(
+            _screen(
+                [
+                    (model, s["effect"], s.get("direction"))
+                    for s in chosen
+                    if "drift" not in eff_by_id[s["effect"]].phases
+                ],
+                (problem, records, criterion, screen, tolerances, regress),
+                workers,
+                executor,
+            )
+        )
         for s in chosen:
             eff = eff_by_id[s["effect"]]
             key = "D" if "drift" in eff.phases else criterion
@@ -888,13 +1109,17 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             # (the drift channel does not depend on the law: no compensation to guard)
             s["repulsive"] = key == "D" or _keeps_repulsive(m2, model, records)
             if not s["repulsive"]:
-                s["note"] = ("the refit's elastic branch P(zeta, 0) pulls at the record's "
-                             "penetration: the effect only fits by undoing the contact spring")
+                s["note"] = (
+                    "the refit's elastic branch P(zeta, 0) pulls at the record's "
+                    "penetration: the effect only fits by undoing the contact spring"
+                )
             s["in_bounds"] = _in_bounds(eff, m2)
             if not s["in_bounds"]:
                 lo, hi = eff.parameters[0].bounds
-                s["note"] = (f"the refit puts {eff.parameters[0].name} = {m2.value(eff):.4g} "
-                             f"outside its physical bounds [{lo:g}, {hi:g}]")
+                s["note"] = (
+                    f"the refit puts {eff.parameters[0].name} = {m2.value(eff):.4g} "
+                    f"outside its physical bounds [{lo:g}, {hi:g}]"
+                )
             s["gap"] = key
             trials.append((after[key] / max(before[key], 1e-300), s, m2, res, evs2, key))
         # the baseline: the law refitted alone, with the same budget; an effect is named
@@ -911,42 +1136,86 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
             null_start = min(null_starts, key=lambda m: problem.value(m, criterion))
         except (IntegrationError, InputError):
             null_start = None
-        refit0 = None if null_start is None else _law_refit(
-            records, null_start, criterion, screen, tolerances, problem, drift)
+        refit0 = (
+            None
+            if null_start is None
+            else _law_refit(records, null_start, criterion, screen, tolerances, problem, drift)
+        )
         if refit0 is not None:
             null, null_after, null_evs = refit0
         for x in trials:
             k = x[5]
             # (the drift channel does not depend on the law: a law refit is no baseline)
-            x[1]["beats_law_refit"] = bool(k == "D" or not null_after or k not in null_after
-                                           or x[1]["criteria_after"][k]
-                                           <= null_after[k] - floor.get(k, 0.0))
+            x[1]["beats_law_refit"] = bool(
+                k == "D"
+                or not null_after
+                or k not in null_after
+                or x[1]["criteria_after"][k] <= null_after[k] - floor.get(k, 0.0)
+            )
         for x in trials:
             # an effect refitted to 0, or to a value within 2 standard errors of 0, only
             # carried a refit of the law
             e_ = eff_by_id[x[1]["effect"]]
-            x[1]["present"] = (_present(e_, x[2], x[3]) if x[3] is not None
-                               else bool(x[2].value(e_) != 0.0))
-        good = [x for x in trials if x[0] <= 0.9 and x[1]["repulsive"] and x[1]["in_bounds"]
-                and x[1]["beats_law_refit"] and x[1]["present"]]
-        if not good and null_after and criterion in null_after \
-                and null_after[criterion] <= 0.9 * before[criterion]:
-            iterations.append(Iteration(model, null.law, before, null_after, floor, loc, scores,
-                                        None, f"no effect beats the law refitted alone ("
-                                        f"{criterion} {before[criterion]:.3g} -> "
-                                        f"{null_after[criterion]:.3g}) by its noise floor: the "
-                                        "law is refitted, nothing is named", [],
-                                        evs[0].simulated, null_evs[0].simulated,
-                                        records[0][1].impulse))
+            x[1]["present"] = (
+                _present(e_, x[2], x[3]) if x[3] is not None else bool(x[2].value(e_) != 0.0)
+            )
+        good = [
+            x
+            for x in trials
+            if x[0] <= 0.9
+            and x[1]["repulsive"]
+            and x[1]["in_bounds"]
+            and x[1]["beats_law_refit"]
+            and x[1]["present"]
+        ]
+        if (
+            not good
+            and null_after
+            and criterion in null_after
+            and null_after[criterion] <= 0.9 * before[criterion]
+        ):
+            iterations.append(
+                Iteration(
+                    model,
+                    null.law,
+                    before,
+                    null_after,
+                    floor,
+                    loc,
+                    scores,
+                    None,
+                    f"no effect beats the law refitted alone ("
+                    f"{criterion} {before[criterion]:.3g} -> "
+                    f"{null_after[criterion]:.3g}) by its noise floor: the "
+                    "law is refitted, nothing is named",
+                    [],
+                    evs[0].simulated,
+                    null_evs[0].simulated,
+                    records[0][1].impulse,
+                )
+            )
             model = null.law
             uncertainties = dict(null.standard_errors)
             continue
         if not good:
-            iterations.append(Iteration(model, model, before, before, floor, loc, scores, None,
-                                        "no refit of a significant effect (or of one without a "
-                                        f"score) lowers {criterion} by 10 %", [],
-                                        evs[0].simulated,
-                                        evs[0].simulated, records[0][1].impulse))
+            iterations.append(
+                Iteration(
+                    model,
+                    model,
+                    before,
+                    before,
+                    floor,
+                    loc,
+                    scores,
+                    None,
+                    "no refit of a significant effect (or of one without a "
+                    f"score) lowers {criterion} by 10 %",
+                    [],
+                    evs[0].simulated,
+                    evs[0].simulated,
+                    records[0][1].impulse,
+                )
+            )
             stopped = "the candidate effects do not shrink the gap when refitted"
             break
         good.sort(key=lambda x: x[0])
@@ -957,47 +1226,86 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
                 res2 = _output_error(records, m2, criterion, budget, tolerances, polish=True)
                 evs3 = problem.evaluations(res2.law, floor=True)
                 after3, _ = _with_drift(_mean(evs3, "criteria"), {}, drift, res2.law)
-                if after3 and after3[key] <= s["criteria_after"][key] \
-                        and _in_bounds(eff_by_id[s["effect"]], res2.law) \
-                        and _keeps_repulsive(res2.law, model, records):
+                if (
+                    after3
+                    and after3[key] <= s["criteria_after"][key]
+                    and _in_bounds(eff_by_id[s["effect"]], res2.law)
+                    and _keeps_repulsive(res2.law, model, records)
+                ):
                     m2, res, evs2 = res2.law, res2, evs3
                     s["criteria_after"] = after3
-                    s["parameters"] = {p.name: m2.value(eff_by_id[s["effect"]])
-                                       for p in eff_by_id[s["effect"]].parameters}
+                    s["parameters"] = {
+                        p.name: m2.value(eff_by_id[s["effect"]])
+                        for p in eff_by_id[s["effect"]].parameters
+                    }
             except (IntegrationError, InputError):
                 pass
         if res is not None and not _present(eff_by_id[s["effect"]], m2, res):
             # polished with the full budget, the effect's parameter is within 2 standard
             # errors of 0: the gain was the law's own refit. Nothing is named; the model is
             # the polished refit without the effect (the loop then screens again)
-            refit = _law_refit(records, model, criterion, budget, tolerances, problem, drift,
-                               polish=True)
+            refit = _law_refit(
+                records, model, criterion, budget, tolerances, problem, drift, polish=True
+            )
             if refit is not None and refit[1] and refit[1][key] < before[key]:
                 law_refit, after_law, evs_law = refit[0].law, refit[1], refit[2]
-                iterations.append(Iteration(
-                    model, law_refit, before, after_law, floor, loc, scores, None,
-                    f"{s['effect']} refitted with the full budget has its parameter within 2 "
-                    "standard errors of 0: the gain was the law's own refit "
-                    f"({key} {before[key]:.3g} -> {after_law[key]:.3g}); nothing is named",
-                    [], evs[0].simulated, evs_law[0].simulated, records[0][1].impulse))
+                iterations.append(
+                    Iteration(
+                        model,
+                        law_refit,
+                        before,
+                        after_law,
+                        floor,
+                        loc,
+                        scores,
+                        None,
+                        f"{s['effect']} refitted with the full budget has its parameter within 2 "
+                        "standard errors of 0: the gain was the law's own refit "
+                        f"({key} {before[key]:.3g} -> {after_law[key]:.3g}); nothing is named",
+                        [],
+                        evs[0].simulated,
+                        evs_law[0].simulated,
+                        records[0][1].impulse,
+                    )
+                )
                 model = law_refit
                 continue
         value = s["criteria_after"][key]
         tol_eq = floor.get(key, 0.0)
-        equivalent = [x[1]["effect"] for x in good[1:]
-                      if x[5] == key and x[1]["criteria_after"][key] <= value + tol_eq]
-        score = (f"score test LM = {s['lm']:.3g} (p = {s['p']:.2g} < {level:.2g})"
-                 if s["lm"] is not None else
-                 "no score test (a small step of it changes the regime)")
-        evidence = (f"{score}; refitted, "
-                    f"{key} {before[key]:.3g} -> {value:.3g} (noise floor "
-                    f"{floor.get(key, float('nan')):.3g}); signature "
-                    f"{'agrees' if s['signature_agrees'] else 'does not agree'} with the "
-                    f"localisation (largest shares: {', '.join(top_phases)})")
-        iterations.append(Iteration(model, m2, before, s["criteria_after"], floor, loc,
-                                    scores, s["effect"], evidence, equivalent,
-                                    evs[0].simulated, evs2[0].simulated,
-                                    records[0][1].impulse))
+        equivalent = [
+            x[1]["effect"]
+            for x in good[1:]
+            if x[5] == key and x[1]["criteria_after"][key] <= value + tol_eq
+        ]
+        score = (
+            f"score test LM = {s['lm']:.3g} (p = {s['p']:.2g} < {level:.2g})"
+            if s["lm"] is not None
+            else "no score test (a small step of it changes the regime)"
+        )
+        evidence = (
+            f"{score}; refitted, "
+            f"{key} {before[key]:.3g} -> {value:.3g} (noise floor "
+            f"{floor.get(key, float('nan')):.3g}); signature "
+            f"{'agrees' if s['signature_agrees'] else 'does not agree'} with the "
+            f"localisation (largest shares: {', '.join(top_phases)})"
+        )
+        iterations.append(
+            Iteration(
+                model,
+                m2,
+                before,
+                s["criteria_after"],
+                floor,
+                loc,
+                scores,
+                s["effect"],
+                evidence,
+                equivalent,
+                evs[0].simulated,
+                evs2[0].simulated,
+                records[0][1].impulse,
+            )
+        )
         model = m2
         if res is not None:
             uncertainties = dict(res.standard_errors)
@@ -1007,21 +1315,41 @@ def explain(scenario, measurement, start="linear", *, criterion="I2", alpha=0.01
     if n_boot_intervals:
         try:
             tick(progress, "explain: bootstrap intervals", 0, n_boot_intervals)
-            intervals = bootstrap_intervals([sc for sc, _ in records], [r for _, r in records],
-                                            model, n_boot=int(n_boot_intervals), seed=seed,
-                                            criterion=criterion, tolerances=tolerances)
+            intervals = bootstrap_intervals(
+                [sc for sc, _ in records],
+                [r for _, r in records],
+                model,
+                n_boot=int(n_boot_intervals),
+                seed=seed,
+                criterion=criterion,
+                tolerances=tolerances,
+            )
         except IntegrationError:
             intervals = None
     return ExplainResult(
         intervals=intervals,
-        iterations=tuple(iterations), final_model=model, uncertainties=uncertainties,
-        criteria=crit, noise_floor=floor,
-        consistent=all(e.consistent for e in evs) and _drift_free(
-            drift, model, records, alpha / max(len(catalogue), 1)),
-        stopped_because=stopped, separability=tuple(separability),
+        iterations=tuple(iterations),
+        final_model=model,
+        uncertainties=uncertainties,
+        criteria=crit,
+        noise_floor=floor,
+        consistent=all(e.consistent for e in evs)
+        and _drift_free(drift, model, records, alpha / max(len(catalogue), 1)),
+        stopped_because=stopped,
+        separability=tuple(separability),
         seconds=time.perf_counter() - t0,
-        settings={"start": str(start), "criterion": criterion, "alpha": alpha,
-                  "max_iterations": max_iterations, "budget": budget, "n_boot": n_boot,
-                  "seed": seed, "effects": [e.id for e in catalogue], "max_refits": max_refits,
-                  "workers": workers,
-                  "records": len(records), "simulations": problem.n_sim})
+        settings={
+            "start": str(start),
+            "criterion": criterion,
+            "alpha": alpha,
+            "max_iterations": max_iterations,
+            "budget": budget,
+            "n_boot": n_boot,
+            "seed": seed,
+            "effects": [e.id for e in catalogue],
+            "max_refits": max_refits,
+            "workers": workers,
+            "records": len(records),
+            "simulations": problem.n_sim,
+        },
+    )

@@ -44,8 +44,7 @@ def _phase_of(t, windows, t_peaks, dt, period):
     return phase
 
 
-def simulated_at(scenario, law, steady, t_record, F_record, *, time_offset=0.0,
-                 tolerances=None):
+def simulated_at(scenario, law, steady, t_record, F_record, *, time_offset=0.0, tolerances=None):
     """States ``(w1, v1, w2, v2)`` of ``law``'s periodic orbit at the record's times (the
     orbit's phase among its ``n`` drive periods: the one whose force matches best)."""
     P = steady.n_periods * scenario.period
@@ -53,9 +52,15 @@ def simulated_at(scenario, law, steady, t_record, F_record, *, time_offset=0.0,
     for k in range(steady.n_periods):
         tau = np.mod(t_record + time_offset - steady.t0 + k * scenario.period, P)
         order = np.argsort(tau)
-        tr = simulate(scenario, law, (steady.t0, steady.t0 + P), y0=steady.y0,
-                      t_eval=steady.t0 + tau[order], tolerances=tolerances,
-                      zeta_max0=steady.zeta_max0)
+        tr = simulate(
+            scenario,
+            law,
+            (steady.t0, steady.t0 + P),
+            y0=steady.y0,
+            t_eval=steady.t0 + tau[order],
+            tolerances=tolerances,
+            zeta_max0=steady.zeta_max0,
+        )
         inv = np.empty_like(order)
         inv[order] = np.arange(order.size)
         d = float(np.sum((tr.force[inv] - F_record) ** 2))
@@ -78,8 +83,12 @@ def _drift(measurement, period, threshold):
     s2 = float(np.sum((peaks - A @ coef) ** 2)) / max(peaks.size - 2, 1)
     se = np.sqrt(s2 / float(np.sum((x - x.mean()) ** 2))) if s2 > 0 else 0.0
     tval = float(coef[1] / se) if se > 0 else 0.0
-    return {"n_impacts": int(peaks.size), "slope": float(coef[1] / np.mean(peaks)),
-            "t": tval, "significant": bool(abs(tval) > 4.0)}
+    return {
+        "n_impacts": int(peaks.size),
+        "slope": float(coef[1] / np.mean(peaks)),
+        "t": tval,
+        "significant": bool(abs(tval) > 4.0),
+    }
 
 
 def localise(scenario, model, reference, evaluation, measurement=None, *, tolerances=None):
@@ -98,11 +107,18 @@ def localise(scenario, model, reference, evaluation, measurement=None, *, tolera
     dt = float(np.median(np.diff(E.t[E.t > 0]))) if E.t.size > 2 else 1.0
     period = E.duration / E.n_periods
     windows = E.support if len(E.support) else np.zeros((0, 2))
-    t_peaks = [E.t[(E.t >= a) & (E.t < b)][np.argmax(E.F[(E.t >= a) & (E.t < b)])]
-               if np.any((E.t >= a) & (E.t < b)) else a for a, b in windows]
+    t_peaks = [
+        E.t[(E.t >= a) & (E.t < b)][np.argmax(E.F[(E.t >= a) & (E.t < b)])]
+        if np.any((E.t >= a) & (E.t < b))
+        else a
+        for a, b in windows
+    ]
     phase = _phase_of(E.t, windows, t_peaks, dt, period)
-    sigma = (reference.noise.get("F", 0.0) / np.sqrt(max(reference.noise.get("n_cycles", 1), 1))
-             if reference.noise else 0.0)
+    sigma = (
+        reference.noise.get("F", 0.0) / np.sqrt(max(reference.noise.get("n_cycles", 1), 1))
+        if reference.noise
+        else 0.0
+    )
     # shares of the energy in excess of the noise (sum r^2 - n sigma^2): long phases of
     # pure noise (free flight) do not look like disagreement
     energy = {name: float(np.sum(r[phase == i] ** 2)) for i, name in enumerate(PHASES)}
@@ -113,19 +129,36 @@ def localise(scenario, model, reference, evaluation, measurement=None, *, tolera
     for name in PHASES:
         e, n = energy[name], count[name]
         ratio = e / (n * sigma**2) if sigma > 0 and n else None
-        phases[name] = {"share": excess[name] / total, "ratio_to_noise": ratio, "n": n,
-                        "exceeds_noise": bool(ratio is None and e > 0 or
-                                              (ratio is not None and ratio > _EXCEEDS))}
-    out = {"phases": phases, "sigma": float(sigma), "rms": float(np.sqrt(np.mean(r**2))),
-           "plane": None, "grid": None, "drift": None}
+        phases[name] = {
+            "share": excess[name] / total,
+            "ratio_to_noise": ratio,
+            "n": n,
+            "exceeds_noise": bool(
+                ratio is None and e > 0 or (ratio is not None and ratio > _EXCEEDS)
+            ),
+        }
+    out = {
+        "phases": phases,
+        "sigma": float(sigma),
+        "rms": float(np.sqrt(np.mean(r**2))),
+        "plane": None,
+        "grid": None,
+        "drift": None,
+    }
     if measurement is None or evaluation.steady is None:
         return out
     # the simulated orbit at the record's steady times: the (zeta, dzeta) plane and w1
     t0 = E.onset
     keep = measurement.t >= t0
-    y, f_sim = simulated_at(scenario, model.law, evaluation.steady, measurement.t[keep],
-                            measurement.F[keep], time_offset=reference.time_offset,
-                            tolerances=tolerances)
+    y, f_sim = simulated_at(
+        scenario,
+        model.law,
+        evaluation.steady,
+        measurement.t[keep],
+        measurement.F[keep],
+        time_offset=reference.time_offset,
+        tolerances=tolerances,
+    )
     zeta, dzeta = y[0] - y[2], y[1] - y[3]
     res = f_sim - measurement.F[keep]
     c = zeta > 0
@@ -150,8 +183,10 @@ def localise(scenario, model, reference, evaluation, measurement=None, *, tolera
         d = w1 - y[0]
         noise = estimate_noise(w1, order=3)
         rms = float(np.sqrt(np.mean((d - d.mean()) ** 2)))
-        out["grid"] = {"rms_relative": rms / rng_w,
-                       "ratio_to_noise": rms / noise if noise > 0 else None,
-                       "exceeds_noise": bool(noise > 0 and rms > 3 * noise)}
+        out["grid"] = {
+            "rms_relative": rms / rng_w,
+            "ratio_to_noise": rms / noise if noise > 0 else None,
+            "exceeds_noise": bool(noise > 0 and rms > 3 * noise),
+        }
     out["drift"] = _drift(measurement, scenario.period, E.threshold)
     return out

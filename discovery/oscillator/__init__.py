@@ -40,8 +40,32 @@ from .explain import Explanation, explain
 from .periodic import PeriodicOrbit, UedaMap, periodic_orbit
 from .system import MODELS, UedaSystem
 
-__all__ = ["UedaSystem", "MODELS", "Attractor", "Basins", "Lyapunov", "Regime", "attractor",
-           "basins", "classify", "classify_points", "lyapunov", "lyapunov_two_trajectory",
-           "rotation_number", "strobe_points", "trajectory", "Discovery", "ForcedPolynomial",
-           "Verification", "discover", "simulate_record", "verify", "UedaMap", "PeriodicOrbit",
-           "periodic_orbit", "EFFECTS", "Explanation", "explain"]
+__all__ = [
+    "UedaSystem",
+    "MODELS",
+    "Attractor",
+    "Basins",
+    "Lyapunov",
+    "Regime",
+    "attractor",
+    "basins",
+    "classify",
+    "classify_points",
+    "lyapunov",
+    "lyapunov_two_trajectory",
+    "rotation_number",
+    "strobe_points",
+    "trajectory",
+    "Discovery",
+    "ForcedPolynomial",
+    "Verification",
+    "discover",
+    "simulate_record",
+    "verify",
+    "UedaMap",
+    "PeriodicOrbit",
+    "periodic_orbit",
+    "EFFECTS",
+    "Explanation",
+    "explain",
+]

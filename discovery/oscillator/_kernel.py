@@ -70,8 +70,9 @@ _adv4 = make_smooth_advance(_rhs4, 4, 2)
 
 
 @njit(cache=True)
-def strobe_run(t0, y0, p, T, n_trans, n_strobe, rtol, atol, hmax, max_steps, t_eval, out_eval,
-               out_strobe):
+def strobe_run(
+    t0, y0, p, T, n_trans, n_strobe, rtol, atol, hmax, max_steps, t_eval, out_eval, out_strobe
+):
     """``n_trans`` periods of transient, then ``n_strobe`` periods, the state at each
     period's end in ``out_strobe[k]`` (steps land on strobe times exactly); dense output
     at ``t_eval`` (absolute times) in ``out_eval``.  Returns
@@ -92,9 +93,23 @@ def strobe_run(t0, y0, p, T, n_trans, n_strobe, rtol, atol, hmax, max_steps, t_e
         k_eval += 1
     for k in range(n_trans + n_strobe):
         t_end = t0 + (k + 1) * T
-        status, t, h, k_eval, ns = _adv2(t, y, t_end, h, p, rtol, atol, hmax,
-                                         max_steps - n_steps, K, ytmp, ynew, t_eval, k_eval,
-                                         out_eval)
+        status, t, h, k_eval, ns = _adv2(
+            t,
+            y,
+            t_end,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            t_eval,
+            k_eval,
+            out_eval,
+        )
         n_steps += ns
         if status != OK:
             break
@@ -127,8 +142,21 @@ def renormalise(y, k, out_logs, out_trace, out_strobe):
 
 
 @njit(cache=True)
-def variational_run(t0, y0, p, T, n_seg, rtol, atol_state, atol_tangent, hmax, max_steps,
-                    out_logs, out_trace, out_strobe):
+def variational_run(
+    t0,
+    y0,
+    p,
+    T,
+    n_seg,
+    rtol,
+    atol_state,
+    atol_tangent,
+    hmax,
+    max_steps,
+    out_logs,
+    out_trace,
+    out_strobe,
+):
     """Benettin's method over ``n_seg`` periods: the state and two tangent vectors
     (started orthonormal), Gram-Schmidt at every strobe time.  ``out_logs[k]`` gets
     ``(log r11, log r22)`` of segment ``k``, ``out_trace[k]`` the integral of the
@@ -157,8 +185,23 @@ def variational_run(t0, y0, p, T, n_seg, rtol, atol_state, atol_tangent, hmax, m
     _rhs7(t, y, p, K[0])
     for k in range(n_seg):
         t_end = t0 + (k + 1) * T
-        status, t, h, _, ns = _adv7(t, y, t_end, h, p, rtol, atol, hmax, max_steps - n_steps, K,
-                                    ytmp, ynew, empty_t, 0, empty_o)
+        status, t, h, _, ns = _adv7(
+            t,
+            y,
+            t_end,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
         n_steps += ns
         if status != OK:
             break
@@ -196,8 +239,23 @@ def pair_run(t0, y0, p, T, n_seg, d0, rtol, atol, hmax, max_steps, out_logs):
     _rhs4(t, y, p, K[0])
     for k in range(n_seg):
         t_end = t0 + (k + 1) * T
-        status, t, h, _, ns = _adv4(t, y, t_end, h, p, rtol, at, hmax, max_steps - n_steps, K,
-                                    ytmp, ynew, empty_t, 0, empty_o)
+        status, t, h, _, ns = _adv4(
+            t,
+            y,
+            t_end,
+            h,
+            p,
+            rtol,
+            at,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
         n_steps += ns
         if status != OK:
             break

@@ -23,19 +23,33 @@ from ._runs import setup as _setup
 from .periodic import periodic_orbit
 from .system import UedaSystem
 
-__all__ = ["Lyapunov", "Regime", "Attractor", "Basins", "strobe_points", "trajectory",
-           "lyapunov", "lyapunov_two_trajectory", "classify", "attractor", "basins",
-           "rotation_number", "REGIMES"]
+__all__ = [
+    "Lyapunov",
+    "Regime",
+    "Attractor",
+    "Basins",
+    "strobe_points",
+    "trajectory",
+    "lyapunov",
+    "lyapunov_two_trajectory",
+    "classify",
+    "attractor",
+    "basins",
+    "rotation_number",
+    "REGIMES",
+]
 
 REGIMES = ("P1", "Pn", "beat", "chaotic")
 
 
 @params(
-    system=UedaSystem, y0=(None, Array(1)), n=Real(1, integer=True),
-    transient=Real(0, integer=True), t0=Real(), tolerances=(Tolerances, None),
+    system=UedaSystem,
+    y0=(None, Array(1)),
+    n=Real(1, integer=True),
+    transient=Real(0, integer=True),
+    t0=Real(),
+    tolerances=(Tolerances, None),
 )
-
-
 def strobe_points(system, y0=None, n=200, *, transient=200, t0=0.0, tolerances=None):
     """The stroboscopic points after a transient.
 
@@ -59,10 +73,21 @@ def strobe_points(system, y0=None, n=200, *, transient=200, t0=0.0, tolerances=N
     """
     tol, T, atol, hmax = _setup(system, tolerances)
     out = np.empty((int(n), 2))
-    status, t, y, _, _ = UK.strobe_run(float(t0), _y0(y0), system.params(), T, int(transient),
-                                       int(n), tol.rtol, atol, hmax,
-                                       _budget(tol, int(n) + int(transient)),
-                                       np.empty(0), np.empty((2, 0)), out)
+    status, t, y, _, _ = UK.strobe_run(
+        float(t0),
+        _y0(y0),
+        system.params(),
+        T,
+        int(transient),
+        int(n),
+        tol.rtol,
+        atol,
+        hmax,
+        _budget(tol, int(n) + int(transient)),
+        np.empty(0),
+        np.empty((2, 0)),
+        out,
+    )
     _check(status, t, "the stroboscopic map")
     return out, y
 
@@ -75,11 +100,12 @@ def _after(system, y0, transient, tol):
 
 
 @params(
-    system=UedaSystem, y0=Array(1), t_span=Array(1), n_samples=Real(2, integer=True),
+    system=UedaSystem,
+    y0=Array(1),
+    t_span=Array(1),
+    n_samples=Real(2, integer=True),
     tolerances=(Tolerances, None),
 )
-
-
 def trajectory(system, y0, t_span, n_samples=4000, *, tolerances=None):
     """``(t, x, v)`` sampled uniformly on ``t_span`` (dense output, no extra steps)."""
     tol, T, atol, hmax = _setup(system, tolerances)
@@ -88,8 +114,21 @@ def trajectory(system, y0, t_span, n_samples=4000, *, tolerances=None):
     out = np.empty((2, te.size))
     n_per = max(1, int(np.ceil((t1 - t0) / T - 1e-9)))
     strobe = np.empty((n_per, 2))
-    status, t, _, _, k = UK.strobe_run(t0, _y0(y0), system.params(), T, 0, n_per, tol.rtol,
-                                       atol, hmax, _budget(tol, n_per), te, out, strobe)
+    status, t, _, _, k = UK.strobe_run(
+        t0,
+        _y0(y0),
+        system.params(),
+        T,
+        0,
+        n_per,
+        tol.rtol,
+        atol,
+        hmax,
+        _budget(tol, n_per),
+        te,
+        out,
+        strobe,
+    )
     _check(status, t, "the trajectory")
     return te[:k], out[0, :k], out[1, :k]
 
@@ -131,11 +170,20 @@ class Lyapunov:
     batch_values: np.ndarray = field(repr=False)
 
     def as_dict(self):
-        return {"value": self.value, "stderr": self.stderr, "second": self.second,
-                "second_stderr": self.second_stderr, "sum": self.sum,
-                "trace_mean": self.trace_mean, "sum_minus_trace": self.sum - self.trace_mean,
-                "n_periods": self.n_periods, "batches": self.batches, "rtol": self.rtol,
-                "method": self.method, "units": "per unit time"}
+        return {
+            "value": self.value,
+            "stderr": self.stderr,
+            "second": self.second,
+            "second_stderr": self.second_stderr,
+            "sum": self.sum,
+            "trace_mean": self.trace_mean,
+            "sum_minus_trace": self.sum - self.trace_mean,
+            "n_periods": self.n_periods,
+            "batches": self.batches,
+            "rtol": self.rtol,
+            "method": self.method,
+            "units": "per unit time",
+        }
 
 
 def _batch_stats(per_period, T, batches):
@@ -149,21 +197,36 @@ def _batch_stats(per_period, T, batches):
 def _variational(system, y, t0, periods, tol, T, atol, hmax):
     n = int(periods)
     logs, trace, strobe = np.empty((n, 2)), np.empty(n), np.empty((n, 2))
-    status, t, yf, _ = UK.variational_run(float(t0), y, system.params(), T, n, tol.rtol, atol,
-                                          tol.atol_variational, hmax,
-                                          _budget(tol, n), logs, trace, strobe)
+    status, t, yf, _ = UK.variational_run(
+        float(t0),
+        y,
+        system.params(),
+        T,
+        n,
+        tol.rtol,
+        atol,
+        tol.atol_variational,
+        hmax,
+        _budget(tol, n),
+        logs,
+        trace,
+        strobe,
+    )
     _check(status, t, "the variational equations")
     return logs, trace, strobe, yf
 
 
 @params(
-    system=UedaSystem, y0=(None, Array(1)), transient=Real(0, integer=True),
-    periods=Real(1, integer=True), batches=Real(1, integer=True), tolerances=(Tolerances, None),
+    system=UedaSystem,
+    y0=(None, Array(1)),
+    transient=Real(0, integer=True),
+    periods=Real(1, integer=True),
+    batches=Real(1, integer=True),
+    tolerances=(Tolerances, None),
 )
-
-
-def lyapunov(system, y0=None, *, transient=200, periods=4000, batches=20, tolerances=None,
-             _run=None):
+def lyapunov(
+    system, y0=None, *, transient=200, periods=4000, batches=20, tolerances=None, _run=None
+):
     """The largest two Lyapunov exponents by the variational equations (Benettin).
 
     Parameters
@@ -191,16 +254,24 @@ def lyapunov(system, y0=None, *, transient=200, periods=4000, batches=20, tolera
     n = logs.shape[0]
     bv, se = _batch_stats(logs, T, batches)
     lam = logs.sum(axis=0) / (n * T)
-    return Lyapunov(value=float(lam[0]), stderr=float(se[0]), second=float(lam[1]),
-                    second_stderr=float(se[1]), sum=float(lam.sum()),
-                    trace_mean=float(trace.sum() / (n * T)), n_periods=n,
-                    batches=int(bv.shape[0]), rtol=tol.rtol,
-                    method="variational equations, Gram-Schmidt (QR) every period",
-                    batch_values=bv[:, 0].copy())
+    return Lyapunov(
+        value=float(lam[0]),
+        stderr=float(se[0]),
+        second=float(lam[1]),
+        second_stderr=float(se[1]),
+        sum=float(lam.sum()),
+        trace_mean=float(trace.sum() / (n * T)),
+        n_periods=n,
+        batches=int(bv.shape[0]),
+        rtol=tol.rtol,
+        method="variational equations, Gram-Schmidt (QR) every period",
+        batch_values=bv[:, 0].copy(),
+    )
 
 
-def lyapunov_two_trajectory(system, y0=None, *, transient=200, periods=4000, batches=20,
-                            d0=1e-7, tolerances=None):
+def lyapunov_two_trajectory(
+    system, y0=None, *, transient=200, periods=4000, batches=20, d0=1e-7, tolerances=None
+):
     """The largest exponent from two trajectories ``d0`` apart (relative to the scale),
     renormalised every period (Benettin/Wolf): ``(value, stderr)`` per unit time."""
     tol, T, atol, hmax = _setup(system, tolerances)
@@ -208,8 +279,9 @@ def lyapunov_two_trajectory(system, y0=None, *, transient=200, periods=4000, bat
     n = int(periods)
     logs = np.empty(n)
     d = float(d0) * float(system.scales()[0])
-    status, t, _, _ = UK.pair_run(0.0, y, system.params(), T, n, d, tol.rtol, atol, hmax,
-                                  _budget(tol, n), logs)
+    status, t, _, _ = UK.pair_run(
+        0.0, y, system.params(), T, n, d, tol.rtol, atol, hmax, _budget(tol, n), logs
+    )
     _check(status, t, "the two-trajectory run")
     _, se = _batch_stats(logs, T, batches)
     return float(logs.sum() / (n * T)), float(se)
@@ -260,12 +332,26 @@ class Regime:
     evidence: dict
 
     def as_dict(self):
-        return {"regime": self.regime, "kind": self.kind, "period": self.period,
-                "evidence": self.evidence}
+        return {
+            "regime": self.regime,
+            "kind": self.kind,
+            "period": self.period,
+            "evidence": self.evidence,
+        }
 
 
-def classify_points(strobe, scale, lam, lam_stderr=0.0, *, max_period=8, closure=1e-5,
-                    chaos_threshold=0.01, period_map=None, shooting_tol=1e-8):
+def classify_points(
+    strobe,
+    scale,
+    lam,
+    lam_stderr=0.0,
+    *,
+    max_period=8,
+    closure=1e-5,
+    chaos_threshold=0.01,
+    period_map=None,
+    shooting_tol=1e-8,
+):
     """Classify from stroboscopic points and the largest exponent (see :class:`Regime`).
 
     Rules, in order: the smallest ``n <= max_period`` whose recurrence distance is below
@@ -283,17 +369,23 @@ def classify_points(strobe, scale, lam, lam_stderr=0.0, *, max_period=8, closure
     """
     s = np.asarray(strobe, dtype=float)
     m = min(len(s) - 1, 3 * max_period)
-    tail = s[-(m + 1):] / scale
+    tail = s[-(m + 1) :] / scale
     rec = {}
     for n in range(1, max_period + 1):
         if n < len(tail):
             rec[n] = float(np.max(np.abs(tail[n:] - tail[:-n])))
-    ev = {"recurrence": rec, "lyapunov": float(lam), "lyapunov_stderr": float(lam_stderr),
-          "closure": closure}
+    ev = {
+        "recurrence": rec,
+        "lyapunov": float(lam),
+        "lyapunov_stderr": float(lam_stderr),
+        "closure": closure,
+    }
     for n, d in rec.items():
         if d < closure:
-            rule = (f"the strobe points repeat after {n} period(s) to {d:.1e} of the "
-                    f"scale (< {closure:g})")
+            rule = (
+                f"the strobe points repeat after {n} period(s) to {d:.1e} of the "
+                f"scale (< {closure:g})"
+            )
             if period_map is None:
                 ev["rule"] = rule
                 return Regime(f"P{n}", "P1" if n == 1 else "Pn", n, ev)
@@ -301,13 +393,19 @@ def classify_points(strobe, scale, lam, lam_stderr=0.0, *, max_period=8, closure
             if orb is not None and orb.converged and orb.stable:
                 n = orb.n_periods
                 big = float(np.max(np.abs(orb.multipliers)))
-                ev["rule"] = (f"{rule}; shooting converged (residual {orb.residual:.1e}) to a "
-                              f"stable period-{n} orbit, largest |Floquet multiplier| "
-                              f"{big:.4g} < 1")
+                ev["rule"] = (
+                    f"{rule}; shooting converged (residual {orb.residual:.1e}) to a "
+                    f"stable period-{n} orbit, largest |Floquet multiplier| "
+                    f"{big:.4g} < 1"
+                )
                 return Regime(f"P{n}", "P1" if n == 1 else "Pn", n, ev)
-            why = ("shooting failed" if orb is None else
-                   "shooting did not converge" if not orb.converged else
-                   "the orbit shooting converged to is unstable")
+            why = (
+                "shooting failed"
+                if orb is None
+                else "shooting did not converge"
+                if not orb.converged
+                else "the orbit shooting converged to is unstable"
+            )
             ev["periodic_rejected"] = f"{rule}, but {why}"
             break
     thr = max(chaos_threshold, 3.0 * lam_stderr)
@@ -318,9 +416,12 @@ def classify_points(strobe, scale, lam, lam_stderr=0.0, *, max_period=8, closure
     if lam > thr:
         ev["rule"] = f"no period <= {max_period}; largest exponent {lam:.3g} > {thr:.3g}"
         return Regime("chaotic", "chaotic", 0, ev)
-    ev["rule"] = (f"no period <= {max_period}; largest exponent {lam:.3g} <= {thr:.3g} (near "
-                  f"0): an invariant closed curve, rotation number {rho:.4f}")
+    ev["rule"] = (
+        f"no period <= {max_period}; largest exponent {lam:.3g} <= {thr:.3g} (near "
+        f"0): an invariant closed curve, rotation number {rho:.4f}"
+    )
     return Regime("beat", "beat", 0, ev)
+
 
 def _shoot(period_map, y, n, tol, ev):
     """Shooting for the period-``n`` orbit near ``y``; its evidence into ``ev``."""
@@ -336,8 +437,7 @@ def _shoot(period_map, y, n, tol, ev):
     return orb
 
 
-def classify(system, y0=None, *, transient=300, periods=400, tolerances=None, shoot=True,
-             **rules):
+def classify(system, y0=None, *, transient=300, periods=400, tolerances=None, shoot=True, **rules):
     """The regime reached from ``y0``: ``(Regime, Lyapunov, strobe points)``.
 
     ``shoot`` (default): a recurring orbit is polished by shooting and called periodic
@@ -347,8 +447,9 @@ def classify(system, y0=None, *, transient=300, periods=400, tolerances=None, sh
     tol, T, atol, hmax = _setup(system, tolerances)
     y = _after(system, y0, transient, tol)
     logs, trace, strobe, _ = _variational(system, y, 0.0, periods, tol, T, atol, hmax)
-    lyap = lyapunov(system, tolerances=tol, batches=min(20, max(2, int(periods) // 20)),
-                    _run=(logs, trace))
+    lyap = lyapunov(
+        system, tolerances=tol, batches=min(20, max(2, int(periods) // 20)), _run=(logs, trace)
+    )
     if shoot and rules.get("period_map") is None:
         from .periodic import UedaMap
 
@@ -395,26 +496,42 @@ class Attractor:
 
     def as_dict(self):
         s = self.strobe
-        return {"system": self.system.as_dict(), "regime": self.regime.regime,
-                "classification": self.regime.as_dict(), "lyapunov": self.lyapunov.as_dict(),
-                "strobe_x_range": [float(s[:, 0].min()), float(s[:, 0].max())],
-                "strobe_y_range": [float(s[:, 1].min()), float(s[:, 1].max())],
-                "n_points": self.n_points, "y0": [float(v) for v in self.y0],
-                "transient_periods": self.transient, "seconds": self.seconds}
+        return {
+            "system": self.system.as_dict(),
+            "regime": self.regime.regime,
+            "classification": self.regime.as_dict(),
+            "lyapunov": self.lyapunov.as_dict(),
+            "strobe_x_range": [float(s[:, 0].min()), float(s[:, 0].max())],
+            "strobe_y_range": [float(s[:, 1].min()), float(s[:, 1].max())],
+            "n_points": self.n_points,
+            "y0": [float(v) for v in self.y0],
+            "transient_periods": self.transient,
+            "seconds": self.seconds,
+        }
 
     def _lines(self):
         return generic_lines(self)
 
 
 @params(
-    system=UedaSystem, y0=(None, Array(1)), transient=Real(0, integer=True),
-    periods=Real(1, integer=True), batches=Real(1, integer=True),
-    trajectory_periods=Real(0, integer=True), tolerances=(Tolerances, None),
+    system=UedaSystem,
+    y0=(None, Array(1)),
+    transient=Real(0, integer=True),
+    periods=Real(1, integer=True),
+    batches=Real(1, integer=True),
+    trajectory_periods=Real(0, integer=True),
+    tolerances=(Tolerances, None),
 )
-
-
-def attractor(system, y0=None, *, transient=500, periods=5000, batches=20,
-              trajectory_periods=30, tolerances=None):
+def attractor(
+    system,
+    y0=None,
+    *,
+    transient=500,
+    periods=5000,
+    batches=20,
+    trajectory_periods=30,
+    tolerances=None,
+):
     """The attractor reached from ``y0``: strobe points, exponents, regime, a trajectory.
 
     The strobe points are those of the Lyapunov run (one trajectory, ``periods``
@@ -431,13 +548,23 @@ def attractor(system, y0=None, *, transient=500, periods=5000, batches=20,
     from .periodic import UedaMap
 
     # a recurring orbit is polished by shooting: its Floquet multipliers are the evidence
-    reg = classify_points(strobe, system.scales(), lyap.value, lyap.stderr,
-                          period_map=UedaMap(system, tol))
+    reg = classify_points(
+        strobe, system.scales(), lyap.value, lyap.stderr, period_map=UedaMap(system, tol)
+    )
     n_tr = int(trajectory_periods)
     t, x, v = trajectory(system, yf, (0.0, n_tr * T), n_samples=200 * n_tr, tolerances=tol)
-    return Attractor(system=system, regime=reg, lyapunov=lyap, strobe=strobe, t=t, x=x, v=v,
-                     y0=y_init, transient=int(transient),
-                     seconds=time.perf_counter() - t_start)
+    return Attractor(
+        system=system,
+        regime=reg,
+        lyapunov=lyap,
+        strobe=strobe,
+        t=t,
+        x=x,
+        v=v,
+        y0=y_init,
+        transient=int(transient),
+        seconds=time.perf_counter() - t_start,
+    )
 
 
 # ------------------------------------------------------------------ coexisting attractors
@@ -464,18 +591,19 @@ class Basins:
     attractors: list
 
     def as_dict(self):
-        return {"grid": [int(self.x0.size), int(self.v0.size)],
-                "x0_range": [float(self.x0[0]), float(self.x0[-1])],
-                "v0_range": [float(self.v0[0]), float(self.v0[-1])],
-                "attractors": [{k: v for k, v in a.items() if k != "points"}
-                               for a in self.attractors]}
+        return {
+            "grid": [int(self.x0.size), int(self.v0.size)],
+            "x0_range": [float(self.x0[0]), float(self.x0[-1])],
+            "v0_range": [float(self.v0[0]), float(self.v0[-1])],
+            "attractors": [{k: v for k, v in a.items() if k != "points"} for a in self.attractors],
+        }
 
 
 def _same_attractor(a, b, reg_a, reg_b, scale, tol=1e-3):
     if reg_a.regime != reg_b.regime:
         return False
     if reg_a.period:  # periodic: the same cycle of points, in any phase
-        A, Bp = a[-reg_a.period:] / scale, b[-reg_b.period:] / scale
+        A, Bp = a[-reg_a.period :] / scale, b[-reg_b.period :] / scale
         return all(np.min(np.max(np.abs(Bp - p), axis=1)) < tol for p in A)
     # beat / chaotic: the same set - the points of each lie as close to the other's as
     # they lie to their own neighbours (median nearest-neighbour distances)
@@ -492,13 +620,24 @@ def _same_attractor(a, b, reg_a, reg_b, scale, tol=1e-3):
 
 
 @params(
-    system=UedaSystem, x_range=Array(1), v_range=Array(1), n=Real(1, integer=True),
-    transient=Real(0, integer=True), periods=Real(1, integer=True), tolerances=(Tolerances, None),
+    system=UedaSystem,
+    x_range=Array(1),
+    v_range=Array(1),
+    n=Real(1, integer=True),
+    transient=Real(0, integer=True),
+    periods=Real(1, integer=True),
+    tolerances=(Tolerances, None),
 )
-
-
-def basins(system, x_range=(-1.0, 1.0), v_range=(-1.0, 1.0), n=10, *, transient=300,
-           periods=200, tolerances=None):
+def basins(
+    system,
+    x_range=(-1.0, 1.0),
+    v_range=(-1.0, 1.0),
+    n=10,
+    *,
+    transient=300,
+    periods=200,
+    tolerances=None,
+):
     """Attractors reached from an ``n x n`` grid of initial states, with basin fractions."""
     x0 = np.linspace(*x_range, int(n))
     v0 = np.linspace(*v_range, int(n))
@@ -507,8 +646,9 @@ def basins(system, x_range=(-1.0, 1.0), v_range=(-1.0, 1.0), n=10, *, transient=
     scale = system.scales()
     for i, vv in enumerate(v0):
         for j, xx in enumerate(x0):
-            reg, lyap, strobe = classify(system, (xx, vv), transient=transient,
-                                         periods=periods, tolerances=tolerances)
+            reg, lyap, strobe = classify(
+                system, (xx, vv), transient=transient, periods=periods, tolerances=tolerances
+            )
             for k, (r, s, _, _) in enumerate(found):
                 if _same_attractor(s, strobe, r, reg, scale):
                     label[i, j] = k
@@ -519,8 +659,15 @@ def basins(system, x_range=(-1.0, 1.0), v_range=(-1.0, 1.0), n=10, *, transient=
     total = label.size
     atts = []
     for k, (r, s, lyap, ex) in enumerate(found):
-        atts.append({"regime": r.regime, "fraction": float(np.sum(label == k) / total),
-                     "lyapunov": lyap.value, "lyapunov_stderr": lyap.stderr,
-                     "centre": [float(c) for c in s.mean(axis=0)], "example_y0": list(ex),
-                     "points": s[-min(len(s), 400):]})
+        atts.append(
+            {
+                "regime": r.regime,
+                "fraction": float(np.sum(label == k) / total),
+                "lyapunov": lyap.value,
+                "lyapunov_stderr": lyap.stderr,
+                "centre": [float(c) for c in s.mean(axis=0)],
+                "example_y0": list(ex),
+                "points": s[-min(len(s), 400) :],
+            }
+        )
     return Basins(system=system, x0=x0, v0=v0, label=label, attractors=atts)

@@ -57,8 +57,22 @@ KINDS = ("P1", "Pn", "beat", "chaotic")  # codes 0..3; -1 failed
 
 
 @njit(cache=True)
-def _scan(y0, p, T, n_max, max_period, min_pairs, closure, inv_scale, rtol, atol, hmax,
-          max_steps, out_strobe, run):
+def _scan(
+    y0,
+    p,
+    T,
+    n_max,
+    max_period,
+    min_pairs,
+    closure,
+    inv_scale,
+    rtol,
+    atol,
+    hmax,
+    max_steps,
+    out_strobe,
+    run,
+):
     """Up to ``n_max`` periods of the stroboscopic map from ``(0, y0)`` (the same steps
     as :func:`~discovery.oscillator._kernel.strobe_run`), stopping early when the strobe
     points repeat: ``run[n]`` counts the consecutive latest pairs ``|S_k - S_{k-n}| /
@@ -84,8 +98,23 @@ def _scan(y0, p, T, n_max, max_period, min_pairs, closure, inv_scale, rtol, atol
     found = 0
     k = 0
     while k < n_max:
-        status, t, h, _, ns = UK._adv2(t, y, (k + 1) * T, h, p, rtol, atol, hmax,
-                                       max_steps - n_steps, K, ytmp, ynew, empty_t, 0, empty_o)
+        status, t, h, _, ns = UK._adv2(
+            t,
+            y,
+            (k + 1) * T,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
         n_steps += ns
         if status != OK:
             break
@@ -101,8 +130,11 @@ def _scan(y0, p, T, n_max, max_period, min_pairs, closure, inv_scale, rtol, atol
             if run[n] >= need:
                 found = n
                 for d in range(1, n):
-                    if n % d == 0 and (run[d] > 0 or _gap(out_strobe, k, d, inv_scale)
-                                       < 0.9 * _gap(out_strobe, k - need, d, inv_scale)):
+                    if n % d == 0 and (
+                        run[d] > 0
+                        or _gap(out_strobe, k, d, inv_scale)
+                        < 0.9 * _gap(out_strobe, k - need, d, inv_scale)
+                    ):
                         found = 0
                 break
         k += 1
@@ -114,8 +146,7 @@ def _scan(y0, p, T, n_max, max_period, min_pairs, closure, inv_scale, rtol, atol
 @njit(cache=True, inline="always")
 def _gap(s, k, n, inv_scale):
     """``max |S_k - S_{k-n}| / scale``."""
-    return max(abs(s[k, 0] - s[k - n, 0]) * inv_scale[0],
-               abs(s[k, 1] - s[k - n, 1]) * inv_scale[1])
+    return max(abs(s[k, 0] - s[k - n, 0]) * inv_scale[0], abs(s[k, 1] - s[k - n, 1]) * inv_scale[1])
 
 
 @njit(cache=True)
@@ -146,8 +177,23 @@ def _monodromy(y0, p, T, n, rtol, atol_state, atol_tangent, hmax, max_steps):
     logs = 0.0
     UK._rhs7(t, y, p, K[0])
     for k in range(n):
-        status, t, h, _, ns = UK._adv7(t, y, (k + 1) * T, h, p, rtol, atol, hmax,
-                                       max_steps - n_steps, K, ytmp, ynew, empty_t, 0, empty_o)
+        status, t, h, _, ns = UK._adv7(
+            t,
+            y,
+            (k + 1) * T,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
         n_steps += ns
         if status != OK:
             break
@@ -244,40 +290,61 @@ class Chart:
         """The CSV header (:meth:`rows`)."""
         cols = ["nu", "B", "regime", "period", "lyapunov", "rotation_number"]
         if self.sweeps == 2:
-            cols += ["regime_down", "period_down", "lyapunov_down", "rotation_number_down",
-                     "coexisting"]
+            cols += [
+                "regime_down",
+                "period_down",
+                "lyapunov_down",
+                "rotation_number_down",
+                "coexisting",
+            ]
         return cols
 
     def rows(self):
         """CSV rows (:attr:`columns`): ``nu, B, regime, period, lyapunov, rotation``
         and, with two sweeps, the same for the sweep in decreasing ``nu`` and
         ``coexisting`` (0/1)."""
+
         def name(k):
             return KINDS[k] if k >= 0 else "failed"
 
         for i, b in enumerate(self.B):
             for j, nu in enumerate(self.nu):
-                row = (float(nu), float(b), name(int(self.kind[i, j])),
-                       int(self.period[i, j]), float(self.lyapunov[i, j]),
-                       float(self.rotation[i, j]))
+                row = (
+                    float(nu),
+                    float(b),
+                    name(int(self.kind[i, j])),
+                    int(self.period[i, j]),
+                    float(self.lyapunov[i, j]),
+                    float(self.rotation[i, j]),
+                )
                 if self.sweeps == 2:
-                    row += (name(int(self.kind_down[i, j])), int(self.period_down[i, j]),
-                            float(self.lyapunov_down[i, j]), float(self.rotation_down[i, j]),
-                            int(self.coexisting[i, j]))
+                    row += (
+                        name(int(self.kind_down[i, j])),
+                        int(self.period_down[i, j]),
+                        float(self.lyapunov_down[i, j]),
+                        float(self.rotation_down[i, j]),
+                        int(self.coexisting[i, j]),
+                    )
                 yield row
 
     def as_dict(self):
         n = int(self.kind.size)
-        out = {"system": self.system.as_dict(), "grid": [int(self.nu.size), int(self.B.size)],
-               "nu_range": [float(self.nu[0]), float(self.nu[-1])],
-               "B_range": [float(self.B[0]), float(self.B[-1])],
-               "fractions": self.fractions(),
-               "periods_found": {f"P{k}": v for k, v in self.period_counts().items()},
-               "seconds": self.seconds, "cpu_seconds": self.cpu_seconds,
-               "workers": self.workers, "points": n, "sweeps": self.sweeps,
-               "seconds_per_point_per_worker": self.seconds * self.workers / n,
-               "cpu_seconds_per_point": self.cpu_seconds / (n * self.sweeps),
-               "settings": self.settings}
+        out = {
+            "system": self.system.as_dict(),
+            "grid": [int(self.nu.size), int(self.B.size)],
+            "nu_range": [float(self.nu[0]), float(self.nu[-1])],
+            "B_range": [float(self.B[0]), float(self.B[-1])],
+            "fractions": self.fractions(),
+            "periods_found": {f"P{k}": v for k, v in self.period_counts().items()},
+            "seconds": self.seconds,
+            "cpu_seconds": self.cpu_seconds,
+            "workers": self.workers,
+            "points": n,
+            "sweeps": self.sweeps,
+            "seconds_per_point_per_worker": self.seconds * self.workers / n,
+            "cpu_seconds_per_point": self.cpu_seconds / (n * self.sweeps),
+            "settings": self.settings,
+        }
         if self.periods_integrated is not None:
             out["mean_periods_integrated"] = float(np.mean(self.periods_integrated))
         if self.sweeps == 2:
@@ -288,15 +355,16 @@ class Chart:
             out["coexisting_points"] = int(np.sum(self.coexisting))
         return out
 
-
-# ------------------------------------------------------------------ one point
+    # ------------------------------------------------------------------ one point
 
     def _lines(self):
         kinds, counts = np.unique(np.asarray(self.kind).astype(str), return_counts=True)
         share = ", ".join(f"{k} {c}" for k, c in zip(kinds, counts, strict=True))
-        return [f"regime chart of {self.system.model} on {np.size(self.nu)} x "
-                f"{np.size(self.B)} points ({self.seconds:.1f} s, {self.workers} worker(s))",
-                f"  regimes: {share}"]
+        return [
+            f"regime chart of {self.system.model} on {np.size(self.nu)} x "
+            f"{np.size(self.B)} points ({self.seconds:.1f} s, {self.workers} worker(s))",
+            f"  regimes: {share}",
+        ]
 
 
 def _floquet(M, logs):
@@ -305,8 +373,10 @@ def _floquet(M, logs):
     r = cmath.sqrt(tr * tr - 4.0 * det)
     a, b = abs(0.5 * (tr + r)), abs(0.5 * (tr - r))
     big, small = max(a, b), min(a, b)
-    return (math.log(big) + logs if big > 0 else -math.inf,
-            math.log(small) + logs if small > 0 else -math.inf)
+    return (
+        math.log(big) + logs if big > 0 else -math.inf,
+        math.log(small) + logs if small > 0 else -math.inf,
+    )
 
 
 class _Point:
@@ -329,7 +399,7 @@ def _recurrence(strobe, inv_scale, max_period, closure, min_pairs):
         need = max(3 * n, min_pairs)
         if need + n > len(s):
             break
-        tail = s[-(need + n):]
+        tail = s[-(need + n) :]
         if np.max(np.abs(tail[n:] - tail[:-n])) < closure:
             return n
     return 0
@@ -338,8 +408,9 @@ def _recurrence(strobe, inv_scale, max_period, closure, min_pairs):
 def _stable_orbit(y, p, T, n, tol, atol, hmax):
     """``log|m_1| / (n T)`` of the period-``n`` orbit through ``y`` (its monodromy over
     ``n`` periods); NaN when it is not stable (``|m_1| >= 1``)."""
-    status, t, M, logs, _ = _monodromy(y, p, T, n, tol.rtol, atol, tol.atol_variational,
-                                       hmax, _budget(tol, n))
+    status, t, M, logs, _ = _monodromy(
+        y, p, T, n, tol.rtol, atol, tol.atol_variational, hmax, _budget(tol, n)
+    )
     _check(status, t, "the variational equations")
     log1, _ = _floquet(M, logs)
     return log1 / (n * T) if log1 < 0.0 else np.nan
@@ -360,28 +431,68 @@ def _point(system, y, s, tol, buffers=None):
     y = np.asarray(y, dtype=float)
     cost = 0
     if n_tr > 0:
-        status, t, y, done, n = _scan(y, p, T, n_tr, P if s["early_exit"] else 0,
-                                      s["min_pairs"], closure, inv, tol.rtol, atol, hmax,
-                                      _budget(tol, n_tr), strobe, run)
+        status, t, y, done, n = _scan(
+            y,
+            p,
+            T,
+            n_tr,
+            P if s["early_exit"] else 0,
+            s["min_pairs"],
+            closure,
+            inv,
+            tol.rtol,
+            atol,
+            hmax,
+            _budget(tol, n_tr),
+            strobe,
+            run,
+        )
         _check(status, t, "the stroboscopic map")
         cost += done
         if n > 0:
             lam = _stable_orbit(y, p, T, n, tol, atol, hmax)
             cost += n
             if np.isfinite(lam):  # a stable orbit: P<n>
-                return _Point(0 if n == 1 else 1, n, lam, np.nan, y, cost,
-                              strobe[done - n:done].copy())
+                return _Point(
+                    0 if n == 1 else 1, n, lam, np.nan, y, cost, strobe[done - n : done].copy()
+                )
             # an unstable orbit repeating by chance: the rest of the transient
-            status, t, y, more, _ = _scan(y, p, T, n_tr - done, 0, 1, closure, inv, tol.rtol,
-                                          atol, hmax, _budget(tol, n_tr), strobe, run)
+            status, t, y, more, _ = _scan(
+                y,
+                p,
+                T,
+                n_tr - done,
+                0,
+                1,
+                closure,
+                inv,
+                tol.rtol,
+                atol,
+                hmax,
+                _budget(tol, n_tr),
+                strobe,
+                run,
+            )
             _check(status, t, "the stroboscopic map")
             cost += more
     logs = np.empty((n_obs, 2))
     trace = np.empty(n_obs)
     obs = np.empty((n_obs, 2))
-    status, t, yf, _ = UK.variational_run(0.0, y, p, T, n_obs, tol.rtol, atol,
-                                          tol.atol_variational, hmax,
-                                          _budget(tol, n_obs), logs, trace, obs)
+    status, t, yf, _ = UK.variational_run(
+        0.0,
+        y,
+        p,
+        T,
+        n_obs,
+        tol.rtol,
+        atol,
+        tol.atol_variational,
+        hmax,
+        _budget(tol, n_obs),
+        logs,
+        trace,
+        obs,
+    )
     _check(status, t, "the variational equations")
     cost += n_obs
     n = _recurrence(obs, inv, P, closure, s["min_pairs"])
@@ -391,10 +502,8 @@ def _point(system, y, s, tol, buffers=None):
         if np.isfinite(lam):
             return _Point(0 if n == 1 else 1, n, lam, np.nan, yf, cost, obs[-n:])
     lam = float(logs[:, 0].sum() / (n_obs * T))
-    reg = classify_points(obs, scale, lam, 0.0, max_period=0,
-                          chaos_threshold=s["chaos_threshold"])
-    return _Point(KINDS.index(reg.kind), 0, lam, reg.evidence["rotation_number"], yf, cost,
-                  obs)
+    reg = classify_points(obs, scale, lam, 0.0, max_period=0, chaos_threshold=s["chaos_threshold"])
+    return _Point(KINDS.index(reg.kind), 0, lam, reg.evidence["rotation_number"], yf, cost, obs)
 
 
 # ------------------------------------------------------------------ same attractor?
@@ -440,8 +549,7 @@ def _row(ctx, job):
     c0 = time.process_time()
     base, s = ctx
     tol = Tolerances(rtol=s["rtol"], hmax_fraction=s["hmax_fraction"])
-    buffers = (np.empty((max(s["transient"], 1), 2)),
-               np.zeros(s["max_period"] + 1, dtype=np.int64))
+    buffers = (np.empty((max(s["transient"], 1), 2)), np.zeros(s["max_period"] + 1, dtype=np.int64))
     up, y = _sweep(base, b, nus, s, tol, np.array(s["y0"], dtype=float), buffers)
 
     def pack(r):
@@ -451,8 +559,9 @@ def _row(ctx, job):
     if s["sweeps"] == 2:
         dn, _ = _sweep(base, b, nus[::-1], s, tol, y, buffers)
         dn = dn[::-1]
-        coex = [_coexisting(base, b, nu, u, d, s, tol) for nu, u, d in zip(nus, up, dn,
-                                                                             strict=True)]
+        coex = [
+            _coexisting(base, b, nu, u, d, s, tol) for nu, u, d in zip(nus, up, dn, strict=True)
+        ]
         down = [pack(r) for r in dn]
     return [pack(r) for r in up], down, coex, time.process_time() - c0
 
@@ -487,15 +596,39 @@ def _axis(values, name):
 
 
 @params(
-    system=UedaSystem, nu=Array(1), B=Array(1), y0=(None, Array(1)),
-    transient=Real(0, integer=True), periods=Real(1, integer=True), rtol=Real(0, 1, open_low=True),
-    hmax_fraction=Real(0, 1, open_low=True), max_period=Real(1, integer=True),
+    system=UedaSystem,
+    nu=Array(1),
+    B=Array(1),
+    y0=(None, Array(1)),
+    transient=Real(0, integer=True),
+    periods=Real(1, integer=True),
+    rtol=Real(0, 1, open_low=True),
+    hmax_fraction=Real(0, 1, open_low=True),
+    max_period=Real(1, integer=True),
     workers=(None, Real(1, integer=True)),
     executor=(None, Instance("discovery.executor", "Executor")),
 )
-def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_fraction=0.1,
-          max_period=16, closure=1e-4, chaos_threshold=0.015, sweeps=1, early_exit=True,
-          min_pairs=12, recheck=5, workers=None, progress=None, executor=None):
+def chart(
+    system,
+    nu,
+    B,
+    *,
+    y0=None,
+    transient=60,
+    periods=80,
+    rtol=1e-6,
+    hmax_fraction=0.1,
+    max_period=16,
+    closure=1e-4,
+    chaos_threshold=0.015,
+    sweeps=1,
+    early_exit=True,
+    min_pairs=12,
+    recheck=5,
+    workers=None,
+    progress=None,
+    executor=None,
+):
     """The regime at every ``(nu, B)`` of a grid (see the module docstring).
 
     Parameters
@@ -554,25 +687,37 @@ def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_f
     if int(transient) < 0:
         raise InputError(f"transient must be >= 0, got {transient!r}")
     if int(periods) < 4 * int(max_period):
-        raise InputError(f"periods ({int(periods)}) must be at least 4 x max_period = "
-                         f"{4 * int(max_period)}: the recurrence test of period n compares "
-                         "three cycles of strobe points with the cycle before")
+        raise InputError(
+            f"periods ({int(periods)}) must be at least 4 x max_period = "
+            f"{4 * int(max_period)}: the recurrence test of period n compares "
+            "three cycles of strobe points with the cycle before"
+        )
     if int(sweeps) not in (1, 2):
         raise InputError(f"sweeps must be 1 or 2, got {sweeps!r}")
     if int(recheck) < 0:
         raise InputError(f"recheck must be >= 0, got {recheck!r}")
     if int(min_pairs) < 1:
         raise InputError(f"min_pairs must be at least 1, got {min_pairs!r}")
-    settings = {"transient": int(transient), "periods": int(periods), "rtol": float(rtol),
-                "hmax_fraction": float(hmax_fraction),
-                "max_period": int(max_period), "closure": float(closure),
-                "chaos_threshold": float(chaos_threshold), "sweeps": int(sweeps),
-                "early_exit": bool(early_exit), "min_pairs": int(min_pairs),
-                "recheck": int(recheck),
-                "y0": [float(v) for v in _y0(y0)],
-                "continuation": "rows swept in increasing nu" + (
-                    ", then back in decreasing nu from the state the first sweep ended in"
-                    if int(sweeps) == 2 else "")}
+    settings = {
+        "transient": int(transient),
+        "periods": int(periods),
+        "rtol": float(rtol),
+        "hmax_fraction": float(hmax_fraction),
+        "max_period": int(max_period),
+        "closure": float(closure),
+        "chaos_threshold": float(chaos_threshold),
+        "sweeps": int(sweeps),
+        "early_exit": bool(early_exit),
+        "min_pairs": int(min_pairs),
+        "recheck": int(recheck),
+        "y0": [float(v) for v in _y0(y0)],
+        "continuation": "rows swept in increasing nu"
+        + (
+            ", then back in decreasing nu from the state the first sweep ended in"
+            if int(sweeps) == 2
+            else ""
+        ),
+    }
     workers = min(int(workers or os.cpu_count() or 1), B.size)
     shape = (B.size, nu.size)
     kind = np.full(shape, -1, dtype=int)
@@ -591,8 +736,9 @@ def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_f
     own = executor is None
     ex = make_executor(workers) if own else executor
     try:
-        for done, (i, (up, down, cx, sec)) in enumerate(ex.run(_row, jobs, (system, settings)),
-                                                        start=1):
+        for done, (i, (up, down, cx, sec)) in enumerate(
+            ex.run(_row, jobs, (system, settings)), start=1
+        ):
             cpu += sec
             for j, (k, n, lv, r, c) in enumerate(up):
                 kind[i, j], period[i, j], lam[i, j], rot[i, j], cost[i, j] = k, n, lv, r, c
@@ -609,8 +755,25 @@ def chart(system, nu, B, *, y0=None, transient=60, periods=80, rtol=1e-6, hmax_f
     workers = min(ex.workers, len(jobs))
     extra = {}
     if two:
-        extra = {"kind_down": kind2, "period_down": period2, "lyapunov_down": lam2,
-                 "rotation_down": rot2, "coexisting": coex}
-    return Chart(system=system, nu=nu, B=B, kind=kind, period=period, lyapunov=lam,
-                 rotation=rot, seconds=time.perf_counter() - t_start, workers=workers,
-                 settings=settings, periods_integrated=cost, cpu_seconds=cpu, **extra)
+        extra = {
+            "kind_down": kind2,
+            "period_down": period2,
+            "lyapunov_down": lam2,
+            "rotation_down": rot2,
+            "coexisting": coex,
+        }
+    return Chart(
+        system=system,
+        nu=nu,
+        B=B,
+        kind=kind,
+        period=period,
+        lyapunov=lam,
+        rotation=rot,
+        seconds=time.perf_counter() - t_start,
+        workers=workers,
+        settings=settings,
+        periods_integrated=cost,
+        cpu_seconds=cpu,
+        **extra,
+    )

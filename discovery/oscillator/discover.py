@@ -49,10 +49,24 @@ from ._kernel import renormalise
 from .attractor import classify_points, rotation_number
 from .system import UedaSystem
 
-__all__ = ["TERMS", "MONOMIALS", "FORCING", "ForcedPolynomial", "Discovery", "Verification",
-           "discover", "verify", "simulate_record", "energy_distance", "record_strobe_points",
-           "classify_record", "read_record_csv", "weak_system", "stlsq",
-           "strobe_block_length"]
+__all__ = [
+    "TERMS",
+    "MONOMIALS",
+    "FORCING",
+    "ForcedPolynomial",
+    "Discovery",
+    "Verification",
+    "discover",
+    "verify",
+    "simulate_record",
+    "energy_distance",
+    "record_strobe_points",
+    "classify_record",
+    "read_record_csv",
+    "weak_system",
+    "stlsq",
+    "strobe_block_length",
+]
 
 #: exponents ``(i, j)`` of the library terms ``x^i x'^j`` (degree <= 3)
 MONOMIALS = ((0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2), (3, 0), (2, 1), (1, 2), (0, 3))
@@ -154,7 +168,7 @@ class ForcedPolynomial:
         rhs = 0
         for (i, j), c in zip(MONOMIALS, self.coefficients, strict=True):
             if c:
-                rhs += sp.Float(float(f"{c:.{digits}g}"), digits) * x ** i * v ** j
+                rhs += sp.Float(float(f"{c:.{digits}g}"), digits) * x**i * v**j
         f = sp.Float(float(f"{self.forcing:.{digits}g}"), digits)
         rhs += (f if self.forcing != 1.0 else 1) * B * sp.cos(nu * t)
         return sp.Eq(x.diff(t, 2), rhs)
@@ -174,12 +188,20 @@ def _poly(x, v, p):
     """``sum_j p[j] x^i v^j`` and its partial derivatives (the MONOMIALS' order)."""
     x2 = x * x
     v2 = v * v
-    a = (p[0] + p[1] * x + p[2] * v + p[3] * x2 + p[4] * x * v + p[5] * v2 + p[6] * x2 * x
-         + p[7] * x2 * v + p[8] * x * v2 + p[9] * v2 * v)
-    ax = (p[1] + 2.0 * p[3] * x + p[4] * v + 3.0 * p[6] * x2 + 2.0 * p[7] * x * v
-          + p[8] * v2)
-    av = (p[2] + p[4] * x + 2.0 * p[5] * v + p[7] * x2 + 2.0 * p[8] * x * v
-          + 3.0 * p[9] * v2)
+    a = (
+        p[0]
+        + p[1] * x
+        + p[2] * v
+        + p[3] * x2
+        + p[4] * x * v
+        + p[5] * v2
+        + p[6] * x2 * x
+        + p[7] * x2 * v
+        + p[8] * x * v2
+        + p[9] * v2 * v
+    )
+    ax = p[1] + 2.0 * p[3] * x + p[4] * v + 3.0 * p[6] * x2 + 2.0 * p[7] * x * v + p[8] * v2
+    av = p[2] + p[4] * x + 2.0 * p[5] * v + p[7] * x2 + 2.0 * p[8] * x * v + 3.0 * p[9] * v2
     return a, ax, av
 
 
@@ -221,8 +243,23 @@ def _strobe_run(t0, y0, p, T, n_trans, rtol, atol, hmax, max_steps):
     n_steps = 0
     status = OK
     for k in range(n_trans):
-        status, t, h, _, ns = _adv2(t, y, t0 + (k + 1) * T, h, p, rtol, atol, hmax,
-                                    max_steps - n_steps, K, ytmp, ynew, empty_t, 0, empty_o)
+        status, t, h, _, ns = _adv2(
+            t,
+            y,
+            t0 + (k + 1) * T,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
         n_steps += ns
         if status != OK or abs(y[0]) > 1e6 or abs(y[1]) > 1e6:
             if status == OK:
@@ -232,8 +269,21 @@ def _strobe_run(t0, y0, p, T, n_trans, rtol, atol, hmax, max_steps):
 
 
 @njit(cache=True)
-def _variational_run(t0, y0, p, T, n_seg, rtol, atol_state, atol_tangent, hmax, max_steps,
-                     out_logs, out_trace, out_strobe):
+def _variational_run(
+    t0,
+    y0,
+    p,
+    T,
+    n_seg,
+    rtol,
+    atol_state,
+    atol_tangent,
+    hmax,
+    max_steps,
+    out_logs,
+    out_trace,
+    out_strobe,
+):
     """Benettin's method (as :func:`discovery.oscillator._kernel.variational_run`)."""
     y = np.zeros(7)
     y[0] = y0[0]
@@ -256,8 +306,23 @@ def _variational_run(t0, y0, p, T, n_seg, rtol, atol_state, atol_tangent, hmax, 
     status = OK
     _rhs7(t, y, p, K[0])
     for k in range(n_seg):
-        status, t, h, _, ns = _adv7(t, y, t0 + (k + 1) * T, h, p, rtol, atol, hmax,
-                                    max_steps - n_steps, K, ytmp, ynew, empty_t, 0, empty_o)
+        status, t, h, _, ns = _adv7(
+            t,
+            y,
+            t0 + (k + 1) * T,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
         n_steps += ns
         if status != OK:
             break
@@ -269,8 +334,7 @@ def _variational_run(t0, y0, p, T, n_seg, rtol, atol_state, atol_tangent, hmax, 
     return status, t, y[:2].copy(), n_steps
 
 
-def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20,
-                   tolerances=None):
+def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20, tolerances=None):
     """Integrate ``model`` (a :class:`ForcedPolynomial`) from ``y0`` at ``t0``: after
     ``transient`` periods, ``periods`` strobe points (at ``t0 + k T``) and the largest
     two Lyapunov exponents (variational equations, batch-means errors).
@@ -290,24 +354,44 @@ def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20
     p = model.params()
     y = np.asarray(y0, dtype=float).copy()
     if transient > 0:
-        status, t, y = _strobe_run(float(t0), y, p, T, int(transient), tol.rtol, atol, hmax,
-                                   _budget(tol, transient))
+        status, t, y = _strobe_run(
+            float(t0), y, p, T, int(transient), tol.rtol, atol, hmax, _budget(tol, transient)
+        )
         check(status, t, "the discovered equation")
     n = int(periods)
     logs, trace, strobe = np.empty((n, 2)), np.empty(n), np.empty((n, 2))
     t_start = float(t0) + int(transient) * T
-    status, t, _, _ = _variational_run(t_start, y, p, T, n, tol.rtol, atol,
-                                       tol.atol_variational, hmax, _budget(tol, n),
-                                       logs, trace, strobe)
+    status, t, _, _ = _variational_run(
+        t_start,
+        y,
+        p,
+        T,
+        n,
+        tol.rtol,
+        atol,
+        tol.atol_variational,
+        hmax,
+        _budget(tol, n),
+        logs,
+        trace,
+        strobe,
+    )
     check(status, t, "the discovered equation")
     bv, se = _batch_stats(logs, T, batches)
     lam = logs.sum(axis=0) / (n * T)
-    lyap = _Lyap(value=float(lam[0]), stderr=float(se[0]), second=float(lam[1]),
-                 second_stderr=float(se[1]), sum=float(lam.sum()),
-                 trace_mean=float(trace.sum() / (n * T)), n_periods=n,
-                 batches=int(bv.shape[0]), rtol=tol.rtol,
-                 method="variational equations, Gram-Schmidt (QR) every period",
-                 batch_values=bv[:, 0].copy())
+    lyap = _Lyap(
+        value=float(lam[0]),
+        stderr=float(se[0]),
+        second=float(lam[1]),
+        second_stderr=float(se[1]),
+        sum=float(lam.sum()),
+        trace_mean=float(trace.sum() / (n * T)),
+        n_periods=n,
+        batches=int(bv.shape[0]),
+        rtol=tol.rtol,
+        method="variational equations, Gram-Schmidt (QR) every period",
+        batch_values=bv[:, 0].copy(),
+    )
     return strobe, lyap
 
 
@@ -321,11 +405,15 @@ def read_record_csv(path):
     header, body, decimal_comma, _ = read_csv_rows(path, "t and x")
     missing = [c for c in ("t", "x") if c not in header]
     if missing:
-        raise InputError(f"data file {str(path)!r}: no column(s) {', '.join(missing)} in the "
-                         f"header {','.join(header)[:80]!r}; name the columns t and x")
+        raise InputError(
+            f"data file {str(path)!r}: no column(s) {', '.join(missing)} in the "
+            f"header {','.join(header)[:80]!r}; name the columns t and x"
+        )
     limits = {"t": (1e7, "s"), "x": (1e6, "")}
-    t, x = (_parse_column(c, c, header.index(c), body, str(path), decimal_comma, limits)
-            for c in ("t", "x"))
+    t, x = (
+        _parse_column(c, c, header.index(c), body, str(path), decimal_comma, limits)
+        for c in ("t", "x")
+    )
     return check_record(t, x, what=f"--data {path}")
 
 
@@ -335,34 +423,50 @@ def check_record(t, x, what="the record"):
     if t.shape != x.shape:
         raise InputError(f"{what}: t and x differ in length ({t.size} vs {x.size})")
     if t.size < 64:
-        raise InputError(f"{what}: {t.size} samples; need at least 64 (e.g. 20 periods at "
-                         "20-50 samples per period)")
+        raise InputError(
+            f"{what}: {t.size} samples; need at least 64 (e.g. 20 periods at "
+            "20-50 samples per period)"
+        )
     bad = ~(np.isfinite(t) & np.isfinite(x))
     if bad.any():
         raise InputError(f"{what}: non-finite value at row {int(np.argmax(bad)) + 1}")
     dt = np.diff(t)
     h = float(np.median(dt))
     if not h > 0 or np.any(dt <= 0):
-        raise InputError(f"{what}: t must increase strictly (row "
-                         f"{int(np.argmax(dt <= 0)) + 2})")
+        raise InputError(f"{what}: t must increase strictly (row {int(np.argmax(dt <= 0)) + 2})")
     if np.max(np.abs(dt - h)) > 1e-6 * h + 1e-12 * np.max(np.abs(t)):
-        raise InputError(f"{what}: t must be uniformly sampled (steps from {dt.min():.6g} to "
-                         f"{dt.max():.6g}); resample it first")
+        raise InputError(
+            f"{what}: t must be uniformly sampled (steps from {dt.min():.6g} to "
+            f"{dt.max():.6g}); resample it first"
+        )
     if np.ptp(x) == 0:
         raise InputError(f"{what}: x is constant")
     return t, x
 
 
 @params(
-    system=(UedaSystem, ForcedPolynomial), periods=Real(1, integer=True),
-    samples_per_period=Real(4, integer=True), noise=Real(0), seed=Real(0, integer=True),
-    transient=Real(0, integer=True), y0=(None, Array(1)), integrator=Text(),
+    system=(UedaSystem, ForcedPolynomial),
+    periods=Real(1, integer=True),
+    samples_per_period=Real(4, integer=True),
+    noise=Real(0),
+    seed=Real(0, integer=True),
+    transient=Real(0, integer=True),
+    y0=(None, Array(1)),
+    integrator=Text(),
     rtol=Real(0, 1, open_low=True),
 )
-
-
-def simulate_record(system, periods=200, samples_per_period=40, noise=0.0, seed=0, *,
-                    transient=200, y0=None, integrator="compiled", rtol=1e-10):
+def simulate_record(
+    system,
+    periods=200,
+    samples_per_period=40,
+    noise=0.0,
+    seed=0,
+    *,
+    transient=200,
+    y0=None,
+    integrator="compiled",
+    rtol=1e-10,
+):
     """A synthetic record of ``system`` (a :class:`UedaSystem` or
     :class:`ForcedPolynomial`): ``(t, x_noisy, x_clean, v_clean)``.
 
@@ -389,16 +493,17 @@ def simulate_record(system, periods=200, samples_per_period=40, noise=0.0, seed=
             y = strobe_points(system, y, 1, transient=int(transient) - 1, tolerances=tol)[1]
         # one period more than needed: the last sample may round past the last strobe time
         spp = int(samples_per_period)
-        _, xc, vc = trajectory(system, y, (0.0, t[-1] + T), n_samples=n + spp,
-                               tolerances=tol)
+        _, xc, vc = trajectory(system, y, (0.0, t[-1] + T), n_samples=n + spp, tolerances=tol)
         xc, vc = xc[:n], vc[:n]
     elif integrator == "scipy":
         if transient > 0:
-            sol = solve_ivp(system.rhs, (0.0, transient * T), y, method="DOP853", rtol=rtol,
-                            atol=rtol * 1e-2)
+            sol = solve_ivp(
+                system.rhs, (0.0, transient * T), y, method="DOP853", rtol=rtol, atol=rtol * 1e-2
+            )
             y = sol.y[:, -1]
-        sol = solve_ivp(system.rhs, (0.0, t[-1]), y, method="DOP853", rtol=rtol,
-                        atol=rtol * 1e-2, t_eval=t)
+        sol = solve_ivp(
+            system.rhs, (0.0, t[-1]), y, method="DOP853", rtol=rtol, atol=rtol * 1e-2, t_eval=t
+        )
         if sol.status != 0:
             raise IntegrationError(f"solve_ivp: {sol.message}")
         xc, vc = sol.y
@@ -413,7 +518,7 @@ def simulate_record(system, periods=200, samples_per_period=40, noise=0.0, seed=
 def _test_function(hs, order):
     s = np.linspace(-1.0, 1.0, 2 * hs + 1)
     q = 1.0 - s * s
-    phi = q ** order
+    phi = q**order
     dphi = -2.0 * order * s * q ** (order - 1)
     ddphi = -2.0 * order * q ** (order - 1) + 4.0 * order * (order - 1) * s * s * q ** (order - 2)
     return phi, dphi, ddphi
@@ -433,7 +538,7 @@ def weak_system(t, x, v, B, nu, half_width, *, order=4, stride=None):
     dt = float(t[1] - t[0])
     H = hs * dt
     phi, dphi, ddphi = _test_function(hs, order)
-    dphi, ddphi = dphi / H, ddphi / H ** 2
+    dphi, ddphi = dphi / H, ddphi / H**2
     w = np.full(phi.size, dt)
     w[0] = w[-1] = dt / 2
     stride = max(1, hs // 2) if stride is None else int(stride)
@@ -444,11 +549,11 @@ def weak_system(t, x, v, B, nu, half_width, *, order=4, stride=None):
     cols = []
     for i, j in MONOMIALS:
         if j == 0:
-            cols.append((X ** i) @ (w * phi))
+            cols.append((X**i) @ (w * phi))
         elif j == 1:
             cols.append(-(X ** (i + 1)) @ (w * dphi) / (i + 1))
         else:
-            cols.append((X ** i * V ** j) @ (w * phi))
+            cols.append((X**i * V**j) @ (w * phi))
     cols.append(u @ (w * phi))
     return np.column_stack(cols), X @ (w * ddphi), t[centres]
 
@@ -480,7 +585,7 @@ def stlsq(G, b, threshold, keep=None, max_iter=25):
     refitted, until the support stops changing.  ``keep``: columns never dropped.
     Returns ``(coefficients, support)`` in the original units."""
     G, b = np.asarray(G, float), np.asarray(b, float)
-    sb = float(np.sqrt(np.mean(b ** 2))) or 1.0
+    sb = float(np.sqrt(np.mean(b**2))) or 1.0
     keep = np.zeros(G.shape[1], bool) if keep is None else np.asarray(keep, bool)
     x, sup = _stlsq_gram(G.T @ G, G.T @ (b / sb), G.shape[0], threshold, keep, max_iter)
     return x * sb, sup
@@ -535,13 +640,20 @@ class Discovery:
         return self.model.latex()
 
     def as_dict(self):
-        return {"terms": list(self.terms), "coefficients": self.coefficients,
-                "standard_errors": self.standard_errors,
-                "ols_standard_errors": self.ols_standard_errors,
-                "equation": str(self.model.sympy()), "latex": self.latex,
-                "residual_rms": self.residual_rms, "n_windows": self.n_windows,
-                "n_blocks": self.n_blocks, "bootstrap_support": self.bootstrap_support,
-                "settings": self.settings, "seconds": self.seconds}
+        return {
+            "terms": list(self.terms),
+            "coefficients": self.coefficients,
+            "standard_errors": self.standard_errors,
+            "ols_standard_errors": self.ols_standard_errors,
+            "equation": str(self.model.sympy()),
+            "latex": self.latex,
+            "residual_rms": self.residual_rms,
+            "n_windows": self.n_windows,
+            "n_blocks": self.n_blocks,
+            "bootstrap_support": self.bootstrap_support,
+            "settings": self.settings,
+            "seconds": self.seconds,
+        }
 
     def _lines(self):
         return generic_lines(self)
@@ -589,21 +701,38 @@ def _record_forcing(t, x, B, nu):
         raise InputError(f"the forcing needs finite B and nu > 0, got B = {B}, nu = {nu}")
     spp = 2 * np.pi / nu / float(t[1] - t[0])
     if spp < 8:
-        raise InputError(f"{spp:.3g} samples per forcing period; need at least 8 (20-50 is "
-                         "typical)")
+        raise InputError(
+            f"{spp:.3g} samples per forcing period; need at least 8 (20-50 is typical)"
+        )
     return t, x, spp
 
 
 @params(
-    t=Array(1), x=Array(1), B=Real(), nu=Real(0, open_low=True), threshold=Real(0),
-    half_width=(None, Real(1, integer=True)), order=Real(1, integer=True),
-    bootstrap=Real(0, integer=True), block_periods=Real(1, integer=True),
+    t=Array(1),
+    x=Array(1),
+    B=Real(),
+    nu=Real(0, open_low=True),
+    threshold=Real(0),
+    half_width=(None, Real(1, integer=True)),
+    order=Real(1, integer=True),
+    bootstrap=Real(0, integer=True),
+    block_periods=Real(1, integer=True),
     seed=Real(0, integer=True),
 )
-
-
-def discover(t, x, B, nu, *, threshold=0.02, half_width=None, order=4, fit_forcing=True,
-             bootstrap=200, block_periods=4, seed=0):
+def discover(
+    t,
+    x,
+    B,
+    nu,
+    *,
+    threshold=0.02,
+    half_width=None,
+    order=4,
+    fit_forcing=True,
+    bootstrap=200,
+    block_periods=4,
+    seed=0,
+):
     """Recover ``x'' = f(x, x') + B cos(nu t)`` from a record (see the module docstring).
 
     Parameters
@@ -636,8 +765,10 @@ def discover(t, x, B, nu, *, threshold=0.02, half_width=None, order=4, fit_forci
     # forcing's coefficient by -0.8 % at 20 samples per period (measured)
     hs = max(7, int(round(spp / 4))) if half_width is None else int(half_width)
     if hs < 2 or 2 * hs + 1 > t.size // 4:
-        raise InputError(f"the record ({t.size} samples) is too short for test windows of "
-                         f"{2 * hs + 1} samples; record more periods")
+        raise InputError(
+            f"the record ({t.size} samples) is too short for test windows of "
+            f"{2 * hs + 1} samples; record more periods"
+        )
     if int(order) < 2:
         raise InputError(f"order must be >= 2, got {order}")
     sm = smooth(t, x, spp)
@@ -649,13 +780,14 @@ def discover(t, x, B, nu, *, threshold=0.02, half_width=None, order=4, fit_forci
     keep = np.zeros(G.shape[1], bool)
     if fit_forcing:
         keep[nt] = True
-    sb = float(np.sqrt(np.mean(b ** 2))) or 1.0
+    sb = float(np.sqrt(np.mean(b**2))) or 1.0
     bn = b / sb
     c, sup = _stlsq_gram(G.T @ G, G.T @ bn, G.shape[0], threshold, keep)
     c = c * sb
     if not sup[:nt].any():
-        raise InputError("no library term was selected; lower the threshold or check the "
-                         "record and the forcing")
+        raise InputError(
+            "no library term was selected; lower the threshold or check the record and the forcing"
+        )
     Gs = G[:, sup]
     r = b - G @ c
     n_rows, p = Gs.shape
@@ -692,21 +824,35 @@ def discover(t, x, B, nu, *, threshold=0.02, half_width=None, order=4, fit_forci
     if not fit_forcing:
         coef[FORCING], ses[FORCING], oses[FORCING] = 1.0, 0.0, 0.0
     model = ForcedPolynomial(tuple(c[:nt]), B, nu, coef[FORCING])
-    settings = {"threshold": threshold, "half_width": hs, "order": int(order),
-                "fit_forcing": bool(fit_forcing), "bootstrap": int(bootstrap) if do_boot else 0,
-                "block_periods": block_periods, "samples_per_period": float(spp),
-                "periods": float((t[-1] - t[0]) / T), "noise_sd": sm.noise_sd,
-                "noise_fraction_of_range": sm.noise_sd / float(np.ptp(sm.x)),
-                "velocity": f"Savitzky-Golay (window {sm.window}, order 5), only in the "
-                            "x'^2, x x'^2, x'^3 columns",
-                "method": "weak-form STLSQ, test functions (1 - s^2)^order"}
-    return Discovery(model=model, terms=tuple(names[k] for k in sel if k < nt),
-                     coefficients=coef, standard_errors=ses, ols_standard_errors=oses,
-                     residual_rms=float(np.sqrt(np.mean(r ** 2) / np.mean(b ** 2))),
-                     n_windows=int(n_rows), n_blocks=n_blocks, settings=settings,
-                     bootstrap_support=({names[k]: float(chosen[k]) for k in range(nt)}
-                                        if do_boot else {}),
-                     seconds=time.perf_counter() - t0, smoothed=sm)
+    settings = {
+        "threshold": threshold,
+        "half_width": hs,
+        "order": int(order),
+        "fit_forcing": bool(fit_forcing),
+        "bootstrap": int(bootstrap) if do_boot else 0,
+        "block_periods": block_periods,
+        "samples_per_period": float(spp),
+        "periods": float((t[-1] - t[0]) / T),
+        "noise_sd": sm.noise_sd,
+        "noise_fraction_of_range": sm.noise_sd / float(np.ptp(sm.x)),
+        "velocity": f"Savitzky-Golay (window {sm.window}, order 5), only in the "
+        "x'^2, x x'^2, x'^3 columns",
+        "method": "weak-form STLSQ, test functions (1 - s^2)^order",
+    }
+    return Discovery(
+        model=model,
+        terms=tuple(names[k] for k in sel if k < nt),
+        coefficients=coef,
+        standard_errors=ses,
+        ols_standard_errors=oses,
+        residual_rms=float(np.sqrt(np.mean(r**2) / np.mean(b**2))),
+        n_windows=int(n_rows),
+        n_blocks=n_blocks,
+        settings=settings,
+        bootstrap_support=({names[k]: float(chosen[k]) for k in range(nt)} if do_boot else {}),
+        seconds=time.perf_counter() - t0,
+        smoothed=sm,
+    )
 
 
 # ------------------------------------------------------------------ verification
@@ -745,23 +891,32 @@ def classify_record(strobe, noise_sd, *, max_period=8, monotone=0.98):
     rng_x = float(np.ptp(s[:, 0])) or 1.0
     closure = 6.0 * float(noise_sd) + 1e-5 * rng_x
     m = min(len(s) - 1, 3 * max_period)
-    tail = s[-(m + 1):, 0]
-    rec = {n: float(np.max(np.abs(tail[n:] - tail[:-n]))) for n in range(1, max_period + 1)
-           if n < len(tail)}
+    tail = s[-(m + 1) :, 0]
+    rec = {
+        n: float(np.max(np.abs(tail[n:] - tail[:-n])))
+        for n in range(1, max_period + 1)
+        if n < len(tail)
+    }
     ev = {"recurrence_x": rec, "closure_x": closure, "noise_sd": float(noise_sd)}
     for n, d in rec.items():
         if d < closure:
-            ev["rule"] = f"x at the strobe points repeats after {n} period(s) ({d:.2g} < " \
-                         f"{closure:.2g}, 6 noise sd)"
+            ev["rule"] = (
+                f"x at the strobe points repeats after {n} period(s) ({d:.2g} < "
+                f"{closure:.2g}, 6 noise sd)"
+            )
             return Regime(f"P{n}", "P1" if n == 1 else "Pn", n, ev)
     rho, mono = rotation_number(s)
     ev["rotation_number"], ev["monotone_fraction"] = rho, mono
     if mono >= monotone:
-        ev["rule"] = (f"no period <= {max_period}; the points turn monotonically around their "
-                      f"centre ({mono:.3f} >= {monotone}): an invariant closed curve")
+        ev["rule"] = (
+            f"no period <= {max_period}; the points turn monotonically around their "
+            f"centre ({mono:.3f} >= {monotone}): an invariant closed curve"
+        )
         return Regime("beat", "beat", 0, ev)
-    ev["rule"] = (f"no period <= {max_period}; the points do not turn monotonically ({mono:.3f} "
-                  f"< {monotone}): chaotic")
+    ev["rule"] = (
+        f"no period <= {max_period}; the points do not turn monotonically ({mono:.3f} "
+        f"< {monotone}): chaotic"
+    )
     return Regime("chaotic", "chaotic", 0, ev)
 
 
@@ -830,25 +985,37 @@ class Verification:
     floor_correlation_lag: object = None
 
     def as_dict(self):
-        return {"energy_distance": self.energy_distance, "floor_q95": self.floor_q95,
-                "floor_median": self.floor_median, "energy_consistent": self.energy_consistent,
-                "consistent": self.consistent, "regime_record": self.regime_record,
-                "regime_model": self.regime_model, "regime_agrees": self.regime_agrees,
-                "lyapunov": self.lyapunov, "diverged": self.diverged,
-                "n_record_points": self.n_record_points, "n_model_points": self.n_model_points,
-                "record_evidence": self.record_evidence, "model_evidence": self.model_evidence,
-                "resamples": self.resamples, "floor_method": self.floor_method,
-                "floor_block_periods": self.floor_block_periods,
-                "floor_correlation_lag": self.floor_correlation_lag,
-                "rule": (f"energy distance (median over halves of the record made of "
-                         f"{self.floor_block_periods}-period blocks vs as many model points "
-                         f"in such blocks) <= the 95 % quantile of the distance between the "
-                         f"record's own block halves, and the same regime"
-                         if self.floor_method == "blocks" else
-                         "energy distance (median over random halves of the record vs as "
-                         "many model points) <= the 95 % quantile of the distance between "
-                         "the record's own random halves, and the same regime"),
-                "seconds": self.seconds}
+        return {
+            "energy_distance": self.energy_distance,
+            "floor_q95": self.floor_q95,
+            "floor_median": self.floor_median,
+            "energy_consistent": self.energy_consistent,
+            "consistent": self.consistent,
+            "regime_record": self.regime_record,
+            "regime_model": self.regime_model,
+            "regime_agrees": self.regime_agrees,
+            "lyapunov": self.lyapunov,
+            "diverged": self.diverged,
+            "n_record_points": self.n_record_points,
+            "n_model_points": self.n_model_points,
+            "record_evidence": self.record_evidence,
+            "model_evidence": self.model_evidence,
+            "resamples": self.resamples,
+            "floor_method": self.floor_method,
+            "floor_block_periods": self.floor_block_periods,
+            "floor_correlation_lag": self.floor_correlation_lag,
+            "rule": (
+                f"energy distance (median over halves of the record made of "
+                f"{self.floor_block_periods}-period blocks vs as many model points "
+                f"in such blocks) <= the 95 % quantile of the distance between the "
+                f"record's own block halves, and the same regime"
+                if self.floor_method == "blocks"
+                else "energy distance (median over random halves of the record vs as "
+                "many model points) <= the 95 % quantile of the distance between "
+                "the record's own random halves, and the same regime"
+            ),
+            "seconds": self.seconds,
+        }
 
     def _lines(self):
         return generic_lines(self)
@@ -877,19 +1044,20 @@ def strobe_block_length(points, *, max_lag=None, run=5, min_block=4, max_block=N
     sd = s.std(axis=0)
     sd[sd == 0] = 1.0
     z = (s - s.mean(axis=0)) / sd
-    feats = np.column_stack([z, z ** 2, z[:, :1] * z[:, 1:2]])
+    feats = np.column_stack([z, z**2, z[:, :1] * z[:, 1:2]])
     feats = feats - feats.mean(axis=0)
-    var = (feats ** 2).mean(axis=0)
+    var = (feats**2).mean(axis=0)
     feats = feats[:, var > 1e-12 * max(float(var.max()), 1e-300)]
     max_lag = max(1, min(n // 4, 50) if max_lag is None else int(max_lag))
     lag = max_lag
     if feats.shape[1]:
-        f = feats / np.sqrt((feats ** 2).mean(axis=0))
-        rho = np.array([np.abs((f[:-k] * f[k:]).sum(axis=0) / n).max()
-                        for k in range(1, max_lag + 1)])
+        f = feats / np.sqrt((feats**2).mean(axis=0))
+        rho = np.array(
+            [np.abs((f[:-k] * f[k:]).sum(axis=0) / n).max() for k in range(1, max_lag + 1)]
+        )
         small = rho < 2.0 * np.sqrt(np.log10(max(n, 10)) / n)
         for k in range(max_lag):
-            if small[k:k + run].all() and k + run <= max_lag:
+            if small[k : k + run].all() and k + run <= max_lag:
                 lag = k  # lags k+1 .. k+run are insignificant
                 break
     else:  # constant points (a fixed point without noise): no correlation to respect
@@ -903,9 +1071,9 @@ def _block_halves(n, L, rng):
     circular offset for the block grid, the blocks shuffled between the halves)."""
     idx = np.roll(np.arange(n), -int(rng.integers(L)))
     nb = n // L
-    blocks = idx[:nb * L].reshape(nb, L)
+    blocks = idx[: nb * L].reshape(nb, L)
     p = rng.permutation(nb)
-    return blocks[p[:nb // 2]].ravel(), blocks[p[nb // 2:]].ravel()
+    return blocks[p[: nb // 2]].ravel(), blocks[p[nb // 2 :]].ravel()
 
 
 def _block_sample(N, size, L, rng):
@@ -917,14 +1085,30 @@ def _block_sample(N, size, L, rng):
 
 
 @params(
-    model=ForcedPolynomial, t=Array(1), x=Array(1), smoothed=(None, Smoothed),
-    transient=Real(0, integer=True), periods=Real(1, integer=True),
-    resamples=Real(0, integer=True), seed=Real(0, integer=True), tolerances=(Tolerances, None),
+    model=ForcedPolynomial,
+    t=Array(1),
+    x=Array(1),
+    smoothed=(None, Smoothed),
+    transient=Real(0, integer=True),
+    periods=Real(1, integer=True),
+    resamples=Real(0, integer=True),
+    seed=Real(0, integer=True),
+    tolerances=(Tolerances, None),
 )
-
-
-def verify(model, t, x, *, smoothed=None, transient=200, periods=2000,
-           resamples=200, seed=0, tolerances=None, floor="blocks", block_periods=None):
+def verify(
+    model,
+    t,
+    x,
+    *,
+    smoothed=None,
+    transient=200,
+    periods=2000,
+    resamples=200,
+    seed=0,
+    tolerances=None,
+    floor="blocks",
+    block_periods=None,
+):
     """Verify ``model`` (a :class:`ForcedPolynomial`) against the record ``(t, x)`` by
     simulation (see :class:`Verification`).
 
@@ -980,22 +1164,47 @@ def verify(model, t, x, *, smoothed=None, transient=200, periods=2000,
     else:
         L = int(block_periods)
         if not 1 <= L <= n // 4:
-            raise InputError(f"block_periods must be 1 .. {n // 4} (a quarter of the record's "
-                             f"{n} strobe points), got {block_periods}")
+            raise InputError(
+                f"block_periods must be 1 .. {n // 4} (a quarter of the record's "
+                f"{n} strobe points), got {block_periods}"
+            )
     reg_rec = classify_record(rs, sm.noise_sd)
     diverged = None
     try:
-        ms, lyap = simulate_model(model, rs[0], ts[0], transient=transient, periods=periods,
-                                  tolerances=tolerances or Tolerances(rtol=1e-8))
+        ms, lyap = simulate_model(
+            model,
+            rs[0],
+            ts[0],
+            transient=transient,
+            periods=periods,
+            tolerances=tolerances or Tolerances(rtol=1e-8),
+        )
     except IntegrationError as exc:
         diverged = str(exc)
     if diverged is not None:
-        return Verification(float("inf"), float("nan"), float("nan"), False, reg_rec.regime,
-                            "diverged", False, False, {}, diverged, len(rs), 0,
-                            reg_rec.as_dict(), {}, int(resamples),
-                            time.perf_counter() - t_start, rs, np.empty((0, 2)),
-                            floor_method=floor, floor_block_periods=L,
-                            floor_correlation_lag=lag)
+        return Verification(
+            float("inf"),
+            float("nan"),
+            float("nan"),
+            False,
+            reg_rec.regime,
+            "diverged",
+            False,
+            False,
+            {},
+            diverged,
+            len(rs),
+            0,
+            reg_rec.as_dict(),
+            {},
+            int(resamples),
+            time.perf_counter() - t_start,
+            rs,
+            np.empty((0, 2)),
+            floor_method=floor,
+            floor_block_periods=L,
+            floor_correlation_lag=lag,
+        )
     reg_mod = classify_points(ms, model.scales(), lyap.value, lyap.stderr)
     scale = rs.std(axis=0)
     scale[scale == 0] = 1.0
@@ -1017,10 +1226,34 @@ def verify(model, t, x, *, smoothed=None, transient=200, periods=2000,
     ed, q95 = float(np.median(test)), float(np.quantile(floor_s, 0.95))
     agrees = _regime_match(reg_rec, reg_mod, lyap)
     e_ok = bool(ed <= q95)
-    return Verification(ed, q95, float(np.median(floor_s)), e_ok, reg_rec.regime,
-                        reg_mod.regime, bool(agrees), bool(e_ok and agrees),
-                        {"value": lyap.value, "stderr": lyap.stderr, "second": lyap.second,
-                         "n_periods": lyap.n_periods, "units": "per unit time"},
-                        None, len(rs), len(ms), reg_rec.as_dict(), reg_mod.as_dict(),
-                        int(resamples), time.perf_counter() - t_start, rs, ms, floor_s, test,
-                        floor_method=floor, floor_block_periods=L, floor_correlation_lag=lag)
+    return Verification(
+        ed,
+        q95,
+        float(np.median(floor_s)),
+        e_ok,
+        reg_rec.regime,
+        reg_mod.regime,
+        bool(agrees),
+        bool(e_ok and agrees),
+        {
+            "value": lyap.value,
+            "stderr": lyap.stderr,
+            "second": lyap.second,
+            "n_periods": lyap.n_periods,
+            "units": "per unit time",
+        },
+        None,
+        len(rs),
+        len(ms),
+        reg_rec.as_dict(),
+        reg_mod.as_dict(),
+        int(resamples),
+        time.perf_counter() - t_start,
+        rs,
+        ms,
+        floor_s,
+        test,
+        floor_method=floor,
+        floor_block_periods=L,
+        floor_correlation_lag=lag,
+    )

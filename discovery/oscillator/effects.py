@@ -27,72 +27,78 @@ EFFECTS = (
         id="van_der_pol_damping",
         title="Amplitude-dependent (van der Pol) damping",
         explanation="The resistance depends on the amplitude: negative (energy fed in) at "
-                    "small |x|, positive (energy taken out) at large |x|, as in a vacuum-tube "
-                    "or tunnel-diode oscillator, mu (1 - gamma x^2) x'. The x^2 x' part is what "
-                    "limits the self-excited growth: without it a negative linear resistance "
-                    "makes the oscillation grow without bound.",
+        "small |x|, positive (energy taken out) at large |x|, as in a vacuum-tube "
+        "or tunnel-diode oscillator, mu (1 - gamma x^2) x'. The x^2 x' part is what "
+        "limits the self-excited growth: without it a negative linear resistance "
+        "makes the oscillation grow without bound.",
         enters="a term c x^2 x' in x'' = ..., c = -mu gamma <= 0",
         signature="damping that grows with the displacement: energy removed at the large-|x| "
-                  "ends of each swing, fed in near x = 0; without it, a negative linear "
-                  "damping lets the model's amplitude run away",
+        "ends of each swing, fed in near x = 0; without it, a negative linear "
+        "damping lets the model's amplitude run away",
         parameters=(Parameter("c_x2_v", "1 (dimensionless)", (-_INF, 0.0)),),
         phases=(),
-        terms=("x^2 x'",)),
+        terms=("x^2 x'",),
+    ),
     Effect(
         id="linear_damping",
         title="Linear (viscous) damping or negative resistance",
         explanation="A force proportional to the velocity: viscous damping (c < 0 in "
-                    "x'' = ...) or, fed by an active element, a negative resistance (c > 0) "
-                    "that makes the rest state unstable and the oscillation self-excited.",
+        "x'' = ...) or, fed by an active element, a negative resistance (c > 0) "
+        "that makes the rest state unstable and the oscillation self-excited.",
         enters="a term c x' in x'' = ..., c of either sign (c = mu - k)",
         signature="energy taken out (or fed in) in proportion to the speed, most near x = 0 "
-                  "where |x'| is largest; an amplitude drift between forcing periods",
+        "where |x'| is largest; an amplitude drift between forcing periods",
         parameters=(Parameter("c_v", "1 (dimensionless)", (-_INF, _INF)),),
         phases=(),
-        terms=("x'",)),
+        terms=("x'",),
+    ),
     Effect(
         id="cubic_stiffness",
         title="Cubic (Duffing) stiffness",
         explanation="A restoring force growing with the cube of the displacement (a hardening "
-                    "spring, c < 0 in x'' = ...; softening when c > 0): the natural frequency "
-                    "rises with the amplitude and the resonance curve bends.",
+        "spring, c < 0 in x'' = ...; softening when c > 0): the natural frequency "
+        "rises with the amplitude and the resonance curve bends.",
         enters="a term c x^3 in x'' = ..., c of either sign (-1 for Ueda's oscillators)",
         signature="a restoring force that stiffens at large |x|: swings of large amplitude "
-                  "are faster than small ones",
+        "are faster than small ones",
         parameters=(Parameter("c_x3", "1 (dimensionless)", (-_INF, _INF)),),
         phases=(),
-        terms=("x^3",)),
+        terms=("x^3",),
+    ),
     Effect(
         id="quadratic_stiffness",
         title="Quadratic stiffness (asymmetric restoring force)",
         explanation="A restoring force that differs for x > 0 and x < 0 (an asymmetric "
-                    "spring, a static preload or a gravity offset of a nonlinear spring): "
-                    "the term c x^2 breaks the symmetry x -> -x of the equation.",
+        "spring, a static preload or a gravity offset of a nonlinear spring): "
+        "the term c x^2 breaks the symmetry x -> -x of the equation.",
         enters="a term c x^2 in x'' = ..., c of either sign",
         signature="the swings to one side stiffer than to the other: the attractor's strobe "
-                  "points and the record's mean shifted to one side",
+        "points and the record's mean shifted to one side",
         parameters=(Parameter("c_x2", "1 (dimensionless)", (-_INF, _INF)),),
         phases=(),
-        terms=("x^2",)),
+        terms=("x^2",),
+    ),
     Effect(
         id="velocity_cubic_damping",
         title="Cubic velocity (Rayleigh) damping",
         explanation="Damping that grows with the cube of the velocity (Rayleigh's oscillator, "
-                    "x' - x'^3 / 3: aerodynamic or friction-like losses at high speed), "
-                    "c x'^3 with c <= 0.",
+        "x' - x'^3 / 3: aerodynamic or friction-like losses at high speed), "
+        "c x'^3 with c <= 0.",
         enters="a term c x'^3 in x'' = ..., c <= 0",
         signature="energy removed where the motion is fastest (near x = 0), little at the "
-                  "turning points; unlike van der Pol damping, it depends on the speed, not "
-                  "the displacement",
+        "turning points; unlike van der Pol damping, it depends on the speed, not "
+        "the displacement",
         parameters=(Parameter("c_v3", "1 (dimensionless)", (-_INF, 0.0)),),
         phases=(),
-        terms=("x'^3",)),
+        terms=("x'^3",),
+    ),
 )
 
 for _e in EFFECTS:
     if not set(_e.terms) <= set(TERMS):  # a catalogue error, caught on import
-        raise AssertionError(f"catalogue: effect {_e.id}: terms {_e.terms} not in the "
-                             f"library {TERMS}")
+        raise AssertionError(
+            f"catalogue: effect {_e.id}: terms {_e.terms} not in the library {TERMS}"
+        )
 
 
 def effect(effect_id):
@@ -100,16 +106,18 @@ def effect(effect_id):
     for e in EFFECTS:
         if e.id == effect_id:
             return e
-    raise InputError(f"unknown effect {effect_id!r}; the catalogue has "
-                     f"{', '.join(e.id for e in EFFECTS)}")
+    raise InputError(
+        f"unknown effect {effect_id!r}; the catalogue has {', '.join(e.id for e in EFFECTS)}"
+    )
 
 
 def in_bounds(eff, values):
     """Whether ``values`` (the coefficients of the effect's terms, in order; a number for
     one term) are within the physical bounds of its parameters."""
     values = np.atleast_1d(np.asarray(values, float))
-    return bool(all(p.bounds[0] <= v <= p.bounds[1]
-                    for p, v in zip(eff.parameters, values, strict=True)))
+    return bool(
+        all(p.bounds[0] <= v <= p.bounds[1] for p, v in zip(eff.parameters, values, strict=True))
+    )
 
 
 def effect_dict(eff):

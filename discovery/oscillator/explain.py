@@ -80,16 +80,19 @@ def parse_terms(spec):
             return ()
         parts = [p for p in (s.strip() for s in spec.split(",")) if p]
         if not parts:
-            raise InputError("the start terms are empty; give library terms such as "
-                             "\"x',x^3\" (or none for the forcing alone)")
+            raise InputError(
+                "the start terms are empty; give library terms such as "
+                '"x\',x^3" (or none for the forcing alone)'
+            )
     else:
         parts = [str(p) for p in spec]
     out = []
     for p in parts:
         name = _BY_NORM.get(_norm(p))
         if name is None:
-            raise InputError(f"unknown term {p!r}; the library terms are {', '.join(TERMS)} "
-                             "(e.g. \"x',x^3\")")
+            raise InputError(
+                f'unknown term {p!r}; the library terms are {", ".join(TERMS)} (e.g. "x\',x^3")'
+            )
         if name not in out:
             out.append(name)
     return tuple(sorted(out, key=TERMS.index))
@@ -107,7 +110,7 @@ def _hac(U, lag):
 
 @dataclass(frozen=True)
 class _Fit:
-    cols: tuple          # column indices of G (library terms, then the forcing's)
+    cols: tuple  # column indices of G (library terms, then the forcing's)
     coef: np.ndarray
     se: np.ndarray
     r: np.ndarray
@@ -129,19 +132,19 @@ class _Weak:
         self.stride = max(1, self.hs // 2)
         # rows share samples up to (2 hs) / stride rows apart; twice that for Bartlett
         self.lag = 2 * int(np.ceil(2 * self.hs / self.stride))
-        self.b_rms = float(np.sqrt(np.mean(self.b ** 2))) or 1.0
+        self.b_rms = float(np.sqrt(np.mean(self.b**2))) or 1.0
         # the residual's floor: b's part from white measurement noise of sd noise_sd
         _, _, ddphi = _test_function(self.hs, order)
         w = np.full(ddphi.size, dt)
         w[0] = w[-1] = dt / 2
         H = self.hs * dt
-        self.noise_rms = float(smoothed.noise_sd * np.linalg.norm(w * ddphi / H ** 2))
+        self.noise_rms = float(smoothed.noise_sd * np.linalg.norm(w * ddphi / H**2))
 
     def fit(self, terms):
         cols = tuple(TERMS.index(n) for n in terms) + ((self.nt,) if self.fit_forcing else ())
         if cols:
             X = self.G[:, cols]
-            s = np.sqrt(np.mean(X ** 2, axis=0))
+            s = np.sqrt(np.mean(X**2, axis=0))
             s[s == 0] = 1.0
             Xs = X / s
             cs = np.linalg.lstsq(Xs, self.b, rcond=None)[0]
@@ -169,24 +172,40 @@ class _Weak:
             Z = Z - Q @ (Q.T @ Z)
         zz = np.einsum("ij,ij->j", Z, Z)
         if np.any(zz <= 1e-24 * max(float(self.b @ self.b), 1e-300)):
-            return {"effect": eff.id, "terms": list(eff.terms), "lm": 0.0, "p": 1.0,
-                    "share": 0.0, "direction": dict.fromkeys(eff.terms, 0.0),
-                    "note": "its columns are absorbed by the current terms"}
+            return {
+                "effect": eff.id,
+                "terms": list(eff.terms),
+                "lm": 0.0,
+                "p": 1.0,
+                "share": 0.0,
+                "direction": dict.fromkeys(eff.terms, 0.0),
+                "note": "its columns are absorbed by the current terms",
+            }
         s = Z.T @ fit.r
         V = _hac(Z * fit.r[:, None], self.lag)
         lm = float(s @ np.linalg.pinv(V) @ s) if np.all(np.diag(V) > 0) else 0.0
         direction = np.linalg.lstsq(Z, fit.r, rcond=None)[0]
         share = float((fit.r @ (Z @ direction)) / max(float(fit.r @ fit.r), 1e-300))
-        return {"effect": eff.id, "terms": list(eff.terms), "lm": lm,
-                "p": float(chi2.sf(lm, len(k))), "share": share,
-                "direction": {n: float(d) for n, d in zip(eff.terms, direction, strict=True)}}
+        return {
+            "effect": eff.id,
+            "terms": list(eff.terms),
+            "lm": lm,
+            "p": float(chi2.sf(lm, len(k))),
+            "share": share,
+            "direction": {n: float(d) for n, d in zip(eff.terms, direction, strict=True)},
+        }
 
     def residual_rms(self, fit):
-        return float(np.sqrt(np.mean(fit.r ** 2))) / self.b_rms
+        return float(np.sqrt(np.mean(fit.r**2))) / self.b_rms
 
     def parameters(self, fit, terms):
-        return {n: {"value": float(fit.coef[fit.cols.index(TERMS.index(n))]),
-                    "stderr": float(fit.se[fit.cols.index(TERMS.index(n))])} for n in terms}
+        return {
+            n: {
+                "value": float(fit.coef[fit.cols.index(TERMS.index(n))]),
+                "stderr": float(fit.se[fit.cols.index(TERMS.index(n))]),
+            }
+            for n in terms
+        }
 
     def coefficients(self, fit):
         names = [TERMS[j] if j < self.nt else FORCING for j in fit.cols]
@@ -240,11 +259,17 @@ class Iteration:
     equivalent: list = field(default_factory=list)
 
     def as_dict(self):
-        return {"effect": self.effect, "evidence": self.evidence, "scores": self.scores,
-                "equivalent": self.equivalent,
-                "criteria_before": self.criteria_before, "criteria_after": self.criteria_after,
-                "parameters": self.parameters, "model_before": _model_dict(self.model_before),
-                "model_after": _model_dict(self.model_after)}
+        return {
+            "effect": self.effect,
+            "evidence": self.evidence,
+            "scores": self.scores,
+            "equivalent": self.equivalent,
+            "criteria_before": self.criteria_before,
+            "criteria_after": self.criteria_after,
+            "parameters": self.parameters,
+            "model_before": _model_dict(self.model_before),
+            "model_after": _model_dict(self.model_after),
+        }
 
 
 @readable
@@ -302,24 +327,33 @@ class Explanation:
         for k in ("residual_rms", "energy_distance"):
             if k in self.criteria_start:
                 a, b = self.criteria_start[k], self.criteria[k]
-                out[k] = {"before": a, "after": b,
-                          "ratio": (a / b) if b > 0 else float("inf")}
+                out[k] = {"before": a, "after": b, "ratio": (a / b) if b > 0 else float("inf")}
         return out
 
     def as_dict(self):
-        return {"start_terms": list(self.start_terms), "final_terms": list(self.final_terms),
-                "effects_added": list(self.effects_added),
-                "iterations": [it.as_dict() for it in self.iterations],
-                "start_model": _model_dict(self.start_model),
-                "final_model": {**_model_dict(self.final_model),
-                                "coefficients": self.coefficients,
-                                "standard_errors": self.standard_errors},
-                "criteria_start": self.criteria_start, "criteria": self.criteria,
-                "gap": self.gap, "noise_floor": self.noise_floor,
-                "consistent": self.consistent, "stopped_because": self.stopped_because,
-                "catalogue": [effect_dict(e) for e in EFFECTS
-                              if e.id in self.settings.get("effects", ())],
-                "settings": self.settings, "seconds": self.seconds}
+        return {
+            "start_terms": list(self.start_terms),
+            "final_terms": list(self.final_terms),
+            "effects_added": list(self.effects_added),
+            "iterations": [it.as_dict() for it in self.iterations],
+            "start_model": _model_dict(self.start_model),
+            "final_model": {
+                **_model_dict(self.final_model),
+                "coefficients": self.coefficients,
+                "standard_errors": self.standard_errors,
+            },
+            "criteria_start": self.criteria_start,
+            "criteria": self.criteria,
+            "gap": self.gap,
+            "noise_floor": self.noise_floor,
+            "consistent": self.consistent,
+            "stopped_because": self.stopped_because,
+            "catalogue": [
+                effect_dict(e) for e in EFFECTS if e.id in self.settings.get("effects", ())
+            ],
+            "settings": self.settings,
+            "seconds": self.seconds,
+        }
 
     def _lines(self):
         return generic_lines(self)
@@ -330,15 +364,36 @@ def _model_dict(m):
 
 
 @params(
-    t=Array(1), x=Array(1), B=Real(), nu=Real(0, open_low=True), alpha=Real(0, 1, open_low=True),
-    max_iterations=Real(1, integer=True), effects=(None, list, tuple), seed=Real(0, integer=True),
+    t=Array(1),
+    x=Array(1),
+    B=Real(),
+    nu=Real(0, open_low=True),
+    alpha=Real(0, 1, open_low=True),
+    max_iterations=Real(1, integer=True),
+    effects=(None, list, tuple),
+    seed=Real(0, integer=True),
 )
-
-
-def explain(t, x, B, nu, start_terms=DEFAULT_START, *, alpha=0.01, max_iterations=3,
-            effects=None, half_width=None, order=4, fit_forcing=True, noise=None,
-            simulate=True, transient=200, periods=2000, resamples=200, seed=0,
-            tolerances=None):
+def explain(
+    t,
+    x,
+    B,
+    nu,
+    start_terms=DEFAULT_START,
+    *,
+    alpha=0.01,
+    max_iterations=3,
+    effects=None,
+    half_width=None,
+    order=4,
+    fit_forcing=True,
+    noise=None,
+    simulate=True,
+    transient=200,
+    periods=2000,
+    resamples=200,
+    seed=0,
+    tolerances=None,
+):
     """Explain the gap between a start model and a record by named effects (see the
     module docstring).
 
@@ -377,8 +432,11 @@ def explain(t, x, B, nu, start_terms=DEFAULT_START, *, alpha=0.01, max_iteration
     t_start = time.perf_counter()
     if not (0 < alpha < 1):
         raise InputError(f"alpha must be in (0, 1); got {alpha!r}")
-    if isinstance(max_iterations, bool) or not isinstance(max_iterations, int | np.integer) \
-            or max_iterations < 0:
+    if (
+        isinstance(max_iterations, bool)
+        or not isinstance(max_iterations, int | np.integer)
+        or max_iterations < 0
+    ):
         raise InputError(f"max_iterations must be an integer >= 0; got {max_iterations!r}")
     start = parse_terms(start_terms)
     catalogue = list(EFFECTS)
@@ -387,15 +445,19 @@ def explain(t, x, B, nu, start_terms=DEFAULT_START, *, alpha=0.01, max_iteration
         known = {e.id for e in EFFECTS}
         unknown = sorted(set(effects) - known)
         if unknown:
-            raise InputError(f"unknown effect(s) {', '.join(unknown)}; the catalogue has "
-                             f"{', '.join(e.id for e in EFFECTS)}")
+            raise InputError(
+                f"unknown effect(s) {', '.join(unknown)}; the catalogue has "
+                f"{', '.join(e.id for e in EFFECTS)}"
+            )
         catalogue = [e for e in EFFECTS if e.id in effects]
     t, x, spp = _record_forcing(t, x, B, nu)
     T = 2 * np.pi / nu
     hs = max(7, int(round(spp / 4))) if half_width is None else int(half_width)
     if hs < 2 or 2 * hs + 1 > t.size // 4:
-        raise InputError(f"the record ({t.size} samples) is too short for test windows of "
-                         f"{2 * hs + 1} samples; record more periods")
+        raise InputError(
+            f"the record ({t.size} samples) is too short for test windows of "
+            f"{2 * hs + 1} samples; record more periods"
+        )
     if int(order) < 2:
         raise InputError(f"order must be >= 2, got {order}")
     sm = smooth(t, x, spp)
@@ -409,13 +471,30 @@ def explain(t, x, B, nu, start_terms=DEFAULT_START, *, alpha=0.01, max_iteration
         crit = {"residual_rms": weak.residual_rms(fit)}
         if not simulate:
             return crit, None
-        v = verify(fit.model, t, x, smoothed=sm, transient=transient, periods=periods,
-                   resamples=resamples, seed=seed, tolerances=tolerances)
-        crit.update({"energy_distance": v.energy_distance, "floor_q95": v.floor_q95,
-                     "energy_consistent": v.energy_consistent,
-                     "regime_record": v.regime_record, "regime_model": v.regime_model,
-                     "regime_agrees": v.regime_agrees, "lyapunov": v.lyapunov,
-                     "consistent": v.consistent, "diverged": v.diverged})
+        v = verify(
+            fit.model,
+            t,
+            x,
+            smoothed=sm,
+            transient=transient,
+            periods=periods,
+            resamples=resamples,
+            seed=seed,
+            tolerances=tolerances,
+        )
+        crit.update(
+            {
+                "energy_distance": v.energy_distance,
+                "floor_q95": v.floor_q95,
+                "energy_consistent": v.energy_consistent,
+                "regime_record": v.regime_record,
+                "regime_model": v.regime_model,
+                "regime_agrees": v.regime_agrees,
+                "lyapunov": v.lyapunov,
+                "consistent": v.consistent,
+                "diverged": v.diverged,
+            }
+        )
         return crit, v
 
     terms = start
@@ -434,25 +513,40 @@ def explain(t, x, B, nu, start_terms=DEFAULT_START, *, alpha=0.01, max_iteration
         for s, e in zip(scores, cands, strict=True):
             s["significant"] = bool(s["p"] < gate)
             s["in_bounds"] = in_bounds(e, [s["direction"][n] for n in e.terms])
-        eligible = sorted((s for s in scores if s["significant"] and s["in_bounds"]),
-                          key=lambda s: -s["share"])
+        eligible = sorted(
+            (s for s in scores if s["significant"] and s["in_bounds"]), key=lambda s: -s["share"]
+        )
         out_of_bounds = [s["effect"] for s in scores if s["significant"] and not s["in_bounds"]]
-        state = ("the model is consistent with the record" if crit.get("consistent") else
-                 "the model is still inconsistent with the record: the catalogue does not "
-                 "explain the rest (the coefficients' uncertainty or an effect outside the "
-                 "catalogue may)" if simulate else "the gap was not simulated")
+        state = (
+            "the model is consistent with the record"
+            if crit.get("consistent")
+            else "the model is still inconsistent with the record: the catalogue does not "
+            "explain the rest (the coefficients' uncertainty or an effect outside the "
+            "catalogue may)"
+            if simulate
+            else "the gap was not simulated"
+        )
         if not eligible or len(iterations) >= max_iterations:
             if eligible:
-                text = (f"the budget of {max_iterations} added effect(s) is used; still "
-                        f"significant: {', '.join(s['effect'] for s in eligible)}")
+                text = (
+                    f"the budget of {max_iterations} added effect(s) is used; still "
+                    f"significant: {', '.join(s['effect'] for s in eligible)}"
+                )
             else:
-                text = (f"no catalogue effect is significant (score tests at family-wise "
-                        f"level {alpha:g}, gate {gate:.2g} for {len(scores)} effects)")
+                text = (
+                    f"no catalogue effect is significant (score tests at family-wise "
+                    f"level {alpha:g}, gate {gate:.2g} for {len(scores)} effects)"
+                )
                 if out_of_bounds:
-                    text += ("; significant but outside its physical bounds (not named): "
-                             + ", ".join(out_of_bounds))
-            iterations.append(Iteration(None, {"text": text}, scores, crit, crit, {},
-                                        fit.model, fit.model, ver, ver))
+                    text += (
+                        "; significant but outside its physical bounds (not named): "
+                        + ", ".join(out_of_bounds)
+                    )
+            iterations.append(
+                Iteration(
+                    None, {"text": text}, scores, crit, crit, {}, fit.model, fit.model, ver, ver
+                )
+            )
             stopped = f"{text}; {state}"
             break
         best = eligible[0]
@@ -470,46 +564,95 @@ def explain(t, x, B, nu, start_terms=DEFAULT_START, *, alpha=0.01, max_iteration
             alt_fit = weak.fit(tuple(sorted(set(terms) | set(alt.terms), key=TERMS.index)))
             if after[alt.id]["p"] >= gate and weak.score(alt_fit, eff)["p"] >= gate:
                 equivalent.append(alt.id)
-        text = (f"score test LM = {best['lm']:.4g} (p = {best['p']:.2g} < gate {gate:.2g}, "
-                f"alpha {alpha:g} over {len(scores)} effects); its term explains "
-                f"{100 * best['share']:.1f} % of the weak-form residual; refitted "
-                + ", ".join(f"{n} {p['value']:.4g} +- {p['stderr']:.2g}"
-                            for n, p in params.items())
-                + f"; residual {crit['residual_rms']:.3g} -> {crit2['residual_rms']:.3g} "
-                f"(noise floor {weak.noise_rms / weak.b_rms:.3g})")
+        text = (
+            f"score test LM = {best['lm']:.4g} (p = {best['p']:.2g} < gate {gate:.2g}, "
+            f"alpha {alpha:g} over {len(scores)} effects); its term explains "
+            f"{100 * best['share']:.1f} % of the weak-form residual; refitted "
+            + ", ".join(f"{n} {p['value']:.4g} +- {p['stderr']:.2g}" for n, p in params.items())
+            + f"; residual {crit['residual_rms']:.3g} -> {crit2['residual_rms']:.3g} "
+            f"(noise floor {weak.noise_rms / weak.b_rms:.3g})"
+        )
         if simulate:
-            text += (f"; energy distance {crit['energy_distance']:.3g} -> "
-                     f"{crit2['energy_distance']:.3g} (floor q95 {crit2['floor_q95']:.3g}), "
-                     f"regime {crit['regime_model']} -> {crit2['regime_model']} (record "
-                     f"{crit2['regime_record']})")
+            text += (
+                f"; energy distance {crit['energy_distance']:.3g} -> "
+                f"{crit2['energy_distance']:.3g} (floor q95 {crit2['floor_q95']:.3g}), "
+                f"regime {crit['regime_model']} -> {crit2['regime_model']} (record "
+                f"{crit2['regime_record']})"
+            )
         if equivalent:
-            text += ("; the record cannot tell it from " + ", ".join(equivalent)
-                     + " (each, added, leaves the other insignificant)")
-        evidence = {"lm": best["lm"], "p": best["p"], "gate": gate, "share": best["share"],
-                    "text": text}
-        iterations.append(Iteration(eff.id, evidence, scores, crit, crit2, params, fit.model,
-                                    fit2.model, ver, ver2, equivalent))
+            text += (
+                "; the record cannot tell it from "
+                + ", ".join(equivalent)
+                + " (each, added, leaves the other insignificant)"
+            )
+        evidence = {
+            "lm": best["lm"],
+            "p": best["p"],
+            "gate": gate,
+            "share": best["share"],
+            "text": text,
+        }
+        iterations.append(
+            Iteration(
+                eff.id,
+                evidence,
+                scores,
+                crit,
+                crit2,
+                params,
+                fit.model,
+                fit2.model,
+                ver,
+                ver2,
+                equivalent,
+            )
+        )
         terms, fit, crit, ver = new_terms, fit2, crit2, ver2
     coef, se = weak.coefficients(fit)
-    floor = {"residual_rms": weak.noise_rms / weak.b_rms, "noise_sd": sm.noise_sd,
-             "noise_fraction_of_range": sm.noise_sd / float(np.ptp(sm.x))}
+    floor = {
+        "residual_rms": weak.noise_rms / weak.b_rms,
+        "noise_sd": sm.noise_sd,
+        "noise_fraction_of_range": sm.noise_sd / float(np.ptp(sm.x)),
+    }
     if ver is not None:
-        floor.update({"energy_distance_q95": ver.floor_q95,
-                      "energy_distance_median": ver.floor_median})
-    settings = {"alpha": alpha, "max_iterations": int(max_iterations),
-                "effects": [e.id for e in catalogue], "half_width": hs, "order": int(order),
-                "fit_forcing": bool(fit_forcing), "simulate": bool(simulate),
-                "transient": transient, "periods": periods, "resamples": resamples,
-                "seed": seed, "samples_per_period": float(spp),
-                "record_periods": float((t[-1] - t[0]) / T), "n_windows": int(weak.G.shape[0]),
-                "hac_lag": weak.lag,
-                "method": "weak-form least squares on a fixed support; score (LM) tests with "
-                          "a Newey-West variance (Bartlett weights), Bonferroni gate; gap by "
-                          "simulation (verify)"}
+        floor.update(
+            {"energy_distance_q95": ver.floor_q95, "energy_distance_median": ver.floor_median}
+        )
+    settings = {
+        "alpha": alpha,
+        "max_iterations": int(max_iterations),
+        "effects": [e.id for e in catalogue],
+        "half_width": hs,
+        "order": int(order),
+        "fit_forcing": bool(fit_forcing),
+        "simulate": bool(simulate),
+        "transient": transient,
+        "periods": periods,
+        "resamples": resamples,
+        "seed": seed,
+        "samples_per_period": float(spp),
+        "record_periods": float((t[-1] - t[0]) / T),
+        "n_windows": int(weak.G.shape[0]),
+        "hac_lag": weak.lag,
+        "method": "weak-form least squares on a fixed support; score (LM) tests with "
+        "a Newey-West variance (Bartlett weights), Bonferroni gate; gap by "
+        "simulation (verify)",
+    }
     return Explanation(
-        iterations=tuple(iterations), start_model=start_fit.model, final_model=fit.model,
-        start_terms=start, final_terms=terms, coefficients=coef, standard_errors=se,
-        criteria_start=crit_start, criteria=crit, noise_floor=floor,
-        consistent=crit.get("consistent"), stopped_because=stopped,
-        seconds=time.perf_counter() - t_start, settings=settings,
-        start_verification=ver_start, final_verification=ver)
+        iterations=tuple(iterations),
+        start_model=start_fit.model,
+        final_model=fit.model,
+        start_terms=start,
+        final_terms=terms,
+        coefficients=coef,
+        standard_errors=se,
+        criteria_start=crit_start,
+        criteria=crit,
+        noise_floor=floor,
+        consistent=crit.get("consistent"),
+        stopped_because=stopped,
+        seconds=time.perf_counter() - t_start,
+        settings=settings,
+        start_verification=ver_start,
+        final_verification=ver,
+    )

@@ -71,8 +71,9 @@ class UedaMap:
         self.tol, self._T, self._atol, self._hmax = _setup(system, tolerances)
         self._p = system.params()
         self.scale = system.scales()
-        self.fd_step = float(fd_step if fd_step is not None
-                             else 1e-5 if difference == "central" else 1e-6)
+        self.fd_step = float(
+            fd_step if fd_step is not None else 1e-5 if difference == "central" else 1e-6
+        )
         self._te = np.empty(0)
         self._oe = np.empty((2, 0))
         self._out = np.empty((1, 2))
@@ -89,8 +90,20 @@ class UedaMap:
         if n < 1:
             raise InputError(f"n must be >= 1, got {n}")
         status, t, yf, steps, _ = UK.strobe_run(
-            0.0, np.asarray(y, dtype=float), self._p, self._T, n - 1, 1, self.tol.rtol,
-            self._atol, self._hmax, _budget(self.tol, n), self._te, self._oe, self._out)
+            0.0,
+            np.asarray(y, dtype=float),
+            self._p,
+            self._T,
+            n - 1,
+            1,
+            self.tol.rtol,
+            self._atol,
+            self._hmax,
+            _budget(self.tol, n),
+            self._te,
+            self._oe,
+            self._out,
+        )
         self.n_calls += 1
         self.n_steps += steps
         _check(status, t, "the stroboscopic map")
@@ -154,23 +167,31 @@ class PeriodicOrbit:
     n_calls: int = 0
 
     def as_dict(self):
-        return {"n_periods": self.n_periods, "y0": [float(v) for v in self.y0],
-                "multipliers_abs": [float(abs(m)) for m in self.multipliers],
-                "multipliers": [[float(m.real), float(m.imag)] for m in self.multipliers],
-                "residual": float(self.residual), "converged": self.converged,
-                "stable": self.stable,
-                "newton_residuals": [float(r) for r in self.newton_residuals],
-                "reduced_from": self.reduced_from, "n_calls": self.n_calls}
+        return {
+            "n_periods": self.n_periods,
+            "y0": [float(v) for v in self.y0],
+            "multipliers_abs": [float(abs(m)) for m in self.multipliers],
+            "multipliers": [[float(m.real), float(m.imag)] for m in self.multipliers],
+            "residual": float(self.residual),
+            "converged": self.converged,
+            "stable": self.stable,
+            "newton_residuals": [float(r) for r in self.newton_residuals],
+            "reduced_from": self.reduced_from,
+            "n_calls": self.n_calls,
+        }
 
 
 @params(
-    system=(UedaSystem, None), y0=Array(1), n=Real(1, integer=True), tol=Real(0, open_low=True),
-    max_newton=Real(1, integer=True), tolerances=(Tolerances, None),
+    system=(UedaSystem, None),
+    y0=Array(1),
+    n=Real(1, integer=True),
+    tol=Real(0, open_low=True),
+    max_newton=Real(1, integer=True),
+    tolerances=(Tolerances, None),
 )
-
-
-def periodic_orbit(system, y0, n=1, *, tol=1e-8, max_newton=12, reduce=True, tolerances=None,
-                   period_map=None):
+def periodic_orbit(
+    system, y0, n=1, *, tol=1e-8, max_newton=12, reduce=True, tolerances=None, period_map=None
+):
     """Converge the period-``n`` orbit near ``y0`` by shooting; its Floquet multipliers.
 
     Parameters
@@ -207,7 +228,14 @@ def periodic_orbit(system, y0, n=1, *, tol=1e-8, max_newton=12, reduce=True, tol
         if red is not None:
             m, y, res, J, _ = red
             mult = floquet_multipliers(J)
-    return PeriodicOrbit(n_periods=m, y0=np.asarray(y, dtype=float), multipliers=mult,
-                         residual=float(res), converged=bool(ok), stable=stable,
-                         newton_residuals=[float(r) for r in hist], reduced_from=n,
-                         n_calls=pm.n_calls - calls0)
+    return PeriodicOrbit(
+        n_periods=m,
+        y0=np.asarray(y, dtype=float),
+        multipliers=mult,
+        residual=float(res),
+        converged=bool(ok),
+        stable=stable,
+        newton_residuals=[float(r) for r in hist],
+        reduced_from=n,
+        n_calls=pm.n_calls - calls0,
+    )

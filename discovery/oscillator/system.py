@@ -57,8 +57,7 @@ class UedaSystem:
 
     def __post_init__(self):
         if self.model not in MODELS:
-            raise InputError(f"unknown model {self.model!r}; choose one of "
-                             f"{', '.join(MODELS)}")
+            raise InputError(f"unknown model {self.model!r}; choose one of {', '.join(MODELS)}")
         for name in ("mu", "gamma", "k", "B", "nu"):
             v = getattr(self, name)
             if not (isinstance(v, int | float | np.floating | np.integer) and np.isfinite(v)):
@@ -76,8 +75,10 @@ class UedaSystem:
             raise InputError(f"unknown model {model!r}; choose one of {', '.join(MODELS)}")
         unknown = set(overrides) - set(MODELS[model])
         if unknown:
-            raise InputError(f"unknown parameter(s) {', '.join(sorted(unknown))}; the "
-                             f"parameters are {', '.join(MODELS[model])}")
+            raise InputError(
+                f"unknown parameter(s) {', '.join(sorted(unknown))}; the "
+                f"parameters are {', '.join(MODELS[model])}"
+            )
         params = dict(MODELS[model])
         params.update({k: v for k, v in overrides.items() if v is not None})
         return cls(model=model, **params)
@@ -107,15 +108,27 @@ class UedaSystem:
     def rhs(self, t, y):
         """``(x', v')`` at time ``t`` (NumPy; the kernels have their own compiled copy)."""
         x, v = y[0], y[1]
-        return np.array([v, (self.mu * (1 - self.gamma * x * x) - self.k) * v - x ** 3
-                         + self.B * np.cos(self.nu * t)])
+        return np.array(
+            [
+                v,
+                (self.mu * (1 - self.gamma * x * x) - self.k) * v
+                - x**3
+                + self.B * np.cos(self.nu * t),
+            ]
+        )
 
     def jacobian(self, t, y):
         """``d(x', v')/d(x, v)``."""
         x, v = y[0], y[1]
-        return np.array([[0.0, 1.0],
-                         [-2.0 * self.mu * self.gamma * x * v - 3.0 * x * x,
-                          self.mu * (1 - self.gamma * x * x) - self.k]])
+        return np.array(
+            [
+                [0.0, 1.0],
+                [
+                    -2.0 * self.mu * self.gamma * x * v - 3.0 * x * x,
+                    self.mu * (1 - self.gamma * x * x) - self.k,
+                ],
+            ]
+        )
 
     def trace(self, x):
         """Trace of the Jacobian, ``mu (1 - gamma x^2) - k`` (the phase-volume rate)."""

@@ -9,11 +9,28 @@ aggregates from the files (:mod:`.aggregate`) -> tables and figures (:func:`stud
 
 from .._lazy import lazy_package
 
-_EXPORTS = {"StudyConfig": "config", "load_study": "config", "FACTORS": "config",
-            "field_record": "records", "run_one": "run", "score": "run",
-            "StudyResult": "driver", "study": "driver", "wilson": "aggregate"}
+_EXPORTS = {
+    "StudyConfig": "config",
+    "load_study": "config",
+    "FACTORS": "config",
+    "field_record": "records",
+    "run_one": "run",
+    "score": "run",
+    "StudyResult": "driver",
+    "study": "driver",
+    "wilson": "aggregate",
+}
 
-__all__ = ["study", "StudyResult", "StudyConfig", "load_study", "FACTORS", "field_record",
-           "run_one", "score", "wilson"]
+__all__ = [
+    "study",
+    "StudyResult",
+    "StudyConfig",
+    "load_study",
+    "FACTORS",
+    "field_record",
+    "run_one",
+    "score",
+    "wilson",
+]
 
 lazy_package(__name__, _EXPORTS)

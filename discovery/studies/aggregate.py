@@ -44,8 +44,10 @@ def wilson(k, n, z=Z95):
 def _factor_text(name, value):
     if name == "scenario":
         items = value if isinstance(value, list) else [value]
-        return " + ".join(it if isinstance(it, str) else
-                          ",".join(f"{k}={v}" for k, v in it.items()) for it in items)
+        return " + ".join(
+            it if isinstance(it, str) else ",".join(f"{k}={v}" for k, v in it.items())
+            for it in items
+        )
     if name == "law" and value is None:
         return "(scenario's)"
     return value if isinstance(value, str | int | float | bool) else json.dumps(value)
@@ -56,10 +58,27 @@ def _median(values):
     return float(np.median(v)) if v else math.nan
 
 
-CELL_COLUMNS = ("runs", "failed", "recovered", "recovery", "recovery_low", "recovery_high",
-                "equivalent", "fp_per_run", "any_fp", "fn_per_run", "covered", "intervals",
-                "coverage", "coverage_low", "coverage_high", "coef_error_median", "consistent",
-                "simulations_median", "seconds_median")
+CELL_COLUMNS = (
+    "runs",
+    "failed",
+    "recovered",
+    "recovery",
+    "recovery_low",
+    "recovery_high",
+    "equivalent",
+    "fp_per_run",
+    "any_fp",
+    "fn_per_run",
+    "covered",
+    "intervals",
+    "coverage",
+    "coverage_low",
+    "coverage_high",
+    "coef_error_median",
+    "consistent",
+    "simulations_median",
+    "seconds_median",
+)
 
 
 def aggregate(config, runs):
@@ -78,19 +97,26 @@ def aggregate(config, runs):
         clo, chi = wilson(sum(cov), len(cov))
         row = {f: _factor_text(f, cell[f]) for f in cell}
         row.update(
-            runs=n, failed=n - len(ok), recovered=k, recovery=k / n if n else math.nan,
-            recovery_low=lo, recovery_high=hi,
+            runs=n,
+            failed=n - len(ok),
+            recovered=k,
+            recovery=k / n if n else math.nan,
+            recovery_low=lo,
+            recovery_high=hi,
             equivalent=(sum(bool(r["truth_equivalent"]) for r in rs) / n) if n else math.nan,
             fp_per_run=float(np.mean([r["fp"] for r in ok])) if ok else math.nan,
             any_fp=float(np.mean([r["fp"] > 0 for r in ok])) if ok else math.nan,
             fn_per_run=float(np.mean([r["fn"] for r in ok])) if ok else math.nan,
-            covered=int(sum(cov)), intervals=len(cov),
+            covered=int(sum(cov)),
+            intervals=len(cov),
             coverage=(sum(cov) / len(cov)) if cov else math.nan,
-            coverage_low=clo, coverage_high=chi,
+            coverage_low=clo,
+            coverage_high=chi,
             coef_error_median=_median([r.get("coef_error") for r in ok]),
             consistent=float(np.mean([r["consistent"] for r in ok])) if ok else math.nan,
             simulations_median=_median([r.get("simulations") for r in ok]),
-            seconds_median=_median([r.get("seconds") for r in rs]))
+            seconds_median=_median([r.get("seconds") for r in rs]),
+        )
         rows.append(row)
         terms = {}
         for r in ok:
@@ -100,9 +126,29 @@ def aggregate(config, runs):
     return rows, inclusion
 
 
-RUN_COLUMNS = ("key", "cell", "seed", "status", "exact", "selected", "tp", "fp", "fn",
-               "truth_equivalent", "coef_error", "covered", "intervals", "interval_method",
-               "consistent", "I2", "I2_floor", "verdict", "simulations", "seconds", "error")
+RUN_COLUMNS = (
+    "key",
+    "cell",
+    "seed",
+    "status",
+    "exact",
+    "selected",
+    "tp",
+    "fp",
+    "fn",
+    "truth_equivalent",
+    "coef_error",
+    "covered",
+    "intervals",
+    "interval_method",
+    "consistent",
+    "I2",
+    "I2_floor",
+    "verdict",
+    "simulations",
+    "seconds",
+    "error",
+)
 
 
 def run_rows(config, runs):
@@ -112,17 +158,29 @@ def run_rows(config, runs):
         cell = config.cells[r["cell"]]
         row = {f: _factor_text(f, cell[f]) for f in cell}
         cov = r.get("coverage", {}) or {}
-        row.update(key=r["key"], cell=r["cell"], seed=r["seed"], status=r["status"],
-                   exact=bool(r.get("exact")), selected=" + ".join(r.get("selected", [])),
-                   tp=r.get("tp"), fp=r.get("fp"), fn=r.get("fn"),
-                   truth_equivalent=bool(r.get("truth_equivalent")),
-                   coef_error=r.get("coef_error"), covered=sum(cov.values()),
-                   intervals=len(cov), interval_method=r.get("interval_method"),
-                   consistent=r.get("consistent"),
-                   I2=(r.get("criteria") or {}).get("I2"),
-                   I2_floor=(r.get("noise_floor") or {}).get("I2"),
-                   verdict=r.get("verdict", ""), simulations=r.get("simulations"),
-                   seconds=r.get("seconds"), error=r.get("error", ""))
+        row.update(
+            key=r["key"],
+            cell=r["cell"],
+            seed=r["seed"],
+            status=r["status"],
+            exact=bool(r.get("exact")),
+            selected=" + ".join(r.get("selected", [])),
+            tp=r.get("tp"),
+            fp=r.get("fp"),
+            fn=r.get("fn"),
+            truth_equivalent=bool(r.get("truth_equivalent")),
+            coef_error=r.get("coef_error"),
+            covered=sum(cov.values()),
+            intervals=len(cov),
+            interval_method=r.get("interval_method"),
+            consistent=r.get("consistent"),
+            I2=(r.get("criteria") or {}).get("I2"),
+            I2_floor=(r.get("noise_floor") or {}).get("I2"),
+            verdict=r.get("verdict", ""),
+            simulations=r.get("simulations"),
+            seconds=r.get("seconds"),
+            error=r.get("error", ""),
+        )
         out.append(row)
     return out
 

@@ -55,7 +55,7 @@ from ..scenario import load_scenario
 __all__ = ["StudyConfig", "load_study", "FACTORS"]
 
 FACTORS = {
-    "law": None,            # None: the (first) scenario's own law
+    "law": None,  # None: the (first) scenario's own law
     "scenario": "paper",
     "force_noise": 0.01,
     "motion_noise": 0.001,
@@ -67,8 +67,18 @@ FACTORS = {
 }
 """Every factor a study may vary, with its default."""
 
-_FIT_KEYS = ("max_terms", "criterion", "shortlist", "stepwise", "n_boot", "n_boot_intervals",
-             "max_simulations", "scoring", "require", "physics")
+_FIT_KEYS = (
+    "max_terms",
+    "criterion",
+    "shortlist",
+    "stepwise",
+    "n_boot",
+    "n_boot_intervals",
+    "max_simulations",
+    "scoring",
+    "require",
+    "physics",
+)
 _RECORD_KEYS = ("transient", "velocities")
 _TOP = ("name", "seeds", "factors", "rows", "fit", "record")
 
@@ -127,17 +137,22 @@ def _scenario_value(value, source):
         elif isinstance(it, dict):
             base = it.get("base", "paper")
             if not isinstance(base, str):
-                _fail(source, "a scenario table needs base = \"paper\" (a name or file)")
+                _fail(source, 'a scenario table needs base = "paper" (a name or file)')
             sc = load_scenario(base)
             changes = {k: v for k, v in it.items() if k != "base"}
-            bad = sorted(set(changes) - {"m1", "m2", "k1", "c1", "A", "frequency", "g", "k3",
-                                          "name"})
+            bad = sorted(
+                set(changes) - {"m1", "m2", "k1", "c1", "A", "frequency", "g", "k3", "name"}
+            )
             if bad:
-                _fail(source, f"unknown scenario key(s) {', '.join(bad)} in a scenario "
-                      "table; valid: base, m1, m2, k1, c1, A, frequency, g, k3, name")
+                _fail(
+                    source,
+                    f"unknown scenario key(s) {', '.join(bad)} in a scenario "
+                    "table; valid: base, m1, m2, k1, c1, A, frequency, g, k3, name",
+                )
             if "name" not in changes:
-                changes["name"] = sc.name + "-" + "-".join(f"{k}{v:g}" for k, v in
-                                                           sorted(changes.items()))
+                changes["name"] = (
+                    sc.name + "-" + "-".join(f"{k}{v:g}" for k, v in sorted(changes.items()))
+                )
             try:
                 out.append(sc.replace(**changes))
             except (TypeError, ValueError) as exc:
@@ -161,7 +176,7 @@ def _check_factor(name, value, source):
             _fail(source, f"fs values are sample rates in Hz; got {value!r}")
     elif name == "library":
         if not isinstance(value, str):
-            _fail(source, f"library values are texts such as \"poly:2\"; got {value!r}")
+            _fail(source, f'library values are texts such as "poly:2"; got {value!r}')
         Library.parse(value)
     elif name == "selection":
         if value not in SELECTIONS:
@@ -171,7 +186,7 @@ def _check_factor(name, value, source):
             _fail(source, f"refine values are true or false; got {value!r}")
     elif name == "law":
         if not isinstance(value, str):
-            _fail(source, f"law values are texts such as \"2e8*z + 1e7*zd\"; got {value!r}")
+            _fail(source, f'law values are texts such as "2e8*z + 1e7*zd"; got {value!r}')
         ForceLaw.parse(value)
     elif name == "scenario":
         _scenario_value(value, source)
@@ -188,21 +203,32 @@ def _resolve(cell, fit, record, seed):
         law = scenarios[0].law.to_text()
     else:
         law = ForceLaw.parse(law).to_text()
-    return {"law": law,
-            "scenarios": [{k: v for k, v in sc.as_dict().items() if k not in ("law", "source")}
-                          for sc in scenarios],
-            "force_noise": float(cell["force_noise"]), "motion_noise": float(cell["motion_noise"]),
-            "periods": int(cell["periods"]), "fs": float(cell["fs"]),
-            "library": str(cell["library"]),
-            "selection": cell["selection"], "refine": bool(cell["refine"]),
-            "fit": dict(sorted(fit.items())), "record": dict(sorted(record.items())),
-            "seed": int(seed)}
+    return {
+        "law": law,
+        "scenarios": [
+            {k: v for k, v in sc.as_dict().items() if k not in ("law", "source")}
+            for sc in scenarios
+        ],
+        "force_noise": float(cell["force_noise"]),
+        "motion_noise": float(cell["motion_noise"]),
+        "periods": int(cell["periods"]),
+        "fs": float(cell["fs"]),
+        "library": str(cell["library"]),
+        "selection": cell["selection"],
+        "refine": bool(cell["refine"]),
+        "fit": dict(sorted(fit.items())),
+        "record": dict(sorted(record.items())),
+        "seed": int(seed),
+    }
 
 
 def _as_list(name, value, source):
     if not isinstance(value, list) or not value:
-        _fail(source, f"[factors] {name} must be a non-empty list, e.g. {name} = "
-              f"[{json.dumps(FACTORS[name] if FACTORS[name] is not None else '2e8*z')}]")
+        _fail(
+            source,
+            f"[factors] {name} must be a non-empty list, e.g. {name} = "
+            f"[{json.dumps(FACTORS[name] if FACTORS[name] is not None else '2e8*z')}]",
+        )
     return value
 
 
@@ -221,8 +247,11 @@ def study_from_mapping(data, source="<dict>"):
         if not 1 <= seeds <= 100000:
             _fail(source, f"seeds = {seeds}: give a count of at least 1 or a list of seeds")
         seeds = list(range(seeds))
-    if not (isinstance(seeds, list) and seeds and all(
-            isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in seeds)):
+    if not (
+        isinstance(seeds, list)
+        and seeds
+        and all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in seeds)
+    ):
         _fail(source, "seeds is a count (seeds = 3) or a list of whole numbers >= 0")
     if len(set(seeds)) != len(seeds):
         _fail(source, "seeds repeats a seed; each seed is one run per cell")
@@ -236,15 +265,19 @@ def study_from_mapping(data, source="<dict>"):
             _fail(source, f"unknown [{tname}] key(s) {', '.join(extra)}; valid: {', '.join(keys)}")
     tr = record.get("transient", "auto")
     if not (tr == "auto" or (isinstance(tr, int) and not isinstance(tr, bool) and 0 <= tr <= 5000)):
-        _fail(source, f"[record] transient is \"auto\" or a number of periods; got {tr!r}")
+        _fail(source, f'[record] transient is "auto" or a number of periods; got {tr!r}')
     factors = data.get("factors", {})
     if not isinstance(factors, dict):
         _fail(source, "[factors] must be a table")
     extra = sorted(set(factors) - set(FACTORS))
     if extra:
         _fail(source, f"unknown factor(s) {', '.join(extra)}; valid: {', '.join(FACTORS)}")
-    levels = {k: [_check_factor(k, v, source) for v in _as_list(k, factors[k], source)]
-              if k in factors else [FACTORS[k]] for k in FACTORS}
+    levels = {
+        k: [_check_factor(k, v, source) for v in _as_list(k, factors[k], source)]
+        if k in factors
+        else [FACTORS[k]]
+        for k in FACTORS
+    }
     if "rows" in data:
         rows = data["rows"]
         if factors:
@@ -255,19 +288,28 @@ def study_from_mapping(data, source="<dict>"):
         for r in rows:
             extra = sorted(set(r) - set(FACTORS))
             if extra:
-                _fail(source, f"unknown factor(s) {', '.join(extra)} in a row; valid: "
-                      f"{', '.join(FACTORS)}")
-            cells.append({k: _check_factor(k, r[k], source) if k in r else FACTORS[k]
-                          for k in FACTORS})
+                _fail(
+                    source,
+                    f"unknown factor(s) {', '.join(extra)} in a row; valid: {', '.join(FACTORS)}",
+                )
+            cells.append(
+                {k: _check_factor(k, r[k], source) if k in r else FACTORS[k] for k in FACTORS}
+            )
         varied = tuple(k for k in FACTORS if len({json.dumps(c[k]) for c in cells}) > 1)
     else:
-        cells = [dict(zip(FACTORS, combo, strict=True))
-                 for combo in itertools.product(*levels.values())]
+        cells = [
+            dict(zip(FACTORS, combo, strict=True)) for combo in itertools.product(*levels.values())
+        ]
         varied = tuple(k for k in FACTORS if len(levels[k]) > 1)
-    return StudyConfig(name=name, cells=tuple(cells), seeds=tuple(seeds), fit=dict(fit),
-                       record={"transient": tr, "velocities": bool(record.get("velocities",
-                                                                               True))},
-                       varied=varied, source=source)
+    return StudyConfig(
+        name=name,
+        cells=tuple(cells),
+        seeds=tuple(seeds),
+        fit=dict(fit),
+        record={"transient": tr, "velocities": bool(record.get("velocities", True))},
+        varied=varied,
+        source=source,
+    )
 
 
 @params(path_or_mapping=(Text(), os.PathLike, dict, StudyConfig))
@@ -281,8 +323,10 @@ def load_study(path_or_mapping):
     try:
         text = path.read_bytes().decode("utf-8-sig")
     except FileNotFoundError:
-        raise InputError(f"study file {str(path)!r} does not exist; give a TOML file such as "
-                         "examples/study_paper.toml") from None
+        raise InputError(
+            f"study file {str(path)!r} does not exist; give a TOML file such as "
+            "examples/study_paper.toml"
+        ) from None
     except IsADirectoryError:
         raise InputError(f"study file {str(path)!r} is a directory; give a TOML file") from None
     except UnicodeDecodeError:

@@ -115,25 +115,30 @@ class StudyResult:
         try:
             import pandas as pd
         except ImportError:
-            raise InputError("StudyResult.table() needs pandas; install it with pip install "
-                             "pandas (or read cells.csv)") from None
+            raise InputError(
+                "StudyResult.table() needs pandas; install it with pip install "
+                "pandas (or read cells.csv)"
+            ) from None
         return pd.DataFrame(run_rows(self.config, self.runs) if runs else self.cells)
 
     def _lines(self):
         cfg = self.config
-        out = [f"study {cfg.name!r}: {len(cfg.cells)} cells x {len(cfg.seeds)} seeds = "
-               f"{cfg.n_runs} runs ({self.executed} run now, {self.reused} from earlier files; "
-               f"{self.seconds:.1f} s on {self.executor})"]
+        out = [
+            f"study {cfg.name!r}: {len(cfg.cells)} cells x {len(cfg.seeds)} seeds = "
+            f"{cfg.n_runs} runs ({self.executed} run now, {self.reused} from earlier files; "
+            f"{self.seconds:.1f} s on {self.executor})"
+        ]
         shown = list(cfg.varied) or ["selection"]
         head = "  ".join(f"{f[:14]:<14}" for f in shown)
         out.append(f"  {head}  recovery (95 % CI)    FP/run  coverage  coef.err")
         for row in self.cells:
             vals = "  ".join(f"{str(row[f])[:14]:<14}" for f in shown)
-            rec = (f"{row['recovered']:>3}/{row['runs']:<3} "
-                   f"({row['recovery_low']:.2f}-{row['recovery_high']:.2f})")
+            rec = (
+                f"{row['recovered']:>3}/{row['runs']:<3} "
+                f"({row['recovery_low']:.2f}-{row['recovery_high']:.2f})"
+            )
             cov = "-" if not row["intervals"] else f"{row['covered']}/{row['intervals']}"
-            err = "-" if math.isnan(row["coef_error_median"]) else \
-                f"{row['coef_error_median']:.2g}"
+            err = "-" if math.isnan(row["coef_error_median"]) else f"{row['coef_error_median']:.2g}"
             fp = "-" if math.isnan(row["fp_per_run"]) else f"{row['fp_per_run']:.2f}"
             out.append(f"  {vals}  {rec:<21} {fp:>6}  {cov:>8}  {err:>8}")
         failed = sum(r["status"] != "ok" for r in self.runs)
@@ -160,10 +165,14 @@ def _design(cfg):
             if v not in vals:
                 vals.append(v)
         levels[f] = vals
-    return {"varied": {f: levels[f] for f in cfg.varied},
-            "fixed": {f: levels[f][0] for f in levels if f not in cfg.varied},
-            "fit": cfg.fit, "record": cfg.record, "seeds": list(cfg.seeds),
-            "cells": len(cfg.cells)}
+    return {
+        "varied": {f: levels[f] for f in cfg.varied},
+        "fixed": {f: levels[f][0] for f in levels if f not in cfg.varied},
+        "fit": cfg.fit,
+        "record": cfg.record,
+        "seeds": list(cfg.seeds),
+        "cells": len(cfg.cells),
+    }
 
 
 def _pooled(records, cfg):
@@ -177,21 +186,39 @@ def _pooled(records, cfg):
         ok = [r for r in rs if r["status"] == "ok"]
         k = sum(bool(r["exact"]) for r in rs)
         cov = [c for r in ok for c in (r.get("coverage") or {}).values()]
-        out[m] = {"runs": len(rs), "recovered": k, "recovery_ci": wilson(k, len(rs)),
-                  "equivalent": sum(bool(r["truth_equivalent"]) for r in rs),
-                  "fp_per_run": (sum(r["fp"] for r in ok) / len(ok)) if ok else None,
-                  "covered": int(sum(cov)), "intervals": len(cov),
-                  "coverage_ci": wilson(sum(cov), len(cov)),
-                  "failed": len(rs) - len(ok)}
+        out[m] = {
+            "runs": len(rs),
+            "recovered": k,
+            "recovery_ci": wilson(k, len(rs)),
+            "equivalent": sum(bool(r["truth_equivalent"]) for r in rs),
+            "fp_per_run": (sum(r["fp"] for r in ok) / len(ok)) if ok else None,
+            "covered": int(sum(cov)),
+            "intervals": len(cov),
+            "coverage_ci": wilson(sum(cov), len(cov)),
+            "failed": len(rs) - len(ok),
+        }
     return out
 
 
-@params(config=(Text(), os.PathLike, dict, StudyConfig), out=(Text(), os.PathLike),
-        workers=(None, Real(1, 4096, integer=True)), scheduler=(None, Text()),
-        executor=(None, Instance("discovery.executor", "Executor")),
-        max_runs=(None, Real(0, integer=True)))
-def study(config, out, *, workers=None, scheduler=None, executor=None, progress=None,
-          max_runs=None, figures=True):
+@params(
+    config=(Text(), os.PathLike, dict, StudyConfig),
+    out=(Text(), os.PathLike),
+    workers=(None, Real(1, 4096, integer=True)),
+    scheduler=(None, Text()),
+    executor=(None, Instance("discovery.executor", "Executor")),
+    max_runs=(None, Real(0, integer=True)),
+)
+def study(
+    config,
+    out,
+    *,
+    workers=None,
+    scheduler=None,
+    executor=None,
+    progress=None,
+    max_runs=None,
+    figures=True,
+):
     """Run a model-term selection study (see :mod:`discovery.studies`).
 
     Parameters
@@ -229,14 +256,29 @@ def study(config, out, *, workers=None, scheduler=None, executor=None, progress=
     rundir = out / "runs"
     rundir.mkdir(parents=True, exist_ok=True)
     _write_manifest(out, ["runs", "config.json"])
-    atomic_write_text(out / "config.json", json.dumps(to_jsonable(
-        {"name": cfg.name, "source": cfg.source, "seeds": cfg.seeds, "fit": cfg.fit,
-         "record": cfg.record, "varied": cfg.varied, "cells": cfg.cells,
-         "code_version": version}), indent=1, allow_nan=True))
+    atomic_write_text(
+        out / "config.json",
+        json.dumps(
+            to_jsonable(
+                {
+                    "name": cfg.name,
+                    "source": cfg.source,
+                    "seeds": cfg.seeds,
+                    "fit": cfg.fit,
+                    "record": cfg.record,
+                    "varied": cfg.varied,
+                    "cells": cfg.cells,
+                    "code_version": version,
+                }
+            ),
+            indent=1,
+            allow_nan=True,
+        ),
+    )
     have = {r["key"] for r in runs if _read_run(rundir / f"{r['key']}.json") is not None}
     todo = [r for r in runs if r["key"] not in have]
     if max_runs is not None:
-        todo = todo[:int(max_runs)]
+        todo = todo[: int(max_runs)]
     own = executor is None
     ex = make_executor(workers, scheduler) if own else executor
     name = repr(ex)
@@ -245,8 +287,10 @@ def study(config, out, *, workers=None, scheduler=None, executor=None, progress=
         tick(progress, "study: runs", len(have), len(runs))
         for _, res in ex.run(run_one, todo):
             res["code_version"] = version
-            atomic_write_text(rundir / f"{res['key']}.json",
-                              json.dumps(to_jsonable(res), indent=1, allow_nan=True))
+            atomic_write_text(
+                rundir / f"{res['key']}.json",
+                json.dumps(to_jsonable(res), indent=1, allow_nan=True),
+            )
             done += 1
             tick(progress, "study: runs", len(have) + done, len(runs))
     finally:
@@ -258,8 +302,10 @@ def study(config, out, *, workers=None, scheduler=None, executor=None, progress=
     atomic_write_text(out / "cells.csv", to_csv(cells))
     atomic_write_text(out / "runs.csv", to_csv(rows))
     terms = sorted({t for inc in inclusion.values() for t in inc})
-    inc_rows = [{**{f: c[f] for f in cfg.varied}, **{t: inclusion[i].get(t, 0.0) for t in terms}}
-                for i, c in enumerate(cells)]
+    inc_rows = [
+        {**{f: c[f] for f in cfg.varied}, **{t: inclusion[i].get(t, 0.0) for t in terms}}
+        for i, c in enumerate(cells)
+    ]
     atomic_write_text(out / "inclusion.csv", to_csv(inc_rows))
     paths = ()
     if figures and records:
@@ -268,21 +314,47 @@ def study(config, out, *, workers=None, scheduler=None, executor=None, progress=
         paths = tuple(study_figures(cfg, records, out))
     written = ["runs", "config.json", "cells.csv", "runs.csv", "inclusion.csv", "summary.json"]
     written += [Path(p).name for p in paths]
-    result = StudyResult(config=cfg, runs=records, cells=cells, inclusion=inclusion, out=out,
-                         executed=done, reused=len(have), seconds=time.perf_counter() - t0,
-                         executor=name, figures=paths)
-    summary = {"command": "study", "kind": "study", "name": cfg.name,
-               "runs": len(runs), "complete": len(records), "executed": done,
-               "reused": len(have), "executor": name, "code_version": version,
-               "design": _design(cfg), "pooled": _pooled(records, cfg),
-               "cells": cells, "seconds": result.seconds,
-               **provenance(settings={"config": cfg.source, "fit": cfg.fit,
-                                      "record": cfg.record, "seeds": list(cfg.seeds),
-                                      "workers": workers, "scheduler": scheduler,
-                                      "max_runs": max_runs},
-                            inputs={"config": cfg.source} if os.path.isfile(cfg.source)
-                            else None)}
-    atomic_write_text(out / "summary.json", json.dumps(to_jsonable(summary), indent=1,
-                                                       allow_nan=True))
+    result = StudyResult(
+        config=cfg,
+        runs=records,
+        cells=cells,
+        inclusion=inclusion,
+        out=out,
+        executed=done,
+        reused=len(have),
+        seconds=time.perf_counter() - t0,
+        executor=name,
+        figures=paths,
+    )
+    summary = {
+        "command": "study",
+        "kind": "study",
+        "name": cfg.name,
+        "runs": len(runs),
+        "complete": len(records),
+        "executed": done,
+        "reused": len(have),
+        "executor": name,
+        "code_version": version,
+        "design": _design(cfg),
+        "pooled": _pooled(records, cfg),
+        "cells": cells,
+        "seconds": result.seconds,
+        **provenance(
+            settings={
+                "config": cfg.source,
+                "fit": cfg.fit,
+                "record": cfg.record,
+                "seeds": list(cfg.seeds),
+                "workers": workers,
+                "scheduler": scheduler,
+                "max_runs": max_runs,
+            },
+            inputs={"config": cfg.source} if os.path.isfile(cfg.source) else None,
+        ),
+    }
+    atomic_write_text(
+        out / "summary.json", json.dumps(to_jsonable(summary), indent=1, allow_nan=True)
+    )
     _write_manifest(out, written)
     return result

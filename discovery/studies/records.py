@@ -30,8 +30,15 @@ from ..law import ForceLaw
 from ..measurement import Measurement
 from ..scenario import Scenario
 
-__all__ = ["field_record", "clean_record", "noisy_measurement", "transient_periods",
-           "auto_transient", "TRANSIENT_MIN", "TRANSIENT_MAX"]
+__all__ = [
+    "field_record",
+    "clean_record",
+    "noisy_measurement",
+    "transient_periods",
+    "auto_transient",
+    "TRANSIENT_MIN",
+    "TRANSIENT_MAX",
+]
 
 TRANSIENT_DECAY = 1e-4
 TRANSIENT_MIN, TRANSIENT_MAX = 30, 600
@@ -87,8 +94,7 @@ def clean_record(scenario, law, periods, fs, transient, record_transient=False):
     else:
         for k in range(0, transient, TRANSIENT_CHUNK):
             k1 = min(transient, k + TRANSIENT_CHUNK)
-            y0 = _reference(scenario, law, (k * T, k1 * T), y0, None,
-                            RTOL_TRANSIENT)["y_final"]
+            y0 = _reference(scenario, law, (k * T, k1 * T), y0, None, RTOL_TRANSIENT)["y_final"]
         n = int(round(periods * T * fs))
         t = t_rec + np.arange(n) / fs
         out = _reference(scenario, law, (t_rec, t_end), y0, t, RTOL_RECORD)
@@ -101,8 +107,9 @@ def clean_record(scenario, law, periods, fs, transient, record_transient=False):
     return t, y, F, events
 
 
-def noisy_measurement(t, y, F, *, force_noise, motion_noise, seed, velocities=True,
-                      source="", notes=()):
+def noisy_measurement(
+    t, y, F, *, force_noise, motion_noise, seed, velocities=True, source="", notes=()
+):
     """A :class:`~discovery.measurement.Measurement` of the noise-free ``t, y, F`` with
     noise on every channel: ``F`` gets ``N(0, force_noise * max|F|)``, ``w1, w2, v1, v2``
     each ``N(0, motion_noise * (max - min))`` of that channel, drawn by
@@ -120,11 +127,28 @@ def noisy_measurement(t, y, F, *, force_noise, motion_noise, seed, velocities=Tr
     return Measurement(np.array(t, dtype=float), F, channels, source=source, notes=tuple(notes))
 
 
-@params(scenario=Scenario, law=ForceLaw, periods=Real(1, 1e5, integer=True),
-        fs=Real(0, 1e8, open_low=True), transient=(None, Real(0, 1e5, integer=True)),
-        force_noise=Real(0, 1), motion_noise=Real(0, 1), seed=Real(0, integer=True))
-def field_record(scenario, law, *, periods=12, fs=10000.0, transient=None, force_noise=0.01,
-                 motion_noise=0.001, seed=0, velocities=True):
+@params(
+    scenario=Scenario,
+    law=ForceLaw,
+    periods=Real(1, 1e5, integer=True),
+    fs=Real(0, 1e8, open_low=True),
+    transient=(None, Real(0, 1e5, integer=True)),
+    force_noise=Real(0, 1),
+    motion_noise=Real(0, 1),
+    seed=Real(0, integer=True),
+)
+def field_record(
+    scenario,
+    law,
+    *,
+    periods=12,
+    fs=10000.0,
+    transient=None,
+    force_noise=0.01,
+    motion_noise=0.001,
+    seed=0,
+    velocities=True,
+):
     """A noisy record of ``law`` in ``scenario`` made by the scipy path from rest.
 
     Parameters
@@ -154,10 +178,20 @@ def field_record(scenario, law, *, periods=12, fs=10000.0, transient=None, force
         transient = auto_transient(scenario, law)
     transient, periods = int(transient), int(periods)
     t, y, F, _ = clean_record(scenario, law, periods, float(fs), transient)
-    notes = (f"reference_simulate from rest; transient {transient} periods "
-             f"(rtol {RTOL_TRANSIENT:g}), recorded at rtol {RTOL_RECORD:g}",
-             f"noise: force {force_noise:g} of max|F|, motion {motion_noise:g} of each "
-             f"channel's range, seed {seed}")
-    return noisy_measurement(t, y, F, force_noise=force_noise, motion_noise=motion_noise,
-                             seed=seed, velocities=velocities,
-                             source=f"reference:{scenario.name}", notes=notes)
+    notes = (
+        f"reference_simulate from rest; transient {transient} periods "
+        f"(rtol {RTOL_TRANSIENT:g}), recorded at rtol {RTOL_RECORD:g}",
+        f"noise: force {force_noise:g} of max|F|, motion {motion_noise:g} of each "
+        f"channel's range, seed {seed}",
+    )
+    return noisy_measurement(
+        t,
+        y,
+        F,
+        force_noise=force_noise,
+        motion_noise=motion_noise,
+        seed=seed,
+        velocities=velocities,
+        source=f"reference:{scenario.name}",
+        notes=notes,
+    )

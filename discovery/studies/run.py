@@ -52,10 +52,19 @@ def _records(spec, law):
         tr = rec.get("transient", "auto")
         transient = auto_transient(sc, law) if tr == "auto" else int(tr)
         seed = int(np.random.SeedSequence([spec["seed"], k]).generate_state(1)[0])
-        out.append(field_record(sc, law, periods=spec["periods"], fs=spec["fs"],
-                                transient=transient, force_noise=spec["force_noise"],
-                                motion_noise=spec["motion_noise"], seed=seed,
-                                velocities=rec.get("velocities", True)))
+        out.append(
+            field_record(
+                sc,
+                law,
+                periods=spec["periods"],
+                fs=spec["fs"],
+                transient=transient,
+                force_noise=spec["force_noise"],
+                motion_noise=spec["motion_noise"],
+                seed=seed,
+                velocities=rec.get("velocities", True),
+            )
+        )
     return scenarios, out
 
 
@@ -94,20 +103,36 @@ def score(result, truth):
             else:
                 continue
             coverage[n] = bool(lo <= true_c[n] <= hi)
-    refine_sims = sum(m.refinement.n_simulations for m in result.ranking
-                      if m.refinement is not None)
+    refine_sims = sum(
+        m.refinement.n_simulations for m in result.ranking if m.refinement is not None
+    )
     checks = sum(len(m.evaluations) for m in result.ranking)
     return {
-        "selected": sorted(S), "coefficients": got_c,
-        "exact": exact, "tp": len(S & T), "fp": len(S - T), "fn": len(T - S),
-        "truth_in_library": T <= lib, "truth_equivalent": bool(equivalent),
-        "coef_error": coef_error, "coverage": coverage,
-        "interval_method": ("bootstrap" if sel.intervals is not None else
-                            "jacobian" if sel.standard_errors else None),
-        "criteria": sel.criteria, "noise_floor": sel.noise_floor,
-        "consistent": bool(sel.consistent), "verdict": sel.verdict,
-        "regime": sel.regime, "simulations": int(refine_sims + checks),
-        "warnings": len(result.warnings)}
+        "selected": sorted(S),
+        "coefficients": got_c,
+        "exact": exact,
+        "tp": len(S & T),
+        "fp": len(S - T),
+        "fn": len(T - S),
+        "truth_in_library": T <= lib,
+        "truth_equivalent": bool(equivalent),
+        "coef_error": coef_error,
+        "coverage": coverage,
+        "interval_method": (
+            "bootstrap"
+            if sel.intervals is not None
+            else "jacobian"
+            if sel.standard_errors
+            else None
+        ),
+        "criteria": sel.criteria,
+        "noise_floor": sel.noise_floor,
+        "consistent": bool(sel.consistent),
+        "verdict": sel.verdict,
+        "regime": sel.regime,
+        "simulations": int(refine_sims + checks),
+        "warnings": len(result.warnings),
+    }
 
 
 def run_one(context, spec):
@@ -120,13 +145,22 @@ def run_one(context, spec):
     truth = ForceLaw.parse(spec["law"])
     try:
         scenarios, records = _records(spec, truth)
-        result = discover(scenarios if len(scenarios) > 1 else scenarios[0],
-                          records if len(records) > 1 else records[0],
-                          library=spec["library"], selection=spec["selection"],
-                          refine=spec["refine"], random_state=spec["seed"], **spec["fit"])
+        result = discover(
+            scenarios if len(scenarios) > 1 else scenarios[0],
+            records if len(records) > 1 else records[0],
+            library=spec["library"],
+            selection=spec["selection"],
+            refine=spec["refine"],
+            random_state=spec["seed"],
+            **spec["fit"],
+        )
         out.update(score(result, truth), status="ok", error="")
     except VidiError as exc:
-        out.update(status="failed", error=f"{type(exc).__name__}: {exc}".splitlines()[0],
-                   exact=False, truth_equivalent=False)
+        out.update(
+            status="failed",
+            error=f"{type(exc).__name__}: {exc}".splitlines()[0],
+            exact=False,
+            truth_equivalent=False,
+        )
     out["seconds"] = time.perf_counter() - t0
     return out

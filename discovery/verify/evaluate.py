@@ -36,10 +36,15 @@ from ..errors import InputError, IntegrationError
 from ..impulse import impulse_from_steady_state
 from .trajectory import block_criteria, simulated_history
 
-__all__ = ["Evaluation", "evaluate", "consistency_limits", "CONSISTENCY_CRITERIA",
-           "CONSISTENCY_SPREAD",
-           "CONSISTENCY_FACTOR",
-           "CONSISTENCY_SLACK"]
+__all__ = [
+    "Evaluation",
+    "evaluate",
+    "consistency_limits",
+    "CONSISTENCY_CRITERIA",
+    "CONSISTENCY_SPREAD",
+    "CONSISTENCY_FACTOR",
+    "CONSISTENCY_SLACK",
+]
 
 CONSISTENCY_CRITERIA = ("I2", "I4")
 CONSISTENCY_FACTOR = 2.0
@@ -57,9 +62,11 @@ def consistency_limits(floor, sd=None):
     percentile is about 3.2 times its mean; twice the mean alone rejected the true law in
     about one record in ten."""
     sd = sd or {}
-    return {k: max(CONSISTENCY_FACTOR * floor[k],
-                   floor[k] + CONSISTENCY_SPREAD * sd.get(k, 0.0)) + CONSISTENCY_SLACK
-            for k in CONSISTENCY_CRITERIA}
+    return {
+        k: max(CONSISTENCY_FACTOR * floor[k], floor[k] + CONSISTENCY_SPREAD * sd.get(k, 0.0))
+        + CONSISTENCY_SLACK
+        for k in CONSISTENCY_CRITERIA
+    }
 
 
 @readable
@@ -104,8 +111,9 @@ class Evaluation:
     @property
     def limits(self):
         """``{criterion: limit}`` of the consistency rule for this evaluation."""
-        return self.extra.get("limits") or (consistency_limits(self.noise_floor)
-                                            if self.noise_floor else {})
+        return self.extra.get("limits") or (
+            consistency_limits(self.noise_floor) if self.noise_floor else {}
+        )
 
     def value(self, name):
         """Criterion ``name``, ``inf`` when there is none (for ranking and optimisers)."""
@@ -113,12 +121,20 @@ class Evaluation:
 
     def as_dict(self):
         ss = self.steady
-        return {"status": self.status, "regime": self.regime, "impacts": self.impacts,
-                "criteria": self.criteria, "noise_floor": self.noise_floor,
-                "limits": self.limits, "consistent": self.consistent, "verdict": self.verdict,
-                "message": self.message,
-                "max_multiplier": None if ss is None or not ss.periodic
-                else float(np.max(np.abs(ss.multipliers)))}
+        return {
+            "status": self.status,
+            "regime": self.regime,
+            "impacts": self.impacts,
+            "criteria": self.criteria,
+            "noise_floor": self.noise_floor,
+            "limits": self.limits,
+            "consistent": self.consistent,
+            "verdict": self.verdict,
+            "message": self.message,
+            "max_multiplier": None
+            if ss is None or not ss.periodic
+            else float(np.max(np.abs(ss.multipliers))),
+        }
 
     def _lines(self):
         out = [f"{self.status}: {self.verdict or self.message}"]
@@ -154,33 +170,51 @@ def _verdict(consistent, reg, imp, crit, floor, lim=None, transient=False):
     over) a regime difference is no mismatch and the law is judged over the span."""
     if not crit:
         return None
-    if (reg["simulated"] != reg["measured"] and not transient) \
-            or imp["simulated"] != imp["measured"]:
-        return (f"inconsistent: regime mismatch (measured {reg['measured']} with "
-                f"{imp['measured']} contact(s), simulated {reg['simulated']} with "
-                f"{imp['simulated']})")
+    if (reg["simulated"] != reg["measured"] and not transient) or imp["simulated"] != imp[
+        "measured"
+    ]:
+        return (
+            f"inconsistent: regime mismatch (measured {reg['measured']} with "
+            f"{imp['measured']} contact(s), simulated {reg['simulated']} with "
+            f"{imp['simulated']})"
+        )
     lim = consistency_limits(floor) if lim is None else lim
     if not all(np.isfinite(v) for v in lim.values()):
-        return ("inconsistent: the noise floor under this law could not be estimated (no "
-                "bootstrap replicate of its force history found the contacts)")
-    rule = (f"max({CONSISTENCY_FACTOR:g} x noise floor, floor + {CONSISTENCY_SPREAD:g} sd) + "
-            f"{CONSISTENCY_SLACK:g}")
+        return (
+            "inconsistent: the noise floor under this law could not be estimated (no "
+            "bootstrap replicate of its force history found the contacts)"
+        )
+    rule = (
+        f"max({CONSISTENCY_FACTOR:g} x noise floor, floor + {CONSISTENCY_SPREAD:g} sd) + "
+        f"{CONSISTENCY_SLACK:g}"
+    )
     if consistent:
         within = ", ".join(f"{k} = {crit[k]:.3g} <= {lim[k]:.3g}" for k in lim)
         where = "over the record's span" if transient else f"same regime {reg['measured']}"
         return f"consistent: {within} ({rule}), {where}"
-    over = ", ".join(f"{k} = {crit[k]:.3g} exceeds {lim[k]:.3g}" for k in lim
-                     if crit[k] > lim[k])
+    over = ", ".join(f"{k} = {crit[k]:.3g} exceeds {lim[k]:.3g}" for k in lim if crit[k] > lim[k])
     if [k for k in lim if crit[k] > lim[k]] == ["I4"]:
-        return (f"inconsistent by I4 alone: {over} ({rule}), while I2 = {crit['I2']:.3g} is "
-                f"within {lim['I2']:.3g}; I4 compares the contact supports, which are "
-                "noise-sensitive on flat force tails and short contacts: check the contact "
-                "ends in the figure before rejecting the law")
+        return (
+            f"inconsistent by I4 alone: {over} ({rule}), while I2 = {crit['I2']:.3g} is "
+            f"within {lim['I2']:.3g}; I4 compares the contact supports, which are "
+            "noise-sensitive on flat force tails and short contacts: check the contact "
+            "ends in the figure before rejecting the law"
+        )
     return f"inconsistent: {over} ({rule})"
 
 
-def evaluate(scenario, law, reference, *, tolerances=None, from_state=True, floor=True,
-             observe=None, smooth_onset=False, **steady_kwargs):
+def evaluate(
+    scenario,
+    law,
+    reference,
+    *,
+    tolerances=None,
+    from_state=True,
+    floor=True,
+    observe=None,
+    smooth_onset=False,
+    **steady_kwargs,
+):
     """Simulate ``law`` and score it against ``reference`` (see the module docstring).
 
     Parameters
@@ -214,50 +248,84 @@ def evaluate(scenario, law, reference, *, tolerances=None, from_state=True, floo
     Evaluation
     """
     if from_state and getattr(reference, "span", None) is not None:
-        return _evaluate_span(scenario, law, reference, tolerances, floor, observe,
-                              steady_kwargs, smooth_onset)
+        return _evaluate_span(
+            scenario, law, reference, tolerances, floor, observe, steady_kwargs, smooth_onset
+        )
     E = reference.impulse
     reg = {"measured": reference.regime, "simulated": None}
     imp = {"measured": reference.impacts, "simulated": None}
     if from_state and reference.start is not None:
-        steady_kwargs = {"y_start": reference.start, "t_start": reference.start_time,
-                         **steady_kwargs}
+        steady_kwargs = {
+            "y_start": reference.start,
+            "t_start": reference.start_time,
+            **steady_kwargs,
+        }
     try:
         ss = steady_state(scenario, law, tolerances=tolerances, **steady_kwargs)
         if not ss.periodic:
-            return Evaluation("nonperiodic", reg, imp, {}, {}, False,
-                              "inconsistent: the law has no stable periodic steady state "
-                              f"(measured {reg['measured']})", steady=ss)
+            return Evaluation(
+                "nonperiodic",
+                reg,
+                imp,
+                {},
+                {},
+                False,
+                "inconsistent: the law has no stable periodic steady state "
+                f"(measured {reg['measured']})",
+                steady=ss,
+            )
         reg["simulated"] = ss.regime
         exact = impulse_from_steady_state(scenario, law, ss, tolerances=tolerances)
     except IntegrationError as exc:
-        return Evaluation("failed", reg, imp, {}, {}, False,
-                          f"the simulation failed: {exc}", message=str(exc))
+        return Evaluation(
+            "failed", reg, imp, {}, {}, False, f"the simulation failed: {exc}", message=str(exc)
+        )
     if exact is not None and observe is not None:
         exact = observe(exact)
     if exact is None:
         imp["simulated"] = 0
-        return Evaluation("no-contact", reg, imp, {}, {}, False,
-                          "inconsistent: the simulated bodies never come into contact",
-                          steady=ss)
+        return Evaluation(
+            "no-contact",
+            reg,
+            imp,
+            {},
+            {},
+            False,
+            "inconsistent: the simulated bodies never come into contact",
+            steady=ss,
+        )
     rot, sim = align(E, exact)
     # contacts per simulated orbit, seen through the measurement's threshold rules
     imp["simulated"] = int(round(len(sim.support) * ss.n_periods / sim.n_periods))
     crit = evaluate_criteria(E, sim)
     if not floor:
-        return Evaluation("ok", reg, imp, crit, {}, False, "", steady=ss, simulated=sim,
-                          extra={"aligned": rot})
+        return Evaluation(
+            "ok", reg, imp, crit, {}, False, "", steady=ss, simulated=sim, extra={"aligned": rot}
+        )
     fl = reference.floor_for(rot)
     same = reg["simulated"] == reg["measured"] and imp["simulated"] == imp["measured"]
     lim = consistency_limits(fl["mean"], fl.get("sd"))
     # an undefined floor (no bootstrap replicate found the contacts) decides nothing
     consistent = bool(same and all(np.isfinite(lim[k]) and crit[k] <= lim[k] for k in lim))
-    only_i4 = bool(same and not consistent and np.isfinite(lim["I4"])
-                   and crit["I2"] <= lim["I2"] and crit["I4"] > lim["I4"])
-    return Evaluation("ok", reg, imp, crit, fl["mean"], consistent,
-                      _verdict(consistent, reg, imp, crit, fl["mean"], lim), steady=ss,
-                      simulated=sim, extra={"aligned": rot, "noise_floor_q95": fl["q95"],
-                                            "only_I4": only_i4, "limits": lim})
+    only_i4 = bool(
+        same
+        and not consistent
+        and np.isfinite(lim["I4"])
+        and crit["I2"] <= lim["I2"]
+        and crit["I4"] > lim["I4"]
+    )
+    return Evaluation(
+        "ok",
+        reg,
+        imp,
+        crit,
+        fl["mean"],
+        consistent,
+        _verdict(consistent, reg, imp, crit, fl["mean"], lim),
+        steady=ss,
+        simulated=sim,
+        extra={"aligned": rot, "noise_floor_q95": fl["q95"], "only_I4": only_i4, "limits": lim},
+    )
 
 
 TRANSIENT_GAP = CONSISTENCY_SLACK
@@ -271,13 +339,21 @@ def _orbit_history(scenario, law, ss, block, tolerances):
     W = ss.n_periods * scenario.period
     fold = block.fold
     t0 = ss.t0 + np.floor((block.state.t - ss.t0) / W) * W
-    tr = simulate(scenario, law, (t0, fold.end), y0=ss.y0, t_eval=fold.td,
-                  tolerances=tolerances, zeta_max0=ss.zeta_max0)
+    tr = simulate(
+        scenario,
+        law,
+        (t0, fold.end),
+        y0=ss.y0,
+        t_eval=fold.td,
+        tolerances=tolerances,
+        zeta_max0=ss.zeta_max0,
+    )
     return np.asarray(tr.force, dtype=float)
 
 
-def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_kwargs,
-                   smooth_onset=False):
+def _evaluate_span(
+    scenario, law, reference, tolerances, floor, observe, steady_kwargs, smooth_onset=False
+):
     """:func:`evaluate` for a record with positions: the law simulated from the machine's
     states across the record's span, block by block, both histories folded by the same
     operator (:mod:`~discovery.verify.trajectory`); the criteria are the blocks' mean
@@ -288,38 +364,54 @@ def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_
     reg = {"measured": reference.regime, "simulated": None}
     imp = {"measured": reference.impacts, "simulated": None}
     try:
-        hist = simulated_history(scenario, law, span, tolerances=tolerances, observe=observe,
-                                 window=smooth_onset)
+        hist = simulated_history(
+            scenario, law, span, tolerances=tolerances, observe=observe, window=smooth_onset
+        )
     except IntegrationError as exc:
-        return Evaluation("failed", reg, imp, {}, {}, False,
-                          f"the simulation failed: {exc}", message=str(exc))
+        return Evaluation(
+            "failed", reg, imp, {}, {}, False, f"the simulation failed: {exc}", message=str(exc)
+        )
     if not any(np.any(h > 0) for h in hist):
         imp["simulated"] = 0
-        return Evaluation("no-contact", reg, imp, {}, {}, False,
-                          "inconsistent: the simulated bodies never come into contact "
-                          "over the record's span")
+        return Evaluation(
+            "no-contact",
+            reg,
+            imp,
+            {},
+            {},
+            False,
+            "inconsistent: the simulated bodies never come into contact over the record's span",
+        )
     sims = span.impulses(hist, onset_record_time=E.onset)
     sim = sims[-1]
     imp["simulated"] = int(len(sim.support))
     crit, per_block = block_criteria(reference.blocks, sims, span)
     last = span.blocks[-1]
-    extra = {"comparison": "record span", "blocks": list(zip(reference.blocks, sims,
-                                                             strict=True)),
-             "span": {"start_time": span.state.t, "cycles": span.n_cycles,
-                      "blocks": len(span.blocks), "state": last.state.method,
-                      "state_samples": last.state.n_samples,
-                      "block_I2": [p["I2"] for p in per_block]}}
+    extra = {
+        "comparison": "record span",
+        "blocks": list(zip(reference.blocks, sims, strict=True)),
+        "span": {
+            "start_time": span.state.t,
+            "cycles": span.n_cycles,
+            "blocks": len(span.blocks),
+            "state": last.state.method,
+            "state_samples": last.state.n_samples,
+            "block_I2": [p["I2"] for p in per_block],
+        },
+    }
     if not floor:
         return Evaluation("ok", reg, imp, crit, {}, False, "", simulated=sim, extra=extra)
-    steady_kwargs = {"y_start": reference.start, "t_start": reference.start_time,
-                     **steady_kwargs}
+    steady_kwargs = {"y_start": reference.start, "t_start": reference.start_time, **steady_kwargs}
     ss, transient = None, None
     try:
         ss = steady_state(scenario, law, tolerances=tolerances, **steady_kwargs)
         if ss.periodic:
             reg["simulated"] = ss.regime
-            orbit = last.fold.impulse(_orbit_history(scenario, law, ss, last, tolerances),
-                                      threshold=last.threshold, noise=span.sigma_f)
+            orbit = last.fold.impulse(
+                _orbit_history(scenario, law, ss, last, tolerances),
+                threshold=last.threshold,
+                noise=span.sigma_f,
+            )
             transient = evaluate_criteria(orbit, sim, ["I2"])["I2"]
         else:
             reg["simulated"] = "nonperiodic"
@@ -327,14 +419,16 @@ def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_
         reg["simulated"] = f"failed ({exc})"
     extra["transient_I2"] = transient
     settled = transient is not None and transient <= TRANSIENT_GAP
-    fl = reference.floor_for(sims, scenario=scenario, law=law, tolerances=tolerances,
-                             observe=observe)
+    fl = reference.floor_for(
+        sims, scenario=scenario, law=law, tolerances=tolerances, observe=observe
+    )
     lim = consistency_limits(fl["mean"], fl.get("sd"))
     # contacts per cycle agree, or the law's own noisy replicates show the measured count
     # (noise near the threshold can split a contact or hide a small one)
     folded = int(len(E.support))  # the record's folded cycle, same operator as the law's
-    same_impacts = imp["simulated"] in (imp["measured"], folded) or \
-        folded in (fl.get("impacts") or [])
+    same_impacts = imp["simulated"] in (imp["measured"], folded) or folded in (
+        fl.get("impacts") or []
+    )
     regime_ok = reg["simulated"] == reg["measured"] or not settled
     within = all(np.isfinite(lim[k]) and crit[k] <= lim[k] for k in lim)
     consistent = bool(same_impacts and regime_ok and within)
@@ -344,28 +438,48 @@ def _evaluate_span(scenario, law, reference, tolerances, floor, observe, steady_
     extra["impacts_folded"] = {"measured": folded, "simulated": imp["simulated"]}
     notes = []
     if same_impacts and imp["simulated"] != imp["measured"]:
-        notes.append(f"the law's folded cycle shows {imp['simulated']} contact(s) where the "
-                     f"record has {imp['measured']}; with the record's noise and sampling "
-                     "they agree (a contact split or hidden near the threshold)")
+        notes.append(
+            f"the law's folded cycle shows {imp['simulated']} contact(s) where the "
+            f"record has {imp['measured']}; with the record's noise and sampling "
+            "they agree (a contact split or hidden near the threshold)"
+        )
         imp = {**imp, "simulated": imp["measured"]}
-    verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim,
-                       transient=transient_mismatch)
+    verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim, transient=transient_mismatch)
     if transient_mismatch:
-        what = (f"settles to {reg['simulated']}" if ss is not None and ss.periodic
-                else f"reaches no stable periodic orbit ({reg['simulated']})")
+        what = (
+            f"settles to {reg['simulated']}"
+            if ss is not None and ss.periodic
+            else f"reaches no stable periodic orbit ({reg['simulated']})"
+        )
         gap = "" if transient is None else f" (I2 {transient:.3g} from its steady orbit)"
-        notes.append(f"the record reads {reg['measured']} but is still in a transient under "
-                     f"this law: from the measured state its trajectory{gap} {what}; the law "
-                     "is judged against the record's own span")
+        notes.append(
+            f"the record reads {reg['measured']} but is still in a transient under "
+            f"this law: from the measured state its trajectory{gap} {what}; the law "
+            "is judged against the record's own span"
+        )
     elif not settled and transient is not None:
-        notes.append(f"the record is still in a transient under this law (I2 {transient:.3g} "
-                     "between its trajectory over the last cycles and its steady orbit); "
-                     "judged against the record's own span")
+        notes.append(
+            f"the record is still in a transient under this law (I2 {transient:.3g} "
+            "between its trajectory over the last cycles and its steady orbit); "
+            "judged against the record's own span"
+        )
     if notes and verdict is not None:
         verdict = f"{verdict}; " + "; ".join(notes)
-    extra.update({"noise_floor_q95": fl["q95"], "notes": notes, "limits": lim,
-                  "only_I4": bool(same_impacts and regime_ok and not consistent
-                                  and np.isfinite(lim["I4"]) and crit["I2"] <= lim["I2"]
-                                  and crit["I4"] > lim["I4"])})
-    return Evaluation("ok", reg, imp, crit, fl["mean"], consistent, verdict, steady=ss,
-                      simulated=sim, extra=extra)
+    extra.update(
+        {
+            "noise_floor_q95": fl["q95"],
+            "notes": notes,
+            "limits": lim,
+            "only_I4": bool(
+                same_impacts
+                and regime_ok
+                and not consistent
+                and np.isfinite(lim["I4"])
+                and crit["I2"] <= lim["I2"]
+                and crit["I4"] > lim["I4"]
+            ),
+        }
+    )
+    return Evaluation(
+        "ok", reg, imp, crit, fl["mean"], consistent, verdict, steady=ss, simulated=sim, extra=extra
+    )

@@ -67,8 +67,12 @@ class Fold:
 
     def average(self, values):
         """Bin means of ``values`` (one per folded sample), ndarray of shape (k,)."""
-        return np.bincount(self.bins, weights=np.asarray(values, dtype=float),
-                           minlength=self.counts.size) / self.counts
+        return (
+            np.bincount(
+                self.bins, weights=np.asarray(values, dtype=float), minlength=self.counts.size
+            )
+            / self.counts
+        )
 
     def impulse(self, values, *, threshold, noise, onset_record_time=None):
         """The folded cycle of ``values`` as an :class:`~discovery.impulse.Impulse` whose
@@ -101,12 +105,22 @@ class Fold:
         tau = np.concatenate([[0.0], p, [W]])
         F = np.concatenate([[Fm[0]], Fm, [Fm[-1]]])
         n_eff = max(self.n_cycles, 1)
-        support = _sampled_support(tau, F, threshold, self.period, noise / np.sqrt(n_eff),
-                                   extrapolate=False)
+        support = _sampled_support(
+            tau, F, threshold, self.period, noise / np.sqrt(n_eff), extrapolate=False
+        )
         onsets = support[:, 0].copy() if len(support) else np.zeros(1)
-        return Impulse(t=tau, F=F, duration=W, support=support, n_periods=self.n_periods,
-                       onset=self.origin if onset_record_time is None else onset_record_time,
-                       threshold=threshold, noise=noise, n_cycles=n_eff, onsets=onsets)
+        return Impulse(
+            t=tau,
+            F=F,
+            duration=W,
+            support=support,
+            n_periods=self.n_periods,
+            onset=self.origin if onset_record_time is None else onset_record_time,
+            threshold=threshold,
+            noise=noise,
+            n_cycles=n_eff,
+            onsets=onsets,
+        )
 
 
 def make_fold(td_all, origin, n_periods, period, t_first, t_last):
@@ -149,5 +163,14 @@ def make_fold(td_all, origin, n_periods, period, t_first, t_last):
     bins = renum[raw]
     counts = counts[keep]
     phase = np.bincount(bins, weights=ph, minlength=counts.size) / counts
-    return Fold(idx=idx, td=td, bins=bins, counts=counts, phase=phase, origin=float(o),
-                duration=W, n_periods=int(n_periods), n_cycles=M)
+    return Fold(
+        idx=idx,
+        td=td,
+        bins=bins,
+        counts=counts,
+        phase=phase,
+        origin=float(o),
+        duration=W,
+        n_periods=int(n_periods),
+        n_cycles=M,
+    )

@@ -31,8 +31,18 @@ def _sawtooth(t, onsets, velocity):
     return velocity * (t - onsets[k])
 
 
-def noise_floor(reference_impulse, period, dt, *, sigma_f, n_cycles, sigma_zeta=None,
-                impact_velocity=None, n_boot=16, seed=0):
+def noise_floor(
+    reference_impulse,
+    period,
+    dt,
+    *,
+    sigma_f,
+    n_cycles,
+    sigma_zeta=None,
+    impact_velocity=None,
+    n_boot=16,
+    seed=0,
+):
     """Expected criteria of the true law against a record with this noise.
 
     Parameters
@@ -86,10 +96,16 @@ def noise_floor(reference_impulse, period, dt, *, sigma_f, n_cycles, sigma_zeta=
         for n, v in crit.items():
             samples[n].append(v)
     if not samples["I2"]:
-        return {"mean": {n: float("inf") for n in CRITERIA},
-                "q95": {n: float("inf") for n in CRITERIA}, "n_boot": 0, "seed": seed}
-    return {"mean": {n: float(np.mean(v)) for n, v in samples.items()},
-            "q95": {n: float(np.quantile(v, 0.95)) for n, v in samples.items()},
-            "sd": {n: float(np.std(v, ddof=1)) if len(v) > 1 else 0.0
-                   for n, v in samples.items()},
-            "n_boot": len(samples["I2"]), "seed": seed}
+        return {
+            "mean": {n: float("inf") for n in CRITERIA},
+            "q95": {n: float("inf") for n in CRITERIA},
+            "n_boot": 0,
+            "seed": seed,
+        }
+    return {
+        "mean": {n: float(np.mean(v)) for n, v in samples.items()},
+        "q95": {n: float(np.quantile(v, 0.95)) for n, v in samples.items()},
+        "sd": {n: float(np.std(v, ddof=1)) if len(v) > 1 else 0.0 for n, v in samples.items()},
+        "n_boot": len(samples["I2"]),
+        "seed": seed,
+    }

@@ -84,15 +84,23 @@ class Reference:
         are one cycle already).  An optimiser far from the answer starts here: a law's
         timing error cannot accumulate over a block, so the output error's basin is wider
         (multiple shooting)."""
-        if self.span is None or self._source is None or all(
-                b.fold.n_cycles == 1 for b in self.span.blocks):
+        if (
+            self.span is None
+            or self._source is None
+            or all(b.fold.n_cycles == 1 for b in self.span.blocks)
+        ):
             return None
         cache = self.__dict__.setdefault("_shortened", {})
         if "ref" not in cache:
             m, sc = self._source
             cache["ref"] = Reference.from_measurement(
-                m, sc, time_offset=self.time_offset, n_boot=self.n_boot, seed=self.seed,
-                block_cycles=1)
+                m,
+                sc,
+                time_offset=self.time_offset,
+                n_boot=self.n_boot,
+                seed=self.seed,
+                block_cycles=1,
+            )
         return cache["ref"]
 
     def floor_for(self, stand_in, *, scenario=None, law=None, tolerances=None, observe=None):
@@ -101,16 +109,31 @@ class Reference:
         a record span (and ``scenario``, ``law``), through the span's own processing
         (:func:`~discovery.verify.trajectory.span_floor`)."""
         if self.span is not None and law is not None:
-            return span_floor(scenario, law, self.span, stand_in, n_boot=self.n_boot,
-                              seed=self.seed, tolerances=tolerances, observe=observe)
+            return span_floor(
+                scenario,
+                law,
+                self.span,
+                stand_in,
+                n_boot=self.n_boot,
+                seed=self.seed,
+                tolerances=tolerances,
+                observe=observe,
+            )
         if not self.noise:
             zero = {n: 0.0 for n in CRITERIA}
             return {"mean": zero, "q95": dict(zero), "n_boot": 0, "seed": self.seed}
         nz = self.noise
-        return noise_floor(stand_in, self.impulse.duration / self.impulse.n_periods, nz["dt"],
-                           sigma_f=nz["F"], n_cycles=nz["n_cycles"], sigma_zeta=nz["zeta"],
-                           impact_velocity=nz["impact_velocity"], n_boot=self.n_boot,
-                           seed=self.seed)
+        return noise_floor(
+            stand_in,
+            self.impulse.duration / self.impulse.n_periods,
+            nz["dt"],
+            sigma_f=nz["F"],
+            n_cycles=nz["n_cycles"],
+            sigma_zeta=nz["zeta"],
+            impact_velocity=nz["impact_velocity"],
+            n_boot=self.n_boot,
+            seed=self.seed,
+        )
 
     @classmethod
     def exact(cls, impulse, source="simulation"):
@@ -118,8 +141,17 @@ class Reference:
         return cls(impulse=impulse, source=source)
 
     @classmethod
-    def from_measurement(cls, measurement, scenario, *, time_offset=0.0, n_boot=16, seed=0,
-                         use_state=True, block_cycles=BLOCK_CYCLES):
+    def from_measurement(
+        cls,
+        measurement,
+        scenario,
+        *,
+        time_offset=0.0,
+        n_boot=16,
+        seed=0,
+        use_state=True,
+        block_cycles=BLOCK_CYCLES,
+    ):
         """Prepare a record: steady cycle, noise model, measured state.
 
         Parameters
@@ -145,15 +177,21 @@ class Reference:
         t = measurement.t
         dt = float(np.median(np.diff(t)))
         zeta = measurement.zeta
-        noise = {"F": estimate_noise(measurement.F), "zeta": None, "impact_velocity": None,
-                 "dt": dt, "n_cycles": E.n_cycles}
+        noise = {
+            "F": estimate_noise(measurement.F),
+            "zeta": None,
+            "impact_velocity": None,
+            "dt": dt,
+            "n_cycles": E.n_cycles,
+        }
         if zeta is not None:
             noise["zeta"] = estimate_noise(zeta, order=3)
             noise["impact_velocity"] = _impact_velocity(t, zeta, E, T, dt)
         start, t_start, span, cycle, blocks = None, 0.0, None, E, ()
         if use_state and zeta is not None:
-            span = record_span(measurement, scenario, E, time_offset=time_offset,
-                               block_cycles=block_cycles)
+            span = record_span(
+                measurement, scenario, E, time_offset=time_offset, block_cycles=block_cycles
+            )
             if span is None:
                 start, t_start = measurement.state_at_strobe(T, time_offset)
             else:
@@ -162,10 +200,20 @@ class Reference:
                 blocks = tuple(span.measured(onset_record_time=E.onset))
                 E = blocks[-1]
                 noise["n_cycles"] = span.n_cycles
-        return cls(impulse=E, noise=noise, start=start, start_time=t_start,
-                   time_offset=float(time_offset), n_boot=int(n_boot), seed=int(seed),
-                   source=measurement.source, span=span, cycle=cycle, blocks=blocks,
-                   _source=(measurement, scenario))
+        return cls(
+            impulse=E,
+            noise=noise,
+            start=start,
+            start_time=t_start,
+            time_offset=float(time_offset),
+            n_boot=int(n_boot),
+            seed=int(seed),
+            source=measurement.source,
+            span=span,
+            cycle=cycle,
+            blocks=blocks,
+            _source=(measurement, scenario),
+        )
 
 
 def _impact_velocity(t, zeta, E, period, dt):
@@ -175,6 +223,6 @@ def _impact_velocity(t, zeta, E, period, dt):
     for c in range(E.n_cycles):
         k = int(np.searchsorted(t, E.onset + c * E.duration))
         if m <= k < t.size - m:
-            a, _ = np.polyfit(t[k - m:k + m] - t[k], zeta[k - m:k + m], 1)
+            a, _ = np.polyfit(t[k - m : k + m] - t[k], zeta[k - m : k + m], 1)
             slopes.append(a)
     return float(np.median(slopes)) if slopes else None

@@ -136,12 +136,15 @@ def free_flight_state(measurement, scenario, run, t_a, *, time_offset=0.0):
     s = td - t_a
     y = np.zeros(4)
     cov = np.zeros((4, 4))
-    noise = {k: max(estimate_noise(ch[k], order=3), 1e-300) for k in ch if k in
-             ("w1", "v1", "w2", "v2")}
+    noise = {
+        k: max(estimate_noise(ch[k], order=3), 1e-300) for k in ch if k in ("w1", "v1", "w2", "v2")
+    }
     # the moulding: a parabola of known curvature
-    rows, obs, sig = [np.stack([np.ones_like(s), s], 1)], [ch["w2"][a:b] + 0.5 * scenario.g
-                                                          * s * s], [np.full(s.size,
-                                                                             noise["w2"])]
+    rows, obs, sig = (
+        [np.stack([np.ones_like(s), s], 1)],
+        [ch["w2"][a:b] + 0.5 * scenario.g * s * s],
+        [np.full(s.size, noise["w2"])],
+    )
     if "v2" in ch:
         rows.append(np.stack([np.zeros_like(s), np.ones_like(s)], 1))
         obs.append(ch["v2"][a:b] + scenario.g * s)
@@ -153,13 +156,16 @@ def free_flight_state(measurement, scenario, run, t_a, *, time_offset=0.0):
         ws, P, Q, w = _frame_particular(scenario)
 
         def xp(tt):
-            return np.stack([ws + P * np.sin(w * tt) + Q * np.cos(w * tt),
-                             w * (P * np.cos(w * tt) - Q * np.sin(w * tt))])
+            return np.stack(
+                [
+                    ws + P * np.sin(w * tt) + Q * np.cos(w * tt),
+                    w * (P * np.cos(w * tt) - Q * np.sin(w * tt)),
+                ]
+            )
 
         Phi = _frame_basis(scenario, s)
         xp_t = xp(td)
-        rows, obs, sig = [Phi[:, 0, :]], [ch["w1"][a:b] - xp_t[0]], [np.full(s.size,
-                                                                          noise["w1"])]
+        rows, obs, sig = [Phi[:, 0, :]], [ch["w1"][a:b] - xp_t[0]], [np.full(s.size, noise["w1"])]
         if "v1" in ch:
             rows.append(Phi[:, 1, :])
             obs.append(ch["v1"][a:b] - xp_t[1])

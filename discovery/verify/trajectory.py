@@ -27,8 +27,15 @@ from ..impulse import Impulse, estimate_noise
 from .fold import make_fold
 from .state import free_flight_runs, free_flight_state
 
-__all__ = ["Block", "RecordSpan", "record_span", "simulated_history", "block_criteria",
-           "span_floor", "BLOCK_CYCLES"]
+__all__ = [
+    "Block",
+    "RecordSpan",
+    "record_span",
+    "simulated_history",
+    "block_criteria",
+    "span_floor",
+    "BLOCK_CYCLES",
+]
 
 _MIN_FLIGHT = 0.08  # shortest free flight that gives a state, in drive periods
 
@@ -100,9 +107,12 @@ class RecordSpan:
     def impulses(self, histories, onset_record_time=None):
         """Each block's history (a list of arrays, one per block) as its folded
         :class:`~discovery.impulse.Impulse`."""
-        return [b.fold.impulse(h, threshold=b.threshold, noise=self.sigma_f,
-                               onset_record_time=onset_record_time)
-                for b, h in zip(self.blocks, histories, strict=True)]
+        return [
+            b.fold.impulse(
+                h, threshold=b.threshold, noise=self.sigma_f, onset_record_time=onset_record_time
+            )
+            for b, h in zip(self.blocks, histories, strict=True)
+        ]
 
     def measured(self, onset_record_time=None):
         """The measured folded cycle of every block."""
@@ -156,8 +166,7 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
     td_all = t + time_offset
     W = cycle.duration
     mids = np.array([0.5 * (td_all[a] + td_all[b - 1]) for a, b in runs])
-    whole = make_fold(td_all, cycle.onset + time_offset, cycle.n_periods, T, mids[0],
-                      td_all[-1])
+    whole = make_fold(td_all, cycle.onset + time_offset, cycle.n_periods, T, mids[0], td_all[-1])
     if whole is None or whole.n_cycles < max(1, int(0.5 * (td_all[-1] - td_all[0]) / W)):
         return None  # the first flights are too late to use most of the record
     sigma = float(estimate_noise(F))
@@ -169,10 +178,10 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
         if not ok.size:
             return None
         j = int(ok[-1])
-        fold = make_fold(td_all, o, cycle.n_periods, T, o, o + count * W + 0.5 * (
-            td_all[1] - td_all[0]))
-        state = free_flight_state(measurement, scenario, runs[j], mids[j],
-                                  time_offset=time_offset)
+        fold = make_fold(
+            td_all, o, cycle.n_periods, T, o, o + count * W + 0.5 * (td_all[1] - td_all[0])
+        )
+        state = free_flight_state(measurement, scenario, runs[j], mids[j], time_offset=time_offset)
         Fi = F[fold.idx]
         peak = float(np.max(fold.average(Fi)))
         thr = max(5.0 * sigma / np.sqrt(fold.n_cycles), 1e-3 * peak)
@@ -185,8 +194,9 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
     return RecordSpan(blocks=tuple(blocks), sigma_f=sigma)
 
 
-def simulated_history(scenario, law, span, *, tolerances=None, starts=None, observe=None,
-                      window=False):
+def simulated_history(
+    scenario, law, span, *, tolerances=None, starts=None, observe=None, window=False
+):
     """The law's force at the span's sample times, each block simulated from its state.
 
     Parameters
@@ -220,14 +230,16 @@ def simulated_history(scenario, law, span, *, tolerances=None, starts=None, obse
         fold, st = blk.fold, blk.state
         y0 = st.y if starts is None else starts[k]
         td = fold.td
-        tr = simulate(scenario, law, (min(st.t, td[0]), fold.end), y0=y0, t_eval=td,
-                      tolerances=tolerances)
+        tr = simulate(
+            scenario, law, (min(st.t, td[0]), fold.end), y0=y0, t_eval=td, tolerances=tolerances
+        )
         zmax = float(np.max(tr.y[0] - tr.y[2]))
         if zmax > SINK_FACTOR * scenario.scales()[0]:
             raise IntegrationError(
                 f"under law '{law}' the moulding sinks into the frame (penetration "
                 f"{zmax:.3g} m, over {SINK_FACTOR:g} times the drive's motion scale): the law "
-                "is far too soft for the record")
+                "is far too soft for the record"
+            )
         Fs = np.asarray(tr.force, dtype=float)
         if window and td.size > 1:
             # the sample whose interval [e_i, e_i+1) holds a contact onset at fraction u is
@@ -236,8 +248,7 @@ def simulated_history(scenario, law, span, *, tolerances=None, starts=None, obse
             # whole at the interval's ends, so the residual is continuous in the law's
             # coefficients and unbiased (at the truth it is the record's noise, weighted)
             mid = 0.5 * (td[1:] + td[:-1])
-            edges = np.concatenate([[td[0] - (mid[0] - td[0])], mid,
-                                    [td[-1] + (td[-1] - mid[-1])]])
+            edges = np.concatenate([[td[0] - (mid[0] - td[0])], mid, [td[-1] + (td[-1] - mid[-1])]])
             on = tr.event_t[tr.event_kind == _K.EV_ONSET]
             k = np.searchsorted(edges, on, "right") - 1
             keep = (k >= 0) & (k < td.size)
@@ -250,8 +261,14 @@ def simulated_history(scenario, law, span, *, tolerances=None, starts=None, obse
             L = fold.end - fold.origin
             tt = np.concatenate([[0.0], fold.td - fold.origin, [L]])
             FF = np.concatenate([[Fs[-1]], Fs, [Fs[-1]]])
-            imp = Impulse(t=tt, F=FF, duration=L, support=np.zeros((0, 2)),
-                          n_periods=fold.n_periods * fold.n_cycles, onset=fold.origin)
+            imp = Impulse(
+                t=tt,
+                F=FF,
+                duration=L,
+                support=np.zeros((0, 2)),
+                n_periods=fold.n_periods * fold.n_cycles,
+                onset=fold.origin,
+            )
             Fs = observe(imp).evaluate(fold.td - fold.origin)
         out.append(Fs)
     return out
@@ -271,8 +288,7 @@ def block_criteria(measured, simulated, span, names=None):
     return {k: float(np.dot(w, [p[k] for p in per])) for k in per[0]}, per
 
 
-def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=None,
-               observe=None):
+def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=None, observe=None):
     """Noise floor of every criterion if ``law`` were the truth, through the span's own
     processing.
 
@@ -296,12 +312,14 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
         noise = [rng.normal(0.0, span.sigma_f, b.F.size) for b in span.blocks]
         try:
             # the truth as a record holds it: point samples
-            hist = simulated_history(scenario, law, span, tolerances=tolerances,
-                                     starts=starts, observe=observe)
+            hist = simulated_history(
+                scenario, law, span, tolerances=tolerances, starts=starts, observe=observe
+            )
         except IntegrationError:  # a failed draw: the measured states' histories instead
             if base is None:
-                base = simulated_history(scenario, law, span, tolerances=tolerances,
-                                         observe=observe)
+                base = simulated_history(
+                    scenario, law, span, tolerances=tolerances, observe=observe
+                )
             hist = base
         try:
             reps = span.impulses([h + e for h, e in zip(hist, noise, strict=True)])
@@ -313,11 +331,19 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
         impacts.append(int(len(reps[-1].support)))
     if not samples["I2"]:
         inf = {n: float("inf") for n in CRITERIA}
-        return {"mean": inf, "q95": dict(inf), "sd": dict(inf), "n_boot": 0, "seed": seed,
-                "impacts": []}
-    return {"impacts": impacts,
-            "mean": {n: float(np.mean(v)) for n, v in samples.items()},
-            "q95": {n: float(np.quantile(v, 0.95)) for n, v in samples.items()},
-            "sd": {n: float(np.std(v, ddof=1)) if len(v) > 1 else 0.0
-                   for n, v in samples.items()},
-            "n_boot": len(samples["I2"]), "seed": seed}
+        return {
+            "mean": inf,
+            "q95": dict(inf),
+            "sd": dict(inf),
+            "n_boot": 0,
+            "seed": seed,
+            "impacts": [],
+        }
+    return {
+        "impacts": impacts,
+        "mean": {n: float(np.mean(v)) for n, v in samples.items()},
+        "q95": {n: float(np.quantile(v, 0.95)) for n, v in samples.items()},
+        "sd": {n: float(np.std(v, ddof=1)) if len(v) > 1 else 0.0 for n, v in samples.items()},
+        "n_boot": len(samples["I2"]),
+        "seed": seed,
+    }

@@ -63,37 +63,63 @@ class VerifyResult:
     def as_dict(self):
         ev = self.evaluation
         E = self.reference.impulse
-        return {"law": self.law.to_text(), **ev.as_dict(),
-                "noise_floor_q95": ev.extra.get("noise_floor_q95"),
-                "measured": {"n_periods": E.n_periods, "n_cycles": E.n_cycles,
-                             "impacts": self.reference.impacts,
-                             "noise": {k: v for k, v in self.reference.noise.items()},
-                             "threshold": E.threshold, "peak": E.peak,
-                             "contact_time": E.contact_time},
-                "start": {"from": "measured state" if self.reference.start is not None
-                          else "scenario initial state",
-                          "state": self.reference.start, "time": self.reference.start_time,
-                          "time_offset": self.reference.time_offset},
-                "default_start": None if self.default_start is None
-                else self.default_start.as_dict(),
-                "notes": list(self.notes), "seconds": self.seconds}
+        return {
+            "law": self.law.to_text(),
+            **ev.as_dict(),
+            "noise_floor_q95": ev.extra.get("noise_floor_q95"),
+            "measured": {
+                "n_periods": E.n_periods,
+                "n_cycles": E.n_cycles,
+                "impacts": self.reference.impacts,
+                "noise": {k: v for k, v in self.reference.noise.items()},
+                "threshold": E.threshold,
+                "peak": E.peak,
+                "contact_time": E.contact_time,
+            },
+            "start": {
+                "from": "measured state"
+                if self.reference.start is not None
+                else "scenario initial state",
+                "state": self.reference.start,
+                "time": self.reference.start_time,
+                "time_offset": self.reference.time_offset,
+            },
+            "default_start": None if self.default_start is None else self.default_start.as_dict(),
+            "notes": list(self.notes),
+            "seconds": self.seconds,
+        }
 
     def _lines(self):
         ev = self.evaluation
         out = [f"{self.law}: {ev.verdict or ev.message}"]
         out += criteria_lines(ev.criteria, ev.noise_floor, ev.limits)
-        out.append(f"  regime measured {ev.regime.get('measured')}, simulated "
-                   f"{ev.regime.get('simulated')}")
+        out.append(
+            f"  regime measured {ev.regime.get('measured')}, simulated {ev.regime.get('simulated')}"
+        )
         out += [f"  note: {n}" for n in self.notes]
         return out
 
 
 @params(
-    scenario=Scenario, measurement=(Measurement, Reference), law=ForceLaw, time_offset=Real(),
-    n_boot=Real(0, integer=True), seed=Real(0, integer=True), tolerances=(Tolerances, None),
+    scenario=Scenario,
+    measurement=(Measurement, Reference),
+    law=ForceLaw,
+    time_offset=Real(),
+    n_boot=Real(0, integer=True),
+    seed=Real(0, integer=True),
+    tolerances=(Tolerances, None),
 )
-def verify(scenario, measurement, law, *, time_offset=0.0, n_boot=16, seed=0,
-           check_default_start=True, tolerances=None):
+def verify(
+    scenario,
+    measurement,
+    law,
+    *,
+    time_offset=0.0,
+    n_boot=16,
+    seed=0,
+    check_default_start=True,
+    tolerances=None,
+):
     """Verify ``law`` against a record by full simulation.
 
     Parameters
@@ -120,26 +146,45 @@ def verify(scenario, measurement, law, *, time_offset=0.0, n_boot=16, seed=0,
     VerifyResult
     """
     t0 = time.perf_counter()
-    ref = measurement if isinstance(measurement, Reference) else Reference.from_measurement(
-        measurement, scenario, time_offset=time_offset, n_boot=n_boot, seed=seed)
+    ref = (
+        measurement
+        if isinstance(measurement, Reference)
+        else Reference.from_measurement(
+            measurement, scenario, time_offset=time_offset, n_boot=n_boot, seed=seed
+        )
+    )
     ev = evaluate(scenario, law, ref, tolerances=tolerances)
     other, notes = None, []
     if check_default_start and ref.start is not None:
-        other = evaluate(scenario, law, ref, tolerances=tolerances, from_state=False,
-                         floor=False)
+        other = evaluate(scenario, law, ref, tolerances=tolerances, from_state=False, floor=False)
         # (with a record span the two criteria come from different comparisons: only the
         # regimes are compared)
         span = ev.extra.get("comparison") == "record span"
         if other.regime["simulated"] != ev.regime["simulated"] or (
-                not span and other.status == "ok" and ev.status == "ok"
-                and abs(other.criteria["I2"] - ev.criteria["I2"]) > 0.01):
-            notes.append(f"from the scenario's initial state the law reaches another attractor "
-                         f"({other.regime['simulated'] or other.status}, I2 "
-                         f"{other.value('I2'):.3g}) than from the measured state "
-                         f"({ev.regime['simulated'] or ev.status}): coexisting attractors")
-    settings = {"time_offset": time_offset, "n_boot": n_boot, "seed": seed,
-                "check_default_start": check_default_start,
-                "tolerances": None if tolerances is None else tolerances.as_dict()}
-    return VerifyResult(law=law, evaluation=ev, reference=ref, default_start=other,
-                        notes=tuple(notes), seconds=time.perf_counter() - t0,
-                        settings=settings)
+            not span
+            and other.status == "ok"
+            and ev.status == "ok"
+            and abs(other.criteria["I2"] - ev.criteria["I2"]) > 0.01
+        ):
+            notes.append(
+                f"from the scenario's initial state the law reaches another attractor "
+                f"({other.regime['simulated'] or other.status}, I2 "
+                f"{other.value('I2'):.3g}) than from the measured state "
+                f"({ev.regime['simulated'] or ev.status}): coexisting attractors"
+            )
+    settings = {
+        "time_offset": time_offset,
+        "n_boot": n_boot,
+        "seed": seed,
+        "check_default_start": check_default_start,
+        "tolerances": None if tolerances is None else tolerances.as_dict(),
+    }
+    return VerifyResult(
+        law=law,
+        evaluation=ev,
+        reference=ref,
+        default_start=other,
+        notes=tuple(notes),
+        seconds=time.perf_counter() - t0,
+        settings=settings,
+    )

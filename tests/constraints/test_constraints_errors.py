@@ -16,9 +16,10 @@ def test_discovery_reexports_the_one_root():
     assert issubclass(discovery.errors.IntegrationError, VidiError)
 
 
-@pytest.mark.parametrize("cls, builtin", [(InputError, ValueError),
-                                          (CertificateError, ValueError),
-                                          (SolverError, RuntimeError)])
+@pytest.mark.parametrize(
+    "cls, builtin",
+    [(InputError, ValueError), (CertificateError, ValueError), (SolverError, RuntimeError)],
+)
 def test_every_constraints_error_is_a_vidi_error_and_its_builtin(cls, builtin):
     assert issubclass(cls, VidiError) and issubclass(cls, builtin)
 

@@ -137,6 +137,7 @@ def test_physical_constraints_are_infeasible_for_contradicting_signs():
 
 def _affine(constraints, x):
     """``(rows, rhs)`` of cvxpy constraints ``g(x) >= 0`` with affine ``g``, by evaluation."""
+
     def g(v):
         x.value = v
         # cvxpy stores ``a >= b`` as ``b <= a``, whose ``expr`` is ``b - a``
@@ -148,11 +149,14 @@ def _affine(constraints, x):
     return rows, rhs
 
 
-@pytest.mark.parametrize("kwargs", [
-    dict(),
-    dict(margin=50.0, force_unit=1e3),
-    dict(monotone=True, signs=[1, -1, 0, 1, 0], elevation=3),
-])
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        dict(),
+        dict(margin=50.0, force_unit=1e3),
+        dict(monotone=True, signs=[1, -1, 0, 1, 0], elevation=3),
+    ],
+)
 def test_constraint_rows_are_the_builders_constraints(kwargs):
     x = cp.Variable(len(LIBRARY))
     rows, rhs = constraint_rows(LIBRARY, BOX, **kwargs)
