@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed
 TEX_PACKAGES := latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended \
 	lmodern poppler-utils
 
-.PHONY: install demo study test test-fast bench lint clean tex
+.PHONY: install demo study test test-slow test-all bench lint clean tex
 
 install: $(STAMP)
 
@@ -66,17 +66,26 @@ tex:
 			-y -qq --no-install-recommends $(TEX_PACKAGES); \
 	fi
 
-test: install
-	$(BIN)/python -m pytest -q
+# The suite on every core (one worker per core; a module's tests share one worker, so its
+# fixtures are built once); the long surveys carry the `slow` mark: `make test-slow`, in CI
+JOBS ?= auto
+PYTEST := $(BIN)/python -m pytest -q -n $(JOBS) --dist loadscope
 
-test-fast: install
-	$(BIN)/python -m pytest -q -m "not slow"
+test: install
+	$(PYTEST) -m "not slow"
+
+test-slow: install
+	$(PYTEST) -m slow
+
+test-all: install
+	$(PYTEST)
 
 bench: install
 	cd bench && ../$(BIN)/python run.py
 
 lint: install
 	$(BIN)/ruff check discovery constraints reports tests bench
+	$(BIN)/ruff format --check discovery constraints reports tests bench
 
 clean:
 	rm -rf out bench/_work .pytest_cache

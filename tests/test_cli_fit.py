@@ -97,6 +97,7 @@ def test_model_tex_names_the_law(fitted):
         assert rf"\texttt{{{name}}} & ${mant}\cdot 10^{{{int(exp)}}}$" in tex, name
 
 
+@pytest.mark.slow  # a second full fit, scored by cross-validation: about 1 min
 def test_fit_scored_by_cross_validation_reports_it(record, tmp_path):
     out = tmp_path / "cv"
     assert (

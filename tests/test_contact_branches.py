@@ -191,6 +191,7 @@ def test_a_moulding_that_sheds_mass_has_no_steady_state(tmp_path, capsys):
     assert len(err) == 1 and "mass_loss = 0" in err[0]
 
 
+@pytest.mark.slow  # the scipy path's record from rest: about 2 min
 def test_a_set_orbit_strobed_inside_its_contact_keeps_its_unloading_memory():
     # the drive's phase 0 falls in this orbit's unloading: the four states do not say from
     # which penetration the set contact unloads, so the steady state carries it.  The orbit

@@ -239,6 +239,7 @@ def noisy_positions(paper):
     return discover(paper, m, library="poly:2", stability=10, n_boot_intervals=0)
 
 
+@pytest.mark.slow  # the fixture's discovery takes 6 min
 @pytest.mark.xfail(
     reason="records judged over their span: with 1 % position noise and no "
     "velocities the biased regression starts the z + zd refinement outside the "
@@ -257,6 +258,7 @@ def test_backward_steps_reach_the_simplest_consistent_law(noisy_positions):
     assert all(len(m.law.names) >= 2 for m in res.ranking if m.consistent)
 
 
+@pytest.mark.slow  # the fixture's discovery takes 6 min
 @pytest.mark.xfail(
     reason="records judged over their span: with 1 % position noise and no "
     "velocities the biased regression starts the z + zd refinement outside the "
@@ -276,6 +278,7 @@ def test_equivalent_models_say_why_and_what_would_separate_them(noisy_positions)
         assert e["separate"]
 
 
+@pytest.mark.slow  # the fixture's discovery takes 6 min
 def test_stability_disagreement_is_a_warning(noisy_positions):
     res = noisy_positions
     strong = [t for t, f in res.stability.items() if f >= 0.5 and t not in res.selected.law.names]
