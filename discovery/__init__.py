@@ -56,6 +56,8 @@ _EXPORTS = {
     "Executor": "executor",
     "make_executor": "executor",
     "report": "report",
+    "verify": "verify.verify",
+    "VerifyResult": "verify.verify",
 }
 
 
@@ -105,6 +107,8 @@ __all__ = [
     "field_record",
     "Executor",
     "make_executor",
+    "verify",
+    "VerifyResult",
 ]
 
 lazy_package(__name__, _EXPORTS)

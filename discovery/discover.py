@@ -33,6 +33,7 @@ criterion; models without a periodic steady state come last.
 
 import time
 from dataclasses import dataclass, field, replace
+from warnings import warn
 
 import numpy as np
 
@@ -472,6 +473,7 @@ class _Checker:
                 method="least-squares",
                 max_simulations=self.budget,
                 tolerances=self.tol,
+                check=False,
             )
         except IntegrationError as exc:
             return RankedModel(
@@ -817,7 +819,8 @@ def _equivalent(ranking, selected, est, samples, criterion):
     sim_rtol=Real(0, open_low=True),
     sim_atol=Real(0),
     tolerances=(Tolerances, None),
-    random_state=Real(0, integer=True),
+    seed=Real(0, integer=True),
+    random_state=(None, Real(0, integer=True)),
     n_boot=Real(0, integer=True),
     max_simulations=Real(0, integer=True),
     stepwise=Real(0, integer=True),
@@ -841,7 +844,7 @@ def discover(
     sim_rtol=0.1,
     sim_atol=0.005,
     tolerances=None,
-    random_state=0,
+    seed=0,
     n_boot=16,
     max_simulations=_REFINE_BUDGET,
     stepwise=3,
@@ -849,6 +852,7 @@ def discover(
     require=(),
     n_boot_intervals=30,
     progress=None,
+    random_state=None,
     **estimator_kwargs,
 ):
     """Discover a contact law from one or several records and check it by simulation.
@@ -883,8 +887,9 @@ def discover(
         Tolerances of the ranking rule.
     tolerances : Tolerances, optional
         Integrator settings (the same for refinement and checks).
-    random_state : int
-        Seed of the stability selection and of the noise-floor bootstrap.
+    seed : int
+        Seed of the stability selection and of the noise-floor bootstrap (the CLI's
+        ``--seed``).
     n_boot : int
         Bootstrap replicates of each candidate's noise floor.
     max_simulations : int
@@ -906,6 +911,8 @@ def discover(
     progress : callable, optional
         ``progress(stage, done, total)`` as the shortlist is simulated and the stepwise
         search and the bootstrap go on (:mod:`discovery._progress`).
+    random_state : int, optional
+        Deprecated name of ``seed``.
     **estimator_kwargs
         Further estimator parameters (``margin``, ``monotone``, ``signs``, ...).
 
@@ -919,6 +926,13 @@ def discover(
         uncertainty (regression bias).
     """
     t0 = time.perf_counter()
+    if random_state is not None:
+        warn(
+            "discover(random_state=...) is renamed seed=... (the CLI's --seed)",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+        seed = random_state
     _criterion(criterion)
     if not (isinstance(shortlist, int | np.integer) and shortlist >= 1):
         raise InputError(
@@ -938,9 +952,7 @@ def discover(
         for sc, m in pairs
     ]
     samples = join_samples(parts)
-    refs = [
-        (sc, Reference.from_measurement(m, sc, n_boot=n_boot, seed=random_state)) for sc, m in pairs
-    ]
+    refs = [(sc, Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)) for sc, m in pairs]
     if isinstance(estimator_kwargs.get("signs"), dict):
         estimator_kwargs["signs"] = _sign_vector(estimator_kwargs["signs"], library)
     est = ConstrainedSparseRegressor(
@@ -1051,7 +1063,7 @@ def discover(
             [r for _, r in refs],
             selected.law,
             n_boot=int(n_boot_intervals),
-            seed=random_state,
+            seed=seed,
             criterion=criterion,
             tolerances=tolerances,
         )
@@ -1068,7 +1080,7 @@ def discover(
             samples.F,
             samples.impact,
             stability,
-            random_state,
+            seed,
             sample_weight=samples.weight,
         )
         if stability
@@ -1100,7 +1112,7 @@ def discover(
         "stability": stability,
         "derivative": samples.derivative,
         "average_cycles": average_cycles,
-        "random_state": random_state,
+        "seed": seed,
         "n_boot": n_boot,
         "records": len(pairs),
         "stepwise": stepwise,

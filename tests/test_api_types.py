@@ -173,6 +173,7 @@ def test_the_cases_cover_every_public_entry():
         "Candidate",
         "IdentificationResult",
         "ExplainResult",
+        "VerifyResult",
         "builtin_scenarios",
         "load_scenario",
         "impulse_from_steady_state",
@@ -209,6 +210,7 @@ def test_the_cases_cover_every_public_entry():
             "load_study",
             "field_record",
             "make_executor",
+            "verify",
         }
     )
     assert not unlisted, f"public entries without a row: {sorted(unlisted)}"

@@ -48,6 +48,18 @@ def test_least_squares_recovers_the_law_within_its_standard_errors(paper, fitted
     assert fitted.failures == []
 
 
+def test_identification_has_a_verdict(paper, reference, fitted):
+    """The identified law is checked against the record with its noise floor, as verify
+    does; without the check the result says so."""
+    assert len(fitted.checks) == 1 and fitted.checks[0].noise_floor
+    assert fitted.consistent is True
+    assert fitted.verdict == fitted.checks[0].verdict and "consistent" in fitted.verdict
+    assert f"verdict: {fitted.verdict}" in str(fitted)
+    assert fitted.as_dict()["consistent"] is True
+    quick = identify(paper, reference, START, max_simulations=4, uncertainty=False, check=False)
+    assert quick.checks == () and quick.consistent is None and "not checked" in quick.verdict
+
+
 def test_budget_counts_every_simulation(paper, reference):
     """The budget bounds all simulations (finite-difference Jacobians included); the
     uncertainty estimate adds one simulation per coefficient and record."""

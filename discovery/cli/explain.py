@@ -49,7 +49,7 @@ def run(args):
             criterion=args.criterion,
             alpha=args.alpha,
             max_iterations=args.max_iterations,
-            budget=args.max_simulations,
+            max_simulations=args.max_simulations,
             n_boot=args.n_boot,
             seed=args.seed,
             effects=effects,

@@ -49,7 +49,7 @@ def run(args):
             stability=args.stability,
             derivative=args.derivative,
             average_cycles=args.average_cycles,
-            random_state=args.seed,
+            seed=args.seed,
             margin=args.margin,
             monotone=args.monotone,
             physics=not args.allow_unphysical,

@@ -40,6 +40,7 @@ import itertools
 import os
 import re
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -263,6 +264,7 @@ def _polish_start(records, fit, criterion, budget, tol):
             max_simulations=budget,
             tolerances=tol,
             short_first=False,
+            check=False,
         )
     except (IntegrationError, InputError):
         return fit
@@ -793,6 +795,7 @@ def _output_error(records, start, criterion, budget, tol, polish=False):
         method="least-squares",
         max_simulations=budget,
         tolerances=tol,
+        check=False,
     )
     left = budget - res.n_simulations
     if not polish or left < 4 * (len(res.law.coefficients) + 1) * len(records):
@@ -806,6 +809,7 @@ def _output_error(records, start, criterion, budget, tol, polish=False):
             method="nelder-mead",
             max_simulations=left,
             tolerances=tol,
+            check=False,
         )
     except IntegrationError:
         return res
@@ -819,7 +823,8 @@ def _output_error(records, start, criterion, budget, tol, polish=False):
     criterion=Text(),
     alpha=Real(0, 1, open_low=True),
     max_iterations=Real(1, integer=True),
-    budget=Real(1, integer=True),
+    max_simulations=Real(1, integer=True),
+    budget=(None, Real(1, integer=True)),
     n_boot=Real(0, integer=True),
     seed=Real(0, integer=True),
     tolerances=(Tolerances, None),
@@ -837,7 +842,7 @@ def explain(
     criterion="I2",
     alpha=0.01,
     max_iterations=3,
-    budget=150,
+    max_simulations=150,
     n_boot=16,
     seed=0,
     tolerances=None,
@@ -847,6 +852,7 @@ def explain(
     n_boot_intervals=30,
     progress=None,
     executor=None,
+    budget=None,
 ):
     """Explain the disagreement of a start model with one or several records by named
     physical effects (see the module docstring).
@@ -865,8 +871,8 @@ def explain(
         Family-wise significance level of the score tests.
     max_iterations : int
         Effects added at most.
-    budget : int
-        Simulations of each refit.
+    max_simulations : int
+        Simulations of each refit (the CLI's ``--max-simulations``).
     n_boot, seed : int
         Noise-floor bootstrap.
     tolerances : Tolerances, optional
@@ -885,12 +891,22 @@ def explain(
         processing (:func:`discovery.intervals.bootstrap_intervals`; 0 = none).
     progress : callable, optional
         ``progress(stage, done, total)`` at each stage and iteration (:mod:`discovery._progress`).
+    budget : int, optional
+        Deprecated name of ``max_simulations``.
 
     Returns
     -------
     ExplainResult
     """
     t0 = time.perf_counter()
+    if budget is not None:
+        warnings.warn(
+            "explain(budget=...) is renamed max_simulations=... (the CLI's --max-simulations)",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+        max_simulations = budget
+    budget = max_simulations
     if not (0 < alpha < 1):
         raise InputError(f"alpha must be in (0, 1); got {alpha!r}")
     if workers is not None and not (isinstance(workers, int) and workers >= 1):
@@ -1343,7 +1359,7 @@ def explain(
             "criterion": criterion,
             "alpha": alpha,
             "max_iterations": max_iterations,
-            "budget": budget,
+            "max_simulations": budget,
             "n_boot": n_boot,
             "seed": seed,
             "effects": [e.id for e in catalogue],

@@ -151,7 +151,7 @@ def run_one(context, spec):
             library=spec["library"],
             selection=spec["selection"],
             refine=spec["refine"],
-            random_state=spec["seed"],
+            seed=spec["seed"],
             **spec["fit"],
         )
         out.update(score(result, truth), status="ok", error="")

@@ -1,0 +1,54 @@
+"""The API says what the CLI says: one name per setting, the same defaults, old names
+deprecated (they still work for now, with a DeprecationWarning)."""
+
+import inspect
+
+import pytest
+
+import discovery
+from discovery.cli import _parser
+from discovery.errors import InputError
+from discovery.measurement import synthesize
+
+
+@pytest.fixture(scope="module")
+def record(paper):
+    return synthesize(paper, paper.law, periods=6, fs=20000, noise=0.01, seed=1)
+
+
+def _cli_default(command, option):
+    sub = next(
+        a for a in _parser()._actions if a.__class__.__name__ == "_SubParsersAction"
+    ).choices[command]
+    return next(a.default for a in sub._actions if option in a.option_strings)
+
+
+def test_identify_default_method_is_the_clis():
+    api = inspect.signature(discovery.identify).parameters["method"].default
+    assert api == _cli_default("identify", "--method") == "least-squares"
+
+
+def test_every_seed_is_called_seed():
+    for f in (discovery.discover, discovery.explain, discovery.identify, discovery.verify):
+        assert "seed" in inspect.signature(f).parameters, f.__name__
+    assert "max_simulations" in inspect.signature(discovery.explain).parameters
+
+
+def test_explain_budget_is_deprecated_for_max_simulations(paper, record):
+    # the old name warns and is taken; alpha=1 then stops the call before any simulation
+    with pytest.warns(DeprecationWarning, match="max_simulations"):
+        with pytest.raises(InputError, match="alpha"):
+            discovery.explain(paper, record, budget=20, alpha=1.0)
+
+
+def test_discover_random_state_is_deprecated_for_seed(paper, record):
+    with pytest.warns(DeprecationWarning, match="seed"):
+        with pytest.raises(InputError, match="criterion"):
+            discovery.discover(paper, record, random_state=3, criterion="I9")
+
+
+def test_verify_from_the_package_is_the_function():
+    from discovery import verify
+
+    assert callable(verify) and verify is discovery.verify
+    assert discovery.VerifyResult.__name__ == "VerifyResult"
