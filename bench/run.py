@@ -36,8 +36,8 @@ from discovery.dynamics.steady_state import steady_state
 from discovery.identify import METHODS, identify
 from discovery.landscape import landscape
 from discovery.law import ForceLaw
-from discovery.measurement import synthesize
 from discovery.scenario import load_scenario
+from discovery.synthesize import synthesize
 
 
 def _best(f, repeat=5):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from discovery.dynamics.steady_state import steady_state
-from discovery.impulse import impulse_from_steady_state
+from discovery.response import impulse_from_steady_state
 from discovery.scenario import load_scenario
 
 

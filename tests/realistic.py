@@ -67,8 +67,8 @@ import numpy as np
 from discovery.dynamics.simulate import Tolerances, simulate
 from discovery.dynamics.steady_state import steady_state
 from discovery.errors import VidiError
-from discovery.impulse import impulse_from_steady_state
 from discovery.law import ForceLaw
+from discovery.response import impulse_from_steady_state
 from discovery.scenario import Scenario
 from discovery.studies.records import (
     RTOL_RECORD,

@@ -16,7 +16,7 @@ import pytest
 
 from discovery.cli import main
 from discovery.errors import VidiError
-from discovery.measurement import synthesize
+from discovery.synthesize import synthesize
 
 GOOD_TOML = """\
 name = "bench"

@@ -9,8 +9,9 @@ import pytest
 from discovery.criteria import CRITERIA, compare, criterion, evaluate_criteria
 from discovery.dynamics.steady_state import steady_state
 from discovery.errors import InputError
-from discovery.impulse import Impulse, impulse_from_steady_state
+from discovery.impulse import Impulse
 from discovery.law import ForceLaw
+from discovery.response import impulse_from_steady_state
 
 NAMES = ["I0", "I1", "I2", "I3", "I4"]
 

@@ -9,8 +9,8 @@ import pytest
 from discovery.discover import RankedModel, discover, rank
 from discovery.errors import InputError
 from discovery.law import ForceLaw
-from discovery.measurement import synthesize
 from discovery.regression import Candidate
+from discovery.synthesize import synthesize
 from discovery.verify import Evaluation
 
 RTOL, ATOL = 0.1, 0.005  # discover()'s default ranking rule

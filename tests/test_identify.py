@@ -11,7 +11,7 @@ from discovery.discover import discover
 from discovery.errors import InputError, IntegrationError, VidiError
 from discovery.identify import as_records, identify
 from discovery.law import ForceLaw
-from discovery.measurement import synthesize
+from discovery.synthesize import synthesize
 from discovery.verify import Reference
 
 START = ForceLaw.parse("1.5e8*z + 0.9e7*zd")

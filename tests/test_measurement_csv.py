@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from discovery.errors import InputError
-from discovery.measurement import JITTER_LIMIT, Measurement, synthesize
+from discovery.measurement import JITTER_LIMIT, Measurement
+from discovery.synthesize import synthesize
 
 FS = 20000.0
 

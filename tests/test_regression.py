@@ -18,9 +18,9 @@ from constraints.errors import SolverError
 from discovery.errors import InputError
 from discovery.law import ForceLaw
 from discovery.library import Library
-from discovery.measurement import synthesize
 from discovery.regression import SELECTIONS, ConstrainedSparseRegressor
 from discovery.samples import contact_samples
+from discovery.synthesize import synthesize
 
 LAW11 = "2.06e8*z + 1.28e7*zd"
 LAW11_ZZD = "2.06e8*z + 1.28e7*zd + 2e10*z*zd"

@@ -5,8 +5,9 @@ import pytest
 
 from discovery.errors import InputError
 from discovery.impulse import impulse_from_samples
-from discovery.measurement import Measurement, synthesize
+from discovery.measurement import Measurement
 from discovery.samples import contact_samples
+from discovery.synthesize import synthesize
 
 
 @pytest.fixture(scope="module")

@@ -28,7 +28,7 @@ MAX_SAMPLES = 10_000_000
 
 
 def run(args):
-    from ..measurement import synthesize
+    from ..synthesize import synthesize
 
     out = check_out(args, kind="file")
     if out.suffix.lower() != ".csv":

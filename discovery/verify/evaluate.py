@@ -33,7 +33,7 @@ from ..criteria import compare, evaluate_criteria
 from ..dynamics.simulate import simulate
 from ..dynamics.steady_state import steady_state
 from ..errors import InputError, IntegrationError
-from ..impulse import impulse_from_steady_state
+from ..response import impulse_from_steady_state
 from .trajectory import block_criteria, simulated_history
 
 __all__ = [

@@ -1,0 +1,70 @@
+"""Integrator tolerances, shared by both systems' integrators."""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validate import Real, check
+from ..errors import InputError
+
+__all__ = ["Tolerances"]
+
+
+@dataclass(frozen=True)
+class Tolerances:
+    """Integrator settings.
+
+    Parameters
+    ----------
+    rtol : float
+        Relative tolerance of the embedded error estimate.
+    atol_scale : float
+        Absolute tolerance as a multiple of ``rtol`` times the scenario's
+        characteristic displacement / velocity (see :meth:`Scenario.scales`).
+    max_steps : int
+        Step budget per call.
+    hmax_fraction : float
+        Largest step as a fraction of the drive period (also bounds how brief a
+        contact can be and still be seen between step ends).
+    """
+
+    rtol: float = 1e-9
+    atol_scale: float = 1e-3
+    max_steps: int = 2_000_000
+    hmax_fraction: float = 0.02
+
+    def __post_init__(self):
+        for name, spec in (
+            ("rtol", Real(0, 1, open_low=True)),
+            ("atol_scale", Real(0, open_low=True)),
+            ("max_steps", Real(1, integer=True)),
+            ("hmax_fraction", Real(0, 1, open_low=True)),
+        ):
+            check(f"Tolerances: {name}", getattr(self, name), spec)
+        if not (0 < self.rtol < 1):
+            raise InputError(f"rtol must be in (0, 1), got {self.rtol!r}")
+        if not self.atol_scale > 0:
+            raise InputError(f"atol_scale must be > 0, got {self.atol_scale!r}")
+        if not (isinstance(self.max_steps, int | np.integer) and self.max_steps > 0):
+            raise InputError(f"max_steps must be a positive integer, got {self.max_steps!r}")
+        if not (0 < self.hmax_fraction <= 1):
+            raise InputError(f"hmax_fraction must be in (0, 1], got {self.hmax_fraction!r}")
+
+    def atol(self, scale):
+        """Absolute tolerances ``rtol * atol_scale * scale`` for states of size ``scale``."""
+        return self.rtol * self.atol_scale * np.asarray(scale, dtype=float)
+
+    @property
+    def atol_variational(self):
+        """Absolute tolerance of the variational (tangent) equations: ``rtol * atol_scale``
+        (tangent vectors are normalised)."""
+        return self.rtol * self.atol_scale
+
+    def as_dict(self):
+        return {
+            "rtol": self.rtol,
+            "atol_scale": self.atol_scale,
+            "max_steps": self.max_steps,
+            "hmax_fraction": self.hmax_fraction,
+            "method": "dopri5+events",
+        }
