@@ -26,13 +26,12 @@ Files from real instruments (:meth:`Measurement.from_csv`):
   value beyond them is a unit or column mix-up and would overflow the processing).
 """
 
-import csv
 import io
-import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._csv import parse_column, read_csv_rows
 from ._io import atomic_write_text
 from ._validate import Array, Text, check
 from .errors import InputError, NoContactError
@@ -182,7 +181,7 @@ class Measurement:
         src, from_a2, extra_notes = _column_sources(header, columns, name, scenario)
         notes += extra_notes
         cols = {
-            key: _parse_column(key, header[j], j, body, name, decimal_comma)
+            key: parse_column(key, header[j], j, body, name, decimal_comma, LIMITS)
             for key, j in src.items()
         }
         t = cols["t"]
@@ -366,100 +365,6 @@ def no_contact_message(t, F, period, source="", threshold=None):
     )
 
 
-def read_csv_rows(path, needs):
-    """The one CSV reader of both systems: ``(header, body, decimal_comma, notes)``.
-
-    UTF-8 (with or without a byte-order mark) or UTF-16 with one; ``,``, ``;`` or tab as
-    the separator (from the header); ``#`` comment lines and blank lines skipped; decimal
-    commas with ``;`` or tab.  ``body`` is ``[(line number, fields), ...]``.  ``needs``
-    names the columns for the messages (``"t and F"``).
-    """
-    name = str(path)
-    text, notes = _read_text(path, name)
-    lines = [
-        (i + 1, ln)
-        for i, ln in enumerate(text.splitlines())
-        if ln.strip() and not ln.lstrip().startswith("#")
-    ]
-    if not lines:
-        raise InputError(f"data file {name!r} is empty; it needs a header with {needs}")
-    delim = _sniff(lines[0][1])
-    rows = []
-    for ln, line in lines:  # one record per line (no quoted line breaks in numbers)
-        try:
-            rows.append(next(csv.reader([line], delimiter=delim), []))
-        except csv.Error as exc:
-            raise InputError(
-                f"data file {name!r}: line {ln} is not a readable CSV row "
-                f"({exc}); save the file as CSV with a header row"
-            ) from None
-    header = [h.strip() for h in rows[0]]
-    body = list(zip((ln for ln, _ in lines[1:]), rows[1:], strict=True))
-    if not body:
-        raise InputError(f"data file {name!r} has a header but no data rows")
-    decimal_comma = delim != "," and any("," in c for _, r in body[:50] for c in r)
-    if decimal_comma:
-        notes += ("decimal commas read as decimal points",)
-    return header, body, decimal_comma, notes
-
-
-def _read_text(path, name):
-    """The file's text (UTF-8 with or without BOM, or UTF-16 with BOM) and notes."""
-    if not name.strip():
-        raise InputError("the data file name is empty; give a CSV file such as D.csv")
-    try:
-        with open(path, "rb") as fh:
-            raw = fh.read()
-    except FileNotFoundError:
-        raise InputError(f"data file {name!r} does not exist; check the path") from None
-    except IsADirectoryError:
-        raise InputError(
-            f"data file {name!r} is a directory; give the CSV file itself, e.g. "
-            f"{os.path.join(name, 'D.csv')!r}"
-        ) from None
-    except PermissionError:
-        raise InputError(
-            f"data file {name!r} cannot be read (permission denied); fix its "
-            "permissions or copy it somewhere readable"
-        ) from None
-    except OSError as exc:
-        raise InputError(
-            f"cannot read data file {name!r} ({exc.strerror or exc}); check the path"
-        ) from None
-    notes = ()
-    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
-        try:
-            text = raw.decode("utf-16")
-        except UnicodeDecodeError:
-            raise InputError(
-                f"data file {name!r} starts with a UTF-16 byte-order mark but is "
-                "not valid UTF-16; re-save it as UTF-8 CSV"
-            ) from None
-        notes = ("read as UTF-16 (byte-order mark)",)
-    else:
-        try:
-            text = raw.decode("utf-8-sig")
-        except UnicodeDecodeError as exc:
-            raise InputError(
-                f"data file {name!r} is not UTF-8 text (byte 0x{raw[exc.start]:02x} "
-                f"at offset {exc.start}); re-save it as UTF-8 (spreadsheets: "
-                "'CSV UTF-8'; or iconv -f latin1 -t utf-8)"
-            ) from None
-    if "\x00" in text:
-        raise InputError(
-            f"data file {name!r} contains NUL bytes: it is binary (or UTF-16 "
-            "without a byte-order mark), not CSV text; export it as CSV (UTF-8)"
-        )
-    return text, notes
-
-
-def _sniff(header_line):
-    """The separator of the header line: the most frequent of tab, ';' and ','."""
-    counts = [(header_line.count(c), -k, c) for k, c in enumerate(("\t", ";", ","))]
-    n, _, c = max(counts)
-    return c if n else ","
-
-
 def _column_sources(header, columns, name, scenario):
     """``{our name: column index}``, whether F comes from a2, and notes."""
     named = [h for h in header if h]
@@ -530,52 +435,3 @@ def _column_sources(header, columns, name, scenario):
     if ignored:
         notes += (f"ignored column(s): {', '.join(ignored)}",)
     return src, from_a2, notes
-
-
-def _parse_column(key, hname, j, body, name, decimal_comma, limits=None):
-    """Column ``j`` of the data rows as floats, with a line-numbered error for a missing,
-    non-numeric, non-finite or out-of-range cell (``limits``: ``{key: (bound, unit)}``,
-    default the vibro-impact channels')."""
-    cells = []
-    for ln, row in body:
-        if j >= len(row):
-            raise InputError(
-                f"data file {name!r}: line {ln} has {len(row)} field(s), no value "
-                f"for column {hname}; every row needs a value in every column"
-            )
-        cells.append(row[j].strip())
-    arr = np.array(cells, dtype=str)
-    if decimal_comma:
-        arr = np.char.replace(arr, ",", ".")
-    try:
-        v = arr.astype(float)
-    except (ValueError, OverflowError):
-        for (ln, _), c in zip(body, arr, strict=True):
-            try:
-                float(c)
-            except ValueError:
-                what = "is empty" if not c else f"has a non-numeric value {c[:20]!r}"
-                raise InputError(
-                    f"data file {name!r}: column {hname} {what} at line {ln}; "
-                    "every row needs a number (remove the row or fill it)"
-                ) from None
-        raise InputError(
-            f"data file {name!r}: column {hname} cannot be read as numbers; "
-            "every row needs a number"
-        ) from None
-    bad = np.flatnonzero(~np.isfinite(v))
-    if bad.size:
-        raise InputError(
-            f"data file {name!r}: column {hname} has the non-finite value "
-            f"{cells[bad[0]][:20]!r} at line {body[bad[0]][0]}; remove the row or "
-            "fill it with a measured number"
-        )
-    lim, unit = (LIMITS if limits is None else limits)[key]
-    big = np.flatnonzero(np.abs(v) > lim)
-    if big.size:
-        raise InputError(
-            f"data file {name!r}: column {hname} has the value {cells[big[0]][:20]} "
-            f"at line {body[big[0]][0]}, beyond the accepted |{key}| <= {lim:g} "
-            f"{unit}; check the column and its units (SI)"
-        )
-    return v

@@ -400,7 +400,7 @@ def read_record_csv(path):
     """``(t, x)`` from a CSV with a header naming columns ``t`` and ``x`` (other columns
     ignored); checked: finite, at least 64 rows, strictly increasing and uniform ``t``
     (to 1e-6 of the step)."""
-    from ..measurement import _parse_column, read_csv_rows
+    from .._csv import parse_column, read_csv_rows
 
     header, body, decimal_comma, _ = read_csv_rows(path, "t and x")
     missing = [c for c in ("t", "x") if c not in header]
@@ -411,7 +411,7 @@ def read_record_csv(path):
         )
     limits = {"t": (1e7, "s"), "x": (1e6, "")}
     t, x = (
-        _parse_column(c, c, header.index(c), body, str(path), decimal_comma, limits)
+        parse_column(c, c, header.index(c), body, str(path), decimal_comma, limits)
         for c in ("t", "x")
     )
     return check_record(t, x, what=f"--data {path}")
