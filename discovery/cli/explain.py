@@ -4,7 +4,6 @@ import time
 
 from .._io import OutputDir, provenance
 from ..criteria import CRITERIA
-from ..errors import InputError
 from ._common import (
     SCENARIO_HELP,
     SCHEDULER_HELP,
@@ -25,21 +24,16 @@ from ._common import (
 def run(args):
     from reports import explain_figure
 
+    from ..catalogue import select
     from ..explain import EFFECTS, explain
 
     t_start = time.perf_counter()
     check_out(args)
     data = args.data
-    known = {e.id for e in EFFECTS}
     effects = None
     if args.effects:
         effects = [e.strip() for e in args.effects.split(",") if e.strip()]
-        bad = sorted(set(effects) - known)
-        if bad or not effects:
-            raise InputError(
-                f"--effects: unknown effect(s) {', '.join(bad) or '(none)'}; "
-                f"choose from {', '.join(sorted(known))}"
-            )
+        select(EFFECTS, effects, where="--effects")
     scs, meas = read_records(args)
     with reporter(args) as rep, executor_of(args) as ex:
         res = explain(

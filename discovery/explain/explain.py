@@ -49,6 +49,7 @@ from scipy.stats import chi2
 from .._printing import criteria_lines, fmt, readable
 from .._progress import tick
 from .._validate import Instance, Real, Text, params
+from ..catalogue import select
 from ..dynamics import Tolerances
 from ..errors import InputError, IntegrationError
 from ..executor import make_executor
@@ -926,13 +927,7 @@ def explain(
             for sc, m in pairs
         ],
     )
-    catalogue = [e for e in EFFECTS if effects is None or e.id in effects]
-    if effects is not None and len(catalogue) != len(set(effects)):
-        known = {e.id for e in EFFECTS}
-        raise InputError(
-            f"unknown effect(s) {sorted(set(effects) - known)}; the catalogue "
-            f"has {', '.join(sorted(known))}"
-        )
+    catalogue = select(EFFECTS, effects)
     problem = _Problem(records, tolerances)
     plain = [m for m in ms if not isinstance(m, Reference)]
     preferred, others = (

@@ -14,8 +14,7 @@ impacts, and where an effect acts in the ``(x, x')`` plane is said in ``signatur
 
 import numpy as np
 
-from ..errors import InputError
-from ..explain.effects import Effect, Parameter
+from ..catalogue import Effect, Parameter, lookup
 from .discover import TERMS
 
 __all__ = ["EFFECTS", "effect", "effect_dict", "in_bounds"]
@@ -102,13 +101,8 @@ for _e in EFFECTS:
 
 
 def effect(effect_id):
-    """The catalogue entry ``effect_id``."""
-    for e in EFFECTS:
-        if e.id == effect_id:
-            return e
-    raise InputError(
-        f"unknown effect {effect_id!r}; the catalogue has {', '.join(e.id for e in EFFECTS)}"
-    )
+    """The catalogue entry ``effect_id`` (:func:`discovery.catalogue.lookup`)."""
+    return lookup(EFFECTS, effect_id)
 
 
 def in_bounds(eff, values):

@@ -44,6 +44,7 @@ from scipy.stats import chi2
 
 from .._printing import generic_lines, readable
 from .._validate import Array, Real, params
+from ..catalogue import select
 from ..errors import InputError
 from .discover import (
     FORCING,
@@ -439,17 +440,7 @@ def explain(
     ):
         raise InputError(f"max_iterations must be an integer >= 0; got {max_iterations!r}")
     start = parse_terms(start_terms)
-    catalogue = list(EFFECTS)
-    if effects is not None:
-        effects = [effects] if isinstance(effects, str) else list(effects)
-        known = {e.id for e in EFFECTS}
-        unknown = sorted(set(effects) - known)
-        if unknown:
-            raise InputError(
-                f"unknown effect(s) {', '.join(unknown)}; the catalogue has "
-                f"{', '.join(e.id for e in EFFECTS)}"
-            )
-        catalogue = [e for e in EFFECTS if e.id in effects]
+    catalogue = select(EFFECTS, effects)
     t, x, spp = _record_forcing(t, x, B, nu)
     T = 2 * np.pi / nu
     hs = max(7, int(round(spp / 4))) if half_width is None else int(half_width)

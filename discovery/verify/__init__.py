@@ -4,18 +4,22 @@ record -> :class:`Reference` (steady cycle, noise floor, measured state) ->
 :func:`evaluate` (simulate, align, criteria, consistency) -> :func:`verify`.
 """
 
-from .evaluate import (
-    CONSISTENCY_CRITERIA,
-    CONSISTENCY_FACTOR,
-    CONSISTENCY_SLACK,
-    Evaluation,
-    align,
-    consistency_limits,
-    evaluate,
-)
-from .noise_floor import noise_floor
-from .reference import Reference
-from .verify import VerifyResult, verify
+from .._lazy import lazy_package
+
+# names are imported on first use: the criteria beside them stay cheap to import
+_EXPORTS = {
+    "CONSISTENCY_CRITERIA": "evaluate",
+    "CONSISTENCY_FACTOR": "evaluate",
+    "CONSISTENCY_SLACK": "evaluate",
+    "Evaluation": "evaluate",
+    "align": "evaluate",
+    "consistency_limits": "evaluate",
+    "evaluate": "evaluate",
+    "noise_floor": "noise_floor",
+    "Reference": "reference",
+    "VerifyResult": "verify",
+    "verify": "verify",
+}
 
 __all__ = [
     "Reference",
@@ -30,3 +34,5 @@ __all__ = [
     "CONSISTENCY_SLACK",
     "consistency_limits",
 ]
+
+lazy_package(__name__, _EXPORTS)
