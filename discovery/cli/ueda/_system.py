@@ -1,0 +1,62 @@
+"""Options and objects every ``vidi ueda`` subcommand shares: the model and its
+parameters, the tolerances."""
+
+from ...errors import InputError
+from .._common import number
+
+_PARAMS = ("mu", "gamma", "k", "B", "nu")
+
+
+def _system(args, **fixed):
+    from ...oscillator import UedaSystem
+
+    over = {p: getattr(args, p, None) for p in _PARAMS}
+    over.update(fixed)
+    return UedaSystem.from_model(args.model, **over)
+
+
+def _tolerances(args):
+    from ...dynamics import Tolerances
+
+    return Tolerances(rtol=args.rtol)
+
+
+def _add_system_options(s, chart=False):
+    s.add_argument(
+        "--model",
+        choices=("negres", "duffing"),
+        default="negres",
+        help="negres: x'' - mu (1 - gamma x^2) x' + x^3 = B cos(nu t) (mu 0.2, "
+        "gamma 8, B 0.35, nu 1.02: the broken egg); duffing: x'' + k x' + x^3 = "
+        "B cos(nu t) (k 0.05, B 7.5, nu 1) (default: %(default)s)",
+    )
+    s.add_argument("--mu", type=number(-10, 10), help="negative resistance (default: the model's)")
+    s.add_argument(
+        "--gamma", type=number(0, 1e3), help="amplitude dependence of the resistance, >= 0"
+    )
+    s.add_argument("--k", type=number(-10, 10), help="linear damping")
+    if not chart:
+        s.add_argument("--B", type=number(-1e3, 1e3), help="forcing amplitude")
+        s.add_argument(
+            "--nu", type=number(0, 100, lo_open=True), help="forcing angular frequency, > 0"
+        )
+    s.add_argument(
+        "--rtol",
+        type=number(1e-13, 1e-3),
+        default=1e-9 if not chart else 1e-6,
+        help="integrator tolerance (default: %(default)g)",
+    )
+
+
+def _forcing(args):
+    from ...oscillator import MODELS
+
+    if args.model is None and (args.B is None or args.nu is None):
+        raise InputError(
+            "give the forcing: --B and --nu (e.g. --B 0.35 --nu 1.02), or --model "
+            "negres|duffing for its forcing"
+        )
+    base = MODELS[args.model] if args.model else {}
+    B = args.B if args.B is not None else base["B"]
+    nu = args.nu if args.nu is not None else base["nu"]
+    return B, nu

@@ -1,0 +1,105 @@
+"""``vidi ueda attractor``: one attractor: strobe points, the two Lyapunov exponents with standard
+errors, the regime with its evidence, figures (optionally the coexisting attractors from a grid
+of initial states)."""
+
+import numpy as np
+
+from ..._io import OutputDir, provenance
+from .._common import check_out, integer, number
+from ._system import _add_system_options, _system, _tolerances
+
+
+def run(args):
+    from reports.ueda_figures import attractor_figure, basins_figure
+
+    from ...oscillator import attractor, basins
+
+    check_out(args)
+    system = _system(args)
+    tol = _tolerances(args)
+    att = attractor(
+        system,
+        (args.x0, args.v0),
+        transient=args.transient,
+        periods=args.periods,
+        batches=args.batches,
+        tolerances=tol,
+    )
+    summary = {"command": "ueda attractor", **att.as_dict()}
+    bas = None
+    if args.basins:
+        bas = basins(
+            system,
+            (-args.grid_extent, args.grid_extent),
+            (-args.grid_extent, args.grid_extent),
+            n=args.basins,
+            tolerances=tol,
+        )
+        summary["coexisting_attractors"] = bas.as_dict()
+    summary.update(provenance(vars(args)))
+    files = ["summary.json", "attractor.png", "attractor.pdf"]
+    with OutputDir(args.out) as out:
+        attractor_figure(att, str(out.path("attractor")))
+        np.savetxt(out.path("strobe.csv"), att.strobe, delimiter=",", header="x,v", comments="")
+        files.append("strobe.csv")
+        if bas is not None:
+            basins_figure(bas, str(out.path("basins")))
+            files += ["basins.png", "basins.pdf"]
+        out.write_json("summary.json", summary)
+    L = att.lyapunov
+    print(f"{system.model}: {att.regime.regime} ({att.regime.evidence['rule']})")
+    print(
+        f"  lyapunov {L.value:.4f} +- {L.stderr:.4f}, second {L.second:.4f} +- "
+        f"{L.second_stderr:.4f} per unit time; sum {L.sum:.6f} vs mean trace "
+        f"{L.trace_mean:.6f}"
+    )
+    if bas is not None:
+        for a in bas.attractors:
+            print(f"  attractor {a['regime']}: basin {100 * a['fraction']:.0f} % of the grid")
+    print(f"outputs in {args.out}/: {', '.join(files)}")
+    return 0
+
+
+def register(sub):
+    """Add ``vidi ueda attractor`` to the ueda subparsers ``sub``."""
+    a = sub.add_parser("attractor", help="one attractor: strobe points, exponents, regime, figures")
+    _add_system_options(a)
+    a.add_argument(
+        "--x0", type=number(-1e3, 1e3), default=0.1, help="initial x (default: %(default)g)"
+    )
+    a.add_argument(
+        "--v0", type=number(-1e3, 1e3), default=0.0, help="initial x' (default: %(default)g)"
+    )
+    a.add_argument(
+        "--transient",
+        type=integer(0, 10**6),
+        default=500,
+        help="periods discarded (default: %(default)s)",
+    )
+    a.add_argument(
+        "--periods",
+        type=integer(20, 10**7),
+        default=5000,
+        help="periods averaged (strobe points) (default: %(default)s)",
+    )
+    a.add_argument(
+        "--batches",
+        type=integer(2, 1000),
+        default=20,
+        help="batches for the standard error (default: %(default)s)",
+    )
+    a.add_argument(
+        "--basins",
+        type=integer(0, 100),
+        default=0,
+        help="also find coexisting attractors from an NxN grid of initial states "
+        "(default: %(default)s, skip)",
+    )
+    a.add_argument(
+        "--grid-extent",
+        type=number(0, 1e3, lo_open=True),
+        default=1.0,
+        help="the grid of initial states covers [-E, E]^2 (default: %(default)g)",
+    )
+    a.add_argument("--out", required=True, help="output directory")
+    a.set_defaults(func=run)

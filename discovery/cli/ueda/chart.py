@@ -1,0 +1,147 @@
+"""``vidi ueda chart``: the regime chart over (nu, B) in parallel processes."""
+
+import argparse
+import csv
+
+import numpy as np
+
+from ..._io import OutputDir, provenance
+from ...errors import InputError
+from .._common import SCHEDULER_HELP, check_out, executor_of, integer, reporter
+from ._system import _add_system_options, _system
+
+
+def _grid(text, option):
+    parts = text.split(":")
+    try:
+        lo, hi, n = float(parts[0]), float(parts[1]), int(parts[2])
+    except (ValueError, IndexError):
+        raise argparse.ArgumentTypeError(f"{text!r}: write LOW:HIGH:N, e.g. 0.8:1.2:200") from None
+    if (
+        len(parts) != 3
+        or not (np.isfinite(lo) and np.isfinite(hi) and lo < hi)
+        or not 1 <= n <= 2000
+    ):
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: need LOW < HIGH (finite) and 1 <= N <= 2000, e.g. 0.8:1.2:200"
+        )
+    return np.linspace(lo, hi, n)
+
+
+def run(args):
+    from reports.ueda_figures import chart_figure
+
+    from ...oscillator.chart import chart
+
+    check_out(args)
+    if args.nu[0] <= 0:
+        raise InputError("--nu: the frequencies must be > 0, e.g. --nu 0.8:1.2:200")
+    system = _system(args, nu=None, B=None)
+
+    if args.periods < 4 * args.max_period:
+        raise InputError(
+            f"--periods {args.periods} is too short for --max-period "
+            f"{args.max_period}: give --periods {4 * args.max_period} or more "
+            "(the recurrence test compares three cycles with the cycle before)"
+        )
+    with reporter(args) as rep, executor_of(args) as ex:
+        ch = chart(
+            system,
+            args.nu,
+            args.B,
+            transient=args.transient,
+            periods=args.periods,
+            rtol=args.rtol,
+            max_period=args.max_period,
+            sweeps=2 if args.both_directions else 1,
+            workers=args.workers,
+            progress=lambda done, total: rep("chart: rows", done, total),
+            executor=ex,
+        )
+    summary = {"command": "ueda chart", **ch.as_dict(), **provenance(vars(args))}
+
+    def cell(value, column):
+        if isinstance(value, float):
+            return f"{value:.10g}" if column in ("nu", "B") else f"{value:.6g}"
+        return value
+
+    with OutputDir(args.out) as out:
+        with open(out.path("chart.csv"), "w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(ch.columns)
+            for r in ch.rows():
+                w.writerow([cell(v, c) for v, c in zip(r, ch.columns, strict=True)])
+        chart_figure(ch, str(out.path("chart")))
+        out.write_json("summary.json", summary)
+    fr = ch.fractions()
+    print(
+        f"{system.model} chart {ch.nu.size}x{ch.B.size}: {ch.seconds:.1f} s on {ch.workers} "
+        f"processes ({ch.cpu_seconds:.1f} CPU s); "
+        + ", ".join(f"{k} {100 * v:.0f} %" for k, v in fr.items())
+    )
+    found = ch.period_counts()
+    if found:
+        print("  periods found (points): " + ", ".join(f"P{n} {c}" for n, c in found.items()))
+    if ch.coexisting is not None:
+        print(
+            f"  coexisting attractors (the sweeps up and down in nu differ) at "
+            f"{int(ch.coexisting.sum())} point(s), {100 * ch.coexisting.mean():.1f} %"
+        )
+    print(f"outputs in {args.out}/: summary.json, chart.csv, chart.png, chart.pdf")
+    return 0
+
+
+def register(sub):
+    """Add ``vidi ueda chart`` to the ueda subparsers ``sub``."""
+    c = sub.add_parser("chart", help="regime chart over (nu, B) in parallel processes")
+    _add_system_options(c, chart=True)
+    c.add_argument(
+        "--nu",
+        type=lambda t: _grid(t, "--nu"),
+        default=_grid("0.8:1.2:200", "--nu"),
+        metavar="LOW:HIGH:N",
+        help="forcing frequencies (default: 0.8:1.2:200)",
+    )
+    c.add_argument(
+        "--B",
+        type=lambda t: _grid(t, "--B"),
+        default=_grid("0:0.6:200", "--B"),
+        metavar="LOW:HIGH:N",
+        help="forcing amplitudes (default: 0:0.6:200)",
+    )
+    c.add_argument(
+        "--transient",
+        type=integer(0, 10**5),
+        default=60,
+        help="periods discarded at most at each point, after continuation from "
+        "the previous nu; a point stops sooner once its strobe points repeat "
+        "(a stable periodic orbit) (default: %(default)s)",
+    )
+    c.add_argument(
+        "--periods",
+        type=integer(20, 10**5),
+        default=80,
+        help="periods observed with the variational equations where no stable "
+        "orbit was found; at least 4 x --max-period (default: %(default)s)",
+    )
+    c.add_argument(
+        "--max-period",
+        type=integer(1, 1000),
+        default=16,
+        help="longest period recognised, in forcing periods; longer locked "
+        "orbits appear as beat (default: %(default)s)",
+    )
+    c.add_argument(
+        "--both-directions",
+        action="store_true",
+        help="sweep every row up and back down in nu, and mark the points where "
+        "the two sweeps end on different attractors (coexisting attractors, "
+        "hysteresis); about twice the time (default: off)",
+    )
+    c.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
+    c.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
+    c.add_argument(
+        "--progress", action="store_true", help="progress bar even when stderr is not a terminal"
+    )
+    c.add_argument("--out", required=True, help="output directory")
+    c.set_defaults(func=run)
