@@ -379,6 +379,56 @@ def _writable_dir(d):
     return True
 
 
+def _check_output_file(p, text, option):
+    """:func:`check_output` for an output file: a regular file vidi wrote, or a new one."""
+    if p.is_dir():
+        raise InputError(
+            f"{option} {text!r} is a directory; give a file name inside it, "
+            f"e.g. {str(p / 'D.csv')!r}"
+        )
+    if p.exists() and not p.is_file():
+        raise InputError(
+            f"{option} {text!r} exists and is not a regular file (a pipe, a "
+            "device or a socket); it is never replaced: give a new file name"
+        )
+    if p.is_file():
+        sidecar = p if p.name.endswith(".summary.json") else p.with_suffix(".summary.json")
+        owner, _ = _owner_file(sidecar)
+        if owner is None and not _RUN["overwrite"] and _RUN["command"]:
+            raise InputError(
+                f"{option} {text!r} exists and was not written by vidi (no "
+                f"{sidecar.name} beside it); give a new file name, or add "
+                "--overwrite to replace it"
+            )
+        _refuse_other_command(owner, text, option)
+
+
+def _check_output_dir(p, text, option, inputs):
+    """:func:`check_output` for an output directory: new, or an earlier result that holds
+    no input and is not the current directory."""
+    if p.exists() and not p.is_dir():
+        raise InputError(
+            f"{option} {text!r} is an existing file; give a directory (it is "
+            "created) or remove the file"
+        )
+    if not p.is_dir():
+        return
+    if _inside(Path.cwd(), p):
+        raise InputError(
+            f"{option} {text!r} is the current directory or above it; the "
+            "result directory is replaced as a whole, so give a new "
+            "subdirectory such as results/run1"
+        )
+    for inp in inputs:
+        if inp is not None and os.path.isfile(inp) and _inside(inp, p):
+            raise InputError(
+                f"{option} {text!r} holds the input file {str(inp)!r}; "
+                "the result directory is replaced as a whole, so give "
+                "another directory"
+            )
+    _check_replaceable(p, text, option)
+
+
 def check_output(path, inputs=(), *, kind="dir", option="--out"):
     """Refuse an output path before any work starts; returns it as a :class:`Path`.
 
@@ -417,47 +467,9 @@ def check_output(path, inputs=(), *, kind="dir", option="--out"):
             "through a link: give the real path or a new name"
         )
     if kind == "file":
-        if p.is_dir():
-            raise InputError(
-                f"{option} {text!r} is a directory; give a file name inside it, "
-                f"e.g. {str(p / 'D.csv')!r}"
-            )
-        if p.exists() and not p.is_file():
-            raise InputError(
-                f"{option} {text!r} exists and is not a regular file (a pipe, a "
-                "device or a socket); it is never replaced: give a new file name"
-            )
-        if p.is_file():
-            sidecar = p if p.name.endswith(".summary.json") else p.with_suffix(".summary.json")
-            owner, _ = _owner_file(sidecar)
-            if owner is None and not _RUN["overwrite"] and _RUN["command"]:
-                raise InputError(
-                    f"{option} {text!r} exists and was not written by vidi (no "
-                    f"{sidecar.name} beside it); give a new file name, or add "
-                    "--overwrite to replace it"
-                )
-            _refuse_other_command(owner, text, option)
+        _check_output_file(p, text, option)
     else:
-        if p.exists() and not p.is_dir():
-            raise InputError(
-                f"{option} {text!r} is an existing file; give a directory (it is "
-                "created) or remove the file"
-            )
-        if p.is_dir():
-            if _inside(Path.cwd(), p):
-                raise InputError(
-                    f"{option} {text!r} is the current directory or above it; the "
-                    "result directory is replaced as a whole, so give a new "
-                    "subdirectory such as results/run1"
-                )
-            for inp in inputs:
-                if inp is not None and os.path.isfile(inp) and _inside(inp, p):
-                    raise InputError(
-                        f"{option} {text!r} holds the input file {str(inp)!r}; "
-                        "the result directory is replaced as a whole, so give "
-                        "another directory"
-                    )
-            _check_replaceable(p, text, option)
+        _check_output_dir(p, text, option, inputs)
     parent = _nearest_existing(Path(os.path.abspath(p)).parent)
     if not parent.is_dir():
         raise InputError(

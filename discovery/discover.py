@@ -805,6 +805,207 @@ def _equivalent(ranking, selected, est, samples, criterion):
     return out
 
 
+def _check_settings(
+    random_state, seed, criterion, shortlist, stability, n_boot, max_simulations, stepwise
+):
+    """The settings :func:`discover` checks beyond their types; returns the seed
+    (``random_state=`` is the deprecated name of ``seed=``)."""
+    if random_state is not None:
+        warn(
+            "discover(random_state=...) is renamed seed=... (the CLI's --seed)",
+            DeprecationWarning,
+            stacklevel=4,
+        )
+        seed = random_state
+    _criterion(criterion)
+    if not (isinstance(shortlist, int | np.integer) and shortlist >= 1):
+        raise InputError(
+            f"shortlist must be a positive integer (candidates simulated); got {shortlist!r}"
+        )
+    for name, v, low in (
+        ("stability", stability, 0),
+        ("n_boot", n_boot, 1),
+        ("max_simulations", max_simulations, 2),
+        ("stepwise", stepwise, 0),
+    ):
+        if not (isinstance(v, int | np.integer) and not isinstance(v, bool) and v >= low):
+            raise InputError(f"{name} must be an integer >= {low}; got {v!r}")
+    return seed
+
+
+def _regression(
+    pairs, library, selection, scoring, max_terms, derivative, average_cycles, estimator_kwargs
+):
+    """Contact samples of every record, joined, and the certified sparse regression on
+    them: ``(samples per record, joined samples, fitted estimator)``."""
+    parts = [
+        contact_samples(m, derivative=derivative, average_cycles=average_cycles, period=sc.period)
+        for sc, m in pairs
+    ]
+    samples = join_samples(parts)
+    if isinstance(estimator_kwargs.get("signs"), dict):
+        estimator_kwargs["signs"] = _sign_vector(estimator_kwargs["signs"], library)
+    est = ConstrainedSparseRegressor(
+        library=library,
+        selection=selection,
+        scoring=scoring,
+        max_terms=max_terms,
+        **estimator_kwargs,
+    )
+    est.fit(samples.X, samples.F, groups=samples.impact, sample_weight=samples.weight)
+    return parts, samples, est
+
+
+def _shortlist(check, est, required, shortlist, progress):
+    """The estimator's best supports (holding the required terms), each checked by
+    simulation."""
+    pool = [c for c in est.candidates_ if required <= set(c.coefficients)]
+    if not pool:
+        raise InputError(
+            f"no candidate support of the library holds the required terms "
+            f"{', '.join(sorted(required))}; raise --max-terms or drop --require"
+        )
+    models = []
+    for k, c in enumerate(pool[:shortlist]):
+        tick(
+            progress,
+            "fit: shortlisted supports checked by simulation",
+            k,
+            min(len(pool), shortlist),
+        )
+        models.append(check(c))
+    return models
+
+
+class _Stepwise:
+    """The output-error stepwise search around the best model: a consistent model loses a
+    term (backward), an inconsistent one gains one (forward: the regression may have been
+    misled, e.g. by noisy penetration), for up to ``stepwise`` moves."""
+
+    def __init__(self, check, criterion, sim_rtol, sim_atol, physics, stepwise, max_terms):
+        self.check, self.criterion, self.physics = check, criterion, physics
+        self.sim_rtol, self.sim_atol = sim_rtol, sim_atol
+        self.stepwise, self.max_terms = stepwise, max_terms
+        self.retried = set()
+
+    def rank(self, models):
+        return rank(models, self.criterion, self.sim_rtol, self.sim_atol, physics=self.physics)
+
+    def more(self, steps, ranking):
+        """Up to ``stepwise`` moves, and one simplifying move more when the last move made
+        the best model consistent (its backward step and restarts would be cut off
+        otherwise)."""
+        if len(steps) < self.stepwise:
+            return True
+        return (
+            len(steps) == self.stepwise
+            and self.stepwise > 0
+            and ranking[0].consistent
+            and steps[-1]["kind"] != "backward"
+        )
+
+    def trials(self, top, models):
+        """The models of one move from ``top``, and the move's kind."""
+        check, physics = self.check, self.physics
+        # supports already simulated successfully are not tried again, except that a
+        # consistent model's backward step retries a smaller support that was inconsistent
+        # from its own (biased regression) start, once, from the consistent coefficients:
+        # a refinement that stalled far from the truth must not hide the simplest model
+        done = frozenset(frozenset(m.law.names) for m in models if m.criteria)
+        if not (top.consistent and not (physics and top.defects)):
+            # both directions: a wrong term may have to go while a missing one comes in
+            trials = check.forward(top, self.max_terms, done) + check.backward(top, done)
+            return trials, "forward+backward"
+        good = frozenset(frozenset(m.law.names) for m in models if m.criteria and m.consistent)
+        trials = check.backward(top, good | self.retried)
+        self.retried |= {frozenset(m.law.names) for m in trials} & done
+        # smaller supports that stalled and no backward step reaches: the two best,
+        # restarted from the consistent model's coefficients
+        stalled = sorted(
+            (
+                m
+                for m in models
+                if m.criteria
+                and not m.consistent
+                and len(m.law.names) <= len(top.law.names)
+                and frozenset(m.law.names) not in self.retried
+                and not (physics and m.defects)
+            ),
+            key=lambda m: m.criteria[self.criterion],
+        )[:_RESTARTS]
+        for m in stalled:
+            self.retried.add(frozenset(m.law.names))
+            trials.append(check.restart(top, set(m.law.names)))
+        return trials, "backward"
+
+    def run(self, models, refs, refine, progress):
+        """``(ranking, steps)`` after the search."""
+        ranking = self.rank(models)
+        steps = []
+        if refine and not ranking[0].criteria:
+            # no regression law has a periodic orbit with contact: start from the record alone
+            start = self.check.physical_start(*refs[0])
+            if start is not None:
+                steps.append({"kind": "physical start", "from": [], "trials": 1})
+                models = models + [start]
+                ranking = self.rank(models)
+        while refine and ranking[0].criteria and self.more(steps, ranking):
+            top = ranking[0]
+            trials, kind = self.trials(top, models)
+            if not trials:
+                break
+            steps.append({"kind": kind, "from": list(top.law.names), "trials": len(trials)})
+            tick(
+                progress, "fit: stepwise search around the best support", len(steps), self.stepwise
+            )
+            models = _best_per_support(models + trials, self.criterion)
+            ranking = self.rank(models)
+            if ranking[0] is top:
+                break
+        return ranking, steps
+
+
+def _with_intervals(ranking, refs, refine, n_boot_intervals, seed, criterion, tolerances, progress):
+    """The selected (best ranked) model, with bootstrap intervals when asked for and it was
+    refined, and the ranking holding it."""
+    selected = ranking[0]
+    if not (
+        n_boot_intervals
+        and refine
+        and selected.refinement is not None
+        and selected.note.startswith("refined")
+    ):
+        return selected, ranking
+    tick(progress, "fit: bootstrap intervals", 0, n_boot_intervals)
+    iv = bootstrap_intervals(
+        [sc for sc, _ in refs],
+        [r for _, r in refs],
+        selected.law,
+        n_boot=int(n_boot_intervals),
+        seed=seed,
+        criterion=criterion,
+        tolerances=tolerances,
+    )
+    if iv is None:
+        return selected, ranking
+    chosen = replace(selected, intervals=iv)
+    return chosen, [chosen if m is selected else m for m in ranking]
+
+
+def _defects_warning(selected, physics):
+    """The warning that the selected law is no contact law."""
+    return (
+        "the selected law is no contact law ("
+        + "; ".join(selected.defects)
+        + "): "
+        + (
+            "no candidate was one; widen the library or --require z"
+            if physics
+            else "ranked by the records alone (--allow-unphysical)"
+        )
+    )
+
+
 @params(
     scenario=(Scenario, list, tuple),
     measurement=(Measurement, list, tuple),
@@ -926,180 +1127,36 @@ def discover(
         uncertainty (regression bias).
     """
     t0 = time.perf_counter()
-    if random_state is not None:
-        warn(
-            "discover(random_state=...) is renamed seed=... (the CLI's --seed)",
-            DeprecationWarning,
-            stacklevel=3,
-        )
-        seed = random_state
-    _criterion(criterion)
-    if not (isinstance(shortlist, int | np.integer) and shortlist >= 1):
-        raise InputError(
-            f"shortlist must be a positive integer (candidates simulated); got {shortlist!r}"
-        )
-    for name, v, low in (
-        ("stability", stability, 0),
-        ("n_boot", n_boot, 1),
-        ("max_simulations", max_simulations, 2),
-        ("stepwise", stepwise, 0),
-    ):
-        if not (isinstance(v, int | np.integer) and not isinstance(v, bool) and v >= low):
-            raise InputError(f"{name} must be an integer >= {low}; got {v!r}")
-    pairs = pair_records(scenario, measurement)
-    parts = [
-        contact_samples(m, derivative=derivative, average_cycles=average_cycles, period=sc.period)
-        for sc, m in pairs
-    ]
-    samples = join_samples(parts)
-    refs = [(sc, Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)) for sc, m in pairs]
-    if isinstance(estimator_kwargs.get("signs"), dict):
-        estimator_kwargs["signs"] = _sign_vector(estimator_kwargs["signs"], library)
-    est = ConstrainedSparseRegressor(
-        library=library,
-        selection=selection,
-        scoring=scoring,
-        max_terms=max_terms,
-        **estimator_kwargs,
+    seed = _check_settings(
+        random_state, seed, criterion, shortlist, stability, n_boot, max_simulations, stepwise
     )
-    est.fit(samples.X, samples.F, groups=samples.impact, sample_weight=samples.weight)
+    pairs = pair_records(scenario, measurement)
+    parts, samples, est = _regression(
+        pairs, library, selection, scoring, max_terms, derivative, average_cycles, estimator_kwargs
+    )
+    refs = [(sc, Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)) for sc, m in pairs]
     required = _required_terms(require, est.library_)
     check = _Checker(est, samples, refs, criterion, refine, tolerances, max_simulations, required)
-    pool = [c for c in est.candidates_ if required <= set(c.coefficients)]
-    if not pool:
-        raise InputError(
-            f"no candidate support of the library holds the required terms "
-            f"{', '.join(sorted(required))}; raise --max-terms or drop --require"
-        )
-    models = []
-    for k, c in enumerate(pool[:shortlist]):
-        tick(
-            progress,
-            "fit: shortlisted supports checked by simulation",
-            k,
-            min(len(pool), shortlist),
-        )
-        models.append(check(c))
+    models = _shortlist(check, est, required, shortlist, progress)
     by_score = list(models)  # the estimator's order (its scoring)
-
-    def rank_all(ms):
-        return rank(ms, criterion, sim_rtol, sim_atol, physics=physics)
-
-    ranking = rank_all(models)
-    steps = []
-    if refine and not ranking[0].criteria:
-        # no regression law has a periodic orbit with contact: start from the record alone
-        start = check.physical_start(*refs[0])
-        if start is not None:
-            steps.append({"kind": "physical start", "from": [], "trials": 1})
-            models = models + [start]
-            ranking = rank_all(models)
-    retried = set()
-
-    def more(steps):
-        # up to `stepwise` moves, and one simplifying move more when the last move made the
-        # best model consistent (its backward step and restarts would be cut off otherwise)
-        if len(steps) < stepwise:
-            return True
-        return (
-            len(steps) == stepwise
-            and stepwise > 0
-            and ranking[0].consistent
-            and steps[-1]["kind"] != "backward"
-        )
-
-    while refine and ranking[0].criteria and more(steps):
-        # output-error stepwise search around the best model: a consistent model loses a
-        # term (backward), an inconsistent one gains one (forward: the regression may have
-        # been misled, e.g. by noisy penetration)
-        top = ranking[0]
-        # supports already simulated successfully are not tried again, except that a
-        # consistent model's backward step retries a smaller support that was inconsistent
-        # from its own (biased regression) start, once, from the consistent coefficients:
-        # a refinement that stalled far from the truth must not hide the simplest model
-        done = frozenset(frozenset(m.law.names) for m in models if m.criteria)
-        if top.consistent and not (physics and top.defects):
-            good = frozenset(frozenset(m.law.names) for m in models if m.criteria and m.consistent)
-            trials, kind = check.backward(top, good | retried), "backward"
-            retried |= {frozenset(m.law.names) for m in trials} & done
-            # smaller supports that stalled and no backward step reaches: the two best,
-            # restarted from the consistent model's coefficients
-            stalled = sorted(
-                (
-                    m
-                    for m in models
-                    if m.criteria
-                    and not m.consistent
-                    and len(m.law.names) <= len(top.law.names)
-                    and frozenset(m.law.names) not in retried
-                    and not (physics and m.defects)
-                ),
-                key=lambda m: m.criteria[criterion],
-            )[:_RESTARTS]
-            for m in stalled:
-                retried.add(frozenset(m.law.names))
-                trials.append(check.restart(top, set(m.law.names)))
-        else:  # both directions: a wrong term may have to go while a missing one comes in
-            trials = check.forward(top, max_terms, done) + check.backward(top, done)
-            kind = "forward+backward"
-        if not trials:
-            break
-        steps.append({"kind": kind, "from": list(top.law.names), "trials": len(trials)})
-        tick(progress, "fit: stepwise search around the best support", len(steps), stepwise)
-        models = _best_per_support(models + trials, criterion)
-        ranking = rank_all(models)
-        if ranking[0] is top:
-            break
-    selected = ranking[0]
-    if (
-        n_boot_intervals
-        and refine
-        and selected.refinement is not None
-        and selected.note.startswith("refined")
-    ):
-        tick(progress, "fit: bootstrap intervals", 0, n_boot_intervals)
-        iv = bootstrap_intervals(
-            [sc for sc, _ in refs],
-            [r for _, r in refs],
-            selected.law,
-            n_boot=int(n_boot_intervals),
-            seed=seed,
-            criterion=criterion,
-            tolerances=tolerances,
-        )
-        if iv is not None:
-            chosen = replace(selected, intervals=iv)
-            ranking = [chosen if m is selected else m for m in ranking]
-            selected = chosen
+    search = _Stepwise(check, criterion, sim_rtol, sim_atol, physics, stepwise, max_terms)
+    ranking, steps = search.run(models, refs, refine, progress)
+    selected, ranking = _with_intervals(
+        ranking, refs, refine, n_boot_intervals, seed, criterion, tolerances, progress
+    )
     # the certificate of the law actually selected (the ranking may prefer another
     # candidate than the estimator's best by BIC); a failure is an error
     cert = require_certificate(selected.certificate)
     stab = (
         est.stability(
-            samples.X,
-            samples.F,
-            samples.impact,
-            stability,
-            seed,
-            sample_weight=samples.weight,
+            samples.X, samples.F, samples.impact, stability, seed, sample_weight=samples.weight
         )
         if stability
         else {}
     )
     warnings = _warnings(selected, by_score, stab, pairs, parts, refs, samples, refine)
     if selected.defects:
-        warnings.insert(
-            0,
-            "the selected law is no contact law ("
-            + "; ".join(selected.defects)
-            + "): "
-            + (
-                "no candidate was one; widen the library or --require z"
-                if physics
-                else "ranked by the records alone (--allow-unphysical)"
-            ),
-        )
-    equivalent = _equivalent(ranking, selected, est, samples, criterion)
+        warnings.insert(0, _defects_warning(selected, physics))
     settings = {
         "library": str(library),
         "selection": selection,
@@ -1133,7 +1190,7 @@ def discover(
         references=tuple(refs),
         stability=stab,
         warnings=warnings,
-        equivalent=equivalent,
+        equivalent=_equivalent(ranking, selected, est, samples, criterion),
         seconds=time.perf_counter() - t0,
         settings=settings,
     )

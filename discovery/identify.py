@@ -431,6 +431,122 @@ def _uncertainty(obj, x, names):
     return se, corr
 
 
+def _checked(scenario, reference, start, method, xtol, max_simulations):
+    """The settings :func:`identify` checks beyond their types; returns the records."""
+    if method not in METHODS:
+        raise InputError(f"unknown method {method!r}; valid methods: {', '.join(METHODS)}")
+    if any(c == 0 for c in start.coefficients):
+        raise InputError("every start coefficient must be non-zero (they set the scale)")
+    if not (np.isfinite(xtol) and xtol > 0):
+        raise InputError(f"xtol must be a positive number, got {xtol!r}")
+    records = as_records(scenario, reference)
+    if not (isinstance(max_simulations, int | np.integer) and max_simulations >= 2 * len(records)):
+        raise InputError(
+            f"the simulation budget must be an integer of at least "
+            f"{2 * len(records)} (two per record); got {max_simulations!r}"
+        )
+    return records
+
+
+def _short_first(
+    records,
+    start,
+    short_first,
+    criterion,
+    method,
+    xtol,
+    max_simulations,
+    tolerances,
+    observe,
+    progress,
+):
+    """With record spans compared in blocks, the start fitted cycle by cycle first (up to
+    half the budget; continuation in block length): ``(start, simulations spent)``.  The
+    caller's start is kept when it already matches the blocks better."""
+    short = [r.shortened() if isinstance(r, Reference) else None for _, r in records]
+    if not (
+        short_first and all(r is not None for r in short) and max_simulations >= 8 * len(records)
+    ):
+        return start, 0
+    spent = 0
+    try:
+        first = identify(
+            [sc for sc, _ in records],
+            short,
+            start,
+            criterion=criterion,
+            method=method,
+            xtol=xtol,
+            max_simulations=max_simulations // 2,
+            tolerances=tolerances,
+            uncertainty=False,
+            observe=observe,
+            short_first=False,
+            progress=None
+            if progress is None
+            else (lambda s, d, t: progress("identify: cycle by cycle", d, t)),
+            check=False,
+        )
+        spent = first.n_simulations
+        if not any(c == 0 for c in first.law.coefficients):
+            start0, start = start, first.law
+            # keep the caller's start when it already matches the blocks better
+            probe = _Objective(records, start0, criterion, tolerances, 10**9, observe)
+            alt = _Objective(records, start, criterion, tolerances, 10**9, observe)
+            x1 = np.ones(len(start.coefficients))
+            v0, v1 = probe(x1), alt(x1)
+            spent += probe.n + alt.n
+            if not v1 <= v0:
+                start = start0
+    except IntegrationError:
+        pass
+    return start, spent
+
+
+def _optimise(obj, x0, method, xtol, max_simulations):
+    """Run ``method`` on the objective from ``x0``; returns the optimiser's message."""
+    try:
+        if method == "coordinate-descent":
+            _coordinate_descent(obj, x0, xtol)
+            return "steps below xtol"
+        if method == "nelder-mead":
+            simplex = np.vstack([x0] + [x0 + 0.1 * np.eye(x0.size)[i] for i in range(x0.size)])
+            res = minimize(
+                obj,
+                x0,
+                method="Nelder-Mead",
+                options={
+                    "xatol": xtol,
+                    "fatol": 1e-12,
+                    "maxfev": max_simulations,
+                    "initial_simplex": simplex,
+                },
+            )
+            return str(res.message)
+        res = least_squares(
+            obj.residuals,
+            x0,
+            method="trf",
+            x_scale=1.0,
+            diff_step=1e-6,
+            xtol=xtol * 1e-2,
+            ftol=1e-12,
+            gtol=1e-12,
+        )
+        return str(res.message)
+    except _Budget:
+        return f"simulation budget of {max_simulations} used"
+
+
+def _checks(records, law, observe, tolerances):
+    """The identified law against every record with its noise floor."""
+    plain, machine, observed = model_parts(law, observe)
+    return tuple(
+        evaluate(machine(sc), plain, ref, tolerances=tolerances, observe=observed)
+        for sc, ref in records
+    )
+
+
 @params(
     scenario=(Scenario, list, tuple),
     reference=(Measurement, Reference, Impulse, list, tuple),
@@ -517,53 +633,20 @@ def identify(
     IntegrationError
         The start law has no periodic steady state with contact.
     """
-    if method not in METHODS:
-        raise InputError(f"unknown method {method!r}; valid methods: {', '.join(METHODS)}")
-    if any(c == 0 for c in start.coefficients):
-        raise InputError("every start coefficient must be non-zero (they set the scale)")
-    if not (np.isfinite(xtol) and xtol > 0):
-        raise InputError(f"xtol must be a positive number, got {xtol!r}")
-    records = as_records(scenario, reference)
-    if not (isinstance(max_simulations, int | np.integer) and max_simulations >= 2 * len(records)):
-        raise InputError(
-            f"the simulation budget must be an integer of at least "
-            f"{2 * len(records)} (two per record); got {max_simulations!r}"
-        )
+    records = _checked(scenario, reference, start, method, xtol, max_simulations)
     t0 = time.perf_counter()
-    spent = 0
-    short = [r.shortened() if isinstance(r, Reference) else None for _, r in records]
-    if short_first and all(r is not None for r in short) and max_simulations >= 8 * len(records):
-        try:
-            first = identify(
-                [sc for sc, _ in records],
-                short,
-                start,
-                criterion=criterion,
-                method=method,
-                xtol=xtol,
-                max_simulations=max_simulations // 2,
-                tolerances=tolerances,
-                uncertainty=False,
-                observe=observe,
-                short_first=False,
-                progress=None
-                if progress is None
-                else (lambda s, d, t: progress("identify: cycle by cycle", d, t)),
-                check=False,
-            )
-            spent = first.n_simulations
-            if not any(c == 0 for c in first.law.coefficients):
-                start0, start = start, first.law
-                # keep the caller's start when it already matches the blocks better
-                probe = _Objective(records, start0, criterion, tolerances, 10**9, observe)
-                alt = _Objective(records, start, criterion, tolerances, 10**9, observe)
-                x1 = np.ones(len(start.coefficients))
-                v0, v1 = probe(x1), alt(x1)
-                spent += probe.n + alt.n
-                if not v1 <= v0:
-                    start = start0
-        except IntegrationError:
-            pass
+    start, spent = _short_first(
+        records,
+        start,
+        short_first,
+        criterion,
+        method,
+        xtol,
+        max_simulations,
+        tolerances,
+        observe,
+        progress,
+    )
     obj = _Objective(
         records,
         start,
@@ -582,39 +665,7 @@ def identify(
             f"{f['status']} ({f['message']}); give start values closer to "
             "the record (e.g. from vidi fit)"
         )
-    message = ""
-    try:
-        if method == "coordinate-descent":
-            _coordinate_descent(obj, x0, xtol)
-            message = "steps below xtol"
-        elif method == "nelder-mead":
-            simplex = np.vstack([x0] + [x0 + 0.1 * np.eye(x0.size)[i] for i in range(x0.size)])
-            res = minimize(
-                obj,
-                x0,
-                method="Nelder-Mead",
-                options={
-                    "xatol": xtol,
-                    "fatol": 1e-12,
-                    "maxfev": max_simulations,
-                    "initial_simplex": simplex,
-                },
-            )
-            message = str(res.message)
-        else:
-            res = least_squares(
-                obj.residuals,
-                x0,
-                method="trf",
-                x_scale=1.0,
-                diff_step=1e-6,
-                xtol=xtol * 1e-2,
-                ftol=1e-12,
-                gtol=1e-12,
-            )
-            message = str(res.message)
-    except _Budget:
-        message = f"simulation budget of {max_simulations} used"
+    message = _optimise(obj, x0, method, xtol, max_simulations)
     if obj.best[1] is None:  # least squares evaluates residuals, which record the path
         obj(x0)
     x_best, value = obj.best[1], float(obj.best[0])  # before the error probes run
@@ -641,15 +692,8 @@ def identify(
             criterion=criterion,
             tolerances=tolerances,
         )
-    checks = ()
-    if check:
-        plain, machine, observed = model_parts(law, observe)
-        checks = tuple(
-            evaluate(machine(sc), plain, ref, tolerances=tolerances, observe=observed)
-            for sc, ref in records
-        )
     return IdentificationResult(
-        checks=checks,
+        checks=_checks(records, law, observe, tolerances) if check else (),
         intervals=intervals,
         law=law,
         criterion=criterion,

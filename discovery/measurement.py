@@ -365,6 +365,40 @@ def no_contact_message(t, F, period, source="", threshold=None):
     )
 
 
+def _mapped_columns(header, columns, name, named):
+    """``{our name: column index}`` of a user's column mapping ``{our name: header}``."""
+    if not isinstance(columns, dict):
+        raise InputError(
+            "columns must map our names to the file's headers, e.g. {'t': 'time_s', 'F': 'force_N'}"
+        )
+    src = {}
+    for key, col in columns.items():
+        if key not in COLUMNS:
+            raise InputError(
+                f"column mapping: unknown name {key!r}; map the names "
+                f"{', '.join(COLUMNS)} to the file's headers, e.g. "
+                "t=time_s,F=force_N"
+            )
+        col = col.strip() if isinstance(col, str) else col
+        if not isinstance(col, str) or not col:
+            raise InputError(
+                f"column mapping {key}=: give the header of the file's "
+                f"column for {key}, e.g. {key}=time_s"
+            )
+        if col not in header:
+            raise InputError(
+                f"column mapping {key}={col}: data file {name!r} has no column "
+                f"{col!r} (found {', '.join(named) or 'no names'})"
+            )
+        src[key] = header.index(col)
+    if len(set(src.values())) != len(src):
+        raise InputError(
+            "column mapping: two names are mapped to the same column; map "
+            "each of the file's columns once"
+        )
+    return src
+
+
 def _column_sources(header, columns, name, scenario):
     """``{our name: column index}``, whether F comes from a2, and notes."""
     named = [h for h in header if h]
@@ -376,35 +410,7 @@ def _column_sources(header, columns, name, scenario):
         )
     src, notes = {}, ()
     if columns:
-        if not isinstance(columns, dict):
-            raise InputError(
-                "columns must map our names to the file's headers, e.g. "
-                "{'t': 'time_s', 'F': 'force_N'}"
-            )
-        for key, col in columns.items():
-            if key not in COLUMNS:
-                raise InputError(
-                    f"column mapping: unknown name {key!r}; map the names "
-                    f"{', '.join(COLUMNS)} to the file's headers, e.g. "
-                    "t=time_s,F=force_N"
-                )
-            col = col.strip() if isinstance(col, str) else col
-            if not isinstance(col, str) or not col:
-                raise InputError(
-                    f"column mapping {key}=: give the header of the file's "
-                    f"column for {key}, e.g. {key}=time_s"
-                )
-            if col not in header:
-                raise InputError(
-                    f"column mapping {key}={col}: data file {name!r} has no column "
-                    f"{col!r} (found {', '.join(named) or 'no names'})"
-                )
-            src[key] = header.index(col)
-        if len(set(src.values())) != len(src):
-            raise InputError(
-                "column mapping: two names are mapped to the same column; map "
-                "each of the file's columns once"
-            )
+        src = _mapped_columns(header, columns, name, named)
         notes += ("columns mapped: " + ", ".join(f"{k} <- {header[j]}" for k, j in src.items()),)
     used = set(src.values())
     for key in COLUMNS:

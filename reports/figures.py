@@ -41,32 +41,11 @@ def coefficient_label(name):
 _save = save
 
 
-def landscape_figure(land, stem, truth=None):
-    """Contours of I1..I4 and I0 (the paper's Figs. 4-5), with the points that have no
-    criteria or another regime marked, the consistent region outlined and the
-    reference's noise floor.
-
-    Parameters
-    ----------
-    land : Landscape
-    stem : str
-        Output path without extension.
-    truth : (float, float), optional
-        Reference coefficients, circled (when inside the grid).
-    """
-    import textwrap
-
-    from matplotlib.lines import Line2D
-    from matplotlib.ticker import MaxNLocator
-
-    a0, a1 = land.axes
-    reg = np.asarray(land.regime, dtype=str)
-    ref_reg = (getattr(land, "reference", None) or {}).get("regime", "P1")
-    exact = (getattr(land, "reference", None) or {}).get("exact", True)
-    floor = getattr(land, "noise_floor", None)
-    cons = getattr(land, "consistent", None)
+def _landscape_marks(reg, ref_reg):
+    """``[(mask, marker style, legend label), ...]`` of the points with another regime, no
+    periodic orbit, no contact or a failed simulation (the non-empty ones)."""
     physical = ("no-contact", "nonperiodic", "failed")
-    marks = [  # (mask, marker style, legend label)
+    marks = [
         (
             (reg != ref_reg) & ~np.isin(reg, physical),
             dict(ls="none", marker="x", color="r", ms=4),
@@ -80,31 +59,108 @@ def landscape_figure(land, stem, truth=None):
             "simulation failed",
         ),
     ]
-    marks = [m for m in marks if m[0].any()]
+    return [m for m in marks if m[0].any()]
+
+
+def _landscape_contours(fig, ax, land, name):
+    """Filled contours of criterion ``name`` with its minimum starred."""
+    from matplotlib.ticker import MaxNLocator
+
+    a0, a1 = land.axes
+    v = land.values[name]
+    ok = np.isfinite(v)
+    if not ok.any():
+        ax.text(
+            0.5,
+            0.5,
+            "no periodic contact\nanywhere in this range",
+            transform=ax.transAxes,
+            ha="center",
+            va="center",
+        )
+        return
+    lo, hi = float(v[ok].min()), float(v[ok].max())
+    levels = MaxNLocator(20).tick_values(lo, hi if hi > lo else lo + 1e-12)
+    cs = ax.contourf(a0, a1, v.T, levels=levels, cmap="viridis")
+    if hi > lo:
+        ax.contour(a0, a1, v.T, levels=levels[::2], colors="k", linewidths=0.4)
+    fig.colorbar(cs, ax=ax, label=f"{name} (dimensionless)")
+    i, j = land.argmin(name)
+    ax.plot(a0[i], a1[j], "w*", ms=10, mec="k")
+
+
+def _landscape_info_lines(land, ref_reg, exact, floor, cons, truth, inside):
+    """The text of the information panel."""
+    import textwrap
+
+    a0, a1 = land.axes
+    info = getattr(land, "reference", None) or {}
+    src = info.get("source", "")
+    src = "the scenario's law (exact)" if src in ("law", "") else src
+    lines = [
+        "Criteria landscape",
+        f"{a0.size} x {a1.size} points, {land.seconds:.1f} s on {land.workers} processes",
+        f"reference: {src}"[:70],
+        f"reference regime: {ref_reg}",
+    ]
+    if not exact and floor:
+        lines.append("noise floor: " + ", ".join(f"{n} {floor[n]:.2g}" for n in _ORDER))
+    counts = land.regime_counts() if hasattr(land, "regime_counts") else {}
+    if counts:
+        lines.append("regimes: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
+    if cons is not None:
+        lines.append(f"consistent with the reference at {int(cons.sum())} point(s)")
+    fails = getattr(land, "failures", (0, "", None))
+    if fails[0]:
+        lines.append(f"{fails[0]} simulation(s) failed, the first:")
+        lines += ["  " + w for w in textwrap.wrap(fails[1], 62)[:4]]
+    if truth is not None and not inside:
+        lines.append("the reference law lies outside this range")
+    return lines
+
+
+def _landscape_legend(ax, inside, show_cons, marks):
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], ls="none", marker="*", mfc="w", mec="k", ms=10, label="minimum")]
+    if inside:
+        handles.append(
+            Line2D([], [], ls="none", marker="o", mfc="none", mec="r", ms=10, label="reference law")
+        )
+    if show_cons:
+        handles.append(
+            Line2D([], [], color="w", ls="--", lw=1.2, label="consistent region (boundary)")
+        )
+    handles += [Line2D([], [], label=label, **style) for _, style, label in marks]
+    leg = ax.legend(handles=handles, loc="lower left", fontsize=8, facecolor="0.85")
+    leg.get_frame().set_edgecolor("0.5")
+
+
+def landscape_figure(land, stem, truth=None):
+    """Contours of I1..I4 and I0 (the paper's Figs. 4-5), with the points that have no
+    criteria or another regime marked, the consistent region outlined and the
+    reference's noise floor.
+
+    Parameters
+    ----------
+    land : Landscape
+    stem : str
+        Output path without extension.
+    truth : (float, float), optional
+        Reference coefficients, circled (when inside the grid).
+    """
+    a0, a1 = land.axes
+    reg = np.asarray(land.regime, dtype=str)
+    ref_reg = (getattr(land, "reference", None) or {}).get("regime", "P1")
+    exact = (getattr(land, "reference", None) or {}).get("exact", True)
+    floor = getattr(land, "noise_floor", None)
+    cons = getattr(land, "consistent", None)
+    marks = _landscape_marks(reg, ref_reg)
     inside = truth is not None and a0[0] <= truth[0] <= a0[-1] and a1[0] <= truth[1] <= a1[-1]
     show_cons = cons is not None and cons.sum() >= 2  # one point: hidden by the star
     fig, axes = subplots(2, 3, figsize=(14, 8.5))
     for ax, name in zip(axes.flat, _ORDER, strict=False):
-        v = land.values[name]
-        ok = np.isfinite(v)
-        if ok.any():
-            lo, hi = float(v[ok].min()), float(v[ok].max())
-            levels = MaxNLocator(20).tick_values(lo, hi if hi > lo else lo + 1e-12)
-            cs = ax.contourf(a0, a1, v.T, levels=levels, cmap="viridis")
-            if hi > lo:
-                ax.contour(a0, a1, v.T, levels=levels[::2], colors="k", linewidths=0.4)
-            fig.colorbar(cs, ax=ax, label=f"{name} (dimensionless)")
-            i, j = land.argmin(name)
-            ax.plot(a0[i], a1[j], "w*", ms=10, mec="k")
-        else:
-            ax.text(
-                0.5,
-                0.5,
-                "no periodic contact\nanywhere in this range",
-                transform=ax.transAxes,
-                ha="center",
-                va="center",
-            )
+        _landscape_contours(fig, ax, land, name)
         if show_cons:
             ax.contour(
                 a0,
@@ -129,41 +185,9 @@ def landscape_figure(land, stem, truth=None):
         ax.set_title(title)
     ax = axes.flat[5]
     ax.axis("off")
-    info = getattr(land, "reference", None) or {}
-    src = info.get("source", "")
-    src = "the scenario's law (exact)" if src in ("law", "") else src
-    lines = [
-        "Criteria landscape",
-        f"{a0.size} x {a1.size} points, {land.seconds:.1f} s on {land.workers} processes",
-        f"reference: {src}"[:70],
-        f"reference regime: {ref_reg}",
-    ]
-    if not exact and floor:
-        lines.append("noise floor: " + ", ".join(f"{n} {floor[n]:.2g}" for n in _ORDER))
-    counts = land.regime_counts() if hasattr(land, "regime_counts") else {}
-    if counts:
-        lines.append("regimes: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
-    if cons is not None:
-        lines.append(f"consistent with the reference at {int(cons.sum())} point(s)")
-    fails = getattr(land, "failures", (0, "", None))
-    if fails[0]:
-        lines.append(f"{fails[0]} simulation(s) failed, the first:")
-        lines += ["  " + w for w in textwrap.wrap(fails[1], 62)[:4]]
-    if truth is not None and not inside:
-        lines.append("the reference law lies outside this range")
+    lines = _landscape_info_lines(land, ref_reg, exact, floor, cons, truth, inside)
     ax.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, transform=ax.transAxes)
-    handles = [Line2D([], [], ls="none", marker="*", mfc="w", mec="k", ms=10, label="minimum")]
-    if inside:
-        handles.append(
-            Line2D([], [], ls="none", marker="o", mfc="none", mec="r", ms=10, label="reference law")
-        )
-    if show_cons:
-        handles.append(
-            Line2D([], [], color="w", ls="--", lw=1.2, label="consistent region (boundary)")
-        )
-    handles += [Line2D([], [], label=label, **style) for _, style, label in marks]
-    leg = ax.legend(handles=handles, loc="lower left", fontsize=8, facecolor="0.85")
-    leg.get_frame().set_edgecolor("0.5")
+    _landscape_legend(ax, inside, show_cons, marks)
     fig.tight_layout()
     return _save(fig, stem)
 
@@ -502,13 +526,8 @@ def verify_figure(result, stem):
     return _save(fig, stem)
 
 
-def explain_figure(iteration, measured, stem, k=1):
-    """One iteration of the missing-effect loop: the force before and after adding the
-    named effect against the record, the residual's share by impact phase (and its ratio
-    to the noise), the mean residual over the simulated (zeta, dzeta) plane, and every
-    candidate effect's score test."""
-    fig, axes = subplots(2, 2, figsize=(13, 8.5), layout="constrained")
-    ax = axes[0, 0]
+def _explain_forces(ax, iteration, measured, k):
+    """The force before and after the named effect, against the record."""
     E = measured
     ax.plot(E.t * 1e3, E.F / 1e3, "k-", lw=2, label="measured")
     if iteration.simulated_before is not None:
@@ -540,7 +559,10 @@ def explain_figure(iteration, measured, stem, k=1):
         fontsize=9,
     )
     ax.legend(fontsize=7)
-    ax = axes[0, 1]
+
+
+def _explain_phases(ax, iteration):
+    """The residual's share by impact phase, and its ratio to the noise."""
     ph = iteration.localisation["phases"]
     names = list(ph)
     shares = [ph[n]["share"] for n in names]
@@ -569,7 +591,10 @@ def explain_figure(iteration, measured, stem, k=1):
         "number: residual energy / noise energy)",
         fontsize=9,
     )
-    ax = axes[1, 0]
+
+
+def _explain_plane(fig, ax, iteration):
+    """The mean residual over the simulated (zeta, dzeta) plane."""
     plane = iteration.localisation.get("plane")
     if plane is not None:
         ze, ve = plane["zeta_edges"], plane["dzeta_edges"]
@@ -592,7 +617,10 @@ def explain_figure(iteration, measured, stem, k=1):
     else:
         ax.text(0.5, 0.5, "no positions in the record", ha="center", transform=ax.transAxes)
     ax.set_title("residual over the (zeta, dzeta) plane (gray: no samples)", fontsize=9)
-    ax = axes[1, 1]
+
+
+def _explain_scores(ax, iteration):
+    """Every candidate effect's score test."""
     sc = [x for x in iteration.scores if x.get("lm") is not None]
     unscored = [x for x in iteration.scores if x.get("lm") is None and "criteria_after" in x]
     if sc or unscored:
@@ -623,4 +651,16 @@ def explain_figure(iteration, measured, stem, k=1):
     ax.set_title(
         "candidate effects (green: named; orange: significant; gray: not significant)", fontsize=9
     )
+
+
+def explain_figure(iteration, measured, stem, k=1):
+    """One iteration of the missing-effect loop: the force before and after adding the
+    named effect against the record, the residual's share by impact phase (and its ratio
+    to the noise), the mean residual over the simulated (zeta, dzeta) plane, and every
+    candidate effect's score test."""
+    fig, axes = subplots(2, 2, figsize=(13, 8.5), layout="constrained")
+    _explain_forces(axes[0, 0], iteration, measured, k)
+    _explain_phases(axes[0, 1], iteration)
+    _explain_plane(fig, axes[1, 0], iteration)
+    _explain_scores(axes[1, 1], iteration)
     return _save(fig, stem)

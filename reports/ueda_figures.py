@@ -201,14 +201,8 @@ def basins_figure(bas, stem):
     return _save(fig, stem)
 
 
-def discover_figure(disc, ver, stem):
-    """(a) the record's stroboscopic points over the discovered model's; (b) the
-    coefficients with their standard errors (bars: 2 SE); (c) the energy distance
-    against its noise floor (random halves of the record)."""
-    fig, axes = subplots(
-        1, 3, figsize=(15, 4.8), layout="constrained", gridspec_kw={"width_ratios": [1.3, 1, 1]}
-    )
-    ax = axes[0]
+def _strobe_panel(ax, ver):
+    """(a) The record's stroboscopic points over the model's."""
     ms, rs = ver.model_strobe, ver.record_strobe
     if len(ms):
         ax.plot(
@@ -234,7 +228,10 @@ def discover_figure(disc, ver, stem):
     )
     ax.set_title(f"(a) stroboscopic points at t = 2 pi k / nu\n{lyap}", fontsize=9)
     ax.grid(alpha=0.3)
-    ax = axes[1]
+
+
+def _coefficient_panel(ax, disc):
+    """(b) The coefficients with their standard errors (bars: 2 SE)."""
     names = list(disc.coefficients)
     c = np.array([disc.coefficients[k] for k in names])
     se = np.array([disc.standard_errors[k] for k in names])
@@ -257,7 +254,10 @@ def discover_figure(disc, ver, stem):
     ax.axvline(0, color="k", lw=0.5)
     ax.set_title("(b) coefficients of x'' = ...\n(error bars: 2 SE, block bootstrap)", fontsize=9)
     ax.grid(alpha=0.3, axis="x")
-    ax = axes[2]
+
+
+def _distance_panel(ax, ver):
+    """(c) The energy distance against its noise floor."""
     hi = max(
         ver.floor_q95 * 1.5, ver.energy_distance * 1.1 if np.isfinite(ver.energy_distance) else 0.0
     )
@@ -303,6 +303,18 @@ def discover_figure(disc, ver, stem):
     ax.set_title(
         f"(c) {verdict}\n(rule: median distance <= floor q95, and the same regime)", fontsize=9
     )
+
+
+def discover_figure(disc, ver, stem):
+    """(a) the record's stroboscopic points over the discovered model's; (b) the
+    coefficients with their standard errors (bars: 2 SE); (c) the energy distance
+    against its noise floor (random halves of the record)."""
+    fig, axes = subplots(
+        1, 3, figsize=(15, 4.8), layout="constrained", gridspec_kw={"width_ratios": [1.3, 1, 1]}
+    )
+    _strobe_panel(axes[0], ver)
+    _coefficient_panel(axes[1], disc)
+    _distance_panel(axes[2], ver)
     eq = "x'' = " + " ".join(
         f"{v:+.4g} {k}" if k != "1" else f"{v:+.4g}" for k, v in disc.model.terms.items()
     )

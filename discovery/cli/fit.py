@@ -23,41 +23,62 @@ from ._common import (
 )
 
 
-def run(args):
-    t_start = time.perf_counter()
+def _discover(args, scs, meas, progress):
+    """The API call the options describe."""
+    from ..discover import discover
+
+    return discover(
+        scs,
+        meas,
+        library=args.library,
+        selection=args.select,
+        scoring=args.score,
+        max_terms=args.max_terms,
+        criterion=args.criterion,
+        shortlist=args.shortlist,
+        refine=not args.no_refine,
+        max_simulations=args.max_simulations,
+        stability=args.stability,
+        derivative=args.derivative,
+        average_cycles=args.average_cycles,
+        seed=args.seed,
+        margin=args.margin,
+        monotone=args.monotone,
+        physics=not args.allow_unphysical,
+        require=args.require or (),
+        n_boot_intervals=args.intervals,
+        progress=progress,
+        **({"signs": args.signs} if args.signs else {}),
+    )
+
+
+def _ranking_csv(res):
+    """``ranking.csv``: one row per ranked candidate."""
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(["rank", "terms", "regime", "bic", "aic", "cv_error", *CRITERIA, "coefficients"])
+    for i, m in enumerate(res.ranking):
+        w.writerow(
+            [
+                i + 1,
+                " + ".join(m.law.names),
+                m.regime,
+                f"{m.candidate.bic:.8g}",
+                f"{m.candidate.aic:.8g}",
+                f"{m.candidate.cv_error:.6g}",
+                *[f"{m.criteria[n]:.6g}" if m.criteria else "" for n in CRITERIA],
+                m.law.to_text(),
+            ]
+        )
+    return buf.getvalue()
+
+
+def _write_outputs(args, res, summary, t_start):
+    """The output directory: ranking, figures, model.tex (and its PDF), summary.json.
+    Returns ``(pdf, why)`` (``why``: the reason there is no PDF)."""
     from reports import fit_impulse_figure, fit_loop_figure, fit_surface_figure
     from reports.document import compile_tex, render
 
-    from ..discover import discover
-
-    check_out(args)
-    data = args.data
-    scs, meas = read_records(args)
-    sc = scs[0]
-    with reporter(args) as rep:
-        res = discover(
-            scs,
-            meas,
-            library=args.library,
-            selection=args.select,
-            scoring=args.score,
-            max_terms=args.max_terms,
-            criterion=args.criterion,
-            shortlist=args.shortlist,
-            refine=not args.no_refine,
-            max_simulations=args.max_simulations,
-            stability=args.stability,
-            derivative=args.derivative,
-            average_cycles=args.average_cycles,
-            seed=args.seed,
-            margin=args.margin,
-            monotone=args.monotone,
-            physics=not args.allow_unphysical,
-            require=args.require or (),
-            n_boot_intervals=args.intervals,
-            progress=rep,
-            **({"signs": args.signs} if args.signs else {}),
-        )
     imps = []
     for k, m in enumerate(res.ranking[:3]):
         if m.criteria:  # aligned with the first record and sampled like it
@@ -68,31 +89,8 @@ def run(args):
                     m.evaluation.simulated,
                 )
             )
-    summary = {
-        "command": "fit",
-        "scenario": sc.as_dict(),
-        "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
-        **res.as_dict(names=[str(p) for p in data]),
-        **provenance(vars(args), inputs=inputs_of(args)),
-    }
     with OutputDir(args.out) as out:
-        buf = io.StringIO()
-        w = csv.writer(buf)
-        w.writerow(["rank", "terms", "regime", "bic", "aic", "cv_error", *CRITERIA, "coefficients"])
-        for i, m in enumerate(res.ranking):
-            w.writerow(
-                [
-                    i + 1,
-                    " + ".join(m.law.names),
-                    m.regime,
-                    f"{m.candidate.bic:.8g}",
-                    f"{m.candidate.aic:.8g}",
-                    f"{m.candidate.cv_error:.6g}",
-                    *[f"{m.criteria[n]:.6g}" if m.criteria else "" for n in CRITERIA],
-                    m.law.to_text(),
-                ]
-            )
-        out.path("ranking.csv").write_text(buf.getvalue())
+        out.path("ranking.csv").write_text(_ranking_csv(res))
         fit_impulse_figure(res, imps, str(out.path("fit_impulse")))
         fit_surface_figure(res, str(out.path("fit_surface")))
         fit_loop_figure(res, str(out.path("fit_loop")))
@@ -108,6 +106,11 @@ def run(args):
         summary["pdf"] = None if pdf is None else "model.pdf"
         summary["seconds"] = time.perf_counter() - t_start  # the whole command
         out.write_json("summary.json", summary)
+    return pdf, why
+
+
+def _print_result(args, res, pdf, why):
+    """The command's printout: the selected law, its checks, the ranking's notes."""
     sel = res.selected
     print(f"selected {sel.law}   [{sel.regime}]")
     if sel.standard_errors:
@@ -140,6 +143,24 @@ def run(args):
         f"{', model.pdf' if pdf else ''}, fit_impulse.png/.pdf, fit_surface.png/.pdf, "
         "fit_loop.png/.pdf"
     )
+
+
+def run(args):
+    t_start = time.perf_counter()
+    check_out(args)
+    data = args.data
+    scs, meas = read_records(args)
+    with reporter(args) as rep:
+        res = _discover(args, scs, meas, rep)
+    summary = {
+        "command": "fit",
+        "scenario": scs[0].as_dict(),
+        "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
+        **res.as_dict(names=[str(p) for p in data]),
+        **provenance(vars(args), inputs=inputs_of(args)),
+    }
+    pdf, why = _write_outputs(args, res, summary, t_start)
+    _print_result(args, res, pdf, why)
     return 0
 
 
@@ -169,129 +190,149 @@ def _terms(text):
     return out
 
 
-def register(sub):
-    s = sub.add_parser(
-        "fit",
-        help="discover a law: sparse certified regression, every candidate checked by simulation",
-    )
-    s.add_argument(
+def _add_inputs(p):
+    """The records and their machines."""
+    p.add_argument(
         "--scenario",
         action="append",
         help=SCENARIO_HELP + "; repeat it, once per --data in the same order, when "
         "the records come from different operating points",
     )
-    s.add_argument(
+    p.add_argument(
         "--data",
         required=True,
         action="append",
         help="CSV with t, F, w1, w2 (v1, v2 optional); repeat it to fit several records jointly",
     )
-    add_record_options(s)
-    s.add_argument(
+    add_record_options(p)
+
+
+def _add_regression_options(p):
+    """Candidate library and the regression that proposes supports."""
+    p.add_argument(
         "--library",
         default="poly:2",
         help="candidate terms: poly:N, hc, a list 'z,zd,z*zd', or sums (default: %(default)s)",
     )
-    s.add_argument(
+    p.add_argument(
         "--select",
         default="best-subset",
         choices=["best-subset", "l1-path", "stlsq", "sr3", "constrained-sr3"],
         help="how supports are proposed (default: %(default)s)",
     )
-    s.add_argument(
+    p.add_argument(
         "--score",
         default="bic",
         choices=["bic", "aic", "cv"],
         help="regression score that orders the candidates (default: %(default)s)",
     )
-    s.add_argument(
+    p.add_argument(
         "--max-terms", type=integer(1, 12), default=4, help="largest support (default: %(default)s)"
     )
-    s.add_argument(
+    p.add_argument(
         "--criterion",
         default="I2",
         choices=list(CRITERIA),
         help="simulation criterion of the ranking (default: %(default)s)",
     )
-    s.add_argument(
+    p.add_argument(
         "--shortlist",
         type=integer(1, 200),
         default=8,
         help="candidates simulated (default: %(default)s)",
     )
-    s.add_argument(
+    p.add_argument(
         "--margin",
         type=number(0.0, unit="N s/m"),
         default=0.0,
         help="dissipativity strictness margin in N s/m (default: %(default)g)",
     )
-    s.add_argument(
+    p.add_argument(
         "--signs",
         type=_signs,
         default=None,
         help="coefficient signs of library terms, e.g. 'z:+,zd:+,zd^2:-' (a term "
         "not named is free; default: none)",
     )
-    s.add_argument(
+    p.add_argument(
         "--require",
         type=_terms,
         default=None,
         help="terms every candidate must contain, e.g. 'z' (a spring) or 'z,zd' (default: none)",
     )
-    s.add_argument(
+
+
+def _add_check_options(p):
+    """Simulation checks, refinement, intervals and stability selection."""
+    p.add_argument(
         "--intervals",
         type=interval_count,
         default=30,
         help="bootstrap replicates of the selected law's 95 %% coefficient intervals "
         "through the full processing (0 = none) (default: %(default)s)",
     )
-    s.add_argument(
+    p.add_argument(
         "--allow-unphysical",
         action="store_true",
         help="rank laws that are no contact laws (no spring: F(zeta, 0) = 0; a "
         "negative damper) by the records alone; by default they come last",
     )
-    s.add_argument("--monotone", action="store_true", help="also require a monotone elastic branch")
-    s.add_argument(
+    p.add_argument("--monotone", action="store_true", help="also require a monotone elastic branch")
+    p.add_argument(
         "--no-refine",
         action="store_true",
         help="skip the refinement of every shortlisted support by simulation "
         "(output error: unbiased coefficients and their standard errors)",
     )
-    s.add_argument(
+    p.add_argument(
         "--max-simulations",
         type=integer(2, 100_000),
         default=120,
         excludes="--no-refine",
         help="simulation budget of each support's refinement (default: %(default)s)",
     )
-    s.add_argument(
+    p.add_argument(
         "--stability",
         type=integer(0, 10_000),
         default=0,
         help="bootstrap resamples of impacts for stability selection "
         "(default: %(default)s, no stability selection)",
     )
-    s.add_argument(
+    p.add_argument(
         "--derivative",
         choices=["velocities", "savgol", "pysindy"],
         help="source of dzeta (default: velocities if recorded, else savgol)",
     )
-    s.add_argument(
+    p.add_argument(
         "--average-cycles",
         action="store_true",
         help="average the steady cycles sample by sample before the regression",
     )
-    s.add_argument(
+    p.add_argument(
         "--seed",
         type=integer(0, 2**32 - 1),
         default=0,
         help="seed of the stability selection (default: %(default)s)",
     )
-    s.add_argument(
+
+
+def _add_output_options(p):
+    """Outputs."""
+    p.add_argument(
         "--no-pdf",
         action="store_true",
         help="do not compile model.tex to model.pdf (compiled when latexmk is installed)",
     )
-    s.add_argument("--out", required=True, help="output directory")
+    p.add_argument("--out", required=True, help="output directory")
+
+
+def register(sub):
+    s = sub.add_parser(
+        "fit",
+        help="discover a law: sparse certified regression, every candidate checked by simulation",
+    )
+    _add_inputs(s)
+    _add_regression_options(s)
+    _add_check_options(s)
+    _add_output_options(s)
     s.set_defaults(func=run)

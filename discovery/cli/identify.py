@@ -87,44 +87,12 @@ def _read_landscape(path, cls):
         ) from None
 
 
-def run(args):
-    from reports import identification_figure
+def _iterate_impulses(sc, start, ref, res):
+    """The impulses the figure shows: a few best-so-far laws found before the identified
+    law, labelled by the simulations spent (``res.iterations`` lists every new best, the
+    finite-difference probes included), then the identified law itself."""
+    from ..verify import evaluate
 
-    from ..identify import identify
-    from ..landscape import Landscape
-    from ..verify import Reference, evaluate
-
-    check_out(args)
-    sc = load_scenario(args.scenario)
-    if not args.start.strip():
-        raise InputError(
-            "--start is empty; give the terms and start values, e.g. '1.5e8*z + 0.9e7*zd'"
-        )
-    start = ForceLaw.parse(args.start)
-    start.check_physical(sc, "--start")
-    land = _load_landscape(args.landscape, Landscape, start, sc) if args.landscape else None
-    meas = read_record(args, sc)
-    for note in meas.notes:
-        print(f"note: {note}")
-    ref = Reference.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
-    E = ref.impulse
-    with reporter(args) as rep:
-        res = identify(
-            sc,
-            ref,
-            start,
-            criterion=args.criterion,
-            method=args.method,
-            max_simulations=args.max_simulations,
-            xtol=args.xtol,
-            n_boot_intervals=args.intervals,
-            seed=args.seed,
-            progress=rep,
-        )
-    final = res.checks[0]  # the identified law against the record, with its noise floor
-    # res.iterations lists every new best-so-far law (finite-difference probes included),
-    # so the impulses are labelled by the simulations spent, not as iterations: a few of
-    # those found before the identified law, then the identified law itself
     its = res.iterations
     found = next(
         (k for k, it in enumerate(its) if it["coefficients"] == res.coefficients), len(its)
@@ -143,45 +111,56 @@ def run(args):
                 ev.simulated,
             )
         )
-    imps.append(("identified law", final.simulated))
-    with OutputDir(args.out) as out:
-        summary = {
-            "command": "identify",
-            "scenario": sc.as_dict(),
-            "data": str(args.data),
-            "measured": {
-                "n_cycles": E.n_cycles,
-                "n_periods": E.n_periods,
-                "noise": E.noise,
-                "threshold": E.threshold,
-                "peak": E.peak,
-                "contact_time": E.contact_time,
-            },
-            "start": start.as_dict(),
-            **res.as_dict(),
-            "criteria": final.criteria,
-            "noise_floor": final.noise_floor,
-            "consistent": final.consistent,
-            "verdict": final.verdict,
-            "regime": final.regime,
-            **provenance(vars(args), inputs=inputs_of(args)),
-        }
-        out.write_json("summary.json", summary)
-        buf = io.StringIO()
-        w = csv.writer(buf)
-        # one row per new best-so-far law (optimiser steps and finite-difference probes)
-        w.writerow(["best_so_far", "n_simulations", res.criterion, *res.law.names])
-        for k, it in enumerate(res.iterations):
-            w.writerow(
-                [
-                    k,
-                    it["n_simulations"],
-                    f"{it['value']:.10g}",
-                    *[f"{v:.10g}" for v in it["coefficients"].values()],
-                ]
-            )
-        out.path("iterations.csv").write_text(buf.getvalue())
-        identification_figure(res, E, imps, str(out.path("identification")), land)
+    imps.append(("identified law", res.checks[0].simulated))
+    return imps
+
+
+def _iterations_csv(res):
+    """``iterations.csv``: one row per new best-so-far law (optimiser steps and
+    finite-difference probes)."""
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(["best_so_far", "n_simulations", res.criterion, *res.law.names])
+    for k, it in enumerate(res.iterations):
+        w.writerow(
+            [
+                k,
+                it["n_simulations"],
+                f"{it['value']:.10g}",
+                *[f"{v:.10g}" for v in it["coefficients"].values()],
+            ]
+        )
+    return buf.getvalue()
+
+
+def _summary(args, sc, start, E, res):
+    """``summary.json`` of the command."""
+    final = res.checks[0]  # the identified law against the record, with its noise floor
+    return {
+        "command": "identify",
+        "scenario": sc.as_dict(),
+        "data": str(args.data),
+        "measured": {
+            "n_cycles": E.n_cycles,
+            "n_periods": E.n_periods,
+            "noise": E.noise,
+            "threshold": E.threshold,
+            "peak": E.peak,
+            "contact_time": E.contact_time,
+        },
+        "start": start.as_dict(),
+        **res.as_dict(),
+        "criteria": final.criteria,
+        "noise_floor": final.noise_floor,
+        "consistent": final.consistent,
+        "verdict": final.verdict,
+        "regime": final.regime,
+        **provenance(vars(args), inputs=inputs_of(args)),
+    }
+
+
+def _print_result(args, res):
+    final = res.checks[0]
     print(f"identified {res.law}")
     # the criterion of the identified law (res.value can be that of a standard-error probe)
     value = res.criteria.get(res.criterion, res.value)
@@ -203,6 +182,47 @@ def run(args):
         f"outputs in {args.out}/: summary.json, iterations.csv, identification.png, "
         "identification.pdf"
     )
+
+
+def run(args):
+    from reports import identification_figure
+
+    from ..identify import identify
+    from ..landscape import Landscape
+    from ..verify import Reference
+
+    check_out(args)
+    sc = load_scenario(args.scenario)
+    if not args.start.strip():
+        raise InputError(
+            "--start is empty; give the terms and start values, e.g. '1.5e8*z + 0.9e7*zd'"
+        )
+    start = ForceLaw.parse(args.start)
+    start.check_physical(sc, "--start")
+    land = _load_landscape(args.landscape, Landscape, start, sc) if args.landscape else None
+    meas = read_record(args, sc)
+    for note in meas.notes:
+        print(f"note: {note}")
+    ref = Reference.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
+    with reporter(args) as rep:
+        res = identify(
+            sc,
+            ref,
+            start,
+            criterion=args.criterion,
+            method=args.method,
+            max_simulations=args.max_simulations,
+            xtol=args.xtol,
+            n_boot_intervals=args.intervals,
+            seed=args.seed,
+            progress=rep,
+        )
+    imps = _iterate_impulses(sc, start, ref, res)
+    with OutputDir(args.out) as out:
+        out.write_json("summary.json", _summary(args, sc, start, ref.impulse, res))
+        out.path("iterations.csv").write_text(_iterations_csv(res))
+        identification_figure(res, ref.impulse, imps, str(out.path("identification")), land)
+    _print_result(args, res)
     return 0
 
 

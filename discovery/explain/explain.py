@@ -42,6 +42,7 @@ import re
 import time
 import warnings
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from scipy.stats import chi2
@@ -817,6 +818,583 @@ def _output_error(records, start, criterion, budget, tol, polish=False):
     return res2 if res2.value < res.value else res
 
 
+class _Trial(NamedTuple):
+    """A candidate effect refitted: its gap ratio (after / before), its score entry, the
+    refitted model, the fit (``None`` for the drift channel), the evaluations of the refitted
+    model and the criterion its gap is measured by."""
+
+    ratio: float
+    score: dict
+    model: object
+    result: object
+    evaluations: list
+    key: str
+
+
+class _Screening(NamedTuple):
+    """The score tests of one iteration: the candidate effects, their scores, the
+    family-wise level, the localisation's two largest phases, the significant effects ranked
+    (and those without a local score) and whether the cycle is within its noise."""
+
+    cands: list
+    scores: list
+    level: float
+    top_phases: list
+    ranked: list
+    quiet: bool
+
+
+@dataclass
+class _Run:
+    """One :func:`explain` call: its fixed inputs and the state of its loop."""
+
+    problem: object
+    records: list
+    catalogue: list
+    criterion: str
+    alpha: float
+    budget: int
+    tolerances: object
+    drift: object
+    regress: object
+    workers: object
+    executor: object
+    max_refits: int
+    meas_first: object
+    model: object = None
+    uncertainties: dict = field(default_factory=dict)
+    iterations: list = field(default_factory=list)
+    separability: tuple = ()
+    stopped: str = ""
+
+    def drift_free(self, model):
+        return _drift_free(
+            self.drift, model, self.records, self.alpha / max(len(self.catalogue), 1)
+        )
+
+
+def _records_of(scenario, measurement, n_boot, seed):
+    """``(pairs, records)``: the records paired with their scenarios, and as references
+    (each with its noise floor from ``n_boot`` replicates)."""
+    pairs = pair_records(scenario, measurement)
+    records = as_records(
+        [sc for sc, _ in pairs],
+        [
+            m
+            if isinstance(m, Reference)
+            else Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)
+            for sc, m in pairs
+        ],
+    )
+    return pairs, records
+
+
+def _fit_start(start, records, plain, problem, criterion, budget, tolerances, progress):
+    """The start law fitted to the records: the first of the start candidates (and their
+    fallbacks) that simulates."""
+    preferred, others = (
+        ([start], []) if isinstance(start, ForceLaw) else _start_candidates(start, records, plain)
+    )
+    fit, why = None, ""
+    for law in _fallbacks(preferred, others, problem, criterion):
+        try:
+            # the start is fitted cycle by cycle (each cycle from the machine's state before
+            # it): over several cycles a law can trade its spring against the missing
+            # effect through the restitution (a soft spring mimics damping while
+            # unloading), and the effect would then look absent
+            short = [(sc, ref.shortened() or ref) for sc, ref in records]
+            tick(progress, "explain: fitting the start cycle by cycle", 0, None)
+            fit = _output_error(short, law, criterion, budget, tolerances, polish=True)
+            fit = _polish_start(records, fit, criterion, max(budget // 3, 8), tolerances)
+            break
+        except IntegrationError as exc:
+            why = str(exc)
+    if fit is None:
+        raise IntegrationError(
+            f"no start law for {start!r} has a periodic steady state with "
+            f"contact for the record ({why}); give --start as a law with "
+            "coefficients closer to the record"
+        )
+    return fit
+
+
+def _stop_consistent(run, before, floor):
+    """The model is consistent: the loop stops (and, when nothing was named, says which
+    effects this record cannot tell from the model)."""
+    run.stopped = (
+        "the model is consistent with the record(s): I2 and I4 within their "
+        "noise floors, no drift across the impacts, nothing left to explain"
+    )
+    if any(it.effect for it in run.iterations):
+        return
+    run.separability = _separability(
+        run.problem,
+        run.records,
+        run.model,
+        run.catalogue,
+        run.criterion,
+        before,
+        floor,
+        max(run.budget // 3, 12),
+        run.tolerances,
+    )
+    hidden = [s["effect"] for s in run.separability if not s["separable"]]
+    if hidden:
+        run.stopped += (
+            "; this record cannot tell " + ", ".join(hidden) + " from the "
+            f"model (each refitted with the model lowers {run.criterion} by "
+            "less than its noise floor: see separability)"
+        )
+
+
+def _screen_effects(run, evs, loc, cycle_ok):
+    """Score tests of the applicable effects at the current model; the significant ones
+    ranked by their statistic."""
+    model, records, problem = run.model, run.records, run.problem
+    r0 = problem.residual(model)
+    J = _jacobian(problem, model, r0)
+    sigma = problem.sigma()
+    # a cycle within its noise leaves only the drift to explain: consistent, or failing
+    # I4 alone (the supports of a noisy record) while the criterion the refits lower is
+    # within its limit (lowering it further would fit the noise)
+    quiet = cycle_ok or _within_noise(evs, run.criterion)
+    cands = [
+        e
+        for e in run.catalogue
+        if e.applicable(model)
+        and (run.drift is not None or "drift" not in e.phases)
+        and (not quiet or "drift" in e.phases)
+    ]
+    scores = [
+        run.drift.score(model, e, _small_step(e, records))
+        if "drift" in e.phases
+        else _score(problem, model, r0, J, e, records, sigma)
+        for e in cands
+    ]
+    level = run.alpha / max(len(scores), 1)
+    top_phases = sorted(loc["phases"], key=lambda p: -loc["phases"][p]["share"])[:2]
+    for s, e in zip(scores, cands, strict=True):
+        s["significant"] = bool(s["p"] is not None and s["p"] < level)
+        s["signature_agrees"] = _signature_agrees(e, loc, top_phases)
+    ranked = sorted((s for s in scores if s["significant"]), key=lambda s: -s["lm"])
+    if any(s.get("channel") == "drift" for s in ranked):
+        # a record that drifts has no steady cycle to compare: the drift comes first
+        ranked = [s for s in ranked if s.get("channel") == "drift"]
+    else:
+        # an effect whose small step already changes the regime has no local score;
+        # its refit (from the regression, over a ladder of values) still decides
+        ranked += [s for s in scores if s["lm"] is None]
+    return _Screening(cands, scores, level, top_phases, ranked, quiet)
+
+
+def _stop_nothing_significant(run, evs, before, floor, loc, screening, cycle_ok):
+    """No effect is significant: the iteration is recorded and the loop stops."""
+    criterion = run.criterion
+    why = f"no catalogue effect is significant (score tests at family-wise level {run.alpha:g})"
+    run.stopped = "no catalogue effect explains the remaining disagreement significantly"
+    if screening.quiet and not cycle_ok:
+        why = (
+            f"{criterion} is within its noise limit and the model fails "
+            f"{', '.join(_failing(evs))} alone, which no effect is fitted to (the "
+            "contact supports of a noisy record); " + why
+        )
+        run.stopped = (
+            f"{criterion} is within its noise limit; the model fails "
+            f"{', '.join(_failing(evs))} alone, which is not explained by an "
+            "effect"
+        )
+    run.iterations.append(
+        Iteration(
+            run.model,
+            run.model,
+            before,
+            before,
+            floor,
+            loc,
+            screening.scores,
+            None,
+            why,
+            [],
+            evs[0].simulated,
+            evs[0].simulated,
+            run.records[0][1].impulse,
+        )
+    )
+
+
+def _refit_trials(run, chosen, eff_by_id, before, screen_budget):
+    """Every chosen effect refitted with ``screen_budget`` simulations (the refits of the
+    force history in parallel, the drift channel here) and checked: physical, within its
+    bounds; the trials."""
+    model, criterion, records = run.model, run.criterion, run.records
+    # the screening refits of the force history are independent: one process each
+    refits = iter(
+        _screen(
+            [
+                (model, s["effect"], s.get("direction"))
+                for s in chosen
+                if "drift" not in eff_by_id[s["effect"]].phases
+            ],
+            (run.problem, records, criterion, screen_budget, run.tolerances, run.regress),
+            run.workers,
+            run.executor,
+        )
+    )
+    trials = []
+    for s in chosen:
+        eff = eff_by_id[s["effect"]]
+        key = "D" if "drift" in eff.phases else criterion
+        try:
+            if key == "D":
+                m2, res = run.drift.refit(model, eff, _small_step(eff, records)), None
+                evs2 = run.problem.evaluations(m2, floor=True)
+            else:
+                m2, res, evs2, error = next(refits)
+                if error is not None:
+                    raise IntegrationError(error)
+        except IntegrationError as exc:
+            s["note"] = f"refit failed: {exc}"
+            continue
+        after, _ = _with_drift(_mean(evs2, "criteria"), {}, run.drift, m2)
+        if not after or key not in after or key not in before:
+            s["note"] = "the refitted model has no periodic steady state with contact"
+            continue
+        s["criteria_after"] = after
+        s["consistent_after"] = all(e.consistent for e in evs2)
+        s["parameters"] = {eff.parameters[0].name: m2.value(eff)}
+        # (the drift channel does not depend on the law: no compensation to guard)
+        s["repulsive"] = key == "D" or _keeps_repulsive(m2, model, records)
+        if not s["repulsive"]:
+            s["note"] = (
+                "the refit's elastic branch P(zeta, 0) pulls at the record's "
+                "penetration: the effect only fits by undoing the contact spring"
+            )
+        s["in_bounds"] = _in_bounds(eff, m2)
+        if not s["in_bounds"]:
+            lo, hi = eff.parameters[0].bounds
+            s["note"] = (
+                f"the refit puts {eff.parameters[0].name} = {m2.value(eff):.4g} "
+                f"outside its physical bounds [{lo:g}, {hi:g}]"
+            )
+        s["gap"] = key
+        trials.append(_Trial(after[key] / max(before[key], 1e-300), s, m2, res, evs2, key))
+    return trials
+
+
+def _law_baseline(run, screen_budget):
+    """The law refitted alone with the same budget (from the better of the current model and
+    the regression on its terms): ``(fit, criteria, evaluations)``, or ``(None, None,
+    None)``.  An effect is named only when its refit beats this by the noise floor (else the
+    gap was the start's own misfit, and the effect only carried a refit of the law)."""
+    model, problem = run.model, run.problem
+    try:
+        null_starts = [model]
+        reg0 = _regressed(model, model.law.names, run.regress)
+        if reg0 is not None:
+            null_starts.append(reg0)
+        null_start = min(null_starts, key=lambda m: problem.value(m, run.criterion))
+    except (IntegrationError, InputError):
+        null_start = None
+    refit0 = (
+        None
+        if null_start is None
+        else _law_refit(
+            run.records,
+            null_start,
+            run.criterion,
+            screen_budget,
+            run.tolerances,
+            problem,
+            run.drift,
+        )
+    )
+    return (None, None, None) if refit0 is None else refit0
+
+
+def _judged(trials, null_after, floor, eff_by_id):
+    """The trials that name an effect: the gap shrinks by 10 %, the refit is physical and
+    within bounds, beats the law refitted alone by the noise floor, and the effect's
+    parameter is not within 2 standard errors of 0."""
+    for x in trials:
+        k = x.key
+        # (the drift channel does not depend on the law: a law refit is no baseline)
+        x.score["beats_law_refit"] = bool(
+            k == "D"
+            or not null_after
+            or k not in null_after
+            or x.score["criteria_after"][k] <= null_after[k] - floor.get(k, 0.0)
+        )
+    for x in trials:
+        # an effect refitted to 0, or to a value within 2 standard errors of 0, only
+        # carried a refit of the law
+        e_ = eff_by_id[x.score["effect"]]
+        x.score["present"] = (
+            _present(e_, x.model, x.result)
+            if x.result is not None
+            else bool(x.model.value(e_) != 0.0)
+        )
+    return [
+        x
+        for x in trials
+        if x.ratio <= 0.9
+        and x.score["repulsive"]
+        and x.score["in_bounds"]
+        and x.score["beats_law_refit"]
+        and x.score["present"]
+    ]
+
+
+def _polish_winner(run, best, eff):
+    """The winner refitted with the full budget, kept when it lowers the gap and stays
+    within bounds and physical: ``(model, fit, evaluations)``."""
+    s, m2, res, evs2, key = best.score, best.model, best.result, best.evaluations, best.key
+    try:
+        res2 = _output_error(
+            run.records, m2, run.criterion, run.budget, run.tolerances, polish=True
+        )
+        evs3 = run.problem.evaluations(res2.law, floor=True)
+        after3, _ = _with_drift(_mean(evs3, "criteria"), {}, run.drift, res2.law)
+        if (
+            after3
+            and after3[key] <= s["criteria_after"][key]
+            and _in_bounds(eff, res2.law)
+            and _keeps_repulsive(res2.law, run.model, run.records)
+        ):
+            m2, res, evs2 = res2.law, res2, evs3
+            s["criteria_after"] = after3
+            s["parameters"] = {p.name: m2.value(eff) for p in eff.parameters}
+    except (IntegrationError, InputError):
+        pass
+    return m2, res, evs2
+
+
+def _only_the_law_refit(run, s, key, evs, before, floor, loc, screening):
+    """Polished with the full budget, the winner's parameter is within 2 standard errors
+    of 0: the gain was the law's own refit.  Nothing is named; when the polished law refit
+    lowers the gap it becomes the model (the loop then screens again).  Returns whether it
+    did."""
+    refit = _law_refit(
+        run.records,
+        run.model,
+        run.criterion,
+        run.budget,
+        run.tolerances,
+        run.problem,
+        run.drift,
+        polish=True,
+    )
+    if refit is None or not refit[1] or not refit[1][key] < before[key]:
+        return False
+    law_refit, after_law, evs_law = refit[0].law, refit[1], refit[2]
+    run.iterations.append(
+        Iteration(
+            run.model,
+            law_refit,
+            before,
+            after_law,
+            floor,
+            loc,
+            screening.scores,
+            None,
+            f"{s['effect']} refitted with the full budget has its parameter within 2 "
+            "standard errors of 0: the gain was the law's own refit "
+            f"({key} {before[key]:.3g} -> {after_law[key]:.3g}); nothing is named",
+            [],
+            evs[0].simulated,
+            evs_law[0].simulated,
+            run.records[0][1].impulse,
+        )
+    )
+    run.model = law_refit
+    return True
+
+
+def _name_effect(run, good, evs, before, floor, loc, screening, m2, res, evs2):
+    """The winner is named: the iteration records its evidence and the effects as good."""
+    s, key = good[0].score, good[0].key
+    value = s["criteria_after"][key]
+    tol_eq = floor.get(key, 0.0)
+    equivalent = [
+        x.score["effect"]
+        for x in good[1:]
+        if x.key == key and x.score["criteria_after"][key] <= value + tol_eq
+    ]
+    score = (
+        f"score test LM = {s['lm']:.3g} (p = {s['p']:.2g} < {screening.level:.2g})"
+        if s["lm"] is not None
+        else "no score test (a small step of it changes the regime)"
+    )
+    evidence = (
+        f"{score}; refitted, "
+        f"{key} {before[key]:.3g} -> {value:.3g} (noise floor "
+        f"{floor.get(key, float('nan')):.3g}); signature "
+        f"{'agrees' if s['signature_agrees'] else 'does not agree'} with the "
+        f"localisation (largest shares: {', '.join(screening.top_phases)})"
+    )
+    run.iterations.append(
+        Iteration(
+            run.model,
+            m2,
+            before,
+            s["criteria_after"],
+            floor,
+            loc,
+            screening.scores,
+            s["effect"],
+            evidence,
+            equivalent,
+            evs[0].simulated,
+            evs2[0].simulated,
+            run.records[0][1].impulse,
+        )
+    )
+    run.model = m2
+    if res is not None:
+        run.uncertainties = dict(res.standard_errors)
+
+
+def _refit_and_name(run, evs, before, floor, loc, screening):
+    """Refit the ranked effects, compare with the law refitted alone, and name the best
+    (or refit the law, or stop).  Returns whether the loop goes on."""
+    criterion = run.criterion
+    # every candidate is refitted with a third of the budget; the winner gets the rest
+    screen_budget = max(run.budget // 3, 4 * len(run.records))
+    eff_by_id = {e.id: e for e in screening.cands}
+    trials = _refit_trials(
+        run, screening.ranked[: run.max_refits], eff_by_id, before, screen_budget
+    )
+    null, null_after, null_evs = _law_baseline(run, screen_budget)
+    good = _judged(trials, null_after, floor, eff_by_id)
+    if (
+        not good
+        and null_after
+        and criterion in null_after
+        and null_after[criterion] <= 0.9 * before[criterion]
+    ):
+        run.iterations.append(
+            Iteration(
+                run.model,
+                null.law,
+                before,
+                null_after,
+                floor,
+                loc,
+                screening.scores,
+                None,
+                f"no effect beats the law refitted alone ("
+                f"{criterion} {before[criterion]:.3g} -> "
+                f"{null_after[criterion]:.3g}) by its noise floor: the "
+                "law is refitted, nothing is named",
+                [],
+                evs[0].simulated,
+                null_evs[0].simulated,
+                run.records[0][1].impulse,
+            )
+        )
+        run.model = null.law
+        run.uncertainties = dict(null.standard_errors)
+        return True
+    if not good:
+        run.iterations.append(
+            Iteration(
+                run.model,
+                run.model,
+                before,
+                before,
+                floor,
+                loc,
+                screening.scores,
+                None,
+                "no refit of a significant effect (or of one without a "
+                f"score) lowers {criterion} by 10 %",
+                [],
+                evs[0].simulated,
+                evs[0].simulated,
+                run.records[0][1].impulse,
+            )
+        )
+        run.stopped = "the candidate effects do not shrink the gap when refitted"
+        return False
+    good.sort(key=lambda x: x.ratio)
+    best = good[0]
+    eff = eff_by_id[best.score["effect"]]
+    m2, res, evs2 = best.model, best.result, best.evaluations
+    if res is not None and run.budget > screen_budget:
+        m2, res, evs2 = _polish_winner(run, best, eff)
+    if res is not None and not _present(eff, m2, res):
+        if _only_the_law_refit(run, best.score, best.key, evs, before, floor, loc, screening):
+            return True
+    _name_effect(run, good, evs, before, floor, loc, screening, m2, res, evs2)
+    return True
+
+
+def _iteration(run, max_iterations):
+    """One iteration of the loop (verify, localise, score, refit, name); returns whether the
+    loop goes on."""
+    evs = run.problem.evaluations(run.model, floor=True)
+    before, floor = _with_drift(
+        _mean(evs, "criteria"), _mean(evs, "noise_floor"), run.drift, run.model
+    )
+    cycle_ok = all(e.consistent for e in evs)
+    if cycle_ok and run.drift_free(run.model):
+        _stop_consistent(run, before, floor)
+        return False
+    if len(run.iterations) >= max_iterations:
+        return False
+    loc = localise(
+        run.model.apply(run.records[0][0]),
+        run.model,
+        run.records[0][1],
+        evs[0],
+        run.meas_first,
+        tolerances=run.tolerances,
+    )
+    screening = _screen_effects(run, evs, loc, cycle_ok)
+    if not screening.ranked:
+        _stop_nothing_significant(run, evs, before, floor, loc, screening, cycle_ok)
+        return False
+    return _refit_and_name(run, evs, before, floor, loc, screening)
+
+
+def _check_settings(max_simulations, budget, alpha, workers, max_iterations):
+    """The settings :func:`explain` checks beyond their types; returns the simulation
+    budget of each refit (``budget=`` is the deprecated name of ``max_simulations=``)."""
+    if budget is not None:
+        warnings.warn(
+            "explain(budget=...) is renamed max_simulations=... (the CLI's --max-simulations)",
+            DeprecationWarning,
+            stacklevel=4,
+        )
+        max_simulations = budget
+    if not (0 < alpha < 1):
+        raise InputError(f"alpha must be in (0, 1); got {alpha!r}")
+    if workers is not None and not (isinstance(workers, int) and workers >= 1):
+        raise InputError(f"workers must be an integer >= 1; got {workers!r}")
+    if not (isinstance(max_iterations, int) and max_iterations >= 0):
+        raise InputError(f"max_iterations must be an integer >= 0; got {max_iterations!r}")
+    return max_simulations
+
+
+def _intervals(run, n_boot_intervals, seed, progress):
+    """Bootstrap intervals of the final model's parameters (``None`` when not asked for or
+    when a replicate cannot be simulated)."""
+    if not n_boot_intervals:
+        return None
+    try:
+        tick(progress, "explain: bootstrap intervals", 0, n_boot_intervals)
+        return bootstrap_intervals(
+            [sc for sc, _ in run.records],
+            [r for _, r in run.records],
+            run.model,
+            n_boot=int(n_boot_intervals),
+            seed=seed,
+            criterion=run.criterion,
+            tolerances=run.tolerances,
+        )
+    except IntegrationError:
+        return None
+
+
 @params(
     scenario=(Scenario, list, tuple),
     measurement=(Measurement, Reference, list, tuple),
@@ -900,454 +1478,69 @@ def explain(
     ExplainResult
     """
     t0 = time.perf_counter()
-    if budget is not None:
-        warnings.warn(
-            "explain(budget=...) is renamed max_simulations=... (the CLI's --max-simulations)",
-            DeprecationWarning,
-            stacklevel=3,
-        )
-        max_simulations = budget
-    budget = max_simulations
-    if not (0 < alpha < 1):
-        raise InputError(f"alpha must be in (0, 1); got {alpha!r}")
-    if workers is not None and not (isinstance(workers, int) and workers >= 1):
-        raise InputError(f"workers must be an integer >= 1; got {workers!r}")
-    if not (isinstance(max_iterations, int) and max_iterations >= 0):
-        raise InputError(f"max_iterations must be an integer >= 0; got {max_iterations!r}")
-    from ..verify import Reference
-
-    pairs = pair_records(scenario, measurement)
+    budget = _check_settings(max_simulations, budget, alpha, workers, max_iterations)
+    pairs, records = _records_of(scenario, measurement, n_boot, seed)
     ms = [m for _, m in pairs]
-    records = as_records(
-        [sc for sc, _ in pairs],
-        [
-            m
-            if isinstance(m, Reference)
-            else Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)
-            for sc, m in pairs
-        ],
-    )
     catalogue = select(EFFECTS, effects)
     problem = _Problem(records, tolerances)
     plain = [m for m in ms if not isinstance(m, Reference)]
-    preferred, others = (
-        ([start], [])
-        if isinstance(start, ForceLaw)
-        else _start_candidates(start, records, plain if len(plain) == len(ms) else None)
-    )
+    all_plain = len(plain) == len(ms)
     scen_list = [sc for sc, _ in records]
-    regress = (
-        (lambda names, loading=False: _regression(names, scen_list, plain, loading))
-        if len(plain) == len(ms)
-        else None
+    fit = _fit_start(
+        start,
+        records,
+        plain if all_plain else None,
+        problem,
+        criterion,
+        budget,
+        tolerances,
+        progress,
     )
-    fit, why = None, ""
-    for law in _fallbacks(preferred, others, problem, criterion):
-        try:
-            # the start is fitted cycle by cycle (each cycle from the machine's state before
-            # it): over several cycles a law can trade its spring against the missing
-            # effect through the restitution (a soft spring mimics damping while
-            # unloading), and the effect would then look absent
-            short = [(sc, ref.shortened() or ref) for sc, ref in records]
-            tick(progress, "explain: fitting the start cycle by cycle", 0, None)
-            fit = _output_error(short, law, criterion, budget, tolerances, polish=True)
-            fit = _polish_start(records, fit, criterion, max(budget // 3, 8), tolerances)
-            break
-        except IntegrationError as exc:
-            why = str(exc)
-    if fit is None:
-        raise IntegrationError(
-            f"no start law for {start!r} has a periodic steady state with "
-            f"contact for the record ({why}); give --start as a law with "
-            "coefficients closer to the record"
-        )
-    model = Model(fit.law)
-    uncertainties = dict(fit.standard_errors)
-    iterations = []
-    separability = ()
-    stopped = f"the budget of {max_iterations} added effect(s) is used"
-    meas_first = ms[0] if not isinstance(ms[0], Reference) else None
-    drift = _Drift(pairs, records) if not any(isinstance(m, Reference) for m in ms) else None
+    run = _Run(
+        problem,
+        records,
+        catalogue,
+        criterion,
+        alpha,
+        budget,
+        tolerances,
+        drift=_Drift(pairs, records) if not any(isinstance(m, Reference) for m in ms) else None,
+        regress=(
+            (lambda names, loading=False: _regression(names, scen_list, plain, loading))
+            if all_plain
+            else None
+        ),
+        workers=workers,
+        executor=executor,
+        max_refits=max_refits,
+        meas_first=ms[0] if not isinstance(ms[0], Reference) else None,
+        model=Model(fit.law),
+        uncertainties=dict(fit.standard_errors),
+        stopped=f"the budget of {max_iterations} added effect(s) is used",
+    )
     for _ in range(max_iterations + 1):
         tick(
             progress,
             "explain: iterations (localise, score, refit)",
-            len(iterations),
+            len(run.iterations),
             max_iterations,
         )
-        evs = problem.evaluations(model, floor=True)
-        before, floor = _with_drift(_mean(evs, "criteria"), _mean(evs, "noise_floor"), drift, model)
-        cycle_ok = all(e.consistent for e in evs)
-        if cycle_ok and _drift_free(drift, model, records, alpha / max(len(catalogue), 1)):
-            stopped = (
-                "the model is consistent with the record(s): I2 and I4 within their "
-                "noise floors, no drift across the impacts, nothing left to explain"
-            )
-            if not any(it.effect for it in iterations):
-                separability = _separability(
-                    problem,
-                    records,
-                    model,
-                    catalogue,
-                    criterion,
-                    before,
-                    floor,
-                    max(budget // 3, 12),
-                    tolerances,
-                )
-                hidden = [s["effect"] for s in separability if not s["separable"]]
-                if hidden:
-                    stopped += (
-                        "; this record cannot tell " + ", ".join(hidden) + " from the "
-                        f"model (each refitted with the model lowers {criterion} by "
-                        "less than its noise floor: see separability)"
-                    )
+        if not _iteration(run, max_iterations):
             break
-        if len(iterations) >= max_iterations:
-            break
-        loc = localise(
-            model.apply(records[0][0]),
-            model,
-            records[0][1],
-            evs[0],
-            meas_first,
-            tolerances=tolerances,
-        )
-        r0 = problem.residual(model)
-        J = _jacobian(problem, model, r0)
-        sigma = problem.sigma()
-        # a cycle within its noise leaves only the drift to explain: consistent, or failing
-        # I4 alone (the supports of a noisy record) while the criterion the refits lower is
-        # within its limit (lowering it further would fit the noise)
-        quiet = cycle_ok or _within_noise(evs, criterion)
-        cands = [
-            e
-            for e in catalogue
-            if e.applicable(model)
-            and (drift is not None or "drift" not in e.phases)
-            and (not quiet or "drift" in e.phases)
-        ]
-        scores = [
-            drift.score(model, e, _small_step(e, records))
-            if "drift" in e.phases
-            else _score(problem, model, r0, J, e, records, sigma)
-            for e in cands
-        ]
-        level = alpha / max(len(scores), 1)
-        top_phases = sorted(loc["phases"], key=lambda p: -loc["phases"][p]["share"])[:2]
-        for s, e in zip(scores, cands, strict=True):
-            s["significant"] = bool(s["p"] is not None and s["p"] < level)
-            s["signature_agrees"] = _signature_agrees(e, loc, top_phases)
-        ranked = sorted((s for s in scores if s["significant"]), key=lambda s: -s["lm"])
-        if any(s.get("channel") == "drift" for s in ranked):
-            # a record that drifts has no steady cycle to compare: the drift comes first
-            ranked = [s for s in ranked if s.get("channel") == "drift"]
-        else:
-            # an effect whose small step already changes the regime has no local score;
-            # its refit (from the regression, over a ladder of values) still decides
-            ranked += [s for s in scores if s["lm"] is None]
-        if not ranked:
-            why = f"no catalogue effect is significant (score tests at family-wise level {alpha:g})"
-            stopped = "no catalogue effect explains the remaining disagreement significantly"
-            if quiet and not cycle_ok:
-                why = (
-                    f"{criterion} is within its noise limit and the model fails "
-                    f"{', '.join(_failing(evs))} alone, which no effect is fitted to (the "
-                    "contact supports of a noisy record); " + why
-                )
-                stopped = (
-                    f"{criterion} is within its noise limit; the model fails "
-                    f"{', '.join(_failing(evs))} alone, which is not explained by an "
-                    "effect"
-                )
-            iterations.append(
-                Iteration(
-                    model,
-                    model,
-                    before,
-                    before,
-                    floor,
-                    loc,
-                    scores,
-                    None,
-                    why,
-                    [],
-                    evs[0].simulated,
-                    evs[0].simulated,
-                    records[0][1].impulse,
-                )
-            )
-            break
-        trials = []
-        # every candidate is refitted with a third of the budget; the winner gets the rest
-        screen = max(budget // 3, 4 * len(records))
-        eff_by_id = {e.id: e for e in cands}
-        chosen = ranked[:max_refits]
-        # the screening refits of the force history are independent: one process each
-        refits = iter(
-            _screen(
-                [
-                    (model, s["effect"], s.get("direction"))
-                    for s in chosen
-                    if "drift" not in eff_by_id[s["effect"]].phases
-                ],
-                (problem, records, criterion, screen, tolerances, regress),
-                workers,
-                executor,
-            )
-        )
-        for s in chosen:
-            eff = eff_by_id[s["effect"]]
-            key = "D" if "drift" in eff.phases else criterion
-            try:
-                if key == "D":
-                    m2, res = drift.refit(model, eff, _small_step(eff, records)), None
-                    evs2 = problem.evaluations(m2, floor=True)
-                else:
-                    m2, res, evs2, error = next(refits)
-                    if error is not None:
-                        raise IntegrationError(error)
-            except IntegrationError as exc:
-                s["note"] = f"refit failed: {exc}"
-                continue
-            after, _ = _with_drift(_mean(evs2, "criteria"), {}, drift, m2)
-            if not after or key not in after or key not in before:
-                s["note"] = "the refitted model has no periodic steady state with contact"
-                continue
-            s["criteria_after"] = after
-            s["consistent_after"] = all(e.consistent for e in evs2)
-            s["parameters"] = {eff.parameters[0].name: m2.value(eff)}
-            # (the drift channel does not depend on the law: no compensation to guard)
-            s["repulsive"] = key == "D" or _keeps_repulsive(m2, model, records)
-            if not s["repulsive"]:
-                s["note"] = (
-                    "the refit's elastic branch P(zeta, 0) pulls at the record's "
-                    "penetration: the effect only fits by undoing the contact spring"
-                )
-            s["in_bounds"] = _in_bounds(eff, m2)
-            if not s["in_bounds"]:
-                lo, hi = eff.parameters[0].bounds
-                s["note"] = (
-                    f"the refit puts {eff.parameters[0].name} = {m2.value(eff):.4g} "
-                    f"outside its physical bounds [{lo:g}, {hi:g}]"
-                )
-            s["gap"] = key
-            trials.append((after[key] / max(before[key], 1e-300), s, m2, res, evs2, key))
-        # the baseline: the law refitted alone, with the same budget; an effect is named
-        # only when its refit beats that by the noise floor (else the gap was the start's
-        # own misfit, and the effect only carried a refit of the law)
-        null_after, null = None, None
-        try:
-            # from the better of the current model and the regression on its terms (the
-            # effects' refits may start from the regression too)
-            null_starts = [model]
-            reg0 = _regressed(model, model.law.names, regress)
-            if reg0 is not None:
-                null_starts.append(reg0)
-            null_start = min(null_starts, key=lambda m: problem.value(m, criterion))
-        except (IntegrationError, InputError):
-            null_start = None
-        refit0 = (
-            None
-            if null_start is None
-            else _law_refit(records, null_start, criterion, screen, tolerances, problem, drift)
-        )
-        if refit0 is not None:
-            null, null_after, null_evs = refit0
-        for x in trials:
-            k = x[5]
-            # (the drift channel does not depend on the law: a law refit is no baseline)
-            x[1]["beats_law_refit"] = bool(
-                k == "D"
-                or not null_after
-                or k not in null_after
-                or x[1]["criteria_after"][k] <= null_after[k] - floor.get(k, 0.0)
-            )
-        for x in trials:
-            # an effect refitted to 0, or to a value within 2 standard errors of 0, only
-            # carried a refit of the law
-            e_ = eff_by_id[x[1]["effect"]]
-            x[1]["present"] = (
-                _present(e_, x[2], x[3]) if x[3] is not None else bool(x[2].value(e_) != 0.0)
-            )
-        good = [
-            x
-            for x in trials
-            if x[0] <= 0.9
-            and x[1]["repulsive"]
-            and x[1]["in_bounds"]
-            and x[1]["beats_law_refit"]
-            and x[1]["present"]
-        ]
-        if (
-            not good
-            and null_after
-            and criterion in null_after
-            and null_after[criterion] <= 0.9 * before[criterion]
-        ):
-            iterations.append(
-                Iteration(
-                    model,
-                    null.law,
-                    before,
-                    null_after,
-                    floor,
-                    loc,
-                    scores,
-                    None,
-                    f"no effect beats the law refitted alone ("
-                    f"{criterion} {before[criterion]:.3g} -> "
-                    f"{null_after[criterion]:.3g}) by its noise floor: the "
-                    "law is refitted, nothing is named",
-                    [],
-                    evs[0].simulated,
-                    null_evs[0].simulated,
-                    records[0][1].impulse,
-                )
-            )
-            model = null.law
-            uncertainties = dict(null.standard_errors)
-            continue
-        if not good:
-            iterations.append(
-                Iteration(
-                    model,
-                    model,
-                    before,
-                    before,
-                    floor,
-                    loc,
-                    scores,
-                    None,
-                    "no refit of a significant effect (or of one without a "
-                    f"score) lowers {criterion} by 10 %",
-                    [],
-                    evs[0].simulated,
-                    evs[0].simulated,
-                    records[0][1].impulse,
-                )
-            )
-            stopped = "the candidate effects do not shrink the gap when refitted"
-            break
-        good.sort(key=lambda x: x[0])
-        _, s, m2, res, evs2, key = good[0]
-        if res is not None and budget > screen:
-            # polish the winner with the full budget
-            try:
-                res2 = _output_error(records, m2, criterion, budget, tolerances, polish=True)
-                evs3 = problem.evaluations(res2.law, floor=True)
-                after3, _ = _with_drift(_mean(evs3, "criteria"), {}, drift, res2.law)
-                if (
-                    after3
-                    and after3[key] <= s["criteria_after"][key]
-                    and _in_bounds(eff_by_id[s["effect"]], res2.law)
-                    and _keeps_repulsive(res2.law, model, records)
-                ):
-                    m2, res, evs2 = res2.law, res2, evs3
-                    s["criteria_after"] = after3
-                    s["parameters"] = {
-                        p.name: m2.value(eff_by_id[s["effect"]])
-                        for p in eff_by_id[s["effect"]].parameters
-                    }
-            except (IntegrationError, InputError):
-                pass
-        if res is not None and not _present(eff_by_id[s["effect"]], m2, res):
-            # polished with the full budget, the effect's parameter is within 2 standard
-            # errors of 0: the gain was the law's own refit. Nothing is named; the model is
-            # the polished refit without the effect (the loop then screens again)
-            refit = _law_refit(
-                records, model, criterion, budget, tolerances, problem, drift, polish=True
-            )
-            if refit is not None and refit[1] and refit[1][key] < before[key]:
-                law_refit, after_law, evs_law = refit[0].law, refit[1], refit[2]
-                iterations.append(
-                    Iteration(
-                        model,
-                        law_refit,
-                        before,
-                        after_law,
-                        floor,
-                        loc,
-                        scores,
-                        None,
-                        f"{s['effect']} refitted with the full budget has its parameter within 2 "
-                        "standard errors of 0: the gain was the law's own refit "
-                        f"({key} {before[key]:.3g} -> {after_law[key]:.3g}); nothing is named",
-                        [],
-                        evs[0].simulated,
-                        evs_law[0].simulated,
-                        records[0][1].impulse,
-                    )
-                )
-                model = law_refit
-                continue
-        value = s["criteria_after"][key]
-        tol_eq = floor.get(key, 0.0)
-        equivalent = [
-            x[1]["effect"]
-            for x in good[1:]
-            if x[5] == key and x[1]["criteria_after"][key] <= value + tol_eq
-        ]
-        score = (
-            f"score test LM = {s['lm']:.3g} (p = {s['p']:.2g} < {level:.2g})"
-            if s["lm"] is not None
-            else "no score test (a small step of it changes the regime)"
-        )
-        evidence = (
-            f"{score}; refitted, "
-            f"{key} {before[key]:.3g} -> {value:.3g} (noise floor "
-            f"{floor.get(key, float('nan')):.3g}); signature "
-            f"{'agrees' if s['signature_agrees'] else 'does not agree'} with the "
-            f"localisation (largest shares: {', '.join(top_phases)})"
-        )
-        iterations.append(
-            Iteration(
-                model,
-                m2,
-                before,
-                s["criteria_after"],
-                floor,
-                loc,
-                scores,
-                s["effect"],
-                evidence,
-                equivalent,
-                evs[0].simulated,
-                evs2[0].simulated,
-                records[0][1].impulse,
-            )
-        )
-        model = m2
-        if res is not None:
-            uncertainties = dict(res.standard_errors)
-    evs = problem.evaluations(model, floor=True)
-    crit, floor = _with_drift(_mean(evs, "criteria"), _mean(evs, "noise_floor"), drift, model)
-    intervals = None
-    if n_boot_intervals:
-        try:
-            tick(progress, "explain: bootstrap intervals", 0, n_boot_intervals)
-            intervals = bootstrap_intervals(
-                [sc for sc, _ in records],
-                [r for _, r in records],
-                model,
-                n_boot=int(n_boot_intervals),
-                seed=seed,
-                criterion=criterion,
-                tolerances=tolerances,
-            )
-        except IntegrationError:
-            intervals = None
+    evs = problem.evaluations(run.model, floor=True)
+    crit, floor = _with_drift(
+        _mean(evs, "criteria"), _mean(evs, "noise_floor"), run.drift, run.model
+    )
     return ExplainResult(
-        intervals=intervals,
-        iterations=tuple(iterations),
-        final_model=model,
-        uncertainties=uncertainties,
+        intervals=_intervals(run, n_boot_intervals, seed, progress),
+        iterations=tuple(run.iterations),
+        final_model=run.model,
+        uncertainties=run.uncertainties,
         criteria=crit,
         noise_floor=floor,
-        consistent=all(e.consistent for e in evs)
-        and _drift_free(drift, model, records, alpha / max(len(catalogue), 1)),
-        stopped_because=stopped,
-        separability=tuple(separability),
+        consistent=all(e.consistent for e in evs) and run.drift_free(run.model),
+        stopped_because=run.stopped,
+        separability=tuple(run.separability),
         seconds=time.perf_counter() - t0,
         settings={
             "start": str(start),

@@ -162,34 +162,63 @@ def _scenario_value(value, source):
     return out
 
 
+def _number(v):
+    return isinstance(v, int | float) and not isinstance(v, bool)
+
+
+def _check_noise(name, value, source):
+    if not (_number(value) and 0 <= value < 1):
+        _fail(source, f"{name} values are fractions in [0, 1); got {value!r}")
+
+
+def _check_periods(name, value, source):
+    if not (isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= 10000):
+        _fail(source, f"periods values are whole numbers of drive periods; got {value!r}")
+
+
+def _check_fs(name, value, source):
+    if not (_number(value) and 0 < value <= 1e7 and math.isfinite(value)):
+        _fail(source, f"fs values are sample rates in Hz; got {value!r}")
+
+
+def _check_library(name, value, source):
+    if not isinstance(value, str):
+        _fail(source, f'library values are texts such as "poly:2"; got {value!r}')
+    Library.parse(value)
+
+
+def _check_selection(name, value, source):
+    if value not in SELECTIONS:
+        _fail(source, f"selection {value!r} is unknown; choose from {', '.join(SELECTIONS)}")
+
+
+def _check_refine(name, value, source):
+    if not isinstance(value, bool):
+        _fail(source, f"refine values are true or false; got {value!r}")
+
+
+def _check_law(name, value, source):
+    if not isinstance(value, str):
+        _fail(source, f'law values are texts such as "2e8*z + 1e7*zd"; got {value!r}')
+    ForceLaw.parse(value)
+
+
+_FACTOR_CHECKS = {
+    "force_noise": _check_noise,
+    "motion_noise": _check_noise,
+    "periods": _check_periods,
+    "fs": _check_fs,
+    "library": _check_library,
+    "selection": _check_selection,
+    "refine": _check_refine,
+    "law": _check_law,
+    "scenario": lambda name, value, source: _scenario_value(value, source),
+}
+
+
 def _check_factor(name, value, source):
     """One factor value, checked (the scenario and law are resolved later)."""
-    num = lambda v: isinstance(v, int | float) and not isinstance(v, bool)  # noqa: E731
-    if name in ("force_noise", "motion_noise"):
-        if not (num(value) and 0 <= value < 1):
-            _fail(source, f"{name} values are fractions in [0, 1); got {value!r}")
-    elif name == "periods":
-        if not (isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= 10000):
-            _fail(source, f"periods values are whole numbers of drive periods; got {value!r}")
-    elif name == "fs":
-        if not (num(value) and 0 < value <= 1e7 and math.isfinite(value)):
-            _fail(source, f"fs values are sample rates in Hz; got {value!r}")
-    elif name == "library":
-        if not isinstance(value, str):
-            _fail(source, f'library values are texts such as "poly:2"; got {value!r}')
-        Library.parse(value)
-    elif name == "selection":
-        if value not in SELECTIONS:
-            _fail(source, f"selection {value!r} is unknown; choose from {', '.join(SELECTIONS)}")
-    elif name == "refine":
-        if not isinstance(value, bool):
-            _fail(source, f"refine values are true or false; got {value!r}")
-    elif name == "law":
-        if not isinstance(value, str):
-            _fail(source, f'law values are texts such as "2e8*z + 1e7*zd"; got {value!r}')
-        ForceLaw.parse(value)
-    elif name == "scenario":
-        _scenario_value(value, source)
+    _FACTOR_CHECKS[name](name, value, source)
     return value
 
 
@@ -232,16 +261,8 @@ def _as_list(name, value, source):
     return value
 
 
-def study_from_mapping(data, source="<dict>"):
-    """Validate a parsed study file (see the module docstring)."""
-    if not isinstance(data, dict):
-        _fail(source, "must be a table of settings")
-    bad = sorted(set(data) - set(_TOP))
-    if bad:
-        _fail(source, f"unknown key(s) or table(s) {', '.join(bad)}; valid: {', '.join(_TOP)}")
-    name = data.get("name", Path(source).stem if source else "study")
-    if not isinstance(name, str) or not name.strip():
-        _fail(source, "name must be non-empty text")
+def _seeds(data, source):
+    """The study's seeds: a count or a list of distinct whole numbers."""
     seeds = data.get("seeds", 1)
     if isinstance(seeds, int) and not isinstance(seeds, bool):
         if not 1 <= seeds <= 100000:
@@ -255,6 +276,11 @@ def study_from_mapping(data, source="<dict>"):
         _fail(source, "seeds is a count (seeds = 3) or a list of whole numbers >= 0")
     if len(set(seeds)) != len(seeds):
         _fail(source, "seeds repeats a seed; each seed is one run per cell")
+    return seeds
+
+
+def _settings(data, source):
+    """The ``[fit]`` and ``[record]`` tables, checked, and the record's transient."""
     fit = data.get("fit", {})
     record = data.get("record", {})
     for tname, table, keys in (("fit", fit, _FIT_KEYS), ("record", record, _RECORD_KEYS)):
@@ -266,18 +292,12 @@ def study_from_mapping(data, source="<dict>"):
     tr = record.get("transient", "auto")
     if not (tr == "auto" or (isinstance(tr, int) and not isinstance(tr, bool) and 0 <= tr <= 5000)):
         _fail(source, f'[record] transient is "auto" or a number of periods; got {tr!r}')
-    factors = data.get("factors", {})
-    if not isinstance(factors, dict):
-        _fail(source, "[factors] must be a table")
-    extra = sorted(set(factors) - set(FACTORS))
-    if extra:
-        _fail(source, f"unknown factor(s) {', '.join(extra)}; valid: {', '.join(FACTORS)}")
-    levels = {
-        k: [_check_factor(k, v, source) for v in _as_list(k, factors[k], source)]
-        if k in factors
-        else [FACTORS[k]]
-        for k in FACTORS
-    }
+    return fit, record, tr
+
+
+def _cells(data, factors, levels, source):
+    """The study's cells (explicit ``[[rows]]`` or the product of the factors' levels) and
+    the factors that vary between them."""
     if "rows" in data:
         rows = data["rows"]
         if factors:
@@ -301,6 +321,34 @@ def study_from_mapping(data, source="<dict>"):
             dict(zip(FACTORS, combo, strict=True)) for combo in itertools.product(*levels.values())
         ]
         varied = tuple(k for k in FACTORS if len(levels[k]) > 1)
+    return cells, varied
+
+
+def study_from_mapping(data, source="<dict>"):
+    """Validate a parsed study file (see the module docstring)."""
+    if not isinstance(data, dict):
+        _fail(source, "must be a table of settings")
+    bad = sorted(set(data) - set(_TOP))
+    if bad:
+        _fail(source, f"unknown key(s) or table(s) {', '.join(bad)}; valid: {', '.join(_TOP)}")
+    name = data.get("name", Path(source).stem if source else "study")
+    if not isinstance(name, str) or not name.strip():
+        _fail(source, "name must be non-empty text")
+    seeds = _seeds(data, source)
+    fit, record, tr = _settings(data, source)
+    factors = data.get("factors", {})
+    if not isinstance(factors, dict):
+        _fail(source, "[factors] must be a table")
+    extra = sorted(set(factors) - set(FACTORS))
+    if extra:
+        _fail(source, f"unknown factor(s) {', '.join(extra)}; valid: {', '.join(FACTORS)}")
+    levels = {
+        k: [_check_factor(k, v, source) for v in _as_list(k, factors[k], source)]
+        if k in factors
+        else [FACTORS[k]]
+        for k in FACTORS
+    }
+    cells, varied = _cells(data, factors, levels, source)
     return StudyConfig(
         name=name,
         cells=tuple(cells),

@@ -200,6 +200,99 @@ def _pooled(records, cfg):
     return out
 
 
+def _write_config(out, cfg, version):
+    """``config.json``: the study as run (its cells, seeds and settings, the code version)."""
+    atomic_write_text(
+        out / "config.json",
+        json.dumps(
+            to_jsonable(
+                {
+                    "name": cfg.name,
+                    "source": cfg.source,
+                    "seeds": cfg.seeds,
+                    "fit": cfg.fit,
+                    "record": cfg.record,
+                    "varied": cfg.varied,
+                    "cells": cfg.cells,
+                    "code_version": version,
+                }
+            ),
+            indent=1,
+            allow_nan=True,
+        ),
+    )
+
+
+def _run_missing(todo, have, runs, rundir, version, workers, scheduler, executor, progress):
+    """Run ``todo`` on the executor, one file per finished run; returns the executor's name
+    and the number of runs done."""
+    own = executor is None
+    ex = make_executor(workers, scheduler) if own else executor
+    name = repr(ex)
+    try:
+        done = 0
+        tick(progress, "study: runs", len(have), len(runs))
+        for _, res in ex.run(run_one, todo):
+            res["code_version"] = version
+            atomic_write_text(
+                rundir / f"{res['key']}.json",
+                json.dumps(to_jsonable(res), indent=1, allow_nan=True),
+            )
+            done += 1
+            tick(progress, "study: runs", len(have) + done, len(runs))
+    finally:
+        if own:
+            ex.close()
+    return name, done
+
+
+def _write_tables(out, cfg, records):
+    """``cells.csv``, ``runs.csv`` and ``inclusion.csv`` from the run files; returns the
+    cells and the term inclusion per cell."""
+    cells, inclusion = aggregate(cfg, records)
+    rows = run_rows(cfg, records)
+    atomic_write_text(out / "cells.csv", to_csv(cells))
+    atomic_write_text(out / "runs.csv", to_csv(rows))
+    terms = sorted({t for inc in inclusion.values() for t in inc})
+    inc_rows = [
+        {**{f: c[f] for f in cfg.varied}, **{t: inclusion[i].get(t, 0.0) for t in terms}}
+        for i, c in enumerate(cells)
+    ]
+    atomic_write_text(out / "inclusion.csv", to_csv(inc_rows))
+    return cells, inclusion
+
+
+def _summary(cfg, runs, records, result, version, cells, workers, scheduler, max_runs):
+    """``summary.json`` of the study."""
+    return {
+        "command": "study",
+        "kind": "study",
+        "name": cfg.name,
+        "runs": len(runs),
+        "complete": len(records),
+        "executed": result.executed,
+        "reused": result.reused,
+        "executor": result.executor,
+        "code_version": version,
+        "design": _design(cfg),
+        "pooled": _pooled(records, cfg),
+        "cells": cells,
+        "seconds": result.seconds,
+        **provenance(
+            settings={
+                "config": cfg.source,
+                "fit": cfg.fit,
+                "record": cfg.record,
+                "seeds": list(cfg.seeds),
+                "workers": workers,
+                "scheduler": scheduler,
+                "max_runs": max_runs,
+            },
+            inputs={"config": cfg.source} if os.path.isfile(cfg.source) else None,
+        ),
+    }
+
+
 @params(
     config=(Text(), os.PathLike, dict, StudyConfig),
     out=(Text(), os.PathLike),
@@ -256,57 +349,16 @@ def study(
     rundir = out / "runs"
     rundir.mkdir(parents=True, exist_ok=True)
     _write_manifest(out, ["runs", "config.json"])
-    atomic_write_text(
-        out / "config.json",
-        json.dumps(
-            to_jsonable(
-                {
-                    "name": cfg.name,
-                    "source": cfg.source,
-                    "seeds": cfg.seeds,
-                    "fit": cfg.fit,
-                    "record": cfg.record,
-                    "varied": cfg.varied,
-                    "cells": cfg.cells,
-                    "code_version": version,
-                }
-            ),
-            indent=1,
-            allow_nan=True,
-        ),
-    )
+    _write_config(out, cfg, version)
     have = {r["key"] for r in runs if _read_run(rundir / f"{r['key']}.json") is not None}
     todo = [r for r in runs if r["key"] not in have]
     if max_runs is not None:
         todo = todo[: int(max_runs)]
-    own = executor is None
-    ex = make_executor(workers, scheduler) if own else executor
-    name = repr(ex)
-    try:
-        done = 0
-        tick(progress, "study: runs", len(have), len(runs))
-        for _, res in ex.run(run_one, todo):
-            res["code_version"] = version
-            atomic_write_text(
-                rundir / f"{res['key']}.json",
-                json.dumps(to_jsonable(res), indent=1, allow_nan=True),
-            )
-            done += 1
-            tick(progress, "study: runs", len(have) + done, len(runs))
-    finally:
-        if own:
-            ex.close()
+    name, done = _run_missing(
+        todo, have, runs, rundir, version, workers, scheduler, executor, progress
+    )
     records = [rec for r in runs if (rec := _read_run(rundir / f"{r['key']}.json")) is not None]
-    cells, inclusion = aggregate(cfg, records)
-    rows = run_rows(cfg, records)
-    atomic_write_text(out / "cells.csv", to_csv(cells))
-    atomic_write_text(out / "runs.csv", to_csv(rows))
-    terms = sorted({t for inc in inclusion.values() for t in inc})
-    inc_rows = [
-        {**{f: c[f] for f in cfg.varied}, **{t: inclusion[i].get(t, 0.0) for t in terms}}
-        for i, c in enumerate(cells)
-    ]
-    atomic_write_text(out / "inclusion.csv", to_csv(inc_rows))
+    cells, inclusion = _write_tables(out, cfg, records)
     paths = ()
     if figures and records:
         from reports.study_figures import study_figures
@@ -326,33 +378,7 @@ def study(
         executor=name,
         figures=paths,
     )
-    summary = {
-        "command": "study",
-        "kind": "study",
-        "name": cfg.name,
-        "runs": len(runs),
-        "complete": len(records),
-        "executed": done,
-        "reused": len(have),
-        "executor": name,
-        "code_version": version,
-        "design": _design(cfg),
-        "pooled": _pooled(records, cfg),
-        "cells": cells,
-        "seconds": result.seconds,
-        **provenance(
-            settings={
-                "config": cfg.source,
-                "fit": cfg.fit,
-                "record": cfg.record,
-                "seeds": list(cfg.seeds),
-                "workers": workers,
-                "scheduler": scheduler,
-                "max_runs": max_runs,
-            },
-            inputs={"config": cfg.source} if os.path.isfile(cfg.source) else None,
-        ),
-    }
+    summary = _summary(cfg, runs, records, result, version, cells, workers, scheduler, max_runs)
     atomic_write_text(
         out / "summary.json", json.dumps(to_jsonable(summary), indent=1, allow_nan=True)
     )
