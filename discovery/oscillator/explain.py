@@ -364,6 +364,203 @@ def _model_dict(m):
     return {**m.as_dict(), "equation": str(m.sympy())}
 
 
+def _check_settings(alpha, max_iterations, order, noise):
+    """The settings :func:`explain` checks beyond their types."""
+    if not (0 < alpha < 1):
+        raise InputError(f"alpha must be in (0, 1); got {alpha!r}")
+    if (
+        isinstance(max_iterations, bool)
+        or not isinstance(max_iterations, int | np.integer)
+        or max_iterations < 0
+    ):
+        raise InputError(f"max_iterations must be an integer >= 0; got {max_iterations!r}")
+    if int(order) < 2:
+        raise InputError(f"order must be >= 2, got {order}")
+    if noise is not None and not (np.isfinite(noise) and noise >= 0):
+        raise InputError(f"noise must be a finite fraction >= 0, got {noise}")
+
+
+class _Measure:
+    """The criteria of a fit: its weak-form residual and, with ``simulate``, its
+    verification by simulation against the record (:func:`verify`)."""
+
+    def __init__(self, weak, t, x, sm, simulate, verify_kwargs):
+        self.weak, self.t, self.x, self.sm = weak, t, x, sm
+        self.simulate, self.verify_kwargs = simulate, verify_kwargs
+
+    def __call__(self, fit):
+        crit = {"residual_rms": self.weak.residual_rms(fit)}
+        if not self.simulate:
+            return crit, None
+        v = verify(fit.model, self.t, self.x, smoothed=self.sm, **self.verify_kwargs)
+        crit.update(
+            {
+                "energy_distance": v.energy_distance,
+                "floor_q95": v.floor_q95,
+                "energy_consistent": v.energy_consistent,
+                "regime_record": v.regime_record,
+                "regime_model": v.regime_model,
+                "regime_agrees": v.regime_agrees,
+                "lyapunov": v.lyapunov,
+                "consistent": v.consistent,
+                "diverged": v.diverged,
+            }
+        )
+        return crit, v
+
+
+def _floor(weak, sm, ver):
+    """The noise floors the criteria are judged against."""
+    floor = {
+        "residual_rms": weak.noise_rms / weak.b_rms,
+        "noise_sd": sm.noise_sd,
+        "noise_fraction_of_range": sm.noise_sd / float(np.ptp(sm.x)),
+    }
+    if ver is not None:
+        floor.update(
+            {"energy_distance_q95": ver.floor_q95, "energy_distance_median": ver.floor_median}
+        )
+    return floor
+
+
+class _Loop:
+    """The loop of :func:`explain`: score the catalogue's effects not in the model, add the
+    most significant one within its bounds, refit, measure; stop when none is significant or
+    the budget of additions is used."""
+
+    def __init__(
+        self, weak, measure, catalogue, alpha, max_iterations, simulate, terms, fit, crit, ver
+    ):
+        self.weak, self.measure, self.catalogue = weak, measure, catalogue
+        self.alpha, self.max_iterations, self.simulate = alpha, max_iterations, simulate
+        self.terms, self.fit, self.crit, self.ver = terms, fit, crit, ver
+        self.iterations, self.stopped = [], ""
+
+    def run(self):
+        while True:
+            cands = [e for e in self.catalogue if not set(e.terms) & set(self.terms)]
+            if not cands:
+                self.stopped = "every catalogue effect is already in the model"
+                return
+            scores, gate, eligible, out_of_bounds = self._scores(cands)
+            if not eligible or len(self.iterations) >= self.max_iterations:
+                self._stop(scores, gate, eligible, out_of_bounds)
+                return
+            self._add(cands, scores, gate, eligible)
+
+    def _scores(self, cands):
+        """Score tests of the candidate effects at the current fit (Bonferroni gate)."""
+        scores = [self.weak.score(self.fit, e) for e in cands]
+        gate = self.alpha / len(scores)
+        for s, e in zip(scores, cands, strict=True):
+            s["significant"] = bool(s["p"] < gate)
+            s["in_bounds"] = in_bounds(e, [s["direction"][n] for n in e.terms])
+        eligible = sorted(
+            (s for s in scores if s["significant"] and s["in_bounds"]), key=lambda s: -s["share"]
+        )
+        out_of_bounds = [s["effect"] for s in scores if s["significant"] and not s["in_bounds"]]
+        return scores, gate, eligible, out_of_bounds
+
+    def _stop(self, scores, gate, eligible, out_of_bounds):
+        """The last iteration: nothing (more) is named, and why."""
+        state = (
+            "the model is consistent with the record"
+            if self.crit.get("consistent")
+            else "the model is still inconsistent with the record: the catalogue does not "
+            "explain the rest (the coefficients' uncertainty or an effect outside the "
+            "catalogue may)"
+            if self.simulate
+            else "the gap was not simulated"
+        )
+        if eligible:
+            text = (
+                f"the budget of {self.max_iterations} added effect(s) is used; still "
+                f"significant: {', '.join(s['effect'] for s in eligible)}"
+            )
+        else:
+            text = (
+                f"no catalogue effect is significant (score tests at family-wise "
+                f"level {self.alpha:g}, gate {gate:.2g} for {len(scores)} effects)"
+            )
+            if out_of_bounds:
+                text += "; significant but outside its physical bounds (not named): " + ", ".join(
+                    out_of_bounds
+                )
+        fit, crit, ver = self.fit, self.crit, self.ver
+        self.iterations.append(
+            Iteration(None, {"text": text}, scores, crit, crit, {}, fit.model, fit.model, ver, ver)
+        )
+        self.stopped = f"{text}; {state}"
+
+    def _equivalent(self, eff, cands, eligible, fit2, gate):
+        """Confounded alternatives: significant effects that, added instead, would leave
+        the named one insignificant while they are insignificant beside it."""
+        weak, terms = self.weak, self.terms
+        equivalent = []
+        after = {e.id: weak.score(fit2, e) for e in cands if e is not eff}
+        for s in eligible[1:]:
+            alt = next(e for e in cands if e.id == s["effect"])
+            alt_fit = weak.fit(tuple(sorted(set(terms) | set(alt.terms), key=TERMS.index)))
+            if after[alt.id]["p"] >= gate and weak.score(alt_fit, eff)["p"] >= gate:
+                equivalent.append(alt.id)
+        return equivalent
+
+    def _add(self, cands, scores, gate, eligible):
+        """Name the most significant effect within its bounds, refit and measure."""
+        weak, crit = self.weak, self.crit
+        best = eligible[0]
+        eff = next(e for e in cands if e.id == best["effect"])
+        new_terms = tuple(sorted(set(self.terms) | set(eff.terms), key=TERMS.index))
+        fit2 = weak.fit(new_terms)
+        crit2, ver2 = self.measure(fit2)
+        params = weak.parameters(fit2, eff.terms)
+        equivalent = self._equivalent(eff, cands, eligible, fit2, gate)
+        text = (
+            f"score test LM = {best['lm']:.4g} (p = {best['p']:.2g} < gate {gate:.2g}, "
+            f"alpha {self.alpha:g} over {len(scores)} effects); its term explains "
+            f"{100 * best['share']:.1f} % of the weak-form residual; refitted "
+            + ", ".join(f"{n} {p['value']:.4g} +- {p['stderr']:.2g}" for n, p in params.items())
+            + f"; residual {crit['residual_rms']:.3g} -> {crit2['residual_rms']:.3g} "
+            f"(noise floor {weak.noise_rms / weak.b_rms:.3g})"
+        )
+        if self.simulate:
+            text += (
+                f"; energy distance {crit['energy_distance']:.3g} -> "
+                f"{crit2['energy_distance']:.3g} (floor q95 {crit2['floor_q95']:.3g}), "
+                f"regime {crit['regime_model']} -> {crit2['regime_model']} (record "
+                f"{crit2['regime_record']})"
+            )
+        if equivalent:
+            text += (
+                "; the record cannot tell it from "
+                + ", ".join(equivalent)
+                + " (each, added, leaves the other insignificant)"
+            )
+        evidence = {
+            "lm": best["lm"],
+            "p": best["p"],
+            "gate": gate,
+            "share": best["share"],
+            "text": text,
+        }
+        self.iterations.append(
+            Iteration(
+                eff.id,
+                evidence,
+                scores,
+                crit,
+                crit2,
+                params,
+                self.fit.model,
+                fit2.model,
+                self.ver,
+                ver2,
+                equivalent,
+            )
+        )
+        self.terms, self.fit, self.crit, self.ver = new_terms, fit2, crit2, ver2
+
+
 @params(
     t=Array(1),
     x=Array(1),
@@ -431,14 +628,7 @@ def explain(
     Explanation
     """
     t_start = time.perf_counter()
-    if not (0 < alpha < 1):
-        raise InputError(f"alpha must be in (0, 1); got {alpha!r}")
-    if (
-        isinstance(max_iterations, bool)
-        or not isinstance(max_iterations, int | np.integer)
-        or max_iterations < 0
-    ):
-        raise InputError(f"max_iterations must be an integer >= 0; got {max_iterations!r}")
+    _check_settings(alpha, max_iterations, order, noise)
     start = parse_terms(start_terms)
     catalogue = select(EFFECTS, effects)
     t, x, spp = _record_forcing(t, x, B, nu)
@@ -449,166 +639,29 @@ def explain(
             f"the record ({t.size} samples) is too short for test windows of "
             f"{2 * hs + 1} samples; record more periods"
         )
-    if int(order) < 2:
-        raise InputError(f"order must be >= 2, got {order}")
     sm = smooth(t, x, spp)
     if noise is not None:
-        if not (np.isfinite(noise) and noise >= 0):
-            raise InputError(f"noise must be a finite fraction >= 0, got {noise}")
         sm = replace(sm, noise_sd=float(noise * np.ptp(x)))
     weak = _Weak(t, x, B, nu, hs, int(order), fit_forcing, sm)
-
-    def measure(fit):
-        crit = {"residual_rms": weak.residual_rms(fit)}
-        if not simulate:
-            return crit, None
-        v = verify(
-            fit.model,
-            t,
-            x,
-            smoothed=sm,
+    measure = _Measure(
+        weak,
+        t,
+        x,
+        sm,
+        simulate,
+        dict(
             transient=transient,
             periods=periods,
             resamples=resamples,
             seed=seed,
             tolerances=tolerances,
-        )
-        crit.update(
-            {
-                "energy_distance": v.energy_distance,
-                "floor_q95": v.floor_q95,
-                "energy_consistent": v.energy_consistent,
-                "regime_record": v.regime_record,
-                "regime_model": v.regime_model,
-                "regime_agrees": v.regime_agrees,
-                "lyapunov": v.lyapunov,
-                "consistent": v.consistent,
-                "diverged": v.diverged,
-            }
-        )
-        return crit, v
-
-    terms = start
-    fit = weak.fit(terms)
+        ),
+    )
+    fit = weak.fit(start)
     crit, ver = measure(fit)
-    start_fit, crit_start, ver_start = fit, crit, ver
-    iterations = []
-    stopped = ""
-    while True:
-        cands = [e for e in catalogue if not set(e.terms) & set(terms)]
-        if not cands:
-            stopped = "every catalogue effect is already in the model"
-            break
-        scores = [weak.score(fit, e) for e in cands]
-        gate = alpha / len(scores)
-        for s, e in zip(scores, cands, strict=True):
-            s["significant"] = bool(s["p"] < gate)
-            s["in_bounds"] = in_bounds(e, [s["direction"][n] for n in e.terms])
-        eligible = sorted(
-            (s for s in scores if s["significant"] and s["in_bounds"]), key=lambda s: -s["share"]
-        )
-        out_of_bounds = [s["effect"] for s in scores if s["significant"] and not s["in_bounds"]]
-        state = (
-            "the model is consistent with the record"
-            if crit.get("consistent")
-            else "the model is still inconsistent with the record: the catalogue does not "
-            "explain the rest (the coefficients' uncertainty or an effect outside the "
-            "catalogue may)"
-            if simulate
-            else "the gap was not simulated"
-        )
-        if not eligible or len(iterations) >= max_iterations:
-            if eligible:
-                text = (
-                    f"the budget of {max_iterations} added effect(s) is used; still "
-                    f"significant: {', '.join(s['effect'] for s in eligible)}"
-                )
-            else:
-                text = (
-                    f"no catalogue effect is significant (score tests at family-wise "
-                    f"level {alpha:g}, gate {gate:.2g} for {len(scores)} effects)"
-                )
-                if out_of_bounds:
-                    text += (
-                        "; significant but outside its physical bounds (not named): "
-                        + ", ".join(out_of_bounds)
-                    )
-            iterations.append(
-                Iteration(
-                    None, {"text": text}, scores, crit, crit, {}, fit.model, fit.model, ver, ver
-                )
-            )
-            stopped = f"{text}; {state}"
-            break
-        best = eligible[0]
-        eff = next(e for e in cands if e.id == best["effect"])
-        new_terms = tuple(sorted(set(terms) | set(eff.terms), key=TERMS.index))
-        fit2 = weak.fit(new_terms)
-        crit2, ver2 = measure(fit2)
-        params = weak.parameters(fit2, eff.terms)
-        # confounded alternatives: significant effects that, added instead, would leave
-        # the named one insignificant while they are insignificant beside it
-        equivalent = []
-        after = {e.id: weak.score(fit2, e) for e in cands if e is not eff}
-        for s in eligible[1:]:
-            alt = next(e for e in cands if e.id == s["effect"])
-            alt_fit = weak.fit(tuple(sorted(set(terms) | set(alt.terms), key=TERMS.index)))
-            if after[alt.id]["p"] >= gate and weak.score(alt_fit, eff)["p"] >= gate:
-                equivalent.append(alt.id)
-        text = (
-            f"score test LM = {best['lm']:.4g} (p = {best['p']:.2g} < gate {gate:.2g}, "
-            f"alpha {alpha:g} over {len(scores)} effects); its term explains "
-            f"{100 * best['share']:.1f} % of the weak-form residual; refitted "
-            + ", ".join(f"{n} {p['value']:.4g} +- {p['stderr']:.2g}" for n, p in params.items())
-            + f"; residual {crit['residual_rms']:.3g} -> {crit2['residual_rms']:.3g} "
-            f"(noise floor {weak.noise_rms / weak.b_rms:.3g})"
-        )
-        if simulate:
-            text += (
-                f"; energy distance {crit['energy_distance']:.3g} -> "
-                f"{crit2['energy_distance']:.3g} (floor q95 {crit2['floor_q95']:.3g}), "
-                f"regime {crit['regime_model']} -> {crit2['regime_model']} (record "
-                f"{crit2['regime_record']})"
-            )
-        if equivalent:
-            text += (
-                "; the record cannot tell it from "
-                + ", ".join(equivalent)
-                + " (each, added, leaves the other insignificant)"
-            )
-        evidence = {
-            "lm": best["lm"],
-            "p": best["p"],
-            "gate": gate,
-            "share": best["share"],
-            "text": text,
-        }
-        iterations.append(
-            Iteration(
-                eff.id,
-                evidence,
-                scores,
-                crit,
-                crit2,
-                params,
-                fit.model,
-                fit2.model,
-                ver,
-                ver2,
-                equivalent,
-            )
-        )
-        terms, fit, crit, ver = new_terms, fit2, crit2, ver2
-    coef, se = weak.coefficients(fit)
-    floor = {
-        "residual_rms": weak.noise_rms / weak.b_rms,
-        "noise_sd": sm.noise_sd,
-        "noise_fraction_of_range": sm.noise_sd / float(np.ptp(sm.x)),
-    }
-    if ver is not None:
-        floor.update(
-            {"energy_distance_q95": ver.floor_q95, "energy_distance_median": ver.floor_median}
-        )
+    loop = _Loop(weak, measure, catalogue, alpha, max_iterations, simulate, start, fit, crit, ver)
+    loop.run()
+    coef, se = weak.coefficients(loop.fit)
     settings = {
         "alpha": alpha,
         "max_iterations": int(max_iterations),
@@ -630,20 +683,20 @@ def explain(
         "simulation (verify)",
     }
     return Explanation(
-        iterations=tuple(iterations),
-        start_model=start_fit.model,
-        final_model=fit.model,
+        iterations=tuple(loop.iterations),
+        start_model=fit.model,
+        final_model=loop.fit.model,
         start_terms=start,
-        final_terms=terms,
+        final_terms=loop.terms,
         coefficients=coef,
         standard_errors=se,
-        criteria_start=crit_start,
-        criteria=crit,
-        noise_floor=floor,
-        consistent=crit.get("consistent"),
-        stopped_because=stopped,
+        criteria_start=crit,
+        criteria=loop.crit,
+        noise_floor=_floor(weak, sm, loop.ver),
+        consistent=loop.crit.get("consistent"),
+        stopped_because=loop.stopped,
         seconds=time.perf_counter() - t_start,
         settings=settings,
-        start_verification=ver_start,
-        final_verification=ver,
+        start_verification=ver,
+        final_verification=loop.ver,
     )
