@@ -11,7 +11,7 @@ system (:mod:`discovery.dynamics._dopri`).
 * :class:`UedaMap`, :func:`periodic_orbit`, :class:`PeriodicOrbit` - the period map,
   shooting and Floquet multipliers (:mod:`discovery.dynamics.shooting`, shared with the
   vibro-impact system) - :mod:`.periodic`;
-* :func:`chart` - the regime chart over ``(nu, B)`` in parallel processes;
+* :func:`chart` -> :class:`Chart` - the regime chart over ``(nu, B)`` in parallel processes;
 * :func:`discover` (equation discovery from a record ``t, x`` with known forcing) and
   :func:`verify` (the discovered equation's attractor against the record's),
   :class:`ForcedPolynomial`, :func:`simulate_record` - :mod:`.discover`;
@@ -19,53 +19,43 @@ system (:mod:`discovery.dynamics._dopri`).
   system's catalogue :data:`EFFECTS` - :mod:`.explain`, :mod:`.effects`.
 """
 
-from .attractor import (
-    Attractor,
-    Basins,
-    Lyapunov,
-    Regime,
-    attractor,
-    basins,
-    classify,
-    classify_points,
-    lyapunov,
-    lyapunov_two_trajectory,
-    rotation_number,
-    strobe_points,
-    trajectory,
-)
-from .discover import Discovery, ForcedPolynomial, Verification, discover, simulate_record, verify
-from .effects import EFFECTS
-from .explain import Explanation, explain
-from .periodic import PeriodicOrbit, UedaMap, periodic_orbit
-from .system import MODELS, UedaSystem
+from .._lazy import lazy_package
 
-__all__ = [
-    "UedaSystem",
-    "MODELS",
-    "Attractor",
-    "Basins",
-    "Lyapunov",
-    "Regime",
-    "attractor",
-    "basins",
-    "classify",
-    "classify_points",
-    "lyapunov",
-    "lyapunov_two_trajectory",
-    "rotation_number",
-    "strobe_points",
-    "trajectory",
-    "Discovery",
-    "ForcedPolynomial",
-    "Verification",
-    "discover",
-    "simulate_record",
-    "verify",
-    "UedaMap",
-    "PeriodicOrbit",
-    "periodic_orbit",
-    "EFFECTS",
-    "Explanation",
-    "explain",
-]
+# names are imported on first use; a function named like its module (chart, discover,
+# explain) stays the function
+_EXPORTS = {
+    "Attractor": "attractor",
+    "Basins": "attractor",
+    "Lyapunov": "attractor",
+    "Regime": "attractor",
+    "attractor": "attractor",
+    "basins": "attractor",
+    "classify": "attractor",
+    "classify_points": "attractor",
+    "lyapunov": "attractor",
+    "lyapunov_two_trajectory": "attractor",
+    "rotation_number": "attractor",
+    "strobe_points": "attractor",
+    "trajectory": "attractor",
+    "Chart": "chart",
+    "chart": "chart",
+    "KINDS": "chart",
+    "Discovery": "discover",
+    "ForcedPolynomial": "discover",
+    "Verification": "discover",
+    "discover": "discover",
+    "simulate_record": "discover",
+    "verify": "discover",
+    "EFFECTS": "effects",
+    "Explanation": "explain",
+    "explain": "explain",
+    "PeriodicOrbit": "periodic",
+    "UedaMap": "periodic",
+    "periodic_orbit": "periodic",
+    "MODELS": "system",
+    "UedaSystem": "system",
+}
+
+__all__ = list(_EXPORTS)
+
+lazy_package(__name__, _EXPORTS)

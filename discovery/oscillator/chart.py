@@ -595,6 +595,94 @@ def _axis(values, name):
     return a
 
 
+def _check_chart(
+    system, nu, B, workers, max_period, transient, periods, sweeps, recheck, min_pairs
+):
+    """The settings :func:`chart` checks beyond their types; returns the axes."""
+    if not isinstance(system, UedaSystem):
+        raise VidiTypeError("system must be a discovery.oscillator.UedaSystem")
+    nu, B = _axis(nu, "nu"), _axis(B, "B")
+    if nu[0] <= 0:
+        raise InputError("nu must be > 0")
+    if workers is not None and int(workers) < 1:
+        raise InputError(f"workers must be at least 1, got {workers!r}")
+    if int(max_period) < 1:
+        raise InputError(f"max_period must be at least 1, got {max_period!r}")
+    if int(transient) < 0:
+        raise InputError(f"transient must be >= 0, got {transient!r}")
+    if int(periods) < 4 * int(max_period):
+        raise InputError(
+            f"periods ({int(periods)}) must be at least 4 x max_period = "
+            f"{4 * int(max_period)}: the recurrence test of period n compares "
+            "three cycles of strobe points with the cycle before"
+        )
+    if int(sweeps) not in (1, 2):
+        raise InputError(f"sweeps must be 1 or 2, got {sweeps!r}")
+    if int(recheck) < 0:
+        raise InputError(f"recheck must be >= 0, got {recheck!r}")
+    if int(min_pairs) < 1:
+        raise InputError(f"min_pairs must be at least 1, got {min_pairs!r}")
+    return nu, B
+
+
+def _run_rows(system, settings, nu, B, workers, executor, progress):
+    """Every row of ``B`` on the executor (one task per row): the chart's grids (regime,
+    period, exponent, rotation, cost, and the second sweep's), the CPU seconds and the
+    workers used."""
+    workers = min(int(workers or os.cpu_count() or 1), B.size)
+    shape = (B.size, nu.size)
+    kind = np.full(shape, -1, dtype=int)
+    period = np.zeros(shape, dtype=int)
+    lam = np.full(shape, np.nan)
+    rot = np.full(shape, np.nan)
+    cost = np.zeros(shape, dtype=int)
+    two = settings["sweeps"] == 2
+    if two:
+        kind2, period2 = kind.copy(), period.copy()
+        lam2, rot2 = lam.copy(), rot.copy()
+        coex = np.zeros(shape, dtype=bool)
+    jobs = [(b, nu) for b in B]
+    cpu = 0.0
+    own = executor is None
+    ex = make_executor(workers) if own else executor
+    try:
+        for done, (i, (up, down, cx, sec)) in enumerate(
+            ex.run(_row, jobs, (system, settings)), start=1
+        ):
+            cpu += sec
+            for j, (k, n, lv, r, c) in enumerate(up):
+                kind[i, j], period[i, j], lam[i, j], rot[i, j], cost[i, j] = k, n, lv, r, c
+            if two:
+                for j, (k, n, lv, r, c) in enumerate(down):
+                    kind2[i, j], period2[i, j], lam2[i, j], rot2[i, j] = k, n, lv, r
+                    cost[i, j] += c
+                coex[i] = cx
+            if progress is not None:
+                progress(done, len(jobs))
+    finally:
+        if own:
+            ex.close()
+    workers = min(ex.workers, len(jobs))
+    extra = {}
+    if two:
+        extra = {
+            "kind_down": kind2,
+            "period_down": period2,
+            "lyapunov_down": lam2,
+            "rotation_down": rot2,
+            "coexisting": coex,
+        }
+    grids = {
+        "kind": kind,
+        "period": period,
+        "lyapunov": lam,
+        "rotation": rot,
+        "periods_integrated": cost,
+        **extra,
+    }
+    return grids, cpu, workers
+
+
 @params(
     system=UedaSystem,
     nu=Array(1),
@@ -675,29 +763,9 @@ def chart(
     -------
     Chart
     """
-    if not isinstance(system, UedaSystem):
-        raise VidiTypeError("system must be a discovery.oscillator.UedaSystem")
-    nu, B = _axis(nu, "nu"), _axis(B, "B")
-    if nu[0] <= 0:
-        raise InputError("nu must be > 0")
-    if workers is not None and int(workers) < 1:
-        raise InputError(f"workers must be at least 1, got {workers!r}")
-    if int(max_period) < 1:
-        raise InputError(f"max_period must be at least 1, got {max_period!r}")
-    if int(transient) < 0:
-        raise InputError(f"transient must be >= 0, got {transient!r}")
-    if int(periods) < 4 * int(max_period):
-        raise InputError(
-            f"periods ({int(periods)}) must be at least 4 x max_period = "
-            f"{4 * int(max_period)}: the recurrence test of period n compares "
-            "three cycles of strobe points with the cycle before"
-        )
-    if int(sweeps) not in (1, 2):
-        raise InputError(f"sweeps must be 1 or 2, got {sweeps!r}")
-    if int(recheck) < 0:
-        raise InputError(f"recheck must be >= 0, got {recheck!r}")
-    if int(min_pairs) < 1:
-        raise InputError(f"min_pairs must be at least 1, got {min_pairs!r}")
+    nu, B = _check_chart(
+        system, nu, B, workers, max_period, transient, periods, sweeps, recheck, min_pairs
+    )
     settings = {
         "transient": int(transient),
         "periods": int(periods),
@@ -718,62 +786,15 @@ def chart(
             else ""
         ),
     }
-    workers = min(int(workers or os.cpu_count() or 1), B.size)
-    shape = (B.size, nu.size)
-    kind = np.full(shape, -1, dtype=int)
-    period = np.zeros(shape, dtype=int)
-    lam = np.full(shape, np.nan)
-    rot = np.full(shape, np.nan)
-    cost = np.zeros(shape, dtype=int)
-    two = int(sweeps) == 2
-    if two:
-        kind2, period2 = kind.copy(), period.copy()
-        lam2, rot2 = lam.copy(), rot.copy()
-        coex = np.zeros(shape, dtype=bool)
-    jobs = [(b, nu) for b in B]
-    cpu = 0.0
     t_start = time.perf_counter()
-    own = executor is None
-    ex = make_executor(workers) if own else executor
-    try:
-        for done, (i, (up, down, cx, sec)) in enumerate(
-            ex.run(_row, jobs, (system, settings)), start=1
-        ):
-            cpu += sec
-            for j, (k, n, lv, r, c) in enumerate(up):
-                kind[i, j], period[i, j], lam[i, j], rot[i, j], cost[i, j] = k, n, lv, r, c
-            if two:
-                for j, (k, n, lv, r, c) in enumerate(down):
-                    kind2[i, j], period2[i, j], lam2[i, j], rot2[i, j] = k, n, lv, r
-                    cost[i, j] += c
-                coex[i] = cx
-            if progress is not None:
-                progress(done, len(jobs))
-    finally:
-        if own:
-            ex.close()
-    workers = min(ex.workers, len(jobs))
-    extra = {}
-    if two:
-        extra = {
-            "kind_down": kind2,
-            "period_down": period2,
-            "lyapunov_down": lam2,
-            "rotation_down": rot2,
-            "coexisting": coex,
-        }
+    grids, cpu, workers = _run_rows(system, settings, nu, B, workers, executor, progress)
     return Chart(
         system=system,
         nu=nu,
         B=B,
-        kind=kind,
-        period=period,
-        lyapunov=lam,
-        rotation=rot,
         seconds=time.perf_counter() - t_start,
         workers=workers,
         settings=settings,
-        periods_integrated=cost,
         cpu_seconds=cpu,
-        **extra,
+        **grids,
     )

@@ -707,6 +707,32 @@ def _record_forcing(t, x, B, nu):
     return t, x, spp
 
 
+def _block_bootstrap(G, bn, sb, sup, keep, centres, block_span, threshold, bootstrap, seed, ols_se):
+    """Standard errors by a block bootstrap: blocks of consecutive windows spanning
+    ``block_span`` time; the normal equations of each block are summed over a resample of
+    blocks.  Returns ``(standard errors, selection frequency per term, number of blocks,
+    whether it ran)``; with fewer than 4 blocks (or ``bootstrap = 0``) the least-squares
+    standard errors."""
+    block = np.floor((centres - centres[0]) / block_span).astype(int)
+    n_blocks = int(block.max()) + 1
+    chosen = np.zeros(G.shape[1])
+    if not (bool(bootstrap) and n_blocks >= 4):
+        return ols_se, chosen, n_blocks, False
+    A_k = np.array([G[block == k].T @ G[block == k] for k in range(n_blocks)])
+    c_k = np.array([G[block == k].T @ bn[block == k] for k in range(n_blocks)])
+    n_k = np.bincount(block, minlength=n_blocks)
+    rng = np.random.default_rng(seed)
+    out = []
+    ix = np.ix_(sup, sup)
+    for _ in range(int(bootstrap)):
+        pick = np.bincount(rng.integers(0, n_blocks, n_blocks), minlength=n_blocks)
+        A = np.tensordot(pick, A_k, axes=1)
+        cc = pick @ c_k
+        out.append(np.linalg.lstsq(A[ix], cc[sup], rcond=None)[0] * sb)
+        chosen += _stlsq_gram(A, cc, int(pick @ n_k), threshold, keep)[1]
+    return np.array(out).std(axis=0, ddof=1), chosen / int(bootstrap), n_blocks, True
+
+
 @params(
     t=Array(1),
     x=Array(1),
@@ -793,31 +819,11 @@ def discover(
     n_rows, p = Gs.shape
     sigma2 = float(r @ r) / max(1, n_rows - p)
     ols_se = np.sqrt(np.diag(sigma2 * np.linalg.pinv(Gs.T @ Gs)))
-    # block bootstrap: blocks of consecutive windows spanning block_periods periods; the
-    # normal equations of each block are summed over a resample of blocks
-    block = np.floor((centres - centres[0]) / (block_periods * T)).astype(int)
-    n_blocks = int(block.max()) + 1
     names = [TERMS[k] if k < nt else FORCING for k in range(G.shape[1])]
     sel = np.flatnonzero(sup)
-    chosen = np.zeros(G.shape[1])
-    do_boot = bool(bootstrap) and n_blocks >= 4
-    if do_boot:
-        A_k = np.array([G[block == k].T @ G[block == k] for k in range(n_blocks)])
-        c_k = np.array([G[block == k].T @ bn[block == k] for k in range(n_blocks)])
-        n_k = np.bincount(block, minlength=n_blocks)
-        rng = np.random.default_rng(seed)
-        out = []
-        ix = np.ix_(sup, sup)
-        for _ in range(int(bootstrap)):
-            pick = np.bincount(rng.integers(0, n_blocks, n_blocks), minlength=n_blocks)
-            A = np.tensordot(pick, A_k, axes=1)
-            cc = pick @ c_k
-            out.append(np.linalg.lstsq(A[ix], cc[sup], rcond=None)[0] * sb)
-            chosen += _stlsq_gram(A, cc, int(pick @ n_k), threshold, keep)[1]
-        se = np.array(out).std(axis=0, ddof=1)
-        chosen /= int(bootstrap)
-    else:
-        se = ols_se
+    se, chosen, n_blocks, do_boot = _block_bootstrap(
+        G, bn, sb, sup, keep, centres, block_periods * T, threshold, bootstrap, seed, ols_se
+    )
     coef = dict(zip([names[k] for k in sel], map(float, c[sel]), strict=True))
     ses = dict(zip([names[k] for k in sel], map(float, se), strict=True))
     oses = dict(zip([names[k] for k in sel], map(float, ols_se), strict=True))
@@ -1084,6 +1090,47 @@ def _block_sample(N, size, L, rng):
     return (starts[:, None] + np.arange(L)).ravel()[:size]
 
 
+def _block_length(rs, floor, block_periods):
+    """The floor's block length in strobe points (1 for random halves) and the record's
+    correlation lag (``None`` unless estimated)."""
+    n = len(rs)
+    if floor == "halves":
+        return 1, None
+    if block_periods is None:
+        return strobe_block_length(rs)
+    L = int(block_periods)
+    if not 1 <= L <= n // 4:
+        raise InputError(
+            f"block_periods must be 1 .. {n // 4} (a quarter of the record's "
+            f"{n} strobe points), got {block_periods}"
+        )
+    return L, None
+
+
+def _energy_resamples(rs, ms, floor, L, resamples, seed):
+    """Energy distances of the record's half against its other half (the floor) and
+    against the model's strobe points (the test), one pair per resample."""
+    n = len(rs)
+    scale = rs.std(axis=0)
+    scale[scale == 0] = 1.0
+    R, M = rs / scale, ms / scale
+    rng = np.random.default_rng(seed)
+    h = n // 2
+    floor_s, test = np.empty(int(resamples)), np.empty(int(resamples))
+    for k in range(int(resamples)):
+        if floor == "halves":
+            perm = rng.permutation(n)
+            r1, r2 = R[perm[:h]], R[perm[h:]]
+            m = M[rng.choice(len(M), n - h, replace=False)]
+        else:
+            i1, i2 = _block_halves(n, L, rng)
+            r1, r2 = R[i1], R[i2]
+            m = M[_block_sample(len(M), len(i2), L, rng)]
+        floor_s[k] = energy_distance(r1, r2)
+        test[k] = energy_distance(r1, m)
+    return floor_s, test
+
+
 @params(
     model=ForcedPolynomial,
     t=Array(1),
@@ -1155,19 +1202,7 @@ def verify(
     rs, ts = record_strobe_points(t, x, model.nu, sm)
     if len(rs) < 20:
         raise InputError(f"the record has {len(rs)} strobe points; need at least 20 periods")
-    n = len(rs)
-    lag = None
-    if floor == "halves":
-        L = 1
-    elif block_periods is None:
-        L, lag = strobe_block_length(rs)
-    else:
-        L = int(block_periods)
-        if not 1 <= L <= n // 4:
-            raise InputError(
-                f"block_periods must be 1 .. {n // 4} (a quarter of the record's "
-                f"{n} strobe points), got {block_periods}"
-            )
+    L, lag = _block_length(rs, floor, block_periods)
     reg_rec = classify_record(rs, sm.noise_sd)
     diverged = None
     try:
@@ -1206,23 +1241,7 @@ def verify(
             floor_correlation_lag=lag,
         )
     reg_mod = classify_points(ms, model.scales(), lyap.value, lyap.stderr)
-    scale = rs.std(axis=0)
-    scale[scale == 0] = 1.0
-    R, M = rs / scale, ms / scale
-    rng = np.random.default_rng(seed)
-    h = n // 2
-    floor_s, test = np.empty(int(resamples)), np.empty(int(resamples))
-    for k in range(int(resamples)):
-        if floor == "halves":
-            perm = rng.permutation(n)
-            r1, r2 = R[perm[:h]], R[perm[h:]]
-            m = M[rng.choice(len(M), n - h, replace=False)]
-        else:
-            i1, i2 = _block_halves(n, L, rng)
-            r1, r2 = R[i1], R[i2]
-            m = M[_block_sample(len(M), len(i2), L, rng)]
-        floor_s[k] = energy_distance(r1, r2)
-        test[k] = energy_distance(r1, m)
+    floor_s, test = _energy_resamples(rs, ms, floor, L, resamples, seed)
     ed, q95 = float(np.median(test)), float(np.quantile(floor_s, 0.95))
     agrees = _regime_match(reg_rec, reg_mod, lyap)
     e_ok = bool(ed <= q95)
