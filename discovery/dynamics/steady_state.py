@@ -207,6 +207,73 @@ class SteadyState:
         ]
 
 
+def _strobe_recurrence(pm, y, max_period):
+    """Strobe points from ``y`` and their recurrence distance per period ``n``: ``(last
+    strobe point, periods advanced, {n: distance}, the one-period distance)``; when the
+    points already recur after one period, only two periods are advanced."""
+    strobe = [y, pm.advance(y, 1), None]
+    strobe[2] = pm.advance(strobe[1], 1)
+    quick = max(np.max(np.abs(strobe[k + 1] - strobe[k]) / pm.scale) for k in (0, 1))
+    if quick < 1e-2:
+        # fast path: the strobe points already recur after one period
+        return strobe[-1], 2, {1: float(quick)}, quick
+    for _ in range(2 * max_period):
+        strobe.append(pm.advance(strobe[-1], 1))
+    return strobe[-1], 2 * max_period + 2, recurrence(strobe, pm.scale, max_period), quick
+
+
+def _orbit(scenario, law, pm, y, n, tol, max_newton, attempt, t0, evidence):
+    """Newton shooting for a period-``n`` orbit from ``y``: the steady state when it
+    converges to a stable orbit (reduced to its smallest period), else ``None``.  Every try
+    is recorded in ``attempt``."""
+    hist = []
+    y_orb, res, J, ok = newton_orbit(pm, y, n, tol, max_newton, hist)
+    mult = floquet_multipliers(J, len(y))
+    stable = bool(ok and is_stable(mult))
+    attempt["tried"].append(
+        {
+            "n": n,
+            "newton_residuals": hist,
+            "converged": ok,
+            "max_multiplier": float(np.max(np.abs(mult))),
+            "stable": stable,
+        }
+    )
+    if not stable:
+        return None
+    reduced = smallest_period(pm, y_orb, n, tol, max_newton) if n > 1 else None
+    if reduced is not None:
+        m, y_orb, res, J, hist_m = reduced
+        attempt["tried"].append(
+            {
+                "n": m,
+                "reduced_from": n,
+                "newton_residuals": hist_m,
+                "converged": True,
+                "stable": True,
+            }
+        )
+        n, mult = m, floquet_multipliers(J)
+    zmax = 0.0
+    if law.permanent_set > 0:
+        # one more orbit from y0 leaves the memory y0 holds (the orbit is periodic)
+        pm.advance(y_orb, n)
+        zmax = pm.zeta_max
+    impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n, zmax)
+    return SteadyState(
+        regime=f"P{n}",
+        n_periods=n,
+        y0=y_orb,
+        t0=t0,
+        impacts=impacts,
+        multipliers=mult,
+        residual=float(res),
+        n_simulations=pm.n_calls,
+        evidence=evidence,
+        zeta_max0=zmax,
+    )
+
+
 @params(
     scenario=Scenario,
     law=ForceLaw,
@@ -301,73 +368,17 @@ def steady_state(
     for phase, n_trans in (("transient", transient), ("long-transient", long_transient)):
         y = pm.advance(y, n_trans)
         t_done += n_trans
-        strobe = [y, pm.advance(y, 1), None]
-        strobe[2] = pm.advance(strobe[1], 1)
-        quick = max(np.max(np.abs(strobe[k + 1] - strobe[k]) / pm.scale) for k in (0, 1))
-        if quick < 1e-2:
-            # fast path: the strobe points already recur after one period
-            y = strobe[-1]
-            t_done += 2
-            dist = {1: float(quick)}
-        else:
-            for _ in range(2 * max_period):
-                strobe.append(pm.advance(strobe[-1], 1))
-            y = strobe[-1]
-            t_done += 2 * max_period + 2
-            dist = recurrence(strobe, pm.scale, max_period)
+        y, periods, dist, quick = _strobe_recurrence(pm, y, max_period)
+        t_done += periods
         order = sorted(dist, key=lambda n: (dist[n] > 1e-2, n if dist[n] <= 1e-2 else dist[n]))
         attempt = {"phase": phase, "recurrence": dist, "tried": []}
         evidence["attempts"].append(attempt)
         if quick < 1e-2:
             order = [1] + [n for n in range(2, max_period + 1)][:2]
         for n in order[:3]:
-            hist = []
-            y_orb, res, J, ok = newton_orbit(pm, y, n, tol, max_newton, hist)
-            mult = floquet_multipliers(J, len(y))
-            stable = bool(ok and is_stable(mult))
-            attempt["tried"].append(
-                {
-                    "n": n,
-                    "newton_residuals": hist,
-                    "converged": ok,
-                    "max_multiplier": float(np.max(np.abs(mult))),
-                    "stable": stable,
-                }
-            )
-            if not stable:
-                continue
-            reduced = smallest_period(pm, y_orb, n, tol, max_newton) if n > 1 else None
-            if reduced is not None:
-                m, y_orb, res, J, hist_m = reduced
-                attempt["tried"].append(
-                    {
-                        "n": m,
-                        "reduced_from": n,
-                        "newton_residuals": hist_m,
-                        "converged": True,
-                        "stable": True,
-                    }
-                )
-                n, mult = m, floquet_multipliers(J)
-            t0 = t_done * T
-            zmax = 0.0
-            if law.permanent_set > 0:
-                # one more orbit from y0 leaves the memory y0 holds (the orbit is periodic)
-                pm.advance(y_orb, n)
-                zmax = pm.zeta_max
-            impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n, zmax)
-            return SteadyState(
-                regime=f"P{n}",
-                n_periods=n,
-                y0=y_orb,
-                t0=t0,
-                impacts=impacts,
-                multipliers=mult,
-                residual=float(res),
-                n_simulations=pm.n_calls,
-                evidence=evidence,
-                zeta_max0=zmax,
-            )
+            found = _orbit(scenario, law, pm, y, n, tol, max_newton, attempt, t_done * T, evidence)
+            if found is not None:
+                return found
     return SteadyState(
         regime="nonperiodic",
         n_periods=0,
