@@ -182,6 +182,79 @@ def _crossing_now(evs, on, trend):
     return None
 
 
+def _make_rhs(scenario, law, mode, state):
+    """The right-hand side in contact ``mode`` (the moulding's mass and the largest
+    penetration as they are now)."""
+    m1, k1, c1, A, om, g = (
+        scenario.m1,
+        scenario.k1,
+        scenario.c1,
+        scenario.A,
+        scenario.omega,
+        scenario.g,
+    )
+    k3 = scenario.k3
+    zmax, m2 = state["zmax"], state["m2"]
+
+    def rhs(tt, yy):
+        f = _force(law, mode, yy[0] - yy[2], yy[1] - yy[3], zmax)
+        return [
+            yy[1],
+            -(c1 * yy[1] + (k1 + k3 * yy[0] ** 2) * yy[0] + A * np.sin(om * tt) + m1 * g + f) / m1,
+            yy[3],
+            f / m2 - g,
+        ]
+
+    return rhs
+
+
+def _held_events(evs, on, g0, t, tau_on):
+    """The segment's terminal events for ``solve_ivp``.  A surface the state starts on is
+    held on its side (where the flow takes it) for an instant: an exact 0 would count as a
+    crossing at the start, a rounded value of the wrong sign would hide a crossing back
+    within the first step."""
+    fns = []
+    for i, (fn, direction, _) in enumerate(evs):
+        if on[i]:
+            hold = -direction * max(abs(g0[i]), 1e-300)
+
+            def ev(tt, yy, fn=fn, hold=hold, t_hold=t + _HOLD * tau_on):
+                return hold if tt <= t_hold else fn(tt, yy)
+        else:
+
+            def ev(tt, yy, fn=fn):
+                return fn(tt, yy)
+
+        ev.terminal, ev.direction = True, direction
+        fns.append(ev)
+    return fns
+
+
+def _sample(sol, te, t_start, t_end, out_y, out_f, law, mode, state):
+    """The segment's states and contact force at the requested times it covers."""
+    mask = (te >= t_start) & (te <= t_end)
+    if mask.any():
+        ys = sol.sol(te[mask])
+        out_y[:, mask] = ys
+        out_f[mask] = [
+            _force(law, mode, w1 - w2, v1 - v2, state["zmax"], clamp=True)
+            for w1, v1, w2, v2 in ys.T
+        ]
+
+
+def _fired(sol, evs, rhs, t, y, T):
+    """The kind of the event that ended the segment: the first in time; a lower-index
+    surface reached at the same instant wins the tie (contact loss before the force
+    reaching zero, as in the kernel)."""
+    fired = [i for i, tev in enumerate(sol.t_events) if len(tev)]
+    i = min(fired, key=lambda i: (sol.t_events[i][0], i))
+    _, on_end, trend_end = _surface_start(
+        evs, rhs, t, y, _TREND_STEP * T, _ON_SURFACE * max(abs(t), T)
+    )
+    j = _crossing_now(evs[:i], on_end[:i], trend_end[:i])
+    return evs[i if j is None else j][2]
+
+
 def reference_simulate(
     scenario,
     law,
@@ -201,17 +274,7 @@ def reference_simulate(
         ``t``, ``y`` (4, n), ``force`` at ``t_eval``; ``events`` list of
         ``(t, kind, y)``; ``y_final``; ``nfev``.
     """
-    m1, m2, k1, c1, A, om, g = (
-        scenario.m1,
-        scenario.m2,
-        scenario.k1,
-        scenario.c1,
-        scenario.A,
-        scenario.omega,
-        scenario.g,
-    )
-    k3, loss = scenario.k3, scenario.mass_loss
-    state = {"m2": m2, "zmax": 0.0}
+    state = {"m2": scenario.m2, "zmax": 0.0}
     T = scenario.period
     y = scenario.initial_state() if y0 is None else np.array(y0, dtype=float)
     if atol is None:
@@ -229,23 +292,8 @@ def reference_simulate(
         if len(events) > max_events:
             raise IntegrationError("reference integration: too many events")
 
-    def make_rhs(mode):
-        zmax, m2 = state["zmax"], state["m2"]
-
-        def rhs(tt, yy):
-            f = _force(law, mode, yy[0] - yy[2], yy[1] - yy[3], zmax)
-            return [
-                yy[1],
-                -(c1 * yy[1] + (k1 + k3 * yy[0] ** 2) * yy[0] + A * np.sin(om * tt) + m1 * g + f)
-                / m1,
-                yy[3],
-                f / m2 - g,
-            ]
-
-        return rhs
-
     while t < t1:
-        rhs = make_rhs(mode)
+        rhs = _make_rhs(scenario, law, mode, state)
         evs = _events(law, mode, state)
         tau_on = _ON_SURFACE * max(abs(t), T)
         g0, on, trend = _surface_start(evs, rhs, t, y, _TREND_STEP * T, tau_on)
@@ -259,25 +307,8 @@ def reference_simulate(
                 )
             kind = evs[i_now][2]
             record(kind, y)
-            mode = _after(law, kind, y, state, loss)
+            mode = _after(law, kind, y, state, scenario.mass_loss)
             continue
-        fns = []
-        for i, (fn, direction, _) in enumerate(evs):
-            if on[i]:
-                # held on its side (where the flow takes it) for an instant: an exact 0
-                # would count as a crossing at the start, a rounded value of the wrong
-                # sign would hide a crossing back within the first step
-                hold = -direction * max(abs(g0[i]), 1e-300)
-
-                def ev(tt, yy, fn=fn, hold=hold, t_hold=t + _HOLD * tau_on):
-                    return hold if tt <= t_hold else fn(tt, yy)
-            else:
-
-                def ev(tt, yy, fn=fn):
-                    return fn(tt, yy)
-
-            ev.terminal, ev.direction = True, direction
-            fns.append(ev)
         t_start = t
         sol = solve_ivp(
             rhs,
@@ -286,7 +317,7 @@ def reference_simulate(
             method=method,
             rtol=rtol,
             atol=atol,
-            events=fns,
+            events=_held_events(evs, on, g0, t, tau_on),
             dense_output=True,
             max_step=T * 0.02,
         )
@@ -294,28 +325,13 @@ def reference_simulate(
         if sol.status == -1:
             raise IntegrationError(f"reference integration failed: {sol.message}")
         t_end = sol.t[-1]
-        mask = (te >= t_start) & (te <= t_end)
-        if mask.any():
-            ys = sol.sol(te[mask])
-            out_y[:, mask] = ys
-            out_f[mask] = [
-                _force(law, mode, w1 - w2, v1 - v2, state["zmax"], clamp=True)
-                for w1, v1, w2, v2 in ys.T
-            ]
+        _sample(sol, te, t_start, t_end, out_y, out_f, law, mode, state)
         y = sol.y[:, -1].copy()
         t = t_end
         if t_end - t_start > _HOLD * tau_on:
             zero_length = 0
         if sol.status == 1:
-            fired = [i for i, tev in enumerate(sol.t_events) if len(tev)]
-            i = min(fired, key=lambda i: (sol.t_events[i][0], i))
-            # a lower-index surface reached at the same instant wins the tie (contact
-            # loss before the force reaching zero, as in the kernel)
-            _, on_end, trend_end = _surface_start(
-                evs, rhs, t, y, _TREND_STEP * T, _ON_SURFACE * max(abs(t), T)
-            )
-            j = _crossing_now(evs[:i], on_end[:i], trend_end[:i])
-            kind = evs[i if j is None else j][2]
+            kind = _fired(sol, evs, rhs, t, y, T)
             record(kind, y)
-            mode = _after(law, kind, y, state, loss)
+            mode = _after(law, kind, y, state, scenario.mass_loss)
     return {"t": te, "y": out_y, "force": out_f, "events": events, "y_final": y, "nfev": nfev}
