@@ -364,6 +364,90 @@ def _edges(t, F, thr, min_len, max_extrap=4.0, noise=0.0):
     return out
 
 
+def _checked_record(t, F, period, n_periods):
+    """``t, F`` as float arrays, refused in one line when they cannot be a record."""
+    t = np.asarray(t, dtype=float)
+    F = np.asarray(F, dtype=float)
+    if not (
+        isinstance(period, int | float | np.floating | np.integer)
+        and np.isfinite(period)
+        and period > 0
+    ):
+        raise InputError(f"period must be a positive number of seconds; got {period!r}")
+    if t.ndim != 1 or F.shape != t.shape or t.size < 2:
+        raise InputError(
+            f"t and F must be 1-D arrays of the same length (at least 2 samples); "
+            f"got shapes {t.shape} and {F.shape}"
+        )
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(F)) and np.all(np.diff(t) > 0)):
+        raise InputError("t must be finite and strictly increasing, and F finite")
+    if n_periods is not None and not (isinstance(n_periods, int | np.integer) and n_periods >= 1):
+        raise InputError(f"n_periods must be a positive integer; got {n_periods!r}")
+    return t, F
+
+
+def _contact_runs(t, F, thr, sigma, period, min_samples, zeta, dt):
+    """The contacts ``[(onset, loss, first sample), ...]`` above ``thr`` (gaps shorter than
+    1 % of a period are noise flicker inside one contact; a contact whose peak barely clears
+    the threshold is noise); with ``zeta``, contacts not separated by a free flight merged
+    and onsets refined on the penetration."""
+    runs = _edges(t, F, thr, *_edge_params(t, period, min_samples), noise=sigma)
+    if runs:
+        # a contact whose peak barely clears the threshold is noise, not an impact
+        pk = np.array([np.max(F[s : int(np.searchsorted(t, off)) + 1]) for _, off, s in runs])
+        runs = [r for r, p in zip(runs, pk, strict=True) if p >= max(3 * thr, 0.02 * pk.max())]
+    if zeta is not None:
+        zeta = np.asarray(zeta, dtype=float)
+        runs = _merge_unseparated(t, zeta, runs)
+        back = 0.25 * period / dt
+        runs = [
+            (_bracket_onset(t, F, s, t_off, thr, _refine_onset(t, zeta, s, t_on, back)), t_off, s)
+            for t_on, t_off, s in runs
+        ]
+    return runs
+
+
+def _recurring(onsets, ref_j, W, period):
+    """The main impacts: walking back one cycle at a time from ``ref_j`` while an impact
+    recurs at the same drive phase; which of these cycles are steady is decided on their
+    whole force history (:func:`_steady_tail`): a sampled impulse of a short contact varies
+    by several per cent with where the samples fall, so it is no test of steadiness."""
+    mains = [ref_j]
+    k = 1
+    while True:
+        target = onsets[ref_j] - k * W
+        j = int(np.argmin(np.abs(onsets - target)))
+        if abs(onsets[j] - target) > 0.02 * period:
+            break
+        mains.insert(0, j)
+        k += 1
+    return mains
+
+
+def _cycle(t, F, t_on, tau, W, thr, exact_onset, onsets, period):
+    """The force of the cycle starting at ``t_on`` on the time axis ``tau`` since its
+    onset."""
+    s = _first_after(t, F, t_on, thr, exact_onset)
+    vals = np.interp(t_on + tau, t, F)
+    # right limit at the onset: extrapolate the first samples after it, and do not
+    # interpolate across a jump between the onset and sample s
+    # (quadratic through samples s, s+1, s+2; a force is never negative)
+    coef = np.polyfit(t[s : s + 3] - t_on, F[s : s + 3], 2)
+    head = tau < t[s] - t_on
+    vals[head] = np.maximum(np.polyval(coef, tau[head]), 0.0)
+    # at the cycle's end hold the last sample before the next onset (left limit): the
+    # next cycle's own onset when it was recorded (the cycles' onsets differ by up to
+    # a sample or two: noise, sampling), else one cycle after this one
+    last = int(np.searchsorted(t, t_on + W - (t[s] - t_on), "right")) - 1
+    nxt = onsets[(onsets > t_on + W - 0.02 * period) & (onsets < t_on + W + 0.02 * period)]
+    if nxt.size:
+        last = min(last, int(np.searchsorted(t, nxt.min(), "left")) - 1)
+    last = min(last, len(t) - 1)
+    tail = t_on + tau > t[last]
+    vals[tail] = F[last]
+    return vals
+
+
 @params(
     t=Array(1),
     F=Array(1),
@@ -407,40 +491,11 @@ def impulse_from_samples(
         Averaged over every complete cycle; ``F(0+)`` estimated by extrapolating
         the first two samples after the onset back to it.
     """
-    t = np.asarray(t, dtype=float)
-    F = np.asarray(F, dtype=float)
-    if not (
-        isinstance(period, int | float | np.floating | np.integer)
-        and np.isfinite(period)
-        and period > 0
-    ):
-        raise InputError(f"period must be a positive number of seconds; got {period!r}")
-    if t.ndim != 1 or F.shape != t.shape or t.size < 2:
-        raise InputError(
-            f"t and F must be 1-D arrays of the same length (at least 2 samples); "
-            f"got shapes {t.shape} and {F.shape}"
-        )
-    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(F)) and np.all(np.diff(t) > 0)):
-        raise InputError("t must be finite and strictly increasing, and F finite")
-    if n_periods is not None and not (isinstance(n_periods, int | np.integer) and n_periods >= 1):
-        raise InputError(f"n_periods must be a positive integer; got {n_periods!r}")
+    t, F = _checked_record(t, F, period, n_periods)
     dt = float(np.median(np.diff(t)))
     sigma = estimate_noise(F)
     thr = max(5.0 * sigma, 1e-3 * float(np.max(F))) if threshold is None else float(threshold)
-    # gaps shorter than 1 % of a period are noise flicker inside one contact
-    runs = _edges(t, F, thr, *_edge_params(t, period, min_samples), noise=sigma)
-    if runs:
-        # a contact whose peak barely clears the threshold is noise, not an impact
-        pk = np.array([np.max(F[s : int(np.searchsorted(t, off)) + 1]) for _, off, s in runs])
-        runs = [r for r, p in zip(runs, pk, strict=True) if p >= max(3 * thr, 0.02 * pk.max())]
-    if zeta is not None:
-        zeta = np.asarray(zeta, dtype=float)
-        runs = _merge_unseparated(t, zeta, runs)
-        back = 0.25 * period / dt
-        runs = [
-            (_bracket_onset(t, F, s, t_off, thr, _refine_onset(t, zeta, s, t_on, back)), t_off, s)
-            for t_on, t_off, s in runs
-        ]
+    runs = _contact_runs(t, F, thr, sigma, period, min_samples, zeta, dt)
     if not runs:
         raise NoContactError(
             "no contact found in the force record (no run of samples above "
@@ -468,42 +523,13 @@ def impulse_from_samples(
     # of these cycles are steady is decided on their whole force history (_steady_tail):
     # a sampled impulse of a short contact varies by several per cent with where the
     # samples fall, so it is no test of steadiness
-    mains = [ref_j]
-    k = 1
-    while True:
-        target = onsets[ref_j] - k * W
-        j = int(np.argmin(np.abs(onsets - target)))
-        if abs(onsets[j] - target) > 0.02 * period:
-            break
-        mains.insert(0, j)
-        k += 1
+    mains = _recurring(onsets, ref_j, W, period)
     # time axis: the first cycle's own sample offsets from its onset (no re-interpolation
     # of that cycle; the others are interpolated onto it, exactly when fs*T is whole)
     t_on0 = runs[mains[0]][0]
     inside = t[_first_after(t, F, t_on0, thr, zeta is not None) :] - t_on0
     tau = np.concatenate([[0.0], inside[inside < W], [W]])
-    stack = []
-    for j in mains:
-        t_on = runs[j][0]
-        s = _first_after(t, F, t_on, thr, zeta is not None)
-        vals = np.interp(t_on + tau, t, F)
-        # right limit at the onset: extrapolate the first samples after it, and do not
-        # interpolate across a jump between the onset and sample s
-        # (quadratic through samples s, s+1, s+2; a force is never negative)
-        coef = np.polyfit(t[s : s + 3] - t_on, F[s : s + 3], 2)
-        head = tau < t[s] - t_on
-        vals[head] = np.maximum(np.polyval(coef, tau[head]), 0.0)
-        # at the cycle's end hold the last sample before the next onset (left limit): the
-        # next cycle's own onset when it was recorded (the cycles' onsets differ by up to
-        # a sample or two: noise, sampling), else one cycle after this one
-        last = int(np.searchsorted(t, t_on + W - (t[s] - t_on), "right")) - 1
-        nxt = onsets[(onsets > t_on + W - 0.02 * period) & (onsets < t_on + W + 0.02 * period)]
-        if nxt.size:
-            last = min(last, int(np.searchsorted(t, nxt.min(), "left")) - 1)
-        last = min(last, len(t) - 1)
-        tail = t_on + tau > t[last]
-        vals[tail] = F[last]
-        stack.append(vals)
+    stack = [_cycle(t, F, runs[j][0], tau, W, thr, zeta is not None, onsets, period) for j in mains]
     steady = _steady_tail(np.array(stack), sigma)
     stack = [stack[i] for i in steady]
     mains = [mains[i] for i in steady]
