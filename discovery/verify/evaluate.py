@@ -351,6 +351,54 @@ def _orbit_history(scenario, law, ss, block, tolerances):
     return np.asarray(tr.force, dtype=float)
 
 
+def _span_steady_state(scenario, law, reference, last, span, sim, reg, tolerances, steady_kwargs):
+    """The law's steady state from the record's state (only to report its regime, set in
+    ``reg``) and ``transient``: I2 between the law's trajectory over the last block and its
+    steady orbit (``None`` without a periodic orbit).  Returns ``(steady state or None,
+    transient)``."""
+    steady_kwargs = {"y_start": reference.start, "t_start": reference.start_time, **steady_kwargs}
+    ss, transient = None, None
+    try:
+        ss = steady_state(scenario, law, tolerances=tolerances, **steady_kwargs)
+        if ss.periodic:
+            reg["simulated"] = ss.regime
+            orbit = last.fold.impulse(
+                _orbit_history(scenario, law, ss, last, tolerances),
+                threshold=last.threshold,
+                noise=span.sigma_f,
+            )
+            transient = evaluate_criteria(orbit, sim, ["I2"])["I2"]
+        else:
+            reg["simulated"] = "nonperiodic"
+    except (IntegrationError, InputError) as exc:
+        reg["simulated"] = f"failed ({exc})"
+    return ss, transient
+
+
+def _transient_notes(transient_mismatch, settled, transient, reg, ss):
+    """What the verdict says about a record still in a transient under this law."""
+    notes = []
+    if transient_mismatch:
+        what = (
+            f"settles to {reg['simulated']}"
+            if ss is not None and ss.periodic
+            else f"reaches no stable periodic orbit ({reg['simulated']})"
+        )
+        gap = "" if transient is None else f" (I2 {transient:.3g} from its steady orbit)"
+        notes.append(
+            f"the record reads {reg['measured']} but is still in a transient under "
+            f"this law: from the measured state its trajectory{gap} {what}; the law "
+            "is judged against the record's own span"
+        )
+    elif not settled and transient is not None:
+        notes.append(
+            f"the record is still in a transient under this law (I2 {transient:.3g} "
+            "between its trajectory over the last cycles and its steady orbit); "
+            "judged against the record's own span"
+        )
+    return notes
+
+
 def _evaluate_span(
     scenario, law, reference, tolerances, floor, observe, steady_kwargs, smooth_onset=False
 ):
@@ -401,22 +449,9 @@ def _evaluate_span(
     }
     if not floor:
         return Evaluation("ok", reg, imp, crit, {}, False, "", simulated=sim, extra=extra)
-    steady_kwargs = {"y_start": reference.start, "t_start": reference.start_time, **steady_kwargs}
-    ss, transient = None, None
-    try:
-        ss = steady_state(scenario, law, tolerances=tolerances, **steady_kwargs)
-        if ss.periodic:
-            reg["simulated"] = ss.regime
-            orbit = last.fold.impulse(
-                _orbit_history(scenario, law, ss, last, tolerances),
-                threshold=last.threshold,
-                noise=span.sigma_f,
-            )
-            transient = evaluate_criteria(orbit, sim, ["I2"])["I2"]
-        else:
-            reg["simulated"] = "nonperiodic"
-    except (IntegrationError, InputError) as exc:
-        reg["simulated"] = f"failed ({exc})"
+    ss, transient = _span_steady_state(
+        scenario, law, reference, last, span, sim, reg, tolerances, steady_kwargs
+    )
     extra["transient_I2"] = transient
     settled = transient is not None and transient <= TRANSIENT_GAP
     fl = reference.floor_for(
@@ -445,24 +480,7 @@ def _evaluate_span(
         )
         imp = {**imp, "simulated": imp["measured"]}
     verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim, transient=transient_mismatch)
-    if transient_mismatch:
-        what = (
-            f"settles to {reg['simulated']}"
-            if ss is not None and ss.periodic
-            else f"reaches no stable periodic orbit ({reg['simulated']})"
-        )
-        gap = "" if transient is None else f" (I2 {transient:.3g} from its steady orbit)"
-        notes.append(
-            f"the record reads {reg['measured']} but is still in a transient under "
-            f"this law: from the measured state its trajectory{gap} {what}; the law "
-            "is judged against the record's own span"
-        )
-    elif not settled and transient is not None:
-        notes.append(
-            f"the record is still in a transient under this law (I2 {transient:.3g} "
-            "between its trajectory over the last cycles and its steady orbit); "
-            "judged against the record's own span"
-        )
+    notes += _transient_notes(transient_mismatch, settled, transient, reg, ss)
     if notes and verdict is not None:
         verdict = f"{verdict}; " + "; ".join(notes)
     extra.update(
