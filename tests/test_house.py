@@ -141,3 +141,36 @@ def test_figures_leave_the_users_backend_alone():
         [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=120
     )
     assert out.stdout.strip() == "ok", out.stderr
+
+
+def _code_lines(node):
+    """Lines of a function without its docstring."""
+    n = node.end_lineno - node.lineno + 1
+    body = node.body
+    if (
+        body
+        and isinstance(body[0], ast.Expr)
+        and isinstance(body[0].value, ast.Constant)
+        and isinstance(body[0].value.value, str)
+    ):
+        n -= body[0].end_lineno - body[0].lineno + 1
+    return n
+
+
+def _compiled(node):
+    """Whether a function is a numba kernel (its decorator names ``njit``/``jit``)."""
+    return any("jit" in ast.unparse(d) for d in node.decorator_list)
+
+
+def test_functions_are_short():
+    """No function of the package is over 100 lines (docstring excluded), the compiled
+    kernels aside: a long function is several steps that deserve names."""
+    long = []
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef) and not _compiled(node):
+                    n = _code_lines(node)
+                    if n > 100:
+                        long.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name} ({n})")
+    assert not long, long
