@@ -36,12 +36,10 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from .._printing import readable
 from .._validate import Array, Instance, Real, params
 from ..dynamics import Tolerances
-from ..dynamics._dopri import OK
 from ..errors import InputError, IntegrationError, VidiTypeError
 from ..executor import make_executor
 from . import _kernel as UK
@@ -54,161 +52,6 @@ from .system import UedaSystem
 __all__ = ["Chart", "chart", "KINDS"]
 
 KINDS = ("P1", "Pn", "beat", "chaotic")  # codes 0..3; -1 failed
-
-
-@njit(cache=True)
-def _scan(
-    y0,
-    p,
-    T,
-    n_max,
-    max_period,
-    min_pairs,
-    closure,
-    inv_scale,
-    rtol,
-    atol,
-    hmax,
-    max_steps,
-    out_strobe,
-    run,
-):
-    """Up to ``n_max`` periods of the stroboscopic map from ``(0, y0)`` (the same steps
-    as :func:`~discovery.oscillator._kernel.strobe_run`), stopping early when the strobe
-    points repeat: ``run[n]`` counts the consecutive latest pairs ``|S_k - S_{k-n}| /
-    scale < closure`` (max norm); the smallest ``n`` with ``run[n] >= max(3 n,
-    min_pairs)`` ends the run unless the run may still be converging to an orbit of a
-    divisor ``d`` of ``n``: ``d`` is closing too (``run[d] > 0``), or its differences
-    ``|S_k - S_{k-d}|`` shrank by more than 10 % over the last ``max(3 n, min_pairs)``
-    periods (e.g. a P1 orbit with a multiplier near -1 repeats after 2 periods long
-    before it repeats after 1).  Returns ``(status, t, y, periods done, n or 0)``."""
-    y = y0.copy()
-    K = np.empty((7, 2))
-    ytmp = np.empty(2)
-    ynew = np.empty(2)
-    empty_t = np.empty(0)
-    empty_o = np.empty((2, 0))
-    for n in range(max_period + 1):
-        run[n] = 0
-    UK._rhs2(0.0, y, p, K[0])
-    t = 0.0
-    h = T / 50.0
-    n_steps = 0
-    status = OK
-    found = 0
-    k = 0
-    while k < n_max:
-        status, t, h, _, ns = UK._adv2(
-            t,
-            y,
-            (k + 1) * T,
-            h,
-            p,
-            rtol,
-            atol,
-            hmax,
-            max_steps - n_steps,
-            K,
-            ytmp,
-            ynew,
-            empty_t,
-            0,
-            empty_o,
-        )
-        n_steps += ns
-        if status != OK:
-            break
-        out_strobe[k, 0] = y[0]
-        out_strobe[k, 1] = y[1]
-        for n in range(1, min(k, max_period) + 1):
-            if _gap(out_strobe, k, n, inv_scale) < closure:
-                run[n] += 1
-            else:
-                run[n] = 0
-        for n in range(1, max_period + 1):
-            need = max(3 * n, min_pairs)
-            if run[n] >= need:
-                found = n
-                for d in range(1, n):
-                    if n % d == 0 and (
-                        run[d] > 0
-                        or _gap(out_strobe, k, d, inv_scale)
-                        < 0.9 * _gap(out_strobe, k - need, d, inv_scale)
-                    ):
-                        found = 0
-                break
-        k += 1
-        if found > 0:
-            break
-    return status, t, y, k, found
-
-
-@njit(cache=True, inline="always")
-def _gap(s, k, n, inv_scale):
-    """``max |S_k - S_{k-n}| / scale``."""
-    return max(abs(s[k, 0] - s[k - n, 0]) * inv_scale[0], abs(s[k, 1] - s[k - n, 1]) * inv_scale[1])
-
-
-@njit(cache=True)
-def _monodromy(y0, p, T, n, rtol, atol_state, atol_tangent, hmax, max_steps):
-    """The variational equations over ``n`` periods from ``(0, y0)`` without
-    orthonormalisation (the tangent matrix only rescaled by its largest entry every
-    period).  Returns ``(status, t, M, log of the scale factors, trace integral)``: the
-    monodromy matrix is ``exp(log) M``."""
-    y = np.zeros(7)
-    y[0] = y0[0]
-    y[1] = y0[1]
-    y[2] = 1.0
-    y[5] = 1.0
-    atol = np.empty(7)
-    atol[0] = atol_state[0]
-    atol[1] = atol_state[1]
-    for j in range(2, 7):
-        atol[j] = atol_tangent
-    K = np.empty((7, 7))
-    ytmp = np.empty(7)
-    ynew = np.empty(7)
-    empty_t = np.empty(0)
-    empty_o = np.empty((2, 0))
-    t = 0.0
-    h = T / 50.0
-    n_steps = 0
-    status = OK
-    logs = 0.0
-    UK._rhs7(t, y, p, K[0])
-    for k in range(n):
-        status, t, h, _, ns = UK._adv7(
-            t,
-            y,
-            (k + 1) * T,
-            h,
-            p,
-            rtol,
-            atol,
-            hmax,
-            max_steps - n_steps,
-            K,
-            ytmp,
-            ynew,
-            empty_t,
-            0,
-            empty_o,
-        )
-        n_steps += ns
-        if status != OK:
-            break
-        m = max(max(abs(y[2]), abs(y[3])), max(abs(y[4]), abs(y[5])))
-        if m > 0.0:
-            for j in range(2, 6):
-                y[j] /= m
-            logs += np.log(m)
-        UK._rhs7(t, y, p, K[0])  # the tangent vectors changed
-    M = np.empty((2, 2))
-    M[0, 0] = y[2]
-    M[1, 0] = y[3]
-    M[0, 1] = y[4]
-    M[1, 1] = y[5]
-    return status, t, M, logs, y[6]
 
 
 @readable
@@ -408,7 +251,7 @@ def _recurrence(strobe, inv_scale, max_period, closure, min_pairs):
 def _stable_orbit(y, p, T, n, tol, atol, hmax):
     """``log|m_1| / (n T)`` of the period-``n`` orbit through ``y`` (its monodromy over
     ``n`` periods); NaN when it is not stable (``|m_1| >= 1``)."""
-    status, t, M, logs, _ = _monodromy(
+    status, t, M, logs, _ = UK.monodromy_run(
         y, p, T, n, tol.rtol, atol, tol.atol_variational, hmax, _budget(tol, n)
     )
     _check(status, t, "the variational equations")
@@ -431,7 +274,7 @@ def _point(system, y, s, tol, buffers=None):
     y = np.asarray(y, dtype=float)
     cost = 0
     if n_tr > 0:
-        status, t, y, done, n = _scan(
+        status, t, y, done, n = UK.scan_run(
             y,
             p,
             T,
@@ -457,7 +300,7 @@ def _point(system, y, s, tol, buffers=None):
                     0 if n == 1 else 1, n, lam, np.nan, y, cost, strobe[done - n : done].copy()
                 )
             # an unstable orbit repeating by chance: the rest of the transient
-            status, t, y, more, _ = _scan(
+            status, t, y, more, _ = UK.scan_run(
                 y,
                 p,
                 T,

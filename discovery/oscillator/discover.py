@@ -38,14 +38,12 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from numba import njit
 
 from .._printing import generic_lines, readable
 from .._validate import Array, Real, Text, params
 from ..dynamics import Tolerances
-from ..dynamics._dopri import OK, make_smooth_advance
 from ..errors import InputError, IntegrationError
-from ._kernel import renormalise
+from . import _kernel as UK
 from .attractor import classify_points, rotation_number
 from .system import UedaSystem
 
@@ -182,158 +180,6 @@ class ForcedPolynomial:
         return {"terms": self.terms, "forcing": self.forcing, "B": self.B, "nu": self.nu}
 
 
-# ------------------------------------------------------------------ compiled integrator
-@njit(cache=True, inline="always")
-def _poly(x, v, p):
-    """``sum_j p[j] x^i v^j`` and its partial derivatives (the MONOMIALS' order)."""
-    x2 = x * x
-    v2 = v * v
-    a = (
-        p[0]
-        + p[1] * x
-        + p[2] * v
-        + p[3] * x2
-        + p[4] * x * v
-        + p[5] * v2
-        + p[6] * x2 * x
-        + p[7] * x2 * v
-        + p[8] * x * v2
-        + p[9] * v2 * v
-    )
-    ax = p[1] + 2.0 * p[3] * x + p[4] * v + 3.0 * p[6] * x2 + 2.0 * p[7] * x * v + p[8] * v2
-    av = p[2] + p[4] * x + 2.0 * p[5] * v + p[7] * x2 + 2.0 * p[8] * x * v + 3.0 * p[9] * v2
-    return a, ax, av
-
-
-@njit(cache=True, inline="always")
-def _rhs2(t, y, p, out):
-    a, _, _ = _poly(y[0], y[1], p)
-    out[0] = y[1]
-    out[1] = a + p[10] * np.cos(p[11] * t)
-
-
-@njit(cache=True, inline="always")
-def _rhs7(t, y, p, out):
-    a, ax, av = _poly(y[0], y[1], p)
-    out[0] = y[1]
-    out[1] = a + p[10] * np.cos(p[11] * t)
-    out[2] = y[3]
-    out[3] = ax * y[2] + av * y[3]
-    out[4] = y[5]
-    out[5] = ax * y[4] + av * y[5]
-    out[6] = av  # trace of [[0, 1], [ax, av]]
-
-
-_adv2 = make_smooth_advance(_rhs2, 2, 2)
-_adv7 = make_smooth_advance(_rhs7, 7, 2)
-
-
-@njit(cache=True)
-def _strobe_run(t0, y0, p, T, n_trans, rtol, atol, hmax, max_steps):
-    """``n_trans`` periods from ``(t0, y0)``: ``(status, t, y)``."""
-    y = y0.copy()
-    K = np.empty((7, 2))
-    ytmp = np.empty(2)
-    ynew = np.empty(2)
-    empty_t = np.empty(0)
-    empty_o = np.empty((2, 0))
-    _rhs2(t0, y, p, K[0])
-    t = t0
-    h = T / 50.0
-    n_steps = 0
-    status = OK
-    for k in range(n_trans):
-        status, t, h, _, ns = _adv2(
-            t,
-            y,
-            t0 + (k + 1) * T,
-            h,
-            p,
-            rtol,
-            atol,
-            hmax,
-            max_steps - n_steps,
-            K,
-            ytmp,
-            ynew,
-            empty_t,
-            0,
-            empty_o,
-        )
-        n_steps += ns
-        if status != OK or abs(y[0]) > 1e6 or abs(y[1]) > 1e6:
-            if status == OK:
-                status = 2
-            break
-    return status, t, y
-
-
-@njit(cache=True)
-def _variational_run(
-    t0,
-    y0,
-    p,
-    T,
-    n_seg,
-    rtol,
-    atol_state,
-    atol_tangent,
-    hmax,
-    max_steps,
-    out_logs,
-    out_trace,
-    out_strobe,
-):
-    """Benettin's method (as :func:`discovery.oscillator._kernel.variational_run`)."""
-    y = np.zeros(7)
-    y[0] = y0[0]
-    y[1] = y0[1]
-    y[2] = 1.0
-    y[5] = 1.0
-    atol = np.empty(7)
-    atol[0] = atol_state[0]
-    atol[1] = atol_state[1]
-    for j in range(2, 7):
-        atol[j] = atol_tangent
-    K = np.empty((7, 7))
-    ytmp = np.empty(7)
-    ynew = np.empty(7)
-    empty_t = np.empty(0)
-    empty_o = np.empty((2, 0))
-    t = t0
-    h = T / 50.0
-    n_steps = 0
-    status = OK
-    _rhs7(t, y, p, K[0])
-    for k in range(n_seg):
-        status, t, h, _, ns = _adv7(
-            t,
-            y,
-            t0 + (k + 1) * T,
-            h,
-            p,
-            rtol,
-            atol,
-            hmax,
-            max_steps - n_steps,
-            K,
-            ytmp,
-            ynew,
-            empty_t,
-            0,
-            empty_o,
-        )
-        n_steps += ns
-        if status != OK:
-            break
-        if abs(y[0]) > 1e6 or abs(y[1]) > 1e6:
-            status = 2
-            break
-        renormalise(y, k, out_logs, out_trace, out_strobe)
-        _rhs7(t, y, p, K[0])
-    return status, t, y[:2].copy(), n_steps
-
-
 def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20, tolerances=None):
     """Integrate ``model`` (a :class:`ForcedPolynomial`) from ``y0`` at ``t0``: after
     ``transient`` periods, ``periods`` strobe points (at ``t0 + k T``) and the largest
@@ -354,14 +200,14 @@ def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20
     p = model.params()
     y = np.asarray(y0, dtype=float).copy()
     if transient > 0:
-        status, t, y = _strobe_run(
+        status, t, y = UK.model_strobe_run(
             float(t0), y, p, T, int(transient), tol.rtol, atol, hmax, _budget(tol, transient)
         )
         check(status, t, "the discovered equation")
     n = int(periods)
     logs, trace, strobe = np.empty((n, 2)), np.empty(n), np.empty((n, 2))
     t_start = float(t0) + int(transient) * T
-    status, t, _, _ = _variational_run(
+    status, t, _, _ = UK.model_variational_run(
         t_start,
         y,
         p,
