@@ -4,8 +4,8 @@ the chart and discovery, so none imports another's private helpers)."""
 
 import numpy as np
 
-from ..dynamics import Tolerances
 from ..dynamics.status import check
+from ..dynamics.tolerances import Tolerances
 from ..errors import InputError, VidiTypeError
 from .system import UedaSystem
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from .._printing import generic_lines, readable
 from .._validate import Array, Real, params
-from ..dynamics import Tolerances
+from ..dynamics.tolerances import Tolerances
 from ..errors import IntegrationError
 from . import _kernel as UK
 from ._runs import budget as _budget

@@ -39,7 +39,7 @@ import numpy as np
 
 from .._printing import readable
 from .._validate import Array, Instance, Real, params
-from ..dynamics import Tolerances
+from ..dynamics.tolerances import Tolerances
 from ..errors import InputError, IntegrationError, VidiTypeError
 from ..executor import make_executor
 from . import _kernel as UK

@@ -41,7 +41,7 @@ import numpy as np
 
 from .._printing import generic_lines, readable
 from .._validate import Array, Real, Text, params
-from ..dynamics import Tolerances
+from ..dynamics.tolerances import Tolerances
 from ..errors import InputError, IntegrationError
 from . import _kernel as UK
 from .attractor import classify_points, rotation_number

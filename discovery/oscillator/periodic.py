@@ -25,8 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._validate import Array, Real, params
-from ..dynamics import Tolerances
 from ..dynamics.shooting import floquet_multipliers, is_stable, newton_orbit, smallest_period
+from ..dynamics.tolerances import Tolerances
 from ..errors import InputError
 from . import _kernel as UK
 from ._runs import budget as _budget

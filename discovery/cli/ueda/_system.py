@@ -16,7 +16,7 @@ def _system(args, **fixed):
 
 
 def _tolerances(args):
-    from ...dynamics import Tolerances
+    from ...dynamics.tolerances import Tolerances
 
     return Tolerances(rtol=args.rtol)
 
