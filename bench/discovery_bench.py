@@ -15,8 +15,8 @@ import numpy as np
 
 from constraints import certify
 from discovery import ForceLaw, load_scenario, synthesize
-from discovery.regression import ConstrainedSparseRegressor, _Problem
-from discovery.samples import contact_samples
+from discovery.vibroimpact.data.samples import contact_samples
+from discovery.vibroimpact.fit.regression import ConstrainedSparseRegressor, _Problem
 
 TRUE = "2.06e8*z + 1.28e7*zd + 2e10*z*zd"
 LIBRARY = "poly:3+z^1.5"
@@ -126,7 +126,7 @@ def bench_pipeline(repeat=3):
     """Wall time of the public entry points, as ratios to one steady state of the same
     scenario and law measured in the same run (the unit of every simulation they make):
 
-    * ``discovery.verify.verify`` on a 20-period steady record (paper scenario, law
+    * ``discovery.vibroimpact.verify.verify`` on a 20-period steady record (paper scenario, law
       (11), 1 % force noise, positions and velocities; best of ``repeat``): one
       steady state from the measured state, the alignment, a 16-replicate noise floor
       and the check from the scenario's default start;
@@ -136,8 +136,8 @@ def bench_pipeline(repeat=3):
       verification of every shortlisted model).
     """
     from discovery import discover
-    from discovery.dynamics.steady_state import steady_state
-    from discovery.verify import verify
+    from discovery.vibroimpact.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.verify import verify
 
     sc = load_scenario("paper")
     steady_state(sc, sc.law)  # compiled kernels loaded

@@ -26,8 +26,8 @@ def bench_explain(repeat=2):
     R = _realistic()
 
     from discovery import ForceLaw, load_scenario
-    from discovery.dynamics.steady_state import steady_state
-    from discovery.explain import EFFECTS, explain
+    from discovery.vibroimpact.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.explain import EFFECTS, explain
 
     sc = load_scenario("paper")
     law = ForceLaw.parse("2.06e8*z + 0.9e7*zd + 2e10*z*zd")  # a hidden coupling

@@ -30,14 +30,14 @@ from pathlib import Path
 import numpy as np
 
 from discovery._io import provenance, to_jsonable
-from discovery.dynamics import Tolerances, simulate
-from discovery.dynamics.reference import reference_simulate
-from discovery.dynamics.steady_state import steady_state
-from discovery.identify import METHODS, identify
-from discovery.landscape import landscape
-from discovery.law import ForceLaw
-from discovery.scenario import load_scenario
-from discovery.synthesize import synthesize
+from discovery.vibroimpact.dynamics import Tolerances, simulate
+from discovery.vibroimpact.dynamics.reference import reference_simulate
+from discovery.vibroimpact.dynamics.steady_state import steady_state
+from discovery.vibroimpact.dynamics.synthesize import synthesize
+from discovery.vibroimpact.fit.identify import METHODS, identify
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.model.scenario import load_scenario
+from discovery.vibroimpact.verify.landscape import landscape
 
 
 def _best(f, repeat=5):
@@ -130,7 +130,7 @@ def bench_study():
     scratch, in the same run: the executors' speed-ups and whether their tables agree."""
     import tempfile
 
-    from discovery.studies import study
+    from discovery.vibroimpact.studies import study
 
     cfg = {
         "name": "bench",

@@ -29,9 +29,9 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from discovery.dynamics import Tolerances
-from discovery.oscillator import UedaSystem, lyapunov
-from discovery.oscillator.chart import _point, chart
+from discovery.ueda import UedaSystem, lyapunov
+from discovery.ueda.chart import _point, chart
+from discovery.vibroimpact.dynamics import Tolerances
 
 
 def _best(f, repeat):

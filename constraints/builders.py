@@ -19,7 +19,7 @@ the constraints well conditioned for any box and coefficient magnitude.
 The rows themselves are plain numpy: :func:`normalized_rows` (the normalisation above),
 :func:`sign_rows` (coefficient signs) and :func:`constraint_rows` (the whole set of
 :func:`physical` as one system ``rows @ x + rhs >= 0``) are shared by the cvxpy builders here
-and by any caller assembling its own problem (e.g. :mod:`discovery.regression`).
+and by any caller assembling its own problem (e.g. :mod:`discovery.vibroimpact.fit.regression`).
 """
 
 from __future__ import annotations

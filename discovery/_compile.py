@@ -7,8 +7,8 @@ from pathlib import Path
 __all__ = ["KERNELS", "cached", "announce_compile"]
 
 KERNELS = {
-    "vibro-impact": (Path(__file__).parent / "dynamics", "_kernel.integrate-"),
-    "oscillator": (Path(__file__).parent / "oscillator", "_kernel."),
+    "vibro-impact": (Path(__file__).parent / "vibroimpact" / "dynamics", "_kernel.integrate-"),
+    "oscillator": (Path(__file__).parent / "ueda", "_kernel."),
 }
 _ANNOUNCED = set()
 

@@ -216,7 +216,7 @@ def _input_record(value):
     path = value
     if isinstance(value, str) and not os.path.exists(value):
         # a built-in scenario name: checksum of the packaged file
-        res = resources.files("discovery") / "scenarios" / f"{value}.toml"
+        res = resources.files("discovery.vibroimpact.model") / "scenarios" / f"{value}.toml"
         if res.is_file():
             return {"path": f"builtin:{value}", "sha256": file_sha256(res)}
     if not isinstance(path, str | os.PathLike) or not os.path.isfile(path):

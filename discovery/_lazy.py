@@ -3,9 +3,9 @@
 ``import discovery`` (and ``vidi --help``) must not load numba, cvxpy, scipy.stats, sympy and
 matplotlib. A package lists its public names with the submodule that defines each; a name
 is imported when it is first read. A function that shares its name with the submodule
-defining it (``discovery.explain``, ``discovery.explain.explain``) would be replaced by the
-submodule as soon as that is imported, so such names are properties of the package's module
-class and always give the function, as the eager ``from .x import x`` did.
+defining it (``discovery.ueda.chart``, ``discovery.vibroimpact.explain.explain``) would be
+replaced by the submodule as soon as that is imported, so such names are properties of the
+package's module class and always give the function, as the eager ``from .x import x`` did.
 """
 
 from __future__ import annotations

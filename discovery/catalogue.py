@@ -1,7 +1,7 @@
 """The missing-effect mechanism, shared by both systems: an :class:`Effect` is a named
 physical effect with one bounded :class:`Parameter` and the place it enters a model; each
-system keeps its own catalogue (:data:`discovery.explain.EFFECTS`,
-:data:`discovery.oscillator.effects.EFFECTS`) and looks entries up here, with one message for
+system keeps its own catalogue (:data:`discovery.vibroimpact.explain.EFFECTS`,
+:data:`discovery.ueda.effects.EFFECTS`) and looks entries up here, with one message for
 an unknown name.
 """
 
@@ -39,8 +39,8 @@ class Effect:
         Its one parameter, with physical bounds.
     phases : tuple of str
         The impact phases where its signature concentrates (checked against the
-        localisation, :func:`discovery.explain.localise`); ``"grid"`` for the grid's free
-        motion, ``"drift"`` for a trend across the impacts of a record.
+        localisation, :func:`discovery.vibroimpact.explain.localise`); ``"grid"`` for the grid's
+        free motion, ``"drift"`` for a trend across the impacts of a record.
     target : str
         Where the parameter enters (:data:`TARGETS`).
     key : str

@@ -19,16 +19,16 @@ def warm():
     """Compile (or load) every kernel: ``{kernel: seconds}``."""
     out = {}
     t0 = time.perf_counter()
-    from .dynamics.steady_state import steady_state
-    from .scenario import load_scenario
+    from .vibroimpact.dynamics.steady_state import steady_state
+    from .vibroimpact.model.scenario import load_scenario
 
     sc = load_scenario("paper")
     steady_state(sc, sc.law)
     out["vibro-impact"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    from .oscillator.attractor import lyapunov, strobe_points
-    from .oscillator.discover import simulate_record
-    from .oscillator.system import UedaSystem
+    from .ueda.attractor import lyapunov, strobe_points
+    from .ueda.discover import simulate_record
+    from .ueda.system import UedaSystem
 
     system = UedaSystem.from_model("negres")
     simulate_record(system, 2, 50, 0.0, 0, transient=2)

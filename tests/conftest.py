@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from discovery.dynamics.steady_state import steady_state
-from discovery.response import impulse_from_steady_state
-from discovery.scenario import load_scenario
+from discovery.vibroimpact.dynamics.response import impulse_from_steady_state
+from discovery.vibroimpact.dynamics.steady_state import steady_state
+from discovery.vibroimpact.model.scenario import load_scenario
 
 
 @pytest.fixture(scope="session")

@@ -15,7 +15,7 @@ contact frequency ``wc`` and damping ratio ``xi`` on the reduced mass ``mu``
   stiffness and damping match ``k``, ``c`` at ``z0``)
 
 and rejects draws until the periodic steady state reached from rest (found with the
-compiled kernel through :func:`~discovery.dynamics.steady_state.steady_state`; fast,
+compiled kernel through :func:`~discovery.vibroimpact.dynamics.steady_state.steady_state`; fast,
 and only used to *classify* the draw) has the property of the requested category,
 and its slowest Floquet mode decays to 1e-4 within the longest transient (600
 periods: max |multiplier| < 0.985 in every category, so every record is steady):
@@ -38,7 +38,7 @@ twice, then four times as long (at most 600 periods; ``Case.transient``) before 
 draw is dropped.
 
 :func:`reference_record` simulates a case with
-:func:`discovery.dynamics.reference.reference_simulate` (scipy DOP853 restarted at
+:func:`discovery.vibroimpact.dynamics.reference.reference_simulate` (scipy DOP853 restarted at
 every contact event, written independently of the compiled kernel) **from rest**,
 through a transient, and samples the next ``periods`` periods with noise on every
 channel relative to that channel's range.  Tolerances: the transient is integrated
@@ -64,13 +64,13 @@ from functools import cache
 
 import numpy as np
 
-from discovery.dynamics.simulate import Tolerances, simulate
-from discovery.dynamics.steady_state import steady_state
 from discovery.errors import VidiError
-from discovery.law import ForceLaw
-from discovery.response import impulse_from_steady_state
-from discovery.scenario import Scenario
-from discovery.studies.records import (
+from discovery.vibroimpact.dynamics.response import impulse_from_steady_state
+from discovery.vibroimpact.dynamics.simulate import Tolerances, simulate
+from discovery.vibroimpact.dynamics.steady_state import steady_state
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.model.scenario import Scenario
+from discovery.vibroimpact.studies.records import (
     RTOL_RECORD,
     RTOL_TRANSIENT,
     TRANSIENT_DECAY,  # noqa: F401 (used by the tests as R.TRANSIENT_DECAY)
@@ -543,7 +543,7 @@ class Trial:
 
 
 def _trial(label, scenario, law, ref, ref_clean, true):
-    from discovery.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK, evaluate
+    from discovery.vibroimpact.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK, evaluate
 
     nan = float("nan")
     ev = evaluate(scenario, law, ref)
@@ -584,7 +584,7 @@ def _trial(label, scenario, law, ref, ref_clean, true):
 
 def verification_trials(case, noise_seed=0, *, wrong=True, **record_kw):
     """The true law and (with ``wrong``) every :func:`wrong_laws` variant verified with
-    :func:`discovery.verify.evaluate` against a noisy :func:`reference_record` of
+    :func:`discovery.vibroimpact.verify.evaluate` against a noisy :func:`reference_record` of
     ``case`` (noise drawn from ``noise_seed``; ``record_kw`` passed on, default 15
     periods at 20 kHz, 1 % force and 0.2 % motion noise), each also against the
     noise-free record to decide whether its difference is detectable.
@@ -594,7 +594,7 @@ def verification_trials(case, noise_seed=0, *, wrong=True, **record_kw):
     list of Trial
         The true law first.
     """
-    from discovery.verify import Reference
+    from discovery.vibroimpact.verify import Reference
 
     sc = case.scenario
     rec = reference_record(case, seed=noise_seed, **record_kw)

@@ -16,7 +16,7 @@ of the draw time).  A note says how many accepted draws the reference check drop
 With ``--properties`` it verifies, on ``--noise-seeds`` noisy records of each case
 (default record: 15 periods at 20 kHz, 1 % force and 0.2 % motion noise), the true
 law and every wrong law of :func:`realistic.wrong_laws` (one real term dropped, one
-coefficient off by 30 %) with :func:`discovery.verify.evaluate`, and prints per
+coefficient off by 30 %) with :func:`discovery.vibroimpact.verify.evaluate`, and prints per
 category and in all:
 
 * the rate at which the true law is consistent with its record;
@@ -110,8 +110,8 @@ def _fmt_rate(k, n):
 
 
 def _properties(args):
-    from discovery.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK
-    from discovery.verify import evaluate as ev_mod
+    from discovery.vibroimpact.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK
+    from discovery.vibroimpact.verify import evaluate as ev_mod
 
     crit = getattr(sys.modules[ev_mod.__module__], "CONSISTENCY_CRITERIA", ("I2",))
     print(

@@ -6,7 +6,7 @@ machine and seed a record is made by the independent scipy path from rest
 frequency, force noise 2 % of the peak, motion noise 0.2 % of each channel's range), the
 true support is identified by output error (:func:`discovery.identify`) from a start
 20 % off the truth (each coefficient up or down at random), verified
-(:func:`discovery.verify.evaluate`), and every coefficient's interval (``identify``'s
+(:func:`discovery.vibroimpact.verify.evaluate`), and every coefficient's interval (``identify``'s
 standard errors, +-1.96 SE) is checked against the truth.  One JSON line per record;
 ``--summary`` prints
 the coverage per machine and term.
@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 from discovery import ForceLaw, Scenario, identify
-from discovery.verify import Reference, evaluate
+from discovery.vibroimpact.verify import Reference, evaluate
 
 from . import realistic as R
 

@@ -29,8 +29,8 @@ import numpy as np
 
 from discovery import ForceLaw
 from discovery._io import provenance
-from discovery.explain import explain
-from discovery.verify import Reference, evaluate
+from discovery.vibroimpact.explain import explain
+from discovery.vibroimpact.verify import Reference, evaluate
 from tests import realistic as R
 
 CATEGORIES = ("p1", "subharmonic", "p1-slow", "short-contact")

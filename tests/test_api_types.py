@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 import discovery as d
-import discovery.oscillator as osc
+import discovery.ueda as osc
 from discovery.errors import InputError, VidiError, VidiTypeError
-from discovery.oscillator.chart import chart as ueda_chart
-from discovery.verify import verify
+from discovery.ueda.chart import chart as ueda_chart
+from discovery.vibroimpact.verify import verify
 
 SC = d.load_scenario("paper")
 LAW = d.ForceLaw.parse("2.06e8*z + 1.28e7*zd")

@@ -16,7 +16,7 @@ import pytest
 
 from discovery.cli import main
 from discovery.errors import VidiError
-from discovery.synthesize import synthesize
+from discovery.vibroimpact.dynamics.synthesize import synthesize
 
 GOOD_TOML = """\
 name = "bench"
@@ -539,7 +539,7 @@ def test_bad_input(workspace, monkeypatch, capsys, argv, needle):
 def _api_cases():
     from discovery import ForceLaw, Measurement, load_scenario
     from discovery._io import check_output
-    from discovery.scenario import Scenario
+    from discovery.vibroimpact.model.scenario import Scenario
 
     t = np.arange(10) / 1000.0
     return [
@@ -609,7 +609,7 @@ def test_a_bug_is_exit_1_not_bad_input(monkeypatch, capsys, exc):
     or any other exception from a bug is exit 1 with one line asking for a report."""
     import importlib
 
-    R = importlib.import_module("discovery.response")  # the module (its function shadows it)
+    R = importlib.import_module("discovery.vibroimpact.dynamics.response")
 
     def broken(*args, **kwargs):
         raise exc

@@ -110,8 +110,8 @@ def test_bad_csv_messages(body, needle, tmp_path, capsys):
 def test_verify_command_writes_summary_and_figure(tmp_path):
 
     from discovery import load_scenario
-    from discovery.dynamics.reference import reference_simulate
-    from discovery.measurement import Measurement
+    from discovery.vibroimpact.data.measurement import Measurement
+    from discovery.vibroimpact.dynamics.reference import reference_simulate
 
     sc = load_scenario("light")
     T = sc.period

@@ -179,7 +179,9 @@ def test_solver_error_exit_2_one_line(record, tmp_path, capsys, monkeypatch):
         )
 
     # the module (the package attribute of the same name is the function)
-    monkeypatch.setattr(importlib.import_module("discovery.discover"), "discover", fail)
+    monkeypatch.setattr(
+        importlib.import_module("discovery.vibroimpact.fit.discover"), "discover", fail
+    )
     out = tmp_path / "o"
     _assert_clean_failure(
         ["fit", "--data", str(record), "--out", str(out)], out, capsys, "status 'infeasible'"

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from discovery.dynamics import _kernel as K
-from discovery.dynamics.simulate import Tolerances, simulate
 from discovery.errors import InputError
-from discovery.law import ForceLaw
-from discovery.scenario import Scenario, load_scenario
+from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.simulate import Tolerances, simulate
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.model.scenario import Scenario, load_scenario
 from tests.test_kernel import _compare_with_reference
 
 M, MU, KW, V0, GAP = 2.0, 1.0, 1.0e6, 1.0, 1.0e-3  # reduced mass 1 kg; w0 = 1000 rad/s
@@ -175,7 +175,7 @@ def test_kernel_matches_reference_extended(name, text, changes):
 
 def test_a_moulding_that_sheds_mass_has_no_steady_state(tmp_path, capsys):
     from discovery.cli import main
-    from discovery.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.dynamics.steady_state import steady_state
 
     sc = load_scenario("paper").replace(mass_loss=0.01)
     with pytest.raises(InputError, match="no periodic steady state"):
@@ -197,8 +197,8 @@ def test_a_set_orbit_strobed_inside_its_contact_keeps_its_unloading_memory():
     # which penetration the set contact unloads, so the steady state carries it.  The orbit
     # and its force must be the independent scipy path's (without the memory the true law
     # failed its own noise-free record with I2 = 0.11)
-    from discovery.dynamics.steady_state import steady_state
-    from discovery.verify import Reference, evaluate
+    from discovery.vibroimpact.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.verify import Reference, evaluate
     from tests.realistic import reference_record
 
     law = ForceLaw.parse("1.4e8*z + 8.24e6*zd; set: 0.44")

@@ -19,9 +19,9 @@ from pathlib import Path
 import pytest
 
 from discovery import ForceLaw, Measurement, load_scenario
-from discovery.discover import discover
-from discovery.explain import explain
-from discovery.verify import Reference, verify
+from discovery.vibroimpact.explain import explain
+from discovery.vibroimpact.fit.discover import discover
+from discovery.vibroimpact.verify import Reference, verify
 
 CORPUS = Path(__file__).resolve().parents[2] / "shared" / "corpus"
 NAMES = (

@@ -6,12 +6,12 @@ import math
 import numpy as np
 import pytest
 
-from discovery.criteria import CRITERIA, compare, criterion, evaluate_criteria
-from discovery.dynamics.steady_state import steady_state
 from discovery.errors import InputError
-from discovery.impulse import Impulse
-from discovery.law import ForceLaw
-from discovery.response import impulse_from_steady_state
+from discovery.vibroimpact.data.impulse import Impulse
+from discovery.vibroimpact.dynamics.response import impulse_from_steady_state
+from discovery.vibroimpact.dynamics.steady_state import steady_state
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.verify.criteria import CRITERIA, compare, criterion, evaluate_criteria
 
 NAMES = ["I0", "I1", "I2", "I3", "I4"]
 

@@ -6,12 +6,12 @@ import math
 import numpy as np
 import pytest
 
-from discovery.discover import RankedModel, discover, rank
 from discovery.errors import InputError
-from discovery.law import ForceLaw
-from discovery.regression import Candidate
-from discovery.synthesize import synthesize
-from discovery.verify import Evaluation
+from discovery.vibroimpact.dynamics.synthesize import synthesize
+from discovery.vibroimpact.fit.discover import RankedModel, discover, rank
+from discovery.vibroimpact.fit.regression import Candidate
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.verify import Evaluation
 
 RTOL, ATOL = 0.1, 0.005  # discover()'s default ranking rule
 
@@ -291,7 +291,7 @@ def test_stability_disagreement_is_a_warning(noisy_positions):
 def test_contact_samples_do_not_split_impacts_at_noise_dips(paper):
     """Position noise of 5 % of the penetration: zeta dips below its threshold near onset
     and loss; one impact per period is still one impact."""
-    from discovery.samples import contact_samples
+    from discovery.vibroimpact.data.samples import contact_samples
 
     m = synthesize(paper, paper.law, periods=30, fs=20000, noise=0.01, seed=0, position_noise=0.05)
     s = contact_samples(m)
@@ -299,9 +299,9 @@ def test_contact_samples_do_not_split_impacts_at_noise_dips(paper):
 
 
 def test_impact_count_that_does_not_fit_the_regime_is_a_warning(paper):
-    from discovery.discover import _impact_warnings
-    from discovery.samples import contact_samples
-    from discovery.verify import Reference
+    from discovery.vibroimpact.data.samples import contact_samples
+    from discovery.vibroimpact.fit.discover import _impact_warnings
+    from discovery.vibroimpact.verify import Reference
 
     m = synthesize(paper, paper.law, periods=30, fs=20000, noise=0.01, seed=0)
     s = contact_samples(m)

@@ -8,9 +8,9 @@ import pytest
 
 from discovery import ForceLaw, landscape, load_scenario
 from discovery.errors import InputError
-from discovery.executor import Pool, Serial, make_executor
-from discovery.oscillator import UedaSystem
-from discovery.oscillator.chart import chart
+from discovery.numerics.executor import Pool, Serial, make_executor
+from discovery.ueda import UedaSystem
+from discovery.ueda.chart import chart
 
 
 def _square(context, job):
@@ -40,7 +40,7 @@ def test_pool_raises_the_job_error_and_leaves_no_worker():
 
 def test_dask_executor_agrees_with_serial():
     pytest.importorskip("distributed")
-    from discovery.executor import Dask
+    from discovery.numerics.executor import Dask
 
     with Dask("local", workers=2) as ex:
         assert ex.map(_square, list(range(12)), 10) == [10 + j * j for j in range(12)]
@@ -64,7 +64,7 @@ def test_landscape_is_bitwise_the_same_on_every_executor():
     with Serial() as ex:
         _same_landscape(serial, _landscape(executor=ex))
     pytest.importorskip("distributed")
-    from discovery.executor import Dask
+    from discovery.numerics.executor import Dask
 
     with Dask("local", workers=2) as ex:
         land = _landscape(executor=ex)

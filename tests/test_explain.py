@@ -14,10 +14,10 @@ import realistic as R
 from discovery import ForceLaw, load_scenario
 from discovery.cli import main
 from discovery.errors import InputError
-from discovery.explain import EFFECTS, effect, explain, first_order_lag
-from discovery.explain.effects import TARGETS
-from discovery.measurement import Measurement
-from discovery.response import response
+from discovery.vibroimpact.data.measurement import Measurement
+from discovery.vibroimpact.dynamics.response import response
+from discovery.vibroimpact.explain import EFFECTS, effect, explain, first_order_lag
+from discovery.vibroimpact.explain.effects import TARGETS
 
 HC = ForceLaw.parse("2.06e8*z + 0.9e7*zd + 2e10*z*zd")  # Hunt-Crossley-type coupling hidden
 
@@ -151,7 +151,7 @@ def test_the_papers_claim_coupling_moves_the_force_maximum_into_the_impact(paper
 
 def test_first_order_lag_is_exact_for_a_step():
     """A unit step through tau F' + F = F_true reaches 1 - exp(-t / tau)."""
-    from discovery.impulse import Impulse
+    from discovery.vibroimpact.data.impulse import Impulse
 
     W, tau = 1.0, 0.01
     t = np.array([0.0, 0.5, 0.5, 1.0])

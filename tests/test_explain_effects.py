@@ -14,9 +14,9 @@ import realistic as R
 
 from discovery import ForceLaw, load_scenario
 from discovery.cli import main
-from discovery.dynamics import _kernel as K
-from discovery.dynamics.simulate import simulate
-from discovery.explain import explain
+from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.simulate import simulate
+from discovery.vibroimpact.explain import explain
 
 BASE = "2.06e8*z + 4e6*zd"  # the paper's machine, a lighter damper (no dominant jump)
 
@@ -77,7 +77,7 @@ def test_hidden_support_nonlinearity_is_named_in_a_subharmonic_regime(paper):
     assert _named(res)[0] == "support_nonlinearity", [it.evidence for it in res.iterations]
     assert _shrinks(it)
     assert 3e10 < res.final_model.scenario["k3"] < 8e10
-    from discovery.verify import Reference, evaluate
+    from discovery.vibroimpact.verify import Reference, evaluate
 
     ev = evaluate(
         paper.replace(k3=res.final_model.scenario["k3"]),

@@ -114,9 +114,11 @@ def test_public_names_are_what_the_docs_say():
 
     for name in ("explain", "landscape", "identify", "discover", "response", "study"):
         assert callable(getattr(discovery, name)), name
-    assert importlib.import_module("discovery.explain").EFFECTS
-    assert callable(importlib.import_module("discovery.landscape").landscape)
-    from discovery.verify import verify
+    assert importlib.import_module("discovery.vibroimpact.explain").EFFECTS
+    assert callable(importlib.import_module("discovery.vibroimpact.verify.landscape").landscape)
+    for name in ("chart", "discover", "explain", "verify"):  # Ueda's, as the README documents
+        assert callable(getattr(importlib.import_module("discovery.ueda"), name)), name
+    from discovery.vibroimpact.verify import verify
 
     assert callable(verify)
 
@@ -129,8 +131,8 @@ def test_figures_leave_the_users_backend_alone():
 
     code = (
         "import sys, matplotlib; matplotlib.use('svg'); "
-        "import reports.figures, reports.ueda_figures, reports.ueda_explain_figure, "
-        "reports.study_figures; "
+        "import reports.vibroimpact.figures, reports.ueda.figures, reports.ueda.explain_figure, "
+        "reports.vibroimpact.study_figures; "
         "from reports._mpl import subplots, save; import tempfile, os; "
         "fig, ax = subplots(figsize=(2, 2)); ax.plot([0, 1]); "
         "d = tempfile.mkdtemp(); save(fig, os.path.join(d, 'x')); "
@@ -174,3 +176,24 @@ def test_functions_are_short():
                     if n > 100:
                         long.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name} ({n})")
     assert not long, long
+
+
+def _package_imports(pkg):
+    """Project modules imported anywhere in package ``pkg`` (a dotted name)."""
+    out = set()
+    for path in sorted(ROOT.joinpath(*pkg.split(".")).rglob("*.py")):
+        out |= _imports(path, _module_name(path))
+    return out
+
+
+def test_two_systems_on_a_shared_floor():
+    """The layout's rules: the shared numerics import neither system, neither system
+    imports the other, and the vibro-impact data layer does not simulate."""
+    floor = _package_imports("discovery.numerics")
+    assert not {m for m in floor if m.startswith(("discovery.vibroimpact", "discovery.ueda"))}
+    ueda = _package_imports("discovery.ueda")
+    assert not {m for m in ueda if m.startswith("discovery.vibroimpact")}
+    vi = _package_imports("discovery.vibroimpact")
+    assert not {m for m in vi if m.startswith("discovery.ueda")}
+    data = _package_imports("discovery.vibroimpact.data")
+    assert not {m for m in data if m.startswith("discovery.vibroimpact.dynamics")}

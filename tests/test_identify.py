@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 
 from discovery.cli import main
-from discovery.discover import discover
 from discovery.errors import InputError, IntegrationError, VidiError
-from discovery.identify import as_records, identify
-from discovery.law import ForceLaw
-from discovery.synthesize import synthesize
-from discovery.verify import Reference
+from discovery.vibroimpact.dynamics.synthesize import synthesize
+from discovery.vibroimpact.fit.discover import discover
+from discovery.vibroimpact.fit.identify import as_records, identify
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.verify import Reference
 
 START = ForceLaw.parse("1.5e8*z + 0.9e7*zd")
 

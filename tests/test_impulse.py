@@ -5,12 +5,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from discovery.criteria import evaluate_criteria
-from discovery.dynamics import _kernel as K
-from discovery.dynamics.simulate import simulate
 from discovery.errors import InputError
-from discovery.impulse import Impulse, estimate_noise, impulse_from_samples
-from discovery.response import impulse_from_steady_state
+from discovery.vibroimpact.data.impulse import Impulse, estimate_noise, impulse_from_samples
+from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.response import impulse_from_steady_state
+from discovery.vibroimpact.dynamics.simulate import simulate
+from discovery.vibroimpact.verify.criteria import evaluate_criteria
 
 FS = 20_000.0  # sampling rate of the synthetic records [Hz]
 DT = 1.0 / FS

@@ -1,5 +1,5 @@
 """Atomic output directories, output checks, stale staging, provenance, file modes and
-worker processes that die with their parent (discovery._io, discovery._workers)."""
+worker processes that die with their parent (discovery._io, discovery.numerics._workers)."""
 
 import hashlib
 import json
@@ -364,7 +364,7 @@ _POOL = textwrap.dedent("""
     import sys, time
     from concurrent.futures import ProcessPoolExecutor
     from multiprocessing import get_context
-    from discovery._workers import worker_initializer
+    from discovery.numerics._workers import worker_initializer
 
     def work(x):
         time.sleep(120)
@@ -409,7 +409,7 @@ def test_workers_die_with_their_parent():
 def test_die_with_parent_in_this_process_is_harmless():
     # run in a child so the signal dispositions of the test process are untouched
     code = (
-        "import os, signal\nfrom discovery._workers import die_with_parent\n"
+        "import os, signal\nfrom discovery.numerics._workers import die_with_parent\n"
         "print(die_with_parent(), signal.getsignal(signal.SIGINT) is signal.SIG_IGN)"
     )
     out = subprocess.run(

@@ -30,8 +30,8 @@ import pytest
 import realistic as R
 
 from discovery import ForceLaw, Scenario
-from discovery.impulse import _bracket_onset, impulse_from_samples
-from discovery.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK, Reference, evaluate
+from discovery.vibroimpact.data.impulse import _bracket_onset, impulse_from_samples
+from discovery.vibroimpact.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK, Reference, evaluate
 
 
 def _verify(sc, law, record, wrong=()):

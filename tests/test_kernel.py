@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 from scipy.integrate._ivp.rk import RK45
 
-from discovery.dynamics import _kernel as K
-from discovery.dynamics import _tableau
-from discovery.dynamics.reference import reference_simulate
-from discovery.dynamics.simulate import EVENT_NAMES, Tolerances, simulate
 from discovery.errors import InputError, IntegrationError, VidiError, VidiTypeError
-from discovery.law import ForceLaw
-from discovery.scenario import Scenario
+from discovery.numerics import _tableau
+from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.reference import reference_simulate
+from discovery.vibroimpact.dynamics.simulate import EVENT_NAMES, Tolerances, simulate
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.model.scenario import Scenario
 
 # ------------------------------------------------------------------------ (a) tableau
 

@@ -5,12 +5,12 @@ contact loss (the state starts the free flight a hair inside the contact), a gra
 import numpy as np
 import pytest
 
-from discovery.dynamics import _kernel as K
-from discovery.dynamics.reference import reference_simulate
-from discovery.dynamics.simulate import Tolerances, simulate
-from discovery.dynamics.steady_state import steady_state
-from discovery.law import ForceLaw
-from discovery.scenario import Scenario
+from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.reference import reference_simulate
+from discovery.vibroimpact.dynamics.simulate import Tolerances, simulate
+from discovery.vibroimpact.dynamics.steady_state import steady_state
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.model.scenario import Scenario
 
 # ---------------------------------------------- re-contact right after a contact loss
 

@@ -1,5 +1,5 @@
-"""Criteria landscapes: every point through discovery.verify.evaluate, failures kept apart
-from physics, records as references, default ranges centred on the law, bad input."""
+"""Criteria landscapes: every point through discovery.vibroimpact.verify.evaluate, failures kept
+apart from physics, records as references, default ranges centred on the law, bad input."""
 
 import hashlib
 import json
@@ -9,12 +9,12 @@ import pytest
 
 from discovery import ForceLaw, load_scenario
 from discovery.cli import main
-from discovery.criteria import CRITERIA
-from discovery.dynamics import Tolerances
 from discovery.errors import InputError
-from discovery.landscape import Landscape, default_range, landscape
-from discovery.response import response
-from discovery.verify import Reference
+from discovery.vibroimpact.dynamics import Tolerances
+from discovery.vibroimpact.dynamics.response import response
+from discovery.vibroimpact.verify import Reference
+from discovery.vibroimpact.verify.criteria import CRITERIA
+from discovery.vibroimpact.verify.landscape import Landscape, default_range, landscape
 
 
 def test_workers_do_not_change_the_result(paper):
@@ -235,7 +235,7 @@ def test_continuation_gives_the_cold_search_result(paper):
     """Each point started from its neighbour's orbit (the default) lands on the orbit the
     cold search from the start state finds: same regimes, impacts and consistency, criteria
     within the shooting tolerance; and a continued steady state agrees with a cold one."""
-    from discovery.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.dynamics.steady_state import steady_state
 
     a0, a1 = np.linspace(1.2e8, 3.0e8, 5), np.linspace(0.7e7, 1.9e7, 7)
     cold = landscape(paper, paper.law, a0, a1, workers=1, continuation=False)

@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from discovery.errors import InputError, LawSyntaxError
-from discovery.law import ZD, ZETA, ForceLaw, Term
+from discovery.vibroimpact.model.law import ZD, ZETA, ForceLaw, Term
 
 # ----------------------------------------------------------------- grammar / round trip
 

@@ -1,4 +1,5 @@
-"""Candidate term libraries (discovery.library) and the estimator's scikit-learn contract."""
+"""Candidate term libraries (discovery.vibroimpact.model.library) and the estimator's scikit-learn
+contract."""
 
 import inspect
 
@@ -7,8 +8,8 @@ import pytest
 from sklearn.base import clone
 
 from discovery.errors import InputError
-from discovery.library import Library
-from discovery.regression import ConstrainedSparseRegressor
+from discovery.vibroimpact.fit.regression import ConstrainedSparseRegressor
+from discovery.vibroimpact.model.library import Library
 
 # ------------------------------------------------------------------ parsing
 

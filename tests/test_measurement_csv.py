@@ -1,5 +1,5 @@
 """CSV records from real instruments: encodings, separators, column mapping, sampling
-jitter and every refusal as one clear line (discovery.measurement)."""
+jitter and every refusal as one clear line (discovery.vibroimpact.data.measurement)."""
 
 import codecs
 
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from discovery.errors import InputError
-from discovery.measurement import JITTER_LIMIT, Measurement
-from discovery.synthesize import synthesize
+from discovery.vibroimpact.data.measurement import JITTER_LIMIT, Measurement
+from discovery.vibroimpact.dynamics.synthesize import synthesize
 
 FS = 20000.0
 

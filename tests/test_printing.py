@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 import discovery as d
-import discovery.oscillator as osc
-from discovery.verify import verify
+import discovery.ueda as osc
+from discovery.vibroimpact.verify import verify
 
 LAW = d.ForceLaw.parse("2.06e8*z + 1.28e7*zd")
 

@@ -11,7 +11,7 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from discovery.errors import InputError
-from discovery.measurement import LIMITS, Measurement
+from discovery.vibroimpact.data.measurement import LIMITS, Measurement
 
 SETTINGS = settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 OPTIONAL = ("w1", "v1", "w2", "v2")

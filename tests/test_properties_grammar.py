@@ -1,4 +1,5 @@
-"""Property-based tests of the force-law grammar (discovery._lawgrammar, ForceLaw.parse):
+"""Property-based tests of the force-law grammar (discovery.vibroimpact.model._lawgrammar,
+ForceLaw.parse):
 every law reads back from its text exactly, user text is never evaluated, and any text
 either parses or raises InputError (never another exception)."""
 
@@ -10,9 +11,9 @@ import sympy
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from discovery._lawgrammar import parse_law_terms
 from discovery.errors import InputError
-from discovery.law import ForceLaw, Term
+from discovery.vibroimpact.model._lawgrammar import parse_law_terms
+from discovery.vibroimpact.model.law import ForceLaw, Term
 
 SETTINGS = settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 

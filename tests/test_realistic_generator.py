@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 import realistic as R
 
-from discovery.dynamics import _kernel as K
-from discovery.dynamics.reference import reference_simulate
-from discovery.dynamics.simulate import Tolerances, simulate
-from discovery.impulse import estimate_noise
+from discovery.vibroimpact.data.impulse import estimate_noise
+from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.reference import reference_simulate
+from discovery.vibroimpact.dynamics.simulate import Tolerances, simulate
 
 STATE = ("w1", "v1", "w2", "v2")
 FAST_CASE = ("p1", 2)  # accepted at the 2nd draw, 30-period transient: about 1 s in all

@@ -3,7 +3,7 @@
 Records: :func:`realistic.reference_record` of cases drawn by
 :func:`realistic.draw_case` (scipy reference path from rest, 15 steady periods at
 20 kHz, 1 % force noise and 0.2 % of each motion channel's range).  Laws verified with
-:func:`discovery.verify.evaluate` (see :func:`realistic.verification_trials`):
+:func:`discovery.vibroimpact.verify.evaluate` (see :func:`realistic.verification_trials`):
 
 * the true law is consistent with its record in >= 95 % of the records;
 * a wrong law (one real term dropped, or one coefficient off by 30 %: see
@@ -25,8 +25,8 @@ import pytest
 import realistic as R
 
 from discovery import ForceLaw, Scenario
-from discovery.impulse import _edges, _merge_unseparated, impulse_from_samples
-from discovery.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK, Reference, evaluate
+from discovery.vibroimpact.data.impulse import _edges, _merge_unseparated, impulse_from_samples
+from discovery.vibroimpact.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK, Reference, evaluate
 
 RATE = 0.95
 NOISE_SEEDS = (0, 1)

@@ -1,4 +1,4 @@
-"""The scipy reference path (``discovery.dynamics.reference``) at contact losses.
+"""The scipy reference path (``discovery.vibroimpact.dynamics.reference``) at contact losses.
 
 Two former bugs, both at a segment that starts on a switching surface:
 
@@ -22,12 +22,12 @@ their start states are the reference's own states at an event, to full precision
 import numpy as np
 import pytest
 
-from discovery.dynamics import _kernel as K
-from discovery.dynamics import reference as R
-from discovery.dynamics.reference import reference_simulate
-from discovery.dynamics.simulate import EVENT_NAMES, Tolerances, simulate
-from discovery.law import ForceLaw
-from discovery.scenario import Scenario, load_scenario
+from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics import reference as R
+from discovery.vibroimpact.dynamics.reference import reference_simulate
+from discovery.vibroimpact.dynamics.simulate import EVENT_NAMES, Tolerances, simulate
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.model.scenario import Scenario, load_scenario
 
 TIGHT = Tolerances(rtol=1e-11)
 

@@ -1,4 +1,4 @@
-"""Sparse certified regression (discovery.regression.ConstrainedSparseRegressor)."""
+"""Sparse certified regression (discovery.vibroimpact.fit.regression.ConstrainedSparseRegressor)."""
 
 import itertools
 import math
@@ -12,15 +12,15 @@ from sklearn.exceptions import NotFittedError
 from sklearn.utils import estimator_checks
 from sklearn.utils.validation import check_is_fitted
 
-import discovery.regression as regression
+import discovery.vibroimpact.fit.regression as regression
 from constraints import certify, constraint_rows
 from constraints.errors import SolverError
 from discovery.errors import InputError
-from discovery.law import ForceLaw
-from discovery.library import Library
-from discovery.regression import SELECTIONS, ConstrainedSparseRegressor
-from discovery.samples import contact_samples
-from discovery.synthesize import synthesize
+from discovery.vibroimpact.data.samples import contact_samples
+from discovery.vibroimpact.dynamics.synthesize import synthesize
+from discovery.vibroimpact.fit.regression import SELECTIONS, ConstrainedSparseRegressor
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.model.library import Library
 
 LAW11 = "2.06e8*z + 1.28e7*zd"
 LAW11_ZZD = "2.06e8*z + 1.28e7*zd + 2e10*z*zd"

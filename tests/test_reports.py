@@ -264,7 +264,7 @@ def test_user_text_in_figures_is_not_read_as_mathtext(tmp_path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from reports.figures import plain
+    from reports.vibroimpact.figures import plain
 
     name = r"r$\frac{1}{0$_x.csv"
     fig, ax = plt.subplots()

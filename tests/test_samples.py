@@ -1,13 +1,14 @@
-"""Contact samples for the regression (discovery.samples) and CSV records with a2."""
+"""Contact samples for the regression (discovery.vibroimpact.data.samples) and CSV records with
+a2."""
 
 import numpy as np
 import pytest
 
 from discovery.errors import InputError
-from discovery.impulse import impulse_from_samples
-from discovery.measurement import Measurement
-from discovery.samples import contact_samples
-from discovery.synthesize import synthesize
+from discovery.vibroimpact.data.impulse import impulse_from_samples
+from discovery.vibroimpact.data.measurement import Measurement
+from discovery.vibroimpact.data.samples import contact_samples
+from discovery.vibroimpact.dynamics.synthesize import synthesize
 
 
 @pytest.fixture(scope="module")

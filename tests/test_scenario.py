@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from discovery.errors import InputError, LawSyntaxError
-from discovery.law import ForceLaw
-from discovery.scenario import Scenario, builtin_scenarios, load_scenario
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.model.scenario import Scenario, builtin_scenarios, load_scenario
 
 GOOD = """\
 name = "bench"

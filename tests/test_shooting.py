@@ -16,8 +16,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 
-from discovery.dynamics import Tolerances
-from discovery.dynamics.shooting import (
+from discovery.numerics.shooting import (
     PeriodMap,
     floquet_multipliers,
     is_stable,
@@ -25,10 +24,11 @@ from discovery.dynamics.shooting import (
     recurrence,
     smallest_period,
 )
-from discovery.law import ForceLaw
-from discovery.oscillator import UedaMap, UedaSystem, classify, periodic_orbit, trajectory
-from discovery.oscillator.attractor import _setup, _variational, classify_points, strobe_points
-from discovery.scenario import Scenario
+from discovery.ueda import UedaMap, UedaSystem, classify, periodic_orbit, trajectory
+from discovery.ueda.attractor import _setup, _variational, classify_points, strobe_points
+from discovery.vibroimpact.dynamics import Tolerances
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.model.scenario import Scenario
 
 ENTRAINED = UedaSystem.from_model("negres", B=0.45, nu=1.05)  # tests/test_ueda.py: P1
 
@@ -183,7 +183,7 @@ def test_vibro_impact_paper_steady_state_unchanged(paper_ss):
 def test_vibro_impact_period_reduction_unchanged():
     """Multiplier -0.985: the recurrence suggests n = 2, shooting reduces it to P1 (the
     path through smallest_period)."""
-    from discovery.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.dynamics.steady_state import steady_state
 
     sc = Scenario(
         m1=4770.989046559852,

@@ -5,12 +5,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from discovery.dynamics import _kernel as K
-from discovery.dynamics.simulate import simulate
-from discovery.dynamics.steady_state import StroboscopicMap, steady_state
 from discovery.errors import IntegrationError
-from discovery.law import ForceLaw
-from discovery.scenario import Scenario
+from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.simulate import simulate
+from discovery.vibroimpact.dynamics.steady_state import StroboscopicMap, steady_state
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.model.scenario import Scenario
 
 
 def _rel(pm, a, b):

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from discovery.errors import InputError
-from discovery.studies import FACTORS, load_study, study, wilson
-from discovery.studies.config import run_key
-from discovery.studies.records import clean_record, field_record
+from discovery.vibroimpact.studies import FACTORS, load_study, study, wilson
+from discovery.vibroimpact.studies.config import run_key
+from discovery.vibroimpact.studies.records import clean_record, field_record
 
 ROOT = Path(__file__).resolve().parent.parent
 VIDI = [sys.executable, "-c", "import sys; from discovery.cli import main; sys.exit(main())"]
@@ -218,7 +218,7 @@ def test_study_survives_a_killed_dask_worker(quick_serial, tmp_path):
     """A worker process killed mid-study: its tasks are rescheduled, every run is done once
     and the numbers do not change."""
     pytest.importorskip("distributed")
-    from discovery.executor import Dask
+    from discovery.numerics.executor import Dask
 
     _, full = quick_serial
     killed = []

@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from discovery.dynamics import Tolerances
-from discovery.oscillator import (
+from discovery.ueda import (
     UedaSystem,
     attractor,
     basins,
@@ -19,7 +18,8 @@ from discovery.oscillator import (
     strobe_points,
     trajectory,
 )
-from discovery.oscillator.chart import KINDS, chart
+from discovery.ueda.chart import KINDS, chart
+from discovery.vibroimpact.dynamics import Tolerances
 
 NEGRES = UedaSystem.from_model("negres")
 DUFFING = UedaSystem.from_model("duffing")

@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 
 from discovery.errors import InputError
-from discovery.oscillator import UedaSystem, basins, classify, periodic_orbit, strobe_points
-from discovery.oscillator.chart import KINDS, chart
+from discovery.ueda import UedaSystem, basins, classify, periodic_orbit, strobe_points
+from discovery.ueda.chart import KINDS, chart
 
 NEGRES = UedaSystem.from_model("negres")
 DUFFING = UedaSystem.from_model("duffing")

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from discovery.errors import InputError
-from discovery.oscillator import UedaSystem
-from discovery.oscillator.discover import (
+from discovery.ueda import UedaSystem
+from discovery.ueda.discover import (
     FORCING,
     ForcedPolynomial,
     classify_record,
@@ -315,7 +315,7 @@ def test_one_csv_reader_for_both_systems(tmp_path):
     """The Ueda records go through the vibro-impact reader: a byte-order mark, ';' with
     decimal commas, comments are read; a huge field, a missing column and text in a number
     are one line each."""
-    from discovery.oscillator.discover import read_record_csv
+    from discovery.ueda.discover import read_record_csv
 
     t = 0.15 * np.arange(400)
     x = np.sin(t)

@@ -11,11 +11,11 @@ import json
 import pytest
 
 from discovery.errors import InputError
-from discovery.explain.effects import Effect, Parameter
-from discovery.oscillator import EFFECTS, UedaSystem, explain
-from discovery.oscillator.discover import FORCING, TERMS, simulate_record
-from discovery.oscillator.effects import effect, in_bounds
-from discovery.oscillator.explain import DEFAULT_START, parse_terms
+from discovery.ueda import EFFECTS, UedaSystem, explain
+from discovery.ueda.discover import FORCING, TERMS, simulate_record
+from discovery.ueda.effects import effect, in_bounds
+from discovery.ueda.explain import DEFAULT_START, parse_terms
+from discovery.vibroimpact.explain.effects import Effect, Parameter
 
 NEGRES = UedaSystem.from_model("negres")
 TRUE_TERMS = ("x'", "x^3", "x^2 x'")  # the library's order

@@ -1,6 +1,6 @@
 """Verification against records made by the independent scipy path with realistic noise.
 
-Every record here comes from :func:`discovery.dynamics.reference.reference_simulate`
+Every record here comes from :func:`discovery.vibroimpact.dynamics.reference.reference_simulate`
 (not the compiled kernel), from rest, through a transient, with noise relative to
 each channel's own range: so the penetration ``w1 - w2`` is noisy.
 """
@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from discovery import ForceLaw, Measurement, Scenario, load_scenario, simulate
-from discovery.dynamics.reference import reference_simulate
-from discovery.impulse import estimate_noise
-from discovery.response import response
-from discovery.verify import Reference, evaluate, verify
+from discovery.vibroimpact.data.impulse import estimate_noise
+from discovery.vibroimpact.dynamics.reference import reference_simulate
+from discovery.vibroimpact.dynamics.response import response
+from discovery.vibroimpact.verify import Reference, evaluate, verify
 
 
 def _record(
@@ -134,7 +134,7 @@ def test_subharmonic_with_several_impacts_is_aligned():
     assert v.consistent, v.verdict
     # without positions (the force alone) the impacts are aligned: each other impact taken
     # as t* matches far worse than the one chosen
-    from discovery.criteria import evaluate_criteria
+    from discovery.vibroimpact.verify.criteria import evaluate_criteria
 
     v = verify(
         _SUB,

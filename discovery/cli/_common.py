@@ -21,8 +21,8 @@ import numpy as np
 
 from .._io import check_output
 from ..errors import InputError
-from ..law import ForceLaw
-from ..scenario import builtin_scenarios
+from ..vibroimpact.model.law import ForceLaw
+from ..vibroimpact.model.scenario import builtin_scenarios
 
 SCENARIO_HELP = (
     f"built-in scenario ({', '.join(builtin_scenarios())}) or a TOML file (default: paper)"
@@ -137,7 +137,7 @@ def parse_range(text, default, name):
 # ------------------------------------------------------------------ records and outputs
 def parse_columns(text, option="--columns"):
     """``"t=time_s,F=force_N"`` -> ``{"t": "time_s", "F": "force_N"}`` (None for None)."""
-    from ..measurement import COLUMNS
+    from ..vibroimpact.data.measurement import COLUMNS
 
     if text is None:
         return None
@@ -185,7 +185,7 @@ def executor_of(args):
 
     if not getattr(args, "scheduler", None):
         return contextlib.nullcontext(None)
-    from ..executor import make_executor
+    from ..numerics.executor import make_executor
 
     return make_executor(getattr(args, "workers", None), args.scheduler)
 
@@ -197,7 +197,7 @@ def add_record_options(parser):
 
 def read_record(args, scenario, path=None):
     """The record ``path`` (default ``args.data``) read with ``args.columns``."""
-    from ..measurement import Measurement
+    from ..vibroimpact.data.measurement import Measurement
 
     columns = parse_columns(getattr(args, "columns", None))
     return Measurement.from_csv(
@@ -240,7 +240,7 @@ def check_out(args, kind="dir", option="--out"):
 def read_records(args):
     """Every ``--data`` record with its scenario (``--scenario`` once per ``--data`` in the
     same order, or once for all): ``(scenarios, measurements)``; notes are printed."""
-    from ..scenario import load_scenario
+    from ..vibroimpact.model.scenario import load_scenario
 
     data = _listed(args.data)
     names = _listed(args.scenario) or ["paper"]
@@ -268,8 +268,8 @@ def criteria_line(criteria, floor):
 
 def coefficients_line(coefficients, errors, intervals=None):
     """``  coefficients (standard error): z c (se), ...`` for the command's printout, and
-    with ``intervals`` (:class:`discovery.intervals.Intervals`) a second line with them and
-    what the standard errors do not cover."""
+    with ``intervals`` (:class:`discovery.vibroimpact.fit.intervals.Intervals`) a second line with
+    them and what the standard errors do not cover."""
     line = "  coefficients (standard error): " + ", ".join(
         f"{t} {c:.4g} ({errors.get(t, float('nan')):.2g})" for t, c in coefficients.items()
     )

@@ -3,7 +3,7 @@
 import time
 
 from .._io import OutputDir, provenance
-from ..criteria import CRITERIA
+from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
     SCENARIO_HELP,
     SCHEDULER_HELP,
@@ -25,7 +25,7 @@ def run(args):
     from reports import explain_figure
 
     from ..catalogue import select
-    from ..explain import EFFECTS, explain
+    from ..vibroimpact.explain import EFFECTS, explain
 
     t_start = time.perf_counter()
     check_out(args)
@@ -102,7 +102,7 @@ def run(args):
 
 
 def _catalogue():
-    from ..explain.effects import EFFECTS
+    from ..vibroimpact.explain.effects import EFFECTS
 
     return EFFECTS
 

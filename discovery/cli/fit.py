@@ -7,7 +7,7 @@ import json
 import time
 
 from .._io import OutputDir, provenance, to_jsonable
-from ..criteria import CRITERIA
+from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
     SCENARIO_HELP,
     add_record_options,
@@ -25,7 +25,7 @@ from ._common import (
 
 def _discover(args, scs, meas, progress):
     """The API call the options describe."""
-    from ..discover import discover
+    from ..vibroimpact.fit.discover import discover
 
     return discover(
         scs,

@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 
 from .._io import OutputDir, provenance
-from ..criteria import CRITERIA
 from ..errors import InputError
-from ..law import ForceLaw
-from ..scenario import load_scenario
+from ..vibroimpact.model.law import ForceLaw
+from ..vibroimpact.model.scenario import load_scenario
+from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
     SCENARIO_HELP,
     add_record_options,
@@ -91,7 +91,7 @@ def _iterate_impulses(sc, start, ref, res):
     """The impulses the figure shows: a few best-so-far laws found before the identified
     law, labelled by the simulations spent (``res.iterations`` lists every new best, the
     finite-difference probes included), then the identified law itself."""
-    from ..verify import evaluate
+    from ..vibroimpact.verify import evaluate
 
     its = res.iterations
     found = next(
@@ -187,9 +187,9 @@ def _print_result(args, res):
 def run(args):
     from reports import identification_figure
 
-    from ..identify import identify
-    from ..landscape import Landscape
-    from ..verify import Reference
+    from ..vibroimpact.fit.identify import identify
+    from ..vibroimpact.verify import Reference
+    from ..vibroimpact.verify.landscape import Landscape
 
     check_out(args)
     sc = load_scenario(args.scenario)

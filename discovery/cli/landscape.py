@@ -7,9 +7,9 @@ import io
 import numpy as np
 
 from .._io import OutputDir, provenance
-from ..criteria import CRITERIA
 from ..errors import InputError
-from ..scenario import load_scenario
+from ..vibroimpact.model.scenario import load_scenario
+from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
     SCENARIO_HELP,
     SCHEDULER_HELP,
@@ -55,7 +55,7 @@ def _sha256(path):
 
 def _ranges(args, law):
     """The two coefficient ranges and where they came from."""
-    from ..landscape import DEFAULT_SPREAD, default_range
+    from ..vibroimpact.verify.landscape import DEFAULT_SPREAD, default_range
 
     out, origin = [], []
     for k, (text, opt) in enumerate(((args.range0, "--range0"), (args.range1, "--range1"))):
@@ -82,7 +82,7 @@ def _ranges(args, law):
 
 def _reference(args, sc):
     """``(Reference or None, description for summary.json, notes)``."""
-    from ..verify import Reference
+    from ..vibroimpact.verify import Reference
 
     if args.data is None:
         if sc.law is None:
@@ -117,7 +117,7 @@ def _reference(args, sc):
 def run(args):
     from reports import landscape_figure
 
-    from ..landscape import landscape, parse_grid
+    from ..vibroimpact.verify.landscape import landscape, parse_grid
 
     check_out(args)
     sc = load_scenario(args.scenario)

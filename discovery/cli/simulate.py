@@ -11,7 +11,7 @@ import time
 
 from .._io import atomic_write_text, check_output, provenance, to_jsonable
 from ..errors import InputError
-from ..scenario import load_scenario
+from ..vibroimpact.model.scenario import load_scenario
 from ._common import (
     LAW_HELP,
     SCENARIO_HELP,
@@ -28,7 +28,7 @@ MAX_SAMPLES = 10_000_000
 
 
 def run(args):
-    from ..synthesize import synthesize
+    from ..vibroimpact.dynamics.synthesize import synthesize
 
     out = check_out(args, kind="file")
     if out.suffix.lower() != ".csv":

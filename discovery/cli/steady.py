@@ -5,12 +5,12 @@ from pathlib import Path
 import numpy as np
 
 from .._io import OutputDir, provenance
-from ..scenario import load_scenario
+from ..vibroimpact.model.scenario import load_scenario
 from ._common import LAW_HELP, SCENARIO_HELP, check_out, inputs_of, law_or_default
 
 
 def run(args):
-    from ..response import response
+    from ..vibroimpact.dynamics.response import response
 
     if args.out is not None:
         check_out(args)

@@ -3,7 +3,7 @@
 
 def run(args):
     from .._io import set_run
-    from ..studies.driver import study
+    from ..vibroimpact.studies.driver import study
     from ._common import reporter
 
     set_run("study", getattr(args, "overwrite", False))

@@ -1,7 +1,7 @@
 """``vidi verify``: is a law consistent with a record?"""
 
 from .._io import OutputDir, provenance
-from ..scenario import load_scenario
+from ..vibroimpact.model.scenario import load_scenario
 from ._common import (
     LAW_HELP,
     SCENARIO_HELP,
@@ -19,7 +19,7 @@ from ._common import (
 def run(args):
     from reports import verify_figure
 
-    from ..verify import verify
+    from ..vibroimpact.verify import verify
 
     check_out(args)
     sc = load_scenario(args.scenario)

@@ -8,7 +8,7 @@ _PARAMS = ("mu", "gamma", "k", "B", "nu")
 
 
 def _system(args, **fixed):
-    from ...oscillator import UedaSystem
+    from ...ueda import UedaSystem
 
     over = {p: getattr(args, p, None) for p in _PARAMS}
     over.update(fixed)
@@ -16,7 +16,7 @@ def _system(args, **fixed):
 
 
 def _tolerances(args):
-    from ...dynamics.tolerances import Tolerances
+    from ...numerics.tolerances import Tolerances
 
     return Tolerances(rtol=args.rtol)
 
@@ -49,7 +49,7 @@ def _add_system_options(s, chart=False):
 
 
 def _forcing(args):
-    from ...oscillator import MODELS
+    from ...ueda import MODELS
 
     if args.model is None and (args.B is None or args.nu is None):
         raise InputError(

@@ -10,9 +10,9 @@ from ._system import _add_system_options, _system, _tolerances
 
 
 def run(args):
-    from reports.ueda_figures import attractor_figure, basins_figure
+    from reports.ueda.figures import attractor_figure, basins_figure
 
-    from ...oscillator import attractor, basins
+    from ...ueda import attractor, basins
 
     check_out(args)
     system = _system(args)

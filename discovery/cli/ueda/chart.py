@@ -29,9 +29,9 @@ def _grid(text, option):
 
 
 def run(args):
-    from reports.ueda_figures import chart_figure
+    from reports.ueda.figures import chart_figure
 
-    from ...oscillator.chart import chart
+    from ...ueda.chart import chart
 
     check_out(args)
     if args.nu[0] <= 0:

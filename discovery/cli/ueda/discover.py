@@ -12,9 +12,9 @@ from ._system import _forcing
 
 
 def run(args):
-    from reports.ueda_figures import discover_figure
+    from reports.ueda.figures import discover_figure
 
-    from ...oscillator.discover import discover, read_record_csv, verify
+    from ...ueda.discover import discover, read_record_csv, verify
 
     check_out(args)
     B, nu = _forcing(args)

@@ -10,10 +10,10 @@ from ._system import _forcing
 
 
 def run(args):
-    from reports.ueda_explain_figure import explain_figure
+    from reports.ueda.explain_figure import explain_figure
 
-    from ...oscillator.discover import read_record_csv
-    from ...oscillator.explain import explain, parse_terms
+    from ...ueda.discover import read_record_csv
+    from ...ueda.explain import explain, parse_terms
 
     check_out(args)
     B, nu = _forcing(args)

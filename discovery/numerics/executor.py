@@ -1,0 +1,225 @@
+"""One executor for every sweep: serial, a local process pool, or a Dask cluster.
+
+A sweep (landscape rows, chart rows, explain's screening refits, study runs) is a list of
+*jobs* and one read-only *context* shared by all of them, and a module-level function
+``fn(context, job)`` that does one job.  :meth:`Executor.run` yields ``(index, result)`` as
+jobs finish, in any order; the caller puts each result in its place, so the outcome does
+not depend on the executor, the worker count or the order of completion::
+
+    with make_executor(workers=2) as ex:           # or scheduler="local" / "tcp://..."
+        for i, out in ex.run(fn, jobs, context):
+            results[i] = out
+
+* :class:`Serial`: in this process (``workers=1``).
+* :class:`Pool`: forked local processes (the default).  The context reaches the workers
+  through the fork, not by pickling; workers die with their parent and leave Ctrl-C to it
+  (:mod:`discovery.numerics._workers`).
+* :class:`Dask`: a ``distributed.Client`` (``scheduler="local"`` starts a ``LocalCluster``
+  of single-threaded worker processes).  The context is scattered once to every worker;
+  tasks are pure functions of their arguments (the seeds are in the jobs), so a task that
+  runs twice (a worker lost mid-task) gives the same result; the scheduler reschedules the
+  tasks of a lost worker.  The numba cache is built once before any worker compiles
+  (concurrent cache builds have crashed workers).
+
+Jobs should each last well over 100 ms on a cluster (per-task overhead is ~1 ms locally and
+more across machines): callers batch short work (a landscape row, not a point).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from multiprocessing import get_context
+
+from .._validate import Real, Text, params
+from ..errors import InputError
+from ._workers import terminate_pool, worker_initializer
+
+__all__ = ["Executor", "Serial", "Pool", "Dask", "make_executor"]
+
+_CONTEXT = {}  # the context of the sweep running in this (worker) process
+_THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
+
+
+def _set_context(context):
+    _CONTEXT.clear()
+    _CONTEXT["value"] = context
+
+
+def _call(fn, job):
+    return fn(_CONTEXT.get("value"), job)
+
+
+def _call_with(fn, context, job):
+    return fn(context, job)
+
+
+class Executor:
+    """Runs ``fn(context, job)`` for every job; see the module docstring."""
+
+    name = "executor"
+    workers = 1
+
+    def run(self, fn, jobs, context=None):
+        """Yield ``(index, fn(context, jobs[index]))`` as the jobs finish."""
+        raise NotImplementedError
+
+    def map(self, fn, jobs, context=None):
+        """The results in the order of ``jobs`` (a list)."""
+        out = [None] * len(jobs)
+        for i, r in self.run(fn, jobs, context):
+            out[i] = r
+        return out
+
+    def close(self):
+        """Release the workers (a no-op for executors that own none)."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def __repr__(self):
+        return f"{type(self).__name__}(workers={self.workers})"
+
+
+class Serial(Executor):
+    """Every job in this process, in order."""
+
+    name = "serial"
+
+    def run(self, fn, jobs, context=None):
+        for i, job in enumerate(jobs):
+            yield i, fn(context, job)
+
+
+class Pool(Executor):
+    """Forked local worker processes (a new pool per sweep: the context is forked in)."""
+
+    name = "process pool"
+
+    def __init__(self, workers=None):
+        self.workers = max(1, int(workers or os.cpu_count() or 1))
+
+    def run(self, fn, jobs, context=None):
+        jobs = list(jobs)
+        n = min(self.workers, len(jobs))
+        if n <= 1:
+            yield from Serial().run(fn, jobs, context)
+            return
+        pool = ProcessPoolExecutor(
+            n, mp_context=get_context("fork"), **worker_initializer(_set_context, (context,))
+        )
+        try:
+            pending = {pool.submit(_call, fn, job): i for i, job in enumerate(jobs)}
+            while pending:
+                done, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for fut in done:
+                    i = pending.pop(fut)
+                    yield i, fut.result()
+        except BaseException:
+            terminate_pool(pool)  # interrupted, failed or abandoned: no waiting for the queue
+            raise
+        pool.shutdown()
+
+
+def _warm_worker():
+    from ..warm import warm
+
+    warm()
+    return os.getpid()
+
+
+class Dask(Executor):
+    """A ``distributed.Client``: ``address`` is a scheduler (``tcp://host:port``) or
+    ``"local"`` for a ``LocalCluster`` of ``workers`` single-threaded processes."""
+
+    name = "dask"
+
+    def __init__(self, address="local", workers=None):
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:
+            raise InputError(
+                "--scheduler needs Dask's distributed scheduler; install it with "
+                "pip install 'vibroimpact-discovery[dask]'"
+            ) from None
+        self.address = str(address)
+        self._cluster = None
+        if self.address == "local":
+            # compile (or load) the kernels here first: the workers then only read the cache
+            _warm_worker()
+            n = max(1, int(workers or os.cpu_count() or 1))
+            import dask
+
+            # the workers get this process's BLAS/OpenMP thread settings, like the pool's
+            # forked workers (Dask sets them to 1 by default; a BLAS initialised with
+            # another thread count can sum in another order and move an optimiser's path)
+            environ = {
+                k: v
+                for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
+                if k not in _THREAD_VARS
+            }
+            environ.update({k: os.environ[k] for k in _THREAD_VARS if k in os.environ})
+            with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
+                self._cluster = LocalCluster(
+                    n_workers=n,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                    silence_logs=50,
+                )
+            self.client = Client(self._cluster)
+        else:
+            try:
+                self.client = Client(self.address, timeout="5s")
+            except (OSError, TimeoutError, ValueError) as exc:
+                raise InputError(
+                    f"cannot reach the Dask scheduler at {self.address} ({exc}); "
+                    "start one (dask scheduler) or use --scheduler local"
+                ) from None
+            workers = sorted(self.client.scheduler_info()["workers"])
+            if workers:  # one worker builds the cache, then the others load it
+                self.client.run(_warm_worker, workers=workers[:1])
+                self.client.run(_warm_worker)
+        self.workers = max(1, len(self.client.scheduler_info()["workers"]))
+
+    def run(self, fn, jobs, context=None):
+        from distributed import as_completed
+
+        jobs = list(jobs)
+        if not jobs:
+            return
+        ctx = self.client.scatter(context, broadcast=True, hash=False)
+        futures = self.client.map(_call_with, [fn] * len(jobs), [ctx] * len(jobs), jobs, pure=False)
+        index = {f.key: i for i, f in enumerate(futures)}
+        try:
+            for fut in as_completed(futures):
+                yield index[fut.key], fut.result()
+        finally:
+            self.client.cancel(futures)
+            with contextlib.suppress(Exception):
+                self.client.cancel([ctx])
+
+    def close(self):
+        with contextlib.suppress(Exception):
+            self.client.close()
+        if self._cluster is not None:
+            with contextlib.suppress(Exception):
+                self._cluster.close()
+
+    def __repr__(self):
+        return f"Dask({self.address!r}, workers={self.workers})"
+
+
+@params(workers=(None, Real(1, 4096, integer=True)), scheduler=(None, Text()))
+def make_executor(workers=None, scheduler=None):
+    """The executor for ``workers`` local processes (``None``: one per CPU; 1: serial), or
+    a Dask cluster when ``scheduler`` is given (``"local"`` or a scheduler address)."""
+    if scheduler:
+        return Dask(scheduler, workers)
+    n = max(1, int(workers or os.cpu_count() or 1))
+    return Serial() if n == 1 else Pool(n)

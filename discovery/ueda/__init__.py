@@ -1,0 +1,61 @@
+"""The second system: Ueda's periodically forced oscillators.
+
+``x'' - (mu (1 - gamma x^2) - k) x' + x^3 = B cos(nu t)`` - the negative-resistance
+oscillator of the "broken egg" (``negres``) and Ueda's classical Duffing-type oscillator
+(``duffing``).  Integrated by the Dormand-Prince machinery shared with the vibro-impact
+system (:mod:`discovery.numerics._dopri`).
+
+* :class:`UedaSystem` - the system description (parameters, rhs, Jacobian, period);
+* :func:`attractor`, :func:`lyapunov`, :func:`lyapunov_two_trajectory`,
+  :func:`classify`, :func:`basins`, :func:`strobe_points`, :func:`trajectory`;
+* :class:`UedaMap`, :func:`periodic_orbit`, :class:`PeriodicOrbit` - the period map,
+  shooting and Floquet multipliers (:mod:`discovery.numerics.shooting`, shared with the
+  vibro-impact system) - :mod:`.periodic`;
+* :func:`chart` -> :class:`Chart` - the regime chart over ``(nu, B)`` in parallel processes;
+* :func:`discover` (equation discovery from a record ``t, x`` with known forcing) and
+  :func:`verify` (the discovered equation's attractor against the record's),
+  :class:`ForcedPolynomial`, :func:`simulate_record` - :mod:`.discover`;
+* :func:`explain` (the missing-effect workflow) -> :class:`Explanation`, over this
+  system's catalogue :data:`EFFECTS` - :mod:`.explain`, :mod:`.effects`.
+"""
+
+from .._lazy import lazy_package
+
+# names are imported on first use; a function named like its module (chart, discover,
+# explain) stays the function
+_EXPORTS = {
+    "Attractor": "attractor",
+    "Basins": "attractor",
+    "Lyapunov": "attractor",
+    "Regime": "attractor",
+    "attractor": "attractor",
+    "basins": "attractor",
+    "classify": "attractor",
+    "classify_points": "attractor",
+    "lyapunov": "attractor",
+    "lyapunov_two_trajectory": "attractor",
+    "rotation_number": "attractor",
+    "strobe_points": "attractor",
+    "trajectory": "attractor",
+    "Chart": "chart",
+    "chart": "chart",
+    "KINDS": "chart",
+    "Discovery": "discover",
+    "ForcedPolynomial": "discover",
+    "Verification": "discover",
+    "discover": "discover",
+    "simulate_record": "discover",
+    "verify": "discover",
+    "EFFECTS": "effects",
+    "Explanation": "explain",
+    "explain": "explain",
+    "PeriodicOrbit": "periodic",
+    "UedaMap": "periodic",
+    "periodic_orbit": "periodic",
+    "MODELS": "system",
+    "UedaSystem": "system",
+}
+
+__all__ = list(_EXPORTS)
+
+lazy_package(__name__, _EXPORTS)

@@ -1,0 +1,593 @@
+"""Compiled integrators of Ueda's forced oscillators, on the shared Dormand–Prince blocks.
+
+One equation covers both built-in models::
+
+    x'' - (mu (1 - gamma x^2) - k) x' + x^3 = B cos(nu t)
+
+(``negres``: ``k = 0``; ``duffing``: ``mu = 0``).  Parameter array
+``p = [mu, gamma, k, B, nu]``.  The right-hand sides are written here; the method
+(stages, error norm, dense output, step control, landing exactly on strobe times) is
+:func:`discovery.numerics._dopri.make_smooth_advance`, the same source the
+vibro-impact kernel's steps use.
+
+Three state layouts, each its own compiled integrator (the state size is a compile-time
+constant of the shared blocks):
+
+* 2 states ``(x, v)``: trajectories and stroboscopic points;
+* 7 states ``(x, v, u1, u2, trace)``: the variational equations for two tangent vectors
+  ``u1, u2`` (Benettin's method, Gram-Schmidt at every strobe time) and the integral
+  of the Jacobian's trace over the segment (the sum of the exponents, checked);
+* 4 states ``(x, v, x', v')``: two nearby trajectories integrated as one system (one
+  step sequence, so their local errors are correlated), renormalised at every strobe
+  time (the two-trajectory estimate of the largest exponent).
+"""
+
+import numpy as np
+from numba import njit
+
+from ..numerics._dopri import OK, make_smooth_advance
+
+__all__ = [
+    "strobe_run",
+    "variational_run",
+    "pair_run",
+    "scan_run",
+    "monodromy_run",
+    "model_strobe_run",
+    "model_variational_run",
+    "OK",
+]
+
+
+@njit(cache=True, inline="always")
+def _accel(t, x, v, p):
+    return (p[0] * (1.0 - p[1] * x * x) - p[2]) * v - x * x * x + p[3] * np.cos(p[4] * t)
+
+
+@njit(cache=True, inline="always")
+def _rhs2(t, y, p, out):
+    out[0] = y[1]
+    out[1] = _accel(t, y[0], y[1], p)
+
+
+@njit(cache=True, inline="always")
+def _rhs7(t, y, p, out):
+    x = y[0]
+    v = y[1]
+    damp = p[0] * (1.0 - p[1] * x * x) - p[2]
+    a10 = -2.0 * p[0] * p[1] * x * v - 3.0 * x * x  # d(accel)/dx
+    out[0] = v
+    out[1] = damp * v - x * x * x + p[3] * np.cos(p[4] * t)
+    out[2] = y[3]
+    out[3] = a10 * y[2] + damp * y[3]
+    out[4] = y[5]
+    out[5] = a10 * y[4] + damp * y[5]
+    out[6] = damp  # trace of the Jacobian [[0, 1], [a10, damp]]
+
+
+@njit(cache=True, inline="always")
+def _rhs4(t, y, p, out):
+    out[0] = y[1]
+    out[1] = _accel(t, y[0], y[1], p)
+    out[2] = y[3]
+    out[3] = _accel(t, y[2], y[3], p)
+
+
+_adv2 = make_smooth_advance(_rhs2, 2, 2)
+_adv7 = make_smooth_advance(_rhs7, 7, 2)
+_adv4 = make_smooth_advance(_rhs4, 4, 2)
+
+
+@njit(cache=True)
+def strobe_run(
+    t0, y0, p, T, n_trans, n_strobe, rtol, atol, hmax, max_steps, t_eval, out_eval, out_strobe
+):
+    """``n_trans`` periods of transient, then ``n_strobe`` periods, the state at each
+    period's end in ``out_strobe[k]`` (steps land on strobe times exactly); dense output
+    at ``t_eval`` (absolute times) in ``out_eval``.  Returns
+    ``(status, t, y, n_steps, k_eval)``."""
+    y = y0.copy()
+    K = np.empty((7, 2))
+    ytmp = np.empty(2)
+    ynew = np.empty(2)
+    _rhs2(t0, y, p, K[0])
+    t = t0
+    h = T / 50.0
+    k_eval = 0
+    n_steps = 0
+    status = OK
+    while k_eval < t_eval.shape[0] and t_eval[k_eval] <= t0:
+        out_eval[0, k_eval] = y[0]
+        out_eval[1, k_eval] = y[1]
+        k_eval += 1
+    for k in range(n_trans + n_strobe):
+        t_end = t0 + (k + 1) * T
+        status, t, h, k_eval, ns = _adv2(
+            t,
+            y,
+            t_end,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            t_eval,
+            k_eval,
+            out_eval,
+        )
+        n_steps += ns
+        if status != OK:
+            break
+        if k >= n_trans:
+            out_strobe[k - n_trans, 0] = y[0]
+            out_strobe[k - n_trans, 1] = y[1]
+    return status, t, y, n_steps, k_eval
+
+
+@njit(cache=True, inline="always")
+def renormalise(y, k, out_logs, out_trace, out_strobe):
+    """Benettin's step at strobe ``k`` on the variational state ``y`` (x, v, two tangent
+    vectors, the trace integral): Gram-Schmidt (QR) of the tangent vectors, their log
+    growths, the trace integral and the strobe point stored; the integral restarts."""
+    r11 = np.sqrt(y[2] * y[2] + y[3] * y[3])
+    y[2] /= r11
+    y[3] /= r11
+    r12 = y[2] * y[4] + y[3] * y[5]
+    y[4] -= r12 * y[2]
+    y[5] -= r12 * y[3]
+    r22 = np.sqrt(y[4] * y[4] + y[5] * y[5])
+    y[4] /= r22
+    y[5] /= r22
+    out_logs[k, 0] = np.log(r11)
+    out_logs[k, 1] = np.log(r22)
+    out_trace[k] = y[6]
+    y[6] = 0.0
+    out_strobe[k, 0] = y[0]
+    out_strobe[k, 1] = y[1]
+
+
+@njit(cache=True)
+def variational_run(
+    t0,
+    y0,
+    p,
+    T,
+    n_seg,
+    rtol,
+    atol_state,
+    atol_tangent,
+    hmax,
+    max_steps,
+    out_logs,
+    out_trace,
+    out_strobe,
+):
+    """Benettin's method over ``n_seg`` periods: the state and two tangent vectors
+    (started orthonormal), Gram-Schmidt at every strobe time.  ``out_logs[k]`` gets
+    ``(log r11, log r22)`` of segment ``k``, ``out_trace[k]`` the integral of the
+    Jacobian's trace over it, ``out_strobe[k]`` the state at its end.  Returns
+    ``(status, t, y, n_steps)``."""
+    y = np.zeros(7)
+    y[0] = y0[0]
+    y[1] = y0[1]
+    y[2] = 1.0
+    y[5] = 1.0
+    atol = np.empty(7)
+    atol[0] = atol_state[0]
+    atol[1] = atol_state[1]
+    for j in range(2, 6):
+        atol[j] = atol_tangent
+    atol[6] = atol_tangent
+    K = np.empty((7, 7))
+    ytmp = np.empty(7)
+    ynew = np.empty(7)
+    empty_t = np.empty(0)
+    empty_o = np.empty((2, 0))
+    t = t0
+    h = T / 50.0
+    n_steps = 0
+    status = OK
+    _rhs7(t, y, p, K[0])
+    for k in range(n_seg):
+        t_end = t0 + (k + 1) * T
+        status, t, h, _, ns = _adv7(
+            t,
+            y,
+            t_end,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
+        n_steps += ns
+        if status != OK:
+            break
+        renormalise(y, k, out_logs, out_trace, out_strobe)
+        _rhs7(t, y, p, K[0])  # the tangent vectors changed
+    return status, t, y[:2].copy(), n_steps
+
+
+@njit(cache=True)
+def pair_run(t0, y0, p, T, n_seg, d0, rtol, atol, hmax, max_steps, out_logs):
+    """Two trajectories ``d0`` apart (along ``(1, 1)/sqrt 2`` in ``(x, v)``), one system;
+    at every strobe time the separation ``d`` is measured, ``log(d / d0)`` stored and
+    the second trajectory put back at distance ``d0`` along it.  Returns
+    ``(status, t, y, n_steps)``."""
+    y = np.empty(4)
+    s = d0 / np.sqrt(2.0)
+    y[0] = y0[0]
+    y[1] = y0[1]
+    y[2] = y0[0] + s
+    y[3] = y0[1] + s
+    at = np.empty(4)
+    at[0] = atol[0]
+    at[1] = atol[1]
+    at[2] = atol[0]
+    at[3] = atol[1]
+    K = np.empty((7, 4))
+    ytmp = np.empty(4)
+    ynew = np.empty(4)
+    empty_t = np.empty(0)
+    empty_o = np.empty((2, 0))
+    t = t0
+    h = T / 50.0
+    n_steps = 0
+    status = OK
+    _rhs4(t, y, p, K[0])
+    for k in range(n_seg):
+        t_end = t0 + (k + 1) * T
+        status, t, h, _, ns = _adv4(
+            t,
+            y,
+            t_end,
+            h,
+            p,
+            rtol,
+            at,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
+        n_steps += ns
+        if status != OK:
+            break
+        dx = y[2] - y[0]
+        dv = y[3] - y[1]
+        d = np.sqrt(dx * dx + dv * dv)
+        out_logs[k] = np.log(d / d0)
+        y[2] = y[0] + dx * d0 / d
+        y[3] = y[1] + dv * d0 / d
+        _rhs4(t, y, p, K[0])
+    return status, t, y[:2].copy(), n_steps
+
+
+@njit(cache=True)
+def scan_run(
+    y0,
+    p,
+    T,
+    n_max,
+    max_period,
+    min_pairs,
+    closure,
+    inv_scale,
+    rtol,
+    atol,
+    hmax,
+    max_steps,
+    out_strobe,
+    run,
+):
+    """Up to ``n_max`` periods of the stroboscopic map from ``(0, y0)`` (the same steps
+    as :func:`strobe_run`), stopping early when the strobe
+    points repeat: ``run[n]`` counts the consecutive latest pairs ``|S_k - S_{k-n}| /
+    scale < closure`` (max norm); the smallest ``n`` with ``run[n] >= max(3 n,
+    min_pairs)`` ends the run unless the run may still be converging to an orbit of a
+    divisor ``d`` of ``n``: ``d`` is closing too (``run[d] > 0``), or its differences
+    ``|S_k - S_{k-d}|`` shrank by more than 10 % over the last ``max(3 n, min_pairs)``
+    periods (e.g. a P1 orbit with a multiplier near -1 repeats after 2 periods long
+    before it repeats after 1).  Returns ``(status, t, y, periods done, n or 0)``."""
+    y = y0.copy()
+    K = np.empty((7, 2))
+    ytmp = np.empty(2)
+    ynew = np.empty(2)
+    empty_t = np.empty(0)
+    empty_o = np.empty((2, 0))
+    for n in range(max_period + 1):
+        run[n] = 0
+    _rhs2(0.0, y, p, K[0])
+    t = 0.0
+    h = T / 50.0
+    n_steps = 0
+    status = OK
+    found = 0
+    k = 0
+    while k < n_max:
+        status, t, h, _, ns = _adv2(
+            t,
+            y,
+            (k + 1) * T,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
+        n_steps += ns
+        if status != OK:
+            break
+        out_strobe[k, 0] = y[0]
+        out_strobe[k, 1] = y[1]
+        for n in range(1, min(k, max_period) + 1):
+            if _gap(out_strobe, k, n, inv_scale) < closure:
+                run[n] += 1
+            else:
+                run[n] = 0
+        for n in range(1, max_period + 1):
+            need = max(3 * n, min_pairs)
+            if run[n] >= need:
+                found = n
+                for d in range(1, n):
+                    if n % d == 0 and (
+                        run[d] > 0
+                        or _gap(out_strobe, k, d, inv_scale)
+                        < 0.9 * _gap(out_strobe, k - need, d, inv_scale)
+                    ):
+                        found = 0
+                break
+        k += 1
+        if found > 0:
+            break
+    return status, t, y, k, found
+
+
+@njit(cache=True, inline="always")
+def _gap(s, k, n, inv_scale):
+    """``max |S_k - S_{k-n}| / scale``."""
+    return max(abs(s[k, 0] - s[k - n, 0]) * inv_scale[0], abs(s[k, 1] - s[k - n, 1]) * inv_scale[1])
+
+
+@njit(cache=True)
+def monodromy_run(y0, p, T, n, rtol, atol_state, atol_tangent, hmax, max_steps):
+    """The variational equations over ``n`` periods from ``(0, y0)`` without
+    orthonormalisation (the tangent matrix only rescaled by its largest entry every
+    period).  Returns ``(status, t, M, log of the scale factors, trace integral)``: the
+    monodromy matrix is ``exp(log) M``."""
+    y = np.zeros(7)
+    y[0] = y0[0]
+    y[1] = y0[1]
+    y[2] = 1.0
+    y[5] = 1.0
+    atol = np.empty(7)
+    atol[0] = atol_state[0]
+    atol[1] = atol_state[1]
+    for j in range(2, 7):
+        atol[j] = atol_tangent
+    K = np.empty((7, 7))
+    ytmp = np.empty(7)
+    ynew = np.empty(7)
+    empty_t = np.empty(0)
+    empty_o = np.empty((2, 0))
+    t = 0.0
+    h = T / 50.0
+    n_steps = 0
+    status = OK
+    logs = 0.0
+    _rhs7(t, y, p, K[0])
+    for k in range(n):
+        status, t, h, _, ns = _adv7(
+            t,
+            y,
+            (k + 1) * T,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
+        n_steps += ns
+        if status != OK:
+            break
+        m = max(max(abs(y[2]), abs(y[3])), max(abs(y[4]), abs(y[5])))
+        if m > 0.0:
+            for j in range(2, 6):
+                y[j] /= m
+            logs += np.log(m)
+        _rhs7(t, y, p, K[0])  # the tangent vectors changed
+    M = np.empty((2, 2))
+    M[0, 0] = y[2]
+    M[1, 0] = y[3]
+    M[0, 1] = y[4]
+    M[1, 1] = y[5]
+    return status, t, M, logs, y[6]
+
+
+# ------------------------------------------------ a discovered model x'' = poly(x, x') + B cos
+# The model's vector field: the MONOMIALS of discovery.ueda.discover with their
+# coefficients, p = [c_0..c_9, forcing B, nu].  Each vector field has its own drivers:
+# numba caches a module-level entry point with the closures it inlines, while a driver
+# made by a factory would be compiled again in every process.
+
+
+@njit(cache=True, inline="always")
+def _model_poly(x, v, p):
+    """``sum_j p[j] x^i v^j`` and its partial derivatives (the MONOMIALS' order)."""
+    x2 = x * x
+    v2 = v * v
+    a = (
+        p[0]
+        + p[1] * x
+        + p[2] * v
+        + p[3] * x2
+        + p[4] * x * v
+        + p[5] * v2
+        + p[6] * x2 * x
+        + p[7] * x2 * v
+        + p[8] * x * v2
+        + p[9] * v2 * v
+    )
+    ax = p[1] + 2.0 * p[3] * x + p[4] * v + 3.0 * p[6] * x2 + 2.0 * p[7] * x * v + p[8] * v2
+    av = p[2] + p[4] * x + 2.0 * p[5] * v + p[7] * x2 + 2.0 * p[8] * x * v + 3.0 * p[9] * v2
+    return a, ax, av
+
+
+@njit(cache=True, inline="always")
+def _model_rhs2(t, y, p, out):
+    a, _, _ = _model_poly(y[0], y[1], p)
+    out[0] = y[1]
+    out[1] = a + p[10] * np.cos(p[11] * t)
+
+
+@njit(cache=True, inline="always")
+def _model_rhs7(t, y, p, out):
+    a, ax, av = _model_poly(y[0], y[1], p)
+    out[0] = y[1]
+    out[1] = a + p[10] * np.cos(p[11] * t)
+    out[2] = y[3]
+    out[3] = ax * y[2] + av * y[3]
+    out[4] = y[5]
+    out[5] = ax * y[4] + av * y[5]
+    out[6] = av  # trace of [[0, 1], [ax, av]]
+
+
+_model_adv2 = make_smooth_advance(_model_rhs2, 2, 2)
+_model_adv7 = make_smooth_advance(_model_rhs7, 7, 2)
+
+
+@njit(cache=True)
+def model_strobe_run(t0, y0, p, T, n_trans, rtol, atol, hmax, max_steps):
+    """``n_trans`` periods of a discovered model from ``(t0, y0)``: ``(status, t, y)``
+    (status 2 when it diverges)."""
+    y = y0.copy()
+    K = np.empty((7, 2))
+    ytmp = np.empty(2)
+    ynew = np.empty(2)
+    empty_t = np.empty(0)
+    empty_o = np.empty((2, 0))
+    _model_rhs2(t0, y, p, K[0])
+    t = t0
+    h = T / 50.0
+    n_steps = 0
+    status = OK
+    for k in range(n_trans):
+        status, t, h, _, ns = _model_adv2(
+            t,
+            y,
+            t0 + (k + 1) * T,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
+        n_steps += ns
+        if status != OK or abs(y[0]) > 1e6 or abs(y[1]) > 1e6:
+            if status == OK:
+                status = 2
+            break
+    return status, t, y
+
+
+@njit(cache=True)
+def model_variational_run(
+    t0,
+    y0,
+    p,
+    T,
+    n_seg,
+    rtol,
+    atol_state,
+    atol_tangent,
+    hmax,
+    max_steps,
+    out_logs,
+    out_trace,
+    out_strobe,
+):
+    """Benettin's method on a discovered model (as :func:`variational_run`), stopped with
+    status 2 when the model diverges (``|x|`` or ``|x'|`` beyond 1e6)."""
+    y = np.zeros(7)
+    y[0] = y0[0]
+    y[1] = y0[1]
+    y[2] = 1.0
+    y[5] = 1.0
+    atol = np.empty(7)
+    atol[0] = atol_state[0]
+    atol[1] = atol_state[1]
+    for j in range(2, 7):
+        atol[j] = atol_tangent
+    K = np.empty((7, 7))
+    ytmp = np.empty(7)
+    ynew = np.empty(7)
+    empty_t = np.empty(0)
+    empty_o = np.empty((2, 0))
+    t = t0
+    h = T / 50.0
+    n_steps = 0
+    status = OK
+    _model_rhs7(t, y, p, K[0])
+    for k in range(n_seg):
+        status, t, h, _, ns = _model_adv7(
+            t,
+            y,
+            t0 + (k + 1) * T,
+            h,
+            p,
+            rtol,
+            atol,
+            hmax,
+            max_steps - n_steps,
+            K,
+            ytmp,
+            ynew,
+            empty_t,
+            0,
+            empty_o,
+        )
+        n_steps += ns
+        if status != OK:
+            break
+        if abs(y[0]) > 1e6 or abs(y[1]) > 1e6:
+            status = 2
+            break
+        renormalise(y, k, out_logs, out_trace, out_strobe)
+        _model_rhs7(t, y, p, K[0])
+    return status, t, y[:2].copy(), n_steps

@@ -1,0 +1,643 @@
+"""Regime charts over the forcing plane ``(nu, B)``, in parallel processes.
+
+Each row of the chart (one ``B``) is swept in increasing ``nu``, every point starting
+from the last state of the previous one (continuation, as an analog-computer sweep; the
+first point of a row starts from ``y0``).  With ``sweeps=2`` the row is swept back in
+decreasing ``nu`` as well, starting from the state the first sweep ended in (the
+up-and-down sweep of a hysteresis experiment): both regimes are recorded, and a point
+where one sweep ends on a stable periodic orbit and the other does not (another orbit,
+or a non-periodic regime), also after ``recheck`` times the transient more from both
+final states, is marked ``coexisting`` (the jump phenomenon near a resonance, two
+coexisting subharmonics).  Two non-periodic results are not compared.
+
+Each point: up to ``transient`` forcing periods of the stroboscopic map (compiled), with
+an early exit as soon as the strobe points repeat after ``n <= max_period`` periods to
+``closure`` (of the scale) over ``max(3 n, min_pairs)`` consecutive pairs, unless the run
+may still be converging to an orbit of a divisor of ``n`` (a P1 orbit with a multiplier
+near -1 repeats after 2 periods long before it repeats after 1).  The orbit's monodromy
+matrix over ``n`` periods then gives its Floquet multipliers: a stable orbit (``|m| <
+1``) is ``P<n>`` with the exponent ``log|m_1| / (n T)``; an unstable one repeated by
+chance and the transient goes on.  Without an early exit, ``periods`` more periods with
+the variational equations (Benettin): ``P<n>`` by the same recurrence test on their
+strobe points (and a stable monodromy), else ``chaotic`` if the largest exponent exceeds
+``chaos_threshold``, else ``beat`` (:func:`~discovery.ueda.classify_points`).
+With ``early_exit=False`` every point takes the second path after the full transient.
+The early exit halves the cost of a chart; the classes of chaotic and quasi-periodic
+points are computed exactly as without it.
+
+Rows are distributed over worker processes (they die with the parent; Ctrl-C stops
+them); the result does not depend on the number of workers.
+"""
+
+import cmath
+import math
+import os
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._printing import readable
+from .._validate import Array, Instance, Real, params
+from ..errors import InputError, IntegrationError, VidiTypeError
+from ..numerics.executor import make_executor
+from ..numerics.tolerances import Tolerances
+from . import _kernel as UK
+from ._runs import budget as _budget
+from ._runs import check as _check
+from ._runs import initial_state as _y0
+from .attractor import classify_points
+from .system import UedaSystem
+
+__all__ = ["Chart", "chart", "KINDS"]
+
+KINDS = ("P1", "Pn", "beat", "chaotic")  # codes 0..3; -1 failed
+
+
+@readable
+@dataclass(frozen=True)
+class Chart:
+    """A regime chart.
+
+    Attributes
+    ----------
+    system : UedaSystem
+        The template (its ``nu`` and ``B`` are replaced by the axes).
+    nu, B : ndarray
+        The axes.
+    kind : ndarray of int, shape (len(B), len(nu))
+        Index into :data:`KINDS` (``-1``: the integration failed); the sweep in
+        increasing ``nu``.
+    period : ndarray of int
+        ``n`` of periodic points, else 0.
+    lyapunov : ndarray
+        Largest exponent at each point: ``log|m_1| / (n T)`` of the largest Floquet
+        multiplier for an orbit found by the early exit, else the Benettin estimate over
+        ``periods`` periods.
+    rotation : ndarray
+        Rotation number of the strobe points (beat and chaos; NaN for periodic points).
+    periods_integrated : ndarray of int
+        Forcing periods integrated at each point, both sweeps (the cost; the early exit
+        shortens it; the rechecks of ``sweeps=2`` are not counted).
+    seconds : float
+        Wall time.
+    cpu_seconds : float
+        CPU time of the rows summed over the processes (the work, whatever the load).
+    workers : int
+    settings : dict
+    kind_down, period_down, lyapunov_down, rotation_down : ndarray or None
+        The same for the sweep in decreasing ``nu`` (``sweeps=2``).
+    coexisting : ndarray of bool or None
+        ``sweeps=2``: the two sweeps ended on different attractors - at least one on a
+        stable periodic orbit, the other on another orbit or a non-periodic regime, also
+        after ``recheck`` times the transient more from both (two non-periodic results
+        are not compared).
+    """
+
+    system: UedaSystem
+    nu: np.ndarray
+    B: np.ndarray
+    kind: np.ndarray = field(repr=False)
+    period: np.ndarray = field(repr=False)
+    lyapunov: np.ndarray = field(repr=False)
+    rotation: np.ndarray = field(repr=False)
+    seconds: float
+    workers: int
+    settings: dict
+    periods_integrated: np.ndarray | None = field(default=None, repr=False)
+    cpu_seconds: float = float("nan")
+    kind_down: np.ndarray | None = field(default=None, repr=False)
+    period_down: np.ndarray | None = field(default=None, repr=False)
+    lyapunov_down: np.ndarray | None = field(default=None, repr=False)
+    rotation_down: np.ndarray | None = field(default=None, repr=False)
+    coexisting: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def sweeps(self):
+        return 1 if self.kind_down is None else 2
+
+    def fractions(self):
+        """Fraction of the points in each class (the sweep in increasing ``nu``)."""
+        n = self.kind.size
+        out = {k: float(np.sum(self.kind == i) / n) for i, k in enumerate(KINDS)}
+        out["failed"] = float(np.sum(self.kind < 0) / n)
+        return out
+
+    def period_counts(self):
+        """``{n: number of points}`` of the periodic points (increasing ``nu``)."""
+        n, c = np.unique(self.period[self.period > 0], return_counts=True)
+        return {int(a): int(b) for a, b in zip(n, c, strict=True)}
+
+    @property
+    def columns(self):
+        """The CSV header (:meth:`rows`)."""
+        cols = ["nu", "B", "regime", "period", "lyapunov", "rotation_number"]
+        if self.sweeps == 2:
+            cols += [
+                "regime_down",
+                "period_down",
+                "lyapunov_down",
+                "rotation_number_down",
+                "coexisting",
+            ]
+        return cols
+
+    def rows(self):
+        """CSV rows (:attr:`columns`): ``nu, B, regime, period, lyapunov, rotation``
+        and, with two sweeps, the same for the sweep in decreasing ``nu`` and
+        ``coexisting`` (0/1)."""
+
+        def name(k):
+            return KINDS[k] if k >= 0 else "failed"
+
+        for i, b in enumerate(self.B):
+            for j, nu in enumerate(self.nu):
+                row = (
+                    float(nu),
+                    float(b),
+                    name(int(self.kind[i, j])),
+                    int(self.period[i, j]),
+                    float(self.lyapunov[i, j]),
+                    float(self.rotation[i, j]),
+                )
+                if self.sweeps == 2:
+                    row += (
+                        name(int(self.kind_down[i, j])),
+                        int(self.period_down[i, j]),
+                        float(self.lyapunov_down[i, j]),
+                        float(self.rotation_down[i, j]),
+                        int(self.coexisting[i, j]),
+                    )
+                yield row
+
+    def as_dict(self):
+        n = int(self.kind.size)
+        out = {
+            "system": self.system.as_dict(),
+            "grid": [int(self.nu.size), int(self.B.size)],
+            "nu_range": [float(self.nu[0]), float(self.nu[-1])],
+            "B_range": [float(self.B[0]), float(self.B[-1])],
+            "fractions": self.fractions(),
+            "periods_found": {f"P{k}": v for k, v in self.period_counts().items()},
+            "seconds": self.seconds,
+            "cpu_seconds": self.cpu_seconds,
+            "workers": self.workers,
+            "points": n,
+            "sweeps": self.sweeps,
+            "seconds_per_point_per_worker": self.seconds * self.workers / n,
+            "cpu_seconds_per_point": self.cpu_seconds / (n * self.sweeps),
+            "settings": self.settings,
+        }
+        if self.periods_integrated is not None:
+            out["mean_periods_integrated"] = float(np.mean(self.periods_integrated))
+        if self.sweeps == 2:
+            down = {k: float(np.sum(self.kind_down == i) / n) for i, k in enumerate(KINDS)}
+            down["failed"] = float(np.sum(self.kind_down < 0) / n)
+            out["fractions_down"] = down
+            out["coexisting_fraction"] = float(np.mean(self.coexisting))
+            out["coexisting_points"] = int(np.sum(self.coexisting))
+        return out
+
+    # ------------------------------------------------------------------ one point
+
+    def _lines(self):
+        kinds, counts = np.unique(np.asarray(self.kind).astype(str), return_counts=True)
+        share = ", ".join(f"{k} {c}" for k, c in zip(kinds, counts, strict=True))
+        return [
+            f"regime chart of {self.system.model} on {np.size(self.nu)} x "
+            f"{np.size(self.B)} points ({self.seconds:.1f} s, {self.workers} worker(s))",
+            f"  regimes: {share}",
+        ]
+
+
+def _floquet(M, logs):
+    """Moduli of the two multipliers (largest first) of ``exp(logs) M``, as logs."""
+    tr, det = M[0, 0] + M[1, 1], M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
+    r = cmath.sqrt(tr * tr - 4.0 * det)
+    a, b = abs(0.5 * (tr + r)), abs(0.5 * (tr - r))
+    big, small = max(a, b), min(a, b)
+    return (
+        math.log(big) + logs if big > 0 else -math.inf,
+        math.log(small) + logs if small > 0 else -math.inf,
+    )
+
+
+class _Point:
+    """Result of one point: ``kind`` code, ``period``, ``lam``, ``rot``, the final state
+    ``y``, the periods integrated (``cost``) and ``points`` (the periodic orbit's strobe
+    points, or the observed strobe points)."""
+
+    __slots__ = ("kind", "period", "lam", "rot", "y", "cost", "points")
+
+    def __init__(self, kind, period, lam, rot, y, cost, points):
+        self.kind, self.period, self.lam, self.rot = kind, period, lam, rot
+        self.y, self.cost, self.points = y, cost, points
+
+
+def _recurrence(strobe, inv_scale, max_period, closure, min_pairs):
+    """The smallest ``n <= max_period`` whose last ``max(3 n, min_pairs)`` pairs
+    ``|S_k - S_{k-n}| / scale`` are all below ``closure`` (0: none)."""
+    s = strobe * inv_scale
+    for n in range(1, max_period + 1):
+        need = max(3 * n, min_pairs)
+        if need + n > len(s):
+            break
+        tail = s[-(need + n) :]
+        if np.max(np.abs(tail[n:] - tail[:-n])) < closure:
+            return n
+    return 0
+
+
+def _stable_orbit(y, p, T, n, tol, atol, hmax):
+    """``log|m_1| / (n T)`` of the period-``n`` orbit through ``y`` (its monodromy over
+    ``n`` periods); NaN when it is not stable (``|m_1| >= 1``)."""
+    status, t, M, logs, _ = UK.monodromy_run(
+        y, p, T, n, tol.rtol, atol, tol.atol_variational, hmax, _budget(tol, n)
+    )
+    _check(status, t, "the variational equations")
+    log1, _ = _floquet(M, logs)
+    return log1 / (n * T) if log1 < 0.0 else np.nan
+
+
+def _point(system, y, s, tol, buffers=None):
+    """The regime at one ``(nu, B)`` from the state ``y`` at the forcing's phase 0."""
+    T = system.period
+    p = system.params()
+    scale = system.scales()
+    inv = 1.0 / scale
+    atol = tol.atol(scale)
+    hmax = T * tol.hmax_fraction
+    n_tr, n_obs, P, closure = s["transient"], s["periods"], s["max_period"], s["closure"]
+    if buffers is None:
+        buffers = (np.empty((max(n_tr, 1), 2)), np.zeros(P + 1, dtype=np.int64))
+    strobe, run = buffers
+    y = np.asarray(y, dtype=float)
+    cost = 0
+    if n_tr > 0:
+        status, t, y, done, n = UK.scan_run(
+            y,
+            p,
+            T,
+            n_tr,
+            P if s["early_exit"] else 0,
+            s["min_pairs"],
+            closure,
+            inv,
+            tol.rtol,
+            atol,
+            hmax,
+            _budget(tol, n_tr),
+            strobe,
+            run,
+        )
+        _check(status, t, "the stroboscopic map")
+        cost += done
+        if n > 0:
+            lam = _stable_orbit(y, p, T, n, tol, atol, hmax)
+            cost += n
+            if np.isfinite(lam):  # a stable orbit: P<n>
+                return _Point(
+                    0 if n == 1 else 1, n, lam, np.nan, y, cost, strobe[done - n : done].copy()
+                )
+            # an unstable orbit repeating by chance: the rest of the transient
+            status, t, y, more, _ = UK.scan_run(
+                y,
+                p,
+                T,
+                n_tr - done,
+                0,
+                1,
+                closure,
+                inv,
+                tol.rtol,
+                atol,
+                hmax,
+                _budget(tol, n_tr),
+                strobe,
+                run,
+            )
+            _check(status, t, "the stroboscopic map")
+            cost += more
+    logs = np.empty((n_obs, 2))
+    trace = np.empty(n_obs)
+    obs = np.empty((n_obs, 2))
+    status, t, yf, _ = UK.variational_run(
+        0.0,
+        y,
+        p,
+        T,
+        n_obs,
+        tol.rtol,
+        atol,
+        tol.atol_variational,
+        hmax,
+        _budget(tol, n_obs),
+        logs,
+        trace,
+        obs,
+    )
+    _check(status, t, "the variational equations")
+    cost += n_obs
+    n = _recurrence(obs, inv, P, closure, s["min_pairs"])
+    if n > 0:
+        lam = _stable_orbit(yf, p, T, n, tol, atol, hmax)
+        cost += n
+        if np.isfinite(lam):
+            return _Point(0 if n == 1 else 1, n, lam, np.nan, yf, cost, obs[-n:])
+    lam = float(logs[:, 0].sum() / (n_obs * T))
+    reg = classify_points(obs, scale, lam, 0.0, max_period=0, chaos_threshold=s["chaos_threshold"])
+    return _Point(KINDS.index(reg.kind), 0, lam, reg.evidence["rotation_number"], yf, cost, obs)
+
+
+# ------------------------------------------------------------------ same attractor?
+def _same_orbit(a, b, T, scale, closure):
+    """Whether two points' results are the same periodic orbit (``False`` when either is
+    not periodic): the same period, and every strobe point of one orbit within ``tol``
+    of the other's (in any phase), ``tol = max(10 closure, 3 (e_a + e_b))`` where ``e =
+    closure / (1 - |m_1|)`` bounds how far a run whose points repeat to ``closure`` can be
+    from its orbit (slow convergence near a bifurcation widens it)."""
+    if not a.period or a.kind != b.kind or a.period != b.period:
+        return False
+
+    def err(r):
+        m = math.exp(min(r.lam * r.period * T, 0.0))
+        return closure / max(1.0 - m, 1e-12)
+
+    A, Bp = a.points / scale, b.points / scale
+    tol = max(10.0 * closure, 3.0 * (err(a) + err(b)))
+    return max(float(np.min(np.max(np.abs(Bp - q), axis=1))) for q in A) <= tol
+
+
+_FAILED = _Point(-1, 0, np.nan, np.nan, None, 0, None)
+
+
+def _sweep(base, b, nus, s, tol, y, buffers):
+    out = []
+    for nu in nus:
+        system = base.with_params(nu=float(nu), B=float(b))
+        try:
+            r = _point(system, y, s, tol, buffers)
+        except IntegrationError:
+            out.append(_FAILED)
+            y = np.array(s["y0"], dtype=float)
+            continue
+        out.append(r)
+        y = r.y
+    return out, y
+
+
+def _row(ctx, job):
+    """One row of the chart (a task of the executor); ``ctx`` is ``(system, settings)``."""
+    b, nus = job
+    c0 = time.process_time()
+    base, s = ctx
+    tol = Tolerances(rtol=s["rtol"], hmax_fraction=s["hmax_fraction"])
+    buffers = (np.empty((max(s["transient"], 1), 2)), np.zeros(s["max_period"] + 1, dtype=np.int64))
+    up, y = _sweep(base, b, nus, s, tol, np.array(s["y0"], dtype=float), buffers)
+
+    def pack(r):
+        return (r.kind, r.period, r.lam, r.rot, r.cost)
+
+    down = coex = None
+    if s["sweeps"] == 2:
+        dn, _ = _sweep(base, b, nus[::-1], s, tol, y, buffers)
+        dn = dn[::-1]
+        coex = [
+            _coexisting(base, b, nu, u, d, s, tol) for nu, u, d in zip(nus, up, dn, strict=True)
+        ]
+        down = [pack(r) for r in dn]
+    return [pack(r) for r in up], down, coex, time.process_time() - c0
+
+
+def _coexisting(base, b, nu, u, d, s, tol):
+    """Whether the two sweeps ended on different attractors at ``(nu, b)``: at least one
+    on a stable periodic orbit and the other not on it - as recorded and again after
+    ``recheck`` times the transient more from both final states (a slow transient is not
+    coexistence).  Two non-periodic results are not compared (a few dozen strobe points
+    do not tell two quasi-periodic or chaotic sets apart reliably)."""
+    if u.kind < 0 or d.kind < 0 or not (u.period or d.period):
+        return False
+    system = base.with_params(nu=float(nu), B=float(b))
+    T, scale = system.period, system.scales()
+    if _same_orbit(u, d, T, scale, s["closure"]):
+        return False
+    if s["recheck"] <= 0 or s["transient"] <= 0:
+        return True
+    longer = dict(s, transient=s["transient"] * s["recheck"])
+    try:
+        u2, d2 = (_point(system, r.y, longer, tol) for r in (u, d))
+    except IntegrationError:
+        return True
+    return bool(u2.period or d2.period) and not _same_orbit(u2, d2, T, scale, s["closure"])
+
+
+def _axis(values, name):
+    a = np.asarray(values, dtype=float).reshape(-1)
+    if a.size < 1 or not np.all(np.isfinite(a)) or np.any(np.diff(a) <= 0):
+        raise InputError(f"the {name} axis must be finite and strictly increasing")
+    return a
+
+
+def _check_chart(
+    system, nu, B, workers, max_period, transient, periods, sweeps, recheck, min_pairs
+):
+    """The settings :func:`chart` checks beyond their types; returns the axes."""
+    if not isinstance(system, UedaSystem):
+        raise VidiTypeError("system must be a discovery.ueda.UedaSystem")
+    nu, B = _axis(nu, "nu"), _axis(B, "B")
+    if nu[0] <= 0:
+        raise InputError("nu must be > 0")
+    if workers is not None and int(workers) < 1:
+        raise InputError(f"workers must be at least 1, got {workers!r}")
+    if int(max_period) < 1:
+        raise InputError(f"max_period must be at least 1, got {max_period!r}")
+    if int(transient) < 0:
+        raise InputError(f"transient must be >= 0, got {transient!r}")
+    if int(periods) < 4 * int(max_period):
+        raise InputError(
+            f"periods ({int(periods)}) must be at least 4 x max_period = "
+            f"{4 * int(max_period)}: the recurrence test of period n compares "
+            "three cycles of strobe points with the cycle before"
+        )
+    if int(sweeps) not in (1, 2):
+        raise InputError(f"sweeps must be 1 or 2, got {sweeps!r}")
+    if int(recheck) < 0:
+        raise InputError(f"recheck must be >= 0, got {recheck!r}")
+    if int(min_pairs) < 1:
+        raise InputError(f"min_pairs must be at least 1, got {min_pairs!r}")
+    return nu, B
+
+
+def _run_rows(system, settings, nu, B, workers, executor, progress):
+    """Every row of ``B`` on the executor (one task per row): the chart's grids (regime,
+    period, exponent, rotation, cost, and the second sweep's), the CPU seconds and the
+    workers used."""
+    workers = min(int(workers or os.cpu_count() or 1), B.size)
+    shape = (B.size, nu.size)
+    kind = np.full(shape, -1, dtype=int)
+    period = np.zeros(shape, dtype=int)
+    lam = np.full(shape, np.nan)
+    rot = np.full(shape, np.nan)
+    cost = np.zeros(shape, dtype=int)
+    two = settings["sweeps"] == 2
+    if two:
+        kind2, period2 = kind.copy(), period.copy()
+        lam2, rot2 = lam.copy(), rot.copy()
+        coex = np.zeros(shape, dtype=bool)
+    jobs = [(b, nu) for b in B]
+    cpu = 0.0
+    own = executor is None
+    ex = make_executor(workers) if own else executor
+    try:
+        for done, (i, (up, down, cx, sec)) in enumerate(
+            ex.run(_row, jobs, (system, settings)), start=1
+        ):
+            cpu += sec
+            for j, (k, n, lv, r, c) in enumerate(up):
+                kind[i, j], period[i, j], lam[i, j], rot[i, j], cost[i, j] = k, n, lv, r, c
+            if two:
+                for j, (k, n, lv, r, c) in enumerate(down):
+                    kind2[i, j], period2[i, j], lam2[i, j], rot2[i, j] = k, n, lv, r
+                    cost[i, j] += c
+                coex[i] = cx
+            if progress is not None:
+                progress(done, len(jobs))
+    finally:
+        if own:
+            ex.close()
+    workers = min(ex.workers, len(jobs))
+    extra = {}
+    if two:
+        extra = {
+            "kind_down": kind2,
+            "period_down": period2,
+            "lyapunov_down": lam2,
+            "rotation_down": rot2,
+            "coexisting": coex,
+        }
+    grids = {
+        "kind": kind,
+        "period": period,
+        "lyapunov": lam,
+        "rotation": rot,
+        "periods_integrated": cost,
+        **extra,
+    }
+    return grids, cpu, workers
+
+
+@params(
+    system=UedaSystem,
+    nu=Array(1),
+    B=Array(1),
+    y0=(None, Array(1)),
+    transient=Real(0, integer=True),
+    periods=Real(1, integer=True),
+    rtol=Real(0, 1, open_low=True),
+    hmax_fraction=Real(0, 1, open_low=True),
+    max_period=Real(1, integer=True),
+    workers=(None, Real(1, integer=True)),
+    executor=(None, Instance("discovery.numerics.executor", "Executor")),
+)
+def chart(
+    system,
+    nu,
+    B,
+    *,
+    y0=None,
+    transient=60,
+    periods=80,
+    rtol=1e-6,
+    hmax_fraction=0.1,
+    max_period=16,
+    closure=1e-4,
+    chaos_threshold=0.015,
+    sweeps=1,
+    early_exit=True,
+    min_pairs=12,
+    recheck=5,
+    workers=None,
+    progress=None,
+    executor=None,
+):
+    """The regime at every ``(nu, B)`` of a grid (see the module docstring).
+
+    Parameters
+    ----------
+    system : UedaSystem
+        Template: model and the other parameters.
+    nu, B : array_like
+        Strictly increasing axes (``nu > 0``).
+    y0 : (x, v), optional
+        Start of every row.
+    transient : int
+        Periods discarded at most (the early exit stops sooner at periodic points).
+    periods : int
+        Periods observed with the variational equations where no stable orbit was found
+        in the transient; at least ``4 max_period`` (the recurrence test of period ``n``
+        compares three cycles of strobe points with the cycle before).
+    rtol, hmax_fraction : float
+        Integrator tolerance and largest step (fraction of a period); charts favour
+        speed (``attractor`` uses 1e-9 and 0.02).
+    max_period : int
+        The longest period recognised (longer locked orbits appear as beat).
+    closure, chaos_threshold
+        The classification rules (:func:`classify_points`).
+    sweeps : {1, 2}
+        2: each row swept in increasing ``nu`` and back; both regimes and
+        ``coexisting`` recorded (twice the work, and the rechecks).
+    recheck : int
+        ``sweeps=2``: where the two sweeps' attractors differ, both are run again from
+        their final states with ``recheck`` times the transient; ``coexisting`` only if
+        they still differ (0: no recheck).
+    early_exit : bool
+        Stop the transient once a period-``n`` orbit repeats (see the module docstring).
+    min_pairs : int
+        Consecutive repeating pairs the early exit needs at least (and ``3 n``).
+    workers : int, optional
+        Processes (default all cores, at most one per row).
+    progress : callable, optional
+        ``progress(done_rows, total_rows)`` after each row.
+    executor : Executor, optional
+        Where the rows run (:mod:`discovery.numerics.executor`); overrides ``workers`` and is not
+        closed here.  One task per row of ``B``.
+
+    Returns
+    -------
+    Chart
+    """
+    nu, B = _check_chart(
+        system, nu, B, workers, max_period, transient, periods, sweeps, recheck, min_pairs
+    )
+    settings = {
+        "transient": int(transient),
+        "periods": int(periods),
+        "rtol": float(rtol),
+        "hmax_fraction": float(hmax_fraction),
+        "max_period": int(max_period),
+        "closure": float(closure),
+        "chaos_threshold": float(chaos_threshold),
+        "sweeps": int(sweeps),
+        "early_exit": bool(early_exit),
+        "min_pairs": int(min_pairs),
+        "recheck": int(recheck),
+        "y0": [float(v) for v in _y0(y0)],
+        "continuation": "rows swept in increasing nu"
+        + (
+            ", then back in decreasing nu from the state the first sweep ended in"
+            if int(sweeps) == 2
+            else ""
+        ),
+    }
+    t_start = time.perf_counter()
+    grids, cpu, workers = _run_rows(system, settings, nu, B, workers, executor, progress)
+    return Chart(
+        system=system,
+        nu=nu,
+        B=B,
+        seconds=time.perf_counter() - t_start,
+        workers=workers,
+        settings=settings,
+        cpu_seconds=cpu,
+        **grids,
+    )

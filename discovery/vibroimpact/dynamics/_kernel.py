@@ -1,0 +1,614 @@
+"""Compiled event-driven Dormand–Prince 5(4) integrator for the two-body system (the
+method's stages, error norm, dense output and step control are shared with every system:
+:mod:`discovery.numerics._dopri`).
+
+The right-hand side is smooth inside each *contact mode*; the mode changes only
+at located events, and no step straddles an event: a step in which a switching
+function changes sign is re-taken with its length cut to the root (found on the
+dense output), so every step integrates one smooth vector field.
+
+Modes
+    FREE     no force (``zeta <= 0``)
+    LOAD     ``F = P(zeta, dzeta)``       (``zeta > 0``, ``dzeta > 0``)
+    UNLOAD   ``F = P(zeta, 0)``           (``zeta > 0``, ``dzeta <= 0``)
+    CLIPPED  ``F = 0`` with ``zeta > 0``  (``P`` would be adhesive, < 0)
+
+Switching functions ``h`` are written so that an event fires when ``h`` goes from
+``>= 0`` to ``< 0`` over a step (direction built in):
+
+    FREE:    onset       h = -zeta
+    LOAD:    loss        h = zeta,  unload  h = dzeta,   release h = P(zeta, dzeta)
+    UNLOAD:  loss        h = zeta,  reload  h = -dzeta,  release h = P(zeta, 0)
+    CLIPPED: loss        h = zeta,  resume  h = -P(zeta, max(dzeta, 0))
+
+Inside a mode the force is extended smoothly past the switching surface (odd
+extension of fractional powers) because Runge–Kutta stages may sample slightly
+beyond it.
+
+Detection (per accepted step, see :func:`_first_crossing`): each function is
+sampled on the dense output at ``theta = 0, 1/3, 2/3, 1``; an event needs a value
+``> 0`` before one ``< 0``.  Right after an event a function may start a hair on
+the wrong side (the re-taken step ends within rounding of the surface, not on its
+side): it is then neither skipped nor fired at once, but the point where the flow
+leaves the surface is searched for, so a contact loss followed by a re-contact
+inside the next step is seen (and a function that starts across but comes back is
+not fired).  In the free and clipped modes the contact surface is also checked at
+the interior extremum of ``zeta`` (a graze between samples).  Mode switches that
+hardly advance time (zero-length ones, or over a thousand events in a row each
+within ``1e-3 hmax`` of the last) stop the run as chattering.
+"""
+
+import numpy as np
+from numba import njit
+
+from ...numerics._dopri import MIN_FACTOR as _MIN_FACTOR
+from ...numerics._dopri import C as _C
+from ...numerics._dopri import blocks
+from ...numerics._dopri import step_factor as _step_factor
+
+# the shared Dormand-Prince blocks for this system's four states (w1, v1, w2, v2)
+_D = blocks(4)
+_stage, _combine, _dense, _error_norm = _D.stage, _D.combine, _D.dense, _D.error_norm
+
+FREE, LOAD, UNLOAD, CLIPPED = 0, 1, 2, 3
+EV_ONSET, EV_LOSS, EV_UNLOAD, EV_RELOAD, EV_RELEASE, EV_RESUME = 1, 2, 3, 4, 5, 6
+OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW, CHATTER = 0, 1, 2, 3, 4
+
+# the parameter vector ``p``: the scenario's m1, m2, k1, c1, A, omega, g (0-6), the
+# supports' cubic stiffness, the mass fraction shed per impact, the law's permanent-set
+# fraction, and one contact state: the current contact's largest penetration.  The kernel
+# updates m2 and z_max in place (callers pass a copy: :func:`kernel_params`).
+P_K3, P_LOSS, P_SET, P_ZMAX, N_PARAMS = 7, 8, 9, 10, 11
+
+# chattering: more than _ZENO_EVENTS located events in a row, each within
+# _ZENO_GAP * hmax of the previous one (mode switches that hardly advance time)
+_ZENO_EVENTS, _ZENO_GAP = 1000, 1e-3
+
+
+@njit(cache=True, inline="always")
+def _pw(x, p):
+    if p == 0.0:
+        return 1.0
+    if p == 1.0:
+        return x
+    if p == 2.0:
+        return x * x
+    if p == 3.0:
+        return x * x * x
+    if x >= 0.0:
+        return x**p
+    return -((-x) ** p)
+
+
+@njit(cache=True, inline="always")
+def poly(z, zd, coef, ea, eb, br):
+    """Loading branch ``P(z, zd) = sum c_i z^a_i zd^b_i`` over the loading terms
+    (``br_i = 0``; odd extension for negative arguments)."""
+    s = 0.0
+    for i in range(coef.shape[0]):
+        if br[i] == 0.0:
+            s += coef[i] * _pw(z, ea[i]) * _pw(zd, eb[i])
+    return s
+
+
+@njit(cache=True, inline="always")
+def _elastic_set(z, p, coef, ea, eb, br):
+    """``P(u, 0)`` at the unloading penetration ``u = (z - s z_max) / (1 - s)``."""
+    rho = p[P_SET]
+    u = (z - rho * p[P_ZMAX]) / (1.0 - rho)
+    s = 0.0
+    for i in range(coef.shape[0]):
+        if br[i] == 0.0:
+            s += coef[i] * _pw(u, ea[i]) * _pw(0.0, eb[i])
+    return s
+
+
+@njit(cache=True, inline="always")
+def load_force(z, v, p, coef, ea, eb, br):
+    """Loading branch: ``P(z, v)``; with a permanent set, a contact that reloads below its
+    largest penetration so far follows its elastic unloading line ``P(u, 0)`` (plus the
+    velocity terms) back up to ``z_max`` (Walton-Braun), continuous there."""
+    if p[P_SET] == 0.0 or z >= p[P_ZMAX]:
+        return poly(z, v, coef, ea, eb, br)
+    return (
+        poly(z, v, coef, ea, eb, br)
+        - poly(z, 0.0, coef, ea, eb, br)
+        + _elastic_set(z, p, coef, ea, eb, br)
+    )
+
+
+@njit(cache=True, inline="always")
+def unload_force(z, v, p, coef, ea, eb, br):
+    """Unloading branch (``dzeta <= 0``): the elastic part ``P(u, 0)`` at the unloading
+    penetration ``u = (z - s z_max) / (1 - s)`` (``s`` the permanent-set fraction, ``z_max``
+    the contact's largest penetration: ``u = z`` without a set), plus the unloading terms
+    (``br_i = 1``) ``c_i z^a_i dzeta^b_i`` at the signed velocity (odd extension: they
+    lower the force while the bodies separate).  With neither it is the paper's
+    ``P(z, 0)``, term for term."""
+    rho = p[P_SET]
+    u = z if rho == 0.0 else (z - rho * p[P_ZMAX]) / (1.0 - rho)
+    s = 0.0
+    for i in range(coef.shape[0]):
+        if br[i] == 0.0:
+            s += coef[i] * _pw(u, ea[i]) * _pw(0.0, eb[i])
+        else:
+            s += coef[i] * _pw(z, ea[i]) * _pw(v, eb[i])
+    return s
+
+
+@njit(cache=True, inline="always")
+def branch_force(z, v, p, coef, ea, eb, br):
+    """The branch force at ``(z, v)``: loading for ``v > 0``, unloading otherwise (the
+    clipped mode's resume function)."""
+    if v > 0.0:
+        return load_force(z, v, p, coef, ea, eb, br)
+    return unload_force(z, v, p, coef, ea, eb, br)
+
+
+@njit(cache=True, inline="always")
+def mode_force(mode, z, v, p, coef, ea, eb, br):
+    """Contact force [N] in a given mode at penetration ``z`` and its rate ``v``."""
+    if mode == LOAD:
+        return load_force(z, v, p, coef, ea, eb, br)
+    if mode == UNLOAD:
+        return unload_force(z, v, p, coef, ea, eb, br)
+    return 0.0
+
+
+@njit(cache=True)
+def resolve_mode(y, p, coef, ea, eb, br):
+    """The mode a state belongs to (used at the start of an integration; a start inside
+    an unloading phase takes its own penetration as the contact's largest)."""
+    z = y[0] - y[2]
+    v = y[1] - y[3]
+    if z < 0.0 or (z == 0.0 and v <= 0.0):
+        return FREE
+    if v > 0.0:
+        return LOAD if load_force(max(z, 0.0), v, p, coef, ea, eb, br) >= 0.0 else CLIPPED
+    p[P_ZMAX] = max(p[P_ZMAX], z)
+    return UNLOAD if unload_force(z, v, p, coef, ea, eb, br) > 0.0 else CLIPPED
+
+
+@njit(cache=True, inline="always")
+def _rhs(t, y, mode, p, coef, ea, eb, br, out):
+    z = y[0] - y[2]
+    v = y[1] - y[3]
+    f = mode_force(mode, z, v, p, coef, ea, eb, br)
+    out[0] = y[1]
+    out[1] = (
+        -(
+            p[3] * y[1]
+            + p[2] * y[0]
+            + p[P_K3] * y[0] * y[0] * y[0]
+            + p[4] * np.sin(p[5] * t)
+            + p[0] * p[6]
+            + f
+        )
+        / p[0]
+    )
+    out[2] = y[3]
+    out[3] = f / p[1] - p[6]
+
+
+@njit(cache=True, inline="always")
+def _switching(mode, y, p, coef, ea, eb, br, h):
+    """Fill ``h`` with the mode's switching functions; return how many."""
+    z = y[0] - y[2]
+    v = y[1] - y[3]
+    if mode == FREE:
+        h[0] = -z
+        return 1
+    h[0] = z
+    if mode == LOAD:
+        h[1] = v
+        h[2] = load_force(z, v, p, coef, ea, eb, br)
+        return 3
+    if mode == UNLOAD:
+        h[1] = -v
+        h[2] = unload_force(z, v, p, coef, ea, eb, br)
+        return 3
+    h[1] = -branch_force(max(z, 0.0), v, p, coef, ea, eb, br)
+    return 2
+
+
+@njit(cache=True)
+def _event_kind(mode, index):
+    if mode == FREE:
+        return EV_ONSET
+    if index == 0:
+        return EV_LOSS
+    if mode == LOAD:
+        return EV_UNLOAD if index == 1 else EV_RELEASE
+    if mode == UNLOAD:
+        return EV_RELOAD if index == 1 else EV_RELEASE
+    return EV_RESUME
+
+
+@njit(cache=True)
+def _mode_after(kind, y, p, coef, ea, eb, br):
+    """The mode after an event, and the contact's state updates it brings (in ``p``): an
+    onset starts a new contact (``z_max = 0``) and sheds the moulding's mass fraction
+    ``p[P_LOSS]``; entering the unloading branch records the largest penetration."""
+    z = max(y[0] - y[2], 0.0)
+    v = y[1] - y[3]
+    if kind == EV_LOSS:
+        return FREE
+    if kind == EV_ONSET:
+        p[P_ZMAX] = 0.0
+        p[1] *= 1.0 - p[P_LOSS]
+    if kind == EV_RELEASE:
+        return CLIPPED
+    if kind == EV_RESUME:
+        # the force crossed to positive at the located root: it is on again, even if the
+        # re-taken step ended a whisker on the adhesive side
+        if v > 0.0:
+            return LOAD
+        p[P_ZMAX] = max(p[P_ZMAX], z)
+        return UNLOAD
+    if kind == EV_UNLOAD or (kind == EV_ONSET and v <= 0.0):
+        p[P_ZMAX] = max(p[P_ZMAX], z)
+        return UNLOAD if unload_force(z, v, p, coef, ea, eb, br) >= 0.0 else CLIPPED
+    # onset with dzeta > 0, or reload
+    return LOAD if load_force(z, max(v, 0.0), p, coef, ea, eb, br) >= 0.0 else CLIPPED
+
+
+@njit(cache=True, inline="always")
+def _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew):
+    """One DP5 step from (t, y) with K[0] = f(t, y) already set; fills K[1:7], ynew
+    (the method's stages from :mod:`._dopri`, this system's right-hand side)."""
+    for s in range(1, 6):
+        _stage(s, y, h, K, ytmp)
+        _rhs(t + _C[s] * h, ytmp, mode, p, coef, ea, eb, br, K[s])
+    _combine(y, h, K, ynew)
+    _rhs(t + h, ynew, mode, p, coef, ea, eb, br, K[6])
+
+
+@njit(cache=True)
+def _locate(y, K, h, mode, p, coef, ea, eb, br, index, th_lo, th_hi, h_lo, h_hi, ybuf, hbuf):
+    """Root in ``theta`` of switching function ``index`` on the dense output (Illinois)."""
+    a, b, fa, fb = th_lo, th_hi, h_lo, h_hi
+    side = 0
+    for _ in range(100):
+        c = (a * fb - b * fa) / (fb - fa)
+        if not (a < c < b):
+            c = 0.5 * (a + b)
+        _dense(y, K, h, c, ybuf)
+        _switching(mode, ybuf, p, coef, ea, eb, br, hbuf)
+        fc = hbuf[index]
+        if fc < 0.0:
+            b, fb = c, fc
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:
+            a, fa = c, fc
+            if side == 1:
+                fb *= 0.5
+            side = 1
+        if b - a <= 1e-15 * max(1.0, b):
+            break
+    return b
+
+
+@njit(cache=True, inline="always")
+def _h_at(y, K, h, mode, p, coef, ea, eb, br, index, theta, ybuf, hbuf):
+    """Switching function ``index`` on the dense output at ``theta``."""
+    _dense(y, K, h, theta, ybuf)
+    _switching(mode, ybuf, p, coef, ea, eb, br, hbuf)
+    return hbuf[index]
+
+
+@njit(cache=True)
+def _rate_root(y, K, h, s, d0, d1, ybuf):
+    """``theta`` where ``s * dzeta`` on the dense output goes from ``d0 < 0`` to ``d1 > 0``:
+    the interior minimum of the switching function ``s * zeta`` (Illinois)."""
+    a, b, fa, fb = 0.0, 1.0, d0, d1
+    side = 0
+    for _ in range(60):
+        c = (a * fb - b * fa) / (fb - fa)
+        if not (a < c < b):
+            c = 0.5 * (a + b)
+        _dense(y, K, h, c, ybuf)
+        fc = s * (ybuf[1] - ybuf[3])
+        if fc < 0.0:
+            a, fa = c, fc
+            if side == -1:
+                fb *= 0.5
+            side = -1
+        else:
+            b, fb = c, fc
+            if side == 1:
+                fa *= 0.5
+            side = 1
+        if b - a <= 1e-12:
+            break
+    return 0.5 * (a + b)
+
+
+@njit(cache=True)
+def _first_crossing(t, y, ynew, K, h, mode, p, coef, ea, eb, br, i, h0, ha, hb, h1, ybuf, hbuf):
+    """``theta`` in ``[0, 1]`` of the first crossing of switching function ``i`` over the
+    step (``0``: at once), or ``2`` if it stays on its side.
+
+    ``h0, ha, hb, h1`` are its values at ``theta = 0, 1/3, 2/3, 1``.  A crossing needs a
+    value strictly on the function's side (``> 0``) before one across it (``< 0``):
+
+    * the start does not count as on its side unless ``h0 > 0``: right after an event
+      the state sits on the surface just crossed (and on any coinciding one) with a
+      value that is zero only to within rounding, of either sign.  Such a function
+      is never skipped (a state a hair across the surface, e.g. ``zeta = +1e-13``
+      right after a contact loss, would otherwise hide a re-contact in the same step
+      and then every later one: the mode would stay wrong for good); instead the
+      point where the flow leaves the surface is searched for by halving towards
+      the start; if there is none, the crossing is at once if the function moves
+      further across (the first probe across is below ``h0``), and there is no event
+      yet if it is coming back (a step cut to an event ends within its local error
+      of the surface; at loose tolerances that can be well beyond rounding);
+    * the contact surface ``zeta = 0`` in modes without a ``dzeta = 0`` surface
+      (free, clipped) is also checked at the interior minimum of its function (where
+      ``dzeta`` changes sign), so a graze that touches and leaves the surface between
+      the probes is seen.
+    """
+    third = 1.0 / 3.0
+    pos_t, pos_f = -1.0, 0.0
+    if h0 > 0.0:
+        pos_t, pos_f = 0.0, h0
+    neg_t, neg_f = -1.0, 0.0
+    if ha < 0.0:
+        neg_t, neg_f = third, ha
+    else:
+        if ha > 0.0:
+            pos_t, pos_f = third, ha
+        if hb < 0.0:
+            neg_t, neg_f = 2.0 * third, hb
+        else:
+            if hb > 0.0:
+                pos_t, pos_f = 2.0 * third, hb
+            if h1 < 0.0:
+                neg_t, neg_f = 1.0, h1
+    if neg_t < 0.0 and i == 0 and (mode == FREE or mode == CLIPPED):
+        s = -1.0 if mode == FREE else 1.0
+        d0 = s * (y[1] - y[3])
+        d1 = s * (ynew[1] - ynew[3])
+        if d0 < 0.0 and d1 > 0.0:
+            th = _rate_root(y, K, h, s, d0, d1, ybuf)
+            fm = _h_at(y, K, h, mode, p, coef, ea, eb, br, 0, th, ybuf, hbuf)
+            if fm < 0.0:
+                neg_t, neg_f = th, fm
+                pos_t = -1.0
+                if h0 > 0.0:
+                    pos_t, pos_f = 0.0, h0
+                if ha > 0.0 and third < th:
+                    pos_t, pos_f = third, ha
+                if hb > 0.0 and 2.0 * third < th:
+                    pos_t, pos_f = 2.0 * third, hb
+    if neg_t < 0.0:
+        return 2.0
+    if pos_t < 0.0:
+        th, f_first = neg_t, neg_f
+        while True:
+            th *= 0.5
+            if th * h <= 1e-15 * max(1.0, abs(t)):
+                # across the surface from the start and nowhere on its side before the
+                # probe: moving further across, it crosses now; coming back (a step cut
+                # to an event ends within its error of the surface, not on it), not yet
+                return 0.0 if f_first <= h0 else 2.0
+            f = _h_at(y, K, h, mode, p, coef, ea, eb, br, i, th, ybuf, hbuf)
+            if f > 0.0:
+                pos_t, pos_f = th, f
+                break
+            if f < 0.0:
+                neg_t, neg_f = th, f
+    return _locate(y, K, h, mode, p, coef, ea, eb, br, i, pos_t, neg_t, pos_f, neg_f, ybuf, hbuf)
+
+
+@njit(cache=True, inline="always")
+def _record_event(t, y, mode, index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes):
+    """Store event ``n_ev`` (if there is room) and return the mode after it."""
+    kind = _event_kind(mode, index)
+    new_mode = _mode_after(kind, y, p, coef, ea, eb, br)
+    if n_ev < ev_t.shape[0]:
+        ev_t[n_ev] = t
+        ev_kind[n_ev] = kind
+        ev_modes[n_ev, 0] = mode
+        ev_modes[n_ev, 1] = new_mode
+        for j in range(4):
+            ev_y[n_ev, j] = y[j]
+    return new_mode
+
+
+@njit(cache=True)
+def integrate(
+    t0,
+    t1,
+    y0,
+    mode0,
+    p,
+    coef,
+    ea,
+    eb,
+    br,
+    rtol,
+    atol,
+    h0,
+    hmax,
+    max_steps,
+    t_eval,
+    out_y,
+    out_f,
+    out_mode,
+    ev_t,
+    ev_kind,
+    ev_y,
+    ev_modes,
+):
+    """Integrate from ``t0`` to ``t1``; see :func:`discovery.vibroimpact.dynamics.simulate`.
+
+    Writes the state, force and mode at each ``t_eval`` (sorted, within
+    ``[t0, t1]``) and up to ``len(ev_t)`` events.  Returns
+    ``(status, t, y, mode, n_steps, n_events, h)``; ``mode0 < 0`` resolves the mode
+    from ``y0``.
+    """
+    y = y0.copy()
+    ynew = np.empty(4)
+    ytmp = np.empty(4)
+    ybuf = np.empty(4)
+    K = np.empty((7, 4))
+    hs0 = np.empty(3)
+    hs1 = np.empty(3)
+    hsa = np.empty(3)
+    hsb = np.empty(3)
+    hsm = np.empty(3)
+    need_h0 = True
+    ns = 0
+    t = t0
+    mode = mode0 if mode0 >= 0 else resolve_mode(y, p, coef, ea, eb, br)
+    h = min(h0, hmax, t1 - t0)
+    n_eval = t_eval.shape[0]
+    k_eval = 0
+    while k_eval < n_eval and t_eval[k_eval] <= t0:
+        for j in range(4):
+            out_y[j, k_eval] = y[j]
+        out_f[k_eval] = mode_force(mode, y[0] - y[2], y[1] - y[3], p, coef, ea, eb, br)
+        out_mode[k_eval] = mode
+        k_eval += 1
+    n_ev = 0
+    n_steps = 0
+    zero_len = 0
+    short_run = 0
+    t_last_ev = -np.inf
+    status = OK
+    need_f = True
+    while t < t1:
+        if n_steps >= max_steps:
+            status = STEP_BUDGET
+            break
+        if need_f:
+            _rhs(t, y, mode, p, coef, ea, eb, br, K[0])
+            need_f = False
+        h = min(h, hmax, t1 - t)
+        if h < 1e-14 * max(1.0, abs(t)) and t1 - t > h:
+            status = STEP_UNDERFLOW
+            break
+        _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew)
+        n_steps += 1
+        err = _error_norm(y, ynew, K, h, rtol, atol)
+        if not np.isfinite(err):
+            h *= _MIN_FACTOR
+            if h < 1e-14 * max(1.0, abs(t)):
+                status = BLOW_UP
+                break
+            continue
+        if err > 1.0:
+            h *= _step_factor(err)
+            continue
+        # ---- accepted step: look for the earliest event in (t, t + h]
+        if need_h0:
+            ns = _switching(mode, y, p, coef, ea, eb, br, hs0)
+            need_h0 = False
+        _switching(mode, ynew, p, coef, ea, eb, br, hs1)
+        best_theta = 2.0
+        best_index = -1
+        # probe the dense output at 1/3 and 2/3 too, so a brief excursion across a
+        # switching surface inside one step is seen (once per step, for all functions)
+        _dense(y, K, h, 1.0 / 3.0, ybuf)
+        _switching(mode, ybuf, p, coef, ea, eb, br, hsa)
+        _dense(y, K, h, 2.0 / 3.0, ybuf)
+        _switching(mode, ybuf, p, coef, ea, eb, br, hsb)
+        for i in range(ns):
+            if hsa[i] >= 0.0 and hsb[i] >= 0.0 and hs1[i] >= 0.0:
+                # fast path: no probe across the surface; only a graze of zeta = 0
+                # between them is left to check (free and clipped modes only)
+                if i != 0 or mode == LOAD or mode == UNLOAD:
+                    continue
+                s = -1.0 if mode == FREE else 1.0
+                if not (s * (y[1] - y[3]) < 0.0 and s * (ynew[1] - ynew[3]) > 0.0):
+                    continue
+            th = _first_crossing(
+                t,
+                y,
+                ynew,
+                K,
+                h,
+                mode,
+                p,
+                coef,
+                ea,
+                eb,
+                br,
+                i,
+                hs0[i],
+                hsa[i],
+                hsb[i],
+                hs1[i],
+                ybuf,
+                hsm,
+            )
+            # near-ties go to the lower index: contact loss (index 0) wins over the
+            # force reaching zero at the same instant (e.g. P(zeta, 0) = k * zeta)
+            if th < best_theta - 1e-9:
+                best_theta, best_index = th, i
+        if best_index >= 0:
+            if best_theta == 0.0:
+                zero_len += 1
+                if zero_len > 4:
+                    status = CHATTER
+                    break
+                mode = _record_event(
+                    t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
+                )
+                n_ev += 1
+                need_f = True
+                need_h0 = True
+                continue
+            # re-take the step so that it ends on the event
+            h_ev = best_theta * h
+            _rk_step(t, y, h_ev, mode, p, coef, ea, eb, br, K, ytmp, ynew)
+            h_used = h_ev
+        else:
+            h_used = h
+        zero_len = 0
+        t_new = t + h_used if best_index >= 0 or h_used < t1 - t else t1
+        # dense output at requested times inside (t, t_new]
+        while k_eval < n_eval and t_eval[k_eval] <= t_new:
+            theta = (t_eval[k_eval] - t) / h_used
+            _dense(y, K, h_used, min(theta, 1.0), ybuf)
+            for j in range(4):
+                out_y[j, k_eval] = ybuf[j]
+            out_f[k_eval] = mode_force(
+                mode, ybuf[0] - ybuf[2], ybuf[1] - ybuf[3], p, coef, ea, eb, br
+            )
+            out_mode[k_eval] = mode
+            k_eval += 1
+        for j in range(4):
+            y[j] = ynew[j]
+            K[0, j] = K[6, j]
+        t = t_new
+        bad = False
+        for j in range(4):
+            if not np.isfinite(y[j]):
+                bad = True
+        if bad:
+            status = BLOW_UP
+            break
+        if best_index >= 0:
+            if t - t_last_ev < _ZENO_GAP * hmax:
+                short_run += 1
+                if short_run > _ZENO_EVENTS:
+                    status = CHATTER
+                    break
+            else:
+                short_run = 0
+            t_last_ev = t
+            mode = _record_event(
+                t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
+            )
+            n_ev += 1
+            need_f = True
+            need_h0 = True
+            # keep the step size that worked before the cut
+        else:
+            for i in range(ns):
+                hs0[i] = hs1[i]
+            h = h * _step_factor(err)
+    return status, t, y, mode, n_steps, n_ev, h

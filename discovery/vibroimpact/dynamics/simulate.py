@@ -1,0 +1,255 @@
+"""Public entry point to the compiled integrator: :func:`simulate` and :class:`Trajectory`."""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..._compile import announce_compile
+from ..._validate import Array, Real, params
+from ...errors import InputError, IntegrationError
+from ...numerics.status import message as status_message
+from ...numerics.tolerances import Tolerances
+from ..model.law import ForceLaw
+from ..model.scenario import Scenario
+from . import _kernel as K
+
+__all__ = ["Trajectory", "simulate", "Tolerances", "MODE_NAMES", "EVENT_NAMES"]
+
+MODE_NAMES = {K.FREE: "free", K.LOAD: "load", K.UNLOAD: "unload", K.CLIPPED: "clipped"}
+EVENT_NAMES = {
+    K.EV_ONSET: "onset",
+    K.EV_LOSS: "loss",
+    K.EV_UNLOAD: "unload",
+    K.EV_RELOAD: "reload",
+    K.EV_RELEASE: "release",
+    K.EV_RESUME: "resume",
+}
+# what to check when the vibro-impact kernel fails (after the meaning from .status)
+_HINTS = {
+    K.STEP_BUDGET: (
+        " (a law too stiff or too fast for the machine: check the coefficients' "
+        "units; API: Tolerances(max_steps=...))"
+    ),
+    K.BLOW_UP: "; check the law's coefficients and signs",
+    K.STEP_UNDERFLOW: "; the law may be too stiff for this tolerance",
+}
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Result of :func:`simulate`.
+
+    Attributes
+    ----------
+    t : ndarray of shape (n,)
+        Output times [s].
+    y : ndarray of shape (4, n)
+        States ``w1 [m], v1 [m/s], w2 [m], v2 [m/s]`` at ``t``.
+    force : ndarray of shape (n,)
+        Contact force [N] at ``t`` (left limit where ``t`` is an event time).
+    mode : ndarray of shape (n,)
+        Contact mode code at ``t`` (see ``MODE_NAMES``).
+    event_t : ndarray of shape (n_events,)
+        Event times [s].
+    event_kind : ndarray of shape (n_events,)
+        Event codes (see ``EVENT_NAMES``).
+    event_y : ndarray of shape (n_events, 4)
+        States at the events.
+    event_modes : ndarray of shape (n_events, 2)
+        Mode before and after each event.
+    t_final, y_final, mode_final
+        Where the integration stopped.
+    n_steps : int
+        Steps attempted.
+    status : int
+        0 on success; see ``message``.
+    message : str
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    force: np.ndarray
+    mode: np.ndarray
+    event_t: np.ndarray
+    event_kind: np.ndarray
+    event_y: np.ndarray
+    event_modes: np.ndarray
+    t_final: float
+    y_final: np.ndarray
+    mode_final: int
+    n_steps: int
+    status: int
+    message: str
+    zeta_max0: float = 0.0
+
+    @property
+    def success(self):
+        return self.status == 0
+
+    @property
+    def zeta(self):
+        """Interpenetration ``w1 - w2`` [m] at ``t``."""
+        return self.y[0] - self.y[2]
+
+    @property
+    def dzeta(self):
+        """Penetration velocity ``v1 - v2`` [m/s] at ``t``."""
+        return self.y[1] - self.y[3]
+
+    def event_forces(self, law):
+        """Left and right limits of the force at each event, ndarray of shape (n_events, 2)."""
+        coef, ea, eb, br = law.kernel_arrays()
+        out = np.empty((len(self.event_t), 2))
+        p = np.zeros(K.N_PARAMS)
+        p[K.P_SET] = law.permanent_set
+        p[K.P_ZMAX] = self.zeta_max0
+        for k, (yk, (m0, m1)) in enumerate(zip(self.event_y, self.event_modes, strict=True)):
+            z, v = yk[0] - yk[2], yk[1] - yk[3]
+            if m0 == K.FREE:
+                p[K.P_ZMAX] = 0.0
+            p[K.P_ZMAX] = max(p[K.P_ZMAX], z)  # the largest penetration so far (events only)
+            out[k, 0] = K.mode_force(m0, z, v, p, coef, ea, eb, br)
+            out[k, 1] = K.mode_force(m1, z, v, p, coef, ea, eb, br)
+        return out
+
+
+def kernel_params(scenario, law):
+    """The compiled kernel's parameter vector (:data:`~discovery.vibroimpact.dynamics._kernel.P_K3`
+    ...): the scenario's parameters, the law's permanent set and a fresh contact state.  The
+    kernel updates the state slots in place: pass each integration its own copy."""
+    p = np.zeros(K.N_PARAMS)
+    base = scenario.params()
+    p[: base.size] = base
+    p[K.P_SET] = law.permanent_set
+    return p
+
+
+def _atol(scenario, tol):
+    x, v = scenario.scales()
+    return tol.atol([x, v, x, v])
+
+
+@params(
+    scenario=Scenario,
+    law=ForceLaw,
+    t_span=Array(1),
+    y0=(None, Array(1)),
+    t_eval=(None, Array(1)),
+    tolerances=(Tolerances, None),
+    max_events=Real(1, integer=True),
+    zeta_max0=Real(0),
+)
+def simulate(
+    scenario,
+    law,
+    t_span,
+    y0=None,
+    t_eval=None,
+    *,
+    tolerances=None,
+    max_events=10_000,
+    mode0=None,
+    throw=True,
+    zeta_max0=0.0,
+):
+    """Integrate the two-body vibro-impact system with a given contact law.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Machine parameters.
+    law : ForceLaw
+        Contact law ``F(zeta, dzeta)``.
+    t_span : (float, float)
+        Start and end time [s].
+    y0 : array_like of shape (4,), optional
+        Initial ``w1, v1, w2, v2``; default :meth:`Scenario.initial_state`.
+    t_eval : array_like of shape (n,), optional
+        Sorted output times within ``t_span`` (dense output, no extra steps).
+    tolerances : Tolerances, optional
+    max_events : int
+        How many events to record (all are located regardless).
+    mode0 : int, optional
+        Contact mode at ``t0``; default resolves it from ``y0``.
+    zeta_max0 : float
+        The current contact's largest penetration so far at ``t0`` (its memory, which a
+        law with a permanent set unloads from; :attr:`SteadyState.zeta_max0` for an orbit
+        strobed inside a contact).  The default takes the start's own penetration.
+    throw : bool
+        Raise :class:`IntegrationError` on failure (default) or return a
+        trajectory whose ``status``/``message`` say what happened.
+
+    Returns
+    -------
+    Trajectory
+    """
+    tol = tolerances or Tolerances()
+    t0, t1 = (float(v) for v in t_span)
+    if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
+        raise InputError(f"t_span must be two finite times with t1 > t0, got {t_span!r}")
+    y0 = scenario.initial_state() if y0 is None else np.array(y0, dtype=float).reshape(4)
+    te = np.zeros(0) if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
+    if te.size and (np.any(np.diff(te) < 0) or te[0] < t0 - 1e-12 or te[-1] > t1 + 1e-12):
+        raise InputError("t_eval must be sorted and inside t_span")
+    coef, ea, eb, br = law.kernel_arrays()
+    out_y = np.empty((4, te.size))
+    out_f = np.empty(te.size)
+    out_m = np.empty(te.size, dtype=np.int64)
+    ev_t = np.empty(max_events)
+    ev_k = np.empty(max_events, dtype=np.int64)
+    ev_y = np.empty((max_events, 4))
+    ev_m = np.empty((max_events, 2), dtype=np.int64)
+    period = scenario.period
+    p = kernel_params(scenario, law)
+    p[K.P_ZMAX] = float(zeta_max0)
+    announce_compile("vibro-impact")
+    status, tf, yf, mf, n_steps, n_ev, _ = K.integrate(
+        t0,
+        t1,
+        y0,
+        -1 if mode0 is None else int(mode0),
+        p,
+        coef,
+        ea,
+        eb,
+        br,
+        tol.rtol,
+        _atol(scenario, tol),
+        period / 100.0,
+        period * tol.hmax_fraction,
+        tol.max_steps,
+        te,
+        out_y,
+        out_f,
+        out_m,
+        ev_t,
+        ev_k,
+        ev_y,
+        ev_m,
+    )
+    message = (
+        "ok"
+        if status == 0
+        else (f"integration stopped at t = {tf:.6g} s: {status_message(status, _HINTS)}")
+    )
+    if status and throw:
+        raise IntegrationError(message)
+    n_keep = min(n_ev, max_events)
+    ok_out = te <= tf if status else slice(None)
+    return Trajectory(
+        t=te[ok_out],
+        y=out_y[:, ok_out],
+        force=out_f[ok_out],
+        mode=out_m[ok_out],
+        event_t=ev_t[:n_keep].copy(),
+        event_kind=ev_k[:n_keep].copy(),
+        event_y=ev_y[:n_keep].copy(),
+        event_modes=ev_m[:n_keep].copy(),
+        t_final=float(tf),
+        y_final=yf,
+        mode_final=int(mf),
+        n_steps=int(n_steps),
+        status=int(status),
+        message=message,
+        zeta_max0=float(zeta_max0),
+    )

@@ -1,0 +1,438 @@
+"""Periodic steady states: stroboscopic map, shooting, Floquet multipliers.
+
+The stroboscopic map ``Phi`` advances a state by one drive period ``T`` (the drive
+phase is fixed, so states are sampled at ``t = kT``).  After a short transient the
+recurrence of the strobe points suggests a period ``n``; a damped Newton method
+on ``Phi^n(y) - y = 0`` (finite-difference Jacobian, which includes the event
+saltation automatically) then converges to the periodic orbit, whose Floquet
+multipliers are the eigenvalues of that Jacobian.  An orbit is accepted only when
+it converged and is stable; otherwise a long transient is integrated and the
+search repeated, and if that fails too the result says "nonperiodic" with the
+evidence.
+
+The recurrence, the Newton shooting, the period reduction and the Floquet multipliers
+are :mod:`discovery.numerics.shooting` (shared with Ueda's oscillators);
+:class:`StroboscopicMap` is this system's period map for it.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..._printing import fmt, readable
+from ..._validate import Array, Instance, Real, params
+from ...errors import InputError, IntegrationError
+from ...numerics.shooting import (
+    floquet_multipliers,
+    is_stable,
+    newton_orbit,
+    recurrence,
+    smallest_period,
+)
+from ...numerics.status import message as status_message
+from ..model.law import ForceLaw
+from ..model.scenario import Scenario
+from . import _kernel as K
+from .simulate import _HINTS, Tolerances, _atol, kernel_params, simulate
+
+__all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
+
+
+class StroboscopicMap:
+    """The period map of one scenario and law (a thin, fast wrapper on the kernel).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    law : ForceLaw
+    tolerances : Tolerances, optional
+    """
+
+    def __init__(self, scenario, law, tolerances=None):
+        self.scenario = scenario
+        self.law = law
+        self.tol = tolerances or Tolerances()
+        self._p = kernel_params(scenario, law)
+        self._coef, self._ea, self._eb, self._br = law.kernel_arrays()
+        self._atol = _atol(scenario, self.tol)
+        self._T = scenario.period
+        self._hmax = self._T * self.tol.hmax_fraction
+        self._empty = np.zeros(0)
+        self._ey = np.empty((4, 0))
+        self._ef = np.empty(0)
+        self._em = np.empty(0, dtype=np.int64)
+        self._evt = np.empty(0)
+        self._evk = np.empty(0, dtype=np.int64)
+        self._evy = np.empty((0, 4))
+        self._evm = np.empty((0, 2), dtype=np.int64)
+        x, v = scenario.scales()
+        self.scale = np.array([x, v, x, v])
+        self.n_calls = 0
+        self.n_steps = 0
+        # a law with a permanent set unloads from the contact's largest penetration, which
+        # the four states do not hold: the map carries it from one call's end to the next
+        # start (exact at a fixed point; Jacobian probes hold it fixed)
+        self._memory = law.permanent_set > 0
+        self.zeta_max = 0.0
+
+    def advance(self, y, n=1, t0=0.0, remember=True):
+        """State after ``n`` periods from ``y`` at time ``t0`` (a multiple of ``T``).
+
+        For a law with a permanent set, a start inside a contact unloads from
+        :attr:`zeta_max`, the largest penetration the previous call ended with; with
+        ``remember`` this call's own end value replaces it."""
+        p = self._p.copy()
+        if self._memory:
+            p[K.P_ZMAX] = self.zeta_max
+        status, tf, yf, _, steps, _, _ = K.integrate(
+            t0,
+            t0 + n * self._T,
+            np.asarray(y, dtype=float),
+            -1,
+            p,
+            self._coef,
+            self._ea,
+            self._eb,
+            self._br,
+            self.tol.rtol,
+            self._atol,
+            self._T / 100.0,
+            self._hmax,
+            self.tol.max_steps,
+            self._empty,
+            self._ey,
+            self._ef,
+            self._em,
+            self._evt,
+            self._evk,
+            self._evy,
+            self._evm,
+        )
+        self.n_calls += 1
+        self.n_steps += steps
+        if self._memory and remember:
+            self.zeta_max = float(p[K.P_ZMAX])
+        if status != K.OK:
+            raise IntegrationError(
+                f"simulation of law '{self.law}' stopped at t = {tf:.6g} s: "
+                f"{status_message(status, _HINTS)}"
+            )
+        if not np.all(np.abs(yf) < 1e6 * self.scale.max() + 1e3):
+            raise IntegrationError(
+                f"simulation of law '{self.law}' left the physical range at t = {tf:.6g} s "
+                "(a displacement over 1e6 times the drive's scale); the law or the scenario "
+                "may be unphysical (negative or huge coefficients, a moulding thrown away)"
+            )
+        return yf
+
+    def jacobian(self, y, n=1, fy=None):
+        """Finite-difference Jacobian of ``Phi^n`` at ``y``, ndarray of shape (4, 4)."""
+        fy = self.advance(y, n) if fy is None else fy
+        J = np.empty((4, 4))
+        for j in range(4):
+            d = 1e-6 * self.scale[j]
+            yp = np.array(y, dtype=float)
+            yp[j] += d
+            J[:, j] = (self.advance(yp, n, remember=False) - fy) / d
+        return J
+
+
+@readable
+@dataclass(frozen=True)
+class SteadyState:
+    """A periodic steady state of the two-body system (or the evidence that none was found).
+
+    Attributes
+    ----------
+    regime : str
+        ``"P1"``, ``"P2"``, ... (period in drive periods) or ``"nonperiodic"``.
+    n_periods : int
+        Period ``n`` of the orbit in drive periods (0 when nonperiodic).
+    y0 : ndarray of shape (4,)
+        State on the orbit at ``t0`` (a multiple of the drive period).
+    t0 : float
+        Time [s] at which ``y0`` holds.
+    impacts : int
+        Contact onsets per orbit (``n`` periods).
+    multipliers : ndarray of shape (4,), complex
+        Floquet multipliers (eigenvalues of the Jacobian of ``Phi^n``).
+    residual : float
+        ``max |Phi^n(y0) - y0| / scale`` at the solution.
+    n_simulations : int
+        Period-map evaluations used.
+    evidence : dict
+        How the decision was reached (recurrence distances, Newton history).
+    zeta_max0 : float
+        For a law with a permanent set: the largest penetration of the contact under way
+        at ``y0`` (its unloading memory; pass it to :func:`simulate` as ``zeta_max0``).
+    """
+
+    regime: str
+    n_periods: int
+    y0: np.ndarray
+    t0: float
+    impacts: int
+    multipliers: np.ndarray
+    residual: float
+    n_simulations: int
+    evidence: dict = field(default_factory=dict)
+    zeta_max0: float = 0.0
+
+    @property
+    def periodic(self):
+        return self.n_periods > 0
+
+    @property
+    def impacts_per_period(self):
+        return self.impacts / self.n_periods if self.n_periods else float("nan")
+
+    def as_dict(self):
+        return {
+            "regime": self.regime,
+            "n_periods": self.n_periods,
+            "impacts": self.impacts,
+            "impacts_per_period": self.impacts_per_period,
+            "multipliers_abs": [float(abs(m)) for m in self.multipliers],
+            "residual": self.residual,
+            "n_simulations": self.n_simulations,
+        }
+
+    def _lines(self):
+        d = self.as_dict()
+        mult = np.abs(np.asarray(self.multipliers)) if self.multipliers is not None else []
+        return [
+            f"steady state {d.get('regime')}: {d.get('impacts')} impact(s) per orbit, "
+            f"max |Floquet multiplier| {fmt(np.max(mult) if len(mult) else None)}, "
+            f"residual {fmt(d.get('residual'), 2)}"
+        ]
+
+
+def _strobe_recurrence(pm, y, max_period):
+    """Strobe points from ``y`` and their recurrence distance per period ``n``: ``(last
+    strobe point, periods advanced, {n: distance}, the one-period distance)``; when the
+    points already recur after one period, only two periods are advanced."""
+    strobe = [y, pm.advance(y, 1), None]
+    strobe[2] = pm.advance(strobe[1], 1)
+    quick = max(np.max(np.abs(strobe[k + 1] - strobe[k]) / pm.scale) for k in (0, 1))
+    if quick < 1e-2:
+        # fast path: the strobe points already recur after one period
+        return strobe[-1], 2, {1: float(quick)}, quick
+    for _ in range(2 * max_period):
+        strobe.append(pm.advance(strobe[-1], 1))
+    return strobe[-1], 2 * max_period + 2, recurrence(strobe, pm.scale, max_period), quick
+
+
+def _orbit(scenario, law, pm, y, n, tol, max_newton, attempt, t0, evidence):
+    """Newton shooting for a period-``n`` orbit from ``y``: the steady state when it
+    converges to a stable orbit (reduced to its smallest period), else ``None``.  Every try
+    is recorded in ``attempt``."""
+    hist = []
+    y_orb, res, J, ok = newton_orbit(pm, y, n, tol, max_newton, hist)
+    mult = floquet_multipliers(J, len(y))
+    stable = bool(ok and is_stable(mult))
+    attempt["tried"].append(
+        {
+            "n": n,
+            "newton_residuals": hist,
+            "converged": ok,
+            "max_multiplier": float(np.max(np.abs(mult))),
+            "stable": stable,
+        }
+    )
+    if not stable:
+        return None
+    reduced = smallest_period(pm, y_orb, n, tol, max_newton) if n > 1 else None
+    if reduced is not None:
+        m, y_orb, res, J, hist_m = reduced
+        attempt["tried"].append(
+            {
+                "n": m,
+                "reduced_from": n,
+                "newton_residuals": hist_m,
+                "converged": True,
+                "stable": True,
+            }
+        )
+        n, mult = m, floquet_multipliers(J)
+    zmax = 0.0
+    if law.permanent_set > 0:
+        # one more orbit from y0 leaves the memory y0 holds (the orbit is periodic)
+        pm.advance(y_orb, n)
+        zmax = pm.zeta_max
+    impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n, zmax)
+    return SteadyState(
+        regime=f"P{n}",
+        n_periods=n,
+        y0=y_orb,
+        t0=t0,
+        impacts=impacts,
+        multipliers=mult,
+        residual=float(res),
+        n_simulations=pm.n_calls,
+        evidence=evidence,
+        zeta_max0=zmax,
+    )
+
+
+@params(
+    scenario=Scenario,
+    law=ForceLaw,
+    transient=Real(0, integer=True),
+    max_period=Real(1, 64, integer=True),
+    tol=Real(0, 1, open_low=True),
+    max_newton=Real(1, integer=True),
+    long_transient=Real(0, integer=True),
+    tolerances=(Tolerances, None),
+    y_start=(None, Array(1)),
+    t_start=Real(),
+    guess=(None, Instance("discovery.vibroimpact.dynamics.steady_state", "SteadyState")),
+)
+def steady_state(
+    scenario,
+    law,
+    *,
+    transient=30,
+    max_period=8,
+    tol=1e-8,
+    max_newton=12,
+    long_transient=300,
+    tolerances=None,
+    y_start=None,
+    t_start=0.0,
+    guess=None,
+):
+    """Find the periodic steady state reached from a given (or the scenario's) state.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    law : ForceLaw
+    transient : int
+        Drive periods integrated before the period search.
+    max_period : int
+        Largest orbit period (in drive periods) looked for.
+    tol : float
+        Newton tolerance on ``max |Phi^n(y) - y| / scale``.
+    max_newton : int
+        Newton iterations per attempt.
+    long_transient : int
+        Periods of the fallback transient when the first search fails.
+    tolerances : Tolerances, optional
+        Integrator settings.
+    y_start : array_like of shape (4,), optional
+        Initial state ``(w1, v1, w2, v2)`` (default the scenario's).  To follow the
+        attractor a machine is on, pass its measured state (see
+        :meth:`~discovery.vibroimpact.data.measurement.Measurement.state_at`).
+    guess : SteadyState, optional
+        Continuation: the periodic orbit of a nearby law (a neighbouring landscape point).
+        Newton starts from its orbit with its period; the orbit is taken when Newton
+        converges within ``CONTINUATION_NEWTON`` iterations to a stable orbit whose period
+        does not reduce; otherwise the search from ``y_start`` runs as without a guess.
+        Where attractors coexist, the continued orbit is the one on the guess's branch.
+    t_start : float
+        Time [s] at which ``y_start`` holds, on the drive's clock (the drive is
+        ``A sin(2 pi f t)``, phase 0 at ``t = 0``); it need not be a multiple of ``T``.
+
+    Returns
+    -------
+    SteadyState
+        ``regime == "nonperiodic"`` when no stable periodic orbit was found.
+
+    Raises
+    ------
+    IntegrationError
+        When a simulation fails (blow-up, step budget): a failure is never reported
+        as the physical regime "nonperiodic".
+    """
+    if scenario.mass_loss > 0:
+        raise InputError(
+            f"scenario {scenario.name!r} sheds {scenario.mass_loss:g} of the "
+            "moulding's mass per impact, so it has no periodic steady state; "
+            "simulate it from rest (vidi simulate --from-rest) or set "
+            "mass_loss = 0"
+        )
+    pm = StroboscopicMap(scenario, law, tolerances)
+    if guess is not None and guess.periodic and law.permanent_set == 0:
+        cont = _continued(scenario, law, pm, guess, tol)
+        if cont is not None:
+            return cont
+    y = scenario.initial_state() if y_start is None else np.asarray(y_start, dtype=float)
+    T = scenario.period
+    evidence = {"attempts": [], "t_start": float(t_start)}
+    k0 = int(np.ceil(t_start / T - 1e-9))
+    if abs(t_start - k0 * T) > 1e-12 * T:
+        # integrate to the next strobe time (drive phase 0)
+        tr = simulate(scenario, law, (t_start, k0 * T), y0=y, tolerances=pm.tol)
+        y = tr.y_final
+    t_done = k0
+    for phase, n_trans in (("transient", transient), ("long-transient", long_transient)):
+        y = pm.advance(y, n_trans)
+        t_done += n_trans
+        y, periods, dist, quick = _strobe_recurrence(pm, y, max_period)
+        t_done += periods
+        order = sorted(dist, key=lambda n: (dist[n] > 1e-2, n if dist[n] <= 1e-2 else dist[n]))
+        attempt = {"phase": phase, "recurrence": dist, "tried": []}
+        evidence["attempts"].append(attempt)
+        if quick < 1e-2:
+            order = [1] + [n for n in range(2, max_period + 1)][:2]
+        for n in order[:3]:
+            found = _orbit(scenario, law, pm, y, n, tol, max_newton, attempt, t_done * T, evidence)
+            if found is not None:
+                return found
+    return SteadyState(
+        regime="nonperiodic",
+        n_periods=0,
+        y0=y,
+        t0=t_done * T,
+        impacts=0,
+        multipliers=np.full(4, np.nan + 0j),
+        residual=float("nan"),
+        n_simulations=pm.n_calls,
+        evidence=evidence,
+    )
+
+
+CONTINUATION_NEWTON = 4
+"""Newton iterations a continuation may take before the cold search runs instead."""
+
+
+def _continued(scenario, law, pm, guess, tol):
+    """The orbit continued from ``guess`` (see :func:`steady_state`), or None."""
+    n = guess.n_periods
+    hist = []
+    try:
+        y_orb, res, J, ok = newton_orbit(
+            pm, np.asarray(guess.y0, dtype=float), n, tol, CONTINUATION_NEWTON, hist
+        )
+    except IntegrationError:
+        return None
+    mult = floquet_multipliers(J, len(y_orb))
+    if not (ok and is_stable(mult)):
+        return None
+    if n > 1 and smallest_period(pm, y_orb, n, tol, CONTINUATION_NEWTON) is not None:
+        return None  # the period reduces here: let the cold search decide
+    evidence = {
+        "attempts": [],
+        "t_start": float(guess.t0),
+        "continued_from": {"regime": guess.regime, "newton_residuals": hist},
+    }
+    impacts = _count_onsets(scenario, law, pm.tol, y_orb, guess.t0, n, 0.0)
+    return SteadyState(
+        regime=f"P{n}",
+        n_periods=n,
+        y0=y_orb,
+        t0=guess.t0,
+        impacts=impacts,
+        multipliers=mult,
+        residual=float(res),
+        n_simulations=pm.n_calls,
+        evidence=evidence,
+        zeta_max0=0.0,
+    )
+
+
+def _count_onsets(scenario, law, tol, y0, t0, n, zeta_max0=0.0):
+    tr = simulate(
+        scenario, law, (t0, t0 + n * scenario.period), y0=y0, tolerances=tol, zeta_max0=zeta_max0
+    )
+    return int(np.sum(tr.event_kind == K.EV_ONSET))

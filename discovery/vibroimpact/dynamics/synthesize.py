@@ -1,0 +1,119 @@
+"""Synthetic records: a law simulated (compiled kernel or the independent scipy path) and
+sampled like a measurement, with noise on every channel."""
+
+import numpy as np
+
+from ..._validate import Choice, Real, params
+from ...errors import InputError
+from ..data.measurement import STATE_COLUMNS, Measurement
+from ..model.law import ForceLaw
+from ..model.scenario import Scenario
+from . import simulate
+from .steady_state import steady_state
+
+__all__ = ["synthesize"]
+
+
+@params(
+    scenario=Scenario,
+    law=ForceLaw,
+    periods=Real(1, integer=True),
+    fs=Real(0, open_low=True),
+    noise=Real(0, 1),
+    seed=Real(0, integer=True),
+    position_noise=Real(0, 1),
+    integrator=Choice("compiled", "scipy"),
+)
+def synthesize(
+    scenario,
+    law,
+    periods=20,
+    fs=20000.0,
+    noise=0.0,
+    seed=0,
+    ss=None,
+    *,
+    from_rest=False,
+    position_noise=0.0,
+    velocities=True,
+    integrator="compiled",
+):
+    """A synthetic measurement of ``law`` sampled at ``fs``.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    law : ForceLaw
+    periods : int
+        Drive periods recorded.
+    fs : float
+        Sampling rate [Hz].
+    noise : float
+        Gaussian noise on ``F`` with standard deviation ``noise * max F``.
+    seed : int
+        Seed of ``numpy.random.default_rng`` for all noise.
+    ss : SteadyState, optional
+        Precomputed steady state.
+    from_rest : bool
+        Record from the scenario's initial state (the run-up, with impacts at many
+        velocities, then the steady state) instead of from a time on the periodic
+        orbit.  Either way the drive phase at ``t = 0`` is zero.
+    position_noise : float
+        Gaussian noise on ``w1`` and ``w2`` with standard deviation
+        ``position_noise * max(w1 - w2)`` (a fraction of the largest penetration).
+    velocities : bool
+        Include the ``v1``, ``v2`` channels.
+    integrator : {"compiled", "scipy"}
+        ``"scipy"``: the independent slow path (:func:`~discovery.vibroimpact.dynamics.reference.
+        reference_simulate`, scipy's DOP853 restarted at every contact event), for records
+        that the compiled kernel which fits them did not make.
+
+    Returns
+    -------
+    Measurement
+    """
+    if not (periods >= 1 and fs > 0 and noise >= 0 and position_noise >= 0):
+        raise InputError("periods must be >= 1, fs > 0 and the noise levels >= 0")
+    n = int(round(periods * scenario.period * fs))
+    t = np.arange(n) / fs
+    if from_rest:
+        span, y0, t_eval, zmax0 = (0.0, t[-1]), None, t, 0.0
+    else:
+        ss = ss or steady_state(scenario, law)
+        if not ss.periodic:
+            raise InputError(
+                f"law '{law}' has no periodic steady state in scenario "
+                f"{scenario.name!r} ({ss.regime}); choose another law or scenario, "
+                "or record from rest"
+            )
+        span, y0, t_eval, zmax0 = (ss.t0, ss.t0 + t[-1]), ss.y0, ss.t0 + t, ss.zeta_max0
+    if integrator == "scipy":
+        if zmax0 and law.permanent_set:
+            raise InputError(
+                "the scipy path records a law with a permanent set from rest "
+                "only; add from_rest=True (--from-rest)"
+            )
+        from .reference import reference_simulate
+
+        out = reference_simulate(scenario, law, span, y0=y0, t_eval=t_eval, rtol=1e-9)
+        force, states = out["force"], out["y"]
+    else:
+        tr = simulate(scenario, law, span, y0=y0, t_eval=t_eval, zeta_max0=zmax0)
+        force, states = tr.force, tr.y
+    rng = np.random.default_rng(seed)
+    F = force.copy()
+    if noise > 0:
+        F = F + rng.normal(0.0, noise * float(np.max(F)), size=F.shape)
+    ch = dict(zip(STATE_COLUMNS, (v.copy() for v in states), strict=True))
+    if position_noise > 0:
+        sd = position_noise * float(np.max(ch["w1"] - ch["w2"]))  # of the largest penetration
+        ch["w1"] += rng.normal(0.0, sd, n)
+        ch["w2"] += rng.normal(0.0, sd, n)
+    if not velocities:
+        del ch["v1"], ch["v2"]
+    return Measurement(
+        t,
+        F,
+        ch,
+        source=f"synthetic:{scenario.name}" + (" (scipy path)" if integrator == "scipy" else ""),
+    )

@@ -1,0 +1,38 @@
+"""The missing-effect workflow: localise the disagreement of a model with a record, name the
+missing physical effect from a catalogue, add it, refit, re-verify.
+
+record + model -> :func:`localise` (phases, (zeta, dzeta) plane, grid motion, drift) ->
+score tests of the catalogue's effects (:data:`EFFECTS`) -> refit -> :func:`explain`.
+"""
+
+from ..._lazy import lazy_package
+
+_EXPORTS = {
+    "EFFECTS": "effects",
+    "Effect": "effects",
+    "Model": "effects",
+    "effect": "effects",
+    "first_order_lag": "effects",
+    "ExplainResult": "explain",
+    "Iteration": "explain",
+    "explain": "explain",
+    "start_law": "explain",
+    "PHASES": "localise",
+    "localise": "localise",
+}
+
+__all__ = [
+    "explain",
+    "ExplainResult",
+    "Iteration",
+    "EFFECTS",
+    "Effect",
+    "Model",
+    "effect",
+    "first_order_lag",
+    "localise",
+    "PHASES",
+    "start_law",
+]
+
+lazy_package(__name__, _EXPORTS)

@@ -1,0 +1,873 @@
+"""Identification by simulation (output error): minimise a criterion over a law's coefficients.
+
+Every objective evaluation is :func:`discovery.vibroimpact.verify.evaluate` (the one evaluation
+function: simulate to the periodic steady state from the record's measured state,
+align the impacts, sample like the record, score I0..I4).  Several records, each with
+its own scenario (operating point), are fitted jointly.  Coefficients are optimised in
+units of the start values (``x_i = c_i / c_i^start``) so all methods see a
+well-scaled problem.  Methods:
+
+``coordinate-descent``
+    The paper's accelerated coordinate descent: along each coefficient in turn
+    try a step, double it while it keeps improving, else try the other direction,
+    else halve it; stop when every step is below ``xtol``.
+``nelder-mead``
+    scipy's Nelder–Mead simplex (derivative-free).
+``least-squares``
+    scipy's trust-region least squares on the residual vector ``(F_N - F_E)`` of every
+    record, weighted so that each record's squared norm is its ``I3^2`` (a smooth
+    surrogate, Gauss–Newton fast); the chosen criterion is reported.
+
+The simulation budget counts every simulation, the finite-difference Jacobians
+included.  A simulation that fails or has no periodic orbit with contact is recorded
+in ``failures`` (the optimiser sees a penalty); a start law that fails is an error.
+
+Coefficient uncertainty: the Jacobian ``J`` of the weighted residuals at the optimum
+(forward differences, one simulation per coefficient and record) gives the
+covariance ``s^2 (J^T J)^-1`` with ``s^2 = RSS / (m - p)`` (as lmfit scales it: the
+residual variance estimated from the fit), hence a standard error per coefficient.
+"""
+
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy.optimize import least_squares, minimize
+
+from ..._printing import coefficient_lines, criteria_lines, fmt, readable
+from ..._progress import tick
+from ..._validate import Real, Text, params
+from ...errors import InputError, IntegrationError
+from ..data.impulse import Impulse
+from ..data.measurement import Measurement
+from ..dynamics import Tolerances
+from ..model.law import ForceLaw
+from ..model.scenario import Scenario
+from ..verify import Reference, evaluate
+from ..verify.criteria import criterion as _criterion
+
+__all__ = [
+    "IdentificationResult",
+    "identify",
+    "METHODS",
+    "as_records",
+    "pair_records",
+    "contact_scales",
+    "record_start",
+    "cycle_pairs",
+    "Intervals",
+    "bootstrap_intervals",
+]
+
+METHODS = ("coordinate-descent", "nelder-mead", "least-squares")
+_PENALTY = 10.0  # criterion value of a failed simulation (criteria are O(1))
+_JAC_STEP = 1e-5  # relative step of the standard-error Jacobian
+
+
+@readable
+@dataclass(frozen=True)
+class IdentificationResult:
+    """Outcome of :func:`identify`.
+
+    Attributes
+    ----------
+    law : ForceLaw or Model
+        Identified law (of the kind ``start`` was: a model when more than a law was
+        fitted).
+    criterion : str
+        The criterion minimised (reported for every method; the mean over records).
+    value : float
+        Its final value.
+    criteria : dict
+        All criteria ``I0..I4`` at the identified law (the mean over records).
+    evaluations : tuple of Evaluation
+        The identified law against each record (without noise floor).
+    method : str
+    n_simulations : int
+        Steady-state simulations used (every record counts, Jacobians included; the final
+        check adds one per record).
+    iterations : list of dict
+        Every improving iterate: ``coefficients`` {term: value}, ``value``,
+        ``n_simulations``.
+    standard_errors : dict
+        ``{term: standard error}`` (empty when not computed or not estimable).
+    correlation : ndarray or None
+        Correlation matrix of the coefficients (order of ``law.names``).
+    failures : list of dict
+        Simulations that failed: ``coefficients``, ``status``, ``message``.
+    seconds : float
+    message : str
+    intervals : Intervals or None
+        Bootstrap intervals (``n_boot_intervals``).
+    checks : tuple of Evaluation
+        The identified law against every record with its noise floor (``check=True``):
+        :attr:`consistent` and :attr:`verdict` come from them.
+    """
+
+    law: object
+    criterion: str
+    value: float
+    criteria: dict
+    method: str
+    n_simulations: int
+    evaluations: tuple = ()
+    iterations: list = field(default_factory=list)
+    standard_errors: dict = field(default_factory=dict)
+    correlation: object = None
+    failures: list = field(default_factory=list)
+    seconds: float = 0.0
+    message: str = ""
+    intervals: object = None
+    checks: tuple = ()
+
+    @property
+    def coefficients(self):
+        return _named(self.law)
+
+    @property
+    def consistent(self):
+        """Consistent with every record (``None`` when not checked)."""
+        return all(ev.consistent for ev in self.checks) if self.checks else None
+
+    @property
+    def verdict(self):
+        """One sentence on the identified law against the record(s)."""
+        if not self.checks:
+            return "not checked against the records' noise floors (check=False)"
+        if len(self.checks) == 1:
+            return self.checks[0].verdict or self.checks[0].message
+        bad = [(i, ev) for i, ev in enumerate(self.checks) if not ev.consistent]
+        if not bad:
+            return f"consistent with all {len(self.checks)} records"
+        i, ev = bad[0]
+        more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
+        return f"inconsistent with record {i + 1}: {ev.verdict or ev.message}{more}"
+
+    def as_dict(self):
+        """The result as JSON-ready data (the identification part of ``summary.json``)."""
+        return {
+            "criterion": self.criterion,
+            "method": self.method,
+            "coefficients": self.coefficients,
+            "law": self.law.to_text(),
+            "latex": self.law.latex(),
+            "standard_errors": self.standard_errors,
+            "intervals": None if self.intervals is None else self.intervals.as_dict(),
+            "correlation": self.correlation,
+            "value": self.value,
+            "criteria_found": self.criteria,
+            "n_simulations": self.n_simulations,
+            "failures": self.failures,
+            "iterations": self.iterations,
+            "message": self.message,
+            "seconds": self.seconds,
+            "consistent": self.consistent,
+            "verdict": self.verdict,
+        }
+
+    def _lines(self):
+        out = [
+            f"identified {self.law}: {self.criterion} = {fmt(self.value, 3)} "
+            f"({self.method}, {self.n_simulations} simulations, {self.seconds:.1f} s)"
+        ]
+        out.append(f"  verdict: {self.verdict}")
+        out += coefficient_lines(self.coefficients, self.standard_errors, self.intervals)
+        out += criteria_lines(self.criteria)
+        if self.message:
+            out.append(f"  optimiser: {self.message}")
+        if self.failures:
+            out.append(f"  {len(self.failures)} simulation(s) failed on the way")
+        return out
+
+
+class _Budget(Exception):
+    """The simulation budget is used up."""
+
+
+def pair_records(scenario, records):
+    """``[(scenario, record), ...]``: one scenario per record, or one for all; a single
+    scenario or record may be given bare."""
+    scs = list(scenario) if isinstance(scenario, list | tuple) else [scenario]
+    recs = list(records) if isinstance(records, list | tuple) else [records]
+    if len(scs) == 1 and len(recs) > 1:
+        scs = scs * len(recs)
+    if not recs or len(scs) != len(recs):
+        raise InputError(
+            f"{len(recs)} record(s) but {len(scs)} scenario(s): give one scenario "
+            "per record (or one for all)"
+        )
+    return list(zip(scs, recs, strict=True))
+
+
+def as_records(scenario, reference):
+    """``[(scenario, Reference), ...]`` from one pair or from two equal-length sequences.
+
+    ``reference`` may be a :class:`~discovery.vibroimpact.verify.Reference`, a
+    :class:`~discovery.vibroimpact.data.measurement.Measurement` (prepared with
+    :meth:`Reference.from_measurement`) or an exact
+    :class:`~discovery.vibroimpact.data.impulse.Impulse`.
+    """
+    out = []
+    for sc, ref in pair_records(scenario, reference):
+        if isinstance(ref, Impulse):
+            ref = Reference.exact(ref, source="impulse")
+        elif not isinstance(ref, Reference):
+            ref = Reference.from_measurement(ref, sc)
+        out.append((sc, ref))
+    return out
+
+
+def contact_scales(scenario, reference):
+    """Typical contact time [s], impact velocity [m/s] and penetration ``v tau / pi`` [m] of
+    a record (the scenario's period and motion scale when the record lacks them)."""
+    E = reference.impulse
+    tau = float(np.median(E.support[:, 1] - E.support[:, 0])) if len(E.support) else scenario.period
+    v = (reference.noise.get("impact_velocity") if reference.noise else None) or scenario.scales()[
+        1
+    ]
+    return tau, v, v * tau / np.pi
+
+
+def record_start(scenario, reference, terms):
+    """Start coefficients for ``terms`` from the record alone (a spring-dashpot estimate, to
+    be refined by simulation): stiffness ``k = mu (pi / tau)^2`` from the contact time and
+    the reduced mass, damping ``c = F(0+) / v`` from the force jump at onset (5 % of
+    critical without a jump), each term scaled to give that force at the typical
+    penetration ``z0``: elastic terms (``b = 0``) ``k z0 / z0^a``, the others ``c / z0^a``.
+
+    Returns
+    -------
+    ndarray
+        One coefficient per term.
+    """
+    E = reference.impulse
+    tau, v, z0 = contact_scales(scenario, reference)
+    mu = scenario.m1 * scenario.m2 / (scenario.m1 + scenario.m2)
+    k = mu * (np.pi / tau) ** 2
+    jump = float(E.evaluate(0.0, "right"))
+    c = jump / v if jump > 0.05 * E.peak else 0.1 * np.sqrt(k * mu)
+    return np.array([(k * z0 if t.b == 0 else c) / z0**t.a for t in terms])
+
+
+def _named(model):
+    return dict(zip(model.names, model.coefficients, strict=True))
+
+
+def model_parts(model, observe=None):
+    """``(law, scenario -> scenario, observation)`` of what :func:`identify` fits: a
+    :class:`ForceLaw`, or a model with more parameters than a law's coefficients (the
+    missing-effect workflow's :class:`~discovery.vibroimpact.explain.Model`: ``coefficients``,
+    ``names``, ``with_coefficients``, ``law``, ``apply(scenario)``, ``observe()``)."""
+    if isinstance(model, ForceLaw):
+        return model, (lambda sc: sc), observe
+    return model.law, model.apply, model.observe()
+
+
+def _measured_cycles(ref):
+    """The measured cycles a record is compared on: every block of a record span, else
+    the one aligned cycle."""
+    return list(ref.blocks) if getattr(ref, "blocks", ()) else [ref.impulse]
+
+
+def cycle_pairs(ev, ref):
+    """``[(measured, simulated), ...]`` of an evaluation, one per compared cycle."""
+    return ev.extra.get("blocks") or [(ref.impulse, ev.simulated)]
+
+
+def _residual_weights(ref):
+    """Per measured cycle: trapezoid-like sample spacing, normalised so that the sum of
+    squared residuals of a cycle is its I3^2, times the square root of its share of the
+    record's cycles."""
+    cycles = _measured_cycles(ref)
+    n = np.array([max(E.n_cycles, 1) for E in cycles], dtype=float)
+    share = np.sqrt(n / n.sum())
+    return [
+        s * np.sqrt(np.gradient(E.t) / max(np.trapezoid(E.F**2, E.t), 1e-300))
+        for E, s in zip(cycles, share, strict=True)
+    ]
+
+
+class _Objective:
+    """Counts and caches simulations, enforces the budget, records the best-so-far path."""
+
+    def __init__(self, records, start, name, tolerances, max_sim, observe=None, progress=None):
+        self.progress = progress
+        self.records, self.start, self.name = records, start, name
+        self.observe = observe
+        self.tol, self.max_sim = tolerances, max_sim
+        _criterion(name)
+        self.c0 = np.array(start.coefficients)
+        self.n = 0
+        self.cache = {}
+        self.best = (np.inf, None)
+        self.path, self.failures = [], []
+        # residual weights: trapezoid-like sample spacing, normalised so that the sum
+        # of squared residuals of a record is its I3^2
+        self.w = [_residual_weights(ref) for _, ref in records]
+
+    def law(self, x):
+        return self.start.with_coefficients(self.c0 * np.asarray(x))
+
+    def evaluations(self, x):
+        key = tuple(np.round(np.asarray(x, dtype=float), 14))
+        if key not in self.cache:
+            if self.n + len(self.records) > self.max_sim:
+                raise _Budget
+            law, machine, observe = model_parts(self.law(x), self.observe)
+            evs = []
+            for sc, ref in self.records:
+                self.n += 1
+                tick(self.progress, "identify: simulations", self.n, self.max_sim)
+                ev = evaluate(
+                    machine(sc),
+                    law,
+                    ref,
+                    tolerances=self.tol,
+                    floor=False,
+                    observe=observe,
+                    smooth_onset=True,
+                )
+                evs.append(ev)
+                if ev.status != "ok":
+                    self.failures.append(
+                        {
+                            "coefficients": _named(self.law(x)),
+                            "status": ev.status,
+                            "message": ev.message or ev.verdict,
+                        }
+                    )
+                    break
+            self.cache[key] = evs if all(e.status == "ok" for e in evs) else None
+        return self.cache[key]
+
+    def __call__(self, x):
+        evs = self.evaluations(x)
+        if evs is None:
+            return _PENALTY
+        v = float(np.mean([e.criteria[self.name] for e in evs]))
+        if v < self.best[0]:
+            self.best = (v, np.array(x, dtype=float))
+            self.path.append(
+                {"coefficients": _named(self.law(x)), "value": v, "n_simulations": self.n}
+            )
+        return v
+
+    def residuals(self, x):
+        evs = self.evaluations(x)
+        if evs is None:
+            # a failed point: residuals as large as an all-wrong force history
+            return np.concatenate(
+                [
+                    _PENALTY * w[1:] * np.max(np.abs(E.F))
+                    for (_, ref), ws in zip(self.records, self.w, strict=True)
+                    for E, w in zip(_measured_cycles(ref), ws, strict=True)
+                ]
+            )
+        self(x)  # records the path with the requested criterion
+        # the first point (F_E(0+), extrapolated from samples for an aligned cycle) is left
+        # out so the fit is not biased by the extrapolation error at the jump
+        return np.concatenate(
+            [
+                ((S.F - E.F) * w)[1:]
+                for ev, (_, ref), ws in zip(evs, self.records, self.w, strict=True)
+                for (E, S), w in zip(cycle_pairs(ev, ref), ws, strict=True)
+            ]
+        )
+
+
+def _coordinate_descent(obj, x0, xtol, step0=0.1):
+    x = np.array(x0, dtype=float)
+    fx = obj(x)
+    steps = np.full(x.size, step0)
+    while np.any(steps > xtol):
+        for i in range(x.size):
+            if steps[i] <= xtol:
+                continue
+            improved = False
+            for direction in (1.0, -1.0):
+                trial = x.copy()
+                trial[i] += direction * steps[i]
+                ft = obj(trial)
+                if ft < fx:
+                    x, fx, improved = trial, ft, True
+                    # accelerate: keep going and double the step while it pays
+                    while True:
+                        steps[i] *= 2.0
+                        trial = x.copy()
+                        trial[i] += direction * steps[i]
+                        ft = obj(trial)
+                        if ft >= fx:
+                            steps[i] *= 0.5
+                            break
+                        x, fx = trial, ft
+                    break
+            if not improved:
+                steps[i] *= 0.5
+    return x
+
+
+def _uncertainty(obj, x, names):
+    """Standard errors and correlations from the residual Jacobian at ``x``."""
+    r0 = obj.residuals(x)
+    J = np.empty((r0.size, x.size))
+    for i in range(x.size):
+        xi = x.copy()
+        h = _JAC_STEP * max(abs(x[i]), 1e-3)
+        xi[i] += h
+        if obj.evaluations(xi) is None:
+            return {}, None
+        J[:, i] = (obj.residuals(xi) - r0) / h
+    m, p = J.shape
+    if m <= p:
+        return {}, None
+    s2 = float(r0 @ r0) / (m - p)
+    try:
+        cov = s2 * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        return {}, None
+    d = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    se = {n: float(abs(c) * s) for n, c, s in zip(names, obj.c0, d, strict=True)}
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(d, d)
+    return se, corr
+
+
+def _checked(scenario, reference, start, method, xtol, max_simulations):
+    """The settings :func:`identify` checks beyond their types; returns the records."""
+    if method not in METHODS:
+        raise InputError(f"unknown method {method!r}; valid methods: {', '.join(METHODS)}")
+    if any(c == 0 for c in start.coefficients):
+        raise InputError("every start coefficient must be non-zero (they set the scale)")
+    if not (np.isfinite(xtol) and xtol > 0):
+        raise InputError(f"xtol must be a positive number, got {xtol!r}")
+    records = as_records(scenario, reference)
+    if not (isinstance(max_simulations, int | np.integer) and max_simulations >= 2 * len(records)):
+        raise InputError(
+            f"the simulation budget must be an integer of at least "
+            f"{2 * len(records)} (two per record); got {max_simulations!r}"
+        )
+    return records
+
+
+def _short_first(
+    records,
+    start,
+    short_first,
+    criterion,
+    method,
+    xtol,
+    max_simulations,
+    tolerances,
+    observe,
+    progress,
+):
+    """With record spans compared in blocks, the start fitted cycle by cycle first (up to
+    half the budget; continuation in block length): ``(start, simulations spent)``.  The
+    caller's start is kept when it already matches the blocks better."""
+    short = [r.shortened() if isinstance(r, Reference) else None for _, r in records]
+    if not (
+        short_first and all(r is not None for r in short) and max_simulations >= 8 * len(records)
+    ):
+        return start, 0
+    spent = 0
+    try:
+        first = identify(
+            [sc for sc, _ in records],
+            short,
+            start,
+            criterion=criterion,
+            method=method,
+            xtol=xtol,
+            max_simulations=max_simulations // 2,
+            tolerances=tolerances,
+            uncertainty=False,
+            observe=observe,
+            short_first=False,
+            progress=None
+            if progress is None
+            else (lambda s, d, t: progress("identify: cycle by cycle", d, t)),
+            check=False,
+        )
+        spent = first.n_simulations
+        if not any(c == 0 for c in first.law.coefficients):
+            start0, start = start, first.law
+            # keep the caller's start when it already matches the blocks better
+            probe = _Objective(records, start0, criterion, tolerances, 10**9, observe)
+            alt = _Objective(records, start, criterion, tolerances, 10**9, observe)
+            x1 = np.ones(len(start.coefficients))
+            v0, v1 = probe(x1), alt(x1)
+            spent += probe.n + alt.n
+            if not v1 <= v0:
+                start = start0
+    except IntegrationError:
+        pass
+    return start, spent
+
+
+def _optimise(obj, x0, method, xtol, max_simulations):
+    """Run ``method`` on the objective from ``x0``; returns the optimiser's message."""
+    try:
+        if method == "coordinate-descent":
+            _coordinate_descent(obj, x0, xtol)
+            return "steps below xtol"
+        if method == "nelder-mead":
+            simplex = np.vstack([x0] + [x0 + 0.1 * np.eye(x0.size)[i] for i in range(x0.size)])
+            res = minimize(
+                obj,
+                x0,
+                method="Nelder-Mead",
+                options={
+                    "xatol": xtol,
+                    "fatol": 1e-12,
+                    "maxfev": max_simulations,
+                    "initial_simplex": simplex,
+                },
+            )
+            return str(res.message)
+        res = least_squares(
+            obj.residuals,
+            x0,
+            method="trf",
+            x_scale=1.0,
+            diff_step=1e-6,
+            xtol=xtol * 1e-2,
+            ftol=1e-12,
+            gtol=1e-12,
+        )
+        return str(res.message)
+    except _Budget:
+        return f"simulation budget of {max_simulations} used"
+
+
+def _checks(records, law, observe, tolerances):
+    """The identified law against every record with its noise floor."""
+    plain, machine, observed = model_parts(law, observe)
+    return tuple(
+        evaluate(machine(sc), plain, ref, tolerances=tolerances, observe=observed)
+        for sc, ref in records
+    )
+
+
+@params(
+    scenario=(Scenario, list, tuple),
+    reference=(Measurement, Reference, Impulse, list, tuple),
+    criterion=Text(),
+    method=Text(),
+    xtol=Real(0, open_low=True),
+    max_simulations=Real(1, integer=True),
+    tolerances=(Tolerances, None),
+    n_boot_intervals=Real(0, integer=True),
+    seed=Real(0, integer=True),
+    check=bool,
+)
+def identify(
+    scenario,
+    reference,
+    start,
+    *,
+    criterion="I2",
+    method="least-squares",
+    xtol=1e-5,
+    max_simulations=600,
+    tolerances=None,
+    uncertainty=True,
+    observe=None,
+    short_first=True,
+    n_boot_intervals=0,
+    seed=0,
+    progress=None,
+    check=True,
+):
+    """Identify the coefficients of ``start`` from one or several records by simulation.
+
+    Parameters
+    ----------
+    scenario : Scenario or sequence of Scenario
+        The known part of the machine; one per record (or one for all).
+    reference : Reference, Measurement or Impulse, or a sequence of them
+        The record(s) (see :func:`as_records`).  A :class:`Reference` built with
+        :meth:`~discovery.vibroimpact.verify.Reference.from_measurement` starts every simulation
+        from the machine's measured state.
+    start : ForceLaw or Model
+        Terms to identify and their start values (all non-zero); or a model whose
+        parameters go beyond a law's coefficients (:func:`model_parts`: an unloading
+        branch, a machine parameter, an observation model, fitted jointly).
+    criterion : str
+        Criterion to minimise (``I0``..``I4``; the mean over records).
+    method : str
+        One of :data:`METHODS` (default ``"least-squares"``, as ``vidi identify``: it needs
+        5-10x fewer simulations than the paper's coordinate descent, ``bench/``).
+    xtol : float
+        Relative coefficient tolerance (> 0).
+    max_simulations : int
+        Simulation budget (every record and every Jacobian evaluation counts).
+    tolerances : Tolerances, optional
+        Integrator settings (the same for every evaluation).
+    uncertainty : bool
+        Estimate standard errors (one more simulation per coefficient and record).
+    observe : callable, optional
+        Observation model of the simulated force (see
+        :func:`discovery.vibroimpact.verify.evaluate`).
+    n_boot_intervals : int
+        Bootstrap replicates of 95 % coefficient intervals through the full processing
+        (:func:`bootstrap_intervals`; records with positions; 0 = none).
+    seed : int
+        Seed of that bootstrap.
+    progress : callable, optional
+        ``progress(stage, done, total)`` after each simulation (:mod:`discovery._progress`).
+    short_first : bool
+        With record spans compared in blocks of several cycles: first fit the records
+        cycle by cycle (:meth:`~discovery.vibroimpact.verify.Reference.shortened`, up to half the
+        budget), where a law's timing error cannot accumulate and the basin is wider, then
+        go on from there on the blocks (continuation in block length).
+    check : bool
+        Verify the identified law against every record with its noise floor (one more
+        evaluation per record): the result's :attr:`~IdentificationResult.verdict`.
+
+    Returns
+    -------
+    IdentificationResult
+
+    Raises
+    ------
+    InputError
+        Bad settings.
+    IntegrationError
+        The start law has no periodic steady state with contact.
+    """
+    records = _checked(scenario, reference, start, method, xtol, max_simulations)
+    t0 = time.perf_counter()
+    start, spent = _short_first(
+        records,
+        start,
+        short_first,
+        criterion,
+        method,
+        xtol,
+        max_simulations,
+        tolerances,
+        observe,
+        progress,
+    )
+    obj = _Objective(
+        records,
+        start,
+        criterion,
+        tolerances,
+        max(int(max_simulations) - spent, 2 * len(records)),
+        observe,
+        progress,
+    )
+    obj.n = 0
+    x0 = np.ones(len(start.coefficients))
+    if obj.evaluations(x0) is None:
+        f = obj.failures[-1]
+        raise IntegrationError(
+            f"the start law {start} cannot be compared with the record: "
+            f"{f['status']} ({f['message']}); give start values closer to "
+            "the record (e.g. from vidi fit)"
+        )
+    message = _optimise(obj, x0, method, xtol, max_simulations)
+    if obj.best[1] is None:  # least squares evaluates residuals, which record the path
+        obj(x0)
+    x_best, value = obj.best[1], float(obj.best[0])  # before the error probes run
+    law = obj.law(x_best)
+    evs = obj.evaluations(x_best)
+    se, corr = {}, None
+    if uncertainty:
+        obj.max_sim += len(x_best) * len(records)  # the error estimate has its own budget
+        se, corr = _uncertainty(obj, x_best, law.names)
+    crit = {k: float(np.mean([e.criteria[k] for e in evs])) for k in evs[0].criteria}
+    if obj.failures:
+        message += (
+            f"; {len(obj.failures)} trial law(s) had no periodic steady state with "
+            "contact (see failures)"
+        )
+    intervals = None
+    if n_boot_intervals:
+        intervals = bootstrap_intervals(
+            [sc for sc, _ in records],
+            [r for _, r in records],
+            law,
+            n_boot=int(n_boot_intervals),
+            seed=seed,
+            criterion=criterion,
+            tolerances=tolerances,
+        )
+    return IdentificationResult(
+        checks=_checks(records, law, observe, tolerances) if check else (),
+        intervals=intervals,
+        law=law,
+        criterion=criterion,
+        value=value,
+        criteria=crit,
+        method=method,
+        n_simulations=obj.n + spent,
+        evaluations=tuple(evs),
+        iterations=obj.path,
+        standard_errors=se,
+        correlation=corr,
+        failures=obj.failures,
+        seconds=time.perf_counter() - t0,
+        message=message,
+    )
+
+
+# ------------------------------------------------------------------ bootstrap intervals
+# Coefficient intervals by a parametric bootstrap through the full processing (a refit per
+# replicate: it lives beside the fit it repeats).
+#
+# Coefficient intervals by a parametric bootstrap through the full processing.
+#
+# The Jacobian standard errors of an output-error fit assume white residuals.  A record
+# compared over its span has two more sources of error that they miss: the machine's state
+# at the start of each block is itself estimated from noisy positions (its error moves
+# every later impact of the block), and the record's own sampling.  The bootstrap repeats
+# the whole experiment under the fitted model: for each replicate, every block is simulated
+# from a state drawn from that block's state-fit covariance, sampled at the record's own
+# sample times with the record's force noise, folded like the record, and refitted from the
+# fitted model; the spread of the refitted coefficients gives the intervals.  Seeds are
+# explicit.
+
+
+@dataclass(frozen=True)
+class Intervals:
+    """Bootstrap intervals of a fitted law's coefficients.
+
+    Attributes
+    ----------
+    bounds : dict
+        ``{name: (low, high)}`` at ``level``: the estimate +- z * (bootstrap sd).
+    sd : dict
+        ``{name: bootstrap standard deviation}``.
+    level : float
+    n_boot : int
+        Replicates whose refit succeeded.
+    seed : int
+    method : str
+    """
+
+    bounds: dict
+    sd: dict
+    level: float
+    n_boot: int
+    seed: int
+    method: str = "parametric bootstrap through the record-span processing"
+
+    def as_dict(self):
+        return {
+            "bounds": {k: list(v) for k, v in self.bounds.items()},
+            "sd": dict(self.sd),
+            "level": self.level,
+            "n_boot": self.n_boot,
+            "seed": self.seed,
+            "method": self.method,
+        }
+
+
+def _replicate(scenario, law, observe, ref, rng, tolerances):
+    """A synthetic copy of ``ref`` made by ``law`` (the same span, states and sample times)."""
+    from ..verify.trajectory import simulated_history
+
+    span = ref.span
+    starts = [b.state.draw(rng) for b in span.blocks]
+    hist = simulated_history(
+        scenario, law, span, tolerances=tolerances, starts=starts, observe=observe
+    )
+    blocks = tuple(
+        replace(b, F=h + rng.normal(0.0, span.sigma_f, h.size))
+        for b, h in zip(span.blocks, hist, strict=True)
+    )
+    span2 = replace(span, blocks=blocks)
+    imps = tuple(span2.measured(onset_record_time=ref.impulse.onset))
+    return replace(ref, span=span2, blocks=imps, impulse=imps[-1], _source=None)
+
+
+def bootstrap_intervals(
+    scenario,
+    reference,
+    model,
+    *,
+    n_boot=30,
+    seed=0,
+    level=0.95,
+    max_simulations=60,
+    criterion="I2",
+    tolerances=None,
+):
+    """Intervals of ``model``'s coefficients by a parametric bootstrap (module docstring).
+
+    Parameters
+    ----------
+    scenario : Scenario or sequence of Scenario
+    reference : Reference or sequence of Reference
+        Records prepared with positions (a record span); others have no bootstrap.
+    model : ForceLaw or Model
+        The fitted law (or a model with effect parameters, :func:`identify.model_parts`).
+    n_boot : int
+        Replicates (>= 5).
+    seed : int
+        Seed of ``numpy.random.default_rng``.
+    level : float
+        Two-sided level in (0, 1).
+    max_simulations : int
+        Budget of each replicate's refit.
+    criterion : str
+    tolerances : Tolerances, optional
+
+    Returns
+    -------
+    Intervals or None
+        ``None`` when a record has no span (no state to draw), a parameter is 0, or fewer
+        than 5 refits succeeded.
+    """
+    from scipy.stats import norm
+
+    if not (isinstance(n_boot, int) and n_boot >= 5):
+        raise InputError(f"n_boot must be an integer >= 5; got {n_boot!r}")
+    if not 0 < level < 1:
+        raise InputError(f"level must be in (0, 1); got {level!r}")
+    records = as_records(scenario, reference)
+    if any(getattr(ref, "span", None) is None for _, ref in records):
+        return None
+    if any(c == 0 for c in model.coefficients):
+        return None  # a parameter at 0 sets no scale for the refits
+    law, machine, observe = model_parts(model)
+    rng = np.random.default_rng(seed)
+    draws = []
+    for _ in range(n_boot):
+        try:
+            reps = [
+                _replicate(machine(sc), law, observe, ref, rng, tolerances) for sc, ref in records
+            ]
+            res = identify(
+                [sc for sc, _ in records],
+                reps,
+                model,
+                criterion=criterion,
+                method="least-squares",
+                max_simulations=max_simulations,
+                tolerances=tolerances,
+                uncertainty=False,
+                short_first=False,
+                check=False,
+            )
+        except IntegrationError:
+            continue
+        draws.append(np.array(res.law.coefficients, dtype=float))
+    if len(draws) < 5:
+        return None
+    D = np.array(draws)
+    names = list(model.names)
+    est = np.array(model.coefficients, dtype=float)
+    sd = D.std(axis=0, ddof=1)
+    z = float(norm.ppf(0.5 + level / 2))
+    return Intervals(
+        bounds={
+            n: (float(e - z * s), float(e + z * s)) for n, e, s in zip(names, est, sd, strict=True)
+        },
+        sd={n: float(s) for n, s in zip(names, sd, strict=True)},
+        level=float(level),
+        n_boot=len(draws),
+        seed=int(seed),
+    )

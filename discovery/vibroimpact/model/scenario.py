@@ -1,0 +1,383 @@
+"""The two-body vibro-impact machine: validated parameters in SI units.
+
+Equations of motion (positions upward, ``zeta = w1 - w2`` the interpenetration)::
+
+    m1 w1'' + c1 w1' + k1 w1 + A sin(2 pi f t) + m1 g + F = 0     (grid frame)
+    m2 w2'' + m2 g - F = 0                                        (moulding)
+
+Notation fix: the paper's equation (1) multiplies its ``C1`` by the velocity and
+``H1`` by the displacement although its text calls ``C1`` the stiffness of the
+supports and ``H1`` the viscosity of the dampers.  We follow the text: ``k1``
+(the paper's ``C1``) multiplies the displacement and ``c1`` (``H1``) the velocity.
+"""
+
+import math
+import tomllib
+from dataclasses import asdict, dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from ..._validate import Text, check
+from ...errors import InputError
+from .law import ForceLaw
+
+__all__ = ["Scenario", "builtin_scenarios", "load_scenario"]
+
+_FIELDS = {
+    "m1": ("kg", True),
+    "m2": ("kg", True),
+    "k1": ("N/m", False),
+    "c1": ("N s/m", False),
+    "A": ("N", False),
+    "frequency": ("Hz", True),
+    "g": ("m/s^2", False),
+    "k3": ("N/m^3", False),
+    "mass_loss": ("per impact", False),
+}
+#: parameters a scenario file may leave out (their defaults: the paper's machine)
+_OPTIONAL = {"g": 9.81, "k3": 0.0, "mass_loss": 0.0}
+#: largest accepted value of each parameter: far beyond any vibro-impact machine, and
+#: small enough that the simulation's scales (A / (m1 omega^2), k1 / m1, ...) stay finite
+LIMITS = {
+    "m1": 1e9,
+    "m2": 1e9,
+    "k1": 1e15,
+    "c1": 1e12,
+    "A": 1e12,
+    "frequency": 1e5,
+    "g": 1e3,
+    "k3": 1e24,
+    "mass_loss": 0.5,
+}
+#: largest accepted |position| [m] and |velocity| [m/s] of the initial state
+INITIAL_LIMITS = (1e3, 1e3)
+#: the tables and keys a scenario file may have
+_TABLES = {
+    "name": None,
+    "machine": tuple(_FIELDS),
+    "law": ("text",),
+    "initial": ("w1", "v1", "w2", "v2"),
+}
+
+
+def _number(value, what, unit):
+    """A float from a number (not a boolean, not text) or raise naming ``what``."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.number):
+        got = (
+            "a boolean"
+            if isinstance(value, bool | np.bool_)
+            else (f"text {value!r}" if isinstance(value, str) else type(value).__name__)
+        )
+        raise InputError(
+            f"{what} must be a number in {unit}, got {got}; write a number such "
+            "as 1.0e4 (no quotes)"
+        )
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """Parameters of the two-body vibro-impact system (SI units).
+
+    Parameters
+    ----------
+    m1, m2 : float
+        Masses of the grid frame and of the moulding [kg], > 0.
+    k1 : float
+        Total stiffness of the elastic supports [N/m], >= 0.
+    c1 : float
+        Total viscosity of the dampers [N s/m], >= 0.
+    A : float
+        Amplitude of the drive ``A sin(2 pi f t)`` [N], >= 0.
+    frequency : float
+        Drive frequency ``f`` [Hz], > 0.
+    g : float
+        Gravitational acceleration [m/s^2], >= 0.
+    k3 : float
+        Cubic stiffness of the supports [N/m^3], >= 0: their force is ``k1 w1 + k3 w1^3``
+        (stiffening supports; 0 for the paper's linear springs).
+    mass_loss : float
+        Fraction of the moulding's mass shed at each impact, in [0, 0.5] (sand falling
+        out of the flask); 0 for the paper's constant mass.  With a loss the motion
+        drifts and has no periodic steady state: it is simulated over a record's span.
+    law : ForceLaw or None
+        The reference ("true") contact law, if the scenario has one.
+    initial : tuple of 4 floats or None
+        Initial state ``(w1, v1, w2, v2)`` at ``t = 0``; ``None`` puts both bodies at
+        rest, the grid at its static deflection ``-m1 g / k1`` and the moulding just
+        touching it.
+    name : str
+        A label used in reports.
+    """
+
+    m1: float
+    m2: float
+    k1: float
+    c1: float
+    A: float
+    frequency: float
+    g: float = 9.81
+    law: ForceLaw | None = None
+    initial: tuple | None = None
+    name: str = "custom"
+    source: str = field(default="", compare=False)
+    k3: float = 0.0
+    mass_loss: float = 0.0
+
+    def __post_init__(self):
+        check("Scenario: name", self.name, Text(200))
+        check("Scenario: source", self.source, Text(4096, empty=True))
+        check("Scenario: law", self.law, (ForceLaw, None))
+        for key, (unit, strict) in _FIELDS.items():
+            value = _number(getattr(self, key), f"scenario {key}", unit)
+            lim = LIMITS[key]
+            if not (math.isfinite(value) and 0 <= value <= lim) or (strict and value == 0):
+                need = "> 0" if strict else ">= 0"
+                raise InputError(
+                    f"scenario {key} = {value:g} {unit} is invalid; it must be finite, {need} "
+                    f"and <= {lim:g} {unit}"
+                )
+            object.__setattr__(self, key, value)
+        if self.initial is not None:
+            if (
+                isinstance(self.initial, str | bytes)
+                or not hasattr(self.initial, "__len__")
+                or len(self.initial) != 4
+            ):
+                raise InputError(
+                    "scenario initial must be 4 numbers (w1, v1, w2, v2) in m, "
+                    f"m/s; got {self.initial!r}"
+                )
+            init = tuple(
+                _number(v, f"scenario initial {k}", u)
+                for v, k, u in zip(
+                    self.initial, ("w1", "v1", "w2", "v2"), ("m", "m/s", "m", "m/s"), strict=True
+                )
+            )
+            wmax, vmax = INITIAL_LIMITS
+            if (
+                not all(math.isfinite(v) for v in init)
+                or max(abs(init[0]), abs(init[2])) > wmax
+                or max(abs(init[1]), abs(init[3])) > vmax
+            ):
+                raise InputError(
+                    "scenario initial must be 4 finite numbers (w1, v1, w2, v2) "
+                    f"with |w| <= {wmax:g} m and |v| <= {vmax:g} m/s"
+                )
+            object.__setattr__(self, "initial", init)
+        if self.law is not None and not isinstance(self.law, ForceLaw):
+            raise InputError(
+                f"scenario law must be a ForceLaw, got {type(self.law).__name__}; "
+                "use ForceLaw.parse(text)"
+            )
+
+    # ------------------------------------------------------------------ derived
+    @property
+    def omega(self):
+        """Drive angular frequency ``2 pi f`` [rad/s]."""
+        return 2.0 * math.pi * self.frequency
+
+    @property
+    def period(self):
+        """Drive period ``T = 1/f`` [s]."""
+        return 1.0 / self.frequency
+
+    @property
+    def reduced_mass(self):
+        """``m1 m2 / (m1 + m2)`` [kg]: the mass seen by the contact."""
+        return self.m1 * self.m2 / (self.m1 + self.m2)
+
+    def initial_state(self):
+        """Initial state ``[w1, v1, w2, v2]`` (ndarray of shape (4,))."""
+        if self.initial is not None:
+            return np.array(self.initial, dtype=float)
+        w1 = -self.m1 * self.g / self.k1 if self.k1 > 0 else 0.0
+        if self.k3 > 0:
+            # the real root of k1 w + k3 w^3 + m1 g = 0 (stiffening supports sag less)
+            roots = np.roots([self.k3, 0.0, self.k1, self.m1 * self.g])
+            w1 = float(np.real(roots[np.argmin(np.abs(np.imag(roots)))]))
+        return np.array([w1, 0.0, w1, 0.0])
+
+    def scales(self):
+        """Characteristic displacement [m] and velocity [m/s] of the motion."""
+        w2 = self.omega**2
+        x = max(self.A / (self.m1 * w2), self.g / w2, 1e-9)
+        return x, x * self.omega
+
+    def params(self):
+        """Parameter vector for the compiled kernel: m1, m2, k1, c1, A, omega, g, k3,
+        mass_loss."""
+        return np.array(
+            [
+                self.m1,
+                self.m2,
+                self.k1,
+                self.c1,
+                self.A,
+                self.omega,
+                self.g,
+                self.k3,
+                self.mass_loss,
+            ]
+        )
+
+    def replace(self, **changes):
+        """A copy with some parameters changed (validated like the original)."""
+        return Scenario(**{**self._fields(), **changes})
+
+    def with_law(self, law):
+        """A copy with another reference law."""
+        return Scenario(**{**self._fields(), "law": law})
+
+    def _fields(self):
+        return {
+            k: getattr(self, k)
+            for k in (
+                "m1",
+                "m2",
+                "k1",
+                "c1",
+                "A",
+                "frequency",
+                "g",
+                "law",
+                "initial",
+                "name",
+                "source",
+                "k3",
+                "mass_loss",
+            )
+        }
+
+    def as_dict(self):
+        """JSON-ready description (provenance for outputs)."""
+        d = {k: v for k, v in asdict(self).items() if k not in ("law", "source")}
+        d["law"] = None if self.law is None else self.law.to_text()
+        d["source"] = self.source
+        return d
+
+    # ------------------------------------------------------------------ loading
+    @classmethod
+    def from_toml(cls, path):
+        """Read a scenario file (``[machine]`` table, optional ``[law] text``, optional
+        ``[initial]``, optional top-level ``name``); every table and key is checked (see
+        :meth:`_from_mapping`)."""
+        path = Path(path)
+        hint = f"give a TOML file or one of {', '.join(builtin_scenarios())}"
+        try:
+            raw = path.read_bytes()
+        except FileNotFoundError:
+            raise InputError(f"scenario file {str(path)!r} does not exist; {hint}") from None
+        except IsADirectoryError:
+            raise InputError(f"scenario {str(path)!r} is a directory; {hint}") from None
+        except PermissionError:
+            raise InputError(
+                f"scenario file {str(path)!r} cannot be read (permission denied); "
+                "fix its permissions"
+            ) from None
+        except OSError as exc:
+            raise InputError(
+                f"cannot read scenario file {str(path)!r} ({exc.strerror or exc}); {hint}"
+            ) from None
+        try:
+            text = raw.decode("utf-8-sig")
+        except UnicodeDecodeError as exc:
+            raise InputError(
+                f"scenario file {str(path)!r} is not UTF-8 text (byte "
+                f"0x{raw[exc.start]:02x} at offset {exc.start}); re-save it as "
+                "UTF-8"
+            ) from None
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise InputError(f"scenario file {str(path)!r} is not valid TOML: {exc}") from None
+        return cls._from_mapping(data, str(path), default_name=path.stem)
+
+    @classmethod
+    def _from_mapping(cls, data, source, default_name):
+        """Validate a parsed scenario file: unknown tables and keys are refused (a typo
+        would otherwise silently fall back to a default), every value is type-checked
+        (a boolean or a quoted number is not a number) and range-checked."""
+        unknown = sorted(set(data) - set(_TABLES))
+        if unknown:
+            raise InputError(
+                f"scenario {source!r}: unknown table(s) or key(s) "
+                f"{', '.join(unknown)}; valid are name, [machine], [law], [initial]"
+            )
+        for table in ("machine", "law", "initial"):
+            if table in data and not isinstance(data[table], dict):
+                raise InputError(
+                    f"scenario {source!r}: {table} must be a table; write "
+                    f"[{table}] on its own line followed by its keys"
+                )
+            extra = sorted(set(data.get(table, {})) - set(_TABLES[table]))
+            if extra:
+                raise InputError(
+                    f"scenario {source!r}: unknown [{table}] key(s) "
+                    f"{', '.join(extra)}; valid keys are "
+                    f"{', '.join(_TABLES[table])}"
+                )
+        machine = data.get("machine")
+        if machine is None:
+            raise InputError(
+                f"scenario {source!r} needs a [machine] table with m1, m2, k1, c1, A, frequency"
+            )
+        missing = [k for k in _FIELDS if k not in _OPTIONAL and k not in machine]
+        if missing:
+            raise InputError(
+                f"scenario {source!r}: [machine] is missing {', '.join(missing)}; "
+                "add them in SI units (kg, N/m, N s/m, N, Hz)"
+            )
+        values = {k: _number(v, f"scenario {k}", _FIELDS[k][0]) for k, v in machine.items()}
+        law = None
+        if "law" in data:
+            law_text = data["law"].get("text")
+            if not isinstance(law_text, str) or not law_text.strip():
+                raise InputError(
+                    f'scenario {source!r}: [law] needs text = "2.06e8*z + '
+                    '1.28e7*zd" (a quoted, non-empty law), or remove the table'
+                )
+            law = ForceLaw.parse(law_text)
+        initial = None
+        if "initial" in data:
+            init = data["initial"]
+            if set(init) != set(_TABLES["initial"]):
+                raise InputError(f"scenario {source!r}: [initial] needs w1, v1, w2, v2")
+            initial = tuple(
+                _number(init[k], f"scenario initial {k}", u)
+                for k, u in zip(_TABLES["initial"], ("m", "m/s", "m", "m/s"), strict=True)
+            )
+        name = data.get("name", default_name)
+        if not isinstance(name, str) or not name.strip():
+            raise InputError(
+                f'scenario {source!r}: name must be non-empty text, e.g. name = "my-grid"'
+            )
+        return cls(**values, law=law, initial=initial, name=name, source=source)
+
+
+def builtin_scenarios():
+    """Names of the scenarios shipped with the package."""
+    files = resources.files("discovery.vibroimpact.model") / "scenarios"
+    return sorted(p.name[:-5] for p in files.iterdir() if p.name.endswith(".toml"))
+
+
+def load_scenario(name_or_path):
+    """A built-in scenario by name (``'paper'``) or a TOML file by path."""
+    if isinstance(name_or_path, Scenario):
+        return name_or_path
+    text = str(name_or_path)
+    if not text.strip():
+        raise InputError(
+            "the scenario is empty; give a built-in name "
+            f"({', '.join(builtin_scenarios())}) or a TOML file"
+        )
+    if text in builtin_scenarios():
+        res = resources.files("discovery.vibroimpact.model") / "scenarios" / f"{text}.toml"
+        data = tomllib.loads(res.read_text())
+        return Scenario._from_mapping(data, f"builtin:{text}", default_name=text)
+    return Scenario.from_toml(text)

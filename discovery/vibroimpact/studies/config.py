@@ -1,0 +1,388 @@
+"""A study's configuration: factors, their product (or explicit rows), and one run per cell
+and seed, each named by a hash of its full configuration and the code version.
+
+The file (TOML)::
+
+    name = "paper-terms"
+    seeds = 2                          # or a list: [0, 1, 7]
+
+    [factors]                          # each a list; the study is their product
+    law = ["2.06e8*z + 1.28e7*zd"]     # any law the grammar takes (unloading branch, set)
+    scenario = ["paper"]               # a name or file, a table {base = "paper", A = 3.5e5},
+                                       # or a list of them: several records in one fit
+    force_noise = [0.005, 0.01, 0.02, 0.05]   # of the force's peak
+    motion_noise = [0.001]             # of each position's / velocity's range
+    periods = [4, 12, 40]              # recorded drive periods (after the transient)
+    fs = [10000.0]                     # sample rate [Hz]
+    library = ["z, zd, z^2, z*zd, zd^2, z^1.5"]
+    selection = ["best-subset", "l1-path", "stlsq", "sr3", "constrained-sr3"]
+    refine = [true]
+
+    [fit]                              # fixed options of every fit (discovery.discover)
+    max_terms = 4
+
+    [record]                           # fixed options of every record
+    transient = "auto"                 # periods from rest, or "auto" (decay to 1e-4)
+    velocities = true
+
+Instead of the product, ``[[rows]]`` tables list the cells one by one (a factor a row leaves
+out takes its default).  Defaults: the scenario's own law, ``paper``, 1 % force and 0.1 %
+motion noise, 12 periods at 10 kHz, ``poly:2``, ``best-subset``, refinement on.
+
+Scenarios and laws are resolved here, in the driver, so that a run is a self-contained
+description (machine parameters, law text, every setting): workers on another machine need
+no files, and the run's key changes when anything that could change its result does.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import os
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..._validate import Text, params
+from ...errors import InputError
+from ..fit.regression import SELECTIONS
+from ..model.law import ForceLaw
+from ..model.library import Library
+from ..model.scenario import load_scenario
+
+__all__ = ["StudyConfig", "load_study", "FACTORS"]
+
+FACTORS = {
+    "law": None,  # None: the (first) scenario's own law
+    "scenario": "paper",
+    "force_noise": 0.01,
+    "motion_noise": 0.001,
+    "periods": 12,
+    "fs": 10000.0,
+    "library": "poly:2",
+    "selection": "best-subset",
+    "refine": True,
+}
+"""Every factor a study may vary, with its default."""
+
+_FIT_KEYS = (
+    "max_terms",
+    "criterion",
+    "shortlist",
+    "stepwise",
+    "n_boot",
+    "n_boot_intervals",
+    "max_simulations",
+    "scoring",
+    "require",
+    "physics",
+)
+_RECORD_KEYS = ("transient", "velocities")
+_TOP = ("name", "seeds", "factors", "rows", "fit", "record")
+
+
+@dataclass(frozen=True)
+class StudyConfig:
+    """A parsed study: ``cells`` (one dict of factor values each), ``seeds``, the fixed
+    ``fit`` and ``record`` options, and ``varied`` (the factors with several values)."""
+
+    name: str
+    cells: tuple
+    seeds: tuple
+    fit: dict = field(default_factory=dict)
+    record: dict = field(default_factory=dict)
+    varied: tuple = ()
+    source: str = ""
+
+    @property
+    def n_runs(self):
+        return len(self.cells) * len(self.seeds)
+
+    def runs(self, code_version=""):
+        """Every run: a JSON-ready description with its ``key`` (hash of the description
+        and ``code_version``), in a fixed order (cells, then seeds)."""
+        out = []
+        for ci, cell in enumerate(self.cells):
+            for seed in self.seeds:
+                spec = _resolve(cell, self.fit, self.record, seed)
+                spec["cell"] = ci
+                spec["key"] = run_key(spec, code_version)
+                out.append(spec)
+        return out
+
+
+def run_key(spec, code_version=""):
+    """Hash (24 hex digits) of a run's description (without ``key``/``cell``) and the code
+    version: the name of its result file."""
+    body = {k: v for k, v in spec.items() if k not in ("key", "cell")}
+    text = json.dumps({"run": body, "code": code_version}, sort_keys=True, allow_nan=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+def _fail(source, what):
+    raise InputError(f"study {source!r}: {what}")
+
+
+def _scenario_value(value, source):
+    """A scenario factor value -> a list of Scenario (several records in one fit)."""
+    items = value if isinstance(value, list) else [value]
+    if not items:
+        _fail(source, "a scenario value is an empty list; give a name, a file or a table")
+    out = []
+    for it in items:
+        if isinstance(it, str):
+            out.append(load_scenario(it))
+        elif isinstance(it, dict):
+            base = it.get("base", "paper")
+            if not isinstance(base, str):
+                _fail(source, 'a scenario table needs base = "paper" (a name or file)')
+            sc = load_scenario(base)
+            changes = {k: v for k, v in it.items() if k != "base"}
+            bad = sorted(
+                set(changes) - {"m1", "m2", "k1", "c1", "A", "frequency", "g", "k3", "name"}
+            )
+            if bad:
+                _fail(
+                    source,
+                    f"unknown scenario key(s) {', '.join(bad)} in a scenario "
+                    "table; valid: base, m1, m2, k1, c1, A, frequency, g, k3, name",
+                )
+            if "name" not in changes:
+                changes["name"] = (
+                    sc.name + "-" + "-".join(f"{k}{v:g}" for k, v in sorted(changes.items()))
+                )
+            try:
+                out.append(sc.replace(**changes))
+            except (TypeError, ValueError) as exc:
+                _fail(source, f"scenario table {it}: {exc}")
+        else:
+            _fail(source, f"a scenario is a name, a file or a table; got {it!r}")
+    return out
+
+
+def _number(v):
+    return isinstance(v, int | float) and not isinstance(v, bool)
+
+
+def _check_noise(name, value, source):
+    if not (_number(value) and 0 <= value < 1):
+        _fail(source, f"{name} values are fractions in [0, 1); got {value!r}")
+
+
+def _check_periods(name, value, source):
+    if not (isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= 10000):
+        _fail(source, f"periods values are whole numbers of drive periods; got {value!r}")
+
+
+def _check_fs(name, value, source):
+    if not (_number(value) and 0 < value <= 1e7 and math.isfinite(value)):
+        _fail(source, f"fs values are sample rates in Hz; got {value!r}")
+
+
+def _check_library(name, value, source):
+    if not isinstance(value, str):
+        _fail(source, f'library values are texts such as "poly:2"; got {value!r}')
+    Library.parse(value)
+
+
+def _check_selection(name, value, source):
+    if value not in SELECTIONS:
+        _fail(source, f"selection {value!r} is unknown; choose from {', '.join(SELECTIONS)}")
+
+
+def _check_refine(name, value, source):
+    if not isinstance(value, bool):
+        _fail(source, f"refine values are true or false; got {value!r}")
+
+
+def _check_law(name, value, source):
+    if not isinstance(value, str):
+        _fail(source, f'law values are texts such as "2e8*z + 1e7*zd"; got {value!r}')
+    ForceLaw.parse(value)
+
+
+_FACTOR_CHECKS = {
+    "force_noise": _check_noise,
+    "motion_noise": _check_noise,
+    "periods": _check_periods,
+    "fs": _check_fs,
+    "library": _check_library,
+    "selection": _check_selection,
+    "refine": _check_refine,
+    "law": _check_law,
+    "scenario": lambda name, value, source: _scenario_value(value, source),
+}
+
+
+def _check_factor(name, value, source):
+    """One factor value, checked (the scenario and law are resolved later)."""
+    _FACTOR_CHECKS[name](name, value, source)
+    return value
+
+
+def _resolve(cell, fit, record, seed):
+    """The self-contained description of one run."""
+    scenarios = _scenario_value(cell["scenario"], "")
+    law = cell["law"]
+    if law is None:
+        if scenarios[0].law is None:
+            raise InputError(f"scenario {scenarios[0].name!r} has no law; give [factors] law")
+        law = scenarios[0].law.to_text()
+    else:
+        law = ForceLaw.parse(law).to_text()
+    return {
+        "law": law,
+        "scenarios": [
+            {k: v for k, v in sc.as_dict().items() if k not in ("law", "source")}
+            for sc in scenarios
+        ],
+        "force_noise": float(cell["force_noise"]),
+        "motion_noise": float(cell["motion_noise"]),
+        "periods": int(cell["periods"]),
+        "fs": float(cell["fs"]),
+        "library": str(cell["library"]),
+        "selection": cell["selection"],
+        "refine": bool(cell["refine"]),
+        "fit": dict(sorted(fit.items())),
+        "record": dict(sorted(record.items())),
+        "seed": int(seed),
+    }
+
+
+def _as_list(name, value, source):
+    if not isinstance(value, list) or not value:
+        _fail(
+            source,
+            f"[factors] {name} must be a non-empty list, e.g. {name} = "
+            f"[{json.dumps(FACTORS[name] if FACTORS[name] is not None else '2e8*z')}]",
+        )
+    return value
+
+
+def _seeds(data, source):
+    """The study's seeds: a count or a list of distinct whole numbers."""
+    seeds = data.get("seeds", 1)
+    if isinstance(seeds, int) and not isinstance(seeds, bool):
+        if not 1 <= seeds <= 100000:
+            _fail(source, f"seeds = {seeds}: give a count of at least 1 or a list of seeds")
+        seeds = list(range(seeds))
+    if not (
+        isinstance(seeds, list)
+        and seeds
+        and all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in seeds)
+    ):
+        _fail(source, "seeds is a count (seeds = 3) or a list of whole numbers >= 0")
+    if len(set(seeds)) != len(seeds):
+        _fail(source, "seeds repeats a seed; each seed is one run per cell")
+    return seeds
+
+
+def _settings(data, source):
+    """The ``[fit]`` and ``[record]`` tables, checked, and the record's transient."""
+    fit = data.get("fit", {})
+    record = data.get("record", {})
+    for tname, table, keys in (("fit", fit, _FIT_KEYS), ("record", record, _RECORD_KEYS)):
+        if not isinstance(table, dict):
+            _fail(source, f"[{tname}] must be a table")
+        extra = sorted(set(table) - set(keys))
+        if extra:
+            _fail(source, f"unknown [{tname}] key(s) {', '.join(extra)}; valid: {', '.join(keys)}")
+    tr = record.get("transient", "auto")
+    if not (tr == "auto" or (isinstance(tr, int) and not isinstance(tr, bool) and 0 <= tr <= 5000)):
+        _fail(source, f'[record] transient is "auto" or a number of periods; got {tr!r}')
+    return fit, record, tr
+
+
+def _cells(data, factors, levels, source):
+    """The study's cells (explicit ``[[rows]]`` or the product of the factors' levels) and
+    the factors that vary between them."""
+    if "rows" in data:
+        rows = data["rows"]
+        if factors:
+            _fail(source, "give either [factors] (their product) or [[rows]], not both")
+        if not (isinstance(rows, list) and rows and all(isinstance(r, dict) for r in rows)):
+            _fail(source, "[[rows]] are tables of factor values, one per cell")
+        cells = []
+        for r in rows:
+            extra = sorted(set(r) - set(FACTORS))
+            if extra:
+                _fail(
+                    source,
+                    f"unknown factor(s) {', '.join(extra)} in a row; valid: {', '.join(FACTORS)}",
+                )
+            cells.append(
+                {k: _check_factor(k, r[k], source) if k in r else FACTORS[k] for k in FACTORS}
+            )
+        varied = tuple(k for k in FACTORS if len({json.dumps(c[k]) for c in cells}) > 1)
+    else:
+        cells = [
+            dict(zip(FACTORS, combo, strict=True)) for combo in itertools.product(*levels.values())
+        ]
+        varied = tuple(k for k in FACTORS if len(levels[k]) > 1)
+    return cells, varied
+
+
+def study_from_mapping(data, source="<dict>"):
+    """Validate a parsed study file (see the module docstring)."""
+    if not isinstance(data, dict):
+        _fail(source, "must be a table of settings")
+    bad = sorted(set(data) - set(_TOP))
+    if bad:
+        _fail(source, f"unknown key(s) or table(s) {', '.join(bad)}; valid: {', '.join(_TOP)}")
+    name = data.get("name", Path(source).stem if source else "study")
+    if not isinstance(name, str) or not name.strip():
+        _fail(source, "name must be non-empty text")
+    seeds = _seeds(data, source)
+    fit, record, tr = _settings(data, source)
+    factors = data.get("factors", {})
+    if not isinstance(factors, dict):
+        _fail(source, "[factors] must be a table")
+    extra = sorted(set(factors) - set(FACTORS))
+    if extra:
+        _fail(source, f"unknown factor(s) {', '.join(extra)}; valid: {', '.join(FACTORS)}")
+    levels = {
+        k: [_check_factor(k, v, source) for v in _as_list(k, factors[k], source)]
+        if k in factors
+        else [FACTORS[k]]
+        for k in FACTORS
+    }
+    cells, varied = _cells(data, factors, levels, source)
+    return StudyConfig(
+        name=name,
+        cells=tuple(cells),
+        seeds=tuple(seeds),
+        fit=dict(fit),
+        record={"transient": tr, "velocities": bool(record.get("velocities", True))},
+        varied=varied,
+        source=source,
+    )
+
+
+@params(path_or_mapping=(Text(), os.PathLike, dict, StudyConfig))
+def load_study(path_or_mapping):
+    """A :class:`StudyConfig` from a TOML file (or an already parsed mapping)."""
+    if isinstance(path_or_mapping, StudyConfig):
+        return path_or_mapping
+    if isinstance(path_or_mapping, dict):
+        return study_from_mapping(path_or_mapping)
+    path = Path(path_or_mapping)
+    try:
+        text = path.read_bytes().decode("utf-8-sig")
+    except FileNotFoundError:
+        raise InputError(
+            f"study file {str(path)!r} does not exist; give a TOML file such as "
+            "examples/study_paper.toml"
+        ) from None
+    except IsADirectoryError:
+        raise InputError(f"study file {str(path)!r} is a directory; give a TOML file") from None
+    except UnicodeDecodeError:
+        raise InputError(f"study file {str(path)!r} is not UTF-8 text; re-save it") from None
+    except OSError as exc:
+        raise InputError(f"cannot read study file {str(path)!r} ({exc.strerror or exc})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"study file {str(path)!r} is not valid TOML: {exc}") from None
+    return study_from_mapping(data, str(path))

@@ -1,0 +1,197 @@
+"""Records for studies and tests, made by the independent scipy path from rest.
+
+A study must never fit records made by the kernel that fits them: :func:`field_record`
+simulates with :func:`discovery.vibroimpact.dynamics.reference.reference_simulate` (scipy's DOP853
+restarted at every contact event, written separately from the compiled kernel) **from
+rest**, through a transient, and samples the next ``periods`` drive periods with noise on
+every channel relative to that channel's own range: the force gets ``force_noise`` of its
+peak, each position and velocity ``motion_noise`` of its range (so the penetration, a
+small difference of two large motions, is noisy, as in a real record).
+
+The transient (:func:`transient_periods`) is as long as the slowest Floquet mode of the
+orbit needs to decay to ``1e-4`` (30 to 600 periods; 600 when the orbit is not periodic):
+the compiled kernel's steady state only sets this length, the data are the scipy path's.
+It is integrated at ``rtol = 1e-8`` in 50-period pieces (only its end matters and the orbit
+attracts), the recorded span at ``rtol = 1e-10``.  Noise-free records are cached in the
+process (``lru_cache``): other noise levels and seeds of the same record are free.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+
+from ..._validate import Real, params
+from ...errors import IntegrationError, VidiError
+from ..data.measurement import Measurement
+from ..dynamics.reference import reference_simulate
+from ..model.law import ForceLaw
+from ..model.scenario import Scenario
+
+__all__ = [
+    "field_record",
+    "clean_record",
+    "noisy_measurement",
+    "transient_periods",
+    "auto_transient",
+    "TRANSIENT_MIN",
+    "TRANSIENT_MAX",
+]
+
+TRANSIENT_DECAY = 1e-4
+TRANSIENT_MIN, TRANSIENT_MAX = 30, 600
+RTOL_TRANSIENT, RTOL_RECORD = 1e-8, 1e-10
+TRANSIENT_CHUNK = 50  # periods per reference call in the transient
+
+
+def transient_periods(max_multiplier):
+    """Periods for the slowest Floquet mode to decay to ``1e-4``: ``ceil(log(1e-4) /
+    log|mu|max)``, at least 30, at most 600 (600 for ``|mu| >= 1`` or unknown)."""
+    mu = float(max_multiplier)
+    if not (0.0 <= mu < 1.0):
+        return TRANSIENT_MAX
+    if mu == 0.0:
+        return TRANSIENT_MIN
+    n = math.ceil(math.log(TRANSIENT_DECAY) / math.log(mu))
+    return int(min(TRANSIENT_MAX, max(TRANSIENT_MIN, n)))
+
+
+def auto_transient(scenario, law):
+    """The transient [drive periods] of a record of ``law`` from rest: the periodic steady
+    state's largest |multiplier| decays to 1e-4 (per orbit: a period-n orbit decays once
+    every n drive periods); 600 when there is no periodic orbit."""
+    from ..dynamics.steady_state import steady_state
+
+    try:
+        ss = steady_state(scenario, law)
+    except VidiError:
+        return TRANSIENT_MAX
+    if not ss.periodic:
+        return TRANSIENT_MAX
+    mult = float(np.max(np.abs(ss.multipliers)))
+    return int(min(TRANSIENT_MAX, max(ss.n_periods, 1) * transient_periods(mult)))
+
+
+def _reference(scenario, law, t_span, y0, t_eval, rtol):
+    return reference_simulate(scenario, law, t_span, y0=y0, t_eval=t_eval, rtol=rtol)
+
+
+@lru_cache(maxsize=32)
+def clean_record(scenario, law, periods, fs, transient, record_transient=False):
+    """Noise-free scipy-path record ``(t, y (4, n), F, events)`` (read-only arrays): from
+    rest, ``transient`` periods, then ``periods`` periods sampled at ``fs`` (with
+    ``record_transient`` the run-up is recorded too)."""
+    T = scenario.period
+    t_rec = transient * T
+    t_end = (transient + periods) * T
+    y0 = scenario.initial_state()
+    if record_transient:
+        n = int(round(t_end * fs))
+        t = np.arange(n) / fs
+        out = _reference(scenario, law, (0.0, t_end), y0, t, RTOL_RECORD)
+    else:
+        for k in range(0, transient, TRANSIENT_CHUNK):
+            k1 = min(transient, k + TRANSIENT_CHUNK)
+            y0 = _reference(scenario, law, (k * T, k1 * T), y0, None, RTOL_TRANSIENT)["y_final"]
+        n = int(round(periods * T * fs))
+        t = t_rec + np.arange(n) / fs
+        out = _reference(scenario, law, (t_rec, t_end), y0, t, RTOL_RECORD)
+    y, F = out["y"], out["force"]
+    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(F))):
+        raise IntegrationError("the reference simulation left samples unset")
+    for a in (t, y, F):
+        a.setflags(write=False)
+    events = tuple((float(te), kind) for te, kind, _ in out["events"])
+    return t, y, F, events
+
+
+def noisy_measurement(
+    t, y, F, *, force_noise, motion_noise, seed, velocities=True, source="", notes=()
+):
+    """A :class:`~discovery.vibroimpact.data.measurement.Measurement` of the noise-free ``t, y, F``
+    with noise on every channel: ``F`` gets ``N(0, force_noise * max|F|)``, ``w1, w2, v1, v2``
+    each ``N(0, motion_noise * (max - min))`` of that channel, drawn by
+    ``numpy.random.default_rng(seed)`` in the order F, w1, w2, v1, v2."""
+    rng = np.random.default_rng(seed)
+    n = t.size
+    F = F + rng.normal(0.0, force_noise * float(np.max(np.abs(F))), n)
+    ch = {}
+    for name, row in (("w1", 0), ("w2", 2), ("v1", 1), ("v2", 3)):
+        x = y[row]
+        ch[name] = x + rng.normal(0.0, motion_noise * float(np.ptp(x)), n)
+    if not velocities:
+        del ch["v1"], ch["v2"]
+    channels = {k: ch[k] for k in ("w1", "v1", "w2", "v2") if k in ch}
+    return Measurement(np.array(t, dtype=float), F, channels, source=source, notes=tuple(notes))
+
+
+@params(
+    scenario=Scenario,
+    law=ForceLaw,
+    periods=Real(1, 1e5, integer=True),
+    fs=Real(0, 1e8, open_low=True),
+    transient=(None, Real(0, 1e5, integer=True)),
+    force_noise=Real(0, 1),
+    motion_noise=Real(0, 1),
+    seed=Real(0, integer=True),
+)
+def field_record(
+    scenario,
+    law,
+    *,
+    periods=12,
+    fs=10000.0,
+    transient=None,
+    force_noise=0.01,
+    motion_noise=0.001,
+    seed=0,
+    velocities=True,
+):
+    """A noisy record of ``law`` in ``scenario`` made by the scipy path from rest.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    law : ForceLaw
+        The true law.
+    periods : int
+        Drive periods recorded after the transient.
+    fs : float
+        Sampling rate [Hz].
+    transient : int, optional
+        Periods from rest before recording (default :func:`auto_transient`).
+    force_noise, motion_noise : float
+        Noise relative to each channel's range (see :func:`noisy_measurement`).
+    seed : int
+        Seed of the noise.
+    velocities : bool
+        Include ``v1`` and ``v2``.
+
+    Returns
+    -------
+    Measurement
+        Times on the drive's clock; the first sample is at ``transient * T``.
+    """
+    if transient is None:
+        transient = auto_transient(scenario, law)
+    transient, periods = int(transient), int(periods)
+    t, y, F, _ = clean_record(scenario, law, periods, float(fs), transient)
+    notes = (
+        f"reference_simulate from rest; transient {transient} periods "
+        f"(rtol {RTOL_TRANSIENT:g}), recorded at rtol {RTOL_RECORD:g}",
+        f"noise: force {force_noise:g} of max|F|, motion {motion_noise:g} of each "
+        f"channel's range, seed {seed}",
+    )
+    return noisy_measurement(
+        t,
+        y,
+        F,
+        force_noise=force_noise,
+        motion_noise=motion_noise,
+        seed=seed,
+        velocities=velocities,
+        source=f"reference:{scenario.name}",
+        notes=notes,
+    )

@@ -1,0 +1,38 @@
+"""Verification: a law simulated to its steady state and compared with a record.
+
+record -> :class:`Reference` (steady cycle, noise floor, measured state) ->
+:func:`evaluate` (simulate, align, criteria, consistency) -> :func:`verify`.
+"""
+
+from ..._lazy import lazy_package
+
+# names are imported on first use: the criteria beside them stay cheap to import
+_EXPORTS = {
+    "CONSISTENCY_CRITERIA": "evaluate",
+    "CONSISTENCY_FACTOR": "evaluate",
+    "CONSISTENCY_SLACK": "evaluate",
+    "Evaluation": "evaluate",
+    "align": "evaluate",
+    "consistency_limits": "evaluate",
+    "evaluate": "evaluate",
+    "noise_floor": "noise_floor",
+    "Reference": "reference",
+    "VerifyResult": "verify",
+    "verify": "verify",
+}
+
+__all__ = [
+    "Reference",
+    "Evaluation",
+    "evaluate",
+    "align",
+    "noise_floor",
+    "verify",
+    "VerifyResult",
+    "CONSISTENCY_CRITERIA",
+    "CONSISTENCY_FACTOR",
+    "CONSISTENCY_SLACK",
+    "consistency_limits",
+]
+
+lazy_package(__name__, _EXPORTS)

@@ -1,0 +1,215 @@
+"""The paper's verification criteria I0..I4 (its equation (8)), in a registry.
+
+With ``F_E`` the measured and ``F_N`` the simulated impulse on a common time axis
+(both onsets at ``t* = 0``) over a whole number of cycles::
+
+    I1 = max |F_N - F_E| / max |F_E|
+    I2 = int |F_N - F_E| dt / int |F_E| dt
+    I3 = sqrt( int (F_N - F_E)^2 dt / int F_E^2 dt )
+    I4 = int |sign F_N - sign F_E| dt / int sign F_E dt
+       = |supp F_N  symmetric-difference  supp F_E| / |supp F_E|
+    I0 = (I1 + I4) / 2
+
+I4 is the measure of the symmetric difference of the contact supports, which
+equals the paper's ``|tau_N - tau_E| / tau_E`` when one contact contains the
+other; with ``|.|`` it is >= 0.  Both signals are piecewise linear with one-sided
+limits at jumps, and the integrals are exact for that representation, so the
+force jump at onset adds no interpolation artefact.  For a measured (noisy) ``F_E``
+both forces are compared inside the contact windows only (the union of both
+supports, widened by 1 % of a period): outside them the simulated force is zero and
+the measured one is sensor noise.  When the two cycles differ
+(e.g. P1 against P2) both are extended periodically to a common length.
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..._validate import Instance, params
+from ...errors import InputError
+
+_IMPULSE = Instance("discovery.vibroimpact.data.impulse", "Impulse")
+
+__all__ = ["CRITERIA", "Comparison", "compare", "evaluate_criteria", "criterion"]
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """Both impulses on a common grid (with duplicated times at jumps).
+
+    Attributes
+    ----------
+    t : ndarray of shape (n,)
+        Common times [s].
+    fe, fn : ndarray of shape (n,)
+        Measured and simulated force [N] at ``t`` (one-sided at jumps).
+    support_e, support_n : ndarray of shape (k, 2)
+        Contact intervals over the common length.
+    length : float
+        Common length [s] (a whole number of both cycles).
+    """
+
+    t: np.ndarray
+    fe: np.ndarray
+    fn: np.ndarray
+    support_e: np.ndarray
+    support_n: np.ndarray
+    length: float
+
+
+def _grid_points(imp, length):
+    """(times, is_right_limit) of one impulse's nodes repeated over ``length``."""
+    reps = int(round(length / imp.duration))
+    # a force jump at the onset (F(0-) != F(0+)) recurs at every cycle boundary k*duration
+    jump = imp.F[-1] != imp.F[0]
+    parts = []
+    for k in range(reps):
+        if k and jump:
+            parts.append([k * imp.duration])
+        parts.append(imp.t[:-1] + k * imp.duration)
+    ts = np.concatenate(parts + [[length]])
+    dup = np.zeros(ts.size, dtype=bool)
+    dup[1:] = ts[1:] == ts[:-1]
+    return ts, dup
+
+
+def compare(measured, simulated):
+    """Put two :class:`~discovery.vibroimpact.data.impulse.Impulse` on a common grid."""
+    if measured is None or simulated is None:
+        raise InputError("both impulses are needed (a simulation without contact has none)")
+    ratio = simulated.duration / measured.duration
+    p, q = measured.n_periods, simulated.n_periods
+    if not math.isclose(ratio, q / p, rel_tol=1e-6):
+        raise InputError("the impulses come from different drive periods; use one scenario")
+    length = measured.duration * (math.lcm(p, q) // p)
+    te, de = _grid_points(measured, length)
+    tn, dn = _grid_points(simulated, length)
+    jumps = np.union1d(te[de], tn[dn])
+    base = np.union1d(te, tn)
+    t = np.sort(np.concatenate([base, jumps]))
+    right = np.zeros(t.size, dtype=bool)
+    right[1:] = t[1:] == t[:-1]
+    right[0] = True
+
+    def ev(imp):
+        out = imp.evaluate(t, "left")
+        out[right] = imp.evaluate(t[right], "right")
+        out[0] = imp.evaluate(0.0, "right")
+        return out
+
+    sup_e = measured.periodic_support(length)
+    sup_n = simulated.periodic_support(length)
+    fe, fn = ev(measured), ev(simulated)
+    if measured.noise > 0:
+        # fair to both signals: outside the contact windows (either support, widened by
+        # 1 % of a period) the simulated force is zero and the measured one is only
+        # noise (condition (3)); both are set to zero there, so noise over the long
+        # free flight does not swamp the criteria of a short contact
+        pad = 0.01 * measured.duration / measured.n_periods
+        inside = _in_intervals(t, np.concatenate([sup_e, sup_n]), pad, length)
+        fe, fn = np.where(inside, fe, 0.0), np.where(inside, fn, 0.0)
+    return Comparison(t=t, fe=fe, fn=fn, support_e=sup_e, support_n=sup_n, length=length)
+
+
+def _in_intervals(t, iv, pad, length):
+    """Whether each time lies in one of the intervals ``iv`` widened by ``pad`` (cyclic
+    over ``length``)."""
+    inside = np.zeros(t.size, dtype=bool)
+    for a, b in iv:
+        for shift in (-length, 0.0, length):
+            inside |= (t >= a - pad + shift) & (t <= b + pad + shift)
+    return inside
+
+
+def _int_abs(t, d):
+    """Exact integral of |d| for d piecewise linear on t."""
+    h = np.diff(t)
+    a, b = d[:-1], d[1:]
+    same = a * b >= 0
+    area = np.where(
+        same,
+        0.5 * (np.abs(a) + np.abs(b)),
+        0.5 * (a * a + b * b) / np.where(same, 1.0, np.abs(a) + np.abs(b)),
+    )
+    return float(np.sum(h * area))
+
+
+def _int_sq(t, d):
+    h = np.diff(t)
+    a, b = d[:-1], d[1:]
+    return float(np.sum(h * (a * a + a * b + b * b) / 3.0))
+
+
+def _measure(iv):
+    return float(np.sum(iv[:, 1] - iv[:, 0])) if len(iv) else 0.0
+
+
+def _intersection(a, b):
+    i = j = 0
+    total = 0.0
+    while i < len(a) and j < len(b):
+        lo, hi = max(a[i, 0], b[j, 0]), min(a[i, 1], b[j, 1])
+        total += max(0.0, hi - lo)
+        if a[i, 1] < b[j, 1]:
+            i += 1
+        else:
+            j += 1
+    return total
+
+
+def _safe(num, den, name):
+    if den <= 0:
+        raise InputError(f"{name} is undefined: the measured impulse is zero")
+    return num / den
+
+
+def _i1(c):
+    return _safe(float(np.max(np.abs(c.fn - c.fe))), float(np.max(np.abs(c.fe))), "I1")
+
+
+def _i2(c):
+    return _safe(_int_abs(c.t, c.fn - c.fe), _int_abs(c.t, c.fe), "I2")
+
+
+def _i3(c):
+    return math.sqrt(_safe(_int_sq(c.t, c.fn - c.fe), _int_sq(c.t, c.fe), "I3"))
+
+
+def _i4(c):
+    me, mn = _measure(c.support_e), _measure(c.support_n)
+    sym = me + mn - 2.0 * _intersection(c.support_e, c.support_n)
+    return _safe(max(sym, 0.0), me, "I4")
+
+
+def _i0(c):
+    return 0.5 * (_i1(c) + _i4(c))
+
+
+CRITERIA = {
+    "I0": _i0,
+    "I1": _i1,
+    "I2": _i2,
+    "I3": _i3,
+    "I4": _i4,
+}
+"""Registry: name -> function of a :class:`Comparison` returning a float >= 0."""
+
+
+def criterion(name):
+    """The criterion function registered under ``name``."""
+    try:
+        return CRITERIA[name]
+    except KeyError:
+        raise InputError(
+            f"unknown criterion {name!r}; valid names: {', '.join(CRITERIA)}"
+        ) from None
+
+
+@params(measured=(_IMPULSE, None), simulated=(_IMPULSE, None), names=(None, list, tuple))
+def evaluate_criteria(measured, simulated, names=None):
+    """``{name: value}`` for the requested criteria (default all), measured vs simulated."""
+    names = list(CRITERIA) if names is None else list(names)
+    funcs = {n: criterion(n) for n in names}
+    c = compare(measured, simulated)
+    return {n: float(f(c)) for n, f in funcs.items()}

@@ -1,0 +1,349 @@
+"""A law judged against what the machine did during the record.
+
+With positions recorded, the simulation starts from the machine's state in the record's
+first free flight (:mod:`~discovery.vibroimpact.verify.state`) and runs across the record's own
+span; its force is sampled at the record's own sample times and both histories are folded onto
+the drive's phase by the same :class:`~discovery.vibroimpact.verify.fold.Fold`.  A record that has
+not yet settled (a slowly decaying alternation near a flip bifurcation, a drift) is then
+compared with the law's own transient from the same state, never with a steady orbit it
+has not reached; and no per-cycle onset is estimated, so the onset's noise does not
+smear the force jump on one side only.
+
+The noise floor goes through exactly the same processing: each replicate is the law's own
+simulated record, started from a state drawn from the state fit's covariance, with the
+record's force noise added at the record's sample times, folded and compared with the
+noise-free fold.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import InputError, IntegrationError
+from ..data.impulse import Impulse, estimate_noise
+from ..dynamics import _kernel as _K
+from ..dynamics.simulate import simulate
+from .criteria import CRITERIA, evaluate_criteria
+from .fold import make_fold
+from .state import free_flight_runs, free_flight_state
+
+__all__ = [
+    "Block",
+    "RecordSpan",
+    "record_span",
+    "simulated_history",
+    "block_criteria",
+    "span_floor",
+    "BLOCK_CYCLES",
+]
+
+_MIN_FLIGHT = 0.08  # shortest free flight that gives a state, in drive periods
+
+
+SINK_FACTOR = 10.0
+"""A simulated penetration beyond this many motion scales (:meth:`Scenario.scales`) is no
+contact any more: the law lets the moulding sink into the frame."""
+
+BLOCK_CYCLES = 4
+"""Cycles per block: a long record (a run-up, a drift) is compared block by block, each
+block folded on its own and simulated from the machine's state just before it."""
+
+
+@dataclass(frozen=True)
+class Block:
+    """Consecutive cycles of a record, folded together, with the state before them.
+
+    Attributes
+    ----------
+    fold : Fold
+    state : StateEstimate
+        The machine's state in the free flight just before the block (the simulation of
+        the block starts there).
+    F : ndarray of shape (m,)
+        The measured force at the folded samples [N].
+    threshold : float
+        Contact threshold of the folded cycle [N].
+    """
+
+    fold: object
+    state: object
+    F: np.ndarray
+    threshold: float
+
+
+@dataclass(frozen=True)
+class RecordSpan:
+    """The part of a record a simulation is compared with, block by block.
+
+    Attributes
+    ----------
+    blocks : tuple of Block
+        In time order; the last one ends with the record.
+    sigma_f : float
+        Force noise of one sample [N].
+    """
+
+    blocks: tuple
+    sigma_f: float
+
+    @property
+    def state(self):
+        """The state where the first block's simulation starts."""
+        return self.blocks[0].state
+
+    @property
+    def fold(self):
+        """The last block's fold (the record's latest cycles)."""
+        return self.blocks[-1].fold
+
+    @property
+    def n_cycles(self):
+        return int(sum(b.fold.n_cycles for b in self.blocks))
+
+    @property
+    def size(self):
+        return int(sum(b.F.size for b in self.blocks))
+
+    def impulses(self, histories, onset_record_time=None):
+        """Each block's history (a list of arrays, one per block) as its folded
+        :class:`~discovery.vibroimpact.data.impulse.Impulse`."""
+        return [
+            b.fold.impulse(
+                h, threshold=b.threshold, noise=self.sigma_f, onset_record_time=onset_record_time
+            )
+            for b, h in zip(self.blocks, histories, strict=True)
+        ]
+
+    def measured(self, onset_record_time=None):
+        """The measured folded cycle of every block."""
+        return self.impulses([b.F for b in self.blocks], onset_record_time)
+
+
+def _block_ranges(M, size):
+    """``[(first, count), ...]`` of cycles, blocks of ``size`` counted from the end; a first
+    block shorter than half a block joins the next."""
+    out = []
+    hi = M
+    while hi > 0:
+        lo = max(0, hi - size)
+        out.insert(0, (lo, hi - lo))
+        hi = lo
+    if len(out) > 1 and out[0][1] < size / 2:
+        (a, n0), (_, n1) = out[0], out[1]
+        out[:2] = [(a, n0 + n1)]
+    return out
+
+
+def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=BLOCK_CYCLES):
+    """The span of a record with positions: from its first usable free flight to its end.
+
+    Parameters
+    ----------
+    measurement : Measurement
+    scenario : Scenario
+    cycle : Impulse
+        The record's cycle from :func:`~discovery.vibroimpact.data.impulse.impulse_from_samples`
+        (its length in periods and its main onset give the fold).
+    time_offset : float
+    block_cycles : int
+        Cycles per block.
+
+    Returns
+    -------
+    RecordSpan or None
+        ``None`` when the record has no free flight to start from or no whole cycle after
+        one.
+    """
+    ch = measurement.channels
+    if "w1" not in ch or "w2" not in ch:
+        return None
+    t, F = measurement.t, measurement.F
+    T = scenario.period
+    zeta = ch["w1"] - ch["w2"]
+    runs = free_flight_runs(t, F, zeta, T, min_fraction=_MIN_FLIGHT)
+    if not runs:
+        return None
+    td_all = t + time_offset
+    W = cycle.duration
+    mids = np.array([0.5 * (td_all[a] + td_all[b - 1]) for a, b in runs])
+    whole = make_fold(td_all, cycle.onset + time_offset, cycle.n_periods, T, mids[0], td_all[-1])
+    if whole is None or whole.n_cycles < max(1, int(0.5 * (td_all[-1] - td_all[0]) / W)):
+        return None  # the first flights are too late to use most of the record
+    sigma = float(estimate_noise(F))
+    blocks = []
+    for first, count in _block_ranges(whole.n_cycles, max(1, int(block_cycles))):
+        o = whole.origin + first * W
+        # the latest free flight that ends before the block starts
+        ok = np.flatnonzero(np.array([td_all[b - 1] for _, b in runs]) <= o)
+        if not ok.size:
+            return None
+        j = int(ok[-1])
+        fold = make_fold(
+            td_all, o, cycle.n_periods, T, o, o + count * W + 0.5 * (td_all[1] - td_all[0])
+        )
+        state = free_flight_state(measurement, scenario, runs[j], mids[j], time_offset=time_offset)
+        Fi = F[fold.idx]
+        peak = float(np.max(fold.average(Fi)))
+        thr = max(5.0 * sigma / np.sqrt(fold.n_cycles), 1e-3 * peak)
+        blk = Block(fold=fold, state=state, F=Fi, threshold=thr)
+        if not len(fold.impulse(Fi, threshold=thr, noise=sigma).support):
+            continue  # no contact in these cycles (a run-up's start): nothing to compare
+        blocks.append(blk)
+    if not blocks:
+        return None
+    return RecordSpan(blocks=tuple(blocks), sigma_f=sigma)
+
+
+def simulated_history(
+    scenario, law, span, *, tolerances=None, starts=None, observe=None, window=False
+):
+    """The law's force at the span's sample times, each block simulated from its state.
+
+    Parameters
+    ----------
+    scenario, law
+    span : RecordSpan
+    tolerances : Tolerances, optional
+    starts : sequence of ndarray of shape (4,), optional
+        Other start states, one per block (a bootstrap draw); default the measured ones.
+    observe : callable, optional
+        Observation model ``Impulse -> Impulse`` applied to each block's simulated history
+        (the block taken as one periodic signal).
+    window : bool
+        For optimisers: a sample whose interval holds a contact onset at fraction ``u`` is
+        blended towards the record's value with weight ``|2u - 1|`` (whole at the
+        interval's ends, nothing where the onset crosses the sample time).  With point
+        values (``False``, the default, like the record's) a force jump at the onset
+        switches a whole sample from 0 to ``F(0+)`` as the law's coefficients change, and
+        the output error is a staircase in the coefficients; blended, it is continuous,
+        and at the truth the blended residual is still the record's noise (no bias, also
+        when the sampling is a multiple of the drive frequency).
+
+    Returns
+    -------
+    list of ndarray
+        One history per block.  Raises :class:`~discovery.errors.IntegrationError` when a
+        simulation fails.
+    """
+    out = []
+    for k, blk in enumerate(span.blocks):
+        fold, st = blk.fold, blk.state
+        y0 = st.y if starts is None else starts[k]
+        td = fold.td
+        tr = simulate(
+            scenario, law, (min(st.t, td[0]), fold.end), y0=y0, t_eval=td, tolerances=tolerances
+        )
+        zmax = float(np.max(tr.y[0] - tr.y[2]))
+        if zmax > SINK_FACTOR * scenario.scales()[0]:
+            raise IntegrationError(
+                f"under law '{law}' the moulding sinks into the frame (penetration "
+                f"{zmax:.3g} m, over {SINK_FACTOR:g} times the drive's motion scale): the law "
+                "is far too soft for the record"
+            )
+        Fs = np.asarray(tr.force, dtype=float)
+        if window and td.size > 1:
+            # the sample whose interval [e_i, e_i+1) holds a contact onset at fraction u is
+            # blended towards the record's value with weight |2u - 1|: its residual is 0
+            # when the onset crosses the sample time (where the point value jumps) and
+            # whole at the interval's ends, so the residual is continuous in the law's
+            # coefficients and unbiased (at the truth it is the record's noise, weighted)
+            mid = 0.5 * (td[1:] + td[:-1])
+            edges = np.concatenate([[td[0] - (mid[0] - td[0])], mid, [td[-1] + (td[-1] - mid[-1])]])
+            on = tr.event_t[tr.event_kind == _K.EV_ONSET]
+            k = np.searchsorted(edges, on, "right") - 1
+            keep = (k >= 0) & (k < td.size)
+            k, on = k[keep], on[keep]
+            if k.size:
+                u = (on - edges[k]) / (edges[k + 1] - edges[k])
+                w = np.abs(2.0 * u - 1.0)
+                Fs[k] = blk.F[k] + w * (Fs[k] - blk.F[k])
+        if observe is not None:
+            L = fold.end - fold.origin
+            tt = np.concatenate([[0.0], fold.td - fold.origin, [L]])
+            FF = np.concatenate([[Fs[-1]], Fs, [Fs[-1]]])
+            imp = Impulse(
+                t=tt,
+                F=FF,
+                duration=L,
+                support=np.zeros((0, 2)),
+                n_periods=fold.n_periods * fold.n_cycles,
+                onset=fold.origin,
+            )
+            Fs = observe(imp).evaluate(fold.td - fold.origin)
+        out.append(Fs)
+    return out
+
+
+def block_criteria(measured, simulated, span, names=None):
+    """Criteria of every block, and their mean weighted by the blocks' cycles.
+
+    Returns
+    -------
+    mean : dict
+    per_block : list of dict
+    """
+    per = [evaluate_criteria(m, s, names) for m, s in zip(measured, simulated, strict=True)]
+    w = np.array([b.fold.n_cycles for b in span.blocks], dtype=float)
+    w = w / w.sum()
+    return {k: float(np.dot(w, [p[k] for p in per])) for k in per[0]}, per
+
+
+def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=None, observe=None):
+    """Noise floor of every criterion if ``law`` were the truth, through the span's own
+    processing.
+
+    Each replicate starts every block from a state drawn from that block's state-fit
+    covariance, adds the record's force noise at the record's sample times, folds, and is
+    compared block by block with ``simulated`` (the folded noise-free histories from the
+    measured states).
+
+    Returns
+    -------
+    dict
+        ``{"mean": {I0..I4}, "q95": {I0..I4}, "sd": {I0..I4}, "n_boot": n, "seed": seed,
+        "impacts": [contacts per cycle of each replicate's last block]}``.
+    """
+    rng = np.random.default_rng(seed)
+    samples = {n: [] for n in CRITERIA}
+    impacts = []  # contacts per cycle each replicate shows (noise can split a contact)
+    base = None
+    for _ in range(n_boot):
+        starts = [b.state.draw(rng) for b in span.blocks]
+        noise = [rng.normal(0.0, span.sigma_f, b.F.size) for b in span.blocks]
+        try:
+            # the truth as a record holds it: point samples
+            hist = simulated_history(
+                scenario, law, span, tolerances=tolerances, starts=starts, observe=observe
+            )
+        except IntegrationError:  # a failed draw: the measured states' histories instead
+            if base is None:
+                base = simulated_history(
+                    scenario, law, span, tolerances=tolerances, observe=observe
+                )
+            hist = base
+        try:
+            reps = span.impulses([h + e for h, e in zip(hist, noise, strict=True)])
+            crit, _ = block_criteria(reps, simulated, span)
+        except InputError:
+            continue
+        for n, v in crit.items():
+            samples[n].append(v)
+        impacts.append(int(len(reps[-1].support)))
+    if not samples["I2"]:
+        inf = {n: float("inf") for n in CRITERIA}
+        return {
+            "mean": inf,
+            "q95": dict(inf),
+            "sd": dict(inf),
+            "n_boot": 0,
+            "seed": seed,
+            "impacts": [],
+        }
+    return {
+        "impacts": impacts,
+        "mean": {n: float(np.mean(v)) for n, v in samples.items()},
+        "q95": {n: float(np.quantile(v, 0.95)) for n, v in samples.items()},
+        "sd": {n: float(np.std(v, ddof=1)) if len(v) > 1 else 0.0 for n, v in samples.items()},
+        "n_boot": len(samples["I2"]),
+        "seed": seed,
+    }

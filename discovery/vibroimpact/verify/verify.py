@@ -1,0 +1,190 @@
+"""``verify``: is a law consistent with a record?"""
+
+import time
+from dataclasses import dataclass, field
+
+from ..._printing import criteria_lines, readable
+from ..._validate import Real, params
+from ..data.measurement import Measurement
+from ..dynamics import Tolerances
+from ..model.law import ForceLaw
+from ..model.scenario import Scenario
+from .evaluate import evaluate
+from .reference import Reference
+
+__all__ = ["VerifyResult", "verify"]
+
+
+@readable
+@dataclass(frozen=True)
+class VerifyResult:
+    """Outcome of :func:`verify`.
+
+    Attributes
+    ----------
+    law : ForceLaw
+    evaluation : Evaluation
+        From the machine's measured state (or the scenario's start without positions).
+    reference : Reference
+        The record's steady cycle, noise floor and state.
+    default_start : Evaluation or None
+        The same law from the scenario's initial state, when it differs from the
+        measured one; ``None`` when not checked.
+    notes : tuple of str
+        E.g. that the scenario's default start reaches another attractor.
+    seconds : float
+    settings : dict
+    """
+
+    law: object
+    evaluation: object
+    reference: object
+    default_start: object = None
+    notes: tuple = ()
+    seconds: float = 0.0
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def consistent(self):
+        return self.evaluation.consistent
+
+    @property
+    def criteria(self):
+        return self.evaluation.criteria
+
+    @property
+    def noise_floor(self):
+        return self.evaluation.noise_floor
+
+    @property
+    def verdict(self):
+        return self.evaluation.verdict
+
+    def as_dict(self):
+        ev = self.evaluation
+        E = self.reference.impulse
+        return {
+            "law": self.law.to_text(),
+            **ev.as_dict(),
+            "noise_floor_q95": ev.extra.get("noise_floor_q95"),
+            "measured": {
+                "n_periods": E.n_periods,
+                "n_cycles": E.n_cycles,
+                "impacts": self.reference.impacts,
+                "noise": {k: v for k, v in self.reference.noise.items()},
+                "threshold": E.threshold,
+                "peak": E.peak,
+                "contact_time": E.contact_time,
+            },
+            "start": {
+                "from": "measured state"
+                if self.reference.start is not None
+                else "scenario initial state",
+                "state": self.reference.start,
+                "time": self.reference.start_time,
+                "time_offset": self.reference.time_offset,
+            },
+            "default_start": None if self.default_start is None else self.default_start.as_dict(),
+            "notes": list(self.notes),
+            "seconds": self.seconds,
+        }
+
+    def _lines(self):
+        ev = self.evaluation
+        out = [f"{self.law}: {ev.verdict or ev.message}"]
+        out += criteria_lines(ev.criteria, ev.noise_floor, ev.limits)
+        out.append(
+            f"  regime measured {ev.regime.get('measured')}, simulated {ev.regime.get('simulated')}"
+        )
+        out += [f"  note: {n}" for n in self.notes]
+        return out
+
+
+@params(
+    scenario=Scenario,
+    measurement=(Measurement, Reference),
+    law=ForceLaw,
+    time_offset=Real(),
+    n_boot=Real(0, integer=True),
+    seed=Real(0, integer=True),
+    tolerances=(Tolerances, None),
+)
+def verify(
+    scenario,
+    measurement,
+    law,
+    *,
+    time_offset=0.0,
+    n_boot=16,
+    seed=0,
+    check_default_start=True,
+    tolerances=None,
+):
+    """Verify ``law`` against a record by full simulation.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The known part of the machine.
+    measurement : Measurement or Reference
+        The record (``t``, ``F``; ``w1, w2`` [``v1, v2``] for the measured state and the
+        exact onsets), or an already prepared :class:`Reference`.
+    law : ForceLaw
+    time_offset : float
+        Drive-clock time [s] of the record's ``t = 0`` (0 when the record follows the
+        convention that the drive ``A sin(2 pi f t)`` has phase 0 at ``t = 0``).
+    n_boot : int
+        Bootstrap replicates of the noise floor.
+    seed : int
+        Seed of the bootstrap.
+    check_default_start : bool
+        Also simulate from the scenario's initial state and note a different attractor.
+    tolerances : Tolerances, optional
+
+    Returns
+    -------
+    VerifyResult
+    """
+    t0 = time.perf_counter()
+    ref = (
+        measurement
+        if isinstance(measurement, Reference)
+        else Reference.from_measurement(
+            measurement, scenario, time_offset=time_offset, n_boot=n_boot, seed=seed
+        )
+    )
+    ev = evaluate(scenario, law, ref, tolerances=tolerances)
+    other, notes = None, []
+    if check_default_start and ref.start is not None:
+        other = evaluate(scenario, law, ref, tolerances=tolerances, from_state=False, floor=False)
+        # (with a record span the two criteria come from different comparisons: only the
+        # regimes are compared)
+        span = ev.extra.get("comparison") == "record span"
+        if other.regime["simulated"] != ev.regime["simulated"] or (
+            not span
+            and other.status == "ok"
+            and ev.status == "ok"
+            and abs(other.criteria["I2"] - ev.criteria["I2"]) > 0.01
+        ):
+            notes.append(
+                f"from the scenario's initial state the law reaches another attractor "
+                f"({other.regime['simulated'] or other.status}, I2 "
+                f"{other.value('I2'):.3g}) than from the measured state "
+                f"({ev.regime['simulated'] or ev.status}): coexisting attractors"
+            )
+    settings = {
+        "time_offset": time_offset,
+        "n_boot": n_boot,
+        "seed": seed,
+        "check_default_start": check_default_start,
+        "tolerances": None if tolerances is None else tolerances.as_dict(),
+    }
+    return VerifyResult(
+        law=law,
+        evaluation=ev,
+        reference=ref,
+        default_start=other,
+        notes=tuple(notes),
+        seconds=time.perf_counter() - t0,
+        settings=settings,
+    )

@@ -1,0 +1,1 @@
+"""Figures of Ueda's oscillator results."""

@@ -1,0 +1,1 @@
+"""Figures of the vibro-impact system's results."""

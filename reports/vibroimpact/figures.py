@@ -1,0 +1,666 @@
+"""Figures as pure functions of result objects (matplotlib Figures, no pyplot).
+
+Each function writes the same figure as PNG and PDF and returns the paths.
+"""
+
+import numpy as np
+
+from .._mpl import colormap, save, subplots
+
+__all__ = ["landscape_figure", "identification_figure", "verify_figure", "explain_figure"]
+
+_ORDER = ("I1", "I2", "I3", "I4", "I0")
+
+
+def _exp(p):
+    return str(int(p)) if float(p).is_integer() else f"{float(p):g}"
+
+
+def term_unit(name):
+    """SI unit of the coefficient of the term ``name`` (``z^a*zd^b``): N m^-a (m/s)^-b,
+    as matplotlib mathtext, e.g. ``'z*zd'`` -> ``N m$^{-1}$ (m/s)$^{-1}$``."""
+    from discovery.vibroimpact.model.law import Term
+
+    try:
+        t = Term.parse(name)
+    except Exception:  # not a single term: say what the coefficient multiplies
+        return f"N per unit of {name}"
+    unit = "N"
+    if t.a:
+        unit += f" m$^{{-{_exp(t.a)}}}$"
+    if t.b:
+        unit += f" (m/s)$^{{-{_exp(t.b)}}}$"
+    return unit
+
+
+def coefficient_label(name):
+    """Axis label of a coefficient with its unit, e.g. ``coefficient of z [N m^-1]``."""
+    return f"coefficient of {name} [{term_unit(name)}]"
+
+
+_save = save
+
+
+def _landscape_marks(reg, ref_reg):
+    """``[(mask, marker style, legend label), ...]`` of the points with another regime, no
+    periodic orbit, no contact or a failed simulation (the non-empty ones)."""
+    physical = ("no-contact", "nonperiodic", "failed")
+    marks = [
+        (
+            (reg != ref_reg) & ~np.isin(reg, physical),
+            dict(ls="none", marker="x", color="r", ms=4),
+            f"periodic, not {ref_reg}",
+        ),
+        (reg == "nonperiodic", dict(ls="none", marker="+", color="orange", ms=5), "nonperiodic"),
+        (reg == "no-contact", dict(ls="none", marker=".", color="0.6", ms=4), "no contact"),
+        (
+            reg == "failed",
+            dict(ls="none", marker="s", mfc="none", mec="k", ms=4),
+            "simulation failed",
+        ),
+    ]
+    return [m for m in marks if m[0].any()]
+
+
+def _landscape_contours(fig, ax, land, name):
+    """Filled contours of criterion ``name`` with its minimum starred."""
+    from matplotlib.ticker import MaxNLocator
+
+    a0, a1 = land.axes
+    v = land.values[name]
+    ok = np.isfinite(v)
+    if not ok.any():
+        ax.text(
+            0.5,
+            0.5,
+            "no periodic contact\nanywhere in this range",
+            transform=ax.transAxes,
+            ha="center",
+            va="center",
+        )
+        return
+    lo, hi = float(v[ok].min()), float(v[ok].max())
+    levels = MaxNLocator(20).tick_values(lo, hi if hi > lo else lo + 1e-12)
+    cs = ax.contourf(a0, a1, v.T, levels=levels, cmap="viridis")
+    if hi > lo:
+        ax.contour(a0, a1, v.T, levels=levels[::2], colors="k", linewidths=0.4)
+    fig.colorbar(cs, ax=ax, label=f"{name} (dimensionless)")
+    i, j = land.argmin(name)
+    ax.plot(a0[i], a1[j], "w*", ms=10, mec="k")
+
+
+def _landscape_info_lines(land, ref_reg, exact, floor, cons, truth, inside):
+    """The text of the information panel."""
+    import textwrap
+
+    a0, a1 = land.axes
+    info = getattr(land, "reference", None) or {}
+    src = info.get("source", "")
+    src = "the scenario's law (exact)" if src in ("law", "") else src
+    lines = [
+        "Criteria landscape",
+        f"{a0.size} x {a1.size} points, {land.seconds:.1f} s on {land.workers} processes",
+        f"reference: {src}"[:70],
+        f"reference regime: {ref_reg}",
+    ]
+    if not exact and floor:
+        lines.append("noise floor: " + ", ".join(f"{n} {floor[n]:.2g}" for n in _ORDER))
+    counts = land.regime_counts() if hasattr(land, "regime_counts") else {}
+    if counts:
+        lines.append("regimes: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
+    if cons is not None:
+        lines.append(f"consistent with the reference at {int(cons.sum())} point(s)")
+    fails = getattr(land, "failures", (0, "", None))
+    if fails[0]:
+        lines.append(f"{fails[0]} simulation(s) failed, the first:")
+        lines += ["  " + w for w in textwrap.wrap(fails[1], 62)[:4]]
+    if truth is not None and not inside:
+        lines.append("the reference law lies outside this range")
+    return lines
+
+
+def _landscape_legend(ax, inside, show_cons, marks):
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], ls="none", marker="*", mfc="w", mec="k", ms=10, label="minimum")]
+    if inside:
+        handles.append(
+            Line2D([], [], ls="none", marker="o", mfc="none", mec="r", ms=10, label="reference law")
+        )
+    if show_cons:
+        handles.append(
+            Line2D([], [], color="w", ls="--", lw=1.2, label="consistent region (boundary)")
+        )
+    handles += [Line2D([], [], label=label, **style) for _, style, label in marks]
+    leg = ax.legend(handles=handles, loc="lower left", fontsize=8, facecolor="0.85")
+    leg.get_frame().set_edgecolor("0.5")
+
+
+def landscape_figure(land, stem, truth=None):
+    """Contours of I1..I4 and I0 (the paper's Figs. 4-5), with the points that have no
+    criteria or another regime marked, the consistent region outlined and the
+    reference's noise floor.
+
+    Parameters
+    ----------
+    land : Landscape
+    stem : str
+        Output path without extension.
+    truth : (float, float), optional
+        Reference coefficients, circled (when inside the grid).
+    """
+    a0, a1 = land.axes
+    reg = np.asarray(land.regime, dtype=str)
+    ref_reg = (getattr(land, "reference", None) or {}).get("regime", "P1")
+    exact = (getattr(land, "reference", None) or {}).get("exact", True)
+    floor = getattr(land, "noise_floor", None)
+    cons = getattr(land, "consistent", None)
+    marks = _landscape_marks(reg, ref_reg)
+    inside = truth is not None and a0[0] <= truth[0] <= a0[-1] and a1[0] <= truth[1] <= a1[-1]
+    show_cons = cons is not None and cons.sum() >= 2  # one point: hidden by the star
+    fig, axes = subplots(2, 3, figsize=(14, 8.5))
+    for ax, name in zip(axes.flat, _ORDER, strict=False):
+        _landscape_contours(fig, ax, land, name)
+        if show_cons:
+            ax.contour(
+                a0,
+                a1,
+                cons.T.astype(float),
+                levels=[0.5],
+                colors="w",
+                linestyles="--",
+                linewidths=1.2,
+            )
+        for mask, style, _ in marks:
+            ij = np.argwhere(mask)
+            ax.plot(a0[ij[:, 0]], a1[ij[:, 1]], **style)
+        if inside:
+            ax.plot(*truth, "o", mfc="none", mec="r", ms=10, mew=1.5)
+        ax.set_xlim(a0[0], a0[-1])
+        ax.set_ylim(a1[0], a1[-1])
+        ax.set_xlabel(coefficient_label(land.terms[0]))
+        ax.set_ylabel(coefficient_label(land.terms[1]))
+        ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
+        title = name if exact or not floor else f"{name} (noise floor {floor[name]:.3g})"
+        ax.set_title(title)
+    ax = axes.flat[5]
+    ax.axis("off")
+    lines = _landscape_info_lines(land, ref_reg, exact, floor, cons, truth, inside)
+    ax.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, transform=ax.transAxes)
+    _landscape_legend(ax, inside, show_cons, marks)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def identification_figure(result, measured, impulses, stem, land=None):
+    """Identification path (Fig. 6), the criterion against the simulations spent, and F_N
+    converging to F_E (Fig. 7).
+
+    ``result.iterations`` lists every simulated law that was the best so far when it was
+    simulated.  Those are not all optimiser steps: with ``least-squares`` most are
+    finite-difference probes of the Jacobian (and the standard-error Jacobian can add one
+    after the search).  So the history is drawn against the simulations spent, each new
+    best marked, and nothing is counted as an iteration or an improvement.
+
+    Parameters
+    ----------
+    result : IdentificationResult
+    measured : Impulse
+        ``F_E``.
+    impulses : list of (label, Impulse)
+        Simulated impulses of selected laws (e.g. the start, some of the best-so-far laws,
+        the identified law).
+    stem : str
+    land : Landscape, optional
+        Background contours of the identified criterion (two-term laws).
+    """
+    names = list(result.law.names)
+    its = list(result.iterations)
+    path = np.array([[it["coefficients"][n] for n in names] for it in its])
+    two = len(names) >= 2 and path.size > 0
+    fig, axes = subplots(1, 3 if two else 2, figsize=(17 if two else 12, 5.2), layout="constrained")
+    crit = result.criterion
+    # the identified law's value (result.value can belong to a standard-error probe)
+    value = result.criteria.get(crit, result.value)
+    if two:
+        ax = axes[0]
+        if land is not None and crit in land.values:
+            a0, a1 = land.axes
+            cs = ax.contourf(a0, a1, land.values[crit].T, levels=20, cmap="viridis")
+            fig.colorbar(cs, ax=ax, label=f"{crit} (dimensionless)")
+        ax.plot(
+            path[:, 0],
+            path[:, 1],
+            "o-",
+            color="w" if land is not None else "C0",
+            mec="k",
+            ms=3.5,
+            lw=1,
+            label="best law so far",
+        )
+        ax.plot(path[0, 0], path[0, 1], "s", mfc="none", mec="r", ms=9, mew=1.5, label="start")
+        final = result.law.as_dict()
+        ax.plot(final[names[0]], final[names[1]], "r*", ms=13, mec="k", label="identified")
+        ax.set_xlabel(coefficient_label(names[0]))
+        ax.set_ylabel(coefficient_label(names[1]))
+        ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
+        more = f" (first two of {len(names)} terms)" if len(names) > 2 else ""
+        ax.set_title(f"{result.method}: path of the best law so far{more}", fontsize=10)
+        ax.legend(fontsize=8, loc="best")
+    ax = axes[1] if two else axes[0]
+    if its:
+        sims = np.array([it["n_simulations"] for it in its], dtype=float)
+        vals = np.array([it["value"] for it in its], dtype=float)
+        xs = np.append(sims, max(result.n_simulations, sims[-1]))
+        ax.step(
+            xs,
+            np.append(vals, vals[-1]),
+            where="post",
+            color="C0",
+            lw=1.2,
+            label=f"best {crit} so far",
+        )
+        ax.plot(
+            sims,
+            vals,
+            "o",
+            color="C0",
+            ms=3.5,
+            label="new best (an optimiser step or a finite-difference probe)",
+        )
+        if np.all(vals > 0):
+            ax.set_yscale("log")
+        ax.legend(fontsize=8)
+    ax.set_xlabel("simulations spent (steady states computed)")
+    ax.set_ylabel(f"best {crit} so far (dimensionless)")
+    ax.set_title(
+        f"identified: {crit} = {value:.3g}, {result.n_simulations} simulations in all", fontsize=10
+    )
+    ax1 = axes[-1]
+    ax1.plot(measured.t * 1e3, measured.F / 1e6, "k-", lw=2.5, label="F_E (measured)")
+    for k, (label, imp) in enumerate(impulses):
+        if imp is not None:
+            ax1.plot(
+                imp.t * 1e3,
+                imp.F / 1e6,
+                "-",
+                lw=1,
+                color=colormap("plasma")(k / max(1, len(impulses))),
+                label=label,
+            )
+    end = measured.support[:, 1].max() if len(measured.support) else measured.duration
+    ax1.set_xlim(-0.05 * end * 1e3, min(measured.duration, 1.4 * end) * 1e3)
+    ax1.set_xlabel("time since onset t - t* [ms]")
+    ax1.set_ylabel("contact force [MN]")
+    ax1.set_title(f"F_N converging to F_E ({crit} = {value:.3g})", fontsize=10)
+    ax1.legend(fontsize=8)
+    return _save(fig, stem)
+
+
+def fit_impulse_figure(result, impulses, stem, n_models=3):
+    """Each record's measured impulse against the simulated ones of the best-ranked models,
+    one panel per record, each re-based on its contact.
+
+    Parameters
+    ----------
+    result : DiscoveryResult
+    impulses : list of (label, Impulse)
+        Labels of the models to draw (their simulated impulses against the first record);
+        the other records' come from each model's evaluations.
+    stem : str
+    """
+    refs = [ref for _, ref in result.references] or [None]  # (scenario, Reference) pairs
+    measured = [r.impulse if r is not None else result.measured for r in refs]
+    models = [m for m in result.ranking if m.evaluations][:n_models]
+    labels = [lab for lab, _ in impulses][: len(models)]
+    fig, axes = subplots(len(measured), 1, figsize=(8, 3.0 + 2.2 * len(measured)), squeeze=False)
+    sc, unit = _force_unit(max(E.peak for E in measured))
+    for r, (E, ax) in enumerate(zip(measured, axes[:, 0], strict=True)):
+        sims = [
+            (
+                labels[k] if k < len(labels) else ", ".join(m.law.names),
+                m.evaluations[r].simulated if r < len(m.evaluations) else None,
+            )
+            for k, m in enumerate(models)
+        ]
+        forces = [E.F] + [np.interp(E.t, imp.t, imp.F) for _, imp in sims if imp is not None]
+        tr, o, (lo, hi) = _contact_view(
+            E.t, E.duration, *forces, threshold=max(0.02 * E.peak, 5.0 * E.noise)
+        )
+        ax.plot(
+            tr[o] * 1e3,
+            E.F[o] * sc,
+            "k-",
+            lw=2.5,
+            alpha=0.6,
+            label=f"measured ({E.n_cycles} cycles)",
+        )
+        styles = ["-", "--", ":"]
+        for k, (label, imp) in enumerate(sims):
+            if imp is None:
+                continue
+            f = np.interp(E.t, imp.t, imp.F)
+            ax.plot(tr[o] * 1e3, f[o] * sc, styles[k % 3], lw=1.4, color=f"C{k}", label=label)
+        ax.set_xlim(lo * 1e3, hi * 1e3)
+        ax.set_ylabel(f"contact force [{unit}]")
+        name = getattr(refs[r], "source", None) or f"record {r + 1}"
+        ax.set_title(
+            f"record {r + 1}: {plain(name)}"
+            if len(measured) > 1
+            else "Measured impulse and the simulated steady states of the best models",
+            fontsize=9,
+        )
+        ax.legend(fontsize=7, loc="upper right")
+    axes[-1, 0].set_xlabel("time since the start of the contact [ms]")
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def fit_surface_figure(result, stem):
+    """The selected law over the box in (zeta, zd), with the contact samples."""
+    est, s = result.estimator, result.samples
+    Z, V = est.box_.zeta_max, est.box_.zd_max
+    zz, vv = np.meshgrid(np.linspace(0, Z, 200), np.linspace(0, V, 200))
+    F = result.selected.law(zz, vv)
+    fig, ax = subplots(figsize=(7, 5))
+    cs = ax.contourf(zz * 1e3, vv, F / 1e3, levels=25, cmap="magma")
+    fig.colorbar(cs, ax=ax, label="F [kN]")
+    step = max(1, len(s) // 4000)
+    ax.plot(
+        s.zeta[::step] * 1e3,
+        np.maximum(s.dzeta[::step], 0),
+        ".",
+        ms=1.5,
+        color="c",
+        alpha=0.6,
+        label="contact samples",
+    )
+    ax.set_xlabel("penetration zeta [mm]")
+    ax.set_ylabel("loading velocity max(dzeta, 0) [m/s]")
+    ax.set_title(f"F = {result.selected.law}", fontsize=8)
+    ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def fit_loop_figure(result, stem, max_impacts=3):
+    """Loading / unloading loops F(zeta) of a few impacts (the paper's Fig. 2a)."""
+    s = result.samples
+    fig, ax = subplots(figsize=(7, 5))
+    impacts = np.unique(s.impact)
+    pick = impacts[np.linspace(0, impacts.size - 1, min(max_impacts, impacts.size)).astype(int)]
+    for k, imp in enumerate(pick):
+        m = s.impact == imp
+        ax.plot(
+            s.zeta[m] * 1e3,
+            s.F[m] / 1e3,
+            ".",
+            ms=3,
+            color=f"C{k}",
+            alpha=0.5,
+            label=f"measured, impact {imp}",
+        )
+        ax.plot(
+            s.zeta[m] * 1e3,
+            result.selected.law(s.zeta[m], s.dzeta[m]) / 1e3,
+            "-",
+            color=f"C{k}",
+            lw=1.5,
+            label=f"model, impact {imp}",
+        )
+    ax.set_xlabel("penetration zeta [mm]")
+    ax.set_ylabel("contact force [kN]")
+    ax.set_title("Loading (upper) and elastic unloading (lower) branches")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def plain(text):
+    """User text (a file or scenario name) for a figure: matplotlib would read ``$...$`` as
+    mathtext (and fail on a broken one)."""
+    return str(text).replace("$", r"\$")
+
+
+def _force_unit(peak):
+    """``(scale, unit)`` to draw forces without an offset label: N, kN or MN."""
+    peak = abs(float(peak)) if np.isfinite(peak) else 0.0
+    if peak >= 1e6:
+        return 1e-6, "MN"
+    if peak >= 1e3:
+        return 1e-3, "kN"
+    return 1.0, "N"
+
+
+def _contact_view(t, period, *forces, threshold=0.0):
+    """Times of a folded cycle re-based on the contact: ``(t', order, (lo, hi))`` with
+    ``t'`` the time since the first sample of the contact (the end of the longest stretch
+    where every force is at most ``threshold``), wrapped so the contact is not cut by the
+    fold, and the x-range around it (the whole cycle when contact fills most of it)."""
+    t = np.asarray(t, dtype=float)
+    active = np.zeros(t.size, dtype=bool)
+    for f in forces:
+        active |= np.abs(np.asarray(f, dtype=float)) > threshold
+    # a noise spike is not a contact: keep only runs of at least 3 samples
+    active &= (
+        (np.roll(active, 1) & np.roll(active, -1))
+        | (np.roll(active, 1) & np.roll(active, 2))
+        | (np.roll(active, -1) & np.roll(active, -2))
+    )
+    n = t.size
+    if not active.any() or active.all():
+        return t - t[0], np.arange(n), (0.0, float(period))
+    # the longest run of inactive samples on the circle
+    doubled = np.concatenate([~active, ~active])
+    best_len, best_end, run = 0, 0, 0
+    for i, free in enumerate(doubled):
+        run = run + 1 if free else 0
+        if run > best_len and run <= n:
+            best_len, best_end = run, i
+    start = (best_end + 1) % n  # first active sample after the longest gap
+    tr = np.mod(t - t[start], period)
+    span = float(period) * (n - best_len) / n
+    margin = 0.15 * span
+    tr = np.where(tr > period - margin, tr - period, tr)
+    order = np.argsort(tr)
+    if span > 0.6 * period:
+        return tr, order, (float(tr.min()), float(tr.max()))
+    return tr, order, (-margin, span + 2.0 * margin)
+
+
+def verify_figure(result, stem):
+    """Measured and simulated force over the whole orbit, the noise band, the residual.
+
+    Parameters
+    ----------
+    result : discovery.vibroimpact.verify.VerifyResult
+    stem : str
+        Output path without extension (PNG and PDF are written).
+    """
+    from discovery.vibroimpact.verify.criteria import compare
+
+    ev = result.evaluation
+    E = result.reference.impulse
+    fig, (ax, axr) = subplots(
+        2, 1, figsize=(8, 5.5), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
+    )
+    band = 2.0 * result.reference.noise.get("F", 0.0) / np.sqrt(max(E.n_cycles, 1))
+    ms = 1e3
+    sc, unit = _force_unit(E.peak)
+    if ev.simulated is not None:
+        c = compare(E, ev.simulated)
+        # the contact, not the whole cycle: re-based on its start, not cut by the fold
+        tr, o, (lo, hi) = _contact_view(
+            c.t, E.duration, c.fe, c.fn, threshold=max(2.0 * band, 0.02 * E.peak, 5.0 * E.noise)
+        )
+        x = tr[o] * ms
+        ax.fill_between(
+            x,
+            (c.fe[o] - band) * sc,
+            (c.fe[o] + band) * sc,
+            color="0.85",
+            label=f"measured +-2 sigma/sqrt({E.n_cycles}) noise band",
+        )
+        ax.plot(x, c.fe[o] * sc, "k-", lw=1.0, label=f"measured F_E ({E.n_cycles} cycles)")
+        ax.plot(x, c.fn[o] * sc, "C3-", lw=1.0, label=f"simulated F_N ({ev.regime['simulated']})")
+        axr.fill_between(x, -band * sc, band * sc, color="0.85")
+        axr.plot(x, (c.fn[o] - c.fe[o]) * sc, "C0-", lw=0.8)
+        ax.set_xlim(lo * ms, hi * ms)
+    else:
+        ax.plot(E.t * ms, E.F * sc, "k-", lw=1.0, label="measured F_E")
+    crit = ", ".join(
+        f"{k} {v:.3g} (floor {ev.noise_floor.get(k, float('nan')):.2g})"
+        for k, v in ev.criteria.items()
+        if k in ("I2", "I4", "I3", "I0")
+    )
+    ax.set_title(
+        f"{result.law}\n{'consistent' if ev.consistent else 'INCONSISTENT'}: {crit or ev.status}",
+        fontsize=9,
+    )
+    ax.set_ylabel(f"contact force F [{unit}]")
+    ax.legend(fontsize=7, loc="upper right")
+    axr.set_ylabel(f"F_N - F_E [{unit}]")
+    axr.set_xlabel("time since the start of the contact [ms] (folded on the drive period)")
+    axr.axhline(0.0, color="k", lw=0.5)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def _explain_forces(ax, iteration, measured, k):
+    """The force before and after the named effect, against the record."""
+    E = measured
+    ax.plot(E.t * 1e3, E.F / 1e3, "k-", lw=2, label="measured")
+    if iteration.simulated_before is not None:
+        ax.plot(
+            E.t * 1e3,
+            iteration.simulated_before.F / 1e3,
+            "-",
+            color="tab:red",
+            label=f"before ({' + '.join(iteration.model_before.law.names)})",
+        )
+    if iteration.effect and iteration.simulated_after is not None:
+        ax.plot(
+            E.t * 1e3,
+            iteration.simulated_after.F / 1e3,
+            "-",
+            color="tab:blue",
+            label=f"after (+ {iteration.effect})",
+        )
+    if len(E.support):
+        a, b = E.support[0]
+        ax.set_xlim(max(a - 0.1 * (b - a), 0) * 1e3, (b + 0.3 * (b - a)) * 1e3)
+    ax.set_xlabel("time since onset [ms]")
+    ax.set_ylabel("contact force [kN]")
+    i2b = iteration.criteria_before.get("I2", float("nan"))
+    i2a = iteration.criteria_after.get("I2", float("nan"))
+    ax.set_title(
+        f"iteration {k}: I2 {i2b:.3g} -> {i2a:.3g} (noise floor "
+        f"{iteration.noise_floor.get('I2', float('nan')):.2g})",
+        fontsize=9,
+    )
+    ax.legend(fontsize=7)
+
+
+def _explain_phases(ax, iteration):
+    """The residual's share by impact phase, and its ratio to the noise."""
+    ph = iteration.localisation["phases"]
+    names = list(ph)
+    shares = [ph[n]["share"] for n in names]
+    x = np.arange(len(names))
+    bars = ax.bar(
+        x, shares, color=["tab:red" if ph[n]["exceeds_noise"] else "tab:gray" for n in names]
+    )
+    # phase names are long next to each other: rotated, anchored at their tick
+    ax.set_xticks(x, names, rotation=30, ha="right", rotation_mode="anchor")
+    for bar, n in zip(bars, names, strict=True):
+        r = ph[n]["ratio_to_noise"]
+        if r is not None:
+            ax.text(
+                bar.get_x() + bar.get_width() / 2,
+                bar.get_height(),
+                f"{r:.0f}x" if r >= 10 else f"{r:.1f}x",
+                ha="center",
+                va="bottom",
+                fontsize=7,
+            )
+    ax.margins(y=0.12)  # room for the numbers above the tallest bar
+    ax.set_xlabel("impact phase")
+    ax.set_ylabel("share of the residual energy\nin excess of the noise (dimensionless)")
+    ax.set_title(
+        "where the model disagrees, by impact phase\n(red: above the noise; "
+        "number: residual energy / noise energy)",
+        fontsize=9,
+    )
+
+
+def _explain_plane(fig, ax, iteration):
+    """The mean residual over the simulated (zeta, dzeta) plane."""
+    plane = iteration.localisation.get("plane")
+    if plane is not None:
+        ze, ve = plane["zeta_edges"], plane["dzeta_edges"]
+        m = plane["mean_residual"]
+        lim = np.nanmax(np.abs(m)) if np.isfinite(m).any() else 1.0
+        # an empty bin (NaN: no sample fell in it) is gray, a zero residual white
+        ax.set_facecolor("0.8")
+        im = ax.pcolormesh(
+            ze * 1e3,
+            ve,
+            np.ma.masked_invalid(m / 1e3).T,
+            cmap="RdBu_r",
+            vmin=-lim / 1e3,
+            vmax=lim / 1e3,
+            shading="flat",
+        )
+        fig.colorbar(im, ax=ax, label="mean residual F_N - F_E [kN]")
+        ax.set_xlabel("zeta [mm] (simulated)")
+        ax.set_ylabel("dzeta [m/s] (simulated)")
+    else:
+        ax.text(0.5, 0.5, "no positions in the record", ha="center", transform=ax.transAxes)
+    ax.set_title("residual over the (zeta, dzeta) plane (gray: no samples)", fontsize=9)
+
+
+def _explain_scores(ax, iteration):
+    """Every candidate effect's score test."""
+    sc = [x for x in iteration.scores if x.get("lm") is not None]
+    unscored = [x for x in iteration.scores if x.get("lm") is None and "criteria_after" in x]
+    if sc or unscored:
+        lm = [max(x["lm"], 1e-3) for x in sc]
+        ax.barh(
+            [x["effect"] for x in sc],
+            lm,
+            color=[
+                "tab:green"
+                if x["effect"] == iteration.effect
+                else ("tab:orange" if x["significant"] else "tab:gray")
+                for x in sc
+            ],
+        )
+        # an effect whose small step changes the regime has no score, only its refit
+        for x in unscored:
+            ax.barh(
+                [x["effect"]],
+                [max(lm, default=1.0)],
+                fill=False,
+                hatch="//",
+                edgecolor="tab:green" if x["effect"] == iteration.effect else "tab:gray",
+            )
+        ax.set_xscale("log")
+    ax.set_xlabel(
+        "score-test (LM) statistic (dimensionless; hatched: no local score, refitted)", fontsize=8
+    )
+    ax.set_title(
+        "candidate effects (green: named; orange: significant; gray: not significant)", fontsize=9
+    )
+
+
+def explain_figure(iteration, measured, stem, k=1):
+    """One iteration of the missing-effect loop: the force before and after adding the
+    named effect against the record, the residual's share by impact phase (and its ratio
+    to the noise), the mean residual over the simulated (zeta, dzeta) plane, and every
+    candidate effect's score test."""
+    fig, axes = subplots(2, 2, figsize=(13, 8.5), layout="constrained")
+    _explain_forces(axes[0, 0], iteration, measured, k)
+    _explain_phases(axes[0, 1], iteration)
+    _explain_plane(fig, axes[1, 0], iteration)
+    _explain_scores(axes[1, 1], iteration)
+    return _save(fig, stem)
