@@ -6,7 +6,7 @@ Names are imported on first use (matplotlib only when a figure is drawn).
 from discovery._lazy import lazy_package
 
 _EXPORTS = {
-    name: "figures"
+    name: "vibroimpact.figures"
     for name in (
         "explain_figure",
         "fit_impulse_figure",

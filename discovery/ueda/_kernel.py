@@ -26,6 +26,7 @@ import numpy as np
 from numba import njit
 
 from ..numerics._dopri import OK, make_smooth_advance
+from .system import UEDA
 
 __all__ = [
     "strobe_run",
@@ -33,44 +34,94 @@ __all__ = [
     "pair_run",
     "scan_run",
     "monodromy_run",
-    "model_strobe_run",
-    "model_variational_run",
     "OK",
 ]
 
 
+#: ``p[0]``: which vector field (Ueda's equation or a discovered polynomial model);
+#: ``p[1]``: the bound on ``|x|`` and ``|x'|`` beyond which a run stops as diverged (status 2);
+#: ``p[2:]``: the vector field's own parameters (``[mu, gamma, k, B, nu]``, or the
+#: polynomial's ``[c_0..c_9, forcing B, nu]``).
+
+
 @njit(cache=True, inline="always")
 def _accel(t, x, v, p):
-    return (p[0] * (1.0 - p[1] * x * x) - p[2]) * v - x * x * x + p[3] * np.cos(p[4] * t)
+    return (p[2] * (1.0 - p[3] * x * x) - p[4]) * v - x * x * x + p[5] * np.cos(p[6] * t)
+
+
+@njit(cache=True, inline="always")
+def _model_poly(x, v, p):
+    """``sum_j c_j x^i v^j`` and its partial derivatives (the MONOMIALS' order of
+    :mod:`discovery.ueda.discover`; ``c = p[2:12]``)."""
+    x2 = x * x
+    v2 = v * v
+    a = (
+        p[2]
+        + p[3] * x
+        + p[4] * v
+        + p[5] * x2
+        + p[6] * x * v
+        + p[7] * v2
+        + p[8] * x2 * x
+        + p[9] * x2 * v
+        + p[10] * x * v2
+        + p[11] * v2 * v
+    )
+    ax = p[3] + 2.0 * p[5] * x + p[6] * v + 3.0 * p[8] * x2 + 2.0 * p[9] * x * v + p[10] * v2
+    av = p[4] + p[6] * x + 2.0 * p[7] * v + p[9] * x2 + 2.0 * p[10] * x * v + 3.0 * p[11] * v2
+    return a, ax, av
+
+
+@njit(cache=True, inline="always")
+def _accel_any(t, x, v, p):
+    if p[0] == UEDA:
+        return _accel(t, x, v, p)
+    a, _, _ = _model_poly(x, v, p)
+    return a + p[12] * np.cos(p[13] * t)
 
 
 @njit(cache=True, inline="always")
 def _rhs2(t, y, p, out):
     out[0] = y[1]
-    out[1] = _accel(t, y[0], y[1], p)
+    out[1] = _accel_any(t, y[0], y[1], p)
 
 
 @njit(cache=True, inline="always")
 def _rhs7(t, y, p, out):
     x = y[0]
     v = y[1]
-    damp = p[0] * (1.0 - p[1] * x * x) - p[2]
-    a10 = -2.0 * p[0] * p[1] * x * v - 3.0 * x * x  # d(accel)/dx
-    out[0] = v
-    out[1] = damp * v - x * x * x + p[3] * np.cos(p[4] * t)
-    out[2] = y[3]
-    out[3] = a10 * y[2] + damp * y[3]
-    out[4] = y[5]
-    out[5] = a10 * y[4] + damp * y[5]
-    out[6] = damp  # trace of the Jacobian [[0, 1], [a10, damp]]
+    if p[0] == UEDA:
+        damp = p[2] * (1.0 - p[3] * x * x) - p[4]
+        a10 = -2.0 * p[2] * p[3] * x * v - 3.0 * x * x  # d(accel)/dx
+        out[0] = v
+        out[1] = damp * v - x * x * x + p[5] * np.cos(p[6] * t)
+        out[2] = y[3]
+        out[3] = a10 * y[2] + damp * y[3]
+        out[4] = y[5]
+        out[5] = a10 * y[4] + damp * y[5]
+        out[6] = damp  # trace of the Jacobian [[0, 1], [a10, damp]]
+    else:
+        a, ax, av = _model_poly(x, v, p)
+        out[0] = v
+        out[1] = a + p[12] * np.cos(p[13] * t)
+        out[2] = y[3]
+        out[3] = ax * y[2] + av * y[3]
+        out[4] = y[5]
+        out[5] = ax * y[4] + av * y[5]
+        out[6] = av  # trace of [[0, 1], [ax, av]]
 
 
 @njit(cache=True, inline="always")
 def _rhs4(t, y, p, out):
     out[0] = y[1]
-    out[1] = _accel(t, y[0], y[1], p)
+    out[1] = _accel_any(t, y[0], y[1], p)
     out[2] = y[3]
-    out[3] = _accel(t, y[2], y[3], p)
+    out[3] = _accel_any(t, y[2], y[3], p)
+
+
+@njit(cache=True, inline="always")
+def _diverged(y, p):
+    return abs(y[0]) > p[1] or abs(y[1]) > p[1]
 
 
 _adv2 = make_smooth_advance(_rhs2, 2, 2)
@@ -121,6 +172,9 @@ def strobe_run(
         )
         n_steps += ns
         if status != OK:
+            break
+        if _diverged(y, p):
+            status = 2
             break
         if k >= n_trans:
             out_strobe[k - n_trans, 0] = y[0]
@@ -213,6 +267,9 @@ def variational_run(
         )
         n_steps += ns
         if status != OK:
+            break
+        if _diverged(y, p):
+            status = 2
             break
         renormalise(y, k, out_logs, out_trace, out_strobe)
         _rhs7(t, y, p, K[0])  # the tangent vectors changed
@@ -431,163 +488,3 @@ def monodromy_run(y0, p, T, n, rtol, atol_state, atol_tangent, hmax, max_steps):
     M[0, 1] = y[4]
     M[1, 1] = y[5]
     return status, t, M, logs, y[6]
-
-
-# ------------------------------------------------ a discovered model x'' = poly(x, x') + B cos
-# The model's vector field: the MONOMIALS of discovery.ueda.discover with their
-# coefficients, p = [c_0..c_9, forcing B, nu].  Each vector field has its own drivers:
-# numba caches a module-level entry point with the closures it inlines, while a driver
-# made by a factory would be compiled again in every process.
-
-
-@njit(cache=True, inline="always")
-def _model_poly(x, v, p):
-    """``sum_j p[j] x^i v^j`` and its partial derivatives (the MONOMIALS' order)."""
-    x2 = x * x
-    v2 = v * v
-    a = (
-        p[0]
-        + p[1] * x
-        + p[2] * v
-        + p[3] * x2
-        + p[4] * x * v
-        + p[5] * v2
-        + p[6] * x2 * x
-        + p[7] * x2 * v
-        + p[8] * x * v2
-        + p[9] * v2 * v
-    )
-    ax = p[1] + 2.0 * p[3] * x + p[4] * v + 3.0 * p[6] * x2 + 2.0 * p[7] * x * v + p[8] * v2
-    av = p[2] + p[4] * x + 2.0 * p[5] * v + p[7] * x2 + 2.0 * p[8] * x * v + 3.0 * p[9] * v2
-    return a, ax, av
-
-
-@njit(cache=True, inline="always")
-def _model_rhs2(t, y, p, out):
-    a, _, _ = _model_poly(y[0], y[1], p)
-    out[0] = y[1]
-    out[1] = a + p[10] * np.cos(p[11] * t)
-
-
-@njit(cache=True, inline="always")
-def _model_rhs7(t, y, p, out):
-    a, ax, av = _model_poly(y[0], y[1], p)
-    out[0] = y[1]
-    out[1] = a + p[10] * np.cos(p[11] * t)
-    out[2] = y[3]
-    out[3] = ax * y[2] + av * y[3]
-    out[4] = y[5]
-    out[5] = ax * y[4] + av * y[5]
-    out[6] = av  # trace of [[0, 1], [ax, av]]
-
-
-_model_adv2 = make_smooth_advance(_model_rhs2, 2, 2)
-_model_adv7 = make_smooth_advance(_model_rhs7, 7, 2)
-
-
-@njit(cache=True)
-def model_strobe_run(t0, y0, p, T, n_trans, rtol, atol, hmax, max_steps):
-    """``n_trans`` periods of a discovered model from ``(t0, y0)``: ``(status, t, y)``
-    (status 2 when it diverges)."""
-    y = y0.copy()
-    K = np.empty((7, 2))
-    ytmp = np.empty(2)
-    ynew = np.empty(2)
-    empty_t = np.empty(0)
-    empty_o = np.empty((2, 0))
-    _model_rhs2(t0, y, p, K[0])
-    t = t0
-    h = T / 50.0
-    n_steps = 0
-    status = OK
-    for k in range(n_trans):
-        status, t, h, _, ns = _model_adv2(
-            t,
-            y,
-            t0 + (k + 1) * T,
-            h,
-            p,
-            rtol,
-            atol,
-            hmax,
-            max_steps - n_steps,
-            K,
-            ytmp,
-            ynew,
-            empty_t,
-            0,
-            empty_o,
-        )
-        n_steps += ns
-        if status != OK or abs(y[0]) > 1e6 or abs(y[1]) > 1e6:
-            if status == OK:
-                status = 2
-            break
-    return status, t, y
-
-
-@njit(cache=True)
-def model_variational_run(
-    t0,
-    y0,
-    p,
-    T,
-    n_seg,
-    rtol,
-    atol_state,
-    atol_tangent,
-    hmax,
-    max_steps,
-    out_logs,
-    out_trace,
-    out_strobe,
-):
-    """Benettin's method on a discovered model (as :func:`variational_run`), stopped with
-    status 2 when the model diverges (``|x|`` or ``|x'|`` beyond 1e6)."""
-    y = np.zeros(7)
-    y[0] = y0[0]
-    y[1] = y0[1]
-    y[2] = 1.0
-    y[5] = 1.0
-    atol = np.empty(7)
-    atol[0] = atol_state[0]
-    atol[1] = atol_state[1]
-    for j in range(2, 7):
-        atol[j] = atol_tangent
-    K = np.empty((7, 7))
-    ytmp = np.empty(7)
-    ynew = np.empty(7)
-    empty_t = np.empty(0)
-    empty_o = np.empty((2, 0))
-    t = t0
-    h = T / 50.0
-    n_steps = 0
-    status = OK
-    _model_rhs7(t, y, p, K[0])
-    for k in range(n_seg):
-        status, t, h, _, ns = _model_adv7(
-            t,
-            y,
-            t0 + (k + 1) * T,
-            h,
-            p,
-            rtol,
-            atol,
-            hmax,
-            max_steps - n_steps,
-            K,
-            ytmp,
-            ynew,
-            empty_t,
-            0,
-            empty_o,
-        )
-        n_steps += ns
-        if status != OK:
-            break
-        if abs(y[0]) > 1e6 or abs(y[1]) > 1e6:
-            status = 2
-            break
-        renormalise(y, k, out_logs, out_trace, out_strobe)
-        _model_rhs7(t, y, p, K[0])
-    return status, t, y[:2].copy(), n_steps

@@ -45,7 +45,7 @@ from ..errors import InputError, IntegrationError
 from ..numerics.tolerances import Tolerances
 from . import _kernel as UK
 from .attractor import classify_points, rotation_number
-from .system import UedaSystem
+from .system import MODEL, UedaSystem
 
 __all__ = [
     "TERMS",
@@ -137,8 +137,10 @@ class ForcedPolynomial:
         return {n: c for n, c in zip(TERMS, self.coefficients, strict=True) if c != 0.0}
 
     def params(self):
-        """The compiled kernel's parameter array ``[c_0..c_9, forcing * B, nu]``."""
-        return np.array([*self.coefficients, self.forcing * self.B, self.nu])
+        """The compiled kernel's parameter array: the polynomial's code, the divergence
+        bound 1e6 on ``|x|`` and ``|x'|``, ``[c_0..c_9, forcing * B, nu]`` (see
+        :mod:`discovery.ueda._kernel`)."""
+        return np.array([MODEL, 1e6, *self.coefficients, self.forcing * self.B, self.nu])
 
     def scales(self):
         x = max(1.0, abs(self.forcing * self.B) ** (1.0 / 3.0))
@@ -200,14 +202,26 @@ def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20
     p = model.params()
     y = np.asarray(y0, dtype=float).copy()
     if transient > 0:
-        status, t, y = UK.model_strobe_run(
-            float(t0), y, p, T, int(transient), tol.rtol, atol, hmax, _budget(tol, transient)
+        status, t, y, _, _ = UK.strobe_run(
+            float(t0),
+            y,
+            p,
+            T,
+            int(transient),
+            0,
+            tol.rtol,
+            atol,
+            hmax,
+            _budget(tol, transient),
+            np.empty(0),
+            np.empty((2, 0)),
+            np.empty((0, 2)),
         )
         check(status, t, "the discovered equation")
     n = int(periods)
     logs, trace, strobe = np.empty((n, 2)), np.empty(n), np.empty((n, 2))
     t_start = float(t0) + int(transient) * T
-    status, t, _, _ = UK.model_variational_run(
+    status, t, _, _ = UK.variational_run(
         t_start,
         y,
         p,

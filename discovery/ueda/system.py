@@ -17,6 +17,10 @@ import numpy as np
 
 from ..errors import InputError
 
+#: codes of the vector fields the compiled kernel integrates (``p[0]`` of its parameter
+#: array, :mod:`discovery.ueda._kernel`): Ueda's equation, a discovered polynomial model
+UEDA, MODEL = 0.0, 1.0
+
 __all__ = ["UedaSystem", "MODELS"]
 
 MODELS = {
@@ -96,8 +100,9 @@ class UedaSystem:
         return _EQUATION[self.model]
 
     def params(self):
-        """The compiled kernel's parameter array ``[mu, gamma, k, B, nu]``."""
-        return np.array([self.mu, self.gamma, self.k, self.B, self.nu])
+        """The compiled kernel's parameter array: this vector field's code, no divergence
+        bound, ``[mu, gamma, k, B, nu]`` (see :mod:`discovery.ueda._kernel`)."""
+        return np.array([UEDA, np.inf, self.mu, self.gamma, self.k, self.B, self.nu])
 
     def scales(self):
         """Characteristic ``(x, v)`` for absolute tolerances and distances: the amplitude
