@@ -91,6 +91,45 @@ def test_signal_exits_with_one_line(earlier, sig, code, word):
     _intact(earlier)
 
 
+# a Ctrl-C that lands in a callback Python cannot propagate from (as an import lock's
+# weakref callback, during the imports): printed as "Exception ignored" and lost, the run
+# went on; vidi's entry point gives it back to the main thread
+_LOST = textwrap.dedent("""
+    import sys, time, weakref
+    import discovery.cli.steady as st
+    real = st.provenance
+    def lost(*a, **k):
+        class Held: pass
+        h = Held()
+        def cb(_):
+            raise KeyboardInterrupt
+        r = weakref.ref(h, cb)
+        del h  # the callback raises: an unraisable interrupt
+        time.sleep(5)
+        return real(*a, **k)
+    st.provenance = lost
+    from discovery.cli import main
+    sys.argv = ["vidi", "steady", "--out", sys.argv[1]]
+    sys.exit(main())
+""")
+
+
+def test_interrupt_in_an_unraisable_callback_still_stops_the_run(earlier):
+    p = subprocess.run(
+        [sys.executable, "-c", _LOST, str(earlier)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert p.returncode == 130, p.stderr
+    assert p.stderr.splitlines() == [
+        "vidi: error: interrupted (Ctrl-C); partial outputs were removed, earlier results "
+        "are unchanged"
+    ], p.stderr
+    _intact(earlier)
+
+
 def test_sigkill_then_next_run_cleans_up(earlier, capsys):
     p = subprocess.Popen(
         [sys.executable, "-c", _CHILD, str(earlier)], cwd=ROOT, stdout=subprocess.PIPE, text=True

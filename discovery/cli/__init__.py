@@ -16,6 +16,7 @@ A value that starts with ``-`` (``--law -1e8*z``) is taken as the option's value
 it is not itself an option; ``--law=-1e8*z`` always works.
 """
 
+import _thread
 import argparse
 import contextlib
 import os
@@ -395,12 +396,50 @@ def _stopped(exc):
     return 130
 
 
+def _redeliver(hook):
+    """An unraisable-exception hook that gives an interrupt back to the main thread.
+
+    A signal that arrives while Python runs a callback it cannot propagate from (an
+    import lock's weakref callback, during the imports) would be printed as "Exception
+    ignored" with a traceback and then lost: the run would go on.  The hook delivers the
+    signal to the main thread again, from a timer thread so that it lands once the hook
+    has returned (raised inside the hook it would be lost the same way); anything else
+    goes to the previous hook."""
+
+    def unraisable(u):
+        if isinstance(u.exc_value, KeyboardInterrupt | Terminated):
+            sig = signal.SIGINT if isinstance(u.exc_value, KeyboardInterrupt) else signal.SIGTERM
+            again = threading.Timer(0.01, _thread.interrupt_main, (sig,))
+            again.daemon = True
+            again.start()
+            return
+        hook(u)
+
+    return unraisable
+
+
+def _leave(code):
+    """End the process after an interrupt without the C library's exit handlers.
+
+    An interrupt during the imports can leave a compiled extension half initialised
+    (matplotlib's font module was seen to), whose static destructors then run after the
+    interpreter is gone and abort the process.  The run's own clean-up (staging removed,
+    the one line printed) is done by now, so the streams are flushed and the process
+    leaves with its code."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(code)
+
+
 def main(argv=None):
     """Run ``vidi``; returns the exit code (0 ok, 2 bad input or failed numerics, 130
-    interrupted, 143 terminated, 1 internal error)."""
+    interrupted, 143 terminated, 1 internal error).  As the process's entry point
+    (``argv`` None), an interrupted run ends the process at once with its code."""
     entry = argv is None
     argv = list(sys.argv[1:] if argv is None else argv)
     old_term = None
+    old_hook = sys.unraisablehook
     in_main_thread = threading.current_thread() is threading.main_thread()
     if in_main_thread:
 
@@ -411,6 +450,7 @@ def main(argv=None):
             old_term = signal.signal(signal.SIGTERM, _terminate)
         except (ValueError, OSError):
             old_term = None
+        sys.unraisablehook = _redeliver(old_hook)
     try:
         code = _run(argv)
     except MemoryError:  # handled out here, once the frames holding the memory are gone
@@ -422,10 +462,13 @@ def main(argv=None):
                 signal.signal(signal.SIGTERM, signal.SIG_IGN)
         elif old_term is not None:
             signal.signal(signal.SIGTERM, old_term)
+        sys.unraisablehook = old_hook
     if code is None:
         with contextlib.suppress(OSError):
             os.write(2, _OUT_OF_MEMORY)
         return 2
+    if entry and code in (130, 143):
+        _leave(code)
     return code
 
 
