@@ -242,3 +242,36 @@ def make_smooth_advance(rhs, n, n_out):
         return status, t, h, k_eval, n_steps
 
     return advance
+
+
+def make_segments(rhs, n, n_out):
+    """The pieces every driver of a smooth system repeats, for inlining (see
+    :func:`make_smooth_advance`).
+
+    Returns
+    -------
+    work : numba function
+        ``work()`` -> the work arrays ``W`` (stages, trial states, an empty dense output).
+    advance : numba function
+        The advance of :func:`make_smooth_advance` (for a driver with dense output,
+        ``W[:3]`` its work arrays).
+    to : numba function
+        ``to(t, y, t_end, h, p, rtol, atol, hmax, max_steps, W)`` -> ``(status, t, h,
+        n_steps)``: ``advance`` to ``t_end`` without dense output.  ``W[0][0]`` must hold
+        ``f(t, y)`` on entry, as for ``advance``.
+    """
+    advance = make_smooth_advance(rhs, n, n_out)
+
+    @njit(inline="always")
+    def work():
+        return np.empty((7, n)), np.empty(n), np.empty(n), np.empty(0), np.empty((n_out, 0))
+
+    @njit(inline="always")
+    def to(t, y, t_end, h, p, rtol, atol, hmax, max_steps, W):
+        K, ytmp, ynew, empty_t, empty_o = W
+        status, t, h, _, ns = advance(
+            t, y, t_end, h, p, rtol, atol, hmax, max_steps, K, ytmp, ynew, empty_t, 0, empty_o
+        )
+        return status, t, h, ns
+
+    return work, advance, to

@@ -25,7 +25,7 @@ constant of the shared blocks):
 import numpy as np
 from numba import njit
 
-from ..numerics._dopri import OK, make_smooth_advance
+from ..numerics._dopri import OK, make_segments
 from .system import UEDA
 
 __all__ = [
@@ -124,9 +124,26 @@ def _diverged(y, p):
     return abs(y[0]) > p[1] or abs(y[1]) > p[1]
 
 
-_adv2 = make_smooth_advance(_rhs2, 2, 2)
-_adv7 = make_smooth_advance(_rhs7, 7, 2)
-_adv4 = make_smooth_advance(_rhs4, 4, 2)
+_work2, _adv2, _to2 = make_segments(_rhs2, 2, 2)
+_work7, _adv7, _to7 = make_segments(_rhs7, 7, 2)
+_work4, _adv4, _to4 = make_segments(_rhs4, 4, 2)
+
+
+@njit(cache=True, inline="always")
+def _tangent_start(y0, atol_state, atol_tangent):
+    """The variational state at a segment's start (the state, the tangent vectors the
+    identity, the trace integral 0) and its absolute tolerances."""
+    y = np.zeros(7)
+    y[0] = y0[0]
+    y[1] = y0[1]
+    y[2] = 1.0
+    y[5] = 1.0
+    atol = np.empty(7)
+    atol[0] = atol_state[0]
+    atol[1] = atol_state[1]
+    for j in range(2, 7):
+        atol[j] = atol_tangent
+    return y, atol
 
 
 @njit(cache=True)
@@ -138,9 +155,7 @@ def strobe_run(
     at ``t_eval`` (absolute times) in ``out_eval``.  Returns
     ``(status, t, y, n_steps, k_eval)``."""
     y = y0.copy()
-    K = np.empty((7, 2))
-    ytmp = np.empty(2)
-    ynew = np.empty(2)
+    K, ytmp, ynew, _, _ = _work2()
     _rhs2(t0, y, p, K[0])
     t = t0
     h = T / 50.0
@@ -225,45 +240,16 @@ def variational_run(
     ``(log r11, log r22)`` of segment ``k``, ``out_trace[k]`` the integral of the
     Jacobian's trace over it, ``out_strobe[k]`` the state at its end.  Returns
     ``(status, t, y, n_steps)``."""
-    y = np.zeros(7)
-    y[0] = y0[0]
-    y[1] = y0[1]
-    y[2] = 1.0
-    y[5] = 1.0
-    atol = np.empty(7)
-    atol[0] = atol_state[0]
-    atol[1] = atol_state[1]
-    for j in range(2, 6):
-        atol[j] = atol_tangent
-    atol[6] = atol_tangent
-    K = np.empty((7, 7))
-    ytmp = np.empty(7)
-    ynew = np.empty(7)
-    empty_t = np.empty(0)
-    empty_o = np.empty((2, 0))
+    y, atol = _tangent_start(y0, atol_state, atol_tangent)
+    W = _work7()
     t = t0
     h = T / 50.0
     n_steps = 0
     status = OK
-    _rhs7(t, y, p, K[0])
+    _rhs7(t, y, p, W[0][0])
     for k in range(n_seg):
-        t_end = t0 + (k + 1) * T
-        status, t, h, _, ns = _adv7(
-            t,
-            y,
-            t_end,
-            h,
-            p,
-            rtol,
-            atol,
-            hmax,
-            max_steps - n_steps,
-            K,
-            ytmp,
-            ynew,
-            empty_t,
-            0,
-            empty_o,
+        status, t, h, ns = _to7(
+            t, y, t0 + (k + 1) * T, h, p, rtol, atol, hmax, max_steps - n_steps, W
         )
         n_steps += ns
         if status != OK:
@@ -272,7 +258,7 @@ def variational_run(
             status = 2
             break
         renormalise(y, k, out_logs, out_trace, out_strobe)
-        _rhs7(t, y, p, K[0])  # the tangent vectors changed
+        _rhs7(t, y, p, W[0][0])  # the tangent vectors changed
     return status, t, y[:2].copy(), n_steps
 
 
@@ -293,34 +279,15 @@ def pair_run(t0, y0, p, T, n_seg, d0, rtol, atol, hmax, max_steps, out_logs):
     at[1] = atol[1]
     at[2] = atol[0]
     at[3] = atol[1]
-    K = np.empty((7, 4))
-    ytmp = np.empty(4)
-    ynew = np.empty(4)
-    empty_t = np.empty(0)
-    empty_o = np.empty((2, 0))
+    W = _work4()
     t = t0
     h = T / 50.0
     n_steps = 0
     status = OK
-    _rhs4(t, y, p, K[0])
+    _rhs4(t, y, p, W[0][0])
     for k in range(n_seg):
-        t_end = t0 + (k + 1) * T
-        status, t, h, _, ns = _adv4(
-            t,
-            y,
-            t_end,
-            h,
-            p,
-            rtol,
-            at,
-            hmax,
-            max_steps - n_steps,
-            K,
-            ytmp,
-            ynew,
-            empty_t,
-            0,
-            empty_o,
+        status, t, h, ns = _to4(
+            t, y, t0 + (k + 1) * T, h, p, rtol, at, hmax, max_steps - n_steps, W
         )
         n_steps += ns
         if status != OK:
@@ -331,7 +298,7 @@ def pair_run(t0, y0, p, T, n_seg, d0, rtol, atol, hmax, max_steps, out_logs):
         out_logs[k] = np.log(d / d0)
         y[2] = y[0] + dx * d0 / d
         y[3] = y[1] + dv * d0 / d
-        _rhs4(t, y, p, K[0])
+        _rhs4(t, y, p, W[0][0])
     return status, t, y[:2].copy(), n_steps
 
 
@@ -362,14 +329,10 @@ def scan_run(
     periods (e.g. a P1 orbit with a multiplier near -1 repeats after 2 periods long
     before it repeats after 1).  Returns ``(status, t, y, periods done, n or 0)``."""
     y = y0.copy()
-    K = np.empty((7, 2))
-    ytmp = np.empty(2)
-    ynew = np.empty(2)
-    empty_t = np.empty(0)
-    empty_o = np.empty((2, 0))
+    W = _work2()
     for n in range(max_period + 1):
         run[n] = 0
-    _rhs2(0.0, y, p, K[0])
+    _rhs2(0.0, y, p, W[0][0])
     t = 0.0
     h = T / 50.0
     n_steps = 0
@@ -377,23 +340,7 @@ def scan_run(
     found = 0
     k = 0
     while k < n_max:
-        status, t, h, _, ns = _adv2(
-            t,
-            y,
-            (k + 1) * T,
-            h,
-            p,
-            rtol,
-            atol,
-            hmax,
-            max_steps - n_steps,
-            K,
-            ytmp,
-            ynew,
-            empty_t,
-            0,
-            empty_o,
-        )
+        status, t, h, ns = _to2(t, y, (k + 1) * T, h, p, rtol, atol, hmax, max_steps - n_steps, W)
         n_steps += ns
         if status != OK:
             break
@@ -434,45 +381,16 @@ def monodromy_run(y0, p, T, n, rtol, atol_state, atol_tangent, hmax, max_steps):
     orthonormalisation (the tangent matrix only rescaled by its largest entry every
     period).  Returns ``(status, t, M, log of the scale factors, trace integral)``: the
     monodromy matrix is ``exp(log) M``."""
-    y = np.zeros(7)
-    y[0] = y0[0]
-    y[1] = y0[1]
-    y[2] = 1.0
-    y[5] = 1.0
-    atol = np.empty(7)
-    atol[0] = atol_state[0]
-    atol[1] = atol_state[1]
-    for j in range(2, 7):
-        atol[j] = atol_tangent
-    K = np.empty((7, 7))
-    ytmp = np.empty(7)
-    ynew = np.empty(7)
-    empty_t = np.empty(0)
-    empty_o = np.empty((2, 0))
+    y, atol = _tangent_start(y0, atol_state, atol_tangent)
+    W = _work7()
     t = 0.0
     h = T / 50.0
     n_steps = 0
     status = OK
     logs = 0.0
-    _rhs7(t, y, p, K[0])
+    _rhs7(t, y, p, W[0][0])
     for k in range(n):
-        status, t, h, _, ns = _adv7(
-            t,
-            y,
-            (k + 1) * T,
-            h,
-            p,
-            rtol,
-            atol,
-            hmax,
-            max_steps - n_steps,
-            K,
-            ytmp,
-            ynew,
-            empty_t,
-            0,
-            empty_o,
-        )
+        status, t, h, ns = _to7(t, y, (k + 1) * T, h, p, rtol, atol, hmax, max_steps - n_steps, W)
         n_steps += ns
         if status != OK:
             break
@@ -481,7 +399,7 @@ def monodromy_run(y0, p, T, n, rtol, atol_state, atol_tangent, hmax, max_steps):
             for j in range(2, 6):
                 y[j] /= m
             logs += np.log(m)
-        _rhs7(t, y, p, K[0])  # the tangent vectors changed
+        _rhs7(t, y, p, W[0][0])  # the tangent vectors changed
     M = np.empty((2, 2))
     M[0, 0] = y[2]
     M[1, 0] = y[3]
