@@ -54,6 +54,7 @@ from ..._validate import Instance, Real, Text, params
 from ...catalogue import select
 from ...errors import InputError, IntegrationError
 from ...numerics.executor import make_executor
+from ...numerics.memo import Memo, value_key
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
 from ..fit.identify import (
@@ -330,21 +331,32 @@ def _physical(names, records):
     return ForceLaw(tuple(terms), tuple(record_start(*records[0], terms)))
 
 
-def _regression(names, scenarios, measurements, loading=False):
-    """The certified regression of the force on exactly these terms (None without
-    positions in every record, or when the regression fails); with ``loading``, on the
-    loading samples (``dzeta > 0``) alone, which an unloading branch or a set leaves as
-    they are."""
+def _joined_samples(scenarios, measurements):
+    """The contact samples of every record joined (None without positions in every
+    record): built once per run, for every regression of the force on a term list."""
     from ..data.samples import contact_samples, join_samples
-    from ..fit.regression import ConstrainedSparseRegressor
 
     try:
-        samples = join_samples(
+        return join_samples(
             [
                 contact_samples(m, period=sc.period)
                 for sc, m in zip(scenarios, measurements, strict=True)
             ]
         )
+    except (InputError, ValueError):
+        return None
+
+
+def _regression(names, samples, loading=False):
+    """The certified regression of the force on exactly these terms over ``samples``
+    (:func:`_joined_samples`; None without them, or when the regression fails); with
+    ``loading``, on the loading samples (``dzeta > 0``) alone, which an unloading branch
+    or a set leaves as they are."""
+    from ..fit.regression import ConstrainedSparseRegressor
+
+    if samples is None:
+        return None
+    try:
         keep = samples.dzeta > 0 if loading else np.ones(len(samples), dtype=bool)
         if np.count_nonzero(keep) < 10 * len(names):
             return None
@@ -397,7 +409,7 @@ def _start_candidates(text, records, measurements):
         raise InputError("the record has no contact to start from")
     reg = None
     if measurements is not None:
-        reg = _regression(names, [sc for sc, _ in records], measurements)
+        reg = _regression(names, _joined_samples([sc for sc, _ in records], measurements))
     phys = _physical(names, records)
     others = [phys]
     if reg is not None and len(names) <= 4 and reg.terms == phys.terms:
@@ -439,8 +451,18 @@ class _Problem:
     def __init__(self, records, tolerances):
         self.records, self.tol = records, tolerances
         self.n_sim = 0
+        # a model named in one iteration is verified again at the start of the next, and
+        # its residual follows its verification: those asks are answered from here (and
+        # the block simulations a floor and a residual share, from the verify layer's)
+        self._memo = Memo(16)
 
     def evaluations(self, model, floor=False, smooth_onset=False):
+        """The model's evaluation on every record (:func:`~discovery.vibroimpact.verify.evaluate`,
+        asked again: answered from the memo)."""
+        key = value_key(model.law, model.observation, model.scenario, floor, smooth_onset)
+        return self._memo.get(key, lambda: self._evaluate(model, floor, smooth_onset))
+
+    def _evaluate(self, model, floor, smooth_onset):
         evs = []
         for sc, ref in self.records:
             self.n_sim += 1
@@ -1487,7 +1509,7 @@ def explain(
     problem = _Problem(records, tolerances)
     plain = [m for m in ms if not isinstance(m, Reference)]
     all_plain = len(plain) == len(ms)
-    scen_list = [sc for sc, _ in records]
+    samples = _joined_samples([sc for sc, _ in records], plain) if all_plain else None
     fit = _fit_start(
         start,
         records,
@@ -1508,8 +1530,8 @@ def explain(
         tolerances,
         drift=_Drift(pairs, records) if not any(isinstance(m, Reference) for m in ms) else None,
         regress=(
-            (lambda names, loading=False: _regression(names, scen_list, plain, loading))
-            if all_plain
+            (lambda names, loading=False: _regression(names, samples, loading))
+            if samples is not None
             else None
         ),
         workers=workers,

@@ -30,6 +30,7 @@ import numpy as np
 
 from ..._printing import criteria_lines, readable
 from ...errors import InputError, IntegrationError
+from ...numerics.memo import Memo, value_key
 from ..dynamics.response import impulse_from_steady_state
 from ..dynamics.simulate import simulate
 from ..dynamics.steady_state import steady_state
@@ -165,6 +166,18 @@ def align(measured, exact):
     return best
 
 
+def _only_i4(same, consistent, crit, lim):
+    """Inconsistent by the contact support (I4) alone: the regime and contacts agree and
+    the force history (I2) is within its limit."""
+    return bool(
+        same
+        and not consistent
+        and np.isfinite(lim["I4"])
+        and crit["I2"] <= lim["I2"]
+        and crit["I4"] > lim["I4"]
+    )
+
+
 def _verdict(consistent, reg, imp, crit, floor, lim=None, transient=False):
     """One sentence; with ``transient`` (a record span the law's trajectory has not settled
     over) a regime difference is no mismatch and the law is judged over the span."""
@@ -201,6 +214,19 @@ def _verdict(consistent, reg, imp, crit, floor, lim=None, transient=False):
             "ends in the figure before rejecting the law"
         )
     return f"inconsistent: {over} ({rule})"
+
+
+MEMO = Memo(32)
+"""Steady states and their force histories (:mod:`discovery.numerics.memo`): a model is
+verified again at the start of the next iteration of ``explain``, an optimiser's last point
+with its noise floor."""
+
+
+def _steady(scenario, law, tolerances, steady_kwargs):
+    return MEMO.get(
+        value_key("steady", scenario, law, tolerances, steady_kwargs),
+        lambda: steady_state(scenario, law, tolerances=tolerances, **steady_kwargs),
+    )
 
 
 def evaluate(
@@ -261,7 +287,7 @@ def evaluate(
             **steady_kwargs,
         }
     try:
-        ss = steady_state(scenario, law, tolerances=tolerances, **steady_kwargs)
+        ss = _steady(scenario, law, tolerances, steady_kwargs)
         if not ss.periodic:
             return Evaluation(
                 "nonperiodic",
@@ -275,7 +301,10 @@ def evaluate(
                 steady=ss,
             )
         reg["simulated"] = ss.regime
-        exact = impulse_from_steady_state(scenario, law, ss, tolerances=tolerances)
+        exact = MEMO.get(
+            value_key("impulse", scenario, law, tolerances, steady_kwargs),
+            lambda: impulse_from_steady_state(scenario, law, ss, tolerances=tolerances),
+        )
     except IntegrationError as exc:
         return Evaluation(
             "failed", reg, imp, {}, {}, False, f"the simulation failed: {exc}", message=str(exc)
@@ -307,13 +336,7 @@ def evaluate(
     lim = consistency_limits(fl["mean"], fl.get("sd"))
     # an undefined floor (no bootstrap replicate found the contacts) decides nothing
     consistent = bool(same and all(np.isfinite(lim[k]) and crit[k] <= lim[k] for k in lim))
-    only_i4 = bool(
-        same
-        and not consistent
-        and np.isfinite(lim["I4"])
-        and crit["I2"] <= lim["I2"]
-        and crit["I4"] > lim["I4"]
-    )
+    only_i4 = _only_i4(same, consistent, crit, lim)
     return Evaluation(
         "ok",
         reg,
@@ -359,7 +382,7 @@ def _span_steady_state(scenario, law, reference, last, span, sim, reg, tolerance
     steady_kwargs = {"y_start": reference.start, "t_start": reference.start_time, **steady_kwargs}
     ss, transient = None, None
     try:
-        ss = steady_state(scenario, law, tolerances=tolerances, **steady_kwargs)
+        ss = _steady(scenario, law, tolerances, steady_kwargs)
         if ss.periodic:
             reg["simulated"] = ss.regime
             orbit = last.fold.impulse(
@@ -488,14 +511,7 @@ def _evaluate_span(
             "noise_floor_q95": fl["q95"],
             "notes": notes,
             "limits": lim,
-            "only_I4": bool(
-                same_impacts
-                and regime_ok
-                and not consistent
-                and np.isfinite(lim["I4"])
-                and crit["I2"] <= lim["I2"]
-                and crit["I4"] > lim["I4"]
-            ),
+            "only_I4": _only_i4(same_impacts and regime_ok, consistent, crit, lim),
         }
     )
     return Evaluation(

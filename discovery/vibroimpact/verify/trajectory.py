@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError, IntegrationError
+from ...numerics.memo import Memo, value_key
 from ..data.impulse import Impulse, estimate_noise
 from ..dynamics import _kernel as _K
 from ..dynamics.simulate import simulate
@@ -194,6 +195,38 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
     return RecordSpan(blocks=tuple(blocks), sigma_f=sigma)
 
 
+MEMO = Memo(64)
+"""The block simulations from the measured states (:mod:`discovery.numerics.memo`): an
+optimiser's last point verified with its noise floor, a model's residual after its
+verification, reuse them.  The key holds the block's identity, so the entry keeps the
+block alive (its id is not reused while cached)."""
+
+
+def _block_run(scenario, law, blk, y0, tolerances):
+    """The law's force at a block's sample times, simulated from ``y0`` (default the
+    block's measured state), and the contact onsets of that run."""
+    fold, st = blk.fold, blk.state
+    td = fold.td
+    tr = simulate(
+        scenario,
+        law,
+        (min(st.t, td[0]), fold.end),
+        y0=st.y if y0 is None else y0,
+        t_eval=td,
+        tolerances=tolerances,
+    )
+    zmax = float(np.max(tr.y[0] - tr.y[2]))
+    if zmax > SINK_FACTOR * scenario.scales()[0]:
+        raise IntegrationError(
+            f"under law '{law}' the moulding sinks into the frame (penetration "
+            f"{zmax:.3g} m, over {SINK_FACTOR:g} times the drive's motion scale): the law "
+            "is far too soft for the record"
+        )
+    F = np.asarray(tr.force, dtype=float)
+    F.setflags(write=False)
+    return F, tr.event_t[tr.event_kind == _K.EV_ONSET]
+
+
 def simulated_history(
     scenario, law, span, *, tolerances=None, starts=None, observe=None, window=False
 ):
@@ -227,20 +260,16 @@ def simulated_history(
     """
     out = []
     for k, blk in enumerate(span.blocks):
-        fold, st = blk.fold, blk.state
-        y0 = st.y if starts is None else starts[k]
+        fold = blk.fold
         td = fold.td
-        tr = simulate(
-            scenario, law, (min(st.t, td[0]), fold.end), y0=y0, t_eval=td, tolerances=tolerances
-        )
-        zmax = float(np.max(tr.y[0] - tr.y[2]))
-        if zmax > SINK_FACTOR * scenario.scales()[0]:
-            raise IntegrationError(
-                f"under law '{law}' the moulding sinks into the frame (penetration "
-                f"{zmax:.3g} m, over {SINK_FACTOR:g} times the drive's motion scale): the law "
-                "is far too soft for the record"
+        if starts is None:  # from the measured state: the fitting loops ask this again
+            key = value_key(scenario, law, tolerances, id(blk))
+            _, F, onsets = MEMO.get(
+                key, lambda b=blk: (b, *_block_run(scenario, law, b, None, tolerances))
             )
-        Fs = np.asarray(tr.force, dtype=float)
+        else:  # a bootstrap draw: asked once
+            F, onsets = _block_run(scenario, law, blk, starts[k], tolerances)
+        Fs = F.copy()
         if window and td.size > 1:
             # the sample whose interval [e_i, e_i+1) holds a contact onset at fraction u is
             # blended towards the record's value with weight |2u - 1|: its residual is 0
@@ -249,7 +278,7 @@ def simulated_history(
             # coefficients and unbiased (at the truth it is the record's noise, weighted)
             mid = 0.5 * (td[1:] + td[:-1])
             edges = np.concatenate([[td[0] - (mid[0] - td[0])], mid, [td[-1] + (td[-1] - mid[-1])]])
-            on = tr.event_t[tr.event_kind == _K.EV_ONSET]
+            on = onsets
             k = np.searchsorted(edges, on, "right") - 1
             keep = (k >= 0) & (k < td.size)
             k, on = k[keep], on[keep]
