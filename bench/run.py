@@ -3,7 +3,8 @@
 Writes ``bench/results.json``.  Figures:
 
 0. start-up: ``vidi --help`` and ``import discovery`` against a bare Python start
-   (goal: help <= 0.3 s);
+   (goal: help <= 0.3 s); the first command after ``make install`` and the same with an
+   empty numba cache (the compile ``make install`` does once);
 1. one steady-state force history: compiled kernel vs the scipy reference path at
    equal accuracy (goal >= 300x faster);
 2. the 41x41 landscape wall time (goal <= 15 s on 2 cores), also as a ratio to
@@ -195,6 +196,38 @@ def bench_start_up(repeat=5):
     }
 
 
+def bench_cold_start():
+    """The first command after ``make install`` (``vidi steady``, the kernels loaded from
+    numba's cache) and the same command with an empty cache (it compiles the vibro-impact
+    kernel first: what ``make install`` does once), as seconds and their ratio."""
+    import subprocess
+    import tempfile
+
+    vidi = str(Path(sys.executable).with_name("vidi"))
+
+    def run(env_extra):
+        with tempfile.TemporaryDirectory() as d:
+            env = {**os.environ, **env_extra(d)}
+            t0 = time.perf_counter()
+            subprocess.run(
+                [vidi, "steady", "--scenario", "paper", "--out", str(Path(d) / "out")],
+                capture_output=True,
+                check=True,
+                env=env,
+            )
+            return time.perf_counter() - t0
+
+    warm = min(run(lambda d: {}) for _ in range(2))
+    cold = run(lambda d: {"NUMBA_CACHE_DIR": str(Path(d) / "numba-cache")})
+    return {
+        "first_command_after_install_seconds": warm,
+        "first_command_empty_cache_seconds": cold,
+        "compile_seconds": cold - warm,
+        "cold_over_warm": cold / warm,
+        "goal": "first command after make install <= 30 s",
+    }
+
+
 def bench_identify(sc):
     meas = synthesize(sc, sc.law, periods=20, fs=20000)
     E = meas.impulse(sc.period)
@@ -234,6 +267,7 @@ def main():
     steady_state(sc, sc.law)  # compile / load the cached kernels first
     results = {
         "start_up": bench_start_up(),
+        "cold_start": bench_cold_start(),
         "kernel_vs_scipy": bench_kernel(sc),
         "landscape_41x41": bench_landscape(sc),
         "identification": bench_identify(sc),
@@ -247,6 +281,12 @@ def main():
     }
     text = json.dumps(to_jsonable(results), indent=2) + "\n"
     Path(__file__).with_name("results.json").write_text(text)
+    c = results["cold_start"]
+    print(
+        f"first command after make install: {c['first_command_after_install_seconds']:.1f} s; "
+        f"with an empty numba cache {c['first_command_empty_cache_seconds']:.1f} s (compiling "
+        f"{c['compile_seconds']:.0f} s)"
+    )
     k, L, idf = results["kernel_vs_scipy"], results["landscape_41x41"], results["identification"]
     s = results["start_up"]
     print(
