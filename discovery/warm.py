@@ -2,9 +2,10 @@
 
 The compiled kernels (the vibro-impact integrator with its event location, and Ueda's
 oscillator) are cached by numba beside their sources (``__pycache__``).  Without a cache
-the first simulation compiles them, which takes minutes on a small machine; ``make
-install`` runs this module once so that the first command after it starts in seconds, and
-`discovery._compile.announce_compile` says so in one line when a command has to compile anyway.
+the first simulation compiles them (about 40 s on two cores, most of it the vibro-impact
+integrator with its event location); ``make install`` runs this module once so that the
+first command after it starts in a second, and `discovery._compile.announce_compile` says
+so in one line when a command has to compile anyway.
 """
 
 import sys
@@ -42,7 +43,7 @@ def main():
     todo = [k for k in KERNELS if not cached(k)]
     if todo:
         print(
-            f"compiling the simulators once ({', '.join(todo)}; a few minutes on two cores) ...",
+            f"compiling the simulators once ({', '.join(todo)}; under a minute on two cores) ...",
             flush=True,
         )
     seconds = warm()
