@@ -1,6 +1,8 @@
 """Whether the compiled kernels are in numba's cache, and one line when a run must compile
 them (see :mod:`discovery.warm`)."""
 
+import hashlib
+import os
 import sys
 from pathlib import Path
 
@@ -13,11 +15,22 @@ KERNELS = {
 _ANNOUNCED = set()
 
 
+def _cache_folder(folder):
+    """Where numba caches the functions of the modules in ``folder``: ``__pycache__`` beside
+    them, or with ``NUMBA_CACHE_DIR`` set, numba's subfolder there (the folder's name and the
+    SHA-1 of its absolute path)."""
+    root = os.environ.get("NUMBA_CACHE_DIR")
+    if not root:
+        return folder / "__pycache__"
+    path = os.path.abspath(folder)
+    return Path(root) / f"{os.path.basename(path)}_{hashlib.sha1(path.encode()).hexdigest()}"
+
+
 def cached(kernel="vibro-impact"):
     """Whether numba's cache holds the compiled ``kernel`` (``"vibro-impact"`` or
     ``"oscillator"``)."""
     folder, prefix = KERNELS[kernel]
-    cache = folder / "__pycache__"
+    cache = _cache_folder(folder)
     return cache.is_dir() and any(
         p.name.startswith(prefix) and p.suffix == ".nbi" for p in cache.iterdir()
     )

@@ -1,0 +1,52 @@
+"""Whether the compiled kernels are cached, wherever numba keeps its cache, and the one line a
+run that must compile prints (:mod:`discovery._compile`)."""
+
+import io
+import os
+import subprocess
+import sys
+import textwrap
+
+import discovery._compile as C
+
+
+def test_the_installed_kernels_are_cached(monkeypatch):
+    # `make install` compiled them (python -m discovery.warm) before the suite runs
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    assert C.cached("vibro-impact") and C.cached("oscillator")
+
+
+def test_the_cache_folder_is_numbas_own_with_numba_cache_dir(tmp_path, monkeypatch):
+    """A module compiled with NUMBA_CACHE_DIR set leaves its index where
+    ``_cache_folder`` looks."""
+    src = tmp_path / "mod"
+    src.mkdir()
+    (src / "m.py").write_text(
+        textwrap.dedent("""
+            from numba import njit
+
+            @njit(cache=True)
+            def f(x):
+                return x + 1
+
+            f(1)
+        """)
+    )
+    cache = tmp_path / "cache"
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(cache)}
+    subprocess.run([sys.executable, "-c", "import m"], cwd=src, env=env, check=True)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(cache))
+    assert any(p.suffix == ".nbi" for p in C._cache_folder(src).iterdir())
+    monkeypatch.delenv("NUMBA_CACHE_DIR")
+    assert C._cache_folder(src) == src / "__pycache__"
+
+
+def test_an_empty_cache_is_announced_once(tmp_path, monkeypatch):
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(C, "_ANNOUNCED", set())
+    assert not C.cached("vibro-impact")
+    out = io.StringIO()
+    C.announce_compile("vibro-impact", stream=out)
+    C.announce_compile("vibro-impact", stream=out)
+    lines = out.getvalue().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("vidi: compiling the vibro-impact simulator")
