@@ -50,3 +50,21 @@ def test_an_empty_cache_is_announced_once(tmp_path, monkeypatch):
     C.announce_compile("vibro-impact", stream=out)
     lines = out.getvalue().splitlines()
     assert len(lines) == 1 and lines[0].startswith("vidi: compiling the vibro-impact simulator")
+
+
+def test_a_steady_state_announces_the_compile_before_its_first_period(
+    tmp_path, monkeypatch, capsys
+):
+    """The stroboscopic map is the first to call the kernel in `vidi steady`: it says so
+    before (the map is built here, nothing is compiled)."""
+    from discovery import load_scenario
+    from discovery.vibroimpact.dynamics.steady_state import StroboscopicMap
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(C, "_ANNOUNCED", set())
+    sc = load_scenario("paper")
+    StroboscopicMap(sc, sc.law)
+    err = capsys.readouterr().err
+    assert (
+        err.startswith("vidi: compiling the vibro-impact simulator once") and err.count("\n") == 1
+    )

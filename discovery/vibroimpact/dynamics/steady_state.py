@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..._compile import announce_compile
 from ..._printing import fmt, readable
 from ..._validate import Array, Instance, Real, params
 from ...errors import InputError, IntegrationError
@@ -74,6 +75,7 @@ class StroboscopicMap:
         # start (exact at a fixed point; Jacobian probes hold it fixed)
         self._memory = law.permanent_set > 0
         self.zeta_max = 0.0
+        announce_compile("vibro-impact")  # the map's first advance may compile the kernel
 
     def advance(self, y, n=1, t0=0.0, remember=True):
         """State after ``n`` periods from ``y`` at time ``t0`` (a multiple of ``T``).
