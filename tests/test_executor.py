@@ -31,6 +31,19 @@ def test_executors_agree_and_place_results_by_index():
     assert isinstance(make_executor(1), Serial) and isinstance(make_executor(2), Pool)
 
 
+def _blas_threads(context, job):
+    from threadpoolctl import threadpool_info
+
+    return sorted({i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"})
+
+
+def test_every_job_runs_with_one_blas_thread():
+    """Wherever a job runs, its BLAS has one thread (idle BLAS threads spin and take the
+    other workers' cores; one count everywhere keeps a job's arithmetic the same)."""
+    assert Serial().map(_blas_threads, [0, 1]) == [[1], [1]]
+    assert Pool(2).map(_blas_threads, [0, 1]) == [[1], [1]]
+
+
 def test_pool_raises_the_job_error_and_leaves_no_worker():
     with pytest.raises(InputError, match="three"):
         Pool(2).map(_fail_on_three, list(range(8)))

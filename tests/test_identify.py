@@ -10,7 +10,7 @@ from discovery.cli import main
 from discovery.errors import InputError, IntegrationError, VidiError
 from discovery.vibroimpact.dynamics.synthesize import synthesize
 from discovery.vibroimpact.fit.discover import discover
-from discovery.vibroimpact.fit.identify import as_records, identify
+from discovery.vibroimpact.fit.identify import as_records, bootstrap_intervals, identify
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.verify import Reference
 
@@ -58,6 +58,32 @@ def test_identification_has_a_verdict(paper, reference, fitted):
     assert fitted.as_dict()["consistent"] is True
     quick = identify(paper, reference, START, max_simulations=4, uncertainty=False, check=False)
     assert quick.checks == () and quick.consistent is None and "not checked" in quick.verdict
+
+
+def test_bootstrap_intervals_do_not_depend_on_workers(paper, reference, fitted):
+    """The replicates are drawn in the calling process, in order; only their refits run
+    in parallel, so the intervals are the same to the last bit."""
+    serial = bootstrap_intervals(paper, reference, fitted.law, n_boot=6, seed=2)
+    parallel = bootstrap_intervals(paper, reference, fitted.law, n_boot=6, seed=2, workers=2)
+    assert serial is not None and serial.n_boot >= 5
+    assert parallel == serial
+    lo, hi = serial.bounds["z"]
+    assert lo < fitted.law.as_dict()["z"] < hi
+
+
+def test_identify_cli_intervals_on_two_processes_are_the_serial_ones(
+    paper, record, tmp_path, capsys
+):
+    record.to_csv(tmp_path / "R.csv")
+    out = {}
+    for w in ("1", "2"):
+        argv = ["identify", "--scenario", "paper", "--data", str(tmp_path / "R.csv")]
+        argv += ["--start", "1.5e8*z + 0.9e7*zd", "--intervals", "5", "--workers", w]
+        assert main([*argv, "--out", str(tmp_path / w)]) == 0
+        out[w] = json.loads((tmp_path / w / "summary.json").read_text())
+    capsys.readouterr()
+    assert out["1"]["intervals"] is not None and out["1"]["intervals"] == out["2"]["intervals"]
+    assert out["2"]["settings"]["workers"] == 2
 
 
 def test_budget_counts_every_simulation(paper, reference):

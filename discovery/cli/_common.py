@@ -178,6 +178,16 @@ SCHEDULER_HELP = (
 )
 
 
+def add_workers_option(parser, what):
+    """``--workers N``: processes for ``what`` (default: every core; the result does not
+    depend on it)."""
+    parser.add_argument(
+        "--workers",
+        type=integer(1, 1024),
+        help=f"processes for {what} (default: all cores; the result does not depend on it)",
+    )
+
+
 def executor_of(args):
     """The executor of ``--scheduler`` (a context manager that closes it), or a null
     context giving ``None`` (the API's default: ``--workers`` local processes)."""

@@ -8,6 +8,7 @@ from ._common import (
     SCENARIO_HELP,
     SCHEDULER_HELP,
     add_record_options,
+    add_workers_option,
     check_out,
     coefficients_line,
     criteria_line,
@@ -181,12 +182,7 @@ def register(sub):
         default=0,
         help="seed of the noise-floor bootstrap (default: %(default)s)",
     )
-    s.add_argument(
-        "--workers",
-        type=integer(1, 1024),
-        help="processes for the screening refits (default: all cores; the result "
-        "does not depend on it)",
-    )
+    add_workers_option(s, "the screening refits and the bootstrap intervals' refits")
     s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
     s.add_argument("--out", required=True, help="output directory")
     s.set_defaults(func=run)

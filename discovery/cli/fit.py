@@ -11,6 +11,7 @@ from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
     SCENARIO_HELP,
     add_record_options,
+    add_workers_option,
     check_out,
     coefficients_line,
     criteria_line,
@@ -47,6 +48,7 @@ def _discover(args, scs, meas, progress):
         physics=not args.allow_unphysical,
         require=args.require or (),
         n_boot_intervals=args.intervals,
+        workers=args.workers,
         progress=progress,
         **({"signs": args.signs} if args.signs else {}),
     )
@@ -271,6 +273,7 @@ def _add_check_options(p):
         help="bootstrap replicates of the selected law's 95 %% coefficient intervals "
         "through the full processing (0 = none) (default: %(default)s)",
     )
+    add_workers_option(p, "the bootstrap intervals' refits")
     p.add_argument(
         "--allow-unphysical",
         action="store_true",

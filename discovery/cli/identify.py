@@ -15,6 +15,7 @@ from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
     SCENARIO_HELP,
     add_record_options,
+    add_workers_option,
     check_out,
     coefficients_line,
     criteria_line,
@@ -215,6 +216,7 @@ def run(args):
             xtol=args.xtol,
             n_boot_intervals=args.intervals,
             seed=args.seed,
+            workers=args.workers,
             progress=rep,
         )
     imps = _iterate_impulses(sc, start, ref, res)
@@ -283,6 +285,7 @@ def register(sub):
         help="bootstrap replicates of the 95 %% coefficient intervals through the "
         "full processing (records with positions; 0 = none) (default: %(default)s)",
     )
+    add_workers_option(s, "the bootstrap intervals' refits")
     s.add_argument(
         "--seed",
         type=integer(0, 2**32 - 1),

@@ -1414,6 +1414,8 @@ def _intervals(run, n_boot_intervals, seed, progress):
             seed=seed,
             criterion=run.criterion,
             tolerances=run.tolerances,
+            workers=run.workers,
+            executor=run.executor,
         )
     except IntegrationError:
         return None

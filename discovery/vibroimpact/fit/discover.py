@@ -965,7 +965,9 @@ class _Stepwise:
         return ranking, steps
 
 
-def _with_intervals(ranking, refs, refine, n_boot_intervals, seed, criterion, tolerances, progress):
+def _with_intervals(
+    ranking, refs, refine, n_boot_intervals, seed, criterion, tolerances, progress, workers=1
+):
     """The selected (best ranked) model, with bootstrap intervals when asked for and it was
     refined, and the ranking holding it."""
     selected = ranking[0]
@@ -985,6 +987,7 @@ def _with_intervals(ranking, refs, refine, n_boot_intervals, seed, criterion, to
         seed=seed,
         criterion=criterion,
         tolerances=tolerances,
+        workers=workers,
     )
     if iv is None:
         return selected, ranking
@@ -1027,6 +1030,7 @@ def _defects_warning(selected, physics):
     stepwise=Real(0, integer=True),
     require=(tuple, list),
     n_boot_intervals=Real(0, integer=True),
+    workers=(None, Real(1, integer=True)),
 )
 def discover(
     scenario,
@@ -1052,6 +1056,7 @@ def discover(
     physics=True,
     require=(),
     n_boot_intervals=30,
+    workers=1,
     progress=None,
     random_state=None,
     **estimator_kwargs,
@@ -1109,6 +1114,9 @@ def discover(
         full processing (:func:`discovery.vibroimpact.fit.intervals.bootstrap_intervals`; records
         with positions, refined models; 0 = none).  The Jacobian standard errors assume white
         residuals and miss the noise of the estimated machine states.
+    workers : int or None
+        Processes for the bootstrap's refits (default 1; ``None``: every core); the
+        intervals do not depend on it.
     progress : callable, optional
         ``progress(stage, done, total)`` as the shortlist is simulated and the stepwise
         search and the bootstrap go on (:mod:`discovery._progress`).
@@ -1142,7 +1150,7 @@ def discover(
     search = _Stepwise(check, criterion, sim_rtol, sim_atol, physics, stepwise, max_terms)
     ranking, steps = search.run(models, refs, refine, progress)
     selected, ranking = _with_intervals(
-        ranking, refs, refine, n_boot_intervals, seed, criterion, tolerances, progress
+        ranking, refs, refine, n_boot_intervals, seed, criterion, tolerances, progress, workers
     )
     # the certificate of the law actually selected (the ranking may prefer another
     # candidate than the estimator's best by BIC); a failure is an error

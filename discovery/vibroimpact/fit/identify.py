@@ -28,6 +28,7 @@ covariance ``s^2 (J^T J)^-1`` with ``s^2 = RSS / (m - p)`` (as lmfit scales it: 
 residual variance estimated from the fit), hence a standard error per coefficient.
 """
 
+import os
 import time
 from dataclasses import dataclass, field, replace
 
@@ -38,6 +39,7 @@ from ..._printing import coefficient_lines, criteria_lines, fmt, readable
 from ..._progress import tick
 from ..._validate import Real, Text, params
 from ...errors import InputError, IntegrationError
+from ...numerics.executor import make_executor
 from ..data.impulse import Impulse
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
@@ -559,6 +561,7 @@ def _checks(records, law, observe, tolerances):
     n_boot_intervals=Real(0, integer=True),
     seed=Real(0, integer=True),
     check=bool,
+    workers=(None, Real(1, integer=True)),
 )
 def identify(
     scenario,
@@ -577,6 +580,7 @@ def identify(
     seed=0,
     progress=None,
     check=True,
+    workers=1,
 ):
     """Identify the coefficients of ``start`` from one or several records by simulation.
 
@@ -613,6 +617,9 @@ def identify(
         (:func:`bootstrap_intervals`; records with positions; 0 = none).
     seed : int
         Seed of that bootstrap.
+    workers : int or None
+        Processes for the bootstrap's refits (default 1; ``None``: every core; the
+        intervals do not depend on it).
     progress : callable, optional
         ``progress(stage, done, total)`` after each simulation (:mod:`discovery._progress`).
     short_first : bool
@@ -693,6 +700,7 @@ def identify(
             seed=seed,
             criterion=criterion,
             tolerances=tolerances,
+            workers=workers,
         )
     return IdentificationResult(
         checks=_checks(records, law, observe, tolerances) if check else (),
@@ -783,6 +791,26 @@ def _replicate(scenario, law, observe, ref, rng, tolerances):
     return replace(ref, span=span2, blocks=imps, impulse=imps[-1], _source=None)
 
 
+def _refit_replicate(context, k):
+    """The coefficients of one bootstrap replicate's refit (a task of the executor; the
+    replicates are in the forked context, so no record is copied), None when it fails."""
+    scenarios, replicates, model, settings = context
+    try:
+        res = identify(
+            scenarios,
+            replicates[k],
+            model,
+            method="least-squares",
+            uncertainty=False,
+            short_first=False,
+            check=False,
+            **settings,
+        )
+    except IntegrationError:
+        return None
+    return np.array(res.law.coefficients, dtype=float)
+
+
 def bootstrap_intervals(
     scenario,
     reference,
@@ -794,6 +822,8 @@ def bootstrap_intervals(
     max_simulations=60,
     criterion="I2",
     tolerances=None,
+    workers=1,
+    executor=None,
 ):
     """Intervals of ``model``'s coefficients by a parametric bootstrap (module docstring).
 
@@ -814,6 +844,13 @@ def bootstrap_intervals(
         Budget of each replicate's refit.
     criterion : str
     tolerances : Tolerances, optional
+    workers : int or None
+        Processes for the replicates' refits (default 1; ``None``: every core).  The
+        replicates are drawn in this process, in order, and only their refits run in
+        parallel, so the intervals do not depend on it.
+    executor : Executor, optional
+        Where the refits run (:mod:`discovery.numerics.executor`); overrides ``workers``
+        and is not closed here.
 
     Returns
     -------
@@ -834,27 +871,32 @@ def bootstrap_intervals(
         return None  # a parameter at 0 sets no scale for the refits
     law, machine, observe = model_parts(model)
     rng = np.random.default_rng(seed)
-    draws = []
+    replicates = []  # drawn here, in order: the rng's sequence does not depend on workers
     for _ in range(n_boot):
         try:
-            reps = [
-                _replicate(machine(sc), law, observe, ref, rng, tolerances) for sc, ref in records
-            ]
-            res = identify(
-                [sc for sc, _ in records],
-                reps,
-                model,
-                criterion=criterion,
-                method="least-squares",
-                max_simulations=max_simulations,
-                tolerances=tolerances,
-                uncertainty=False,
-                short_first=False,
-                check=False,
+            replicates.append(
+                [_replicate(machine(sc), law, observe, ref, rng, tolerances) for sc, ref in records]
             )
         except IntegrationError:
             continue
-        draws.append(np.array(res.law.coefficients, dtype=float))
+    context = (
+        [sc for sc, _ in records],
+        replicates,
+        model,
+        {"criterion": criterion, "max_simulations": max_simulations, "tolerances": tolerances},
+    )
+    jobs = list(range(len(replicates)))
+    own = executor is None
+    ex = (
+        make_executor(min(int(workers or os.cpu_count() or 1), max(len(jobs), 1)))
+        if own
+        else executor
+    )
+    try:
+        draws = [d for d in ex.map(_refit_replicate, jobs, context) if d is not None]
+    finally:
+        if own:
+            ex.close()
     if len(draws) < 5:
         return None
     D = np.array(draws)
