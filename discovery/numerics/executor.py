@@ -36,7 +36,7 @@ from .._validate import Real, Text, params
 from ..errors import InputError
 from ._workers import terminate_pool, worker_initializer
 
-__all__ = ["Executor", "Serial", "Pool", "Dask", "make_executor"]
+__all__ = ["Executor", "Serial", "Pool", "Dask", "make_executor", "map_on"]
 
 _CONTEXT = {}  # the context of the sweep running in this (worker) process
 _THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
@@ -231,6 +231,17 @@ class Dask(Executor):
 
     def __repr__(self):
         return f"Dask({self.address!r}, workers={self.workers})"
+
+
+def map_on(fn, jobs, context=None, *, workers=None, executor=None):
+    """``executor.map(fn, jobs, context)``, or without an executor on one of ``workers``
+    local processes (``None``: one per CPU; never more than the jobs) made for this call
+    and closed after it."""
+    jobs = list(jobs)
+    if executor is not None:
+        return executor.map(fn, jobs, context)
+    with make_executor(min(int(workers or os.cpu_count() or 1), max(len(jobs), 1))) as ex:
+        return ex.map(fn, jobs, context)
 
 
 @params(workers=(None, Real(1, 4096, integer=True)), scheduler=(None, Text()))

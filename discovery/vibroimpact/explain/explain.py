@@ -38,7 +38,6 @@ One iteration (:func:`explain`):
 """
 
 import itertools
-import os
 import re
 import time
 import warnings
@@ -53,7 +52,7 @@ from ..._progress import tick
 from ..._validate import Instance, Real, Text, params
 from ...catalogue import select
 from ...errors import InputError, IntegrationError
-from ...numerics.executor import make_executor
+from ...numerics.executor import map_on
 from ...numerics.memo import Memo, value_key
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
@@ -791,17 +790,7 @@ def _screen(jobs, context, workers, executor=None):
     problem's count whichever process ran it."""
     problem = context[0]
     n0 = problem.n_sim
-    own = executor is None
-    ex = (
-        make_executor(min(int(workers or os.cpu_count() or 1), max(len(jobs), 1)))
-        if own
-        else executor
-    )
-    try:
-        out = ex.map(_screen_one, jobs, context)
-    finally:
-        if own:
-            ex.close()
+    out = map_on(_screen_one, jobs, context, workers=workers, executor=executor)
     problem.n_sim = n0 + sum(r[4] for r in out)
     return [r[:4] for r in out]
 

@@ -28,7 +28,6 @@ covariance ``s^2 (J^T J)^-1`` with ``s^2 = RSS / (m - p)`` (as lmfit scales it: 
 residual variance estimated from the fit), hence a standard error per coefficient.
 """
 
-import os
 import time
 from dataclasses import dataclass, field, replace
 
@@ -39,7 +38,7 @@ from ..._printing import coefficient_lines, criteria_lines, fmt, readable
 from ..._progress import tick
 from ..._validate import Real, Text, params
 from ...errors import InputError, IntegrationError
-from ...numerics.executor import make_executor
+from ...numerics.executor import map_on
 from ..data.impulse import Impulse
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
@@ -885,18 +884,10 @@ def bootstrap_intervals(
         model,
         {"criterion": criterion, "max_simulations": max_simulations, "tolerances": tolerances},
     )
-    jobs = list(range(len(replicates)))
-    own = executor is None
-    ex = (
-        make_executor(min(int(workers or os.cpu_count() or 1), max(len(jobs), 1)))
-        if own
-        else executor
+    refits = map_on(
+        _refit_replicate, range(len(replicates)), context, workers=workers, executor=executor
     )
-    try:
-        draws = [d for d in ex.map(_refit_replicate, jobs, context) if d is not None]
-    finally:
-        if own:
-            ex.close()
+    draws = [d for d in refits if d is not None]
     if len(draws) < 5:
         return None
     D = np.array(draws)
