@@ -128,8 +128,10 @@ def test_stroboscopic_map_jacobian_shape_and_counters(paper, paper_ss):
     pm = StroboscopicMap(paper, paper.law)
     J = pm.jacobian(paper_ss.y0)
     assert J.shape == (4, 4) and np.all(np.isfinite(J))
-    assert pm.n_calls == 5 and pm.n_steps > 0
-    # P1 orbit: Phi^2 has the squared multipliers (rel 1e-3: FD noise as above)
+    # exact: one run with the variational equations (finite differences took five)
+    assert pm.n_calls == 1 and pm.n_exact == 1 and pm.n_steps > 0
+    # P1 orbit: Phi^2 has the squared multipliers (the shooting's Jacobian is exact too;
+    # 2e-3 kept from the finite-difference days)
     J2 = pm.jacobian(paper_ss.y0, n=2)
     np.testing.assert_allclose(
         np.sort(np.abs(np.linalg.eigvals(J2))),

@@ -53,6 +53,10 @@ from ...numerics._dopri import MIN_FACTOR as _MIN_FACTOR
 from ...numerics._dopri import C as _C
 from ...numerics._dopri import blocks
 from ...numerics._dopri import step_factor as _step_factor
+from ...numerics._tableau import A as _A
+from ...numerics._tableau import B as _B
+from ...numerics._tableau import E as _E
+from ...numerics._tableau import P as _P
 
 # the shared Dormand-Prince blocks for this system's four states (w1, v1, w2, v2)
 _D = blocks(4)
@@ -163,6 +167,45 @@ def mode_force(mode, z, v, p, coef, ea, eb, br):
     return 0.0
 
 
+@njit(cache=True, inline="always")
+def _dpw(x, p):
+    """Derivative of :func:`_pw` in ``x`` (``p |x|^(p-1)`` for the odd extension)."""
+    if p == 0.0:
+        return 0.0
+    if p == 1.0:
+        return 1.0
+    if p == 2.0:
+        return 2.0 * x
+    if p == 3.0:
+        return 3.0 * x * x
+    if x == 0.0:
+        return 0.0 if p > 1.0 else np.inf
+    return p * abs(x) ** (p - 1.0)
+
+
+@njit(cache=True)
+def force_partials(mode, z, v, coef, ea, eb, br, dc):
+    """``(dF/dz, dF/dv)`` of the mode's force at ``(z, v)``, and ``dc[i] = dF/dc_i`` (a law
+    without a permanent set: the sensitivities are not carried for one)."""
+    fz = 0.0
+    fv = 0.0
+    for i in range(coef.shape[0]):
+        dc[i] = 0.0
+        if mode == LOAD and br[i] == 0.0:
+            pz, pv = _pw(z, ea[i]), _pw(v, eb[i])
+            dc[i] = pz * pv
+            fz += coef[i] * _dpw(z, ea[i]) * pv
+            fv += coef[i] * pz * _dpw(v, eb[i])
+        elif mode == UNLOAD:
+            vv = 0.0 if br[i] == 0.0 else v
+            pz, pv = _pw(z, ea[i]), _pw(vv, eb[i])
+            dc[i] = pz * pv
+            fz += coef[i] * _dpw(z, ea[i]) * pv
+            if br[i] != 0.0:
+                fv += coef[i] * pz * _dpw(v, eb[i])
+    return fz, fv
+
+
 @njit(cache=True)
 def resolve_mode(y, p, coef, ea, eb, br):
     """The mode a state belongs to (used at the start of an integration; a start inside
@@ -269,6 +312,145 @@ def _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew):
         _rhs(t + _C[s] * h, ytmp, mode, p, coef, ea, eb, br, K[s])
     _combine(y, h, K, ynew)
     _rhs(t + h, ynew, mode, p, coef, ea, eb, br, K[6])
+
+
+# ---- sensitivities: ``S`` (4, m), column j the derivative of the state along a direction
+# of the start (``spar[j] < 0``) or of the law's coefficient ``spar[j]``.  They follow the
+# discrete Runge-Kutta map of each accepted step (the step's own stages, so at the end of a
+# step they are the exact derivative of its result at fixed step length), and jump by the
+# saltation matrix at every located event.
+
+
+@njit(cache=True)
+def _rhs_sens(y, mode, p, coef, ea, eb, br, S, spar, dc, out):
+    """``out[:, j] = (df/dy) S[:, j] + df/dq_j`` at ``y`` in ``mode``."""
+    fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
+    ky = p[2] + 3.0 * p[P_K3] * y[0] * y[0]
+    for j in range(S.shape[1]):
+        df = fz * (S[0, j] - S[2, j]) + fv * (S[1, j] - S[3, j])
+        if spar[j] >= 0:
+            df += dc[spar[j]]
+        out[0, j] = S[1, j]
+        out[1, j] = -(p[3] * S[1, j] + ky * S[0, j] + df) / p[0]
+        out[2, j] = S[3, j]
+        out[3, j] = df / p[1]
+
+
+@njit(cache=True)
+def _rk_sens(y, h, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew):
+    """The sensitivities through the step ``y -> ynew`` of length ``h`` whose stages are in
+    ``K``: fills the stage derivatives ``KS`` (7, 4, m) and ``Snew``."""
+    m = S.shape[1]
+    _rhs_sens(y, mode, p, coef, ea, eb, br, S, spar, dc, KS[0])
+    for s in range(1, 7):
+        if s < 6:
+            _stage(s, y, h, K, ytmp)
+        else:
+            _combine(y, h, K, ytmp)
+        for r in range(4):
+            for j in range(m):
+                acc = 0.0
+                for i in range(s):
+                    acc += (_A[s, i] if s < 6 else _B[i]) * KS[i, r, j]
+                SS[r, j] = S[r, j] + h * acc
+        _rhs_sens(ytmp, mode, p, coef, ea, eb, br, SS, spar, dc, KS[s])
+    for r in range(4):
+        for j in range(m):
+            Snew[r, j] = SS[r, j]
+
+
+@njit(cache=True)
+def _sens_error(S, Snew, KS, h, rtol, atol, sscale):
+    """The embedded error estimate of the sensitivities, scaled as the state's is: column
+    ``j`` times ``sscale[j]`` (the size of a perturbation along it) is the response of the
+    state, with the state's tolerances (RMS over the columns)."""
+    acc = 0.0
+    for r in range(4):
+        for j in range(S.shape[1]):
+            e = 0.0
+            for i in range(7):
+                e += _E[i] * KS[i, r, j]
+            w = sscale[j]
+            sc = atol[r] + rtol * w * max(abs(S[r, j]), abs(Snew[r, j]))
+            q = h * e * w / sc
+            acc += q * q
+    return np.sqrt(acc / (4.0 * S.shape[1]))
+
+
+@njit(cache=True)
+def _dense_sens(S, KS, h, theta, out):
+    """The sensitivities on the dense output at ``theta`` (the weights of ``_dense``)."""
+    t2 = theta * theta
+    t3 = t2 * theta
+    t4 = t3 * theta
+    w = np.zeros(7)
+    w[0] = _P[0, 0] * theta + _P[0, 1] * t2 + _P[0, 2] * t3 + _P[0, 3] * t4
+    for i in range(2, 7):
+        w[i] = _P[i, 1] * t2 + _P[i, 2] * t3 + _P[i, 3] * t4
+    for r in range(4):
+        for j in range(S.shape[1]):
+            acc = 0.0
+            for i in range(7):
+                acc += w[i] * KS[i, r, j]
+            out[r, j] = S[r, j] + h * acc
+
+
+@njit(cache=True)
+def _force_sens(mode, y, S, spar, coef, ea, eb, br, dc, out, k):
+    """``out[j, k] = dF/dq_j`` of the force at ``y`` (sensitivities ``S``) in ``mode``."""
+    fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
+    for j in range(S.shape[1]):
+        df = fz * (S[0, j] - S[2, j]) + fv * (S[1, j] - S[3, j])
+        if spar[j] >= 0:
+            df += dc[spar[j]]
+        out[j, k] = df
+
+
+@njit(cache=True)
+def _event_time_sens(t, y, mode, index, p, coef, ea, eb, br, S, spar, dc, fminus, tau):
+    """Before an event: the vector field ``fminus`` of the mode left, and ``tau[j]``, the
+    derivative of the event time along column ``j``: ``-(grad h . S_j + dh/dq_j) /
+    (grad h . f-)`` for the switching function ``index`` that fired."""
+    _rhs(t, y, mode, p, coef, ea, eb, br, fminus)
+    z = y[0] - y[2]
+    v = y[1] - y[3]
+    cs = 0.0
+    if mode == FREE:
+        gz, gv = -1.0, 0.0
+    elif index == 0:
+        gz, gv = 1.0, 0.0
+    elif mode == CLIPPED:
+        fz, fv = force_partials(LOAD if v > 0.0 else UNLOAD, max(z, 0.0), v, coef, ea, eb, br, dc)
+        gz, gv, cs = -fz, -fv, -1.0
+    elif index == 1:
+        gz, gv = 0.0, (1.0 if mode == LOAD else -1.0)
+    else:
+        fz, fv = force_partials(mode, z, v, coef, ea, eb, br, dc)
+        gz, gv, cs = fz, fv, 1.0
+    den = gz * (fminus[0] - fminus[2]) + gv * (fminus[1] - fminus[3])
+    for j in range(S.shape[1]):
+        num = gz * (S[0, j] - S[2, j]) + gv * (S[1, j] - S[3, j])
+        if cs != 0.0 and spar[j] >= 0:
+            num += cs * dc[spar[j]]
+        # a flow tangent to the surface (a graze) has no event-time derivative
+        tau[j] = -num / den if den != 0.0 else np.nan
+
+
+@njit(cache=True)
+def _store_tau(tau, n_ev, ev_tau):
+    """Keep an event's time derivatives (if there is room)."""
+    if n_ev < ev_tau.shape[0]:
+        for j in range(tau.shape[0]):
+            ev_tau[n_ev, j] = tau[j]
+
+
+@njit(cache=True)
+def _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus):
+    """After an event into ``mode``: ``S_j += (f- - f+) tau_j``."""
+    _rhs(t, y, mode, p, coef, ea, eb, br, fplus)
+    for j in range(S.shape[1]):
+        for r in range(4):
+            S[r, j] += (fminus[r] - fplus[r]) * tau[j]
 
 
 @njit(cache=True)
@@ -449,6 +631,11 @@ def integrate(
     ev_kind,
     ev_y,
     ev_modes,
+    S,
+    spar,
+    sscale,
+    out_dF,
+    ev_tau,
 ):
     """Integrate from ``t0`` to ``t1``; see :func:`discovery.vibroimpact.dynamics.simulate`.
 
@@ -456,6 +643,15 @@ def integrate(
     ``[t0, t1]``) and up to ``len(ev_t)`` events.  Returns
     ``(status, t, y, mode, n_steps, n_events, h)``; ``mode0 < 0`` resolves the mode
     from ``y0``.
+
+    Sensitivities (``S`` of shape (4, m), ``m = 0`` for none): ``S`` holds the
+    derivatives of the start along ``m`` directions and is replaced by those of the end;
+    column ``j`` also moves the law's coefficient ``spar[j]`` when ``spar[j] >= 0``;
+    ``sscale[j]`` is the size of a perturbation along it (their error is controlled as the
+    state's, so a run with sensitivities takes its own steps).  With
+    ``out_dF`` of shape (m, len(t_eval)) the force's derivatives at ``t_eval`` are written
+    too (shape (m, 0) for none), and with ``ev_tau`` of shape (len(ev_t), m) the events'
+    time derivatives (shape (0, m) for none).  Not for a law with a permanent set.
     """
     y = y0.copy()
     ynew = np.empty(4)
@@ -470,6 +666,16 @@ def integrate(
     need_h0 = True
     ns = 0
     t = t0
+    m_s = S.shape[1]
+    want_df = out_dF.shape[1] > 0
+    KS = np.empty((7, 4, m_s))
+    SS = np.empty((4, m_s))
+    Snew = np.empty((4, m_s))
+    Sbuf = np.empty((4, m_s))
+    dc = np.empty(coef.shape[0])
+    fminus = np.empty(4)
+    fplus = np.empty(4)
+    tau = np.empty(m_s)
     mode = mode0 if mode0 >= 0 else resolve_mode(y, p, coef, ea, eb, br)
     h = min(h0, hmax, t1 - t0)
     n_eval = t_eval.shape[0]
@@ -479,6 +685,8 @@ def integrate(
             out_y[j, k_eval] = y[j]
         out_f[k_eval] = mode_force(mode, y[0] - y[2], y[1] - y[3], p, coef, ea, eb, br)
         out_mode[k_eval] = mode
+        if want_df:
+            _force_sens(mode, y, S, spar, coef, ea, eb, br, dc, out_dF, k_eval)
         k_eval += 1
     n_ev = 0
     n_steps = 0
@@ -501,6 +709,11 @@ def integrate(
         _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew)
         n_steps += 1
         err = _error_norm(y, ynew, K, h, rtol, atol)
+        if m_s:
+            # the sensitivities are held to the state's accuracy too (a fractional power
+            # makes the variational equations stiffer than the state near an onset)
+            _rk_sens(y, h, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew)
+            err = max(err, _sens_error(S, Snew, KS, h, rtol, atol, sscale))
         if not np.isfinite(err):
             h *= _MIN_FACTOR
             if h < 1e-14 * max(1.0, abs(t)):
@@ -562,9 +775,16 @@ def integrate(
                 if zero_len > 4:
                     status = CHATTER
                     break
+                if m_s:
+                    _event_time_sens(
+                        t, y, mode, best_index, p, coef, ea, eb, br, S, spar, dc, fminus, tau
+                    )
                 mode = _record_event(
                     t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
                 )
+                if m_s:
+                    _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus)
+                    _store_tau(tau, n_ev, ev_tau)
                 n_ev += 1
                 need_f = True
                 need_h0 = True
@@ -573,6 +793,8 @@ def integrate(
             h_ev = best_theta * h
             _rk_step(t, y, h_ev, mode, p, coef, ea, eb, br, K, ytmp, ynew)
             h_used = h_ev
+            if m_s:
+                _rk_sens(y, h_used, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew)
         else:
             h_used = h
         zero_len = 0
@@ -587,10 +809,16 @@ def integrate(
                 mode, ybuf[0] - ybuf[2], ybuf[1] - ybuf[3], p, coef, ea, eb, br
             )
             out_mode[k_eval] = mode
+            if want_df:
+                _dense_sens(S, KS, h_used, min(theta, 1.0), Sbuf)
+                _force_sens(mode, ybuf, Sbuf, spar, coef, ea, eb, br, dc, out_dF, k_eval)
             k_eval += 1
         for j in range(4):
             y[j] = ynew[j]
             K[0, j] = K[6, j]
+        for r in range(4):
+            for j in range(m_s):
+                S[r, j] = Snew[r, j]
         t = t_new
         bad = False
         for j in range(4):
@@ -608,9 +836,16 @@ def integrate(
             else:
                 short_run = 0
             t_last_ev = t
+            if m_s:
+                _event_time_sens(
+                    t, y, mode, best_index, p, coef, ea, eb, br, S, spar, dc, fminus, tau
+                )
             mode = _record_event(
                 t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
             )
+            if m_s:
+                _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus)
+                _store_tau(tau, n_ev, ev_tau)
             n_ev += 1
             need_f = True
             need_h0 = True

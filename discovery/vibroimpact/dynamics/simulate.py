@@ -5,7 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._compile import announce_compile
-from ..._validate import Array, Real, params
+from ..._validate import Array, Choice, Real, params
 from ...errors import InputError, IntegrationError
 from ...numerics.status import message as status_message
 from ...numerics.tolerances import Tolerances
@@ -13,7 +13,7 @@ from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from . import _kernel as K
 
-__all__ = ["Trajectory", "simulate", "Tolerances", "MODE_NAMES", "EVENT_NAMES"]
+__all__ = ["Trajectory", "simulate", "Tolerances", "MODE_NAMES", "EVENT_NAMES", "SENSITIVITIES"]
 
 MODE_NAMES = {K.FREE: "free", K.LOAD: "load", K.UNLOAD: "unload", K.CLIPPED: "clipped"}
 EVENT_NAMES = {
@@ -64,6 +64,16 @@ class Trajectory:
     status : int
         0 on success; see ``message``.
     message : str
+    sensitivity : ndarray of shape (4, m) or None
+        With ``simulate(..., sensitivities=...)``: the derivatives of the final state along
+        each of ``m`` directions, named in ``sensitivity_names``: ``"w1", "v1", "w2", "v2"``
+        (the start's states: the columns are the Jacobian of the flow) and the law's
+        coefficients (loading terms by name, unloading terms as ``"unloading: name"``).
+    force_sensitivity : ndarray of shape (m, n) or None
+        The force's derivatives at ``t`` along the same directions.
+    event_time_sensitivity : ndarray of shape (n_events, m) or None
+        The events' time derivatives along the same directions (NaN at a graze).
+    sensitivity_names : tuple of str
     """
 
     t: np.ndarray
@@ -81,6 +91,10 @@ class Trajectory:
     status: int
     message: str
     zeta_max0: float = 0.0
+    sensitivity: np.ndarray | None = None
+    force_sensitivity: np.ndarray | None = None
+    sensitivity_names: tuple = ()
+    event_time_sensitivity: np.ndarray | None = None
 
     @property
     def success(self):
@@ -124,6 +138,51 @@ def kernel_params(scenario, law):
     return p
 
 
+def no_sensitivities():
+    """The kernel's sensitivity arguments for a run without them (``m = 0``)."""
+    return (
+        np.empty((4, 0)),
+        np.empty(0, dtype=np.int64),
+        np.empty(0),
+        np.empty((0, 0)),
+        np.empty((0, 0)),
+    )
+
+
+SENSITIVITIES = ("state", "coefficients", "all")
+_STATE_NAMES = ("w1", "v1", "w2", "v2")
+
+
+def sensitivity_setup(scenario, law, which, n_eval=0, n_events=0):
+    """The kernel's sensitivity arguments ``(S, spar, sscale, out_dF, ev_tau)`` and the
+    columns' names for ``which`` (one of :data:`SENSITIVITIES`): the start's four states
+    (``S`` the identity there) and/or the law's coefficients (``S`` zero there)."""
+    if law.permanent_set > 0:
+        raise InputError(
+            "sensitivities are not available for a law with a permanent set (its unloading "
+            "memory is a state the kernel does not differentiate); leave `set:` out, or use "
+            "finite differences"
+        )
+    coef = np.array(law.coefficients + law.unloading_coefficients, dtype=float)
+    names, spar, sscale = [], [], []
+    x, v = scenario.scales()
+    if which in ("state", "all"):
+        names += list(_STATE_NAMES)
+        spar += [-1] * 4
+        sscale += [x, v, x, v]
+    if which in ("coefficients", "all"):
+        names += list(law.names) + [f"unloading: {t.name}" for t in law.unloading]
+        spar += list(range(coef.size))
+        sscale += [max(abs(c), 1e-300) for c in coef]
+    m = len(names)
+    S = np.zeros((4, m))
+    if which in ("state", "all"):
+        S[:, :4] = np.eye(4)
+    out_dF = np.empty((m, n_eval))
+    ev_tau = np.full((n_events, m), np.nan)
+    return (S, np.array(spar, dtype=np.int64), np.array(sscale), out_dF, ev_tau), tuple(names)
+
+
 def _atol(scenario, tol):
     x, v = scenario.scales()
     return tol.atol([x, v, x, v])
@@ -138,6 +197,7 @@ def _atol(scenario, tol):
     tolerances=(Tolerances, None),
     max_events=Real(1, integer=True),
     zeta_max0=Real(0),
+    sensitivities=(None, Choice(*SENSITIVITIES)),
 )
 def simulate(
     scenario,
@@ -151,6 +211,7 @@ def simulate(
     mode0=None,
     throw=True,
     zeta_max0=0.0,
+    sensitivities=None,
 ):
     """Integrate the two-body vibro-impact system with a given contact law.
 
@@ -178,6 +239,13 @@ def simulate(
     throw : bool
         Raise :class:`IntegrationError` on failure (default) or return a
         trajectory whose ``status``/``message`` say what happened.
+    sensitivities : {"state", "coefficients", "all"}, optional
+        Also integrate the variational equations (with the saltation matrix at every
+        event) and return the derivatives of the final state and of the force at ``t``
+        along the start's states, the law's coefficients, or both: one run instead of
+        one per direction of finite differences.  Their error is controlled with the
+        state's, so the run takes its own steps (the trajectory agrees with a plain run
+        to the tolerances).  Not for a law with a permanent set.
 
     Returns
     -------
@@ -202,6 +270,10 @@ def simulate(
     period = scenario.period
     p = kernel_params(scenario, law)
     p[K.P_ZMAX] = float(zeta_max0)
+    if sensitivities is None:
+        sens, names = no_sensitivities(), ()
+    else:
+        sens, names = sensitivity_setup(scenario, law, sensitivities, te.size, max_events)
     announce_compile("vibro-impact")
     status, tf, yf, mf, n_steps, n_ev, _ = K.integrate(
         t0,
@@ -226,6 +298,7 @@ def simulate(
         ev_k,
         ev_y,
         ev_m,
+        *sens,
     )
     message = (
         "ok"
@@ -252,4 +325,8 @@ def simulate(
         status=int(status),
         message=message,
         zeta_max0=float(zeta_max0),
+        sensitivity=sens[0] if names else None,
+        force_sensitivity=sens[3][:, ok_out] if names else None,
+        event_time_sensitivity=sens[4][:n_keep] if names else None,
+        sensitivity_names=names,
     )

@@ -34,7 +34,7 @@ from ...numerics.status import message as status_message
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from . import _kernel as K
-from .simulate import _HINTS, Tolerances, _atol, kernel_params, simulate
+from .simulate import _HINTS, Tolerances, _atol, kernel_params, no_sensitivities, simulate
 
 __all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
 
@@ -75,6 +75,12 @@ class StroboscopicMap:
         # start (exact at a fixed point; Jacobian probes hold it fixed)
         self._memory = law.permanent_set > 0
         self.zeta_max = 0.0
+        self._no_sens = no_sensitivities()
+        self._state_dirs = np.full(4, -1, dtype=np.int64)
+        # exact Jacobians (one run with the variational equations) unless the law has a
+        # permanent set; ``n_exact`` counts them
+        self.exact = not self._memory
+        self.n_exact = 0
         announce_compile("vibro-impact")  # the map's first advance may compile the kernel
 
     def advance(self, y, n=1, t0=0.0, remember=True):
@@ -83,6 +89,9 @@ class StroboscopicMap:
         For a law with a permanent set, a start inside a contact unloads from
         :attr:`zeta_max`, the largest penetration the previous call ended with; with
         ``remember`` this call's own end value replaces it."""
+        return self._run(y, n, t0, remember, self._no_sens)
+
+    def _run(self, y, n, t0, remember, sens):
         p = self._p.copy()
         if self._memory:
             p[K.P_ZMAX] = self.zeta_max
@@ -109,6 +118,7 @@ class StroboscopicMap:
             self._evk,
             self._evy,
             self._evm,
+            *sens,
         )
         self.n_calls += 1
         self.n_steps += steps
@@ -128,7 +138,22 @@ class StroboscopicMap:
         return yf
 
     def jacobian(self, y, n=1, fy=None):
-        """Finite-difference Jacobian of ``Phi^n`` at ``y``, ndarray of shape (4, 4)."""
+        """Jacobian of ``Phi^n`` at ``y``, ndarray of shape (4, 4): exact (the variational
+        equations through the steps, the saltation matrix at every event), from one
+        simulation.  A law with a permanent set (whose unloading memory the four states do
+        not hold), or a run whose exact Jacobian is not finite (a grazing contact), takes
+        finite differences instead (four more simulations)."""
+        if self.exact:
+            S = np.eye(4)
+            self._run(y, n, 0.0, False, (S, self._state_dirs, self.scale, *self._no_sens[3:]))
+            self.n_exact += 1
+            if np.all(np.isfinite(S)):
+                return S
+        return self.fd_jacobian(y, n, fy)
+
+    def fd_jacobian(self, y, n=1, fy=None):
+        """Finite-difference Jacobian of ``Phi^n`` at ``y`` (forward steps of ``1e-6``
+        of each state's scale)."""
         fy = self.advance(y, n) if fy is None else fy
         J = np.empty((4, 4))
         for j in range(4):
