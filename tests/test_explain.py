@@ -52,15 +52,20 @@ def test_hidden_coupling_is_named_and_the_gap_shrinks(hidden_coupling):
     # the effect acts (compared over the record's span, the start law's misfit in the contact
     # also moves the separation, so unloading can carry the largest share), with the onset,
     # where a linear damper's force jump is too high, beyond the noise
+    # The score's rank is not asserted: at this start (I2 1.35) it is fragile.  A change of
+    # 2e-4 in the start's stiffness (exact against finite-difference Jacobians in the start's
+    # fit) moved the coupling's LM statistic from 2.7e5 (the largest) to 1.1e5, below the
+    # unloading damping's 1.8e5.  The refits decide what is named: the coupling's refit
+    # lowers I2 the most.
     s = next(x for x in it.scores if x["effect"] == "penetration_velocity_coupling")
-    assert s["significant"] and s["lm"] == max(x["lm"] for x in it.scores if x["lm"])
+    assert s["significant"]
+    refitted = [x for x in it.scores if x.get("criteria_after")]
+    best = min(refitted, key=lambda x: x["criteria_after"]["I2"])
+    assert best["effect"] == "penetration_velocity_coupling"
     phases = it.localisation["phases"]
-    assert max(phases, key=lambda p: phases[p]["share"]) in (
-        "onset",
-        "loading",
-        "peak",
-        "unloading",
-    )
+    # the contact's phases carry most of it (measured 0.57: onset 0.18, unloading 0.39; the
+    # separation 0.40 and unloading 0.39 swap places with that 2e-4 change of the start)
+    assert sum(phases[p]["share"] for p in ("onset", "loading", "peak", "unloading")) > 0.5
     assert phases["onset"]["exceeds_noise"]
 
 
@@ -165,9 +170,38 @@ def test_first_order_lag_is_exact_for_a_step():
     )
     out = first_order_lag(imp, tau)
     for s in (0.01, 0.03, 0.1):
-        # periodic steady state of the filter: the step starts from the decayed tail
-        assert out.evaluate(s) == pytest.approx(1 - np.exp(-s / tau), abs=5e-3)  # 64 pts/tau
-    assert out.evaluate(0.5 + 0.02) == pytest.approx(np.exp(-0.02 / tau), abs=5e-3)
+        # periodic steady state of the filter: the step starts from the decayed tail; the
+        # closed form written on 16 points per tau, read back by linear interpolation
+        # (measured within 2e-4)
+        assert out.evaluate(s) == pytest.approx(1 - np.exp(-s / tau), abs=1e-3)
+    assert out.evaluate(0.5 + 0.02) == pytest.approx(np.exp(-0.02 / tau), abs=1e-3)
+    assert np.all(out.F >= 0)
+
+
+def test_first_order_lag_matches_an_integration_of_its_equation():
+    """A piecewise-linear periodic pulse with a jump at the cycle's origin: the closed form
+    at the knots and between them against scipy's integration of tau G' + G = F over many
+    cycles (measured 6e-9 of the peak)."""
+    from scipy.integrate import solve_ivp
+
+    from discovery.numerics.lag import lag_at, lag_at_knots
+
+    W, tau = 0.04, 3e-4
+    t = np.array([0.0, 0.002, 0.005, 0.008, 0.03, W])
+    F = np.array([5e4, 2e5, 1e5, 0.0, 0.0, 0.0])
+    G = lag_at_knots(t, F, tau)
+    sol = solve_ivp(
+        lambda s, g: (np.interp(s % W, t, F) - g) / tau,
+        (0.0, 20 * W),
+        [0.0],
+        rtol=1e-11,
+        atol=1e-6,
+        max_step=1e-5,
+        dense_output=True,
+    )
+    tq = np.linspace(0.0, W, 777)
+    ref = sol.sol(19 * W + tq)[0]
+    assert np.max(np.abs(lag_at(t, F, G, tau, tq) - ref)) < 1e-7 * F.max()
 
 
 def test_catalogue_entries_are_complete():

@@ -189,3 +189,87 @@ def test_a_run_with_sensitivities_agrees_with_a_plain_run():
     np.testing.assert_allclose(a.force, b.force, atol=1e-5 * np.abs(a.force).max())
     with pytest.raises(InputError, match="sensitivities"):
         simulate(PAPER, PAPER.law, (0.0, T), sensitivities="everything")
+
+
+# ------------------------------------------------------------ the output-error Jacobian
+@pytest.fixture(scope="module")
+def span_record():
+    from discovery.vibroimpact.dynamics.synthesize import synthesize
+    from discovery.vibroimpact.verify import Reference
+
+    rec = synthesize(PAPER, PAPER.law, periods=20, fs=20000, noise=0.01, seed=3)
+    return Reference.from_measurement(rec, PAPER, n_boot=8, seed=0)
+
+
+def _objective(model, span_record):
+    from discovery.vibroimpact.fit.identify import _Objective, as_records
+
+    return _Objective(as_records(PAPER, span_record), model, "I2", None, 10**6)
+
+
+def _central(obj, x, h=1e-6):
+    cols = []
+    for i in range(x.size):
+        e = np.zeros(x.size)
+        e[i] = h
+        cols.append((obj.residuals(x + e) - obj.residuals(x - e)) / (2 * h))
+    return np.array(cols).T
+
+
+def _models():
+    from discovery.vibroimpact.explain.effects import Model, effect
+
+    base = Model(ForceLaw.parse("1.5e8*z + 0.9e7*zd"))
+    return {
+        "law": (ForceLaw.parse("1.5e8*z + 0.9e7*zd"), [True, True]),
+        "unloading damping": (base.with_effect(effect("unloading_damping"), 2e6), [True] * 3),
+        "supports": (base.with_effect(effect("support_nonlinearity"), 1e11), [True, True, False]),
+        "sensor lag": (base.with_effect(effect("sensor_lag"), 2e-5), [True, True, False]),
+    }
+
+
+@pytest.mark.parametrize("name", ["law", "unloading damping", "supports", "sensor lag"])
+def test_output_error_jacobian_matches_central_differences(name, span_record):
+    """The residuals' Jacobian on a record compared over its span: the law's coefficients
+    (loading and unloading) from one run with the variational equations, through the
+    onset blend, the sensor's lag (linear in the force) and the fold; a machine parameter
+    and the lag's time constant by differences.  Measured within 4e-6 of central
+    differences (relative, per column)."""
+    model, exact = _models()[name]
+    obj = _objective(model, span_record)
+    cols, ok = obj._exact_columns()
+    assert ok and [c is not None for c in cols] == exact
+    x = np.linspace(1.1, 0.95, len(model.coefficients))
+    n0 = obj.n
+    J = obj.jacobian(x)
+    # one run for the exact columns, one more per column by differences (and the residual)
+    assert obj.n - n0 <= 2 + exact.count(False)
+    Jc = _central(obj, x)
+    err = np.linalg.norm(J - Jc, axis=0) / np.linalg.norm(Jc, axis=0)
+    assert err.max() < 1e-4
+
+
+def test_a_nonlinear_observation_model_takes_differences(span_record):
+    from discovery.vibroimpact.fit.identify import _Objective, as_records
+
+    law = ForceLaw.parse("1.5e8*z + 0.9e7*zd")
+    clipped = lambda imp: imp  # noqa: E731 - not declared linear in the force
+    obj = _Objective(as_records(PAPER, span_record), law, "I2", None, 10**6, observe=clipped)
+    assert not obj._exact_columns()[1]
+    assert obj.jacobian(np.ones(2)).shape[1] == 2  # forward differences
+
+
+def test_identify_with_the_exact_jacobian_needs_fewer_simulations(span_record, monkeypatch):
+    """Same law as with forward differences (to the fit's tolerance), in fewer runs."""
+    import importlib
+
+    mod = importlib.import_module("discovery.vibroimpact.fit.identify")
+    api = mod.identify
+    start = ForceLaw.parse("1.5e8*z + 0.9e7*zd")
+    exact = api(PAPER, span_record, start, check=False)
+    monkeypatch.setattr(mod._Objective, "_exact_columns", lambda self: ([None, None], False))
+    fd = api(PAPER, span_record, start, check=False)
+    np.testing.assert_allclose(exact.law.coefficients, fd.law.coefficients, rtol=1e-4)
+    assert exact.n_simulations < fd.n_simulations
+    for k in exact.standard_errors:
+        assert exact.standard_errors[k] == pytest.approx(fd.standard_errors[k], rel=0.02)

@@ -378,12 +378,13 @@ def _sens_error(S, Snew, KS, h, rtol, atol, sscale):
 
 
 @njit(cache=True)
-def _dense_sens(S, KS, h, theta, out):
-    """The sensitivities on the dense output at ``theta`` (the weights of ``_dense``)."""
+def _dense_sens(S, KS, h, theta, w, out):
+    """The sensitivities on the dense output at ``theta`` (the weights of ``_dense``, in the
+    work array ``w`` of size 7)."""
     t2 = theta * theta
     t3 = t2 * theta
     t4 = t3 * theta
-    w = np.zeros(7)
+    w[1] = 0.0
     w[0] = _P[0, 0] * theta + _P[0, 1] * t2 + _P[0, 2] * t3 + _P[0, 3] * t4
     for i in range(2, 7):
         w[i] = _P[i, 1] * t2 + _P[i, 2] * t3 + _P[i, 3] * t4
@@ -647,8 +648,9 @@ def integrate(
     Sensitivities (``S`` of shape (4, m), ``m = 0`` for none): ``S`` holds the
     derivatives of the start along ``m`` directions and is replaced by those of the end;
     column ``j`` also moves the law's coefficient ``spar[j]`` when ``spar[j] >= 0``;
-    ``sscale[j]`` is the size of a perturbation along it (their error is controlled as the
-    state's, so a run with sensitivities takes its own steps).  With
+    ``sscale[j]`` is the size of a perturbation along it: their error is then controlled
+    as the state's, so the run takes its own steps (``sscale`` of size 0: the state's
+    steps, and the state's results bitwise those of a run without sensitivities).  With
     ``out_dF`` of shape (m, len(t_eval)) the force's derivatives at ``t_eval`` are written
     too (shape (m, 0) for none), and with ``ev_tau`` of shape (len(ev_t), m) the events'
     time derivatives (shape (0, m) for none).  Not for a law with a permanent set.
@@ -667,11 +669,13 @@ def integrate(
     ns = 0
     t = t0
     m_s = S.shape[1]
+    ctl_s = m_s > 0 and sscale.shape[0] > 0
     want_df = out_dF.shape[1] > 0
     KS = np.empty((7, 4, m_s))
     SS = np.empty((4, m_s))
     Snew = np.empty((4, m_s))
     Sbuf = np.empty((4, m_s))
+    wbuf = np.empty(7)
     dc = np.empty(coef.shape[0])
     fminus = np.empty(4)
     fplus = np.empty(4)
@@ -709,7 +713,7 @@ def integrate(
         _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew)
         n_steps += 1
         err = _error_norm(y, ynew, K, h, rtol, atol)
-        if m_s:
+        if ctl_s:
             # the sensitivities are held to the state's accuracy too (a fractional power
             # makes the variational equations stiffer than the state near an onset)
             _rk_sens(y, h, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew)
@@ -797,6 +801,8 @@ def integrate(
                 _rk_sens(y, h_used, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew)
         else:
             h_used = h
+            if m_s and not ctl_s:
+                _rk_sens(y, h_used, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew)
         zero_len = 0
         t_new = t + h_used if best_index >= 0 or h_used < t1 - t else t1
         # dense output at requested times inside (t, t_new]
@@ -810,7 +816,7 @@ def integrate(
             )
             out_mode[k_eval] = mode
             if want_df:
-                _dense_sens(S, KS, h_used, min(theta, 1.0), Sbuf)
+                _dense_sens(S, KS, h_used, min(theta, 1.0), wbuf, Sbuf)
                 _force_sens(mode, ybuf, Sbuf, spar, coef, ea, eb, br, dc, out_dF, k_eval)
             k_eval += 1
         for j in range(4):

@@ -42,7 +42,7 @@ from ...numerics.executor import map_on
 from ..data.impulse import Impulse
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
-from ..model.law import ForceLaw
+from ..model.law import ForceLaw, Term
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
 from ..verify.criteria import criterion as _criterion
@@ -375,6 +375,80 @@ class _Objective:
             ]
         )
 
+    # ------------------------------------------------ the residuals' Jacobian
+    def _exact_columns(self):
+        """For each parameter, its index among the kernel's coefficients (loading, then
+        unloading terms) when its residual column can be had from the variational
+        equations, else ``None`` (a machine parameter, a permanent set: differences); and
+        whether any column can (every record compared over its span, an observation
+        model linear in the force or none, no permanent set)."""
+        model = self.start
+        law, _, observe = model_parts(model, self.observe)
+        n = len(law.coefficients)
+        cols = list(range(n))
+        if not isinstance(model, ForceLaw):
+            for e in model._free():
+                t = Term.parse(e.key) if e.target == "unloading" else None
+                cols.append(n + law.unloading.index(t) if t in law.unloading else None)
+        ok = (
+            (observe is None or getattr(observe, "linear", False))
+            and law.permanent_set == 0
+            and all(getattr(ref, "span", None) is not None for _, ref in self.records)
+        )
+        return cols, ok
+
+    def jacobian(self, x):
+        """``d residuals / d x``: the law's coefficients' columns from one run per record
+        with the variational equations (:func:`~discovery.vibroimpact.verify.trajectory.
+        history_sensitivities`), the other parameters' by forward differences (scipy's
+        2-point step); all by differences when no column can be exact."""
+        x = np.asarray(x, dtype=float)
+        r0 = self.residuals(x)
+        cols, ok = self._exact_columns()
+        J = np.empty((r0.size, x.size))
+        exact = np.zeros(x.size, dtype=bool)
+        if ok and self.evaluations(x) is not None:
+            try:
+                J[:, :] = 0.0
+                exact = self._exact_jacobian(x, cols, J)
+            except (IntegrationError, InputError):
+                exact[:] = False
+            # a column that is not finite (a graze at an onset, an infinite slope of a
+            # fractional power at zero penetration) is taken by differences
+            exact &= np.all(np.isfinite(J), axis=0)
+        for i in np.flatnonzero(~exact):
+            xi = x.copy()
+            h = 1e-6 * max(1.0, abs(x[i]))
+            xi[i] += h
+            J[:, i] = (self.residuals(xi) - r0) / h
+        return J
+
+    def _exact_jacobian(self, x, cols, J):
+        """Fill the exact columns of ``J`` (in units of ``x``); returns which are."""
+        from ..verify.trajectory import history_sensitivities
+
+        law, machine, observe = model_parts(self.law(x), self.observe)
+        exact = np.array([c is not None for c in cols])
+        if self.n + len(self.records) > self.max_sim:
+            raise _Budget
+        row = 0
+        for (sc, ref), ws in zip(self.records, self.w, strict=True):
+            self.n += 1
+            tick(self.progress, "identify: simulations", self.n, self.max_sim)
+            dH = history_sensitivities(
+                machine(sc), law, ref.span, tolerances=self.tol, observe=observe
+            )
+            for blk, d, w in zip(ref.span.blocks, dH, ws, strict=True):
+                fold = blk.fold
+                for i, c in enumerate(cols):
+                    if c is None:
+                        continue
+                    dm = fold.average(d[c])
+                    dS = np.concatenate([[dm[0]], dm, [dm[-1]]])
+                    J[row : row + w.size - 1, i] = (dS * w)[1:] * self.c0[i]
+                row += w.size - 1
+        return exact
+
 
 def _coordinate_descent(obj, x0, xtol, step0=0.1):
     x = np.array(x0, dtype=float)
@@ -408,16 +482,20 @@ def _coordinate_descent(obj, x0, xtol, step0=0.1):
 
 
 def _uncertainty(obj, x, names):
-    """Standard errors and correlations from the residual Jacobian at ``x``."""
+    """Standard errors and correlations from the residual Jacobian at ``x`` (exact where
+    :meth:`_Objective.jacobian` can be, else forward differences)."""
     r0 = obj.residuals(x)
-    J = np.empty((r0.size, x.size))
-    for i in range(x.size):
-        xi = x.copy()
-        h = _JAC_STEP * max(abs(x[i]), 1e-3)
-        xi[i] += h
-        if obj.evaluations(xi) is None:
-            return {}, None
-        J[:, i] = (obj.residuals(xi) - r0) / h
+    if obj._exact_columns()[1]:
+        J = obj.jacobian(x)
+    else:
+        J = np.empty((r0.size, x.size))
+        for i in range(x.size):
+            xi = x.copy()
+            h = _JAC_STEP * max(abs(x[i]), 1e-3)
+            xi[i] += h
+            if obj.evaluations(xi) is None:
+                return {}, None
+            J[:, i] = (obj.residuals(xi) - r0) / h
     m, p = J.shape
     if m <= p:
         return {}, None
@@ -505,6 +583,23 @@ def _short_first(
     return start, spent
 
 
+def _x_bounds(model):
+    """Bounds of the least-squares variables ``x = c / c_start``: none for a law's
+    coefficients; an added effect's physical bounds for its parameter (a time constant, a
+    set, a stiffness is not negative), so the trust region does not step beyond a bound the
+    model would clip to (where the clipped parameter no longer moves the residual and the
+    fit stalls there)."""
+    c0 = np.asarray(model.coefficients, dtype=float)
+    lo, hi = np.full(c0.size, -np.inf), np.full(c0.size, np.inf)
+    if isinstance(model, ForceLaw):
+        return lo, hi
+    n = len(model.law.coefficients)
+    for i, e in enumerate(model._free(), start=n):
+        a, b = (v / c0[i] for v in e.parameters[0].bounds)
+        lo[i], hi[i] = min(a, b), max(a, b)
+    return lo, hi
+
+
 def _optimise(obj, x0, method, xtol, max_simulations):
     """Run ``method`` on the objective from ``x0``; returns the optimiser's message."""
     try:
@@ -525,9 +620,13 @@ def _optimise(obj, x0, method, xtol, max_simulations):
                 },
             )
             return str(res.message)
+        # the law's coefficients' columns exact when they can be (one run per record
+        # with the variational equations), else scipy's forward differences
         res = least_squares(
             obj.residuals,
             x0,
+            jac=obj.jacobian if obj._exact_columns()[1] else "2-point",
+            bounds=_x_bounds(obj.start),
             method="trf",
             x_scale=1.0,
             diff_step=1e-6,

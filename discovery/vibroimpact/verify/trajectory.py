@@ -33,6 +33,7 @@ __all__ = [
     "RecordSpan",
     "record_span",
     "simulated_history",
+    "history_sensitivities",
     "block_criteria",
     "span_floor",
     "BLOCK_CYCLES",
@@ -227,6 +228,71 @@ def _block_run(scenario, law, blk, y0, tolerances):
     return F, tr.event_t[tr.event_kind == _K.EV_ONSET]
 
 
+def _onset_weights(td, onsets):
+    """The samples whose interval holds a contact onset, the onset's fraction ``u`` of it,
+    and the intervals' lengths (see :func:`simulated_history`)."""
+    mid = 0.5 * (td[1:] + td[:-1])
+    edges = np.concatenate([[td[0] - (mid[0] - td[0])], mid, [td[-1] + (td[-1] - mid[-1])]])
+    k = np.searchsorted(edges, onsets, "right") - 1
+    keep = (k >= 0) & (k < td.size)
+    k = k[keep]
+    width = edges[k + 1] - edges[k]
+    return k, (onsets[keep] - edges[k]) / width, width, keep
+
+
+def _sensitivity_run(scenario, law, blk, tolerances):
+    """A block's run from its measured state with the coefficients' sensitivities (the
+    state's steps: the force is the plain run's): ``(F, dF, onsets, d_onsets)``."""
+    fold, st = blk.fold, blk.state
+    tr = simulate(
+        scenario,
+        law,
+        (min(st.t, fold.td[0]), fold.end),
+        y0=st.y,
+        t_eval=fold.td,
+        tolerances=tolerances,
+        sensitivities="coefficients",
+        control_sensitivities=False,
+    )
+    on = tr.event_kind == _K.EV_ONSET
+    return tr.force, tr.force_sensitivity, tr.event_t[on], tr.event_time_sensitivity[on]
+
+
+def history_sensitivities(scenario, law, span, *, tolerances=None, observe=None):
+    """The derivatives of the optimisers' force history (:func:`simulated_history` with
+    ``window=True``) along the law's coefficients (loading, then unloading terms), one
+    array of shape (m, samples) per block, each from one simulation with the variational
+    equations (:func:`~discovery.vibroimpact.dynamics.simulate`'s ``sensitivities``); the
+    onset blend's weight moves with the onset's own time derivative.  An observation model
+    must be linear in the force (``observe.linear``, e.g. a sensor's lag): it is applied to
+    each derivative.  Raises :class:`~discovery.errors.InputError` for a law with a
+    permanent set or a nonlinear observation and
+    :class:`~discovery.errors.IntegrationError` when a run fails."""
+    if observe is not None and not getattr(observe, "linear", False):
+        raise InputError("the observation model is not linear in the force")
+    out = []
+    for blk in span.blocks:
+        td = blk.fold.td
+        key = value_key("sensitivities", scenario, law, tolerances, id(blk))
+        _, F, dF, onsets, d_on = MEMO.get(
+            key, lambda b=blk: (b, *_sensitivity_run(scenario, law, b, tolerances))
+        )
+        dH = dF.copy()
+        if td.size > 1 and onsets.size:
+            k, u, width, keep = _onset_weights(td, onsets)
+            d_on = d_on[keep]
+            for i, kk in enumerate(k):
+                # blended value blk.F + |2u - 1| (F - blk.F): the weight's own derivative
+                # moves with the onset time
+                w = abs(2.0 * u[i] - 1.0)
+                dw = 2.0 * np.sign(2.0 * u[i] - 1.0) / width[i] * d_on[i]
+                dH[:, kk] = w * dF[:, kk] + dw * (F[kk] - blk.F[kk])
+        if observe is not None:
+            dH = np.array([_observed(blk.fold, d, observe) for d in dH]).reshape(dH.shape)
+        out.append(dH)
+    return out
+
+
 def simulated_history(
     scenario, law, span, *, tolerances=None, starts=None, observe=None, window=False
 ):
@@ -276,31 +342,27 @@ def simulated_history(
             # when the onset crosses the sample time (where the point value jumps) and
             # whole at the interval's ends, so the residual is continuous in the law's
             # coefficients and unbiased (at the truth it is the record's noise, weighted)
-            mid = 0.5 * (td[1:] + td[:-1])
-            edges = np.concatenate([[td[0] - (mid[0] - td[0])], mid, [td[-1] + (td[-1] - mid[-1])]])
-            on = onsets
-            k = np.searchsorted(edges, on, "right") - 1
-            keep = (k >= 0) & (k < td.size)
-            k, on = k[keep], on[keep]
+            k, u, _, _ = _onset_weights(td, onsets)
             if k.size:
-                u = (on - edges[k]) / (edges[k + 1] - edges[k])
                 w = np.abs(2.0 * u - 1.0)
                 Fs[k] = blk.F[k] + w * (Fs[k] - blk.F[k])
-        if observe is not None:
-            L = fold.end - fold.origin
-            tt = np.concatenate([[0.0], fold.td - fold.origin, [L]])
-            FF = np.concatenate([[Fs[-1]], Fs, [Fs[-1]]])
-            imp = Impulse(
-                t=tt,
-                F=FF,
-                duration=L,
-                support=np.zeros((0, 2)),
-                n_periods=fold.n_periods * fold.n_cycles,
-                onset=fold.origin,
-            )
-            Fs = observe(imp).evaluate(fold.td - fold.origin)
-        out.append(Fs)
+        out.append(Fs if observe is None else _observed(fold, Fs, observe))
     return out
+
+
+def _observed(fold, Fs, observe):
+    """A block's history at its sample times seen through the observation model (the
+    block taken as one periodic signal)."""
+    L = fold.end - fold.origin
+    imp = Impulse(
+        t=np.concatenate([[0.0], fold.td - fold.origin, [L]]),
+        F=np.concatenate([[Fs[-1]], Fs, [Fs[-1]]]),
+        duration=L,
+        support=np.zeros((0, 2)),
+        n_periods=fold.n_periods * fold.n_cycles,
+        onset=fold.origin,
+    )
+    return observe(imp).evaluate(fold.td - fold.origin)
 
 
 def block_criteria(measured, simulated, span, names=None):
