@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import OutputDir, provenance
+from ..errors import InputError
 from ..vibroimpact.model.scenario import load_scenario
 from ._common import LAW_HELP, SCENARIO_HELP, check_out, inputs_of, law_or_default
 
@@ -16,6 +17,11 @@ def run(args):
         check_out(args)
     sc = load_scenario(args.scenario)
     law = law_or_default(args.law, sc)
+    if args.sensitivities and law.permanent_set > 0:
+        raise InputError(
+            "--sensitivities is not available for a law with a permanent set ('set:' in "
+            "--law): its unloading memory is a state the sensitivities do not carry"
+        )
     r = response(sc, law)
     ss = r.steady
     info = ss.as_dict()
@@ -28,6 +34,12 @@ def run(args):
     )
     if r.impulse is not None:
         print(f"peak force {r.impulse.peak:.4g} N, contact time {r.impulse.contact_time:.4g} s")
+    if args.sensitivities:
+        from ..vibroimpact.dynamics.orbit_sensitivity import orbit_sensitivity
+
+        sens = orbit_sensitivity(sc, law, ss)
+        print(sens)
+        info["sensitivities"] = sens.as_dict()
     if args.out:
         with OutputDir(args.out) as out:
             out.write_json(
@@ -50,6 +62,13 @@ def register(sub):
     )
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
     s.add_argument("--law", help=LAW_HELP)
+    s.add_argument(
+        "--sensitivities",
+        action="store_true",
+        help="also how each impact's peak force, contact time and largest penetration move "
+        "with each coefficient (exact derivatives of the periodic orbit, printed as "
+        "elasticities; not for a law with a permanent set)",
+    )
     s.add_argument(
         "--out", help="optional output directory for summary.json (default: none, print only)"
     )

@@ -138,6 +138,20 @@ def kernel_params(scenario, law):
     return p
 
 
+def _buffers(n_eval, max_events):
+    """The kernel's output arrays: state, force and mode at the output times, and the
+    events' times, kinds, states and modes."""
+    return (
+        np.empty((4, n_eval)),
+        np.empty(n_eval),
+        np.empty(n_eval, dtype=np.int64),
+        np.empty(max_events),
+        np.empty(max_events, dtype=np.int64),
+        np.empty((max_events, 4)),
+        np.empty((max_events, 2), dtype=np.int64),
+    )
+
+
 def no_sensitivities():
     """The kernel's sensitivity arguments for a run without them (``m = 0``)."""
     return (
@@ -153,11 +167,12 @@ SENSITIVITIES = ("state", "coefficients", "all")
 _STATE_NAMES = ("w1", "v1", "w2", "v2")
 
 
-def sensitivity_setup(scenario, law, which, n_eval=0, n_events=0, controlled=True):
+def sensitivity_setup(scenario, law, which, n_eval=0, n_events=0, controlled=True, start=None):
     """The kernel's sensitivity arguments ``(S, spar, sscale, out_dF, ev_tau)`` and the
     columns' names for ``which`` (one of :data:`SENSITIVITIES`): the start's four states
     (``S`` the identity there) and/or the law's coefficients (``S`` zero there); with
-    ``controlled`` their error is held to the state's tolerances."""
+    ``controlled`` their error is held to the state's tolerances; ``start`` (4, m) replaces
+    the start's derivatives."""
     if law.permanent_set > 0:
         raise InputError(
             "sensitivities are not available for a law with a permanent set (its unloading "
@@ -179,6 +194,14 @@ def sensitivity_setup(scenario, law, which, n_eval=0, n_events=0, controlled=Tru
     S = np.zeros((4, m))
     if which in ("state", "all"):
         S[:, :4] = np.eye(4)
+    if start is not None:
+        S0 = np.asarray(start, dtype=float)
+        if S0.shape != S.shape or not np.all(np.isfinite(S0)):
+            raise InputError(
+                f"sensitivity_start must be finite, of shape {S.shape} (4 states by the "
+                f"columns {', '.join(names)}); got shape {S0.shape}"
+            )
+        S[:] = S0
     out_dF = np.empty((m, n_eval))
     ev_tau = np.full((n_events, m), np.nan)
     sscale = np.array(sscale) if controlled else np.empty(0)
@@ -201,6 +224,7 @@ def _atol(scenario, tol):
     zeta_max0=Real(0),
     sensitivities=(None, Choice(*SENSITIVITIES)),
     control_sensitivities=bool,
+    sensitivity_start=(None, Array(2)),
 )
 def simulate(
     scenario,
@@ -216,6 +240,7 @@ def simulate(
     zeta_max0=0.0,
     sensitivities=None,
     control_sensitivities=True,
+    sensitivity_start=None,
 ):
     """Integrate the two-body vibro-impact system with a given contact law.
 
@@ -244,17 +269,16 @@ def simulate(
         Raise :class:`IntegrationError` on failure (default) or return a
         trajectory whose ``status``/``message`` say what happened.
     sensitivities : {"state", "coefficients", "all"}, optional
-        Also integrate the variational equations (with the saltation matrix at every
-        event) and return the derivatives of the final state and of the force at ``t``
-        along the start's states, the law's coefficients, or both: one run instead of
-        one per direction of finite differences.  Their error is controlled with the
-        state's, so the run takes its own steps (the trajectory agrees with a plain run
-        to the tolerances).  Not for a law with a permanent set.
-    control_sensitivities : bool
-        With ``False`` the sensitivities' error is not controlled: the run takes the
-        state's steps (its motion is bitwise a plain run's) and costs less, and the
-        sensitivities are as accurate as those steps allow (measured within 1e-3 of
-        central differences near a Hertz law's onset, 1e-7 for integer powers).
+        Also integrate the variational equations (the saltation matrix at every event):
+        the derivatives of the final state, of the force at ``t`` and of the event times
+        along the start's states, the law's coefficients or both, from one run (not for a
+        law with a permanent set).  ``control_sensitivities`` (default) holds their error
+        to the state's tolerances (the run takes its own steps); ``False`` keeps the
+        state's steps (the motion is bitwise a plain run's; measured within 1e-3 of
+        central differences near a Hertz onset, 1e-7 for integer powers).
+        ``sensitivity_start`` (4, m) replaces the start's derivatives (default: identity
+        for the states, zero for the coefficients), e.g. a periodic orbit's
+        (:mod:`~discovery.vibroimpact.dynamics.orbit_sensitivity`).
 
     Returns
     -------
@@ -268,14 +292,8 @@ def simulate(
     te = np.zeros(0) if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
     if te.size and (np.any(np.diff(te) < 0) or te[0] < t0 - 1e-12 or te[-1] > t1 + 1e-12):
         raise InputError("t_eval must be sorted and inside t_span")
-    coef, ea, eb, br = law.kernel_arrays()
-    out_y = np.empty((4, te.size))
-    out_f = np.empty(te.size)
-    out_m = np.empty(te.size, dtype=np.int64)
-    ev_t = np.empty(max_events)
-    ev_k = np.empty(max_events, dtype=np.int64)
-    ev_y = np.empty((max_events, 4))
-    ev_m = np.empty((max_events, 2), dtype=np.int64)
+    bufs = _buffers(te.size, max_events)
+    out_y, out_f, out_m, ev_t, ev_k, ev_y, ev_m = bufs
     period = scenario.period
     p = kernel_params(scenario, law)
     p[K.P_ZMAX] = float(zeta_max0)
@@ -283,7 +301,13 @@ def simulate(
         sens, names = no_sensitivities(), ()
     else:
         sens, names = sensitivity_setup(
-            scenario, law, sensitivities, te.size, max_events, control_sensitivities
+            scenario,
+            law,
+            sensitivities,
+            te.size,
+            max_events,
+            control_sensitivities,
+            sensitivity_start,
         )
     announce_compile("vibro-impact")
     status, tf, yf, mf, n_steps, n_ev, _ = K.integrate(
@@ -292,23 +316,14 @@ def simulate(
         y0,
         -1 if mode0 is None else int(mode0),
         p,
-        coef,
-        ea,
-        eb,
-        br,
+        *law.kernel_arrays(),
         tol.rtol,
         _atol(scenario, tol),
         period / 100.0,
         period * tol.hmax_fraction,
         tol.max_steps,
         te,
-        out_y,
-        out_f,
-        out_m,
-        ev_t,
-        ev_k,
-        ev_y,
-        ev_m,
+        *bufs,
         *sens,
     )
     message = (

@@ -390,10 +390,12 @@ class _Objective:
             for e in model._free():
                 t = Term.parse(e.key) if e.target == "unloading" else None
                 cols.append(n + law.unloading.index(t) if t in law.unloading else None)
-        ok = (
-            (observe is None or getattr(observe, "linear", False))
-            and law.permanent_set == 0
-            and all(getattr(ref, "span", None) is not None for _, ref in self.records)
+        # a record compared over its span takes an observation linear in the force; one
+        # compared with its steady orbit (a force-only record) takes none
+        linear = observe is None or getattr(observe, "linear", False)
+        ok = law.permanent_set == 0 and all(
+            linear if getattr(ref, "span", None) is not None else observe is None
+            for _, ref in self.records
         )
         return cols, ok
 
@@ -432,22 +434,45 @@ class _Objective:
         if self.n + len(self.records) > self.max_sim:
             raise _Budget
         row = 0
-        for (sc, ref), ws in zip(self.records, self.w, strict=True):
+        evs = self.evaluations(x)
+        for (sc, ref), ws, ev in zip(self.records, self.w, evs, strict=True):
             self.n += 1
             tick(self.progress, "identify: simulations", self.n, self.max_sim)
-            dH = history_sensitivities(
-                machine(sc), law, ref.span, tolerances=self.tol, observe=observe
-            )
-            for blk, d, w in zip(ref.span.blocks, dH, ws, strict=True):
-                fold = blk.fold
+            if getattr(ref, "span", None) is not None:
+                dH = history_sensitivities(
+                    machine(sc), law, ref.span, tolerances=self.tol, observe=observe
+                )
+                dS = []
+                for blk, d in zip(ref.span.blocks, dH, strict=True):
+                    dm = np.array([blk.fold.average(r) for r in d]).reshape(len(d), -1)
+                    dS.append(np.concatenate([dm[:, :1], dm, dm[:, -1:]], axis=1))
+            else:
+                dS = [_aligned_sensitivity(machine(sc), law, ref, ev, self.tol)]
+            for d, w in zip(dS, ws, strict=True):
                 for i, c in enumerate(cols):
-                    if c is None:
-                        continue
-                    dm = fold.average(d[c])
-                    dS = np.concatenate([[dm[0]], dm, [dm[-1]]])
-                    J[row : row + w.size - 1, i] = (dS * w)[1:] * self.c0[i]
+                    if c is not None:
+                        J[row : row + w.size - 1, i] = (d[c] * w)[1:] * self.c0[i]
                 row += w.size - 1
         return exact
+
+
+def _aligned_sensitivity(scenario, law, ref, ev, tolerances):
+    """The derivatives along the law's coefficients of a steady orbit's force sampled like
+    the measured cycle, seen from the onset the alignment chose (which moves with the
+    coefficients): :meth:`~discovery.vibroimpact.dynamics.orbit_sensitivity.
+    OrbitSensitivity.from_onset` at the measured sample times, shape (m, samples)."""
+    from ..dynamics import _kernel as K
+    from ..dynamics.orbit_sensitivity import orbit_sensitivity
+
+    os_ = orbit_sensitivity(scenario, law, ev.steady, impacts=False, tolerances=tolerances)
+    W = scenario.period * ev.steady.n_periods
+    on = np.flatnonzero(os_.event_kind == K.EV_ONSET)
+    if not on.size:
+        raise IntegrationError("the orbit has no contact onset")
+    # the onset the alignment put at t* = 0 (the rotated impulse's own onset, on the orbit)
+    gap = np.abs(np.mod(os_.event_t[on] - ev.extra["aligned"].onset + 0.5 * W, W) - 0.5 * W)
+    _, dF = os_.from_onset(on[int(np.argmin(gap))], ref.impulse.t)
+    return dF
 
 
 def _coordinate_descent(obj, x0, xtol, step0=0.1):
