@@ -18,7 +18,10 @@ Writes ``bench/results.json``.  Figures:
    and ``discover(..., library="poly:2" / "poly:3", refine=True)`` on a run-up record,
    as ratios to one steady state measured in the same run;
 6. ``explain`` on a 20-period record with the full catalogue (``bench/explain_bench.py``);
-7. Ueda's oscillator (``bench/ueda_bench.py``): one chart point against scipy, a chart's
+7. exact sensitivities against the finite differences they replace, same run
+   (``bench/sensitivity_bench.py``): a steady state, identify on a force-only record and
+   on a record compared over its span, a run with sensitivities over a plain one;
+8. Ueda's oscillator (``bench/ueda_bench.py``): one chart point against scipy, a chart's
    wall time (and the 200x200 extrapolation), the duffing exponent per period against scipy.
 """
 
@@ -261,6 +264,7 @@ def bench_identify(sc):
 def main():
     from discovery_bench import bench_discovery, bench_pipeline
     from explain_bench import bench_explain
+    from sensitivity_bench import bench_sensitivities
     from ueda_bench import bench_ueda
 
     sc = load_scenario("paper")
@@ -271,6 +275,7 @@ def main():
         "kernel_vs_scipy": bench_kernel(sc),
         "landscape_41x41": bench_landscape(sc),
         "identification": bench_identify(sc),
+        "sensitivities": bench_sensitivities(),
         "study": bench_study(),
         "discovery": bench_discovery(),
         "pipeline": bench_pipeline(),
@@ -321,6 +326,19 @@ def main():
             f"identify {m}: {idf[m]['simulations_to_0.1%']} simulations to 0.1 % "
             f"({idf[m]['fewer_than_coordinate_descent']} x fewer than coordinate descent)"
         )
+    se = results["sensitivities"]
+    print(
+        "exact sensitivities over finite differences: steady state {:.2f}x ({} vs {} runs), "
+        "identify force-only {:.2f}x, over the span {:.2f}x; a run with 3 coefficients' "
+        "sensitivities {:.1f}x a plain run".format(
+            se["steady_state"]["speedup"],
+            se["steady_state"]["exact_runs"],
+            se["steady_state"]["differences_runs"],
+            se["identify_force_only"]["speedup"],
+            se["identify_span"]["speedup"],
+            se["run_with_3_coefficient_sensitivities_over_plain"],
+        )
+    )
     d = results["discovery"]
     ours, ps_ = d["ours_max_terms_4"], d["pysindy_constrained_sr3_grid30"]
     print(

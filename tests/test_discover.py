@@ -288,6 +288,21 @@ def test_stability_disagreement_is_a_warning(noisy_positions):
     )
 
 
+def test_stability_warning_names_the_terms_it_disagrees_on():
+    """The warning's rule on its own: a stable term left out and a selected term that is
+    rarely chosen are both named; an agreeing support gives none."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.fit.discover import _stability_warning
+
+    sel = SimpleNamespace(law=ForceLaw.parse("1*z + 1*z*zd"))
+    w = _stability_warning({"z": 1.0, "zd": 0.9, "z*zd": 0.2}, sel)
+    assert "stability selection disagrees" in w
+    assert "not selected: zd (0.90)" in w and "< 50 % of resamples: z*zd (0.20)" in w
+    assert _stability_warning({"z": 1.0, "z*zd": 0.7, "zd": 0.1}, sel) is None
+    assert _stability_warning({}, sel) is None
+
+
 def test_contact_samples_do_not_split_impacts_at_noise_dips(paper):
     """Position noise of 5 % of the penetration: zeta dips below its threshold near onset
     and loss; one impact per period is still one impact."""

@@ -18,12 +18,14 @@ well-scaled problem.  Methods:
     record, weighted so that each record's squared norm is its ``I3^2`` (a smooth
     surrogate, Gauss–Newton fast); the chosen criterion is reported.
 
-The simulation budget counts every simulation, the finite-difference Jacobians
-included.  A simulation that fails or has no periodic orbit with contact is recorded
-in ``failures`` (the optimiser sees a penalty); a start law that fails is an error.
+The simulation budget counts every simulation, the Jacobians' included (one run per record
+with the variational equations for the law's coefficients: :meth:`_Objective.jacobian`;
+forward differences for other parameters).  A simulation that fails or has no periodic
+orbit with contact is recorded in ``failures`` (the optimiser sees a penalty); a start law
+that fails is an error.
 
 Coefficient uncertainty: the Jacobian ``J`` of the weighted residuals at the optimum
-(forward differences, one simulation per coefficient and record) gives the
+(as the least squares' own, exact where it can be) gives the
 covariance ``s^2 (J^T J)^-1`` with ``s^2 = RSS / (m - p)`` (as lmfit scales it: the
 residual variance estimated from the fit), hence a standard error per coefficient.
 """
