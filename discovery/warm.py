@@ -43,7 +43,7 @@ def main():
     todo = [k for k in KERNELS if not cached(k)]
     if todo:
         print(
-            f"compiling the simulators once ({', '.join(todo)}; under a minute on two cores) ...",
+            f"compiling the simulators once ({', '.join(todo)}; about a minute on two cores) ...",
             flush=True,
         )
     seconds = warm()

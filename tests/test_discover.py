@@ -243,8 +243,8 @@ def noisy_positions(paper):
 @pytest.mark.xfail(
     reason="records judged over their span: with 1 % position noise and no "
     "velocities the biased regression starts the z + zd refinement outside the "
-    "basin (it ends at 3.9e7*z, I2 1.39; the true law is consistent at 0.023), "
-    "and z + z*zd + zd^2 is selected (README, limits)",
+    "basin (the true law is consistent at 0.023); no consistent model is found and "
+    "the selected z + zd + z*zd + zd^2 is no contact law (README, limits)",
     strict=False,
 )
 def test_backward_steps_reach_the_simplest_consistent_law(noisy_positions):
@@ -262,8 +262,8 @@ def test_backward_steps_reach_the_simplest_consistent_law(noisy_positions):
 @pytest.mark.xfail(
     reason="records judged over their span: with 1 % position noise and no "
     "velocities the biased regression starts the z + zd refinement outside the "
-    "basin (it ends at 3.9e7*z, I2 1.39; the true law is consistent at 0.023), "
-    "and z + z*zd + zd^2 is selected (README, limits)",
+    "basin (the true law is consistent at 0.023); no consistent model is found and "
+    "the selected z + zd + z*zd + zd^2 is no contact law (README, limits)",
     strict=False,
 )
 def test_equivalent_models_say_why_and_what_would_separate_them(noisy_positions):
@@ -279,6 +279,14 @@ def test_equivalent_models_say_why_and_what_would_separate_them(noisy_positions)
 
 
 @pytest.mark.slow  # the fixture's discovery takes 6 min
+@pytest.mark.xfail(
+    reason="with exact output-error Jacobians the refinements from this biased regression "
+    "reach no consistent model: the selected z + zd + z*zd + zd^2 (no contact law, I2 1.55) "
+    "holds every stable term, so stability selection has nothing to disagree with (with "
+    "forward differences z + z*zd + zd^2 was consistent and zd the disagreement); the "
+    "warning's rule is tested on its own (README, limits)",
+    strict=False,
+)
 def test_stability_disagreement_is_a_warning(noisy_positions):
     res = noisy_positions
     strong = [t for t, f in res.stability.items() if f >= 0.5 and t not in res.selected.law.names]

@@ -242,6 +242,13 @@ def _rhs(t, y, mode, p, coef, ea, eb, br, out):
 
 
 @njit(cache=True)
+def _rhs_at(t, y, mode, p, coef, ea, eb, br, out):
+    """:func:`_rhs` as a call (for the once-per-event saltation: inlined there it would be
+    typed again at each site, which costs compile time, not run time)."""
+    _rhs(t, y, mode, p, coef, ea, eb, br, out)
+
+
+@njit(cache=True)
 def _switching(mode, y, p, coef, ea, eb, br, h):
     """Fill ``h`` with the mode's switching functions; return how many."""
     z = y[0] - y[2]
@@ -412,7 +419,7 @@ def _event_time_sens(t, y, mode, index, p, coef, ea, eb, br, S, spar, dc, fminus
     """Before an event: the vector field ``fminus`` of the mode left, and ``tau[j]``, the
     derivative of the event time along column ``j``: ``-(grad h . S_j + dh/dq_j) /
     (grad h . f-)`` for the switching function ``index`` that fired."""
-    _rhs(t, y, mode, p, coef, ea, eb, br, fminus)
+    _rhs_at(t, y, mode, p, coef, ea, eb, br, fminus)
     z = y[0] - y[2]
     v = y[1] - y[3]
     cs = 0.0
@@ -448,7 +455,7 @@ def _store_tau(tau, n_ev, ev_tau):
 @njit(cache=True)
 def _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus):
     """After an event into ``mode``: ``S_j += (f- - f+) tau_j``."""
-    _rhs(t, y, mode, p, coef, ea, eb, br, fplus)
+    _rhs_at(t, y, mode, p, coef, ea, eb, br, fplus)
     for j in range(S.shape[1]):
         for r in range(4):
             S[r, j] += (fminus[r] - fplus[r]) * tau[j]
