@@ -2,16 +2,17 @@
 
 The compiled kernels (the vibro-impact integrator with its event location, and Ueda's
 oscillator) are cached by numba beside their sources (``__pycache__``).  Without a cache
-the first simulation compiles them (about 40 s on two cores, most of it the vibro-impact
-integrator with its event location); ``make install`` runs this module once so that the
-first command after it starts in a second, and `discovery._compile.announce_compile` says
-so in one line when a command has to compile anyway.
+the first simulation compiles them (about a minute on two cores, most of it the
+vibro-impact integrator with its event location and sensitivities); ``make install`` runs
+this module once so that the first command after it starts in a second, and
+`discovery._compile.announce_compile` says so in one line when a command has to compile
+anyway.
 """
 
 import sys
 import time
 
-from ._compile import KERNELS, cached
+from ._compile import _ANNOUNCED, KERNELS, cached
 
 __all__ = ["warm", "main"]
 
@@ -46,6 +47,8 @@ def main():
             f"compiling the simulators once ({', '.join(todo)}; about a minute on two cores) ...",
             flush=True,
         )
+    # said here once: the runs below need not announce their compile again
+    _ANNOUNCED.update(KERNELS)
     seconds = warm()
     print(
         "simulators ready ("

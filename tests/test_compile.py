@@ -68,3 +68,17 @@ def test_a_steady_state_announces_the_compile_before_its_first_period(
     assert (
         err.startswith("vidi: compiling the vibro-impact simulator once") and err.count("\n") == 1
     )
+
+
+def test_warm_announces_the_compile_once(tmp_path, monkeypatch, capsys):
+    """`make install`'s compile says so in one line, not once more per kernel call."""
+    import discovery.warm as W
+
+    monkeypatch.setattr(C, "_ANNOUNCED", set())
+    monkeypatch.setattr(W, "_ANNOUNCED", C._ANNOUNCED)
+    monkeypatch.setattr(W, "cached", lambda kernel: False)  # as with an empty cache
+    monkeypatch.setattr(W, "warm", lambda: {k: 0.0 for k in C.KERNELS})
+    assert W.main() == 0
+    C.announce_compile("vibro-impact")  # what the first run would print
+    out, err = capsys.readouterr()
+    assert out.count("compiling the simulators once") == 1 and "vidi: compiling" not in err
