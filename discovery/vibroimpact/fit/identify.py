@@ -611,19 +611,22 @@ def _short_first(
 
 
 def _x_bounds(model):
-    """Bounds of the least-squares variables ``x = c / c_start``: none for a law's
-    coefficients; an added effect's physical bounds for its parameter (a time constant, a
-    set, a stiffness is not negative), so the trust region does not step beyond a bound the
-    model would clip to (where the clipped parameter no longer moves the residual and the
-    fit stalls there)."""
+    """Bounds of the least-squares variables ``x = c / c_start``: an observation model's
+    parameter (a sensor's time constant) within its physical bounds, so the trust region
+    does not step beyond a bound the model would clip to: a lag refit from a stiff start
+    stepped to ``tau < 0``, was clipped to 0 (no filter) and stalled there.  Everything else
+    is unbounded, as before: bounded, scipy's trust region scales every variable by its
+    distance to a bound, and the demo's unloading-damping fit then stopped 1.5 standard
+    errors from the truth (the model clips those parameters as before)."""
     c0 = np.asarray(model.coefficients, dtype=float)
     lo, hi = np.full(c0.size, -np.inf), np.full(c0.size, np.inf)
     if isinstance(model, ForceLaw):
         return lo, hi
     n = len(model.law.coefficients)
     for i, e in enumerate(model._free(), start=n):
-        a, b = (v / c0[i] for v in e.parameters[0].bounds)
-        lo[i], hi[i] = min(a, b), max(a, b)
+        if e.target == "observation":
+            a, b = (v / c0[i] for v in e.parameters[0].bounds)
+            lo[i], hi[i] = min(a, b), max(a, b)
     return lo, hi
 
 
