@@ -328,15 +328,23 @@ def _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew):
 # saltation matrix at every located event.
 
 
+@njit(cache=True, inline="always")
+def _dforce(fz, fv, S, j, spar, dc):
+    """The force's derivative along column ``j`` (the state's move ``S[:, j]``, and the
+    coefficient ``spar[j]`` when it is one)."""
+    df = fz * (S[0, j] - S[2, j]) + fv * (S[1, j] - S[3, j])
+    if spar[j] >= 0:
+        df += dc[spar[j]]
+    return df
+
+
 @njit(cache=True)
 def _rhs_sens(y, mode, p, coef, ea, eb, br, S, spar, dc, out):
     """``out[:, j] = (df/dy) S[:, j] + df/dq_j`` at ``y`` in ``mode``."""
     fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
     ky = p[2] + 3.0 * p[P_K3] * y[0] * y[0]
     for j in range(S.shape[1]):
-        df = fz * (S[0, j] - S[2, j]) + fv * (S[1, j] - S[3, j])
-        if spar[j] >= 0:
-            df += dc[spar[j]]
+        df = _dforce(fz, fv, S, j, spar, dc)
         out[0, j] = S[1, j]
         out[1, j] = -(p[3] * S[1, j] + ky * S[0, j] + df) / p[0]
         out[2, j] = S[3, j]
@@ -408,10 +416,7 @@ def _force_sens(mode, y, S, spar, coef, ea, eb, br, dc, out, k):
     """``out[j, k] = dF/dq_j`` of the force at ``y`` (sensitivities ``S``) in ``mode``."""
     fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
     for j in range(S.shape[1]):
-        df = fz * (S[0, j] - S[2, j]) + fv * (S[1, j] - S[3, j])
-        if spar[j] >= 0:
-            df += dc[spar[j]]
-        out[j, k] = df
+        out[j, k] = _dforce(fz, fv, S, j, spar, dc)
 
 
 @njit(cache=True)
@@ -445,20 +450,15 @@ def _event_time_sens(t, y, mode, index, p, coef, ea, eb, br, S, spar, dc, fminus
 
 
 @njit(cache=True)
-def _store_tau(tau, n_ev, ev_tau):
-    """Keep an event's time derivatives (if there is room)."""
-    if n_ev < ev_tau.shape[0]:
-        for j in range(tau.shape[0]):
-            ev_tau[n_ev, j] = tau[j]
-
-
-@njit(cache=True)
-def _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus):
-    """After an event into ``mode``: ``S_j += (f- - f+) tau_j``."""
+def _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau):
+    """After an event into ``mode``: ``S_j += (f- - f+) tau_j``, and the event's time
+    derivatives kept in ``ev_tau`` (if there is room)."""
     _rhs_at(t, y, mode, p, coef, ea, eb, br, fplus)
     for j in range(S.shape[1]):
         for r in range(4):
             S[r, j] += (fminus[r] - fplus[r]) * tau[j]
+        if n_ev < ev_tau.shape[0]:
+            ev_tau[n_ev, j] = tau[j]
 
 
 @njit(cache=True)
@@ -794,8 +794,7 @@ def integrate(
                     t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
                 )
                 if m_s:
-                    _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus)
-                    _store_tau(tau, n_ev, ev_tau)
+                    _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau)
                 n_ev += 1
                 need_f = True
                 need_h0 = True
@@ -857,8 +856,7 @@ def integrate(
                 t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
             )
             if m_s:
-                _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus)
-                _store_tau(tau, n_ev, ev_tau)
+                _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau)
             n_ev += 1
             need_f = True
             need_h0 = True

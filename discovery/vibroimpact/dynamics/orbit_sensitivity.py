@@ -129,13 +129,14 @@ def _force_rate(scenario, law, t, y, mode):
     m1, m2, k1, c1, A, om, g = scenario.params()[:7]
     k3 = scenario.k3
     dc = np.empty(coef.size)
+    p = np.zeros(K.N_PARAMS)  # no permanent set: no contact state
     out = np.zeros(t.size)
     for i in range(t.size):
         w1, v1, w2, v2 = y[:, i]
         z, v = w1 - w2, v1 - v2
         if mode[i] not in (K.LOAD, K.UNLOAD):
             continue
-        F = K.mode_force(mode[i], z, v, np.zeros(K.N_PARAMS), coef, ea, eb, br)
+        F = K.mode_force(mode[i], z, v, p, coef, ea, eb, br)
         fz, fv = K.force_partials(mode[i], z, v, coef, ea, eb, br, dc)
         a1 = -(c1 * v1 + k1 * w1 + k3 * w1**3 + A * np.sin(om * t[i]) + m1 * g + F) / m1
         a2 = F / m2 - g

@@ -307,6 +307,8 @@ class _Objective:
         # residual weights: trapezoid-like sample spacing, normalised so that the sum
         # of squared residuals of a record is its I3^2
         self.w = [_residual_weights(ref) for _, ref in records]
+        # which residual columns the variational equations give (fixed by the start)
+        self.exact_columns = self._exact_columns()
 
     def law(self, x):
         return self.start.with_coefficients(self.c0 * np.asarray(x))
@@ -408,7 +410,7 @@ class _Objective:
         2-point step); all by differences when no column can be exact."""
         x = np.asarray(x, dtype=float)
         r0 = self.residuals(x)
-        cols, ok = self._exact_columns()
+        cols, ok = self.exact_columns
         J = np.empty((r0.size, x.size))
         exact = np.zeros(x.size, dtype=bool)
         if ok and self.evaluations(x) is not None:
@@ -512,7 +514,7 @@ def _uncertainty(obj, x, names):
     """Standard errors and correlations from the residual Jacobian at ``x`` (exact where
     :meth:`_Objective.jacobian` can be, else forward differences)."""
     r0 = obj.residuals(x)
-    if obj._exact_columns()[1]:
+    if obj.exact_columns[1]:
         J = obj.jacobian(x)
     else:
         J = np.empty((r0.size, x.size))
@@ -655,7 +657,7 @@ def _optimise(obj, x0, method, xtol, max_simulations):
         res = least_squares(
             obj.residuals,
             x0,
-            jac=obj.jacobian if obj._exact_columns()[1] else "2-point",
+            jac=obj.jacobian if obj.exact_columns[1] else "2-point",
             bounds=_x_bounds(obj.start),
             method="trf",
             x_scale=1.0,

@@ -203,19 +203,25 @@ verification, reuse them.  The key holds the block's identity, so the entry keep
 block alive (its id is not reused while cached)."""
 
 
+def _simulate_block(scenario, law, blk, y0, tolerances, **kwargs):
+    """The law simulated over a block from ``y0`` (default the block's measured state),
+    sampled at its sample times."""
+    fold, st = blk.fold, blk.state
+    return simulate(
+        scenario,
+        law,
+        (min(st.t, fold.td[0]), fold.end),
+        y0=st.y if y0 is None else y0,
+        t_eval=fold.td,
+        tolerances=tolerances,
+        **kwargs,
+    )
+
+
 def _block_run(scenario, law, blk, y0, tolerances):
     """The law's force at a block's sample times, simulated from ``y0`` (default the
     block's measured state), and the contact onsets of that run."""
-    fold, st = blk.fold, blk.state
-    td = fold.td
-    tr = simulate(
-        scenario,
-        law,
-        (min(st.t, td[0]), fold.end),
-        y0=st.y if y0 is None else y0,
-        t_eval=td,
-        tolerances=tolerances,
-    )
+    tr = _simulate_block(scenario, law, blk, y0, tolerances)
     zmax = float(np.max(tr.y[0] - tr.y[2]))
     if zmax > SINK_FACTOR * scenario.scales()[0]:
         raise IntegrationError(
@@ -243,14 +249,12 @@ def _onset_weights(td, onsets):
 def _sensitivity_run(scenario, law, blk, tolerances):
     """A block's run from its measured state with the coefficients' sensitivities (the
     state's steps: the force is the plain run's): ``(F, dF, onsets, d_onsets)``."""
-    fold, st = blk.fold, blk.state
-    tr = simulate(
+    tr = _simulate_block(
         scenario,
         law,
-        (min(st.t, fold.td[0]), fold.end),
-        y0=st.y,
-        t_eval=fold.td,
-        tolerances=tolerances,
+        blk,
+        None,
+        tolerances,
         sensitivities="coefficients",
         control_sensitivities=False,
     )
