@@ -2,7 +2,7 @@
 
 The compiled kernels (the vibro-impact integrator with its event location, and Ueda's
 oscillator) are cached by numba beside their sources (``__pycache__``).  Without a cache
-the first simulation compiles them (about a minute on two cores, most of it the
+the first simulation compiles them (about half a minute on two cores, most of it the
 vibro-impact integrator with its event location and sensitivities); ``make install`` runs
 this module once so that the first command after it starts in a second, and
 `discovery._compile.announce_compile` says so in one line when a command has to compile
@@ -44,7 +44,7 @@ def main():
     todo = [k for k in KERNELS if not cached(k)]
     if todo:
         print(
-            f"compiling the simulators once ({', '.join(todo)}; about a minute on two cores) ...",
+            f"compiling the simulators once ({', '.join(todo)}; half a minute on two cores) ...",
             flush=True,
         )
     # said here once: the runs below need not announce their compile again

@@ -122,6 +122,13 @@ def load_force(z, v, p, coef, ea, eb, br):
     velocity terms) back up to ``z_max`` (Walton-Braun), continuous there."""
     if p[P_SET] == 0.0 or z >= p[P_ZMAX]:
         return poly(z, v, coef, ea, eb, br)
+    return _reload_set(z, v, p, coef, ea, eb, br)
+
+
+@njit(cache=True)
+def _reload_set(z, v, p, coef, ea, eb, br):
+    """The loading branch below ``z_max`` with a permanent set: a call, not inlined (the
+    rare branch, typed once instead of at each of the step's seven stages)."""
     return (
         poly(z, v, coef, ea, eb, br)
         - poly(z, 0.0, coef, ea, eb, br)
