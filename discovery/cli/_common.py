@@ -178,6 +178,18 @@ SCHEDULER_HELP = (
 )
 
 
+def add_interval_refit_option(parser):
+    """``--interval-refit``: how each bootstrap replicate of the intervals is refitted."""
+    parser.add_argument(
+        "--interval-refit",
+        choices=("two-step", "full"),  # identify.INTERVAL_REFITS (not imported: --help stays fast)
+        default="two-step",
+        help="how each bootstrap replicate is refitted: two Gauss-Newton steps from the fit "
+        "with exact Jacobians, or a full least-squares refit (about 3x the time) "
+        "(default: %(default)s)",
+    )
+
+
 def add_workers_option(parser, what):
     """``--workers N``: processes for ``what`` (default: every core; the result does not
     depend on it)."""

@@ -7,6 +7,7 @@ from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
     SCENARIO_HELP,
     SCHEDULER_HELP,
+    add_interval_refit_option,
     add_record_options,
     add_workers_option,
     check_out,
@@ -50,6 +51,7 @@ def run(args):
             effects=effects,
             workers=args.workers,
             n_boot_intervals=args.intervals,
+            interval_refit=args.interval_refit,
             progress=rep,
             executor=ex,
         )
@@ -182,6 +184,7 @@ def register(sub):
         default=0,
         help="seed of the noise-floor bootstrap (default: %(default)s)",
     )
+    add_interval_refit_option(s)
     add_workers_option(s, "the screening refits and the bootstrap intervals' refits")
     s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
     s.add_argument("--out", required=True, help="output directory")

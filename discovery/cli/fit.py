@@ -10,6 +10,7 @@ from .._io import OutputDir, provenance, to_jsonable
 from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
     SCENARIO_HELP,
+    add_interval_refit_option,
     add_record_options,
     add_workers_option,
     check_out,
@@ -48,6 +49,7 @@ def _discover(args, scs, meas, progress):
         physics=not args.allow_unphysical,
         require=args.require or (),
         n_boot_intervals=args.intervals,
+        interval_refit=args.interval_refit,
         workers=args.workers,
         progress=progress,
         **({"signs": args.signs} if args.signs else {}),
@@ -273,6 +275,7 @@ def _add_check_options(p):
         help="bootstrap replicates of the selected law's 95 %% coefficient intervals "
         "through the full processing (0 = none) (default: %(default)s)",
     )
+    add_interval_refit_option(p)
     add_workers_option(p, "the bootstrap intervals' refits")
     p.add_argument(
         "--allow-unphysical",

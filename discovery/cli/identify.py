@@ -14,6 +14,7 @@ from ..vibroimpact.model.scenario import load_scenario
 from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
     SCENARIO_HELP,
+    add_interval_refit_option,
     add_record_options,
     add_workers_option,
     check_out,
@@ -215,6 +216,7 @@ def run(args):
             max_simulations=args.max_simulations,
             xtol=args.xtol,
             n_boot_intervals=args.intervals,
+            interval_refit=args.interval_refit,
             seed=args.seed,
             workers=args.workers,
             progress=rep,
@@ -285,6 +287,7 @@ def register(sub):
         help="bootstrap replicates of the 95 %% coefficient intervals through the "
         "full processing (records with positions; 0 = none) (default: %(default)s)",
     )
+    add_interval_refit_option(s)
     add_workers_option(s, "the bootstrap intervals' refits")
     s.add_argument(
         "--seed",
