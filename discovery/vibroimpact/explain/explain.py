@@ -1389,6 +1389,10 @@ def _check_settings(max_simulations, budget, alpha, workers, max_iterations):
     return max_simulations
 
 
+# the progress stage of explain's iterations
+_ITERATIONS = "explain: iterations (localise, score, refit)"
+
+
 def _intervals(run, n_boot_intervals, seed, progress, refit="two-step"):
     """Bootstrap intervals of the final model's parameters (``None`` when not asked for or
     when a replicate cannot be simulated)."""
@@ -1484,13 +1488,9 @@ def explain(
     executor : Executor, optional
         Where the screening refits run (:mod:`discovery.numerics.executor`); overrides ``workers``
         and is not closed here.
-    n_boot_intervals : int
-        Bootstrap replicates of the final model's 95 % parameter intervals through the full
-        processing (:func:`discovery.vibroimpact.fit.intervals.bootstrap_intervals`; 0 = none).
-    interval_refit : str
-        How each bootstrap replicate is refitted: ``"two-step"`` (default, two Gauss-Newton
-        steps from the fitted model with exact Jacobians) or ``"full"`` (a least-squares
-        refit; about three times the time, standard deviations within 10 %).
+    n_boot_intervals, interval_refit : int, str
+        Bootstrap replicates of the final model's 95 % parameter intervals (0 = none) and how
+        each is refitted (:func:`discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
     progress : callable, optional
         ``progress(stage, done, total)`` at each stage and iteration (:mod:`discovery._progress`).
     budget : int, optional
@@ -1542,12 +1542,7 @@ def explain(
         stopped=f"the budget of {max_iterations} added effect(s) is used",
     )
     for _ in range(max_iterations + 1):
-        tick(
-            progress,
-            "explain: iterations (localise, score, refit)",
-            len(run.iterations),
-            max_iterations,
-        )
+        tick(progress, _ITERATIONS, len(run.iterations), max_iterations)
         if not _iteration(run, max_iterations):
             break
     evs = problem.evaluations(run.model, floor=True)
@@ -1576,8 +1571,7 @@ def explain(
             "effects": [e.id for e in catalogue],
             "max_refits": max_refits,
             "workers": workers,
-            "n_boot_intervals": n_boot_intervals,
-            "interval_refit": interval_refit,
+            "intervals": {"replicates": n_boot_intervals, "refit": interval_refit},
             "records": len(records),
             "simulations": problem.n_sim,
         },

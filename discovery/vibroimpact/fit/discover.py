@@ -971,20 +971,10 @@ class _Stepwise:
         return ranking, steps
 
 
-def _with_intervals(
-    ranking,
-    refs,
-    refine,
-    n_boot_intervals,
-    seed,
-    criterion,
-    tolerances,
-    progress,
-    workers=1,
-    refit="two-step",
-):
+def _with_intervals(ranking, refs, refine, boot, criterion, tolerances, progress):
     """The selected (best ranked) model, with bootstrap intervals when asked for and it was
-    refined, and the ranking holding it."""
+    refined, and the ranking holding it; ``boot``: ``(replicates, seed, workers, refit)``."""
+    n_boot_intervals, seed, workers, refit = boot
     selected = ranking[0]
     if not (
         n_boot_intervals
@@ -1133,9 +1123,8 @@ def discover(
         with positions, refined models; 0 = none).  The Jacobian standard errors assume white
         residuals and miss the noise of the estimated machine states.
     interval_refit : str
-        How each bootstrap replicate is refitted: ``"two-step"`` (default, two Gauss-Newton
-        steps from the fitted model with exact Jacobians) or ``"full"`` (a least-squares
-        refit; about three times the time, standard deviations within 10 %).
+        How a bootstrap replicate is refitted (``"two-step"`` or ``"full"``: see
+        :func:`discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
     workers : int or None
         Processes for the bootstrap's refits (default 1; ``None``: every core); the
         intervals do not depend on it.
@@ -1171,17 +1160,9 @@ def discover(
     by_score = list(models)  # the estimator's order (its scoring)
     search = _Stepwise(check, criterion, sim_rtol, sim_atol, physics, stepwise, max_terms)
     ranking, steps = search.run(models, refs, refine, progress)
+    boot = (n_boot_intervals, seed, workers, interval_refit)
     selected, ranking = _with_intervals(
-        ranking,
-        refs,
-        refine,
-        n_boot_intervals,
-        seed,
-        criterion,
-        tolerances,
-        progress,
-        workers,
-        interval_refit,
+        ranking, refs, refine, boot, criterion, tolerances, progress
     )
     # the certificate of the law actually selected (the ranking may prefer another
     # candidate than the estimator's best by BIC); a failure is an error

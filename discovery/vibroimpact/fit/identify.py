@@ -755,9 +755,7 @@ def identify(
         Processes for the bootstrap's refits (default 1; ``None``: every core; the
         intervals do not depend on it).
     interval_refit : str
-        How each bootstrap replicate is refitted: ``"two-step"`` (default, two Gauss-Newton
-        steps from the fitted model with exact Jacobians) or ``"full"`` (a least-squares
-        refit; about three times the time, standard deviations within 10 %).
+        How a bootstrap replicate is refitted (:func:`bootstrap_intervals`: ``"two-step"``).
     progress : callable, optional
         ``progress(stage, done, total)`` after each simulation (:mod:`discovery._progress`).
     short_first : bool
