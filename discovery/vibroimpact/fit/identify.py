@@ -306,6 +306,10 @@ class _Objective:
         self.cache = {}
         self.best = (np.inf, None)
         self.path, self.failures = [], []
+        # continuation: per record compared with its steady orbit, the solved orbits
+        # ``[(x, SteadyState), ...]``; the next one starts from the nearest (Newton from
+        # it, the cold search only when that fails: steady_state's ``guess``)
+        self.orbits = [[] for _ in records]
         # residual weights: trapezoid-like sample spacing, normalised so that the sum
         # of squared residuals of a record is its I3^2
         self.w = [_residual_weights(ref) for _, ref in records]
@@ -322,7 +326,7 @@ class _Objective:
                 raise _Budget
             law, machine, observe = model_parts(self.law(x), self.observe)
             evs = []
-            for sc, ref in self.records:
+            for i, (sc, ref) in enumerate(self.records):
                 self.n += 1
                 tick(self.progress, "identify: simulations", self.n, self.max_sim)
                 ev = evaluate(
@@ -333,7 +337,10 @@ class _Objective:
                     floor=False,
                     observe=observe,
                     smooth_onset=True,
+                    **self._continued(i, x),
                 )
+                if ev.status == "ok" and getattr(ref, "span", None) is None:
+                    self.orbits[i].append((np.asarray(x, dtype=float), ev.steady))
                 evs.append(ev)
                 if ev.status != "ok":
                     self.failures.append(
@@ -346,6 +353,14 @@ class _Objective:
                     break
             self.cache[key] = evs if all(e.status == "ok" for e in evs) else None
         return self.cache[key]
+
+    def _continued(self, i, x):
+        """``{"guess": orbit}``: the solved steady orbit of record ``i`` nearest to ``x``
+        (none for a record compared over its span, or before the first)."""
+        if not self.orbits[i]:
+            return {}
+        d = [np.max(np.abs(xs - x) / np.maximum(np.abs(xs), 1e-12)) for xs, _ in self.orbits[i]]
+        return {"guess": self.orbits[i][int(np.argmin(d))][1]}
 
     def __call__(self, x):
         evs = self.evaluations(x)

@@ -223,8 +223,13 @@ with its noise floor."""
 
 
 def _steady(scenario, law, tolerances, steady_kwargs):
+    # a continuation's guess is keyed by the orbit it starts from
+    g = steady_kwargs.get("guess")
+    keyed = (
+        {**steady_kwargs, "guess": (g.y0, g.n_periods, g.t0)} if g is not None else steady_kwargs
+    )
     return MEMO.get(
-        value_key("steady", scenario, law, tolerances, steady_kwargs),
+        value_key("steady", scenario, law, tolerances, keyed),
         lambda: steady_state(scenario, law, tolerances=tolerances, **steady_kwargs),
     )
 
