@@ -400,9 +400,11 @@ def _sens_error(S, Snew, KS, h, rtol, atol, sscale):
 
 
 @njit(cache=True)
-def _dense_sens(S, KS, h, theta, w, out):
-    """The sensitivities on the dense output at ``theta`` (the weights of ``_dense``, in the
-    work array ``w`` of size 7)."""
+def _dense_force_sens(mode, y, S, KS, h, theta, w, spar, coef, ea, eb, br, dc, out, k):
+    """``out[j, k] = dF/dq_j`` at the dense output ``y`` (step fraction ``theta``): only the
+    penetration's and its rate's sensitivities are interpolated (the dense output's
+    weights of :mod:`._dopri`'s stages, in the work array ``w`` of size 7), the two
+    combinations of rows the force needs."""
     t2 = theta * theta
     t3 = t2 * theta
     t4 = t3 * theta
@@ -410,12 +412,17 @@ def _dense_sens(S, KS, h, theta, w, out):
     w[0] = _P[0, 0] * theta + _P[0, 1] * t2 + _P[0, 2] * t3 + _P[0, 3] * t4
     for i in range(2, 7):
         w[i] = _P[i, 1] * t2 + _P[i, 2] * t3 + _P[i, 3] * t4
-    for r in range(4):
-        for j in range(S.shape[1]):
-            acc = 0.0
-            for i in range(7):
-                acc += w[i] * KS[i, r, j]
-            out[r, j] = S[r, j] + h * acc
+    fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
+    for j in range(S.shape[1]):
+        az = 0.0
+        av = 0.0
+        for i in range(7):
+            az += w[i] * (KS[i, 0, j] - KS[i, 2, j])
+            av += w[i] * (KS[i, 1, j] - KS[i, 3, j])
+        df = fz * (S[0, j] - S[2, j] + h * az) + fv * (S[1, j] - S[3, j] + h * av)
+        if spar[j] >= 0:
+            df += dc[spar[j]]
+        out[j, k] = df
 
 
 @njit(cache=True)
@@ -688,7 +695,6 @@ def integrate(
     KS = np.empty((7, 4, m_s))
     SS = np.empty((4, m_s))
     Snew = np.empty((4, m_s))
-    Sbuf = np.empty((4, m_s))
     wbuf = np.empty(7)
     dc = np.empty(coef.shape[0])
     fminus = np.empty(4)
@@ -829,8 +835,23 @@ def integrate(
             )
             out_mode[k_eval] = mode
             if want_df:
-                _dense_sens(S, KS, h_used, min(theta, 1.0), wbuf, Sbuf)
-                _force_sens(mode, ybuf, Sbuf, spar, coef, ea, eb, br, dc, out_dF, k_eval)
+                _dense_force_sens(
+                    mode,
+                    ybuf,
+                    S,
+                    KS,
+                    h_used,
+                    min(theta, 1.0),
+                    wbuf,
+                    spar,
+                    coef,
+                    ea,
+                    eb,
+                    br,
+                    dc,
+                    out_dF,
+                    k_eval,
+                )
             k_eval += 1
         for j in range(4):
             y[j] = ynew[j]
