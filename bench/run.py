@@ -359,9 +359,15 @@ def main():
         if "error" in d_:
             print(f"discover {lib}: failed: {d_['error']}")
         else:
+            par = (
+                f"; {d_['parallel_speedup']:.2f}x faster on {d_['cores']} cores "
+                f"(same ranking {d_['same_ranking_all_cores']})"
+                if "parallel_speedup" in d_
+                else ""
+            )
             print(
                 f"discover {lib}, refine: {d_['seconds']:.1f} s "
-                f"({d_['ratio_to_one_steady_state']:.0f} x one steady state)"
+                f"({d_['ratio_to_one_steady_state']:.0f} x one steady state){par}"
             )
     e = results["explain"]
     print(

@@ -108,6 +108,22 @@ def test_result_bookkeeping(result):
         assert (origin == "regression" and tuple(m.law.names) in terms) or "step" in origin
 
 
+def test_refinements_on_two_processes_are_the_serial_ones(paper):
+    """The shortlist's refinements and each stepwise move's trials run on the workers; each
+    refinement is deterministic and results are put back in their order, so the ranking
+    is the serial one to the last bit."""
+    m = synthesize(paper, paper.law, periods=40, fs=20000, noise=0.01, seed=5, from_rest=True)
+    kw = dict(library="poly:2", shortlist=3, stepwise=1, n_boot_intervals=0)
+    seen = []
+    serial = discover(paper, m, workers=1, **kw)
+    parallel = discover(paper, m, workers=2, progress=lambda *a: seen.append(a), **kw)
+    assert [str(r.law) for r in parallel.ranking] == [str(r.law) for r in serial.ranking]
+    assert [r.criteria for r in parallel.ranking] == [r.criteria for r in serial.ranking]
+    assert [r.note for r in parallel.ranking] == [r.note for r in serial.ranking]
+    shortlist = [a for a in seen if a[0].startswith("fit: shortlisted")]
+    assert shortlist[0][1:] == (0, 3) and shortlist[-1][1:] == (3, 3)
+
+
 def test_refinement_reduces_the_criterion_of_a_biased_regression(biased):
     plain, refined = biased
     assert plain.refinement is None and refined.refinement is not None

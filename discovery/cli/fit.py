@@ -276,7 +276,7 @@ def _add_check_options(p):
         "through the full processing (0 = none) (default: %(default)s)",
     )
     add_interval_refit_option(p)
-    add_workers_option(p, "the bootstrap intervals' refits")
+    add_workers_option(p, "the refinements of each search step and the bootstrap intervals' refits")
     p.add_argument(
         "--allow-unphysical",
         action="store_true",

@@ -31,6 +31,7 @@ those whose simulation criterion (default I2) is within ``sim_rtol`` (relative) 
 criterion; models without a periodic steady state come last.
 """
 
+import os
 import time
 from dataclasses import dataclass, field, replace
 from warnings import warn
@@ -43,6 +44,7 @@ from ..._printing import coefficient_lines, criteria_lines, fmt, readable
 from ..._progress import tick
 from ..._validate import Choice, Real, Text, params
 from ...errors import InputError, IntegrationError, VidiError
+from ...numerics.executor import make_executor
 from ..data.measurement import Measurement
 from ..data.samples import contact_samples, join_samples
 from ..dynamics import Tolerances
@@ -442,24 +444,58 @@ def _steady_from(ref):
     return float(ref.impulse.onset)
 
 
+def _trial(check, job):
+    """One trial of the search (a task of the executor, the checker its forked context):
+    ``job = (starts, origin)``, the first of the ``(law, candidate)`` starts whose
+    refinement simulates (the last one's result when none does)."""
+    starts, origin = job
+    for law, cand in starts:
+        trial = check.refined(law, cand, origin)
+        if trial.criteria:
+            break
+    return trial
+
+
 class _Checker:
-    """Refines (optionally) and evaluates one regression candidate against all records."""
+    """Refines (optionally) and evaluates regression candidates against all records; the
+    trials of one step (the shortlist, a forward or backward move) run on ``workers``
+    processes (their results do not depend on it: each refinement is deterministic)."""
 
     def __init__(
-        self, est, samples, refs, criterion, refine, tolerances, budget, required=frozenset()
+        self,
+        est,
+        samples,
+        refs,
+        criterion,
+        refine,
+        tolerances,
+        budget,
+        required=frozenset(),
+        workers=1,
     ):
         self.est, self.samples, self.refs = est, samples, refs
         self.required = frozenset(required)
         self.criterion, self.refine, self.tol, self.budget = criterion, refine, tolerances, budget
+        self.workers = workers
 
     def evaluate(self, law):
         return tuple(evaluate(sc, law, ref, tolerances=self.tol) for sc, ref in self.refs)
 
-    def __call__(self, cand):
-        """Refine and check a regression candidate."""
-        est = self.est
-        law = est.library_.law([cand.coefficients.get(t.name, 0.0) for t in est.library_.terms])
-        return self.refined(law, cand, "regression")
+    def run(self, jobs, stage=None, progress=None):
+        """The trials of ``jobs`` (see :func:`_trial`) in their order, on up to ``workers``
+        forked processes (never more than the jobs)."""
+        out = [None] * len(jobs)
+        n = min(int(self.workers or os.cpu_count() or 1), max(len(jobs), 1))
+        with make_executor(n) as ex:
+            for done, (i, r) in enumerate(ex.run(_trial, jobs, self), start=1):
+                out[i] = r
+                tick(progress, stage, done, len(jobs))
+        return out
+
+    def regression_law(self, cand):
+        """A regression candidate's law."""
+        lib = self.est.library_
+        return lib.law([cand.coefficients.get(t.name, 0.0) for t in lib.terms])
 
     def refined(self, law, cand, origin):
         """Refine ``law`` (from ``origin``: "regression" or a forward step) and check it."""
@@ -561,7 +597,7 @@ class _Checker:
         if len(names) < 2:
             return []
         lib = self.est.library_
-        out = []
+        jobs = []
         for term in names:
             if term in self.required or frozenset(names) - {term} in skip:
                 continue
@@ -570,8 +606,8 @@ class _Checker:
             cand = self.est.rescore(
                 coef, self.samples.X, self.samples.F, self.samples.weight, self.samples.impact
             )
-            out.append(self.refined(lib.law(coef), cand, f"backward step from {' + '.join(names)}"))
-        return out
+            jobs.append(([(lib.law(coef), cand)], f"backward step from {' + '.join(names)}"))
+        return self.run(jobs)
 
     def restart(self, base, support):
         """``support`` refined again from ``base``'s coefficients (its other terms started
@@ -605,22 +641,20 @@ class _Checker:
         have = set(base.law.names)
         if len(have) >= max_terms:
             return []
-        out = []
+        jobs = []
         for i, term in enumerate(lib.terms):
             if term.name in have or corner[i] <= 0 or frozenset(have | {term.name}) in skip:
                 continue
-            origin = f"forward step from {' + '.join(base.law.names)}"
+            starts = []
             for frac in _FORWARD_STARTS:
                 coef = _coefficients(base.law, lib)
                 coef[i] = frac * peak / corner[i]
                 cand = est.rescore(
                     coef, self.samples.X, self.samples.F, self.samples.weight, self.samples.impact
                 )
-                trial = self.refined(lib.law(coef), cand, origin)
-                if trial.criteria:
-                    break
-            out.append(trial)
-        return out
+                starts.append((lib.law(coef), cand))
+            jobs.append((starts, f"forward step from {' + '.join(base.law.names)}"))
+        return self.run(jobs)
 
 
 def _stability_warning(stab, selected):
@@ -862,6 +896,9 @@ def _regression(
     return parts, samples, est
 
 
+_SHORTLIST_STAGE = "fit: shortlisted supports checked by simulation"
+
+
 def _shortlist(check, est, required, shortlist, progress):
     """The estimator's best supports (holding the required terms), each checked by
     simulation."""
@@ -871,16 +908,9 @@ def _shortlist(check, est, required, shortlist, progress):
             f"no candidate support of the library holds the required terms "
             f"{', '.join(sorted(required))}; raise --max-terms or drop --require"
         )
-    models = []
-    for k, c in enumerate(pool[:shortlist]):
-        tick(
-            progress,
-            "fit: shortlisted supports checked by simulation",
-            k,
-            min(len(pool), shortlist),
-        )
-        models.append(check(c))
-    return models
+    jobs = [([(check.regression_law(c), c)], "regression") for c in pool[:shortlist]]
+    tick(progress, _SHORTLIST_STAGE, 0, len(jobs))
+    return check.run(jobs, _SHORTLIST_STAGE, progress)
 
 
 class _Stepwise:
@@ -1126,8 +1156,9 @@ def discover(
         How a bootstrap replicate is refitted (``"two-step"`` or ``"full"``: see
         :func:`discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
     workers : int or None
-        Processes for the bootstrap's refits (default 1; ``None``: every core); the
-        intervals do not depend on it.
+        Processes for the refinements of the shortlist and of each stepwise move, and for
+        the bootstrap's refits (default 1; ``None``: every core); the result does not
+        depend on it.
     progress : callable, optional
         ``progress(stage, done, total)`` as the shortlist is simulated and the stepwise
         search and the bootstrap go on (:mod:`discovery._progress`).
@@ -1155,7 +1186,9 @@ def discover(
     )
     refs = [(sc, Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)) for sc, m in pairs]
     required = _required_terms(require, est.library_)
-    check = _Checker(est, samples, refs, criterion, refine, tolerances, max_simulations, required)
+    check = _Checker(
+        est, samples, refs, criterion, refine, tolerances, max_simulations, required, workers
+    )
     models = _shortlist(check, est, required, shortlist, progress)
     by_score = list(models)  # the estimator's order (its scoring)
     search = _Stepwise(check, criterion, sim_rtol, sim_atol, physics, stepwise, max_terms)
