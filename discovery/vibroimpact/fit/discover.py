@@ -896,6 +896,15 @@ def _regression(
     return parts, samples, est
 
 
+def _stability(est, samples, resamples, seed):
+    """Stability selection's term frequencies over ``resamples`` bootstrap resamples of
+    impacts (``{}`` for none)."""
+    if not resamples:
+        return {}
+    s = samples
+    return est.stability(s.X, s.F, s.impact, resamples, seed, sample_weight=s.weight)
+
+
 _SHORTLIST_STAGE = "fit: shortlisted supports checked by simulation"
 
 
@@ -1200,13 +1209,7 @@ def discover(
     # the certificate of the law actually selected (the ranking may prefer another
     # candidate than the estimator's best by BIC); a failure is an error
     cert = require_certificate(selected.certificate)
-    stab = (
-        est.stability(
-            samples.X, samples.F, samples.impact, stability, seed, sample_weight=samples.weight
-        )
-        if stability
-        else {}
-    )
+    stab = _stability(est, samples, stability, seed)
     warnings = _warnings(selected, by_score, stab, pairs, parts, refs, samples, refine)
     if selected.defects:
         warnings.insert(0, _defects_warning(selected, physics))
