@@ -8,7 +8,7 @@ import pytest
 
 from discovery import ForceLaw, landscape, load_scenario
 from discovery.errors import InputError
-from discovery.numerics.executor import Pool, Serial, make_executor
+from discovery.numerics.executor import Pool, Serial, make_executor, map_on
 from discovery.ueda import UedaSystem
 from discovery.ueda.chart import chart
 
@@ -29,6 +29,16 @@ def test_executors_agree_and_place_results_by_index():
     assert Serial().map(_square, jobs, 10) == want
     assert Pool(2).map(_square, jobs, 10) == want
     assert isinstance(make_executor(1), Serial) and isinstance(make_executor(2), Pool)
+
+
+def test_map_on_reports_each_finished_job_once():
+    for workers in (1, 2):
+        seen = []
+        got = map_on(
+            _square, range(7), 1, workers=workers, done=lambda k, n, s=seen: s.append((k, n))
+        )
+        assert got == [1 + j * j for j in range(7)]
+        assert seen == [(k, 7) for k in range(1, 8)]
 
 
 def _blas_threads(context, job):

@@ -45,7 +45,17 @@ from ._tableau import C
 from ._tableau import E as _E
 from ._tableau import P as _P
 
-__all__ = ["C", "SAFETY", "MIN_FACTOR", "MAX_FACTOR", "Blocks", "blocks", "step_factor", "ORDER"]
+__all__ = [
+    "C",
+    "SAFETY",
+    "MIN_FACTOR",
+    "MAX_FACTOR",
+    "Blocks",
+    "blocks",
+    "dense_weights",
+    "step_factor",
+    "ORDER",
+]
 
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 ORDER = 5  # the error estimate is of order 4: factors use err^(-1/5)
@@ -59,6 +69,23 @@ class Blocks(NamedTuple):
     combine: object
     dense: object
     error_norm: object
+
+
+@njit(inline="always")
+def dense_weights(theta):
+    """The weights ``(w0, w2, w3, w4, w5, w6)`` of the stages in Shampine's continuous
+    extension at ``t + theta h`` (stage 1's is 0)."""
+    t2 = theta * theta
+    t3 = t2 * theta
+    t4 = t3 * theta
+    return (
+        _P[0, 0] * theta + _P[0, 1] * t2 + _P[0, 2] * t3 + _P[0, 3] * t4,
+        _P[2, 1] * t2 + _P[2, 2] * t3 + _P[2, 3] * t4,
+        _P[3, 1] * t2 + _P[3, 2] * t3 + _P[3, 3] * t4,
+        _P[4, 1] * t2 + _P[4, 2] * t3 + _P[4, 3] * t4,
+        _P[5, 1] * t2 + _P[5, 2] * t3 + _P[5, 3] * t4,
+        _P[6, 1] * t2 + _P[6, 2] * t3 + _P[6, 3] * t4,
+    )
 
 
 def _build(n):
@@ -89,15 +116,7 @@ def _build(n):
     @njit(inline="always")
     def dense(y, K, h, theta, out):
         """Shampine's continuous extension at ``t + theta h`` (``0 <= theta <= 1``)."""
-        t2 = theta * theta
-        t3 = t2 * theta
-        t4 = t3 * theta
-        w0 = _P[0, 0] * theta + _P[0, 1] * t2 + _P[0, 2] * t3 + _P[0, 3] * t4
-        w2 = _P[2, 1] * t2 + _P[2, 2] * t3 + _P[2, 3] * t4
-        w3 = _P[3, 1] * t2 + _P[3, 2] * t3 + _P[3, 3] * t4
-        w4 = _P[4, 1] * t2 + _P[4, 2] * t3 + _P[4, 3] * t4
-        w5 = _P[5, 1] * t2 + _P[5, 2] * t3 + _P[5, 3] * t4
-        w6 = _P[6, 1] * t2 + _P[6, 2] * t3 + _P[6, 3] * t4
+        w0, w2, w3, w4, w5, w6 = dense_weights(theta)
         for j in range(n):
             out[j] = y[j] + h * (
                 w0 * K[0, j]

@@ -83,11 +83,14 @@ class Executor:
         """Yield ``(index, fn(context, jobs[index]))`` as the jobs finish."""
         raise NotImplementedError
 
-    def map(self, fn, jobs, context=None):
-        """The results in the order of ``jobs`` (a list)."""
+    def map(self, fn, jobs, context=None, done=None):
+        """The results in the order of ``jobs`` (a list); ``done(k, n)`` after each of the
+        ``n`` jobs finishes (progress)."""
         out = [None] * len(jobs)
-        for i, r in self.run(fn, jobs, context):
+        for k, (i, r) in enumerate(self.run(fn, jobs, context), start=1):
             out[i] = r
+            if done is not None:
+                done(k, len(jobs))
         return out
 
     def close(self):
@@ -233,15 +236,15 @@ class Dask(Executor):
         return f"Dask({self.address!r}, workers={self.workers})"
 
 
-def map_on(fn, jobs, context=None, *, workers=None, executor=None):
-    """``executor.map(fn, jobs, context)``, or without an executor on one of ``workers``
-    local processes (``None``: one per CPU; never more than the jobs) made for this call
-    and closed after it."""
+def map_on(fn, jobs, context=None, *, workers=None, executor=None, done=None):
+    """``executor.map(fn, jobs, context, done)``, or without an executor on one of
+    ``workers`` local processes (``None``: one per CPU; never more than the jobs) made for
+    this call and closed after it."""
     jobs = list(jobs)
     if executor is not None:
-        return executor.map(fn, jobs, context)
+        return executor.map(fn, jobs, context, done)
     with make_executor(min(int(workers or os.cpu_count() or 1), max(len(jobs), 1))) as ex:
-        return ex.map(fn, jobs, context)
+        return ex.map(fn, jobs, context, done)
 
 
 @params(workers=(None, Real(1, 4096, integer=True)), scheduler=(None, Text()))

@@ -52,11 +52,11 @@ from numba import njit
 from ...numerics._dopri import MIN_FACTOR as _MIN_FACTOR
 from ...numerics._dopri import C as _C
 from ...numerics._dopri import blocks
+from ...numerics._dopri import dense_weights as _dense_weights
 from ...numerics._dopri import step_factor as _step_factor
 from ...numerics._tableau import A as _A
 from ...numerics._tableau import B as _B
 from ...numerics._tableau import E as _E
-from ...numerics._tableau import P as _P
 
 # the shared Dormand-Prince blocks for this system's four states (w1, v1, w2, v2)
 _D = blocks(4)
@@ -336,10 +336,10 @@ def _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew):
 
 
 @njit(cache=True, inline="always")
-def _dforce(fz, fv, S, j, spar, dc):
-    """The force's derivative along column ``j`` (the state's move ``S[:, j]``, and the
-    coefficient ``spar[j]`` when it is one)."""
-    df = fz * (S[0, j] - S[2, j]) + fv * (S[1, j] - S[3, j])
+def _dforce(fz, fv, dz, dv, j, spar, dc):
+    """The force's derivative along column ``j``: the penetration's and its rate's
+    derivatives ``dz``, ``dv`` along it, and the coefficient ``spar[j]`` when it is one."""
+    df = fz * dz + fv * dv
     if spar[j] >= 0:
         df += dc[spar[j]]
     return df
@@ -351,7 +351,7 @@ def _rhs_sens(y, mode, p, coef, ea, eb, br, S, spar, dc, out):
     fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
     ky = p[2] + 3.0 * p[P_K3] * y[0] * y[0]
     for j in range(S.shape[1]):
-        df = _dforce(fz, fv, S, j, spar, dc)
+        df = _dforce(fz, fv, S[0, j] - S[2, j], S[1, j] - S[3, j], j, spar, dc)
         out[0, j] = S[1, j]
         out[1, j] = -(p[3] * S[1, j] + ky * S[0, j] + df) / p[0]
         out[2, j] = S[3, j]
@@ -399,30 +399,37 @@ def _sens_error(S, Snew, KS, h, rtol, atol, sscale):
     return np.sqrt(acc / (4.0 * S.shape[1]))
 
 
+@njit(cache=True, inline="always")
+def _dense_diff(S, KS, h, w, r, j):
+    """Row ``r`` minus row ``r + 2`` of column ``j`` of the dense sensitivities (the
+    penetration's derivative for ``r = 0``, its rate's for ``r = 1``); ``w`` the dense
+    output's weights."""
+    w0, w2, w3, w4, w5, w6 = w
+    return (
+        S[r, j]
+        - S[r + 2, j]
+        + h
+        * (
+            w0 * (KS[0, r, j] - KS[0, r + 2, j])
+            + w2 * (KS[2, r, j] - KS[2, r + 2, j])
+            + w3 * (KS[3, r, j] - KS[3, r + 2, j])
+            + w4 * (KS[4, r, j] - KS[4, r + 2, j])
+            + w5 * (KS[5, r, j] - KS[5, r + 2, j])
+            + w6 * (KS[6, r, j] - KS[6, r + 2, j])
+        )
+    )
+
+
 @njit(cache=True)
-def _dense_force_sens(mode, y, S, KS, h, theta, w, spar, coef, ea, eb, br, dc, out, k):
+def _dense_force_sens(mode, y, S, KS, h, theta, spar, coef, ea, eb, br, dc, out, k):
     """``out[j, k] = dF/dq_j`` at the dense output ``y`` (step fraction ``theta``): only the
-    penetration's and its rate's sensitivities are interpolated (the dense output's
-    weights of :mod:`._dopri`'s stages, in the work array ``w`` of size 7), the two
-    combinations of rows the force needs."""
-    t2 = theta * theta
-    t3 = t2 * theta
-    t4 = t3 * theta
-    w[1] = 0.0
-    w[0] = _P[0, 0] * theta + _P[0, 1] * t2 + _P[0, 2] * t3 + _P[0, 3] * t4
-    for i in range(2, 7):
-        w[i] = _P[i, 1] * t2 + _P[i, 2] * t3 + _P[i, 3] * t4
+    penetration's and its rate's sensitivities are interpolated, the two combinations of
+    rows the force needs."""
+    w = _dense_weights(theta)
     fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
     for j in range(S.shape[1]):
-        az = 0.0
-        av = 0.0
-        for i in range(7):
-            az += w[i] * (KS[i, 0, j] - KS[i, 2, j])
-            av += w[i] * (KS[i, 1, j] - KS[i, 3, j])
-        df = fz * (S[0, j] - S[2, j] + h * az) + fv * (S[1, j] - S[3, j] + h * av)
-        if spar[j] >= 0:
-            df += dc[spar[j]]
-        out[j, k] = df
+        dz, dv = _dense_diff(S, KS, h, w, 0, j), _dense_diff(S, KS, h, w, 1, j)
+        out[j, k] = _dforce(fz, fv, dz, dv, j, spar, dc)
 
 
 @njit(cache=True)
@@ -430,7 +437,7 @@ def _force_sens(mode, y, S, spar, coef, ea, eb, br, dc, out, k):
     """``out[j, k] = dF/dq_j`` of the force at ``y`` (sensitivities ``S``) in ``mode``."""
     fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
     for j in range(S.shape[1]):
-        out[j, k] = _dforce(fz, fv, S, j, spar, dc)
+        out[j, k] = _dforce(fz, fv, S[0, j] - S[2, j], S[1, j] - S[3, j], j, spar, dc)
 
 
 @njit(cache=True)
@@ -695,7 +702,6 @@ def integrate(
     KS = np.empty((7, 4, m_s))
     SS = np.empty((4, m_s))
     Snew = np.empty((4, m_s))
-    wbuf = np.empty(7)
     dc = np.empty(coef.shape[0])
     fminus = np.empty(4)
     fplus = np.empty(4)
@@ -842,7 +848,6 @@ def integrate(
                     KS,
                     h_used,
                     min(theta, 1.0),
-                    wbuf,
                     spar,
                     coef,
                     ea,

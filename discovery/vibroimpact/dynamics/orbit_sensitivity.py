@@ -22,7 +22,7 @@ import numpy as np
 from ..._printing import readable
 from ...errors import InputError
 from . import _kernel as K
-from .simulate import simulate
+from .simulate import kernel_params, simulate
 
 __all__ = ["OrbitSensitivity", "orbit_sensitivity"]
 
@@ -124,23 +124,20 @@ class OrbitSensitivity:
 
 
 def _force_rate(scenario, law, t, y, mode):
-    """``dF/dt`` along the motion (``F_z dzeta/dt + F_v d(dzeta)/dt``) at states ``y``."""
+    """``dF/dt`` along the motion (``F_z dzeta/dt + F_v d(dzeta)/dt``) at states ``y``, the
+    accelerations from the kernel's own right-hand side."""
     coef, ea, eb, br = law.kernel_arrays()
-    m1, m2, k1, c1, A, om, g = scenario.params()[:7]
-    k3 = scenario.k3
+    p = kernel_params(scenario, law)  # no permanent set: no contact state
     dc = np.empty(coef.size)
-    p = np.zeros(K.N_PARAMS)  # no permanent set: no contact state
+    f = np.empty(4)
     out = np.zeros(t.size)
     for i in range(t.size):
-        w1, v1, w2, v2 = y[:, i]
-        z, v = w1 - w2, v1 - v2
         if mode[i] not in (K.LOAD, K.UNLOAD):
             continue
-        F = K.mode_force(mode[i], z, v, p, coef, ea, eb, br)
+        z, v = y[0, i] - y[2, i], y[1, i] - y[3, i]
         fz, fv = K.force_partials(mode[i], z, v, coef, ea, eb, br, dc)
-        a1 = -(c1 * v1 + k1 * w1 + k3 * w1**3 + A * np.sin(om * t[i]) + m1 * g + F) / m1
-        a2 = F / m2 - g
-        out[i] = fz * v + fv * (a1 - a2)
+        K._rhs_at(t[i], y[:, i].copy(), mode[i], p, coef, ea, eb, br, f)
+        out[i] = fz * v + fv * (f[1] - f[3])
     return out
 
 

@@ -31,7 +31,6 @@ those whose simulation criterion (default I2) is within ``sim_rtol`` (relative) 
 criterion; models without a periodic steady state come last.
 """
 
-import os
 import time
 from dataclasses import dataclass, field, replace
 from warnings import warn
@@ -44,7 +43,7 @@ from ..._printing import coefficient_lines, criteria_lines, fmt, readable
 from ..._progress import tick
 from ..._validate import Choice, Real, Text, params
 from ...errors import InputError, IntegrationError, VidiError
-from ...numerics.executor import make_executor
+from ...numerics.executor import map_on
 from ..data.measurement import Measurement
 from ..data.samples import contact_samples, join_samples
 from ..dynamics import Tolerances
@@ -484,13 +483,9 @@ class _Checker:
     def run(self, jobs, stage=None, progress=None):
         """The trials of ``jobs`` (see :func:`_trial`) in their order, on up to ``workers``
         forked processes (never more than the jobs)."""
-        out = [None] * len(jobs)
-        n = min(int(self.workers or os.cpu_count() or 1), max(len(jobs), 1))
-        with make_executor(n) as ex:
-            for done, (i, r) in enumerate(ex.run(_trial, jobs, self), start=1):
-                out[i] = r
-                tick(progress, stage, done, len(jobs))
-        return out
+        return map_on(
+            _trial, jobs, self, workers=self.workers, done=lambda k, n: tick(progress, stage, k, n)
+        )
 
     def regression_law(self, cand):
         """A regression candidate's law."""

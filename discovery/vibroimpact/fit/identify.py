@@ -971,15 +971,17 @@ def _refit_replicate(context, k):
     return np.array(res.law.coefficients, dtype=float)
 
 
+_GN_STEPS = 2  # the Gauss-Newton steps of a "two-step" replicate
+
+
 def _step_replicate(context, k):
-    """The coefficients after ``settings["steps"]`` Gauss-Newton steps from the fitted model
-    on one bootstrap replicate (a task of the executor, as :func:`_refit_replicate`), None
-    when it fails."""
+    """The coefficients after two Gauss-Newton steps from the fitted model on one bootstrap
+    replicate (a task of the executor, as :func:`_refit_replicate`), None when it fails."""
     scenarios, replicates, model, settings = context
     records = list(zip(scenarios, replicates[k], strict=True))
     obj = _Objective(records, model, settings["criterion"], settings["tolerances"], 10**9)
     x = np.ones(len(model.coefficients))
-    for _ in range(settings.get("steps", 1)):
+    for _ in range(_GN_STEPS):
         try:
             if obj.evaluations(x) is None:
                 return None
@@ -1077,7 +1079,6 @@ def bootstrap_intervals(
             "criterion": criterion,
             "max_simulations": max_simulations,
             "tolerances": tolerances,
-            "steps": 2,
         },
     )
     refits = map_on(
