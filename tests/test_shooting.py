@@ -140,7 +140,9 @@ def test_logistic_period_two_is_not_reduced_to_the_unstable_fixed_point():
 # recorded with the implementation before the move (steady_state.py's own _newton,
 # _reduce_period, _recurrence) and its finite-difference Jacobians; since the Jacobian is
 # exact (variational equations and saltation, tests/test_sensitivities.py) Newton takes
-# other steps to the same orbit and the multipliers lose the differences' error
+# other steps to the same orbit and the multipliers lose the differences' error; since
+# each full Newton step's state and Jacobian come from one run, five runs fewer (29 -> 24,
+# 32 -> 27)
 PAPER = {
     "y0": [-0.005653106861707833, 0.28098294771776317, -0.0058524706348867615, 0.06132476750837263],
     "mult": [
@@ -158,7 +160,7 @@ PAPER = {
     "residual": 2.589742359771409e-13,
     "t0": 1.92,
     "n_simulations": 44,
-    "exact_simulations": 29,
+    "exact_simulations": 24,
 }
 PD = {
     "y0": [0.0012036689521576082, 0.06697651816161, 0.0010927289183266834, 0.10318728497831268],
@@ -177,7 +179,7 @@ PD = {
     "residual": 3.3199423404977085e-10,
     "t0": 1.2873007448065161,
     "n_simulations": 50,
-    "exact_simulations": 32,
+    "exact_simulations": 27,
 }
 
 
@@ -191,7 +193,7 @@ def _same(ss, ref):
     np.testing.assert_allclose(ss.multipliers, ref["exact_mult"], rtol=1e-6, atol=1e-8)
     assert ss.residual < 10 * max(ref["residual"], 1e-13)
     assert ss.t0 == pytest.approx(ref["t0"], rel=1e-12)
-    # fewer runs (one exact Jacobian in place of four differences)
+    # fewer runs (one exact Jacobian in place of four differences, with the step's state)
     assert ss.n_simulations == ref["exact_simulations"] < ref["n_simulations"]
 
 
@@ -204,7 +206,14 @@ def test_vibro_impact_period_reduction_unchanged():
     path through smallest_period)."""
     from discovery.vibroimpact.dynamics.steady_state import steady_state
 
-    sc = Scenario(
+    ss = steady_state(_pd_scenario(), ForceLaw.parse("1448000000*z + 9927000*zd"), tol=1e-6)
+    _same(ss, PD)
+    tried = ss.evidence["attempts"][-1]["tried"]
+    assert tried[0]["n"] == 2 and tried[-1]["n"] == 1 and tried[-1]["reduced_from"] == 2
+
+
+def _pd_scenario():
+    return Scenario(
         m1=4770.989046559852,
         m2=5430.940884957566,
         k1=161209836.32495606,
@@ -212,10 +221,27 @@ def test_vibro_impact_period_reduction_unchanged():
         A=231045.9099917681 * 1.01,
         frequency=37.287324033370695,
     )
-    ss = steady_state(sc, ForceLaw.parse("1448000000*z + 9927000*zd"), tol=1e-6)
-    _same(ss, PD)
-    tried = ss.evidence["attempts"][-1]["tried"]
-    assert tried[0]["n"] == 2 and tried[-1]["n"] == 1 and tried[-1]["reduced_from"] == 2
+
+
+@pytest.mark.parametrize("case", ["paper", "light", "multiplier -0.985", "twice round"])
+def test_newton_state_and_jacobian_from_one_run(case, paper, light):
+    """Newton's full steps take the state and the Jacobian from one run: the Jacobian
+    exactly :meth:`jacobian`'s, the state the plain map's within the integrator's
+    tolerance."""
+    from discovery.vibroimpact.dynamics.steady_state import StroboscopicMap, steady_state
+
+    sc, law, n = {
+        "paper": (paper, paper.law, 1),
+        "light": (light, light.law, 1),
+        "multiplier -0.985": (_pd_scenario(), ForceLaw.parse("1448000000*z + 9927000*zd"), 1),
+        "twice round": (paper, paper.law, 2),
+    }[case]
+    ss = steady_state(sc, law, tol=1e-6)
+    pm = StroboscopicMap(sc, law)
+    for y in (ss.y0, ss.y0 * (1 + 1e-3)):  # on the orbit and off it (a Newton start)
+        fy, J = pm.advance_jacobian(y, n)
+        assert np.array_equal(J, pm.jacobian(y, n))
+        assert np.max(np.abs(fy - pm.advance(y, n)) / pm.scale) < 1e-8
 
 
 # ------------------------------------------------------------------ Ueda's oscillator

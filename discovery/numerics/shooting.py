@@ -8,8 +8,8 @@ fixed forcing phase) following the small protocol :class:`PeriodMap`.  On such a
 
 * :func:`recurrence` measures how closely the strobe points repeat after ``n`` periods;
 * :func:`newton_orbit` solves ``Phi^n(y) = y`` by damped Newton (the Jacobian is the
-  map's own: finite differences, which include the event saltation of the vibro-impact
-  system automatically);
+  map's own: the vibro-impact map's from its variational equations with the saltation
+  matrix at every event, Ueda's by finite differences);
 * :func:`floquet_multipliers` are the eigenvalues of the Jacobian of ``Phi^n`` at the
   orbit (the monodromy matrix);
 * :func:`smallest_period` reduces a stable period-``n`` orbit to its smallest period.
@@ -56,6 +56,10 @@ class PeriodMap(Protocol):
     jacobian(y, n=1, fy=None)
         ``d Phi^n / d y`` at ``y``, ndarray of shape ``(n_states, n_states)``; ``fy`` is
         ``Phi^n(y)`` when the caller already has it.
+    advance_jacobian(y, n=1), optional
+        ``(Phi^n(y), d Phi^n / d y)`` from one run (a map whose Jacobian comes from the
+        variational equations integrated with the state); :func:`newton_orbit` then
+        takes each full step's state and Jacobian together.
     """
 
     scale: np.ndarray
@@ -110,37 +114,53 @@ def newton_orbit(pm, y, n, tol, max_iter, history=None):
     history = [] if history is None else history
     s = pm.scale
     eye = np.eye(len(y))
-    fy = pm.advance(y, n)
+    both = getattr(pm, "advance_jacobian", None)
+    if both is None:
+        fy, Jy = pm.advance(y, n), None
+    else:
+        fy, Jy = both(y, n)
     res = np.max(np.abs(fy - y) / s)
     J = None
     for _ in range(max_iter):
         history.append(res)
         if res < tol:
             break
-        J = pm.jacobian(y, n, fy)
+        J = Jy if Jy is not None else pm.jacobian(y, n, fy)
         try:
             step = np.linalg.solve(J - eye, -(fy - y))
         except np.linalg.LinAlgError:
             return y, res, J, False
-        lam = 1.0
-        while lam > 1e-3:
-            y_try = y + lam * step
-            try:
-                f_try = pm.advance(y_try, n)
-            except IntegrationError:
-                lam *= 0.5
-                continue
-            r_try = np.max(np.abs(f_try - y_try) / s)
-            if r_try < res:
-                y, fy, res = y_try, f_try, r_try
-                break
-            lam *= 0.5
-        else:
+        found = _line_search(pm, n, y, step, res, both)
+        if found is None:
             return y, res, J, False
+        y, fy, res, Jy = found
     converged = res < tol
     if converged:
-        J = pm.jacobian(y, n, fy)
+        J = Jy if Jy is not None else pm.jacobian(y, n, fy)
     return y, res, J, converged
+
+
+def _line_search(pm, n, y, step, res, both):
+    """``(y, Phi^n(y), residual, Jacobian or None)`` at the first of ``y + step``,
+    ``y + step / 2``, ... (down to 1e-3) that lowers the residual, or None.  The full
+    step, the one Newton takes near an orbit, is evaluated with its Jacobian when the map
+    gives both from one run (``both``); the damped ones plainly."""
+    lam = 1.0
+    while lam > 1e-3:
+        y_try = y + lam * step
+        try:
+            if lam == 1.0 and both is not None:
+                f_try, J_try = both(y_try, n)
+            else:
+                f_try, J_try = pm.advance(y_try, n), None
+        except IntegrationError:
+            lam *= 0.5
+            continue
+        r_try = np.max(np.abs(f_try - y_try) / pm.scale)
+        if r_try < res:
+            return y_try, f_try, r_try, J_try
+        lam *= 0.5
+    return None
 
 
 def floquet_multipliers(J, n_states=None):

@@ -18,7 +18,7 @@ differed at 2 of 441 points, both on the boundary of the consistent region.  So
 
 import os
 import time
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -261,18 +261,34 @@ def _point(ctx, law, guess=None):
 def _row(ctx, job):
     """One row of the grid (a task of the executor: a row, not a point, lasts long enough
     to amortise a task's overhead).  With continuation each point's steady state starts
-    from its neighbour's orbit (:func:`~discovery.vibroimpact.dynamics.steady_state.steady_state`'s
-    ``guess``), and from the cold search when that fails."""
+    from its neighbours' orbit (:func:`~discovery.vibroimpact.dynamics.steady_state.steady_state`'s
+    ``guess``, see :func:`_predicted`), and from the cold search when that fails."""
     v0, axis1 = job
     law, continuation = ctx[1], ctx[5]
-    out, guess = [], None
+    out, solved = [], []
     for v1 in axis1:
         coefs = list(law.coefficients)
         coefs[0], coefs[1] = v0, v1
+        guess = _predicted(solved, v1) if continuation else None
         res, ss = _point(ctx, law.with_coefficients(coefs), guess)
         out.append(res)
-        guess = ss if continuation and ss is not None and ss.periodic else None
+        solved = [*solved[-1:], (v1, ss)] if ss is not None and ss.periodic else []
     return out
+
+
+def _predicted(solved, v):
+    """The guess at coefficient ``v`` from the last one or two solved points of the row,
+    ``[(coefficient, SteadyState), ...]``: the last orbit, its state moved along the secant
+    through the one before when both have the same period (a first-order predictor: it
+    starts Newton about one iteration closer than the last orbit alone)."""
+    if not solved:
+        return None
+    v_last, last = solved[-1]
+    if len(solved) < 2 or solved[0][1].n_periods != last.n_periods:
+        return last
+    v_before, before = solved[0]
+    r = (v - v_last) / (v_last - v_before)
+    return replace(last, y0=last.y0 + r * (last.y0 - before.y0))
 
 
 def _floor_once(scenario, law, reference, tolerances, from_state):
