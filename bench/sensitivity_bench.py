@@ -3,8 +3,8 @@
 The same computations with the exact Jacobians (variational equations and saltation in the
 compiled kernel) and with the finite differences they replace, one after the other:
 
-* a steady state's Newton shooting and Floquet multipliers (the period map's Jacobian:
-  one run with the variational equations, or four more runs);
+* a steady state's Newton shooting and Floquet multipliers (the period map's state and
+  Jacobian: one run with the variational equations, or a plain run and four more);
 * identify by least squares on a force-only record (the residuals' Jacobian from the
   orbit's derivatives) and on a record compared over its span (from one run per block);
 * the cost of one run with the coefficients' sensitivities as a multiple of a plain run.
@@ -35,6 +35,12 @@ def _time(f, repeat=3):
     return best, out
 
 
+def _differences(self, y, n=1):
+    """The period map's state and its Jacobian by forward differences (four more runs)."""
+    fy = self.advance(y, n)
+    return fy, self.fd_jacobian(y, n, fy)
+
+
 def bench_sensitivities():
     from discovery import ForceLaw, load_scenario
     from discovery.vibroimpact.dynamics.simulate import simulate
@@ -48,13 +54,14 @@ def bench_sensitivities():
     out = {}
 
     # the period map's Jacobian
-    exact_jac = StroboscopicMap.jacobian
+    exact = StroboscopicMap.jacobian, StroboscopicMap.advance_jacobian
     t_ex, ss_ex = _time(lambda: steady_state(sc, law))
     StroboscopicMap.jacobian = StroboscopicMap.fd_jacobian
+    StroboscopicMap.advance_jacobian = _differences
     try:
         t_fd, ss_fd = _time(lambda: steady_state(sc, law))
     finally:
-        StroboscopicMap.jacobian = exact_jac
+        StroboscopicMap.jacobian, StroboscopicMap.advance_jacobian = exact
     out["steady_state"] = {
         "exact_seconds": t_ex,
         "differences_seconds": t_fd,
