@@ -44,11 +44,35 @@ def lag_at_knots(t, F, tau):
     return out
 
 
+@njit(cache=True)
+def _at(t, F, G, tau, tq, out):
+    # the knot interval of each query by a walk from the previous one's (one pass over
+    # the knots for sorted queries, as the uniform grid of explain's sensor lag)
+    last = t.shape[0] - 2
+    i = 0
+    for q in range(tq.shape[0]):
+        x = tq[q]
+        while i > 0 and t[i] > x:
+            i -= 1
+        while i < last and t[i + 1] <= x:
+            i += 1
+        h = t[i + 1] - t[i]
+        s = (F[i + 1] - F[i]) / h if h > 0.0 else 0.0
+        u = x - t[i]
+        out[q] = F[i] + s * (u - tau) + (G[i] - F[i] + s * tau) * np.exp(-u / tau)
+
+
 def lag_at(t, F, G, tau, tq):
-    """The response at times ``tq`` in ``[t[0], t[-1]]`` from its knot values ``G``."""
-    i = np.clip(np.searchsorted(t, tq, "right") - 1, 0, t.size - 2)
-    # a query on a jump's knot takes the interval after it (G is continuous there)
-    h = t[i + 1] - t[i]
-    s = np.where(h > 0.0, (F[i + 1] - F[i]) / np.where(h > 0.0, h, 1.0), 0.0)
-    u = tq - t[i]
-    return F[i] + s * (u - tau) + (G[i] - F[i] + s * tau) * np.exp(-u / tau)
+    """The response at times ``tq`` in ``[t[0], t[-1]]`` from its knot values ``G`` (a
+    query on a jump's knot takes the interval after it: ``G`` is continuous there)."""
+    tq = np.ascontiguousarray(tq, dtype=float)
+    out = np.empty(tq.size)
+    _at(
+        np.ascontiguousarray(t, dtype=float),
+        np.ascontiguousarray(F, dtype=float),
+        np.ascontiguousarray(G, dtype=float),
+        float(tau),
+        tq.ravel(),
+        out,
+    )
+    return out.reshape(tq.shape)
