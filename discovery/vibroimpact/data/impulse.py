@@ -104,19 +104,9 @@ class Impulse:
         side : {"right", "left"}
             Which limit to take where the force jumps.
         """
-        tq = np.asarray(tq, dtype=float)
-        q = np.mod(tq, self.duration)
-        if side == "left":
-            q = np.where((q == 0) & (tq > 0), self.duration, q)
-        t, F = self.t, self.F
-        if side == "right":
-            i = np.clip(np.searchsorted(t, q, "right") - 1, 0, len(t) - 2)
-        else:
-            i = np.clip(np.searchsorted(t, q, "left") - 1, 0, len(t) - 2)
-        t0, t1 = t[i], t[i + 1]
-        at_jump = 1.0 if side == "left" else 0.0
-        w = np.where(t1 > t0, (q - t0) / np.where(t1 > t0, t1 - t0, 1.0), at_jump)
-        return F[i] + np.clip(w, 0.0, 1.0) * (F[i + 1] - F[i])
+        from ...numerics.piecewise import periodic_values  # numba: not for `vidi --help`
+
+        return periodic_values(self.t, self.F, self.duration, tq, side)
 
     def resampled_like(self, other):
         """This impulse seen through ``other``'s sampling (the simulated impulse
