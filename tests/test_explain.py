@@ -176,6 +176,19 @@ def test_first_order_lag_is_exact_for_a_step():
         assert out.evaluate(s) == pytest.approx(1 - np.exp(-s / tau), abs=1e-3)
     assert out.evaluate(0.5 + 0.02) == pytest.approx(np.exp(-0.02 / tau), abs=1e-3)
     assert np.all(out.F >= 0)
+    # at given times the closed form itself (a record's block needs only its sample
+    # times): exact, within the grid's interpolation error of the impulse's values, also
+    # periodic and through a model's observation
+    from discovery.vibroimpact.explain.effects import Model, first_order_lag_at
+
+    s = np.array([0.01, 0.03, 0.1, 0.52, 1.03, -0.97])
+    want = np.where(np.mod(s, W) < 0.5, 1 - np.exp(-np.mod(s, W) / tau), 0.0)
+    want[3] = np.exp(-0.02 / tau)
+    got = first_order_lag_at(imp, tau, s)
+    np.testing.assert_allclose(got, want, atol=1e-12)
+    np.testing.assert_allclose(got, out.evaluate(s), atol=1e-3)
+    observe = Model(ForceLaw.parse("1e8*z")).with_effect(effect("sensor_lag"), tau).observe()
+    np.testing.assert_array_equal(observe.at(imp, s), got)
 
 
 def test_first_order_lag_matches_an_integration_of_its_equation():

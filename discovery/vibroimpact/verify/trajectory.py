@@ -356,7 +356,8 @@ def simulated_history(
 
 def _observed(fold, Fs, observe):
     """A block's history at its sample times seen through the observation model (the
-    block taken as one periodic signal)."""
+    block taken as one periodic signal); ``observe.at(impulse, times)``, when the model
+    has it, gives those values without the observed impulse."""
     L = fold.end - fold.origin
     imp = Impulse(
         t=np.concatenate([[0.0], fold.td - fold.origin, [L]]),
@@ -366,7 +367,9 @@ def _observed(fold, Fs, observe):
         n_periods=fold.n_periods * fold.n_cycles,
         onset=fold.origin,
     )
-    return observe(imp).evaluate(fold.td - fold.origin)
+    at = getattr(observe, "at", None)
+    tq = fold.td - fold.origin
+    return at(imp, tq) if at is not None else observe(imp).evaluate(tq)
 
 
 def block_criteria(measured, simulated, span, names=None):
