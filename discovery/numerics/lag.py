@@ -47,7 +47,7 @@ def lag_at_knots(t, F, tau):
 @njit(cache=True)
 def _at(t, F, G, tau, tq, out):
     # the knot interval of each query by a walk from the previous one's (one pass over
-    # the knots for sorted queries, as the uniform grid of explain's sensor lag)
+    # the knots for sorted queries: a grid, or a record's sample times)
     last = t.shape[0] - 2
     i = 0
     for q in range(tq.shape[0]):

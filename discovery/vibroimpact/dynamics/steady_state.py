@@ -142,30 +142,24 @@ class StroboscopicMap:
         equations through the steps, the saltation matrix at every event), from one
         simulation.  A law with a permanent set (whose unloading memory the four states do
         not hold), or a run whose exact Jacobian is not finite (a grazing contact), takes
-        finite differences instead (four more simulations)."""
-        if self.exact:
-            S = np.eye(4)
-            self._run(y, n, 0.0, False, (S, self._state_dirs, self.scale, *self._no_sens[3:]))
-            self.n_exact += 1
-            if np.all(np.isfinite(S)):
-                return S
-        return self.fd_jacobian(y, n, fy)
+        finite differences instead (four more simulations, from ``fy`` when given)."""
+        return self.advance_jacobian(y, n, fy)[1]
 
-    def advance_jacobian(self, y, n=1):
-        """``(Phi^n(y), d Phi^n / d y)`` from one run with the variational equations, as
-        :meth:`jacobian`.  Its steps also control the Jacobian's error, so its state
+    def advance_jacobian(self, y, n=1, fy=None):
+        """``(Phi^n(y), d Phi^n / d y)`` from one run with the variational equations (see
+        :meth:`jacobian`).  Its steps also control the Jacobian's error, so its state
         differs from :meth:`advance`'s within the integrator's tolerance (2.6e-10 of the
         scales on the paper's orbit); Newton's reported residual is this run's.  (Along
         the state's own steps the Jacobian of the light scenario's orbit was off by 7e-5
-        and its multipliers by 3e-5.)  A law with a permanent set, or a run whose exact
-        Jacobian is not finite, gives the plain state and the finite differences."""
+        and its multipliers by 3e-5.)  Where the Jacobian takes differences the state is
+        the plain run's (``fy`` when given)."""
         if self.exact:
             S = np.eye(4)
-            fy = self._run(y, n, 0.0, True, (S, self._state_dirs, self.scale, *self._no_sens[3:]))
+            f = self._run(y, n, 0.0, False, (S, self._state_dirs, self.scale, *self._no_sens[3:]))
             self.n_exact += 1
             if np.all(np.isfinite(S)):
-                return fy, S
-        fy = self.advance(y, n)
+                return f, S
+        fy = self.advance(y, n) if fy is None else fy
         return fy, self.fd_jacobian(y, n, fy)
 
     def fd_jacobian(self, y, n=1, fy=None):
