@@ -35,7 +35,8 @@ from ..dynamics.response import impulse_from_steady_state
 from ..dynamics.simulate import simulate
 from ..dynamics.steady_state import steady_state
 from .criteria import compare, evaluate_criteria
-from .trajectory import block_criteria, simulated_history
+from .motion import MOTION_CRITERION, block_penetration
+from .trajectory import block_criteria, simulated_history, simulated_motion
 
 __all__ = [
     "Evaluation",
@@ -47,7 +48,11 @@ __all__ = [
     "CONSISTENCY_SLACK",
 ]
 
-CONSISTENCY_CRITERIA = ("I2", "I4")
+CONSISTENCY_CRITERIA = ("I2", "I4", "I5")
+"""The criteria the rule holds to their limits: I2 (the force history), I4 (the contact
+support) and, where positions are recorded, I5 (the penetration over the contacts,
+:mod:`~discovery.vibroimpact.verify.motion`); a criterion the record cannot give is not
+held."""
 CONSISTENCY_FACTOR = 2.0
 CONSISTENCY_SLACK = 0.005  # numerical agreement of two simulators, sampling effects
 
@@ -67,6 +72,7 @@ def consistency_limits(floor, sd=None):
         k: max(CONSISTENCY_FACTOR * floor[k], floor[k] + CONSISTENCY_SPREAD * sd.get(k, 0.0))
         + CONSISTENCY_SLACK
         for k in CONSISTENCY_CRITERIA
+        if k in floor
     }
 
 
@@ -440,7 +446,7 @@ def _evaluate_span(
     reg = {"measured": reference.regime, "simulated": None}
     imp = {"measured": reference.impacts, "simulated": None}
     try:
-        hist = simulated_history(
+        hist, z_sim = simulated_motion(
             scenario, law, span, tolerances=tolerances, observe=observe, window=smooth_onset
         )
     except IntegrationError as exc:
@@ -462,9 +468,14 @@ def _evaluate_span(
     sim = sims[-1]
     imp["simulated"] = int(len(sim.support))
     crit, per_block = block_criteria(reference.blocks, sims, span)
+    if span.sigma_z > 0:
+        crit[MOTION_CRITERION], _ = block_penetration(
+            span, reference.blocks, sims, [b.Z for b in span.blocks], z_sim
+        )
     last = span.blocks[-1]
     extra = {
         "comparison": "record span",
+        "penetration": z_sim,
         "blocks": list(zip(reference.blocks, sims, strict=True)),
         "span": {
             "start_time": span.state.t,
