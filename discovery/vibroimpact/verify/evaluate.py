@@ -36,7 +36,7 @@ from ..dynamics.simulate import simulate
 from ..dynamics.steady_state import steady_state
 from .criteria import compare, evaluate_criteria
 from .motion import MOTION_CRITERION, block_penetration
-from .trajectory import block_criteria, simulated_history, simulated_motion
+from .trajectory import block_criteria, simulated_motion
 
 __all__ = [
     "Evaluation",

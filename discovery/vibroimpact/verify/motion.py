@@ -46,10 +46,10 @@ def _runs(mask):
 def contact_window(fold, impulses, penetrations=(), pad=WINDOW_PAD):
     """Whether each of the fold's bins lies in the contact window, ndarray of bool of shape
     (k,): where either side is in contact by its force (the ``impulses``' supports) or by
-    its geometry (a folded penetration ``> 0``), widened by :data:`WINDOW_PAD` of a period
-    (``pad`` periods) on each side (cyclic over the fold's cycle).  The geometry matters: a law whose force
-    tail stays under the contact threshold still holds the bodies together, while the
-    recorded ones have parted."""
+    its geometry (a folded penetration ``> 0``), widened by ``pad`` drive periods on each
+    side (cyclic over the fold's cycle).  The geometry matters: a law whose force tail
+    stays under the contact threshold still holds the bodies together, while the recorded
+    ones have parted."""
     W = fold.duration
     pad = pad * fold.period
     iv = [np.asarray(imp.support, dtype=float).reshape(-1, 2) for imp in impulses]
