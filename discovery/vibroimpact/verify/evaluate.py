@@ -293,7 +293,7 @@ def evaluate(
     imp = {"measured": reference.impacts, "simulated": None}
     if from_state and reference.start is not None:
         steady_kwargs = {
-            "y_start": reference.start,
+            "y_start": scenario.model_state(reference.start),
             "t_start": reference.start_time,
             **steady_kwargs,
         }
@@ -390,7 +390,11 @@ def _span_steady_state(scenario, law, reference, last, span, sim, reg, tolerance
     ``reg``) and ``transient``: I2 between the law's trajectory over the last block and its
     steady orbit (``None`` without a periodic orbit).  Returns ``(steady state or None,
     transient)``."""
-    steady_kwargs = {"y_start": reference.start, "t_start": reference.start_time, **steady_kwargs}
+    steady_kwargs = {
+        "y_start": scenario.model_state(reference.start),
+        "t_start": reference.start_time,
+        **steady_kwargs,
+    }
     ss, transient = None, None
     try:
         ss = _steady(scenario, law, tolerances, steady_kwargs)

@@ -219,7 +219,7 @@ def _simulate_block(scenario, law, blk, y0, tolerances, **kwargs):
         scenario,
         law,
         (min(st.t, fold.td[0]), fold.end),
-        y0=st.y if y0 is None else y0,
+        y0=scenario.model_state(st.y if y0 is None else y0),
         t_eval=fold.td,
         tolerances=tolerances,
         **kwargs,
@@ -231,9 +231,9 @@ def _block_run(scenario, law, blk, y0, tolerances):
     block's measured state), the contact onsets of that run and its penetration at the
     sample times."""
     tr = _simulate_block(scenario, law, blk, y0, tolerances)
-    Z = np.asarray(tr.y[0] - tr.y[2], dtype=float)
+    zmax = float(np.max(tr.y[0] - tr.y[2]))
+    Z = scenario.recorded_penetration(tr.y[0] - tr.y[2])
     Z.setflags(write=False)
-    zmax = float(np.max(Z))
     if zmax > SINK_FACTOR * scenario.scales()[0]:
         raise IntegrationError(
             f"under law '{law}' the moulding sinks into the frame (penetration "
