@@ -449,8 +449,12 @@ class _Objective:
             # fractional power at zero penetration) is taken by differences
             exact &= np.all(np.isfinite(J), axis=0)
         # the variational equations give the force's rows; the penetration's rows of an
-        # exact column, and every row of the others, by forward differences
+        # exact column, and every row of the others, by forward differences.  Those
+        # penetration runs complete the exact Jacobian's one run: they are counted, but on
+        # top of the budget (which bounds the optimiser's own steps, as without positions)
         nf = r0.size - self.n_motion
+        if self.n_motion:
+            self.max_sim += int(np.count_nonzero(exact)) * len(self.records)
         for i in range(x.size):
             if exact[i] and not self.n_motion:
                 continue

@@ -348,6 +348,12 @@ def evaluate(
     # an undefined floor (no bootstrap replicate found the contacts) decides nothing
     consistent = bool(same and all(np.isfinite(lim[k]) and crit[k] <= lim[k] for k in lim))
     only_i4 = _only_i4(same, consistent, crit, lim)
+    verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim)
+    if verdict is not None and reference.noise:  # a record, not an exact reference
+        verdict += (
+            f"; {MOTION_CRITERION} (the penetration) not checked: the record has no "
+            "positions, or no free flight to start a simulation from"
+        )
     return Evaluation(
         "ok",
         reg,
@@ -355,7 +361,7 @@ def evaluate(
         crit,
         fl["mean"],
         consistent,
-        _verdict(consistent, reg, imp, crit, fl["mean"], lim),
+        verdict,
         steady=ss,
         simulated=sim,
         extra={"aligned": rot, "noise_floor_q95": fl["q95"], "only_I4": only_i4, "limits": lim},
