@@ -60,7 +60,8 @@ def test_identify_recovers_true_law(record, tmp_path):
     # noise-free data sampled at 20 kHz: the onset is known to O(dt^3), 0.3 % is ample
     assert abs(c["z"] / 2.06e8 - 1) < 3e-3 and abs(c["zd"] / 1.28e7 - 1) < 3e-3
     assert s["iterations"] and s["n_simulations"] >= s["iterations"][-1]["n_simulations"]
-    assert set(s["criteria"]) == {"I0", "I1", "I2", "I3", "I4"}
+    # I0..I4 of the force, I5 of the recorded penetration (the record has positions)
+    assert set(s["criteria"]) == {"I0", "I1", "I2", "I3", "I4", "I5"}
 
 
 @pytest.mark.parametrize(
@@ -143,7 +144,7 @@ def test_verify_command_writes_summary_and_figure(tmp_path):
     )
     d = json.loads((out / "summary.json").read_text())
     assert d["consistent"] is True and d["regime"] == {"measured": "P1", "simulated": "P1"}
-    assert set(d["noise_floor"]) == {"I0", "I1", "I2", "I3", "I4"}
+    assert set(d["noise_floor"]) == {"I0", "I1", "I2", "I3", "I4", "I5"}
     assert d["criteria"]["I2"] <= 2 * d["noise_floor"]["I2"] + 0.005
     assert (out / "verify.png").stat().st_size > 0
     # a wrong law is inconsistent; an empty law is one clear line, exit 2

@@ -53,7 +53,7 @@ def test_fit_summary_contents(fitted):
     # 150 periods from rest, 1 % noise: coefficients within 3 % (measured 0.2 %)
     assert abs(sel["coefficients"]["z"] / 2.06e8 - 1) < 0.03
     assert abs(sel["coefficients"]["zd"] / 1.28e7 - 1) < 0.03
-    assert set(sel["criteria"]) == {"I0", "I1", "I2", "I3", "I4"}
+    assert set(sel["criteria"]) == {"I0", "I1", "I2", "I3", "I4", "I5"}
     assert isinstance(s["ranking"], list) and s["ranking"]
     assert s["ranking"][0]["terms"] == sel["terms"]
     for m in s["ranking"]:

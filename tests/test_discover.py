@@ -62,7 +62,7 @@ def test_selects_true_support_p1_and_certified(result, paper):
         assert abs(c - true) < max(3 * se[name], 0.005 * abs(true)), (name, c, se[name])
         assert 0 < se[name] < 0.05 * abs(true)
     assert sel.regime == "P1"
-    assert set(sel.criteria) == {"I0", "I1", "I2", "I3", "I4"}
+    assert set(sel.criteria) == {"I0", "I1", "I2", "I3", "I4", "I5"}
     assert result.certificate.holds and result.certificate.worst_violation <= 1e-7
     # the certificate is on the data's box
     assert result.certificate.domain["zeta_max"] >= result.samples.zeta.max()

@@ -228,7 +228,9 @@ def test_catalogue_entries_are_complete():
         assert e.id and e.explanation and e.enters and e.signature and e.parameters
         assert e.target in TARGETS and e.key
         d = e.as_dict()
-        assert d["parameters"][0]["bounds"][0] >= 0
+        lo, hi = d["parameters"][0]["bounds"]
+        # zero (the effect absent) is within bounds; only an offset can be negative
+        assert lo <= 0 <= hi and (lo == 0 or e.id == "contact_offset"), e.id
     # the effects the paper's model cannot have say which of its conditions they leave
     assert "condition (5)" in effect("unloading_damping").departs
     assert {e.id for e in EFFECTS} >= {
@@ -257,8 +259,10 @@ def test_explain_cli_end_to_end(hidden_coupling, tmp_path, capsys):
     fm = s["final_model"]
     assert set(fm) >= {"terms", "coefficients", "uncertainties", "latex", "effects"}
     assert fm["effects"] == ["penetration_velocity_coupling"]
-    # I0..I4 of the averaged cycle, and D of the drift channel (orbit by orbit)
-    assert set(s["noise_floor"]) == {"I0", "I1", "I2", "I3", "I4", "D"} and s["stopped_because"]
+    # I0..I4 of the averaged cycle, I5 of the recorded penetration, and D of the drift
+    # channel (orbit by orbit)
+    assert set(s["noise_floor"]) == {"I0", "I1", "I2", "I3", "I4", "I5", "D"}
+    assert s["stopped_because"]
     assert (out / "explain_1.png").stat().st_size > 10_000
     assert "penetration_velocity_coupling" in capsys.readouterr().out
     bad = tmp_path / "bad"

@@ -114,7 +114,8 @@ def test_landscape_against_a_record(noisy_record, tmp_path, capsys):
     assert ref["sha256"] == hashlib.sha256(noisy_record.read_bytes()).hexdigest()
     assert ref["regime"] == "P1" and ref["start"] == "measured state"
     floor = s["noise_floor"]
-    assert set(floor) == set(CRITERIA) and all(v > 0 for v in floor.values())
+    # the force's criteria and I5, the recorded penetration's (the record has positions)
+    assert set(floor) == {*CRITERIA, "I5"} and all(v > 0 for v in floor.values())
     assert s["noise_floor_under"] == "206000000*z + 12800000*zd"
     # default ranges: 0.5x..1.5x the scenario's law, whose point is the centre
     assert s["alpha1"][2] == 2.06e8 and s["alpha2"][2] == 1.28e7

@@ -76,7 +76,8 @@ def test_a_residual_after_a_verification_reuses_its_simulations(span_record):
     runs = traj.MEMO.misses
     assert runs == len(ref.span.blocks)
     smooth = evaluate(sc, law, ref, floor=False, smooth_onset=True)
-    assert traj.MEMO.misses == runs and traj.MEMO.hits == runs
+    # no new run: the floor and the residual asked the verification's runs again
+    assert traj.MEMO.misses == runs and traj.MEMO.hits >= runs
     again = evaluate(sc, law, ref)
     _same(full, again)
     traj.MEMO.clear()

@@ -66,6 +66,9 @@ __all__ = [
 METHODS = ("coordinate-descent", "nelder-mead", "least-squares")
 # how a bootstrap replicate of the intervals is refitted (see bootstrap_intervals)
 INTERVAL_REFITS = ("two-step", "full")
+#: the bootstrap replicates' noise: the record's own residuals, each cycle's multiplied by
+#: one weight (``"cycles"``, the default), or white noise of the record's level (``"white"``)
+INTERVAL_NOISE = ("cycles", "white")
 _PENALTY = 10.0  # criterion value of a failed simulation (criteria are O(1))
 _JAC_STEP = 1e-5  # relative step of the standard-error Jacobian
 
@@ -732,6 +735,7 @@ def _checks(records, law, observe, tolerances):
     check=bool,
     workers=(None, Real(1, integer=True)),
     interval_refit=Choice(*INTERVAL_REFITS),
+    interval_noise=Choice(*INTERVAL_NOISE),
 )
 def identify(
     scenario,
@@ -752,6 +756,7 @@ def identify(
     check=True,
     workers=1,
     interval_refit="two-step",
+    interval_noise="cycles",
 ):
     """Identify the coefficients of ``start`` from one or several records by simulation.
 
@@ -793,6 +798,8 @@ def identify(
         intervals do not depend on it).
     interval_refit : str
         How a bootstrap replicate is refitted (:func:`bootstrap_intervals`: ``"two-step"``).
+    interval_noise : str
+        The replicates' noise (:func:`bootstrap_intervals`: ``"cycles"``).
     progress : callable, optional
         ``progress(stage, done, total)`` after each simulation (:mod:`discovery._progress`).
     short_first : bool
@@ -855,8 +862,7 @@ def identify(
     evs = obj.evaluations(x_best)
     se, corr = {}, None
     if uncertainty:
-        # the error estimate has its own budget: a sensitivity run per record, and the
-        # penetration's rows by differences
+        # the error estimate's own budget (the penetration's rows by differences)
         obj.max_sim += (len(x_best) + 1) * len(records) * (2 if obj.n_motion else 1)
         se, corr = _uncertainty(obj, x_best, law.names)
     crit = {k: float(np.mean([e.criteria[k] for e in evs])) for k in evs[0].criteria}
@@ -868,8 +874,7 @@ def identify(
     intervals = None
     if n_boot_intervals:
         intervals = bootstrap_intervals(
-            [sc for sc, _ in records],
-            [r for _, r in records],
+            *zip(*records, strict=True),
             law,
             n_boot=int(n_boot_intervals),
             seed=seed,
@@ -877,6 +882,7 @@ def identify(
             tolerances=tolerances,
             workers=workers,
             refit=interval_refit,
+            noise=interval_noise,
         )
     return IdentificationResult(
         checks=_checks(records, law, observe, tolerances) if check else (),
@@ -898,8 +904,8 @@ def identify(
 
 
 # ------------------------------------------------------------------ bootstrap intervals
-# Coefficient intervals by a parametric bootstrap through the full processing (a refit per
-# replicate: it lives beside the fit it repeats).
+# Coefficient intervals by a bootstrap through the full processing (a refit per replicate:
+# it lives beside the fit it repeats).
 #
 # The Jacobian standard errors of an output-error fit assume white residuals.  A record
 # compared over its span has two more sources of error that they miss: the machine's state
@@ -907,9 +913,15 @@ def identify(
 # every later impact of the block), and the record's own sampling.  The bootstrap repeats
 # the whole experiment under the fitted model: for each replicate, every block is simulated
 # from a state drawn from that block's state-fit covariance, sampled at the record's own
-# sample times with the record's force noise, folded like the record, and refitted from the
-# fitted model; the spread of the refitted coefficients gives the intervals.  Seeds are
-# explicit.
+# sample times with noise, folded like the record, and refitted from the fitted model; the
+# spread of the refitted coefficients gives the intervals.  Seeds are explicit.
+#
+# The noise is the record's own residual against the fitted model, force and penetration,
+# each cycle's multiplied by one weight drawn from Webb's six-point distribution (a wild
+# bootstrap with the cycles as clusters: Cameron, Gelbach & Miller 2008; Webb 2023).  White
+# noise of the record's level (``noise="white"``) misses what repeats within a cycle: an
+# onset's timing, a force sensor's own structure, a misfit the model leaves; the cycles'
+# residuals carry it.
 #
 # The refit is two Gauss-Newton steps from the fitted model by default (the k-step
 # bootstrap of Davidson & MacKinnon 1999 and Andrews 2002, k = 2: the replicate's estimate
@@ -955,8 +967,26 @@ class Intervals:
         }
 
 
-def _replicate(scenario, law, observe, ref, rng, tolerances):
-    """A synthetic copy of ``ref`` made by ``law`` (the same span, states and sample times)."""
+# Webb's six-point weights: mean 0, variance 1, and more distinct replicates than signs when
+# a record has a dozen cycles
+_WEBB = np.array([-np.sqrt(1.5), -1.0, -np.sqrt(0.5), np.sqrt(0.5), 1.0, np.sqrt(1.5)])
+
+
+def _cycle_weights(fold, rng):
+    """One Webb weight per cycle of ``fold``, at each folded sample, ndarray of shape (m,)."""
+    c = np.clip(((fold.td - fold.origin) // fold.duration).astype(int), 0, fold.n_cycles - 1)
+    return rng.choice(_WEBB, fold.n_cycles)[c]
+
+
+def _replicate(scenario, law, observe, ref, rng, tolerances, noise="cycles"):
+    """A synthetic copy of ``ref`` made by ``law`` (the same span, states and sample times).
+
+    Every block is simulated from a state drawn from its state fit's covariance; its noise
+    is, with ``noise="cycles"``, the record's own residual against ``law`` (force and
+    penetration) with each cycle's multiplied by one random weight (a wild bootstrap by
+    cycles: what repeats within a cycle, correlated noise, an onset's timing, a misfit the
+    model leaves, is kept, and only its sign and size vary between cycles), or white noise
+    of the record's level (``"white"``)."""
     from ..verify.trajectory import simulated_motion
 
     span = ref.span
@@ -964,14 +994,22 @@ def _replicate(scenario, law, observe, ref, rng, tolerances):
     hist, zs = simulated_motion(
         scenario, law, span, tolerances=tolerances, starts=starts, observe=observe
     )
-    blocks = tuple(
-        replace(
-            b,
-            F=h + rng.normal(0.0, span.sigma_f, h.size),
-            Z=z + rng.normal(0.0, span.sigma_z, z.size),
+    if noise == "cycles":
+        fit_F, fit_Z = simulated_motion(scenario, law, span, tolerances=tolerances, observe=observe)
+        blocks = []
+        for b, h, z, f0, z0 in zip(span.blocks, hist, zs, fit_F, fit_Z, strict=True):
+            v = _cycle_weights(b.fold, rng)
+            blocks.append(replace(b, F=h + v * (b.F - f0), Z=z + v * (b.Z - z0)))
+        blocks = tuple(blocks)
+    else:
+        blocks = tuple(
+            replace(
+                b,
+                F=h + rng.normal(0.0, span.sigma_f, h.size),
+                Z=z + rng.normal(0.0, span.sigma_z, z.size),
+            )
+            for b, h, z in zip(span.blocks, hist, zs, strict=True)
         )
-        for b, h, z in zip(span.blocks, hist, zs, strict=True)
-    )
     span2 = replace(span, blocks=blocks)
     imps = tuple(span2.measured(onset_record_time=ref.impulse.onset))
     return replace(ref, span=span2, blocks=imps, impulse=imps[-1], _source=None)
@@ -1039,8 +1077,10 @@ def bootstrap_intervals(
     workers=1,
     executor=None,
     refit="two-step",
+    noise="cycles",
 ):
-    """Intervals of ``model``'s coefficients by a parametric bootstrap (module docstring).
+    """Intervals of ``model``'s coefficients by a bootstrap through the record-span
+    processing (the comment above).
 
     Parameters
     ----------
@@ -1069,6 +1109,10 @@ def bootstrap_intervals(
     refit : str
         ``"two-step"`` (default): two Gauss-Newton steps from the fitted model with the
         exact Jacobian (the comment above); ``"full"``: a least-squares refit.
+    noise : str
+        The replicates' noise (:data:`INTERVAL_NOISE`): ``"cycles"`` (default), the
+        record's own residuals with one random weight per cycle; ``"white"``, white noise
+        of the record's level (a parametric bootstrap).
 
     Returns
     -------
@@ -1084,6 +1128,8 @@ def bootstrap_intervals(
         raise InputError(f"level must be in (0, 1); got {level!r}")
     if refit not in INTERVAL_REFITS:
         raise InputError(f"unknown refit {refit!r}; valid: {', '.join(INTERVAL_REFITS)}")
+    if noise not in INTERVAL_NOISE:
+        raise InputError(f"unknown noise {noise!r}; valid: {', '.join(INTERVAL_NOISE)}")
     records = as_records(scenario, reference)
     if any(getattr(ref, "span", None) is None for _, ref in records):
         return None
@@ -1095,7 +1141,10 @@ def bootstrap_intervals(
     for _ in range(n_boot):
         try:
             replicates.append(
-                [_replicate(machine(sc), law, observe, ref, rng, tolerances) for sc, ref in records]
+                [
+                    _replicate(machine(sc), law, observe, ref, rng, tolerances, noise)
+                    for sc, ref in records
+                ]
             )
         except IntegrationError:
             continue
@@ -1128,7 +1177,12 @@ def bootstrap_intervals(
         level=float(level),
         n_boot=len(draws),
         seed=int(seed),
-        method="parametric bootstrap through the record-span processing ("
+        method=(
+            "wild bootstrap by cycles (the record's residuals, one weight per cycle)"
+            if noise == "cycles"
+            else "parametric bootstrap"
+        )
+        + " through the record-span processing ("
         + ("two Gauss-Newton steps" if refit == "two-step" else "a least-squares refit")
         + " per replicate)",
     )

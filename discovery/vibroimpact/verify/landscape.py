@@ -126,7 +126,7 @@ class Landscape:
         a0, a1 = self.axes
         count, first, at = self.failures
         minima = {}
-        for n in CRITERIA:
+        for n in self.values:
             ij = self.argmin(n)
             minima[n] = (
                 None
@@ -137,14 +137,14 @@ class Landscape:
                     "value": self.values[n][ij],
                     "regime": self.regime[ij],
                     "consistent": bool(self.consistent[ij]),
-                    "noise_floor": self.noise_floor[n],
+                    "noise_floor": (self.noise_floor or {}).get(n),
                 }
             )
         return {
             "terms": self.terms,
             "alpha1": a0,
             "alpha2": a1,
-            **{n: self.values[n] for n in CRITERIA},
+            **self.values,
             "regime": self.regime.tolist(),
             "impacts": self.impacts,
             "consistent": self.consistent,
@@ -421,8 +421,8 @@ def landscape(
             for j, (reg, k, crit, ok, msg) in enumerate(row):
                 regime[i, j], impacts[i, j], consistent[i, j], messages[i, j] = reg, k, ok, msg
                 if crit is not None:
-                    for n, v in crit.items():
-                        values[n][i, j] = v
+                    for n, v in crit.items():  # I5 too where the record has positions
+                        values.setdefault(n, np.full(shape, np.nan))[i, j] = v
     finally:
         if own:
             ex.close()

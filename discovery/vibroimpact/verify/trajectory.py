@@ -48,6 +48,11 @@ SINK_FACTOR = 10.0
 """A simulated penetration beyond this many motion scales (:meth:`Scenario.scales`) is no
 contact any more: the law lets the moulding sink into the frame."""
 
+POSITION_RESOLUTION = 1e-4
+"""The penetration's noise is taken as at least this share of its range over the record (a
+position sensor of about 14 bits): noise-free positions (a synthetic record) would weigh the
+penetration without bound against the force."""
+
 BLOCK_CYCLES = 4
 """Cycles per block: a long record (a run-up, a drift) is compared block by block, each
 block folded on its own and simulated from the machine's state just before it."""
@@ -201,7 +206,8 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
         blocks.append(blk)
     if not blocks:
         return None
-    return RecordSpan(blocks=tuple(blocks), sigma_f=sigma, sigma_z=float(estimate_noise(zeta, 3)))
+    sigma_z = max(float(estimate_noise(zeta, 3)), POSITION_RESOLUTION * float(np.ptp(zeta)))
+    return RecordSpan(blocks=tuple(blocks), sigma_f=sigma, sigma_z=sigma_z)
 
 
 MEMO = Memo(64)
