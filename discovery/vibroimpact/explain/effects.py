@@ -264,6 +264,8 @@ def small_step(eff, scenario, peak, tau, v, z0):
         return 0.02
     if eff.target == "observation":
         return 0.01 * tau
+    if eff.key == "offset":
+        return 0.01 * z0
     if eff.key == "k3":
         x = abs(float(scenario.initial_state()[0])) + scenario.scales()[0]
         return 0.01 * max(scenario.k1, 1e-300) / x**2
@@ -366,6 +368,22 @@ EFFECTS = (
         phases=("drift",),
         target="scenario",
         key="mass_loss",
+    ),
+    Effect(
+        id="contact_offset",
+        title="Contact offset (a clearance, or the position sensors' zero offset)",
+        explanation="The contact does not start where the recorded penetration w1 - w2 "
+        "crosses zero but at a recorded penetration delta0: a clearance between the "
+        "bodies, or position sensors whose zeros differ by delta0. The force then "
+        "acts only beyond delta0, and a law fitted from zero penetration trades its "
+        "spring for damping.",
+        enters="the machine's contact offset delta0 [m] (the recorded penetration at which "
+        "contact starts; a record with positions)",
+        signature="the force starts and ends at a recorded penetration that is not zero",
+        parameters=(Parameter("delta0", "m", (-1.0, 1.0)),),
+        phases=("onset", "separation"),
+        target="scenario",
+        key="offset",
     ),
     Effect(
         id="sensor_lag",

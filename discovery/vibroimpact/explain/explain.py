@@ -69,6 +69,7 @@ from ..fit.identify import (
 from ..model.law import ForceLaw, Term
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
+from ..verify.motion import MOTION_CRITERION, penetration_residuals
 from . import drift as D
 from .effects import EFFECTS, Model, effect, small_step
 from .localise import localise
@@ -480,7 +481,9 @@ class _Problem:
         return evs
 
     def residual(self, model):
-        """The force residual of every compared cycle (the optimisers' continuous form)."""
+        """The force residual of every compared cycle (the optimisers' continuous form),
+        then the recorded penetration's in the force's units
+        (:func:`~discovery.vibroimpact.verify.motion.penetration_residuals`)."""
         evs = self.evaluations(model, smooth_onset=True)
         if not all(e.status == "ok" for e in evs):
             return None
@@ -490,6 +493,7 @@ class _Problem:
                 for e, (_, ref) in zip(evs, self.records, strict=True)
                 for E, S in cycle_pairs(e, ref)
             ]
+            + [penetration_residuals(ref, e) for e, (_, ref) in zip(evs, self.records, strict=True)]
         )
 
     def value(self, model, criterion):
@@ -583,6 +587,17 @@ def _within_noise(evs, criterion):
         if criterion not in lim or not e.criteria[criterion] <= lim[criterion]:
             return False
     return True
+
+
+def _motion_within(evs):
+    """The recorded penetration (I5) within its consistency limit on every record that has
+    it: a law that trades spring for damping matches the force, not the motion, and is
+    still to be explained."""
+    return all(
+        MOTION_CRITERION not in e.limits
+        or e.criteria.get(MOTION_CRITERION, np.inf) <= e.limits[MOTION_CRITERION]
+        for e in evs
+    )
 
 
 def _failing(evs):
@@ -971,7 +986,7 @@ def _screen_effects(run, evs, loc, cycle_ok):
     # a cycle within its noise leaves only the drift to explain: consistent, or failing
     # I4 alone (the supports of a noisy record) while the criterion the refits lower is
     # within its limit (lowering it further would fit the noise)
-    quiet = cycle_ok or _within_noise(evs, run.criterion)
+    quiet = cycle_ok or (_within_noise(evs, run.criterion) and _motion_within(evs))
     cands = [
         e
         for e in run.catalogue

@@ -48,6 +48,7 @@ from ..model.law import ForceLaw, Term
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
 from ..verify.criteria import criterion as _criterion
+from ..verify.motion import penetration_residuals, penetration_size
 
 __all__ = [
     "IdentificationResult",
@@ -315,6 +316,8 @@ class _Objective:
         self.w = [_residual_weights(ref) for _, ref in records]
         # which residual columns the variational equations give (fixed by the start)
         self.exact_columns = self._exact_columns()
+        # the penetration's residual rows (records with positions), after the force's
+        self.n_motion = sum(penetration_size(ref) for _, ref in self.records)
 
     def law(self, x):
         return self.start.with_coefficients(self.c0 * np.asarray(x))
@@ -384,15 +387,21 @@ class _Objective:
                     for (_, ref), ws in zip(self.records, self.w, strict=True)
                     for E, w in zip(_measured_cycles(ref), ws, strict=True)
                 ]
+                + [np.zeros(self.n_motion)]
             )
         self(x)  # records the path with the requested criterion
         # the first point (F_E(0+), extrapolated from samples for an aligned cycle) is left
-        # out so the fit is not biased by the extrapolation error at the jump
+        # out so the fit is not biased by the extrapolation error at the jump; the recorded
+        # penetration's residual (records with positions) follows the force's
         return np.concatenate(
             [
                 ((S.F - E.F) * w)[1:]
                 for ev, (_, ref), ws in zip(evs, self.records, self.w, strict=True)
                 for (E, S), w in zip(cycle_pairs(ev, ref), ws, strict=True)
+            ]
+            + [
+                penetration_residuals(ref, ev, ws)
+                for ev, (_, ref), ws in zip(evs, self.records, self.w, strict=True)
             ]
         )
 
@@ -439,11 +448,24 @@ class _Objective:
             # a column that is not finite (a graze at an onset, an infinite slope of a
             # fractional power at zero penetration) is taken by differences
             exact &= np.all(np.isfinite(J), axis=0)
-        for i in np.flatnonzero(~exact):
+        # the variational equations give the force's rows; the penetration's rows of an
+        # exact column, and every row of the others, by forward differences.  Those
+        # penetration runs complete the exact Jacobian's one run: they are counted, but on
+        # top of the budget (which bounds the optimiser's own steps, as without positions)
+        nf = r0.size - self.n_motion
+        if self.n_motion:
+            self.max_sim += int(np.count_nonzero(exact)) * len(self.records)
+        for i in range(x.size):
+            if exact[i] and not self.n_motion:
+                continue
             xi = x.copy()
             h = 1e-6 * max(1.0, abs(x[i]))
             xi[i] += h
-            J[:, i] = (self.residuals(xi) - r0) / h
+            d = (self.residuals(xi) - r0) / h
+            if exact[i]:
+                J[nf:, i] = d[nf:]
+            else:
+                J[:, i] = d
         return J
 
     def _exact_jacobian(self, x, cols, J):
@@ -833,7 +855,9 @@ def identify(
     evs = obj.evaluations(x_best)
     se, corr = {}, None
     if uncertainty:
-        obj.max_sim += len(x_best) * len(records)  # the error estimate has its own budget
+        # the error estimate has its own budget: a sensitivity run per record, and the
+        # penetration's rows by differences
+        obj.max_sim += (len(x_best) + 1) * len(records) * (2 if obj.n_motion else 1)
         se, corr = _uncertainty(obj, x_best, law.names)
     crit = {k: float(np.mean([e.criteria[k] for e in evs])) for k in evs[0].criteria}
     if obj.failures:
@@ -933,16 +957,20 @@ class Intervals:
 
 def _replicate(scenario, law, observe, ref, rng, tolerances):
     """A synthetic copy of ``ref`` made by ``law`` (the same span, states and sample times)."""
-    from ..verify.trajectory import simulated_history
+    from ..verify.trajectory import simulated_motion
 
     span = ref.span
     starts = [b.state.draw(rng) for b in span.blocks]
-    hist = simulated_history(
+    hist, zs = simulated_motion(
         scenario, law, span, tolerances=tolerances, starts=starts, observe=observe
     )
     blocks = tuple(
-        replace(b, F=h + rng.normal(0.0, span.sigma_f, h.size))
-        for b, h in zip(span.blocks, hist, strict=True)
+        replace(
+            b,
+            F=h + rng.normal(0.0, span.sigma_f, h.size),
+            Z=z + rng.normal(0.0, span.sigma_z, z.size),
+        )
+        for b, h, z in zip(span.blocks, hist, zs, strict=True)
     )
     span2 = replace(span, blocks=blocks)
     imps = tuple(span2.measured(onset_record_time=ref.impulse.onset))

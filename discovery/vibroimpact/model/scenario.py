@@ -35,9 +35,12 @@ _FIELDS = {
     "g": ("m/s^2", False),
     "k3": ("N/m^3", False),
     "mass_loss": ("per impact", False),
+    "offset": ("m", False),
 }
+#: parameters that may be negative (|value| <= the limit)
+_SIGNED = {"offset"}
 #: parameters a scenario file may leave out (their defaults: the paper's machine)
-_OPTIONAL = {"g": 9.81, "k3": 0.0, "mass_loss": 0.0}
+_OPTIONAL = {"g": 9.81, "k3": 0.0, "mass_loss": 0.0, "offset": 0.0}
 #: largest accepted value of each parameter: far beyond any vibro-impact machine, and
 #: small enough that the simulation's scales (A / (m1 omega^2), k1 / m1, ...) stay finite
 LIMITS = {
@@ -50,6 +53,7 @@ LIMITS = {
     "g": 1e3,
     "k3": 1e24,
     "mass_loss": 0.5,
+    "offset": 1.0,
 }
 #: largest accepted |position| [m] and |velocity| [m/s] of the initial state
 INITIAL_LIMITS = (1e3, 1e3)
@@ -105,6 +109,13 @@ class Scenario:
         Fraction of the moulding's mass shed at each impact, in [0, 0.5] (sand falling
         out of the flask); 0 for the paper's constant mass.  With a loss the motion
         drifts and has no periodic steady state: it is simulated over a record's span.
+    offset : float
+        Contact offset ``delta0`` [m], ``|delta0| <= 1``: contact starts where the
+        *recorded* penetration ``w1 - w2`` reaches ``delta0`` (a clearance, or a zero
+        offset of the position sensors); 0 when the sensors' zero is the contact.  The
+        moulding moves freely between contacts, so the offset shifts the recorded moulding
+        position against the model's and changes no dynamics: it enters wherever a
+        simulation starts from, or is compared with, recorded positions.
     law : ForceLaw or None
         The reference ("true") contact law, if the scenario has one.
     initial : tuple of 4 floats or None
@@ -128,6 +139,7 @@ class Scenario:
     source: str = field(default="", compare=False)
     k3: float = 0.0
     mass_loss: float = 0.0
+    offset: float = 0.0
 
     def __post_init__(self):
         check("Scenario: name", self.name, Text(200))
@@ -136,8 +148,9 @@ class Scenario:
         for key, (unit, strict) in _FIELDS.items():
             value = _number(getattr(self, key), f"scenario {key}", unit)
             lim = LIMITS[key]
-            if not (math.isfinite(value) and 0 <= value <= lim) or (strict and value == 0):
-                need = "> 0" if strict else ">= 0"
+            low = -lim if key in _SIGNED else 0.0
+            if not (math.isfinite(value) and low <= value <= lim) or (strict and value == 0):
+                need = "> 0" if strict else (f">= {low:g}" if low else ">= 0")
                 raise InputError(
                     f"scenario {key} = {value:g} {unit} is invalid; it must be finite, {need} "
                     f"and <= {lim:g} {unit}"
@@ -203,6 +216,18 @@ class Scenario:
             w1 = float(np.real(roots[np.argmin(np.abs(np.imag(roots)))]))
         return np.array([w1, 0.0, w1, 0.0])
 
+    def model_state(self, y):
+        """A recorded state ``(w1, v1, w2, v2)`` in the model's coordinates: the moulding's
+        position shifted by the contact :attr:`offset` (a copy, ndarray of shape (4,))."""
+        y = np.array(y, dtype=float)
+        y[2] += self.offset
+        return y
+
+    def recorded_penetration(self, zeta):
+        """The model's penetration ``zeta`` [m] as the position sensors record it
+        (``zeta + offset``), ndarray."""
+        return np.asarray(zeta, dtype=float) + self.offset
+
     def scales(self):
         """Characteristic displacement [m] and velocity [m/s] of the motion."""
         w2 = self.omega**2
@@ -251,6 +276,7 @@ class Scenario:
                 "source",
                 "k3",
                 "mass_loss",
+                "offset",
             )
         }
 

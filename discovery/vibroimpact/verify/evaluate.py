@@ -35,7 +35,8 @@ from ..dynamics.response import impulse_from_steady_state
 from ..dynamics.simulate import simulate
 from ..dynamics.steady_state import steady_state
 from .criteria import compare, evaluate_criteria
-from .trajectory import block_criteria, simulated_history
+from .motion import MOTION_CRITERION, block_penetration
+from .trajectory import block_criteria, simulated_motion
 
 __all__ = [
     "Evaluation",
@@ -47,7 +48,11 @@ __all__ = [
     "CONSISTENCY_SLACK",
 ]
 
-CONSISTENCY_CRITERIA = ("I2", "I4")
+CONSISTENCY_CRITERIA = ("I2", "I4", "I5")
+"""The criteria the rule holds to their limits: I2 (the force history), I4 (the contact
+support) and, where positions are recorded, I5 (the penetration over the contacts,
+:mod:`~discovery.vibroimpact.verify.motion`); a criterion the record cannot give is not
+held."""
 CONSISTENCY_FACTOR = 2.0
 CONSISTENCY_SLACK = 0.005  # numerical agreement of two simulators, sampling effects
 
@@ -67,6 +72,7 @@ def consistency_limits(floor, sd=None):
         k: max(CONSISTENCY_FACTOR * floor[k], floor[k] + CONSISTENCY_SPREAD * sd.get(k, 0.0))
         + CONSISTENCY_SLACK
         for k in CONSISTENCY_CRITERIA
+        if k in floor
     }
 
 
@@ -287,7 +293,7 @@ def evaluate(
     imp = {"measured": reference.impacts, "simulated": None}
     if from_state and reference.start is not None:
         steady_kwargs = {
-            "y_start": reference.start,
+            "y_start": scenario.model_state(reference.start),
             "t_start": reference.start_time,
             **steady_kwargs,
         }
@@ -342,6 +348,12 @@ def evaluate(
     # an undefined floor (no bootstrap replicate found the contacts) decides nothing
     consistent = bool(same and all(np.isfinite(lim[k]) and crit[k] <= lim[k] for k in lim))
     only_i4 = _only_i4(same, consistent, crit, lim)
+    verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim)
+    if verdict is not None and reference.noise:  # a record, not an exact reference
+        verdict += (
+            f"; {MOTION_CRITERION} (the penetration) not checked: the record has no "
+            "positions, or no free flight to start a simulation from"
+        )
     return Evaluation(
         "ok",
         reg,
@@ -349,7 +361,7 @@ def evaluate(
         crit,
         fl["mean"],
         consistent,
-        _verdict(consistent, reg, imp, crit, fl["mean"], lim),
+        verdict,
         steady=ss,
         simulated=sim,
         extra={"aligned": rot, "noise_floor_q95": fl["q95"], "only_I4": only_i4, "limits": lim},
@@ -384,7 +396,11 @@ def _span_steady_state(scenario, law, reference, last, span, sim, reg, tolerance
     ``reg``) and ``transient``: I2 between the law's trajectory over the last block and its
     steady orbit (``None`` without a periodic orbit).  Returns ``(steady state or None,
     transient)``."""
-    steady_kwargs = {"y_start": reference.start, "t_start": reference.start_time, **steady_kwargs}
+    steady_kwargs = {
+        "y_start": scenario.model_state(reference.start),
+        "t_start": reference.start_time,
+        **steady_kwargs,
+    }
     ss, transient = None, None
     try:
         ss = _steady(scenario, law, tolerances, steady_kwargs)
@@ -440,7 +456,7 @@ def _evaluate_span(
     reg = {"measured": reference.regime, "simulated": None}
     imp = {"measured": reference.impacts, "simulated": None}
     try:
-        hist = simulated_history(
+        hist, z_sim = simulated_motion(
             scenario, law, span, tolerances=tolerances, observe=observe, window=smooth_onset
         )
     except IntegrationError as exc:
@@ -462,9 +478,14 @@ def _evaluate_span(
     sim = sims[-1]
     imp["simulated"] = int(len(sim.support))
     crit, per_block = block_criteria(reference.blocks, sims, span)
+    if span.sigma_z > 0:
+        crit[MOTION_CRITERION], _ = block_penetration(
+            span, reference.blocks, sims, [b.Z for b in span.blocks], z_sim
+        )
     last = span.blocks[-1]
     extra = {
         "comparison": "record span",
+        "penetration": z_sim,
         "blocks": list(zip(reference.blocks, sims, strict=True)),
         "span": {
             "start_time": span.state.t,

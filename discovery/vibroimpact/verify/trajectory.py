@@ -26,6 +26,7 @@ from ..dynamics import _kernel as _K
 from ..dynamics.simulate import simulate
 from .criteria import CRITERIA, evaluate_criteria
 from .fold import make_fold
+from .motion import MOTION_CRITERION, block_penetration
 from .state import free_flight_runs, free_flight_state
 
 __all__ = [
@@ -33,6 +34,7 @@ __all__ = [
     "RecordSpan",
     "record_span",
     "simulated_history",
+    "simulated_motion",
     "history_sensitivities",
     "block_criteria",
     "span_floor",
@@ -65,12 +67,15 @@ class Block:
         The measured force at the folded samples [N].
     threshold : float
         Contact threshold of the folded cycle [N].
+    Z : ndarray of shape (m,)
+        The recorded penetration ``w1 - w2`` at the folded samples [m].
     """
 
     fold: object
     state: object
     F: np.ndarray
     threshold: float
+    Z: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -83,10 +88,13 @@ class RecordSpan:
         In time order; the last one ends with the record.
     sigma_f : float
         Force noise of one sample [N].
+    sigma_z : float
+        Penetration noise of one sample [m] (both position channels').
     """
 
     blocks: tuple
     sigma_f: float
+    sigma_z: float = 0.0
 
     @property
     def state(self):
@@ -187,13 +195,13 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
         Fi = F[fold.idx]
         peak = float(np.max(fold.average(Fi)))
         thr = max(5.0 * sigma / np.sqrt(fold.n_cycles), 1e-3 * peak)
-        blk = Block(fold=fold, state=state, F=Fi, threshold=thr)
+        blk = Block(fold=fold, state=state, F=Fi, threshold=thr, Z=zeta[fold.idx])
         if not len(fold.impulse(Fi, threshold=thr, noise=sigma).support):
             continue  # no contact in these cycles (a run-up's start): nothing to compare
         blocks.append(blk)
     if not blocks:
         return None
-    return RecordSpan(blocks=tuple(blocks), sigma_f=sigma)
+    return RecordSpan(blocks=tuple(blocks), sigma_f=sigma, sigma_z=float(estimate_noise(zeta, 3)))
 
 
 MEMO = Memo(64)
@@ -211,7 +219,7 @@ def _simulate_block(scenario, law, blk, y0, tolerances, **kwargs):
         scenario,
         law,
         (min(st.t, fold.td[0]), fold.end),
-        y0=st.y if y0 is None else y0,
+        y0=scenario.model_state(st.y if y0 is None else y0),
         t_eval=fold.td,
         tolerances=tolerances,
         **kwargs,
@@ -220,9 +228,12 @@ def _simulate_block(scenario, law, blk, y0, tolerances, **kwargs):
 
 def _block_run(scenario, law, blk, y0, tolerances):
     """The law's force at a block's sample times, simulated from ``y0`` (default the
-    block's measured state), and the contact onsets of that run."""
+    block's measured state), the contact onsets of that run and its penetration at the
+    sample times."""
     tr = _simulate_block(scenario, law, blk, y0, tolerances)
     zmax = float(np.max(tr.y[0] - tr.y[2]))
+    Z = scenario.recorded_penetration(tr.y[0] - tr.y[2])
+    Z.setflags(write=False)
     if zmax > SINK_FACTOR * scenario.scales()[0]:
         raise IntegrationError(
             f"under law '{law}' the moulding sinks into the frame (penetration "
@@ -231,7 +242,7 @@ def _block_run(scenario, law, blk, y0, tolerances):
         )
     F = np.asarray(tr.force, dtype=float)
     F.setflags(write=False)
-    return F, tr.event_t[tr.event_kind == _K.EV_ONSET]
+    return F, tr.event_t[tr.event_kind == _K.EV_ONSET], Z
 
 
 def _onset_weights(td, onsets):
@@ -328,17 +339,32 @@ def simulated_history(
         One history per block.  Raises :class:`~discovery.errors.IntegrationError` when a
         simulation fails.
     """
-    out = []
+    return simulated_motion(
+        scenario, law, span, tolerances=tolerances, starts=starts, observe=observe, window=window
+    )[0]
+
+
+def _runs(scenario, law, span, tolerances, starts):
+    """Each block's run ``(block, F, onsets, Z)`` from its measured state (memoised: the
+    fitting loops ask again) or from ``starts`` (a bootstrap draw: asked once)."""
     for k, blk in enumerate(span.blocks):
+        if starts is None:
+            key = value_key(scenario, law, tolerances, id(blk))
+            yield MEMO.get(key, lambda b=blk: (b, *_block_run(scenario, law, b, None, tolerances)))
+        else:
+            yield (blk, *_block_run(scenario, law, blk, starts[k], tolerances))
+
+
+def simulated_motion(
+    scenario, law, span, *, tolerances=None, starts=None, observe=None, window=False
+):
+    """:func:`simulated_history` and, from the same runs, the simulated penetration at the
+    span's sample times: ``(histories, penetrations)``, one array per block each."""
+    out, zs = [], []
+    for blk, F, onsets, Z in _runs(scenario, law, span, tolerances, starts):
         fold = blk.fold
         td = fold.td
-        if starts is None:  # from the measured state: the fitting loops ask this again
-            key = value_key(scenario, law, tolerances, id(blk))
-            _, F, onsets = MEMO.get(
-                key, lambda b=blk: (b, *_block_run(scenario, law, b, None, tolerances))
-            )
-        else:  # a bootstrap draw: asked once
-            F, onsets = _block_run(scenario, law, blk, starts[k], tolerances)
+        zs.append(Z)
         Fs = F.copy()
         if window and td.size > 1:
             # the sample whose interval [e_i, e_i+1) holds a contact onset at fraction u is
@@ -351,7 +377,7 @@ def simulated_history(
                 w = np.abs(2.0 * u - 1.0)
                 Fs[k] = blk.F[k] + w * (Fs[k] - blk.F[k])
         out.append(Fs if observe is None else _observed(fold, Fs, observe))
-    return out
+    return out, zs
 
 
 def _observed(fold, Fs, observe):
@@ -398,37 +424,46 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
     Returns
     -------
     dict
-        ``{"mean": {I0..I4}, "q95": {I0..I4}, "sd": {I0..I4}, "n_boot": n, "seed": seed,
+        ``{"mean": {I0..I5}, "q95": {I0..I5}, "sd": {I0..I5}, "n_boot": n, "seed": seed,
         "impacts": [contacts per cycle of each replicate's last block]}``.
     """
     rng = np.random.default_rng(seed)
-    samples = {n: [] for n in CRITERIA}
+    # the penetration noise from its own stream: the force criteria's floor is unchanged
+    rng_z = np.random.default_rng((seed, 5))
+    names = list(CRITERIA) + ([MOTION_CRITERION] if span.sigma_z > 0 else [])
+    samples = {n: [] for n in names}
     impacts = []  # contacts per cycle each replicate shows (noise can split a contact)
     base = None
+    z_sim = None
     for _ in range(n_boot):
         starts = [b.state.draw(rng) for b in span.blocks]
         noise = [rng.normal(0.0, span.sigma_f, b.F.size) for b in span.blocks]
+        noise_z = [rng_z.normal(0.0, span.sigma_z, b.F.size) for b in span.blocks]
         try:
             # the truth as a record holds it: point samples
-            hist = simulated_history(
+            hist, zs = simulated_motion(
                 scenario, law, span, tolerances=tolerances, starts=starts, observe=observe
             )
         except IntegrationError:  # a failed draw: the measured states' histories instead
             if base is None:
-                base = simulated_history(
-                    scenario, law, span, tolerances=tolerances, observe=observe
-                )
-            hist = base
+                base = simulated_motion(scenario, law, span, tolerances=tolerances, observe=observe)
+            hist, zs = base
         try:
             reps = span.impulses([h + e for h, e in zip(hist, noise, strict=True)])
             crit, _ = block_criteria(reps, simulated, span)
         except InputError:
             continue
+        if MOTION_CRITERION in samples:
+            if z_sim is None:  # the noise-free penetrations from the measured states
+                z_sim = simulated_motion(scenario, law, span, tolerances=tolerances)[1]
+            crit[MOTION_CRITERION] = block_penetration(
+                span, reps, simulated, [z + e for z, e in zip(zs, noise_z, strict=True)], z_sim
+            )[0]
         for n, v in crit.items():
             samples[n].append(v)
         impacts.append(int(len(reps[-1].support)))
     if not samples["I2"]:
-        inf = {n: float("inf") for n in CRITERIA}
+        inf = {n: float("inf") for n in names}
         return {
             "mean": inf,
             "q95": dict(inf),

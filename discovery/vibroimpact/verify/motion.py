@@ -1,0 +1,177 @@
+"""The motion criterion I5: the recorded penetration against the simulated one over the contacts.
+
+The force criteria I0-I4 cannot tell two laws apart whose force histories differ by less
+than the force noise: a spring several times too soft with more damping reaches nearly the
+same depth and impulse, but at the contact's turning point (where the rate is zero and only
+the spring acts) its force is far smaller, and a small force tail keeps the bodies together
+longer.  Those differences sit under the force noise; the penetration ``zeta = w1 - w2``
+shows them.  With positions recorded, both penetrations go through the same fold as the
+force (:class:`~discovery.vibroimpact.verify.fold.Fold`, the same sample times and bins)::
+
+    I5 = sqrt( sum_b n_b (Z_N,b - Z_E,b)^2 / sum_b n_b Z_E,b^2 )
+
+over the bins ``b`` (``n_b`` samples each) inside the contact window: where either side is
+in contact by its force (the folded supports) or by its geometry (a folded penetration
+``> 0``), widened by 1 % of a drive period (as the force criteria's window).
+``Z_E`` is the recorded penetration, ``Z_N`` the simulated one, both bin means.  For a
+record span it is the blocks' mean weighted by their cycles, like the force criteria.  Its
+noise floor comes from the same replicates as theirs (the law's own runs from start states
+drawn from the state fit's covariance, with the record's penetration noise added at its
+sample times).  A record without positions has no I5; its verdict says so.
+"""
+
+import numpy as np
+
+__all__ = [
+    "MOTION_CRITERION",
+    "penetration_criterion",
+    "block_penetration",
+    "contact_window",
+    "penetration_residuals",
+]
+
+MOTION_CRITERION = "I5"
+"""The criterion's name in every table, floor and limit."""
+
+WINDOW_PAD = 0.01
+"""The contact window's widening on each side, in drive periods (as the force criteria's)."""
+
+
+def _runs(mask):
+    """``(first, last)`` bin indices of each run of ``True`` in ``mask``."""
+    d = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1) - 1, strict=True)
+
+
+def contact_window(fold, impulses, penetrations=(), pad=WINDOW_PAD):
+    """Whether each of the fold's bins lies in the contact window, ndarray of bool of shape
+    (k,): where either side is in contact by its force (the ``impulses``' supports) or by
+    its geometry (a folded penetration ``> 0``), widened by ``pad`` drive periods on each
+    side (cyclic over the fold's cycle).  The geometry matters: a law whose force tail
+    stays under the contact threshold still holds the bodies together, while the recorded
+    ones have parted."""
+    W = fold.duration
+    pad = pad * fold.period
+    iv = [np.asarray(imp.support, dtype=float).reshape(-1, 2) for imp in impulses]
+    for z in penetrations:
+        on = fold.average(z) > 0.0
+        iv.append(np.array([[fold.phase[a], fold.phase[b]] for a, b in _runs(on)]).reshape(-1, 2))
+    inside = np.zeros(fold.phase.size, dtype=bool)
+    for a, b in np.concatenate(iv):
+        for shift in (-W, 0.0, W):
+            inside |= (fold.phase >= a - pad + shift) & (fold.phase <= b + pad + shift)
+    return inside
+
+
+def penetration_criterion(fold, z_measured, z_simulated, window):
+    """I5 of one fold: the bin means of both penetrations compared inside ``window``.
+
+    Parameters
+    ----------
+    fold : Fold
+    z_measured, z_simulated : ndarray of shape (m,)
+        The penetrations at the fold's samples [m].
+    window : ndarray of bool, shape (k,)
+        The bins compared (:func:`contact_window`).
+
+    Returns
+    -------
+    float
+        ``inf`` when the window is empty or the recorded penetration is zero there.
+    """
+    if not np.any(window):
+        return float("inf")
+    ze = fold.average(z_measured)[window]
+    zn = fold.average(z_simulated)[window]
+    n = fold.counts[window].astype(float)
+    den = float(np.sum(n * ze * ze))
+    if den <= 0.0:
+        return float("inf")
+    return float(np.sqrt(np.sum(n * (zn - ze) ** 2) / den))
+
+
+def block_penetration(span, measured, simulated, z_measured, z_simulated):
+    """I5 of a record span: each block's value and their mean weighted by cycles.
+
+    Parameters
+    ----------
+    span : RecordSpan
+    measured, simulated : sequence of Impulse
+        Each block's folded force cycles (their supports make the window).
+    z_measured, z_simulated : sequence of ndarray
+        Each block's penetration at its folded samples [m].
+
+    Returns
+    -------
+    mean : float
+    per_block : list of float
+    """
+    per = [
+        penetration_criterion(b.fold, zm, zs, contact_window(b.fold, (m, s), (zm, zs)))
+        for b, m, s, zm, zs in zip(
+            span.blocks, measured, simulated, z_measured, z_simulated, strict=True
+        )
+    ]
+    w = np.array([b.fold.n_cycles for b in span.blocks], dtype=float)
+    return float(np.dot(w / w.sum(), per)), per
+
+
+RESIDUAL_PAD = 0.1
+"""The output-error residual's penetration window: the record's own contact window widened
+by this many drive periods on each side, fixed by the record (a residual vector of one size
+for every law), wide enough to hold a law's longer contact."""
+
+
+def _residual_window(blk, measured):
+    # fixed by the record: asked once per block
+    w = _WINDOWS.get(id(blk))
+    if w is None or w[0] is not blk:
+        w = (blk, contact_window(blk.fold, (measured,), (blk.Z,), pad=RESIDUAL_PAD))
+        if len(_WINDOWS) > 256:
+            _WINDOWS.clear()
+        _WINDOWS[id(blk)] = w
+    return w[1]
+
+
+_WINDOWS = {}
+
+
+def penetration_residuals(reference, evaluation, weights=None):
+    """The penetration part of the output-error residual, in the force's units.
+
+    Per block of a record span: the bin means of ``Z_N - Z_E`` inside the record's contact
+    window (:data:`RESIDUAL_PAD`), times ``sigma_F / sigma_Z`` (so a bin's noise is a force
+    bin's) and the force residual's own weight of that bin (``weights``: one array per
+    block, the force cycle's, of shape (bins + 2,)).  Empty for a record without positions
+    (or compared with its steady orbit).
+
+    Returns
+    -------
+    ndarray of shape (n,)
+    """
+    span = getattr(reference, "span", None)
+    z_sim = evaluation.extra.get("penetration") if evaluation is not None else None
+    if span is None or span.sigma_z <= 0 or z_sim is None:
+        return np.zeros(0)
+    scale = span.sigma_f / span.sigma_z
+    out = []
+    for k, (blk, E, zs) in enumerate(zip(span.blocks, reference.blocks, z_sim, strict=True)):
+        win = _residual_window(blk, E)
+        r = blk.fold.average(zs - blk.Z) * scale
+        if weights is not None:
+            r = r * weights[k][1:-1]
+        out.append(r[win])
+    return np.concatenate(out) if out else np.zeros(0)
+
+
+def penetration_size(reference):
+    """The length of :func:`penetration_residuals` for ``reference`` (0 without positions)."""
+    span = getattr(reference, "span", None)
+    if span is None or span.sigma_z <= 0:
+        return 0
+    return int(
+        sum(
+            np.count_nonzero(_residual_window(b, E))
+            for b, E in zip(span.blocks, reference.blocks, strict=True)
+        )
+    )
