@@ -356,3 +356,22 @@ def test_first_onset_against_brute_force_sampling_of_the_exact_flight():
         else:
             missed += 1
     assert checked >= 20 and missed >= 5  # 46 crossings, 14 flights without one
+
+
+def test_a_contact_offset_moves_only_the_recorded_state():
+    """The catalogue's contact offset shifts the recorded moulding against the model's
+    (:meth:`Scenario.model_state`); the kernel's flights are the model's, so the closed form
+    covers it: both paths agree, and the onset is where the recorded penetration reaches
+    the offset."""
+    sc = PAPER.replace(offset=1.5e-3)
+    y_rec = np.array([0.0, 0.05, 0.0, 0.3])  # recorded penetration 0, below the offset
+    y0 = sc.model_state(y_rec)
+    T = sc.period
+    a, b = (
+        simulate(sc, sc.law, (0.0, 3 * T), y0=y0, tolerances=Tolerances(free_flight=ff))
+        for ff in ("closed", "integrate")
+    )
+    assert a.event_kind[0] == K.EV_ONSET and list(a.event_kind) == list(b.event_kind)
+    assert np.max(np.abs(a.event_t - b.event_t)) < 1e-8 * T
+    zeta_on = a.event_y[0, 0] - a.event_y[0, 2]
+    assert sc.recorded_penetration(zeta_on) == pytest.approx(1.5e-3, abs=1e-15)
