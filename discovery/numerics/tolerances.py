@@ -7,7 +7,10 @@ import numpy as np
 from .._validate import Real, check
 from ..errors import InputError
 
-__all__ = ["Tolerances"]
+__all__ = ["Tolerances", "FREE_FLIGHT"]
+
+#: the vibro-impact kernel's free-flight paths (:attr:`Tolerances.free_flight`)
+FREE_FLIGHT = ("closed", "integrate")
 
 
 @dataclass(frozen=True)
@@ -26,12 +29,19 @@ class Tolerances:
     hmax_fraction : float
         Largest step as a fraction of the drive period (also bounds how brief a
         contact can be and still be seen between step ends).
+    free_flight : {"closed", "integrate"}
+        The vibro-impact kernel's free flights: ``"closed"`` (default) advances them in
+        closed form to the next onset, found as the first root of the exact penetration
+        (supports without a cubic term; otherwise the integrator's steps), and integrates
+        only the contact; ``"integrate"`` takes the integrator's steps throughout (the
+        cross-check path).  Ueda's oscillators ignore it.
     """
 
     rtol: float = 1e-9
     atol_scale: float = 1e-3
     max_steps: int = 2_000_000
     hmax_fraction: float = 0.02
+    free_flight: str = "closed"
 
     def __post_init__(self):
         for name, spec in (
@@ -49,6 +59,10 @@ class Tolerances:
             raise InputError(f"max_steps must be a positive integer, got {self.max_steps!r}")
         if not (0 < self.hmax_fraction <= 1):
             raise InputError(f"hmax_fraction must be in (0, 1], got {self.hmax_fraction!r}")
+        if self.free_flight not in FREE_FLIGHT:
+            raise InputError(
+                f"free_flight must be one of {', '.join(FREE_FLIGHT)}, got {self.free_flight!r}"
+            )
 
     def atol(self, scale):
         """Absolute tolerances ``rtol * atol_scale * scale`` for states of size ``scale``."""
@@ -67,4 +81,5 @@ class Tolerances:
             "max_steps": self.max_steps,
             "hmax_fraction": self.hmax_fraction,
             "method": "dopri5+events",
+            "free_flight": self.free_flight,
         }

@@ -37,6 +37,13 @@ the interior extremum of ``zeta`` (a graze between samples).  Mode switches that
 hardly advance time (zero-length ones, or over a thousand events in a row each
 within ``1e-3 hmax`` of the last) stop the run as chattering.
 
+Free flight: by default (``p[P_FLIGHT] = 1``, :attr:`Tolerances.free_flight` ``"closed"``)
+the free mode is not stepped: the flight is advanced in closed form to the first root of
+the exact penetration, bracketed by a proven bound (:func:`_flight`), and only the contact
+is integrated.  Supports with a cubic term, ``k1 <= 0`` or ``c1 < 0``, and a start across
+the surface that is not closing take the integrator's steps, as does every free flight with
+``p[P_FLIGHT] = 0`` (the cross-check path).
+
 Compilation: numba inlines an ``inline="always"`` function in its own IR and types the
 body again at every call site, so a chain of inlined functions costs compile time by the
 product of their call sites.  Only the leaves called at every Runge-Kutta stage (the force
@@ -68,9 +75,11 @@ OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW, CHATTER = 0, 1, 2, 3, 4
 
 # the parameter vector ``p``: the scenario's m1, m2, k1, c1, A, omega, g (0-6), the
 # supports' cubic stiffness, the mass fraction shed per impact, the law's permanent-set
-# fraction, and one contact state: the current contact's largest penetration.  The kernel
-# updates m2 and z_max in place (callers pass a copy: :func:`kernel_params`).
-P_K3, P_LOSS, P_SET, P_ZMAX, N_PARAMS = 7, 8, 9, 10, 11
+# fraction, one contact state: the current contact's largest penetration, and the choice of
+# the free-flight path (``p[P_FLIGHT] = 1``: in closed form where it applies, 0: the
+# integrator's steps throughout).  The kernel updates m2 and z_max in place (callers pass a
+# copy: :func:`kernel_params`).
+P_K3, P_LOSS, P_SET, P_ZMAX, P_FLIGHT, N_PARAMS = 7, 8, 9, 10, 11, 12
 
 # chattering: more than _ZENO_EVENTS located events in a row, each within
 # _ZENO_GAP * hmax of the previous one (mode switches that hardly advance time)
@@ -636,6 +645,233 @@ def _record_event(t, y, mode, index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, e
     return new_mode
 
 
+# ---- free flight in closed form.  Between contacts (mode FREE, no force) the two bodies
+# obey linear equations: the moulding falls freely, ``w2 = w2a + v2a s - g s^2 / 2``, and
+# the frame (supports without a cubic term) is a damped oscillator driven by ``A sin(w t)``:
+# ``x(t) = x_p(t) + Phi(s) (x_a - x_p(t_a))`` with ``x = (w1, v1)``, ``x_p = (w_p, w_p')``,
+# ``w_p = w_s + P sin(w t) + Q cos(w t)`` its periodic particular solution (``w_s = -m1 g /
+# k1``) and ``Phi(s) = exp(M s)`` its transition matrix, ``M = [[0, 1], [-k1/m1, -c1/m1]]``.
+# The flight is advanced exactly to the next contact onset, the first root of the
+# penetration ``z = w1 - w2`` (from below), or to the end of the run.
+#
+# The root is bracketed safely: over ``[a, a + H]`` the penetration is bounded above by
+# ``z(a) + z'(a) tau + B tau^2 / 2`` with ``B`` an upper bound of ``z'' = w1'' + g`` for all
+# later times: ``g + w^2 |(P, Q)| + (w0 + 2 alpha) sqrt(E(a))`` with ``E = w0^2 u^2 + u'^2``
+# the energy of the homogeneous part ``u = w1 - w_p`` (``w0^2 = k1/m1``, ``alpha = c1 /
+# 2 m1``), which never grows (``E' = -4 alpha u'^2``), and ``|u''| <= w0^2 |u| + 2 alpha
+# |u'| <= (w0 + 2 alpha) sqrt(E)``.  ``H`` is the bound's positive root, so ``[a, a + H)``
+# holds no root; the next interval starts at its end.  Far from the surface the intervals
+# are long; approaching a crossing they shrink quadratically onto it from below (Newton's
+# rate with the curvature bound), and a tangency (a graze) is passed in a bounded number
+# of intervals.  The first point found across is polished to the time's resolution.
+#
+# The free flight's sensitivities are its transition matrix: ``S <- blockdiag(Phi(s),
+# [[1, s], [0, 1]]) S`` (the law does not act; the coefficient columns move with the
+# state's); the onset's saltation is applied as after an integrated step.
+
+_FLIGHT_ITERS = 4000  # intervals per flight before the integrator takes over (a safeguard)
+_NF = 16  # the flight's constants, :func:`_flight_setup`
+
+
+@njit(cache=True)
+def _flight_ok(p):
+    """Whether the free flight has the closed form (requested, linear supports with ``k1 >
+    0``, ``c1 >= 0``, and a periodic particular solution)."""
+    if p[P_FLIGHT] == 0.0 or p[P_K3] != 0.0:
+        return False
+    m1, k1, c1, w = p[0], p[2], p[3], p[5]
+    if not (m1 > 0.0 and k1 > 0.0 and c1 >= 0.0 and w > 0.0):
+        return False
+    a, b = k1 - m1 * w * w, c1 * w
+    return a * a + b * b > 0.0 and np.isfinite(a) and np.isfinite(b)
+
+
+@njit(cache=True)
+def _flight_setup(t0, y, p, fl):
+    """The flight's constants from ``(t0, y)`` into ``fl``: alpha, w0^2, w0^2 - alpha^2,
+    w_s, P, Q, w, g, t0, u(t0), u'(t0), w2(t0), v2(t0), the bound's constant part
+    ``g + w^2 |(P, Q)|``, ``w0 + 2 alpha``, ``w0``."""
+    m1, k1, c1, A, w, g = p[0], p[2], p[3], p[4], p[5], p[6]
+    al = 0.5 * c1 / m1
+    w0sq = k1 / m1
+    a, b = k1 - m1 * w * w, c1 * w
+    det = a * a + b * b
+    P = -A * a / det
+    Q = A * b / det
+    ws = -m1 * g / k1
+    sn, cs = np.sin(w * t0), np.cos(w * t0)
+    fl[0], fl[1], fl[2] = al, w0sq, w0sq - al * al
+    fl[3], fl[4], fl[5], fl[6], fl[7], fl[8] = ws, P, Q, w, g, t0
+    fl[9] = y[0] - (ws + P * sn + Q * cs)
+    fl[10] = y[1] - w * (P * cs - Q * sn)
+    fl[11], fl[12] = y[2], y[3]
+    fl[13] = g + w * w * np.sqrt(P * P + Q * Q)
+    fl[14] = np.sqrt(w0sq) + 2.0 * al
+    fl[15] = np.sqrt(w0sq)
+
+
+@njit(cache=True)
+def _flight_phi(s, fl):
+    """The frame's transition matrix ``Phi(s)`` (four entries, row by row)."""
+    al, w0sq, q = fl[0], fl[1], fl[2]
+    e = np.exp(-al * s)
+    if q > 0.0:
+        r = np.sqrt(q)
+        eC = e * np.cos(r * s)
+        eS = e * np.sin(r * s) / r
+    elif q < 0.0:
+        r = np.sqrt(-q)
+        if r * s < 1.0:
+            eC = e * np.cosh(r * s)
+            eS = e * np.sinh(r * s) / r
+        else:
+            # overdamped, long flight: e^(-alpha s) cosh(r s) without overflow
+            ep, em = np.exp((r - al) * s), np.exp(-(r + al) * s)
+            eC = 0.5 * (ep + em)
+            eS = 0.5 * (ep - em) / r
+    else:
+        eC = e
+        eS = e * s
+    return eC + al * eS, eS, -w0sq * eS, eC - al * eS
+
+
+@njit(cache=True)
+def _flight_state(s, fl, out):
+    """The state ``s`` after the flight's start into ``out``; returns ``(u, u')``, the
+    frame's homogeneous part."""
+    f00, f01, f10, f11 = _flight_phi(s, fl)
+    u = f00 * fl[9] + f01 * fl[10]
+    ud = f10 * fl[9] + f11 * fl[10]
+    w = fl[6]
+    tt = fl[8] + s
+    sn, cs = np.sin(w * tt), np.cos(w * tt)
+    out[0] = fl[3] + fl[4] * sn + fl[5] * cs + u
+    out[1] = w * (fl[4] * cs - fl[5] * sn) + ud
+    out[2] = fl[11] + s * (fl[12] - 0.5 * fl[7] * s)
+    out[3] = fl[12] - fl[7] * s
+    return u, ud
+
+
+@njit(cache=True)
+def _flight_res(fl, s):
+    """The time resolution at ``s`` after the flight's start: a few units in the last place
+    of the absolute time, and at least 1e-15 of the drive period."""
+    return 4.0e-16 * max(abs(fl[8] + s), 2.0 * np.pi / fl[6])
+
+
+@njit(cache=True)
+def _flight_polish(a, b, fl, ybuf):
+    """The first root of the penetration in ``[a, b]`` (``z(a) <= 0 < z(b)``, no root in
+    ``[a, b)`` but the crossing's): safeguarded Newton to the time's resolution; the point
+    returned is across (``z > 0``), as a located event's."""
+    lo, hi = a, b
+    _flight_state(hi, fl, ybuf)
+    zs, ds = ybuf[0] - ybuf[2], ybuf[1] - ybuf[3]
+    s = hi
+    for _ in range(200):
+        res = _flight_res(fl, hi)
+        if hi - lo <= res:
+            break
+        c = s - zs / ds if ds > 0.0 else 0.5 * (lo + hi)
+        if not (lo < c < hi):
+            c = 0.5 * (lo + hi)
+        if abs(c - s) <= res:
+            # Newton has converged from one side: probe just across to close the bracket
+            c = s - res if zs > 0.0 else s + res
+            if not (lo < c < hi):
+                c = 0.5 * (lo + hi)
+        _flight_state(c, fl, ybuf)
+        zc, dc = ybuf[0] - ybuf[2], ybuf[1] - ybuf[3]
+        if zc > 0.0:
+            hi = c
+        else:
+            lo = c
+        s, zs, ds = c, zc, dc
+    return hi
+
+
+@njit(cache=True)
+def _flight_search(z0, d0, s_end, fl, ybuf):
+    """The first onset in ``(0, s_end]`` of the flight set up in ``fl`` (the start's
+    penetration ``z0 <= 0``, its rate ``d0``): ``(s, code)``, ``code`` 1 for an onset at
+    ``s``, 0 for none up to ``s = s_end``, 4 if the safeguard's interval budget ran out at
+    ``s`` (no onset before it)."""
+    a, z, d = 0.0, z0, d0
+    u, ud = fl[9], fl[10]
+    w0sq, kE, Bc = fl[1], fl[14], fl[13]
+    for _ in range(_FLIGHT_ITERS):
+        B = Bc + kE * np.sqrt(w0sq * u * u + ud * ud)
+        if not B > 1e-300:
+            B = 1e-300
+        zz = -z if z < 0.0 else 0.0
+        disc = np.sqrt(d * d + 2.0 * B * zz)
+        H = 2.0 * zz / (d + disc) if d > 0.0 else (disc - d) / B
+        if a + H >= s_end:
+            return s_end, 0
+        H = max(H, _flight_res(fl, a))
+        b = min(a + H, s_end)
+        u, ud = _flight_state(b, fl, ybuf)
+        zb, db = ybuf[0] - ybuf[2], ybuf[1] - ybuf[3]
+        if zb > 0.0:
+            return _flight_polish(a, b, fl, ybuf), 1
+        if b >= s_end:
+            return s_end, 0
+        a, z, d = b, zb, db
+    return a, 4
+
+
+@njit(cache=True)
+def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mode, out_dF):
+    """One free flight from ``(t, y)`` in closed form: ``(code, t_new, k_eval)``.
+
+    ``code`` 0: no onset up to ``t1`` (``y`` and ``S`` advanced to it); 1: an onset at
+    ``t_new`` (advanced to it: the caller records the event); 2: an onset at once (the start
+    is across the surface and moving further across, as the integrator's); 3: not here (the
+    start is across the surface by more than ``hair`` and not closing: the integrator's
+    steps); 4: advanced to ``t_new`` without an onset, the integrator's steps next (the
+    safeguard's interval budget ran out).  Writes the dense output at ``t_eval[k_eval:]`` up
+    to ``t_new`` (free: no force, no force derivatives)."""
+    z0 = y[0] - y[2]
+    d0 = y[1] - y[3]
+    if z0 >= 0.0 and d0 >= 0.0:
+        # on or across the surface: an onset at once if moving further across (at rest on
+        # it, if the relative acceleration ``w1'' + g`` presses the bodies together)
+        if d0 > 0.0:
+            return 2, t, k_eval
+        acc = -(p[3] * y[1] + p[2] * y[0] + p[4] * np.sin(p[5] * t) + p[0] * p[6]) / p[0]
+        if acc + p[6] >= 0.0:
+            return 2, t, k_eval
+    if z0 > 0.0 and (z0 > hair or d0 == 0.0):
+        return 3, t, k_eval
+    _flight_setup(t, y, p, fl)
+    s_end = t1 - t
+    s, code = _flight_search(min(z0, 0.0), d0, s_end, fl, ybuf)
+    t_new = t1 if code == 0 else t + s
+    n_eval = t_eval.shape[0]
+    want_df = out_dF.shape[1] > 0
+    while k_eval < n_eval and t_eval[k_eval] <= t_new:
+        _flight_state(max(t_eval[k_eval] - t, 0.0), fl, ybuf)
+        for j in range(4):
+            out_y[j, k_eval] = ybuf[j]
+        out_f[k_eval] = 0.0
+        out_mode[k_eval] = FREE
+        if want_df:
+            for j in range(out_dF.shape[0]):
+                out_dF[j, k_eval] = 0.0
+        k_eval += 1
+    if s > 0.0:
+        _flight_state(s, fl, ybuf)
+        for j in range(4):
+            y[j] = ybuf[j]
+        f00, f01, f10, f11 = _flight_phi(s, fl)
+        for j in range(S.shape[1]):
+            a0, a1, a2, a3 = S[0, j], S[1, j], S[2, j], S[3, j]
+            S[0, j] = f00 * a0 + f01 * a1
+            S[1, j] = f10 * a0 + f11 * a1
+            S[2, j] = a2 + s * a3
+    return code, t_new, k_eval
+
+
 @njit(cache=True)
 def integrate(
     t0,
@@ -725,10 +961,66 @@ def integrate(
     t_last_ev = -np.inf
     status = OK
     need_f = True
+    # free flight in closed form where it applies (:func:`_flight`); ``hold``: the
+    # integrator's steps until one is accepted (a start across the surface, not closing)
+    use_flight = _flight_ok(p)
+    fl = np.empty(_NF)
+    hold = False
     while t < t1:
         if n_steps >= max_steps:
             status = STEP_BUDGET
             break
+        if use_flight and mode == FREE and not hold:
+            code, t_new, k_eval = _flight(
+                t, t1, y, p, atol[0], fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mode, out_dF
+            )
+            if code == 3:
+                hold = True
+            else:
+                if code != 2:
+                    n_steps += 1
+                    t = t_new
+                    need_f = True
+                    need_h0 = True
+                    if not (
+                        np.isfinite(y[0])
+                        and np.isfinite(y[1])
+                        and np.isfinite(y[2])
+                        and np.isfinite(y[3])
+                    ):
+                        status = BLOW_UP
+                        break
+                if code == 0:
+                    continue
+                if code == 4:
+                    hold = True
+                    continue
+                if code == 2:
+                    zero_len += 1
+                    if zero_len > 4:
+                        status = CHATTER
+                        break
+                else:
+                    zero_len = 0
+                    if t - t_last_ev < _ZENO_GAP * hmax:
+                        short_run += 1
+                        if short_run > _ZENO_EVENTS:
+                            status = CHATTER
+                            break
+                    else:
+                        short_run = 0
+                    t_last_ev = t
+                if m_s:
+                    _event_time_sens(t, y, mode, 0, p, coef, ea, eb, br, S, spar, dc, fminus, tau)
+                mode = _record_event(
+                    t, y, mode, 0, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
+                )
+                if m_s:
+                    _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau)
+                n_ev += 1
+                need_f = True
+                need_h0 = True
+                continue
         if need_f:
             _rhs(t, y, mode, p, coef, ea, eb, br, K[0])
             need_f = False
@@ -829,6 +1121,7 @@ def integrate(
             if m_s and not ctl_s:
                 _rk_sens(y, h_used, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew)
         zero_len = 0
+        hold = False
         t_new = t + h_used if best_index >= 0 or h_used < t1 - t else t1
         # dense output at requested times inside (t, t_new]
         while k_eval < n_eval and t_eval[k_eval] <= t_new:

@@ -127,14 +127,18 @@ class Trajectory:
         return out
 
 
-def kernel_params(scenario, law):
+def kernel_params(scenario, law, tolerances=None):
     """The compiled kernel's parameter vector (:data:`~discovery.vibroimpact.dynamics._kernel.P_K3`
-    ...): the scenario's parameters, the law's permanent set and a fresh contact state.  The
-    kernel updates the state slots in place: pass each integration its own copy."""
+    ...): the scenario's parameters, the law's permanent set, a fresh contact state and the
+    free-flight path of ``tolerances`` (:attr:`Tolerances.free_flight`; default closed
+    form).  The kernel updates the state slots in place: pass each integration its own
+    copy."""
     p = np.zeros(K.N_PARAMS)
     base = scenario.params()
     p[: base.size] = base
     p[K.P_SET] = law.permanent_set
+    closed = tolerances is None or tolerances.free_flight == "closed"
+    p[K.P_FLIGHT] = 1.0 if closed else 0.0
     return p
 
 
@@ -295,7 +299,7 @@ def simulate(
     bufs = _buffers(te.size, max_events)
     out_y, out_f, out_m, ev_t, ev_k, ev_y, ev_m = bufs
     period = scenario.period
-    p = kernel_params(scenario, law)
+    p = kernel_params(scenario, law, tol)
     p[K.P_ZMAX] = float(zeta_max0)
     if sensitivities is None:
         sens, names = no_sensitivities(), ()

@@ -53,7 +53,7 @@ class StroboscopicMap:
         self.scenario = scenario
         self.law = law
         self.tol = tolerances or Tolerances()
-        self._p = kernel_params(scenario, law)
+        self._p = kernel_params(scenario, law, self.tol)
         self._coef, self._ea, self._eb, self._br = law.kernel_arrays()
         self._atol = _atol(scenario, self.tol)
         self._T = scenario.period
