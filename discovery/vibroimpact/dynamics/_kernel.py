@@ -436,17 +436,22 @@ def _dense_force_sens(mode, y, S, KS, h, theta, spar, coef, ea, eb, br, dc, out,
     rows the force needs."""
     w = _dense_weights(theta)
     fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
-    for j in range(S.shape[1]):
+    m = S.shape[1]
+    for j in range(m):
         dz, dv = _dense_diff(S, KS, h, w, 0, j), _dense_diff(S, KS, h, w, 1, j)
         out[j, k] = _dforce(fz, fv, dz, dv, j, spar, dc)
+        out[m + j, k] = dz
 
 
 @njit(cache=True)
 def _force_sens(mode, y, S, spar, coef, ea, eb, br, dc, out, k):
-    """``out[j, k] = dF/dq_j`` of the force at ``y`` (sensitivities ``S``) in ``mode``."""
+    """``out[j, k] = dF/dq_j`` of the force at ``y`` (sensitivities ``S``) in ``mode``, and
+    ``out[m + j, k]`` the penetration's."""
     fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
-    for j in range(S.shape[1]):
+    m = S.shape[1]
+    for j in range(m):
         out[j, k] = _dforce(fz, fv, S[0, j] - S[2, j], S[1, j] - S[3, j], j, spar, dc)
+        out[m + j, k] = S[0, j] - S[2, j]
 
 
 @njit(cache=True)
@@ -849,15 +854,20 @@ def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mo
     t_new = t1 if code == 0 else t + s
     n_eval = t_eval.shape[0]
     want_df = out_dF.shape[1] > 0
+    m = S.shape[1]
     while k_eval < n_eval and t_eval[k_eval] <= t_new:
-        _flight_state(max(t_eval[k_eval] - t, 0.0), fl, ybuf)
+        se = max(t_eval[k_eval] - t, 0.0)
+        _flight_state(se, fl, ybuf)
         for j in range(4):
             out_y[j, k_eval] = ybuf[j]
         out_f[k_eval] = 0.0
         out_mode[k_eval] = FREE
         if want_df:
-            for j in range(out_dF.shape[0]):
+            # no force in flight; the penetration's derivatives by the transition matrix
+            g00, g01, _, _ = _flight_phi(se, fl)
+            for j in range(m):
                 out_dF[j, k_eval] = 0.0
+                out_dF[m + j, k_eval] = (g00 * S[0, j] + g01 * S[1, j]) - (S[2, j] + se * S[3, j])
         k_eval += 1
     if s > 0.0:
         _flight_state(s, fl, ybuf)

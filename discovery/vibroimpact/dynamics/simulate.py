@@ -71,6 +71,8 @@ class Trajectory:
         coefficients (loading terms by name, unloading terms as ``"unloading: name"``).
     force_sensitivity : ndarray of shape (m, n) or None
         The force's derivatives at ``t`` along the same directions.
+    penetration_sensitivity : ndarray of shape (m, n) or None
+        The penetration's (``w1 - w2``) derivatives at ``t`` along the same directions.
     event_time_sensitivity : ndarray of shape (n_events, m) or None
         The events' time derivatives along the same directions (NaN at a graze).
     sensitivity_names : tuple of str
@@ -93,6 +95,7 @@ class Trajectory:
     zeta_max0: float = 0.0
     sensitivity: np.ndarray | None = None
     force_sensitivity: np.ndarray | None = None
+    penetration_sensitivity: np.ndarray | None = None
     sensitivity_names: tuple = ()
     event_time_sensitivity: np.ndarray | None = None
 
@@ -206,7 +209,7 @@ def sensitivity_setup(scenario, law, which, n_eval=0, n_events=0, controlled=Tru
                 f"columns {', '.join(names)}); got shape {S0.shape}"
             )
         S[:] = S0
-    out_dF = np.empty((m, n_eval))
+    out_dF = np.empty((2 * m, n_eval))  # the force's derivatives, then the penetration's
     ev_tau = np.full((n_events, m), np.nan)
     sscale = np.array(sscale) if controlled else np.empty(0)
     return (S, np.array(spar, dtype=np.int64), sscale, out_dF, ev_tau), tuple(names)
@@ -356,7 +359,8 @@ def simulate(
         message=message,
         zeta_max0=float(zeta_max0),
         sensitivity=sens[0] if names else None,
-        force_sensitivity=sens[3][:, ok_out] if names else None,
+        force_sensitivity=sens[3][: len(names), ok_out] if names else None,
+        penetration_sensitivity=sens[3][len(names) :, ok_out] if names else None,
         event_time_sensitivity=sens[4][:n_keep] if names else None,
         sensitivity_names=names,
     )

@@ -48,7 +48,7 @@ from ..model.law import ForceLaw, Term
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
 from ..verify.criteria import criterion as _criterion
-from ..verify.motion import penetration_residuals, penetration_size
+from ..verify.motion import penetration_jacobian, penetration_residuals, penetration_size
 
 __all__ = [
     "IdentificationResult",
@@ -451,29 +451,18 @@ class _Objective:
             # a column that is not finite (a graze at an onset, an infinite slope of a
             # fractional power at zero penetration) is taken by differences
             exact &= np.all(np.isfinite(J), axis=0)
-        # the variational equations give the force's rows; the penetration's rows of an
-        # exact column, and every row of the others, by forward differences.  Those
-        # penetration runs complete the exact Jacobian's one run: they are counted, but on
-        # top of the budget (which bounds the optimiser's own steps, as without positions)
-        nf = r0.size - self.n_motion
-        if self.n_motion:
-            self.max_sim += int(np.count_nonzero(exact)) * len(self.records)
-        for i in range(x.size):
-            if exact[i] and not self.n_motion:
-                continue
+        # the variational equations give the force's and the penetration's rows of the
+        # exact columns; the other columns by forward differences
+        for i in np.flatnonzero(~exact):
             xi = x.copy()
             h = 1e-6 * max(1.0, abs(x[i]))
             xi[i] += h
-            d = (self.residuals(xi) - r0) / h
-            if exact[i]:
-                J[nf:, i] = d[nf:]
-            else:
-                J[:, i] = d
+            J[:, i] = (self.residuals(xi) - r0) / h
         return J
 
     def _exact_jacobian(self, x, cols, J):
         """Fill the exact columns of ``J`` (in units of ``x``); returns which are."""
-        from ..verify.trajectory import history_sensitivities
+        from ..verify.trajectory import history_sensitivities, penetration_sensitivities
 
         law, machine, observe = model_parts(self.law(x), self.observe)
         exact = np.array([c is not None for c in cols])
@@ -481,6 +470,7 @@ class _Objective:
             raise _Budget
         row = 0
         evs = self.evaluations(x)
+        motion = []  # the penetration's rows, after every force row
         for (sc, ref), ws, ev in zip(self.records, self.w, evs, strict=True):
             self.n += 1
             tick(self.progress, "identify: simulations", self.n, self.max_sim)
@@ -488,6 +478,9 @@ class _Objective:
                 dH = history_sensitivities(
                     machine(sc), law, ref.span, tolerances=self.tol, observe=observe
                 )
+                if penetration_size(ref):
+                    dZ = penetration_sensitivities(machine(sc), law, ref.span, tolerances=self.tol)
+                    motion.append(penetration_jacobian(ref, dZ, ws))
                 dS = []
                 for blk, d in zip(ref.span.blocks, dH, strict=True):
                     dm = np.array([blk.fold.average(r) for r in d]).reshape(len(d), -1)
@@ -499,6 +492,11 @@ class _Objective:
                     if c is not None:
                         J[row : row + w.size - 1, i] = (d[c] * w)[1:] * self.c0[i]
                 row += w.size - 1
+        for dz in motion:
+            for i, c in enumerate(cols):
+                if c is not None:
+                    J[row : row + dz.shape[0], i] = dz[:, c] * self.c0[i]
+            row += dz.shape[0]
         return exact
 
 
@@ -862,8 +860,7 @@ def identify(
     evs = obj.evaluations(x_best)
     se, corr = {}, None
     if uncertainty:
-        # the error estimate's own budget (the penetration's rows by differences)
-        obj.max_sim += (len(x_best) + 1) * len(records) * (2 if obj.n_motion else 1)
+        obj.max_sim += len(x_best) * len(records)  # the error estimate has its own budget
         se, corr = _uncertainty(obj, x_best, law.names)
     crit = {k: float(np.mean([e.criteria[k] for e in evs])) for k in evs[0].criteria}
     if obj.failures:

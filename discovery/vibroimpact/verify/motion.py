@@ -28,6 +28,8 @@ __all__ = [
     "block_penetration",
     "contact_window",
     "penetration_residuals",
+    "penetration_jacobian",
+    "penetration_size",
 ]
 
 MOTION_CRITERION = "I5"
@@ -162,6 +164,27 @@ def penetration_residuals(reference, evaluation, weights=None):
             r = r * weights[k][1:-1]
         out.append(r[win])
     return np.concatenate(out) if out else np.zeros(0)
+
+
+def penetration_jacobian(reference, derivatives, weights=None):
+    """The derivatives of :func:`penetration_residuals` along ``m`` parameters, from the
+    simulated penetration's derivatives at every block's samples (``derivatives``: one
+    array of shape (m, samples) per block; the residual is linear in the penetration).
+
+    Returns
+    -------
+    ndarray of shape (n, m)
+    """
+    span = reference.span
+    scale = span.sigma_f / span.sigma_z
+    out = []
+    for k, (blk, E, d) in enumerate(zip(span.blocks, reference.blocks, derivatives, strict=True)):
+        win = _residual_window(blk, E)
+        rows = np.array([blk.fold.average(r) for r in d]).reshape(len(d), -1) * scale
+        if weights is not None:
+            rows = rows * weights[k][1:-1]
+        out.append(rows[:, win].T)
+    return np.concatenate(out)
 
 
 def penetration_size(reference):

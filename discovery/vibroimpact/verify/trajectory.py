@@ -36,6 +36,7 @@ __all__ = [
     "simulated_history",
     "simulated_motion",
     "history_sensitivities",
+    "penetration_sensitivities",
     "block_criteria",
     "span_floor",
     "BLOCK_CYCLES",
@@ -276,7 +277,28 @@ def _sensitivity_run(scenario, law, blk, tolerances):
         control_sensitivities=False,
     )
     on = tr.event_kind == _K.EV_ONSET
-    return tr.force, tr.force_sensitivity, tr.event_t[on], tr.event_time_sensitivity[on]
+    return (
+        tr.force,
+        tr.force_sensitivity,
+        tr.event_t[on],
+        tr.event_time_sensitivity[on],
+        tr.penetration_sensitivity,
+    )
+
+
+def _sensitivities(scenario, law, blk, tolerances):
+    """A block's sensitivity run (memoised: asked by the force's and the penetration's
+    rows of one Jacobian)."""
+    key = value_key("sensitivities", scenario, law, tolerances, id(blk))
+    return MEMO.get(key, lambda: (blk, *_sensitivity_run(scenario, law, blk, tolerances)))[1:]
+
+
+def penetration_sensitivities(scenario, law, span, *, tolerances=None):
+    """The derivatives of the simulated penetration at the span's sample times along the
+    law's coefficients (loading, then unloading terms), one array of shape (m, samples)
+    per block, from the same runs as :func:`history_sensitivities` (a contact offset only
+    shifts the penetration, so it is the model's)."""
+    return [_sensitivities(scenario, law, blk, tolerances)[4] for blk in span.blocks]
 
 
 def history_sensitivities(scenario, law, span, *, tolerances=None, observe=None):
@@ -294,10 +316,7 @@ def history_sensitivities(scenario, law, span, *, tolerances=None, observe=None)
     out = []
     for blk in span.blocks:
         td = blk.fold.td
-        key = value_key("sensitivities", scenario, law, tolerances, id(blk))
-        _, F, dF, onsets, d_on = MEMO.get(
-            key, lambda b=blk: (b, *_sensitivity_run(scenario, law, b, tolerances))
-        )
+        F, dF, onsets, d_on, _ = _sensitivities(scenario, law, blk, tolerances)
         dH = dF.copy()
         if td.size > 1 and onsets.size:
             k, u, width, keep = _onset_weights(td, onsets)
