@@ -18,7 +18,7 @@ import argparse
 import json
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
@@ -149,11 +149,12 @@ def main(argv=None):
     idx = range(a.first, a.first + a.records)
     rows = []
     kw = {"n_boot": a.bootstrap, "noise_model": a.noise}
-    if a.workers > 1:
+    if a.workers > 1:  # each record's line as soon as it is done
         with ProcessPoolExecutor(a.workers) as ex:
-            for row in ex.map(_run_kw, [(i, kw) for i in idx]):
-                rows.append(row)
-                print(json.dumps(row), flush=True)
+            futures = [ex.submit(_run_kw, (i, kw)) for i in idx]
+            for f in as_completed(futures):
+                rows.append(f.result())
+                print(json.dumps(rows[-1]), flush=True)
     else:
         for i in idx:
             rows.append(run(i, **kw))
