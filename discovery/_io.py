@@ -68,6 +68,8 @@ __all__ = [
     "set_run",
     "running",
     "MANIFEST",
+    "vidi_writes",
+    "short",
 ]
 
 # the solvers cvxpy uses here: CLARABEL (default), OSQP (fallback in the regression)
@@ -124,22 +126,83 @@ def running(command):
         _RUN.update(prev)
 
 
-def _owner(directory):
-    """``(command, files)`` of an earlier result directory: from its manifest, else from a
-    legacy ``summary.json`` (command only, files unknown), else ``(None, None)``."""
-    d = Path(directory)
-    for name, legacy in ((MANIFEST, False), ("summary.json", True)):
-        try:
-            with open(d / name, encoding="utf-8") as fh:
-                data = json.load(fh)
-        except (OSError, ValueError):
-            continue
+# the names a vidi command can write into a result directory: a manifest entry outside
+# them (a user's notes, a data folder) is never taken as vidi's, whatever the manifest says
+_VIDI_WRITES = re.compile(
+    r"^(?:summary|config)\.json$"
+    r"|^(?:ranking|iterations|strobe(?:_[\w.-]+)?|chart|landscape|cells|runs|inclusion)\.csv$"
+    r"|^(?:verify|fit_impulse|fit_surface|fit_loop|model|identification|explain(?:_\w+)?"
+    r"|attractor|basins|discover|chart|landscape|recovery_noise|recovery_map|coverage"
+    r"|inclusion|report)\.(?:png|pdf)$"
+    r"|^(?:model|report|snippet-\w+)\.(?:tex|log)$"
+    r"|^runs$|^runs/[0-9a-f]+\.json$"
+)
+
+
+def vidi_writes(name):
+    """True when ``name`` (relative to a result directory, ``/`` between folders) is a name
+    some vidi command writes there."""
+    return bool(_VIDI_WRITES.match(name))
+
+
+def short(text, limit=160):
+    """``text`` for a one-line message: a very long path shows its start and end only."""
+    text = str(text)
+    if len(text) <= limit:
+        return text
+    half = (limit - 5) // 2
+    return f"{text[:half]} ... {text[-half:]}"
+
+
+def _read_manifest(path, strict):
+    """``(command, files)`` of a manifest file, ``None`` when there is none.  A malformed one
+    (not an object, ``files`` not a list of names) raises :class:`InputError` when
+    ``strict``, else reads as ``(None, [])``: nothing in it is claimed as vidi's."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            data = json.load(fh)
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError, RecursionError) as exc:
+        why = f"cannot be read as JSON ({type(exc).__name__})"
+        data = None
+    else:
+        why = None
+    if why is None:
         if not isinstance(data, dict):
-            continue
-        cmd = data.get("command")
-        files = None if legacy else [f for f in data.get("files", []) if isinstance(f, str)]
-        return (cmd if isinstance(cmd, str) else None), files
-    return None, None
+            why = f"holds a JSON {type(data).__name__}, not an object"
+        elif not isinstance(data.get("files", []), list) or not all(
+            isinstance(f, str) for f in data.get("files", [])
+        ):
+            why = "its 'files' is not a list of file names"
+        elif data.get("command") is not None and not isinstance(data["command"], str):
+            why = "its 'command' is not a text"
+    if why is not None:
+        if strict:
+            raise InputError(
+                f"{short(path)!r} is not a vidi manifest ({why}); remove it if the "
+                "directory is yours, or give another output directory"
+            )
+        return None, []
+    return data.get("command"), [f for f in data.get("files", []) if vidi_writes(f)]
+
+
+def _owner(directory, strict=False):
+    """``(command, files)`` of an earlier result directory: from its manifest (only the
+    names a vidi command can write count), else from a legacy ``summary.json`` that names
+    its command (files unknown), else ``(None, None)``: a ``summary.json`` without a
+    ``command`` is the user's own file, not a vidi result."""
+    d = Path(directory)
+    got = _read_manifest(d / MANIFEST, strict)
+    if got is not None:
+        return got
+    try:
+        with open(d / "summary.json", encoding="utf-8") as fh:
+            data = json.load(fh)
+    except (OSError, ValueError, RecursionError):
+        return None, None
+    cmd = data.get("command") if isinstance(data, dict) else None
+    return (cmd, None) if isinstance(cmd, str) and cmd else (None, None)
 
 
 def _refuse_other_command(owner, text, option):
@@ -456,6 +519,7 @@ def check_output(path, inputs=(), *, kind="dir", option="--out"):
         what = "a directory such as results/run1" if kind == "dir" else "a file such as D.csv"
         raise InputError(f"{option} is empty; give {what}")
     p = Path(text)
+    text = short(text)  # the messages below show a very long path shortened
     for inp in inputs:
         if inp is not None and os.path.isfile(inp) and _same_file(p, inp):
             raise InputError(
@@ -502,26 +566,18 @@ def _check_replaceable(p, text, option):
     entries = [e for e in os.scandir(p) if not _OWNED.match(e.name)]
     if not entries:
         return
-    owner, files = _owner(p)
+    owner, files = _owner(p, strict=True)
     if owner is not None or files is not None:
         _refuse_other_command(owner, text, option)
         return
-    names = {e.name for e in entries}
-    subdirs = sorted(e.name for e in entries if e.is_dir(follow_symlinks=False))
-    odd = sorted(
-        e.name
-        for e in entries
-        if not e.is_dir(follow_symlinks=False)
-        and not (e.is_file(follow_symlinks=False) and _RESULT_FILE.match(e.name))
+    # no manifest, no summary.json naming its command: not a vidi result
+    shown = ", ".join(short(n, 60) for n in sorted(e.name for e in entries)[:3])
+    raise InputError(
+        f"{option} {text!r} is a non-empty directory that is not an earlier "
+        f"vidi result (it holds {shown}); results replace the directory as a "
+        "whole, so give a new or empty directory such as "
+        f"{short(p / 'run1')!r}"
     )
-    if subdirs or odd or "summary.json" not in names:
-        shown = ", ".join((subdirs + odd)[:3] or sorted(names)[:3])
-        raise InputError(
-            f"{option} {text!r} is a non-empty directory that is not an earlier "
-            f"vidi result (it holds {shown}); results replace the directory as a "
-            "whole, so give a new or empty directory such as "
-            f"{str(p / 'run1')!r}"
-        )
 
 
 # ---------------------------------------------------------------- staging directories
@@ -666,7 +722,7 @@ class OutputDir:
                 with contextlib.suppress(OSError):
                     d.rmdir()
             raise InputError(
-                f"--out {str(self.target)!r}: cannot create {exc.filename!r} "
+                f"--out {short(self.target)!r}: cannot create {short(exc.filename)!r} "
                 f"({exc.strerror}); choose a writable location"
             ) from None
         _chmod_default(self.stage, directory=True)
@@ -683,7 +739,11 @@ class OutputDir:
             fh.write("\n")
 
     def _write_manifest(self):
-        files = sorted(f.name for f in self.stage.iterdir() if f.name != MANIFEST)
+        files = sorted(
+            str(f.relative_to(self.stage).as_posix())
+            for f in self.stage.rglob("*")
+            if f.name != MANIFEST and not f.is_dir()
+        )
         try:
             version = metadata.version("vibroimpact-discovery")
         except metadata.PackageNotFoundError:
@@ -694,18 +754,30 @@ class OutputDir:
 
     def _keep_user_files(self, old, target):
         """Move every entry of the earlier directory ``old`` that the earlier run did not
-        write (not in its manifest; for a legacy result without one, not a name of the new
-        result) back into ``target``: a user's notes, a file dropped in during the run.  A
-        name the new result also uses is kept as ``NAME.kept``."""
+        write back into ``target``: a user's notes, a file dropped in during the run, a file
+        added inside one of vidi's folders.  vidi's are the names its manifest lists that a
+        command can write (:func:`vidi_writes`; a folder listed whole, as older manifests
+        did, is vidi's with what it holds); a legacy result without a manifest: the names
+        the new result uses.  A name the new result also uses is kept as ``NAME.kept``."""
         _, files = _owner(old)
-        ours = (
-            set(files) | {MANIFEST}
-            if files is not None
-            else {f.name for f in target.iterdir()} | {"summary.json"}
-        )
+        if files is None:
+            ours = {f.name for f in target.iterdir()} | {"summary.json"}
+        else:
+            ours = set(files) | {MANIFEST}
+        self._keep_from(Path(old), Path(target), ours, "")
+
+    def _keep_from(self, old, target, ours, prefix):
         for e in list(os.scandir(old)):
-            if e.name in ours or _OWNED.match(e.name):
+            rel = prefix + e.name
+            if rel in ours or (not prefix and _OWNED.match(e.name)):
                 continue
+            if e.is_dir(follow_symlinks=False) and any(f.startswith(rel + "/") for f in ours):
+                sub = target / e.name
+                if not os.path.lexists(sub):
+                    os.mkdir(sub)
+                if sub.is_dir() and not sub.is_symlink():
+                    self._keep_from(Path(e.path), sub, ours, rel + "/")
+                    continue
             dest = target / e.name
             k = 0
             while os.path.lexists(dest):
@@ -727,7 +799,7 @@ class OutputDir:
             return
         if target.is_symlink() or not target.is_dir():
             raise InputError(
-                f"--out {str(self.target)!r} became a file or a link during the "
+                f"--out {short(self.target)!r} became a file or a link during the "
                 "run; the results were not written"
             )
         if _exchange(self.stage, target):

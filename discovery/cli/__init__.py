@@ -388,11 +388,15 @@ def _interruption(exc):
     return None
 
 
-def _stopped(exc):
+def _stopped(exc, outer=None):
+    """The one line of an interrupted run: what was kept (a study's finished runs, named by
+    the note it attaches to the interrupt) or that the partial outputs were removed."""
+    note = getattr(outer, "vidi_note", None) or getattr(exc, "vidi_note", None)
+    what = note or "partial outputs were removed, earlier results are unchanged"
     if isinstance(exc, Terminated):
-        _error("terminated (SIGTERM); partial outputs were removed, earlier results are unchanged")
+        _error(f"terminated (SIGTERM); {what}")
         return 143
-    _error("interrupted (Ctrl-C); partial outputs were removed, earlier results are unchanged")
+    _error(f"interrupted (Ctrl-C); {what}")
     return 130
 
 
@@ -503,7 +507,7 @@ def _run(argv):
     except Exception as exc:
         stop = _interruption(exc)  # an interrupt re-raised by compiled code or a solver
         if stop is not None:
-            return _stopped(stop)
+            return _stopped(stop, exc)
         if isinstance(exc, VidiError):  # bad input or failed numerics, by type
             _error(exc)
             return 2
