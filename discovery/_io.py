@@ -126,16 +126,12 @@ def running(command):
         _RUN.update(prev)
 
 
-# the names a vidi command can write into a result directory: a manifest entry outside
-# them (a user's notes, a data folder) is never taken as vidi's, whatever the manifest says
+# the names a vidi command can write into a result directory (its kinds of file at the top,
+# a study's runs/ folder): a manifest entry outside them (a user's notes.txt, a data folder)
+# is never taken as vidi's, whatever the manifest says
 _VIDI_WRITES = re.compile(
-    r"^(?:summary|config)\.json$"
-    r"|^(?:ranking|iterations|strobe(?:_[\w.-]+)?|chart|landscape|cells|runs|inclusion)\.csv$"
-    r"|^(?:verify|fit_impulse|fit_surface|fit_loop|model|identification|explain(?:_\w+)?"
-    r"|attractor|basins|discover|chart|landscape|recovery_noise|recovery_map|coverage"
-    r"|inclusion|report)\.(?:png|pdf)$"
-    r"|^(?:model|report|snippet-\w+)\.(?:tex|log)$"
-    r"|^runs$|^runs/[0-9a-f]+\.json$"
+    r"^[^/]+\.(?:json|csv|png|pdf|tex|log|svg)$"  # the kinds of file a result holds
+    r"|^runs$|^runs/[^/]+\.json$"  # a study's run files (an older manifest lists the folder)
 )
 
 
@@ -571,7 +567,15 @@ def _check_replaceable(p, text, option):
         _refuse_other_command(owner, text, option)
         return
     # no manifest, no summary.json naming its command: not a vidi result
-    shown = ", ".join(short(n, 60) for n in sorted(e.name for e in entries)[:3])
+    subdirs = sorted(e.name for e in entries if e.is_dir(follow_symlinks=False))
+    odd = sorted(
+        e.name
+        for e in entries
+        if not e.is_dir(follow_symlinks=False)
+        and not (e.is_file(follow_symlinks=False) and _RESULT_FILE.match(e.name))
+    )
+    rest = sorted(e.name for e in entries if e.name not in subdirs and e.name not in odd)
+    shown = ", ".join(short(n, 60) for n in ((subdirs + odd)[:3] or rest[:3]))
     raise InputError(
         f"{option} {text!r} is a non-empty directory that is not an earlier "
         f"vidi result (it holds {shown}); results replace the directory as a "

@@ -253,14 +253,16 @@ def test_study_killed_with_sigkill_resumes_with_every_run_once(quick_serial, tmp
         "--no-figures",
         "--quiet",
     ]
+    work = tmp_path / ".killed.vidi-study"  # the runs land here until the study is put in place
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 300
-    while len(_files(out)) < 3 and time.monotonic() < deadline and proc.poll() is None:
+    while len(_files(work)) < 3 and time.monotonic() < deadline and proc.poll() is None:
         time.sleep(0.05)
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait()
-    before = len(_files(out))
+    before = len(_files(work))
     assert 3 <= before < 8, "the study must be killed halfway"
+    assert not out.exists(), "a killed study writes nothing into its directory"
     again = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     assert again.returncode == 0, again.stderr
     runs = _runs(out)
@@ -268,9 +270,8 @@ def test_study_killed_with_sigkill_resumes_with_every_run_once(quick_serial, tmp
     assert all(f.stem == json.loads(f.read_text())["key"] for f in _files(out))
     assert f"{8 - before} run now, {before} from earlier files" in again.stdout
     assert runs == _runs(full) and _cells(out) == _cells(full)
-    assert not [p for p in (out / "runs").iterdir() if p.name.startswith(".")] or all(
-        "vidi-tmp" in p.name for p in (out / "runs").iterdir() if p.name.startswith(".")
-    )
+    assert not [p for p in (out / "runs").iterdir() if p.name.startswith(".")]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["killed", "quick.toml"]
 
 
 def test_cli_study_bad_inputs_are_one_line(tmp_path):

@@ -367,7 +367,10 @@ def _refuse_orphans(parser, argv):
 
 
 def _error(message):
-    print(f"vidi: error: {' '.join(str(message).split())}", file=sys.stderr)
+    text = " ".join(str(message).split())
+    if len(text) > 1200:  # a message echoing a very long path or value: its ends only
+        text = f"{text[:597]} ... {text[-597:]}"
+    print(f"vidi: error: {text}", file=sys.stderr)
 
 
 _OUT_OF_MEMORY = (
@@ -478,7 +481,7 @@ def main(argv=None):
 
 def _run(argv):
     try:
-        from .._io import set_run
+        from .._io import set_run, short
 
         parser = _parser()
         if not argv:  # plain `vidi`: the overview, not an error
@@ -512,7 +515,7 @@ def _run(argv):
             _error(exc)
             return 2
         if isinstance(exc, OSError):  # the environment: disk full, permissions, a vanished file
-            where = f" ({exc.filename})" if exc.filename else ""
+            where = f" ({short(exc.filename)})" if exc.filename else ""
             _error(
                 f"{exc.strerror or exc}{where}; check the path, its permissions and the free space"
             )

@@ -564,13 +564,18 @@ class _Work:
         """Say what was kept: the interrupt's message names the work directory and how to
         continue; a study that stopped with no run kept leaves nothing behind."""
         kept = self.n_runs()
+        where = (
+            f"{short(out)!r} is unchanged"
+            if self.target.exists()
+            else f"nothing was written to {short(out)!r}"
+        )
         if kept:
             note = (
-                f"{kept} finished run(s) of {total} kept in {short(self.path)!r}; run the same "
-                f"command again to continue; {short(out)!r} is unchanged"
+                f"{kept} finished run(s) of {total} kept in {short(self.path)!r}; run the "
+                f"same command again to continue; {where}"
             )
         else:
-            note = f"no run was kept; {short(out)!r} is unchanged"
+            note = f"no run was kept; {where}"
         with contextlib.suppress(Exception):
             exc.vidi_note = note
         if not kept:
