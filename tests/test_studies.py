@@ -106,12 +106,43 @@ def test_config_rows_and_scenario_tables():
         ({"factors": {"refine": [True]}, "rows": [{}]}, "not both"),
         ({"factors": {"scenario": [{"base": "paper", "mass": 3}]}}, "unknown scenario key"),
         ({"factors": {"law": ["2e8*z +"]}}, ""),
+        # every [fit] and [record] option by the API's own checks, types strict
+        ({"fit": {"max_terms": "four"}}, "[fit] max_terms must be an integer"),
+        ({"fit": {"max_terms": -3}}, "[fit] max_terms must be an integer in [1, 64]; got -3"),
+        ({"fit": {"criterion": "I9"}}, "unknown criterion 'I9'"),
+        ({"fit": {"max_simulations": 0}}, "max_simulations must be an integer >= 2"),
+        ({"fit": {"scoring": "r2"}}, "scoring must be one of"),
+        ({"fit": {"physics": "no"}}, "physics must be true or false"),
+        ({"record": {"velocities": "no"}}, "velocities is true or false; got 'no'"),
+        ({"factors": {"law": ["-2e8*z"]}}, "never pushes the bodies apart"),
+        ({"factors": {"scenario": [{"base": "paper", "A": "big"}]}}, "A = 'big' is not a number"),
+        # bounds on cells, runs and samples, with the number
+        (
+            {
+                "factors": {
+                    "force_noise": [i / 1e4 for i in range(1000)],
+                    "fs": [1e3 + i for i in range(1000)],
+                }
+            },
+            "make 1000000 cells",
+        ),
+        ({"seeds": 100000, "factors": {"force_noise": [0.01, 0.02]}}, "= 200000 runs"),
+        ({"factors": {"periods": [10000], "fs": [1e7]}}, "is 4e+09 samples a record"),
     ],
 )
 def test_config_refuses_bad_studies_in_one_line(bad, words):
+    bad = {
+        "factors": {"law": ["2.06e8*z + 1.28e7*zd"], **bad.get("factors", {})},
+        **{k: v for k, v in bad.items() if k != "factors"},
+    }
     with pytest.raises(InputError) as err:
         load_study(bad)
     assert words in str(err.value) and "\n" not in str(err.value)
+
+
+def test_a_huge_study_file_is_not_read_whole():
+    with pytest.raises(InputError, match="larger than 1048576 bytes"):
+        load_study("/dev/zero")
 
 
 def test_wilson_interval_closed_form():
