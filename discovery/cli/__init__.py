@@ -61,9 +61,10 @@ def _one_line(message, prog, command=None):
     m = re.match(r"argument (\S+?)(?:/\S+)?: expected one argument$", message)
     if m:
         opt = m.group(1)
+        example = "-1e8*z" if opt in ("--law", "--start", "--truth") else "-1e-3"
         return (
             f"{opt} needs a value; write {opt} VALUE, and a value that starts with '-' as "
-            f"{opt}=-VALUE (e.g. {opt}=-1e8*z)"
+            f"{opt}=-VALUE (e.g. {opt}={example})"
         )
     m = re.match(r"the following arguments are required: (.*)$", message)
     if m:
@@ -281,6 +282,14 @@ def _attach_dash_values(parser, argv):
         return argv
     parser.command_hint = command
     sp = sub.choices[command]
+    rest = argv[argv.index(command) + 1 :]
+    while True:  # down to the innermost subcommand named (`ueda attractor`)
+        inner = next((a for a in sp._actions if isinstance(a, argparse._SubParsersAction)), None)
+        name = next((t for t in rest if not t.startswith("-")), None)
+        if inner is None or name not in inner.choices:
+            break
+        sp = inner.choices[name]
+        rest = rest[rest.index(name) + 1 :]
     takes_value = {
         s
         for a in sp._actions

@@ -7,7 +7,7 @@ import io
 import numpy as np
 
 from .._io import OutputDir, provenance
-from ..errors import InputError
+from ..errors import InputError, IntegrationError
 from ..vibroimpact.model.scenario import load_scenario
 from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
@@ -145,6 +145,13 @@ def run(args):
             progress=rep,
             executor=ex,
             continuation=not args.no_continuation,
+        )
+    count, first, at = land.failures
+    if count and count >= n0 * n1:  # nothing to show: one line and no output
+        raise IntegrationError(
+            f"every one of the {count} simulations of the landscape failed, first at "
+            f"({a0[at[0]]:.4g}, {a1[at[1]]:.4g}): {first}; give --range0/--range1 nearer "
+            "the coefficients of the record's law"
         )
     ref_info.update(regime=land.reference["regime"], start=land.reference["start"])
     if ref is None:
