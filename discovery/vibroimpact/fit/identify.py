@@ -39,7 +39,7 @@ from scipy.optimize import least_squares, minimize
 from ..._printing import coefficient_lines, criteria_lines, fmt, readable
 from ..._progress import tick
 from ..._validate import Choice, Real, Text, params
-from ...errors import InputError, IntegrationError
+from ...errors import InputError, IntegrationError, VidiTypeError
 from ...numerics.executor import map_on
 from ..data.impulse import Impulse
 from ..data.measurement import Measurement
@@ -793,6 +793,11 @@ def identify(
     IntegrationError
         The start law has no periodic steady state with contact.
     """
+    if isinstance(start, str):
+        raise VidiTypeError(
+            f"identify: start must be a ForceLaw or a Model (parse text with "
+            f"ForceLaw.parse({start[:30]!r})); got str"
+        )
     records = _checked(scenario, reference, start, method, xtol, max_simulations)
     t0 = time.perf_counter()
     start, spent = _short_first(
