@@ -172,6 +172,9 @@ def run(args):
         truth = None
         if ref is None and sc.law.names[:2] == law.names[:2]:
             truth = tuple(sc.law.coefficients[:2])
+        src = land.reference.get("source") if isinstance(land.reference, dict) else None
+        if isinstance(src, str) and "$" in src:  # a file name is text, never mathtext
+            land.reference["source"] = src.replace("$", r"\$")
         landscape_figure(land, str(out.path("landscape")), truth=truth)
     src = "the scenario's law" if ref is None else f"{args.data}"
     count, first, at = land.failures
