@@ -246,3 +246,45 @@ def test_the_users_file_inside_a_study_folder_survives_verify_overwrite(tmp_path
     assert json.loads((out / ".vidi-manifest.json").read_text())["command"] == "steady"
     assert not list((out / "runs").glob("*.json"))
     assert os.path.exists(out / "summary.json")
+
+
+@pytest.mark.slow
+def test_ctrl_c_of_a_dask_study_is_one_line(tmp_path):
+    """Ctrl-C at a terminal reaches the whole process group: the workers of the local
+    cluster start with SIGINT ignored, so only vidi's one line is printed."""
+    pytest.importorskip("distributed")
+    out = tmp_path / "dask"
+    cfg = tmp_path / "long.toml"
+    cfg.write_text(LONG)
+    cmd = [*VIDI, "study", "--config", str(cfg), "--out", str(out), "--scheduler", "local"]
+    proc = subprocess.Popen(
+        [*cmd, "--workers", "2", "--no-figures", "--quiet"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    runs = _work(out) / "runs"
+    deadline = time.monotonic() + 180
+    while time.monotonic() < deadline and proc.poll() is None:
+        if runs.is_dir() and len(list(runs.glob("*.json"))) >= 2:
+            break
+        time.sleep(0.1)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130
+    assert len(err.strip().splitlines()) == 1, err
+    assert "kept in" in err and not out.exists()
+
+
+def test_two_studies_into_one_directory_at_once_are_refused(tmp_path):
+    import fcntl
+
+    out = tmp_path / "s"
+    work = _work(out)
+    work.mkdir()
+    with open(work / ".lock", "w") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)  # another study holds it
+        with pytest.raises(InputError, match="another study is writing"):
+            study(TINY, out, workers=1, figures=False)
+    assert not out.exists()
