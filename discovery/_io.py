@@ -69,6 +69,7 @@ __all__ = [
     "running",
     "MANIFEST",
     "vidi_writes",
+    "read_manifest",
     "short",
 ]
 
@@ -150,7 +151,7 @@ def short(text, limit=160):
     return f"{text[:half]} ... {text[-half:]}"
 
 
-def _read_manifest(path, strict):
+def read_manifest(path, strict=False):
     """``(command, files)`` of a manifest file, ``None`` when there is none.  A malformed one
     (not an object, ``files`` not a list of names) raises :class:`InputError` when
     ``strict``, else reads as ``(None, [])``: nothing in it is claimed as vidi's."""
@@ -189,7 +190,7 @@ def _owner(directory, strict=False):
     its command (files unknown), else ``(None, None)``: a ``summary.json`` without a
     ``command`` is the user's own file, not a vidi result."""
     d = Path(directory)
-    got = _read_manifest(d / MANIFEST, strict)
+    got = read_manifest(d / MANIFEST, strict)
     if got is not None:
         return got
     try:

@@ -195,6 +195,10 @@ def test_a_malformed_manifest_is_one_line(tmp_path, capsys, files):
     err = capsys.readouterr().err.strip()
     assert "not a vidi manifest" in err and "\n" not in err
     assert _snapshot(out) == before
+    assert main(["report", str(out), "--no-pdf"]) == 2  # vidi report checks it too
+    err = capsys.readouterr().err.strip()
+    assert "not a vidi manifest" in err and "\n" not in err
+    assert _snapshot(out) == before
 
 
 def test_a_manifest_that_is_a_list_is_one_line(tmp_path, capsys):
