@@ -96,3 +96,26 @@ def test_a_tiny_mass_is_refused_without_numpy_warnings(tmp_path):
     )
     assert p.returncode == 2
     assert "Warning" not in p.stderr and len(p.stderr.strip().splitlines()) == 1, p.stderr
+
+
+def test_an_attractor_its_own_check_disputes_is_not_a_result(tmp_path, capsys, monkeypatch):
+    """The Lyapunov sum must equal the mean trace of the flow; when the integration from
+    the given start makes them disagree, `ueda attractor` says so (exit 2), no output."""
+    import dataclasses
+
+    import discovery.ueda as ueda
+
+    real = ueda.attractor
+    where = sys.modules["discovery.ueda.attractor"]  # the package reads the name from here
+
+    def off(*a, **k):
+        att = real(*a, **k)
+        lyap = dataclasses.replace(att.lyapunov, sum=att.lyapunov.sum + 0.5)
+        return dataclasses.replace(att, lyapunov=lyap)
+
+    monkeypatch.setattr(where, "attractor", off)
+    out = tmp_path / "a"
+    argv = ["ueda", "attractor", "--x0", "1000", "--periods", "200", "--transient", "20"]
+    assert main([*argv, "--batches", "4", "--out", str(out)]) == 2
+    assert "disagrees with the mean trace" in _one_line(capsys)
+    assert not out.exists()
