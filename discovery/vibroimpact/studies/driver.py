@@ -467,7 +467,7 @@ def study(
                 version,
             )
         except BaseException as exc:
-            work.failed(exc, len(have), len(runs), out)
+            work.failed(exc, [r["key"] for r in runs], out)
             raise
         result = StudyResult(
             config=cfg,
@@ -554,16 +554,19 @@ class _Work:
         self._lock = fd
         return self
 
-    def n_runs(self):
+    def n_runs(self, keys=None):
+        """Run files in the work directory (of ``keys`` only, when given)."""
         try:
-            return sum(1 for f in self.runs.iterdir() if f.suffix == ".json")
+            names = {f.name for f in self.runs.iterdir() if f.suffix == ".json"}
         except OSError:
             return 0
+        return len(names if keys is None else names & {f"{k}.json" for k in keys})
 
-    def failed(self, exc, have, total, out):
+    def failed(self, exc, keys, out):
         """Say what was kept: the interrupt's message names the work directory and how to
         continue; a study that stopped with no run kept leaves nothing behind."""
-        kept = self.n_runs()
+        kept = self.n_runs(keys)
+        total = len(keys)
         where = (
             f"{short(out)!r} is unchanged"
             if self.target.exists()
@@ -578,7 +581,7 @@ class _Work:
             note = f"no run was kept; {where}"
         with contextlib.suppress(Exception):
             exc.vidi_note = note
-        if not kept:
+        if not self.n_runs():  # nothing of this or an earlier interrupted study there
             self._remove()
 
     def finish(self):
