@@ -190,6 +190,7 @@ def test_check_output_refusals(tmp_path, monkeypatch):
     with pytest.raises(InputError, match="not an earlier vidi result"):
         check_output("prev", [data])
     (tmp_path / "prev" / "summary.json").write_text('{"command": "landscape"}')
+    monkeypatch.setitem(_io._RUN, "command", "landscape")  # whatever ran before in-process
     for ok in ("new/deeper/res", "empty", "prev"):
         assert check_output(ok, [data]) == Path(ok)
     assert sorted(p.name for p in tmp_path.iterdir()) == [
