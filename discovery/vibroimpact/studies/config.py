@@ -110,10 +110,11 @@ class StudyConfig:
     def runs(self, code_version=""):
         """Every run: a JSON-ready description with its ``key`` (hash of the description
         and ``code_version``), in a fixed order (cells, then seeds)."""
-        out = []
+        out, cache = [], {}
         for ci, cell in enumerate(self.cells):
+            base = _resolve(cell, self.fit, self.record, 0, cache)  # runs differ by seed
             for seed in self.seeds:
-                spec = _resolve(cell, self.fit, self.record, seed)
+                spec = {**base, "seed": int(seed)}
                 spec["cell"] = ci
                 spec["key"] = run_key(spec, code_version)
                 out.append(spec)
@@ -241,22 +242,35 @@ def _check_factor(name, value, source):
     return value
 
 
-def _resolve(cell, fit, record, seed):
-    """The self-contained description of one run."""
-    scenarios = _scenario_value(cell["scenario"], "")
+def _resolve(cell, fit, record, seed, cache=None):
+    """The self-contained description of one run (``cache``: the scenarios and laws already
+    resolved, by their text)."""
+    cache = {} if cache is None else cache
+    sk = ("scenario", json.dumps(cell["scenario"], sort_keys=True, default=str))
+    if sk not in cache:
+        scenarios = _scenario_value(cell["scenario"], "")
+        cache[sk] = (
+            scenarios[0].law,
+            [
+                {k: v for k, v in sc.as_dict().items() if k not in ("law", "source")}
+                for sc in scenarios
+            ],
+            scenarios[0].name,
+        )
+    own_law, scenario_dicts, first = cache[sk]
     law = cell["law"]
     if law is None:
-        if scenarios[0].law is None:
-            raise InputError(f"scenario {scenarios[0].name!r} has no law; give [factors] law")
-        law = scenarios[0].law.to_text()
+        if own_law is None:
+            raise InputError(f"scenario {first!r} has no law; give [factors] law")
+        law = own_law.to_text()
     else:
-        law = ForceLaw.parse(law).to_text()
+        lk = ("law", law)
+        if lk not in cache:
+            cache[lk] = ForceLaw.parse(law).to_text()
+        law = cache[lk]
     return {
         "law": law,
-        "scenarios": [
-            {k: v for k, v in sc.as_dict().items() if k not in ("law", "source")}
-            for sc in scenarios
-        ],
+        "scenarios": [dict(d) for d in scenario_dicts],
         "force_noise": float(cell["force_noise"]),
         "motion_noise": float(cell["motion_noise"]),
         "periods": int(cell["periods"]),
@@ -406,9 +420,12 @@ def _check_cells(cells, source):
     """What only a cell shows: each record's size (periods at the sample rate, at the
     scenario's drive frequency) within :data:`MAX_SAMPLES`, and each true law one a machine
     could have (:meth:`ForceLaw.check_physical` on its scenario)."""
-    seen = set()
+    seen, loaded = set(), {}
     for cell in cells:
-        scenarios = _scenario_value(cell["scenario"], source)
+        sk = json.dumps(cell["scenario"], sort_keys=True, default=str)
+        if sk not in loaded:
+            loaded[sk] = _scenario_value(cell["scenario"], source)
+        scenarios = loaded[sk]
         for sc in scenarios:
             n = cell["periods"] * cell["fs"] / sc.frequency
             if not n <= MAX_SAMPLES:
@@ -419,7 +436,7 @@ def _check_cells(cells, source):
                     f"{MAX_SAMPLES:.0e}: lower fs or periods",
                 )
         law = cell["law"]
-        key = (law, json.dumps(cell["scenario"], sort_keys=True, default=str))
+        key = (law, sk)
         if key in seen:
             continue
         seen.add(key)
