@@ -329,6 +329,8 @@ def test_cli_study_bad_inputs_are_one_line(tmp_path):
         )
         assert p.returncode == 2, p.stderr
         assert words in p.stderr and len(p.stderr.strip().splitlines()) == 1, p.stderr
+        # a failed study leaves nothing behind: no directory, no work directory
+        assert sorted(q.name for q in tmp_path.iterdir()) == ["bad.toml"], p.stderr
 
 
 def test_study_refuses_a_directory_that_is_not_a_study(tmp_path):
