@@ -136,6 +136,9 @@ _VIDI_WRITES = re.compile(
 )
 
 
+_RUN_FILE = re.compile(r"^[0-9a-f]+\.json$")  # a study's run file, in its runs/ folder
+
+
 def vidi_writes(name):
     """True when ``name`` (relative to a result directory, ``/`` between folders) is a name
     some vidi command writes there."""
@@ -771,17 +774,23 @@ class OutputDir:
             ours = set(files) | {MANIFEST}
         self._keep_from(Path(old), Path(target), ours, "")
 
-    def _keep_from(self, old, target, ours, prefix):
+    def _keep_from(self, old, target, ours, prefix, whole=False):
+        """Move the user's entries of folder ``old`` into ``target`` (see
+        :meth:`_keep_user_files`); ``whole``: an older manifest listed this folder whole, so
+        its run files (``HEX.json``) are vidi's and anything else in it the user's."""
         for e in list(os.scandir(old)):
             rel = prefix + e.name
-            if rel in ours or (not prefix and _OWNED.match(e.name)):
+            if _OWNED.match(e.name):  # a temporary file or staging folder of a killed run
                 continue
-            if e.is_dir(follow_symlinks=False) and any(f.startswith(rel + "/") for f in ours):
+            is_dir = e.is_dir(follow_symlinks=False)
+            if not is_dir and (rel in ours or (whole and _RUN_FILE.match(e.name))):
+                continue
+            if is_dir and (rel in ours or any(f.startswith(rel + "/") for f in ours)):
                 sub = target / e.name
                 if not os.path.lexists(sub):
                     os.mkdir(sub)
                 if sub.is_dir() and not sub.is_symlink():
-                    self._keep_from(Path(e.path), sub, ours, rel + "/")
+                    self._keep_from(Path(e.path), sub, ours, rel + "/", rel in ours)
                     continue
             dest = target / e.name
             k = 0

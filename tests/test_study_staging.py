@@ -292,3 +292,17 @@ def test_two_studies_into_one_directory_at_once_are_refused(tmp_path):
         with pytest.raises(InputError, match="another study is writing"):
             study(TINY, out, workers=1, figures=False)
     assert not out.exists()
+
+
+def test_an_older_manifest_listing_runs_whole_keeps_the_users_file_in_it(tmp_path, capsys):
+    out = tmp_path / "old"
+    (out / "runs").mkdir(parents=True)
+    (out / "runs" / "0123abcd.json").write_text("{}")
+    (out / "runs" / "mine.txt").write_text("mine")
+    (out / "summary.json").write_text('{"command": "steady"}')
+    man = {"command": "steady", "files": ["runs", "summary.json"]}
+    (out / ".vidi-manifest.json").write_text(json.dumps(man))
+    assert main(["steady", "--out", str(out)]) == 0
+    capsys.readouterr()
+    assert (out / "runs" / "mine.txt").read_text() == "mine"
+    assert not (out / "runs" / "0123abcd.json").exists()
