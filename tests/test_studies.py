@@ -113,6 +113,8 @@ def test_config_rows_and_scenario_tables():
         ({"fit": {"max_simulations": 0}}, "max_simulations must be an integer >= 2"),
         ({"fit": {"scoring": "r2"}}, "scoring must be one of"),
         ({"fit": {"physics": "no"}}, "physics must be true or false"),
+        ({"fit": {"n_boot": 10**9}}, "n_boot must be at most 10000"),
+        ({"fit": {"n_boot_intervals": 3}}, "cannot give an interval"),
         ({"record": {"velocities": "no"}}, "velocities is true or false; got 'no'"),
         ({"factors": {"law": ["-2e8*z"]}}, "never pushes the bodies apart"),
         ({"factors": {"scenario": [{"base": "paper", "A": "big"}]}}, "A = 'big' is not a number"),

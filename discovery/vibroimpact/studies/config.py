@@ -87,6 +87,13 @@ MAX_CELLS = 10_000
 MAX_RUNS = 100_000
 MAX_SAMPLES = 10_000_000  # samples of one run's records, like `vidi simulate`
 MAX_FILE_BYTES = 1 << 20  # a study file larger than this is not read
+_FIT_BOUNDS = {
+    "shortlist": 200,
+    "max_simulations": 100_000,
+    "n_boot": 10_000,
+    "n_boot_intervals": 10_000,
+    "stepwise": 64,
+}
 _TOP = ("name", "seeds", "factors", "rows", "fit", "record")
 
 
@@ -369,9 +376,13 @@ def _check_fit(fit, source):
             fit.get("max_simulations", 2),
             fit.get("stepwise", 0),
         )
-        if "n_boot_intervals" in fit and fit["n_boot_intervals"] > 100_000:
+        for k, hi in _FIT_BOUNDS.items():  # the command line's bounds (`vidi fit`)
+            if k in fit and fit[k] > hi:
+                raise InputError(f"{k} must be at most {hi}; got {fit[k]}")
+        if 0 < fit.get("n_boot_intervals", 0) < 5:
             raise InputError(
-                f"n_boot_intervals must be at most 100000; got {fit['n_boot_intervals']}"
+                f"n_boot_intervals = {fit['n_boot_intervals']} replicates cannot give an "
+                "interval; give 0 (none) or at least 5"
             )
     except VidiError as exc:
         bad(exc)
