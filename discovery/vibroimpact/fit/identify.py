@@ -559,6 +559,11 @@ def _uncertainty(obj, x, names):
 
 def _checked(scenario, reference, start, method, xtol, max_simulations):
     """The settings :func:`identify` checks beyond their types; returns the records."""
+    if isinstance(start, str):
+        raise VidiTypeError(
+            f"identify: start must be a ForceLaw or a Model (parse text with "
+            f"ForceLaw.parse({start[:30]!r})); got str"
+        )
     if method not in METHODS:
         raise InputError(f"unknown method {method!r}; valid methods: {', '.join(METHODS)}")
     if any(c == 0 for c in start.coefficients):
@@ -793,11 +798,6 @@ def identify(
     IntegrationError
         The start law has no periodic steady state with contact.
     """
-    if isinstance(start, str):
-        raise VidiTypeError(
-            f"identify: start must be a ForceLaw or a Model (parse text with "
-            f"ForceLaw.parse({start[:30]!r})); got str"
-        )
     records = _checked(scenario, reference, start, method, xtol, max_simulations)
     t0 = time.perf_counter()
     start, spent = _short_first(
