@@ -386,8 +386,11 @@ def study(
     config : str, Path, dict or StudyConfig
         A study file (TOML), its parsed mapping, or a :class:`StudyConfig`.
     out : str or Path
-        The study directory.  Runs already there (from an interrupted or earlier call with
-        the same code version) are reused, not run again.
+        The study directory, written as a whole at the end (the runs land in
+        ``.OUT.vidi-study`` beside it meanwhile).  Runs of an interrupted call (kept there)
+        or of the finished study in ``out`` (the same cells, seeds and options) with the
+        same code version are reused, not run again; another study there is refused
+        unless the CLI's ``--overwrite``.
     workers : int, optional
         Local worker processes (default one per CPU; 1 runs in this process).
     scheduler : str, optional
@@ -395,7 +398,8 @@ def study(
     executor : Executor, optional
         Use this executor (overrides ``workers`` and ``scheduler``; not closed here).
     progress : callable, optional
-        ``progress(stage, done, total)`` as runs finish.
+        ``progress(stage, done, total)`` as runs finish (anything else not callable is a
+        :class:`~discovery.errors.VidiTypeError`).
     max_runs : int, optional
         Do at most this many missing runs, then aggregate what the files hold (a study in
         slices; the rest runs on the next call).
