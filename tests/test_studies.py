@@ -117,6 +117,7 @@ def test_config_rows_and_scenario_tables():
         ({"fit": {"n_boot_intervals": 3}}, "cannot give an interval"),
         ({"record": {"velocities": "no"}}, "velocities is true or false; got 'no'"),
         ({"factors": {"law": ["-2e8*z"]}}, "never pushes the bodies apart"),
+        ({"factors": {"scenario": [{"base": "paper", "m2": 1e-300}]}}, "too stiff"),
         ({"factors": {"scenario": [{"base": "paper", "A": "big"}]}}, "A = 'big' is not a number"),
         # bounds on cells, runs and samples, with the number
         (

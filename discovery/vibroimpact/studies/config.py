@@ -454,10 +454,12 @@ def _check_cells(cells, source):
         if law is None:
             if scenarios[0].law is None:
                 _fail(source, f"scenario {scenarios[0].name!r} has no law; give [factors] law")
-            continue
+            truth, what = scenarios[0].law, f"the scenario's law ({scenarios[0].name})"
+        else:
+            truth, what = ForceLaw.parse(law), "[factors] law"
         for sc in scenarios:
             try:
-                ForceLaw.parse(law).check_physical(sc, "[factors] law")
+                truth.check_physical(sc, what)
             except InputError as exc:
                 _fail(source, str(exc))
 
