@@ -7,7 +7,8 @@ import os
 
 import numpy as np
 
-from .errors import InputError
+from ._io import short
+from .errors import InputError, VidiTypeError
 
 __all__ = ["read_csv_rows", "parse_column"]
 
@@ -20,7 +21,12 @@ def read_csv_rows(path, needs):
     commas with ``;`` or tab.  ``body`` is ``[(line number, fields), ...]``.  ``needs``
     names the columns for the messages (``"t and F"``).
     """
-    name = str(path)
+    if not isinstance(path, str | os.PathLike):  # an int would be read as a file descriptor
+        raise VidiTypeError(
+            f"the data file must be a path (text or os.PathLike); got {type(path).__name__} "
+            f"{str(path)[:40]!r}"
+        )
+    name = short(path)
     text, notes = _read_text(path, name)
     lines = [
         (i + 1, ln)
@@ -41,6 +47,13 @@ def read_csv_rows(path, needs):
             ) from None
     header = [h.strip() for h in rows[0]]
     body = list(zip((ln for ln, _ in lines[1:]), rows[1:], strict=True))
+    for ln, row in body:  # a value without a column: a shifted or merged row
+        if len(row) > len(header) and any(c.strip() for c in row[len(header) :]):
+            raise InputError(
+                f"data file {name!r}: line {ln} has {len(row)} fields under a header of "
+                f"{len(header)} columns; fix the row (a separator too many?) or name the "
+                "extra column in the header"
+            )
     if not body:
         raise InputError(f"data file {name!r} has a header but no data rows")
     decimal_comma = delim != "," and any("," in c for _, r in body[:50] for c in r)

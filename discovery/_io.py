@@ -68,6 +68,9 @@ __all__ = [
     "set_run",
     "running",
     "MANIFEST",
+    "vidi_writes",
+    "read_manifest",
+    "short",
 ]
 
 # the solvers cvxpy uses here: CLARABEL (default), OSQP (fallback in the regression)
@@ -124,22 +127,82 @@ def running(command):
         _RUN.update(prev)
 
 
-def _owner(directory):
-    """``(command, files)`` of an earlier result directory: from its manifest, else from a
-    legacy ``summary.json`` (command only, files unknown), else ``(None, None)``."""
-    d = Path(directory)
-    for name, legacy in ((MANIFEST, False), ("summary.json", True)):
-        try:
-            with open(d / name, encoding="utf-8") as fh:
-                data = json.load(fh)
-        except (OSError, ValueError):
-            continue
+# the names a vidi command can write into a result directory (its kinds of file at the top,
+# a study's runs/ folder): a manifest entry outside them (a user's notes.txt, a data folder)
+# is never taken as vidi's, whatever the manifest says
+_VIDI_WRITES = re.compile(
+    r"^[^/]+\.(?:json|csv|png|pdf|tex|log|svg)$"  # the kinds of file a result holds
+    r"|^runs$|^runs/[^/]+\.json$"  # a study's run files (an older manifest lists the folder)
+)
+
+
+_RUN_FILE = re.compile(r"^[0-9a-f]+\.json$")  # a study's run file, in its runs/ folder
+
+
+def vidi_writes(name):
+    """True when ``name`` (relative to a result directory, ``/`` between folders) is a name
+    some vidi command writes there."""
+    return bool(_VIDI_WRITES.match(name))
+
+
+def short(text, limit=160):
+    """``text`` for a one-line message: a very long path shows its start and end only."""
+    text = str(text)
+    if len(text) <= limit:
+        return text
+    half = (limit - 5) // 2
+    return f"{text[:half]} ... {text[-half:]}"
+
+
+def read_manifest(path, strict=False):
+    """``(command, files)`` of a manifest file, ``None`` when there is none.  A malformed one
+    (not an object, ``files`` not a list of names) raises :class:`InputError` when
+    ``strict``, else reads as ``(None, [])``: nothing in it is claimed as vidi's."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            data = json.load(fh)
+    except FileNotFoundError:
+        return None
+    except (OSError, ValueError, RecursionError) as exc:
+        why = f"cannot be read as JSON ({type(exc).__name__})"
+        data = None
+    else:
+        why = None
+    if why is None:
         if not isinstance(data, dict):
-            continue
-        cmd = data.get("command")
-        files = None if legacy else [f for f in data.get("files", []) if isinstance(f, str)]
-        return (cmd if isinstance(cmd, str) else None), files
-    return None, None
+            why = f"holds a JSON {type(data).__name__}, not an object"
+        elif not isinstance(data.get("files", []), list) or not all(
+            isinstance(f, str) for f in data.get("files", [])
+        ):
+            why = "its 'files' is not a list of file names"
+        elif data.get("command") is not None and not isinstance(data["command"], str):
+            why = "its 'command' is not a text"
+    if why is not None:
+        if strict:
+            raise InputError(
+                f"{short(path)!r} is not a vidi manifest ({why}); remove it if the "
+                "directory is yours, or give another output directory"
+            )
+        return None, []
+    return data.get("command"), [f for f in data.get("files", []) if vidi_writes(f)]
+
+
+def _owner(directory, strict=False):
+    """``(command, files)`` of an earlier result directory: from its manifest (only the
+    names a vidi command can write count), else from a legacy ``summary.json`` that names
+    its command (files unknown), else ``(None, None)``: a ``summary.json`` without a
+    ``command`` is the user's own file, not a vidi result."""
+    d = Path(directory)
+    got = read_manifest(d / MANIFEST, strict)
+    if got is not None:
+        return got
+    try:
+        with open(d / "summary.json", encoding="utf-8") as fh:
+            data = json.load(fh)
+    except (OSError, ValueError, RecursionError):
+        return None, None
+    cmd = data.get("command") if isinstance(data, dict) else None
+    return (cmd, None) if isinstance(cmd, str) and cmd else (None, None)
 
 
 def _refuse_other_command(owner, text, option):
@@ -456,6 +519,7 @@ def check_output(path, inputs=(), *, kind="dir", option="--out"):
         what = "a directory such as results/run1" if kind == "dir" else "a file such as D.csv"
         raise InputError(f"{option} is empty; give {what}")
     p = Path(text)
+    text = short(text)  # the messages below show a very long path shortened
     for inp in inputs:
         if inp is not None and os.path.isfile(inp) and _same_file(p, inp):
             raise InputError(
@@ -502,11 +566,11 @@ def _check_replaceable(p, text, option):
     entries = [e for e in os.scandir(p) if not _OWNED.match(e.name)]
     if not entries:
         return
-    owner, files = _owner(p)
+    owner, files = _owner(p, strict=True)
     if owner is not None or files is not None:
         _refuse_other_command(owner, text, option)
         return
-    names = {e.name for e in entries}
+    # no manifest, no summary.json naming its command: not a vidi result
     subdirs = sorted(e.name for e in entries if e.is_dir(follow_symlinks=False))
     odd = sorted(
         e.name
@@ -514,14 +578,14 @@ def _check_replaceable(p, text, option):
         if not e.is_dir(follow_symlinks=False)
         and not (e.is_file(follow_symlinks=False) and _RESULT_FILE.match(e.name))
     )
-    if subdirs or odd or "summary.json" not in names:
-        shown = ", ".join((subdirs + odd)[:3] or sorted(names)[:3])
-        raise InputError(
-            f"{option} {text!r} is a non-empty directory that is not an earlier "
-            f"vidi result (it holds {shown}); results replace the directory as a "
-            "whole, so give a new or empty directory such as "
-            f"{str(p / 'run1')!r}"
-        )
+    rest = sorted(e.name for e in entries if e.name not in subdirs and e.name not in odd)
+    shown = ", ".join(short(n, 60) for n in ((subdirs + odd)[:3] or rest[:3]))
+    raise InputError(
+        f"{option} {text!r} is a non-empty directory that is not an earlier "
+        f"vidi result (it holds {shown}); results replace the directory as a "
+        "whole, so give a new or empty directory such as "
+        f"{short(p / 'run1')!r}"
+    )
 
 
 # ---------------------------------------------------------------- staging directories
@@ -666,7 +730,7 @@ class OutputDir:
                 with contextlib.suppress(OSError):
                     d.rmdir()
             raise InputError(
-                f"--out {str(self.target)!r}: cannot create {exc.filename!r} "
+                f"--out {short(self.target)!r}: cannot create {short(exc.filename)!r} "
                 f"({exc.strerror}); choose a writable location"
             ) from None
         _chmod_default(self.stage, directory=True)
@@ -683,7 +747,11 @@ class OutputDir:
             fh.write("\n")
 
     def _write_manifest(self):
-        files = sorted(f.name for f in self.stage.iterdir() if f.name != MANIFEST)
+        files = sorted(
+            str(f.relative_to(self.stage).as_posix())
+            for f in self.stage.rglob("*")
+            if f.name != MANIFEST and not f.is_dir()
+        )
         try:
             version = metadata.version("vibroimpact-discovery")
         except metadata.PackageNotFoundError:
@@ -694,18 +762,36 @@ class OutputDir:
 
     def _keep_user_files(self, old, target):
         """Move every entry of the earlier directory ``old`` that the earlier run did not
-        write (not in its manifest; for a legacy result without one, not a name of the new
-        result) back into ``target``: a user's notes, a file dropped in during the run.  A
-        name the new result also uses is kept as ``NAME.kept``."""
+        write back into ``target``: a user's notes, a file dropped in during the run, a file
+        added inside one of vidi's folders.  vidi's are the names its manifest lists that a
+        command can write (:func:`vidi_writes`; a folder listed whole, as older manifests
+        did, is vidi's with what it holds); a legacy result without a manifest: the names
+        the new result uses.  A name the new result also uses is kept as ``NAME.kept``."""
         _, files = _owner(old)
-        ours = (
-            set(files) | {MANIFEST}
-            if files is not None
-            else {f.name for f in target.iterdir()} | {"summary.json"}
-        )
+        if files is None:
+            ours = {f.name for f in target.iterdir()} | {"summary.json"}
+        else:
+            ours = set(files) | {MANIFEST}
+        self._keep_from(Path(old), Path(target), ours, "")
+
+    def _keep_from(self, old, target, ours, prefix, whole=False):
+        """Move the user's entries of folder ``old`` into ``target`` (see
+        :meth:`_keep_user_files`); ``whole``: an older manifest listed this folder whole, so
+        its run files (``HEX.json``) are vidi's and anything else in it the user's."""
         for e in list(os.scandir(old)):
-            if e.name in ours or _OWNED.match(e.name):
+            rel = prefix + e.name
+            if _OWNED.match(e.name):  # a temporary file or staging folder of a killed run
                 continue
+            is_dir = e.is_dir(follow_symlinks=False)
+            if not is_dir and (rel in ours or (whole and _RUN_FILE.match(e.name))):
+                continue
+            if is_dir and (rel in ours or any(f.startswith(rel + "/") for f in ours)):
+                sub = target / e.name
+                if not os.path.lexists(sub):
+                    os.mkdir(sub)
+                if sub.is_dir() and not sub.is_symlink():
+                    self._keep_from(Path(e.path), sub, ours, rel + "/", rel in ours)
+                    continue
             dest = target / e.name
             k = 0
             while os.path.lexists(dest):
@@ -727,7 +813,7 @@ class OutputDir:
             return
         if target.is_symlink() or not target.is_dir():
             raise InputError(
-                f"--out {str(self.target)!r} became a file or a link during the "
+                f"--out {short(self.target)!r} became a file or a link during the "
                 "run; the results were not written"
             )
         if _exchange(self.stage, target):

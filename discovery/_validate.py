@@ -202,6 +202,7 @@ def params(**specs):
                     check(f"{owner}: {name}", bound.arguments[name], spec)
             return func(*args, **kwargs)
 
+        checked.__vidi_params__ = dict(specs)  # for callers that check options up front
         return checked
 
     return wrap

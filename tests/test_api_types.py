@@ -6,6 +6,8 @@ the builtin a Python user expects (``TypeError`` for a wrong type, ``ValueError`
 value out of range), with one line naming the parameter, and raised before any work.
 """
 
+import os
+
 import numpy as np
 import pytest
 
@@ -113,7 +115,37 @@ CASES = [
     ("ueda explain alpha text", lambda: osc.explain(T, F, 0.9, 1.0, alpha="a"), TYPE, "alpha"),
     ("ueda periodic n 0", lambda: osc.periodic_orbit(UEDA, [0.0, 0.0], n=0), VALUE, "n"),
     ("ueda record periods text", lambda: osc.simulate_record(UEDA, periods="a"), TYPE, "periods"),
+    # issue 29's sweep: each of these raised outside the hierarchy
+    ("from_csv None", lambda: d.Measurement.from_csv(None), TYPE, "path"),
+    ("from_csv an int (a file descriptor)", lambda: d.Measurement.from_csv(123), TYPE, "path"),
+    ("simulate y0 of 2", lambda: d.simulate(SC, LAW, (0, 0.1), y0=[0.0, 0.0]), VALUE, "y0"),
+    ("synthesize periods 1e12", lambda: d.synthesize(SC, LAW, periods=10**12), VALUE, "periods"),
+    ("identify start text", lambda: d.identify(SC, REC, "2e8*z"), TYPE, "start"),
+    (
+        "regressor fit texts",
+        lambda: d.ConstrainedSparseRegressor().fit("a", "b"),
+        TYPE,
+        "X",
+    ),
 ]
+
+
+def test_an_unfitted_regressor_is_a_vidi_error_and_sklearns():
+    from sklearn.exceptions import NotFittedError
+
+    with pytest.raises(VidiError) as info:
+        d.ConstrainedSparseRegressor().predict(np.zeros((3, 2)))
+    assert isinstance(info.value, NotFittedError)
+
+
+def test_from_csv_never_reads_a_file_descriptor(tmp_path):
+    r, w = os.pipe()
+    try:
+        with pytest.raises(VidiTypeError):
+            d.Measurement.from_csv(r)
+    finally:
+        os.close(r)
+        os.close(w)
 
 
 @pytest.mark.parametrize("call, error, name", [c[1:] for c in CASES], ids=[c[0] for c in CASES])

@@ -83,12 +83,15 @@ def test_bad_input_one_line_exit_2(argv, needle, capsys, tmp_path, monkeypatch):
 def test_bad_csv_does_not_destroy_earlier_results(record, tmp_path, capsys):
     out = tmp_path / "id"
     out.mkdir()
-    (out / "summary.json").write_text('{"earlier": true}')
+    (out / "summary.json").write_text('{"command": "identify", "earlier": true}')
     bad = tmp_path / "bad.csv"
     bad.write_text("t,F\n0,0\n1e-4,1\n1e-4,2\n3e-4,0\n4e-4,0\n")
     assert main(["identify", "--data", str(bad), "--start", "z", "--out", str(out)]) == 2
     assert "duplicate time" in capsys.readouterr().err
-    assert json.loads((out / "summary.json").read_text()) == {"earlier": True}
+    assert json.loads((out / "summary.json").read_text()) == {
+        "command": "identify",
+        "earlier": True,
+    }
     assert list(tmp_path.glob(".id.*")) == []
 
 

@@ -186,6 +186,11 @@ def test_check_output_refusals(tmp_path, monkeypatch):
     (tmp_path / "prev").mkdir()
     (tmp_path / "prev" / "summary.json").write_text("{}")
     (tmp_path / "prev" / "fig.png").write_bytes(b"png")
+    # a summary.json that names no command is the user's own file, not a vidi result
+    with pytest.raises(InputError, match="not an earlier vidi result"):
+        check_output("prev", [data])
+    (tmp_path / "prev" / "summary.json").write_text('{"command": "landscape"}')
+    monkeypatch.setitem(_io._RUN, "command", "landscape")  # whatever ran before in-process
     for ok in ("new/deeper/res", "empty", "prev"):
         assert check_output(ok, [data]) == Path(ok)
     assert sorted(p.name for p in tmp_path.iterdir()) == [

@@ -40,17 +40,21 @@ def _wait_staged(p):
     raise AssertionError("the child ended before staging its output")
 
 
+EARLIER = {"command": "steady", "earlier": True}
+
+
 @pytest.fixture
 def earlier(tmp_path):
     out = tmp_path / "res"
     out.mkdir()
-    (out / "summary.json").write_text('{"earlier": true}\n')
+    # an earlier result (a summary.json naming the command that wrote it)
+    (out / "summary.json").write_text('{"command": "steady", "earlier": true}\n')
     (out / "figure.png").write_bytes(b"old figure")
     return out
 
 
 def _intact(out):
-    assert json.loads((out / "summary.json").read_text()) == {"earlier": True}
+    assert json.loads((out / "summary.json").read_text()) == EARLIER
     assert (out / "figure.png").read_bytes() == b"old figure"
     assert sorted(p.name for p in out.parent.iterdir()) == ["res"]
 
@@ -140,7 +144,7 @@ def test_sigkill_then_next_run_cleans_up(earlier, capsys):
     p.stdout.close()
     left = [q for q in earlier.parent.iterdir() if ".vidi-staging." in q.name]
     assert len(left) == 1
-    assert json.loads((earlier / "summary.json").read_text()) == {"earlier": True}
+    assert json.loads((earlier / "summary.json").read_text()) == EARLIER
     assert main(["steady", "--out", str(earlier)]) == 0
     capsys.readouterr()
     assert sorted(q.name for q in earlier.parent.iterdir()) == ["res"]

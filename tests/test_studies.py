@@ -106,12 +106,46 @@ def test_config_rows_and_scenario_tables():
         ({"factors": {"refine": [True]}, "rows": [{}]}, "not both"),
         ({"factors": {"scenario": [{"base": "paper", "mass": 3}]}}, "unknown scenario key"),
         ({"factors": {"law": ["2e8*z +"]}}, ""),
+        # every [fit] and [record] option by the API's own checks, types strict
+        ({"fit": {"max_terms": "four"}}, "[fit] max_terms must be an integer"),
+        ({"fit": {"max_terms": -3}}, "[fit] max_terms must be an integer in [1, 64]; got -3"),
+        ({"fit": {"criterion": "I9"}}, "unknown criterion 'I9'"),
+        ({"fit": {"max_simulations": 0}}, "max_simulations must be an integer >= 2"),
+        ({"fit": {"scoring": "r2"}}, "scoring must be one of"),
+        ({"fit": {"physics": "no"}}, "physics must be true or false"),
+        ({"fit": {"n_boot": 10**9}}, "n_boot must be at most 10000"),
+        ({"fit": {"n_boot_intervals": 3}}, "cannot give an interval"),
+        ({"record": {"velocities": "no"}}, "velocities is true or false; got 'no'"),
+        ({"factors": {"law": ["-2e8*z"]}}, "never pushes the bodies apart"),
+        ({"factors": {"scenario": [{"base": "paper", "m2": 1e-300}]}}, "too stiff"),
+        ({"factors": {"scenario": [{"base": "paper", "A": "big"}]}}, "A = 'big' is not a number"),
+        # bounds on cells, runs and samples, with the number
+        (
+            {
+                "factors": {
+                    "force_noise": [i / 1e4 for i in range(1000)],
+                    "fs": [1e3 + i for i in range(1000)],
+                }
+            },
+            "make 1000000 cells",
+        ),
+        ({"seeds": 100000, "factors": {"force_noise": [0.01, 0.02]}}, "= 200000 runs"),
+        ({"factors": {"periods": [10000], "fs": [1e7]}}, "is 4e+09 samples a record"),
     ],
 )
 def test_config_refuses_bad_studies_in_one_line(bad, words):
+    bad = {
+        "factors": {"law": ["2.06e8*z + 1.28e7*zd"], **bad.get("factors", {})},
+        **{k: v for k, v in bad.items() if k != "factors"},
+    }
     with pytest.raises(InputError) as err:
         load_study(bad)
     assert words in str(err.value) and "\n" not in str(err.value)
+
+
+def test_a_huge_study_file_is_not_read_whole():
+    with pytest.raises(InputError, match="larger than 1048576 bytes"):
+        load_study("/dev/zero")
 
 
 def test_wilson_interval_closed_form():
@@ -253,14 +287,16 @@ def test_study_killed_with_sigkill_resumes_with_every_run_once(quick_serial, tmp
         "--no-figures",
         "--quiet",
     ]
+    work = tmp_path / ".killed.vidi-study"  # the runs land here until the study is put in place
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     deadline = time.monotonic() + 300
-    while len(_files(out)) < 3 and time.monotonic() < deadline and proc.poll() is None:
+    while len(_files(work)) < 3 and time.monotonic() < deadline and proc.poll() is None:
         time.sleep(0.05)
     os.kill(proc.pid, signal.SIGKILL)
     proc.wait()
-    before = len(_files(out))
+    before = len(_files(work))
     assert 3 <= before < 8, "the study must be killed halfway"
+    assert not out.exists(), "a killed study writes nothing into its directory"
     again = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     assert again.returncode == 0, again.stderr
     runs = _runs(out)
@@ -268,9 +304,8 @@ def test_study_killed_with_sigkill_resumes_with_every_run_once(quick_serial, tmp
     assert all(f.stem == json.loads(f.read_text())["key"] for f in _files(out))
     assert f"{8 - before} run now, {before} from earlier files" in again.stdout
     assert runs == _runs(full) and _cells(out) == _cells(full)
-    assert not [p for p in (out / "runs").iterdir() if p.name.startswith(".")] or all(
-        "vidi-tmp" in p.name for p in (out / "runs").iterdir() if p.name.startswith(".")
-    )
+    assert not [p for p in (out / "runs").iterdir() if p.name.startswith(".")]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["killed", "quick.toml"]
 
 
 def test_cli_study_bad_inputs_are_one_line(tmp_path):
@@ -297,6 +332,8 @@ def test_cli_study_bad_inputs_are_one_line(tmp_path):
         )
         assert p.returncode == 2, p.stderr
         assert words in p.stderr and len(p.stderr.strip().splitlines()) == 1, p.stderr
+        # a failed study leaves nothing behind: no directory, no work directory
+        assert sorted(q.name for q in tmp_path.iterdir()) == ["bad.toml"], p.stderr
 
 
 def test_study_refuses_a_directory_that_is_not_a_study(tmp_path):

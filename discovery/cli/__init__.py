@@ -61,9 +61,10 @@ def _one_line(message, prog, command=None):
     m = re.match(r"argument (\S+?)(?:/\S+)?: expected one argument$", message)
     if m:
         opt = m.group(1)
+        example = "-1e8*z" if opt in ("--law", "--start", "--truth") else "-1e-3"
         return (
             f"{opt} needs a value; write {opt} VALUE, and a value that starts with '-' as "
-            f"{opt}=-VALUE (e.g. {opt}=-1e8*z)"
+            f"{opt}=-VALUE (e.g. {opt}={example})"
         )
     m = re.match(r"the following arguments are required: (.*)$", message)
     if m:
@@ -281,6 +282,14 @@ def _attach_dash_values(parser, argv):
         return argv
     parser.command_hint = command
     sp = sub.choices[command]
+    rest = argv[argv.index(command) + 1 :]
+    while True:  # down to the innermost subcommand named (`ueda attractor`)
+        inner = next((a for a in sp._actions if isinstance(a, argparse._SubParsersAction)), None)
+        name = next((t for t in rest if not t.startswith("-")), None)
+        if inner is None or name not in inner.choices:
+            break
+        sp = inner.choices[name]
+        rest = rest[rest.index(name) + 1 :]
     takes_value = {
         s
         for a in sp._actions
@@ -367,7 +376,10 @@ def _refuse_orphans(parser, argv):
 
 
 def _error(message):
-    print(f"vidi: error: {' '.join(str(message).split())}", file=sys.stderr)
+    text = " ".join(str(message).split())
+    if len(text) > 1200:  # a message echoing a very long path or value: its ends only
+        text = f"{text[:597]} ... {text[-597:]}"
+    print(f"vidi: error: {text}", file=sys.stderr)
 
 
 _OUT_OF_MEMORY = (
@@ -388,11 +400,15 @@ def _interruption(exc):
     return None
 
 
-def _stopped(exc):
+def _stopped(exc, outer=None):
+    """The one line of an interrupted run: what was kept (a study's finished runs, named by
+    the note it attaches to the interrupt) or that the partial outputs were removed."""
+    note = getattr(outer, "vidi_note", None) or getattr(exc, "vidi_note", None)
+    what = note or "partial outputs were removed, earlier results are unchanged"
     if isinstance(exc, Terminated):
-        _error("terminated (SIGTERM); partial outputs were removed, earlier results are unchanged")
+        _error(f"terminated (SIGTERM); {what}")
         return 143
-    _error("interrupted (Ctrl-C); partial outputs were removed, earlier results are unchanged")
+    _error(f"interrupted (Ctrl-C); {what}")
     return 130
 
 
@@ -474,7 +490,7 @@ def main(argv=None):
 
 def _run(argv):
     try:
-        from .._io import set_run
+        from .._io import set_run, short
 
         parser = _parser()
         if not argv:  # plain `vidi`: the overview, not an error
@@ -503,12 +519,12 @@ def _run(argv):
     except Exception as exc:
         stop = _interruption(exc)  # an interrupt re-raised by compiled code or a solver
         if stop is not None:
-            return _stopped(stop)
+            return _stopped(stop, exc)
         if isinstance(exc, VidiError):  # bad input or failed numerics, by type
             _error(exc)
             return 2
         if isinstance(exc, OSError):  # the environment: disk full, permissions, a vanished file
-            where = f" ({exc.filename})" if exc.filename else ""
+            where = f" ({short(exc.filename)})" if exc.filename else ""
             _error(
                 f"{exc.strerror or exc}{where}; check the path, its permissions and the free space"
             )

@@ -27,8 +27,22 @@ from ._common import (
 
 def _discover(args, scs, meas, progress):
     """The API call the options describe."""
+    from ..errors import SolverError
     from ..vibroimpact.fit.discover import discover
 
+    try:
+        return _call(discover, args, scs, meas, progress)
+    except SolverError as exc:
+        if not args.margin:
+            raise
+        raise SolverError(
+            f"the regression's solvers failed with --margin {args.margin:g} N s/m "
+            f"({str(exc).splitlines()[0][:120]}); give a smaller --margin, e.g. 0 or "
+            "a fraction of the damping coefficients you expect"
+        ) from None
+
+
+def _call(discover, args, scs, meas, progress):
     return discover(
         scs,
         meas,
@@ -247,7 +261,7 @@ def _add_regression_options(p):
     )
     p.add_argument(
         "--margin",
-        type=number(0.0, unit="N s/m"),
+        type=number(0.0, 1e12, unit="N s/m"),
         default=0.0,
         help="dissipativity strictness margin in N s/m (default: %(default)g)",
     )

@@ -7,7 +7,7 @@ import io
 import numpy as np
 
 from .._io import OutputDir, provenance
-from ..errors import InputError
+from ..errors import InputError, IntegrationError
 from ..vibroimpact.model.scenario import load_scenario
 from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
@@ -146,6 +146,13 @@ def run(args):
             executor=ex,
             continuation=not args.no_continuation,
         )
+    count, first, at = land.failures
+    if count and count >= n0 * n1:  # nothing to show: one line and no output
+        raise IntegrationError(
+            f"every one of the {count} simulations of the landscape failed, first at "
+            f"({a0[at[0]]:.4g}, {a1[at[1]]:.4g}): {first}; give --range0/--range1 nearer "
+            "the coefficients of the record's law"
+        )
     ref_info.update(regime=land.reference["regime"], start=land.reference["start"])
     if ref is None:
         ref_info["impacts"] = land.reference["impacts"]
@@ -165,6 +172,9 @@ def run(args):
         truth = None
         if ref is None and sc.law.names[:2] == law.names[:2]:
             truth = tuple(sc.law.coefficients[:2])
+        src = land.reference.get("source") if isinstance(land.reference, dict) else None
+        if isinstance(src, str) and "$" in src:  # a file name is text, never mathtext
+            land.reference["source"] = src.replace("$", r"\$")
         landscape_figure(land, str(out.path("landscape")), truth=truth)
     src = "the scenario's law" if ref is None else f"{args.data}"
     count, first, at = land.failures

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 
 from .._io import OutputDir, provenance
-from ..errors import InputError
+from ..errors import InputError, IntegrationError
 from ..vibroimpact.model.scenario import load_scenario
 from ._common import LAW_HELP, SCENARIO_HELP, check_out, inputs_of, law_or_default
 
@@ -24,6 +24,12 @@ def run(args):
         )
     r = response(sc, law)
     ss = r.steady
+    if not (np.all(np.isfinite(ss.multipliers)) and np.isfinite(ss.residual)):
+        raise IntegrationError(
+            f"the steady state of {law} in scenario {sc.name!r} could not be computed "
+            "(non-finite Floquet multipliers or residual: the simulation failed); check the "
+            "scenario's drive amplitude, masses and the law's coefficients"
+        )
     info = ss.as_dict()
     if r.impulse is not None:
         info.update(peak_force=r.impulse.peak, contact_time=r.impulse.contact_time)

@@ -34,9 +34,11 @@ def register(sub):
         "(true law, scenario(s), noise, record length, sample rate, library, selection "
         "method, refinement) and seeds. Each run makes its record(s) with the independent "
         "scipy path from rest, discovers a law, checks it by simulation and scores it "
-        "against the truth. Each run is one file in DIR/runs named by a hash of its "
-        "configuration: an interrupted study (Ctrl-C, kill -9) continues where it stopped "
-        "when the same command is run again. Writes cells.csv (recovery with its 95 %% "
+        "against the truth. Each run is one file named by a hash of its configuration, kept "
+        "in .DIR.vidi-study beside DIR until the whole study replaces DIR at the end: an "
+        "interrupted study (Ctrl-C, kill -9) leaves DIR as it was and continues where it "
+        "stopped when the same command is run again; a study of other cells into a "
+        "finished DIR needs --overwrite. Writes cells.csv (recovery with its 95 % "
         "interval, false positives, interval coverage, coefficient error per cell), "
         "runs.csv, inclusion.csv, figures and summary.json.",
     )

@@ -185,12 +185,15 @@ class Dask(Executor):
                 if k not in _THREAD_VARS
             }
             environ.update({k: os.environ[k] for k in _THREAD_VARS if k in os.environ})
-            with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
+            with (
+                dask.config.set({"distributed.nanny.pre-spawn-environ": environ}),
+                _sigint_blocked(),
+            ):
                 self._cluster = LocalCluster(
                     n_workers=n,
                     threads_per_worker=1,
                     processes=True,
-                    dashboard_address=None,
+                    dashboard_address=":0",  # no warning when another cluster holds 8787
                     silence_logs=50,
                 )
             self.client = Client(self._cluster)
@@ -245,6 +248,30 @@ def map_on(fn, jobs, context=None, *, workers=None, executor=None, done=None):
         return executor.map(fn, jobs, context, done)
     with make_executor(min(int(workers or os.cpu_count() or 1), max(len(jobs), 1))) as ex:
         return ex.map(fn, jobs, context, done)
+
+
+@contextlib.contextmanager
+def _sigint_blocked():
+    """SIGINT ignored while a LocalCluster spawns its workers: they start with it ignored
+    (a disposition that survives ``exec``), so a Ctrl-C at the terminal (sent to the whole
+    process group) reaches this process only, which stops the study and closes the
+    cluster, instead of printing every worker's traceback.  This process's own handler is
+    back once the cluster has started."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    try:
+        old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except (ValueError, OSError):
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
 
 
 @params(workers=(None, Real(1, 4096, integer=True)), scheduler=(None, Text()))

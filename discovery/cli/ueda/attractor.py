@@ -25,6 +25,17 @@ def run(args):
         batches=args.batches,
         tolerances=tol,
     )
+    L = att.lyapunov
+    gap = abs(L.sum - L.trace_mean)
+    if not gap <= 1e-6 + 1e-3 * abs(L.trace_mean):  # NaN fails too
+        from ...errors import IntegrationError
+
+        raise IntegrationError(
+            f"the Lyapunov exponents' sum {L.sum:.6g} disagrees with the mean trace "
+            f"{L.trace_mean:.6g} of the flow (they are equal for an accurate integration) "
+            f"from (x0, v0) = ({args.x0:g}, {args.v0:g}); start nearer the attractor or "
+            "lower --rtol"
+        )
     summary = {"command": "ueda attractor", **att.as_dict()}
     bas = None
     if args.basins:
@@ -46,7 +57,6 @@ def run(args):
             basins_figure(bas, str(out.path("basins")))
             files += ["basins.png", "basins.pdf"]
         out.write_json("summary.json", summary)
-    L = att.lyapunov
     print(f"{system.model}: {att.regime.regime} ({att.regime.evidence['rule']})")
     print(
         f"  lyapunov {L.value:.4f} +- {L.stderr:.4f}, second {L.second:.4f} +- "

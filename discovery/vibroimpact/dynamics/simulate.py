@@ -291,6 +291,8 @@ def simulate(
     -------
     Trajectory
     """
+    if y0 is not None and np.size(y0) != 4:
+        raise InputError(f"simulate: y0 must be the 4 states (w1, v1, w2, v2); got {np.size(y0)}")
     tol = tolerances or Tolerances()
     t0, t1 = (float(v) for v in t_span)
     if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):

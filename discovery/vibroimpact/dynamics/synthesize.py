@@ -11,6 +11,8 @@ from ..model.scenario import Scenario
 from . import simulate
 from .steady_state import steady_state
 
+MAX_SAMPLES = 10_000_000  # samples of one record (as `vidi simulate`)
+
 __all__ = ["synthesize"]
 
 
@@ -74,6 +76,11 @@ def synthesize(
     """
     if not (periods >= 1 and fs > 0 and noise >= 0 and position_noise >= 0):
         raise InputError("periods must be >= 1, fs > 0 and the noise levels >= 0")
+    if not periods * scenario.period * fs <= MAX_SAMPLES:
+        raise InputError(
+            f"synthesize: periods = {periods} at fs = {fs:g} Hz is "
+            f"{periods * scenario.period * fs:.3g} samples; the limit is {MAX_SAMPLES:.0e}"
+        )
     n = int(round(periods * scenario.period * fs))
     t = np.arange(n) / fs
     if from_rest:

@@ -39,7 +39,7 @@ from scipy.optimize import least_squares, minimize
 from ..._printing import coefficient_lines, criteria_lines, fmt, readable
 from ..._progress import tick
 from ..._validate import Choice, Real, Text, params
-from ...errors import InputError, IntegrationError
+from ...errors import InputError, IntegrationError, VidiTypeError
 from ...numerics.executor import map_on
 from ..data.impulse import Impulse
 from ..data.measurement import Measurement
@@ -582,6 +582,11 @@ def _uncertainty(obj, x, names):
 
 def _checked(scenario, reference, start, method, xtol, max_simulations):
     """The settings :func:`identify` checks beyond their types; returns the records."""
+    if isinstance(start, str):
+        raise VidiTypeError(
+            f"identify: start must be a ForceLaw or a Model (parse text with "
+            f"ForceLaw.parse({start[:30]!r})); got str"
+        )
     if method not in METHODS:
         raise InputError(f"unknown method {method!r}; valid methods: {', '.join(METHODS)}")
     if any(c == 0 for c in start.coefficients):

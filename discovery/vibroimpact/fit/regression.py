@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 import cvxpy as cp
 import numpy as np
 from sklearn.base import BaseEstimator, RegressorMixin
+from sklearn.exceptions import NotFittedError as SkNotFittedError
 from sklearn.utils.validation import check_is_fitted
 
 from constraints import (
@@ -49,7 +50,8 @@ from constraints import (
 )
 from constraints.errors import SolverError
 
-from ...errors import InputError
+from ..._validate import Array, check
+from ...errors import InputError, VidiError
 from ..model.library import Library
 
 __all__ = ["ConstrainedSparseRegressor", "Candidate", "SELECTIONS", "SCORES"]
@@ -58,6 +60,11 @@ SELECTIONS = ("best-subset", "l1-path", "stlsq", "sr3", "constrained-sr3")
 SCORES = ("bic", "aic", "cv")
 _RSS_FLOOR = 1e-14  # relative to mean square force: data are never more exact than this
 _INFEASIBLE = ("infeasible", "infeasible_inaccurate")
+
+
+class NotFittedError(VidiError, SkNotFittedError):
+    """The estimator is used before :meth:`ConstrainedSparseRegressor.fit` (a ``VidiError``
+    and scikit-learn's ``NotFittedError``)."""
 
 
 class _InfeasibleSupport(SolverError):
@@ -358,6 +365,8 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         -------
         self
         """
+        check("ConstrainedSparseRegressor.fit: X", X, Array(2))
+        check("ConstrainedSparseRegressor.fit: y", y, Array())
         t0 = time.perf_counter()
         self._validate()
         X = np.asarray(X, dtype=float)
@@ -680,7 +689,10 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
     # --------------------------------------------------------------- predict
     def predict(self, X):
         """Contact force [N] at ``X`` (conditions (3)-(5) applied)."""
-        check_is_fitted(self)
+        try:
+            check_is_fitted(self)
+        except SkNotFittedError as exc:
+            raise NotFittedError(str(exc)) from None
         X = np.asarray(X, dtype=float)
         if X.ndim != 2 or X.shape[1] != self.n_features_in_:
             raise InputError(

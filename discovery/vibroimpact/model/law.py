@@ -400,10 +400,11 @@ class ForceLaw:
             )
         # a contact far shorter than any step the drive period allows cannot be simulated
         m = scenario.m1 * scenario.m2 / (scenario.m1 + scenario.m2)
-        rate = max(
-            float(np.sqrt(np.max(self.polynomial(zz, np.zeros_like(vv)) / zz) / m)),
-            float(np.max(D / np.maximum(vv, 1e-300)) / m),
-        )
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # a tiny mass: inf
+            rate = max(
+                float(np.sqrt(np.max(self.polynomial(zz, np.zeros_like(vv)) / zz) / m)),
+                float(np.max(D / np.maximum(vv, 1e-300)) / m),
+            )
         if rate * scenario.period > FASTEST_CONTACT:
             raise InputError(
                 f"{what} '{self}' is too stiff for this machine: a contact would last about "

@@ -45,8 +45,9 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..._validate import Text, params
-from ...errors import InputError
+from ..._io import short
+from ..._validate import Text, check, params
+from ...errors import InputError, VidiError
 from ..fit.regression import SELECTIONS
 from ..model.law import ForceLaw
 from ..model.library import Library
@@ -80,6 +81,19 @@ _FIT_KEYS = (
     "physics",
 )
 _RECORD_KEYS = ("transient", "velocities")
+
+# bounds on a study's size, checked before any work (each message gives the number)
+MAX_CELLS = 10_000
+MAX_RUNS = 100_000
+MAX_SAMPLES = 10_000_000  # samples of one run's records, like `vidi simulate`
+MAX_FILE_BYTES = 1 << 20  # a study file larger than this is not read
+_FIT_BOUNDS = {
+    "shortlist": 200,
+    "max_simulations": 100_000,
+    "n_boot": 10_000,
+    "n_boot_intervals": 10_000,
+    "stepwise": 64,
+}
 _TOP = ("name", "seeds", "factors", "rows", "fit", "record")
 
 
@@ -103,10 +117,11 @@ class StudyConfig:
     def runs(self, code_version=""):
         """Every run: a JSON-ready description with its ``key`` (hash of the description
         and ``code_version``), in a fixed order (cells, then seeds)."""
-        out = []
+        out, cache = [], {}
         for ci, cell in enumerate(self.cells):
+            base = _resolve(cell, self.fit, self.record, 0, cache)  # runs differ by seed
             for seed in self.seeds:
-                spec = _resolve(cell, self.fit, self.record, seed)
+                spec = {**base, "seed": int(seed)}
                 spec["cell"] = ci
                 spec["key"] = run_key(spec, code_version)
                 out.append(spec)
@@ -122,7 +137,7 @@ def run_key(spec, code_version=""):
 
 
 def _fail(source, what):
-    raise InputError(f"study {source!r}: {what}")
+    raise InputError(f"study {short(source)!r}: {what}")
 
 
 def _scenario_value(value, source):
@@ -149,6 +164,18 @@ def _scenario_value(value, source):
                     f"unknown scenario key(s) {', '.join(bad)} in a scenario "
                     "table; valid: base, m1, m2, k1, c1, A, frequency, g, k3, name",
                 )
+            odd = sorted(
+                k
+                for k, v in changes.items()
+                if k != "name" and not (isinstance(v, int | float) and not isinstance(v, bool))
+            )
+            if odd or not isinstance(changes.get("name", ""), str):
+                what = ", ".join(f"{k} = {changes[k]!r}" for k in odd) or "name"
+                _fail(
+                    source,
+                    f"scenario table {short(it, 80)}: {what} is not a number (name is text); "
+                    "give e.g. A = 3.5e5",
+                )
             if "name" not in changes:
                 changes["name"] = (
                     sc.name + "-" + "-".join(f"{k}{v:g}" for k, v in sorted(changes.items()))
@@ -156,7 +183,7 @@ def _scenario_value(value, source):
             try:
                 out.append(sc.replace(**changes))
             except (TypeError, ValueError) as exc:
-                _fail(source, f"scenario table {it}: {exc}")
+                _fail(source, f"scenario table {short(it, 80)}: {exc}")
         else:
             _fail(source, f"a scenario is a name, a file or a table; got {it!r}")
     return out
@@ -222,22 +249,35 @@ def _check_factor(name, value, source):
     return value
 
 
-def _resolve(cell, fit, record, seed):
-    """The self-contained description of one run."""
-    scenarios = _scenario_value(cell["scenario"], "")
+def _resolve(cell, fit, record, seed, cache=None):
+    """The self-contained description of one run (``cache``: the scenarios and laws already
+    resolved, by their text)."""
+    cache = {} if cache is None else cache
+    sk = ("scenario", json.dumps(cell["scenario"], sort_keys=True, default=str))
+    if sk not in cache:
+        scenarios = _scenario_value(cell["scenario"], "")
+        cache[sk] = (
+            scenarios[0].law,
+            [
+                {k: v for k, v in sc.as_dict().items() if k not in ("law", "source")}
+                for sc in scenarios
+            ],
+            scenarios[0].name,
+        )
+    own_law, scenario_dicts, first = cache[sk]
     law = cell["law"]
     if law is None:
-        if scenarios[0].law is None:
-            raise InputError(f"scenario {scenarios[0].name!r} has no law; give [factors] law")
-        law = scenarios[0].law.to_text()
+        if own_law is None:
+            raise InputError(f"scenario {first!r} has no law; give [factors] law")
+        law = own_law.to_text()
     else:
-        law = ForceLaw.parse(law).to_text()
+        lk = ("law", law)
+        if lk not in cache:
+            cache[lk] = ForceLaw.parse(law).to_text()
+        law = cache[lk]
     return {
         "law": law,
-        "scenarios": [
-            {k: v for k, v in sc.as_dict().items() if k not in ("law", "source")}
-            for sc in scenarios
-        ],
+        "scenarios": [dict(d) for d in scenario_dicts],
         "force_noise": float(cell["force_noise"]),
         "motion_noise": float(cell["motion_noise"]),
         "periods": int(cell["periods"]),
@@ -292,7 +332,60 @@ def _settings(data, source):
     tr = record.get("transient", "auto")
     if not (tr == "auto" or (isinstance(tr, int) and not isinstance(tr, bool) and 0 <= tr <= 5000)):
         _fail(source, f'[record] transient is "auto" or a number of periods; got {tr!r}')
+    vel = record.get("velocities", True)
+    if not isinstance(vel, bool):
+        _fail(source, f"[record] velocities is true or false; got {vel!r}")
+    _check_fit(fit, source)
     return fit, record, tr
+
+
+def _check_fit(fit, source):
+    """Every ``[fit]`` option by the checks :func:`~discovery.vibroimpact.fit.discover`
+    makes of its arguments (their types, ranges and names), so that a bad option stops the
+    study up front instead of failing every run."""
+    from ..fit.discover import _check_settings, discover
+    from ..fit.regression import SCORES
+    from ..verify.criteria import criterion as _criterion
+
+    specs = getattr(discover, "__vidi_params__", {})
+
+    def bad(exc):
+        text = str(exc).removeprefix("discover: ")
+        _fail(source, f"[fit] {text}")
+
+    try:
+        for k, v in fit.items():
+            if k in specs:
+                check(k, v, specs[k])
+        if "criterion" in fit:
+            _criterion(fit["criterion"])
+        if "scoring" in fit and fit["scoring"] not in SCORES:
+            raise InputError(f"scoring must be one of {', '.join(SCORES)}; got {fit['scoring']!r}")
+        if "physics" in fit and not isinstance(fit["physics"], bool):
+            raise InputError(f"physics must be true or false; got {fit['physics']!r}")
+        req = fit.get("require", [])
+        if not (isinstance(req, list) and all(isinstance(r, str) and r for r in req)):
+            raise InputError(f'require must be a list of term names such as ["z"]; got {req!r}')
+        _check_settings(
+            None,
+            0,
+            fit.get("criterion", "I2"),
+            fit.get("shortlist", 1),
+            0,
+            fit.get("n_boot", 1),
+            fit.get("max_simulations", 2),
+            fit.get("stepwise", 0),
+        )
+        for k, hi in _FIT_BOUNDS.items():  # the command line's bounds (`vidi fit`)
+            if k in fit and fit[k] > hi:
+                raise InputError(f"{k} must be at most {hi}; got {fit[k]}")
+        if 0 < fit.get("n_boot_intervals", 0) < 5:
+            raise InputError(
+                f"n_boot_intervals = {fit['n_boot_intervals']} replicates cannot give an "
+                "interval; give 0 (none) or at least 5"
+            )
+    except VidiError as exc:
+        bad(exc)
 
 
 def _cells(data, factors, levels, source):
@@ -304,6 +397,8 @@ def _cells(data, factors, levels, source):
             _fail(source, "give either [factors] (their product) or [[rows]], not both")
         if not (isinstance(rows, list) and rows and all(isinstance(r, dict) for r in rows)):
             _fail(source, "[[rows]] are tables of factor values, one per cell")
+        if len(rows) > MAX_CELLS:
+            _fail(source, f"{len(rows)} [[rows]]; the limit is {MAX_CELLS} cells")
         cells = []
         for r in rows:
             extra = sorted(set(r) - set(FACTORS))
@@ -317,11 +412,56 @@ def _cells(data, factors, levels, source):
             )
         varied = tuple(k for k in FACTORS if len({json.dumps(c[k]) for c in cells}) > 1)
     else:
+        n = math.prod(len(v) for v in levels.values())
+        if n > MAX_CELLS:
+            _fail(
+                source,
+                f"the factors' levels make {n} cells (the product of "
+                f"{' x '.join(str(len(v)) for v in levels.values() if len(v) > 1)}); the "
+                f"limit is {MAX_CELLS}: vary fewer factors or give fewer levels",
+            )
         cells = [
             dict(zip(FACTORS, combo, strict=True)) for combo in itertools.product(*levels.values())
         ]
         varied = tuple(k for k in FACTORS if len(levels[k]) > 1)
     return cells, varied
+
+
+def _check_cells(cells, source):
+    """What only a cell shows: each record's size (periods at the sample rate, at the
+    scenario's drive frequency) within :data:`MAX_SAMPLES`, and each true law one a machine
+    could have (:meth:`ForceLaw.check_physical` on its scenario)."""
+    seen, loaded = set(), {}
+    for cell in cells:
+        sk = json.dumps(cell["scenario"], sort_keys=True, default=str)
+        if sk not in loaded:
+            loaded[sk] = _scenario_value(cell["scenario"], source)
+        scenarios = loaded[sk]
+        for sc in scenarios:
+            n = cell["periods"] * cell["fs"] / sc.frequency
+            if not n <= MAX_SAMPLES:
+                _fail(
+                    source,
+                    f"periods = {cell['periods']} at fs = {cell['fs']:g} Hz is {n:.3g} samples "
+                    f"a record (scenario {sc.name!r} at {sc.frequency:g} Hz); the limit is "
+                    f"{MAX_SAMPLES:.0e}: lower fs or periods",
+                )
+        law = cell["law"]
+        key = (law, sk)
+        if key in seen:
+            continue
+        seen.add(key)
+        if law is None:
+            if scenarios[0].law is None:
+                _fail(source, f"scenario {scenarios[0].name!r} has no law; give [factors] law")
+            truth, what = scenarios[0].law, f"the scenario's law ({scenarios[0].name})"
+        else:
+            truth, what = ForceLaw.parse(law), "[factors] law"
+        for sc in scenarios:
+            try:
+                truth.check_physical(sc, what)
+            except InputError as exc:
+                _fail(source, str(exc))
 
 
 def study_from_mapping(data, source="<dict>"):
@@ -349,12 +489,19 @@ def study_from_mapping(data, source="<dict>"):
         for k in FACTORS
     }
     cells, varied = _cells(data, factors, levels, source)
+    if len(cells) * len(seeds) > MAX_RUNS:
+        _fail(
+            source,
+            f"{len(cells)} cells x {len(seeds)} seeds = {len(cells) * len(seeds)} runs; the "
+            f"limit is {MAX_RUNS}: give fewer seeds or cells",
+        )
+    _check_cells(cells, source)
     return StudyConfig(
         name=name,
         cells=tuple(cells),
         seeds=tuple(seeds),
         fit=dict(fit),
-        record={"transient": tr, "velocities": bool(record.get("velocities", True))},
+        record={"transient": tr, "velocities": record.get("velocities", True)},
         varied=varied,
         source=source,
     )
@@ -369,20 +516,29 @@ def load_study(path_or_mapping):
         return study_from_mapping(path_or_mapping)
     path = Path(path_or_mapping)
     try:
-        text = path.read_bytes().decode("utf-8-sig")
+        with open(path, "rb") as fh:
+            raw = fh.read(MAX_FILE_BYTES + 1)
+        if len(raw) > MAX_FILE_BYTES:
+            raise InputError(
+                f"study file {short(path)!r} is larger than {MAX_FILE_BYTES} bytes (or not "
+                "a file); give a TOML study file"
+            )
+        text = raw.decode("utf-8-sig")
     except FileNotFoundError:
         raise InputError(
-            f"study file {str(path)!r} does not exist; give a TOML file such as "
+            f"study file {short(path)!r} does not exist; give a TOML file such as "
             "examples/study_paper.toml"
         ) from None
     except IsADirectoryError:
-        raise InputError(f"study file {str(path)!r} is a directory; give a TOML file") from None
+        raise InputError(f"study file {short(path)!r} is a directory; give a TOML file") from None
     except UnicodeDecodeError:
-        raise InputError(f"study file {str(path)!r} is not UTF-8 text; re-save it") from None
+        raise InputError(f"study file {short(path)!r} is not UTF-8 text; re-save it") from None
     except OSError as exc:
-        raise InputError(f"cannot read study file {str(path)!r} ({exc.strerror or exc})") from None
+        raise InputError(
+            f"cannot read study file {short(path)!r} ({exc.strerror or exc})"
+        ) from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"study file {str(path)!r} is not valid TOML: {exc}") from None
+        raise InputError(f"study file {short(path)!r} is not valid TOML: {exc}") from None
     return study_from_mapping(data, str(path))

@@ -17,22 +17,45 @@ Output directory::
 
 The aggregates are always computed from the run files of the study's runs, never from
 memory, so a resumed study and one run in one go give the same tables.
+
+A study is staged like every other result: its runs land in a work directory beside the
+target, ``.DIR.vidi-study/runs`` (kept when the study is interrupted or killed, so the same
+command continues where it stopped; removed when no run landed), and the whole directory
+(runs, config, tables, figures, manifest) replaces ``DIR`` in one step only at the end.  An
+interrupted or failing study therefore leaves an earlier ``DIR`` exactly as it was.  A study
+whose cells, seeds or options differ from the finished one in ``DIR`` is refused unless
+``--overwrite`` (then it replaces it whole; the files a user added are kept).  Every run file
+is checked against its name and its schema; a bad one is named and run again.
 """
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import json
 import math
 import os
+import shutil
+import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..._io import MANIFEST, atomic_write_text, check_output, provenance, running, to_jsonable
+from ..._io import (
+    _RUN,
+    MANIFEST,
+    OutputDir,
+    atomic_write_text,
+    check_output,
+    provenance,
+    running,
+    short,
+    to_jsonable,
+)
 from ..._printing import readable
 from ..._progress import tick
 from ..._validate import Instance, Real, Text, params
-from ...errors import InputError
+from ...errors import InputError, VidiTypeError
 from ...numerics.executor import make_executor
 from .aggregate import aggregate, run_rows, to_csv
 from .config import StudyConfig, load_study
@@ -68,13 +91,66 @@ def _source_hash():
     return h.hexdigest()[:12]
 
 
-def _read_run(path):
+# a run file's fields and their types (the driver's own records; anything else is redone)
+_RUN_FIELDS = {
+    "key": str,
+    "cell": int,
+    "status": str,
+    "exact": bool,
+    "truth_equivalent": bool,
+    "seconds": (int, float),
+}
+_OK_FIELDS = {"selected": list, "fp": int, "tp": int, "fn": int, "coverage": dict}
+
+
+def _run_problem(data, key, n_cells):
+    """Why ``data`` (a parsed run file named ``key``) is not a run of this study, else None."""
+    if not isinstance(data, dict):
+        return "not a JSON object"
+    for name, kind in _RUN_FIELDS.items():
+        v = data.get(name)
+        if not isinstance(v, kind) or (kind is int and isinstance(v, bool)):
+            return f"field {name!r} missing or of the wrong type"
+    if data["key"] != key:
+        return "the key it holds is not its file name (a copied file?)"
+    if not 0 <= data["cell"] < n_cells:
+        return "its cell is not one of the study's"
+    if data["status"] not in ("ok", "failed"):
+        return "its status is neither ok nor failed"
+    if data["status"] == "ok":
+        for name, kind in _OK_FIELDS.items():
+            v = data.get(name)
+            if not isinstance(v, kind) or (kind is int and isinstance(v, bool)):
+                return f"field {name!r} missing or of the wrong type"
+    return None
+
+
+def _read_run(path, run=None, n_cells=None, bad=None):
+    """The record in run file ``path``, or None when there is none or it is not a run of
+    this study (checked against ``run``, the run it should hold: its key and cell; the
+    reason goes to ``bad``)."""
     try:
         with open(path, encoding="utf-8") as fh:
             data = json.load(fh)
-    except (OSError, ValueError):
+    except FileNotFoundError:
         return None
-    return data if isinstance(data, dict) and "key" in data else None
+    except (OSError, ValueError, RecursionError) as exc:
+        if bad is not None:
+            bad.append((path, f"cannot be read ({type(exc).__name__})"))
+        return None
+    key = Path(path).stem
+    why = _run_problem(data, key, n_cells if n_cells is not None else 1 << 62)
+    if why is None and run is not None and data["cell"] != run["cell"]:
+        why = "its cell is not the one its key names"
+    if why is not None:
+        if bad is not None:
+            bad.append((path, why))
+        return None
+    return data
+
+
+def _note(text):
+    print(f"vidi: note: {text}", file=sys.stderr)
 
 
 @readable
@@ -148,11 +224,6 @@ class StudyResult:
         return out
 
 
-def _write_manifest(out, names):
-    data = {"command": "study", "files": sorted(set(names))}
-    atomic_write_text(out / MANIFEST, json.dumps(data, indent=1))
-
-
 def _design(cfg):
     """The factors with their levels (varied ones first), the fixed options and seeds."""
     from .aggregate import _factor_text
@@ -224,8 +295,8 @@ def _write_config(out, cfg, version):
 
 
 def _run_missing(todo, have, runs, rundir, version, workers, scheduler, executor, progress):
-    """Run ``todo`` on the executor, one file per finished run; returns the executor's name
-    and the number of runs done."""
+    """Run ``todo`` on the executor, one file per finished run (its record also goes into
+    ``have``); returns the executor's name and the number of runs done."""
     own = executor is None
     ex = make_executor(workers, scheduler) if own else executor
     name = repr(ex)
@@ -234,12 +305,13 @@ def _run_missing(todo, have, runs, rundir, version, workers, scheduler, executor
         tick(progress, "study: runs", len(have), len(runs))
         for _, res in ex.run(run_one, todo):
             res["code_version"] = version
+            res = to_jsonable(res)
             atomic_write_text(
-                rundir / f"{res['key']}.json",
-                json.dumps(to_jsonable(res), indent=1, allow_nan=True),
+                rundir / f"{res['key']}.json", json.dumps(res, indent=1, allow_nan=True)
             )
+            have[res["key"]] = res
             done += 1
-            tick(progress, "study: runs", len(have) + done, len(runs))
+            tick(progress, "study: runs", len(have), len(runs))
     finally:
         if own:
             ex.close()
@@ -262,31 +334,26 @@ def _write_tables(out, cfg, records):
     return cells, inclusion
 
 
-def _summary(cfg, runs, records, result, version, cells, workers, scheduler, max_runs):
+def _summary(cfg, n_runs, records, info, version, cells, settings):
     """``summary.json`` of the study."""
     return {
         "command": "study",
         "kind": "study",
         "name": cfg.name,
-        "runs": len(runs),
+        "runs": n_runs,
         "complete": len(records),
-        "executed": result.executed,
-        "reused": result.reused,
-        "executor": result.executor,
+        **info,
         "code_version": version,
         "design": _design(cfg),
         "pooled": _pooled(records, cfg),
         "cells": cells,
-        "seconds": result.seconds,
         **provenance(
             settings={
                 "config": cfg.source,
                 "fit": cfg.fit,
                 "record": cfg.record,
                 "seeds": list(cfg.seeds),
-                "workers": workers,
-                "scheduler": scheduler,
-                "max_runs": max_runs,
+                **settings,
             },
             inputs={"config": cfg.source} if os.path.isfile(cfg.source) else None,
         ),
@@ -319,8 +386,11 @@ def study(
     config : str, Path, dict or StudyConfig
         A study file (TOML), its parsed mapping, or a :class:`StudyConfig`.
     out : str or Path
-        The study directory.  Runs already there (from an interrupted or earlier call with
-        the same code version) are reused, not run again.
+        The study directory, written as a whole at the end (the runs land in
+        ``.OUT.vidi-study`` beside it meanwhile).  Runs of an interrupted call (kept there)
+        or of the finished study in ``out`` (the same cells, seeds and options) with the
+        same code version are reused, not run again; another study there is refused
+        unless the CLI's ``--overwrite``.
     workers : int, optional
         Local worker processes (default one per CPU; 1 runs in this process).
     scheduler : str, optional
@@ -328,7 +398,8 @@ def study(
     executor : Executor, optional
         Use this executor (overrides ``workers`` and ``scheduler``; not closed here).
     progress : callable, optional
-        ``progress(stage, done, total)`` as runs finish.
+        ``progress(stage, done, total)`` as runs finish (anything else not callable is a
+        :class:`~discovery.errors.VidiTypeError`).
     max_runs : int, optional
         Do at most this many missing runs, then aggregate what the files hold (a study in
         slices; the rest runs on the next call).
@@ -340,47 +411,222 @@ def study(
     StudyResult
     """
     t0 = time.perf_counter()
+    if progress is not None and not callable(progress):
+        raise VidiTypeError(
+            f"progress must be a callable progress(stage, done, total) or None, "
+            f"not {type(progress).__name__}"
+        )
     cfg = load_study(config)
     cfg = StudyConfig(**{**cfg.__dict__, "fit": {**_FIT_DEFAULTS, **cfg.fit}})
+    inputs = [cfg.source] if cfg.source and os.path.isfile(cfg.source) else []
     with running("study"):  # the directory is a study's, whatever ran before in this process
-        out = check_output(out, [cfg.source] if cfg.source else [])
+        out = check_output(out, inputs)
+        overwrite = _RUN["overwrite"]
+    earlier = _earlier_study(out)
+    if earlier is not None and earlier != _identity(cfg) and not overwrite:
+        raise InputError(
+            f"--out {short(out)!r} holds a finished study of other cells, seeds or options; "
+            "give this study its own directory, or add --overwrite to replace it (files you "
+            "added there are kept)"
+        )
     version = code_version()
     runs = cfg.runs(version)
-    rundir = out / "runs"
-    rundir.mkdir(parents=True, exist_ok=True)
-    _write_manifest(out, ["runs", "config.json"])
-    _write_config(out, cfg, version)
-    have = {r["key"] for r in runs if _read_run(rundir / f"{r['key']}.json") is not None}
-    todo = [r for r in runs if r["key"] not in have]
-    if max_runs is not None:
-        todo = todo[: int(max_runs)]
-    name, done = _run_missing(
-        todo, have, runs, rundir, version, workers, scheduler, executor, progress
-    )
-    records = [rec for r in runs if (rec := _read_run(rundir / f"{r['key']}.json")) is not None]
-    cells, inclusion = _write_tables(out, cfg, records)
-    paths = ()
-    if figures and records:
-        from reports.vibroimpact.study_figures import study_figures
-
-        paths = tuple(study_figures(cfg, records, out))
-    written = ["runs", "config.json", "cells.csv", "runs.csv", "inclusion.csv", "summary.json"]
-    written += [Path(p).name for p in paths]
-    result = StudyResult(
-        config=cfg,
-        runs=records,
-        cells=cells,
-        inclusion=inclusion,
-        out=out,
-        executed=done,
-        reused=len(have),
-        seconds=time.perf_counter() - t0,
-        executor=name,
-        figures=paths,
-    )
-    summary = _summary(cfg, runs, records, result, version, cells, workers, scheduler, max_runs)
-    atomic_write_text(
-        out / "summary.json", json.dumps(to_jsonable(summary), indent=1, allow_nan=True)
-    )
-    _write_manifest(out, written)
+    n_cells = len(cfg.cells)
+    with _Work(out) as work:
+        bad = []
+        have = {}
+        for r in runs:
+            rec = _read_run(work.runs / f"{r['key']}.json", r, n_cells, bad)
+            if rec is None and earlier is not None:
+                rec = _read_run(out / "runs" / f"{r['key']}.json", r, n_cells, bad)
+            if rec is not None:
+                have[r["key"]] = rec
+        for path, why in bad:
+            _note(f"run file {short(path)!r} is not a run of this study ({why}); it is run again")
+            if Path(path).parent == work.runs:
+                Path(path).unlink(missing_ok=True)
+        todo = [r for r in runs if r["key"] not in have]
+        if max_runs is not None:
+            todo = todo[: int(max_runs)]
+        try:
+            name, done = _run_missing(
+                todo, have, runs, work.runs, version, workers, scheduler, executor, progress
+            )
+            records = [have[r["key"]] for r in runs if r["key"] in have]
+            info = {
+                "executed": done,
+                "reused": len(records) - done,
+                "executor": name,
+                "seconds": time.perf_counter() - t0,
+            }
+            settings = {"workers": workers, "scheduler": scheduler, "max_runs": max_runs}
+            paths, cells, inclusion = _stage(
+                out,
+                inputs,
+                cfg,
+                records,
+                figures,
+                work,
+                lambda cells: _summary(cfg, len(runs), records, info, version, cells, settings),
+                version,
+            )
+        except BaseException as exc:
+            work.failed(exc, [r["key"] for r in runs], out)
+            raise
+        result = StudyResult(
+            config=cfg,
+            runs=records,
+            cells=cells,
+            inclusion=inclusion,
+            out=out,
+            executed=done,
+            reused=len(records) - done,
+            seconds=time.perf_counter() - t0,
+            executor=name,
+            figures=tuple(out / Path(p).name for p in paths),
+        )
+        work.finish()
     return result
+
+
+def _identity(cfg):
+    """What makes two studies the same study: cells, seeds and fixed options."""
+    return json.dumps(
+        to_jsonable({"cells": cfg.cells, "seeds": cfg.seeds, "fit": cfg.fit, "record": cfg.record}),
+        sort_keys=True,
+    )
+
+
+def _earlier_study(out):
+    """The identity of the finished study in ``out`` (from its ``config.json``), else None;
+    a study directory whose config cannot be read counts as another study."""
+    p = Path(out)
+    try:
+        with open(p / MANIFEST, encoding="utf-8") as fh:
+            man = json.load(fh)
+    except (OSError, ValueError, RecursionError):
+        return None
+    if not isinstance(man, dict) or man.get("command") != "study":
+        return None
+    try:
+        with open(p / "config.json", encoding="utf-8") as fh:
+            data = json.load(fh)
+        return json.dumps(
+            to_jsonable({k: data[k] for k in ("cells", "seeds", "fit", "record")}),
+            sort_keys=True,
+        )
+    except (OSError, ValueError, RecursionError, KeyError, TypeError):
+        return ""
+
+
+class _Work:
+    """The study's work directory ``.DIR.vidi-study`` beside ``DIR``: its runs as they land,
+    locked against a second study into the same ``DIR``; kept when the study stops with
+    runs in it (so the same command continues), removed when it holds none or the study
+    was put in place."""
+
+    def __init__(self, out):
+        target = Path(os.path.abspath(out))
+        self.target = target
+        self.path = target.parent / f".{target.name}.vidi-study"
+        self.runs = self.path / "runs"
+        self._lock = None
+
+    def __enter__(self):
+        self._parents = []
+        p = self.path.parent
+        while not p.exists():
+            self._parents.append(p)
+            p = p.parent
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.runs.mkdir(parents=True, exist_ok=True)
+            fd = os.open(self.path / ".lock", os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError as exc:
+            raise InputError(
+                f"cannot create the study's work directory {short(self.path)!r} "
+                f"({exc.strerror}); choose a writable location"
+            ) from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            raise InputError(
+                f"another study is writing to {short(self.target)!r} now; wait for it to "
+                "finish, or give this one its own --out"
+            ) from None
+        self._lock = fd
+        return self
+
+    def n_runs(self, keys=None):
+        """Run files in the work directory (of ``keys`` only, when given)."""
+        try:
+            names = {f.name for f in self.runs.iterdir() if f.suffix == ".json"}
+        except OSError:
+            return 0
+        return len(names if keys is None else names & {f"{k}.json" for k in keys})
+
+    def failed(self, exc, keys, out):
+        """Say what was kept: the interrupt's message names the work directory and how to
+        continue; a study that stopped with no run kept leaves nothing behind."""
+        kept = self.n_runs(keys)
+        total = len(keys)
+        where = (
+            f"{short(out)!r} is unchanged"
+            if self.target.exists()
+            else f"nothing was written to {short(out)!r}"
+        )
+        if kept:
+            note = (
+                f"{kept} finished run(s) of {total} kept in {short(self.path)!r}; run the "
+                f"same command again to continue; {where}"
+            )
+        else:
+            note = f"no run was kept; {where}"
+        with contextlib.suppress(Exception):
+            exc.vidi_note = note
+        if not self.n_runs():  # nothing of this or an earlier interrupted study there
+            self._remove()
+
+    def finish(self):
+        self._remove()
+
+    def _remove(self):
+        shutil.rmtree(self.path, ignore_errors=True)
+        if not self.target.exists():
+            for d in self._parents:  # folders made for a study that left nothing
+                with contextlib.suppress(OSError):
+                    d.rmdir()
+
+    def __exit__(self, *exc):
+        if self._lock is not None:
+            with contextlib.suppress(OSError):
+                os.close(self._lock)
+        return False
+
+
+def _stage(out, inputs, cfg, records, figures, work, summary, version):
+    """Write the whole study (runs, config, tables, figures, summary) into a staging
+    directory and put it in place of ``out`` as a whole; returns the figures' names, the
+    cells and the term inclusion."""
+    with running("study"), OutputDir(out, inputs) as od:
+        stage = od.stage
+        os.mkdir(stage / "runs")
+        for rec in records:
+            name = f"{rec['key']}.json"
+            src = work.runs / name
+            if not src.is_file():
+                src = Path(out) / "runs" / name
+            try:
+                os.link(src, stage / "runs" / name)
+            except OSError:
+                shutil.copyfile(src, stage / "runs" / name)
+        _write_config(stage, cfg, version)
+        cells, inclusion = _write_tables(stage, cfg, records)
+        paths = ()
+        if figures and records:
+            from reports.vibroimpact.study_figures import study_figures
+
+            paths = tuple(study_figures(cfg, records, stage))
+        od.write_json("summary.json", summary(cells))
+    return paths, cells, inclusion
