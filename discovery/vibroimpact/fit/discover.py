@@ -132,6 +132,12 @@ class RankedModel:
         }
 
     @property
+    def limits(self):
+        """The consistency limits the law was judged by: the record's own (empty for
+        several records: each has its own, in ``records``)."""
+        return dict(self.evaluation.limits) if len(self.evaluations) == 1 else {}
+
+    @property
     def consistent(self):
         """Consistent with every record."""
         return all(ev.consistent for ev in self.evaluations)
@@ -180,6 +186,7 @@ class RankedModel:
             "status": ev.status,
             "criteria": self.criteria,
             "noise_floor": self.noise_floor,
+            "limits": self.limits,
             "consistent": self.consistent,
             "verdict": self.verdict,
             "bic": self.candidate.bic,
@@ -315,7 +322,7 @@ class DiscoveryResult:
             f"{'consistent' if sel.consistent else 'NOT consistent'} with the record(s)"
         )
         out = [head, *coefficient_lines(sel.law.as_dict(), sel.standard_errors, sel.intervals)]
-        out += criteria_lines(sel.criteria, sel.noise_floor)
+        out += criteria_lines(sel.criteria, sel.noise_floor, sel.limits)
         out.append(f"  verdict: {sel.verdict}")
         out.append(f"ranking ({len(self.ranking)} candidates, criterion {crit}):")
         for i, m in enumerate(self.ranking[:8]):
