@@ -55,7 +55,9 @@ FIGURE_CAPTIONS = {
     "verify": "Measured force (black) and the law's simulated force (red), folded on the "
     "drive phase over the record's span.",
     "fit_impulse": "Measured impulse and the simulated steady states of the best models.",
-    "fit_surface": "The selected law over the (zeta, dzeta) plane with the contact samples.",
+    "fit_surface": Tex(
+        r"The selected law over the ($\zeta$, $\dot\zeta_+$) plane with the contact samples."
+    ),
     "fit_loop": "Loading and unloading branches, measured and modelled, for a few impacts.",
     "identification": "Identification: the path of the best law so far and the simulated "
     "force converging to the measured one.",
@@ -122,7 +124,7 @@ def _provenance(s, run_dir):
         for k, val in settings.items()
         if k not in ("command", "func", "out", "ueda_command") and val not in (None, False)
     }
-    rows.append(["settings", "; ".join(f"{k}={val}" for k, val in shown.items()) or "--"])
+    rows.append(["settings", prose("; ".join(f"{k}={val}" for k, val in shown.items()) or "--")])
     return rows
 
 
@@ -209,6 +211,8 @@ def _figures(run_dir, order):
                 {
                     "file": p.name,
                     "caption": FIGURE_CAPTIONS.get(p.stem, FIGURE_CAPTIONS.get(base, p.stem)),
+                    # a figure drawn a page tall (explain's four panels) is printed so
+                    "height": Tex("0.85" if base == "explain" else "0.42"),
                 }
             )
     seen, out = set(), []
@@ -460,7 +464,7 @@ def _identify(s, run_dir):
         "method": s.get("method", "--"),
         "criterion": s.get("criterion", "I2"),
         "n_simulations": s.get("n_simulations", "--"),
-        "message": s.get("message", ""),
+        "message": prose(s.get("message", "")),
     }
     concl = [
         f"{s.get('method', '?')} spent {s.get('n_simulations', '?')} simulations; the "
@@ -483,8 +487,8 @@ def _landscape(s, run_dir):
     mins = s.get("minima") or {}
     c = {
         "title": "Criteria landscape over two coefficients",
-        "terms": terms,
-        "law": s.get("law", "--"),
+        "terms": [term_tex(t) for t in terms[:2]],
+        "law": law_inline(law_of(s["law"], "law")) if s.get("law") else Tex("--"),
         "grid": "x".join(str(g) for g in s.get("grid") or []),
         "minima": [
             [

@@ -8,6 +8,7 @@ path. Where TeX is not installed the PDF tests are skipped, except when
 
 import json
 import os
+import re
 import shutil
 import subprocess
 
@@ -127,6 +128,19 @@ def runs(tmp_path_factory):
         }
         for kind, argv in cmds.items():
             assert main([*argv, "--out", kind]) == 0, kind
+        # a fit over two scenarios (two drive amplitudes), each with its record
+        low = d / "low.toml"
+        low.write_text(scen.read_text().replace("A = 5.0e5", "A = 3.5e5").replace("100% #1", "low"))
+        assert (
+            main(
+                ["simulate", "--scenario", str(low), "--periods", "12", "--noise", "0.01"]
+                + ["--seed", "3", "--out", "low.csv"]
+            )
+            == 0
+        )
+        fit2 = ["fit", "--scenario", str(scen), "--scenario", str(low), "--data", rec]
+        fit2 += ["--data", "low.csv", "--no-refine", "--intervals", "0", "--out", "fit2"]
+        assert main(fit2) == 0
         assert main(["ueda", "simulate", "--periods", "120", "--out", "U.csv"]) == 0
         assert (
             main(
@@ -522,3 +536,33 @@ def test_an_interrupted_report_leaves_nothing_that_blocks_the_next(runs, tmp_pat
     (d / ".vidi-tex-999999999-1.deadbeef").mkdir()  # a staging dir of a killed report
     r = report(d, compile=HAVE_TEX, timeout=120)
     assert r.tex.exists() and not [p for p in d.iterdir() if p.name.startswith(".vidi-tex-")]
+
+
+def _body(pdf):
+    """A report's text up to its provenance (where settings and hashes are verbatim)."""
+    return _text(pdf).split("Provenance")[0]
+
+
+@pytest.mark.parametrize("kind", ["verify", "fit", "fit2", "identify", "landscape", "ueda"])
+def test_reports_are_typeset_as_a_person_would(runs, kind):
+    """The defects a reader saw: literal carets, laws as raw integers (206000000*z),
+    code turned into quotes, verdicts cut to "(and 1 more)", a "--:" label."""
+    _need_tex()
+    r = report(runs / kind, timeout=120)
+    tex, body = r.tex.read_text(), _body(r.pdf)
+    assert "\\textasciicircum" not in tex.split("section{Provenance}")[0], kind
+    assert "^" not in body and "ˆ" not in body, kind
+    assert not re.search(r"(?<![\d.,])\d{6,}(?![\d.])", body), kind
+    assert not re.search(r"\d\*z", body), kind
+    assert "(and " not in body and "more)" not in body, kind
+    assert "−−:" not in body and "--:" not in body
+    assert "``" not in tex and "\\textasciigrave" not in tex.split("section{Provenance}")[0]
+
+
+def test_a_two_scenario_fit_lists_every_scenario_and_record(runs):
+    _need_tex()
+    r = report(runs / "fit2", timeout=120)
+    body = _body(r.pdf)
+    for needle in ("Scenarios", "low", "100% #1", "low.csv", "_$x$.csv", "Record 1", "Record 2"):
+        assert needle in body, needle
+    assert "3.50 · 105" in body.replace("\u22c5", "·") or "3.50" in body

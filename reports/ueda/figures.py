@@ -20,6 +20,37 @@ _KIND_LABELS = ("synchronisation (P1)", "subharmonic (Pn)", "beat (quasi-periodi
 _save = save
 
 
+def _term_math(name):
+    r"""A library term (``x^2 x'``, ``1``) as mathtext: ``$x^{2}\,\dot{x}$``."""
+    from discovery.ueda.discover import MONOMIALS, TERMS
+
+    if name not in TERMS:
+        return str(name).replace("$", r"\$")
+    i, j = MONOMIALS[TERMS.index(name)]
+    parts = ([("x" if i == 1 else f"x^{{{i}}}")] if i else []) + (
+        [(r"\dot{x}" if j == 1 else rf"\dot{{x}}^{{{j}}}")] if j else []
+    )
+    return "$" + (r"\,".join(parts) or "1") + "$"
+
+
+def _sci(v):
+    from reports.lawtex import sci
+
+    return sci(v, 4)
+
+
+def _equation_math(model):
+    """``x'' = ...`` of a discovered model as mathtext, coefficients to 4 digits."""
+    parts = []
+    for k, v in model.terms.items():
+        sym = "" if k == "1" else _term_math(k).strip("$")
+        parts.append(("-" if v < 0 else "+") + rf" {_sci(abs(v))}\,{sym}")
+    f = model.forcing
+    parts.append(("-" if f < 0 else "+") + rf" {_sci(abs(f))}\,B\cos\nu t")
+    rhs = " ".join(parts)
+    return r"$\ddot{x} = " + (rhs[2:] if rhs.startswith("+ ") else rhs) + "$"
+
+
 def attractor_figure(att, stem):
     """(a) the stroboscopic points ``(x, x')`` at ``t = 2 pi k / nu``; (b) a stretch of
     trajectory in the ``(x, x')`` plane with the strobe points on it."""
@@ -237,7 +268,7 @@ def _coefficient_panel(ax, disc):
     se = np.array([disc.standard_errors[k] for k in names])
     y = np.arange(len(names))
     ax.barh(y, c, xerr=2 * se, color="tab:blue", alpha=0.7, capsize=3)
-    ax.set_yticks(y, names, fontsize=8)
+    ax.set_yticks(y, [_term_math(k) for k in names], fontsize=8)
     span = float(np.max(np.abs(c))) if len(c) else 1.0
     for yi, ci, si in zip(y, c, se, strict=True):  # the value beside its bar, inside the axes
         ax.text(
@@ -252,7 +283,9 @@ def _coefficient_panel(ax, disc):
         -1.15 * span if np.any(c < 0) else -0.6 * span, 1.15 * span if np.any(c > 0) else 0.6 * span
     )
     ax.axvline(0, color="k", lw=0.5)
-    ax.set_title("(b) coefficients of x'' = ...\n(error bars: 2 SE, block bootstrap)", fontsize=9)
+    ax.set_title(
+        "(b) coefficients of $\\ddot{x}$ = ...\n(error bars: 2 SE, block bootstrap)", fontsize=9
+    )
     ax.grid(alpha=0.3, axis="x")
 
 
@@ -315,9 +348,9 @@ def discover_figure(disc, ver, stem):
     _strobe_panel(axes[0], ver)
     _coefficient_panel(axes[1], disc)
     _distance_panel(axes[2], ver)
-    eq = "x'' = " + " ".join(
-        f"{v:+.4g} {k}" if k != "1" else f"{v:+.4g}" for k, v in disc.model.terms.items()
+    fig.suptitle(
+        f"discovered: {_equation_math(disc.model)};  $B$ = {disc.model.B:g}, "
+        f"$\\nu$ = {disc.model.nu:g}",
+        fontsize=10,
     )
-    eq += f" {disc.model.forcing:+.4g} B cos(nu t)"
-    fig.suptitle(f"discovered: {eq};  B = {disc.model.B:g}, nu = {disc.model.nu:g}", fontsize=10)
     return _save(fig, stem)
