@@ -212,7 +212,7 @@ def _figures(run_dir, order):
                     "file": p.name,
                     "caption": FIGURE_CAPTIONS.get(p.stem, FIGURE_CAPTIONS.get(base, p.stem)),
                     # a figure drawn a page tall (explain's four panels) is printed so
-                    "height": Tex("0.85" if base == "explain" else "0.42"),
+                    "height": Tex("0.75" if base in ("explain", "discover") else "0.42"),
                 }
             )
     seen, out = set(), []
@@ -744,6 +744,11 @@ def _study(s, run_dir):
                     f"{m}: the 95 % intervals held the truth in {share:.0%} of "
                     f"{p['intervals']} cases ({lo:.2f}--{hi:.2f}), {verdict}."
                 )
+    if pooled and not any(p.get("intervals") for p in pooled.values()):
+        concl.append(
+            "No run has coefficient intervals (they come from the refinement by "
+            "simulation: set refine = [true]), so there is no coverage chart."
+        )
     concl.append(
         "Records were made by the independent scipy path from rest; no selection "
         "used the truth (no oracle settings)."

@@ -89,7 +89,7 @@ def test_print_and_reports_read_the_registry():
         assert row.endswith(c.meaning)
     assert "0.025" in next(ln for ln in lines if ln.split()[0] == "I2")
     rows = _criteria_table(crit, {}, {})
-    for row, (name, c) in zip(rows, CRITERIA.items(), strict=True):
+    for row, c in zip(rows, CRITERIA.values(), strict=True):
         assert c.latex in row[-1] and c.meaning in row[-1]
 
 

@@ -330,8 +330,11 @@ def test_study_report_states_recovery_coverage_and_figures(tmp_path):
     ):
         assert words in text, words
     tex = r.tex.read_text()
-    for fig in ("recovery_noise.pdf", "recovery_map.pdf", "coverage.pdf", "inclusion.pdf"):
+    for fig in ("recovery_noise.pdf", "recovery_map.pdf", "inclusion.pdf"):
         assert fig in tex
+    # no refinement, no intervals: no empty coverage chart, and a sentence says why
+    assert "coverage.pdf" not in tex and not (out / "coverage.pdf").exists()
+    assert "so there is no coverage chart" in text
 
 
 # ------------------------------------------------- a summary is text, never trusted TeX

@@ -64,7 +64,7 @@ def attractor_figure(att, stem):
     ax.set_title(
         f"(a) stroboscopic points ({att.n_points}), {att.regime.regime}\n"
         f"lambda1 = {L.value:.4f} +- {L.stderr:.4f}, lambda2 = {L.second:.4f}",
-        fontsize=9,
+        fontsize=8,
     )
     ax = axes[1]
     ax.plot(att.x, att.v, lw=0.5, color="tab:blue")
@@ -188,7 +188,7 @@ def chart_figure(ch, stem):
         f"{ch.seconds:.0f} s on {ch.workers} processes\n"
         f"black lines: boundaries between regimes (or periods), to the grid's "
         f"resolution; numbers: periods (up to {maxp})",
-        fontsize=9,
+        fontsize=8,
     )
     ax.set_xlim(en[0], en[-1])
     ax.set_ylim(eb[0], eb[-1])
@@ -213,7 +213,7 @@ def basins_figure(bas, stem):
     )
     ax.set_xlabel("x(0)")
     ax.set_ylabel("x'(0)")
-    ax.set_title(f"(a) basins on a {bas.x0.size}x{bas.v0.size} grid", fontsize=9)
+    ax.set_title(f"(a) basins on a {bas.x0.size}x{bas.v0.size} grid", fontsize=8)
     ax = axes[1]
     for k, a in enumerate(bas.attractors):
         p = np.asarray(a["points"])
@@ -228,7 +228,7 @@ def basins_figure(bas, stem):
     ax.legend(fontsize=8)
     ax.set_xlabel("x")
     ax.set_ylabel("x'")
-    ax.set_title("(b) the attractors' strobe points", fontsize=9)
+    ax.set_title("(b) the attractors' strobe points", fontsize=8)
     return _save(fig, stem)
 
 
@@ -257,7 +257,7 @@ def _strobe_panel(ax, ver):
         if L
         else f"model diverged: {ver.diverged}"
     )
-    ax.set_title(f"(a) stroboscopic points at t = 2 pi k / nu\n{lyap}", fontsize=9)
+    ax.set_title(f"(a) stroboscopic points at t = 2 pi k / nu\n{lyap}", fontsize=8)
     ax.grid(alpha=0.3)
 
 
@@ -330,8 +330,8 @@ def _distance_panel(ax, ver):
         )
     ax.set_xlim(0, hi)
     ax.set_ylabel("resamples")
-    ax.legend(fontsize=8, loc="upper right")
-    ax.set_xlabel("energy distance of strobe points (scaled by the record's sd)", fontsize=8)
+    ax.legend(fontsize=7, loc="upper right", framealpha=0.8)
+    ax.set_xlabel("energy distance of strobe points\n(scaled by the record's sd)", fontsize=8)
     verdict = "consistent" if ver.consistent else "INCONSISTENT"
     ax.set_title(
         f"(c) {verdict}\n(rule: median distance <= floor q95, and the same regime)", fontsize=9
@@ -342,15 +342,19 @@ def discover_figure(disc, ver, stem):
     """(a) the record's stroboscopic points over the discovered model's; (b) the
     coefficients with their standard errors (bars: 2 SE); (c) the energy distance
     against its noise floor (random halves of the record)."""
-    fig, axes = subplots(
-        1, 3, figsize=(15, 4.8), layout="constrained", gridspec_kw={"width_ratios": [1.3, 1, 1]}
-    )
-    _strobe_panel(axes[0], ver)
-    _coefficient_panel(axes[1], disc)
-    _distance_panel(axes[2], ver)
-    fig.suptitle(
-        f"discovered: {_equation_math(disc.model)};  $B$ = {disc.model.B:g}, "
-        f"$\\nu$ = {disc.model.nu:g}",
-        fontsize=10,
-    )
-    return _save(fig, stem)
+    from matplotlib.figure import Figure
+
+    from .._mpl import PRINT_WIDTH, print_sizes
+
+    with print_sizes():  # drawn at the width it is printed: its text 7 to 8 pt on paper
+        fig = Figure(figsize=(PRINT_WIDTH, 6.6), layout="constrained")
+        axd = fig.subplot_mosaic([["a", "a"], ["b", "c"]], height_ratios=[1.1, 1])
+        _strobe_panel(axd["a"], ver)
+        _coefficient_panel(axd["b"], disc)
+        _distance_panel(axd["c"], ver)
+        fig.suptitle(
+            f"discovered: {_equation_math(disc.model)};  $B$ = {disc.model.B:g}, "
+            f"$\\nu$ = {disc.model.nu:g}",
+            fontsize=8,
+        )
+        return _save(fig, stem)

@@ -715,7 +715,7 @@ def explain_figure(iteration, measured, stem, k=1):
     to the noise), the mean residual over the simulated (zeta, dzeta) plane, and every
     candidate effect's score test."""
     with print_sizes():  # drawn at the width it is printed: its text 7 to 8 pt on paper
-        fig, axes = subplots(2, 2, figsize=(PRINT_WIDTH, 7.6), layout="constrained")
+        fig, axes = subplots(2, 2, figsize=(PRINT_WIDTH, 6.6), layout="constrained")
         _explain_forces(axes[0, 0], iteration, measured, k)
         _explain_phases(axes[0, 1], iteration)
         _explain_plane(fig, axes[1, 0], iteration)
