@@ -673,11 +673,11 @@ def _study(s, run_dir):
     c = {
         "title": "Model-term selection study" + (f": {s['name']}" if s.get("name") else ""),
         "design": [
-            [Tex(r"\texttt{" + escape(k) + "}"), ", ".join(map(str, v))]
+            [Tex(r"\texttt{" + escape(k) + "}"), prose(", ".join(map(str, v)))]
             for k, v in (d.get("varied") or {}).items()
         ]
         + [
-            [Tex(r"\texttt{" + escape(k) + "}"), f"{v} (fixed)"]
+            [Tex(r"\texttt{" + escape(k) + "}"), prose(f"{v} (fixed)")]
             for k, v in (d.get("fixed") or {}).items()
         ]
         + [
@@ -706,7 +706,7 @@ def _study(s, run_dir):
         ],
         "cells": [
             [
-                *(str(row.get(f, "")) for f in varied),
+                *(prose(str(row.get(f, ""))) for f in varied),
                 _frac(
                     row["recovered"],
                     row["runs"],

@@ -335,6 +335,7 @@ def test_study_report_states_recovery_coverage_and_figures(tmp_path):
     # no refinement, no intervals: no empty coverage chart, and a sentence says why
     assert "coverage.pdf" not in tex and not (out / "coverage.pdf").exists()
     assert "so there is no coverage chart" in text
+    assert "^" not in _body(r.pdf) and "ˆ" not in _body(r.pdf)  # "z^2" as an exponent
 
 
 # ------------------------------------------------- a summary is text, never trusted TeX
