@@ -79,6 +79,10 @@ FIGURE_CAPTIONS = {
 }
 
 
+# figures drawn a page tall at the text width (their text 7-8 pt when printed)
+_TALL = ("explain", "discover", "landscape", "identification")
+
+
 def _model_tex(value, where):
     """The equation of a law rebuilt from its text or coefficients (never read as LaTeX);
     ``--`` when the summary has none."""
@@ -212,7 +216,7 @@ def _figures(run_dir, order):
                     "file": p.name,
                     "caption": FIGURE_CAPTIONS.get(p.stem, FIGURE_CAPTIONS.get(base, p.stem)),
                     # a figure drawn a page tall (explain's four panels) is printed so
-                    "height": Tex("0.75" if base in ("explain", "discover") else "0.42"),
+                    "height": Tex("0.75" if base in _TALL else "0.42"),
                 }
             )
     seen, out = set(), []

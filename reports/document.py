@@ -356,17 +356,31 @@ def compile_tex(tex_path, figures=(), timeout=300, staged=None):
     return dest, f"wrote {dest}"
 
 
+def _manifest(run_dir):
+    """``(manifest dict or None, the names it lists)``: only a JSON object's list of plain
+    names counts (a manifest edited to hold ``"files": 5``, a string or paths lists none)."""
+    from discovery._io import MANIFEST
+
+    try:
+        man = json.loads((Path(run_dir) / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None, set()
+    if not isinstance(man, dict):
+        return None, set()
+    files = man.get("files")
+    names = {
+        f for f in (files if isinstance(files, list) else []) if isinstance(f, str) and "/" not in f
+    }
+    return man, names
+
+
 def _check_ours(run_dir, names):
     """Refuse, before writing, to replace a file of these names that vidi did not write
     (not in the run's manifest): a user's own ``report.tex`` is never overwritten."""
-    from discovery._io import MANIFEST
     from discovery.errors import InputError
 
     d = Path(run_dir)
-    try:
-        listed = set(json.loads((d / MANIFEST).read_text(encoding="utf-8")).get("files") or [])
-    except (OSError, ValueError, AttributeError):
-        listed = set()
+    listed = _manifest(d)[1]
     for name in names:
         p = d / name
         if os.path.lexists(p) and (name not in listed or p.is_symlink() or not p.is_file()):
@@ -382,11 +396,9 @@ def _record_in_manifest(run_dir, names):
     from discovery._io import MANIFEST, atomic_write_text
 
     p = Path(run_dir) / MANIFEST
-    try:
-        man = json.loads(p.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    man, files = _manifest(run_dir)
+    if man is None:
         return
-    files = set(man.get("files") or [])
     files.update(names)
     man["files"] = sorted(files)
     atomic_write_text(p, json.dumps(man, indent=2) + "\n")

@@ -570,3 +570,17 @@ def test_a_two_scenario_fit_lists_every_scenario_and_record(runs):
     for needle in ("Scenarios", "low", "100% #1", "low.csv", "_$x$.csv", "Record 1", "Record 2"):
         assert needle in body, needle
     assert "3.50 · 105" in body.replace("\u22c5", "·") or "3.50" in body
+
+
+@pytest.mark.parametrize("files", [5, "report.tex", {"a": 1}, None, [1, ["x"]]])
+def test_a_malformed_manifest_is_one_line_or_a_report(runs, tmp_path, capsys, files):
+    d = _copy_run(runs, "landscape", tmp_path)
+    man = json.loads((d / ".vidi-manifest.json").read_text())
+    man["files"] = files
+    (d / ".vidi-manifest.json").write_text(json.dumps(man))
+    assert main(["report", str(d), "--no-pdf"]) == 0
+    assert "Traceback" not in capsys.readouterr().err
+    assert "report.tex" in json.loads((d / ".vidi-manifest.json").read_text())["files"]
+    (d / ".vidi-manifest.json").write_text("[1, 2]")
+    assert main(["report", str(d), "--no-pdf"]) == 2  # report.tex is no longer listed as vidi's
+    assert capsys.readouterr().err.count("\n") == 1

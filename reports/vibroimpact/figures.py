@@ -158,38 +158,39 @@ def landscape_figure(land, stem, truth=None):
     marks = _landscape_marks(reg, ref_reg)
     inside = truth is not None and a0[0] <= truth[0] <= a0[-1] and a1[0] <= truth[1] <= a1[-1]
     show_cons = cons is not None and cons.sum() >= 2  # one point: hidden by the star
-    fig, axes = subplots(2, 3, figsize=(14, 8.5))
-    for ax, name in zip(axes.flat, _ORDER, strict=False):
-        _landscape_contours(fig, ax, land, name)
-        if show_cons:
-            ax.contour(
-                a0,
-                a1,
-                cons.T.astype(float),
-                levels=[0.5],
-                colors="w",
-                linestyles="--",
-                linewidths=1.2,
-            )
-        for mask, style, _ in marks:
-            ij = np.argwhere(mask)
-            ax.plot(a0[ij[:, 0]], a1[ij[:, 1]], **style)
-        if inside:
-            ax.plot(*truth, "o", mfc="none", mec="r", ms=10, mew=1.5)
-        ax.set_xlim(a0[0], a0[-1])
-        ax.set_ylim(a1[0], a1[-1])
-        ax.set_xlabel(coefficient_label(land.terms[0]))
-        ax.set_ylabel(coefficient_label(land.terms[1]))
-        ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
-        title = name if exact or not floor else f"{name} (noise floor {floor[name]:.3g})"
-        ax.set_title(title)
-    ax = axes.flat[5]
-    ax.axis("off")
-    lines = _landscape_info_lines(land, ref_reg, exact, floor, cons, truth, inside)
-    ax.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, transform=ax.transAxes)
-    _landscape_legend(ax, inside, show_cons, marks)
-    fig.tight_layout()
-    return _save(fig, stem)
+    with print_sizes():  # drawn at the width it is printed: its text 7 to 8 pt
+        fig, axes = subplots(3, 2, figsize=(PRINT_WIDTH, 7.2))
+        for ax, name in zip(axes.flat, _ORDER, strict=False):
+            _landscape_contours(fig, ax, land, name)
+            if show_cons:
+                ax.contour(
+                    a0,
+                    a1,
+                    cons.T.astype(float),
+                    levels=[0.5],
+                    colors="w",
+                    linestyles="--",
+                    linewidths=1.2,
+                )
+            for mask, style, _ in marks:
+                ij = np.argwhere(mask)
+                ax.plot(a0[ij[:, 0]], a1[ij[:, 1]], **style)
+            if inside:
+                ax.plot(*truth, "o", mfc="none", mec="r", ms=10, mew=1.5)
+            ax.set_xlim(a0[0], a0[-1])
+            ax.set_ylim(a1[0], a1[-1])
+            ax.set_xlabel(coefficient_label(land.terms[0]))
+            ax.set_ylabel(coefficient_label(land.terms[1]))
+            ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
+            title = name if exact or not floor else f"{name} (noise floor {floor[name]:.3g})"
+            ax.set_title(title)
+        ax = axes.flat[5]
+        ax.axis("off")
+        lines = _landscape_info_lines(land, ref_reg, exact, floor, cons, truth, inside)
+        ax.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=7, transform=ax.transAxes)
+        _landscape_legend(ax, inside, show_cons, marks)
+        fig.tight_layout()
+        return _save(fig, stem)
 
 
 def identification_figure(result, measured, impulses, stem, land=None):
@@ -218,7 +219,14 @@ def identification_figure(result, measured, impulses, stem, land=None):
     its = list(result.iterations)
     path = np.array([[it["coefficients"][n] for n in names] for it in its])
     two = len(names) >= 2 and path.size > 0
-    fig, axes = subplots(1, 3 if two else 2, figsize=(17 if two else 12, 5.2), layout="constrained")
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(PRINT_WIDTH, 6.6 if two else 3.4), layout="constrained")
+    if two:  # the path and the history side by side, the forces below at full width
+        axd = fig.subplot_mosaic([["a", "b"], ["c", "c"]])
+        axes = [axd["a"], axd["b"], axd["c"]]
+    else:
+        axes = list(fig.subplots(1, 2))
     crit = result.criterion
     # the identified law's value (result.value can belong to a standard-error probe)
     value = result.criteria.get(crit, result.value)
@@ -245,8 +253,8 @@ def identification_figure(result, measured, impulses, stem, land=None):
         ax.set_ylabel(coefficient_label(names[1]))
         ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
         more = f" (first two of {len(names)} terms)" if len(names) > 2 else ""
-        ax.set_title(f"{result.method}: path of the best law so far{more}", fontsize=10)
-        ax.legend(fontsize=8, loc="best")
+        ax.set_title(f"{result.method}: path of the best law so far{more}", fontsize=8)
+        ax.legend(fontsize=7, loc="best")
     ax = axes[1] if two else axes[0]
     if its:
         sims = np.array([it["n_simulations"] for it in its], dtype=float)
@@ -270,11 +278,11 @@ def identification_figure(result, measured, impulses, stem, land=None):
         )
         if np.all(vals > 0):
             ax.set_yscale("log")
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=7)
     ax.set_xlabel("simulations spent (steady states computed)")
     ax.set_ylabel(f"best {crit} so far (dimensionless)")
     ax.set_title(
-        f"identified: {crit} = {value:.3g}, {result.n_simulations} simulations in all", fontsize=10
+        f"identified: {crit} = {value:.3g}, {result.n_simulations} simulations in all", fontsize=8
     )
     ax1 = axes[-1]
     ax1.plot(measured.t * 1e3, measured.F / 1e6, "k-", lw=2.5, label="F_E (measured)")
@@ -292,8 +300,8 @@ def identification_figure(result, measured, impulses, stem, land=None):
     ax1.set_xlim(-0.05 * end * 1e3, min(measured.duration, 1.4 * end) * 1e3)
     ax1.set_xlabel("time since onset t - t* [ms]")
     ax1.set_ylabel("contact force [MN]")
-    ax1.set_title(f"F_N converging to F_E ({crit} = {value:.3g})", fontsize=10)
-    ax1.legend(fontsize=8)
+    ax1.set_title(f"F_N converging to F_E ({crit} = {value:.3g})", fontsize=8)
+    ax1.legend(fontsize=7)
     return _save(fig, stem)
 
 

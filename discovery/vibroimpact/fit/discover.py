@@ -149,9 +149,12 @@ class RankedModel:
         bad = [(i, ev) for i, ev in enumerate(self.evaluations) if not ev.consistent]
         if not bad:
             return f"consistent with all {len(self.evaluations)} records"
-        i, ev = bad[0]
-        return f"inconsistent with record {i + 1}: {ev.verdict}" + (
-            f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
+        if len(bad) == 1:
+            i, ev = bad[0]
+            return f"inconsistent with record {i + 1}: {ev.verdict}"
+        # every record's verdict in full: none is cut to "(and 1 more)"
+        return f"inconsistent with {len(bad)} of {len(self.evaluations)} records: " + "; ".join(
+            f"record {i + 1}: {ev.verdict}" for i, ev in bad
         )
 
     @property
