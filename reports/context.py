@@ -637,7 +637,7 @@ def _ueda(s, run_dir):
             for k, v in (s.get("gap") or {}).items()
             if isinstance(v, dict)
         )
-        added = ", ".join(s["effects_added"]) or "none"
+        added = ", ".join(str(e).replace("_", " ") for e in s["effects_added"]) or "none"
         concl.append(
             f"Effects named and added: {added}; the gap: {gaps}. The final model is "
             f"{'consistent' if s.get('consistent') else 'NOT consistent'} with the "

@@ -9,7 +9,7 @@ Each function writes PNG and PDF and returns the paths.
 import numpy as np
 from matplotlib.colors import ListedColormap
 
-from .._mpl import colormap, save, subplots
+from .._mpl import PRINT_WIDTH, colormap, save, subplots
 
 __all__ = ["attractor_figure", "chart_figure", "basins_figure", "discover_figure"]
 
@@ -31,6 +31,13 @@ def _term_math(name):
         [(r"\dot{x}" if j == 1 else rf"\dot{{x}}^{{{j}}}")] if j else []
     )
     return "$" + (r"\,".join(parts) or "1") + "$"
+
+
+def _carets(text):
+    """Text with its exponents (``x^2``) raised as mathtext, the rest as it is."""
+    import re
+
+    return re.sub(r"\^(\d+)", r"$^{\1}$", str(text).replace("$", r"\$"))
 
 
 def _sci(v):
@@ -55,7 +62,7 @@ def attractor_figure(att, stem):
     """(a) the stroboscopic points ``(x, x')`` at ``t = 2 pi k / nu``; (b) a stretch of
     trajectory in the ``(x, x')`` plane with the strobe points on it."""
     s = att.system
-    fig, axes = subplots(1, 2, figsize=(11, 4.8))
+    fig, axes = subplots(1, 2, figsize=(PRINT_WIDTH, 3.4), layout="constrained")
     ax = axes[0]
     ax.plot(att.strobe[:, 0], att.strobe[:, 1], ".", ms=1.2, color="k")
     ax.set_xlabel("x")
@@ -83,7 +90,7 @@ def attractor_figure(att, stem):
         if s.model == "negres"
         else f"k = {s.k:g}, B = {s.B:g}, nu = {s.nu:g}"
     )
-    fig.suptitle(f"{s.model}: {s.equation};  {pars}", fontsize=10)
+    fig.suptitle(f"{s.model}: {_carets(s.equation)};  {pars}", fontsize=8)
     for a in axes:
         a.grid(alpha=0.3)
     return _save(fig, stem)
@@ -96,7 +103,7 @@ def chart_figure(ch, stem):
     in both directions, the points where the two sweeps ended on different attractors
     (coexisting attractors: hysteresis) marked ``x``."""
     kind = np.where(ch.kind < 0, np.nan, ch.kind.astype(float))
-    fig, ax = subplots(figsize=(8, 6.4))
+    fig, ax = subplots(figsize=(PRINT_WIDTH, 5.2), layout="constrained")
     nu, B = ch.nu, ch.B
 
     def edges(a):
@@ -198,7 +205,7 @@ def chart_figure(ch, stem):
 def basins_figure(bas, stem):
     """The grid of initial states coloured by the attractor each reaches, beside the
     attractors' strobe points."""
-    fig, axes = subplots(1, 2, figsize=(11, 4.8))
+    fig, axes = subplots(1, 2, figsize=(PRINT_WIDTH, 3.4), layout="constrained")
     n = len(bas.attractors)
     cmap = colormap("tab10")
     ax = axes[0]
