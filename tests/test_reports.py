@@ -584,3 +584,13 @@ def test_a_malformed_manifest_is_one_line_or_a_report(runs, tmp_path, capsys, fi
     (d / ".vidi-manifest.json").write_text("[1, 2]")
     assert main(["report", str(d), "--no-pdf"]) == 2  # report.tex is no longer listed as vidi's
     assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_the_api_checks_its_arguments(runs):
+    from discovery.errors import VidiError
+    from discovery.report import report as api_report
+
+    with pytest.raises(VidiError, match="compile"):
+        api_report(runs / "landscape", compile="no")
+    with pytest.raises(VidiError, match="timeout"):
+        api_report(runs / "landscape", timeout="60")
