@@ -216,7 +216,7 @@ def _figures(run_dir, order):
                     "file": p.name,
                     "caption": FIGURE_CAPTIONS.get(p.stem, FIGURE_CAPTIONS.get(base, p.stem)),
                     # a figure drawn a page tall (explain's four panels) is printed so
-                    "height": Tex("0.75" if base in _TALL else "0.42"),
+                    "height": Tex("0.75" if base in _TALL else "0.55"),
                 }
             )
     seen, out = set(), []

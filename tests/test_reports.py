@@ -594,3 +594,27 @@ def test_the_api_checks_its_arguments(runs):
         api_report(runs / "landscape", compile="no")
     with pytest.raises(VidiError, match="timeout"):
         api_report(runs / "landscape", timeout="60")
+
+
+TEXT_WIDTH_IN, TEXT_HEIGHT_IN = 6.77, 9.27  # letter paper, 2.2 cm margins
+
+
+@pytest.mark.parametrize("kind", ["verify", "fit", "fit2", "identify", "landscape", "ueda"])
+def test_figures_are_printed_at_the_size_they_were_drawn(runs, kind):
+    """Every figure is drawn about as large as the report prints it (scaled by 0.9 or
+    more), so text drawn at 7 pt or more stays 6.3 pt or more on paper, where a figure
+    drawn 13-17 in wide was shrunk to half its size."""
+    _need_tex()
+    r = report(runs / kind, compile=False)
+    tex = r.tex.read_text()
+    found = re.findall(r"height=([0-9.]+)\\textheight,keepaspectratio\]\{([^}]+)\}", tex)
+    assert found, kind
+    for frac, name in found:
+        info = subprocess.run(
+            ["pdfinfo", str(runs / kind / name)], capture_output=True, text=True, check=True
+        ).stdout
+        w, h = (
+            float(v) / 72 for v in re.search(r"Page size:\s+([\d.]+) x ([\d.]+)", info).groups()
+        )
+        scale = min(TEXT_WIDTH_IN / w, float(frac) * TEXT_HEIGHT_IN / h)
+        assert scale >= 0.9, (kind, name, w, h, scale)
