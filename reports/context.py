@@ -79,6 +79,9 @@ FIGURE_CAPTIONS = {
 }
 
 
+# the certificate's domain bounds by their symbols
+_DOMAIN = {"zeta_max": Tex(r"$\zeta_{\max}$"), "zd_max": Tex(r"$\dot\zeta_{+,\max}$")}
+
 # figures drawn a page tall at the text width (their text 7-8 pt when printed)
 _TALL = ("explain", "discover", "landscape", "identification")
 
@@ -411,7 +414,7 @@ def _fit(s, run_dir):
             "holds": bool(cert.get("holds")),
             "worst": num(cert.get("worst_violation")),
             "domain": {
-                k: num(v)
+                _DOMAIN.get(k, k): num(v)
                 for k, v in (cert.get("domain") or {}).items()
                 if isinstance(v, int | float)
             },

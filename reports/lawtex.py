@@ -222,13 +222,38 @@ def _plain(text):
     return "".join(out)
 
 
+_ENUM = re.compile(r"(?<![\w.])([-+]?\d+(?:\.\d+)?)[eE]([-+]?\d+)(?![\w.])")
+
+
+def _symbols(text):
+    """Escaped text with ``->``, ``<=`` and ``>=`` as their symbols."""
+    return (
+        escape(text)
+        .replace(r"-\textgreater{}", r"$\to$")
+        .replace(r"\textless{}=", r"$\le$")
+        .replace(r"\textgreater{}=", r"$\ge$")
+    )
+
+
+def _numbers(text):
+    r"""Escaped text with numbers like ``3.93e+06`` set as ``$3.93\cdot 10^{6}$``."""
+    out, pos = [], 0
+    for m in _ENUM.finditer(text):
+        out.append(_symbols(text[pos : m.start()]))
+        exp = int(m.group(2))
+        out.append(f"${m.group(1)}" + (rf"\cdot 10^{{{exp}}}$" if exp else "$"))
+        pos = m.end()
+    out.append(_symbols(text[pos:]))
+    return "".join(out)
+
+
 def _carets(text):
     out, pos = [], 0
     for m in _CARET.finditer(text):
-        out.append(escape(text[pos : m.start()]))
+        out.append(_numbers(text[pos : m.start()]))
         out.append(f"$^{{{m.group(1)}}}$")
         pos = m.end()
-    out.append(escape(text[pos:]))
+    out.append(_numbers(text[pos:]))
     return "".join(out)
 
 
