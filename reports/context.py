@@ -94,11 +94,6 @@ def _model_tex(value, where):
     return law_equation(law_of(value, where))
 
 
-def _rows_from(d, keys=None, fmt=num):
-    keys = list(d) if keys is None else [k for k in keys if k in d]
-    return [[Tex(r"\texttt{" + escape(k) + "}"), fmt(d[k])] for k in keys]
-
-
 def _provenance(s, run_dir):
     v = s.get("versions") or {}
     git = s.get("git") or {}
