@@ -560,6 +560,9 @@ def test_reports_are_typeset_as_a_person_would(runs, kind):
     assert not re.search(r"\d\*z", body), kind
     assert "(and " not in body and "more)" not in body, kind
     assert "−−:" not in body and "--:" not in body
+    assert "Eq(" not in body and "Derivative" not in body  # no sympy repr (Ueda)
+    summary = json.loads((runs / kind / "summary.json").read_text())
+    assert "Eq(" not in str(summary.get("equation", ""))
     assert "``" not in tex and "\\textasciigrave" not in tex.split("section{Provenance}")[0]
 
 
