@@ -392,7 +392,7 @@ def _fit(s, run_dir):
         "library": fs.get("library", "--"),
         "selection": fs.get("selection", "--"),
         "scoring": fs.get("scoring", "--"),
-        "criterion": fs.get("criterion", "I2"),
+        "criterion": criterion_tex(fs.get("criterion", "I2")),
         "records": [
             [
                 r.get("data", "--"),
@@ -464,7 +464,7 @@ def _identify(s, run_dir):
         "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
         "verdict": prose(s.get("verdict") or "--"),
         "method": s.get("method", "--"),
-        "criterion": s.get("criterion", "I2"),
+        "criterion": criterion_tex(s.get("criterion", "I2")),
         "n_simulations": s.get("n_simulations", "--"),
         "message": prose(s.get("message", "")),
     }
