@@ -533,16 +533,16 @@ def _explain(s, run_dir):
             fm.get("coefficients") or {}, fm.get("uncertainties"), _intervals(fm)
         )
         + [
-            [Tex("unloading " + term_tex(k)), num(v, 4), Tex("--"), Tex("--")]
+            [Tex("unloading " + term_tex(k, unloading=True)), num(v, 4), Tex("--"), Tex("--")]
             for k, v in (fm.get("unloading") or {}).items()
         ],
-        "effects": list(fm.get("effects") or []),
+        "effects": [str(e).replace("_", " ") for e in fm.get("effects") or []],
         "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
         "stopped": prose(s.get("stopped_because", "--")),
         "iterations": [
             [
                 str(k + 1),
-                it.get("effect") or "nothing named",
+                str(it.get("effect") or "nothing named").replace("_", " "),
                 num((it.get("criteria_before") or {}).get("I2")),
                 num((it.get("criteria_after") or {}).get("I2")),
                 num((it.get("noise_floor") or {}).get("I2")),
@@ -563,7 +563,7 @@ def _explain(s, run_dir):
     }
     named_its = [it for it in its if it.get("effect")]
     if named_its:
-        named = ", ".join(it["effect"] for it in named_its)
+        named = ", ".join(str(it["effect"]).replace("_", " ") for it in named_its)
         state = "consistent" if s.get("consistent") else "still NOT consistent"
         concl = [
             f"Named and added: {named}. The gap to the record shrank as the table shows; "

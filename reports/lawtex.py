@@ -65,14 +65,15 @@ def _monomial(term, names=(_ZETA, _ZD)):
     return r"\,".join(parts)
 
 
-def term_tex(name):
-    """A term's name (``z^2*zd``) as math (``$\\zeta^{2}\\,\\dot\\zeta_{+}$``); a name that is
-    not a term is escaped text."""
+def term_tex(name, unloading=False):
+    """A term's name (``z^2*zd``) as math (``$\\zeta^{2}\\,\\dot\\zeta_{+}$``; an unloading
+    term's velocity as ``|\\dot\\zeta|``); a name that is not a term is escaped text."""
     from discovery.errors import VidiError
     from discovery.vibroimpact.model.law import Term
 
     try:
-        return Tex(f"${_monomial(Term.parse(str(name)))}$")
+        names = (_ZETA, _ZDABS) if unloading else (_ZETA, _ZD)
+        return Tex(f"${_monomial(Term.parse(str(name)), names)}$")
     except (VidiError, TypeError, ValueError):
         return Tex(r"\texttt{" + escape(name) + "}")
 
