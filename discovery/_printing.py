@@ -13,8 +13,6 @@ import html
 
 __all__ = ["readable", "criteria_lines", "coefficient_lines", "fmt", "generic_lines"]
 
-CRITERIA = ("I0", "I1", "I2", "I3", "I4")
-
 
 def fmt(v, digits=4):
     """A number in a few significant digits (``--`` when missing)."""
@@ -27,17 +25,23 @@ def fmt(v, digits=4):
 
 
 def criteria_lines(criteria, floor=None, limits=None, indent="  "):
-    """The criteria table: value, noise floor and (when judged) the limit."""
+    """The criteria table: value, noise floor, the limit (for the criteria the consistency
+    rule judges; ``--`` for the others) and the meaning, from the criteria registry
+    (:data:`discovery.vibroimpact.verify.criteria.CRITERIA`, the one definition)."""
+    from .vibroimpact.verify.criteria import CRITERIA, definition
+
     if not criteria:
         return []
-    out = [f"{indent}{'criterion':<10}{'value':>10}{'floor':>10}{'limit':>10}"]
+    out = [f"{indent}{'criterion':<10}{'value':>10}{'floor':>10}{'limit':>10}   meaning"]
     for k in (*CRITERIA, *(k for k in criteria if k not in CRITERIA)):
         if k in criteria:
             lim = (limits or {}).get(k)
+            meaning = definition(k).meaning if k in CRITERIA else ""
             out.append(
                 f"{indent}{k:<10}{fmt(criteria[k], 3):>10}"
                 f"{fmt((floor or {}).get(k), 3):>10}"
-                f"{fmt(lim, 3) if lim is not None else '':>10}"
+                f"{fmt(lim, 3) if lim is not None else '--':>10}"
+                + (f"   {meaning}" if meaning else "")
             )
     return out
 

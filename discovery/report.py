@@ -16,6 +16,7 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300):
 
     check("report: snippet", snippet, (None, Choice("model", "table", "criteria", "figure")))
     check("report: timeout", timeout, Real(1))
+    check("report: compile", compile, bool)  # "no" is text, not False
     if not isinstance(run_dir, str | bytes) and not hasattr(run_dir, "__fspath__"):
         from .errors import VidiTypeError
 

@@ -4,9 +4,29 @@ never switches the backend of a notebook or a GUI session that imported ``discov
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
-__all__ = ["subplots", "save", "colormap"]
+__all__ = ["subplots", "save", "colormap", "PRINT_WIDTH", "print_sizes"]
 
 _FIGURE_KEYS = ("figsize", "dpi", "layout")
+
+#: inches: the text width of a report page (letter paper, 2.2 cm margins) a figure is
+#: printed at; a figure drawn this wide is printed at its own size, its text as drawn
+PRINT_WIDTH = 6.7
+
+
+def print_sizes():
+    """An rc context for a figure drawn at :data:`PRINT_WIDTH`: text of 7 to 8 pt."""
+    import matplotlib
+
+    return matplotlib.rc_context(
+        {
+            "font.size": 8,
+            "axes.titlesize": 8,
+            "axes.labelsize": 8,
+            "xtick.labelsize": 7,
+            "ytick.labelsize": 7,
+            "legend.fontsize": 7,
+        }
+    )
 
 
 def subplots(nrows=1, ncols=1, **kwargs):

@@ -9,25 +9,55 @@ run made last year reads the same as today's.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
+from discovery.vibroimpact.verify.criteria import CRITERIA as _REGISTRY
+from discovery.vibroimpact.verify.criteria import definition
+
+from .lawtex import (
+    law_equation,
+    law_inline,
+    law_of,
+    prose,
+    term_tex,
+    ueda_equation,
+    ueda_term_tex,
+    unit_tex,
+)
 from .texenv import Tex, escape, num
 
-__all__ = ["context", "KINDS"]
+__all__ = ["context", "KINDS", "criterion_names"]
 
-CRITERIA = ("I0", "I1", "I2", "I3", "I4")
-CRITERION_MEANING = {
-    "I0": "relative L2 distance of the impulses",
-    "I1": "relative distance of the peak forces",
-    "I2": "relative L2 distance over the contact (the paper's main criterion)",
-    "I3": "relative distance of the contact times",
-    "I4": "relative distance of the transmitted momenta",
-}
+
+def criterion_names(*mappings):
+    """The criteria of the registry (its order) found in any of ``mappings``; a name the
+    registry does not hold (an edited summary) is not shown."""
+    return [k for k in _REGISTRY if any(isinstance(m, dict) and k in m for m in mappings)]
+
+
+def criterion_tex(name):
+    """``$I_{2}$`` for the paper's criteria, the name in typewriter for any other."""
+    name = str(name)
+    if re.fullmatch(r"I\d", name):
+        return Tex(f"$I_{{{name[1]}}}$")
+    return Tex(r"\texttt{" + escape(name) + "}")
+
+
+def criterion_definition(name):
+    """The registry's formula and meaning of a criterion, as one table cell."""
+    d = definition(name)
+    formula = f"${d.latex}$: " if d.latex else ""
+    return Tex(formula + escape(d.meaning or "--"))
+
+
 FIGURE_CAPTIONS = {
     "verify": "Measured force (black) and the law's simulated force (red), folded on the "
     "drive phase over the record's span.",
     "fit_impulse": "Measured impulse and the simulated steady states of the best models.",
-    "fit_surface": "The selected law over the (zeta, dzeta) plane with the contact samples.",
+    "fit_surface": Tex(
+        r"The selected law over the ($\zeta$, $\dot\zeta_+$) plane with the contact samples."
+    ),
     "fit_loop": "Loading and unloading branches, measured and modelled, for a few impacts.",
     "identification": "Identification: the path of the best law so far and the simulated "
     "force converging to the measured one.",
@@ -49,13 +79,19 @@ FIGURE_CAPTIONS = {
 }
 
 
-def _model_tex(latex):
-    return Tex(latex) if latex else Tex("--")
+# the certificate's domain bounds by their symbols
+_DOMAIN = {"zeta_max": Tex(r"$\zeta_{\max}$"), "zd_max": Tex(r"$\dot\zeta_{+,\max}$")}
+
+# figures drawn a page tall at the text width (their text 7-8 pt when printed)
+_TALL = ("explain", "discover", "landscape", "identification")
 
 
-def _rows_from(d, keys=None, fmt=num):
-    keys = list(d) if keys is None else [k for k in keys if k in d]
-    return [[Tex(r"\texttt{" + escape(k) + "}"), fmt(d[k])] for k in keys]
+def _model_tex(value, where):
+    """The equation of a law rebuilt from its text or coefficients (never read as LaTeX);
+    ``--`` when the summary has none."""
+    if value in (None, "", {}):
+        return Tex("--")
+    return law_equation(law_of(value, where))
 
 
 def _provenance(s, run_dir):
@@ -90,7 +126,7 @@ def _provenance(s, run_dir):
         for k, val in settings.items()
         if k not in ("command", "func", "out", "ueda_command") and val not in (None, False)
     }
-    rows.append(["settings", "; ".join(f"{k}={val}" for k, val in shown.items()) or "--"])
+    rows.append(["settings", prose("; ".join(f"{k}={val}" for k, val in shown.items()) or "--")])
     return rows
 
 
@@ -111,26 +147,38 @@ def _scenario_rows(sc):
     rows = [["name", sc.get("name", "--")]]
     for k, unit in units.items():
         if k in sc and not (k in ("k3", "mass_loss") and not sc[k]):
-            rows.append([k, Tex(num(sc[k]) + r"\ " + escape(unit))])
+            rows.append([k, Tex(num(sc[k]) + r"\ " + unit_tex(unit))])
     if sc.get("law"):
-        rows.append(["reference law", Tex(r"\texttt{" + escape(sc["law"]) + "}")])
+        rows.append(["reference law", law_inline(law_of(sc["law"], "scenario.law"))])
+    return rows
+
+
+def _scenarios_table(scenarios):
+    """Every scenario of a run side by side: one column per scenario."""
+    scs = [sc for sc in scenarios if isinstance(sc, dict)]
+    if not scs:
+        return None
+    per = [_scenario_rows(sc) for sc in scs]
+    labels = [r[0] for r in per[0]]
+    rows = []
+    for i, label in enumerate(labels):
+        rows.append([label, *(p[i][1] if i < len(p) and p[i][0] == label else "--" for p in per)])
     return rows
 
 
 def _criteria_table(criteria, floor, limits=None):
-    """Rows: criterion, value, noise floor, limit (when judged), its meaning."""
+    """Rows: criterion, value, noise floor, limit (when judged: ``--`` for a criterion the
+    consistency rule does not judge), its formula and meaning (the criteria registry)."""
     rows = []
-    for k in CRITERIA:
-        if k not in (criteria or {}):
-            continue
+    for k in criterion_names(criteria):
         lim = (limits or {}).get(k)
         rows.append(
             [
-                Tex(f"$I_{k[1]}$"),
+                criterion_tex(k),
                 num(criteria[k]),
                 num((floor or {}).get(k)),
                 num(lim) if lim is not None else Tex("--"),
-                CRITERION_MEANING[k],
+                criterion_definition(k),
             ]
         )
     return rows
@@ -165,6 +213,8 @@ def _figures(run_dir, order):
                 {
                     "file": p.name,
                     "caption": FIGURE_CAPTIONS.get(p.stem, FIGURE_CAPTIONS.get(base, p.stem)),
+                    # a figure drawn a page tall (explain's four panels) is printed so
+                    "height": Tex("0.75" if base in _TALL else "0.55"),
                 }
             )
     seen, out = set(), []
@@ -184,13 +234,13 @@ def _intervals(entry):
     return iv.get("bounds", iv) if isinstance(iv, dict) else {}
 
 
-def _coef_rows(coefs, errors=None, intervals=None, start=None):
+def _coef_rows(coefs, errors=None, intervals=None, start=None, term=term_tex):
     rows = []
     for k, v in coefs.items():
         lo_hi = (intervals or {}).get(k)
         rows.append(
             [
-                Tex(r"\texttt{" + escape(k) + "}"),
+                term(k),
                 num(v, 4),
                 num((errors or {}).get(k), 2),
                 Tex(f"[{num(lo_hi[0], 4)}, {num(lo_hi[1], 4)}]") if lo_hi else Tex("--"),
@@ -204,11 +254,11 @@ def _coef_rows(coefs, errors=None, intervals=None, start=None):
 def _verify(s, run_dir):
     c = {
         "title": "Verification of a contact law against a record",
-        "law": Tex(r"\texttt{" + escape(s.get("law", "")) + "}"),
+        "law": _model_tex(s.get("law"), "law"),
         "data": s.get("data"),
         "measured": _measured_rows(s.get("measured")),
         "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
-        "verdict": s.get("verdict") or s.get("message") or "--",
+        "verdict": prose(s.get("verdict") or s.get("message") or "--"),
         "consistent": bool(s.get("consistent")),
         "regime": s.get("regime") or {},
         "impacts": s.get("impacts") or {},
@@ -247,13 +297,18 @@ def _verify(s, run_dir):
         )
     if _transient(s.get("verdict")):
         concl.append(
-            "The record is not yet steady under this law: it was compared with the "
-            "law's own trajectory from the measured state, block by block, not with "
-            "its steady orbit."
+            "The law's simulation from the measured state is not yet steady over the "
+            "record's span: the record was compared with that trajectory, block by block, "
+            "not with the law's steady orbit."
         )
-    c["conclusions"] = concl
+    c["conclusions"] = [prose(x) for x in concl]
     c["figures"] = _figures(run_dir, ["verify"])
     return c
+
+
+def _terms_tex(terms):
+    """Term names as math, comma separated."""
+    return Tex(", ".join(term_tex(t) for t in terms))
 
 
 def _selected_conclusions(s):
@@ -261,26 +316,61 @@ def _selected_conclusions(s):
     concl = []
     terms = sel.get("terms") or list((sel.get("coefficients") or {}).keys())
     lib = (s.get("fit_settings") or {}).get("library", "?")
-    state = "consistent" if sel.get("consistent") else "NOT consistent"
-    concl.append(
-        f"From the library {lib}, the data support the terms {', '.join(terms)}: "
-        f"the selected law is {state}"
-        " with the record by full simulation."
-    )
+    n_rec = len(s.get("records") or []) or 1
+    records = "the record" if n_rec == 1 else f"all {n_rec} records"
+    if sel.get("consistent"):
+        concl.append(
+            Tex(
+                f"From the library \\texttt{{{escape(lib)}}}, the data support the terms "
+                f"{_terms_tex(terms)}: the selected law is consistent with {records} by "
+                "full simulation."
+            )
+        )
+    else:
+        concl.append(
+            Tex(
+                f"From the library \\texttt{{{escape(lib)}}}, the best-supported terms are "
+                f"{_terms_tex(terms)}, but no model of the library is consistent with "
+                f"{records} by full simulation: the record holds an effect these "
+                "polynomials do not describe (or the scenario is wrong). "
+                "\\texttt{vidi explain} names the missing effect."
+            )
+        )
     eq = s.get("equivalent") or []
     if eq:
-        names = "; ".join(", ".join(e.get("terms") or e.get("coefficients", {}).keys()) for e in eq)
         concl.append(
-            f"{len(eq)} other model(s) fit the record as well within its noise "
-            f"({names}). They cannot be told apart from this record; a second "
-            "operating point (another drive amplitude or frequency) or lower noise "
-            "would separate them (see each model's reason below)."
+            Tex(
+                f"{len(eq)} other model(s) fit the record as well within its noise (listed "
+                "under Selection). They cannot be told apart from this record; a second "
+                "operating point (another drive amplitude or frequency) or lower noise "
+                "would separate them."
+            )
         )
-    for w in s.get("warnings") or []:
-        concl.append(f"Warning: {w}")
+    if s.get("warnings"):
+        concl.append(Tex(f"The run gave {len(s['warnings'])} warning(s); see Notes from the run."))
     if sel.get("contact_defects"):
-        concl.append("The selected law has contact defects: " + "; ".join(sel["contact_defects"]))
+        concl.append(
+            prose("The selected law has contact defects: " + "; ".join(sel["contact_defects"]))
+        )
     return concl
+
+
+def _record_checks(sel, records):
+    """Each record's own check of the selected law: criteria, floors, limits, full verdict."""
+    out = []
+    for i, ev in enumerate(sel.get("records") or []):
+        rec = records[i] if i < len(records) and isinstance(records[i], dict) else {}
+        out.append(
+            {
+                "name": f"Record {i + 1}: {rec.get('data', '--')} (scenario "
+                f"{rec.get('scenario', '--')})",
+                "criteria": _criteria_table(
+                    ev.get("criteria"), ev.get("noise_floor"), ev.get("limits")
+                ),
+                "verdict": prose(ev.get("verdict") or ev.get("message") or "--"),
+            }
+        )
+    return out
 
 
 def _fit(s, run_dir):
@@ -289,19 +379,20 @@ def _fit(s, run_dir):
     cert = s.get("certificate") or {}
     c = {
         "title": "Discovery of a contact law",
-        "model": _model_tex(sel.get("latex")),
+        "model": _model_tex(sel.get("coefficients"), "selected.coefficients"),
         "coefficients": _coef_rows(
             sel.get("coefficients") or {}, sel.get("standard_errors"), _intervals(sel)
         ),
         "interval_method": sel.get("interval_method") or "no bootstrap intervals",
-        "criteria": _criteria_table(sel.get("criteria"), sel.get("noise_floor")),
-        "verdict": sel.get("verdict") or "--",
+        "criteria": _criteria_table(sel.get("criteria"), sel.get("noise_floor"), sel.get("limits")),
+        "record_checks": _record_checks(sel, s.get("records") or []),
+        "verdict": prose(sel.get("verdict") or "--"),
         "regime": sel.get("regime", "--"),
         "refinement": sel.get("refinement", "--"),
         "library": fs.get("library", "--"),
         "selection": fs.get("selection", "--"),
         "scoring": fs.get("scoring", "--"),
-        "criterion": fs.get("criterion", "I2"),
+        "criterion": criterion_tex(fs.get("criterion", "I2")),
         "records": [
             [
                 r.get("data", "--"),
@@ -318,7 +409,7 @@ def _fit(s, run_dir):
             "holds": bool(cert.get("holds")),
             "worst": num(cert.get("worst_violation")),
             "domain": {
-                k: num(v)
+                _DOMAIN.get(k, k): num(v)
                 for k, v in (cert.get("domain") or {}).items()
                 if isinstance(v, int | float)
             },
@@ -335,7 +426,7 @@ def _fit(s, run_dir):
         "ranking": [
             [
                 str(i + 1),
-                ", ".join(m.get("terms") or []),
+                _terms_tex(m.get("terms") or []),
                 m.get("regime", "--"),
                 num(m.get("bic"), 6),
                 num((m.get("criteria") or {}).get(fs.get("criterion", "I2"))),
@@ -345,13 +436,14 @@ def _fit(s, run_dir):
         ],
         "equivalent": [
             {
-                "model": _model_tex(e.get("latex")),
-                "reason": e.get("reason", ""),
-                "separate": e.get("separate", ""),
+                "model": _model_tex(e.get("law") or e.get("coefficients"), f"equivalent[{i}].law"),
+                "reason": prose(e.get("reason", "")),
+                "separate": prose(e.get("separate", "")),
             }
-            for e in s.get("equivalent") or []
+            for i, e in enumerate(s.get("equivalent") or [])
         ],
-        "warnings": list(s.get("warnings") or []),
+        "warnings": [prose(w) for w in s.get("warnings") or []],
+        "scenarios": _scenarios_table(s.get("scenarios") or [s.get("scenario")]),
     }
     c["conclusions"] = _selected_conclusions(s)
     c["figures"] = _figures(run_dir, ["fit_impulse", "fit_surface", "fit_loop"])
@@ -361,7 +453,7 @@ def _fit(s, run_dir):
 def _identify(s, run_dir):
     c = {
         "title": "Identification of a contact law by simulation",
-        "model": _model_tex(s.get("latex")),
+        "model": _model_tex(s.get("law") or s.get("coefficients"), "law"),
         "coefficients": _coef_rows(
             s.get("coefficients") or {},
             s.get("standard_errors"),
@@ -369,12 +461,12 @@ def _identify(s, run_dir):
             start=s.get("start") or {},
         ),
         "measured": _measured_rows(s.get("measured")),
-        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor")),
-        "verdict": s.get("verdict") or "--",
+        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
+        "verdict": prose(s.get("verdict") or "--"),
         "method": s.get("method", "--"),
-        "criterion": s.get("criterion", "I2"),
+        "criterion": criterion_tex(s.get("criterion", "I2")),
         "n_simulations": s.get("n_simulations", "--"),
-        "message": s.get("message", ""),
+        "message": prose(s.get("message", "")),
     }
     concl = [
         f"{s.get('method', '?')} spent {s.get('n_simulations', '?')} simulations; the "
@@ -387,7 +479,7 @@ def _identify(s, run_dir):
             "effect (run `vidi explain`) or a local minimum: start nearer (the "
             "coefficients of `vidi fit`), or look at the landscape."
         )
-    c["conclusions"] = concl
+    c["conclusions"] = [prose(x) for x in concl]
     c["figures"] = _figures(run_dir, ["identification"])
     return c
 
@@ -397,12 +489,12 @@ def _landscape(s, run_dir):
     mins = s.get("minima") or {}
     c = {
         "title": "Criteria landscape over two coefficients",
-        "terms": terms,
-        "law": s.get("law", "--"),
+        "terms": [term_tex(t) for t in terms[:2]],
+        "law": law_inline(law_of(s["law"], "law")) if s.get("law") else Tex("--"),
         "grid": "x".join(str(g) for g in s.get("grid") or []),
         "minima": [
             [
-                Tex(f"$I_{k[1]}$"),
+                criterion_tex(k),
                 num(m.get("alpha1")),
                 num(m.get("alpha2")),
                 num(m.get("value")),
@@ -411,7 +503,9 @@ def _landscape(s, run_dir):
             ]
             for k, m in mins.items()
         ],
-        "noise_floor": _rows_from(s.get("noise_floor") or {}),
+        "noise_floor": [
+            [criterion_tex(k), num(v)] for k, v in (s.get("noise_floor") or {}).items()
+        ],
         "n_consistent": s.get("n_consistent", 0),
         "regimes": ", ".join(f"{k}: {v}" for k, v in (s.get("regimes") or {}).items()),
         "reference": (s.get("reference") or {}).get("source", "--"),
@@ -434,26 +528,25 @@ def _explain(s, run_dir):
     its = s.get("iterations") or []
     c = {
         "title": "The missing physical effect",
-        "model": _model_tex(fm.get("latex")),
+        "model": _model_tex(fm.get("text") or fm.get("coefficients"), "final_model.text"),
         "coefficients": _coef_rows(
-            {
-                **(fm.get("coefficients") or {}),
-                **{f"d_{k}": v for k, v in (fm.get("unloading") or {}).items()},
-            },
-            fm.get("uncertainties"),
-            _intervals(fm),
-        ),
-        "effects": list(fm.get("effects") or []),
-        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor")),
-        "stopped": s.get("stopped_because", "--"),
+            fm.get("coefficients") or {}, fm.get("uncertainties"), _intervals(fm)
+        )
+        + [
+            [Tex("unloading " + term_tex(k, unloading=True)), num(v, 4), Tex("--"), Tex("--")]
+            for k, v in (fm.get("unloading") or {}).items()
+        ],
+        "effects": [str(e).replace("_", " ") for e in fm.get("effects") or []],
+        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
+        "stopped": prose(s.get("stopped_because", "--")),
         "iterations": [
             [
                 str(k + 1),
-                it.get("effect") or "nothing named",
+                str(it.get("effect") or "nothing named").replace("_", " "),
                 num((it.get("criteria_before") or {}).get("I2")),
                 num((it.get("criteria_after") or {}).get("I2")),
                 num((it.get("noise_floor") or {}).get("I2")),
-                it.get("evidence", ""),
+                prose(it.get("evidence", "")),
             ]
             for k, it in enumerate(its)
         ],
@@ -470,7 +563,7 @@ def _explain(s, run_dir):
     }
     named_its = [it for it in its if it.get("effect")]
     if named_its:
-        named = ", ".join(it["effect"] for it in named_its)
+        named = ", ".join(str(it["effect"]).replace("_", " ") for it in named_its)
         state = "consistent" if s.get("consistent") else "still NOT consistent"
         concl = [
             f"Named and added: {named}. The gap to the record shrank as the table shows; "
@@ -481,7 +574,7 @@ def _explain(s, run_dir):
             "No effect was added: "
             + str(s.get("stopped_because", "the start model already agrees with the record"))
         ]
-    c["conclusions"] = concl
+    c["conclusions"] = [prose(x) for x in concl]
     c["figures"] = _figures(run_dir, ["explain", "localise", "screen", "drift"])
     return c
 
@@ -496,18 +589,21 @@ def _ueda(s, run_dir):
             rows.append(
                 [
                     key.replace("_", " "),
-                    ", ".join(map(str, val))
+                    prose(", ".join(map(str, val)))
                     if isinstance(val, list)
                     else (
-                        "; ".join(f"{k}={v}" for k, v in val.items())
+                        prose("; ".join(f"{k}={v}" for k, v in val.items()))
                         if isinstance(val, dict)
-                        else (num(val) if isinstance(val, float) else val)
+                        else (num(val) if isinstance(val, float) else prose(val))
                     ),
                 ]
             )
     c["facts"] = rows
-    c["model"] = _model_tex(s.get("latex") or (s.get("final") or {}).get("latex"))
-    c["coefficients"] = _coef_rows(s.get("coefficients") or {}, s.get("standard_errors"))
+    coefs = s.get("coefficients") or (s.get("final_model") or {}).get("coefficients")
+    c["model"] = ueda_equation(coefs) if coefs else Tex("--")
+    c["coefficients"] = _coef_rows(
+        s.get("coefficients") or {}, s.get("standard_errors"), term=ueda_term_tex
+    )
     ver = s.get("verification") or {}
     c["verification"] = [
         [k.replace("_", " "), num(v) if isinstance(v, int | float) else v]
@@ -539,7 +635,7 @@ def _ueda(s, run_dir):
             for k, v in (s.get("gap") or {}).items()
             if isinstance(v, dict)
         )
-        added = ", ".join(s["effects_added"]) or "none"
+        added = ", ".join(str(e).replace("_", " ") for e in s["effects_added"]) or "none"
         concl.append(
             f"Effects named and added: {added}; the gap: {gaps}. The final model is "
             f"{'consistent' if s.get('consistent') else 'NOT consistent'} with the "
@@ -547,14 +643,16 @@ def _ueda(s, run_dir):
         )
         final = s.get("final_model") or {}
         if final.get("coefficients"):
-            c["coefficients"] = _coef_rows(final["coefficients"], final.get("standard_errors"))
+            c["coefficients"] = _coef_rows(
+                final["coefficients"], final.get("standard_errors"), term=ueda_term_tex
+            )
     if "lyapunov" in s and isinstance(s["lyapunov"], dict):
         L = s["lyapunov"]
         concl.append(
             f"Largest Lyapunov exponent {L.get('value', float('nan')):.4g} per unit "
             "time: " + ("chaotic." if L.get("value", 0) > 0.01 else "not chaotic.")
         )
-    c["conclusions"] = concl or ["See the tables and figures."]
+    c["conclusions"] = [prose(x) for x in concl] or ["See the tables and figures."]
     c["figures"] = _figures(run_dir, ["discover", "explain", "attractor", "basins", "chart"])
     return c
 
@@ -577,11 +675,11 @@ def _study(s, run_dir):
     c = {
         "title": "Model-term selection study" + (f": {s['name']}" if s.get("name") else ""),
         "design": [
-            [Tex(r"\texttt{" + escape(k) + "}"), ", ".join(map(str, v))]
+            [Tex(r"\texttt{" + escape(k) + "}"), prose(", ".join(map(str, v)))]
             for k, v in (d.get("varied") or {}).items()
         ]
         + [
-            [Tex(r"\texttt{" + escape(k) + "}"), f"{v} (fixed)"]
+            [Tex(r"\texttt{" + escape(k) + "}"), prose(f"{v} (fixed)")]
             for k, v in (d.get("fixed") or {}).items()
         ]
         + [
@@ -610,7 +708,7 @@ def _study(s, run_dir):
         ],
         "cells": [
             [
-                *(str(row.get(f, "")) for f in varied),
+                *(prose(str(row.get(f, ""))) for f in varied),
                 _frac(
                     row["recovered"],
                     row["runs"],
@@ -648,6 +746,11 @@ def _study(s, run_dir):
                     f"{m}: the 95 % intervals held the truth in {share:.0%} of "
                     f"{p['intervals']} cases ({lo:.2f}--{hi:.2f}), {verdict}."
                 )
+    if pooled and not any(p.get("intervals") for p in pooled.values()):
+        concl.append(
+            "No run has coefficient intervals (they come from the refinement by "
+            "simulation: set refine = [true]), so there is no coverage chart."
+        )
     concl.append(
         "Records were made by the independent scipy path from rest; no selection "
         "used the truth (no oracle settings)."

@@ -14,9 +14,12 @@ import contextlib
 import json
 import os
 import re
+import secrets
 import shutil
+import signal
+import stat
 import subprocess
-import tempfile
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -95,30 +98,61 @@ def _load(run_dir):
     return summary
 
 
-def render(summary, run_dir, snippet=None, template=None):
+def render(summary, run_dir, snippet=None, template=None, skipped=None):
     """The report's LaTeX text (or one snippet's) from a summary and its run directory;
-    ``template`` names another document of the run (``"model"``: the fit's model.tex)."""
-    from discovery.errors import InputError
+    ``template`` names another document of the run (``"model"``: the fit's model.tex).
 
-    ctx = context(summary, run_dir)
-    ctx["figures"] = [
-        dict(f, file=Tex(f["file"])) for f in ctx["figures"] if _SAFE_FILE.match(f["file"])
-    ]
-    ctx["created"] = summary.get("created", "")
-    env = environment()
-    if template is not None:
-        return env.get_template(f"{template}.tex.j2").render(**ctx)
-    if snippet is None:
-        return env.get_template(ctx["template"]).render(**ctx)
-    if snippet not in SNIPPETS:
-        raise InputError(f"unknown snippet {snippet!r}; choose one of {', '.join(SNIPPETS)}")
-    if snippet == "model" and ctx.get("model") in (None, "--"):
+    Every field of the summary is read as text: a law is rebuilt from its own text by the
+    law grammar, every other string is escaped. A field of the wrong type (an edited
+    summary) is one :class:`~discovery.errors.InputError`. A figure that is a link or not a
+    plain file of the run directory is left out (its name appended to ``skipped``).
+    """
+    import jinja2
+
+    from discovery.errors import InputError, VidiError
+
+    try:
+        ctx = context(summary, run_dir)
+        figures = []
+        for f in ctx["figures"]:
+            if _safe_figure(run_dir, f["file"]) is not None:
+                figures.append(dict(f, file=Tex(f["file"])))
+            elif skipped is not None:
+                skipped.append(f["file"])
+        ctx["figures"] = figures
+        ctx["created"] = summary.get("created", "")
+        env = environment()
+        if template is not None:
+            return env.get_template(f"{template}.tex.j2").render(**ctx)
+        if snippet is None:
+            return env.get_template(ctx["template"]).render(**ctx)
+        if snippet not in SNIPPETS:
+            raise InputError(f"unknown snippet {snippet!r}; choose one of {', '.join(SNIPPETS)}")
+        if snippet == "model" and ctx.get("model") in (None, "--"):
+            raise InputError(
+                f"a {ctx['kind']} run has no model to paste; use --snippet criteria, table "
+                "or figure"
+            )
+        if snippet == "figure" and not ctx["figures"]:
+            raise InputError(f"the {ctx['kind']} run wrote no PDF figure to paste")
+        return env.get_template("snippets.tex.j2").render(snippet=snippet, **ctx)
+    except VidiError:
+        raise
+    except (
+        TypeError,
+        AttributeError,
+        KeyError,
+        ValueError,
+        IndexError,
+        OverflowError,
+        jinja2.TemplateError,
+    ) as exc:
+        where = Path(run_dir) / "summary.json"
+        why = " ".join(str(exc).split())[:120]
         raise InputError(
-            f"a {ctx['kind']} run has no model to paste; use --snippet criteria, table or figure"
-        )
-    if snippet == "figure" and not ctx["figures"]:
-        raise InputError(f"the {ctx['kind']} run wrote no PDF figure to paste")
-    return env.get_template("snippets.tex.j2").render(snippet=snippet, **ctx)
+            f"{str(where)!r} has a field of the wrong type or a missing one "
+            f"({type(exc).__name__}: {why}); run the command again to rewrite it"
+        ) from None
 
 
 def _first_error(log_text):
@@ -139,12 +173,130 @@ def _pages(pdf):
     return int(m.group(1)) if m else None
 
 
-def compile_tex(tex_path, figures=(), timeout=300):
+_STAGE = re.compile(r"^\.vidi-tex-(?P<pid>\d+)-(?P<start>\d+)\.[0-9a-f]+$")
+
+
+def _stage_dir(parent):
+    """A private staging directory ``.vidi-tex-PID-START.TOKEN`` in ``parent`` (the PID and
+    its start time name the run that owns it); stale ones of killed runs are removed first."""
+    from discovery._io import _proc_start
+
+    clean_stale_staging(parent)
+    pid = os.getpid()
+    d = Path(parent) / f".vidi-tex-{pid}-{_proc_start(pid)}.{secrets.token_hex(4)}"
+    d.mkdir(mode=0o700)
+    return d
+
+
+def clean_stale_staging(parent):
+    """Remove the ``.vidi-tex-*`` staging directories in ``parent`` whose run is gone (a
+    report killed with SIGKILL, or a machine that lost power); returns what was removed."""
+    from discovery._io import _alive
+
+    gone = []
+    try:
+        entries = list(os.scandir(parent))
+    except OSError:
+        return gone
+    for e in entries:
+        m = _STAGE.match(e.name)
+        if m and e.is_dir(follow_symlinks=False) and not _alive(int(m["pid"]), int(m["start"])):
+            shutil.rmtree(e.path, ignore_errors=True)
+            gone.append(Path(e.path))
+    return gone
+
+
+def _safe_figure(parent, name):
+    """``parent/name`` when it is a plain file inside ``parent`` (no link, no path), else
+    None: a figure replaced by a link to a file elsewhere is never read into the PDF."""
+    if not _SAFE_FILE.match(name):
+        return None
+    src = Path(parent) / name
+    try:
+        st = os.lstat(src)
+    except OSError:
+        return None
+    return src if stat.S_ISREG(st.st_mode) else None
+
+
+def _kill_group(proc):
+    """End latexmk and every child it started (its own process group)."""
+    with contextlib.suppress(OSError):
+        os.killpg(proc.pid, signal.SIGKILL)
+    with contextlib.suppress(OSError, subprocess.TimeoutExpired):
+        proc.wait(timeout=10)
+
+
+_PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent():
+    """In the child, before exec: SIGTERM when the parent (vidi) dies, even by SIGKILL
+    (Linux); ``timeout`` passes it on to latexmk's whole group."""
+    import ctypes
+    import ctypes.util
+
+    with contextlib.suppress(OSError, AttributeError):
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or None, use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0)
+
+
+def _run_latexmk(cmd, cwd, env, timeout):
+    """Run latexmk in its own session (process group); on a timeout, an interrupt or any
+    error the whole group is killed, so no pdflatex outlives the report. Under coreutils'
+    ``timeout`` (when installed) the group also ends by itself a little after ``timeout``
+    and when vidi is killed outright. Returns ``(returncode, output)`` or raises
+    :class:`subprocess.TimeoutExpired`."""
+    if shutil.which("timeout") is not None:
+        cmd = ["timeout", "-s", "KILL", str(int(timeout) + 10), *cmd]
+    proc = subprocess.Popen(
+        cmd,
+        preexec_fn=_die_with_parent if os.name == "posix" else None,
+        cwd=cwd,
+        env=env,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        errors="replace",
+        start_new_session=True,
+    )
+    old = None
+    if threading.current_thread() is threading.main_thread():
+        # outside the CLI SIGTERM would end Python at once and leave the group running:
+        # for the compilation it ends the group first, then Python as before
+        with contextlib.suppress(ValueError, OSError):
+            if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
+
+                def _term(signum, frame):
+                    _kill_group(proc)
+                    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+                    os.kill(os.getpid(), signal.SIGTERM)
+
+                old = signal.signal(signal.SIGTERM, _term)
+    try:
+        out, _ = proc.communicate(timeout=timeout)
+        return proc.returncode, out or ""
+    finally:
+        if proc.returncode is None or proc.poll() is None:
+            _kill_group(proc)
+        else:
+            with contextlib.suppress(OSError):  # a child latexmk left behind, if any
+                os.killpg(proc.pid, signal.SIGKILL)
+        if old is not None:
+            with contextlib.suppress(ValueError, OSError):
+                signal.signal(signal.SIGTERM, old)
+
+
+def compile_tex(tex_path, figures=(), timeout=300, staged=None):
     """Compile ``tex_path`` (with the figure files beside it) in a private directory.
 
     Returns ``(pdf_path or None, message)``. The PDF replaces ``NAME.pdf`` beside the source
     only when the compilation succeeded; on failure ``NAME.log`` is kept beside it and the
-    message names the first TeX error.
+    message names the first TeX error. latexmk and its children run in their own process
+    group, killed together on a timeout, Ctrl-C or SIGTERM. A figure that is a link (or not
+    a plain file in the source's directory) is left out, and the message says so.
+    ``staged``: a staging directory that already holds the source (see :func:`report`).
     """
     tex = Path(tex_path)
     if shutil.which("latexmk") is None or shutil.which("pdflatex") is None:
@@ -153,13 +305,23 @@ def compile_tex(tex_path, figures=(), timeout=300):
             f"TeX Live: apt-get install {TEX_PACKAGES}"
         )
     env = dict(os.environ, openin_any="p", openout_any="p", shell_escape="f", TEXMFOUTPUT="")
-    with tempfile.TemporaryDirectory(prefix=".vidi-tex-", dir=tex.parent) as work:
-        w = Path(work)
-        shutil.copy2(tex, w / tex.name)
+    own = staged is None
+    w = _stage_dir(tex.parent) if own else Path(staged)
+    try:
+        if own:
+            shutil.copyfile(tex, w / tex.name)
+        skipped = []
         for f in figures:
-            src = tex.parent / f
-            if src.is_file():
-                shutil.copy2(src, w / f)
+            src = _safe_figure(tex.parent, f)
+            if src is None:
+                skipped.append(f)
+            else:
+                shutil.copyfile(src, w / f, follow_symlinks=False)
+        if skipped:
+            return None, (
+                f"no PDF: figure(s) {', '.join(skipped)} are links or not plain files in "
+                f"{tex.parent}; they are not read (run the command again to redraw them)"
+            )
         cmd = [
             "latexmk",
             "-pdf",
@@ -170,39 +332,55 @@ def compile_tex(tex_path, figures=(), timeout=300):
             tex.name,
         ]
         try:
-            run = subprocess.run(
-                cmd, cwd=w, capture_output=True, text=True, timeout=timeout, env=env
-            )
+            code, output = _run_latexmk(cmd, w, env, timeout)
         except subprocess.TimeoutExpired:
             return None, f"no PDF: latexmk took more than {timeout} s; the source is {tex}"
         pdf = w / tex.with_suffix(".pdf").name
         log = w / tex.with_suffix(".log").name
-        if run.returncode != 0 or not pdf.is_file():
-            text = log.read_text(errors="replace") if log.is_file() else run.stdout + run.stderr
+        if code != 0 or not pdf.is_file():
+            text = log.read_text(errors="replace") if log.is_file() else output
             kept = tex.with_suffix(".log")
             with contextlib.suppress(OSError):
-                shutil.copy2(log, kept)
+                shutil.copyfile(log, kept)
             return None, (f"no PDF: LaTeX failed ({_first_error(text)}); the log is {kept}")
         dest = tex.with_suffix(".pdf")
-        tmp = dest.with_name(f".{dest.name}.tmp")
-        shutil.copy2(pdf, tmp)
-        os.replace(tmp, dest)
+        if own:
+            os.replace(pdf, dest)
+        else:
+            dest = pdf  # the caller moves it into place
+    finally:
+        if own:
+            shutil.rmtree(w, ignore_errors=True)
     with contextlib.suppress(OSError):
         tex.with_suffix(".log").unlink()  # a log of an earlier failure is stale now
     return dest, f"wrote {dest}"
 
 
+def _manifest(run_dir):
+    """``(manifest dict or None, the names it lists)``: only a JSON object's list of plain
+    names counts (a manifest edited to hold ``"files": 5``, a string or paths lists none)."""
+    from discovery._io import MANIFEST
+
+    try:
+        man = json.loads((Path(run_dir) / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None, set()
+    if not isinstance(man, dict):
+        return None, set()
+    files = man.get("files")
+    names = {
+        f for f in (files if isinstance(files, list) else []) if isinstance(f, str) and "/" not in f
+    }
+    return man, names
+
+
 def _check_ours(run_dir, names):
     """Refuse, before writing, to replace a file of these names that vidi did not write
     (not in the run's manifest): a user's own ``report.tex`` is never overwritten."""
-    from discovery._io import MANIFEST
     from discovery.errors import InputError
 
     d = Path(run_dir)
-    try:
-        listed = set(json.loads((d / MANIFEST).read_text(encoding="utf-8")).get("files") or [])
-    except (OSError, ValueError, AttributeError):
-        listed = set()
+    listed = _manifest(d)[1]
     for name in names:
         p = d / name
         if os.path.lexists(p) and (name not in listed or p.is_symlink() or not p.is_file()):
@@ -218,11 +396,9 @@ def _record_in_manifest(run_dir, names):
     from discovery._io import MANIFEST, atomic_write_text
 
     p = Path(run_dir) / MANIFEST
-    try:
-        man = json.loads(p.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    man, files = _manifest(run_dir)
+    if man is None:
         return
-    files = set(man.get("files") or [])
     files.update(names)
     man["files"] = sorted(files)
     atomic_write_text(p, json.dumps(man, indent=2) + "\n")
@@ -246,27 +422,49 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300):
     Returns
     -------
     Report
+
+    The report's names are entered in the run's manifest before any of them is written,
+    and the source and PDF are made in a staging directory and moved into place when
+    done: a report interrupted (or out of space) leaves nothing that blocks the next one,
+    and the staging directory of a killed report is removed by the next.
     """
     from discovery._io import atomic_write_text
 
     summary = _load(run_dir)
-    text = render(summary, run_dir, snippet)
+    skipped = []
+    text = render(summary, run_dir, snippet, skipped=skipped)
     d = Path(run_dir)
     name = "report.tex" if snippet is None else f"snippet-{snippet}.tex"
-    _check_ours(
-        d, [name] if snippet is not None or not compile else [name, "report.pdf", "report.log"]
-    )
+    names = [name] if snippet is not None or not compile else [name, "report.pdf", "report.log"]
+    _check_ours(d, names)
+    _record_in_manifest(d, names)  # claimed first: a killed report leaves vidi's names only
+    clean_stale_staging(d)
     tex = d / name
-    atomic_write_text(tex, text)
     ctx_figs = re.findall(r"\\includegraphics(?:\[[^\]]*\])?\{([^}]+)\}", text)
-    written = [name]
+    note = (
+        f"; left out figure(s) {', '.join(skipped)}: links or not plain files (not read)"
+        if skipped
+        else ""
+    )
     if snippet is not None or not compile:
-        _record_in_manifest(d, written)
-        return Report(tex, None, f"wrote {tex}", summary["command"], None, ctx_figs)
-    pdf, message = compile_tex(tex, ctx_figs, timeout=timeout)
-    if pdf is not None:
-        written.append(pdf.name)
-    _record_in_manifest(d, written)
+        atomic_write_text(tex, text)
+        return Report(tex, None, f"wrote {tex}{note}", summary["command"], None, ctx_figs)
+    w = _stage_dir(d)
+    try:
+        (w / name).write_text(text, encoding="utf-8")
+        pdf, message = compile_tex(tex, ctx_figs, timeout=timeout, staged=w)
+        os.replace(w / name, tex)
+        if pdf is not None:
+            dest = d / "report.pdf"
+            os.replace(pdf, dest)
+            pdf, message = dest, f"wrote {dest}"
+    finally:
+        shutil.rmtree(w, ignore_errors=True)
     return Report(
-        tex, pdf, message, summary["command"], _pages(pdf) if pdf is not None else None, ctx_figs
+        tex,
+        pdf,
+        message + note,
+        summary["command"],
+        _pages(pdf) if pdf is not None else None,
+        ctx_figs,
     )

@@ -30,6 +30,7 @@ _SPECIAL = {
     "}": r"\}",
     "^": r"\textasciicircum{}",
     "~": r"\textasciitilde{}",
+    "`": r"\textasciigrave{}",
     "<": r"\textless{}",
     ">": r"\textgreater{}",
     "\n": " ",

@@ -91,10 +91,14 @@ def test_model_tex_names_the_law(fitted):
     _, out = fitted
     tex = (out / "model.tex").read_text()
     sel = json.loads((out / "summary.json").read_text())["selected"]
-    assert sel["latex"] in tex  # the fitted law's formula
+    from discovery.vibroimpact.model.law import ForceLaw
+    from reports.lawtex import law_equation, term_tex
+
+    # the fitted law's equation, rebuilt from its coefficients (never read as LaTeX)
+    assert law_equation(ForceLaw.from_dict(sel["coefficients"])) in tex
     for name, value in sel["coefficients"].items():  # one table row per fitted term
         mant, exp = f"{value:.3e}".split("e")
-        assert rf"\texttt{{{name}}} & ${mant}\cdot 10^{{{int(exp)}}}$" in tex, name
+        assert rf"{term_tex(name)} & ${mant}\cdot 10^{{{int(exp)}}}$" in tex, name
 
 
 @pytest.mark.slow  # a second full fit, scored by cross-validation: about 1 min

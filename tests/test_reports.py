@@ -8,6 +8,7 @@ path. Where TeX is not installed the PDF tests are skipped, except when
 
 import json
 import os
+import re
 import shutil
 import subprocess
 
@@ -127,6 +128,19 @@ def runs(tmp_path_factory):
         }
         for kind, argv in cmds.items():
             assert main([*argv, "--out", kind]) == 0, kind
+        # a fit over two scenarios (two drive amplitudes), each with its record
+        low = d / "low.toml"
+        low.write_text(scen.read_text().replace("A = 5.0e5", "A = 3.5e5").replace("100% #1", "low"))
+        assert (
+            main(
+                ["simulate", "--scenario", str(low), "--periods", "12", "--noise", "0.01"]
+                + ["--seed", "3", "--out", "low.csv"]
+            )
+            == 0
+        )
+        fit2 = ["fit", "--scenario", str(scen), "--scenario", str(low), "--data", rec]
+        fit2 += ["--data", "low.csv", "--no-refine", "--intervals", "0", "--out", "fit2"]
+        assert main(fit2) == 0
         assert main(["ueda", "simulate", "--periods", "120", "--out", "U.csv"]) == 0
         assert (
             main(
@@ -215,15 +229,20 @@ def test_the_fit_report_is_at_least_three_pages_with_model_criteria_figures(runs
     text = _text(r.pdf)
     for needle in (
         "Conclusions",
-        "data support the terms",
+        "From the library",
         "criterion",
         "I2",
         "Library, constraints and certificate",
         "Figures",
     ):
         assert needle in text, needle
+    # the law is rebuilt from its coefficients by the law grammar, never read as LaTeX
+    from discovery.vibroimpact.model.law import ForceLaw
+    from reports.lawtex import law_equation
+
     s = json.loads((runs / "fit" / "summary.json").read_text())
-    assert s["selected"]["latex"] in (runs / "fit" / "report.tex").read_text()
+    law = ForceLaw.from_dict(s["selected"]["coefficients"])
+    assert law_equation(law) in (runs / "fit" / "report.tex").read_text()
 
 
 def test_snippets_and_refusals(runs, capsys):
@@ -311,5 +330,294 @@ def test_study_report_states_recovery_coverage_and_figures(tmp_path):
     ):
         assert words in text, words
     tex = r.tex.read_text()
-    for fig in ("recovery_noise.pdf", "recovery_map.pdf", "coverage.pdf", "inclusion.pdf"):
+    for fig in ("recovery_noise.pdf", "recovery_map.pdf", "inclusion.pdf"):
         assert fig in tex
+    # no refinement, no intervals: no empty coverage chart, and a sentence says why
+    assert "coverage.pdf" not in tex and not (out / "coverage.pdf").exists()
+    assert "so there is no coverage chart" in text
+    assert "^" not in _body(r.pdf) and "ˆ" not in _body(r.pdf)  # "z^2" as an exponent
+
+
+# ------------------------------------------------- a summary is text, never trusted TeX
+PAYLOAD = r"\input{/etc/passwd}\def\x{\x}\x\catcode`\^=12 $^_&%#{}~"
+
+
+def _poisoned(value):
+    """Every string of a summary replaced by TeX that would read a file and loop."""
+    if isinstance(value, str):
+        return PAYLOAD
+    if isinstance(value, list):
+        return [_poisoned(v) for v in value]
+    if isinstance(value, dict):
+        return {k: (v if k == "command" else _poisoned(v)) for k, v in value.items()}
+    return value
+
+
+def _copy_run(runs, kind, tmp_path):
+    d = tmp_path / kind
+    shutil.copytree(runs / kind, d)
+    for p in d.glob("report.*"):
+        p.unlink()
+    return d
+
+
+@pytest.mark.parametrize("kind", ["fit", "identify", "landscape", "ueda"])
+def test_an_edited_summary_with_latex_in_every_field_is_text(runs, kind, tmp_path, capsys):
+    """LaTeX written into every string field of summary.json (selected.latex, verdicts,
+    names, paths...) is printed as text or refused in one line; a law is rebuilt from its
+    own text by the law grammar, so the report never runs TeX it read."""
+    _need_tex()
+    d = _copy_run(runs, kind, tmp_path)
+    s = json.loads((d / "summary.json").read_text())
+    (d / "summary.json").write_text(json.dumps(_poisoned(s)))
+    code = main(["report", str(d)])
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    if code == 2:  # a field the report needs as a law (identify's law text) is no law now
+        assert err.count("\n") == 1 and "is not a force law" in err, err
+        assert not (d / "report.tex").exists()
+        return
+    assert code == 0, err
+    tex = (d / "report.tex").read_text()
+    assert "\\input{" not in tex and "\\def\\x" not in tex and "\\catcode" not in tex
+    assert "\\textbackslash{}input\\{/etc/passwd\\}" in tex
+    text = _text(d / "report.pdf")
+    assert "root:" not in text and "\\input{/etc/passwd}" in text
+
+
+def test_the_fit_law_is_never_read_from_the_latex_fields(runs, tmp_path):
+    d = _copy_run(runs, "fit", tmp_path)
+    s = json.loads((d / "summary.json").read_text())
+    s["selected"]["latex"] = r"\input{/etc/passwd}"
+    for e in s.get("equivalent") or []:
+        e["latex"] = r"\input{/etc/passwd}"
+    (d / "summary.json").write_text(json.dumps(s))
+    r = report(d, compile=False)
+    assert "\\input{/etc/passwd}" not in r.tex.read_text()
+
+
+@pytest.mark.parametrize("kind", ["verify", "fit", "identify", "landscape", "ueda"])
+def test_wrongly_typed_fields_of_an_edited_summary_are_one_line(runs, kind, tmp_path, capsys):
+    """Each top-level field (and each field of ``selected``) replaced by a value of another
+    type: the report is written or refused in one line (exit 2), never an internal error."""
+    d = _copy_run(runs, kind, tmp_path)
+    s = json.loads((d / "summary.json").read_text())
+    edits = [(k,) for k in s if k != "command"] + [("selected", k) for k in s.get("selected", {})]
+    for path in edits:
+        for bad in (5, "text", [1, "a"], {"a": 1}, None, True, 1e308):
+            t = json.loads(json.dumps(s))
+            node = t
+            for k in path[:-1]:
+                node = node[k]
+            node[path[-1]] = bad
+            (d / "summary.json").write_text(json.dumps(t))
+            code = main(["report", str(d), "--no-pdf"])
+            err = capsys.readouterr().err
+            assert code in (0, 2), (path, bad, err)
+            assert "Traceback" not in err and err.count("\n") <= 1, (path, bad, err)
+
+
+def test_a_figure_linked_outside_the_directory_is_not_read(runs, tmp_path):
+    _need_tex()
+    d = _copy_run(runs, "verify", tmp_path)
+    outside = tmp_path / "secret.pdf"
+    shutil.copy(runs / "fit" / "fit_impulse.pdf", outside)
+    (d / "verify.pdf").unlink()
+    (d / "verify.pdf").symlink_to(outside)
+    r = report(d, timeout=120)
+    assert r.pdf is not None and "verify.pdf" in r.message and "links" in r.message
+    assert "verify.pdf" not in r.tex.read_text()
+    # compile_tex itself refuses a linked figure
+    tex = d / "fig.tex"
+    tex.write_text(
+        "\\documentclass{article}\\usepackage{graphicx}\\begin{document}"
+        "\\includegraphics{verify.pdf}\\end{document}\n"
+    )
+    pdf, why = compile_tex(tex, ["verify.pdf"], timeout=60)
+    assert pdf is None and "links" in why
+
+
+LOOP = "\\documentclass{article}\\begin{document}\\def\\x{\\x}\\x\\end{document}\n"
+
+
+def _procs_with(word):
+    """Live processes whose command line holds ``word``."""
+    out = []
+    for p in os.listdir("/proc"):
+        if p.isdigit():
+            try:
+                with open(f"/proc/{p}/cmdline", "rb") as fh:
+                    cmd = fh.read().replace(b"\0", b" ").decode(errors="replace")
+                with open(f"/proc/{p}/stat") as fh:
+                    state = fh.read().rsplit(")", 1)[1].split()[0]
+            except OSError:
+                continue
+            if word in cmd and state != "Z" and "pytest" not in cmd:
+                out.append(cmd)
+    return out
+
+
+def _wait_for(cond, seconds):
+    import time
+
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if cond():
+            return True
+        time.sleep(0.2)
+    return cond()
+
+
+def test_a_looping_tex_file_is_killed_with_its_children_on_timeout(tmp_path):
+    _need_tex()
+    name = f"loop{os.getpid()}t"
+    tex = tmp_path / f"{name}.tex"
+    tex.write_text(LOOP)
+    pdf, why = compile_tex(tex, timeout=4)
+    assert pdf is None and "more than 4 s" in why
+    assert _wait_for(lambda: not _procs_with(name), 5), _procs_with(name)
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".vidi-tex-")]
+
+
+@pytest.mark.parametrize("how", ["SIGTERM", "SIGINT", "SIGTERM-handled", "SIGKILL"])
+def test_a_signal_ends_latexmk_and_pdflatex_too(tmp_path, how):
+    """vidi ended while pdflatex loops: nothing of the compilation is left running, and
+    the staging directory a SIGKILL leaves is removed by the next compilation."""
+    _need_tex()
+    import signal
+    import sys
+
+    name = f"loop{os.getpid()}{how[-4:].lower()}"
+    tex = tmp_path / f"{name}.tex"
+    tex.write_text(LOOP)
+    handler = (
+        "import signal, sys\n"
+        "def _h(*a):\n    raise SystemExit(143)\n"
+        "signal.signal(signal.SIGTERM, _h)\n"
+        if how == "SIGTERM-handled"
+        else ""
+    )
+    code = handler + (
+        f"from reports.document import compile_tex\ncompile_tex({str(tex)!r}, timeout=300)\n"
+    )
+    proc = subprocess.Popen([sys.executable, "-c", code], cwd=os.getcwd())
+    try:
+        assert _wait_for(lambda: any("pdflatex" in c for c in _procs_with(name)), 60)
+        sig = {"SIGINT": signal.SIGINT, "SIGKILL": signal.SIGKILL}.get(how, signal.SIGTERM)
+        proc.send_signal(sig)
+        proc.wait(timeout=30)
+        assert _wait_for(lambda: not _procs_with(name), 10), _procs_with(name)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    left = [p for p in tmp_path.iterdir() if p.name.startswith(".vidi-tex-")]
+    if how in ("SIGINT", "SIGTERM-handled"):  # unwound: the staging directory is gone
+        assert not left
+    # after SIGKILL (or SIGTERM with no handler: Python ends at once) the next
+    # compilation removes the staging directory of the dead run
+    ok = tmp_path / "ok.tex"
+    ok.write_text("\\documentclass{article}\\begin{document}ok\\end{document}\n")
+    pdf, _ = compile_tex(ok, timeout=120)
+    assert pdf is not None
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".vidi-tex-")]
+
+
+def test_an_interrupted_report_leaves_nothing_that_blocks_the_next(runs, tmp_path, monkeypatch):
+    """A report killed while compiling (or out of space) has written no report.tex of its
+    own outside the manifest: the next report is made, not refused."""
+    import reports.document as doc
+
+    d = _copy_run(runs, "identify", tmp_path)
+
+    def boom(*a, **k):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(doc, "compile_tex", boom)
+    with pytest.raises(OSError):
+        report(d)
+    assert not [p for p in d.iterdir() if p.name.startswith(".vidi-tex-")]
+    monkeypatch.undo()
+    (d / ".vidi-tex-999999999-1.deadbeef").mkdir()  # a staging dir of a killed report
+    r = report(d, compile=HAVE_TEX, timeout=120)
+    assert r.tex.exists() and not [p for p in d.iterdir() if p.name.startswith(".vidi-tex-")]
+
+
+def _body(pdf):
+    """A report's text up to its provenance (where settings and hashes are verbatim)."""
+    return _text(pdf).split("Provenance")[0]
+
+
+@pytest.mark.parametrize("kind", ["verify", "fit", "fit2", "identify", "landscape", "ueda"])
+def test_reports_are_typeset_as_a_person_would(runs, kind):
+    """The defects a reader saw: literal carets, laws as raw integers (206000000*z),
+    code turned into quotes, verdicts cut to "(and 1 more)", a "--:" label."""
+    _need_tex()
+    r = report(runs / kind, timeout=120)
+    tex, body = r.tex.read_text(), _body(r.pdf)
+    assert "\\textasciicircum" not in tex.split("section{Provenance}")[0], kind
+    assert "^" not in body and "ˆ" not in body, kind
+    assert not re.search(r"(?<![\d.,])\d{6,}(?![\d.])", body), kind
+    assert not re.search(r"\d\*z", body), kind
+    assert "(and " not in body and "more)" not in body, kind
+    assert "−−:" not in body and "--:" not in body
+    assert "Eq(" not in body and "Derivative" not in body  # no sympy repr (Ueda)
+    summary = json.loads((runs / kind / "summary.json").read_text())
+    assert "Eq(" not in str(summary.get("equation", ""))
+    assert "``" not in tex and "\\textasciigrave" not in tex.split("section{Provenance}")[0]
+
+
+def test_a_two_scenario_fit_lists_every_scenario_and_record(runs):
+    _need_tex()
+    r = report(runs / "fit2", timeout=120)
+    body = _body(r.pdf)
+    for needle in ("Scenarios", "low", "100% #1", "low.csv", "_$x$.csv", "Record 1", "Record 2"):
+        assert needle in body, needle
+    assert "3.50 · 105" in body.replace("\u22c5", "·") or "3.50" in body
+
+
+@pytest.mark.parametrize("files", [5, "report.tex", {"a": 1}, None, [1, ["x"]]])
+def test_a_malformed_manifest_is_one_line_or_a_report(runs, tmp_path, capsys, files):
+    d = _copy_run(runs, "landscape", tmp_path)
+    man = json.loads((d / ".vidi-manifest.json").read_text())
+    man["files"] = files
+    (d / ".vidi-manifest.json").write_text(json.dumps(man))
+    assert main(["report", str(d), "--no-pdf"]) == 0
+    assert "Traceback" not in capsys.readouterr().err
+    assert "report.tex" in json.loads((d / ".vidi-manifest.json").read_text())["files"]
+    (d / ".vidi-manifest.json").write_text("[1, 2]")
+    assert main(["report", str(d), "--no-pdf"]) == 2  # report.tex is no longer listed as vidi's
+    assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_the_api_checks_its_arguments(runs):
+    from discovery.errors import VidiError
+    from discovery.report import report as api_report
+
+    with pytest.raises(VidiError, match="compile"):
+        api_report(runs / "landscape", compile="no")
+    with pytest.raises(VidiError, match="timeout"):
+        api_report(runs / "landscape", timeout="60")
+
+
+TEXT_WIDTH_IN, TEXT_HEIGHT_IN = 6.77, 9.27  # letter paper, 2.2 cm margins
+
+
+@pytest.mark.parametrize("kind", ["verify", "fit", "fit2", "identify", "landscape", "ueda"])
+def test_figures_are_printed_at_the_size_they_were_drawn(runs, kind):
+    """Every figure is drawn about as large as the report prints it (scaled by 0.9 or
+    more), so text drawn at 7 pt or more stays 6.3 pt or more on paper, where a figure
+    drawn 13-17 in wide was shrunk to half its size."""
+    _need_tex()
+    r = report(runs / kind, compile=False)
+    tex = r.tex.read_text()
+    found = re.findall(r"height=([0-9.]+)\\textheight,keepaspectratio\]\{([^}]+)\}", tex)
+    assert found, kind
+    for frac, name in found:
+        info = subprocess.run(
+            ["pdfinfo", str(runs / kind / name)], capture_output=True, text=True, check=True
+        ).stdout
+        w, h = (
+            float(v) / 72 for v in re.search(r"Page size:\s+([\d.]+) x ([\d.]+)", info).groups()
+        )
+        scale = min(TEXT_WIDTH_IN / w, float(frac) * TEXT_HEIGHT_IN / h)
+        assert scale >= 0.9, (kind, name, w, h, scale)

@@ -192,10 +192,10 @@ def test_study_runs_scores_and_writes_tables(quick_serial):
         "config.json",
         "recovery_noise.png",
         "recovery_map.pdf",
-        "coverage.png",
         "inclusion.png",
     ):
         assert (out / f).stat().st_size > 0, f
+    assert not (out / "coverage.png").exists()  # no refinement, no intervals: no empty chart
     for r in res.runs:
         assert r["status"] == "ok", r.get("error")
         assert r["tp"] + r["fn"] == 2 and r["tp"] + r["fp"] == len(r["selected"])

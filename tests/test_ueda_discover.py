@@ -347,3 +347,12 @@ def test_one_csv_reader_for_both_systems(tmp_path):
         with pytest.raises(InputError) as info:
             read_record_csv(bad)
         assert needle in str(info.value) and "\n" not in str(info.value), str(info.value)
+
+
+def test_the_equation_text_is_readable_not_a_sympy_repr():
+    from discovery.ueda.discover import TERMS, ForcedPolynomial
+
+    c = [0.0] * len(TERMS)
+    c[TERMS.index("x'")], c[TERMS.index("x^3")] = 0.2, -1.0
+    m = ForcedPolynomial(c, 0.35, 1.02)
+    assert m.text() == "x'' = 0.2 x' - x^3 + B cos(nu t)" == str(m)

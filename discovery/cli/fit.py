@@ -173,6 +173,7 @@ def run(args):
     summary = {
         "command": "fit",
         "scenario": scs[0].as_dict(),
+        "scenarios": [sc.as_dict() for sc in scs] if len(scs) > 1 else None,
         "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
         **res.as_dict(names=[str(p) for p in data]),
         **provenance(vars(args), inputs=inputs_of(args)),

@@ -178,6 +178,27 @@ class ForcedPolynomial:
 
         return sp.latex(self.sympy(digits))
 
+    def text(self, digits=4):
+        """The equation as readable text: ``x'' = 0.2 x' - x^3 - 1.6 x^2 x' + B cos(nu t)``
+        (coefficients to ``digits`` significant digits)."""
+        parts = []
+        for name, c in zip(TERMS, self.coefficients, strict=True):
+            if c:
+                mag = f"{abs(c):.{digits}g}"
+                body = name if name != "1" else mag
+                if name != "1" and mag != "1":
+                    body = f"{mag} {name}"
+                parts.append(("- " if c < 0 else "+ ") + body)
+        f = f"{abs(self.forcing):.{digits}g}"
+        parts.append(
+            ("- " if self.forcing < 0 else "+ ") + ("" if f == "1" else f + " ") + "B cos(nu t)"
+        )
+        rhs = " ".join(parts)
+        return "x'' = " + (rhs[2:] if rhs.startswith("+ ") else "-" + rhs[2:])
+
+    def __str__(self):
+        return self.text()
+
     def as_dict(self):
         return {"terms": self.terms, "forcing": self.forcing, "B": self.B, "nu": self.nu}
 
@@ -505,7 +526,7 @@ class Discovery:
             "coefficients": self.coefficients,
             "standard_errors": self.standard_errors,
             "ols_standard_errors": self.ols_standard_errors,
-            "equation": str(self.model.sympy()),
+            "equation": self.model.text(),
             "latex": self.latex,
             "residual_rms": self.residual_rms,
             "n_windows": self.n_windows,

@@ -361,7 +361,7 @@ class Explanation:
 
 
 def _model_dict(m):
-    return {**m.as_dict(), "equation": str(m.sympy())}
+    return {**m.as_dict(), "equation": m.text()}
 
 
 def _check_settings(alpha, max_iterations, order, noise):

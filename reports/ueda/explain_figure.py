@@ -5,10 +5,12 @@ final model's.  Writes PNG and PDF and returns the paths.
 """
 
 import numpy as np
+from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 from scipy.stats import chi2
 
-from .._mpl import colormap, save, subplots
+from .._mpl import PRINT_WIDTH, colormap, print_sizes, save
+from .figures import _equation_math, _term_math
 
 _save = save
 
@@ -61,21 +63,30 @@ def _strobe_panel(ax, ver, label, color, title):
     ax.set_ylim(lo[1] - pad[1], hi[1] + pad[1])
     ax.set_xlabel("x")
     ax.set_ylabel("x'")
-    ax.legend(loc="upper right", fontsize=7)
+    ax.legend(loc="best", fontsize=7, framealpha=0.8)
     if ver.diverged:
         gap = "model diverged"
     else:
         gap = (
-            f"energy distance {ver.energy_distance:.3g} (floor q95 {ver.floor_q95:.3g}): "
+            f"energy distance {ver.energy_distance:.3g}\n(floor q95 {ver.floor_q95:.3g}): "
             f"{'consistent' if ver.consistent else 'INCONSISTENT'}"
         )
-    ax.set_title(f"{title}\n{gap}", fontsize=9)
+    ax.set_title(f"{title}\n{gap}", fontsize=8)
     ax.grid(alpha=0.3)
 
 
 def explain_figure(ex, stem):
-    """The figure of an :class:`~discovery.ueda.explain.Explanation`."""
-    fig, axes = subplots(1, 3, figsize=(16, 4.8), gridspec_kw={"width_ratios": [1.3, 1, 1]})
+    """The figure of an :class:`~discovery.ueda.explain.Explanation`, drawn at the width it
+    is printed (its text 7 to 8 pt): the score tests above, the start and final models'
+    strobe points below."""
+    with print_sizes():
+        return _draw(ex, stem)
+
+
+def _draw(ex, stem):
+    fig = Figure(figsize=(PRINT_WIDTH, 6.6), layout="constrained")
+    axd = fig.subplot_mosaic([["a", "a"], ["b", "c"]], height_ratios=[1, 1.15])
+    axes = [axd["a"], axd["b"], axd["c"]]
     ax = axes[0]
     its = ex.iterations
     ids = [s["effect"] for s in its[0].scores] if its else []
@@ -101,20 +112,25 @@ def explain_figure(ex, stem):
     ax.set_yscale("log")
     ax.set_xticks(
         np.arange(len(its)),
-        [f"{k + 1}: {it.effect or 'none named'}" for k, it in enumerate(its)],
+        [f"{k + 1}: {(it.effect or 'none named').replace('_', ' ')}" for k, it in enumerate(its)],
         fontsize=8,
     )
-    ax.set_ylabel("score statistic LM (chi^2(1))")
+    ax.set_ylabel(r"score statistic LM ($\chi^2(1)$)")
     ax.legend(
-        [Patch(color=colors(j % 10)) for j in range(len(ids))], ids, fontsize=7, loc="upper right"
+        [Patch(color=colors(j % 10)) for j in range(len(ids))],
+        [i.replace("_", " ") for i in ids],
+        fontsize=7,
+        loc="upper left",
+        bbox_to_anchor=(1.01, 1.0),
+        borderaxespad=0.0,
     )
     ax.set_title(
         "(a) score tests of the catalogue's effects per iteration\n(red dashes: the "
         "Bonferroni gate; black edge: the effect named)",
-        fontsize=9,
+        fontsize=8,
     )
     ax.grid(alpha=0.3, axis="y")
-    start = ", ".join(ex.start_terms) or "none"
+    start = ", ".join(_term_math(t) for t in ex.start_terms) or "none"
     _strobe_panel(
         axes[1], ex.start_verification, "start model", "tab:orange", f"(b) start model ({start})"
     )
@@ -123,14 +139,9 @@ def explain_figure(ex, stem):
         ex.final_verification,
         "final model",
         "tab:blue",
-        f"(c) final model (+ {', '.join(ex.effects_added) or 'nothing'})",
+        "(c) final model\n(+ "
+        + (", ".join(e.replace("_", " ") for e in ex.effects_added) or "nothing")
+        + ")",
     )
-    eq = "x'' = " + " ".join(
-        f"{v:+.4g} {k}" if k != "1" else f"{v:+.4g}" for k, v in ex.final_model.terms.items()
-    )
-    eq += f" {ex.final_model.forcing:+.4g} B cos(nu t)"
-    import textwrap
-
-    stopped = textwrap.fill(f"stopped: {ex.stopped_because}", 170)
-    fig.suptitle(f"final: {eq}\n{stopped}", fontsize=9, y=1.04 + 0.03 * stopped.count("\n"))
+    fig.suptitle(f"final: {_equation_math(ex.final_model)}", fontsize=8)
     return _save(fig, stem)

@@ -9,7 +9,7 @@ Each function writes PNG and PDF and returns the paths.
 import numpy as np
 from matplotlib.colors import ListedColormap
 
-from .._mpl import colormap, save, subplots
+from .._mpl import PRINT_WIDTH, colormap, save, subplots
 
 __all__ = ["attractor_figure", "chart_figure", "basins_figure", "discover_figure"]
 
@@ -20,11 +20,49 @@ _KIND_LABELS = ("synchronisation (P1)", "subharmonic (Pn)", "beat (quasi-periodi
 _save = save
 
 
+def _term_math(name):
+    r"""A library term (``x^2 x'``, ``1``) as mathtext: ``$x^{2}\,\dot{x}$``."""
+    from discovery.ueda.discover import MONOMIALS, TERMS
+
+    if name not in TERMS:
+        return str(name).replace("$", r"\$")
+    i, j = MONOMIALS[TERMS.index(name)]
+    parts = ([("x" if i == 1 else f"x^{{{i}}}")] if i else []) + (
+        [(r"\dot{x}" if j == 1 else rf"\dot{{x}}^{{{j}}}")] if j else []
+    )
+    return "$" + (r"\,".join(parts) or "1") + "$"
+
+
+def _carets(text):
+    """Text with its exponents (``x^2``) raised as mathtext, the rest as it is."""
+    import re
+
+    return re.sub(r"\^(\d+)", r"$^{\1}$", str(text).replace("$", r"\$"))
+
+
+def _sci(v):
+    from reports.lawtex import sci
+
+    return sci(v, 4)
+
+
+def _equation_math(model):
+    """``x'' = ...`` of a discovered model as mathtext, coefficients to 4 digits."""
+    parts = []
+    for k, v in model.terms.items():
+        sym = "" if k == "1" else _term_math(k).strip("$")
+        parts.append(("-" if v < 0 else "+") + rf" {_sci(abs(v))}\,{sym}")
+    f = model.forcing
+    parts.append(("-" if f < 0 else "+") + rf" {_sci(abs(f))}\,B\cos\nu t")
+    rhs = " ".join(parts)
+    return r"$\ddot{x} = " + (rhs[2:] if rhs.startswith("+ ") else rhs) + "$"
+
+
 def attractor_figure(att, stem):
     """(a) the stroboscopic points ``(x, x')`` at ``t = 2 pi k / nu``; (b) a stretch of
     trajectory in the ``(x, x')`` plane with the strobe points on it."""
     s = att.system
-    fig, axes = subplots(1, 2, figsize=(11, 4.8))
+    fig, axes = subplots(1, 2, figsize=(PRINT_WIDTH, 3.4), layout="constrained")
     ax = axes[0]
     ax.plot(att.strobe[:, 0], att.strobe[:, 1], ".", ms=1.2, color="k")
     ax.set_xlabel("x")
@@ -33,7 +71,7 @@ def attractor_figure(att, stem):
     ax.set_title(
         f"(a) stroboscopic points ({att.n_points}), {att.regime.regime}\n"
         f"lambda1 = {L.value:.4f} +- {L.stderr:.4f}, lambda2 = {L.second:.4f}",
-        fontsize=9,
+        fontsize=8,
     )
     ax = axes[1]
     ax.plot(att.x, att.v, lw=0.5, color="tab:blue")
@@ -52,7 +90,7 @@ def attractor_figure(att, stem):
         if s.model == "negres"
         else f"k = {s.k:g}, B = {s.B:g}, nu = {s.nu:g}"
     )
-    fig.suptitle(f"{s.model}: {s.equation};  {pars}", fontsize=10)
+    fig.suptitle(f"{s.model}: {_carets(s.equation)};  {pars}", fontsize=8)
     for a in axes:
         a.grid(alpha=0.3)
     return _save(fig, stem)
@@ -65,7 +103,7 @@ def chart_figure(ch, stem):
     in both directions, the points where the two sweeps ended on different attractors
     (coexisting attractors: hysteresis) marked ``x``."""
     kind = np.where(ch.kind < 0, np.nan, ch.kind.astype(float))
-    fig, ax = subplots(figsize=(8, 6.4))
+    fig, ax = subplots(figsize=(PRINT_WIDTH, 5.2), layout="constrained")
     nu, B = ch.nu, ch.B
 
     def edges(a):
@@ -157,7 +195,7 @@ def chart_figure(ch, stem):
         f"{ch.seconds:.0f} s on {ch.workers} processes\n"
         f"black lines: boundaries between regimes (or periods), to the grid's "
         f"resolution; numbers: periods (up to {maxp})",
-        fontsize=9,
+        fontsize=8,
     )
     ax.set_xlim(en[0], en[-1])
     ax.set_ylim(eb[0], eb[-1])
@@ -167,7 +205,7 @@ def chart_figure(ch, stem):
 def basins_figure(bas, stem):
     """The grid of initial states coloured by the attractor each reaches, beside the
     attractors' strobe points."""
-    fig, axes = subplots(1, 2, figsize=(11, 4.8))
+    fig, axes = subplots(1, 2, figsize=(PRINT_WIDTH, 3.4), layout="constrained")
     n = len(bas.attractors)
     cmap = colormap("tab10")
     ax = axes[0]
@@ -182,7 +220,7 @@ def basins_figure(bas, stem):
     )
     ax.set_xlabel("x(0)")
     ax.set_ylabel("x'(0)")
-    ax.set_title(f"(a) basins on a {bas.x0.size}x{bas.v0.size} grid", fontsize=9)
+    ax.set_title(f"(a) basins on a {bas.x0.size}x{bas.v0.size} grid", fontsize=8)
     ax = axes[1]
     for k, a in enumerate(bas.attractors):
         p = np.asarray(a["points"])
@@ -197,7 +235,7 @@ def basins_figure(bas, stem):
     ax.legend(fontsize=8)
     ax.set_xlabel("x")
     ax.set_ylabel("x'")
-    ax.set_title("(b) the attractors' strobe points", fontsize=9)
+    ax.set_title("(b) the attractors' strobe points", fontsize=8)
     return _save(fig, stem)
 
 
@@ -226,7 +264,7 @@ def _strobe_panel(ax, ver):
         if L
         else f"model diverged: {ver.diverged}"
     )
-    ax.set_title(f"(a) stroboscopic points at t = 2 pi k / nu\n{lyap}", fontsize=9)
+    ax.set_title(f"(a) stroboscopic points at t = 2 pi k / nu\n{lyap}", fontsize=8)
     ax.grid(alpha=0.3)
 
 
@@ -237,7 +275,7 @@ def _coefficient_panel(ax, disc):
     se = np.array([disc.standard_errors[k] for k in names])
     y = np.arange(len(names))
     ax.barh(y, c, xerr=2 * se, color="tab:blue", alpha=0.7, capsize=3)
-    ax.set_yticks(y, names, fontsize=8)
+    ax.set_yticks(y, [_term_math(k) for k in names], fontsize=8)
     span = float(np.max(np.abs(c))) if len(c) else 1.0
     for yi, ci, si in zip(y, c, se, strict=True):  # the value beside its bar, inside the axes
         ax.text(
@@ -252,7 +290,9 @@ def _coefficient_panel(ax, disc):
         -1.15 * span if np.any(c < 0) else -0.6 * span, 1.15 * span if np.any(c > 0) else 0.6 * span
     )
     ax.axvline(0, color="k", lw=0.5)
-    ax.set_title("(b) coefficients of x'' = ...\n(error bars: 2 SE, block bootstrap)", fontsize=9)
+    ax.set_title(
+        "(b) coefficients of $\\ddot{x}$ = ...\n(error bars: 2 SE, block bootstrap)", fontsize=9
+    )
     ax.grid(alpha=0.3, axis="x")
 
 
@@ -297,8 +337,8 @@ def _distance_panel(ax, ver):
         )
     ax.set_xlim(0, hi)
     ax.set_ylabel("resamples")
-    ax.legend(fontsize=8, loc="upper right")
-    ax.set_xlabel("energy distance of strobe points (scaled by the record's sd)", fontsize=8)
+    ax.legend(fontsize=7, loc="upper right", framealpha=0.8)
+    ax.set_xlabel("energy distance of strobe points\n(scaled by the record's sd)", fontsize=8)
     verdict = "consistent" if ver.consistent else "INCONSISTENT"
     ax.set_title(
         f"(c) {verdict}\n(rule: median distance <= floor q95, and the same regime)", fontsize=9
@@ -309,15 +349,19 @@ def discover_figure(disc, ver, stem):
     """(a) the record's stroboscopic points over the discovered model's; (b) the
     coefficients with their standard errors (bars: 2 SE); (c) the energy distance
     against its noise floor (random halves of the record)."""
-    fig, axes = subplots(
-        1, 3, figsize=(15, 4.8), layout="constrained", gridspec_kw={"width_ratios": [1.3, 1, 1]}
-    )
-    _strobe_panel(axes[0], ver)
-    _coefficient_panel(axes[1], disc)
-    _distance_panel(axes[2], ver)
-    eq = "x'' = " + " ".join(
-        f"{v:+.4g} {k}" if k != "1" else f"{v:+.4g}" for k, v in disc.model.terms.items()
-    )
-    eq += f" {disc.model.forcing:+.4g} B cos(nu t)"
-    fig.suptitle(f"discovered: {eq};  B = {disc.model.B:g}, nu = {disc.model.nu:g}", fontsize=10)
-    return _save(fig, stem)
+    from matplotlib.figure import Figure
+
+    from .._mpl import PRINT_WIDTH, print_sizes
+
+    with print_sizes():  # drawn at the width it is printed: its text 7 to 8 pt on paper
+        fig = Figure(figsize=(PRINT_WIDTH, 6.6), layout="constrained")
+        axd = fig.subplot_mosaic([["a", "a"], ["b", "c"]], height_ratios=[1.1, 1])
+        _strobe_panel(axd["a"], ver)
+        _coefficient_panel(axd["b"], disc)
+        _distance_panel(axd["c"], ver)
+        fig.suptitle(
+            f"discovered: {_equation_math(disc.model)};  $B$ = {disc.model.B:g}, "
+            f"$\\nu$ = {disc.model.nu:g}",
+            fontsize=8,
+        )
+        return _save(fig, stem)

@@ -5,7 +5,7 @@ Each function writes the same figure as PNG and PDF and returns the paths.
 
 import numpy as np
 
-from .._mpl import colormap, save, subplots
+from .._mpl import PRINT_WIDTH, colormap, print_sizes, save, subplots
 
 __all__ = ["landscape_figure", "identification_figure", "verify_figure", "explain_figure"]
 
@@ -158,38 +158,39 @@ def landscape_figure(land, stem, truth=None):
     marks = _landscape_marks(reg, ref_reg)
     inside = truth is not None and a0[0] <= truth[0] <= a0[-1] and a1[0] <= truth[1] <= a1[-1]
     show_cons = cons is not None and cons.sum() >= 2  # one point: hidden by the star
-    fig, axes = subplots(2, 3, figsize=(14, 8.5))
-    for ax, name in zip(axes.flat, _ORDER, strict=False):
-        _landscape_contours(fig, ax, land, name)
-        if show_cons:
-            ax.contour(
-                a0,
-                a1,
-                cons.T.astype(float),
-                levels=[0.5],
-                colors="w",
-                linestyles="--",
-                linewidths=1.2,
-            )
-        for mask, style, _ in marks:
-            ij = np.argwhere(mask)
-            ax.plot(a0[ij[:, 0]], a1[ij[:, 1]], **style)
-        if inside:
-            ax.plot(*truth, "o", mfc="none", mec="r", ms=10, mew=1.5)
-        ax.set_xlim(a0[0], a0[-1])
-        ax.set_ylim(a1[0], a1[-1])
-        ax.set_xlabel(coefficient_label(land.terms[0]))
-        ax.set_ylabel(coefficient_label(land.terms[1]))
-        ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
-        title = name if exact or not floor else f"{name} (noise floor {floor[name]:.3g})"
-        ax.set_title(title)
-    ax = axes.flat[5]
-    ax.axis("off")
-    lines = _landscape_info_lines(land, ref_reg, exact, floor, cons, truth, inside)
-    ax.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=9, transform=ax.transAxes)
-    _landscape_legend(ax, inside, show_cons, marks)
-    fig.tight_layout()
-    return _save(fig, stem)
+    with print_sizes():  # drawn at the width it is printed: its text 7 to 8 pt
+        fig, axes = subplots(3, 2, figsize=(PRINT_WIDTH, 7.2))
+        for ax, name in zip(axes.flat, _ORDER, strict=False):
+            _landscape_contours(fig, ax, land, name)
+            if show_cons:
+                ax.contour(
+                    a0,
+                    a1,
+                    cons.T.astype(float),
+                    levels=[0.5],
+                    colors="w",
+                    linestyles="--",
+                    linewidths=1.2,
+                )
+            for mask, style, _ in marks:
+                ij = np.argwhere(mask)
+                ax.plot(a0[ij[:, 0]], a1[ij[:, 1]], **style)
+            if inside:
+                ax.plot(*truth, "o", mfc="none", mec="r", ms=10, mew=1.5)
+            ax.set_xlim(a0[0], a0[-1])
+            ax.set_ylim(a1[0], a1[-1])
+            ax.set_xlabel(coefficient_label(land.terms[0]))
+            ax.set_ylabel(coefficient_label(land.terms[1]))
+            ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
+            title = name if exact or not floor else f"{name} (noise floor {floor[name]:.3g})"
+            ax.set_title(title)
+        ax = axes.flat[5]
+        ax.axis("off")
+        lines = _landscape_info_lines(land, ref_reg, exact, floor, cons, truth, inside)
+        ax.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=7, transform=ax.transAxes)
+        _landscape_legend(ax, inside, show_cons, marks)
+        fig.tight_layout()
+        return _save(fig, stem)
 
 
 def identification_figure(result, measured, impulses, stem, land=None):
@@ -218,7 +219,14 @@ def identification_figure(result, measured, impulses, stem, land=None):
     its = list(result.iterations)
     path = np.array([[it["coefficients"][n] for n in names] for it in its])
     two = len(names) >= 2 and path.size > 0
-    fig, axes = subplots(1, 3 if two else 2, figsize=(17 if two else 12, 5.2), layout="constrained")
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(PRINT_WIDTH, 6.6 if two else 3.4), layout="constrained")
+    if two:  # the path and the history side by side, the forces below at full width
+        axd = fig.subplot_mosaic([["a", "b"], ["c", "c"]])
+        axes = [axd["a"], axd["b"], axd["c"]]
+    else:
+        axes = list(fig.subplots(1, 2))
     crit = result.criterion
     # the identified law's value (result.value can belong to a standard-error probe)
     value = result.criteria.get(crit, result.value)
@@ -245,8 +253,8 @@ def identification_figure(result, measured, impulses, stem, land=None):
         ax.set_ylabel(coefficient_label(names[1]))
         ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
         more = f" (first two of {len(names)} terms)" if len(names) > 2 else ""
-        ax.set_title(f"{result.method}: path of the best law so far{more}", fontsize=10)
-        ax.legend(fontsize=8, loc="best")
+        ax.set_title(f"{result.method}: path of the best law so far{more}", fontsize=8)
+        ax.legend(fontsize=7, loc="best")
     ax = axes[1] if two else axes[0]
     if its:
         sims = np.array([it["n_simulations"] for it in its], dtype=float)
@@ -270,11 +278,11 @@ def identification_figure(result, measured, impulses, stem, land=None):
         )
         if np.all(vals > 0):
             ax.set_yscale("log")
-        ax.legend(fontsize=8)
+        ax.legend(fontsize=7)
     ax.set_xlabel("simulations spent (steady states computed)")
     ax.set_ylabel(f"best {crit} so far (dimensionless)")
     ax.set_title(
-        f"identified: {crit} = {value:.3g}, {result.n_simulations} simulations in all", fontsize=10
+        f"identified: {crit} = {value:.3g}, {result.n_simulations} simulations in all", fontsize=8
     )
     ax1 = axes[-1]
     ax1.plot(measured.t * 1e3, measured.F / 1e6, "k-", lw=2.5, label="F_E (measured)")
@@ -292,8 +300,8 @@ def identification_figure(result, measured, impulses, stem, land=None):
     ax1.set_xlim(-0.05 * end * 1e3, min(measured.duration, 1.4 * end) * 1e3)
     ax1.set_xlabel("time since onset t - t* [ms]")
     ax1.set_ylabel("contact force [MN]")
-    ax1.set_title(f"F_N converging to F_E ({crit} = {value:.3g})", fontsize=10)
-    ax1.legend(fontsize=8)
+    ax1.set_title(f"F_N converging to F_E ({crit} = {value:.3g})", fontsize=8)
+    ax1.legend(fontsize=7)
     return _save(fig, stem)
 
 
@@ -313,7 +321,9 @@ def fit_impulse_figure(result, impulses, stem, n_models=3):
     measured = [r.impulse if r is not None else result.measured for r in refs]
     models = [m for m in result.ranking if m.evaluations][:n_models]
     labels = [lab for lab, _ in impulses][: len(models)]
-    fig, axes = subplots(len(measured), 1, figsize=(8, 3.0 + 2.2 * len(measured)), squeeze=False)
+    fig, axes = subplots(
+        len(measured), 1, figsize=(PRINT_WIDTH, 1.2 + 2.2 * len(measured)), squeeze=False
+    )
     sc, unit = _force_unit(max(E.peak for E in measured))
     for r, (E, ax) in enumerate(zip(measured, axes[:, 0], strict=True)):
         sims = [
@@ -340,7 +350,14 @@ def fit_impulse_figure(result, impulses, stem, n_models=3):
             if imp is None:
                 continue
             f = np.interp(E.t, imp.t, imp.F)
-            ax.plot(tr[o] * 1e3, f[o] * sc, styles[k % 3], lw=1.4, color=f"C{k}", label=label)
+            ax.plot(
+                tr[o] * 1e3,
+                f[o] * sc,
+                styles[k % 3],
+                lw=1.4,
+                color=f"C{k}",
+                label=terms_math(label),
+            )
         ax.set_xlim(lo * 1e3, hi * 1e3)
         ax.set_ylabel(f"contact force [{unit}]")
         name = getattr(refs[r], "source", None) or f"record {r + 1}"
@@ -348,9 +365,9 @@ def fit_impulse_figure(result, impulses, stem, n_models=3):
             f"record {r + 1}: {plain(name)}"
             if len(measured) > 1
             else "Measured impulse and the simulated steady states of the best models",
-            fontsize=9,
+            fontsize=8,
         )
-        ax.legend(fontsize=7, loc="upper right")
+        ax.legend(fontsize=7, loc="best", framealpha=0.8)
     axes[-1, 0].set_xlabel("time since the start of the contact [ms]")
     fig.tight_layout()
     return _save(fig, stem)
@@ -362,7 +379,7 @@ def fit_surface_figure(result, stem):
     Z, V = est.box_.zeta_max, est.box_.zd_max
     zz, vv = np.meshgrid(np.linspace(0, Z, 200), np.linspace(0, V, 200))
     F = result.selected.law(zz, vv)
-    fig, ax = subplots(figsize=(7, 5))
+    fig, ax = subplots(figsize=(PRINT_WIDTH, 4.6))
     cs = ax.contourf(zz * 1e3, vv, F / 1e3, levels=25, cmap="magma")
     fig.colorbar(cs, ax=ax, label="F [kN]")
     step = max(1, len(s) // 4000)
@@ -375,45 +392,96 @@ def fit_surface_figure(result, stem):
         alpha=0.6,
         label="contact samples",
     )
-    ax.set_xlabel("penetration zeta [mm]")
-    ax.set_ylabel("loading velocity max(dzeta, 0) [m/s]")
-    ax.set_title(f"F = {result.selected.law}", fontsize=8)
-    ax.legend(loc="upper right", fontsize=8)
+    ax.set_xlabel(r"penetration $\zeta$ [mm]")
+    ax.set_ylabel(r"loading velocity $\dot{\zeta}_{+} = \max(\dot{\zeta}, 0)$ [m/s]")
+    ax.set_title(law_math(result.selected.law), fontsize=8)
+    ax.legend(loc="best", fontsize=7, framealpha=0.8)
     fig.tight_layout()
     return _save(fig, stem)
 
 
 def fit_loop_figure(result, stem, max_impacts=3):
-    """Loading / unloading loops F(zeta) of a few impacts (the paper's Fig. 2a)."""
+    """Loading / unloading loops F(zeta) of a few impacts (the paper's Fig. 2a): the
+    measured samples, and the model's force at them, loading (solid) and unloading
+    (dashed) drawn apart. The impacts shown are among the deeper ones, so every branch
+    is visible."""
     s = result.samples
-    fig, ax = subplots(figsize=(7, 5))
-    impacts = np.unique(s.impact)
-    pick = impacts[np.linspace(0, impacts.size - 1, min(max_impacts, impacts.size)).astype(int)]
-    for k, imp in enumerate(pick):
-        m = s.impact == imp
-        ax.plot(
-            s.zeta[m] * 1e3,
-            s.F[m] / 1e3,
-            ".",
-            ms=3,
-            color=f"C{k}",
-            alpha=0.5,
-            label=f"measured, impact {imp}",
-        )
-        ax.plot(
-            s.zeta[m] * 1e3,
-            result.selected.law(s.zeta[m], s.dzeta[m]) / 1e3,
-            "-",
-            color=f"C{k}",
-            lw=1.5,
-            label=f"model, impact {imp}",
-        )
-    ax.set_xlabel("penetration zeta [mm]")
-    ax.set_ylabel("contact force [kN]")
-    ax.set_title("Loading (upper) and elastic unloading (lower) branches")
-    ax.legend(fontsize=7)
-    fig.tight_layout()
+    with print_sizes():
+        fig, ax = subplots(figsize=(PRINT_WIDTH, 4.4))
+        impacts = np.unique(s.impact)
+        depth = np.array([np.max(s.zeta[s.impact == i]) for i in impacts])
+        deep = impacts[depth >= 0.5 * depth.max()] if impacts.size else impacts
+        pick = deep[np.linspace(0, deep.size - 1, min(max_impacts, deep.size)).astype(int)]
+        for k, imp in enumerate(pick):
+            m = s.impact == imp
+            z, dz = s.zeta[m], s.dzeta[m]
+            ax.plot(
+                z * 1e3, s.F[m] / 1e3, ".", ms=3, color=f"C{k}", alpha=0.5,
+                label=f"measured, impact {imp}",
+            )  # fmt: skip
+            model = result.selected.law(z, dz) / 1e3
+            for branch, style in ((dz > 0, "-"), (dz <= 0, "--")):
+                mm = np.where(branch, model, np.nan)
+                ax.plot(
+                    z * 1e3, mm, style, color=f"C{k}", lw=1.6,
+                    label=f"model, impact {imp}" if style == "-" else None,
+                )  # fmt: skip
+        ax.plot([], [], "k-", lw=1.6, label="model loading (solid)")
+        ax.plot([], [], "k--", lw=1.6, label="model unloading (dashed)")
+        ax.set_xlabel(r"penetration $\zeta$ [mm]")
+        ax.set_ylabel("contact force [kN]")
+        ax.set_title("Loading and unloading branches, measured and modelled")
+        ax.legend(loc="best", framealpha=0.8)
+        fig.tight_layout()
     return _save(fig, stem)
+
+
+def _monomial_math(term, unloading=False):
+    zd = r"|\dot{\zeta}|" if unloading else r"\dot{\zeta}_{+}"
+    parts = []
+    if term.a:
+        parts.append(r"\zeta" if term.a == 1 else rf"\zeta^{{{_exp(term.a)}}}")
+    if term.b:
+        parts.append(zd if term.b == 1 else rf"{zd}^{{{_exp(term.b)}}}")
+    return r"\,".join(parts)
+
+
+def law_math(law):
+    r"""A law as matplotlib mathtext: ``$F = 2.06\cdot 10^{8}\,\zeta + ...$`` (the
+    unloading terms after a semicolon)."""
+    from reports.lawtex import sci
+
+    def poly(coefs, terms, unloading=False):
+        out = [
+            ("-" if c < 0 else "+") + rf" {sci(abs(c))}\,{_monomial_math(t, unloading)}"
+            for c, t in zip(coefs, terms, strict=True)
+        ]
+        text = " ".join(out)
+        return text[2:] if text.startswith("+ ") else text
+
+    text = f"$P = {poly(law.coefficients, law.terms)}$"
+    if law.unloading:
+        text += f"; unloading $Q = {poly(law.unloading_coefficients, law.unloading, True)}$"
+    if law.permanent_set:
+        text += f"; set {law.permanent_set:.3g}"
+    return text
+
+
+def terms_math(text):
+    """User or label text with its term names (``z^2*zd``) as mathtext, the rest plain."""
+    from discovery.vibroimpact.model.law import Term
+    from reports.lawtex import _TERMISH
+
+    text = plain(text)
+    out, pos = [], 0
+    for m in _TERMISH.finditer(text):
+        try:
+            term = Term.parse(m.group(0))
+        except Exception:  # not a term after all
+            continue
+        out.append(text[pos : m.start()] + f"${_monomial_math(term)}$")
+        pos = m.end()
+    return "".join(out) + text[pos:]
 
 
 def plain(text):
@@ -482,7 +550,7 @@ def verify_figure(result, stem):
     ev = result.evaluation
     E = result.reference.impulse
     fig, (ax, axr) = subplots(
-        2, 1, figsize=(8, 5.5), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
+        2, 1, figsize=(PRINT_WIDTH, 4.8), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
     )
     band = 2.0 * result.reference.noise.get("F", 0.0) / np.sqrt(max(E.n_cycles, 1))
     ms = 1e3
@@ -514,11 +582,12 @@ def verify_figure(result, stem):
         if k in ("I2", "I4", "I3", "I0")
     )
     ax.set_title(
-        f"{result.law}\n{'consistent' if ev.consistent else 'INCONSISTENT'}: {crit or ev.status}",
-        fontsize=9,
+        f"{law_math(result.law)}\n"
+        f"{'consistent' if ev.consistent else 'INCONSISTENT'}: {crit or ev.status}",
+        fontsize=8,
     )
     ax.set_ylabel(f"contact force F [{unit}]")
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=7, loc="best", framealpha=0.8)
     axr.set_ylabel(f"F_N - F_E [{unit}]")
     axr.set_xlabel("time since the start of the contact [ms] (folded on the drive period)")
     axr.axhline(0.0, color="k", lw=0.5)
@@ -536,7 +605,7 @@ def _explain_forces(ax, iteration, measured, k):
             iteration.simulated_before.F / 1e3,
             "-",
             color="tab:red",
-            label=f"before ({' + '.join(iteration.model_before.law.names)})",
+            label=terms_math(f"before ({' + '.join(iteration.model_before.law.names)})"),
         )
     if iteration.effect and iteration.simulated_after is not None:
         ax.plot(
@@ -544,7 +613,7 @@ def _explain_forces(ax, iteration, measured, k):
             iteration.simulated_after.F / 1e3,
             "-",
             color="tab:blue",
-            label=f"after (+ {iteration.effect})",
+            label=f"after (+ {iteration.effect.replace('_', ' ')})",
         )
     if len(E.support):
         a, b = E.support[0]
@@ -554,11 +623,10 @@ def _explain_forces(ax, iteration, measured, k):
     i2b = iteration.criteria_before.get("I2", float("nan"))
     i2a = iteration.criteria_after.get("I2", float("nan"))
     ax.set_title(
-        f"iteration {k}: I2 {i2b:.3g} -> {i2a:.3g} (noise floor "
+        f"iteration {k}: I2 {i2b:.3g} -> {i2a:.3g}\n(noise floor "
         f"{iteration.noise_floor.get('I2', float('nan')):.2g})",
-        fontsize=9,
     )
-    ax.legend(fontsize=7)
+    ax.legend(loc="best", framealpha=0.8)
 
 
 def _explain_phases(ax, iteration):
@@ -571,7 +639,9 @@ def _explain_phases(ax, iteration):
         x, shares, color=["tab:red" if ph[n]["exceeds_noise"] else "tab:gray" for n in names]
     )
     # phase names are long next to each other: rotated, anchored at their tick
-    ax.set_xticks(x, names, rotation=30, ha="right", rotation_mode="anchor")
+    ax.set_xticks(
+        x, [n.replace("_", " ") for n in names], rotation=30, ha="right", rotation_mode="anchor"
+    )
     for bar, n in zip(bars, names, strict=True):
         r = ph[n]["ratio_to_noise"]
         if r is not None:
@@ -581,15 +651,13 @@ def _explain_phases(ax, iteration):
                 f"{r:.0f}x" if r >= 10 else f"{r:.1f}x",
                 ha="center",
                 va="bottom",
-                fontsize=7,
             )
     ax.margins(y=0.12)  # room for the numbers above the tallest bar
     ax.set_xlabel("impact phase")
-    ax.set_ylabel("share of the residual energy\nin excess of the noise (dimensionless)")
+    ax.set_ylabel("share of the residual energy\nabove the noise")
     ax.set_title(
-        "where the model disagrees, by impact phase\n(red: above the noise; "
+        "where the model disagrees, by impact phase\n(red: above the noise;\n"
         "number: residual energy / noise energy)",
-        fontsize=9,
     )
 
 
@@ -611,12 +679,12 @@ def _explain_plane(fig, ax, iteration):
             vmax=lim / 1e3,
             shading="flat",
         )
-        fig.colorbar(im, ax=ax, label="mean residual F_N - F_E [kN]")
-        ax.set_xlabel("zeta [mm] (simulated)")
-        ax.set_ylabel("dzeta [m/s] (simulated)")
+        fig.colorbar(im, ax=ax, label=r"mean residual $F_N - F_E$ [kN]")
+        ax.set_xlabel(r"$\zeta$ [mm] (simulated)")
+        ax.set_ylabel(r"$\dot{\zeta}$ [m/s] (simulated)")
     else:
         ax.text(0.5, 0.5, "no positions in the record", ha="center", transform=ax.transAxes)
-    ax.set_title("residual over the (zeta, dzeta) plane (gray: no samples)", fontsize=9)
+    ax.set_title(r"residual over the ($\zeta$, $\dot{\zeta}$) plane" + "\n(gray: no samples)")
 
 
 def _explain_scores(ax, iteration):
@@ -626,7 +694,7 @@ def _explain_scores(ax, iteration):
     if sc or unscored:
         lm = [max(x["lm"], 1e-3) for x in sc]
         ax.barh(
-            [x["effect"] for x in sc],
+            [x["effect"].replace("_", " ") for x in sc],
             lm,
             color=[
                 "tab:green"
@@ -638,19 +706,15 @@ def _explain_scores(ax, iteration):
         # an effect whose small step changes the regime has no score, only its refit
         for x in unscored:
             ax.barh(
-                [x["effect"]],
+                [x["effect"].replace("_", " ")],
                 [max(lm, default=1.0)],
                 fill=False,
                 hatch="//",
                 edgecolor="tab:green" if x["effect"] == iteration.effect else "tab:gray",
             )
         ax.set_xscale("log")
-    ax.set_xlabel(
-        "score-test (LM) statistic (dimensionless; hatched: no local score, refitted)", fontsize=8
-    )
-    ax.set_title(
-        "candidate effects (green: named; orange: significant; gray: not significant)", fontsize=9
-    )
+    ax.set_xlabel("score-test (LM) statistic\n(hatched: no local score, refitted)")
+    ax.set_title("candidate effects\n(green: named; orange: significant;\ngray: not significant)")
 
 
 def explain_figure(iteration, measured, stem, k=1):
@@ -658,9 +722,10 @@ def explain_figure(iteration, measured, stem, k=1):
     named effect against the record, the residual's share by impact phase (and its ratio
     to the noise), the mean residual over the simulated (zeta, dzeta) plane, and every
     candidate effect's score test."""
-    fig, axes = subplots(2, 2, figsize=(13, 8.5), layout="constrained")
-    _explain_forces(axes[0, 0], iteration, measured, k)
-    _explain_phases(axes[0, 1], iteration)
-    _explain_plane(fig, axes[1, 0], iteration)
-    _explain_scores(axes[1, 1], iteration)
-    return _save(fig, stem)
+    with print_sizes():  # drawn at the width it is printed: its text 7 to 8 pt on paper
+        fig, axes = subplots(2, 2, figsize=(PRINT_WIDTH, 6.6), layout="constrained")
+        _explain_forces(axes[0, 0], iteration, measured, k)
+        _explain_phases(axes[0, 1], iteration)
+        _explain_plane(fig, axes[1, 0], iteration)
+        _explain_scores(axes[1, 1], iteration)
+        return _save(fig, stem)

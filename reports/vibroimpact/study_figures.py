@@ -21,6 +21,7 @@ import numpy as np
 from discovery.vibroimpact.studies.aggregate import wilson
 
 from .._mpl import save
+from .figures import terms_math
 
 __all__ = ["study_figures"]
 
@@ -61,7 +62,7 @@ def recovery_noise_figure(runs, cells, stem):
     methods = _levels(runs, cells, "selection")
     noises = _levels(runs, cells, "force_noise")
     lengths = _levels(runs, cells, "periods")
-    fig = _figure(figsize=(4.2 * len(lengths), 3.6))
+    fig = _figure(figsize=(4.2 * len(lengths) + 1.2, 3.6), layout="constrained")
     axes = fig.subplots(1, len(lengths), squeeze=False, sharey=True)[0]
     x = np.arange(len(noises))
     for ax, n_per in zip(axes, lengths, strict=True):
@@ -79,7 +80,7 @@ def recovery_noise_figure(runs, cells, stem):
         ax.set_ylim(-0.05, 1.05)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("exact support recovered")
-    axes[-1].legend(fontsize=8, loc="lower left")
+    axes[-1].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
     fig.suptitle("Recovery of the true support (Wilson 95 % intervals)", fontsize=11)
     return _save(fig, stem)
 
@@ -120,7 +121,7 @@ def recovery_map_figure(runs, cells, stem):
 def coverage_figure(runs, cells, stem):
     methods = _levels(runs, cells, "selection")
     noises = _levels(runs, cells, "force_noise")
-    fig = _figure(figsize=(6.4, 3.6))
+    fig = _figure(figsize=(6.7, 3.6), layout="constrained")
     ax = fig.subplots()
     width = 0.8 / max(len(noises), 1)
     for j, s in enumerate(noises):
@@ -162,7 +163,8 @@ def coverage_figure(runs, cells, stem):
     ax.set_title(
         "Coverage of the coefficient intervals (exact supports; n at the foot)", fontsize=10
     )
-    ax.legend(fontsize=7, loc="lower right")
+    # beside the axes, not over the bars
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     return _save(fig, stem)
 
 
@@ -184,7 +186,9 @@ def inclusion_figure(runs, cells, stem, truth_terms):
         im = ax.imshow(grid, origin="upper", vmin=0, vmax=1, cmap="Blues", aspect="auto")
         ax.set_xticks(range(len(noises)), [_pct(s) for s in noises], fontsize=8)
         ax.set_yticks(
-            range(len(terms)), [f"{t} (true)" if t in truth_terms else t for t in terms], fontsize=8
+            range(len(terms)),
+            [terms_math(t) + (" (true)" if t in truth_terms else "") for t in terms],
+            fontsize=8,
         )
         ax.set_xlabel("force noise")
         ax.set_title(m, fontsize=10)
@@ -203,6 +207,7 @@ def study_figures(config, runs, out):
     paths = []
     paths += recovery_noise_figure(runs, cells, str(out / "recovery_noise"))
     paths += recovery_map_figure(runs, cells, str(out / "recovery_map"))
-    paths += coverage_figure(runs, cells, str(out / "coverage"))
+    if any((r.get("coverage") or {}) for r in runs):  # no intervals: no empty chart
+        paths += coverage_figure(runs, cells, str(out / "coverage"))
     paths += inclusion_figure(runs, cells, str(out / "inclusion"), truth)
     return paths

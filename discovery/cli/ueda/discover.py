@@ -67,7 +67,7 @@ def run(args):
             out.path("strobe_model.csv"), ver.model_strobe, delimiter=",", header="x,v", comments=""
         )
         out.write_json("summary.json", summary)
-    print(f"discovered: {d.model.sympy()}")
+    print(f"discovered: {d.model.text()}")
     for k, c in d.coefficients.items():
         print(f"  {k:>12}: {c: .5f} +- {d.standard_errors[k]:.5f}")
     L = ver.lyapunov

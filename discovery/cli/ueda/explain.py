@@ -70,11 +70,11 @@ def run(args):
             comments="",
         )
         out.write_json("summary.json", summary)
-    print(f"start: {ex.start_model.sympy()}")
+    print(f"start: {ex.start_model.text()}")
     for it in ex.iterations:
         if it.effect:
             print(f"named {it.effect}: {it.evidence['text']}")
-    print(f"final: {ex.final_model.sympy()}")
+    print(f"final: {ex.final_model.text()}")
     for k, c in ex.coefficients.items():
         print(f"  {k:>12}: {c: .5f} +- {ex.standard_errors[k]:.5f}")
     for k, g in ex.gap.items():

@@ -188,6 +188,9 @@ class ExplainResult:
     noise_floor : dict
     consistent : bool
         The final model is consistent with every record.
+    limits : dict
+        The consistency limits of the record (one record only: with several, each
+        record has its own).
     stopped_because : str
     seconds : float
     settings : dict
@@ -212,6 +215,7 @@ class ExplainResult:
     settings: dict = field(default_factory=dict)
     separability: tuple = ()
     intervals: object = None
+    limits: dict = field(default_factory=dict)
 
     def as_dict(self):
         return {
@@ -223,6 +227,7 @@ class ExplainResult:
             },
             "criteria": self.criteria,
             "noise_floor": self.noise_floor,
+            "limits": self.limits,
             "consistent": self.consistent,
             "stopped_because": self.stopped_because,
             "separability": list(self.separability),
@@ -246,7 +251,7 @@ class ExplainResult:
                 else ""
             )
             out.append(f"  iteration {k + 1}: {it.effect or 'nothing named'}  {gap}")
-        out += criteria_lines(self.criteria, self.noise_floor)
+        out += criteria_lines(self.criteria, self.noise_floor, self.limits)
         out.append(f"  stopped because {self.stopped_because}")
         out.append(f"{self.seconds:.1f} s")
         return out
@@ -1571,6 +1576,7 @@ def explain(
         uncertainties=run.uncertainties,
         criteria=crit,
         noise_floor=floor,
+        limits=dict(evs[0].limits) if len(evs) == 1 else {},
         consistent=all(e.consistent for e in evs) and run.drift_free(run.model),
         stopped_because=run.stopped,
         separability=tuple(run.separability),

@@ -132,6 +132,12 @@ class RankedModel:
         }
 
     @property
+    def limits(self):
+        """The consistency limits the law was judged by: the record's own (empty for
+        several records: each has its own, in ``records``)."""
+        return dict(self.evaluation.limits) if len(self.evaluations) == 1 else {}
+
+    @property
     def consistent(self):
         """Consistent with every record."""
         return all(ev.consistent for ev in self.evaluations)
@@ -143,9 +149,12 @@ class RankedModel:
         bad = [(i, ev) for i, ev in enumerate(self.evaluations) if not ev.consistent]
         if not bad:
             return f"consistent with all {len(self.evaluations)} records"
-        i, ev = bad[0]
-        return f"inconsistent with record {i + 1}: {ev.verdict}" + (
-            f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
+        if len(bad) == 1:
+            i, ev = bad[0]
+            return f"inconsistent with record {i + 1}: {ev.verdict}"
+        # every record's verdict in full: none is cut to "(and 1 more)"
+        return f"inconsistent with {len(bad)} of {len(self.evaluations)} records: " + "; ".join(
+            f"record {i + 1}: {ev.verdict}" for i, ev in bad
         )
 
     @property
@@ -180,6 +189,7 @@ class RankedModel:
             "status": ev.status,
             "criteria": self.criteria,
             "noise_floor": self.noise_floor,
+            "limits": self.limits,
             "consistent": self.consistent,
             "verdict": self.verdict,
             "bic": self.candidate.bic,
@@ -315,7 +325,7 @@ class DiscoveryResult:
             f"{'consistent' if sel.consistent else 'NOT consistent'} with the record(s)"
         )
         out = [head, *coefficient_lines(sel.law.as_dict(), sel.standard_errors, sel.intervals)]
-        out += criteria_lines(sel.criteria, sel.noise_floor)
+        out += criteria_lines(sel.criteria, sel.noise_floor, sel.limits)
         out.append(f"  verdict: {sel.verdict}")
         out.append(f"ranking ({len(self.ranking)} candidates, criterion {crit}):")
         for i, m in enumerate(self.ranking[:8]):

@@ -148,9 +148,13 @@ class IdentificationResult:
         bad = [(i, ev) for i, ev in enumerate(self.checks) if not ev.consistent]
         if not bad:
             return f"consistent with all {len(self.checks)} records"
-        i, ev = bad[0]
-        more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
-        return f"inconsistent with record {i + 1}: {ev.verdict or ev.message}{more}"
+        if len(bad) == 1:
+            i, ev = bad[0]
+            return f"inconsistent with record {i + 1}: {ev.verdict or ev.message}"
+        # every record's verdict in full: none is cut to "(and 1 more)"
+        return f"inconsistent with {len(bad)} of {len(self.checks)} records: " + "; ".join(
+            f"record {i + 1}: {ev.verdict or ev.message}" for i, ev in bad
+        )
 
     def as_dict(self):
         """The result as JSON-ready data (the identification part of ``summary.json``)."""
@@ -172,6 +176,9 @@ class IdentificationResult:
             "seconds": self.seconds,
             "consistent": self.consistent,
             "verdict": self.verdict,
+            # the consistency limits the law was judged by (one record; with several,
+            # each record has its own)
+            "limits": dict(self.checks[0].limits) if len(self.checks) == 1 else {},
         }
 
     def _lines(self):
@@ -181,7 +188,12 @@ class IdentificationResult:
         ]
         out.append(f"  verdict: {self.verdict}")
         out += coefficient_lines(self.coefficients, self.standard_errors, self.intervals)
-        out += criteria_lines(self.criteria)
+        one = self.checks[0] if len(self.checks) == 1 else None
+        out += criteria_lines(
+            self.criteria,
+            one.noise_floor if one is not None else None,
+            one.limits if one is not None else None,
+        )
         if self.message:
             out.append(f"  optimiser: {self.message}")
         if self.failures:

@@ -31,7 +31,15 @@ from ...errors import InputError
 
 _IMPULSE = Instance("discovery.vibroimpact.data.impulse", "Impulse")
 
-__all__ = ["CRITERIA", "Comparison", "compare", "evaluate_criteria", "criterion"]
+__all__ = [
+    "CRITERIA",
+    "Criterion",
+    "Comparison",
+    "compare",
+    "evaluate_criteria",
+    "criterion",
+    "definition",
+]
 
 
 @dataclass(frozen=True)
@@ -186,14 +194,97 @@ def _i0(c):
     return 0.5 * (_i1(c) + _i4(c))
 
 
+@dataclass(frozen=True)
+class Criterion:
+    """One criterion: its function and how every printout and report names it.
+
+    The one definition of a criterion: ``print()`` of results, the CLI's tables and every
+    report read ``formula``, ``meaning`` and ``unit`` from here (see :func:`definition`).
+    Calling it computes it: ``CRITERIA["I2"](comparison)``.
+
+    Attributes
+    ----------
+    name : str
+        ``"I2"``.
+    function : callable
+        ``Comparison -> float``.
+    formula : str
+        Plain text, ``F_E`` measured and ``F_N`` simulated force, ``supp`` a contact
+        support, ``|.|`` its measure.
+    latex : str
+        The formula as LaTeX (math mode).
+    meaning : str
+        What it measures, in a few words.
+    unit : str
+        ``"1"``: every criterion is a ratio (dimensionless).
+    """
+
+    name: str
+    function: object
+    formula: str
+    latex: str
+    meaning: str
+    unit: str = "1"
+
+    def __call__(self, comparison):
+        return self.function(comparison)
+
+
 CRITERIA = {
-    "I0": _i0,
-    "I1": _i1,
-    "I2": _i2,
-    "I3": _i3,
-    "I4": _i4,
+    c.name: c
+    for c in (
+        Criterion(
+            "I0",
+            _i0,
+            "(I1 + I4) / 2",
+            r"\tfrac12 (I_1 + I_4)",
+            "mean of the peak-force error I1 and the contact-time mismatch I4",
+        ),
+        Criterion(
+            "I1",
+            _i1,
+            "max |F_N - F_E| / max |F_E|",
+            r"\max|F_N - F_E| \,/\, \max|F_E|",
+            "largest force difference relative to the measured peak",
+        ),
+        Criterion(
+            "I2",
+            _i2,
+            "int |F_N - F_E| dt / int |F_E| dt",
+            r"\int|F_N - F_E|\,dt \,/\, \int|F_E|\,dt",
+            "relative L1 distance of the force histories",
+        ),
+        Criterion(
+            "I3",
+            _i3,
+            "sqrt( int (F_N - F_E)^2 dt / int F_E^2 dt )",
+            r"\bigl(\int(F_N - F_E)^{2}\,dt \,/\, \int F_E^{2}\,dt\bigr)^{1/2}",
+            "relative L2 distance of the force histories",
+        ),
+        Criterion(
+            "I4",
+            _i4,
+            "|supp F_N (symmetric difference) supp F_E| / |supp F_E|",
+            r"|\operatorname{supp}F_N \,\triangle\, \operatorname{supp}F_E| \,/\, "
+            r"|\operatorname{supp}F_E|",
+            "contact-time mismatch: symmetric difference of the contact supports",
+        ),
+    )
 }
-"""Registry: name -> function of a :class:`Comparison` returning a float >= 0."""
+"""Registry: name -> :class:`Criterion` (callable on a :class:`Comparison`, returning a
+float >= 0).  A new criterion is one entry here; a plain function registered here works
+too (its printouts then say only its name, see :func:`definition`)."""
+
+
+def definition(name):
+    """The :class:`Criterion` of ``name`` for printouts and reports: the registry's entry,
+    or, for a name registered as a plain function or not registered, one that says only
+    the name (and the function's first docstring line as its meaning)."""
+    c = CRITERIA.get(name)
+    if isinstance(c, Criterion):
+        return c
+    doc = (getattr(c, "__doc__", None) or "").strip().splitlines()
+    return Criterion(str(name), c, "", "", doc[0] if doc else "", "1")
 
 
 def criterion(name):
