@@ -36,7 +36,7 @@ def criteria_lines(criteria, floor=None, limits=None, indent="  "):
     for k in (*CRITERIA, *(k for k in criteria if k not in CRITERIA)):
         if k in criteria:
             lim = (limits or {}).get(k)
-            meaning = definition(k).meaning if k in CRITERIA else ""
+            meaning = definition(k).meaning
             out.append(
                 f"{indent}{k:<10}{fmt(criteria[k], 3):>10}"
                 f"{fmt((floor or {}).get(k), 3):>10}"

@@ -276,11 +276,28 @@ float >= 0).  A new criterion is one entry here; a plain function registered her
 too (its printouts then say only its name, see :func:`definition`)."""
 
 
+MOTION_DEFINITIONS = {
+    "I5": Criterion(
+        "I5",
+        None,
+        "sqrt( sum_b n_b (Z_N,b - Z_E,b)^2 / sum_b n_b Z_E,b^2 ) over the contact window",
+        r"\bigl(\sum_b n_b (\zeta_{N,b} - \zeta_{E,b})^{2} \,/\, "
+        r"\sum_b n_b \zeta_{E,b}^{2}\bigr)^{1/2}",
+        "relative L2 distance of the recorded and simulated penetration over the contacts",
+    )
+}
+"""Criteria of the recorded motion, computed over a record span's folds
+(:mod:`~discovery.vibroimpact.verify.motion`: ``b`` a folded bin of ``n_b`` samples inside
+the contact window, ``zeta`` the penetration ``w1 - w2``), not from a :class:`Comparison`
+of forces; defined here beside the force's so that every printout reads one table."""
+
+
 def definition(name):
-    """The :class:`Criterion` of ``name`` for printouts and reports: the registry's entry,
-    or, for a name registered as a plain function or not registered, one that says only
-    the name (and the function's first docstring line as its meaning)."""
-    c = CRITERIA.get(name)
+    """The :class:`Criterion` of ``name`` for printouts and reports: the registry's entry
+    (or the motion's, :data:`MOTION_DEFINITIONS`), or, for a name registered as a plain
+    function or not registered, one that says only the name (and the function's first
+    docstring line as its meaning)."""
+    c = CRITERIA.get(name) or MOTION_DEFINITIONS.get(name)
     if isinstance(c, Criterion):
         return c
     doc = (getattr(c, "__doc__", None) or "").strip().splitlines()
