@@ -29,6 +29,11 @@ def print_sizes():
     )
 
 
+def figure(**kwargs):
+    """A standalone Figure (``figsize``, ``dpi``, ``layout``), for a grid of its own."""
+    return Figure(**kwargs)
+
+
 def subplots(nrows=1, ncols=1, **kwargs):
     """``(figure, axes)`` like ``pyplot.subplots``, on a standalone Figure."""
     fig = Figure(**{k: kwargs.pop(k) for k in _FIGURE_KEYS if k in kwargs})

@@ -5,7 +5,7 @@ Each function writes the same figure as PNG and PDF and returns the paths.
 
 import numpy as np
 
-from .._mpl import PRINT_WIDTH, colormap, print_sizes, save, subplots
+from .._mpl import PRINT_WIDTH, colormap, figure, print_sizes, save, subplots
 
 __all__ = ["landscape_figure", "identification_figure", "verify_figure", "explain_figure"]
 
@@ -546,12 +546,21 @@ def verify_figure(result, stem):
         Output path without extension (PNG and PDF are written).
     """
     from discovery.vibroimpact.verify.criteria import compare
+    from discovery.vibroimpact.verify.motion import force_penetration_loops
 
     ev = result.evaluation
     E = result.reference.impulse
-    fig, (ax, axr) = subplots(
-        2, 1, figsize=(PRINT_WIDTH, 4.8), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
-    )
+    loops = force_penetration_loops(result.reference, ev)
+    if loops is None:
+        fig, (ax, axr) = subplots(
+            2, 1, figsize=(PRINT_WIDTH, 4.8), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
+        )
+    else:  # the force-penetration loops beside the force histories
+        fig = figure(figsize=(PRINT_WIDTH, 5.6))
+        grid = fig.add_gridspec(2, 2, height_ratios=[3, 2], width_ratios=[1.5, 1])
+        ax = fig.add_subplot(grid[0, 0])
+        axr = fig.add_subplot(grid[1, 0], sharex=ax)
+        _loops_panel(fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, 1]), loops, ev)
     band = 2.0 * result.reference.noise.get("F", 0.0) / np.sqrt(max(E.n_cycles, 1))
     ms = 1e3
     sc, unit = _force_unit(E.peak)
@@ -579,7 +588,7 @@ def verify_figure(result, stem):
     crit = ", ".join(
         f"{k} {v:.3g} (floor {ev.noise_floor.get(k, float('nan')):.2g})"
         for k, v in ev.criteria.items()
-        if k in ("I2", "I4", "I3", "I0")
+        if k in ("I2", "I4", "I5")
     )
     ax.set_title(
         f"{law_math(result.law)}\n"
@@ -589,10 +598,43 @@ def verify_figure(result, stem):
     ax.set_ylabel(f"contact force F [{unit}]")
     ax.legend(fontsize=7, loc="best", framealpha=0.8)
     axr.set_ylabel(f"F_N - F_E [{unit}]")
-    axr.set_xlabel("time since the start of the contact [ms] (folded on the drive period)")
+    axr.set_xlabel("time since the contact's start [ms] (folded)")
     axr.axhline(0.0, color="k", lw=0.5)
     fig.tight_layout()
     return _save(fig, stem)
+
+
+def _loops_panel(ax, axz, loops, ev):
+    """The force against the penetration over the contacts (the loop), and both
+    penetrations over time there (what I5 compares)."""
+    t = loops["phase"] * 1e3
+    # the window's separate runs (a cycle's end, another contact) are not joined by a line
+    gap = np.flatnonzero(np.diff(t) > 5.0 * np.median(np.diff(t))) + 1 if t.size > 2 else []
+
+    def runs(v):
+        return np.insert(np.asarray(v, dtype=float), gap, np.nan)
+
+    zm, fm = (runs(v) for v in loops["measured"])
+    zn, fn = (runs(v) for v in loops["simulated"])
+    t = runs(t)
+    sc, unit = _force_unit(max(float(np.nanmax(np.abs(fm))), 1e-300))
+    ax.plot(zm * 1e3, fm * sc, "k.-", lw=0.8, ms=2, label="measured")
+    ax.plot(zn * 1e3, fn * sc, "C3.-", lw=0.8, ms=2, label="simulated")
+    ax.set_title("force-penetration loop", fontsize=8)
+    ax.set_xlabel("penetration w1 - w2 [mm]")
+    ax.set_ylabel(f"F [{unit}]")
+    ax.axvline(0.0, color="0.6", lw=0.5)
+    ax.legend(fontsize=7, loc="best", framealpha=0.8)
+    axz.plot(t, zm * 1e3, "k-", lw=0.8)
+    axz.plot(t, zn * 1e3, "C3-", lw=0.8)
+    axz.axhline(0.0, color="0.6", lw=0.5)
+    i5, lim = ev.criteria.get("I5"), (ev.limits or {}).get("I5")
+    if i5 is not None:
+        axz.set_title(
+            f"I5 {i5:.3g}" + (f" (limit {lim:.3g})" if lim is not None else ""), fontsize=8
+        )
+    axz.set_xlabel("time in the cycle [ms]")
+    axz.set_ylabel("w1 - w2 [mm]")
 
 
 def _explain_forces(ax, iteration, measured, k):

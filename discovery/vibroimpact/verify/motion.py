@@ -30,6 +30,7 @@ __all__ = [
     "penetration_residuals",
     "penetration_jacobian",
     "penetration_size",
+    "force_penetration_loops",
 ]
 
 MOTION_CRITERION = "I5"
@@ -198,3 +199,31 @@ def penetration_size(reference):
             for b, E in zip(span.blocks, reference.blocks, strict=True)
         )
     )
+
+
+def force_penetration_loops(reference, evaluation):
+    """The measured and simulated force-penetration loops of a record span's latest block:
+    the folded bin means inside the contact window, in phase order.
+
+    Returns
+    -------
+    dict or None
+        ``{"measured": (zeta, F), "simulated": (zeta, F), "phase": t}`` (ndarrays [m],
+        [N], and the bins' times since the fold's origin [s]); ``None``
+        for a record without positions or an evaluation without a simulation.
+    """
+    span = getattr(reference, "span", None)
+    z_sim = evaluation.extra.get("penetration") if evaluation is not None else None
+    blocks = evaluation.extra.get("blocks") if evaluation is not None else None
+    if span is None or span.sigma_z <= 0 or not z_sim or not blocks:
+        return None
+    blk, (E, S), zs = span.blocks[-1], blocks[-1], z_sim[-1]
+    fold = blk.fold
+    zm, zn = fold.average(blk.Z), fold.average(zs)
+    win = contact_window(fold, (E, S), (blk.Z, zs))
+    # the folded force at the bins (the impulses hold the bins between their two end knots)
+    return {
+        "measured": (zm[win], np.asarray(E.F[1:-1])[win]),
+        "simulated": (zn[win], np.asarray(S.F[1:-1])[win]),
+        "phase": fold.phase[win],
+    }
