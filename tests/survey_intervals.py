@@ -51,7 +51,7 @@ def _z0(case):
     return sc.scales()[1] / wc
 
 
-def run(i, *, n_boot=30, noise_model="cycles", periods=12):
+def run(i, *, n_boot=30, noise_model="cycles", periods=12, refit="two-step"):
     from discovery import identify
     from discovery.vibroimpact.verify import Reference, evaluate
 
@@ -61,7 +61,14 @@ def run(i, *, n_boot=30, noise_model="cycles", periods=12):
     fnoise, mnoise = NOISE[level]
     rng = np.random.default_rng(7000 + i)
     fs = float(rng.uniform(5000.0, 20000.0))
-    row = {"i": i, "category": category, "noise": level, "fs": fs, "interval_noise": noise_model}
+    row = {
+        "i": i,
+        "category": category,
+        "noise": level,
+        "fs": fs,
+        "interval_noise": noise_model,
+        "interval_refit": refit,
+    }
     try:
         case = R.draw_case(category, 100 + i)
         sc, law = case.scenario, case.law
@@ -87,6 +94,7 @@ def run(i, *, n_boot=30, noise_model="cycles", periods=12):
             max_simulations=200,
             n_boot_intervals=n_boot,
             interval_noise=noise_model,
+            interval_refit=refit,
             seed=i,
         )
         ev = evaluate(sc, res.law, ref)
@@ -111,6 +119,10 @@ def run(i, *, n_boot=30, noise_model="cycles", periods=12):
         sd = res.intervals.sd[name]
         row["covered"][name] = bool(lo <= true <= hi)
         row["z"][name] = (res.law.as_dict()[name] - true) / sd if sd > 0 else float("inf")
+        se = res.standard_errors.get(name, 0.0)
+        row.setdefault("z_jacobian", {})[name] = (
+            (res.law.as_dict()[name] - true) / se if se > 0 else float("inf")
+        )
     return row
 
 
@@ -125,6 +137,9 @@ def summary(rows):
     if not allv:
         return
     print(f"all: {sum(allv)}/{len(allv)} = {sum(allv) / len(allv):.1%} of coefficients")
+    jac = [abs(v) <= 1.96 for r in ok for v in r.get("z_jacobian", {}).values()]
+    if jac:
+        print(f"Jacobian standard errors (+-1.96 SE): {sum(jac)}/{len(jac)} = {np.mean(jac):.1%}")
     for key in ("category", "kind", "noise"):
         by = {}
         for r in ok:
@@ -139,6 +154,7 @@ def main(argv=None):
     p.add_argument("--first", type=int, default=0)
     p.add_argument("--bootstrap", type=int, default=30)
     p.add_argument("--noise", default="cycles", choices=("cycles", "white"))
+    p.add_argument("--refit", default="two-step", choices=("two-step", "full"))
     p.add_argument("--workers", type=int, default=1)
     p.add_argument("--summary", metavar="JSONL")
     a = p.parse_args(argv)
@@ -148,7 +164,7 @@ def main(argv=None):
         return 0
     idx = range(a.first, a.first + a.records)
     rows = []
-    kw = {"n_boot": a.bootstrap, "noise_model": a.noise}
+    kw = {"n_boot": a.bootstrap, "noise_model": a.noise, "refit": a.refit}
     if a.workers > 1:  # each record's line as soon as it is done
         with ProcessPoolExecutor(a.workers) as ex:
             futures = [ex.submit(_run_kw, (i, kw)) for i in idx]

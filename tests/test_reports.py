@@ -576,16 +576,20 @@ def test_a_two_scenario_fit_lists_every_scenario_and_record(runs):
 
 
 @pytest.mark.parametrize("files", [5, "report.tex", {"a": 1}, None, [1, ["x"]]])
-def test_a_malformed_manifest_is_one_line_or_a_report(runs, tmp_path, capsys, files):
+def test_a_malformed_manifest_is_one_line(runs, tmp_path, capsys, files):
+    """An edited manifest is a claim the report does not trust: one line, exit 2, and the
+    directory as it was (the manifest is not repaired behind the user's back)."""
     d = _copy_run(runs, "landscape", tmp_path)
     man = json.loads((d / ".vidi-manifest.json").read_text())
     man["files"] = files
     (d / ".vidi-manifest.json").write_text(json.dumps(man))
-    assert main(["report", str(d), "--no-pdf"]) == 0
-    assert "Traceback" not in capsys.readouterr().err
-    assert "report.tex" in json.loads((d / ".vidi-manifest.json").read_text())["files"]
+    before = sorted(p.name for p in d.iterdir())
+    assert main(["report", str(d), "--no-pdf"]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and err.count("\n") == 1
+    assert sorted(p.name for p in d.iterdir()) == before
     (d / ".vidi-manifest.json").write_text("[1, 2]")
-    assert main(["report", str(d), "--no-pdf"]) == 2  # report.tex is no longer listed as vidi's
+    assert main(["report", str(d), "--no-pdf"]) == 2
     assert capsys.readouterr().err.count("\n") == 1
 
 
