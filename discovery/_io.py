@@ -154,20 +154,25 @@ def short(text, limit=160):
     return f"{text[:half]} ... {text[-half:]}"
 
 
+def load_json(path):
+    """``(data, None)`` of a JSON file, ``(None, None)`` when there is none, ``(None, why)``
+    when it cannot be read as JSON (why in a few words)."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            return json.load(fh), None
+    except FileNotFoundError:
+        return None, None
+    except (OSError, ValueError, RecursionError) as exc:
+        return None, f"cannot be read as JSON ({type(exc).__name__})"
+
+
 def read_manifest(path, strict=False):
     """``(command, files)`` of a manifest file, ``None`` when there is none.  A malformed one
     (not an object, ``files`` not a list of names) raises :class:`InputError` when
     ``strict``, else reads as ``(None, [])``: nothing in it is claimed as vidi's."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            data = json.load(fh)
-    except FileNotFoundError:
+    data, why = load_json(path)
+    if data is None and why is None:
         return None
-    except (OSError, ValueError, RecursionError) as exc:
-        why = f"cannot be read as JSON ({type(exc).__name__})"
-        data = None
-    else:
-        why = None
     if why is None:
         if not isinstance(data, dict):
             why = f"holds a JSON {type(data).__name__}, not an object"

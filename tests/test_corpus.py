@@ -139,6 +139,8 @@ def _named(res):
     [
         ("c02-steep-onset", "penetration_velocity_coupling"),
         ("c06-unloading-damping", "unloading_damping"),
+        ("c08-strong-coupling", "penetration_velocity_coupling"),
+        ("c09-soft-hertz", "hertzian_stiffening"),
         ("c10-unloading-stiff", "unloading_damping"),
     ],
 )
@@ -186,3 +188,27 @@ def test_explain_names_the_contact_offset_within_its_interval(records):
     assert lo <= 0.0015 <= hi, (lo, hi)
     for name, true in law.as_dict().items():
         assert abs(res.final_model.law.as_dict()[name] - true) <= 0.05 * true, name
+
+
+def test_fit_selects_the_strong_coupling_support_with_intervals_that_hold(records):
+    """c08: the true support's refinement no longer stalls (it stopped at I2 0.632 and a law
+    without a damper was selected); measured: 1.503e8, 3.12e6, 1.187e11 for 1.5e8, 3e6,
+    1.2e11, each inside its 95 % interval."""
+    sc, m, law, _ = records["c08-strong-coupling"]
+    sel = discover(sc, m, library="poly:2", n_boot_intervals=30).selected
+    assert sel.law.names == law.names and sel.consistent, sel.verdict
+    for name, true in law.as_dict().items():
+        lo, hi = sel.intervals.bounds[name]
+        assert lo <= true <= hi, (name, lo, hi)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="not yet: explain names the coupling on c12, then stops with a spring 4x too soft "
+    "and no unloading damper, consistent by every criterion (I5 0.057 against its limit "
+    "0.068): the penetration's floor on this record is too wide to reject the soft spring",
+)
+def test_explain_names_both_hidden_effects_on_c12(records):
+    sc, m, _, _ = records["c12-coupling-unloading"]
+    res = explain(sc, m, "linear", workers=1, n_boot_intervals=0)
+    assert set(_named(res)) == {"penetration_velocity_coupling", "unloading_damping"}

@@ -86,6 +86,13 @@ P_K3, P_LOSS, P_SET, P_ZMAX, P_FLIGHT, N_PARAMS = 7, 8, 9, 10, 11, 12
 _ZENO_EVENTS, _ZENO_GAP = 1000, 1e-3
 
 
+@njit(cache=True)
+def _zeno_run(t, t_last_ev, hmax, short_run):
+    """The count of events in a row each within ``_ZENO_GAP * hmax`` of the previous one,
+    after an event at ``t`` (chattering beyond ``_ZENO_EVENTS``)."""
+    return short_run + 1 if t - t_last_ev < _ZENO_GAP * hmax else 0
+
+
 @njit(cache=True, inline="always")
 def _pw(x, p):
     if p == 0.0:
@@ -1012,13 +1019,10 @@ def integrate(
                         break
                 else:
                     zero_len = 0
-                    if t - t_last_ev < _ZENO_GAP * hmax:
-                        short_run += 1
-                        if short_run > _ZENO_EVENTS:
-                            status = CHATTER
-                            break
-                    else:
-                        short_run = 0
+                    short_run = _zeno_run(t, t_last_ev, hmax, short_run)
+                    if short_run > _ZENO_EVENTS:
+                        status = CHATTER
+                        break
                     t_last_ev = t
                 if m_s:
                     _event_time_sens(t, y, mode, 0, p, coef, ea, eb, br, S, spar, dc, fminus, tau)
@@ -1176,13 +1180,10 @@ def integrate(
             status = BLOW_UP
             break
         if best_index >= 0:
-            if t - t_last_ev < _ZENO_GAP * hmax:
-                short_run += 1
-                if short_run > _ZENO_EVENTS:
-                    status = CHATTER
-                    break
-            else:
-                short_run = 0
+            short_run = _zeno_run(t, t_last_ev, hmax, short_run)
+            if short_run > _ZENO_EVENTS:
+                status = CHATTER
+                break
             t_last_ev = t
             if m_s:
                 _event_time_sens(

@@ -47,6 +47,7 @@ from ..._io import (
     OutputDir,
     atomic_write_text,
     check_output,
+    load_json,
     provenance,
     running,
     short,
@@ -129,14 +130,10 @@ def _read_run(path, run=None, n_cells=None, bad=None):
     """The record in run file ``path``, or None when there is none or it is not a run of
     this study (checked against ``run``, the run it should hold: its key and cell; the
     reason goes to ``bad``)."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            data = json.load(fh)
-    except FileNotFoundError:
-        return None
-    except (OSError, ValueError, RecursionError) as exc:
-        if bad is not None:
-            bad.append((path, f"cannot be read ({type(exc).__name__})"))
+    data, why = load_json(path)
+    if data is None:
+        if why is not None and bad is not None:
+            bad.append((path, why))
         return None
     key = Path(path).stem
     why = _run_problem(data, key, n_cells if n_cells is not None else 1 << 62)
