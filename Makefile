@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed
 TEX_PACKAGES := latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended \
 	lmodern poppler-utils
 
-.PHONY: install demo study test test-slow test-all bench lint clean tex
+.PHONY: install demo study test test-slow test-all bench lint clean tex docs
 
 install: $(STAMP)
 
@@ -83,9 +83,13 @@ test-all: install
 bench: install
 	cd bench && ../$(BIN)/python run.py
 
+# The documentation site (docs/*.md, API reference from the docstrings), warnings as errors
+docs: install
+	$(BIN)/sphinx-build -W --keep-going -b html docs docs/_build/html
+
 lint: install
 	$(BIN)/ruff check discovery constraints reports tests bench
 	$(BIN)/ruff format --check discovery constraints reports tests bench
 
 clean:
-	rm -rf out bench/_work .pytest_cache
+	rm -rf out bench/_work .pytest_cache docs/_build
