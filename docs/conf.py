@@ -18,7 +18,7 @@ extensions = [
 
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 root_doc = "index"
-exclude_patterns = ["_build"]
+exclude_patterns = ["_build", "_generated"]
 
 # the pages are Markdown (MyST); headings get anchors so pages can link to sections
 myst_heading_anchors = 3
@@ -31,4 +31,22 @@ autodoc_member_order = "bysource"
 autodoc_typehints = "description"
 
 html_theme = "alabaster"
+
+
+def _criteria_page():
+    """docs/_generated/criteria.md: the criteria as the code defines them (the registry that
+    print(), the CLI and every report read), included by verification.md."""
+    from discovery.vibroimpact.verify.criteria import CRITERIA, MOTION_DEFINITIONS
+
+    lines = []
+    for c in (*CRITERIA.values(), *MOTION_DEFINITIONS.values()):
+        lines.append(f"- **{c.name}** = `{c.formula}`: {c.meaning} (unit {c.unit})")
+    out = Path(__file__).parent / "_generated" / "criteria.md"
+    out.parent.mkdir(exist_ok=True)
+    text = "\n".join(lines) + "\n"
+    if not out.exists() or out.read_text() != text:
+        out.write_text(text)
+
+
+_criteria_page()
 html_title = "vidi"
