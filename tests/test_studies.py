@@ -201,6 +201,9 @@ def test_study_runs_scores_and_writes_tables(quick_serial):
         assert r["tp"] + r["fn"] == 2 and r["tp"] + r["fp"] == len(r["selected"])
         assert r["exact"] == (sorted(r["selected"]) == ["z", "zd"])
         assert r["coef_error"] >= 0 and set(r["criteria"]) >= {"I0", "I2", "I3"}
+    # the runs' seconds over the wall time (one worker here: close to 1)
+    eff = json.loads((out / "summary.json").read_text())["parallel_efficiency"]
+    assert 0.3 < eff <= 1.05
     # the aggregates follow from the runs
     for row, ci in zip(res.cells, range(4), strict=True):
         rs = [r for r in res.runs if r["cell"] == ci]
@@ -379,3 +382,15 @@ def test_study_owns_its_directory_whatever_ran_before(tmp_path):
     finally:
         _RUN.update(prev)
     assert again.reused == 1 and again.executed == 0
+
+
+def test_runs_are_scheduled_longest_first():
+    """Longer records, larger libraries, the pysindy-based methods and refinements cost
+    more; the driver runs the most costly first so that no worker ends with one long run."""
+    from discovery.vibroimpact.studies.run import run_cost
+
+    base = {"periods": 12, "fs": 1e4, "library": "z, zd", "selection": "best-subset"}
+    assert run_cost({**base, "periods": 40}) > run_cost(base)
+    assert run_cost({**base, "library": "z, zd, z^2"}) > run_cost(base)
+    assert run_cost({**base, "selection": "sr3"}) > run_cost(base)
+    assert run_cost({**base, "refine": True}) > run_cost(base)

@@ -60,7 +60,7 @@ from ...errors import InputError, VidiTypeError
 from ...numerics.executor import make_executor
 from .aggregate import aggregate, run_rows, to_csv
 from .config import StudyConfig, load_study
-from .run import run_one
+from .run import run_cost, run_one
 
 __all__ = ["study", "StudyResult", "code_version"]
 
@@ -292,15 +292,22 @@ def _write_config(out, cfg, version):
 
 
 def _run_missing(todo, have, runs, rundir, version, workers, scheduler, executor, progress):
-    """Run ``todo`` on the executor, one file per finished run (its record also goes into
-    ``have``); returns the executor's name and the number of runs done."""
+    """Run ``todo`` on the executor, longest first (:func:`run_cost`), one file per finished
+    run (its record also goes into ``have``); returns the executor's name, the number of
+    runs done and the parallel efficiency (the runs' seconds over the wall time times the
+    workers; None when nothing ran)."""
     own = executor is None
     ex = make_executor(workers, scheduler) if own else executor
     name = repr(ex)
+    # the longest runs first, so no worker is left with one long run at the end (the
+    # results do not depend on the order: one file per run, tables from the files)
+    todo = sorted(todo, key=run_cost, reverse=True)
+    t0, busy = time.perf_counter(), 0.0
     try:
         done = 0
         tick(progress, "study: runs", len(have), len(runs))
         for _, res in ex.run(run_one, todo):
+            busy += float(res.get("seconds", 0.0))
             res["code_version"] = version
             res = to_jsonable(res)
             atomic_write_text(
@@ -312,7 +319,11 @@ def _run_missing(todo, have, runs, rundir, version, workers, scheduler, executor
     finally:
         if own:
             ex.close()
-    return name, done
+    wall = time.perf_counter() - t0
+    slots = max(1, min(int(getattr(ex, "workers", 1) or 1), len(todo)))
+    # the runs' own seconds over the wall time the workers were held
+    efficiency = busy / (wall * slots) if done and wall > 0 else None
+    return name, done, efficiency
 
 
 def _write_tables(out, cfg, records):
@@ -446,7 +457,7 @@ def study(
         if max_runs is not None:
             todo = todo[: int(max_runs)]
         try:
-            name, done = _run_missing(
+            name, done, efficiency = _run_missing(
                 todo, have, runs, work.runs, version, workers, scheduler, executor, progress
             )
             records = [have[r["key"]] for r in runs if r["key"] in have]
@@ -455,6 +466,7 @@ def study(
                 "reused": len(records) - done,
                 "executor": name,
                 "seconds": time.perf_counter() - t0,
+                "parallel_efficiency": efficiency,
             }
             settings = {"workers": workers, "scheduler": scheduler, "max_runs": max_runs}
             paths, cells, inclusion = _stage(

@@ -135,6 +135,22 @@ def score(result, truth):
     }
 
 
+#: relative cost of a selection method per run (measured on the paper study: the
+#: pysindy-based methods take about 3x a best-subset run)
+_METHOD_COST = {"stlsq": 3.0, "sr3": 3.0, "constrained-sr3": 3.0}
+
+
+def run_cost(spec):
+    """A run's predicted cost, in arbitrary units, for scheduling the longest runs first:
+    samples recorded (periods x sample rate, the record's own simulation and every
+    refinement's scale with them), the library's terms, the selection method, and a
+    refinement by simulation."""
+    terms = max(1, len(str(spec.get("library", "")).split(",")))
+    samples = float(spec.get("periods", 1)) * float(spec.get("fs", 1.0))
+    method = _METHOD_COST.get(str(spec.get("selection")), 1.0)
+    return samples * terms * method * (3.0 if spec.get("refine") else 1.0)
+
+
 def run_one(context, spec):
     """Do one run (``context`` is unused: every run is self-contained).  Returns the run's
     description with its measures, ``status`` and ``seconds``."""
