@@ -4,6 +4,7 @@
 - every backticked dotted path ``discovery.X.Y`` (also ``reports``, ``constraints``) resolves;
 - every Python block marked ``<!-- runnable ... -->`` runs as printed, in a directory holding
   the quickstart's record (``vidi simulate`` as the README prints it);
+- every relative link and image of the pages exists;
 - the docs' quickstart is the README's.
 """
 
@@ -73,6 +74,17 @@ def test_every_documented_path_resolves():
                 _resolve(p)
             except (ImportError, AttributeError) as exc:
                 bad.append(f"{page.name}: {p} ({exc})")
+    assert not bad, bad
+
+
+def test_every_relative_link_and_image_exists():
+    bad = []
+    for page in PAGES:
+        for target in re.findall(r"\]\(([^)\s]+)\)", page.read_text()):
+            if re.match(r"[a-z]+:", target) or target.startswith("#"):
+                continue
+            if not (page.parent / target.split("#")[0]).exists():
+                bad.append(f"{page.name}: {target}")
     assert not bad, bad
 
 
