@@ -92,4 +92,4 @@ lint: install
 	$(BIN)/ruff format --check discovery constraints reports tests bench
 
 clean:
-	rm -rf out bench/_work .pytest_cache docs/_build
+	rm -rf out bench/_work .pytest_cache docs/_build docs/_generated
