@@ -5,7 +5,7 @@ One iteration (:func:`explain`):
 
 1. **Verify** the current model against every record
 (:func:`discovery.vibroimpact.verify.evaluate`):
-   if it is consistent (same regime; I2 and I4 within their noise floors) there is
+   if it is consistent (same regime; I2, I4 and I5 within their limits) there is
    nothing to explain, and the loop stops: no false discoveries.
 2. **Localise** the disagreement (:func:`~discovery.vibroimpact.explain.localise.localise`).
 3. **Score** every applicable catalogue effect by a Lagrange-multiplier (score) test for
@@ -966,8 +966,9 @@ def _stop_consistent(run, before, floor):
     """The model is consistent: the loop stops (and, when nothing was named, says which
     effects this record cannot tell from the model)."""
     run.stopped = (
-        "the model is consistent with the record(s): I2 and I4 within their "
-        "noise floors, no drift across the impacts, nothing left to explain"
+        "the model is consistent with the record(s): I2, I4 (and I5 with positions) "
+        "within their consistency limits, no drift across the impacts, nothing left to "
+        "explain"
     )
     if any(it.effect for it in run.iterations):
         return
