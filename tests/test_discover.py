@@ -240,7 +240,9 @@ def test_rank_keeps_every_model():
 def noisy_positions(paper):
     """Positions with 1 % noise and no velocities, the poly:2 library, stability selection:
     the regression proposes four-term supports; the output-error backward steps find the
-    simplest consistent law."""
+    simplest consistent law.  (They did not while the refinement compared the force alone:
+    the z + zd refinement started outside its basin; with the recorded penetration in the
+    residual it reaches it.)"""
     m = synthesize(
         paper,
         paper.law,
@@ -255,14 +257,7 @@ def noisy_positions(paper):
     return discover(paper, m, library="poly:2", stability=10, n_boot_intervals=0)
 
 
-@pytest.mark.slow  # the fixture's discovery takes 6 min
-@pytest.mark.xfail(
-    reason="records judged over their span: with 1 % position noise and no "
-    "velocities the biased regression starts the z + zd refinement outside the "
-    "basin (the true law is consistent at 0.023); no consistent model is found and "
-    "the selected z + zd + z*zd + zd^2 is no contact law (README, limits)",
-    strict=False,
-)
+@pytest.mark.slow  # the fixture's discovery takes about 20 min on two cores
 def test_backward_steps_reach_the_simplest_consistent_law(noisy_positions):
     res = noisy_positions
     sel = res.selected
@@ -274,14 +269,7 @@ def test_backward_steps_reach_the_simplest_consistent_law(noisy_positions):
     assert all(len(m.law.names) >= 2 for m in res.ranking if m.consistent)
 
 
-@pytest.mark.slow  # the fixture's discovery takes 6 min
-@pytest.mark.xfail(
-    reason="records judged over their span: with 1 % position noise and no "
-    "velocities the biased regression starts the z + zd refinement outside the "
-    "basin (the true law is consistent at 0.023); no consistent model is found and "
-    "the selected z + zd + z*zd + zd^2 is no contact law (README, limits)",
-    strict=False,
-)
+@pytest.mark.slow  # the fixture's discovery takes about 20 min on two cores
 def test_equivalent_models_say_why_and_what_would_separate_them(noisy_positions):
     res = noisy_positions
     sel = res.selected
@@ -294,15 +282,7 @@ def test_equivalent_models_say_why_and_what_would_separate_them(noisy_positions)
         assert e["separate"]
 
 
-@pytest.mark.slow  # the fixture's discovery takes 6 min
-@pytest.mark.xfail(
-    reason="with exact output-error Jacobians the refinements from this biased regression "
-    "reach no consistent model: the selected z + zd + z*zd + zd^2 (no contact law, I2 1.55) "
-    "holds every stable term, so stability selection has nothing to disagree with (with "
-    "forward differences z + z*zd + zd^2 was consistent and zd the disagreement); the "
-    "warning's rule is tested on its own (README, limits)",
-    strict=False,
-)
+@pytest.mark.slow  # the fixture's discovery takes about 20 min on two cores
 def test_stability_disagreement_is_a_warning(noisy_positions):
     res = noisy_positions
     strong = [t for t, f in res.stability.items() if f >= 0.5 and t not in res.selected.law.names]
