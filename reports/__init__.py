@@ -15,6 +15,7 @@ _EXPORTS = {
         "identification_figure",
         "landscape_figure",
         "verify_figure",
+        "loops_figure",
     )
 }
 
@@ -26,6 +27,7 @@ __all__ = [
     "fit_loop_figure",
     "verify_figure",
     "explain_figure",
+    "loops_figure",
 ]
 
 lazy_package(__name__, _EXPORTS)

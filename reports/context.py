@@ -53,7 +53,8 @@ def criterion_definition(name):
 
 FIGURE_CAPTIONS = {
     "verify": "Measured force (black) and the law's simulated force (red), folded on the "
-    "drive phase over the record's span.",
+    "drive phase over the record's span; with positions, the force-penetration loop and both "
+    "penetrations over the contacts (what I5 compares).",
     "fit_impulse": "Measured impulse and the simulated steady states of the best models.",
     "fit_surface": Tex(
         r"The selected law over the ($\zeta$, $\dot\zeta_+$) plane with the contact samples."
@@ -69,6 +70,8 @@ FIGURE_CAPTIONS = {
     "basins": "Basins of the coexisting attractors.",
     "chart": "Regime chart over the forcing frequency and amplitude.",
     "explain": "The missing effect: where the model disagrees before and after it is added.",
+    "explain_loops": "The final model against the record: the force-penetration loop and both "
+    "penetrations over the contacts (what I5 compares).",
     "recovery_noise": "Exact-support recovery against the force noise, per selection method "
     "and record length (Wilson 95 % intervals).",
     "recovery_map": "Recovery over force noise and record length, per selection method "
@@ -523,6 +526,29 @@ def _landscape(s, run_dir):
     return c
 
 
+def _effect_parameter_rows(fm, catalogue):
+    """Rows of the added effects' own parameters (a machine parameter such as the contact
+    offset, an observation's such as a sensor's lag), by the catalogue's names and units."""
+    if not isinstance(catalogue, list):
+        return []
+    values = {**(fm.get("scenario") or {}), **(fm.get("observation") or {})}
+    rows = []
+    for e in catalogue:
+        if not isinstance(e, dict) or e.get("id") not in (fm.get("effects") or []):
+            continue
+        key, params = e.get("key"), e.get("parameters") or []
+        if key not in values or not params or not isinstance(params[0], dict):
+            continue
+        name, unit = str(params[0].get("name")), str(params[0].get("unit", ""))
+        rows += _coef_rows(
+            {name: values[key]},
+            fm.get("uncertainties"),
+            _intervals(fm),
+            term=lambda n, u=unit: Tex(r"\texttt{" + escape(n) + "} [" + escape(u) + "]"),
+        )
+    return rows
+
+
 def _explain(s, run_dir):
     fm = s.get("final_model") or {}
     its = s.get("iterations") or []
@@ -535,7 +561,8 @@ def _explain(s, run_dir):
         + [
             [Tex("unloading " + term_tex(k, unloading=True)), num(v, 4), Tex("--"), Tex("--")]
             for k, v in (fm.get("unloading") or {}).items()
-        ],
+        ]
+        + _effect_parameter_rows(fm, s.get("catalogue")),
         "effects": [str(e).replace("_", " ") for e in fm.get("effects") or []],
         "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
         "stopped": prose(s.get("stopped_because", "--")),

@@ -264,6 +264,8 @@ def test_explain_cli_end_to_end(hidden_coupling, tmp_path, capsys):
     assert set(s["noise_floor"]) == {"I0", "I1", "I2", "I3", "I4", "I5", "D"}
     assert s["stopped_because"]
     assert (out / "explain_1.png").stat().st_size > 10_000
+    # the final model's force-penetration loops against the record (it has positions)
+    assert (out / "explain_loops.png").stat().st_size > 10_000
     assert "penetration_velocity_coupling" in capsys.readouterr().out
     bad = tmp_path / "bad"
     assert main(["explain", "--data", str(data), "--effects", "gremlins", "--out", str(bad)]) == 2

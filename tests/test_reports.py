@@ -625,3 +625,22 @@ def test_figures_are_printed_at_the_size_they_were_drawn(runs, kind):
         )
         scale = min(TEXT_WIDTH_IN / w, float(frac) * TEXT_HEIGHT_IN / h)
         assert scale >= 0.9, (kind, name, w, h, scale)
+
+
+def test_an_explain_report_lists_the_effects_own_parameters():
+    """A machine or observation parameter an effect added (the contact offset's delta0, a
+    sensor's lag) is a row of the final model's table, with its unit and interval."""
+    from discovery.vibroimpact.explain import EFFECTS
+    from reports.context import _effect_parameter_rows
+
+    fm = {
+        "effects": ["contact_offset"],
+        "scenario": {"offset": 0.0015},
+        "uncertainties": {"delta0": 3e-7},
+        "intervals": {"bounds": {"delta0": [0.001499, 0.001501]}},
+    }
+    rows = _effect_parameter_rows(fm, [e.as_dict() for e in EFFECTS])
+    assert len(rows) == 1
+    assert "delta0" in str(rows[0][0]) and "[m]" in str(rows[0][0])
+    assert "0.001499" in str(rows[0][3])
+    assert _effect_parameter_rows(fm, None) == []  # an edited summary without a catalogue

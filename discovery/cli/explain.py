@@ -23,8 +23,24 @@ from ._common import (
 )
 
 
+def _final_loops(res, scenario, measurement, args):
+    """``(loops, evaluation)`` of the final model against the first record (its
+    force-penetration loops: :func:`~discovery.vibroimpact.verify.motion.
+    force_penetration_loops`), None without positions."""
+    from ..vibroimpact.verify import Reference, evaluate
+    from ..vibroimpact.verify.motion import force_penetration_loops
+
+    if isinstance(measurement, Reference):
+        return None
+    fm = res.final_model
+    ref = Reference.from_measurement(measurement, scenario, n_boot=args.n_boot, seed=args.seed)
+    ev = evaluate(fm.apply(scenario), fm.law, ref, observe=fm.observe())
+    loops = force_penetration_loops(ref, ev)
+    return None if loops is None else (loops, ev)
+
+
 def run(args):
-    from reports import explain_figure
+    from reports import explain_figure, loops_figure
 
     from ..catalogue import select
     from ..vibroimpact.explain import EFFECTS, explain
@@ -63,11 +79,20 @@ def run(args):
         "catalogue": [e.as_dict() for e in EFFECTS],
         "explain_settings": res.settings,
     }
+    loops = _final_loops(res, scs[0], meas[0], args)
     with OutputDir(args.out) as out:
         files = []
         for k, it in enumerate(res.iterations, start=1):
             explain_figure(it, it.measured, str(out.path(f"explain_{k}")), k)
             files.append(f"explain_{k}.png/.pdf")
+        if loops is not None:
+            loops_figure(
+                *loops,
+                str(out.path("explain_loops")),
+                res.final_model.law,
+                "final model against the first record",
+            )
+            files.append("explain_loops.png/.pdf")
         summary["seconds"] = time.perf_counter() - t_start
         out.write_json(
             "summary.json", {**summary, **provenance(vars(args), inputs=inputs_of(args))}

@@ -604,6 +604,29 @@ def verify_figure(result, stem):
     return _save(fig, stem)
 
 
+def loops_figure(loops, evaluation, stem, law, what):
+    """The force-penetration loop and both penetrations over the contacts of a model
+    against a record (:func:`discovery.vibroimpact.verify.motion.force_penetration_loops`),
+    e.g. explain's final model.
+
+    Parameters
+    ----------
+    loops : dict
+    evaluation : Evaluation
+        Its I5 and limit go in the title.
+    stem : str
+        Output path without extension (PNG and PDF are written).
+    law : ForceLaw
+    what : str
+        What the law is, for the title (e.g. "final model").
+    """
+    fig, (ax, axz) = subplots(1, 2, figsize=(PRINT_WIDTH, 3.0))
+    _loops_panel(ax, axz, loops, evaluation)
+    fig.suptitle(f"{what}: {law_math(law)}", fontsize=8)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
 def _loops_panel(ax, axz, loops, ev):
     """The force against the penetration over the contacts (the loop), and both
     penetrations over time there (what I5 compares)."""
