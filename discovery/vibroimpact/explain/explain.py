@@ -1283,6 +1283,13 @@ def _name_effect(run, good, evs, before, floor, loc, screening, m2, res, evs2):
         f"{floor.get(key, float('nan')):.3g}); signature "
         f"{'agrees' if s['signature_agrees'] else 'does not agree'} with the "
         f"localisation (largest shares: {', '.join(screening.top_phases)})"
+        + (
+            ""
+            if s["signature_agrees"]
+            else "; named on the score test and the refit, which decide: the phases "
+            "where the residual is largest are a hint, and an effect that changes the "
+            "impact as a whole moves the residual everywhere"
+        )
     )
     run.iterations.append(
         Iteration(
