@@ -157,11 +157,15 @@ def _verify_data(name, *extra):
 
 CASES = [
     # ---------------------------------------------------------------- the command line
-    ("unknown-command", ["simulat"], "unknown command 'simulat'; choose one of"),
+    (
+        "unknown-command",
+        ["simulat"],
+        "unknown command 'simulat' (did you mean 'simulate'?); choose one of",
+    ),
     (
         "unknown-option",
         ["steady", "--bogus"],
-        "unrecognized option(s) or value(s) --bogus; see vidi steady --help",
+        "unknown option '--bogus'; see vidi steady --help",
     ),
     ("stray-value", ["steady", "paper"], "unrecognized option(s) or value(s) paper"),
     ("missing-required", ["verify", "--data", "good.csv"], "missing required option(s) --out"),

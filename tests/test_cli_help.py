@@ -169,3 +169,21 @@ def test_help_loads_no_heavy_library():
         [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
     ).stdout.strip()
     assert out == "", f"vidi --help imports {out}"
+
+
+def test_a_mistyped_command_or_option_gets_a_did_you_mean(capsys, tmp_path):
+    """One line, exit 2, the closest name; an unambiguous prefix is still an option."""
+    from discovery.cli import main
+
+    assert main(["fitt"]) == 2
+    err = capsys.readouterr().err
+    assert "did you mean 'fit'" in err and err.count("\n") == 1
+    assert main(["fit", "--dta", "x.csv", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "unknown option '--dta'" in err and "did you mean '--data'" in err
+    assert main(["ueda", "attractor", "--modle", "negres"]) == 2
+    assert "did you mean '--model'" in capsys.readouterr().err
+    # a prefix argparse takes: the command goes on to the missing file
+    assert main(["fit", "--dat", str(tmp_path / "none.csv"), "--out", str(tmp_path / "o")]) == 2
+    assert "does not exist" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()

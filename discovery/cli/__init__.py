@@ -50,9 +50,10 @@ def _one_line(message, prog, command=None):
     if m:
         opt, value, choices = m.groups()
         choices = choices.replace("'", "")
+        hint = _did_you_mean(value, [c.strip() for c in choices.split(",")])
         if opt in ("COMMAND", "command"):
-            return f"unknown command {value!r}; choose one of {choices} ({see})"
-        return f"{opt}: invalid choice {value!r}; choose one of {choices}"
+            return f"unknown command {value!r}{hint}; choose one of {choices} ({see})"
+        return f"{opt}: invalid choice {value!r}{hint}; choose one of {choices}"
     m = re.match(r"argument (\S+?)(?:/\S+)?: invalid (\w+) value: '(.*)'$", message, re.S)
     if m:
         opt, kind, value = m.groups()
@@ -342,6 +343,41 @@ def _options_on_line(parser, argv):
     return sp, found
 
 
+def _did_you_mean(word, choices):
+    """`` (did you mean 'x'?)`` for the closest of ``choices``, or nothing."""
+    import difflib
+
+    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def _refuse_unknown(parser, argv):
+    """A long option the (sub)command does not have is named, with the closest one it has
+    (argparse would first complain of a missing required option, or name it without a
+    hint); an unambiguous prefix of an option is accepted, as argparse does."""
+    sp, rest = parser, list(argv)
+    while True:
+        sub = next((a for a in sp._actions if isinstance(a, argparse._SubParsersAction)), None)
+        name = next((t for t in rest if not t.startswith("-")), None)
+        if sub is None or name not in sub.choices:
+            break
+        sp, rest = sub.choices[name], rest[rest.index(name) + 1 :]
+    options = [o for o in sp._option_string_actions if o.startswith("--")]
+    for tok in rest:
+        if tok == "--":
+            break
+        opt = tok.split("=", 1)[0]
+        if not opt.startswith("--") or opt in sp._option_string_actions:
+            continue
+        if len({sp._option_string_actions[o].dest for o in options if o.startswith(opt)}) == 1:
+            continue  # an abbreviation argparse takes
+        command = sp.prog.removeprefix("vidi").strip()
+        see = f"vidi {command} --help" if command else "vidi --help"
+        # compared without the dashes every option shares
+        hint = _did_you_mean(opt[2:], [o[2:] for o in options]).replace(" '", " '--", 1)
+        raise UsageError(f"unknown option {opt!r}{hint}; see {see}")
+
+
 def _refuse_repeats(parser, argv):
     """A value option given twice (``--law A --law B``) is refused: argparse would keep the
     last one silently.  Options that collect values (``--data`` of ``fit``) may repeat."""
@@ -498,6 +534,7 @@ def _run(argv):
             return 0
         try:
             line = _attach_dash_values(parser, argv)
+            _refuse_unknown(parser, line)
             _refuse_repeats(parser, line)
             args = parser.parse_args(line)
             _refuse_orphans(parser, line)
