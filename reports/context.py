@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 
 from discovery.vibroimpact.verify.criteria import CRITERIA as _REGISTRY
-from discovery.vibroimpact.verify.criteria import definition
+from discovery.vibroimpact.verify.criteria import MOTION_DEFINITIONS, definition
 
 from .lawtex import (
     law_equation,
@@ -31,9 +31,13 @@ __all__ = ["context", "KINDS", "criterion_names"]
 
 
 def criterion_names(*mappings):
-    """The criteria of the registry (its order) found in any of ``mappings``; a name the
-    registry does not hold (an edited summary) is not shown."""
-    return [k for k in _REGISTRY if any(isinstance(m, dict) and k in m for m in mappings)]
+    """The criteria of the registry (its order, then the motion's: I5) found in any of
+    ``mappings``; a name neither defines (an edited summary) is not shown."""
+    return [
+        k
+        for k in (*_REGISTRY, *MOTION_DEFINITIONS)
+        if any(isinstance(m, dict) and k in m for m in mappings)
+    ]
 
 
 def criterion_tex(name):
@@ -288,9 +292,13 @@ def _verify(s, run_dir):
                 if over
                 else ""
             )
-            + ". The figure shows where the simulated force "
-            "departs from the measured one; `vidi explain` names the effect most "
-            "likely missing."
+            + (
+                ". The figure shows where the simulated force and penetration depart "
+                "from the measured ones"
+                if "I5" in over
+                else ". The figure shows where the simulated force departs from the measured one"
+            )
+            + "; `vidi explain` names the effect most likely missing."
         )
     reg = c["regime"]
     if reg and reg.get("measured") != reg.get("simulated"):

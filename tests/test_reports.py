@@ -644,3 +644,14 @@ def test_an_explain_report_lists_the_effects_own_parameters():
     assert "delta0" in str(rows[0][0]) and "[m]" in str(rows[0][0])
     assert "0.001499" in str(rows[0][3])
     assert _effect_parameter_rows(fm, None) == []  # an edited summary without a catalogue
+
+
+def test_the_criteria_table_holds_the_motion_criterion():
+    """I5 (the recorded penetration) is a row of every criteria table where the result has
+    it, after the force's, with its formula and meaning."""
+    from reports.context import _criteria_table, criterion_names
+
+    crit = {"I2": 0.04, "I5": 0.126, "bogus": 1.0}
+    assert criterion_names(crit) == ["I2", "I5"]
+    rows = _criteria_table(crit, {"I2": 0.02, "I5": 0.012}, {"I2": 0.054, "I5": 0.0295})
+    assert "penetration" in str(rows[1][4]) and "0.0295" in str(rows[1][3])
