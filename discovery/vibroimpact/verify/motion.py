@@ -22,6 +22,8 @@ sample times).  A record without positions has no I5; its verdict says so.
 
 import numpy as np
 
+from ...numerics.memo import Memo
+
 __all__ = [
     "MOTION_CRITERION",
     "penetration_criterion",
@@ -126,17 +128,15 @@ for every law), wide enough to hold a law's longer contact."""
 
 
 def _residual_window(blk, measured):
-    # fixed by the record: asked once per block
-    w = _WINDOWS.get(id(blk))
-    if w is None or w[0] is not blk:
-        w = (blk, contact_window(blk.fold, (measured,), (blk.Z,), pad=RESIDUAL_PAD))
-        if len(_WINDOWS) > 256:
-            _WINDOWS.clear()
-        _WINDOWS[id(blk)] = w
-    return w[1]
+    """The record's residual window of a block, asked once per block (the memo's entry
+    keeps the block, so its id is not reused while cached)."""
+    return _WINDOWS.get(
+        id(blk),
+        lambda: (blk, contact_window(blk.fold, (measured,), (blk.Z,), pad=RESIDUAL_PAD)),
+    )[1]
 
 
-_WINDOWS = {}
+_WINDOWS = Memo(256)
 
 
 def penetration_residuals(reference, evaluation, weights=None):
