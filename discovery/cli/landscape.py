@@ -206,7 +206,7 @@ def run(args):
 def register(sub):
     s = sub.add_parser(
         "landscape",
-        help="criteria I0..I4 over a grid of the first two coefficients (paper Figs. 4-5)",
+        help="criteria I0..I5 over a grid of the first two coefficients (paper Figs. 4-5)",
     )
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
     s.add_argument(

@@ -66,7 +66,7 @@ def register(sub):
     s = sub.add_parser(
         "verify",
         help="is a law consistent with a record? full simulation, "
-        "criteria I0..I4 against their noise floor",
+        "criteria I0..I4 (force) and I5 (penetration, with positions) against their noise floors",
     )
     s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
     s.add_argument(
