@@ -10,6 +10,7 @@ from ..._lazy import lazy_package
 _EXPORTS = {
     "CONSISTENCY_CRITERIA": "evaluate",
     "CONSISTENCY_FACTOR": "evaluate",
+    "CONSISTENCY_FACTORS": "evaluate",
     "CONSISTENCY_SLACK": "evaluate",
     "Evaluation": "evaluate",
     "align": "evaluate",
@@ -31,6 +32,7 @@ __all__ = [
     "VerifyResult",
     "CONSISTENCY_CRITERIA",
     "CONSISTENCY_FACTOR",
+    "CONSISTENCY_FACTORS",
     "CONSISTENCY_SLACK",
     "consistency_limits",
 ]
