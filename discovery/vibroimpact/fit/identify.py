@@ -992,6 +992,12 @@ def identify(
 # block, where a least-squares refit took about five of each.  On 12-period records of the
 # coverage survey the bootstrap's standard deviations stayed within 10 % of the full
 # refits' (one step: 23 %), in a third of the time.  ``refit="full"`` keeps the full refit.
+#
+# A record has few cycles (a dozen, six for a period-two orbit) against two to four
+# parameters, and a cluster bootstrap's spread, like the cluster-robust variance it mimics,
+# is then too small by about ``(G - p) / G`` and itself uncertain.  The spread is scaled by
+# ``sqrt(G / (G - p))`` and the interval takes Student's t with ``G - p`` degrees of freedom
+# (Cameron & Miller 2015, section VI), as a regression's does with ``N - p``.
 
 
 @dataclass(frozen=True)
@@ -1001,14 +1007,18 @@ class Intervals:
     Attributes
     ----------
     bounds : dict
-        ``{name: (low, high)}`` at ``level``: the estimate +- z * (bootstrap sd).
+        ``{name: (low, high)}`` at ``level``: the estimate +- q * sd, ``q`` the quantile of
+        Student's t with ``dof`` degrees of freedom (the normal's when ``dof`` is 0).
     sd : dict
-        ``{name: bootstrap standard deviation}``.
+        ``{name: standard error}``: the bootstrap's standard deviation, scaled by
+        ``sqrt(G / (G - p))`` for ``G`` resampled cycles and ``p`` parameters.
     level : float
     n_boot : int
         Replicates whose refit succeeded.
     seed : int
     method : str
+    dof : int
+        ``G - p`` (0: white noise, the normal quantile).
     """
 
     bounds: dict
@@ -1017,6 +1027,7 @@ class Intervals:
     n_boot: int
     seed: int
     method: str = "parametric bootstrap through the record-span processing"
+    dof: int = 0
 
     def as_dict(self):
         return {
@@ -1026,6 +1037,7 @@ class Intervals:
             "n_boot": self.n_boot,
             "seed": self.seed,
             "method": self.method,
+            "dof": self.dof,
         }
 
 
@@ -1183,6 +1195,7 @@ def bootstrap_intervals(
         than 5 refits succeeded.
     """
     from scipy.stats import norm
+    from scipy.stats import t as student_t
 
     if not (isinstance(n_boot, int) and n_boot >= 5):
         raise InputError(f"n_boot must be an integer >= 5; got {n_boot!r}")
@@ -1230,7 +1243,17 @@ def bootstrap_intervals(
     names = list(model.names)
     est = np.array(model.coefficients, dtype=float)
     sd = D.std(axis=0, ddof=1)
+    dof = 0
     z = float(norm.ppf(0.5 + level / 2))
+    if noise == "cycles":
+        # few clusters (the cycles) against the parameters: the t interval of G - p degrees
+        # of freedom on the spread scaled by sqrt(G / (G - p)) (see the comment above)
+        G = sum(b.fold.n_cycles for _, ref in records for b in ref.span.blocks)
+        dof = G - len(names)
+        if dof < 1:
+            return None  # fewer cycles than parameters: the cycles cannot give a spread
+        sd = sd * np.sqrt(G / dof)
+        z = float(student_t.ppf(0.5 + level / 2, dof))
     return Intervals(
         bounds={
             n: (float(e - z * s), float(e + z * s)) for n, e, s in zip(names, est, sd, strict=True)
@@ -1240,11 +1263,13 @@ def bootstrap_intervals(
         n_boot=len(draws),
         seed=int(seed),
         method=(
-            "wild bootstrap by cycles (the record's residuals, one weight per cycle)"
+            f"wild bootstrap by cycles (the record's residuals, one weight per cycle; Student "
+            f"t with {dof} degrees of freedom)"
             if noise == "cycles"
             else "parametric bootstrap"
         )
         + " through the record-span processing ("
         + ("two Gauss-Newton steps" if refit == "two-step" else "a least-squares refit")
         + " per replicate)",
+        dof=int(dof),
     )
