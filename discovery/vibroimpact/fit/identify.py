@@ -1136,6 +1136,11 @@ def _step_replicate(context, k):
 
 REFITS = {"two-step": _step_replicate, "full": _refit_replicate}
 
+MIN_CYCLE_DOF = 3
+"""The fewest resampled cycles beyond the parameters (``G - p``) for the bootstrap by
+cycles; below it (a period-four orbit over 12 periods: three cycles) the replicates take
+white noise of the record's level."""
+
 
 def bootstrap_intervals(
     scenario,
@@ -1185,8 +1190,9 @@ def bootstrap_intervals(
         exact Jacobian (the comment above); ``"full"``: a least-squares refit.
     noise : str
         The replicates' noise (:data:`INTERVAL_NOISE`): ``"cycles"`` (default), the
-        record's own residuals with one random weight per cycle; ``"white"``, white noise
-        of the record's level (a parametric bootstrap).
+        record's own residuals with one random weight per cycle (white noise when the
+        cycles are too few: :data:`MIN_CYCLE_DOF`); ``"white"``, white noise of the
+        record's level (a parametric bootstrap).
 
     Returns
     -------
@@ -1211,6 +1217,12 @@ def bootstrap_intervals(
     if any(c == 0 for c in model.coefficients):
         return None  # a parameter at 0 sets no scale for the refits
     law, machine, observe = model_parts(model)
+    # the resampled cycles against the parameters (see the comment above): too few, and the
+    # replicates take white noise of the record's level instead
+    G = sum(b.fold.n_cycles for _, ref in records for b in ref.span.blocks)
+    few = noise == "cycles" and G - len(model.names) < MIN_CYCLE_DOF
+    if few:
+        noise = "white"
     rng = np.random.default_rng(seed)
     replicates = []  # drawn here, in order: the rng's sequence does not depend on workers
     for _ in range(n_boot):
@@ -1248,10 +1260,7 @@ def bootstrap_intervals(
     if noise == "cycles":
         # few clusters (the cycles) against the parameters: the t interval of G - p degrees
         # of freedom on the spread scaled by sqrt(G / (G - p)) (see the comment above)
-        G = sum(b.fold.n_cycles for _, ref in records for b in ref.span.blocks)
         dof = G - len(names)
-        if dof < 1:
-            return None  # fewer cycles than parameters: the cycles cannot give a spread
         sd = sd * np.sqrt(G / dof)
         z = float(student_t.ppf(0.5 + level / 2, dof))
     return Intervals(
@@ -1267,6 +1276,12 @@ def bootstrap_intervals(
             f"t with {dof} degrees of freedom)"
             if noise == "cycles"
             else "parametric bootstrap"
+            + (
+                f" (white noise of the record's level: {G} cycles for {len(names)} "
+                "parameters are too few to resample)"
+                if few
+                else ""
+            )
         )
         + " through the record-span processing ("
         + ("two Gauss-Newton steps" if refit == "two-step" else "a least-squares refit")
