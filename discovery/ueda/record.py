@@ -48,13 +48,18 @@ def read_record_csv(path):
         )
     limits = {"t": (1e7, "s"), "x": (1e6, "")}
     t, x = (
-        parse_column(c, c, header.index(c), body, str(path), decimal_comma, limits)
+        parse_column(
+            c, c, header.index(c), body, str(path), decimal_comma=decimal_comma, limits=limits
+        )
         for c in ("t", "x")
     )
     return check_record(t, x, what=f"--data {path}")
 
 
 def check_record(t, x, what="the record"):
+    """The record as flat float arrays ``(t, x)``, checked: the same length, at least 64
+    finite samples, ``t`` strictly increasing and uniform (to 1e-6 of the step), ``x`` not
+    constant; an error names ``what``."""
     t = np.asarray(t, dtype=float).ravel()
     x = np.asarray(x, dtype=float).ravel()
     if t.shape != x.shape:

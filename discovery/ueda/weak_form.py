@@ -106,5 +106,5 @@ def stlsq(G, b, threshold, keep=None, max_iter=25):
     G, b = np.asarray(G, float), np.asarray(b, float)
     sb = float(np.sqrt(np.mean(b**2))) or 1.0
     keep = np.zeros(G.shape[1], bool) if keep is None else np.asarray(keep, bool)
-    x, sup = stlsq_gram(G.T @ G, G.T @ (b / sb), G.shape[0], threshold, keep, max_iter)
+    x, sup = stlsq_gram(G.T @ G, G.T @ (b / sb), G.shape[0], threshold, keep, max_iter=max_iter)
     return x * sb, sup

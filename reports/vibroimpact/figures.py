@@ -190,7 +190,9 @@ def landscape_figure(land, stem, truth=None):
             ax.set_title(title)
         ax = axes.flat[5]
         ax.axis("off")
-        lines = _landscape_info_lines(land, ref_reg, exact, floor, cons, truth, inside)
+        lines = _landscape_info_lines(
+            land, ref_reg, exact=exact, floor=floor, cons=cons, truth=truth, inside=inside
+        )
         ax.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=7, transform=ax.transAxes)
         _landscape_legend(ax, inside, show_cons, marks)
         fig.tight_layout()
