@@ -39,6 +39,7 @@ __all__ = [
     "evaluate_criteria",
     "criterion",
     "definition",
+    "MOTION_DEFINITIONS",
 ]
 
 
