@@ -39,7 +39,7 @@ import numpy as np
 
 from constraints import require as require_certificate
 
-from ..._printing import coefficient_lines, criteria_lines, fmt, readable
+from ..._printing import coefficient_lines, fmt, readable
 from ..._progress import tick
 from ..._validate import Choice, Real, Text, params
 from ...errors import InputError, IntegrationError, VidiError
@@ -51,6 +51,7 @@ from ..model.law import Term
 from ..model.library import Library
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
+from ..verify.criteria import criteria_lines
 from ..verify.criteria import criterion as _criterion
 from .identify import (
     INTERVAL_REFITS,

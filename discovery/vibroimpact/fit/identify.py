@@ -36,7 +36,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.optimize import least_squares, minimize
 
-from ..._printing import coefficient_lines, criteria_lines, fmt, readable
+from ..._printing import coefficient_lines, fmt, readable
 from ..._progress import tick
 from ..._validate import Choice, Real, Text, params
 from ...errors import InputError, IntegrationError, VidiTypeError
@@ -47,6 +47,7 @@ from ..dynamics import Tolerances
 from ..model.law import ForceLaw, Term
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
+from ..verify.criteria import criteria_lines
 from ..verify.criteria import criterion as _criterion
 from ..verify.motion import penetration_jacobian, penetration_residuals, penetration_size
 
