@@ -449,7 +449,7 @@ class _Objective:
         n = len(law.coefficients)
         cols = list(range(n))
         if not isinstance(model, ForceLaw):
-            for e in model._free():
+            for e in model.free_effects():
                 t = Term.parse(e.key) if e.target == "unloading" else None
                 cols.append(n + law.unloading.index(t) if t in law.unloading else None)
         # a record compared over its span takes an observation linear in the force; one
@@ -699,7 +699,7 @@ def _x_bounds(model):
     if isinstance(model, ForceLaw):
         return lo, hi
     n = len(model.law.coefficients)
-    for i, e in enumerate(model._free(), start=n):
+    for i, e in enumerate(model.free_effects(), start=n):
         if e.target == "observation":
             a, b = (v / c0[i] for v in e.parameters[0].bounds)
             lo[i], hi[i] = min(a, b), max(a, b)
