@@ -338,3 +338,97 @@ def test_no_module_calls_a_private_method_of_another_modules_class():
             ):
                 bad.append(f"{name}:{node.lineno} .{node.func.attr}()")
     assert not bad, bad
+
+
+DOCS = ("README.md", *sorted(str(p.relative_to(ROOT)) for p in (ROOT / "docs").glob("*.md")))
+_INLINE_IMPORT = re.compile(r"`((?:from\s+\S+\s+)?import\s+[^`]+)`")
+
+
+def _doc_imports(text):
+    """The import statements a document shows of this project: those in its ```python
+    blocks and inline ones (`` `from discovery import a, b` ``), as AST nodes."""
+    sources = re.findall(r"```python\n(.*?)```", text, re.S)
+    sources += _INLINE_IMPORT.findall(text)
+    out = []
+    for src in sources:
+        lines = [ln for ln in src.splitlines() if re.match(r"\s*(from|import)\s", ln)]
+        for line in lines:
+            line = line.strip().rstrip(",").replace(", ...", "").replace("...", "")
+            try:
+                tree = ast.parse(line.split("#")[0].strip().rstrip(","))
+            except SyntaxError:  # an import continued on the next lines: the block decides
+                continue
+            out += [
+                n
+                for n in tree.body
+                if isinstance(n, ast.Import | ast.ImportFrom)
+                and (n.module if isinstance(n, ast.ImportFrom) else n.names[0].name).split(".")[0]
+                in PACKAGES
+            ]
+        try:
+            tree = ast.parse(src)
+        except SyntaxError:
+            continue
+        out += [
+            n
+            for n in ast.walk(tree)
+            if isinstance(n, ast.ImportFrom) and (n.module or "").split(".")[0] in PACKAGES
+        ]
+    return out
+
+
+def _alias_paths(text):
+    """``package.attr`` for each ``alias.attr`` a ```python block uses after ``import package
+    as alias`` (``d.discover`` after ``import discovery as d``)."""
+    out = set()
+    for src in re.findall(r"```python\n(.*?)```", text, re.S):
+        try:
+            tree = ast.parse(src)
+        except SyntaxError:
+            continue
+        alias = {
+            a.asname or a.name: a.name
+            for n in ast.walk(tree)
+            if isinstance(n, ast.Import)
+            for a in n.names
+            if a.name.split(".")[0] in PACKAGES
+        }
+        out |= {
+            f"{alias[n.value.id]}.{n.attr}"
+            for n in ast.walk(tree)
+            if isinstance(n, ast.Attribute)
+            and isinstance(n.value, ast.Name)
+            and n.value.id in alias
+        }
+    return out
+
+
+def test_every_import_the_docs_show_resolves():
+    """Each ``import`` / ``from ... import`` the README and docs/ show (code blocks and inline)
+    imports, and each dotted path they name in backticks or use through an imported alias
+    resolves."""
+    bad, seen = [], 0
+    for doc in DOCS:
+        text = (ROOT / doc).read_text()
+        nodes = {ast.unparse(n): n for n in _doc_imports(text)}
+        for node in nodes.values():
+            seen += 1
+            try:
+                if isinstance(node, ast.Import):
+                    for a in node.names:
+                        importlib.import_module(a.name)
+                else:
+                    mod = importlib.import_module(node.module)
+                    for a in node.names:
+                        getattr(mod, a.name)
+            except (ImportError, AttributeError) as exc:
+                bad.append(f"{doc}: {ast.unparse(node)} ({exc})")
+        named = set(re.findall(r"`((?:discovery|reports|constraints)(?:\.[A-Za-z_]\w*)+)", text))
+        for p in sorted(named | _alias_paths(text)):
+            seen += 1
+            try:
+                _resolve(p)
+            except (ImportError, AttributeError) as exc:
+                bad.append(f"{doc}: {p} ({exc})")
+    assert seen >= 60, seen
+    assert not bad, bad
