@@ -449,11 +449,6 @@ def _required_terms(require, library):
     return frozenset(out)
 
 
-def _steady_from(ref):
-    """Record time from which a record is steady: its first averaged cycle's onset."""
-    return float(ref.impulse.onset)
-
-
 def _trial(check, job):
     """One trial of the search (a task of the executor, the checker its forked context):
     ``job = (starts, origin)``, the first of the ``(law, candidate)`` starts whose
