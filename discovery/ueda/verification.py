@@ -39,7 +39,7 @@ class Verification:
         strobe points and as many of the model's (coordinates scaled by the record's
         standard deviations); with ``floor_method == "blocks"`` (the default) both are
         made of contiguous blocks of ``floor_block_periods`` strobe points (see
-        :func:`verify`), with ``"halves"`` (the former scheme) they are random points.
+        :func:`verify`), with ``"halves"`` they are random points.
     floor_q95, floor_median : float
         Quantiles of the noise floor: the energy distance between the two halves of the
         record's own strobe points (same resamples, same kind of halves).
@@ -172,32 +172,24 @@ def verify(
     consecutive points are correlated over a few periods (in x' the negres points
     alternate, lag-2 autocorrelation -0.45; duffing's x stays correlated, +0.1 to lag
     ~8), so a segment departs from the invariant measure by more (duffing) or less
-    (negres) than ``n`` independent points would.  Random halves of the record
-    (``floor="halves"``, the former scheme) interleave in time and share that departure:
-    their distance is the independent-points one, too small for duffing (its truth was
-    rejected on 6 % of 100 noise-free 199-period segments, ratio up to 2.0) and too large
-    for negres (power lost).  ``floor="blocks"`` (the default) cuts the record into
-    contiguous blocks of ``L`` periods (``block_periods``, default
+    (negres) than ``n`` independent points would.  The floor must therefore be made of
+    halves that keep that correlation: ``floor="blocks"`` (the default) cuts the record
+    into contiguous blocks of ``L`` periods (``block_periods``, default
     :func:`strobe_block_length`: twice the record's own decorrelation lag, at least 4, at
     most ``n // 8``; a random circular offset of the block grid), and shuffles the
     blocks between two halves: the floor is the distance between the halves, the test
     the distance between one half and as many model points drawn as blocks of ``L``
     consecutive model periods.  Floor and test are then alike under the null hypothesis
     (a half of one correlated segment against a half's worth of an independent
-    correlated segment).  Rejected alternative: the whole record against the whole
-    simulation, with the block floor rescaled by the sample sizes (more power in
-    principle, but the rescaling assumes Gaussian fluctuations; duffing's are
-    heavy-tailed, and it rejected its truth on 15-30 % of segments).
-    Measured (ratio ``energy_distance / floor_q95``, random halves -> blocks), 10 noisy
-    records of 200 periods (noise 0.2 %): true negres 0.23-0.34 -> 0.25-0.48, true duffing
-    0.37-0.71 -> 0.23-0.37 (all consistent); negres gamma x0.9 1.1-2.9 -> 2.4-6.0 (all
-    rejected).  On 100 noise-free 199-period segments: duffing's truth rejected 6 % -> 4 %
-    (median 0.45 -> 0.30; what is left are segments atypical on the scale of the whole
-    record, which no floor from the record itself can see); negres gamma x0.95 rejected
-    1 % -> 18 %.  Duffing with k x0.8 or B x0.95 cannot be told from the truth on 200
-    periods by either floor (rejected on 2 %, 7 % of segments with blocks, 9 %, 19 % with
-    random halves: about the false-alarm rate); B x0.9: 99 % -> 76 % (part of the former
-    power came from the too-tight floor).
+    correlated segment).  Random halves (``floor="halves"``) interleave in time and share
+    the segment's departure: their floor is the independent-points one, too tight for
+    duffing (its truth is rejected more often than the level says) and too loose for
+    negres.  The whole record is not compared with the whole simulation under a floor
+    rescaled by the sample sizes: the rescaling assumes Gaussian fluctuations, and
+    duffing's are heavy-tailed.  What neither floor can see: a segment atypical on the
+    scale of the whole record, and differences smaller than the false-alarm rate allows on
+    the record's length (duffing with ``k`` x0.8 or ``B`` x0.95 on 200 periods).  The
+    rates behind these rules are in the CHANGELOG (Ueda: verification).
     """
     t_start = time.perf_counter()
     if floor not in ("blocks", "halves"):
