@@ -1,5 +1,5 @@
-"""The missing-effect workflow for Ueda's forced oscillators (issue 9, section 3): from a
-model missing a term, name the missing physical effect from this system's catalogue
+"""The missing-effect workflow for Ueda's forced oscillators: from a model missing a
+term, name the missing physical effect from this system's catalogue
 (:data:`discovery.ueda.effects.EFFECTS`), add it, refit, and show the gap shrink.
 
 One iteration (:func:`explain`):
@@ -18,12 +18,12 @@ One iteration (:func:`explain`):
    (Bonferroni), and eligible when the coefficient it would take
    (``z^T r / z^T z``) is within its physical bounds (a sign).
 3. **Name** the eligible effect whose column explains the largest share of the residual
-   (the largest drop of the weak-form residual when refitted; ranking by LM instead
-   named the van der Pol damping before the linear damping in 83 of 100 duffing records
-   at 1 % noise), add its term, **refit** (least squares on the new support; standard
+   (the largest drop of the weak-form residual when refitted, not the largest LM: LM says
+   how sure the test is that a term is missing, the share how much of the gap it
+   closes), add its term, **refit** (least squares on the new support; standard
    errors from the same sandwich), and measure the gap before and after by
-   **simulation**: :func:`discovery.ueda.discover.verify`
-   (energy distance of strobe points against the noise floor of the record's own random
+   **simulation**: :func:`discovery.ueda.verify`
+   (energy distance of strobe points against the noise floor of the record's own block
    halves, regime, Lyapunov exponent), with the weak-form residual beside it.  Other
    significant effects the record cannot tell from the named one (added instead, each
    leaves the named one insignificant, and beside it each is insignificant) are reported
