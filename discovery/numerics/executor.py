@@ -49,11 +49,11 @@ def _set_context(context):
 
 
 def _one_blas_thread():
-    """A job runs with one BLAS thread wherever it runs.  A BLAS left with its default
-    threads gains nothing on these jobs (its idle threads spin: a serial bootstrap used
-    two cores' CPU time for one core's wall time) and, in two parallel workers, the
-    spinning threads took the other worker's core; and one thread count everywhere makes
-    a job's arithmetic the same on every executor."""
+    """A job runs with one BLAS thread wherever it runs.  A BLAS with its default threads
+    gains nothing on these small jobs: its idle threads spin, using a second core's CPU
+    time for one core's wall time, and in parallel workers they take the other workers'
+    cores.  One thread count everywhere also makes a job's arithmetic the same on every
+    executor."""
     try:
         from threadpoolctl import threadpool_limits
     except ImportError:  # pragma: no cover - a dependency
