@@ -689,11 +689,10 @@ def _short_first(
 def _x_bounds(model):
     """Bounds of the least-squares variables ``x = c / c_start``: an observation model's
     parameter (a sensor's time constant) within its physical bounds, so the trust region
-    does not step beyond a bound the model would clip to: a lag refit from a stiff start
-    stepped to ``tau < 0``, was clipped to 0 (no filter) and stalled there.  Everything else
-    is unbounded, as before: bounded, scipy's trust region scales every variable by its
-    distance to a bound, and the demo's unloading-damping fit then stopped 1.5 standard
-    errors from the truth (the model clips those parameters as before)."""
+    does not step beyond a bound the model clips to (a step to ``tau < 0`` is clipped to no
+    filter, where the fit stalls).  Everything else is unbounded, the model clipping those
+    parameters itself: scipy's trust region scales every bounded variable by its distance
+    to the bound, which stops a fit near a bound short of the optimum."""
     c0 = np.asarray(model.coefficients, dtype=float)
     lo, hi = np.full(c0.size, -np.inf), np.full(c0.size, np.inf)
     if isinstance(model, ForceLaw):
@@ -750,8 +749,8 @@ RESTART_FACTORS = (1.25, 0.8)
 parameter scaled by each factor, while the budget allows, and the best point is kept (by the
 sum of squares for least squares, else by the criterion).  A law refitted from a start 20 %
 off can stop in a basin whose spring is too soft (another contact sequence along the
-record's transient); the restart from 1.25 times the point reached the true law's basin in
-3 of 4 such stalled fits on random slow-P1 and subharmonic records."""
+record's transient); a restart from a stiffer and a softer point often leaves such a basin
+(the rates: CHANGELOG)."""
 
 
 def _restarted(obj, method, xtol, max_simulations, message):
@@ -990,9 +989,9 @@ def identify(
 # bootstrap of Davidson & MacKinnon 1999 and Andrews 2002, k = 2: the replicate's estimate
 # lies within a standard error of the fit, where Newton's steps converge fast): each step is
 # the replicate's residuals and their exact Jacobian, one plain and one sensitivity run per
-# block, where a least-squares refit took about five of each.  On 12-period records of the
-# coverage survey the bootstrap's standard deviations stayed within 10 % of the full
-# refits' (one step: 23 %), in a third of the time.  ``refit="full"`` keeps the full refit.
+# block, where a least-squares refit takes about five of each; two steps keep the
+# bootstrap's standard deviations close to the full refits' (one step does not; the
+# numbers: CHANGELOG).  ``refit="full"`` keeps the full refit.
 
 
 @dataclass(frozen=True)
