@@ -54,7 +54,7 @@ _EXPORTS = {
     "load_study": "vibroimpact.studies.config",
     "field_record": "vibroimpact.studies.records",
     "Executor": "numerics.executor",
-    "make_executor": "numerics.executor",
+    "make_executor": "parallel",
     "report": "report",
     "verify": "vibroimpact.verify.verify",
     "VerifyResult": "vibroimpact.verify.verify",

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import html
 
-__all__ = ["readable", "criteria_lines", "coefficient_lines", "fmt", "generic_lines"]
+__all__ = ["readable", "coefficient_lines", "fmt", "generic_lines"]
 
 
 def fmt(v, digits=4):
@@ -22,28 +22,6 @@ def fmt(v, digits=4):
         return f"{float(v):.{digits}g}"
     except (TypeError, ValueError):
         return str(v)
-
-
-def criteria_lines(criteria, floor=None, limits=None, indent="  "):
-    """The criteria table: value, noise floor, the limit (for the criteria the consistency
-    rule judges; ``--`` for the others) and the meaning, from the criteria registry
-    (:data:`discovery.vibroimpact.verify.criteria.CRITERIA`, the one definition)."""
-    from .vibroimpact.verify.criteria import CRITERIA, definition
-
-    if not criteria:
-        return []
-    out = [f"{indent}{'criterion':<10}{'value':>10}{'floor':>10}{'limit':>10}   meaning"]
-    for k in (*CRITERIA, *(k for k in criteria if k not in CRITERIA)):
-        if k in criteria:
-            lim = (limits or {}).get(k)
-            meaning = definition(k).meaning
-            out.append(
-                f"{indent}{k:<10}{fmt(criteria[k], 3):>10}"
-                f"{fmt((floor or {}).get(k), 3):>10}"
-                f"{fmt(lim, 3) if lim is not None else '--':>10}"
-                + (f"   {meaning}" if meaning else "")
-            )
-    return out
 
 
 def coefficient_lines(coefficients, errors=None, intervals=None, indent="  "):

@@ -21,19 +21,13 @@ def warm():
     """Compile (or load) every kernel: ``{kernel: seconds}``."""
     out = {}
     t0 = time.perf_counter()
-    from .numerics.lag import lag_at, lag_at_knots
-    from .vibroimpact.dynamics.response import impulse_from_steady_state
-    from .vibroimpact.dynamics.steady_state import steady_state
-    from .vibroimpact.model.scenario import load_scenario
+    from .vibroimpact.dynamics.warmup import compile_kernels
 
-    sc = load_scenario("paper")
-    imp = impulse_from_steady_state(sc, sc.law, steady_state(sc, sc.law))
-    imp.evaluate(imp.t)  # the criteria's compiled interpolation
-    lag_at(imp.t, imp.F, lag_at_knots(imp.t, imp.F, 1e-4), 1e-4, imp.t)  # a sensor's lag
+    compile_kernels()
     out["vibro-impact"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     from .ueda.attractor import lyapunov, strobe_points
-    from .ueda.discover import simulate_record
+    from .ueda.record import simulate_record
     from .ueda.system import UedaSystem
 
     system = UedaSystem.from_model("negres")

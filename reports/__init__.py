@@ -1,22 +1,19 @@
 """Reports: figures and LaTeX documents as pure functions of results.
 
-Names are imported on first use (matplotlib only when a figure is drawn).
+Names are imported on first use (PEP 562; matplotlib only when a figure is drawn).
 """
 
-from discovery._lazy import lazy_package
+import importlib
 
 _EXPORTS = {
-    name: "vibroimpact.figures"
-    for name in (
-        "explain_figure",
-        "fit_impulse_figure",
-        "fit_loop_figure",
-        "fit_surface_figure",
-        "identification_figure",
-        "landscape_figure",
-        "verify_figure",
-        "loops_figure",
-    )
+    "explain_figure": "vibroimpact.explain_figures",
+    "fit_impulse_figure": "vibroimpact.fit_figures",
+    "fit_loop_figure": "vibroimpact.fit_figures",
+    "fit_surface_figure": "vibroimpact.fit_figures",
+    "identification_figure": "vibroimpact.figures",
+    "landscape_figure": "vibroimpact.figures",
+    "verify_figure": "vibroimpact.verify_figures",
+    "loops_figure": "vibroimpact.verify_figures",
 }
 
 __all__ = [
@@ -30,4 +27,14 @@ __all__ = [
     "loops_figure",
 ]
 
-lazy_package(__name__, _EXPORTS)
+
+def __getattr__(name):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))

@@ -179,11 +179,11 @@ _STAGE = re.compile(r"^\.vidi-tex-(?P<pid>\d+)-(?P<start>\d+)\.[0-9a-f]+$")
 def _stage_dir(parent):
     """A private staging directory ``.vidi-tex-PID-START.TOKEN`` in ``parent`` (the PID and
     its start time name the run that owns it); stale ones of killed runs are removed first."""
-    from discovery._io import _proc_start
+    from discovery.outputs import process_start
 
     clean_stale_staging(parent)
     pid = os.getpid()
-    d = Path(parent) / f".vidi-tex-{pid}-{_proc_start(pid)}.{secrets.token_hex(4)}"
+    d = Path(parent) / f".vidi-tex-{pid}-{process_start(pid)}.{secrets.token_hex(4)}"
     d.mkdir(mode=0o700)
     return d
 
@@ -191,7 +191,7 @@ def _stage_dir(parent):
 def clean_stale_staging(parent):
     """Remove the ``.vidi-tex-*`` staging directories in ``parent`` whose run is gone (a
     report killed with SIGKILL, or a machine that lost power); returns what was removed."""
-    from discovery._io import _alive
+    from discovery.outputs import process_alive
 
     gone = []
     try:
@@ -200,7 +200,11 @@ def clean_stale_staging(parent):
         return gone
     for e in entries:
         m = _STAGE.match(e.name)
-        if m and e.is_dir(follow_symlinks=False) and not _alive(int(m["pid"]), int(m["start"])):
+        if (
+            m
+            and e.is_dir(follow_symlinks=False)
+            and not process_alive(int(m["pid"]), int(m["start"]))
+        ):
             shutil.rmtree(e.path, ignore_errors=True)
             gone.append(Path(e.path))
     return gone
@@ -359,7 +363,7 @@ def compile_tex(tex_path, figures=(), timeout=300, staged=None):
 def _manifest(run_dir):
     """``(manifest dict or None, the names it lists)``: only a JSON object's list of plain
     names counts (a manifest edited to hold ``"files": 5``, a string or paths lists none)."""
-    from discovery._io import MANIFEST
+    from discovery.outputs import MANIFEST
 
     try:
         man = json.loads((Path(run_dir) / MANIFEST).read_text(encoding="utf-8"))
@@ -393,7 +397,7 @@ def _check_ours(run_dir, names):
 def _record_in_manifest(run_dir, names):
     """Add the report's files to the run's manifest: they are vidi's, so a later run into
     the directory may replace them (and never mistakes them for a user's)."""
-    from discovery._io import MANIFEST, atomic_write_text
+    from discovery.outputs import MANIFEST, atomic_write_text
 
     p = Path(run_dir) / MANIFEST
     man, files = _manifest(run_dir)
@@ -428,7 +432,7 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300):
     done: a report interrupted (or out of space) leaves nothing that blocks the next one,
     and the staging directory of a killed report is removed by the next.
     """
-    from discovery._io import atomic_write_text
+    from discovery.outputs import atomic_write_text
 
     summary = _load(run_dir)
     skipped = []

@@ -161,7 +161,7 @@ def ueda_equation(coefficients, where="coefficients"):
     """``\\ddot x = ...`` from a Ueda discovery's ``{term: coefficient}`` (the library's
     names ``x``, ``x'``, ``x^2 x'``, ..., and ``B cos(nu t)``)."""
     from discovery.errors import InputError
-    from discovery.ueda.discover import MONOMIALS, TERMS
+    from discovery.ueda.polynomial import MONOMIALS, TERMS
 
     if not isinstance(coefficients, dict) or not coefficients:
         raise InputError(f"summary.json: {where} is not a mapping of terms to numbers")
@@ -190,7 +190,7 @@ def ueda_equation(coefficients, where="coefficients"):
 
 def ueda_term_tex(name):
     """A Ueda library term (``x^2 x'``, ``B cos(nu t)``) as math; anything else escaped."""
-    from discovery.ueda.discover import MONOMIALS, TERMS
+    from discovery.ueda.polynomial import MONOMIALS, TERMS
 
     if name == "B cos(nu t)":
         return Tex(r"$B\cos\nu t$")

@@ -8,9 +8,8 @@ triangle and a later, lower, longer one), and compared with what the registry co
 import numpy as np
 import pytest
 
-from discovery._printing import criteria_lines
 from discovery.vibroimpact.data.impulse import Impulse
-from discovery.vibroimpact.verify.criteria import CRITERIA, Criterion, definition
+from discovery.vibroimpact.verify.criteria import CRITERIA, Criterion, criteria_lines, definition
 
 DURATION = 1.0
 

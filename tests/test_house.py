@@ -178,22 +178,257 @@ def test_functions_are_short():
     assert not long, long
 
 
-def _package_imports(pkg):
-    """Project modules imported anywhere in package ``pkg`` (a dotted name)."""
-    out = set()
-    for path in sorted(ROOT.joinpath(*pkg.split(".")).rglob("*.py")):
-        out |= _imports(path, _module_name(path))
+def _graph():
+    """Every module of the project -> the project modules its source imports (anywhere:
+    top level or in functions), package ``__init__`` files included."""
+    graph = {}
+    for pkg in PACKAGES:
+        for path in (ROOT / pkg).rglob("*.py"):
+            name = _module_name(path)
+            graph[name] = _imports(path, name)
+    return graph
+
+
+def _parents(mod):
+    """The packages whose ``__init__`` runs when ``mod`` is imported."""
+    parts = mod.split(".")
+    return {".".join(parts[:i]) for i in range(1, len(parts))}
+
+
+def _closure(graph, start):
+    """Every project module that importing ``start`` may import, directly or through
+    others (importing ``a.b.c`` runs ``a`` and ``a.b`` too)."""
+    seen, todo = set(), [start]
+    while todo:
+        m = todo.pop()
+        for dep in graph.get(m, set()) | _parents(m):
+            if dep not in seen:
+                seen.add(dep)
+                todo.append(dep)
+    seen.discard(start)
+    return seen
+
+
+def _modules_in(graph, pkg):
+    return sorted(m for m in graph if m == pkg or m.startswith(pkg + "."))
+
+
+def _crossings(graph, pkgs, forbidden):
+    """``module -> forbidden modules it may import`` for every module of ``pkgs``."""
+    out = {}
+    for pkg in pkgs:
+        for m in _modules_in(graph, pkg):
+            bad = sorted(d for d in _closure(graph, m) if d.startswith(forbidden))
+            if bad:
+                out[m] = bad
     return out
 
 
+def test_the_import_graph_follows_imports_through_other_modules():
+    """The graph the layer tests walk: a module reaches what its imports import."""
+    graph = _graph()
+    assert "discovery.vibroimpact.dynamics.steady_state" in _closure(
+        graph, "discovery.vibroimpact.verify.evaluate"
+    )
+    reach = _closure(graph, "discovery.warm")
+    assert "discovery.ueda.attractor" in reach and "discovery.vibroimpact.dynamics" in reach
+    assert "discovery" in _closure(graph, "discovery.numerics.executor")  # its packages
+
+
 def test_two_systems_on_a_shared_floor():
-    """The layout's rules: the shared numerics import neither system, neither system
+    """The layout's rules, even through other modules: the shared floor imports neither
+    system (nor what imports them: the warm-up, the CLI, the reports), neither system
     imports the other, and the vibro-impact data layer does not simulate."""
-    floor = _package_imports("discovery.numerics")
-    assert not {m for m in floor if m.startswith(("discovery.vibroimpact", "discovery.ueda"))}
-    ueda = _package_imports("discovery.ueda")
-    assert not {m for m in ueda if m.startswith("discovery.vibroimpact")}
-    vi = _package_imports("discovery.vibroimpact")
-    assert not {m for m in vi if m.startswith("discovery.ueda")}
-    data = _package_imports("discovery.vibroimpact.data")
-    assert not {m for m in data if m.startswith("discovery.vibroimpact.dynamics")}
+    graph = _graph()
+    systems = ("discovery.vibroimpact", "discovery.ueda")
+    above = ("discovery.warm", "discovery.parallel", "discovery.cli", "discovery.report")
+    assert not _crossings(graph, ["discovery.numerics"], systems + above + ("reports",))
+    assert not _crossings(graph, ["discovery.ueda"], ("discovery.vibroimpact",))
+    assert not _crossings(graph, ["discovery.vibroimpact"], ("discovery.ueda",))
+    assert not _crossings(
+        graph, ["discovery.vibroimpact.data"], ("discovery.vibroimpact.dynamics",)
+    )
+
+
+def test_the_package_draws_no_figures():
+    """The systems (studies included) reach no report module: figures and documents are the
+    report layer's, which the CLI calls (a study is handed its drawer)."""
+    graph = _graph()
+    pkgs = ["discovery.numerics", "discovery.vibroimpact", "discovery.ueda"]
+    assert not _crossings(graph, pkgs, ("reports",))
+
+
+def test_reports_and_the_package_do_not_import_each_other_in_a_cycle():
+    """``discovery.report`` builds on ``reports``; nothing in ``reports`` reaches back to it
+    (nor to the CLI), and the ``reports`` package itself imports nothing of ``discovery``."""
+    graph = _graph()
+    assert not _crossings(graph, ["reports"], ("discovery.report", "discovery.cli"))
+    assert not {m for m in _closure(graph, "reports") if m.startswith("discovery")}
+
+
+def _all_names(mod):
+    """The module's ``__all__`` (statically), or None when it defines none."""
+    p = ROOT.joinpath(*mod.split("."))
+    path = p / "__init__.py" if (p / "__init__.py").is_file() else p.with_suffix(".py")
+    for node in ast.parse(path.read_text()).body:
+        if isinstance(node, ast.Assign) and any(
+            isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets
+        ):
+            try:
+                return set(ast.literal_eval(node.value))
+            except ValueError:
+                return None
+    return None
+
+
+def test_reports_use_the_packages_public_api_only():
+    """``reports`` imports from ``discovery`` public modules only (no ``_`` in the path) and
+    only the names those modules export (their ``__all__``)."""
+    bad = []
+    for path in sorted((ROOT / "reports").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                mods = [(a.name, None) for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+                mods = [(node.module, [a.name for a in node.names])]
+            else:
+                continue
+            for mod, names in mods:
+                if mod.split(".")[0] != "discovery":
+                    continue
+                where = f"{path.relative_to(ROOT)}:{node.lineno} {mod}"
+                if any(part.startswith("_") for part in mod.split(".")):
+                    bad.append(f"{where} (a private module)")
+                    continue
+                exported = _all_names(mod)
+                for n in names or ():
+                    if n.startswith("_") or (exported is not None and n not in exported):
+                        bad.append(f"{where}.{n} (not exported)")
+    assert not bad, bad
+
+
+def test_no_module_calls_a_private_method_of_another_modules_class():
+    """A method named ``_x`` is called only in the module that defines it (``fit`` does not
+    reach into explain's models): what other modules need gets a public name."""
+    defined = {}  # private method name -> modules whose classes define it
+    trees = {}
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            name = _module_name(path)
+            trees[name] = tree = ast.parse(path.read_text())
+            for cls in (n for n in ast.walk(tree) if isinstance(n, ast.ClassDef)):
+                for f in cls.body:
+                    if (
+                        isinstance(f, ast.FunctionDef)
+                        and f.name.startswith("_")
+                        and not f.name.startswith("__")
+                    ):
+                        defined.setdefault(f.name, set()).add(name)
+    bad = []
+    for name, tree in trees.items():
+        for node in ast.walk(tree):
+            if (
+                isinstance(node, ast.Call)
+                and isinstance(node.func, ast.Attribute)
+                and node.func.attr in defined
+                and name not in defined[node.func.attr]
+                and not (
+                    isinstance(node.func.value, ast.Name) and node.func.value.id in ("self", "cls")
+                )
+            ):
+                bad.append(f"{name}:{node.lineno} .{node.func.attr}()")
+    assert not bad, bad
+
+
+DOCS = ("README.md", *sorted(str(p.relative_to(ROOT)) for p in (ROOT / "docs").glob("*.md")))
+_INLINE_IMPORT = re.compile(r"`((?:from\s+\S+\s+)?import\s+[^`]+)`")
+
+
+def _doc_imports(text):
+    """The import statements a document shows of this project: those in its ```python
+    blocks and inline ones (`` `from discovery import a, b` ``), as AST nodes."""
+    sources = re.findall(r"```python\n(.*?)```", text, re.S)
+    sources += _INLINE_IMPORT.findall(text)
+    out = []
+    for src in sources:
+        lines = [ln for ln in src.splitlines() if re.match(r"\s*(from|import)\s", ln)]
+        for line in lines:
+            line = line.strip().rstrip(",").replace(", ...", "").replace("...", "")
+            try:
+                tree = ast.parse(line.split("#")[0].strip().rstrip(","))
+            except SyntaxError:  # an import continued on the next lines: the block decides
+                continue
+            out += [
+                n
+                for n in tree.body
+                if isinstance(n, ast.Import | ast.ImportFrom)
+                and (n.module if isinstance(n, ast.ImportFrom) else n.names[0].name).split(".")[0]
+                in PACKAGES
+            ]
+        try:
+            tree = ast.parse(src)
+        except SyntaxError:
+            continue
+        out += [
+            n
+            for n in ast.walk(tree)
+            if isinstance(n, ast.ImportFrom) and (n.module or "").split(".")[0] in PACKAGES
+        ]
+    return out
+
+
+def _alias_paths(text):
+    """``package.attr`` for each ``alias.attr`` a ```python block uses after ``import package
+    as alias`` (``d.discover`` after ``import discovery as d``)."""
+    out = set()
+    for src in re.findall(r"```python\n(.*?)```", text, re.S):
+        try:
+            tree = ast.parse(src)
+        except SyntaxError:
+            continue
+        alias = {
+            a.asname or a.name: a.name
+            for n in ast.walk(tree)
+            if isinstance(n, ast.Import)
+            for a in n.names
+            if a.name.split(".")[0] in PACKAGES
+        }
+        out |= {
+            f"{alias[n.value.id]}.{n.attr}"
+            for n in ast.walk(tree)
+            if isinstance(n, ast.Attribute)
+            and isinstance(n.value, ast.Name)
+            and n.value.id in alias
+        }
+    return out
+
+
+def test_every_import_the_docs_show_resolves():
+    """Each ``import`` / ``from ... import`` the README and docs/ show (code blocks and inline)
+    imports, and each dotted path they name in backticks or use through an imported alias
+    resolves."""
+    bad, seen = [], 0
+    for doc in DOCS:
+        text = (ROOT / doc).read_text()
+        nodes = {ast.unparse(n): n for n in _doc_imports(text)}
+        for node in nodes.values():
+            seen += 1
+            try:
+                if isinstance(node, ast.Import):
+                    for a in node.names:
+                        importlib.import_module(a.name)
+                else:
+                    mod = importlib.import_module(node.module)
+                    for a in node.names:
+                        getattr(mod, a.name)
+            except (ImportError, AttributeError) as exc:
+                bad.append(f"{doc}: {ast.unparse(node)} ({exc})")
+        named = set(re.findall(r"`((?:discovery|reports|constraints)(?:\.[A-Za-z_]\w*)+)", text))
+        for p in sorted(named | _alias_paths(text)):
+            seen += 1
+            try:
+                _resolve(p)
+            except (ImportError, AttributeError) as exc:
+                bad.append(f"{doc}: {p} ({exc})")
+    assert seen >= 60, seen
+    assert not bad, bad

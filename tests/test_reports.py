@@ -303,6 +303,7 @@ def test_study_report_states_recovery_coverage_and_figures(tmp_path):
     _need_tex()
     from discovery import study
     from discovery.report import report
+    from reports.vibroimpact.study_figures import study_figures
 
     cfg = {
         "name": "tiny & 100%",
@@ -316,7 +317,7 @@ def test_study_report_states_recovery_coverage_and_figures(tmp_path):
         },
     }
     out = tmp_path / "s"
-    study(cfg, out, workers=1)
+    study(cfg, out, workers=1, figures=study_figures)
     r = report(out)
     text = _text(r.pdf)
     assert "Model-term selection study: tiny & 100%" in text

@@ -16,6 +16,7 @@ from discovery.errors import InputError
 from discovery.vibroimpact.studies import FACTORS, load_study, study, wilson
 from discovery.vibroimpact.studies.config import run_key
 from discovery.vibroimpact.studies.records import clean_record, field_record
+from reports.vibroimpact.study_figures import study_figures
 
 ROOT = Path(__file__).resolve().parent.parent
 VIDI = [sys.executable, "-c", "import sys; from discovery.cli import main; sys.exit(main())"]
@@ -177,7 +178,7 @@ def test_field_record_noise_is_relative_to_each_channel(paper):
 @pytest.fixture(scope="module")
 def quick_serial(tmp_path_factory):
     out = tmp_path_factory.mktemp("study") / "serial"
-    return study(QUICK, out, workers=1), out
+    return study(QUICK, out, workers=1, figures=study_figures), out
 
 
 def test_study_runs_scores_and_writes_tables(quick_serial):

@@ -1,7 +1,7 @@
 """``vidi``: a thin command line over the :mod:`discovery` API.
 
-One module per command (``simulate``, ``fit``, ``verify``, ``steady``, ``landscape``,
-``identify``), each with ``register(subparsers)`` and ``run(args)``.  Every command
+One module per command of :data:`COMMANDS` (``ueda`` a package with one module per
+subcommand), each with ``register(subparsers)`` and ``run(args)``.  Every command
 writes ``summary.json`` (results, versions, settings) beside its other outputs;
 outputs are staged and put in place as a whole only when the command succeeds
 (:class:`discovery._io.OutputDir`).

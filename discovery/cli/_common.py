@@ -207,7 +207,7 @@ def executor_of(args):
 
     if not getattr(args, "scheduler", None):
         return contextlib.nullcontext(None)
-    from ..numerics.executor import make_executor
+    from ..parallel import make_executor
 
     return make_executor(getattr(args, "workers", None), args.scheduler)
 

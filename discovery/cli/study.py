@@ -2,6 +2,8 @@
 
 
 def run(args):
+    from reports.vibroimpact.study_figures import study_figures
+
     from .._io import set_run
     from ..vibroimpact.studies.driver import study
     from ._common import reporter
@@ -15,7 +17,7 @@ def run(args):
             scheduler=args.scheduler,
             progress=rep,
             max_runs=args.max_runs,
-            figures=not args.no_figures,
+            figures=None if args.no_figures else study_figures,
         )
     print(r)
     left = r.config.n_runs - len(r.runs)

@@ -17,12 +17,11 @@ functions and its own right-hand side::
 Why building blocks and not a factory closing over the right-hand side: numba caches a
 module-level function on disk, but a jitted closure over a jitted right-hand side (and
 a jitted function taking one as an argument) is compiled again in every new process and
-adds a cache entry each time (measured with numba 0.68: ``NUMBA_DEBUG_CACHE`` shows a
-new ``.nbc`` per start, about 1 s of compilation each).  The blocks are closures over
-the state size only and are inlined by numba (``inline="always"``) into the system's
-module-level ``@njit(cache=True)`` integrator, which is cached as before.  The
-floating-point operations are in the same order as in the original vibro-impact kernel,
-so its results are bitwise unchanged.
+adds a cache entry each time (numba 0.68: ``NUMBA_DEBUG_CACHE`` shows a new ``.nbc`` per
+start, about 1 s of compilation each).  The blocks are closures over the state size only
+and are inlined by numba (``inline="always"``) into the system's module-level
+``@njit(cache=True)`` integrator, which numba caches.  The blocks fix the order of the
+floating-point operations: changing it changes every result in its last bits.
 
 Caveat (numba's): a cached integrator is invalidated only when the *content* of its own
 source file changes (numba 0.68 stamps sources by a content hash; touching does not
@@ -90,9 +89,8 @@ def dense_weights(theta):
 
 def _build(n):
     """The building blocks for states of size ``n`` (a compile-time constant: numba
-    unrolls the loops over the state as it did with the literal 4 of the original
-    vibro-impact kernel; with ``y.shape[0]`` as the bound that kernel ran 5-20 % slower,
-    measured)."""
+    unrolls the loops over the state; with ``y.shape[0]`` as the bound the vibro-impact
+    integrator runs 5-20 % slower)."""
     nf = float(n)
 
     @njit(inline="always")

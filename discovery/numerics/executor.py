@@ -18,8 +18,9 @@ not depend on the executor, the worker count or the order of completion::
   of single-threaded worker processes).  The context is scattered once to every worker;
   tasks are pure functions of their arguments (the seeds are in the jobs), so a task that
   runs twice (a worker lost mid-task) gives the same result; the scheduler reschedules the
-  tasks of a lost worker.  The numba cache is built once before any worker compiles
-  (concurrent cache builds have crashed workers).
+  tasks of a lost worker.  A ``warm`` callable (the caller's: it compiles the kernels its
+  jobs use) runs here and on one worker before the others, so that numba's cache is built
+  once before any worker compiles (concurrent cache builds crash workers).
 
 Jobs should each last well over 100 ms on a cluster (per-task overhead is ~1 ms locally and
 more across machines): callers batch short work (a landscape row, not a point).
@@ -48,11 +49,11 @@ def _set_context(context):
 
 
 def _one_blas_thread():
-    """A job runs with one BLAS thread wherever it runs.  A BLAS left with its default
-    threads gains nothing on these jobs (its idle threads spin: a serial bootstrap used
-    two cores' CPU time for one core's wall time) and, in two parallel workers, the
-    spinning threads took the other worker's core; and one thread count everywhere makes
-    a job's arithmetic the same on every executor."""
+    """A job runs with one BLAS thread wherever it runs.  A BLAS with its default threads
+    gains nothing on these small jobs: its idle threads spin, using a second core's CPU
+    time for one core's wall time, and in parallel workers they take the other workers'
+    cores.  One thread count everywhere also makes a job's arithmetic the same on every
+    executor."""
     try:
         from threadpoolctl import threadpool_limits
     except ImportError:  # pragma: no cover - a dependency
@@ -147,20 +148,22 @@ class Pool(Executor):
         pool.shutdown()
 
 
-def _warm_worker():
-    from ..warm import warm
-
-    warm()
+def _warm_worker(warm):
+    """Run the warm-up callable ``warm`` (if any) in this process; returns its PID."""
+    if warm is not None:
+        warm()
     return os.getpid()
 
 
 class Dask(Executor):
     """A ``distributed.Client``: ``address`` is a scheduler (``tcp://host:port``) or
-    ``"local"`` for a ``LocalCluster`` of ``workers`` single-threaded processes."""
+    ``"local"`` for a ``LocalCluster`` of ``workers`` single-threaded processes; ``warm``
+    (a callable without arguments, or None) compiles the kernels before any job: here and
+    on one worker first, then on the rest, which only read numba's cache."""
 
     name = "dask"
 
-    def __init__(self, address="local", workers=None):
+    def __init__(self, address="local", workers=None, warm=None):
         try:
             from distributed import Client, LocalCluster
         except ImportError:
@@ -172,7 +175,7 @@ class Dask(Executor):
         self._cluster = None
         if self.address == "local":
             # compile (or load) the kernels here first: the workers then only read the cache
-            _warm_worker()
+            _warm_worker(warm)
             n = max(1, int(workers or os.cpu_count() or 1))
             import dask
 
@@ -207,8 +210,8 @@ class Dask(Executor):
                 ) from None
             workers = sorted(self.client.scheduler_info()["workers"])
             if workers:  # one worker builds the cache, then the others load it
-                self.client.run(_warm_worker, workers=workers[:1])
-                self.client.run(_warm_worker)
+                self.client.run(_warm_worker, warm, workers=workers[:1])
+                self.client.run(_warm_worker, warm)
         self.workers = max(1, len(self.client.scheduler_info()["workers"]))
 
     def run(self, fn, jobs, context=None):
@@ -275,10 +278,12 @@ def _sigint_blocked():
 
 
 @params(workers=(None, Real(1, 4096, integer=True)), scheduler=(None, Text()))
-def make_executor(workers=None, scheduler=None):
+def make_executor(workers=None, scheduler=None, *, warm=None):
     """The executor for ``workers`` local processes (``None``: one per CPU; 1: serial), or
-    a Dask cluster when ``scheduler`` is given (``"local"`` or a scheduler address)."""
+    a Dask cluster when ``scheduler`` is given (``"local"`` or a scheduler address), whose
+    workers first run ``warm`` (see :class:`Dask`; :func:`discovery.make_executor` passes
+    the package's :func:`discovery.warm.warm`)."""
     if scheduler:
-        return Dask(scheduler, workers)
+        return Dask(scheduler, workers, warm)
     n = max(1, int(workers or os.cpu_count() or 1))
     return Serial() if n == 1 else Pool(n)

@@ -12,11 +12,15 @@ system (:mod:`discovery.numerics._dopri`).
   shooting and Floquet multipliers (:mod:`discovery.numerics.shooting`, shared with the
   vibro-impact system) - :mod:`.periodic`;
 * :func:`chart` -> :class:`Chart` - the regime chart over ``(nu, B)`` in parallel processes;
-* :func:`discover` (equation discovery from a record ``t, x`` with known forcing) and
-  :func:`verify` (the discovered equation's attractor against the record's),
-  :class:`ForcedPolynomial`, :func:`simulate_record` - :mod:`.discover`;
+* :class:`ForcedPolynomial` (an equation, simulable) - :mod:`.polynomial`; a record:
+  :func:`simulate_record`, reading, checking and smoothing it - :mod:`.record`;
+* :func:`discover` (equation discovery from a record ``t, x`` with known forcing,
+  :mod:`.discover` on the weak form of :mod:`.weak_form`) and :func:`verify` (the
+  discovered equation's attractor against the record's, :mod:`.verification` with the
+  energy-distance test of :mod:`.strobe_resampling`);
 * :func:`explain` (the missing-effect workflow) -> :class:`Explanation`, over this
-  system's catalogue :data:`EFFECTS` - :mod:`.explain`, :mod:`.effects`.
+  system's catalogue :data:`EFFECTS` - :mod:`.explain` (the loop), :mod:`.weak_fits` (fits
+  and score tests), :mod:`.explanation` (its outcome), :mod:`.effects`.
 """
 
 from .._lazy import lazy_package
@@ -41,13 +45,13 @@ _EXPORTS = {
     "chart": "chart",
     "KINDS": "chart",
     "Discovery": "discover",
-    "ForcedPolynomial": "discover",
-    "Verification": "discover",
+    "ForcedPolynomial": "polynomial",
+    "Verification": "verification",
     "discover": "discover",
-    "simulate_record": "discover",
-    "verify": "discover",
+    "simulate_record": "record",
+    "verify": "verification",
     "EFFECTS": "effects",
-    "Explanation": "explain",
+    "Explanation": "explanation",
     "explain": "explain",
     "PeriodicOrbit": "periodic",
     "UedaMap": "periodic",

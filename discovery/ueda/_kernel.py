@@ -52,7 +52,7 @@ def _accel(t, x, v, p):
 @njit(cache=True, inline="always")
 def _model_poly(x, v, p):
     """``sum_j c_j x^i v^j`` and its partial derivatives (the MONOMIALS' order of
-    :mod:`discovery.ueda.discover`; ``c = p[2:12]``)."""
+    :mod:`discovery.ueda.polynomial`; ``c = p[2:12]``)."""
     x2 = x * x
     v2 = v * v
     a = (

@@ -6,7 +6,7 @@ whose
 :class:`~discovery.vibroimpact.explain.effects.Effect` and
 :class:`~discovery.vibroimpact.explain.effects.Parameter`
 are reused): an effect adds terms of the polynomial library (:data:`TERMS` of
-:mod:`discovery.ueda.discover`) to a :class:`ForcedPolynomial`; its parameter is the
+:mod:`discovery.ueda.polynomial`) to a :class:`ForcedPolynomial`; its parameter is the
 coefficient in the ``x'' = ...`` form, with physical bounds (a sign).  Nothing
 effect-specific enters the integrator.
 
@@ -17,7 +17,7 @@ impacts, and where an effect acts in the ``(x, x')`` plane is said in ``signatur
 import numpy as np
 
 from ..catalogue import Effect, Parameter, lookup
-from .discover import TERMS
+from .polynomial import TERMS
 
 __all__ = ["EFFECTS", "effect", "effect_dict", "in_bounds"]
 

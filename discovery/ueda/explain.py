@@ -1,5 +1,5 @@
-"""The missing-effect workflow for Ueda's forced oscillators (issue 9, section 3): from a
-model missing a term, name the missing physical effect from this system's catalogue
+"""The missing-effect workflow for Ueda's forced oscillators: from a model missing a
+term, name the missing physical effect from this system's catalogue
 (:data:`discovery.ueda.effects.EFFECTS`), add it, refit, and show the gap shrink.
 
 One iteration (:func:`explain`):
@@ -18,12 +18,12 @@ One iteration (:func:`explain`):
    (Bonferroni), and eligible when the coefficient it would take
    (``z^T r / z^T z``) is within its physical bounds (a sign).
 3. **Name** the eligible effect whose column explains the largest share of the residual
-   (the largest drop of the weak-form residual when refitted; ranking by LM instead
-   named the van der Pol damping before the linear damping in 83 of 100 duffing records
-   at 1 % noise), add its term, **refit** (least squares on the new support; standard
+   (the largest drop of the weak-form residual when refitted, not the largest LM: LM says
+   how sure the test is that a term is missing, the share how much of the gap it
+   closes), add its term, **refit** (least squares on the new support; standard
    errors from the same sandwich), and measure the gap before and after by
-   **simulation**: :func:`discovery.ueda.discover.verify`
-   (energy distance of strobe points against the noise floor of the record's own random
+   **simulation**: :func:`discovery.ueda.verify`
+   (energy distance of strobe points against the noise floor of the record's own block
    halves, regime, Lyapunov exponent), with the weak-form residual beside it.  Other
    significant effects the record cannot tell from the named one (added instead, each
    leaves the named one insignificant, and beside it each is insignificant) are reported
@@ -37,27 +37,20 @@ significant to add (measured false-discovery rates in the README).
 """
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.stats import chi2
 
-from .._printing import generic_lines, readable
 from .._validate import Array, Real, params
 from ..catalogue import select
 from ..errors import InputError
-from .discover import (
-    FORCING,
-    MONOMIALS,
-    TERMS,
-    ForcedPolynomial,
-    _record_forcing,
-    _test_function,
-    smooth,
-    verify,
-    weak_system,
-)
-from .effects import EFFECTS, effect_dict, in_bounds
+from .effects import EFFECTS, in_bounds
+from .explanation import Explanation, Iteration
+from .polynomial import TERMS
+from .record import check_forcing, smooth
+from .verification import verify
+from .weak_fits import Fit, WeakFits, WeakSettings
+from .weak_form import window_half_width
 
 __all__ = ["Explanation", "Iteration", "explain", "parse_terms", "DEFAULT_START"]
 
@@ -99,271 +92,6 @@ def parse_terms(spec):
     return tuple(sorted(out, key=TERMS.index))
 
 
-def _hac(U, lag):
-    """Newey-West estimate of ``Var(sum_i U_i)`` (rows ``U_i``, Bartlett weights)."""
-    U = U.reshape(U.shape[0], -1)
-    V = U.T @ U
-    for k in range(1, min(lag, U.shape[0] - 1) + 1):
-        C = U[k:].T @ U[:-k]
-        V += (1.0 - k / (lag + 1.0)) * (C + C.T)
-    return V
-
-
-@dataclass(frozen=True)
-class _Fit:
-    cols: tuple  # column indices of G (library terms, then the forcing's)
-    coef: np.ndarray
-    se: np.ndarray
-    r: np.ndarray
-    model: ForcedPolynomial
-
-
-class _Weak:
-    """The weak-form system of one record and least-squares fits on given supports."""
-
-    def __init__(self, t, x, B, nu, half_width, order, fit_forcing, smoothed):
-        self.B, self.nu = B, nu
-        dt = float(t[1] - t[0])
-        self.hs = int(half_width)
-        G, b, self.centres = weak_system(t, x, smoothed.v, B, nu, self.hs, order=order)
-        self.nt = len(MONOMIALS)
-        self.fit_forcing = bool(fit_forcing)
-        self.b = b if fit_forcing else b - G[:, self.nt]
-        self.G = G
-        self.stride = max(1, self.hs // 2)
-        # rows share samples up to (2 hs) / stride rows apart; twice that for Bartlett
-        self.lag = 2 * int(np.ceil(2 * self.hs / self.stride))
-        self.b_rms = float(np.sqrt(np.mean(self.b**2))) or 1.0
-        # the residual's floor: b's part from white measurement noise of sd noise_sd
-        _, _, ddphi = _test_function(self.hs, order)
-        w = np.full(ddphi.size, dt)
-        w[0] = w[-1] = dt / 2
-        H = self.hs * dt
-        self.noise_rms = float(smoothed.noise_sd * np.linalg.norm(w * ddphi / H**2))
-
-    def fit(self, terms):
-        cols = tuple(TERMS.index(n) for n in terms) + ((self.nt,) if self.fit_forcing else ())
-        if cols:
-            X = self.G[:, cols]
-            s = np.sqrt(np.mean(X**2, axis=0))
-            s[s == 0] = 1.0
-            Xs = X / s
-            cs = np.linalg.lstsq(Xs, self.b, rcond=None)[0]
-            r = self.b - Xs @ cs
-            A = np.linalg.pinv(Xs.T @ Xs)
-            cov = A @ _hac(Xs * r[:, None], self.lag) @ A
-            coef, se = cs / s, np.sqrt(np.maximum(np.diag(cov), 0.0)) / s
-        else:
-            coef, se, r = np.zeros(0), np.zeros(0), self.b.copy()
-        c = np.zeros(self.nt)
-        forcing = 1.0
-        for j, v in zip(cols, coef, strict=True):
-            if j < self.nt:
-                c[j] = v
-            else:
-                forcing = float(v)
-        return _Fit(cols, coef, se, r, ForcedPolynomial(tuple(c), self.B, self.nu, forcing))
-
-    def score(self, fit, eff):
-        """The robust LM test of adding ``eff``'s terms to ``fit``."""
-        k = [TERMS.index(n) for n in eff.terms]
-        Z = self.G[:, k]
-        if fit.cols:
-            Q, _ = np.linalg.qr(self.G[:, fit.cols])
-            Z = Z - Q @ (Q.T @ Z)
-        zz = np.einsum("ij,ij->j", Z, Z)
-        if np.any(zz <= 1e-24 * max(float(self.b @ self.b), 1e-300)):
-            return {
-                "effect": eff.id,
-                "terms": list(eff.terms),
-                "lm": 0.0,
-                "p": 1.0,
-                "share": 0.0,
-                "direction": dict.fromkeys(eff.terms, 0.0),
-                "note": "its columns are absorbed by the current terms",
-            }
-        s = Z.T @ fit.r
-        V = _hac(Z * fit.r[:, None], self.lag)
-        lm = float(s @ np.linalg.pinv(V) @ s) if np.all(np.diag(V) > 0) else 0.0
-        direction = np.linalg.lstsq(Z, fit.r, rcond=None)[0]
-        share = float((fit.r @ (Z @ direction)) / max(float(fit.r @ fit.r), 1e-300))
-        return {
-            "effect": eff.id,
-            "terms": list(eff.terms),
-            "lm": lm,
-            "p": float(chi2.sf(lm, len(k))),
-            "share": share,
-            "direction": {n: float(d) for n, d in zip(eff.terms, direction, strict=True)},
-        }
-
-    def residual_rms(self, fit):
-        return float(np.sqrt(np.mean(fit.r**2))) / self.b_rms
-
-    def parameters(self, fit, terms):
-        return {
-            n: {
-                "value": float(fit.coef[fit.cols.index(TERMS.index(n))]),
-                "stderr": float(fit.se[fit.cols.index(TERMS.index(n))]),
-            }
-            for n in terms
-        }
-
-    def coefficients(self, fit):
-        names = [TERMS[j] if j < self.nt else FORCING for j in fit.cols]
-        coef = dict(zip(names, map(float, fit.coef), strict=True))
-        se = dict(zip(names, map(float, fit.se), strict=True))
-        if not self.fit_forcing:
-            coef[FORCING], se[FORCING] = 1.0, 0.0
-        return coef, se
-
-
-@dataclass(frozen=True)
-class Iteration:
-    """One pass of the loop.
-
-    Attributes
-    ----------
-    effect : str or None
-        The effect named (None when this pass stopped the loop).
-    evidence : dict
-        For the named effect: ``lm`` (score statistic), ``p``, ``gate`` (the Bonferroni
-        level), ``share`` (fraction of the weak-form residual's sum of squares its column
-        explains), ``text``; otherwise ``text`` only.
-    scores : list of dict
-        Every scored effect: ``effect``, ``terms``, ``lm``, ``p``, ``share``,
-        ``direction`` (the coefficient it would take), ``significant``, ``in_bounds``.
-    criteria_before, criteria_after : dict
-        ``residual_rms`` (weak form, relative to ``b``), ``energy_distance``,
-        ``floor_q95``, ``energy_consistent``, ``regime_record``, ``regime_model``,
-        ``regime_agrees``, ``lyapunov``, ``consistent``, ``diverged`` (the simulation
-        entries only when simulating).
-    parameters : dict
-        ``{term: {"value", "stderr"}}`` of the added terms after the refit.
-    model_before, model_after : ForcedPolynomial
-    verification_before, verification_after : Verification or None
-        The simulations behind the criteria (for figures).
-    equivalent : list of str
-        Significant effects the record cannot tell from the named one: added instead,
-        each leaves the named one insignificant, and beside it each is insignificant.
-    """
-
-    effect: str | None
-    evidence: dict
-    scores: list
-    criteria_before: dict
-    criteria_after: dict
-    parameters: dict
-    model_before: ForcedPolynomial
-    model_after: ForcedPolynomial
-    verification_before: object = field(default=None, repr=False)
-    verification_after: object = field(default=None, repr=False)
-    equivalent: list = field(default_factory=list)
-
-    def as_dict(self):
-        return {
-            "effect": self.effect,
-            "evidence": self.evidence,
-            "scores": self.scores,
-            "equivalent": self.equivalent,
-            "criteria_before": self.criteria_before,
-            "criteria_after": self.criteria_after,
-            "parameters": self.parameters,
-            "model_before": _model_dict(self.model_before),
-            "model_after": _model_dict(self.model_after),
-        }
-
-
-@readable
-@dataclass(frozen=True)
-class Explanation:
-    """Outcome of :func:`explain`.
-
-    Attributes
-    ----------
-    iterations : tuple of Iteration
-    start_model, final_model : ForcedPolynomial
-    start_terms, final_terms : tuple of str
-    coefficients, standard_errors : dict
-        Of the final model's terms and the forcing (weak-form least squares; standard
-        errors from the autocorrelation-consistent sandwich).
-    criteria_start, criteria : dict
-        Of the start and the final model (see :class:`Iteration`).
-    noise_floor : dict
-        ``residual_rms`` (the relative weak-form residual that white measurement noise of
-        the estimated sd alone gives), ``energy_distance_q95`` and ``_median`` (the record's
-        random halves), ``noise_sd``, ``noise_fraction_of_range``.
-    consistent : bool
-        The final model's attractor is consistent with the record's (None without
-        simulation).
-    stopped_because : str
-    """
-
-    iterations: tuple
-    start_model: ForcedPolynomial
-    final_model: ForcedPolynomial
-    start_terms: tuple
-    final_terms: tuple
-    coefficients: dict
-    standard_errors: dict
-    criteria_start: dict
-    criteria: dict
-    noise_floor: dict
-    consistent: object
-    stopped_because: str
-    seconds: float = 0.0
-    settings: dict = field(default_factory=dict)
-    start_verification: object = field(default=None, repr=False)
-    final_verification: object = field(default=None, repr=False)
-
-    @property
-    def effects_added(self):
-        """Ids of the effects named, in order."""
-        return tuple(it.effect for it in self.iterations if it.effect)
-
-    @property
-    def gap(self):
-        """The start model's gap against the final model's: ``{criterion: {"before",
-        "after", "ratio"}}`` for the weak-form residual and the energy distance."""
-        out = {}
-        for k in ("residual_rms", "energy_distance"):
-            if k in self.criteria_start:
-                a, b = self.criteria_start[k], self.criteria[k]
-                out[k] = {"before": a, "after": b, "ratio": (a / b) if b > 0 else float("inf")}
-        return out
-
-    def as_dict(self):
-        return {
-            "start_terms": list(self.start_terms),
-            "final_terms": list(self.final_terms),
-            "effects_added": list(self.effects_added),
-            "iterations": [it.as_dict() for it in self.iterations],
-            "start_model": _model_dict(self.start_model),
-            "final_model": {
-                **_model_dict(self.final_model),
-                "coefficients": self.coefficients,
-                "standard_errors": self.standard_errors,
-            },
-            "criteria_start": self.criteria_start,
-            "criteria": self.criteria,
-            "gap": self.gap,
-            "noise_floor": self.noise_floor,
-            "consistent": self.consistent,
-            "stopped_because": self.stopped_because,
-            "catalogue": [
-                effect_dict(e) for e in EFFECTS if e.id in self.settings.get("effects", ())
-            ],
-            "settings": self.settings,
-            "seconds": self.seconds,
-        }
-
-    def _lines(self):
-        return generic_lines(self)
-
-
-def _model_dict(m):
-    return {**m.as_dict(), "equation": m.text()}
-
-
 def _check_settings(alpha, max_iterations, order, noise):
     """The settings :func:`explain` checks beyond their types."""
     if not (0 < alpha < 1):
@@ -380,13 +108,18 @@ def _check_settings(alpha, max_iterations, order, noise):
         raise InputError(f"noise must be a finite fraction >= 0, got {noise}")
 
 
+@dataclass(frozen=True)
 class _Measure:
     """The criteria of a fit: its weak-form residual and, with ``simulate``, its
-    verification by simulation against the record (:func:`verify`)."""
+    verification by simulation against the record ``t, x`` (:func:`verify`, with the
+    record's smoothing ``sm`` and ``verify_kwargs``)."""
 
-    def __init__(self, weak, t, x, sm, simulate, verify_kwargs):
-        self.weak, self.t, self.x, self.sm = weak, t, x, sm
-        self.simulate, self.verify_kwargs = simulate, verify_kwargs
+    weak: WeakFits
+    t: np.ndarray
+    x: np.ndarray
+    sm: object
+    simulate: bool
+    verify_kwargs: dict
 
     def __call__(self, fit):
         crit = {"residual_rms": self.weak.residual_rms(fit)}
@@ -423,35 +156,71 @@ def _floor(weak, sm, ver):
     return floor
 
 
+@dataclass(frozen=True)
+class _Settings:
+    """What the loop may name and when it stops: the ``catalogue`` of effects, the
+    family-wise level ``alpha``, the budget ``max_iterations``, and whether the gap is
+    simulated."""
+
+    catalogue: tuple
+    alpha: float
+    max_iterations: int
+    simulate: bool
+
+
+@dataclass(frozen=True)
+class _State:
+    """The model the loop has reached: its ``terms``, ``fit``, criteria ``crit`` and the
+    verification ``ver`` behind them (None without simulation)."""
+
+    terms: tuple
+    fit: Fit
+    crit: dict
+    ver: object
+
+
+@dataclass(frozen=True)
+class _Round:
+    """One round of score tests: the candidate effects, their ``scores``, the Bonferroni
+    ``gate``, the ``eligible`` scores (significant and within bounds, largest share of the
+    residual first) and the significant effects ``out_of_bounds``."""
+
+    cands: list
+    scores: list
+    gate: float
+    eligible: list
+    out_of_bounds: list
+
+    def effect(self, effect_id):
+        return next(e for e in self.cands if e.id == effect_id)
+
+
 class _Loop:
     """The loop of :func:`explain`: score the catalogue's effects not in the model, add the
     most significant one within its bounds, refit, measure; stop when none is significant or
     the budget of additions is used."""
 
-    def __init__(
-        self, weak, measure, catalogue, alpha, max_iterations, simulate, terms, fit, crit, ver
-    ):
-        self.weak, self.measure, self.catalogue = weak, measure, catalogue
-        self.alpha, self.max_iterations, self.simulate = alpha, max_iterations, simulate
-        self.terms, self.fit, self.crit, self.ver = terms, fit, crit, ver
+    def __init__(self, weak, measure, settings, state):
+        self.weak, self.measure, self.settings, self.state = weak, measure, settings, state
         self.iterations, self.stopped = [], ""
 
     def run(self):
         while True:
-            cands = [e for e in self.catalogue if not set(e.terms) & set(self.terms)]
+            terms = set(self.state.terms)
+            cands = [e for e in self.settings.catalogue if not set(e.terms) & terms]
             if not cands:
                 self.stopped = "every catalogue effect is already in the model"
                 return
-            scores, gate, eligible, out_of_bounds = self._scores(cands)
-            if not eligible or len(self.iterations) >= self.max_iterations:
-                self._stop(scores, gate, eligible, out_of_bounds)
+            scored = self._scores(cands)
+            if not scored.eligible or len(self.iterations) >= self.settings.max_iterations:
+                self._stop(scored)
                 return
-            self._add(cands, scores, gate, eligible)
+            self._add(scored)
 
     def _scores(self, cands):
         """Score tests of the candidate effects at the current fit (Bonferroni gate)."""
-        scores = [self.weak.score(self.fit, e) for e in cands]
-        gate = self.alpha / len(scores)
+        scores = [self.weak.score(self.state.fit, e) for e in cands]
+        gate = self.settings.alpha / len(scores)
         for s, e in zip(scores, cands, strict=True):
             s["significant"] = bool(s["p"] < gate)
             s["in_bounds"] = in_bounds(e, [s["direction"][n] for n in e.terms])
@@ -459,71 +228,84 @@ class _Loop:
             (s for s in scores if s["significant"] and s["in_bounds"]), key=lambda s: -s["share"]
         )
         out_of_bounds = [s["effect"] for s in scores if s["significant"] and not s["in_bounds"]]
-        return scores, gate, eligible, out_of_bounds
+        return _Round(cands, scores, gate, eligible, out_of_bounds)
 
-    def _stop(self, scores, gate, eligible, out_of_bounds):
+    def _stop(self, scored):
         """The last iteration: nothing (more) is named, and why."""
-        state = (
+        settings, state = self.settings, self.state
+        why = (
             "the model is consistent with the record"
-            if self.crit.get("consistent")
+            if state.crit.get("consistent")
             else "the model is still inconsistent with the record: the catalogue does not "
             "explain the rest (the coefficients' uncertainty or an effect outside the "
             "catalogue may)"
-            if self.simulate
+            if settings.simulate
             else "the gap was not simulated"
         )
-        if eligible:
+        if scored.eligible:
             text = (
-                f"the budget of {self.max_iterations} added effect(s) is used; still "
-                f"significant: {', '.join(s['effect'] for s in eligible)}"
+                f"the budget of {settings.max_iterations} added effect(s) is used; still "
+                f"significant: {', '.join(s['effect'] for s in scored.eligible)}"
             )
         else:
             text = (
                 f"no catalogue effect is significant (score tests at family-wise "
-                f"level {self.alpha:g}, gate {gate:.2g} for {len(scores)} effects)"
+                f"level {settings.alpha:g}, gate {scored.gate:.2g} for {len(scored.scores)} "
+                "effects)"
             )
-            if out_of_bounds:
+            if scored.out_of_bounds:
                 text += "; significant but outside its physical bounds (not named): " + ", ".join(
-                    out_of_bounds
+                    scored.out_of_bounds
                 )
-        fit, crit, ver = self.fit, self.crit, self.ver
         self.iterations.append(
-            Iteration(None, {"text": text}, scores, crit, crit, {}, fit.model, fit.model, ver, ver)
+            Iteration(
+                effect=None,
+                evidence={"text": text},
+                scores=scored.scores,
+                criteria_before=state.crit,
+                criteria_after=state.crit,
+                parameters={},
+                model_before=state.fit.model,
+                model_after=state.fit.model,
+                verification_before=state.ver,
+                verification_after=state.ver,
+            )
         )
-        self.stopped = f"{text}; {state}"
+        self.stopped = f"{text}; {why}"
 
-    def _equivalent(self, eff, cands, eligible, fit2, gate):
+    def _equivalent(self, eff, scored, fit2):
         """Confounded alternatives: significant effects that, added instead, would leave
         the named one insignificant while they are insignificant beside it."""
-        weak, terms = self.weak, self.terms
+        weak, terms, gate = self.weak, self.state.terms, scored.gate
         equivalent = []
-        after = {e.id: weak.score(fit2, e) for e in cands if e is not eff}
-        for s in eligible[1:]:
-            alt = next(e for e in cands if e.id == s["effect"])
+        after = {e.id: weak.score(fit2, e) for e in scored.cands if e is not eff}
+        for s in scored.eligible[1:]:
+            alt = scored.effect(s["effect"])
             alt_fit = weak.fit(tuple(sorted(set(terms) | set(alt.terms), key=TERMS.index)))
             if after[alt.id]["p"] >= gate and weak.score(alt_fit, eff)["p"] >= gate:
                 equivalent.append(alt.id)
         return equivalent
 
-    def _add(self, cands, scores, gate, eligible):
+    def _add(self, scored):
         """Name the most significant effect within its bounds, refit and measure."""
-        weak, crit = self.weak, self.crit
-        best = eligible[0]
-        eff = next(e for e in cands if e.id == best["effect"])
-        new_terms = tuple(sorted(set(self.terms) | set(eff.terms), key=TERMS.index))
+        weak, state, gate = self.weak, self.state, scored.gate
+        crit = state.crit
+        best = scored.eligible[0]
+        eff = scored.effect(best["effect"])
+        new_terms = tuple(sorted(set(state.terms) | set(eff.terms), key=TERMS.index))
         fit2 = weak.fit(new_terms)
         crit2, ver2 = self.measure(fit2)
         params = weak.parameters(fit2, eff.terms)
-        equivalent = self._equivalent(eff, cands, eligible, fit2, gate)
+        equivalent = self._equivalent(eff, scored, fit2)
         text = (
             f"score test LM = {best['lm']:.4g} (p = {best['p']:.2g} < gate {gate:.2g}, "
-            f"alpha {self.alpha:g} over {len(scores)} effects); its term explains "
-            f"{100 * best['share']:.1f} % of the weak-form residual; refitted "
+            f"alpha {self.settings.alpha:g} over {len(scored.scores)} effects); its term "
+            f"explains {100 * best['share']:.1f} % of the weak-form residual; refitted "
             + ", ".join(f"{n} {p['value']:.4g} +- {p['stderr']:.2g}" for n, p in params.items())
             + f"; residual {crit['residual_rms']:.3g} -> {crit2['residual_rms']:.3g} "
             f"(noise floor {weak.noise_rms / weak.b_rms:.3g})"
         )
-        if self.simulate:
+        if self.settings.simulate:
             text += (
                 f"; energy distance {crit['energy_distance']:.3g} -> "
                 f"{crit2['energy_distance']:.3g} (floor q95 {crit2['floor_q95']:.3g}), "
@@ -545,20 +327,20 @@ class _Loop:
         }
         self.iterations.append(
             Iteration(
-                eff.id,
-                evidence,
-                scores,
-                crit,
-                crit2,
-                params,
-                self.fit.model,
-                fit2.model,
-                self.ver,
-                ver2,
-                equivalent,
+                effect=eff.id,
+                evidence=evidence,
+                scores=scored.scores,
+                criteria_before=crit,
+                criteria_after=crit2,
+                parameters=params,
+                model_before=state.fit.model,
+                model_after=fit2.model,
+                verification_before=state.ver,
+                verification_after=ver2,
+                equivalent=equivalent,
             )
         )
-        self.terms, self.fit, self.crit, self.ver = new_terms, fit2, crit2, ver2
+        self.state = _State(new_terms, fit2, crit2, ver2)
 
 
 @params(
@@ -631,25 +413,20 @@ def explain(
     _check_settings(alpha, max_iterations, order, noise)
     start = parse_terms(start_terms)
     catalogue = select(EFFECTS, effects)
-    t, x, spp = _record_forcing(t, x, B, nu)
+    t, x, spp = check_forcing(t, x, B, nu)
     T = 2 * np.pi / nu
-    hs = max(7, int(round(spp / 4))) if half_width is None else int(half_width)
-    if hs < 2 or 2 * hs + 1 > t.size // 4:
-        raise InputError(
-            f"the record ({t.size} samples) is too short for test windows of "
-            f"{2 * hs + 1} samples; record more periods"
-        )
+    hs = window_half_width(t.size, spp, half_width)
     sm = smooth(t, x, spp)
     if noise is not None:
         sm = replace(sm, noise_sd=float(noise * np.ptp(x)))
-    weak = _Weak(t, x, B, nu, hs, int(order), fit_forcing, sm)
+    weak = WeakFits(t, x, sm, B=B, nu=nu, settings=WeakSettings(hs, int(order), fit_forcing))
     measure = _Measure(
-        weak,
-        t,
-        x,
-        sm,
-        simulate,
-        dict(
+        weak=weak,
+        t=t,
+        x=x,
+        sm=sm,
+        simulate=simulate,
+        verify_kwargs=dict(
             transient=transient,
             periods=periods,
             resamples=resamples,
@@ -659,9 +436,15 @@ def explain(
     )
     fit = weak.fit(start)
     crit, ver = measure(fit)
-    loop = _Loop(weak, measure, catalogue, alpha, max_iterations, simulate, start, fit, crit, ver)
+    loop = _Loop(
+        weak,
+        measure,
+        _Settings(tuple(catalogue), alpha, max_iterations, simulate),
+        _State(start, fit, crit, ver),
+    )
     loop.run()
-    coef, se = weak.coefficients(loop.fit)
+    final = loop.state
+    coef, se = weak.coefficients(final.fit)
     settings = {
         "alpha": alpha,
         "max_iterations": int(max_iterations),
@@ -685,18 +468,18 @@ def explain(
     return Explanation(
         iterations=tuple(loop.iterations),
         start_model=fit.model,
-        final_model=loop.fit.model,
+        final_model=final.fit.model,
         start_terms=start,
-        final_terms=loop.terms,
+        final_terms=final.terms,
         coefficients=coef,
         standard_errors=se,
         criteria_start=crit,
-        criteria=loop.crit,
-        noise_floor=_floor(weak, sm, loop.ver),
-        consistent=loop.crit.get("consistent"),
+        criteria=final.crit,
+        noise_floor=_floor(weak, sm, final.ver),
+        consistent=final.crit.get("consistent"),
         stopped_because=loop.stopped,
         seconds=time.perf_counter() - t_start,
         settings=settings,
         start_verification=ver,
-        final_verification=loop.ver,
+        final_verification=final.ver,
     )

@@ -22,7 +22,7 @@ _save = save
 
 def _term_math(name):
     r"""A library term (``x^2 x'``, ``1``) as mathtext: ``$x^{2}\,\dot{x}$``."""
-    from discovery.ueda.discover import MONOMIALS, TERMS
+    from discovery.ueda.polynomial import MONOMIALS, TERMS
 
     if name not in TERMS:
         return str(name).replace("$", r"\$")

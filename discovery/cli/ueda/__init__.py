@@ -19,8 +19,8 @@ def register(sub):
     """Add ``vidi ueda`` and its subcommands to the command subparsers ``sub``."""
     u = sub.add_parser(
         "ueda",
-        help="Ueda's forced oscillators: attractors, Lyapunov "
-        "exponents, regime charts, equation discovery",
+        help="Ueda's forced oscillators: attractors, Lyapunov exponents, regime charts, "
+        "synthetic records, equation discovery, missing effects",
     )
     usub = u.add_subparsers(
         dest="ueda_command", required=True, metavar="SUBCOMMAND", parser_class=type(u)

@@ -14,7 +14,9 @@ from ._system import _forcing
 def run(args):
     from reports.ueda.figures import discover_figure
 
-    from ...ueda.discover import discover, read_record_csv, verify
+    from ...ueda.discover import discover
+    from ...ueda.record import read_record_csv
+    from ...ueda.verification import verify
 
     check_out(args)
     B, nu = _forcing(args)

@@ -12,8 +12,8 @@ from ._system import _forcing
 def run(args):
     from reports.ueda.explain_figure import explain_figure
 
-    from ...ueda.discover import read_record_csv
     from ...ueda.explain import explain, parse_terms
+    from ...ueda.record import read_record_csv
 
     check_out(args)
     B, nu = _forcing(args)

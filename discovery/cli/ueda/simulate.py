@@ -14,7 +14,7 @@ def run(args):
     import time
 
     from ..._io import atomic_write_text, check_output, to_jsonable
-    from ...ueda.discover import simulate_record
+    from ...ueda.record import simulate_record
 
     out = check_out(args, kind="file")
     if out.suffix.lower() != ".csv":

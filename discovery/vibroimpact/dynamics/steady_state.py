@@ -149,10 +149,10 @@ class StroboscopicMap:
         """``(Phi^n(y), d Phi^n / d y)`` from one run with the variational equations (see
         :meth:`jacobian`).  Its steps also control the Jacobian's error, so its state
         differs from :meth:`advance`'s within the integrator's tolerance (2.6e-10 of the
-        scales on the paper's orbit); Newton's reported residual is this run's.  (Along
-        the state's own steps the Jacobian of the light scenario's orbit was off by 7e-5
-        and its multipliers by 3e-5.)  Where the Jacobian takes differences the state is
-        the plain run's (``fy`` when given)."""
+        scales on the paper's orbit); Newton's reported residual is this run's.  The
+        Jacobian's error needs that control: along the state's own steps the light
+        scenario's Jacobian is 7e-5 off and its multipliers 3e-5.  Where the Jacobian
+        takes differences the state is the plain run's (``fy`` when given)."""
         if self.exact:
             S = np.eye(4)
             f = self._run(y, n, 0.0, False, (S, self._state_dirs, self.scale, *self._no_sens[3:]))

@@ -171,7 +171,7 @@ class Model:
         return replace(self, law=law)
 
     # ------------------------------------------- the parameters identify() fits
-    def _free(self):
+    def free_effects(self):
         """Added effects whose parameter is not a coefficient of the loading law."""
         return [
             e
@@ -182,11 +182,11 @@ class Model:
     @property
     def coefficients(self):
         """The law's coefficients, then the added effects' other parameters."""
-        return self.law.coefficients + tuple(self.value(e) for e in self._free())
+        return self.law.coefficients + tuple(self.value(e) for e in self.free_effects())
 
     @property
     def names(self):
-        return list(self.law.names) + [e.parameters[0].name for e in self._free()]
+        return list(self.law.names) + [e.parameters[0].name for e in self.free_effects()]
 
     def with_coefficients(self, values):
         """The model with new :attr:`coefficients` (each effect parameter clipped to its
@@ -194,7 +194,7 @@ class Model:
         values = [float(v) for v in values]
         n = len(self.law.coefficients)
         m = self.with_law(self.law.with_coefficients(values[:n]))
-        for e, v in zip(self._free(), values[n:], strict=True):
+        for e, v in zip(self.free_effects(), values[n:], strict=True):
             lo, hi = e.parameters[0].bounds
             m = m.with_effect(e, min(max(v, lo), hi), add=False)
         return m

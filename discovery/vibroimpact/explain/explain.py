@@ -47,7 +47,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.stats import chi2
 
-from ..._printing import criteria_lines, fmt, readable
+from ..._printing import fmt, readable
 from ..._progress import tick
 from ..._validate import Choice, Instance, Real, Text, params
 from ...catalogue import select
@@ -69,6 +69,7 @@ from ..fit.identify import (
 from ..model.law import ForceLaw, Term
 from ..model.scenario import Scenario
 from ..verify import CONSISTENCY_FACTORS, Reference, evaluate
+from ..verify.criteria import criteria_lines
 from ..verify.motion import MOTION_CRITERION, penetration_residuals
 from . import drift as D
 from .effects import EFFECTS, Model, effect, small_step

@@ -39,7 +39,7 @@ import numpy as np
 
 from constraints import require as require_certificate
 
-from ..._printing import coefficient_lines, criteria_lines, fmt, readable
+from ..._printing import coefficient_lines, fmt, readable
 from ..._progress import tick
 from ..._validate import Choice, Real, Text, params
 from ...errors import InputError, IntegrationError, VidiError
@@ -51,6 +51,7 @@ from ..model.law import Term
 from ..model.library import Library
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
+from ..verify.criteria import criteria_lines
 from ..verify.criteria import criterion as _criterion
 from .identify import (
     INTERVAL_REFITS,
@@ -446,11 +447,6 @@ def _required_terms(require, library):
             )
         out.add(name)
     return frozenset(out)
-
-
-def _steady_from(ref):
-    """Record time from which a record is steady: its first averaged cycle's onset."""
-    return float(ref.impulse.onset)
 
 
 def _trial(check, job):

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.optimize import least_squares, minimize
 
-from ..._printing import coefficient_lines, criteria_lines, fmt, readable
+from ..._printing import coefficient_lines, fmt, readable
 from ..._progress import tick
 from ..._validate import Choice, Real, Text, params
 from ...errors import InputError, IntegrationError, VidiTypeError
@@ -47,6 +47,7 @@ from ..dynamics import Tolerances
 from ..model.law import ForceLaw, Term
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
+from ..verify.criteria import criteria_lines
 from ..verify.criteria import criterion as _criterion
 from ..verify.motion import penetration_jacobian, penetration_residuals, penetration_size
 
@@ -448,7 +449,7 @@ class _Objective:
         n = len(law.coefficients)
         cols = list(range(n))
         if not isinstance(model, ForceLaw):
-            for e in model._free():
+            for e in model.free_effects():
                 t = Term.parse(e.key) if e.target == "unloading" else None
                 cols.append(n + law.unloading.index(t) if t in law.unloading else None)
         # a record compared over its span takes an observation linear in the force; one
@@ -688,17 +689,16 @@ def _short_first(
 def _x_bounds(model):
     """Bounds of the least-squares variables ``x = c / c_start``: an observation model's
     parameter (a sensor's time constant) within its physical bounds, so the trust region
-    does not step beyond a bound the model would clip to: a lag refit from a stiff start
-    stepped to ``tau < 0``, was clipped to 0 (no filter) and stalled there.  Everything else
-    is unbounded, as before: bounded, scipy's trust region scales every variable by its
-    distance to a bound, and the demo's unloading-damping fit then stopped 1.5 standard
-    errors from the truth (the model clips those parameters as before)."""
+    does not step beyond a bound the model clips to (a step to ``tau < 0`` is clipped to no
+    filter, where the fit stalls).  Everything else is unbounded, the model clipping those
+    parameters itself: scipy's trust region scales every bounded variable by its distance
+    to the bound, which stops a fit near a bound short of the optimum."""
     c0 = np.asarray(model.coefficients, dtype=float)
     lo, hi = np.full(c0.size, -np.inf), np.full(c0.size, np.inf)
     if isinstance(model, ForceLaw):
         return lo, hi
     n = len(model.law.coefficients)
-    for i, e in enumerate(model._free(), start=n):
+    for i, e in enumerate(model.free_effects(), start=n):
         if e.target == "observation":
             a, b = (v / c0[i] for v in e.parameters[0].bounds)
             lo[i], hi[i] = min(a, b), max(a, b)
@@ -749,8 +749,8 @@ RESTART_FACTORS = (1.25, 0.8)
 parameter scaled by each factor, while the budget allows, and the best point is kept (by the
 sum of squares for least squares, else by the criterion).  A law refitted from a start 20 %
 off can stop in a basin whose spring is too soft (another contact sequence along the
-record's transient); the restart from 1.25 times the point reached the true law's basin in
-3 of 4 such stalled fits on random slow-P1 and subharmonic records."""
+record's transient); a restart from a stiffer and a softer point often leaves such a basin
+(the rates: CHANGELOG)."""
 
 
 def _restarted(obj, method, xtol, max_simulations, message):
@@ -988,9 +988,9 @@ def identify(
 # bootstrap of Davidson & MacKinnon 1999 and Andrews 2002, k = 2: the replicate's estimate
 # lies within a standard error of the fit, where Newton's steps converge fast): each step is
 # the replicate's residuals and their exact Jacobian, one plain and one sensitivity run per
-# block, where a least-squares refit took about five of each.  On 12-period records of the
-# coverage survey the bootstrap's standard deviations stayed within 10 % of the full
-# refits' (one step: 23 %), in a third of the time.  ``refit="full"`` keeps the full refit.
+# block, where a least-squares refit takes about five of each; two steps keep the
+# bootstrap's standard deviations close to the full refits' (one step does not; the
+# numbers: CHANGELOG).  ``refit="full"`` keeps the full refit.
 #
 # A record has few cycles (a dozen, six for a period-two orbit) against two to four
 # parameters, and a cluster bootstrap's spread, like the cluster-robust variance it mimics,

@@ -111,11 +111,6 @@ class Term:
             parts.append("zd" if self.b == 1 else f"zd^{_fmt_exp(self.b)}")
         return "*".join(parts)
 
-    @property
-    def is_dissipative(self):
-        """True when the term depends on the loading velocity (``b > 0``)."""
-        return self.b > 0
-
     def __call__(self, zeta, zd):
         """Evaluate ``zeta^a * zd^b`` (arrays broadcast; inputs must be >= 0)."""
         zeta = np.asarray(zeta, dtype=float)

@@ -58,6 +58,7 @@ from ..._progress import tick
 from ..._validate import Instance, Real, Text, params
 from ...errors import InputError, VidiTypeError
 from ...numerics.executor import make_executor
+from ..dynamics.warmup import compile_kernels
 from .aggregate import aggregate, run_rows, to_csv
 from .config import StudyConfig, load_study
 from .run import run_cost, run_one
@@ -297,7 +298,7 @@ def _run_missing(todo, have, runs, rundir, version, workers, scheduler, executor
     runs done and the parallel efficiency (the runs' seconds over the wall time times the
     workers; None when nothing ran)."""
     own = executor is None
-    ex = make_executor(workers, scheduler) if own else executor
+    ex = make_executor(workers, scheduler, warm=compile_kernels) if own else executor
     name = repr(ex)
     # the longest runs first, so no worker is left with one long run at the end (the
     # results do not depend on the order: one file per run, tables from the files)
@@ -385,7 +386,7 @@ def study(
     executor=None,
     progress=None,
     max_runs=None,
-    figures=True,
+    figures=None,
 ):
     """Run a model-term selection study (see :mod:`discovery.vibroimpact.studies`).
 
@@ -411,14 +412,23 @@ def study(
     max_runs : int, optional
         Do at most this many missing runs, then aggregate what the files hold (a study in
         slices; the rest runs on the next call).
-    figures : bool
-        Draw the figures.
+    figures : callable, optional
+        ``figures(config, records, directory) -> paths``: draws the study's figures into
+        the directory written as a whole (the report layer's
+        :func:`reports.vibroimpact.study_figures.study_figures`, which ``vidi study``
+        passes); None or False: no figures.  The study itself draws nothing.
 
     Returns
     -------
     StudyResult
     """
     t0 = time.perf_counter()
+    if figures is not None and figures is not False and not callable(figures):
+        raise VidiTypeError(
+            "figures must be a callable figures(config, records, directory) -> paths (e.g. "
+            "reports.vibroimpact.study_figures.study_figures) or None, "
+            f"not {type(figures).__name__}"
+        )
     if progress is not None and not callable(progress):
         raise VidiTypeError(
             f"progress must be a callable progress(stage, done, total) or None, "
@@ -634,8 +644,6 @@ def _stage(out, inputs, cfg, records, figures, work, summary, version):
         cells, inclusion = _write_tables(stage, cfg, records)
         paths = ()
         if figures and records:
-            from reports.vibroimpact.study_figures import study_figures
-
-            paths = tuple(study_figures(cfg, records, stage))
+            paths = tuple(figures(cfg, records, stage))
         od.write_json("summary.json", summary(cells))
     return paths, cells, inclusion

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._printing import fmt
 from ..._validate import Instance, params
 from ...errors import InputError
 
@@ -39,6 +40,8 @@ __all__ = [
     "evaluate_criteria",
     "criterion",
     "definition",
+    "MOTION_DEFINITIONS",
+    "criteria_lines",
 ]
 
 
@@ -321,3 +324,23 @@ def evaluate_criteria(measured, simulated, names=None):
     funcs = {n: criterion(n) for n in names}
     c = compare(measured, simulated)
     return {n: float(f(c)) for n, f in funcs.items()}
+
+
+def criteria_lines(criteria, floor=None, limits=None, indent="  "):
+    """The criteria table: value, noise floor, the limit (for the criteria the consistency
+    rule judges; ``--`` for the others) and the meaning, from :data:`CRITERIA` (the one
+    definition)."""
+    if not criteria:
+        return []
+    out = [f"{indent}{'criterion':<10}{'value':>10}{'floor':>10}{'limit':>10}   meaning"]
+    for k in (*CRITERIA, *(k for k in criteria if k not in CRITERIA)):
+        if k in criteria:
+            lim = (limits or {}).get(k)
+            meaning = definition(k).meaning
+            out.append(
+                f"{indent}{k:<10}{fmt(criteria[k], 3):>10}"
+                f"{fmt((floor or {}).get(k), 3):>10}"
+                f"{fmt(lim, 3) if lim is not None else '--':>10}"
+                + (f"   {meaning}" if meaning else "")
+            )
+    return out

@@ -29,13 +29,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._printing import criteria_lines, readable
+from ..._printing import readable
 from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
 from ..dynamics.response import impulse_from_steady_state
 from ..dynamics.simulate import simulate
 from ..dynamics.steady_state import steady_state
-from .criteria import compare, evaluate_criteria
+from .criteria import compare, criteria_lines, evaluate_criteria
 from .motion import MOTION_CRITERION, block_penetration
 from .trajectory import block_criteria, simulated_motion
 

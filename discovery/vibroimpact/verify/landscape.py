@@ -8,12 +8,12 @@ criteria I0..I4.  Points are independent, so they are computed in parallel proce
 and the result does not depend on the order of evaluation or the number of processes.
 
 The reference's noise floor is computed **once**, under the template law, and every
-point is judged by ``evaluate``'s consistency rule against that floor.  A floor per point
-(a parametric bootstrap, ~0.1 s) would cost 10-20 times the point's simulation from a
-measured state (21 x 21 on the paper's record with 1 % noise: 52 s instead of 2.7 s);
-there the floor of I2 varied by ~5 % over the consistent points and the per-point rule
-differed at 2 of 441 points, both on the boundary of the consistent region.  So
-``consistent`` is exact for the template law and a close approximation elsewhere.
+point is judged by ``evaluate``'s consistency rule against that floor: a floor per point
+(a parametric bootstrap, ~0.1 s) costs 10-20 times the point's simulation from a measured
+state, and the floor varies little over the consistent points (I2's by about 5 % on the
+paper's record with 1 % noise).  So ``consistent`` is exact for the template law and a
+close approximation elsewhere: only points on the boundary of the consistent region can
+be judged otherwise by a floor of their own.
 """
 
 import os

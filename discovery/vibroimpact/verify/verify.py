@@ -3,12 +3,13 @@
 import time
 from dataclasses import dataclass, field
 
-from ..._printing import criteria_lines, readable
+from ..._printing import readable
 from ..._validate import Real, params
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
+from .criteria import criteria_lines
 from .evaluate import evaluate
 from .reference import Reference
 

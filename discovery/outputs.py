@@ -1,0 +1,9 @@
+"""What a run directory holds and how vidi writes into it, for the layers above the package
+(the reports): the manifest's name, atomic writes, and whether the run that owns a staging
+directory is still alive (its PID and start time)."""
+
+from ._io import MANIFEST, atomic_write_text
+from ._io import _alive as process_alive
+from ._io import _proc_start as process_start
+
+__all__ = ["MANIFEST", "atomic_write_text", "process_alive", "process_start"]

@@ -1,0 +1,147 @@
+"""The figure of one iteration of the missing-effect workflow (``vidi explain``): forces
+before and after, phases, the coefficient plane and the effects' scores."""
+
+import numpy as np
+
+from .._mpl import PRINT_WIDTH, print_sizes, save, subplots
+from .figure_parts import terms_math
+
+__all__ = ["explain_figure"]
+
+_save = save
+
+
+def _explain_forces(ax, iteration, measured, k):
+    """The force before and after the named effect, against the record."""
+    E = measured
+    ax.plot(E.t * 1e3, E.F / 1e3, "k-", lw=2, label="measured")
+    if iteration.simulated_before is not None:
+        ax.plot(
+            E.t * 1e3,
+            iteration.simulated_before.F / 1e3,
+            "-",
+            color="tab:red",
+            label=terms_math(f"before ({' + '.join(iteration.model_before.law.names)})"),
+        )
+    if iteration.effect and iteration.simulated_after is not None:
+        ax.plot(
+            E.t * 1e3,
+            iteration.simulated_after.F / 1e3,
+            "-",
+            color="tab:blue",
+            label=f"after (+ {iteration.effect.replace('_', ' ')})",
+        )
+    if len(E.support):
+        a, b = E.support[0]
+        ax.set_xlim(max(a - 0.1 * (b - a), 0) * 1e3, (b + 0.3 * (b - a)) * 1e3)
+    ax.set_xlabel("time since onset [ms]")
+    ax.set_ylabel("contact force [kN]")
+    i2b = iteration.criteria_before.get("I2", float("nan"))
+    i2a = iteration.criteria_after.get("I2", float("nan"))
+    ax.set_title(
+        f"iteration {k}: I2 {i2b:.3g} -> {i2a:.3g}\n(noise floor "
+        f"{iteration.noise_floor.get('I2', float('nan')):.2g})",
+    )
+    ax.legend(loc="best", framealpha=0.8)
+
+
+def _explain_phases(ax, iteration):
+    """The residual's share by impact phase, and its ratio to the noise."""
+    ph = iteration.localisation["phases"]
+    names = list(ph)
+    shares = [ph[n]["share"] for n in names]
+    x = np.arange(len(names))
+    bars = ax.bar(
+        x, shares, color=["tab:red" if ph[n]["exceeds_noise"] else "tab:gray" for n in names]
+    )
+    # phase names are long next to each other: rotated, anchored at their tick
+    ax.set_xticks(
+        x, [n.replace("_", " ") for n in names], rotation=30, ha="right", rotation_mode="anchor"
+    )
+    for bar, n in zip(bars, names, strict=True):
+        r = ph[n]["ratio_to_noise"]
+        if r is not None:
+            ax.text(
+                bar.get_x() + bar.get_width() / 2,
+                bar.get_height(),
+                f"{r:.0f}x" if r >= 10 else f"{r:.1f}x",
+                ha="center",
+                va="bottom",
+            )
+    ax.margins(y=0.12)  # room for the numbers above the tallest bar
+    ax.set_xlabel("impact phase")
+    ax.set_ylabel("share of the residual energy\nabove the noise")
+    ax.set_title(
+        "where the model disagrees, by impact phase\n(red: above the noise;\n"
+        "number: residual energy / noise energy)",
+    )
+
+
+def _explain_plane(fig, ax, iteration):
+    """The mean residual over the simulated (zeta, dzeta) plane."""
+    plane = iteration.localisation.get("plane")
+    if plane is not None:
+        ze, ve = plane["zeta_edges"], plane["dzeta_edges"]
+        m = plane["mean_residual"]
+        lim = np.nanmax(np.abs(m)) if np.isfinite(m).any() else 1.0
+        # an empty bin (NaN: no sample fell in it) is gray, a zero residual white
+        ax.set_facecolor("0.8")
+        im = ax.pcolormesh(
+            ze * 1e3,
+            ve,
+            np.ma.masked_invalid(m / 1e3).T,
+            cmap="RdBu_r",
+            vmin=-lim / 1e3,
+            vmax=lim / 1e3,
+            shading="flat",
+        )
+        fig.colorbar(im, ax=ax, label=r"mean residual $F_N - F_E$ [kN]")
+        ax.set_xlabel(r"$\zeta$ [mm] (simulated)")
+        ax.set_ylabel(r"$\dot{\zeta}$ [m/s] (simulated)")
+    else:
+        ax.text(0.5, 0.5, "no positions in the record", ha="center", transform=ax.transAxes)
+    ax.set_title(r"residual over the ($\zeta$, $\dot{\zeta}$) plane" + "\n(gray: no samples)")
+
+
+def _explain_scores(ax, iteration):
+    """Every candidate effect's score test."""
+    sc = [x for x in iteration.scores if x.get("lm") is not None]
+    unscored = [x for x in iteration.scores if x.get("lm") is None and "criteria_after" in x]
+    if sc or unscored:
+        lm = [max(x["lm"], 1e-3) for x in sc]
+        ax.barh(
+            [x["effect"].replace("_", " ") for x in sc],
+            lm,
+            color=[
+                "tab:green"
+                if x["effect"] == iteration.effect
+                else ("tab:orange" if x["significant"] else "tab:gray")
+                for x in sc
+            ],
+        )
+        # an effect whose small step changes the regime has no score, only its refit
+        for x in unscored:
+            ax.barh(
+                [x["effect"].replace("_", " ")],
+                [max(lm, default=1.0)],
+                fill=False,
+                hatch="//",
+                edgecolor="tab:green" if x["effect"] == iteration.effect else "tab:gray",
+            )
+        ax.set_xscale("log")
+    ax.set_xlabel("score-test (LM) statistic\n(hatched: no local score, refitted)")
+    ax.set_title("candidate effects\n(green: named; orange: significant;\ngray: not significant)")
+
+
+def explain_figure(iteration, measured, stem, k=1):
+    """One iteration of the missing-effect loop: the force before and after adding the
+    named effect against the record, the residual's share by impact phase (and its ratio
+    to the noise), the mean residual over the simulated (zeta, dzeta) plane, and every
+    candidate effect's score test."""
+    with print_sizes():  # drawn at the width it is printed: its text 7 to 8 pt on paper
+        fig, axes = subplots(2, 2, figsize=(PRINT_WIDTH, 6.6), layout="constrained")
+        _explain_forces(axes[0, 0], iteration, measured, k)
+        _explain_phases(axes[0, 1], iteration)
+        _explain_plane(fig, axes[1, 0], iteration)
+        _explain_scores(axes[1, 1], iteration)
+        return _save(fig, stem)

@@ -1,0 +1,135 @@
+"""Figures of a verification (``vidi verify``): measured and simulated force over the orbit,
+and the force-penetration loops."""
+
+import numpy as np
+
+from .._mpl import PRINT_WIDTH, figure, save, subplots
+from .figure_parts import contact_view, force_unit, law_math
+
+__all__ = ["verify_figure", "loops_figure"]
+
+_save = save
+
+
+def verify_figure(result, stem):
+    """Measured and simulated force over the whole orbit, the noise band, the residual.
+
+    Parameters
+    ----------
+    result : discovery.vibroimpact.verify.VerifyResult
+    stem : str
+        Output path without extension (PNG and PDF are written).
+    """
+    from discovery.vibroimpact.verify.criteria import compare
+    from discovery.vibroimpact.verify.motion import force_penetration_loops
+
+    ev = result.evaluation
+    E = result.reference.impulse
+    loops = force_penetration_loops(result.reference, ev)
+    if loops is None:
+        fig, (ax, axr) = subplots(
+            2, 1, figsize=(PRINT_WIDTH, 4.8), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
+        )
+    else:  # the force-penetration loops beside the force histories
+        fig = figure(figsize=(PRINT_WIDTH, 5.6))
+        grid = fig.add_gridspec(2, 2, height_ratios=[3, 2], width_ratios=[1.5, 1])
+        ax = fig.add_subplot(grid[0, 0])
+        axr = fig.add_subplot(grid[1, 0], sharex=ax)
+        _loops_panel(fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, 1]), loops, ev)
+    band = 2.0 * result.reference.noise.get("F", 0.0) / np.sqrt(max(E.n_cycles, 1))
+    ms = 1e3
+    sc, unit = force_unit(E.peak)
+    if ev.simulated is not None:
+        c = compare(E, ev.simulated)
+        # the contact, not the whole cycle: re-based on its start, not cut by the fold
+        tr, o, (lo, hi) = contact_view(
+            c.t, E.duration, c.fe, c.fn, threshold=max(2.0 * band, 0.02 * E.peak, 5.0 * E.noise)
+        )
+        x = tr[o] * ms
+        ax.fill_between(
+            x,
+            (c.fe[o] - band) * sc,
+            (c.fe[o] + band) * sc,
+            color="0.85",
+            label=f"measured +-2 sigma/sqrt({E.n_cycles}) noise band",
+        )
+        ax.plot(x, c.fe[o] * sc, "k-", lw=1.0, label=f"measured F_E ({E.n_cycles} cycles)")
+        ax.plot(x, c.fn[o] * sc, "C3-", lw=1.0, label=f"simulated F_N ({ev.regime['simulated']})")
+        axr.fill_between(x, -band * sc, band * sc, color="0.85")
+        axr.plot(x, (c.fn[o] - c.fe[o]) * sc, "C0-", lw=0.8)
+        ax.set_xlim(lo * ms, hi * ms)
+    else:
+        ax.plot(E.t * ms, E.F * sc, "k-", lw=1.0, label="measured F_E")
+    crit = ", ".join(
+        f"{k} {v:.3g} (floor {ev.noise_floor.get(k, float('nan')):.2g})"
+        for k, v in ev.criteria.items()
+        if k in ("I2", "I4", "I5")
+    )
+    ax.set_title(
+        f"{law_math(result.law)}\n"
+        f"{'consistent' if ev.consistent else 'INCONSISTENT'}: {crit or ev.status}",
+        fontsize=8,
+    )
+    ax.set_ylabel(f"contact force F [{unit}]")
+    ax.legend(fontsize=7, loc="best", framealpha=0.8)
+    axr.set_ylabel(f"F_N - F_E [{unit}]")
+    axr.set_xlabel("time since the contact's start [ms] (folded)")
+    axr.axhline(0.0, color="k", lw=0.5)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def loops_figure(loops, evaluation, stem, law, what):
+    """The force-penetration loop and both penetrations over the contacts of a model
+    against a record (:func:`discovery.vibroimpact.verify.motion.force_penetration_loops`),
+    e.g. explain's final model.
+
+    Parameters
+    ----------
+    loops : dict
+    evaluation : Evaluation
+        Its I5 and limit go in the title.
+    stem : str
+        Output path without extension (PNG and PDF are written).
+    law : ForceLaw
+    what : str
+        What the law is, for the title (e.g. "final model").
+    """
+    fig, (ax, axz) = subplots(1, 2, figsize=(PRINT_WIDTH, 3.0))
+    _loops_panel(ax, axz, loops, evaluation)
+    fig.suptitle(f"{what}: {law_math(law)}", fontsize=8)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def _loops_panel(ax, axz, loops, ev):
+    """The force against the penetration over the contacts (the loop), and both
+    penetrations over time there (what I5 compares)."""
+    t = loops["phase"] * 1e3
+    # the window's separate runs (a cycle's end, another contact) are not joined by a line
+    gap = np.flatnonzero(np.diff(t) > 5.0 * np.median(np.diff(t))) + 1 if t.size > 2 else []
+
+    def runs(v):
+        return np.insert(np.asarray(v, dtype=float), gap, np.nan)
+
+    zm, fm = (runs(v) for v in loops["measured"])
+    zn, fn = (runs(v) for v in loops["simulated"])
+    t = runs(t)
+    sc, unit = force_unit(max(float(np.nanmax(np.abs(fm))), 1e-300))
+    ax.plot(zm * 1e3, fm * sc, "k.-", lw=0.8, ms=2, label="measured")
+    ax.plot(zn * 1e3, fn * sc, "C3.-", lw=0.8, ms=2, label="simulated")
+    ax.set_title("force-penetration loop", fontsize=8)
+    ax.set_xlabel("penetration w1 - w2 [mm]")
+    ax.set_ylabel(f"F [{unit}]")
+    ax.axvline(0.0, color="0.6", lw=0.5)
+    ax.legend(fontsize=7, loc="best", framealpha=0.8)
+    axz.plot(t, zm * 1e3, "k-", lw=0.8)
+    axz.plot(t, zn * 1e3, "C3-", lw=0.8)
+    axz.axhline(0.0, color="0.6", lw=0.5)
+    i5, lim = ev.criteria.get("I5"), (ev.limits or {}).get("I5")
+    if i5 is not None:
+        axz.set_title(
+            f"I5 {i5:.3g}" + (f" (limit {lim:.3g})" if lim is not None else ""), fontsize=8
+        )
+    axz.set_xlabel("time in the cycle [ms]")
+    axz.set_ylabel("w1 - w2 [mm]")
