@@ -138,7 +138,7 @@ def _iterations_csv(res):
 def _summary(args, sc, start, E, res):
     """``summary.json`` of the command."""
     final = res.checks[0]  # the identified law against the record, with its noise floor
-    return {
+    head = {
         "command": "identify",
         "scenario": sc.as_dict(),
         "data": str(args.data),
@@ -151,7 +151,8 @@ def _summary(args, sc, start, E, res):
             "contact_time": E.contact_time,
         },
         "start": start.as_dict(),
-        **res.as_dict(),
+    }
+    tail = {
         "criteria": final.criteria,
         "noise_floor": final.noise_floor,
         "consistent": final.consistent,
@@ -159,6 +160,7 @@ def _summary(args, sc, start, E, res):
         "regime": final.regime,
         **provenance(vars(args), inputs=inputs_of(args)),
     }
+    return res.record_run(head, tail)
 
 
 def _print_result(args, res):
@@ -223,7 +225,7 @@ def run(args):
         )
     imps = _iterate_impulses(sc, start, ref, res)
     with OutputDir(args.out) as out:
-        out.write_json("summary.json", _summary(args, sc, start, ref.impulse, res))
+        _summary(args, sc, start, ref.impulse, res).write_into(out)
         out.path("iterations.csv").write_text(_iterations_csv(res))
         identification_figure(res, ref.impulse, imps, str(out.path("identification")), land)
     _print_result(args, res)

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._printing import readable
+from .._result import Result
 from .._validate import Array, Instance, Real, params
 from ..errors import InputError, IntegrationError, VidiTypeError
 from ..numerics.executor import make_executor
@@ -55,8 +56,8 @@ KINDS = ("P1", "Pn", "beat", "chaotic")  # codes 0..3; -1 failed
 
 
 @readable
-@dataclass(frozen=True)
-class Chart:
+@dataclass(frozen=True, eq=False)
+class Chart(Result):
     """A regime chart.
 
     Attributes
@@ -93,6 +94,23 @@ class Chart:
         after ``recheck`` times the transient more from both (two non-periodic results
         are not compared).
     """
+
+    KIND = "ueda-chart"
+    _LOAD = {
+        "system": lambda d: UedaSystem.from_dict(d["system"]),
+        "nu": lambda d: None,
+        "B": lambda d: None,
+        "kind": lambda d: None,
+        "period": lambda d: None,
+        "lyapunov": lambda d: None,
+        "rotation": lambda d: None,
+        "periods_integrated": lambda d: None,
+        "kind_down": lambda d: None,
+        "period_down": lambda d: None,
+        "lyapunov_down": lambda d: None,
+        "rotation_down": lambda d: None,
+        "coexisting": lambda d: None,
+    }
 
     system: UedaSystem
     nu: np.ndarray

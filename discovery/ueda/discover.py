@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._printing import generic_lines, readable
+from .._result import Result
 from .._validate import Array, Real, Text, params
 from ..errors import InputError, IntegrationError
 from ..numerics.tolerances import Tolerances
@@ -473,8 +474,8 @@ def stlsq(G, b, threshold, keep=None, max_iter=25):
 
 
 @readable
-@dataclass(frozen=True)
-class Discovery:
+@dataclass(frozen=True, eq=False)
+class Discovery(Result):
     """A discovered equation with its uncertainty.
 
     Attributes
@@ -499,6 +500,13 @@ class Discovery:
         ``{term: fraction}``: how often STLSQ selects each term on bootstrap resamples.
     """
 
+    KIND = "ueda-discover"
+    _LOAD = {
+        "model": lambda d: None,
+        "terms": lambda d: tuple(d["terms"]),
+        "settings": lambda d: d.get("discovery_settings", d.get("settings")),
+    }
+
     model: ForcedPolynomial
     terms: tuple
     coefficients: dict
@@ -520,7 +528,9 @@ class Discovery:
     def latex(self):
         return self.model.latex()
 
-    def as_dict(self):
+    def as_dict(self, settings_key="settings"):
+        """The document's keys; ``settings_key`` names the discovery's settings (the
+        command line keeps ``settings`` for its options)."""
         return {
             "terms": list(self.terms),
             "coefficients": self.coefficients,
@@ -532,7 +542,7 @@ class Discovery:
             "n_windows": self.n_windows,
             "n_blocks": self.n_blocks,
             "bootstrap_support": self.bootstrap_support,
-            "settings": self.settings,
+            settings_key: self.settings,
             "seconds": self.seconds,
         }
 

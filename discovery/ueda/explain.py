@@ -43,6 +43,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from .._printing import generic_lines, readable
+from .._result import Result, part
 from .._validate import Array, Real, params
 from ..catalogue import select
 from ..errors import InputError
@@ -217,8 +218,8 @@ class _Weak:
         return coef, se
 
 
-@dataclass(frozen=True)
-class Iteration:
+@dataclass(frozen=True, eq=False)
+class Iteration(Result):
     """One pass of the loop.
 
     Attributes
@@ -247,6 +248,8 @@ class Iteration:
         each leaves the named one insignificant, and beside it each is insignificant.
     """
 
+    KIND = "ueda-explain-iteration"
+
     effect: str | None
     evidence: dict
     scores: list
@@ -274,8 +277,8 @@ class Iteration:
 
 
 @readable
-@dataclass(frozen=True)
-class Explanation:
+@dataclass(frozen=True, eq=False)
+class Explanation(Result):
     """Outcome of :func:`explain`.
 
     Attributes
@@ -297,6 +300,16 @@ class Explanation:
         simulation).
     stopped_because : str
     """
+
+    KIND = "ueda-explain"
+    _LOAD = {
+        "iterations": lambda d: tuple(part(Iteration, it) for it in d["iterations"]),
+        "start_terms": lambda d: tuple(d["start_terms"]),
+        "final_terms": lambda d: tuple(d["final_terms"]),
+        "settings": lambda d: (
+            d["method"] if isinstance(d.get("method"), dict) else d.get("settings")
+        ),
+    }
 
     iterations: tuple
     start_model: ForcedPolynomial
@@ -331,7 +344,9 @@ class Explanation:
                 out[k] = {"before": a, "after": b, "ratio": (a / b) if b > 0 else float("inf")}
         return out
 
-    def as_dict(self):
+    def as_dict(self, settings_key="settings"):
+        """The document's keys; ``settings_key`` names the method's settings (the command
+        line keeps ``settings`` for its options)."""
         return {
             "start_terms": list(self.start_terms),
             "final_terms": list(self.final_terms),
@@ -352,7 +367,7 @@ class Explanation:
             "catalogue": [
                 effect_dict(e) for e in EFFECTS if e.id in self.settings.get("effects", ())
             ],
-            "settings": self.settings,
+            settings_key: self.settings,
             "seconds": self.seconds,
         }
 

@@ -38,6 +38,7 @@ from scipy.optimize import least_squares, minimize
 
 from ..._printing import coefficient_lines, criteria_lines, fmt, readable
 from ..._progress import tick
+from ..._result import Result, part
 from ..._validate import Choice, Real, Text, params
 from ...errors import InputError, IntegrationError, VidiTypeError
 from ...numerics.executor import map_on
@@ -48,6 +49,7 @@ from ..model.law import ForceLaw, Term
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
 from ..verify.criteria import criterion as _criterion
+from ..verify.evaluate import Evaluation
 from ..verify.motion import penetration_jacobian, penetration_residuals, penetration_size
 
 __all__ = [
@@ -74,8 +76,8 @@ _JAC_STEP = 1e-5  # relative step of the standard-error Jacobian
 
 
 @readable
-@dataclass(frozen=True)
-class IdentificationResult:
+@dataclass(frozen=True, eq=False)
+class IdentificationResult(Result):
     """Outcome of :func:`identify`.
 
     Attributes
@@ -112,6 +114,17 @@ class IdentificationResult:
         The identified law against every record with its noise floor (``check=True``):
         :attr:`consistent` and :attr:`verdict` come from them.
     """
+
+    KIND = "identify"
+    _LOAD = {
+        "law": lambda d: ForceLaw.parse(d["law"]),
+        "criteria": lambda d: d.get("criteria_found", {}),
+        "correlation": lambda d: (
+            None if d.get("correlation") is None else np.array(d["correlation"], float)
+        ),
+        "intervals": lambda d: part(Intervals, d.get("intervals")),
+        "checks": lambda d: tuple(part(Evaluation, e) for e in d.get("checks", ())),
+    }
 
     law: object
     criterion: str
@@ -179,6 +192,7 @@ class IdentificationResult:
             # the consistency limits the law was judged by (one record; with several,
             # each record has its own)
             "limits": dict(self.checks[0].limits) if len(self.checks) == 1 else {},
+            "checks": [ev.as_dict() for ev in self.checks],
         }
 
     def _lines(self):
@@ -974,8 +988,8 @@ def identify(
 # refits' (one step: 23 %), in a third of the time.  ``refit="full"`` keeps the full refit.
 
 
-@dataclass(frozen=True)
-class Intervals:
+@dataclass(frozen=True, eq=False)
+class Intervals(Result):
     """Bootstrap intervals of a fitted law's coefficients.
 
     Attributes
@@ -990,6 +1004,9 @@ class Intervals:
     seed : int
     method : str
     """
+
+    KIND = "intervals"
+    _LOAD = {"bounds": lambda d: {k: tuple(v) for k, v in d["bounds"].items()}}
 
     bounds: dict
     sd: dict

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._printing import criteria_lines, readable
+from ..._result import Result
 from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
 from ..dynamics.response import impulse_from_steady_state
@@ -77,8 +78,8 @@ def consistency_limits(floor, sd=None):
 
 
 @readable
-@dataclass(frozen=True)
-class Evaluation:
+@dataclass(frozen=True, eq=False)
+class Evaluation(Result):
     """A law scored against a reference.
 
     Attributes
@@ -114,6 +115,9 @@ class Evaluation:
     simulated: object = None
     message: str = ""
     extra: dict = field(default_factory=dict)
+
+    KIND = "evaluation"
+    _LOAD = {"extra": lambda d: {"limits": d.get("limits") or {}}}
 
     @property
     def limits(self):
