@@ -210,3 +210,24 @@ def part(cls, d):
     if d is None:
         return None
     return cls.from_dict({**d, "schema_version": SCHEMA_VERSION, "result": cls.KIND})
+
+
+#: the command whose report a result kind has (a saved result names no command)
+_COMMANDS = {
+    "verify": "verify",
+    "landscape": "landscape",
+    "fit": "fit",
+    "identify": "identify",
+    "explain": "explain",
+    "ueda-attractor": "ueda attractor",
+    "ueda-chart": "ueda chart",
+    "ueda-discover": "ueda discover",
+    "ueda-explain": "ueda explain",
+}
+
+
+def command_of(doc):
+    """``doc`` with its ``command`` (a result saved from Python has none: its kind's)."""
+    if "command" in doc or doc.get("result") not in _COMMANDS:
+        return doc
+    return {**doc, "command": _COMMANDS[doc["result"]]}

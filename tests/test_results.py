@@ -171,3 +171,22 @@ def test_an_old_summary_is_one_clear_error(runs, tmp_path, capsys):
         part.__globals__["check_document"](doc, "x")
     with pytest.raises(InputError, match="holds no summary.json"):
         discovery.load(tmp_path)
+
+
+@pytest.mark.parametrize("out", ["verify", "fit", "landscape", "ueda-discover"])
+def test_a_report_from_a_result_equals_the_report_from_its_directory(runs, out, tmp_path):
+    d, objects = runs
+    r = objects[out]
+    from_dir = discovery.report(d / out, compile=False).tex.read_text()
+    from_object = discovery.report(r, out=d / out, compile=False).tex.read_text()
+    assert from_object == from_dir
+    # saved from Python into an empty directory: the same report, less the command's
+    # own keys (no figures, no provenance)
+    plain = type(r).from_dict({k: v for k, v in r.to_dict().items() if k not in ("command",)})
+    rep = discovery.report(plain, out=tmp_path / "saved", compile=False)
+    assert rep.kind == r.to_dict()["command"]
+    assert discovery.report(tmp_path / "saved", compile=False).tex.read_text() == (
+        rep.tex.read_text()
+    )
+    with pytest.raises(InputError, match="holds another result"):
+        discovery.report(objects["identify"], out=d / out, compile=False)
