@@ -48,6 +48,7 @@ KINDS = {
     "intervals": "discovery.vibroimpact.fit.identify:Intervals",
     "explain-iteration": "discovery.vibroimpact.explain.explain:Iteration",
     "explain": "discovery.vibroimpact.explain.explain:ExplainResult",
+    "simulate": "discovery.vibroimpact.dynamics.synthesize:SimulatedRecord",
     "ueda-lyapunov": "discovery.ueda.attractor:Lyapunov",
     "ueda-attractor": "discovery.ueda.attractor:Attractor",
     "ueda-chart": "discovery.ueda.chart:Chart",
@@ -98,6 +99,11 @@ class Result:
         run = {"head": dict(head or {}), "tail": dict(tail or {}), "options": options}
         object.__setattr__(self, "_run", run)
         return self
+
+    @property
+    def run_record(self):
+        """What :meth:`record_run` recorded: ``{"head", "tail", "options"}``."""
+        return self.__dict__.get("_run") or {"head": {}, "tail": {}, "options": {}}
 
     @classmethod
     def from_dict(cls, d):

@@ -32,6 +32,7 @@ COMMANDS = {
     + ["--transient", "50", "--periods", "40", "--max-period", "4", "--workers", "1"],
 }
 KIND_OF = {
+    "simulate": "simulate",
     "verify": "verify",
     "fit": "fit",
     "identify": "identify",
@@ -64,7 +65,7 @@ def runs(tmp_path_factory):
         sim = ["simulate", "--periods", "12", "--noise", "0.01", "--seed", "1", "--out", "D.csv"]
         assert main(sim) == 0
         assert main(["ueda", "simulate", "--periods", "120", "--out", "U.csv"]) == 0
-        objects = {}
+        objects = {"simulate": caught["simulate"]}
         for out, argv in COMMANDS.items():
             assert main([*argv, "--out", out]) == 0, out
             objects[out] = caught[" ".join(argv[:2]) if argv[0] == "ueda" else argv[0]]
@@ -74,7 +75,11 @@ def runs(tmp_path_factory):
     return d, objects
 
 
-@pytest.mark.parametrize("out", list(COMMANDS))
+# where each run's summary is (simulate writes D.summary.json beside D.csv)
+SUMMARY = {"simulate": "D.summary.json", **{k: f"{k}/summary.json" for k in COMMANDS}}
+
+
+@pytest.mark.parametrize("out", list(KIND_OF))
 def test_every_result_round_trips_and_is_json(runs, out):
     d, objects = runs
     r = objects[out]
@@ -86,12 +91,12 @@ def test_every_result_round_trips_and_is_json(runs, out):
     assert isinstance(back, result_class(KIND_OF[out]))
 
 
-@pytest.mark.parametrize("out", list(COMMANDS))
+@pytest.mark.parametrize("out", list(KIND_OF))
 def test_each_command_summary_is_its_result_to_dict(runs, out):
     d, objects = runs
-    saved = json.loads((d / out / "summary.json").read_text())
+    saved = json.loads((d / SUMMARY[out]).read_text())
     assert saved == objects[out].to_dict()
-    loaded = discovery.load(d / out)
+    loaded = discovery.load(d / SUMMARY[out])
     assert type(loaded) is type(objects[out]) and loaded == objects[out]
 
 
@@ -123,6 +128,9 @@ def test_typed_fields_come_back(runs):
     assert [m.law for m in fit.ranking] == [m.law for m in objects["fit"].ranking]
     ex = discovery.load(d / "explain")
     assert ex.final_model.law == objects["explain"].final_model.law
+    np.testing.assert_array_equal(discovery.load(d / "ueda-chart").nu, objects["ueda-chart"].nu)
+    rec = discovery.load(d / "D.summary.json")
+    assert rec.law == discovery.ForceLaw.parse("2.06e8*z + 1.28e7*zd") and rec.samples == 9600
     att = discovery.load(d / "ueda-attractor")
     assert att.system == objects["ueda-attractor"].system
     assert att.lyapunov.value == objects["ueda-attractor"].lyapunov.value

@@ -119,13 +119,16 @@ def _write_outputs(args, res, t_start):
             else (None, None)
         )
         why = None if pdf is not None else why
-        run = res._run
-        tail = {
-            **run["tail"],
-            "pdf": None if pdf is None else "model.pdf",
-            "seconds": time.perf_counter() - t_start,  # the whole command
-        }
-        res.record_run(run["head"], tail, **run["options"]).write_into(out)
+        # the run's record, with the PDF and the whole command's wall time
+        res.record_run(
+            res.run_record["head"],
+            {
+                **res.run_record["tail"],
+                "pdf": None if pdf is None else "model.pdf",
+                "seconds": time.perf_counter() - t_start,
+            },
+            **res.run_record["options"],
+        ).write_into(out)
     return pdf, why
 
 
@@ -178,9 +181,8 @@ def run(args):
         "scenarios": [sc.as_dict() for sc in scs] if len(scs) > 1 else None,
         "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
     }
-    res.record_run(
-        head, provenance(vars(args), inputs=inputs_of(args)), names=[str(p) for p in data]
-    )
+    prov = provenance(vars(args), inputs=inputs_of(args))
+    res.record_run(head, prov, names=[str(p) for p in data])
     pdf, why = _write_outputs(args, res, t_start)
     _print_result(args, res, pdf, why)
     return 0

@@ -98,8 +98,8 @@ class Chart(Result):
     KIND = "ueda-chart"
     _LOAD = {
         "system": lambda d: UedaSystem.from_dict(d["system"]),
-        "nu": lambda d: None,
-        "B": lambda d: None,
+        "nu": lambda d: np.array(d["nu"], float),
+        "B": lambda d: np.array(d["B"], float),
         "kind": lambda d: None,
         "period": lambda d: None,
         "lyapunov": lambda d: None,
@@ -195,6 +195,8 @@ class Chart(Result):
             "grid": [int(self.nu.size), int(self.B.size)],
             "nu_range": [float(self.nu[0]), float(self.nu[-1])],
             "B_range": [float(self.B[0]), float(self.B[-1])],
+            "nu": self.nu,
+            "B": self.B,
             "fractions": self.fractions(),
             "periods_found": {f"P{k}": v for k, v in self.period_counts().items()},
             "seconds": self.seconds,
