@@ -112,7 +112,14 @@ class Result:
         obj = cls.__new__(cls)
         for f in dataclasses.fields(cls):
             if f.name in cls._LOAD:
-                value = cls._LOAD[f.name](d)
+                try:
+                    value = cls._LOAD[f.name](d)
+                except (KeyError, TypeError, ValueError, AttributeError, InputError) as exc:
+                    raise InputError(
+                        f"from_dict: the {cls.KIND!r} document's {f.name!r} cannot be read "
+                        f"({type(exc).__name__}: {short(exc, 80)}); was it edited? run the "
+                        "command again"
+                    ) from None
             elif f.name in d:
                 value = d[f.name]
             elif f.default is not dataclasses.MISSING:

@@ -349,7 +349,8 @@ def _poisoned(value):
     if isinstance(value, list):
         return [_poisoned(v) for v in value]
     if isinstance(value, dict):
-        return {k: (v if k == "command" else _poisoned(v)) for k, v in value.items()}
+        # the command and the result's kind stay (an edited kind is refused by the loader)
+        return {k: (v if k in ("command", "result") else _poisoned(v)) for k, v in value.items()}
     return value
 
 

@@ -131,6 +131,11 @@ def test_typed_fields_come_back(runs):
     np.testing.assert_array_equal(discovery.load(d / "ueda-chart").nu, objects["ueda-chart"].nu)
     rec = discovery.load(d / "D.summary.json")
     assert rec.law == discovery.ForceLaw.parse("2.06e8*z + 1.28e7*zd") and rec.samples == 9600
+    uex = discovery.load(d / "ueda-explain")
+    assert uex.final_model == objects["ueda-explain"].final_model
+    assert [it.model_after for it in uex.iterations] == [
+        it.model_after for it in objects["ueda-explain"].iterations
+    ]
     att = discovery.load(d / "ueda-attractor")
     assert att.system == objects["ueda-attractor"].system
     assert att.lyapunov.value == objects["ueda-attractor"].lyapunov.value
@@ -198,3 +203,27 @@ def test_a_report_from_a_result_equals_the_report_from_its_directory(runs, out, 
     )
     with pytest.raises(InputError, match="holds another result"):
         discovery.report(objects["identify"], out=d / out, compile=False)
+
+
+def test_an_old_or_edited_summary_in_the_cli_is_exit_2_and_one_line(runs, tmp_path, capsys):
+    d, _ = runs
+    old = tmp_path / "old-landscape"
+    old.mkdir()
+    doc = json.loads((d / "landscape" / "summary.json").read_text())
+    (old / "summary.json").write_text(
+        json.dumps({k: v for k, v in doc.items() if k not in ("schema_version", "result")})
+    )
+    argv = ["identify", "--data", str(d / "D.csv"), "--start", "1.8e8*z + 1.1e7*zd"]
+    argv += ["--max-simulations", "4", "--out", str(tmp_path / "i")]
+    capsys.readouterr()
+    assert main([*argv, "--landscape", str(old)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "no schema_version" in err and "vidi landscape" in err
+    edited = tmp_path / "edited"
+    edited.mkdir()
+    (edited / "summary.json").write_text(json.dumps({**doc, "alpha1": "many"}))
+    assert main([*argv, "--landscape", str(edited)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "'axes' cannot be read" in err
+    # the report of an old run directory still reads (from its keys, as before)
+    assert "Criteria landscape" in discovery.report(old, compile=False).tex.read_text()

@@ -2,8 +2,6 @@
 
 import csv
 import io
-import json
-from pathlib import Path
 
 import numpy as np
 
@@ -65,28 +63,29 @@ def _load_landscape(path, cls, start, scenario):
 
 
 def _read_landscape(path, cls):
-    p = Path(path)
-    p = p / "summary.json" if p.is_dir() else p
+    """``(Landscape, its document)`` of a saved landscape (through :func:`discovery.load`:
+    a summary from before the schema version is one clear error)."""
+    from .._result import load
+
     try:
-        d = json.loads(p.read_text())
-    except (OSError, ValueError):
-        raise InputError(f"--landscape {path!r}: no readable landscape summary.json") from None
-    try:
-        vals = {n: np.array(d[n], dtype=float) for n in CRITERIA}
-        land = cls(
-            terms=tuple(d["terms"]),
-            axes=(np.array(d["alpha1"], dtype=float), np.array(d["alpha2"], dtype=float)),
-            values=vals,
-            regime=np.array(d["regime"], dtype=object),
-            seconds=d["seconds"],
-            workers=d["workers"],
-        )
-        return land, d
-    except (KeyError, TypeError, ValueError):
+        land = load(path)
+    except InputError as exc:
+        raise InputError(f"--landscape: {exc}") from None
+    if not isinstance(land, cls):
         raise InputError(
             f"--landscape {path!r} is not a landscape result (made by vidi "
             "landscape); give its output directory or summary.json"
-        ) from None
+        )
+    try:
+        bad = [n for n in CRITERIA if n not in land.values] or land.regime is None
+    except (AttributeError, TypeError):
+        bad = True
+    if bad:
+        raise InputError(
+            f"--landscape {path!r} is not a complete landscape result; make it again with "
+            "vidi landscape"
+        )
+    return land, land.to_dict()
 
 
 def _iterate_impulses(sc, start, ref, res):

@@ -249,6 +249,10 @@ class Iteration(Result):
     """
 
     KIND = "ueda-explain-iteration"
+    _LOAD = {
+        "model_before": lambda d: ForcedPolynomial.from_dict(d.get("model_before")),
+        "model_after": lambda d: ForcedPolynomial.from_dict(d.get("model_after")),
+    }
 
     effect: str | None
     evidence: dict
@@ -304,6 +308,8 @@ class Explanation(Result):
     KIND = "ueda-explain"
     _LOAD = {
         "iterations": lambda d: tuple(part(Iteration, it) for it in d["iterations"]),
+        "start_model": lambda d: ForcedPolynomial.from_dict(d.get("start_model")),
+        "final_model": lambda d: ForcedPolynomial.from_dict(d.get("final_model")),
         "start_terms": lambda d: tuple(d["start_terms"]),
         "final_terms": lambda d: tuple(d["final_terms"]),
         "settings": lambda d: (
