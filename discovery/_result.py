@@ -48,6 +48,7 @@ KINDS = {
     "intervals": "discovery.vibroimpact.fit.identify:Intervals",
     "explain-iteration": "discovery.vibroimpact.explain.explain:Iteration",
     "explain": "discovery.vibroimpact.explain.explain:ExplainResult",
+    "study": "discovery.vibroimpact.studies.driver:StudyResult",
     "simulate": "discovery.vibroimpact.dynamics.synthesize:SimulatedRecord",
     "ueda-lyapunov": "discovery.ueda.attractor:Lyapunov",
     "ueda-attractor": "discovery.ueda.attractor:Attractor",
@@ -114,7 +115,14 @@ class Result:
             if f.name in cls._LOAD:
                 try:
                     value = cls._LOAD[f.name](d)
-                except (KeyError, TypeError, ValueError, AttributeError, InputError) as exc:
+                except (
+                    KeyError,
+                    TypeError,
+                    ValueError,
+                    ArithmeticError,
+                    AttributeError,
+                    InputError,
+                ) as exc:
                     raise InputError(
                         f"from_dict: the {cls.KIND!r} document's {f.name!r} cannot be read "
                         f"({type(exc).__name__}: {short(exc, 80)}); was it edited? run the "
@@ -175,7 +183,7 @@ def check_document(d, where, expect=None):
             "this vidi reads; load it with the vidi that wrote it, or run the command again"
         )
     kind = d.get("result")
-    if kind not in KINDS:
+    if not isinstance(kind, str) or kind not in KINDS:
         raise InputError(f"{where}: unknown result kind {kind!r}; known: {', '.join(KINDS)}")
     if expect is not None and kind != expect:
         raise InputError(f"{where}: the document is a {kind!r} result, not {expect!r}")
@@ -232,6 +240,7 @@ _COMMANDS = {
     "fit": "fit",
     "identify": "identify",
     "explain": "explain",
+    "study": "study",
     "ueda-attractor": "ueda attractor",
     "ueda-chart": "ueda chart",
     "ueda-discover": "ueda discover",
@@ -241,6 +250,7 @@ _COMMANDS = {
 
 def command_of(doc):
     """``doc`` with its ``command`` (a result saved from Python has none: its kind's)."""
-    if "command" in doc or doc.get("result") not in _COMMANDS:
+    kind = doc.get("result")
+    if "command" in doc or not isinstance(kind, str) or kind not in _COMMANDS:
         return doc
-    return {**doc, "command": _COMMANDS[doc["result"]]}
+    return {**doc, "command": _COMMANDS[kind]}

@@ -227,3 +227,25 @@ def test_an_old_or_edited_summary_in_the_cli_is_exit_2_and_one_line(runs, tmp_pa
     assert len(err.splitlines()) == 1 and "'axes' cannot be read" in err
     # the report of an old run directory still reads (from its keys, as before)
     assert "Criteria landscape" in discovery.report(old, compile=False).tex.read_text()
+
+
+def test_a_study_round_trips_and_its_summary_is_its_to_dict(tmp_path):
+    cfg = {
+        "name": "tiny",
+        "seeds": 1,
+        "factors": {
+            "force_noise": [0.01],
+            "periods": [4],
+            "library": ["z, zd"],
+            "selection": ["best-subset"],
+            "refine": [False],
+        },
+    }
+    r = discovery.study(cfg, tmp_path / "s", workers=1)
+    doc = json.loads(json.dumps(r.to_dict(), allow_nan=False))
+    assert doc == json.loads((tmp_path / "s" / "summary.json").read_text())
+    assert doc["result"] == "study" and doc["command"] == "study" and doc["runs"] == 1
+    loaded = discovery.load(tmp_path / "s")
+    assert loaded == r and type(r).from_dict(doc) == r
+    assert loaded.config.name == "tiny" and loaded.config.varied == r.config.varied
+    assert len(loaded.cells) == len(r.cells) and loaded.figures == r.figures and loaded.runs == []
