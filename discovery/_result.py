@@ -58,9 +58,6 @@ KINDS = {
     "ueda-explain": "discovery.ueda.explain:Explanation",
 }
 
-# the keys of a document that are not the result's own (the kind and the run's record)
-_HEAD = ("schema_version", "result")
-
 
 def _document(data):
     """``data`` as pure JSON values (non-finite numbers ``null``); raises ``TypeError``
