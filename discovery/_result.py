@@ -217,6 +217,12 @@ def load(path):
     its own type (:class:`~discovery.VerifyResult`, :class:`~discovery.DiscoveryResult`,
     ...).  A summary written before results had a schema version is one
     :class:`~discovery.errors.InputError` saying so."""
+    if not isinstance(path, str) and not hasattr(path, "__fspath__"):
+        from .errors import VidiTypeError
+
+        raise VidiTypeError(
+            f"load: path must be a result directory or a summary file; got {type(path).__name__}"
+        )
     d = load_summary(path)
     kind = check_document(d, f"load {short(str(path))!r}")
     return result_class(kind).from_dict(d)

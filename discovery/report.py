@@ -15,9 +15,9 @@ def report(run, *, out=None, snippet=None, compile=True, timeout=300):
     Parameters
     ----------
     run : Result or str or Path
-        A result object (:class:`~discovery.VerifyResult`, :class:`~discovery.DiscoveryResult`,
-        ...) or a run directory: the ``--out`` of any ``vidi`` command that writes a
-        ``summary.json``, or a directory a result was saved into (``result.save(dir)``).
+        A result object (``VerifyResult``, ``DiscoveryResult``, ...) or a run directory:
+        the ``--out`` of any ``vidi`` command that writes a ``summary.json``, or a
+        directory a result was saved into (``result.save(dir)``).
     out : str or Path, optional
         With a result object: the directory of the report.  When it holds no result, the
         result is saved there first (``summary.json``); when it holds this result (a run
@@ -26,6 +26,12 @@ def report(run, *, out=None, snippet=None, compile=True, timeout=300):
     snippet, compile, timeout
         See :func:`reports.document.report`.
 
+    Returns
+    -------
+    Report
+
+    Notes
+    -----
     A directory whose ``summary.json`` has a ``schema_version`` is read through
     :func:`discovery.load` (its version and kind checked); one written before results had
     a schema version is reported from its keys as before.

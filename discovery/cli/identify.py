@@ -70,7 +70,7 @@ def _read_landscape(path, cls):
     try:
         land = load(path)
     except InputError as exc:
-        raise InputError(f"--landscape: {exc}") from None
+        raise InputError(f"--landscape {path!r}: {exc}") from None
     if not isinstance(land, cls):
         raise InputError(
             f"--landscape {path!r} is not a landscape result (made by vidi "
