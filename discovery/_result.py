@@ -49,6 +49,7 @@ KINDS = {
     "explain-iteration": "discovery.vibroimpact.explain.explain:Iteration",
     "explain": "discovery.vibroimpact.explain.explain:ExplainResult",
     "study": "discovery.vibroimpact.studies.driver:StudyResult",
+    "steady": "discovery.vibroimpact.dynamics.steady_state:SteadyState",
     "simulate": "discovery.vibroimpact.dynamics.synthesize:SimulatedRecord",
     "ueda-lyapunov": "discovery.ueda.attractor:Lyapunov",
     "ueda-attractor": "discovery.ueda.attractor:Attractor",

@@ -22,6 +22,7 @@ COMMANDS = {
     "identify": ["identify", "--data", "D.csv", "--start", "1.8e8*z + 1.1e7*zd"]
     + ["--max-simulations", "40"],
     "landscape": ["landscape", "--grid", "3x3", "--workers", "1"],
+    "steady": ["steady", "--law", LAW, "--sensitivities"],
     "explain": ["explain", "--data", "D.csv", "--start", "linear", "--max-iterations", "1"],
     "ueda-discover": ["ueda", "discover", "--data", "U.csv", "--model", "negres"]
     + ["--model-periods", "400", "--resamples", "40"],
@@ -37,6 +38,7 @@ KIND_OF = {
     "fit": "fit",
     "identify": "identify",
     "landscape": "landscape",
+    "steady": "steady",
     "explain": "explain",
     "ueda-discover": "ueda-discover",
     "ueda-explain": "ueda-explain",
@@ -100,7 +102,7 @@ def test_each_command_summary_is_its_result_to_dict(runs, out):
     assert type(loaded) is type(objects[out]) and loaded == objects[out]
 
 
-@pytest.mark.parametrize("out", ["verify", "fit", "identify", "landscape", "explain"])
+@pytest.mark.parametrize("out", ["verify", "fit", "identify", "landscape", "explain", "steady"])
 def test_a_loaded_result_prints_as_the_original(runs, out):
     """The typed fields come back: the printed report of a loaded result is the
     original's (the vibro-impact results, whose printing reads their fields)."""
