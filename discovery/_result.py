@@ -51,6 +51,7 @@ KINDS = {
     "study": "discovery.vibroimpact.studies.driver:StudyResult",
     "steady": "discovery.vibroimpact.dynamics.steady_state:SteadyState",
     "simulate": "discovery.vibroimpact.dynamics.synthesize:SimulatedRecord",
+    "ueda-simulate": "discovery.ueda.record:SimulatedUedaRecord",
     "ueda-lyapunov": "discovery.ueda.attractor:Lyapunov",
     "ueda-attractor": "discovery.ueda.attractor:Attractor",
     "ueda-chart": "discovery.ueda.chart:Chart",

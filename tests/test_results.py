@@ -34,6 +34,7 @@ COMMANDS = {
 }
 KIND_OF = {
     "simulate": "simulate",
+    "ueda-simulate": "ueda-simulate",
     "verify": "verify",
     "fit": "fit",
     "identify": "identify",
@@ -67,7 +68,7 @@ def runs(tmp_path_factory):
         sim = ["simulate", "--periods", "12", "--noise", "0.01", "--seed", "1", "--out", "D.csv"]
         assert main(sim) == 0
         assert main(["ueda", "simulate", "--periods", "120", "--out", "U.csv"]) == 0
-        objects = {"simulate": caught["simulate"]}
+        objects = {"simulate": caught["simulate"], "ueda-simulate": caught["ueda simulate"]}
         for out, argv in COMMANDS.items():
             assert main([*argv, "--out", out]) == 0, out
             objects[out] = caught[" ".join(argv[:2]) if argv[0] == "ueda" else argv[0]]
@@ -78,7 +79,11 @@ def runs(tmp_path_factory):
 
 
 # where each run's summary is (simulate writes D.summary.json beside D.csv)
-SUMMARY = {"simulate": "D.summary.json", **{k: f"{k}/summary.json" for k in COMMANDS}}
+SUMMARY = {
+    "simulate": "D.summary.json",
+    "ueda-simulate": "U.summary.json",
+    **{k: f"{k}/summary.json" for k in COMMANDS},
+}
 
 
 @pytest.mark.parametrize("out", list(KIND_OF))
