@@ -20,7 +20,7 @@ COMMANDS = {
     "verify": ["verify", "--data", "D.csv", "--law", LAW],
     "fit": ["fit", "--data", "D.csv", "--no-refine", "--intervals", "0"],
     "identify": ["identify", "--data", "D.csv", "--start", "1.8e8*z + 1.1e7*zd"]
-    + ["--max-simulations", "40"],
+    + ["--max-simulations", "20"],
     "landscape": ["landscape", "--grid", "3x3", "--workers", "1"],
     "steady": ["steady", "--law", LAW, "--sensitivities"],
     "explain": ["explain", "--data", "D.csv", "--start", "linear", "--max-iterations", "1"],
