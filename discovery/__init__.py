@@ -56,6 +56,8 @@ _EXPORTS = {
     "Executor": "numerics.executor",
     "make_executor": "parallel",
     "report": "report",
+    "load": "_result",
+    "Result": "_result",
     "verify": "vibroimpact.verify.verify",
     "VerifyResult": "vibroimpact.verify.verify",
 }
@@ -101,6 +103,8 @@ __all__ = [
     "ExplainResult",
     "report",
     "Report",
+    "load",
+    "Result",
     "study",
     "StudyResult",
     "load_study",

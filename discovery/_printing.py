@@ -57,7 +57,8 @@ def readable(cls):
 
 def generic_lines(result, limit=12):
     """Lines from ``result.as_dict()``: its scalar entries and short mappings."""
-    d = result.as_dict()
+    d = result.to_dict() if getattr(result, "loaded", False) else result.as_dict()
+    d = {k: v for k, v in d.items() if k not in ("schema_version", "result")}
     out = [type(result).__name__]
     for k, v in d.items():
         if isinstance(v, bool | int | float | str) and len(str(v)) < 120:

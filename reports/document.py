@@ -408,7 +408,7 @@ def _record_in_manifest(run_dir, names):
     atomic_write_text(p, json.dumps(man, indent=2) + "\n")
 
 
-def report(run_dir, *, snippet=None, compile=True, timeout=300):
+def report(run_dir, *, snippet=None, compile=True, timeout=300, summary=None):
     """Write ``run_dir/report.tex`` from the run's results and compile ``report.pdf``.
 
     Parameters
@@ -422,6 +422,9 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300):
         or ``"figure"``; written to ``snippet-KIND.tex`` and not compiled.
     compile : bool
         Compile the PDF (when TeX is installed).
+    summary : dict, optional
+        The run's document when the caller has read it already (``discovery.report``
+        reads it through ``discovery.load``); default: ``run_dir/summary.json``.
 
     Returns
     -------
@@ -434,7 +437,7 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300):
     """
     from discovery.outputs import atomic_write_text
 
-    summary = _load(run_dir)
+    summary = _load(run_dir) if summary is None else summary
     skipped = []
     text = render(summary, run_dir, snippet, skipped=skipped)
     d = Path(run_dir)

@@ -127,6 +127,8 @@ CASES = [
         TYPE,
         "X",
     ),
+    ("load path number", lambda: d.load(5), TYPE, "path"),
+    ("load path missing", lambda: d.load("no-such-run-dir"), VALUE, "no-such-run-dir"),
 ]
 
 
@@ -212,6 +214,7 @@ def test_the_cases_cover_every_public_entry():
         "Report",
         "report",
         "StudyResult",
+        "Result",
         "Executor",
         # a scikit-learn estimator checks its parameters in fit, not in __init__
         # (tests/test_regression.py)
@@ -243,6 +246,7 @@ def test_the_cases_cover_every_public_entry():
             "field_record",
             "make_executor",
             "verify",
+            "load",
         }
     )
     assert not unlisted, f"public entries without a row: {sorted(unlisted)}"

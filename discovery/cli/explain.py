@@ -71,14 +71,12 @@ def run(args):
             progress=rep,
             executor=ex,
         )
-    summary = {
+    head = {
         "command": "explain",
         "scenario": scs[0].as_dict(),
         "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
-        **res.as_dict(),
-        "catalogue": [e.as_dict() for e in EFFECTS],
-        "explain_settings": res.settings,
     }
+    tail = {"catalogue": [e.as_dict() for e in EFFECTS], "explain_settings": res.settings}
     loops = _final_loops(res, scs[0], meas[0], args)
     with OutputDir(args.out) as out:
         files = []
@@ -93,10 +91,9 @@ def run(args):
                 "final model against the first record",
             )
             files.append("explain_loops.png/.pdf")
-        summary["seconds"] = time.perf_counter() - t_start
-        out.write_json(
-            "summary.json", {**summary, **provenance(vars(args), inputs=inputs_of(args))}
-        )
+        tail["seconds"] = time.perf_counter() - t_start
+        tail.update(provenance(vars(args), inputs=inputs_of(args)))
+        res.record_run(head, tail).write_into(out)
     for k, it in enumerate(res.iterations, start=1):
         name = it.effect or "nothing named"
         print(f"iteration {k}: {name}: {it.evidence}")

@@ -3,10 +3,9 @@
 import argparse
 import csv
 import io
-import json
 import time
 
-from .._io import OutputDir, provenance, to_jsonable
+from .._io import OutputDir, provenance
 from ..vibroimpact.verify.criteria import CRITERIA
 from ._common import (
     SCENARIO_HELP,
@@ -91,7 +90,7 @@ def _ranking_csv(res):
     return buf.getvalue()
 
 
-def _write_outputs(args, res, summary, t_start):
+def _write_outputs(args, res, t_start):
     """The output directory: ranking, figures, model.tex (and its PDF), summary.json.
     Returns ``(pdf, why)`` (``why``: the reason there is no PDF)."""
     from reports import fit_impulse_figure, fit_loop_figure, fit_surface_figure
@@ -113,17 +112,23 @@ def _write_outputs(args, res, summary, t_start):
         fit_surface_figure(res, str(out.path("fit_surface")))
         fit_loop_figure(res, str(out.path("fit_loop")))
         # model.tex is a template of the report system, rendered from the summary itself
-        as_json = json.loads(json.dumps(to_jsonable(summary)))
-        out.path("model.tex").write_text(render(as_json, out.stage, template="model"))
+        out.path("model.tex").write_text(render(res.to_dict(), out.stage, template="model"))
         pdf, why = (
             compile_tex(out.path("model.tex"), ["fit_impulse.pdf"])
             if not args.no_pdf
             else (None, None)
         )
         why = None if pdf is not None else why
-        summary["pdf"] = None if pdf is None else "model.pdf"
-        summary["seconds"] = time.perf_counter() - t_start  # the whole command
-        out.write_json("summary.json", summary)
+        # the run's record, with the PDF and the whole command's wall time
+        res.record_run(
+            res.run_record["head"],
+            {
+                **res.run_record["tail"],
+                "pdf": None if pdf is None else "model.pdf",
+                "seconds": time.perf_counter() - t_start,
+            },
+            **res.run_record["options"],
+        ).write_into(out)
     return pdf, why
 
 
@@ -170,15 +175,15 @@ def run(args):
     scs, meas = read_records(args)
     with reporter(args) as rep:
         res = _discover(args, scs, meas, rep)
-    summary = {
+    head = {
         "command": "fit",
         "scenario": scs[0].as_dict(),
         "scenarios": [sc.as_dict() for sc in scs] if len(scs) > 1 else None,
         "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
-        **res.as_dict(names=[str(p) for p in data]),
-        **provenance(vars(args), inputs=inputs_of(args)),
     }
-    pdf, why = _write_outputs(args, res, summary, t_start)
+    prov = provenance(vars(args), inputs=inputs_of(args))
+    res.record_run(head, prov, names=[str(p) for p in data])
+    pdf, why = _write_outputs(args, res, t_start)
     _print_result(args, res, pdf, why)
     return 0
 

@@ -2,8 +2,6 @@
 
 import csv
 import io
-import json
-from pathlib import Path
 
 import numpy as np
 
@@ -65,28 +63,29 @@ def _load_landscape(path, cls, start, scenario):
 
 
 def _read_landscape(path, cls):
-    p = Path(path)
-    p = p / "summary.json" if p.is_dir() else p
+    """``(Landscape, its document)`` of a saved landscape (through :func:`discovery.load`:
+    a summary from before the schema version is one clear error)."""
+    from .._result import load
+
     try:
-        d = json.loads(p.read_text())
-    except (OSError, ValueError):
-        raise InputError(f"--landscape {path!r}: no readable landscape summary.json") from None
-    try:
-        vals = {n: np.array(d[n], dtype=float) for n in CRITERIA}
-        land = cls(
-            terms=tuple(d["terms"]),
-            axes=(np.array(d["alpha1"], dtype=float), np.array(d["alpha2"], dtype=float)),
-            values=vals,
-            regime=np.array(d["regime"], dtype=object),
-            seconds=d["seconds"],
-            workers=d["workers"],
-        )
-        return land, d
-    except (KeyError, TypeError, ValueError):
+        land = load(path)
+    except InputError as exc:
+        raise InputError(f"--landscape {path!r}: {exc}") from None
+    if not isinstance(land, cls):
         raise InputError(
             f"--landscape {path!r} is not a landscape result (made by vidi "
             "landscape); give its output directory or summary.json"
-        ) from None
+        )
+    try:
+        bad = [n for n in CRITERIA if n not in land.values] or land.regime is None
+    except (AttributeError, TypeError):
+        bad = True
+    if bad:
+        raise InputError(
+            f"--landscape {path!r} is not a complete landscape result; make it again with "
+            "vidi landscape"
+        )
+    return land, land.to_dict()
 
 
 def _iterate_impulses(sc, start, ref, res):
@@ -138,7 +137,7 @@ def _iterations_csv(res):
 def _summary(args, sc, start, E, res):
     """``summary.json`` of the command."""
     final = res.checks[0]  # the identified law against the record, with its noise floor
-    return {
+    head = {
         "command": "identify",
         "scenario": sc.as_dict(),
         "data": str(args.data),
@@ -151,7 +150,8 @@ def _summary(args, sc, start, E, res):
             "contact_time": E.contact_time,
         },
         "start": start.as_dict(),
-        **res.as_dict(),
+    }
+    tail = {
         "criteria": final.criteria,
         "noise_floor": final.noise_floor,
         "consistent": final.consistent,
@@ -159,6 +159,7 @@ def _summary(args, sc, start, E, res):
         "regime": final.regime,
         **provenance(vars(args), inputs=inputs_of(args)),
     }
+    return res.record_run(head, tail)
 
 
 def _print_result(args, res):
@@ -223,7 +224,7 @@ def run(args):
         )
     imps = _iterate_impulses(sc, start, ref, res)
     with OutputDir(args.out) as out:
-        out.write_json("summary.json", _summary(args, sc, start, ref.impulse, res))
+        _summary(args, sc, start, ref.impulse, res).write_into(out)
         out.path("iterations.csv").write_text(_iterations_csv(res))
         identification_figure(res, ref.impulse, imps, str(out.path("identification")), land)
     _print_result(args, res)

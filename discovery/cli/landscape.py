@@ -157,16 +157,16 @@ def run(args):
     if ref is None:
         ref_info["impacts"] = land.reference["impacts"]
     with OutputDir(args.out) as out:
-        summary = {
-            "command": "landscape",
-            "scenario": sc.as_dict(),
-            "law": law.to_text(),
-            **land.as_dict(),
-            "reference": ref_info,
-            "grid": [n0, n1],
-            "ranges": {"alpha1": list(r0), "alpha2": list(r1), "from": origin},
-            **provenance(vars(args), inputs=inputs_of(args)),
-        }
+        land.record_run(
+            {"command": "landscape", "scenario": sc.as_dict(), "law": law.to_text()},
+            {
+                "reference": ref_info,
+                "grid": [n0, n1],
+                "ranges": {"alpha1": list(r0), "alpha2": list(r1), "from": origin},
+                **provenance(vars(args), inputs=inputs_of(args)),
+            },
+        )
+        summary = land.to_dict()
         out.write_json("summary.json", summary)
         out.path("landscape.csv").write_text(_grid_csv(land))
         truth = None

@@ -5,11 +5,10 @@ summary records the sha256 of the CSV it describes (``outputs``), so a pair from
 different runs (a kill between the two renames) is detectable.
 """
 
-import hashlib
 import json
 import time
 
-from .._io import atomic_write_text, check_output, provenance, to_jsonable
+from .._io import atomic_write_text, check_output, provenance
 from ..errors import InputError
 from ..vibroimpact.model.scenario import load_scenario
 from ._common import (
@@ -28,7 +27,7 @@ MAX_SAMPLES = 10_000_000
 
 
 def run(args):
-    from ..vibroimpact.dynamics.synthesize import synthesize
+    from ..vibroimpact.dynamics.synthesize import SimulatedRecord, synthesize
 
     out = check_out(args, kind="file")
     if out.suffix.lower() != ".csv":
@@ -66,16 +65,10 @@ def run(args):
         integrator=args.integrator,
     )
     csv_text = meas.to_csv_text()
-    summary = {
-        "command": "simulate",
-        "scenario": sc.as_dict(),
-        "law": law.to_text(),
-        "samples": int(meas.t.size),
-        "seconds": time.perf_counter() - t0,
-        "outputs": {out.name: {"sha256": hashlib.sha256(csv_text.encode()).hexdigest()}},
-        **provenance(vars(args), inputs=inputs_of(args)),
-    }
-    text = json.dumps(to_jsonable(summary), indent=2) + "\n"
+    summary = SimulatedRecord.of(
+        sc, law, out.name, csv_text, int(meas.t.size), time.perf_counter() - t0
+    ).record_run({"command": "simulate"}, provenance(vars(args), inputs=inputs_of(args)))
+    text = json.dumps(summary.to_dict(), indent=2) + "\n"
     atomic_write_text(out, csv_text)
     atomic_write_text(out.with_suffix(".summary.json"), text)
     print(

@@ -30,7 +30,7 @@ def run(args):
             "(non-finite Floquet multipliers or residual: the simulation failed); check the "
             "scenario's drive amplitude, masses and the law's coefficients"
         )
-    info = ss.as_dict()
+    info = {}
     if r.impulse is not None:
         info.update(peak_force=r.impulse.peak, contact_time=r.impulse.contact_time)
     print(
@@ -47,17 +47,12 @@ def run(args):
         print(sens)
         info["sensitivities"] = sens.as_dict()
     if args.out:
+        ss.record_run(
+            {"command": "steady", "law": law.to_text(), "scenario": sc.as_dict()},
+            {**info, **provenance(vars(args), inputs=inputs_of(args))},
+        )
         with OutputDir(args.out) as out:
-            out.write_json(
-                "summary.json",
-                {
-                    "command": "steady",
-                    "law": law.to_text(),
-                    "scenario": sc.as_dict(),
-                    **info,
-                    **provenance(vars(args), inputs=inputs_of(args)),
-                },
-            )
+            ss.write_into(out)
         print(f"wrote {Path(args.out) / 'summary.json'}")
     return 0
 

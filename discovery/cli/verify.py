@@ -36,16 +36,12 @@ def run(args):
         seed=args.seed,
         check_default_start=not args.no_default_start,
     )
-    summary = {
-        "command": "verify",
-        "scenario": sc.as_dict(),
-        "data": str(args.data),
-        **res.as_dict(),
-        "verify_settings": res.settings,
-        **provenance(vars(args), inputs=inputs_of(args)),
-    }
+    res.record_run(
+        {"command": "verify", "scenario": sc.as_dict(), "data": str(args.data)},
+        provenance(vars(args), inputs=inputs_of(args)),
+    )
     with OutputDir(args.out) as out:
-        out.write_json("summary.json", summary)
+        res.write_into(out)
         verify_figure(res, str(out.path("verify")))
     ev = res.evaluation
     print(f"{law}: {res.verdict}")

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._printing import generic_lines, readable
+from .._result import Result, part
 from .._validate import Array, Real, params
 from ..errors import IntegrationError
 from ..numerics.tolerances import Tolerances
@@ -134,8 +135,8 @@ def trajectory(system, y0, t_span, n_samples=4000, *, tolerances=None):
 
 
 # ------------------------------------------------------------------ Lyapunov exponents
-@dataclass(frozen=True)
-class Lyapunov:
+@dataclass(frozen=True, eq=False)
+class Lyapunov(Result):
     """The two Lyapunov exponents [1/unit time] of one trajectory.
 
     Attributes
@@ -156,6 +157,9 @@ class Lyapunov:
     batch_values : ndarray of shape (batches,)
         Largest exponent of each batch.
     """
+
+    KIND = "ueda-lyapunov"
+    _LOAD = {"batch_values": lambda d: np.array(d.get("batch_values", []), float)}
 
     value: float
     stderr: float
@@ -460,8 +464,8 @@ def classify(system, y0=None, *, transient=300, periods=400, tolerances=None, sh
 
 # ------------------------------------------------------------------ one attractor
 @readable
-@dataclass(frozen=True)
-class Attractor:
+@dataclass(frozen=True, eq=False)
+class Attractor(Result):
     """An attractor reached from one initial state.
 
     Attributes
@@ -478,6 +482,19 @@ class Attractor:
     transient : int
     seconds : float
     """
+
+    KIND = "ueda-attractor"
+    _LOAD = {
+        "system": lambda d: UedaSystem.from_dict(d["system"]),
+        "lyapunov": lambda d: part(Lyapunov, d["lyapunov"]),
+        "regime": lambda d: None,
+        "strobe": lambda d: None,
+        "t": lambda d: None,
+        "x": lambda d: None,
+        "v": lambda d: None,
+        "y0": lambda d: np.array(d["y0"], float),
+        "transient": lambda d: d["transient_periods"],
+    }
 
     system: UedaSystem
     regime: Regime

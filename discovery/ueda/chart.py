@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._printing import readable
+from .._result import Result
 from .._validate import Array, Instance, Real, params
 from ..errors import InputError, IntegrationError, VidiTypeError
 from ..numerics.executor import make_executor
@@ -55,8 +56,8 @@ KINDS = ("P1", "Pn", "beat", "chaotic")  # codes 0..3; -1 failed
 
 
 @readable
-@dataclass(frozen=True)
-class Chart:
+@dataclass(frozen=True, eq=False)
+class Chart(Result):
     """A regime chart.
 
     Attributes
@@ -93,6 +94,23 @@ class Chart:
         after ``recheck`` times the transient more from both (two non-periodic results
         are not compared).
     """
+
+    KIND = "ueda-chart"
+    _LOAD = {
+        "system": lambda d: UedaSystem.from_dict(d["system"]),
+        "nu": lambda d: np.array(d["nu"], float),
+        "B": lambda d: np.array(d["B"], float),
+        "kind": lambda d: None,
+        "period": lambda d: None,
+        "lyapunov": lambda d: None,
+        "rotation": lambda d: None,
+        "periods_integrated": lambda d: None,
+        "kind_down": lambda d: None,
+        "period_down": lambda d: None,
+        "lyapunov_down": lambda d: None,
+        "rotation_down": lambda d: None,
+        "coexisting": lambda d: None,
+    }
 
     system: UedaSystem
     nu: np.ndarray
@@ -177,6 +195,8 @@ class Chart:
             "grid": [int(self.nu.size), int(self.B.size)],
             "nu_range": [float(self.nu[0]), float(self.nu[-1])],
             "B_range": [float(self.B[0]), float(self.B[-1])],
+            "nu": self.nu,
+            "B": self.B,
             "fractions": self.fractions(),
             "periods_found": {f"P{k}": v for k, v in self.period_counts().items()},
             "seconds": self.seconds,

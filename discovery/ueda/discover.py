@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._printing import generic_lines, readable
+from .._result import Result
 from .._validate import Array, Real, params
 from ..errors import InputError
 from .polynomial import FORCING, MONOMIALS, TERMS, ForcedPolynomial
@@ -65,8 +66,8 @@ __all__ = [
 
 
 @readable
-@dataclass(frozen=True)
-class Discovery:
+@dataclass(frozen=True, eq=False)
+class Discovery(Result):
     """A discovered equation with its uncertainty.
 
     Attributes
@@ -91,6 +92,13 @@ class Discovery:
         ``{term: fraction}``: how often STLSQ selects each term on bootstrap resamples.
     """
 
+    KIND = "ueda-discover"
+    _LOAD = {
+        "model": lambda d: None,
+        "terms": lambda d: tuple(d["terms"]),
+        "settings": lambda d: d.get("discovery_settings", d.get("settings")),
+    }
+
     model: ForcedPolynomial
     terms: tuple
     coefficients: dict
@@ -112,7 +120,9 @@ class Discovery:
     def latex(self):
         return self.model.latex()
 
-    def as_dict(self):
+    def as_dict(self, settings_key="settings"):
+        """The document's keys; ``settings_key`` names the discovery's settings (the
+        command line keeps ``settings`` for its options)."""
         return {
             "terms": list(self.terms),
             "coefficients": self.coefficients,
@@ -124,7 +134,7 @@ class Discovery:
             "n_windows": self.n_windows,
             "n_blocks": self.n_blocks,
             "bootstrap_support": self.bootstrap_support,
-            "settings": self.settings,
+            settings_key: self.settings,
             "seconds": self.seconds,
         }
 

@@ -5,14 +5,15 @@
 from dataclasses import dataclass, field
 
 from .._printing import generic_lines, readable
+from .._result import Result, part
 from .effects import EFFECTS, effect_dict
 from .polynomial import ForcedPolynomial
 
 __all__ = ["Iteration", "Explanation", "model_dict"]
 
 
-@dataclass(frozen=True)
-class Iteration:
+@dataclass(frozen=True, eq=False)
+class Iteration(Result):
     """One pass of the loop.
 
     Attributes
@@ -41,6 +42,12 @@ class Iteration:
         each leaves the named one insignificant, and beside it each is insignificant.
     """
 
+    KIND = "ueda-explain-iteration"
+    _LOAD = {
+        "model_before": lambda d: ForcedPolynomial.from_dict(d.get("model_before")),
+        "model_after": lambda d: ForcedPolynomial.from_dict(d.get("model_after")),
+    }
+
     effect: str | None
     evidence: dict
     scores: list
@@ -68,8 +75,8 @@ class Iteration:
 
 
 @readable
-@dataclass(frozen=True)
-class Explanation:
+@dataclass(frozen=True, eq=False)
+class Explanation(Result):
     """Outcome of :func:`explain`.
 
     Attributes
@@ -91,6 +98,18 @@ class Explanation:
         simulation).
     stopped_because : str
     """
+
+    KIND = "ueda-explain"
+    _LOAD = {
+        "iterations": lambda d: tuple(part(Iteration, it) for it in d["iterations"]),
+        "start_model": lambda d: ForcedPolynomial.from_dict(d.get("start_model")),
+        "final_model": lambda d: ForcedPolynomial.from_dict(d.get("final_model")),
+        "start_terms": lambda d: tuple(d["start_terms"]),
+        "final_terms": lambda d: tuple(d["final_terms"]),
+        "settings": lambda d: (
+            d["method"] if isinstance(d.get("method"), dict) else d.get("settings")
+        ),
+    }
 
     iterations: tuple
     start_model: ForcedPolynomial
@@ -125,7 +144,9 @@ class Explanation:
                 out[k] = {"before": a, "after": b, "ratio": (a / b) if b > 0 else float("inf")}
         return out
 
-    def as_dict(self):
+    def as_dict(self, settings_key="settings"):
+        """The document's keys; ``settings_key`` names the method's settings (the command
+        line keeps ``settings`` for its options)."""
         return {
             "start_terms": list(self.start_terms),
             "final_terms": list(self.final_terms),
@@ -146,7 +167,7 @@ class Explanation:
             "catalogue": [
                 effect_dict(e) for e in EFFECTS if e.id in self.settings.get("effects", ())
             ],
-            "settings": self.settings,
+            settings_key: self.settings,
             "seconds": self.seconds,
         }
 

@@ -153,6 +153,11 @@ class ForcedPolynomial:
     def as_dict(self):
         return {"terms": self.terms, "forcing": self.forcing, "B": self.B, "nu": self.nu}
 
+    @classmethod
+    def from_dict(cls, d):
+        """The equation of :meth:`as_dict`'s document (``None`` for ``None``)."""
+        return None if d is None else cls.from_terms(d["terms"], d["B"], d["nu"], d["forcing"])
+
 
 def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20, tolerances=None):
     """Integrate ``model`` (a :class:`ForcedPolynomial`) from ``y0`` at ``t0``: after

@@ -11,7 +11,7 @@ Built-in models (every parameter can be set):
   ``k = 0.05, B = 7.5`` (published largest Lyapunov exponent about 0.103).
 """
 
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
@@ -141,3 +141,8 @@ class UedaSystem:
 
     def as_dict(self):
         return {**asdict(self), "equation": self.equation, "period": self.period}
+
+    @classmethod
+    def from_dict(cls, d):
+        """The system of :meth:`as_dict`'s document (its derived keys ignored)."""
+        return cls(**{f.name: d[f.name] for f in fields(cls) if f.name in d})

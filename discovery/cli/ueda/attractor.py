@@ -36,7 +36,7 @@ def run(args):
             f"from (x0, v0) = ({args.x0:g}, {args.v0:g}); start nearer the attractor or "
             "lower --rtol"
         )
-    summary = {"command": "ueda attractor", **att.as_dict()}
+    tail = {}
     bas = None
     if args.basins:
         bas = basins(
@@ -46,8 +46,8 @@ def run(args):
             n=args.basins,
             tolerances=tol,
         )
-        summary["coexisting_attractors"] = bas.as_dict()
-    summary.update(provenance(vars(args)))
+        tail["coexisting_attractors"] = bas.as_dict()
+    att.record_run({"command": "ueda attractor"}, {**tail, **provenance(vars(args))})
     files = ["summary.json", "attractor.png", "attractor.pdf"]
     with OutputDir(args.out) as out:
         attractor_figure(att, str(out.path("attractor")))
@@ -56,7 +56,7 @@ def run(args):
         if bas is not None:
             basins_figure(bas, str(out.path("basins")))
             files += ["basins.png", "basins.pdf"]
-        out.write_json("summary.json", summary)
+        att.write_into(out)
     print(f"{system.model}: {att.regime.regime} ({att.regime.evidence['rule']})")
     print(
         f"  lyapunov {L.value:.4f} +- {L.stderr:.4f}, second {L.second:.4f} +- "

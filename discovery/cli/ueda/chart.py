@@ -58,7 +58,7 @@ def run(args):
             progress=lambda done, total: rep("chart: rows", done, total),
             executor=ex,
         )
-    summary = {"command": "ueda chart", **ch.as_dict(), **provenance(vars(args))}
+    ch.record_run({"command": "ueda chart"}, provenance(vars(args)))
 
     def cell(value, column):
         if isinstance(value, float):
@@ -72,7 +72,7 @@ def run(args):
             for r in ch.rows():
                 w.writerow([cell(v, c) for v, c in zip(r, ch.columns, strict=True)])
         chart_figure(ch, str(out.path("chart")))
-        out.write_json("summary.json", summary)
+        ch.write_into(out)
     fr = ch.fractions()
     print(
         f"{system.model} chart {ch.nu.size}x{ch.B.size}: {ch.seconds:.1f} s on {ch.workers} "

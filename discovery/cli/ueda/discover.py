@@ -46,16 +46,15 @@ def run(args):
         resamples=args.resamples,
         seed=args.seed,
     )
-    result = d.as_dict()
     # "settings" is provenance's (the command-line options); keep the discovery's own
-    result["discovery_settings"] = result.pop("settings")
-    summary = {
-        "command": "ueda discover",
-        "forcing": {"B": B, "nu": nu},
-        **result,
-        "verification": ver.as_dict(),
-        **provenance(vars(args), inputs={"data": args.data}),
-    }
+    d.record_run(
+        {"command": "ueda discover", "forcing": {"B": B, "nu": nu}},
+        {
+            "verification": ver.as_dict(),
+            **provenance(vars(args), inputs={"data": args.data}),
+        },
+        settings_key="discovery_settings",
+    )
     with OutputDir(args.out, inputs=[args.data]) as out:
         discover_figure(d, ver, str(out.path("discover")))
         np.savetxt(
@@ -68,7 +67,7 @@ def run(args):
         np.savetxt(
             out.path("strobe_model.csv"), ver.model_strobe, delimiter=",", header="x,v", comments=""
         )
-        out.write_json("summary.json", summary)
+        d.write_into(out)
     print(f"discovered: {d.model.text()}")
     for k, c in d.coefficients.items():
         print(f"  {k:>12}: {c: .5f} +- {d.standard_errors[k]:.5f}")

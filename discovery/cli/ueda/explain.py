@@ -44,14 +44,11 @@ def run(args):
         resamples=args.resamples,
         seed=args.seed,
     )
-    result = ex.as_dict()
-    result["method"] = result.pop("settings")  # "settings" is provenance's (the options)
-    summary = {
-        "command": "ueda explain",
-        "forcing": {"B": B, "nu": nu},
-        **result,
-        **provenance(vars(args), inputs={"data": args.data}),
-    }
+    ex.record_run(  # "settings" is provenance's (the options): the method's is "method"
+        {"command": "ueda explain", "forcing": {"B": B, "nu": nu}},
+        provenance(vars(args), inputs={"data": args.data}),
+        settings_key="method",
+    )
     with OutputDir(args.out, inputs=[args.data]) as out:
         explain_figure(ex, str(out.path("explain")))
         for name, ver in (("start", ex.start_verification), ("final", ex.final_verification)):
@@ -69,7 +66,7 @@ def run(args):
             header="x,v",
             comments="",
         )
-        out.write_json("summary.json", summary)
+        ex.write_into(out)
     print(f"start: {ex.start_model.text()}")
     for it in ex.iterations:
         if it.effect:

@@ -9,12 +9,12 @@ from ._system import _add_system_options, _system
 
 
 def run(args):
-    import hashlib
     import json
     import time
 
-    from ..._io import atomic_write_text, check_output, to_jsonable
+    from ..._io import atomic_write_text, check_output
     from ...ueda.record import simulate_record
+    from ...ueda.simulated_record import SimulatedUedaRecord
 
     out = check_out(args, kind="file")
     if out.suffix.lower() != ".csv":
@@ -44,24 +44,20 @@ def run(args):
         raise InputError("the simulation produced non-finite values; check the parameters")
     lines = ["t,x"] + [f"{a:.12g},{b:.12g}" for a, b in zip(t, x, strict=True)]
     csv_text = "\n".join(lines) + "\n"
-    summary = {
-        "command": "ueda simulate",
-        "system": system.as_dict(),
-        "samples": int(t.size),
-        "periods": args.periods,
-        "samples_per_period": args.samples_per_period,
-        "noise": {
-            "fraction_of_range": args.noise,
-            "sd": float(args.noise * np.ptp(xc)),
-            "x_range": [float(xc.min()), float(xc.max())],
-        },
-        "integrator": args.integrator,
-        "seconds": time.perf_counter() - t0,
-        "outputs": {out.name: {"sha256": hashlib.sha256(csv_text.encode()).hexdigest()}},
-        **provenance(vars(args)),
-    }
+    summary = SimulatedUedaRecord.of(
+        system,
+        xc,
+        args.noise,
+        out.name,
+        csv_text,
+        samples=int(t.size),
+        periods=args.periods,
+        samples_per_period=args.samples_per_period,
+        integrator=args.integrator,
+        seconds=time.perf_counter() - t0,
+    ).record_run({"command": "ueda simulate"}, provenance(vars(args)))
     atomic_write_text(out, csv_text)
-    atomic_write_text(summary_path, json.dumps(to_jsonable(summary), indent=2) + "\n")
+    atomic_write_text(summary_path, json.dumps(summary.to_dict(), indent=2) + "\n")
     print(
         f"wrote {out} ({t.size} samples, {args.periods} periods of {system.model}, "
         f"{args.samples_per_period} samples per period, noise {args.noise:g} of the range) "

@@ -21,6 +21,7 @@ import numpy as np
 
 from ..._compile import announce_compile
 from ..._printing import fmt, readable
+from ..._result import Result
 from ..._validate import Array, Instance, Real, params
 from ...errors import InputError, IntegrationError
 from ...numerics.shooting import (
@@ -176,8 +177,8 @@ class StroboscopicMap:
 
 
 @readable
-@dataclass(frozen=True)
-class SteadyState:
+@dataclass(frozen=True, eq=False)
+class SteadyState(Result):
     """A periodic steady state of the two-body system (or the evidence that none was found).
 
     Attributes
@@ -218,6 +219,17 @@ class SteadyState:
     evidence: dict = field(default_factory=dict)
     zeta_max0: float = 0.0
 
+    KIND = "steady"
+    _LOAD = {
+        "y0": lambda d: np.array(d["y0"], float),
+        # [re, im] pairs; a part that is not finite was written as null
+        "multipliers": lambda d: np.array(
+            [complex(*(np.nan if v is None else v for v in m)) for m in d["multipliers"]]
+        ),
+        "residual": lambda d: np.nan if d.get("residual") is None else d["residual"],
+        "evidence": lambda d: {},  # how the decision was reached: not in the document
+    }
+
     @property
     def periodic(self):
         return self.n_periods > 0
@@ -235,6 +247,10 @@ class SteadyState:
             "multipliers_abs": [float(abs(m)) for m in self.multipliers],
             "residual": self.residual,
             "n_simulations": self.n_simulations,
+            "y0": self.y0,
+            "t0": self.t0,
+            "multipliers": [[float(m.real), float(m.imag)] for m in np.asarray(self.multipliers)],
+            "zeta_max0": self.zeta_max0,
         }
 
     def _lines(self):

@@ -1,8 +1,12 @@
 """Synthetic records: a law simulated (compiled kernel or the independent scipy path) and
 sampled like a measurement, with noise on every channel."""
 
+import hashlib
+from dataclasses import dataclass, field
+
 import numpy as np
 
+from ..._result import Result
 from ..._validate import Choice, Real, params
 from ...errors import InputError
 from ..data.measurement import STATE_COLUMNS, Measurement
@@ -13,7 +17,52 @@ from .steady_state import steady_state
 
 MAX_SAMPLES = 10_000_000  # samples of one record (as `vidi simulate`)
 
-__all__ = ["synthesize"]
+__all__ = ["synthesize", "SimulatedRecord"]
+
+
+@dataclass(frozen=True, eq=False)
+class SimulatedRecord(Result):
+    """What a synthetic record is (``D.summary.json`` beside ``D.csv`` of ``vidi
+    simulate``).
+
+    Attributes
+    ----------
+    scenario : dict
+        The scenario (:meth:`Scenario.as_dict`).
+    law : ForceLaw
+    samples : int
+    seconds : float
+    outputs : dict
+        ``{file name: {"sha256": ...}}`` of the record's CSV text, so a summary and a
+        record from two runs are not taken for a pair.
+    """
+
+    scenario: dict
+    law: ForceLaw
+    samples: int
+    seconds: float = 0.0
+    outputs: dict = field(default_factory=dict)
+
+    KIND = "simulate"
+    _LOAD = {"law": lambda d: ForceLaw.parse(d["law"])}
+
+    @classmethod
+    def of(cls, scenario, law, csv_name, csv_text, samples, seconds=0.0):
+        """The summary of the record ``csv_text`` written as ``csv_name``."""
+        digest = hashlib.sha256(csv_text.encode()).hexdigest()
+        return cls(scenario.as_dict(), law, samples, seconds, {csv_name: {"sha256": digest}})
+
+    def as_dict(self):
+        return {
+            "scenario": self.scenario,
+            "law": self.law.to_text(),
+            "samples": self.samples,
+            "seconds": self.seconds,
+            "outputs": self.outputs,
+        }
+
+    def __str__(self):
+        return f"simulated record of {self.law} ({self.samples} samples)"
 
 
 @params(

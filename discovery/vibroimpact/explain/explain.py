@@ -49,6 +49,7 @@ from scipy.stats import chi2
 
 from ..._printing import fmt, readable
 from ..._progress import tick
+from ..._result import Result, part
 from ..._validate import Choice, Instance, Real, Text, params
 from ...catalogue import select
 from ...errors import InputError, IntegrationError
@@ -58,6 +59,7 @@ from ..data.measurement import Measurement
 from ..dynamics import Tolerances
 from ..fit.identify import (
     INTERVAL_REFITS,
+    Intervals,
     as_records,
     bootstrap_intervals,
     contact_scales,
@@ -102,8 +104,24 @@ def _law_refit(records, model, criterion, budget, tolerances, problem, drift, po
 _HAS_COEFFICIENT = re.compile(r"(^|[+\-])\s*[0-9.]+([eE][+\-]?[0-9]+)?\s*\*")
 
 
-@dataclass(frozen=True)
-class Iteration:
+def loaded_model(d):
+    """The :class:`Model` of its ``as_dict()`` document."""
+    law = ForceLaw.from_dict(d["coefficients"])
+    un = d.get("unloading") or {}
+    if un or d.get("permanent_set"):
+        law = law.with_unloading(
+            [Term.parse(k) for k in un], list(un.values()), d.get("permanent_set") or 0.0
+        )
+    return Model(
+        law,
+        observation=dict(d.get("observation") or {}),
+        effects=tuple(d.get("effects") or ()),
+        scenario=dict(d.get("scenario") or {}),
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class Iteration(Result):
     """One pass of the loop.
 
     Attributes
@@ -127,6 +145,12 @@ class Iteration:
     measured : Impulse or None
         The first record's measured cycle.
     """
+
+    KIND = "explain-iteration"
+    _LOAD = {
+        "model_before": lambda d: loaded_model(d["model_before"]),
+        "model_after": lambda d: loaded_model(d["model_after"]),
+    }
 
     model_before: Model
     model_after: Model
@@ -174,8 +198,8 @@ def _parameters(it):
 
 
 @readable
-@dataclass(frozen=True)
-class ExplainResult:
+@dataclass(frozen=True, eq=False)
+class ExplainResult(Result):
     """Outcome of :func:`explain`.
 
     Attributes
@@ -204,6 +228,15 @@ class ExplainResult:
     intervals : Intervals or None
         Bootstrap intervals of the final model's parameters through the full processing.
     """
+
+    KIND = "explain"
+    _LOAD = {
+        "iterations": lambda d: tuple(part(Iteration, it) for it in d["iterations"]),
+        "final_model": lambda d: loaded_model(d["final_model"]),
+        "uncertainties": lambda d: d["final_model"].get("uncertainties", {}),
+        "intervals": lambda d: part(Intervals, d["final_model"].get("intervals")),
+        "separability": lambda d: tuple(d.get("separability", ())),
+    }
 
     iterations: tuple
     final_model: Model

@@ -37,24 +37,28 @@ from warnings import warn
 
 import numpy as np
 
+from constraints import Certificate
 from constraints import require as require_certificate
 
 from ..._printing import coefficient_lines, fmt, readable
 from ..._progress import tick
+from ..._result import Result, part
 from ..._validate import Choice, Real, Text, params
 from ...errors import InputError, IntegrationError, VidiError
 from ...numerics.executor import map_on
 from ..data.measurement import Measurement
 from ..data.samples import contact_samples, join_samples
 from ..dynamics import Tolerances
-from ..model.law import Term
+from ..model.law import ForceLaw, Term
 from ..model.library import Library
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
 from ..verify.criteria import criteria_lines
 from ..verify.criteria import criterion as _criterion
+from ..verify.evaluate import Evaluation
 from .identify import (
     INTERVAL_REFITS,
+    Intervals,
     bootstrap_intervals,
     identify,
     pair_records,
@@ -69,8 +73,30 @@ _FORWARD_STARTS = (0.01, 0.001)  # a new term's start force at the box corner / 
 _RESTARTS = 2  # stalled smaller supports restarted from a consistent model, per step
 
 
-@dataclass(frozen=True)
-class RankedModel:
+def _loaded_evaluations(d):
+    """A loaded ranked model's evaluations: every record's, or the one record's (its
+    regime the simulated one's)."""
+    if d.get("records"):
+        return tuple(part(Evaluation, e) for e in d["records"])
+    regime = {"measured": None, "simulated": d.get("regime")}
+    return (part(Evaluation, {**d, "regime": regime, "impacts": {}}),)
+
+
+def _loaded_intervals(d):
+    if not d.get("intervals"):
+        return None
+    return Intervals(
+        bounds={k: tuple(v) for k, v in d["intervals"].items()},
+        sd={},
+        level=d.get("interval_level"),
+        n_boot=None,
+        seed=None,
+        method=d.get("interval_method"),
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class RankedModel(Result):
     """A candidate law with its simulation check against every record.
 
     Attributes
@@ -94,6 +120,17 @@ class RankedModel:
         Bootstrap intervals of the coefficients through the full processing
         (:func:`discovery.vibroimpact.fit.intervals.bootstrap_intervals`; the selected model only).
     """
+
+    KIND = "ranked-model"
+    _LOAD = {
+        "law": lambda d: ForceLaw.from_dict(d["coefficients"]),
+        "evaluations": _loaded_evaluations,
+        "candidate": lambda d: None,
+        "refinement": lambda d: None,
+        "certificate": lambda d: None,
+        "note": lambda d: d.get("refinement", ""),
+        "intervals": _loaded_intervals,
+    }
 
     law: object
     candidate: object
@@ -209,8 +246,8 @@ class RankedModel:
 
 
 @readable
-@dataclass(frozen=True)
-class DiscoveryResult:
+@dataclass(frozen=True, eq=False)
+class DiscoveryResult(Result):
     """Outcome of :func:`discover`.
 
     Attributes
@@ -241,6 +278,18 @@ class DiscoveryResult:
         Wall time of the whole discovery.
     settings : dict
     """
+
+    KIND = "fit"
+    _LOAD = {
+        "selected": lambda d: part(RankedModel, d["selected"]),
+        "ranking": lambda d: [part(RankedModel, m) for m in d["ranking"]],
+        "certificate": lambda d: d.get("certificate") and Certificate(**d["certificate"]),
+        "samples": lambda d: None,
+        "measured": lambda d: None,
+        "references": lambda d: (),
+        "seconds": lambda d: d.get("discovery_seconds", 0.0),
+        "settings": lambda d: d.get("fit_settings", {}),
+    }
 
     selected: RankedModel
     ranking: list

@@ -38,6 +38,7 @@ from scipy.optimize import least_squares, minimize
 
 from ..._printing import coefficient_lines, fmt, readable
 from ..._progress import tick
+from ..._result import Result, part
 from ..._validate import Choice, Real, Text, params
 from ...errors import InputError, IntegrationError, VidiTypeError
 from ...numerics.executor import map_on
@@ -49,6 +50,7 @@ from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
 from ..verify.criteria import criteria_lines
 from ..verify.criteria import criterion as _criterion
+from ..verify.evaluate import Evaluation
 from ..verify.motion import penetration_jacobian, penetration_residuals, penetration_size
 
 __all__ = [
@@ -75,8 +77,8 @@ _JAC_STEP = 1e-5  # relative step of the standard-error Jacobian
 
 
 @readable
-@dataclass(frozen=True)
-class IdentificationResult:
+@dataclass(frozen=True, eq=False)
+class IdentificationResult(Result):
     """Outcome of :func:`identify`.
 
     Attributes
@@ -113,6 +115,17 @@ class IdentificationResult:
         The identified law against every record with its noise floor (``check=True``):
         :attr:`consistent` and :attr:`verdict` come from them.
     """
+
+    KIND = "identify"
+    _LOAD = {
+        "law": lambda d: ForceLaw.parse(d["law"]),
+        "criteria": lambda d: d.get("criteria_found", {}),
+        "correlation": lambda d: (
+            None if d.get("correlation") is None else np.array(d["correlation"], float)
+        ),
+        "intervals": lambda d: part(Intervals, d.get("intervals")),
+        "checks": lambda d: tuple(part(Evaluation, e) for e in d.get("checks", ())),
+    }
 
     law: object
     criterion: str
@@ -180,6 +193,7 @@ class IdentificationResult:
             # the consistency limits the law was judged by (one record; with several,
             # each record has its own)
             "limits": dict(self.checks[0].limits) if len(self.checks) == 1 else {},
+            "checks": [ev.as_dict() for ev in self.checks],
         }
 
     def _lines(self):
@@ -999,8 +1013,8 @@ def identify(
 # (Cameron & Miller 2015, section VI), as a regression's does with ``N - p``.
 
 
-@dataclass(frozen=True)
-class Intervals:
+@dataclass(frozen=True, eq=False)
+class Intervals(Result):
     """Bootstrap intervals of a fitted law's coefficients.
 
     Attributes
@@ -1019,6 +1033,9 @@ class Intervals:
     dof : int
         ``G - p`` (0: white noise, the normal quantile).
     """
+
+    KIND = "intervals"
+    _LOAD = {"bounds": lambda d: {k: tuple(v) for k, v in d["bounds"].items()}}
 
     bounds: dict
     sd: dict

@@ -55,6 +55,7 @@ from ..._io import (
 )
 from ..._printing import readable
 from ..._progress import tick
+from ..._result import Result
 from ..._validate import Instance, Real, Text, params
 from ...errors import InputError, VidiTypeError
 from ...numerics.executor import make_executor
@@ -151,9 +152,22 @@ def _note(text):
     print(f"vidi: note: {text}", file=sys.stderr)
 
 
+def _loaded_config(d):
+    c = d["config"]
+    return StudyConfig(
+        name=c["name"],
+        cells=tuple(c["cells"]),
+        seeds=tuple(c["seeds"]),
+        fit=c["fit"],
+        record=c["record"],
+        varied=tuple(c["varied"]),
+        source=c["source"],
+    )
+
+
 @readable
-@dataclass(frozen=True)
-class StudyResult:
+@dataclass(frozen=True, eq=False)
+class StudyResult(Result):
     """Outcome of :func:`study`.
 
     Attributes
@@ -171,7 +185,21 @@ class StudyResult:
         Runs done by this call, and runs found in files from an earlier call.
     seconds : float
     executor : str
+    n_runs : int
+        Runs the design asks for (``runs`` holds the complete ones).
+    parallel_efficiency : float or None
+    code_version : str
+        The code version the run files are keyed by.
     """
+
+    KIND = "study"
+    _LOAD = {
+        "config": _loaded_config,
+        "runs": lambda d: [],  # in the study's runs/ folder, not in its summary
+        "n_runs": lambda d: d["runs"],
+        "out": lambda d: Path(d["out"]),
+        "figures": lambda d: tuple(Path(d["out"]) / f for f in d.get("figures", ())),
+    }
 
     config: StudyConfig
     runs: list
@@ -183,6 +211,31 @@ class StudyResult:
     seconds: float = 0.0
     executor: str = ""
     figures: tuple = field(default_factory=tuple)
+    n_runs: int = 0
+    parallel_efficiency: float | None = None
+    code_version: str = ""
+
+    def as_dict(self):
+        """The study's summary (``summary.json``, less the run's provenance)."""
+        cfg = self.config
+        return {
+            "kind": "study",
+            "name": cfg.name,
+            "runs": self.n_runs,
+            "complete": len(self.runs),
+            "executed": self.executed,
+            "reused": self.reused,
+            "executor": self.executor,
+            "seconds": self.seconds,
+            "parallel_efficiency": self.parallel_efficiency,
+            "code_version": self.code_version,
+            "design": _design(cfg),
+            "pooled": _pooled(self.runs, cfg),
+            "cells": self.cells,
+            "config": _config_dict(cfg, self.code_version),
+            "out": str(self.out),
+            "figures": [Path(f).name for f in self.figures],
+        }
 
     def table(self, runs=False):
         """The cells (or with ``runs=True`` every run) as a pandas DataFrame."""
@@ -273,23 +326,22 @@ def _write_config(out, cfg, version):
     """``config.json``: the study as run (its cells, seeds and settings, the code version)."""
     atomic_write_text(
         out / "config.json",
-        json.dumps(
-            to_jsonable(
-                {
-                    "name": cfg.name,
-                    "source": cfg.source,
-                    "seeds": cfg.seeds,
-                    "fit": cfg.fit,
-                    "record": cfg.record,
-                    "varied": cfg.varied,
-                    "cells": cfg.cells,
-                    "code_version": version,
-                }
-            ),
-            indent=1,
-            allow_nan=True,
-        ),
+        json.dumps(to_jsonable(_config_dict(cfg, version)), indent=1, allow_nan=True),
     )
+
+
+def _config_dict(cfg, version):
+    """The study as run: its cells, seeds and settings, the code version."""
+    return {
+        "name": cfg.name,
+        "source": cfg.source,
+        "seeds": cfg.seeds,
+        "fit": cfg.fit,
+        "record": cfg.record,
+        "varied": cfg.varied,
+        "cells": cfg.cells,
+        "code_version": version,
+    }
 
 
 def _run_missing(todo, have, runs, rundir, version, workers, scheduler, executor, progress):
@@ -343,30 +395,18 @@ def _write_tables(out, cfg, records):
     return cells, inclusion
 
 
-def _summary(cfg, n_runs, records, info, version, cells, settings):
-    """``summary.json`` of the study."""
-    return {
-        "command": "study",
-        "kind": "study",
-        "name": cfg.name,
-        "runs": n_runs,
-        "complete": len(records),
-        **info,
-        "code_version": version,
-        "design": _design(cfg),
-        "pooled": _pooled(records, cfg),
-        "cells": cells,
-        **provenance(
-            settings={
-                "config": cfg.source,
-                "fit": cfg.fit,
-                "record": cfg.record,
-                "seeds": list(cfg.seeds),
-                **settings,
-            },
-            inputs={"config": cfg.source} if os.path.isfile(cfg.source) else None,
-        ),
-    }
+def _provenance(cfg, settings):
+    """The study's provenance (its ``summary.json`` after the result's keys)."""
+    return provenance(
+        settings={
+            "config": cfg.source,
+            "fit": cfg.fit,
+            "record": cfg.record,
+            "seeds": list(cfg.seeds),
+            **settings,
+        },
+        inputs={"config": cfg.source} if os.path.isfile(cfg.source) else None,
+    )
 
 
 @params(
@@ -471,39 +511,30 @@ def study(
                 todo, have, runs, work.runs, version, workers, scheduler, executor, progress
             )
             records = [have[r["key"]] for r in runs if r["key"] in have]
-            info = {
-                "executed": done,
-                "reused": len(records) - done,
-                "executor": name,
-                "seconds": time.perf_counter() - t0,
-                "parallel_efficiency": efficiency,
-            }
             settings = {"workers": workers, "scheduler": scheduler, "max_runs": max_runs}
-            paths, cells, inclusion = _stage(
-                out,
-                inputs,
-                cfg,
-                records,
-                figures,
-                work,
-                lambda cells: _summary(cfg, len(runs), records, info, version, cells, settings),
-                version,
-            )
+            seconds = time.perf_counter() - t0  # the runs' (the tables and figures follow)
+
+            def result_of(cells, inclusion, paths):
+                return StudyResult(
+                    config=cfg,
+                    runs=records,
+                    cells=cells,
+                    inclusion=inclusion,
+                    out=out,
+                    executed=done,
+                    reused=len(records) - done,
+                    seconds=seconds,
+                    executor=name,
+                    figures=tuple(out / Path(p).name for p in paths),
+                    n_runs=len(runs),
+                    parallel_efficiency=efficiency,
+                    code_version=version,
+                ).record_run({"command": "study"}, _provenance(cfg, settings))
+
+            result = _stage(out, inputs, cfg, records, figures, work, result_of, version)
         except BaseException as exc:
             work.failed(exc, [r["key"] for r in runs], out)
             raise
-        result = StudyResult(
-            config=cfg,
-            runs=records,
-            cells=cells,
-            inclusion=inclusion,
-            out=out,
-            executed=done,
-            reused=len(records) - done,
-            seconds=time.perf_counter() - t0,
-            executor=name,
-            figures=tuple(out / Path(p).name for p in paths),
-        )
         work.finish()
     return result
 
@@ -624,10 +655,10 @@ class _Work:
         return False
 
 
-def _stage(out, inputs, cfg, records, figures, work, summary, version):
+def _stage(out, inputs, cfg, records, figures, work, result_of, version):
     """Write the whole study (runs, config, tables, figures, summary) into a staging
-    directory and put it in place of ``out`` as a whole; returns the figures' names, the
-    cells and the term inclusion."""
+    directory and put it in place of ``out`` as a whole; returns the result
+    (``result_of(cells, inclusion, figure paths)``), whose ``to_dict()`` is the summary."""
     with running("study"), OutputDir(out, inputs) as od:
         stage = od.stage
         os.mkdir(stage / "runs")
@@ -645,5 +676,6 @@ def _stage(out, inputs, cfg, records, figures, work, summary, version):
         paths = ()
         if figures and records:
             paths = tuple(figures(cfg, records, stage))
-        od.write_json("summary.json", summary(cells))
-    return paths, cells, inclusion
+        result = result_of(cells, inclusion, paths)
+        result.write_into(od)
+    return result

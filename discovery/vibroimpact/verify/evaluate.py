@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._printing import readable
+from ..._result import Result
 from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
 from ..dynamics.response import impulse_from_steady_state
@@ -89,8 +90,8 @@ def consistency_limits(floor, sd=None):
 
 
 @readable
-@dataclass(frozen=True)
-class Evaluation:
+@dataclass(frozen=True, eq=False)
+class Evaluation(Result):
     """A law scored against a reference.
 
     Attributes
@@ -126,6 +127,9 @@ class Evaluation:
     simulated: object = None
     message: str = ""
     extra: dict = field(default_factory=dict)
+
+    KIND = "evaluation"
+    _LOAD = {"extra": lambda d: {"limits": d.get("limits") or {}}}
 
     @property
     def limits(self):

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..._printing import fmt, readable
 from ..._progress import tick
+from ..._result import Result
 from ..._validate import Array, Instance, Real, params
 from ...errors import InputError, VidiError, VidiTypeError
 from ...numerics.executor import make_executor
@@ -41,9 +42,16 @@ DEFAULT_SPREAD = 0.5
 """Default ranges: ``(1 - s) c .. (1 + s) c`` around each template coefficient ``c``."""
 
 
+def _array(key, dtype=float):
+    def get(d):
+        return None if d.get(key) is None else np.array(d[key], dtype=dtype)
+
+    return get
+
+
 @readable
-@dataclass(frozen=True)
-class Landscape:
+@dataclass(frozen=True, eq=False)
+class Landscape(Result):
     """Criteria over ``axes[0] x axes[1]`` coefficient values.
 
     Attributes
@@ -94,6 +102,17 @@ class Landscape:
     noise_floor_under: str = ""
     reference: dict = field(default_factory=dict)
     continuation: bool = False
+
+    KIND = "landscape"
+    _LOAD = {
+        "terms": lambda d: tuple(d["terms"]),
+        "axes": lambda d: (np.array(d["alpha1"], float), np.array(d["alpha2"], float)),
+        "values": lambda d: {k: np.array(d[k], float) for k in d["minima"]},
+        "regime": _array("regime", object),
+        "consistent": _array("consistent", bool),
+        "impacts": _array("impacts", int),
+        "messages": _array("messages", str),
+    }
 
     def argmin(self, name):
         """Index ``(i, j)`` of the smallest value of criterion ``name``; ``None`` when no
@@ -162,6 +181,7 @@ class Landscape:
             "seconds": self.seconds,
             "workers": self.workers,
             "continuation": self.continuation,
+            "messages": self.messages,
         }
 
     def _lines(self):

@@ -4,21 +4,26 @@ import time
 from dataclasses import dataclass, field
 
 from ..._printing import readable
+from ..._result import Result, part
 from ..._validate import Real, params
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from .criteria import criteria_lines
-from .evaluate import evaluate
+from .evaluate import Evaluation, evaluate
 from .reference import Reference
 
 __all__ = ["VerifyResult", "verify"]
 
 
+def _law(d):
+    return None if d.get("law") is None else ForceLaw.parse(d["law"])
+
+
 @readable
-@dataclass(frozen=True)
-class VerifyResult:
+@dataclass(frozen=True, eq=False)
+class VerifyResult(Result):
     """Outcome of :func:`verify`.
 
     Attributes
@@ -44,6 +49,15 @@ class VerifyResult:
     notes: tuple = ()
     seconds: float = 0.0
     settings: dict = field(default_factory=dict)
+
+    KIND = "verify"
+    _LOAD = {
+        "law": _law,
+        "evaluation": lambda d: part(Evaluation, d),
+        "default_start": lambda d: part(Evaluation, d.get("default_start")),
+        "notes": lambda d: tuple(d.get("notes", ())),
+        "settings": lambda d: d.get("verify_settings") or {},
+    }
 
     @property
     def consistent(self):
@@ -88,6 +102,7 @@ class VerifyResult:
             "default_start": None if self.default_start is None else self.default_start.as_dict(),
             "notes": list(self.notes),
             "seconds": self.seconds,
+            "verify_settings": self.settings,
         }
 
     def _lines(self):

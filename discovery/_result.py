@@ -1,0 +1,261 @@
+"""Results as a data model: a versioned JSON document per result, and one loader.
+
+Every result the API returns (:class:`~discovery.VerifyResult`, :class:`~discovery.Landscape`,
+:class:`~discovery.DiscoveryResult`, ...) derives from :class:`Result`:
+
+* ``r.to_dict()`` is a JSON-safe ``dict`` (``json.dumps(r.to_dict())`` works): its
+  ``schema_version`` (:data:`SCHEMA_VERSION`), its kind (``"result"``: ``"verify"``,
+  ``"fit"``, ...), then the result's own keys (the keys ``summary.json`` has always had).
+  Conventions: arrays and tuples are lists, dictionary keys are text, and a number that is
+  not finite (NaN, +-inf) is ``null``.
+* ``type(r).from_dict(d)`` rebuilds the result: every field the document holds comes back
+  typed (a law as a :class:`~discovery.ForceLaw`, iterations as their class, arrays as
+  arrays); what the document does not hold (the simulated force histories, the contact
+  samples, a fitted estimator, the record itself) is ``None`` on a loaded result.  A loaded
+  result keeps its document, so ``to_dict()`` gives it back unchanged.
+* Two results are equal when their documents are: ``from_dict(r.to_dict()) == r``.
+* ``r.save(dir)`` writes ``dir/summary.json`` through :class:`~discovery._io.OutputDir`
+  (staged, put in place whole or not at all); :func:`load` reads any saved result back as
+  its own type.
+
+A command line run records its provenance (versions, settings, input checksums) on the
+result before saving (:meth:`Result.record_run`): a command's ``summary.json`` is its
+result's ``to_dict()``.
+"""
+
+import copy
+import dataclasses
+import json
+from importlib import import_module
+from pathlib import Path
+
+from ._io import OutputDir, short, to_jsonable
+from .errors import InputError
+
+__all__ = ["SCHEMA_VERSION", "Result", "load", "load_summary", "part", "KINDS"]
+
+SCHEMA_VERSION = 1
+"""The version of every result document; a document of another version is refused."""
+
+#: kind -> "module:Class" of every result type (the loader imports the class on use)
+KINDS = {
+    "evaluation": "discovery.vibroimpact.verify.evaluate:Evaluation",
+    "verify": "discovery.vibroimpact.verify.verify:VerifyResult",
+    "landscape": "discovery.vibroimpact.verify.landscape:Landscape",
+    "ranked-model": "discovery.vibroimpact.fit.discover:RankedModel",
+    "fit": "discovery.vibroimpact.fit.discover:DiscoveryResult",
+    "identify": "discovery.vibroimpact.fit.identify:IdentificationResult",
+    "intervals": "discovery.vibroimpact.fit.identify:Intervals",
+    "explain-iteration": "discovery.vibroimpact.explain.explain:Iteration",
+    "explain": "discovery.vibroimpact.explain.explain:ExplainResult",
+    "study": "discovery.vibroimpact.studies.driver:StudyResult",
+    "steady": "discovery.vibroimpact.dynamics.steady_state:SteadyState",
+    "simulate": "discovery.vibroimpact.dynamics.synthesize:SimulatedRecord",
+    "ueda-simulate": "discovery.ueda.simulated_record:SimulatedUedaRecord",
+    "ueda-lyapunov": "discovery.ueda.attractor:Lyapunov",
+    "ueda-attractor": "discovery.ueda.attractor:Attractor",
+    "ueda-chart": "discovery.ueda.chart:Chart",
+    "ueda-discover": "discovery.ueda.discover:Discovery",
+    "ueda-explain-iteration": "discovery.ueda.explanation:Iteration",
+    "ueda-explain": "discovery.ueda.explanation:Explanation",
+}
+
+
+def _document(data):
+    """``data`` as pure JSON values (non-finite numbers ``null``); raises ``TypeError``
+    naming the value that is not data."""
+    return json.loads(json.dumps(to_jsonable(data), allow_nan=False))
+
+
+class Result:
+    """The data-model side of a result (see the module docstring).
+
+    A subclass sets ``KIND`` (a key of :data:`KINDS`), implements ``as_dict()`` (its own
+    keys) and may set ``_LOAD``: ``{field: function of the document}`` for the fields that
+    are not plain values of the same name.  Subclasses are dataclasses with ``eq=False``
+    (equality is :meth:`__eq__`'s).
+    """
+
+    KIND = None
+    _LOAD = {}
+
+    # ---------------------------------------------------------------- the document
+    def to_dict(self):
+        """The result as a JSON-safe document (see the module docstring)."""
+        doc = self.__dict__.get("_document")
+        if doc is not None:
+            return copy.deepcopy(doc)
+        run = self.__dict__.get("_run") or {}
+        out = {"schema_version": SCHEMA_VERSION, "result": self.KIND}
+        out.update(run.get("head", {}))
+        out.update(self.as_dict(**run.get("options", {})))
+        out.update(run.get("tail", {}))
+        return _document(out)
+
+    def record_run(self, head=None, tail=None, **options):
+        """Record what a run adds to the document: ``head`` (the command and its inputs)
+        before the result's keys, ``tail`` (provenance, which wins a clash of keys) after,
+        ``options`` for ``as_dict``; returns the result itself."""
+        run = {"head": dict(head or {}), "tail": dict(tail or {}), "options": options}
+        object.__setattr__(self, "_run", run)
+        return self
+
+    @property
+    def run_record(self):
+        """What :meth:`record_run` recorded: ``{"head", "tail", "options"}``."""
+        return self.__dict__.get("_run") or {"head": {}, "tail": {}, "options": {}}
+
+    @classmethod
+    def from_dict(cls, d):
+        """The result a document describes (the inverse of :meth:`to_dict`)."""
+        check_document(d, "from_dict", expect=cls.KIND)
+        obj = cls.__new__(cls)
+        for f in dataclasses.fields(cls):
+            if f.name in cls._LOAD:
+                try:
+                    value = cls._LOAD[f.name](d)
+                except (
+                    KeyError,
+                    TypeError,
+                    ValueError,
+                    ArithmeticError,
+                    AttributeError,
+                    InputError,
+                ) as exc:
+                    raise InputError(
+                        f"from_dict: the {cls.KIND!r} document's {f.name!r} cannot be read "
+                        f"({type(exc).__name__}: {short(exc, 80)}); was it edited? run the "
+                        "command again"
+                    ) from None
+            elif f.name in d:
+                value = d[f.name]
+            elif f.default is not dataclasses.MISSING:
+                value = f.default
+            elif f.default_factory is not dataclasses.MISSING:
+                value = f.default_factory()
+            else:
+                value = None
+            object.__setattr__(obj, f.name, value)
+        object.__setattr__(obj, "_document", copy.deepcopy(d))
+        return obj
+
+    @property
+    def loaded(self):
+        """True for a result read back from a document (its simulations are not here)."""
+        return self.__dict__.get("_document") is not None
+
+    def __eq__(self, other):
+        if type(other) is not type(self):
+            return NotImplemented
+        return self.to_dict() == other.to_dict()
+
+    __hash__ = None
+
+    # ---------------------------------------------------------------- files
+    def save(self, directory):
+        """Write ``directory/summary.json`` (the document), staged and put in place as a
+        whole (:class:`~discovery._io.OutputDir`); returns the directory's path."""
+        with OutputDir(directory) as out:
+            self.write_into(out)
+        return Path(directory)
+
+    def write_into(self, out):
+        """Write the document as ``summary.json`` into an open :class:`OutputDir`."""
+        out.write_json("summary.json", self.to_dict())
+
+
+def check_document(d, where, expect=None):
+    """Refuse what is not a result document of this version (one :class:`InputError`)."""
+    if not isinstance(d, dict):
+        raise InputError(f"{where}: a result document is a dict; got {type(d).__name__}")
+    version = d.get("schema_version")
+    if version is None:
+        cmd = d.get("command")
+        rerun = f"run `vidi {cmd}` again" if isinstance(cmd, str) else "run the command again"
+        raise InputError(
+            f"{where}: the summary has no schema_version (written by a vidi older than "
+            f"results with a data model); {rerun} to get a result that loads"
+        )
+    if version != SCHEMA_VERSION:
+        raise InputError(
+            f"{where}: schema_version {version!r} is not {SCHEMA_VERSION}, the version "
+            "this vidi reads; load it with the vidi that wrote it, or run the command again"
+        )
+    kind = d.get("result")
+    if not isinstance(kind, str) or kind not in KINDS:
+        raise InputError(f"{where}: unknown result kind {kind!r}; known: {', '.join(KINDS)}")
+    if expect is not None and kind != expect:
+        raise InputError(f"{where}: the document is a {kind!r} result, not {expect!r}")
+    return kind
+
+
+def result_class(kind):
+    """The class of a result kind (a key of :data:`KINDS`)."""
+    module, name = KINDS[kind].split(":")
+    return getattr(import_module(module), name)
+
+
+def load_summary(path):
+    """The document of a saved result: ``path`` is a result directory (its
+    ``summary.json``) or a summary file (``D.summary.json`` of ``vidi simulate``)."""
+    p = Path(path)
+    f = p / "summary.json" if p.is_dir() else p
+    try:
+        return json.loads(f.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(
+            f"{short(str(path))!r} holds no summary.json: give the --out directory of a vidi "
+            "command (or a .summary.json file)"
+        ) from None
+    except (OSError, ValueError) as exc:
+        raise InputError(
+            f"{short(str(f))!r} cannot be read as JSON ({type(exc).__name__}); run the "
+            "command again"
+        ) from None
+
+
+def load(path):
+    """The result saved in ``path`` (a result directory or a ``.summary.json`` file), as
+    its own type (:class:`~discovery.VerifyResult`, :class:`~discovery.DiscoveryResult`,
+    ...).  A summary written before results had a schema version is one
+    :class:`~discovery.errors.InputError` saying so."""
+    if not isinstance(path, str) and not hasattr(path, "__fspath__"):
+        from .errors import VidiTypeError
+
+        raise VidiTypeError(
+            f"load: path must be a result directory or a summary file; got {type(path).__name__}"
+        )
+    d = load_summary(path)
+    kind = check_document(d, f"load {short(str(path))!r}")
+    return result_class(kind).from_dict(d)
+
+
+def part(cls, d):
+    """A result nested in a document (``d`` a dict without the head, or ``None``), as a
+    loaded ``cls``."""
+    if d is None:
+        return None
+    return cls.from_dict({**d, "schema_version": SCHEMA_VERSION, "result": cls.KIND})
+
+
+#: the command whose report a result kind has (a saved result names no command)
+_COMMANDS = {
+    "verify": "verify",
+    "landscape": "landscape",
+    "fit": "fit",
+    "identify": "identify",
+    "explain": "explain",
+    "study": "study",
+    "ueda-attractor": "ueda attractor",
+    "ueda-chart": "ueda chart",
+    "ueda-discover": "ueda discover",
+    "ueda-explain": "ueda explain",
+}
+
+
+def command_of(doc):
+    """``doc`` with its ``command`` (a result saved from Python has none: its kind's)."""
+    kind = doc.get("result")
+    if "command" in doc or not isinstance(kind, str) or kind not in _COMMANDS:
+        return doc
+    return {**doc, "command": _COMMANDS[kind]}

@@ -1,0 +1,248 @@
+"""The cells, rows and tables every report kind shares (criteria, coefficients, scenario,
+provenance, figures), each computed from a run's document alone."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from discovery.vibroimpact.verify.criteria import CRITERIA as _REGISTRY
+from discovery.vibroimpact.verify.criteria import MOTION_DEFINITIONS, definition
+
+from .lawtex import (
+    law_equation,
+    law_inline,
+    law_of,
+    prose,
+    term_tex,
+    unit_tex,
+)
+from .texenv import Tex, escape, num
+
+
+def criterion_names(*mappings):
+    """The criteria of the registry (its order, then the motion's: I5) found in any of
+    ``mappings``; a name neither defines (an edited summary) is not shown."""
+    return [
+        k
+        for k in (*_REGISTRY, *MOTION_DEFINITIONS)
+        if any(isinstance(m, dict) and k in m for m in mappings)
+    ]
+
+
+def criterion_tex(name):
+    """``$I_{2}$`` for the paper's criteria, the name in typewriter for any other."""
+    name = str(name)
+    if re.fullmatch(r"I\d", name):
+        return Tex(f"$I_{{{name[1]}}}$")
+    return Tex(r"\texttt{" + escape(name) + "}")
+
+
+def criterion_definition(name):
+    """The registry's formula and meaning of a criterion, as one table cell."""
+    d = definition(name)
+    formula = f"${d.latex}$: " if d.latex else ""
+    return Tex(formula + escape(d.meaning or "--"))
+
+
+FIGURE_CAPTIONS = {
+    "verify": "Measured force (black) and the law's simulated force (red), folded on the "
+    "drive phase over the record's span; with positions, the force-penetration loop and both "
+    "penetrations over the contacts (what I5 compares).",
+    "fit_impulse": "Measured impulse and the simulated steady states of the best models.",
+    "fit_surface": Tex(
+        r"The selected law over the ($\zeta$, $\dot\zeta_+$) plane with the contact samples."
+    ),
+    "fit_loop": "Loading and unloading branches, measured and modelled, for a few impacts.",
+    "identification": "Identification: the path of the best law so far and the simulated "
+    "force converging to the measured one.",
+    "landscape": "Criteria over the two coefficients; the noise floor and the consistent "
+    "region are marked.",
+    "discover": "Recovered equation: strobe points, coefficients with error bars and the "
+    "verification by simulation.",
+    "attractor": "Stroboscopic points and a trajectory of the attractor.",
+    "basins": "Basins of the coexisting attractors.",
+    "chart": "Regime chart over the forcing frequency and amplitude.",
+    "explain": "The missing effect: where the model disagrees before and after it is added.",
+    "explain_loops": "The final model against the record: the force-penetration loop and both "
+    "penetrations over the contacts (what I5 compares).",
+    "recovery_noise": "Exact-support recovery against the force noise, per selection method "
+    "and record length (Wilson 95 % intervals).",
+    "recovery_map": "Recovery over force noise and record length, per selection method "
+    "(recovered/runs in each cell).",
+    "coverage": "Share of true coefficients inside their 95 % intervals (exact supports), "
+    "against the nominal 95 %.",
+    "inclusion": "How often each term was selected, per method and noise level.",
+}
+
+
+# the certificate's domain bounds by their symbols
+_DOMAIN = {"zeta_max": Tex(r"$\zeta_{\max}$"), "zd_max": Tex(r"$\dot\zeta_{+,\max}$")}
+
+
+# figures drawn a page tall at the text width (their text 7-8 pt when printed)
+_TALL = ("explain", "discover", "landscape", "identification")
+
+
+def _model_tex(value, where):
+    """The equation of a law rebuilt from its text or coefficients (never read as LaTeX);
+    ``--`` when the summary has none."""
+    if value in (None, "", {}):
+        return Tex("--")
+    return law_equation(law_of(value, where))
+
+
+def _provenance(s, run_dir):
+    v = s.get("versions") or {}
+    git = s.get("git") or {}
+    rows = [
+        ["command", Tex(r"\texttt{vidi " + escape(s.get("command", "?")) + "}")],
+        ["created", s.get("created", "--")],
+        ["vidi", v.get("vibroimpact-discovery", "--")],
+        [
+            "git commit",
+            (git.get("commit") or "--")[:12]
+            + (" (uncommitted changes)" if git.get("dirty") else ""),
+        ],
+        ["platform", s.get("platform", "--")],
+        [
+            "libraries",
+            ", ".join(f"{k} {val}" for k, val in v.items() if k != "vibroimpact-discovery"),
+        ],
+    ]
+    for name, inp in (s.get("inputs") or {}).items():
+        if isinstance(inp, dict):
+            rows.append(
+                [
+                    f"input {name}",
+                    f"{inp.get('path', '')} (sha256 {str(inp.get('sha256', ''))[:16]}...)",
+                ]
+            )
+    settings = s.get("settings") or {}
+    shown = {
+        k: val
+        for k, val in settings.items()
+        if k not in ("command", "func", "out", "ueda_command") and val not in (None, False)
+    }
+    rows.append(["settings", prose("; ".join(f"{k}={val}" for k, val in shown.items()) or "--")])
+    return rows
+
+
+def _scenario_rows(sc):
+    if not sc:
+        return []
+    units = {
+        "m1": "kg",
+        "m2": "kg",
+        "k1": "N/m",
+        "c1": "N s/m",
+        "A": "N",
+        "frequency": "Hz",
+        "g": "m/s^2",
+        "k3": "N/m^3",
+        "mass_loss": "per impact",
+    }
+    rows = [["name", sc.get("name", "--")]]
+    for k, unit in units.items():
+        if k in sc and not (k in ("k3", "mass_loss") and not sc[k]):
+            rows.append([k, Tex(num(sc[k]) + r"\ " + unit_tex(unit))])
+    if sc.get("law"):
+        rows.append(["reference law", law_inline(law_of(sc["law"], "scenario.law"))])
+    return rows
+
+
+def _scenarios_table(scenarios):
+    """Every scenario of a run side by side: one column per scenario."""
+    scs = [sc for sc in scenarios if isinstance(sc, dict)]
+    if not scs:
+        return None
+    per = [_scenario_rows(sc) for sc in scs]
+    labels = [r[0] for r in per[0]]
+    rows = []
+    for i, label in enumerate(labels):
+        rows.append([label, *(p[i][1] if i < len(p) and p[i][0] == label else "--" for p in per)])
+    return rows
+
+
+def _criteria_table(criteria, floor, limits=None):
+    """Rows: criterion, value, noise floor, limit (when judged: ``--`` for a criterion the
+    consistency rule does not judge), its formula and meaning (the criteria registry)."""
+    rows = []
+    for k in criterion_names(criteria):
+        lim = (limits or {}).get(k)
+        rows.append(
+            [
+                criterion_tex(k),
+                num(criteria[k]),
+                num((floor or {}).get(k)),
+                num(lim) if lim is not None else Tex("--"),
+                criterion_definition(k),
+            ]
+        )
+    return rows
+
+
+def _measured_rows(m, records=None):
+    if not m:
+        return []
+    noise = m.get("noise")
+    noise_f = noise.get("F") if isinstance(noise, dict) else noise
+    rows = [
+        ["drive periods per cycle", m.get("n_periods", "--")],
+        ["cycles in the record", m.get("n_cycles", "--")],
+        ["contacts per cycle", m.get("impacts", "--")],
+        ["force noise (sd)", Tex(num(noise_f) + r"\,N")],
+        ["peak force", Tex(num(m.get("peak")) + r"\,N")],
+        ["contact time", Tex(num(m.get("contact_time")) + r"\,s")],
+    ]
+    if isinstance(noise, dict) and "dt" in noise:
+        rows.insert(0, ["sampling step", Tex(num(noise["dt"]) + r"\,s")])
+    return rows
+
+
+def _figures(run_dir, order):
+    figs = []
+    for stem in order:
+        for p in sorted(Path(run_dir).glob(f"{stem}*.pdf")):
+            if p.stem in ("report", "model"):
+                continue
+            base = p.stem.split("_")[0] if p.stem not in FIGURE_CAPTIONS else p.stem
+            figs.append(
+                {
+                    "file": p.name,
+                    "caption": FIGURE_CAPTIONS.get(p.stem, FIGURE_CAPTIONS.get(base, p.stem)),
+                    # a figure drawn a page tall (explain's four panels) is printed so
+                    "height": Tex("0.75" if base in _TALL else "0.55"),
+                }
+            )
+    seen, out = set(), []
+    for f in figs:
+        if f["file"] not in seen:
+            seen.add(f["file"])
+            out.append(f)
+    return out
+
+
+def _transient(verdict):
+    return "transient" in (verdict or "")
+
+
+def _intervals(entry):
+    iv = entry.get("intervals") or {}
+    return iv.get("bounds", iv) if isinstance(iv, dict) else {}
+
+
+def _coef_rows(coefs, errors=None, intervals=None, start=None, term=term_tex):
+    rows = []
+    for k, v in coefs.items():
+        lo_hi = (intervals or {}).get(k)
+        rows.append(
+            [
+                term(k),
+                num(v, 4),
+                num((errors or {}).get(k), 2),
+                Tex(f"[{num(lo_hi[0], 4)}, {num(lo_hi[1], 4)}]") if lo_hi else Tex("--"),
+            ]
+            + ([num((start or {}).get(k), 3)] if start is not None else [])
+        )
+    return rows

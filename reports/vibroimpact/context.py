@@ -1,0 +1,382 @@
+"""What the reports of the vibro-impact commands (verify, fit, identify, landscape,
+explain) say: each turns its run's document into the template's context, with conclusions
+written from the numbers."""
+
+from __future__ import annotations
+
+from ..cells import (
+    _DOMAIN,
+    _coef_rows,
+    _criteria_table,
+    _figures,
+    _intervals,
+    _measured_rows,
+    _model_tex,
+    _scenarios_table,
+    _transient,
+    criterion_tex,
+)
+from ..lawtex import (
+    law_inline,
+    law_of,
+    prose,
+    term_tex,
+)
+from ..texenv import Tex, escape, num
+
+
+# ----------------------------------------------------------------------------- kinds
+def _verify(s, run_dir):
+    c = {
+        "title": "Verification of a contact law against a record",
+        "law": _model_tex(s.get("law"), "law"),
+        "data": s.get("data"),
+        "measured": _measured_rows(s.get("measured")),
+        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
+        "verdict": prose(s.get("verdict") or s.get("message") or "--"),
+        "consistent": bool(s.get("consistent")),
+        "regime": s.get("regime") or {},
+        "impacts": s.get("impacts") or {},
+        "start": s.get("start") or {},
+        "default_start": s.get("default_start"),
+    }
+    lim = s.get("limits") or {}
+    crit = s.get("criteria") or {}
+    concl = []
+    if c["consistent"]:
+        concl.append(
+            f"The law is consistent with the record: every judged criterion is within "
+            f"its limit (I2 {crit.get('I2', float('nan')):.3g} against "
+            f"{lim.get('I2', float('nan')):.3g}), the limit being what the true law "
+            "scores on records this noisy (twice the noise floor, or the floor plus "
+            "three of its standard deviations, plus 0.005)."
+        )
+    else:
+        over = [k for k in lim if crit.get(k, 0) > lim[k]]
+        concl.append(
+            "The law is inconsistent with the record"
+            + (
+                f": {', '.join(over)} exceed{'s' if len(over) == 1 else ''} the noise limit"
+                if over
+                else ""
+            )
+            + (
+                ". The figure shows where the simulated force and penetration depart "
+                "from the measured ones"
+                if "I5" in over
+                else ". The figure shows where the simulated force departs from the measured one"
+            )
+            + "; `vidi explain` names the effect most likely missing."
+        )
+    reg = c["regime"]
+    if reg and reg.get("measured") != reg.get("simulated"):
+        concl.append(
+            f"The measured regime is {reg.get('measured')}, the simulated one "
+            f"{reg.get('simulated')}."
+        )
+    if _transient(s.get("verdict")):
+        concl.append(
+            "The law's simulation from the measured state is not yet steady over the "
+            "record's span: the record was compared with that trajectory, block by block, "
+            "not with the law's steady orbit."
+        )
+    c["conclusions"] = [prose(x) for x in concl]
+    c["figures"] = _figures(run_dir, ["verify"])
+    return c
+
+
+def _terms_tex(terms):
+    """Term names as math, comma separated."""
+    return Tex(", ".join(term_tex(t) for t in terms))
+
+
+def _selected_conclusions(s):
+    sel = s.get("selected") or {}
+    concl = []
+    terms = sel.get("terms") or list((sel.get("coefficients") or {}).keys())
+    lib = (s.get("fit_settings") or {}).get("library", "?")
+    n_rec = len(s.get("records") or []) or 1
+    records = "the record" if n_rec == 1 else f"all {n_rec} records"
+    if sel.get("consistent"):
+        concl.append(
+            Tex(
+                f"From the library \\texttt{{{escape(lib)}}}, the data support the terms "
+                f"{_terms_tex(terms)}: the selected law is consistent with {records} by "
+                "full simulation."
+            )
+        )
+    else:
+        concl.append(
+            Tex(
+                f"From the library \\texttt{{{escape(lib)}}}, the best-supported terms are "
+                f"{_terms_tex(terms)}, but no model of the library is consistent with "
+                f"{records} by full simulation: the record holds an effect these "
+                "polynomials do not describe (or the scenario is wrong). "
+                "\\texttt{vidi explain} names the missing effect."
+            )
+        )
+    eq = s.get("equivalent") or []
+    if eq:
+        concl.append(
+            Tex(
+                f"{len(eq)} other model(s) fit the record as well within its noise (listed "
+                "under Selection). They cannot be told apart from this record; a second "
+                "operating point (another drive amplitude or frequency) or lower noise "
+                "would separate them."
+            )
+        )
+    if s.get("warnings"):
+        concl.append(Tex(f"The run gave {len(s['warnings'])} warning(s); see Notes from the run."))
+    if sel.get("contact_defects"):
+        concl.append(
+            prose("The selected law has contact defects: " + "; ".join(sel["contact_defects"]))
+        )
+    return concl
+
+
+def _record_checks(sel, records):
+    """Each record's own check of the selected law: criteria, floors, limits, full verdict."""
+    out = []
+    for i, ev in enumerate(sel.get("records") or []):
+        rec = records[i] if i < len(records) and isinstance(records[i], dict) else {}
+        out.append(
+            {
+                "name": f"Record {i + 1}: {rec.get('data', '--')} (scenario "
+                f"{rec.get('scenario', '--')})",
+                "criteria": _criteria_table(
+                    ev.get("criteria"), ev.get("noise_floor"), ev.get("limits")
+                ),
+                "verdict": prose(ev.get("verdict") or ev.get("message") or "--"),
+            }
+        )
+    return out
+
+
+def _fit(s, run_dir):
+    sel = s.get("selected") or {}
+    fs = s.get("fit_settings") or {}
+    cert = s.get("certificate") or {}
+    c = {
+        "title": "Discovery of a contact law",
+        "model": _model_tex(sel.get("coefficients"), "selected.coefficients"),
+        "coefficients": _coef_rows(
+            sel.get("coefficients") or {}, sel.get("standard_errors"), _intervals(sel)
+        ),
+        "interval_method": sel.get("interval_method") or "no bootstrap intervals",
+        "criteria": _criteria_table(sel.get("criteria"), sel.get("noise_floor"), sel.get("limits")),
+        "record_checks": _record_checks(sel, s.get("records") or []),
+        "verdict": prose(sel.get("verdict") or "--"),
+        "regime": sel.get("regime", "--"),
+        "refinement": sel.get("refinement", "--"),
+        "library": fs.get("library", "--"),
+        "selection": fs.get("selection", "--"),
+        "scoring": fs.get("scoring", "--"),
+        "criterion": criterion_tex(fs.get("criterion", "I2")),
+        "records": [
+            [
+                r.get("data", "--"),
+                r.get("scenario", "--"),
+                r.get("regime", "--"),
+                r.get("impacts", "--"),
+                num((r.get("noise") or {}).get("F")),
+                (r.get("noise") or {}).get("n_cycles", "--"),
+            ]
+            for r in s.get("records") or []
+        ],
+        "certificate": {
+            "method": cert.get("method", "--"),
+            "holds": bool(cert.get("holds")),
+            "worst": num(cert.get("worst_violation")),
+            "domain": {
+                _DOMAIN.get(k, k): num(v)
+                for k, v in (cert.get("domain") or {}).items()
+                if isinstance(v, int | float)
+            },
+            "conditions": [
+                [
+                    k.replace("_", " "),
+                    v.get("quantity", ""),
+                    "holds" if v.get("holds") else "FAILS",
+                    num(v.get("grid_min_rel")),
+                ]
+                for k, v in (cert.get("conditions") or {}).items()
+            ],
+        },
+        "ranking": [
+            [
+                str(i + 1),
+                _terms_tex(m.get("terms") or []),
+                m.get("regime", "--"),
+                num(m.get("bic"), 6),
+                num((m.get("criteria") or {}).get(fs.get("criterion", "I2"))),
+                "yes" if m.get("consistent") else "no",
+            ]
+            for i, m in enumerate(s.get("ranking") or [])
+        ],
+        "equivalent": [
+            {
+                "model": _model_tex(e.get("law") or e.get("coefficients"), f"equivalent[{i}].law"),
+                "reason": prose(e.get("reason", "")),
+                "separate": prose(e.get("separate", "")),
+            }
+            for i, e in enumerate(s.get("equivalent") or [])
+        ],
+        "warnings": [prose(w) for w in s.get("warnings") or []],
+        "scenarios": _scenarios_table(s.get("scenarios") or [s.get("scenario")]),
+    }
+    c["conclusions"] = _selected_conclusions(s)
+    c["figures"] = _figures(run_dir, ["fit_impulse", "fit_surface", "fit_loop"])
+    return c
+
+
+def _identify(s, run_dir):
+    c = {
+        "title": "Identification of a contact law by simulation",
+        "model": _model_tex(s.get("law") or s.get("coefficients"), "law"),
+        "coefficients": _coef_rows(
+            s.get("coefficients") or {},
+            s.get("standard_errors"),
+            _intervals(s),
+            start=s.get("start") or {},
+        ),
+        "measured": _measured_rows(s.get("measured")),
+        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
+        "verdict": prose(s.get("verdict") or "--"),
+        "method": s.get("method", "--"),
+        "criterion": criterion_tex(s.get("criterion", "I2")),
+        "n_simulations": s.get("n_simulations", "--"),
+        "message": prose(s.get("message", "")),
+    }
+    concl = [
+        f"{s.get('method', '?')} spent {s.get('n_simulations', '?')} simulations; the "
+        f"identified law is {'consistent' if s.get('consistent') else 'NOT consistent'} "
+        "with the record."
+    ]
+    if not s.get("consistent"):
+        concl.append(
+            "An inconsistent result after identification means either a missing "
+            "effect (run `vidi explain`) or a local minimum: start nearer (the "
+            "coefficients of `vidi fit`), or look at the landscape."
+        )
+    c["conclusions"] = [prose(x) for x in concl]
+    c["figures"] = _figures(run_dir, ["identification"])
+    return c
+
+
+def _landscape(s, run_dir):
+    terms = s.get("terms") or ["?", "?"]
+    mins = s.get("minima") or {}
+    c = {
+        "title": "Criteria landscape over two coefficients",
+        "terms": [term_tex(t) for t in terms[:2]],
+        "law": law_inline(law_of(s["law"], "law")) if s.get("law") else Tex("--"),
+        "grid": "x".join(str(g) for g in s.get("grid") or []),
+        "minima": [
+            [
+                criterion_tex(k),
+                num(m.get("alpha1")),
+                num(m.get("alpha2")),
+                num(m.get("value")),
+                m.get("regime", "--"),
+                "yes" if m.get("consistent") else "no",
+            ]
+            for k, m in mins.items()
+        ],
+        "noise_floor": [
+            [criterion_tex(k), num(v)] for k, v in (s.get("noise_floor") or {}).items()
+        ],
+        "n_consistent": s.get("n_consistent", 0),
+        "regimes": ", ".join(f"{k}: {v}" for k, v in (s.get("regimes") or {}).items()),
+        "reference": (s.get("reference") or {}).get("source", "--"),
+    }
+    n = s.get("n_consistent", 0)
+    c["conclusions"] = [
+        f"{n} grid point(s) are consistent with the reference within the noise limit"
+        + (
+            "; the consistent region's size is the coefficients' uncertainty from this record."
+            if n
+            else "; no pair of these coefficients explains the record on this grid."
+        )
+    ]
+    c["figures"] = _figures(run_dir, ["landscape"])
+    return c
+
+
+def _effect_parameter_rows(fm, catalogue):
+    """Rows of the added effects' own parameters (a machine parameter such as the contact
+    offset, an observation's such as a sensor's lag), by the catalogue's names and units."""
+    if not isinstance(catalogue, list):
+        return []
+    values = {**(fm.get("scenario") or {}), **(fm.get("observation") or {})}
+    rows = []
+    for e in catalogue:
+        if not isinstance(e, dict) or e.get("id") not in (fm.get("effects") or []):
+            continue
+        key, params = e.get("key"), e.get("parameters") or []
+        if key not in values or not params or not isinstance(params[0], dict):
+            continue
+        name, unit = str(params[0].get("name")), str(params[0].get("unit", ""))
+        rows += _coef_rows(
+            {name: values[key]},
+            fm.get("uncertainties"),
+            _intervals(fm),
+            term=lambda n, u=unit: Tex(r"\texttt{" + escape(n) + "} [" + escape(u) + "]"),
+        )
+    return rows
+
+
+def _explain(s, run_dir):
+    fm = s.get("final_model") or {}
+    its = s.get("iterations") or []
+    c = {
+        "title": "The missing physical effect",
+        "model": _model_tex(fm.get("text") or fm.get("coefficients"), "final_model.text"),
+        "coefficients": _coef_rows(
+            fm.get("coefficients") or {}, fm.get("uncertainties"), _intervals(fm)
+        )
+        + [
+            [Tex("unloading " + term_tex(k, unloading=True)), num(v, 4), Tex("--"), Tex("--")]
+            for k, v in (fm.get("unloading") or {}).items()
+        ]
+        + _effect_parameter_rows(fm, s.get("catalogue")),
+        "effects": [str(e).replace("_", " ") for e in fm.get("effects") or []],
+        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
+        "stopped": prose(s.get("stopped_because", "--")),
+        "iterations": [
+            [
+                str(k + 1),
+                str(it.get("effect") or "nothing named").replace("_", " "),
+                num((it.get("criteria_before") or {}).get("I2")),
+                num((it.get("criteria_after") or {}).get("I2")),
+                num((it.get("noise_floor") or {}).get("I2")),
+                prose(it.get("evidence", "")),
+            ]
+            for k, it in enumerate(its)
+        ],
+        "separability": [
+            [
+                r.get("effect", "--"),
+                num(r.get("before")),
+                num(r.get("after")),
+                num(r.get("floor")),
+                "yes" if r.get("separable") else "no",
+            ]
+            for r in s.get("separability") or []
+        ],
+    }
+    named_its = [it for it in its if it.get("effect")]
+    if named_its:
+        named = ", ".join(str(it["effect"]).replace("_", " ") for it in named_its)
+        state = "consistent" if s.get("consistent") else "still NOT consistent"
+        concl = [
+            f"Named and added: {named}. The gap to the record shrank as the table shows; "
+            f"the final model is {state} with the record."
+        ]
+    else:
+        concl = [
+            "No effect was added: "
+            + str(s.get("stopped_because", "the start model already agrees with the record"))
+        ]
+    c["conclusions"] = [prose(x) for x in concl]
+    c["figures"] = _figures(run_dir, ["explain", "localise", "screen", "drift"])
+    return c
