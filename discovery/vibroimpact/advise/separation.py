@@ -1,0 +1,355 @@
+"""One operating point: every candidate simulated to its steady state, and every pair's
+predicted records compared by the verdict's own rule.
+
+For an ordered pair (``a`` true, ``b`` judged) the record ``a`` predicts at the point is its
+exact steady-state impulse with the next record's noise model (force noise ``relative x``
+``a``'s peak, the sampling step, the cycles recorded); ``b`` is judged against it by
+:func:`~discovery.vibroimpact.verify.evaluate.evaluate` (the verdict's evaluation: simulate,
+align, criteria, noise floor under ``b`` by the parametric bootstrap, consistency limits).
+The *separation* of the direction is ``max_k I_k / limit_k`` over the verdict's consistency
+criteria (I2 and I4 for a force record), so 1 is where the verdict starts to reject ``b``;
+that of the pair is the smaller of its two directions (a record settles the pair only when
+it rejects the false law whichever of the two is true).  A difference of regime (period or
+contacts per orbit) rejects outright: the pair is *separated by regime*, and its criteria
+ratio is still reported.
+
+The predicted record is noise-free (its noise enters through the floor): a noisy record
+scores a wrong law higher on average (``E|d + n| >= |d|``), so a separation >= 1 is a
+conservative prediction of a rejection.  I5 (the penetration) is not predicted: it would
+only add rejections where positions are recorded.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ...errors import InputError, IntegrationError
+from ..dynamics.response import impulse_from_steady_state
+from ..dynamics.simulate import simulate
+from ..dynamics.steady_state import steady_state
+from ..verify.evaluate import evaluate
+from ..verify.reference import Reference
+
+__all__ = ["Prediction", "PairSeparation", "Point", "evaluate_point", "point_job"]
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """What one candidate predicts at a point.
+
+    Attributes
+    ----------
+    status : str
+        ``"ok"``, ``"nonperiodic"``, ``"no-contact"`` or ``"failed"``.
+    regime : str
+        ``"P1"``, ... (``""`` unless ok).
+    impacts : int
+        Contacts per orbit.
+    peak_force : float
+        Largest contact force [N] on the orbit (0 unless ok).
+    max_penetration : float
+        Largest penetration ``w1 - w2`` [m] on the orbit (0 unless ok).
+    message : str
+    """
+
+    status: str
+    regime: str = ""
+    impacts: int = 0
+    peak_force: float = 0.0
+    max_penetration: float = 0.0
+    message: str = ""
+
+    def to_dict(self):
+        return {
+            "status": self.status,
+            "regime": self.regime,
+            "impacts": int(self.impacts),
+            "peak_force": _num(self.peak_force),
+            "max_penetration": _num(self.max_penetration),
+            "message": self.message,
+        }
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(
+            status=d["status"],
+            regime=d["regime"],
+            impacts=int(d["impacts"]),
+            peak_force=_float(d["peak_force"]),
+            max_penetration=_float(d["max_penetration"]),
+            message=d["message"],
+        )
+
+
+@dataclass(frozen=True)
+class PairSeparation:
+    """How far two candidates' predicted records are apart at a point.
+
+    Attributes
+    ----------
+    pair : (int, int)
+        Candidate indices ``(i, j)``, ``i < j``.
+    separation : float
+        ``min`` over the two directions of ``max_k I_k / limit_k``: >= 1 means a record
+        here rejects the false one of the two whichever is true.
+    directions : (float, float)
+        ``j`` judged with ``i`` true, ``i`` judged with ``j`` true.
+    criteria : (dict, dict)
+        The criteria of each direction.
+    limits : (dict, dict)
+        The verdict's limits of each direction (from the noise floor).
+    regime_change : bool
+        The two predict different regimes or contacts per orbit: separated outright.
+    """
+
+    pair: tuple
+    separation: float
+    directions: tuple
+    criteria: tuple
+    limits: tuple
+    regime_change: bool = False
+
+    @property
+    def separated(self):
+        return bool(self.regime_change or self.separation >= 1.0)
+
+    @property
+    def score(self):
+        """For ranking: a regime change counts as infinitely separated."""
+        return float("inf") if self.regime_change else self.separation
+
+    def to_dict(self):
+        return {
+            "pair": [int(k) for k in self.pair],
+            "separation": _num(self.separation),
+            "directions": [_num(v) for v in self.directions],
+            "criteria": [{k: _num(v) for k, v in c.items()} for c in self.criteria],
+            "limits": [{k: _num(v) for k, v in c.items()} for c in self.limits],
+            "regime_change": bool(self.regime_change),
+        }
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(
+            pair=tuple(int(k) for k in d["pair"]),
+            separation=_float(d["separation"]),
+            directions=tuple(_float(v) for v in d["directions"]),
+            criteria=tuple({k: _float(v) for k, v in c.items()} for c in d["criteria"]),
+            limits=tuple({k: _float(v) for k, v in c.items()} for c in d["limits"]),
+            regime_change=bool(d["regime_change"]),
+        )
+
+
+@dataclass(frozen=True)
+class Point:
+    """One operating point of the grid.
+
+    Attributes
+    ----------
+    amplitude, frequency : float
+        Drive amplitude [N] and frequency [Hz].
+    m2 : float or None
+        Moulding mass [kg] (``None``: the scenario's).
+    predictions : tuple of Prediction
+        One per candidate.
+    pairs : tuple of PairSeparation
+        Every pair (empty when the point is not usable).
+    excluded : str
+        Why the point is not advised (``""`` when usable): outside the safe region, or a
+        candidate without a periodic steady state with contact.
+    unsafe : bool
+        Excluded by the safe region.
+    stage : str
+        ``"coarse"`` or ``"refine"``.
+    """
+
+    amplitude: float
+    frequency: float
+    m2: float | None
+    predictions: tuple
+    pairs: tuple = ()
+    excluded: str = ""
+    unsafe: bool = False
+    stage: str = "coarse"
+
+    @property
+    def usable(self):
+        return not self.excluded
+
+    @property
+    def smallest(self):
+        """The smallest pair separation (``nan`` when not usable)."""
+        return min((p.separation for p in self.pairs), default=float("nan"))
+
+    @property
+    def score(self):
+        """The ranking score: the smallest pair score (a regime change counts as inf)."""
+        return min((p.score for p in self.pairs), default=float("nan"))
+
+    def to_dict(self):
+        return {
+            "amplitude": float(self.amplitude),
+            "frequency": float(self.frequency),
+            "m2": None if self.m2 is None else float(self.m2),
+            "predictions": [p.to_dict() for p in self.predictions],
+            "pairs": [p.to_dict() for p in self.pairs],
+            "excluded": self.excluded,
+            "unsafe": bool(self.unsafe),
+            "stage": self.stage,
+            "smallest_separation": _num(self.smallest),
+        }
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(
+            amplitude=float(d["amplitude"]),
+            frequency=float(d["frequency"]),
+            m2=None if d["m2"] is None else float(d["m2"]),
+            predictions=tuple(Prediction.from_dict(p) for p in d["predictions"]),
+            pairs=tuple(PairSeparation.from_dict(p) for p in d["pairs"]),
+            excluded=d["excluded"],
+            unsafe=bool(d["unsafe"]),
+            stage=d["stage"],
+        )
+
+
+def _num(v):
+    """JSON-safe float: ``None`` for nan, ``"inf"`` for infinity."""
+    v = float(v)
+    if np.isnan(v):
+        return None
+    if np.isinf(v):
+        return "inf" if v > 0 else "-inf"
+    return v
+
+
+def _float(v):
+    return float("nan") if v is None else float(v)
+
+
+@dataclass(frozen=True)
+class _Orbit:
+    """A candidate's steady state and exact impulse at a point (internal)."""
+
+    prediction: Prediction
+    impulse: object = None
+    extra: dict = field(default_factory=dict)
+
+
+def _orbit(scenario, law, tolerances):
+    try:
+        ss = steady_state(scenario, law, tolerances=tolerances)
+        if not ss.periodic:
+            return _Orbit(Prediction("nonperiodic", message="no stable periodic steady state"))
+        imp = impulse_from_steady_state(scenario, law, ss, tolerances=tolerances)
+        if imp is None:
+            return _Orbit(Prediction("no-contact", regime=ss.regime, message="no contact"))
+        W = ss.n_periods * scenario.period
+        tr = simulate(
+            scenario,
+            law,
+            (ss.t0, ss.t0 + W),
+            y0=ss.y0,
+            t_eval=np.linspace(ss.t0, ss.t0 + W, 400 * ss.n_periods + 1),
+            tolerances=tolerances,
+            zeta_max0=ss.zeta_max0,
+        )
+        pen = float(np.max(tr.y[0] - tr.y[2]))
+    except (IntegrationError, InputError) as exc:
+        return _Orbit(Prediction("failed", message=str(exc)))
+    pred = Prediction("ok", ss.regime, int(ss.impacts), imp.peak, max(pen, 0.0))
+    return _Orbit(pred, imp)
+
+
+def _predicted_reference(orbit, scenario, noise):
+    """The record a candidate predicts: its exact cycle with the next record's noise."""
+    imp = orbit.impulse
+    sigma = noise.relative * imp.peak
+    n_cycles = max(1, int(noise.periods // imp.n_periods) - 1)
+    E = type(imp)(
+        t=imp.t,
+        F=imp.F,
+        duration=imp.duration,
+        support=imp.support,
+        n_periods=imp.n_periods,
+        onset=imp.onset,
+        noise=sigma,
+        n_cycles=n_cycles,
+        onsets=imp.onsets,
+    )
+    nz = {"F": sigma, "zeta": None, "impact_velocity": None, "dt": noise.dt, "n_cycles": n_cycles}
+    return Reference(impulse=E, noise=nz, n_boot=noise.n_boot, seed=noise.seed, source="prediction")
+
+
+def _direction(scenario, judged, reference, tolerances):
+    """``(ratio, criteria, limits, regime differs)`` of ``judged`` against a predicted
+    record, by the verdict's evaluation."""
+    ev = evaluate(scenario, judged, reference, tolerances=tolerances)
+    if ev.status != "ok":
+        return float("inf"), {}, {}, True
+    lim = ev.limits
+    ratio = max(ev.criteria[k] / lim[k] for k in lim)
+    differs = (
+        ev.regime["simulated"] != ev.regime["measured"]
+        or ev.impacts["simulated"] != ev.impacts["measured"]
+    )
+    return float(ratio), {k: ev.criteria[k] for k in lim}, dict(lim), bool(differs)
+
+
+def evaluate_point(context, amplitude, frequency, m2=None, stage="coarse"):
+    """Evaluate one operating point (see the module docstring).
+
+    Parameters
+    ----------
+    context : _Context
+        The scenario, candidates, noise model, safe region and tolerances.
+    amplitude, frequency : float
+    m2 : float or None
+    stage : str
+
+    Returns
+    -------
+    Point
+    """
+    changes = {"A": float(amplitude), "frequency": float(frequency)}
+    if m2 is not None:
+        changes["m2"] = float(m2)
+    sc = context.scenario.replace(**changes)
+    orbits = [_orbit(sc, law, context.tolerances) for law in context.laws]
+    preds = tuple(o.prediction for o in orbits)
+    point = {"amplitude": amplitude, "frequency": frequency, "m2": m2, "stage": stage}
+    bad = [(k, p) for k, p in enumerate(preds) if p.status != "ok"]
+    if bad:
+        why = "; ".join(f"candidate {k + 1}: {p.status}" for k, p in bad)
+        return Point(predictions=preds, excluded=why, **point)
+    unsafe = [
+        (k, context.safe.violation(p.peak_force, p.max_penetration)) for k, p in enumerate(preds)
+    ]
+    unsafe = [(k, w) for k, w in unsafe if w]
+    if unsafe:
+        why = "; ".join(f"candidate {k + 1}: {w}" for k, w in unsafe)
+        return Point(predictions=preds, excluded=f"unsafe ({why})", unsafe=True, **point)
+    refs = [_predicted_reference(o, sc, context.noise) for o in orbits]
+    pairs = []
+    n = len(orbits)
+    for i in range(n):
+        for j in range(i + 1, n):
+            r_ij, c_ij, l_ij, d_ij = _direction(sc, context.laws[j], refs[i], context.tolerances)
+            r_ji, c_ji, l_ji, d_ji = _direction(sc, context.laws[i], refs[j], context.tolerances)
+            regime = preds[i].regime != preds[j].regime or preds[i].impacts != preds[j].impacts
+            pairs.append(
+                PairSeparation(
+                    pair=(i, j),
+                    separation=min(r_ij, r_ji),
+                    directions=(r_ij, r_ji),
+                    criteria=(c_ij, c_ji),
+                    limits=(l_ij, l_ji),
+                    regime_change=bool(regime or d_ij or d_ji),
+                )
+            )
+    return Point(predictions=preds, pairs=tuple(pairs), **point)
+
+
+def point_job(context, job):
+    """The executor's task: one point ``(amplitude, frequency, m2, stage)``."""
+    return evaluate_point(context, *job)
