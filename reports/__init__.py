@@ -18,8 +18,10 @@ _EXPORTS = {
         "loops_figure",
     )
 }
+_EXPORTS["advise_figure"] = "vibroimpact.advise_figures"
 
 __all__ = [
+    "advise_figure",
     "landscape_figure",
     "identification_figure",
     "fit_impulse_figure",

@@ -795,8 +795,15 @@ def _study(s, run_dir):
     return c
 
 
+def _advise(s, run_dir):
+    from .vibroimpact.advise_report import advise_context
+
+    return advise_context(s, run_dir, _figures)
+
+
 KINDS = {
     "verify": _verify,
+    "advise": _advise,
     "fit": _fit,
     "identify": _identify,
     "landscape": _landscape,
@@ -809,6 +816,7 @@ KINDS = {
 }
 TEMPLATES = {
     "verify": "verify",
+    "advise": "advise",
     "fit": "fit",
     "identify": "identify",
     "landscape": "landscape",
