@@ -73,7 +73,7 @@ def _conclusions(s, n_laws):
             _t(
                 "There the verdict rejects the false law of every pair whichever is true "
                 "(smallest separation ",
-                _f(adv.get("smallest_separation")),
+                _f(s.get("smallest_separation")),
                 "; 1 is the limit).",
             )
         )
@@ -86,6 +86,11 @@ def _conclusions(s, n_laws):
         out.append(
             f"{len(regime)} pair(s) predict different regimes there: they are separated "
             "outright by the regime, which a record near a regime boundary may not reach."
+        )
+    for q in s.get("inseparable") or []:
+        out.append(
+            f"No point of the bounds separates candidates {q[0] + 1} and {q[1] + 1}: within "
+            "the noise they are the same law there; they are left out of the ranking."
         )
     unsafe = sum(bool(p.get("unsafe")) for p in s.get("points") or [])
     if unsafe:

@@ -17,7 +17,7 @@ from ..dynamics import Tolerances
 from ..model.scenario import Scenario
 from .candidates import Knobs, NoiseModel, SafeRegion, unique_laws
 from .result import AdviseResult
-from .separation import point_job
+from .separation import inseparable, point_job, rank_key
 
 __all__ = ["advise"]
 
@@ -38,7 +38,8 @@ def _refined(knobs, coarse, done):
     a, f, _ = knobs.axes()
     da = (a[1] - a[0]) / 2 if a.size > 1 else 0.0
     df = (f[1] - f[0]) / 2 if f.size > 1 else 0.0
-    best = sorted((p for p in coarse if p.usable), key=lambda p: (-p.score, -p.smallest))
+    ignore = inseparable(coarse)
+    best = sorted((p for p in coarse if p.usable), key=lambda p: rank_key(p, ignore))
     jobs, seen = [], set(done)
     for p in best[: knobs.refine]:
         for sa in (-1, 0, 1):

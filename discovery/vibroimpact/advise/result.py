@@ -9,7 +9,7 @@ import numpy as np
 from ..._printing import readable
 from ..model.law import ForceLaw
 from .candidates import Knobs, NoiseModel, SafeRegion
-from .separation import Point
+from .separation import Point, inseparable, rank_key
 
 __all__ = ["AdviseResult", "SCHEMA_VERSION"]
 
@@ -52,11 +52,19 @@ class AdviseResult:
         """The candidates as :class:`ForceLaw`."""
         return tuple(ForceLaw.parse(t) for t in self.laws)
 
+    @property
+    def inseparable(self):
+        """Pairs no point of the bounds separates (see
+        :func:`~discovery.vibroimpact.advise.separation.inseparable`), sorted."""
+        return sorted(inseparable(self.points))
+
     def ranked(self):
-        """The usable points, best first: largest smallest-pair score (a regime change
-        counts as infinitely separated), then largest smallest criteria ratio."""
+        """The usable points, best first (:func:`.separation.rank_key`): most pairs separated,
+        then the largest smallest separation (a regime change counting as infinite), over
+        the pairs some point separates."""
+        ignore = frozenset(self.inseparable)
         usable = [p for p in self.points if p.usable]
-        return sorted(usable, key=lambda p: (-p.score, -p.smallest, p.amplitude, p.frequency))
+        return sorted(usable, key=lambda p: rank_key(p, ignore))
 
     @property
     def best(self):
@@ -66,9 +74,10 @@ class AdviseResult:
 
     @property
     def separates(self):
-        """Whether the advised point separates every pair (by criteria or regime)."""
-        b = self.best
-        return b is not None and all(p.separated for p in b.pairs)
+        """Whether the advised point separates every pair that some point separates (by
+        criteria or regime)."""
+        b, ignore = self.best, frozenset(self.inseparable)
+        return b is not None and all(p.separated for p in b.pairs if p.pair not in ignore)
 
     def map(self):
         """The coarse/refined points on the amplitude x frequency plane.
@@ -77,10 +86,12 @@ class AdviseResult:
         -------
         dict
             ``amplitude``, ``frequency`` (ndarrays of shape (n,)), ``smallest`` (the
-            best smallest separation over ``m2`` at each (A, f); nan where excluded),
+            smallest separation over the pairs some point separates, of the best point over
+            ``m2`` at each (A, f); nan where excluded),
             ``unsafe`` and ``excluded`` (bool, every m2 excluded), ``regime`` (bool, the
             best point there separates by regime).
         """
+        ignore = frozenset(self.inseparable)
         cells = {}
         for p in self.points:
             key = (p.amplitude, p.frequency)
@@ -93,8 +104,8 @@ class AdviseResult:
         smallest, unsafe, excl, regime = [], [], [], []
         for k in keys:
             ps = [p for p in cells[k] if p.usable]
-            best = max(ps, key=lambda p: (p.score, p.smallest)) if ps else None
-            smallest.append(best.smallest if best else np.nan)
+            best = min(ps, key=lambda p: rank_key(p, ignore)) if ps else None
+            smallest.append(best.smallest_separation(ignore) if best else np.nan)
             regime.append(bool(best and any(q.regime_change for q in best.pairs)))
             unsafe.append(not ps and any(p.unsafe for p in cells[k]))
             excl.append(not ps)
@@ -122,6 +133,10 @@ class AdviseResult:
             "points": [p.to_dict() for p in self.points],
             "ranking": [index[id(p)] for p in ranked],
             "advised": None if not ranked else ranked[0].to_dict(),
+            "inseparable": [list(q) for q in self.inseparable],
+            "smallest_separation": None
+            if not ranked
+            else ranked[0].smallest_separation(frozenset(self.inseparable)),
             "separates": self.separates,
             "seconds": float(self.seconds),
             "settings": dict(self.settings),
@@ -182,6 +197,11 @@ class AdviseResult:
             return out
         out.append(f"advised: {_where(b)}")
         out += point_lines(b, self)
+        for q in self.inseparable:
+            out.append(
+                f"  pair {self.pair_label(q)}: no point of the bounds separates them (the same "
+                "law within the noise there); left out of the ranking"
+            )
         if not self.separates:
             out.append(
                 "  the advised point does not separate every pair (separation < 1): a record "

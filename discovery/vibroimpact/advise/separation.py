@@ -30,7 +30,15 @@ from ..dynamics.steady_state import steady_state
 from ..verify.evaluate import evaluate
 from ..verify.reference import Reference
 
-__all__ = ["Prediction", "PairSeparation", "Point", "evaluate_point", "point_job"]
+__all__ = [
+    "Prediction",
+    "PairSeparation",
+    "Point",
+    "evaluate_point",
+    "point_job",
+    "inseparable",
+    "rank_key",
+]
 
 
 @dataclass(frozen=True)
@@ -179,12 +187,13 @@ class Point:
     @property
     def smallest(self):
         """The smallest pair separation (``nan`` when not usable)."""
-        return min((p.separation for p in self.pairs), default=float("nan"))
+        return self.smallest_separation()
 
-    @property
-    def score(self):
-        """The ranking score: the smallest pair score (a regime change counts as inf)."""
-        return min((p.score for p in self.pairs), default=float("nan"))
+    def smallest_separation(self, ignore=frozenset()):
+        """The smallest separation over the pairs not in ``ignore`` (all pairs when every
+        pair is ignored; ``nan`` when not usable)."""
+        qs = [q for q in self.pairs if q.pair not in ignore] or self.pairs
+        return min((q.separation for q in qs), default=float("nan"))
 
     def to_dict(self):
         return {
@@ -348,6 +357,33 @@ def evaluate_point(context, amplitude, frequency, m2=None, stage="coarse"):
                 )
             )
     return Point(predictions=preds, pairs=tuple(pairs), **point)
+
+
+def inseparable(points):
+    """The pairs no usable point separates (separation < 1 and the same regime at every
+    point): within the noise they are one law over the whole bounds (e.g. a model and the
+    same model with a tiny extra term), so no record in the bounds can settle them and the
+    ranking leaves them out.  frozenset of ``(i, j)``."""
+    usable = [p for p in points if p.usable]
+    if not usable:
+        return frozenset()
+    pairs = {q.pair for q in usable[0].pairs}
+    separated = {q.pair for p in usable for q in p.pairs if q.separated}
+    return frozenset(pairs - separated)
+
+
+def rank_key(point, ignore=frozenset()):
+    """Sort key of a usable point, best first: more pairs separated, then the largest
+    smallest separation (a regime change counting as infinite), then the largest smallest
+    criteria ratio, over the pairs not in ``ignore`` (see :func:`inseparable`)."""
+    qs = [q for q in point.pairs if q.pair not in ignore] or list(point.pairs)
+    return (
+        -sum(q.separated for q in qs),
+        -min(q.score for q in qs),
+        -min(q.separation for q in qs),
+        point.amplitude,
+        point.frequency,
+    )
 
 
 def point_job(context, job):
