@@ -88,6 +88,7 @@ def second_fit(sc0, rec0, law, point, seed):
         "point": list(point),
         "settled": _settles(res, law),
         "selected": res.selected.law.to_text(),
+        "selected_terms": list(res.selected.law.names),
         "equivalent": [e["terms"] for e in res.equivalent],
     }
 
@@ -118,7 +119,9 @@ def run_case(i):
         return row
     row["advised"] = {
         "point": [b.amplitude, b.frequency],
-        "smallest_separation": b.smallest,
+        "smallest_separation": b.smallest_separation(frozenset(adv.inseparable)),
+        "inseparable": [list(q) for q in adv.inseparable],
+        "separates": adv.separates,
         "regime_change": any(p.regime_change for p in b.pairs),
         "regimes": [p.regime for p in b.predictions],
     }
@@ -134,6 +137,7 @@ def summary(rows):
     counted = [r for r in rows if r.get("counted")]
     adv = sum(r["with_advised"]["settled"] for r in counted)
     rnd = sum(r["with_random"]["settled"] for r in counted)
+    first = sum(bool(r.get("first_settled")) for r in counted)
     for r in rows:
         if not r.get("counted"):
             print(f"{r['i']:3d} {r['machine']:9s} {r['law']:34s} not counted: {r.get('why')}")
@@ -146,7 +150,11 @@ def summary(rows):
             f"{'settled' if r['with_advised']['settled'] else 'not settled'}; random: "
             f"{'settled' if r['with_random']['settled'] else 'not settled'}"
         )
-    print(f"counted cases {len(counted)} of {len(rows)}: advised point settles {adv}, random {rnd}")
+    print(
+        f"counted cases {len(counted)} of {len(rows)}: the first record alone selects the true "
+        f"law in {first}; with a second record at the advised point {adv}, at a random point "
+        f"{rnd}"
+    )
     return adv, rnd, len(counted)
 
 
