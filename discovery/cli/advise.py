@@ -84,7 +84,15 @@ def run(args):
     knobs = _knobs(args)
     safe = SafeRegion(args.max_force, args.max_penetration)
     laws, fit_scenario = _candidates(args)
-    sc = load_scenario(args.scenario or fit_scenario or "paper")
+    try:
+        sc = load_scenario(args.scenario or fit_scenario or "paper")
+    except InputError as exc:
+        if args.scenario:
+            raise
+        raise InputError(
+            f"the fit's scenario {fit_scenario!r} cannot be loaded here ({exc}); give "
+            "--scenario (a built-in name or the fit's TOML file)"
+        ) from None
     noise = _noise(args, sc)
     with reporter(args) as rep, executor_of(args) as ex:
         res = advise(sc, laws, knobs, noise, safe, workers=args.workers, progress=rep, executor=ex)

@@ -272,8 +272,9 @@ def candidates_from_fit(run_dir):
     Returns
     -------
     laws : tuple of ForceLaw
-    scenario_name : str or None
-        The fit's scenario name (to load it when none is given).
+    scenario : str or None
+        The fit's ``--scenario`` (a built-in name or a file), else its scenario's name (to
+        load it when none is given).
     """
     p = Path(run_dir) / "summary.json"
     try:
@@ -299,5 +300,9 @@ def candidates_from_fit(run_dir):
             f"the fit in {str(run_dir)!r} lists no equivalent model: its record already "
             "tells the laws apart; to compare other laws give --law twice or more"
         )
+    given = (s.get("settings") or {}).get("scenario")
+    if isinstance(given, list):  # several records: the first one's
+        given = given[0] if given else None
     sc = s.get("scenario") or {}
-    return unique_laws(laws), sc.get("name") if isinstance(sc, dict) else None
+    name = sc.get("name") if isinstance(sc, dict) else None
+    return unique_laws(laws), given if isinstance(given, str) and given else name
