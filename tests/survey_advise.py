@@ -133,11 +133,20 @@ def run_case(i):
     return row
 
 
+def resolved(fit, law_text):
+    """Settled, and every model still listed as equivalent holds the true law's terms (the
+    truth plus a negligible term cannot be told from it within the noise anywhere)."""
+    truth = set(ForceLaw.parse(law_text).names)
+    return bool(fit["settled"]) and all(truth <= set(e) for e in fit.get("equivalent") or [])
+
+
 def summary(rows):
     counted = [r for r in rows if r.get("counted")]
     adv = sum(r["with_advised"]["settled"] for r in counted)
     rnd = sum(r["with_random"]["settled"] for r in counted)
     first = sum(bool(r.get("first_settled")) for r in counted)
+    adv_res = sum(resolved(r["with_advised"], r["law"]) for r in counted)
+    rnd_res = sum(resolved(r["with_random"], r["law"]) for r in counted)
     for r in rows:
         if not r.get("counted"):
             print(f"{r['i']:3d} {r['machine']:9s} {r['law']:34s} not counted: {r.get('why')}")
@@ -154,6 +163,10 @@ def summary(rows):
         f"counted cases {len(counted)} of {len(rows)}: the first record alone selects the true "
         f"law in {first}; with a second record at the advised point {adv}, at a random point "
         f"{rnd}"
+    )
+    print(
+        f"  and no rival law left equivalent (only supersets of the truth): advised {adv_res}, "
+        f"random {rnd_res}"
     )
     return adv, rnd, len(counted)
 
