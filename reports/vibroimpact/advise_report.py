@@ -90,7 +90,7 @@ def _conclusions(s, n_laws):
     for q in s.get("inseparable") or []:
         out.append(
             f"No point of the bounds separates candidates {q[0] + 1} and {q[1] + 1}: within "
-            "the noise they are the same law there; they are left out of the ranking."
+            "the noise they are the same law there."
         )
     unsafe = sum(bool(p.get("unsafe")) for p in s.get("points") or [])
     if unsafe:

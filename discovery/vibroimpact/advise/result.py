@@ -74,10 +74,10 @@ class AdviseResult:
 
     @property
     def separates(self):
-        """Whether the advised point separates every pair that some point separates (by
-        criteria or regime)."""
-        b, ignore = self.best, frozenset(self.inseparable)
-        return b is not None and all(p.separated for p in b.pairs if p.pair not in ignore)
+        """Whether the advised point separates every pair (by criteria or regime); false
+        when a pair is :attr:`inseparable`."""
+        b = self.best
+        return b is not None and all(p.separated for p in b.pairs)
 
     def map(self):
         """The coarse/refined points on the amplitude x frequency plane.
@@ -197,10 +197,11 @@ class AdviseResult:
             return out
         out.append(f"advised: {_where(b)}")
         out += point_lines(b, self)
+        left_out = len(self.inseparable) < len(b.pairs)
         for q in self.inseparable:
             out.append(
                 f"  pair {self.pair_label(q)}: no point of the bounds separates them (the same "
-                "law within the noise there); left out of the ranking"
+                "law within the noise there)" + ("; left out of the ranking" if left_out else "")
             )
         if not self.separates:
             out.append(
