@@ -128,7 +128,10 @@ def register(sub):
         action="append",
         help="a candidate law (repeat: two or more), instead of --fit",
     )
-    s.add_argument("--scenario", help=SCENARIO_HELP + " (default: the fit's scenario, else paper)")
+    s.add_argument(
+        "--scenario",
+        help=SCENARIO_HELP.replace("(default: paper)", "(default: the fit's; with --law, paper)"),
+    )
     s.add_argument("--data", help="the record whose noise level the next one will have")
     add_record_options(s).needs = "--data"
     s.add_argument(
