@@ -3,7 +3,8 @@
 For each case (a machine, a true law, a noise seed) a first record is made by the
 independent scipy path (:func:`tests.realistic.reference_record`: 1 % force noise, 0.2 % of
 each motion channel's range, 20 kHz, 15 periods after the transient from rest) and fitted
-(``discover``, the polynomial library ``poly:2``).  A case counts only when that fit lists
+(``discover``, the polynomial library ``poly:2``; ``--force-noise`` sets another force noise
+for both records).  A case counts only when that fit lists
 one or more ``equivalent`` models (two or more candidate laws).  Then:
 
 1. ``advise`` over the candidates (the selected law and its equivalents), with the drive
@@ -64,8 +65,13 @@ def case_of(i):
     return machine(name).with_law(law), law, 1000 + i
 
 
+FORCE_NOISE = [0.01]  # set by --force-noise
+
+
 def record(scenario, law, seed):
-    return R.reference_record((scenario, law), force_noise=0.01, motion_noise=0.002, seed=seed)
+    return R.reference_record(
+        (scenario, law), force_noise=FORCE_NOISE[0], motion_noise=0.002, seed=seed
+    )
 
 
 def fit(scenarios, records):
@@ -96,7 +102,13 @@ def second_fit(sc0, rec0, law, point, seed):
 def run_case(i):
     t0 = time.time()
     sc, law, seed = case_of(i)
-    row = {"i": i, "machine": sc.name, "law": law.to_text(), "seed": seed}
+    row = {
+        "i": i,
+        "machine": sc.name,
+        "law": law.to_text(),
+        "seed": seed,
+        "force_noise": FORCE_NOISE[0],
+    }
     rec0 = record(sc, law, seed)
     res0 = fit(sc, rec0)
     laws = [res0.selected.law] + [ForceLaw.from_dict(e["coefficients"]) for e in res0.equivalent]
@@ -176,7 +188,11 @@ def main(argv=None):
     ap.add_argument("--cases", nargs=2, type=int, metavar=("FIRST", "STOP"))
     ap.add_argument("--out", help="JSON-lines file the rows are appended to")
     ap.add_argument("--summary", help="count the outcomes of a JSON-lines file")
+    ap.add_argument(
+        "--force-noise", type=float, default=0.01, help="force noise of both records (0.01)"
+    )
     args = ap.parse_args(argv)
+    FORCE_NOISE[0] = args.force_noise
     if args.summary:
         with open(args.summary) as f:
             summary([json.loads(line) for line in f])
