@@ -189,3 +189,13 @@ def test_a_record_at_the_advised_point_settles_the_law():
     a = row["advised"]["point"]
     assert 0.7 * 5e5 <= a[0] <= 1.3 * 5e5 and 0.8 * 25 <= a[1] <= 1.2 * 25
     assert row["with_advised"]["settled"], row["with_advised"]
+
+
+def test_the_moulding_mass_is_a_third_knob_and_the_map_keeps_the_best_over_it():
+    knobs = Knobs((5e5, 5e5), (25.0, 25.0), m2=(8e3, 1.2e4), grid=(1, 1), m2_points=2, refine=0)
+    r = advise(load_scenario("paper"), [BASE, "2.06e8*z + 1.6e7*zd"], knobs, NoiseModel(0.01))
+    assert sorted(p.m2 for p in r.points) == [8e3, 1.2e4]
+    m = r.map()
+    assert m["amplitude"].shape == (1,)
+    assert m["smallest"][0] == pytest.approx(max(p.smallest for p in r.points if p.usable))
+    assert AdviseResult.from_dict(r.to_dict()) == r
