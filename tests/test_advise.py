@@ -16,9 +16,10 @@ from discovery.vibroimpact.advise.separation import inseparable
 BASE = "2.06e8*z + 1.28e7*zd"
 
 
-def _one_point(laws, noise=0.01, safe=None, amplitude=5e5, frequency=25.0):
+def _one_point(laws, noise=0.01, safe=None, amplitude=5e5, frequency=25.0, position=None):
     knobs = Knobs((amplitude, amplitude), (frequency, frequency), grid=(1, 1), refine=0)
-    return advise(load_scenario("paper"), laws, knobs, NoiseModel(noise), safe, workers=1)
+    noise = NoiseModel(noise, position=position)
+    return advise(load_scenario("paper"), laws, knobs, noise, safe, workers=1)
 
 
 def test_separation_grows_with_the_difference_of_the_laws():
@@ -35,6 +36,17 @@ def test_separation_grows_with_the_difference_of_the_laws():
     assert far.separated and far.separation > 1.0
     assert set(far.criteria[0]) == {"I2", "I4"} and set(far.limits[0]) == {"I2", "I4"}
     assert all(pr.regime == "P1" for pr in p.predictions)
+
+
+def test_with_positions_the_pairs_are_judged_by_i5_too():
+    # the predicted records carry positions: the verdict's record-span comparison, I5 held
+    r = _one_point([BASE, "2.06e8*z + 1.792e7*zd"], position=0.01)
+    (q,) = r.points[0].pairs
+    assert set(q.criteria[0]) == {"I2", "I4", "I5"} and set(q.limits[1]) == {"I2", "I4", "I5"}
+    assert q.separated and q.separation > 1.0
+    same = _one_point([BASE, "2.06e8*z + 1.2808e7*zd"], position=0.01)
+    assert same.points[0].pairs[0].separation < 1.0  # 0.06 % apart: within the noise
+    assert AdviseResult.from_dict(r.to_dict()) == r and r.noise.position == 0.01
 
 
 def test_more_noise_means_less_separation():

@@ -58,6 +58,7 @@ def _noise(args, sc):
         n_boot=args.n_boot,
         seed=args.seed,
         source="given as a fraction of the peak force",
+        position=args.position_noise,
     )
 
 
@@ -117,10 +118,11 @@ def register(sub):
         "separates the laws a record cannot tell apart",
         description="Simulate every candidate law to its steady state over a grid of the "
         "drive amplitude and frequency (optionally the moulding mass), judge every pair by "
-        "the verdict's rule (criteria I2, I4 against their noise-floor limits at the "
-        "record's noise level), and rank the points by the smallest pair separation "
-        "(>= 1: a record there rejects the false law of every pair). Points where a "
-        "candidate exceeds --max-force or --max-penetration are excluded.",
+        "the verdict's rule (criteria I2, I4, and I5 where positions are recorded, against "
+        "their noise-floor limits at the record's noise level), and rank the points by the "
+        "smallest pair separation (>= 1: a record there rejects the false law of every "
+        "pair). Points where a candidate exceeds --max-force or --max-penetration are "
+        "excluded.",
     )
     s.add_argument("--fit", metavar="DIR", help="a vidi fit run: its law and equivalent models")
     s.add_argument(
@@ -138,6 +140,13 @@ def register(sub):
         "--noise",
         type=number(0, 1, lo_open=True),
         help="force noise as a fraction of the peak force, instead of --data (e.g. 0.01)",
+    )
+    s.add_argument(
+        "--position-noise",
+        type=number(0, 1, lo_open=True),
+        help="with --noise: the next record also holds positions w1, w2 with this noise (a "
+        "fraction of the largest penetration); the pairs are then judged by I2, I4 and I5 "
+        "(default: a force record, I2 and I4; with --data: as the record)",
     )
     s.add_argument(
         "--sample-rate",

@@ -183,9 +183,15 @@ class NoiseModel:
     n_boot : int
         Bootstrap replicates of each noise floor.
     seed : int
-        Seed of the bootstrap (the same at every point: the map is reproducible).
+        Seed of the bootstrap and of the predicted records' noise (the same at every point:
+        the map is reproducible).
     source : str
         Where the noise level came from.
+    position : float or None
+        With positions recorded: noise on ``w1`` and on ``w2`` as a fraction of the largest
+        penetration (as ``vidi simulate --position-noise``); the predicted records then
+        carry positions and are judged by the verdict's record-span comparison, I5
+        included.  ``None``: a force record (I2, I4).
     """
 
     relative: float
@@ -194,6 +200,7 @@ class NoiseModel:
     n_boot: int = 16
     seed: int = 0
     source: str = "given"
+    position: float | None = None
 
     def __post_init__(self):
         checks = (
@@ -212,6 +219,17 @@ class NoiseModel:
             object.__setattr__(self, name, v)
         if not 1 <= int(self.n_boot) <= 10_000:
             raise InputError(f"n_boot must be 1..10000, got {self.n_boot!r}")
+        if self.position is not None:
+            try:
+                v = float(self.position)
+            except (TypeError, ValueError):
+                v = float("nan")
+            if not (math.isfinite(v) and 0 < v < 1):
+                raise InputError(
+                    "noise position must be a fraction of the largest penetration in (0, 1), "
+                    f"e.g. 0.01, or None; got {self.position!r}"
+                )
+            object.__setattr__(self, "position", v)
 
     @classmethod
     def from_measurement(cls, measurement, scenario, *, n_boot=16, seed=0):
@@ -225,6 +243,12 @@ class NoiseModel:
         if not peak > 0:
             raise InputError(f"the record {measurement.source!r} has no force; give --noise")
         rel = estimate_noise(F) / peak
+        position = None
+        zeta = measurement.zeta
+        if zeta is not None and np.max(zeta) > 0:
+            # noise on w1 and w2 each: the penetration's noise is sqrt(2) times it
+            position = estimate_noise(zeta, order=3) / np.sqrt(2.0) / float(np.max(zeta))
+            position = min(max(position, 1e-6), 0.5)
         return cls(
             relative=min(max(rel, 1e-6), 0.5),
             dt=float(np.median(np.diff(t))),
@@ -232,6 +256,7 @@ class NoiseModel:
             n_boot=n_boot,
             seed=seed,
             source=f"record {measurement.source}",
+            position=position,
         )
 
     def to_dict(self):
@@ -242,11 +267,13 @@ class NoiseModel:
             "n_boot": int(self.n_boot),
             "seed": int(self.seed),
             "source": self.source,
+            "position": self.position,
         }
 
     @classmethod
     def from_dict(cls, d):
-        return cls(**{k: d[k] for k in ("relative", "dt", "periods", "n_boot", "seed", "source")})
+        keys = ("relative", "dt", "periods", "n_boot", "seed", "source", "position")
+        return cls(**{k: d[k] for k in keys})
 
 
 def unique_laws(laws):
