@@ -125,6 +125,14 @@ def advise_context(s, run_dir, figures):
             ["max peak force", _f((s.get("safe") or {}).get("max_force"))],
             ["max penetration", _f((s.get("safe") or {}).get("max_penetration"))],
             ["force noise", Tex(num(100 * noise.get("relative", 0.0)) + r"\,\% of the peak")],
+            [
+                "position noise",
+                "none (a force record: I2, I4)"
+                if noise.get("position") is None
+                else Tex(
+                    num(100 * noise["position"]) + r"\,\% of the largest penetration (I2, I4, I5)"
+                ),
+            ],
             ["noise from", noise.get("source", "--")],
         ],
         "pair_heads": pair_heads,
