@@ -16,12 +16,13 @@ ratio is still reported.
 Without positions (a force record) the predicted record is noise-free (its noise enters
 through the floor): a noisy record scores a wrong law higher on average (``E|d + n| >=
 |d|``), so a separation >= 1 is a conservative prediction of a rejection.  With positions
-(``NoiseModel.position``) the predicted record is a synthetic measurement of ``a`` on its
-orbit (:func:`~discovery.vibroimpact.dynamics.synthesize.synthesize`, force and position
-noise seeded by ``NoiseModel.seed``) prepared like any record
-(:meth:`~discovery.vibroimpact.verify.reference.Reference.from_measurement`: its span, the
-machine's states), and ``b`` is judged by the verdict's record-span comparison: I2, I4 and
-I5 (the penetration) against their limits, one noise realisation.
+(``NoiseModel.position``) the predicted records are synthetic measurements of ``a`` on its
+orbit (:func:`~discovery.vibroimpact.dynamics.synthesize.synthesize`) prepared like any
+record (:meth:`~discovery.vibroimpact.verify.reference.Reference.from_measurement`: its span,
+the machine's states), and ``b`` is judged by the verdict's record-span comparison: I2, I4
+and I5 (the penetration) of ``b`` against the noise-free one, over their limits from the
+noisy one (force and position noise seeded by ``NoiseModel.seed``; the limits come from the
+noise floor under ``b``).
 """
 
 from dataclasses import dataclass
@@ -276,21 +277,32 @@ def _orbit(scenario, law, tolerances):
     return _Orbit(pred, imp, ss)
 
 
+def _synthetic(orbit, scenario, law, noise, noisy):
+    """A synthetic record of ``law`` on its orbit, prepared like any record."""
+    meas = synthesize(
+        scenario,
+        law,
+        periods=max(2, int(round(noise.periods))),
+        fs=1.0 / noise.dt,
+        noise=noise.relative if noisy else 0.0,
+        seed=noise.seed,
+        ss=orbit.steady,
+        position_noise=noise.position if noisy else 0.0,
+    )
+    return Reference.from_measurement(meas, scenario, n_boot=noise.n_boot, seed=noise.seed)
+
+
 def _predicted_reference(orbit, scenario, law, noise):
-    """The record a candidate predicts: its exact cycle with the next record's noise, or
-    with positions a synthetic record on its orbit."""
+    """The records a candidate predicts, ``(noisy, clean)``: the first sets the verdict's
+    limits (its noise floor), the second the criteria.  Without positions both are its
+    exact cycle with the next record's noise model; with positions, synthetic records on
+    its orbit with and without the noise (a judged law's criteria against one noise
+    realisation would make the grid's best point the luckiest realisation)."""
     if noise.position is not None:
-        meas = synthesize(
-            scenario,
-            law,
-            periods=max(2, int(round(noise.periods))),
-            fs=1.0 / noise.dt,
-            noise=noise.relative,
-            seed=noise.seed,
-            ss=orbit.steady,
-            position_noise=noise.position,
+        return (
+            _synthetic(orbit, scenario, law, noise, True),
+            _synthetic(orbit, scenario, law, noise, False),
         )
-        return Reference.from_measurement(meas, scenario, n_boot=noise.n_boot, seed=noise.seed)
     imp = orbit.impulse
     sigma = noise.relative * imp.peak
     n_cycles = max(1, int(noise.periods // imp.n_periods) - 1)
@@ -306,19 +318,28 @@ def _predicted_reference(orbit, scenario, law, noise):
         onsets=imp.onsets,
     )
     nz = {"F": sigma, "zeta": None, "impact_velocity": None, "dt": noise.dt, "n_cycles": n_cycles}
-    return Reference(impulse=E, noise=nz, n_boot=noise.n_boot, seed=noise.seed, source="prediction")
+    ref = Reference(impulse=E, noise=nz, n_boot=noise.n_boot, seed=noise.seed, source="prediction")
+    return ref, ref
 
 
-def _direction(scenario, judged, reference, tolerances):
-    """``(ratio, criteria, limits)`` of ``judged`` against a predicted record, by the
-    verdict's evaluation (a judged law without a periodic orbit with contact there is
-    rejected: ``inf``)."""
-    ev = evaluate(scenario, judged, reference, tolerances=tolerances)
+def _direction(scenario, judged, references, tolerances):
+    """``(ratio, criteria, limits)`` of ``judged`` against a candidate's predicted records
+    ``(noisy, clean)``, by the verdict's evaluation: the limits from the noisy one (its
+    noise floor under ``judged``), the criteria from the clean one (a judged law without a
+    periodic orbit with contact there is rejected: ``inf``)."""
+    noisy, clean = references
+    ev = evaluate(scenario, judged, noisy, tolerances=tolerances)
     if ev.status != "ok":
         return float("inf"), {}, {}
     lim = ev.limits
-    ratio = max(ev.criteria[k] / lim[k] for k in lim)
-    return float(ratio), {k: ev.criteria[k] for k in lim}, dict(lim)
+    crit = ev.criteria
+    if clean is not noisy:
+        ev_c = evaluate(scenario, judged, clean, tolerances=tolerances, floor=False)
+        if ev_c.status != "ok":
+            return float("inf"), {}, {}
+        crit = ev_c.criteria
+    ratio = max(crit[k] / lim[k] for k in lim)
+    return float(ratio), {k: crit[k] for k in lim}, dict(lim)
 
 
 def evaluate_point(context, amplitude, frequency, m2=None, stage="coarse"):
