@@ -60,6 +60,11 @@ _EXPORTS = {
     "Result": "_result",
     "verify": "vibroimpact.verify.verify",
     "VerifyResult": "vibroimpact.verify.verify",
+    "advise": "vibroimpact.advise.advise",
+    "AdviseResult": "vibroimpact.advise.result",
+    "Knobs": "vibroimpact.advise.candidates",
+    "NoiseModel": "vibroimpact.advise.candidates",
+    "SafeRegion": "vibroimpact.advise.candidates",
 }
 
 
@@ -113,6 +118,11 @@ __all__ = [
     "make_executor",
     "verify",
     "VerifyResult",
+    "advise",
+    "AdviseResult",
+    "Knobs",
+    "NoiseModel",
+    "SafeRegion",
 ]
 
 lazy_package(__name__, _EXPORTS)

@@ -15,8 +15,10 @@ _EXPORTS = {
     "verify_figure": "vibroimpact.verify_figures",
     "loops_figure": "vibroimpact.verify_figures",
 }
+_EXPORTS["advise_figure"] = "vibroimpact.advise_figures"
 
 __all__ = [
+    "advise_figure",
     "landscape_figure",
     "identification_figure",
     "fit_impulse_figure",

@@ -16,6 +16,7 @@ from __future__ import annotations
 from .cells import (  # noqa: F401  (the shared cells, read by the tests from here)
     FIGURE_CAPTIONS,
     _criteria_table,
+    _figures,
     _provenance,
     _scenario_rows,
     criterion_definition,
@@ -36,8 +37,15 @@ from .vibroimpact.study_context import _study
 __all__ = ["context", "KINDS", "criterion_names"]
 
 
+def _advise(s, run_dir):
+    from .vibroimpact.advise_report import advise_context
+
+    return advise_context(s, run_dir, _figures)
+
+
 KINDS = {
     "verify": _verify,
+    "advise": _advise,
     "fit": _fit,
     "identify": _identify,
     "landscape": _landscape,
@@ -52,6 +60,7 @@ KINDS = {
 
 TEMPLATES = {
     "verify": "verify",
+    "advise": "advise",
     "fit": "fit",
     "identify": "identify",
     "landscape": "landscape",

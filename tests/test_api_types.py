@@ -90,6 +90,11 @@ CASES = [
         "force_noise",
     ),
     ("make_executor workers text", lambda: d.make_executor("2"), TYPE, "workers"),
+    ("advise scenario text", lambda: d.advise("paper", [LAW, LAW], None, None), TYPE, "scenario"),
+    ("advise knobs text", lambda: d.advise(SC, [LAW, LAW], "3e5:6e5", None), TYPE, "knobs"),
+    ("Knobs amplitude text", lambda: d.Knobs("abc", (20, 30)), VALUE, "amplitude"),
+    ("NoiseModel relative text", lambda: d.NoiseModel("a"), VALUE, "relative"),
+    ("SafeRegion max_force 0", lambda: d.SafeRegion(max_force=0), VALUE, "max_force"),
     ("landscape axis text", lambda: d.landscape(SC, LAW, "1,2", [1, 2]), TYPE, "axis0"),
     (
         "landscape workers 0",
@@ -208,6 +213,7 @@ def test_the_cases_cover_every_public_entry():
         "IdentificationResult",
         "ExplainResult",
         "VerifyResult",
+        "AdviseResult",
         "builtin_scenarios",
         "load_scenario",
         "impulse_from_steady_state",
@@ -247,6 +253,10 @@ def test_the_cases_cover_every_public_entry():
             "make_executor",
             "verify",
             "load",
+            "advise",
+            "Knobs",
+            "NoiseModel",
+            "SafeRegion",
         }
     )
     assert not unlisted, f"public entries without a row: {sorted(unlisted)}"

@@ -128,6 +128,12 @@ EXAMPLES = {
         "vidi landscape --data D.csv --range0 1e8:3e8 --out out/landscape2",
     ],
     "identify": ["vidi identify --data D.csv --start '1.5e8*z + 0.9e7*zd' --out out/identify"],
+    "advise": [
+        "vidi advise --fit out/fit --data D.csv --amplitude 3e5:6e5 --frequency 20:30 "
+        "--out out/advise",
+        "vidi advise --law '2.06e8*z + 1.28e7*zd' --law '2.06e8*z + 9e6*zd + 1e9*z*zd' "
+        "--noise 0.01 --amplitude 3e5:6e5 --frequency 20:30 --max-force 2e7 --out out/advise2",
+    ],
     "study": [
         "vidi study --config examples/study_paper.toml --out out/study",
         "vidi study --config examples/study_paper.toml --out out/study --scheduler local",
@@ -184,6 +190,7 @@ COMMANDS = (
     "steady",
     "landscape",
     "identify",
+    "advise",
     "study",
     "report",
     "ueda",
@@ -206,7 +213,19 @@ def _parser():
         dest="command", required=True, metavar="COMMAND", parser_class=VidiArgumentParser
     )
     # imported here, inside main()'s handlers: a Ctrl-C while they load is an interrupt too
-    from . import explain, fit, identify, landscape, report, simulate, steady, study, ueda, verify
+    from . import (
+        advise,
+        explain,
+        fit,
+        identify,
+        landscape,
+        report,
+        simulate,
+        steady,
+        study,
+        ueda,
+        verify,
+    )
 
     modules = {
         "simulate": simulate,
@@ -216,6 +235,7 @@ def _parser():
         "steady": steady,
         "landscape": landscape,
         "identify": identify,
+        "advise": advise,
         "study": study,
         "report": report,
         "ueda": ueda,
@@ -228,7 +248,15 @@ def _parser():
     return p
 
 
-LONG = ("fit", "identify", "landscape", "explain", "study", "ueda chart")  # they report progress
+LONG = (
+    "fit",
+    "identify",
+    "landscape",
+    "explain",
+    "advise",
+    "study",
+    "ueda chart",
+)  # they report progress
 
 
 def _add_quiet(parser, path=()):

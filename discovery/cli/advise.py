@@ -1,0 +1,202 @@
+"""``vidi advise``: where should the next record be taken to separate the candidate laws?"""
+
+from .._io import OutputDir, provenance
+from ..errors import InputError
+from ._common import (
+    SCENARIO_HELP,
+    SCHEDULER_HELP,
+    add_record_options,
+    check_out,
+    executor_of,
+    inputs_of,
+    integer,
+    number,
+    parse_range,
+    read_record,
+    reporter,
+)
+
+
+def _grid(text):
+    from ..vibroimpact.verify.landscape import parse_grid
+
+    return parse_grid(text)
+
+
+def _candidates(args):
+    """``(laws, scenario name from the fit or None)``."""
+    from ..vibroimpact.advise.candidates import candidates_from_fit, unique_laws
+    from ..vibroimpact.model.law import ForceLaw
+
+    if args.fit is not None and args.law:
+        raise InputError("give either --fit DIR or --law (twice or more), not both")
+    if args.fit is not None:
+        return candidates_from_fit(args.fit)
+    if not args.law:
+        raise InputError(
+            "no candidates: give --fit DIR (a vidi fit run with equivalent models) or "
+            "--law twice or more, e.g. --law '2e8*z + 1e7*zd' --law '2e8*z + 5e9*z*zd'"
+        )
+    return unique_laws([ForceLaw.parse(t) for t in args.law]), None
+
+
+def _noise(args, sc):
+    from ..vibroimpact.advise.candidates import NoiseModel
+
+    if (args.data is None) == (args.noise is None):
+        raise InputError(
+            "give the noise level either from a record (--data D.csv) or as --noise "
+            "(a fraction of the peak force, e.g. 0.01), not both and not neither"
+        )
+    if args.data is not None:
+        meas = read_record(args, sc)
+        return NoiseModel.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
+    return NoiseModel(
+        relative=args.noise,
+        dt=1.0 / args.sample_rate,
+        periods=args.periods,
+        n_boot=args.n_boot,
+        seed=args.seed,
+        source="given as a fraction of the peak force",
+        position=args.position_noise,
+    )
+
+
+def _knobs(args):
+    from ..vibroimpact.advise.candidates import Knobs
+
+    amp = parse_range(args.amplitude, None, "--amplitude")
+    freq = parse_range(args.frequency, None, "--frequency")
+    m2 = parse_range(args.m2, None, "--m2")
+    for name, (lo, _) in (("--amplitude", amp), ("--frequency", freq), ("--m2", m2 or (1, 1))):
+        if lo <= 0:
+            raise InputError(f"{name} needs positive bounds LOW:HIGH, got a low of {lo:g}")
+    return Knobs(amp, freq, m2, grid=_grid(args.grid), refine=args.refine)
+
+
+def run(args):
+    from reports import advise_figure
+
+    from ..vibroimpact.advise import SafeRegion, advise
+    from ..vibroimpact.advise.result import point_lines
+    from ..vibroimpact.model.scenario import load_scenario
+
+    check_out(args)
+    knobs = _knobs(args)
+    safe = SafeRegion(args.max_force, args.max_penetration)
+    laws, fit_scenario = _candidates(args)
+    try:
+        sc = load_scenario(args.scenario or fit_scenario or "paper")
+    except InputError as exc:
+        if args.scenario:
+            raise
+        raise InputError(
+            f"the fit's scenario {fit_scenario!r} cannot be loaded here ({exc}); give "
+            "--scenario (a built-in name or the fit's TOML file)"
+        ) from None
+    noise = _noise(args, sc)
+    with reporter(args) as rep, executor_of(args) as ex:
+        res = advise(sc, laws, knobs, noise, safe, workers=args.workers, progress=rep, executor=ex)
+    prov = provenance(vars(args), inputs=inputs_of(args))
+    prov["settings"] = {**res.settings, **prov["settings"]}
+    with OutputDir(args.out) as out:
+        out.write_json("summary.json", {**res.to_dict(), **prov})
+        out.path("advise.csv").write_text(res.csv())
+        advise_figure(res, str(out.path("advise_map")))
+    print(res)
+    for k, p in enumerate(res.ranked()[1:4], start=2):
+        print(f"rank {k}: A = {p.amplitude:.4g} N, f = {p.frequency:.4g} Hz")
+        print("\n".join(point_lines(p, res)[: len(p.pairs)]))
+    print(f"outputs in {args.out}/: summary.json, advise.csv, advise_map.png/.pdf")
+    return 0
+
+
+def register(sub):
+    s = sub.add_parser(
+        "advise",
+        help="the operating point (drive amplitude, frequency) where a next record "
+        "separates the laws a record cannot tell apart",
+        description="Simulate every candidate law to its steady state over a grid of the "
+        "drive amplitude and frequency (optionally the moulding mass), judge every pair by "
+        "the verdict's rule (criteria I2, I4, and I5 where positions are recorded, against "
+        "their noise-floor limits at the record's noise level), and rank the points by the "
+        "smallest pair separation (>= 1: a record there rejects the false law of every "
+        "pair). Points where a candidate exceeds --max-force or --max-penetration are "
+        "excluded.",
+    )
+    s.add_argument("--fit", metavar="DIR", help="a vidi fit run: its law and equivalent models")
+    s.add_argument(
+        "--law",
+        action="append",
+        help="a candidate law (repeat: two or more), instead of --fit",
+    )
+    s.add_argument(
+        "--scenario",
+        help=SCENARIO_HELP.replace("(default: paper)", "(default: the fit's; with --law, paper)"),
+    )
+    s.add_argument("--data", help="the record whose noise level the next one will have")
+    add_record_options(s).needs = "--data"
+    s.add_argument(
+        "--noise",
+        type=number(0, 1, lo_open=True),
+        help="force noise as a fraction of the peak force, instead of --data (e.g. 0.01)",
+    )
+    s.add_argument(
+        "--position-noise",
+        type=number(0, 1, lo_open=True),
+        help="with --noise: the next record also holds positions w1, w2 with this noise (a "
+        "fraction of the largest penetration); the pairs are then judged by I2, I4 and I5 "
+        "(default: a force record, I2 and I4; with --data: as the record)",
+    )
+    s.add_argument(
+        "--sample-rate",
+        type=number(1, 1e9, unit="Hz"),
+        default=20000.0,
+        help="with --noise: the next record's sampling rate [Hz] (default: %(default)g)",
+    )
+    s.add_argument(
+        "--periods",
+        type=number(1, 1e5),
+        default=12.0,
+        help="with --noise: drive periods the next record holds (default: %(default)g)",
+    )
+    s.add_argument(
+        "--amplitude", required=True, help="drive amplitude bounds LOW:HIGH [N], e.g. 3e5:6e5"
+    )
+    s.add_argument(
+        "--frequency", required=True, help="drive frequency bounds LOW:HIGH [Hz], e.g. 20:30"
+    )
+    s.add_argument("--m2", help="moulding mass bounds LOW:HIGH [kg] (default: the scenario's)")
+    s.add_argument(
+        "--max-force", type=number(0, lo_open=True, unit="N"), help="largest safe peak force [N]"
+    )
+    s.add_argument(
+        "--max-penetration",
+        type=number(0, lo_open=True, unit="m"),
+        help="largest safe penetration w1 - w2 [m]",
+    )
+    s.add_argument(
+        "--grid", default="5x5", help="coarse points over amplitude x frequency (default: 5x5)"
+    )
+    s.add_argument(
+        "--refine",
+        type=integer(0, 100),
+        default=3,
+        help="best coarse points refined by a 3x3 grid at half the spacing (default: 3)",
+    )
+    s.add_argument(
+        "--n-boot",
+        type=integer(1, 10_000),
+        default=16,
+        help="bootstrap replicates of each noise floor (default: %(default)s)",
+    )
+    s.add_argument(
+        "--seed",
+        type=integer(0, 2**32 - 1),
+        default=0,
+        help="seed of the noise floors' bootstrap (default: %(default)s)",
+    )
+    s.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
+    s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
+    s.add_argument("--out", required=True, help="output directory")
+    s.set_defaults(func=run)

@@ -1,0 +1,36 @@
+"""Advice on the next experiment: the operating point (drive amplitude, frequency, moulding
+mass) where the records the candidate laws predict differ most, by the verdict's own rule.
+
+candidates (:mod:`.candidates`) -> every grid point (:mod:`.separation`) -> coarse grid and
+refinement (:mod:`.advise`) -> :class:`AdviseResult` (:mod:`.result`).
+"""
+
+from ..._lazy import lazy_package
+
+_EXPORTS = {
+    "advise": "advise",
+    "AdviseResult": "result",
+    "Knobs": "candidates",
+    "NoiseModel": "candidates",
+    "SafeRegion": "candidates",
+    "candidates_from_fit": "candidates",
+    "Point": "separation",
+    "PairSeparation": "separation",
+    "Prediction": "separation",
+    "evaluate_point": "separation",
+}
+
+__all__ = [
+    "advise",
+    "AdviseResult",
+    "Knobs",
+    "NoiseModel",
+    "SafeRegion",
+    "candidates_from_fit",
+    "Point",
+    "PairSeparation",
+    "Prediction",
+    "evaluate_point",
+]
+
+lazy_package(__name__, _EXPORTS)

@@ -1,0 +1,147 @@
+"""``advise``: the operating point where a next record separates the candidate laws.
+
+candidates (a fit's equivalent models, or laws) + knobs' bounds + safe region + noise ->
+coarse grid over amplitude x frequency (x m2) -> every point evaluated
+(:mod:`~discovery.vibroimpact.advise.separation`: each candidate to its steady state, every
+pair judged by the verdict's rule) -> the best points refined -> :class:`AdviseResult`.
+"""
+
+import os
+import time
+from dataclasses import dataclass
+
+from ..._progress import tick
+from ..._validate import Instance, Real, params
+from ...numerics.executor import make_executor
+from ..dynamics import Tolerances
+from ..model.scenario import Scenario
+from .candidates import Knobs, NoiseModel, SafeRegion, unique_laws
+from .result import AdviseResult
+from .separation import inseparable, point_job, rank_key
+
+__all__ = ["advise"]
+
+
+@dataclass(frozen=True)
+class _Context:
+    """What every point's evaluation reads (shared by the executor's workers)."""
+
+    scenario: Scenario
+    laws: tuple
+    noise: NoiseModel
+    safe: SafeRegion
+    tolerances: object = None
+
+
+def _refined(knobs, coarse, done):
+    """Jobs of a 3 x 3 grid at half the coarse spacing around the best usable points."""
+    a, f, _ = knobs.axes()
+    da = (a[1] - a[0]) / 2 if a.size > 1 else 0.0
+    df = (f[1] - f[0]) / 2 if f.size > 1 else 0.0
+    ignore = inseparable(coarse)
+    best = sorted((p for p in coarse if p.usable), key=lambda p: rank_key(p, ignore))
+    jobs, seen = [], set(done)
+    for p in best[: knobs.refine]:
+        for sa in (-1, 0, 1):
+            for sf in (-1, 0, 1):
+                q = (float(p.amplitude + sa * da), float(p.frequency + sf * df), p.m2)
+                if q in seen or not knobs.contains(*q):
+                    continue
+                seen.add(q)
+                jobs.append((*q, "refine"))
+    return jobs
+
+
+def _run(ex, context, jobs, progress, stage):
+    out = [None] * len(jobs)
+    for done, (i, point) in enumerate(ex.run(point_job, jobs, context), start=1):
+        out[i] = point
+        tick(progress, stage, done, len(jobs))
+    return out
+
+
+@params(
+    scenario=Scenario,
+    laws=(list, tuple),
+    knobs=Knobs,
+    noise=NoiseModel,
+    safe=(SafeRegion, None),
+    workers=(None, Real(1, integer=True)),
+    tolerances=(Tolerances, None),
+    executor=(None, Instance("discovery.numerics.executor", "Executor")),
+)
+def advise(
+    scenario,
+    laws,
+    knobs,
+    noise,
+    safe=None,
+    *,
+    workers=None,
+    tolerances=None,
+    progress=None,
+    executor=None,
+):
+    """Find the operating point where the candidates' predicted records differ most.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The machine; its drive amplitude, frequency (and moulding mass) are varied.
+    laws : list of ForceLaw or str
+        Two or more candidate laws (e.g. a fit's selected law and its equivalent models,
+        :func:`~discovery.vibroimpact.advise.candidates.candidates_from_fit`).
+    knobs : Knobs
+        Bounds of amplitude, frequency (and m2), grid and refinement.
+    noise : NoiseModel
+        The next record's noise (relative to its peak force), sampling and length.
+    safe : SafeRegion, optional
+        Peak force and penetration the machine may not exceed (default: no bound).
+    workers : int, optional
+        Processes (default: all cores); the result does not depend on it.
+    tolerances : Tolerances, optional
+    progress : callable, optional
+        ``progress(stage, done, total)`` after each point.
+    executor : Executor, optional
+        Where the points run (:mod:`discovery.numerics.executor`); not closed here.
+
+    Returns
+    -------
+    AdviseResult
+        ``best`` is the advised point; ``ranked()`` every usable point, best first.
+    """
+    t0 = time.perf_counter()
+    laws = unique_laws(laws)
+    for k, law in enumerate(laws):
+        law.check_physical(scenario, f"candidate {k + 1}")
+    safe = SafeRegion() if safe is None else safe
+    context = _Context(scenario, laws, noise, safe, tolerances)
+    a, f, m = knobs.axes()
+    jobs = [
+        (float(x), float(y), None if z is None else float(z), "coarse")
+        for x in a
+        for y in f
+        for z in m
+    ]
+    own = executor is None
+    ex = executor
+    if own:
+        ex = make_executor(min(int(workers or os.cpu_count() or 1), len(jobs)))
+    try:
+        coarse = _run(ex, context, jobs, progress, "advise: coarse grid")
+        more = _refined(knobs, coarse, [j[:3] for j in jobs])
+        fine = _run(ex, context, more, progress, "advise: refining the best points") if more else []
+        n_workers = getattr(ex, "workers", 1)
+    finally:
+        if own:
+            ex.close()
+    return AdviseResult(
+        laws=tuple(law.to_text() for law in laws),
+        scenario=scenario.as_dict(),
+        knobs=knobs,
+        safe=safe,
+        noise=noise,
+        points=tuple(coarse + fine),
+        seconds=time.perf_counter() - t0,
+        settings={"workers": int(n_workers), "evaluated": len(jobs) + len(more)},
+    )

@@ -1,0 +1,213 @@
+"""advise: the separation of two laws' predicted records by the verdict's rule, the safe
+region, the knobs' bounds, the result's round trip, the CLI and its report; and (slow) the
+loop closed: a record at the advised point settles the law."""
+
+import json
+
+import numpy as np
+import pytest
+
+from discovery import AdviseResult, ForceLaw, Knobs, NoiseModel, SafeRegion, advise, load_scenario
+from discovery.cli import main
+from discovery.errors import InputError
+from discovery.vibroimpact.advise import candidates_from_fit
+from discovery.vibroimpact.advise.separation import inseparable
+
+BASE = "2.06e8*z + 1.28e7*zd"
+
+
+def _one_point(laws, noise=0.01, safe=None, amplitude=5e5, frequency=25.0, position=None):
+    knobs = Knobs((amplitude, amplitude), (frequency, frequency), grid=(1, 1), refine=0)
+    noise = NoiseModel(noise, position=position)
+    return advise(load_scenario("paper"), laws, knobs, noise, safe, workers=1)
+
+
+def test_separation_grows_with_the_difference_of_the_laws():
+    # the damper 10 % and 40 % off: the farther law's predicted record is farther away in
+    # units of the verdict's limit, in both directions (tolerance: strict order)
+    r = _one_point([BASE, "2.06e8*z + 1.408e7*zd", "2.06e8*z + 1.792e7*zd"])
+    (p,) = r.points
+    assert p.usable and len(p.pairs) == 3
+    sep = {q.pair: q for q in p.pairs}
+    near, far = sep[(0, 1)], sep[(0, 2)]
+    assert far.separation > near.separation
+    assert far.directions[0] > near.directions[0] and far.directions[1] > near.directions[1]
+    # 40 % off is rejected by the verdict's rule (I2 over its limit) at 1 % noise
+    assert far.separated and far.separation > 1.0
+    assert set(far.criteria[0]) == {"I2", "I4"} and set(far.limits[0]) == {"I2", "I4"}
+    assert all(pr.regime == "P1" for pr in p.predictions)
+
+
+def test_with_positions_the_pairs_are_judged_by_i5_too():
+    # the predicted records carry positions: the verdict's record-span comparison, I5 held
+    r = _one_point([BASE, "2.06e8*z + 1.792e7*zd"], position=0.01)
+    (q,) = r.points[0].pairs
+    assert set(q.criteria[0]) == {"I2", "I4", "I5"} and set(q.limits[1]) == {"I2", "I4", "I5"}
+    assert q.separated and q.separation > 1.0
+    same = _one_point([BASE, "2.06e8*z + 1.2808e7*zd"], position=0.01)
+    assert same.points[0].pairs[0].separation < 1.0  # 0.06 % apart: within the noise
+    assert AdviseResult.from_dict(r.to_dict()) == r and r.noise.position == 0.01
+
+
+def test_more_noise_means_less_separation():
+    laws = [BASE, "2.06e8*z + 1.6e7*zd"]
+    quiet = _one_point(laws, noise=0.005).points[0].pairs[0].separation
+    loud = _one_point(laws, noise=0.05).points[0].pairs[0].separation
+    assert loud < quiet
+
+
+def test_a_law_and_itself_with_a_tiny_term_are_inseparable():
+    r = _one_point([BASE, "2.06e8*z + 1.28e7*zd + 1e3*z*zd"])
+    assert r.points[0].pairs[0].separation < 0.2
+    assert inseparable(r.points) == {(0, 1)} and r.inseparable == [(0, 1)]
+    assert "no point of the bounds separates them" in str(r) and not r.separates
+
+
+def test_the_safe_region_excludes_points():
+    laws = [BASE, "2.06e8*z + 1.6e7*zd"]
+    free = _one_point(laws)
+    peak = max(pr.peak_force for pr in free.points[0].predictions)
+    tight = _one_point(laws, safe=SafeRegion(max_force=0.5 * peak))
+    (p,) = tight.points
+    assert p.unsafe and not p.usable and "peak force" in p.excluded
+    assert tight.best is None and "no usable point" in str(tight)
+    loose = _one_point(laws, safe=SafeRegion(max_force=2 * peak, max_penetration=1.0))
+    assert loose.best is not None and not loose.points[0].unsafe
+    pen = _one_point(laws, safe=SafeRegion(max_penetration=1e-6))
+    assert pen.points[0].unsafe and "penetration" in pen.points[0].excluded
+
+
+def test_grid_refines_and_stays_in_bounds_and_round_trips(tmp_path):
+    knobs = Knobs((4e5, 6e5), (22.0, 28.0), grid=(2, 2), refine=1)
+    r = advise(load_scenario("paper"), [BASE, "2.06e8*z + 1.6e7*zd"], knobs, NoiseModel(0.01))
+    assert len([p for p in r.points if p.stage == "coarse"]) == 4
+    assert any(p.stage == "refine" for p in r.points)
+    assert all(knobs.contains(p.amplitude, p.frequency) for p in r.points)
+    assert r.best is r.ranked()[0]
+    d = r.to_dict()
+    assert d["schema_version"] == 1
+    back = AdviseResult.from_dict(json.loads(json.dumps(d)))
+    assert back == r
+    r.save(tmp_path)
+    assert AdviseResult.from_dict(json.loads((tmp_path / "summary.json").read_text())) == r
+    m = r.map()
+    assert m["smallest"].shape == m["amplitude"].shape and np.isfinite(m["smallest"]).all()
+
+
+@pytest.mark.parametrize(
+    "make, words",
+    [
+        (lambda: Knobs((6e5, 3e5), (20, 30)), "LOW <= HIGH"),
+        (lambda: Knobs((3e5, 6e5), (-1, 30)), "frequency bounds"),
+        (lambda: Knobs((3e5, 6e5), (20, 30), grid=(0, 3)), "grid"),
+        (lambda: SafeRegion(max_force=-1), "max_force"),
+        (lambda: NoiseModel(1.5), "noise relative"),
+        (lambda: _one_point([BASE, BASE]), "two or more candidate laws"),
+    ],
+)
+def test_bad_settings_are_one_input_error(make, words):
+    with pytest.raises(InputError, match=words):
+        make()
+
+
+def _cli(tmp_path, *extra):
+    return [
+        "advise",
+        "--law",
+        BASE,
+        "--law",
+        "2.06e8*z + 1.6e7*zd",
+        "--noise",
+        "0.01",
+        "--grid",
+        "2x2",
+        "--refine",
+        "0",
+        "--workers",
+        "1",
+        "--quiet",
+        *extra,
+    ]
+
+
+@pytest.mark.parametrize(
+    "bounds, words",
+    [
+        (["--amplitude", "6e5:3e5", "--frequency", "20:30"], "--amplitude"),
+        (["--amplitude", "3e5:6e5", "--frequency", "twenty:30"], "--frequency"),
+        (["--amplitude", "-3e5:6e5", "--frequency", "20:30"], "positive bounds"),
+    ],
+)
+def test_cli_bad_bounds_are_one_line_exit_2(tmp_path, capsys, bounds, words):
+    code = main(_cli(tmp_path, *bounds, "--out", str(tmp_path / "o")))
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and words in err
+    assert "Traceback" not in err
+
+
+def test_cli_needs_candidates_and_one_noise(tmp_path, capsys):
+    out = str(tmp_path / "o")
+    common = ["--amplitude", "3e5:6e5", "--frequency", "20:30", "--out", out]
+    assert main(["advise", "--noise", "0.01", *common]) == 2
+    assert "no candidates" in capsys.readouterr().err
+    assert main(["advise", "--law", BASE, "--law", "2e8*z + 1e7*zd", *common]) == 2
+    assert "noise level" in capsys.readouterr().err
+
+
+def test_cli_writes_map_summary_and_report(tmp_path, capsys):
+    out = tmp_path / "adv"
+    args = _cli(tmp_path, "--amplitude", "4e5:6e5", "--frequency", "22:28", "--out", str(out))
+    assert main(args) == 0
+    printed = capsys.readouterr().out
+    assert "advised: A = " in printed and "pair 1-2: separation" in printed
+    for name in ("summary.json", "advise.csv", "advise_map.png", "advise_map.pdf"):
+        assert (out / name).is_file()
+    s = json.loads((out / "summary.json").read_text())
+    assert s["command"] == "advise" and s["schema_version"] == 1 and "versions" in s
+    assert AdviseResult.from_dict(s).best.amplitude == s["advised"]["amplitude"]
+    assert main(["report", str(out), "--no-pdf"]) == 0
+    tex = (out / "report.tex").read_text()
+    assert "Ranked points" in tex and "advise_map.pdf" in tex and "Take the next record" in tex
+
+
+def test_candidates_from_a_fit_directory(tmp_path):
+    law, other = ForceLaw.parse(BASE), ForceLaw.parse("2e8*z + 5e9*z*zd")
+    s = {
+        "command": "fit",
+        "scenario": {"name": "paper"},
+        "selected": {"coefficients": law.as_dict()},
+        "equivalent": [{"coefficients": other.as_dict()}],
+    }
+    (tmp_path / "summary.json").write_text(json.dumps(s))
+    laws, name = candidates_from_fit(tmp_path)
+    assert [x.to_text() for x in laws] == [law.to_text(), other.to_text()] and name == "paper"
+    s["equivalent"] = []
+    (tmp_path / "summary.json").write_text(json.dumps(s))
+    with pytest.raises(InputError, match="lists no equivalent model"):
+        candidates_from_fit(tmp_path)
+    with pytest.raises(InputError, match="does not exist"):
+        candidates_from_fit(tmp_path / "nowhere")
+
+
+@pytest.mark.slow
+def test_a_record_at_the_advised_point_settles_the_law():
+    """The loop on one case of ``tests/survey_advise.py``: scipy records, a first fit with
+    equivalent models, advise, a second record there, the joint fit selects the truth."""
+    from tests import survey_advise as S
+
+    row = S.run_case(0)
+    assert row["counted"], row.get("why")
+    assert len(row["candidates"]) >= 2
+    a = row["advised"]["point"]
+    assert 0.7 * 5e5 <= a[0] <= 1.3 * 5e5 and 0.8 * 25 <= a[1] <= 1.2 * 25
+    assert row["with_advised"]["settled"], row["with_advised"]
+
+
+def test_the_moulding_mass_is_a_third_knob_and_the_map_keeps_the_best_over_it():
+    knobs = Knobs((5e5, 5e5), (25.0, 25.0), m2=(8e3, 1.2e4), grid=(1, 1), m2_points=2, refine=0)
+    r = advise(load_scenario("paper"), [BASE, "2.06e8*z + 1.6e7*zd"], knobs, NoiseModel(0.01))
+    assert sorted(p.m2 for p in r.points) == [8e3, 1.2e4]
+    m = r.map()
+    assert m["amplitude"].shape == (1,)
+    assert m["smallest"][0] == pytest.approx(max(p.smallest for p in r.points if p.usable))
+    assert AdviseResult.from_dict(r.to_dict()) == r
