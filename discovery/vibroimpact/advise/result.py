@@ -37,6 +37,8 @@ class AdviseResult:
         Versions-free settings (workers, ...); provenance is added by the CLI.
     """
 
+    KIND = "advise"  # its kind among the results discovery.load reads
+
     laws: tuple
     scenario: dict
     knobs: Knobs
