@@ -38,7 +38,7 @@ from discovery.vibroimpact.model.contact_models import (  # noqa: E402
 )
 from discovery.vibroimpact.verify import Reference  # noqa: E402
 
-PARAMS_CHECKED = ("k", "n", "e")
+PARAMS_CHECKED = ("k", "n", "e", "lambda", "c")
 
 
 def named_law(case, name, rng):
@@ -102,19 +102,25 @@ def one_record(truth_name, seed, max_sim):
         "fits": [f.to_dict() for f in res.fits],
     }
     if truth is not None:
-        fit = res.fit(truth_name)
-        cover = {}
-        for key in PARAMS_CHECKED:
-            if key in fit.intervals and key in truth.params and key in MODELS[truth_name]:
-                lo, hi = fit.intervals[key]
-                cover[key] = bool(lo <= truth.params[key] <= hi)
-        row["covered"] = cover
-        row["true_consistent"] = fit.consistent
+        row["covered"] = _covered(row)
+        row["true_consistent"] = res.fit(truth_name).consistent
     return row
 
 
+def _covered(row):
+    """``{parameter: inside its 95 % interval}`` of the true model's fit in a row."""
+    fit = next(f for f in row["fits"] if f["model"] == row["truth"])
+    out = {}
+    for key in MODELS[row["truth"]]:
+        lo, hi = fit["intervals"].get(key, (float("nan"),) * 2)
+        out[key] = bool(lo <= row["true_params"][key] <= hi)
+    return out
+
+
 def summary(rows):
-    lines = ["truth                 records  right name  right or equivalent  in 95 % (k, n, e)"]
+    lines = [
+        "truth                 records  right name  right or equivalent  in their 95 % intervals"
+    ]
     for name in [*MODELS, "polynomial"]:
         rs = [r for r in rows if r["truth"] == name and not r.get("skipped")]
         if not rs:
@@ -128,7 +134,7 @@ def summary(rows):
             continue
         right = sum(r["selected"] == name for r in rs)
         either = sum(r["selected"] == name or name in r["equivalent"] for r in rs)
-        cov = {k: [r["covered"][k] for r in rs if k in r["covered"]] for k in PARAMS_CHECKED}
+        cov = {k: [c[k] for c in map(_covered, rs) if k in c] for k in PARAMS_CHECKED}
         cov_text = ", ".join(f"{k} {sum(v)}/{len(v)}" for k, v in cov.items() if v)
         lines.append(
             f"{name:<21s} {len(rs):7d}  {right:4d}/{len(rs):<5d} "
@@ -144,7 +150,14 @@ def main(argv=None):
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--max-simulations", type=int, default=60)
     ap.add_argument("--out", default="out/survey_contact_models.jsonl")
+    ap.add_argument(
+        "--summarize", action="store_true", help="only print the table of the rows in --out"
+    )
     a = ap.parse_args(argv)
+    if a.summarize:
+        rows = [json.loads(line) for line in Path(a.out).read_text().splitlines() if line]
+        print(summary(rows))
+        return
     out = Path(a.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     rows = []

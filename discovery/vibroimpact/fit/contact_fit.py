@@ -203,39 +203,62 @@ class ContactModelsResult:
 
 _START_N = (1.0, 1.25, 1.5)
 _START_XI = (0.05, 0.2, 0.6)  # damping ratios of the start grid
+# stiffness factors of the start grid: the contact time's spring is too stiff when the
+# force rises slowly from zero (a Hertzian onset, Hunt-Crossley damping), where the
+# record's threshold cuts the contact short
+_START_K = (1.0, 0.3, 0.1)
+
+
+def _candidate(name, k, n, c, v0, z0):
+    """A start model of stiffness ``k`` and a dashpot ``c`` at the typical penetration."""
+    if name in ("kelvin-voigt", "hertz-damper"):
+        return ContactModel(name, (k, c))
+    if name == "hunt-crossley":
+        return ContactModel(name, (k, n, c / z0**n))
+    e = restitution_from_ratio(name, c / z0**n * v0 / k)
+    e = e if np.isfinite(e) else 0.3
+    return ContactModel(name, (k, n, min(max(e, 0.1), 0.95)))
 
 
 def _start_candidates(name, scenario, ref):
     """The start grid of a model: ``n`` in :data:`_START_N` (the model's own when fixed),
-    damping ratios :data:`_START_XI` at the record's spring-dashpot stiffness."""
+    the record's spring-dashpot stiffness times :data:`_START_K`, damping ratios
+    :data:`_START_XI`."""
     mu = scenario.m1 * scenario.m2 / (scenario.m1 + scenario.m2)
-    tau, v, z0 = contact_scales(scenario, ref)
+    _, v0, z0 = contact_scales(scenario, ref)
     fixed = {"kelvin-voigt": 1.0, "hertz-damper": 1.5}.get(name)
     out = []
     for n in (fixed,) if fixed else _START_N:
         (k,) = record_start(scenario, ref, [Term(n, 0.0)])
-        k_lin = k * z0 ** (n - 1.0)  # the secant stiffness at the typical penetration
-        for xi in _START_XI:
-            c = 2.0 * xi * np.sqrt(k_lin * mu)  # a dashpot's coefficient
-            if fixed:
-                out.append(ContactModel(name, (k, c)))
-            elif name == "hunt-crossley":
-                out.append(ContactModel(name, (k, n, c / z0**n)))
-            else:
-                e = restitution_from_ratio(name, c / z0**n * v / k)
-                e = e if np.isfinite(e) else 0.3
-                out.append(ContactModel(name, (k, n, min(max(e, 0.1), 0.95))))
+        for kf in _START_K:
+            k_lin = kf * k * z0 ** (n - 1.0)  # the secant stiffness at the typical penetration
+            for xi in _START_XI:
+                c = 2.0 * xi * np.sqrt(k_lin * mu)
+                out.append(_candidate(name, kf * k, n, c, v0, z0))
     return out
 
 
-def _start(name, records, tolerances):
-    """The start of a model's fit: the best of its start grid by the mean I2 (one
-    simulation per record and candidate)."""
+def _from_hunt_crossley(name, fit, scenario, ref):
+    """A Lankarani-Nikravesh or Flores start from a fitted Hunt-Crossley model: the same
+    force at the record's typical impact velocity (``r = lambda v0 / k``), or None."""
+    if fit is None or fit.consistent is None:
+        return None
+    p = fit.parameters
+    v0 = contact_scales(scenario, ref)[1]
+    e = restitution_from_ratio(name, p["lambda"] * v0 / p["k"])
+    if not np.isfinite(e):
+        return None
+    return ContactModel(name, (p["k"], p["n"], min(max(e, 0.05), 0.98)))
+
+
+def _start(name, records, tolerances, extra=()):
+    """The start of a model's fit: the best of its start grid (and ``extra`` starts) by
+    the mean I2 (one simulation per record and candidate)."""
     from ..verify import evaluate
 
     sc0, ref0 = records[0]
     best, best_v = None, np.inf
-    for cand in _start_candidates(name, sc0, ref0):
+    for cand in [*_start_candidates(name, sc0, ref0), *(m for m in extra if m is not None)]:
         vals = []
         for sc, ref in records:
             ev = evaluate(sc, cand.law, ref, tolerances=tolerances, floor=False)
@@ -264,8 +287,12 @@ def _intervals(model, res, n_boot, records, seed, tolerances):
     }
 
 
-def _fit_one(name, records, settings, progress):
-    start = _start(name, records, settings["tolerances"])
+def _fit_one(name, records, settings, progress, hunt_crossley=None):
+    sc0, ref0 = records[0]
+    extra = ()
+    if name in ("lankarani-nikravesh", "flores"):
+        extra = (_from_hunt_crossley(name, hunt_crossley, sc0, ref0),)
+    start = _start(name, records, settings["tolerances"], extra)
     try:
         res = identify(
             [sc for sc, _ in records],
@@ -352,10 +379,14 @@ def fit_contact_models(
         "tolerances": tolerances,
     }
     fits = []
-    for i, name in enumerate(names):
+    # Hunt-Crossley first: its fit starts Lankarani-Nikravesh and Flores (the same force
+    # at one impact velocity)
+    order = sorted(names, key=lambda m: m in ("lankarani-nikravesh", "flores"))
+    for i, name in enumerate(order):
         if progress is not None:
             progress("contact models", i, len(names))
-        fits.append(_fit_one(name, records, settings, None))
+        hc = next((f for f in fits if f.model == "hunt-crossley"), None)
+        fits.append(_fit_one(name, records, settings, None, hc))
     if progress is not None:
         progress("contact models", len(names), len(names))
     fits.sort(key=lambda f: f.value)

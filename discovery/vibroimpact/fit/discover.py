@@ -1190,6 +1190,16 @@ def discover(
         consistent model, a refinement that moved coefficients far beyond their
         uncertainty (regression bias).
     """
+    if library == "contact-models":  # the named contact models, fitted by name
+        from .contact_fit import fit_contact_models
+
+        return fit_contact_models(
+            scenario,
+            measurement,
+            n_boot=n_boot_intervals,
+            seed=0 if seed is None else seed,
+            progress=progress,
+        )
     t0 = time.perf_counter()
     seed = _check_settings(
         random_state, seed, criterion, shortlist, stability, n_boot, max_simulations, stepwise
