@@ -96,10 +96,10 @@ def _mode_of(law, y, state):
     z, v = y[0] - y[2], y[1] - y[3]
     if z < 0 or (z == 0 and v <= 0):
         return "free"
-    if law.impact_scaled and state["law"] is None:
+    if law.impact_scaled and state.get("law") is None:
         # a start inside a contact whose onset is not known: its own penetration rate
         state["law"] = law.at_impact(max(abs(v), 1e-12))
-    law = state["law"]
+    law = state.get("law") or law
     if v > 0:
         return "load" if _load(law, max(z, 0.0), v, state["zmax"]) >= 0 else "clipped"
     state["zmax"] = max(state["zmax"], z)
@@ -145,7 +145,7 @@ def _after(law, kind, y, state, loss):
         state["m2"] *= 1.0 - loss
         if law.impact_scaled:  # this impact's own law: velocity terms over its v0
             state["law"] = law.at_impact(max(v, 1e-12))
-    law = state["law"]
+    law = state.get("law") or law
     if kind == "loss":
         return "free"
     if kind in ("release", "resume") and z <= 0:

@@ -1059,6 +1059,16 @@ def _defects_warning(selected, physics):
     )
 
 
+def _contact_models(scenario, measurement, n_boot, seed, progress):
+    """``library="contact-models"``: the named contact models fitted by name
+    (:func:`~discovery.vibroimpact.fit.contact_fit.fit_contact_models`)."""
+    from .contact_fit import fit_contact_models
+
+    return fit_contact_models(
+        scenario, measurement, n_boot=n_boot, seed=0 if seed is None else seed, progress=progress
+    )
+
+
 @params(
     scenario=(Scenario, list, tuple),
     measurement=(Measurement, list, tuple),
@@ -1191,15 +1201,7 @@ def discover(
         uncertainty (regression bias).
     """
     if library == "contact-models":  # the named contact models, fitted by name
-        from .contact_fit import fit_contact_models
-
-        return fit_contact_models(
-            scenario,
-            measurement,
-            n_boot=n_boot_intervals,
-            seed=0 if seed is None else seed,
-            progress=progress,
-        )
+        return _contact_models(scenario, measurement, n_boot_intervals, seed, progress)
     t0 = time.perf_counter()
     seed = _check_settings(
         random_state, seed, criterion, shortlist, stability, n_boot, max_simulations, stepwise

@@ -32,7 +32,14 @@ import numpy as np
 from ...errors import InputError
 from .law import ForceLaw, Term
 
-__all__ = ["MODELS", "ContactModel", "parse_model", "is_model_text", "restitution_ratio"]
+__all__ = [
+    "MODELS",
+    "ContactModel",
+    "parse_model",
+    "parse_law",
+    "is_model_text",
+    "restitution_ratio",
+]
 
 #: the models, each with its parameters in order and whether ``n`` is its own
 MODELS = {
@@ -230,3 +237,11 @@ def parse_model(text):
     if missing:
         raise InputError(f"{text!r}: {name} needs {', '.join(missing)} too")
     return ContactModel(name, tuple(got[k] for k in MODELS[name]))
+
+
+def parse_law(text):
+    """A :class:`ForceLaw` from law text (``ForceLaw.parse``) or from a named model's text
+    (``"flores: k=2e9, n=1.5, e=0.6"``): what ``--law`` reads."""
+    if is_model_text(text):
+        return parse_model(text).law
+    return ForceLaw.parse(text)

@@ -229,10 +229,6 @@ class ForceLaw:
         (velocity terms over each impact's approach velocity)."""
         if not isinstance(text, str):
             return cls(*cls._merged(text))  # the grammar's own "must be text" error
-        from .contact_models import is_model_text, parse_model
-
-        if is_model_text(text):  # a named contact model, "hunt-crossley: k=..., n=..., ..."
-            return parse_model(text).law
         main, *parts = text.split(";")
         extra = {}
         for part in parts:
