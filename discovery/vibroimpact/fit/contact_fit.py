@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._printing import readable
-from ...errors import InputError, IntegrationError
+from ...errors import InputError, IntegrationError, VidiError
 from ..model.contact_models import MODELS, ContactModel, restitution_from_ratio
 from ..model.law import Term
 from .identify import as_records, contact_scales, identify, record_start
@@ -238,6 +238,58 @@ def _start_candidates(name, scenario, ref):
     return out
 
 
+_LS_N = np.linspace(1.0, 1.6, 13)  # exponents the regression start tries
+
+
+def _impact_velocities(samples):
+    """Each sample's impact approach velocity: the penetration rate of its impact's first
+    sample in contact."""
+    imp = samples.impact
+    first = {}
+    for i, j in enumerate(imp):
+        first.setdefault(int(j), max(float(samples.dzeta[i]), 1e-9))
+    return np.array([first[int(j)] for j in imp])
+
+
+def _regression_start(name, samples):
+    """The model fitted to the record's contact samples by linear least squares (each ``n``
+    of :data:`_LS_N` for the models that fit it, the best kept), or None: a start near the
+    answer when the positions are recorded (the samples are noisy, the fit by simulation
+    then removes the bias).  Samples with a clipped force (under 5 % of the peak) are left
+    out."""
+    if samples is None or len(samples) < 10:
+        return None
+    keep = samples.F > 0.05 * np.max(samples.F)
+    z = np.maximum(samples.zeta[keep], 0.0)
+    dz, F = samples.dzeta[keep], samples.F[keep]
+    v0 = _impact_velocities(samples)[keep]
+    fixed = {"kelvin-voigt": 1.0, "hertz-damper": 1.5}.get(name)
+    best, best_r = None, np.inf
+    for n in (fixed,) if fixed else _LS_N:
+        zn = z**n
+        if fixed:
+            damp = dz  # a linear dashpot
+        elif name == "hunt-crossley":
+            damp = zn * dz
+        else:
+            damp = zn * dz / v0  # lambda = k r / v0: the second coefficient is k r
+        A = np.column_stack([zn, damp])
+        coef, *_ = np.linalg.lstsq(A, F, rcond=None)
+        r = float(np.sum((A @ coef - F) ** 2))
+        k, c = float(coef[0]), max(float(coef[1]), 0.0)
+        if not (k > 0 and r < best_r):
+            continue
+        if fixed:
+            cand = (k, c)
+        elif name == "hunt-crossley":
+            cand = (k, n, c)
+        else:
+            e = restitution_from_ratio(name, c / k)
+            cand = (k, n, min(max(e if np.isfinite(e) else 0.05, 0.05), 0.98))
+        best, best_r = ContactModel(name, cand), r
+    return best
+
+
 def _from_hunt_crossley(name, fit, scenario, ref):
     """A Lankarani-Nikravesh or Flores start from a fitted Hunt-Crossley model: the same
     force at the record's typical impact velocity (``r = lambda v0 / k``), or None."""
@@ -289,9 +341,9 @@ def _intervals(model, res, n_boot, records, seed, tolerances):
 
 def _fit_one(name, records, settings, progress, hunt_crossley=None):
     sc0, ref0 = records[0]
-    extra = ()
+    extra = (_regression_start(name, settings["samples"]),)
     if name in ("lankarani-nikravesh", "flores"):
-        extra = (_from_hunt_crossley(name, hunt_crossley, sc0, ref0),)
+        extra += (_from_hunt_crossley(name, hunt_crossley, sc0, ref0),)
     start = _start(name, records, settings["tolerances"], extra)
     try:
         res = identify(
@@ -329,6 +381,22 @@ def _fit_one(name, records, settings, progress, hunt_crossley=None):
         message=res.message,
         n_simulations=res.n_simulations,
     )
+
+
+def _samples(scenario, reference):
+    """The first record's contact samples (None without positions or for a prepared
+    :class:`~discovery.vibroimpact.verify.Reference`)."""
+    from ..data.measurement import Measurement
+    from ..data.samples import contact_samples
+
+    meas = reference[0] if isinstance(reference, list | tuple) else reference
+    sc = scenario[0] if isinstance(scenario, list | tuple) else scenario
+    if not isinstance(meas, Measurement):
+        return None
+    try:
+        return contact_samples(meas, period=sc.period)
+    except (VidiError, ValueError):
+        return None
 
 
 def fit_contact_models(
@@ -373,6 +441,7 @@ def fit_contact_models(
         )
     records = as_records(scenario, reference)
     settings = {
+        "samples": _samples(scenario, reference),
         "max_simulations": int(max_simulations),
         "n_boot": int(n_boot),
         "seed": int(seed),
