@@ -58,6 +58,10 @@ _EXPORTS = {
     "report": "report",
     "verify": "vibroimpact.verify.verify",
     "VerifyResult": "vibroimpact.verify.verify",
+    "ContactModel": "vibroimpact.model.contact_models",
+    "parse_law": "vibroimpact.model.contact_models",
+    "ContactModelsResult": "vibroimpact.fit.contact_fit",
+    "fit_contact_models": "vibroimpact.fit.contact_fit",
 }
 
 
@@ -108,6 +112,10 @@ __all__ = [
     "Executor",
     "make_executor",
     "verify",
+    "ContactModel",
+    "parse_law",
+    "ContactModelsResult",
+    "fit_contact_models",
     "VerifyResult",
 ]
 

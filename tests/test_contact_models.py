@@ -193,3 +193,42 @@ def test_fit_names_the_model_of_a_clean_record():
     for key, true in model.params.items():
         assert fit.parameters[key] == pytest.approx(true, rel=0.02)
     assert "kelvin-voigt" not in res.equivalent and "hertz-damper" not in res.equivalent
+
+
+def test_a_study_scores_a_contact_models_fit():
+    """A study file takes named-model laws and the contact-models library; a run's
+    measures are the named model's."""
+    from discovery.vibroimpact.studies.config import load_study
+    from discovery.vibroimpact.studies.run import score_contact
+
+    cfg = load_study(Path(__file__).resolve().parents[1] / "examples/study_contact_models.toml")
+    runs = cfg.runs()
+    assert {r["library"] for r in runs} == {"contact-models"}
+    assert any(r["law"].startswith("flores:") for r in runs)
+    fit = ContactFit(
+        model="flores",
+        parameters={"k": 1.5e9, "n": 1.3, "e": 0.45},
+        intervals={"k": (1.4e9, 1.6e9), "n": (1.2, 1.4), "e": (0.46, 0.5)},
+        criteria={"I2": 0.01},
+        value=0.01,
+        consistent=True,
+        law="",
+    )
+    other = ContactFit(
+        model="hunt-crossley",
+        parameters={"k": 1.5e9, "n": 1.3, "lambda": 4e9},
+        intervals={},
+        criteria={"I2": 0.011},
+        value=0.011,
+        consistent=True,
+        law="",
+    )
+    res = ContactModelsResult(fits=(fit, other), selected="flores", equivalent=("hunt-crossley",))
+    m = score_contact(res, "flores: k=1.43e9, n=1.3, e=0.45")
+    assert m["exact"] and m["truth_equivalent"] and m["selected"] == ["flores"]
+    assert m["coverage"] == {"k": True, "n": True, "e": False}
+    assert m["coef_error"] == pytest.approx(np.sqrt(np.mean([(0.07 / 1.43) ** 2, 0, 0])))
+    m = score_contact(res, "hunt-crossley: k=1.43e9, n=1.3, lambda=4.1e9")
+    assert not m["exact"] and m["truth_equivalent"] and m["fp"] == 1
+    m = score_contact(res, "2.06e8*z + 1.28e7*zd")  # a polynomial truth: never in the family
+    assert not m["exact"] and not m["truth_in_library"] and m["selected"] == ["flores"]

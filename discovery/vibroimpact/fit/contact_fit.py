@@ -28,9 +28,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._printing import readable
+from ..._validate import Real, params
 from ...errors import InputError, IntegrationError, VidiError
+from ..data.measurement import Measurement
 from ..model.contact_models import MODELS, ContactModel, restitution_from_ratio
 from ..model.law import Term
+from ..model.scenario import Scenario
+from ..verify import Reference
 from .identify import as_records, contact_scales, identify, record_start
 
 __all__ = ["ContactFit", "ContactModelsResult", "fit_contact_models"]
@@ -333,9 +337,10 @@ def _intervals(model, res, n_boot, records, seed, tolerances):
         if iv is not None:
             return {k: tuple(v) for k, v in iv.bounds.items()}
     se = res.standard_errors or {}
-    return {
-        k: (v - _Z95 * se[k], v + _Z95 * se[k]) if k in se else (np.nan, np.nan)
+    return {  # a parameter whose standard error is not estimable has no interval
+        k: (v - _Z95 * se[k], v + _Z95 * se[k])
         for k, v in zip(model.names, model.values, strict=True)
+        if k in se and np.isfinite(se[k])
     }
 
 
@@ -386,7 +391,6 @@ def _fit_one(name, records, settings, progress, hunt_crossley=None):
 def _samples(scenario, reference):
     """The first record's contact samples (None without positions or for a prepared
     :class:`~discovery.vibroimpact.verify.Reference`)."""
-    from ..data.measurement import Measurement
     from ..data.samples import contact_samples
 
     meas = reference[0] if isinstance(reference, list | tuple) else reference
@@ -399,6 +403,14 @@ def _samples(scenario, reference):
         return None
 
 
+@params(
+    scenario=(Scenario, list, tuple),
+    reference=(Measurement, Reference, list, tuple),
+    models=(None, list, tuple),
+    max_simulations=Real(2, integer=True),
+    n_boot=Real(0, integer=True),
+    seed=Real(0, integer=True),
+)
 def fit_contact_models(
     scenario,
     reference,

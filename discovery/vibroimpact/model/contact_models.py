@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._validate import Real, Text, check
 from ...errors import InputError
 from .law import ForceLaw, Term
 
@@ -87,6 +88,10 @@ class ContactModel:
     exact_jacobian = False
 
     def __post_init__(self):
+        check("ContactModel: name", self.name, Text())
+        check("ContactModel: values", self.values, (tuple, list))
+        for v in self.values:
+            check("ContactModel: each of values", v, Real())
         if self.name not in MODELS:
             raise InputError(
                 f"unknown contact model {self.name!r}; the models: {', '.join(MODELS)}"
