@@ -232,3 +232,42 @@ def test_a_study_scores_a_contact_models_fit():
     assert not m["exact"] and m["truth_equivalent"] and m["fp"] == 1
     m = score_contact(res, "2.06e8*z + 1.28e7*zd")  # a polynomial truth: never in the family
     assert not m["exact"] and not m["truth_in_library"] and m["selected"] == ["flores"]
+
+
+def test_cli_takes_a_named_model_as_law(tmp_path, capsys):
+    from discovery.cli import main
+
+    rec = tmp_path / "KV.csv"
+    law = "kelvin-voigt: k=2.06e8, c=4.06e5"
+    assert main(["simulate", "--law", law, "--integrator", "scipy", "--out", str(rec)]) == 0
+    capsys.readouterr()
+    bad = ["simulate", "--law", "kelvin-voigt: k=2.06e8", "--out", str(tmp_path / "x.csv")]
+    assert main(bad) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "needs c" in err[0]
+
+
+@pytest.mark.slow
+def test_cli_fit_contact_models(tmp_path, capsys):
+    """``vidi fit --library contact-models`` end to end: summary.json is the result's
+    ``to_dict()`` (with the provenance), the printout names the model."""
+    import json
+
+    from discovery.cli import main
+
+    rec = tmp_path / "F.csv"
+    law = "flores: k=1.43e9, n=1.3, e=0.45"
+    argv = ["simulate", "--law", law, "--integrator", "scipy", "--periods", "12"]
+    assert main([*argv, "--noise", "0.01", "--seed", "2", "--out", str(rec)]) == 0
+    out = tmp_path / "fit"
+    argv = ["fit", "--data", str(rec), "--library", "contact-models", "--intervals", "0"]
+    assert main([*argv, "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["schema_version"] == 1 and summary["library"] == "contact-models"
+    # one impact velocity: Flores and Hunt-Crossley make the same force; both are named
+    assert {summary["selected"], *summary["equivalent"]} >= {"flores", "hunt-crossley"}
+    assert "cannot tell" in text
+    res = ContactModelsResult.from_dict(summary)
+    e = res.fit("flores").intervals["e"]
+    assert e[0] <= 0.45 <= e[1] or abs(res.fit("flores").parameters["e"] - 0.45) < 0.01
