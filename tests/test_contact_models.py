@@ -170,6 +170,11 @@ def test_result_round_trip(tmp_path):
     assert ContactFit.from_dict(fit.to_dict()) == fit
     assert (res.save(tmp_path)).exists()
     assert "supports flores" in str(res)
+    # the report of a contact-models run: the models' table and the conclusion
+    from reports.document import render
+
+    tex = render({**d, "command": "fit"}, tmp_path)
+    assert r"flores $\star$" in tex and "The record supports flores" in tex
 
 
 def test_fit_names_the_model_of_a_clean_record():

@@ -181,7 +181,8 @@ def _run_contact_models(args, scs, meas, t_start):
     summary = {
         **res.to_dict(),
         "command": "fit",
-        "data": [str(p) for p in args.data],
+        "scenario": scs[0].as_dict(),
+        "data": [str(p) for p in args.data] if len(args.data) > 1 else str(args.data[0]),
         **provenance(vars(args), inputs=inputs_of(args)),
     }
     summary["seconds"] = time.perf_counter() - t_start

@@ -150,7 +150,7 @@ class ContactModelsResult:
             "selected": self.selected,
             "equivalent": list(self.equivalent),
             "fits": [f.to_dict() for f in self.fits],
-            "settings": dict(self.settings),
+            "fit_settings": dict(self.settings),
             "seconds": float(self.seconds),
             "conclusion": self.conclusion,
         }
@@ -161,7 +161,7 @@ class ContactModelsResult:
             fits=tuple(ContactFit.from_dict(f) for f in d["fits"]),
             selected=d["selected"],
             equivalent=tuple(d["equivalent"]),
-            settings=dict(d["settings"]),
+            settings=dict(d["fit_settings"]),
             seconds=float(d["seconds"]),
         )
 
@@ -181,10 +181,10 @@ class ContactModelsResult:
         if self.selected is None:
             best = self.fits[0].model if self.fits else "none"
             return (
-                f"no named contact model is consistent with the record (closest: {best}); "
+                f"No named contact model is consistent with the record (closest: {best}); "
                 "the contact is none of them, try the polynomial library or vidi explain"
             )
-        text = f"the record supports {self.selected}"
+        text = f"The record supports {self.selected}"
         if self.equivalent:
             text += (
                 f"; it cannot tell it from {', '.join(self.equivalent)} (consistent too: a "
