@@ -31,6 +31,7 @@ from realistic import draw_case, reference_record  # noqa: E402
 from discovery.errors import VidiError  # noqa: E402
 from discovery.vibroimpact.dynamics.steady_state import steady_state  # noqa: E402
 from discovery.vibroimpact.fit.contact_fit import fit_contact_models  # noqa: E402
+from discovery.vibroimpact.fit.identify import bootstrap_intervals  # noqa: E402
 from discovery.vibroimpact.model.contact_models import (  # noqa: E402
     MODELS,
     ContactModel,
@@ -90,7 +91,7 @@ def one_record(truth_name, seed, max_sim):
     else:
         return {"truth": truth_name, "seed": seed, "skipped": True}
     t0 = time.perf_counter()
-    res = fit_contact_models(sc, meas, max_simulations=max_sim)
+    res = fit_contact_models(sc, meas, max_simulations=max_sim, n_boot=0)
     row = {
         "truth": truth_name,
         "seed": seed,
@@ -103,16 +104,29 @@ def one_record(truth_name, seed, max_sim):
     }
     if truth is not None:
         row["covered"] = _covered(row)
-        row["true_consistent"] = res.fit(truth_name).consistent
+        fit = res.fit(truth_name)
+        row["true_consistent"] = fit.consistent
+        # the bootstrap through the record-span processing, for the true model's fit
+        if fit.consistent is not None:
+            model = ContactModel(truth_name, tuple(fit.parameters[k] for k in MODELS[truth_name]))
+            iv = bootstrap_intervals(sc, Reference.from_measurement(meas, sc), model, n_boot=30)
+            row["boot_intervals"] = (
+                None if iv is None else {k: list(v) for k, v in iv.bounds.items()}
+            )
+            row["boot_covered"] = _covered(row, boot=True)
     return row
 
 
-def _covered(row):
-    """``{parameter: inside its 95 % interval}`` of the true model's fit in a row."""
+def _covered(row, boot=False):
+    """``{parameter: inside its 95 % interval}`` of the true model's fit in a row (the
+    Jacobian's intervals, or with ``boot`` the bootstrap's)."""
     fit = next(f for f in row["fits"] if f["model"] == row["truth"])
+    ivs = (row.get("boot_intervals") or {}) if boot else fit["intervals"]
     out = {}
     for key in MODELS[row["truth"]]:
-        lo, hi = fit["intervals"].get(key, (float("nan"),) * 2)
+        if key not in ivs:
+            continue
+        lo, hi = ivs[key]
         out[key] = bool(lo <= row["true_params"][key] <= hi)
     return out
 
@@ -136,6 +150,12 @@ def summary(rows):
         either = sum(r["selected"] == name or name in r["equivalent"] for r in rs)
         cov = {k: [c[k] for c in map(_covered, rs) if k in c] for k in PARAMS_CHECKED}
         cov_text = ", ".join(f"{k} {sum(v)}/{len(v)}" for k, v in cov.items() if v)
+        boot = [_covered(r, boot=True) for r in rs if r.get("boot_intervals")]
+        bcov = {k: [c[k] for c in boot if k in c] for k in PARAMS_CHECKED}
+        if boot:
+            cov_text += "; bootstrap: " + ", ".join(
+                f"{k} {sum(v)}/{len(v)}" for k, v in bcov.items() if v
+            )
         lines.append(
             f"{name:<21s} {len(rs):7d}  {right:4d}/{len(rs):<5d} "
             f"{either:4d}/{len(rs):<14d} {cov_text}"
@@ -149,16 +169,18 @@ def main(argv=None):
     ap.add_argument("--poly", type=int, default=2)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--max-simulations", type=int, default=60)
-    ap.add_argument("--out", default="out/survey_contact_models.jsonl")
+    ap.add_argument("--out", default="out/survey_contact_models.jsonl", nargs="+")
     ap.add_argument(
         "--summarize", action="store_true", help="only print the table of the rows in --out"
     )
     a = ap.parse_args(argv)
     if a.summarize:
-        rows = [json.loads(line) for line in Path(a.out).read_text().splitlines() if line]
+        rows = [
+            json.loads(line) for f in a.out for line in Path(f).read_text().splitlines() if line
+        ]
         print(summary(rows))
         return
-    out = Path(a.out)
+    out = Path(a.out[0])
     out.parent.mkdir(parents=True, exist_ok=True)
     rows = []
     jobs = [(m, a.seed + 1000 * j + i) for i in range(a.per_model) for j, m in enumerate(MODELS)]

@@ -191,7 +191,11 @@ def test_fit_names_the_model_of_a_clean_record():
         check=False,
     )
     res = fit_contact_models(
-        sc, meas, models=("kelvin-voigt", "hertz-damper", "hunt-crossley"), max_simulations=120
+        sc,
+        meas,
+        models=("kelvin-voigt", "hertz-damper", "hunt-crossley"),
+        max_simulations=120,
+        n_boot=0,
     )
     assert res.selected == "hunt-crossley", str(res)
     fit = res.fit("hunt-crossley")

@@ -76,6 +76,7 @@ class ContactFit:
     law: str
     message: str = ""
     n_simulations: int = 0
+    interval_method: str = ""
 
     def to_dict(self):
         return {
@@ -89,6 +90,7 @@ class ContactFit:
             "law": self.law,
             "message": self.message,
             "n_simulations": int(self.n_simulations),
+            "interval_method": self.interval_method,
         }
 
     @classmethod
@@ -103,6 +105,7 @@ class ContactFit:
             law=d["law"],
             message=d.get("message", ""),
             n_simulations=int(d.get("n_simulations", 0)),
+            interval_method=d.get("interval_method", ""),
         )
 
     def __post_init__(self):
@@ -335,13 +338,13 @@ def _intervals(model, res, n_boot, records, seed, tolerances):
             *zip(*records, strict=True), model, n_boot=n_boot, seed=seed, tolerances=tolerances
         )
         if iv is not None:
-            return {k: tuple(v) for k, v in iv.bounds.items()}
+            return {k: tuple(v) for k, v in iv.bounds.items()}, "bootstrap"
     se = res.standard_errors or {}
     return {  # a parameter whose standard error is not estimable has no interval
         k: (v - _Z95 * se[k], v + _Z95 * se[k])
         for k, v in zip(model.names, model.values, strict=True)
         if k in se and np.isfinite(se[k])
-    }
+    }, "1.96 standard errors (Jacobian)"
 
 
 def _fit_one(name, records, settings, progress, hunt_crossley=None):
@@ -371,7 +374,7 @@ def _fit_one(name, records, settings, progress, hunt_crossley=None):
             message=f"fit failed: {exc}",
         )
     model = res.law
-    iv = _intervals(
+    iv, method = _intervals(
         model, res, settings["n_boot"], records, settings["seed"], settings["tolerances"]
     )
     params = dict(zip(model.names, model.values, strict=True))
@@ -385,6 +388,7 @@ def _fit_one(name, records, settings, progress, hunt_crossley=None):
         law=model.law.to_text(),
         message=res.message,
         n_simulations=res.n_simulations,
+        interval_method=method,
     )
 
 
@@ -417,7 +421,7 @@ def fit_contact_models(
     *,
     models=None,
     max_simulations=200,
-    n_boot=0,
+    n_boot=30,
     seed=0,
     tolerances=None,
     progress=None,
@@ -434,7 +438,9 @@ def fit_contact_models(
     max_simulations : int
         Budget of each model's fit.
     n_boot : int
-        Bootstrap replicates of the intervals (0: +-1.96 standard errors).
+        Bootstrap replicates of the intervals through the record-span processing (default
+        30, as ``vidi fit``; 0 or a record without positions: +-1.96 standard errors of
+        the fit's Jacobian).
     seed : int
     tolerances : Tolerances, optional
     progress : callable, optional
@@ -482,7 +488,12 @@ def fit_contact_models(
             "max_simulations": int(max_simulations),
             "n_boot": int(n_boot),
             "seed": int(seed),
-            "interval_method": "bootstrap" if n_boot else "1.96 standard errors (Jacobian)",
+            "interval_method": (
+                f"bootstrap ({int(n_boot)} replicates) where the record allows, else "
+                "1.96 standard errors (Jacobian)"
+                if n_boot
+                else "1.96 standard errors (Jacobian)"
+            ),
         },
         seconds=time.perf_counter() - t0,
     )
