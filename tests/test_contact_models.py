@@ -146,6 +146,21 @@ def test_bad_text_is_one_input_error(text, match):
         parse_law(text)
 
 
+@pytest.mark.parametrize("name", list(MODELS))
+def test_the_papers_conditions(name):
+    _, model = _paper_model(name)
+    cond = model.conditions()
+    assert cond["(3)"]["holds"] and cond["(4)"]["holds"] and cond["(6)"]["holds"]
+    assert not cond["(5)"]["holds"]  # damping while unloading: outside (5) on purpose
+    plain = model.with_coefficients(
+        [
+            0.0 if k in ("c", "lambda") else (1.0 if k == "e" else v)
+            for k, v in zip(model.names, model.values, strict=True)
+        ]
+    )
+    assert plain.conditions()["(5)"]["holds"]  # no damping: (5) holds
+
+
 def test_restitution_maps_invert():
     for name in ("lankarani-nikravesh", "flores"):
         for e in (0.3, 0.6, 0.9):
@@ -162,6 +177,7 @@ def test_result_round_trip(tmp_path):
         value=0.01,
         consistent=True,
         law="2e9*z^1.3",
+        conditions=ContactModel("flores", (2e9, 1.3, 0.6)).conditions(),
     )
     res = ContactModelsResult(fits=(fit,), selected="flores", equivalent=(), settings={"a": 1})
     d = res.to_dict()

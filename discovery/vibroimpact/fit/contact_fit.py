@@ -64,6 +64,11 @@ class ContactFit:
         The fitted law's text (``ForceLaw.to_text``).
     message : str
     n_simulations : int
+    interval_method : str
+        How the intervals were made (the bootstrap, or the Jacobian's standard errors).
+    conditions : dict
+        The paper's conditions (3)-(6) for the fitted model
+        (:meth:`~discovery.vibroimpact.model.contact_models.ContactModel.conditions`).
     """
 
     model: str
@@ -76,6 +81,7 @@ class ContactFit:
     message: str = ""
     n_simulations: int = 0
     interval_method: str = ""
+    conditions: dict = field(default_factory=dict)
 
     def to_dict(self):
         return {
@@ -90,6 +96,7 @@ class ContactFit:
             "message": self.message,
             "n_simulations": int(self.n_simulations),
             "interval_method": self.interval_method,
+            "conditions": {k: dict(v) for k, v in self.conditions.items()},
         }
 
     @classmethod
@@ -105,6 +112,7 @@ class ContactFit:
             message=d.get("message", ""),
             n_simulations=int(d.get("n_simulations", 0)),
             interval_method=d.get("interval_method", ""),
+            conditions={k: dict(v) for k, v in d.get("conditions", {}).items()},
         )
 
     def __post_init__(self):
@@ -204,6 +212,14 @@ class ContactModelsResult:
             for k, v in f.parameters.items():
                 lo, hi = f.intervals.get(k, (np.nan, np.nan))
                 out.append(f"      {k:<7s} {v:.5g}  95 % [{lo:.5g}, {hi:.5g}]")
+            if f.model == self.selected and f.conditions:
+                out.append(
+                    "      conditions: "
+                    + ", ".join(
+                        f"{k} {'holds' if c['holds'] else 'does not hold'}"
+                        for k, c in f.conditions.items()
+                    )
+                )
         return out
 
 
@@ -268,6 +284,7 @@ def _fit_one(name, records, settings, progress, hunt_crossley=None):
         message=res.message,
         n_simulations=res.n_simulations,
         interval_method=method,
+        conditions=model.conditions(),
     )
 
 

@@ -186,6 +186,34 @@ class ContactModel:
     def _free(self):
         return []
 
+    def conditions(self):
+        """The paper's conditions (3)-(6) for this model: ``{"(3)": {"holds": bool, "why":
+        str}, ...}`` (analytic: each follows from the model's form and its parameters)."""
+        p = self.params
+        if self.name in ("lankarani-nikravesh", "flores"):
+            damping, what = (
+                self.law.coefficients[-1] if len(self.law.coefficients) > 1 else 0.0,
+                "k r(e)",
+            )
+        else:
+            damping, what = p.get("c", p.get("lambda", 0.0)), "c" if "c" in p else "lambda"
+        return {
+            "(3)": {"holds": True, "why": "no force without contact (F = 0 for zeta <= 0)"},
+            "(4)": {"holds": True, "why": "never adhesive (the force is clipped at 0)"},
+            "(5)": {
+                "holds": damping == 0,
+                "why": "the damping also acts while the bodies separate (dzeta < 0): the "
+                "model's hysteresis, outside the paper's condition on purpose"
+                if damping
+                else "no damping: a negative rate has no effect",
+            },
+            "(6)": {
+                "holds": damping >= 0,
+                "why": f"dissipative: F(zeta, zd) >= F(zeta, 0) for zd >= 0 as {what} = "
+                f"{damping:.4g} >= 0",
+            },
+        }
+
     # ----------------------------------------------------------------- text
     def to_text(self):
         """Text that :func:`parse_model` reads back to the same model."""
