@@ -129,10 +129,12 @@ class ContactModel:
 
     @property
     def coefficients(self):
+        """The parameters in the model's order (what a fit varies)."""
         return self.values
 
     @property
     def names(self):
+        """The parameters' names, in order."""
         return list(MODELS[self.name])
 
     def with_coefficients(self, values):
@@ -178,13 +180,16 @@ class ContactModel:
         )
 
     def apply(self, scenario):
+        """The scenario a record is compared with: unchanged (a model changes no machine
+        parameter)."""
         return scenario
 
     def observe(self):
+        """No observation model."""
         return None
 
     def _free(self):
-        return []
+        return []  # no parameter beyond the model's own (identify's bounds)
 
     def conditions(self):
         """The paper's conditions (3)-(6) for this model: ``{"(3)": {"holds": bool, "why":
