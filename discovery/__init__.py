@@ -65,6 +65,10 @@ _EXPORTS = {
     "Knobs": "vibroimpact.advise.candidates",
     "NoiseModel": "vibroimpact.advise.candidates",
     "SafeRegion": "vibroimpact.advise.candidates",
+    "ContactModel": "vibroimpact.model.contact_models",
+    "parse_law": "vibroimpact.model.contact_models",
+    "ContactModelsResult": "vibroimpact.fit.contact_fit",
+    "fit_contact_models": "vibroimpact.fit.contact_fit",
 }
 
 
@@ -117,6 +121,10 @@ __all__ = [
     "Executor",
     "make_executor",
     "verify",
+    "ContactModel",
+    "parse_law",
+    "ContactModelsResult",
+    "fit_contact_models",
     "VerifyResult",
     "advise",
     "AdviseResult",

@@ -67,11 +67,10 @@ def report(run, *, out=None, snippet=None, compile=True, timeout=300):
             f"report: run must be a result or a run directory; got {type(run).__name__}"
         )
     doc = _saved(run)
-    summary = (
-        command_of(load(run).to_dict())
-        if isinstance(doc, dict) and "schema_version" in doc
-        else None
-    )
+    summary = None
+    if isinstance(doc, dict) and "schema_version" in doc:
+        load(run)  # its version and kind checked, every field readable
+        summary = command_of(doc)
     return _report(run, snippet=snippet, compile=compile, timeout=timeout, summary=summary)
 
 

@@ -73,13 +73,18 @@ def context(summary, run_dir):
     """The template context of a run: the kind's own part plus provenance and scenario."""
     kind = summary.get("command")
     build = KINDS.get(kind)
+    named = kind == "fit" and summary.get("library") == "contact-models"
+    if named:
+        from .contact_models import contact_models_context  # the named models' fit
+
+        build = contact_models_context
     if build is None:
         from discovery.errors import InputError
 
         raise InputError(f"no report for a {kind!r} run; reports cover {', '.join(KINDS)} runs")
     c = build(summary, run_dir)
     c["kind"] = kind
-    c["template"] = TEMPLATES.get(kind, "ueda") + ".tex.j2"
+    c["template"] = ("contact_models" if named else TEMPLATES.get(kind, "ueda")) + ".tex.j2"
     c["provenance"] = _provenance(summary, run_dir)
     c["scenario"] = _scenario_rows(summary.get("scenario"))
     c["data"] = summary.get("data") or (summary.get("settings") or {}).get("data")

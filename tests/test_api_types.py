@@ -29,6 +29,15 @@ TYPE, VALUE = VidiTypeError, InputError
 CASES = [
     # (id, call, error, parameter named in the message)
     ("Term a text", lambda: d.Term("x", 1), TYPE, "a"),
+    ("ContactModel values text", lambda: d.ContactModel("flores", "abc"), TYPE, "values"),
+    ("ContactModel name int", lambda: d.ContactModel(5, (1.0,)), TYPE, "name"),
+    ("parse_law int", lambda: d.parse_law(5), VALUE, "text"),
+    (
+        "fit_contact_models scenario text",
+        lambda: d.fit_contact_models("paper", REC),
+        TYPE,
+        "scenario",
+    ),
     ("Term b None", lambda: d.Term(1, None), TYPE, "b"),
     ("Term exponent 1e4", lambda: d.Term(1e4, 0), VALUE, "a"),
     ("Term bool", lambda: d.Term(True, 0), TYPE, "a"),
@@ -197,6 +206,9 @@ def test_the_cases_cover_every_public_entry():
         "ueda explain",
         "ueda periodic",
         "ueda record",
+        "contactmodel",
+        "parse_law",
+        "fit_contact_models",
     ]
     missing = [e for e in entries if e not in covered]
     assert not missing, missing
@@ -214,6 +226,7 @@ def test_the_cases_cover_every_public_entry():
         "ExplainResult",
         "VerifyResult",
         "AdviseResult",
+        "ContactModelsResult",
         "builtin_scenarios",
         "load_scenario",
         "impulse_from_steady_state",
@@ -257,6 +270,9 @@ def test_the_cases_cover_every_public_entry():
             "Knobs",
             "NoiseModel",
             "SafeRegion",
+            "ContactModel",
+            "parse_law",
+            "fit_contact_models",
         }
     )
     assert not unlisted, f"public entries without a row: {sorted(unlisted)}"

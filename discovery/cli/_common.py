@@ -21,7 +21,6 @@ import numpy as np
 
 from .._io import check_output
 from ..errors import InputError
-from ..vibroimpact.model.law import ForceLaw
 from ..vibroimpact.model.scenario import builtin_scenarios
 
 SCENARIO_HELP = (
@@ -30,7 +29,8 @@ SCENARIO_HELP = (
 LAW_HELP = (
     "force law in z = zeta (penetration w1 - w2, m) and zd = dzeta (its rate while "
     "loading, m/s), e.g. '2.06e8*z + 1.28e7*zd' (default: the scenario's law); a law "
-    "starting with '-' as --law=-1e8*z"
+    "starting with '-' as --law=-1e8*z; or a named contact model, e.g. 'hunt-crossley: "
+    "k=2e9, n=1.5, lambda=3e9', 'flores: k=2e9, n=1.5, e=0.6', 'kelvin-voigt: k=2e8, c=1e6'"
 )
 COLUMNS_HELP = (
     "the file's header names for our columns when they differ, e.g. "
@@ -113,7 +113,9 @@ def law_or_default(text, scenario, what="--law"):
                 f"{what} is empty; give a law such as '2.06e8*z + 1.28e7*zd' or "
                 "leave the option out to use the scenario's law"
             )
-        law = ForceLaw.parse(text)
+        from ..vibroimpact.model.contact_models import parse_law
+
+        law = parse_law(text)  # law text, or a named contact model's ("flores: k=..., ...")
         law.check_physical(scenario, what)
         return law
     if scenario.law is None:

@@ -52,7 +52,7 @@ def _call(discover, args, scs, meas, progress):
         criterion=args.criterion,
         shortlist=args.shortlist,
         refine=not args.no_refine,
-        max_simulations=args.max_simulations,
+        max_simulations=args.max_simulations or 120,
         stability=args.stability,
         derivative=args.derivative,
         average_cycles=args.average_cycles,
@@ -168,11 +168,43 @@ def _print_result(args, res, pdf, why):
     )
 
 
+def _run_contact_models(args, scs, meas, t_start):
+    """``--library contact-models``: every named contact model fitted, the one the record
+    supports and those it cannot tell from it (``summary.json`` is the result's
+    ``to_dict()`` with the provenance)."""
+    from ..vibroimpact.fit.contact_fit import fit_contact_models
+
+    with reporter(args) as rep:
+        res = fit_contact_models(
+            scs,
+            meas,
+            max_simulations=args.max_simulations or 200,
+            n_boot=args.intervals,
+            seed=args.seed or 0,
+            progress=rep,
+        )
+    summary = {
+        **res.to_dict(),
+        "command": "fit",
+        "scenario": scs[0].as_dict(),
+        "data": [str(p) for p in args.data] if len(args.data) > 1 else str(args.data[0]),
+        **provenance(vars(args), inputs=inputs_of(args)),
+    }
+    summary["seconds"] = time.perf_counter() - t_start
+    with OutputDir(args.out) as out:
+        out.write_json("summary.json", summary)
+    print(res)
+    print(f"outputs in {args.out}/: summary.json")
+    return 0
+
+
 def run(args):
     t_start = time.perf_counter()
     check_out(args)
     data = args.data
     scs, meas = read_records(args)
+    if args.library == "contact-models":
+        return _run_contact_models(args, scs, meas, t_start)
     with reporter(args) as rep:
         res = _discover(args, scs, meas, rep)
     head = {
@@ -236,7 +268,9 @@ def _add_regression_options(p):
     p.add_argument(
         "--library",
         default="poly:2",
-        help="candidate terms: poly:N, hc, a list 'z,zd,z*zd', or sums (default: %(default)s)",
+        help="candidate terms: poly:N, hc, a list 'z,zd,z*zd', or sums; or 'contact-models': "
+        "the named models (kelvin-voigt, hertz-damper, hunt-crossley, lankarani-nikravesh, "
+        "flores) fitted by name (default: %(default)s)",
     )
     p.add_argument(
         "--select",
@@ -313,9 +347,10 @@ def _add_check_options(p):
     p.add_argument(
         "--max-simulations",
         type=integer(2, 100_000),
-        default=120,
+        default=None,
         excludes="--no-refine",
-        help="simulation budget of each support's refinement (default: %(default)s)",
+        help="simulation budget of each support's refinement (default: 120; with --library "
+        "contact-models each model's fit, default 200)",
     )
     p.add_argument(
         "--stability",

@@ -78,8 +78,11 @@ OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW, CHATTER = 0, 1, 2, 3, 4
 # fraction, one contact state: the current contact's largest penetration, and the choice of
 # the free-flight path (``p[P_FLIGHT] = 1``: in closed form where it applies, 0: the
 # integrator's steps throughout).  The kernel updates m2 and z_max in place (callers pass a
-# copy: :func:`kernel_params`).
-P_K3, P_LOSS, P_SET, P_ZMAX, P_FLIGHT, N_PARAMS = 7, 8, 9, 10, 11, 12
+# copy: :func:`kernel_params`).  A law whose velocity terms are scaled by each impact's
+# approach velocity (``p[P_VSCALE] = 1``: Lankarani-Nikravesh, Flores) divides their
+# coefficients by ``p[P_V0]``, the current contact's penetration rate at its onset (a
+# second contact state, set at every onset).
+P_K3, P_LOSS, P_SET, P_ZMAX, P_FLIGHT, P_V0, P_VSCALE, N_PARAMS = 7, 8, 9, 10, 11, 12, 13, 14
 
 # chattering: more than _ZENO_EVENTS located events in a row, each within
 # _ZENO_GAP * hmax of the previous one (mode switches that hardly advance time)
@@ -109,13 +112,25 @@ def _pw(x, p):
 
 
 @njit(cache=True, inline="always")
-def poly(z, zd, coef, ea, eb, br):
+def _vscale(p):
+    """The factor of the velocity terms' coefficients: ``1 / v0`` for a law scaled by each
+    impact's approach velocity (``p[P_VSCALE] = 1``), else 1."""
+    if p[P_VSCALE] == 0.0:
+        return 1.0
+    return 1.0 / max(p[P_V0], 1e-12)
+
+
+@njit(cache=True, inline="always")
+def poly(z, zd, p, coef, ea, eb, br):
     """Loading branch ``P(z, zd) = sum c_i z^a_i zd^b_i`` over the loading terms
-    (``br_i = 0``; odd extension for negative arguments)."""
+    (``br_i = 0``; odd extension for negative arguments; velocity terms over ``v0`` for a
+    law scaled by the impact velocity)."""
     s = 0.0
+    f = _vscale(p)
     for i in range(coef.shape[0]):
         if br[i] == 0.0:
-            s += coef[i] * _pw(z, ea[i]) * _pw(zd, eb[i])
+            c = coef[i] * f if eb[i] > 0.0 else coef[i]
+            s += c * _pw(z, ea[i]) * _pw(zd, eb[i])
     return s
 
 
@@ -137,7 +152,7 @@ def load_force(z, v, p, coef, ea, eb, br):
     largest penetration so far follows its elastic unloading line ``P(u, 0)`` (plus the
     velocity terms) back up to ``z_max`` (Walton-Braun), continuous there."""
     if p[P_SET] == 0.0 or z >= p[P_ZMAX]:
-        return poly(z, v, coef, ea, eb, br)
+        return poly(z, v, p, coef, ea, eb, br)
     return _reload_set(z, v, p, coef, ea, eb, br)
 
 
@@ -146,8 +161,8 @@ def _reload_set(z, v, p, coef, ea, eb, br):
     """The loading branch below ``z_max`` with a permanent set: a call, not inlined (the
     rare branch, typed once instead of at each of the step's seven stages)."""
     return (
-        poly(z, v, coef, ea, eb, br)
-        - poly(z, 0.0, coef, ea, eb, br)
+        poly(z, v, p, coef, ea, eb, br)
+        - poly(z, 0.0, p, coef, ea, eb, br)
         + _elastic_set(z, p, coef, ea, eb, br)
     )
 
@@ -163,11 +178,12 @@ def unload_force(z, v, p, coef, ea, eb, br):
     rho = p[P_SET]
     u = z if rho == 0.0 else (z - rho * p[P_ZMAX]) / (1.0 - rho)
     s = 0.0
+    f = _vscale(p)
     for i in range(coef.shape[0]):
         if br[i] == 0.0:
             s += coef[i] * _pw(u, ea[i]) * _pw(0.0, eb[i])
         else:
-            s += coef[i] * _pw(z, ea[i]) * _pw(v, eb[i])
+            s += coef[i] * f * _pw(z, ea[i]) * _pw(v, eb[i])
     return s
 
 
@@ -237,6 +253,9 @@ def resolve_mode(y, p, coef, ea, eb, br):
     v = y[1] - y[3]
     if z < 0.0 or (z == 0.0 and v <= 0.0):
         return FREE
+    if p[P_V0] <= 0.0:
+        # a start inside a contact whose onset the caller does not know: its own rate
+        p[P_V0] = max(abs(v), 1e-12)
     if v > 0.0:
         return LOAD if load_force(max(z, 0.0), v, p, coef, ea, eb, br) >= 0.0 else CLIPPED
     p[P_ZMAX] = max(p[P_ZMAX], z)
@@ -316,6 +335,7 @@ def _mode_after(kind, y, p, coef, ea, eb, br):
         return FREE
     if kind == EV_ONSET:
         p[P_ZMAX] = 0.0
+        p[P_V0] = max(v, 1e-12)  # the approach velocity of this impact
         p[1] *= 1.0 - p[P_LOSS]
     if kind == EV_RELEASE:
         return CLIPPED

@@ -83,6 +83,7 @@ def _orbit_events(scenario, law, ss, tolerances):
         tolerances=tolerances,
         t_eval=np.linspace(t0, t0 + n * T, 400 * n + 1),
         zeta_max0=ss.zeta_max0,
+        impact_v0=ss.impact_v0,
     )
     return tr
 

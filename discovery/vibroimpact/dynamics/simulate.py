@@ -93,6 +93,7 @@ class Trajectory:
     status: int
     message: str
     zeta_max0: float = 0.0
+    impact_v0: float = 0.0
     sensitivity: np.ndarray | None = None
     force_sensitivity: np.ndarray | None = None
     penetration_sensitivity: np.ndarray | None = None
@@ -120,10 +121,13 @@ class Trajectory:
         p = np.zeros(K.N_PARAMS)
         p[K.P_SET] = law.permanent_set
         p[K.P_ZMAX] = self.zeta_max0
+        p[K.P_VSCALE] = 1.0 if law.impact_scaled else 0.0
+        p[K.P_V0] = self.impact_v0
         for k, (yk, (m0, m1)) in enumerate(zip(self.event_y, self.event_modes, strict=True)):
             z, v = yk[0] - yk[2], yk[1] - yk[3]
             if m0 == K.FREE:
                 p[K.P_ZMAX] = 0.0
+                p[K.P_V0] = max(v, 1e-12)
             p[K.P_ZMAX] = max(p[K.P_ZMAX], z)  # the largest penetration so far (events only)
             out[k, 0] = K.mode_force(m0, z, v, p, coef, ea, eb, br)
             out[k, 1] = K.mode_force(m1, z, v, p, coef, ea, eb, br)
@@ -140,6 +144,7 @@ def kernel_params(scenario, law, tolerances=None):
     base = scenario.params()
     p[: base.size] = base
     p[K.P_SET] = law.permanent_set
+    p[K.P_VSCALE] = 1.0 if law.impact_scaled else 0.0
     closed = tolerances is None or tolerances.free_flight == "closed"
     p[K.P_FLIGHT] = 1.0 if closed else 0.0
     return p
@@ -186,6 +191,12 @@ def sensitivity_setup(scenario, law, which, n_eval=0, n_events=0, controlled=Tru
             "memory is a state the kernel does not differentiate); leave `set:` out, or use "
             "finite differences"
         )
+    if law.impact_scaled:
+        raise InputError(
+            "sensitivities are not available for a law scaled by each impact's approach "
+            "velocity (that velocity is a contact state the kernel does not differentiate); "
+            "use finite differences"
+        )
     coef = np.array(law.coefficients + law.unloading_coefficients, dtype=float)
     names, spar, sscale = [], [], []
     x, v = scenario.scales()
@@ -229,6 +240,7 @@ def _atol(scenario, tol):
     tolerances=(Tolerances, None),
     max_events=Real(1, integer=True),
     zeta_max0=Real(0),
+    impact_v0=Real(0),
     sensitivities=(None, Choice(*SENSITIVITIES)),
     control_sensitivities=bool,
     sensitivity_start=(None, Array(2)),
@@ -245,6 +257,7 @@ def simulate(
     mode0=None,
     throw=True,
     zeta_max0=0.0,
+    impact_v0=0.0,
     sensitivities=None,
     control_sensitivities=True,
     sensitivity_start=None,
@@ -272,6 +285,10 @@ def simulate(
         The current contact's largest penetration so far at ``t0`` (its memory, which a
         law with a permanent set unloads from; :attr:`SteadyState.zeta_max0` for an orbit
         strobed inside a contact).  The default takes the start's own penetration.
+    impact_v0 : float
+        For a law scaled by each impact's approach velocity (Lankarani-Nikravesh, Flores):
+        that velocity of the contact under way at ``t0`` (:attr:`SteadyState.impact_v0`);
+        0 (default) takes the start's own penetration rate.
     throw : bool
         Raise :class:`IntegrationError` on failure (default) or return a
         trajectory whose ``status``/``message`` say what happened.
@@ -306,6 +323,8 @@ def simulate(
     period = scenario.period
     p = kernel_params(scenario, law, tol)
     p[K.P_ZMAX] = float(zeta_max0)
+    v0_start = float(impact_v0) if impact_v0 > 0 else abs(float(y0[1] - y0[3]))
+    p[K.P_V0] = v0_start
     if sensitivities is None:
         sens, names = no_sensitivities(), ()
     else:
@@ -360,6 +379,7 @@ def simulate(
         status=int(status),
         message=message,
         zeta_max0=float(zeta_max0),
+        impact_v0=v0_start,
         sensitivity=sens[0] if names else None,
         force_sensitivity=sens[3][: len(names), ok_out] if names else None,
         penetration_sensitivity=sens[3][len(names) :, ok_out] if names else None,

@@ -74,8 +74,10 @@ class StroboscopicMap:
         # a law with a permanent set unloads from the contact's largest penetration, which
         # the four states do not hold: the map carries it from one call's end to the next
         # start (exact at a fixed point; Jacobian probes hold it fixed)
-        self._memory = law.permanent_set > 0
+        # (a law scaled by each impact's approach velocity carries that velocity the same way)
+        self._memory = law.has_memory
         self.zeta_max = 0.0
+        self.impact_v0 = 0.0
         self._no_sens = no_sensitivities()
         self._state_dirs = np.full(4, -1, dtype=np.int64)
         # exact Jacobians (one run with the variational equations) unless the law has a
@@ -96,6 +98,7 @@ class StroboscopicMap:
         p = self._p.copy()
         if self._memory:
             p[K.P_ZMAX] = self.zeta_max
+            p[K.P_V0] = self.impact_v0
         status, tf, yf, _, steps, _, _ = K.integrate(
             t0,
             t0 + n * self._T,
@@ -125,6 +128,7 @@ class StroboscopicMap:
         self.n_steps += steps
         if self._memory and remember:
             self.zeta_max = float(p[K.P_ZMAX])
+            self.impact_v0 = float(p[K.P_V0])
         if status != K.OK:
             raise IntegrationError(
                 f"simulation of law '{self.law}' stopped at t = {tf:.6g} s: "
@@ -206,6 +210,9 @@ class SteadyState(Result):
     zeta_max0 : float
         For a law with a permanent set: the largest penetration of the contact under way
         at ``y0`` (its unloading memory; pass it to :func:`simulate` as ``zeta_max0``).
+    impact_v0 : float
+        For a law scaled by each impact's approach velocity: that velocity of the contact
+        under way at ``y0`` (pass it to :func:`simulate` as ``impact_v0``; 0 when none).
     """
 
     regime: str
@@ -218,6 +225,7 @@ class SteadyState(Result):
     n_simulations: int
     evidence: dict = field(default_factory=dict)
     zeta_max0: float = 0.0
+    impact_v0: float = 0.0
 
     KIND = "steady"
     _LOAD = {
@@ -310,12 +318,12 @@ def _orbit(scenario, law, pm, y, n, tol, max_newton, attempt, t0, evidence):
             }
         )
         n, mult = m, floquet_multipliers(J)
-    zmax = 0.0
-    if law.permanent_set > 0:
+    zmax, v0 = 0.0, 0.0
+    if law.has_memory:
         # one more orbit from y0 leaves the memory y0 holds (the orbit is periodic)
         pm.advance(y_orb, n)
-        zmax = pm.zeta_max
-    impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n, zmax)
+        zmax, v0 = pm.zeta_max, pm.impact_v0
+    impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n, zmax, v0)
     return SteadyState(
         regime=f"P{n}",
         n_periods=n,
@@ -327,6 +335,7 @@ def _orbit(scenario, law, pm, y, n, tol, max_newton, attempt, t0, evidence):
         n_simulations=pm.n_calls,
         evidence=evidence,
         zeta_max0=zmax,
+        impact_v0=v0,
     )
 
 
@@ -408,7 +417,7 @@ def steady_state(
             "mass_loss = 0"
         )
     pm = StroboscopicMap(scenario, law, tolerances)
-    if guess is not None and guess.periodic and law.permanent_set == 0:
+    if guess is not None and guess.periodic and not law.has_memory:
         cont = _continued(scenario, law, pm, guess, tol)
         if cont is not None:
             return cont
@@ -487,8 +496,14 @@ def _continued(scenario, law, pm, guess, tol):
     )
 
 
-def _count_onsets(scenario, law, tol, y0, t0, n, zeta_max0=0.0):
+def _count_onsets(scenario, law, tol, y0, t0, n, zeta_max0=0.0, impact_v0=0.0):
     tr = simulate(
-        scenario, law, (t0, t0 + n * scenario.period), y0=y0, tolerances=tol, zeta_max0=zeta_max0
+        scenario,
+        law,
+        (t0, t0 + n * scenario.period),
+        y0=y0,
+        tolerances=tol,
+        zeta_max0=zeta_max0,
+        impact_v0=impact_v0,
     )
     return int(np.sum(tr.event_kind == K.EV_ONSET))

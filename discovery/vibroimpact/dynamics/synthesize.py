@@ -133,7 +133,7 @@ def synthesize(
     n = int(round(periods * scenario.period * fs))
     t = np.arange(n) / fs
     if from_rest:
-        span, y0, t_eval, zmax0 = (0.0, t[-1]), None, t, 0.0
+        span, y0, t_eval, zmax0, v0 = (0.0, t[-1]), None, t, 0.0, 0.0
     else:
         ss = ss or steady_state(scenario, law)
         if not ss.periodic:
@@ -143,6 +143,7 @@ def synthesize(
                 "or record from rest"
             )
         span, y0, t_eval, zmax0 = (ss.t0, ss.t0 + t[-1]), ss.y0, ss.t0 + t, ss.zeta_max0
+        v0 = ss.impact_v0
     if integrator == "scipy":
         if zmax0 and law.permanent_set:
             raise InputError(
@@ -151,10 +152,10 @@ def synthesize(
             )
         from .reference import reference_simulate
 
-        out = reference_simulate(scenario, law, span, y0=y0, t_eval=t_eval, rtol=1e-9)
+        out = reference_simulate(scenario, law, span, y0=y0, t_eval=t_eval, rtol=1e-9, impact_v0=v0)
         force, states = out["force"], out["y"]
     else:
-        tr = simulate(scenario, law, span, y0=y0, t_eval=t_eval, zeta_max0=zmax0)
+        tr = simulate(scenario, law, span, y0=y0, t_eval=t_eval, zeta_max0=zmax0, impact_v0=v0)
         force, states = tr.force, tr.y
     rng = np.random.default_rng(seed)
     F = force.copy()

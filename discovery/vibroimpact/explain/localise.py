@@ -60,6 +60,7 @@ def simulated_at(scenario, law, steady, t_record, F_record, *, time_offset=0.0, 
             t_eval=steady.t0 + tau[order],
             tolerances=tolerances,
             zeta_max0=steady.zeta_max0,
+            impact_v0=steady.impact_v0,
         )
         inv = np.empty_like(order)
         inv[order] = np.arange(order.size)

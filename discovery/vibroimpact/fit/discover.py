@@ -1104,6 +1104,16 @@ def _defects_warning(selected, physics):
     )
 
 
+def _contact_models(scenario, measurement, n_boot, seed, progress):
+    """``library="contact-models"``: the named contact models fitted by name
+    (:func:`~discovery.vibroimpact.fit.contact_fit.fit_contact_models`)."""
+    from .contact_fit import fit_contact_models
+
+    return fit_contact_models(
+        scenario, measurement, n_boot=n_boot, seed=0 if seed is None else seed, progress=progress
+    )
+
+
 @params(
     scenario=(Scenario, list, tuple),
     measurement=(Measurement, list, tuple),
@@ -1235,6 +1245,8 @@ def discover(
         consistent model, a refinement that moved coefficients far beyond their
         uncertainty (regression bias).
     """
+    if library == "contact-models":  # the named contact models, fitted by name
+        return _contact_models(scenario, measurement, n_boot_intervals, seed, progress)
     t0 = time.perf_counter()
     seed = _check_settings(
         random_state, seed, criterion, shortlist, stability, n_boot, max_simulations, stepwise

@@ -469,7 +469,10 @@ class _Objective:
         # a record compared over its span takes an observation linear in the force; one
         # compared with its steady orbit (a force-only record) takes none
         linear = observe is None or getattr(observe, "linear", False)
-        ok = law.permanent_set == 0 and all(
+        if getattr(model, "exact_jacobian", True) is False:
+            # a named contact model: its parameters are not the kernel's coefficients
+            return [None] * len(model.coefficients), False
+        ok = not law.has_memory and all(
             linear if getattr(ref, "span", None) is not None else observe is None
             for _, ref in self.records
         )

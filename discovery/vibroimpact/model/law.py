@@ -25,6 +25,12 @@ for machines the paper's model does not describe:
   reloads before it ends climbs back along that line up to ``zeta_max``.  The set is
   recovered between impacts (each contact starts from the undeformed surface).
 
+A third, ``impact_scaled``, divides every velocity term (loading and unloading) by the
+approach velocity ``v0`` of the impact under way (the penetration rate at the contact's
+onset, a per-contact memory like ``zeta_max``): the Lankarani-Nikravesh and Flores contact
+models, whose hysteresis damping ``lambda = k r(e) / v0`` is set per impact
+(:mod:`~discovery.vibroimpact.model.contact_models`).  Text part ``"; scale: v0"``.
+
 Text form: ``"2e8*z + 1e7*zd; unloading: 4e6*zd; set: 0.2"``.  Units are
 SI: ``zeta`` [m], ``dzeta`` [m/s], ``F`` [N]; a coefficient of ``z^a*zd^b`` has
 units N m^-a (m/s)^-b.
@@ -151,6 +157,7 @@ class ForceLaw:
     unloading: tuple = ()
     unloading_coefficients: tuple = ()
     permanent_set: float = 0.0
+    impact_scaled: bool = False
 
     def __post_init__(self):
         for name in ("terms", "coefficients", "unloading", "unloading_coefficients"):
@@ -205,12 +212,16 @@ class ForceLaw:
         object.__setattr__(self, "unloading", uterms)
         object.__setattr__(self, "unloading_coefficients", ucoefs)
         object.__setattr__(self, "permanent_set", float(rho))
+        if not isinstance(self.impact_scaled, bool | np.bool_):
+            raise InputError(f"impact_scaled must be True or False; got {self.impact_scaled!r}")
+        object.__setattr__(self, "impact_scaled", bool(self.impact_scaled))
 
     # ----------------------------------------------------------- construction
     @classmethod
     def parse(cls, text):
         """Law from text like ``"2.06e8*z + 1.28e7*zd"`` (like terms are summed), with
-        optional parts ``"; unloading: 4e6*zd"`` and ``"; set: 0.2"``."""
+        optional parts ``"; unloading: 4e6*zd"``, ``"; set: 0.2"`` and ``"; scale: v0"``
+        (velocity terms over each impact's approach velocity)."""
         if not isinstance(text, str):
             return cls(*cls._merged(text))  # the grammar's own "must be text" error
         main, *parts = text.split(";")
@@ -218,10 +229,10 @@ class ForceLaw:
         for part in parts:
             key, sep, value = part.partition(":")
             key = key.strip().lower()
-            if not sep or key not in ("unloading", "set") or key in extra:
+            if not sep or key not in ("unloading", "set", "scale") or key in extra:
                 raise InputError(
-                    f"force law {text!r}: after ';' give 'unloading: <terms>' or "
-                    "'set: <fraction>' once each, e.g. '2e8*z + 1e7*zd; "
+                    f"force law {text!r}: after ';' give 'unloading: <terms>', "
+                    "'set: <fraction>' or 'scale: v0' once each, e.g. '2e8*z + 1e7*zd; "
                     "unloading: 4e6*zd; set: 0.2'"
                 )
             extra[key] = value.strip()
@@ -236,7 +247,12 @@ class ForceLaw:
                     f"force law {text!r}: 'set:' needs a number in [0, "
                     f"{_MAX_SET}], got {extra['set']!r}"
                 ) from None
-        return cls(terms, coefs, uterms, ucoefs, rho)
+        if "scale" in extra and extra["scale"].lower() != "v0":
+            raise InputError(
+                f"force law {text!r}: 'scale:' takes only 'v0' (velocity terms divided by "
+                f"each impact's approach velocity), got {extra['scale']!r}"
+            )
+        return cls(terms, coefs, uterms, ucoefs, rho, "scale" in extra)
 
     @staticmethod
     def _merged(text):
@@ -266,6 +282,31 @@ class ForceLaw:
             if coefficients is None
             else tuple(coefficients),
             permanent_set=self.permanent_set if permanent_set is None else permanent_set,
+        )
+
+    @property
+    def has_memory(self):
+        """True when the force depends on a contact's history (a permanent set's largest
+        penetration, an impact-scaled law's approach velocity), which the state does not
+        hold."""
+        return self.permanent_set > 0 or self.impact_scaled
+
+    def at_impact(self, v0):
+        """The plain law of one impact of an impact-scaled law: every velocity term's
+        coefficient divided by the approach velocity ``v0`` [m/s] (the law itself when it
+        is not scaled)."""
+        if not self.impact_scaled:
+            return self
+        v0 = float(v0)
+        if not (np.isfinite(v0) and v0 > 0):
+            raise InputError(f"an impact's approach velocity must be > 0; got {v0!r}")
+        return replace(
+            self,
+            coefficients=tuple(
+                c / v0 if t.b > 0 else c for c, t in zip(self.coefficients, self.terms, strict=True)
+            ),
+            unloading_coefficients=tuple(c / v0 for c in self.unloading_coefficients),
+            impact_scaled=False,
         )
 
     @property
@@ -310,6 +351,8 @@ class ForceLaw:
             text += "; unloading: " + poly(self.unloading, self.unloading_coefficients)
         if self.permanent_set:
             text += f"; set: {fraction(self.permanent_set)}"
+        if self.impact_scaled:
+            text += "; scale: v0"
         return text
 
     def __str__(self):
@@ -368,6 +411,8 @@ class ForceLaw:
                 f"{what} '{self}' has no non-zero coefficient; give a law such "
                 "as '2.06e8*z + 1.28e7*zd'"
             )
+        if self.impact_scaled:  # judged as the impact at the motion's velocity scale
+            return self.at_impact(scenario.scales()[1]).check_physical(scenario, what)
         x, v = scenario.scales()
         Z, V = x, 4.0 * v
         zz, vv = np.meshgrid(np.linspace(Z / 64, Z, 64), np.linspace(0.0, V, 65))
@@ -408,10 +453,11 @@ class ForceLaw:
                 "resolves; check the coefficients' units (N/m, N s/m) and the scenario's masses"
             )
 
-    def __call__(self, zeta, dzeta, zeta_max=None):
+    def __call__(self, zeta, dzeta, zeta_max=None, v0=None):
         """Contact force ``F(zeta, dzeta)`` [N] with conditions (3)-(5) applied (and the
         law's unloading branch, if it has one: ``zeta_max`` is then the contact's largest
-        penetration, default ``zeta`` itself).
+        penetration, default ``zeta`` itself; ``v0`` the impact's approach velocity of an
+        impact-scaled law, required for one).
 
         Parameters
         ----------
@@ -420,6 +466,13 @@ class ForceLaw:
         dzeta : array_like
             Penetration velocity [m/s] (negative values act as 0).
         """
+        if self.impact_scaled:
+            if v0 is None:
+                raise InputError(
+                    f"law '{self}' scales its damping by each impact's approach velocity: "
+                    "give v0 (the penetration rate at the contact's onset)"
+                )
+            return self.at_impact(v0)(zeta, dzeta, zeta_max)
         zeta = np.asarray(zeta, dtype=float)
         dzeta = np.asarray(dzeta, dtype=float)
         zp = np.maximum(zeta, 0.0)
@@ -485,6 +538,8 @@ class ForceLaw:
             )
         if self.permanent_set:
             text += rf"\quad\text{{set }} s = {self.permanent_set:.{digits}g}"
+        if self.impact_scaled:
+            text += r"\quad\text{velocity terms over the impact velocity } v_0"
         return text
 
 

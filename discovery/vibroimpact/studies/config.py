@@ -49,7 +49,7 @@ from ..._io import short
 from ..._validate import Text, check, params
 from ...errors import InputError, VidiError
 from ..fit.regression import SELECTIONS
-from ..model.law import ForceLaw
+from ..model.contact_models import is_model_text, parse_law
 from ..model.library import Library
 from ..model.scenario import load_scenario
 
@@ -211,7 +211,8 @@ def _check_fs(name, value, source):
 def _check_library(name, value, source):
     if not isinstance(value, str):
         _fail(source, f'library values are texts such as "poly:2"; got {value!r}')
-    Library.parse(value)
+    if value != "contact-models":  # the named contact models (fit.contact_fit)
+        Library.parse(value)
 
 
 def _check_selection(name, value, source):
@@ -227,7 +228,7 @@ def _check_refine(name, value, source):
 def _check_law(name, value, source):
     if not isinstance(value, str):
         _fail(source, f'law values are texts such as "2e8*z + 1e7*zd"; got {value!r}')
-    ForceLaw.parse(value)
+    parse_law(value)
 
 
 _FACTOR_CHECKS = {
@@ -273,7 +274,8 @@ def _resolve(cell, fit, record, seed, cache=None):
     else:
         lk = ("law", law)
         if lk not in cache:
-            cache[lk] = ForceLaw.parse(law).to_text()
+            # a named model keeps its name (the truth a contact-models fit is scored by)
+            cache[lk] = parse_law(law).to_text() if not is_model_text(law) else law
         law = cache[lk]
     return {
         "law": law,
@@ -456,7 +458,7 @@ def _check_cells(cells, source):
                 _fail(source, f"scenario {scenarios[0].name!r} has no law; give [factors] law")
             truth, what = scenarios[0].law, f"the scenario's law ({scenarios[0].name})"
         else:
-            truth, what = ForceLaw.parse(law), "[factors] law"
+            truth, what = parse_law(law), "[factors] law"
         for sc in scenarios:
             try:
                 truth.check_physical(sc, what)

@@ -403,6 +403,7 @@ def _orbit_history(scenario, law, ss, block, tolerances):
         t_eval=fold.td,
         tolerances=tolerances,
         zeta_max0=ss.zeta_max0,
+        impact_v0=ss.impact_v0,
     )
     return np.asarray(tr.force, dtype=float)
 

@@ -1,0 +1,383 @@
+"""Fit the named contact models (:mod:`~discovery.vibroimpact.model.contact_models`) to
+records and say which one they support.
+
+Each model is fitted by output error (:func:`discovery.identify`: every evaluation a full
+simulation from the record's measured state, least squares on the force and penetration
+residuals) over its physical parameters themselves (``k, c``; ``k, n, lambda``;
+``k, n, e``), the Jacobian by differences of full simulations: ``n`` and ``e`` enter
+the force non-linearly, and ``e`` through each impact's approach velocity, a contact state
+the kernel does not differentiate.  The start is the record's spring-dashpot estimate
+(:func:`~discovery.vibroimpact.fit.identify.record_start`) at ``n = 1.25`` for the models
+that fit ``n``.  Every fitted model is then checked against every record with its noise
+floor (the verdict of :mod:`discovery.vibroimpact.verify`), and the 95 % intervals are
+``+-1.96`` standard errors from that Jacobian (or the bootstrap through the record-span
+processing with ``n_boot > 0``).
+
+Selection: the model with the lowest mean criterion (I2) among those consistent with every
+record (among all when none is); every other consistent model is one the record cannot
+tell from it (``equivalent``).  Lankarani-Nikravesh and Flores make the same force for
+``e`` related by ``r = 3 (1 - e_LN^2) / 4 = 8 (1 - e_F) / (5 e_F)``; on a record whose
+impacts all arrive at one velocity (a periodic orbit), Hunt-Crossley with
+``lambda = k r / v0`` makes it too.  Those are reported as equivalent, never guessed
+between.
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..._printing import readable
+from ..._validate import Real, params
+from ...errors import InputError, IntegrationError
+from ..data.measurement import Measurement
+from ..model.contact_models import MODELS
+from ..model.scenario import Scenario
+from ..verify import Reference
+from .contact_starts import from_hunt_crossley, record_samples, regression_start, start_model
+from .identify import as_records, identify
+
+__all__ = ["ContactFit", "ContactModelsResult", "fit_contact_models"]
+
+SCHEMA_VERSION = 1
+_Z95 = 1.959963984540054
+
+
+@dataclass(frozen=True)
+class ContactFit:
+    """One named model fitted to the record(s).
+
+    Attributes
+    ----------
+    model : str
+    parameters : dict
+        ``{name: value}`` of the fitted model (``k``, ``n``, ``c`` / ``lambda`` / ``e``).
+    intervals : dict
+        ``{name: [low, high]}``, 95 %.
+    criteria : dict
+        Mean criteria I0..I5 over the records.
+    value : float
+        The mean I2.
+    consistent : bool or None
+        Consistent with every record (None: the fit failed).
+    law : str
+        The fitted law's text (``ForceLaw.to_text``).
+    message : str
+    n_simulations : int
+    interval_method : str
+        How the intervals were made (the bootstrap, or the Jacobian's standard errors).
+    conditions : dict
+        The paper's conditions (3)-(6) for the fitted model
+        (:meth:`~discovery.vibroimpact.model.contact_models.ContactModel.conditions`).
+    """
+
+    model: str
+    parameters: dict
+    intervals: dict
+    criteria: dict
+    value: float
+    consistent: object
+    law: str
+    message: str = ""
+    n_simulations: int = 0
+    interval_method: str = ""
+    conditions: dict = field(default_factory=dict)
+
+    def to_dict(self):
+        return {
+            "schema_version": SCHEMA_VERSION,
+            "model": self.model,
+            "parameters": {k: float(v) for k, v in self.parameters.items()},
+            "intervals": {k: [float(a), float(b)] for k, (a, b) in self.intervals.items()},
+            "criteria": {k: float(v) for k, v in self.criteria.items()},
+            "value": float(self.value),
+            "consistent": self.consistent,
+            "law": self.law,
+            "message": self.message,
+            "n_simulations": int(self.n_simulations),
+            "interval_method": self.interval_method,
+            "conditions": {k: dict(v) for k, v in self.conditions.items()},
+        }
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(
+            model=d["model"],
+            parameters=dict(d["parameters"]),
+            intervals={k: tuple(v) for k, v in d["intervals"].items()},
+            criteria=dict(d["criteria"]),
+            value=float(d["value"]),
+            consistent=d["consistent"],
+            law=d["law"],
+            message=d.get("message", ""),
+            n_simulations=int(d.get("n_simulations", 0)),
+            interval_method=d.get("interval_method", ""),
+            conditions={k: dict(v) for k, v in d.get("conditions", {}).items()},
+        )
+
+    def __post_init__(self):
+        object.__setattr__(
+            self, "intervals", {k: tuple(float(x) for x in v) for k, v in self.intervals.items()}
+        )
+
+
+@readable
+@dataclass(frozen=True)
+class ContactModelsResult:
+    """Which named contact model the record(s) support.
+
+    Attributes
+    ----------
+    fits : tuple of ContactFit
+        Every model fitted, best (lowest I2) first.
+    selected : str or None
+        The model the record supports: the consistent model with the lowest I2 (None when
+        none is consistent).
+    equivalent : tuple of str
+        The other models consistent with every record: the record cannot tell them from
+        the selected one.
+    settings : dict
+    seconds : float
+    """
+
+    KIND = "contact-models"  # its kind among the results discovery.load reads
+
+    fits: tuple
+    selected: object
+    equivalent: tuple = ()
+    settings: dict = field(default_factory=dict)
+    seconds: float = 0.0
+
+    def fit(self, name):
+        """The :class:`ContactFit` of a model."""
+        for f in self.fits:
+            if f.model == name:
+                return f
+        raise KeyError(name)
+
+    def to_dict(self):
+        return {
+            "schema_version": SCHEMA_VERSION,
+            "result": self.KIND,
+            "library": "contact-models",
+            "selected": self.selected,
+            "equivalent": list(self.equivalent),
+            "fits": [f.to_dict() for f in self.fits],
+            "fit_settings": dict(self.settings),
+            "seconds": float(self.seconds),
+            "conclusion": self.conclusion,
+        }
+
+    @classmethod
+    def from_dict(cls, d):
+        return cls(
+            fits=tuple(ContactFit.from_dict(f) for f in d["fits"]),
+            selected=d["selected"],
+            equivalent=tuple(d["equivalent"]),
+            settings=dict(d["fit_settings"]),
+            seconds=float(d["seconds"]),
+        )
+
+    def save(self, directory):
+        """Write ``summary.json`` (:meth:`to_dict`) into ``directory``."""
+        import json
+        from pathlib import Path
+
+        path = Path(directory)
+        path.mkdir(parents=True, exist_ok=True)
+        (path / "summary.json").write_text(json.dumps(self.to_dict(), indent=2, default=str))
+        return path / "summary.json"
+
+    @property
+    def conclusion(self):
+        """One sentence: the model the record supports and those it cannot tell from it."""
+        if self.selected is None:
+            best = self.fits[0].model if self.fits else "none"
+            return (
+                f"No named contact model is consistent with the record (closest: {best}); "
+                "the contact is none of them, try the polynomial library or vidi explain"
+            )
+        text = f"The record supports {self.selected}"
+        if self.equivalent:
+            text += (
+                f"; it cannot tell it from {', '.join(self.equivalent)} (consistent too: a "
+                "record with impacts at other velocities, e.g. another drive amplitude, "
+                "would separate them)"
+            )
+        return text
+
+    def _lines(self):
+        out = [self.conclusion]
+        for f in self.fits:
+            mark = "*" if f.model == self.selected else " "
+            ok = {True: "consistent", False: "inconsistent", None: "failed"}[f.consistent]
+            out.append(f" {mark} {f.model:<20s} I2 {f.value:.4g}  {ok}")
+            for k, v in f.parameters.items():
+                lo, hi = f.intervals.get(k, (np.nan, np.nan))
+                out.append(f"      {k:<7s} {v:.5g}  95 % [{lo:.5g}, {hi:.5g}]")
+            if f.model == self.selected and f.conditions:
+                out.append(
+                    "      conditions: "
+                    + ", ".join(
+                        f"{k} {'holds' if c['holds'] else 'does not hold'}"
+                        for k, c in f.conditions.items()
+                    )
+                )
+        return out
+
+
+def _intervals(model, res, n_boot, records, seed, tolerances):
+    """95 % intervals: the bootstrap's when asked for and available, else +-1.96 standard
+    errors."""
+    if n_boot:
+        from .identify import bootstrap_intervals
+
+        iv = bootstrap_intervals(
+            *zip(*records, strict=True), model, n_boot=n_boot, seed=seed, tolerances=tolerances
+        )
+        if iv is not None:
+            return {k: tuple(v) for k, v in iv.bounds.items()}, "bootstrap"
+    se = res.standard_errors or {}
+    return {  # a parameter whose standard error is not estimable has no interval
+        k: (v - _Z95 * se[k], v + _Z95 * se[k])
+        for k, v in zip(model.names, model.values, strict=True)
+        if k in se and np.isfinite(se[k])
+    }, "1.96 standard errors (Jacobian)"
+
+
+def _fit_one(name, records, settings, progress, hunt_crossley=None):
+    sc0, ref0 = records[0]
+    extra = (regression_start(name, settings["samples"]),)
+    if name in ("lankarani-nikravesh", "flores"):
+        extra += (from_hunt_crossley(name, hunt_crossley, sc0, ref0),)
+    start = start_model(name, records, settings["tolerances"], extra)
+    try:
+        res = identify(
+            [sc for sc, _ in records],
+            [ref for _, ref in records],
+            start,
+            max_simulations=settings["max_simulations"],
+            tolerances=settings["tolerances"],
+            progress=progress,
+        )
+    except (IntegrationError, InputError) as exc:
+        return ContactFit(
+            model=name,
+            parameters=start.params,
+            intervals={},
+            criteria={},
+            value=float("inf"),
+            consistent=None,
+            law=start.law.to_text(),
+            message=f"fit failed: {exc}",
+        )
+    model = res.law
+    iv, method = _intervals(
+        model, res, settings["n_boot"], records, settings["seed"], settings["tolerances"]
+    )
+    params = dict(zip(model.names, model.values, strict=True))
+    return ContactFit(
+        model=name,
+        parameters=params,
+        intervals=iv,
+        criteria={k: float(v) for k, v in res.criteria.items()},
+        value=float(res.criteria.get("I2", res.value)),
+        consistent=bool(res.consistent),
+        law=model.law.to_text(),
+        message=res.message,
+        n_simulations=res.n_simulations,
+        interval_method=method,
+        conditions=model.conditions(),
+    )
+
+
+@params(
+    scenario=(Scenario, list, tuple),
+    reference=(Measurement, Reference, list, tuple),
+    models=(None, list, tuple),
+    max_simulations=Real(2, integer=True),
+    n_boot=Real(0, integer=True),
+    seed=Real(0, integer=True),
+)
+def fit_contact_models(
+    scenario,
+    reference,
+    *,
+    models=None,
+    max_simulations=200,
+    n_boot=30,
+    seed=0,
+    tolerances=None,
+    progress=None,
+):
+    """Fit every named contact model to the record(s) and select the one they support.
+
+    Parameters
+    ----------
+    scenario : Scenario or sequence of Scenario
+        One per record (or one for all).
+    reference : Measurement or Reference, or a sequence of them
+    models : sequence of str, optional
+        Models to fit (default all of :data:`~discovery.vibroimpact.model.contact_models.MODELS`).
+    max_simulations : int
+        Budget of each model's fit.
+    n_boot : int
+        Bootstrap replicates of the intervals through the record-span processing (default
+        30, as ``vidi fit``; 0 or a record without positions: +-1.96 standard errors of
+        the fit's Jacobian).
+    seed : int
+    tolerances : Tolerances, optional
+    progress : callable, optional
+        ``progress(stage, done, total)``.
+
+    Returns
+    -------
+    ContactModelsResult
+    """
+    t0 = time.perf_counter()
+    names = list(MODELS) if models is None else [str(m) for m in models]
+    bad = [m for m in names if m not in MODELS]
+    if bad or not names:
+        raise InputError(
+            f"unknown contact model {bad[0] if bad else ''!r}; the models: {', '.join(MODELS)}"
+        )
+    records = as_records(scenario, reference)
+    settings = {
+        "samples": record_samples(scenario, reference),
+        "max_simulations": int(max_simulations),
+        "n_boot": int(n_boot),
+        "seed": int(seed),
+        "tolerances": tolerances,
+    }
+    fits = []
+    # Hunt-Crossley first: its fit starts Lankarani-Nikravesh and Flores (the same force
+    # at one impact velocity)
+    order = sorted(names, key=lambda m: m in ("lankarani-nikravesh", "flores"))
+    for i, name in enumerate(order):
+        if progress is not None:
+            progress("contact models", i, len(names))
+        hc = next((f for f in fits if f.model == "hunt-crossley"), None)
+        fits.append(_fit_one(name, records, settings, None, hc))
+    if progress is not None:
+        progress("contact models", len(names), len(names))
+    fits.sort(key=lambda f: f.value)
+    ok = [f.model for f in fits if f.consistent]
+    selected = ok[0] if ok else None
+    return ContactModelsResult(
+        fits=tuple(fits),
+        selected=selected,
+        equivalent=tuple(ok[1:]),
+        settings={
+            "models": names,
+            "max_simulations": int(max_simulations),
+            "n_boot": int(n_boot),
+            "seed": int(seed),
+            "interval_method": (
+                f"bootstrap ({int(n_boot)} replicates) where the record allows, else "
+                "1.96 standard errors (Jacobian)"
+                if n_boot
+                else "1.96 standard errors (Jacobian)"
+            ),
+        },
+        seconds=time.perf_counter() - t0,
+    )

@@ -1,0 +1,54 @@
+"""The report of a ``vidi fit --library contact-models`` run, from its ``summary.json``
+alone: every named model fitted, its parameters with their 95 % intervals, its verdict,
+and which model the record supports and which it cannot tell from it."""
+
+from __future__ import annotations
+
+from .lawtex import prose
+from .texenv import Tex, escape, num
+
+__all__ = ["contact_models_context"]
+
+_PARAM_TEX = {"k": "k", "n": "n", "c": "c", "lambda": r"\lambda", "e": "e"}
+_FORMS = {
+    "kelvin-voigt": r"k\zeta + c\dot\zeta",
+    "hertz-damper": r"k\zeta^{1.5} + c\dot\zeta",
+    "hunt-crossley": r"k\zeta^n + \lambda\zeta^n\dot\zeta",
+    "lankarani-nikravesh": r"k\zeta^n\left(1 + \tfrac{3(1-e^2)}{4}\,\dot\zeta/v_0\right)",
+    "flores": r"k\zeta^n\left(1 + \tfrac{8(1-e)}{5e}\,\dot\zeta/v_0\right)",
+}
+
+
+def _rows(fits, selected):
+    rows = []
+    for f in fits:
+        name = Tex(escape(f["model"]) + (r" $\star$" if f["model"] == selected else ""))
+        ok = {True: "consistent", False: "inconsistent"}.get(f.get("consistent"), "failed")
+        params = []
+        for k, v in f["parameters"].items():
+            iv = f["intervals"].get(k)
+            text = f"${_PARAM_TEX.get(k, escape(k))}$ = {num(v, 4)}"
+            if iv:
+                text += f" [{num(iv[0], 4)}, {num(iv[1], 4)}]"
+            params.append(text)
+        rows.append(
+            [
+                name,
+                Tex(f"${_FORMS.get(f['model'], '')}$"),
+                num(f.get("value"), 3),
+                escape(ok),
+                Tex("; ".join(params)),
+            ]
+        )
+    return rows
+
+
+def contact_models_context(s, run_dir):
+    """The template context (``contact_models.tex.j2``)."""
+    return {
+        "title": "The named contact models against a record",
+        "rows": _rows(s.get("fits") or [], s.get("selected")),
+        "conclusions": [prose(s.get("conclusion") or "--")],
+        "interval_method": escape((s.get("fit_settings") or {}).get("interval_method", "--")),
+        "figures": [],
+    }

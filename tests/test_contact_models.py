@@ -1,0 +1,298 @@
+"""The named contact models: the per-impact approach velocity in both simulators, the law
+text, the result's round trip, and the fit that names the model of a record."""
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from realistic import reference_record  # noqa: E402
+
+from discovery.errors import InputError  # noqa: E402
+from discovery.vibroimpact.dynamics.reference import reference_simulate  # noqa: E402
+from discovery.vibroimpact.dynamics.simulate import simulate  # noqa: E402
+from discovery.vibroimpact.dynamics.steady_state import steady_state  # noqa: E402
+from discovery.vibroimpact.fit.contact_fit import (  # noqa: E402
+    ContactFit,
+    ContactModelsResult,
+    fit_contact_models,
+)
+from discovery.vibroimpact.model.contact_models import (  # noqa: E402
+    MODELS,
+    ContactModel,
+    parse_law,
+    parse_model,
+    restitution_from_ratio,
+    restitution_ratio,
+)
+from discovery.vibroimpact.model.law import ForceLaw  # noqa: E402
+from discovery.vibroimpact.model.scenario import load_scenario  # noqa: E402
+
+
+def _paper_model(name, n=1.3, e=0.6):
+    """A model on the paper's machine: the paper's stiffness at the typical penetration."""
+    sc = load_scenario("paper")
+    mu = sc.m1 * sc.m2 / (sc.m1 + sc.m2)
+    v = sc.scales()[1]
+    k_lin = 2.06e8
+    z0 = v * math.sqrt(mu / k_lin)
+    n = {"kelvin-voigt": 1.0, "hertz-damper": 1.5}.get(name, n)
+    k = k_lin * z0 ** (1 - n)
+    if name in ("kelvin-voigt", "hertz-damper"):
+        return sc, ContactModel(name, (k, 0.4 * math.sqrt(k_lin * mu)))
+    if name == "hunt-crossley":
+        return sc, ContactModel(name, (k, n, k * restitution_ratio("flores", e) / v))
+    return sc, ContactModel(name, (k, n, e))
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+def test_kernel_and_scipy_path_agree(name):
+    sc, model = _paper_model(name)
+    law = model.law
+    T = sc.period
+    te = np.linspace(0.0, 12 * T, 2401)
+    tr = simulate(sc, law, (0.0, 12 * T), t_eval=te)
+    ref = reference_simulate(sc, law, (0.0, 12 * T), t_eval=te, rtol=1e-10)
+    scale = np.max(ref["force"])
+    assert scale > 0
+    assert np.max(np.abs(tr.force - ref["force"])) < 1e-5 * scale
+    # the impacts really differ in velocity from rest, so the per-impact memory is exercised
+    onsets = [y for _, kind, y in ref["events"] if kind == "onset"]
+    v0 = [y[1] - y[3] for y in onsets]
+    assert len(v0) >= 3 and max(v0) > 1.05 * min(v0)
+
+
+def test_impact_scaling_is_per_impact():
+    """An impact-scaled law is the plain law of each impact's own approach velocity."""
+    _, model = _paper_model("flores")
+    law = model.law
+    assert law.impact_scaled and law.has_memory
+    plain = law.at_impact(0.5)
+    assert not plain.impact_scaled
+    np.testing.assert_allclose(law(1e-4, 0.2, v0=0.5), plain(1e-4, 0.2), rtol=1e-14)
+    with pytest.raises(InputError, match="v0"):
+        law(1e-4, 0.2)
+
+
+def test_steady_state_with_impact_scaling():
+    sc, model = _paper_model("flores", n=1.3, e=0.45)
+    ss = steady_state(sc, model.law)
+    assert ss.periodic and ss.impact_v0 > 0
+    n = ss.n_periods
+    tr = simulate(
+        sc,
+        model.law,
+        (ss.t0, ss.t0 + n * sc.period),
+        y0=ss.y0,
+        zeta_max0=ss.zeta_max0,
+        impact_v0=ss.impact_v0,
+    )
+    x, v = sc.scales()
+    assert np.max(np.abs(tr.y_final - ss.y0) / np.array([x, v, x, v])) < 1e-6
+
+
+def test_a_start_inside_a_contact_takes_its_approach_velocity():
+    """Started inside a contact with that contact's approach velocity, both simulators
+    continue the run they were cut from; with another velocity they do not."""
+    sc, model = _paper_model("flores", n=1.3, e=0.45)
+    law, T = model.law, sc.period
+    te = np.linspace(0.0, 6 * T, 60001)
+    full = simulate(sc, law, (0.0, 6 * T), t_eval=te)
+    inside = np.flatnonzero((full.zeta > 0) & (full.mode == 1) & (te > 3 * T))
+    i = int(inside[len(inside) // 2])
+    onset = np.flatnonzero((full.event_kind == 1) & (full.event_t < te[i]))[-1]
+    v0 = float(full.event_y[onset, 1] - full.event_y[onset, 3])
+    t_end = te[i] + 0.3 * T
+    x, v = sc.scales()
+    scale = np.array([x, v, x, v])
+    whole = simulate(sc, law, (0.0, t_end)).y_final
+    for v_start, close in ((v0, True), (2 * v0, False)):
+        k = simulate(sc, law, (te[i], t_end), y0=full.y[:, i], impact_v0=v_start).y_final
+        r = reference_simulate(
+            sc, law, (te[i], t_end), y0=full.y[:, i], rtol=1e-10, impact_v0=v_start
+        )["y_final"]
+        assert np.max(np.abs(k - r) / scale) < 1e-6  # the two simulators agree
+        assert (np.max(np.abs(k - whole) / scale) < 1e-5) == close
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+def test_text_round_trip(name):
+    _, model = _paper_model(name)
+    assert parse_model(model.to_text()) == model
+    law = model.law
+    assert ForceLaw.parse(law.to_text()) == law
+    assert parse_law(model.to_text()) == law  # --law takes the model's text
+    assert parse_law(law.to_text()) == law
+    assert parse_model(model.format(17).replace(" ", "  ")).values == pytest.approx(model.values)
+
+
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("hunt-crossley: k=2e9, n=1.5", "needs lambda"),
+        ("hunt-crossley: k=2e9, n=1.5, lambda=1e9, e=0.5", "once each"),
+        ("flores: k=2e9, n=1.5, e=1.5", "restitution"),
+        ("flores: k=-2e9, n=1.5, e=0.5", "stiffness"),
+        ("kelvin-voigt: k=2e8, c=abc", "number"),
+        ("2e8*z; scale: v1", "scale"),
+    ],
+)
+def test_bad_text_is_one_input_error(text, match):
+    with pytest.raises(InputError, match=match):
+        parse_law(text)
+
+
+@pytest.mark.parametrize("name", list(MODELS))
+def test_the_papers_conditions(name):
+    _, model = _paper_model(name)
+    cond = model.conditions()
+    assert cond["(3)"]["holds"] and cond["(4)"]["holds"] and cond["(6)"]["holds"]
+    assert not cond["(5)"]["holds"]  # damping while unloading: outside (5) on purpose
+    plain = model.with_coefficients(
+        [
+            0.0 if k in ("c", "lambda") else (1.0 if k == "e" else v)
+            for k, v in zip(model.names, model.values, strict=True)
+        ]
+    )
+    assert plain.conditions()["(5)"]["holds"]  # no damping: (5) holds
+
+
+def test_restitution_maps_invert():
+    for name in ("lankarani-nikravesh", "flores"):
+        for e in (0.3, 0.6, 0.9):
+            assert restitution_from_ratio(name, restitution_ratio(name, e)) == pytest.approx(e)
+    assert math.isnan(restitution_from_ratio("lankarani-nikravesh", 0.8))
+
+
+def test_result_round_trip(tmp_path):
+    fit = ContactFit(
+        model="flores",
+        parameters={"k": 2e9, "n": 1.3, "e": 0.6},
+        intervals={"k": (1.9e9, 2.1e9), "n": (1.2, 1.4), "e": (0.55, 0.65)},
+        criteria={"I2": 0.01},
+        value=0.01,
+        consistent=True,
+        law="2e9*z^1.3",
+        conditions=ContactModel("flores", (2e9, 1.3, 0.6)).conditions(),
+    )
+    res = ContactModelsResult(fits=(fit,), selected="flores", equivalent=(), settings={"a": 1})
+    d = res.to_dict()
+    assert d["schema_version"] == 1
+    assert ContactModelsResult.from_dict(d) == res
+    assert ContactFit.from_dict(fit.to_dict()) == fit
+    assert (res.save(tmp_path)).exists()
+    assert "supports flores" in str(res)
+    # the report of a contact-models run: the models' table and the conclusion
+    from reports.document import render
+
+    tex = render({**d, "command": "fit"}, tmp_path)
+    assert r"flores $\star$" in tex and "The record supports flores" in tex
+
+
+def test_fit_names_the_model_of_a_clean_record():
+    """A Hunt-Crossley record of the paper's machine (scipy path, from rest, no noise) is
+    named Hunt-Crossley, its parameters inside their intervals; Kelvin-Voigt and the
+    Hertz-damper are not consistent with it."""
+    sc, model = _paper_model("hunt-crossley", n=1.2, e=0.8)
+    meas = reference_record(
+        (sc.replace(law=model.law), model.law),
+        periods=8,
+        transient=60,
+        force_noise=0.0,
+        motion_noise=0.0,
+        check=False,
+    )
+    res = fit_contact_models(
+        sc,
+        meas,
+        models=("kelvin-voigt", "hertz-damper", "hunt-crossley"),
+        max_simulations=120,
+        n_boot=0,
+    )
+    assert res.selected == "hunt-crossley", str(res)
+    fit = res.fit("hunt-crossley")
+    for key, true in model.params.items():
+        assert fit.parameters[key] == pytest.approx(true, rel=0.02)
+    assert "kelvin-voigt" not in res.equivalent and "hertz-damper" not in res.equivalent
+
+
+def test_a_study_scores_a_contact_models_fit():
+    """A study file takes named-model laws and the contact-models library; a run's
+    measures are the named model's."""
+    from discovery.vibroimpact.studies.config import load_study
+    from discovery.vibroimpact.studies.run import score_contact
+
+    cfg = load_study(Path(__file__).resolve().parents[1] / "examples/study_contact_models.toml")
+    runs = cfg.runs()
+    assert {r["library"] for r in runs} == {"contact-models"}
+    assert any(r["law"].startswith("flores:") for r in runs)
+    fit = ContactFit(
+        model="flores",
+        parameters={"k": 1.5e9, "n": 1.3, "e": 0.45},
+        intervals={"k": (1.4e9, 1.6e9), "n": (1.2, 1.4), "e": (0.46, 0.5)},
+        criteria={"I2": 0.01},
+        value=0.01,
+        consistent=True,
+        law="",
+    )
+    other = ContactFit(
+        model="hunt-crossley",
+        parameters={"k": 1.5e9, "n": 1.3, "lambda": 4e9},
+        intervals={},
+        criteria={"I2": 0.011},
+        value=0.011,
+        consistent=True,
+        law="",
+    )
+    res = ContactModelsResult(fits=(fit, other), selected="flores", equivalent=("hunt-crossley",))
+    m = score_contact(res, "flores: k=1.43e9, n=1.3, e=0.45")
+    assert m["exact"] and m["truth_equivalent"] and m["selected"] == ["flores"]
+    assert m["coverage"] == {"k": True, "n": True, "e": False}
+    assert m["coef_error"] == pytest.approx(np.sqrt(np.mean([(0.07 / 1.43) ** 2, 0, 0])))
+    m = score_contact(res, "hunt-crossley: k=1.43e9, n=1.3, lambda=4.1e9")
+    assert not m["exact"] and m["truth_equivalent"] and m["fp"] == 1
+    m = score_contact(res, "2.06e8*z + 1.28e7*zd")  # a polynomial truth: never in the family
+    assert not m["exact"] and not m["truth_in_library"] and m["selected"] == ["flores"]
+
+
+def test_cli_takes_a_named_model_as_law(tmp_path, capsys):
+    from discovery.cli import main
+
+    rec = tmp_path / "KV.csv"
+    law = "kelvin-voigt: k=2.06e8, c=4.06e5"
+    assert main(["simulate", "--law", law, "--integrator", "scipy", "--out", str(rec)]) == 0
+    capsys.readouterr()
+    bad = ["simulate", "--law", "kelvin-voigt: k=2.06e8", "--out", str(tmp_path / "x.csv")]
+    assert main(bad) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "needs c" in err[0]
+
+
+@pytest.mark.slow
+def test_cli_fit_contact_models(tmp_path, capsys):
+    """``vidi fit --library contact-models`` end to end: summary.json is the result's
+    ``to_dict()`` (with the provenance), the printout names the model."""
+    import json
+
+    from discovery.cli import main
+
+    rec = tmp_path / "F.csv"
+    law = "flores: k=1.43e9, n=1.3, e=0.45"
+    argv = ["simulate", "--law", law, "--integrator", "scipy", "--periods", "12"]
+    assert main([*argv, "--noise", "0.01", "--seed", "2", "--out", str(rec)]) == 0
+    out = tmp_path / "fit"
+    argv = ["fit", "--data", str(rec), "--library", "contact-models", "--intervals", "0"]
+    assert main([*argv, "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["schema_version"] == 1 and summary["library"] == "contact-models"
+    # one impact velocity: Flores and Hunt-Crossley make the same force; both are named
+    assert {summary["selected"], *summary["equivalent"]} >= {"flores", "hunt-crossley"}
+    assert "cannot tell" in text
+    res = ContactModelsResult.from_dict(summary)
+    e = res.fit("flores").intervals["e"]
+    assert e[0] <= 0.45 <= e[1] or abs(res.fit("flores").parameters["e"] - 0.45) < 0.01
