@@ -65,6 +65,7 @@ def run(i, *, n_boot=30, noise_model="cycles", periods=12, refit="two-step"):
     fs = float(rng.uniform(5000.0, 20000.0))
     row = {
         "i": i,
+        "code": _code(),
         "category": category,
         "noise": level,
         "fs": fs,
@@ -162,7 +163,7 @@ def run_corpus(name, *, n_boot=30, noise_model="cycles", refit="two-step"):
     from .test_corpus import CORPUS
 
     t0 = time.perf_counter()
-    row = {"i": name, "category": "corpus", "noise": "corpus", "kind": name}
+    row = {"i": name, "code": _code(), "category": "corpus", "noise": "corpus", "kind": name}
     try:
         sc, model, truth = _corpus_model(name)
         rng = np.random.default_rng(int(name[1:3]))
@@ -207,6 +208,49 @@ def run_corpus(name, *, n_boot=30, noise_model="cycles", refit="two-step"):
     return row
 
 
+def _code():
+    from discovery.vibroimpact.studies.driver import code_version
+
+    return code_version()
+
+
+CLASSES = {
+    "category": ("p1", "p1-slow", "short-contact", "subharmonic"),
+    "kind": ("linear", "coupling-strong", "coupling-weak", "hertz"),
+    "noise": ("low", "high"),
+}
+
+
+def markdown_row(rows, label):
+    """One row of the README's coverage table: the coverage per class and in all, and the
+    code versions that made the rows."""
+    ok = [r for r in rows if "error" not in r and r.get("consistent") and r.get("covered")]
+    cells = [f"{label} ({len(ok)} of {len(rows)} records with intervals)"]
+    for key, names in CLASSES.items():
+        rates = []
+        for n in names:
+            v = [c for r in ok if r[key] == n for c in r["covered"].values()]
+            rates.append(f"{sum(v)}/{len(v)}" if v else "-")
+        cells.append(" / ".join(rates))
+    allv = [v for r in ok for v in r["covered"].values()]
+    cells.append(f"{sum(allv)}/{len(allv)} = **{sum(allv) / max(len(allv), 1):.1%}**")
+    codes = sorted({r.get("code", "?") for r in rows})
+    cells.append(", ".join(codes))
+    return "| " + " | ".join(cells) + " |"
+
+
+def read_rows(paths):
+    """The JSON lines of ``paths``; a record run again in a later file replaces its row."""
+    rows = {}
+    for path in paths:
+        with open(path) as fh:
+            for line in fh:
+                if line.startswith("{"):
+                    r = json.loads(line)
+                    rows[r["i"]] = r
+    return list(rows.values())
+
+
 def summary(rows):
     ok = [r for r in rows if "error" not in r and r.get("consistent") and r.get("covered")]
     print(
@@ -237,12 +281,13 @@ def main(argv=None):
     p.add_argument("--noise", default="cycles", choices=("cycles", "white"))
     p.add_argument("--refit", default="two-step", choices=("two-step", "full"))
     p.add_argument("--workers", type=int, default=1)
-    p.add_argument("--summary", metavar="JSONL")
+    p.add_argument("--summary", metavar="JSONL", nargs="+")
+    p.add_argument("--markdown", metavar="LABEL", help="with --summary: the table row")
     p.add_argument("--corpus", action="store_true", help="the corpus's records instead")
     a = p.parse_args(argv)
     if a.summary:
-        with open(a.summary) as fh:
-            summary([json.loads(line) for line in fh if line.startswith("{")])
+        rows = read_rows(a.summary)
+        print(markdown_row(rows, a.markdown)) if a.markdown else summary(rows)
         return 0
     if a.corpus:
         from .test_corpus import NAMES
