@@ -303,3 +303,20 @@ def test_fit_cli_with_two_records_and_their_scenarios(two_points, tmp_path, caps
     )
     assert "one --scenario per --data" in capsys.readouterr().err
     assert not out2.exists()
+
+
+def test_standard_errors_beyond_the_budget_are_left_out(paper, reference, monkeypatch):
+    """The standard errors' Jacobian has its own budget; when it needs more simulations than
+    that, the fit is returned without them (no internal budget error escapes)."""
+    import importlib
+
+    ident = importlib.import_module("discovery.vibroimpact.fit.identify")
+
+    def over_budget(self, x):
+        raise ident._Budget
+
+    monkeypatch.setattr(ident._Objective, "jacobian", over_budget)
+    monkeypatch.setattr(ident._Objective, "_exact_columns", lambda self: ([0, 1], True))
+    res = identify(paper, reference, START, method="nelder-mead", max_simulations=30, check=False)
+    assert res.standard_errors == {} and res.correlation is None
+    assert np.all(np.isfinite(res.law.coefficients))

@@ -598,7 +598,15 @@ def _coordinate_descent(obj, x0, xtol, step0=0.1):
 
 def _uncertainty(obj, x, names):
     """Standard errors and correlations from the residual Jacobian at ``x`` (exact where
-    :meth:`_Objective.jacobian` can be, else forward differences)."""
+    :meth:`_Objective.jacobian` can be, else forward differences); none when the
+    simulations they need are beyond the budget."""
+    try:
+        return _standard_errors(obj, x, names)
+    except _Budget:
+        return {}, None
+
+
+def _standard_errors(obj, x, names):
     r0 = obj.residuals(x)
     if obj.exact_columns[1]:
         J = obj.jacobian(x)
