@@ -18,16 +18,17 @@ from discovery.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 
-# `vidi steady --out DIR`, held inside the output stage (the staging directory exists)
+# `vidi steady --out DIR`, held inside the output stage (the staging directory exists):
+# the result is written into the open stage (``Result.write_into``)
 _CHILD = textwrap.dedent("""
     import sys, time
-    import discovery.cli.steady as st
-    real = st.provenance
+    import discovery._result as R
+    real = R.Result.write_into
     def slow(*a, **k):
         print("staged", flush=True)
         time.sleep(120)
         return real(*a, **k)
-    st.provenance = slow
+    R.Result.write_into = slow
     from discovery.cli import main
     sys.exit(main(["steady", "--out", sys.argv[1]]))
 """)
@@ -100,8 +101,8 @@ def test_signal_exits_with_one_line(earlier, sig, code, word):
 # went on; vidi's entry point gives it back to the main thread
 _LOST = textwrap.dedent("""
     import sys, time, weakref
-    import discovery.cli.steady as st
-    real = st.provenance
+    import discovery._result as R
+    real = R.Result.write_into
     def lost(*a, **k):
         class Held: pass
         h = Held()
@@ -111,7 +112,7 @@ _LOST = textwrap.dedent("""
         del h  # the callback raises: an unraisable interrupt
         time.sleep(5)
         return real(*a, **k)
-    st.provenance = lost
+    R.Result.write_into = lost
     from discovery.cli import main
     sys.argv = ["vidi", "steady", "--out", sys.argv[1]]
     sys.exit(main())

@@ -188,7 +188,7 @@ class ContactModel:
         """No observation model."""
         return None
 
-    def _free(self):
+    def free_effects(self):
         return []  # no parameter beyond the model's own (identify's bounds)
 
     def conditions(self):
