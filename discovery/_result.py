@@ -45,7 +45,7 @@ KINDS = {
     "ranked-model": "discovery.vibroimpact.fit.discover:RankedModel",
     "fit": "discovery.vibroimpact.fit.discover:DiscoveryResult",
     "identify": "discovery.vibroimpact.fit.identify:IdentificationResult",
-    "intervals": "discovery.vibroimpact.fit.identify:Intervals",
+    "intervals": "discovery.vibroimpact.fit.intervals:Intervals",
     "explain-iteration": "discovery.vibroimpact.explain.explain:Iteration",
     "explain": "discovery.vibroimpact.explain.explain:ExplainResult",
     "study": "discovery.vibroimpact.studies.driver:StudyResult",
