@@ -1,88 +1,18 @@
-"""The residual problem of the missing-effect loop: a model's evaluations on every record (with
-a memo), its force and penetration residuals, mean criteria and the noise; and the drift
-channel across the impacts (:mod:`discovery.vibroimpact.explain.drift`).
+"""The residual problem of the missing-effect loop (the fit's
+:class:`~discovery.vibroimpact.fit.problem.ModelProblem`: a model's evaluations on every record
+with a memo, its residuals, mean criteria and the noise), the drift channel across the impacts
+(:mod:`discovery.vibroimpact.explain.drift`), and the mean criteria with the drift's.
 """
 
 import numpy as np
 
-from ...numerics.memo import Memo, value_key
-from ..fit.records import contact_scales, cycle_pairs
-from ..verify import evaluate
-from ..verify.motion import penetration_residuals
+from ..fit.problem import ModelProblem
+from ..fit.records import contact_scales
 from . import drift as D
 from .effects import EFFECTS, small_step
 
-
-class _Problem:
-    """Residuals of a model against all records, and their sensitivities."""
-
-    def __init__(self, records, tolerances):
-        self.records, self.tol = records, tolerances
-        self.n_sim = 0
-        # a model named in one iteration is verified again at the start of the next, and
-        # its residual follows its verification: those asks are answered from here (and
-        # the block simulations a floor and a residual share, from the verify layer's)
-        self._memo = Memo(16)
-
-    def evaluations(self, model, floor=False, smooth_onset=False):
-        """The model's evaluation on every record (:func:`~discovery.vibroimpact.verify.evaluate`,
-        asked again: answered from the memo)."""
-        key = value_key(model.law, model.observation, model.scenario, floor, smooth_onset)
-        return self._memo.get(key, lambda: self._evaluate(model, floor, smooth_onset))
-
-    def _evaluate(self, model, floor, smooth_onset):
-        evs = []
-        for sc, ref in self.records:
-            self.n_sim += 1
-            evs.append(
-                evaluate(
-                    model.apply(sc),
-                    model.law,
-                    ref,
-                    tolerances=self.tol,
-                    floor=floor,
-                    observe=model.observe(),
-                    smooth_onset=smooth_onset,
-                )
-            )
-        return evs
-
-    def residual(self, model):
-        """The force residual of every compared cycle (the optimisers' continuous form),
-        then the recorded penetration's in the force's units
-        (:func:`~discovery.vibroimpact.verify.motion.penetration_residuals`)."""
-        evs = self.evaluations(model, smooth_onset=True)
-        if not all(e.status == "ok" for e in evs):
-            return None
-        return np.concatenate(
-            [
-                S.F - E.F
-                for e, (_, ref) in zip(evs, self.records, strict=True)
-                for E, S in cycle_pairs(e, ref)
-            ]
-            + [penetration_residuals(ref, e) for e, (_, ref) in zip(evs, self.records, strict=True)]
-        )
-
-    def squares(self, model):
-        """The sum of squared residuals (force and penetration, :meth:`residual`): what the
-        output-error refits minimise (inf when a record has no steady cycle)."""
-        r = self.residual(model)
-        return np.inf if r is None else float(r @ r)
-
-    def value(self, model, criterion):
-        """The mean ``criterion`` over records (inf when a record has no steady cycle)."""
-        evs = self.evaluations(model)
-        if not all(e.status == "ok" and criterion in (e.criteria or {}) for e in evs):
-            return np.inf
-        return float(np.mean([e.criteria[criterion] for e in evs]))
-
-    def sigma(self):
-        s = [
-            ref.noise["F"] / np.sqrt(max(ref.noise["n_cycles"], 1))
-            for _, ref in self.records
-            if ref.noise
-        ]
-        return float(np.sqrt(np.mean(np.square(s)))) if s else 0.0
+#: the loop's residual problem: the fit's :class:`~discovery.vibroimpact.fit.problem.ModelProblem`
+_Problem = ModelProblem
 
 
 class _Drift:

@@ -1,17 +1,23 @@
-"""The residual problem of an output-error fit: a model's coefficients (in units of the start
-values) -> every record's evaluation, the criterion and the weighted residuals, with a memo of
-the simulations, the simulation budget and the best point met; the residuals' Jacobian (exact
-from the variational equations where it can be) and the standard errors it gives.
+"""The residual problem of an output-error fit, for identify and for the missing-effect loop.
 
-Every evaluation is :func:`discovery.vibroimpact.verify.evaluate`.  The residual vector is
-``(F_N - F_E)`` of every measured cycle, weighted so that each record's squared norm is its
-``I3^2``, followed by the recorded penetration's residual (records with positions).
+:func:`output_residuals` is the residual rule: ``(F_N - F_E)`` of every compared cycle, then
+each record's recorded penetration residual in the force's units (records with positions).
+:class:`ModelProblem` is a model (a :class:`ForceLaw` or a model with more parameters,
+:func:`~.records.model_parts`) against every record, with a memo of its evaluations.
+:class:`_Objective` is identify's: a model's coefficients in units of the start values ->
+every record's evaluation, the criterion and the weighted residuals (each record's squared
+norm its ``I3^2``), with a cache of the simulations, the simulation budget and the best point
+met; the residuals' Jacobian (exact from the variational equations where it can be) and the
+standard errors it gives.
+
+Every evaluation is :func:`discovery.vibroimpact.verify.evaluate`.
 """
 
 import numpy as np
 
 from ..._progress import tick
 from ...errors import InputError, IntegrationError
+from ...numerics.memo import Memo, value_key
 from ..model.law import ForceLaw, Term
 from ..verify import evaluate
 from ..verify.criteria import criterion as _criterion
@@ -24,6 +30,122 @@ _JAC_STEP = 1e-5  # relative step of the standard-error Jacobian
 
 class _Budget(Exception):
     """The simulation budget is used up."""
+
+
+def output_residuals(evaluations, records, weights=None):
+    """The output-error residual of a model's ``evaluations`` on ``records``: the simulated
+    minus the measured force of every compared cycle (:func:`~.records.cycle_pairs`), record
+    by record, then every record's penetration residual in the force's units
+    (:func:`~discovery.vibroimpact.verify.motion.penetration_residuals`).
+
+    With ``weights`` (per record, one array per compared cycle: the sample spacing normalised
+    so that a record's squared norm is its ``I3^2``) each cycle's residual is weighted and its
+    first point (``F_E(0+)``, extrapolated from samples for an aligned cycle) left out, so a
+    fit is not biased by the extrapolation error at the jump; without, the plain differences.
+
+    Returns
+    -------
+    ndarray of shape (n,)
+    """
+    ws_all = [None] * len(records) if weights is None else weights
+    force, motion = [], []
+    for ev, (_, ref), ws in zip(evaluations, records, ws_all, strict=True):
+        pairs = cycle_pairs(ev, ref)
+        if ws is None:
+            force += [S.F - E.F for E, S in pairs]
+        else:
+            force += [((S.F - E.F) * w)[1:] for (E, S), w in zip(pairs, ws, strict=True)]
+        motion.append(penetration_residuals(ref, ev, ws))
+    return np.concatenate(force + motion)
+
+
+class ModelProblem:
+    """A model against every record: its evaluations (with a memo), residuals, mean criteria
+    and the noise of the averaged cycles.
+
+    Parameters
+    ----------
+    records : list of (Scenario, Reference)
+        The records (:func:`~.records.as_records`).
+    tolerances : Tolerances or None
+        Integrator settings of every evaluation.
+
+    Attributes
+    ----------
+    n_sim : int
+        Evaluations run (one per record; answers from the memo do not count).
+    """
+
+    def __init__(self, records, tolerances):
+        self.records, self.tol = records, tolerances
+        self.n_sim = 0
+        # a model asked for again (in the missing-effect loop: verified at the start of an
+        # iteration and named in the one before; its residual follows its verification) is
+        # answered from here (and the block simulations a floor and a residual share, from
+        # the verify layer's)
+        self._memo = Memo(16)
+
+    def evaluations(self, model, floor=False, smooth_onset=False):
+        """The model's evaluation on every record (:func:`~discovery.vibroimpact.verify.evaluate`,
+        asked again: answered from the memo)."""
+        law = model if isinstance(model, ForceLaw) else model.law
+        key = value_key(
+            law,
+            getattr(model, "observation", None),
+            getattr(model, "scenario", None),
+            floor,
+            smooth_onset,
+        )
+        return self._memo.get(key, lambda: self._evaluate(model, floor, smooth_onset))
+
+    def _evaluate(self, model, floor, smooth_onset):
+        law, machine, observe = model_parts(model)
+        evs = []
+        for sc, ref in self.records:
+            self.n_sim += 1
+            evs.append(
+                evaluate(
+                    machine(sc),
+                    law,
+                    ref,
+                    tolerances=self.tol,
+                    floor=floor,
+                    observe=observe,
+                    smooth_onset=smooth_onset,
+                )
+            )
+        return evs
+
+    def residual(self, model):
+        """The force residual of every compared cycle (the optimisers' continuous form),
+        then the recorded penetration's in the force's units (:func:`output_residuals`,
+        unweighted); None when a record has no steady cycle."""
+        evs = self.evaluations(model, smooth_onset=True)
+        if not all(e.status == "ok" for e in evs):
+            return None
+        return output_residuals(evs, self.records)
+
+    def squares(self, model):
+        """The sum of squared residuals (force and penetration, :meth:`residual`): what the
+        output-error refits minimise (inf when a record has no steady cycle)."""
+        r = self.residual(model)
+        return np.inf if r is None else float(r @ r)
+
+    def value(self, model, criterion):
+        """The mean ``criterion`` over records (inf when a record has no steady cycle)."""
+        evs = self.evaluations(model)
+        if not all(e.status == "ok" and criterion in (e.criteria or {}) for e in evs):
+            return np.inf
+        return float(np.mean([e.criteria[criterion] for e in evs]))
+
+    def sigma(self):
+        """The force noise of the averaged cycles (rms over records; 0 without noise)."""
+        s = [
+            ref.noise["F"] / np.sqrt(max(ref.noise["n_cycles"], 1))
+            for _, ref in self.records
+            if ref.noise
+        ]
+        return float(np.sqrt(np.mean(np.square(s)))) if s else 0.0
 
 
 class _Objective:
@@ -126,20 +248,7 @@ class _Objective:
                 + [np.zeros(self.n_motion)]
             )
         self(x)  # records the path with the requested criterion
-        # the first point (F_E(0+), extrapolated from samples for an aligned cycle) is left
-        # out so the fit is not biased by the extrapolation error at the jump; the recorded
-        # penetration's residual (records with positions) follows the force's
-        r = np.concatenate(
-            [
-                ((S.F - E.F) * w)[1:]
-                for ev, (_, ref), ws in zip(evs, self.records, self.w, strict=True)
-                for (E, S), w in zip(cycle_pairs(ev, ref), ws, strict=True)
-            ]
-            + [
-                penetration_residuals(ref, ev, ws)
-                for ev, (_, ref), ws in zip(evs, self.records, self.w, strict=True)
-            ]
-        )
+        r = output_residuals(evs, self.records, self.w)
         cost = float(r @ r)
         if cost < self.best_squares[0]:
             self.best_squares = (cost, np.array(x, dtype=float))
