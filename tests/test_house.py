@@ -123,6 +123,30 @@ def test_public_names_are_what_the_docs_say():
     assert callable(verify)
 
 
+def test_split_modules_keep_the_names_of_the_module_they_were():
+    """``fit/identify.py`` and ``explain/explain.py`` are split by job; every name other modules
+    and tests import from them is still there (the same object as in its new module)."""
+    ident = importlib.import_module("discovery.vibroimpact.fit.identify")
+    for mod, names in {
+        "problem": ("_Objective", "_PENALTY", "_Budget", "_uncertainty"),
+        "intervals": ("Intervals", "bootstrap_intervals", "MIN_CYCLE_DOF", "INTERVAL_REFITS"),
+        "optimise": ("METHODS", "RESTART_FACTORS", "_optimise", "_coordinate_descent"),
+        "records": ("as_records", "pair_records", "record_start", "model_parts", "cycle_pairs"),
+    }.items():
+        new = importlib.import_module(f"discovery.vibroimpact.fit.{mod}")
+        for n in names:
+            assert getattr(ident, n) is getattr(new, n), n
+    old = importlib.import_module("discovery.vibroimpact.explain.explain")
+    pkg = importlib.import_module("discovery.vibroimpact.explain")
+    for n in ("ExplainResult", "Iteration", "start_law"):
+        assert getattr(old, n) is getattr(pkg, n), n
+    assert old.explain is pkg.explain
+    fit_problem = importlib.import_module("discovery.vibroimpact.fit.problem")
+    assert old._Problem is fit_problem.ModelProblem  # one residual problem
+    for n in ("_within_noise", "_output_error", "_Screening", "_Trial", "_Run", "loaded_model"):
+        assert hasattr(old, n), n
+
+
 def test_figures_leave_the_users_backend_alone():
     """Drawing a report's figures neither loads pyplot nor switches matplotlib's backend (a
     notebook user's inline backend stays)."""

@@ -1,4 +1,5 @@
 """Fitting force laws: the certified sparse regressor (``regression``),
 discovery with full-simulation ranking (``discover``), output-error identification
-(``identify``) and coefficient intervals (``intervals``).
+(``identify``, over ``records``, the residual ``problem`` and the optimisers of ``optimise``)
+and coefficient intervals by a bootstrap (``intervals``).
 """

@@ -1,11 +1,367 @@
-"""Coefficient intervals by a parametric bootstrap through the full processing.
+"""Coefficient intervals by a bootstrap through the full processing (a refit per replicate)."""
 
-The bootstrap refits the model for every replicate, so it lives with the fit it repeats:
-:func:`discovery.vibroimpact.fit.identify.bootstrap_intervals` and
-:class:`discovery.vibroimpact.fit.identify.Intervals`,
-re-exported here (the path the documentation has always given).
-"""
+from dataclasses import dataclass, replace
 
-from .identify import Intervals, bootstrap_intervals
+import numpy as np
 
-__all__ = ["Intervals", "bootstrap_intervals"]
+from ..._result import Result
+from ...errors import InputError, IntegrationError
+from ...numerics.executor import map_on
+from .optimise import _checked, _fitted
+from .problem import _Objective
+from .records import as_records, model_parts
+
+__all__ = ["Intervals", "bootstrap_intervals", "INTERVAL_REFITS", "INTERVAL_NOISE"]
+
+# how a bootstrap replicate of the intervals is refitted (see bootstrap_intervals)
+INTERVAL_REFITS = ("two-step", "full")
+#: the bootstrap replicates' noise: the record's own residuals, each cycle's multiplied by
+#: one weight (``"cycles"``, the default), or white noise of the record's level (``"white"``)
+INTERVAL_NOISE = ("cycles", "white")
+
+
+# ------------------------------------------------------------------ bootstrap intervals
+# The Jacobian standard errors of an output-error fit assume white residuals.  A record
+# compared over its span has two more sources of error that they miss: the machine's state
+# at the start of each block is itself estimated from noisy positions (its error moves
+# every later impact of the block), and the record's own sampling.  The bootstrap repeats
+# the whole experiment under the fitted model: for each replicate, every block is simulated
+# from a state drawn from that block's state-fit covariance, sampled at the record's own
+# sample times with noise, folded like the record, and refitted from the fitted model; the
+# spread of the refitted coefficients gives the intervals.  Seeds are explicit.
+#
+# The noise is the record's own residual against the fitted model, force and penetration,
+# each cycle's multiplied by one weight drawn from Webb's six-point distribution (a wild
+# bootstrap with the cycles as clusters: Cameron, Gelbach & Miller 2008; Webb 2023).  White
+# noise of the record's level (``noise="white"``) misses what repeats within a cycle: an
+# onset's timing, a force sensor's own structure, a misfit the model leaves; the cycles'
+# residuals carry it.
+#
+# The refit is two Gauss-Newton steps from the fitted model by default (the k-step
+# bootstrap of Davidson & MacKinnon 1999 and Andrews 2002, k = 2: the replicate's estimate
+# lies within a standard error of the fit, where Newton's steps converge fast): each step is
+# the replicate's residuals and their exact Jacobian, one plain and one sensitivity run per
+# block, where a least-squares refit takes about five of each; two steps keep the
+# bootstrap's standard deviations close to the full refits' (one step does not; the
+# numbers: CHANGELOG).  ``refit="full"`` keeps the full refit.
+#
+# A record has few cycles (a dozen, six for a period-two orbit) against two to four
+# parameters, and a cluster bootstrap's spread, like the cluster-robust variance it mimics,
+# is then too small by about ``(G - p) / G`` and itself uncertain.  The spread is scaled by
+# ``sqrt(G / (G - p))`` and the interval takes Student's t with ``G - p`` degrees of freedom
+# (Cameron & Miller 2015, section VI), as a regression's does with ``N - p``.
+
+
+@dataclass(frozen=True, eq=False)
+class Intervals(Result):
+    """Bootstrap intervals of a fitted law's coefficients.
+
+    Attributes
+    ----------
+    bounds : dict
+        ``{name: (low, high)}`` at ``level``: the estimate +- q * sd, ``q`` the quantile of
+        Student's t with ``dof`` degrees of freedom (the normal's when ``dof`` is 0).
+    sd : dict
+        ``{name: standard error}``: the bootstrap's standard deviation, scaled by
+        ``sqrt(G / (G - p))`` for ``G`` resampled cycles and ``p`` parameters.
+    level : float
+    n_boot : int
+        Replicates whose refit succeeded.
+    seed : int
+    method : str
+    dof : int
+        ``G - p`` (0: white noise, the normal quantile).
+    """
+
+    KIND = "intervals"
+    _LOAD = {"bounds": lambda d: {k: tuple(v) for k, v in d["bounds"].items()}}
+
+    bounds: dict
+    sd: dict
+    level: float
+    n_boot: int
+    seed: int
+    method: str = "parametric bootstrap through the record-span processing"
+    dof: int = 0
+
+    def as_dict(self):
+        return {
+            "bounds": {k: list(v) for k, v in self.bounds.items()},
+            "sd": dict(self.sd),
+            "level": self.level,
+            "n_boot": self.n_boot,
+            "seed": self.seed,
+            "method": self.method,
+            "dof": self.dof,
+        }
+
+
+# Webb's six-point weights: mean 0, variance 1, and more distinct replicates than signs when
+# a record has a dozen cycles
+_WEBB = np.array([-np.sqrt(1.5), -1.0, -np.sqrt(0.5), np.sqrt(0.5), 1.0, np.sqrt(1.5)])
+
+
+def _cycle_weights(fold, rng):
+    """One Webb weight per cycle of ``fold``, at each folded sample, ndarray of shape (m,)."""
+    c = np.clip(((fold.td - fold.origin) // fold.duration).astype(int), 0, fold.n_cycles - 1)
+    return rng.choice(_WEBB, fold.n_cycles)[c]
+
+
+def _replicate(scenario, law, observe, ref, rng, *, tolerances=None, noise="cycles"):
+    """A synthetic copy of ``ref`` made by ``law`` (the same span, states and sample times).
+
+    Every block is simulated from a state drawn from its state fit's covariance; its noise
+    is, with ``noise="cycles"``, the record's own residual against ``law`` (force and
+    penetration) with each cycle's multiplied by one random weight (a wild bootstrap by
+    cycles: what repeats within a cycle, correlated noise, an onset's timing, a misfit the
+    model leaves, is kept, and only its sign and size vary between cycles), or white noise
+    of the record's level (``"white"``)."""
+    from ..verify.trajectory import simulated_motion
+
+    span = ref.span
+    starts = [b.state.draw(rng) for b in span.blocks]
+    hist, zs = simulated_motion(
+        scenario, law, span, tolerances=tolerances, starts=starts, observe=observe
+    )
+    if noise == "cycles":
+        fit_F, fit_Z = simulated_motion(scenario, law, span, tolerances=tolerances, observe=observe)
+        blocks = []
+        for b, h, z, f0, z0 in zip(span.blocks, hist, zs, fit_F, fit_Z, strict=True):
+            v = _cycle_weights(b.fold, rng)
+            blocks.append(replace(b, F=h + v * (b.F - f0), Z=z + v * (b.Z - z0)))
+        blocks = tuple(blocks)
+    else:
+        blocks = tuple(
+            replace(
+                b,
+                F=h + rng.normal(0.0, span.sigma_f, h.size),
+                Z=z + rng.normal(0.0, span.sigma_z, z.size),
+            )
+            for b, h, z in zip(span.blocks, hist, zs, strict=True)
+        )
+    span2 = replace(span, blocks=blocks)
+    imps = tuple(span2.measured(onset_record_time=ref.impulse.onset))
+    return replace(ref, span=span2, blocks=imps, impulse=imps[-1], _source=None)
+
+
+def _refit_replicate(context, k):
+    """The coefficients of one bootstrap replicate's least-squares refit (as
+    :func:`~discovery.vibroimpact.fit.identify.identify` without short first, uncertainty or
+    check; a task of the executor; the replicates are in the forked context, so no record is
+    copied), None when it fails."""
+    scenarios, replicates, model, settings = context
+    method, xtol, budget = "least-squares", 1e-5, settings["max_simulations"]
+    try:
+        records = _checked(
+            scenarios, replicates[k], model, method=method, xtol=xtol, max_simulations=budget
+        )
+        obj = _Objective(
+            records,
+            model,
+            settings["criterion"],
+            settings["tolerances"],
+            max(int(budget), 2 * len(records)),
+        )
+        x, _ = _fitted(obj, method, xtol, budget)
+    except IntegrationError:
+        return None
+    return np.array(obj.law(x).coefficients, dtype=float)
+
+
+_GN_STEPS = 2  # the Gauss-Newton steps of a "two-step" replicate
+
+
+def _step_replicate(context, k):
+    """The coefficients after two Gauss-Newton steps from the fitted model on one bootstrap
+    replicate (a task of the executor, as :func:`_refit_replicate`), None when it fails."""
+    scenarios, replicates, model, settings = context
+    records = list(zip(scenarios, replicates[k], strict=True))
+    obj = _Objective(records, model, settings["criterion"], settings["tolerances"], 10**9)
+    x = np.ones(len(model.coefficients))
+    for _ in range(_GN_STEPS):
+        try:
+            if obj.evaluations(x) is None:
+                return None
+            r, J = obj.residuals(x), obj.jacobian(x)
+        except IntegrationError:
+            return None
+        if not (np.all(np.isfinite(r)) and np.all(np.isfinite(J))):
+            return None
+        x = x + np.linalg.lstsq(J, -r, rcond=None)[0]
+    return np.array(model.coefficients, dtype=float) * x
+
+
+REFITS = {"two-step": _step_replicate, "full": _refit_replicate}
+
+MIN_CYCLE_DOF = 3
+"""The fewest resampled cycles beyond the parameters (``G - p``) for the bootstrap by
+cycles; below it (a period-four orbit over 12 periods: three cycles) the replicates take
+white noise of the record's level."""
+
+
+def bootstrap_intervals(
+    scenario,
+    reference,
+    model,
+    *,
+    n_boot=30,
+    seed=0,
+    level=0.95,
+    max_simulations=60,
+    criterion="I2",
+    tolerances=None,
+    workers=1,
+    executor=None,
+    refit="two-step",
+    noise="cycles",
+):
+    """Intervals of ``model``'s coefficients by a bootstrap through the record-span
+    processing (the comment above).
+
+    Parameters
+    ----------
+    scenario : Scenario or sequence of Scenario
+    reference : Reference or sequence of Reference
+        Records prepared with positions (a record span); others have no bootstrap.
+    model : ForceLaw or Model
+        The fitted law (or a model with effect parameters, :func:`identify.model_parts`).
+    n_boot : int
+        Replicates (>= 5).
+    seed : int
+        Seed of ``numpy.random.default_rng``.
+    level : float
+        Two-sided level in (0, 1).
+    max_simulations : int
+        Budget of each replicate's full refit.
+    criterion : str
+    tolerances : Tolerances, optional
+    workers : int or None
+        Processes for the replicates' refits (default 1; ``None``: every core).  The
+        replicates are drawn in this process, in order, and only their refits run in
+        parallel, so the intervals do not depend on it.
+    executor : Executor, optional
+        Where the refits run (:mod:`discovery.numerics.executor`); overrides ``workers``
+        and is not closed here.
+    refit : str
+        ``"two-step"`` (default): two Gauss-Newton steps from the fitted model with the
+        exact Jacobian (the comment above); ``"full"``: a least-squares refit.
+    noise : str
+        The replicates' noise (:data:`INTERVAL_NOISE`): ``"cycles"`` (default), the
+        record's own residuals with one random weight per cycle (white noise when the
+        cycles are too few: :data:`MIN_CYCLE_DOF`); ``"white"``, white noise of the
+        record's level (a parametric bootstrap).
+
+    Returns
+    -------
+    Intervals or None
+        ``None`` when a record has no span (no state to draw), a parameter is 0, or fewer
+        than 5 refits succeeded.
+    """
+    if not (isinstance(n_boot, int) and n_boot >= 5):
+        raise InputError(f"n_boot must be an integer >= 5; got {n_boot!r}")
+    if not 0 < level < 1:
+        raise InputError(f"level must be in (0, 1); got {level!r}")
+    if refit not in INTERVAL_REFITS:
+        raise InputError(f"unknown refit {refit!r}; valid: {', '.join(INTERVAL_REFITS)}")
+    if noise not in INTERVAL_NOISE:
+        raise InputError(f"unknown noise {noise!r}; valid: {', '.join(INTERVAL_NOISE)}")
+    records = as_records(scenario, reference)
+    if any(getattr(ref, "span", None) is None for _, ref in records):
+        return None
+    if any(c == 0 for c in model.coefficients):
+        return None  # a parameter at 0 sets no scale for the refits
+    law, machine, observe = model_parts(model)
+    # the resampled cycles against the parameters (see the comment above): too few, and the
+    # replicates take white noise of the record's level instead
+    G = sum(b.fold.n_cycles for _, ref in records for b in ref.span.blocks)
+    few = noise == "cycles" and G - len(model.names) < MIN_CYCLE_DOF
+    if few:
+        noise = "white"
+    rng = np.random.default_rng(seed)
+    replicates = []  # drawn here, in order: the rng's sequence does not depend on workers
+    for _ in range(n_boot):
+        try:
+            replicates.append(
+                [
+                    _replicate(
+                        machine(sc), law, observe, ref, rng, tolerances=tolerances, noise=noise
+                    )
+                    for sc, ref in records
+                ]
+            )
+        except IntegrationError:
+            continue
+    context = (
+        [sc for sc, _ in records],
+        replicates,
+        model,
+        {
+            "criterion": criterion,
+            "max_simulations": max_simulations,
+            "tolerances": tolerances,
+        },
+    )
+    refits = map_on(
+        REFITS[refit], range(len(replicates)), context, workers=workers, executor=executor
+    )
+    draws = [d for d in refits if d is not None]
+    if len(draws) < 5:
+        return None
+    how = _Resampling(cycles=G, noise=noise, few=few, refit=refit, level=level, seed=seed)
+    return _intervals(np.array(draws), model, how)
+
+
+@dataclass(frozen=True)
+class _Resampling:
+    """How the replicates were made: ``G`` cycles, their noise, whether the cycles were too
+    few (white noise instead), the refit, the level and the seed."""
+
+    cycles: int
+    noise: str
+    few: bool
+    refit: str
+    level: float
+    seed: int
+
+
+def _intervals(D, model, how):
+    """The :class:`Intervals` of the refitted coefficients ``D`` (replicates x parameters)
+    around ``model``'s: normal quantiles on the spread for white noise; for the cycles, the
+    spread scaled by ``sqrt(G / (G - p))`` and Student's t with ``G - p`` degrees of freedom
+    (the comment above)."""
+    from scipy.stats import norm
+    from scipy.stats import t as student_t
+
+    names = list(model.names)
+    est = np.array(model.coefficients, dtype=float)
+    sd = D.std(axis=0, ddof=1)
+    dof, G = 0, how.cycles
+    z = float(norm.ppf(0.5 + how.level / 2))
+    if how.noise == "cycles":
+        dof = G - len(names)
+        sd = sd * np.sqrt(G / dof)
+        z = float(student_t.ppf(0.5 + how.level / 2, dof))
+    method = (
+        f"wild bootstrap by cycles (the record's residuals, one weight per cycle; Student t "
+        f"with {dof} degrees of freedom)"
+        if how.noise == "cycles"
+        else "parametric bootstrap"
+        + (
+            f" (white noise of the record's level: {G} cycles for {len(names)} parameters "
+            "are too few to resample)"
+            if how.few
+            else ""
+        )
+    )
+    step = "two Gauss-Newton steps" if how.refit == "two-step" else "a least-squares refit"
+    return Intervals(
+        bounds={
+            n: (float(e - z * s), float(e + z * s)) for n, e, s in zip(names, est, sd, strict=True)
+        },
+        sd={n: float(s) for n, s in zip(names, sd, strict=True)},
+        level=float(how.level),
+        n_boot=len(D),
+        seed=int(how.seed),
+        method=f"{method} through the record-span processing ({step} per replicate)",
+        dof=int(dof),
+    )

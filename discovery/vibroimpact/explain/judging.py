@@ -1,0 +1,87 @@
+"""The rules a model or a refit is judged by in the missing-effect loop: within the noise,
+the recorded motion, a repulsive contact spring, a parameter within its bounds and away from 0.
+"""
+
+import numpy as np
+
+from ..fit.records import contact_scales
+from ..verify.motion import MOTION_CRITERION
+
+
+def _present(eff, model, res):
+    """The effect's parameter is away from 0 by more than 2 standard errors."""
+    name = eff.parameters[0].name
+    v = model.value(eff)
+    se = res.standard_errors.get(name)
+    return bool(v != 0.0 and (se is None or not np.isfinite(se) or abs(v) > 2.0 * se))
+
+
+def _within_noise(evs, criterion):
+    """Every record in the measured regime with ``criterion`` within its consistency limit
+    (:func:`discovery.vibroimpact.verify.consistency_limits`)."""
+    for e in evs:
+        if (
+            e.status != "ok"
+            or e.regime["simulated"] != e.regime["measured"]
+            or e.impacts["simulated"] != e.impacts["measured"]
+            or not e.noise_floor
+        ):
+            return False
+        lim = e.limits
+        if criterion not in lim or not e.criteria[criterion] <= lim[criterion]:
+            return False
+    return True
+
+
+def _motion_within(evs):
+    """The recorded penetration (I5) within its consistency limit on every record that has
+    it: a law that trades spring for damping matches the force, not the motion, and is
+    still to be explained."""
+    return all(
+        MOTION_CRITERION not in e.limits
+        or e.criteria.get(MOTION_CRITERION, np.inf) <= e.limits[MOTION_CRITERION]
+        for e in evs
+    )
+
+
+def _motion_worse(before, after, evs):
+    """Whether a refit takes the recorded penetration (I5) further from the record and
+    beyond its limit on a record: a fit of the force by another motion (a sensor lag that
+    smears the force of a too-soft spring), which names nothing."""
+    k = MOTION_CRITERION
+    if k not in before or k not in after or after[k] <= before[k]:
+        return False
+    return any(k in e.limits and e.criteria.get(k, 0.0) > e.limits[k] for e in evs)
+
+
+def _failing(evs):
+    """The criteria beyond their consistency limit in any record."""
+    out = []
+    for e in evs:
+        lim = e.limits
+        out += [k for k in lim if e.criteria.get(k, 0.0) > lim[k] and k not in out]
+    return out or ["the comparison"]
+
+
+def _repulsive(law, records):
+    """Whether the law's elastic branch pushes the bodies apart at the records' typical
+    penetration (a refit that turns the contact spring into a pull has explained the
+    residual by undoing the contact, not by the effect; a start that already pulls is
+    not held against the effect)."""
+    for sc, ref in records:
+        _, _, z0 = contact_scales(sc, ref)
+        if not float(law.polynomial(z0, 0.0)) > 0:
+            return False
+    return True
+
+
+def _keeps_repulsive(refit, model, records):
+    """Whether a refit keeps the contact spring pushing (:func:`_repulsive`); a start that
+    already pulls is not held against it."""
+    return _repulsive(refit.law, records) or not _repulsive(model.law, records)
+
+
+def _in_bounds(eff, model):
+    """Whether the effect's parameter in ``model`` is within its physical bounds."""
+    lo, hi = eff.parameters[0].bounds
+    return bool(lo <= model.value(eff) <= hi)

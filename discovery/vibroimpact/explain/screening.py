@@ -1,0 +1,160 @@
+"""Screening: the score (Lagrange-multiplier) test of every applicable catalogue effect at
+the current model, and the significant effects ranked.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+from .judging import _motion_within, _within_noise
+from .problem import _small_step
+
+
+def _signature_agrees(eff, loc, top_phases):
+    """Whether the localisation shows the effect's signature: its phases among the two
+    with the largest shares, the grid's motion off beyond its noise (``"grid"``), or a
+    significant trend across the impacts (``"drift"``)."""
+    if set(eff.phases) & set(top_phases):
+        return True
+    if "grid" in eff.phases and (loc.get("grid") or {}).get("exceeds_noise"):
+        return True
+    return bool("drift" in eff.phases and (loc.get("drift") or {}).get("significant"))
+
+
+@dataclass(frozen=True)
+class _Linearisation:
+    """The current model's residual on every record, the output Jacobian of its own
+    coefficients (forward differences through full simulations) and the noise of the
+    averaged cycles: what a score test needs."""
+
+    problem: object
+    records: list
+    model: object
+    r0: np.ndarray
+    J: np.ndarray
+    sigma: float
+
+    @classmethod
+    def at(cls, problem, records, model):
+        r0 = problem.residual(model)
+        return cls(
+            problem=problem,
+            records=records,
+            model=model,
+            r0=r0,
+            J=_jacobian(problem, model, r0),
+            sigma=problem.sigma(),
+        )
+
+    def score(self, eff):
+        """The score test of ``eff``: ``effect``, ``lm``, ``p``, ``significant`` (set by the
+        screening) and ``direction`` (the LM step), or a ``note`` without a sensitivity."""
+        problem, model, r0, J, sigma = self.problem, self.model, self.r0, self.J, self.sigma
+        # the sensitivity between h and 2h, not from 0: switching an effect on can change the
+        # simulated history by a step of its own (an observation model resamples it)
+        h = _small_step(eff, self.records)
+        r1 = problem.residual(model.with_effect(eff, h))
+        r2 = problem.residual(model.with_effect(eff, 2 * h)) if r1 is not None else None
+        if r2 is None or sigma <= 0:
+            return {
+                "effect": eff.id,
+                "lm": None,
+                "p": None,
+                "significant": False,
+                "note": "its sensitivity could not be simulated",
+            }
+        s = (r2 - r1) / h
+        if J.shape[1]:
+            Q, _ = np.linalg.qr(J)
+            s_perp = s - Q @ (Q.T @ s)
+            r_perp = r0 - Q @ (Q.T @ r0)
+        else:
+            s_perp, r_perp = s, r0
+        den = float(s_perp @ s_perp)
+        lm = float((s_perp @ r_perp) ** 2 / (sigma**2 * den)) if den > 0 else 0.0
+        return {
+            "effect": eff.id,
+            "lm": lm,
+            "p": float(chi2.sf(lm, 1)),
+            "significant": False,
+            "direction": float(-(s_perp @ r_perp) / den) if den > 0 else 0.0,
+        }
+
+
+def _jacobian(problem, model, r0):
+    law = model.law
+    cols = []
+    for i, c in enumerate(law.coefficients):
+        h = 1e-4 * abs(c)
+        coefs = list(law.coefficients)
+        coefs[i] = c + h
+        r1 = problem.residual(model.with_law(law.with_coefficients(coefs)))
+        if r1 is None:
+            continue
+        cols.append((r1 - r0) / h)
+    return np.column_stack(cols) if cols else np.zeros((r0.size, 0))
+
+
+@dataclass
+class _Screening:
+    """The score tests of one iteration: the candidate effects, their scores, the
+    family-wise level, the localisation's two largest phases, the significant effects ranked
+    (and those without a local score) and whether the cycle is within its noise."""
+
+    cands: list
+    scores: list
+    level: float
+    top_phases: list
+    ranked: list
+    quiet: bool
+
+    @classmethod
+    def of(cls, run, step):
+        """Score tests of the applicable effects at the current model (``step``); the
+        significant ones ranked by their statistic."""
+        model, evs, loc = run.model, step.evaluations, step.loc
+        # a cycle within its noise leaves only the drift to explain: consistent, or failing
+        # I4 alone (the supports of a noisy record) while the criterion the refits lower is
+        # within its limit (lowering it further would fit the noise)
+        quiet = step.cycle_ok or (_within_noise(evs, run.criterion) and _motion_within(evs))
+        cands = [
+            e
+            for e in run.catalogue
+            if e.applicable(model)
+            and (run.drift is not None or "drift" not in e.phases)
+            and (not quiet or "drift" in e.phases)
+        ]
+        local = _Linearisation.at(run.problem, run.records, model)
+        scores = [
+            run.drift.score(model, e, _small_step(e, run.records))
+            if "drift" in e.phases
+            else local.score(e)
+            for e in cands
+        ]
+        level = run.alpha / max(len(scores), 1)
+        top_phases = sorted(loc["phases"], key=lambda p: -loc["phases"][p]["share"])[:2]
+        for s, e in zip(scores, cands, strict=True):
+            s["significant"] = bool(s["p"] is not None and s["p"] < level)
+            s["signature_agrees"] = _signature_agrees(e, loc, top_phases)
+        ranked = sorted((s for s in scores if s["significant"]), key=lambda s: -s["lm"])
+        if any(s.get("channel") == "drift" for s in ranked):
+            # a record that drifts has no steady cycle to compare: the drift comes first
+            ranked = [s for s in ranked if s.get("channel") == "drift"]
+        else:
+            # an effect whose small step already changes the regime has no local score;
+            # its refit (from the regression, over a ladder of values) still decides
+            ranked += [s for s in scores if s["lm"] is None]
+        return cls(
+            cands=cands,
+            scores=scores,
+            level=level,
+            top_phases=top_phases,
+            ranked=ranked,
+            quiet=quiet,
+        )
+
+    @property
+    def by_id(self):
+        """``{id: effect}`` of the candidate effects."""
+        return {e.id: e for e in self.cands}

@@ -1,0 +1,287 @@
+"""Where the missing-effect loop starts and how it refits: the records, start laws from the
+certified regression and from the record alone, the start fitted cycle by cycle, and the
+output-error refits (:func:`~discovery.vibroimpact.fit.identify.identify`).
+"""
+
+import itertools
+import re
+
+import numpy as np
+
+from ..._progress import tick
+from ...errors import InputError, IntegrationError
+from ..fit.identify import identify
+from ..fit.records import as_records, pair_records, record_start
+from ..model.law import ForceLaw, Term
+from ..verify import Reference, evaluate
+from .effects import Model
+
+# a number multiplying a factor: the start is a law with coefficients, not a term list
+_HAS_COEFFICIENT = re.compile(r"(^|[+\-])\s*[0-9.]+([eE][+\-]?[0-9]+)?\s*\*")
+
+
+def _records_of(scenario, measurement, n_boot, seed):
+    """``(pairs, records)``: the records paired with their scenarios, and as references
+    (each with its noise floor from ``n_boot`` replicates)."""
+    pairs = pair_records(scenario, measurement)
+    records = as_records(
+        [sc for sc, _ in pairs],
+        [
+            m
+            if isinstance(m, Reference)
+            else Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)
+            for sc, m in pairs
+        ],
+    )
+    return pairs, records
+
+
+def _output_error(records, start, criterion, budget, tol, *, polish=False):
+    """Output-error identification of a law or model on every record: least squares, and
+    with ``polish`` Nelder-Mead on the budget least squares left.  Least squares can stop
+    early, its step rejected, where the residual is not smooth in the coefficients (a force
+    jump at the onset moving across the samples); the simplex, which only compares
+    criterion values, goes on from there."""
+    scs, refs = [s for s, _ in records], [r for _, r in records]
+    res = identify(
+        scs,
+        refs,
+        start,
+        criterion=criterion,
+        method="least-squares",
+        max_simulations=budget,
+        tolerances=tol,
+        check=False,
+    )
+    left = budget - res.n_simulations
+    if not polish or left < 4 * (len(res.law.coefficients) + 1) * len(records):
+        return res
+    try:
+        res2 = identify(
+            scs,
+            refs,
+            res.law,
+            criterion=criterion,
+            method="nelder-mead",
+            max_simulations=left,
+            tolerances=tol,
+            check=False,
+        )
+    except IntegrationError:
+        return res
+    return res2 if res2.value < res.value else res
+
+
+def _polish_start(records, fit, criterion, budget, tol):
+    """The cycle-by-cycle start refined on the records' blocks, kept when it keeps the
+    measured number of contacts in every record and lowers the criterion, and either stays
+    local (every coefficient within 3 standard errors of the cycle-by-cycle fit) or is
+    consistent with every record (a far refit that trades the spring for the restitution
+    has left the start's basin without explaining the record)."""
+    scs, refs = [s for s, _ in records], [r for _, r in records]
+    try:
+        res = identify(
+            scs,
+            refs,
+            fit.law,
+            criterion=criterion,
+            method="least-squares",
+            max_simulations=budget,
+            tolerances=tol,
+            short_first=False,
+            check=False,
+        )
+    except (IntegrationError, InputError):
+        return fit
+    same = all(e.impacts["simulated"] == e.impacts["measured"] for e in res.evaluations)
+    base = [evaluate(sc, fit.law, ref, tolerances=tol, floor=False) for sc, ref in records]
+    v0 = float(np.mean([e.criteria.get(criterion, np.inf) for e in base]))
+    if not (same and res.value <= v0):
+        return fit
+    se = fit.standard_errors
+    near = all(
+        abs(b - a) <= 3.0 * se.get(n, 0.0)
+        for n, a, b in zip(fit.law.names, fit.law.coefficients, res.law.coefficients, strict=True)
+    )
+    # a far move is kept only when it reaches a law consistent with every record
+    return (
+        res
+        if near or all(evaluate(sc, res.law, ref, tolerances=tol).consistent for sc, ref in records)
+        else fit
+    )
+
+
+def _physical(names, records):
+    """Start values from the record alone
+    (:func:`discovery.vibroimpact.fit.identify.record_start`)."""
+    terms = [ForceLaw.parse(f"1*{n}").terms[0] for n in names]
+    return ForceLaw(tuple(terms), tuple(record_start(*records[0], terms)))
+
+
+def _joined_samples(scenarios, measurements):
+    """The contact samples of every record joined (None without positions in every
+    record): built once per run, for every regression of the force on a term list."""
+    from ..data.samples import contact_samples, join_samples
+
+    try:
+        return join_samples(
+            [
+                contact_samples(m, period=sc.period)
+                for sc, m in zip(scenarios, measurements, strict=True)
+            ]
+        )
+    except (InputError, ValueError):
+        return None
+
+
+def _regression(names, samples, loading=False):
+    """The certified regression of the force on exactly these terms over ``samples``
+    (:func:`_joined_samples`; None without them, or when the regression fails); with
+    ``loading``, on the loading samples (``dzeta > 0``) alone, which an unloading branch
+    or a set leaves as they are."""
+    from ..fit.regression import ConstrainedSparseRegressor
+
+    if samples is None:
+        return None
+    try:
+        keep = samples.dzeta > 0 if loading else np.ones(len(samples), dtype=bool)
+        if np.count_nonzero(keep) < 10 * len(names):
+            return None
+        est = ConstrainedSparseRegressor(library=",".join(names), max_terms=len(names))
+        est.fit(
+            samples.X[keep],
+            samples.F[keep],
+            groups=samples.impact[keep],
+            sample_weight=samples.weight[keep],
+        )
+    except (InputError, ValueError):
+        return None
+    full = [c for c in est.candidates_ if len(c.terms) == len(names)]
+    if not full:
+        return None
+    coef = full[0].coefficients
+    terms = [Term.parse(n) for n in names]
+    if not all(coef.get(t.name, 0.0) for t in terms):
+        return None
+    return ForceLaw(tuple(terms), tuple(float(coef[t.name]) for t in terms))
+
+
+def _regressed(model, names, regress, loading=False):
+    """``model`` with every loading coefficient from the certified regression of the
+    measured force on the terms ``names`` (its unloading branch and added effects kept);
+    None when the records have no positions or the regression fails.  The regression sees
+    the force against the measured penetration alone, so a start law that has compensated
+    for a missing effect with its coefficients (a stiffer spring for a Hertz term or for
+    stiffening supports) does not hold the refit in its basin."""
+    if regress is None:
+        return None
+    fit = regress(list(names), loading)
+    if fit is None:
+        return None
+    law = model.law
+    return model.with_law(
+        ForceLaw(
+            fit.terms,
+            fit.coefficients,
+            law.unloading,
+            law.unloading_coefficients,
+            law.permanent_set,
+        )
+    )
+
+
+def start_law(text, records, measurements=None):
+    """Candidate start laws: ``linear`` (z, zd) or a term list (``z,zd``) gets its
+    coefficients from the certified regression on the contact samples (when the records
+    have positions: first), then from the record alone (contact time, reduced mass, force
+    jump), term-wise mixtures of the two and softer springs; a law with coefficients
+    (``2e8*z + 1e7*zd``) is used as given."""
+    preferred, others = _start_candidates(text, records, measurements)
+    return preferred + others
+
+
+def _start_candidates(text, records, measurements):
+    """``(preferred, others)`` of :func:`start_law`: the given law or the regression (a
+    fit to the force itself), and the fallbacks :func:`explain` ranks by one simulation
+    each."""
+    text = str(text).strip()
+    if not text:
+        raise InputError(
+            "--start is empty; give 'linear', a term list such as 'z,zd' or a "
+            "law such as '2e8*z + 1e7*zd'"
+        )
+    if text != "linear" and "," not in text and _HAS_COEFFICIENT.search(text):
+        return [ForceLaw.parse(text)], []
+    names = ["z", "zd"] if text == "linear" else [n.strip() for n in text.split(",") if n.strip()]
+    for n in names:
+        ForceLaw.parse(f"1*{n}")  # a clear error for a bad term name
+    E = records[0][1].impulse
+    if not len(E.support):
+        raise InputError("the record has no contact to start from")
+    reg = None
+    if measurements is not None:
+        reg = _regression(names, _joined_samples([sc for sc, _ in records], measurements))
+    phys = _physical(names, records)
+    others = [phys]
+    if reg is not None and len(names) <= 4 and reg.terms == phys.terms:
+        # term-wise mixtures: the regression's damping with the contact time's stiffness
+        # (a short contact's few noisy penetration samples can bias one coefficient only)
+        for mask in itertools.product((0, 1), repeat=len(names)):
+            if 0 < sum(mask) < len(names):
+                others.append(
+                    reg.with_coefficients(
+                        [(phys if m else reg).coefficients[i] for i, m in enumerate(mask)]
+                    )
+                )
+    # softer springs: a contact that damping ends early (the paper's law unloads
+    # elastically, so the contact lasts at least a quarter of the spring's period) is far
+    # shorter than the half period the contact-time stiffness assumes
+    for f in (0.25, 0.25**2, 0.25**3):
+        others.append(
+            phys.with_coefficients(
+                [
+                    c * f if t.b == 0 else c
+                    for t, c in zip(phys.terms, phys.coefficients, strict=True)
+                ]
+            )
+        )
+    return ([reg] if reg is not None else []), others
+
+
+def _fallbacks(preferred, others, problem, criterion):
+    """The start laws in the order they are tried: the preferred ones, then (only when
+    those fail) the three closest fallbacks, ranked by one simulation each (a start can
+    land in another regime's basin)."""
+    yield from preferred
+    yield from sorted(others, key=lambda law: problem.value(Model(law), criterion))[:3]
+
+
+def _fit_start(run, start, plain, progress):
+    """The start law fitted to ``run``'s records (``plain``: their measurements, for the
+    regression; None when not every record has one): the first of the start candidates
+    (and their fallbacks) that simulates."""
+    records, criterion, budget, tolerances = run.records, run.criterion, run.budget, run.tolerances
+    preferred, others = (
+        ([start], []) if isinstance(start, ForceLaw) else _start_candidates(start, records, plain)
+    )
+    fit, why = None, ""
+    for law in _fallbacks(preferred, others, run.problem, criterion):
+        try:
+            # the start is fitted cycle by cycle (each cycle from the machine's state before
+            # it): over several cycles a law can trade its spring against the missing
+            # effect through the restitution (a soft spring mimics damping while
+            # unloading), and the effect would then look absent
+            short = [(sc, ref.shortened() or ref) for sc, ref in records]
+            tick(progress, "explain: fitting the start cycle by cycle", 0, None)
+            fit = _output_error(short, law, criterion, budget, tolerances, polish=True)
+            fit = _polish_start(records, fit, criterion, max(budget // 3, 8), tolerances)
+            break
+        except IntegrationError as exc:
+            why = str(exc)
+    if fit is None:
+        raise IntegrationError(
+            f"no start law for {start!r} has a periodic steady state with "
+            f"contact for the record ({why}); give --start as a law with "
+            "coefficients closer to the record"
+        )
+    return fit

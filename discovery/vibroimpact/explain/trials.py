@@ -1,0 +1,310 @@
+"""Trials: every significant effect refitted with the model (in parallel), the law refitted
+alone as the baseline, and the trials judged; the winner polished with the full budget.
+"""
+
+from dataclasses import dataclass, replace
+
+from ...errors import InputError, IntegrationError
+from ...numerics.executor import map_on
+from ..model.law import Term
+from ..verify import CONSISTENCY_FACTORS
+from ..verify.motion import MOTION_CRITERION
+from .effects import effect
+from .judging import _in_bounds, _keeps_repulsive, _motion_worse, _present
+from .problem import _mean, _small_step, _with_drift
+from .starts import _output_error, _regressed
+
+
+def _extend(model, eff, value):
+    return model.with_effect(eff, value)
+
+
+#: the effect's value on the regressed law: its small step times these
+_LADDER = tuple(4.0**k for k in range(7))
+
+
+@dataclass(frozen=True)
+class _Refits:
+    """How a screening refit runs (the executor's context: the records stay in the forked
+    processes): the residual problem, the records, the criterion, the simulations of each
+    refit, the integrator's tolerances and the regression of the force on a term list
+    (``None`` without positions)."""
+
+    problem: object
+    records: list
+    criterion: str
+    budget: int
+    tolerances: object
+    regress: object = None
+
+    def refit(self, model, eff, guess):
+        """Add ``eff`` and refit the extended model by output error: the law's coefficients
+        and every added effect's parameter jointly (:func:`discovery.identify` on the
+        :class:`Model`); returns ``(model, identification)``.
+
+        The start is the best (by the sum of squared residuals of force and penetration,
+        what the refit minimises: one simulation each) of the current law with the effect
+        at its LM direction ``guess`` (a small value when that is unusable) and the law from
+        the certified regression (:func:`_regressed`) with the effect: for a term effect
+        the regression on the extended term set; for any other, the regression on the
+        current terms (on the loading samples alone for an effect on the unloading branch)
+        with the effect's value from a ladder (its small step times 1, 4, ... 4096, within
+        its bounds)."""
+        problem, regress = self.problem, self.regress
+        h = _small_step(eff, self.records)
+        hi = eff.parameters[0].bounds[1]
+        cands = [_extend(model, eff, min(guess if guess and guess > 0 else h, 0.5 * hi))]
+        if eff.target == "term":
+            names = list(model.law.names) + [Term.parse(eff.key).name]
+            reg = _regressed(model.with_effect(eff, 0.0), names, regress)
+            if reg is not None:
+                cands.append(reg)
+        else:
+            # an effect on the unloading branch leaves the loading samples as they are
+            reg = _regressed(
+                model, model.law.names, regress, loading=eff.target in ("unloading", "set")
+            )
+            if reg is not None:
+                values = sorted({min(h * f, 0.9 * hi) for f in _LADDER})
+                cands += [_extend(reg, eff, v) for v in values]
+        ranked = (
+            [cands[0]]
+            if len(cands) == 1
+            else [m for _, _, m in sorted((problem.squares(m), i, m) for i, m in enumerate(cands))]
+        )
+        starts = ranked[:2] + [_extend(model, eff, min(h, 0.5 * hi))]
+        for i, start in enumerate(starts):
+            try:
+                res = _output_error(
+                    self.records, start, self.criterion, self.budget, self.tolerances
+                )
+                return res.law, res
+            except IntegrationError:
+                if i == len(starts) - 1:
+                    raise
+
+
+def _screen_one(refits, job):
+    """One screening refit (:meth:`_Refits.refit`, a task of the executor): ``(model,
+    identification, evaluations, error, simulations)``."""
+    problem = refits.problem
+    model, eff_id, direction = job
+    n0 = problem.n_sim
+    try:
+        m2, res = refits.refit(model, effect(eff_id), direction)
+        evs = problem.evaluations(m2, floor=True)
+    except IntegrationError as exc:
+        return None, None, None, str(exc), problem.n_sim - n0
+    return m2, res, evs, None, problem.n_sim - n0
+
+
+def _screen(jobs, refits, workers, executor=None):
+    """The screening refits ``[(model, identification, evaluations, error)]`` in the order of
+    ``jobs``, on ``executor`` (default: ``workers`` forked processes, so the records are not
+    copied; in this process for one worker).  The simulations of every refit are added to the
+    problem's count whichever process ran it."""
+    problem = refits.problem
+    n0 = problem.n_sim
+    out = map_on(_screen_one, jobs, refits, workers=workers, executor=executor)
+    problem.n_sim = n0 + sum(r[4] for r in out)
+    return [r[:4] for r in out]
+
+
+@dataclass(frozen=True)
+class _Trial:
+    """A candidate effect refitted: its gap ratio (after / before), its score entry, the
+    refitted model, the fit (``None`` for the drift channel), the evaluations of the refitted
+    model and the criterion its gap is measured by."""
+
+    ratio: float
+    score: dict
+    model: object
+    result: object
+    evaluations: list
+    key: str
+
+    def judge(self, eff, null_after, floor):
+        """Record in the score entry whether the refit beats the law refitted alone
+        (``null_after``) by the criterion's margin (its floor times its consistency factor
+        less one: the floor for the force, a quarter of it for the penetration,
+        :data:`~discovery.vibroimpact.verify.CONSISTENCY_FACTORS`) and whether the effect's
+        parameter ``eff`` is present (not within 2 standard errors of 0)."""
+        k, s = self.key, self.score
+        margin = floor.get(k, 0.0) * (CONSISTENCY_FACTORS.get(k, 2.0) - 1.0)
+        # (the drift channel does not depend on the law: a law refit is no baseline)
+        s["beats_law_refit"] = bool(
+            k == "D"
+            or not null_after
+            or k not in null_after
+            or s["criteria_after"][k] <= null_after[k] - margin
+        )
+        # an effect refitted to 0, or to a value within 2 standard errors of 0, only
+        # carried a refit of the law
+        s["present"] = (
+            _present(eff, self.model, self.result)
+            if self.result is not None
+            else bool(self.model.value(eff) != 0.0)
+        )
+
+    @property
+    def names(self):
+        """Whether the trial names its effect (once judged): the gap shrinks by 10 %, the
+        refit is physical and within bounds, beats the law refitted alone, the parameter is
+        present, and the recorded motion is not made worse."""
+        s = self.score
+        return bool(
+            self.ratio <= 0.9
+            and s["repulsive"]
+            and s["in_bounds"]
+            and s["beats_law_refit"]
+            and s["present"]
+            and not s.get("motion_worse")
+        )
+
+
+def _law_refit(run, model, budget, *, polish=False):
+    """``(result, criteria, evaluations)`` of the model refitted alone (no effect added) on
+    ``run``'s records, or None when the refit fails (e.g. a parameter at 0)."""
+    try:
+        res = _output_error(
+            run.records, model, run.criterion, budget, run.tolerances, polish=polish
+        )
+        evs = run.problem.evaluations(res.law, floor=True)
+        after, _ = _with_drift(_mean(evs, "criteria"), {}, run.drift, res.law)
+    except (IntegrationError, InputError):
+        return None
+    return res, after, evs
+
+
+def _refit_trials(run, step, screen_budget, gap):
+    """Every chosen effect (the screening's ranked ones, at most ``run.max_refits``) refitted
+    with ``screen_budget`` simulations (the refits of the force history in parallel, the
+    drift channel here) and checked: physical, within its bounds; the trials."""
+    model, records, before = run.model, run.records, step.before
+    chosen = step.screening.ranked[: run.max_refits]
+    eff_by_id = step.screening.by_id
+    # the screening refits of the force history are independent: one process each
+    refits = iter(
+        _screen(
+            [
+                (model, s["effect"], s.get("direction"))
+                for s in chosen
+                if "drift" not in eff_by_id[s["effect"]].phases
+            ],
+            _Refits(
+                problem=run.problem,
+                records=records,
+                criterion=run.criterion,
+                budget=screen_budget,
+                tolerances=run.tolerances,
+                regress=run.regress,
+            ),
+            run.workers,
+            run.executor,
+        )
+    )
+    trials = []
+    for s in chosen:
+        eff = eff_by_id[s["effect"]]
+        key = "D" if "drift" in eff.phases else gap
+        try:
+            if key == "D":
+                m2, res = run.drift.refit(model, eff, _small_step(eff, records)), None
+                evs2 = run.problem.evaluations(m2, floor=True)
+            else:
+                m2, res, evs2, error = next(refits)
+                if error is not None:
+                    raise IntegrationError(error)
+        except IntegrationError as exc:
+            s["note"] = f"refit failed: {exc}"
+            continue
+        after, _ = _with_drift(_mean(evs2, "criteria"), {}, run.drift, m2)
+        if not after or key not in after or key not in before:
+            s["note"] = "the refitted model has no periodic steady state with contact"
+            continue
+        s["criteria_after"] = after
+        s["consistent_after"] = all(e.consistent for e in evs2)
+        s["parameters"] = {eff.parameters[0].name: m2.value(eff)}
+        # (the drift channel does not depend on the law: no compensation to guard)
+        s["repulsive"] = key == "D" or _keeps_repulsive(m2, model, records)
+        if not s["repulsive"]:
+            s["note"] = (
+                "the refit's elastic branch P(zeta, 0) pulls at the record's "
+                "penetration: the effect only fits by undoing the contact spring"
+            )
+        s["in_bounds"] = _in_bounds(eff, m2)
+        if not s["in_bounds"]:
+            lo, hi = eff.parameters[0].bounds
+            s["note"] = (
+                f"the refit puts {eff.parameters[0].name} = {m2.value(eff):.4g} "
+                f"outside its physical bounds [{lo:g}, {hi:g}]"
+            )
+        s["gap"] = key
+        s["motion_worse"] = _motion_worse(before, after, evs2)
+        if s["motion_worse"]:
+            s["note"] = (
+                f"the refit moves the recorded penetration further away ({MOTION_CRITERION} "
+                f"{before[MOTION_CRITERION]:.3g} -> {after[MOTION_CRITERION]:.3g}, beyond its "
+                "limit): it fits the force by another motion"
+            )
+        trials.append(
+            _Trial(
+                ratio=after[key] / max(before[key], 1e-300),
+                score=s,
+                model=m2,
+                result=res,
+                evaluations=evs2,
+                key=key,
+            )
+        )
+    return trials
+
+
+def _law_baseline(run, screen_budget):
+    """The law refitted alone with the same budget (from the better of the current model and
+    the regression on its terms): ``(fit, criteria, evaluations)``, or ``(None, None,
+    None)``.  An effect is named only when its refit beats this by the noise floor (else the
+    gap was the start's own misfit, and the effect only carried a refit of the law)."""
+    model, problem = run.model, run.problem
+    try:
+        null_starts = [model]
+        reg0 = _regressed(model, model.law.names, run.regress)
+        if reg0 is not None:
+            null_starts.append(reg0)
+        null_start = min(null_starts, key=lambda m: problem.value(m, run.criterion))
+    except (IntegrationError, InputError):
+        null_start = None
+    refit0 = None if null_start is None else _law_refit(run, null_start, screen_budget)
+    return (None, None, None) if refit0 is None else refit0
+
+
+def _judged(trials, null_after, floor, eff_by_id):
+    """The trials that name an effect, each judged (:meth:`_Trial.judge`) against the law
+    refitted alone (``null_after``) and the noise ``floor``."""
+    for x in trials:
+        x.judge(eff_by_id[x.score["effect"]], null_after, floor)
+    return [x for x in trials if x.names]
+
+
+def _polish_winner(run, best, eff):
+    """The winner refitted with the full budget, kept when it lowers the gap and stays
+    within bounds and physical: the trial with that model, fit and evaluations."""
+    s, m2, res, evs2, key = best.score, best.model, best.result, best.evaluations, best.key
+    try:
+        res2 = _output_error(
+            run.records, m2, run.criterion, run.budget, run.tolerances, polish=True
+        )
+        evs3 = run.problem.evaluations(res2.law, floor=True)
+        after3, _ = _with_drift(_mean(evs3, "criteria"), {}, run.drift, res2.law)
+        if (
+            after3
+            and after3[key] <= s["criteria_after"][key]
+            and _in_bounds(eff, res2.law)
+            and _keeps_repulsive(res2.law, run.model, run.records)
+        ):
+            m2, res, evs2 = res2.law, res2, evs3
+            s["criteria_after"] = after3
+            s["parameters"] = {p.name: m2.value(eff) for p in eff.parameters}
+    except (IntegrationError, InputError):
+        pass
+    return replace(best, model=m2, result=res, evaluations=evs2)

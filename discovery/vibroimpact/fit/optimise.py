@@ -1,0 +1,181 @@
+"""The optimisers of an output-error fit over a :class:`~.problem._Objective`: the paper's
+coordinate descent, scipy's Nelder-Mead and trust-region least squares, restarts from the best
+point, and the settings they check.
+"""
+
+import numpy as np
+from scipy.optimize import least_squares, minimize
+
+from ...errors import InputError, IntegrationError, VidiTypeError
+from ..model.law import ForceLaw
+from .problem import _Budget
+from .records import as_records
+
+__all__ = ["METHODS", "RESTART_FACTORS"]
+
+METHODS = ("coordinate-descent", "nelder-mead", "least-squares")
+
+
+def _coordinate_descent(obj, x0, xtol, step0=0.1):
+    x = np.array(x0, dtype=float)
+    fx = obj(x)
+    steps = np.full(x.size, step0)
+    while np.any(steps > xtol):
+        for i in range(x.size):
+            if steps[i] <= xtol:
+                continue
+            improved = False
+            for direction in (1.0, -1.0):
+                trial = x.copy()
+                trial[i] += direction * steps[i]
+                ft = obj(trial)
+                if ft < fx:
+                    x, fx, improved = trial, ft, True
+                    # accelerate: keep going and double the step while it pays
+                    while True:
+                        steps[i] *= 2.0
+                        trial = x.copy()
+                        trial[i] += direction * steps[i]
+                        ft = obj(trial)
+                        if ft >= fx:
+                            steps[i] *= 0.5
+                            break
+                        x, fx = trial, ft
+                    break
+            if not improved:
+                steps[i] *= 0.5
+    return x
+
+
+def _checked(scenario, reference, start, *, method, xtol, max_simulations):
+    """The settings :func:`identify` checks beyond their types; returns the records."""
+    if isinstance(start, str):
+        raise VidiTypeError(
+            f"identify: start must be a ForceLaw or a Model (parse text with "
+            f"ForceLaw.parse({start[:30]!r})); got str"
+        )
+    if method not in METHODS:
+        raise InputError(f"unknown method {method!r}; valid methods: {', '.join(METHODS)}")
+    if any(c == 0 for c in start.coefficients):
+        raise InputError("every start coefficient must be non-zero (they set the scale)")
+    if not (np.isfinite(xtol) and xtol > 0):
+        raise InputError(f"xtol must be a positive number, got {xtol!r}")
+    records = as_records(scenario, reference)
+    if not (isinstance(max_simulations, int | np.integer) and max_simulations >= 2 * len(records)):
+        raise InputError(
+            f"the simulation budget must be an integer of at least "
+            f"{2 * len(records)} (two per record); got {max_simulations!r}"
+        )
+    return records
+
+
+def _x_bounds(model):
+    """Bounds of the least-squares variables ``x = c / c_start``: an observation model's
+    parameter (a sensor's time constant) within its physical bounds, so the trust region
+    does not step beyond a bound the model clips to (a step to ``tau < 0`` is clipped to no
+    filter, where the fit stalls).  Everything else is unbounded, the model clipping those
+    parameters itself: scipy's trust region scales every bounded variable by its distance
+    to the bound, which stops a fit near a bound short of the optimum."""
+    c0 = np.asarray(model.coefficients, dtype=float)
+    lo, hi = np.full(c0.size, -np.inf), np.full(c0.size, np.inf)
+    if isinstance(model, ForceLaw):
+        return lo, hi
+    n = len(model.law.coefficients)
+    for i, e in enumerate(model.free_effects(), start=n):
+        if e.target == "observation":
+            a, b = (v / c0[i] for v in e.parameters[0].bounds)
+            lo[i], hi[i] = min(a, b), max(a, b)
+    return lo, hi
+
+
+def _optimise(obj, x0, method, xtol, max_simulations):
+    """Run ``method`` on the objective from ``x0``; returns the optimiser's message."""
+    try:
+        if method == "coordinate-descent":
+            _coordinate_descent(obj, x0, xtol)
+            return "steps below xtol"
+        if method == "nelder-mead":
+            simplex = np.vstack([x0] + [x0 + 0.1 * np.eye(x0.size)[i] for i in range(x0.size)])
+            res = minimize(
+                obj,
+                x0,
+                method="Nelder-Mead",
+                options={
+                    "xatol": xtol,
+                    "fatol": 1e-12,
+                    "maxfev": max_simulations,
+                    "initial_simplex": simplex,
+                },
+            )
+            return str(res.message)
+        # the law's coefficients' columns exact when they can be (one run per record
+        # with the variational equations), else scipy's forward differences
+        res = least_squares(
+            obj.residuals,
+            x0,
+            jac=obj.jacobian if obj.exact_columns[1] else "2-point",
+            bounds=_x_bounds(obj.start),
+            method="trf",
+            x_scale=1.0,
+            diff_step=1e-6,
+            xtol=xtol * 1e-2,
+            ftol=1e-12,
+            gtol=1e-12,
+        )
+        return str(res.message)
+    except _Budget:
+        return f"simulation budget of {max_simulations} used"
+
+
+RESTART_FACTORS = (1.25, 0.8)
+"""After the first optimisation, it is started again from its best point with every
+parameter scaled by each factor, while the budget allows, and the best point is kept (by the
+sum of squares for least squares, else by the criterion).  A law refitted from a start 20 %
+off can stop in a basin whose spring is too soft (another contact sequence along the
+record's transient); a restart from a stiffer and a softer point often leaves such a basin
+(the rates: CHANGELOG)."""
+
+
+def _restarted(obj, method, xtol, max_simulations, message):
+    """:data:`RESTART_FACTORS` restarts from the best point (see there); the message says
+    which improved it."""
+    lo, hi = _x_bounds(obj.start)
+    squares = method == "least-squares"
+    for f in RESTART_FACTORS:
+        x_best = obj.estimate(method)
+        if x_best is None or obj.n + 4 * len(obj.records) > obj.max_sim:
+            break
+        before = obj.best_squares[0] if squares else obj.best[0]
+        x = np.clip(x_best * f, np.nextafter(lo, np.inf), np.nextafter(hi, -np.inf))
+        _optimise(obj, x, method, xtol, max_simulations)
+        after = obj.best_squares[0] if squares else obj.best[0]
+        if after < before:
+            what = "sum of squares" if squares else obj.name
+            message += (
+                f"; restarted from the best point x {f:g}: {what} {before:.3g} -> {after:.3g}"
+            )
+    return message
+
+
+def _fitted(obj, method, xtol, max_simulations):
+    """Optimise ``obj`` from its start (``x = 1``), then restart from the best point
+    (:func:`_restarted`): ``(the fitted x, the optimiser's message)``.
+
+    Raises
+    ------
+    IntegrationError
+        The start cannot be compared with the records.
+    """
+    x0 = np.ones(len(obj.start.coefficients))
+    if obj.evaluations(x0) is None:
+        f = obj.failures[-1]
+        raise IntegrationError(
+            f"the start law {obj.start} cannot be compared with the record: "
+            f"{f['status']} ({f['message']}); give start values closer to "
+            "the record (e.g. from vidi fit)"
+        )
+    message = _optimise(obj, x0, method, xtol, max_simulations)
+    if obj.best[1] is None:  # least squares evaluates residuals, which record the path
+        obj(x0)
+    message = _restarted(obj, method, xtol, max_simulations, message)
+    return obj.estimate(method), message
