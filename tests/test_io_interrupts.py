@@ -18,6 +18,14 @@ from discovery.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 
+
+def _restore_sigint():
+    """A child's Ctrl-C as in a terminal: a suite started as a background job (``make test
+    &``, some CI runners) passes SIGINT ignored to its children, and Python then installs
+    no KeyboardInterrupt handler."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 # `vidi steady --out DIR`, held inside the output stage (the staging directory exists):
 # the result is written into the open stage (``Result.write_into``)
 _CHILD = textwrap.dedent("""
@@ -84,6 +92,7 @@ def test_signal_exits_with_one_line(earlier, sig, code, word):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=_restore_sigint,
     )
     _wait_staged(p)
     assert any(".vidi-staging." in q.name for q in earlier.parent.iterdir())
@@ -126,6 +135,7 @@ def test_interrupt_in_an_unraisable_callback_still_stops_the_run(earlier):
         capture_output=True,
         text=True,
         timeout=120,
+        preexec_fn=_restore_sigint,
     )
     assert p.returncode == 130, p.stderr
     assert p.stderr.splitlines() == [
@@ -175,10 +185,6 @@ def test_interrupt_reraised_by_compiled_code_is_an_interrupt(earlier, monkeypatc
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("vidi: error: interrupted (Ctrl-C)")
     _intact(earlier)
-
-
-def _restore_sigint():
-    signal.signal(signal.SIGINT, signal.SIG_DFL)  # as in a terminal, not a background job
 
 
 @pytest.mark.parametrize("delay", [0.3, 2.0, 4.0, 7.0])

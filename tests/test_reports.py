@@ -504,7 +504,12 @@ def test_a_signal_ends_latexmk_and_pdflatex_too(tmp_path, how):
     code = handler + (
         f"from reports.document import compile_tex\ncompile_tex({str(tex)!r}, timeout=300)\n"
     )
-    proc = subprocess.Popen([sys.executable, "-c", code], cwd=os.getcwd())
+    # Ctrl-C as in a terminal, also when the suite runs as a background job (SIGINT ignored)
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code],
+        cwd=os.getcwd(),
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     try:
         assert _wait_for(lambda: any("pdflatex" in c for c in _procs_with(name)), 60)
         sig = {"SIGINT": signal.SIGINT, "SIGKILL": signal.SIGKILL}.get(how, signal.SIGTERM)

@@ -70,8 +70,14 @@ def _start(tmp_path, out, *extra):
     cfg.write_text(LONG)
     cmd = [*VIDI, "study", "--config", str(cfg), "--out", str(out), "--workers", "1"]
     cmd += ["--no-figures", "--quiet", *extra]
+    # Ctrl-C as in a terminal, also when the suite runs as a background job (SIGINT ignored)
     proc = subprocess.Popen(
-        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, cwd=tmp_path
+        cmd,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+        cwd=tmp_path,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     runs = _work(out) / "runs"
     deadline = time.monotonic() + 120
