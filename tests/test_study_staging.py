@@ -65,6 +65,12 @@ def _work(out):
     return out.parent / f".{out.name}.vidi-study"
 
 
+def _sigint_as_in_a_terminal():
+    """A child's Ctrl-C as in a terminal: a suite started as a background job passes SIGINT
+    ignored to its children, and Python then installs no KeyboardInterrupt handler."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _start(tmp_path, out, *extra):
     cfg = tmp_path / "long.toml"
     cfg.write_text(LONG)
@@ -77,7 +83,7 @@ def _start(tmp_path, out, *extra):
         stderr=subprocess.PIPE,
         text=True,
         cwd=tmp_path,
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+        preexec_fn=_sigint_as_in_a_terminal,
     )
     runs = _work(out) / "runs"
     deadline = time.monotonic() + 120
@@ -273,6 +279,7 @@ def test_ctrl_c_of_a_dask_study_is_one_line(tmp_path):
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        preexec_fn=_sigint_as_in_a_terminal,
     )
     runs = _work(out) / "runs"
     deadline = time.monotonic() + 180
