@@ -53,8 +53,29 @@ def _z0(case):
     return sc.scales()[1] / wc
 
 
-def run(i, *, n_boot=30, noise_model="cycles", periods=12, refit="two-step"):
+def _identified(sc, ref, truth, rng, *, seed, n_boot, noise, refit):
+    """``truth`` identified on ``ref`` from a start 20 % off (each parameter up or down at
+    random from ``rng``), least squares, with bootstrap intervals."""
     from discovery import identify
+
+    start = truth.with_coefficients(
+        [c * (1 + 0.2 * rng.choice([-1, 1])) for c in truth.coefficients]
+    )
+    return identify(
+        sc,
+        ref,
+        start,
+        criterion="I2",
+        method="least-squares",
+        max_simulations=200,
+        n_boot_intervals=n_boot,
+        interval_noise=noise,
+        interval_refit=refit,
+        seed=seed,
+    )
+
+
+def run(i, *, n_boot=30, noise_model="cycles", periods=12, refit="two-step"):
     from discovery.vibroimpact.verify import Reference, evaluate
 
     t0 = time.perf_counter()
@@ -84,22 +105,8 @@ def run(i, *, n_boot=30, noise_model="cycles", periods=12, refit="two-step"):
             seed=i,
             check=False,
         )
-        start = law.with_coefficients(
-            [c * (1 + 0.2 * rng.choice([-1, 1])) for c in law.coefficients]
-        )
         ref = Reference.from_measurement(rec, sc)
-        res = identify(
-            sc,
-            ref,
-            start,
-            criterion="I2",
-            method="least-squares",
-            max_simulations=200,
-            n_boot_intervals=n_boot,
-            interval_noise=noise_model,
-            interval_refit=refit,
-            seed=i,
-        )
+        res = _identified(sc, ref, law, rng, seed=i, n_boot=n_boot, noise=noise_model, refit=refit)
         ev = evaluate(sc, res.law, ref)
     except Exception as exc:  # a survey records every outcome
         row.update(error=f"{type(exc).__name__}: {exc}", seconds=time.perf_counter() - t0)
@@ -157,7 +164,7 @@ def run_corpus(name, *, n_boot=30, noise_model="cycles", refit="two-step"):
     """One corpus record (``../shared/corpus/NAME``): its true model identified from a
     start 20 % off (every parameter up or down at random), with bootstrap intervals, each
     checked against the truth."""
-    from discovery import Measurement, identify
+    from discovery import Measurement
     from discovery.vibroimpact.verify import Reference
 
     from .test_corpus import CORPUS
@@ -167,22 +174,10 @@ def run_corpus(name, *, n_boot=30, noise_model="cycles", refit="two-step"):
     try:
         sc, model, truth = _corpus_model(name)
         rng = np.random.default_rng(int(name[1:3]))
-        start = model.with_coefficients(
-            [c * (1 + 0.2 * rng.choice([-1, 1])) for c in model.coefficients]
-        )
         m = Measurement.from_csv(str(CORPUS / name / "measured.csv"))
         ref = Reference.from_measurement(m, sc)
-        res = identify(
-            sc,
-            ref,
-            start,
-            criterion="I2",
-            method="least-squares",
-            max_simulations=200,
-            n_boot_intervals=n_boot,
-            interval_noise=noise_model,
-            interval_refit=refit,
-            seed=0,
+        res = _identified(
+            sc, ref, model, rng, seed=0, n_boot=n_boot, noise=noise_model, refit=refit
         )
         fitted = res.law  # the model identify fitted (a law with effects)
     except Exception as exc:  # a survey records every outcome
