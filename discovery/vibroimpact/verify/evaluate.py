@@ -219,9 +219,10 @@ def _verdict(consistent, reg, imp, crit, floor, lim=None, transient=False):
             "inconsistent: the noise floor under this law could not be estimated (no "
             "bootstrap replicate of its force history found the contacts)"
         )
+    factors = ", ".join(f"{CONSISTENCY_FACTORS[k]:g} for {k}" for k in lim)
     rule = (
-        f"max({CONSISTENCY_FACTOR:g} x noise floor, floor + {CONSISTENCY_SPREAD:g} sd) + "
-        f"{CONSISTENCY_SLACK:g}"
+        f"max(f x noise floor, floor + {CONSISTENCY_SPREAD:g} sd) + {CONSISTENCY_SLACK:g}, "
+        f"f = {factors}"
     )
     if consistent:
         within = ", ".join(f"{k} = {crit[k]:.3g} <= {lim[k]:.3g}" for k in lim)
