@@ -23,6 +23,8 @@ Writes ``bench/results.json``.  Figures:
    on a record compared over its span, a run with sensitivities over a plain one;
 8. Ueda's oscillator (``bench/ueda_bench.py``): one chart point against scipy, a chart's
    wall time (and the 200x200 extrapolation), the duffing exponent per period against scipy.
+9. how parallel work scales (``bench/scaling_bench.py``): a 24-run study and ``explain`` on
+   1, 2 and every core, with the study's parallel efficiency.
 """
 
 import json
@@ -363,6 +365,7 @@ def main_kernel():
 def main():
     from discovery_bench import bench_discovery, bench_pipeline
     from explain_bench import bench_explain
+    from scaling_bench import bench_scaling, print_scaling
     from sensitivity_bench import bench_sensitivities
     from ueda_bench import bench_ueda
 
@@ -380,6 +383,7 @@ def main():
         "pipeline": bench_pipeline(),
         "explain": bench_explain(),
         "ueda": bench_ueda(),
+        "scaling": bench_scaling(),
         "cores": os.cpu_count(),
         **provenance({"scenario": "paper"}),
     }
@@ -477,9 +481,41 @@ def main():
         f"(200x200 extrapolated {u['chart']['extrapolated_200x200_seconds']:.0f} s); duffing "
         f"exponent {u['lyapunov_duffing']['value']:.4f} +- {u['lyapunov_duffing']['stderr']:.4f}"
     )
+    print_scaling(results["scaling"])
     print("wrote bench/results.json")
     return 0
 
 
+def main_scaling(argv):
+    """``python run.py scaling [--workers 1,2,16] [--paper-study] [--out FILE]``: the scaling
+    section alone (written to FILE, default bench/scaling.json)."""
+    import argparse
+
+    from scaling_bench import bench_scaling, print_scaling, worker_counts
+
+    ap = argparse.ArgumentParser(prog="run.py scaling")
+    ap.add_argument("--workers", help="comma-separated worker counts (default 1, 2, all)")
+    ap.add_argument("--study-workers", help="the study's worker counts (default: --workers)")
+    ap.add_argument("--paper-study", action="store_true", help="also the 120-run paper study")
+    ap.add_argument("--out", default=str(Path(__file__).with_name("scaling.json")))
+    a = ap.parse_args(argv)
+    sc = load_scenario("paper")
+    steady_state(sc, sc.law)  # compile / load the cached kernels first
+    res = {
+        **bench_scaling(
+            worker_counts(a.workers),
+            paper_study=a.paper_study,
+            study_counts=worker_counts(a.study_workers) if a.study_workers else None,
+        ),
+        **provenance({"scenario": "paper"}),
+    }
+    Path(a.out).write_text(json.dumps(to_jsonable(res), indent=2) + "\n")
+    print_scaling(res)
+    print(f"wrote {a.out}")
+    return 0
+
+
 if __name__ == "__main__":
+    if sys.argv[1:2] == ["scaling"]:
+        sys.exit(main_scaling(sys.argv[2:]))
     sys.exit(main_kernel() if sys.argv[1:] == ["kernel"] else main())
