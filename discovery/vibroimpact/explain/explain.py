@@ -82,7 +82,7 @@ from .state import _Run
 from .state import _Step as _Step
 from .trials import _LADDER as _LADDER
 from .trials import _extend as _extend
-from .trials import _judged, _law_baseline, _law_refit, _polish_winner, _refit_trials
+from .trials import _judged, _law_refit, _polish_winner, _refit_trials
 from .trials import _Refits as _Refits
 from .trials import _screen as _screen
 from .trials import _screen_one as _screen_one
@@ -224,8 +224,7 @@ def _refit_and_name(run, step):
     screen_budget = max(run.budget // 3, 4 * len(run.records))
     eff_by_id = step.screening.by_id
     gap = _gap(run, evs)
-    trials = _refit_trials(run, step, screen_budget, gap)
-    null, null_after, null_evs = _law_baseline(run, screen_budget)
+    trials, (null, null_after, null_evs) = _refit_trials(run, step, screen_budget, gap)
     good = _judged(trials, null_after, step.floor, eff_by_id)
     if not good and null_after and gap in null_after and null_after[gap] <= 0.9 * before[gap]:
         run.iterations.append(

@@ -85,15 +85,22 @@ class _Refits:
 
 
 def _screen_one(refits, job):
-    """One screening refit (:meth:`_Refits.refit`, a task of the executor): ``(model,
+    """One screening refit (:meth:`_Refits.refit`, a task of the executor), or with no
+    effect (``eff_id`` None) the law refitted alone from ``model``: ``(model,
     identification, evaluations, error, simulations)``."""
     problem = refits.problem
     model, eff_id, direction = job
     n0 = problem.n_sim
     try:
-        m2, res = refits.refit(model, effect(eff_id), direction)
+        if eff_id is None:
+            res = _output_error(
+                refits.records, model, refits.criterion, refits.budget, refits.tolerances
+            )
+            m2 = res.law
+        else:
+            m2, res = refits.refit(model, effect(eff_id), direction)
         evs = problem.evaluations(m2, floor=True)
-    except IntegrationError as exc:
+    except (IntegrationError, InputError) as exc:
         return None, None, None, str(exc), problem.n_sim - n0
     return m2, res, evs, None, problem.n_sim - n0
 
@@ -178,31 +185,43 @@ def _law_refit(run, model, budget, *, polish=False):
 
 def _refit_trials(run, step, screen_budget, gap):
     """Every chosen effect (the screening's ranked ones, at most ``run.max_refits``) refitted
-    with ``screen_budget`` simulations (the refits of the force history in parallel, the
-    drift channel here) and checked: physical, within its bounds; the trials."""
+    with ``screen_budget`` simulations and checked (physical, within its bounds), and the
+    law refitted alone with the same budget (:func:`_law_start`): the refits of the force
+    history, the law's among them, run in parallel (the law's last, so one process does
+    them in the order written), the drift channel here.  Returns ``(trials, baseline)``,
+    ``baseline`` is ``(fit, criteria, evaluations)`` of the law refitted alone, or three
+    Nones when that refit fails."""
     model, records, before = run.model, run.records, step.before
     chosen = step.screening.ranked[: run.max_refits]
     eff_by_id = step.screening.by_id
-    # the screening refits of the force history are independent: one process each
-    refits = iter(
-        _screen(
-            [
-                (model, s["effect"], s.get("direction"))
-                for s in chosen
-                if "drift" not in eff_by_id[s["effect"]].phases
-            ],
-            _Refits(
-                problem=run.problem,
-                records=records,
-                criterion=run.criterion,
-                budget=screen_budget,
-                tolerances=run.tolerances,
-                regress=run.regress,
-            ),
-            run.workers,
-            run.executor,
-        )
+    jobs = [
+        (model, s["effect"], s.get("direction"))
+        for s in chosen
+        if "drift" not in eff_by_id[s["effect"]].phases
+    ]
+    law_start = _law_start(run)
+    if law_start is not None:
+        jobs.append((law_start, None, None))
+    out = _screen(
+        jobs,
+        _Refits(
+            problem=run.problem,
+            records=records,
+            criterion=run.criterion,
+            budget=screen_budget,
+            tolerances=run.tolerances,
+            regress=run.regress,
+        ),
+        run.workers,
+        run.executor,
     )
+    baseline = (None, None, None)
+    if law_start is not None:
+        law, res, evs, error = out.pop()
+        if error is None:
+            after, _ = _with_drift(_mean(evs, "criteria"), {}, run.drift, law)
+            baseline = (res, after, evs)
+    refits = iter(out)
     trials = []
     for s in chosen:
         eff = eff_by_id[s["effect"]]
@@ -257,25 +276,24 @@ def _refit_trials(run, step, screen_budget, gap):
                 key=key,
             )
         )
-    return trials
+    return trials, baseline
 
 
-def _law_baseline(run, screen_budget):
-    """The law refitted alone with the same budget (from the better of the current model and
-    the regression on its terms): ``(fit, criteria, evaluations)``, or ``(None, None,
-    None)``.  An effect is named only when its refit beats this by the noise floor (else the
-    gap was the start's own misfit, and the effect only carried a refit of the law)."""
+def _law_start(run):
+    """Where the law refitted alone starts: the better (by the criterion, one simulation
+    each) of the current model and the regression on its terms; None when neither
+    simulates.  An effect is named only when its refit beats this law's refit by the noise
+    floor (else the gap was the start's own misfit, and the effect only carried a refit of
+    the law)."""
     model, problem = run.model, run.problem
     try:
-        null_starts = [model]
+        starts = [model]
         reg0 = _regressed(model, model.law.names, run.regress)
         if reg0 is not None:
-            null_starts.append(reg0)
-        null_start = min(null_starts, key=lambda m: problem.value(m, run.criterion))
+            starts.append(reg0)
+        return min(starts, key=lambda m: problem.value(m, run.criterion))
     except (IntegrationError, InputError):
-        null_start = None
-    refit0 = None if null_start is None else _law_refit(run, null_start, screen_budget)
-    return (None, None, None) if refit0 is None else refit0
+        return None
 
 
 def _judged(trials, null_after, floor, eff_by_id):
