@@ -143,7 +143,7 @@ def test_subharmonic_with_several_impacts_is_aligned():
         check_default_start=False,
     )
     assert v.consistent, v.verdict
-    exact = v.evaluation.extra["aligned"]
+    exact = v.evaluation.aligned
     E = v.reference.impulse
     others = [
         evaluate_criteria(E, exact.rotated(o).resampled_like(E))["I2"] for o in exact.onsets[1:]

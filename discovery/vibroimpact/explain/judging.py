@@ -17,31 +17,16 @@ def _present(eff, model, res):
 
 
 def _within_noise(evs, criterion):
-    """Every record in the measured regime with ``criterion`` within its consistency limit
-    (:func:`discovery.vibroimpact.verify.consistency_limits`)."""
-    for e in evs:
-        if (
-            e.status != "ok"
-            or e.regime["simulated"] != e.regime["measured"]
-            or e.impacts["simulated"] != e.impacts["measured"]
-            or not e.noise_floor
-        ):
-            return False
-        lim = e.limits
-        if criterion not in lim or not e.criteria[criterion] <= lim[criterion]:
-            return False
-    return True
+    """Every record in the measured regime, with a floor, and ``criterion`` within its
+    consistency limit (:meth:`~discovery.vibroimpact.verify.Evaluation.within`)."""
+    return all(e.same_regime and e.noise_floor and e.within(criterion) for e in evs)
 
 
 def _motion_within(evs):
     """The recorded penetration (I5) within its consistency limit on every record that has
     it: a law that trades spring for damping matches the force, not the motion, and is
     still to be explained."""
-    return all(
-        MOTION_CRITERION not in e.limits
-        or e.criteria.get(MOTION_CRITERION, np.inf) <= e.limits[MOTION_CRITERION]
-        for e in evs
-    )
+    return all(e.within(MOTION_CRITERION, absent=True) for e in evs)
 
 
 def _motion_worse(before, after, evs):
@@ -58,8 +43,7 @@ def _failing(evs):
     """The criteria beyond their consistency limit in any record."""
     out = []
     for e in evs:
-        lim = e.limits
-        out += [k for k in lim if e.criteria.get(k, 0.0) > lim[k] and k not in out]
+        out += [k for k in e.failing() if k not in out]
     return out or ["the comparison"]
 
 

@@ -769,7 +769,7 @@ def _warnings(selected, by_bic, stab, pairs, parts, refs, samples, refine):
     if (
         not selected.consistent
         and selected.criteria
-        and all(ev.consistent or ev.extra.get("only_I4") for ev in selected.evaluations)
+        and all(ev.consistent or ev.only_i4 for ev in selected.evaluations)
     ):
         out.append(
             "the selected model fails the consistency rule by I4 alone (the contact "

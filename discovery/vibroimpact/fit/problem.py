@@ -372,7 +372,7 @@ def _aligned_sensitivity(scenario, law, ref, ev, tolerances):
     if not on.size:
         raise IntegrationError("the orbit has no contact onset")
     # the onset the alignment put at t* = 0 (the rotated impulse's own onset, on the orbit)
-    gap = np.abs(np.mod(os_.event_t[on] - ev.extra["aligned"].onset + 0.5 * W, W) - 0.5 * W)
+    gap = np.abs(np.mod(os_.event_t[on] - ev.aligned.onset + 0.5 * W, W) - 0.5 * W)
     _, dF = os_.from_onset(on[int(np.argmin(gap))], ref.impulse.t)
     return dF
 

@@ -107,7 +107,7 @@ def _measured_cycles(ref):
 
 def cycle_pairs(ev, ref):
     """``[(measured, simulated), ...]`` of an evaluation, one per compared cycle."""
-    return ev.extra.get("blocks") or [(ref.impulse, ev.simulated)]
+    return ev.blocks or [(ref.impulse, ev.simulated)]
 
 
 def _residual_weights(ref):

@@ -26,6 +26,7 @@ in the same way:
 """
 
 from dataclasses import dataclass, field
+from enum import StrEnum
 
 import numpy as np
 
@@ -89,6 +90,17 @@ def consistency_limits(floor, sd=None):
     }
 
 
+class Status(StrEnum):
+    """How an evaluation ended: ``"ok"`` (scored), ``"nonperiodic"`` (no stable periodic orbit:
+    physical), ``"no-contact"`` (the bodies never touch) or ``"failed"`` (the simulation
+    failed).  Compares equal to its text."""
+
+    OK = "ok"
+    NONPERIODIC = "nonperiodic"
+    NO_CONTACT = "no-contact"
+    FAILED = "failed"
+
+
 @readable
 @dataclass(frozen=True, eq=False)
 class Evaluation(Result):
@@ -96,15 +108,13 @@ class Evaluation(Result):
 
     Attributes
     ----------
-    status : str
-        ``"ok"``, ``"nonperiodic"`` (no stable periodic orbit: physical), ``"no-contact"``
-        or ``"failed"`` (the simulation failed: see ``message``).
+    status : Status
     regime : dict
         ``{"measured": "P1", "simulated": "P1" or None}``.
     impacts : dict
         Contacts per orbit, ``{"measured": k, "simulated": k or None}``.
     criteria : dict
-        ``I0..I4`` (empty unless ``status == "ok"``).
+        ``I0..I4`` (and I5 with positions; empty unless ``status`` is ``"ok"``).
     noise_floor : dict
         The reference's floor of every criterion (mean over replicates).
     consistent : bool
@@ -114,9 +124,34 @@ class Evaluation(Result):
     simulated : Impulse or None
         The aligned simulated impulse sampled like the measurement.
     message : str
+    limits : dict
+        ``{criterion: limit}`` of the consistency rule (from the floor's mean and spread;
+        from the mean alone when not given).
+    noise_floor_q95 : dict
+        The floor's 95th percentile of every criterion.
+    only_i4 : bool
+        Inconsistent by the contact support (I4) alone (:func:`_only_i4`).
+    aligned : Impulse or None
+        The exact simulated orbit rotated onto the measured cycle (a steady-orbit comparison).
+    comparison : str
+        ``"steady orbit"`` or ``"record span"`` (block by block over the record).
+    blocks : list or None
+        ``[(measured, simulated)]`` impulses of each block of a record-span comparison.
+    penetration : list or None
+        The simulated penetration at each block's samples (a record-span comparison with
+        positions).
+    span : dict or None
+        The record span compared: start time, cycles, blocks, the state fit, I2 per block.
+    transient_i2 : float or None
+        I2 between the law's trajectory over the record's span and its steady orbit (above
+        :data:`TRANSIENT_GAP` the record is still in a transient under that law).
+    impacts_folded : dict or None
+        Contacts of the folded cycles, measured and simulated.
+    notes : tuple of str
+        What the verdict adds (contacts that agree within the noise, a transient).
     """
 
-    status: str
+    status: Status
     regime: dict
     impacts: dict
     criteria: dict
@@ -126,26 +161,60 @@ class Evaluation(Result):
     steady: object = None
     simulated: object = None
     message: str = ""
-    extra: dict = field(default_factory=dict)
+    limits: dict = None
+    noise_floor_q95: dict = field(default_factory=dict)
+    only_i4: bool = False
+    aligned: object = None
+    comparison: str = "steady orbit"
+    blocks: list = None
+    penetration: list = None
+    span: dict = None
+    transient_i2: float = None
+    impacts_folded: dict = None
+    notes: tuple = ()
 
     KIND = "evaluation"
-    _LOAD = {"extra": lambda d: {"limits": d.get("limits") or {}}}
+    _LOAD = {
+        "status": lambda d: Status(d["status"]),
+        "limits": lambda d: d.get("limits") or {},
+        "notes": lambda d: tuple(d.get("notes", ())),
+    }
 
-    @property
-    def limits(self):
-        """``{criterion: limit}`` of the consistency rule for this evaluation."""
-        return self.extra.get("limits") or (
-            consistency_limits(self.noise_floor) if self.noise_floor else {}
-        )
+    def __post_init__(self):
+        object.__setattr__(self, "status", Status(self.status))
+        if self.limits is None:
+            lim = consistency_limits(self.noise_floor) if self.noise_floor else {}
+            object.__setattr__(self, "limits", lim)
+        object.__setattr__(self, "notes", tuple(self.notes))
 
     def value(self, name):
         """Criterion ``name``, ``inf`` when there is none (for ranking and optimisers)."""
         return self.criteria.get(name, float("inf"))
 
+    @property
+    def same_regime(self):
+        """Scored, in the measured regime with the measured contacts per orbit."""
+        return bool(
+            self.status == Status.OK
+            and self.regime["simulated"] == self.regime["measured"]
+            and self.impacts["simulated"] == self.impacts["measured"]
+        )
+
+    def within(self, criterion, *, absent=False):
+        """Whether ``criterion`` is within its consistency limit (``absent`` when the
+        evaluation has no limit for it, e.g. I5 on a record without positions)."""
+        if criterion not in self.limits:
+            return absent
+        return bool(self.criteria.get(criterion, np.inf) <= self.limits[criterion])
+
+    def failing(self):
+        """The criteria beyond their consistency limit."""
+        return [k for k in self.limits if self.criteria.get(k, 0.0) > self.limits[k]]
+
     def as_dict(self):
         ss = self.steady
         return {
-            "status": self.status,
+            "status": str(self.status),
             "regime": self.regime,
             "impacts": self.impacts,
             "criteria": self.criteria,
@@ -154,6 +223,9 @@ class Evaluation(Result):
             "consistent": self.consistent,
             "verdict": self.verdict,
             "message": self.message,
+            "comparison": self.comparison,
+            "notes": list(self.notes),
+            "transient_i2": self.transient_i2,
             "max_multiplier": None
             if ss is None or not ss.periodic
             else float(np.max(np.abs(ss.multipliers))),
@@ -357,7 +429,7 @@ def evaluate(
     crit = evaluate_criteria(E, sim)
     if not floor:
         return Evaluation(
-            "ok", reg, imp, crit, {}, False, "", steady=ss, simulated=sim, extra={"aligned": rot}
+            "ok", reg, imp, crit, {}, False, "", steady=ss, simulated=sim, aligned=rot
         )
     fl = reference.floor_for(rot)
     same = reg["simulated"] == reg["measured"] and imp["simulated"] == imp["measured"]
@@ -381,7 +453,10 @@ def evaluate(
         verdict,
         steady=ss,
         simulated=sim,
-        extra={"aligned": rot, "noise_floor_q95": fl["q95"], "only_I4": only_i4, "limits": lim},
+        aligned=rot,
+        noise_floor_q95=fl["q95"],
+        only_i4=only_i4,
+        limits=lim,
     )
 
 
@@ -501,7 +576,7 @@ def _evaluate_span(
             span, reference.blocks, sims, [b.Z for b in span.blocks], z_sim
         )
     last = span.blocks[-1]
-    extra = {
+    found = {
         "comparison": "record span",
         "penetration": z_sim,
         "blocks": list(zip(reference.blocks, sims, strict=True)),
@@ -515,11 +590,11 @@ def _evaluate_span(
         },
     }
     if not floor:
-        return Evaluation("ok", reg, imp, crit, {}, False, "", simulated=sim, extra=extra)
+        return Evaluation("ok", reg, imp, crit, {}, False, "", simulated=sim, **found)
     ss, transient = _span_steady_state(
         scenario, law, reference, last, span, sim, reg, tolerances, steady_kwargs
     )
-    extra["transient_I2"] = transient
+    found["transient_i2"] = transient
     settled = transient is not None and transient <= TRANSIENT_GAP
     fl = reference.floor_for(
         sims, scenario=scenario, law=law, tolerances=tolerances, observe=observe
@@ -537,7 +612,7 @@ def _evaluate_span(
     # a regime "mismatch" while the law's own trajectory over the span has not settled is a
     # transient, judged by the block-by-block comparison alone
     transient_mismatch = not settled and reg["simulated"] != reg["measured"]
-    extra["impacts_folded"] = {"measured": folded, "simulated": imp["simulated"]}
+    found["impacts_folded"] = {"measured": folded, "simulated": imp["simulated"]}
     notes = []
     if same_impacts and imp["simulated"] != imp["measured"]:
         notes.append(
@@ -550,14 +625,12 @@ def _evaluate_span(
     notes += _transient_notes(transient_mismatch, settled, transient, reg, ss)
     if notes and verdict is not None:
         verdict = f"{verdict}; " + "; ".join(notes)
-    extra.update(
-        {
-            "noise_floor_q95": fl["q95"],
-            "notes": notes,
-            "limits": lim,
-            "only_I4": _only_i4(same_impacts and regime_ok, consistent, crit, lim),
-        }
+    found.update(
+        noise_floor_q95=fl["q95"],
+        notes=notes,
+        limits=lim,
+        only_i4=_only_i4(same_impacts and regime_ok, consistent, crit, lim),
     )
     return Evaluation(
-        "ok", reg, imp, crit, fl["mean"], consistent, verdict, steady=ss, simulated=sim, extra=extra
+        "ok", reg, imp, crit, fl["mean"], consistent, verdict, steady=ss, simulated=sim, **found
     )

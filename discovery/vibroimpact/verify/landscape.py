@@ -327,7 +327,7 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
         if ev.status == "ok":
             return (
                 dict(ev.noise_floor),
-                dict(ev.extra.get("noise_floor_q95") or {}),
+                dict(ev.noise_floor_q95 or {}),
                 cand.to_text(),
             )
         tried.append((cand.to_text(), ev.status))

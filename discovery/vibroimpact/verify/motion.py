@@ -153,7 +153,7 @@ def penetration_residuals(reference, evaluation, weights=None):
     ndarray of shape (n,)
     """
     span = getattr(reference, "span", None)
-    z_sim = evaluation.extra.get("penetration") if evaluation is not None else None
+    z_sim = evaluation.penetration if evaluation is not None else None
     if span is None or span.sigma_z <= 0 or z_sim is None:
         return np.zeros(0)
     scale = span.sigma_f / span.sigma_z
@@ -213,8 +213,8 @@ def force_penetration_loops(reference, evaluation):
         for a record without positions or an evaluation without a simulation.
     """
     span = getattr(reference, "span", None)
-    z_sim = evaluation.extra.get("penetration") if evaluation is not None else None
-    blocks = evaluation.extra.get("blocks") if evaluation is not None else None
+    z_sim = evaluation.penetration if evaluation is not None else None
+    blocks = evaluation.blocks if evaluation is not None else None
     if span is None or span.sigma_z <= 0 or not z_sim or not blocks:
         return None
     blk, (E, S), zs = span.blocks[-1], blocks[-1], z_sim[-1]

@@ -81,7 +81,7 @@ class VerifyResult(Result):
         return {
             "law": self.law.to_text(),
             **ev.as_dict(),
-            "noise_floor_q95": ev.extra.get("noise_floor_q95"),
+            "noise_floor_q95": ev.noise_floor_q95,
             "measured": {
                 "n_periods": E.n_periods,
                 "n_cycles": E.n_cycles,
@@ -175,7 +175,7 @@ def verify(
         other = evaluate(scenario, law, ref, tolerances=tolerances, from_state=False, floor=False)
         # (with a record span the two criteria come from different comparisons: only the
         # regimes are compared)
-        span = ev.extra.get("comparison") == "record span"
+        span = ev.comparison == "record span"
         if other.regime["simulated"] != ev.regime["simulated"] or (
             not span
             and other.status == "ok"
