@@ -623,15 +623,21 @@ class _Work:
             if self.target.exists()
             else f"nothing was written to {short(out)!r}"
         )
-        if kept:
-            note = (
-                f"{kept} finished run(s) of {total} kept in {short(self.path)!r}; run the "
-                f"same command again to continue; {where}"
+
+        def note(resume):
+            if not kept:
+                return f"no run was kept; {where}"
+            return (
+                f"{kept} finished run(s) of {total} kept in {short(self.path)!r}; {resume}; {where}"
             )
-        else:
-            note = f"no run was kept; {where}"
+
         with contextlib.suppress(Exception):
-            exc.vidi_note = note
+            exc.vidi_note = note("run the same command again to continue")  # the CLI's line
+        if isinstance(exc, KeyboardInterrupt) and hasattr(exc, "add_note"):
+            # the API's traceback ends with what was kept and how to go on
+            exc.add_note(
+                "study: " + note("call study() again with the same config and out to continue")
+            )
         if not self.n_runs():  # nothing of this or an earlier interrupted study there
             self._remove()
 
