@@ -95,6 +95,7 @@ def _loaded_intervals(d):
     )
 
 
+@readable
 @dataclass(frozen=True, eq=False)
 class RankedModel(Result):
     """A candidate law with its simulation check against every record.
@@ -243,6 +244,18 @@ class RankedModel(Result):
         if len(self.evaluations) > 1:
             d["records"] = [e.as_dict() for e in self.evaluations]
         return d
+
+    def _lines(self):
+        head = (
+            f"{self.law}  [{self.regime}]: "
+            f"{'consistent' if self.consistent else 'NOT consistent'} with the record(s)"
+        )
+        out = [head, *coefficient_lines(self.law.as_dict(), self.standard_errors, self.intervals)]
+        out += criteria_lines(self.criteria, self.noise_floor, self.limits)
+        out.append(f"  verdict: {self.verdict}")
+        if self.note:
+            out.append(f"  refinement: {self.note}")
+        return out
 
 
 @readable
