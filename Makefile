@@ -94,7 +94,7 @@ tables: install
 	$(BIN)/python -m tests.tables
 
 surveys: install
-	rm -f $(MEASURED)/intervals-*.jsonl $(MEASURED)/advise-*.jsonl
+	rm -f $(MEASURED)/intervals-*.jsonl $(MEASURED)/advise-*.jsonl $(MEASURED)/realistic-*.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 272 \
 		--workers $(SURVEY_WORKERS) --out $(MEASURED)/intervals-272.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 208 \
@@ -104,6 +104,10 @@ surveys: install
 	$(BIN)/python -m tests.survey_advise --cases 0 14 --out $(MEASURED)/advise-1.jsonl
 	$(BIN)/python -m tests.survey_advise --cases 0 12 --force-noise 0.03 \
 		--out $(MEASURED)/advise-3.jsonl
+	$(BIN)/python -m tests.realistic_survey --properties --n 8 --noise-seeds 1 \
+		--out $(MEASURED)/realistic-default.jsonl
+	$(BIN)/python -m tests.realistic_survey --properties --n 8 --noise-seeds 1 --field \
+		--out $(MEASURED)/realistic-field.jsonl
 	$(MAKE) tables
 
 # The documentation site (docs/*.md, API reference from the docstrings), warnings as errors

@@ -18,7 +18,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import measured, survey_advise, survey_intervals
+from . import measured, realistic_survey, survey_advise, survey_intervals
 
 ROOT = measured.ROOT
 
@@ -35,6 +35,11 @@ class Table:
     rows: tuple
     row: object
     read: object
+
+
+def _rows(paths):
+    """Every row of the run files ``paths``."""
+    return [r for p in paths for r in measured.read(p)[1]]
 
 
 _INTERVAL_RUNS = {
@@ -84,7 +89,21 @@ TABLES = {
         ),
         rows=(("1 %", ("advise-1*.jsonl",)), ("3 %", ("advise-3*.jsonl",))),
         row=survey_advise.markdown_row,
-        read=lambda paths: [r for p in paths for r in measured.read(p)[1]],
+        read=_rows,
+    ),
+    "realistic-span": Table(
+        page="docs/validation.md",
+        header=(
+            "| setting | true law consistent | wrong law inconsistent (detectable) | not "
+            "detectable |",
+            "|---|---|---|---|",
+        ),
+        rows=(
+            ("default (as above)", ("realistic-default*.jsonl",)),
+            ("field-like (`--field`)", ("realistic-field*.jsonl",)),
+        ),
+        row=realistic_survey.markdown_row,
+        read=_rows,
     ),
 }
 
