@@ -46,6 +46,16 @@ def _in_kernel():
     return getattr(shell, "kernel", None) is not None
 
 
+def _shown(stream):
+    """Whether ``stream`` is a terminal or a notebook's output (a bar reads well there)."""
+    isatty = getattr(stream, "isatty", None)
+    try:
+        tty = bool(isatty()) if callable(isatty) else False
+    except (OSError, ValueError):  # a closed or detached stream
+        tty = False
+    return tty or _in_kernel()
+
+
 def interactive(stream=None):
     """Whether a person watches ``stream`` (default stderr): a terminal, or a notebook's
     output (a Jupyter kernel), from the main thread of the main process."""
@@ -53,13 +63,7 @@ def interactive(stream=None):
         return False
     if multiprocessing.parent_process() is not None:
         return False
-    stream = sys.stderr if stream is None else stream
-    isatty = getattr(stream, "isatty", None)
-    try:
-        tty = bool(isatty()) if callable(isatty) else False
-    except (OSError, ValueError):  # a closed or detached stream
-        tty = False
-    return tty or _in_kernel()
+    return _shown(sys.stderr if stream is None else stream)
 
 
 def resolve(progress, where="progress"):
@@ -70,7 +74,7 @@ def resolve(progress, where="progress"):
             return None, False
         return Reporter(bar=True), True
     if progress is True:
-        return Reporter(), True
+        return Reporter(bar=_shown(sys.stderr)), True
     if progress is False:
         return None, False
     if callable(progress):

@@ -113,9 +113,10 @@ def test_a_notebook_kernel_is_interactive(monkeypatch):
     assert interactive(io.StringIO())
     out = io.StringIO()
     monkeypatch.setattr(sys, "stderr", out)
-    rep, owned = resolve(None)
-    assert owned and rep.bar  # a bar in the notebook's output
-    rep.close()
+    for progress in (None, True):
+        rep, owned = resolve(progress)
+        assert owned and rep.bar  # a bar in the notebook's output
+        rep.close()
 
 
 def test_ipython_absent_is_not_imported(monkeypatch, no_kernel):
