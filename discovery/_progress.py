@@ -109,6 +109,7 @@ def reports_progress(func):
             if owned:
                 rep.close()
 
+    reporting.__vidi_progress__ = True  # for the test that every long function resolves it
     return reporting
 
 

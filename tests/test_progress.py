@@ -165,3 +165,27 @@ def test_the_ueda_chart_reports_with_the_one_protocol():
         progress=lambda *a: calls.append(a),
     )
     assert calls == [("chart: rows", 1, 2), ("chart: rows", 2, 2)]
+
+
+def test_every_public_function_with_progress_resolves_it_one_way():
+    """Every public function that takes ``progress`` goes through the one resolver."""
+    import inspect
+
+    import discovery
+    import discovery.ueda
+    import discovery.ueda.chart
+
+    found = []
+    for module in (discovery, discovery.ueda, discovery.ueda.chart):
+        for name in getattr(module, "__all__", dir(module)):
+            obj = getattr(module, name)
+            if inspect.isfunction(obj) and "progress" in inspect.signature(obj).parameters:
+                found.append(name)
+                chain, wrapped = obj, False
+                while chain is not None and not wrapped:
+                    wrapped = getattr(chain, "__vidi_progress__", False)
+                    chain = getattr(chain, "__wrapped__", None)
+                assert wrapped, f"{module.__name__}.{name} does not resolve progress"
+    assert {"study", "discover", "explain", "identify", "landscape", "advise", "chart"} <= set(
+        found
+    )
