@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed
 TEX_PACKAGES := latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended \
 	lmodern poppler-utils
 
-.PHONY: install demo study test test-slow test-all bench lint clean tex docs
+.PHONY: install demo study test test-slow test-all bench lint clean tex docs tables surveys
 
 install: $(STAMP)
 
@@ -82,6 +82,33 @@ test-all: install
 
 bench: install
 	cd bench && ../$(BIN)/python run.py
+
+# The measured tables of docs/validation.md and the README, rendered between their
+# <!-- table:NAME --> markers from the surveys' saved runs in docs/_measured/ (seconds; each
+# table names the commit and date of its runs; tests/test_tables.py holds the pages to it).
+# `make surveys` runs the surveys again first: hours on two cores (SURVEY_WORKERS processes).
+MEASURED := docs/_measured
+SURVEY_WORKERS ?= 2
+
+tables: install
+	$(BIN)/python -m tests.tables
+
+surveys: install
+	rm -f $(MEASURED)/intervals-*.jsonl $(MEASURED)/advise-*.jsonl $(MEASURED)/realistic-*.jsonl
+	$(BIN)/python -m tests.survey_intervals --records 64 --first 272 \
+		--workers $(SURVEY_WORKERS) --out $(MEASURED)/intervals-272.jsonl
+	$(BIN)/python -m tests.survey_intervals --records 64 --first 208 \
+		--workers $(SURVEY_WORKERS) --out $(MEASURED)/intervals-208.jsonl
+	$(BIN)/python -m tests.survey_intervals --corpus \
+		--workers $(SURVEY_WORKERS) --out $(MEASURED)/intervals-corpus.jsonl
+	$(BIN)/python -m tests.survey_advise --cases 0 14 --out $(MEASURED)/advise-1.jsonl
+	$(BIN)/python -m tests.survey_advise --cases 0 12 --force-noise 0.03 \
+		--out $(MEASURED)/advise-3.jsonl
+	$(BIN)/python -m tests.realistic_survey --properties --n 8 --noise-seeds 1 \
+		--out $(MEASURED)/realistic-default.jsonl
+	$(BIN)/python -m tests.realistic_survey --properties --n 8 --noise-seeds 1 --field \
+		--out $(MEASURED)/realistic-field.jsonl
+	$(MAKE) tables
 
 # The documentation site (docs/*.md, API reference from the docstrings), warnings as errors
 docs: install

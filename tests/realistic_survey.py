@@ -25,22 +25,69 @@ category and in all:
   the one computed on the noisy record; or another regime there): see
   :class:`realistic.Trial`;
 
-with their counts, and every failure of either property on its own line.
+with their counts, and every failure of either property on its own line.  ``--out FILE``
+also writes every trial as a JSON line to a run file of :mod:`tests.measured` (the
+measured tables of docs/validation.md are rendered from such files, :mod:`tests.tables`).
 """
 
 import argparse
+import math
 import sys
 import time
 from collections import defaultdict
 from pathlib import Path
+from types import SimpleNamespace
 
 HERE = Path(__file__).resolve().parent
-# the repository root must come before tests/ (tests/constraints would shadow the
-# top-level constraints package)
-sys.path[0:1] = [str(HERE.parent)]
-sys.path.append(str(HERE))
+if not __package__:  # run as a script: python tests/realistic_survey.py
+    # the repository root must come before tests/ (tests/constraints would shadow the
+    # top-level constraints package)
+    sys.path[0:1] = [str(HERE.parent)]
 
-import realistic as R  # noqa: E402
+from tests import measured  # noqa: E402
+from tests import realistic as R  # noqa: E402
+
+_TRIAL_FIELDS = (
+    "label",
+    "status",
+    "consistent",
+    "detectable",
+    "i2",
+    "floor_i2",
+    "i2_clean",
+    "regime",
+    "verdict",
+    "i2_rule",
+)
+
+
+def trial_row(cat, seed, noise_seed, tr):
+    """One trial as a JSON-able row of a run file (NaN as None)."""
+    row = {"category": cat, "seed": seed, "noise_seed": noise_seed, "law": str(tr.law)}
+    for k in _TRIAL_FIELDS:
+        v = getattr(tr, k)
+        if k in ("consistent", "i2_rule") or (k == "detectable" and v is not None):
+            v = bool(v)
+        elif k in ("i2", "floor_i2", "i2_clean"):
+            v = None if v is None or math.isnan(float(v)) else float(v)
+        row[k] = v
+    return row
+
+
+def trials_of(rows):
+    """The ``(category, seed, noise_seed, trial)`` tuples of run-file rows (for :func:`rates`)."""
+    return [(r["category"], r["seed"], r["noise_seed"], SimpleNamespace(**r)) for r in rows]
+
+
+def markdown_row(rows, label):
+    """One row of docs/validation.md's table of the verification properties: the true law
+    consistent, the detectable wrong laws inconsistent, the undetectable ones."""
+    r = rates(trials_of(rows))
+    return f"| {label} | {_pct(*r['true'])} | {_pct(*r['wrong'])} | {r['undetectable']} |"
+
+
+def _pct(k, n):
+    return f"{k}/{n} = {100.0 * k / n:.1f} %".replace(".0 %", " %") if n else f"{k}/{n}"
 
 
 def _draw_table(args):
@@ -119,6 +166,7 @@ def _properties(args):
         f"{CONSISTENCY_SLACK:g}, same regime; noise seeds per case {args.noise_seeds}"
     )
     all_trials = []
+    out = measured.RunFile(args.out, "realistic_survey", args.argv) if args.out else None
     t_start = time.perf_counter()
     for cat in args.categories.split(","):
         for seed in range(args.first_seed, args.first_seed + args.n):
@@ -138,6 +186,8 @@ def _properties(args):
                     print(f"{cat:<14} {seed:>4} noise {ns}: {exc}", flush=True)
                     continue
                 all_trials += [(cat, seed, ns, tr) for tr in trials]
+                for tr in trials if out is not None else ():
+                    out.write(trial_row(cat, seed, ns, tr))
                 r = rates([(cat, seed, ns, tr) for tr in trials])
                 print(
                     f"{cat:<14} {seed:>4} n{ns} {case.regime:<3} imp {case.impacts} "
@@ -202,7 +252,9 @@ def main(argv=None):
         help="the field-like setting (realistic.FIELD): slow P1 up to multiplier "
         "0.995, records after at most 250 periods from rest, 5 or 20 kHz",
     )
+    ap.add_argument("--out", metavar="JSONL", help="with --properties: also write a run file")
     args = ap.parse_args(argv)
+    args.argv = sys.argv[1:] if argv is None else argv
     if args.field:
         R.MAX_MULTIPLIER = R.FIELD["multiplier"]
     if args.properties:

@@ -36,6 +36,7 @@ from discovery import ForceLaw, discover, load_scenario
 from discovery._io import provenance
 from discovery.vibroimpact.advise import Knobs, NoiseModel, SafeRegion, advise
 from discovery.vibroimpact.model.scenario import Scenario
+from tests import measured
 from tests import realistic as R
 
 CORPUS_B = {"m1": 9000.0, "m2": 6000.0, "k1": 2.2e7, "c1": 8e4, "A": 4.2e5, "frequency": 26.0}
@@ -183,6 +184,24 @@ def summary(rows):
     return adv, rnd, len(counted)
 
 
+def markdown_row(rows, label):
+    """One row of docs/validation.md's table: cases run and counted, how many select the
+    true law (the first record alone, with the advised and with the random second record)
+    and how many leave no rival law equivalent."""
+    counted = [r for r in rows if r.get("counted")]
+    cells = [
+        label,
+        len(rows),
+        len(counted),
+        sum(bool(r["first_settled"]) for r in counted),
+        f"**{sum(r['with_advised']['settled'] for r in counted)}**",
+        sum(r["with_random"]["settled"] for r in counted),
+        f"**{sum(resolved(r['with_advised'], r['law']) for r in counted)}**",
+        sum(resolved(r["with_random"], r["law"]) for r in counted),
+    ]
+    return "| " + " | ".join(str(c) for c in cells) + " |"
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--cases", nargs=2, type=int, metavar=("FIRST", "STOP"))
@@ -194,12 +213,12 @@ def main(argv=None):
     args = ap.parse_args(argv)
     FORCE_NOISE[0] = args.force_noise
     if args.summary:
-        with open(args.summary) as f:
-            summary([json.loads(line) for line in f])
+        summary(measured.read(args.summary)[1])
         return 0
     if not (args.cases and args.out):
         ap.error("give --cases FIRST STOP and --out FILE, or --summary FILE")
     versions = provenance()["versions"]
+    out = measured.RunFile(args.out, "survey_advise", argv, append=True)
     for i in range(*args.cases):
         try:
             row = run_case(i)
@@ -207,8 +226,7 @@ def main(argv=None):
             row = {"i": i, "machine": "?", "law": "?", "counted": False, "why": repr(exc)}
             traceback.print_exc()
         row["versions"] = versions
-        with open(args.out, "a") as f:
-            print(json.dumps(row, default=float), file=f, flush=True)
+        out.write(row)
         print(json.dumps(row, default=float)[:400], flush=True)
     return 0
 

@@ -16,7 +16,6 @@ One JSON line per record (appended as it goes), then a summary table on stdout.
 """
 
 import argparse
-import json
 import math
 import sys
 import time
@@ -25,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.append(str(Path(__file__).resolve().parents[1]))  # for tests.measured
 
 from realistic import draw_case, reference_record  # noqa: E402
 
@@ -38,6 +38,7 @@ from discovery.vibroimpact.model.contact_models import (  # noqa: E402
     restitution_ratio,
 )
 from discovery.vibroimpact.verify import Reference  # noqa: E402
+from tests import measured  # noqa: E402
 
 PARAMS_CHECKED = ("k", "n", "e", "lambda", "c")
 
@@ -175,13 +176,10 @@ def main(argv=None):
     )
     a = ap.parse_args(argv)
     if a.summarize:
-        rows = [
-            json.loads(line) for f in a.out for line in Path(f).read_text().splitlines() if line
-        ]
+        rows = [r for f in a.out for r in measured.read(f)[1]]
         print(summary(rows))
         return
-    out = Path(a.out[0])
-    out.parent.mkdir(parents=True, exist_ok=True)
+    out = measured.RunFile(a.out[0], "survey_contact_models", argv, append=True)
     rows = []
     jobs = [(m, a.seed + 1000 * j + i) for i in range(a.per_model) for j, m in enumerate(MODELS)]
     jobs += [("polynomial", a.seed + 9000 + i) for i in range(a.poly)]
@@ -190,8 +188,7 @@ def main(argv=None):
     for name, seed in jobs:
         row = one_record(name, seed, a.max_simulations)
         rows.append(row)
-        with out.open("a") as fh:
-            fh.write(json.dumps(row, default=float) + "\n")
+        out.write(row)
         print(
             f"{name:<20s} seed {seed}: selected {row.get('selected')} "
             f"equivalent {row.get('equivalent')} covered {row.get('covered')} "

@@ -22,6 +22,7 @@ import numpy as np
 from discovery import ForceLaw, Scenario, identify
 from discovery.vibroimpact.verify import Reference, evaluate
 
+from . import measured
 from . import realistic as R
 
 # the corpus machine (an independent simulator's shake-out grid) and the paper's machine
@@ -124,17 +125,20 @@ def main(argv=None):
         help="replicates of the bootstrap intervals (0 = Jacobian only)",
     )
     p.add_argument("--summary", metavar="JSONL", help="summarise an earlier run's output")
+    p.add_argument("--out", metavar="JSONL", help="also write the rows to this run file")
     a = p.parse_args(argv)
     if a.summary:
-        with open(a.summary) as fh:
-            summary([json.loads(line) for line in fh if line.startswith("{")])
+        summary(measured.read(a.summary)[1])
         return 0
+    out = measured.RunFile(a.out, "survey_coverage", argv) if a.out else None
     rows = []
     for m in a.machines.split(","):
         for seed in range(a.records):
             row = run(m, seed, n_boot=a.bootstrap)
             rows.append(row)
             print(json.dumps(row), flush=True)
+            if out is not None:
+                out.write(row)
     summary(rows)
     return 0
 

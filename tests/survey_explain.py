@@ -21,7 +21,6 @@ Each output line is one draw (JSON) with the versions it ran with.
 
 import argparse
 import collections
-import json
 import sys
 import time
 
@@ -31,6 +30,7 @@ from discovery import ForceLaw
 from discovery._io import provenance
 from discovery.vibroimpact.explain import explain
 from discovery.vibroimpact.verify import Reference, evaluate
+from tests import measured
 from tests import realistic as R
 
 CATEGORIES = ("p1", "subharmonic", "p1-slow", "short-contact")
@@ -134,12 +134,11 @@ def main(argv=None):
     ap.add_argument(
         "--draws", nargs=2, type=int, metavar=("FIRST", "STOP"), help="draw indices FIRST .. STOP-1"
     )
-    ap.add_argument("--out", help="JSON-lines file the rows are appended to")
+    ap.add_argument("--out", help="run file (tests.measured) the rows are appended to")
     ap.add_argument("--summary", help="count the outcomes of a JSON-lines file")
     args = ap.parse_args(argv)
     if args.summary:
-        with open(args.summary) as f:
-            rows = [json.loads(line) for line in f]
+        rows = measured.read(args.summary)[1]
         for r in rows:
             print(
                 f"{r['i']:3d} {r['category']:14s} {r.get('regime', '-'):4s} "
@@ -149,10 +148,9 @@ def main(argv=None):
         return 0
     if not (args.draws and args.out):
         ap.error("give --draws FIRST STOP and --out FILE, or --summary FILE")
+    out = measured.RunFile(args.out, "survey_explain", argv, append=True)
     for i in range(*args.draws):
-        row = draw(i)
-        with open(args.out, "a") as f:
-            print(json.dumps(row), file=f, flush=True)
+        out.write(draw(i))
     return 0
 
 

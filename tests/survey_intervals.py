@@ -9,7 +9,8 @@ at a random sample rate of 5-20 kHz (not a multiple of the drive frequency), at 
 (force 0.5 % of its peak, motion 0.1 % of each channel's range) or high noise (3 %, 0.3 %)
 in turn.  The true support is identified by output error from a start 20 % off the truth,
 with bootstrap intervals (:func:`discovery.vibroimpact.fit.identify.bootstrap_intervals`),
-and each interval is checked against the truth.  One JSON line per record; ``--summary
+and each interval is checked against the truth.  One JSON line per record (``--out FILE``:
+a run file of :mod:`tests.measured`, headed by the commit and code version); ``--summary
 FILE`` prints the coverage per class (category, kind, coupling share, noise level) of the
 fits consistent with their records.  ``--workers N`` runs records in N processes.
 ``--corpus`` runs the thirteen records of ``../shared/corpus`` instead (each one's true law
@@ -24,6 +25,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 
+from . import measured
 from . import realistic as R
 
 NOISE = {"low": (0.005, 0.001), "high": (0.03, 0.003)}
@@ -216,33 +218,53 @@ CLASSES = {
 }
 
 
-def markdown_row(rows, label):
-    """One row of the README's coverage table: the coverage per class and in all, and the
-    code versions that made the rows."""
+def _covered(rows):
+    """The rows with intervals (fits consistent with their records) and, per class, the
+    covered flags of their coefficients (None for a class no record fell in)."""
     ok = [r for r in rows if "error" not in r and r.get("consistent") and r.get("covered")]
+    by = {
+        key: [[c for r in ok if r[key] == n for c in r["covered"].values()] for n in names]
+        for key, names in CLASSES.items()
+    }
+    return ok, by, [v for r in ok for v in r["covered"].values()]
+
+
+def markdown_row(rows, label):
+    """One row of docs/validation.md's coverage table: the coverage per class and in all,
+    and the code versions that made the rows (a class no record fell in is left blank)."""
+    ok, by, allv = _covered(rows)
     cells = [f"{label} ({len(ok)} of {len(rows)} records with intervals)"]
-    for key, names in CLASSES.items():
-        rates = []
-        for n in names:
-            v = [c for r in ok if r[key] == n for c in r["covered"].values()]
-            rates.append(f"{sum(v)}/{len(v)}" if v else "-")
-        cells.append(" / ".join(rates))
-    allv = [v for r in ok for v in r["covered"].values()]
+    for classes in by.values():
+        rates = [f"{sum(v)}/{len(v)}" if v else "-" for v in classes]
+        cells.append(" / ".join(rates) if any(classes) else "")
     cells.append(f"{sum(allv)}/{len(allv)} = **{sum(allv) / max(len(allv), 1):.1%}**")
     codes = sorted({r.get("code", "?") for r in rows})
     cells.append(", ".join(codes))
     return "| " + " | ".join(cells) + " |"
 
 
+def readme_row(rows, label):
+    """The same row as the README shows it: whole percentages per class."""
+    _, by, allv = _covered(rows)
+    cells = [label]
+    for classes in by.values():
+        rates = [f"{100 * sum(v) / len(v):.0f}" if v else "-" for v in classes]
+        cells.append(" / ".join(rates) + " %" if any(classes) else "")
+    cells.append(f"{sum(allv)}/{len(allv)} = {100 * sum(allv) / max(len(allv), 1):.1f} %")
+    return "| " + " | ".join(cells) + " |"
+
+
 def read_rows(paths):
-    """The JSON lines of ``paths``; a record run again in a later file replaces its row."""
+    """The rows of the run files ``paths`` (:func:`tests.measured.read`); a record run
+    again in a later file replaces its row; a row without its own code version takes its
+    run's (or, for runs before the survey recorded it, the run's commit)."""
     rows = {}
     for path in paths:
-        with open(path) as fh:
-            for line in fh:
-                if line.startswith("{"):
-                    r = json.loads(line)
-                    rows[r["i"]] = r
+        header, found = measured.read(path)
+        for r in found:
+            if "code" not in r and (header.get("code") or header.get("commit")):
+                r["code"] = header.get("code") or header["commit"]
+            rows[r["i"]] = r
     return list(rows.values())
 
 
@@ -279,6 +301,7 @@ def main(argv=None):
     p.add_argument("--summary", metavar="JSONL", nargs="+")
     p.add_argument("--markdown", metavar="LABEL", help="with --summary: the table row")
     p.add_argument("--corpus", action="store_true", help="the corpus's records instead")
+    p.add_argument("--out", metavar="JSONL", help="also write the rows to this run file")
     a = p.parse_args(argv)
     if a.summary:
         rows = read_rows(a.summary)
@@ -292,16 +315,22 @@ def main(argv=None):
         idx = range(a.first, a.first + a.records)
     rows = []
     kw = {"n_boot": a.bootstrap, "noise_model": a.noise, "refit": a.refit}
-    if a.workers > 1:  # each record's line as soon as it is done
+    out = measured.RunFile(a.out, "survey_intervals", argv) if a.out else None
+
+    def done(row):  # each record's line as soon as it is done
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+        if out is not None:
+            out.write(row)
+
+    if a.workers > 1:
         with ProcessPoolExecutor(a.workers) as ex:
             futures = [ex.submit(_run_kw, (i, kw)) for i in idx]
             for f in as_completed(futures):
-                rows.append(f.result())
-                print(json.dumps(rows[-1]), flush=True)
+                done(f.result())
     else:
         for i in idx:
-            rows.append(_run_kw((i, kw)))
-            print(json.dumps(rows[-1]), flush=True)
+            done(_run_kw((i, kw)))
     summary(rows)
     return 0
 

@@ -181,6 +181,9 @@ def test_a_mistyped_command_or_option_gets_a_did_you_mean(capsys, tmp_path):
     assert main(["fit", "--dta", "x.csv", "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "unknown option '--dta'" in err and "did you mean '--data'" in err
+    assert main(["ueda", "chrt"]) == 2  # a subcommand as a command
+    err = capsys.readouterr().err
+    assert "unknown command 'chrt' (did you mean 'chart'?)" in err and "vidi ueda --help" in err
     assert main(["ueda", "attractor", "--modle", "negres"]) == 2
     assert "did you mean '--model'" in capsys.readouterr().err
     # a prefix argparse takes: the command goes on to the missing file

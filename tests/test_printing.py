@@ -27,6 +27,15 @@ def results():
     disc = osc.discover(t, x, 0.35, 1.02)
     out["ueda discover"] = disc
     out["ueda verify"] = osc.verify(disc.model, t, x, periods=300, resamples=20)
+    out["response"] = d.response(sc, LAW)
+    out["impulse"] = out["response"].impulse
+    out["measurement"] = rec
+    out["contact samples"] = d.contact_samples(rec)
+    out["ranked model"] = out["discover"].ranking[0]
+    out["candidate"] = out["ranked model"].candidate
+    out["regime"], out["lyapunov"], _ = osc.classify(system, transient=50, periods=60)
+    out["periodic orbit"] = osc.periodic_orbit(system, (0.5, 0.0))
+    out["basins"] = osc.basins(system, n=2, transient=20, periods=30)
     return out
 
 
@@ -40,6 +49,16 @@ def results():
         ("steady", ["steady state P1", "Floquet"]),
         ("ueda discover", ["Discovery", "residual_rms"]),
         ("ueda verify", ["Verification", "energy_distance", "consistent"]),
+        ("response", ["response: steady state P1", "impulse over 1 period(s)"]),
+        ("impulse", ["impulse over 1 period(s)", "peak", "exact (simulated)"]),
+        ("measurement", ["record of 8000 samples", "channels w1, v1, w2, v2", "synthetic"]),
+        ("contact samples", ["contact samples of", "impact(s)", "noise"]),
+        ("ranked model", ["consistent", "std error", "I2", "verdict"]),
+        ("candidate", ["support", "BIC", "value"]),
+        ("regime", ["regime chaotic"]),
+        ("lyapunov", ["Lyapunov exponents", "+-"]),
+        ("periodic orbit", ["periodic orbit P1", "Floquet multipliers", "residual"]),
+        ("basins", ["attractor(s) from a 2x2 grid", "% of the grid"]),
     ],
 )
 def test_print_of_a_result_is_a_short_report(results, name, needles):
@@ -56,3 +75,32 @@ def test_print_of_a_result_is_a_short_report(results, name, needles):
 def test_the_discovery_printout_is_small_where_it_was_half_a_megabyte(results):
     assert len(repr(results["discover"])) < 300 and len(str(results["discover"])) < 4000
     assert np.isfinite(results["discover"].selected.criteria["I2"])
+
+
+# inputs and settings: their dataclass repr is what one would type to make them
+_INPUTS = {
+    "Tolerances",
+    "Scenario",
+    "Library",
+    "Knobs",
+    "NoiseModel",
+    "SafeRegion",
+    "ConstrainedSparseRegressor",
+    "Executor",
+    "Result",
+    "UedaSystem",
+    "UedaMap",
+}
+
+
+@pytest.mark.parametrize("module", [d, osc])
+def test_every_public_result_class_prints_readably(module):
+    """A public class is an input (its repr is its constructor call) or prints as text of
+    its own (a law, a short report by ``_printing.readable``): no dataclass dump of arrays."""
+    import inspect
+
+    for name in module.__all__:
+        obj = getattr(module, name)
+        if not inspect.isclass(obj) or issubclass(obj, BaseException) or name in _INPUTS:
+            continue
+        assert obj.__str__ is not object.__str__, f"print() of a {name} is its repr"

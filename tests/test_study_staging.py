@@ -95,6 +95,24 @@ def _start(tmp_path, out, *extra):
     return proc, cmd
 
 
+def test_an_interrupted_api_study_says_what_was_kept_and_how_to_go_on(tmp_path):
+    """Ctrl-C in ``study()``: the traceback's last line names the kept runs and the call
+    that continues; the next call runs only the rest."""
+    cfg = {**TINY, "seeds": 3}
+
+    def stop_after_one(stage, done, total):
+        if done >= 1:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt) as info:
+        study(cfg, tmp_path / "s", workers=1, progress=stop_after_one)
+    (note,) = info.value.__notes__
+    assert note.startswith("study: 1 finished run(s) of 3 kept in ")
+    assert "call study() again with the same config and out to continue" in note
+    assert "nothing was written to" in note
+    assert study(cfg, tmp_path / "s", workers=1, progress=False).executed == 2
+
+
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL])
 def test_a_stopped_study_leaves_an_earlier_result_exactly_as_it_was(tmp_path, sig):
     out = tmp_path / "res"

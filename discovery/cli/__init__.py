@@ -51,7 +51,7 @@ def _one_line(message, prog, command=None):
         opt, value, choices = m.groups()
         choices = choices.replace("'", "")
         hint = _did_you_mean(value, [c.strip() for c in choices.split(",")])
-        if opt in ("COMMAND", "command"):
+        if opt in ("COMMAND", "command", "SUBCOMMAND"):
             return f"unknown command {value!r}{hint}; choose one of {choices} ({see})"
         return f"{opt}: invalid choice {value!r}{hint}; choose one of {choices}"
     m = re.match(r"argument (\S+?)(?:/\S+)?: invalid (\w+) value: '(.*)'$", message, re.S)

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._printing import generic_lines, readable
+from .._printing import fmt, generic_lines, readable
 from .._result import Result, part
 from .._validate import Array, Real, params
 from ..errors import IntegrationError
@@ -135,6 +135,7 @@ def trajectory(system, y0, t_span, n_samples=4000, *, tolerances=None):
 
 
 # ------------------------------------------------------------------ Lyapunov exponents
+@readable
 @dataclass(frozen=True, eq=False)
 class Lyapunov(Result):
     """The two Lyapunov exponents [1/unit time] of one trajectory.
@@ -188,6 +189,15 @@ class Lyapunov(Result):
             "method": self.method,
             "units": "per unit time",
         }
+
+    def _lines(self):
+        return [
+            f"Lyapunov exponents {fmt(self.value, 4)} +- {fmt(self.stderr, 2)} and "
+            f"{fmt(self.second, 4)} +- {fmt(self.second_stderr, 2)} per unit time",
+            f"  sum {fmt(self.sum, 4)} against the mean trace {fmt(self.trace_mean, 4)}; "
+            f"{self.n_periods} periods in {self.batches} batches, rtol {fmt(self.rtol, 2)} "
+            f"({self.method})",
+        ]
 
 
 def _batch_stats(per_period, T, batches):
@@ -307,6 +317,7 @@ def rotation_number(points):
     return abs(rho), mono
 
 
+@readable
 @dataclass(frozen=True)
 class Regime:
     """The kind of steady state, with its evidence.
@@ -342,6 +353,10 @@ class Regime:
             "period": self.period,
             "evidence": self.evidence,
         }
+
+    def _lines(self):
+        rule = self.evidence.get("rule")
+        return [f"regime {self.regime}" + (f": {rule}" if rule else "")]
 
 
 def classify_points(
@@ -585,6 +600,7 @@ def attractor(
 
 
 # ------------------------------------------------------------------ coexisting attractors
+@readable
 @dataclass(frozen=True)
 class Basins:
     """Coexisting attractors found from a grid of initial states.
@@ -614,6 +630,19 @@ class Basins:
             "v0_range": [float(self.v0[0]), float(self.v0[-1])],
             "attractors": [{k: v for k, v in a.items() if k != "points"} for a in self.attractors],
         }
+
+    def _lines(self):
+        out = [
+            f"{len(self.attractors)} attractor(s) from a {self.x0.size}x{self.v0.size} grid of "
+            f"initial states (x0 {fmt(self.x0[0], 3)} to {fmt(self.x0[-1], 3)}, v0 "
+            f"{fmt(self.v0[0], 3)} to {fmt(self.v0[-1], 3)})"
+        ]
+        for i, a in enumerate(self.attractors):
+            out.append(
+                f"  {i}: {a.get('regime')}, {100 * float(a.get('fraction', 0)):.1f} % of the "
+                f"grid, largest Lyapunov exponent {fmt(a.get('lyapunov'), 3)}"
+            )
+        return out
 
 
 def _same_attractor(a, b, reg_a, reg_b, scale, tol=1e-3):

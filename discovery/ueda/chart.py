@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._printing import readable
+from .._progress import reports_progress, tick
 from .._result import Result
 from .._validate import Array, Instance, Real, params
 from ..errors import InputError, IntegrationError, VidiTypeError
@@ -520,8 +521,7 @@ def _run_rows(system, settings, nu, B, workers, executor, progress):
                     kind2[i, j], period2[i, j], lam2[i, j], rot2[i, j] = k, n, lv, r
                     cost[i, j] += c
                 coex[i] = cx
-            if progress is not None:
-                progress(done, len(jobs))
+            tick(progress, "chart: rows", done, len(jobs))
     finally:
         if own:
             ex.close()
@@ -559,6 +559,7 @@ def _run_rows(system, settings, nu, B, workers, executor, progress):
     workers=(None, Real(1, integer=True)),
     executor=(None, Instance("discovery.numerics.executor", "Executor")),
 )
+@reports_progress
 def chart(
     system,
     nu,
@@ -616,8 +617,9 @@ def chart(
         Consecutive repeating pairs the early exit needs at least (and ``3 n``).
     workers : int, optional
         Processes (default all cores, at most one per row).
-    progress : callable, optional
-        ``progress(done_rows, total_rows)`` after each row.
+    progress : callable or bool, optional
+        ``progress(stage, done, total)`` after each row (stage ``"chart: rows"``); None:
+        a bar when the session is interactive, False: none (:mod:`discovery._progress`).
     executor : Executor, optional
         Where the rows run (:mod:`discovery.numerics.executor`); overrides ``workers`` and is not
         closed here.  One task per row of ``B``.

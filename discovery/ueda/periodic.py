@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._printing import fmt, readable
 from .._validate import Array, Real, params
 from ..errors import InputError
 from ..numerics.shooting import floquet_multipliers, is_stable, newton_orbit, smallest_period
@@ -129,6 +130,7 @@ class UedaMap:
         return J
 
 
+@readable
 @dataclass(frozen=True)
 class PeriodicOrbit:
     """A periodic orbit of the stroboscopic map (or the evidence that shooting failed).
@@ -179,6 +181,22 @@ class PeriodicOrbit:
             "reduced_from": self.reduced_from,
             "n_calls": self.n_calls,
         }
+
+    def _lines(self):
+        mult = np.abs(np.asarray(self.multipliers))
+        state = ("stable" if self.stable else "unstable") if self.converged else "NOT converged"
+        reduced = (
+            f" (reduced from P{self.reduced_from})"
+            if self.reduced_from not in (0, self.n_periods)
+            else ""
+        )
+        return [
+            f"periodic orbit P{self.n_periods}{reduced}: {state}, |Floquet multipliers| "
+            + ", ".join(fmt(m, 3) for m in mult)
+            + f", residual {fmt(self.residual, 2)}",
+            f"  at phase 0: x {fmt(self.y0[0], 6)}, v {fmt(self.y0[1], 6)}; "
+            f"{self.n_calls} period-map evaluations",
+        ]
 
 
 @params(

@@ -55,7 +55,7 @@ def run(args):
             max_period=args.max_period,
             sweeps=2 if args.both_directions else 1,
             workers=args.workers,
-            progress=lambda done, total: rep("chart: rows", done, total),
+            progress=rep,
             executor=ex,
         )
     ch.record_run({"command": "ueda chart"}, provenance(vars(args)))

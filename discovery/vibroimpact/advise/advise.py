@@ -10,7 +10,7 @@ import os
 import time
 from dataclasses import dataclass
 
-from ..._progress import tick
+from ..._progress import reports_progress, tick
 from ..._validate import Instance, Real, params
 from ...numerics.executor import make_executor
 from ..dynamics import Tolerances
@@ -70,6 +70,7 @@ def _run(ex, context, jobs, progress, stage):
     tolerances=(Tolerances, None),
     executor=(None, Instance("discovery.numerics.executor", "Executor")),
 )
+@reports_progress
 def advise(
     scenario,
     laws,
@@ -100,8 +101,9 @@ def advise(
     workers : int, optional
         Processes (default: all cores); the result does not depend on it.
     tolerances : Tolerances, optional
-    progress : callable, optional
-        ``progress(stage, done, total)`` after each point.
+    progress : callable or bool, optional
+        ``progress(stage, done, total)`` after each point; None: a bar when the session is
+        interactive, False: none (:mod:`discovery._progress`).
     executor : Executor, optional
         Where the points run (:mod:`discovery.numerics.executor`); not closed here.
 

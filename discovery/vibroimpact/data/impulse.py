@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.ndimage import uniform_filter1d
 
+from ..._printing import fmt, readable
 from ..._validate import Array, Real, params
 from ...errors import InputError, NoContactError
 
@@ -33,6 +34,7 @@ __all__ = [
 ]
 
 
+@readable
 @dataclass(frozen=True)
 class Impulse:
     """Force over one cycle from the impact onset.
@@ -195,6 +197,24 @@ class Impulse:
             if len(self.support)
             else np.zeros((0, 2))
         )
+
+    def _lines(self):
+        contact = float(np.sum(np.diff(self.support, axis=1))) if len(self.support) else 0.0
+        out = [
+            f"impulse over {self.n_periods} period(s) ({fmt(self.duration)} s): peak "
+            f"{fmt(np.max(self.F) if len(self.F) else None)} N, in contact {fmt(contact)} s "
+            f"in {len(self.support)} interval(s), {len(self.onsets)} impact(s) per cycle"
+        ]
+        out.append(
+            f"  onset at {fmt(self.onset, 6)} s, {self.t.size} samples, "
+            + (
+                "exact (simulated)"
+                if self.noise == 0 and self.threshold == 0
+                else f"noise {fmt(self.noise, 3)} N, contact threshold {fmt(self.threshold, 3)} "
+                f"N, {self.n_cycles} cycle(s) averaged"
+            )
+        )
+        return out
 
 
 def estimate_noise(x, order=1):

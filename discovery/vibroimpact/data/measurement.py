@@ -33,6 +33,7 @@ import numpy as np
 
 from ..._csv import parse_column, read_csv_rows
 from ..._io import atomic_write_text
+from ..._printing import fmt, readable
 from ..._validate import Array, Text, check
 from ...errors import InputError, NoContactError
 from .impulse import _edge_params, estimate_noise, impulse_from_samples
@@ -69,6 +70,7 @@ def _fmt(x):
     return f"{float(x):.10g}"
 
 
+@readable
 @dataclass(frozen=True)
 class Measurement:
     """A force record, optionally with the bodies' positions and velocities.
@@ -306,6 +308,21 @@ class Measurement:
             raise NoContactError(
                 no_contact_message(self.t, self.F, period, self.source, kwargs.get("threshold"))
             ) from None
+
+    def _lines(self):
+        n = self.t.size
+        span = float(self.t[-1] - self.t[0]) if n > 1 else 0.0
+        rate = (n - 1) / span if span > 0 else None
+        channels = ", ".join(self.channels) or "none"
+        out = [
+            f"record of {n} samples over {fmt(span)} s ({fmt(rate)} Hz): force "
+            f"{fmt(np.min(self.F) if n else None)} to {fmt(np.max(self.F) if n else None)} N, "
+            f"channels {channels}"
+        ]
+        if self.source:
+            out.append(f"  from {self.source}")
+        out += [f"  note: {x}" for x in self.notes]
+        return out
 
 
 def _nonuniform_message(where, jit, med, lo, hi):

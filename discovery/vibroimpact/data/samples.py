@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import savgol_filter
 
+from ..._printing import fmt, readable
 from ..._validate import Real, Text, params
 from ...errors import InputError
 from .impulse import estimate_noise, impulse_from_samples
@@ -26,6 +27,7 @@ __all__ = ["ContactSamples", "contact_samples", "join_samples"]
 DERIVATIVES = ("velocities", "savgol", "pysindy")
 
 
+@readable
 @dataclass(frozen=True)
 class ContactSamples:
     """Samples in contact.
@@ -68,6 +70,16 @@ class ContactSamples:
 
     def __len__(self):
         return self.zeta.size
+
+    def _lines(self):
+        if not self.F.size:
+            return ["no contact samples"]
+        return [
+            f"{self.F.size} contact samples of {self.n_impacts} impact(s): penetration up to "
+            f"{fmt(np.max(self.zeta), 3)} m, its velocity {fmt(np.min(self.dzeta), 3)} to "
+            f"{fmt(np.max(self.dzeta), 3)} m/s, force up to {fmt(np.max(self.F))} N",
+            f"  noise {fmt(self.noise, 3)} N, velocity by {self.derivative}",
+        ]
 
 
 def join_samples(parts):

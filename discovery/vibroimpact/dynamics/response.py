@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._printing import readable
 from ..._validate import Real, params
 from ...errors import InputError
 from ..data.impulse import Impulse
@@ -23,6 +24,7 @@ from .steady_state import steady_state
 __all__ = ["Response", "response", "impulse_from_steady_state"]
 
 
+@readable
 @dataclass(frozen=True)
 class Response:
     """A law's steady state and its impulse (``None`` if nonperiodic or no contact)."""
@@ -39,6 +41,11 @@ class Response:
         if self.impulse is None:
             return None
         return self.impulse.resampled_like(measured)
+
+    def _lines(self):
+        head = self.steady._lines()[0]
+        impulse = self.impulse._lines()[0] if self.impulse is not None else "no impulse"
+        return [f"response: {head}", f"  {impulse}"]
 
 
 @params(

@@ -39,7 +39,7 @@ One iteration (:func:`explain`):
 import time
 import warnings
 
-from ..._progress import tick
+from ..._progress import reports_progress, tick
 from ..._validate import Choice, Instance, Real, Text, params
 from ...catalogue import select
 from ...errors import InputError, IntegrationError
@@ -354,6 +354,7 @@ def _intervals(run, n_boot_intervals, seed, progress, refit="two-step"):
     interval_refit=Choice(*INTERVAL_REFITS),
     executor=(None, Instance("discovery.numerics.executor", "Executor")),
 )
+@reports_progress
 def explain(
     scenario,
     measurement,
@@ -412,8 +413,9 @@ def explain(
     n_boot_intervals, interval_refit : int, str
         Bootstrap replicates of the final model's 95 % parameter intervals (0 = none) and how
         each is refitted (:func:`discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
-    progress : callable, optional
-        ``progress(stage, done, total)`` at each stage and iteration (:mod:`discovery._progress`).
+    progress : callable or bool, optional
+        ``progress(stage, done, total)`` at each stage and iteration; None: a bar when the
+        session is interactive, False: none (:mod:`discovery._progress`).
     budget : int, optional
         Deprecated name of ``max_simulations``.
 

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._printing import readable
+from ..._progress import reports_progress
 from ..._validate import Real, params
 from ...errors import InputError, IntegrationError
 from ..data.measurement import Measurement
@@ -299,6 +300,7 @@ def _fit_one(name, records, settings, progress, hunt_crossley=None):
     n_boot=Real(0, integer=True),
     seed=Real(0, integer=True),
 )
+@reports_progress
 def fit_contact_models(
     scenario,
     reference,
@@ -327,8 +329,9 @@ def fit_contact_models(
         the fit's Jacobian).
     seed : int
     tolerances : Tolerances, optional
-    progress : callable, optional
-        ``progress(stage, done, total)``.
+    progress : callable or bool, optional
+        ``progress(stage, done, total)`` as each model is fitted; None: a bar when the session is
+        interactive, False: none (:mod:`discovery._progress`).
 
     Returns
     -------

@@ -41,7 +41,7 @@ from constraints import Certificate
 from constraints import require as require_certificate
 
 from ..._printing import coefficient_lines, fmt, readable
-from ..._progress import tick
+from ..._progress import reports_progress, tick
 from ..._result import Result, part
 from ..._validate import Choice, Real, Text, params
 from ...errors import InputError, IntegrationError, VidiError
@@ -95,6 +95,7 @@ def _loaded_intervals(d):
     )
 
 
+@readable
 @dataclass(frozen=True, eq=False)
 class RankedModel(Result):
     """A candidate law with its simulation check against every record.
@@ -243,6 +244,18 @@ class RankedModel(Result):
         if len(self.evaluations) > 1:
             d["records"] = [e.as_dict() for e in self.evaluations]
         return d
+
+    def _lines(self):
+        head = (
+            f"{self.law}  [{self.regime}]: "
+            f"{'consistent' if self.consistent else 'NOT consistent'} with the record(s)"
+        )
+        out = [head, *coefficient_lines(self.law.as_dict(), self.standard_errors, self.intervals)]
+        out += criteria_lines(self.criteria, self.noise_floor, self.limits)
+        out.append(f"  verdict: {self.verdict}")
+        if self.note:
+            out.append(f"  refinement: {self.note}")
+        return out
 
 
 @readable
@@ -1138,6 +1151,7 @@ def _contact_models(scenario, measurement, n_boot, seed, progress):
     interval_refit=Choice(*INTERVAL_REFITS),
     workers=(None, Real(1, integer=True)),
 )
+@reports_progress
 def discover(
     scenario,
     measurement,
@@ -1228,9 +1242,10 @@ def discover(
         Processes for the refinements of the shortlist and of each stepwise move, and for
         the bootstrap's refits (default 1; ``None``: every core); the result does not
         depend on it.
-    progress : callable, optional
+    progress : callable or bool, optional
         ``progress(stage, done, total)`` as the shortlist is simulated and the stepwise
-        search and the bootstrap go on (:mod:`discovery._progress`).
+        search and the bootstrap go on; None: a bar when the session is
+        interactive, False: none (:mod:`discovery._progress`).
     random_state : int, optional
         Deprecated name of ``seed``.
     **estimator_kwargs

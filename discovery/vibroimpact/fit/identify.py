@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._printing import coefficient_lines, fmt, readable
+from ..._progress import reports_progress
 from ..._result import Result, part
 from ..._validate import Choice, Real, Text, params
 from ...errors import IntegrationError
@@ -270,7 +271,7 @@ def _short_first(records, start, fit):
             uncertainty=False,
             observe=fit.observe,
             short_first=False,
-            progress=None
+            progress=False
             if fit.progress is None
             else (lambda s, d, t: fit.progress("identify: cycle by cycle", d, t)),
             check=False,
@@ -319,6 +320,7 @@ def _checks(records, law, observe, tolerances):
     interval_refit=Choice(*INTERVAL_REFITS),
     interval_noise=Choice(*INTERVAL_NOISE),
 )
+@reports_progress
 def identify(
     scenario,
     reference,
@@ -382,8 +384,9 @@ def identify(
         How a bootstrap replicate is refitted (:func:`bootstrap_intervals`: ``"two-step"``).
     interval_noise : str
         The replicates' noise (:func:`bootstrap_intervals`: ``"cycles"``).
-    progress : callable, optional
-        ``progress(stage, done, total)`` after each simulation (:mod:`discovery._progress`).
+    progress : callable or bool, optional
+        ``progress(stage, done, total)`` after each simulation; None: a bar when the session is
+        interactive, False: none (:mod:`discovery._progress`).
     short_first : bool
         With record spans compared in blocks of several cycles: first fit the records
         cycle by cycle (:meth:`~discovery.vibroimpact.verify.Reference.shortened`, up to half the

@@ -50,6 +50,7 @@ from constraints import (
 )
 from constraints.errors import SolverError
 
+from ..._printing import coefficient_lines, fmt, readable
 from ..._validate import Array, check
 from ...errors import InputError, VidiError
 from ..model.library import Library
@@ -74,6 +75,7 @@ class _InfeasibleSupport(SolverError):
         super().__init__(message, status="infeasible")
 
 
+@readable
 @dataclass(frozen=True)
 class Candidate:
     """One fitted support.
@@ -120,6 +122,15 @@ class Candidate:
             "constrained": self.constrained,
             **self.extra,
         }
+
+    def _lines(self):
+        cv = "" if np.isnan(self.cv_error) else f", cross-validated error {fmt(self.cv_error, 3)}"
+        return [
+            f"support {' + '.join(self.terms) or '(none)'}: rss {fmt(self.rss, 4)} N², BIC "
+            f"{fmt(self.bic, 6)}, AIC {fmt(self.aic, 6)}{cv}"
+            + (", a constraint active" if self.constrained else ""),
+            *coefficient_lines(self.coefficients),
+        ]
 
 
 class _Problem:

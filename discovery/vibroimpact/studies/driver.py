@@ -54,7 +54,7 @@ from ..._io import (
     to_jsonable,
 )
 from ..._printing import readable
-from ..._progress import tick
+from ..._progress import reports_progress, tick
 from ..._result import Result
 from ..._validate import Instance, Real, Text, params
 from ...errors import InputError, VidiTypeError
@@ -417,6 +417,7 @@ def _provenance(cfg, settings):
     executor=(None, Instance("discovery.numerics.executor", "Executor")),
     max_runs=(None, Real(0, integer=True)),
 )
+@reports_progress
 def study(
     config,
     out,
@@ -446,9 +447,10 @@ def study(
         A Dask scheduler address (``tcp://host:port``) or ``"local"`` for a LocalCluster.
     executor : Executor, optional
         Use this executor (overrides ``workers`` and ``scheduler``; not closed here).
-    progress : callable, optional
-        ``progress(stage, done, total)`` as runs finish (anything else not callable is a
-        :class:`~discovery.errors.VidiTypeError`).
+    progress : callable or bool, optional
+        ``progress(stage, done, total)`` as runs finish; None: a bar when the session is
+        interactive, False: none (:mod:`discovery._progress`). Anything else is a
+        :class:`~discovery.errors.VidiTypeError`.
     max_runs : int, optional
         Do at most this many missing runs, then aggregate what the files hold (a study in
         slices; the rest runs on the next call).
@@ -468,11 +470,6 @@ def study(
             "figures must be a callable figures(config, records, directory) -> paths (e.g. "
             "reports.vibroimpact.study_figures.study_figures) or None, "
             f"not {type(figures).__name__}"
-        )
-    if progress is not None and not callable(progress):
-        raise VidiTypeError(
-            f"progress must be a callable progress(stage, done, total) or None, "
-            f"not {type(progress).__name__}"
         )
     cfg = load_study(config)
     cfg = StudyConfig(**{**cfg.__dict__, "fit": {**_FIT_DEFAULTS, **cfg.fit}})
@@ -626,15 +623,21 @@ class _Work:
             if self.target.exists()
             else f"nothing was written to {short(out)!r}"
         )
-        if kept:
-            note = (
-                f"{kept} finished run(s) of {total} kept in {short(self.path)!r}; run the "
-                f"same command again to continue; {where}"
+
+        def note(resume):
+            if not kept:
+                return f"no run was kept; {where}"
+            return (
+                f"{kept} finished run(s) of {total} kept in {short(self.path)!r}; {resume}; {where}"
             )
-        else:
-            note = f"no run was kept; {where}"
+
         with contextlib.suppress(Exception):
-            exc.vidi_note = note
+            exc.vidi_note = note("run the same command again to continue")  # the CLI's line
+        if isinstance(exc, KeyboardInterrupt) and hasattr(exc, "add_note"):
+            # the API's traceback ends with what was kept and how to go on
+            exc.add_note(
+                "study: " + note("call study() again with the same config and out to continue")
+            )
         if not self.n_runs():  # nothing of this or an earlier interrupted study there
             self._remove()
 

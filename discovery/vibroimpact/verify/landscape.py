@@ -23,7 +23,7 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from ..._printing import fmt, readable
-from ..._progress import tick
+from ..._progress import reports_progress, tick
 from ..._result import Result
 from ..._validate import Array, Instance, Real, params
 from ...errors import InputError, VidiError, VidiTypeError
@@ -346,6 +346,7 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
     tolerances=(Tolerances, None),
     executor=(None, Instance("discovery.numerics.executor", "Executor")),
 )
+@reports_progress
 def landscape(
     scenario,
     law,
@@ -380,8 +381,9 @@ def landscape(
     from_state : bool
         Start each simulation from the reference's measured state when it has one
         (default), else from the scenario's initial state.
-    progress : callable, optional
-        ``progress(stage, done, total)`` after each row of the grid.
+    progress : callable or bool, optional
+        ``progress(stage, done, total)`` after each row of the grid; None: a bar when the session is
+        interactive, False: none (:mod:`discovery._progress`).
     executor : Executor, optional
         Where the rows run (:mod:`discovery.numerics.executor`: serial, a process pool, a Dask
         cluster); overrides ``workers`` and is not closed here.  One task per row.

@@ -1,0 +1,201 @@
+"""The measured tables of the documentation, rendered from the surveys' saved runs.
+
+Not a test module.  A table lives in its page between ``<!-- table:NAME -->`` and
+``<!-- /table:NAME -->``; :data:`TABLES` says which run files of ``docs/_measured/``
+(:mod:`tests.measured`) make each row and how.  Below every table a line names the runs it
+was made from, with the commit and the date of each, so a table says which code made it.
+
+    python -m tests.tables          # rewrite the tables in docs/ and the README (make tables)
+    python -m tests.tables --check  # exit 1, naming them, when a page's table is stale
+
+The renderer reads the saved runs only (seconds); ``make surveys`` runs the surveys again
+first (hours).  ``tests/test_tables.py`` holds the pages to what this renders.
+"""
+
+import argparse
+import re
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import measured, realistic_survey, survey_advise, survey_intervals
+
+ROOT = measured.ROOT
+
+
+@dataclass(frozen=True)
+class Table:
+    """A measured table: its page, header lines, and its rows, each a label and the glob
+    patterns of its run files in ``docs/_measured/`` (read in the order the runs started,
+    a later run's row of a record replacing an earlier one) that ``read`` gathers and
+    ``row(rows, label)`` turns into a markdown row."""
+
+    page: str
+    header: tuple
+    rows: tuple
+    row: object
+    read: object
+
+
+def _rows(paths):
+    """Every row of the run files ``paths``."""
+    return [r for p in paths for r in measured.read(p)[1]]
+
+
+_INTERVAL_RUNS = {
+    "held out": ("intervals-272*.jsonl",),
+    "mended": ("intervals-208*.jsonl",),  # with the P4 records run again, if any
+    "corpus": ("intervals-corpus*.jsonl",),
+}
+
+TABLES = {
+    "intervals": Table(
+        page="docs/validation.md",
+        header=(
+            "| records | category: P1 / slow P1 / short / subharmonic | kind: linear / coupling "
+            "strong / weak / Hunt-Crossley | noise: low / high | all | code |",
+            "|---|---|---|---|---|---|",
+        ),
+        rows=(
+            ("seeds 272-335, held out", _INTERVAL_RUNS["held out"]),
+            ("seeds 208-271", _INTERVAL_RUNS["mended"]),
+            ("corpus c01-c13", _INTERVAL_RUNS["corpus"]),
+        ),
+        row=survey_intervals.markdown_row,
+        read=survey_intervals.read_rows,
+    ),
+    "intervals-readme": Table(
+        page="README.md",
+        header=(
+            "| records | P1 / slow P1 / short / subharmonic | linear / coupling strong / weak / "
+            "Hertz | noise low / high | all |",
+            "|---|---|---|---|---|",
+        ),
+        rows=(
+            ("64 random, held out", _INTERVAL_RUNS["held out"]),
+            ("64 random", _INTERVAL_RUNS["mended"]),
+            ("corpus c01-c13", _INTERVAL_RUNS["corpus"]),
+        ),
+        row=survey_intervals.readme_row,
+        read=survey_intervals.read_rows,
+    ),
+    "advise": Table(
+        page="docs/validation.md",
+        header=(
+            "| force noise | cases run | counted | first record alone selects | + advised point: "
+            "selected | + random point: selected | advised: no rival left | random: no rival "
+            "left |",
+            "|---|---|---|---|---|---|---|---|",
+        ),
+        rows=(("1 %", ("advise-1*.jsonl",)), ("3 %", ("advise-3*.jsonl",))),
+        row=survey_advise.markdown_row,
+        read=_rows,
+    ),
+    "realistic-span": Table(
+        page="docs/validation.md",
+        header=(
+            "| setting | true law consistent | wrong law inconsistent (detectable) | not "
+            "detectable |",
+            "|---|---|---|---|",
+        ),
+        rows=(
+            ("default (as above)", ("realistic-default*.jsonl",)),
+            ("field-like (`--field`)", ("realistic-field*.jsonl",)),
+        ),
+        row=realistic_survey.markdown_row,
+        read=_rows,
+    ),
+}
+
+
+def run_files(patterns):
+    """The run files matching ``patterns``, in the order the runs started."""
+    found = {p for pattern in patterns for p in measured.MEASURED.glob(pattern)}
+    if not found:
+        raise SystemExit(f"no saved survey run matches {', '.join(patterns)} in docs/_measured")
+    return sorted(found, key=lambda p: (str(measured.read(p)[0].get("started", "")), p.name))
+
+
+def _stamp(files):
+    """The line under a table: each run file it was made from, its commit and date."""
+    runs = []
+    for path in files:
+        header, _ = measured.read(path)
+        name = path.name
+        commit = f"commit {header['commit']}" if header.get("commit") else "commit not recorded"
+        runs.append(f"`{name}` ({commit}, {str(header.get('started', '?'))[:10]})")
+    return (
+        "*Rendered by `make tables` from the survey runs in `docs/_measured/`: "
+        + ", ".join(runs)
+        + ".*"
+    )
+
+
+def render(name):
+    """The lines of table ``name`` between its markers (without indentation)."""
+    table = TABLES[name]
+    lines = list(table.header)
+    files = []
+    for label, patterns in table.rows:
+        paths = run_files(patterns)
+        lines.append(table.row(table.read(paths), label))
+        files += [p for p in paths if p not in files]
+    return [*lines, "", _stamp(files)]
+
+
+def _block(name):
+    return re.compile(
+        rf"^(?P<indent>[ \t]*)<!-- table:{re.escape(name)} -->\n.*?^[ \t]*<!-- /table:"
+        rf"{re.escape(name)} -->$",
+        re.M | re.S,
+    )
+
+
+def rendered_page(page):
+    """The text of ``page`` (relative to the repository root) with its tables rendered."""
+    text = (ROOT / page).read_text()
+    for name, table in TABLES.items():
+        if table.page != page:
+            continue
+        found = _block(name).search(text)
+        if found is None:
+            raise SystemExit(f"{page}: no <!-- table:{name} --> ... <!-- /table:{name} -->")
+        pad = found.group("indent")
+        body = [f"{pad}{line}" if line else "" for line in render(name)]
+        new = "\n".join([f"{pad}<!-- table:{name} -->", *body, f"{pad}<!-- /table:{name} -->"])
+        text = text[: found.start()] + new + text[found.end() :]
+    return text
+
+
+def markers(page):
+    """The table names marked in ``page``."""
+    return re.findall(r"<!-- table:([\w-]+) -->", (ROOT / page).read_text())
+
+
+def pages():
+    return sorted({t.page for t in TABLES.values()})
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--check", action="store_true", help="exit 1 when a table is stale")
+    args = ap.parse_args(argv)
+    stale = []
+    for page in pages():
+        unknown = set(markers(page)) - set(TABLES)
+        if unknown:
+            raise SystemExit(f"{page}: tables with no definition in tests/tables.py: {unknown}")
+        text = rendered_page(page)
+        if text != (ROOT / page).read_text():
+            stale.append(page)
+            if not args.check:
+                Path(ROOT / page).write_text(text)
+    if args.check and stale:
+        print(f"stale measured tables in {', '.join(stale)}: run make tables", file=sys.stderr)
+        return 1
+    print(("rewrote " + ", ".join(stale)) if stale else "the measured tables are up to date")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
