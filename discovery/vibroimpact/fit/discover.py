@@ -32,7 +32,7 @@ criterion; models without a periodic steady state come last.
 """
 
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from warnings import warn
 
 import numpy as np
@@ -53,9 +53,9 @@ from .discovery_warnings import _defects_warning, _warnings
 from .discovery_warnings import _impact_warnings as _impact_warnings
 from .discovery_warnings import _stability_warning as _stability_warning
 from .equivalence import _equivalent
-from .evidence import _regression, _required_terms, _stability
+from .evidence import _contact_samples, _Evidence, _regression, _required_terms, _stability
 from .intervals import INTERVAL_REFITS, bootstrap_intervals
-from .ranking import rank
+from .ranking import _RankingRule, rank
 from .records import pair_records
 from .shortlist import _Checker, _shortlist
 from .stepwise import _Stepwise
@@ -65,18 +65,20 @@ __all__ = ["RankedModel", "DiscoveryResult", "discover", "rank"]
 _REFINE_BUDGET = 120  # simulations per shortlisted support (every record counts)
 
 
-def _check_settings(
-    random_state, seed, criterion, shortlist, stability, n_boot, max_simulations, stepwise
-):
-    """The settings :func:`discover` checks beyond their types; returns the seed
-    (``random_state=`` is the deprecated name of ``seed=``)."""
+def _seed(random_state, seed):
+    """The seed of :func:`discover` (``random_state=`` is the deprecated name of ``seed=``)."""
     if random_state is not None:
         warn(
             "discover(random_state=...) is renamed seed=... (the CLI's --seed)",
             DeprecationWarning,
             stacklevel=4,
         )
-        seed = random_state
+        return random_state
+    return seed
+
+
+def _check_settings(criterion, shortlist, stability, n_boot, max_simulations, stepwise):
+    """The settings :func:`discover` checks beyond their types."""
     _criterion(criterion)
     if not (isinstance(shortlist, int | np.integer) and shortlist >= 1):
         raise InputError(
@@ -90,37 +92,77 @@ def _check_settings(
     ):
         if not (isinstance(v, int | np.integer) and not isinstance(v, bool) and v >= low):
             raise InputError(f"{name} must be an integer >= {low}; got {v!r}")
-    return seed
 
 
-def _with_intervals(ranking, refs, refine, boot, criterion, tolerances, progress):
-    """The selected (best ranked) model, with bootstrap intervals when asked for and it was
-    refined, and the ranking holding it; ``boot``: ``(replicates, seed, workers, refit)``."""
-    n_boot_intervals, seed, workers, refit = boot
-    selected = ranking[0]
-    if not (
-        n_boot_intervals
-        and refine
-        and selected.refinement is not None
-        and selected.note.startswith("refined")
-    ):
-        return selected, ranking
-    tick(progress, "fit: bootstrap intervals", 0, n_boot_intervals)
-    iv = bootstrap_intervals(
-        [sc for sc, _ in refs],
-        [r for _, r in refs],
-        selected.law,
-        n_boot=int(n_boot_intervals),
-        seed=seed,
-        criterion=criterion,
-        tolerances=tolerances,
-        workers=workers,
-        refit=refit,
-    )
-    if iv is None:
-        return selected, ranking
-    chosen = replace(selected, intervals=iv)
-    return chosen, [chosen if m is selected else m for m in ranking]
+@dataclass(frozen=True)
+class _Bootstrap:
+    """The selected model's bootstrap intervals as :func:`discover` asks for them: the
+    settings of :func:`~discovery.vibroimpact.fit.intervals.bootstrap_intervals`
+    (``replicates`` 0: none)."""
+
+    replicates: int
+    seed: int
+    workers: int | None
+    refit: str
+    criterion: str
+    tolerances: Tolerances | None
+
+    def selected(self, ranking, refs, refine, progress):
+        """The selected (best ranked) model, with bootstrap intervals when asked for and it
+        was refined, and the ranking holding it."""
+        selected = ranking[0]
+        if not (
+            self.replicates
+            and refine
+            and selected.refinement is not None
+            and selected.note.startswith("refined")
+        ):
+            return selected, ranking
+        tick(progress, "fit: bootstrap intervals", 0, self.replicates)
+        iv = bootstrap_intervals(
+            [sc for sc, _ in refs],
+            [r for _, r in refs],
+            selected.law,
+            n_boot=int(self.replicates),
+            seed=self.seed,
+            criterion=self.criterion,
+            tolerances=self.tolerances,
+            workers=self.workers,
+            refit=self.refit,
+        )
+        if iv is None:
+            return selected, ranking
+        chosen = replace(selected, intervals=iv)
+        return chosen, [chosen if m is selected else m for m in ranking]
+
+
+def _settings(evidence, check, search, boot, *, shortlist, stability, n_boot, average_cycles):
+    """The settings a discovery reports, read from the objects that ran it."""
+    est = evidence.est
+    return {
+        "library": str(est.library),
+        "selection": est.selection,
+        "scoring": est.scoring,
+        "max_terms": est.max_terms,
+        "criterion": check.criterion,
+        "shortlist": shortlist,
+        "refine": check.refine,
+        "max_simulations": check.budget,
+        "stability": stability,
+        "derivative": evidence.samples.derivative,
+        "average_cycles": average_cycles,
+        "seed": boot.seed,
+        "n_boot": n_boot,
+        "records": len(evidence.pairs),
+        "stepwise": search.stepwise,
+        "steps": search.steps,
+        "physics": search.rank.physics,
+        "n_boot_intervals": boot.replicates,
+        "interval_refit": boot.refit,
+        "require": sorted(check.required),
+        "ranking_rule": {"sim_rtol": search.rank.sim_rtol, "sim_atol": search.rank.sim_atol},
+        "estimator": est.get_params(),
+    }
 
 
 def _contact_models(scenario, measurement, n_boot, seed, progress):
@@ -267,57 +309,50 @@ def discover(
     if library == "contact-models":  # the named contact models, fitted by name
         return _contact_models(scenario, measurement, n_boot_intervals, seed, progress)
     t0 = time.perf_counter()
-    seed = _check_settings(
-        random_state, seed, criterion, shortlist, stability, n_boot, max_simulations, stepwise
-    )
+    seed = _seed(random_state, seed)
+    _check_settings(criterion, shortlist, stability, n_boot, max_simulations, stepwise)
     pairs = pair_records(scenario, measurement)
-    parts, samples, est = _regression(
-        pairs, library, selection, scoring, max_terms, derivative, average_cycles, estimator_kwargs
-    )
+    parts, samples = _contact_samples(pairs, derivative, average_cycles)
+    regressor = dict(library=library, selection=selection, scoring=scoring, max_terms=max_terms)
+    est = _regression(samples, {**regressor, **estimator_kwargs})
     refs = [(sc, Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)) for sc, m in pairs]
+    evidence = _Evidence(pairs, parts, samples, est, refs)
     required = _required_terms(require, est.library_)
     check = _Checker(
-        est, samples, refs, criterion, refine, tolerances, max_simulations, required, workers
+        est=est,
+        samples=samples,
+        refs=refs,
+        criterion=criterion,
+        refine=refine,
+        tol=tolerances,
+        budget=max_simulations,
+        required=required,
+        workers=workers,
     )
     models = _shortlist(check, est, required, shortlist, progress)
     by_score = list(models)  # the estimator's order (its scoring)
-    search = _Stepwise(check, criterion, sim_rtol, sim_atol, physics, stepwise, max_terms)
-    ranking, steps = search.run(models, refs, refine, progress)
-    boot = (n_boot_intervals, seed, workers, interval_refit)
-    selected, ranking = _with_intervals(
-        ranking, refs, refine, boot, criterion, tolerances, progress
-    )
+    rule = _RankingRule(criterion, sim_rtol, sim_atol, physics)
+    search = _Stepwise(check, rule, stepwise=stepwise, max_terms=max_terms)
+    ranking = search.run(models, refs, refine, progress)
+    boot = _Bootstrap(n_boot_intervals, seed, workers, interval_refit, criterion, tolerances)
+    selected, ranking = boot.selected(ranking, refs, refine, progress)
     # the certificate of the law actually selected (the ranking may prefer another
     # candidate than the estimator's best by BIC); a failure is an error
     cert = require_certificate(selected.certificate)
     stab = _stability(est, samples, stability, seed)
-    warnings = _warnings(selected, by_score, stab, pairs, parts, refs, samples, refine)
+    warnings = _warnings(selected, by_score, stab, evidence, refine)
     if selected.defects:
         warnings.insert(0, _defects_warning(selected, physics))
-    settings = {
-        "library": str(library),
-        "selection": selection,
-        "scoring": scoring,
-        "max_terms": max_terms,
-        "criterion": criterion,
-        "shortlist": shortlist,
-        "refine": refine,
-        "max_simulations": max_simulations,
-        "stability": stability,
-        "derivative": samples.derivative,
-        "average_cycles": average_cycles,
-        "seed": seed,
-        "n_boot": n_boot,
-        "records": len(pairs),
-        "stepwise": stepwise,
-        "steps": steps,
-        "physics": physics,
-        "n_boot_intervals": n_boot_intervals,
-        "interval_refit": interval_refit,
-        "require": sorted(required),
-        "ranking_rule": {"sim_rtol": sim_rtol, "sim_atol": sim_atol},
-        "estimator": est.get_params(),
-    }
+    settings = _settings(
+        evidence,
+        check,
+        search,
+        boot,
+        shortlist=shortlist,
+        stability=stability,
+        n_boot=n_boot,
+        average_cycles=average_cycles,
+    )
     return DiscoveryResult(
         selected=selected,
         ranking=ranking,

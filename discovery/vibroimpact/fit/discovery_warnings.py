@@ -46,12 +46,16 @@ def _impact_warnings(pairs, parts, refs):
     return out
 
 
-def _warnings(selected, by_bic, stab, pairs, parts, refs, samples, refine):
+def _warnings(selected, by_score, stab, evidence, refine):
+    """The warnings of a discovery that selected ``selected`` (``by_score``: the shortlist
+    in the regression's order, ``stab``: stability selection's term frequencies,
+    ``evidence``: the records as fitted)."""
+    samples = evidence.samples
     out = []
     w = _stability_warning(stab, selected)
     if w:
         out.append(w)
-    failing = [m for m in by_bic[:3] if not m.criteria]
+    failing = [m for m in by_score[:3] if not m.criteria]
     if failing:
         out.append(
             f"{len(failing)} of the 3 best candidates by the regression score have no "
@@ -59,7 +63,7 @@ def _warnings(selected, by_bic, stab, pairs, parts, refs, samples, refine):
             + "; ".join(f"{' + '.join(m.law.names)}: {m.evaluation.status}" for m in failing)
             + "): the regression alone would mislead here"
         )
-    out.extend(_impact_warnings(pairs, parts, refs))
+    out.extend(_impact_warnings(evidence.pairs, evidence.parts, evidence.refs))
     if (
         not selected.consistent
         and selected.criteria

@@ -2,10 +2,12 @@
 reference, the certified sparse regression on the samples, the required terms, stability
 selection."""
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ...errors import InputError, VidiError
-from ..data.samples import contact_samples, join_samples
+from ..data.samples import ContactSamples, contact_samples, join_samples
 from ..model.law import Term
 from ..model.library import Library
 from .regression import ConstrainedSparseRegressor
@@ -49,27 +51,48 @@ def _required_terms(require, library):
     return frozenset(out)
 
 
-def _regression(
-    pairs, library, selection, scoring, max_terms, derivative, average_cycles, estimator_kwargs
-):
-    """Contact samples of every record, joined, and the certified sparse regression on
-    them: ``(samples per record, joined samples, fitted estimator)``."""
+@dataclass(frozen=True, eq=False)
+class _Evidence:
+    """The records of one discovery as it fits and checks them.
+
+    Attributes
+    ----------
+    pairs : list of (Scenario, Measurement)
+        Every record with its scenario.
+    parts : list of ContactSamples
+        Every record's contact samples.
+    samples : ContactSamples
+        Their join (what the regression is fitted to).
+    est : ConstrainedSparseRegressor
+        The certified sparse regression fitted to ``samples``.
+    refs : list of (Scenario, Reference)
+        Every record's reference (what each law is simulated against).
+    """
+
+    pairs: list
+    parts: list
+    samples: ContactSamples
+    est: ConstrainedSparseRegressor
+    refs: list
+
+
+def _contact_samples(pairs, derivative, average_cycles):
+    """Contact samples of every record and their join: ``(parts, samples)``."""
     parts = [
         contact_samples(m, derivative=derivative, average_cycles=average_cycles, period=sc.period)
         for sc, m in pairs
     ]
-    samples = join_samples(parts)
-    if isinstance(estimator_kwargs.get("signs"), dict):
-        estimator_kwargs["signs"] = _sign_vector(estimator_kwargs["signs"], library)
-    est = ConstrainedSparseRegressor(
-        library=library,
-        selection=selection,
-        scoring=scoring,
-        max_terms=max_terms,
-        **estimator_kwargs,
-    )
+    return parts, join_samples(parts)
+
+
+def _regression(samples, settings):
+    """The certified sparse regression ``ConstrainedSparseRegressor(**settings)`` fitted to
+    ``samples`` (``settings["signs"]`` may be ``{term: sign}``)."""
+    if isinstance(settings.get("signs"), dict):
+        settings = {**settings, "signs": _sign_vector(settings["signs"], settings["library"])}
+    est = ConstrainedSparseRegressor(**settings)
     est.fit(samples.X, samples.F, groups=samples.impact, sample_weight=samples.weight)
-    return parts, samples, est
+    return est
 
 
 def _stability(est, samples, resamples, seed):

@@ -1,5 +1,7 @@
 """The ranking rule of discovery: which checked model comes first."""
 
+from dataclasses import dataclass
+
 import numpy as np
 
 __all__ = ["rank"]
@@ -59,3 +61,16 @@ def _best_per_support(models, criterion):
             best[key] = (score, m)
     keep = {id(m) for _, m in best.values()}
     return [m for m in models if id(m) in keep]
+
+
+@dataclass(frozen=True)
+class _RankingRule:
+    """The settings of :func:`rank`, applied by calling the rule on models."""
+
+    criterion: str = "I2"
+    sim_rtol: float = 0.1
+    sim_atol: float = 0.005
+    physics: bool = True
+
+    def __call__(self, models):
+        return rank(models, self.criterion, self.sim_rtol, self.sim_atol, physics=self.physics)

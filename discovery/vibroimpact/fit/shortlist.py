@@ -1,17 +1,20 @@
 """Candidate laws refined by simulation and checked against every record: the shortlist of
 the regression's best supports and the trials of each stepwise move."""
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..._progress import tick
 from ...errors import InputError, IntegrationError
 from ...numerics.executor import map_on
+from ..data.samples import ContactSamples
+from ..dynamics import Tolerances
 from ..verify import evaluate
 from .discovery_result import RankedModel
 from .identify import identify
 from .records import record_start
+from .regression import ConstrainedSparseRegressor
 
 _FORWARD_STARTS = (0.01, 0.001)  # a new term's start force at the box corner / peak force
 
@@ -34,27 +37,25 @@ def _trial(check, job):
     return trial
 
 
+@dataclass(eq=False)
 class _Checker:
     """Refines (optionally) and evaluates regression candidates against all records; the
     trials of one step (the shortlist, a forward or backward move) run on ``workers``
-    processes (their results do not depend on it: each refinement is deterministic)."""
+    processes (their results do not depend on it: each refinement is deterministic).
 
-    def __init__(
-        self,
-        est,
-        samples,
-        refs,
-        criterion,
-        refine,
-        tolerances,
-        budget,
-        required=frozenset(),
-        workers=1,
-    ):
-        self.est, self.samples, self.refs = est, samples, refs
-        self.required = frozenset(required)
-        self.criterion, self.refine, self.tol, self.budget = criterion, refine, tolerances, budget
-        self.workers = workers
+    ``est`` is the fitted regression, ``samples`` the records' joined contact samples,
+    ``refs`` every record's ``(Scenario, Reference)``, ``budget`` the simulations of one
+    refinement, ``required`` the terms no backward step drops."""
+
+    est: ConstrainedSparseRegressor
+    samples: ContactSamples
+    refs: list
+    criterion: str
+    refine: bool
+    tol: Tolerances | None
+    budget: int
+    required: frozenset = frozenset()
+    workers: int | None = 1
 
     def evaluate(self, law):
         return tuple(evaluate(sc, law, ref, tolerances=self.tol) for sc, ref in self.refs)

@@ -1,24 +1,28 @@
 """The output-error stepwise search around the best model."""
 
+from dataclasses import dataclass, field
+
 from ..._progress import tick
-from .ranking import _best_per_support, rank
+from .ranking import _best_per_support, _RankingRule
+from .shortlist import _Checker
 
 _RESTARTS = 2  # stalled smaller supports restarted from a consistent model, per step
 
 
+@dataclass(eq=False)
 class _Stepwise:
     """The output-error stepwise search around the best model: a consistent model loses a
     term (backward), an inconsistent one gains one (forward: the regression may have been
-    misled, e.g. by noisy penetration), for up to ``stepwise`` moves."""
+    misled, e.g. by noisy penetration), for up to ``stepwise`` moves.  ``retried``: the
+    supports already restarted from a consistent model (each once); ``steps``: the moves
+    made, each ``{"kind", "from", "trials"}``."""
 
-    def __init__(self, check, criterion, sim_rtol, sim_atol, physics, stepwise, max_terms):
-        self.check, self.criterion, self.physics = check, criterion, physics
-        self.sim_rtol, self.sim_atol = sim_rtol, sim_atol
-        self.stepwise, self.max_terms = stepwise, max_terms
-        self.retried = set()
-
-    def rank(self, models):
-        return rank(models, self.criterion, self.sim_rtol, self.sim_atol, physics=self.physics)
+    check: _Checker
+    rank: _RankingRule
+    stepwise: int
+    max_terms: int
+    retried: set = field(default_factory=set)
+    steps: list = field(default_factory=list)
 
     def more(self, steps, ranking):
         """Up to ``stepwise`` moves, and one simplifying move more when the last move made
@@ -35,7 +39,7 @@ class _Stepwise:
 
     def trials(self, top, models):
         """The models of one move from ``top``, and the move's kind."""
-        check, physics = self.check, self.physics
+        check, physics = self.check, self.rank.physics
         # supports already simulated successfully are not tried again, except that a
         # consistent model's backward step retries a smaller support that was inconsistent
         # from its own (biased regression) start, once, from the consistent coefficients:
@@ -60,7 +64,7 @@ class _Stepwise:
                 and frozenset(m.law.names) not in self.retried
                 and not (physics and m.defects)
             ),
-            key=lambda m: m.criteria[self.criterion],
+            key=lambda m: m.criteria[self.rank.criterion],
         )[:_RESTARTS]
         for m in stalled:
             self.retried.add(frozenset(m.law.names))
@@ -68,9 +72,9 @@ class _Stepwise:
         return trials, "backward"
 
     def run(self, models, refs, refine, progress):
-        """``(ranking, steps)`` after the search."""
+        """The ranking after the search (its moves in ``steps``)."""
         ranking = self.rank(models)
-        steps = []
+        steps = self.steps
         if refine and not ranking[0].criteria:
             # no regression law has a periodic orbit with contact: start from the record alone
             start = self.check.physical_start(*refs[0])
@@ -87,8 +91,8 @@ class _Stepwise:
             tick(
                 progress, "fit: stepwise search around the best support", len(steps), self.stepwise
             )
-            models = _best_per_support(models + trials, self.criterion)
+            models = _best_per_support(models + trials, self.rank.criterion)
             ranking = self.rank(models)
             if ranking[0] is top:
                 break
-        return ranking, steps
+        return ranking
