@@ -13,8 +13,17 @@ from ..model.law import ForceLaw
 from ..verify.criteria import criteria_lines
 from ..verify.evaluate import Evaluation
 from .intervals import Intervals
+from .records import records_verdict
 
 __all__ = ["RankedModel", "DiscoveryResult"]
+
+
+def _mean_over(dicts):
+    """The key-wise mean of ``dicts`` over the first one's keys (empty unless every one has
+    entries)."""
+    if not all(dicts):
+        return {}
+    return {k: float(np.mean([d[k] for d in dicts])) for k in dicts[0]}
 
 
 def _loaded_evaluations(d):
@@ -96,22 +105,12 @@ class RankedModel(Result):
     @property
     def criteria(self):
         """Criteria I0..I4, the mean over records (empty unless every record is ``ok``)."""
-        if not all(ev.criteria for ev in self.evaluations):
-            return {}
-        return {
-            k: float(np.mean([ev.criteria[k] for ev in self.evaluations]))
-            for k in self.evaluations[0].criteria
-        }
+        return _mean_over([ev.criteria for ev in self.evaluations])
 
     @property
     def noise_floor(self):
         """Noise floor of every criterion, the mean over records."""
-        if not all(ev.noise_floor for ev in self.evaluations):
-            return {}
-        return {
-            k: float(np.mean([ev.noise_floor[k] for ev in self.evaluations]))
-            for k in self.evaluations[0].noise_floor
-        }
+        return _mean_over([ev.noise_floor for ev in self.evaluations])
 
     @property
     def limits(self):
@@ -128,16 +127,7 @@ class RankedModel(Result):
     def verdict(self):
         if len(self.evaluations) == 1:
             return self.evaluation.verdict
-        bad = [(i, ev) for i, ev in enumerate(self.evaluations) if not ev.consistent]
-        if not bad:
-            return f"consistent with all {len(self.evaluations)} records"
-        if len(bad) == 1:
-            i, ev = bad[0]
-            return f"inconsistent with record {i + 1}: {ev.verdict}"
-        # every record's verdict in full: none is cut to "(and 1 more)"
-        return f"inconsistent with {len(bad)} of {len(self.evaluations)} records: " + "; ".join(
-            f"record {i + 1}: {ev.verdict}" for i, ev in bad
-        )
+        return records_verdict(self.evaluations, lambda ev: ev.verdict)
 
     @property
     def defects(self):
