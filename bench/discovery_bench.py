@@ -17,7 +17,8 @@ import numpy as np
 from constraints import certify
 from discovery import ForceLaw, load_scenario, synthesize
 from discovery.vibroimpact.data.samples import contact_samples
-from discovery.vibroimpact.fit.regression import ConstrainedSparseRegressor, _Problem
+from discovery.vibroimpact.fit.constrained_lsq import _Problem
+from discovery.vibroimpact.fit.regression import ConstrainedSparseRegressor
 
 TRUE = "2.06e8*z + 1.28e7*zd + 2e10*z*zd"
 LIBRARY = "poly:3+z^1.5"

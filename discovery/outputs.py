@@ -3,7 +3,7 @@
 directory is still alive (its PID and start time)."""
 
 from ._io import MANIFEST, atomic_write_text
-from ._io import _alive as process_alive
-from ._io import _proc_start as process_start
+from ._staging import _alive as process_alive
+from ._staging import _proc_start as process_start
 
 __all__ = ["MANIFEST", "atomic_write_text", "process_alive", "process_start"]

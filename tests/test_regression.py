@@ -12,7 +12,7 @@ from sklearn.exceptions import NotFittedError
 from sklearn.utils import estimator_checks
 from sklearn.utils.validation import check_is_fitted
 
-import discovery.vibroimpact.fit.regression as regression
+import discovery.vibroimpact.fit.constrained_lsq as constrained_lsq
 from constraints import certify, constraint_rows
 from constraints.errors import SolverError
 from discovery.errors import InputError
@@ -400,7 +400,7 @@ def test_no_feasible_support_is_a_one_line_input_error(kwargs, needle):
 
 
 def _failing(monkeypatch, failing):
-    real = regression.solve
+    real = constrained_lsq.solve  # the certified fit of a support solves here
 
     def solve(problem, solver=None, **options):
         if solver in failing:
@@ -411,7 +411,7 @@ def _failing(monkeypatch, failing):
             )
         return real(problem, solver, **options)
 
-    monkeypatch.setattr(regression, "solve", solve)
+    monkeypatch.setattr(constrained_lsq, "solve", solve)
 
 
 def test_solver_fallback_is_recorded(monkeypatch):

@@ -79,7 +79,15 @@ from .problem import _aligned_sensitivity as _aligned_sensitivity
 from .problem import _Budget as _Budget
 from .problem import _Objective, _uncertainty
 from .records import _measured_cycles as _measured_cycles
-from .records import _named, as_records, contact_scales, cycle_pairs, model_parts, pair_records
+from .records import (
+    _named,
+    as_records,
+    contact_scales,
+    cycle_pairs,
+    model_parts,
+    pair_records,
+    records_verdict,
+)
 from .records import _residual_weights as _residual_weights
 from .records import record_start as record_start
 
@@ -180,16 +188,7 @@ class IdentificationResult(Result):
             return "not checked against the records' noise floors (check=False)"
         if len(self.checks) == 1:
             return self.checks[0].verdict or self.checks[0].message
-        bad = [(i, ev) for i, ev in enumerate(self.checks) if not ev.consistent]
-        if not bad:
-            return f"consistent with all {len(self.checks)} records"
-        if len(bad) == 1:
-            i, ev = bad[0]
-            return f"inconsistent with record {i + 1}: {ev.verdict or ev.message}"
-        # every record's verdict in full: none is cut to "(and 1 more)"
-        return f"inconsistent with {len(bad)} of {len(self.checks)} records: " + "; ".join(
-            f"record {i + 1}: {ev.verdict or ev.message}" for i, ev in bad
-        )
+        return records_verdict(self.checks, lambda ev: ev.verdict or ev.message)
 
     def as_dict(self):
         """The result as JSON-ready data (the identification part of ``summary.json``)."""

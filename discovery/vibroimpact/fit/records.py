@@ -1,6 +1,6 @@
 """The records a fit compares with: pairing scenarios and records, a record's contact scales
-and start coefficients, what a model fits (:func:`model_parts`), and the measured cycles with
-their residual weights.
+and start coefficients, what a model fits (:func:`model_parts`), the measured cycles with
+their residual weights, and the verdict of a law against several records.
 """
 
 import numpy as np
@@ -121,3 +121,18 @@ def _residual_weights(ref):
         s * np.sqrt(np.gradient(E.t) / max(np.trapezoid(E.F**2, E.t), 1e-300))
         for E, s in zip(cycles, share, strict=True)
     ]
+
+
+def records_verdict(evaluations, text):
+    """One sentence on a law against several records (each an Evaluation, ``text(ev)`` its
+    verdict): consistent with all, or the records it is inconsistent with, every one's
+    verdict in full (none is cut to "(and 1 more)")."""
+    bad = [(i, ev) for i, ev in enumerate(evaluations) if not ev.consistent]
+    if not bad:
+        return f"consistent with all {len(evaluations)} records"
+    if len(bad) == 1:
+        i, ev = bad[0]
+        return f"inconsistent with record {i + 1}: {text(ev)}"
+    return f"inconsistent with {len(bad)} of {len(evaluations)} records: " + "; ".join(
+        f"record {i + 1}: {text(ev)}" for i, ev in bad
+    )

@@ -28,51 +28,32 @@ scored by BIC and AIC; K-fold cross-validation over whole impacts is computed wh
 ``scoring="cv"`` or ``cv_report=True`` (``cv_error`` is ``nan`` otherwise).
 """
 
-import itertools
-import math
 import time
 from dataclasses import dataclass, field
 
-import cvxpy as cp
 import numpy as np
 from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.exceptions import NotFittedError as SkNotFittedError
 from sklearn.utils.validation import check_is_fitted
 
-from constraints import (
-    Box,
-    certify,
-    constraint_rows,
-    normalized_rows,
-    require,
-    scale_factors,
-    solve,
-)
-from constraints.errors import SolverError
+from constraints import Box, certify, require
 
 from ..._printing import coefficient_lines, fmt, readable
 from ..._validate import Array, check
 from ...errors import InputError, VidiError
 from ..model.library import Library
+from .constrained_lsq import _InfeasibleSupport, _Problem, _weights_and_groups
+from .proposals import _best_subsets, _l1_path, _pysindy_supports
 
 __all__ = ["ConstrainedSparseRegressor", "Candidate", "SELECTIONS", "SCORES"]
 
 SELECTIONS = ("best-subset", "l1-path", "stlsq", "sr3", "constrained-sr3")
 SCORES = ("bic", "aic", "cv")
-_RSS_FLOOR = 1e-14  # relative to mean square force: data are never more exact than this
-_INFEASIBLE = ("infeasible", "infeasible_inaccurate")
 
 
 class NotFittedError(VidiError, SkNotFittedError):
     """The estimator is used before :meth:`ConstrainedSparseRegressor.fit` (a ``VidiError``
     and scikit-learn's ``NotFittedError``)."""
-
-
-class _InfeasibleSupport(SolverError):
-    """No coefficients on this support satisfy the constraints (not a solver failure)."""
-
-    def __init__(self, message):
-        super().__init__(message, status="infeasible")
 
 
 @readable
@@ -131,136 +112,6 @@ class Candidate:
             + (", a constraint active" if self.constrained else ""),
             *coefficient_lines(self.coefficients),
         ]
-
-
-class _Problem:
-    """Scaled least squares with the certified constraints for one library and box."""
-
-    def __init__(self, library, box, X, y, w, *, margin, monotone, signs, elevation, solver):
-        self.library, self.box = library, box
-        exps = library.exponents
-        self.scale = scale_factors(exps, box)  # Z^a V^b: each term's value at the far corner
-        theta = library.transform(X)
-        self.fscale = float(np.sqrt(np.average(y**2, weights=w))) or 1.0
-        sw = np.sqrt(w)
-        self.A = theta / self.scale * sw[:, None]  # features scaled to [0, 1], weighted
-        self.b = y / self.fscale * sw
-        self.n = float(np.sum(w))
-        self.G = self.A.T @ self.A
-        self.h = self.A.T @ self.b
-        self.yy = float(self.b @ self.b)
-        if signs is not None:
-            signs = np.broadcast_to(np.asarray(signs, dtype=float), (len(library),))
-        # the rows of the cvxpy builders (constraints.builders), as one system M x + off >= 0
-        # in units of fscale newtons (offsets come from the dissipativity margin)
-        self.M, self.off = constraint_rows(
-            exps,
-            box,
-            margin=margin,
-            monotone=monotone,
-            signs=signs,
-            elevation=elevation,
-            force_unit=self.fscale,
-        )
-        self.solver = solver
-        self.n_solves = 0
-        self.fallbacks = []  # (support, failed solver, its status, solver that succeeded)
-        self.infeasible = {}  # support -> reason
-        self._solved = {}  # support -> (x, rss, solver)
-
-    def feasible(self, idx, x, tol=1e-10):
-        return bool(np.all(self.M[:, idx] @ x + self.off >= -tol))
-
-    def unconstrained(self, idx):
-        G = self.G[np.ix_(idx, idx)]
-        try:
-            x = np.linalg.solve(G, self.h[idx])
-        except np.linalg.LinAlgError:
-            x = np.linalg.lstsq(G, self.h[idx], rcond=None)[0]
-        rss = max(self.yy - 2 * self.h[idx] @ x + x @ G @ x, 0.0)
-        return x, rss
-
-    def precise(self, idx):
-        """Least squares on the (weighted, scaled) data by QR: full precision."""
-        x = np.linalg.lstsq(self.A[:, idx], self.b, rcond=None)[0]
-        r = self.A[:, idx] @ x - self.b
-        return x, float(r @ r)
-
-    def constrained(self, idx):
-        """Certified least squares on a support: ``(x, rss, solver)``.
-
-        The data enter through a QR of the support's columns, so the cvxpy problem has
-        k x k data whatever n is.  Raises :class:`_InfeasibleSupport` when no coefficients
-        on the support satisfy the constraints, :class:`SolverError` when both solvers fail.
-        """
-        key = tuple(idx)
-        if key in self._solved:
-            return self._solved[key]
-        if key in self.infeasible:
-            raise _InfeasibleSupport(self.infeasible[key])
-        # rows that vanish on this support are dropped; one with a negative offset (a margin
-        # and no term it acts on) cannot hold for any coefficients
-        M, off, impossible = normalized_rows(self.M[:, idx], self.off)
-        if impossible.size:
-            self._infeasible(
-                key,
-                "a constraint has no term on this support to act on (a "
-                "dissipativity margin needs a term zd^b, 0 < b <= 1, without zeta)",
-            )
-        Q, R = np.linalg.qr(self.A[:, idx])
-        qb = Q.T @ self.b
-        x = cp.Variable(len(idx))
-        cons = [M @ x + off >= 0] if M.shape[0] else []
-        prob = cp.Problem(cp.Minimize(cp.sum_squares(R @ x - qb)), cons)
-        used = self.solver
-        try:
-            solve(prob, self.solver)
-        except SolverError as first:
-            # one more interior/first-order solver before giving up (then it raises)
-            used = "OSQP" if self.solver != "OSQP" else "CLARABEL"
-            opts = (
-                {"eps_abs": 1e-10, "eps_rel": 1e-10, "max_iter": 200000} if used == "OSQP" else {}
-            )
-            try:
-                solve(prob, used, **opts)
-            except SolverError as second:
-                if first.status in _INFEASIBLE and second.status in _INFEASIBLE:
-                    self._infeasible(
-                        key,
-                        f"{self.solver} and {used} report the constraints "
-                        "infeasible on this support",
-                    )
-                raise SolverError(
-                    f"{first}; fallback: {second}", status=second.status, solver=used
-                ) from second
-            self.fallbacks.append((key, self.solver, first.status, used))
-        self.n_solves += 1
-        xv = np.asarray(x.value, dtype=float)
-        r = self.A[:, idx] @ xv - self.b
-        self._solved[key] = (xv, float(r @ r), used)
-        return self._solved[key]
-
-    def _infeasible(self, key, reason):
-        self.infeasible[key] = reason
-        raise _InfeasibleSupport(reason)
-
-    def fit_support(self, idx):
-        """(x, rss, constrained?, solver) of the best certified fit on a support."""
-        x, rss = self.precise(idx)
-        if self.feasible(idx, x):
-            return x, rss, False, "lstsq"
-        x, rss, used = self.constrained(idx)
-        return x, rss, True, used
-
-    def physical(self, idx, x):
-        c = np.zeros(len(self.library))
-        c[idx] = x * self.fscale / self.scale[idx]
-        return c
-
-    def scores(self, rss, k):
-        mse = max(rss / self.n, _RSS_FLOOR * self.yy / self.n)
-        ll = self.n * math.log(mse)
-        return ll + k * math.log(self.n), ll + 2 * k
 
 
 class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
@@ -405,7 +256,7 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         self.box_ = Box(zp.max() * (1 + self.box_margin), vp.max() * (1 + self.box_margin))
         self.n_features_in_ = 2
         prob = self._problem(X, y, w)
-        supports = self._propose(prob, X, y, w)
+        supports = self._propose(prob)
         cands = []
         for idx in supports:
             try:
@@ -566,104 +417,19 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
         )
 
     # ------------------------------------------------------- support proposal
-    def _propose(self, prob, X, y, w):
+    def _propose(self, prob):
+        """The supports the selection method proposes (:mod:`.proposals`)."""
         if self.selection == "best-subset":
-            return self._best_subsets(prob)
+            out = _best_subsets(prob, len(self.library_), self.max_terms)
+            if not out:
+                self.infeasible_ = [
+                    {"support": self._names(k), "reason": r} for k, r in prob.infeasible.items()
+                ]
+                self._no_feasible_support()
+            return out
         if self.selection == "l1-path":
-            return self._l1_path(prob)
-        return self._pysindy_supports(prob, X, y, w)
-
-    def _best_subsets(self, prob):
-        """Exact best certified subset of each size (branch and bound on the RSS)."""
-        n = len(self.library_)
-        if n > 16:
-            raise InputError(
-                f"best-subset handles libraries up to 16 terms (got {n}); use l1-path or stlsq"
-            )
-        out = []
-        for k in range(1, min(self.max_terms, n) + 1):
-            subsets = [list(s) for s in itertools.combinations(range(n), k)]
-            unc = []
-            for idx in subsets:
-                x, rss = prob.unconstrained(idx)
-                unc.append((rss, idx, x))
-            unc.sort(key=lambda r: r[0])
-            best_rss, best_idx = math.inf, None
-            for rss, idx, x in unc:
-                if rss >= best_rss * (1 + 1e-9) + 1e-300:
-                    break  # no later subset can beat the best constrained fit
-                if prob.feasible(idx, x):
-                    if rss < best_rss:
-                        best_rss, best_idx = rss, idx
-                    break  # feasible and smallest remaining unconstrained RSS
-                try:
-                    _, crss, _ = prob.constrained(idx)  # a solver failure raises
-                except _InfeasibleSupport:
-                    continue  # no coefficients on this subset are physical: recorded, skipped
-                if crss < best_rss:
-                    best_rss, best_idx = crss, idx
-            if best_idx is not None:
-                out.append(tuple(best_idx))
-        if not out:
-            self.infeasible_ = [
-                {"support": self._names(k), "reason": r} for k, r in prob.infeasible.items()
-            ]
-            self._no_feasible_support()
-        return out
-
-    def _l1_path(self, prob):
-        n = len(self.library_)
-        x = cp.Variable(n)
-        lam = cp.Parameter(nonneg=True)
-        Q, R = np.linalg.qr(prob.A)  # k x k data in the cvxpy problem, whatever n is
-        obj = cp.sum_squares(R @ x - Q.T @ prob.b) + lam * cp.norm1(x)
-        problem = cp.Problem(cp.Minimize(obj), [prob.M @ x + prob.off >= 0])
-        lam_max = 2 * float(np.max(np.abs(prob.h)))
-        supports = []
-        for value in np.geomspace(lam_max, lam_max * 1e-6, self.n_lambdas):
-            lam.value = value
-            solve(problem, self.solver)
-            prob.n_solves += 1
-            xv = np.asarray(x.value)
-            idx = tuple(np.flatnonzero(np.abs(xv) > 1e-6 * max(np.max(np.abs(xv)), 1e-300)))
-            if idx and idx not in supports and len(idx) <= self.max_terms:
-                supports.append(idx)
-        if not supports:
-            raise InputError("the l1 path selected no term; lower box_margin or check the data")
-        return supports
-
-    def _pysindy_supports(self, prob, X, y, w):
-        """Supports proposed by a pysindy optimizer over a threshold path.
-
-        pysindy's ConstrainedSR3 returns no exact zeros, so a term counts as proposed
-        when ``|x_i| > 1e-3 max |x|`` (scaled units) for every pysindy method.
-        """
-        import warnings
-
-        import pysindy as ps
-
-        supports = []
-        for thr in self.threshold * np.geomspace(0.1, 10.0, 9):
-            if self.selection == "stlsq":
-                opt = ps.STLSQ(threshold=thr, alpha=1e-8)
-            elif self.selection == "sr3":
-                opt = ps.SR3(reg_weight_lam=thr**2 / 2, regularizer="L0")
-            else:
-                opt = _pysindy_constrained(prob, thr)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                opt.fit(prob.A, prob.b)
-            coef = np.asarray(opt.coef_).ravel()
-            big = np.max(np.abs(coef)) if coef.size else 0.0
-            idx = tuple(np.flatnonzero(np.abs(coef) > 1e-3 * big)) if big > 0 else ()
-            if idx and idx not in supports:
-                supports.append(idx)
-        if not supports:
-            raise InputError(
-                f"pysindy's {self.selection} selected no term at any threshold "
-                f"around {self.threshold}; change threshold"
-            )
-        return supports
+            return _l1_path(prob, self.max_terms, self.n_lambdas, self.solver)
+        return _pysindy_supports(prob, self.selection, self.threshold)
 
     def _cross_validate(self, X, y, w, groups, supports):
         ug = np.unique(groups)
@@ -754,32 +520,3 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
             est.fit(X[rows], y[rows], groups=new_groups, sample_weight=w[rows])
             counts += est.support_
         return {t.name: float(c / n_resamples) for t, c in zip(lib.terms, counts, strict=True)}
-
-
-def _weights_and_groups(n, sample_weight, groups):
-    """Validated ``(weights, groups)`` for ``n`` samples (defaults: ones, one group each)."""
-    w = np.ones(n) if sample_weight is None else np.asarray(sample_weight, dtype=float)
-    if w.shape != (n,) or not np.all(np.isfinite(w)) or np.any(w < 0) or not w.sum() > 0:
-        raise InputError(
-            f"sample_weight must be {n} finite values >= 0, not all zero; got shape {w.shape}"
-        )
-    groups = np.arange(n) if groups is None else np.asarray(groups)
-    if groups.shape != (n,):
-        raise InputError(
-            f"groups must give the impact of each of the {n} samples; got shape {groups.shape}"
-        )
-    return w, groups
-
-
-def _pysindy_constrained(prob, thr):
-    """pysindy ConstrainedSR3 with the Bernstein rows as (sample-free) inequalities."""
-    import pysindy as ps
-
-    return ps.ConstrainedSR3(
-        reg_weight_lam=thr,
-        regularizer="L1",
-        constraint_lhs=-prob.M,
-        constraint_rhs=prob.off,
-        constraint_order="feature",
-        inequality_constraints=True,
-    )

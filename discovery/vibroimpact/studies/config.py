@@ -369,8 +369,6 @@ def _check_fit(fit, source):
         if not (isinstance(req, list) and all(isinstance(r, str) and r for r in req)):
             raise InputError(f'require must be a list of term names such as ["z"]; got {req!r}')
         _check_settings(
-            None,
-            0,
             fit.get("criterion", "I2"),
             fit.get("shortlist", 1),
             0,

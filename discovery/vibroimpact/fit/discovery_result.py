@@ -1,0 +1,345 @@
+"""The results of :func:`~discovery.vibroimpact.fit.discover.discover`: each checked model
+(:class:`RankedModel`) and the discovery (:class:`DiscoveryResult`), with their loaders."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from constraints import Certificate
+
+from ..._printing import coefficient_lines, fmt, readable
+from ..._result import Result, part
+from ..model.law import ForceLaw
+from ..verify.criteria import criteria_lines
+from ..verify.evaluate import Evaluation
+from .intervals import Intervals
+from .records import records_verdict
+
+__all__ = ["RankedModel", "DiscoveryResult"]
+
+
+def _mean_over(dicts):
+    """The key-wise mean of ``dicts`` over the first one's keys (empty unless every one has
+    entries)."""
+    if not all(dicts):
+        return {}
+    return {k: float(np.mean([d[k] for d in dicts])) for k in dicts[0]}
+
+
+def _loaded_evaluations(d):
+    """A loaded ranked model's evaluations: every record's, or the one record's (its
+    regime the simulated one's)."""
+    if d.get("records"):
+        return tuple(part(Evaluation, e) for e in d["records"])
+    regime = {"measured": None, "simulated": d.get("regime")}
+    return (part(Evaluation, {**d, "regime": regime, "impacts": {}}),)
+
+
+def _loaded_intervals(d):
+    if not d.get("intervals"):
+        return None
+    return Intervals(
+        bounds={k: tuple(v) for k, v in d["intervals"].items()},
+        sd={},
+        level=d.get("interval_level"),
+        n_boot=None,
+        seed=None,
+        method=d.get("interval_method"),
+    )
+
+
+@readable
+@dataclass(frozen=True, eq=False)
+class RankedModel(Result):
+    """A candidate law with its simulation check against every record.
+
+    Attributes
+    ----------
+    law : ForceLaw
+        The law (refined by simulation when refinement ran and kept the certificate).
+    candidate : Candidate
+        Regression statistics of ``law`` on the contact samples (rss, bic, aic; for a
+        refined law recomputed for the refined coefficients; the regression's own
+        coefficients are in ``candidate.extra["regression_coefficients"]``).
+    evaluations : tuple of Evaluation
+        The law simulated and scored against each record
+        (:func:`discovery.vibroimpact.verify.evaluate`): regime, criteria, noise floor, consistency.
+    refinement : IdentificationResult or None
+        The output-error refinement (standard errors, simulations used).
+    note : str
+        What happened to the refinement (kept, or why not).
+    certificate : constraints.Certificate or None
+        Of ``law`` on the box of the samples it was fitted to.
+    intervals : Intervals or None
+        Bootstrap intervals of the coefficients through the full processing
+        (:func:`discovery.vibroimpact.fit.intervals.bootstrap_intervals`; the selected model only).
+    """
+
+    KIND = "ranked-model"
+    _LOAD = {
+        "law": lambda d: ForceLaw.from_dict(d["coefficients"]),
+        "evaluations": _loaded_evaluations,
+        "candidate": lambda d: None,
+        "refinement": lambda d: None,
+        "certificate": lambda d: None,
+        "note": lambda d: d.get("refinement", ""),
+        "intervals": _loaded_intervals,
+    }
+
+    law: object
+    candidate: object
+    evaluations: tuple
+    refinement: object = None
+    note: str = ""
+    certificate: object = None
+    intervals: object = None
+
+    @property
+    def evaluation(self):
+        """The evaluation against the first record."""
+        return self.evaluations[0]
+
+    @property
+    def regime(self):
+        return ", ".join(ev.regime["simulated"] or ev.status for ev in self.evaluations)
+
+    @property
+    def criteria(self):
+        """Criteria I0..I4, the mean over records (empty unless every record is ``ok``)."""
+        return _mean_over([ev.criteria for ev in self.evaluations])
+
+    @property
+    def noise_floor(self):
+        """Noise floor of every criterion, the mean over records."""
+        return _mean_over([ev.noise_floor for ev in self.evaluations])
+
+    @property
+    def limits(self):
+        """The consistency limits the law was judged by: the record's own (empty for
+        several records: each has its own, in ``records``)."""
+        return dict(self.evaluation.limits) if len(self.evaluations) == 1 else {}
+
+    @property
+    def consistent(self):
+        """Consistent with every record."""
+        return all(ev.consistent for ev in self.evaluations)
+
+    @property
+    def verdict(self):
+        if len(self.evaluations) == 1:
+            return self.evaluation.verdict
+        return records_verdict(self.evaluations, lambda ev: ev.verdict)
+
+    @property
+    def defects(self):
+        """Why the law is not a contact law (:meth:`ForceLaw.contact_defects`)."""
+        return self.law.contact_defects()
+
+    @property
+    def standard_errors(self):
+        """``{term: standard error}`` from the refinement (empty without it)."""
+        return (
+            dict(self.refinement.standard_errors)
+            if self.refinement is not None and self.note.startswith("refined")
+            else {}
+        )
+
+    def as_dict(self):
+        ev = self.evaluation
+        iv = self.intervals
+        d = {
+            "terms": list(self.law.names),
+            "coefficients": self.law.as_dict(),
+            "standard_errors": self.standard_errors,
+            "intervals": {} if iv is None else {k: list(v) for k, v in iv.bounds.items()},
+            "interval_method": None if iv is None else iv.method,
+            "interval_level": None if iv is None else iv.level,
+            "regression_coefficients": self.candidate.extra.get(
+                "regression_coefficients", self.candidate.coefficients
+            ),
+            "latex": self.law.latex(),
+            "regime": self.regime,
+            "status": ev.status,
+            "criteria": self.criteria,
+            "noise_floor": self.noise_floor,
+            "limits": self.limits,
+            "consistent": self.consistent,
+            "verdict": self.verdict,
+            "bic": self.candidate.bic,
+            "aic": self.candidate.aic,
+            "cv_error": self.candidate.cv_error,
+            "rss": self.candidate.rss,
+            "constrained": self.candidate.constrained,
+            "refinement": self.note,
+            "contact_defects": self.defects,
+        }
+        if self.refinement is not None:
+            d["n_simulations"] = self.refinement.n_simulations
+        if len(self.evaluations) > 1:
+            d["records"] = [e.as_dict() for e in self.evaluations]
+        return d
+
+    def _lines(self):
+        head = (
+            f"{self.law}  [{self.regime}]: "
+            f"{'consistent' if self.consistent else 'NOT consistent'} with the record(s)"
+        )
+        out = [head, *coefficient_lines(self.law.as_dict(), self.standard_errors, self.intervals)]
+        out += criteria_lines(self.criteria, self.noise_floor, self.limits)
+        out.append(f"  verdict: {self.verdict}")
+        if self.note:
+            out.append(f"  refinement: {self.note}")
+        return out
+
+
+@readable
+@dataclass(frozen=True, eq=False)
+class DiscoveryResult(Result):
+    """Outcome of :func:`discover`.
+
+    Attributes
+    ----------
+    selected : RankedModel
+        The chosen model.
+    ranking : list of RankedModel
+        Every shortlisted candidate, best first.
+    certificate : constraints.Certificate
+        Of the selected law on the data's box.
+    estimator : ConstrainedSparseRegressor
+        The fitted estimator.
+    samples : ContactSamples
+        The contact samples of all records, joined.
+    measured : Impulse
+        The first record's measured cycle.
+    references : tuple of (Scenario, Reference)
+        Every record with its scenario.
+    stability : dict
+        ``{term: selection frequency}`` over bootstrap resamples of impacts (empty if
+        not requested).
+    warnings : list of str
+        Why the record(s) may not identify the law (see :func:`discover`).
+    equivalent : list of dict
+        Models the records cannot tell apart from the selected one, with the reason and
+        what data would separate them.
+    seconds : float
+        Wall time of the whole discovery.
+    settings : dict
+    """
+
+    KIND = "fit"
+    _LOAD = {
+        "selected": lambda d: part(RankedModel, d["selected"]),
+        "ranking": lambda d: [part(RankedModel, m) for m in d["ranking"]],
+        "certificate": lambda d: d.get("certificate") and Certificate(**d["certificate"]),
+        "samples": lambda d: None,
+        "measured": lambda d: None,
+        "references": lambda d: (),
+        "seconds": lambda d: d.get("discovery_seconds", 0.0),
+        "settings": lambda d: d.get("fit_settings", {}),
+    }
+
+    selected: RankedModel
+    ranking: list
+    certificate: object
+    estimator: object
+    samples: object
+    measured: object
+    references: tuple = ()
+    stability: dict = field(default_factory=dict)
+    warnings: list = field(default_factory=list)
+    equivalent: list = field(default_factory=list)
+    seconds: float = 0.0
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def refinement(self):
+        """The selected model's refinement (or None)."""
+        return self.selected.refinement
+
+    def as_dict(self, names=None):
+        """The result as JSON-ready data (``summary.json`` of ``vidi fit``); ``names``
+        labels the records (default: their sources)."""
+        cert = self.certificate
+        refs = [ref for _, ref in self.references]
+        names = list(names) if names is not None else [getattr(r, "source", "") for r in refs]
+        ref_out = self.refinement
+        return {
+            "records": [
+                {
+                    "data": n,
+                    "scenario": s_k.name,
+                    "regime": ref.regime,
+                    "impacts": ref.impacts,
+                    "noise": ref.noise,
+                }
+                for n, (s_k, ref) in zip(names, self.references, strict=True)
+            ],
+            "selected": self.selected.as_dict(),
+            "warnings": self.warnings,
+            "equivalent": self.equivalent,
+            "ranking": [m.as_dict() for m in self.ranking],
+            "certificate": None
+            if cert is None
+            else {
+                "method": cert.method,
+                "holds": cert.holds,
+                "worst_violation": cert.worst_violation,
+                "domain": cert.domain,
+                "conditions": cert.conditions,
+            },
+            "stability": self.stability,
+            "refinement": None
+            if ref_out is None
+            else {
+                "coefficients": ref_out.coefficients,
+                "criteria": ref_out.criteria,
+                "standard_errors": ref_out.standard_errors,
+                "n_simulations": ref_out.n_simulations,
+                "message": ref_out.message,
+                "failures": len(ref_out.failures),
+            },
+            "samples": {
+                "n": len(self.samples),
+                "impacts": self.samples.n_impacts,
+                "derivative": self.samples.derivative,
+                "noise": self.samples.noise,
+            },
+            "measured": {
+                "n_cycles": self.measured.n_cycles,
+                "n_periods": self.measured.n_periods,
+                "noise": self.measured.noise,
+                "threshold": self.measured.threshold,
+            },
+            "discovery_seconds": self.seconds,
+            "fit_settings": self.settings,
+        }
+
+    def _lines(self):
+        sel = self.selected
+        crit = self.settings.get("criterion", "I2")
+        head = (
+            f"selected {sel.law}  [{sel.regime}]: "
+            f"{'consistent' if sel.consistent else 'NOT consistent'} with the record(s)"
+        )
+        out = [head, *coefficient_lines(sel.law.as_dict(), sel.standard_errors, sel.intervals)]
+        out += criteria_lines(sel.criteria, sel.noise_floor, sel.limits)
+        out.append(f"  verdict: {sel.verdict}")
+        out.append(f"ranking ({len(self.ranking)} candidates, criterion {crit}):")
+        for i, m in enumerate(self.ranking[:8]):
+            out.append(
+                f"  {i + 1:>2}. {' + '.join(m.law.names):<28} {m.regime:<6} "
+                f"{crit} {fmt((m.criteria or {}).get(crit), 3):>8}  "
+                f"{'consistent' if m.consistent else ''}"
+            )
+        if len(self.ranking) > 8:
+            out.append(f"  ... {len(self.ranking) - 8} more")
+        for e in self.equivalent:
+            out.append(f"equivalent: {e.get('law', e.get('terms'))}: {e.get('reason', '')}")
+        cert = self.certificate
+        if cert is not None:
+            out.append(
+                f"certificate: conditions {'hold' if cert.holds else 'DO NOT hold'} ({cert.method})"
+            )
+        out += [f"warning: {w}" for w in self.warnings]
+        out.append(f"{self.seconds:.1f} s")
+        return out

@@ -1,0 +1,249 @@
+"""Candidate laws refined by simulation and checked against every record: the shortlist of
+the regression's best supports and the trials of each stepwise move."""
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..._progress import tick
+from ...errors import InputError, IntegrationError
+from ...numerics.executor import map_on
+from ..data.samples import ContactSamples
+from ..dynamics import Tolerances
+from ..verify import evaluate
+from .discovery_result import RankedModel
+from .identify import identify
+from .records import record_start
+from .regression import ConstrainedSparseRegressor
+
+_FORWARD_STARTS = (0.01, 0.001)  # a new term's start force at the box corner / peak force
+
+
+def _coefficients(law, library):
+    """Coefficient vector of ``law`` over ``library`` (zeros for absent terms)."""
+    d = law.as_dict()
+    return np.array([d.get(t.name, 0.0) for t in library.terms])
+
+
+def _trial(check, job):
+    """One trial of the search (a task of the executor, the checker its forked context):
+    ``job = (starts, origin)``, the first of the ``(law, candidate)`` starts whose
+    refinement simulates (the last one's result when none does)."""
+    starts, origin = job
+    for law, cand in starts:
+        trial = check.refined(law, cand, origin)
+        if trial.criteria:
+            break
+    return trial
+
+
+@dataclass(eq=False)
+class _Checker:
+    """Refines (optionally) and evaluates regression candidates against all records; the
+    trials of one step (the shortlist, a forward or backward move) run on ``workers``
+    processes (their results do not depend on it: each refinement is deterministic).
+
+    ``est`` is the fitted regression, ``samples`` the records' joined contact samples,
+    ``refs`` every record's ``(Scenario, Reference)``, ``budget`` the simulations of one
+    refinement, ``required`` the terms no backward step drops."""
+
+    est: ConstrainedSparseRegressor
+    samples: ContactSamples
+    refs: list
+    criterion: str
+    refine: bool
+    tol: Tolerances | None
+    budget: int
+    required: frozenset = frozenset()
+    workers: int | None = 1
+
+    def evaluate(self, law):
+        return tuple(evaluate(sc, law, ref, tolerances=self.tol) for sc, ref in self.refs)
+
+    def run(self, jobs, stage=None, progress=None):
+        """The trials of ``jobs`` (see :func:`_trial`) in their order, on up to ``workers``
+        forked processes (never more than the jobs)."""
+        return map_on(
+            _trial, jobs, self, workers=self.workers, done=lambda k, n: tick(progress, stage, k, n)
+        )
+
+    def regression_law(self, cand):
+        """A regression candidate's law."""
+        lib = self.est.library_
+        return lib.law([cand.coefficients.get(t.name, 0.0) for t in lib.terms])
+
+    def refined(self, law, cand, origin):
+        """Refine ``law`` (from ``origin``: "regression" or a forward step) and check it."""
+        est = self.est
+        extra = {"regression_coefficients": dict(cand.coefficients), "origin": origin}
+        cand = replace(cand, extra={**cand.extra, **extra})
+        cert0 = est.certify(_coefficients(law, est.library_))
+        if not self.refine:
+            return RankedModel(law, cand, self.evaluate(law), note="not refined", certificate=cert0)
+        law = self._scaled_start(law)
+        try:
+            ref = identify(
+                [sc for sc, _ in self.refs],
+                [r for _, r in self.refs],
+                law,
+                criterion=self.criterion,
+                method="least-squares",
+                max_simulations=self.budget,
+                tolerances=self.tol,
+                check=False,
+            )
+        except IntegrationError as exc:
+            return RankedModel(
+                law,
+                cand,
+                self.evaluate(law),
+                note=f"not refined: the {origin} law fails ({exc})",
+                certificate=cert0,
+            )
+        coef = _coefficients(ref.law, est.library_)
+        cert = est.certify(coef)
+        if not cert.holds:
+            return RankedModel(
+                law,
+                cand,
+                self.evaluate(law),
+                refinement=ref,
+                note="not refined: the refined coefficients break a physical "
+                f"condition (worst violation {cert.worst_violation:.2g})",
+                certificate=cert0,
+            )
+        s = self.samples
+        rescored = est.rescore(
+            coef, s.X, s.F, s.weight, s.impact, constrained=cand.constrained, extra=cand.extra
+        )
+        if origin == "regression":  # the support's cross-validated error is the candidate's
+            rescored = replace(rescored, cv_error=cand.cv_error)
+        return RankedModel(
+            ref.law,
+            rescored,
+            self.evaluate(ref.law),
+            refinement=ref,
+            note=f"refined by simulation from the {origin} "
+            f"({ref.n_simulations} simulations, {self.criterion} "
+            f"{ref.value:.3g})",
+            certificate=cert,
+        )
+
+    def _scaled_start(self, law):
+        """The refinement works in units of the start coefficients: a term whose start is
+        negligible (its force at the box's far corner below 0.1 % of the peak force) could
+        never grow, so it starts at 1 % of the peak instead (with its sign)."""
+        lib, est = self.est.library_, self.est
+        corner = lib.transform(np.array([[est.box_.zeta_max, est.box_.zd_max]]))[0]
+        peak = float(np.max(np.abs(self.samples.F)))
+        coef = _coefficients(law, lib)
+        small = (coef != 0) & (np.abs(coef) * corner < 1e-3 * peak) & (corner > 0)
+        if not small.any():
+            return law
+        coef[small] = np.sign(coef[small]) * _FORWARD_STARTS[0] * peak / corner[small]
+        return lib.law(coef)
+
+    def physical_start(self, scenario, ref):
+        """A spring-dashpot start from the record alone, refined by simulation: stiffness from
+        the measured contact time (``k = mu (pi / tau)^2``, ``mu`` the reduced mass), damping
+        from the force jump at onset (``c = F(0+) / v``, ``v`` the impact velocity; 5 % of
+        critical when there is no jump), put on the library's lowest elastic and damping
+        terms at the typical penetration ``v tau / pi``.  ``None`` when the library has
+        neither kind of term or the record gives no contact time."""
+        est = self.est
+        lib = est.library_
+        if not len(ref.impulse.support):
+            return None
+        coef = np.zeros(len(lib))
+        elastic = [i for i, t in enumerate(lib.terms) if t.b == 0]
+        damping = [i for i, t in enumerate(lib.terms) if t.b == 1]
+        chosen = [min(group, key=lambda j: lib.terms[j].a) for group in (elastic, damping) if group]
+        if not chosen:
+            return None
+        coef[chosen] = record_start(scenario, ref, [lib.terms[i] for i in chosen])
+        s = self.samples
+        cand = est.rescore(coef, s.X, s.F, s.weight, s.impact)
+        return self.refined(lib.law(coef), cand, "physical start (contact time, onset jump)")
+
+    def backward(self, base, skip=frozenset()):
+        """Output-error backward step: ``base`` without each of its terms in turn, refined
+        by simulation from the other coefficients (the simplest consistent model wins)."""
+        names = base.law.names
+        if len(names) < 2:
+            return []
+        lib = self.est.library_
+        jobs = []
+        for term in names:
+            if term in self.required or frozenset(names) - {term} in skip:
+                continue
+            coef = _coefficients(base.law, lib)
+            coef[[t.name for t in lib.terms].index(term)] = 0.0
+            cand = self.est.rescore(
+                coef, self.samples.X, self.samples.F, self.samples.weight, self.samples.impact
+            )
+            jobs.append(([(lib.law(coef), cand)], f"backward step from {' + '.join(names)}"))
+        return self.run(jobs)
+
+    def restart(self, base, support):
+        """``support`` refined again from ``base``'s coefficients (its other terms started
+        like a forward step's new term): a smaller support whose refinement from the
+        biased regression stalled, retried from a consistent model's start."""
+        est = self.est
+        lib = est.library_
+        peak = float(np.max(np.abs(self.samples.F)))
+        corner = lib.transform(np.array([[est.box_.zeta_max, est.box_.zd_max]]))[0]
+        coef = np.zeros(len(lib))
+        base_c = _coefficients(base.law, lib)
+        for i, term in enumerate(lib.terms):
+            if term.name in support:
+                coef[i] = (
+                    base_c[i] if base_c[i] else _FORWARD_STARTS[0] * peak / max(corner[i], 1e-300)
+                )
+        cand = est.rescore(
+            coef, self.samples.X, self.samples.F, self.samples.weight, self.samples.impact
+        )
+        return self.refined(lib.law(coef), cand, f"restart from {' + '.join(base.law.names)}")
+
+    def forward(self, base, max_terms, skip=frozenset()):
+        """Output-error forward step: ``base`` plus each library term it lacks, every trial
+        refined by simulation from ``base``'s coefficients and a small start value of the
+        new term (its force at the far corner of the data's box 1 % of the peak force, or
+        0.1 % when that start has no periodic orbit)."""
+        est = self.est
+        lib = est.library_
+        peak = float(np.max(np.abs(self.samples.F)))
+        corner = lib.transform(np.array([[est.box_.zeta_max, est.box_.zd_max]]))[0]
+        have = set(base.law.names)
+        if len(have) >= max_terms:
+            return []
+        jobs = []
+        for i, term in enumerate(lib.terms):
+            if term.name in have or corner[i] <= 0 or frozenset(have | {term.name}) in skip:
+                continue
+            starts = []
+            for frac in _FORWARD_STARTS:
+                coef = _coefficients(base.law, lib)
+                coef[i] = frac * peak / corner[i]
+                cand = est.rescore(
+                    coef, self.samples.X, self.samples.F, self.samples.weight, self.samples.impact
+                )
+                starts.append((lib.law(coef), cand))
+            jobs.append((starts, f"forward step from {' + '.join(base.law.names)}"))
+        return self.run(jobs)
+
+
+_SHORTLIST_STAGE = "fit: shortlisted supports checked by simulation"
+
+
+def _shortlist(check, est, required, shortlist, progress):
+    """The estimator's best supports (holding the required terms), each checked by
+    simulation."""
+    pool = [c for c in est.candidates_ if required <= set(c.coefficients)]
+    if not pool:
+        raise InputError(
+            f"no candidate support of the library holds the required terms "
+            f"{', '.join(sorted(required))}; raise --max-terms or drop --require"
+        )
+    jobs = [([(check.regression_law(c), c)], "regression") for c in pool[:shortlist]]
+    tick(progress, _SHORTLIST_STAGE, 0, len(jobs))
+    return check.run(jobs, _SHORTLIST_STAGE, progress)
