@@ -81,8 +81,10 @@ OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW, CHATTER = 0, 1, 2, 3, 4
 # copy: :func:`kernel_params`).  A law whose velocity terms are scaled by each impact's
 # approach velocity (``p[P_VSCALE] = 1``: Lankarani-Nikravesh, Flores) divides their
 # coefficients by ``p[P_V0]``, the current contact's penetration rate at its onset (a
-# second contact state, set at every onset).
-P_K3, P_LOSS, P_SET, P_ZMAX, P_FLIGHT, P_V0, P_VSCALE, N_PARAMS = 7, 8, 9, 10, 11, 12, 13, 14
+# second contact state, set at every onset).  ``p[P_CONTACT] = 1`` advances the contact in
+# closed form where it applies (0: the integrator's steps).
+P_K3, P_LOSS, P_SET, P_ZMAX, P_FLIGHT, P_V0, P_VSCALE = 7, 8, 9, 10, 11, 12, 13
+P_CONTACT, N_PARAMS = 14, 15
 
 # chattering: more than _ZENO_EVENTS located events in a row, each within
 # _ZENO_GAP * hmax of the previous one (mode switches that hardly advance time)
@@ -909,6 +911,376 @@ def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mo
     return code, t_new, k_eval
 
 
+# ---- the contact in closed form.  With a linear law (loading ``F = k z + c zd``, unloading
+# ``F = k' z + c' zd``: terms ``z`` and ``zd`` only) and nothing else acting during the
+# contact (no cubic support, mass loss, permanent set or impact-scaled terms), the loading and
+# the unloading modes are linear systems ``y' = M y + b_c + b_s sin(w t)`` (``b_c`` gravity,
+# ``b_s`` the drive on the frame).  With ``M = V diag(lambda) V^-1`` the modal coordinates
+# ``q = V^-1 y`` decouple: ``q_j' = lambda_j q_j + beta_cj + beta_sj sin(w t)``, and ``q_j =
+# u_j + q_sj(t)`` with the periodic part ``q_sj = (A_j e^(iwt) - A'_j e^(-iwt)) / 2i`` (``A_j =
+# beta_sj / (iw - lambda_j)``, ``A'_j = beta_sj / (-iw - lambda_j)``) and ``u_j(s) =
+# e^(lambda_j s) u_j(0) + beta_cj s phi1(lambda_j s)`` (``phi1(x) = (e^x - 1) / x``: a zero
+# eigenvalue, a frame with ``k1 = 0``, needs no special case).  The decomposition is made once
+# per run and mode, of ``M`` in the state scaled by the absolute tolerances; a mode whose
+# scaled eigenvectors are ill-conditioned (condition above ``_CONTACT_COND``: near a
+# defective, critically damped pair, or a free frame ``k1 = c1 = 0``) or with an eigenvalue
+# within ``1e-9 w`` of the drive's ``+-iw`` (an undamped resonance) is integrated instead.
+#
+# Every switching function of the two modes is linear in the state, ``h = gz z + gv zd``
+# (loss ``z``, unload ``zd`` or reload ``-zd``, release ``F``), and its first root is proven
+# as the flight's onset: over ``[a, a + H]``, ``|h''| <= K = sum_j |G_j| (|lambda_j| |d_j|
+# max(e^(Re lambda_j a), e^(Re lambda_j (a + H))) + w^2 (|A_j| + |A'_j|) / 2)`` with ``G_j =
+# g . v_j`` and ``d_j = u_j'(0)`` (``u_j'' = lambda_j e^(lambda_j s) d_j``, ``q_sj'' = -w^2
+# q_sj``), so ``h >= h(a) + h'(a) tau - K tau^2 / 2`` there and no interval is passed unless
+# that stays positive over it for every function.  A mode with a growing eigenvalue (``Re
+# lambda > 0``, a law with negative coefficients) caps the intervals at ``1 / Re lambda``.
+# The first point across is polished by safeguarded Newton on the closed form.
+#
+# Not with sensitivities: a run that carries them integrates its contacts.
+
+_CONTACT_COND = 1e5  # the largest condition number of a mode's scaled eigenvectors
+_NE = 12  # a mode's complex constants per eigenvalue, :func:`_contact_setup`
+_NR = 5  # a mode's real constants, :func:`_contact_setup`
+
+
+@njit(cache=True)
+def _contact_law(p, coef, ea, eb, br, kc):
+    """Whether the contact has the closed form: requested (``p[P_CONTACT] = 1``), a linear
+    law and nothing else acting during the contact (see above); fills ``kc`` with the
+    loading force's ``(k, c)``, then the unloading force's."""
+    if p[P_CONTACT] == 0.0 or p[P_K3] != 0.0 or p[P_LOSS] != 0.0:
+        return False
+    if p[P_SET] != 0.0 or p[P_VSCALE] != 0.0:
+        return False
+    if not (p[0] > 0.0 and p[1] > 0.0 and p[5] > 0.0):
+        return False
+    for j in range(4):
+        kc[j] = 0.0
+    for i in range(coef.shape[0]):
+        if ea[i] == 1.0 and eb[i] == 0.0:
+            if br[i] == 0.0:
+                kc[0] += coef[i]  # the elastic part acts in both branches
+            kc[2] += coef[i]
+        elif ea[i] == 0.0 and eb[i] == 1.0:
+            kc[1 if br[i] == 0.0 else 3] += coef[i]
+        else:
+            return False
+    for j in range(4):
+        if not np.isfinite(kc[j]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _contact_g(mode, kc, i):
+    """Switching function ``i`` of a contact mode as ``(gz, gv)``: ``h = gz z + gv zd``
+    (loss, unload or reload, release: as :func:`_switching`)."""
+    if i == 0:
+        return 1.0, 0.0
+    if i == 1:
+        return 0.0, (1.0 if mode == LOAD else -1.0)
+    if mode == LOAD:
+        return kc[0], kc[1]
+    return kc[2], kc[3]
+
+
+@njit(cache=True)
+def _cinv4(A, out):
+    """``out = A^-1`` of a complex 4x4 by Gauss-Jordan with partial pivoting; False if a
+    pivot vanishes (singular to working precision)."""
+    W = A.copy()
+    for r in range(4):
+        for c in range(4):
+            out[r, c] = 1.0 if r == c else 0.0
+    for c in range(4):
+        piv, big = c, abs(W[c, c])
+        for r in range(c + 1, 4):
+            if abs(W[r, c]) > big:
+                piv, big = r, abs(W[r, c])
+        if not big > 1e-300:
+            return False
+        for k in range(4):
+            W[c, k], W[piv, k] = W[piv, k], W[c, k]
+            out[c, k], out[piv, k] = out[piv, k], out[c, k]
+        d = W[c, c]
+        for k in range(4):
+            W[c, k] /= d
+            out[c, k] /= d
+        for r in range(4):
+            if r != c:
+                m = W[r, c]
+                for k in range(4):
+                    W[r, k] -= m * W[c, k]
+                    out[r, k] -= m * out[c, k]
+    return True
+
+
+@njit(cache=True)
+def _contact_matrix(p, k, c, dsc, Ms):
+    """``Ms = D^-1 M D``: the contact mode's system matrix (force ``k z + c zd``) in the state
+    scaled by ``D = diag(dsc)``; False if not finite."""
+    m1, m2, k1, c1 = p[0], p[1], p[2], p[3]
+    M = np.zeros((4, 4))
+    M[0, 1] = 1.0
+    M[1, 0], M[1, 1], M[1, 2], M[1, 3] = -(k1 + k) / m1, -(c1 + c) / m1, k / m1, c / m1
+    M[2, 3] = 1.0
+    M[3, 0], M[3, 1], M[3, 2], M[3, 3] = k / m2, c / m2, -k / m2, -c / m2
+    for r in range(4):
+        for q in range(4):
+            if not np.isfinite(M[r, q]):
+                return False
+            Ms[r, q] = M[r, q] * dsc[q] / dsc[r]
+    return True
+
+
+@njit(cache=True)
+def _contact_setup(p, kc, mode, dsc, E, R):
+    """The closed form's constants of a contact mode (``mi = 0`` loading, 1 unloading): for
+    each eigenvalue ``j``, ``E[mi, j]`` holds its eigenvector ``v_j`` (4), the row ``j`` of
+    ``V^-1`` (4), ``lambda_j``, ``beta_cj``, ``A_j``, ``A'_j``; ``R[mi]`` holds 1 where the
+    mode has the closed form (else 0 and nothing else), the periodic parts' curvature bound
+    of its three switching functions, and the largest ``Re lambda``."""
+    mi = 0 if mode == LOAD else 1
+    R[mi, 0] = 0.0
+    w, g = p[5], p[6]
+    Ms = np.empty((4, 4), dtype=np.complex128)
+    if not _contact_matrix(p, kc[2 * mi], kc[2 * mi + 1], dsc, Ms):
+        return
+    lam, Vs = np.linalg.eig(Ms)
+    Vis = np.empty((4, 4), dtype=np.complex128)
+    if not _cinv4(Vs, Vis):
+        return
+    n1, n2 = 0.0, 0.0
+    for r in range(4):
+        for q in range(4):
+            n1 += abs(Vs[r, q]) ** 2
+            n2 += abs(Vis[r, q]) ** 2
+    if not np.sqrt(n1 * n2) <= _CONTACT_COND:
+        return
+    grow = -np.inf
+    for j in range(4):
+        la = lam[j]
+        dp, dm = 1j * w - la, -1j * w - la
+        if not (abs(dp) > 1e-9 * w and abs(dm) > 1e-9 * w):
+            return
+        for r in range(4):
+            E[mi, j, r] = Vs[r, j] * dsc[r]
+            E[mi, j, 4 + r] = Vis[j, r] / dsc[r]
+        beta_s = -E[mi, j, 5] * p[4] / p[0]  # the drive -A sin(w t) / m1 on v1
+        E[mi, j, 8] = la
+        E[mi, j, 9] = -g * (E[mi, j, 5] + E[mi, j, 7])  # gravity on v1 and v2
+        E[mi, j, 10] = beta_s / dp
+        E[mi, j, 11] = beta_s / dm
+        grow = max(grow, la.real)
+    for i in range(3):
+        gz, gv = _contact_g(mode, kc, i)
+        kf = 0.0
+        for j in range(4):
+            G = gz * (E[mi, j, 0] - E[mi, j, 2]) + gv * (E[mi, j, 1] - E[mi, j, 3])
+            kf += abs(G) * (abs(E[mi, j, 10]) + abs(E[mi, j, 11]))
+        R[mi, 1 + i] = 0.5 * w * w * kf
+    R[mi, 4] = grow
+    R[mi, 0] = 1.0
+
+
+@njit(cache=True)
+def _phi1(x):
+    """``(e^x - 1) / x`` (1 at 0) for a complex ``x``, without cancellation near 0."""
+    if abs(x) < 1e-2:
+        return 1.0 + x * (1.0 + x * (1.0 + x * (1.0 + x * (1.0 + x / 6.0) / 5.0) / 4.0) / 3.0) / 2.0
+    return (np.exp(x) - 1.0) / x
+
+
+@njit(cache=True)
+def _contact_start(t0, y, mi, w, E, qm):
+    """The phase's modal data from ``(t0, y)``: ``qm[j] = (u_j(0), d_j)``, ``d_j = lambda_j
+    u_j(0) + beta_cj`` (``u_j``'s rate at the start)."""
+    ew = np.cos(w * t0) + 1j * np.sin(w * t0)
+    for j in range(4):
+        q = 0j
+        for r in range(4):
+            q += E[mi, j, 4 + r] * y[r]
+        u0 = q + 0.5j * (E[mi, j, 10] * ew - E[mi, j, 11] * np.conj(ew))
+        qm[j, 0] = u0
+        qm[j, 1] = E[mi, j, 8] * u0 + E[mi, j, 9]
+
+
+@njit(cache=True)
+def _contact_state(s, t0, w, mi, E, qm, out):
+    """The state ``s`` after the phase's start (at ``t0``) into ``out``."""
+    tt = t0 + s
+    ew = np.cos(w * tt) + 1j * np.sin(w * tt)
+    a0, a1, a2, a3 = 0j, 0j, 0j, 0j
+    for j in range(4):
+        x = E[mi, j, 8] * s
+        q = np.exp(x) * qm[j, 0] + E[mi, j, 9] * s * _phi1(x)
+        q -= 0.5j * (E[mi, j, 10] * ew - E[mi, j, 11] * np.conj(ew))
+        a0 += E[mi, j, 0] * q
+        a1 += E[mi, j, 1] * q
+        a2 += E[mi, j, 2] * q
+        a3 += E[mi, j, 3] * q
+    out[0], out[1], out[2], out[3] = a0.real, a1.real, a2.real, a3.real
+
+
+@njit(cache=True)
+def _contact_h(i, mode, kc, t, y, p):
+    """Switching function ``i`` of a contact mode and its rate at ``(t, y)``."""
+    gz, gv = _contact_g(mode, kc, i)
+    k, c = (kc[0], kc[1]) if mode == LOAD else (kc[2], kc[3])
+    z, zd = y[0] - y[2], y[1] - y[3]
+    f = k * z + c * zd
+    a1 = -(p[3] * y[1] + p[2] * y[0] + p[4] * np.sin(p[5] * t) + p[0] * p[6] + f) / p[0]
+    a2 = f / p[1] - p[6]
+    return gz * z + gv * zd, gz * zd + gv * (a1 - a2)
+
+
+@njit(cache=True)
+def _contact_gap(f, fd, K):
+    """The positive root of ``f + fd tau - K tau^2 / 2`` (``f >= 0``): how far a function at
+    ``f`` with rate ``fd`` and curvature at least ``-K`` stays positive."""
+    if not K > 1e-300:
+        K = 1e-300
+    if f <= 0.0 and fd <= 0.0:
+        return 0.0
+    disc = np.sqrt(fd * fd + 2.0 * K * f)
+    return (fd + disc) / K if fd > 0.0 else 2.0 * f / (disc - fd)
+
+
+@njit(cache=True)
+def _time_res(t, w):
+    """The time resolution at ``t``: a few units in the last place of the absolute time, and
+    at least 1e-15 of the drive period."""
+    return 4.0e-16 * max(abs(t), 2.0 * np.pi / w)
+
+
+@njit(cache=True)
+def _contact_polish(i, mode, a, b, hb, hdb, t0, p, kc, mi, E, qm, ybuf):
+    """The first root of switching function ``i`` in ``[a, b]`` (``h(a) >= 0 > h(b) = hb``,
+    rate ``hdb``; no root in ``[a, b)`` but the crossing's): safeguarded Newton to the
+    time's resolution; the point returned is across (``h < 0``), as a located event's."""
+    w = p[5]
+    lo, hi = a, b
+    s, hs, hds = b, hb, hdb
+    for _ in range(200):
+        res = _time_res(t0 + hi, w)
+        if hi - lo <= res:
+            break
+        c = s - hs / hds if hds < 0.0 else 0.5 * (lo + hi)
+        if not (lo < c < hi):
+            c = 0.5 * (lo + hi)
+        if abs(c - s) <= res:
+            # Newton has converged from one side: probe just across to close the bracket
+            c = s - res if hs < 0.0 else s + res
+            if not (lo < c < hi):
+                c = 0.5 * (lo + hi)
+        _contact_state(c, t0, w, mi, E, qm, ybuf)
+        hc, hdc = _contact_h(i, mode, kc, t0 + c, ybuf, p)
+        if hc < 0.0:
+            hi = c
+        else:
+            lo = c
+        s, hs, hds = c, hc, hdc
+    return hi
+
+
+@njit(cache=True)
+def _contact_bound(i, mi, a, hcap, E, R, cb):
+    """The curvature bound ``K`` of switching function ``i`` over ``[a, a + hcap]``."""
+    K = R[mi, 1 + i]
+    for j in range(4):
+        re = E[mi, j, 8].real
+        K += cb[i, j] * max(np.exp(re * a), np.exp(re * (a + hcap)))
+    return K
+
+
+@njit(cache=True)
+def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf):
+    """The first event in ``(0, s_end]`` of the contact phase set up (the switching
+    functions' values ``f >= 0`` and rates ``fd`` at its start): ``(s, index)``, ``index`` the
+    function that fires at ``s``, -1 for none up to ``s = s_end``, -2 if the safeguard's
+    interval budget ran out at ``s`` (no event before it)."""
+    w = p[5]
+    a = 0.0
+    grow = R[mi, 4]
+    for _ in range(_FLIGHT_ITERS):
+        hcap = s_end - a
+        if grow > 0.0:
+            hcap = min(hcap, 1.0 / grow)
+        H = hcap
+        for i in range(3):
+            H = min(H, _contact_gap(f[i], fd[i], _contact_bound(i, mi, a, hcap, E, R, cb)))
+        if a + H >= s_end:
+            return s_end, -1
+        b = min(a + max(H, _time_res(t0 + a, w)), s_end)
+        _contact_state(b, t0, w, mi, E, qm, ybuf)
+        best_s, best_i = np.inf, -1
+        for i in range(3):
+            hb, hdb = _contact_h(i, mode, kc, t0 + b, ybuf, p)
+            f[i], fd[i] = hb, hdb
+        for i in range(3):
+            if f[i] < 0.0:
+                si = _contact_polish(i, mode, a, b, f[i], fd[i], t0, p, kc, mi, E, qm, ybuf)
+                # near-ties go to the lower index (loss before release at once)
+                if si < best_s - 2.0 * _time_res(t0 + si, w):
+                    best_s, best_i = si, i
+        if best_i >= 0:
+            return best_s, best_i
+        if b >= s_end:
+            return s_end, -1
+        a = b
+    return a, -2
+
+
+@njit(cache=True)
+def _contact(
+    t, t1, y, mode, p, kc, E, R, atol, qm, cb, f, fd, ybuf, t_eval, k_eval, out_y, out_f, out_mode
+):
+    """One contact phase (loading or unloading) from ``(t, y)`` in closed form: ``(code,
+    t_new, k_eval, index)``.
+
+    ``code`` 0: no event up to ``t1`` (``y`` advanced to it); 1: switching function ``index``
+    fires at ``t_new`` (advanced to it: the caller records the event); 3: not here (the mode
+    has no closed form, or a switching function starts across its surface by more than a
+    hair of the absolute tolerances, or not leaving it: the integrator's steps); 4: advanced
+    to ``t_new`` without an event, the integrator's steps next (the safeguard's interval
+    budget ran out).  Writes the state, force and mode at ``t_eval[k_eval:]`` up to
+    ``t_new``."""
+    mi = 0 if mode == LOAD else 1
+    if R[mi, 0] == 0.0:
+        return 3, t, k_eval, -1
+    for i in range(3):
+        h, hd = _contact_h(i, mode, kc, t, y, p)
+        f[i], fd[i] = h, hd
+        if h > 0.0:
+            continue
+        gz, gv = _contact_g(mode, kc, i)
+        if h < -(abs(gz) * atol[0] + abs(gv) * atol[1]) or not hd > 0.0:
+            return 3, t, k_eval, -1
+        f[i] = 0.0  # a hair across, leaving: on the surface
+    w = p[5]
+    _contact_start(t, y, mi, w, E, qm)
+    for i in range(3):
+        gz, gv = _contact_g(mode, kc, i)
+        for j in range(4):
+            G = gz * (E[mi, j, 0] - E[mi, j, 2]) + gv * (E[mi, j, 1] - E[mi, j, 3])
+            cb[i, j] = abs(G) * abs(E[mi, j, 8]) * abs(qm[j, 1])
+    s, index = _contact_search(mode, t, t1 - t, p, kc, mi, E, R, qm, cb, f, fd, ybuf)
+    code = 1 if index >= 0 else (0 if index == -1 else 4)
+    t_new = t1 if code == 0 else t + s
+    k, c = kc[2 * mi], kc[2 * mi + 1]
+    while k_eval < t_eval.shape[0] and t_eval[k_eval] <= t_new:
+        _contact_state(max(t_eval[k_eval] - t, 0.0), t, w, mi, E, qm, ybuf)
+        for j in range(4):
+            out_y[j, k_eval] = ybuf[j]
+        out_f[k_eval] = k * (ybuf[0] - ybuf[2]) + c * (ybuf[1] - ybuf[3])
+        out_mode[k_eval] = mode
+        k_eval += 1
+    _contact_state(s, t, w, mi, E, qm, ybuf)
+    for j in range(4):
+        y[j] = ybuf[j]
+    return code, t_new, k_eval, index
+
+
 @njit(cache=True)
 def integrate(
     t0,
@@ -1003,6 +1375,19 @@ def integrate(
     use_flight = _flight_ok(p)
     fl = np.empty(_NF)
     hold = False
+    # the contact in closed form where it applies (:func:`_contact`; not with sensitivities)
+    kc = np.zeros(4)
+    use_contact = m_s == 0 and not want_df and _contact_law(p, coef, ea, eb, br, kc)
+    E = np.zeros((2, 4, _NE), dtype=np.complex128)
+    R = np.zeros((2, _NR))
+    if use_contact:
+        _contact_setup(p, kc, LOAD, atol, E, R)
+        _contact_setup(p, kc, UNLOAD, atol, E, R)
+        use_contact = R[0, 0] != 0.0 or R[1, 0] != 0.0
+    qm = np.empty((4, 2), dtype=np.complex128)
+    cb = np.empty((3, 4))
+    fc = np.empty(3)
+    fcd = np.empty(3)
     while t < t1:
         if n_steps >= max_steps:
             status = STEP_BUDGET
@@ -1054,6 +1439,58 @@ def integrate(
                 n_ev += 1
                 need_f = True
                 need_h0 = True
+                continue
+        if use_contact and (mode == LOAD or mode == UNLOAD) and not hold:
+            code, t_new, k_eval, idx = _contact(
+                t,
+                t1,
+                y,
+                mode,
+                p,
+                kc,
+                E,
+                R,
+                atol,
+                qm,
+                cb,
+                fc,
+                fcd,
+                ybuf,
+                t_eval,
+                k_eval,
+                out_y,
+                out_f,
+                out_mode,
+            )
+            if code == 3:
+                hold = True
+            else:
+                n_steps += 1
+                t = t_new
+                need_f = True
+                need_h0 = True
+                if not (
+                    np.isfinite(y[0])
+                    and np.isfinite(y[1])
+                    and np.isfinite(y[2])
+                    and np.isfinite(y[3])
+                ):
+                    status = BLOW_UP
+                    break
+                if code == 4:
+                    hold = True
+                if code != 1:
+                    continue
+                zero_len = 0
+                short_run = _zeno_run(t, t_last_ev, hmax, short_run)
+                if short_run > _ZENO_EVENTS:
+                    status = CHATTER
+                    break
+                t_last_ev = t
+                mode = _record_event(
+                    t, y, mode, idx, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
+                )
+                n_ev += 1
                 continue
         if need_f:
             _rhs(t, y, mode, p, coef, ea, eb, br, K[0])
