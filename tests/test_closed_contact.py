@@ -284,3 +284,25 @@ def test_runs_with_sensitivities_integrate_their_contacts():
     # and the plain run's end agrees with theirs: measured 2.4e-11 of the scales
     c = simulate(sc, law, span, tolerances=Tolerances(rtol=1e-10))
     assert np.max(np.abs(c.y_final - a.y_final) / _scale(sc)[:, 0]) < 1e-9
+
+
+@pytest.mark.parametrize("c1", [0.0, 20.0, 100.0, 2000.0])  # undamped to overdamped frames
+def test_frames_from_undamped_to_overdamped(c1):
+    """tests/test_free_flight.py's machines (critical damping at c1 = 20), whose contacts are
+    short and stiff: the closed-form run against the integrator path at rtol 1e-13 (at rtol
+    1e-10 its own error in these contacts reaches 7e-7 T)."""
+    sc = Scenario(
+        m1=1.0,
+        m2=0.5,
+        k1=100.0,
+        c1=c1,
+        A=30.0,
+        frequency=2.0,
+        g=9.81,
+        initial=(0.0, 0.0, 0.01, 3.0),
+    )
+    law = ForceLaw.parse("1e6*z + 50*zd")
+    a, b = _run(sc, law, 6, "closed"), _run(sc, law, 6, "integrate", rtol=1e-13)
+    assert np.sum(a.event_kind == K.EV_ONSET) >= 3
+    # measured <= 2.6e-9 T, 2.9e-9 of the scales, 4.7e-9 of the force's peak
+    _agree(a, b, sc, 1e-8, 1e-7, 1e-7)
