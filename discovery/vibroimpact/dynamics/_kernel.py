@@ -39,10 +39,18 @@ within ``1e-3 hmax`` of the last) stop the run as chattering.
 
 Free flight: by default (``p[P_FLIGHT] = 1``, :attr:`Tolerances.free_flight` ``"closed"``)
 the free mode is not stepped: the flight is advanced in closed form to the first root of
-the exact penetration, bracketed by a proven bound (:func:`_flight`), and only the contact
-is integrated.  Supports with a cubic term, ``k1 <= 0`` or ``c1 < 0``, and a start across
-the surface that is not closing take the integrator's steps, as does every free flight with
-``p[P_FLIGHT] = 0`` (the cross-check path).
+the exact penetration, bracketed by a proven bound (:func:`_flight`).  Supports with a cubic
+term, ``k1 <= 0`` or ``c1 < 0``, and a start across the surface that is not closing take the
+integrator's steps, as does every free flight with ``p[P_FLIGHT] = 0`` (the cross-check
+path).
+
+Contact: by default (``p[P_CONTACT] = 1``, :attr:`Tolerances.contact` ``"closed"``, only
+with closed-form flights) a linear law's loading and unloading phases (``F = k z + c zd``,
+nothing else acting during the contact) are not stepped either: each is advanced by its
+modal solution to the first root of its switching functions, bracketed by a proven bound
+(:func:`_contact`).  Other laws, the clipped mode, a mode whose eigenvectors are
+ill-conditioned, a start across a switching surface, runs with a law coefficient's
+sensitivities and every contact with ``p[P_CONTACT] = 0`` take the integrator's steps.
 
 Compilation: numba inlines an ``inline="always"`` function in its own IR and types the
 body again at every call site, so a chain of inlined functions costs compile time by the
@@ -936,7 +944,10 @@ def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mo
 # lambda > 0``, a law with negative coefficients) caps the intervals at ``1 / Re lambda``.
 # The first point across is polished by safeguarded Newton on the closed form.
 #
-# Not with sensitivities: a run that carries them integrates its contacts.
+# Sensitivities along the start's states move by the transition matrix, ``S <- Re(V
+# diag(e^(lambda s)) V^-1) S``, and jump by the saltation matrix at the events as after an
+# integrated step; a run that carries a law coefficient's column integrates its contacts
+# (the closed form does not differentiate the law).
 
 _CONTACT_COND = 1e5  # the largest condition number of a mode's scaled eigenvectors
 _NE = 12  # a mode's complex constants per eigenvalue, :func:`_contact_setup`
@@ -1083,12 +1094,13 @@ def _contact_setup(p, kc, mode, dsc, E, R):
     R[mi, 0] = 1.0
 
 
-@njit(cache=True)
-def _phi1(x):
-    """``(e^x - 1) / x`` (1 at 0) for a complex ``x``, without cancellation near 0."""
+@njit(cache=True, inline="always")
+def _phi1(x, ex):
+    """``(e^x - 1) / x`` (1 at 0) for a complex ``x`` with ``ex = e^x``, without cancellation
+    near 0."""
     if abs(x) < 1e-2:
         return 1.0 + x * (1.0 + x * (1.0 + x * (1.0 + x * (1.0 + x / 6.0) / 5.0) / 4.0) / 3.0) / 2.0
-    return (np.exp(x) - 1.0) / x
+    return (ex - 1.0) / x
 
 
 @njit(cache=True)
@@ -1113,13 +1125,48 @@ def _contact_state(s, t0, w, mi, E, qm, out):
     a0, a1, a2, a3 = 0j, 0j, 0j, 0j
     for j in range(4):
         x = E[mi, j, 8] * s
-        q = np.exp(x) * qm[j, 0] + E[mi, j, 9] * s * _phi1(x)
+        ex = np.exp(x)
+        q = ex * qm[j, 0] + E[mi, j, 9] * s * _phi1(x, ex)
         q -= 0.5j * (E[mi, j, 10] * ew - E[mi, j, 11] * np.conj(ew))
         a0 += E[mi, j, 0] * q
         a1 += E[mi, j, 1] * q
         a2 += E[mi, j, 2] * q
         a3 += E[mi, j, 3] * q
     out[0], out[1], out[2], out[3] = a0.real, a1.real, a2.real, a3.real
+
+
+@njit(cache=True)
+def _contact_phi(s, mi, E, out):
+    """The mode's transition matrix ``Phi(s) = V diag(e^(lambda s)) V^-1`` into ``out``."""
+    for r in range(4):
+        for q in range(4):
+            out[r, q] = 0.0
+    for j in range(4):
+        ej = np.exp(E[mi, j, 8] * s)
+        for r in range(4):
+            vr = E[mi, j, r] * ej
+            for q in range(4):
+                out[r, q] += (vr * E[mi, j, 4 + q]).real
+
+
+@njit(cache=True)
+def _contact_sens(s, mi, E, S, phi, kF, cF, out_dF, k):
+    """Through ``s`` of the phase: ``S <- Phi(s) S`` (state columns only: the law's
+    coefficients are not among them); with ``k >= 0`` instead the force's and the
+    penetration's derivatives at ``s`` into ``out_dF[:, k]``, ``S`` kept."""
+    _contact_phi(s, mi, E, phi)
+    m = S.shape[1]
+    for j in range(m):
+        a0, a1, a2, a3 = S[0, j], S[1, j], S[2, j], S[3, j]
+        b0 = phi[0, 0] * a0 + phi[0, 1] * a1 + phi[0, 2] * a2 + phi[0, 3] * a3
+        b1 = phi[1, 0] * a0 + phi[1, 1] * a1 + phi[1, 2] * a2 + phi[1, 3] * a3
+        b2 = phi[2, 0] * a0 + phi[2, 1] * a1 + phi[2, 2] * a2 + phi[2, 3] * a3
+        b3 = phi[3, 0] * a0 + phi[3, 1] * a1 + phi[3, 2] * a2 + phi[3, 3] * a3
+        if k >= 0:
+            out_dF[j, k] = kF * (b0 - b2) + cF * (b1 - b3)
+            out_dF[m + j, k] = b0 - b2
+        else:
+            S[0, j], S[1, j], S[2, j], S[3, j] = b0, b1, b2, b3
 
 
 @njit(cache=True)
@@ -1233,7 +1280,28 @@ def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf):
 
 @njit(cache=True)
 def _contact(
-    t, t1, y, mode, p, kc, E, R, atol, qm, cb, f, fd, ybuf, t_eval, k_eval, out_y, out_f, out_mode
+    t,
+    t1,
+    y,
+    mode,
+    p,
+    kc,
+    E,
+    R,
+    atol,
+    qm,
+    cb,
+    f,
+    fd,
+    ybuf,
+    S,
+    phi,
+    t_eval,
+    k_eval,
+    out_y,
+    out_f,
+    out_mode,
+    out_dF,
 ):
     """One contact phase (loading or unloading) from ``(t, y)`` in closed form: ``(code,
     t_new, k_eval, index)``.
@@ -1244,7 +1312,8 @@ def _contact(
     hair of the absolute tolerances, or not leaving it: the integrator's steps); 4: advanced
     to ``t_new`` without an event, the integrator's steps next (the safeguard's interval
     budget ran out).  Writes the state, force and mode at ``t_eval[k_eval:]`` up to
-    ``t_new``."""
+    ``t_new`` (and the force's derivatives with ``out_dF``); ``S`` (state columns only) moves
+    with the state."""
     mi = 0 if mode == LOAD else 1
     if R[mi, 0] == 0.0:
         return 3, t, k_eval, -1
@@ -1274,10 +1343,14 @@ def _contact(
             out_y[j, k_eval] = ybuf[j]
         out_f[k_eval] = k * (ybuf[0] - ybuf[2]) + c * (ybuf[1] - ybuf[3])
         out_mode[k_eval] = mode
+        if out_dF.shape[1] > 0:
+            _contact_sens(max(t_eval[k_eval] - t, 0.0), mi, E, S, phi, k, c, out_dF, k_eval)
         k_eval += 1
     _contact_state(s, t, w, mi, E, qm, ybuf)
     for j in range(4):
         y[j] = ybuf[j]
+    if S.shape[1] > 0:
+        _contact_sens(s, mi, E, S, phi, k, c, out_dF, -1)
     return code, t_new, k_eval, index
 
 
@@ -1377,7 +1450,10 @@ def integrate(
     hold = False
     # the contact in closed form where it applies (:func:`_contact`; not with sensitivities)
     kc = np.zeros(4)
-    use_contact = m_s == 0 and not want_df and _contact_law(p, coef, ea, eb, br, kc)
+    use_contact = _contact_law(p, coef, ea, eb, br, kc)
+    for j in range(m_s):
+        if spar[j] >= 0:
+            use_contact = False  # a coefficient's column: the contacts are integrated
     E = np.zeros((2, 4, _NE), dtype=np.complex128)
     R = np.zeros((2, _NR))
     if use_contact:
@@ -1385,6 +1461,7 @@ def integrate(
         _contact_setup(p, kc, UNLOAD, atol, E, R)
         use_contact = R[0, 0] != 0.0 or R[1, 0] != 0.0
     qm = np.empty((4, 2), dtype=np.complex128)
+    phi = np.empty((4, 4))
     cb = np.empty((3, 4))
     fc = np.empty(3)
     fcd = np.empty(3)
@@ -1456,11 +1533,14 @@ def integrate(
                 fc,
                 fcd,
                 ybuf,
+                S,
+                phi,
                 t_eval,
                 k_eval,
                 out_y,
                 out_f,
                 out_mode,
+                out_dF,
             )
             if code == 3:
                 hold = True
@@ -1487,9 +1567,13 @@ def integrate(
                     status = CHATTER
                     break
                 t_last_ev = t
+                if m_s:
+                    _event_time_sens(t, y, mode, idx, p, coef, ea, eb, br, S, spar, dc, fminus, tau)
                 mode = _record_event(
                     t, y, mode, idx, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
                 )
+                if m_s:
+                    _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau)
                 n_ev += 1
                 continue
         if need_f:
