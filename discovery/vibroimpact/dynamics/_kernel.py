@@ -942,7 +942,9 @@ def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mo
 # q_sj``), so ``h >= h(a) + h'(a) tau - K tau^2 / 2`` there and no interval is passed unless
 # that stays positive over it for every function.  A mode with a growing eigenvalue (``Re
 # lambda > 0``, a law with negative coefficients) caps the intervals at ``1 / Re lambda``.
-# The first point across is polished by safeguarded Newton on the closed form.
+# The first root is polished by safeguarded Newton on the closed form; the event is recorded at
+# the last point of the phase (every switching function still >= 0) within the time's
+# resolution of it.
 #
 # Sensitivities along the start's states move by the transition matrix, ``S <- Re(V
 # diag(e^(lambda s)) V^-1) S``, and jump by the saltation matrix at the events as after an
@@ -1204,7 +1206,11 @@ def _time_res(t, w):
 def _contact_polish(i, mode, a, b, hb, hdb, t0, p, kc, mi, E, qm, ybuf):
     """The first root of switching function ``i`` in ``[a, b]`` (``h(a) >= 0 > h(b) = hb``,
     rate ``hdb``; no root in ``[a, b)`` but the crossing's): safeguarded Newton to the
-    time's resolution; the point returned is across (``h < 0``), as a located event's."""
+    time's resolution.  The point returned is the last one on the function's side (``h >=
+    0``), within that resolution of the root: a phase's event state keeps every function of
+    its mode at ``>= 0`` (the penetration and the force have their signs up to the end of
+    the contact, as its left limits must), and the next mode starts a hair across its own
+    surface at most, leaving it."""
     w = p[5]
     lo, hi = a, b
     s, hs, hds = b, hb, hdb
@@ -1227,7 +1233,7 @@ def _contact_polish(i, mode, a, b, hb, hdb, t0, p, kc, mi, E, qm, ybuf):
         else:
             lo = c
         s, hs, hds = c, hc, hdc
-    return hi
+    return lo
 
 
 @njit(cache=True)
