@@ -39,9 +39,9 @@ class Tolerances:
         cross-check path).  Ueda's oscillators ignore it.
     contact : {"closed", "integrate"}
         The vibro-impact kernel's loading and unloading phases: ``"closed"`` (default)
-        advances them in closed form to the next event (a linear law, ``k z + c zd``, with
-        nothing else acting during the contact, in a run without sensitivities; otherwise
-        the integrator's steps); ``"integrate"`` takes the integrator's steps (the
+        advances them in closed form to the next event, sensitivities included (a linear
+        law, ``k z + c zd``, with nothing else acting during the contact; otherwise the
+        integrator's steps); ``"integrate"`` takes the integrator's steps (the
         cross-check path).  Only with ``free_flight="closed"``: ``free_flight="integrate"``
         integrates the contacts too.  Ueda's oscillators ignore it.
     """

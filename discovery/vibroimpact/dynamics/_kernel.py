@@ -49,8 +49,9 @@ with closed-form flights) a linear law's loading and unloading phases (``F = k z
 nothing else acting during the contact) are not stepped either: each is advanced by its
 modal solution to the first root of its switching functions, bracketed by a proven bound
 (:func:`_contact`).  Other laws, the clipped mode, a mode whose eigenvectors are
-ill-conditioned, a start across a switching surface, runs with a law coefficient's
-sensitivities and every contact with ``p[P_CONTACT] = 0`` take the integrator's steps.
+ill-conditioned, a start across a switching surface, a law coefficient's sensitivities in
+a mode with a zero eigenvalue (``k1 = 0``) and every contact with ``p[P_CONTACT] = 0`` take
+the integrator's steps; the sensitivities follow the closed form too.
 
 Compilation: numba inlines an ``inline="always"`` function in its own IR and types the
 body again at every call site, so a chain of inlined functions costs compile time by the
@@ -946,14 +947,16 @@ def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mo
 # the last point of the phase (every switching function still >= 0) within the time's
 # resolution of it.
 #
-# Sensitivities along the start's states move by the transition matrix, ``S <- Re(V
-# diag(e^(lambda s)) V^-1) S``, and jump by the saltation matrix at the events as after an
-# integrated step; a run that carries a law coefficient's column integrates its contacts
-# (the closed form does not differentiate the law).
+# Sensitivities move by the transition matrix, ``S <- Re(V diag(e^(lambda s)) V^-1) S``, and
+# a law coefficient's column gains the response to its force term (``z`` or ``zd``, the
+# derivative of the mode's force in it), integrated in modal form (:func:`_contact_forced`);
+# they jump by the saltation matrix at the events as after an integrated step.  The
+# coefficients' columns need the mode's eigenvalues away from 0 (a frame without a spring
+# has a zero one: its contacts are then integrated in a run that carries them).
 
 _CONTACT_COND = 1e5  # the largest condition number of a mode's scaled eigenvectors
 _NE = 12  # a mode's complex constants per eigenvalue, :func:`_contact_setup`
-_NR = 5  # a mode's real constants, :func:`_contact_setup`
+_NR = 6  # a mode's real constants, :func:`_contact_setup`
 
 
 @njit(cache=True)
@@ -1052,7 +1055,8 @@ def _contact_setup(p, kc, mode, dsc, E, R):
     each eigenvalue ``j``, ``E[mi, j]`` holds its eigenvector ``v_j`` (4), the row ``j`` of
     ``V^-1`` (4), ``lambda_j``, ``beta_cj``, ``A_j``, ``A'_j``; ``R[mi]`` holds 1 where the
     mode has the closed form (else 0 and nothing else), the periodic parts' curvature bound
-    of its three switching functions, and the largest ``Re lambda``."""
+    of its three switching functions, the largest ``Re lambda`` and the smallest
+    ``|lambda|``."""
     mi = 0 if mode == LOAD else 1
     R[mi, 0] = 0.0
     w, g = p[5], p[6]
@@ -1093,6 +1097,7 @@ def _contact_setup(p, kc, mode, dsc, E, R):
             kf += abs(G) * (abs(E[mi, j, 10]) + abs(E[mi, j, 11]))
         R[mi, 1 + i] = 0.5 * w * w * kf
     R[mi, 4] = grow
+    R[mi, 5] = min(abs(lam[0]), abs(lam[1]), abs(lam[2]), abs(lam[3]))
     R[mi, 0] = 1.0
 
 
@@ -1152,20 +1157,80 @@ def _contact_phi(s, mi, E, out):
 
 
 @njit(cache=True)
-def _contact_sens(s, mi, E, S, phi, kF, cF, out_dF, k):
-    """Through ``s`` of the phase: ``S <- Phi(s) S`` (state columns only: the law's
-    coefficients are not among them); with ``k >= 0`` instead the force's and the
-    penetration's derivatives at ``s`` into ``out_dF[:, k]``, ``S`` kept."""
+def _eint(lj, mu, ej, emu, s):
+    """``int_0^s e^(lambda (s - u)) e^(mu u) du`` from ``ej = e^(lambda s)``, ``emu = e^(mu
+    s)`` (``s e^(lambda s) phi1((mu - lambda) s)`` near ``mu = lambda``)."""
+    d = mu - lj
+    x = d * s
+    if abs(x) < 1e-2:
+        return s * ej * _phi1(x, 0j)
+    return (emu - ej) / d
+
+
+@njit(cache=True)
+def _contact_forced(s, t0, w, mi, E, qm, m1, m2, ex, W):
+    """``W[0]``, ``W[1]``: the state's response at ``s`` of the phase (zero at its start) to a
+    force ``z``, and to a force ``zd``, added to the contact's: ``int_0^s Phi(s - u) e_F z(u)
+    du`` with ``e_F = (0, -1/m1, 0, 1/m2)``, a coefficient's column's forced part.  In modal
+    form each mode ``j`` integrates ``e^(lambda_j (s - u))`` against the modal solution's
+    exponentials, constant and drive (``E(lambda, mu) = int e^(lambda (s - u)) e^(mu u) du``);
+    the constant part ``beta s phi1(lambda s) = beta (e^(lambda s) - 1) / lambda`` needs a
+    mode's ``|lambda|`` away from 0 (the caller's check)."""
+    for j in range(4):
+        ex[j] = np.exp(E[mi, j, 8] * s)
+    ew0 = np.cos(w * t0) + 1j * np.sin(w * t0)
+    ews = np.cos(w * s) + 1j * np.sin(w * s)
+    for r in range(4):
+        W[0, r] = 0.0
+        W[1, r] = 0.0
+    for j in range(4):
+        lj, ej = E[mi, j, 8], ex[j]
+        e0 = _eint(lj, 0j, ej, 1.0 + 0j, s)
+        ep = _eint(lj, 1j * w, ej, ews, s)
+        em = _eint(lj, -1j * w, ej, np.conj(ews), s)
+        iz, iv = 0j, 0j
+        for q in range(4):
+            lq = E[mi, q, 8]
+            el = _eint(lj, lq, ej, ex[q], s)
+            drive = E[mi, q, 10] * ew0 * ep - E[mi, q, 11] * np.conj(ew0) * em
+            iq = qm[q, 0] * el + E[mi, q, 9] * (el - e0) / lq - 0.5j * drive
+            iz += (E[mi, q, 0] - E[mi, q, 2]) * iq
+            iv += (E[mi, q, 1] - E[mi, q, 3]) * iq
+        eps = E[mi, j, 7] / m2 - E[mi, j, 5] / m1
+        for r in range(4):
+            W[0, r] += (E[mi, j, r] * eps * iz).real
+            W[1, r] += (E[mi, j, r] * eps * iv).real
+
+
+@njit(cache=True)
+def _contact_sens(s, t0, mi, E, qm, p, S, spar, gcol, phi, ex, W, kF, cF, y, out_dF, k):
+    """Through ``s`` of the phase: ``S <- Phi(s) S``, plus ``gcol[0, j] W[0] + gcol[1, j]
+    W[1]`` for a coefficient's column ``j`` (``dF/dc = gcol[0, j] z + gcol[1, j] zd`` in this
+    mode, :func:`_contact_forced`); with ``k >= 0`` instead the force's and the
+    penetration's derivatives at ``s`` (the state ``y`` there) into ``out_dF[:, k]``, ``S``
+    kept."""
     _contact_phi(s, mi, E, phi)
     m = S.shape[1]
+    for j in range(m):
+        if spar[j] >= 0:
+            _contact_forced(s, t0, p[5], mi, E, qm, p[0], p[1], ex, W)
+            break
     for j in range(m):
         a0, a1, a2, a3 = S[0, j], S[1, j], S[2, j], S[3, j]
         b0 = phi[0, 0] * a0 + phi[0, 1] * a1 + phi[0, 2] * a2 + phi[0, 3] * a3
         b1 = phi[1, 0] * a0 + phi[1, 1] * a1 + phi[1, 2] * a2 + phi[1, 3] * a3
         b2 = phi[2, 0] * a0 + phi[2, 1] * a1 + phi[2, 2] * a2 + phi[2, 3] * a3
         b3 = phi[3, 0] * a0 + phi[3, 1] * a1 + phi[3, 2] * a2 + phi[3, 3] * a3
+        direct = 0.0
+        if spar[j] >= 0:
+            gz, gv = gcol[0, j], gcol[1, j]
+            b0 += gz * W[0, 0] + gv * W[1, 0]
+            b1 += gz * W[0, 1] + gv * W[1, 1]
+            b2 += gz * W[0, 2] + gv * W[1, 2]
+            b3 += gz * W[0, 3] + gv * W[1, 3]
+            direct = gz * (y[0] - y[2]) + gv * (y[1] - y[3])
         if k >= 0:
-            out_dF[j, k] = kF * (b0 - b2) + cF * (b1 - b3)
+            out_dF[j, k] = kF * (b0 - b2) + cF * (b1 - b3) + direct
             out_dF[m + j, k] = b0 - b2
         else:
             S[0, j], S[1, j], S[2, j], S[3, j] = b0, b1, b2, b3
@@ -1301,7 +1366,13 @@ def _contact(
     fd,
     ybuf,
     S,
-    phi,
+    spar,
+    coef,
+    ea,
+    eb,
+    br,
+    dc,
+    sw,
     t_eval,
     k_eval,
     out_y,
@@ -1318,11 +1389,25 @@ def _contact(
     hair of the absolute tolerances, or not leaving it: the integrator's steps); 4: advanced
     to ``t_new`` without an event, the integrator's steps next (the safeguard's interval
     budget ran out).  Writes the state, force and mode at ``t_eval[k_eval:]`` up to
-    ``t_new`` (and the force's derivatives with ``out_dF``); ``S`` (state columns only) moves
-    with the state."""
+    ``t_new`` (and the force's derivatives with ``out_dF``); ``S`` moves with the state
+    (``sw``: its work arrays, :func:`_contact_sens`).  A law coefficient's column needs the
+    mode's eigenvalues away from 0 (``|lambda| > 1e-3 w``), else the integrator's steps."""
     mi = 0 if mode == LOAD else 1
     if R[mi, 0] == 0.0:
         return 3, t, k_eval, -1
+    gcol, phi, W, ex = sw
+    m = S.shape[1]
+    for j in range(m):
+        if spar[j] >= 0 and not R[mi, 5] > 1e-3 * p[5]:
+            return 3, t, k_eval, -1
+    if m:
+        # dF/dc of each coefficient's column in this mode: gcol[0] z + gcol[1] zd
+        force_partials(mode, 1.0, 0.0, coef, ea, eb, br, dc)
+        for j in range(m):
+            gcol[0, j] = dc[spar[j]] if spar[j] >= 0 else 0.0
+        force_partials(mode, 0.0, 1.0, coef, ea, eb, br, dc)
+        for j in range(m):
+            gcol[1, j] = dc[spar[j]] if spar[j] >= 0 else 0.0
     for i in range(3):
         h, hd = _contact_h(i, mode, kc, t, y, p)
         f[i], fd[i] = h, hd
@@ -1350,13 +1435,16 @@ def _contact(
         out_f[k_eval] = k * (ybuf[0] - ybuf[2]) + c * (ybuf[1] - ybuf[3])
         out_mode[k_eval] = mode
         if out_dF.shape[1] > 0:
-            _contact_sens(max(t_eval[k_eval] - t, 0.0), mi, E, S, phi, k, c, out_dF, k_eval)
+            se = max(t_eval[k_eval] - t, 0.0)
+            _contact_sens(
+                se, t, mi, E, qm, p, S, spar, gcol, phi, ex, W, k, c, ybuf, out_dF, k_eval
+            )
         k_eval += 1
     _contact_state(s, t, w, mi, E, qm, ybuf)
     for j in range(4):
         y[j] = ybuf[j]
-    if S.shape[1] > 0:
-        _contact_sens(s, mi, E, S, phi, k, c, out_dF, -1)
+    if m:
+        _contact_sens(s, t, mi, E, qm, p, S, spar, gcol, phi, ex, W, k, c, ybuf, out_dF, -1)
     return code, t_new, k_eval, index
 
 
@@ -1457,9 +1545,6 @@ def integrate(
     # the contact in closed form where it applies (:func:`_contact`; not with sensitivities)
     kc = np.zeros(4)
     use_contact = _contact_law(p, coef, ea, eb, br, kc)
-    for j in range(m_s):
-        if spar[j] >= 0:
-            use_contact = False  # a coefficient's column: the contacts are integrated
     E = np.zeros((2, 4, _NE), dtype=np.complex128)
     R = np.zeros((2, _NR))
     if use_contact:
@@ -1467,7 +1552,8 @@ def integrate(
         _contact_setup(p, kc, UNLOAD, atol, E, R)
         use_contact = R[0, 0] != 0.0 or R[1, 0] != 0.0
     qm = np.empty((4, 2), dtype=np.complex128)
-    phi = np.empty((4, 4))
+    # the closed-form sensitivities' work arrays (:func:`_contact_sens`)
+    sw = (np.empty((2, m_s)), np.empty((4, 4)), np.empty((2, 4)), np.empty(4, dtype=np.complex128))
     cb = np.empty((3, 4))
     fc = np.empty(3)
     fcd = np.empty(3)
@@ -1540,7 +1626,13 @@ def integrate(
                 fcd,
                 ybuf,
                 S,
-                phi,
+                spar,
+                coef,
+                ea,
+                eb,
+                br,
+                dc,
+                sw,
                 t_eval,
                 k_eval,
                 out_y,
