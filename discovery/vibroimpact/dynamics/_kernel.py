@@ -930,10 +930,14 @@ def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mo
 # beta_sj / (iw - lambda_j)``, ``A'_j = beta_sj / (-iw - lambda_j)``) and ``u_j(s) =
 # e^(lambda_j s) u_j(0) + beta_cj s phi1(lambda_j s)`` (``phi1(x) = (e^x - 1) / x``: a zero
 # eigenvalue, a frame with ``k1 = 0``, needs no special case).  The decomposition is made once
-# per run and mode, of ``M`` in the state scaled by the absolute tolerances; a mode whose
-# scaled eigenvectors are ill-conditioned (condition above ``_CONTACT_COND``: near a
-# defective, critically damped pair, or a free frame ``k1 = c1 = 0``) or with an eigenvalue
-# within ``1e-9 w`` of the drive's ``+-iw`` (an undamped resonance) is integrated instead.
+# per run and mode (:func:`_contact_eig`: the eigenvalues are the roots of the two-mass
+# system's quartic ``det(lambda^2 Mass + lambda C + K)``, whose coefficients have no
+# cancellation, the eigenvectors its 2x2 null vectors; no LAPACK call, a few microseconds),
+# and checked in the state scaled by the absolute tolerances; a mode whose eigenpairs miss
+# their residual, whose scaled eigenvectors are ill-conditioned (condition above
+# ``_CONTACT_COND``: near a defective, critically damped pair, or a free frame ``k1 = c1 =
+# 0``) or with an eigenvalue within ``1e-9 w`` of the drive's ``+-iw`` (an undamped
+# resonance) is integrated instead.
 #
 # Every switching function of the two modes is linear in the state, ``h = gz z + gv zd``
 # (loss ``z``, unload ``zd`` or reload ``-zd``, release ``F``), and its first root is proven
@@ -1050,6 +1054,109 @@ def _contact_matrix(p, k, c, dsc, Ms):
 
 
 @njit(cache=True)
+def _quartic_roots(a3, a2, a1, a0, z):
+    """The roots of ``x^4 + a3 x^3 + a2 x^2 + a1 x + a0`` into ``z`` (complex, 4): the
+    Aberth-Ehrlich iteration on the polynomial scaled to roots of order 1 at most (the caller
+    checks the eigenpairs they give)."""
+    r = max(abs(a3), np.sqrt(abs(a2)), abs(a1) ** (1.0 / 3.0), np.sqrt(np.sqrt(abs(a0))))
+    if not r > 0.0:
+        for k in range(4):
+            z[k] = 0.0
+        return
+    b3, b2, b1, b0 = a3 / r, a2 / r**2, a1 / r**3, a0 / r**4
+    # the starts: the roots' sizes as the coefficients' ratios suggest (exact for widely
+    # separated roots), at spread angles
+    z[0] = abs(b3)
+    z[1] = abs(b2 / b3) if b3 != 0.0 else 1.0
+    z[2] = abs(b1 / b2) if b2 != 0.0 else 1.0
+    z[3] = abs(b0 / b1) if b1 != 0.0 else 1e-3
+    for k in range(4):
+        rad = min(max(z[k].real, 1e-8), 2.0)
+        z[k] = rad * np.exp(1j * (0.4 + 1.6 * k))
+    last = np.inf
+    for _ in range(100):
+        big = 0.0
+        for k in range(4):
+            x = z[k]
+            f = (((x + b3) * x + b2) * x + b1) * x + b0
+            df = ((4.0 * x + 3.0 * b3) * x + 2.0 * b2) * x + b1
+            if f == 0.0:
+                continue
+            s = 0j
+            for j in range(4):
+                if j != k:
+                    s += 1.0 / (x - z[j])
+            ratio = f / df if df != 0.0 else f
+            step = ratio / (1.0 - ratio * s)
+            z[k] = x - step
+            big = max(big, abs(step) / max(abs(z[k]), 1e-12))
+        # converged: the steps at rounding level, or no longer shrinking once small
+        if big < 4e-16 or (big < 1e-9 and big >= 0.5 * last):
+            break
+        last = big
+    for k in range(4):
+        z[k] *= r
+
+
+@njit(cache=True)
+def _contact_eig(p, k, c, lam, V):
+    """The eigenvalues ``lam`` and eigenvectors ``V`` (columns, in the state's order) of a
+    contact mode's system (force ``k z + c zd``): the roots of ``det(lambda^2 Mass + lambda C +
+    K)``, whose coefficients are sums of non-negative terms for non-negative parameters
+    (``k1 k / (m1 m2)``, ...: no cancellation), and each root's null vector ``x`` of that
+    2x2 matrix, ``v = (x1, lambda x1, x2, lambda x2)``."""
+    m1, m2, k1, c1 = p[0], p[1], p[2], p[3]
+    a3 = (c1 + c) / m1 + c / m2
+    a2 = (k1 + k) / m1 + k / m2 + c1 * c / (m1 * m2)
+    a1 = (c1 * k + c * k1) / (m1 * m2)
+    a0 = k1 * k / (m1 * m2)
+    _quartic_roots(a3, a2, a1, a0, lam)
+    for j in range(4):
+        la = lam[j]
+        q11 = la * la + la * (c1 + c) / m1 + (k1 + k) / m1
+        q12 = -(la * c + k) / m1
+        q21 = -(la * c + k) / m2
+        q22 = la * la + la * c / m2 + k / m2
+        if abs(q11) + abs(q12) >= abs(q21) + abs(q22):
+            x1, x2 = -q12, q11
+        else:
+            x1, x2 = q22, -q21
+        V[0, j], V[1, j], V[2, j], V[3, j] = x1, la * x1, x2, la * x2
+
+
+@njit(cache=True)
+def _contact_eig_scaled(p, k, c, dsc, Ms, lam, Vs):
+    """The eigen-decomposition of ``Ms`` (:func:`_contact_matrix`) by :func:`_contact_eig`,
+    its eigenvectors scaled by ``D^-1`` and normalised; False if a pair misses ``Ms v = lambda
+    v`` by more than 1e-12 of ``|Ms|``."""
+    _contact_eig(p, k, c, lam, Vs)
+    nm = 0.0
+    for r in range(4):
+        for q in range(4):
+            nm += abs(Ms[r, q]) ** 2
+    nm = np.sqrt(nm)
+    for j in range(4):
+        n = 0.0
+        for r in range(4):
+            Vs[r, j] /= dsc[r]
+            n += abs(Vs[r, j]) ** 2
+        n = np.sqrt(n)
+        if not n > 0.0:
+            return False
+        for r in range(4):
+            Vs[r, j] /= n
+        res = 0.0
+        for r in range(4):
+            acc = -lam[j] * Vs[r, j]
+            for q in range(4):
+                acc += Ms[r, q] * Vs[q, j]
+            res += abs(acc) ** 2
+        if not np.sqrt(res) <= 1e-12 * nm:
+            return False
+    return True
+
+
+@njit(cache=True)
 def _contact_setup(p, kc, mode, dsc, E, R):
     """The closed form's constants of a contact mode (``mi = 0`` loading, 1 unloading): for
     each eigenvalue ``j``, ``E[mi, j]`` holds its eigenvector ``v_j`` (4), the row ``j`` of
@@ -1063,7 +1170,10 @@ def _contact_setup(p, kc, mode, dsc, E, R):
     Ms = np.empty((4, 4), dtype=np.complex128)
     if not _contact_matrix(p, kc[2 * mi], kc[2 * mi + 1], dsc, Ms):
         return
-    lam, Vs = np.linalg.eig(Ms)
+    lam = np.empty(4, dtype=np.complex128)
+    Vs = np.empty((4, 4), dtype=np.complex128)
+    if not _contact_eig_scaled(p, kc[2 * mi], kc[2 * mi + 1], dsc, Ms, lam, Vs):
+        return
     Vis = np.empty((4, 4), dtype=np.complex128)
     if not _cinv4(Vs, Vis):
         return
