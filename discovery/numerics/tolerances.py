@@ -7,10 +7,12 @@ import numpy as np
 from .._validate import Real, check
 from ..errors import InputError
 
-__all__ = ["Tolerances", "FREE_FLIGHT"]
+__all__ = ["Tolerances", "FREE_FLIGHT", "CONTACT"]
 
 #: the vibro-impact kernel's free-flight paths (:attr:`Tolerances.free_flight`)
 FREE_FLIGHT = ("closed", "integrate")
+#: the vibro-impact kernel's contact paths (:attr:`Tolerances.contact`)
+CONTACT = ("closed", "integrate")
 
 
 @dataclass(frozen=True)
@@ -35,6 +37,13 @@ class Tolerances:
         (supports without a cubic term; otherwise the integrator's steps), and integrates
         only the contact; ``"integrate"`` takes the integrator's steps throughout (the
         cross-check path).  Ueda's oscillators ignore it.
+    contact : {"closed", "integrate"}
+        The vibro-impact kernel's loading and unloading phases: ``"closed"`` (default)
+        advances them in closed form to the next event, sensitivities included (a linear
+        law, ``k z + c zd``, with nothing else acting during the contact; otherwise the
+        integrator's steps); ``"integrate"`` takes the integrator's steps (the
+        cross-check path).  Only with ``free_flight="closed"``: ``free_flight="integrate"``
+        integrates the contacts too.  Ueda's oscillators ignore it.
     """
 
     rtol: float = 1e-9
@@ -42,6 +51,7 @@ class Tolerances:
     max_steps: int = 2_000_000
     hmax_fraction: float = 0.02
     free_flight: str = "closed"
+    contact: str = "closed"
 
     def __post_init__(self):
         for name, spec in (
@@ -63,6 +73,8 @@ class Tolerances:
             raise InputError(
                 f"free_flight must be one of {', '.join(FREE_FLIGHT)}, got {self.free_flight!r}"
             )
+        if self.contact not in CONTACT:
+            raise InputError(f"contact must be one of {', '.join(CONTACT)}, got {self.contact!r}")
 
     def atol(self, scale):
         """Absolute tolerances ``rtol * atol_scale * scale`` for states of size ``scale``."""
@@ -82,4 +94,5 @@ class Tolerances:
             "hmax_fraction": self.hmax_fraction,
             "method": "dopri5+events",
             "free_flight": self.free_flight,
+            "contact": self.contact,
         }

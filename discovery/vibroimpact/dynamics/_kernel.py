@@ -39,10 +39,19 @@ within ``1e-3 hmax`` of the last) stop the run as chattering.
 
 Free flight: by default (``p[P_FLIGHT] = 1``, :attr:`Tolerances.free_flight` ``"closed"``)
 the free mode is not stepped: the flight is advanced in closed form to the first root of
-the exact penetration, bracketed by a proven bound (:func:`_flight`), and only the contact
-is integrated.  Supports with a cubic term, ``k1 <= 0`` or ``c1 < 0``, and a start across
-the surface that is not closing take the integrator's steps, as does every free flight with
-``p[P_FLIGHT] = 0`` (the cross-check path).
+the exact penetration, bracketed by a proven bound (:func:`_flight`).  Supports with a cubic
+term, ``k1 <= 0`` or ``c1 < 0``, and a start across the surface that is not closing take the
+integrator's steps, as does every free flight with ``p[P_FLIGHT] = 0`` (the cross-check
+path).
+
+Contact: by default (``p[P_CONTACT] = 1``, :attr:`Tolerances.contact` ``"closed"``, only
+with closed-form flights) a linear law's loading and unloading phases (``F = k z + c zd``,
+nothing else acting during the contact) are not stepped either: each is advanced by its
+modal solution to the first root of its switching functions, bracketed by a proven bound
+(:func:`_contact`).  Other laws, the clipped mode, a mode whose eigenvectors are
+ill-conditioned, a start across a switching surface, a law coefficient's sensitivities in
+a mode with a zero eigenvalue (``k1 = 0``) and every contact with ``p[P_CONTACT] = 0`` take
+the integrator's steps; the sensitivities follow the closed form too.
 
 Compilation: numba inlines an ``inline="always"`` function in its own IR and types the
 body again at every call site, so a chain of inlined functions costs compile time by the
@@ -81,8 +90,10 @@ OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW, CHATTER = 0, 1, 2, 3, 4
 # copy: :func:`kernel_params`).  A law whose velocity terms are scaled by each impact's
 # approach velocity (``p[P_VSCALE] = 1``: Lankarani-Nikravesh, Flores) divides their
 # coefficients by ``p[P_V0]``, the current contact's penetration rate at its onset (a
-# second contact state, set at every onset).
-P_K3, P_LOSS, P_SET, P_ZMAX, P_FLIGHT, P_V0, P_VSCALE, N_PARAMS = 7, 8, 9, 10, 11, 12, 13, 14
+# second contact state, set at every onset).  ``p[P_CONTACT] = 1`` advances the contact in
+# closed form where it applies (0: the integrator's steps).
+P_K3, P_LOSS, P_SET, P_ZMAX, P_FLIGHT, P_V0, P_VSCALE = 7, 8, 9, 10, 11, 12, 13
+P_CONTACT, N_PARAMS = 14, 15
 
 # chattering: more than _ZENO_EVENTS located events in a row, each within
 # _ZENO_GAP * hmax of the previous one (mode switches that hardly advance time)
@@ -909,6 +920,644 @@ def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mo
     return code, t_new, k_eval
 
 
+# ---- the contact in closed form.  With a linear law (loading ``F = k z + c zd``, unloading
+# ``F = k' z + c' zd``: terms ``z`` and ``zd`` only) and nothing else acting during the
+# contact (no cubic support, mass loss, permanent set or impact-scaled terms), the loading and
+# the unloading modes are linear systems ``y' = M y + b_c + b_s sin(w t)`` (``b_c`` gravity,
+# ``b_s`` the drive on the frame).  With ``M = V diag(lambda) V^-1`` the modal coordinates
+# ``q = V^-1 y`` decouple: ``q_j' = lambda_j q_j + beta_cj + beta_sj sin(w t)``, and ``q_j =
+# u_j + q_sj(t)`` with the periodic part ``q_sj = (A_j e^(iwt) - A'_j e^(-iwt)) / 2i`` (``A_j =
+# beta_sj / (iw - lambda_j)``, ``A'_j = beta_sj / (-iw - lambda_j)``) and ``u_j(s) =
+# e^(lambda_j s) u_j(0) + beta_cj s phi1(lambda_j s)`` (``phi1(x) = (e^x - 1) / x``: a zero
+# eigenvalue, a frame with ``k1 = 0``, needs no special case).  The decomposition is made once
+# per run and mode (:func:`_contact_eig`: the eigenvalues are the roots of the two-mass
+# system's quartic ``det(lambda^2 Mass + lambda C + K)``, whose coefficients have no
+# cancellation, the eigenvectors its 2x2 null vectors; no LAPACK call, a few microseconds),
+# and checked in the state scaled by the absolute tolerances; a mode whose eigenpairs miss
+# their residual, whose scaled eigenvectors are ill-conditioned (condition above
+# ``_CONTACT_COND``: near a defective, critically damped pair, or a free frame ``k1 = c1 =
+# 0``) or with an eigenvalue within ``1e-9 w`` of the drive's ``+-iw`` (an undamped
+# resonance) is integrated instead.
+#
+# Every switching function of the two modes is linear in the state, ``h = gz z + gv zd``
+# (loss ``z``, unload ``zd`` or reload ``-zd``, release ``F``), and its first root is proven
+# as the flight's onset: over ``[a, a + H]``, ``|h''| <= K = sum_j |G_j| (|lambda_j| |d_j|
+# max(e^(Re lambda_j a), e^(Re lambda_j (a + H))) + w^2 (|A_j| + |A'_j|) / 2)`` with ``G_j =
+# g . v_j`` and ``d_j = u_j'(0)`` (``u_j'' = lambda_j e^(lambda_j s) d_j``, ``q_sj'' = -w^2
+# q_sj``), so ``h >= h(a) + h'(a) tau - K tau^2 / 2`` there and no interval is passed unless
+# that stays positive over it for every function.  A mode with a growing eigenvalue (``Re
+# lambda > 0``, a law with negative coefficients) caps the intervals at ``1 / Re lambda``.
+# The first root is polished by safeguarded Newton on the closed form; the event is recorded at
+# the last point of the phase (every switching function still >= 0) within the time's
+# resolution of it.
+#
+# Sensitivities move by the transition matrix, ``S <- Re(V diag(e^(lambda s)) V^-1) S``, and
+# a law coefficient's column gains the response to its force term (``z`` or ``zd``, the
+# derivative of the mode's force in it), integrated in modal form (:func:`_contact_forced`);
+# they jump by the saltation matrix at the events as after an integrated step.  The
+# coefficients' columns need the mode's eigenvalues away from 0 (a frame without a spring
+# has a zero one: its contacts are then integrated in a run that carries them).
+
+_CONTACT_COND = 1e5  # the largest condition number of a mode's scaled eigenvectors
+_NE = 12  # a mode's complex constants per eigenvalue, :func:`_contact_setup`
+_NR = 6  # a mode's real constants, :func:`_contact_setup`
+
+
+@njit(cache=True)
+def _contact_law(p, coef, ea, eb, br, kc):
+    """Whether the contact has the closed form: requested (``p[P_CONTACT] = 1``), a linear
+    law and nothing else acting during the contact (see above); fills ``kc`` with the
+    loading force's ``(k, c)``, then the unloading force's."""
+    if p[P_CONTACT] == 0.0 or p[P_K3] != 0.0 or p[P_LOSS] != 0.0:
+        return False
+    if p[P_SET] != 0.0 or p[P_VSCALE] != 0.0:
+        return False
+    if not (p[0] > 0.0 and p[1] > 0.0 and p[5] > 0.0):
+        return False
+    for j in range(4):
+        kc[j] = 0.0
+    for i in range(coef.shape[0]):
+        if ea[i] == 1.0 and eb[i] == 0.0:
+            if br[i] == 0.0:
+                kc[0] += coef[i]  # the elastic part acts in both branches
+            kc[2] += coef[i]
+        elif ea[i] == 0.0 and eb[i] == 1.0:
+            kc[1 if br[i] == 0.0 else 3] += coef[i]
+        else:
+            return False
+    for j in range(4):
+        if not np.isfinite(kc[j]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _contact_g(mode, kc, i):
+    """Switching function ``i`` of a contact mode as ``(gz, gv)``: ``h = gz z + gv zd``
+    (loss, unload or reload, release: as :func:`_switching`)."""
+    if i == 0:
+        return 1.0, 0.0
+    if i == 1:
+        return 0.0, (1.0 if mode == LOAD else -1.0)
+    if mode == LOAD:
+        return kc[0], kc[1]
+    return kc[2], kc[3]
+
+
+@njit(cache=True)
+def _cinv4(A, out):
+    """``out = A^-1`` of a complex 4x4 by Gauss-Jordan with partial pivoting; False if a
+    pivot vanishes (singular to working precision)."""
+    W = A.copy()
+    for r in range(4):
+        for c in range(4):
+            out[r, c] = 1.0 if r == c else 0.0
+    for c in range(4):
+        piv, big = c, abs(W[c, c])
+        for r in range(c + 1, 4):
+            if abs(W[r, c]) > big:
+                piv, big = r, abs(W[r, c])
+        if not big > 1e-300:
+            return False
+        for k in range(4):
+            W[c, k], W[piv, k] = W[piv, k], W[c, k]
+            out[c, k], out[piv, k] = out[piv, k], out[c, k]
+        d = W[c, c]
+        for k in range(4):
+            W[c, k] /= d
+            out[c, k] /= d
+        for r in range(4):
+            if r != c:
+                m = W[r, c]
+                for k in range(4):
+                    W[r, k] -= m * W[c, k]
+                    out[r, k] -= m * out[c, k]
+    return True
+
+
+@njit(cache=True)
+def _contact_matrix(p, k, c, dsc, Ms):
+    """``Ms = D^-1 M D``: the contact mode's system matrix (force ``k z + c zd``) in the state
+    scaled by ``D = diag(dsc)``; False if not finite."""
+    m1, m2, k1, c1 = p[0], p[1], p[2], p[3]
+    M = np.zeros((4, 4))
+    M[0, 1] = 1.0
+    M[1, 0], M[1, 1], M[1, 2], M[1, 3] = -(k1 + k) / m1, -(c1 + c) / m1, k / m1, c / m1
+    M[2, 3] = 1.0
+    M[3, 0], M[3, 1], M[3, 2], M[3, 3] = k / m2, c / m2, -k / m2, -c / m2
+    for r in range(4):
+        for q in range(4):
+            if not np.isfinite(M[r, q]):
+                return False
+            Ms[r, q] = M[r, q] * dsc[q] / dsc[r]
+    return True
+
+
+@njit(cache=True)
+def _quartic_roots(a3, a2, a1, a0, z):
+    """The roots of ``x^4 + a3 x^3 + a2 x^2 + a1 x + a0`` into ``z`` (complex, 4): the
+    Aberth-Ehrlich iteration on the polynomial scaled to roots of order 1 at most (the caller
+    checks the eigenpairs they give)."""
+    r = max(abs(a3), np.sqrt(abs(a2)), abs(a1) ** (1.0 / 3.0), np.sqrt(np.sqrt(abs(a0))))
+    if not r > 0.0:
+        for k in range(4):
+            z[k] = 0.0
+        return
+    b3, b2, b1, b0 = a3 / r, a2 / r**2, a1 / r**3, a0 / r**4
+    # the starts: the roots' sizes as the coefficients' ratios suggest (exact for widely
+    # separated roots), at spread angles
+    z[0] = abs(b3)
+    z[1] = abs(b2 / b3) if b3 != 0.0 else 1.0
+    z[2] = abs(b1 / b2) if b2 != 0.0 else 1.0
+    z[3] = abs(b0 / b1) if b1 != 0.0 else 1e-3
+    for k in range(4):
+        rad = min(max(z[k].real, 1e-8), 2.0)
+        z[k] = rad * np.exp(1j * (0.4 + 1.6 * k))
+    last = np.inf
+    for _ in range(100):
+        big = 0.0
+        for k in range(4):
+            x = z[k]
+            f = (((x + b3) * x + b2) * x + b1) * x + b0
+            df = ((4.0 * x + 3.0 * b3) * x + 2.0 * b2) * x + b1
+            if f == 0.0:
+                continue
+            s = 0j
+            for j in range(4):
+                if j != k:
+                    s += 1.0 / (x - z[j])
+            ratio = f / df if df != 0.0 else f
+            step = ratio / (1.0 - ratio * s)
+            z[k] = x - step
+            big = max(big, abs(step) / max(abs(z[k]), 1e-12))
+        # converged: the steps at rounding level, or no longer shrinking once small
+        if big < 4e-16 or (big < 1e-9 and big >= 0.5 * last):
+            break
+        last = big
+    for k in range(4):
+        z[k] *= r
+
+
+@njit(cache=True)
+def _contact_eig(p, k, c, lam, V):
+    """The eigenvalues ``lam`` and eigenvectors ``V`` (columns, in the state's order) of a
+    contact mode's system (force ``k z + c zd``): the roots of ``det(lambda^2 Mass + lambda C +
+    K)``, whose coefficients are sums of non-negative terms for non-negative parameters
+    (``k1 k / (m1 m2)``, ...: no cancellation), and each root's null vector ``x`` of that
+    2x2 matrix, ``v = (x1, lambda x1, x2, lambda x2)``."""
+    m1, m2, k1, c1 = p[0], p[1], p[2], p[3]
+    a3 = (c1 + c) / m1 + c / m2
+    a2 = (k1 + k) / m1 + k / m2 + c1 * c / (m1 * m2)
+    a1 = (c1 * k + c * k1) / (m1 * m2)
+    a0 = k1 * k / (m1 * m2)
+    _quartic_roots(a3, a2, a1, a0, lam)
+    for j in range(4):
+        la = lam[j]
+        q11 = la * la + la * (c1 + c) / m1 + (k1 + k) / m1
+        q12 = -(la * c + k) / m1
+        q21 = -(la * c + k) / m2
+        q22 = la * la + la * c / m2 + k / m2
+        if abs(q11) + abs(q12) >= abs(q21) + abs(q22):
+            x1, x2 = -q12, q11
+        else:
+            x1, x2 = q22, -q21
+        V[0, j], V[1, j], V[2, j], V[3, j] = x1, la * x1, x2, la * x2
+
+
+@njit(cache=True)
+def _contact_eig_scaled(p, k, c, dsc, Ms, lam, Vs):
+    """The eigen-decomposition of ``Ms`` (:func:`_contact_matrix`) by :func:`_contact_eig`,
+    its eigenvectors scaled by ``D^-1`` and normalised; False if a pair misses ``Ms v = lambda
+    v`` by more than 1e-12 of ``|Ms|``."""
+    _contact_eig(p, k, c, lam, Vs)
+    nm = 0.0
+    for r in range(4):
+        for q in range(4):
+            nm += abs(Ms[r, q]) ** 2
+    nm = np.sqrt(nm)
+    for j in range(4):
+        n = 0.0
+        for r in range(4):
+            Vs[r, j] /= dsc[r]
+            n += abs(Vs[r, j]) ** 2
+        n = np.sqrt(n)
+        if not n > 0.0:
+            return False
+        for r in range(4):
+            Vs[r, j] /= n
+        res = 0.0
+        for r in range(4):
+            acc = -lam[j] * Vs[r, j]
+            for q in range(4):
+                acc += Ms[r, q] * Vs[q, j]
+            res += abs(acc) ** 2
+        if not np.sqrt(res) <= 1e-12 * nm:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _contact_setup(p, kc, mode, dsc, E, R):
+    """The closed form's constants of a contact mode (``mi = 0`` loading, 1 unloading): for
+    each eigenvalue ``j``, ``E[mi, j]`` holds its eigenvector ``v_j`` (4), the row ``j`` of
+    ``V^-1`` (4), ``lambda_j``, ``beta_cj``, ``A_j``, ``A'_j``; ``R[mi]`` holds 1 where the
+    mode has the closed form (else 0 and nothing else), the periodic parts' curvature bound
+    of its three switching functions, the largest ``Re lambda`` and the smallest
+    ``|lambda|``."""
+    mi = 0 if mode == LOAD else 1
+    R[mi, 0] = 0.0
+    w, g = p[5], p[6]
+    Ms = np.empty((4, 4), dtype=np.complex128)
+    if not _contact_matrix(p, kc[2 * mi], kc[2 * mi + 1], dsc, Ms):
+        return
+    lam = np.empty(4, dtype=np.complex128)
+    Vs = np.empty((4, 4), dtype=np.complex128)
+    if not _contact_eig_scaled(p, kc[2 * mi], kc[2 * mi + 1], dsc, Ms, lam, Vs):
+        return
+    Vis = np.empty((4, 4), dtype=np.complex128)
+    if not _cinv4(Vs, Vis):
+        return
+    n1, n2 = 0.0, 0.0
+    for r in range(4):
+        for q in range(4):
+            n1 += abs(Vs[r, q]) ** 2
+            n2 += abs(Vis[r, q]) ** 2
+    if not np.sqrt(n1 * n2) <= _CONTACT_COND:
+        return
+    grow = -np.inf
+    for j in range(4):
+        la = lam[j]
+        dp, dm = 1j * w - la, -1j * w - la
+        if not (abs(dp) > 1e-9 * w and abs(dm) > 1e-9 * w):
+            return
+        for r in range(4):
+            E[mi, j, r] = Vs[r, j] * dsc[r]
+            E[mi, j, 4 + r] = Vis[j, r] / dsc[r]
+        beta_s = -E[mi, j, 5] * p[4] / p[0]  # the drive -A sin(w t) / m1 on v1
+        E[mi, j, 8] = la
+        E[mi, j, 9] = -g * (E[mi, j, 5] + E[mi, j, 7])  # gravity on v1 and v2
+        E[mi, j, 10] = beta_s / dp
+        E[mi, j, 11] = beta_s / dm
+        grow = max(grow, la.real)
+    for i in range(3):
+        gz, gv = _contact_g(mode, kc, i)
+        kf = 0.0
+        for j in range(4):
+            G = gz * (E[mi, j, 0] - E[mi, j, 2]) + gv * (E[mi, j, 1] - E[mi, j, 3])
+            kf += abs(G) * (abs(E[mi, j, 10]) + abs(E[mi, j, 11]))
+        R[mi, 1 + i] = 0.5 * w * w * kf
+    R[mi, 4] = grow
+    R[mi, 5] = min(abs(lam[0]), abs(lam[1]), abs(lam[2]), abs(lam[3]))
+    R[mi, 0] = 1.0
+
+
+@njit(cache=True, inline="always")
+def _phi1(x, ex):
+    """``(e^x - 1) / x`` (1 at 0) for a complex ``x`` with ``ex = e^x``, without cancellation
+    near 0."""
+    if abs(x) < 1e-2:
+        return 1.0 + x * (1.0 + x * (1.0 + x * (1.0 + x * (1.0 + x / 6.0) / 5.0) / 4.0) / 3.0) / 2.0
+    return (ex - 1.0) / x
+
+
+@njit(cache=True)
+def _contact_start(t0, y, mi, w, E, qm):
+    """The phase's modal data from ``(t0, y)``: ``qm[j] = (u_j(0), d_j)``, ``d_j = lambda_j
+    u_j(0) + beta_cj`` (``u_j``'s rate at the start)."""
+    ew = np.cos(w * t0) + 1j * np.sin(w * t0)
+    for j in range(4):
+        q = 0j
+        for r in range(4):
+            q += E[mi, j, 4 + r] * y[r]
+        u0 = q + 0.5j * (E[mi, j, 10] * ew - E[mi, j, 11] * np.conj(ew))
+        qm[j, 0] = u0
+        qm[j, 1] = E[mi, j, 8] * u0 + E[mi, j, 9]
+
+
+@njit(cache=True)
+def _contact_state(s, t0, w, mi, E, qm, out):
+    """The state ``s`` after the phase's start (at ``t0``) into ``out``."""
+    tt = t0 + s
+    ew = np.cos(w * tt) + 1j * np.sin(w * tt)
+    a0, a1, a2, a3 = 0j, 0j, 0j, 0j
+    for j in range(4):
+        x = E[mi, j, 8] * s
+        ex = np.exp(x)
+        q = ex * qm[j, 0] + E[mi, j, 9] * s * _phi1(x, ex)
+        q -= 0.5j * (E[mi, j, 10] * ew - E[mi, j, 11] * np.conj(ew))
+        a0 += E[mi, j, 0] * q
+        a1 += E[mi, j, 1] * q
+        a2 += E[mi, j, 2] * q
+        a3 += E[mi, j, 3] * q
+    out[0], out[1], out[2], out[3] = a0.real, a1.real, a2.real, a3.real
+
+
+@njit(cache=True)
+def _contact_phi(s, mi, E, out):
+    """The mode's transition matrix ``Phi(s) = V diag(e^(lambda s)) V^-1`` into ``out``."""
+    for r in range(4):
+        for q in range(4):
+            out[r, q] = 0.0
+    for j in range(4):
+        ej = np.exp(E[mi, j, 8] * s)
+        for r in range(4):
+            vr = E[mi, j, r] * ej
+            for q in range(4):
+                out[r, q] += (vr * E[mi, j, 4 + q]).real
+
+
+@njit(cache=True)
+def _eint(lj, mu, ej, emu, s):
+    """``int_0^s e^(lambda (s - u)) e^(mu u) du`` from ``ej = e^(lambda s)``, ``emu = e^(mu
+    s)`` (``s e^(lambda s) phi1((mu - lambda) s)`` near ``mu = lambda``)."""
+    d = mu - lj
+    x = d * s
+    if abs(x) < 1e-2:
+        return s * ej * _phi1(x, 0j)
+    return (emu - ej) / d
+
+
+@njit(cache=True)
+def _contact_forced(s, t0, w, mi, E, qm, m1, m2, ex, W):
+    """``W[0]``, ``W[1]``: the state's response at ``s`` of the phase (zero at its start) to a
+    force ``z``, and to a force ``zd``, added to the contact's: ``int_0^s Phi(s - u) e_F z(u)
+    du`` with ``e_F = (0, -1/m1, 0, 1/m2)``, a coefficient's column's forced part.  In modal
+    form each mode ``j`` integrates ``e^(lambda_j (s - u))`` against the modal solution's
+    exponentials, constant and drive (``E(lambda, mu) = int e^(lambda (s - u)) e^(mu u) du``);
+    the constant part ``beta s phi1(lambda s) = beta (e^(lambda s) - 1) / lambda`` needs a
+    mode's ``|lambda|`` away from 0 (the caller's check)."""
+    for j in range(4):
+        ex[j] = np.exp(E[mi, j, 8] * s)
+    ew0 = np.cos(w * t0) + 1j * np.sin(w * t0)
+    ews = np.cos(w * s) + 1j * np.sin(w * s)
+    for r in range(4):
+        W[0, r] = 0.0
+        W[1, r] = 0.0
+    for j in range(4):
+        lj, ej = E[mi, j, 8], ex[j]
+        e0 = _eint(lj, 0j, ej, 1.0 + 0j, s)
+        ep = _eint(lj, 1j * w, ej, ews, s)
+        em = _eint(lj, -1j * w, ej, np.conj(ews), s)
+        iz, iv = 0j, 0j
+        for q in range(4):
+            lq = E[mi, q, 8]
+            el = _eint(lj, lq, ej, ex[q], s)
+            drive = E[mi, q, 10] * ew0 * ep - E[mi, q, 11] * np.conj(ew0) * em
+            iq = qm[q, 0] * el + E[mi, q, 9] * (el - e0) / lq - 0.5j * drive
+            iz += (E[mi, q, 0] - E[mi, q, 2]) * iq
+            iv += (E[mi, q, 1] - E[mi, q, 3]) * iq
+        eps = E[mi, j, 7] / m2 - E[mi, j, 5] / m1
+        for r in range(4):
+            W[0, r] += (E[mi, j, r] * eps * iz).real
+            W[1, r] += (E[mi, j, r] * eps * iv).real
+
+
+@njit(cache=True)
+def _contact_sens(s, t0, mi, E, qm, p, S, spar, gcol, phi, ex, W, kF, cF, y, out_dF, k):
+    """Through ``s`` of the phase: ``S <- Phi(s) S``, plus ``gcol[0, j] W[0] + gcol[1, j]
+    W[1]`` for a coefficient's column ``j`` (``dF/dc = gcol[0, j] z + gcol[1, j] zd`` in this
+    mode, :func:`_contact_forced`); with ``k >= 0`` instead the force's and the
+    penetration's derivatives at ``s`` (the state ``y`` there) into ``out_dF[:, k]``, ``S``
+    kept."""
+    _contact_phi(s, mi, E, phi)
+    m = S.shape[1]
+    for j in range(m):
+        if spar[j] >= 0:
+            _contact_forced(s, t0, p[5], mi, E, qm, p[0], p[1], ex, W)
+            break
+    for j in range(m):
+        a0, a1, a2, a3 = S[0, j], S[1, j], S[2, j], S[3, j]
+        b0 = phi[0, 0] * a0 + phi[0, 1] * a1 + phi[0, 2] * a2 + phi[0, 3] * a3
+        b1 = phi[1, 0] * a0 + phi[1, 1] * a1 + phi[1, 2] * a2 + phi[1, 3] * a3
+        b2 = phi[2, 0] * a0 + phi[2, 1] * a1 + phi[2, 2] * a2 + phi[2, 3] * a3
+        b3 = phi[3, 0] * a0 + phi[3, 1] * a1 + phi[3, 2] * a2 + phi[3, 3] * a3
+        direct = 0.0
+        if spar[j] >= 0:
+            gz, gv = gcol[0, j], gcol[1, j]
+            b0 += gz * W[0, 0] + gv * W[1, 0]
+            b1 += gz * W[0, 1] + gv * W[1, 1]
+            b2 += gz * W[0, 2] + gv * W[1, 2]
+            b3 += gz * W[0, 3] + gv * W[1, 3]
+            direct = gz * (y[0] - y[2]) + gv * (y[1] - y[3])
+        if k >= 0:
+            out_dF[j, k] = kF * (b0 - b2) + cF * (b1 - b3) + direct
+            out_dF[m + j, k] = b0 - b2
+        else:
+            S[0, j], S[1, j], S[2, j], S[3, j] = b0, b1, b2, b3
+
+
+@njit(cache=True)
+def _contact_h(i, mode, kc, t, y, p):
+    """Switching function ``i`` of a contact mode and its rate at ``(t, y)``."""
+    gz, gv = _contact_g(mode, kc, i)
+    k, c = (kc[0], kc[1]) if mode == LOAD else (kc[2], kc[3])
+    z, zd = y[0] - y[2], y[1] - y[3]
+    f = k * z + c * zd
+    a1 = -(p[3] * y[1] + p[2] * y[0] + p[4] * np.sin(p[5] * t) + p[0] * p[6] + f) / p[0]
+    a2 = f / p[1] - p[6]
+    return gz * z + gv * zd, gz * zd + gv * (a1 - a2)
+
+
+@njit(cache=True)
+def _contact_gap(f, fd, K):
+    """The positive root of ``f + fd tau - K tau^2 / 2`` (``f >= 0``): how far a function at
+    ``f`` with rate ``fd`` and curvature at least ``-K`` stays positive."""
+    if not K > 1e-300:
+        K = 1e-300
+    if f <= 0.0 and fd <= 0.0:
+        return 0.0
+    disc = np.sqrt(fd * fd + 2.0 * K * f)
+    return (fd + disc) / K if fd > 0.0 else 2.0 * f / (disc - fd)
+
+
+@njit(cache=True)
+def _time_res(t, w):
+    """The time resolution at ``t``: a few units in the last place of the absolute time, and
+    at least 1e-15 of the drive period."""
+    return 4.0e-16 * max(abs(t), 2.0 * np.pi / w)
+
+
+@njit(cache=True)
+def _contact_polish(i, mode, a, b, hb, hdb, t0, p, kc, mi, E, qm, ybuf):
+    """The first root of switching function ``i`` in ``[a, b]`` (``h(a) >= 0 > h(b) = hb``,
+    rate ``hdb``; no root in ``[a, b)`` but the crossing's): safeguarded Newton to the
+    time's resolution.  The point returned is the last one on the function's side (``h >=
+    0``), within that resolution of the root: a phase's event state keeps every function of
+    its mode at ``>= 0`` (the penetration and the force have their signs up to the end of
+    the contact, as its left limits must), and the next mode starts a hair across its own
+    surface at most, leaving it."""
+    w = p[5]
+    lo, hi = a, b
+    s, hs, hds = b, hb, hdb
+    for _ in range(200):
+        res = _time_res(t0 + hi, w)
+        if hi - lo <= res:
+            break
+        c = s - hs / hds if hds < 0.0 else 0.5 * (lo + hi)
+        if not (lo < c < hi):
+            c = 0.5 * (lo + hi)
+        if abs(c - s) <= res:
+            # Newton has converged from one side: probe just across to close the bracket
+            c = s - res if hs < 0.0 else s + res
+            if not (lo < c < hi):
+                c = 0.5 * (lo + hi)
+        _contact_state(c, t0, w, mi, E, qm, ybuf)
+        hc, hdc = _contact_h(i, mode, kc, t0 + c, ybuf, p)
+        if hc < 0.0:
+            hi = c
+        else:
+            lo = c
+        s, hs, hds = c, hc, hdc
+    return lo
+
+
+@njit(cache=True)
+def _contact_bound(i, mi, a, hcap, E, R, cb):
+    """The curvature bound ``K`` of switching function ``i`` over ``[a, a + hcap]``."""
+    K = R[mi, 1 + i]
+    for j in range(4):
+        re = E[mi, j, 8].real
+        K += cb[i, j] * max(np.exp(re * a), np.exp(re * (a + hcap)))
+    return K
+
+
+@njit(cache=True)
+def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf):
+    """The first event in ``(0, s_end]`` of the contact phase set up (the switching
+    functions' values ``f >= 0`` and rates ``fd`` at its start): ``(s, index)``, ``index`` the
+    function that fires at ``s``, -1 for none up to ``s = s_end``, -2 if the safeguard's
+    interval budget ran out at ``s`` (no event before it)."""
+    w = p[5]
+    a = 0.0
+    grow = R[mi, 4]
+    for _ in range(_FLIGHT_ITERS):
+        hcap = s_end - a
+        if grow > 0.0:
+            hcap = min(hcap, 1.0 / grow)
+        H = hcap
+        for i in range(3):
+            H = min(H, _contact_gap(f[i], fd[i], _contact_bound(i, mi, a, hcap, E, R, cb)))
+        if a + H >= s_end:
+            return s_end, -1
+        b = min(a + max(H, _time_res(t0 + a, w)), s_end)
+        _contact_state(b, t0, w, mi, E, qm, ybuf)
+        best_s, best_i = np.inf, -1
+        for i in range(3):
+            hb, hdb = _contact_h(i, mode, kc, t0 + b, ybuf, p)
+            f[i], fd[i] = hb, hdb
+        for i in range(3):
+            if f[i] < 0.0:
+                si = _contact_polish(i, mode, a, b, f[i], fd[i], t0, p, kc, mi, E, qm, ybuf)
+                # near-ties go to the lower index (loss before release at once)
+                if si < best_s - 2.0 * _time_res(t0 + si, w):
+                    best_s, best_i = si, i
+        if best_i >= 0:
+            return best_s, best_i
+        if b >= s_end:
+            return s_end, -1
+        a = b
+    return a, -2
+
+
+@njit(cache=True)
+def _contact(
+    t,
+    t1,
+    y,
+    mode,
+    p,
+    kc,
+    E,
+    R,
+    atol,
+    qm,
+    cb,
+    f,
+    fd,
+    ybuf,
+    S,
+    spar,
+    coef,
+    ea,
+    eb,
+    br,
+    dc,
+    sw,
+    t_eval,
+    k_eval,
+    out_y,
+    out_f,
+    out_mode,
+    out_dF,
+):
+    """One contact phase (loading or unloading) from ``(t, y)`` in closed form: ``(code,
+    t_new, k_eval, index)``.
+
+    ``code`` 0: no event up to ``t1`` (``y`` advanced to it); 1: switching function ``index``
+    fires at ``t_new`` (advanced to it: the caller records the event); 3: not here (the mode
+    has no closed form, or a switching function starts across its surface by more than a
+    hair of the absolute tolerances, or not leaving it: the integrator's steps); 4: advanced
+    to ``t_new`` without an event, the integrator's steps next (the safeguard's interval
+    budget ran out).  Writes the state, force and mode at ``t_eval[k_eval:]`` up to
+    ``t_new`` (and the force's derivatives with ``out_dF``); ``S`` moves with the state
+    (``sw``: its work arrays, :func:`_contact_sens`).  A law coefficient's column needs the
+    mode's eigenvalues away from 0 (``|lambda| > 1e-3 w``), else the integrator's steps."""
+    mi = 0 if mode == LOAD else 1
+    if R[mi, 0] == 0.0:
+        return 3, t, k_eval, -1
+    gcol, phi, W, ex = sw
+    m = S.shape[1]
+    for j in range(m):
+        if spar[j] >= 0 and not R[mi, 5] > 1e-3 * p[5]:
+            return 3, t, k_eval, -1
+    if m:
+        # dF/dc of each coefficient's column in this mode: gcol[0] z + gcol[1] zd
+        force_partials(mode, 1.0, 0.0, coef, ea, eb, br, dc)
+        for j in range(m):
+            gcol[0, j] = dc[spar[j]] if spar[j] >= 0 else 0.0
+        force_partials(mode, 0.0, 1.0, coef, ea, eb, br, dc)
+        for j in range(m):
+            gcol[1, j] = dc[spar[j]] if spar[j] >= 0 else 0.0
+    for i in range(3):
+        h, hd = _contact_h(i, mode, kc, t, y, p)
+        f[i], fd[i] = h, hd
+        if h > 0.0:
+            continue
+        gz, gv = _contact_g(mode, kc, i)
+        if h < -(abs(gz) * atol[0] + abs(gv) * atol[1]) or not hd > 0.0:
+            return 3, t, k_eval, -1
+        f[i] = 0.0  # a hair across, leaving: on the surface
+    w = p[5]
+    _contact_start(t, y, mi, w, E, qm)
+    for i in range(3):
+        gz, gv = _contact_g(mode, kc, i)
+        for j in range(4):
+            G = gz * (E[mi, j, 0] - E[mi, j, 2]) + gv * (E[mi, j, 1] - E[mi, j, 3])
+            cb[i, j] = abs(G) * abs(E[mi, j, 8]) * abs(qm[j, 1])
+    s, index = _contact_search(mode, t, t1 - t, p, kc, mi, E, R, qm, cb, f, fd, ybuf)
+    code = 1 if index >= 0 else (0 if index == -1 else 4)
+    t_new = t1 if code == 0 else t + s
+    k, c = kc[2 * mi], kc[2 * mi + 1]
+    while k_eval < t_eval.shape[0] and t_eval[k_eval] <= t_new:
+        _contact_state(max(t_eval[k_eval] - t, 0.0), t, w, mi, E, qm, ybuf)
+        for j in range(4):
+            out_y[j, k_eval] = ybuf[j]
+        out_f[k_eval] = k * (ybuf[0] - ybuf[2]) + c * (ybuf[1] - ybuf[3])
+        out_mode[k_eval] = mode
+        if out_dF.shape[1] > 0:
+            se = max(t_eval[k_eval] - t, 0.0)
+            _contact_sens(
+                se, t, mi, E, qm, p, S, spar, gcol, phi, ex, W, k, c, ybuf, out_dF, k_eval
+            )
+        k_eval += 1
+    _contact_state(s, t, w, mi, E, qm, ybuf)
+    for j in range(4):
+        y[j] = ybuf[j]
+    if m:
+        _contact_sens(s, t, mi, E, qm, p, S, spar, gcol, phi, ex, W, k, c, ybuf, out_dF, -1)
+    return code, t_new, k_eval, index
+
+
 @njit(cache=True)
 def integrate(
     t0,
@@ -1003,6 +1652,21 @@ def integrate(
     use_flight = _flight_ok(p)
     fl = np.empty(_NF)
     hold = False
+    # the contact in closed form where it applies (:func:`_contact`; not with sensitivities)
+    kc = np.zeros(4)
+    use_contact = _contact_law(p, coef, ea, eb, br, kc)
+    E = np.zeros((2, 4, _NE), dtype=np.complex128)
+    R = np.zeros((2, _NR))
+    if use_contact:
+        _contact_setup(p, kc, LOAD, atol, E, R)
+        _contact_setup(p, kc, UNLOAD, atol, E, R)
+        use_contact = R[0, 0] != 0.0 or R[1, 0] != 0.0
+    qm = np.empty((4, 2), dtype=np.complex128)
+    # the closed-form sensitivities' work arrays (:func:`_contact_sens`)
+    sw = (np.empty((2, m_s)), np.empty((4, 4)), np.empty((2, 4)), np.empty(4, dtype=np.complex128))
+    cb = np.empty((3, 4))
+    fc = np.empty(3)
+    fcd = np.empty(3)
     while t < t1:
         if n_steps >= max_steps:
             status = STEP_BUDGET
@@ -1054,6 +1718,71 @@ def integrate(
                 n_ev += 1
                 need_f = True
                 need_h0 = True
+                continue
+        if use_contact and (mode == LOAD or mode == UNLOAD) and not hold:
+            code, t_new, k_eval, idx = _contact(
+                t,
+                t1,
+                y,
+                mode,
+                p,
+                kc,
+                E,
+                R,
+                atol,
+                qm,
+                cb,
+                fc,
+                fcd,
+                ybuf,
+                S,
+                spar,
+                coef,
+                ea,
+                eb,
+                br,
+                dc,
+                sw,
+                t_eval,
+                k_eval,
+                out_y,
+                out_f,
+                out_mode,
+                out_dF,
+            )
+            if code == 3:
+                hold = True
+            else:
+                n_steps += 1
+                t = t_new
+                need_f = True
+                need_h0 = True
+                if not (
+                    np.isfinite(y[0])
+                    and np.isfinite(y[1])
+                    and np.isfinite(y[2])
+                    and np.isfinite(y[3])
+                ):
+                    status = BLOW_UP
+                    break
+                if code == 4:
+                    hold = True
+                if code != 1:
+                    continue
+                zero_len = 0
+                short_run = _zeno_run(t, t_last_ev, hmax, short_run)
+                if short_run > _ZENO_EVENTS:
+                    status = CHATTER
+                    break
+                t_last_ev = t
+                if m_s:
+                    _event_time_sens(t, y, mode, idx, p, coef, ea, eb, br, S, spar, dc, fminus, tau)
+                mode = _record_event(
+                    t, y, mode, idx, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
+                )
+                if m_s:
+                    _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau)
+                n_ev += 1
                 continue
         if need_f:
             _rhs(t, y, mode, p, coef, ea, eb, br, K[0])

@@ -137,8 +137,9 @@ class Trajectory:
 def kernel_params(scenario, law, tolerances=None):
     """The compiled kernel's parameter vector (:data:`~discovery.vibroimpact.dynamics._kernel.P_K3`
     ...): the scenario's parameters, the law's permanent set, a fresh contact state and the
-    free-flight path of ``tolerances`` (:attr:`Tolerances.free_flight`; default closed
-    form).  The kernel updates the state slots in place: pass each integration its own
+    free-flight and contact paths of ``tolerances`` (:attr:`Tolerances.free_flight`,
+    :attr:`Tolerances.contact`; default closed form, the contact's only with closed-form
+    flights).  The kernel updates the state slots in place: pass each integration its own
     copy."""
     p = np.zeros(K.N_PARAMS)
     base = scenario.params()
@@ -147,6 +148,8 @@ def kernel_params(scenario, law, tolerances=None):
     p[K.P_VSCALE] = 1.0 if law.impact_scaled else 0.0
     closed = tolerances is None or tolerances.free_flight == "closed"
     p[K.P_FLIGHT] = 1.0 if closed else 0.0
+    contact = tolerances is None or tolerances.contact == "closed"
+    p[K.P_CONTACT] = 1.0 if closed and contact else 0.0
     return p
 
 
