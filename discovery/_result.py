@@ -116,6 +116,9 @@ class Result:
             if f.name in cls._LOAD:
                 try:
                     value = cls._LOAD[f.name](d)
+                except _Unreadable as exc:
+                    # a nested result's field: the message names the whole path to it
+                    raise _Unreadable(cls.KIND, (f.name, *exc.path), exc.cause) from None
                 except (
                     KeyError,
                     TypeError,
@@ -124,11 +127,7 @@ class Result:
                     AttributeError,
                     InputError,
                 ) as exc:
-                    raise InputError(
-                        f"from_dict: the {cls.KIND!r} document's {f.name!r} cannot be read "
-                        f"({type(exc).__name__}: {short(exc, 80)}); was it edited? run the "
-                        "command again"
-                    ) from None
+                    raise _Unreadable(cls.KIND, (f.name,), exc) from None
             elif f.name in d:
                 value = d[f.name]
             elif f.default is not dataclasses.MISSING:
@@ -230,6 +229,19 @@ def load(path):
     d = load_summary(path)
     kind = check_document(d, f"load {short(str(path))!r}")
     return result_class(kind).from_dict(d)
+
+
+class _Unreadable(InputError):
+    """A document's field that cannot be read, named by its path from the outer document
+    (``selected.status``), with the reason."""
+
+    def __init__(self, kind, path, cause):
+        self.kind, self.path, self.cause = kind, tuple(path), cause
+        super().__init__(
+            f"from_dict: the {kind!r} document's {'.'.join(self.path)!r} cannot be read "
+            f"({type(cause).__name__}: {short(cause, 80)}); was it edited? run the "
+            "command again"
+        )
 
 
 def part(cls, d):
