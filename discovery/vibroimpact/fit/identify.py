@@ -111,7 +111,8 @@ class IdentificationResult(Result):
     value : float
         Its final value.
     criteria : dict
-        All criteria ``I0..I4`` at the identified law (the mean over records).
+        All criteria ``I0..I4`` at the identified law, and ``I5`` where records have
+        positions (each the mean over the records that have it).
     evaluations : tuple of Evaluation
         The identified law against each record (without noise floor).
     method : str
