@@ -318,12 +318,15 @@ def arm_table(rows, arms):
     (:func:`settled`), and in how many records a second record was made."""
     lines = [
         "truth                 arm       records  right name  right or equivalent  settled  "
-        "second record made"
+        "second record made  settled where the first left the other family open"
     ]
     for name in MODELS:
         rs = [r for r in rows if r["truth"] == name and not r.get("skipped")]
         if not rs:
             continue
+        # the records whose first fit left a model of the other damping family consistent
+        open_ = [r for r in rs if r["truth"] in [r["selected"], *r["equivalent"]]]
+        open_ = [r for r in open_ if not settled(r, "none")]
         for arm in arms:
             right = sum(final(r, arm)[0] == name for r in rs)
             either = sum(name in [final(r, arm)[0], *final(r, arm)[1]] for r in rs)
@@ -331,7 +334,8 @@ def arm_table(rows, arms):
             lines.append(
                 f"{name:<21s} {arm:<9s} {len(rs):7d}  {right:4d}/{len(rs):<5d} "
                 f"{either:4d}/{len(rs):<14d} {sum(settled(r, arm) for r in rs):3d}/{len(rs):<4d}"
-                f" {done if arm != 'none' else '-'}"
+                f" {done if arm != 'none' else '-':>4}"
+                f"{sum(settled(r, arm) for r in open_):>20d}/{len(open_)}"
             )
         seeds = sorted(r["seed"] for r in rs)
         lines.append(f"{'':21s} seeds {' '.join(map(str, seeds))}")
@@ -391,6 +395,8 @@ def main(argv=None):
         rows = [
             json.loads(line) for f in a.out for line in Path(f).read_text().splitlines() if line
         ]
+        # a record surveyed twice (a run resumed) counts once: its last row
+        rows = list({(r["truth"], r["seed"]): r for r in rows}.values())
         print(summary(rows))
         return
     out = Path(a.out[0])

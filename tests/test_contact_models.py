@@ -380,3 +380,21 @@ def test_cli_fit_contact_models_on_two_operating_points(tmp_path, capsys):
     a = json.loads((adv / "summary.json").read_text())
     assert len(a["laws"]) >= 2 and any("scale: v0" in law for law in a["laws"])
     assert "advised: A = " in capsys.readouterr().out
+
+
+@pytest.mark.slow
+def test_the_survey_closes_the_loop_on_one_record():
+    """One case of ``tests/survey_contact_models.py --second-point advised``: a
+    Hunt-Crossley record whose fit leaves Flores equivalent; the advised point lies within
+    the bounds, and the record made there, fitted with the first, settles the family."""
+    import survey_contact_models as S
+
+    row = S.one_record("hunt-crossley", 2001, 60, n_boot=0, second=("advised",))
+    assert row["equivalent"], row["selected"]
+    got = row["second"]["advised"]
+    assert got["made"], got
+    sc = row["scenario"]
+    A, f = got["point"]
+    assert 0.5 * sc["A"] <= A <= 2 * sc["A"] and 0.7 * sc["frequency"] <= f <= 1.4 * sc["frequency"]
+    assert S.settled(row, "advised") and not S.settled(row, "none")
+    assert S.final(row, "advised")[0] == "hunt-crossley"
