@@ -261,6 +261,8 @@ def test_cli_advise_takes_named_models_as_laws(tmp_path, capsys):
     assert "advised: A = " in capsys.readouterr().out
     s = json.loads((out / "summary.json").read_text())
     assert s["laws"][1].endswith("scale: v0")
+    assert main(["report", str(out), "--no-pdf"]) == 0
+    assert "Ranked points" in (out / "report.tex").read_text()
     bad = ["advise", "--law", models[0], "--law", "flores: k=1e9, n=1.2", "--noise", "0.01"]
     assert main([*bad, "--amplitude", "1:2", "--frequency", "1:2", "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
