@@ -10,8 +10,32 @@ penetration (``tests/realistic.py``'s draw), Kelvin-Voigt and Hertz-damper dampi
 the same damping ratio range.  Polynomial laws: the draws of ``tests/realistic.py``
 (linear, ``z*zd`` and Hertz with ``z^1.5*zd`` damping in loading only).
 
-Run:  .venv/bin/python tests/survey_contact_models.py --per-model 4 --poly 4 \
-          --out out/survey_contact_models.jsonl
+Second operating point (``--second-point advised random``, issue 33's loop): in a
+periodic steady state every impact arrives at one velocity ``v0``, so Hunt-Crossley
+(constant ``lambda``) and Lankarani-Nikravesh / Flores (``lambda`` set by ``e`` and each
+impact's ``v0``) make the same record at one operating point.  When the first record's fit
+reports equivalent models, a second record of the same machine and law is made (the same
+scipy path, the same noise levels, noise seed ``seed + 1``) at another drive setting and
+both records are fitted jointly (shared ``k, n, e / lambda``):
+
+* ``advised``: the point :func:`discovery.advise` proposes for the first fit's selected
+  and equivalent models, the drive amplitude in ``--amplitude-range`` (default 0.5..2 x)
+  and the frequency in ``--frequency-range`` (0.7..1.4 x) of the first record's, the noise
+  of the first record, and a safe region of ``--max-force-factor`` (3) times its peak force;
+* ``random``: a point drawn uniformly in the same bounds (``default_rng([seed, 2])``;
+  drawn again, up to 5 times, where no record with contact can be made there);
+* ``none``: the first fit alone.
+
+The joint fit fits the first fit's selected and equivalent models (``--joint-models
+candidates``, the default) or every model (``all``).  Each row holds every arm, the code
+version (git commit) and every setting.
+
+Run from the repository root (the package of the checkout is imported):
+    PYTHONPATH=. python tests/survey_contact_models.py --per-model 4 --poly 4 \
+        --out out/survey_contact_models.jsonl
+    PYTHONPATH=. python tests/survey_contact_models.py --models hunt-crossley \
+        lankarani-nikravesh --seeds 1 2 3 --second-point advised random --boot 0 \
+        --out out/two_points.jsonl
 One JSON line per record (appended as it goes), then a summary table on stdout.
 """
 
@@ -28,7 +52,9 @@ sys.path.append(str(Path(__file__).resolve().parents[1]))  # for tests.measured
 
 from realistic import draw_case, reference_record  # noqa: E402
 
+from discovery._io import git_state, provenance  # noqa: E402
 from discovery.errors import VidiError  # noqa: E402
+from discovery.vibroimpact.advise import Knobs, NoiseModel, SafeRegion, advise  # noqa: E402
 from discovery.vibroimpact.dynamics.steady_state import steady_state  # noqa: E402
 from discovery.vibroimpact.fit.contact_fit import fit_contact_models  # noqa: E402
 from discovery.vibroimpact.fit.identify import bootstrap_intervals  # noqa: E402
@@ -71,7 +97,9 @@ def _usable(sc, law):
     return ss.periodic and ss.impacts >= 1
 
 
-def one_record(truth_name, seed, max_sim):
+def make_record(truth_name, seed):
+    """``(scenario, law, true model or None, record)`` of a truth and seed, or None when
+    no usable draw was found in 30 tries."""
     rng = np.random.default_rng(seed)
     for attempt in range(30):
         case = draw_case("p1", int(seed * 100 + attempt), check_reference=False)
@@ -88,15 +116,22 @@ def one_record(truth_name, seed, max_sim):
             Reference.from_measurement(meas, sc)  # a record the verdict can read
         except (VidiError, RuntimeError, ValueError):
             continue
-        break
-    else:
+        return sc, law, truth, meas
+    return None
+
+
+def one_record(truth_name, seed, max_sim, n_boot=30, second=("none",), opts=None):
+    made = make_record(truth_name, seed)
+    if made is None:
         return {"truth": truth_name, "seed": seed, "skipped": True}
+    sc, law, truth, meas = made
     t0 = time.perf_counter()
     res = fit_contact_models(sc, meas, max_simulations=max_sim, n_boot=0)
     row = {
         "truth": truth_name,
         "seed": seed,
         "law": law.to_text(),
+        "scenario": sc.as_dict(),
         "true_params": None if truth is None else truth.params,
         "selected": res.selected,
         "equivalent": list(res.equivalent),
@@ -108,14 +143,126 @@ def one_record(truth_name, seed, max_sim):
         fit = res.fit(truth_name)
         row["true_consistent"] = fit.consistent
         # the bootstrap through the record-span processing, for the true model's fit
-        if fit.consistent is not None:
+        if fit.consistent is not None and n_boot:
             model = ContactModel(truth_name, tuple(fit.parameters[k] for k in MODELS[truth_name]))
-            iv = bootstrap_intervals(sc, Reference.from_measurement(meas, sc), model, n_boot=30)
+            iv = bootstrap_intervals(sc, Reference.from_measurement(meas, sc), model, n_boot=n_boot)
             row["boot_intervals"] = (
                 None if iv is None else {k: list(v) for k, v in iv.bounds.items()}
             )
             row["boot_covered"] = _covered(row, boot=True)
+    arms = [a for a in second if a != "none"]
+    if arms:
+        row["second"] = second_points(res, sc, law, meas, seed, arms, max_sim, opts or {})
     return row
+
+
+def _bounds(sc, opts):
+    """The knobs' bounds around the first record's drive setting."""
+    ar, fr = opts.get("amplitude_range", (0.5, 2.0)), opts.get("frequency_range", (0.7, 1.4))
+    return Knobs(
+        (ar[0] * sc.A, ar[1] * sc.A),
+        (fr[0] * sc.frequency, fr[1] * sc.frequency),
+        grid=tuple(opts.get("grid", (4, 4))),
+        refine=int(opts.get("refine", 2)),
+    )
+
+
+def _joint(res, sc0, meas0, law, point, seed, max_sim, opts):
+    """The second record at ``point = (A, f)`` and the joint fit of both records; None
+    when no record with contact can be made there."""
+    sc1 = sc0.replace(A=float(point[0]), frequency=float(point[1]))
+    try:
+        meas1 = reference_record((sc1, law), periods=12, seed=seed + 1, check=False)
+        Reference.from_measurement(meas1, sc1)
+    except (VidiError, RuntimeError, ValueError) as exc:
+        return None, f"{type(exc).__name__}: {exc}"
+    names = (
+        None if opts.get("joint_models", "candidates") == "all" else [res.selected, *res.equivalent]
+    )
+    t0 = time.perf_counter()
+    joint = fit_contact_models(
+        [sc0, sc1], [meas0, meas1], models=names, max_simulations=max_sim, n_boot=0
+    )
+    return {
+        "point": [float(point[0]), float(point[1])],
+        "models": names,
+        "selected": joint.selected,
+        "equivalent": list(joint.equivalent),
+        "fits": [f.to_dict() for f in joint.fits],
+        "seconds": time.perf_counter() - t0,
+    }, ""
+
+
+def second_points(res, sc, law, meas, seed, arms, max_sim, opts):
+    """``{arm: outcome}`` of the second record at the advised and at a random point
+    (``{"made": False, "why": ...}`` where none was made: the first fit lists no
+    equivalent model, advise finds no usable point, or no record can be made)."""
+    if res.selected is None or not res.equivalent:
+        why = "the first fit lists no equivalent model" if res.selected else "none consistent"
+        return {arm: {"made": False, "why": why} for arm in arms}
+    knobs = _bounds(sc, opts)
+    out = {}
+    if "advised" in arms:
+        t0 = time.perf_counter()
+        noise = NoiseModel.from_measurement(meas, sc, seed=seed)
+        safe = SafeRegion(max_force=opts.get("max_force_factor", 3.0) * float(np.max(meas.F)))
+        adv = advise(sc, res, knobs, noise, safe, workers=1)
+        b = adv.best
+        info = {"advise_seconds": time.perf_counter() - t0, "candidates": list(adv.laws)}
+        if b is None:
+            out["advised"] = {"made": False, "why": "advise found no usable point", **info}
+        else:
+            info.update(
+                smallest_separation=b.smallest_separation(frozenset(adv.inseparable)),
+                inseparable=[list(q) for q in adv.inseparable],
+                regimes=[p.regime for p in b.predictions],
+            )
+            got, why = _joint(res, sc, meas, law, (b.amplitude, b.frequency), seed, max_sim, opts)
+            out["advised"] = (
+                {"made": True, **got, **info}
+                if got
+                else {"made": False, "why": why, "point": [b.amplitude, b.frequency], **info}
+            )
+    if "random" in arms:
+        rng = np.random.default_rng([seed, 2])
+        tried = []
+        for _ in range(5):
+            point = (rng.uniform(*knobs.amplitude), rng.uniform(*knobs.frequency))
+            got, why = _joint(res, sc, meas, law, point, seed, max_sim, opts)
+            if got:
+                out["random"] = {"made": True, **got, "draws": len(tried) + 1, "refused": tried}
+                break
+            tried.append({"point": list(point), "why": why})
+        else:
+            out["random"] = {"made": False, "why": "no record at 5 random points", "refused": tried}
+    return out
+
+
+def final(row, arm):
+    """``(selected, equivalent)`` a row ends with in an arm: the joint fit's where a
+    second record was made, else the first fit's."""
+    got = (row.get("second") or {}).get(arm) if arm != "none" else None
+    if got and got.get("made"):
+        return got["selected"], got["equivalent"]
+    return row["selected"], row["equivalent"]
+
+
+_FAMILY = {
+    "hunt-crossley": "constant lambda",
+    "lankarani-nikravesh": "lambda by v0",
+    "flores": "lambda by v0",
+}
+
+
+def settled(row, arm):
+    """The truth selected or equivalent, and no model of the other damping family
+    (constant ``lambda`` against ``lambda`` set by each impact's ``v0``) still consistent:
+    what a second operating point can decide (Lankarani-Nikravesh and Flores make the same
+    force wherever ``r <= 3/4``; no record tells them apart)."""
+    sel, eq = final(row, arm)
+    names = [sel, *eq] if sel else []
+    fam = _FAMILY.get(row["truth"])
+    return row["truth"] in names and all(_FAMILY.get(m, fam) == fam for m in names)
 
 
 def _covered(row, boot=False):
@@ -161,6 +308,38 @@ def summary(rows):
             f"{name:<21s} {len(rs):7d}  {right:4d}/{len(rs):<5d} "
             f"{either:4d}/{len(rs):<14d} {cov_text}"
         )
+    arms = sorted({a for r in rows for a in (r.get("second") or {})})
+    if arms:
+        lines += ["", arm_table(rows, ["none", *arms])]
+    return "\n".join(lines)
+
+
+def arm_table(rows, arms):
+    """Per truth and arm: the right name selected, right or equivalent, settled
+    (:func:`settled`), and in how many records a second record was made."""
+    lines = [
+        "truth                 arm       records  right name  right or equivalent  settled  "
+        "second record made  settled where the first left the other family open"
+    ]
+    for name in MODELS:
+        rs = [r for r in rows if r["truth"] == name and not r.get("skipped")]
+        if not rs:
+            continue
+        # the records whose first fit left a model of the other damping family consistent
+        open_ = [r for r in rs if r["truth"] in [r["selected"], *r["equivalent"]]]
+        open_ = [r for r in open_ if not settled(r, "none")]
+        for arm in arms:
+            right = sum(final(r, arm)[0] == name for r in rs)
+            either = sum(name in [final(r, arm)[0], *final(r, arm)[1]] for r in rs)
+            done = sum(bool(((r.get("second") or {}).get(arm) or {}).get("made")) for r in rs)
+            lines.append(
+                f"{name:<21s} {arm:<9s} {len(rs):7d}  {right:4d}/{len(rs):<5d} "
+                f"{either:4d}/{len(rs):<14d} {sum(settled(r, arm) for r in rs):3d}/{len(rs):<4d}"
+                f" {done if arm != 'none' else '-':>4}"
+                f"{sum(settled(r, arm) for r in open_):>20d}/{len(open_)}"
+            )
+        seeds = sorted(r["seed"] for r in rs)
+        lines.append(f"{'':21s} seeds {' '.join(map(str, seeds))}")
     return "\n".join(lines)
 
 
@@ -170,6 +349,44 @@ def main(argv=None):
     ap.add_argument("--poly", type=int, default=2)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--max-simulations", type=int, default=60)
+    ap.add_argument(
+        "--models",
+        nargs="+",
+        choices=[*MODELS, "polynomial"],
+        help="the truths surveyed (default: every model, --per-model each, and --poly "
+        "polynomial laws)",
+    )
+    ap.add_argument(
+        "--seeds",
+        nargs="+",
+        type=int,
+        help="the seeds of each truth (instead of --per-model and --seed)",
+    )
+    ap.add_argument(
+        "--second-point",
+        nargs="+",
+        choices=("none", "advised", "random"),
+        default=["none"],
+        help="second records made where the first fit reports equivalent models (one run "
+        "may make both on the same first record)",
+    )
+    ap.add_argument(
+        "--joint-models",
+        choices=("candidates", "all"),
+        default="candidates",
+        help="the joint fit's models: the first fit's selected and equivalent, or all",
+    )
+    ap.add_argument("--amplitude-range", nargs=2, type=float, default=(0.5, 2.0))
+    ap.add_argument("--frequency-range", nargs=2, type=float, default=(0.7, 1.4))
+    ap.add_argument("--max-force-factor", type=float, default=3.0)
+    ap.add_argument("--advise-grid", nargs=2, type=int, default=(4, 4))
+    ap.add_argument("--advise-refine", type=int, default=2)
+    ap.add_argument(
+        "--boot",
+        type=int,
+        default=30,
+        help="bootstrap replicates of the true model's intervals (0: none)",
+    )
     ap.add_argument("--out", default="out/survey_contact_models.jsonl", nargs="+")
     ap.add_argument(
         "--summarize", action="store_true", help="only print the table of the rows in --out"
@@ -177,16 +394,43 @@ def main(argv=None):
     a = ap.parse_args(argv)
     if a.summarize:
         rows = [r for f in a.out for r in measured.read(f)[1]]
+        # a record surveyed twice (a run resumed) counts once: its last row
+        rows = list({(r["truth"], r["seed"]): r for r in rows}.values())
         print(summary(rows))
         return
     out = measured.RunFile(a.out[0], "survey_contact_models", argv, append=True)
     rows = []
-    jobs = [(m, a.seed + 1000 * j + i) for i in range(a.per_model) for j, m in enumerate(MODELS)]
-    jobs += [("polynomial", a.seed + 9000 + i) for i in range(a.poly)]
-    # interleave so a run cut short still has every model
-    jobs.sort(key=lambda j: (j[1] % 1000, j[0]))
+    truths = a.models or [*MODELS, "polynomial"]
+    if a.seeds:
+        jobs = [(m, seed) for seed in a.seeds for m in truths]
+    else:
+        jobs = [
+            (m, a.seed + 1000 * j + i)
+            for i in range(a.per_model)
+            for j, m in enumerate(MODELS)
+            if m in truths
+        ]
+        if "polynomial" in truths:
+            jobs += [("polynomial", a.seed + 9000 + i) for i in range(a.poly)]
+        # interleave so a run cut short still has every model
+        jobs.sort(key=lambda j: (j[1] % 1000, j[0]))
+    opts = {
+        "amplitude_range": tuple(a.amplitude_range),
+        "frequency_range": tuple(a.frequency_range),
+        "max_force_factor": a.max_force_factor,
+        "grid": tuple(a.advise_grid),
+        "refine": a.advise_refine,
+        "joint_models": a.joint_models,
+    }
+    commit, dirty = git_state()
+    stamp = {
+        "code": {"commit": commit, "dirty": dirty},
+        "versions": provenance()["versions"],
+        "settings": {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(a).items()},
+    }
     for name, seed in jobs:
-        row = one_record(name, seed, a.max_simulations)
+        row = one_record(name, seed, a.max_simulations, a.boot, tuple(a.second_point), opts)
+        row.update(stamp)
         rows.append(row)
         out.write(row)
         print(
@@ -195,6 +439,14 @@ def main(argv=None):
             f"{row.get('seconds', 0):.0f} s",
             flush=True,
         )
+        for arm, got in (row.get("second") or {}).items():
+            what = (
+                f"at {got['point'][0]:.4g} N, {got['point'][1]:.4g} Hz: selected "
+                f"{got['selected']} equivalent {got['equivalent']} {got['seconds']:.0f} s"
+                if got.get("made")
+                else f"none made ({got.get('why')})"
+            )
+            print(f"    {arm:<8s} {what}", flush=True)
     print(summary(rows))
 
 

@@ -10,7 +10,7 @@ import pytest
 from discovery import AdviseResult, ForceLaw, Knobs, NoiseModel, SafeRegion, advise, load_scenario
 from discovery.cli import main
 from discovery.errors import InputError
-from discovery.vibroimpact.advise import candidates_from_fit
+from discovery.vibroimpact.advise import candidates_from_fit, contact_candidates
 from discovery.vibroimpact.advise.separation import inseparable
 
 BASE = "2.06e8*z + 1.28e7*zd"
@@ -187,6 +187,86 @@ def test_candidates_from_a_fit_directory(tmp_path):
         candidates_from_fit(tmp_path)
     with pytest.raises(InputError, match="does not exist"):
         candidates_from_fit(tmp_path / "nowhere")
+
+
+def _contact_fit(selected="hunt-crossley", equivalent=("flores",)):
+    """A contact-models fit of a Hunt-Crossley record of the paper's machine at one
+    operating point (the parameters of ``tests/test_contact_models.py``'s record): Flores
+    makes the same force at its one impact velocity."""
+    from discovery.vibroimpact.fit.contact_fit import ContactFit, ContactModelsResult
+
+    params = {
+        "hunt-crossley": {"k": 7.4833e8, "n": 1.1997, "lambda": 2.5074e9},
+        "flores": {"k": 7.4832e8, "n": 1.1997, "e": 0.41365},
+        "kelvin-voigt": {"k": 2.06e8, "c": 1.28e7},
+    }
+    fits = tuple(
+        ContactFit(
+            model=name,
+            parameters=p,
+            intervals={},
+            criteria={"I2": 0.0078},
+            value=0.0078,
+            consistent=name in (selected, *equivalent),
+            law="",
+        )
+        for name, p in params.items()
+    )
+    return ContactModelsResult(fits=fits, selected=selected, equivalent=tuple(equivalent))
+
+
+def test_advise_takes_named_contact_models_and_a_contact_models_fit(tmp_path):
+    """The candidates may be a contact-models fit (its selected model and those it reports
+    equivalent), named models, or their text; a point with another impact velocity
+    separates Hunt-Crossley from Flores, which make the same record at the fit's point."""
+    from discovery import ContactModel
+    from discovery.vibroimpact.advise.candidates import unique_laws
+
+    res = _contact_fit()
+    models = contact_candidates(res)
+    assert [m.name for m in models] == ["hunt-crossley", "flores"]
+    assert models[1] == ContactModel("flores", (7.4832e8, 1.1997, 0.41365))
+    laws = [m.law for m in models]
+    assert unique_laws(res) == unique_laws(models) == unique_laws([m.to_text() for m in models])
+    assert unique_laws(models) == tuple(laws)
+    assert contact_candidates(res.to_dict()) == models
+    with pytest.raises(InputError, match="selected no model"):
+        contact_candidates(_contact_fit(selected=None, equivalent=()))
+    # at the fit's own point the two are one record; at a faster drive they separate
+    same = _one_point(res)
+    assert same.best is None or same.best.smallest < 1
+    knobs = Knobs((2.5e5, 1e6), (17.5, 35.0), grid=(3, 3), refine=0)
+    r = advise(load_scenario("paper"), res, knobs, NoiseModel(0.01), workers=1)
+    b = r.best
+    assert b is not None and knobs.contains(b.amplitude, b.frequency)
+    assert r.laws == tuple(law.to_text() for law in laws) and b.smallest >= 1
+    # a contact-models fit directory
+    (tmp_path / "summary.json").write_text(
+        json.dumps({**res.to_dict(), "command": "fit", "scenario": {"name": "paper"}})
+    )
+    got, name = candidates_from_fit(tmp_path)
+    assert got == tuple(laws) and name == "paper"
+    lone = _contact_fit(equivalent=())
+    (tmp_path / "summary.json").write_text(json.dumps({**lone.to_dict(), "command": "fit"}))
+    with pytest.raises(InputError, match="lists no equivalent model"):
+        candidates_from_fit(tmp_path)
+
+
+def test_cli_advise_takes_named_models_as_laws(tmp_path, capsys):
+    models = [m.to_text() for m in contact_candidates(_contact_fit())]
+    out = tmp_path / "adv"
+    argv = ["advise", "--law", models[0], "--law", models[1], "--noise", "0.01"]
+    argv += ["--amplitude", "2.5e5:1e6", "--frequency", "17.5:35", "--grid", "2x2"]
+    assert main([*argv, "--refine", "0", "--workers", "1", "--out", str(out)]) == 0
+    assert "advised: A = " in capsys.readouterr().out
+    s = json.loads((out / "summary.json").read_text())
+    assert s["laws"][1].endswith("scale: v0")
+    assert main(["report", str(out), "--no-pdf"]) == 0
+    assert "Ranked points" in (out / "report.tex").read_text()
+    bad = ["advise", "--law", models[0], "--law", "flores: k=1e9, n=1.2", "--noise", "0.01"]
+    assert main([*bad, "--amplitude", "1:2", "--frequency", "1:2", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "needs e" in err[0]
 
 
 @pytest.mark.slow

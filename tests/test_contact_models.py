@@ -220,6 +220,44 @@ def test_fit_names_the_model_of_a_clean_record():
     assert "kelvin-voigt" not in res.equivalent and "hertz-damper" not in res.equivalent
 
 
+def _hunt_crossley_records(points, seed=3):
+    """Records of one Hunt-Crossley machine (the paper's, ``n = 1.2``, the damping of
+    Flores' ``e = 0.6`` at the paper's impact velocity) by the scipy path, 1 % force
+    noise, at the drive settings ``points = [(A, f), ...]``."""
+    sc, model = _paper_model("hunt-crossley", n=1.2, e=0.6)
+    scs, recs = [], []
+    for A, f in points:
+        s = sc.replace(law=model.law, A=A, frequency=f)
+        scs.append(s)
+        recs.append(reference_record((s, model.law), periods=8, seed=seed, check=False))
+    return model, scs, recs
+
+
+def test_two_operating_points_tell_hunt_crossley_from_flores():
+    """One operating point: every impact arrives at one velocity, and Flores makes the
+    Hunt-Crossley record too (equivalent).  Fitted jointly with a record at another drive
+    (shared k, n, lambda / e), the impacts arrive at two velocities: Hunt-Crossley is
+    selected, Flores and Lankarani-Nikravesh are no longer consistent."""
+    from discovery.vibroimpact.fit.contact_starts import record_samples
+
+    model, scs, recs = _hunt_crossley_records([(5e5, 25.0), (6.25e5, 35.0)])
+    models = ("hunt-crossley", "lankarani-nikravesh", "flores")
+    one = fit_contact_models(scs[0], recs[0], models=models, max_simulations=60, n_boot=0)
+    assert one.selected in ("hunt-crossley", "flores"), str(one)
+    assert {one.selected, *one.equivalent} >= {"hunt-crossley", "flores"}, str(one)
+    # the start's contact samples hold both records' impacts, each its own group
+    both = record_samples(scs, recs)
+    parts = [record_samples(s, r) for s, r in zip(scs, recs, strict=True)]
+    assert len(both) == sum(len(p) for p in parts)
+    assert both.n_impacts == sum(p.n_impacts for p in parts)
+    joint = fit_contact_models(scs, recs, models=models, max_simulations=60, n_boot=0)
+    assert joint.selected == "hunt-crossley" and joint.equivalent == (), str(joint)
+    fit = joint.fit("hunt-crossley")
+    for key, true in model.params.items():
+        assert fit.parameters[key] == pytest.approx(true, rel=0.05)
+    assert fit.criteria and joint.fit("flores").consistent is False
+
+
 def test_a_study_scores_a_contact_models_fit():
     """A study file takes named-model laws and the contact-models library; a run's
     measures are the named model's."""
@@ -296,3 +334,67 @@ def test_cli_fit_contact_models(tmp_path, capsys):
     res = ContactModelsResult.from_dict(summary)
     e = res.fit("flores").intervals["e"]
     assert e[0] <= 0.45 <= e[1] or abs(res.fit("flores").parameters["e"] - 0.45) < 0.01
+
+
+@pytest.mark.slow
+def test_cli_fit_contact_models_on_two_operating_points(tmp_path, capsys):
+    """``vidi fit --library contact-models`` with two records of one machine at two drive
+    settings (``--data`` and ``--scenario`` once each, in order) fits every model jointly;
+    the Hunt-Crossley truth is named alone, and ``vidi advise --fit`` on the first record's
+    fit takes its selected and equivalent models as the candidates."""
+    import json
+
+    from discovery.cli import main
+
+    _, model = _paper_model("hunt-crossley", n=1.2, e=0.6)
+    root = Path(__file__).resolve().parents[1]
+    text = (root / "discovery/vibroimpact/model/scenarios/paper.toml").read_text()
+    recs, tomls = [], []
+    for i, (A, f) in enumerate(((5e5, 25.0), (6.25e5, 35.0))):
+        toml = tmp_path / f"s{i}.toml"
+        toml.write_text(text.replace("A = 5.0e5", f"A = {A!r}").replace("= 25.0", f"= {f!r}"))
+        rec = tmp_path / f"HC{i}.csv"
+        argv = ["simulate", "--scenario", str(toml), "--law", model.to_text()]
+        argv += ["--integrator", "scipy", "--periods", "12", "--noise", "0.01"]
+        assert main([*argv, "--seed", str(2 + i), "--out", str(rec)]) == 0
+        recs.append(rec)
+        tomls.append(toml)
+    fit = ["fit", "--library", "contact-models", "--intervals", "0", "--max-simulations", "60"]
+    one = tmp_path / "one"
+    assert main([*fit, "--data", str(recs[0]), "--scenario", str(tomls[0]), "--out", str(one)]) == 0
+    s = json.loads((one / "summary.json").read_text())
+    assert {s["selected"], *s["equivalent"]} >= {"hunt-crossley", "flores"}
+    joint = tmp_path / "joint"
+    argv = [*fit, "--out", str(joint)]
+    for rec, toml in zip(recs, tomls, strict=True):
+        argv += ["--data", str(rec), "--scenario", str(toml)]
+    assert main(argv) == 0
+    s = json.loads((joint / "summary.json").read_text())
+    assert s["selected"] == "hunt-crossley" and s["equivalent"] == [], s["conclusion"]
+    assert len(s["scenarios"]) == 2 and s["scenarios"][1]["A"] == 6.25e5
+    capsys.readouterr()
+    adv = tmp_path / "adv"
+    argv = ["advise", "--fit", str(one), "--noise", "0.01", "--amplitude", "2.5e5:1e6"]
+    argv += ["--frequency", "17.5:35", "--grid", "2x2", "--refine", "0", "--workers", "1"]
+    assert main([*argv, "--out", str(adv)]) == 0
+    a = json.loads((adv / "summary.json").read_text())
+    assert len(a["laws"]) >= 2 and any("scale: v0" in law for law in a["laws"])
+    assert "advised: A = " in capsys.readouterr().out
+
+
+@pytest.mark.slow
+def test_the_survey_closes_the_loop_on_one_record():
+    """One case of ``tests/survey_contact_models.py --second-point advised``: a
+    Hunt-Crossley record whose fit leaves Flores equivalent; the advised point lies within
+    the bounds, and the record made there, fitted with the first, settles the family."""
+    import survey_contact_models as S
+
+    row = S.one_record("hunt-crossley", 2001, 60, n_boot=0, second=("advised",))
+    assert row["equivalent"], row["selected"]
+    got = row["second"]["advised"]
+    assert got["made"], got
+    sc = row["scenario"]
+    A, f = got["point"]
+    assert 0.5 * sc["A"] <= A <= 2 * sc["A"] and 0.7 * sc["frequency"] <= f <= 1.4 * sc["frequency"]
+    assert S.settled(row, "advised") and not S.settled(row, "none")
+    assert S.final(row, "advised")[0] == "hunt-crossley"

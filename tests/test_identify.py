@@ -235,6 +235,18 @@ def test_discover_fits_several_records_jointly(two_points, paper):
     assert res.settings["records"] == 2
 
 
+def test_identify_on_a_record_with_positions_and_one_without(two_points, paper):
+    """A joint fit of a record with positions (criteria I0..I5) and a force record (no
+    I5): each criterion is the mean over the records that have it."""
+    scs, recs = two_points
+    force_only = dataclasses.replace(recs[1], channels={})
+    res = identify(list(scs), [recs[0], force_only], START, max_simulations=40)
+    assert res.criteria["I5"] == pytest.approx(res.evaluations[0].criteria["I5"])
+    assert "I5" not in res.evaluations[1].criteria
+    i2 = [e.criteria["I2"] for e in res.evaluations]
+    assert res.criteria["I2"] == pytest.approx(np.mean(i2))
+
+
 def test_discover_needs_one_scenario_per_record(two_points):
     scs, recs = two_points
     with pytest.raises(InputError, match="one scenario per record"):

@@ -26,7 +26,7 @@ def _grid(text):
 def _candidates(args):
     """``(laws, scenario name from the fit or None)``."""
     from ..vibroimpact.advise.candidates import candidates_from_fit, unique_laws
-    from ..vibroimpact.model.law import ForceLaw
+    from ..vibroimpact.model.contact_models import parse_law
 
     if args.fit is not None and args.law:
         raise InputError("give either --fit DIR or --law (twice or more), not both")
@@ -37,7 +37,7 @@ def _candidates(args):
             "no candidates: give --fit DIR (a vidi fit run with equivalent models) or "
             "--law twice or more, e.g. --law '2e8*z + 1e7*zd' --law '2e8*z + 5e9*z*zd'"
         )
-    return unique_laws([ForceLaw.parse(t) for t in args.law]), None
+    return unique_laws([parse_law(t) for t in args.law]), None
 
 
 def _noise(args, sc):
@@ -124,11 +124,17 @@ def register(sub):
         "pair). Points where a candidate exceeds --max-force or --max-penetration are "
         "excluded.",
     )
-    s.add_argument("--fit", metavar="DIR", help="a vidi fit run: its law and equivalent models")
+    s.add_argument(
+        "--fit",
+        metavar="DIR",
+        help="a vidi fit run: its law and equivalent models (with --library contact-models: "
+        "its selected named model and those it reports equivalent)",
+    )
     s.add_argument(
         "--law",
         action="append",
-        help="a candidate law (repeat: two or more), instead of --fit",
+        help="a candidate law or named contact model, e.g. 'flores: k=1.4e9, n=1.3, "
+        "e=0.45' (repeat: two or more), instead of --fit",
     )
     s.add_argument(
         "--scenario",

@@ -187,6 +187,7 @@ def _run_contact_models(args, scs, meas, t_start):
         **res.to_dict(),
         "command": "fit",
         "scenario": scs[0].as_dict(),
+        "scenarios": [sc.as_dict() for sc in scs] if len(scs) > 1 else None,
         "data": [str(p) for p in args.data] if len(args.data) > 1 else str(args.data[0]),
         **provenance(vars(args), inputs=inputs_of(args)),
     }

@@ -62,7 +62,7 @@ def _run(ex, context, jobs, progress, stage):
 
 @params(
     scenario=Scenario,
-    laws=(list, tuple),
+    laws=(list, tuple, Instance("discovery.vibroimpact.fit.contact_fit", "ContactModelsResult")),
     knobs=Knobs,
     noise=NoiseModel,
     safe=(SafeRegion, None),
@@ -89,9 +89,13 @@ def advise(
     ----------
     scenario : Scenario
         The machine; its drive amplitude, frequency (and moulding mass) are varied.
-    laws : list of ForceLaw or str
+    laws : list of ForceLaw, ContactModel or str, or a ContactModelsResult
         Two or more candidate laws (e.g. a fit's selected law and its equivalent models,
-        :func:`~discovery.vibroimpact.advise.candidates.candidates_from_fit`).
+        :func:`~discovery.vibroimpact.advise.candidates.candidates_from_fit`), named
+        contact models (:class:`~discovery.vibroimpact.model.contact_models.ContactModel`
+        or their text, ``"flores: k=1.4e9, n=1.3, e=0.45"``), or the result of
+        :func:`~discovery.fit_contact_models`: its selected model and those it reports
+        equivalent (:func:`~discovery.vibroimpact.advise.candidates.contact_candidates`).
     knobs : Knobs
         Bounds of amplitude, frequency (and m2), grid and refinement.
     noise : NoiseModel

@@ -2,11 +2,13 @@
 bounds, the safe region and the noise of the next record.
 
 The candidates come from a ``vidi fit`` run directory (its selected law and the
-``equivalent`` models the record could not tell from it, read from ``summary.json``) or
-from a list of laws.  The noise is a *relative* force noise (a fraction of the peak force,
-as ``vidi simulate --noise``) with a sampling step and a record length: a record made at
-another operating point with the same sensor has another peak force, so its noise in
-newtons follows the peak.
+``equivalent`` models the record could not tell from it, read from ``summary.json``; with
+``--library contact-models`` its selected named model and the named models it reports
+equivalent), from a contact-models fit result, or from a list of laws or named models.
+The noise is a *relative* force noise (a fraction of the peak force, as ``vidi simulate
+--noise``) with a sampling step and a record length: a record made at another operating
+point with the same sensor has another peak force, so its noise in newtons follows the
+peak.
 """
 
 import json
@@ -19,7 +21,14 @@ import numpy as np
 from ...errors import InputError
 from ..model.law import ForceLaw
 
-__all__ = ["Knobs", "SafeRegion", "NoiseModel", "candidates_from_fit", "unique_laws"]
+__all__ = [
+    "Knobs",
+    "SafeRegion",
+    "NoiseModel",
+    "candidates_from_fit",
+    "contact_candidates",
+    "unique_laws",
+]
 
 
 def _pair(value, what, unit, low=0.0):
@@ -276,12 +285,31 @@ class NoiseModel:
         return cls(**{k: d[k] for k in keys})
 
 
+def _as_law(law):
+    """A candidate as a :class:`ForceLaw`: a law, a named contact model
+    (:class:`~discovery.vibroimpact.model.contact_models.ContactModel`, its law), or the
+    text of either (``"2e8*z + 1e7*zd"``, ``"flores: k=1.4e9, n=1.3, e=0.45"``)."""
+    from ..model.contact_models import ContactModel, parse_law
+
+    if isinstance(law, ForceLaw):
+        return law
+    if isinstance(law, ContactModel):
+        return law.law
+    return parse_law(str(law))
+
+
 def unique_laws(laws):
-    """The laws without repeats (same text), in order; fewer than two is an error."""
+    """The laws without repeats (same text), in order; fewer than two is an error.  Each
+    may be a :class:`ForceLaw`, a named contact model or the text of either; a
+    :class:`~discovery.vibroimpact.fit.contact_fit.ContactModelsResult` stands for its
+    selected model and the models it reports equivalent (:func:`contact_candidates`)."""
+    from ..fit.contact_fit import ContactModelsResult
+
+    if isinstance(laws, ContactModelsResult):
+        laws = contact_candidates(laws)
     out, seen = [], set()
     for law in laws:
-        if not isinstance(law, ForceLaw):
-            law = ForceLaw.parse(str(law))
+        law = _as_law(law)
         if law.to_text() not in seen:
             seen.add(law.to_text())
             out.append(law)
@@ -293,8 +321,32 @@ def unique_laws(laws):
     return tuple(out)
 
 
+def contact_candidates(result):
+    """The selected named contact model of a contact-models fit
+    (:class:`~discovery.vibroimpact.fit.contact_fit.ContactModelsResult`, or its
+    ``to_dict()``) and the models it reports equivalent, each with its fitted parameters:
+    a tuple of :class:`~discovery.vibroimpact.model.contact_models.ContactModel`."""
+    from ..fit.contact_fit import ContactModelsResult
+    from ..model.contact_models import MODELS, ContactModel
+
+    if isinstance(result, dict):
+        result = ContactModelsResult.from_dict(result)
+    if result.selected is None:
+        raise InputError(
+            "the contact-models fit selected no model (none is consistent with the record): "
+            "there are no candidates to separate; try the polynomial library"
+        )
+    out = []
+    for name in (result.selected, *result.equivalent):
+        p = result.fit(name).parameters
+        out.append(ContactModel(name, tuple(p[k] for k in MODELS[name])))
+    return tuple(out)
+
+
 def candidates_from_fit(run_dir):
-    """The selected law and its ``equivalent`` models of a ``vidi fit`` run directory.
+    """The selected law and its ``equivalent`` models of a ``vidi fit`` run directory (a
+    polynomial fit's, or a ``--library contact-models`` fit's: its selected named model
+    and those it reports equivalent, :func:`contact_candidates`).
 
     Returns
     -------
@@ -314,14 +366,17 @@ def candidates_from_fit(run_dir):
         raise InputError(f"{str(p)!r} is not readable JSON; run vidi fit again") from None
     if not isinstance(s, dict) or s.get("command") != "fit":
         raise InputError(f"{str(p)!r} is not a vidi fit summary; give a fit's --out directory")
-    try:
-        laws = [ForceLaw.from_dict(s["selected"]["coefficients"])]
-        laws += [ForceLaw.from_dict(e["coefficients"]) for e in s.get("equivalent") or []]
-    except (KeyError, TypeError, ValueError) as exc:
-        raise InputError(
-            f"{str(p)!r} has no readable selected law or equivalent models ({exc}); "
-            "run vidi fit again"
-        ) from None
+    if s.get("library") == "contact-models":
+        try:
+            laws = contact_candidates(s)
+        except InputError:
+            raise
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(
+                f"{str(p)!r} has no readable contact-models fit ({exc}); run vidi fit again"
+            ) from None
+    else:
+        laws = _polynomial_candidates(s, p)
     if len(laws) < 2:
         raise InputError(
             f"the fit in {str(run_dir)!r} lists no equivalent model: its record already "
@@ -333,3 +388,16 @@ def candidates_from_fit(run_dir):
     sc = s.get("scenario") or {}
     name = sc.get("name") if isinstance(sc, dict) else None
     return unique_laws(laws), given if isinstance(given, str) and given else name
+
+
+def _polynomial_candidates(s, p):
+    """The selected law and the equivalent models of a polynomial fit's summary."""
+    try:
+        laws = [ForceLaw.from_dict(s["selected"]["coefficients"])]
+        laws += [ForceLaw.from_dict(e["coefficients"]) for e in s.get("equivalent") or []]
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(
+            f"{str(p)!r} has no readable selected law or equivalent models ({exc}); "
+            "run vidi fit again"
+        ) from None
+    return laws

@@ -133,16 +133,24 @@ def start_model(name, records, tolerances, extra=()):
 
 
 def record_samples(scenario, reference):
-    """The first record's contact samples (None without positions or for a prepared
-    :class:`~discovery.vibroimpact.verify.Reference`)."""
+    """The contact samples of every record that holds positions, as one set (each
+    record's impacts their own groups, so each keeps its own approach velocity), or None
+    when no record has them (force records, prepared
+    :class:`~discovery.vibroimpact.verify.Reference` objects).  With records at several
+    operating points the impacts arrive at several velocities, and the regression start
+    separates a constant ``lambda`` from one set by each impact's ``v0``."""
     from ..data.measurement import Measurement
-    from ..data.samples import contact_samples
+    from ..data.samples import contact_samples, join_samples
+    from .records import pair_records
 
-    meas = reference[0] if isinstance(reference, list | tuple) else reference
-    sc = scenario[0] if isinstance(scenario, list | tuple) else scenario
-    if not isinstance(meas, Measurement):
-        return None
-    try:
-        return contact_samples(meas, period=sc.period)
-    except (VidiError, ValueError):
-        return None
+    parts = []
+    for sc, meas in pair_records(scenario, reference):
+        if not isinstance(meas, Measurement):
+            continue
+        try:
+            part = contact_samples(meas, period=sc.period)
+        except (VidiError, ValueError):
+            continue
+        if len(part):
+            parts.append(part)
+    return join_samples(parts) if parts else None

@@ -120,7 +120,8 @@ class IdentificationResult(Result):
     value : float
         Its final value.
     criteria : dict
-        All criteria ``I0..I4`` at the identified law (the mean over records).
+        All criteria ``I0..I4`` at the identified law, and ``I5`` where records have
+        positions (each the mean over the records that have it).
     evaluations : tuple of Evaluation
         The identified law against each record (without noise floor).
     method : str
@@ -304,6 +305,13 @@ def _checks(records, law, observe, tolerances):
     )
 
 
+def _mean_criteria(evs):
+    """Each criterion's mean over the records that have it (a record without positions,
+    or whose evaluation has no penetration to compare, has no I5)."""
+    keys = dict.fromkeys(k for e in evs for k in e.criteria)
+    return {k: float(np.mean([e.criteria[k] for e in evs if k in e.criteria])) for k in keys}
+
+
 @params(
     scenario=(Scenario, list, tuple),
     reference=(Measurement, Reference, Impulse, list, tuple),
@@ -439,7 +447,7 @@ def identify(
     if uncertainty:
         obj.max_sim += len(x_best) * len(records)  # the error estimate has its own budget
         se, corr = _uncertainty(obj, x_best, law.names)
-    crit = {k: float(np.mean([e.criteria[k] for e in evs])) for k in evs[0].criteria}
+    crit = _mean_criteria(evs)
     if obj.failures:
         message += (
             f"; {len(obj.failures)} trial law(s) had no periodic steady state with "
