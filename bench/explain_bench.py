@@ -22,16 +22,22 @@ def _realistic():
     return mod
 
 
-def bench_explain(repeat=2):
-    R = _realistic()
-
+def bench_record():
+    """``(scenario, record)``: the paper's machine and a 20-period scipy-path record of a law
+    with a hidden coupling (what explain is timed on)."""
     from discovery import ForceLaw, load_scenario
-    from discovery.vibroimpact.dynamics.steady_state import steady_state
-    from discovery.vibroimpact.explain import EFFECTS, explain
 
     sc = load_scenario("paper")
     law = ForceLaw.parse("2.06e8*z + 0.9e7*zd + 2e10*z*zd")  # a hidden coupling
-    rec = R.reference_record((sc.with_law(law), law), periods=20, seed=0, check=False)
+    rec = _realistic().reference_record((sc.with_law(law), law), periods=20, seed=0, check=False)
+    return sc, rec
+
+
+def bench_explain(repeat=2):
+    from discovery.vibroimpact.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.explain import EFFECTS, explain
+
+    sc, rec = bench_record()
     steady_state(sc, sc.law)  # compiled kernels loaded
     t_ss = min(_time(lambda: steady_state(sc, sc.law)) for _ in range(5))
     times, serial, res = [], [], None

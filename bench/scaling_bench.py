@@ -87,16 +87,12 @@ def bench_paper_study(workers):
 
 def bench_explain_scaling(counts):
     """explain on the bench's record with each worker count (the same effect named)."""
-    from explain_bench import _realistic
+    from explain_bench import bench_record
 
-    from discovery import ForceLaw, load_scenario
     from discovery.vibroimpact.dynamics.steady_state import steady_state
     from discovery.vibroimpact.explain import explain
 
-    R = _realistic()
-    sc = load_scenario("paper")
-    law = ForceLaw.parse("2.06e8*z + 0.9e7*zd + 2e10*z*zd")  # a hidden coupling
-    rec = R.reference_record((sc.with_law(law), law), periods=20, seed=0, check=False)
+    sc, rec = bench_record()
     steady_state(sc, sc.law)  # kernels loaded
     rows, named = [], []
     for w in counts:
