@@ -253,47 +253,39 @@ class _Fit:
 def _short_first(records, start, fit):
     """With record spans compared in blocks, the start fitted cycle by cycle first (up to
     half the budget; continuation in block length): ``(start, simulations spent)``.  The
-    caller's start is kept when it already matches the blocks better."""
+    caller's start is kept when it already matches the blocks better.  This first fit is
+    not restarted (:func:`~.optimise._fitted`): it only seeds the fit on the blocks, which
+    is."""
     short = [r.shortened() if isinstance(r, Reference) else None for _, r in records]
     if not (all(r is not None for r in short) and fit.max_simulations >= 8 * len(records)):
         return start, 0
-    spent = 0
+    progress = (
+        None
+        if fit.progress is None
+        else (lambda s, d, t: fit.progress("identify: cycle by cycle", d, t))
+    )
+    first = _Objective(
+        [(sc, r) for (sc, _), r in zip(records, short, strict=True)],
+        start,
+        fit.criterion,
+        fit.tolerances,
+        fit.max_simulations // 2,
+        observe=fit.observe,
+        progress=progress,
+    )
     try:
-        first = identify(
-            [sc for sc, _ in records],
-            short,
-            start,
-            criterion=fit.criterion,
-            method=fit.method,
-            xtol=fit.xtol,
-            max_simulations=fit.max_simulations // 2,
-            tolerances=fit.tolerances,
-            uncertainty=False,
-            observe=fit.observe,
-            short_first=False,
-            progress=False
-            if fit.progress is None
-            else (lambda s, d, t: fit.progress("identify: cycle by cycle", d, t)),
-            check=False,
-        )
-        spent = first.n_simulations
-        if not any(c == 0 for c in first.law.coefficients):
-            start0, start = start, first.law
-            # keep the caller's start when it already matches the blocks better
-            probe = _Objective(
-                records, start0, fit.criterion, fit.tolerances, 10**9, observe=fit.observe
-            )
-            alt = _Objective(
-                records, start, fit.criterion, fit.tolerances, 10**9, observe=fit.observe
-            )
-            x1 = np.ones(len(start.coefficients))
-            v0, v1 = probe(x1), alt(x1)
-            spent += probe.n + alt.n
-            if not v1 <= v0:
-                start = start0
+        x, _ = _fitted(first, fit.method, fit.xtol, fit.max_simulations // 2, restarts=False)
     except IntegrationError:
-        pass
-    return start, spent
+        return start, first.n
+    spent, law = first.n, first.law(x)
+    if any(c == 0 for c in law.coefficients):
+        return start, spent
+    # keep the caller's start when it already matches the blocks better
+    probe = _Objective(records, start, fit.criterion, fit.tolerances, 10**9, observe=fit.observe)
+    alt = _Objective(records, law, fit.criterion, fit.tolerances, 10**9, observe=fit.observe)
+    x1 = np.ones(len(law.coefficients))
+    v0, v1 = probe(x1), alt(x1)
+    return (law if v1 <= v0 else start), spent + probe.n + alt.n
 
 
 def _checks(records, law, observe, tolerances):
