@@ -107,7 +107,7 @@ class Fold:
         F = np.concatenate([[Fm[0]], Fm, [Fm[-1]]])
         n_eff = max(self.n_cycles, 1)
         support = _sampled_support(
-            tau, F, threshold, self.period, noise / np.sqrt(n_eff), extrapolate=False
+            tau, F, threshold, self.period, noise=noise / np.sqrt(n_eff), extrapolate=False
         )
         onsets = support[:, 0].copy() if len(support) else np.zeros(1)
         return Impulse(
