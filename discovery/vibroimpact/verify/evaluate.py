@@ -272,7 +272,7 @@ def _only_i4(same, consistent, crit, lim):
     )
 
 
-def _verdict(consistent, reg, imp, crit, floor, lim=None, transient=False):
+def _verdict(consistent, reg, imp, crit, floor, *, lim=None, transient=False):
     """One sentence; with ``transient`` (a record span the law's trajectory has not settled
     over) a regime difference is no mismatch and the law is judged over the span."""
     if not crit:
@@ -375,7 +375,14 @@ def evaluate(
     """
     if from_state and getattr(reference, "span", None) is not None:
         return _evaluate_span(
-            scenario, law, reference, tolerances, floor, observe, steady_kwargs, smooth_onset
+            scenario,
+            law,
+            reference,
+            tolerances=tolerances,
+            floor=floor,
+            observe=observe,
+            steady_kwargs=steady_kwargs,
+            smooth_onset=smooth_onset,
         )
     E = reference.impulse
     reg = {"measured": reference.regime, "simulated": None}
@@ -437,7 +444,7 @@ def evaluate(
     # an undefined floor (no bootstrap replicate found the contacts) decides nothing
     consistent = bool(same and all(np.isfinite(lim[k]) and crit[k] <= lim[k] for k in lim))
     only_i4 = _only_i4(same, consistent, crit, lim)
-    verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim)
+    verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim=lim)
     if verdict is not None and reference.noise:  # a record, not an exact reference
         verdict += (
             f"; {MOTION_CRITERION} (the penetration) not checked: the record has no "
@@ -484,11 +491,13 @@ def _orbit_history(scenario, law, ss, block, tolerances):
     return np.asarray(tr.force, dtype=float)
 
 
-def _span_steady_state(scenario, law, reference, last, span, sim, reg, tolerances, steady_kwargs):
+def _span_steady_state(scenario, law, reference, sim, reg, *, tolerances, steady_kwargs):
     """The law's steady state from the record's state (only to report its regime, set in
-    ``reg``) and ``transient``: I2 between the law's trajectory over the last block and its
-    steady orbit (``None`` without a periodic orbit).  Returns ``(steady state or None,
-    transient)``."""
+    ``reg``) and ``transient``: I2 between the law's trajectory over the last block of
+    ``reference.span`` (``sim``, its folded cycle) and its steady orbit (``None`` without a
+    periodic orbit).  Returns ``(steady state or None, transient)``."""
+    span = reference.span
+    last = span.blocks[-1]
     steady_kwargs = {
         "y_start": scenario.model_state(reference.start),
         "t_start": reference.start_time,
@@ -537,7 +546,7 @@ def _transient_notes(transient_mismatch, settled, transient, reg, ss):
 
 
 def _evaluate_span(
-    scenario, law, reference, tolerances, floor, observe, steady_kwargs, smooth_onset=False
+    scenario, law, reference, *, tolerances, floor, observe, steady_kwargs, smooth_onset=False
 ):
     """:func:`evaluate` for a record with positions: the law simulated from the machine's
     states across the record's span, block by block, both histories folded by the same
@@ -592,7 +601,7 @@ def _evaluate_span(
     if not floor:
         return Evaluation("ok", reg, imp, crit, {}, False, "", simulated=sim, **found)
     ss, transient = _span_steady_state(
-        scenario, law, reference, last, span, sim, reg, tolerances, steady_kwargs
+        scenario, law, reference, sim, reg, tolerances=tolerances, steady_kwargs=steady_kwargs
     )
     found["transient_i2"] = transient
     settled = transient is not None and transient <= TRANSIENT_GAP
@@ -621,7 +630,9 @@ def _evaluate_span(
             "they agree (a contact split or hidden near the threshold)"
         )
         imp = {**imp, "simulated": imp["measured"]}
-    verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim, transient=transient_mismatch)
+    verdict = _verdict(
+        consistent, reg, imp, crit, fl["mean"], lim=lim, transient=transient_mismatch
+    )
     notes += _transient_notes(transient_mismatch, settled, transient, reg, ss)
     if notes and verdict is not None:
         verdict = f"{verdict}; " + "; ".join(notes)
