@@ -317,6 +317,16 @@ verified again at the start of the next iteration of ``explain``, an optimiser's
 with its noise floor."""
 
 
+def _from_start(scenario, reference, steady_kwargs):
+    """``steady_kwargs`` with the search started from the record's measured state (what the
+    caller gave overriding it)."""
+    return {
+        "y_start": scenario.model_state(reference.start),
+        "t_start": reference.start_time,
+        **steady_kwargs,
+    }
+
+
 def _steady(scenario, law, tolerances, steady_kwargs):
     # a continuation's guess is keyed by the orbit it starts from
     g = steady_kwargs.get("guess")
@@ -384,15 +394,10 @@ def evaluate(
             steady_kwargs=steady_kwargs,
             smooth_onset=smooth_onset,
         )
-    E = reference.impulse
     reg = {"measured": reference.regime, "simulated": None}
     imp = {"measured": reference.impacts, "simulated": None}
     if from_state and reference.start is not None:
-        steady_kwargs = {
-            "y_start": scenario.model_state(reference.start),
-            "t_start": reference.start_time,
-            **steady_kwargs,
-        }
+        steady_kwargs = _from_start(scenario, reference, steady_kwargs)
     try:
         ss = _steady(scenario, law, tolerances, steady_kwargs)
         if not ss.periodic:
@@ -430,10 +435,10 @@ def evaluate(
             "inconsistent: the simulated bodies never come into contact",
             steady=ss,
         )
-    rot, sim = align(E, exact)
+    rot, sim = align(reference.impulse, exact)
     # contacts per simulated orbit, seen through the measurement's threshold rules
     imp["simulated"] = int(round(len(sim.support) * ss.n_periods / sim.n_periods))
-    crit = evaluate_criteria(E, sim)
+    crit = evaluate_criteria(reference.impulse, sim)
     if not floor:
         return Evaluation(
             "ok", reg, imp, crit, {}, False, "", steady=ss, simulated=sim, aligned=rot
@@ -498,11 +503,7 @@ def _span_steady_state(scenario, law, reference, sim, reg, *, tolerances, steady
     periodic orbit).  Returns ``(steady state or None, transient)``."""
     span = reference.span
     last = span.blocks[-1]
-    steady_kwargs = {
-        "y_start": scenario.model_state(reference.start),
-        "t_start": reference.start_time,
-        **steady_kwargs,
-    }
+    steady_kwargs = _from_start(scenario, reference, steady_kwargs)
     ss, transient = None, None
     try:
         ss = _steady(scenario, law, tolerances, steady_kwargs)
