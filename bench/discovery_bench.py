@@ -17,7 +17,7 @@ import numpy as np
 from constraints import certify
 from discovery import ForceLaw, load_scenario, synthesize
 from discovery.vibroimpact.data.samples import contact_samples
-from discovery.vibroimpact.fit.constrained_lsq import _Problem
+from discovery.vibroimpact.fit.constrained_lsq import _Constraints, _Problem
 from discovery.vibroimpact.fit.regression import ConstrainedSparseRegressor
 
 TRUE = "2.06e8*z + 1.28e7*zd + 2e10*z*zd"
@@ -47,14 +47,10 @@ def _pysindy_grid(est_template, X, y, grid=30, thr=0.05):
     est = est_template
     prob = _Problem(
         est.library_,
-        est.box_,
+        _Constraints(box=est.box_, margin=0.0, monotone=False, signs=None, elevation=2),
         X,
         y,
         np.ones(y.size),
-        margin=0.0,
-        monotone=False,
-        signs=None,
-        elevation=2,
         solver="CLARABEL",
     )
     lib = est.library_

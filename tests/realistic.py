@@ -265,7 +265,7 @@ def _reference_problem(scenario, law, ss, transient):
     are fixed and tested in ``tests/test_reference_sim.py``.
     """
     try:
-        t, y, _, _ = _clean(scenario, law, 15, 20000.0, int(transient), False)
+        t, y, _, _ = _clean(scenario, law, 15, 20000.0, int(transient), record_transient=False)
     except (VidiError, RuntimeError) as exc:
         return f"reference path failed: {exc}"
     T, n = scenario.period, ss.n_periods
@@ -454,7 +454,9 @@ def reference_record(
     transient, periods = int(transient), int(periods)
     if transient < 0 or periods < 1 or not fs > 0 or force_noise < 0 or motion_noise < 0:
         raise ValueError("need transient >= 0, periods >= 1, fs > 0 and noise levels >= 0")
-    t, y, F, _ = _clean(scenario, law, periods, float(fs), transient, bool(record_transient))
+    t, y, F, _ = _clean(
+        scenario, law, periods, float(fs), transient, record_transient=bool(record_transient)
+    )
     if check:
         err = _kernel_mismatch(scenario, law, t, y)
         if not err < CHECK_TOL:
@@ -490,7 +492,14 @@ def reference_events(
     scenario, law, _ = _unpack(case_or_pair)
     if transient is None:
         transient = default_transient(case_or_pair)
-    return _clean(scenario, law, int(periods), float(fs), int(transient), bool(record_transient))[3]
+    return _clean(
+        scenario,
+        law,
+        int(periods),
+        float(fs),
+        int(transient),
+        record_transient=bool(record_transient),
+    )[3]
 
 
 # ------------------------------------------------------ verification properties

@@ -202,10 +202,10 @@ def test_case5_onset_is_bracketed_by_the_force_jump():
     F = np.array([0, 0, 0, 0, 9e5, 8e5, 6e5, 3e5, 0, 0], dtype=float)
     s, thr = 4, 5e4
     # a zeta onset two samples early, or late, is brought into (t[3], t[4]]
-    assert _bracket_onset(t, F, s, t[8], thr, t[1] + 0.3e-4) == t[3]
-    assert _bracket_onset(t, F, s, t[8], thr, t[6]) == t[4]
-    assert _bracket_onset(t, F, s, t[8], thr, t[3] + 0.4e-4) == t[3] + 0.4e-4
+    assert _bracket_onset(t, F, (t[1] + 0.3e-4, t[8], s), thr) == t[3]
+    assert _bracket_onset(t, F, (t[6], t[8], s), thr) == t[4]
+    assert _bracket_onset(t, F, (t[3] + 0.4e-4, t[8], s), thr) == t[3] + 0.4e-4
     # a smooth rise (small first sample above the threshold) keeps an early onset
     G = np.array([0, 0, 0, 2e4, 6e4, 2e5, 5e5, 9e5, 3e5, 0], dtype=float)
-    assert _bracket_onset(t, G, s, t[9], thr, t[2] + 0.5e-4) == t[2] + 0.5e-4
-    assert _bracket_onset(t, G, s, t[9], thr, t[6]) == t[4]
+    assert _bracket_onset(t, G, (t[2] + 0.5e-4, t[9], s), thr) == t[2] + 0.5e-4
+    assert _bracket_onset(t, G, (t[6], t[9], s), thr) == t[4]

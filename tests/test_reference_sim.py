@@ -188,11 +188,21 @@ def test_a_surface_function_at_the_start_follows_the_flow():
     evs = R._events(law, "free", {"m2": 1.0, "zmax": 0.0})
     # on the surface and moving across: the onset happens now (a zero-length segment)
     g0, on, trend = R._surface_start(
-        evs, lambda t, y: [y[1], 0.0, y[3], 0.0], 0.0, np.array([0.0, 1.0, 0.0, 0.0]), 1e-8, 1e-12
+        evs,
+        lambda t, y: [y[1], 0.0, y[3], 0.0],
+        0.0,
+        np.array([0.0, 1.0, 0.0, 0.0]),
+        dt_trend=1e-8,
+        tau_on=1e-12,
     )
     assert on[0] and trend[0] == 1.0 and R._crossing_now(evs, on, trend) == 0
     # moving away: held, not fired
     g0, on, trend = R._surface_start(
-        evs, lambda t, y: [y[1], 0.0, y[3], 0.0], 0.0, np.array([0.0, -1.0, 0.0, 0.0]), 1e-8, 1e-12
+        evs,
+        lambda t, y: [y[1], 0.0, y[3], 0.0],
+        0.0,
+        np.array([0.0, -1.0, 0.0, 0.0]),
+        dt_trend=1e-8,
+        tau_on=1e-12,
     )
     assert on[0] and trend[0] == -1.0 and R._crossing_now(evs, on, trend) is None

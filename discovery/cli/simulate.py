@@ -66,7 +66,12 @@ def run(args):
     )
     csv_text = meas.to_csv_text()
     summary = SimulatedRecord.of(
-        sc, law, out.name, csv_text, int(meas.t.size), time.perf_counter() - t0
+        sc,
+        law,
+        out.name,
+        csv_text,
+        samples=int(meas.t.size),
+        seconds=time.perf_counter() - t0,
     ).record_run({"command": "simulate"}, provenance(vars(args), inputs=inputs_of(args)))
     text = json.dumps(summary.to_dict(), indent=2) + "\n"
     atomic_write_text(out, csv_text)

@@ -123,7 +123,7 @@ class Impulse:
                 vals,
                 other.threshold,
                 other.duration / other.n_periods,
-                other.noise / np.sqrt(max(other.n_cycles, 1)),
+                noise=other.noise / np.sqrt(max(other.n_cycles, 1)),
             )
         else:
             support = self.periodic_support(reps * self.duration)
@@ -273,13 +273,15 @@ def _merge_unseparated(t, zeta, runs):
     return out
 
 
-def _bracket_onset(t, F, s, t_off, thr, t_on):
-    """A ``zeta`` onset kept where the force allows it: not after sample ``s``, the first
+def _bracket_onset(t, F, run, thr):
+    """The ``zeta`` onset of ``run = (t_on, t_off, s)`` (onset, loss, first sample above
+    ``thr``) kept where the force allows it: not after sample ``s``, the first
     one above the threshold (the contact has begun there), and, when the force *jumps*
     at ``s`` (from at most half the threshold to a quarter of the contact's peak or
     more: a viscous contact's ``F(0+)``), not before sample ``s - 1`` either (the force
     was still zero there).  A noisy ``zeta`` can be a sample or two off; a force jump
     brackets the onset within one sample."""
+    t_on, t_off, s = run
     hi = t[s]
     lo = -np.inf
     if s >= 1:
@@ -295,7 +297,7 @@ def _edge_params(t, period, min_samples=3):
     return max(min_samples, int(0.01 * period / dt)), max(4.0, 0.02 * period / dt)
 
 
-def _sampled_support(tau, F, thr, period, noise=0.0, extrapolate=True):
+def _sampled_support(tau, F, thr, period, *, noise=0.0, extrapolate=True):
     """Support of a cycle sampled at ``tau`` (starting at the onset, ``tau[0] = 0``).
 
     When its noise is not negligible (``noise > thr / 100``) the cycle is first smoothed
@@ -310,13 +312,18 @@ def _sampled_support(tau, F, thr, period, noise=0.0, extrapolate=True):
     t_ext = np.concatenate([[-dt], tau, [tau[-1] + dt]])
     f_ext = np.concatenate([[0.0], Fs, [0.0]])
     runs = _edges(
-        t_ext, f_ext, thr, min_len, max_extrap if extrapolate else None, noise / np.sqrt(width)
+        t_ext,
+        f_ext,
+        thr,
+        min_len,
+        max_extrap=max_extrap if extrapolate else None,
+        noise=noise / np.sqrt(width),
     )
     sup = [(max(a, 0.0), min(b, tau[-1])) for a, b, _ in runs]
     return np.array(sup, dtype=float).reshape(-1, 2)
 
 
-def _edges(t, F, thr, min_len, max_extrap=4.0, noise=0.0):
+def _edges(t, F, thr, min_len, *, max_extrap=4.0, noise=0.0):
     """Sub-sample start/end times of the runs where F > thr (runs shorter than
     ``min_len`` samples dropped unless they last 3 samples and peak above ``3 thr``;
     gaps shorter than ``min_len``, or not going below ``thr - 3 noise``, closed).
@@ -396,12 +403,13 @@ def _checked_record(t, F, period, n_periods):
     return t, F
 
 
-def _contact_runs(t, F, thr, sigma, period, min_samples, zeta, dt):
+def _contact_runs(t, F, thr, sigma, period, *, min_samples, zeta):
     """The contacts ``[(onset, loss, first sample), ...]`` above ``thr`` (gaps shorter than
     1 % of a period are noise flicker inside one contact; a contact whose peak barely clears
     the threshold is noise); with ``zeta``, contacts not separated by a free flight merged
     and onsets refined on the penetration."""
-    runs = _edges(t, F, thr, *_edge_params(t, period, min_samples), noise=sigma)
+    min_len, max_extrap = _edge_params(t, period, min_samples)
+    runs = _edges(t, F, thr, min_len, max_extrap=max_extrap, noise=sigma)
     if runs:
         # a contact whose peak barely clears the threshold is noise, not an impact
         pk = np.array([np.max(F[s : int(np.searchsorted(t, off)) + 1]) for _, off, s in runs])
@@ -409,9 +417,9 @@ def _contact_runs(t, F, thr, sigma, period, min_samples, zeta, dt):
     if zeta is not None:
         zeta = np.asarray(zeta, dtype=float)
         runs = _merge_unseparated(t, zeta, runs)
-        back = 0.25 * period / dt
+        back = 0.25 * period / float(np.median(np.diff(t)))
         runs = [
-            (_bracket_onset(t, F, s, t_off, thr, _refine_onset(t, zeta, s, t_on, back)), t_off, s)
+            (_bracket_onset(t, F, (_refine_onset(t, zeta, s, t_on, back), t_off, s), thr), t_off, s)
             for t_on, t_off, s in runs
         ]
     return runs
@@ -434,10 +442,39 @@ def _recurring(onsets, ref_j, W, period):
     return mains
 
 
-def _cycle(t, F, t_on, tau, W, thr, exact_onset, onsets, period):
-    """The force of the cycle starting at ``t_on`` on the time axis ``tau`` since its
-    onset."""
-    s = _first_after(t, F, t_on, thr, exact_onset)
+@dataclass(frozen=True)
+class _CycleFrame:
+    """What every cycle of one record is cut with.
+
+    Attributes
+    ----------
+    tau : ndarray of shape (m,)
+        Time axis since a cycle's onset [s], from 0 to ``W``.
+    W : float
+        Cycle length ``n_periods * period`` [s].
+    thr : float
+        Contact threshold [N].
+    exact_onset : bool
+        Whether the onsets were refined on ``zeta`` (see :func:`_first_after`).
+    onsets : ndarray of shape (k,)
+        Every contact onset in the record [s].
+    period : float
+        Drive period [s].
+    """
+
+    tau: np.ndarray
+    W: float
+    thr: float
+    exact_onset: bool
+    onsets: np.ndarray
+    period: float
+
+
+def _cycle(t, F, t_on, frame):
+    """The force of the cycle starting at ``t_on`` on the time axis ``frame.tau`` since
+    its onset."""
+    tau, W, onsets, period = frame.tau, frame.W, frame.onsets, frame.period
+    s = _first_after(t, F, t_on, frame.thr, frame.exact_onset)
     vals = np.interp(t_on + tau, t, F)
     # right limit at the onset: extrapolate the first samples after it, and do not
     # interpolate across a jump between the onset and sample s
@@ -505,7 +542,7 @@ def impulse_from_samples(
     dt = float(np.median(np.diff(t)))
     sigma = estimate_noise(F)
     thr = max(5.0 * sigma, 1e-3 * float(np.max(F))) if threshold is None else float(threshold)
-    runs = _contact_runs(t, F, thr, sigma, period, min_samples, zeta, dt)
+    runs = _contact_runs(t, F, thr, sigma, period, min_samples=min_samples, zeta=zeta)
     if not runs:
         raise NoContactError(
             "no contact found in the force record (no run of samples above "
@@ -539,7 +576,8 @@ def impulse_from_samples(
     t_on0 = runs[mains[0]][0]
     inside = t[_first_after(t, F, t_on0, thr, zeta is not None) :] - t_on0
     tau = np.concatenate([[0.0], inside[inside < W], [W]])
-    stack = [_cycle(t, F, runs[j][0], tau, W, thr, zeta is not None, onsets, period) for j in mains]
+    frame = _CycleFrame(tau, W, thr, zeta is not None, onsets, period)
+    stack = [_cycle(t, F, runs[j][0], frame) for j in mains]
     steady = _steady_tail(np.array(stack), sigma)
     stack = [stack[i] for i in steady]
     mains = [mains[i] for i in steady]
@@ -550,7 +588,7 @@ def impulse_from_samples(
         if threshold is not None
         else max(5.0 * sigma / np.sqrt(len(mains)), 1e-3 * float(np.max(F)))
     )
-    support = _sampled_support(tau, Fm, thr_avg, period, sigma / np.sqrt(len(mains)))
+    support = _sampled_support(tau, Fm, thr_avg, period, noise=sigma / np.sqrt(len(mains)))
     # the cyclic sequence of impacts, from the last steady cycle
     j_last = mains[-1]
     rel = onsets - onsets[j_last]

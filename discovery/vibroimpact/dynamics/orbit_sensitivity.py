@@ -141,10 +141,23 @@ def _force_rate(scenario, law, t, y, mode):
     return out
 
 
-def _impacts(t, F, dF, ev_t, ev_k, dev, t_end):
+def _impacts(t, tr, t_end):
     """Peak force and contact time of each contact (onset to loss) and their derivatives
     (at an interior maximum the derivative at fixed time is the maximum's), and when its
-    penetration is largest (the first switch to unloading)."""
+    penetration is largest (the first switch to unloading).
+
+    Parameters
+    ----------
+    t : ndarray of shape (k,)
+        The times [s] ``tr`` was sampled at.
+    tr : Trajectory
+        A run with coefficient sensitivities (its force, the force's and the events'
+        derivatives).
+    t_end : float
+        End [s] of the first orbit: only its onsets are summarised.
+    """
+    F, dF = tr.force, tr.force_sensitivity
+    ev_t, ev_k, dev = tr.event_t, tr.event_kind, tr.event_time_sensitivity
     out = []
     on = np.flatnonzero((ev_k == K.EV_ONSET) & (ev_t < t_end))  # onsets of the first orbit
     for j in on:
@@ -218,11 +231,21 @@ def orbit_sensitivity(scenario, law, ss, *, impacts=True, points_per_period=4000
         "impacts": [],
     }
     if impacts:
-        out.update(_sampled(scenario, law, ss, dy0, span, points_per_period, tolerances))
+        out.update(
+            _sampled(
+                scenario,
+                law,
+                ss,
+                dy0,
+                span,
+                points_per_period=points_per_period,
+                tolerances=tolerances,
+            )
+        )
     return OrbitSensitivity(**out, scenario=scenario, law=law, steady=ss, tolerances=tolerances)
 
 
-def _sampled(scenario, law, ss, dy0, span, points_per_period, tolerances):
+def _sampled(scenario, law, ss, dy0, span, *, points_per_period, tolerances):
     """Two orbits sampled with their derivatives (a contact under way at ``t0`` ends in the
     second), and each contact of the first orbit's summary."""
     n = ss.n_periods
@@ -239,7 +262,7 @@ def _sampled(scenario, law, ss, dy0, span, points_per_period, tolerances):
         sensitivity_start=dy0,
     )
     dev = tr.event_time_sensitivity
-    impacts = _impacts(te, tr.force, tr.force_sensitivity, tr.event_t, tr.event_kind, dev, span[1])
+    impacts = _impacts(te, tr, span[1])
     for imp in impacts:
         # the largest penetration is where the bodies stop closing (dzeta = 0): its
         # derivative is the penetration's at that fixed time, from a run that ends there

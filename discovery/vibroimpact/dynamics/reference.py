@@ -28,6 +28,8 @@ A run of more than ``_MAX_ZERO_LENGTH`` zero-length segments at one instant rais
 :class:`~discovery.errors.IntegrationError` (chattering between modes).
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -77,7 +79,7 @@ def _unload(law, z, v, zmax):
     )
 
 
-def _force(law, mode, z, v, zmax, clamp=False):
+def _force(law, mode, z, v, zmax, *, clamp=False):
     """Contact force of a mode.  Inside the integration the vector field is extended
     smoothly past the loss surface (odd extension of ``P``: a Runge-Kutta step that
     straddles the loss samples it there, and a kink would spoil the step's accuracy,
@@ -164,7 +166,7 @@ def _after(law, kind, y, state, loss):
     return "load" if _load(law, z, max(v, 0.0), state["zmax"]) >= 0 else "clipped"
 
 
-def _surface_start(evs, rhs, t, y, dt_trend, tau_on):
+def _surface_start(evs, rhs, t, y, *, dt_trend, tau_on):
     """Each surface function's value at the start of a segment and where it goes.
 
     Returns ``(g0, on, trend)``: values, whether each is on its surface (within
@@ -237,26 +239,55 @@ def _held_events(evs, on, g0, t, tau_on):
     return fns
 
 
-def _sample(sol, te, t_start, t_end, out_y, out_f, law, mode, state):
-    """The segment's states and contact force at the requested times it covers."""
-    mask = (te >= t_start) & (te <= t_end)
-    if mask.any():
-        ys = sol.sol(te[mask])
-        out_y[:, mask] = ys
-        out_f[mask] = [
-            _force(law, mode, w1 - w2, v1 - v2, state["zmax"], clamp=True)
-            for w1, v1, w2, v2 in ys.T
-        ]
+@dataclass(frozen=True)
+class _Samples:
+    """The requested output times and the states and forces filled in at them.
+
+    Attributes
+    ----------
+    t : ndarray of shape (n,)
+        Requested times [s].
+    y : ndarray of shape (4, n)
+        States there (NaN until a segment covers them).
+    force : ndarray of shape (n,)
+        Contact force [N] there (NaN until a segment covers them).
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    force: np.ndarray
+
+    @classmethod
+    def at(cls, te):
+        """Empty samples at times ``te``."""
+        return cls(te, np.full((4, te.size), np.nan), np.full(te.size, np.nan))
+
+    def fill(self, sol, span, law, mode, zmax):
+        """The states and contact force of the segment ``sol`` of ``mode`` (largest
+        penetration ``zmax``) at the requested times it covers, ``span = (t_start,
+        t_end)``."""
+        mask = (self.t >= span[0]) & (self.t <= span[1])
+        if mask.any():
+            ys = sol.sol(self.t[mask])
+            self.y[:, mask] = ys
+            self.force[mask] = [
+                _force(law, mode, w1 - w2, v1 - v2, zmax, clamp=True) for w1, v1, w2, v2 in ys.T
+            ]
 
 
-def _fired(sol, evs, rhs, t, y, T):
+def _fired(sol, evs, rhs, t, y, *, period):
     """The kind of the event that ended the segment: the first in time; a lower-index
     surface reached at the same instant wins the tie (contact loss before the force
     reaching zero, as in the kernel)."""
     fired = [i for i, tev in enumerate(sol.t_events) if len(tev)]
     i = min(fired, key=lambda i: (sol.t_events[i][0], i))
     _, on_end, trend_end = _surface_start(
-        evs, rhs, t, y, _TREND_STEP * T, _ON_SURFACE * max(abs(t), T)
+        evs,
+        rhs,
+        t,
+        y,
+        dt_trend=_TREND_STEP * period,
+        tau_on=_ON_SURFACE * max(abs(t), period),
     )
     j = _crossing_now(evs[:i], on_end[:i], trend_end[:i])
     return evs[i if j is None else j][2]
@@ -266,6 +297,7 @@ def reference_simulate(
     scenario,
     law,
     t_span,
+    *,
     y0=None,
     t_eval=None,
     rtol=1e-10,
@@ -296,8 +328,7 @@ def reference_simulate(
         atol = rtol * 1e-3 * np.array([x, v, x, v])
     t, t1 = float(t_span[0]), float(t_span[1])
     te = np.zeros(0) if t_eval is None else np.asarray(t_eval, dtype=float)
-    out_y = np.full((4, te.size), np.nan)
-    out_f = np.full(te.size, np.nan)
+    samples = _Samples.at(te)
     mode = _mode_of(law, y, state)
     events, nfev, zero_length = [], 0, 0
 
@@ -310,7 +341,7 @@ def reference_simulate(
         rhs = _make_rhs(scenario, state["law"], mode, state)
         evs = _events(state["law"], mode, state)
         tau_on = _ON_SURFACE * max(abs(t), T)
-        g0, on, trend = _surface_start(evs, rhs, t, y, _TREND_STEP * T, tau_on)
+        g0, on, trend = _surface_start(evs, rhs, t, y, dt_trend=_TREND_STEP * T, tau_on=tau_on)
         i_now = _crossing_now(evs, on, trend)
         if i_now is not None:  # an event at the segment's start: a zero-length segment
             zero_length += 1
@@ -339,13 +370,20 @@ def reference_simulate(
         if sol.status == -1:
             raise IntegrationError(f"reference integration failed: {sol.message}")
         t_end = sol.t[-1]
-        _sample(sol, te, t_start, t_end, out_y, out_f, state["law"], mode, state)
+        samples.fill(sol, (t_start, t_end), state["law"], mode, state["zmax"])
         y = sol.y[:, -1].copy()
         t = t_end
         if t_end - t_start > _HOLD * tau_on:
             zero_length = 0
         if sol.status == 1:
-            kind = _fired(sol, evs, rhs, t, y, T)
+            kind = _fired(sol, evs, rhs, t, y, period=T)
             record(kind, y)
             mode = _after(law, kind, y, state, scenario.mass_loss)
-    return {"t": te, "y": out_y, "force": out_f, "events": events, "y_final": y, "nfev": nfev}
+    return {
+        "t": te,
+        "y": samples.y,
+        "force": samples.force,
+        "events": events,
+        "y_final": y,
+        "nfev": nfev,
+    }

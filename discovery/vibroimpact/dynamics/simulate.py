@@ -182,7 +182,7 @@ SENSITIVITIES = ("state", "coefficients", "all")
 _STATE_NAMES = ("w1", "v1", "w2", "v2")
 
 
-def sensitivity_setup(scenario, law, which, n_eval=0, n_events=0, controlled=True, start=None):
+def sensitivity_setup(scenario, law, which, *, n_eval=0, n_events=0, controlled=True, start=None):
     """The kernel's sensitivity arguments ``(S, spar, sscale, out_dF, ev_tau)`` and the
     columns' names for ``which`` (one of :data:`SENSITIVITIES`): the start's four states
     (``S`` the identity there) and/or the law's coefficients (``S`` zero there); with
@@ -335,10 +335,10 @@ def simulate(
             scenario,
             law,
             sensitivities,
-            te.size,
-            max_events,
-            control_sensitivities,
-            sensitivity_start,
+            n_eval=te.size,
+            n_events=max_events,
+            controlled=control_sensitivities,
+            start=sensitivity_start,
         )
     announce_compile("vibro-impact")
     status, tf, yf, mf, n_steps, n_ev, _ = K.integrate(

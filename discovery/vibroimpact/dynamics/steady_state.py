@@ -286,10 +286,12 @@ def _strobe_recurrence(pm, y, max_period):
     return strobe[-1], 2 * max_period + 2, recurrence(strobe, pm.scale, max_period), quick
 
 
-def _orbit(scenario, law, pm, y, n, tol, max_newton, attempt, t0, evidence):
-    """Newton shooting for a period-``n`` orbit from ``y``: the steady state when it
-    converges to a stable orbit (reduced to its smallest period), else ``None``.  Every try
-    is recorded in ``attempt``."""
+def _orbit(pm, y, n, t0, *, tol, max_newton, attempt, evidence):
+    """Newton shooting for a period-``n`` orbit from ``y`` (at time ``t0`` [s]) on the
+    stroboscopic map ``pm`` of a scenario and law: the steady state when it converges to a
+    stable orbit (reduced to its smallest period), else ``None``.  Every try is recorded in
+    ``attempt`` (one of ``evidence``'s attempts); ``tol`` and ``max_newton`` are Newton's
+    (see :func:`steady_state`)."""
     hist = []
     y_orb, res, J, ok = newton_orbit(pm, y, n, tol, max_newton, hist)
     mult = floquet_multipliers(J, len(y))
@@ -319,11 +321,11 @@ def _orbit(scenario, law, pm, y, n, tol, max_newton, attempt, t0, evidence):
         )
         n, mult = m, floquet_multipliers(J)
     zmax, v0 = 0.0, 0.0
-    if law.has_memory:
+    if pm.law.has_memory:
         # one more orbit from y0 leaves the memory y0 holds (the orbit is periodic)
         pm.advance(y_orb, n)
         zmax, v0 = pm.zeta_max, pm.impact_v0
-    impacts = _count_onsets(scenario, law, pm.tol, y_orb, t0, n, zmax, v0)
+    impacts = _count_onsets(pm, y_orb, t0, n, zeta_max0=zmax, impact_v0=v0)
     return SteadyState(
         regime=f"P{n}",
         n_periods=n,
@@ -441,7 +443,16 @@ def steady_state(
         if quick < 1e-2:
             order = [1] + [n for n in range(2, max_period + 1)][:2]
         for n in order[:3]:
-            found = _orbit(scenario, law, pm, y, n, tol, max_newton, attempt, t_done * T, evidence)
+            found = _orbit(
+                pm,
+                y,
+                n,
+                t_done * T,
+                tol=tol,
+                max_newton=max_newton,
+                attempt=attempt,
+                evidence=evidence,
+            )
             if found is not None:
                 return found
     return SteadyState(
@@ -481,7 +492,7 @@ def _continued(scenario, law, pm, guess, tol):
         "t_start": float(guess.t0),
         "continued_from": {"regime": guess.regime, "newton_residuals": hist},
     }
-    impacts = _count_onsets(scenario, law, pm.tol, y_orb, guess.t0, n, 0.0)
+    impacts = _count_onsets(pm, y_orb, guess.t0, n)
     return SteadyState(
         regime=f"P{n}",
         n_periods=n,
@@ -496,13 +507,16 @@ def _continued(scenario, law, pm, guess, tol):
     )
 
 
-def _count_onsets(scenario, law, tol, y0, t0, n, zeta_max0=0.0, impact_v0=0.0):
+def _count_onsets(pm, y0, t0, n, *, zeta_max0=0.0, impact_v0=0.0):
+    """Contact onsets over ``n`` drive periods from ``y0`` at ``t0`` [s], simulated with
+    the scenario, law and tolerances of the stroboscopic map ``pm`` (and the contact
+    memory ``zeta_max0``, ``impact_v0`` the start holds)."""
     tr = simulate(
-        scenario,
-        law,
-        (t0, t0 + n * scenario.period),
+        pm.scenario,
+        pm.law,
+        (t0, t0 + n * pm.scenario.period),
         y0=y0,
-        tolerances=tol,
+        tolerances=pm.tol,
         zeta_max0=zeta_max0,
         impact_v0=impact_v0,
     )

@@ -47,8 +47,22 @@ class SimulatedRecord(Result):
     _LOAD = {"law": lambda d: ForceLaw.parse(d["law"])}
 
     @classmethod
-    def of(cls, scenario, law, csv_name, csv_text, samples, seconds=0.0):
-        """The summary of the record ``csv_text`` written as ``csv_name``."""
+    def of(cls, scenario, law, csv_name, csv_text, *, samples, seconds=0.0):
+        """The summary of the record ``csv_text`` written as ``csv_name``.
+
+        Parameters
+        ----------
+        scenario : Scenario
+        law : ForceLaw
+        csv_name : str
+            The record's file name.
+        csv_text : str
+            The record's CSV text (its SHA-256 goes into ``outputs``).
+        samples : int
+            Samples in the record.
+        seconds : float
+            Time taken to make it [s].
+        """
         digest = hashlib.sha256(csv_text.encode()).hexdigest()
         return cls(scenario.as_dict(), law, samples, seconds, {csv_name: {"sha256": digest}})
 
@@ -78,12 +92,12 @@ class SimulatedRecord(Result):
 def synthesize(
     scenario,
     law,
+    *,
     periods=20,
     fs=20000.0,
     noise=0.0,
     seed=0,
     ss=None,
-    *,
     from_rest=False,
     position_noise=0.0,
     velocities=True,

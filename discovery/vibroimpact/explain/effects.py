@@ -252,7 +252,7 @@ class Model:
         return str(self.law) + (f"  ({'; '.join(extra)})" if extra else "")
 
 
-def small_step(eff, scenario, peak, tau, v, z0):
+def small_step(eff, scenario, peak, *, tau, v, z0):
     """A small value of an effect's parameter: one that changes the force by about 1 % of
     its peak (``peak`` [N], at the typical penetration ``z0`` and impact velocity ``v``),
     1 % of the contact time ``tau`` for a time constant, a 2 % set, supports 1 % stiffer at

@@ -2,6 +2,7 @@
 unconstrained, precise and constrained fits (with the solver fallback), and its scores."""
 
 import math
+from dataclasses import dataclass
 
 import cvxpy as cp
 import numpy as np
@@ -22,10 +23,50 @@ class _InfeasibleSupport(SolverError):
         super().__init__(message, status="infeasible")
 
 
-class _Problem:
-    """Scaled least squares with the certified constraints for one library and box."""
+@dataclass(frozen=True)
+class _Constraints:
+    """The certified constraints a fit holds to (see :func:`constraints.constraint_rows`).
 
-    def __init__(self, library, box, X, y, w, *, margin, monotone, signs, elevation, solver):
+    Attributes
+    ----------
+    box : constraints.Box
+        Where they hold: ``0 <= zeta <= Z``, ``0 <= dzeta <= V``.
+    margin : float
+        Dissipativity strictness margin [N s/m] (0 = certified >= 0).
+    monotone : bool
+        Also a monotone elastic branch ``dF/dzeta(zeta, 0) >= 0``.
+    signs : None, int or sequence of int
+        Coefficient signs (+1, -1, 0 = free) per library term.
+    elevation : int
+        Bernstein degree elevation.
+    """
+
+    box: object
+    margin: float
+    monotone: bool
+    signs: object
+    elevation: int
+
+
+class _Problem:
+    """Scaled least squares with the certified constraints for one library and box.
+
+    Parameters
+    ----------
+    library : Library
+    constraints : _Constraints
+    X : ndarray of shape (n_samples, 2)
+        ``zeta`` [m], ``dzeta`` [m/s].
+    y : ndarray of shape (n_samples,)
+        Force [N].
+    w : ndarray of shape (n_samples,)
+        Sample weights.
+    solver : str
+        cvxpy solver (the other of CLARABEL/OSQP is the fallback).
+    """
+
+    def __init__(self, library, constraints, X, y, w, *, solver):
+        box, signs = constraints.box, constraints.signs
         self.library, self.box = library, box
         exps = library.exponents
         self.scale = scale_factors(exps, box)  # Z^a V^b: each term's value at the far corner
@@ -45,10 +86,10 @@ class _Problem:
         self.M, self.off = constraint_rows(
             exps,
             box,
-            margin=margin,
-            monotone=monotone,
+            margin=constraints.margin,
+            monotone=constraints.monotone,
             signs=signs,
-            elevation=elevation,
+            elevation=constraints.elevation,
             force_unit=self.fscale,
         )
         self.solver = solver

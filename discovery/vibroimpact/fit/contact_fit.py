@@ -227,14 +227,20 @@ class ContactModelsResult:
         return out
 
 
-def _intervals(model, res, n_boot, records, seed, tolerances):
-    """95 % intervals: the bootstrap's when asked for and available, else +-1.96 standard
-    errors."""
-    if n_boot:
+def _intervals(res, records, settings):
+    """95 % intervals of the fitted ``res.law``: the bootstrap's when asked for
+    (``settings["n_boot"]``, with the settings' ``seed`` and ``tolerances``) and available,
+    else +-1.96 standard errors."""
+    model = res.law
+    if settings["n_boot"]:
         from .identify import bootstrap_intervals
 
         iv = bootstrap_intervals(
-            *zip(*records, strict=True), model, n_boot=n_boot, seed=seed, tolerances=tolerances
+            *zip(*records, strict=True),
+            model,
+            n_boot=settings["n_boot"],
+            seed=settings["seed"],
+            tolerances=settings["tolerances"],
         )
         if iv is not None:
             return {k: tuple(v) for k, v in iv.bounds.items()}, "bootstrap"
@@ -273,9 +279,7 @@ def _fit_one(name, records, settings, progress, hunt_crossley=None):
             message=f"fit failed: {exc}",
         )
     model = res.law
-    iv, method = _intervals(
-        model, res, settings["n_boot"], records, settings["seed"], settings["tolerances"]
-    )
+    iv, method = _intervals(res, records, settings)
     params = dict(zip(model.names, model.values, strict=True))
     return ContactFit(
         model=name,

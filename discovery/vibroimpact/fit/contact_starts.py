@@ -20,8 +20,9 @@ _START_XI = (0.05, 0.2, 0.6)  # damping ratios of the start grid
 _START_K = (1.0, 0.3, 0.1)
 
 
-def _candidate(name, k, n, c, v0, z0):
-    """A start model of stiffness ``k`` and a dashpot ``c`` at the typical penetration."""
+def _candidate(name, k, n, c, *, v0, z0):
+    """A start model of stiffness ``k``, exponent ``n`` and a dashpot ``c`` at the typical
+    penetration ``z0`` [m] and impact velocity ``v0`` [m/s]."""
     if name in ("kelvin-voigt", "hertz-damper"):
         return ContactModel(name, (k, c))
     if name == "hunt-crossley":
@@ -45,7 +46,7 @@ def _start_candidates(name, scenario, ref):
             k_lin = kf * k * z0 ** (n - 1.0)  # the secant stiffness at the typical penetration
             for xi in _START_XI:
                 c = 2.0 * xi * np.sqrt(k_lin * mu)
-                out.append(_candidate(name, kf * k, n, c, v0, z0))
+                out.append(_candidate(name, kf * k, n, c, v0=v0, z0=z0))
     return out
 
 

@@ -77,7 +77,7 @@ def _seed(random_state, seed):
     return seed
 
 
-def _check_settings(criterion, shortlist, stability, n_boot, max_simulations, stepwise):
+def _check_settings(*, criterion, shortlist, stability, n_boot, max_simulations, stepwise):
     """The settings :func:`discover` checks beyond their types."""
     _criterion(criterion)
     if not (isinstance(shortlist, int | np.integer) and shortlist >= 1):
@@ -312,7 +312,14 @@ def discover(
         return _contact_models(scenario, measurement, n_boot_intervals, seed, progress)
     t0 = time.perf_counter()
     seed = _seed(random_state, seed)
-    _check_settings(criterion, shortlist, stability, n_boot, max_simulations, stepwise)
+    _check_settings(
+        criterion=criterion,
+        shortlist=shortlist,
+        stability=stability,
+        n_boot=n_boot,
+        max_simulations=max_simulations,
+        stepwise=stepwise,
+    )
     pairs = pair_records(scenario, measurement)
     parts, samples = _contact_samples(pairs, derivative, average_cycles)
     regressor = dict(library=library, selection=selection, scoring=scoring, max_terms=max_terms)

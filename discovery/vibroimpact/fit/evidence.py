@@ -101,4 +101,6 @@ def _stability(est, samples, resamples, seed):
     if not resamples:
         return {}
     s = samples
-    return est.stability(s.X, s.F, s.impact, resamples, seed, sample_weight=s.weight)
+    return est.stability(
+        s.X, s.F, s.impact, n_resamples=resamples, random_state=seed, sample_weight=s.weight
+    )

@@ -42,7 +42,7 @@ from ..._printing import coefficient_lines, fmt, readable
 from ..._validate import Array, check
 from ...errors import InputError, VidiError
 from ..model.library import Library
-from .constrained_lsq import _InfeasibleSupport, _Problem, _weights_and_groups
+from .constrained_lsq import _Constraints, _InfeasibleSupport, _Problem, _weights_and_groups
 from .proposals import _best_subsets, _l1_path, _pysindy_supports
 
 __all__ = ["ConstrainedSparseRegressor", "Candidate", "SELECTIONS", "SCORES"]
@@ -179,6 +179,7 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
     def __init__(
         self,
         library="poly:2",
+        *,
         selection="best-subset",
         scoring="bic",
         max_terms=4,
@@ -403,18 +404,14 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
             raise InputError(f"elevation must be an integer >= 0; got {self.elevation!r}")
 
     def _problem(self, X, y, w):
-        return _Problem(
-            self.library_,
-            self.box_,
-            X,
-            y,
-            w,
+        constraints = _Constraints(
+            box=self.box_,
             margin=self.margin,
             monotone=self.monotone,
             signs=self.signs,
             elevation=self.elevation,
-            solver=self.solver,
         )
+        return _Problem(self.library_, constraints, X, y, w, solver=self.solver)
 
     # ------------------------------------------------------- support proposal
     def _propose(self, prob):
@@ -478,7 +475,7 @@ class ConstrainedSparseRegressor(RegressorMixin, BaseEstimator):
             )
         return self.law_(X[:, 0], X[:, 1])
 
-    def stability(self, X, y, groups, n_resamples=50, random_state=0, sample_weight=None):
+    def stability(self, X, y, groups, *, n_resamples=50, random_state=0, sample_weight=None):
         """How often each term is selected over bootstrap resamples of whole impacts.
 
         Each resample draws impacts (those of non-zero total weight) with replacement and

@@ -369,12 +369,12 @@ def _check_fit(fit, source):
         if not (isinstance(req, list) and all(isinstance(r, str) and r for r in req)):
             raise InputError(f'require must be a list of term names such as ["z"]; got {req!r}')
         _check_settings(
-            fit.get("criterion", "I2"),
-            fit.get("shortlist", 1),
-            0,
-            fit.get("n_boot", 1),
-            fit.get("max_simulations", 2),
-            fit.get("stepwise", 0),
+            criterion=fit.get("criterion", "I2"),
+            shortlist=fit.get("shortlist", 1),
+            stability=0,
+            n_boot=fit.get("n_boot", 1),
+            max_simulations=fit.get("max_simulations", 2),
+            stepwise=fit.get("stepwise", 0),
         )
         for k, hi in _FIT_BOUNDS.items():  # the command line's bounds (`vidi fit`)
             if k in fit and fit[k] > hi:

@@ -344,41 +344,6 @@ def _config_dict(cfg, version):
     }
 
 
-def _run_missing(todo, have, runs, rundir, version, workers, scheduler, executor, progress):
-    """Run ``todo`` on the executor, longest first (:func:`run_cost`), one file per finished
-    run (its record also goes into ``have``); returns the executor's name, the number of
-    runs done and the parallel efficiency (the runs' seconds over the wall time times the
-    workers; None when nothing ran)."""
-    own = executor is None
-    ex = make_executor(workers, scheduler, warm=compile_kernels) if own else executor
-    name = repr(ex)
-    # the longest runs first, so no worker is left with one long run at the end (the
-    # results do not depend on the order: one file per run, tables from the files)
-    todo = sorted(todo, key=run_cost, reverse=True)
-    t0, busy = time.perf_counter(), 0.0
-    try:
-        done = 0
-        tick(progress, "study: runs", len(have), len(runs))
-        for _, res in ex.run(run_one, todo):
-            busy += float(res.get("seconds", 0.0))
-            res["code_version"] = version
-            res = to_jsonable(res)
-            atomic_write_text(
-                rundir / f"{res['key']}.json", json.dumps(res, indent=1, allow_nan=True)
-            )
-            have[res["key"]] = res
-            done += 1
-            tick(progress, "study: runs", len(have), len(runs))
-    finally:
-        if own:
-            ex.close()
-    wall = time.perf_counter() - t0
-    slots = max(1, min(int(getattr(ex, "workers", 1) or 1), len(todo)))
-    # the runs' own seconds over the wall time the workers were held
-    efficiency = busy / (wall * slots) if done and wall > 0 else None
-    return name, done, efficiency
-
-
 def _write_tables(out, cfg, records):
     """``cells.csv``, ``runs.csv`` and ``inclusion.csv`` from the run files; returns the
     cells and the term inclusion per cell."""
@@ -504,8 +469,15 @@ def study(
         if max_runs is not None:
             todo = todo[: int(max_runs)]
         try:
-            name, done, efficiency = _run_missing(
-                todo, have, runs, work.runs, version, workers, scheduler, executor, progress
+            name, done, efficiency = work.run_missing(
+                todo,
+                have,
+                runs,
+                version,
+                workers=workers,
+                scheduler=scheduler,
+                executor=executor,
+                progress=progress,
             )
             records = [have[r["key"]] for r in runs if r["key"] in have]
             settings = {"workers": workers, "scheduler": scheduler, "max_runs": max_runs}
@@ -528,7 +500,9 @@ def study(
                     code_version=version,
                 ).record_run({"command": "study"}, _provenance(cfg, settings))
 
-            result = _stage(out, inputs, cfg, records, figures, work, result_of, version)
+            result = work.stage(
+                out, inputs, cfg, records, figures=figures, result_of=result_of, version=version
+            )
         except BaseException as exc:
             work.failed(exc, [r["key"] for r in runs], out)
             raise
@@ -657,28 +631,64 @@ class _Work:
                 os.close(self._lock)
         return False
 
+    def run_missing(self, todo, have, runs, version, *, workers, scheduler, executor, progress):
+        """Run ``todo`` on the executor, longest first (:func:`run_cost`), one file per finished
+        run in :attr:`runs` (its record also goes into ``have``; ``runs`` is the study's every
+        run, for the progress); returns the executor's name, the number of runs done and the
+        parallel efficiency (the runs' seconds over the wall time times the workers; None when
+        nothing ran).  ``workers``, ``scheduler``, ``executor`` and ``progress`` are
+        :func:`study`'s."""
+        own = executor is None
+        ex = make_executor(workers, scheduler, warm=compile_kernels) if own else executor
+        name = repr(ex)
+        # the longest runs first, so no worker is left with one long run at the end (the
+        # results do not depend on the order: one file per run, tables from the files)
+        todo = sorted(todo, key=run_cost, reverse=True)
+        t0, busy = time.perf_counter(), 0.0
+        try:
+            done = 0
+            tick(progress, "study: runs", len(have), len(runs))
+            for _, res in ex.run(run_one, todo):
+                busy += float(res.get("seconds", 0.0))
+                res["code_version"] = version
+                res = to_jsonable(res)
+                atomic_write_text(
+                    self.runs / f"{res['key']}.json", json.dumps(res, indent=1, allow_nan=True)
+                )
+                have[res["key"]] = res
+                done += 1
+                tick(progress, "study: runs", len(have), len(runs))
+        finally:
+            if own:
+                ex.close()
+        wall = time.perf_counter() - t0
+        slots = max(1, min(int(getattr(ex, "workers", 1) or 1), len(todo)))
+        # the runs' own seconds over the wall time the workers were held
+        efficiency = busy / (wall * slots) if done and wall > 0 else None
+        return name, done, efficiency
 
-def _stage(out, inputs, cfg, records, figures, work, result_of, version):
-    """Write the whole study (runs, config, tables, figures, summary) into a staging
-    directory and put it in place of ``out`` as a whole; returns the result
-    (``result_of(cells, inclusion, figure paths)``), whose ``to_dict()`` is the summary."""
-    with running("study"), OutputDir(out, inputs) as od:
-        stage = od.stage
-        os.mkdir(stage / "runs")
-        for rec in records:
-            name = f"{rec['key']}.json"
-            src = work.runs / name
-            if not src.is_file():
-                src = Path(out) / "runs" / name
-            try:
-                os.link(src, stage / "runs" / name)
-            except OSError:
-                shutil.copyfile(src, stage / "runs" / name)
-        _write_config(stage, cfg, version)
-        cells, inclusion = _write_tables(stage, cfg, records)
-        paths = ()
-        if figures and records:
-            paths = tuple(figures(cfg, records, stage))
-        result = result_of(cells, inclusion, paths)
-        result.write_into(od)
-    return result
+    def stage(self, out, inputs, cfg, records, *, figures, result_of, version):
+        """Write the whole study (runs, config, tables, figures, summary) into a staging
+        directory and put it in place of ``out`` as a whole (a run's file from this work
+        directory, else from ``out``); returns the result (``result_of(cells, inclusion, figure
+        paths)``), whose ``to_dict()`` is the summary."""
+        with running("study"), OutputDir(out, inputs) as od:
+            stage = od.stage
+            os.mkdir(stage / "runs")
+            for rec in records:
+                name = f"{rec['key']}.json"
+                src = self.runs / name
+                if not src.is_file():
+                    src = Path(out) / "runs" / name
+                try:
+                    os.link(src, stage / "runs" / name)
+                except OSError:
+                    shutil.copyfile(src, stage / "runs" / name)
+            _write_config(stage, cfg, version)
+            cells, inclusion = _write_tables(stage, cfg, records)
+            paths = ()
+            if figures and records:
+                paths = tuple(figures(cfg, records, stage))
+            result = result_of(cells, inclusion, paths)
+            result.write_into(od)
+        return result

@@ -74,12 +74,8 @@ def auto_transient(scenario, law):
     return int(min(TRANSIENT_MAX, max(ss.n_periods, 1) * transient_periods(mult)))
 
 
-def _reference(scenario, law, t_span, y0, t_eval, rtol):
-    return reference_simulate(scenario, law, t_span, y0=y0, t_eval=t_eval, rtol=rtol)
-
-
 @lru_cache(maxsize=32)
-def clean_record(scenario, law, periods, fs, transient, record_transient=False):
+def clean_record(scenario, law, periods, fs, transient, *, record_transient=False):
     """Noise-free scipy-path record ``(t, y (4, n), F, events)`` (read-only arrays): from
     rest, ``transient`` periods, then ``periods`` periods sampled at ``fs`` (with
     ``record_transient`` the run-up is recorded too)."""
@@ -90,14 +86,16 @@ def clean_record(scenario, law, periods, fs, transient, record_transient=False):
     if record_transient:
         n = int(round(t_end * fs))
         t = np.arange(n) / fs
-        out = _reference(scenario, law, (0.0, t_end), y0, t, RTOL_RECORD)
+        out = reference_simulate(scenario, law, (0.0, t_end), y0=y0, t_eval=t, rtol=RTOL_RECORD)
     else:
         for k in range(0, transient, TRANSIENT_CHUNK):
             k1 = min(transient, k + TRANSIENT_CHUNK)
-            y0 = _reference(scenario, law, (k * T, k1 * T), y0, None, RTOL_TRANSIENT)["y_final"]
+            y0 = reference_simulate(scenario, law, (k * T, k1 * T), y0=y0, rtol=RTOL_TRANSIENT)[
+                "y_final"
+            ]
         n = int(round(periods * T * fs))
         t = t_rec + np.arange(n) / fs
-        out = _reference(scenario, law, (t_rec, t_end), y0, t, RTOL_RECORD)
+        out = reference_simulate(scenario, law, (t_rec, t_end), y0=y0, t_eval=t, rtol=RTOL_RECORD)
     y, F = out["y"], out["force"]
     if not (np.all(np.isfinite(y)) and np.all(np.isfinite(F))):
         raise IntegrationError("the reference simulation left samples unset")

@@ -272,7 +272,7 @@ def _only_i4(same, consistent, crit, lim):
     )
 
 
-def _verdict(consistent, reg, imp, crit, floor, lim=None, transient=False):
+def _verdict(consistent, reg, imp, crit, floor, *, lim=None, transient=False):
     """One sentence; with ``transient`` (a record span the law's trajectory has not settled
     over) a regime difference is no mismatch and the law is judged over the span."""
     if not crit:
@@ -315,6 +315,16 @@ MEMO = Memo(32)
 """Steady states and their force histories (:mod:`discovery.numerics.memo`): a model is
 verified again at the start of the next iteration of ``explain``, an optimiser's last point
 with its noise floor."""
+
+
+def _from_start(scenario, reference, steady_kwargs):
+    """``steady_kwargs`` with the search started from the record's measured state (what the
+    caller gave overriding it)."""
+    return {
+        "y_start": scenario.model_state(reference.start),
+        "t_start": reference.start_time,
+        **steady_kwargs,
+    }
 
 
 def _steady(scenario, law, tolerances, steady_kwargs):
@@ -375,17 +385,19 @@ def evaluate(
     """
     if from_state and getattr(reference, "span", None) is not None:
         return _evaluate_span(
-            scenario, law, reference, tolerances, floor, observe, steady_kwargs, smooth_onset
+            scenario,
+            law,
+            reference,
+            tolerances=tolerances,
+            floor=floor,
+            observe=observe,
+            steady_kwargs=steady_kwargs,
+            smooth_onset=smooth_onset,
         )
-    E = reference.impulse
     reg = {"measured": reference.regime, "simulated": None}
     imp = {"measured": reference.impacts, "simulated": None}
     if from_state and reference.start is not None:
-        steady_kwargs = {
-            "y_start": scenario.model_state(reference.start),
-            "t_start": reference.start_time,
-            **steady_kwargs,
-        }
+        steady_kwargs = _from_start(scenario, reference, steady_kwargs)
     try:
         ss = _steady(scenario, law, tolerances, steady_kwargs)
         if not ss.periodic:
@@ -423,10 +435,10 @@ def evaluate(
             "inconsistent: the simulated bodies never come into contact",
             steady=ss,
         )
-    rot, sim = align(E, exact)
+    rot, sim = align(reference.impulse, exact)
     # contacts per simulated orbit, seen through the measurement's threshold rules
     imp["simulated"] = int(round(len(sim.support) * ss.n_periods / sim.n_periods))
-    crit = evaluate_criteria(E, sim)
+    crit = evaluate_criteria(reference.impulse, sim)
     if not floor:
         return Evaluation(
             "ok", reg, imp, crit, {}, False, "", steady=ss, simulated=sim, aligned=rot
@@ -437,7 +449,7 @@ def evaluate(
     # an undefined floor (no bootstrap replicate found the contacts) decides nothing
     consistent = bool(same and all(np.isfinite(lim[k]) and crit[k] <= lim[k] for k in lim))
     only_i4 = _only_i4(same, consistent, crit, lim)
-    verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim)
+    verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim=lim)
     if verdict is not None and reference.noise:  # a record, not an exact reference
         verdict += (
             f"; {MOTION_CRITERION} (the penetration) not checked: the record has no "
@@ -484,16 +496,14 @@ def _orbit_history(scenario, law, ss, block, tolerances):
     return np.asarray(tr.force, dtype=float)
 
 
-def _span_steady_state(scenario, law, reference, last, span, sim, reg, tolerances, steady_kwargs):
+def _span_steady_state(scenario, law, reference, sim, reg, *, tolerances, steady_kwargs):
     """The law's steady state from the record's state (only to report its regime, set in
-    ``reg``) and ``transient``: I2 between the law's trajectory over the last block and its
-    steady orbit (``None`` without a periodic orbit).  Returns ``(steady state or None,
-    transient)``."""
-    steady_kwargs = {
-        "y_start": scenario.model_state(reference.start),
-        "t_start": reference.start_time,
-        **steady_kwargs,
-    }
+    ``reg``) and ``transient``: I2 between the law's trajectory over the last block of
+    ``reference.span`` (``sim``, its folded cycle) and its steady orbit (``None`` without a
+    periodic orbit).  Returns ``(steady state or None, transient)``."""
+    span = reference.span
+    last = span.blocks[-1]
+    steady_kwargs = _from_start(scenario, reference, steady_kwargs)
     ss, transient = None, None
     try:
         ss = _steady(scenario, law, tolerances, steady_kwargs)
@@ -537,7 +547,7 @@ def _transient_notes(transient_mismatch, settled, transient, reg, ss):
 
 
 def _evaluate_span(
-    scenario, law, reference, tolerances, floor, observe, steady_kwargs, smooth_onset=False
+    scenario, law, reference, *, tolerances, floor, observe, steady_kwargs, smooth_onset=False
 ):
     """:func:`evaluate` for a record with positions: the law simulated from the machine's
     states across the record's span, block by block, both histories folded by the same
@@ -592,7 +602,7 @@ def _evaluate_span(
     if not floor:
         return Evaluation("ok", reg, imp, crit, {}, False, "", simulated=sim, **found)
     ss, transient = _span_steady_state(
-        scenario, law, reference, last, span, sim, reg, tolerances, steady_kwargs
+        scenario, law, reference, sim, reg, tolerances=tolerances, steady_kwargs=steady_kwargs
     )
     found["transient_i2"] = transient
     settled = transient is not None and transient <= TRANSIENT_GAP
@@ -621,7 +631,9 @@ def _evaluate_span(
             "they agree (a contact split or hidden near the threshold)"
         )
         imp = {**imp, "simulated": imp["measured"]}
-    verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim, transient=transient_mismatch)
+    verdict = _verdict(
+        consistent, reg, imp, crit, fl["mean"], lim=lim, transient=transient_mismatch
+    )
     notes += _transient_notes(transient_mismatch, settled, transient, reg, ss)
     if notes and verdict is not None:
         verdict = f"{verdict}; " + "; ".join(notes)

@@ -107,7 +107,7 @@ class Fold:
         F = np.concatenate([[Fm[0]], Fm, [Fm[-1]]])
         n_eff = max(self.n_cycles, 1)
         support = _sampled_support(
-            tau, F, threshold, self.period, noise / np.sqrt(n_eff), extrapolate=False
+            tau, F, threshold, self.period, noise=noise / np.sqrt(n_eff), extrapolate=False
         )
         onsets = support[:, 0].copy() if len(support) else np.zeros(1)
         return Impulse(
@@ -124,8 +124,8 @@ class Fold:
         )
 
 
-def make_fold(td_all, origin, n_periods, period, t_first, t_last):
-    """Fold the whole cycles of a record between ``t_first`` and ``t_last`` (drive clock).
+def make_fold(td_all, origin, n_periods, period, span):
+    """Fold the whole cycles of a record within ``span = (t_first, t_last)`` (drive clock).
 
     Parameters
     ----------
@@ -138,14 +138,15 @@ def make_fold(td_all, origin, n_periods, period, t_first, t_last):
         Cycle length in drive periods.
     period : float
         Drive period [s].
-    t_first, t_last : float
-        The span that can be used [s].
+    span : tuple of float
+        ``(t_first, t_last)``: the span that can be used [s].
 
     Returns
     -------
     Fold or None
         ``None`` when not one whole cycle fits.
     """
+    t_first, t_last = span
     W = n_periods * period
     o = origin + np.ceil((t_first - origin) / W - 1e-12) * W
     M = int(np.floor((t_last - o) / W + 1e-12))

@@ -182,7 +182,7 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
     td_all = t + time_offset
     W = cycle.duration
     mids = np.array([0.5 * (td_all[a] + td_all[b - 1]) for a, b in runs])
-    whole = make_fold(td_all, cycle.onset + time_offset, cycle.n_periods, T, mids[0], td_all[-1])
+    whole = make_fold(td_all, cycle.onset + time_offset, cycle.n_periods, T, (mids[0], td_all[-1]))
     if whole is None or whole.n_cycles < max(1, int(0.5 * (td_all[-1] - td_all[0]) / W)):
         return None  # the first flights are too late to use most of the record
     sigma = float(estimate_noise(F))
@@ -195,7 +195,7 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
             return None
         j = int(ok[-1])
         fold = make_fold(
-            td_all, o, cycle.n_periods, T, o, o + count * W + 0.5 * (td_all[1] - td_all[0])
+            td_all, o, cycle.n_periods, T, (o, o + count * W + 0.5 * (td_all[1] - td_all[0]))
         )
         state = free_flight_state(measurement, scenario, runs[j], mids[j], time_offset=time_offset)
         Fi = F[fold.idx]
