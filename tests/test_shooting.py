@@ -25,7 +25,10 @@ from discovery.numerics.shooting import (
     smallest_period,
 )
 from discovery.ueda import UedaMap, UedaSystem, classify, periodic_orbit, trajectory
-from discovery.ueda.attractor import _setup, _variational, classify_points, strobe_points
+from discovery.ueda._runs import Integration
+from discovery.ueda.exponents import variational_run
+from discovery.ueda.regimes import classify_points
+from discovery.ueda.strobe import strobe_points
 from discovery.vibroimpact.dynamics import Tolerances
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario
@@ -304,8 +307,7 @@ def test_ueda_multipliers_match_scipy_monodromy_and_variational_run(entrained):
     # the compiled variational run from the orbit: after a few periods of QR iteration
     # the per-period growths are the multipliers' moduli (real multipliers here), and the
     # per-period trace integral is log |det|
-    tol, T, atol, hmax = _setup(s, None)
-    logs, trace, strobe, _ = _variational(s, orb.y0, 0.0, 12, tol, T, atol, hmax)
+    logs, trace, strobe, _ = variational_run(Integration.of(s), orb.y0, 12)
     assert np.max(np.abs(strobe - orb.y0) / s.scales()) < 1e-7  # stays on the orbit
     np.testing.assert_allclose(np.exp(logs[-1]), np.sort(np.abs(orb.multipliers))[::-1], rtol=1e-6)
     assert np.exp(trace[-1]) == pytest.approx(abs(np.prod(orb.multipliers)), rel=1e-7)

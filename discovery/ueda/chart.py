@@ -48,7 +48,7 @@ from . import _kernel as UK
 from ._runs import budget as _budget
 from ._runs import check as _check
 from ._runs import initial_state as _y0
-from .attractor import classify_points
+from .regimes import RegimeRules, classify_points
 from .system import UedaSystem
 
 __all__ = ["Chart", "chart", "KINDS"]
@@ -366,7 +366,8 @@ def _point(system, y, s, tol, buffers=None):
         if np.isfinite(lam):
             return _Point(0 if n == 1 else 1, n, lam, np.nan, yf, cost, obs[-n:])
     lam = float(logs[:, 0].sum() / (n_obs * T))
-    reg = classify_points(obs, scale, lam, 0.0, max_period=0, chaos_threshold=s["chaos_threshold"])
+    rules = RegimeRules(max_period=0, chaos_threshold=s["chaos_threshold"])
+    reg = classify_points(obs, scale, lam, 0.0, rules=rules)
     return _Point(KINDS.index(reg.kind), 0, lam, reg.evidence["rotation_number"], yf, cost, obs)
 
 

@@ -17,8 +17,8 @@ import numpy as np
 from .._validate import Array, Real, Text, params
 from ..errors import InputError, IntegrationError
 from ..numerics.tolerances import Tolerances
-from .attractor import rotation_number
 from .polynomial import ForcedPolynomial
+from .regimes import rotation_number
 from .system import UedaSystem
 
 __all__ = [
@@ -126,7 +126,7 @@ def simulate_record(
     t = np.arange(n) * (T / int(samples_per_period))
     y = np.array((0.1, 0.0) if y0 is None else y0, dtype=float)
     if integrator == "compiled":
-        from .attractor import strobe_points, trajectory
+        from .strobe import strobe_points, trajectory
 
         if not isinstance(system, UedaSystem):
             raise InputError("the compiled integrator simulates a UedaSystem; use scipy")
@@ -226,7 +226,7 @@ def classify_record(strobe, noise_sd, *, max_period=8, monotone=0.98):
     ``6 noise_sd`` (plus 1e-5 of the range); else ``beat`` if the points turn around
     their centre monotonically (fraction >= ``monotone``: an invariant closed curve);
     else ``chaotic``.  Returns a :class:`~discovery.ueda.Regime`."""
-    from .attractor import Regime
+    from .regimes import Regime
 
     s = np.asarray(strobe, float)
     rng_x = float(np.ptp(s[:, 0])) or 1.0
