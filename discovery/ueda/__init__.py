@@ -48,7 +48,7 @@ _EXPORTS = {
     "trajectory": "strobe",
     "Chart": "chart",
     "chart": "chart",
-    "KINDS": "chart",
+    "KINDS": "sweep",
     "Discovery": "discover",
     "ForcedPolynomial": "polynomial",
     "Verification": "verification",
