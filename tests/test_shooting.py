@@ -109,7 +109,7 @@ def test_linear_forced_oscillator_orbit_and_multipliers():
     assert isinstance(pm, PeriodMap)
     y_exact, mult_exact = pm.exact()
     hist = []
-    y, res, J, ok = newton_orbit(pm, np.array([2.0, -1.0]), 1, 1e-12, 10, hist)
+    y, res, J, ok = newton_orbit(pm, np.array([2.0, -1.0]), 1, tol=1e-12, max_iter=10, history=hist)
     assert ok and res < 1e-12 and len(hist) <= 3  # affine map: one Newton step
     np.testing.assert_allclose(y, y_exact, rtol=0, atol=1e-10)
     mult = floquet_multipliers(J)
@@ -117,7 +117,7 @@ def test_linear_forced_oscillator_orbit_and_multipliers():
     np.testing.assert_allclose(np.sort_complex(mult), np.sort_complex(mult_exact), atol=1e-8)
     assert is_stable(mult)
     # shooting at n = 2 finds the same orbit and reduces it to period 1
-    y2, _, J2, ok2 = newton_orbit(pm, np.array([0.3, 0.1]), 2, 1e-12, 10)
+    y2, _, J2, ok2 = newton_orbit(pm, np.array([0.3, 0.1]), 2, tol=1e-12, max_iter=10)
     assert ok2 and is_stable(floquet_multipliers(J2))
     m, y1, _, J1, _ = smallest_period(pm, y2, 2, 1e-12, 10)
     assert m == 1
@@ -129,7 +129,7 @@ def test_logistic_period_two_is_not_reduced_to_the_unstable_fixed_point():
     r = 3.2
     pm = LogisticMap(r)
     a, b = sorted(np.roots([r * r, -r * (r + 1), r + 1]).real)  # the 2-cycle, closed form
-    y, res, J, ok = newton_orbit(pm, np.array([0.5]), 2, 1e-14, 20)
+    y, res, J, ok = newton_orbit(pm, np.array([0.5]), 2, tol=1e-14, max_iter=20)
     assert ok and abs(y[0] - a) < 1e-12
     assert floquet_multipliers(J)[0] == pytest.approx(4 + 2 * r - r * r, abs=1e-12)
     # Newton at m = 1 converges to the fixed point 1 - 1/r, far away and unstable (2 - r)

@@ -291,7 +291,7 @@ def _orbit(scenario, law, pm, y, n, tol, max_newton, attempt, t0, evidence):
     converges to a stable orbit (reduced to its smallest period), else ``None``.  Every try
     is recorded in ``attempt``."""
     hist = []
-    y_orb, res, J, ok = newton_orbit(pm, y, n, tol, max_newton, hist)
+    y_orb, res, J, ok = newton_orbit(pm, y, n, tol=tol, max_iter=max_newton, history=hist)
     mult = floquet_multipliers(J, len(y))
     stable = bool(ok and is_stable(mult))
     attempt["tried"].append(
@@ -467,7 +467,12 @@ def _continued(scenario, law, pm, guess, tol):
     hist = []
     try:
         y_orb, res, J, ok = newton_orbit(
-            pm, np.asarray(guess.y0, dtype=float), n, tol, CONTINUATION_NEWTON, hist
+            pm,
+            np.asarray(guess.y0, dtype=float),
+            n,
+            tol=tol,
+            max_iter=CONTINUATION_NEWTON,
+            history=hist,
         )
     except IntegrationError:
         return None
