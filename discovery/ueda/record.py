@@ -39,7 +39,8 @@ def read_record_csv(path):
     (to 1e-6 of the step)."""
     from .._csv import parse_column, read_csv_rows
 
-    header, body, decimal_comma, _ = read_csv_rows(path, "t and x")
+    rows = read_csv_rows(path, "t and x")
+    header = rows.header
     missing = [c for c in ("t", "x") if c not in header]
     if missing:
         raise InputError(
@@ -48,10 +49,7 @@ def read_record_csv(path):
         )
     limits = {"t": (1e7, "s"), "x": (1e6, "")}
     t, x = (
-        parse_column(
-            c, c, header.index(c), body, str(path), decimal_comma=decimal_comma, limits=limits
-        )
-        for c in ("t", "x")
+        parse_column(rows, c, header.index(c), name=str(path), limits=limits) for c in ("t", "x")
     )
     return check_record(t, x, what=f"--data {path}")
 
