@@ -30,7 +30,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from discovery.ueda import UedaSystem, lyapunov
-from discovery.ueda.chart import _point, chart
+from discovery.ueda.chart import chart
+from discovery.ueda.sweep import point
 from discovery.vibroimpact.dynamics import Tolerances
 
 
@@ -91,8 +92,8 @@ def bench_ueda(grid=60):
     }
     tol = Tolerances(rtol=1e-6, hmax_fraction=0.1)
     y0 = np.array([0.1, 0.0])
-    _point(system, y0, s, tol)  # compile / load the cache
-    t_fast, r = _best(lambda: _point(system, y0, s, tol), 20)
+    point(system, y0, s, tol)  # compile / load the cache
+    t_fast, r = _best(lambda: point(system, y0, s, tol), 20)
     assert r.cost == 140, "the reference point must take the full path"
     t_scipy, _ = _best(lambda: _scipy_point(system, y0, 60, 80, 1e-6, 0.1), 2)
     nu, B = np.linspace(0.8, 1.2, grid), np.linspace(0.0, 0.6, grid)

@@ -4,22 +4,54 @@ one clear line for a bad file."""
 
 import csv
 import os
+from dataclasses import dataclass
 
 import numpy as np
 
 from ._io import short
 from .errors import InputError, VidiTypeError
 
-__all__ = ["read_csv_rows", "parse_column"]
+__all__ = ["CsvRows", "read_csv_rows", "parse_column"]
+
+
+@dataclass(frozen=True)
+class CsvRows:
+    """The rows of a CSV file as read (:func:`read_csv_rows`), not yet numbers.
+
+    Attributes
+    ----------
+    header : list of str
+        The column names, stripped.
+    body : list of (int, list of str)
+        The data rows: ``(line number, fields)``.
+    decimal_comma : bool
+        Whether the numbers are written with decimal commas.
+    notes : tuple of str
+        What was noticed reading it (the encoding, decimal commas).
+    """
+
+    header: list
+    body: list
+    decimal_comma: bool
+    notes: tuple
 
 
 def read_csv_rows(path, needs):
-    """The one CSV reader of both systems: ``(header, body, decimal_comma, notes)``.
+    """The one CSV reader of both systems.
 
     UTF-8 (with or without a byte-order mark) or UTF-16 with one; ``,``, ``;`` or tab as
     the separator (from the header); ``#`` comment lines and blank lines skipped; decimal
-    commas with ``;`` or tab.  ``body`` is ``[(line number, fields), ...]``.  ``needs``
-    names the columns for the messages (``"t and F"``).
+    commas with ``;`` or tab.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+    needs : str
+        Names the columns for the messages (``"t and F"``).
+
+    Returns
+    -------
+    CsvRows
     """
     if not isinstance(path, str | os.PathLike):  # an int would be read as a file descriptor
         raise VidiTypeError(
@@ -59,7 +91,7 @@ def read_csv_rows(path, needs):
     decimal_comma = delim != "," and any("," in c for _, r in body[:50] for c in r)
     if decimal_comma:
         notes += ("decimal commas read as decimal points",)
-    return header, body, decimal_comma, notes
+    return CsvRows(header=header, body=body, decimal_comma=decimal_comma, notes=notes)
 
 
 def _read_text(path, name):
@@ -119,10 +151,27 @@ def _sniff(header_line):
     return c if n else ","
 
 
-def parse_column(key, hname, j, body, name, decimal_comma, limits):
+def parse_column(rows, key, j, *, name, limits):
     """Column ``j`` of the data rows as floats, with a line-numbered error for a missing,
-    non-numeric, non-finite or out-of-range cell (``limits``: ``{key: (bound, unit)}``,
-    default the vibro-impact channels')."""
+    non-numeric, non-finite or out-of-range cell.
+
+    Parameters
+    ----------
+    rows : CsvRows
+    key : str
+        Our name of the column (looked up in ``limits``).
+    j : int
+        Its index in ``rows.header``.
+    name : str
+        The file, as the messages call it.
+    limits : dict
+        ``{key: (bound, unit)}``: values beyond ``|bound|`` are refused.
+
+    Returns
+    -------
+    ndarray of shape (n_rows,)
+    """
+    hname, body = rows.header[j], rows.body
     cells = []
     for ln, row in body:
         if j >= len(row):
@@ -132,7 +181,7 @@ def parse_column(key, hname, j, body, name, decimal_comma, limits):
             )
         cells.append(row[j].strip())
     arr = np.array(cells, dtype=str)
-    if decimal_comma:
+    if rows.decimal_comma:
         arr = np.char.replace(arr, ",", ".")
     try:
         v = arr.astype(float)

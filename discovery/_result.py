@@ -54,7 +54,7 @@ KINDS = {
     "steady": "discovery.vibroimpact.dynamics.steady_state:SteadyState",
     "simulate": "discovery.vibroimpact.dynamics.synthesize:SimulatedRecord",
     "ueda-simulate": "discovery.ueda.simulated_record:SimulatedUedaRecord",
-    "ueda-lyapunov": "discovery.ueda.attractor:Lyapunov",
+    "ueda-lyapunov": "discovery.ueda.exponents:Lyapunov",
     "ueda-attractor": "discovery.ueda.attractor:Attractor",
     "ueda-chart": "discovery.ueda.chart:Chart",
     "ueda-discover": "discovery.ueda.discover:Discovery",

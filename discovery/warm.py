@@ -26,8 +26,9 @@ def warm():
     compile_kernels()
     out["vibro-impact"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    from .ueda.attractor import lyapunov, strobe_points
+    from .ueda.exponents import lyapunov
     from .ueda.record import simulate_record
+    from .ueda.strobe import strobe_points
     from .ueda.system import UedaSystem
 
     system = UedaSystem.from_model("negres")

@@ -90,6 +90,7 @@ _INPUTS = {
     "Result",
     "UedaSystem",
     "UedaMap",
+    "RegimeRules",
 }
 
 

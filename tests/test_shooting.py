@@ -25,7 +25,10 @@ from discovery.numerics.shooting import (
     smallest_period,
 )
 from discovery.ueda import UedaMap, UedaSystem, classify, periodic_orbit, trajectory
-from discovery.ueda.attractor import _setup, _variational, classify_points, strobe_points
+from discovery.ueda._runs import Integration
+from discovery.ueda.exponents import variational_run
+from discovery.ueda.regimes import classify_points
+from discovery.ueda.strobe import strobe_points
 from discovery.vibroimpact.dynamics import Tolerances
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario
@@ -106,7 +109,7 @@ def test_linear_forced_oscillator_orbit_and_multipliers():
     assert isinstance(pm, PeriodMap)
     y_exact, mult_exact = pm.exact()
     hist = []
-    y, res, J, ok = newton_orbit(pm, np.array([2.0, -1.0]), 1, 1e-12, 10, hist)
+    y, res, J, ok = newton_orbit(pm, np.array([2.0, -1.0]), 1, tol=1e-12, max_iter=10, history=hist)
     assert ok and res < 1e-12 and len(hist) <= 3  # affine map: one Newton step
     np.testing.assert_allclose(y, y_exact, rtol=0, atol=1e-10)
     mult = floquet_multipliers(J)
@@ -114,7 +117,7 @@ def test_linear_forced_oscillator_orbit_and_multipliers():
     np.testing.assert_allclose(np.sort_complex(mult), np.sort_complex(mult_exact), atol=1e-8)
     assert is_stable(mult)
     # shooting at n = 2 finds the same orbit and reduces it to period 1
-    y2, _, J2, ok2 = newton_orbit(pm, np.array([0.3, 0.1]), 2, 1e-12, 10)
+    y2, _, J2, ok2 = newton_orbit(pm, np.array([0.3, 0.1]), 2, tol=1e-12, max_iter=10)
     assert ok2 and is_stable(floquet_multipliers(J2))
     m, y1, _, J1, _ = smallest_period(pm, y2, 2, 1e-12, 10)
     assert m == 1
@@ -126,7 +129,7 @@ def test_logistic_period_two_is_not_reduced_to_the_unstable_fixed_point():
     r = 3.2
     pm = LogisticMap(r)
     a, b = sorted(np.roots([r * r, -r * (r + 1), r + 1]).real)  # the 2-cycle, closed form
-    y, res, J, ok = newton_orbit(pm, np.array([0.5]), 2, 1e-14, 20)
+    y, res, J, ok = newton_orbit(pm, np.array([0.5]), 2, tol=1e-14, max_iter=20)
     assert ok and abs(y[0] - a) < 1e-12
     assert floquet_multipliers(J)[0] == pytest.approx(4 + 2 * r - r * r, abs=1e-12)
     # Newton at m = 1 converges to the fixed point 1 - 1/r, far away and unstable (2 - r)
@@ -304,8 +307,7 @@ def test_ueda_multipliers_match_scipy_monodromy_and_variational_run(entrained):
     # the compiled variational run from the orbit: after a few periods of QR iteration
     # the per-period growths are the multipliers' moduli (real multipliers here), and the
     # per-period trace integral is log |det|
-    tol, T, atol, hmax = _setup(s, None)
-    logs, trace, strobe, _ = _variational(s, orb.y0, 0.0, 12, tol, T, atol, hmax)
+    logs, trace, strobe, _ = variational_run(Integration.of(s), orb.y0, 12)
     assert np.max(np.abs(strobe - orb.y0) / s.scales()) < 1e-7  # stays on the orbit
     np.testing.assert_allclose(np.exp(logs[-1]), np.sort(np.abs(orb.multipliers))[::-1], rtol=1e-6)
     assert np.exp(trace[-1]) == pytest.approx(abs(np.prod(orb.multipliers)), rel=1e-7)

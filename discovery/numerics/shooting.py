@@ -83,7 +83,7 @@ def recurrence(strobe, scale, max_period):
     return d
 
 
-def newton_orbit(pm, y, n, tol, max_iter, history=None):
+def newton_orbit(pm, y, n, *, tol, max_iter, history=None):
     """Damped Newton on ``G(y) = Phi^n(y) - y``.
 
     Parameters
@@ -130,7 +130,7 @@ def newton_orbit(pm, y, n, tol, max_iter, history=None):
             step = np.linalg.solve(J - eye, -(fy - y))
         except np.linalg.LinAlgError:
             return y, res, J, False
-        found = _line_search(pm, n, y, step, res, both)
+        found = _line_search(pm, n, y, step, res)
         if found is None:
             return y, res, J, False
         y, fy, res, Jy = found
@@ -140,11 +140,12 @@ def newton_orbit(pm, y, n, tol, max_iter, history=None):
     return y, res, J, converged
 
 
-def _line_search(pm, n, y, step, res, both):
+def _line_search(pm, n, y, step, res):
     """``(y, Phi^n(y), residual, Jacobian or None)`` at the first of ``y + step``,
     ``y + step / 2``, ... (down to 1e-3) that lowers the residual, or None.  The full
     step, the one Newton takes near an orbit, is evaluated with its Jacobian when the map
-    gives both from one run (``both``); the damped ones plainly."""
+    gives both from one run (``advance_jacobian``); the damped ones plainly."""
+    both = getattr(pm, "advance_jacobian", None)
     lam = 1.0
     while lam > 1e-3:
         y_try = y + lam * step
@@ -197,7 +198,9 @@ def smallest_period(pm, y_orb, n, tol, max_newton):
         if n % m:
             continue
         hist = []
-        y_m, res_m, J_m, ok_m = newton_orbit(pm, y_orb, m, tol, max_newton, hist)
+        y_m, res_m, J_m, ok_m = newton_orbit(
+            pm, y_orb, m, tol=tol, max_iter=max_newton, history=hist
+        )
         if not ok_m:
             continue
         mult = floquet_multipliers(J_m)

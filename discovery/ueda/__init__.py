@@ -6,8 +6,12 @@ oscillator of the "broken egg" (``negres``) and Ueda's classical Duffing-type os
 system (:mod:`discovery.numerics._dopri`).
 
 * :class:`UedaSystem` - the system description (parameters, rhs, Jacobian, period);
-* :func:`attractor`, :func:`lyapunov`, :func:`lyapunov_two_trajectory`,
-  :func:`classify`, :func:`basins`, :func:`strobe_points`, :func:`trajectory`;
+* :func:`strobe_points`, :func:`trajectory` - the stroboscopic map - :mod:`.strobe`;
+  :func:`lyapunov`, :func:`lyapunov_two_trajectory` -> :class:`Lyapunov` -
+  :mod:`.exponents`; :func:`classify`, :func:`classify_points` (thresholds
+  :class:`RegimeRules`) -> :class:`Regime` - :mod:`.regimes`; :func:`attractor` ->
+  :class:`Attractor` - :mod:`.attractor`; :func:`basins` -> :class:`Basins` (coexisting
+  attractors) - :mod:`.coexisting`;
 * :class:`UedaMap`, :func:`periodic_orbit`, :class:`PeriodicOrbit` - the period map,
   shooting and Floquet multipliers (:mod:`discovery.numerics.shooting`, shared with the
   vibro-impact system) - :mod:`.periodic`;
@@ -29,21 +33,22 @@ from .._lazy import lazy_package
 # explain) stays the function
 _EXPORTS = {
     "Attractor": "attractor",
-    "Basins": "attractor",
-    "Lyapunov": "attractor",
-    "Regime": "attractor",
     "attractor": "attractor",
-    "basins": "attractor",
-    "classify": "attractor",
-    "classify_points": "attractor",
-    "lyapunov": "attractor",
-    "lyapunov_two_trajectory": "attractor",
-    "rotation_number": "attractor",
-    "strobe_points": "attractor",
-    "trajectory": "attractor",
+    "Basins": "coexisting",
+    "basins": "coexisting",
+    "Lyapunov": "exponents",
+    "lyapunov": "exponents",
+    "lyapunov_two_trajectory": "exponents",
+    "Regime": "regimes",
+    "RegimeRules": "regimes",
+    "classify": "regimes",
+    "classify_points": "regimes",
+    "rotation_number": "regimes",
+    "strobe_points": "strobe",
+    "trajectory": "strobe",
     "Chart": "chart",
     "chart": "chart",
-    "KINDS": "chart",
+    "KINDS": "sweep",
     "Discovery": "discover",
     "ForcedPolynomial": "polynomial",
     "Verification": "verification",

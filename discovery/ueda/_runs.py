@@ -2,6 +2,8 @@
 step budget, the initial state, the status check (shared by the attractor, the period map,
 the chart and discovery, so none imports another's private helpers)."""
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..errors import InputError, VidiTypeError
@@ -9,7 +11,7 @@ from ..numerics.status import check
 from ..numerics.tolerances import Tolerances
 from .system import UedaSystem
 
-__all__ = ["DEFAULT_Y0", "budget", "check", "setup", "initial_state"]
+__all__ = ["DEFAULT_Y0", "Integration", "budget", "check", "setup", "initial_state"]
 
 DEFAULT_Y0 = (0.1, 0.0)
 
@@ -26,6 +28,41 @@ def setup(system, tolerances):
     tol = tolerances or Tolerances()
     T = system.period
     return tol, T, tol.atol(system.scales()), T * tol.hmax_fraction
+
+
+@dataclass(frozen=True, eq=False)
+class Integration:
+    """How the compiled runs of one system integrate (:func:`setup` with the system's
+    parameters), handed from function to function as one object.
+
+    Attributes
+    ----------
+    params : ndarray
+        The system's parameters as the kernels take them (:meth:`UedaSystem.params`).
+    period : float
+        The forcing period ``T``.
+    tol : Tolerances
+    atol : ndarray of shape (2,)
+        Absolute tolerances of ``(x, x')``: ``rtol * atol_scale * scale``.
+    hmax : float
+        Largest step: ``hmax_fraction`` of the period.
+    """
+
+    params: np.ndarray
+    period: float
+    tol: Tolerances
+    atol: np.ndarray
+    hmax: float
+
+    @classmethod
+    def of(cls, system, tolerances=None):
+        """The integration of ``system`` with ``tolerances`` (default :class:`Tolerances`)."""
+        tol, T, atol, hmax = setup(system, tolerances)
+        return cls(params=system.params(), period=T, tol=tol, atol=atol, hmax=hmax)
+
+    def budget(self, n_periods):
+        """Step budget of a run of ``n_periods`` (:func:`budget`)."""
+        return budget(self.tol, n_periods)
 
 
 def initial_state(y0):

@@ -1,36 +1,13 @@
 """Regime charts over the forcing plane ``(nu, B)``, in parallel processes.
 
-Each row of the chart (one ``B``) is swept in increasing ``nu``, every point starting
-from the last state of the previous one (continuation, as an analog-computer sweep; the
-first point of a row starts from ``y0``).  With ``sweeps=2`` the row is swept back in
-decreasing ``nu`` as well, starting from the state the first sweep ended in (the
-up-and-down sweep of a hysteresis experiment): both regimes are recorded, and a point
-where one sweep ends on a stable periodic orbit and the other does not (another orbit,
-or a non-periodic regime), also after ``recheck`` times the transient more from both
-final states, is marked ``coexisting`` (the jump phenomenon near a resonance, two
-coexisting subharmonics).  Two non-periodic results are not compared.
-
-Each point: up to ``transient`` forcing periods of the stroboscopic map (compiled), with
-an early exit as soon as the strobe points repeat after ``n <= max_period`` periods to
-``closure`` (of the scale) over ``max(3 n, min_pairs)`` consecutive pairs, unless the run
-may still be converging to an orbit of a divisor of ``n`` (a P1 orbit with a multiplier
-near -1 repeats after 2 periods long before it repeats after 1).  The orbit's monodromy
-matrix over ``n`` periods then gives its Floquet multipliers: a stable orbit (``|m| <
-1``) is ``P<n>`` with the exponent ``log|m_1| / (n T)``; an unstable one repeated by
-chance and the transient goes on.  Without an early exit, ``periods`` more periods with
-the variational equations (Benettin): ``P<n>`` by the same recurrence test on their
-strobe points (and a stable monodromy), else ``chaotic`` if the largest exponent exceeds
-``chaos_threshold``, else ``beat`` (:func:`~discovery.ueda.classify_points`).
-With ``early_exit=False`` every point takes the second path after the full transient.
-The early exit halves the cost of a chart; the classes of chaotic and quasi-periodic
-points are computed exactly as without it.
+Each row of the chart (one ``B``) is a continuation sweep in ``nu`` (and back, with
+``sweeps=2``), each point classified by the stroboscopic map, its early exit and the
+variational equations: :mod:`.sweep` says how.
 
 Rows are distributed over worker processes (they die with the parent; Ctrl-C stops
 them); the result does not depend on the number of workers.
 """
 
-import cmath
-import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -41,19 +18,13 @@ from .._printing import readable
 from .._progress import reports_progress, tick
 from .._result import Result
 from .._validate import Array, Instance, Real, params
-from ..errors import InputError, IntegrationError, VidiTypeError
+from ..errors import InputError, VidiTypeError
 from ..numerics.executor import make_executor
-from ..numerics.tolerances import Tolerances
-from . import _kernel as UK
-from ._runs import budget as _budget
-from ._runs import check as _check
 from ._runs import initial_state as _y0
-from .attractor import classify_points
+from .sweep import KINDS, sweep_row
 from .system import UedaSystem
 
 __all__ = ["Chart", "chart", "KINDS"]
-
-KINDS = ("P1", "Pn", "beat", "chaotic")  # codes 0..3; -1 failed
 
 
 @readable
@@ -219,8 +190,6 @@ class Chart(Result):
             out["coexisting_points"] = int(np.sum(self.coexisting))
         return out
 
-    # ------------------------------------------------------------------ one point
-
     def _lines(self):
         kinds, counts = np.unique(np.asarray(self.kind).astype(str), return_counts=True)
         share = ", ".join(f"{k} {c}" for k, c in zip(kinds, counts, strict=True))
@@ -231,227 +200,6 @@ class Chart(Result):
         ]
 
 
-def _floquet(M, logs):
-    """Moduli of the two multipliers (largest first) of ``exp(logs) M``, as logs."""
-    tr, det = M[0, 0] + M[1, 1], M[0, 0] * M[1, 1] - M[0, 1] * M[1, 0]
-    r = cmath.sqrt(tr * tr - 4.0 * det)
-    a, b = abs(0.5 * (tr + r)), abs(0.5 * (tr - r))
-    big, small = max(a, b), min(a, b)
-    return (
-        math.log(big) + logs if big > 0 else -math.inf,
-        math.log(small) + logs if small > 0 else -math.inf,
-    )
-
-
-class _Point:
-    """Result of one point: ``kind`` code, ``period``, ``lam``, ``rot``, the final state
-    ``y``, the periods integrated (``cost``) and ``points`` (the periodic orbit's strobe
-    points, or the observed strobe points)."""
-
-    __slots__ = ("kind", "period", "lam", "rot", "y", "cost", "points")
-
-    def __init__(self, kind, period, lam, rot, y, cost, points):
-        self.kind, self.period, self.lam, self.rot = kind, period, lam, rot
-        self.y, self.cost, self.points = y, cost, points
-
-
-def _recurrence(strobe, inv_scale, max_period, closure, min_pairs):
-    """The smallest ``n <= max_period`` whose last ``max(3 n, min_pairs)`` pairs
-    ``|S_k - S_{k-n}| / scale`` are all below ``closure`` (0: none)."""
-    s = strobe * inv_scale
-    for n in range(1, max_period + 1):
-        need = max(3 * n, min_pairs)
-        if need + n > len(s):
-            break
-        tail = s[-(need + n) :]
-        if np.max(np.abs(tail[n:] - tail[:-n])) < closure:
-            return n
-    return 0
-
-
-def _stable_orbit(y, p, T, n, tol, atol, hmax):
-    """``log|m_1| / (n T)`` of the period-``n`` orbit through ``y`` (its monodromy over
-    ``n`` periods); NaN when it is not stable (``|m_1| >= 1``)."""
-    status, t, M, logs, _ = UK.monodromy_run(
-        y, p, T, n, tol.rtol, atol, tol.atol_variational, hmax, _budget(tol, n)
-    )
-    _check(status, t, "the variational equations")
-    log1, _ = _floquet(M, logs)
-    return log1 / (n * T) if log1 < 0.0 else np.nan
-
-
-def _point(system, y, s, tol, buffers=None):
-    """The regime at one ``(nu, B)`` from the state ``y`` at the forcing's phase 0."""
-    T = system.period
-    p = system.params()
-    scale = system.scales()
-    inv = 1.0 / scale
-    atol = tol.atol(scale)
-    hmax = T * tol.hmax_fraction
-    n_tr, n_obs, P, closure = s["transient"], s["periods"], s["max_period"], s["closure"]
-    if buffers is None:
-        buffers = (np.empty((max(n_tr, 1), 2)), np.zeros(P + 1, dtype=np.int64))
-    strobe, run = buffers
-    y = np.asarray(y, dtype=float)
-    cost = 0
-    if n_tr > 0:
-        status, t, y, done, n = UK.scan_run(
-            y,
-            p,
-            T,
-            n_tr,
-            P if s["early_exit"] else 0,
-            s["min_pairs"],
-            closure,
-            inv,
-            tol.rtol,
-            atol,
-            hmax,
-            _budget(tol, n_tr),
-            strobe,
-            run,
-        )
-        _check(status, t, "the stroboscopic map")
-        cost += done
-        if n > 0:
-            lam = _stable_orbit(y, p, T, n, tol, atol, hmax)
-            cost += n
-            if np.isfinite(lam):  # a stable orbit: P<n>
-                return _Point(
-                    0 if n == 1 else 1, n, lam, np.nan, y, cost, strobe[done - n : done].copy()
-                )
-            # an unstable orbit repeating by chance: the rest of the transient
-            status, t, y, more, _ = UK.scan_run(
-                y,
-                p,
-                T,
-                n_tr - done,
-                0,
-                1,
-                closure,
-                inv,
-                tol.rtol,
-                atol,
-                hmax,
-                _budget(tol, n_tr),
-                strobe,
-                run,
-            )
-            _check(status, t, "the stroboscopic map")
-            cost += more
-    logs = np.empty((n_obs, 2))
-    trace = np.empty(n_obs)
-    obs = np.empty((n_obs, 2))
-    status, t, yf, _ = UK.variational_run(
-        0.0,
-        y,
-        p,
-        T,
-        n_obs,
-        tol.rtol,
-        atol,
-        tol.atol_variational,
-        hmax,
-        _budget(tol, n_obs),
-        logs,
-        trace,
-        obs,
-    )
-    _check(status, t, "the variational equations")
-    cost += n_obs
-    n = _recurrence(obs, inv, P, closure, s["min_pairs"])
-    if n > 0:
-        lam = _stable_orbit(yf, p, T, n, tol, atol, hmax)
-        cost += n
-        if np.isfinite(lam):
-            return _Point(0 if n == 1 else 1, n, lam, np.nan, yf, cost, obs[-n:])
-    lam = float(logs[:, 0].sum() / (n_obs * T))
-    reg = classify_points(obs, scale, lam, 0.0, max_period=0, chaos_threshold=s["chaos_threshold"])
-    return _Point(KINDS.index(reg.kind), 0, lam, reg.evidence["rotation_number"], yf, cost, obs)
-
-
-# ------------------------------------------------------------------ same attractor?
-def _same_orbit(a, b, T, scale, closure):
-    """Whether two points' results are the same periodic orbit (``False`` when either is
-    not periodic): the same period, and every strobe point of one orbit within ``tol``
-    of the other's (in any phase), ``tol = max(10 closure, 3 (e_a + e_b))`` where ``e =
-    closure / (1 - |m_1|)`` bounds how far a run whose points repeat to ``closure`` can be
-    from its orbit (slow convergence near a bifurcation widens it)."""
-    if not a.period or a.kind != b.kind or a.period != b.period:
-        return False
-
-    def err(r):
-        m = math.exp(min(r.lam * r.period * T, 0.0))
-        return closure / max(1.0 - m, 1e-12)
-
-    A, Bp = a.points / scale, b.points / scale
-    tol = max(10.0 * closure, 3.0 * (err(a) + err(b)))
-    return max(float(np.min(np.max(np.abs(Bp - q), axis=1))) for q in A) <= tol
-
-
-_FAILED = _Point(-1, 0, np.nan, np.nan, None, 0, None)
-
-
-def _sweep(base, b, nus, s, tol, y, buffers):
-    out = []
-    for nu in nus:
-        system = base.with_params(nu=float(nu), B=float(b))
-        try:
-            r = _point(system, y, s, tol, buffers)
-        except IntegrationError:
-            out.append(_FAILED)
-            y = np.array(s["y0"], dtype=float)
-            continue
-        out.append(r)
-        y = r.y
-    return out, y
-
-
-def _row(ctx, job):
-    """One row of the chart (a task of the executor); ``ctx`` is ``(system, settings)``."""
-    b, nus = job
-    c0 = time.process_time()
-    base, s = ctx
-    tol = Tolerances(rtol=s["rtol"], hmax_fraction=s["hmax_fraction"])
-    buffers = (np.empty((max(s["transient"], 1), 2)), np.zeros(s["max_period"] + 1, dtype=np.int64))
-    up, y = _sweep(base, b, nus, s, tol, np.array(s["y0"], dtype=float), buffers)
-
-    def pack(r):
-        return (r.kind, r.period, r.lam, r.rot, r.cost)
-
-    down = coex = None
-    if s["sweeps"] == 2:
-        dn, _ = _sweep(base, b, nus[::-1], s, tol, y, buffers)
-        dn = dn[::-1]
-        coex = [
-            _coexisting(base, b, nu, u, d, s, tol) for nu, u, d in zip(nus, up, dn, strict=True)
-        ]
-        down = [pack(r) for r in dn]
-    return [pack(r) for r in up], down, coex, time.process_time() - c0
-
-
-def _coexisting(base, b, nu, u, d, s, tol):
-    """Whether the two sweeps ended on different attractors at ``(nu, b)``: at least one
-    on a stable periodic orbit and the other not on it - as recorded and again after
-    ``recheck`` times the transient more from both final states (a slow transient is not
-    coexistence).  Two non-periodic results are not compared (a few dozen strobe points
-    do not tell two quasi-periodic or chaotic sets apart reliably)."""
-    if u.kind < 0 or d.kind < 0 or not (u.period or d.period):
-        return False
-    system = base.with_params(nu=float(nu), B=float(b))
-    T, scale = system.period, system.scales()
-    if _same_orbit(u, d, T, scale, s["closure"]):
-        return False
-    if s["recheck"] <= 0 or s["transient"] <= 0:
-        return True
-    longer = dict(s, transient=s["transient"] * s["recheck"])
-    try:
-        u2, d2 = (_point(system, r.y, longer, tol) for r in (u, d))
-    except IntegrationError:
-        return True
-    return bool(u2.period or d2.period) and not _same_orbit(u2, d2, T, scale, s["closure"])
-
-
 def _axis(values, name):
     a = np.asarray(values, dtype=float).reshape(-1)
     if a.size < 1 or not np.all(np.isfinite(a)) or np.any(np.diff(a) <= 0):
@@ -459,10 +207,8 @@ def _axis(values, name):
     return a
 
 
-def _check_chart(
-    system, nu, B, workers, max_period, transient, periods, sweeps, recheck, min_pairs
-):
-    """The settings :func:`chart` checks beyond their types; returns the axes."""
+def _check_grid(system, nu, B, workers):
+    """The system, the axes and ``workers`` of :func:`chart`, checked; returns the axes."""
     if not isinstance(system, UedaSystem):
         raise VidiTypeError("system must be a discovery.ueda.UedaSystem")
     nu, B = _axis(nu, "nu"), _axis(B, "B")
@@ -470,6 +216,14 @@ def _check_chart(
         raise InputError("nu must be > 0")
     if workers is not None and int(workers) < 1:
         raise InputError(f"workers must be at least 1, got {workers!r}")
+    return nu, B
+
+
+def _check_settings(settings):
+    """The settings :func:`chart` checks beyond their types (:attr:`Chart.settings`)."""
+    s = settings
+    max_period, transient, periods = s["max_period"], s["transient"], s["periods"]
+    sweeps, recheck, min_pairs = s["sweeps"], s["recheck"], s["min_pairs"]
     if int(max_period) < 1:
         raise InputError(f"max_period must be at least 1, got {max_period!r}")
     if int(transient) < 0:
@@ -486,13 +240,13 @@ def _check_chart(
         raise InputError(f"recheck must be >= 0, got {recheck!r}")
     if int(min_pairs) < 1:
         raise InputError(f"min_pairs must be at least 1, got {min_pairs!r}")
-    return nu, B
 
 
-def _run_rows(system, settings, nu, B, workers, executor, progress):
+def _run_rows(system, settings, nu, B, *, workers, executor, progress):
     """Every row of ``B`` on the executor (one task per row): the chart's grids (regime,
     period, exponent, rotation, cost, and the second sweep's), the CPU seconds and the
-    workers used."""
+    workers used (``workers``, ``executor`` and ``progress`` as :func:`chart` takes
+    them)."""
     workers = min(int(workers or os.cpu_count() or 1), B.size)
     shape = (B.size, nu.size)
     kind = np.full(shape, -1, dtype=int)
@@ -511,7 +265,7 @@ def _run_rows(system, settings, nu, B, workers, executor, progress):
     ex = make_executor(workers) if own else executor
     try:
         for done, (i, (up, down, cx, sec)) in enumerate(
-            ex.run(_row, jobs, (system, settings)), start=1
+            ex.run(sweep_row, jobs, (system, settings)), start=1
         ):
             cpu += sec
             for j, (k, n, lv, r, c) in enumerate(up):
@@ -581,7 +335,7 @@ def chart(
     progress=None,
     executor=None,
 ):
-    """The regime at every ``(nu, B)`` of a grid (see the module docstring).
+    """The regime at every ``(nu, B)`` of a grid (see :mod:`discovery.ueda.sweep`).
 
     Parameters
     ----------
@@ -612,7 +366,7 @@ def chart(
         their final states with ``recheck`` times the transient; ``coexisting`` only if
         they still differ (0: no recheck).
     early_exit : bool
-        Stop the transient once a period-``n`` orbit repeats (see the module docstring).
+        Stop the transient once a period-``n`` orbit repeats (see :mod:`discovery.ueda.sweep`).
     min_pairs : int
         Consecutive repeating pairs the early exit needs at least (and ``3 n``).
     workers : int, optional
@@ -628,9 +382,7 @@ def chart(
     -------
     Chart
     """
-    nu, B = _check_chart(
-        system, nu, B, workers, max_period, transient, periods, sweeps, recheck, min_pairs
-    )
+    nu, B = _check_grid(system, nu, B, workers)
     settings = {
         "transient": int(transient),
         "periods": int(periods),
@@ -651,8 +403,11 @@ def chart(
             else ""
         ),
     }
+    _check_settings(settings)
     t_start = time.perf_counter()
-    grids, cpu, workers = _run_rows(system, settings, nu, B, workers, executor, progress)
+    grids, cpu, workers = _run_rows(
+        system, settings, nu, B, workers=workers, executor=executor, progress=progress
+    )
     return Chart(
         system=system,
         nu=nu,

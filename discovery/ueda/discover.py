@@ -190,7 +190,7 @@ def _block_bootstrap(system, sup, ols_se, boot):
         A = np.tensordot(pick, A_k, axes=1)
         cc = pick @ c_k
         out.append(np.linalg.lstsq(A[ix], cc[sup], rcond=None)[0] * system.sb)
-        chosen += stlsq_gram(A, cc, int(pick @ n_k), boot.threshold, system.keep)[1]
+        chosen += stlsq_gram(A, cc, int(pick @ n_k), threshold=boot.threshold, keep=system.keep)[1]
     return np.array(out).std(axis=0, ddof=1), chosen / int(boot.resamples), n_blocks, True
 
 
@@ -262,7 +262,7 @@ def discover(
         keep[nt] = True
     sb = float(np.sqrt(np.mean(b**2))) or 1.0
     bn = b / sb
-    c, sup = stlsq_gram(G.T @ G, G.T @ bn, G.shape[0], threshold, keep)
+    c, sup = stlsq_gram(G.T @ G, G.T @ bn, G.shape[0], threshold=threshold, keep=keep)
     c = c * sb
     if not sup[:nt].any():
         raise InputError(

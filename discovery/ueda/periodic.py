@@ -237,7 +237,7 @@ def periodic_orbit(
     calls0 = pm.n_calls
     n = int(n)
     hist = []
-    y, res, J, ok = newton_orbit(pm, _y0(y0), n, tol, max_newton, hist)
+    y, res, J, ok = newton_orbit(pm, _y0(y0), n, tol=tol, max_iter=max_newton, history=hist)
     mult = floquet_multipliers(J, 2)
     stable = bool(ok and is_stable(mult))
     m = n

@@ -169,8 +169,7 @@ def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20
     """
     from ._runs import budget as _budget
     from ._runs import check
-    from .attractor import Lyapunov as _Lyap
-    from .attractor import _batch_stats
+    from .exponents import Lyapunov
 
     tol = tolerances or Tolerances()
     T = model.period
@@ -214,19 +213,4 @@ def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20
         strobe,
     )
     check(status, t, "the discovered equation")
-    bv, se = _batch_stats(logs, T, batches)
-    lam = logs.sum(axis=0) / (n * T)
-    lyap = _Lyap(
-        value=float(lam[0]),
-        stderr=float(se[0]),
-        second=float(lam[1]),
-        second_stderr=float(se[1]),
-        sum=float(lam.sum()),
-        trace_mean=float(trace.sum() / (n * T)),
-        n_periods=n,
-        batches=int(bv.shape[0]),
-        rtol=tol.rtol,
-        method="variational equations, Gram-Schmidt (QR) every period",
-        batch_values=bv[:, 0].copy(),
-    )
-    return strobe, lyap
+    return strobe, Lyapunov.from_logs(logs, trace, T, batches=batches, rtol=tol.rtol)

@@ -17,8 +17,8 @@ import numpy as np
 from .._validate import Array, Real, Text, params
 from ..errors import InputError, IntegrationError
 from ..numerics.tolerances import Tolerances
-from .attractor import rotation_number
 from .polynomial import ForcedPolynomial
+from .regimes import rotation_number
 from .system import UedaSystem
 
 __all__ = [
@@ -39,7 +39,8 @@ def read_record_csv(path):
     (to 1e-6 of the step)."""
     from .._csv import parse_column, read_csv_rows
 
-    header, body, decimal_comma, _ = read_csv_rows(path, "t and x")
+    rows = read_csv_rows(path, "t and x")
+    header = rows.header
     missing = [c for c in ("t", "x") if c not in header]
     if missing:
         raise InputError(
@@ -48,10 +49,7 @@ def read_record_csv(path):
         )
     limits = {"t": (1e7, "s"), "x": (1e6, "")}
     t, x = (
-        parse_column(
-            c, c, header.index(c), body, str(path), decimal_comma=decimal_comma, limits=limits
-        )
-        for c in ("t", "x")
+        parse_column(rows, c, header.index(c), name=str(path), limits=limits) for c in ("t", "x")
     )
     return check_record(t, x, what=f"--data {path}")
 
@@ -126,7 +124,7 @@ def simulate_record(
     t = np.arange(n) * (T / int(samples_per_period))
     y = np.array((0.1, 0.0) if y0 is None else y0, dtype=float)
     if integrator == "compiled":
-        from .attractor import strobe_points, trajectory
+        from .strobe import strobe_points, trajectory
 
         if not isinstance(system, UedaSystem):
             raise InputError("the compiled integrator simulates a UedaSystem; use scipy")
@@ -226,7 +224,7 @@ def classify_record(strobe, noise_sd, *, max_period=8, monotone=0.98):
     ``6 noise_sd`` (plus 1e-5 of the range); else ``beat`` if the points turn around
     their centre monotonically (fraction >= ``monotone``: an invariant closed curve);
     else ``chaotic``.  Returns a :class:`~discovery.ueda.Regime`."""
-    from .attractor import Regime
+    from .regimes import Regime
 
     s = np.asarray(strobe, float)
     rng_x = float(np.ptp(s[:, 0])) or 1.0

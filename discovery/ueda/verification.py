@@ -19,9 +19,9 @@ from .._printing import generic_lines, readable
 from .._validate import Array, Real, params
 from ..errors import InputError, IntegrationError
 from ..numerics.tolerances import Tolerances
-from .attractor import classify_points
 from .polynomial import ForcedPolynomial, simulate_model
 from .record import Smoothed, check_forcing, classify_record, record_strobe_points, smooth
+from .regimes import classify_points
 from .strobe_resampling import energy_resamples, floor_scheme
 
 __all__ = ["Verification", "verify"]

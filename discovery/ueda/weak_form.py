@@ -29,7 +29,7 @@ def test_function(hs, order):
     return phi, dphi, ddphi
 
 
-def weak_system(t, x, v, B, nu, half_width, *, order=4, stride=None):
+def weak_system(t, x, v, B, nu, *, half_width, order=4, stride=None):
     """The weak-form regression ``G c = b`` (rows: test windows).
 
     ``b_k = int phi_k'' x dt``; column ``j`` is ``int phi_k theta_j dt`` (terms linear in
@@ -37,7 +37,25 @@ def weak_system(t, x, v, B, nu, half_width, *, order=4, stride=None):
     the last column is ``int phi_k B cos(nu t) dt``.  Trapezoidal quadrature (exact to
     high order: ``phi`` vanishes with its derivatives at the window's ends).
 
-    Returns ``(G, b, centres)`` (``centres``: the windows' centre times).
+    Parameters
+    ----------
+    t, x, v : ndarray of shape (n_samples,)
+        The record: uniform times, position and (estimated) velocity.
+    B, nu : float
+        The forcing's amplitude and angular frequency.
+    half_width : int
+        The test windows' half width in samples (:func:`window_half_width`).
+    order : int
+        The test functions' order (``(1 - s^2)^order``).
+    stride : int, optional
+        Samples between window centres (default ``max(1, half_width // 2)``).
+
+    Returns
+    -------
+    G : ndarray of shape (n_windows, n_terms + 1)
+    b : ndarray of shape (n_windows,)
+    centres : ndarray of shape (n_windows,)
+        The windows' centre times.
     """
     hs = int(half_width)
     dt = float(t[1] - t[0])
@@ -77,9 +95,29 @@ def window_half_width(n_samples, samples_per_period, half_width=None):
     return hs
 
 
-def stlsq_gram(A, c, n, threshold, keep, max_iter=25):
-    """STLSQ from the normal equations ``A = G^T G``, ``c = G^T b`` of ``n`` rows and
-    ``bb = b^T b`` (columns scaled to unit RMS, ``b`` too)."""
+def stlsq_gram(A, c, n, *, threshold, keep, max_iter=25):
+    """STLSQ from the normal equations ``A = G^T G``, ``c = G^T b`` of ``n`` rows
+    (columns scaled to unit RMS, ``b`` too).
+
+    Parameters
+    ----------
+    A : ndarray of shape (n_terms, n_terms)
+    c : ndarray of shape (n_terms,)
+    n : int
+        Rows of ``G``.
+    threshold : float
+        Scaled coefficients below it are dropped.
+    keep : ndarray of bool, shape (n_terms,)
+        Columns never dropped.
+    max_iter : int
+        Thresholding rounds at most.
+
+    Returns
+    -------
+    coefficients : ndarray of shape (n_terms,)
+        In the units of ``A`` and ``c``.
+    support : ndarray of bool, shape (n_terms,)
+    """
     s = np.sqrt(np.maximum(np.diag(A), 0.0) / n)
     s[s == 0] = 1.0
     An = A / np.outer(s, s)
@@ -106,5 +144,7 @@ def stlsq(G, b, threshold, keep=None, max_iter=25):
     G, b = np.asarray(G, float), np.asarray(b, float)
     sb = float(np.sqrt(np.mean(b**2))) or 1.0
     keep = np.zeros(G.shape[1], bool) if keep is None else np.asarray(keep, bool)
-    x, sup = stlsq_gram(G.T @ G, G.T @ (b / sb), G.shape[0], threshold, keep, max_iter=max_iter)
+    x, sup = stlsq_gram(
+        G.T @ G, G.T @ (b / sb), G.shape[0], threshold=threshold, keep=keep, max_iter=max_iter
+    )
     return x * sb, sup

@@ -179,13 +179,11 @@ class Measurement:
             One line naming the problem (file, column, line) and the fix.
         """
         name = str(path)
-        header, body, decimal_comma, notes = read_csv_rows(path, "t and F")
-        src, from_a2, extra_notes = _column_sources(header, columns, name, scenario)
-        notes += extra_notes
-        cols = {
-            key: parse_column(key, header[j], j, body, name, decimal_comma, LIMITS)
-            for key, j in src.items()
-        }
+        rows = read_csv_rows(path, "t and F")
+        body = rows.body
+        src, from_a2, extra_notes = _column_sources(rows.header, columns, name, scenario)
+        notes = rows.notes + extra_notes
+        cols = {key: parse_column(rows, key, j, name=name, limits=LIMITS) for key, j in src.items()}
         t = cols["t"]
         d = np.diff(t)
         if np.any(d == 0):

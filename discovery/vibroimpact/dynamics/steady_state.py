@@ -293,7 +293,7 @@ def _orbit(pm, y, n, t0, *, tol, max_newton, attempt, evidence):
     ``attempt`` (one of ``evidence``'s attempts); ``tol`` and ``max_newton`` are Newton's
     (see :func:`steady_state`)."""
     hist = []
-    y_orb, res, J, ok = newton_orbit(pm, y, n, tol, max_newton, hist)
+    y_orb, res, J, ok = newton_orbit(pm, y, n, tol=tol, max_iter=max_newton, history=hist)
     mult = floquet_multipliers(J, len(y))
     stable = bool(ok and is_stable(mult))
     attempt["tried"].append(
@@ -478,7 +478,12 @@ def _continued(scenario, law, pm, guess, tol):
     hist = []
     try:
         y_orb, res, J, ok = newton_orbit(
-            pm, np.asarray(guess.y0, dtype=float), n, tol, CONTINUATION_NEWTON, hist
+            pm,
+            np.asarray(guess.y0, dtype=float),
+            n,
+            tol=tol,
+            max_iter=CONTINUATION_NEWTON,
+            history=hist,
         )
     except IntegrationError:
         return None
