@@ -28,6 +28,7 @@ from discovery.vibroimpact.model.contact_models import (  # noqa: E402
     parse_model,
     restitution_from_ratio,
     restitution_ratio,
+    same_force,
 )
 from discovery.vibroimpact.model.law import ForceLaw  # noqa: E402
 from discovery.vibroimpact.model.scenario import load_scenario  # noqa: E402
@@ -166,6 +167,50 @@ def test_restitution_maps_invert():
         for e in (0.3, 0.6, 0.9):
             assert restitution_from_ratio(name, restitution_ratio(name, e)) == pytest.approx(e)
     assert math.isnan(restitution_from_ratio("lankarani-nikravesh", 0.8))
+
+
+def test_lankarani_nikravesh_and_flores_are_one_force_family():
+    ln = ContactModel("lankarani-nikravesh", (2e9, 1.3, 0.5))
+    other, p = same_force("lankarani-nikravesh", {"k": 2e9, "n": 1.3, "e": 0.5})
+    fl = ContactModel(other, (p["k"], p["n"], p["e"]))
+    # the same force at any impact velocity: the two laws' terms are the same
+    for v0 in (0.05, 0.3, 2.0):
+        a, b = ln.law.at_impact(v0), fl.law.at_impact(v0)
+        assert a.names == b.names
+        assert a.unloading == b.unloading
+        assert np.allclose(a.coefficients, b.coefficients, rtol=1e-12)
+        assert np.allclose(a.unloading_coefficients, b.unloading_coefficients, rtol=1e-12)
+    back = same_force("flores", p)
+    assert back[0] == "lankarani-nikravesh" and back[1]["e"] == pytest.approx(0.5)
+    assert same_force("flores", {"k": 2e9, "n": 1.3, "e": 0.3}) is None  # r > 3/4
+    assert same_force("hunt-crossley", {"k": 2e9, "n": 1.3, "lambda": 1e9}) is None
+
+
+def test_the_conclusion_says_when_no_record_can_separate_two_models():
+    def fit(model, params):
+        return ContactFit(
+            model=model,
+            parameters=params,
+            intervals={},
+            criteria={"I2": 0.01},
+            value=0.01,
+            consistent=True,
+            law="",
+        )
+
+    ln = fit("lankarani-nikravesh", {"k": 2e9, "n": 1.3, "e": 0.5})
+    fl = fit("flores", {"k": 2e9, "n": 1.3, "e": 0.74})
+    hc = fit("hunt-crossley", {"k": 2e9, "n": 1.3, "lambda": 1e9})
+    res = ContactModelsResult(
+        fits=(ln, fl, hc), selected="lankarani-nikravesh", equivalent=("flores", "hunt-crossley")
+    )
+    text = res.conclusion
+    assert "flores with e = 0.74 makes the same force at every impact velocity" in text
+    assert "no record can separate them" in text
+    assert "cannot tell it from hunt-crossley" in text and "from flores" not in text
+    assert res.to_dict()["conclusion"] == text
+    alone = ContactModelsResult(fits=(hc,), selected="hunt-crossley")
+    assert alone.same_force is None and "same force" not in alone.conclusion
 
 
 def test_result_round_trip(tmp_path):

@@ -32,7 +32,7 @@ from ..._progress import reports_progress
 from ..._validate import Real, params
 from ...errors import InputError, IntegrationError
 from ..data.measurement import Measurement
-from ..model.contact_models import MODELS
+from ..model.contact_models import MODELS, same_force
 from ..model.scenario import Scenario
 from ..verify import Reference
 from .contact_starts import from_hunt_crossley, record_samples, regression_start, start_model
@@ -199,13 +199,30 @@ class ContactModelsResult:
                 "the contact is none of them, try the polynomial library or vidi explain"
             )
         text = f"The record supports {self.selected}"
-        if self.equivalent:
+        twin = self.same_force
+        if twin is not None:
+            other, p = twin
             text += (
-                f"; it cannot tell it from {', '.join(self.equivalent)} (consistent too: a "
+                f"; {other} with e = {p['e']:.3g} makes the same force at every impact "
+                "velocity (one family: no record can separate them)"
+            )
+        rest = [m for m in self.equivalent if twin is None or m != twin[0]]
+        if rest:
+            text += (
+                f"; it cannot tell it from {', '.join(rest)} (consistent too: a "
                 "record with impacts at other velocities, e.g. another drive amplitude, "
                 "would separate them)"
             )
         return text
+
+    @property
+    def same_force(self):
+        """``(model, parameters)``: the model that makes exactly the selected model's
+        force at every impact velocity (Lankarani-Nikravesh and Flores,
+        :func:`~discovery.vibroimpact.model.contact_models.same_force`), or ``None``."""
+        if self.selected is None:
+            return None
+        return same_force(self.selected, self.fit(self.selected).parameters)
 
     def _lines(self):
         out = [self.conclusion]

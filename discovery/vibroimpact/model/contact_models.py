@@ -40,6 +40,7 @@ __all__ = [
     "parse_law",
     "is_model_text",
     "restitution_ratio",
+    "same_force",
 ]
 
 #: the models, each with its parameters in order and whether ``n`` is its own
@@ -70,6 +71,28 @@ def restitution_from_ratio(name, r):
     if name == "lankarani-nikravesh":
         return float(np.sqrt(1.0 - 4.0 * r / 3.0)) if r <= 0.75 else float("nan")
     return 8.0 / (8.0 + 5.0 * r)
+
+
+#: the models that are one force family ``k z^n (1 + r dz / v0)``, each reading ``e`` from ``r``
+_ONE_FAMILY = ("lankarani-nikravesh", "flores")
+
+
+def same_force(name, parameters):
+    """``(other model, its parameters)`` making exactly the same force as model ``name``
+    with ``parameters`` at every impact velocity, or ``None``.
+
+    Lankarani-Nikravesh and Flores are one family: the same ``k``, ``n`` and ratio
+    ``r`` give the same force, so no record, at any operating point, can tell them apart.
+    A Flores model whose ``r`` exceeds ``3/4`` (``e < 8/11.75``) has no Lankarani-Nikravesh
+    counterpart.
+    """
+    if name not in _ONE_FAMILY:
+        return None
+    other = _ONE_FAMILY[1 - _ONE_FAMILY.index(name)]
+    e = restitution_from_ratio(other, restitution_ratio(name, float(parameters["e"])))
+    if not np.isfinite(e):
+        return None
+    return other, {"k": float(parameters["k"]), "n": float(parameters["n"]), "e": e}
 
 
 @dataclass(frozen=True)
