@@ -232,6 +232,30 @@ def test_advise_takes_named_contact_models_and_a_contact_models_fit(tmp_path):
     assert contact_candidates(res.to_dict()) == models
     with pytest.raises(InputError, match="selected no model"):
         contact_candidates(_contact_fit(selected=None, equivalent=()))
+    # Flores's same-force twin is no candidate; alone, it leaves nothing to advise
+    from discovery.vibroimpact.fit.contact_fit import ContactFit, ContactModelsResult
+
+    ln = ContactFit(
+        model="lankarani-nikravesh",
+        parameters={"k": 7.4832e8, "n": 1.1997, "e": 0.8},
+        intervals={},
+        criteria={"I2": 0.0078},
+        value=0.0078,
+        consistent=True,
+        law="",
+    )
+    fl = ContactFit(**{**ln.__dict__, "model": "flores", "parameters": {**ln.parameters}})
+    twins = ContactModelsResult(
+        fits=(ln, fl), selected="lankarani-nikravesh", equivalent=("flores",)
+    )
+    with pytest.raises(InputError, match="same force at every impact velocity"):
+        contact_candidates(twins)
+    with_hc = ContactModelsResult(
+        fits=(ln, fl, res.fit("hunt-crossley")),
+        selected="lankarani-nikravesh",
+        equivalent=("flores", "hunt-crossley"),
+    )
+    assert [m.name for m in contact_candidates(with_hc)] == ["lankarani-nikravesh", "hunt-crossley"]
     # at the fit's own point the two are one record; at a faster drive they separate
     same = _one_point(res)
     assert same.best is None or same.best.smallest < 1

@@ -325,7 +325,10 @@ def contact_candidates(result):
     """The selected named contact model of a contact-models fit
     (:class:`~discovery.vibroimpact.fit.contact_fit.ContactModelsResult`, or its
     ``to_dict()``) and the models it reports equivalent, each with its fitted parameters:
-    a tuple of :class:`~discovery.vibroimpact.model.contact_models.ContactModel`."""
+    a tuple of :class:`~discovery.vibroimpact.model.contact_models.ContactModel`.  The
+    selected model's same-force twin
+    (:attr:`~discovery.vibroimpact.fit.contact_fit.ContactModelsResult.same_force`) is left
+    out, and a fit whose only equivalent model is that twin is refused (InputError)."""
     from ..fit.contact_fit import ContactModelsResult
     from ..model.contact_models import MODELS, ContactModel
 
@@ -336,8 +339,17 @@ def contact_candidates(result):
             "the contact-models fit selected no model (none is consistent with the record): "
             "there are no candidates to separate; try the polynomial library"
         )
+    # the selected model's same-force twin is no candidate: no operating point separates it
+    twin = result.same_force
+    names = [m for m in result.equivalent if twin is None or m != twin[0]]
+    if twin is not None and twin[0] in result.equivalent and not names:
+        raise InputError(
+            f"the only model the fit could not tell from {result.selected} is {twin[0]}, "
+            "which makes the same force at every impact velocity: no operating point "
+            "separates them, so there is nothing to advise"
+        )
     out = []
-    for name in (result.selected, *result.equivalent):
+    for name in (result.selected, *names):
         p = result.fit(name).parameters
         out.append(ContactModel(name, tuple(p[k] for k in MODELS[name])))
     return tuple(out)
