@@ -8,7 +8,7 @@ from scipy.optimize import least_squares, minimize
 
 from ...errors import InputError, IntegrationError, VidiTypeError
 from ..model.law import ForceLaw
-from .problem import _Budget, _Rejoined
+from .problem import _Budget
 from .records import as_records
 
 __all__ = ["METHODS", "RESTART_FACTORS"]
@@ -125,8 +125,6 @@ def _optimise(obj, x0, method, xtol, max_simulations):
         return str(res.message)
     except _Budget:
         return f"simulation budget of {max_simulations} used"
-    except _Rejoined:
-        return "came back to the best point"
 
 
 RESTART_FACTORS = (1.25, 0.8)
@@ -135,9 +133,7 @@ parameter scaled by each factor, while the budget allows, and the best point is 
 sum of squares for least squares, else by the criterion).  A law refitted from a start 20 %
 off can stop in a basin whose spring is too soft (another contact sequence along the
 record's transient); a restart from a stiffer and a softer point often leaves such a basin
-(the rates: CHANGELOG).  A restart stops as soon as it comes back within
-:data:`~.problem.REJOIN` of the best point: it is in that point's basin, which the first
-optimisation has already converged in."""
+(the rates: CHANGELOG)."""
 
 
 def _restarted(obj, method, xtol, max_simulations, message):
@@ -151,11 +147,7 @@ def _restarted(obj, method, xtol, max_simulations, message):
             break
         before = obj.best_squares[0] if squares else obj.best[0]
         x = np.clip(x_best * f, np.nextafter(lo, np.inf), np.nextafter(hi, -np.inf))
-        obj.rejoin = x_best
-        try:
-            _optimise(obj, x, method, xtol, max_simulations)
-        finally:
-            obj.rejoin = None
+        _optimise(obj, x, method, xtol, max_simulations)
         after = obj.best_squares[0] if squares else obj.best[0]
         if after < before:
             what = "sum of squares" if squares else obj.name

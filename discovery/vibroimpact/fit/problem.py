@@ -32,16 +32,6 @@ class _Budget(Exception):
     """The simulation budget is used up."""
 
 
-class _Rejoined(Exception):
-    """A restart came back within :data:`REJOIN` of the point it was started from."""
-
-
-REJOIN = 1e-3
-"""A restart (:data:`~.optimise.RESTART_FACTORS`) that comes this close to the best point
-(every parameter within this relative distance) has fallen back into its basin and stops
-there, without simulating the point."""
-
-
 def output_residuals(evaluations, records, weights=None):
     """The output-error residual of a model's ``evaluations`` on ``records``: the simulated
     minus the measured force of every compared cycle (:func:`~.records.cycle_pairs`), record
@@ -175,8 +165,6 @@ class _Objective:
         # spread the standard errors and the bootstrap describe), apart from the criterion's
         self.best_squares = (np.inf, None)
         self.path, self.failures = [], []
-        # during a restart: the best point it started from (:data:`REJOIN`)
-        self.rejoin = None
         # continuation: per record compared with its steady orbit, the solved orbits
         # ``[(x, SteadyState), ...]``; the next one starts from the nearest (Newton from
         # it, the cold search only when that fails: steady_state's ``guess``)
@@ -197,10 +185,6 @@ class _Objective:
         if key not in self.cache:
             if self.n + len(self.records) > self.max_sim:
                 raise _Budget
-            if self.rejoin is not None and np.all(
-                np.abs(np.asarray(x) - self.rejoin) <= REJOIN * np.abs(self.rejoin)
-            ):
-                raise _Rejoined
             law, machine, observe = model_parts(self.law(x), self.observe)
             evs = []
             for i, (sc, ref) in enumerate(self.records):
