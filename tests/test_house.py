@@ -115,7 +115,9 @@ def test_public_names_are_what_the_docs_say():
     for name in ("explain", "landscape", "identify", "discover", "response", "study"):
         assert callable(getattr(discovery, name)), name
     assert importlib.import_module("discovery.vibroimpact.explain").EFFECTS
-    assert callable(importlib.import_module("discovery.vibroimpact.verify.landscape").landscape)
+    assert callable(
+        importlib.import_module("discovery.vibroimpact.verify.criteria_landscape").landscape
+    )
     for name in ("chart", "discover", "explain", "verify"):  # Ueda's, as the README documents
         assert callable(getattr(importlib.import_module("discovery.ueda"), name)), name
     from discovery.vibroimpact.verify import verify
@@ -124,17 +126,17 @@ def test_public_names_are_what_the_docs_say():
 
 
 def test_split_modules_keep_the_names_of_the_module_they_were():
-    """``fit/identify.py``, ``fit/discover.py`` and ``explain/explain.py`` are split by job;
+    """``fit/identification.py``, ``fit/discovery.py`` and ``explain/loop.py`` are split by job;
     every name other modules and tests import from them is still there (the same object as
     in its new module)."""
     for old_mod, moved in {
-        "identify": {
+        "identification": {
             "problem": ("_Objective", "_PENALTY", "_Budget", "_uncertainty"),
             "intervals": ("Intervals", "bootstrap_intervals", "MIN_CYCLE_DOF", "INTERVAL_REFITS"),
             "optimise": ("METHODS", "RESTART_FACTORS", "_optimise", "_coordinate_descent"),
             "records": ("as_records", "pair_records", "record_start", "model_parts", "cycle_pairs"),
         },
-        "discover": {
+        "discovery": {
             "discovery_result": ("RankedModel", "DiscoveryResult"),
             "ranking": ("rank",),
             "discovery_warnings": ("_stability_warning", "_impact_warnings"),
@@ -145,7 +147,7 @@ def test_split_modules_keep_the_names_of_the_module_they_were():
             new = importlib.import_module(f"discovery.vibroimpact.fit.{mod}")
             for n in names:
                 assert getattr(split, n) is getattr(new, n), n
-    old = importlib.import_module("discovery.vibroimpact.explain.explain")
+    old = importlib.import_module("discovery.vibroimpact.explain.loop")
     pkg = importlib.import_module("discovery.vibroimpact.explain")
     for n in ("ExplainResult", "Iteration", "start_law"):
         assert getattr(old, n) is getattr(pkg, n), n
@@ -260,8 +262,8 @@ def _crossings(graph, pkgs, forbidden):
 def test_the_import_graph_follows_imports_through_other_modules():
     """The graph the layer tests walk: a module reaches what its imports import."""
     graph = _graph()
-    assert "discovery.vibroimpact.dynamics.steady_state" in _closure(
-        graph, "discovery.vibroimpact.verify.evaluate"
+    assert "discovery.vibroimpact.dynamics.steady_states" in _closure(
+        graph, "discovery.vibroimpact.verify.evaluation"
     )
     reach = _closure(graph, "discovery.warm")
     assert "discovery.ueda.exponents" in reach and "discovery.vibroimpact.dynamics" in reach
@@ -274,7 +276,7 @@ def test_two_systems_on_a_shared_floor():
     imports the other, and the vibro-impact data layer does not simulate."""
     graph = _graph()
     systems = ("discovery.vibroimpact", "discovery.ueda")
-    above = ("discovery.warm", "discovery.parallel", "discovery.cli", "discovery.report")
+    above = ("discovery.warm", "discovery.parallel", "discovery.cli", "discovery.reporting")
     assert not _crossings(graph, ["discovery.numerics"], systems + above + ("reports",))
     assert not _crossings(graph, ["discovery.ueda"], ("discovery.vibroimpact",))
     assert not _crossings(graph, ["discovery.vibroimpact"], ("discovery.ueda",))
@@ -295,7 +297,7 @@ def test_reports_and_the_package_do_not_import_each_other_in_a_cycle():
     """``discovery.report`` builds on ``reports``; nothing in ``reports`` reaches back to it
     (nor to the CLI), and the ``reports`` package itself imports nothing of ``discovery``."""
     graph = _graph()
-    assert not _crossings(graph, ["reports"], ("discovery.report", "discovery.cli"))
+    assert not _crossings(graph, ["reports"], ("discovery.reporting", "discovery.cli"))
     assert not {m for m in _closure(graph, "reports") if m.startswith("discovery")}
 
 
