@@ -29,8 +29,7 @@ system (:mod:`discovery.numerics._dopri`).
 
 from .._lazy import lazy_package
 
-# names are imported on first use; a function named like its module (chart, discover,
-# explain) stays the function
+# names are imported on first use (:mod:`discovery._lazy`)
 _EXPORTS = {
     "Attractor": "attractor_analysis",
     "attractor": "attractor_analysis",
