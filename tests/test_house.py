@@ -3,7 +3,11 @@
 import ast
 import importlib
 import re
+import sys
+import types
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGES = ("discovery", "constraints", "reports")
@@ -123,6 +127,79 @@ def test_public_names_are_what_the_docs_say():
     from discovery.vibroimpact.verify import verify
 
     assert callable(verify)
+
+
+def _modules(*packages):
+    """Every module (not package) of ``packages``, as ``(dotted name, path)``."""
+    for pkg in packages:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            if path.name != "__init__.py":
+                yield _module_name(path), path
+
+
+def _exported_here(package, name, module):
+    """Whether ``package`` exports ``name`` defined in ``module``: a lazy package's
+    ``_EXPORTS`` names the module; an eager one's ``__all__`` (checked for the parent)."""
+    pkg = importlib.import_module(package)
+    exports = getattr(pkg, "_EXPORTS", None)
+    if exports is not None and name in exports:
+        return f"{package}.{exports[name]}" == module
+    return package == module.rpartition(".")[0] and name in getattr(pkg, "__all__", ())
+
+
+def test_no_module_is_named_like_a_public_name_it_defines():
+    """A module is named for what it holds, never like a function or class it defines that a
+    package exports: importing ``pkg.chart`` would replace ``pkg.chart`` the function by the
+    module, and ``import pkg.chart as m`` would give the function (``regime_chart``
+    defines ``chart``)."""
+    bad = []
+    for name, path in _modules(*PACKAGES):
+        stem = path.stem
+        if stem.startswith("_"):
+            continue
+        tree = ast.parse(path.read_text())
+        defined = {
+            n.name
+            for n in tree.body
+            if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef))
+        }
+        if stem not in defined:
+            continue
+        parts = name.split(".")
+        owners = [".".join(parts[:i]) for i in range(len(parts) - 1, 0, -1)]
+        bad += [
+            f"{name} ({owner} exports {stem})"
+            for owner in owners
+            if _exported_here(owner, stem, name)
+        ]
+    assert not bad, bad
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_every_submodule_imports_as_a_module(package):
+    """``import pkg.sub.mod as m`` gives the module for every module of the project (no
+    public name of a package hides a module of the same name)."""
+    bad = []
+    for name, _ in _modules(package):
+        ns = {}
+        exec(f"import {name} as m", ns)
+        if not isinstance(ns["m"], types.ModuleType) or ns["m"] is not sys.modules[name]:
+            bad.append(f"{name} -> {ns['m']!r}")
+    assert not bad, bad
+
+
+def test_a_lazy_package_refuses_a_name_its_module_shares(tmp_path, monkeypatch):
+    """``lazy_package`` raises at import when an export is named like its module."""
+    pkg = tmp_path / "vidi_shadow_pkg"
+    pkg.mkdir()
+    (pkg / "thing.py").write_text("def thing():\n    return 1\n")
+    (pkg / "__init__.py").write_text(
+        "from discovery._lazy import lazy_package\nlazy_package(__name__, {'thing': 'thing'})\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "vidi_shadow_pkg", raising=False)
+    with pytest.raises(ImportError, match="'thing' \\(from .thing\\).*rename the module"):
+        importlib.import_module("vidi_shadow_pkg")
 
 
 def test_split_modules_keep_the_names_of_the_module_they_were():
