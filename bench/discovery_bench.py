@@ -135,7 +135,7 @@ def bench_pipeline(repeat=3):
       refinements of each search step in parallel) for the speed-up and the same ranking.
     """
     from discovery import discover
-    from discovery.vibroimpact.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.dynamics.steady_states import steady_state
     from discovery.vibroimpact.verify import verify
 
     sc = load_scenario("paper")

@@ -34,7 +34,7 @@ def bench_record():
 
 
 def bench_explain(repeat=2):
-    from discovery.vibroimpact.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.dynamics.steady_states import steady_state
     from discovery.vibroimpact.explain import EFFECTS, explain
 
     sc, rec = bench_record()

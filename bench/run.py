@@ -38,12 +38,12 @@ import numpy as np
 from discovery._io import provenance, to_jsonable
 from discovery.vibroimpact.dynamics import Tolerances, simulate
 from discovery.vibroimpact.dynamics.reference import reference_simulate
-from discovery.vibroimpact.dynamics.steady_state import steady_state
-from discovery.vibroimpact.dynamics.synthesize import synthesize
-from discovery.vibroimpact.fit.identify import METHODS, identify
+from discovery.vibroimpact.dynamics.steady_states import steady_state
+from discovery.vibroimpact.dynamics.synthetic import synthesize
+from discovery.vibroimpact.fit.identification import METHODS, identify
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import load_scenario
-from discovery.vibroimpact.verify.landscape import landscape
+from discovery.vibroimpact.verify.criteria_landscape import landscape
 
 
 def _best(f, repeat=5):

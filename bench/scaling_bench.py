@@ -89,7 +89,7 @@ def bench_explain_scaling(counts):
     """explain on the bench's record with each worker count (the same effect named)."""
     from explain_bench import bench_record
 
-    from discovery.vibroimpact.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.dynamics.steady_states import steady_state
     from discovery.vibroimpact.explain import explain
 
     sc, rec = bench_record()

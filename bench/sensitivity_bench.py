@@ -19,7 +19,7 @@ import numpy as np
 def _clear_memos():
     """Every timed run starts without the simulations an earlier one cached."""
     for name in (
-        "discovery.vibroimpact.verify.evaluate",
+        "discovery.vibroimpact.verify.evaluation",
         "discovery.vibroimpact.verify.trajectory",
     ):
         importlib.import_module(name).MEMO.clear()
@@ -43,12 +43,12 @@ def _differences(self, y, n=1):
 
 def bench_sensitivities():
     from discovery import ForceLaw, load_scenario
-    from discovery.vibroimpact.dynamics.simulate import simulate
-    from discovery.vibroimpact.dynamics.steady_state import StroboscopicMap, steady_state
-    from discovery.vibroimpact.dynamics.synthesize import synthesize
+    from discovery.vibroimpact.dynamics.simulation import simulate
+    from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state
+    from discovery.vibroimpact.dynamics.synthetic import synthesize
     from discovery.vibroimpact.verify import Reference
 
-    ident = importlib.import_module("discovery.vibroimpact.fit.identify")
+    ident = importlib.import_module("discovery.vibroimpact.fit.identification")
     sc = load_scenario("paper")
     law = ForceLaw.parse("2.06e8*z + 1.28e7*zd + 2e10*z*zd")
     out = {}

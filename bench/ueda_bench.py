@@ -30,7 +30,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from discovery.ueda import UedaSystem, lyapunov
-from discovery.ueda.chart import chart
+from discovery.ueda.regime_chart import chart
 from discovery.ueda.sweep import point
 from discovery.vibroimpact.dynamics import Tolerances
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from discovery.vibroimpact.dynamics.response import impulse_from_steady_state
-from discovery.vibroimpact.dynamics.steady_state import steady_state
+from discovery.vibroimpact.dynamics.law_response import impulse_from_steady_state
+from discovery.vibroimpact.dynamics.steady_states import steady_state
 from discovery.vibroimpact.model.scenario import load_scenario
 
 

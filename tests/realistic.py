@@ -15,7 +15,7 @@ contact frequency ``wc`` and damping ratio ``xi`` on the reduced mass ``mu``
   stiffness and damping match ``k``, ``c`` at ``z0``)
 
 and rejects draws until the periodic steady state reached from rest (found with the
-compiled kernel through :func:`~discovery.vibroimpact.dynamics.steady_state.steady_state`; fast,
+compiled kernel through :func:`~discovery.vibroimpact.dynamics.steady_states.steady_state`; fast,
 and only used to *classify* the draw) has the property of the requested category,
 and its slowest Floquet mode decays to 1e-4 within the longest transient (600
 periods: max |multiplier| < 0.985 in every category, so every record is steady):
@@ -65,9 +65,9 @@ from functools import cache
 import numpy as np
 
 from discovery.errors import VidiError
-from discovery.vibroimpact.dynamics.response import impulse_from_steady_state
-from discovery.vibroimpact.dynamics.simulate import Tolerances, simulate
-from discovery.vibroimpact.dynamics.steady_state import steady_state
+from discovery.vibroimpact.dynamics.law_response import impulse_from_steady_state
+from discovery.vibroimpact.dynamics.simulation import Tolerances, simulate
+from discovery.vibroimpact.dynamics.steady_states import steady_state
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario
 from discovery.vibroimpact.studies.records import (

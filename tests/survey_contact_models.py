@@ -55,9 +55,9 @@ from realistic import draw_case, reference_record  # noqa: E402
 from discovery._io import git_state, provenance  # noqa: E402
 from discovery.errors import VidiError  # noqa: E402
 from discovery.vibroimpact.advise import Knobs, NoiseModel, SafeRegion, advise  # noqa: E402
-from discovery.vibroimpact.dynamics.steady_state import steady_state  # noqa: E402
+from discovery.vibroimpact.dynamics.steady_states import steady_state  # noqa: E402
 from discovery.vibroimpact.fit.contact_fit import fit_contact_models  # noqa: E402
-from discovery.vibroimpact.fit.identify import bootstrap_intervals  # noqa: E402
+from discovery.vibroimpact.fit.identification import bootstrap_intervals  # noqa: E402
 from discovery.vibroimpact.model.contact_models import (  # noqa: E402
     MODELS,
     ContactModel,

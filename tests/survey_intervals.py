@@ -8,7 +8,7 @@ recorded by the independent scipy path from rest (:func:`tests.realistic.referen
 at a random sample rate of 5-20 kHz (not a multiple of the drive frequency), at low noise
 (force 0.5 % of its peak, motion 0.1 % of each channel's range) or high noise (3 %, 0.3 %)
 in turn.  The true support is identified by output error from a start 20 % off the truth,
-with bootstrap intervals (:func:`discovery.vibroimpact.fit.identify.bootstrap_intervals`),
+with bootstrap intervals (:func:`discovery.vibroimpact.fit.identification.bootstrap_intervals`),
 and each interval is checked against the truth.  One JSON line per record (``--out FILE``:
 a run file of :mod:`tests.measured`, headed by the commit and code version); ``--summary
 FILE`` prints the coverage per class (category, kind, coupling share, noise level) of the

@@ -8,7 +8,7 @@ import pytest
 import discovery
 from discovery.cli import _parser
 from discovery.errors import InputError
-from discovery.vibroimpact.dynamics.synthesize import synthesize
+from discovery.vibroimpact.dynamics.synthetic import synthesize
 
 
 @pytest.fixture(scope="module")

@@ -14,7 +14,7 @@ import pytest
 import discovery as d
 import discovery.ueda as osc
 from discovery.errors import InputError, VidiError, VidiTypeError
-from discovery.ueda.chart import chart as ueda_chart
+from discovery.ueda.regime_chart import chart as ueda_chart
 from discovery.vibroimpact.verify import verify
 
 SC = d.load_scenario("paper")

@@ -16,7 +16,7 @@ import pytest
 
 from discovery.cli import main
 from discovery.errors import VidiError
-from discovery.vibroimpact.dynamics.synthesize import synthesize
+from discovery.vibroimpact.dynamics.synthetic import synthesize
 
 GOOD_TOML = """\
 name = "bench"
@@ -613,7 +613,7 @@ def test_a_bug_is_exit_1_not_bad_input(monkeypatch, capsys, exc):
     or any other exception from a bug is exit 1 with one line asking for a report."""
     import importlib
 
-    R = importlib.import_module("discovery.vibroimpact.dynamics.response")
+    R = importlib.import_module("discovery.vibroimpact.dynamics.law_response")
 
     def broken(*args, **kwargs):
         raise exc

@@ -184,7 +184,7 @@ def test_solver_error_exit_2_one_line(record, tmp_path, capsys, monkeypatch):
 
     # the module (the package attribute of the same name is the function)
     monkeypatch.setattr(
-        importlib.import_module("discovery.vibroimpact.fit.discover"), "discover", fail
+        importlib.import_module("discovery.vibroimpact.fit.discovery"), "discover", fail
     )
     out = tmp_path / "o"
     _assert_clean_failure(

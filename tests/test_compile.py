@@ -58,7 +58,7 @@ def test_a_steady_state_announces_the_compile_before_its_first_period(
     """The stroboscopic map is the first to call the kernel in `vidi steady`: it says so
     before (the map is built here, nothing is compiled)."""
     from discovery import load_scenario
-    from discovery.vibroimpact.dynamics.steady_state import StroboscopicMap
+    from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap
 
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
     monkeypatch.setattr(C, "_ANNOUNCED", set())

@@ -8,7 +8,7 @@ from scipy.optimize import brentq
 
 from discovery.errors import InputError
 from discovery.vibroimpact.dynamics import _kernel as K
-from discovery.vibroimpact.dynamics.simulate import Tolerances, simulate
+from discovery.vibroimpact.dynamics.simulation import Tolerances, simulate
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario, load_scenario
 from tests.test_kernel import _compare_with_reference
@@ -175,7 +175,7 @@ def test_kernel_matches_reference_extended(name, text, changes):
 
 def test_a_moulding_that_sheds_mass_has_no_steady_state(tmp_path, capsys):
     from discovery.cli import main
-    from discovery.vibroimpact.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.dynamics.steady_states import steady_state
 
     sc = load_scenario("paper").replace(mass_loss=0.01)
     with pytest.raises(InputError, match="no periodic steady state"):
@@ -197,7 +197,7 @@ def test_a_set_orbit_strobed_inside_its_contact_keeps_its_unloading_memory():
     # which penetration the set contact unloads, so the steady state carries it.  The orbit
     # and its force must be the independent scipy path's (without the memory the true law
     # failed its own noise-free record with I2 = 0.11)
-    from discovery.vibroimpact.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.dynamics.steady_states import steady_state
     from discovery.vibroimpact.verify import Reference, evaluate
     from tests.realistic import reference_record
 

@@ -14,8 +14,8 @@ from realistic import reference_record  # noqa: E402
 
 from discovery.errors import InputError  # noqa: E402
 from discovery.vibroimpact.dynamics.reference import reference_simulate  # noqa: E402
-from discovery.vibroimpact.dynamics.simulate import simulate  # noqa: E402
-from discovery.vibroimpact.dynamics.steady_state import steady_state  # noqa: E402
+from discovery.vibroimpact.dynamics.simulation import simulate  # noqa: E402
+from discovery.vibroimpact.dynamics.steady_states import steady_state  # noqa: E402
 from discovery.vibroimpact.fit.contact_fit import (  # noqa: E402
     ContactFit,
     ContactModelsResult,

@@ -23,7 +23,7 @@ import pytest
 
 from discovery import ForceLaw, Measurement, load_scenario
 from discovery.vibroimpact.explain import explain
-from discovery.vibroimpact.fit.discover import discover
+from discovery.vibroimpact.fit.discovery import discover
 from discovery.vibroimpact.verify import Reference, verify
 
 CORPUS = Path(__file__).resolve().parents[2] / "shared" / "corpus"

@@ -8,8 +8,8 @@ import pytest
 
 from discovery.errors import InputError
 from discovery.vibroimpact.data.impulse import Impulse
-from discovery.vibroimpact.dynamics.response import impulse_from_steady_state
-from discovery.vibroimpact.dynamics.steady_state import steady_state
+from discovery.vibroimpact.dynamics.law_response import impulse_from_steady_state
+from discovery.vibroimpact.dynamics.steady_states import steady_state
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.verify.criteria import CRITERIA, compare, criterion, evaluate_criteria
 

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from discovery.errors import InputError
-from discovery.vibroimpact.dynamics.synthesize import synthesize
-from discovery.vibroimpact.fit.discover import RankedModel, discover, rank
+from discovery.vibroimpact.dynamics.synthetic import synthesize
+from discovery.vibroimpact.fit.discovery import RankedModel, discover, rank
 from discovery.vibroimpact.fit.regression import Candidate
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.verify import Evaluation
@@ -298,7 +298,7 @@ def test_stability_warning_names_the_terms_it_disagrees_on():
     rarely chosen are both named; an agreeing support gives none."""
     from types import SimpleNamespace
 
-    from discovery.vibroimpact.fit.discover import _stability_warning
+    from discovery.vibroimpact.fit.discovery import _stability_warning
 
     sel = SimpleNamespace(law=ForceLaw.parse("1*z + 1*z*zd"))
     w = _stability_warning({"z": 1.0, "zd": 0.9, "z*zd": 0.2}, sel)
@@ -320,7 +320,7 @@ def test_contact_samples_do_not_split_impacts_at_noise_dips(paper):
 
 def test_impact_count_that_does_not_fit_the_regime_is_a_warning(paper):
     from discovery.vibroimpact.data.samples import contact_samples
-    from discovery.vibroimpact.fit.discover import _impact_warnings
+    from discovery.vibroimpact.fit.discovery import _impact_warnings
     from discovery.vibroimpact.verify import Reference
 
     m = synthesize(paper, paper.law, periods=30, fs=20000, noise=0.01, seed=0)

@@ -10,7 +10,7 @@ from discovery import ForceLaw, landscape, load_scenario
 from discovery.errors import InputError
 from discovery.numerics.executor import Pool, Serial, make_executor, map_on
 from discovery.ueda import UedaSystem
-from discovery.ueda.chart import chart
+from discovery.ueda.regime_chart import chart
 
 
 def _square(context, job):

@@ -15,7 +15,7 @@ from discovery import ForceLaw, load_scenario
 from discovery.cli import main
 from discovery.errors import InputError
 from discovery.vibroimpact.data.measurement import Measurement
-from discovery.vibroimpact.dynamics.response import response
+from discovery.vibroimpact.dynamics.law_response import response
 from discovery.vibroimpact.explain import EFFECTS, effect, explain, first_order_lag
 from discovery.vibroimpact.explain.effects import TARGETS
 

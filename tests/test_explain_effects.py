@@ -15,7 +15,7 @@ import realistic as R
 from discovery import ForceLaw, load_scenario
 from discovery.cli import main
 from discovery.vibroimpact.dynamics import _kernel as K
-from discovery.vibroimpact.dynamics.simulate import simulate
+from discovery.vibroimpact.dynamics.simulation import simulate
 from discovery.vibroimpact.explain import explain
 
 BASE = "2.06e8*z + 4e6*zd"  # the paper's machine, a lighter damper (no dominant jump)

@@ -10,8 +10,8 @@ import pytest
 from discovery.errors import InputError
 from discovery.vibroimpact.dynamics import _kernel as K
 from discovery.vibroimpact.dynamics.reference import reference_simulate
-from discovery.vibroimpact.dynamics.simulate import EVENT_NAMES, Tolerances, simulate
-from discovery.vibroimpact.dynamics.steady_state import StroboscopicMap, steady_state
+from discovery.vibroimpact.dynamics.simulation import EVENT_NAMES, Tolerances, simulate
+from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario, load_scenario
 

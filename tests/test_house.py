@@ -3,7 +3,11 @@
 import ast
 import importlib
 import re
+import sys
+import types
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGES = ("discovery", "constraints", "reports")
@@ -115,7 +119,9 @@ def test_public_names_are_what_the_docs_say():
     for name in ("explain", "landscape", "identify", "discover", "response", "study"):
         assert callable(getattr(discovery, name)), name
     assert importlib.import_module("discovery.vibroimpact.explain").EFFECTS
-    assert callable(importlib.import_module("discovery.vibroimpact.verify.landscape").landscape)
+    assert callable(
+        importlib.import_module("discovery.vibroimpact.verify.criteria_landscape").landscape
+    )
     for name in ("chart", "discover", "explain", "verify"):  # Ueda's, as the README documents
         assert callable(getattr(importlib.import_module("discovery.ueda"), name)), name
     from discovery.vibroimpact.verify import verify
@@ -123,18 +129,91 @@ def test_public_names_are_what_the_docs_say():
     assert callable(verify)
 
 
+def _modules(*packages):
+    """Every module (not package) of ``packages``, as ``(dotted name, path)``."""
+    for pkg in packages:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            if path.name != "__init__.py":
+                yield _module_name(path), path
+
+
+def _exported_here(package, name, module):
+    """Whether ``package`` exports ``name`` defined in ``module``: a lazy package's
+    ``_EXPORTS`` names the module; an eager one's ``__all__`` (checked for the parent)."""
+    pkg = importlib.import_module(package)
+    exports = getattr(pkg, "_EXPORTS", None)
+    if exports is not None and name in exports:
+        return f"{package}.{exports[name]}" == module
+    return package == module.rpartition(".")[0] and name in getattr(pkg, "__all__", ())
+
+
+def test_no_module_is_named_like_a_public_name_it_defines():
+    """A module is named for what it holds, never like a function or class it defines that a
+    package exports: importing ``pkg.chart`` would replace ``pkg.chart`` the function by the
+    module, and ``import pkg.chart as m`` would give the function (``regime_chart``
+    defines ``chart``)."""
+    bad = []
+    for name, path in _modules(*PACKAGES):
+        stem = path.stem
+        if stem.startswith("_"):
+            continue
+        tree = ast.parse(path.read_text())
+        defined = {
+            n.name
+            for n in tree.body
+            if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef))
+        }
+        if stem not in defined:
+            continue
+        parts = name.split(".")
+        owners = [".".join(parts[:i]) for i in range(len(parts) - 1, 0, -1)]
+        bad += [
+            f"{name} ({owner} exports {stem})"
+            for owner in owners
+            if _exported_here(owner, stem, name)
+        ]
+    assert not bad, bad
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_every_submodule_imports_as_a_module(package):
+    """``import pkg.sub.mod as m`` gives the module for every module of the project (no
+    public name of a package hides a module of the same name)."""
+    bad = []
+    for name, _ in _modules(package):
+        ns = {}
+        exec(f"import {name} as m", ns)
+        if not isinstance(ns["m"], types.ModuleType) or ns["m"] is not sys.modules[name]:
+            bad.append(f"{name} -> {ns['m']!r}")
+    assert not bad, bad
+
+
+def test_a_lazy_package_refuses_a_name_its_module_shares(tmp_path, monkeypatch):
+    """``lazy_package`` raises at import when an export is named like its module."""
+    pkg = tmp_path / "vidi_shadow_pkg"
+    pkg.mkdir()
+    (pkg / "thing.py").write_text("def thing():\n    return 1\n")
+    (pkg / "__init__.py").write_text(
+        "from discovery._lazy import lazy_package\nlazy_package(__name__, {'thing': 'thing'})\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "vidi_shadow_pkg", raising=False)
+    with pytest.raises(ImportError, match="'thing' \\(from .thing\\).*rename the module"):
+        importlib.import_module("vidi_shadow_pkg")
+
+
 def test_split_modules_keep_the_names_of_the_module_they_were():
-    """``fit/identify.py``, ``fit/discover.py`` and ``explain/explain.py`` are split by job;
+    """``fit/identification.py``, ``fit/discovery.py`` and ``explain/loop.py`` are split by job;
     every name other modules and tests import from them is still there (the same object as
     in its new module)."""
     for old_mod, moved in {
-        "identify": {
+        "identification": {
             "problem": ("_Objective", "_PENALTY", "_Budget", "_uncertainty"),
             "intervals": ("Intervals", "bootstrap_intervals", "MIN_CYCLE_DOF", "INTERVAL_REFITS"),
             "optimise": ("METHODS", "RESTART_FACTORS", "_optimise", "_coordinate_descent"),
             "records": ("as_records", "pair_records", "record_start", "model_parts", "cycle_pairs"),
         },
-        "discover": {
+        "discovery": {
             "discovery_result": ("RankedModel", "DiscoveryResult"),
             "ranking": ("rank",),
             "discovery_warnings": ("_stability_warning", "_impact_warnings"),
@@ -145,7 +224,7 @@ def test_split_modules_keep_the_names_of_the_module_they_were():
             new = importlib.import_module(f"discovery.vibroimpact.fit.{mod}")
             for n in names:
                 assert getattr(split, n) is getattr(new, n), n
-    old = importlib.import_module("discovery.vibroimpact.explain.explain")
+    old = importlib.import_module("discovery.vibroimpact.explain.loop")
     pkg = importlib.import_module("discovery.vibroimpact.explain")
     for n in ("ExplainResult", "Iteration", "start_law"):
         assert getattr(old, n) is getattr(pkg, n), n
@@ -260,8 +339,8 @@ def _crossings(graph, pkgs, forbidden):
 def test_the_import_graph_follows_imports_through_other_modules():
     """The graph the layer tests walk: a module reaches what its imports import."""
     graph = _graph()
-    assert "discovery.vibroimpact.dynamics.steady_state" in _closure(
-        graph, "discovery.vibroimpact.verify.evaluate"
+    assert "discovery.vibroimpact.dynamics.steady_states" in _closure(
+        graph, "discovery.vibroimpact.verify.evaluation"
     )
     reach = _closure(graph, "discovery.warm")
     assert "discovery.ueda.exponents" in reach and "discovery.vibroimpact.dynamics" in reach
@@ -274,7 +353,7 @@ def test_two_systems_on_a_shared_floor():
     imports the other, and the vibro-impact data layer does not simulate."""
     graph = _graph()
     systems = ("discovery.vibroimpact", "discovery.ueda")
-    above = ("discovery.warm", "discovery.parallel", "discovery.cli", "discovery.report")
+    above = ("discovery.warm", "discovery.parallel", "discovery.cli", "discovery.reporting")
     assert not _crossings(graph, ["discovery.numerics"], systems + above + ("reports",))
     assert not _crossings(graph, ["discovery.ueda"], ("discovery.vibroimpact",))
     assert not _crossings(graph, ["discovery.vibroimpact"], ("discovery.ueda",))
@@ -295,7 +374,7 @@ def test_reports_and_the_package_do_not_import_each_other_in_a_cycle():
     """``discovery.report`` builds on ``reports``; nothing in ``reports`` reaches back to it
     (nor to the CLI), and the ``reports`` package itself imports nothing of ``discovery``."""
     graph = _graph()
-    assert not _crossings(graph, ["reports"], ("discovery.report", "discovery.cli"))
+    assert not _crossings(graph, ["reports"], ("discovery.reporting", "discovery.cli"))
     assert not {m for m in _closure(graph, "reports") if m.startswith("discovery")}
 
 

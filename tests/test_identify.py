@@ -8,9 +8,9 @@ import pytest
 
 from discovery.cli import main
 from discovery.errors import InputError, IntegrationError, VidiError
-from discovery.vibroimpact.dynamics.synthesize import synthesize
-from discovery.vibroimpact.fit.discover import discover
-from discovery.vibroimpact.fit.identify import as_records, bootstrap_intervals, identify
+from discovery.vibroimpact.dynamics.synthetic import synthesize
+from discovery.vibroimpact.fit.discovery import discover
+from discovery.vibroimpact.fit.identification import as_records, bootstrap_intervals, identify
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.verify import Reference
 
@@ -78,7 +78,7 @@ def test_force_only_identification_continues_its_steady_states(paper, record, mo
     on this record)."""
     import importlib
 
-    ident = importlib.import_module("discovery.vibroimpact.fit.identify")
+    ident = importlib.import_module("discovery.vibroimpact.fit.identification")
     ref = record.impulse(paper.period)
     start = ForceLaw.parse("1.8e8*z + 1.1e7*zd")
     cont = identify(paper, ref, start, check=False)
@@ -322,7 +322,7 @@ def test_standard_errors_beyond_the_budget_are_left_out(paper, reference, monkey
     that, the fit is returned without them (no internal budget error escapes)."""
     import importlib
 
-    ident = importlib.import_module("discovery.vibroimpact.fit.identify")
+    ident = importlib.import_module("discovery.vibroimpact.fit.identification")
 
     def over_budget(self, x):
         raise ident._Budget

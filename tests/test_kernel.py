@@ -8,7 +8,7 @@ from discovery.errors import InputError, IntegrationError, VidiError, VidiTypeEr
 from discovery.numerics import _tableau
 from discovery.vibroimpact.dynamics import _kernel as K
 from discovery.vibroimpact.dynamics.reference import reference_simulate
-from discovery.vibroimpact.dynamics.simulate import EVENT_NAMES, Tolerances, simulate
+from discovery.vibroimpact.dynamics.simulation import EVENT_NAMES, Tolerances, simulate
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario
 

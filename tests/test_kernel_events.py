@@ -7,8 +7,8 @@ import pytest
 
 from discovery.vibroimpact.dynamics import _kernel as K
 from discovery.vibroimpact.dynamics.reference import reference_simulate
-from discovery.vibroimpact.dynamics.simulate import Tolerances, simulate
-from discovery.vibroimpact.dynamics.steady_state import steady_state
+from discovery.vibroimpact.dynamics.simulation import Tolerances, simulate
+from discovery.vibroimpact.dynamics.steady_states import steady_state
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario
 

@@ -11,10 +11,10 @@ from discovery import ForceLaw, load_scenario
 from discovery.cli import main
 from discovery.errors import InputError
 from discovery.vibroimpact.dynamics import Tolerances
-from discovery.vibroimpact.dynamics.response import response
+from discovery.vibroimpact.dynamics.law_response import response
 from discovery.vibroimpact.verify import Reference
 from discovery.vibroimpact.verify.criteria import CRITERIA
-from discovery.vibroimpact.verify.landscape import Landscape, default_range, landscape
+from discovery.vibroimpact.verify.criteria_landscape import Landscape, default_range, landscape
 
 
 def test_workers_do_not_change_the_result(paper):
@@ -238,7 +238,7 @@ def test_continuation_gives_the_cold_search_result(paper):
     """Each point started from its neighbour's orbit (the default) lands on the orbit the
     cold search from the start state finds: same regimes, impacts and consistency, criteria
     within the shooting tolerance; and a continued steady state agrees with a cold one."""
-    from discovery.vibroimpact.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.dynamics.steady_states import steady_state
 
     a0, a1 = np.linspace(1.2e8, 3.0e8, 5), np.linspace(0.7e7, 1.9e7, 7)
     cold = landscape(paper, paper.law, a0, a1, workers=1, continuation=False)

@@ -8,7 +8,7 @@ import pytest
 
 from discovery.errors import InputError
 from discovery.vibroimpact.data.measurement import JITTER_LIMIT, Measurement
-from discovery.vibroimpact.dynamics.synthesize import synthesize
+from discovery.vibroimpact.dynamics.synthetic import synthesize
 
 FS = 20000.0
 

@@ -88,7 +88,7 @@ def test_a_residual_after_a_verification_reuses_its_simulations(span_record):
 
 
 def test_a_steady_state_is_reused_for_the_same_law_and_start(span_record):
-    ev = sys.modules["discovery.vibroimpact.verify.evaluate"]
+    ev = sys.modules["discovery.vibroimpact.verify.evaluation"]
     sc, _ = span_record
     ref = Reference.from_measurement(
         Measurement(*_steady_record(sc)), sc, n_boot=4, use_state=False

@@ -13,7 +13,7 @@ from discovery._progress import Reporter, interactive, reports_progress, resolve
 from discovery.cli import main
 from discovery.errors import VidiTypeError
 from discovery.ueda import UedaSystem
-from discovery.ueda.chart import chart
+from discovery.ueda.regime_chart import chart
 
 
 def test_reporter_modes():
@@ -173,10 +173,10 @@ def test_every_public_function_with_progress_resolves_it_one_way():
 
     import discovery
     import discovery.ueda
-    import discovery.ueda.chart
+    import discovery.ueda.regime_chart
 
     found = []
-    for module in (discovery, discovery.ueda, discovery.ueda.chart):
+    for module in (discovery, discovery.ueda, discovery.ueda.regime_chart):
         for name in getattr(module, "__all__", dir(module)):
             obj = getattr(module, name)
             if inspect.isfunction(obj) and "progress" in inspect.signature(obj).parameters:

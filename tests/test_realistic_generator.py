@@ -15,7 +15,7 @@ import realistic as R
 from discovery.vibroimpact.data.impulse import estimate_noise
 from discovery.vibroimpact.dynamics import _kernel as K
 from discovery.vibroimpact.dynamics.reference import reference_simulate
-from discovery.vibroimpact.dynamics.simulate import Tolerances, simulate
+from discovery.vibroimpact.dynamics.simulation import Tolerances, simulate
 
 STATE = ("w1", "v1", "w2", "v2")
 FAST_CASE = ("p1", 2)  # accepted at the 2nd draw, 30-period transient: about 1 s in all

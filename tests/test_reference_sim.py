@@ -25,7 +25,7 @@ import pytest
 from discovery.vibroimpact.dynamics import _kernel as K
 from discovery.vibroimpact.dynamics import reference as R
 from discovery.vibroimpact.dynamics.reference import reference_simulate
-from discovery.vibroimpact.dynamics.simulate import EVENT_NAMES, Tolerances, simulate
+from discovery.vibroimpact.dynamics.simulation import EVENT_NAMES, Tolerances, simulate
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario, load_scenario
 

@@ -17,7 +17,7 @@ from constraints import certify, constraint_rows
 from constraints.errors import SolverError
 from discovery.errors import InputError
 from discovery.vibroimpact.data.samples import contact_samples
-from discovery.vibroimpact.dynamics.synthesize import synthesize
+from discovery.vibroimpact.dynamics.synthetic import synthesize
 from discovery.vibroimpact.fit.regression import SELECTIONS, ConstrainedSparseRegressor
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.library import Library

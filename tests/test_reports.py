@@ -302,7 +302,7 @@ def test_study_report_states_recovery_coverage_and_figures(tmp_path):
     four figures, compiled to a PDF."""
     _need_tex()
     from discovery import study
-    from discovery.report import report
+    from discovery.reporting import report
     from reports.vibroimpact.study_figures import study_figures
 
     cfg = {
@@ -607,7 +607,7 @@ def test_a_malformed_manifest_is_one_line(runs, tmp_path, capsys, files):
 
 def test_the_api_checks_its_arguments(runs):
     from discovery.errors import VidiError
-    from discovery.report import report as api_report
+    from discovery.reporting import report as api_report
 
     with pytest.raises(VidiError, match="compile"):
         api_report(runs / "landscape", compile="no")

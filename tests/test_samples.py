@@ -8,7 +8,7 @@ from discovery.errors import InputError
 from discovery.vibroimpact.data.impulse import impulse_from_samples
 from discovery.vibroimpact.data.measurement import Measurement
 from discovery.vibroimpact.data.samples import contact_samples
-from discovery.vibroimpact.dynamics.synthesize import synthesize
+from discovery.vibroimpact.dynamics.synthetic import synthesize
 
 
 @pytest.fixture(scope="module")

@@ -9,8 +9,8 @@ from scipy.linalg import expm
 
 from discovery.errors import InputError
 from discovery.vibroimpact.dynamics import _kernel as K
-from discovery.vibroimpact.dynamics.simulate import Tolerances, simulate
-from discovery.vibroimpact.dynamics.steady_state import StroboscopicMap, steady_state
+from discovery.vibroimpact.dynamics.simulation import Tolerances, simulate
+from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario, load_scenario
 
@@ -207,7 +207,7 @@ def test_a_run_with_sensitivities_agrees_with_a_plain_run():
 # ------------------------------------------------------------ the output-error Jacobian
 @pytest.fixture(scope="module")
 def span_record():
-    from discovery.vibroimpact.dynamics.synthesize import synthesize
+    from discovery.vibroimpact.dynamics.synthetic import synthesize
     from discovery.vibroimpact.verify import Reference
 
     rec = synthesize(PAPER, PAPER.law, periods=20, fs=20000, noise=0.01, seed=3)
@@ -215,7 +215,7 @@ def span_record():
 
 
 def _objective(model, span_record):
-    from discovery.vibroimpact.fit.identify import _Objective, as_records
+    from discovery.vibroimpact.fit.identification import _Objective, as_records
 
     return _Objective(as_records(PAPER, span_record), model, "I2", None, 10**6)
 
@@ -264,7 +264,7 @@ def test_output_error_jacobian_matches_central_differences(name, span_record):
 
 
 def test_a_nonlinear_observation_model_takes_differences(span_record):
-    from discovery.vibroimpact.fit.identify import _Objective, as_records
+    from discovery.vibroimpact.fit.identification import _Objective, as_records
 
     law = ForceLaw.parse("1.5e8*z + 0.9e7*zd")
     clipped = lambda imp: imp  # noqa: E731 - not declared linear in the force
@@ -277,7 +277,7 @@ def test_identify_with_the_exact_jacobian_needs_fewer_simulations(span_record, m
     """Same law as with forward differences (to the fit's tolerance), in fewer runs."""
     import importlib
 
-    mod = importlib.import_module("discovery.vibroimpact.fit.identify")
+    mod = importlib.import_module("discovery.vibroimpact.fit.identification")
     api = mod.identify
     start = ForceLaw.parse("1.5e8*z + 0.9e7*zd")
     exact = api(PAPER, span_record, start, check=False)
@@ -332,9 +332,9 @@ def test_force_only_jacobian_matches_central_differences_and_saves_runs(monkeypa
     in fewer runs than with forward differences."""
     import importlib
 
-    from discovery.vibroimpact.dynamics.synthesize import synthesize
+    from discovery.vibroimpact.dynamics.synthetic import synthesize
 
-    mod = importlib.import_module("discovery.vibroimpact.fit.identify")
+    mod = importlib.import_module("discovery.vibroimpact.fit.identification")
     E = synthesize(PAPER, PAPER.law, periods=20, fs=20000).impulse(PAPER.period)
     start = ForceLaw.parse("1.5e8*z + 0.9e7*zd")
     obj = mod._Objective(mod.as_records(PAPER, E), start, "I2", None, 10**6)

@@ -206,8 +206,8 @@ def _same(ss, ref, scale=None):
 
 
 def test_vibro_impact_paper_steady_state_unchanged(paper, paper_ss):
-    from discovery.vibroimpact.dynamics.simulate import Tolerances
-    from discovery.vibroimpact.dynamics.steady_state import StroboscopicMap, steady_state
+    from discovery.vibroimpact.dynamics.simulation import Tolerances
+    from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state
 
     # as recorded on the integrator path (every free flight stepped), and on the default
     # path (free flights in closed form) within the integrator's tolerance
@@ -218,7 +218,7 @@ def test_vibro_impact_paper_steady_state_unchanged(paper, paper_ss):
 def test_vibro_impact_period_reduction_unchanged():
     """Multiplier -0.985: the recurrence suggests n = 2, shooting reduces it to P1 (the
     path through smallest_period)."""
-    from discovery.vibroimpact.dynamics.steady_state import steady_state
+    from discovery.vibroimpact.dynamics.steady_states import steady_state
 
     ss = steady_state(_pd_scenario(), ForceLaw.parse("1448000000*z + 9927000*zd"), tol=1e-6)
     _same(ss, PD)
@@ -242,7 +242,7 @@ def test_newton_state_and_jacobian_from_one_run(case, paper, light):
     """Newton's full steps take the state and the Jacobian from one run: the Jacobian
     exactly :meth:`jacobian`'s, the state the plain map's within the integrator's
     tolerance."""
-    from discovery.vibroimpact.dynamics.steady_state import StroboscopicMap, steady_state
+    from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state
 
     sc, law, n = {
         "paper": (paper, paper.law, 1),

@@ -7,8 +7,8 @@ import pytest
 
 from discovery.errors import IntegrationError
 from discovery.vibroimpact.dynamics import _kernel as K
-from discovery.vibroimpact.dynamics.simulate import simulate
-from discovery.vibroimpact.dynamics.steady_state import StroboscopicMap, steady_state
+from discovery.vibroimpact.dynamics.simulation import simulate
+from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario
 

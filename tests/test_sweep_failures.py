@@ -106,7 +106,7 @@ def test_an_attractor_its_own_check_disputes_is_not_a_result(tmp_path, capsys, m
     import discovery.ueda as ueda
 
     real = ueda.attractor
-    where = sys.modules["discovery.ueda.attractor"]  # the package reads the name from here
+    where = sys.modules["discovery.ueda.attractor_analysis"]  # the package reads the name from here
 
     def off(*a, **k):
         att = real(*a, **k)

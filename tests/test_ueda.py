@@ -18,7 +18,7 @@ from discovery.ueda import (
     strobe_points,
     trajectory,
 )
-from discovery.ueda.chart import KINDS, chart
+from discovery.ueda.regime_chart import KINDS, chart
 from discovery.vibroimpact.dynamics import Tolerances
 
 NEGRES = UedaSystem.from_model("negres")

@@ -20,7 +20,7 @@ import pytest
 
 from discovery.errors import InputError
 from discovery.ueda import UedaSystem, basins, classify, periodic_orbit, strobe_points
-from discovery.ueda.chart import KINDS, chart
+from discovery.ueda.regime_chart import KINDS, chart
 
 NEGRES = UedaSystem.from_model("negres")
 DUFFING = UedaSystem.from_model("duffing")

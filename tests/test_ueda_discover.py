@@ -10,7 +10,7 @@ import pytest
 
 from discovery.errors import InputError
 from discovery.ueda import UedaSystem
-from discovery.ueda.discover import (
+from discovery.ueda.equation_discovery import (
     FORCING,
     ForcedPolynomial,
     classify_record,
@@ -315,7 +315,7 @@ def test_one_csv_reader_for_both_systems(tmp_path):
     """The Ueda records go through the vibro-impact reader: a byte-order mark, ';' with
     decimal commas, comments are read; a huge field, a missing column and text in a number
     are one line each."""
-    from discovery.ueda.discover import read_record_csv
+    from discovery.ueda.equation_discovery import read_record_csv
 
     t = 0.15 * np.arange(400)
     x = np.sin(t)
@@ -350,7 +350,7 @@ def test_one_csv_reader_for_both_systems(tmp_path):
 
 
 def test_the_equation_text_is_readable_not_a_sympy_repr():
-    from discovery.ueda.discover import TERMS, ForcedPolynomial
+    from discovery.ueda.equation_discovery import TERMS, ForcedPolynomial
 
     c = [0.0] * len(TERMS)
     c[TERMS.index("x'")], c[TERMS.index("x^3")] = 0.2, -1.0

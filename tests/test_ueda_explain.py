@@ -12,9 +12,9 @@ import pytest
 
 from discovery.errors import InputError
 from discovery.ueda import EFFECTS, UedaSystem, explain
-from discovery.ueda.discover import FORCING, TERMS, simulate_record
 from discovery.ueda.effects import effect, in_bounds
-from discovery.ueda.explain import DEFAULT_START, parse_terms
+from discovery.ueda.equation_discovery import FORCING, TERMS, simulate_record
+from discovery.ueda.explain_loop import DEFAULT_START, parse_terms
 from discovery.vibroimpact.explain.effects import Effect, Parameter
 
 NEGRES = UedaSystem.from_model("negres")

@@ -10,8 +10,8 @@ import pytest
 
 from discovery import ForceLaw, Measurement, Scenario, load_scenario, simulate
 from discovery.vibroimpact.data.impulse import estimate_noise
+from discovery.vibroimpact.dynamics.law_response import response
 from discovery.vibroimpact.dynamics.reference import reference_simulate
-from discovery.vibroimpact.dynamics.response import response
 from discovery.vibroimpact.verify import Reference, evaluate, verify
 
 

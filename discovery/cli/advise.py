@@ -18,7 +18,7 @@ from ._common import (
 
 
 def _grid(text):
-    from ..vibroimpact.verify.landscape import parse_grid
+    from ..vibroimpact.verify.criteria_landscape import parse_grid
 
     return parse_grid(text)
 

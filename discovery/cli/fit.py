@@ -27,7 +27,7 @@ from ._common import (
 def _discover(args, scs, meas, progress):
     """The API call the options describe."""
     from ..errors import SolverError
-    from ..vibroimpact.fit.discover import discover
+    from ..vibroimpact.fit.discovery import discover
 
     try:
         return _call(discover, args, scs, meas, progress)

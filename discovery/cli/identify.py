@@ -190,9 +190,9 @@ def _print_result(args, res):
 def run(args):
     from reports import identification_figure
 
-    from ..vibroimpact.fit.identify import identify
+    from ..vibroimpact.fit.identification import identify
     from ..vibroimpact.verify import Reference
-    from ..vibroimpact.verify.landscape import Landscape
+    from ..vibroimpact.verify.criteria_landscape import Landscape
 
     check_out(args)
     sc = load_scenario(args.scenario)

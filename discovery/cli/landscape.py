@@ -55,7 +55,7 @@ def _sha256(path):
 
 def _ranges(args, law):
     """The two coefficient ranges and where they came from."""
-    from ..vibroimpact.verify.landscape import DEFAULT_SPREAD, default_range
+    from ..vibroimpact.verify.criteria_landscape import DEFAULT_SPREAD, default_range
 
     out, origin = [], []
     for k, (text, opt) in enumerate(((args.range0, "--range0"), (args.range1, "--range1"))):
@@ -117,7 +117,7 @@ def _reference(args, sc):
 def run(args):
     from reports import landscape_figure
 
-    from ..vibroimpact.verify.landscape import landscape, parse_grid
+    from ..vibroimpact.verify.criteria_landscape import landscape, parse_grid
 
     check_out(args)
     sc = load_scenario(args.scenario)

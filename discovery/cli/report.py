@@ -5,7 +5,7 @@ def run(args):
     from pathlib import Path
 
     from .._io import MANIFEST, read_manifest
-    from ..report import report
+    from ..reporting import report
 
     # a malformed manifest (files not a list of names, not an object) is one line, exit 2
     read_manifest(Path(args.run_dir) / MANIFEST, strict=True)

@@ -27,7 +27,7 @@ MAX_SAMPLES = 10_000_000
 
 
 def run(args):
-    from ..vibroimpact.dynamics.synthesize import SimulatedRecord, synthesize
+    from ..vibroimpact.dynamics.synthetic import SimulatedRecord, synthesize
 
     out = check_out(args, kind="file")
     if out.suffix.lower() != ".csv":

@@ -11,7 +11,7 @@ from ._common import LAW_HELP, SCENARIO_HELP, check_out, inputs_of, law_or_defau
 
 
 def run(args):
-    from ..vibroimpact.dynamics.response import response
+    from ..vibroimpact.dynamics.law_response import response
 
     if args.out is not None:
         check_out(args)

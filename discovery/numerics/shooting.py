@@ -1,7 +1,7 @@
 """Shooting and Floquet multipliers, shared by every periodically forced system.
 
 One implementation for the vibro-impact system
-(:class:`~discovery.vibroimpact.dynamics.steady_state.
+(:class:`~discovery.vibroimpact.dynamics.steady_states.
 StroboscopicMap`) and Ueda's oscillators (:class:`~discovery.ueda.periodic.UedaMap`):
 both are *period maps* ``Phi`` (the state advanced by one forcing period, sampled at a
 fixed forcing phase) following the small protocol :class:`PeriodMap`.  On such a map

@@ -10,7 +10,7 @@ system (:mod:`discovery.numerics._dopri`).
   :func:`lyapunov`, :func:`lyapunov_two_trajectory` -> :class:`Lyapunov` -
   :mod:`.exponents`; :func:`classify`, :func:`classify_points` (thresholds
   :class:`RegimeRules`) -> :class:`Regime` - :mod:`.regimes`; :func:`attractor` ->
-  :class:`Attractor` - :mod:`.attractor`; :func:`basins` -> :class:`Basins` (coexisting
+  :class:`Attractor` - :mod:`.attractor_analysis`; :func:`basins` -> :class:`Basins` (coexisting
   attractors) - :mod:`.coexisting`;
 * :class:`UedaMap`, :func:`periodic_orbit`, :class:`PeriodicOrbit` - the period map,
   shooting and Floquet multipliers (:mod:`discovery.numerics.shooting`, shared with the
@@ -19,21 +19,20 @@ system (:mod:`discovery.numerics._dopri`).
 * :class:`ForcedPolynomial` (an equation, simulable) - :mod:`.polynomial`; a record:
   :func:`simulate_record`, reading, checking and smoothing it - :mod:`.record`;
 * :func:`discover` (equation discovery from a record ``t, x`` with known forcing,
-  :mod:`.discover` on the weak form of :mod:`.weak_form`) and :func:`verify` (the
+  :mod:`.equation_discovery` on the weak form of :mod:`.weak_form`) and :func:`verify` (the
   discovered equation's attractor against the record's, :mod:`.verification` with the
   energy-distance test of :mod:`.strobe_resampling`);
 * :func:`explain` (the missing-effect workflow) -> :class:`Explanation`, over this
-  system's catalogue :data:`EFFECTS` - :mod:`.explain` (the loop), :mod:`.weak_fits` (fits
+  system's catalogue :data:`EFFECTS` - :mod:`.explain_loop` (the loop), :mod:`.weak_fits` (fits
   and score tests), :mod:`.explanation` (its outcome), :mod:`.effects`.
 """
 
 from .._lazy import lazy_package
 
-# names are imported on first use; a function named like its module (chart, discover,
-# explain) stays the function
+# names are imported on first use (:mod:`discovery._lazy`)
 _EXPORTS = {
-    "Attractor": "attractor",
-    "attractor": "attractor",
+    "Attractor": "attractor_analysis",
+    "attractor": "attractor_analysis",
     "Basins": "coexisting",
     "basins": "coexisting",
     "Lyapunov": "exponents",
@@ -46,18 +45,18 @@ _EXPORTS = {
     "rotation_number": "regimes",
     "strobe_points": "strobe",
     "trajectory": "strobe",
-    "Chart": "chart",
-    "chart": "chart",
+    "Chart": "regime_chart",
+    "chart": "regime_chart",
     "KINDS": "sweep",
-    "Discovery": "discover",
+    "Discovery": "equation_discovery",
     "ForcedPolynomial": "polynomial",
     "Verification": "verification",
-    "discover": "discover",
+    "discover": "equation_discovery",
     "simulate_record": "record",
     "verify": "verification",
     "EFFECTS": "effects",
     "Explanation": "explanation",
-    "explain": "explain",
+    "explain": "explain_loop",
     "PeriodicOrbit": "periodic",
     "UedaMap": "periodic",
     "periodic_orbit": "periodic",

@@ -25,7 +25,7 @@ With ``early_exit=False`` every point takes the second path after the full trans
 The early exit halves the cost of a chart; the classes of chaotic and quasi-periodic
 points are computed exactly as without it.
 
-The settings are the chart's (:attr:`~discovery.ueda.chart.Chart.settings`, a dict).
+The settings are the chart's (:attr:`~discovery.ueda.regime_chart.Chart.settings`, a dict).
 """
 
 import cmath

@@ -76,7 +76,7 @@ def _strobe_panel(ax, ver, label, color, title):
 
 
 def explain_figure(ex, stem):
-    """The figure of an :class:`~discovery.ueda.explain.Explanation`, drawn at the width it
+    """The figure of an :class:`~discovery.ueda.explanation.Explanation`, drawn at the width it
     is printed (its text 7 to 8 pt): the score tests above, the start and final models'
     strobe points below."""
     with print_sizes():

@@ -31,7 +31,7 @@ def _grid(text, option):
 def run(args):
     from reports.ueda.figures import chart_figure
 
-    from ...ueda.chart import chart
+    from ...ueda.regime_chart import chart
 
     check_out(args)
     if args.nu[0] <= 0:

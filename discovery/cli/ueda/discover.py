@@ -14,7 +14,7 @@ from ._system import _forcing
 def run(args):
     from reports.ueda.figures import discover_figure
 
-    from ...ueda.discover import discover
+    from ...ueda.equation_discovery import discover
     from ...ueda.record import read_record_csv
     from ...ueda.verification import verify
 

@@ -12,7 +12,7 @@ from ._system import _forcing
 def run(args):
     from reports.ueda.explain_figure import explain_figure
 
-    from ...ueda.explain import explain, parse_terms
+    from ...ueda.explain_loop import explain, parse_terms
     from ...ueda.record import read_record_csv
 
     check_out(args)

@@ -2,13 +2,13 @@
 mass) where the records the candidate laws predict differ most, by the verdict's own rule.
 
 candidates (:mod:`.candidates`) -> every grid point (:mod:`.separation`) -> coarse grid and
-refinement (:mod:`.advise`) -> :class:`AdviseResult` (:mod:`.result`).
+refinement (:mod:`.search`) -> :class:`AdviseResult` (:mod:`.result`).
 """
 
 from ..._lazy import lazy_package
 
 _EXPORTS = {
-    "advise": "advise",
+    "advise": "search",
     "AdviseResult": "result",
     "Knobs": "candidates",
     "NoiseModel": "candidates",

@@ -4,7 +4,7 @@ predicted records compared by the verdict's own rule.
 For an ordered pair (``a`` true, ``b`` judged) the record ``a`` predicts at the point is its
 exact steady-state impulse with the next record's noise model (force noise ``relative x``
 ``a``'s peak, the sampling step, the cycles recorded); ``b`` is judged against it by
-:func:`~discovery.vibroimpact.verify.evaluate.evaluate` (the verdict's evaluation: simulate,
+:func:`~discovery.vibroimpact.verify.evaluation.evaluate` (the verdict's evaluation: simulate,
 align, criteria, noise floor under ``b`` by the parametric bootstrap, consistency limits).
 The *separation* of the direction is ``max_k I_k / limit_k`` over the verdict's consistency
 criteria (I2 and I4 for a force record), so 1 is where the verdict starts to reject ``b``;
@@ -17,7 +17,7 @@ Without positions (a force record) the predicted record is noise-free (its noise
 through the floor): a noisy record scores a wrong law higher on average (``E|d + n| >=
 |d|``), so a separation >= 1 is a conservative prediction of a rejection.  With positions
 (``NoiseModel.position``) the predicted records are synthetic measurements of ``a`` on its
-orbit (:func:`~discovery.vibroimpact.dynamics.synthesize.synthesize`) prepared like any
+orbit (:func:`~discovery.vibroimpact.dynamics.synthetic.synthesize`) prepared like any
 record (:meth:`~discovery.vibroimpact.verify.reference.Reference.from_measurement`: its span,
 the machine's states), and ``b`` is judged by the verdict's record-span comparison: I2, I4
 and I5 (the penetration) of ``b`` against the noise-free one, over their limits from the
@@ -30,11 +30,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError, IntegrationError, VidiError
-from ..dynamics.response import impulse_from_steady_state
-from ..dynamics.simulate import simulate
-from ..dynamics.steady_state import steady_state
-from ..dynamics.synthesize import synthesize
-from ..verify.evaluate import evaluate
+from ..dynamics.law_response import impulse_from_steady_state
+from ..dynamics.simulation import simulate
+from ..dynamics.steady_states import steady_state
+from ..dynamics.synthetic import synthesize
+from ..verify.evaluation import evaluate
 from ..verify.reference import Reference
 
 __all__ = [

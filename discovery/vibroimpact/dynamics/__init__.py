@@ -2,7 +2,7 @@
 the shooting and Floquet multipliers shared with Ueda's oscillators (:mod:`.shooting`)."""
 
 from ...numerics.shooting import PeriodMap, floquet_multipliers, newton_orbit, smallest_period
-from .simulate import EVENT_NAMES, MODE_NAMES, Tolerances, Trajectory, simulate
+from .simulation import EVENT_NAMES, MODE_NAMES, Tolerances, Trajectory, simulate
 
 __all__ = [
     "simulate",

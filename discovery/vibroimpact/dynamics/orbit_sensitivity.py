@@ -6,7 +6,7 @@ The orbit's state ``y*`` at the strobe time is a fixed point of the period map,
     dy*/dc_j = (I - M)^-1 dPhi^n/dc_j
 
 with ``M`` the monodromy matrix; one run with the variational equations gives both ``M``
-and ``dPhi^n/dc`` (saltation at every event included, :func:`~.simulate.simulate`'s
+and ``dPhi^n/dc`` (saltation at every event included, :func:`~.simulation.simulate`'s
 ``sensitivities``).  A second run from ``y*`` with those derivatives as its start carries
 them along the orbit: the force's derivative at fixed time, and every event time's.  From
 these follow the derivatives of what a designer reads off an impact (peak force, contact
@@ -22,7 +22,7 @@ import numpy as np
 from ..._printing import readable
 from ...errors import InputError
 from . import _kernel as K
-from .simulate import kernel_params, simulate
+from .simulation import kernel_params, simulate
 
 __all__ = ["OrbitSensitivity", "orbit_sensitivity"]
 

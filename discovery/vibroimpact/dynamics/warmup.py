@@ -14,8 +14,8 @@ def compile_kernels():
     a sensor's lag once each; returns nothing."""
     from ...numerics.lag import lag_at, lag_at_knots
     from ..model.scenario import load_scenario
-    from .response import impulse_from_steady_state
-    from .steady_state import steady_state
+    from .law_response import impulse_from_steady_state
+    from .steady_states import steady_state
 
     sc = load_scenario("paper")
     imp = impulse_from_steady_state(sc, sc.law, steady_state(sc, sc.law))

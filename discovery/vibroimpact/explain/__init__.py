@@ -14,12 +14,12 @@ _EXPORTS = {
     "effect": "effects",
     "first_order_lag": "effects",
     "first_order_lag_at": "effects",
-    "ExplainResult": "explain",
-    "Iteration": "explain",
-    "explain": "explain",
-    "start_law": "explain",
-    "PHASES": "localise",
-    "localise": "localise",
+    "ExplainResult": "loop",
+    "Iteration": "loop",
+    "explain": "loop",
+    "start_law": "loop",
+    "PHASES": "disagreement",
+    "localise": "disagreement",
 }
 
 __all__ = [

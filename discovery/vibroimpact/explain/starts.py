@@ -1,6 +1,6 @@
 """Where the missing-effect loop starts and how it refits: the records, start laws from the
 certified regression and from the record alone, the start fitted cycle by cycle, and the
-output-error refits (:func:`~discovery.vibroimpact.fit.identify.identify`).
+output-error refits (:func:`~discovery.vibroimpact.fit.identification.identify`).
 """
 
 import itertools
@@ -10,7 +10,7 @@ import numpy as np
 
 from ..._progress import tick
 from ...errors import InputError, IntegrationError
-from ..fit.identify import identify
+from ..fit.identification import identify
 from ..fit.records import as_records, pair_records, record_start
 from ..model.law import ForceLaw, Term
 from ..verify import Reference, evaluate
@@ -113,7 +113,7 @@ def _polish_start(records, fit, criterion, budget, tol):
 
 def _physical(names, records):
     """Start values from the record alone
-    (:func:`discovery.vibroimpact.fit.identify.record_start`)."""
+    (:func:`discovery.vibroimpact.fit.identification.record_start`)."""
     terms = [ForceLaw.parse(f"1*{n}").terms[0] for n in names]
     return ForceLaw(tuple(terms), tuple(record_start(*records[0], terms)))
 

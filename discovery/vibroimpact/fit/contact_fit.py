@@ -7,7 +7,7 @@ residuals) over its physical parameters themselves (``k, c``; ``k, n, lambda``;
 ``k, n, e``), the Jacobian by differences of full simulations: ``n`` and ``e`` enter
 the force non-linearly, and ``e`` through each impact's approach velocity, a contact state
 the kernel does not differentiate.  The start is the record's spring-dashpot estimate
-(:func:`~discovery.vibroimpact.fit.identify.record_start`) at ``n = 1.25`` for the models
+(:func:`~discovery.vibroimpact.fit.identification.record_start`) at ``n = 1.25`` for the models
 that fit ``n``.  Every fitted model is then checked against every record with its noise
 floor (the verdict of :mod:`discovery.vibroimpact.verify`), and the 95 % intervals are
 ``+-1.96`` standard errors from that Jacobian (or the bootstrap through the record-span
@@ -36,7 +36,7 @@ from ..model.contact_models import MODELS, same_force
 from ..model.scenario import Scenario
 from ..verify import Reference
 from .contact_starts import from_hunt_crossley, record_samples, regression_start, start_model
-from .identify import as_records, identify
+from .identification import as_records, identify
 
 __all__ = ["ContactFit", "ContactModelsResult", "fit_contact_models"]
 
@@ -250,7 +250,7 @@ def _intervals(res, records, settings):
     else +-1.96 standard errors."""
     model = res.law
     if settings["n_boot"]:
-        from .identify import bootstrap_intervals
+        from .identification import bootstrap_intervals
 
         iv = bootstrap_intervals(
             *zip(*records, strict=True),

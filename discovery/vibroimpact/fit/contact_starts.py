@@ -8,7 +8,7 @@ import numpy as np
 from ...errors import VidiError
 from ..model.contact_models import ContactModel, restitution_from_ratio
 from ..model.law import Term
-from .identify import contact_scales, record_start
+from .identification import contact_scales, record_start
 
 __all__ = ["start_model", "record_samples", "from_hunt_crossley", "regression_start"]
 

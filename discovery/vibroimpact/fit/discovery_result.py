@@ -1,4 +1,4 @@
-"""The results of :func:`~discovery.vibroimpact.fit.discover.discover`: each checked model
+"""The results of :func:`~discovery.vibroimpact.fit.discovery.discover`: each checked model
 (:class:`RankedModel`) and the discovery (:class:`DiscoveryResult`), with their loaders."""
 
 from dataclasses import dataclass, field
@@ -11,7 +11,7 @@ from ..._printing import coefficient_lines, fmt, readable
 from ..._result import Result, part
 from ..model.law import ForceLaw
 from ..verify.criteria import criteria_lines
-from ..verify.evaluate import Evaluation
+from ..verify.evaluation import Evaluation
 from .intervals import Intervals
 from .records import records_verdict
 

@@ -146,7 +146,7 @@ def _replicate(scenario, law, observe, ref, rng, *, tolerances=None, noise="cycl
 
 def _refit_replicate(context, k):
     """The coefficients of one bootstrap replicate's least-squares refit (as
-    :func:`~discovery.vibroimpact.fit.identify.identify` without short first, uncertainty or
+    :func:`~discovery.vibroimpact.fit.identification.identify` without short first, uncertainty or
     check; a task of the executor; the replicates are in the forked context, so no record is
     copied), None when it fails."""
     scenarios, replicates, model, settings = context

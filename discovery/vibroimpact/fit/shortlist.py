@@ -12,7 +12,7 @@ from ..data.samples import ContactSamples
 from ..dynamics import Tolerances
 from ..verify import evaluate
 from .discovery_result import RankedModel
-from .identify import identify
+from .identification import identify
 from .records import record_start
 from .regression import ConstrainedSparseRegressor
 

@@ -342,10 +342,10 @@ def _settings(data, source):
 
 
 def _check_fit(fit, source):
-    """Every ``[fit]`` option by the checks :func:`~discovery.vibroimpact.fit.discover`
+    """Every ``[fit]`` option by the checks :func:`~discovery.vibroimpact.fit.discovery.discover`
     makes of its arguments (their types, ranges and names), so that a bad option stops the
     study up front instead of failing every run."""
-    from ..fit.discover import _check_settings, discover
+    from ..fit.discovery import _check_settings, discover
     from ..fit.regression import SCORES
     from ..verify.criteria import criterion as _criterion
 

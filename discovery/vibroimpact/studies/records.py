@@ -62,7 +62,7 @@ def auto_transient(scenario, law):
     """The transient [drive periods] of a record of ``law`` from rest: the periodic steady
     state's largest |multiplier| decays to 1e-4 (per orbit: a period-n orbit decays once
     every n drive periods); 600 when there is no periodic orbit."""
-    from ..dynamics.steady_state import steady_state
+    from ..dynamics.steady_states import steady_state
 
     try:
         ss = steady_state(scenario, law)

@@ -185,7 +185,7 @@ def score_contact(result, truth_text):
 
 def _fit(spec, scenarios, records):
     """The run's fit and its measures (``discover``, or the named contact models)."""
-    from ..fit.discover import discover
+    from ..fit.discovery import discover
 
     scs = scenarios if len(scenarios) > 1 else scenarios[0]
     recs = records if len(records) > 1 else records[0]

@@ -9,7 +9,7 @@ import numpy as np
 from ...errors import InputError
 from ..data.impulse import check_drive_period, estimate_noise
 from .criteria import CRITERIA
-from .noise_floor import noise_floor
+from .noise_bootstrap import noise_floor
 from .trajectory import BLOCK_CYCLES, record_span, span_floor
 
 __all__ = ["Reference"]

@@ -23,7 +23,7 @@ from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
 from ..data.impulse import Impulse, estimate_noise
 from ..dynamics import _kernel as _K
-from ..dynamics.simulate import simulate
+from ..dynamics.simulation import simulate
 from .criteria import CRITERIA, evaluate_criteria
 from .fold import make_fold
 from .motion import MOTION_CRITERION, block_penetration

@@ -7,7 +7,7 @@ One iteration (:func:`explain`):
 (:func:`discovery.vibroimpact.verify.evaluate`):
    if it is consistent (same regime; I2, I4 and I5 within their limits) there is
    nothing to explain, and the loop stops: no false discoveries.
-2. **Localise** the disagreement (:func:`~discovery.vibroimpact.explain.localise.localise`).
+2. **Localise** the disagreement (:func:`~discovery.vibroimpact.explain.disagreement.localise`).
 3. **Score** every applicable catalogue effect by a Lagrange-multiplier (score) test for
    an omitted variable: with the residual ``r = F_N - F_E`` of all records, the output
    Jacobian ``J`` of the model's own coefficients and the output sensitivity ``s`` to the
@@ -50,6 +50,7 @@ from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from ..verify import Reference
 from ..verify.motion import MOTION_CRITERION
+from .disagreement import localise
 from .effects import EFFECTS, Model
 
 # the loop's parts (result, problem, starts, screening, trials, judging, separability); a
@@ -59,7 +60,6 @@ from .judging import _in_bounds as _in_bounds
 from .judging import _keeps_repulsive as _keeps_repulsive
 from .judging import _motion_worse as _motion_worse
 from .judging import _repulsive as _repulsive
-from .localise import localise
 from .problem import _Drift, _mean, _Problem, _with_drift
 from .problem import _drift_free as _drift_free
 from .problem import _small_step as _small_step

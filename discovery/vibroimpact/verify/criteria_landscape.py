@@ -30,7 +30,7 @@ from ...errors import InputError, VidiError, VidiTypeError
 from ...numerics.executor import make_executor
 from ..data.impulse import Impulse
 from ..dynamics import Tolerances
-from ..dynamics.response import response
+from ..dynamics.law_response import response
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from . import Reference, evaluate
@@ -281,7 +281,7 @@ def _point(ctx, law, guess=None):
 def _row(ctx, job):
     """One row of the grid (a task of the executor: a row, not a point, lasts long enough
     to amortise a task's overhead).  With continuation each point's steady state starts
-    from its neighbours' orbit (:func:`~discovery.vibroimpact.dynamics.steady_state.steady_state`'s
+    from its neighbours' orbit (:func:`~discovery.vibroimpact.dynamics.steady_states.steady_state`'s
     ``guess``, see :func:`_predicted`), and from the cold search when that fails."""
     v0, axis1 = job
     law, continuation = ctx[1], ctx[5]

@@ -18,8 +18,8 @@ from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from . import Tolerances
 from . import _kernel as K
-from .simulate import simulate
-from .steady_state import steady_state
+from .simulation import simulate
+from .steady_states import steady_state
 
 __all__ = ["Response", "response", "impulse_from_steady_state"]
 
@@ -65,7 +65,7 @@ def response(scenario, law, *, tolerances=None, points_per_period=2000, **steady
     points_per_period : int
         Resolution of the exact impulse.
     **steady_kwargs
-        Passed to :func:`~discovery.vibroimpact.dynamics.steady_state.steady_state`.
+        Passed to :func:`~discovery.vibroimpact.dynamics.steady_states.steady_state`.
 
     Returns
     -------

@@ -5,7 +5,7 @@ term, name the missing physical effect from this system's catalogue
 One iteration (:func:`explain`):
 
 1. **Fit** the current terms by least squares on the weak form of the equation (the
-   regression of :func:`discovery.ueda.discover.discover`, ``G c = b``, with the
+   regression of :func:`discovery.ueda.equation_discovery.discover`, ``G c = b``, with the
    support fixed: no thresholding) and take the weak-form residual ``r = b - G_S c``.
 2. **Score** every applicable catalogue effect (its terms not yet in the model) by a
    Lagrange-multiplier (score) test for an omitted variable: ``z`` the effect's weak-form
@@ -380,7 +380,7 @@ def explain(
     Parameters
     ----------
     t, x : array
-        Uniformly sampled record (as for :func:`~discovery.ueda.discover.discover`).
+        Uniformly sampled record (as for :func:`~discovery.ueda.equation_discovery.discover`).
     B, nu : float
         The known forcing ``B cos(nu t)``.
     start_terms : str or sequence of str

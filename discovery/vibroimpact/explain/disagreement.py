@@ -22,7 +22,7 @@ for a drift (a trend of the peak force across impacts).
 
 import numpy as np
 
-from ..dynamics.simulate import simulate
+from ..dynamics.simulation import simulate
 
 __all__ = ["PHASES", "localise", "simulated_at"]
 

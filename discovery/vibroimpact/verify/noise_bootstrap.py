@@ -8,7 +8,7 @@ penetration, a penetration signal crossing zero at every onset with the record's
 impact velocity and penetration noise.  The replicate goes through the *same*
 processing as the record (:func:`~discovery.vibroimpact.data.impulse.impulse_from_samples`: onsets,
 averaging, thresholds, supports), is aligned with the stand-in in the same way
-(:func:`~discovery.vibroimpact.verify.evaluate.align`) and compared with it by the same
+(:func:`~discovery.vibroimpact.verify.evaluation.align`) and compared with it by the same
 criteria.  The mean over replicates is the floor; a model whose criteria are within
 a small factor of it agrees with the record as well as the truth could.
 """
@@ -18,7 +18,7 @@ import numpy as np
 from ...errors import InputError
 from ..data.impulse import impulse_from_samples
 from .criteria import CRITERIA, evaluate_criteria
-from .evaluate import align
+from .evaluation import align
 
 __all__ = ["noise_floor"]
 

@@ -35,7 +35,7 @@ from ...numerics.status import message as status_message
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from . import _kernel as K
-from .simulate import _HINTS, Tolerances, _atol, kernel_params, no_sensitivities, simulate
+from .simulation import _HINTS, Tolerances, _atol, kernel_params, no_sensitivities, simulate
 
 __all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
 
@@ -352,7 +352,7 @@ def _orbit(pm, y, n, t0, *, tol, max_newton, attempt, evidence):
     tolerances=(Tolerances, None),
     y_start=(None, Array(1)),
     t_start=Real(),
-    guess=(None, Instance("discovery.vibroimpact.dynamics.steady_state", "SteadyState")),
+    guess=(None, Instance("discovery.vibroimpact.dynamics.steady_states", "SteadyState")),
 )
 def steady_state(
     scenario,

@@ -34,9 +34,9 @@ from ..._printing import readable
 from ..._result import Result
 from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
-from ..dynamics.response import impulse_from_steady_state
-from ..dynamics.simulate import simulate
-from ..dynamics.steady_state import steady_state
+from ..dynamics.law_response import impulse_from_steady_state
+from ..dynamics.simulation import simulate
+from ..dynamics.steady_states import steady_state
 from .criteria import compare, criteria_lines, evaluate_criteria
 from .motion import MOTION_CRITERION, block_penetration
 from .trajectory import block_criteria, simulated_motion
@@ -377,7 +377,7 @@ def evaluate(
         continuous in the law's coefficients (optimisers: ``identify``); the default
         compares point samples with the record's point samples (the verdict).
     **steady_kwargs
-        Passed to :func:`~discovery.vibroimpact.dynamics.steady_state.steady_state`.
+        Passed to :func:`~discovery.vibroimpact.dynamics.steady_states.steady_state`.
 
     Returns
     -------

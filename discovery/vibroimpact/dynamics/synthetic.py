@@ -12,8 +12,8 @@ from ...errors import InputError
 from ..data.measurement import STATE_COLUMNS, Measurement
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
-from . import simulate
-from .steady_state import steady_state
+from .simulation import simulate
+from .steady_states import steady_state
 
 MAX_SAMPLES = 10_000_000  # samples of one record (as `vidi simulate`)
 

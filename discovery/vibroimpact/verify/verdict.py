@@ -11,7 +11,7 @@ from ..dynamics import Tolerances
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from .criteria import criteria_lines
-from .evaluate import Evaluation, evaluate
+from .evaluation import Evaluation, evaluate
 from .reference import Reference
 
 __all__ = ["VerifyResult", "verify"]

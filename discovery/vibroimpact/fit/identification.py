@@ -47,7 +47,7 @@ from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
 from ..verify.criteria import criteria_lines
-from ..verify.evaluate import Evaluation
+from ..verify.evaluation import Evaluation
 
 # the fit's parts (records, problem, optimise, intervals), also importable from here under the
 # names this module has always had (``x as x``: a re-export)
