@@ -8,7 +8,8 @@ true law, c11's as a linear law behind a contact offset):
 * the true law verified: I2 and I5 with their limits and floors, the verdict, the regime the
   record reads and the one the law's orbit has (and, on c10, the soft law that hides its
   unloading damping);
-* every coefficient of the true law scaled by 0.7 and by 1.3: how many are inconsistent;
+* every coefficient of the true law (its unloading branch's too) scaled by 0.7 and by 1.3:
+  how many are inconsistent;
 * ``explain`` from ``z + zd`` (the record's own scenario, 30 bootstrap replicates): the
   effects named, each one's gap before and after with its floor, the final model's
   parameters with their 95 % intervals, and the truth in the same terms
@@ -61,17 +62,23 @@ def _verified(sc, ref, law):
 
 
 def _scaled(sc, ref, law):
-    """Every coefficient of ``law`` times 0.7 and 1.3: the ones still consistent."""
+    """Every coefficient of ``law`` (its unloading branch's too) times 0.7 and 1.3: the ones
+    still consistent."""
     from discovery.vibroimpact.verify import verify
 
+    n = len(law.coefficients)
+    values = [*law.coefficients, *law.unloading_coefficients]
+    labels = [*law.names, *(f"unloading {t.name}" for t in law.unloading)]
     consistent, total = [], 0
-    for i, term in enumerate(law.names):
+    for i, term in enumerate(labels):
         for f in (0.7, 1.3):
-            c = list(law.coefficients)
+            c = list(values)
             c[i] *= f
+            scaled = law.with_coefficients(c[:n]).with_unloading(coefficients=c[n:])
             total += 1
-            if verify(sc, ref, law.with_coefficients(c), check_default_start=False).consistent:
-                consistent.append(f"{term} x{f}")
+            if not verify(sc, ref, scaled, check_default_start=False).consistent:
+                continue
+            consistent.append(f"{term} x{f}")
     return {"total": total, "inconsistent": total - len(consistent), "consistent": consistent}
 
 
@@ -155,14 +162,24 @@ EFFECTS = {
 
 
 def _g(x, digits=2):
-    """``x`` to ``digits`` significant figures past the first, as the pages write them."""
+    """``x`` as the pages write a criterion: ``1.15``, ``0.027`` (``digits`` decimals past
+    the point's zero; one more for ``digits=3``: ``0.0131``)."""
     if x is None:
         return "-"
-    return f"{x:.{digits}g}" if abs(x) >= 1 else f"{x:.3f}" if abs(x) >= 0.01 else f"{x:.1e}"
+    if abs(x) >= 1:
+        return f"{x:.{digits + 1}g}"
+    return f"{x:.{digits + 1}f}" if abs(x) >= 0.01 else f"{x:.1e}"
 
 
 def _e(x):
     return f"{x:.3e}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
+
+
+def _law(parameters):
+    """A law's text from its coefficients, four figures each: ``1.131e8*z + 7.05e6*zd``."""
+    return " + ".join(
+        f"{v:.4g}".replace("e+0", "e").replace("e+", "e") + f"*{n}" for n, v in parameters.items()
+    )
 
 
 def _find(rows, label):
@@ -252,15 +269,15 @@ def _explain_cell(r):
     x = r["explain"]
     lim = x["limits"]
     if not x["named"]:
-        state = "consistent" if x["consistent"] else "inconsistent"
-        cell = f"nothing named: `{x['final']}` {state}"
+        cell = "nothing named" if x["consistent"] else f"nothing named, inconsistent: {x['final']}"
         hidden = r.get("hidden")
         hidden = hidden if isinstance(hidden, list) else [hidden] if hidden else []
         for s in x["separability"]:
             if s["effect"] in hidden and s["after"] is not None:
-                tell = "does not lower" if not s["separable"] else "lowers"
+                tell = "lowers" if s["separable"] else "does not lower"
                 cell += (
-                    f"; {EFFECTS.get(s['effect'], s['effect'])} refitted {tell} I2 by its floor "
+                    f": `{_law(x['parameters'])}` consistent; "
+                    f"{EFFECTS.get(s['effect'], s['effect'])} refitted {tell} I2 by its floor "
                     f"({_g(s['before'], 3)} -> {_g(s['after'], 3)}, floor {_g(s['floor'])})"
                 )
         return cell
