@@ -23,6 +23,7 @@ tests.tables``).
 """
 
 import argparse
+import re
 import sys
 import time
 
@@ -91,8 +92,8 @@ def _iteration(it):
     }
 
 
-def _explained(sc, m, truth):
-    """``explain`` from ``z + zd`` and its outcome against ``truth`` (``{name: value}``)."""
+def _explained(sc, m):
+    """``explain`` from ``z + zd``: what it named and the model it ended with."""
     from discovery.vibroimpact.explain import explain
 
     t0 = time.perf_counter()
@@ -111,7 +112,6 @@ def _explained(sc, m, truth):
         "final": str(final),
         "parameters": got,
         "intervals": {k: [float(lo), float(hi)] for k, (lo, hi) in bounds.items()},
-        "truth": truth if set(truth) == set(got) else None,
         "separability": [
             {k: s.get(k) for k in ("effect", "before", "after", "floor", "separable")}
             for s in res.separability
@@ -144,7 +144,8 @@ def run(name):
         row["scaled"] = _scaled(sc, ref, law)
         # explain starts from the record's own scenario (c11's without its offset)
         own = load_scenario(str(CORPUS / name / "scenario.toml"))
-        row["explain"] = _explained(own, m, _corpus_model(name)[2])
+        row["truth"] = _corpus_model(name)[2]
+        row["explain"] = _explained(own, m)
     except Exception as exc:  # a survey records every outcome
         row["error"] = f"{type(exc).__name__}: {exc}"
     row["seconds"] = time.perf_counter() - t0
@@ -161,6 +162,10 @@ EFFECTS = {
 }
 
 
+def _effect(name):
+    return EFFECTS.get(name, name.replace("_", " "))
+
+
 def _g(x, digits=2):
     """``x`` as the pages write a criterion: ``1.15``, ``0.027`` (``digits`` decimals past
     the point's zero; one more for ``digits=3``: ``0.0131``)."""
@@ -168,18 +173,38 @@ def _g(x, digits=2):
         return "-"
     if abs(x) >= 1:
         return f"{x:.{digits + 1}g}"
-    return f"{x:.{digits + 1}f}" if abs(x) >= 0.01 else f"{x:.1e}"
+    return f"{x:.{digits + 1}f}" if abs(x) >= 0.01 else f"{x:.{digits + 2}f}"
+
+
+def _exp(text):
+    return text.replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
 
 
 def _e(x):
-    return f"{x:.3e}".replace("e+0", "e").replace("e-0", "e-").replace("e+", "e")
+    """Four figures: ``1.504e8``."""
+    return _exp(f"{x:.3e}")
+
+
+def _short(x):
+    """As short as it reads: ``1.5e8``, ``0.0015``."""
+    return _exp(f"{x:.4g}")
+
+
+_TERM = re.compile(r"^z[z^*d.0-9]*$|^zd[z^*d.0-9]*$")
 
 
 def _law(parameters):
-    """A law's text from its coefficients, four figures each: ``1.131e8*z + 7.05e6*zd``."""
-    return " + ".join(
-        f"{v:.4g}".replace("e+0", "e").replace("e+", "e") + f"*{n}" for n, v in parameters.items()
-    )
+    """A model's text from its parameters, four figures each: ``1.131e8*z + 7.05e6*zd``,
+    an effect's parameter after it (``1.23e8*z + 4.056e6*zd, set = 0.95``)."""
+    terms = [f"{_short(v)}*{n}" for n, v in parameters.items() if _TERM.match(n)]
+    other = [f"{n} = {_short(v)}" for n, v in parameters.items() if not _TERM.match(n)]
+    return ", ".join([" + ".join(terms), *other])
+
+
+def _text(law):
+    """A law's text (``39900000*z + 5950000*zd``) as :func:`_law` writes it."""
+    coefficient, name = zip(*(t.split("*", 1) for t in law.split(" + ")), strict=True)
+    return _law(dict(zip(name, map(float, coefficient), strict=True)))
 
 
 def _find(rows, label):
@@ -207,12 +232,12 @@ def _law_cell(r, *, floors):
     scores = ", ".join(f"{k} {_g(v[k])} / {_g(v[f'{k}_limit'])}" for k in CRITERIA if k in v)
     cell = f"{_verdict(v)} ({scores})"
     if r.get("offset"):
-        cell = f"{_verdict(v)} with `{v['law']}` and `offset = {r['offset']:g}` ({scores})"
+        cell = f"{_verdict(v)} with `{_text(v['law'])}` and `offset = {r['offset']:g}` ({scores})"
     for o in r.get("also", ()):
         fails = _failing(o)
         by = f" by {', '.join(fails)}" if fails and not o["consistent"] else ""
         scores = ", ".join(f"{k} {_g(o[k])} / {_g(o[f'{k}_limit'])}" for k in CRITERIA if k in o)
-        cell += f"; the soft law `{o['law']}` {_verdict(o)}{by} ({scores})"
+        cell += f"; the soft law `{_text(o['law'])}` {_verdict(o)}{by} ({scores})"
     return cell
 
 
@@ -236,19 +261,21 @@ def _step(it, limits):
     if it["I2_before"] is not None and it["I2_before"] <= (limits.get("I2") or float("inf")):
         k = "I5" if it.get("I5_before") is not None else "I2"
     return (
-        f"{EFFECTS.get(it['effect'], it['effect'])} named, {k} {_g(it[f'{k}_before'])} -> "
+        f"{_effect(it['effect'])} named, {k} {_g(it[f'{k}_before'])} -> "
         f"{_g(it[f'{k}_after'])} (floor {_g(it[f'{k}_floor'])})"
     )
 
 
-def _final(x):
-    """The final model's parameters, against the truth with their intervals."""
-    got, truth, bounds = x["parameters"], x["truth"], x["intervals"]
-    if truth is None:
-        return f"`{x['final']}`"
+def _final(x, truth):
+    """The final model's parameters, against the truth (``truth``: in the model's terms
+    when it has the truth's parameters) with their intervals."""
+    got, bounds = x["parameters"], x["intervals"]
+    if set(got) != set(truth):
+        true = ", ".join(f"{n} {_short(v)}" for n, v in truth.items())
+        return f"`{_law(got)}` (true {true})"
     names = list(got)
     cell = ", ".join(f"{n} {_e(got[n])}" for n in names)
-    cell += f" (true {', '.join(f'{truth[n]:g}' for n in names)})"
+    cell += f" (true {', '.join(_short(truth[n]) for n in names)})"
     if not bounds:
         return cell + ", no intervals"
     missed = [n for n in names if n in bounds and not bounds[n][0] <= truth[n] <= bounds[n][1]]
@@ -277,14 +304,14 @@ def _explain_cell(r):
                 tell = "lowers" if s["separable"] else "does not lower"
                 cell += (
                     f": `{_law(x['parameters'])}` consistent; "
-                    f"{EFFECTS.get(s['effect'], s['effect'])} refitted {tell} I2 by its floor "
+                    f"{_effect(s['effect'])} refitted {tell} I2 by its floor "
                     f"({_g(s['before'], 3)} -> {_g(s['after'], 3)}, floor {_g(s['floor'])})"
                 )
         return cell
     cell = ", then ".join(_step(it, lim) for it in x["iterations"])
     if not x["consistent"]:
         cell += f"; inconsistent: {x['stopped_because']}"
-    return f"{cell}: {_final(x)}"
+    return f"{cell}: {_final(x, r['truth'])}"
 
 
 def markdown_row(rows, label):
