@@ -94,7 +94,8 @@ tables: install
 	$(BIN)/python -m tests.tables
 
 surveys: install
-	rm -f $(MEASURED)/intervals-*.jsonl $(MEASURED)/advise-*.jsonl $(MEASURED)/realistic-*.jsonl
+	rm -f $(MEASURED)/intervals-*.jsonl $(MEASURED)/advise-*.jsonl $(MEASURED)/realistic-*.jsonl \
+		$(MEASURED)/corpus*.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 272 \
 		--workers $(SURVEY_WORKERS) --out $(MEASURED)/intervals-272.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 208 \
@@ -108,6 +109,7 @@ surveys: install
 		--out $(MEASURED)/realistic-default.jsonl
 	$(BIN)/python -m tests.realistic_survey --properties --n 8 --noise-seeds 1 --field \
 		--out $(MEASURED)/realistic-field.jsonl
+	$(BIN)/python -m tests.survey_corpus --out $(MEASURED)/corpus.jsonl
 	$(MAKE) tables
 
 # The documentation site (docs/*.md, API reference from the docstrings), warnings as errors

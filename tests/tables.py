@@ -18,7 +18,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import measured, realistic_survey, survey_advise, survey_intervals
+from . import measured, realistic_survey, survey_advise, survey_corpus, survey_intervals
 
 ROOT = measured.ROOT
 
@@ -47,6 +47,9 @@ _INTERVAL_RUNS = {
     "mended": ("intervals-208*.jsonl",),  # with the P4 records run again, if any
     "corpus": ("intervals-corpus*.jsonl",),
 }
+
+#: the corpus's two tables, one row per record (a later run of a record replaces its row)
+_CORPUS_RUNS = ("corpus*.jsonl",)
 
 TABLES = {
     "intervals": Table(
@@ -90,6 +93,49 @@ TABLES = {
         rows=(("1 %", ("advise-1*.jsonl",)), ("3 %", ("advise-3*.jsonl",))),
         row=survey_advise.markdown_row,
         read=_rows,
+    ),
+    "corpus": Table(
+        page="docs/validation.md",
+        header=(
+            "| record | true law verified | regime read (simulated) | every coefficient x0.7 "
+            "and x1.3 | `explain` from `z + zd` |",
+            "|---|---|---|---|---|",
+        ),
+        rows=tuple(
+            (label, _CORPUS_RUNS)
+            for label in (
+                "c01 slow transient (multiplier ~0.99)",
+                "c02 steep onset (`z*zd`, 2 % noise)",
+                "c03 Hertz",
+                "c04 period two",
+                "c05 5 kHz",
+                "c06 unloading damping",
+                "c07 3 % noise",
+            )
+        ),
+        row=survey_corpus.markdown_row,
+        read=survey_corpus.read_rows,
+    ),
+    "corpus-effects": Table(
+        page="docs/validation.md",
+        header=(
+            "| record | true law verified (I2, I5 against their limits) | `explain` from "
+            "`z + zd` |",
+            "|---|---|---|",
+        ),
+        rows=tuple(
+            (label, _CORPUS_RUNS)
+            for label in (
+                "c08 strong coupling",
+                "c09 soft Hertz (P2)",
+                "c10 unloading damping behind a stiff spring",
+                "c11 contact offset 1.5 mm",
+                "c12 coupling and unloading damping",
+                "c13 steep onset at 0.5 % noise",
+            )
+        ),
+        row=survey_corpus.effects_row,
+        read=survey_corpus.read_rows,
     ),
     "realistic-span": Table(
         page="docs/validation.md",

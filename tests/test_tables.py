@@ -64,3 +64,24 @@ def test_a_changed_run_makes_the_check_fail(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(measured, "MEASURED", saved)
     assert tables.main(["--check"]) == 1
     assert "stale measured tables in docs/validation.md" in capsys.readouterr().err
+
+
+def test_the_corpus_tables_have_a_row_per_record_of_their_run():
+    """tests.survey_corpus's rows: each of the thirteen records in one of the two tables,
+    and the cells say what the numbers say."""
+    from tests import survey_corpus
+
+    labels = [
+        label for name in ("corpus", "corpus-effects") for label, _ in tables.TABLES[name].rows
+    ]
+    rows = survey_corpus.read_rows(tables.run_files(tables.TABLES["corpus"].rows[0][1]))
+    assert sorted(r["i"].split("-")[0] for r in rows) == sorted(x.split()[0] for x in labels)
+    row = {
+        "i": "c99-test",
+        "verified": {"consistent": True, "I2": 0.0271, "I2_floor": 0.0249, "regime": {}},
+        "scaled": {"total": 4, "inconsistent": 3, "consistent": ["zd x0.7"]},
+        "explain": {"named": [], "consistent": True, "separability": [], "limits": {}},
+    }
+    assert survey_corpus._law_cell(row, floors=True) == "consistent (I2 0.027, floor 0.025)"
+    assert survey_corpus._scaled_cell(row) == "3 of 4 inconsistent (zd x0.7 not)"
+    assert survey_corpus._explain_cell(row) == "nothing named"
