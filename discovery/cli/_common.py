@@ -1,6 +1,6 @@
-"""Shared pieces of the command modules: option help texts, option types that check
-values at parse time (before any work), and the record/output helpers every command
-calls first.
+"""Shared pieces of the command modules: option types that check values at parse time
+(before any work), and the record/output helpers every command calls (the options
+several commands share are in :mod:`._options`).
 
 For the command modules:
 
@@ -8,8 +8,11 @@ For the command modules:
   header names for our columns); ``read_record(args, scenario)`` then loads
   ``args.data`` with that mapping (:meth:`discovery.Measurement.from_csv`).
 * ``check_out(args, kind="dir")`` refuses a bad ``--out`` before any work
-  (:func:`discovery._io.check_output` with the command's input files).
-* ``inputs_of(args)`` gives the input files for ``provenance(..., inputs=...)``.
+  (:func:`discovery._io.check_output` with the command's input files);
+  ``check_record_out(args)`` and ``write_record(...)`` do it for a command that writes a
+  record (``D.csv`` and ``D.summary.json``).
+* ``provenance_of(args)`` is the provenance of ``summary.json`` (the options and the
+  input files of ``inputs_of(args)``).
 * ``number(...)`` and ``integer(...)`` are argparse ``type=`` functions with ranges.
 """
 
@@ -23,15 +26,6 @@ from .._io import check_output
 from ..errors import InputError
 from ..vibroimpact.model.scenario import builtin_scenarios
 
-SCENARIO_HELP = (
-    f"built-in scenario ({', '.join(builtin_scenarios())}) or a TOML file (default: paper)"
-)
-LAW_HELP = (
-    "force law in z = zeta (penetration w1 - w2, m) and zd = dzeta (its rate while "
-    "loading, m/s), e.g. '2.06e8*z + 1.28e7*zd' (default: the scenario's law); a law "
-    "starting with '-' as --law=-1e8*z; or a named contact model, e.g. 'hunt-crossley: "
-    "k=2e9, n=1.5, lambda=3e9', 'flores: k=2e9, n=1.5, e=0.6', 'kelvin-voigt: k=2e8, c=1e6'"
-)
 COLUMNS_HELP = (
     "the file's header names for our columns when they differ, e.g. "
     "t=time_s,F=force_N (names: t, F, w1, v1, w2, v2, a2; default: the headers are "
@@ -173,35 +167,6 @@ def reporter(args):
     )
 
 
-SCHEDULER_HELP = (
-    "run on Dask: 'local' starts a LocalCluster of single-threaded workers, "
-    "tcp://host:port joins a running scheduler (its workers started with "
-    "--nthreads 1); needs pip install 'vibroimpact-discovery[dask]'"
-)
-
-
-def add_interval_refit_option(parser):
-    """``--interval-refit``: how each bootstrap replicate of the intervals is refitted."""
-    parser.add_argument(
-        "--interval-refit",
-        choices=("two-step", "full"),  # identify.INTERVAL_REFITS (not imported: --help stays fast)
-        default="two-step",
-        help="how each bootstrap replicate is refitted: two Gauss-Newton steps from the fit "
-        "with exact Jacobians, or a full least-squares refit (about 3x the time) "
-        "(default: %(default)s)",
-    )
-
-
-def add_workers_option(parser, what):
-    """``--workers N``: processes for ``what`` (default: every core; the result does not
-    depend on it)."""
-    parser.add_argument(
-        "--workers",
-        type=integer(1, 1024),
-        help=f"processes for {what} (default: all cores; the result does not depend on it)",
-    )
-
-
 def executor_of(args):
     """The executor of ``--scheduler`` (a context manager that closes it), or a null
     context giving ``None`` (the API's default: ``--workers`` local processes)."""
@@ -254,11 +219,60 @@ def inputs_of(args):
     return out
 
 
+def check_out_inputs(args):
+    """The input files an output may not replace: the records and scenario files."""
+    inputs = [p for p in _listed(getattr(args, "data", None)) if p]
+    return inputs + [p for p in map(scenario_file, _listed(getattr(args, "scenario", None))) if p]
+
+
 def check_out(args, kind="dir", option="--out"):
     """Refuse a bad ``--out`` before any work (see :func:`discovery._io.check_output`)."""
-    inputs = [p for p in _listed(getattr(args, "data", None)) if p]
-    inputs += [p for p in map(scenario_file, _listed(getattr(args, "scenario", None))) if p]
-    return check_output(getattr(args, "out", None), inputs, kind=kind, option=option)
+    return check_output(
+        getattr(args, "out", None), check_out_inputs(args), kind=kind, option=option
+    )
+
+
+def provenance_of(args):
+    """The ``summary.json`` provenance of a command: its options and its input files
+    (:func:`inputs_of`)."""
+    from .._io import provenance
+
+    return provenance(vars(args), inputs=inputs_of(args))
+
+
+def data_entry(data):
+    """The ``data`` entry of a summary: the one ``--data`` record, or the list of them."""
+    return [str(p) for p in data] if len(data) > 1 else str(data[0])
+
+
+def check_record_out(args):
+    """``--out`` of a command that writes a record: a new ``.csv`` file and the
+    ``.summary.json`` beside it, refused before any work; returns ``(csv, summary)``."""
+    out = check_out(args, kind="file")
+    if out.suffix.lower() != ".csv":
+        raise InputError(f"--out {args.out!r} must name a .csv file, e.g. D.csv")
+    summary = out.with_suffix(".summary.json")
+    check_output(summary, check_out_inputs(args), kind="file", option="--out's summary")
+    return out, summary
+
+
+def write_record(paths, csv_text, summary):
+    """The record ``csv_text`` and its ``summary`` result, each written atomically to the
+    ``(csv, summary)`` paths of :func:`check_record_out` (the summary holds the CSV's
+    sha256, so a pair from two runs is detectable)."""
+    import json
+
+    from .._io import atomic_write_text
+
+    out, summary_path = paths
+    text = json.dumps(summary.to_dict(), indent=2) + "\n"
+    atomic_write_text(out, csv_text)
+    atomic_write_text(summary_path, text)
+
+
+def outputs_line(args, files):
+    """``outputs in OUT/: a, b, ...``: the last line of a command's printout."""
+    return f"outputs in {args.out}/: {', '.join(files)}"
 
 
 def read_records(args):

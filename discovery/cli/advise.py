@@ -1,17 +1,17 @@
 """``vidi advise``: where should the next record be taken to separate the candidate laws?"""
 
-from .._io import OutputDir, provenance
+from .._io import OutputDir
 from ..errors import InputError
+from . import _options
 from ._common import (
-    SCENARIO_HELP,
-    SCHEDULER_HELP,
     add_record_options,
     check_out,
     executor_of,
-    inputs_of,
     integer,
     number,
+    outputs_line,
     parse_range,
+    provenance_of,
     read_record,
     reporter,
 )
@@ -97,7 +97,7 @@ def run(args):
     noise = _noise(args, sc)
     with reporter(args) as rep, executor_of(args) as ex:
         res = advise(sc, laws, knobs, noise, safe, workers=args.workers, progress=rep, executor=ex)
-    prov = provenance(vars(args), inputs=inputs_of(args))
+    prov = provenance_of(args)
     prov["settings"] = {**res.settings, **prov["settings"]}
     with OutputDir(args.out) as out:
         out.write_json("summary.json", {**res.to_dict(), **prov})
@@ -107,7 +107,7 @@ def run(args):
     for k, p in enumerate(res.ranked()[1:4], start=2):
         print(f"rank {k}: A = {p.amplitude:.4g} N, f = {p.frequency:.4g} Hz")
         print("\n".join(point_lines(p, res)[: len(p.pairs)]))
-    print(f"outputs in {args.out}/: summary.json, advise.csv, advise_map.png/.pdf")
+    print(outputs_line(args, ["summary.json", "advise.csv", "advise_map.png/.pdf"]))
     return 0
 
 
@@ -138,7 +138,9 @@ def register(sub):
     )
     s.add_argument(
         "--scenario",
-        help=SCENARIO_HELP.replace("(default: paper)", "(default: the fit's; with --law, paper)"),
+        help=_options.SCENARIO_HELP.replace(
+            "(default: paper)", "(default: the fit's; with --law, paper)"
+        ),
     )
     s.add_argument("--data", help="the record whose noise level the next one will have")
     add_record_options(s).needs = "--data"
@@ -190,19 +192,8 @@ def register(sub):
         default=3,
         help="best coarse points refined by a 3x3 grid at half the spacing (default: 3)",
     )
-    s.add_argument(
-        "--n-boot",
-        type=integer(1, 10_000),
-        default=16,
-        help="bootstrap replicates of each noise floor (default: %(default)s)",
-    )
-    s.add_argument(
-        "--seed",
-        type=integer(0, 2**32 - 1),
-        default=0,
-        help="seed of the noise floors' bootstrap (default: %(default)s)",
-    )
-    s.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
-    s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
-    s.add_argument("--out", required=True, help="output directory")
+    _options.add_n_boot_option(s, of="each noise floor")
+    _options.add_seed_option(s, "seed of the noise floors' bootstrap")
+    _options.add_parallel_options(s)
+    _options.add_out_option(s)
     s.set_defaults(func=run)

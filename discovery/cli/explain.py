@@ -2,22 +2,17 @@
 
 import time
 
-from .._io import OutputDir, provenance
-from ..vibroimpact.verify.criteria import CRITERIA
+from .._io import OutputDir
+from . import _options
 from ._common import (
-    SCENARIO_HELP,
-    SCHEDULER_HELP,
-    add_interval_refit_option,
     add_record_options,
-    add_workers_option,
     check_out,
     coefficients_line,
     criteria_line,
+    data_entry,
     executor_of,
-    inputs_of,
-    integer,
-    interval_count,
-    number,
+    outputs_line,
+    provenance_of,
     read_records,
     reporter,
 )
@@ -47,7 +42,6 @@ def run(args):
 
     t_start = time.perf_counter()
     check_out(args)
-    data = args.data
     effects = None
     if args.effects:
         effects = [e.strip() for e in args.effects.split(",") if e.strip()]
@@ -71,11 +65,7 @@ def run(args):
             progress=rep,
             executor=ex,
         )
-    head = {
-        "command": "explain",
-        "scenario": scs[0].as_dict(),
-        "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
-    }
+    head = {"command": "explain", "scenario": scs[0].as_dict(), "data": data_entry(args.data)}
     tail = {"catalogue": [e.as_dict() for e in EFFECTS], "explain_settings": res.settings}
     loops = _final_loops(res, scs[0], meas[0], args)
     with OutputDir(args.out) as out:
@@ -92,7 +82,7 @@ def run(args):
             )
             files.append("explain_loops.png/.pdf")
         tail["seconds"] = time.perf_counter() - t_start
-        tail.update(provenance(vars(args), inputs=inputs_of(args)))
+        tail.update(provenance_of(args))
         res.record_run(head, tail).write_into(out)
     for k, it in enumerate(res.iterations, start=1):
         name = it.effect or "nothing named"
@@ -122,7 +112,7 @@ def run(args):
             f"  {s['effect']}: {'separable' if s['separable'] else 'not separable'} by this "
             f"record ({how})"
         )
-    print(f"outputs in {args.out}/: summary.json" + "".join(f", {f}" for f in files))
+    print(outputs_line(args, ["summary.json", *files]))
     return 0
 
 
@@ -138,17 +128,11 @@ def register(sub):
         help="find where a model and a record disagree, name the "
         "missing physical effect, add it, refit, show the gap shrink",
     )
-    s.add_argument(
-        "--scenario",
-        action="append",
-        help=SCENARIO_HELP + "; repeat it, once per --data in the same order",
-    )
-    s.add_argument(
-        "--data",
-        required=True,
-        action="append",
-        help="CSV with t, F, w1, w2 (v1, v2 recommended); repeat it to explain "
-        "several records jointly",
+    _options.add_scenario_option(s, repeat=True)
+    _options.add_data_option(
+        s,
+        "CSV with t, F, w1, w2 (v1, v2 recommended); repeat it to explain several records jointly",
+        repeat=True,
     )
     add_record_options(s)
     s.add_argument(
@@ -163,51 +147,18 @@ def register(sub):
         help="comma-separated catalogue ids to consider (default: all "
         "of " + ", ".join(e.id for e in _catalogue()) + ")",
     )
-    s.add_argument(
-        "--criterion",
-        default="I2",
-        choices=list(CRITERIA),
-        help="criterion of the refits (default: %(default)s)",
+    _options.add_criterion_option(s, "criterion of the refits")
+    _options.add_effect_search_options(
+        s,
+        alpha_most=0.5,
+        alpha_help="family-wise significance level of the score tests",
+        max_iterations=10,
     )
-    s.add_argument(
-        "--alpha",
-        type=number(0.0, 0.5, lo_open=True),
-        default=0.01,
-        help="family-wise significance level of the score tests (default: %(default)g)",
-    )
-    s.add_argument(
-        "--max-iterations",
-        type=integer(0, 10),
-        default=3,
-        help="effects added at most (default: %(default)s)",
-    )
-    s.add_argument(
-        "--max-simulations",
-        type=integer(10, 100_000),
-        default=150,
-        help="simulation budget of each refit (default: %(default)s)",
-    )
-    s.add_argument(
-        "--n-boot",
-        type=integer(1, 10_000),
-        default=16,
-        help="bootstrap replicates of the noise floor (default: %(default)s)",
-    )
-    s.add_argument(
-        "--intervals",
-        type=interval_count,
-        default=30,
-        help="bootstrap replicates of the final model's 95 %% parameter intervals "
-        "through the full processing (0 = none) (default: %(default)s)",
-    )
-    s.add_argument(
-        "--seed",
-        type=integer(0, 2**32 - 1),
-        default=0,
-        help="seed of the noise-floor bootstrap (default: %(default)s)",
-    )
-    add_interval_refit_option(s)
-    add_workers_option(s, "the screening refits and the bootstrap intervals' refits")
-    s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
-    s.add_argument("--out", required=True, help="output directory")
+    _options.add_max_simulations_option(s, least=10, most=100_000, default=150, of=" of each refit")
+    _options.add_n_boot_option(s)
+    _options.add_intervals_option(s, "the final model's 95 % parameter intervals")
+    _options.add_seed_option(s, "seed of the noise-floor bootstrap")
+    _options.add_interval_refit_option(s)
+    _options.add_parallel_options(s, "the screening refits and the bootstrap intervals' refits")
+    _options.add_out_option(s)
     s.set_defaults(func=run)

@@ -5,20 +5,19 @@ import csv
 import io
 import time
 
-from .._io import OutputDir, provenance
+from .._io import OutputDir
 from ..vibroimpact.verify.criteria import CRITERIA
+from . import _options
 from ._common import (
-    SCENARIO_HELP,
-    add_interval_refit_option,
     add_record_options,
-    add_workers_option,
     check_out,
     coefficients_line,
     criteria_line,
-    inputs_of,
+    data_entry,
     integer,
-    interval_count,
     number,
+    outputs_line,
+    provenance_of,
     read_records,
     reporter,
 )
@@ -161,11 +160,9 @@ def _print_result(args, res, pdf, why):
         print(f"  warning: {w}")
     if why:
         print(f"  note: {why}")
-    print(
-        f"outputs in {args.out}/: summary.json, ranking.csv, model.tex"
-        f"{', model.pdf' if pdf else ''}, fit_impulse.png/.pdf, fit_surface.png/.pdf, "
-        "fit_loop.png/.pdf"
-    )
+    pdfs = ["model.pdf"] if pdf else []
+    figures = ["fit_impulse.png/.pdf", "fit_surface.png/.pdf", "fit_loop.png/.pdf"]
+    print(outputs_line(args, ["summary.json", "ranking.csv", "model.tex", *pdfs, *figures]))
 
 
 def _run_contact_models(args, scs, meas, t_start):
@@ -183,39 +180,34 @@ def _run_contact_models(args, scs, meas, t_start):
             seed=args.seed or 0,
             progress=rep,
         )
-    summary = {
-        **res.to_dict(),
-        "command": "fit",
-        "scenario": scs[0].as_dict(),
-        "scenarios": [sc.as_dict() for sc in scs] if len(scs) > 1 else None,
-        "data": [str(p) for p in args.data] if len(args.data) > 1 else str(args.data[0]),
-        **provenance(vars(args), inputs=inputs_of(args)),
-    }
+    summary = {**res.to_dict(), **_head(args, scs), **provenance_of(args)}
     summary["seconds"] = time.perf_counter() - t_start
     with OutputDir(args.out) as out:
         out.write_json("summary.json", summary)
     print(res)
-    print(f"outputs in {args.out}/: summary.json")
+    print(outputs_line(args, ["summary.json"]))
     return 0
+
+
+def _head(args, scs):
+    """The command's part of ``summary.json``: the records and their scenarios."""
+    return {
+        "command": "fit",
+        "scenario": scs[0].as_dict(),
+        "scenarios": [sc.as_dict() for sc in scs] if len(scs) > 1 else None,
+        "data": data_entry(args.data),
+    }
 
 
 def run(args):
     t_start = time.perf_counter()
     check_out(args)
-    data = args.data
     scs, meas = read_records(args)
     if args.library == "contact-models":
         return _run_contact_models(args, scs, meas, t_start)
     with reporter(args) as rep:
         res = _discover(args, scs, meas, rep)
-    head = {
-        "command": "fit",
-        "scenario": scs[0].as_dict(),
-        "scenarios": [sc.as_dict() for sc in scs] if len(scs) > 1 else None,
-        "data": [str(p) for p in data] if len(data) > 1 else str(data[0]),
-    }
-    prov = provenance(vars(args), inputs=inputs_of(args))
-    res.record_run(head, prov, names=[str(p) for p in data])
+    res.record_run(_head(args, scs), provenance_of(args), names=[str(p) for p in args.data])
     pdf, why = _write_outputs(args, res, t_start)
     _print_result(args, res, pdf, why)
     return 0
@@ -249,17 +241,13 @@ def _terms(text):
 
 def _add_inputs(p):
     """The records and their machines."""
-    p.add_argument(
-        "--scenario",
-        action="append",
-        help=SCENARIO_HELP + "; repeat it, once per --data in the same order, when "
-        "the records come from different operating points",
+    _options.add_scenario_option(
+        p, repeat=True, help_suffix=", when the records come from different operating points"
     )
-    p.add_argument(
-        "--data",
-        required=True,
-        action="append",
-        help="CSV with t, F, w1, w2 (v1, v2 optional); repeat it to fit several records jointly",
+    _options.add_data_option(
+        p,
+        "CSV with t, F, w1, w2 (v1, v2 optional); repeat it to fit several records jointly",
+        repeat=True,
     )
     add_record_options(p)
 
@@ -288,12 +276,7 @@ def _add_regression_options(p):
     p.add_argument(
         "--max-terms", type=integer(1, 12), default=4, help="largest support (default: %(default)s)"
     )
-    p.add_argument(
-        "--criterion",
-        default="I2",
-        choices=list(CRITERIA),
-        help="simulation criterion of the ranking (default: %(default)s)",
-    )
+    _options.add_criterion_option(p, "simulation criterion of the ranking")
     p.add_argument(
         "--shortlist",
         type=integer(1, 200),
@@ -323,15 +306,11 @@ def _add_regression_options(p):
 
 def _add_check_options(p):
     """Simulation checks, refinement, intervals and stability selection."""
-    p.add_argument(
-        "--intervals",
-        type=interval_count,
-        default=30,
-        help="bootstrap replicates of the selected law's 95 %% coefficient intervals "
-        "through the full processing (0 = none) (default: %(default)s)",
+    _options.add_intervals_option(p, "the selected law's 95 % coefficient intervals")
+    _options.add_interval_refit_option(p)
+    _options.add_workers_option(
+        p, "the refinements of each search step and the bootstrap intervals' refits"
     )
-    add_interval_refit_option(p)
-    add_workers_option(p, "the refinements of each search step and the bootstrap intervals' refits")
     p.add_argument(
         "--allow-unphysical",
         action="store_true",
@@ -345,13 +324,14 @@ def _add_check_options(p):
         help="skip the refinement of every shortlisted support by simulation "
         "(output error: unbiased coefficients and their standard errors)",
     )
-    p.add_argument(
-        "--max-simulations",
-        type=integer(2, 100_000),
+    _options.add_max_simulations_option(
+        p,
+        least=2,
+        most=100_000,
         default=None,
+        of=" of each support's refinement",
+        default_help="default: 120; with --library contact-models each model's fit, default 200",
         excludes="--no-refine",
-        help="simulation budget of each support's refinement (default: 120; with --library "
-        "contact-models each model's fit, default 200)",
     )
     p.add_argument(
         "--stability",
@@ -370,12 +350,7 @@ def _add_check_options(p):
         action="store_true",
         help="average the steady cycles sample by sample before the regression",
     )
-    p.add_argument(
-        "--seed",
-        type=integer(0, 2**32 - 1),
-        default=0,
-        help="seed of the stability selection (default: %(default)s)",
-    )
+    _options.add_seed_option(p, "seed of the stability selection")
 
 
 def _add_output_options(p):
@@ -385,7 +360,7 @@ def _add_output_options(p):
         action="store_true",
         help="do not compile model.tex to model.pdf (compiled when latexmk is installed)",
     )
-    p.add_argument("--out", required=True, help="output directory")
+    _options.add_out_option(p)
 
 
 def register(sub):

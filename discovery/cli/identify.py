@@ -5,23 +5,20 @@ import io
 
 import numpy as np
 
-from .._io import OutputDir, provenance
+from .._io import OutputDir
 from ..errors import InputError
 from ..vibroimpact.model.law import ForceLaw
 from ..vibroimpact.model.scenario import load_scenario
 from ..vibroimpact.verify.criteria import CRITERIA
+from . import _options
 from ._common import (
-    SCENARIO_HELP,
-    add_interval_refit_option,
     add_record_options,
-    add_workers_option,
     check_out,
     coefficients_line,
     criteria_line,
-    inputs_of,
-    integer,
-    interval_count,
     number,
+    outputs_line,
+    provenance_of,
     read_record,
     reporter,
 )
@@ -157,7 +154,7 @@ def _summary(args, sc, start, E, res):
         "consistent": final.consistent,
         "verdict": final.verdict,
         "regime": final.regime,
-        **provenance(vars(args), inputs=inputs_of(args)),
+        **provenance_of(args),
     }
     return res.record_run(head, tail)
 
@@ -181,10 +178,8 @@ def _print_result(args, res):
             f"  note: {len(res.failures)} trial law(s) had no periodic steady state with "
             "contact (listed in summary.json)"
         )
-    print(
-        f"outputs in {args.out}/: summary.json, iterations.csv, identification.png, "
-        "identification.pdf"
-    )
+    files = ["summary.json", "iterations.csv", "identification.png", "identification.pdf"]
+    print(outputs_line(args, files))
 
 
 def run(args):
@@ -236,20 +231,10 @@ def register(sub):
         "identify",
         help="identify a law's coefficients from a measured CSV by simulation (paper Figs. 6-7)",
     )
-    s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
-    s.add_argument(
-        "--data",
-        required=True,
-        help="CSV with t [s], F [N] (w1, v1, w2, v2 recommended: exact onsets and "
-        "the machine's state)",
-    )
+    _options.add_scenario_option(s)
+    _options.add_data_option(s)
     add_record_options(s)
-    s.add_argument(
-        "--criterion",
-        default="I2",
-        choices=list(CRITERIA),
-        help="criterion to minimise (default: %(default)s)",
-    )
+    _options.add_criterion_option(s, "criterion to minimise")
     s.add_argument(
         "--method",
         default="least-squares",
@@ -259,12 +244,7 @@ def register(sub):
     s.add_argument(
         "--start", required=True, help="terms and start values, e.g. '1.5e8*z + 0.9e7*zd'"
     )
-    s.add_argument(
-        "--max-simulations",
-        type=integer(2, 1_000_000),
-        default=600,
-        help="simulation budget (default: %(default)s)",
-    )
+    _options.add_max_simulations_option(s, least=2, most=1_000_000, default=600)
     s.add_argument(
         "--xtol",
         type=number(0.0, 1.0, lo_open=True),
@@ -275,26 +255,12 @@ def register(sub):
         "--landscape",
         help="a landscape output (directory or summary.json) to draw the path on (default: none)",
     )
-    s.add_argument(
-        "--n-boot",
-        type=integer(1, 10_000),
-        default=16,
-        help="bootstrap replicates of the noise floor (default: %(default)s)",
+    _options.add_n_boot_option(s)
+    _options.add_intervals_option(
+        s, "the 95 % coefficient intervals", "records with positions; 0 = none"
     )
-    s.add_argument(
-        "--intervals",
-        type=interval_count,
-        default=30,
-        help="bootstrap replicates of the 95 %% coefficient intervals through the "
-        "full processing (records with positions; 0 = none) (default: %(default)s)",
-    )
-    add_interval_refit_option(s)
-    add_workers_option(s, "the bootstrap intervals' refits")
-    s.add_argument(
-        "--seed",
-        type=integer(0, 2**32 - 1),
-        default=0,
-        help="seed of the noise-floor and interval bootstraps (default: %(default)s)",
-    )
-    s.add_argument("--out", required=True, help="output directory")
+    _options.add_interval_refit_option(s)
+    _options.add_workers_option(s, "the bootstrap intervals' refits")
+    _options.add_seed_option(s, "seed of the noise-floor and interval bootstraps")
+    _options.add_out_option(s)
     s.set_defaults(func=run)

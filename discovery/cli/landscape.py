@@ -6,21 +6,20 @@ import io
 
 import numpy as np
 
-from .._io import OutputDir, provenance
+from .._io import OutputDir
 from ..errors import InputError, IntegrationError
 from ..vibroimpact.model.scenario import load_scenario
 from ..vibroimpact.verify.criteria import CRITERIA
+from . import _options
 from ._common import (
-    SCENARIO_HELP,
-    SCHEDULER_HELP,
     add_record_options,
     check_out,
     executor_of,
-    inputs_of,
-    integer,
     law_or_default,
     number,
+    outputs_line,
     parse_range,
+    provenance_of,
     read_record,
     reporter,
 )
@@ -163,7 +162,7 @@ def run(args):
                 "reference": ref_info,
                 "grid": [n0, n1],
                 "ranges": {"alpha1": list(r0), "alpha2": list(r1), "from": origin},
-                **provenance(vars(args), inputs=inputs_of(args)),
+                **provenance_of(args),
             },
         )
         summary = land.to_dict()
@@ -199,7 +198,7 @@ def run(args):
         print(f"  {n}: minimum {m['value']:.3g}{beside} at ({m['alpha1']:.4g}, {m['alpha2']:.4g})")
     if not exact:
         print(f"  noise floor under {land.noise_floor_under}")
-    print(f"outputs in {args.out}/: summary.json, landscape.csv, landscape.png, landscape.pdf")
+    print(outputs_line(args, ["summary.json", "landscape.csv", "landscape.png", "landscape.pdf"]))
     return 0
 
 
@@ -208,7 +207,7 @@ def register(sub):
         "landscape",
         help="criteria I0..I5 over a grid of the first two coefficients (paper Figs. 4-5)",
     )
-    s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
+    _options.add_scenario_option(s)
     s.add_argument(
         "--law", help="template law whose first two coefficients vary (default: the scenario's law)"
     )
@@ -236,20 +235,8 @@ def register(sub):
         needs="--data",
         help="with --data: drive-clock time [s] of the record's t = 0 (default: %(default)g)",
     )
-    s.add_argument(
-        "--n-boot",
-        type=integer(1, 10_000),
-        default=16,
-        needs="--data",
-        help="with --data: bootstrap replicates of the noise floor (default: %(default)s)",
-    )
-    s.add_argument(
-        "--seed",
-        type=integer(0, 2**32 - 1),
-        default=0,
-        needs="--data",
-        help="with --data: seed of the bootstrap (default: %(default)s)",
-    )
+    _options.add_n_boot_option(s, help_prefix="with --data: ", needs="--data")
+    _options.add_seed_option(s, "with --data: seed of the bootstrap", needs="--data")
     s.add_argument(
         "--no-continuation",
         action="store_true",
@@ -257,7 +244,6 @@ def register(sub):
         "each point starts from its neighbour's orbit along the row, several "
         "times faster; the search from the start state when that fails)",
     )
-    s.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
-    s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
-    s.add_argument("--out", required=True, help="output directory")
+    _options.add_parallel_options(s)
+    _options.add_out_option(s)
     s.set_defaults(func=run)

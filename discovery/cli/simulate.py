@@ -5,21 +5,18 @@ summary records the sha256 of the CSV it describes (``outputs``), so a pair from
 different runs (a kill between the two renames) is detectable.
 """
 
-import json
 import time
 
-from .._io import atomic_write_text, check_output, provenance
 from ..errors import InputError
 from ..vibroimpact.model.scenario import load_scenario
+from . import _options
 from ._common import (
-    LAW_HELP,
-    SCENARIO_HELP,
-    check_out,
-    inputs_of,
+    check_record_out,
     integer,
     law_or_default,
     number,
-    scenario_file,
+    provenance_of,
+    write_record,
 )
 
 #: largest record written (samples): 1e7 rows of 6 columns is ~1 GB of text
@@ -29,15 +26,7 @@ MAX_SAMPLES = 10_000_000
 def run(args):
     from ..vibroimpact.dynamics.synthetic import SimulatedRecord, synthesize
 
-    out = check_out(args, kind="file")
-    if out.suffix.lower() != ".csv":
-        raise InputError(f"--out {args.out!r} must name a .csv file, e.g. D.csv")
-    check_output(
-        out.with_suffix(".summary.json"),
-        [scenario_file(args.scenario)],
-        kind="file",
-        option="--out's summary",
-    )
+    paths = out, summary_path = check_record_out(args)
     sc = load_scenario(args.scenario)
     law = law_or_default(args.law, sc)
     n = args.periods * sc.period * args.fs
@@ -72,21 +61,19 @@ def run(args):
         csv_text,
         samples=int(meas.t.size),
         seconds=time.perf_counter() - t0,
-    ).record_run({"command": "simulate"}, provenance(vars(args), inputs=inputs_of(args)))
-    text = json.dumps(summary.to_dict(), indent=2) + "\n"
-    atomic_write_text(out, csv_text)
-    atomic_write_text(out.with_suffix(".summary.json"), text)
+    ).record_run({"command": "simulate"}, provenance_of(args))
+    write_record(paths, csv_text, summary)
     print(
         f"wrote {out} ({meas.t.size} samples, {args.periods} periods at {args.fs:g} Hz, "
-        f"noise {args.noise:g}) and {out.with_suffix('.summary.json')}"
+        f"noise {args.noise:g}) and {summary_path}"
     )
     return 0
 
 
 def register(sub):
     s = sub.add_parser("simulate", help="write a synthetic measurement CSV of a law's steady state")
-    s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
-    s.add_argument("--law", help=LAW_HELP)
+    _options.add_scenario_option(s)
+    _options.add_law_option(s)
     s.add_argument(
         "--periods",
         type=integer(1, 100_000),
@@ -105,9 +92,7 @@ def register(sub):
         default=0.0,
         help="Gaussian noise on F as a fraction of the peak force, 0..1 (default: %(default)g)",
     )
-    s.add_argument(
-        "--seed", type=integer(0), default=0, help="noise seed, >= 0 (default: %(default)s)"
-    )
+    _options.add_seed_option(s, "noise seed, >= 0", most=None)
     s.add_argument(
         "--from-rest",
         action="store_true",
@@ -134,5 +119,5 @@ def register(sub):
         action="store_true",
         help="leave out the v1, v2 columns (discovery then differentiates w1 - w2)",
     )
-    s.add_argument("--out", required=True, help="output CSV (t, F, w1, v1, w2, v2)")
+    _options.add_out_option(s, "output CSV (t, F, w1, v1, w2, v2)")
     s.set_defaults(func=run)

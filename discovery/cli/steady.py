@@ -4,10 +4,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .._io import OutputDir, provenance
+from .._io import OutputDir
 from ..errors import InputError, IntegrationError
 from ..vibroimpact.model.scenario import load_scenario
-from ._common import LAW_HELP, SCENARIO_HELP, check_out, inputs_of, law_or_default
+from . import _options
+from ._common import check_out, law_or_default, provenance_of
 
 
 def run(args):
@@ -49,7 +50,7 @@ def run(args):
     if args.out:
         ss.record_run(
             {"command": "steady", "law": law.to_text(), "scenario": sc.as_dict()},
-            {**info, **provenance(vars(args), inputs=inputs_of(args))},
+            {**info, **provenance_of(args)},
         )
         with OutputDir(args.out) as out:
             ss.write_into(out)
@@ -61,8 +62,8 @@ def register(sub):
     s = sub.add_parser(
         "steady", help="periodic steady state of a law: regime, impacts, Floquet multipliers"
     )
-    s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
-    s.add_argument("--law", help=LAW_HELP)
+    _options.add_scenario_option(s)
+    _options.add_law_option(s)
     s.add_argument(
         "--sensitivities",
         action="store_true",

@@ -27,7 +27,8 @@ def run(args):
 
 
 def register(sub):
-    from ._common import SCHEDULER_HELP, integer
+    from . import _options
+    from ._common import integer
 
     s = sub.add_parser(
         "study",
@@ -61,7 +62,7 @@ def register(sub):
         type=integer(1, 4096),
         help="worker processes (default: one per core; 1 runs in this process)",
     )
-    s.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
+    _options.add_scheduler_option(s)
     s.add_argument(
         "--max-runs",
         type=integer(0, 10**9),

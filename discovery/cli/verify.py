@@ -1,17 +1,16 @@
 """``vidi verify``: is a law consistent with a record?"""
 
-from .._io import OutputDir, provenance
+from .._io import OutputDir
 from ..vibroimpact.model.scenario import load_scenario
+from . import _options
 from ._common import (
-    LAW_HELP,
-    SCENARIO_HELP,
     add_record_options,
     check_out,
     criteria_line,
-    inputs_of,
-    integer,
     law_or_default,
     number,
+    outputs_line,
+    provenance_of,
     read_record,
 )
 
@@ -38,7 +37,7 @@ def run(args):
     )
     res.record_run(
         {"command": "verify", "scenario": sc.as_dict(), "data": str(args.data)},
-        provenance(vars(args), inputs=inputs_of(args)),
+        provenance_of(args),
     )
     with OutputDir(args.out) as out:
         res.write_into(out)
@@ -54,7 +53,7 @@ def run(args):
         print(criteria_line(ev.criteria, ev.noise_floor))
     for note in res.notes:
         print(f"  note: {note}")
-    print(f"outputs in {args.out}/: summary.json, verify.png, verify.pdf")
+    print(outputs_line(args, ["summary.json", "verify.png", "verify.pdf"]))
     return 0
 
 
@@ -64,14 +63,9 @@ def register(sub):
         help="is a law consistent with a record? full simulation, "
         "criteria I0..I4 (force) and I5 (penetration, with positions) against their noise floors",
     )
-    s.add_argument("--scenario", default="paper", help=SCENARIO_HELP)
-    s.add_argument(
-        "--data",
-        required=True,
-        help="CSV with t [s], F [N] (w1, v1, w2, v2 "
-        "recommended: exact onsets and the machine's state)",
-    )
-    s.add_argument("--law", help=LAW_HELP)
+    _options.add_scenario_option(s)
+    _options.add_data_option(s)
+    _options.add_law_option(s)
     add_record_options(s)
     s.add_argument(
         "--time-offset",
@@ -80,22 +74,12 @@ def register(sub):
         help="drive-clock time [s] of the record's t = 0, when the record does not "
         "start at drive phase 0 (default: %(default)g)",
     )
-    s.add_argument(
-        "--n-boot",
-        type=integer(1, 10_000),
-        default=16,
-        help="bootstrap replicates of the noise floor, 1..10000 (default: %(default)s)",
-    )
-    s.add_argument(
-        "--seed",
-        type=integer(0),
-        default=0,
-        help="seed of the bootstrap, >= 0 (default: %(default)s)",
-    )
+    _options.add_n_boot_option(s, help_suffix=", 1..10000")
+    _options.add_seed_option(s, "seed of the bootstrap, >= 0", most=None)
     s.add_argument(
         "--no-default-start",
         action="store_true",
         help="skip the check of the attractor reached from the scenario's initial state",
     )
-    s.add_argument("--out", required=True, help="output directory")
+    _options.add_out_option(s)
     s.set_defaults(func=run)

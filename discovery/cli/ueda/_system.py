@@ -1,5 +1,5 @@
-"""Options and objects every ``vidi ueda`` subcommand shares: the model and its
-parameters, the tolerances."""
+"""Options and objects the ``vidi ueda`` subcommands share: the model and its
+parameters, the forcing, the initial state, the tolerances."""
 
 from ...errors import InputError
 from .._common import number
@@ -36,15 +36,38 @@ def _add_system_options(s, chart=False):
     )
     s.add_argument("--k", type=number(-10, 10), help="linear damping")
     if not chart:
-        s.add_argument("--B", type=number(-1e3, 1e3), help="forcing amplitude")
-        s.add_argument(
-            "--nu", type=number(0, 100, lo_open=True), help="forcing angular frequency, > 0"
-        )
+        _add_forcing_values(s)
     s.add_argument(
         "--rtol",
         type=number(1e-13, 1e-3),
         default=1e-9 if not chart else 1e-6,
         help="integrator tolerance (default: %(default)g)",
+    )
+
+
+def _add_forcing_values(s):
+    """``--B`` and ``--nu``: the forcing B cos(nu t) (default: the model's)."""
+    s.add_argument("--B", type=number(-1e3, 1e3), help="forcing amplitude")
+    s.add_argument("--nu", type=number(0, 100, lo_open=True), help="forcing angular frequency, > 0")
+
+
+def _add_forcing_options(s):
+    """``--model`` (no default) for its forcing, ``--B`` and ``--nu`` (see :func:`_forcing`)."""
+    s.add_argument(
+        "--model",
+        choices=("negres", "duffing"),
+        help="take the forcing B, nu from this model (override with --B, --nu)",
+    )
+    _add_forcing_values(s)
+
+
+def _add_start_options(s):
+    """``--x0`` and ``--v0``: the initial state."""
+    s.add_argument(
+        "--x0", type=number(-1e3, 1e3), default=0.1, help="initial x (default: %(default)g)"
+    )
+    s.add_argument(
+        "--v0", type=number(-1e3, 1e3), default=0.0, help="initial x' (default: %(default)g)"
     )
 
 

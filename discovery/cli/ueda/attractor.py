@@ -2,11 +2,11 @@
 errors, the regime with its evidence, figures (optionally the coexisting attractors from a grid
 of initial states)."""
 
-import numpy as np
-
 from ..._io import OutputDir, provenance
-from .._common import check_out, integer, number
-from ._system import _add_system_options, _system, _tolerances
+from .. import _options
+from .._common import check_out, integer, number, outputs_line
+from . import _record
+from ._system import _add_start_options, _add_system_options, _system, _tolerances
 
 
 def run(args):
@@ -51,7 +51,7 @@ def run(args):
     files = ["summary.json", "attractor.png", "attractor.pdf"]
     with OutputDir(args.out) as out:
         attractor_figure(att, str(out.path("attractor")))
-        np.savetxt(out.path("strobe.csv"), att.strobe, delimiter=",", header="x,v", comments="")
+        _record.write_strobe(out.path("strobe.csv"), att.strobe)
         files.append("strobe.csv")
         if bas is not None:
             basins_figure(bas, str(out.path("basins")))
@@ -66,7 +66,7 @@ def run(args):
     if bas is not None:
         for a in bas.attractors:
             print(f"  attractor {a['regime']}: basin {100 * a['fraction']:.0f} % of the grid")
-    print(f"outputs in {args.out}/: {', '.join(files)}")
+    print(outputs_line(args, files))
     return 0
 
 
@@ -74,12 +74,7 @@ def register(sub):
     """Add ``vidi ueda attractor`` to the ueda subparsers ``sub``."""
     a = sub.add_parser("attractor", help="one attractor: strobe points, exponents, regime, figures")
     _add_system_options(a)
-    a.add_argument(
-        "--x0", type=number(-1e3, 1e3), default=0.1, help="initial x (default: %(default)g)"
-    )
-    a.add_argument(
-        "--v0", type=number(-1e3, 1e3), default=0.0, help="initial x' (default: %(default)g)"
-    )
+    _add_start_options(a)
     a.add_argument(
         "--transient",
         type=integer(0, 10**6),
@@ -111,5 +106,5 @@ def register(sub):
         default=1.0,
         help="the grid of initial states covers [-E, E]^2 (default: %(default)g)",
     )
-    a.add_argument("--out", required=True, help="output directory")
+    _options.add_out_option(a)
     a.set_defaults(func=run)

@@ -7,7 +7,8 @@ import numpy as np
 
 from ..._io import OutputDir, provenance
 from ...errors import InputError
-from .._common import SCHEDULER_HELP, check_out, executor_of, integer, reporter
+from .. import _options
+from .._common import check_out, executor_of, integer, reporter
 from ._system import _add_system_options, _system
 
 
@@ -26,6 +27,17 @@ def _grid(text, option):
             f"{text!r}: need LOW < HIGH (finite) and 1 <= N <= 2000, e.g. 0.8:1.2:200"
         )
     return np.linspace(lo, hi, n)
+
+
+def _add_grid_option(c, option, default, what):
+    """``option`` LOW:HIGH:N, the points of one axis of the chart (see :func:`_grid`)."""
+    c.add_argument(
+        option,
+        type=lambda t: _grid(t, option),
+        default=_grid(default, option),
+        metavar="LOW:HIGH:N",
+        help=f"{what} (default: {default})",
+    )
 
 
 def run(args):
@@ -95,20 +107,8 @@ def register(sub):
     """Add ``vidi ueda chart`` to the ueda subparsers ``sub``."""
     c = sub.add_parser("chart", help="regime chart over (nu, B) in parallel processes")
     _add_system_options(c, chart=True)
-    c.add_argument(
-        "--nu",
-        type=lambda t: _grid(t, "--nu"),
-        default=_grid("0.8:1.2:200", "--nu"),
-        metavar="LOW:HIGH:N",
-        help="forcing frequencies (default: 0.8:1.2:200)",
-    )
-    c.add_argument(
-        "--B",
-        type=lambda t: _grid(t, "--B"),
-        default=_grid("0:0.6:200", "--B"),
-        metavar="LOW:HIGH:N",
-        help="forcing amplitudes (default: 0:0.6:200)",
-    )
+    _add_grid_option(c, "--nu", "0.8:1.2:200", "forcing frequencies")
+    _add_grid_option(c, "--B", "0:0.6:200", "forcing amplitudes")
     c.add_argument(
         "--transient",
         type=integer(0, 10**5),
@@ -138,10 +138,9 @@ def register(sub):
         "the two sweeps end on different attractors (coexisting attractors, "
         "hysteresis); about twice the time (default: off)",
     )
-    c.add_argument("--workers", type=integer(1, 1024), help="processes (default: all cores)")
-    c.add_argument("--scheduler", metavar="ADDR", help=SCHEDULER_HELP)
+    _options.add_parallel_options(c)
     c.add_argument(
         "--progress", action="store_true", help="progress bar even when stderr is not a terminal"
     )
-    c.add_argument("--out", required=True, help="output directory")
+    _options.add_out_option(c)
     c.set_defaults(func=run)

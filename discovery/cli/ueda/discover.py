@@ -6,9 +6,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..._io import OutputDir, provenance
-from .._common import check_out, integer, number
-from ._system import _forcing
+from ..._io import OutputDir
+from .. import _options
+from .._common import check_out, integer, number, outputs_line, provenance_of
+from . import _record
+from ._system import _add_forcing_options, _forcing
 
 
 def run(args):
@@ -51,26 +53,17 @@ def run(args):
         {"command": "ueda discover", "forcing": {"B": B, "nu": nu}},
         {
             "verification": ver.as_dict(),
-            **provenance(vars(args), inputs={"data": args.data}),
+            **provenance_of(args),
         },
         settings_key="discovery_settings",
     )
     with OutputDir(args.out, inputs=[args.data]) as out:
         discover_figure(d, ver, str(out.path("discover")))
-        np.savetxt(
-            out.path("strobe_record.csv"),
-            ver.record_strobe,
-            delimiter=",",
-            header="x,v",
-            comments="",
-        )
-        np.savetxt(
-            out.path("strobe_model.csv"), ver.model_strobe, delimiter=",", header="x,v", comments=""
-        )
+        _record.write_strobe(out.path("strobe_record.csv"), ver.record_strobe)
+        _record.write_strobe(out.path("strobe_model.csv"), ver.model_strobe)
         d.write_into(out)
     print(f"discovered: {d.model.text()}")
-    for k, c in d.coefficients.items():
-        print(f"  {k:>12}: {c: .5f} +- {d.standard_errors[k]:.5f}")
+    _record.print_coefficients(d)
     L = ver.lyapunov
     lyap = f"{L['value']:.4f} +- {L['stderr']:.4f}" if L else "n/a"
     print(
@@ -80,10 +73,8 @@ def run(args):
         f"{ver.regime_model}; model lyapunov {lyap}: "
         f"{'consistent' if ver.consistent else 'INCONSISTENT'}"
     )
-    print(
-        f"outputs in {args.out}/: summary.json, discover.png, discover.pdf, "
-        "strobe_record.csv, strobe_model.csv"
-    )
+    files = ["discover.png", "discover.pdf", "strobe_record.csv", "strobe_model.csv"]
+    print(outputs_line(args, ["summary.json", *files]))
     return 0
 
 
@@ -94,36 +85,16 @@ def register(sub):
         help="recover the equation from a record t, x with "
         "known forcing, and verify it by simulation",
     )
-    d.add_argument("--data", required=True, help="CSV with columns t (uniform) and x")
-    d.add_argument(
-        "--model",
-        choices=("negres", "duffing"),
-        help="take the forcing B, nu from this model (override with --B, --nu)",
-    )
-    d.add_argument("--B", type=number(-1e3, 1e3), help="forcing amplitude")
-    d.add_argument("--nu", type=number(0, 100, lo_open=True), help="forcing angular frequency, > 0")
-    d.add_argument(
-        "--noise",
-        type=number(0, 1),
-        help="known noise sd as a fraction of x's "
-        "range (default: estimated from the smoothing residual)",
-    )
+    _options.add_data_option(d, _record.RECORD_HELP)
+    _add_forcing_options(d)
+    _record.add_noise_option(d)
     d.add_argument(
         "--threshold",
         type=number(0, 1),
         default=0.02,
         help="STLSQ threshold on scaled coefficients (default: %(default)g)",
     )
-    d.add_argument(
-        "--half-width",
-        type=integer(2, 10**4),
-        help="test-window half width in samples (default: a quarter period, at least 7)",
-    )
-    d.add_argument(
-        "--fix-forcing",
-        action="store_true",
-        help="fix the forcing's coefficient at 1 instead of fitting it",
-    )
+    _record.add_weak_form_options(d)
     d.add_argument(
         "--bootstrap",
         type=integer(0, 10**5),
@@ -136,26 +107,6 @@ def register(sub):
         default=4,
         help="bootstrap block length in forcing periods (default: %(default)s)",
     )
-    d.add_argument(
-        "--model-periods",
-        type=integer(50, 10**6),
-        default=2000,
-        help="periods of the discovered model simulated (default: %(default)s)",
-    )
-    d.add_argument(
-        "--transient",
-        type=integer(0, 10**6),
-        default=200,
-        help="periods of the discovered model discarded first (default: %(default)s)",
-    )
-    d.add_argument(
-        "--resamples",
-        type=integer(10, 10**5),
-        default=200,
-        help="random halves for the energy-distance noise floor (default: %(default)s)",
-    )
-    d.add_argument(
-        "--seed", type=integer(0), default=0, help="seed of the resampling (default: %(default)s)"
-    )
-    d.add_argument("--out", required=True, help="output directory")
+    _record.add_verification_options(d, "the discovered model")
+    _options.add_out_option(d)
     d.set_defaults(func=run)

@@ -1,12 +1,12 @@
 """``vidi ueda explain``: the missing-effect workflow: from a start model, name the missing effect
 of this system's catalogue by score tests, add it, refit, and show the gap shrink."""
 
-import numpy as np
-
-from ..._io import OutputDir, provenance
+from ..._io import OutputDir
 from ...errors import InputError
-from .._common import check_out, integer, number
-from ._system import _forcing
+from .. import _options
+from .._common import check_out, outputs_line, provenance_of
+from . import _record
+from ._system import _add_forcing_options, _forcing
 
 
 def run(args):
@@ -46,41 +46,30 @@ def run(args):
     )
     ex.record_run(  # "settings" is provenance's (the options): the method's is "method"
         {"command": "ueda explain", "forcing": {"B": B, "nu": nu}},
-        provenance(vars(args), inputs={"data": args.data}),
+        provenance_of(args),
         settings_key="method",
     )
     with OutputDir(args.out, inputs=[args.data]) as out:
         explain_figure(ex, str(out.path("explain")))
         for name, ver in (("start", ex.start_verification), ("final", ex.final_verification)):
-            np.savetxt(
-                out.path(f"strobe_{name}.csv"),
-                ver.model_strobe,
-                delimiter=",",
-                header="x,v",
-                comments="",
-            )
-        np.savetxt(
-            out.path("strobe_record.csv"),
-            ex.final_verification.record_strobe,
-            delimiter=",",
-            header="x,v",
-            comments="",
-        )
+            _record.write_strobe(out.path(f"strobe_{name}.csv"), ver.model_strobe)
+        _record.write_strobe(out.path("strobe_record.csv"), ex.final_verification.record_strobe)
         ex.write_into(out)
     print(f"start: {ex.start_model.text()}")
     for it in ex.iterations:
         if it.effect:
             print(f"named {it.effect}: {it.evidence['text']}")
     print(f"final: {ex.final_model.text()}")
-    for k, c in ex.coefficients.items():
-        print(f"  {k:>12}: {c: .5f} +- {ex.standard_errors[k]:.5f}")
+    _record.print_coefficients(ex)
     for k, g in ex.gap.items():
         print(f"  gap {k}: {g['before']:.4g} -> {g['after']:.4g} ({g['ratio']:.3g}x)")
     print(f"stopped: {ex.stopped_because}")
-    print(
-        f"outputs in {args.out}/: summary.json, explain.png, explain.pdf, strobe_record.csv, "
-        "strobe_start.csv, strobe_final.csv"
-    )
+    files = [
+        "explain.png",
+        "explain.pdf",
+        *(f"strobe_{n}.csv" for n in ("record", "start", "final")),
+    ]
+    print(outputs_line(args, ["summary.json", *files]))
     return 0
 
 
@@ -92,7 +81,7 @@ def register(sub):
         "(score tests over this system's catalogue), add it, refit, and show "
         "the gap shrink by simulation",
     )
-    e.add_argument("--data", required=True, help="CSV with columns t (uniform) and x")
+    _options.add_data_option(e, _record.RECORD_HELP)
     e.add_argument(
         "--start",
         default="x',x^3",
@@ -101,67 +90,21 @@ def register(sub):
         "alone); x',x^3 is negres without its van der Pol damping x^2 x' "
         "(default: %(default)s)",
     )
-    e.add_argument(
-        "--model",
-        choices=("negres", "duffing"),
-        help="take the forcing B, nu from this model (override with --B, --nu)",
-    )
-    e.add_argument("--B", type=number(-1e3, 1e3), help="forcing amplitude")
-    e.add_argument("--nu", type=number(0, 100, lo_open=True), help="forcing angular frequency, > 0")
+    _add_forcing_options(e)
     e.add_argument(
         "--effects",
         help="catalogue ids to consider, separated by commas "
         "(default: all of van_der_pol_damping, linear_damping, cubic_stiffness, "
         "quadratic_stiffness, velocity_cubic_damping)",
     )
-    e.add_argument(
-        "--alpha",
-        type=number(0, 1, lo_open=True),
-        default=0.01,
-        help="family-wise level of the score tests, Bonferroni (default: %(default)g)",
+    _options.add_effect_search_options(
+        e,
+        alpha_most=1,
+        alpha_help="family-wise level of the score tests, Bonferroni",
+        max_iterations=20,
     )
-    e.add_argument(
-        "--max-iterations",
-        type=integer(0, 20),
-        default=3,
-        help="effects added at most (default: %(default)s)",
-    )
-    e.add_argument(
-        "--noise",
-        type=number(0, 1),
-        help="known noise sd as a fraction of x's "
-        "range (default: estimated from the smoothing residual)",
-    )
-    e.add_argument(
-        "--half-width",
-        type=integer(2, 10**4),
-        help="test-window half width in samples (default: a quarter period, at least 7)",
-    )
-    e.add_argument(
-        "--fix-forcing",
-        action="store_true",
-        help="fix the forcing's coefficient at 1 instead of fitting it",
-    )
-    e.add_argument(
-        "--model-periods",
-        type=integer(50, 10**6),
-        default=2000,
-        help="periods of each model simulated (default: %(default)s)",
-    )
-    e.add_argument(
-        "--transient",
-        type=integer(0, 10**6),
-        default=200,
-        help="periods of each model discarded first (default: %(default)s)",
-    )
-    e.add_argument(
-        "--resamples",
-        type=integer(10, 10**5),
-        default=200,
-        help="random halves for the energy-distance noise floor (default: %(default)s)",
-    )
-    e.add_argument(
-        "--seed", type=integer(0), default=0, help="seed of the resampling (default: %(default)s)"
-    )
-    e.add_argument("--out", required=True, help="output directory")
+    _record.add_noise_option(e)
+    _record.add_weak_form_options(e)
+    _record.add_verification_options(e, "each model")
+    _options.add_out_option(e)
     e.set_defaults(func=run)

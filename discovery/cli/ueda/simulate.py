@@ -4,23 +4,18 @@ import numpy as np
 
 from ..._io import provenance
 from ...errors import InputError
-from .._common import check_out, integer, number
-from ._system import _add_system_options, _system
+from .. import _options
+from .._common import check_record_out, integer, number, write_record
+from ._system import _add_start_options, _add_system_options, _system
 
 
 def run(args):
-    import json
     import time
 
-    from ..._io import atomic_write_text, check_output
     from ...ueda.record import simulate_record
     from ...ueda.simulated_record import SimulatedUedaRecord
 
-    out = check_out(args, kind="file")
-    if out.suffix.lower() != ".csv":
-        raise InputError(f"--out {args.out!r} must name a .csv file, e.g. D.csv")
-    summary_path = out.with_suffix(".summary.json")
-    check_output(summary_path, [], kind="file", option="--out's summary")
+    paths = out, summary_path = check_record_out(args)
     n = args.periods * args.samples_per_period
     if n > 10_000_000:
         raise InputError(
@@ -56,8 +51,7 @@ def run(args):
         integrator=args.integrator,
         seconds=time.perf_counter() - t0,
     ).record_run({"command": "ueda simulate"}, provenance(vars(args)))
-    atomic_write_text(out, csv_text)
-    atomic_write_text(summary_path, json.dumps(summary.to_dict(), indent=2) + "\n")
+    write_record(paths, csv_text, summary)
     print(
         f"wrote {out} ({t.size} samples, {args.periods} periods of {system.model}, "
         f"{args.samples_per_period} samples per period, noise {args.noise:g} of the range) "
@@ -90,19 +84,14 @@ def register(sub):
         help="Gaussian noise on x, standard deviation as a fraction of x's range, "
         "0..1 (default: %(default)g)",
     )
-    m.add_argument("--seed", type=integer(0), default=0, help="noise seed (default: %(default)s)")
+    _options.add_seed_option(m, "noise seed", most=None)
     m.add_argument(
         "--transient",
         type=integer(0, 10**6),
         default=200,
         help="periods discarded before the record (default: %(default)s)",
     )
-    m.add_argument(
-        "--x0", type=number(-1e3, 1e3), default=0.1, help="initial x (default: %(default)g)"
-    )
-    m.add_argument(
-        "--v0", type=number(-1e3, 1e3), default=0.0, help="initial x' (default: %(default)g)"
-    )
+    _add_start_options(m)
     m.add_argument(
         "--integrator",
         choices=("compiled", "scipy"),
@@ -110,9 +99,5 @@ def register(sub):
         help="compiled (Dormand-Prince kernel) or scipy (solve_ivp DOP853, the "
         "independent path) (default: %(default)s)",
     )
-    m.add_argument(
-        "--out",
-        required=True,
-        help="output CSV (columns t, x); the summary goes to OUT.summary.json",
-    )
+    _options.add_out_option(m, "output CSV (columns t, x); the summary goes to OUT.summary.json")
     m.set_defaults(func=run)
