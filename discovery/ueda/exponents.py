@@ -68,9 +68,9 @@ class Lyapunov(Result):
 
         Parameters
         ----------
-        logs : ndarray of shape (n_periods, 2)
-            Logarithmic growth of the two tangent directions over each period.
-        trace : ndarray of shape (n_periods,)
+        logs : ndarray of shape (m, 2)
+            Logarithmic growth of the two tangent directions over each of ``m`` periods.
+        trace : ndarray of shape (m,)
             Integral of the Jacobian's trace over each period.
         period : float
             The forcing period ``T``.
@@ -131,7 +131,7 @@ def batch_stats(per_period, T, batches):
 
     Parameters
     ----------
-    per_period : ndarray of shape (n_periods, ...)
+    per_period : ndarray of shape (m, ...)
         A value per forcing period (logarithmic growths).
     T : float
         The forcing period.
