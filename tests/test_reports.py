@@ -11,6 +11,7 @@ import os
 import re
 import shutil
 import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -667,3 +668,66 @@ def test_the_criteria_table_holds_the_motion_criterion():
     assert criterion_names(crit) == ["I2", "I5"]
     rows = _criteria_table(crit, {"I2": 0.02, "I5": 0.012}, {"I2": 0.054, "I5": 0.0295})
     assert "penetration" in str(rows[1][4]) and "0.0295" in str(rows[1][3])
+
+
+def test_the_limit_rule_names_each_criterion_s_factor():
+    """The criteria sections state the limit with the factor each judged criterion has (2
+    for I2 and I4, 1.25 for I5), as the verdict applies it: not "2 floor" for all."""
+    from discovery.vibroimpact.verify.evaluate import CONSISTENCY_FACTORS
+    from reports.texenv import environment
+
+    text = (
+        environment()
+        .from_string('((* import "macros.tex.j2" as m *))((( m.limit_rule() )))')
+        .render()
+    )
+    assert r"\max(f\," in text and r"\max(2\," not in text
+    for k, f in CONSISTENCY_FACTORS.items():
+        assert f"$f = {f:g}$ for" in text and f"$I_{k[1:]}$" in text
+    for name in ("verify", "fit"):
+        src = (Path(__file__).parents[1] / "reports" / "templates" / f"{name}.tex.j2").read_text()
+        assert "m.limit_rule()" in src and r"\max(2\," not in src
+
+
+def test_explain_s_unloading_term_carries_its_error_and_interval():
+    """The unloading coefficient's standard error and interval (parameter ``d_zd``) are in
+    the final model's table, not "--"."""
+    from reports.vibroimpact.context import _unloading_rows
+
+    fm = {
+        "unloading": {"zd": 4.05e6},
+        "uncertainties": {"z": 3.3e4, "d_zd": 1056.5},
+        "intervals": {"bounds": {"d_zd": [3.99e6, 4.11e6]}},
+    }
+    (row,) = _unloading_rows(fm)
+    assert "unloading" in str(row[0]) and "zeta" in str(row[0])
+    assert "1056" in str(row[2]) or "1.1" in str(row[2])
+    assert "3.990" in str(row[3]) and "4.110" in str(row[3])
+    assert _unloading_rows({}) == []
+
+
+def test_a_contact_models_report_lists_every_record_and_scenario():
+    """A contact-models fit on two records names both records and both scenarios."""
+    from reports.contact_models import contact_models_context
+
+    sc = {"name": "grid-high", "m1": 1e4, "m2": 1e4, "k1": 2.75e7, "c1": 1e5, "A": 5e5}
+    s = {
+        "fits": [],
+        "data": ["high.csv", "low.csv"],
+        "scenario": sc,
+        "scenarios": [sc, {**sc, "name": "grid-low", "A": 3.5e5}],
+    }
+    c = contact_models_context(s, ".")
+    assert [str(r) for r in c["records"]] == ["high.csv", "low.csv"]
+    assert c["scenarios"][0][1:] == ["grid-high", "grid-low"]
+    src = (Path(__file__).parents[1] / "reports/templates/contact_models.tex.j2").read_text()
+    assert "records" in src
+
+
+def test_identify_s_message_is_not_ended_twice():
+    """The optimiser's message ends with a period; the sentence around it is not given a
+    second one ("satisfied..")."""
+    from reports.vibroimpact.context import _identify
+
+    c = _identify({"message": "Both `ftol` and `xtol` conditions are satisfied."}, ".")
+    assert not str(c["message"]).endswith(".")
