@@ -731,3 +731,113 @@ def test_identify_s_message_is_not_ended_twice():
 
     c = _identify({"message": "Both `ftol` and `xtol` conditions are satisfied."}, ".")
     assert not str(c["message"]).endswith(".")
+
+
+def _ns(**kw):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(**kw)
+
+
+def test_verify_figure_names_each_criterion_s_floor_and_limit_apart():
+    """The verify figure's verdict line gives every judged criterion's floor and limit."""
+    from reports.vibroimpact.verify_figures import _criterion_text
+
+    ev = _ns(noise_floor={"I2": 0.0335}, limits={"I2": 0.072})
+    assert _criterion_text("I2", 1.01, ev) == "I2 1.01 (floor 0.034, limit 0.072)"
+    assert _criterion_text("I2", 1.01, _ns(noise_floor={"I2": 0.0335}, limits=None)) == (
+        "I2 1.01 (floor 0.034)"
+    )
+
+
+def test_fit_loop_draws_the_model_above_every_impact_s_samples(tmp_path):
+    """The model's branches (the unloading one runs along the samples near zero force) are
+    drawn above the measured samples of every impact, so none hides them."""
+    import numpy as np
+
+    from reports.vibroimpact import fit_figures
+
+    n = 40
+    up = np.linspace(0, 1e-3, n)
+    zeta = np.concatenate([up, up[::-1]] * 2)
+    dz = np.concatenate([np.full(n, 0.5), np.full(n, -0.5)] * 2)
+    samples = _ns(zeta=zeta, dzeta=dz, F=2e8 * zeta, impact=np.repeat([0, 1], 2 * n))
+    law = lambda z, v: 2e8 * z + 1e6 * np.maximum(v, 0)  # noqa: E731
+    result = _ns(samples=samples, selected=_ns(law=law))
+    drawn = []
+    fit_figures._save = lambda fig, stem: drawn.append(fig)
+    try:
+        fit_figures.fit_loop_figure(result, str(tmp_path / "loop"))
+    finally:
+        fit_figures._save = fit_figures.save
+    (ax,) = drawn[0].axes
+    dots = [ln for ln in ax.lines if ln.get_marker() == "."]
+    model = [ln for ln in ax.lines if ln.get_marker() != "." and len(ln.get_xdata())]
+    assert len(model) == 4 and min(m.get_zorder() for m in model) > max(
+        d.get_zorder() for d in dots
+    )
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "model, impact 0" in labels and "model unloading (dashed)" in labels
+
+
+def test_explain_forces_legend_covers_no_curve():
+    """The legend of explain's force panel sits above every curve (it hid the peak)."""
+    import numpy as np
+
+    from reports._mpl import print_sizes, subplots
+    from reports.vibroimpact.explain_figures import _explain_forces
+
+    t = np.linspace(0, 6e-3, 300)
+    F = 2e6 * np.exp(-t / 1.5e-3) * (t > 2e-4)
+    imp = _ns(t=t, F=F, support=np.array([[2e-4, 5e-3]]))
+    it = _ns(
+        simulated_before=_ns(F=0.9 * F),
+        simulated_after=_ns(F=F),
+        model_before=_ns(law=_ns(names=["z", "zd"])),
+        effect="unloading_damping",
+        criteria_before={"I2": 0.136},
+        criteria_after={"I2": 0.0245},
+        noise_floor={"I2": 0.026},
+    )
+    with print_sizes():  # as explain_figure draws it: one of four panels of the page
+        fig, ax = subplots(figsize=(3.3, 3.0))
+        _explain_forces(ax, it, imp, 1)
+        fig.canvas.draw()
+    box = ax.get_legend().get_window_extent()
+    top = max(ax.transData.transform(np.c_[ln.get_xdata(), ln.get_ydata()])[:, 1].max()
+              for ln in ax.lines)  # fmt: skip
+    assert box.y0 > top
+
+
+def test_identify_figure_names_the_search_value_and_the_final_check_s():
+    """Where the search's criterion and the final check's differ (0.183 against the
+    report's 0.189), the figure names both, not one that contradicts the table."""
+    import numpy as np
+
+    from reports.vibroimpact import figures
+
+    t = np.linspace(0, 6e-3, 50)
+    imp = _ns(t=t, F=1e6 * np.exp(-t / 1e-3), support=np.array([[0.0, 4e-3]]), duration=6e-3)
+    law = _ns(names=["z", "zd"], as_dict=lambda: {"z": 3.7e7, "zd": 5.0e6})
+    result = _ns(
+        law=law,
+        iterations=[
+            {"coefficients": {"z": 4e7, "zd": 5.1e6}, "n_simulations": 1, "value": 0.21},
+            {"coefficients": {"z": 3.7e7, "zd": 5.0e6}, "n_simulations": 3, "value": 0.183},
+        ],
+        criterion="I2",
+        criteria={"I2": 0.183},
+        value=0.183,
+        checks=[_ns(criteria={"I2": 0.189})],
+        n_simulations=46,
+        method="least-squares",
+    )
+    drawn = []
+    figures._save = lambda fig, stem: drawn.append(fig)
+    try:
+        figures.identification_figure(result, imp, [("identified law", imp)], "x")
+    finally:
+        figures._save = figures.save
+    titles = " | ".join(ax.get_title() for ax in drawn[0].axes)
+    assert "0.183 in the search, 0.189 in the final check" in titles
+    assert "F_N converging" not in titles and "0.189 in the final check)" in titles
