@@ -294,7 +294,7 @@ def identification_figure(result, measured, impulses, stem, land=None):
     checked = float(np.mean(done)) if done else value
     both = f" in the search, {checked:.3g} in the final check" if done else ""
     ax.set_title(
-        f"identified: {crit} = {value:.3g}{both}, {result.n_simulations} simulations in all",
+        f"identified: {crit} = {value:.3g}{both}\n{result.n_simulations} simulations in all",
         fontsize=8,
     )
     ax1 = axes[-1]
