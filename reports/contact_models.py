@@ -4,6 +4,7 @@ and which model the record supports and which it cannot tell from it."""
 
 from __future__ import annotations
 
+from .cells import _scenarios_table
 from .lawtex import prose
 from .texenv import Tex, escape, num
 
@@ -51,4 +52,13 @@ def contact_models_context(s, run_dir):
         "conclusions": [prose(s.get("conclusion") or "--")],
         "interval_method": escape((s.get("fit_settings") or {}).get("interval_method", "--")),
         "figures": [],
+        "records": [escape(str(d)) for d in _listed(s.get("data"))],
+        "scenarios": _scenarios_table(s.get("scenarios") or [s.get("scenario")]),
     }
+
+
+def _listed(value):
+    """A field that is one name or a list of them, as a list."""
+    if value is None:
+        return []
+    return list(value) if isinstance(value, list) else [value]

@@ -11,6 +11,7 @@ import os
 import re
 import shutil
 import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -667,3 +668,176 @@ def test_the_criteria_table_holds_the_motion_criterion():
     assert criterion_names(crit) == ["I2", "I5"]
     rows = _criteria_table(crit, {"I2": 0.02, "I5": 0.012}, {"I2": 0.054, "I5": 0.0295})
     assert "penetration" in str(rows[1][4]) and "0.0295" in str(rows[1][3])
+
+
+def test_the_limit_rule_names_each_criterion_s_factor():
+    """The criteria sections state the limit with the factor each judged criterion has (2
+    for I2 and I4, 1.25 for I5), as the verdict applies it: not "2 floor" for all."""
+    from discovery.vibroimpact.verify.evaluate import CONSISTENCY_FACTORS
+    from reports.texenv import environment
+
+    text = (
+        environment()
+        .from_string('((* import "macros.tex.j2" as m *))((( m.limit_rule() )))')
+        .render()
+    )
+    assert r"\max(f\," in text and r"\max(2\," not in text
+    for k, f in CONSISTENCY_FACTORS.items():
+        assert f"$f = {f:g}$ for" in text and f"$I_{k[1:]}$" in text
+    for name in ("verify", "fit"):
+        src = (Path(__file__).parents[1] / "reports" / "templates" / f"{name}.tex.j2").read_text()
+        assert "m.limit_rule()" in src and r"\max(2\," not in src
+
+
+def test_explain_s_unloading_term_carries_its_error_and_interval():
+    """The unloading coefficient's standard error and interval (parameter ``d_zd``) are in
+    the final model's table, not "--"."""
+    from reports.vibroimpact.context import _unloading_rows
+
+    fm = {
+        "unloading": {"zd": 4.05e6},
+        "uncertainties": {"z": 3.3e4, "d_zd": 1056.5},
+        "intervals": {"bounds": {"d_zd": [3.99e6, 4.11e6]}},
+    }
+    (row,) = _unloading_rows(fm)
+    assert "unloading" in str(row[0]) and "zeta" in str(row[0])
+    assert "1056" in str(row[2]) or "1.1" in str(row[2])
+    assert "3.990" in str(row[3]) and "4.110" in str(row[3])
+    assert _unloading_rows({}) == []
+
+
+def test_a_contact_models_report_lists_every_record_and_scenario():
+    """A contact-models fit on two records names both records and both scenarios."""
+    from reports.contact_models import contact_models_context
+
+    sc = {"name": "grid-high", "m1": 1e4, "m2": 1e4, "k1": 2.75e7, "c1": 1e5, "A": 5e5}
+    s = {
+        "fits": [],
+        "data": ["high.csv", "low.csv"],
+        "scenario": sc,
+        "scenarios": [sc, {**sc, "name": "grid-low", "A": 3.5e5}],
+    }
+    c = contact_models_context(s, ".")
+    assert [str(r) for r in c["records"]] == ["high.csv", "low.csv"]
+    assert c["scenarios"][0][1:] == ["grid-high", "grid-low"]
+    src = (Path(__file__).parents[1] / "reports/templates/contact_models.tex.j2").read_text()
+    assert "records" in src
+
+
+def test_identify_s_message_is_not_ended_twice():
+    """The optimiser's message ends with a period; the sentence around it is not given a
+    second one ("satisfied..")."""
+    from reports.vibroimpact.context import _identify
+
+    c = _identify({"message": "Both `ftol` and `xtol` conditions are satisfied."}, ".")
+    assert not str(c["message"]).endswith(".")
+
+
+def _ns(**kw):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(**kw)
+
+
+def test_verify_figure_names_each_criterion_s_floor_and_limit_apart():
+    """The verify figure's verdict line gives every judged criterion's floor and limit."""
+    from reports.vibroimpact.verify_figures import _criterion_text
+
+    ev = _ns(noise_floor={"I2": 0.0335}, limits={"I2": 0.072})
+    assert _criterion_text("I2", 1.01, ev) == "I2 1.01 (floor 0.034, limit 0.072)"
+    assert _criterion_text("I2", 1.01, _ns(noise_floor={"I2": 0.0335}, limits=None)) == (
+        "I2 1.01 (floor 0.034)"
+    )
+
+
+def test_fit_loop_draws_the_model_above_every_impact_s_samples(tmp_path):
+    """The model's branches (the unloading one runs along the samples near zero force) are
+    drawn above the measured samples of every impact, so none hides them."""
+    import numpy as np
+
+    from reports.vibroimpact import fit_figures
+
+    n = 40
+    up = np.linspace(0, 1e-3, n)
+    zeta = np.concatenate([up, up[::-1]] * 2)
+    dz = np.concatenate([np.full(n, 0.5), np.full(n, -0.5)] * 2)
+    samples = _ns(zeta=zeta, dzeta=dz, F=2e8 * zeta, impact=np.repeat([0, 1], 2 * n))
+    law = lambda z, v: 2e8 * z + 1e6 * np.maximum(v, 0)  # noqa: E731
+    result = _ns(samples=samples, selected=_ns(law=law))
+    drawn = []
+    fit_figures._save = lambda fig, stem: drawn.append(fig)
+    try:
+        fit_figures.fit_loop_figure(result, str(tmp_path / "loop"))
+    finally:
+        fit_figures._save = fit_figures.save
+    (ax,) = drawn[0].axes
+    dots = [ln for ln in ax.lines if ln.get_marker() == "."]
+    model = [ln for ln in ax.lines if ln.get_marker() != "." and len(ln.get_xdata())]
+    assert len(model) == 4 and min(m.get_zorder() for m in model) > max(
+        d.get_zorder() for d in dots
+    )
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "model, impact 0" in labels and "model unloading (dashed)" in labels
+
+
+def test_explain_forces_legend_covers_no_curve():
+    """The legend of explain's force panel sits above every curve (it hid the peak)."""
+    import numpy as np
+
+    from reports._mpl import print_sizes, subplots
+    from reports.vibroimpact.explain_figures import _explain_forces
+
+    t = np.linspace(0, 6e-3, 300)
+    F = 2e6 * np.exp(-t / 1.5e-3) * (t > 2e-4)
+    imp = _ns(t=t, F=F, support=np.array([[2e-4, 5e-3]]))
+    it = _ns(
+        simulated_before=_ns(F=0.9 * F),
+        simulated_after=_ns(F=F),
+        model_before=_ns(law=_ns(names=["z", "zd"])),
+        effect="unloading_damping",
+        criteria_before={"I2": 0.136},
+        criteria_after={"I2": 0.0245},
+        noise_floor={"I2": 0.026},
+    )
+    with print_sizes():  # as explain_figure draws it: one of four panels of the page
+        fig, ax = subplots(figsize=(3.3, 3.0))
+        _explain_forces(ax, it, imp, 1)
+        fig.canvas.draw()
+    box = ax.get_legend().get_window_extent()
+    top = max(ax.transData.transform(np.c_[ln.get_xdata(), ln.get_ydata()])[:, 1].max()
+              for ln in ax.lines)  # fmt: skip
+    assert box.y0 > top
+
+
+def test_identify_figure_names_the_search_value_and_the_final_check_s():
+    """Where the search's criterion and the final check's differ (0.183 against the
+    report's 0.189), the figure names both, not one that contradicts the table."""
+    import numpy as np
+
+    from reports.vibroimpact import figures
+
+    t = np.linspace(0, 6e-3, 50)
+    imp = _ns(t=t, F=1e6 * np.exp(-t / 1e-3), support=np.array([[0.0, 4e-3]]), duration=6e-3)
+    law = _ns(names=["z", "zd"], as_dict=lambda: {"z": 3.7e7, "zd": 5.0e6})
+    result = _ns(
+        law=law,
+        iterations=[
+            {"coefficients": {"z": 4e7, "zd": 5.1e6}, "n_simulations": 1, "value": 0.21},
+            {"coefficients": {"z": 3.7e7, "zd": 5.0e6}, "n_simulations": 3, "value": 0.183},
+        ],
+        criterion="I2",
+        criteria={"I2": 0.183},
+        value=0.183,
+        checks=[_ns(criteria={"I2": 0.189})],
+        n_simulations=46,
+        method="least-squares",
+    )
+    drawn = []
+    figures._save = lambda fig, stem: drawn.append(fig)
+    try:
+        figures.identification_figure(result, imp, [("identified law", imp)], "x")
+    finally:
+        figures._save = figures.save
+    titles = " | ".join(ax.get_title() for ax in drawn[0].axes)
+    assert "0.183 in the search, 0.189 in the final check" in titles
+    assert "F_N converging" not in titles and "0.189 in the final check)" in titles

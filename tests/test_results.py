@@ -256,3 +256,12 @@ def test_a_study_round_trips_and_its_summary_is_its_to_dict(tmp_path):
     assert loaded == r and type(r).from_dict(doc) == r
     assert loaded.config.name == "tiny" and loaded.config.varied == r.config.varied
     assert len(loaded.cells) == len(r.cells) and loaded.figures == r.figures and loaded.runs == []
+
+
+def test_a_ranked_model_s_mean_criteria_skip_what_one_record_lacks():
+    """Two records, one judged over its span (with I5), one on the steady orbit (without):
+    the mean over the records has the criteria both have, no KeyError (the demo's fit)."""
+    from discovery.vibroimpact.fit.discovery_result import _mean_over
+
+    assert _mean_over([{"I2": 0.1, "I5": 0.04}, {"I2": 0.3}]) == pytest.approx({"I2": 0.2})
+    assert _mean_over([{"I2": 0.1}, {}]) == {}

@@ -48,8 +48,9 @@ def _verify(s, run_dir):
             f"The law is consistent with the record: every judged criterion is within "
             f"its limit (I2 {crit.get('I2', float('nan')):.3g} against "
             f"{lim.get('I2', float('nan')):.3g}), the limit being what the true law "
-            "scores on records this noisy (twice the noise floor, or the floor plus "
-            "three of its standard deviations, plus 0.005)."
+            "scores on records this noisy (f times the noise floor, f = 2 for I2 and I4 "
+            "and 1.25 for I5, or the floor plus three of its standard deviations, plus "
+            "0.005)."
         )
     else:
         over = [k for k in lim if crit.get(k, 0) > lim[k]]
@@ -245,7 +246,7 @@ def _identify(s, run_dir):
         "method": s.get("method", "--"),
         "criterion": criterion_tex(s.get("criterion", "I2")),
         "n_simulations": s.get("n_simulations", "--"),
-        "message": prose(s.get("message", "")),
+        "message": prose(str(s.get("message", "")).rstrip(".")),  # the template ends it
     }
     concl = [
         f"{s.get('method', '?')} spent {s.get('n_simulations', '?')} simulations; the "
@@ -325,6 +326,21 @@ def _effect_parameter_rows(fm, catalogue):
     return rows
 
 
+def _unloading_rows(fm):
+    """Rows of the unloading branch's terms, with the standard errors and intervals of
+    their coefficients (parameters ``d_<term>``, as the unloading-damping effect names
+    them)."""
+    unl = fm.get("unloading") or {}
+    iv = _intervals(fm)
+    errors = fm.get("uncertainties") or {}
+    return _coef_rows(
+        {f"d_{k}": v for k, v in unl.items()},
+        errors,
+        iv,
+        term=lambda n: Tex("unloading " + term_tex(n[2:], unloading=True)),
+    )
+
+
 def _explain(s, run_dir):
     fm = s.get("final_model") or {}
     its = s.get("iterations") or []
@@ -334,10 +350,7 @@ def _explain(s, run_dir):
         "coefficients": _coef_rows(
             fm.get("coefficients") or {}, fm.get("uncertainties"), _intervals(fm)
         )
-        + [
-            [Tex("unloading " + term_tex(k, unloading=True)), num(v, 4), Tex("--"), Tex("--")]
-            for k, v in (fm.get("unloading") or {}).items()
-        ]
+        + _unloading_rows(fm)
         + _effect_parameter_rows(fm, s.get("catalogue")),
         "effects": [str(e).replace("_", " ") for e in fm.get("effects") or []],
         "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),

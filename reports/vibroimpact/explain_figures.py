@@ -42,7 +42,10 @@ def _explain_forces(ax, iteration, measured, k):
         f"iteration {k}: I2 {i2b:.3g} -> {i2a:.3g}\n(noise floor "
         f"{iteration.noise_floor.get('I2', float('nan')):.2g})",
     )
-    ax.legend(loc="best", framealpha=0.8)
+    # room above the curves for the legend, which then covers none of them
+    lo, hi = ax.get_ylim()
+    ax.set_ylim(lo, hi + 0.55 * (hi - lo))
+    ax.legend(loc="upper right", framealpha=0.8)
 
 
 def _explain_phases(ax, iteration):

@@ -129,9 +129,14 @@ def fit_loop_figure(result, stem, max_impacts=3):
             for branch, style in ((dz > 0, "-"), (dz <= 0, "--")):
                 mm = np.where(branch, model, np.nan)
                 ax.plot(
-                    z * 1e3, mm, style, color=f"C{k}", lw=1.6,
+                    z * 1e3,
+                    mm,
+                    style,
+                    color=f"C{k}",
+                    lw=1.6,
+                    zorder=3,
                     label=f"model, impact {imp}" if style == "-" else None,
-                )  # fmt: skip
+                )  # fmt: skip  (above every impact's samples: the unloading branch near 0)
         ax.plot([], [], "k-", lw=1.6, label="model loading (solid)")
         ax.plot([], [], "k--", lw=1.6, label="model unloading (dashed)")
         ax.set_xlabel(r"penetration $\zeta$ [mm]")

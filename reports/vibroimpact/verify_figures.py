@@ -1,6 +1,8 @@
 """Figures of a verification (``vidi verify``): measured and simulated force over the orbit,
 and the force-penetration loops."""
 
+import textwrap
+
 import numpy as np
 
 from .._mpl import PRINT_WIDTH, figure, save, subplots
@@ -9,6 +11,16 @@ from .figure_parts import contact_view, force_unit, law_math
 __all__ = ["verify_figure", "loops_figure"]
 
 _save = save
+
+
+_JUDGED = ("I2", "I4", "I5")
+
+
+def _criterion_text(k, v, ev):
+    """A judged criterion with its noise floor and its limit, named apart."""
+    floor = (ev.noise_floor or {}).get(k, float("nan"))
+    lim = (ev.limits or {}).get(k)
+    return f"{k} {v:.3g} (floor {floor:.2g}" + (f", limit {lim:.2g})" if lim is not None else ")")
 
 
 def verify_figure(result, stem):
@@ -51,28 +63,26 @@ def verify_figure(result, stem):
             (c.fe[o] - band) * sc,
             (c.fe[o] + band) * sc,
             color="0.85",
-            label=f"measured +-2 sigma/sqrt({E.n_cycles}) noise band",
+            label=rf"measured $\pm 2\sigma/\sqrt{{{E.n_cycles}}}$ noise band",
         )
-        ax.plot(x, c.fe[o] * sc, "k-", lw=1.0, label=f"measured F_E ({E.n_cycles} cycles)")
-        ax.plot(x, c.fn[o] * sc, "C3-", lw=1.0, label=f"simulated F_N ({ev.regime['simulated']})")
+        ax.plot(x, c.fe[o] * sc, "k-", lw=1.0, label=rf"measured $F_E$ ({E.n_cycles} cycles)")
+        ax.plot(
+            x, c.fn[o] * sc, "C3-", lw=1.0, label=rf"simulated $F_N$ ({ev.regime['simulated']})"
+        )
         axr.fill_between(x, -band * sc, band * sc, color="0.85")
         axr.plot(x, (c.fn[o] - c.fe[o]) * sc, "C0-", lw=0.8)
         ax.set_xlim(lo * ms, hi * ms)
     else:
-        ax.plot(E.t * ms, E.F * sc, "k-", lw=1.0, label="measured F_E")
-    crit = ", ".join(
-        f"{k} {v:.3g} (floor {ev.noise_floor.get(k, float('nan')):.2g})"
-        for k, v in ev.criteria.items()
-        if k in ("I2", "I4", "I5")
-    )
+        ax.plot(E.t * ms, E.F * sc, "k-", lw=1.0, label=r"measured $F_E$")
+    crit = ", ".join(_criterion_text(k, v, ev) for k, v in ev.criteria.items() if k in _JUDGED)
+    verdict = f"{'consistent' if ev.consistent else 'INCONSISTENT'}: {crit or ev.status}"
     ax.set_title(
-        f"{law_math(result.law)}\n"
-        f"{'consistent' if ev.consistent else 'INCONSISTENT'}: {crit or ev.status}",
+        f"{law_math(result.law)}\n" + textwrap.fill(verdict, 72),
         fontsize=8,
     )
     ax.set_ylabel(f"contact force F [{unit}]")
     ax.legend(fontsize=7, loc="best", framealpha=0.8)
-    axr.set_ylabel(f"F_N - F_E [{unit}]")
+    axr.set_ylabel(f"$F_N - F_E$ [{unit}]")
     axr.set_xlabel("time since the contact's start [ms] (folded)")
     axr.axhline(0.0, color="k", lw=0.5)
     fig.tight_layout()

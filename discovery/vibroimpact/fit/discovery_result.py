@@ -19,11 +19,14 @@ __all__ = ["RankedModel", "DiscoveryResult"]
 
 
 def _mean_over(dicts):
-    """The key-wise mean of ``dicts`` over the first one's keys (empty unless every one has
-    entries)."""
+    """The key-wise mean of ``dicts`` over the keys every one has (empty unless every one has
+    entries): a record judged on its steady orbit has no I5 where another, judged over its
+    span, has one, and a mean over the records has none."""
     if not all(dicts):
         return {}
-    return {k: float(np.mean([d[k] for d in dicts])) for k in dicts[0]}
+    return {
+        k: float(np.mean([d[k] for d in dicts])) for k in dicts[0] if all(k in d for d in dicts)
+    }
 
 
 def _loaded_evaluations(d):

@@ -523,7 +523,8 @@ def _span_steady_state(scenario, law, reference, sim, reg, *, tolerances, steady
 
 
 def _transient_notes(transient_mismatch, settled, transient, reg, ss):
-    """What the verdict says about a record still in a transient under this law."""
+    """What the verdict says when the law's trajectory from the measured state is still in a
+    transient over the record's span (the law's, not the record's)."""
     notes = []
     if transient_mismatch:
         what = (
@@ -533,15 +534,15 @@ def _transient_notes(transient_mismatch, settled, transient, reg, ss):
         )
         gap = "" if transient is None else f" (I2 {transient:.3g} from its steady orbit)"
         notes.append(
-            f"the record reads {reg['measured']} but is still in a transient under "
-            f"this law: from the measured state its trajectory{gap} {what}; the law "
+            f"the record reads {reg['measured']}, but this law's trajectory from the "
+            f"measured state is still in a transient: it{gap} {what}; the law "
             "is judged against the record's own span"
         )
     elif not settled and transient is not None:
         notes.append(
-            f"the record is still in a transient under this law (I2 {transient:.3g} "
-            "between its trajectory over the last cycles and its steady orbit); "
-            "judged against the record's own span"
+            "this law's trajectory from the measured state is still in a transient "
+            f"(I2 {transient:.3g} between it over the last cycles and the law's steady "
+            "orbit); the law is judged against the record's own span"
         )
     return notes
 
