@@ -80,8 +80,11 @@ test-slow: install
 test-all: install
 	$(PYTEST)
 
+# make bench also appends its run to docs/_measured/bench-history.jsonl and writes its scaling
+# section to docs/_measured/scaling-bench.jsonl, then renders the tables made from them.
 bench: install
 	cd bench && ../$(BIN)/python run.py
+	$(BIN)/python -m tests.tables
 
 # The measured tables of docs/validation.md and the README, rendered between their
 # <!-- table:NAME --> markers from the surveys' saved runs in docs/_measured/ (seconds; each

@@ -25,6 +25,11 @@ Writes ``bench/results.json``.  Figures:
    wall time (and the 200x200 extrapolation), the duffing exponent per period against scipy.
 9. how parallel work scales (``bench/scaling_bench.py``): a 24-run study and ``explain`` on
    1, 2 and every core, with the study's parallel efficiency.
+
+Each run is also saved for the documentation's tables (``make tables``): appended as a row to
+``docs/_measured/bench-history.jsonl`` (``tests/bench_history.py``; ``python run.py kernel``
+appends its kernel-only run too) and its scaling section written to
+``docs/_measured/scaling-bench.jsonl`` (``tests/bench_scaling.py``).
 """
 
 import json
@@ -44,6 +49,36 @@ from discovery.vibroimpact.fit.identification import METHODS, identify
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import load_scenario
 from discovery.vibroimpact.verify.criteria_landscape import landscape
+
+ROOT = Path(__file__).resolve().parent.parent
+MEASURED = ROOT / "docs" / "_measured"
+_PROVENANCE = ("versions", "git", "platform", "created", "settings")
+
+
+def _saved_runs():
+    """``tests.bench_history`` and ``tests.bench_scaling``: they keep the runs the
+    documentation's tables are rendered from."""
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from tests import bench_history, bench_scaling
+
+    return bench_history, bench_scaling
+
+
+def save_history(results):
+    """Append the runs of ``results`` (a results file's dict) to the bench history."""
+    history, _ = _saved_runs()
+    for run in history.append(json.loads(json.dumps(to_jsonable(results)))):
+        print(f"added the run at {history.label(run)} to {history.PATH.relative_to(ROOT)}")
+
+
+def save_scaling(scaling, prov, path, command, append=False):
+    """Write the scaling section ``scaling`` with the run's provenance ``prov`` as a row of
+    the run file ``path`` (``docs/_measured/scaling*.jsonl``: the scaling table's rows)."""
+    _, bench_scaling = _saved_runs()
+    row = json.loads(json.dumps(to_jsonable({**scaling, **prov})))
+    bench_scaling.write_run(path, row, command, append=append)
+    print(f"wrote {path}")
 
 
 def _best(f, repeat=5):
@@ -359,6 +394,7 @@ def main_kernel():
     results["kernel_vs_scipy_provenance"] = provenance({"scenario": "paper"})
     path.write_text(json.dumps(to_jsonable(results), indent=2) + "\n")
     _print_kernel(k)
+    save_history(results)
     return 0
 
 
@@ -483,12 +519,19 @@ def main():
     )
     print_scaling(results["scaling"])
     print("wrote bench/results.json")
+    save_history(results)
+    prov = {k: results[k] for k in _PROVENANCE}
+    path = MEASURED / "scaling-bench.jsonl"
+    save_scaling(results["scaling"], prov, path, "make bench (cd bench && python run.py)")
     return 0
 
 
 def main_scaling(argv):
-    """``python run.py scaling [--workers 1,2,16] [--paper-study] [--out FILE]``: the scaling
-    section alone (written to FILE, default bench/scaling.json)."""
+    """``python run.py scaling [--workers 1,2,16] [--paper-study] [--out FILE [--append]]``:
+    the scaling section alone, written to FILE (default bench/scaling.json); a FILE ending
+    in ``.jsonl`` is a run file of the scaling table's rows (``--out
+    ../docs/_measured/scaling-NAME.jsonl``, then ``make tables``; ``--append`` adds the row
+    to it instead of replacing it)."""
     import argparse
 
     from scaling_bench import bench_scaling, print_scaling, worker_counts
@@ -498,19 +541,24 @@ def main_scaling(argv):
     ap.add_argument("--study-workers", help="the study's worker counts (default: --workers)")
     ap.add_argument("--paper-study", action="store_true", help="also the 120-run paper study")
     ap.add_argument("--out", default=str(Path(__file__).with_name("scaling.json")))
+    ap.add_argument("--append", action="store_true", help="add the row to a .jsonl --out")
     a = ap.parse_args(argv)
+    if a.append and not a.out.endswith(".jsonl"):
+        ap.error("--append needs a .jsonl --out (a run file of the scaling table's rows)")
     sc = load_scenario("paper")
     steady_state(sc, sc.law)  # compile / load the cached kernels first
-    res = {
-        **bench_scaling(
-            worker_counts(a.workers),
-            paper_study=a.paper_study,
-            study_counts=worker_counts(a.study_workers) if a.study_workers else None,
-        ),
-        **provenance({"scenario": "paper"}),
-    }
-    Path(a.out).write_text(json.dumps(to_jsonable(res), indent=2) + "\n")
-    print_scaling(res)
+    scaling = bench_scaling(
+        worker_counts(a.workers),
+        paper_study=a.paper_study,
+        study_counts=worker_counts(a.study_workers) if a.study_workers else None,
+    )
+    prov = provenance({"scenario": "paper"})
+    print_scaling(scaling)
+    if a.out.endswith(".jsonl"):
+        command = " ".join(["cd bench && python run.py scaling", *argv])
+        save_scaling(scaling, prov, a.out, command, append=a.append)
+        return 0
+    Path(a.out).write_text(json.dumps(to_jsonable({**scaling, **prov}), indent=2) + "\n")
     print(f"wrote {a.out}")
     return 0
 

@@ -28,9 +28,10 @@ def git(*args):
     return out.stdout.strip()
 
 
-def stamp(survey, argv=None):
-    """The header of a run started now: the survey, its command, the commit (with
-    ``+dirty`` when the package's source differs from it) and the code version."""
+def stamp(survey, argv=None, command=None):
+    """The header of a run started now: the survey, its command (``python -m
+    tests.SURVEY ARGV`` unless ``command`` says otherwise), the commit (with ``+dirty`` when
+    the package's source differs from it) and the code version."""
     from discovery.vibroimpact.studies.driver import code_version
 
     commit = git("rev-parse", "--short", "HEAD")
@@ -39,7 +40,7 @@ def stamp(survey, argv=None):
     argv = sys.argv[1:] if argv is None else argv
     return {
         "survey": survey,
-        "command": " ".join(["python -m", f"tests.{survey}", *argv]),
+        "command": command or " ".join(["python -m", f"tests.{survey}", *argv]),
         "commit": commit,
         "code": code_version(),
         "started": dt.datetime.now(dt.UTC).strftime("%Y-%m-%dT%H:%MZ"),
@@ -48,15 +49,17 @@ def stamp(survey, argv=None):
 
 class RunFile:
     """A run file being written: the header first (a new file replaces an old one, or
-    ``append`` continues it), then each row as soon as it is made."""
+    ``append`` continues it; ``header``'s items are added to it, such as the machine), then
+    each row as soon as it is made."""
 
-    def __init__(self, path, survey, argv=None, append=False):
+    def __init__(self, path, survey, argv=None, append=False, command=None, **header):
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         fresh = not (append and self.path.exists() and self.path.stat().st_size)
         if fresh:
             with open(self.path, "w") as fh:
-                print(json.dumps({"run": stamp(survey, argv)}), file=fh, flush=True)
+                run = {**stamp(survey, argv, command), **header}
+                print(json.dumps({"run": run}), file=fh, flush=True)
 
     def write(self, row):
         with open(self.path, "a") as fh:

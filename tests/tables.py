@@ -18,7 +18,15 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import measured, realistic_survey, survey_advise, survey_corpus, survey_intervals
+from . import (
+    bench_history,
+    bench_scaling,
+    measured,
+    realistic_survey,
+    survey_advise,
+    survey_corpus,
+    survey_intervals,
+)
 
 ROOT = measured.ROOT
 
@@ -28,13 +36,17 @@ class Table:
     """A measured table: its page, header lines, and its rows, each a label and the glob
     patterns of its run files in ``docs/_measured/`` (read in the order the runs started,
     a later run's row of a record replacing an earlier one) that ``read`` gathers and
-    ``row(rows, label)`` turns into a markdown row."""
+    ``row(rows, label)`` turns into a markdown row (or a list of them).  A table whose
+    columns come from its runs has ``header(rows)`` instead of fixed lines (``rows``: every
+    row of its run files, as ``read`` gives them), and ``stamp(files, rows)`` its own line
+    under it (naming what the columns are made from)."""
 
     page: str
-    header: tuple
+    header: object
     rows: tuple
     row: object
     read: object
+    stamp: object = None
 
 
 def _rows(paths):
@@ -50,6 +62,9 @@ _INTERVAL_RUNS = {
 
 #: the corpus's two tables, one row per record (a later run of a record replaces its row)
 _CORPUS_RUNS = ("corpus*.jsonl",)
+
+#: the scaling bench on each machine (a later run on as many cores replaces its rows)
+_SCALING_RUNS = ("scaling*.jsonl",)
 
 TABLES = {
     "intervals": Table(
@@ -151,6 +166,23 @@ TABLES = {
         row=realistic_survey.markdown_row,
         read=_rows,
     ),
+    # make bench's runs as columns, the last few (tests/bench_history.py)
+    "bench-history": Table(
+        page="docs/validation.md",
+        header=bench_history.header,
+        rows=tuple((label, ("bench-history*.jsonl",)) for label in bench_history.ROWS),
+        row=bench_history.markdown_row,
+        read=bench_history.read_rows,
+        stamp=bench_history.stamp,
+    ),
+    "scaling": Table(
+        page="docs/validation.md",
+        header=bench_scaling.header,
+        rows=((bench_scaling.STUDY, _SCALING_RUNS), (bench_scaling.EXPLAIN, _SCALING_RUNS)),
+        row=bench_scaling.markdown_row,
+        read=bench_scaling.read_rows,
+        stamp=bench_scaling.stamp,
+    ),
 }
 
 
@@ -180,13 +212,16 @@ def _stamp(files):
 def render(name):
     """The lines of table ``name`` between its markers (without indentation)."""
     table = TABLES[name]
-    lines = list(table.header)
     files = []
+    for _, patterns in table.rows:
+        files += [p for p in run_files(patterns) if p not in files]
+    everything = table.read(files) if callable(table.header) or table.stamp else None
+    lines = list(table.header(everything) if callable(table.header) else table.header)
     for label, patterns in table.rows:
-        paths = run_files(patterns)
-        lines.append(table.row(table.read(paths), label))
-        files += [p for p in paths if p not in files]
-    return [*lines, "", _stamp(files)]
+        row = table.row(table.read(run_files(patterns)), label)
+        lines += [row] if isinstance(row, str) else list(row)
+    stamp = table.stamp(files, everything) if table.stamp else _stamp(files)
+    return [*lines, "", stamp]
 
 
 def _block(name):

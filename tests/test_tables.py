@@ -2,6 +2,7 @@
 saved survey runs (``docs/_measured/``), so they cannot go stale, and each names the commit
 and date of the runs that made it."""
 
+import json
 import re
 
 import pytest
@@ -29,6 +30,8 @@ def test_every_marked_table_has_a_definition_and_one_page():
 
 def test_each_table_names_the_commit_and_date_of_its_runs():
     for name, table in tables.TABLES.items():
+        if table.stamp:  # its own line: the tests of its module below
+            continue
         stamp = tables.render(name)[-1]
         for _, patterns in table.rows:
             for path in tables.run_files(patterns):
@@ -85,3 +88,119 @@ def test_the_corpus_tables_have_a_row_per_record_of_their_run():
     assert survey_corpus._law_cell(row, floors=True) == "consistent (I2 0.027, floor 0.025)"
     assert survey_corpus._scaled_cell(row) == "3 of 4 inconsistent (zd x0.7 not)"
     assert survey_corpus._explain_cell(row) == "nothing named"
+
+
+# --------------------------------------------------------------------------- make bench's
+
+
+def _results(commit, created, **sections):
+    """A results file of ``bench/run.py`` with ``sections``."""
+    return {
+        **sections,
+        "cores": 2,
+        "versions": {"python": "3.11"},
+        "git": {"commit": commit * 40, "dirty": False},
+        "platform": "test",
+        "created": created,
+        "settings": {},
+    }
+
+
+def test_the_speed_history_names_each_columns_commit_and_date():
+    from tests import bench_history
+
+    table = tables.TABLES["bench-history"]
+    runs = bench_history.read_rows(tables.run_files(table.rows[0][1]))
+    cols = bench_history.columns(runs)
+    lines = tables.render("bench-history")
+    assert 0 < len(cols) <= bench_history.COLUMNS and cols[-1] is runs[-1]
+    assert lines[0] == "| figure | " + " | ".join(bench_history.label(r) for r in cols) + " |"
+    for r in cols:
+        assert f"{bench_history.label(r)} ({r['created'][:10]}" in lines[-1]
+    assert all(r["created"] and (r["commit"] or r["saved_in"]) for r in runs)
+
+
+def test_the_speed_history_holds_every_run_bench_results_saved():
+    """Every run of every committed bench/results.json is a row of bench-history.jsonl."""
+    from tests import bench_history
+
+    if not measured.git("rev-parse", "HEAD"):
+        pytest.skip("not a git checkout")
+    saved = {bench_history.key(r) for r in measured.read(bench_history.PATH)[1]}
+    assert {bench_history.key(r) for r in bench_history.from_git()} <= saved
+
+
+def test_a_kernel_run_after_the_bench_is_a_run_of_its_own(tmp_path):
+    """python run.py kernel's figures (with their own provenance) are a partial run; make
+    bench's append adds each run once; a partial run measured again by the next one is not
+    a column; a figure a run lacks is a blank cell."""
+    from tests import bench_history as h
+
+    kernel = {"speedup": 44.4, "long_run_40_periods_speedup": 60.5}
+    full = _results(
+        "a",
+        "2026-01-01T00:00:00+00:00",
+        kernel_vs_scipy=kernel,
+        start_up={"vidi_help_seconds": 0.1326},
+        explain={"seconds": 7.07, "ratio_to_one_steady_state": 604.4, "parallel_speedup": 1.258},
+    )
+    path = tmp_path / "history.jsonl"
+    assert [r["commit"] for r in h.append(full, path)] == ["aaaaaaa"]
+    again = {**full, "kernel_vs_scipy": {**kernel, "speedup": 70.0}}
+    for commit, created in (("b", "2026-01-02T00:00:00+00:00"), ("c", "2026-01-03T00:00:00+00:00")):
+        again["kernel_vs_scipy_provenance"] = _results(commit, created)
+        new = h.append(again, path)
+        assert [(r["commit"], r["partial"], r["sections"]) for r in new] == [
+            (f"{commit * 7}", True, ["kernel_vs_scipy"])
+        ]
+    assert h.append(again, path) == []
+    runs = h.read_rows([path])
+    assert [r["commit"] for r in runs] == ["aaaaaaa", "bbbbbbb", "ccccccc"]
+    assert [h.label(r) for r in h.columns(runs)] == ["aaaaaaa", "ccccccc"]
+    assert h.header(runs)[0] == "| figure | aaaaaaa | ccccccc |"
+    assert h.markdown_row(runs, "`vidi --help`") == "| `vidi --help` | 0.13 s |  |"
+    assert h.markdown_row(runs, "`explain`, full catalogue").endswith("| 7.1 s, 604 x |  |")
+    assert "| 44x / 60x | 70x / 60x |" in h.markdown_row(
+        runs, "kernel vs scipy at equal accuracy, one period / 40 periods"
+    )
+    assert h.markdown_row(runs, "Ueda chart 60x60") == "| Ueda chart 60x60 |  |  |"
+
+
+def test_a_scaling_run_adds_its_machines_rows(tmp_path):
+    """A scaling run file (as run.py scaling --out FILE.jsonl writes it) is headed by its
+    command, commit and machine; the table has a row per machine and work, a later run on as
+    many cores replacing an earlier one, and a column per worker count measured."""
+    from tests import bench_scaling as s
+
+    def result(cores, study, explain):
+        return {
+            "cores": cores,
+            "study": {"runs": 24, "by_workers": study, "same_table": True},
+            "explain": {"by_workers": explain, "named": [], "same_named": True},
+        }
+
+    def saved(name, result):  # a run file of an earlier run
+        path = tmp_path / name
+        path.write_text('{"run": {"started": "2000-01-01"}}\n' + json.dumps(result) + "\n")
+        return path
+
+    explain = [{"workers": 1, "seconds": 10.0}, {"workers": 4, "seconds": 5.0}]
+    old = saved("scaling-old.jsonl", result(4, [], explain))
+    big = saved("scaling-big.jsonl", result(32, [], [{"workers": 32, "seconds": 2.0}]))
+    path = tmp_path / "scaling-new.jsonl"
+    study = [{"workers": 4, "seconds": 120.4, "parallel_efficiency": 0.9}]
+    s.write_run(path, result(4, study, explain), "cd bench && python run.py scaling")
+    header, rows = measured.read(path)
+    assert header["command"] == "cd bench && python run.py scaling" and header["started"]
+    assert header["cores"] == rows[0]["cores"] == 4 and "code" in header
+
+    files = [old, big, path]
+    runs = s.read_rows(files)
+    assert [r["cores"] for r in runs] == [32, 4]
+    assert s.header(runs)[0] == "| work | machine | 1 worker | 4 | 32 |"
+    assert s.markdown_row(runs, s.STUDY)[1].endswith(
+        "| 4 cores" + (f", {s.cpu_model()}" if s.cpu_model() else "") + " |  | 120 s (0.90) |  |"
+    )
+    assert s.markdown_row(runs, s.EXPLAIN)[1].endswith("| 10.0 s | 5.0 s (2.00x) |  |")
+    stamp = s.stamp(files, runs)
+    assert "scaling-old.jsonl" not in stamp and "`scaling-new.jsonl` (" in stamp
