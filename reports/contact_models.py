@@ -4,6 +4,9 @@ and which model the record supports and which it cannot tell from it."""
 
 from __future__ import annotations
 
+from discovery._text import records as the_records
+from discovery._text import verb
+
 from .cells import _scenarios_table
 from .lawtex import prose
 from .texenv import Tex, escape, num
@@ -46,8 +49,10 @@ def _rows(fits, selected):
 
 def contact_models_context(s, run_dir):
     """The template context (``contact_models.tex.j2``)."""
+    n = s.get("n_records") or len(_listed(s.get("data"))) or 1
     return {
         "title": "The named contact models against a record",
+        "supports": f"{the_records(n)} {verb(n, 'supports', 'support')}",
         "rows": _rows(s.get("fits") or [], s.get("selected")),
         "conclusions": [prose(s.get("conclusion") or "--")],
         "interval_method": escape((s.get("fit_settings") or {}).get("interval_method", "--")),

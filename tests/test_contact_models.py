@@ -443,3 +443,32 @@ def test_the_survey_closes_the_loop_on_one_record():
     assert 0.5 * sc["A"] <= A <= 2 * sc["A"] and 0.7 * sc["frequency"] <= f <= 1.4 * sc["frequency"]
     assert S.settled(row, "advised") and not S.settled(row, "none")
     assert S.final(row, "advised")[0] == "hunt-crossley"
+
+
+def test_the_conclusion_follows_the_number_of_records(tmp_path):
+    """Two records "support" a model (not "the record supports"), and the sentence ends."""
+    fit = ContactFit(
+        model="kelvin-voigt",
+        parameters={"k": 2e8, "c": 4e6},
+        intervals={},
+        criteria={"I2": 0.01},
+        value=0.01,
+        consistent=True,
+        law="2e8*z + 4e6*zd",
+    )
+    hc = ContactFit(**{**fit.__dict__, "model": "hunt-crossley"})
+    two = ContactModelsResult(
+        fits=(fit, hc), selected="kelvin-voigt", equivalent=("hunt-crossley",), n_records=2
+    )
+    assert two.conclusion.startswith("The 2 records support kelvin-voigt; they cannot tell")
+    assert two.conclusion.endswith(".") and not two.conclusion.endswith("..")
+    assert ContactModelsResult.from_dict(two.to_dict()) == two
+    one = ContactModelsResult(fits=(fit,), selected="kelvin-voigt")
+    assert one.conclusion == "The record supports kelvin-voigt."
+    none = ContactModelsResult(fits=(fit,), selected=None, n_records=2)
+    assert "consistent with all 2 records" in none.conclusion
+    assert none.conclusion.endswith(".")
+    from reports.document import render
+
+    tex = render({**two.to_dict(), "command": "fit"}, tmp_path)
+    assert "the model the 2 records support." in tex and "The 2 records support" in tex

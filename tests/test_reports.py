@@ -841,3 +841,22 @@ def test_identify_figure_names_the_search_value_and_the_final_check_s():
     titles = " | ".join(ax.get_title() for ax in drawn[0].axes)
     assert "0.183 in the search, 0.189 in the final check" in titles
     assert "F_N converging" not in titles and "0.189 in the final check)" in titles
+
+
+def test_conclusions_follow_the_number_of_records():
+    """A fit of two records says the records hold an effect (not "the record holds"); one
+    record keeps the singular."""
+    from reports.vibroimpact.context import _fit
+
+    s = {
+        "selected": {"coefficients": {"z": 2e8}, "terms": ["z"], "consistent": False},
+        "fit_settings": {"library": "poly:2"},
+        "records": [{"data": "high.csv"}, {"data": "low.csv"}],
+        "equivalent": [{"law": "2e8*z"}],
+    }
+    text = " ".join(_fit(s, ".")["conclusions"])
+    assert "all 2 records" in text and "the 2 records hold an effect" in text
+    assert "the record holds" not in text and "this record" not in text
+    assert "fit the 2 records as well within their noise" in text
+    one = " ".join(_fit({**s, "records": [{"data": "high.csv"}]}, ".")["conclusions"])
+    assert "the record holds an effect" in one and "from this record" in one

@@ -4,6 +4,9 @@ written from the numbers."""
 
 from __future__ import annotations
 
+from discovery._text import records as the_records
+from discovery._text import verb
+
 from ..cells import (
     _DOMAIN,
     _coef_rows,
@@ -97,7 +100,7 @@ def _selected_conclusions(s):
     terms = sel.get("terms") or list((sel.get("coefficients") or {}).keys())
     lib = (s.get("fit_settings") or {}).get("library", "?")
     n_rec = len(s.get("records") or []) or 1
-    records = "the record" if n_rec == 1 else f"all {n_rec} records"
+    records = the_records(n_rec, every=True)
     if sel.get("consistent"):
         concl.append(
             Tex(
@@ -111,7 +114,8 @@ def _selected_conclusions(s):
             Tex(
                 f"From the library \\texttt{{{escape(lib)}}}, the best-supported terms are "
                 f"{_terms_tex(terms)}, but no model of the library is consistent with "
-                f"{records} by full simulation: the record holds an effect these "
+                f"{records} by full simulation: {the_records(n_rec)} "
+                f"{verb(n_rec, 'holds', 'hold')} an effect these "
                 "polynomials do not describe (or the scenario is wrong). "
                 "\\texttt{vidi explain} names the missing effect."
             )
@@ -120,8 +124,9 @@ def _selected_conclusions(s):
     if eq:
         concl.append(
             Tex(
-                f"{len(eq)} other model(s) fit the record as well within its noise (listed "
-                "under Selection). They cannot be told apart from this record; a second "
+                f"{len(eq)} other model(s) fit {the_records(n_rec)} as well within "
+                f"{verb(n_rec, 'its', 'their')} noise (listed under Selection). They cannot "
+                f"be told apart from {verb(n_rec, 'this record', 'these records')}; another "
                 "operating point (another drive amplitude or frequency) or lower noise "
                 "would separate them."
             )
@@ -224,6 +229,7 @@ def _fit(s, run_dir):
         ],
         "warnings": [prose(w) for w in s.get("warnings") or []],
         "scenarios": _scenarios_table(s.get("scenarios") or [s.get("scenario")]),
+        "the_records": the_records(len(s.get("records") or [])),
     }
     c["conclusions"] = _selected_conclusions(s)
     c["figures"] = _figures(run_dir, ["fit_impulse", "fit_surface", "fit_loop"])

@@ -29,6 +29,8 @@ import numpy as np
 
 from ..._printing import readable
 from ..._progress import reports_progress
+from ..._text import records as the_records
+from ..._text import verb
 from ..._validate import Real, params
 from ...errors import InputError, IntegrationError
 from ..data.measurement import Measurement
@@ -139,6 +141,8 @@ class ContactModelsResult:
         the selected one.
     settings : dict
     seconds : float
+    n_records : int
+        How many records were fitted together (the conclusion follows their number).
     """
 
     KIND = "contact-models"  # its kind among the results discovery.load reads
@@ -148,6 +152,7 @@ class ContactModelsResult:
     equivalent: tuple = ()
     settings: dict = field(default_factory=dict)
     seconds: float = 0.0
+    n_records: int = 1
 
     def fit(self, name):
         """The :class:`ContactFit` of a model."""
@@ -166,6 +171,7 @@ class ContactModelsResult:
             "fits": [f.to_dict() for f in self.fits],
             "fit_settings": dict(self.settings),
             "seconds": float(self.seconds),
+            "n_records": int(self.n_records),
             "conclusion": self.conclusion,
         }
 
@@ -177,6 +183,7 @@ class ContactModelsResult:
             equivalent=tuple(d["equivalent"]),
             settings=dict(d["fit_settings"]),
             seconds=float(d["seconds"]),
+            n_records=int(d.get("n_records", 1)),
         )
 
     def save(self, directory):
@@ -191,14 +198,16 @@ class ContactModelsResult:
 
     @property
     def conclusion(self):
-        """One sentence: the model the record supports and those it cannot tell from it."""
+        """One sentence: the model the record(s) support and those they cannot tell from it."""
+        n = self.n_records
         if self.selected is None:
             best = self.fits[0].model if self.fits else "none"
             return (
-                f"No named contact model is consistent with the record (closest: {best}); "
-                "the contact is none of them, try the polynomial library or vidi explain"
+                f"No named contact model is consistent with {the_records(n, every=n > 1)} "
+                f"(closest: {best}); the contact is none of them, try the polynomial library "
+                "or vidi explain."
             )
-        text = f"The record supports {self.selected}"
+        text = f"{the_records(n).capitalize()} {verb(n, 'supports', 'support')} {self.selected}"
         twin = self.same_force
         if twin is not None:
             other, p = twin
@@ -209,11 +218,11 @@ class ContactModelsResult:
         rest = [m for m in self.equivalent if twin is None or m != twin[0]]
         if rest:
             text += (
-                f"; it cannot tell it from {', '.join(rest)} (consistent too: a "
-                "record with impacts at other velocities, e.g. another drive amplitude, "
+                f"; {verb(n, 'it', 'they')} cannot tell it from {', '.join(rest)} (consistent "
+                "too: a record with impacts at other velocities, e.g. another drive amplitude, "
                 "would separate them)"
             )
-        return text
+        return text + "."
 
     @property
     def same_force(self):
@@ -388,6 +397,7 @@ def fit_contact_models(
     ok = [f.model for f in fits if f.consistent]
     selected = ok[0] if ok else None
     return ContactModelsResult(
+        n_records=len(records),
         fits=tuple(fits),
         selected=selected,
         equivalent=tuple(ok[1:]),
