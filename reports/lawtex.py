@@ -201,23 +201,24 @@ def ueda_term_tex(name):
     return Tex(r"\texttt{" + escape(name) + "}")
 
 
+# a term's name (``z``, ``zd``, ``z^2*zd``) or the penetration's (``zeta``) standing alone:
+# not part of a word, a path or a file name (``z.csv``, ``data/z``)
 _TERMISH = re.compile(
-    r"(?<![\w^.])(?:zd|z)(?:\^\d+(?:\.\d+)?)?(?:\*(?:zd|z)(?:\^\d+(?:\.\d+)?)?)*(?![\w^])"
+    r"(?<![\w^./\\-])(?:zeta|(?:zd|z)(?:\^\d+(?:\.\d+)?)?(?:\*(?:zd|z)(?:\^\d+(?:\.\d+)?)?)*)"
+    r"(?![\w^/\\-]|\.\w)"
 )
 _CARET = re.compile(r"\^(-?\d+(?:\.\d+)?)")
 _CODE = re.compile(r"`([^`\n]{1,200})`")
 
 
 def _plain(text):
-    """Escaped text with ``^n`` set as an exponent and term names (with a ``^`` or ``*``)
-    as math."""
+    """Escaped text with ``^n`` set as an exponent and every term name (``zd`` as well as
+    ``z^2``) and ``zeta`` as math, as the tables set them."""
     out, pos = [], 0
     for m in _TERMISH.finditer(text):
         tok = m.group(0)
-        if "^" not in tok and "*" not in tok:
-            continue
         out.append(_carets(text[pos : m.start()]))
-        out.append(term_tex(tok))
+        out.append(Tex(f"${_ZETA}$") if tok == "zeta" else term_tex(tok))
         pos = m.end()
     out.append(_carets(text[pos:]))
     return "".join(out)

@@ -860,3 +860,18 @@ def test_conclusions_follow_the_number_of_records():
     assert "fit the 2 records as well within their noise" in text
     one = " ".join(_fit({**s, "records": [{"data": "high.csv"}]}, ".")["conclusions"])
     assert "the record holds an effect" in one and "from this record" in one
+
+
+def test_prose_typesets_every_term_alike():
+    """In a note, ``zd`` is typeset as the tables set it, as ``z^2`` and ``z*zd`` are (it
+    stayed plain text); a term inside a word, a path or a file name stays text."""
+    from reports.lawtex import prose, term_tex
+
+    note = "moved (zd 3.93e+06 -> 3.17e+06; z^2 1.42e+11; z*zd 9.17e+08)"
+    text = str(prose(note))
+    for t in ("zd", "z^2", "z*zd"):
+        assert str(term_tex(t)) in text
+    assert "zd " not in text and "(zd" not in text
+    assert str(prose("F(zeta, 0) at z = 1")) == r"F($\zeta$, 0) at $\zeta$ = 1"
+    kept = str(prose("record z.csv, data/zd, z-axis, zd\\_max, zebra, `zd`"))
+    assert "$" not in kept and r"\texttt{zd}" in kept
