@@ -13,9 +13,9 @@ from .lawtex import (
     law_equation,
     law_inline,
     law_of,
-    prose,
     term_tex,
     unit_tex,
+    value_tex,
 )
 from .texenv import Tex, escape, num
 
@@ -124,7 +124,12 @@ def _provenance(s, run_dir):
         for k, val in settings.items()
         if k not in ("command", "func", "out", "ueda_command") and val not in (None, False)
     }
-    rows.append(["settings", prose("; ".join(f"{k}={val}" for k, val in shown.items()) or "--")])
+    rows.append(
+        [
+            "settings",
+            Tex("; ".join(escape(k) + "=" + value_tex(val) for k, val in shown.items()) or "--"),
+        ]
+    )
     return rows
 
 

@@ -24,6 +24,7 @@ __all__ = [
     "ueda_equation",
     "ueda_term_tex",
     "prose",
+    "value_tex",
     "unit_tex",
 ]
 
@@ -272,6 +273,32 @@ def prose(text):
         pos = m.end()
     out.append(_plain(text[pos:]))
     return Tex("".join(out))
+
+
+def _as_law(text):
+    """The :class:`ForceLaw` a setting's text writes with its coefficients
+    (``2.06e8*z + 4e6*zd``), or None (a term list, a name, a number)."""
+    from discovery.errors import VidiError
+    from discovery.vibroimpact.model.law import ForceLaw
+
+    if not isinstance(text, str) or "z" not in text or not re.search(r"\d", _CARET.sub("", text)):
+        return None  # a term, a name: no coefficient outside the exponents
+    try:
+        return ForceLaw.parse(text)
+    except (VidiError, TypeError, ValueError):
+        return None
+
+
+def value_tex(value):
+    """A setting's value (a study's design, a run's settings) as LaTeX: a law typeset whole
+    as the report's equations set it (:func:`law_inline`), a list item by item, anything
+    else as :func:`prose`."""
+    if isinstance(value, list | tuple):
+        return Tex(", ".join(value_tex(v) for v in value))
+    law = _as_law(value)
+    if law is not None:
+        return law_inline(law)
+    return prose("" if value is None else str(value))
 
 
 def unit_tex(unit):

@@ -875,3 +875,26 @@ def test_prose_typesets_every_term_alike():
     assert str(prose("F(zeta, 0) at z = 1")) == r"F($\zeta$, 0) at $\zeta$ = 1"
     kept = str(prose("record z.csv, data/zd, z-axis, zd\\_max, zebra, `zd`"))
     assert "$" not in kept and r"\texttt{zd}" in kept
+
+
+def test_a_law_in_the_settings_and_the_study_design_is_typeset_whole():
+    """A law given as a setting (identify's --start, advise's laws, a study's fixed law) is
+    typeset whole, as the report's equations set it: not half math, half text."""
+    from reports.cells import _provenance
+    from reports.lawtex import law_inline, law_of, prose, value_tex
+    from reports.vibroimpact.study_context import _study
+
+    start = "1.5e8*z + 0.9e7*zd"
+    whole = str(law_inline(law_of(start, "start")))
+    row = str(
+        _provenance({"settings": {"start": start, "law": [start, "7.3e9*z^1.5"]}}, ".")[-1][1]
+    )
+    assert f"start={whole}" in row and "*z" not in row and "*$" not in row
+    assert f"law={whole}, " + str(law_inline(law_of("7.3e9*z^1.5", "law"))) in row
+    design = {"varied": {"law": [start]}, "fixed": {"law": start, "library": "z, zd"}}
+    c = _study({"design": design, "cells": [{"law": start, "runs": 0, "recovered": 0}]}, ".")
+    cells = [str(x) for r in c["design"] for x in r] + [str(x) for x in c["cells"][0]]
+    assert whole in cells and f"{whole} (fixed)" in cells and "*z" not in " ".join(cells)
+    assert str(value_tex("z,zd")) == r"$\zeta$,$\dot\zeta_{+}$"  # a term list is no law
+    assert str(value_tex("z^2*zd")) == str(prose("z^2*zd"))  # a term, not a law of 1 z^2 zd
+    assert str(value_tex("linear")) == "linear" and str(value_tex(3)) == "3"

@@ -5,9 +5,7 @@ from __future__ import annotations
 from ..cells import (
     _figures,
 )
-from ..lawtex import (
-    prose,
-)
+from ..lawtex import value_tex
 from ..texenv import Tex, escape, num
 
 
@@ -29,11 +27,11 @@ def _study(s, run_dir):
     c = {
         "title": "Model-term selection study" + (f": {s['name']}" if s.get("name") else ""),
         "design": [
-            [Tex(r"\texttt{" + escape(k) + "}"), prose(", ".join(map(str, v)))]
+            [Tex(r"\texttt{" + escape(k) + "}"), value_tex(v)]
             for k, v in (d.get("varied") or {}).items()
         ]
         + [
-            [Tex(r"\texttt{" + escape(k) + "}"), prose(f"{v} (fixed)")]
+            [Tex(r"\texttt{" + escape(k) + "}"), Tex(value_tex(v) + " (fixed)")]
             for k, v in (d.get("fixed") or {}).items()
         ]
         + [
@@ -62,7 +60,7 @@ def _study(s, run_dir):
         ],
         "cells": [
             [
-                *(prose(str(row.get(f, ""))) for f in varied),
+                *(value_tex(row.get(f, "")) for f in varied),
                 _frac(
                     row["recovered"],
                     row["runs"],
