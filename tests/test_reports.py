@@ -898,3 +898,38 @@ def test_a_law_in_the_settings_and_the_study_design_is_typeset_whole():
     assert str(value_tex("z,zd")) == r"$\zeta$,$\dot\zeta_{+}$"  # a term list is no law
     assert str(value_tex("z^2*zd")) == str(prose("z^2*zd"))  # a term, not a law of 1 z^2 zd
     assert str(value_tex("linear")) == "linear" and str(value_tex(3)) == "3"
+
+
+def test_identify_figure_marks_the_start_at_the_given_values():
+    """The start marker sits at the start values the report lists (1.5e8, 0.9e7), not on
+    the first best-so-far law (the search may first fit the start cycle by cycle)."""
+    import numpy as np
+
+    from reports.vibroimpact import figures
+
+    t = np.linspace(0, 6e-3, 50)
+    imp = _ns(t=t, F=1e6 * np.exp(-t / 1e-3), support=np.array([[0.0, 4e-3]]), duration=6e-3)
+    law = _ns(names=["z", "zd"], as_dict=lambda: {"z": 3.7e7, "zd": 5.0e6})
+    result = _ns(
+        law=law,
+        iterations=[
+            {"coefficients": {"z": 4e7, "zd": 5.1e6}, "n_simulations": 1, "value": 0.21},
+            {"coefficients": {"z": 3.7e7, "zd": 5.0e6}, "n_simulations": 3, "value": 0.183},
+        ],
+        criterion="I2",
+        criteria={"I2": 0.183},
+        value=0.183,
+        checks=[],
+        n_simulations=46,
+        method="least-squares",
+    )
+    drawn = []
+    figures._save = lambda fig, stem: drawn.append(fig)
+    try:
+        figures.identification_figure(result, imp, [], "x", start={"z": 1.5e8, "zd": 0.9e7})
+        figures.identification_figure(result, imp, [], "x")
+    finally:
+        figures._save = figures.save
+    (mark,) = [ln for ln in drawn[0].axes[0].lines if ln.get_label().startswith("start")]
+    assert (mark.get_xdata()[0], mark.get_ydata()[0]) == (1.5e8, 0.9e7)
+    assert not [ln for ln in drawn[1].axes[0].lines if ln.get_label().startswith("start")]

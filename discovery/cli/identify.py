@@ -221,7 +221,9 @@ def run(args):
     with OutputDir(args.out) as out:
         _summary(args, sc, start, ref.impulse, res).write_into(out)
         out.path("iterations.csv").write_text(_iterations_csv(res))
-        identification_figure(res, ref.impulse, imps, str(out.path("identification")), land)
+        identification_figure(
+            res, ref.impulse, imps, str(out.path("identification")), land, start=start
+        )
     _print_result(args, res)
     return 0
 

@@ -199,7 +199,7 @@ def landscape_figure(land, stem, truth=None):
         return _save(fig, stem)
 
 
-def identification_figure(result, measured, impulses, stem, land=None):
+def identification_figure(result, measured, impulses, stem, land=None, start=None):
     """Identification path (Fig. 6), the criterion against the simulations spent, and F_N
     converging to F_E (Fig. 7).
 
@@ -220,6 +220,10 @@ def identification_figure(result, measured, impulses, stem, land=None):
     stem : str
     land : Landscape, optional
         Background contours of the identified criterion (two-term laws).
+    start : ForceLaw or dict, optional
+        The start law the search was given (the values the report lists): marked as the
+        start.  The first best-so-far law is not it when the search first fitted the start
+        cycle by cycle; without ``start`` no start is marked.
     """
     names = list(result.law.names)
     its = list(result.iterations)
@@ -252,7 +256,12 @@ def identification_figure(result, measured, impulses, stem, land=None):
             lw=1,
             label="best law so far",
         )
-        ax.plot(path[0, 0], path[0, 1], "s", mfc="none", mec="r", ms=9, mew=1.5, label="start")
+        if start is not None:
+            given = start if isinstance(start, dict) else start.as_dict()
+            s0 = [float(given[n]) for n in names[:2]]
+            if not np.allclose(s0, path[0, :2]):  # the search began elsewhere: joined dashed
+                ax.plot([s0[0], path[0, 0]], [s0[1], path[0, 1]], ":", color="r", lw=1)
+            ax.plot(*s0, "s", mfc="none", mec="r", ms=9, mew=1.5, label="start (given)")
         final = result.law.as_dict()
         ax.plot(final[names[0]], final[names[1]], "r*", ms=13, mec="k", label="identified")
         ax.set_xlabel(coefficient_label(names[0]))
