@@ -933,3 +933,15 @@ def test_identify_figure_marks_the_start_at_the_given_values():
     (mark,) = [ln for ln in drawn[0].axes[0].lines if ln.get_label().startswith("start")]
     assert (mark.get_xdata()[0], mark.get_ydata()[0]) == (1.5e8, 0.9e7)
     assert not [ln for ln in drawn[1].axes[0].lines if ln.get_label().startswith("start")]
+
+
+@pytest.mark.parametrize("kind", ["verify", "identify"])
+def test_the_data_table_states_the_contacts_per_cycle(runs, kind):
+    """Every command's summary states the record the same way (``Reference.measured``):
+    identify's Data table showed "contacts per cycle --" on a record with contacts."""
+    from reports.cells import _measured_rows
+
+    m = json.loads((runs / kind / "summary.json").read_text())["measured"]
+    assert m["impacts"] >= 1 and m["n_cycles"] >= 1 and "F" in m["noise"]
+    rows = dict((str(k), v) for k, v in _measured_rows(m))
+    assert rows["contacts per cycle"] == m["impacts"]

@@ -131,21 +131,14 @@ def _iterations_csv(res):
     return buf.getvalue()
 
 
-def _summary(args, sc, start, E, res):
+def _summary(args, sc, start, ref, res):
     """``summary.json`` of the command."""
     final = res.checks[0]  # the identified law against the record, with its noise floor
     head = {
         "command": "identify",
         "scenario": sc.as_dict(),
         "data": str(args.data),
-        "measured": {
-            "n_cycles": E.n_cycles,
-            "n_periods": E.n_periods,
-            "noise": E.noise,
-            "threshold": E.threshold,
-            "peak": E.peak,
-            "contact_time": E.contact_time,
-        },
+        "measured": ref.measured(),
         "start": start.as_dict(),
     }
     tail = {
@@ -219,7 +212,7 @@ def run(args):
         )
     imps = _iterate_impulses(sc, start, ref, res)
     with OutputDir(args.out) as out:
-        _summary(args, sc, start, ref.impulse, res).write_into(out)
+        _summary(args, sc, start, ref, res).write_into(out)
         out.path("iterations.csv").write_text(_iterations_csv(res))
         identification_figure(
             res, ref.impulse, imps, str(out.path("identification")), land, start=start

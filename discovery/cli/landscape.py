@@ -94,17 +94,10 @@ def _reference(args, sc):
     ref = Reference.from_measurement(
         meas, sc, time_offset=args.time_offset, n_boot=args.n_boot, seed=args.seed
     )
-    E = ref.impulse
     info = {
         "source": str(args.data),
         "sha256": _sha256(args.data),
-        "n_periods": E.n_periods,
-        "n_cycles": E.n_cycles,
-        "impacts": ref.impacts,
-        "noise": dict(ref.noise),
-        "threshold": E.threshold,
-        "peak": E.peak,
-        "contact_time": E.contact_time,
+        **ref.measured(),
         "time_offset": ref.time_offset,
         "n_boot": ref.n_boot,
         "seed": ref.seed,

@@ -78,6 +78,21 @@ class Reference:
             return int(len(self.cycle.support))
         return int(len(self.impulse.support))
 
+    def measured(self):
+        """What a summary states of the record (its ``measured`` block, which the reports'
+        Data tables read): periods and cycles, contacts per cycle, noise, threshold, peak
+        force and contact time."""
+        E = self.impulse
+        return {
+            "n_periods": E.n_periods,
+            "n_cycles": E.n_cycles,
+            "impacts": self.impacts,
+            "noise": dict(self.noise),
+            "threshold": E.threshold,
+            "peak": E.peak,
+            "contact_time": E.contact_time,
+        }
+
     def shortened(self):
         """The same record compared cycle by cycle: blocks of one cycle, each simulated
         from the state just before it (``None`` without a record span, or when the blocks

@@ -77,20 +77,11 @@ class VerifyResult(Result):
 
     def as_dict(self):
         ev = self.evaluation
-        E = self.reference.impulse
         return {
             "law": self.law.to_text(),
             **ev.as_dict(),
             "noise_floor_q95": ev.noise_floor_q95,
-            "measured": {
-                "n_periods": E.n_periods,
-                "n_cycles": E.n_cycles,
-                "impacts": self.reference.impacts,
-                "noise": {k: v for k, v in self.reference.noise.items()},
-                "threshold": E.threshold,
-                "peak": E.peak,
-                "contact_time": E.contact_time,
-            },
+            "measured": self.reference.measured(),
             "start": {
                 "from": "measured state"
                 if self.reference.start is not None
