@@ -219,3 +219,33 @@ def test_a_transient_verdict_names_the_law_s_trajectory_not_the_record():
     (note,) = _transient_notes(True, False, 0.3, {"measured": "P1", "simulated": "P2"}, None)
     assert "record reads P1, but this law's trajectory" in note
     assert "record is still in a transient" not in note
+
+
+def test_a_verdict_without_i5_states_why(light, light_record, monkeypatch):
+    """A record with positions whose span cannot be simulated from a measured free flight
+    is compared with the law's steady orbit: the verdict says so (it said "the record has
+    no positions, or no free flight", though the record had positions)."""
+    from discovery.vibroimpact.verify import reference
+
+    why = "no free flight of the record ends before its first compared cycle"
+
+    def no_span(*args, **kwargs):
+        kwargs["why"].append(why)
+
+    monkeypatch.setattr(reference, "record_span", no_span)
+    ref = Reference.from_measurement(light_record, light, n_boot=4)
+    assert ref.span is None and ref.noise["zeta"] is not None and ref.no_span == why
+    ev = evaluate(light, light.law, ref)
+    assert ev.comparison == "steady orbit"
+    assert (
+        "I5 (the penetration) not checked: the record was compared with the law's steady "
+        f"orbit, where the penetration is not compared ({why})"
+    ) in ev.verdict
+    assert "no positions" not in ev.verdict
+    # without positions the verdict says just that
+    ch = {k: v for k, v in light_record.channels.items() if k not in ("w1", "w2", "v1", "v2")}
+    bare = Measurement(light_record.t, light_record.F, ch, source="force only")
+    ref = Reference.from_measurement(bare, light, n_boot=4)
+    assert ref.no_span == "the record has no positions"
+    verdict = evaluate(light, light.law, ref).verdict
+    assert verdict.endswith("I5 (the penetration) not checked: the record has no positions")

@@ -339,6 +339,24 @@ def _steady(scenario, law, tolerances, steady_kwargs):
     )
 
 
+def _motion_not_checked(reference, from_state):
+    """Why a record's verdict has no I5: the record was compared with the law's steady
+    orbit, which has no penetration to compare, and why it was (the record has no
+    positions, no usable free flight, or the caller asked for the steady orbit)."""
+    why = getattr(reference, "no_span", "")
+    if not why and reference.noise.get("zeta") is None:
+        why = "the record has no positions"
+    if not why and getattr(reference, "span", None) is not None and not from_state:
+        why = "the steady orbit was asked for"
+    if why == "the record has no positions":
+        return f"{MOTION_CRITERION} (the penetration) not checked: {why}"
+    return (
+        f"{MOTION_CRITERION} (the penetration) not checked: the record was compared with "
+        "the law's steady orbit, where the penetration is not compared"
+        + (f" ({why})" if why else "")
+    )
+
+
 def evaluate(
     scenario,
     law,
@@ -451,10 +469,7 @@ def evaluate(
     only_i4 = _only_i4(same, consistent, crit, lim)
     verdict = _verdict(consistent, reg, imp, crit, fl["mean"], lim=lim)
     if verdict is not None and reference.noise:  # a record, not an exact reference
-        verdict += (
-            f"; {MOTION_CRITERION} (the penetration) not checked: the record has no "
-            "positions, or no free flight to start a simulation from"
-        )
+        verdict += "; " + _motion_not_checked(reference, from_state)
     return Evaluation(
         "ok",
         reg,

@@ -50,6 +50,10 @@ class Reference:
     blocks : tuple of Impulse
         With a span: the measured folded cycle of each of its blocks (the last is
         ``impulse``).
+    no_span : str
+        A record without a span: why (``"the record has no positions"``, ``"no free flight
+        of the record ends before its first compared cycle"``); a law is then compared with
+        its steady orbit, where the penetration (I5) is not compared.
     """
 
     impulse: object
@@ -63,6 +67,7 @@ class Reference:
     span: object = None
     cycle: object = None
     blocks: tuple = ()
+    no_span: str = ""
     _source: object = field(default=None, repr=False, compare=False)
 
     @property
@@ -203,9 +208,17 @@ class Reference:
             noise["zeta"] = estimate_noise(zeta, order=3)
             noise["impact_velocity"] = _impact_velocity(t, zeta, E, T, dt)
         start, t_start, span, cycle, blocks = None, 0.0, None, E, ()
+        why = ["the record has no positions"] if zeta is None else []
+        if not use_state and zeta is not None:
+            why.append("its simulations do not start from the measured states")
         if use_state and zeta is not None:
             span = record_span(
-                measurement, scenario, E, time_offset=time_offset, block_cycles=block_cycles
+                measurement,
+                scenario,
+                E,
+                time_offset=time_offset,
+                block_cycles=block_cycles,
+                why=why,
             )
             if span is None:
                 start, t_start = measurement.state_at_strobe(T, time_offset)
@@ -227,6 +240,7 @@ class Reference:
             span=span,
             cycle=cycle,
             blocks=blocks,
+            no_span="" if span is not None else (why[0] if why else ""),
             _source=(measurement, scenario),
         )
 

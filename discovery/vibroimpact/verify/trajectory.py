@@ -150,7 +150,9 @@ def _block_ranges(M, size):
     return out
 
 
-def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=BLOCK_CYCLES):
+def record_span(
+    measurement, scenario, cycle, *, time_offset=0.0, block_cycles=BLOCK_CYCLES, why=None
+):
     """The span of a record with positions: from its first usable free flight to its end.
 
     Parameters
@@ -163,6 +165,9 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
     time_offset : float
     block_cycles : int
         Cycles per block.
+    why : list, optional
+        Where the span is ``None``, the reason is appended to it (a clause a verdict can
+        state: ``"no free flight ends before its first compared cycle"``).
 
     Returns
     -------
@@ -170,21 +175,28 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
         ``None`` when the record has no free flight to start from or no whole cycle after
         one.
     """
+
+    def none(reason):
+        if why is not None:
+            why.append(reason)
+        return None
+
     ch = measurement.channels
     if "w1" not in ch or "w2" not in ch:
-        return None
+        return none("the record has no positions")
     t, F = measurement.t, measurement.F
     T = scenario.period
     zeta = ch["w1"] - ch["w2"]
     runs = free_flight_runs(t, F, zeta, T, min_fraction=_MIN_FLIGHT)
     if not runs:
-        return None
+        return none("the record has no free flight to start a simulation from")
     td_all = t + time_offset
     W = cycle.duration
     mids = np.array([0.5 * (td_all[a] + td_all[b - 1]) for a, b in runs])
     whole = make_fold(td_all, cycle.onset + time_offset, cycle.n_periods, T, (mids[0], td_all[-1]))
     if whole is None or whole.n_cycles < max(1, int(0.5 * (td_all[-1] - td_all[0]) / W)):
-        return None  # the first flights are too late to use most of the record
+        # the first flights are too late to use most of the record
+        return none("the record's first free flight comes too late to use most of the record")
     sigma = float(estimate_noise(F))
     blocks = []
     for first, count in _block_ranges(whole.n_cycles, max(1, int(block_cycles))):
@@ -192,7 +204,7 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
         # the latest free flight that ends before the block starts
         ok = np.flatnonzero(np.array([td_all[b - 1] for _, b in runs]) <= o)
         if not ok.size:
-            return None
+            return none("no free flight of the record ends before its first compared cycle")
         j = int(ok[-1])
         fold = make_fold(
             td_all, o, cycle.n_periods, T, (o, o + count * W + 0.5 * (td_all[1] - td_all[0]))
@@ -206,7 +218,7 @@ def record_span(measurement, scenario, cycle, *, time_offset=0.0, block_cycles=B
             continue  # no contact in these cycles (a run-up's start): nothing to compare
         blocks.append(blk)
     if not blocks:
-        return None
+        return none("no compared cycle of the record has a contact")
     sigma_z = max(float(estimate_noise(zeta, 3)), POSITION_RESOLUTION * float(np.ptp(zeta)))
     return RecordSpan(blocks=tuple(blocks), sigma_f=sigma, sigma_z=sigma_z)
 
