@@ -190,7 +190,7 @@ def run(args):
         beside = "" if exact else f" (noise floor {land.noise_floor[n]:.3g})"
         print(f"  {n}: minimum {m['value']:.3g}{beside} at ({m['alpha1']:.4g}, {m['alpha2']:.4g})")
     if not exact:
-        print(f"  noise floor under {land.noise_floor_under}")
+        print(f"  noise floor under {land.floor_under}")
     print(outputs_line(args, ["summary.json", "landscape.csv", "landscape.png", "landscape.pdf"]))
     return 0
 

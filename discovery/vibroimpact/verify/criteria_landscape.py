@@ -82,7 +82,8 @@ class Landscape(Result):
         zeros for an exact reference).
     noise_floor_q95 : dict, optional
     noise_floor_under : str
-        The law (or the measured cycle) the floor was computed under.
+        The law (its exact text) or the measured cycle the floor was computed under
+        (:meth:`floor_under` is it to print).
     reference : dict
         What the points were compared with: ``source``, ``exact``, ``regime``,
         ``impacts``, ``start``.
@@ -183,6 +184,15 @@ class Landscape(Result):
             "continuation": self.continuation,
             "messages": self.messages,
         }
+
+    @property
+    def floor_under(self):
+        """What the floor was computed under, to print: a law as every printout writes it
+        (:meth:`ForceLaw.format`, ``2.06e+08*z``), not its exact text (``206000000*z``)."""
+        try:
+            return str(ForceLaw.parse(self.noise_floor_under))
+        except (VidiError, TypeError, ValueError):
+            return self.noise_floor_under
 
     def _lines(self):
         n0, n1 = (len(a) for a in self.axes)
@@ -332,7 +342,7 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
             )
         tried.append((cand.to_text(), ev.status))
     fl = reference.floor_for(reference.impulse)
-    why = "; ".join(f"'{t}' gives {st}" for t, st in tried)
+    why = "; ".join(f"'{ForceLaw.parse(t)}' gives {st}" for t, st in tried)
     return fl["mean"], fl["q95"], f"the measured cycle ({why})"
 
 
