@@ -74,7 +74,7 @@ def test_keyboard_interrupt_in_process(earlier, monkeypatch, capsys):
     def interrupt(*a, **k):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(st, "provenance", interrupt)
+    monkeypatch.setattr(st, "provenance_of", interrupt)
     assert main(["steady", "--out", str(earlier)]) == 130
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("vidi: error: interrupted (Ctrl-C)")
@@ -180,7 +180,7 @@ def test_interrupt_reraised_by_compiled_code_is_an_interrupt(earlier, monkeypatc
         except KeyboardInterrupt as exc:
             raise SystemError("CPUDispatcher returned a result with an exception set") from exc
 
-    monkeypatch.setattr(st, "provenance", compiled)
+    monkeypatch.setattr(st, "provenance_of", compiled)
     assert main(["steady", "--out", str(earlier)]) == 130
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("vidi: error: interrupted (Ctrl-C)")
@@ -249,7 +249,7 @@ def test_out_of_memory_is_one_line_once_the_memory_is_freed(earlier, monkeypatch
         hog = [bytearray(1 << 20)]  # noqa: F841  (a frame holding memory)
         raise MemoryError
 
-    monkeypatch.setattr(st, "provenance", exhaust)
+    monkeypatch.setattr(st, "provenance_of", exhaust)
     assert main(["steady", "--out", str(earlier)]) == 2
     err = capfd.readouterr().err
     assert err.splitlines() == [

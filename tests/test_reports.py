@@ -673,7 +673,7 @@ def test_the_criteria_table_holds_the_motion_criterion():
 def test_the_limit_rule_names_each_criterion_s_factor():
     """The criteria sections state the limit with the factor each judged criterion has (2
     for I2 and I4, 1.25 for I5), as the verdict applies it: not "2 floor" for all."""
-    from discovery.vibroimpact.verify.evaluate import CONSISTENCY_FACTORS
+    from discovery.vibroimpact.verify import CONSISTENCY_FACTORS
     from reports.texenv import environment
 
     text = (

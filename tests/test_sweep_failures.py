@@ -105,15 +105,14 @@ def test_an_attractor_its_own_check_disputes_is_not_a_result(tmp_path, capsys, m
 
     import discovery.ueda as ueda
 
-    real = ueda.attractor
-    where = sys.modules["discovery.ueda.attractor_analysis"]  # the package reads the name from here
+    real = ueda.attractor  # the command reads the package's name
 
     def off(*a, **k):
         att = real(*a, **k)
         lyap = dataclasses.replace(att.lyapunov, sum=att.lyapunov.sum + 0.5)
         return dataclasses.replace(att, lyapunov=lyap)
 
-    monkeypatch.setattr(where, "attractor", off)
+    monkeypatch.setattr(ueda, "attractor", off)
     out = tmp_path / "a"
     argv = ["ueda", "attractor", "--x0", "1000", "--periods", "200", "--transient", "20"]
     assert main([*argv, "--batches", "4", "--out", str(out)]) == 2
