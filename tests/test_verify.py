@@ -249,3 +249,26 @@ def test_a_verdict_without_i5_states_why(light, light_record, monkeypatch):
     assert ref.no_span == "the record has no positions"
     verdict = evaluate(light, light.law, ref).verdict
     assert verdict.endswith("I5 (the penetration) not checked: the record has no positions")
+
+
+def test_a_run_up_whose_first_cycle_begins_inside_its_first_flight_keeps_its_span():
+    """The demo's low-amplitude record (scipy path, from rest): its first whole cycle began
+    inside the first free flight, so no flight ended before the first block and the whole
+    record fell back to the law's steady orbit (no I5).  The compared cycles now begin after
+    the first flight ends; a record that already had its span keeps the same blocks."""
+    from discovery import synthesize
+    from discovery.vibroimpact.verify.trajectory import record_span
+
+    law = ForceLaw.parse("2.06e8*z + 4e6*zd; unloading: 4e6*zd")
+    base = dict(m1=1.0e4, m2=1.0e4, k1=2.75e7, c1=1.0e5, frequency=25.0)
+    low = Scenario(name="grid-low", A=3.5e5, law=law, **base)
+    rec = synthesize(low, law, periods=30, noise=0.01, seed=2, from_rest=True, integrator="scipy")
+    ref = Reference.from_measurement(rec, low, n_boot=4)
+    assert ref.span is not None and ref.span.n_cycles >= 25
+    ends = []
+    span = record_span(rec, low, ref.impulse, why=ends)
+    assert span is not None and not ends
+    # every block starts after a flight that ended before it
+    assert all(b.state is not None for b in span.blocks)
+    ev = evaluate(low, law, ref)
+    assert ev.comparison != "steady orbit" and "I5" in ev.criteria

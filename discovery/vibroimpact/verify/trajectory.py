@@ -193,7 +193,10 @@ def record_span(
     td_all = t + time_offset
     W = cycle.duration
     mids = np.array([0.5 * (td_all[a] + td_all[b - 1]) for a, b in runs])
-    whole = make_fold(td_all, cycle.onset + time_offset, cycle.n_periods, T, (mids[0], td_all[-1]))
+    ends = np.array([td_all[b - 1] for _, b in runs])
+    # the compared cycles begin after the first free flight ends: every block then has a
+    # flight that ends before it to start from
+    whole = make_fold(td_all, cycle.onset + time_offset, cycle.n_periods, T, (ends[0], td_all[-1]))
     if whole is None or whole.n_cycles < max(1, int(0.5 * (td_all[-1] - td_all[0]) / W)):
         # the first flights are too late to use most of the record
         return none("the record's first free flight comes too late to use most of the record")
@@ -202,7 +205,7 @@ def record_span(
     for first, count in _block_ranges(whole.n_cycles, max(1, int(block_cycles))):
         o = whole.origin + first * W
         # the latest free flight that ends before the block starts
-        ok = np.flatnonzero(np.array([td_all[b - 1] for _, b in runs]) <= o)
+        ok = np.flatnonzero(ends <= o)
         if not ok.size:
             return none("no free flight of the record ends before its first compared cycle")
         j = int(ok[-1])
