@@ -12,7 +12,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from realistic import reference_record  # noqa: E402
 
-from discovery.errors import InputError  # noqa: E402
+from discovery.errors import InputError, IntegrationError  # noqa: E402
+from discovery.numerics.status import STEP_BUDGET  # noqa: E402
+from discovery.numerics.tolerances import Tolerances  # noqa: E402
 from discovery.vibroimpact.dynamics.reference import reference_simulate  # noqa: E402
 from discovery.vibroimpact.dynamics.simulation import simulate  # noqa: E402
 from discovery.vibroimpact.dynamics.steady_states import steady_state  # noqa: E402
@@ -118,6 +120,30 @@ def test_a_start_inside_a_contact_takes_its_approach_velocity():
         )["y_final"]
         assert np.max(np.abs(k - r) / scale) < 1e-6  # the two simulators agree
         assert (np.max(np.abs(k - whole) / scale) < 1e-5) == close
+
+
+def _resting_contact():
+    """Issue 33's stall (the survey's Lankarani-Nikravesh record of seed 3009, its first
+    random second point): a drive too weak to lift the moulding off the table at once, so
+    the contact that starts at rest stays closed with its damping over an approach velocity
+    of ``1e-12`` m/s; steps of ``1e-8`` s."""
+    sc = load_scenario("paper").replace(
+        m1=16400.0, m2=5400.0, k1=1.86e9, c1=1.83e6, A=240050.12, frequency=25.437287
+    )
+    model = ContactModel(
+        "lankarani-nikravesh", (1.1214401691859e10, 1.138026560021, 0.755500748532)
+    )
+    return sc, model.law
+
+
+def test_a_resting_contact_too_stiff_to_integrate_stops_in_both_simulators():
+    sc, law = _resting_contact()
+    T = sc.period
+    tr = simulate(sc, law, (0.0, T), tolerances=Tolerances(max_steps=100_000), throw=False)
+    assert tr.status == STEP_BUDGET and tr.t_final < 0.25 * T  # 1e5 steps: not a quarter period
+    # the scipy path stops at its budget too (with the default it ran for hours)
+    with pytest.raises(IntegrationError, match="step budget"):
+        reference_simulate(sc, law, (0.0, T), rtol=1e-8, max_nfev=100_000)
 
 
 @pytest.mark.parametrize("name", list(MODELS))

@@ -25,7 +25,12 @@ put it on several):
   ``max(zeta, 0)``, so the contact is never adhesive.
 
 A run of more than ``_MAX_ZERO_LENGTH`` zero-length segments at one instant raises
-:class:`~discovery.errors.IntegrationError` (chattering between modes).
+:class:`~discovery.errors.IntegrationError` (chattering between modes), and so does a run
+whose right-hand side is evaluated more than its budget (``max_nfev``, per 100 drive
+periods of the span): the compiled kernel's step budget, so that a law made stiff
+beyond what the machine's time scales need (e.g. a Lankarani-Nikravesh contact that
+starts at rest: its damping over an approach velocity of ``1e-12`` m/s) stops with a
+clear message instead of taking steps of ``1e-8`` s for hours.
 """
 
 from dataclasses import dataclass
@@ -34,6 +39,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ...errors import IntegrationError
+from ...numerics.status import STEP_BUDGET
+from ...numerics.status import message as status_message
 
 __all__ = ["reference_simulate"]
 
@@ -41,6 +48,14 @@ _TREND_STEP = 1e-8  # Heun step for the trend of a surface function [periods]
 _ON_SURFACE = 1e-12  # "on the surface": within this time [max(t, T)] of it at its rate
 _HOLD = 10.0  # a held function keeps its start value for _HOLD x that time
 _MAX_ZERO_LENGTH = 8  # zero-length segments in a row before raising
+# right-hand-side evaluations per 100 drive periods of a run before raising: about the
+# compiled kernel's default step budget (2e6 steps) in DOP853 steps (12 stages and 3
+# for the dense output); an ordinary record spends 1e5 to 1e7
+MAX_NFEV = 30_000_000
+
+
+class _OverBudget(Exception):
+    """The right-hand-side evaluation budget is used up."""
 
 
 def _signed_pow(x, a):
@@ -305,12 +320,17 @@ def reference_simulate(
     method="DOP853",
     max_events=100_000,
     impact_v0=0.0,
+    max_nfev=MAX_NFEV,
 ):
     """Simulate with scipy, restarting at events.
 
     A law scaled by each impact's approach velocity (``law.impact_scaled``) is integrated
     as the plain law :meth:`ForceLaw.at_impact` makes at each onset (``impact_v0``: that
     velocity of a contact under way at the start; 0 takes the start's own rate).
+
+    ``max_nfev`` right-hand-side evaluations per 100 drive periods of ``t_span`` (at least
+    one allowance) are allowed: beyond them the run raises
+    :class:`~discovery.errors.IntegrationError` (the step budget, like the kernel's).
 
     Returns
     -------
@@ -331,6 +351,17 @@ def reference_simulate(
     samples = _Samples.at(te)
     mode = _mode_of(law, y, state)
     events, nfev, zero_length = [], 0, 0
+    budget = int(max_nfev) * (1 + int((t1 - t) / (100.0 * T)))
+    calls = [0]
+
+    def counted(f):
+        def rhs(tt, yy):
+            calls[0] += 1
+            if calls[0] > budget:
+                raise _OverBudget(tt)
+            return f(tt, yy)
+
+        return rhs
 
     def record(kind, yy):
         events.append((t, kind, yy.copy()))
@@ -355,17 +386,25 @@ def reference_simulate(
             mode = _after(law, kind, y, state, scenario.mass_loss)
             continue
         t_start = t
-        sol = solve_ivp(
-            rhs,
-            (t, t1),
-            y,
-            method=method,
-            rtol=rtol,
-            atol=atol,
-            events=_held_events(evs, on, g0, t, tau_on),
-            dense_output=True,
-            max_step=T * 0.02,
-        )
+        try:
+            sol = solve_ivp(
+                counted(rhs),
+                (t, t1),
+                y,
+                method=method,
+                rtol=rtol,
+                atol=atol,
+                events=_held_events(evs, on, g0, t, tau_on),
+                dense_output=True,
+                max_step=T * 0.02,
+            )
+        except _OverBudget as stop:
+            raise IntegrationError(
+                f"reference integration stopped at t = {stop.args[0]:.6g} s: "
+                f"{status_message(STEP_BUDGET)} ({calls[0] - 1} right-hand-side evaluations "
+                f"from t = {float(t_span[0]):.6g} s; the law is too stiff for the machine, "
+                "e.g. damping over an impact velocity near 0)"
+            ) from None
         nfev += sol.nfev
         if sol.status == -1:
             raise IntegrationError(f"reference integration failed: {sol.message}")
