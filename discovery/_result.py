@@ -275,3 +275,15 @@ def command_of(doc):
     if "command" in doc or not isinstance(kind, str) or kind not in _COMMANDS:
         return doc
     return {**doc, "command": _COMMANDS[kind]}
+
+
+def kind_of(doc):
+    """The result kind of a run's document: its ``result``, or for a summary written before
+    the schema version the kind of its command (``None`` when it names none)."""
+    kind = doc.get("result")
+    if isinstance(kind, str) and kind in KINDS:
+        return kind
+    cmd = doc.get("command")
+    if cmd == "fit" and doc.get("library") == "contact-models":
+        return "contact-models"
+    return next((k for k, c in _COMMANDS.items() if c == cmd and k != "contact-models"), None)
