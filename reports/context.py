@@ -23,6 +23,7 @@ from .cells import (  # noqa: F401  (the shared cells, read by the tests from he
     criterion_names,
     criterion_tex,
 )
+from .run import run_document
 from .ueda.context import _ueda
 from .vibroimpact.context import (  # noqa: F401
     _effect_parameter_rows,
@@ -32,7 +33,6 @@ from .vibroimpact.context import (  # noqa: F401
     _landscape,
     _verify,
 )
-from .run import run_document
 from .vibroimpact.study_context import _study
 
 __all__ = ["context", "KINDS", "criterion_names"]
@@ -72,7 +72,7 @@ TEMPLATES = {
 
 #: the kinds whose context reads the run's typed result (a :class:`~reports.run.RunDocument`);
 #: the others read the summary's keys
-TYPED = set()
+TYPED = {_verify, _identify, _landscape}
 
 
 def context(doc, run_dir):

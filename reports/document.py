@@ -113,10 +113,11 @@ def render(summary, run_dir, snippet=None, template=None, skipped=None):
     document of the run (``"model"``: the fit's model.tex).
 
     The report reads the run's typed result (``doc.result``) and, for what only the summary
-    holds (the command's provenance, input names), the summary. Every field of the summary is read as text: a law is rebuilt from its own text by the
-    law grammar, every other string is escaped. A field of the wrong type (an edited
-    summary) is one :class:`~discovery.errors.InputError`. A figure that is a link or not a
-    plain file of the run directory is left out (its name appended to ``skipped``).
+    holds (the command's provenance, input names), the summary. Every field is read as
+    text: a law is rebuilt from its own text by the law grammar, every other string is
+    escaped. A field of the wrong type (an edited summary) is one
+    :class:`~discovery.errors.InputError`. A figure that is a link or not a plain file of
+    the run directory is left out (its name appended to ``skipped``).
     """
     import jinja2
 
