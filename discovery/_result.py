@@ -140,6 +140,18 @@ class Result:
         object.__setattr__(obj, "_document", copy.deepcopy(d))
         return obj
 
+    @staticmethod
+    def from_summary(doc):
+        """The result a run's ``summary.json`` describes, as its own type: the kind is the
+        document's ``result``, or for a summary written before the schema version its
+        command's (read with the keys it has); ``None`` for a command with no result kind."""
+        kind = kind_of(doc)
+        if kind is None:
+            return None
+        if "schema_version" not in doc:
+            doc = {**doc, "schema_version": SCHEMA_VERSION, "result": kind}
+        return result_class(kind).from_dict(doc)
+
     @property
     def loaded(self):
         """True for a result read back from a document (its simulations are not here)."""

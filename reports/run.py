@@ -51,13 +51,11 @@ def run_document(run, result=None):
 
 
 def _typed(summary):
-    from discovery._result import SCHEMA_VERSION, kind_of, result_class
+    from discovery import Result
 
-    kind = kind_of(summary)
-    if kind is None:
+    result = Result.from_summary(summary)
+    if result is None:
         from discovery.errors import InputError
 
         raise InputError(f"a {summary.get('command')!r} run has no result to report")
-    if "schema_version" not in summary:  # written before the schema version: same keys
-        summary = {**summary, "schema_version": SCHEMA_VERSION, "result": kind}
-    return result_class(kind).from_dict(summary)
+    return result
