@@ -140,6 +140,18 @@ class Result:
         object.__setattr__(obj, "_document", copy.deepcopy(d))
         return obj
 
+    @staticmethod
+    def from_summary(doc):
+        """The result a run's ``summary.json`` describes, as its own type: the kind is the
+        document's ``result``, or for a summary written before the schema version its
+        command's (read with the keys it has); ``None`` for a command with no result kind."""
+        kind = kind_of(doc)
+        if kind is None:
+            return None
+        if "schema_version" not in doc:
+            doc = {**doc, "schema_version": SCHEMA_VERSION, "result": kind}
+        return result_class(kind).from_dict(doc)
+
     @property
     def loaded(self):
         """True for a result read back from a document (its simulations are not here)."""
@@ -275,3 +287,15 @@ def command_of(doc):
     if "command" in doc or not isinstance(kind, str) or kind not in _COMMANDS:
         return doc
     return {**doc, "command": _COMMANDS[kind]}
+
+
+def kind_of(doc):
+    """The result kind of a run's document: its ``result``, or for a summary written before
+    the schema version the kind of its command (``None`` when it names none)."""
+    kind = doc.get("result")
+    if isinstance(kind, str) and kind in KINDS:
+        return kind
+    cmd = doc.get("command")
+    if cmd == "fit" and doc.get("library") == "contact-models":
+        return "contact-models"
+    return next((k for k, c in _COMMANDS.items() if c == cmd and k != "contact-models"), None)

@@ -5,6 +5,7 @@ from pathlib import Path
 
 from reports.document import Report, compile_tex, render
 from reports.document import report as _report
+from reports.run import run_document
 
 __all__ = ["Report", "report", "render", "compile_tex"]
 
@@ -59,7 +60,9 @@ def report(run, *, out=None, snippet=None, compile=True, timeout=300):
                 f"report: {str(out)!r} holds another result; give an empty directory or the "
                 "result's own run directory"
             )
-        return _report(out, snippet=snippet, compile=compile, timeout=timeout, summary=doc)
+        # a live result (not loaded) is read back from its document, as its directory is
+        summary = run_document(doc, result=run if run.loaded else None)
+        return _report(out, snippet=snippet, compile=compile, timeout=timeout, summary=summary)
     if out is not None:
         raise InputError("report: out= is for a result object; a run directory gets its report")
     if not isinstance(run, str | bytes) and not hasattr(run, "__fspath__"):
@@ -69,8 +72,8 @@ def report(run, *, out=None, snippet=None, compile=True, timeout=300):
     doc = _saved(run)
     summary = None
     if isinstance(doc, dict) and "schema_version" in doc:
-        load(run)  # its version and kind checked, every field readable
-        summary = command_of(doc)
+        # its version and kind checked, every field readable: the report reads this result
+        summary = run_document(command_of(doc), result=load(run))
     return _report(run, snippet=snippet, compile=compile, timeout=timeout, summary=summary)
 
 

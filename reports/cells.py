@@ -87,7 +87,7 @@ _TALL = ("explain", "discover", "landscape", "identification")
 def _model_tex(value, where):
     """The equation of a law rebuilt from its text or coefficients (never read as LaTeX);
     ``--`` when the summary has none."""
-    if value in (None, "", {}):
+    if value is None or (isinstance(value, str | dict) and not value):
         return Tex("--")
     return law_equation(law_of(value, where))
 

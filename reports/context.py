@@ -23,6 +23,7 @@ from .cells import (  # noqa: F401  (the shared cells, read by the tests from he
     criterion_names,
     criterion_tex,
 )
+from .run import run_document
 from .ueda.context import _ueda
 from .vibroimpact.context import (  # noqa: F401
     _effect_parameter_rows,
@@ -69,9 +70,17 @@ TEMPLATES = {
 }
 
 
-def context(summary, run_dir):
-    """The template context of a run: the kind's own part plus provenance and scenario."""
-    kind = summary.get("command")
+#: the kinds whose context reads the run's typed result (a :class:`~reports.run.RunDocument`);
+#: the others read the summary's keys
+TYPED = {_verify, _identify, _landscape}
+
+
+def context(doc, run_dir):
+    """The template context of a run (a :class:`~reports.run.RunDocument`, or its summary
+    dict): the kind's own part plus provenance and scenario."""
+    doc = run_document(doc)
+    summary = doc.summary
+    kind = doc.command
     build = KINDS.get(kind)
     named = kind == "fit" and summary.get("library") == "contact-models"
     if named:
@@ -82,7 +91,7 @@ def context(summary, run_dir):
         from discovery.errors import InputError
 
         raise InputError(f"no report for a {kind!r} run; reports cover {', '.join(KINDS)} runs")
-    c = build(summary, run_dir)
+    c = build(doc if build in TYPED else summary, run_dir)
     c["kind"] = kind
     c["template"] = ("contact_models" if named else TEMPLATES.get(kind, "ueda")) + ".tex.j2"
     c["provenance"] = _provenance(summary, run_dir)

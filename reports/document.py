@@ -24,9 +24,18 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .context import context
+from .run import RunDocument, run_document
 from .texenv import Tex, environment
 
-__all__ = ["Report", "report", "render", "SNIPPETS", "TEX_PACKAGES", "compile_tex"]
+__all__ = [
+    "Report",
+    "report",
+    "render",
+    "RunDocument",
+    "SNIPPETS",
+    "TEX_PACKAGES",
+    "compile_tex",
+]
 
 TEX_PACKAGES = (
     "latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended lmodern"
@@ -99,20 +108,24 @@ def _load(run_dir):
 
 
 def render(summary, run_dir, snippet=None, template=None, skipped=None):
-    """The report's LaTeX text (or one snippet's) from a summary and its run directory;
-    ``template`` names another document of the run (``"model"``: the fit's model.tex).
+    """The report's LaTeX text (or one snippet's) from a run's document (a summary dict or
+    a :class:`~reports.run.RunDocument`) and its run directory; ``template`` names another
+    document of the run (``"model"``: the fit's model.tex).
 
-    Every field of the summary is read as text: a law is rebuilt from its own text by the
-    law grammar, every other string is escaped. A field of the wrong type (an edited
-    summary) is one :class:`~discovery.errors.InputError`. A figure that is a link or not a
-    plain file of the run directory is left out (its name appended to ``skipped``).
+    The report reads the run's typed result (``doc.result``) and, for what only the summary
+    holds (the command's provenance, input names), the summary. Every field is read as
+    text: a law is rebuilt from its own text by the law grammar, every other string is
+    escaped. A field of the wrong type (an edited summary) is one
+    :class:`~discovery.errors.InputError`. A figure that is a link or not a plain file of
+    the run directory is left out (its name appended to ``skipped``).
     """
     import jinja2
 
     from discovery.errors import InputError, VidiError
 
+    doc = run_document(summary)
     try:
-        ctx = context(summary, run_dir)
+        ctx = context(doc, run_dir)
         figures = []
         for f in ctx["figures"]:
             if _safe_figure(run_dir, f["file"]) is not None:
@@ -120,7 +133,7 @@ def render(summary, run_dir, snippet=None, template=None, skipped=None):
             elif skipped is not None:
                 skipped.append(f["file"])
         ctx["figures"] = figures
-        ctx["created"] = summary.get("created", "")
+        ctx["created"] = doc.summary.get("created", "")
         env = environment()
         if template is not None:
             return env.get_template(f"{template}.tex.j2").render(**ctx)
@@ -422,9 +435,10 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300, summary=None):
         or ``"figure"``; written to ``snippet-KIND.tex`` and not compiled.
     compile : bool
         Compile the PDF (when TeX is installed).
-    summary : dict, optional
+    summary : dict or RunDocument, optional
         The run's document when the caller has read it already (``discovery.report``
-        reads it through ``discovery.load``); default: ``run_dir/summary.json``.
+        reads it through ``discovery.load`` and gives its typed result with it); default:
+        ``run_dir/summary.json``.
 
     Returns
     -------
@@ -437,9 +451,9 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300, summary=None):
     """
     from discovery.outputs import atomic_write_text
 
-    summary = _load(run_dir) if summary is None else summary
+    doc = run_document(_load(run_dir) if summary is None else summary)
     skipped = []
-    text = render(summary, run_dir, snippet, skipped=skipped)
+    text = render(doc, run_dir, snippet, skipped=skipped)
     d = Path(run_dir)
     name = "report.tex" if snippet is None else f"snippet-{snippet}.tex"
     names = [name] if snippet is not None or not compile else [name, "report.pdf", "report.log"]
@@ -455,7 +469,7 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300, summary=None):
     )
     if snippet is not None or not compile:
         atomic_write_text(tex, text)
-        return Report(tex, None, f"wrote {tex}{note}", summary["command"], None, ctx_figs)
+        return Report(tex, None, f"wrote {tex}{note}", doc.command, None, ctx_figs)
     w = _stage_dir(d)
     try:
         (w / name).write_text(text, encoding="utf-8")
@@ -471,7 +485,7 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300, summary=None):
         tex,
         pdf,
         message + note,
-        summary["command"],
+        doc.command,
         _pages(pdf) if pdf is not None else None,
         ctx_figs,
     )

@@ -80,11 +80,14 @@ def term_tex(name, unloading=False):
 
 
 def law_of(value, where):
-    """A :class:`ForceLaw` from a summary's law text or ``{term: coefficient}`` mapping;
+    """A :class:`ForceLaw` from a summary's law text or ``{term: coefficient}`` mapping (a
+    ``ForceLaw`` itself as it is);
     :class:`InputError` naming ``where`` when it is neither."""
     from discovery.errors import InputError, VidiError
     from discovery.vibroimpact.model.law import ForceLaw
 
+    if isinstance(value, ForceLaw):  # a typed result's law
+        return value
     try:
         if isinstance(value, str):
             return ForceLaw.parse(value)

@@ -727,9 +727,21 @@ def test_a_contact_models_report_lists_every_record_and_scenario():
 def test_identify_s_message_is_not_ended_twice():
     """The optimiser's message ends with a period; the sentence around it is not given a
     second one ("satisfied..")."""
+    from reports.run import run_document
     from reports.vibroimpact.context import _identify
 
-    c = _identify({"message": "Both `ftol` and `xtol` conditions are satisfied."}, ".")
+    r = _ns(
+        law=None,
+        checks=(),
+        coefficients={},
+        standard_errors={},
+        intervals=None,
+        method="trf",
+        criterion="I2",
+        n_simulations=3,
+        message="Both `ftol` and `xtol` conditions are satisfied.",
+    )
+    c = _identify(run_document({}, result=r), ".")
     assert not str(c["message"]).endswith(".")
 
 

@@ -29,22 +29,24 @@ from ..texenv import Tex, escape, num
 
 
 # ----------------------------------------------------------------------------- kinds
-def _verify(s, run_dir):
+def _verify(doc, run_dir):
+    r = doc.result
+    ev = r.evaluation
     c = {
         "title": "Verification of a contact law against a record",
-        "law": _model_tex(s.get("law"), "law"),
-        "data": s.get("data"),
-        "measured": _measured_rows(s.get("measured")),
-        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
-        "verdict": prose(s.get("verdict") or s.get("message") or "--"),
-        "consistent": bool(s.get("consistent")),
-        "regime": s.get("regime") or {},
-        "impacts": s.get("impacts") or {},
-        "start": s.get("start") or {},
-        "default_start": s.get("default_start"),
+        "law": _model_tex(r.law, "law"),
+        # the record's measured block and the start are the run's (not kept by a loaded result)
+        "measured": _measured_rows(doc.summary.get("measured")),
+        "criteria": _criteria_table(ev.criteria, ev.noise_floor, ev.limits),
+        "verdict": prose(ev.verdict or ev.message or "--"),
+        "consistent": bool(ev.consistent),
+        "regime": ev.regime or {},
+        "impacts": ev.impacts or {},
+        "start": doc.summary.get("start") or {},
+        "default_start": r.default_start,
     }
-    lim = s.get("limits") or {}
-    crit = s.get("criteria") or {}
+    lim = ev.limits or {}
+    crit = ev.criteria or {}
     concl = []
     if c["consistent"]:
         concl.append(
@@ -78,7 +80,7 @@ def _verify(s, run_dir):
             f"The measured regime is {reg.get('measured')}, the simulated one "
             f"{reg.get('simulated')}."
         )
-    if _transient(s.get("verdict")):
+    if _transient(ev.verdict):
         concl.append(
             "The law's simulation from the measured state is not yet steady over the "
             "record's span: the record was compared with that trajectory, block by block, "
@@ -236,30 +238,39 @@ def _fit(s, run_dir):
     return c
 
 
-def _identify(s, run_dir):
+def _identify(doc, run_dir):
+    r = doc.result
+    # the identified law against the record, with its noise floor (the command checks one)
+    one = r.checks[0] if r.checks else None
     c = {
         "title": "Identification of a contact law by simulation",
-        "model": _model_tex(s.get("law") or s.get("coefficients"), "law"),
+        "model": _model_tex(r.law, "law"),
         "coefficients": _coef_rows(
-            s.get("coefficients") or {},
-            s.get("standard_errors"),
-            _intervals(s),
-            start=s.get("start") or {},
+            r.coefficients or {},
+            r.standard_errors,
+            r.intervals.bounds if r.intervals is not None else {},
+            # the start as given and the record's measured block are the run's
+            start=doc.summary.get("start") or {},
         ),
-        "measured": _measured_rows(s.get("measured")),
-        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
-        "verdict": prose(s.get("verdict") or "--"),
-        "method": s.get("method", "--"),
-        "criterion": criterion_tex(s.get("criterion", "I2")),
-        "n_simulations": s.get("n_simulations", "--"),
-        "message": prose(str(s.get("message", "")).rstrip(".")),  # the template ends it
+        "measured": _measured_rows(doc.summary.get("measured")),
+        "criteria": _criteria_table(
+            one and one.criteria,
+            one and one.noise_floor,
+            one.limits if len(r.checks) == 1 else {},
+        ),
+        "verdict": prose((one and one.verdict) or "--"),
+        "method": r.method or "--",
+        "criterion": criterion_tex(r.criterion or "I2"),
+        "n_simulations": r.n_simulations if r.n_simulations is not None else "--",
+        "message": prose(str(r.message).rstrip(".")),  # the template ends it
     }
+    consistent = bool(one and one.consistent)
     concl = [
-        f"{s.get('method', '?')} spent {s.get('n_simulations', '?')} simulations; the "
-        f"identified law is {'consistent' if s.get('consistent') else 'NOT consistent'} "
+        f"{r.method or '?'} spent {r.n_simulations if r.n_simulations is not None else '?'} "
+        f"simulations; the identified law is {'consistent' if consistent else 'NOT consistent'} "
         "with the record."
     ]
-    if not s.get("consistent"):
+    if not consistent:
         concl.append(
             "An inconsistent result after identification means either a missing "
             "effect (run `vidi explain`) or a local minimum: start nearer (the "
@@ -270,33 +281,33 @@ def _identify(s, run_dir):
     return c
 
 
-def _landscape(s, run_dir):
-    terms = s.get("terms") or ["?", "?"]
-    mins = s.get("minima") or {}
+def _landscape(doc, run_dir):
+    r = doc.result
+    terms = list(r.terms or ("?", "?"))
+    n = int(r.consistent.sum()) if r.consistent is not None else 0
+    law = doc.summary.get("law")  # the law and the grid as the command was given them
     c = {
         "title": "Criteria landscape over two coefficients",
         "terms": [term_tex(t) for t in terms[:2]],
-        "law": law_inline(law_of(s["law"], "law")) if s.get("law") else Tex("--"),
-        "grid": "x".join(str(g) for g in s.get("grid") or []),
+        "law": law_inline(law_of(law, "law")) if law else Tex("--"),
+        "grid": "x".join(str(g) for g in doc.summary.get("grid") or []),
         "minima": [
             [
                 criterion_tex(k),
-                num(m.get("alpha1")),
-                num(m.get("alpha2")),
-                num(m.get("value")),
-                m.get("regime", "--"),
-                "yes" if m.get("consistent") else "no",
+                num(m["alpha1"]),
+                num(m["alpha2"]),
+                num(m["value"]),
+                m["regime"],
+                "yes" if m["consistent"] else "no",
             ]
-            for k, m in mins.items()
+            for k, m in r.minima().items()
+            if m is not None
         ],
-        "noise_floor": [
-            [criterion_tex(k), num(v)] for k, v in (s.get("noise_floor") or {}).items()
-        ],
-        "n_consistent": s.get("n_consistent", 0),
-        "regimes": ", ".join(f"{k}: {v}" for k, v in (s.get("regimes") or {}).items()),
-        "reference": (s.get("reference") or {}).get("source", "--"),
+        "noise_floor": [[criterion_tex(k), num(v)] for k, v in (r.noise_floor or {}).items()],
+        "n_consistent": n,
+        "regimes": ", ".join(f"{k}: {v}" for k, v in r.regime_counts().items()),
+        "reference": (r.reference or {}).get("source", "--"),
     }
-    n = s.get("n_consistent", 0)
     c["conclusions"] = [
         f"{n} grid point(s) are consistent with the reference within the noise limit"
         + (

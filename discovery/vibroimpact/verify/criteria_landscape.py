@@ -141,10 +141,11 @@ class Landscape(Result):
         msg = "" if self.messages is None else str(self.messages[i, j])
         return int(len(bad)), msg, (i, j)
 
-    def as_dict(self):
-        """The landscape as JSON-ready data (``summary.json`` of ``vidi landscape``)."""
+    def minima(self):
+        """``{criterion: its smallest value's point}``: ``alpha1``, ``alpha2``, ``value``,
+        ``regime``, ``consistent`` and the criterion's ``noise_floor`` there (``None`` for a
+        criterion no point has a value of)."""
         a0, a1 = self.axes
-        count, first, at = self.failures
         minima = {}
         for n in self.values:
             ij = self.argmin(n)
@@ -160,6 +161,12 @@ class Landscape(Result):
                     "noise_floor": (self.noise_floor or {}).get(n),
                 }
             )
+        return minima
+
+    def as_dict(self):
+        """The landscape as JSON-ready data (``summary.json`` of ``vidi landscape``)."""
+        a0, a1 = self.axes
+        count, first, at = self.failures
         return {
             "terms": self.terms,
             "alpha1": a0,
@@ -178,7 +185,7 @@ class Landscape(Result):
             "noise_floor": self.noise_floor,
             "noise_floor_q95": self.noise_floor_q95,
             "noise_floor_under": self.noise_floor_under,
-            "minima": minima,
+            "minima": self.minima(),
             "seconds": self.seconds,
             "workers": self.workers,
             "continuation": self.continuation,
