@@ -4,8 +4,8 @@ and which model the record supports and which it cannot tell from it."""
 
 from __future__ import annotations
 
-from discovery._text import records as the_records
-from discovery._text import verb
+from discovery.wording import records as the_records
+from discovery.wording import verb
 
 from .cells import _scenarios_table
 from .lawtex import prose

@@ -4,8 +4,8 @@ written from the numbers."""
 
 from __future__ import annotations
 
-from discovery._text import records as the_records
-from discovery._text import verb
+from discovery.wording import records as the_records
+from discovery.wording import verb
 
 from ..cells import (
     _DOMAIN,

@@ -199,6 +199,16 @@ def landscape_figure(land, stem, truth=None):
         return _save(fig, stem)
 
 
+def _mark_start(ax, start, names, path):
+    """The start law given (``ForceLaw`` or dict) on the path's axes, joined dotted to the
+    path's first point when the search began elsewhere (a cycle-by-cycle refit)."""
+    given = start if isinstance(start, dict) else start.as_dict()
+    s0 = [float(given[n]) for n in names[:2]]
+    if not np.allclose(s0, path[0, :2]):
+        ax.plot([s0[0], path[0, 0]], [s0[1], path[0, 1]], ":", color="r", lw=1)
+    ax.plot(*s0, "s", mfc="none", mec="r", ms=9, mew=1.5, label="start (given)")
+
+
 def identification_figure(result, measured, impulses, stem, land=None, start=None):
     """Identification path (Fig. 6), the criterion against the simulations spent, and F_N
     converging to F_E (Fig. 7).
@@ -257,11 +267,7 @@ def identification_figure(result, measured, impulses, stem, land=None, start=Non
             label="best law so far",
         )
         if start is not None:
-            given = start if isinstance(start, dict) else start.as_dict()
-            s0 = [float(given[n]) for n in names[:2]]
-            if not np.allclose(s0, path[0, :2]):  # the search began elsewhere: joined dashed
-                ax.plot([s0[0], path[0, 0]], [s0[1], path[0, 1]], ":", color="r", lw=1)
-            ax.plot(*s0, "s", mfc="none", mec="r", ms=9, mew=1.5, label="start (given)")
+            _mark_start(ax, start, names, path)
         final = result.law.as_dict()
         ax.plot(final[names[0]], final[names[1]], "r*", ms=13, mec="k", label="identified")
         ax.set_xlabel(coefficient_label(names[0]))

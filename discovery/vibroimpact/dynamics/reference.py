@@ -308,6 +308,32 @@ def _fired(sol, evs, rhs, t, y, *, period):
     return evs[i if j is None else j][2]
 
 
+class _Counted:
+    """A right-hand side's evaluations counted against ``budget`` (:class:`_OverBudget`
+    beyond it)."""
+
+    def __init__(self, budget):
+        self.budget, self.calls = budget, 0
+
+    def __call__(self, f):
+        def rhs(tt, yy):
+            self.calls += 1
+            if self.calls > self.budget:
+                raise _OverBudget(tt)
+            return f(tt, yy)
+
+        return rhs
+
+    def error(self, t_stop, t_first):
+        """The :class:`~discovery.errors.IntegrationError` of a run stopped at ``t_stop``."""
+        return IntegrationError(
+            f"reference integration stopped at t = {t_stop:.6g} s: "
+            f"{status_message(STEP_BUDGET)} ({self.calls - 1} right-hand-side evaluations "
+            f"from t = {t_first:.6g} s; the law is too stiff for the machine, "
+            "e.g. damping over an impact velocity near 0)"
+        )
+
+
 def reference_simulate(
     scenario,
     law,
@@ -351,17 +377,7 @@ def reference_simulate(
     samples = _Samples.at(te)
     mode = _mode_of(law, y, state)
     events, nfev, zero_length = [], 0, 0
-    budget = int(max_nfev) * (1 + int((t1 - t) / (100.0 * T)))
-    calls = [0]
-
-    def counted(f):
-        def rhs(tt, yy):
-            calls[0] += 1
-            if calls[0] > budget:
-                raise _OverBudget(tt)
-            return f(tt, yy)
-
-        return rhs
+    counted = _Counted(int(max_nfev) * (1 + int((t1 - t) / (100.0 * T))))
 
     def record(kind, yy):
         events.append((t, kind, yy.copy()))
@@ -399,12 +415,7 @@ def reference_simulate(
                 max_step=T * 0.02,
             )
         except _OverBudget as stop:
-            raise IntegrationError(
-                f"reference integration stopped at t = {stop.args[0]:.6g} s: "
-                f"{status_message(STEP_BUDGET)} ({calls[0] - 1} right-hand-side evaluations "
-                f"from t = {float(t_span[0]):.6g} s; the law is too stiff for the machine, "
-                "e.g. damping over an impact velocity near 0)"
-            ) from None
+            raise counted.error(stop.args[0], float(t_span[0])) from None
         nfev += sol.nfev
         if sol.status == -1:
             raise IntegrationError(f"reference integration failed: {sol.message}")

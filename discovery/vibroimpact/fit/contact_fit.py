@@ -29,10 +29,10 @@ import numpy as np
 
 from ..._printing import readable
 from ..._progress import reports_progress
-from ..._text import records as the_records
-from ..._text import verb
 from ..._validate import Real, params
 from ...errors import InputError, IntegrationError
+from ...wording import records as the_records
+from ...wording import verb
 from ..data.measurement import Measurement
 from ..model.contact_models import MODELS, same_force
 from ..model.scenario import Scenario
