@@ -98,7 +98,7 @@ tables: install
 
 surveys: install
 	rm -f $(MEASURED)/intervals-*.jsonl $(MEASURED)/advise-*.jsonl $(MEASURED)/realistic-*.jsonl \
-		$(MEASURED)/corpus*.jsonl
+		$(MEASURED)/corpus*.jsonl $(MEASURED)/contact-two-points*.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 272 \
 		--workers $(SURVEY_WORKERS) --out $(MEASURED)/intervals-272.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 208 \
@@ -113,6 +113,9 @@ surveys: install
 	$(BIN)/python -m tests.realistic_survey --properties --n 8 --noise-seeds 1 --field \
 		--out $(MEASURED)/realistic-field.jsonl
 	$(BIN)/python -m tests.survey_corpus --out $(MEASURED)/corpus.jsonl
+	$(BIN)/python -m tests.survey_contact_models --models hunt-crossley lankarani-nikravesh \
+		--per-model 10 --seed 1 --max-simulations 60 --second-point advised random --boot 0 \
+		--out $(MEASURED)/contact-two-points.jsonl
 	$(MAKE) tables
 
 # The documentation site (docs/*.md, API reference from the docstrings), warnings as errors

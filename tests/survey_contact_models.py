@@ -314,6 +314,47 @@ def summary(rows):
     return "\n".join(lines)
 
 
+ARM_NAMES = {"none": "one point", "advised": "advised", "random": "random"}
+
+
+def read_rows(files):
+    """The rows of run files (a record surveyed twice, a run resumed, counts once: its last
+    row)."""
+    rows = [r for f in files for r in measured.read(f)[1]]
+    return list({(r["truth"], r["seed"]): r for r in rows}.values())
+
+
+def stamp(files, rows):
+    """The line under the docs' table: its run files and the commits their rows were made
+    by (each row records its code version)."""
+    commits = sorted({(r.get("code") or {}).get("commit") or "not recorded" for r in rows})
+    return (
+        "*Rendered by `make tables` from the survey runs in `docs/_measured/`: "
+        + ", ".join(f"`{f.name}`" for f in files)
+        + " (rows made by commit "
+        + ", ".join(c[:7] for c in commits)
+        + ").*"
+    )
+
+
+def markdown_row(rows, label):
+    """The docs' row of a truth and an arm (``label``: ``"hunt-crossley/advised"``): records,
+    right name, right or equivalent, settled, and settled where the first record left the
+    other damping family open (the counts of :func:`arm_table`)."""
+    name, arm = label.split("/")
+    rs = [r for r in rows if r["truth"] == name and not r.get("skipped")]
+    open_ = [r for r in rs if r["truth"] in [r["selected"], *r["equivalent"]]]
+    open_ = [r for r in open_ if not settled(r, "none")]
+    right = sum(final(r, arm)[0] == name for r in rs)
+    either = sum(name in [final(r, arm)[0], *final(r, arm)[1]] for r in rs)
+    done = sum(settled(r, arm) for r in rs)
+    n = len(rs)
+    return (
+        f"| {name} | {ARM_NAMES[arm]} | {n} | {right}/{n} | {either}/{n} | {done}/{n} | "
+        f"{sum(settled(r, arm) for r in open_)}/{len(open_)} |"
+    )
+
+
 def arm_table(rows, arms):
     """Per truth and arm: the right name selected, right or equivalent, settled
     (:func:`settled`), and in how many records a second record was made."""
@@ -393,10 +434,7 @@ def main(argv=None):
     )
     a = ap.parse_args(argv)
     if a.summarize:
-        rows = [r for f in a.out for r in measured.read(f)[1]]
-        # a record surveyed twice (a run resumed) counts once: its last row
-        rows = list({(r["truth"], r["seed"]): r for r in rows}.values())
-        print(summary(rows))
+        print(summary(read_rows(a.out)))
         return
     out = measured.RunFile(a.out[0], "survey_contact_models", argv, append=True)
     rows = []

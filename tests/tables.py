@@ -24,6 +24,7 @@ from . import (
     measured,
     realistic_survey,
     survey_advise,
+    survey_contact_models,
     survey_corpus,
     survey_intervals,
 )
@@ -165,6 +166,22 @@ TABLES = {
         ),
         row=realistic_survey.markdown_row,
         read=_rows,
+    ),
+    "contact-two-points": Table(
+        page="docs/contact-models.md",
+        header=(
+            "| truth | arm | records | right name | right or equivalent | settled | settled "
+            "where the first record left the other family open |",
+            "|---|---|---|---|---|---|---|",
+        ),
+        rows=tuple(
+            (f"{truth}/{arm}", ("contact-two-points*.jsonl",))
+            for truth in ("hunt-crossley", "lankarani-nikravesh")
+            for arm in ("none", "advised", "random")
+        ),
+        row=survey_contact_models.markdown_row,
+        read=survey_contact_models.read_rows,
+        stamp=survey_contact_models.stamp,
     ),
     # make bench's runs as columns, the last few (tests/bench_history.py)
     "bench-history": Table(
