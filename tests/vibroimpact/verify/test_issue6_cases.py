@@ -27,11 +27,11 @@ or built for the case), so the tests do not move when the generator changes.
 
 import numpy as np
 import pytest
-import realistic as R
 
 from discovery import ForceLaw, Scenario
 from discovery.vibroimpact.data.impulse import _bracket_onset, impulse_from_samples
 from discovery.vibroimpact.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK, Reference, evaluate
+from tests import realistic as R
 
 
 def _verify(sc, law, record, wrong=()):
