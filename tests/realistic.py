@@ -54,7 +54,8 @@ default record of a drawn case was already made by its check.
 :func:`verification_trials` verifies the true law and its :func:`wrong_laws` (one real
 term dropped, one coefficient off by 30 %) against a noisy record of a case, and says
 for each wrong law whether its difference is detectable (:class:`Trial`); used by
-``tests/test_realistic_properties.py`` and ``tests/realistic_survey.py --properties``.
+``tests/vibroimpact/verify/test_realistic_properties.py`` and
+``tests/realistic_survey.py --properties``.
 """
 
 import math
@@ -262,7 +263,7 @@ def _reference_problem(scenario, law, ss, transient):
     two reference-path bugs at contact losses as well (a sticky contact after a "release"
     located a hair past the loss, and an endless loss/onset loop after a re-contact
     within one solver step: 3 of 6 accepted ``p1-slow`` draws in a 3-seed survey); both
-    are fixed and tested in ``tests/test_reference_sim.py``.
+    are fixed and tested in ``tests/vibroimpact/dynamics/test_reference_sim.py``.
     """
     try:
         t, y, _, _ = _clean(scenario, law, 15, 20000.0, int(transient), record_transient=False)

@@ -47,10 +47,10 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-sys.path.append(str(Path(__file__).resolve().parents[1]))  # for tests.measured
-
-from realistic import draw_case, reference_record  # noqa: E402
+if not __package__:  # run as a script: python tests/survey_contact_models.py
+    # the repository root, not tests/ (whose constraints/ and reports/ folders of tests are
+    # packages that would shadow the top-level ones)
+    sys.path[0:1] = [str(Path(__file__).resolve().parents[1])]
 
 from discovery._io import git_state, provenance  # noqa: E402
 from discovery.errors import VidiError  # noqa: E402
@@ -65,6 +65,7 @@ from discovery.vibroimpact.model.contact_models import (  # noqa: E402
 )
 from discovery.vibroimpact.verify import Reference  # noqa: E402
 from tests import measured  # noqa: E402
+from tests.realistic import draw_case, reference_record  # noqa: E402
 
 PARAMS_CHECKED = ("k", "n", "e", "lambda", "c")
 

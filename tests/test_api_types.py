@@ -236,7 +236,7 @@ def test_the_cases_cover_every_public_entry():
         "Result",
         "Executor",
         # a scikit-learn estimator checks its parameters in fit, not in __init__
-        # (tests/test_regression.py)
+        # (tests/vibroimpact/fit/test_regression.py)
         "ConstrainedSparseRegressor",
     }
     unlisted = (

@@ -10,12 +10,12 @@ import math
 
 import numpy as np
 import pytest
-import realistic as R
 
 from discovery.vibroimpact.data.impulse import estimate_noise
 from discovery.vibroimpact.dynamics import _kernel as K
 from discovery.vibroimpact.dynamics.reference import reference_simulate
 from discovery.vibroimpact.dynamics.simulation import Tolerances, simulate
+from tests import realistic as R
 
 STATE = ("w1", "v1", "w2", "v2")
 FAST_CASE = ("p1", 2)  # accepted at the 2nd draw, 30-period transient: about 1 s in all

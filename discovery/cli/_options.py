@@ -4,7 +4,7 @@ Where commands give an option the same meaning, its type, range, default and hel
 written here once; the parameters carry what differs between commands (what a seed
 seeds, what a budget is spent on), so every ``--help`` reads as the command's own.  The
 help of an option with a default ends ``(default: %(default)s)`` (see
-``tests/test_cli_help.py``).
+``tests/cli/test_cli_help.py``).
 """
 
 from ..vibroimpact.model.scenario import builtin_scenarios

@@ -2,28 +2,23 @@
 text, the result's round trip, and the fit that names the model of a record."""
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from realistic import reference_record  # noqa: E402
-
-from discovery.errors import InputError, IntegrationError  # noqa: E402
-from discovery.numerics.status import STEP_BUDGET  # noqa: E402
-from discovery.numerics.tolerances import Tolerances  # noqa: E402
-from discovery.vibroimpact.dynamics.reference import reference_simulate  # noqa: E402
-from discovery.vibroimpact.dynamics.simulation import simulate  # noqa: E402
-from discovery.vibroimpact.dynamics.steady_states import steady_state  # noqa: E402
-from discovery.vibroimpact.fit.contact_fit import (  # noqa: E402
+from discovery.errors import InputError, IntegrationError
+from discovery.numerics.status import STEP_BUDGET
+from discovery.numerics.tolerances import Tolerances
+from discovery.vibroimpact.dynamics.reference import reference_simulate
+from discovery.vibroimpact.dynamics.simulation import simulate
+from discovery.vibroimpact.dynamics.steady_states import steady_state
+from discovery.vibroimpact.fit.contact_fit import (
     ContactFit,
     ContactModelsResult,
     fit_contact_models,
 )
-from discovery.vibroimpact.model.contact_models import (  # noqa: E402
+from discovery.vibroimpact.model.contact_models import (
     MODELS,
     ContactModel,
     parse_law,
@@ -32,8 +27,9 @@ from discovery.vibroimpact.model.contact_models import (  # noqa: E402
     restitution_ratio,
     same_force,
 )
-from discovery.vibroimpact.model.law import ForceLaw  # noqa: E402
-from discovery.vibroimpact.model.scenario import load_scenario  # noqa: E402
+from discovery.vibroimpact.model.law import ForceLaw
+from discovery.vibroimpact.model.scenario import load_scenario
+from tests.realistic import reference_record
 
 
 def _paper_model(name, n=1.3, e=0.6):
@@ -335,7 +331,7 @@ def test_a_study_scores_a_contact_models_fit():
     from discovery.vibroimpact.studies.config import load_study
     from discovery.vibroimpact.studies.run import score_contact
 
-    cfg = load_study(Path(__file__).resolve().parents[1] / "examples/study_contact_models.toml")
+    cfg = load_study(Path(__file__).resolve().parents[3] / "examples/study_contact_models.toml")
     runs = cfg.runs()
     assert {r["library"] for r in runs} == {"contact-models"}
     assert any(r["law"].startswith("flores:") for r in runs)
@@ -418,7 +414,7 @@ def test_cli_fit_contact_models_on_two_operating_points(tmp_path, capsys):
     from discovery.cli import main
 
     _, model = _paper_model("hunt-crossley", n=1.2, e=0.6)
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[3]
     text = (root / "discovery/vibroimpact/model/scenarios/paper.toml").read_text()
     recs, tomls = [], []
     for i, (A, f) in enumerate(((5e5, 25.0), (6.25e5, 35.0))):

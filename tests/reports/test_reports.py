@@ -685,7 +685,7 @@ def test_the_limit_rule_names_each_criterion_s_factor():
     for k, f in CONSISTENCY_FACTORS.items():
         assert f"$f = {f:g}$ for" in text and f"$I_{k[1:]}$" in text
     for name in ("verify", "fit"):
-        src = (Path(__file__).parents[1] / "reports" / "templates" / f"{name}.tex.j2").read_text()
+        src = (Path(__file__).parents[2] / "reports" / "templates" / f"{name}.tex.j2").read_text()
         assert "m.limit_rule()" in src and r"\max(2\," not in src
 
 
@@ -720,7 +720,7 @@ def test_a_contact_models_report_lists_every_record_and_scenario():
     c = contact_models_context(s, ".")
     assert [str(r) for r in c["records"]] == ["high.csv", "low.csv"]
     assert c["scenarios"][0][1:] == ["grid-high", "grid-low"]
-    src = (Path(__file__).parents[1] / "reports/templates/contact_models.tex.j2").read_text()
+    src = (Path(__file__).parents[2] / "reports/templates/contact_models.tex.j2").read_text()
     assert "records" in src
 
 

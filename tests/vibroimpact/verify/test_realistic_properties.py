@@ -22,11 +22,11 @@ Below them, regression tests for the defects the survey found.
 
 import numpy as np
 import pytest
-import realistic as R
 
 from discovery import ForceLaw, Scenario
 from discovery.vibroimpact.data.impulse import _edges, _merge_unseparated, impulse_from_samples
 from discovery.vibroimpact.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK, Reference, evaluate
+from tests import realistic as R
 
 RATE = 0.95
 NOISE_SEEDS = (0, 1)

@@ -33,7 +33,7 @@ from discovery.vibroimpact.dynamics import Tolerances
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario
 
-ENTRAINED = UedaSystem.from_model("negres", B=0.45, nu=1.05)  # tests/test_ueda.py: P1
+ENTRAINED = UedaSystem.from_model("negres", B=0.45, nu=1.05)  # tests/ueda/test_ueda.py: P1
 
 
 class LinearForcedMap:
@@ -142,10 +142,10 @@ def test_logistic_period_two_is_not_reduced_to_the_unstable_fixed_point():
 # ------------------------------------------------------------------ vibro-impact unchanged
 # recorded with the implementation before the move (steady_state.py's own _newton,
 # _reduce_period, _recurrence) and its finite-difference Jacobians; since the Jacobian is
-# exact (variational equations and saltation, tests/test_sensitivities.py) Newton takes
-# other steps to the same orbit and the multipliers lose the differences' error; since
-# each full Newton step's state and Jacobian come from one run, five runs fewer (29 -> 24,
-# 32 -> 27)
+# exact (variational equations and saltation, tests/vibroimpact/dynamics/test_sensitivities.py)
+# Newton takes other steps to the same orbit and the multipliers lose the differences' error;
+# since each full Newton step's state and Jacobian come from one run, five runs fewer
+# (29 -> 24, 32 -> 27)
 PAPER = {
     "y0": [-0.005653106861707833, 0.28098294771776317, -0.0058524706348867615, 0.06132476750837263],
     "mult": [

@@ -11,7 +11,7 @@ from discovery.vibroimpact.dynamics import _kernel as K
 from discovery.vibroimpact.dynamics.simulation import Tolerances, simulate
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario, load_scenario
-from tests.test_kernel import _compare_with_reference
+from tests.vibroimpact.dynamics.test_kernel import _compare_with_reference
 
 M, MU, KW, V0, GAP = 2.0, 1.0, 1.0e6, 1.0, 1.0e-3  # reduced mass 1 kg; w0 = 1000 rad/s
 W0 = np.sqrt(KW / MU)

@@ -191,8 +191,8 @@ def test_candidates_from_a_fit_directory(tmp_path):
 
 def _contact_fit(selected="hunt-crossley", equivalent=("flores",)):
     """A contact-models fit of a Hunt-Crossley record of the paper's machine at one
-    operating point (the parameters of ``tests/test_contact_models.py``'s record): Flores
-    makes the same force at its one impact velocity."""
+    operating point (the parameters of ``tests/vibroimpact/model/test_contact_models.py``'s
+    record): Flores makes the same force at its one impact velocity."""
     from discovery.vibroimpact.fit.contact_fit import ContactFit, ContactModelsResult
 
     params = {

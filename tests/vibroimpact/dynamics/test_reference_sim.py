@@ -101,8 +101,8 @@ def test_no_release_is_reported_at_a_loss_where_the_force_vanishes():
 
 @pytest.mark.parametrize("text", ["2.06e8*z", "2.06e8*z + 1.28e7*zd"])
 def test_reference_matches_kernel_without_normalising_events(text):
-    # tests/test_kernel.py drops a "release" reported at the instant of a loss: there
-    # are none now, so the raw sequences are equal
+    # tests/vibroimpact/dynamics/test_kernel.py drops a "release" reported at the instant of a
+    # loss: there are none now, so the raw sequences are equal
     sc = load_scenario("paper")
     law = ForceLaw.parse(text)
     ref, tr = _agrees_with_kernel(sc, law, 0.0, sc.initial_state(), periods=6, rtol=1e-10)

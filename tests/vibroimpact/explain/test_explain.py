@@ -9,7 +9,6 @@ import json
 
 import numpy as np
 import pytest
-import realistic as R
 
 from discovery import ForceLaw, load_scenario
 from discovery.cli import main
@@ -18,6 +17,7 @@ from discovery.vibroimpact.data.measurement import Measurement
 from discovery.vibroimpact.dynamics.law_response import response
 from discovery.vibroimpact.explain import EFFECTS, effect, explain, first_order_lag
 from discovery.vibroimpact.explain.effects import TARGETS
+from tests import realistic as R
 
 HC = ForceLaw.parse("2.06e8*z + 0.9e7*zd + 2e10*z*zd")  # Hunt-Crossley-type coupling hidden
 

@@ -10,13 +10,13 @@ import json
 
 import numpy as np
 import pytest
-import realistic as R
 
 from discovery import ForceLaw, load_scenario
 from discovery.cli import main
 from discovery.vibroimpact.dynamics import _kernel as K
 from discovery.vibroimpact.dynamics.simulation import simulate
 from discovery.vibroimpact.explain import explain
+from tests import realistic as R
 
 BASE = "2.06e8*z + 4e6*zd"  # the paper's machine, a lighter damper (no dominant jump)
 

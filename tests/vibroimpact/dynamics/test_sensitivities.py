@@ -40,7 +40,8 @@ M, KW, V0, GAP = 2.0, 1.0e6, 1.0, 1.0e-3  # two free masses: reduced mass 1, w0 
 
 def _restitution_and_loss(k, c):
     """The paper's law ``k z + c zd`` (unloading ``k z``) on two free masses: restitution
-    ``exp(-xi phi)`` and the contact loss time (tests/test_kernel.py's closed form)."""
+    ``exp(-xi phi)`` and the contact loss time (the closed form of
+    tests/vibroimpact/dynamics/test_kernel.py)."""
     xi, w0 = c / (2.0 * np.sqrt(k)), np.sqrt(k)
     phi = np.arccos(xi) / np.sqrt(1 - xi**2) if xi < 1 else np.arccosh(xi) / np.sqrt(xi**2 - 1)
     return np.exp(-xi * phi), GAP / V0 + (phi + np.pi / 2) / w0

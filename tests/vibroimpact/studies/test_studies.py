@@ -18,7 +18,7 @@ from discovery.vibroimpact.studies.config import run_key
 from discovery.vibroimpact.studies.records import clean_record, field_record
 from reports.vibroimpact.study_figures import study_figures
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[3]
 VIDI = [sys.executable, "-c", "import sys; from discovery.cli import main; sys.exit(main())"]
 
 # the paper's law, two noise levels and two methods, regression only: 8 runs in seconds

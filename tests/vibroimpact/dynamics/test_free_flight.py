@@ -17,7 +17,7 @@ from discovery.vibroimpact.model.scenario import Scenario, load_scenario
 
 PAPER, LIGHT = load_scenario("paper"), load_scenario("light")
 _P4 = Scenario(m1=10800.0, m2=5960.0, k1=216000000.0, c1=96300.0, A=393000.0, frequency=13.7)
-_PD = Scenario(  # tests/test_steady_state.py
+_PD = Scenario(  # tests/vibroimpact/dynamics/test_steady_state.py
     m1=4770.989046559852,
     m2=5430.940884957566,
     k1=161209836.32495606,
@@ -104,7 +104,8 @@ def test_closed_form_flight_agrees_with_the_integrator(name):
 
 @pytest.mark.parametrize(
     "name",
-    # (not the re-contact case: scipy steps over its brief dip, tests/test_kernel_events.py)
+    # (not the re-contact case: scipy steps over its brief dip,
+    # tests/vibroimpact/dynamics/test_kernel_events.py)
     ["P1 paper", "P4 subharmonic", "permanent_set", "sticking (long contacts)", "short contact"],
 )
 def test_closed_form_flight_agrees_with_the_scipy_reference(name):
@@ -204,7 +205,7 @@ AMP, OMEGA = 1.0e-3, 10 * np.pi
 def _graze(depth, shift=0.0, g=0.0, c1=0.0):
     """The frame oscillates on its spring (no drive), the moulding floats at ``AMP - depth``
     (no gravity): ``zeta`` peaks at ``+depth`` (a graze) or stays ``-depth`` short of the
-    surface (a near miss) once a cycle (tests/test_kernel_events.py)."""
+    surface (a near miss) once a cycle (tests/vibroimpact/dynamics/test_kernel_events.py)."""
     return Scenario(
         m1=1.0,
         m2=1.0,
@@ -294,7 +295,7 @@ def test_frames_from_undamped_to_overdamped(c1):
     )
     law = ForceLaw.parse("1e6*z + 50*zd")
     # the flights alone: the same integrated contacts on both paths (this stiff law's
-    # closed-form contacts are checked in tests/test_closed_contact.py)
+    # closed-form contacts are checked in tests/vibroimpact/dynamics/test_closed_contact.py)
     a = _run(sc, law, 6, "closed", contact="integrate")
     b = _run(sc, law, 6, "integrate")
     assert [EVENT_NAMES[k] for k in a.event_kind] == [EVENT_NAMES[k] for k in b.event_kind]

@@ -6,15 +6,16 @@ channel's range); the machines and laws are fixed here (drawn once by the genera
 or built for the case), so the tests do not move when the generator changes.
 
 1. A slow P1 orbit (Floquet multiplier ~ -0.985) is never read as P2: already covered
-   by ``tests/test_steady_state.py::test_p1_with_multiplier_near_minus_one_is_not_read_as_p2``
-   (the steady state) and ``tests/test_verify.py::test_slow_p1_record_is_read_as_p1``
+   by ``test_p1_with_multiplier_near_minus_one_is_not_read_as_p2`` of
+   ``tests/vibroimpact/dynamics/test_steady_state.py`` (the steady state) and
+   ``tests/vibroimpact/verify/test_verify.py::test_slow_p1_record_is_read_as_p1``
    (its record, verified).  Not repeated here.
 2. A subharmonic P4 orbit with 3 impacts is aligned impact to impact (true law I2 small,
-   consistent): covered by
-   ``tests/test_verify.py::test_subharmonic_with_several_impacts_is_aligned``.  Added
-   here: the *noise floor* aligns its replicates the same way (before, a replicate whose
-   main impact was the other one of two similar impacts was compared misaligned, and
-   the floor of a P4 orbit reached 0.2-1.4, so a law without its stiffness passed).
+   consistent): covered by ``test_subharmonic_with_several_impacts_is_aligned`` of
+   ``tests/vibroimpact/verify/test_verify.py``.  Added here: the *noise floor* aligns its
+   replicates the same way (before, a replicate whose main impact was the other one of two
+   similar impacts was compared misaligned, and the floor of a P4 orbit reached 0.2-1.4,
+   so a law without its stiffness passed).
 3. A P1 record whose cycle was read as two periods: read as P1, true law I1 small.
 4. A short contact (1.5 ms of a 42 ms period) at 2 % force noise: the true law is
    consistent, a law missing a real term is not.
@@ -27,11 +28,11 @@ or built for the case), so the tests do not move when the generator changes.
 
 import numpy as np
 import pytest
-import realistic as R
 
 from discovery import ForceLaw, Scenario
 from discovery.vibroimpact.data.impulse import _bracket_onset, impulse_from_samples
 from discovery.vibroimpact.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK, Reference, evaluate
+from tests import realistic as R
 
 
 def _verify(sc, law, record, wrong=()):

@@ -18,7 +18,7 @@ from discovery.vibroimpact.model.scenario import Scenario, load_scenario
 
 PAPER, LIGHT = load_scenario("paper"), load_scenario("light")
 _P4 = Scenario(m1=10800.0, m2=5960.0, k1=216000000.0, c1=96300.0, A=393000.0, frequency=13.7)
-_PD = Scenario(  # tests/test_steady_state.py
+_PD = Scenario(  # tests/vibroimpact/dynamics/test_steady_state.py
     m1=4770.989046559852,
     m2=5430.940884957566,
     k1=161209836.32495606,
@@ -450,9 +450,9 @@ def test_a_frame_without_a_spring_integrates_its_contacts_coefficient_sensitivit
 
 @pytest.mark.parametrize("c1", [0.0, 20.0, 100.0, 2000.0])  # undamped to overdamped frames
 def test_frames_from_undamped_to_overdamped(c1):
-    """tests/test_free_flight.py's machines (critical damping at c1 = 20), whose contacts are
-    short and stiff: the closed-form run against the integrator path at rtol 1e-13 (at rtol
-    1e-10 its own error in these contacts reaches 7e-7 T)."""
+    """tests/vibroimpact/dynamics/test_free_flight.py's machines (critical damping at
+    c1 = 20), whose contacts are short and stiff: the closed-form run against the integrator
+    path at rtol 1e-13 (at rtol 1e-10 its own error in these contacts reaches 7e-7 T)."""
     sc = Scenario(
         m1=1.0,
         m2=0.5,
