@@ -646,17 +646,14 @@ def test_an_explain_report_lists_the_effects_own_parameters():
     from discovery.vibroimpact.explain import EFFECTS
     from reports.context import _effect_parameter_rows
 
-    fm = {
-        "effects": ["contact_offset"],
-        "scenario": {"offset": 0.0015},
-        "uncertainties": {"delta0": 3e-7},
-        "intervals": {"bounds": {"delta0": [0.001499, 0.001501]}},
-    }
-    rows = _effect_parameter_rows(fm, [e.as_dict() for e in EFFECTS])
+    fm = _ns(effects=("contact_offset",), scenario={"offset": 0.0015}, observation={})
+    errors, bounds = {"delta0": 3e-7}, {"delta0": (0.001499, 0.001501)}
+    rows = _effect_parameter_rows(fm, errors, bounds, [e.as_dict() for e in EFFECTS])
     assert len(rows) == 1
     assert "delta0" in str(rows[0][0]) and "[m]" in str(rows[0][0])
     assert "0.001499" in str(rows[0][3])
-    assert _effect_parameter_rows(fm, None) == []  # an edited summary without a catalogue
+    # an edited summary without a catalogue
+    assert _effect_parameter_rows(fm, errors, bounds, None) == []
 
 
 def test_the_criteria_table_holds_the_motion_criterion():
@@ -692,18 +689,17 @@ def test_the_limit_rule_names_each_criterion_s_factor():
 def test_explain_s_unloading_term_carries_its_error_and_interval():
     """The unloading coefficient's standard error and interval (parameter ``d_zd``) are in
     the final model's table, not "--"."""
+    from discovery import ForceLaw
+    from discovery.vibroimpact.model.law import Term
     from reports.vibroimpact.context import _unloading_rows
 
-    fm = {
-        "unloading": {"zd": 4.05e6},
-        "uncertainties": {"z": 3.3e4, "d_zd": 1056.5},
-        "intervals": {"bounds": {"d_zd": [3.99e6, 4.11e6]}},
-    }
-    (row,) = _unloading_rows(fm)
+    law = ForceLaw.parse("2e8*z").with_unloading([Term.parse("zd")], [4.05e6], 0.0)
+    errors = {"z": 3.3e4, "d_zd": 1056.5}
+    (row,) = _unloading_rows(law, errors, {"d_zd": (3.99e6, 4.11e6)})
     assert "unloading" in str(row[0]) and "zeta" in str(row[0])
     assert "1056" in str(row[2]) or "1.1" in str(row[2])
     assert "3.990" in str(row[3]) and "4.110" in str(row[3])
-    assert _unloading_rows({}) == []
+    assert _unloading_rows(ForceLaw.parse("2e8*z"), errors, {}) == []
 
 
 def test_a_contact_models_report_lists_every_record_and_scenario():
