@@ -890,6 +890,7 @@ def test_a_law_in_the_settings_and_the_study_design_is_typeset_whole():
     typeset whole, as the report's equations set it: not half math, half text."""
     from reports.cells import _provenance
     from reports.lawtex import law_inline, law_of, prose, value_tex
+    from reports.run import run_document
     from reports.vibroimpact.study_context import _study
 
     start = "1.5e8*z + 0.9e7*zd"
@@ -900,7 +901,15 @@ def test_a_law_in_the_settings_and_the_study_design_is_typeset_whole():
     assert f"start={whole}" in row and "*z" not in row and "*$" not in row
     assert f"law={whole}, " + str(law_inline(law_of("7.3e9*z^1.5", "law"))) in row
     design = {"varied": {"law": [start]}, "fixed": {"law": start, "library": "z, zd"}}
-    c = _study({"design": design, "cells": [{"law": start, "runs": 0, "recovered": 0}]}, ".")
+    study = _ns(
+        design=lambda: design,
+        pooled=dict,
+        cells=[{"law": start, "runs": 0, "recovered": 0}],
+        config=_ns(name=""),
+        complete=0,
+        n_runs=0,
+    )
+    c = _study(run_document({}, result=study), ".")
     cells = [str(x) for r in c["design"] for x in r] + [str(x) for x in c["cells"][0]]
     assert whole in cells and f"{whole} (fixed)" in cells and "*z" not in " ".join(cells)
     assert str(value_tex("z,zd")) == r"$\zeta$,$\dot\zeta_{+}$"  # a term list is no law
