@@ -38,10 +38,10 @@ from .vibroimpact.study_context import _study
 __all__ = ["context", "KINDS", "criterion_names"]
 
 
-def _advise(s, run_dir):
+def _advise(doc, run_dir):
     from .vibroimpact.advise_report import advise_context
 
-    return advise_context(s, run_dir, _figures)
+    return advise_context(doc, run_dir, _figures)
 
 
 KINDS = {
@@ -72,7 +72,7 @@ TEMPLATES = {
 
 #: the kinds whose context reads the run's typed result (a :class:`~reports.run.RunDocument`);
 #: the others read the summary's keys
-TYPED = {_verify, _identify, _landscape, _explain, _study}
+TYPED = {_verify, _identify, _landscape, _explain, _study, _advise}
 
 
 def context(doc, run_dir):
