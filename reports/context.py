@@ -91,7 +91,8 @@ def context(doc, run_dir):
         from discovery.errors import InputError
 
         raise InputError(f"no report for a {kind!r} run; reports cover {', '.join(KINDS)} runs")
-    c = build(doc if build in TYPED else summary, run_dir)
+    # the contact models' fit reads its typed result (ContactModelsResult) too
+    c = build(doc if build in TYPED or named else summary, run_dir)
     c["kind"] = kind
     c["template"] = ("contact_models" if named else TEMPLATES.get(kind, "ueda")) + ".tex.j2"
     c["provenance"] = _provenance(summary, run_dir)

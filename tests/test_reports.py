@@ -704,16 +704,18 @@ def test_explain_s_unloading_term_carries_its_error_and_interval():
 
 def test_a_contact_models_report_lists_every_record_and_scenario():
     """A contact-models fit on two records names both records and both scenarios."""
+    from discovery import ContactModelsResult
     from reports.contact_models import contact_models_context
+    from reports.run import run_document
 
     sc = {"name": "grid-high", "m1": 1e4, "m2": 1e4, "k1": 2.75e7, "c1": 1e5, "A": 5e5}
     s = {
-        "fits": [],
         "data": ["high.csv", "low.csv"],
         "scenario": sc,
         "scenarios": [sc, {**sc, "name": "grid-low", "A": 3.5e5}],
     }
-    c = contact_models_context(s, ".")
+    r = ContactModelsResult(fits=(), selected=None, n_records=2)
+    c = contact_models_context(run_document(s, result=r), ".")
     assert [str(r) for r in c["records"]] == ["high.csv", "low.csv"]
     assert c["scenarios"][0][1:] == ["grid-high", "grid-low"]
     src = (Path(__file__).parents[1] / "reports/templates/contact_models.tex.j2").read_text()
