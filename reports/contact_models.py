@@ -1,6 +1,7 @@
-"""The report of a ``vidi fit --library contact-models`` run, from its ``summary.json``
-alone: every named model fitted, its parameters with their 95 % intervals, its verdict,
-and which model the record supports and which it cannot tell from it."""
+"""The report of a ``vidi fit --library contact-models`` run, from its typed result
+(:class:`~discovery.ContactModelsResult`): every named model fitted, its parameters with
+their 95 % intervals, its verdict, and which model the record supports and which it cannot
+tell from it."""
 
 from __future__ import annotations
 
@@ -26,11 +27,11 @@ _FORMS = {
 def _rows(fits, selected):
     rows = []
     for f in fits:
-        name = Tex(escape(f["model"]) + (r" $\star$" if f["model"] == selected else ""))
-        ok = {True: "consistent", False: "inconsistent"}.get(f.get("consistent"), "failed")
+        name = Tex(escape(f.model) + (r" $\star$" if f.model == selected else ""))
+        ok = {True: "consistent", False: "inconsistent"}.get(f.consistent, "failed")
         params = []
-        for k, v in f["parameters"].items():
-            iv = f["intervals"].get(k)
+        for k, v in f.parameters.items():
+            iv = f.intervals.get(k)
             text = f"${_PARAM_TEX.get(k, escape(k))}$ = {num(v, 4)}"
             if iv:
                 text += f" [{num(iv[0], 4)}, {num(iv[1], 4)}]"
@@ -38,8 +39,8 @@ def _rows(fits, selected):
         rows.append(
             [
                 name,
-                Tex(f"${_FORMS.get(f['model'], '')}$"),
-                num(f.get("value"), 3),
+                Tex(f"${_FORMS.get(f.model, '')}$"),
+                num(f.value, 3),
                 escape(ok),
                 Tex("; ".join(params)),
             ]
@@ -47,15 +48,20 @@ def _rows(fits, selected):
     return rows
 
 
-def contact_models_context(s, run_dir):
-    """The template context (``contact_models.tex.j2``)."""
-    n = s.get("n_records") or len(_listed(s.get("data"))) or 1
+def contact_models_context(doc, run_dir):
+    """The template context (``contact_models.tex.j2``) of a
+    :class:`~reports.run.RunDocument`."""
+    r = doc.result
+    s = doc.summary  # the records and scenarios as the command was given them
+    n = r.n_records or len(_listed(s.get("data"))) or 1
     return {
         "title": "The named contact models against a record",
         "supports": f"{the_records(n)} {verb(n, 'supports', 'support')}",
-        "rows": _rows(s.get("fits") or [], s.get("selected")),
-        "conclusions": [prose(s.get("conclusion") or "--")],
-        "interval_method": escape((s.get("fit_settings") or {}).get("interval_method", "--")),
+        "rows": _rows(r.fits or (), r.selected),
+        # the run's conclusion as it wrote it (one written before the summary kept the
+        # number of records named a single record and had no final period)
+        "conclusions": [prose(s.get("conclusion") or r.conclusion or "--")],
+        "interval_method": escape((r.settings or {}).get("interval_method", "--")),
         "figures": [],
         "records": [escape(str(d)) for d in _listed(s.get("data"))],
         "scenarios": _scenarios_table(s.get("scenarios") or [s.get("scenario")]),

@@ -38,10 +38,10 @@ from .vibroimpact.study_context import _study
 __all__ = ["context", "KINDS", "criterion_names"]
 
 
-def _advise(s, run_dir):
+def _advise(doc, run_dir):
     from .vibroimpact.advise_report import advise_context
 
-    return advise_context(s, run_dir, _figures)
+    return advise_context(doc, run_dir, _figures)
 
 
 KINDS = {
@@ -72,7 +72,7 @@ TEMPLATES = {
 
 #: the kinds whose context reads the run's typed result (a :class:`~reports.run.RunDocument`);
 #: the others read the summary's keys
-TYPED = {_verify, _identify, _landscape}
+TYPED = {_verify, _identify, _landscape, _explain, _study, _advise}
 
 
 def context(doc, run_dir):
@@ -91,7 +91,8 @@ def context(doc, run_dir):
         from discovery.errors import InputError
 
         raise InputError(f"no report for a {kind!r} run; reports cover {', '.join(KINDS)} runs")
-    c = build(doc if build in TYPED else summary, run_dir)
+    # the contact models' fit reads its typed result (ContactModelsResult) too
+    c = build(doc if build in TYPED or named else summary, run_dir)
     c["kind"] = kind
     c["template"] = ("contact_models" if named else TEMPLATES.get(kind, "ueda")) + ".tex.j2"
     c["provenance"] = _provenance(summary, run_dir)

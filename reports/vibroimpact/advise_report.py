@@ -1,6 +1,6 @@
-"""The report of an ``advise`` run, from its ``summary.json`` alone (see
-:mod:`reports.context`): the candidates, the advised point, the ranked points with every
-pair's separation and every candidate's regime, and the map."""
+"""The report of an ``advise`` run, from its typed result (see :mod:`reports.context`):
+the candidates, the advised point, the ranked points with every pair's separation and every
+candidate's regime, and the map."""
 
 from __future__ import annotations
 
@@ -17,32 +17,29 @@ CAPTION = (
 
 
 def _f(v):
-    """A summary number (``"inf"`` or None allowed) as table text."""
-    if v == "inf":
+    """A number of the result (infinity, nan or None allowed; ``"inf"`` as a summary wrote
+    it) as table text."""
+    if v == "inf" or v == float("inf"):
         return Tex(r"$\infty$")
     return num(v) if v is not None else "--"
 
 
 def _pair_cell(q):
-    tag = " (regime)" if q.get("regime_change") else ""
-    return Tex(f"{_f(q['separation'])}{tag}")
+    tag = " (regime)" if q.regime_change else ""
+    return Tex(f"{_f(q.separation)}{tag}")
 
 
-def _ranked_rows(s, n_laws, limit=12):
-    points = s.get("points") or []
+def _ranked_rows(r, limit=12):
     rows = []
-    for rank, k in enumerate((s.get("ranking") or [])[:limit], start=1):
-        p = points[k]
-        regimes = ", ".join(
-            f"{pr.get('regime')}/{pr.get('impacts')}" for pr in p.get("predictions") or []
-        )
+    for rank, p in enumerate(r.ranked()[:limit], start=1):
+        regimes = ", ".join(f"{pr.regime}/{pr.impacts}" for pr in p.predictions or ())
         rows.append(
             [
                 rank,
-                num(p["amplitude"]),
-                num(p["frequency"]),
-                "--" if p.get("m2") is None else num(p["m2"]),
-                *[_pair_cell(q) for q in p.get("pairs") or []],
+                num(p.amplitude),
+                num(p.frequency),
+                "--" if p.m2 is None else num(p.m2),
+                *[_pair_cell(q) for q in p.pairs or ()],
                 regimes,
             ]
         )
@@ -54,26 +51,26 @@ def _t(*parts):
     return Tex("".join(p if isinstance(p, Tex) else str(escape(str(p))) for p in parts))
 
 
-def _conclusions(s, n_laws):
-    adv = s.get("advised")
-    if not adv:
+def _conclusions(r):
+    adv = r.best
+    if adv is None:
         return [
             "No point of the bounds is usable (every one is outside the safe region or a "
             "candidate has no periodic orbit with contact there): widen the bounds."
         ]
-    pairs = adv.get("pairs") or []
-    regime = [q for q in pairs if q.get("regime_change")]
-    where = ["Take the next record at A = ", num(adv["amplitude"]), " N, f = "]
-    where += [num(adv["frequency"]), " Hz"]
-    if adv.get("m2") is not None:
-        where += [", m2 = ", num(adv["m2"]), " kg"]
+    regime = [q for q in adv.pairs or () if q.regime_change]
+    where = ["Take the next record at A = ", num(adv.amplitude), " N, f = "]
+    where += [num(adv.frequency), " Hz"]
+    if adv.m2 is not None:
+        where += [", m2 = ", num(adv.m2), " kg"]
     out = [_t(*where, ".")]
-    if s.get("separates"):
+    if r.separates:
+        smallest = adv.smallest_separation(frozenset(r.inseparable))
         out.append(
             _t(
                 "There the verdict rejects the false law of every pair whichever is true "
                 "(smallest separation ",
-                _f(s.get("smallest_separation")),
+                _f(smallest),
                 "; 1 is the limit).",
             )
         )
@@ -87,57 +84,54 @@ def _conclusions(s, n_laws):
             f"{len(regime)} pair(s) predict different regimes there: they are separated "
             "outright by the regime, which a record near a regime boundary may not reach."
         )
-    for q in s.get("inseparable") or []:
+    for q in r.inseparable:
         out.append(
             f"No point of the bounds separates candidates {q[0] + 1} and {q[1] + 1}: within "
             "the noise they are the same law there."
         )
-    unsafe = sum(bool(p.get("unsafe")) for p in s.get("points") or [])
+    unsafe = sum(bool(p.unsafe) for p in r.points or ())
     if unsafe:
         out.append(f"{unsafe} point(s) were excluded by the safe region.")
     return out
 
 
-def advise_context(s, run_dir, figures):
-    """The template context of an advise run; ``figures`` is :func:`reports.context._figures`."""
-    laws = s.get("laws") or []
+def advise_context(doc, run_dir, figures):
+    """The template context of an advise run (a :class:`~reports.run.RunDocument` of an
+    :class:`~discovery.AdviseResult`); ``figures`` is :func:`reports.context._figures`."""
+    r = doc.result
+    laws = r.laws or ()
     n = len(laws)
-    adv = s.get("advised") or {}
-    noise = s.get("noise") or {}
-    pair_heads = [
-        f"{q['pair'][0] + 1}-{q['pair'][1] + 1}"
-        for q in (adv.get("pairs") or [])
-        or [{"pair": (i, j)} for i in range(n) for j in range(i + 1, n)]
+    adv = r.best
+    noise, knobs, safe = r.noise, r.knobs, r.safe
+    pairs = [q.pair for q in (adv.pairs if adv is not None else ())] or [
+        (i, j) for i in range(n) for j in range(i + 1, n)
     ]
-    knobs = s.get("knobs") or {}
     return {
         "title": "Where to take the next record",
         "candidates": [[k + 1, law_inline(law_of(t, "laws"))] for k, t in enumerate(laws)],
         "bounds": [
-            ["drive amplitude", Tex(" -- ".join(num(v) for v in knobs.get("amplitude") or []))],
-            ["drive frequency", Tex(" -- ".join(num(v) for v in knobs.get("frequency") or []))],
+            ["drive amplitude", Tex(" -- ".join(num(v) for v in knobs.amplitude or ()))],
+            ["drive frequency", Tex(" -- ".join(num(v) for v in knobs.frequency or ()))],
             [
                 "moulding mass",
-                "scenario's"
-                if not knobs.get("m2")
-                else Tex(" -- ".join(num(v) for v in knobs["m2"])),
+                "scenario's" if not knobs.m2 else Tex(" -- ".join(num(v) for v in knobs.m2)),
             ],
-            ["max peak force", _f((s.get("safe") or {}).get("max_force"))],
-            ["max penetration", _f((s.get("safe") or {}).get("max_penetration"))],
-            ["force noise", Tex(num(100 * noise.get("relative", 0.0)) + r"\,\% of the peak")],
+            ["max peak force", _f(safe.max_force)],
+            ["max penetration", _f(safe.max_penetration)],
+            ["force noise", Tex(num(100 * (noise.relative or 0.0)) + r"\,\% of the peak")],
             [
                 "position noise",
                 "none (a force record: I2, I4)"
-                if noise.get("position") is None
+                if noise.position is None
                 else Tex(
-                    num(100 * noise["position"]) + r"\,\% of the largest penetration (I2, I4, I5)"
+                    num(100 * noise.position) + r"\,\% of the largest penetration (I2, I4, I5)"
                 ),
             ],
-            ["noise from", noise.get("source", "--")],
+            ["noise from", noise.source or "--"],
         ],
-        "pair_heads": pair_heads,
-        "ranked": _ranked_rows(s, n),
-        "n_points": len(s.get("points") or []),
-        "conclusions": _conclusions(s, n),
+        "pair_heads": [f"{i + 1}-{j + 1}" for i, j in pairs],
+        "ranked": _ranked_rows(r),
+        "n_points": len(r.points or ()),
+        "conclusions": _conclusions(r),
         "figures": [dict(f, caption=CAPTION) for f in figures(run_dir, ["advise_map"])],
     }

@@ -320,15 +320,17 @@ def _landscape(doc, run_dir):
     return c
 
 
-def _effect_parameter_rows(fm, catalogue):
+def _effect_parameter_rows(model, errors, intervals, catalogue):
     """Rows of the added effects' own parameters (a machine parameter such as the contact
-    offset, an observation's such as a sensor's lag), by the catalogue's names and units."""
+    offset, an observation's such as a sensor's lag), by the catalogue's names and units:
+    ``model`` the final :class:`~discovery.vibroimpact.explain.effects.Model`, ``errors``
+    and ``intervals`` its parameters' standard errors and bounds."""
     if not isinstance(catalogue, list):
         return []
-    values = {**(fm.get("scenario") or {}), **(fm.get("observation") or {})}
+    values = {**(model.scenario or {}), **(model.observation or {})}
     rows = []
     for e in catalogue:
-        if not isinstance(e, dict) or e.get("id") not in (fm.get("effects") or []):
+        if not isinstance(e, dict) or e.get("id") not in (model.effects or ()):
             continue
         key, params = e.get("key"), e.get("parameters") or []
         if key not in values or not params or not isinstance(params[0], dict):
@@ -336,68 +338,68 @@ def _effect_parameter_rows(fm, catalogue):
         name, unit = str(params[0].get("name")), str(params[0].get("unit", ""))
         rows += _coef_rows(
             {name: values[key]},
-            fm.get("uncertainties"),
-            _intervals(fm),
+            errors,
+            intervals,
             term=lambda n, u=unit: Tex(r"\texttt{" + escape(n) + "} [" + escape(u) + "]"),
         )
     return rows
 
 
-def _unloading_rows(fm):
-    """Rows of the unloading branch's terms, with the standard errors and intervals of
-    their coefficients (parameters ``d_<term>``, as the unloading-damping effect names
-    them)."""
-    unl = fm.get("unloading") or {}
-    iv = _intervals(fm)
-    errors = fm.get("uncertainties") or {}
+def _unloading_rows(law, errors, intervals):
+    """Rows of the unloading branch's terms of ``law``, with the standard errors and
+    intervals of their coefficients (parameters ``d_<term>``, as the unloading-damping
+    effect names them)."""
+    unl = zip([t.name for t in law.unloading], law.unloading_coefficients, strict=True)
     return _coef_rows(
-        {f"d_{k}": v for k, v in unl.items()},
+        {f"d_{k}": v for k, v in unl},
         errors,
-        iv,
+        intervals,
         term=lambda n: Tex("unloading " + term_tex(n[2:], unloading=True)),
     )
 
 
-def _explain(s, run_dir):
-    fm = s.get("final_model") or {}
-    its = s.get("iterations") or []
+def _explain(doc, run_dir):
+    r = doc.result
+    fm = r.final_model
+    its = r.iterations or ()
+    iv = r.intervals.bounds if r.intervals is not None else {}
+    stopped = r.stopped_because
     c = {
         "title": "The missing physical effect",
-        "model": _model_tex(fm.get("text") or fm.get("coefficients"), "final_model.text"),
-        "coefficients": _coef_rows(
-            fm.get("coefficients") or {}, fm.get("uncertainties"), _intervals(fm)
-        )
-        + _unloading_rows(fm)
-        + _effect_parameter_rows(fm, s.get("catalogue")),
-        "effects": [str(e).replace("_", " ") for e in fm.get("effects") or []],
-        "criteria": _criteria_table(s.get("criteria"), s.get("noise_floor"), s.get("limits")),
-        "stopped": prose(s.get("stopped_because", "--")),
+        "model": _model_tex(fm.law, "final_model.text"),
+        "coefficients": _coef_rows(fm.law.as_dict(), r.uncertainties, iv)
+        + _unloading_rows(fm.law, r.uncertainties, iv)
+        # the effects' catalogue is the command's (the result does not keep it)
+        + _effect_parameter_rows(fm, r.uncertainties, iv, doc.summary.get("catalogue")),
+        "effects": [str(e).replace("_", " ") for e in fm.effects or ()],
+        "criteria": _criteria_table(r.criteria, r.noise_floor, r.limits),
+        "stopped": prose("--" if stopped is None else stopped),
         "iterations": [
             [
                 str(k + 1),
-                str(it.get("effect") or "nothing named").replace("_", " "),
-                num((it.get("criteria_before") or {}).get("I2")),
-                num((it.get("criteria_after") or {}).get("I2")),
-                num((it.get("noise_floor") or {}).get("I2")),
-                prose(it.get("evidence", "")),
+                str(it.effect or "nothing named").replace("_", " "),
+                num((it.criteria_before or {}).get("I2")),
+                num((it.criteria_after or {}).get("I2")),
+                num((it.noise_floor or {}).get("I2")),
+                prose(it.evidence or ""),
             ]
             for k, it in enumerate(its)
         ],
         "separability": [
             [
-                r.get("effect", "--"),
-                num(r.get("before")),
-                num(r.get("after")),
-                num(r.get("floor")),
-                "yes" if r.get("separable") else "no",
+                s.get("effect", "--"),
+                num(s.get("before")),
+                num(s.get("after")),
+                num(s.get("floor")),
+                "yes" if s.get("separable") else "no",
             ]
-            for r in s.get("separability") or []
+            for s in r.separability or ()
         ],
     }
-    named_its = [it for it in its if it.get("effect")]
+    named_its = [it for it in its if it.effect]
     if named_its:
-        named = ", ".join(str(it["effect"]).replace("_", " ") for it in named_its)
-        state = "consistent" if s.get("consistent") else "still NOT consistent"
+        named = ", ".join(str(it.effect).replace("_", " ") for it in named_its)
+        state = "consistent" if r.consistent else "still NOT consistent"
         concl = [
             f"Named and added: {named}. The gap to the record shrank as the table shows; "
             f"the final model is {state} with the record."
@@ -405,7 +407,7 @@ def _explain(s, run_dir):
     else:
         concl = [
             "No effect was added: "
-            + str(s.get("stopped_because", "the start model already agrees with the record"))
+            + str("the start model already agrees with the record" if stopped is None else stopped)
         ]
     c["conclusions"] = [prose(x) for x in concl]
     c["figures"] = _figures(run_dir, ["explain", "localise", "screen", "drift"])

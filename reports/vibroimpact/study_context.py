@@ -19,13 +19,15 @@ def _frac(k, n, ci=None):
     return Tex(out)
 
 
-def _study(s, run_dir):
-    d = s.get("design") or {}
+def _study(doc, run_dir):
+    r = doc.result
+    d = r.design()
     varied = list(d.get("varied") or {})
-    pooled = s.get("pooled") or {}
-    cells = s.get("cells") or []
+    pooled = r.pooled()
+    cells = r.cells or []
+    name = r.config.name
     c = {
-        "title": "Model-term selection study" + (f": {s['name']}" if s.get("name") else ""),
+        "title": "Model-term selection study" + (f": {name}" if name else ""),
         "design": [
             [Tex(r"\texttt{" + escape(k) + "}"), value_tex(v)]
             for k, v in (d.get("varied") or {}).items()
@@ -43,7 +45,7 @@ def _study(s, run_dir):
             ["seeds", ", ".join(map(str, d.get("seeds") or []))],
             [
                 "runs",
-                f"{s.get('complete', 0)} of {s.get('runs', 0)} done ({d.get('cells', '?')} cells)",
+                f"{r.complete or 0} of {r.n_runs or 0} done ({d.get('cells', '?')} cells)",
             ],
         ],
         "varied": varied,

@@ -646,17 +646,14 @@ def test_an_explain_report_lists_the_effects_own_parameters():
     from discovery.vibroimpact.explain import EFFECTS
     from reports.context import _effect_parameter_rows
 
-    fm = {
-        "effects": ["contact_offset"],
-        "scenario": {"offset": 0.0015},
-        "uncertainties": {"delta0": 3e-7},
-        "intervals": {"bounds": {"delta0": [0.001499, 0.001501]}},
-    }
-    rows = _effect_parameter_rows(fm, [e.as_dict() for e in EFFECTS])
+    fm = _ns(effects=("contact_offset",), scenario={"offset": 0.0015}, observation={})
+    errors, bounds = {"delta0": 3e-7}, {"delta0": (0.001499, 0.001501)}
+    rows = _effect_parameter_rows(fm, errors, bounds, [e.as_dict() for e in EFFECTS])
     assert len(rows) == 1
     assert "delta0" in str(rows[0][0]) and "[m]" in str(rows[0][0])
     assert "0.001499" in str(rows[0][3])
-    assert _effect_parameter_rows(fm, None) == []  # an edited summary without a catalogue
+    # an edited summary without a catalogue
+    assert _effect_parameter_rows(fm, errors, bounds, None) == []
 
 
 def test_the_criteria_table_holds_the_motion_criterion():
@@ -692,32 +689,33 @@ def test_the_limit_rule_names_each_criterion_s_factor():
 def test_explain_s_unloading_term_carries_its_error_and_interval():
     """The unloading coefficient's standard error and interval (parameter ``d_zd``) are in
     the final model's table, not "--"."""
+    from discovery import ForceLaw
+    from discovery.vibroimpact.model.law import Term
     from reports.vibroimpact.context import _unloading_rows
 
-    fm = {
-        "unloading": {"zd": 4.05e6},
-        "uncertainties": {"z": 3.3e4, "d_zd": 1056.5},
-        "intervals": {"bounds": {"d_zd": [3.99e6, 4.11e6]}},
-    }
-    (row,) = _unloading_rows(fm)
+    law = ForceLaw.parse("2e8*z").with_unloading([Term.parse("zd")], [4.05e6], 0.0)
+    errors = {"z": 3.3e4, "d_zd": 1056.5}
+    (row,) = _unloading_rows(law, errors, {"d_zd": (3.99e6, 4.11e6)})
     assert "unloading" in str(row[0]) and "zeta" in str(row[0])
     assert "1056" in str(row[2]) or "1.1" in str(row[2])
     assert "3.990" in str(row[3]) and "4.110" in str(row[3])
-    assert _unloading_rows({}) == []
+    assert _unloading_rows(ForceLaw.parse("2e8*z"), errors, {}) == []
 
 
 def test_a_contact_models_report_lists_every_record_and_scenario():
     """A contact-models fit on two records names both records and both scenarios."""
+    from discovery import ContactModelsResult
     from reports.contact_models import contact_models_context
+    from reports.run import run_document
 
     sc = {"name": "grid-high", "m1": 1e4, "m2": 1e4, "k1": 2.75e7, "c1": 1e5, "A": 5e5}
     s = {
-        "fits": [],
         "data": ["high.csv", "low.csv"],
         "scenario": sc,
         "scenarios": [sc, {**sc, "name": "grid-low", "A": 3.5e5}],
     }
-    c = contact_models_context(s, ".")
+    r = ContactModelsResult(fits=(), selected=None, n_records=2)
+    c = contact_models_context(run_document(s, result=r), ".")
     assert [str(r) for r in c["records"]] == ["high.csv", "low.csv"]
     assert c["scenarios"][0][1:] == ["grid-high", "grid-low"]
     src = (Path(__file__).parents[2] / "reports/templates/contact_models.tex.j2").read_text()
@@ -894,6 +892,7 @@ def test_a_law_in_the_settings_and_the_study_design_is_typeset_whole():
     typeset whole, as the report's equations set it: not half math, half text."""
     from reports.cells import _provenance
     from reports.lawtex import law_inline, law_of, prose, value_tex
+    from reports.run import run_document
     from reports.vibroimpact.study_context import _study
 
     start = "1.5e8*z + 0.9e7*zd"
@@ -904,7 +903,15 @@ def test_a_law_in_the_settings_and_the_study_design_is_typeset_whole():
     assert f"start={whole}" in row and "*z" not in row and "*$" not in row
     assert f"law={whole}, " + str(law_inline(law_of("7.3e9*z^1.5", "law"))) in row
     design = {"varied": {"law": [start]}, "fixed": {"law": start, "library": "z, zd"}}
-    c = _study({"design": design, "cells": [{"law": start, "runs": 0, "recovered": 0}]}, ".")
+    study = _ns(
+        design=lambda: design,
+        pooled=dict,
+        cells=[{"law": start, "runs": 0, "recovered": 0}],
+        config=_ns(name=""),
+        complete=0,
+        n_runs=0,
+    )
+    c = _study(run_document({}, result=study), ".")
     cells = [str(x) for r in c["design"] for x in r] + [str(x) for x in c["cells"][0]]
     assert whole in cells and f"{whole} (fixed)" in cells and "*z" not in " ".join(cells)
     assert str(value_tex("z,zd")) == r"$\zeta$,$\dot\zeta_{+}$"  # a term list is no law

@@ -183,7 +183,8 @@ class ContactModelsResult:
             equivalent=tuple(d["equivalent"]),
             settings=dict(d["fit_settings"]),
             seconds=float(d["seconds"]),
-            n_records=int(d.get("n_records", 1)),
+            # a summary written before it kept n_records: the records it names
+            n_records=int(d.get("n_records") or _count(d.get("data")) or 1),
         )
 
     def save(self, directory):
@@ -251,6 +252,13 @@ class ContactModelsResult:
                     )
                 )
         return out
+
+
+def _count(data):
+    """The number of records a summary's ``data`` names (one name or a list of them)."""
+    if data is None:
+        return 0
+    return len(data) if isinstance(data, list) else 1
 
 
 def _intervals(res, records, settings):

@@ -31,6 +31,7 @@ is checked against its name and its schema; a bad one is named and run again.
 from __future__ import annotations
 
 import contextlib
+import copy
 import fcntl
 import json
 import math
@@ -222,20 +223,41 @@ class StudyResult(Result):
             "kind": "study",
             "name": cfg.name,
             "runs": self.n_runs,
-            "complete": len(self.runs),
+            "complete": self.complete,
             "executed": self.executed,
             "reused": self.reused,
             "executor": self.executor,
             "seconds": self.seconds,
             "parallel_efficiency": self.parallel_efficiency,
             "code_version": self.code_version,
-            "design": _design(cfg),
-            "pooled": _pooled(self.runs, cfg),
+            "design": self.design(),
+            "pooled": self.pooled(),
             "cells": self.cells,
             "config": _config_dict(cfg, self.code_version),
             "out": str(self.out),
             "figures": [Path(f).name for f in self.figures],
         }
+
+    @property
+    def complete(self):
+        """The number of runs done (on a loaded result, whose runs are in the study's
+        ``runs/`` folder and not in its summary, the summary's count)."""
+        if self.loaded:
+            return self.__dict__["_document"].get("complete", 0)
+        return len(self.runs)
+
+    def design(self):
+        """The factors with their levels (varied ones first), the fixed options, the fit's
+        and the record's options, the seeds and the number of cells."""
+        return _design(self.config)
+
+    def pooled(self):
+        """``{selection method: recovery, truth among the equivalent models, false
+        positives, coverage}`` over the runs (on a loaded result, whose runs are not in its
+        summary, the summary's)."""
+        if self.loaded:
+            return copy.deepcopy(self.__dict__["_document"].get("pooled") or {})
+        return _pooled(self.runs, self.config)
 
     def table(self, runs=False):
         """The cells (or with ``runs=True`` every run) as a pandas DataFrame."""
