@@ -454,7 +454,7 @@ def test_the_survey_closes_the_loop_on_one_record():
     """One case of ``tests/survey_contact_models.py --second-point advised``: a
     Hunt-Crossley record whose fit leaves Flores equivalent; the advised point lies within
     the bounds, and the record made there, fitted with the first, settles the family."""
-    import survey_contact_models as S
+    from tests import survey_contact_models as S
 
     row = S.one_record("hunt-crossley", 2001, 60, n_boot=0, second=("advised",))
     assert row["equivalent"], row["selected"]
