@@ -78,8 +78,10 @@ def _warnings(selected, by_score, stab, evidence, refine):
     elif not selected.consistent:
         out.append(
             "no shortlisted model is consistent with the record(s) within the noise "
-            "floor: try a larger library (e.g. poly:3+hc), a longer shortlist, or check "
-            "the scenario (masses, supports, drive)"
+            "floor: the record may hold an effect no polynomial law has (damping while "
+            "unloading, a permanent set, a sensor lag, ...), which `vidi explain` names; "
+            "else try a larger library (e.g. poly:3+hc), a longer shortlist, or check the "
+            "scenario (masses, supports, drive)"
         )
     if samples.derivative != "velocities" and not refine:
         out.append(
