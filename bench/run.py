@@ -93,7 +93,7 @@ def _best(f, repeat=5):
 def _periods_integrated(sc, law, tol):
     """One cold steady state and the drive periods its period map integrated (each run's
     span, Newton's and the recurrence's alike)."""
-    from discovery.vibroimpact.dynamics import steady_state as S
+    from discovery.vibroimpact.dynamics import steady_states as S
 
     n = [0]
     run = S.StroboscopicMap._run

@@ -31,6 +31,11 @@ COMMANDS = {
     "ueda-attractor": ["ueda", "attractor", "--model", "negres", "--periods", "200"],
     "ueda-chart": ["ueda", "chart", "--nu", "0.9:1.1:3", "--B", "0.2:0.4:2"]
     + ["--transient", "50", "--periods", "40", "--max-period", "4", "--workers", "1"],
+    "contact-models": ["fit", "--data", "D.csv", "--library", "contact-models"]
+    + ["--intervals", "0", "--max-simulations", "10"],
+    "advise": ["advise", "--law", LAW, "--law", "2.06e8*z + 1.6e7*zd", "--noise", "0.01"]
+    + ["--amplitude", "4e5:6e5", "--frequency", "22:28", "--grid", "2x2", "--refine", "0"]
+    + ["--workers", "1"],
 }
 KIND_OF = {
     "simulate": "simulate",
@@ -45,6 +50,8 @@ KIND_OF = {
     "ueda-explain": "ueda-explain",
     "ueda-attractor": "ueda-attractor",
     "ueda-chart": "ueda-chart",
+    "contact-models": "contact-models",
+    "advise": "advise",
 }
 
 
@@ -57,7 +64,7 @@ def runs(tmp_path_factory):
     original = Result.record_run
 
     def catch(self, head=None, tail=None, **options):
-        caught[(head or {}).get("command")] = self
+        caught[(head or {}).get("command") or self.KIND] = self
         return original(self, head, tail, **options)
 
     cwd = os.getcwd()
@@ -265,3 +272,22 @@ def test_a_ranked_model_s_mean_criteria_skip_what_one_record_lacks():
 
     assert _mean_over([{"I2": 0.1, "I5": 0.04}, {"I2": 0.3}]) == pytest.approx({"I2": 0.2})
     assert _mean_over([{"I2": 0.1}, {}]) == {}
+
+
+@pytest.mark.parametrize("out", ["advise", "contact-models"])
+def test_advise_and_contact_models_are_results_like_the_others(runs, out, tmp_path):
+    """An advise and a contact-models run: the loaded result prints as the original, and
+    its report from the object equals the report from its directory (saved from Python
+    into an empty directory too)."""
+    d, objects = runs
+    r = objects[out]
+    assert isinstance(r, Result)
+    assert str(discovery.load(d / out)) == str(r)
+    from_dir = discovery.report(d / out, compile=False).tex.read_text()
+    assert discovery.report(r, out=d / out, compile=False).tex.read_text() == from_dir
+    saved = r.save(tmp_path / "saved")
+    assert (saved / "summary.json").is_file()
+    if out == "advise":  # its table of every point goes with its document
+        assert (saved / "advise.csv").read_text() == (d / out / "advise.csv").read_text()
+    rep = discovery.report(r, out=saved, compile=False)
+    assert "\\section" in rep.tex.read_text()

@@ -100,8 +100,7 @@ def run(args):
     prov = provenance_of(args)
     prov["settings"] = {**res.settings, **prov["settings"]}
     with OutputDir(args.out) as out:
-        out.write_json("summary.json", {**res.to_dict(), **prov})
-        out.path("advise.csv").write_text(res.csv())
+        res.record_run(tail=prov).write_into(out)
         advise_figure(res, str(out.path("advise_map")))
     print(res)
     for k, p in enumerate(res.ranked()[1:4], start=2):

@@ -180,10 +180,9 @@ def _run_contact_models(args, scs, meas, t_start):
             seed=args.seed or 0,
             progress=rep,
         )
-    summary = {**res.to_dict(), **_head(args, scs), **provenance_of(args)}
-    summary["seconds"] = time.perf_counter() - t_start
+    tail = {**provenance_of(args), "seconds": time.perf_counter() - t_start}
     with OutputDir(args.out) as out:
-        out.write_json("summary.json", summary)
+        res.record_run(_head(args, scs), tail).write_into(out)
     print(res)
     print(outputs_line(args, ["summary.json"]))
     return 0

@@ -1,24 +1,21 @@
 """The outcome of ``advise``: every evaluated point, ranked, with its round trip to JSON."""
 
-import json
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from ..._printing import readable
+from ..._result import Result
 from ..model.law import ForceLaw
 from .candidates import Knobs, NoiseModel, SafeRegion
 from .separation import Point, inseparable, rank_key
 
-__all__ = ["AdviseResult", "SCHEMA_VERSION"]
-
-SCHEMA_VERSION = 1
+__all__ = ["AdviseResult"]
 
 
 @readable
-@dataclass(frozen=True)
-class AdviseResult:
+@dataclass(frozen=True, eq=False)
+class AdviseResult(Result):
     """Where a next record separates the candidate laws.
 
     Attributes
@@ -37,7 +34,17 @@ class AdviseResult:
         Versions-free settings (workers, ...); provenance is added by the CLI.
     """
 
-    KIND = "advise"  # its kind among the results discovery.load reads
+    KIND = "advise"
+    _LOAD = {
+        "laws": lambda d: tuple(d["laws"]),
+        "scenario": lambda d: dict(d["scenario"]),
+        "knobs": lambda d: Knobs.from_dict(d["knobs"]),
+        "safe": lambda d: SafeRegion.from_dict(d["safe"]),
+        "noise": lambda d: NoiseModel.from_dict(d["noise"]),
+        "points": lambda d: tuple(Point.from_dict(p) for p in d["points"]),
+        "seconds": lambda d: float(d["seconds"]),
+        "settings": lambda d: dict(d["settings"]),
+    }
 
     laws: tuple
     scenario: dict
@@ -120,13 +127,12 @@ class AdviseResult:
         return out
 
     # ------------------------------------------------------------------ JSON
-    def to_dict(self):
-        """JSON-safe (plain floats, lists and strings; ``inf`` as ``"inf"``, nan as None)."""
+    def as_dict(self):
+        """The result's keys of its document (:meth:`~discovery.Result.to_dict` adds the
+        schema version and kind): plain floats, lists and strings, ``inf`` as ``"inf"``."""
         ranked = self.ranked()
         index = {id(p): k for k, p in enumerate(self.points)}
         return {
-            "schema_version": SCHEMA_VERSION,
-            "result": "advise",
             "command": "advise",
             "laws": list(self.laws),
             "scenario": self.scenario,
@@ -145,29 +151,12 @@ class AdviseResult:
             "settings": dict(self.settings),
         }
 
-    @classmethod
-    def from_dict(cls, d):
-        return cls(
-            laws=tuple(d["laws"]),
-            scenario=dict(d["scenario"]),
-            knobs=Knobs.from_dict(d["knobs"]),
-            safe=SafeRegion.from_dict(d["safe"]),
-            noise=NoiseModel.from_dict(d["noise"]),
-            points=tuple(Point.from_dict(p) for p in d["points"]),
-            seconds=float(d["seconds"]),
-            settings=dict(d["settings"]),
-        )
-
-    def save(self, directory):
-        """Write ``summary.json`` (:meth:`to_dict`) and ``advise.csv`` into ``directory``;
-        returns its path."""
-        from ..._io import atomic_write_text, to_jsonable
-
-        d = Path(directory)
-        d.mkdir(parents=True, exist_ok=True)
-        atomic_write_text(d / "summary.json", json.dumps(to_jsonable(self.to_dict()), indent=2))
-        atomic_write_text(d / "advise.csv", self.csv())
-        return d
+    def write_into(self, out):
+        """``summary.json`` (the document) and ``advise.csv`` into an open
+        :class:`~discovery._io.OutputDir` (``save(dir)`` stages both and puts them in
+        place together)."""
+        super().write_into(out)
+        out.path("advise.csv").write_text(self.csv())
 
     def csv(self):
         """One row per point: knobs, stage, smallest separation, exclusion."""

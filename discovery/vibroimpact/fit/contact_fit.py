@@ -29,6 +29,7 @@ import numpy as np
 
 from ..._printing import readable
 from ..._progress import reports_progress
+from ..._result import SCHEMA_VERSION, Result
 from ..._validate import Real, params
 from ...errors import InputError, IntegrationError
 from ...wording import records as the_records
@@ -42,7 +43,6 @@ from .identification import as_records, identify
 
 __all__ = ["ContactFit", "ContactModelsResult", "fit_contact_models"]
 
-SCHEMA_VERSION = 1
 _Z95 = 1.959963984540054
 
 
@@ -125,8 +125,8 @@ class ContactFit:
 
 
 @readable
-@dataclass(frozen=True)
-class ContactModelsResult:
+@dataclass(frozen=True, eq=False)
+class ContactModelsResult(Result):
     """Which named contact model the record(s) support.
 
     Attributes
@@ -145,7 +145,15 @@ class ContactModelsResult:
         How many records were fitted together (the conclusion follows their number).
     """
 
-    KIND = "contact-models"  # its kind among the results discovery.load reads
+    KIND = "contact-models"
+    _LOAD = {
+        "fits": lambda d: tuple(ContactFit.from_dict(f) for f in d["fits"]),
+        "equivalent": lambda d: tuple(d["equivalent"]),
+        "settings": lambda d: dict(d["fit_settings"]),
+        "seconds": lambda d: float(d["seconds"]),
+        # a summary written before it kept n_records: the records it names
+        "n_records": lambda d: int(d.get("n_records") or _count(d.get("data")) or 1),
+    }
 
     fits: tuple
     selected: object
@@ -161,10 +169,10 @@ class ContactModelsResult:
                 return f
         raise KeyError(name)
 
-    def to_dict(self):
+    def as_dict(self):
+        """The result's keys of its document (:meth:`~discovery.Result.to_dict` adds the
+        schema version and kind)."""
         return {
-            "schema_version": SCHEMA_VERSION,
-            "result": self.KIND,
             "library": "contact-models",
             "selected": self.selected,
             "equivalent": list(self.equivalent),
@@ -174,28 +182,6 @@ class ContactModelsResult:
             "n_records": int(self.n_records),
             "conclusion": self.conclusion,
         }
-
-    @classmethod
-    def from_dict(cls, d):
-        return cls(
-            fits=tuple(ContactFit.from_dict(f) for f in d["fits"]),
-            selected=d["selected"],
-            equivalent=tuple(d["equivalent"]),
-            settings=dict(d["fit_settings"]),
-            seconds=float(d["seconds"]),
-            # a summary written before it kept n_records: the records it names
-            n_records=int(d.get("n_records") or _count(d.get("data")) or 1),
-        )
-
-    def save(self, directory):
-        """Write ``summary.json`` (:meth:`to_dict`) into ``directory``."""
-        import json
-        from pathlib import Path
-
-        path = Path(directory)
-        path.mkdir(parents=True, exist_ok=True)
-        (path / "summary.json").write_text(json.dumps(self.to_dict(), indent=2, default=str))
-        return path / "summary.json"
 
     @property
     def conclusion(self):
