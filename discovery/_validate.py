@@ -181,6 +181,35 @@ def check(where, value, spec):
     spec(where, value)
 
 
+def _binder(signature):
+    """A function ``(args, kwargs) -> {name: value}`` of the arguments a call gives, as
+    ``signature.bind`` would name them, for a call that binds plainly (positionals within
+    the positional parameters, keywords by name, each once, every required one given);
+    ``None`` for any other call (``signature.bind`` then names the problem).  Binding is
+    most of a check's cost, and the checked functions are called in inner loops."""
+    kinds = inspect.Parameter
+    ps = list(signature.parameters.values())
+    if any(p.kind in (kinds.VAR_POSITIONAL, kinds.VAR_KEYWORD) for p in ps):
+        return lambda args, kwargs: None
+    positional = [
+        p.name for p in ps if p.kind in (kinds.POSITIONAL_ONLY, kinds.POSITIONAL_OR_KEYWORD)
+    ]
+    by_keyword = {p.name for p in ps if p.kind != kinds.POSITIONAL_ONLY}
+    required = {p.name for p in ps if p.default is inspect.Parameter.empty}
+
+    def arguments(args, kwargs):
+        if len(args) > len(positional):
+            return None
+        given = dict(zip(positional, args, strict=False))
+        for k, v in kwargs.items():
+            if k in given or k not in by_keyword:
+                return None
+            given[k] = v
+        return given if required.issubset(given) else None
+
+    return arguments
+
+
 def params(**specs):
     """Decorator: check the named arguments of every call against their specs."""
 
@@ -190,16 +219,19 @@ def params(**specs):
         if unknown:  # a programming error in this package, caught at import
             raise AssertionError(f"{func.__qualname__}: no parameters {sorted(unknown)}")
         owner = func.__qualname__.replace(".__init__", "")
+        arguments = _binder(signature)
 
         @functools.wraps(func)
         def checked(*args, **kwargs):
-            try:
-                bound = signature.bind(*args, **kwargs)
-            except TypeError as exc:
-                raise VidiTypeError(f"{owner}: {exc}") from None
+            given = arguments(args, kwargs)
+            if given is None:  # an unusual call: the signature says what is wrong with it
+                try:
+                    given = signature.bind(*args, **kwargs).arguments
+                except TypeError as exc:
+                    raise VidiTypeError(f"{owner}: {exc}") from None
             for name, spec in specs.items():
-                if name in bound.arguments:
-                    check(f"{owner}: {name}", bound.arguments[name], spec)
+                if name in given:
+                    check(f"{owner}: {name}", given[name], spec)
             return func(*args, **kwargs)
 
         checked.__vidi_params__ = dict(specs)  # for callers that check options up front

@@ -276,3 +276,36 @@ def test_the_cases_cover_every_public_entry():
         }
     )
     assert not unlisted, f"public entries without a row: {sorted(unlisted)}"
+
+
+def test_the_checks_name_the_arguments_as_the_signature_binds_them():
+    """The checked functions' fast binding (no ``inspect.Signature.bind`` on a plain call)
+    names every argument as ``bind`` does, and leaves every other call to ``bind``."""
+    import inspect
+    import itertools
+
+    from discovery._validate import _binder
+
+    def f1(a, b, c=1, *, d, e=2):
+        pass
+
+    def f2(a, /, b, *, c=3):
+        pass
+
+    def f3(self, x=1):
+        pass
+
+    for f in (f1, f2, f3):
+        sig = inspect.signature(f)
+        arguments = _binder(sig)
+        names = [*sig.parameters, "unknown"]
+        for n_args in range(5):
+            for keys in itertools.chain.from_iterable(
+                itertools.combinations(names, k) for k in range(4)
+            ):
+                args, kwargs = tuple(range(n_args)), {k: k for k in keys}
+                try:
+                    expected = dict(sig.bind(*args, **kwargs).arguments)
+                except TypeError:
+                    expected = None
+                assert arguments(args, kwargs) == expected, (f.__name__, args, kwargs)
