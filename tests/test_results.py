@@ -212,6 +212,11 @@ def test_a_report_from_a_result_equals_the_report_from_its_directory(runs, out, 
         discovery.report(objects["identify"], out=d / out, compile=False)
 
 
+@pytest.mark.parametrize("out", ["ueda-attractor", "ueda-chart", "ueda-explain"])
+def test_a_ueda_report_from_a_result_equals_the_report_from_its_directory(runs, out, tmp_path):
+    test_a_report_from_a_result_equals_the_report_from_its_directory(runs, out, tmp_path)
+
+
 def test_a_loaded_ueda_result_has_what_its_report_reads(runs):
     """The fields of Ueda's results that their reports read come back typed (the regime,
     the final model's coefficients); a loaded chart, whose grids are not in its summary,
