@@ -24,7 +24,7 @@ from .cells import (  # noqa: F401  (the shared cells, read by the tests from he
     criterion_tex,
 )
 from .run import run_document
-from .ueda.context import _ueda
+from .ueda.context import _ueda_attractor, _ueda_chart, _ueda_discover, _ueda_explain
 from .vibroimpact.context import (  # noqa: F401
     _effect_parameter_rows,
     _explain,
@@ -51,10 +51,10 @@ KINDS = {
     "identify": _identify,
     "landscape": _landscape,
     "explain": _explain,
-    "ueda attractor": _ueda,
-    "ueda chart": _ueda,
-    "ueda discover": _ueda,
-    "ueda explain": _ueda,
+    "ueda attractor": _ueda_attractor,
+    "ueda chart": _ueda_chart,
+    "ueda discover": _ueda_discover,
+    "ueda explain": _ueda_explain,
     "study": _study,
 }
 
@@ -72,7 +72,18 @@ TEMPLATES = {
 
 #: the kinds whose context reads the run's typed result (a :class:`~reports.run.RunDocument`);
 #: the others read the summary's keys
-TYPED = {_verify, _identify, _landscape, _explain, _study, _advise}
+TYPED = {
+    _verify,
+    _identify,
+    _landscape,
+    _explain,
+    _study,
+    _advise,
+    _ueda_attractor,
+    _ueda_chart,
+    _ueda_discover,
+    _ueda_explain,
+}
 
 
 def context(doc, run_dir):

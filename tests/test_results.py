@@ -219,6 +219,36 @@ def test_a_report_from_a_result_equals_the_report_from_its_directory(runs, out, 
         discovery.report(objects["identify"], out=d / out, compile=False)
 
 
+@pytest.mark.parametrize("out", ["ueda-attractor", "ueda-chart", "ueda-explain"])
+def test_a_ueda_report_from_a_result_equals_the_report_from_its_directory(runs, out, tmp_path):
+    test_a_report_from_a_result_equals_the_report_from_its_directory(runs, out, tmp_path)
+
+
+def test_a_loaded_ueda_result_has_what_its_report_reads(runs):
+    """The fields of Ueda's results that their reports read come back typed (the regime,
+    the final model's coefficients); a loaded chart, whose grids are not in its summary,
+    gives its summary's fractions and periods."""
+    d, objects = runs
+    att, orig = discovery.load(d / "ueda-attractor"), objects["ueda-attractor"]
+    assert (att.regime.regime, att.regime.kind, att.regime.period) == (
+        orig.regime.regime,
+        orig.regime.kind,
+        orig.regime.period,
+    )
+    assert att.regime.evidence["rule"] == orig.regime.evidence["rule"]
+    ch, orig = discovery.load(d / "ueda-chart"), objects["ueda-chart"]
+    assert ch.fractions() == orig.fractions() and ch.period_counts() == orig.period_counts()
+    np.testing.assert_array_equal(ch.B, orig.B)
+    dis, orig = discovery.load(d / "ueda-discover"), objects["ueda-discover"]
+    assert dis.terms == orig.terms and dis.coefficients == orig.coefficients
+    assert dis.standard_errors == orig.standard_errors and dis.n_windows == orig.n_windows
+    ex, orig = discovery.load(d / "ueda-explain"), objects["ueda-explain"]
+    assert ex.coefficients == orig.coefficients
+    assert ex.standard_errors == orig.standard_errors
+    assert ex.effects_added == orig.effects_added and ex.gap == orig.gap
+    assert ex.consistent == orig.consistent and ex.stopped_because == orig.stopped_because
+
+
 def test_an_old_or_edited_summary_in_the_cli_is_exit_2_and_one_line(runs, tmp_path, capsys):
     d, _ = runs
     old = tmp_path / "old-landscape"

@@ -50,7 +50,7 @@ class Attractor(Result):
     _LOAD = {
         "system": lambda d: UedaSystem.from_dict(d["system"]),
         "lyapunov": lambda d: part(Lyapunov, d["lyapunov"]),
-        "regime": lambda d: None,
+        "regime": lambda d: Regime.from_dict(d["classification"]),
         "strobe": lambda d: None,
         "t": lambda d: None,
         "x": lambda d: None,

@@ -106,6 +106,9 @@ class Explanation(Result):
         "final_model": lambda d: ForcedPolynomial.from_dict(d.get("final_model")),
         "start_terms": lambda d: tuple(d["start_terms"]),
         "final_terms": lambda d: tuple(d["final_terms"]),
+        # the final model's coefficients are saved with the final model
+        "coefficients": lambda d: d["final_model"].get("coefficients"),
+        "standard_errors": lambda d: d["final_model"].get("standard_errors"),
         "settings": lambda d: (
             d["method"] if isinstance(d.get("method"), dict) else d.get("settings")
         ),

@@ -8,6 +8,7 @@ Rows are distributed over worker processes (they die with the parent; Ctrl-C sto
 them); the result does not depend on the number of workers.
 """
 
+import copy
 import os
 import time
 from dataclasses import dataclass, field
@@ -107,14 +108,21 @@ class Chart(Result):
         return 1 if self.kind_down is None else 2
 
     def fractions(self):
-        """Fraction of the points in each class (the sweep in increasing ``nu``)."""
+        """Fraction of the points in each class (the sweep in increasing ``nu``; on a
+        loaded chart, whose grids are not in its summary, the summary's)."""
+        if self.loaded:
+            return copy.deepcopy(self.__dict__["_document"].get("fractions") or {})
         n = self.kind.size
         out = {k: float(np.sum(self.kind == i) / n) for i, k in enumerate(KINDS)}
         out["failed"] = float(np.sum(self.kind < 0) / n)
         return out
 
     def period_counts(self):
-        """``{n: number of points}`` of the periodic points (increasing ``nu``)."""
+        """``{n: number of points}`` of the periodic points (increasing ``nu``; on a loaded
+        chart the summary's ``periods_found``, ``{"P<n>": number of points}``)."""
+        if self.loaded:
+            found = self.__dict__["_document"].get("periods_found") or {}
+            return {int(k.removeprefix("P")): v for k, v in found.items()}
         n, c = np.unique(self.period[self.period > 0], return_counts=True)
         return {int(a): int(b) for a, b in zip(n, c, strict=True)}
 

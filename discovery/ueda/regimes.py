@@ -93,6 +93,12 @@ class Regime:
             "evidence": self.evidence,
         }
 
+    @classmethod
+    def from_dict(cls, d):
+        """The regime of :meth:`as_dict`'s document (its evidence as the document holds
+        it: text keys, lists for arrays)."""
+        return cls(regime=d["regime"], kind=d["kind"], period=d["period"], evidence=d["evidence"])
+
     def _lines(self):
         rule = self.evidence.get("rule")
         return [f"regime {self.regime}" + (f": {rule}" if rule else "")]

@@ -1,4 +1,11 @@
-"""What the reports of Ueda's commands (attractor, chart, discover, explain) say."""
+"""What the reports of Ueda's commands (attractor, chart, discover, explain) say.
+
+One function per command reads its run's typed result (``doc.result``: an
+:class:`~discovery.ueda.Attractor`, a :class:`~discovery.ueda.regime_chart.Chart`, a
+:class:`~discovery.ueda.equation_discovery.Discovery` or an
+:class:`~discovery.ueda.explanation.Explanation`) and, for what the command line adds (the
+forcing as given, the discovered equation's verification), its summary.
+"""
 
 from __future__ import annotations
 
@@ -13,38 +20,73 @@ from ..lawtex import (
 )
 from ..texenv import Tex, num
 
+#: the figures of a Ueda report, in this order (whichever the run wrote)
+_FIGURES = ["discover", "explain", "attractor", "basins", "chart"]
 
-def _ueda(s, run_dir):
-    cmd = s.get("command", "ueda")
-    c = {"title": f"Ueda's forced oscillator: {cmd.replace('ueda ', '')}"}
-    rows = []
-    for key in ("model", "regime", "terms", "forcing", "residual_rms", "n_windows"):
-        if key in s:
-            val = s[key]
-            rows.append(
-                [
-                    key.replace("_", " "),
-                    prose(", ".join(map(str, val)))
-                    if isinstance(val, list)
-                    else (
-                        prose("; ".join(f"{k}={v}" for k, v in val.items()))
-                        if isinstance(val, dict)
-                        else (num(val) if isinstance(val, float) else prose(val))
-                    ),
-                ]
-            )
-    c["facts"] = rows
-    coefs = s.get("coefficients") or (s.get("final_model") or {}).get("coefficients")
-    c["model"] = ueda_equation(coefs) if coefs else Tex("--")
-    c["coefficients"] = _coef_rows(
-        s.get("coefficients") or {}, s.get("standard_errors"), term=ueda_term_tex
-    )
-    ver = s.get("verification") or {}
-    c["verification"] = [
-        [k.replace("_", " "), num(v) if isinstance(v, int | float) else v]
-        for k, v in ver.items()
-        if isinstance(v, int | float | str) and not isinstance(v, bool)
+
+def _fact(name, value):
+    """A row of the facts table: a sequence joined by commas, a mapping as ``k=v`` pairs,
+    a float as a number, anything else as text."""
+    if isinstance(value, list | tuple):
+        cell = prose(", ".join(map(str, value)))
+    elif isinstance(value, dict):
+        cell = prose("; ".join(f"{k}={v}" for k, v in value.items()))
+    else:
+        cell = num(value) if isinstance(value, float) else prose(value)
+    return [name.replace("_", " "), cell]
+
+
+def _forcing(doc):
+    """The facts row of the forcing as the command line gave it (none when saved from
+    Python)."""
+    forcing = doc.summary.get("forcing")
+    return [] if forcing is None else [_fact("forcing", forcing)]
+
+
+def _page(doc, run_dir, facts, conclusions, coefficients=None, standard_errors=None):
+    """The context of a Ueda report: its title, the facts rows, the equation and
+    coefficients table of ``coefficients`` (``{term: value}``, none: no equation), the
+    conclusions and the figures."""
+    return {
+        "title": f"Ueda's forced oscillator: {doc.command.replace('ueda ', '')}",
+        "facts": facts,
+        "model": ueda_equation(coefficients) if coefficients else Tex("--"),
+        "coefficients": _coef_rows(coefficients or {}, standard_errors, term=ueda_term_tex),
+        "verification": [],
+        "conclusions": [prose(x) for x in conclusions] or ["See the tables and figures."],
+        "figures": _figures(run_dir, _FIGURES),
+    }
+
+
+def _ueda_attractor(doc, run_dir):
+    r = doc.result
+    L = r.lyapunov
+    concl = [
+        f"Largest Lyapunov exponent {L.value:.4g} per unit time: "
+        + ("chaotic." if L.value > 0.01 else "not chaotic.")
     ]
+    return _page(doc, run_dir, [_fact("regime", r.regime.regime)], concl)
+
+
+def _ueda_chart(doc, run_dir):
+    r = doc.result
+    grid = f"{r.nu.size}x{r.B.size}"
+    nu_range, B_range = [float(r.nu[0]), float(r.nu[-1])], [float(r.B[0]), float(r.B[-1])]
+    share = ", ".join(f"{k} {100 * v:.0f} %" for k, v in r.fractions().items() if v)
+    periods = ", ".join(f"P{n} ({c} points)" for n, c in r.period_counts().items())
+    concl = [
+        f"Over nu in {nu_range} and B in {B_range} on a {grid} "
+        f"grid the regimes are: {share}." + (f" Periods found: {periods}." if periods else "")
+    ]
+    return _page(doc, run_dir, [], concl)
+
+
+def _ueda_discover(doc, run_dir):
+    r = doc.result
+    facts = [_fact("terms", r.terms), *_forcing(doc)]
+    facts += [_fact("residual_rms", r.residual_rms), _fact("n_windows", r.n_windows)]
+    # the verification by simulation is the command line's (not part of the discovery)
+    ver = doc.summary.get("verification") or {}
     concl = []
     if ver:
         state = "consistent" if ver.get("consistent") else "NOT consistent"
@@ -55,38 +97,26 @@ def _ueda(s, run_dir):
             f"the record {ver.get('regime_record', '?')}, of the model "
             f"{ver.get('regime_model', '?')})."
         )
-    fr = s.get("fractions")
-    if isinstance(fr, dict):
-        grid = "x".join(str(g) for g in s.get("grid") or [])
-        share = ", ".join(f"{k} {100 * v:.0f} %" for k, v in fr.items() if v)
-        periods = ", ".join(f"{k} ({v} points)" for k, v in (s.get("periods_found") or {}).items())
-        concl.append(
-            f"Over nu in {s.get('nu_range')} and B in {s.get('B_range')} on a {grid} "
-            f"grid the regimes are: {share}." + (f" Periods found: {periods}." if periods else "")
-        )
-    if "effects_added" in s:
-        gaps = "; ".join(
-            f"{k.replace('_', ' ')} {v['before']:.3g} -> {v['after']:.3g} ({v['ratio']:.0f}x)"
-            for k, v in (s.get("gap") or {}).items()
-            if isinstance(v, dict)
-        )
-        added = ", ".join(str(e).replace("_", " ") for e in s["effects_added"]) or "none"
-        concl.append(
-            f"Effects named and added: {added}; the gap: {gaps}. The final model is "
-            f"{'consistent' if s.get('consistent') else 'NOT consistent'} with the "
-            f"record. Stopped because {s.get('stopped_because', '--')}."
-        )
-        final = s.get("final_model") or {}
-        if final.get("coefficients"):
-            c["coefficients"] = _coef_rows(
-                final["coefficients"], final.get("standard_errors"), term=ueda_term_tex
-            )
-    if "lyapunov" in s and isinstance(s["lyapunov"], dict):
-        L = s["lyapunov"]
-        concl.append(
-            f"Largest Lyapunov exponent {L.get('value', float('nan')):.4g} per unit "
-            "time: " + ("chaotic." if L.get("value", 0) > 0.01 else "not chaotic.")
-        )
-    c["conclusions"] = [prose(x) for x in concl] or ["See the tables and figures."]
-    c["figures"] = _figures(run_dir, ["discover", "explain", "attractor", "basins", "chart"])
+    c = _page(doc, run_dir, facts, concl, r.coefficients, r.standard_errors)
+    c["verification"] = [
+        [k.replace("_", " "), num(v) if isinstance(v, int | float) else v]
+        for k, v in ver.items()
+        if isinstance(v, int | float | str) and not isinstance(v, bool)
+    ]
     return c
+
+
+def _ueda_explain(doc, run_dir):
+    r = doc.result
+    gaps = "; ".join(
+        f"{k.replace('_', ' ')} {v['before']:.3g} -> {v['after']:.3g} ({v['ratio']:.0f}x)"
+        for k, v in r.gap.items()
+    )
+    added = ", ".join(str(e).replace("_", " ") for e in r.effects_added) or "none"
+    stopped = "--" if r.stopped_because is None else r.stopped_because
+    concl = [
+        f"Effects named and added: {added}; the gap: {gaps}. The final model is "
+        f"{'consistent' if r.consistent else 'NOT consistent'} with the "
+        f"record. Stopped because {stopped}."
+    ]
+    return _page(doc, run_dir, _forcing(doc), concl, r.coefficients, r.standard_errors)
