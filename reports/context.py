@@ -72,7 +72,7 @@ TEMPLATES = {
 
 #: the kinds whose context reads the run's typed result (a :class:`~reports.run.RunDocument`);
 #: the others read the summary's keys
-TYPED = {_verify, _identify, _landscape, _explain, _study, _advise}
+TYPED = {_verify, _fit, _identify, _landscape, _explain, _study, _advise}
 
 
 def context(doc, run_dir):
