@@ -100,6 +100,26 @@ class Certificate:
             "force_scale": float(self.force_scale),
         }
 
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Certificate:
+        """The certificate :meth:`as_dict` describes, also after a JSON round trip (a
+        number that is not finite written as ``null`` reads as ``nan``); ``tolerance`` and
+        ``force_scale``, which a result's document leaves out, default as in the
+        constructor."""
+
+        def real(v: Any) -> float:
+            return math.nan if v is None else float(v)
+
+        return cls(
+            method=d["method"],
+            holds=bool(d["holds"]),
+            worst_violation=real(d["worst_violation"]),
+            domain={k: real(v) for k, v in d["domain"].items()},
+            conditions=copy.deepcopy(dict(d["conditions"])),
+            tolerance=real(d.get("tolerance", DEFAULT_TOLERANCE)),
+            force_scale=real(d.get("force_scale", 0.0)),
+        )
+
 
 def _grid_shape(grid: int | Sequence[int]) -> tuple[int, int]:
     sizes = (grid, grid) if np.ndim(grid) == 0 else tuple(grid)

@@ -232,11 +232,6 @@ def _transient(verdict):
     return "transient" in (verdict or "")
 
 
-def _intervals(entry):
-    iv = entry.get("intervals") or {}
-    return iv.get("bounds", iv) if isinstance(iv, dict) else {}
-
-
 def _coef_rows(coefs, errors=None, intervals=None, start=None, term=term_tex):
     rows = []
     for k, v in coefs.items():

@@ -74,6 +74,7 @@ TEMPLATES = {
 #: the others read the summary's keys
 TYPED = {
     _verify,
+    _fit,
     _identify,
     _landscape,
     _explain,

@@ -19,6 +19,7 @@ LAW = "2.06e8*z + 1.28e7*zd"
 COMMANDS = {
     "verify": ["verify", "--data", "D.csv", "--law", LAW],
     "fit": ["fit", "--data", "D.csv", "--no-refine", "--intervals", "0"],
+    "fit-refined": ["fit", "--data", "D.csv", "--intervals", "5", "--workers", "1"],
     "identify": ["identify", "--data", "D.csv", "--start", "1.8e8*z + 1.1e7*zd"]
     + ["--max-simulations", "20"],
     "landscape": ["landscape", "--grid", "3x3", "--workers", "1"],
@@ -42,6 +43,7 @@ KIND_OF = {
     "ueda-simulate": "ueda-simulate",
     "verify": "verify",
     "fit": "fit",
+    "fit-refined": "fit",
     "identify": "identify",
     "landscape": "landscape",
     "steady": "steady",
@@ -114,7 +116,9 @@ def test_each_command_summary_is_its_result_to_dict(runs, out):
     assert type(loaded) is type(objects[out]) and loaded == objects[out]
 
 
-@pytest.mark.parametrize("out", ["verify", "fit", "identify", "landscape", "explain", "steady"])
+@pytest.mark.parametrize(
+    "out", ["verify", "fit", "fit-refined", "identify", "landscape", "explain", "steady"]
+)
 def test_a_loaded_result_prints_as_the_original(runs, out):
     """The typed fields come back: the printed report of a loaded result is the
     original's (the vibro-impact results, whose printing reads their fields)."""
@@ -153,6 +157,36 @@ def test_typed_fields_come_back(runs):
     att = discovery.load(d / "ueda-attractor")
     assert att.system == objects["ueda-attractor"].system
     assert att.lyapunov.value == objects["ueda-attractor"].lyapunov.value
+
+
+def test_a_loaded_fit_holds_what_its_report_reads(runs):
+    """The standard errors, intervals, each candidate's BIC, the certificate (the selected
+    model's too), the records and each record's check come back typed, equal to the fresh
+    result's."""
+    d, objects = runs
+    fresh, loaded = objects["fit-refined"], discovery.load(d / "fit-refined")
+    sel, orig = loaded.selected, fresh.selected
+    assert sel.refinement is None and orig.refinement is not None
+    assert sel.standard_errors and sel.standard_errors == orig.standard_errors
+    assert all(type(v) is float for v in sel.standard_errors.values())
+    assert sel.intervals.bounds == {k: tuple(v) for k, v in orig.intervals.bounds.items()}
+    assert sel.intervals.method == orig.intervals.method
+    assert [m.bic for m in loaded.ranking] == [m.bic for m in fresh.ranking]
+    assert [type(m.bic) for m in loaded.ranking] == [float] * len(fresh.ranking)
+    assert [m.candidate.rss for m in loaded.ranking] == [m.candidate.rss for m in fresh.ranking]
+    kept = ("method", "holds", "worst_violation", "domain", "conditions")
+    as_kept = {k: v for k, v in fresh.certificate.as_dict().items() if k in kept}
+    assert {k: v for k, v in loaded.certificate.as_dict().items() if k in kept} == as_kept
+    assert sel.certificate == loaded.certificate and loaded.ranking[1].certificate is None
+    assert loaded.records == fresh.records and [r.data for r in loaded.records] == ["D.csv"]
+    assert [ev.criteria for ev in sel.evaluations] == [ev.criteria for ev in orig.evaluations]
+    assert (sel.criteria, sel.noise_floor, sel.limits) == (
+        orig.criteria,
+        orig.noise_floor,
+        orig.limits,
+    )
+    assert (loaded.equivalent, loaded.warnings) == (fresh.equivalent, fresh.warnings)
+    assert loaded.settings == fresh.settings and sel.defects == orig.defects
 
 
 def test_save_and_load_from_the_api(runs, tmp_path):
@@ -200,7 +234,7 @@ def test_an_old_summary_is_one_clear_error(runs, tmp_path, capsys):
         discovery.load(tmp_path)
 
 
-@pytest.mark.parametrize("out", ["verify", "fit", "landscape", "ueda-discover"])
+@pytest.mark.parametrize("out", ["verify", "fit", "fit-refined", "landscape", "ueda-discover"])
 def test_a_report_from_a_result_equals_the_report_from_its_directory(runs, out, tmp_path):
     d, objects = runs
     r = objects[out]

@@ -4,6 +4,8 @@ written from the numbers."""
 
 from __future__ import annotations
 
+import math
+
 from discovery.wording import records as the_records
 from discovery.wording import verb
 
@@ -12,7 +14,6 @@ from ..cells import (
     _coef_rows,
     _criteria_table,
     _figures,
-    _intervals,
     _measured_rows,
     _model_tex,
     _scenarios_table,
@@ -96,130 +97,133 @@ def _terms_tex(terms):
     return Tex(", ".join(term_tex(t) for t in terms))
 
 
-def _selected_conclusions(s):
-    sel = s.get("selected") or {}
+def _selected_conclusions(r):
+    """What the data support (the selected terms, consistent or not), the equivalent
+    models, the warnings and the selected law's contact defects, from a
+    :class:`~discovery.DiscoveryResult`."""
+    sel = r.selected
     concl = []
-    terms = sel.get("terms") or list((sel.get("coefficients") or {}).keys())
-    lib = (s.get("fit_settings") or {}).get("library", "?")
-    n_rec = len(s.get("records") or []) or 1
+    lib = r.settings.get("library", "?")
+    n_rec = len(r.records) or 1
     records = the_records(n_rec, every=True)
-    if sel.get("consistent"):
+    if sel.consistent:
         concl.append(
             Tex(
                 f"From the library \\texttt{{{escape(lib)}}}, the data support the terms "
-                f"{_terms_tex(terms)}: the selected law is consistent with {records} by "
-                "full simulation."
+                f"{_terms_tex(sel.law.names)}: the selected law is consistent with {records} "
+                "by full simulation."
             )
         )
     else:
         concl.append(
             Tex(
                 f"From the library \\texttt{{{escape(lib)}}}, the best-supported terms are "
-                f"{_terms_tex(terms)}, but no model of the library is consistent with "
+                f"{_terms_tex(sel.law.names)}, but no model of the library is consistent with "
                 f"{records} by full simulation: {the_records(n_rec)} "
                 f"{verb(n_rec, 'holds', 'hold')} an effect these "
                 "polynomials do not describe (or the scenario is wrong). "
                 "\\texttt{vidi explain} names the missing effect."
             )
         )
-    eq = s.get("equivalent") or []
-    if eq:
+    if r.equivalent:
         concl.append(
             Tex(
-                f"{len(eq)} other model(s) fit {the_records(n_rec)} as well within "
+                f"{len(r.equivalent)} other model(s) fit {the_records(n_rec)} as well within "
                 f"{verb(n_rec, 'its', 'their')} noise (listed under Selection). They cannot "
                 f"be told apart from {verb(n_rec, 'this record', 'these records')}; another "
                 "operating point (another drive amplitude or frequency) or lower noise "
                 "would separate them."
             )
         )
-    if s.get("warnings"):
-        concl.append(Tex(f"The run gave {len(s['warnings'])} warning(s); see Notes from the run."))
-    if sel.get("contact_defects"):
-        concl.append(
-            prose("The selected law has contact defects: " + "; ".join(sel["contact_defects"]))
-        )
+    if r.warnings:
+        concl.append(Tex(f"The run gave {len(r.warnings)} warning(s); see Notes from the run."))
+    if sel.defects:
+        concl.append(prose("The selected law has contact defects: " + "; ".join(sel.defects)))
     return concl
 
 
 def _record_checks(sel, records):
-    """Each record's own check of the selected law: criteria, floors, limits, full verdict."""
+    """Each record's own check of the selected law (a model checked against several
+    records): criteria, floors, limits, full verdict."""
+    if len(sel.evaluations) < 2:
+        return []
     out = []
-    for i, ev in enumerate(sel.get("records") or []):
-        rec = records[i] if i < len(records) and isinstance(records[i], dict) else {}
+    for i, ev in enumerate(sel.evaluations):
+        rec = records[i] if i < len(records) else None
         out.append(
             {
-                "name": f"Record {i + 1}: {rec.get('data', '--')} (scenario "
-                f"{rec.get('scenario', '--')})",
-                "criteria": _criteria_table(
-                    ev.get("criteria"), ev.get("noise_floor"), ev.get("limits")
-                ),
-                "verdict": prose(ev.get("verdict") or ev.get("message") or "--"),
+                "name": f"Record {i + 1}: {rec.data if rec else '--'} (scenario "
+                f"{rec.scenario if rec else '--'})",
+                "criteria": _criteria_table(ev.criteria, ev.noise_floor, ev.limits),
+                "verdict": prose(ev.verdict or ev.message or "--"),
             }
         )
     return out
 
 
-def _fit(s, run_dir):
-    sel = s.get("selected") or {}
-    fs = s.get("fit_settings") or {}
-    cert = s.get("certificate") or {}
+def _certificate(cert):
+    """The certificate's cells (``--`` and "fails" without one)."""
+    if cert is None:
+        return {"method": "--", "holds": False, "worst": num(None), "domain": {}, "conditions": []}
+    return {
+        "method": cert.method,
+        "holds": bool(cert.holds),
+        "worst": num(cert.worst_violation),
+        "domain": {
+            _DOMAIN.get(k, k): num(v)
+            for k, v in cert.domain.items()
+            if isinstance(v, int | float) and not math.isnan(v)
+        },
+        "conditions": [
+            [
+                k.replace("_", " "),
+                v.get("quantity", ""),
+                "holds" if v.get("holds") else "FAILS",
+                num(v.get("grid_min_rel")),
+            ]
+            for k, v in cert.conditions.items()
+        ],
+    }
+
+
+def _fit(doc, run_dir):
+    r = doc.result
+    sel = r.selected
+    crit = r.settings.get("criterion", "I2")
+    iv = sel.intervals
+    records = r.records
     c = {
         "title": "Discovery of a contact law",
-        "model": _model_tex(sel.get("coefficients"), "selected.coefficients"),
+        "model": _model_tex(sel.law, "selected.coefficients"),
         "coefficients": _coef_rows(
-            sel.get("coefficients") or {}, sel.get("standard_errors"), _intervals(sel)
+            sel.law.as_dict(), sel.standard_errors, iv.bounds if iv is not None else {}
         ),
-        "interval_method": sel.get("interval_method") or "no bootstrap intervals",
-        "criteria": _criteria_table(sel.get("criteria"), sel.get("noise_floor"), sel.get("limits")),
-        "record_checks": _record_checks(sel, s.get("records") or []),
-        "verdict": prose(sel.get("verdict") or "--"),
-        "regime": sel.get("regime", "--"),
-        "refinement": sel.get("refinement", "--"),
-        "library": fs.get("library", "--"),
-        "selection": fs.get("selection", "--"),
-        "scoring": fs.get("scoring", "--"),
-        "criterion": criterion_tex(fs.get("criterion", "I2")),
+        "interval_method": (iv.method if iv is not None else None) or "no bootstrap intervals",
+        "criteria": _criteria_table(sel.criteria, sel.noise_floor, sel.limits),
+        "record_checks": _record_checks(sel, records),
+        "verdict": prose(sel.verdict or "--"),
+        "regime": sel.regime,
+        "refinement": sel.note,
+        "library": r.settings.get("library", "--"),
+        "selection": r.settings.get("selection", "--"),
+        "scoring": r.settings.get("scoring", "--"),
+        "criterion": criterion_tex(crit),
         "records": [
-            [
-                r.get("data", "--"),
-                r.get("scenario", "--"),
-                r.get("regime", "--"),
-                r.get("impacts", "--"),
-                num((r.get("noise") or {}).get("F")),
-                (r.get("noise") or {}).get("n_cycles", "--"),
-            ]
-            for r in s.get("records") or []
+            [rec.data, rec.scenario, rec.regime, rec.impacts]
+            + [num(rec.noise.get("F")), rec.noise.get("n_cycles", "--")]
+            for rec in records
         ],
-        "certificate": {
-            "method": cert.get("method", "--"),
-            "holds": bool(cert.get("holds")),
-            "worst": num(cert.get("worst_violation")),
-            "domain": {
-                _DOMAIN.get(k, k): num(v)
-                for k, v in (cert.get("domain") or {}).items()
-                if isinstance(v, int | float)
-            },
-            "conditions": [
-                [
-                    k.replace("_", " "),
-                    v.get("quantity", ""),
-                    "holds" if v.get("holds") else "FAILS",
-                    num(v.get("grid_min_rel")),
-                ]
-                for k, v in (cert.get("conditions") or {}).items()
-            ],
-        },
+        "certificate": _certificate(r.certificate),
         "ranking": [
             [
                 str(i + 1),
-                _terms_tex(m.get("terms") or []),
-                m.get("regime", "--"),
-                num(m.get("bic"), 6),
-                num((m.get("criteria") or {}).get(fs.get("criterion", "I2"))),
-                "yes" if m.get("consistent") else "no",
+                _terms_tex(m.law.names),
+                m.regime,
+                num(m.bic, 6),
+                num(m.criteria.get(crit)),
+                "yes" if m.consistent else "no",
             ]
-            for i, m in enumerate(s.get("ranking") or [])
+            for i, m in enumerate(r.ranking)
         ],
         "equivalent": [
             {
@@ -227,13 +231,16 @@ def _fit(s, run_dir):
                 "reason": prose(e.get("reason", "")),
                 "separate": prose(e.get("separate", "")),
             }
-            for i, e in enumerate(s.get("equivalent") or [])
+            for i, e in enumerate(r.equivalent)
         ],
-        "warnings": [prose(w) for w in s.get("warnings") or []],
-        "scenarios": _scenarios_table(s.get("scenarios") or [s.get("scenario")]),
-        "the_records": the_records(len(s.get("records") or [])),
+        "warnings": [prose(w) for w in r.warnings],
+        # the scenarios as the command was given them (a result keeps their names only)
+        "scenarios": _scenarios_table(
+            doc.summary.get("scenarios") or [doc.summary.get("scenario")]
+        ),
+        "the_records": the_records(len(records)),
     }
-    c["conclusions"] = _selected_conclusions(s)
+    c["conclusions"] = _selected_conclusions(r)
     c["figures"] = _figures(run_dir, ["fit_impulse", "fit_surface", "fit_loop"])
     return c
 

@@ -10,7 +10,9 @@ from scipy.optimize import minimize
 
 from constraints import (
     DEFAULT_GRID,
+    DEFAULT_TOLERANCE,
     Box,
+    Certificate,
     CertificateError,
     bernstein_coefficients,
     certify,
@@ -51,6 +53,20 @@ def test_non_negative_laws_are_certified(library, x):
     assert cert.worst_violation == 0.0
     assert require(cert) is cert
     json.dumps(cert.as_dict())  # JSON-ready
+
+
+def test_a_certificate_reads_back_from_its_dict():
+    """``from_dict`` inverts ``as_dict``, also through JSON; a result's document (without
+    the tolerance and the force scale, a number not finite as null) reads too."""
+    library = [(1.5, 0), (1.5, 1)]
+    cert = certify(_physical([1e5, 3e4], library), library, BOX, ALL, grid=21)
+    assert Certificate.from_dict(cert.as_dict()) == cert
+    assert Certificate.from_dict(json.loads(json.dumps(cert.as_dict()))) == cert
+    doc = {k: v for k, v in cert.as_dict().items() if k not in ("tolerance", "force_scale")}
+    back = Certificate.from_dict(json.loads(json.dumps({**doc, "worst_violation": None})))
+    assert back.tolerance == DEFAULT_TOLERANCE and back.force_scale == 0.0
+    assert np.isnan(back.worst_violation) and back.conditions == cert.conditions
+    assert back.domain == cert.domain and back.holds is cert.holds
 
 
 def test_interior_adhesion_is_found_and_located():

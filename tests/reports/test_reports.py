@@ -856,19 +856,29 @@ def test_identify_figure_names_the_search_value_and_the_final_check_s():
 def test_conclusions_follow_the_number_of_records():
     """A fit of two records says the records hold an effect (not "the record holds"); one
     record keeps the singular."""
+    from discovery._result import SCHEMA_VERSION
+    from reports.run import run_document
     from reports.vibroimpact.context import _fit
 
+    sel = {"coefficients": {"z": 2e8}, "terms": ["z"], "consistent": False, "status": "ok"}
     s = {
-        "selected": {"coefficients": {"z": 2e8}, "terms": ["z"], "consistent": False},
+        "schema_version": SCHEMA_VERSION,
+        "result": "fit",
+        "selected": sel,
+        "ranking": [sel],
         "fit_settings": {"library": "poly:2"},
-        "records": [{"data": "high.csv"}, {"data": "low.csv"}],
+        "records": [
+            {"data": d, "scenario": "grid", "regime": "P1", "impacts": 1, "noise": {}}
+            for d in ("high.csv", "low.csv")
+        ],
         "equivalent": [{"law": "2e8*z"}],
     }
-    text = " ".join(_fit(s, ".")["conclusions"])
+    text = " ".join(_fit(run_document(s), ".")["conclusions"])
     assert "all 2 records" in text and "the 2 records hold an effect" in text
     assert "the record holds" not in text and "this record" not in text
     assert "fit the 2 records as well within their noise" in text
-    one = " ".join(_fit({**s, "records": [{"data": "high.csv"}]}, ".")["conclusions"])
+    one = {**s, "records": s["records"][:1]}
+    one = " ".join(_fit(run_document(one), ".")["conclusions"])
     assert "the record holds an effect" in one and "from this record" in one
 
 

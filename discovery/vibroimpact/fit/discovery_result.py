@@ -1,6 +1,16 @@
 """The results of :func:`~discovery.vibroimpact.fit.discovery.discover`: each checked model
-(:class:`RankedModel`) and the discovery (:class:`DiscoveryResult`), with their loaders."""
+(:class:`RankedModel`), each record as the discovery describes it (:class:`FitRecord`) and the
+discovery (:class:`DiscoveryResult`), with their loaders.
 
+A loaded result holds, typed, the laws, each record's evaluation, the candidates' regression
+statistics (a :class:`Candidate` whose coefficients are the law's), the selected model's
+standard errors and intervals, the certificate (the selected model's too), the records, the
+warnings, the equivalent models and the settings.  What the document does not hold is
+``None`` or empty: the refinements themselves, the other ranked models' certificates, the
+estimator, the samples, the measured cycle and the references.
+"""
+
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -15,7 +25,12 @@ from ..verify.evaluation import Evaluation
 from .intervals import Intervals
 from .records import records_verdict
 
-__all__ = ["RankedModel", "DiscoveryResult"]
+__all__ = ["RankedModel", "FitRecord", "DiscoveryResult"]
+
+
+def _real(value):
+    """A document's number as a float (``null``, written for one not finite: ``nan``)."""
+    return math.nan if value is None else float(value)
 
 
 def _mean_over(dicts):
@@ -38,11 +53,28 @@ def _loaded_evaluations(d):
     return (part(Evaluation, {**d, "regime": regime, "impacts": {}}),)
 
 
+def _loaded_candidate(d):
+    """A loaded ranked model's regression statistics: the law's terms and coefficients, the
+    regression's own coefficients in ``extra`` (as a refined candidate keeps them)."""
+    from .regression import Candidate
+
+    return Candidate(
+        terms=tuple(d["terms"]),
+        coefficients=dict(d["coefficients"]),
+        rss=_real(d.get("rss")),
+        bic=_real(d.get("bic")),
+        aic=_real(d.get("aic")),
+        cv_error=_real(d.get("cv_error")),
+        constrained=bool(d.get("constrained", False)),
+        extra={"regression_coefficients": dict(d.get("regression_coefficients") or {})},
+    )
+
+
 def _loaded_intervals(d):
-    if not d.get("intervals"):
+    if not d.get("intervals") and d.get("interval_method") is None:
         return None
     return Intervals(
-        bounds={k: tuple(v) for k, v in d["intervals"].items()},
+        bounds={k: tuple(v) for k, v in (d.get("intervals") or {}).items()},
         sd={},
         level=d.get("interval_level"),
         n_boot=None,
@@ -63,7 +95,8 @@ class RankedModel(Result):
     candidate : Candidate
         Regression statistics of ``law`` on the contact samples (rss, bic, aic; for a
         refined law recomputed for the refined coefficients; the regression's own
-        coefficients are in ``candidate.extra["regression_coefficients"]``).
+        coefficients are in ``candidate.extra["regression_coefficients"]``).  A loaded
+        model's holds what its document does, its coefficients the law's.
     evaluations : tuple of Evaluation
         The law simulated and scored against each record
         (:func:`discovery.vibroimpact.verify.evaluate`): regime, criteria, noise floor, consistency.
@@ -72,7 +105,8 @@ class RankedModel(Result):
     note : str
         What happened to the refinement (kept, or why not).
     certificate : constraints.Certificate or None
-        Of ``law`` on the box of the samples it was fitted to.
+        Of ``law`` on the box of the samples it was fitted to (a loaded result keeps the
+        selected model's only).
     intervals : Intervals or None
         Bootstrap intervals of the coefficients through the full processing
         (:func:`discovery.vibroimpact.fit.intervals.bootstrap_intervals`; the selected model only).
@@ -82,7 +116,7 @@ class RankedModel(Result):
     _LOAD = {
         "law": lambda d: ForceLaw.from_dict(d["coefficients"]),
         "evaluations": _loaded_evaluations,
-        "candidate": lambda d: None,
+        "candidate": _loaded_candidate,
         "refinement": lambda d: None,
         "certificate": lambda d: None,
         "note": lambda d: d.get("refinement", ""),
@@ -140,12 +174,21 @@ class RankedModel(Result):
 
     @property
     def standard_errors(self):
-        """``{term: standard error}`` from the refinement (empty without it)."""
+        """``{term: standard error}`` from the refinement when its law was kept (empty
+        without it); a loaded model's are its document's (its refinement is not kept)."""
+        if self.refinement is None and self.loaded:
+            kept = self.__dict__["_document"].get("standard_errors") or {}
+            return {k: _real(v) for k, v in kept.items()}
         return (
             dict(self.refinement.standard_errors)
             if self.refinement is not None and self.note.startswith("refined")
             else {}
         )
+
+    @property
+    def bic(self):
+        """The BIC of the law on the contact samples (the candidate's)."""
+        return self.candidate.bic
 
     def as_dict(self):
         ev = self.evaluation
@@ -195,6 +238,51 @@ class RankedModel(Result):
         return out
 
 
+@dataclass(frozen=True)
+class FitRecord:
+    """A record of a discovery as its document describes it.
+
+    Attributes
+    ----------
+    data : str
+        The record's name (the file as given to ``vidi fit``, else its source).
+    scenario : str
+        The name of its scenario.
+    regime : str
+        Its measured regime (``"P1"``, ...).
+    impacts : int
+        Contacts per orbit.
+    noise : dict
+        Its noise model (``F`` [N], ``zeta`` [m], ``n_cycles``, ...).
+    """
+
+    data: str
+    scenario: str
+    regime: str
+    impacts: int
+    noise: dict
+
+    def as_dict(self):
+        return {
+            "data": self.data,
+            "scenario": self.scenario,
+            "regime": self.regime,
+            "impacts": self.impacts,
+            "noise": self.noise,
+        }
+
+
+def _loaded_certificate(d):
+    return Certificate.from_dict(d["certificate"]) if d.get("certificate") else None
+
+
+def _loaded_selected(d):
+    """The loaded selected model, with the result's certificate (the selected law's)."""
+    selected = part(RankedModel, d["selected"])
+    object.__setattr__(selected, "certificate", _loaded_certificate(d))
+    return selected
+
+
 @readable
 @dataclass(frozen=True, eq=False)
 class DiscoveryResult(Result):
@@ -215,7 +303,8 @@ class DiscoveryResult(Result):
     measured : Impulse
         The first record's measured cycle.
     references : tuple of (Scenario, Reference)
-        Every record with its scenario.
+        Every record with its scenario (empty on a loaded result: :attr:`records` has what
+        its document holds of them).
     stability : dict
         ``{term: selection frequency}`` over bootstrap resamples of impacts (empty if
         not requested).
@@ -231,9 +320,9 @@ class DiscoveryResult(Result):
 
     KIND = "fit"
     _LOAD = {
-        "selected": lambda d: part(RankedModel, d["selected"]),
+        "selected": _loaded_selected,
         "ranking": lambda d: [part(RankedModel, m) for m in d["ranking"]],
-        "certificate": lambda d: d.get("certificate") and Certificate(**d["certificate"]),
+        "certificate": _loaded_certificate,
         "samples": lambda d: None,
         "measured": lambda d: None,
         "references": lambda d: (),
@@ -259,24 +348,33 @@ class DiscoveryResult(Result):
         """The selected model's refinement (or None)."""
         return self.selected.refinement
 
+    @property
+    def records(self):
+        """Every record as a :class:`FitRecord`, named as the run named it (the files as
+        given to ``vidi fit``; without a run, their sources); a loaded result's are its
+        document's."""
+        if self.loaded:
+            return tuple(
+                FitRecord(r["data"], r["scenario"], r["regime"], r["impacts"], r["noise"])
+                for r in self.__dict__["_document"].get("records") or ()
+            )
+        return self._records(self.run_record["options"].get("names"))
+
+    def _records(self, names):
+        refs = [ref for _, ref in self.references]
+        names = list(names) if names is not None else [getattr(r, "source", "") for r in refs]
+        return tuple(
+            FitRecord(n, s_k.name, ref.regime, ref.impacts, ref.noise)
+            for n, (s_k, ref) in zip(names, self.references, strict=True)
+        )
+
     def as_dict(self, names=None):
         """The result as JSON-ready data (``summary.json`` of ``vidi fit``); ``names``
         labels the records (default: their sources)."""
         cert = self.certificate
-        refs = [ref for _, ref in self.references]
-        names = list(names) if names is not None else [getattr(r, "source", "") for r in refs]
         ref_out = self.refinement
         return {
-            "records": [
-                {
-                    "data": n,
-                    "scenario": s_k.name,
-                    "regime": ref.regime,
-                    "impacts": ref.impacts,
-                    "noise": ref.noise,
-                }
-                for n, (s_k, ref) in zip(names, self.references, strict=True)
-            ],
+            "records": [r.as_dict() for r in self._records(names)],
             "selected": self.selected.as_dict(),
             "warnings": self.warnings,
             "equivalent": self.equivalent,
