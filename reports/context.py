@@ -70,23 +70,6 @@ TEMPLATES = {
 }
 
 
-#: the kinds whose context reads the run's typed result (a :class:`~reports.run.RunDocument`);
-#: the others read the summary's keys
-TYPED = {
-    _verify,
-    _fit,
-    _identify,
-    _landscape,
-    _explain,
-    _study,
-    _advise,
-    _ueda_attractor,
-    _ueda_chart,
-    _ueda_discover,
-    _ueda_explain,
-}
-
-
 def context(doc, run_dir):
     """The template context of a run (a :class:`~reports.run.RunDocument`, or its summary
     dict): the kind's own part plus provenance and scenario."""
@@ -103,8 +86,7 @@ def context(doc, run_dir):
         from discovery.errors import InputError
 
         raise InputError(f"no report for a {kind!r} run; reports cover {', '.join(KINDS)} runs")
-    # the contact models' fit reads its typed result (ContactModelsResult) too
-    c = build(doc if build in TYPED or named else summary, run_dir)
+    c = build(doc, run_dir)  # every kind's context reads the run's typed result
     c["kind"] = kind
     c["template"] = ("contact_models" if named else TEMPLATES.get(kind, "ueda")) + ".tex.j2"
     c["provenance"] = _provenance(summary, run_dir)

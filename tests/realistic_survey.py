@@ -86,6 +86,14 @@ def markdown_row(rows, label):
     return f"| {label} | {_pct(*r['true'])} | {_pct(*r['wrong'])} | {r['undetectable']} |"
 
 
+def category_row(rows, label):
+    """One row of the per-category table: ``label`` a category in backquotes (its records'
+    trials) or ``all`` (every record's)."""
+    name = label.strip("`")
+    mine = rows if name == "all" else [r for r in rows if r["category"] == name]
+    return markdown_row(mine, label)
+
+
 def _pct(k, n):
     return f"{k}/{n} = {100.0 * k / n:.1f} %".replace(".0 %", " %") if n else f"{k}/{n}"
 
