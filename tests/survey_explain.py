@@ -1,4 +1,4 @@
-"""Random survey of the missing-effect workflow (the README's rates).
+"""Random survey of the missing-effect workflow (the table of docs/validation.md).
 
 Draws machines and laws with the test generator (:func:`tests.realistic.draw_case`: P1,
 slow P1, subharmonic and short-contact categories in turn), hides one effect, makes a
@@ -167,8 +167,10 @@ def counts(rows):
     return out
 
 
-def _percent(k, n):
-    return f"{k} ({k / n:.0%})".replace("%", " %") if n else str(k)
+def _percent(k, n, of=False):
+    """``k (P %)`` of ``n`` (``k of n (P %)`` with ``of``)."""
+    text = f"{k} of {n}" if of else str(k)
+    return f"{text} ({100 * k / n:.0f} %)" if n else text
 
 
 def markdown_row(rows, label):
@@ -197,6 +199,22 @@ def markdown_row(rows, label):
         bold(n["wrong effect named"]),
         n["missed"],
         n["more than one named"],
+    ]
+    return "| " + " | ".join(str(c) for c in cells) + " |"
+
+
+def readme_row(rows, label):
+    """The README's row: the draws (``label`` after their number); where the start's I2 is
+    beyond its limit, the right effect named first with the gap to the bar; wrong effects
+    named; false discoveries."""
+    n = counts(rows)
+    beyond = sum(n[o] for o in BEYOND)
+    clean = n["clean: nothing added"] + n["false discovery"]
+    cells = [
+        f"{len(rows)} {label}",
+        _percent(n["named, gap shrinks to the bar"], beyond, of=True),
+        n["wrong effect named"],
+        f"{n['false discovery']} of {clean}",
     ]
     return "| " + " | ".join(str(c) for c in cells) + " |"
 
