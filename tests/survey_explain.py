@@ -26,6 +26,7 @@ the draws by :func:`outcome`.
 
 import argparse
 import collections
+import re
 import sys
 import time
 
@@ -117,6 +118,8 @@ def outcome(r):
     """The row's class for the rates."""
     if "skip" in r:
         return "skipped"
+    if "error" in r and r.get("true_consistent"):
+        return "explain raised an error"
     if "error" in r or not r.get("true_consistent"):
         return "invalid: the true model is not consistent with its own record"
     named, hidden = r["named"], r["hidden"]
@@ -185,6 +188,7 @@ def markdown_row(rows, label):
     weak = n["too weak: the linear start is consistent"]
     weak_i4 = n["too weak: I2 within its noise, I4 alone fails"]
     beyond = sum(n[o] for o in BEYOND)
+    raised = n["explain raised an error"]
     bold = "**{}**".format if label == "all" else str
     cells = [
         bold(label),
@@ -193,6 +197,7 @@ def markdown_row(rows, label):
         nothing,
         f"{n['false discovery']} of {clean}",
         f"{weak + weak_i4}" + (f" ({weak_i4} by I4 alone)" if weak_i4 else ""),
+        bold(raised) if raised else raised,
         beyond,
         bold(_percent(n["named, gap shrinks to the bar"], beyond)),
         n["named, gap short of the bar"],
@@ -206,7 +211,7 @@ def markdown_row(rows, label):
 def readme_row(rows, label):
     """The README's row: the draws (``label`` after their number); where the start's I2 is
     beyond its limit, the right effect named first with the gap to the bar; wrong effects
-    named; false discoveries."""
+    named; false discoveries; ``explain`` raising an error."""
     n = counts(rows)
     beyond = sum(n[o] for o in BEYOND)
     clean = n["clean: nothing added"] + n["false discovery"]
@@ -215,14 +220,15 @@ def readme_row(rows, label):
         _percent(n["named, gap shrinks to the bar"], beyond, of=True),
         n["wrong effect named"],
         f"{n['false discovery']} of {clean}",
+        n["explain raised an error"],
     ]
     return "| " + " | ".join(str(c) for c in cells) + " |"
 
 
 def _is_miss(r):
-    """A draw the rates count against ``explain``: a false discovery, the right effect
+    """A draw the rates count against ``explain`` (a false discovery, the right effect
     short of the bar, a wrong effect, nothing named for an effect that shows, more than one
-    effect named, or a run that failed."""
+    effect named, ``explain`` raising an error) or one whose run raised an error."""
     o = outcome(r)
     return (
         o in ("false discovery", *BEYOND[1:])
@@ -240,7 +246,8 @@ def _hidden_cell(r):
     if hidden == "support_nonlinearity":
         return f"{hidden} (k3 {r['k3']:.3g})"
     if hidden in ("permanent_set", "unloading_damping"):
-        return f"{hidden} (`{r['true'].split(';', 1)[-1].strip()}`)"
+        part = r["true"].split(";", 1)[-1].strip()
+        return f"{hidden} (`{re.sub(r'[0-9.]+', lambda m: f'{float(m[0]):.3g}', part)}`)"
     return hidden
 
 
@@ -251,7 +258,8 @@ def misses_rows(rows, label=None):
     for r in rows:
         if not _is_miss(r):
             continue
-        regime = r.get("regime", "-") + (f", {r['impacts']} impacts" if r.get("impacts") else "")
+        k = r.get("impacts")
+        regime = r.get("regime", "-") + (f", {k} impact{'s' * (k > 1)}" if k else "")
         named = ", ".join(f"`{e}`" for e in r.get("named") or ()) or "nothing"
         if "error" in r:
             named, gap = "-", r["error"].replace("|", "/")

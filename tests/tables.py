@@ -175,10 +175,10 @@ TABLES = {
         page="docs/validation.md",
         header=(
             "| draws | run | Hertz-type (skipped) | tests nothing | clean: an effect named | "
-            "hidden effect too weak | start's I2 beyond its limit | right effect first, gap "
-            "to the bar | right first, short of the bar | wrong effect first | nothing named "
-            "| more than one named |",
-            "|---|---|---|---|---|---|---|---|---|---|---|---|",
+            "hidden effect too weak | `explain` raised an error | start's I2 beyond its limit "
+            "| right effect first, gap to the bar | right first, short of the bar | wrong "
+            "effect first | nothing named | more than one named |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
         ),
         rows=tuple((label, _EXPLAIN_RUNS) for label in survey_explain.LABELS),
         row=survey_explain.markdown_row,
@@ -188,8 +188,8 @@ TABLES = {
         page="README.md",
         header=(
             "| draws | start's I2 beyond its limit: right effect first, gap to the bar | "
-            "wrong effect first | clean records: an effect named |",
-            "|---|---|---|---|",
+            "wrong effect first | clean records: an effect named | `explain` raised an error |",
+            "|---|---|---|---|---|",
         ),
         rows=(("random", _EXPLAIN_RUNS),),
         row=survey_explain.readme_row,

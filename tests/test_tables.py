@@ -93,7 +93,8 @@ def test_the_corpus_tables_have_a_row_per_record_of_their_run():
 def test_the_explain_table_counts_the_draws_by_their_outcome(tmp_path):
     """tests.survey_explain's rows: a later row of a draw replaces an earlier one; each draw
     in one column by its outcome (the bar: a third of the start's I2, or 1.5 floors); the
-    misses listed by draw."""
+    misses listed by draw; an error in ``explain`` on a valid draw is a column of its own,
+    not a draw that tests nothing."""
     from tests import survey_explain as s
 
     def row(i, cat="p1", hidden="permanent_set", named=(), start=0.3, final=0.05, **kw):
@@ -128,6 +129,8 @@ def test_the_explain_table_counts_the_draws_by_their_outcome(tmp_path):
         row(9),
         row(10, true_consistent=False),
         row(11, cat="subharmonic", named=["permanent_set"]),
+        row(12, cat="subharmonic", error="TypeError: x"),  # explain raised
+        row(13, cat="subharmonic", true_consistent=False, error="TypeError: x"),
     ]
     path = tmp_path / "explain-random-test.jsonl"
     out = measured.RunFile(path, "survey_explain", ["--draws", "0", "12"])
@@ -135,17 +138,18 @@ def test_the_explain_table_counts_the_draws_by_their_outcome(tmp_path):
         out.write(r)
     out.write(row(9, named=["permanent_set"], final=0.06))  # draw 9 again: now to the bar
     read = s.read_rows([path])
-    assert [r["i"] for r in read] == list(range(12)) and read[9]["named"] == ["permanent_set"]
+    assert [r["i"] for r in read] == list(range(14)) and read[9]["named"] == ["permanent_set"]
     assert s.markdown_row(read, "P1") == (
-        "| P1 | 11 | 1 | 1 | 1 of 2 | 2 (1 by I4 alone) | 5 | 3 (60 %) | 1 | 1 | 0 | 1 |"
+        "| P1 | 11 | 1 | 1 | 1 of 2 | 2 (1 by I4 alone) | 0 | 5 | 3 (60 %) | 1 | 1 | 0 | 1 |"
     )
-    assert s.markdown_row(read, "all").startswith("| **all** | 12 | 1 | 1 | 1 of 2 |")
-    assert "| 6 | **4 (67 %)** | 1 | **1** | 0 | 1 |" in s.markdown_row(read, "all")
+    assert s.markdown_row(read, "all").startswith("| **all** | 14 | 1 | 2 | 1 of 2 | 2 (1 ")
+    assert "| **1** | 6 | **4 (67 %)** | 1 | **1** | 0 | 1 |" in s.markdown_row(read, "all")
     misses = s.misses_rows(read)
-    assert [int(m.split("|")[1]) for m in misses] == [2, 6, 8]
+    assert [int(m.split("|")[1]) for m in misses] == [2, 6, 8, 12, 13]
+    assert misses[3].endswith("| TypeError: x | explain raised an error |")
     assert "| 0.3 -> 0.11 (floor 0.02) | named, gap short of the bar |" in misses[1]
     assert s.misses_rows(read[:2]) == ["| none |  |  |  |  |  |  |"]
-    assert s.readme_row(read, "random") == "| 12 random | 4 of 6 (67 %) | 1 | 1 of 2 |"
+    assert s.readme_row(read, "random") == "| 14 random | 4 of 6 (67 %) | 1 | 1 of 2 | 1 |"
 
 
 # --------------------------------------------------------------------------- make bench's
