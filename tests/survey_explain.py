@@ -11,7 +11,7 @@ start:
   the loading damper, or stiffening supports at 10-50 % of ``k1`` at the grid's excursion;
 * a Hertz-type draw is skipped (its law has no linear start).
 
-Run from the repository root (about 40 minutes for 60 draws on two cores)::
+Run from the repository root (60 draws: about 15 minutes with two workers on two cores)::
 
     python -m tests.survey_explain --draws 0 60 --workers 2 --out survey.jsonl
     python -m tests.survey_explain --summary survey.jsonl
