@@ -98,7 +98,8 @@ tables: install
 
 surveys: install
 	rm -f $(MEASURED)/intervals-*.jsonl $(MEASURED)/advise-*.jsonl $(MEASURED)/realistic-*.jsonl \
-		$(MEASURED)/corpus*.jsonl $(MEASURED)/contact-two-points*.jsonl
+		$(MEASURED)/corpus*.jsonl $(MEASURED)/contact-two-points*.jsonl \
+		$(MEASURED)/explain-random*.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 272 \
 		--workers $(SURVEY_WORKERS) --out $(MEASURED)/intervals-272.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 208 \
@@ -116,6 +117,8 @@ surveys: install
 	$(BIN)/python -m tests.survey_contact_models --models hunt-crossley lankarani-nikravesh \
 		--per-model 10 --seed 1 --max-simulations 60 --second-point advised random --boot 0 \
 		--out $(MEASURED)/contact-two-points.jsonl
+	$(BIN)/python -m tests.survey_explain --draws 0 60 --workers $(SURVEY_WORKERS) \
+		--out $(MEASURED)/explain-random.jsonl
 	$(MAKE) tables
 
 # The documentation site (docs/*.md, API reference from the docstrings), warnings as errors

@@ -26,6 +26,7 @@ from . import (
     survey_advise,
     survey_contact_models,
     survey_corpus,
+    survey_explain,
     survey_intervals,
 )
 
@@ -63,6 +64,9 @@ _INTERVAL_RUNS = {
 
 #: the corpus's two tables, one row per record (a later run of a record replaces its row)
 _CORPUS_RUNS = ("corpus*.jsonl",)
+
+#: explain's random survey (a later run of a draw replaces its row)
+_EXPLAIN_RUNS = ("explain-random*.jsonl",)
 
 #: the scaling bench on each machine (a later run on as many cores replaces its rows)
 _SCALING_RUNS = ("scaling*.jsonl",)
@@ -166,6 +170,40 @@ TABLES = {
         ),
         row=realistic_survey.markdown_row,
         read=_rows,
+    ),
+    "explain-random": Table(
+        page="docs/validation.md",
+        header=(
+            "| draws | run | Hertz-type (skipped) | tests nothing | clean: an effect named | "
+            "hidden effect too weak | `explain` raised an error | start's I2 beyond its limit "
+            "| right effect first, gap to the bar | right first, short of the bar | wrong "
+            "effect first | nothing named | more than one named |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        ),
+        rows=tuple((label, _EXPLAIN_RUNS) for label in survey_explain.LABELS),
+        row=survey_explain.markdown_row,
+        read=survey_explain.read_rows,
+    ),
+    "explain-random-readme": Table(
+        page="README.md",
+        header=(
+            "| draws | start's I2 beyond its limit: right effect first, gap to the bar | "
+            "wrong effect first | clean records: an effect named | `explain` raised an error |",
+            "|---|---|---|---|---|",
+        ),
+        rows=(("random", _EXPLAIN_RUNS),),
+        row=survey_explain.readme_row,
+        read=survey_explain.read_rows,
+    ),
+    "explain-random-misses": Table(
+        page="docs/validation.md",
+        header=(
+            "| draw | category | regime | hidden | named | I2 start -> final (floor) | outcome |",
+            "|---|---|---|---|---|---|---|",
+        ),
+        rows=(("misses", _EXPLAIN_RUNS),),
+        row=survey_explain.misses_rows,
+        read=survey_explain.read_rows,
     ),
     "contact-two-points": Table(
         page="docs/contact-models.md",

@@ -90,6 +90,68 @@ def test_the_corpus_tables_have_a_row_per_record_of_their_run():
     assert survey_corpus._explain_cell(row) == "nothing named"
 
 
+def test_the_explain_table_counts_the_draws_by_their_outcome(tmp_path):
+    """tests.survey_explain's rows: a later row of a draw replaces an earlier one; each draw
+    in one column by its outcome (the bar: a third of the start's I2, or 1.5 floors); the
+    misses listed by draw; an error in ``explain`` on a valid draw is a column of its own,
+    not a draw that tests nothing."""
+    from tests import survey_explain as s
+
+    def row(i, cat="p1", hidden="permanent_set", named=(), start=0.3, final=0.05, **kw):
+        return {
+            "i": i,
+            "category": cat,
+            "regime": "P1",
+            "impacts": 1,
+            "hidden": hidden,
+            "true": "1e8*z + 1e6*zd; set: 0.3",
+            "k3": 0.0,
+            "true_consistent": True,
+            "named": list(named),
+            "I2_start": start,
+            "I2_final": final,
+            "floor": 0.02,
+            "start_consistent": False,
+            "stopped": "",
+            **kw,
+        }
+
+    rows = [
+        {"i": 0, "category": "p1", "skip": "hertz law (no linear start)"},
+        row(1, hidden="none"),
+        row(2, hidden="none", named=["sensor_lag"]),
+        row(3, start_consistent=True),
+        row(4, stopped="I4 alone fails"),
+        row(5, named=["permanent_set"], final=0.099),  # under a third of 0.3: the bar
+        row(6, named=["permanent_set"], final=0.11),  # short of it
+        row(7, named=["permanent_set"], final=0.029),  # under 1.5 floors
+        row(8, named=["unloading_damping", "permanent_set"]),
+        row(9),
+        row(10, true_consistent=False),
+        row(11, cat="subharmonic", named=["permanent_set"]),
+        row(12, cat="subharmonic", error="TypeError: x"),  # explain raised
+        row(13, cat="subharmonic", true_consistent=False, error="TypeError: x"),
+    ]
+    path = tmp_path / "explain-random-test.jsonl"
+    out = measured.RunFile(path, "survey_explain", ["--draws", "0", "12"])
+    for r in rows:
+        out.write(r)
+    out.write(row(9, named=["permanent_set"], final=0.06))  # draw 9 again: now to the bar
+    read = s.read_rows([path])
+    assert [r["i"] for r in read] == list(range(14)) and read[9]["named"] == ["permanent_set"]
+    assert s.markdown_row(read, "P1") == (
+        "| P1 | 11 | 1 | 1 | 1 of 2 | 2 (1 by I4 alone) | 0 | 5 | 3 (60 %) | 1 | 1 | 0 | 1 |"
+    )
+    assert s.markdown_row(read, "all").startswith("| **all** | 14 | 1 | 2 | 1 of 2 | 2 (1 ")
+    assert "| **1** | 6 | **4 (67 %)** | 1 | **1** | 0 | 1 |" in s.markdown_row(read, "all")
+    misses = s.misses_rows(read)
+    assert [int(m.split("|")[1]) for m in misses] == [2, 6, 8, 12, 13]
+    assert misses[3].endswith("| TypeError: x | explain raised an error |")
+    assert "| 0.3 -> 0.11 (floor 0.02) | named, gap short of the bar |" in misses[1]
+    assert s.misses_rows(read[:2]) == ["| none |  |  |  |  |  |  |"]
+    assert s.readme_row(read, "random") == "| 14 random | 4 of 6 (67 %) | 1 | 1 of 2 | 1 |"
+
+
 # --------------------------------------------------------------------------- make bench's
 
 
