@@ -148,6 +148,11 @@ def localise(scenario, model, reference, evaluation, measurement=None, *, tolera
     }
     if measurement is None or evaluation.steady is None:
         return out
+    out["drift"] = _drift(measurement, scenario.period, E.threshold)
+    if not evaluation.steady.periodic:
+        # no periodic orbit of the law to sample at the record's times (a law judged over
+        # the record's span whose trajectory settles on none): the phases say where
+        return out
     # the simulated orbit at the record's steady times: the (zeta, dzeta) plane and w1
     t0 = E.onset
     keep = measurement.t >= t0
@@ -189,5 +194,4 @@ def localise(scenario, model, reference, evaluation, measurement=None, *, tolera
             "ratio_to_noise": rms / noise if noise > 0 else None,
             "exceeds_noise": bool(noise > 0 and rms > 3 * noise),
         }
-    out["drift"] = _drift(measurement, scenario.period, E.threshold)
     return out

@@ -270,3 +270,27 @@ def test_explain_cli_end_to_end(hidden_coupling, tmp_path, capsys):
     bad = tmp_path / "bad"
     assert main(["explain", "--data", str(data), "--effects", "gremlins", "--out", str(bad)]) == 2
     assert "unknown effect" in capsys.readouterr().err and not bad.exists()
+
+
+def test_localisation_of_a_law_with_no_periodic_orbit(paper, hidden_coupling):
+    """A law judged over the record's span whose trajectory settles on no periodic orbit
+    (its steady state ``nonperiodic``): the disagreement is localised by phase and the drift
+    is read; the orbit's plane and grid are left out (there is no orbit to sample), where
+    this once raised a TypeError inside ``explain``."""
+    from dataclasses import replace
+
+    from discovery.vibroimpact.explain.disagreement import localise
+    from discovery.vibroimpact.explain.effects import Model
+    from discovery.vibroimpact.verify import Reference, evaluate
+
+    rec, _ = hidden_coupling
+    law = ForceLaw.parse("2.06e8*z + 1.28e7*zd")
+    ref = Reference.from_measurement(rec, paper, n_boot=8, seed=0)
+    ev = evaluate(paper, law, ref)
+    assert ev.steady.periodic
+    periodic = localise(paper, Model(law), ref, ev, rec)
+    assert periodic["plane"] is not None and periodic["drift"] is not None
+    none = replace(ev.steady, regime="nonperiodic", n_periods=0)
+    out = localise(paper, Model(law), ref, replace(ev, steady=none), rec)
+    assert out["phases"] == periodic["phases"] and out["drift"] == periodic["drift"]
+    assert out["plane"] is None and out["grid"] is None
