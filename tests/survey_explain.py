@@ -99,6 +99,8 @@ def draw(i, workers=None):
         row.update(
             seconds=time.perf_counter() - t0,
             named=[it.effect for it in res.iterations if it.effect],
+            kept=list(res.final_model.effects),
+            dropped=[d["effect"] for d in res.dropped],
             I2_start=(res.iterations[0].criteria_before if res.iterations else res.criteria).get(
                 "I2"
             ),
@@ -122,7 +124,9 @@ def outcome(r):
         return "explain raised an error"
     if "error" in r or not r.get("true_consistent"):
         return "invalid: the true model is not consistent with its own record"
-    named, hidden = r["named"], r["hidden"]
+    # the effects the final model keeps (an effect named early and taken out again, once a
+    # later refit made it negligible, is not the answer); rows from before that step: named
+    named, hidden = r.get("kept", r["named"]), r["hidden"]
     if hidden == "none":
         return "clean: nothing added" if not named else "false discovery"
     if not named:

@@ -416,6 +416,10 @@ def _explain(doc, run_dir):
             "No effect was added: "
             + str("the start model already agrees with the record" if stopped is None else stopped)
         ]
+    concl += [
+        f"Taken out of the final model: {str(d['effect']).replace('_', ' ')}, {d['reason']}."
+        for d in r.dropped or ()
+    ]
     c["conclusions"] = [prose(x) for x in concl]
     c["figures"] = _figures(run_dir, ["explain", "localise", "screen", "drift"])
     return c

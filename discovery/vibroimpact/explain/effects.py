@@ -167,6 +167,31 @@ class Model:
         ids = self.effects + ((eff.id,) if add and eff.id not in self.effects else ())
         return Model(law, obs, ids, scen)
 
+    def without_effect(self, eff):
+        """The model with the effect taken out (its term, unloading term, set, machine
+        change or observation model removed, and its id)."""
+        law, obs, scen = self.law, dict(self.observation), dict(self.scenario)
+        if eff.target == "term":
+            keep = [i for i, t in enumerate(law.terms) if t != _term(eff.key)]
+            law = replace(
+                law,
+                terms=tuple(law.terms[i] for i in keep),
+                coefficients=tuple(law.coefficients[i] for i in keep),
+            )
+        elif eff.target == "unloading":
+            keep = [i for i, t in enumerate(law.unloading) if t != _term(eff.key)]
+            law = law.with_unloading(
+                tuple(law.unloading[i] for i in keep),
+                tuple(law.unloading_coefficients[i] for i in keep),
+            )
+        elif eff.target == "set":
+            law = law.with_unloading(permanent_set=0.0)
+        elif eff.target == "scenario":
+            scen.pop(eff.key, None)
+        else:
+            obs.pop(eff.key, None)
+        return Model(law, obs, tuple(i for i in self.effects if i != eff.id), scen)
+
     def with_law(self, law):
         return replace(self, law=law)
 

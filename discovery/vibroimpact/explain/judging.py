@@ -8,12 +8,29 @@ from ..fit.records import contact_scales
 from ..verify.motion import MOTION_CRITERION
 
 
-def _present(eff, model, res):
-    """The effect's parameter is away from 0 by more than 2 standard errors."""
+def _present(eff, model, res, negligible=0.0):
+    """The effect's parameter is away from 0 by more than 2 standard errors and larger than
+    ``negligible`` (:func:`negligible`: a value whose effect on the force is below about
+    0.1 % of its peak explains no gap; a refit that lands there carried a refit of the law)."""
     name = eff.parameters[0].name
     v = model.value(eff)
     se = res.standard_errors.get(name)
-    return bool(v != 0.0 and (se is None or not np.isfinite(se) or abs(v) > 2.0 * se))
+    return bool(
+        v != 0.0
+        and abs(v) > negligible
+        and (se is None or not np.isfinite(se) or abs(v) > 2.0 * se)
+    )
+
+
+NEGLIGIBLE = 0.1
+"""An effect's parameter below this fraction of its small step
+(:func:`~discovery.vibroimpact.explain.effects.small_step`: about 1 % of the peak force, 1 %
+of the contact time for a time constant) is negligible: it is not named."""
+
+
+def negligible(small):
+    """The largest negligible value of a parameter whose small step is ``small``."""
+    return NEGLIGIBLE * abs(float(small))
 
 
 def _within_noise(evs, criterion):
@@ -29,14 +46,26 @@ def _motion_within(evs):
     return all(e.within(MOTION_CRITERION, absent=True) for e in evs)
 
 
+def _worse(k, before, after, evs):
+    """Whether a refit takes criterion ``k`` further from the record and beyond its limit on
+    a record."""
+    if k not in before or k not in after or after[k] <= before[k]:
+        return False
+    return any(k in e.limits and e.criteria.get(k, 0.0) > e.limits[k] for e in evs)
+
+
 def _motion_worse(before, after, evs):
     """Whether a refit takes the recorded penetration (I5) further from the record and
     beyond its limit on a record: a fit of the force by another motion (a sensor lag that
     smears the force of a too-soft spring), which names nothing."""
-    k = MOTION_CRITERION
-    if k not in before or k not in after or after[k] <= before[k]:
-        return False
-    return any(k in e.limits and e.criteria.get(k, 0.0) > e.limits[k] for e in evs)
+    return _worse(MOTION_CRITERION, before, after, evs)
+
+
+def _force_worse(criterion, gap, before, after, evs):
+    """Whether a refit judged by the penetration's gap (``gap`` is I5: the force was within
+    its limit) takes the force's ``criterion`` further from the record and beyond its limit:
+    a fit of the motion by another force, which names nothing."""
+    return gap == MOTION_CRITERION and _worse(criterion, before, after, evs)
 
 
 def _failing(evs):

@@ -63,6 +63,7 @@ from .judging import _repulsive as _repulsive
 from .problem import _Drift, _mean, _Problem, _with_drift
 from .problem import _drift_free as _drift_free
 from .problem import _small_step as _small_step
+from .pruning import drop_collapsed
 from .result import ExplainResult, Iteration
 from .result import _parameters as _parameters
 from .result import loaded_model as loaded_model
@@ -258,7 +259,8 @@ def _refit_and_name(run, step):
     eff = eff_by_id[best.score["effect"]]
     if best.result is not None and run.budget > screen_budget:
         winner = _polish_winner(run, best, eff)
-    if winner.result is not None and not _present(eff, winner.model, winner.result):
+    small = best.score.get("negligible", 0.0)
+    if winner.result is not None and not _present(eff, winner.model, winner.result, small):
         if _only_the_law_refit(run, step, best):
             return True
     _name_effect(run, step, good, winner)
@@ -460,6 +462,7 @@ def explain(
         tick(progress, _ITERATIONS, len(run.iterations), max_iterations)
         if not _iteration(run, max_iterations):
             break
+    dropped = drop_collapsed(run)
     evs = problem.evaluations(run.model, floor=True)
     crit, floor = _with_drift(
         _mean(evs, "criteria"), _mean(evs, "noise_floor"), run.drift, run.model
@@ -475,6 +478,7 @@ def explain(
         consistent=all(e.consistent for e in evs) and run.drift_free(run.model),
         stopped_because=run.stopped,
         separability=tuple(run.separability),
+        dropped=tuple(dropped),
         seconds=time.perf_counter() - t0,
         settings={
             "start": str(start),

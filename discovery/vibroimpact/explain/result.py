@@ -138,6 +138,10 @@ class ExplainResult(Result):
         cannot tell from the model (e.g. a Hertz term on a record a linear law matches).
     intervals : Intervals or None
         Bootstrap intervals of the final model's parameters through the full processing.
+    dropped : tuple of dict
+        Effects named in an iteration and taken out of the final model because a later
+        refit made them negligible (``effect``, ``parameter``, ``value``, ``reason``;
+        :mod:`~discovery.vibroimpact.explain.pruning`).
     """
 
     KIND = "explain"
@@ -147,6 +151,7 @@ class ExplainResult(Result):
         "uncertainties": lambda d: d["final_model"].get("uncertainties", {}),
         "intervals": lambda d: part(Intervals, d["final_model"].get("intervals")),
         "separability": lambda d: tuple(d.get("separability", ())),
+        "dropped": lambda d: tuple(d.get("dropped", ())),
     }
 
     iterations: tuple
@@ -161,6 +166,7 @@ class ExplainResult(Result):
     separability: tuple = ()
     intervals: object = None
     limits: dict = field(default_factory=dict)
+    dropped: tuple = ()
 
     def as_dict(self):
         return {
@@ -176,11 +182,12 @@ class ExplainResult(Result):
             "consistent": self.consistent,
             "stopped_because": self.stopped_because,
             "separability": list(self.separability),
+            "dropped": list(self.dropped),
             "seconds": self.seconds,
         }
 
     def _lines(self):
-        named = [it.effect for it in self.iterations if it.effect]
+        named = list(self.final_model.effects)
         out = [
             f"final model {self.final_model.law}"
             + (f" with {', '.join(named)}" if named else " (nothing named)")
@@ -196,6 +203,8 @@ class ExplainResult(Result):
                 else ""
             )
             out.append(f"  iteration {k + 1}: {it.effect or 'nothing named'}  {gap}")
+        for d in self.dropped:
+            out.append(f"  taken out: {d['effect']} ({d['reason']})")
         out += criteria_lines(self.criteria, self.noise_floor, self.limits)
         out.append(f"  stopped because {self.stopped_because}")
         out.append(f"{self.seconds:.1f} s")

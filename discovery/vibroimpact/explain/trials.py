@@ -10,7 +10,14 @@ from ..model.law import Term
 from ..verify import CONSISTENCY_FACTORS
 from ..verify.motion import MOTION_CRITERION
 from .effects import effect
-from .judging import _in_bounds, _keeps_repulsive, _motion_worse, _present
+from .judging import (
+    _force_worse,
+    _in_bounds,
+    _keeps_repulsive,
+    _motion_worse,
+    _present,
+    negligible,
+)
 from .problem import _mean, _small_step, _with_drift
 from .starts import _output_error, _regressed
 
@@ -148,7 +155,7 @@ class _Trial:
         # an effect refitted to 0, or to a value within 2 standard errors of 0, only
         # carried a refit of the law
         s["present"] = (
-            _present(eff, self.model, self.result)
+            _present(eff, self.model, self.result, s.get("negligible", 0.0))
             if self.result is not None
             else bool(self.model.value(eff) != 0.0)
         )
@@ -166,6 +173,7 @@ class _Trial:
             and s["beats_law_refit"]
             and s["present"]
             and not s.get("motion_worse")
+            and not s.get("force_worse")
         )
 
 
@@ -259,12 +267,20 @@ def _refit_trials(run, step, screen_budget, gap):
                 f"outside its physical bounds [{lo:g}, {hi:g}]"
             )
         s["gap"] = key
+        s["negligible"] = negligible(_small_step(eff, records))
         s["motion_worse"] = _motion_worse(before, after, evs2)
         if s["motion_worse"]:
             s["note"] = (
                 f"the refit moves the recorded penetration further away ({MOTION_CRITERION} "
                 f"{before[MOTION_CRITERION]:.3g} -> {after[MOTION_CRITERION]:.3g}, beyond its "
                 "limit): it fits the force by another motion"
+            )
+        s["force_worse"] = _force_worse(run.criterion, key, before, after, evs2)
+        if s["force_worse"]:
+            c = run.criterion
+            s["note"] = (
+                f"the refit moves the force history further away ({c} {before[c]:.3g} -> "
+                f"{after[c]:.3g}, beyond its limit): it fits the penetration by another force"
             )
         trials.append(
             _Trial(

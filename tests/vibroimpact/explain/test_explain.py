@@ -294,3 +294,70 @@ def test_localisation_of_a_law_with_no_periodic_orbit(paper, hidden_coupling):
     out = localise(paper, Model(law), ref, replace(ev, steady=none), rec)
     assert out["phases"] == periodic["phases"] and out["drift"] == periodic["drift"]
     assert out["plane"] is None and out["grid"] is None
+
+
+def test_an_effect_a_later_refit_made_negligible_is_taken_out(monkeypatch):
+    """``without_effect`` takes each kind of effect out; the pruning step takes out a named
+    effect whose parameter is below a tenth of its small step when the model without it is
+    as consistent, and keeps it when taking it out loses a record's consistency."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.explain import pruning
+    from discovery.vibroimpact.explain.effects import Model
+
+    law = ForceLaw.parse("2e8*z + 1e7*zd")
+    m = Model(law)
+    for eid, v in [
+        ("penetration_velocity_coupling", 2e10),
+        ("unloading_damping", 4e6),
+        ("permanent_set", 0.3),
+        ("support_nonlinearity", 1e11),
+        ("sensor_lag", 1e-5),
+    ]:
+        with_it = m.with_effect(effect(eid), v)
+        assert eid in with_it.effects and with_it.value(effect(eid)) == v
+        back = with_it.without_effect(effect(eid))
+        assert back == m, eid
+
+    lag, coupling = effect("sensor_lag"), effect("penetration_velocity_coupling")
+    model = m.with_effect(lag, 1e-10).with_effect(coupling, 2e10)
+    monkeypatch.setattr(pruning, "_small_step", lambda eff, records: 1e-5)
+
+    def run_with(consistent_without):
+        def evaluations(mod, floor=True):
+            ok = consistent_without or "sensor_lag" in mod.effects
+            return [SimpleNamespace(consistent=ok)]
+
+        return SimpleNamespace(
+            model=model,
+            records=[None],
+            problem=SimpleNamespace(evaluations=evaluations),
+            uncertainties={"tau": 1e-11, "z": 1.0},
+        )
+
+    run = run_with(True)
+    dropped = pruning.drop_collapsed(run)
+    assert [d["effect"] for d in dropped] == ["sensor_lag"]
+    assert run.model.effects == ("penetration_velocity_coupling",) and "tau" not in run.uncertainties
+    # the coupling (2e10, far above a tenth of its step) stays
+    assert run.model.value(coupling) == 2e10
+    run = run_with(False)  # without the lag the record is no longer consistent: kept
+    assert pruning.drop_collapsed(run) == [] and "sensor_lag" in run.model.effects
+
+
+def test_a_refit_judged_by_the_motion_that_breaks_the_force_names_nothing():
+    """With the gap measured on the penetration (I5; the force within its limit), a refit
+    that takes the force's I2 further away and beyond its limit is a fit of the motion by
+    another force: ``_force_worse`` holds it, as ``_motion_worse`` holds the converse."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.explain.judging import _force_worse, _motion_worse
+
+    before = {"I2": 0.090, "I5": 0.375}
+    after = {"I2": 0.108, "I5": 0.239}
+    evs = [SimpleNamespace(limits={"I2": 0.096, "I5": 0.088}, criteria=after)]
+    assert _force_worse("I2", "I5", before, after, evs)
+    assert not _force_worse("I2", "I2", before, after, evs)  # gap on the force: not this rule
+    assert not _motion_worse(before, after, evs)
+    within = [SimpleNamespace(limits={"I2": 0.2, "I5": 0.088}, criteria=after)]
+    assert not _force_worse("I2", "I5", before, after, within)  # worse, but within its limit
