@@ -338,7 +338,8 @@ def test_an_effect_a_later_refit_made_negligible_is_taken_out(monkeypatch):
     run = run_with(True)
     dropped = pruning.drop_collapsed(run)
     assert [d["effect"] for d in dropped] == ["sensor_lag"]
-    assert run.model.effects == ("penetration_velocity_coupling",) and "tau" not in run.uncertainties
+    assert run.model.effects == ("penetration_velocity_coupling",)
+    assert "tau" not in run.uncertainties
     # the coupling (2e10, far above a tenth of its step) stays
     assert run.model.value(coupling) == 2e10
     run = run_with(False)  # without the lag the record is no longer consistent: kept
