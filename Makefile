@@ -109,6 +109,8 @@ surveys: install
 	$(BIN)/python -m tests.survey_advise --cases 0 14 --out $(MEASURED)/advise-1.jsonl
 	$(BIN)/python -m tests.survey_advise --cases 0 12 --force-noise 0.03 \
 		--out $(MEASURED)/advise-3.jsonl
+	$(BIN)/python -m tests.realistic_survey --properties --n 25 --noise-seeds 2 \
+		--out $(MEASURED)/realistic-properties.jsonl
 	$(BIN)/python -m tests.realistic_survey --properties --n 8 --noise-seeds 1 \
 		--out $(MEASURED)/realistic-default.jsonl
 	$(BIN)/python -m tests.realistic_survey --properties --n 8 --noise-seeds 1 --field \

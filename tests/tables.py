@@ -157,6 +157,20 @@ TABLES = {
         row=survey_corpus.effects_row,
         read=survey_corpus.read_rows,
     ),
+    "realistic-properties": Table(
+        page="docs/validation.md",
+        header=(
+            "| category | true law consistent | wrong law inconsistent (detectable) | not "
+            "detectable |",
+            "|---|---|---|---|",
+        ),
+        rows=tuple(
+            (label, ("realistic-properties*.jsonl",))
+            for label in ("`p1`", "`p1-slow`", "`subharmonic`", "`short-contact`", "all")
+        ),
+        row=realistic_survey.category_row,
+        read=_rows,
+    ),
     "realistic-span": Table(
         page="docs/validation.md",
         header=(
