@@ -166,11 +166,17 @@ def read_rows(paths):
     return [by_draw[i] for i in sorted(by_draw)]
 
 
+def _kept(r):
+    """The effects the row's final model keeps (rows from before that was recorded: the
+    effects named)."""
+    return r.get("kept", r.get("named")) or ()
+
+
 def counts(rows):
-    """``{outcome: draws}`` of ``rows``, with ``"more than one named"`` (any draw whose
-    ``explain`` named more than one effect)."""
+    """``{outcome: draws}`` of ``rows``, with ``"more than one kept"`` (any draw whose
+    final model keeps more than one effect)."""
     out = collections.Counter(outcome(r) for r in rows)
-    out["more than one named"] = sum(len(r.get("named") or ()) > 1 for r in rows)
+    out["more than one kept"] = sum(len(_kept(r)) > 1 for r in rows)
     return out
 
 
@@ -207,7 +213,7 @@ def markdown_row(rows, label):
         n["named, gap short of the bar"],
         bold(n["wrong effect named"]),
         n["missed"],
-        n["more than one named"],
+        n["more than one kept"],
     ]
     return "| " + " | ".join(str(c) for c in cells) + " |"
 
@@ -232,11 +238,11 @@ def readme_row(rows, label):
 def _is_miss(r):
     """A draw the rates count against ``explain`` (a false discovery, the right effect
     short of the bar, a wrong effect, nothing named for an effect that shows, more than one
-    effect named, ``explain`` raising an error) or one whose run raised an error."""
+    effect kept, ``explain`` raising an error) or one whose run raised an error."""
     o = outcome(r)
     return (
         o in ("false discovery", *BEYOND[1:])
-        or len(r.get("named") or ()) > 1
+        or len(_kept(r)) > 1
         or ("error" in r and "skip" not in r)
     )
 
@@ -264,7 +270,13 @@ def misses_rows(rows, label=None):
             continue
         k = r.get("impacts")
         regime = r.get("regime", "-") + (f", {k} impact{'s' * (k > 1)}" if k else "")
-        named = ", ".join(f"`{e}`" for e in r.get("named") or ()) or "nothing"
+        gone = r.get("dropped") or ()
+        named = (
+            ", ".join(
+                f"`{e}`" + (" (taken out)" if e in gone else "") for e in r.get("named") or ()
+            )
+            or "nothing"
+        )
         if "error" in r:
             named, gap = "-", r["error"].replace("|", "/")
         else:

@@ -191,7 +191,7 @@ TABLES = {
             "| draws | run | Hertz-type (skipped) | tests nothing | clean: an effect named | "
             "hidden effect too weak | `explain` raised an error | start's I2 beyond its limit "
             "| right effect first, gap to the bar | right first, short of the bar | wrong "
-            "effect first | nothing named | more than one named |",
+            "effect first | nothing named | more than one kept |",
             "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
         ),
         rows=tuple((label, _EXPLAIN_RUNS) for label in survey_explain.LABELS),
