@@ -22,6 +22,22 @@ from tests import measured
 
 CONFIG = measured.ROOT / "examples" / "study_paper.toml"
 
+#: the docs' copies of the study's figures (docs/validation.md and the gallery show them)
+FIGURES = measured.ROOT / "reports" / "assets"
+_FIGURES = {"recovery_map.png": "study_recovery_map.png", "coverage.png": "study_coverage.png"}
+
+
+def keep_figures(study_dir, figures):
+    """Copy the study's recovery map and coverage figures (PNG) from its directory into
+    ``figures`` under the names the docs show, so they are the table's run."""
+    import shutil
+
+    for name, kept in _FIGURES.items():
+        found = sorted(study_dir.rglob(name))
+        if found:
+            shutil.copyfile(found[0], figures / kept)
+
+
 #: the cell's keys kept in the run file (the factors that vary, then the counts)
 _CELL_KEYS = (
     "selection",
@@ -105,6 +121,7 @@ def markdown_row(rows, label):
 def stamp(files, rows):
     """The line under the table: the run file, its commit and date, and the study's cost."""
     head, _ = measured.read(files[-1])
+    note = f" ({head['note']})" if head.get("note") else ""
     cells = [r for r in rows if r["kind"] == "cell"]
     _, periods = _noise_levels(rows)
     seconds = [r["seconds"] for r in rows if r["kind"] == "timing"]
@@ -115,7 +132,7 @@ def stamp(files, rows):
         f"from `{files[-1].name}` (commit {head.get('commit') or 'not recorded'}, "
         f"{str(head.get('started', '?'))[:10]}): {len(cells)} cells, "
         f"{sum(r['runs'] for r in cells)} runs, {minutes:.1f} min on "
-        f"{head.get('workers', '?')} worker process(es).*"
+        f"{head.get('workers', '?')} worker process(es){note}.*"
     )
 
 
@@ -124,14 +141,23 @@ def main(argv=None):
     ap.add_argument("--workers", type=int, default=2, help="worker processes (2)")
     ap.add_argument("--out", required=True, help="the run file to write")
     ap.add_argument("--config", default=str(CONFIG), help="the study (the shipped example)")
+    ap.add_argument(
+        "--figures",
+        default=str(FIGURES),
+        help="where the study's recovery map and coverage figures are copied (the docs')",
+    )
     args = ap.parse_args(argv)
     from discovery import study
+    from reports.vibroimpact.study_figures import study_figures
 
     run = measured.RunFile(args.out, "survey_study", argv, workers=args.workers)
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
-        result = study(args.config, Path(tmp) / "study", workers=args.workers)
+        result = study(
+            args.config, Path(tmp) / "study", workers=args.workers, figures=study_figures
+        )
         rows = rows_of(result)
+        keep_figures(Path(tmp) / "study", Path(args.figures))
     for r in rows:
         run.write(r)
     run.write({"kind": "timing", "seconds": time.perf_counter() - t0})

@@ -28,6 +28,7 @@ from . import (
     survey_corpus,
     survey_explain,
     survey_intervals,
+    survey_study,
 )
 
 ROOT = measured.ROOT
@@ -156,6 +157,17 @@ TABLES = {
         ),
         row=survey_corpus.effects_row,
         read=survey_corpus.read_rows,
+    ),
+    "study-paper": Table(
+        page="docs/validation.md",
+        header=survey_study.header,
+        rows=tuple(
+            (method, ("study-paper*.jsonl",))
+            for method in ("best-subset", "l1-path", "constrained-sr3", "stlsq", "sr3")
+        ),
+        row=survey_study.markdown_row,
+        read=_rows,
+        stamp=survey_study.stamp,
     ),
     "realistic-properties": Table(
         page="docs/validation.md",

@@ -266,3 +266,40 @@ def test_a_scaling_run_adds_its_machines_rows(tmp_path):
     assert s.markdown_row(runs, s.EXPLAIN)[1].endswith("| 10.0 s | 5.0 s (2.00x) |  |")
     stamp = s.stamp(files, runs)
     assert "scaling-old.jsonl" not in stamp and "`scaling-new.jsonl` (" in stamp
+
+
+def test_the_study_table_is_each_methods_cells_and_pooled_counts(tmp_path):
+    """The shipped study's table: per method, each force noise's recoveries at each record
+    length, then the pooled count with its Wilson interval, false terms and coverage; the
+    line under it names the run's commit, cells, runs and time."""
+    from tests import survey_study
+
+    rows = []
+    for noise in (0.01, 0.05):
+        for periods in (4, 40):
+            for method, k in (("best-subset", 2), ("stlsq", 0)):
+                rows.append(
+                    {"kind": "cell", "selection": method, "force_noise": noise}
+                    | {"periods": periods, "runs": 2, "recovered": k - (noise == 0.05)}
+                )
+    rows += [
+        {"kind": "pooled", "selection": "best-subset", "runs": 8, "recovered": 4}
+        | {"recovery_ci": [0.2, 0.8], "fp_per_run": 0.25, "covered": 9, "intervals": 10}
+        | {"coverage_ci": [0.6, 0.98]},
+        {"kind": "pooled", "selection": "stlsq", "runs": 8, "recovered": 0}
+        | {"recovery_ci": [0.0, 0.3], "fp_per_run": None, "covered": 0, "intervals": 0}
+        | {"coverage_ci": [None, None]},
+        {"kind": "timing", "seconds": 600.0},
+    ]
+    head = survey_study.header(rows)
+    assert head[0].startswith("| method | 1 % | 5 % | all (95 % CI) |")
+    assert head[1].count("---") == 6
+    best = survey_study.markdown_row(rows, "best-subset")
+    assert best == "| best-subset | 2/2 2/2 | 1/2 1/2 | 4/8 (0.20-0.80) | 0.25 | 9/10 (0.60-0.98) |"
+    assert survey_study.markdown_row(rows, "stlsq").endswith("| 0/8 (0.00-0.30) | -- | -- |")
+    path = tmp_path / "study-paper.jsonl"
+    run = measured.RunFile(path, "survey_study", ["--workers", "2"], workers=2)
+    for r in rows:
+        run.write(r)
+    line = survey_study.stamp([path], rows)
+    assert "4 / 40 recorded periods" in line and "8 cells, 16 runs, 10.0 min on 2" in line
