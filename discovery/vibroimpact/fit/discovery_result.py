@@ -10,6 +10,7 @@ warnings, the equivalent models and the settings.  What the document does not ho
 estimator, the samples, the measured cycle and the references.
 """
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -263,13 +264,7 @@ class FitRecord:
     noise: dict
 
     def as_dict(self):
-        return {
-            "data": self.data,
-            "scenario": self.scenario,
-            "regime": self.regime,
-            "impacts": self.impacts,
-            "noise": self.noise,
-        }
+        return dataclasses.asdict(self)
 
 
 def _loaded_certificate(d):
