@@ -49,7 +49,7 @@ _EXPORTS = {
     "builtin_scenarios": "vibroimpact.model.scenario",
     "load_scenario": "vibroimpact.model.scenario",
     "Report": "reporting",
-    "StudyResult": "vibroimpact.studies.driver",
+    "StudyResult": "vibroimpact.studies.result",
     "study": "vibroimpact.studies.driver",
     "load_study": "vibroimpact.studies.config",
     "field_record": "vibroimpact.studies.records",

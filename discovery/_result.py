@@ -48,7 +48,7 @@ KINDS = {
     "intervals": "discovery.vibroimpact.fit.intervals:Intervals",
     "explain-iteration": "discovery.vibroimpact.explain.result:Iteration",
     "explain": "discovery.vibroimpact.explain.result:ExplainResult",
-    "study": "discovery.vibroimpact.studies.driver:StudyResult",
+    "study": "discovery.vibroimpact.studies.result:StudyResult",
     "advise": "discovery.vibroimpact.advise.result:AdviseResult",
     "contact-models": "discovery.vibroimpact.fit.contact_fit:ContactModelsResult",
     "steady": "discovery.vibroimpact.dynamics.steady_states:SteadyState",

@@ -16,7 +16,7 @@ _EXPORTS = {
     "field_record": "records",
     "run_one": "run",
     "score": "run",
-    "StudyResult": "driver",
+    "StudyResult": "result",
     "study": "driver",
     "wilson": "aggregate",
 }
