@@ -32,7 +32,7 @@ def stamp(survey, argv=None, command=None):
     """The header of a run started now: the survey, its command (``python -m
     tests.SURVEY ARGV`` unless ``command`` says otherwise), the commit (with ``+dirty`` when
     the package's source differs from it) and the code version."""
-    from discovery.vibroimpact.studies.driver import code_version
+    from discovery.vibroimpact.studies.run_files import code_version
 
     commit = git("rev-parse", "--short", "HEAD")
     if commit and git("status", "--porcelain", "--", "discovery", "constraints"):

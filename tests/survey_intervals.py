@@ -206,7 +206,7 @@ def run_corpus(name, *, n_boot=30, noise_model="cycles", refit="two-step"):
 
 
 def _code():
-    from discovery.vibroimpact.studies.driver import code_version
+    from discovery.vibroimpact.studies.run_files import code_version
 
     return code_version()
 
