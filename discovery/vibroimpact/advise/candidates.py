@@ -244,7 +244,7 @@ class NoiseModel:
     def from_measurement(cls, measurement, scenario, *, n_boot=16, seed=0):
         """The noise of a record: its force noise relative to its peak, its sampling step
         and its length in drive periods."""
-        from ..data.impulse import estimate_noise
+        from ..data.noise import estimate_noise
 
         F = np.asarray(measurement.F, dtype=float)
         t = np.asarray(measurement.t, dtype=float)

@@ -15,15 +15,16 @@ Two constructors:
   and averaging over all complete cycles in the record.
 """
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
 
 from ..._printing import fmt, readable
 from ..._validate import Array, Real, params
 from ...errors import InputError, NoContactError
+from .contact_edges import _contact_runs, _sampled_support
+from .noise import estimate_noise
+from .periods import _cycle_periods, check_drive_period, own_period
 
 __all__ = [
     "Impulse",
@@ -217,170 +218,6 @@ class Impulse:
         return out
 
 
-def estimate_noise(x, order=1):
-    """Robust noise standard deviation of a sampled signal (MAD of differences).
-
-    Differences of order ``k`` cancel a smooth trend (a polynomial of degree < k)
-    while white noise of variance ``s^2`` gives them variance ``C(2k, k) s^2``; the
-    median absolute deviation makes the estimate robust to the few differences that
-    straddle a jump.  Order 1 suits mostly-flat signals (a force record), order 3
-    smooth ones (positions).
-    """
-    d = np.diff(np.asarray(x, dtype=float), n=order)
-    if d.size < 2:
-        return 0.0
-    return float(
-        1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(math.comb(2 * order, order))
-    )
-
-
-def _refine_onset(t, zeta, s, t_on, max_back):
-    """Onset as the zero up-crossing of zeta at or before sample ``s`` (searched back
-    at most ``max_back`` samples): a quadratic through the three samples before the
-    crossing (free flight, smooth) extrapolated into the crossing interval, O(dt^3)."""
-    k = min(s, len(t) - 1)
-    stop = max(3, k - int(max_back))
-    while k > stop and zeta[k - 1] > 0.0:
-        k -= 1
-    if not (k >= 3 and zeta[k - 1] <= 0.0 < zeta[k]):
-        return t_on
-    a, b, c = np.polyfit(t[k - 3 : k] - t[k - 1], zeta[k - 3 : k], 2)
-    roots = np.roots([a, b, c]) if a != 0 else np.array([-c / b])
-    h = t[k] - t[k - 1]
-    ok = [r.real for r in roots if abs(r.imag) < 1e-12 and -1e-9 * h <= r.real <= h]
-    if ok:
-        return t[k - 1] + min(ok)
-    return t[k - 1] + (0.0 - zeta[k - 1]) / (zeta[k] - zeta[k - 1]) * h
-
-
-def _merge_unseparated(t, zeta, runs):
-    """Runs of force whose gap has no separation are one contact: when ``zeta`` never
-    goes clearly below zero between them (by three times its noise), the force only
-    dipped below the threshold within a contact (a near-loss), and the second run is
-    neither a new impact nor, however large, the main one (its "onset" would be a
-    point inside the contact)."""
-    if len(runs) < 2:
-        return runs
-    sz = estimate_noise(zeta, order=3)
-    out = [runs[0]]
-    for r in runs[1:]:
-        t_on, t_off, s = out[-1]
-        a, b = int(np.searchsorted(t, t_off)), r[2]
-        if b > a and np.min(zeta[a:b]) > -3.0 * sz:
-            out[-1] = (t_on, r[1], s)
-        else:
-            out.append(r)
-    return out
-
-
-def _bracket_onset(t, F, run, thr):
-    """The ``zeta`` onset of ``run = (t_on, t_off, s)`` (onset, loss, first sample above
-    ``thr``) kept where the force allows it: not after sample ``s``, the first
-    one above the threshold (the contact has begun there), and, when the force *jumps*
-    at ``s`` (from at most half the threshold to a quarter of the contact's peak or
-    more: a viscous contact's ``F(0+)``), not before sample ``s - 1`` either (the force
-    was still zero there).  A noisy ``zeta`` can be a sample or two off; a force jump
-    brackets the onset within one sample."""
-    t_on, t_off, s = run
-    hi = t[s]
-    lo = -np.inf
-    if s >= 1:
-        e = max(int(np.searchsorted(t, t_off)), s + 1)
-        if F[s - 1] <= 0.5 * thr and F[s] >= 0.25 * float(np.max(F[s:e])):
-            lo = t[s - 1]
-    return float(min(max(t_on, lo), hi))
-
-
-def _edge_params(t, period, min_samples=3):
-    """Debounce length and edge extrapolation bound [samples] for a sampling."""
-    dt = float(np.median(np.diff(t)))
-    return max(min_samples, int(0.01 * period / dt)), max(4.0, 0.02 * period / dt)
-
-
-def _sampled_support(tau, F, thr, period, *, noise=0.0, extrapolate=True):
-    """Support of a cycle sampled at ``tau`` (starting at the onset, ``tau[0] = 0``).
-
-    When its noise is not negligible (``noise > thr / 100``) the cycle is first smoothed
-    by a moving average over 1 % of a period, so noise near a flat tail does not stretch
-    the support by chance crossings of the threshold (the measured and the simulated
-    cycle go through the same operator; a smoothed edge moves by up to half a window)."""
-    min_len, max_extrap = _edge_params(tau, period)
-    dt = tau[2] - tau[1]
-    width = max(1, int(0.01 * period / dt)) | 1 if noise > thr / 100.0 else 1
-    Fs = uniform_filter1d(np.asarray(F, dtype=float), width, mode="nearest")
-    Fs[0] = F[0]
-    t_ext = np.concatenate([[-dt], tau, [tau[-1] + dt]])
-    f_ext = np.concatenate([[0.0], Fs, [0.0]])
-    runs = _edges(
-        t_ext,
-        f_ext,
-        thr,
-        min_len,
-        max_extrap=max_extrap if extrapolate else None,
-        noise=noise / np.sqrt(width),
-    )
-    sup = [(max(a, 0.0), min(b, tau[-1])) for a, b, _ in runs]
-    return np.array(sup, dtype=float).reshape(-1, 2)
-
-
-def _edges(t, F, thr, min_len, *, max_extrap=4.0, noise=0.0):
-    """Sub-sample start/end times of the runs where F > thr (runs shorter than
-    ``min_len`` samples dropped unless they last 3 samples and peak above ``3 thr``;
-    gaps shorter than ``min_len``, or not going below ``thr - 3 noise``, closed).
-
-    An edge whose step between samples clearly exceeds the noise (``> 3 noise``) is
-    extrapolated along its slope to zero force, by at most ``max_extrap`` samples, so
-    the part of a smooth rise or fall below the threshold is not cut off; a flat,
-    noisy edge has no meaningful slope and ends at its threshold crossing."""
-    above = F > thr
-    idx = np.flatnonzero(np.diff(above.astype(np.int8)))
-    starts = list(idx[~above[idx]] + 1)
-    ends = list(idx[above[idx]] + 1)
-    if above[0]:
-        starts.insert(0, 0)
-    if above[-1]:
-        ends.append(len(F))
-    runs = [[s, e] for s, e in zip(starts, ends, strict=True)]
-    merged = []
-    for r in runs:
-        # a gap is closed when it is short, or when it never goes clearly below the
-        # threshold (a dip of the force within the noise of it: noise must not decide
-        # whether a contact is one or two)
-        if merged and (
-            r[0] - merged[-1][1] < min_len
-            or (noise > 0 and np.min(F[merged[-1][1] : r[0]]) > thr - 3.0 * noise)
-        ):
-            merged[-1][1] = r[1]
-        else:
-            merged.append(r)
-    # short runs are threshold flicker, unless the force clearly stands out: a contact
-    # shorter than the debounce length (< 1 % of a period) is still a contact
-    runs = [
-        r
-        for r in merged
-        if r[1] - r[0] >= min_len or (r[1] - r[0] >= 3 and np.max(F[r[0] : r[1]]) >= 3.0 * thr)
-    ]
-    out = []
-    for s, e in runs:
-        if s == 0 or e >= len(F):
-            continue  # incomplete at the record's ends
-        f0, f1 = F[s - 1], F[s]
-        steep = max_extrap is not None and f1 - f0 > 3.0 * noise
-        lo = -max_extrap if steep else 0.0
-        frac = ((0.0 if steep else thr) - f0) / (f1 - f0) if f1 > f0 else 1.0
-        t_on = t[s - 1] + float(np.clip(frac, lo, 1.0)) * (t[s] - t[s - 1])
-        g0, g1 = F[e - 1], F[e]
-        steep = max_extrap is not None and g0 - g1 > 3.0 * noise
-        hi = 1.0 + max_extrap if steep else 1.0
-        frac = ((0.0 if steep else thr) - g0) / (g1 - g0) if g1 < g0 else 0.0
-        t_off = t[e - 1] + float(np.clip(frac, 0.0, hi)) * (t[e] - t[e - 1])
-        if out and t_on <= out[-1][1]:  # extrapolated edges met: one contact
-            out[-1] = (out[-1][0], max(out[-1][1], t_off), out[-1][2])
-        else:
-            out.append((t_on, t_off, s))
-    return out
-
-
 def _checked_record(t, F, period, n_periods):
     """``t, F`` as float arrays, refused in one line when they cannot be a record."""
     t = np.asarray(t, dtype=float)
@@ -401,28 +238,6 @@ def _checked_record(t, F, period, n_periods):
     if n_periods is not None and not (isinstance(n_periods, int | np.integer) and n_periods >= 1):
         raise InputError(f"n_periods must be a positive integer; got {n_periods!r}")
     return t, F
-
-
-def _contact_runs(t, F, thr, sigma, period, *, min_samples, zeta):
-    """The contacts ``[(onset, loss, first sample), ...]`` above ``thr`` (gaps shorter than
-    1 % of a period are noise flicker inside one contact; a contact whose peak barely clears
-    the threshold is noise); with ``zeta``, contacts not separated by a free flight merged
-    and onsets refined on the penetration."""
-    min_len, max_extrap = _edge_params(t, period, min_samples)
-    runs = _edges(t, F, thr, min_len, max_extrap=max_extrap, noise=sigma)
-    if runs:
-        # a contact whose peak barely clears the threshold is noise, not an impact
-        pk = np.array([np.max(F[s : int(np.searchsorted(t, off)) + 1]) for _, off, s in runs])
-        runs = [r for r, p in zip(runs, pk, strict=True) if p >= max(3 * thr, 0.02 * pk.max())]
-    if zeta is not None:
-        zeta = np.asarray(zeta, dtype=float)
-        runs = _merge_unseparated(t, zeta, runs)
-        back = 0.25 * period / float(np.median(np.diff(t)))
-        runs = [
-            (_bracket_onset(t, F, (_refine_onset(t, zeta, s, t_on, back), t_off, s), thr), t_off, s)
-            for t_on, t_off, s in runs
-        ]
-    return runs
 
 
 def _recurring(onsets, ref_j, W, period):
@@ -653,79 +468,3 @@ def _first_after(t, F, t_on, thr, exact_onset):
         if F[j] > thr:
             return j if j > k and F[j - 1] <= 0.5 * thr else k
     return k
-
-
-def own_period(t, F, period, max_periods=4.5):
-    """The record's own period from its force history: the lag of the autocorrelation's
-    highest peak between half a drive period and ``max_periods`` periods.
-
-    Returns
-    -------
-    (lag, strength) : (float, float)
-        Lag [s] and the normalised autocorrelation there (1: exactly periodic).
-    """
-    t = np.asarray(t, dtype=float)
-    x = np.asarray(F, dtype=float)
-    x = x - x.mean()
-    dt = float(np.median(np.diff(t)))
-    n = x.size
-    lo, hi = int(0.5 * period / dt), min(int(max_periods * period / dt), n // 2)
-    if hi <= lo + 2 or not np.any(x):
-        return float("nan"), 0.0
-    m = 1 << int(np.ceil(np.log2(2 * n)))
-    X = np.fft.rfft(x, m)
-    ac = np.fft.irfft(X * np.conj(X), m)[:n]
-    ac = ac / ac[0]
-    k = lo + int(np.argmax(ac[lo:hi]))
-    return k * dt, float(ac[k])
-
-
-def check_drive_period(t, F, period, source=""):
-    """Refuse a record whose force repeats at a period that is no whole number of the
-    scenario's drive periods (a record of another machine or drive frequency, or a time
-    column in other units): everything downstream would be meaningless.  A record without a
-    clear period (strength below 0.3: chaos, too short) passes."""
-    lag, strength = own_period(t, F, period)
-    if not (np.isfinite(lag) and strength >= 0.3):
-        return
-    r = lag / period
-    if abs(r - round(r)) > 0.03:
-        where = f" of {source}" if source else ""
-        raise InputError(
-            f"the force{where} repeats every {lag:.4g} s ({r:.3g} of the scenario's drive "
-            f"period {period:.4g} s, i.e. a drive of {round(r) / lag if round(r) else 1 / lag:.4g}"
-            f" Hz rather than {1 / period:.4g} Hz); give the scenario of the machine that made "
-            "the record (its frequency), or check the t column's units"
-        )
-
-
-def _cycle_periods(t, F, period, max_period):
-    """Smallest ``n`` (drive periods) after which the second half of the record repeats.
-
-    ``D(n)`` is the mean square difference between ``F(t)`` and ``F(t + nT)`` over the
-    record's second half (the steady part).  Pure noise gives ``2 sigma^2`` for every
-    ``n``, a transient that is still decaying adds a drift growing with ``n``, and a
-    wrong period adds the difference between its cycles.  ``n`` is the smallest period
-    with ``D(n) <= 1.5 min D + R / 2``, where ``R``, the mean square difference of
-    consecutive samples, bounds the error of interpolating between samples (different
-    ``n`` fall at different sub-sample offsets).  So a slowly settling P1 record is
-    never read as P2, and a period doubling is resolved once its two cycles differ by
-    more than about a sample's worth of force change.
-    """
-    dt = float(np.median(np.diff(t)))
-    half = t >= t[0] + 0.5 * (t[-1] - t[0])
-    D = {}
-    for n in range(1, max_period + 1):
-        sel = half & (t + n * period <= t[-1])
-        if sel.sum() < max(8, 0.5 * period / dt):
-            break
-        d = np.interp(t[sel] + n * period, t, F) - F[sel]
-        D[n] = float(np.mean(d * d))
-    if not D:
-        raise InputError(
-            "the record is shorter than one cycle in its second half (it needs "
-            f"at least 3 drive periods, {3 * period:.4g} s); record more periods"
-        )
-    R = float(np.mean(np.diff(F[half]) ** 2))
-    limit = 1.5 * min(D.values()) + 0.5 * R
-    return min(n for n, v in D.items() if v <= limit)

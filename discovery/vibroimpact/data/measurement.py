@@ -36,7 +36,9 @@ from ..._io import atomic_write_text
 from ..._printing import fmt, readable
 from ..._validate import Array, Text, check
 from ...errors import InputError, NoContactError
-from .impulse import _edge_params, estimate_noise, impulse_from_samples
+from .contact_edges import _edge_params
+from .impulse import impulse_from_samples
+from .noise import estimate_noise
 
 __all__ = ["Measurement", "COLUMNS", "LIMITS", "JITTER_LIMIT", "STATE_COLUMNS"]
 

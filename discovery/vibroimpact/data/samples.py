@@ -19,8 +19,9 @@ from scipy.signal import savgol_filter
 from ..._printing import fmt, readable
 from ..._validate import Real, Text, params
 from ...errors import InputError
-from .impulse import estimate_noise, impulse_from_samples
+from .impulse import impulse_from_samples
 from .measurement import Measurement
+from .noise import estimate_noise
 
 __all__ = ["ContactSamples", "contact_samples", "join_samples"]
 
@@ -207,7 +208,7 @@ def contact_samples(
     k_sigma : float
         A sample counts as in contact when ``zeta > k_sigma * sigma_zeta`` (noise level
         of ``zeta`` from third differences,
-        :func:`~discovery.vibroimpact.data.impulse.estimate_noise`;
+        :func:`~discovery.vibroimpact.data.noise.estimate_noise`;
         a tiny floor for noise-free data).
     weights : {"uniform", "per-impact"}
         ``"per-impact"`` gives every impact the same total weight.

@@ -183,7 +183,7 @@ def localise(scenario, model, reference, evaluation, measurement=None, *, tolera
     ch = measurement.channels
     if "w1" in ch:
         w1 = ch["w1"][keep]
-        from ..data.impulse import estimate_noise
+        from ..data.noise import estimate_noise
 
         rng_w = float(np.ptp(w1)) or 1.0
         d = w1 - y[0]

@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..data.impulse import Impulse, _sampled_support
+from ..data.contact_edges import _sampled_support
+from ..data.impulse import Impulse
 
 __all__ = ["Fold", "make_fold"]
 

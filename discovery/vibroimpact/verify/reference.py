@@ -7,7 +7,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import InputError
-from ..data.impulse import check_drive_period, estimate_noise
+from ..data.noise import estimate_noise
+from ..data.periods import check_drive_period
 from .criteria import CRITERIA
 from .noise_bootstrap import noise_floor
 from .trajectory import BLOCK_CYCLES, record_span, span_floor

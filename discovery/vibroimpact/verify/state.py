@@ -22,7 +22,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..data.impulse import estimate_noise
+from ..data.noise import estimate_noise
 
 __all__ = ["StateEstimate", "free_flight_runs", "free_flight_state"]
 

@@ -21,7 +21,8 @@ import numpy as np
 
 from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
-from ..data.impulse import Impulse, estimate_noise
+from ..data.impulse import Impulse
+from ..data.noise import estimate_noise
 from ..dynamics import _kernel as _K
 from ..dynamics.simulation import simulate
 from .criteria import CRITERIA, evaluate_criteria

@@ -24,7 +24,8 @@ import numpy as np
 import pytest
 
 from discovery import ForceLaw, Scenario
-from discovery.vibroimpact.data.impulse import _edges, _merge_unseparated, impulse_from_samples
+from discovery.vibroimpact.data.contact_edges import _edges, _merge_unseparated
+from discovery.vibroimpact.data.impulse import impulse_from_samples
 from discovery.vibroimpact.verify import CONSISTENCY_FACTOR, CONSISTENCY_SLACK, Reference, evaluate
 from tests import realistic as R
 
