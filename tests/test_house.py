@@ -235,6 +235,25 @@ def test_split_modules_keep_the_names_of_the_module_they_were():
         assert hasattr(old, n), n
 
 
+def test_split_study_and_impulse_modules_keep_their_public_names():
+    """``studies/driver.py`` and ``data/impulse.py`` are split by job; every name of their
+    ``__all__`` is still there, a moved one the same object as in its new module."""
+    for old_mod, moved in {
+        "studies.driver": {"result": ("StudyResult",), "run_files": ("code_version",)},
+        "data.impulse": {
+            "noise": ("estimate_noise",),
+            "periods": ("own_period", "check_drive_period"),
+        },
+    }.items():
+        split = importlib.import_module(f"discovery.vibroimpact.{old_mod}")
+        assert all(hasattr(split, n) for n in split.__all__), old_mod
+        package = old_mod.rpartition(".")[0]
+        for mod, names in moved.items():
+            new = importlib.import_module(f"discovery.vibroimpact.{package}.{mod}")
+            for n in names:
+                assert n in split.__all__ and getattr(split, n) is getattr(new, n), n
+
+
 def test_figures_leave_the_users_backend_alone():
     """Drawing a report's figures neither loads pyplot nor switches matplotlib's backend (a
     notebook user's inline backend stays)."""
