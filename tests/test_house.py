@@ -309,6 +309,21 @@ def test_functions_are_short():
     assert not long, long
 
 
+def test_modules_are_short():
+    """No module of the package is over 700 lines, the compiled kernels aside (a module whose
+    functions are all numba kernels): a longer module holds several jobs that deserve
+    modules of their own."""
+    long = []
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            text = path.read_text()
+            n = len(text.splitlines())
+            funcs = [f for f in ast.parse(text).body if isinstance(f, ast.FunctionDef)]
+            if n > 700 and not (funcs and all(_compiled(f) for f in funcs)):
+                long.append(f"{path.relative_to(ROOT)} ({n})")
+    assert not long, long
+
+
 def _graph():
     """Every module of the project -> the project modules its source imports (anywhere:
     top level or in functions), package ``__init__`` files included."""
