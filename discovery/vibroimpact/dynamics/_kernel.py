@@ -1294,11 +1294,20 @@ def _contact_state(s, t0, w, mi, E, qm, out):
     """The state ``s`` after the phase's start (at ``t0``) into ``out``."""
     tt = t0 + s
     ew = np.cos(w * tt) + 1j * np.sin(w * tt)
+    ex = np.empty(4, dtype=np.complex128)
+    for j in range(4):
+        ex[j] = np.exp(E[mi, j, 8] * s)
+    _contact_state_at(s, ew, ex, mi, E, qm, out)
+
+
+@njit(cache=True)
+def _contact_state_at(s, ew, ex, mi, E, qm, out):
+    """:func:`_contact_state` from the exponentials at ``s``: ``ew = e^(i w (t0 + s))``,
+    ``ex[j] = e^(lambda_j s)``."""
     a0, a1, a2, a3 = 0j, 0j, 0j, 0j
     for j in range(4):
         x = E[mi, j, 8] * s
-        ex = np.exp(x)
-        q = ex * qm[j, 0] + E[mi, j, 9] * s * _phi1(x, ex)
+        q = ex[j] * qm[j, 0] + E[mi, j, 9] * s * _phi1(x, ex[j])
         q -= 0.5j * (E[mi, j, 10] * ew - E[mi, j, 11] * np.conj(ew))
         a0 += E[mi, j, 0] * q
         a1 += E[mi, j, 1] * q
@@ -1308,13 +1317,14 @@ def _contact_state(s, t0, w, mi, E, qm, out):
 
 
 @njit(cache=True)
-def _contact_phi(s, mi, E, out):
-    """The mode's transition matrix ``Phi(s) = V diag(e^(lambda s)) V^-1`` into ``out``."""
+def _contact_phi(ex, mi, E, out):
+    """The mode's transition matrix ``Phi(s) = V diag(e^(lambda s)) V^-1`` into ``out``
+    (``ex[j] = e^(lambda_j s)``)."""
     for r in range(4):
         for q in range(4):
             out[r, q] = 0.0
     for j in range(4):
-        ej = np.exp(E[mi, j, 8] * s)
+        ej = ex[j]
         for r in range(4):
             vr = E[mi, j, r] * ej
             for q in range(4):
@@ -1333,18 +1343,16 @@ def _eint(lj, mu, ej, emu, s):
 
 
 @njit(cache=True)
-def _contact_forced(s, t0, w, mi, E, qm, m1, m2, ex, W):
+def _contact_forced(s, t0, w, mi, E, qm, m1, m2, ex, ews, W):
     """``W[0]``, ``W[1]``: the state's response at ``s`` of the phase (zero at its start) to a
     force ``z``, and to a force ``zd``, added to the contact's: ``int_0^s Phi(s - u) e_F z(u)
     du`` with ``e_F = (0, -1/m1, 0, 1/m2)``, a coefficient's column's forced part.  In modal
     form each mode ``j`` integrates ``e^(lambda_j (s - u))`` against the modal solution's
     exponentials, constant and drive (``E(lambda, mu) = int e^(lambda (s - u)) e^(mu u) du``);
     the constant part ``beta s phi1(lambda s) = beta (e^(lambda s) - 1) / lambda`` needs a
-    mode's ``|lambda|`` away from 0 (the caller's check)."""
-    for j in range(4):
-        ex[j] = np.exp(E[mi, j, 8] * s)
+    mode's ``|lambda|`` away from 0 (the caller's check).  ``ex[j] = e^(lambda_j s)`` and
+    ``ews = e^(i w s)`` are given."""
     ew0 = np.cos(w * t0) + 1j * np.sin(w * t0)
-    ews = np.cos(w * s) + 1j * np.sin(w * s)
     for r in range(4):
         W[0, r] = 0.0
         W[1, r] = 0.0
@@ -1368,17 +1376,17 @@ def _contact_forced(s, t0, w, mi, E, qm, m1, m2, ex, W):
 
 
 @njit(cache=True)
-def _contact_sens(s, t0, mi, E, qm, p, S, spar, gcol, phi, ex, W, kF, cF, y, out_dF, k):
-    """Through ``s`` of the phase: ``S <- Phi(s) S``, plus ``gcol[0, j] W[0] + gcol[1, j]
-    W[1]`` for a coefficient's column ``j`` (``dF/dc = gcol[0, j] z + gcol[1, j] zd`` in this
-    mode, :func:`_contact_forced`); with ``k >= 0`` instead the force's and the
-    penetration's derivatives at ``s`` (the state ``y`` there) into ``out_dF[:, k]``, ``S``
-    kept."""
-    _contact_phi(s, mi, E, phi)
+def _contact_sens(s, t0, mi, E, qm, p, S, spar, gcol, phi, ex, ews, W, kF, cF, y, out_dF, k):
+    """Through ``s`` of the phase (``ex[j] = e^(lambda_j s)``, ``ews = e^(i w s)``): ``S <-
+    Phi(s) S``, plus ``gcol[0, j] W[0] + gcol[1, j] W[1]`` for a coefficient's column ``j``
+    (``dF/dc = gcol[0, j] z + gcol[1, j] zd`` in this mode, :func:`_contact_forced`); with
+    ``k >= 0`` instead the force's and the penetration's derivatives at ``s`` (the state
+    ``y`` there) into ``out_dF[:, k]``, ``S`` kept."""
+    _contact_phi(ex, mi, E, phi)
     m = S.shape[1]
     for j in range(m):
         if spar[j] >= 0:
-            _contact_forced(s, t0, p[5], mi, E, qm, p[0], p[1], ex, W)
+            _contact_forced(s, t0, p[5], mi, E, qm, p[0], p[1], ex, ews, W)
             break
     for j in range(m):
         a0, a1, a2, a3 = S[0, j], S[1, j], S[2, j], S[3, j]
@@ -1593,24 +1601,113 @@ def _contact(
     code = 1 if index >= 0 else (0 if index == -1 else 4)
     t_new = t1 if code == 0 else t + s
     k, c = kc[2 * mi], kc[2 * mi + 1]
-    while k_eval < t_eval.shape[0] and t_eval[k_eval] <= t_new:
-        _contact_state(max(t_eval[k_eval] - t, 0.0), t, w, mi, E, qm, ybuf)
-        for j in range(4):
-            out_y[j, k_eval] = ybuf[j]
-        out_f[k_eval] = k * (ybuf[0] - ybuf[2]) + c * (ybuf[1] - ybuf[3])
-        out_mode[k_eval] = mode
-        if out_dF.shape[1] > 0:
-            se = max(t_eval[k_eval] - t, 0.0)
-            _contact_sens(
-                se, t, mi, E, qm, p, S, spar, gcol, phi, ex, W, k, c, ybuf, out_dF, k_eval
-            )
-        k_eval += 1
+    k_eval = _contact_samples(
+        t,
+        t_new,
+        mode,
+        mi,
+        k,
+        c,
+        w,
+        E,
+        qm,
+        p,
+        S,
+        spar,
+        sw,
+        ybuf,
+        t_eval,
+        k_eval,
+        out_y,
+        out_f,
+        out_mode,
+        out_dF,
+    )
     _contact_state(s, t, w, mi, E, qm, ybuf)
     for j in range(4):
         y[j] = ybuf[j]
     if m:
-        _contact_sens(s, t, mi, E, qm, p, S, spar, gcol, phi, ex, W, k, c, ybuf, out_dF, -1)
+        _contact_exps(s, w, mi, E, ex)
+        ews = np.cos(w * s) + 1j * np.sin(w * s)
+        _contact_sens(s, t, mi, E, qm, p, S, spar, gcol, phi, ex, ews, W, k, c, ybuf, out_dF, -1)
     return code, t_new, k_eval, index
+
+
+@njit(cache=True)
+def _contact_exps(s, w, mi, E, ex):
+    """``ex[j] = e^(lambda_j s)`` of the contact mode ``mi``."""
+    for j in range(4):
+        ex[j] = np.exp(E[mi, j, 8] * s)
+
+
+@njit(cache=True)
+def _contact_samples(
+    t,
+    t_new,
+    mode,
+    mi,
+    k,
+    c,
+    w,
+    E,
+    qm,
+    p,
+    S,
+    spar,
+    sw,
+    ybuf,
+    t_eval,
+    k_eval,
+    out_y,
+    out_f,
+    out_mode,
+    out_dF,
+):
+    """The dense output of the contact phase started at ``t`` (its modal data ``qm``, its
+    force ``k z + c zd``) at the samples ``t_eval[k_eval:]`` up to ``t_new``: the state, the
+    force, the mode and (with ``out_dF``) the force's and the penetration's derivatives;
+    returns the next sample's index.  Evenly spaced samples advance the exponentials by
+    their semigroup (``e^(lambda (s + h)) = e^(lambda s) e^(lambda h)``, the drive's phase
+    rotated by ``w h``) between anchors evaluated directly, as the free flight's samples
+    (:func:`_flight_samples`)."""
+    gcol, phi, W, ex = sw
+    eh = np.empty(4, dtype=np.complex128)
+    want_df = out_dF.shape[1] > 0
+    slip = _SAMPLE_SLIP * 2.0 * np.pi / w
+    ew0 = np.cos(w * t) + 1j * np.sin(w * t)
+    h = 0.0
+    run = _SAMPLE_ANCHOR
+    se0 = 0.0
+    ews = 0j
+    ewh = 0j
+    while k_eval < t_eval.shape[0] and t_eval[k_eval] <= t_new:
+        se = max(t_eval[k_eval] - t, 0.0)
+        if run < _SAMPLE_ANCHOR and h > 0.0 and abs(se - (se0 + run * h)) <= slip:
+            for j in range(4):
+                ex[j] *= eh[j]
+            ews *= ewh
+            run += 1
+        else:
+            _contact_exps(se, w, mi, E, ex)
+            ews = np.cos(w * se) + 1j * np.sin(w * se)
+            se0, run = se, 1
+            hn = t_eval[k_eval + 1] - t_eval[k_eval] if k_eval + 1 < t_eval.shape[0] else 0.0
+            if hn != h:
+                h = hn
+                if h > 0.0:
+                    _contact_exps(h, w, mi, E, eh)
+                    ewh = np.cos(w * h) + 1j * np.sin(w * h)
+        _contact_state_at(se, ew0 * ews, ex, mi, E, qm, ybuf)
+        for j in range(4):
+            out_y[j, k_eval] = ybuf[j]
+        out_f[k_eval] = k * (ybuf[0] - ybuf[2]) + c * (ybuf[1] - ybuf[3])
+        out_mode[k_eval] = mode
+        if want_df:
+            _contact_sens(
+                se, t, mi, E, qm, p, S, spar, gcol, phi, ex, ews, W, k, c, ybuf, out_dF, k_eval
+            )
+        k_eval += 1
+    return k_eval
 
 
 @njit(cache=True)
