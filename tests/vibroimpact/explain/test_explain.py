@@ -31,10 +31,16 @@ def paper():
     return load_scenario("paper")
 
 
-@pytest.fixture(scope="module")
-def hidden_coupling(paper):
+def hidden_coupling_case(paper):
+    """``(record, explain's result)`` of the hidden coupling ``HC`` on the paper's machine
+    (also a case of ``tests/survey_explain_cases.py``)."""
     rec = _record(paper, HC, seed=0)
     return rec, explain(paper, rec, "linear", n_boot_intervals=0)
+
+
+@pytest.fixture(scope="module")
+def hidden_coupling(paper):
+    return hidden_coupling_case(paper)
 
 
 def test_hidden_coupling_is_named_and_the_gap_shrinks(hidden_coupling):
@@ -109,19 +115,35 @@ def test_an_effect_too_weak_to_matter_is_not_named(paper):
     assert [it.effect for it in res.iterations if it.effect] == []
 
 
+#: the effects explain screens on the lagged record
+LAG_EFFECTS = ["sensor_lag", "penetration_velocity_coupling"]
+
+
+def lagged_record(paper, tau=1e-4, seed=4):
+    """The paper's record with its force channel seen through a first-order sensor (time
+    constant ``tau``): the clean record's force is filtered, then noise is added."""
+    rec = _record(paper, paper.law, seed=seed, force_noise=0.0)
+    E = response(paper, paper.law).impulse
+    T = paper.period
+    lagged = first_order_lag(E, tau)
+    phase = np.mod(rec.t - (E.onset % T), T)  # P1: one cycle per period
+    F = lagged.evaluate(phase, "right")
+    F = F + np.random.default_rng(seed).normal(0.0, 0.01 * F.max(), F.size)
+    return Measurement(rec.t, F, rec.channels, source="lagged")
+
+
+def hidden_lag_case(paper, **kw):
+    """``(record, explain's result)`` of the hidden sensor lag (``kw``: explain's
+    ``workers``; also a case of ``tests/survey_explain_cases.py``)."""
+    rec = lagged_record(paper)
+    return rec, explain(paper, rec, "linear", effects=LAG_EFFECTS, n_boot_intervals=0, **kw)
+
+
 def test_hidden_sensor_lag_is_named(paper):
     """The force channel seen through a first-order sensor (tau = 0.1 ms, a 2.4 ms contact):
     the clean record's force is filtered, then noise is added."""
-    rec = _record(paper, paper.law, seed=4, force_noise=0.0)
-    E = response(paper, paper.law).impulse
-    T = paper.period
-    lagged = first_order_lag(E, 1e-4)
-    phase = np.mod(rec.t - (E.onset % T), T)  # P1: one cycle per period
-    F = lagged.evaluate(phase, "right")
-    F = F + np.random.default_rng(4).normal(0.0, 0.01 * F.max(), F.size)
-    rec = Measurement(rec.t, F, rec.channels, source="lagged")
-    pick = ["sensor_lag", "penetration_velocity_coupling"]
-    res = explain(paper, rec, "linear", effects=pick, workers=2, n_boot_intervals=0)
+    rec, res = hidden_lag_case(paper, workers=2)
+    pick = LAG_EFFECTS
     named = [it.effect for it in res.iterations if it.effect]
     assert named and named[0] == "sensor_lag", [it.evidence for it in res.iterations]
     tau = res.final_model.observation["sensor_lag"]

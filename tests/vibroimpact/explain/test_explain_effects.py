@@ -19,6 +19,11 @@ from discovery.vibroimpact.explain import explain
 from tests import realistic as R
 
 BASE = "2.06e8*z + 4e6*zd"  # the paper's machine, a lighter damper (no dominant jump)
+# the hidden laws (also cases of tests/survey_explain_cases.py)
+UNLOADING = BASE + "; unloading: 4e6*zd"
+SET = BASE + "; set: 0.4"
+HERTZ = "1e8*z + 3e6*zd + 1e10*z^1.5"
+COUPLED = "2.06e8*z + 0.9e7*zd + 2e10*z*zd"  # hidden with a mass loss
 
 
 def _explain(sc, law, seed=0, periods=15, **changes):
@@ -26,6 +31,27 @@ def _explain(sc, law, seed=0, periods=15, **changes):
         (sc.replace(**changes).with_law(law), law), periods=periods, seed=seed, check=False
     )
     return rec, explain(sc.with_law(ForceLaw.parse(BASE)), rec, "linear", n_boot_intervals=0)
+
+
+def support_case(paper, k3=5e10, law=BASE, periods=16):
+    """``(record, explain's result)`` of stiffening grid supports ``k3`` hidden on the
+    paper's machine with ``law`` (text or a ForceLaw), explained from its linear start on the
+    machine without them."""
+    law = ForceLaw.parse(law) if isinstance(law, str) else law
+    sc = paper.replace(k3=k3)
+    rec = R.reference_record((sc.with_law(law), law), periods=periods, seed=0, check=False)
+    return rec, explain(paper.with_law(law), rec, "linear", n_boot_intervals=0)
+
+
+def mass_loss_case(paper, law, delta=0.005, trans=40):
+    """``(record, explain's result)`` of a moulding that sheds ``delta`` of its mass per
+    impact, in a 40-period record of the paper's machine with ``law`` (a ForceLaw), the
+    record starting at the scenario's mass after the transient's impacts."""
+    lossy = paper.replace(mass_loss=delta)
+    n = int(np.sum(simulate(lossy, law, (0, trans * paper.period)).event_kind == K.EV_ONSET))
+    true = lossy.replace(m2=paper.m2 / (1 - delta) ** n)
+    rec = R.reference_record((true, law), periods=40, transient=trans, seed=0, check=False)
+    return rec, explain(paper, rec, "linear", n_boot_intervals=0)
 
 
 def _named(res):
@@ -46,7 +72,7 @@ def test_hidden_unloading_damping_is_named(paper):
     """Damping that also acts while unloading (departs from the paper's condition (5)):
     measured I2 0.0575 -> 0.0188 (floor 0.0136), d = 4.07e6 for a hidden 4e6.  A stiffening
     support fits as well only by turning the contact spring into a pull: not named."""
-    _, res = _explain(paper, ForceLaw.parse(BASE + "; unloading: 4e6*zd"))
+    _, res = _explain(paper, ForceLaw.parse(UNLOADING))
     assert _named(res)[0] == "unloading_damping", [it.evidence for it in res.iterations]
     it = res.iterations[0]
     assert _shrinks(it)
@@ -57,7 +83,7 @@ def test_hidden_unloading_damping_is_named(paper):
 
 def test_hidden_permanent_set_is_named(paper):
     """Walton-Braun plastic indentation, set 0.4: measured I2 0.044 -> 0.009, set 0.40."""
-    _, res = _explain(paper, ForceLaw.parse(BASE + "; set: 0.4"))
+    _, res = _explain(paper, ForceLaw.parse(SET))
     assert _named(res)[0] == "permanent_set", [it.evidence for it in res.iterations]
     assert _shrinks(res.iterations[0])
     assert 0.3 < res.final_model.law.permanent_set < 0.5
@@ -75,10 +101,7 @@ def test_hidden_support_nonlinearity_is_named_in_a_subharmonic_regime(paper):
     2.4x too soft and has no local score for k3 (a small step of it changes the regime);
     its refit starts from the certified regression with k3 from a ladder.  Measured: named,
     k3 = 4.99e10, law 2.067e8*z + 3.98e6*zd, I2 0.933 -> 0.033 (floor 0.034)."""
-    sc = paper.replace(k3=5e10)
-    law = ForceLaw.parse(BASE)
-    rec = R.reference_record((sc.with_law(law), law), periods=16, seed=0, check=False)
-    res = explain(paper.with_law(law), rec, "linear", n_boot_intervals=0)
+    rec, res = support_case(paper)
     it = res.iterations[0]
     assert _named(res)[0] == "support_nonlinearity", [it.evidence for it in res.iterations]
     assert _shrinks(it)
@@ -98,13 +121,7 @@ def test_hidden_mass_loss_is_named_on_the_drift_channel(paper):
     """The moulding sheds 0.5 % of its mass per impact (17 % over a 40-period record): the
     averaged cycle is consistent with the linear law, but the drift channel's score test
     finds the trend; measured loss 0.0064 and D 0.073 -> 0.044 (floor 0.035)."""
-    delta, trans = 0.005, 40
-    lossy = paper.replace(mass_loss=delta)
-    # the record starts at the scenario's mass after the transient's impacts
-    n = int(np.sum(simulate(lossy, paper.law, (0, trans * paper.period)).event_kind == K.EV_ONSET))
-    true = lossy.replace(m2=paper.m2 / (1 - delta) ** n)
-    rec = R.reference_record((true, paper.law), periods=40, transient=trans, seed=0, check=False)
-    res = explain(paper, rec, "linear", n_boot_intervals=0)
+    _, res = mass_loss_case(paper, paper.law)
     assert _named(res)[0] == "mass_loss", [it.evidence for it in res.iterations]
     it = res.iterations[0]
     assert _shrinks(it, "D")
@@ -131,13 +148,7 @@ def test_two_hidden_effects_are_both_found(paper):
     (loss 0.0063), then the coupling (2e10 -> 1.85e10); measured I2 0.125 -> 0.045 after
     the coupling.  (A stiffening support was then added too: the averaged cycle of a
     drifting record is compared at the scenario's mass, and k3 takes up the difference.)"""
-    law = ForceLaw.parse("2.06e8*z + 0.9e7*zd + 2e10*z*zd")
-    delta, trans = 0.005, 40
-    lossy = paper.replace(mass_loss=delta)
-    n = int(np.sum(simulate(lossy, law, (0, trans * paper.period)).event_kind == K.EV_ONSET))
-    true = lossy.replace(m2=paper.m2 / (1 - delta) ** n)
-    rec = R.reference_record((true, law), periods=40, transient=trans, seed=0, check=False)
-    res = explain(paper, rec, "linear", n_boot_intervals=0)
+    _, res = mass_loss_case(paper, ForceLaw.parse(COUPLED))
     named = _named(res)
     assert named[:2] == ["mass_loss", "penetration_velocity_coupling"], [
         it.evidence for it in res.iterations
@@ -149,7 +160,7 @@ def test_two_hidden_effects_are_both_found(paper):
 
 
 def test_explain_cli_reports_the_unloading_branch(paper, tmp_path):
-    law = ForceLaw.parse(BASE + "; set: 0.4")
+    law = ForceLaw.parse(SET)
     rec = R.reference_record((paper.with_law(law), law), periods=15, seed=0, check=False)
     data = tmp_path / "set.csv"
     rec.to_csv(data)
@@ -172,7 +183,7 @@ def test_hidden_hertzian_stiffening_is_named(paper):
     local score), so the refit starts from the certified regression on z, zd, z^1.5 and
     is polished by the simplex.  Measured: named, k = 9.3e9, I2 0.16 -> 0.029 (floor
     0.032), consistent."""
-    _, res = _explain(paper, ForceLaw.parse("1e8*z + 3e6*zd + 1e10*z^1.5"))
+    _, res = _explain(paper, ForceLaw.parse(HERTZ))
     assert _named(res) == ["hertzian_stiffening"], [it.evidence for it in res.iterations]
     assert _shrinks(res.iterations[0])
     assert 7e9 < res.final_model.law.as_dict()["z^1.5"] < 1.3e10
