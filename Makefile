@@ -99,7 +99,8 @@ tables: install
 surveys: install
 	rm -f $(MEASURED)/intervals-*.jsonl $(MEASURED)/advise-*.jsonl $(MEASURED)/realistic-*.jsonl \
 		$(MEASURED)/corpus*.jsonl $(MEASURED)/contact-two-points*.jsonl \
-		$(MEASURED)/explain-random*.jsonl $(MEASURED)/study-paper*.jsonl
+		$(MEASURED)/explain-random*.jsonl $(MEASURED)/study-paper*.jsonl \
+		$(MEASURED)/explain-cases*.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 272 \
 		--workers $(SURVEY_WORKERS) --out $(MEASURED)/intervals-272.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 208 \
@@ -121,6 +122,7 @@ surveys: install
 		--out $(MEASURED)/contact-two-points.jsonl
 	$(BIN)/python -m tests.survey_explain --draws 0 60 --workers $(SURVEY_WORKERS) \
 		--out $(MEASURED)/explain-random.jsonl
+	$(BIN)/python -m tests.survey_explain_cases --out $(MEASURED)/explain-cases.jsonl
 	$(BIN)/python -m tests.survey_study --workers $(SURVEY_WORKERS) \
 		--out $(MEASURED)/study-paper.jsonl
 	$(MAKE) tables

@@ -7,6 +7,12 @@ was made from, with the commit and the date of each, so a table says which code 
 
     python -m tests.tables          # rewrite the tables in docs/ and the README (make tables)
     python -m tests.tables --check  # exit 1, naming them, when a page's table is stale
+    python -m tests.tables --show NAME [--runs FILE ...]  # print one table (from FILEs)
+
+A *draft* table (``draft=True``) is defined before its runs are saved: its page keeps a
+hand-written table, without the markers, until then (``--show NAME --runs FILE`` renders it
+from any run files).  Once its runs are in ``docs/_measured/``, put its markers in the page
+in place of the hand-written table, run ``make tables`` and drop ``draft=True``.
 
 The renderer reads the saved runs only (seconds); ``make surveys`` runs the surveys again
 first (hours).  ``tests/test_tables.py`` holds the pages to what this renders.
@@ -27,6 +33,7 @@ from . import (
     survey_contact_models,
     survey_corpus,
     survey_explain,
+    survey_explain_cases,
     survey_intervals,
     survey_study,
 )
@@ -42,7 +49,8 @@ class Table:
     ``row(rows, label)`` turns into a markdown row (or a list of them).  A table whose
     columns come from its runs has ``header(rows)`` instead of fixed lines (``rows``: every
     row of its run files, as ``read`` gives them), and ``stamp(files, rows)`` its own line
-    under it (naming what the columns are made from)."""
+    under it (naming what the columns are made from).  A ``draft`` table's page may lack
+    its markers (its runs are not saved yet: see the module's docstring)."""
 
     page: str
     header: object
@@ -50,6 +58,7 @@ class Table:
     row: object
     read: object
     stamp: object = None
+    draft: bool = False
 
 
 def _rows(paths):
@@ -231,6 +240,15 @@ TABLES = {
         row=survey_explain.misses_rows,
         read=survey_explain.read_rows,
     ),
+    # draft: docs/validation.md keeps its hand-written table until the runs are saved
+    "explain-cases": Table(
+        page="docs/validation.md",
+        header=survey_explain_cases.HEADER,
+        rows=tuple((name, ("explain-cases*.jsonl",)) for name in survey_explain_cases.CASES),
+        row=survey_explain_cases.markdown_row,
+        read=survey_explain_cases.read_rows,
+        draft=True,
+    ),
     "contact-two-points": Table(
         page="docs/contact-models.md",
         header=(
@@ -290,16 +308,18 @@ def _stamp(files):
     )
 
 
-def render(name):
-    """The lines of table ``name`` between its markers (without indentation)."""
+def render(name, runs=None):
+    """The lines of table ``name`` between its markers (without indentation); ``runs``:
+    run files every row is made from, in place of its saved runs."""
     table = TABLES[name]
-    files = []
-    for _, patterns in table.rows:
-        files += [p for p in run_files(patterns) if p not in files]
+    files = list(runs or ())
+    if runs is None:
+        for _, patterns in table.rows:
+            files += [p for p in run_files(patterns) if p not in files]
     everything = table.read(files) if callable(table.header) or table.stamp else None
     lines = list(table.header(everything) if callable(table.header) else table.header)
     for label, patterns in table.rows:
-        row = table.row(table.read(run_files(patterns)), label)
+        row = table.row(table.read(run_files(patterns) if runs is None else files), label)
         lines += [row] if isinstance(row, str) else list(row)
     stamp = table.stamp(files, everything) if table.stamp else _stamp(files)
     return [*lines, "", stamp]
@@ -320,6 +340,8 @@ def rendered_page(page):
         if table.page != page:
             continue
         found = _block(name).search(text)
+        if found is None and table.draft:
+            continue  # not in its page yet
         if found is None:
             raise SystemExit(f"{page}: no <!-- table:{name} --> ... <!-- /table:{name} -->")
         pad = found.group("indent")
@@ -341,7 +363,14 @@ def pages():
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--check", action="store_true", help="exit 1 when a table is stale")
+    ap.add_argument("--show", metavar="NAME", choices=list(TABLES), help="print one table")
+    ap.add_argument(
+        "--runs", nargs="+", type=Path, help="with --show: the run files to render it from"
+    )
     args = ap.parse_args(argv)
+    if args.show:
+        print("\n".join(render(args.show, args.runs)))
+        return 0
     stale = []
     for page in pages():
         unknown = set(markers(page)) - set(TABLES)
