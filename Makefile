@@ -92,6 +92,9 @@ bench: install
 # `make surveys` runs the surveys again first: hours on two cores (SURVEY_WORKERS processes).
 MEASURED := docs/_measured
 SURVEY_WORKERS ?= 2
+# the named contact models' survey: a run per seed, each 2 records of every model and 2
+# polynomial laws (60 records in all)
+CONTACT_SEEDS := 1 200 400 600 800
 
 tables: install
 	$(BIN)/python -m tests.tables
@@ -100,7 +103,7 @@ surveys: install
 	rm -f $(MEASURED)/intervals-*.jsonl $(MEASURED)/advise-*.jsonl $(MEASURED)/realistic-*.jsonl \
 		$(MEASURED)/corpus*.jsonl $(MEASURED)/contact-two-points*.jsonl \
 		$(MEASURED)/explain-random*.jsonl $(MEASURED)/study-paper*.jsonl \
-		$(MEASURED)/explain-cases*.jsonl
+		$(MEASURED)/contact-models-*.jsonl $(MEASURED)/explain-cases*.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 272 \
 		--workers $(SURVEY_WORKERS) --out $(MEASURED)/intervals-272.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 208 \
@@ -120,6 +123,11 @@ surveys: install
 	$(BIN)/python -m tests.survey_contact_models --models hunt-crossley lankarani-nikravesh \
 		--per-model 10 --seed 1 --max-simulations 60 --second-point advised random --boot 0 \
 		--out $(MEASURED)/contact-two-points.jsonl
+	for seed in $(CONTACT_SEEDS); do \
+		$(BIN)/python -m tests.survey_contact_models --seed $$seed --per-model 2 --poly 2 \
+			--max-simulations 200 --boot 30 --workers $(SURVEY_WORKERS) \
+			--out $(MEASURED)/contact-models-$$seed.jsonl || exit 1; \
+	done
 	$(BIN)/python -m tests.survey_explain --draws 0 60 --workers $(SURVEY_WORKERS) \
 		--out $(MEASURED)/explain-random.jsonl
 	$(BIN)/python -m tests.survey_explain_cases --out $(MEASURED)/explain-cases.jsonl

@@ -31,12 +31,19 @@ candidates``, the default) or every model (``all``).  Each row holds every arm, 
 version (git commit) and every setting.
 
 Run from the repository root (the package of the checkout is imported):
-    PYTHONPATH=. python tests/survey_contact_models.py --per-model 4 --poly 4 \
+    python -m tests.survey_contact_models --per-model 4 --poly 4 \
         --out out/survey_contact_models.jsonl
-    PYTHONPATH=. python tests/survey_contact_models.py --models hunt-crossley \
+    python -m tests.survey_contact_models --models hunt-crossley \
         lankarani-nikravesh --seeds 1 2 3 --second-point advised random --boot 0 \
         --out out/two_points.jsonl
-One JSON line per record (appended as it goes), then a summary table on stdout.
+The output is a run file (:mod:`tests.measured`, appended to when it exists): a header
+naming the command, commit and code version, then one JSON line per record as it is made;
+then a summary table on stdout.  ``--workers N`` makes N records at once, in processes (the
+rows do not depend on it; a record's ``seconds`` do, on a machine with fewer free cores).
+docs/validation.md's table of the named models (:func:`models_row`, ``make tables``)
+combines the rows of several runs (``docs/_measured/contact-models-*.jsonl``), and
+docs/contact-models.md's table of the second operating point (:func:`markdown_row`) those of
+``contact-two-points.jsonl``.
 """
 
 import argparse
@@ -356,6 +363,106 @@ def markdown_row(rows, label):
     )
 
 
+#: docs/validation.md's table of the named models: a row per truth, then ``"all"`` (the
+#: line under it: every parameter of every record together)
+MODELS_LABELS = (*MODELS, "polynomial", "all")
+
+MODELS_HEADER = (
+    "| truth | records | right name selected | right name selected or equivalent | in their "
+    "95 % intervals (Jacobian) | (bootstrap) |",
+    "|---|---|---|---|---|---|",
+)
+
+
+def _coverage(rows, boot=False):
+    """``{parameter: [inside its interval, per record]}`` of the rows' true models (the
+    Jacobian's intervals, or with ``boot`` the bootstrap's, where a row has them)."""
+    covered = [_covered(r, boot) for r in rows if not boot or r.get("boot_intervals")]
+    return {k: [c[k] for c in covered if k in c] for k in PARAMS_CHECKED}
+
+
+def _coverage_cell(cov):
+    return ", ".join(f"{k} {sum(v)}/{len(v)}" for k, v in cov.items() if v) or "-"
+
+
+def _together(rows, boot=False):
+    """``(inside, intervals)``: every checked parameter of every named-model row."""
+    named = [r for r in rows if r["truth"] in MODELS]
+    flat = [x for v in _coverage(named, boot).values() for x in v]
+    return sum(flat), len(flat)
+
+
+def models_row(rows, label):
+    """docs/validation.md's row of a truth (``label``: a model or ``"polynomial"``): its
+    records, the right name selected, selected or equivalent, and how many of each true
+    parameter lie in the true model's 95 % intervals; a polynomial truth: how many records
+    had a named model selected.  ``"all"``: the line under the table (a list of lines),
+    every parameter of every record together."""
+    rows = [r for r in rows if not r.get("skipped")]
+    if label == "all":
+        parts = []
+        for boot, whose in ((False, "the Jacobian's"), (True, "the bootstrap's")):
+            k, n = _together(rows, boot)
+            if n:
+                parts.append(f"{k}/{n} = {100 * k / n:.1f} % inside {whose} intervals")
+        return ["", "All parameters together: " + (", ".join(parts) or "no intervals") + "."]
+    rs = [r for r in rows if r["truth"] == label]
+    n = len(rs)
+    if label == "polynomial":
+        named = sum(r["selected"] is not None for r in rs)
+        none = sum(r["selected"] is None for r in rs)
+        return (
+            f"| polynomial | {n} | a named model selected {named}/{n} (no named model "
+            f"consistent with {none} of the {n}) | | | |"
+        )
+    right = sum(r["selected"] == label for r in rs)
+    either = sum(label in [r["selected"], *r["equivalent"]] for r in rs)
+    cells = [
+        label,
+        n,
+        f"{right}/{n}",
+        f"{either}/{n}",
+        _coverage_cell(_coverage(rs)),
+        _coverage_cell(_coverage(rs, boot=True)),
+    ]
+    return "| " + " | ".join(str(c) for c in cells) + " |"
+
+
+def _setting(rows, key):
+    """The values of a setting over the rows (``"60/200"`` where runs differ)."""
+    seen = []
+    for r in rows:
+        v = (r.get("settings") or {}).get(key)
+        if v is not None and v not in seen:
+            seen.append(v)
+    return "/".join(str(v) for v in seen) or "?"
+
+
+def models_stamp(files, rows):
+    """The line under docs/validation.md's table of the named models: each run file with
+    its commit and date, the records, the fits' budget, the median time of a record's fits
+    and the records the bootstrap was run on."""
+    runs = []
+    for f in files:
+        head, _ = measured.read(f)
+        commit = f"commit {head['commit']}" if head.get("commit") else "commit not recorded"
+        runs.append(f"`{f.name}` ({commit}, {str(head.get('started', '?'))[:10]})")
+    done = [r for r in rows if not r.get("skipped")]
+    seconds = [r["seconds"] for r in done if r.get("seconds") is not None]
+    median = f"{float(np.median(seconds)):.0f} s" if seconds else "?"
+    boot = [r for r in done if r.get("boot_intervals")]
+    skipped = len(rows) - len(done)
+    return (
+        "*Rendered by `make tables` from the survey runs in `docs/_measured/`: "
+        + ", ".join(runs)
+        + f": {len(done)} records"
+        + (f" (and {skipped} seed{'s' * (skipped > 1)} skipped: no usable draw)" if skipped else "")
+        + f", each fitted by every model (up to {_setting(done, 'max_simulations')} "
+        f"simulations a fit; median {median} a record), the bootstrap "
+        f"({_setting(boot, 'boot')} replicates) for the true model's fit on {len(boot)}.*"
+    )
+
+
 def arm_table(rows, arms):
     """Per truth and arm: the right name selected, right or equivalent, settled
     (:func:`settled`), and in how many records a second record was made."""
@@ -383,6 +490,28 @@ def arm_table(rows, arms):
         seeds = sorted(r["seed"] for r in rs)
         lines.append(f"{'':21s} seeds {' '.join(map(str, seeds))}")
     return "\n".join(lines)
+
+
+def _one(context, job):
+    """One record in an executor's worker."""
+    max_sim, boot, second, opts = context
+    return one_record(*job, max_sim, boot, second, opts)
+
+
+def _records(jobs, context, workers):
+    """The rows of ``jobs`` (``(truth, seed)``), as they are made (in ``workers``
+    processes: in the order they finish)."""
+    if workers <= 1:
+        for job in jobs:
+            yield _one(context, job)
+        return
+    from discovery.numerics.executor import make_executor
+    from discovery.warm import warm
+
+    warm()  # numba's cache built here, before the workers load it
+    with make_executor(workers) as ex:
+        for _, row in ex.run(_one, jobs, context):
+            yield row
 
 
 def main(argv=None):
@@ -429,7 +558,15 @@ def main(argv=None):
         default=30,
         help="bootstrap replicates of the true model's intervals (0: none)",
     )
-    ap.add_argument("--out", default="out/survey_contact_models.jsonl", nargs="+")
+    ap.add_argument(
+        "--workers", type=int, default=1, help="records made at once, in processes (default 1)"
+    )
+    ap.add_argument(
+        "--out",
+        default=["out/survey_contact_models.jsonl"],
+        nargs="+",
+        help="the run file the rows are appended to (with --summarize: the files to read)",
+    )
     ap.add_argument(
         "--summarize", action="store_true", help="only print the table of the rows in --out"
     )
@@ -467,13 +604,13 @@ def main(argv=None):
         "versions": provenance()["versions"],
         "settings": {k: (list(v) if isinstance(v, tuple) else v) for k, v in vars(a).items()},
     }
-    for name, seed in jobs:
-        row = one_record(name, seed, a.max_simulations, a.boot, tuple(a.second_point), opts)
+    context = (a.max_simulations, a.boot, tuple(a.second_point), opts)
+    for row in _records(jobs, context, a.workers):
         row.update(stamp)
         rows.append(row)
         out.write(row)
         print(
-            f"{name:<20s} seed {seed}: selected {row.get('selected')} "
+            f"{row['truth']:<20s} seed {row['seed']}: selected {row.get('selected')} "
             f"equivalent {row.get('equivalent')} covered {row.get('covered')} "
             f"{row.get('seconds', 0):.0f} s",
             flush=True,

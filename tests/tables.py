@@ -249,6 +249,18 @@ TABLES = {
         read=survey_explain_cases.read_rows,
         draft=True,
     ),
+    # draft: several seeds' runs combined (make surveys)
+    "contact-models": Table(
+        page="docs/validation.md",
+        header=survey_contact_models.MODELS_HEADER,
+        rows=tuple(
+            (label, ("contact-models-*.jsonl",)) for label in survey_contact_models.MODELS_LABELS
+        ),
+        row=survey_contact_models.models_row,
+        read=survey_contact_models.read_rows,
+        stamp=survey_contact_models.models_stamp,
+        draft=True,
+    ),
     "contact-two-points": Table(
         page="docs/contact-models.md",
         header=(

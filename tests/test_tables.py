@@ -178,6 +178,88 @@ def test_a_draft_table_renders_from_the_run_files_given(tmp_path, capsys):
             assert f"table:{name}" not in tables.rendered_page(table.page)
 
 
+def _contact_row(truth, seed, selected, equivalent=(), covered=None, boot=None, **kw):
+    """A row of tests.survey_contact_models: the true model's fit with an interval per
+    parameter (``covered``: which hold the true value), and the bootstrap's (``boot``)."""
+    from discovery.vibroimpact.model.contact_models import MODELS
+
+    keys = MODELS.get(truth, ())
+    true = {k: 1.0 for k in keys}
+    inside = {k: [0.5, 1.5] if (covered or {}).get(k, True) else [2.0, 3.0] for k in keys}
+    row = {
+        "truth": truth,
+        "seed": seed,
+        "true_params": true if keys else None,
+        "selected": selected,
+        "equivalent": list(equivalent),
+        "seconds": 20.0,
+        "fits": [{"model": truth, "intervals": inside}] if keys else [],
+        "settings": {"max_simulations": 200, "boot": 30},
+        **kw,
+    }
+    if boot is not None:
+        row["boot_intervals"] = {k: [0.5, 1.5] if boot.get(k, True) else [2.0, 3.0] for k in keys}
+    return row
+
+
+def test_the_contact_models_table_combines_several_runs(tmp_path):
+    """tests.survey_contact_models's rows of several runs (seeds) make one table: per
+    truth, the right name, right or equivalent, and each parameter inside the true model's
+    Jacobian and bootstrap intervals; a polynomial truth counts named models selected; a
+    record made twice counts once (its last row); a skipped seed is no record; the line
+    under it pools every parameter."""
+    from tests import survey_contact_models as s
+
+    first = [
+        _contact_row("kelvin-voigt", 1, "kelvin-voigt", covered={"c": False}),
+        _contact_row("hunt-crossley", 1001, "flores", ["hunt-crossley"], boot={"n": False}),
+        _contact_row("polynomial", 9001, None),
+        {"truth": "flores", "seed": 4001, "skipped": True},
+    ]
+    second = [
+        _contact_row("kelvin-voigt", 2, "hertz-damper", boot={}),
+        _contact_row("kelvin-voigt", 1, "kelvin-voigt"),  # seed 1 again: replaces it
+        _contact_row("polynomial", 9002, "flores"),
+    ]
+    files = []
+    for k, rows in enumerate((first, second)):
+        path = tmp_path / f"contact-models-{k}.jsonl"
+        run = measured.RunFile(path, "survey_contact_models", ["--seed", str(k)])
+        for r in rows:
+            run.write(r)
+        files.append(path)
+    rows = s.read_rows(files)
+    assert len(rows) == 6
+    row = s.models_row
+    assert (
+        row(rows, "kelvin-voigt")
+        == "| kelvin-voigt | 2 | 1/2 | 1/2 | k 2/2, c 2/2 | k 1/1, c 1/1 |"
+    )
+    assert row(rows, "hunt-crossley") == (
+        "| hunt-crossley | 1 | 0/1 | 1/1 | k 1/1, n 1/1, lambda 1/1 | k 1/1, n 0/1, lambda 1/1 |"
+    )
+    assert row(rows, "flores") == "| flores | 0 | 0/0 | 0/0 | - | - |"
+    assert row(rows, "polynomial") == (
+        "| polynomial | 2 | a named model selected 1/2 (no named model consistent with 1 of "
+        "the 2) | | | |"
+    )
+    assert row(rows, "all") == [
+        "",
+        "All parameters together: 7/7 = 100.0 % inside the Jacobian's intervals, "
+        "4/5 = 80.0 % inside the bootstrap's intervals.",
+    ]
+    stamp = s.models_stamp(files, rows)
+    for path in files:
+        header, _ = measured.read(path)
+        assert f"`{path.name}` (commit {header['commit']}, {header['started'][:10]})" in stamp
+    assert ": 5 records (and 1 seed skipped: no usable draw), each fitted by every model" in stamp
+    assert "(up to 200 simulations a fit; median 20 s a record)" in stamp
+    assert "the bootstrap (30 replicates) for the true model's fit on 2.*" in stamp
+    lines = tables.render("contact-models", files)
+    assert lines[:2] == list(s.MODELS_HEADER) and lines[-1] == stamp
+    assert len(lines) == 2 + 6 + 2 + 2  # header, truths, the pooled line, the stamp
+
+
 def test_the_explain_cases_table_reads_each_cases_steps(tmp_path):
     """tests.survey_explain_cases's rows: the regime read from the record (bold beyond
     P1), the effects named (one taken out, a wrong one first), the values kept with their
