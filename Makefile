@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed
 TEX_PACKAGES := latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended \
 	lmodern poppler-utils
 
-.PHONY: install demo study test test-slow test-all bench lint clean tex docs tables surveys
+.PHONY: install demo study test test-slow test-all bench lint clean tex docs tables surveys gallery
 
 install: $(STAMP)
 
@@ -134,6 +134,11 @@ surveys: install
 	$(BIN)/python -m tests.survey_study --workers $(SURVEY_WORKERS) \
 		--out $(MEASURED)/study-paper.jsonl
 	$(MAKE) tables
+
+# The demo's explain figure shown in the README and the gallery (reports/assets), made by
+# running the demo and its reports
+gallery: demo
+	cp $(DEMO)/explain/explain_1.png reports/assets/demo_explain.png
 
 # The documentation site (docs/*.md, API reference from the docstrings), warnings as errors
 docs: install

@@ -39,7 +39,7 @@ def _explain_forces(ax, iteration, measured, k):
     i2b = iteration.criteria_before.get("I2", float("nan"))
     i2a = iteration.criteria_after.get("I2", float("nan"))
     ax.set_title(
-        f"iteration {k}: I2 {i2b:.3g} -> {i2a:.3g}\n(noise floor "
+        f"iteration {k}: I2 {i2b:.3g} -> {i2a:.3g}\n(noise floor before "
         f"{iteration.noise_floor.get('I2', float('nan')):.2g})",
     )
     # room above the curves for the legend, which then covers none of them

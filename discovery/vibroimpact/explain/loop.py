@@ -39,6 +39,8 @@ One iteration (:func:`explain`):
 import time
 import warnings
 
+import numpy as np
+
 from ..._progress import reports_progress, tick
 from ..._validate import Choice, Instance, Real, Text, params
 from ...catalogue import select
@@ -162,9 +164,26 @@ def _only_the_law_refit(run, step, best):
     return True
 
 
-def _name_effect(run, step, good, winner):
+def _others(trials, named, key):
+    """The clause naming the other refitted effects by their criterion after the refit (the
+    decision is the refit's, not the score's), best first; empty when there are none."""
+    rest = sorted(
+        (t.score["criteria_after"][key], t.score["effect"])
+        for t in trials
+        if t.key == key
+        and t.score["effect"] != named
+        and np.isfinite(t.score.get("criteria_after", {}).get(key, np.nan))
+    )
+    if not rest:
+        return ""
+    shown = ", ".join(f"{e} {v:.3g}" for v, e in rest[:4])
+    more = f" and {len(rest) - 4} more" if len(rest) > 4 else ""
+    return f"; the other effects refitted reach {key} {shown}{more}"
+
+
+def _name_effect(run, step, good, winner, trials):
     """The winner (``good[0]`` polished: ``winner``) is named: the iteration records its
-    evidence and the effects as good."""
+    evidence (with the other refits' criteria, ``trials``) and the effects as good."""
     s, key = good[0].score, good[0].key
     before, floor, screening = step.before, step.floor, step.screening
     value = s["criteria_after"][key]
@@ -181,7 +200,7 @@ def _name_effect(run, step, good, winner):
     )
     evidence = (
         f"{score}; refitted, "
-        f"{key} {before[key]:.3g} -> {value:.3g} (noise floor "
+        f"{key} {before[key]:.3g} -> {value:.3g} (the noise floor of the model before: "
         f"{floor.get(key, float('nan')):.3g}); signature "
         f"{'agrees' if s['signature_agrees'] else 'does not agree'} with the "
         f"localisation (largest shares: {', '.join(screening.top_phases)})"
@@ -192,6 +211,7 @@ def _name_effect(run, step, good, winner):
             "where the residual is largest are a hint, and an effect that changes the "
             "impact as a whole moves the residual everywhere"
         )
+        + _others(trials, s["effect"], key)
     )
     run.iterations.append(
         step.iteration(
@@ -263,7 +283,7 @@ def _refit_and_name(run, step):
     if winner.result is not None and not _present(eff, winner.model, winner.result, small):
         if _only_the_law_refit(run, step, best):
             return True
-    _name_effect(run, step, good, winner)
+    _name_effect(run, step, good, winner, trials)
     return True
 
 

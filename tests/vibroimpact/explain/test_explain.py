@@ -68,6 +68,13 @@ def test_hidden_coupling_is_named_and_the_gap_shrinks(hidden_coupling):
     refitted = [x for x in it.scores if x.get("criteria_after")]
     best = min(refitted, key=lambda x: x["criteria_after"]["I2"])
     assert best["effect"] == "penetration_velocity_coupling"
+    # the evidence states the decision: the floor is the start's, and the other refits
+    # (which decide over the scores) are named with their criterion
+    assert "the noise floor of the model before" in it.evidence
+    others = [x for x in refitted if x is not s and x["criteria_after"].get("I2") is not None]
+    if others:
+        assert "the other effects refitted reach I2 " in it.evidence
+        assert min(others, key=lambda x: x["criteria_after"]["I2"])["effect"] in it.evidence
     phases = it.localisation["phases"]
     # the contact's phases carry most of it (measured 0.57: onset 0.18, unloading 0.39; the
     # separation 0.40 and unloading 0.39 swap places with that 2e-4 change of the start)
