@@ -260,6 +260,21 @@ def align(measured, exact):
     return best
 
 
+def _failed(reg, imp, exc):
+    """The evaluation of a law whose simulation failed: inconsistent (the law cannot
+    reproduce the record), with the failure's message and no criteria."""
+    return Evaluation(
+        "failed",
+        reg,
+        imp,
+        {},
+        {},
+        False,
+        f"inconsistent: the law's simulation failed: {exc}",
+        message=str(exc),
+    )
+
+
 def _only_i4(same, consistent, crit, lim):
     """Inconsistent by the contact support (I4) alone: the regime and contacts agree and
     the force history (I2) is within its limit."""
@@ -436,9 +451,7 @@ def evaluate(
             lambda: impulse_from_steady_state(scenario, law, ss, tolerances=tolerances),
         )
     except IntegrationError as exc:
-        return Evaluation(
-            "failed", reg, imp, {}, {}, False, f"the simulation failed: {exc}", message=str(exc)
-        )
+        return _failed(reg, imp, exc)
     if exact is not None and observe is not None:
         exact = observe(exact)
     if exact is None:
@@ -511,55 +524,108 @@ def _orbit_history(scenario, law, ss, block, tolerances):
     return np.asarray(tr.force, dtype=float)
 
 
+def _orbit_gap(orbit, sim):
+    """I2 between the law's trajectory over the last block (``sim``) and its steady orbit
+    there (``orbit``); when the orbit has no contact force there (I2 is undefined), 0 if the
+    trajectory has none either, else ``inf``."""
+    c = compare(orbit, sim)
+    if not np.any(c.fe > 0):
+        return 0.0 if not np.any(c.fn > 0) else float("inf")
+    return evaluate_criteria(orbit, sim, ["I2"])["I2"]
+
+
 def _span_steady_state(scenario, law, reference, sim, reg, *, tolerances, steady_kwargs):
     """The law's steady state from the record's state (only to report its regime, set in
     ``reg``) and ``transient``: I2 between the law's trajectory over the last block of
     ``reference.span`` (``sim``, its folded cycle) and its steady orbit (``None`` without a
-    periodic orbit).  Returns ``(steady state or None, transient)``."""
+    periodic orbit).  Returns ``(steady state or None, transient, why)``, ``why`` saying
+    why the law's steady orbit is unknown (empty when it is known); the regime is then
+    ``"unknown"``: the span was compared, only the orbit that reports the regime is
+    missing."""
     span = reference.span
     last = span.blocks[-1]
     steady_kwargs = _from_start(scenario, reference, steady_kwargs)
-    ss, transient = None, None
     try:
         ss = _steady(scenario, law, tolerances, steady_kwargs)
-        if ss.periodic:
-            reg["simulated"] = ss.regime
-            orbit = last.fold.impulse(
-                _orbit_history(scenario, law, ss, last, tolerances),
-                threshold=last.threshold,
-                noise=span.sigma_f,
-            )
-            transient = evaluate_criteria(orbit, sim, ["I2"])["I2"]
-        else:
-            reg["simulated"] = "nonperiodic"
     except (IntegrationError, InputError) as exc:
-        reg["simulated"] = f"failed ({exc})"
-    return ss, transient
-
-
-def _transient_notes(transient_mismatch, settled, transient, reg, ss):
-    """What the verdict says when the law's trajectory from the measured state is still in a
-    transient over the record's span (the law's, not the record's)."""
-    notes = []
-    if transient_mismatch:
-        what = (
-            f"settles to {reg['simulated']}"
-            if ss is not None and ss.periodic
-            else f"reaches no stable periodic orbit ({reg['simulated']})"
+        reg["simulated"] = "unknown"
+        return None, None, f"the search for its steady orbit failed ({exc})"
+    if not ss.periodic:
+        reg["simulated"] = "nonperiodic"
+        return ss, None, ""
+    reg["simulated"] = ss.regime
+    try:
+        orbit = last.fold.impulse(
+            _orbit_history(scenario, law, ss, last, tolerances),
+            threshold=last.threshold,
+            noise=span.sigma_f,
         )
-        gap = "" if transient is None else f" (I2 {transient:.3g} from its steady orbit)"
+    except (IntegrationError, InputError) as exc:
+        return ss, None, f"its steady orbit could not be followed over the record's span ({exc})"
+    return ss, _orbit_gap(orbit, sim), ""
+
+
+JUDGED_OVER_SPAN = "the law is judged against the record's own span"
+"""How every note on an unsettled trajectory ends (the reports look for it)."""
+
+
+def _gap_text(transient, orbit):
+    """Where the law's trajectory is, over the record's last cycles, from ``orbit``."""
+    if np.isinf(transient):
+        return f"over its last cycles it has contact force where {orbit} has none"
+    return f"over its last cycles it is I2 = {transient:.3g} from {orbit}"
+
+
+def _transient_notes(transient_mismatch, settled, transient, reg, ss, why=""):
+    """What the verdict says when the law's trajectory from the measured state has not
+    settled over the record's span (the law's trajectory, not the record), or when the law's
+    steady orbit is unknown (``why``)."""
+    notes = []
+    if why:
+        notes.append(
+            f"the law's regime is unknown: {why}; {JUDGED_OVER_SPAN}"
+            if transient_mismatch
+            else f"the law's steady orbit is unknown: {why}"
+        )
+    elif transient_mismatch:
+        if ss is not None and ss.periodic:
+            what = f"has not settled by the record's end: it tends to {reg['simulated']}" + (
+                "" if transient is None else f" ({_gap_text(transient, 'that orbit')})"
+            )
+        else:
+            what = f"reaches no stable periodic orbit ({reg['simulated']})"
         notes.append(
             f"the record reads {reg['measured']}, but this law's trajectory from the "
-            f"measured state is still in a transient: it{gap} {what}; the law "
-            "is judged against the record's own span"
+            f"measured state {what}; {JUDGED_OVER_SPAN}"
         )
     elif not settled and transient is not None:
+        gap = _gap_text(transient, "the law's steady orbit")
         notes.append(
-            "this law's trajectory from the measured state is still in a transient "
-            f"(I2 {transient:.3g} between it over the last cycles and the law's steady "
-            "orbit); the law is judged against the record's own span"
+            "the law's trajectory from the measured state has not settled by the record's "
+            f"end: {gap}; {JUDGED_OVER_SPAN}"
         )
     return notes
+
+
+def _contacts(n):
+    return f"{n} contact" if n == 1 else f"{n} contacts"
+
+
+def _contacts_note(simulated, measured, folded):
+    """Why the contacts per cycle are taken to agree though the law's folded cycle shows
+    ``simulated`` and the record ``measured`` (its folded cycle ``folded``)."""
+    if simulated == folded:
+        why = (
+            f"the record's folded cycle shows {_contacts(folded)} too (its cycles taken one "
+            f"by one show {measured})"
+        )
+    else:
+        why = f"the law's own records with the record's noise show the record's {_contacts(folded)}"
+    return (
+        f"the law's folded cycle shows {_contacts(simulated)} and the record "
+        f"{_contacts(measured)}; {why}, so within the record's noise and sampling the "
+        "contact counts agree (a contact split or hidden near the threshold)"
+    )
 
 
 def _evaluate_span(
@@ -579,9 +645,7 @@ def _evaluate_span(
             scenario, law, span, tolerances=tolerances, observe=observe, window=smooth_onset
         )
     except IntegrationError as exc:
-        return Evaluation(
-            "failed", reg, imp, {}, {}, False, f"the simulation failed: {exc}", message=str(exc)
-        )
+        return _failed(reg, imp, exc)
     if not any(np.any(h > 0) for h in hist):
         imp["simulated"] = 0
         return Evaluation(
@@ -617,7 +681,7 @@ def _evaluate_span(
     }
     if not floor:
         return Evaluation("ok", reg, imp, crit, {}, False, "", simulated=sim, **found)
-    ss, transient = _span_steady_state(
+    ss, transient, why = _span_steady_state(
         scenario, law, reference, sim, reg, tolerances=tolerances, steady_kwargs=steady_kwargs
     )
     found["transient_i2"] = transient
@@ -641,16 +705,12 @@ def _evaluate_span(
     found["impacts_folded"] = {"measured": folded, "simulated": imp["simulated"]}
     notes = []
     if same_impacts and imp["simulated"] != imp["measured"]:
-        notes.append(
-            f"the law's folded cycle shows {imp['simulated']} contact(s) where the "
-            f"record has {imp['measured']}; with the record's noise and sampling "
-            "they agree (a contact split or hidden near the threshold)"
-        )
+        notes.append(_contacts_note(imp["simulated"], imp["measured"], folded))
         imp = {**imp, "simulated": imp["measured"]}
     verdict = _verdict(
         consistent, reg, imp, crit, fl["mean"], lim=lim, transient=transient_mismatch
     )
-    notes += _transient_notes(transient_mismatch, settled, transient, reg, ss)
+    notes += _transient_notes(transient_mismatch, settled, transient, reg, ss, why)
     if notes and verdict is not None:
         verdict = f"{verdict}; " + "; ".join(notes)
     found.update(

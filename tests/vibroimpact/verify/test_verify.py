@@ -214,7 +214,7 @@ def test_a_transient_verdict_names_the_law_s_trajectory_not_the_record():
     from discovery.vibroimpact.verify.evaluation import _transient_notes
 
     (note,) = _transient_notes(False, False, 0.611, {"measured": "P1", "simulated": "P1"}, None)
-    assert note.startswith("this law's trajectory from the measured state is still in a")
+    assert note.startswith("the law's trajectory from the measured state has not settled")
     assert "record is still in a transient" not in note and "0.611" in note
     (note,) = _transient_notes(True, False, 0.3, {"measured": "P1", "simulated": "P2"}, None)
     assert "record reads P1, but this law's trajectory" in note
