@@ -3,6 +3,8 @@
 import time
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ..._printing import readable
 from ..._result import Result, part
 from ..._validate import Real, params
@@ -15,6 +17,10 @@ from .evaluation import Evaluation, evaluate
 from .reference import Reference
 
 __all__ = ["VerifyResult", "verify"]
+
+
+def _contacts(n):
+    return f"{n} contact(s)"
 
 
 def _law(d):
@@ -96,15 +102,96 @@ class VerifyResult(Result):
             "verify_settings": self.settings,
         }
 
+    def regime_line(self):
+        """The measured and simulated regimes with their contacts per cycle, as one line
+        (a failed simulation has neither)."""
+        ev = self.evaluation
+        out = (
+            f"regime measured {ev.regime.get('measured')} "
+            f"({_contacts(ev.impacts.get('measured'))}), simulated "
+        )
+        if ev.status == "failed":
+            return out + "none (the simulation failed)"
+        sim = ev.regime.get("simulated") or ev.status
+        n = ev.impacts.get("simulated")
+        return out + (sim if n is None else f"{sim} ({_contacts(n)})")
+
     def _lines(self):
         ev = self.evaluation
         out = [f"{self.law}: {ev.verdict or ev.message}"]
         out += criteria_lines(ev.criteria, ev.noise_floor, ev.limits)
-        out.append(
-            f"  regime measured {ev.regime.get('measured')}, simulated {ev.regime.get('simulated')}"
-        )
+        out.append(f"  {self.regime_line()}")
         out += [f"  note: {n}" for n in self.notes]
         return out
+
+
+def _attractor(ev):
+    """What an evaluation's simulation reached: its periodic regime (``"P1"``...),
+    ``"nonperiodic"``, or ``None`` when that is not known (the simulation failed, or the
+    steady orbit of a record-span comparison could not be found)."""
+    if ev.status == "failed":
+        return None
+    reg = ev.regime.get("simulated")
+    if ev.status == "nonperiodic" or reg == "nonperiodic":
+        return "nonperiodic"
+    if reg in (None, "unknown") or str(reg).startswith("failed"):
+        return None
+    return reg
+
+
+def _reached(ev, attractor):
+    """The attractor an evaluation reached, for a note (``"P1 without contact"``)."""
+    if attractor is None:
+        return str(ev.status)
+    return f"{attractor} without contact" if ev.status == "no-contact" else attractor
+
+
+def _default_start_note(ev, other):
+    """The note on the law from the scenario's initial state (``other``) against the same
+    law from the measured state (``ev``), or ``""``.
+
+    Coexisting attractors are claimed only when both simulations reached an attractor and
+    the two differ: another periodic regime, a periodic orbit against none, or (both on the
+    same periodic regime, compared with the law's steady orbit) another orbit, by its I2.
+    Two nonperiodic motions cannot be told apart this way, and a failed simulation reached
+    no attractor: then only what is known is said."""
+    a, b = _attractor(other), _attractor(ev)
+    if a is None or b is None:
+        if other.status == "failed" and ev.status == "failed":
+            return ""  # the verdict already says the simulation failed
+        if other.status == "failed":
+            return (
+                f"from the scenario's initial state the law's simulation failed ({other.message})"
+            )
+        if ev.status == "failed":
+            return (
+                "from the scenario's initial state the law's simulation does not fail: it "
+                f"reaches {_reached(other, a)}"
+            )
+        return ""
+    if a == b == "nonperiodic":
+        return ""
+    # (with a record span the two criteria come from different comparisons: only the
+    # regimes are compared)
+    span = ev.comparison == "record span"
+    other_orbit = a == b and (
+        (other.status == "no-contact") != (ev.status == "no-contact")
+        or (
+            not span
+            and other.status == "ok"
+            and ev.status == "ok"
+            and abs(other.criteria["I2"] - ev.criteria["I2"]) > 0.01
+        )
+    )
+    if a == b and not other_orbit:
+        return ""
+    i2 = other.value("I2")
+    return (
+        f"from the scenario's initial state the law reaches another attractor "
+        f"({_reached(other, a)}"
+        + (f", I2 {i2:.3g}" if np.isfinite(i2) else "")
+        + f") than from the measured state ({_reached(ev, b)}): coexisting attractors"
+    )
 
 
 @params(
@@ -164,21 +251,9 @@ def verify(
     other, notes = None, []
     if check_default_start and ref.start is not None:
         other = evaluate(scenario, law, ref, tolerances=tolerances, from_state=False, floor=False)
-        # (with a record span the two criteria come from different comparisons: only the
-        # regimes are compared)
-        span = ev.comparison == "record span"
-        if other.regime["simulated"] != ev.regime["simulated"] or (
-            not span
-            and other.status == "ok"
-            and ev.status == "ok"
-            and abs(other.criteria["I2"] - ev.criteria["I2"]) > 0.01
-        ):
-            notes.append(
-                f"from the scenario's initial state the law reaches another attractor "
-                f"({other.regime['simulated'] or other.status}, I2 "
-                f"{other.value('I2'):.3g}) than from the measured state "
-                f"({ev.regime['simulated'] or ev.status}): coexisting attractors"
-            )
+        note = _default_start_note(ev, other)
+        if note:
+            notes.append(note)
     settings = {
         "time_offset": time_offset,
         "n_boot": n_boot,
