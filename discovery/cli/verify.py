@@ -44,11 +44,7 @@ def run(args):
         verify_figure(res, str(out.path("verify")))
     ev = res.evaluation
     print(f"{law}: {res.verdict}")
-    print(
-        f"  regime measured {ev.regime['measured']} ({ev.impacts['measured']} contact(s)), "
-        f"simulated {ev.regime['simulated'] or ev.status} "
-        f"({ev.impacts['simulated']} contact(s))"
-    )
+    print(f"  {res.regime_line()}")
     if ev.criteria:
         print(criteria_line(ev.criteria, ev.noise_floor))
     for note in res.notes:
