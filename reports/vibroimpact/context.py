@@ -49,7 +49,11 @@ def _verify(doc, run_dir):
     lim = ev.limits or {}
     crit = ev.criteria or {}
     concl = []
-    if c["consistent"]:
+    nothing = _nothing_compared(ev)
+    c["nothing_compared"] = nothing and prose(nothing)
+    if nothing:
+        concl.append(f"The law is inconsistent with the record: {nothing}.")
+    elif c["consistent"]:
         concl.append(
             f"The law is consistent with the record: every judged criterion is within "
             f"its limit (I2 {crit.get('I2', float('nan')):.3g} against "
@@ -76,12 +80,12 @@ def _verify(doc, run_dir):
             + "; `vidi explain` names the effect most likely missing."
         )
     reg = c["regime"]
-    if reg and reg.get("measured") != reg.get("simulated"):
+    if reg.get("simulated") and reg.get("measured") != reg.get("simulated"):
         concl.append(
             f"The measured regime is {reg.get('measured')}, the simulated one "
             f"{reg.get('simulated')}."
         )
-    if _transient(ev.verdict):
+    if not nothing and _transient(ev.verdict):
         concl.append(
             "The law's simulation from the measured state is not yet steady over the "
             "record's span: the record was compared with that trajectory, block by block, "
@@ -89,7 +93,30 @@ def _verify(doc, run_dir):
         )
     c["conclusions"] = [prose(x) for x in concl]
     c["figures"] = _figures(run_dir, ["verify"])
+    if nothing:  # the figure shows the measured force alone
+        for f in c["figures"]:
+            f["caption"] = prose(f"The measured force alone: {nothing}.")
     return c
+
+
+def _nothing_compared(ev):
+    """Why a verification has no criteria (its simulation failed, has no periodic steady
+    state, or never touches), as a clause; ``""`` when it was compared."""
+    if ev.criteria:
+        return ""
+    if ev.status == "failed":
+        return (
+            f"the law's simulation failed ({ev.message or 'no message'}), so there is no simulated "
+            "force to compare with the measured one"
+        )
+    if ev.status == "nonperiodic":
+        return (
+            "the law has no stable periodic steady state, so there is no simulated orbit to "
+            "compare with the measured cycle"
+        )
+    if ev.status == "no-contact":
+        return "the simulated bodies never come into contact, so there is no force to compare"
+    return "no criteria were computed"
 
 
 def _terms_tex(terms):

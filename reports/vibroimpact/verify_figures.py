@@ -38,7 +38,10 @@ def verify_figure(result, stem):
     ev = result.evaluation
     E = result.reference.impulse
     loops = force_penetration_loops(result.reference, ev)
-    if loops is None:
+    if ev.simulated is None:  # nothing simulated to compare: the measured force alone
+        fig, ax = subplots(1, 1, figsize=(PRINT_WIDTH, 3.4))
+        axr = None
+    elif loops is None:
         fig, (ax, axr) = subplots(
             2, 1, figsize=(PRINT_WIDTH, 4.8), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
         )
@@ -74,19 +77,32 @@ def verify_figure(result, stem):
         ax.set_xlim(lo * ms, hi * ms)
     else:
         ax.plot(E.t * ms, E.F * sc, "k-", lw=1.0, label=r"measured $F_E$")
+        ax.set_xlabel("time in the folded cycle [ms]")
     crit = ", ".join(_criterion_text(k, v, ev) for k, v in ev.criteria.items() if k in _JUDGED)
-    verdict = f"{'consistent' if ev.consistent else 'INCONSISTENT'}: {crit or ev.status}"
+    verdict = f"{'consistent' if ev.consistent else 'INCONSISTENT'}: {crit or _why_none(ev)}"
     ax.set_title(
         f"{law_math(result.law)}\n" + textwrap.fill(verdict, 72),
         fontsize=8,
     )
     ax.set_ylabel(f"contact force F [{unit}]")
     ax.legend(fontsize=7, loc="best", framealpha=0.8)
-    axr.set_ylabel(f"$F_N - F_E$ [{unit}]")
-    axr.set_xlabel("time since the contact's start [ms] (folded)")
-    axr.axhline(0.0, color="k", lw=0.5)
+    if axr is not None:
+        axr.set_ylabel(f"$F_N - F_E$ [{unit}]")
+        axr.set_xlabel("time since the contact's start [ms] (folded)")
+        axr.axhline(0.0, color="k", lw=0.5)
     fig.tight_layout()
     return _save(fig, stem)
+
+
+def _why_none(ev):
+    """Why a verification has no simulated force to show."""
+    if ev.status == "failed":
+        return "the law's simulation failed, nothing to compare"
+    if ev.status == "nonperiodic":
+        return "the law has no stable periodic steady state, nothing to compare"
+    if ev.status == "no-contact":
+        return "the simulated bodies never touch, nothing to compare"
+    return str(ev.status)
 
 
 def loops_figure(loops, evaluation, stem, law, what):
