@@ -50,9 +50,9 @@ def _one_line(message, prog, command=None):
     if m:
         opt, value, choices = m.groups()
         choices = choices.replace("'", "")
-        hint = _did_you_mean(value, [c.strip() for c in choices.split(",")])
         if opt in ("COMMAND", "command", "SUBCOMMAND"):
-            return f"unknown command {value!r}{hint}; choose one of {choices} ({see})"
+            return _unknown_command(value, [c.strip() for c in choices.split(",")], see)
+        hint = _did_you_mean(value, [c.strip() for c in choices.split(",")])
         return f"{opt}: invalid choice {value!r}{hint}; choose one of {choices}"
     m = re.match(r"argument (\S+?)(?:/\S+)?: invalid (\w+) value: '(.*)'$", message, re.S)
     if m:
@@ -379,14 +379,25 @@ def _did_you_mean(word, choices):
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
+def _unknown_command(value, choices, see):
+    """The one line for a (sub)command that does not exist, with the closest one."""
+    hint = _did_you_mean(value, choices)
+    return f"unknown command {value!r}{hint}; choose one of {', '.join(choices)} ({see})"
+
+
 def _refuse_unknown(parser, argv):
-    """A long option the (sub)command does not have is named, with the closest one it has
-    (argparse would first complain of a missing required option, or name it without a
-    hint); an unambiguous prefix of an option is accepted, as argparse does."""
+    """A (sub)command that does not exist is named first, whatever options follow it;
+    then a long option the (sub)command does not have is named, with the closest one it
+    has (argparse would first complain of a missing required option, or name it without
+    a hint); an unambiguous prefix of an option is accepted, as argparse does."""
     sp, rest = parser, list(argv)
     while True:
         sub = next((a for a in sp._actions if isinstance(a, argparse._SubParsersAction)), None)
         name = next((t for t in rest if not t.startswith("-")), None)
+        if sub is not None and name is not None and name not in sub.choices:
+            command = sp.prog.removeprefix("vidi").strip()
+            see = f"see vidi {command} --help" if command else "see vidi --help"
+            raise UsageError(_unknown_command(name, list(sub.choices), see))
         if sub is None or name not in sub.choices:
             break
         sp, rest = sub.choices[name], rest[rest.index(name) + 1 :]

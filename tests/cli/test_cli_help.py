@@ -190,3 +190,22 @@ def test_a_mistyped_command_or_option_gets_a_did_you_mean(capsys, tmp_path):
     assert main(["fit", "--dat", str(tmp_path / "none.csv"), "--out", str(tmp_path / "o")]) == 2
     assert "does not exist" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    "line, expected",
+    [
+        (["fitt", "--data", "D.csv", "--out", "x"], "unknown command 'fitt' (did you mean 'fit'?)"),
+        (
+            ["ueda", "atractor", "--out", "x"],
+            "unknown command 'atractor' (did you mean 'attractor'?)",
+        ),
+    ],
+)
+def test_a_mistyped_command_is_named_before_the_options_that_follow_it(capsys, line, expected):
+    """The options after an unknown command are not checked against the parent's."""
+    from discovery.cli import main
+
+    assert main(line) == 2
+    err = capsys.readouterr().err
+    assert expected in err and "unknown option" not in err and err.count("\n") == 1
