@@ -105,3 +105,66 @@ def test_every_public_result_class_prints_readably(module):
         if not inspect.isclass(obj) or issubclass(obj, BaseException) or name in _INPUTS:
             continue
         assert obj.__str__ is not object.__str__, f"print() of a {name} is its repr"
+
+
+# ------------------------------------------------------------------ the fit's printout
+def _ranked(terms, regime, value, consistent=True, intervals=None):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(
+        law=d.ForceLaw.from_dict(dict.fromkeys(terms, 1e8)),
+        regime=regime,
+        criteria={"I2": value},
+        noise_floor={},
+        limits={},
+        consistent=consistent,
+        standard_errors={},
+        intervals=intervals,
+        verdict="consistent",
+    )
+
+
+def _discovery(ranking, equivalent=()):
+    from discovery.vibroimpact.fit.discovery_result import DiscoveryResult
+
+    return DiscoveryResult(
+        selected=ranking[0],
+        ranking=list(ranking),
+        certificate=None,
+        estimator=None,
+        samples=None,
+        measured=None,
+        equivalent=list(equivalent),
+        seconds=6.0,
+    )
+
+
+def test_the_ranking_stays_in_columns_whatever_the_regime_says():
+    """A long regime (nonperiodic, a failure's reason) neither shifts the criterion column
+    nor runs the row on: the reason goes on its own indented line below its row."""
+    reason = "failed (I2 is undefined: the measured impulse is zero)"
+    res = _discovery(
+        [
+            _ranked(["z", "zd"], "P1", 0.0178),
+            _ranked(["z", "z*zd", "zd^2", "z^2"], "P1", 0.0177),
+            _ranked(["z"], "nonperiodic", 0.98, consistent=False),
+            _ranked(["zd"], reason, 0.981, consistent=False),
+        ]
+    )
+    lines = str(res).splitlines()
+    start = next(i for i, ln in enumerate(lines) if ln.startswith("ranking")) + 1
+    rows = [ln for ln in lines[start : start + 5] if ln[4:5] == "."]
+    assert len(rows) == 4, lines
+    assert len({ln.index(" I2 ") for ln in rows}) == 1, rows  # one criterion column
+    assert len({ln.index("1", ln.index(" I2 ") + 4) for ln in rows[:2]}) == 1
+    assert all(len(ln) < 70 for ln in rows), rows
+    below = lines[lines.index(rows[3]) + 1]
+    assert below.startswith("      ") and below.strip() == reason
+
+
+def test_equivalent_models_and_the_time_read_as_text():
+    equivalent = [{"terms": ["z", "z*zd", "zd^2"], "reason": "near-collinear"}]
+    text = str(_discovery([_ranked(["z", "zd"], "P1", 0.0178)], equivalent))
+    assert "equivalent: z + z*zd + zd^2 (near-collinear)" in text, text
+    assert "[" not in text.split("equivalent:")[1].split("\n")[0]
+    assert text.splitlines()[-1] == "fitted in 6.0 s"

@@ -133,6 +133,8 @@ def _write_outputs(args, res, t_start):
 
 def _print_result(args, res, pdf, why):
     """The command's printout: the selected law, its checks, the ranking's notes."""
+    from ..vibroimpact.fit.discovery_result import equivalent_text
+
     sel = res.selected
     print(f"selected {sel.law}   [{sel.regime}]")
     if sel.standard_errors:
@@ -155,7 +157,7 @@ def _print_result(args, res, pdf, why):
             "  stability: " + ", ".join(f"{k} {v:.2f}" for k, v in res.stability.items() if v > 0)
         )
     for e in res.equivalent:
-        print(f"  equivalent: {' + '.join(e['terms'])} ({e['reason']})")
+        print(f"  equivalent: {equivalent_text(e)}")
     for w in res.warnings:
         print(f"  warning: {w}")
     if why:

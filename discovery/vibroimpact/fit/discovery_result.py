@@ -12,6 +12,7 @@ estimator, the samples, the measured cycle and the references.
 
 import dataclasses
 import math
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -267,6 +268,52 @@ class FitRecord:
         return dataclasses.asdict(self)
 
 
+def _regime_head(regime):
+    """``regime`` without its parenthesised reasons (``failed (I2 is undefined: ...)`` ->
+    ``failed``)."""
+    out, depth = [], 0
+    for ch in regime:
+        depth += ch == "("
+        if depth == 0:
+            out.append(ch)
+        depth -= ch == ")" and depth > 0
+    return re.sub(r" +", " ", "".join(out)).strip().replace(" ,", ",")
+
+
+def ranking_lines(ranking, criterion, shown=8):
+    """The first ``shown`` ranked models, one row each in aligned columns (terms, regime,
+    criterion, consistency); a regime's reason (a failed simulation's) on its own indented
+    line below the row."""
+    rows = ranking[:shown]
+    names = [" + ".join(m.law.names) for m in rows]
+    regimes = [str(m.regime) for m in rows]
+    heads = [_regime_head(r) for r in regimes]
+    wn = max((len(n) for n in names), default=0)
+    wr = max((len(h) for h in heads), default=0)
+    out = []
+    for i, (m, name, regime, head) in enumerate(zip(rows, names, regimes, heads, strict=True)):
+        value = fmt((m.criteria or {}).get(criterion), 3)
+        row = (
+            f"  {i + 1:>2}. {name:<{wn}}  {head:<{wr}}  {criterion} {value:>8}  "
+            f"{'consistent' if m.consistent else ''}"
+        )
+        out.append(row.rstrip())
+        if head != regime:
+            out.append(f"      {regime}")
+    if len(ranking) > shown:
+        out.append(f"  ... {len(ranking) - shown} more")
+    return out
+
+
+def equivalent_text(e):
+    """An equivalent model (an entry of ``DiscoveryResult.equivalent``) as text: its terms
+    and why the records cannot tell it from the selected one."""
+    terms = e.get("terms") or e.get("law") or ()
+    terms = terms if isinstance(terms, str) else " + ".join(terms)
+    reason = e.get("reason")
+    return f"{terms} ({reason})" if reason else terms
+
+
 def _loaded_certificate(d):
     return Certificate.from_dict(d["certificate"]) if d.get("certificate") else None
 
@@ -421,21 +468,13 @@ class DiscoveryResult(Result):
         out += criteria_lines(sel.criteria, sel.noise_floor, sel.limits)
         out.append(f"  verdict: {sel.verdict}")
         out.append(f"ranking ({len(self.ranking)} candidates, criterion {crit}):")
-        for i, m in enumerate(self.ranking[:8]):
-            out.append(
-                f"  {i + 1:>2}. {' + '.join(m.law.names):<28} {m.regime:<6} "
-                f"{crit} {fmt((m.criteria or {}).get(crit), 3):>8}  "
-                f"{'consistent' if m.consistent else ''}"
-            )
-        if len(self.ranking) > 8:
-            out.append(f"  ... {len(self.ranking) - 8} more")
-        for e in self.equivalent:
-            out.append(f"equivalent: {e.get('law', e.get('terms'))}: {e.get('reason', '')}")
+        out += ranking_lines(self.ranking, crit)
+        out += [f"equivalent: {equivalent_text(e)}" for e in self.equivalent]
         cert = self.certificate
         if cert is not None:
             out.append(
                 f"certificate: conditions {'hold' if cert.holds else 'DO NOT hold'} ({cert.method})"
             )
         out += [f"warning: {w}" for w in self.warnings]
-        out.append(f"{self.seconds:.1f} s")
+        out.append(f"fitted in {self.seconds:.1f} s")
         return out
