@@ -10,8 +10,16 @@ the same text in a notebook. The lines are a pure function of the result.
 from __future__ import annotations
 
 import html
+import math
 
-__all__ = ["readable", "coefficient_lines", "fmt", "generic_lines"]
+__all__ = [
+    "readable",
+    "coefficient_lines",
+    "fmt",
+    "generic_lines",
+    "interval_digits",
+    "interval_text",
+]
 
 
 def fmt(v, digits=4):
@@ -24,6 +32,30 @@ def fmt(v, digits=4):
         return str(v)
 
 
+def interval_digits(lo, hi, least=4, most=8):
+    """Significant digits that print an interval's two bounds apart: ``least``, more while
+    they round alike (a narrow interval around a large value), at most ``most``."""
+    try:
+        lo, hi = float(lo), float(hi)
+    except (TypeError, ValueError):
+        return least
+    if lo == hi or not (math.isfinite(lo) and math.isfinite(hi)):
+        return least
+    for digits in range(least, most):
+        if f"{lo:.{digits - 1}e}" != f"{hi:.{digits - 1}e}":
+            return digits
+    return most
+
+
+def interval_text(lo, hi, least=4):
+    """``[lo, hi]`` with enough significant digits that the bounds differ
+    (:func:`interval_digits`; the extra digits printed on both bounds alike)."""
+    digits = interval_digits(lo, hi, least)
+    if digits == least:
+        return f"[{fmt(lo, digits)}, {fmt(hi, digits)}]"
+    return f"[{float(lo):#.{digits}g}, {float(hi):#.{digits}g}]"
+
+
 def coefficient_lines(coefficients, errors=None, intervals=None, indent="  "):
     """One line per coefficient: value, standard error, 95 % interval."""
     if not coefficients:
@@ -32,7 +64,7 @@ def coefficient_lines(coefficients, errors=None, intervals=None, indent="  "):
     out = [f"{indent}{'term':<12}{'value':>13}{'std error':>12}   95 % interval"]
     for k, v in coefficients.items():
         b = bounds.get(k) if isinstance(bounds, dict) else None
-        iv = f"[{fmt(b[0])}, {fmt(b[1])}]" if b is not None else "--"
+        iv = interval_text(b[0], b[1]) if b is not None else "--"
         out.append(f"{indent}{k:<12}{fmt(v, 6):>13}{fmt((errors or {}).get(k), 2):>12}   {iv}")
     return out
 

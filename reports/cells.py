@@ -17,7 +17,7 @@ from .lawtex import (
     unit_tex,
     value_tex,
 )
-from .texenv import Tex, escape, num
+from .texenv import Tex, escape, interval, num
 
 
 def criterion_names(*mappings):
@@ -244,7 +244,7 @@ def _coef_rows(coefs, errors=None, intervals=None, start=None, term=term_tex):
                 term(k),
                 num(v, 4),
                 num((errors or {}).get(k), 2),
-                Tex(f"[{num(lo_hi[0], 4)}, {num(lo_hi[1], 4)}]") if lo_hi else Tex("--"),
+                interval(*lo_hi) if lo_hi else Tex("--"),
             ]
             + ([num((start or {}).get(k), 3)] if start is not None else [])
         )

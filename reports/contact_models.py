@@ -10,7 +10,7 @@ from discovery.wording import verb
 
 from .cells import _scenarios_table
 from .lawtex import prose
-from .texenv import Tex, escape, num
+from .texenv import Tex, escape, interval, num
 
 __all__ = ["contact_models_context"]
 
@@ -34,7 +34,7 @@ def _rows(fits, selected):
             iv = f.intervals.get(k)
             text = f"${_PARAM_TEX.get(k, escape(k))}$ = {num(v, 4)}"
             if iv:
-                text += f" [{num(iv[0], 4)}, {num(iv[1], 4)}]"
+                text += f" {interval(*iv)}"
             params.append(text)
         rows.append(
             [

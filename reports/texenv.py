@@ -17,7 +17,9 @@ import math
 import re
 from pathlib import Path
 
-__all__ = ["Tex", "escape", "num", "environment"]
+from discovery._printing import interval_digits
+
+__all__ = ["Tex", "escape", "num", "interval", "environment"]
 
 _SPECIAL = {
     "\\": r"\textbackslash{}",
@@ -85,6 +87,13 @@ def num(value, digits=3, unit=None):
                 mant = f"{v / 10**exp:.{digits - 1}f}"
             body = rf"{mant}\cdot 10^{{{exp}}}"
     return Tex(f"${body}$" + (rf"\,\mathrm{{{unit}}}" if unit else ""))
+
+
+def interval(lo, hi, digits=4):
+    """``[lo, hi]`` as LaTeX numbers (:func:`num`), with more than ``digits`` significant
+    digits where the bounds would otherwise print alike."""
+    d = interval_digits(lo, hi, digits)
+    return Tex(f"[{num(lo, d)}, {num(hi, d)}]")
 
 
 def _final(value):

@@ -168,3 +168,28 @@ def test_equivalent_models_and_the_time_read_as_text():
     assert "equivalent: z + z*zd + zd^2 (near-collinear)" in text, text
     assert "[" not in text.split("equivalent:")[1].split("\n")[0]
     assert text.splitlines()[-1] == "fitted in 6.0 s"
+
+
+def test_interval_bounds_print_apart():
+    """A narrow interval around a large value keeps digits until its bounds differ."""
+    from discovery._printing import coefficient_lines, interval_digits, interval_text
+
+    assert interval_text(1.9e8, 2.2e8) == "[1.9e+08, 2.2e+08]"  # wide: 4 digits, as before
+    assert interval_text(2.06e8, 2.06001e8) == "[2.06000e+08, 2.06001e+08]"
+    assert interval_text(1.279999e7, 1.280002e7) == "[1.279999e+07, 1.280002e+07]"
+    assert interval_digits(2.06e8, 2.06e8) == 4 and interval_digits(1.0, 1.0 + 1e-12) == 8
+    assert interval_text(None, 1.0) == "[--, 1]"
+    (line,) = coefficient_lines({"z": 2.06e8}, {}, {"z": (2.0599e8, 2.0601e8)})[1:]
+    assert line.endswith("[2.0599e+08, 2.0601e+08]"), line
+
+
+def test_the_command_s_interval_line_prints_the_bounds_apart():
+    from types import SimpleNamespace
+
+    from discovery.cli._common import coefficients_line
+
+    iv = SimpleNamespace(
+        bounds={"z": (2.06e8, 2.06001e8)}, level=0.95, method="bootstrap", n_boot=6
+    )
+    line = coefficients_line({"z": 2.06e8}, {"z": 7.7e3}, iv)
+    assert "z [2.06000e+08, 2.06001e+08]" in line, line

@@ -23,6 +23,7 @@ import os
 import numpy as np
 
 from .._io import check_output
+from .._printing import interval_text
 from ..errors import InputError
 from ..vibroimpact.model.scenario import builtin_scenarios
 
@@ -322,5 +323,5 @@ def coefficients_line(coefficients, errors, intervals=None):
     return line + (
         f"\n  {intervals.level:.0%} intervals ({intervals.method}, "
         f"{intervals.n_boot} replicates): "
-        + ", ".join(f"{t} [{b[t][0]:.4g}, {b[t][1]:.4g}]" for t in coefficients if t in b)
+        + ", ".join(f"{t} {interval_text(*b[t])}" for t in coefficients if t in b)
     )

@@ -56,6 +56,16 @@ def test_numbers_as_math():
     assert num(float("nan")) == "--" and num(None) == "--" and num(12.5) == "$12.5$"
 
 
+def test_a_narrow_interval_s_bounds_are_typeset_apart():
+    """The coefficient table's interval keeps digits until its bounds differ."""
+    from reports.cells import _coef_rows
+
+    ((_, _, _, iv),) = _coef_rows({"z": 2.06e8}, {"z": 7.7e3}, {"z": (2.06e8, 2.06001e8)})
+    assert iv == r"[$2.06000\cdot 10^{8}$, $2.06001\cdot 10^{8}$]", iv
+    ((_, _, _, iv),) = _coef_rows({"z": 2.06e8}, {}, {"z": (1.9e8, 2.2e8)})
+    assert iv == r"[$1.900\cdot 10^{8}$, $2.200\cdot 10^{8}$]", iv  # wide: 4 digits
+
+
 def test_without_tex_the_source_is_written_and_the_packages_named(tmp_path, monkeypatch):
     import reports.document as doc
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._printing import readable
+from ..._printing import interval_text, readable
 from ..._progress import reports_progress
 from ..._result import SCHEMA_VERSION, Result
 from ..._validate import Real, params
@@ -228,7 +228,7 @@ class ContactModelsResult(Result):
             out.append(f" {mark} {f.model:<20s} I2 {f.value:.4g}  {ok}")
             for k, v in f.parameters.items():
                 lo, hi = f.intervals.get(k, (np.nan, np.nan))
-                out.append(f"      {k:<7s} {v:.5g}  95 % [{lo:.5g}, {hi:.5g}]")
+                out.append(f"      {k:<7s} {v:.5g}  95 % {interval_text(lo, hi, least=5)}")
             if f.model == self.selected and f.conditions:
                 out.append(
                     "      conditions: "
