@@ -148,7 +148,9 @@ def _describe(spec):
 
 
 def _a(name):
-    return f"{'an' if name[0] in 'AEIOUaeiou' else 'a'} {name}"
+    from .wording import a
+
+    return a(name)
 
 
 def check(where, value, spec):

@@ -70,11 +70,18 @@ class Report:
     figures: list = field(default_factory=list)
 
     def __str__(self):
-        article = "an" if self.kind[0] in "aeiou" else "a"
-        lines = [f"report of {article} {self.kind} run", f"  source: {self.tex}"]
+        from discovery.wording import a
+
+        kind = re.sub(r"^ueda\b", "Ueda", self.kind)
+        lines = [f"report of {a(kind)} run", f"  source: {self.tex}"]
         if self.pdf is not None:
             lines.append(f"  PDF: {self.pdf}" + (f" ({self.pages} pages)" if self.pages else ""))
-        lines.append(f"  {self.message}")
+        message = self.message
+        for path in (self.pdf, self.tex):  # a file the lines above name already
+            if path is not None and message.startswith(f"wrote {path}"):
+                message = message[len(f"wrote {path}") :].lstrip("; ")
+        if message:
+            lines.append(f"  {message}")
         return "\n".join(lines)
 
 

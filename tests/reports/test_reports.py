@@ -56,6 +56,23 @@ def test_numbers_as_math():
     assert num(float("nan")) == "--" and num(None) == "--" and num(12.5) == "$12.5$"
 
 
+def test_the_report_s_printout_names_each_file_once_with_the_right_article(tmp_path):
+    from reports.document import Report
+
+    tex, pdf = tmp_path / "report.tex", tmp_path / "report.pdf"
+    text = str(Report(tex, pdf, f"wrote {pdf}", "ueda attractor", 4))
+    assert text.splitlines()[0] == "report of a Ueda attractor run", text
+    assert text.count(str(pdf)) == 1 and f"PDF: {pdf} (4 pages)" in text, text
+    text = str(Report(tex, None, f"wrote {tex}; left out figure(s) x.pdf", "identify"))
+    assert text.splitlines()[0] == "report of an identify run"
+    assert text.count(str(tex)) == 1 and "left out figure(s) x.pdf" in text, text
+    text = str(Report(tex, None, "no PDF: LaTeX failed (x); the log is y", "fit"))
+    assert text.splitlines()[0] == "report of a fit run" and "no PDF: LaTeX failed" in text
+    from discovery._validate import Instance
+
+    assert Instance("discovery.ueda", "UedaSystem").describe() == "a UedaSystem"
+
+
 def test_a_narrow_interval_s_bounds_are_typeset_apart():
     """The coefficient table's interval keeps digits until its bounds differ."""
     from reports.cells import _coef_rows
