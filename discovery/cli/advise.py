@@ -175,12 +175,14 @@ def register(sub):
     )
     s.add_argument("--m2", help="moulding mass bounds LOW:HIGH [kg] (default: the scenario's)")
     s.add_argument(
-        "--max-force", type=number(0, lo_open=True, unit="N"), help="largest safe peak force [N]"
+        "--max-force",
+        type=number(0, lo_open=True, unit="N"),
+        help="largest safe peak force [N] (default: none, no bound)",
     )
     s.add_argument(
         "--max-penetration",
         type=number(0, lo_open=True, unit="m"),
-        help="largest safe penetration w1 - w2 [m]",
+        help="largest safe penetration w1 - w2 [m] (default: none, no bound)",
     )
     s.add_argument(
         "--grid", default="5x5", help="coarse points over amplitude x frequency (default: 5x5)"

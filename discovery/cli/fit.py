@@ -258,7 +258,9 @@ def _add_regression_options(p):
     p.add_argument(
         "--library",
         default="poly:2",
-        help="candidate terms: poly:N, hc, a list 'z,zd,z*zd', or sums; or 'contact-models': "
+        help="candidate terms: poly:N (every z^a zd^b with 1 <= a+b <= N), hc (the "
+        "Hunt-Crossley terms z^1.5 and z^1.5*zd), a list 'z,zd,z*zd', or sums (poly:2+hc); "
+        "or 'contact-models': "
         "the named models (kelvin-voigt, hertz-damper, hunt-crossley, lankarani-nikravesh, "
         "flores) fitted by name (default: %(default)s)",
     )
@@ -351,7 +353,12 @@ def _add_check_options(p):
         action="store_true",
         help="average the steady cycles sample by sample before the regression",
     )
-    _options.add_seed_option(p, "seed of the stability selection")
+    _options.add_seed_option(
+        p,
+        "seed of the resampling: the stability selection's resamples, each record's "
+        "noise-floor bootstrap and the bootstrap coefficient intervals (with --library "
+        "contact-models: the models' intervals)",
+    )
 
 
 def _add_output_options(p):

@@ -209,3 +209,38 @@ def test_a_mistyped_command_is_named_before_the_options_that_follow_it(capsys, l
     assert main(line) == 2
     err = capsys.readouterr().err
     assert expected in err and "unknown option" not in err and err.count("\n") == 1
+
+
+def _help_of(path, option):
+    parser = dict(PARSERS)[tuple(path)]
+    action = parser._option_string_actions[option]
+    return " ".join(_expanded_help(parser, action).split())
+
+
+def test_fit_s_library_and_seed_say_what_they_are():
+    assert "Hunt-Crossley terms z^1.5 and z^1.5*zd" in _help_of(["fit"], "--library")
+    seed = _help_of(["fit"], "--seed")
+    for what in ("stability selection", "noise-floor bootstrap", "coefficient intervals"):
+        assert what in seed, seed
+
+
+@pytest.mark.parametrize(
+    "path", [["ueda", c] for c in ("attractor", "simulate", "chart", "discover", "explain")]
+)
+def test_a_ueda_parameter_shows_each_model_s_default(path):
+    """An option whose default is the model's value names that value for each model."""
+    from discovery.ueda.system import MODELS
+
+    parser = dict(PARSERS)[tuple(path)]
+    for p in ("mu", "gamma", "k", "B", "nu"):
+        action = parser._option_string_actions.get(f"--{p}")
+        if action is None or action.default is not None:  # chart's grids: their own
+            continue
+        text = _help_of(path, f"--{p}")
+        values = ", ".join(f"{m} {v[p]:g}" for m, v in MODELS.items())
+        assert f"(default: the --model's: {values})" in text, (path, p, text)
+
+
+def test_advise_s_safety_limits_say_they_are_unbounded_by_default():
+    for option in ("--max-force", "--max-penetration"):
+        assert "(default: none, no bound)" in _help_of(["advise"], option)

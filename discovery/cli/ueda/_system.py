@@ -21,6 +21,15 @@ def _tolerances(args):
     return Tolerances(rtol=args.rtol)
 
 
+def _models_default(param):
+    """`` (default: the --model's: negres 8, duffing 0)``: a parameter's value in each
+    built-in model, for an option whose default is the model's."""
+    from ...ueda.system import MODELS
+
+    values = ", ".join(f"{m} {v[param]:g}" for m, v in MODELS.items())
+    return f" (default: the --model's: {values})"
+
+
 def _add_system_options(s, chart=False):
     s.add_argument(
         "--model",
@@ -30,11 +39,13 @@ def _add_system_options(s, chart=False):
         "gamma 8, B 0.35, nu 1.02: the broken egg); duffing: x'' + k x' + x^3 = "
         "B cos(nu t) (k 0.05, B 7.5, nu 1) (default: %(default)s)",
     )
-    s.add_argument("--mu", type=number(-10, 10), help="negative resistance (default: the model's)")
+    s.add_argument("--mu", type=number(-10, 10), help="negative resistance" + _models_default("mu"))
     s.add_argument(
-        "--gamma", type=number(0, 1e3), help="amplitude dependence of the resistance, >= 0"
+        "--gamma",
+        type=number(0, 1e3),
+        help="amplitude dependence of the resistance, >= 0" + _models_default("gamma"),
     )
-    s.add_argument("--k", type=number(-10, 10), help="linear damping")
+    s.add_argument("--k", type=number(-10, 10), help="linear damping" + _models_default("k"))
     if not chart:
         _add_forcing_values(s)
     s.add_argument(
@@ -47,8 +58,12 @@ def _add_system_options(s, chart=False):
 
 def _add_forcing_values(s):
     """``--B`` and ``--nu``: the forcing B cos(nu t) (default: the model's)."""
-    s.add_argument("--B", type=number(-1e3, 1e3), help="forcing amplitude")
-    s.add_argument("--nu", type=number(0, 100, lo_open=True), help="forcing angular frequency, > 0")
+    s.add_argument("--B", type=number(-1e3, 1e3), help="forcing amplitude" + _models_default("B"))
+    s.add_argument(
+        "--nu",
+        type=number(0, 100, lo_open=True),
+        help="forcing angular frequency, > 0" + _models_default("nu"),
+    )
 
 
 def _add_forcing_options(s):
