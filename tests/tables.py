@@ -240,16 +240,14 @@ TABLES = {
         row=survey_explain.misses_rows,
         read=survey_explain.read_rows,
     ),
-    # draft: docs/validation.md keeps its hand-written table until the runs are saved
     "explain-cases": Table(
         page="docs/validation.md",
         header=survey_explain_cases.HEADER,
         rows=tuple((name, ("explain-cases*.jsonl",)) for name in survey_explain_cases.CASES),
         row=survey_explain_cases.markdown_row,
         read=survey_explain_cases.read_rows,
-        draft=True,
     ),
-    # draft: several seeds' runs combined (make surveys)
+    # several seeds' runs combined (make surveys)
     "contact-models": Table(
         page="docs/validation.md",
         header=survey_contact_models.MODELS_HEADER,
@@ -259,7 +257,6 @@ TABLES = {
         row=survey_contact_models.models_row,
         read=survey_contact_models.read_rows,
         stamp=survey_contact_models.models_stamp,
-        draft=True,
     ),
     "contact-two-points": Table(
         page="docs/contact-models.md",
