@@ -49,7 +49,9 @@ FIGURE_CAPTIONS = {
     "verify": "Measured force (black) and the law's simulated force (red), folded on the "
     "drive phase over the record's span; with positions, the force-penetration loop and both "
     "penetrations over the contacts (what I5 compares).",
-    "fit_impulse": "Measured impulse and the simulated steady states of the best models.",
+    "fit_impulse": "The measured contact force and the best models' simulated force, folded "
+    "on the drive phase the same way (with positions, each from the machine's measured state "
+    "over the record's last block of cycles, as the verdict compares them).",
     "fit_surface": Tex(
         r"The selected law over the ($\zeta$, $\dot\zeta_+$) plane with the contact samples."
     ),
@@ -194,7 +196,7 @@ def _measured_rows(m, records=None):
     noise_f = noise.get("F") if isinstance(noise, dict) else noise
     rows = [
         ["drive periods per cycle", m.get("n_periods", "--")],
-        ["cycles in the record", m.get("n_cycles", "--")],
+        ["cycles averaged in the folded cycle", m.get("n_cycles", "--")],
         ["contacts per cycle", m.get("impacts", "--")],
         ["force noise (sd)", Tex(num(noise_f) + r"\,N")],
         ["peak force", Tex(num(m.get("peak")) + r"\,N")],

@@ -278,6 +278,17 @@ def prose(text):
     return Tex("".join(out))
 
 
+_RULE = re.compile(r" \(max\(f x noise floor, floor \+ [^)]*\) \+ [^,]*, f = [^)]*\)")
+
+
+def verdict_tex(text):
+    """A verdict as LaTeX (:func:`prose`) without the consistency rule's parenthesis, which
+    the report typesets once beside its criteria table (``limit_rule``)."""
+    if isinstance(text, Tex) or text is None:
+        return prose(text)
+    return prose(_RULE.sub("", str(text)))
+
+
 def _as_law(text):
     """The :class:`ForceLaw` a setting's text writes with its coefficients
     (``2.06e8*z + 4e6*zd``), or None (a term list, a name, a number)."""

@@ -25,6 +25,7 @@ from ..lawtex import (
     law_of,
     prose,
     term_tex,
+    verdict_tex,
 )
 from ..texenv import Tex, escape, num
 
@@ -39,7 +40,7 @@ def _verify(doc, run_dir):
         # the record's measured block and the start are the run's (not kept by a loaded result)
         "measured": _measured_rows(doc.summary.get("measured")),
         "criteria": _criteria_table(ev.criteria, ev.noise_floor, ev.limits),
-        "verdict": prose(ev.verdict or ev.message or "--"),
+        "verdict": verdict_tex(ev.verdict or ev.message or "--"),
         "consistent": bool(ev.consistent),
         "regime": ev.regime or {},
         "impacts": ev.impacts or {},
@@ -182,7 +183,7 @@ def _record_checks(sel, records):
                 "name": f"Record {i + 1}: {rec.data if rec else '--'} (scenario "
                 f"{rec.scenario if rec else '--'})",
                 "criteria": _criteria_table(ev.criteria, ev.noise_floor, ev.limits),
-                "verdict": prose(ev.verdict or ev.message or "--"),
+                "verdict": verdict_tex(ev.verdict or ev.message or "--"),
             }
         )
     return out
@@ -228,7 +229,7 @@ def _fit(doc, run_dir):
         "interval_method": (iv.method if iv is not None else None) or "no bootstrap intervals",
         "criteria": _criteria_table(sel.criteria, sel.noise_floor, sel.limits),
         "record_checks": _record_checks(sel, records),
-        "verdict": prose(sel.verdict or "--"),
+        "verdict": verdict_tex(sel.verdict or "--"),
         "regime": sel.regime,
         "refinement": sel.note,
         "library": r.settings.get("library", "--"),
@@ -292,7 +293,7 @@ def _identify(doc, run_dir):
             one and one.noise_floor,
             one.limits if len(r.checks) == 1 else {},
         ),
-        "verdict": prose((one and one.verdict) or "--"),
+        "verdict": verdict_tex((one and one.verdict) or "--"),
         "method": r.method or "--",
         "criterion": criterion_tex(r.criterion or "I2"),
         "n_simulations": r.n_simulations if r.n_simulations is not None else "--",

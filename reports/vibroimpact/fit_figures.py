@@ -70,7 +70,7 @@ def fit_impulse_figure(result, impulses, stem, n_models=3):
         ax.set_title(
             f"record {r + 1}: {plain(name)}"
             if len(measured) > 1
-            else "Measured impulse and the simulated steady states of the best models",
+            else "Measured and simulated contact force of the best models",
             fontsize=8,
         )
         ax.legend(fontsize=7, loc="best", framealpha=0.8)

@@ -604,6 +604,8 @@ def test_reports_are_typeset_as_a_person_would(runs, kind):
     summary = json.loads((runs / kind / "summary.json").read_text())
     assert "Eq(" not in str(summary.get("equation", ""))
     assert "``" not in tex and "\\textasciigrave" not in tex.split("section{Provenance}")[0]
+    # the consistency rule is typeset once (beside the criteria), not pasted into verdicts
+    assert "noise floor, floor +" not in body, kind
 
 
 def test_a_two_scenario_fit_lists_every_scenario_and_record(runs):
@@ -1001,3 +1003,16 @@ def test_the_data_table_states_the_contacts_per_cycle(runs, kind):
     assert m["impacts"] >= 1 and m["n_cycles"] >= 1 and "F" in m["noise"]
     rows = dict((str(k), v) for k, v in _measured_rows(m))
     assert rows["contacts per cycle"] == m["impacts"]
+
+
+def test_a_verdict_is_typeset_without_the_rule_stated_beside_it():
+    from reports.lawtex import verdict_tex
+
+    v = (
+        "inconsistent: I2 = 0.238 exceeds 0.054, I4 = 0.111 exceeds 0.0231 (max(f x noise "
+        "floor, floor + 3 sd) + 0.005, f = 2 for I2, 2 for I4); the law's folded cycle differs"
+    )
+    out = str(verdict_tex(v))
+    assert "noise floor" not in out and "f = 2" not in out
+    assert out.startswith("inconsistent: I2 = 0.238 exceeds 0.054, I4 = 0.111 exceeds 0.0231;")
+    assert out.endswith("the law's folded cycle differs")
