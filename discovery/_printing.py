@@ -10,14 +10,14 @@ the same text in a notebook. The lines are a pure function of the result.
 from __future__ import annotations
 
 import html
-import math
+
+from .wording import interval_digits
 
 __all__ = [
     "readable",
     "coefficient_lines",
     "fmt",
     "generic_lines",
-    "interval_digits",
     "interval_text",
 ]
 
@@ -30,21 +30,6 @@ def fmt(v, digits=4):
         return f"{float(v):.{digits}g}"
     except (TypeError, ValueError):
         return str(v)
-
-
-def interval_digits(lo, hi, least=4, most=8):
-    """Significant digits that print an interval's two bounds apart: ``least``, more while
-    they round alike (a narrow interval around a large value), at most ``most``."""
-    try:
-        lo, hi = float(lo), float(hi)
-    except (TypeError, ValueError):
-        return least
-    if lo == hi or not (math.isfinite(lo) and math.isfinite(hi)):
-        return least
-    for digits in range(least, most):
-        if f"{lo:.{digits - 1}e}" != f"{hi:.{digits - 1}e}":
-            return digits
-    return most
 
 
 def interval_text(lo, hi, least=4):

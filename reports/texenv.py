@@ -17,7 +17,7 @@ import math
 import re
 from pathlib import Path
 
-from discovery._printing import interval_digits
+from discovery.wording import interval_digits
 
 __all__ = ["Tex", "escape", "num", "interval", "environment"]
 

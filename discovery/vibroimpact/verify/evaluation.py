@@ -39,6 +39,7 @@ from ..dynamics.simulation import simulate
 from ..dynamics.steady_states import steady_state
 from .criteria import compare, criteria_lines, evaluate_criteria
 from .motion import MOTION_CRITERION, block_penetration
+from .notes import contacts_note, transient_notes
 from .trajectory import block_criteria, simulated_motion
 
 __all__ = [
@@ -565,69 +566,6 @@ def _span_steady_state(scenario, law, reference, sim, reg, *, tolerances, steady
     return ss, _orbit_gap(orbit, sim), ""
 
 
-JUDGED_OVER_SPAN = "the law is judged against the record's own span"
-"""How every note on an unsettled trajectory ends (the reports look for it)."""
-
-
-def _gap_text(transient, orbit):
-    """Where the law's trajectory is, over the record's last cycles, from ``orbit``."""
-    if np.isinf(transient):
-        return f"over its last cycles it has contact force where {orbit} has none"
-    return f"over its last cycles it is I2 = {transient:.3g} from {orbit}"
-
-
-def _transient_notes(transient_mismatch, settled, transient, reg, ss, why=""):
-    """What the verdict says when the law's trajectory from the measured state has not
-    settled over the record's span (the law's trajectory, not the record), or when the law's
-    steady orbit is unknown (``why``)."""
-    notes = []
-    if why:
-        notes.append(
-            f"the law's regime is unknown: {why}; {JUDGED_OVER_SPAN}"
-            if transient_mismatch
-            else f"the law's steady orbit is unknown: {why}"
-        )
-    elif transient_mismatch:
-        if ss is not None and ss.periodic:
-            what = f"has not settled by the record's end: it tends to {reg['simulated']}" + (
-                "" if transient is None else f" ({_gap_text(transient, 'that orbit')})"
-            )
-        else:
-            what = f"reaches no stable periodic orbit ({reg['simulated']})"
-        notes.append(
-            f"the record reads {reg['measured']}, but this law's trajectory from the "
-            f"measured state {what}; {JUDGED_OVER_SPAN}"
-        )
-    elif not settled and transient is not None:
-        gap = _gap_text(transient, "the law's steady orbit")
-        notes.append(
-            "the law's trajectory from the measured state has not settled by the record's "
-            f"end: {gap}; {JUDGED_OVER_SPAN}"
-        )
-    return notes
-
-
-def _contacts(n):
-    return f"{n} contact" if n == 1 else f"{n} contacts"
-
-
-def _contacts_note(simulated, measured, folded):
-    """Why the contacts per cycle are taken to agree though the law's folded cycle shows
-    ``simulated`` and the record ``measured`` (its folded cycle ``folded``)."""
-    if simulated == folded:
-        why = (
-            f"the record's folded cycle shows {_contacts(folded)} too (its cycles taken one "
-            f"by one show {measured})"
-        )
-    else:
-        why = f"the law's own records with the record's noise show the record's {_contacts(folded)}"
-    return (
-        f"the law's folded cycle shows {_contacts(simulated)} and the record "
-        f"{_contacts(measured)}; {why}, so within the record's noise and sampling the "
-        "contact counts agree (a contact split or hidden near the threshold)"
-    )
-
-
 def _evaluate_span(
     scenario, law, reference, *, tolerances, floor, observe, steady_kwargs, smooth_onset=False
 ):
@@ -705,12 +643,12 @@ def _evaluate_span(
     found["impacts_folded"] = {"measured": folded, "simulated": imp["simulated"]}
     notes = []
     if same_impacts and imp["simulated"] != imp["measured"]:
-        notes.append(_contacts_note(imp["simulated"], imp["measured"], folded))
+        notes.append(contacts_note(imp["simulated"], imp["measured"], folded))
         imp = {**imp, "simulated": imp["measured"]}
     verdict = _verdict(
         consistent, reg, imp, crit, fl["mean"], lim=lim, transient=transient_mismatch
     )
-    notes += _transient_notes(transient_mismatch, settled, transient, reg, ss, why)
+    notes += transient_notes(transient_mismatch, settled, transient, reg, ss, why)
     if notes and verdict is not None:
         verdict = f"{verdict}; " + "; ".join(notes)
     found.update(

@@ -7,7 +7,7 @@ import pytest
 from discovery import ForceLaw, load_scenario
 from discovery.vibroimpact.dynamics.synthetic import synthesize
 from discovery.vibroimpact.verify import Evaluation, Reference, evaluate, verify
-from discovery.vibroimpact.verify.evaluation import _contacts_note, _transient_notes
+from discovery.vibroimpact.verify.notes import contacts_note, transient_notes
 from discovery.vibroimpact.verify.verdict import _default_start_note
 
 
@@ -74,17 +74,17 @@ def test_the_default_start_note_claims_coexisting_attractors_only_when_they_diff
 
 
 def test_a_transient_note_reads_as_a_sentence():
-    (note,) = _transient_notes(False, False, 0.611, {"measured": "P1", "simulated": "P1"}, None)
+    (note,) = transient_notes(False, False, 0.611, {"measured": "P1", "simulated": "P1"}, None)
     assert note == (
         "the law's trajectory from the measured state has not settled by the record's end: "
         "over its last cycles it is I2 = 0.611 from the law's steady orbit; the law is judged "
         "against the record's own span"
     )
-    (note,) = _transient_notes(
+    (note,) = transient_notes(
         False, False, float("inf"), {"measured": "P1", "simulated": "P1"}, None
     )
     assert "inf" not in note and "contact force where the law's steady orbit has none" in note
-    (note,) = _transient_notes(True, False, None, {"measured": "P1", "simulated": "P2"}, None)
+    (note,) = transient_notes(True, False, None, {"measured": "P1", "simulated": "P2"}, None)
     assert note.startswith("the record reads P1, but this law's trajectory from the measured")
     assert "record is still in a transient" not in note
 
@@ -92,11 +92,11 @@ def test_a_transient_note_reads_as_a_sentence():
 def test_the_contacts_note_states_one_thing():
     """The law's folded cycle and the record's counts differ, yet they are taken to agree:
     the note says why, without contradicting itself."""
-    note = _contacts_note(2, 1, 1)
+    note = contacts_note(2, 1, 1)
     assert note.startswith("the law's folded cycle shows 2 contacts and the record 1 contact;")
     assert "the law's own records with the record's noise show the record's 1 contact" in note
     assert "the contact counts agree" in note and "where the record has" not in note
-    note = _contacts_note(2, 1, 2)
+    note = contacts_note(2, 1, 2)
     assert "the record's folded cycle shows 2 contacts too" in note
 
 

@@ -211,12 +211,12 @@ def test_a_record_of_another_drive_frequency_is_refused_up_front(light_record):
 def test_a_transient_verdict_names_the_law_s_trajectory_not_the_record():
     """When the law's trajectory from the measured state has not settled over the span, the
     verdict says so of the law's trajectory (the record is what was measured)."""
-    from discovery.vibroimpact.verify.evaluation import _transient_notes
+    from discovery.vibroimpact.verify.notes import transient_notes
 
-    (note,) = _transient_notes(False, False, 0.611, {"measured": "P1", "simulated": "P1"}, None)
+    (note,) = transient_notes(False, False, 0.611, {"measured": "P1", "simulated": "P1"}, None)
     assert note.startswith("the law's trajectory from the measured state has not settled")
     assert "record is still in a transient" not in note and "0.611" in note
-    (note,) = _transient_notes(True, False, 0.3, {"measured": "P1", "simulated": "P2"}, None)
+    (note,) = transient_notes(True, False, 0.3, {"measured": "P1", "simulated": "P2"}, None)
     assert "record reads P1, but this law's trajectory" in note
     assert "record is still in a transient" not in note
 
