@@ -119,7 +119,10 @@ class ForcedPolynomial:
         rhs = 0
         for (i, j), c in zip(MONOMIALS, self.coefficients, strict=True):
             if c:
-                rhs += sp.Float(float(f"{c:.{digits}g}"), digits) * x**i * v**j
+                val = float(f"{c:.{digits}g}")
+                # a unit coefficient as the integer: "- x^3", not "- 1.0 x^3"
+                k = sp.Integer(int(val)) if abs(val) == 1.0 else sp.Float(val, digits)
+                rhs += k * x**i * v**j
         f = sp.Float(float(f"{self.forcing:.{digits}g}"), digits)
         rhs += (f if self.forcing != 1.0 else 1) * B * sp.cos(nu * t)
         return sp.Eq(x.diff(t, 2), rhs)

@@ -9,6 +9,9 @@ forcing as given, the discovered equation's verification), its summary.
 
 from __future__ import annotations
 
+from discovery.errors import InputError
+from discovery.ueda.effects import effect
+
 from ..cells import (
     _coef_rows,
     _figures,
@@ -112,11 +115,24 @@ def _ueda_explain(doc, run_dir):
         f"{k.replace('_', ' ')} {v['before']:.3g} -> {v['after']:.3g} ({v['ratio']:.0f}x)"
         for k, v in r.gap.items()
     )
-    added = ", ".join(str(e).replace("_", " ") for e in r.effects_added) or "none"
+    added = ", ".join(_effect_title(e) for e in r.effects_added) or "none"
     stopped = "--" if r.stopped_because is None else r.stopped_because
+    verdict = (
+        ""  # the reason it stopped says so
+        if "consistent" in stopped
+        else f" The final model is {'consistent' if r.consistent else 'NOT consistent'} "
+        "with the record."
+    )
     concl = [
-        f"Effects named and added: {added}; the gap: {gaps}. The final model is "
-        f"{'consistent' if r.consistent else 'NOT consistent'} with the "
-        f"record. Stopped because {stopped}."
+        f"Effects named and added: {added}; the gap: {gaps}.{verdict} Stopped because {stopped}."
     ]
     return _page(doc, run_dir, _forcing(doc), concl, r.coefficients, r.standard_errors)
+
+
+def _effect_title(effect_id):
+    """A catalogue effect's title (``Amplitude-dependent (van der Pol) damping``), or its
+    id in words when the catalogue no longer has it (a run saved by another version)."""
+    try:
+        return effect(str(effect_id)).title
+    except InputError:
+        return str(effect_id).replace("_", " ")

@@ -1016,3 +1016,10 @@ def test_a_verdict_is_typeset_without_the_rule_stated_beside_it():
     assert "noise floor" not in out and "f = 2" not in out
     assert out.startswith("inconsistent: I2 = 0.238 exceeds 0.054, I4 = 0.111 exceeds 0.0231;")
     assert out.endswith("the law's folded cycle differs")
+
+
+def test_a_ueda_effect_is_named_by_its_catalogue_title():
+    from reports.ueda.context import _effect_title
+
+    assert _effect_title("van_der_pol_damping") == "Amplitude-dependent (van der Pol) damping"
+    assert _effect_title("gone_effect") == "gone effect"  # a run saved by another version

@@ -78,6 +78,9 @@ def test_equation_as_sympy_and_latex():
     m = ForcedPolynomial.from_system(NEGRES)
     assert m.terms == {"x'": 0.2, "x^3": -1.0, "x^2 x'": pytest.approx(-1.6)}
     assert "Derivative" in str(m.sympy()) and "cos" in m.latex()
+    # a unit coefficient (-1.0000 after rounding) is written as a sign, not "1.0 x^3"
+    fitted = ForcedPolynomial.from_terms({"x'": 0.2003, "x^3": -1.00002}, 0.35, 1.02)
+    assert "- x^{3}" in fitted.latex() and "1.0 x" not in fitted.latex()
     y = np.array([0.3, -0.2])
     assert np.allclose(m.rhs(1.3, y), NEGRES.rhs(1.3, y))
 
