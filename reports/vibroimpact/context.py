@@ -236,6 +236,7 @@ def _fit(doc, run_dir):
         "selection": r.settings.get("selection", "--"),
         "scoring": r.settings.get("scoring", "--"),
         "criterion": criterion_tex(crit),
+        "rank_within": _rank_within(r.settings.get("ranking_rule") or {}),
         "records": [
             [rec.data, rec.scenario, rec.regime, rec.impacts]
             + [num(rec.noise.get("F")), rec.noise.get("n_cycles", "--")]
@@ -249,9 +250,14 @@ def _fit(doc, run_dir):
                 m.regime,
                 num(m.bic, 6),
                 num(m.criteria.get(crit)),
-                "yes" if m.consistent else "no",
+                ("yes" if m.consistent else "no") + ("; no contact law" if m.defects else ""),
             ]
             for i, m in enumerate(r.ranking)
+        ],
+        "demoted": [
+            Tex(f"\\#{i + 1} " + prose("; ".join(m.defects)))
+            for i, m in enumerate(r.ranking)
+            if m.defects
         ],
         "equivalent": [
             {
@@ -451,3 +457,10 @@ def _explain(doc, run_dir):
     c["conclusions"] = [prose(x) for x in concl]
     c["figures"] = _figures(run_dir, ["explain", "localise", "screen", "drift"])
     return c
+
+
+def _rank_within(rule):
+    """How close to the best criterion a model must be to be ranked by BIC (the ranking
+    rule's ``sim_rtol`` and ``sim_atol``), as LaTeX."""
+    rtol, atol = rule.get("sim_rtol", 0.1), rule.get("sim_atol", 0.005)
+    return Tex(f"{num(100 * rtol)}\\,\\% (or {num(atol)})")

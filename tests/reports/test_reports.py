@@ -606,6 +606,8 @@ def test_reports_are_typeset_as_a_person_would(runs, kind):
     assert "``" not in tex and "\\textasciigrave" not in tex.split("section{Provenance}")[0]
     # the consistency rule is typeset once (beside the criteria), not pasted into verdicts
     assert "noise floor, floor +" not in body, kind
+    if kind.startswith("fit"):  # the ranking's order is stated, not left to guess
+        assert "The ranking: the models consistent with the records first" in body
 
 
 def test_a_two_scenario_fit_lists_every_scenario_and_record(runs):
