@@ -10,7 +10,6 @@ forcing as given, the discovered equation's verification), its summary.
 from __future__ import annotations
 
 from discovery.errors import InputError
-from discovery.ueda.effects import effect
 
 from ..cells import (
     _coef_rows,
@@ -132,6 +131,8 @@ def _ueda_explain(doc, run_dir):
 def _effect_title(effect_id):
     """A catalogue effect's title (``Amplitude-dependent (van der Pol) damping``), or its
     id in words when the catalogue no longer has it (a run saved by another version)."""
+    from discovery.ueda.effects import effect  # the catalogue loads the compiled kernel
+
     try:
         return effect(str(effect_id)).title
     except InputError:
