@@ -67,7 +67,15 @@ def _ueda_attractor(doc, run_dir):
         f"Largest Lyapunov exponent {L.value:.4g} per unit time: "
         + ("chaotic." if L.value > 0.01 else "not chaotic.")
     ]
-    return _page(doc, run_dir, [_fact("regime", r.regime.regime)], concl)
+    s, L = r.system, r.lyapunov
+    facts = [
+        _fact("model", s.model),
+        _fact("parameters", {k: f"{getattr(s, k):g}" for k in ("mu", "gamma", "k", "B", "nu")}),
+        _fact("regime", r.regime.regime),
+        _fact("largest Lyapunov exponent", f"{L.value:.4g} (standard error {L.stderr:.2g})"),
+        _fact("second exponent", f"{L.second:.4g}"),
+    ]
+    return _page(doc, run_dir, facts, concl)
 
 
 def _ueda_chart(doc, run_dir):

@@ -70,7 +70,7 @@ def attractor_figure(att, stem):
     L = att.lyapunov
     ax.set_title(
         f"(a) stroboscopic points ({att.n_points}), {att.regime.regime}\n"
-        f"lambda1 = {L.value:.4f} +- {L.stderr:.4f}, lambda2 = {L.second:.4f}",
+        rf"$\lambda_1$ = {L.value:.4f} $\pm$ {L.stderr:.4f}, $\lambda_2$ = {L.second:.4f}",
         fontsize=8,
     )
     ax = axes[1]
@@ -86,9 +86,9 @@ def attractor_figure(att, stem):
         f"(b) trajectory in the (x, x') plane, {att.t[-1] - att.t[0]:.0f} time units", fontsize=9
     )
     pars = (
-        f"mu = {s.mu:g}, gamma = {s.gamma:g}, B = {s.B:g}, nu = {s.nu:g}"
+        rf"$\mu$ = {s.mu:g}, $\gamma$ = {s.gamma:g}, B = {s.B:g}, $\nu$ = {s.nu:g}"
         if s.model == "negres"
-        else f"k = {s.k:g}, B = {s.B:g}, nu = {s.nu:g}"
+        else rf"k = {s.k:g}, B = {s.B:g}, $\nu$ = {s.nu:g}"
     )
     fig.suptitle(f"{s.model}: {_carets(s.equation)};  {pars}", fontsize=8)
     for a in axes:
@@ -260,11 +260,11 @@ def _strobe_panel(ax, ver):
     ax.legend(loc="upper right", fontsize=8)
     L = ver.lyapunov
     lyap = (
-        f"model lambda1 = {L['value']:.4f} +- {L['stderr']:.4f}"
+        rf"model $\lambda_1$ = {L['value']:.4f} $\pm$ {L['stderr']:.4f}"
         if L
         else f"model diverged: {ver.diverged}"
     )
-    ax.set_title(f"(a) stroboscopic points at t = 2 pi k / nu\n{lyap}", fontsize=8)
+    ax.set_title(f"(a) stroboscopic points at $t = 2\\pi k / \\nu$\n{lyap}", fontsize=8)
     ax.grid(alpha=0.3)
 
 
@@ -281,7 +281,7 @@ def _coefficient_panel(ax, disc):
         ax.text(
             0.02 * span if ci < 0 else -0.02 * span,
             yi,
-            f"{ci:.4g} +- {si:.2g}",
+            rf"{ci:.4g} $\pm$ {si:.2g}",
             ha="left" if ci < 0 else "right",
             va="center",
             fontsize=7,

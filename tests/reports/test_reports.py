@@ -1025,3 +1025,20 @@ def test_a_ueda_effect_is_named_by_its_catalogue_title():
 
     assert _effect_title("van_der_pol_damping") == "Amplitude-dependent (van der Pol) damping"
     assert _effect_title("gone_effect") == "gone effect"  # a run saved by another version
+
+
+def test_a_ueda_attractor_report_states_its_oscillator(tmp_path):
+    """The attractor's page names the model, its parameters and both exponents (the
+    figure's title alone held them), with the Greek letters typeset in the figure."""
+    out = tmp_path / "att"
+    assert main(["ueda", "attractor", "--periods", "400", "--batches", "4", "--out", str(out)]) == 0
+    r = report(out, compile=False)
+    tex = r.tex.read_text()
+    for words in (
+        "parameters",
+        "mu=0.2",
+        "nu=1.02",
+        "largest Lyapunov exponent",
+        "second exponent",
+    ):
+        assert words in tex, words
