@@ -1290,14 +1290,12 @@ def _contact_start(t0, y, mi, w, E, qm):
 
 
 @njit(cache=True)
-def _contact_state(s, t0, w, mi, E, qm, out):
-    """The state ``s`` after the phase's start (at ``t0``) into ``out``."""
+def _contact_state(s, t0, w, mi, E, qm, out, ex):
+    """The state ``s`` after the phase's start (at ``t0``) into ``out`` (``ex``: a work
+    array of 4 complex numbers, left holding ``e^(lambda_j s)``)."""
     tt = t0 + s
-    ew = np.cos(w * tt) + 1j * np.sin(w * tt)
-    ex = np.empty(4, dtype=np.complex128)
-    for j in range(4):
-        ex[j] = np.exp(E[mi, j, 8] * s)
-    _contact_state_at(s, ew, ex, mi, E, qm, out)
+    _contact_exps(s, w, mi, E, ex)
+    _contact_state_at(s, np.cos(w * tt) + 1j * np.sin(w * tt), ex, mi, E, qm, out)
 
 
 @njit(cache=True)
@@ -1441,7 +1439,7 @@ def _time_res(t, w):
 
 
 @njit(cache=True)
-def _contact_polish(i, mode, a, b, hb, hdb, t0, p, kc, mi, E, qm, ybuf):
+def _contact_polish(i, mode, a, b, hb, hdb, t0, p, kc, mi, E, qm, ybuf, ex):
     """The first root of switching function ``i`` in ``[a, b]`` (``h(a) >= 0 > h(b) = hb``,
     rate ``hdb``; no root in ``[a, b)`` but the crossing's): safeguarded Newton to the
     time's resolution.  The point returned is the last one on the function's side (``h >=
@@ -1464,7 +1462,7 @@ def _contact_polish(i, mode, a, b, hb, hdb, t0, p, kc, mi, E, qm, ybuf):
             c = s - res if hs < 0.0 else s + res
             if not (lo < c < hi):
                 c = 0.5 * (lo + hi)
-        _contact_state(c, t0, w, mi, E, qm, ybuf)
+        _contact_state(c, t0, w, mi, E, qm, ybuf, ex)
         hc, hdc = _contact_h(i, mode, kc, t0 + c, ybuf, p)
         if hc < 0.0:
             hi = c
@@ -1485,7 +1483,7 @@ def _contact_bound(i, mi, a, hcap, E, R, cb):
 
 
 @njit(cache=True)
-def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf):
+def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf, ex):
     """The first event in ``(0, s_end]`` of the contact phase set up (the switching
     functions' values ``f >= 0`` and rates ``fd`` at its start): ``(s, index)``, ``index`` the
     function that fires at ``s``, -1 for none up to ``s = s_end``, -2 if the safeguard's
@@ -1503,14 +1501,14 @@ def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf):
         if a + H >= s_end:
             return s_end, -1
         b = min(a + max(H, _time_res(t0 + a, w)), s_end)
-        _contact_state(b, t0, w, mi, E, qm, ybuf)
+        _contact_state(b, t0, w, mi, E, qm, ybuf, ex)
         best_s, best_i = np.inf, -1
         for i in range(3):
             hb, hdb = _contact_h(i, mode, kc, t0 + b, ybuf, p)
             f[i], fd[i] = hb, hdb
         for i in range(3):
             if f[i] < 0.0:
-                si = _contact_polish(i, mode, a, b, f[i], fd[i], t0, p, kc, mi, E, qm, ybuf)
+                si = _contact_polish(i, mode, a, b, f[i], fd[i], t0, p, kc, mi, E, qm, ybuf, ex)
                 # near-ties go to the lower index (loss before release at once)
                 if si < best_s - 2.0 * _time_res(t0 + si, w):
                     best_s, best_i = si, i
@@ -1597,7 +1595,7 @@ def _contact(
         for j in range(4):
             G = gz * (E[mi, j, 0] - E[mi, j, 2]) + gv * (E[mi, j, 1] - E[mi, j, 3])
             cb[i, j] = abs(G) * abs(E[mi, j, 8]) * abs(qm[j, 1])
-    s, index = _contact_search(mode, t, t1 - t, p, kc, mi, E, R, qm, cb, f, fd, ybuf)
+    s, index = _contact_search(mode, t, t1 - t, p, kc, mi, E, R, qm, cb, f, fd, ybuf, ex)
     code = 1 if index >= 0 else (0 if index == -1 else 4)
     t_new = t1 if code == 0 else t + s
     k, c = kc[2 * mi], kc[2 * mi + 1]
@@ -1623,11 +1621,10 @@ def _contact(
         out_mode,
         out_dF,
     )
-    _contact_state(s, t, w, mi, E, qm, ybuf)
+    _contact_state(s, t, w, mi, E, qm, ybuf, ex)  # ex: e^(lambda_j s) for the sensitivities
     for j in range(4):
         y[j] = ybuf[j]
     if m:
-        _contact_exps(s, w, mi, E, ex)
         ews = np.cos(w * s) + 1j * np.sin(w * s)
         _contact_sens(s, t, mi, E, qm, p, S, spar, gcol, phi, ex, ews, W, k, c, ybuf, out_dF, -1)
     return code, t_new, k_eval, index
@@ -1670,6 +1667,8 @@ def _contact_samples(
     their semigroup (``e^(lambda (s + h)) = e^(lambda s) e^(lambda h)``, the drive's phase
     rotated by ``w h``) between anchors evaluated directly, as the free flight's samples
     (:func:`_flight_samples`)."""
+    if k_eval >= t_eval.shape[0] or t_eval[k_eval] > t_new:
+        return k_eval  # no sample in the phase
     gcol, phi, W, ex = sw
     eh = np.empty(4, dtype=np.complex128)
     want_df = out_dF.shape[1] > 0
