@@ -144,6 +144,8 @@ class IdentificationResult(Result):
     checks : tuple of Evaluation
         The identified law against every record with its noise floor (``check=True``):
         :attr:`consistent` and :attr:`verdict` come from them.
+    given_up : bool
+        The fit stopped after its cycle-by-cycle first fit (``give_up_above``).
     """
 
     KIND = "identify"
@@ -172,6 +174,7 @@ class IdentificationResult(Result):
     message: str = ""
     intervals: object = None
     checks: tuple = ()
+    given_up: bool = False
 
     @property
     def coefficients(self):
@@ -208,6 +211,7 @@ class IdentificationResult(Result):
             "failures": self.failures,
             "iterations": self.iterations,
             "message": self.message,
+            "given_up": self.given_up,
             "seconds": self.seconds,
             "consistent": self.consistent,
             "verdict": self.verdict,
@@ -252,13 +256,14 @@ class _Fit:
 
 def _short_first(records, start, fit):
     """With record spans compared in blocks, the start fitted cycle by cycle first (up to
-    half the budget; continuation in block length): ``(start, simulations spent)``.  The
-    caller's start is kept when it already matches the blocks better.  This first fit is
+    half the budget; continuation in block length): ``(start, simulations spent, its
+    criterion on the blocks or None)``.  The caller's start is kept when it already matches
+    the blocks better.  This first fit is
     not restarted (:func:`~.optimise._fitted`): it only seeds the fit on the blocks, which
     is."""
     short = [r.shortened() if isinstance(r, Reference) else None for _, r in records]
     if not (all(r is not None for r in short) and fit.max_simulations >= 8 * len(records)):
-        return start, 0
+        return start, 0, None
     progress = (
         None
         if fit.progress is None
@@ -276,16 +281,16 @@ def _short_first(records, start, fit):
     try:
         x, _ = _fitted(first, fit.method, fit.xtol, fit.max_simulations // 2, restarts=False)
     except IntegrationError:
-        return start, first.n
+        return start, first.n, None
     spent, law = first.n, first.law(x)
     if any(c == 0 for c in law.coefficients):
-        return start, spent
+        return start, spent, None
     # keep the caller's start when it already matches the blocks better
     probe = _Objective(records, start, fit.criterion, fit.tolerances, 10**9, observe=fit.observe)
     alt = _Objective(records, law, fit.criterion, fit.tolerances, 10**9, observe=fit.observe)
     x1 = np.ones(len(law.coefficients))
     v0, v1 = probe(x1), alt(x1)
-    return (law if v1 <= v0 else start), spent + probe.n + alt.n
+    return (law if v1 <= v0 else start), spent + probe.n + alt.n, min(v0, v1)
 
 
 def _checks(records, law, observe, tolerances):
@@ -318,6 +323,7 @@ def _mean_criteria(evs):
     workers=(None, Real(1, integer=True)),
     interval_refit=Choice(*INTERVAL_REFITS),
     interval_noise=Choice(*INTERVAL_NOISE),
+    give_up_above=(None, Real(0, open_low=True)),
 )
 @reports_progress
 def identify(
@@ -340,6 +346,7 @@ def identify(
     workers=1,
     interval_refit="two-step",
     interval_noise="cycles",
+    give_up_above=None,
 ):
     """Identify the coefficients of ``start`` from one or several records by simulation.
 
@@ -394,6 +401,13 @@ def identify(
     check : bool
         Verify the identified law against every record with its noise floor (one more
         evaluation per record): the result's :attr:`~IdentificationResult.verdict`.
+    give_up_above : float, optional
+        Stop after the cycle-by-cycle first fit (``short_first``) when the criterion of its
+        law on the blocks is above this value: the law is returned as that fit left it,
+        without the fit on the blocks and without standard errors (the result's
+        :attr:`~IdentificationResult.given_up`).  ``discover`` sets it at ten times the
+        record's consistency limit of the criterion
+        (:data:`~discovery.vibroimpact.fit.shortlist.GIVE_UP_FACTOR`).
 
     Returns
     -------
@@ -410,7 +424,7 @@ def identify(
         scenario, reference, start, method=method, xtol=xtol, max_simulations=max_simulations
     )
     t0 = time.perf_counter()
-    spent = 0
+    spent, short_value = 0, None
     if short_first:
         fit = _Fit(
             criterion=criterion,
@@ -421,7 +435,8 @@ def identify(
             observe=observe,
             progress=progress,
         )
-        start, spent = _short_first(records, start, fit)
+        start, spent, short_value = _short_first(records, start, fit)
+    given_up = None not in (give_up_above, short_value) and short_value > give_up_above
     obj = _Objective(
         records,
         start,
@@ -432,11 +447,20 @@ def identify(
         progress=progress,
     )
     obj.n = 0
-    x_best, message = _fitted(obj, method, xtol, max_simulations)  # before the error probes
+    if given_up:
+        x_best = np.ones(len(start.coefficients))
+        message = (
+            f"given up after the cycle-by-cycle fit: {criterion} {short_value:.3g} on the "
+            f"blocks is above {give_up_above:.3g}"
+        )
+    else:
+        x_best, message = _fitted(obj, method, xtol, max_simulations)  # before the error probes
     law = obj.law(x_best)
     evs = obj.evaluations(x_best)
+    if evs is None:  # a given-up start compared on the blocks before: never, short of a bug
+        raise IntegrationError(f"the law {law} cannot be compared with the record")
     se, corr = {}, None
-    if uncertainty:
+    if uncertainty and not given_up:
         obj.max_sim += len(x_best) * len(records)  # the error estimate has its own budget
         se, corr = _uncertainty(obj, x_best, law.names)
     crit = _mean_criteria(evs)
@@ -474,4 +498,5 @@ def identify(
         failures=obj.failures,
         seconds=time.perf_counter() - t0,
         message=message,
+        given_up=given_up,
     )

@@ -10,6 +10,7 @@ from discovery.errors import InputError
 from discovery.vibroimpact.dynamics.synthetic import synthesize
 from discovery.vibroimpact.fit.discovery import RankedModel, discover, rank
 from discovery.vibroimpact.fit.regression import Candidate
+from discovery.vibroimpact.fit.shortlist import GIVE_UP_FACTOR
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.verify import Evaluation
 
@@ -106,6 +107,19 @@ def test_result_bookkeeping(result):
     for m in result.ranking:
         origin = m.candidate.extra["origin"]
         assert (origin == "regression" and tuple(m.law.names) in terms) or "step" in origin
+
+
+def test_supports_that_cannot_explain_the_record_are_given_up_not_polished(result):
+    """A refinement still beyond ten times the record's consistency limit after its
+    cycle-by-cycle first fit stops there, and its note says so; no model that ends
+    consistent was given up."""
+    limit = max(e.limits["I2"] for e in result.selected.evaluations)
+    given_up = [m for m in result.ranking if m.refinement is not None and m.refinement.given_up]
+    assert given_up
+    for m in given_up:
+        assert "given up after its cycle-by-cycle fit" in m.note
+        assert m.refinement.value > GIVE_UP_FACTOR * limit and not m.consistent
+    assert not any(m.refinement.given_up for m in result.ranking if m.consistent)
 
 
 def test_refinements_on_two_processes_are_the_serial_ones(paper):

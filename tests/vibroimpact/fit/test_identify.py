@@ -332,3 +332,20 @@ def test_standard_errors_beyond_the_budget_are_left_out(paper, reference, monkey
     res = identify(paper, reference, START, method="nelder-mead", max_simulations=30, check=False)
     assert res.standard_errors == {} and res.correlation is None
     assert np.all(np.isfinite(res.law.coefficients))
+
+
+def test_a_hopeless_fit_is_given_up_after_its_cycle_by_cycle_fit(paper, reference, fitted):
+    """``give_up_above``: a law without a stiffness term stays far from the record after
+    the cycle-by-cycle first fit, and stops there (no fit on the blocks, no standard
+    errors); a law that can explain the record is not stopped, and ends as without it."""
+    hopeless = ForceLaw.parse("1.5e7*zd")
+    full = identify(paper, reference, hopeless, max_simulations=120, check=False)
+    quit = identify(paper, reference, hopeless, max_simulations=120, check=False, give_up_above=0.5)
+    assert full.value > 0.5 and not full.given_up
+    assert quit.given_up and "given up after the cycle-by-cycle fit" in quit.message
+    assert quit.n_simulations < full.n_simulations and not quit.standard_errors
+    assert quit.value > 0.5
+    assert type(quit).from_dict(json.loads(json.dumps(quit.to_dict()))).given_up
+    kept = identify(paper, reference, START, method="least-squares", give_up_above=0.5)
+    assert not kept.given_up
+    assert kept.law.coefficients == fitted.law.coefficients
