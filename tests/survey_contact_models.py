@@ -60,7 +60,7 @@ if not __package__:  # run as a script: python tests/survey_contact_models.py
     sys.path[0:1] = [str(Path(__file__).resolve().parents[1])]
 
 from discovery._io import git_state, provenance  # noqa: E402
-from discovery.errors import VidiError  # noqa: E402
+from discovery.errors import InputError, VidiError  # noqa: E402
 from discovery.vibroimpact.advise import Knobs, NoiseModel, SafeRegion, advise  # noqa: E402
 from discovery.vibroimpact.dynamics.steady_states import steady_state  # noqa: E402
 from discovery.vibroimpact.fit.contact_fit import fit_contact_models  # noqa: E402
@@ -204,7 +204,9 @@ def _joint(res, sc0, meas0, law, point, seed, max_sim, opts):
 def second_points(res, sc, law, meas, seed, arms, max_sim, opts):
     """``{arm: outcome}`` of the second record at the advised and at a random point
     (``{"made": False, "why": ...}`` where none was made: the first fit lists no
-    equivalent model, advise finds no usable point, or no record can be made)."""
+    equivalent model, or only models that make the same force at every impact velocity
+    (advise refuses: no point separates them; then neither arm makes a record), advise
+    finds no usable point, or no record can be made)."""
     if res.selected is None or not res.equivalent:
         why = "the first fit lists no equivalent model" if res.selected else "none consistent"
         return {arm: {"made": False, "why": why} for arm in arms}
@@ -214,7 +216,10 @@ def second_points(res, sc, law, meas, seed, arms, max_sim, opts):
         t0 = time.perf_counter()
         noise = NoiseModel.from_measurement(meas, sc, seed=seed)
         safe = SafeRegion(max_force=opts.get("max_force_factor", 3.0) * float(np.max(meas.F)))
-        adv = advise(sc, res, knobs, noise, safe, workers=1)
+        try:
+            adv = advise(sc, res, knobs, noise, safe, workers=1)
+        except InputError as exc:  # only same-force twins left: no point separates them
+            return {arm: {"made": False, "why": str(exc)} for arm in arms}
         b = adv.best
         info = {"advise_seconds": time.perf_counter() - t0, "candidates": list(adv.laws)}
         if b is None:
