@@ -102,6 +102,7 @@ tables: install
 surveys: install
 	rm -f $(MEASURED)/intervals-*.jsonl $(MEASURED)/advise-*.jsonl $(MEASURED)/realistic-*.jsonl \
 		$(MEASURED)/corpus*.jsonl $(MEASURED)/contact-two-points*.jsonl \
+		$(MEASURED)/contact-narrow-points*.jsonl \
 		$(MEASURED)/explain-random*.jsonl $(MEASURED)/study-paper*.jsonl \
 		$(MEASURED)/contact-models-*.jsonl $(MEASURED)/explain-cases*.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 272 \
@@ -123,6 +124,10 @@ surveys: install
 	$(BIN)/python -m tests.survey_contact_models --models hunt-crossley lankarani-nikravesh \
 		--per-model 10 --seed 1 --max-simulations 60 --second-point advised random --boot 0 \
 		--out $(MEASURED)/contact-two-points.jsonl
+	$(BIN)/python -m tests.survey_contact_models --models hunt-crossley lankarani-nikravesh \
+		--per-model 10 --seed 1 --max-simulations 60 --second-point advised random --boot 0 \
+		--amplitude-range 0.9 1.1 --frequency-range 0.95 1.05 \
+		--out $(MEASURED)/contact-narrow-points.jsonl
 	for seed in $(CONTACT_SEEDS); do \
 		$(BIN)/python -m tests.survey_contact_models --seed $$seed --per-model 2 --poly 2 \
 			--max-simulations 200 --boot 30 --workers $(SURVEY_WORKERS) \

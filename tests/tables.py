@@ -81,6 +81,28 @@ _EXPLAIN_RUNS = ("explain-random*.jsonl",)
 #: the scaling bench on each machine (a later run on as many cores replaces its rows)
 _SCALING_RUNS = ("scaling*.jsonl",)
 
+
+def _two_points(pattern):
+    """docs/contact-models.md's table of a second operating point (the run files of
+    ``pattern``): a row per truth and arm (:func:`survey_contact_models.markdown_row`)."""
+    return Table(
+        page="docs/contact-models.md",
+        header=(
+            "| truth | arm | records | right name | right or equivalent | settled | settled "
+            "where the first record left the other family open |",
+            "|---|---|---|---|---|---|---|",
+        ),
+        rows=tuple(
+            (f"{truth}/{arm}", (pattern,))
+            for truth in ("hunt-crossley", "lankarani-nikravesh")
+            for arm in ("none", "advised", "random")
+        ),
+        row=survey_contact_models.markdown_row,
+        read=survey_contact_models.read_rows,
+        stamp=survey_contact_models.stamp,
+    )
+
+
 TABLES = {
     "intervals": Table(
         page="docs/validation.md",
@@ -258,22 +280,9 @@ TABLES = {
         read=survey_contact_models.read_rows,
         stamp=survey_contact_models.models_stamp,
     ),
-    "contact-two-points": Table(
-        page="docs/contact-models.md",
-        header=(
-            "| truth | arm | records | right name | right or equivalent | settled | settled "
-            "where the first record left the other family open |",
-            "|---|---|---|---|---|---|---|",
-        ),
-        rows=tuple(
-            (f"{truth}/{arm}", ("contact-two-points*.jsonl",))
-            for truth in ("hunt-crossley", "lankarani-nikravesh")
-            for arm in ("none", "advised", "random")
-        ),
-        row=survey_contact_models.markdown_row,
-        read=survey_contact_models.read_rows,
-        stamp=survey_contact_models.stamp,
-    ),
+    "contact-two-points": _two_points("contact-two-points*.jsonl"),
+    # the same, with the drive's knobs limited to +-10 % amplitude and +-5 % frequency
+    "contact-narrow-points": _two_points("contact-narrow-points*.jsonl"),
     # make bench's runs as columns, the last few (tests/bench_history.py)
     "bench-history": Table(
         page="docs/validation.md",

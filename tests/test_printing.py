@@ -162,6 +162,19 @@ def test_the_ranking_stays_in_columns_whatever_the_regime_says():
     assert below.startswith("      ") and below.strip() == reason
 
 
+def test_a_law_that_is_no_contact_law_says_why_below_its_row():
+    """A consistent law with a negative damper ranks after an inconsistent contact law; its
+    row says why."""
+    bad = _ranked(["z", "zd"], "P1", 0.016)
+    bad.law = d.ForceLaw.parse("2e8*z - 1e6*zd")
+    res = _discovery([_ranked(["z", "zd"], "P1", 0.0178), _ranked(["z"], "P1", 0.3, False), bad])
+    lines = str(res).splitlines()
+    row = next(i for i, ln in enumerate(lines) if ln.startswith("   3. z + zd"))
+    assert lines[row + 1] == "      no contact law: " + "; ".join(bad.law.contact_defects())
+    assert "negative" in lines[row + 1]
+    assert not any("no contact law" in ln for ln in lines[:row])
+
+
 def test_equivalent_models_and_the_time_read_as_text():
     equivalent = [{"terms": ["z", "z*zd", "zd^2"], "reason": "near-collinear"}]
     text = str(_discovery([_ranked(["z", "zd"], "P1", 0.0178)], equivalent))

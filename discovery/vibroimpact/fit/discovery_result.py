@@ -282,8 +282,9 @@ def _regime_head(regime):
 
 def ranking_lines(ranking, criterion, shown=8):
     """The first ``shown`` ranked models, one row each in aligned columns (terms, regime,
-    criterion, consistency); a regime's reason (a failed simulation's) on its own indented
-    line below the row."""
+    criterion, consistency); a regime's reason (a failed simulation's), and why a law is no
+    contact law (it ranks after every contact law, consistent or not), on their own
+    indented lines below the row."""
     rows = ranking[:shown]
     names = [" + ".join(m.law.names) for m in rows]
     regimes = [str(m.regime) for m in rows]
@@ -300,6 +301,9 @@ def ranking_lines(ranking, criterion, shown=8):
         out.append(row.rstrip())
         if head != regime:
             out.append(f"      {regime}")
+        defects = m.law.contact_defects()
+        if defects:  # ranked after every contact law (the ranking rule's physics)
+            out.append(f"      no contact law: {'; '.join(defects)}")
     if len(ranking) > shown:
         out.append(f"  ... {len(ranking) - shown} more")
     return out
