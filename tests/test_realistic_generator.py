@@ -300,3 +300,18 @@ def test_every_category_has_its_property(category, seed):
     case_ = R.draw_case(category, seed)
     assert case_.category == category and case_.seed == seed
     _check_category(case_)
+
+
+def test_a_machine_that_sheds_mass_keeps_its_mass_across_the_transient_chunks():
+    """The transient is integrated in chunks of ``TRANSIENT_CHUNK`` periods; a moulding that
+    sheds mass at each impact goes on from each chunk with the mass it ended with, so the
+    record is the tail of one run from rest."""
+    from discovery import load_scenario
+    from discovery.vibroimpact.studies.records import TRANSIENT_CHUNK
+
+    sc = load_scenario("paper").replace(mass_loss=0.002)
+    trans = TRANSIENT_CHUNK + 10
+    rec = _clean((sc, sc.law), transient=trans, periods=2)
+    one = reference_simulate(sc, sc.law, (0.0, rec.t[-1]), t_eval=rec.t, rtol=1e-10)
+    assert np.max(np.abs(rec.F - one["force"])) <= 1e-4 * np.max(one["force"])
+    assert one["m2_final"] < sc.m2 * (1 - 0.002) ** trans

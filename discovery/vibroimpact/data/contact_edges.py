@@ -1,7 +1,7 @@
 """Contacts in a sampled force record: the runs above a threshold with their sub-sample
 onsets and losses (:func:`_edges`), as the record's contacts (:func:`_contact_runs`: noise
-runs dropped, onsets refined on the penetration) or as a cycle's support
-(:func:`_sampled_support`)."""
+runs dropped, onsets refined on the penetration; their onsets: :func:`contact_onsets`) or as
+a cycle's support (:func:`_sampled_support`)."""
 
 import numpy as np
 from scipy.ndimage import uniform_filter1d
@@ -176,3 +176,15 @@ def _contact_runs(t, F, thr, sigma, period, *, min_samples, zeta):
             for t_on, t_off, s in runs
         ]
     return runs
+
+
+def contact_onsets(t, F, period, *, zeta=None, min_samples=3):
+    """The onset times [s] of a record's contacts, as
+    :func:`~discovery.vibroimpact.data.impulse.impulse_from_samples` finds them (threshold
+    ``max(5 sigma, 1e-3 max F)``, noise runs dropped; with ``zeta``, contacts not separated
+    by a free flight are one)."""
+    t, F = np.asarray(t, dtype=float), np.asarray(F, dtype=float)
+    sigma = estimate_noise(F)
+    thr = max(5.0 * sigma, 1e-3 * float(np.max(F)))
+    runs = _contact_runs(t, F, thr, sigma, period, min_samples=min_samples, zeta=zeta)
+    return np.array([r[0] for r in runs], dtype=float)

@@ -362,7 +362,8 @@ def reference_simulate(
     -------
     dict
         ``t``, ``y`` (4, n), ``force`` at ``t_eval``; ``events`` list of
-        ``(t, kind, y)``; ``y_final``; ``nfev``.
+        ``(t, kind, y)``; ``y_final``; ``m2_final`` (the moulding's mass at the end: less
+        than the scenario's after impacts with a ``mass_loss``); ``nfev``.
     """
     state = {"m2": scenario.m2, "zmax": 0.0, "law": law}
     if law.impact_scaled:
@@ -435,5 +436,6 @@ def reference_simulate(
         "force": samples.force,
         "events": events,
         "y_final": y,
+        "m2_final": state["m2"],
         "nfev": nfev,
     }

@@ -76,9 +76,12 @@ def auto_transient(scenario, law):
 
 @lru_cache(maxsize=32)
 def clean_record(scenario, law, periods, fs, transient, *, record_transient=False):
-    """Noise-free scipy-path record ``(t, y (4, n), F, events)`` (read-only arrays): from
+    """Noise-free scipy-path record ``(t, y (4, n), F, events, m2)`` (read-only arrays; ``m2``
+    the moulding's mass at the first sample): from
     rest, ``transient`` periods, then ``periods`` periods sampled at ``fs`` (with
-    ``record_transient`` the run-up is recorded too)."""
+    ``record_transient`` the run-up is recorded too).  The transient is integrated in
+    chunks; a machine that sheds mass at each impact goes on from each chunk with the
+    mass it ended with."""
     T = scenario.period
     t_rec = transient * T
     t_end = (transient + periods) * T
@@ -90,9 +93,10 @@ def clean_record(scenario, law, periods, fs, transient, *, record_transient=Fals
     else:
         for k in range(0, transient, TRANSIENT_CHUNK):
             k1 = min(transient, k + TRANSIENT_CHUNK)
-            y0 = reference_simulate(scenario, law, (k * T, k1 * T), y0=y0, rtol=RTOL_TRANSIENT)[
-                "y_final"
-            ]
+            run = reference_simulate(scenario, law, (k * T, k1 * T), y0=y0, rtol=RTOL_TRANSIENT)
+            y0 = run["y_final"]
+            if run["m2_final"] != scenario.m2:
+                scenario = scenario.replace(m2=run["m2_final"])
         n = int(round(periods * T * fs))
         t = t_rec + np.arange(n) / fs
         out = reference_simulate(scenario, law, (t_rec, t_end), y0=y0, t_eval=t, rtol=RTOL_RECORD)
@@ -102,7 +106,7 @@ def clean_record(scenario, law, periods, fs, transient, *, record_transient=Fals
     for a in (t, y, F):
         a.setflags(write=False)
     events = tuple((float(te), kind) for te, kind, _ in out["events"])
-    return t, y, F, events
+    return t, y, F, events, scenario.m2
 
 
 def noisy_measurement(
@@ -175,7 +179,7 @@ def field_record(
     if transient is None:
         transient = auto_transient(scenario, law)
     transient, periods = int(transient), int(periods)
-    t, y, F, _ = clean_record(scenario, law, periods, float(fs), transient)
+    t, y, F, *_ = clean_record(scenario, law, periods, float(fs), transient)
     notes = (
         f"reference_simulate from rest; transient {transient} periods "
         f"(rtol {RTOL_TRANSIENT:g}), recorded at rtol {RTOL_RECORD:g}",

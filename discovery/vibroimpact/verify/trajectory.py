@@ -21,6 +21,7 @@ import numpy as np
 
 from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
+from ..data.contact_edges import contact_onsets
 from ..data.impulse import Impulse
 from ..data.noise import estimate_noise
 from ..dynamics import _kernel as _K
@@ -76,6 +77,9 @@ class Block:
         Contact threshold of the folded cycle [N].
     Z : ndarray of shape (m,)
         The recorded penetration ``w1 - w2`` at the folded samples [m].
+    impacts_before : int
+        The record's contacts before :attr:`state` (a machine that sheds mass at each
+        impact starts the block lighter: :meth:`machine`).
     """
 
     fold: object
@@ -83,6 +87,15 @@ class Block:
     F: np.ndarray
     threshold: float
     Z: np.ndarray
+    impacts_before: int = 0
+
+    def machine(self, scenario):
+        """``scenario`` as it is when the block starts: with a mass loss per impact, the
+        moulding's mass after the record's impacts before it,
+        ``m2 (1 - loss)^impacts_before`` (the drift channel's mass)."""
+        if not (scenario.mass_loss and self.impacts_before):
+            return scenario
+        return scenario.replace(m2=scenario.m2 * (1.0 - scenario.mass_loss) ** self.impacts_before)
 
 
 @dataclass(frozen=True)
@@ -202,6 +215,8 @@ def record_span(
         # the first flights are too late to use most of the record
         return none("the record's first free flight comes too late to use most of the record")
     sigma = float(estimate_noise(F))
+    # the record's contacts (a machine that sheds mass per impact starts each block lighter)
+    onsets = contact_onsets(t, F, T, zeta=zeta)
     blocks = []
     for first, count in _block_ranges(whole.n_cycles, max(1, int(block_cycles))):
         o = whole.origin + first * W
@@ -217,7 +232,14 @@ def record_span(
         Fi = F[fold.idx]
         peak = float(np.max(fold.average(Fi)))
         thr = max(5.0 * sigma / np.sqrt(fold.n_cycles), 1e-3 * peak)
-        blk = Block(fold=fold, state=state, F=Fi, threshold=thr, Z=zeta[fold.idx])
+        blk = Block(
+            fold=fold,
+            state=state,
+            F=Fi,
+            threshold=thr,
+            Z=zeta[fold.idx],
+            impacts_before=int(np.count_nonzero(onsets + time_offset < state.t)),
+        )
         if not len(fold.impulse(Fi, threshold=thr, noise=sigma).support):
             continue  # no contact in these cycles (a run-up's start): nothing to compare
         blocks.append(blk)
@@ -238,6 +260,7 @@ def _simulate_block(scenario, law, blk, y0, tolerances, **kwargs):
     """The law simulated over a block from ``y0`` (default the block's measured state),
     sampled at its sample times."""
     fold, st = blk.fold, blk.state
+    scenario = blk.machine(scenario)
     return simulate(
         scenario,
         law,

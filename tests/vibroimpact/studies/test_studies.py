@@ -163,7 +163,7 @@ def test_field_record_noise_is_relative_to_each_channel(paper):
     m = field_record(
         paper, law, periods=4, fs=10000.0, transient=30, force_noise=0.02, motion_noise=0.01, seed=5
     )
-    t, y, F, _ = clean
+    t, y, F, *_ = clean
     assert np.array_equal(m.t, t) and m.t[0] == pytest.approx(30 * paper.period)
     assert np.std(m.F - F) == pytest.approx(0.02 * np.max(np.abs(F)), rel=0.1)
     for name, row in (("w1", 0), ("v1", 1), ("w2", 2), ("v2", 3)):

@@ -272,3 +272,24 @@ def test_a_run_up_whose_first_cycle_begins_inside_its_first_flight_keeps_its_spa
     assert all(b.state is not None for b in span.blocks)
     ev = evaluate(low, law, ref)
     assert ev.comparison != "steady orbit" and "I5" in ev.criteria
+
+
+def test_a_block_of_a_record_that_sheds_mass_starts_with_the_mass_left():
+    """Compared over its span, each block of a record whose moulding sheds mass at each
+    impact is simulated with the mass after the record's impacts before it: the true law
+    and loss are consistent with a noisy scipy-path record (the scenario's mass the one at
+    the record's start), the law without the loss is not, and each block counts the
+    record's impacts before it."""
+    from tests import realistic as R
+
+    paper = load_scenario("paper")
+    lossy = paper.replace(mass_loss=0.005)
+    rec = R.reference_record((lossy, paper.law), periods=30, transient=5, seed=2)
+    m2 = reference_simulate(lossy, paper.law, (0.0, 5 * paper.period))["m2_final"]
+    start = lossy.replace(m2=m2)
+    ref = Reference.from_measurement(rec, start, n_boot=8, seed=0)
+    before = [b.impacts_before for b in ref.span.blocks]
+    assert before == sorted(before) and before[-1] >= 20
+    ev = evaluate(start, paper.law, ref)
+    assert ev.consistent, ev.verdict
+    assert not evaluate(start.replace(mass_loss=0.0), paper.law, ref).consistent
