@@ -224,12 +224,16 @@ class Model:
             m = m.with_effect(e, min(max(v, lo), hi), add=False)
         return m
 
-    def apply(self, scenario):
-        """The scenario a record's averaged cycle is compared with: the record's, with
-        this model's machine changes except a mass loss.  A drifting record has no steady
-        state; its drift is checked orbit by orbit (:mod:`discovery.vibroimpact.explain.drift`), and
-        its averaged cycle stays compared with the scenario's mass."""
-        changes = {k: v for k, v in self.scenario.items() if k != "mass_loss"}
+    def apply(self, scenario, record=None):
+        """The scenario ``record`` (a :class:`~discovery.vibroimpact.verify.Reference`) is
+        compared with: the record's, with this model's machine changes.  A mass loss applies
+        to a record compared over its span (each block starts with the mass left after the
+        record's impacts before it); a drifting record has no steady state, so its averaged
+        cycle (a record without positions, or ``record`` None) stays compared with the
+        scenario's mass, and its drift is checked orbit by orbit
+        (:mod:`discovery.vibroimpact.explain.drift`)."""
+        spans = getattr(record, "span", None) is not None
+        changes = {k: v for k, v in self.scenario.items() if spans or k != "mass_loss"}
         return scenario.replace(**changes) if changes else scenario
 
     def observe(self):

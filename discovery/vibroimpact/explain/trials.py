@@ -156,7 +156,7 @@ class _Trial:
         # carried a refit of the law
         s["present"] = (
             _present(eff, self.model, self.result, s.get("negligible", 0.0))
-            if self.result is not None
+            if self.result is not None and k != "D"
             else bool(self.model.value(eff) != 0.0)
         )
 
@@ -236,7 +236,8 @@ def _refit_trials(run, step, screen_budget, gap):
         key = "D" if "drift" in eff.phases else gap
         try:
             if key == "D":
-                m2, res = run.drift.refit(model, eff, _small_step(eff, records)), None
+                m2 = run.drift.refit(model, eff, _small_step(eff, records))
+                m2, res = _law_with_the_drift(run, m2, screen_budget, gap)
                 evs2 = run.problem.evaluations(m2, floor=True)
             else:
                 m2, res, evs2, error = next(refits)
@@ -342,3 +343,20 @@ def _polish_winner(run, best, eff):
     except (IntegrationError, InputError):
         pass
     return replace(best, model=m2, result=res, evaluations=evs2)
+
+
+def _law_with_the_drift(run, model, budget, gap):
+    """A drift effect's model (its parameter fitted to the drift channel) with the law
+    refitted by output error, the drift parameter held: the law was fitted without the
+    drift, and on a record compared over its span each block now starts with the mass
+    left.  ``(model, fit)``: the refit where it lowers the gap criterion, else ``model``
+    and ``None``."""
+    try:
+        res = _output_error(run.records, model, run.criterion, budget, run.tolerances)
+        old = _mean(run.problem.evaluations(model, floor=False), "criteria")
+        new = _mean(run.problem.evaluations(res.law, floor=False), "criteria")
+    except (IntegrationError, InputError):
+        return model, None
+    if new.get(gap, float("inf")) < old.get(gap, float("inf")):
+        return res.law, res
+    return model, None

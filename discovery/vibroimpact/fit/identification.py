@@ -297,7 +297,7 @@ def _checks(records, law, observe, tolerances):
     """The identified law against every record with its noise floor."""
     plain, machine, observed = model_parts(law, observe)
     return tuple(
-        evaluate(machine(sc), plain, ref, tolerances=tolerances, observe=observed)
+        evaluate(machine(sc, ref), plain, ref, tolerances=tolerances, observe=observed)
         for sc, ref in records
     )
 

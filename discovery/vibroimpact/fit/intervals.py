@@ -284,7 +284,7 @@ def bootstrap_intervals(
             replicates.append(
                 [
                     _replicate(
-                        machine(sc), law, observe, ref, rng, tolerances=tolerances, noise=noise
+                        machine(sc, ref), law, observe, ref, rng, tolerances=tolerances, noise=noise
                     )
                     for sc, ref in records
                 ]

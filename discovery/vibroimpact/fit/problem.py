@@ -105,7 +105,7 @@ class ModelProblem:
             self.n_sim += 1
             evs.append(
                 evaluate(
-                    machine(sc),
+                    machine(sc, ref),
                     law,
                     ref,
                     tolerances=self.tol,
@@ -191,7 +191,7 @@ class _Objective:
                 self.n += 1
                 tick(self.progress, "identify: simulations", self.n, self.max_sim)
                 ev = evaluate(
-                    machine(sc),
+                    machine(sc, ref),
                     law,
                     ref,
                     tolerances=self.tol,
@@ -334,17 +334,19 @@ class _Objective:
             tick(self.progress, "identify: simulations", self.n, self.max_sim)
             if getattr(ref, "span", None) is not None:
                 dH = history_sensitivities(
-                    machine(sc), law, ref.span, tolerances=self.tol, observe=observe
+                    machine(sc, ref), law, ref.span, tolerances=self.tol, observe=observe
                 )
                 if penetration_size(ref):
-                    dZ = penetration_sensitivities(machine(sc), law, ref.span, tolerances=self.tol)
+                    dZ = penetration_sensitivities(
+                        machine(sc, ref), law, ref.span, tolerances=self.tol
+                    )
                     motion.append(penetration_jacobian(ref, dZ, ws))
                 dS = []
                 for blk, d in zip(ref.span.blocks, dH, strict=True):
                     dm = np.array([blk.fold.average(r) for r in d]).reshape(len(d), -1)
                     dS.append(np.concatenate([dm[:, :1], dm, dm[:, -1:]], axis=1))
             else:
-                dS = [_aligned_sensitivity(machine(sc), law, ref, ev, self.tol)]
+                dS = [_aligned_sensitivity(machine(sc, ref), law, ref, ev, self.tol)]
             for d, w in zip(dS, ws, strict=True):
                 for i, c in enumerate(cols):
                     if c is not None:

@@ -90,12 +90,14 @@ def _named(model):
 
 
 def model_parts(model, observe=None):
-    """``(law, scenario -> scenario, observation)`` of what :func:`identify` fits: a
-    :class:`ForceLaw`, or a model with more parameters than a law's coefficients (the
+    """``(law, (scenario, record) -> scenario, observation)`` of what :func:`identify` fits:
+    a :class:`ForceLaw`, or a model with more parameters than a law's coefficients (the
     missing-effect workflow's :class:`~discovery.vibroimpact.explain.Model`: ``coefficients``,
-    ``names``, ``with_coefficients``, ``law``, ``apply(scenario)``, ``observe()``)."""
+    ``names``, ``with_coefficients``, ``law``, ``apply(scenario, record)``, ``observe()``).
+    The machine a record is simulated with may depend on how the record is compared (a
+    mass loss per impact applies to a record compared over its span only)."""
     if isinstance(model, ForceLaw):
-        return model, (lambda sc: sc), observe
+        return model, (lambda sc, ref=None: sc), observe
     return model.law, model.apply, model.observe()
 
 
