@@ -29,7 +29,7 @@ def _final_loops(res, scenario, measurement, args):
         return None
     fm = res.final_model
     ref = Reference.from_measurement(measurement, scenario, n_boot=args.n_boot, seed=args.seed)
-    ev = evaluate(fm.apply(scenario), fm.law, ref, observe=fm.observe())
+    ev = evaluate(fm.apply(scenario, ref), fm.law, ref, observe=fm.observe())
     loops = force_penetration_loops(ref, ev)
     return None if loops is None else (loops, ev)
 
