@@ -122,12 +122,17 @@ class Model:
         Machine parameters changed from the record's scenario, e.g. ``{"k3": 3e12}``.
     effects : tuple of str
         Ids of the effects added so far.
+    fit_drift : bool
+        Whether :func:`discovery.identify` fits a drift effect's parameter too (records
+        compared over their span, where each block starts with the mass left); by default
+        the drift channel fits it.
     """
 
     law: ForceLaw
     observation: dict = field(default_factory=dict)
     effects: tuple = ()
     scenario: dict = field(default_factory=dict)
+    fit_drift: bool = field(default=False, compare=False)
 
     # ------------------------------------------------------------- one mechanism
     def value(self, eff):
@@ -165,7 +170,7 @@ class Model:
         else:
             obs[eff.key] = float(value)
         ids = self.effects + ((eff.id,) if add and eff.id not in self.effects else ())
-        return Model(law, obs, ids, scen)
+        return Model(law, obs, ids, scen, fit_drift=self.fit_drift)
 
     def without_effect(self, eff):
         """The model with the effect taken out (its term, unloading term, set, machine
@@ -190,7 +195,9 @@ class Model:
             scen.pop(eff.key, None)
         else:
             obs.pop(eff.key, None)
-        return Model(law, obs, tuple(i for i in self.effects if i != eff.id), scen)
+        return Model(
+            law, obs, tuple(i for i in self.effects if i != eff.id), scen, fit_drift=self.fit_drift
+        )
 
     def with_law(self, law):
         return replace(self, law=law)
@@ -201,7 +208,7 @@ class Model:
         return [
             e
             for e in (effect(i) for i in self.effects)
-            if e.target != "term" and "drift" not in e.phases
+            if e.target != "term" and (self.fit_drift or "drift" not in e.phases)
         ]
 
     @property

@@ -347,16 +347,23 @@ def _polish_winner(run, best, eff):
 
 def _law_with_the_drift(run, model, budget, gap):
     """A drift effect's model (its parameter fitted to the drift channel) with the law
-    refitted by output error, the drift parameter held: the law was fitted without the
-    drift, and on a record compared over its span each block now starts with the mass
-    left.  ``(model, fit)``: the refit where it lowers the gap criterion, else ``model``
-    and ``None``."""
+    refitted by output error, first with the drift parameter held (the law was fitted
+    without the drift: this brings it into the record's basin), then, on records compared
+    over their span, where each block starts with the mass left, jointly with the drift
+    parameter (the blocks fix it far more tightly than the drift channel; a record without
+    positions keeps the drift channel's value).  ``(model, fit)``: the refit where it
+    lowers the gap criterion, else ``model`` and ``None``."""
+    spans = all(getattr(ref, "span", None) is not None for _, ref in run.records)
     try:
         res = _output_error(run.records, model, run.criterion, budget, run.tolerances)
+        if spans:
+            start = replace(res.law, fit_drift=True)
+            res = _output_error(run.records, start, run.criterion, budget, run.tolerances)
+        fitted = replace(res.law, fit_drift=False)
         old = _mean(run.problem.evaluations(model, floor=False), "criteria")
-        new = _mean(run.problem.evaluations(res.law, floor=False), "criteria")
+        new = _mean(run.problem.evaluations(fitted, floor=False), "criteria")
     except (IntegrationError, InputError):
         return model, None
     if new.get(gap, float("inf")) < old.get(gap, float("inf")):
-        return res.law, res
+        return fitted, res
     return model, None

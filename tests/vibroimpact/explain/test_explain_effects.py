@@ -142,8 +142,8 @@ def test_a_clean_record_shows_no_drift(paper):
 def test_two_hidden_effects_are_both_found(paper):
     """A penetration-velocity coupling in the law and a moulding that sheds 0.5 % of its
     mass per impact, hidden together in a 40-period record: the drift is explained first,
-    with the law refitted on blocks that start with the mass left (I2 0.998 -> 0.118), then
-    the coupling (1.8e10 for 2e10; I2 0.118 -> 0.047, its limit 0.044)."""
+    with the law refitted on blocks that start with the mass left (I2 0.998 -> 0.114, loss
+    0.00515), then the coupling (1.79e10 for 2e10; I2 0.114 -> 0.046)."""
     _, res = mass_loss_case(paper, ForceLaw.parse(COUPLED))
     named = _named(res)
     assert named[:2] == ["mass_loss", "penetration_velocity_coupling"], [
