@@ -22,13 +22,14 @@ GIVE_UP_FACTOR = 10.0
 GIVE_UP_FLOOR = 0.5
 """A refinement stops after its cycle-by-cycle first fit when the law's criterion on the
 record's blocks is still above :data:`GIVE_UP_FACTOR` times the record's consistency limit
-and above :data:`GIVE_UP_FLOOR` (:func:`identify`'s ``give_up_above``): the force histories
-then differ by more than half the force, and the fit on the blocks would only polish that
-(on the bench record, a law without a stiffness term went from I2 1.25 to 1.22 in 80 more
-simulations).  The floor keeps a low-noise record's small limit from stopping a right
-support whose biased regression start the cycle-by-cycle fit has not yet brought close:
-with ten times the limit alone (0.15 at 0.5 % force noise) the shipped study selected a
-false-positive term in 7 more of its 120 runs."""
+and above :data:`GIVE_UP_FLOOR`, and that fit did not lower it (:func:`identify`'s
+``give_up_above``): the force histories then differ by more than half the force, and the
+fit on the blocks would only polish that (on the bench record, a law without a stiffness
+term went from I2 1.25 to 1.22 in 80 more simulations).  The floor keeps a low-noise
+record's small limit (0.15 at 0.5 % force noise) from stopping right supports whose poor
+starts the cycle-by-cycle fit has not yet brought close: with ten times the limit alone,
+the shipped study selected a false-positive term more often (in its cells at 0.5 % force
+noise)."""
 
 
 def _coefficients(law, library):
@@ -157,7 +158,7 @@ class _Checker:
                 f"refinement from the {origin} given up after its cycle-by-cycle fit "
                 f"({ref.n_simulations} simulations): {self.criterion} {ref.value:.3g}, above "
                 f"{self.give_up_above:.3g} (the larger of {GIVE_UP_FACTOR:g} x the "
-                f"consistency limit and {GIVE_UP_FLOOR:g})"
+                f"consistency limit and {GIVE_UP_FLOOR:g}), and that fit did not lower it"
             )
         else:
             note = (
