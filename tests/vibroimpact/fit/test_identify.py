@@ -335,10 +335,11 @@ def test_standard_errors_beyond_the_budget_are_left_out(paper, reference, monkey
 
 
 def test_a_hopeless_fit_is_given_up_after_its_cycle_by_cycle_fit(paper, reference, fitted):
-    """``give_up_above``: a law without a stiffness term stays far from the record after
-    the cycle-by-cycle first fit, and stops there (no fit on the blocks, no standard
-    errors); a law that can explain the record is not stopped, and ends as without it."""
-    hopeless = ForceLaw.parse("1.5e7*zd")
+    """``give_up_above``: a law without a stiffness term or a linear damper stays far from
+    the record after the cycle-by-cycle first fit, which does not lower its criterion, and
+    stops there (no fit on the blocks, no standard errors); a law that can explain the
+    record is not stopped, and ends as without it."""
+    hopeless = ForceLaw.parse("2e10*z*zd")
     full = identify(paper, reference, hopeless, max_simulations=120, check=False)
     quit = identify(paper, reference, hopeless, max_simulations=120, check=False, give_up_above=0.5)
     assert full.value > 0.5 and not full.given_up
