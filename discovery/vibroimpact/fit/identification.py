@@ -249,6 +249,20 @@ consistent model's other coefficients went from 1.22 to 0.67 (and was consistent
 the fit on the blocks)."""
 
 
+def _hopeless(short_value, give_up_above):
+    """Why a fit is given up after its cycle-by-cycle first fit (``short_value``: the
+    start's and that fit's criterion on the blocks), or ``""`` (see ``give_up_above``)."""
+    if give_up_above is None or short_value is None:
+        return ""
+    v0, v1 = short_value
+    if min(v0, v1) <= give_up_above or v1 <= _NO_PROGRESS * v0:
+        return ""
+    return (
+        f"{min(v0, v1):.3g} on the blocks is above {give_up_above:.3g}, and the fit lowered "
+        f"it by less than {1 - _NO_PROGRESS:.0%}"
+    )
+
+
 @dataclass(frozen=True)
 class _Fit:
     """The settings of one :func:`identify` call that the cycle-by-cycle first fit repeats."""
@@ -445,12 +459,7 @@ def identify(
             progress=progress,
         )
         start, spent, short_value = _short_first(records, start, fit)
-    given_up = (
-        give_up_above is not None
-        and short_value is not None
-        and min(short_value) > give_up_above
-        and short_value[1] > _NO_PROGRESS * short_value[0]
-    )
+    given_up = _hopeless(short_value, give_up_above)
     obj = _Objective(
         records,
         start,
@@ -463,11 +472,7 @@ def identify(
     obj.n = 0
     if given_up:
         x_best = np.ones(len(start.coefficients))
-        message = (
-            f"given up after the cycle-by-cycle fit: {criterion} {min(short_value):.3g} on "
-            f"the blocks is above {give_up_above:.3g}, and the fit lowered it by less than "
-            f"{1 - _NO_PROGRESS:.0%}"
-        )
+        message = f"given up after the cycle-by-cycle fit: {criterion} {given_up}"
     else:
         x_best, message = _fitted(obj, method, xtol, max_simulations)  # before the error probes
     law = obj.law(x_best)
@@ -513,5 +518,5 @@ def identify(
         failures=obj.failures,
         seconds=time.perf_counter() - t0,
         message=message,
-        given_up=given_up,
+        given_up=bool(given_up),
     )

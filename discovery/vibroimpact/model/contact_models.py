@@ -202,8 +202,8 @@ class ContactModel:
             impact_scaled=self.name in ("lankarani-nikravesh", "flores"),
         )
 
-    def apply(self, scenario):
-        """The scenario a record is compared with: unchanged (a model changes no machine
+    def apply(self, scenario, record=None):
+        """The scenario ``record`` is compared with: unchanged (a model changes no machine
         parameter)."""
         return scenario
 
