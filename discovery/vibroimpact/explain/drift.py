@@ -81,7 +81,7 @@ class DriftRecord:
 
 def predicted(scenario, rec, loss):
     """The model's contact impulse of every window: ``m2 (1 - loss)^n g W``."""
-    return scenario.m2 * (1.0 - loss) ** rec.impacts_before * scenario.g * rec.window
+    return scenario.mass_after(rec.impacts_before, loss) * scenario.g * rec.window
 
 
 def drift_residual(scenario, rec, loss):

@@ -284,8 +284,9 @@ def _shortlist(check, est, required, shortlist, progress):
             f"no candidate support of the library holds the required terms "
             f"{', '.join(sorted(required))}; raise --max-terms or drop --require"
         )
-    jobs = [([(check.regression_law(c), c)], "regression") for c in pool[:shortlist]]
+    laws = [check.regression_law(c) for c in pool[:shortlist]]
+    jobs = [([(law, c)], "regression") for law, c in zip(laws, pool, strict=False)]
     if check.refine:
-        check.screen_from([law for ((law, _),) in (starts for starts, _ in jobs)])
+        check.screen_from(laws)
     tick(progress, _SHORTLIST_STAGE, 0, len(jobs))
     return check.run(jobs, _SHORTLIST_STAGE, progress)

@@ -228,6 +228,11 @@ class Scenario:
         (``zeta + offset``), ndarray."""
         return np.asarray(zeta, dtype=float) + self.offset
 
+    def mass_after(self, impacts, loss=None):
+        """The moulding's mass after ``impacts`` impacts (a number or an array), each shedding
+        ``loss`` (default :attr:`mass_loss`) of it: ``m2 (1 - loss)^impacts``."""
+        return self.m2 * (1.0 - (self.mass_loss if loss is None else loss)) ** impacts
+
     def scales(self):
         """Characteristic displacement [m] and velocity [m/s] of the motion."""
         w2 = self.omega**2

@@ -95,7 +95,7 @@ class Block:
         ``m2 (1 - loss)^impacts_before`` (the drift channel's mass)."""
         if not (scenario.mass_loss and self.impacts_before):
             return scenario
-        return scenario.replace(m2=scenario.m2 * (1.0 - scenario.mass_loss) ** self.impacts_before)
+        return scenario.replace(m2=scenario.mass_after(self.impacts_before))
 
 
 @dataclass(frozen=True)
