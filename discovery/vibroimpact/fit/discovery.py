@@ -40,6 +40,7 @@ import numpy as np
 from constraints import require as require_certificate
 
 from ..._progress import reports_progress, tick
+from ..._settings import Settings, option, takes
 from ..._validate import Choice, Real, Text, params
 from ...errors import InputError
 from ..data.measurement import Measurement
@@ -175,61 +176,40 @@ def _contact_models(scenario, measurement, n_boot, seed, progress):
     )
 
 
-@params(
-    scenario=(Scenario, list, tuple),
-    measurement=(Measurement, list, tuple),
-    library=(Text(), Library, list, tuple),
-    selection=Text(),
-    scoring=Text(),
-    max_terms=Real(1, 64, integer=True),
-    criterion=Text(),
-    shortlist=Real(1, integer=True),
-    stability=Real(0, integer=True),
-    derivative=(None, Text()),
-    sim_rtol=Real(0, open_low=True),
-    sim_atol=Real(0),
-    tolerances=(Tolerances, None),
-    seed=Real(0, integer=True),
-    random_state=(None, Real(0, integer=True)),
-    n_boot=Real(0, integer=True),
-    max_simulations=Real(0, integer=True),
-    stepwise=Real(0, integer=True),
-    require=(tuple, list),
-    n_boot_intervals=Real(0, integer=True),
-    interval_refit=Choice(*INTERVAL_REFITS),
-    workers=(None, Real(1, integer=True)),
-)
+@dataclass(frozen=True)
+class DiscoverSettings(Settings):
+    """The options of :func:`discover` (each is also a keyword of it; see its parameters)."""
+
+    library: object = option("poly:2", (Text(), Library, list, tuple))
+    selection: str = option("best-subset", Text())
+    scoring: str = option("bic", Text())
+    max_terms: int = option(4, Real(1, 64, integer=True))
+    criterion: str = option("I2", Text())
+    shortlist: int = option(8, Real(1, integer=True))
+    refine: bool = option(True)
+    stability: int = option(0, Real(0, integer=True))
+    derivative: object = option(None, (None, Text()))
+    average_cycles: bool = option(False)
+    sim_rtol: float = option(0.1, Real(0, open_low=True))
+    sim_atol: float = option(0.005, Real(0))
+    tolerances: object = option(None, (Tolerances, None))
+    seed: int = option(0, Real(0, integer=True))
+    n_boot: int = option(16, Real(0, integer=True))
+    max_simulations: int = option(_REFINE_BUDGET, Real(0, integer=True))
+    stepwise: int = option(3, Real(0, integer=True))
+    physics: bool = option(True)
+    require: tuple = option((), (tuple, list))
+    n_boot_intervals: int = option(30, Real(0, integer=True))
+    interval_refit: str = option("two-step", Choice(*INTERVAL_REFITS))
+    workers: object = option(1, (None, Real(1, integer=True)))
+    random_state: object = option(None, (None, Real(0, integer=True)))
+    estimator: object = option(None, (None, dict))
+
+
+@takes(DiscoverSettings)
+@params(scenario=(Scenario, list, tuple), measurement=(Measurement, list, tuple))
 @reports_progress
-def discover(
-    scenario,
-    measurement,
-    *,
-    library="poly:2",
-    selection="best-subset",
-    scoring="bic",
-    max_terms=4,
-    criterion="I2",
-    shortlist=8,
-    refine=True,
-    stability=0,
-    derivative=None,
-    average_cycles=False,
-    sim_rtol=0.1,
-    sim_atol=0.005,
-    tolerances=None,
-    seed=0,
-    n_boot=16,
-    max_simulations=_REFINE_BUDGET,
-    stepwise=3,
-    physics=True,
-    require=(),
-    n_boot_intervals=30,
-    interval_refit="two-step",
-    workers=1,
-    progress=None,
-    random_state=None,
-    **estimator_kwargs,
-):
+def discover(scenario, measurement, *, settings=None, progress=None, **options):
     """Discover a contact law from one or several records and check it by simulation.
 
     Parameters
@@ -241,6 +221,8 @@ def discover(
     measurement : Measurement or sequence of Measurement
         Each needs ``t``, ``F``, ``w1``, ``w2`` (``v1``, ``v2`` optional).  All records
         are fitted jointly: several operating points separate terms one orbit cannot.
+    settings : DiscoverSettings, optional
+        The options below in one object; keywords override its fields.
     library, selection, scoring, max_terms
         Passed to :class:`~discovery.vibroimpact.fit.regression.ConstrainedSparseRegressor`.
     criterion : str
@@ -296,8 +278,9 @@ def discover(
         interactive, False: none (:mod:`discovery._progress`).
     random_state : int, optional
         Deprecated name of ``seed``.
-    **estimator_kwargs
-        Further estimator parameters (``margin``, ``monotone``, ``signs``, ...).
+    estimator : dict, optional
+        Further estimator parameters (``margin``, ``monotone``, ``signs``, ...); they may
+        also be given as keywords.
 
     Returns
     -------
@@ -308,59 +291,64 @@ def discover(
         consistent model, a refinement that moved coefficients far beyond their
         uncertainty (regression bias).
     """
-    if library == "contact-models":  # the named contact models, fitted by name
-        return _contact_models(scenario, measurement, n_boot_intervals, seed, progress)
+    s, more = DiscoverSettings.of("discover", settings, options, rest=True)
+    if s.library == "contact-models":  # the named contact models, fitted by name
+        return _contact_models(scenario, measurement, s.n_boot_intervals, s.seed, progress)
     t0 = time.perf_counter()
-    seed = _seed(random_state, seed)
+    seed = _seed(s.random_state, s.seed)
     _check_settings(
-        criterion=criterion,
-        shortlist=shortlist,
-        stability=stability,
-        n_boot=n_boot,
-        max_simulations=max_simulations,
-        stepwise=stepwise,
+        criterion=s.criterion,
+        shortlist=s.shortlist,
+        stability=s.stability,
+        n_boot=s.n_boot,
+        max_simulations=s.max_simulations,
+        stepwise=s.stepwise,
     )
     pairs = pair_records(scenario, measurement)
-    parts, samples = _contact_samples(pairs, derivative, average_cycles)
-    regressor = dict(library=library, selection=selection, scoring=scoring, max_terms=max_terms)
-    est = _regression(samples, {**regressor, **estimator_kwargs})
-    refs = [(sc, Reference.from_measurement(m, sc, n_boot=n_boot, seed=seed)) for sc, m in pairs]
+    parts, samples = _contact_samples(pairs, s.derivative, s.average_cycles)
+    regressor = dict(
+        library=s.library, selection=s.selection, scoring=s.scoring, max_terms=s.max_terms
+    )
+    est = _regression(samples, {**regressor, **(s.estimator or {}), **more})
+    refs = [(sc, Reference.from_measurement(m, sc, n_boot=s.n_boot, seed=seed)) for sc, m in pairs]
     evidence = _Evidence(pairs, parts, samples, est, refs)
-    required = _required_terms(require, est.library_)
+    required = _required_terms(s.require, est.library_)
     check = _Checker(
         est=est,
         samples=samples,
         refs=refs,
-        criterion=criterion,
-        refine=refine,
-        tol=tolerances,
-        budget=max_simulations,
+        criterion=s.criterion,
+        refine=s.refine,
+        tol=s.tolerances,
+        budget=s.max_simulations,
         required=required,
-        workers=workers,
+        workers=s.workers,
     )
-    models = _shortlist(check, est, required, shortlist, progress)
+    models = _shortlist(check, est, required, s.shortlist, progress)
     by_score = list(models)  # the estimator's order (its scoring)
-    rule = _RankingRule(criterion, sim_rtol, sim_atol, physics)
-    search = _Stepwise(check, rule, stepwise=stepwise, max_terms=max_terms)
-    ranking = search.run(models, refs, refine, progress)
-    boot = _Bootstrap(n_boot_intervals, seed, workers, interval_refit, criterion, tolerances)
-    selected, ranking = boot.selected(ranking, refs, refine, progress)
+    rule = _RankingRule(s.criterion, s.sim_rtol, s.sim_atol, s.physics)
+    search = _Stepwise(check, rule, stepwise=s.stepwise, max_terms=s.max_terms)
+    ranking = search.run(models, refs, s.refine, progress)
+    boot = _Bootstrap(
+        s.n_boot_intervals, seed, s.workers, s.interval_refit, s.criterion, s.tolerances
+    )
+    selected, ranking = boot.selected(ranking, refs, s.refine, progress)
     # the certificate of the law actually selected (the ranking may prefer another
     # candidate than the estimator's best by BIC); a failure is an error
     cert = require_certificate(selected.certificate)
-    stab = _stability(est, samples, stability, seed)
-    warnings = _warnings(selected, by_score, stab, evidence, refine)
+    stab = _stability(est, samples, s.stability, seed)
+    warnings = _warnings(selected, by_score, stab, evidence, s.refine)
     if selected.defects:
-        warnings.insert(0, _defects_warning(selected, physics))
-    settings = _settings(
+        warnings.insert(0, _defects_warning(selected, s.physics))
+    recorded = _settings(
         evidence,
         check,
         search,
         boot,
-        shortlist=shortlist,
-        stability=stability,
-        n_boot=n_boot,
-        average_cycles=average_cycles,
+        shortlist=s.shortlist,
+        stability=s.stability,
+        n_boot=s.n_boot,
+        average_cycles=s.average_cycles,
     )
     return DiscoveryResult(
         selected=selected,
@@ -372,7 +360,7 @@ def discover(
         references=tuple(refs),
         stability=stab,
         warnings=warnings,
-        equivalent=_equivalent(ranking, selected, est, samples, criterion),
+        equivalent=_equivalent(ranking, selected, est, samples, s.criterion),
         seconds=time.perf_counter() - t0,
-        settings=settings,
+        settings=recorded,
     )

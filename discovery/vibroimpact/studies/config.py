@@ -46,7 +46,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..._io import short
-from ..._validate import Text, check, params
+from ..._validate import Text, params
 from ...errors import InputError, VidiError
 from ..fit.regression import SELECTIONS
 from ..model.contact_models import is_model_text, parse_law
@@ -345,20 +345,17 @@ def _check_fit(fit, source):
     """Every ``[fit]`` option by the checks :func:`~discovery.vibroimpact.fit.discovery.discover`
     makes of its arguments (their types, ranges and names), so that a bad option stops the
     study up front instead of failing every run."""
-    from ..fit.discovery import _check_settings, discover
+    from ..fit.discovery import DiscoverSettings, _check_settings
     from ..fit.regression import SCORES
     from ..verify.criteria import criterion as _criterion
-
-    specs = getattr(discover, "__vidi_params__", {})
 
     def bad(exc):
         text = str(exc).removeprefix("discover: ")
         _fail(source, f"[fit] {text}")
 
     try:
-        for k, v in fit.items():
-            if k in specs:
-                check(k, v, specs[k])
+        known = {k: v for k, v in fit.items() if k in DiscoverSettings.names()}
+        DiscoverSettings.of("discover", None, known)
         if "criterion" in fit:
             _criterion(fit["criterion"])
         if "scoring" in fit and fit["scoring"] not in SCORES:

@@ -1,0 +1,152 @@
+"""Settings objects: the options of a public function with many, in one named, checked object.
+
+A public function with more options than a signature should carry takes them as keywords
+(``discover(scenario, record, library="poly:3", shortlist=4)``) or as one object
+(``discover(scenario, record, settings=DiscoverSettings(library="poly:3"))``), or both: the
+keywords then override the object's fields.  The object is a frozen dataclass derived from
+:class:`Settings`; each field declares its default and the spec of :mod:`discovery._validate`
+that checks it (:func:`option`).
+
+* :meth:`Settings.of` merges an object and keywords for a function: an unknown keyword is one
+  line naming it, the closest field and the settings class (a ``TypeError``, as Python's own
+  unexpected keyword is); a wrong value is one line naming the function and the field.
+* A settings object checks its fields when it is made (``DiscoverSettings(max_terms=0)``
+  raises), so an object passed around is valid.
+* ``to_dict()`` / ``from_dict()`` give a JSON-safe document and back, for records of the
+  settings a result was made with.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import difflib
+import functools
+
+from ._validate import _received, check
+from .errors import VidiTypeError
+
+__all__ = ["Settings", "option", "takes", "options_of"]
+
+
+def option(default=None, spec=None, *, factory=None):
+    """A settings field: its default (or a ``factory`` of it) and the spec that checks it."""
+    metadata = {"spec": spec}
+    if factory is not None:
+        return dataclasses.field(default_factory=factory, metadata=metadata)
+    return dataclasses.field(default=default, metadata=metadata)
+
+
+@dataclasses.dataclass(frozen=True)
+class Settings:
+    """Base of the settings classes: a frozen dataclass of checked options."""
+
+    def __post_init__(self):
+        self._check(type(self).__name__)
+
+    def _check(self, where, names=None):
+        for f in self._fields():
+            if names is not None and f.name not in names:
+                continue
+            spec = f.metadata.get("spec")
+            if spec is not None:
+                check(f"{where}: {f.name}", getattr(self, f.name), spec)
+
+    @classmethod
+    @functools.cache
+    def _fields(cls):
+        return dataclasses.fields(cls)
+
+    @classmethod
+    @functools.cache
+    def names(cls):
+        """The fields' names, in order."""
+        return tuple(f.name for f in cls._fields())
+
+    @classmethod
+    @functools.cache
+    def defaults(cls):
+        """The settings every field at its default."""
+        return cls()
+
+    @classmethod
+    def of(cls, where, settings=None, options=None, *, rest=False):
+        """The settings a call of ``where`` asks for: ``settings`` (an instance or None)
+        with the keyword ``options`` over its fields.  With ``rest``, keywords that are no
+        field are returned beside the settings (``(settings, rest)``) for the function to
+        pass on; without it they are refused."""
+        if settings is not None and not isinstance(settings, cls):
+            raise VidiTypeError(
+                f"{where}: settings must be a {cls.__name__} or None; got {_received(settings)}"
+            )
+        options = dict(options or {})
+        known = cls.names()
+        unknown = {k: options.pop(k) for k in list(options) if k not in known}
+        if unknown and not rest:
+            name = next(iter(unknown))
+            close = difflib.get_close_matches(name, known, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise VidiTypeError(
+                f"{where}: unexpected keyword {name!r}{hint}; the options are the fields of "
+                f"{cls.__name__}"
+            )
+        base = cls.defaults() if settings is None else settings
+        if options:  # only the given values need a check (naming the function called)
+            base = copy.copy(base)
+            for k, v in options.items():
+                object.__setattr__(base, k, v)
+            base._check(where, options)
+        return (base, unknown) if rest else base
+
+    def changed(self):
+        """``{name: value}`` of the fields not at their default."""
+        d = self.defaults()
+        return {n: getattr(self, n) for n in self.names() if getattr(self, n) != getattr(d, n)}
+
+    def to_dict(self):
+        """A JSON-safe ``{name: value}`` of every field."""
+        from ._io import to_jsonable
+
+        return {n: to_jsonable(getattr(self, n)) for n in self.names()}
+
+    @classmethod
+    def from_dict(cls, doc):
+        """The settings a :meth:`to_dict` document holds (missing fields at their
+        default; lists back as tuples where the default is a tuple)."""
+        d = cls.defaults()
+        values = {}
+        for n in cls.names():
+            if n in doc:
+                v = doc[n]
+                values[n] = (
+                    tuple(v) if isinstance(getattr(d, n), tuple) and isinstance(v, list) else v
+                )
+        return dataclasses.replace(d, **values)
+
+
+def takes(cls):
+    """Decorator of a public function whose options are the fields of ``cls`` (a
+    :class:`Settings`): :func:`options_of` then lists them beside its parameters."""
+
+    def mark(func):
+        func.__vidi_settings__ = cls
+        return func
+
+    return mark
+
+
+def options_of(func):
+    """``{name: default}`` of every option of ``func``: its named parameters (other than
+    ``settings``) and the fields of the settings class it takes."""
+    import inspect
+
+    out = {
+        n: p.default
+        for n, p in inspect.signature(func).parameters.items()
+        if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD) and n != "settings"
+    }
+    cls = getattr(func, "__vidi_settings__", None)
+    if cls is not None:
+        d = cls.defaults()
+        out.update({n: getattr(d, n) for n in cls.names()})
+    return out
