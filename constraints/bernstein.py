@@ -338,7 +338,7 @@ def bernstein_map(
         matrix = np.zeros((n_s + 1, exps.shape[0]))
         for i in np.flatnonzero(active):
             matrix[:, i] = weights[i] * monomial_bernstein(int(powers[i]), n_s)
-        return _freeze(condition, matrix, np.zeros(n_s + 1), (n_s,), (q, 1), box)
+        return _freeze(BernsteinMap(condition, matrix, np.zeros(n_s + 1), (n_s,), (q, 1), box))
 
     active = np.ones_like(a, dtype=bool) if condition == "non_adhesion" else b > 0.0
     q = lattice_factor(a[active])
@@ -359,13 +359,14 @@ def bernstein_map(
         # - margin * zd = - margin * V * u**r, constant in s (all-ones Bernstein coefficients)
         offset = -margin * box.zd_max * np.outer(np.ones(n_s + 1), monomial_bernstein(r, n_u))
         offset = offset.ravel()
-    return _freeze(condition, matrix, offset, (n_s, n_u), (q, r), box)
+    return _freeze(BernsteinMap(condition, matrix, offset, (n_s, n_u), (q, r), box))
 
 
-def _freeze(condition, matrix, offset, degrees, lattice, box) -> BernsteinMap:
-    matrix.setflags(write=False)
-    offset.setflags(write=False)
-    return BernsteinMap(condition, matrix, offset, degrees, lattice, box)
+def _freeze(bmap: BernsteinMap) -> BernsteinMap:
+    """The map with its arrays read-only."""
+    bmap.matrix.setflags(write=False)
+    bmap.offset.setflags(write=False)
+    return bmap
 
 
 def bernstein_coefficients(

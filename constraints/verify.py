@@ -151,13 +151,14 @@ def _scan(
     weights: np.ndarray,
     alpha: np.ndarray,
     beta: np.ndarray,
-    s: np.ndarray,
-    u: np.ndarray,
+    axes: tuple[np.ndarray, np.ndarray],
     chunk_rows: int,
 ) -> tuple[float, tuple[int, int], float]:
-    """Min, argmin (i, j) and max |.| of sum_k w_k s_i**alpha_k u_j**beta_k over the grid."""
+    """Min, argmin (i, j) and max |.| of sum_k w_k s_i**alpha_k u_j**beta_k over the grid
+    ``axes = (s, u)``."""
     if weights.size == 0:
         return 0.0, (0, 0), 0.0
+    s, u = axes
     s_pow = s[:, None] ** alpha[None, :] * weights[None, :]
     u_pow_t = (u[:, None] ** beta[None, :]).T
     best, where, peak = math.inf, (0, 0), 0.0
@@ -222,7 +223,7 @@ def grid_minimum(
     shape = _grid_shape(grid)
     x, exps = _scaled(coef, library, box)
     s, u = _axes(shape, condition)
-    value, (i, j), _ = _scan(*_terms(x, exps, box, condition, margin), s, u, chunk_rows)
+    value, (i, j), _ = _scan(*_terms(x, exps, box, condition, margin), (s, u), chunk_rows)
     return value, (float(s[i] * box.zeta_max), float(u[j] * box.zd_max))
 
 
@@ -237,7 +238,7 @@ def force_scale(
     """Force scale ``max |P|`` over the grid [N]."""
     x, exps = _scaled(coef, library, box)
     s, u = _axes(_grid_shape(grid), "non_adhesion")
-    return _scan(x, exps[:, 0], exps[:, 1], s, u, chunk_rows)[2]
+    return _scan(x, exps[:, 0], exps[:, 1], (s, u), chunk_rows)[2]
 
 
 def certify(
@@ -250,7 +251,6 @@ def certify(
     grid: int | Sequence[int] = DEFAULT_GRID,
     margin: float = 0.0,
     tol: float = DEFAULT_TOLERANCE,
-    chunk_rows: int = 128,
 ) -> Certificate:
     """Certify a law on the whole box by Bernstein coefficients and a dense grid.
 
@@ -272,8 +272,6 @@ def certify(
         Dissipativity margin [N s/m].
     tol : float, optional
         Relative tolerance (fraction of ``max |P|``).
-    chunk_rows : int, optional
-        Grid rows evaluated at once.
 
     Returns
     -------
@@ -290,7 +288,7 @@ def certify(
         raise InputError(f"tol must be a finite number >= 0, got {tol!r}")
     shape = _grid_shape(grid)
     x, exps = _scaled(coef, library, box)
-    scale = force_scale(coef, exps, box, grid=shape, chunk_rows=chunk_rows)
+    scale = force_scale(coef, exps, box, grid=shape)
     reference = scale if scale > 0.0 else 1.0
     results: dict[str, dict[str, Any]] = {}
     worst = 0.0
@@ -300,9 +298,7 @@ def certify(
         bern = np.asarray(bmap.matrix) @ x + np.asarray(bmap.offset)
         row = int(np.argmin(bern))
         bern_min = float(bern[row])
-        grid_value, location = grid_minimum(
-            coef, exps, box, name, grid=shape, margin=cond_margin, chunk_rows=chunk_rows
-        )
+        grid_value, location = grid_minimum(coef, exps, box, name, grid=shape, margin=cond_margin)
         grid_min = min(0.0, grid_value)
         ok = bern_min >= -tol * reference and grid_min >= -tol * reference
         worst = max(worst, -grid_min / reference)

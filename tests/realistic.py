@@ -475,9 +475,7 @@ def reference_record(
         f"channel's range, seed {seed}",
     )
     return noisy_measurement(
-        t,
-        y,
-        F,
+        (t, y, F),
         force_noise=force_noise,
         motion_noise=motion_noise,
         seed=seed,

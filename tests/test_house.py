@@ -309,6 +309,43 @@ def test_functions_are_short():
     assert not long, long
 
 
+def _sklearn_constructors(tree):
+    """The ``__init__`` nodes of scikit-learn estimators (classes deriving ``BaseEstimator``)."""
+    out = set()
+    for cls in ast.walk(tree):
+        if isinstance(cls, ast.ClassDef) and any(
+            "BaseEstimator" in ast.unparse(b) for b in cls.bases
+        ):
+            out |= {f for f in cls.body if isinstance(f, ast.FunctionDef) and f.name == "__init__"}
+    return out
+
+
+def test_functions_take_few_parameters():
+    """No function of the package takes more than 8 parameters, nor more than 5
+    positionally (``self``/``cls``, ``*args`` and ``**kwargs`` aside): a longer list is state
+    that deserves a named object (a public function's options are a settings object,
+    :mod:`discovery._settings`).  Exempt: the compiled kernels, and a scikit-learn
+    estimator's ``__init__``, whose contract is every hyper-parameter an explicit keyword
+    of the constructor (``get_params``, ``set_params``, ``clone``)."""
+    wide = []
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            tree = ast.parse(path.read_text())
+            exempt = _sklearn_constructors(tree)
+            for node in ast.walk(tree):
+                if not isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                    continue
+                if node in exempt or _compiled(node):
+                    continue
+                a = node.args
+                positional = [x for x in a.posonlyargs + a.args if x.arg not in ("self", "cls")]
+                n = len(positional) + len(a.kwonlyargs)
+                if n > 8 or len(positional) > 5:
+                    where = f"{path.relative_to(ROOT)}:{node.lineno} {node.name}"
+                    wide.append(f"{where} ({n} parameters, {len(positional)} positional)")
+    assert not wide, wide
+
+
 def test_modules_are_short():
     """No module of the package is over 700 lines, the compiled kernels aside (a module whose
     functions are all numba kernels): a longer module holds several jobs that deserve

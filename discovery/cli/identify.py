@@ -215,7 +215,7 @@ def run(args):
         _summary(args, sc, start, ref, res).write_into(out)
         out.path("iterations.csv").write_text(_iterations_csv(res))
         identification_figure(
-            res, ref.impulse, imps, str(out.path("identification")), land, start=start
+            res, ref.impulse, imps, str(out.path("identification")), land=land, start=start
         )
     _print_result(args, res)
     return 0

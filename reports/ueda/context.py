@@ -45,7 +45,7 @@ def _forcing(doc):
     return [] if forcing is None else [_fact("forcing", forcing)]
 
 
-def _page(doc, run_dir, facts, conclusions, coefficients=None, standard_errors=None):
+def _page(doc, run_dir, facts, conclusions, *, coefficients=None, standard_errors=None):
     """The context of a Ueda report: its title, the facts rows, the equation and
     coefficients table of ``coefficients`` (``{term: value}``, none: no equation), the
     conclusions and the figures."""
@@ -107,7 +107,9 @@ def _ueda_discover(doc, run_dir):
             f"the record {ver.get('regime_record', '?')}, of the model "
             f"{ver.get('regime_model', '?')})."
         )
-    c = _page(doc, run_dir, facts, concl, r.coefficients, r.standard_errors)
+    c = _page(
+        doc, run_dir, facts, concl, coefficients=r.coefficients, standard_errors=r.standard_errors
+    )
     c["verification"] = [
         [k.replace("_", " "), num(v) if isinstance(v, int | float) else v]
         for k, v in ver.items()
@@ -133,7 +135,14 @@ def _ueda_explain(doc, run_dir):
     concl = [
         f"Effects named and added: {added}; the gap: {gaps}.{verdict} Stopped because {stopped}."
     ]
-    return _page(doc, run_dir, _forcing(doc), concl, r.coefficients, r.standard_errors)
+    return _page(
+        doc,
+        run_dir,
+        _forcing(doc),
+        concl,
+        coefficients=r.coefficients,
+        standard_errors=r.standard_errors,
+    )
 
 
 def _effect_title(effect_id):

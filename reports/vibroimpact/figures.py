@@ -93,7 +93,7 @@ def _landscape_contours(fig, ax, land, name):
     ax.plot(a0[i], a1[j], "w*", ms=10, mec="k")
 
 
-def _landscape_info_lines(land, ref_reg, exact, floor, cons, truth, inside):
+def _landscape_info_lines(land, ref_reg, *, exact, floor, cons, truth, inside):
     """The text of the information panel."""
     import textwrap
 
@@ -209,7 +209,7 @@ def _mark_start(ax, start, names, path):
     ax.plot(*s0, "s", mfc="none", mec="r", ms=9, mew=1.5, label="start (given)")
 
 
-def identification_figure(result, measured, impulses, stem, land=None, start=None):
+def identification_figure(result, measured, impulses, stem, *, land=None, start=None):
     """Identification path (Fig. 6), the criterion against the simulations spent, and F_N
     converging to F_E (Fig. 7).
 

@@ -11,6 +11,7 @@ import time
 from dataclasses import dataclass
 
 from ..._progress import reports_progress, tick
+from ..._settings import Settings, option, takes
 from ..._validate import Instance, Real, params
 from ...numerics.executor import make_executor
 from ..dynamics import Tolerances
@@ -60,14 +61,21 @@ def _run(ex, context, jobs, progress, stage):
     return out
 
 
+@dataclass(frozen=True)
+class AdviseSettings(Settings):
+    """The options of :func:`advise` (each is also a keyword of it)."""
+
+    workers: object = option(None, (None, Real(1, integer=True)))
+    tolerances: object = option(None, (Tolerances, None))
+
+
+@takes(AdviseSettings)
 @params(
     scenario=Scenario,
     laws=(list, tuple, Instance("discovery.vibroimpact.fit.contact_fit", "ContactModelsResult")),
     knobs=Knobs,
     noise=NoiseModel,
     safe=(SafeRegion, None),
-    workers=(None, Real(1, integer=True)),
-    tolerances=(Tolerances, None),
     executor=(None, Instance("discovery.numerics.executor", "Executor")),
 )
 @reports_progress
@@ -78,10 +86,10 @@ def advise(
     noise,
     safe=None,
     *,
-    workers=None,
-    tolerances=None,
+    settings=None,
     progress=None,
     executor=None,
+    **options,
 ):
     """Find the operating point where the candidates' predicted records differ most.
 
@@ -102,6 +110,9 @@ def advise(
         The next record's noise (relative to its peak force), sampling and length.
     safe : SafeRegion, optional
         Peak force and penetration the machine may not exceed (default: no bound).
+    settings : AdviseSettings, optional
+        The options ``workers`` and ``tolerances`` in one object; keywords override its
+        fields.
     workers : int, optional
         Processes (default: all cores); the result does not depend on it.
     tolerances : Tolerances, optional
@@ -116,12 +127,13 @@ def advise(
     AdviseResult
         ``best`` is the advised point; ``ranked()`` every usable point, best first.
     """
+    s = AdviseSettings.of("advise", settings, options)
     t0 = time.perf_counter()
     laws = unique_laws(laws)
     for k, law in enumerate(laws):
         law.check_physical(scenario, f"candidate {k + 1}")
     safe = SafeRegion() if safe is None else safe
-    context = _Context(scenario, laws, noise, safe, tolerances)
+    context = _Context(scenario, laws, noise, safe, s.tolerances)
     a, f, m = knobs.axes()
     jobs = [
         (float(x), float(y), None if z is None else float(z), "coarse")
@@ -132,7 +144,7 @@ def advise(
     own = executor is None
     ex = executor
     if own:
-        ex = make_executor(min(int(workers or os.cpu_count() or 1), len(jobs)))
+        ex = make_executor(min(int(s.workers or os.cpu_count() or 1), len(jobs)))
     try:
         coarse = _run(ex, context, jobs, progress, "advise: coarse grid")
         more = _refined(knobs, coarse, [j[:3] for j in jobs])

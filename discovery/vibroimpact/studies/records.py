@@ -19,10 +19,12 @@ process (``lru_cache``): other noise levels and seeds of the same record are fre
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
+from ..._settings import Settings, option, takes
 from ..._validate import Real, params
 from ...errors import IntegrationError, VidiError
 from ..data.measurement import Measurement
@@ -110,12 +112,14 @@ def clean_record(scenario, law, periods, fs, transient, *, record_transient=Fals
 
 
 def noisy_measurement(
-    t, y, F, *, force_noise, motion_noise, seed, velocities=True, source="", notes=()
+    clean, *, force_noise, motion_noise, seed, velocities=True, source="", notes=()
 ):
-    """A :class:`~discovery.vibroimpact.data.measurement.Measurement` of the noise-free ``t, y, F``
-    with noise on every channel: ``F`` gets ``N(0, force_noise * max|F|)``, ``w1, w2, v1, v2``
-    each ``N(0, motion_noise * (max - min))`` of that channel, drawn by
+    """A :class:`~discovery.vibroimpact.data.measurement.Measurement` of the noise-free record
+    ``clean = (t, y, F, ...)`` (as :func:`clean_record` returns it) with noise on every
+    channel: ``F`` gets ``N(0, force_noise * max|F|)``, ``w1, w2, v1, v2`` each
+    ``N(0, motion_noise * (max - min))`` of that channel, drawn by
     ``numpy.random.default_rng(seed)`` in the order F, w1, w2, v1, v2."""
+    t, y, F = clean[:3]
     rng = np.random.default_rng(seed)
     n = t.size
     F = F + rng.normal(0.0, force_noise * float(np.max(np.abs(F))), n)
@@ -129,28 +133,22 @@ def noisy_measurement(
     return Measurement(np.array(t, dtype=float), F, channels, source=source, notes=tuple(notes))
 
 
-@params(
-    scenario=Scenario,
-    law=ForceLaw,
-    periods=Real(1, 1e5, integer=True),
-    fs=Real(0, 1e8, open_low=True),
-    transient=(None, Real(0, 1e5, integer=True)),
-    force_noise=Real(0, 1),
-    motion_noise=Real(0, 1),
-    seed=Real(0, integer=True),
-)
-def field_record(
-    scenario,
-    law,
-    *,
-    periods=12,
-    fs=10000.0,
-    transient=None,
-    force_noise=0.01,
-    motion_noise=0.001,
-    seed=0,
-    velocities=True,
-):
+@dataclass(frozen=True)
+class FieldRecordSettings(Settings):
+    """The options of :func:`field_record` (each is also a keyword of it)."""
+
+    periods: int = option(12, Real(1, 1e5, integer=True))
+    fs: float = option(10000.0, Real(0, 1e8, open_low=True))
+    transient: object = option(None, (None, Real(0, 1e5, integer=True)))
+    force_noise: float = option(0.01, Real(0, 1))
+    motion_noise: float = option(0.001, Real(0, 1))
+    seed: int = option(0, Real(0, integer=True))
+    velocities: bool = option(True)
+
+
+@takes(FieldRecordSettings)
+@params(scenario=Scenario, law=ForceLaw)
+def field_record(scenario, law, *, settings=None, **options):
     """A noisy record of ``law`` in ``scenario`` made by the scipy path from rest.
 
     Parameters
@@ -158,6 +156,8 @@ def field_record(
     scenario : Scenario
     law : ForceLaw
         The true law.
+    settings : FieldRecordSettings, optional
+        The options below in one object; keywords override its fields.
     periods : int
         Drive periods recorded after the transient.
     fs : float
@@ -176,24 +176,22 @@ def field_record(
     Measurement
         Times on the drive's clock; the first sample is at ``transient * T``.
     """
-    if transient is None:
-        transient = auto_transient(scenario, law)
-    transient, periods = int(transient), int(periods)
-    t, y, F, *_ = clean_record(scenario, law, periods, float(fs), transient)
+    s = FieldRecordSettings.of("field_record", settings, options)
+    transient = auto_transient(scenario, law) if s.transient is None else s.transient
+    transient, periods = int(transient), int(s.periods)
+    clean = clean_record(scenario, law, periods, float(s.fs), transient)
     notes = (
         f"reference_simulate from rest; transient {transient} periods "
         f"(rtol {RTOL_TRANSIENT:g}), recorded at rtol {RTOL_RECORD:g}",
-        f"noise: force {force_noise:g} of max|F|, motion {motion_noise:g} of each "
-        f"channel's range, seed {seed}",
+        f"noise: force {s.force_noise:g} of max|F|, motion {s.motion_noise:g} of each "
+        f"channel's range, seed {s.seed}",
     )
     return noisy_measurement(
-        t,
-        y,
-        F,
-        force_noise=force_noise,
-        motion_noise=motion_noise,
-        seed=seed,
-        velocities=velocities,
+        clean,
+        force_noise=s.force_noise,
+        motion_noise=s.motion_noise,
+        seed=s.seed,
+        velocities=s.velocities,
         source=f"reference:{scenario.name}",
         notes=notes,
     )

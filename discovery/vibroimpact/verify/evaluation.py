@@ -648,7 +648,7 @@ def _evaluate_span(
     verdict = _verdict(
         consistent, reg, imp, crit, fl["mean"], lim=lim, transient=transient_mismatch
     )
-    notes += transient_notes(transient_mismatch, settled, transient, reg, ss, why)
+    notes += transient_notes(transient_mismatch, settled, transient, reg, ss, why=why)
     if notes and verdict is not None:
         verdict = f"{verdict}; " + "; ".join(notes)
     found.update(

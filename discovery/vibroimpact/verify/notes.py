@@ -18,7 +18,7 @@ def _gap_text(transient, orbit):
     return f"over its last cycles it is I2 = {transient:.3g} from {orbit}"
 
 
-def transient_notes(transient_mismatch, settled, transient, reg, ss, why=""):
+def transient_notes(transient_mismatch, settled, transient, reg, ss, *, why=""):
     """What the verdict says when the law's trajectory from the measured state has not
     settled over the record's span (the law's trajectory, not the record), or when the law's
     steady orbit is unknown (``why``)."""
