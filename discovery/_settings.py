@@ -101,27 +101,51 @@ class Settings:
     def changed(self):
         """``{name: value}`` of the fields not at their default."""
         d = self.defaults()
-        return {n: getattr(self, n) for n in self.names() if getattr(self, n) != getattr(d, n)}
+        return {
+            n: getattr(self, n) for n in self.names() if not _same(getattr(self, n), getattr(d, n))
+        }
 
     def to_dict(self):
         """A JSON-safe ``{name: value}`` of every field."""
         from ._io import to_jsonable
 
-        return {n: to_jsonable(getattr(self, n)) for n in self.names()}
+        def plain(v):
+            return dataclasses.asdict(v) if dataclasses.is_dataclass(v) else v
+
+        return {n: to_jsonable(plain(getattr(self, n))) for n in self.names()}
 
     @classmethod
     def from_dict(cls, doc):
         """The settings a :meth:`to_dict` document holds (missing fields at their
-        default; lists back as tuples where the default is a tuple)."""
+        default; lists back as tuples where the default is a tuple; an object's fields
+        back as the object its spec names, e.g. a ``Tolerances``)."""
         d = cls.defaults()
         values = {}
-        for n in cls.names():
-            if n in doc:
-                v = doc[n]
-                values[n] = (
-                    tuple(v) if isinstance(getattr(d, n), tuple) and isinstance(v, list) else v
-                )
+        for f in cls._fields():
+            if f.name in doc:
+                v = doc[f.name]
+                if isinstance(getattr(d, f.name), tuple) and isinstance(v, list):
+                    v = tuple(v)
+                values[f.name] = _rebuilt(f.metadata.get("spec"), v)
         return dataclasses.replace(d, **values)
+
+
+def _same(a, b):
+    """Whether two field values are equal (an array against anything: only itself)."""
+    try:
+        return bool(a == b)
+    except (TypeError, ValueError):
+        return a is b
+
+
+def _rebuilt(spec, value):
+    """``value`` as the dataclass its spec allows, when it is that dataclass's fields."""
+    if not isinstance(value, dict):
+        return value
+    for kind in spec if isinstance(spec, tuple) else (spec,):
+        if isinstance(kind, type) and dataclasses.is_dataclass(kind):
+            return kind(**value)
+    return value
 
 
 def takes(cls):
