@@ -30,6 +30,7 @@ import numpy as np
 
 from .._printing import generic_lines, readable
 from .._result import Result
+from .._settings import Settings, option, takes
 from .._validate import Array, Real, params
 from ..errors import InputError
 from .polynomial import FORCING, MONOMIALS, TERMS, ForcedPolynomial
@@ -194,32 +195,22 @@ def _block_bootstrap(system, sup, ols_se, boot):
     return np.array(out).std(axis=0, ddof=1), chosen / int(boot.resamples), n_blocks, True
 
 
-@params(
-    t=Array(1),
-    x=Array(1),
-    B=Real(),
-    nu=Real(0, open_low=True),
-    threshold=Real(0),
-    half_width=(None, Real(1, integer=True)),
-    order=Real(1, integer=True),
-    bootstrap=Real(0, integer=True),
-    block_periods=Real(1, integer=True),
-    seed=Real(0, integer=True),
-)
-def discover(
-    t,
-    x,
-    B,
-    nu,
-    *,
-    threshold=0.02,
-    half_width=None,
-    order=4,
-    fit_forcing=True,
-    bootstrap=200,
-    block_periods=4,
-    seed=0,
-):
+@dataclass(frozen=True)
+class UedaDiscoverSettings(Settings):
+    """The options of :func:`discover` (each is also a keyword of it; see its parameters)."""
+
+    threshold: float = option(0.02, Real(0))
+    half_width: object = option(None, (None, Real(1, integer=True)))
+    order: int = option(4, Real(1, integer=True))
+    fit_forcing: bool = option(True)
+    bootstrap: int = option(200, Real(0, integer=True))
+    block_periods: int = option(4, Real(1, integer=True))
+    seed: int = option(0, Real(0, integer=True))
+
+
+@takes(UedaDiscoverSettings)
+@params(t=Array(1), x=Array(1), B=Real(), nu=Real(0, open_low=True))
+def discover(t, x, B, nu, *, settings=None, **options):
     """Recover ``x'' = f(x, x') + B cos(nu t)`` from a record (see the module docstring).
 
     Parameters
@@ -228,6 +219,8 @@ def discover(
         Uniformly sampled record (at least 64 samples, preferably >= 50 periods).
     B, nu : float
         The known forcing ``B cos(nu t)``.
+    settings : UedaDiscoverSettings, optional
+        The options below in one object; keywords override its fields.
     threshold : float
         STLSQ threshold on coefficients of unit-RMS columns (relative to the RMS of ``b``).
     half_width : int, optional
@@ -245,24 +238,25 @@ def discover(
     -------
     Discovery
     """
+    s = UedaDiscoverSettings.of("discover", settings, options)
     t0 = time.perf_counter()
     t, x, spp = check_forcing(t, x, B, nu)
     T = 2 * np.pi / nu
-    hs = window_half_width(t.size, spp, half_width)
-    if int(order) < 2:
-        raise InputError(f"order must be >= 2, got {order}")
+    hs = window_half_width(t.size, spp, s.half_width)
+    if int(s.order) < 2:
+        raise InputError(f"order must be >= 2, got {s.order}")
     sm = smooth(t, x, spp)
-    G, b, centres = weak_system(t, x, sm.v, B, nu, half_width=hs, order=int(order))
+    G, b, centres = weak_system(t, x, sm.v, B, nu, half_width=hs, order=int(s.order))
     nt = len(MONOMIALS)
-    if not fit_forcing:
+    if not s.fit_forcing:
         b = b - G[:, nt]
         G = G[:, :nt]
     keep = np.zeros(G.shape[1], bool)
-    if fit_forcing:
+    if s.fit_forcing:
         keep[nt] = True
     sb = float(np.sqrt(np.mean(b**2))) or 1.0
     bn = b / sb
-    c, sup = stlsq_gram(G.T @ G, G.T @ bn, G.shape[0], threshold=threshold, keep=keep)
+    c, sup = stlsq_gram(G.T @ G, G.T @ bn, G.shape[0], threshold=s.threshold, keep=keep)
     c = c * sb
     if not sup[:nt].any():
         raise InputError(
@@ -279,21 +273,21 @@ def discover(
         _WeakSystem(G, bn, sb, keep, centres),
         sup,
         ols_se,
-        _Bootstrap(bootstrap, block_periods * T, threshold, seed),
+        _Bootstrap(s.bootstrap, s.block_periods * T, s.threshold, s.seed),
     )
     coef = dict(zip([names[k] for k in sel], map(float, c[sel]), strict=True))
     ses = dict(zip([names[k] for k in sel], map(float, se), strict=True))
     oses = dict(zip([names[k] for k in sel], map(float, ols_se), strict=True))
-    if not fit_forcing:
+    if not s.fit_forcing:
         coef[FORCING], ses[FORCING], oses[FORCING] = 1.0, 0.0, 0.0
     model = ForcedPolynomial(tuple(c[:nt]), B, nu, coef[FORCING])
-    settings = {
-        "threshold": threshold,
+    recorded = {
+        "threshold": s.threshold,
         "half_width": hs,
-        "order": int(order),
-        "fit_forcing": bool(fit_forcing),
-        "bootstrap": int(bootstrap) if do_boot else 0,
-        "block_periods": block_periods,
+        "order": int(s.order),
+        "fit_forcing": bool(s.fit_forcing),
+        "bootstrap": int(s.bootstrap) if do_boot else 0,
+        "block_periods": s.block_periods,
         "samples_per_period": float(spp),
         "periods": float((t[-1] - t[0]) / T),
         "noise_sd": sm.noise_sd,
@@ -311,7 +305,7 @@ def discover(
         residual_rms=float(np.sqrt(np.mean(r**2) / np.mean(b**2))),
         n_windows=int(n_rows),
         n_blocks=n_blocks,
-        settings=settings,
+        settings=recorded,
         bootstrap_support=({names[k]: float(chosen[k]) for k in range(nt)} if do_boot else {}),
         seconds=time.perf_counter() - t0,
         smoothed=sm,

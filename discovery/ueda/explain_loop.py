@@ -41,6 +41,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .._settings import Settings, option, takes
 from .._validate import Array, Real, params
 from ..catalogue import select
 from ..errors import InputError
@@ -343,37 +344,28 @@ class _Loop:
         self.state = _State(new_terms, fit2, crit2, ver2)
 
 
-@params(
-    t=Array(1),
-    x=Array(1),
-    B=Real(),
-    nu=Real(0, open_low=True),
-    alpha=Real(0, 1, open_low=True),
-    max_iterations=Real(1, integer=True),
-    effects=(None, list, tuple),
-    seed=Real(0, integer=True),
-)
-def explain(
-    t,
-    x,
-    B,
-    nu,
-    start_terms=DEFAULT_START,
-    *,
-    alpha=0.01,
-    max_iterations=3,
-    effects=None,
-    half_width=None,
-    order=4,
-    fit_forcing=True,
-    noise=None,
-    simulate=True,
-    transient=200,
-    periods=2000,
-    resamples=200,
-    seed=0,
-    tolerances=None,
-):
+@dataclass(frozen=True)
+class UedaExplainSettings(Settings):
+    """The options of :func:`explain` (each is also a keyword of it; see its parameters)."""
+
+    alpha: float = option(0.01, Real(0, 1, open_low=True))
+    max_iterations: int = option(3, Real(1, integer=True))
+    effects: object = option(None, (None, list, tuple))
+    half_width: object = option(None)
+    order: int = option(4)
+    fit_forcing: bool = option(True)
+    noise: object = option(None)
+    simulate: bool = option(True)
+    transient: int = option(200)
+    periods: int = option(2000)
+    resamples: int = option(200)
+    seed: int = option(0, Real(0, integer=True))
+    tolerances: object = option(None)
+
+
+@takes(UedaExplainSettings)
+@params(t=Array(1), x=Array(1), B=Real(), nu=Real(0, open_low=True))
+def explain(t, x, B, nu, start_terms=DEFAULT_START, *, settings=None, **options):
     """Explain the gap between a start model and a record by named effects (see the
     module docstring).
 
@@ -386,6 +378,8 @@ def explain(
     start_terms : str or sequence of str
         Library terms of the start model (``"x',x^3"``: negres without the van der Pol
         damping, the default), see :func:`parse_terms`.
+    settings : UedaExplainSettings, optional
+        The options below in one object; keywords override its fields.
     alpha : float
         Family-wise level of the score tests (Bonferroni over the effects scored).
     max_iterations : int
@@ -409,29 +403,30 @@ def explain(
     -------
     Explanation
     """
+    s = UedaExplainSettings.of("explain", settings, options)
     t_start = time.perf_counter()
-    _check_settings(alpha, max_iterations, order, noise)
+    _check_settings(s.alpha, s.max_iterations, s.order, s.noise)
     start = parse_terms(start_terms)
-    catalogue = select(EFFECTS, effects)
+    catalogue = select(EFFECTS, s.effects)
     t, x, spp = check_forcing(t, x, B, nu)
     T = 2 * np.pi / nu
-    hs = window_half_width(t.size, spp, half_width)
+    hs = window_half_width(t.size, spp, s.half_width)
     sm = smooth(t, x, spp)
-    if noise is not None:
-        sm = replace(sm, noise_sd=float(noise * np.ptp(x)))
-    weak = WeakFits(t, x, sm, B=B, nu=nu, settings=WeakSettings(hs, int(order), fit_forcing))
+    if s.noise is not None:
+        sm = replace(sm, noise_sd=float(s.noise * np.ptp(x)))
+    weak = WeakFits(t, x, sm, B=B, nu=nu, settings=WeakSettings(hs, int(s.order), s.fit_forcing))
     measure = _Measure(
         weak=weak,
         t=t,
         x=x,
         sm=sm,
-        simulate=simulate,
+        simulate=s.simulate,
         verify_kwargs=dict(
-            transient=transient,
-            periods=periods,
-            resamples=resamples,
-            seed=seed,
-            tolerances=tolerances,
+            transient=s.transient,
+            periods=s.periods,
+            resamples=s.resamples,
+            seed=s.seed,
+            tolerances=s.tolerances,
         ),
     )
     fit = weak.fit(start)
@@ -439,24 +434,24 @@ def explain(
     loop = _Loop(
         weak,
         measure,
-        _Settings(tuple(catalogue), alpha, max_iterations, simulate),
+        _Settings(tuple(catalogue), s.alpha, s.max_iterations, s.simulate),
         _State(start, fit, crit, ver),
     )
     loop.run()
     final = loop.state
     coef, se = weak.coefficients(final.fit)
-    settings = {
-        "alpha": alpha,
-        "max_iterations": int(max_iterations),
+    recorded = {
+        "alpha": s.alpha,
+        "max_iterations": int(s.max_iterations),
         "effects": [e.id for e in catalogue],
         "half_width": hs,
-        "order": int(order),
-        "fit_forcing": bool(fit_forcing),
-        "simulate": bool(simulate),
-        "transient": transient,
-        "periods": periods,
-        "resamples": resamples,
-        "seed": seed,
+        "order": int(s.order),
+        "fit_forcing": bool(s.fit_forcing),
+        "simulate": bool(s.simulate),
+        "transient": s.transient,
+        "periods": s.periods,
+        "resamples": s.resamples,
+        "seed": s.seed,
         "samples_per_period": float(spp),
         "record_periods": float((t[-1] - t[0]) / T),
         "n_windows": int(weak.G.shape[0]),
@@ -479,7 +474,7 @@ def explain(
         consistent=final.crit.get("consistent"),
         stopped_because=loop.stopped,
         seconds=time.perf_counter() - t_start,
-        settings=settings,
+        settings=recorded,
         start_verification=ver,
         final_verification=final.ver,
     )

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._settings import Settings, option, takes
 from .._validate import Array, Real, Text, params
 from ..errors import InputError, IntegrationError
 from ..numerics.tolerances import Tolerances
@@ -84,28 +85,26 @@ def check_record(t, x, what="the record"):
     return t, x
 
 
+@dataclass(frozen=True)
+class UedaRecordSettings(Settings):
+    """The keyword options of :func:`simulate_record` (each is also a keyword of it)."""
+
+    transient: int = option(200, Real(0, integer=True))
+    y0: object = option(None, (None, Array(1)))
+    integrator: str = option("compiled", Text())
+    rtol: float = option(1e-10, Real(0, 1, open_low=True))
+
+
+@takes(UedaRecordSettings)
 @params(
     system=(UedaSystem, ForcedPolynomial),
     periods=Real(1, integer=True),
     samples_per_period=Real(4, integer=True),
     noise=Real(0),
     seed=Real(0, integer=True),
-    transient=Real(0, integer=True),
-    y0=(None, Array(1)),
-    integrator=Text(),
-    rtol=Real(0, 1, open_low=True),
 )
 def simulate_record(
-    system,
-    periods=200,
-    samples_per_period=40,
-    noise=0.0,
-    seed=0,
-    *,
-    transient=200,
-    y0=None,
-    integrator="compiled",
-    rtol=1e-10,
+    system, periods=200, samples_per_period=40, noise=0.0, seed=0, *, settings=None, **options
 ):
     """A synthetic record of ``system`` (a :class:`UedaSystem` or
     :class:`ForcedPolynomial`): ``(t, x_noisy, x_clean, v_clean)``.
@@ -115,40 +114,48 @@ def simulate_record(
     phase 0: the first sample is a strobe point).  Gaussian noise of standard deviation
     ``noise * (max x - min x)`` on ``x``.  ``integrator``: ``"compiled"`` (the
     :mod:`discovery.ueda` kernel, UedaSystem only) or ``"scipy"`` (``solve_ivp``,
-    DOP853, the independent path).
+    DOP853, the independent path).  ``settings`` (a :class:`UedaRecordSettings`) holds
+    ``transient``, ``y0``, ``integrator`` and ``rtol`` in one object; keywords override
+    its fields.
     """
+    s = UedaRecordSettings.of("simulate_record", settings, options)
     from scipy.integrate import solve_ivp
 
     T = system.period
     n = int(periods) * int(samples_per_period) + 1
     t = np.arange(n) * (T / int(samples_per_period))
-    y = np.array((0.1, 0.0) if y0 is None else y0, dtype=float)
-    if integrator == "compiled":
+    y = np.array((0.1, 0.0) if s.y0 is None else s.y0, dtype=float)
+    if s.integrator == "compiled":
         from .strobe import strobe_points, trajectory
 
         if not isinstance(system, UedaSystem):
             raise InputError("the compiled integrator simulates a UedaSystem; use scipy")
-        tol = Tolerances(rtol=rtol)
-        if transient > 0:
-            y = strobe_points(system, y, 1, transient=int(transient) - 1, tolerances=tol)[1]
+        tol = Tolerances(rtol=s.rtol)
+        if s.transient > 0:
+            y = strobe_points(system, y, 1, transient=int(s.transient) - 1, tolerances=tol)[1]
         # one period more than needed: the last sample may round past the last strobe time
         spp = int(samples_per_period)
         _, xc, vc = trajectory(system, y, (0.0, t[-1] + T), n_samples=n + spp, tolerances=tol)
         xc, vc = xc[:n], vc[:n]
-    elif integrator == "scipy":
-        if transient > 0:
+    elif s.integrator == "scipy":
+        if s.transient > 0:
             sol = solve_ivp(
-                system.rhs, (0.0, transient * T), y, method="DOP853", rtol=rtol, atol=rtol * 1e-2
+                system.rhs,
+                (0.0, s.transient * T),
+                y,
+                method="DOP853",
+                rtol=s.rtol,
+                atol=s.rtol * 1e-2,
             )
             y = sol.y[:, -1]
         sol = solve_ivp(
-            system.rhs, (0.0, t[-1]), y, method="DOP853", rtol=rtol, atol=rtol * 1e-2, t_eval=t
+            system.rhs, (0.0, t[-1]), y, method="DOP853", rtol=s.rtol, atol=s.rtol * 1e-2, t_eval=t
         )
         if sol.status != 0:
             raise IntegrationError(f"solve_ivp: {sol.message}")
         xc, vc = sol.y
     else:
-        raise InputError(f"integrator must be 'compiled' or 'scipy', got {integrator!r}")
+        raise InputError(f"integrator must be 'compiled' or 'scipy', got {s.integrator!r}")
     rng = np.random.default_rng(seed)
     xn = xc + float(noise) * np.ptp(xc) * rng.standard_normal(xc.size)
     return t, xn, xc, vc

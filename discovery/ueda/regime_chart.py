@@ -18,6 +18,7 @@ import numpy as np
 from .._printing import readable
 from .._progress import reports_progress, tick
 from .._result import Result
+from .._settings import Settings, option, takes
 from .._validate import Array, Instance, Real, params
 from ..errors import InputError, VidiTypeError
 from ..numerics.executor import make_executor
@@ -308,41 +309,34 @@ def _run_rows(system, settings, nu, B, *, workers, executor, progress):
     return grids, cpu, workers
 
 
+@dataclass(frozen=True)
+class UedaChartSettings(Settings):
+    """The options of :func:`chart` (each is also a keyword of it; see its parameters)."""
+
+    y0: object = option(None, (None, Array(1)))
+    transient: int = option(60, Real(0, integer=True))
+    periods: int = option(80, Real(1, integer=True))
+    rtol: float = option(1e-6, Real(0, 1, open_low=True))
+    hmax_fraction: float = option(0.1, Real(0, 1, open_low=True))
+    max_period: int = option(16, Real(1, integer=True))
+    closure: float = option(1e-4)
+    chaos_threshold: float = option(0.015)
+    sweeps: int = option(1)
+    early_exit: bool = option(True)
+    min_pairs: int = option(12)
+    recheck: int = option(5)
+    workers: object = option(None, (None, Real(1, integer=True)))
+
+
+@takes(UedaChartSettings)
 @params(
     system=UedaSystem,
     nu=Array(1),
     B=Array(1),
-    y0=(None, Array(1)),
-    transient=Real(0, integer=True),
-    periods=Real(1, integer=True),
-    rtol=Real(0, 1, open_low=True),
-    hmax_fraction=Real(0, 1, open_low=True),
-    max_period=Real(1, integer=True),
-    workers=(None, Real(1, integer=True)),
     executor=(None, Instance("discovery.numerics.executor", "Executor")),
 )
 @reports_progress
-def chart(
-    system,
-    nu,
-    B,
-    *,
-    y0=None,
-    transient=60,
-    periods=80,
-    rtol=1e-6,
-    hmax_fraction=0.1,
-    max_period=16,
-    closure=1e-4,
-    chaos_threshold=0.015,
-    sweeps=1,
-    early_exit=True,
-    min_pairs=12,
-    recheck=5,
-    workers=None,
-    progress=None,
-    executor=None,
-):
+def chart(system, nu, B, *, settings=None, progress=None, executor=None, **options):
     """The regime at every ``(nu, B)`` of a grid (see :mod:`discovery.ueda.sweep`).
 
     Parameters
@@ -351,6 +345,8 @@ def chart(
         Template: model and the other parameters.
     nu, B : array_like
         Strictly increasing axes (``nu > 0``).
+    settings : UedaChartSettings, optional
+        The options below in one object; keywords override its fields.
     y0 : (x, v), optional
         Start of every row.
     transient : int
@@ -390,31 +386,32 @@ def chart(
     -------
     Chart
     """
-    nu, B = _check_grid(system, nu, B, workers)
-    settings = {
-        "transient": int(transient),
-        "periods": int(periods),
-        "rtol": float(rtol),
-        "hmax_fraction": float(hmax_fraction),
-        "max_period": int(max_period),
-        "closure": float(closure),
-        "chaos_threshold": float(chaos_threshold),
-        "sweeps": int(sweeps),
-        "early_exit": bool(early_exit),
-        "min_pairs": int(min_pairs),
-        "recheck": int(recheck),
-        "y0": [float(v) for v in _y0(y0)],
+    s = UedaChartSettings.of("chart", settings, options)
+    nu, B = _check_grid(system, nu, B, s.workers)
+    recorded = {
+        "transient": int(s.transient),
+        "periods": int(s.periods),
+        "rtol": float(s.rtol),
+        "hmax_fraction": float(s.hmax_fraction),
+        "max_period": int(s.max_period),
+        "closure": float(s.closure),
+        "chaos_threshold": float(s.chaos_threshold),
+        "sweeps": int(s.sweeps),
+        "early_exit": bool(s.early_exit),
+        "min_pairs": int(s.min_pairs),
+        "recheck": int(s.recheck),
+        "y0": [float(v) for v in _y0(s.y0)],
         "continuation": "rows swept in increasing nu"
         + (
             ", then back in decreasing nu from the state the first sweep ended in"
-            if int(sweeps) == 2
+            if int(s.sweeps) == 2
             else ""
         ),
     }
-    _check_settings(settings)
+    _check_settings(recorded)
     t_start = time.perf_counter()
     grids, cpu, workers = _run_rows(
-        system, settings, nu, B, workers=workers, executor=executor, progress=progress
+        system, recorded, nu, B, workers=s.workers, executor=executor, progress=progress
     )
     return Chart(
         system=system,
@@ -422,7 +419,7 @@ def chart(
         B=B,
         seconds=time.perf_counter() - t_start,
         workers=workers,
-        settings=settings,
+        settings=recorded,
         cpu_seconds=cpu,
         **grids,
     )

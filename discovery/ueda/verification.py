@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._printing import generic_lines, readable
+from .._settings import Settings, option, takes
 from .._validate import Array, Real, params
 from ..errors import InputError, IntegrationError
 from ..numerics.tolerances import Tolerances
@@ -136,31 +137,22 @@ def _regime_match(rec, mod, lyap):
     return mod.kind == "beat"
 
 
-@params(
-    model=ForcedPolynomial,
-    t=Array(1),
-    x=Array(1),
-    smoothed=(None, Smoothed),
-    transient=Real(0, integer=True),
-    periods=Real(1, integer=True),
-    resamples=Real(0, integer=True),
-    seed=Real(0, integer=True),
-    tolerances=(Tolerances, None),
-)
-def verify(
-    model,
-    t,
-    x,
-    *,
-    smoothed=None,
-    transient=200,
-    periods=2000,
-    resamples=200,
-    seed=0,
-    tolerances=None,
-    floor="blocks",
-    block_periods=None,
-):
+@dataclass(frozen=True)
+class UedaVerifySettings(Settings):
+    """The options of :func:`verify` (each is also a keyword of it; see its docstring)."""
+
+    transient: int = option(200, Real(0, integer=True))
+    periods: int = option(2000, Real(1, integer=True))
+    resamples: int = option(200, Real(0, integer=True))
+    seed: int = option(0, Real(0, integer=True))
+    tolerances: object = option(None, (Tolerances, None))
+    floor: str = option("blocks")
+    block_periods: object = option(None)
+
+
+@takes(UedaVerifySettings)
+@params(model=ForcedPolynomial, t=Array(1), x=Array(1), smoothed=(None, Smoothed))
+def verify(model, t, x, *, smoothed=None, settings=None, **options):
     """Verify ``model`` (a :class:`ForcedPolynomial`) against the record ``(t, x)`` by
     simulation (see :class:`Verification`).
 
@@ -190,24 +182,30 @@ def verify(
     scale of the whole record, and differences smaller than the false-alarm rate allows on
     the record's length (duffing with ``k`` x0.8 or ``B`` x0.95 on 200 periods).  The
     rates behind these rules are in the CHANGELOG (Ueda: verification).
+
+    ``smoothed``: the record's smoothing (:func:`~discovery.ueda.record.smooth`), if made.
+    ``settings`` (a :class:`UedaVerifySettings`) holds the options ``transient``,
+    ``periods``, ``resamples``, ``seed``, ``tolerances``, ``floor`` and ``block_periods``
+    in one object; keywords override its fields.
     """
+    s = UedaVerifySettings.of("verify", settings, options)
     t_start = time.perf_counter()
-    if floor not in ("blocks", "halves"):
-        raise InputError(f"floor must be 'blocks' or 'halves', got {floor!r}")
+    if s.floor not in ("blocks", "halves"):
+        raise InputError(f"floor must be 'blocks' or 'halves', got {s.floor!r}")
     t, x, spp = check_forcing(t, x, model.B, model.nu)
     sm = smooth(t, x, spp) if smoothed is None else smoothed
     rs, ts = record_strobe_points(t, x, model.nu, sm)
     if len(rs) < 20:
         raise InputError(f"the record has {len(rs)} strobe points; need at least 20 periods")
-    scheme = floor_scheme(rs, floor, block_periods)
+    scheme = floor_scheme(rs, s.floor, s.block_periods)
     reg_rec = classify_record(rs, sm.noise_sd)
     record = {
         "regime_record": reg_rec.regime,
         "n_record_points": len(rs),
         "record_evidence": reg_rec.as_dict(),
-        "resamples": int(resamples),
+        "resamples": int(s.resamples),
         "record_strobe": rs,
-        "floor_method": floor,
+        "floor_method": s.floor,
         "floor_block_periods": scheme.block,
         "floor_correlation_lag": scheme.lag,
     }
@@ -216,14 +214,14 @@ def verify(
             model,
             rs[0],
             ts[0],
-            transient=transient,
-            periods=periods,
-            tolerances=tolerances or Tolerances(rtol=1e-8),
+            transient=s.transient,
+            periods=s.periods,
+            tolerances=s.tolerances or Tolerances(rtol=1e-8),
         )
     except IntegrationError as exc:
         return _diverged(record, str(exc), time.perf_counter() - t_start)
     reg_mod = classify_points(ms, model.scales(), lyap.value, lyap.stderr)
-    floor_s, test = energy_resamples(rs, ms, scheme, resamples, seed)
+    floor_s, test = energy_resamples(rs, ms, scheme, s.resamples, s.seed)
     ed, q95 = float(np.median(test)), float(np.quantile(floor_s, 0.95))
     agrees = _regime_match(reg_rec, reg_mod, lyap)
     e_ok = bool(ed <= q95)
