@@ -38,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from ..._settings import Settings, option, takes
 from ...errors import IntegrationError
 from ...numerics.status import STEP_BUDGET
 from ...numerics.status import message as status_message
@@ -334,20 +335,20 @@ class _Counted:
         )
 
 
-def reference_simulate(
-    scenario,
-    law,
-    t_span,
-    *,
-    y0=None,
-    t_eval=None,
-    rtol=1e-10,
-    atol=None,
-    method="DOP853",
-    max_events=100_000,
-    impact_v0=0.0,
-    max_nfev=MAX_NFEV,
-):
+@dataclass(frozen=True)
+class ReferenceSimulateSettings(Settings):
+    """The options of :func:`reference_simulate` (each is also a keyword of it)."""
+
+    rtol: float = option(1e-10)
+    atol: object = option(None)
+    method: str = option("DOP853")
+    max_events: int = option(100_000)
+    impact_v0: float = option(0.0)
+    max_nfev: int = option(MAX_NFEV)
+
+
+@takes(ReferenceSimulateSettings)
+def reference_simulate(scenario, law, t_span, *, y0=None, t_eval=None, settings=None, **options):
     """Simulate with scipy, restarting at events.
 
     A law scaled by each impact's approach velocity (``law.impact_scaled``) is integrated
@@ -358,6 +359,26 @@ def reference_simulate(
     one allowance) are allowed: beyond them the run raises
     :class:`~discovery.errors.IntegrationError` (the step budget, like the kernel's).
 
+    Parameters
+    ----------
+    scenario : Scenario
+    law : ForceLaw
+    t_span : (float, float)
+        Start and end time [s].
+    y0 : array_like of shape (4,), optional
+        Initial ``w1, v1, w2, v2``; default :meth:`Scenario.initial_state`.
+    t_eval : array_like, optional
+        Output times.
+    settings : ReferenceSimulateSettings, optional
+        The options below in one object; keywords override its fields.
+    rtol, atol, method
+        scipy's ``solve_ivp`` settings (``atol`` default ``rtol * 1e-3`` of the state's
+        scales).
+    max_events : int
+        Events allowed before the run raises.
+    impact_v0, max_nfev
+        As above.
+
     Returns
     -------
     dict
@@ -365,24 +386,26 @@ def reference_simulate(
         ``(t, kind, y)``; ``y_final``; ``m2_final`` (the moulding's mass at the end: less
         than the scenario's after impacts with a ``mass_loss``); ``nfev``.
     """
+    s = ReferenceSimulateSettings.of("reference_simulate", settings, options)
     state = {"m2": scenario.m2, "zmax": 0.0, "law": law}
     if law.impact_scaled:
-        state["law"] = law.at_impact(impact_v0) if impact_v0 > 0 else None
+        state["law"] = law.at_impact(s.impact_v0) if s.impact_v0 > 0 else None
     T = scenario.period
     y = scenario.initial_state() if y0 is None else np.array(y0, dtype=float)
+    atol = s.atol
     if atol is None:
         x, v = scenario.scales()
-        atol = rtol * 1e-3 * np.array([x, v, x, v])
+        atol = s.rtol * 1e-3 * np.array([x, v, x, v])
     t, t1 = float(t_span[0]), float(t_span[1])
     te = np.zeros(0) if t_eval is None else np.asarray(t_eval, dtype=float)
     samples = _Samples.at(te)
     mode = _mode_of(law, y, state)
     events, nfev, zero_length = [], 0, 0
-    counted = _Counted(int(max_nfev) * (1 + int((t1 - t) / (100.0 * T))))
+    counted = _Counted(int(s.max_nfev) * (1 + int((t1 - t) / (100.0 * T))))
 
     def record(kind, yy):
         events.append((t, kind, yy.copy()))
-        if len(events) > max_events:
+        if len(events) > s.max_events:
             raise IntegrationError("reference integration: too many events")
 
     while t < t1:
@@ -408,8 +431,8 @@ def reference_simulate(
                 counted(rhs),
                 (t, t1),
                 y,
-                method=method,
-                rtol=rtol,
+                method=s.method,
+                rtol=s.rtol,
                 atol=atol,
                 events=_held_events(evs, on, g0, t, tau_on),
                 dense_output=True,

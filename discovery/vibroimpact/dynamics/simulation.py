@@ -5,6 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._compile import announce_compile
+from ..._settings import Settings, option, takes
 from ..._validate import Array, Choice, Real, params
 from ...errors import InputError, IntegrationError
 from ...numerics.status import message as status_message
@@ -234,37 +235,30 @@ def _atol(scenario, tol):
     return tol.atol([x, v, x, v])
 
 
+@dataclass(frozen=True)
+class SimulateSettings(Settings):
+    """The options of :func:`simulate` (each is also a keyword of it; see its parameters)."""
+
+    tolerances: object = option(None, (Tolerances, None))
+    max_events: int = option(10_000, Real(1, integer=True))
+    mode0: object = option(None)
+    throw: bool = option(True)
+    zeta_max0: float = option(0.0, Real(0))
+    impact_v0: float = option(0.0, Real(0))
+    sensitivities: object = option(None, (None, Choice(*SENSITIVITIES)))
+    control_sensitivities: bool = option(True, bool)
+    sensitivity_start: object = option(None, (None, Array(2)))
+
+
+@takes(SimulateSettings)
 @params(
     scenario=Scenario,
     law=ForceLaw,
     t_span=Array(1),
     y0=(None, Array(1)),
     t_eval=(None, Array(1)),
-    tolerances=(Tolerances, None),
-    max_events=Real(1, integer=True),
-    zeta_max0=Real(0),
-    impact_v0=Real(0),
-    sensitivities=(None, Choice(*SENSITIVITIES)),
-    control_sensitivities=bool,
-    sensitivity_start=(None, Array(2)),
 )
-def simulate(
-    scenario,
-    law,
-    t_span,
-    y0=None,
-    t_eval=None,
-    *,
-    tolerances=None,
-    max_events=10_000,
-    mode0=None,
-    throw=True,
-    zeta_max0=0.0,
-    impact_v0=0.0,
-    sensitivities=None,
-    control_sensitivities=True,
-    sensitivity_start=None,
-):
+def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **options):
     """Integrate the two-body vibro-impact system with a given contact law.
 
     Parameters
@@ -279,6 +273,8 @@ def simulate(
         Initial ``w1, v1, w2, v2``; default :meth:`Scenario.initial_state`.
     t_eval : array_like of shape (n,), optional
         Sorted output times within ``t_span`` (dense output, no extra steps).
+    settings : SimulateSettings, optional
+        The options below in one object; keywords override its fields.
     tolerances : Tolerances, optional
     max_events : int
         How many events to record (all are located regardless).
@@ -311,9 +307,10 @@ def simulate(
     -------
     Trajectory
     """
+    s = SimulateSettings.of("simulate", settings, options)
     if y0 is not None and np.size(y0) != 4:
         raise InputError(f"simulate: y0 must be the 4 states (w1, v1, w2, v2); got {np.size(y0)}")
-    tol = tolerances or Tolerances()
+    tol = s.tolerances or Tolerances()
     t0, t1 = (float(v) for v in t_span)
     if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
         raise InputError(f"t_span must be two finite times with t1 > t0, got {t_span!r}")
@@ -321,31 +318,31 @@ def simulate(
     te = np.zeros(0) if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
     if te.size and (np.any(np.diff(te) < 0) or te[0] < t0 - 1e-12 or te[-1] > t1 + 1e-12):
         raise InputError("t_eval must be sorted and inside t_span")
-    bufs = _buffers(te.size, max_events)
+    bufs = _buffers(te.size, s.max_events)
     out_y, out_f, out_m, ev_t, ev_k, ev_y, ev_m = bufs
     period = scenario.period
     p = kernel_params(scenario, law, tol)
-    p[K.P_ZMAX] = float(zeta_max0)
-    v0_start = float(impact_v0) if impact_v0 > 0 else abs(float(y0[1] - y0[3]))
+    p[K.P_ZMAX] = float(s.zeta_max0)
+    v0_start = float(s.impact_v0) if s.impact_v0 > 0 else abs(float(y0[1] - y0[3]))
     p[K.P_V0] = v0_start
-    if sensitivities is None:
+    if s.sensitivities is None:
         sens, names = no_sensitivities(), ()
     else:
         sens, names = sensitivity_setup(
             scenario,
             law,
-            sensitivities,
+            s.sensitivities,
             n_eval=te.size,
-            n_events=max_events,
-            controlled=control_sensitivities,
-            start=sensitivity_start,
+            n_events=s.max_events,
+            controlled=s.control_sensitivities,
+            start=s.sensitivity_start,
         )
     announce_compile("vibro-impact")
     status, tf, yf, mf, n_steps, n_ev, _ = K.integrate(
         t0,
         t1,
         y0,
-        -1 if mode0 is None else int(mode0),
+        -1 if s.mode0 is None else int(s.mode0),
         p,
         *law.kernel_arrays(),
         tol.rtol,
@@ -362,9 +359,9 @@ def simulate(
         if status == 0
         else (f"integration stopped at t = {tf:.6g} s: {status_message(status, _HINTS)}")
     )
-    if status and throw:
+    if status and s.throw:
         raise IntegrationError(message)
-    n_keep = min(n_ev, max_events)
+    n_keep = min(n_ev, s.max_events)
     ok_out = te <= tf if status else slice(None)
     return Trajectory(
         t=te[ok_out],
@@ -381,7 +378,7 @@ def simulate(
         n_steps=int(n_steps),
         status=int(status),
         message=message,
-        zeta_max0=float(zeta_max0),
+        zeta_max0=float(s.zeta_max0),
         impact_v0=v0_start,
         sensitivity=sens[0] if names else None,
         force_sensitivity=sens[3][: len(names), ok_out] if names else None,

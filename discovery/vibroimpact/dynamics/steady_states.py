@@ -22,6 +22,7 @@ import numpy as np
 from ..._compile import announce_compile
 from ..._printing import fmt, readable
 from ..._result import Result
+from ..._settings import Settings, option, takes
 from ..._validate import Array, Instance, Real, params
 from ...errors import InputError, IntegrationError
 from ...numerics.shooting import (
@@ -341,39 +342,34 @@ def _orbit(pm, y, n, t0, *, tol, max_newton, attempt, evidence):
     )
 
 
-@params(
-    scenario=Scenario,
-    law=ForceLaw,
-    transient=Real(0, integer=True),
-    max_period=Real(1, 64, integer=True),
-    tol=Real(0, 1, open_low=True),
-    max_newton=Real(1, integer=True),
-    long_transient=Real(0, integer=True),
-    tolerances=(Tolerances, None),
-    y_start=(None, Array(1)),
-    t_start=Real(),
-    guess=(None, Instance("discovery.vibroimpact.dynamics.steady_states", "SteadyState")),
-)
-def steady_state(
-    scenario,
-    law,
-    *,
-    transient=30,
-    max_period=8,
-    tol=1e-8,
-    max_newton=12,
-    long_transient=300,
-    tolerances=None,
-    y_start=None,
-    t_start=0.0,
-    guess=None,
-):
+@dataclass(frozen=True)
+class SteadyStateSettings(Settings):
+    """The options of :func:`steady_state` (each is also a keyword of it; see its parameters)."""
+
+    transient: int = option(30, Real(0, integer=True))
+    max_period: int = option(8, Real(1, 64, integer=True))
+    tol: float = option(1e-8, Real(0, 1, open_low=True))
+    max_newton: int = option(12, Real(1, integer=True))
+    long_transient: int = option(300, Real(0, integer=True))
+    tolerances: object = option(None, (Tolerances, None))
+    y_start: object = option(None, (None, Array(1)))
+    t_start: float = option(0.0, Real())
+    guess: object = option(
+        None, (None, Instance("discovery.vibroimpact.dynamics.steady_states", "SteadyState"))
+    )
+
+
+@takes(SteadyStateSettings)
+@params(scenario=Scenario, law=ForceLaw)
+def steady_state(scenario, law, *, settings=None, **options):
     """Find the periodic steady state reached from a given (or the scenario's) state.
 
     Parameters
     ----------
     scenario : Scenario
     law : ForceLaw
+    settings : SteadyStateSettings, optional
+        The options below in one object; keywords override its fields.
     transient : int
         Drive periods integrated before the period search.
     max_period : int
@@ -411,6 +407,7 @@ def steady_state(
         When a simulation fails (blow-up, step budget): a failure is never reported
         as the physical regime "nonperiodic".
     """
+    s = SteadyStateSettings.of("steady_state", settings, options)
     if scenario.mass_loss > 0:
         raise InputError(
             f"scenario {scenario.name!r} sheds {scenario.mass_loss:g} of the "
@@ -418,38 +415,38 @@ def steady_state(
             "simulate it from rest (vidi simulate --from-rest) or set "
             "mass_loss = 0"
         )
-    pm = StroboscopicMap(scenario, law, tolerances)
-    if guess is not None and guess.periodic and not law.has_memory:
-        cont = _continued(scenario, law, pm, guess, tol)
+    pm = StroboscopicMap(scenario, law, s.tolerances)
+    if s.guess is not None and s.guess.periodic and not law.has_memory:
+        cont = _continued(scenario, law, pm, s.guess, s.tol)
         if cont is not None:
             return cont
-    y = scenario.initial_state() if y_start is None else np.asarray(y_start, dtype=float)
+    y = scenario.initial_state() if s.y_start is None else np.asarray(s.y_start, dtype=float)
     T = scenario.period
-    evidence = {"attempts": [], "t_start": float(t_start)}
-    k0 = int(np.ceil(t_start / T - 1e-9))
-    if abs(t_start - k0 * T) > 1e-12 * T:
+    evidence = {"attempts": [], "t_start": float(s.t_start)}
+    k0 = int(np.ceil(s.t_start / T - 1e-9))
+    if abs(s.t_start - k0 * T) > 1e-12 * T:
         # integrate to the next strobe time (drive phase 0)
-        tr = simulate(scenario, law, (t_start, k0 * T), y0=y, tolerances=pm.tol)
+        tr = simulate(scenario, law, (s.t_start, k0 * T), y0=y, tolerances=pm.tol)
         y = tr.y_final
     t_done = k0
-    for phase, n_trans in (("transient", transient), ("long-transient", long_transient)):
+    for phase, n_trans in (("transient", s.transient), ("long-transient", s.long_transient)):
         y = pm.advance(y, n_trans)
         t_done += n_trans
-        y, periods, dist, quick = _strobe_recurrence(pm, y, max_period)
+        y, periods, dist, quick = _strobe_recurrence(pm, y, s.max_period)
         t_done += periods
         order = sorted(dist, key=lambda n: (dist[n] > 1e-2, n if dist[n] <= 1e-2 else dist[n]))
         attempt = {"phase": phase, "recurrence": dist, "tried": []}
         evidence["attempts"].append(attempt)
         if quick < 1e-2:
-            order = [1] + [n for n in range(2, max_period + 1)][:2]
+            order = [1] + [n for n in range(2, s.max_period + 1)][:2]
         for n in order[:3]:
             found = _orbit(
                 pm,
                 y,
                 n,
                 t_done * T,
-                tol=tol,
-                max_newton=max_newton,
+                tol=s.tol,
+                max_newton=s.max_newton,
                 attempt=attempt,
                 evidence=evidence,
             )

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..._result import Result
+from ..._settings import Settings, option, takes
 from ..._validate import Choice, Real, params
 from ...errors import InputError
 from ..data.measurement import STATE_COLUMNS, Measurement
@@ -79,36 +80,32 @@ class SimulatedRecord(Result):
         return f"simulated record of {self.law} ({self.samples} samples)"
 
 
-@params(
-    scenario=Scenario,
-    law=ForceLaw,
-    periods=Real(1, integer=True),
-    fs=Real(0, open_low=True),
-    noise=Real(0, 1),
-    seed=Real(0, integer=True),
-    position_noise=Real(0, 1),
-    integrator=Choice("compiled", "scipy"),
-)
-def synthesize(
-    scenario,
-    law,
-    *,
-    periods=20,
-    fs=20000.0,
-    noise=0.0,
-    seed=0,
-    ss=None,
-    from_rest=False,
-    position_noise=0.0,
-    velocities=True,
-    integrator="compiled",
-):
+@dataclass(frozen=True)
+class SynthesizeSettings(Settings):
+    """The options of :func:`synthesize` (each is also a keyword of it; see its parameters)."""
+
+    periods: int = option(20, Real(1, integer=True))
+    fs: float = option(20000.0, Real(0, open_low=True))
+    noise: float = option(0.0, Real(0, 1))
+    seed: int = option(0, Real(0, integer=True))
+    ss: object = option(None)
+    from_rest: bool = option(False)
+    position_noise: float = option(0.0, Real(0, 1))
+    velocities: bool = option(True)
+    integrator: str = option("compiled", Choice("compiled", "scipy"))
+
+
+@takes(SynthesizeSettings)
+@params(scenario=Scenario, law=ForceLaw)
+def synthesize(scenario, law, *, settings=None, **options):
     """A synthetic measurement of ``law`` sampled at ``fs``.
 
     Parameters
     ----------
     scenario : Scenario
     law : ForceLaw
+    settings : SynthesizeSettings, optional
+        The options below in one object; keywords override its fields.
     periods : int
         Drive periods recorded.
     fs : float
@@ -137,19 +134,20 @@ def synthesize(
     -------
     Measurement
     """
-    if not (periods >= 1 and fs > 0 and noise >= 0 and position_noise >= 0):
+    s = SynthesizeSettings.of("synthesize", settings, options)
+    if not (s.periods >= 1 and s.fs > 0 and s.noise >= 0 and s.position_noise >= 0):
         raise InputError("periods must be >= 1, fs > 0 and the noise levels >= 0")
-    if not periods * scenario.period * fs <= MAX_SAMPLES:
+    if not s.periods * scenario.period * s.fs <= MAX_SAMPLES:
         raise InputError(
-            f"synthesize: periods = {periods} at fs = {fs:g} Hz is "
-            f"{periods * scenario.period * fs:.3g} samples; the limit is {MAX_SAMPLES:.0e}"
+            f"synthesize: periods = {s.periods} at fs = {s.fs:g} Hz is "
+            f"{s.periods * scenario.period * s.fs:.3g} samples; the limit is {MAX_SAMPLES:.0e}"
         )
-    n = int(round(periods * scenario.period * fs))
-    t = np.arange(n) / fs
-    if from_rest:
+    n = int(round(s.periods * scenario.period * s.fs))
+    t = np.arange(n) / s.fs
+    if s.from_rest:
         span, y0, t_eval, zmax0, v0 = (0.0, t[-1]), None, t, 0.0, 0.0
     else:
-        ss = ss or steady_state(scenario, law)
+        ss = s.ss or steady_state(scenario, law)
         if not ss.periodic:
             raise InputError(
                 f"law '{law}' has no periodic steady state in scenario "
@@ -158,7 +156,7 @@ def synthesize(
             )
         span, y0, t_eval, zmax0 = (ss.t0, ss.t0 + t[-1]), ss.y0, ss.t0 + t, ss.zeta_max0
         v0 = ss.impact_v0
-    if integrator == "scipy":
+    if s.integrator == "scipy":
         if zmax0 and law.permanent_set:
             raise InputError(
                 "the scipy path records a law with a permanent set from rest "
@@ -171,20 +169,20 @@ def synthesize(
     else:
         tr = simulate(scenario, law, span, y0=y0, t_eval=t_eval, zeta_max0=zmax0, impact_v0=v0)
         force, states = tr.force, tr.y
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(s.seed)
     F = force.copy()
-    if noise > 0:
-        F = F + rng.normal(0.0, noise * float(np.max(F)), size=F.shape)
+    if s.noise > 0:
+        F = F + rng.normal(0.0, s.noise * float(np.max(F)), size=F.shape)
     ch = dict(zip(STATE_COLUMNS, (v.copy() for v in states), strict=True))
-    if position_noise > 0:
-        sd = position_noise * float(np.max(ch["w1"] - ch["w2"]))  # of the largest penetration
+    if s.position_noise > 0:
+        sd = s.position_noise * float(np.max(ch["w1"] - ch["w2"]))  # of the largest penetration
         ch["w1"] += rng.normal(0.0, sd, n)
         ch["w2"] += rng.normal(0.0, sd, n)
-    if not velocities:
+    if not s.velocities:
         del ch["v1"], ch["v2"]
     return Measurement(
         t,
         F,
         ch,
-        source=f"synthetic:{scenario.name}" + (" (scipy path)" if integrator == "scipy" else ""),
+        source=f"synthetic:{scenario.name}" + (" (scipy path)" if s.integrator == "scipy" else ""),
     )

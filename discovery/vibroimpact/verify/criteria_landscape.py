@@ -25,6 +25,7 @@ import numpy as np
 from ..._printing import fmt, readable
 from ..._progress import reports_progress, tick
 from ..._result import Result
+from ..._settings import Settings, option, takes
 from ..._validate import Array, Instance, Real, params
 from ...errors import InputError, VidiError, VidiTypeError
 from ...numerics.executor import make_executor
@@ -353,14 +354,23 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
     return fl["mean"], fl["q95"], f"the measured cycle ({why})"
 
 
+@dataclass(frozen=True)
+class LandscapeSettings(Settings):
+    """The options of :func:`landscape` (each is also a keyword of it; see its parameters)."""
+
+    workers: object = option(None, (None, Real(1, integer=True)))
+    tolerances: object = option(None, (Tolerances, None))
+    from_state: bool = option(True)
+    continuation: bool = option(True)
+
+
+@takes(LandscapeSettings)
 @params(
     scenario=Scenario,
     law=ForceLaw,
     axis0=Array(1),
     axis1=Array(1),
     reference=(None, Reference, Impulse),
-    workers=(None, Real(1, integer=True)),
-    tolerances=(Tolerances, None),
     executor=(None, Instance("discovery.numerics.executor", "Executor")),
 )
 @reports_progress
@@ -371,12 +381,10 @@ def landscape(
     axis1,
     reference=None,
     *,
-    workers=None,
-    tolerances=None,
-    from_state=True,
+    settings=None,
     progress=None,
     executor=None,
-    continuation=True,
+    **options,
 ):
     """Compute all criteria over a grid of the first two coefficients of ``law``.
 
@@ -392,6 +400,8 @@ def landscape(
         What every point is compared with: a measured record
         (:meth:`Reference.from_measurement`) or an exact impulse
         (:meth:`Reference.exact`); default the exact impulse of ``scenario.law``.
+    settings : LandscapeSettings, optional
+        The options below in one object; keywords override its fields.
     workers : int, optional
         Processes (default: all cores); the result does not depend on it.
     tolerances : Tolerances, optional
@@ -404,11 +414,15 @@ def landscape(
     executor : Executor, optional
         Where the rows run (:mod:`discovery.numerics.executor`: serial, a process pool, a Dask
         cluster); overrides ``workers`` and is not closed here.  One task per row.
+    continuation : bool
+        Start each point's steady state from its neighbours' orbit along a row (default),
+        falling back on the cold search; False: every point from the cold search.
 
     Returns
     -------
     Landscape
     """
+    s = LandscapeSettings.of("landscape", settings, options)
     if len(law.terms) < 2:
         raise InputError(
             f"a landscape varies two coefficients but the law '{law}' has "
@@ -417,8 +431,8 @@ def landscape(
         )
     axis0 = _axis(axis0, "axis0")
     axis1 = _axis(axis1, "axis1")
-    if workers is not None and int(workers) < 1:
-        raise InputError(f"workers must be at least 1, got {workers!r}")
+    if s.workers is not None and int(s.workers) < 1:
+        raise InputError(f"workers must be at least 1, got {s.workers!r}")
     t_start = time.perf_counter()
     if reference is None:
         if scenario.law is None:
@@ -426,7 +440,7 @@ def landscape(
                 f"scenario {scenario.name!r} has no reference law; add [law] text "
                 "or compare with a measured record"
             )
-        imp = response(scenario, scenario.law, tolerances=tolerances).impulse
+        imp = response(scenario, scenario.law, tolerances=s.tolerances).impulse
         if imp is None:
             raise InputError(
                 f"the reference law '{scenario.law}' has no periodic steady state with contact"
@@ -438,12 +452,12 @@ def landscape(
             "with Reference.exact(impulse) or prepare a record with "
             "Reference.from_measurement(measurement, scenario)"
         )
-    floor, q95, under = _floor_once(scenario, law, reference, tolerances, from_state)
+    floor, q95, under = _floor_once(scenario, law, reference, s.tolerances, s.from_state)
     ref = _FixedFloor(
         **{f.name: getattr(reference, f.name) for f in fields(Reference)},
         fixed_floor={"mean": floor, "q95": q95, "n_boot": reference.n_boot, "seed": reference.seed},
     )
-    workers = min(int(workers or os.cpu_count() or 1), axis0.size)
+    workers = min(int(s.workers or os.cpu_count() or 1), axis0.size)
     shape = (axis0.size, axis1.size)
     regime = np.empty(shape, dtype=object)
     impacts = np.full(shape, -1, dtype=int)
@@ -451,7 +465,7 @@ def landscape(
     messages = np.full(shape, "", dtype=object)
     values = {n: np.full(shape, np.nan) for n in CRITERIA}
     jobs = [(v0, axis1) for v0 in axis0]
-    context = (scenario, law, ref, tolerances, from_state, bool(continuation))
+    context = (scenario, law, ref, s.tolerances, s.from_state, bool(s.continuation))
     own = executor is None
     ex = make_executor(workers) if own else executor
     try:
@@ -472,7 +486,7 @@ def landscape(
         "regime": reference.regime,
         "impacts": reference.impacts,
         "start": "measured state"
-        if from_state and reference.start is not None
+        if s.from_state and reference.start is not None
         else "scenario initial state",
     }
     return Landscape(
@@ -489,5 +503,5 @@ def landscape(
         noise_floor_q95=dict(q95),
         noise_floor_under=under,
         reference=info,
-        continuation=bool(continuation),
+        continuation=bool(s.continuation),
     )
