@@ -69,6 +69,13 @@ _EXPORTS = {
     "parse_law": "vibroimpact.model.contact_models",
     "ContactModelsResult": "vibroimpact.fit.contact_fit",
     "fit_contact_models": "vibroimpact.fit.contact_fit",
+    "DiscoverSettings": "vibroimpact.fit.discovery",
+    "SimulateSettings": "vibroimpact.dynamics",
+    "SteadyStateSettings": "vibroimpact.dynamics.steady_states",
+    "SynthesizeSettings": "vibroimpact.dynamics.synthetic",
+    "LandscapeSettings": "vibroimpact.verify.criteria_landscape",
+    "FieldRecordSettings": "vibroimpact.studies.records",
+    "AdviseSettings": "vibroimpact.advise.search",
 }
 
 
@@ -131,6 +138,13 @@ __all__ = [
     "Knobs",
     "NoiseModel",
     "SafeRegion",
+    "DiscoverSettings",
+    "SimulateSettings",
+    "SteadyStateSettings",
+    "SynthesizeSettings",
+    "LandscapeSettings",
+    "FieldRecordSettings",
+    "AdviseSettings",
 ]
 
 lazy_package(__name__, _EXPORTS)

@@ -143,6 +143,29 @@ CASES = [
     ),
     ("load path number", lambda: d.load(5), TYPE, "path"),
     ("load path missing", lambda: d.load("no-such-run-dir"), VALUE, "no-such-run-dir"),
+    # the settings objects: each field checked when made, an unknown keyword named
+    ("DiscoverSettings max_terms 0", lambda: d.DiscoverSettings(max_terms=0), VALUE, "max_terms"),
+    ("discover unknown keyword", lambda: d.discover(SC, REC, shortlst=2), TYPE, "shortlst"),
+    ("discover settings dict", lambda: d.discover(SC, REC, settings={}), TYPE, "settings"),
+    ("SimulateSettings max_events", lambda: d.SimulateSettings(max_events=-1), VALUE, "max_events"),
+    (
+        "SteadyStateSettings max_period 0",
+        lambda: d.SteadyStateSettings(max_period=0),
+        VALUE,
+        "max_period",
+    ),
+    ("SynthesizeSettings fs 0", lambda: d.SynthesizeSettings(fs=0), VALUE, "fs"),
+    ("LandscapeSettings workers 0", lambda: d.LandscapeSettings(workers=0), VALUE, "workers"),
+    ("FieldRecordSettings seed -1", lambda: d.FieldRecordSettings(seed=-1), VALUE, "seed"),
+    ("AdviseSettings workers text", lambda: d.AdviseSettings(workers="a"), VALUE, "workers"),
+    ("IdentifySettings xtol text", lambda: d.IdentifySettings(xtol="a"), VALUE, "xtol"),
+    ("ExplainSettings alpha 2", lambda: d.ExplainSettings(alpha=2.0), VALUE, "alpha"),
+    (
+        "ueda UedaChartSettings periods 0",
+        lambda: osc.UedaChartSettings(periods=0),
+        VALUE,
+        "periods",
+    ),
 ]
 
 
@@ -273,6 +296,15 @@ def test_the_cases_cover_every_public_entry():
             "ContactModel",
             "parse_law",
             "fit_contact_models",
+            "DiscoverSettings",
+            "SimulateSettings",
+            "SteadyStateSettings",
+            "SynthesizeSettings",
+            "LandscapeSettings",
+            "FieldRecordSettings",
+            "AdviseSettings",
+            "IdentifySettings",
+            "ExplainSettings",
         }
     )
     assert not unlisted, f"public entries without a row: {sorted(unlisted)}"

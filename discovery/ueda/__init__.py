@@ -62,6 +62,11 @@ _EXPORTS = {
     "periodic_orbit": "periodic",
     "MODELS": "system",
     "UedaSystem": "system",
+    "UedaRecordSettings": "record",
+    "UedaVerifySettings": "verification",
+    "UedaChartSettings": "regime_chart",
+    "UedaDiscoverSettings": "equation_discovery",
+    "UedaExplainSettings": "explain_loop",
 }
 
 __all__ = list(_EXPORTS)

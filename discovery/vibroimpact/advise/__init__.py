@@ -9,6 +9,7 @@ from ..._lazy import lazy_package
 
 _EXPORTS = {
     "advise": "search",
+    "AdviseSettings": "search",
     "AdviseResult": "result",
     "Knobs": "candidates",
     "NoiseModel": "candidates",
@@ -23,6 +24,7 @@ _EXPORTS = {
 
 __all__ = [
     "advise",
+    "AdviseSettings",
     "AdviseResult",
     "Knobs",
     "NoiseModel",

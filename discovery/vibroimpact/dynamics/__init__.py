@@ -2,10 +2,18 @@
 the shooting and Floquet multipliers shared with Ueda's oscillators (:mod:`.shooting`)."""
 
 from ...numerics.shooting import PeriodMap, floquet_multipliers, newton_orbit, smallest_period
-from .simulation import EVENT_NAMES, MODE_NAMES, Tolerances, Trajectory, simulate
+from .simulation import (
+    EVENT_NAMES,
+    MODE_NAMES,
+    SimulateSettings,
+    Tolerances,
+    Trajectory,
+    simulate,
+)
 
 __all__ = [
     "simulate",
+    "SimulateSettings",
     "Trajectory",
     "Tolerances",
     "MODE_NAMES",
