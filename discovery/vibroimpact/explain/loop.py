@@ -38,10 +38,12 @@ One iteration (:func:`explain`):
 
 import time
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..._progress import reports_progress, tick
+from ..._settings import Settings, option, takes
 from ..._validate import Choice, Instance, Real, Text, params
 from ...catalogue import select
 from ...errors import InputError, IntegrationError
@@ -357,23 +359,30 @@ def _intervals(run, n_boot_intervals, seed, progress, refit="two-step"):
         return None
 
 
+@dataclass(frozen=True)
+class ExplainSettings(Settings):
+    """The options of :func:`explain` (each is also a keyword of it; see its parameters)."""
+
+    criterion: str = option("I2", Text())
+    alpha: float = option(0.01, Real(0, 1, open_low=True))
+    max_iterations: int = option(3, Real(1, integer=True))
+    max_simulations: int = option(150, Real(1, integer=True))
+    n_boot: int = option(16, Real(0, integer=True))
+    seed: int = option(0, Real(0, integer=True))
+    tolerances: object = option(None, (Tolerances, None))
+    effects: object = option(None, (None, list, tuple))
+    max_refits: int = option(8, Real(1, integer=True))
+    workers: object = option(None, (None, Real(1, integer=True)))
+    n_boot_intervals: int = option(30, Real(0, integer=True))
+    interval_refit: str = option("two-step", Choice(*INTERVAL_REFITS))
+    budget: object = option(None, (None, Real(1, integer=True)))
+
+
+@takes(ExplainSettings)
 @params(
     scenario=(Scenario, list, tuple),
     measurement=(Measurement, Reference, list, tuple),
     start=(Text(), ForceLaw),
-    criterion=Text(),
-    alpha=Real(0, 1, open_low=True),
-    max_iterations=Real(1, integer=True),
-    max_simulations=Real(1, integer=True),
-    budget=(None, Real(1, integer=True)),
-    n_boot=Real(0, integer=True),
-    seed=Real(0, integer=True),
-    tolerances=(Tolerances, None),
-    effects=(None, list, tuple),
-    max_refits=Real(1, integer=True),
-    workers=(None, Real(1, integer=True)),
-    n_boot_intervals=Real(0, integer=True),
-    interval_refit=Choice(*INTERVAL_REFITS),
     executor=(None, Instance("discovery.numerics.executor", "Executor")),
 )
 @reports_progress
@@ -382,21 +391,10 @@ def explain(
     measurement,
     start="linear",
     *,
-    criterion="I2",
-    alpha=0.01,
-    max_iterations=3,
-    max_simulations=150,
-    n_boot=16,
-    seed=0,
-    tolerances=None,
-    effects=None,
-    max_refits=8,
-    workers=None,
-    n_boot_intervals=30,
-    interval_refit="two-step",
+    settings=None,
     progress=None,
     executor=None,
-    budget=None,
+    **options,
 ):
     """Explain the disagreement of a start model with one or several records by named
     physical effects (see the module docstring).
@@ -409,6 +407,8 @@ def explain(
     start : str or ForceLaw
         ``"linear"`` (z, zd), a term list (``"z,zd"``) or a law with coefficients; the
         start is first refined by simulation.
+    settings : ExplainSettings, optional
+        The options below in one object; keywords override its fields.
     criterion : str
         Criterion of the refits (the mean over records).
     alpha : float
@@ -445,12 +445,13 @@ def explain(
     -------
     ExplainResult
     """
+    s = ExplainSettings.of("explain", settings, options)
     t0 = time.perf_counter()
-    budget = _check_settings(max_simulations, budget, alpha, workers, max_iterations)
-    pairs, records = _records_of(scenario, measurement, n_boot, seed)
+    budget = _check_settings(s.max_simulations, s.budget, s.alpha, s.workers, s.max_iterations)
+    pairs, records = _records_of(scenario, measurement, s.n_boot, s.seed)
     ms = [m for _, m in pairs]
-    catalogue = select(EFFECTS, effects)
-    problem = _Problem(records, tolerances)
+    catalogue = select(EFFECTS, s.effects)
+    problem = _Problem(records, s.tolerances)
     plain = [m for m in ms if not isinstance(m, Reference)]
     all_plain = len(plain) == len(ms)
     samples = _joined_samples([sc for sc, _ in records], plain) if all_plain else None
@@ -458,29 +459,29 @@ def explain(
         problem=problem,
         records=records,
         catalogue=catalogue,
-        criterion=criterion,
-        alpha=alpha,
+        criterion=s.criterion,
+        alpha=s.alpha,
         budget=budget,
-        tolerances=tolerances,
+        tolerances=s.tolerances,
         drift=None,
         regress=(
             (lambda names, loading=False: _regression(names, samples, loading))
             if samples is not None
             else None
         ),
-        workers=workers,
+        workers=s.workers,
         executor=executor,
-        max_refits=max_refits,
+        max_refits=s.max_refits,
         meas_first=ms[0] if not isinstance(ms[0], Reference) else None,
-        stopped=f"the budget of {max_iterations} added effect(s) is used",
+        stopped=f"the budget of {s.max_iterations} added effect(s) is used",
     )
     fit = _fit_start(run, start, plain if all_plain else None, progress)
     if not any(isinstance(m, Reference) for m in ms):
         run.drift = _Drift(pairs, records)
     run.model, run.uncertainties = Model(fit.law), dict(fit.standard_errors)
-    for _ in range(max_iterations + 1):
-        tick(progress, _ITERATIONS, len(run.iterations), max_iterations)
-        if not _iteration(run, max_iterations):
+    for _ in range(s.max_iterations + 1):
+        tick(progress, _ITERATIONS, len(run.iterations), s.max_iterations)
+        if not _iteration(run, s.max_iterations):
             break
     dropped = drop_collapsed(run)
     evs = problem.evaluations(run.model, floor=True)
@@ -488,7 +489,7 @@ def explain(
         _mean(evs, "criteria"), _mean(evs, "noise_floor"), run.drift, run.model
     )
     return ExplainResult(
-        intervals=_intervals(run, n_boot_intervals, seed, progress, interval_refit),
+        intervals=_intervals(run, s.n_boot_intervals, s.seed, progress, s.interval_refit),
         iterations=tuple(run.iterations),
         final_model=run.model,
         uncertainties=run.uncertainties,
@@ -502,16 +503,16 @@ def explain(
         seconds=time.perf_counter() - t0,
         settings={
             "start": str(start),
-            "criterion": criterion,
-            "alpha": alpha,
-            "max_iterations": max_iterations,
+            "criterion": s.criterion,
+            "alpha": s.alpha,
+            "max_iterations": s.max_iterations,
             "max_simulations": budget,
-            "n_boot": n_boot,
-            "seed": seed,
+            "n_boot": s.n_boot,
+            "seed": s.seed,
             "effects": [e.id for e in catalogue],
-            "max_refits": max_refits,
-            "workers": workers,
-            "intervals": {"replicates": n_boot_intervals, "refit": interval_refit},
+            "max_refits": s.max_refits,
+            "workers": s.workers,
+            "intervals": {"replicates": s.n_boot_intervals, "refit": s.interval_refit},
             "records": len(records),
             "simulations": problem.n_sim,
         },

@@ -38,6 +38,7 @@ import numpy as np
 from ..._printing import coefficient_lines, fmt, readable
 from ..._progress import reports_progress
 from ..._result import Result, part
+from ..._settings import Settings, option, takes
 from ..._validate import Choice, Real, Text, params
 from ...errors import IntegrationError
 from ..data.impulse import Impulse
@@ -331,45 +332,34 @@ def _mean_criteria(evs):
     return {k: float(np.mean([e.criteria[k] for e in evs if k in e.criteria])) for k in keys}
 
 
+@dataclass(frozen=True)
+class IdentifySettings(Settings):
+    """The options of :func:`identify` (each is also a keyword of it; see its parameters)."""
+
+    criterion: str = option("I2", Text())
+    method: str = option("least-squares", Text())
+    xtol: float = option(1e-5, Real(0, open_low=True))
+    max_simulations: int = option(600, Real(1, integer=True))
+    tolerances: object = option(None, (Tolerances, None))
+    uncertainty: bool = option(True)
+    observe: object = option(None)
+    short_first: bool = option(True)
+    n_boot_intervals: int = option(0, Real(0, integer=True))
+    seed: int = option(0, Real(0, integer=True))
+    check: bool = option(True, bool)
+    workers: object = option(1, (None, Real(1, integer=True)))
+    interval_refit: str = option("two-step", Choice(*INTERVAL_REFITS))
+    interval_noise: str = option("cycles", Choice(*INTERVAL_NOISE))
+    give_up_above: object = option(None, (None, Real(0, open_low=True)))
+
+
+@takes(IdentifySettings)
 @params(
     scenario=(Scenario, list, tuple),
     reference=(Measurement, Reference, Impulse, list, tuple),
-    criterion=Text(),
-    method=Text(),
-    xtol=Real(0, open_low=True),
-    max_simulations=Real(1, integer=True),
-    tolerances=(Tolerances, None),
-    n_boot_intervals=Real(0, integer=True),
-    seed=Real(0, integer=True),
-    check=bool,
-    workers=(None, Real(1, integer=True)),
-    interval_refit=Choice(*INTERVAL_REFITS),
-    interval_noise=Choice(*INTERVAL_NOISE),
-    give_up_above=(None, Real(0, open_low=True)),
 )
 @reports_progress
-def identify(
-    scenario,
-    reference,
-    start,
-    *,
-    criterion="I2",
-    method="least-squares",
-    xtol=1e-5,
-    max_simulations=600,
-    tolerances=None,
-    uncertainty=True,
-    observe=None,
-    short_first=True,
-    n_boot_intervals=0,
-    seed=0,
-    progress=None,
-    check=True,
-    workers=1,
-    interval_refit="two-step",
-    interval_noise="cycles",
-    give_up_above=None,
-):
+def identify(scenario, reference, start, *, settings=None, progress=None, **options):
     """Identify the coefficients of ``start`` from one or several records by simulation.
 
     Parameters
@@ -384,6 +374,8 @@ def identify(
         Terms to identify and their start values (all non-zero); or a model whose
         parameters go beyond a law's coefficients (:func:`model_parts`: an unloading
         branch, a machine parameter, an observation model, fitted jointly).
+    settings : IdentifySettings, optional
+        The options below in one object; keywords override its fields.
     criterion : str
         Criterion to minimise (``I0``..``I4``; the mean over records).
     method : str
@@ -443,44 +435,46 @@ def identify(
     IntegrationError
         The start law has no periodic steady state with contact.
     """
+    s = IdentifySettings.of("identify", settings, options)
     records = _checked(
-        scenario, reference, start, method=method, xtol=xtol, max_simulations=max_simulations
+        scenario, reference, start, method=s.method, xtol=s.xtol, max_simulations=s.max_simulations
     )
     t0 = time.perf_counter()
     spent, short_value = 0, None
-    if short_first:
+    if s.short_first:
         fit = _Fit(
-            criterion=criterion,
-            method=method,
-            xtol=xtol,
-            max_simulations=max_simulations,
-            tolerances=tolerances,
-            observe=observe,
+            criterion=s.criterion,
+            method=s.method,
+            xtol=s.xtol,
+            max_simulations=s.max_simulations,
+            tolerances=s.tolerances,
+            observe=s.observe,
             progress=progress,
         )
         start, spent, short_value = _short_first(records, start, fit)
-    given_up = _hopeless(short_value, give_up_above)
+    given_up = _hopeless(short_value, s.give_up_above)
     obj = _Objective(
         records,
         start,
-        criterion,
-        tolerances,
-        max(int(max_simulations) - spent, 2 * len(records)),
-        observe=observe,
+        s.criterion,
+        s.tolerances,
+        max(int(s.max_simulations) - spent, 2 * len(records)),
+        observe=s.observe,
         progress=progress,
     )
     obj.n = 0
     if given_up:
         x_best = np.ones(len(start.coefficients))
-        message = f"given up after the cycle-by-cycle fit: {criterion} {given_up}"
+        message = f"given up after the cycle-by-cycle fit: {s.criterion} {given_up}"
     else:
-        x_best, message = _fitted(obj, method, xtol, max_simulations)  # before the error probes
+        # before the error probes
+        x_best, message = _fitted(obj, s.method, s.xtol, s.max_simulations)
     law = obj.law(x_best)
     evs = obj.evaluations(x_best)
     if evs is None:  # a given-up start compared on the blocks before: never, short of a bug
         raise IntegrationError(f"the law {law} cannot be compared with the record")
     se, corr = {}, None
-    if uncertainty and not given_up:
+    if s.uncertainty and not given_up:
         obj.max_sim += len(x_best) * len(records)  # the error estimate has its own budget
         se, corr = _uncertainty(obj, x_best, law.names)
     crit = _mean_criteria(evs)
@@ -490,26 +484,26 @@ def identify(
             "contact (see failures)"
         )
     intervals = None
-    if n_boot_intervals:
+    if s.n_boot_intervals:
         intervals = bootstrap_intervals(
             *zip(*records, strict=True),
             law,
-            n_boot=int(n_boot_intervals),
-            seed=seed,
-            criterion=criterion,
-            tolerances=tolerances,
-            workers=workers,
-            refit=interval_refit,
-            noise=interval_noise,
+            n_boot=int(s.n_boot_intervals),
+            seed=s.seed,
+            criterion=s.criterion,
+            tolerances=s.tolerances,
+            workers=s.workers,
+            refit=s.interval_refit,
+            noise=s.interval_noise,
         )
     return IdentificationResult(
-        checks=_checks(records, law, observe, tolerances) if check else (),
+        checks=_checks(records, law, s.observe, s.tolerances) if s.check else (),
         intervals=intervals,
         law=law,
-        criterion=criterion,
-        value=crit[criterion],
+        criterion=s.criterion,
+        value=crit[s.criterion],
         criteria=crit,
-        method=method,
+        method=s.method,
         n_simulations=obj.n + spent,
         evaluations=tuple(evs),
         iterations=obj.path,

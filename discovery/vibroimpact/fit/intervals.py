@@ -5,6 +5,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..._result import Result
+from ..._settings import Settings, option, takes
 from ...errors import InputError, IntegrationError
 from ...numerics.executor import map_on
 from .optimise import _checked, _fitted
@@ -199,22 +200,24 @@ cycles; below it (a period-four orbit over 12 periods: three cycles) the replica
 white noise of the record's level."""
 
 
-def bootstrap_intervals(
-    scenario,
-    reference,
-    model,
-    *,
-    n_boot=30,
-    seed=0,
-    level=0.95,
-    max_simulations=60,
-    criterion="I2",
-    tolerances=None,
-    workers=1,
-    executor=None,
-    refit="two-step",
-    noise="cycles",
-):
+@dataclass(frozen=True)
+class BootstrapIntervalsSettings(Settings):
+    """The options of :func:`bootstrap_intervals` (each is also a keyword of it; see its
+    parameters)."""
+
+    n_boot: int = option(30)
+    seed: int = option(0)
+    level: float = option(0.95)
+    max_simulations: int = option(60)
+    criterion: str = option("I2")
+    tolerances: object = option(None)
+    workers: object = option(1)
+    refit: str = option("two-step")
+    noise: str = option("cycles")
+
+
+@takes(BootstrapIntervalsSettings)
+def bootstrap_intervals(scenario, reference, model, *, settings=None, executor=None, **options):
     """Intervals of ``model``'s coefficients by a bootstrap through the record-span
     processing (the comment above).
 
@@ -225,6 +228,8 @@ def bootstrap_intervals(
         Records prepared with positions (a record span); others have no bootstrap.
     model : ForceLaw or Model
         The fitted law (or a model with effect parameters, :func:`identify.model_parts`).
+    settings : BootstrapIntervalsSettings, optional
+        The options below in one object; keywords override its fields.
     n_boot : int
         Replicates (>= 5).
     seed : int
@@ -257,14 +262,15 @@ def bootstrap_intervals(
         ``None`` when a record has no span (no state to draw), a parameter is 0, or fewer
         than 5 refits succeeded.
     """
-    if not (isinstance(n_boot, int) and n_boot >= 5):
-        raise InputError(f"n_boot must be an integer >= 5; got {n_boot!r}")
-    if not 0 < level < 1:
-        raise InputError(f"level must be in (0, 1); got {level!r}")
-    if refit not in INTERVAL_REFITS:
-        raise InputError(f"unknown refit {refit!r}; valid: {', '.join(INTERVAL_REFITS)}")
-    if noise not in INTERVAL_NOISE:
-        raise InputError(f"unknown noise {noise!r}; valid: {', '.join(INTERVAL_NOISE)}")
+    s = BootstrapIntervalsSettings.of("bootstrap_intervals", settings, options)
+    if not (isinstance(s.n_boot, int) and s.n_boot >= 5):
+        raise InputError(f"n_boot must be an integer >= 5; got {s.n_boot!r}")
+    if not 0 < s.level < 1:
+        raise InputError(f"level must be in (0, 1); got {s.level!r}")
+    if s.refit not in INTERVAL_REFITS:
+        raise InputError(f"unknown refit {s.refit!r}; valid: {', '.join(INTERVAL_REFITS)}")
+    if s.noise not in INTERVAL_NOISE:
+        raise InputError(f"unknown noise {s.noise!r}; valid: {', '.join(INTERVAL_NOISE)}")
     records = as_records(scenario, reference)
     if any(getattr(ref, "span", None) is None for _, ref in records):
         return None
@@ -274,17 +280,22 @@ def bootstrap_intervals(
     # the resampled cycles against the parameters (see the comment above): too few, and the
     # replicates take white noise of the record's level instead
     G = sum(b.fold.n_cycles for _, ref in records for b in ref.span.blocks)
-    few = noise == "cycles" and G - len(model.names) < MIN_CYCLE_DOF
-    if few:
-        noise = "white"
-    rng = np.random.default_rng(seed)
+    few = s.noise == "cycles" and G - len(model.names) < MIN_CYCLE_DOF
+    noise = "white" if few else s.noise
+    rng = np.random.default_rng(s.seed)
     replicates = []  # drawn here, in order: the rng's sequence does not depend on workers
-    for _ in range(n_boot):
+    for _ in range(s.n_boot):
         try:
             replicates.append(
                 [
                     _replicate(
-                        machine(sc, ref), law, observe, ref, rng, tolerances=tolerances, noise=noise
+                        machine(sc, ref),
+                        law,
+                        observe,
+                        ref,
+                        rng,
+                        tolerances=s.tolerances,
+                        noise=noise,
                     )
                     for sc, ref in records
                 ]
@@ -296,18 +307,18 @@ def bootstrap_intervals(
         replicates,
         model,
         {
-            "criterion": criterion,
-            "max_simulations": max_simulations,
-            "tolerances": tolerances,
+            "criterion": s.criterion,
+            "max_simulations": s.max_simulations,
+            "tolerances": s.tolerances,
         },
     )
     refits = map_on(
-        REFITS[refit], range(len(replicates)), context, workers=workers, executor=executor
+        REFITS[s.refit], range(len(replicates)), context, workers=s.workers, executor=executor
     )
     draws = [d for d in refits if d is not None]
     if len(draws) < 5:
         return None
-    how = _Resampling(cycles=G, noise=noise, few=few, refit=refit, level=level, seed=seed)
+    how = _Resampling(cycles=G, noise=noise, few=few, refit=s.refit, level=s.level, seed=s.seed)
     return _intervals(np.array(draws), model, how)
 
 

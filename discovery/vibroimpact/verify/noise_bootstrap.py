@@ -13,8 +13,11 @@ criteria.  The mean over replicates is the floor; a model whose criteria are wit
 a small factor of it agrees with the record as well as the truth could.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from ..._settings import Settings, option, takes
 from ...errors import InputError
 from ..data.impulse import impulse_from_samples
 from .criteria import CRITERIA, evaluate_criteria
@@ -31,6 +34,15 @@ def _sawtooth(t, onsets, velocity):
     return velocity * (t - onsets[k])
 
 
+@dataclass(frozen=True)
+class NoiseFloorSettings(Settings):
+    """The bootstrap's options of :func:`noise_floor` (each is also a keyword of it)."""
+
+    n_boot: int = option(16)
+    seed: int = option(0)
+
+
+@takes(NoiseFloorSettings)
 def noise_floor(
     reference_impulse,
     period,
@@ -40,8 +52,8 @@ def noise_floor(
     n_cycles,
     sigma_zeta=None,
     impact_velocity=None,
-    n_boot=16,
-    seed=0,
+    settings=None,
+    **options,
 ):
     """Expected criteria of the true law against a record with this noise.
 
@@ -61,6 +73,8 @@ def noise_floor(
         Penetration noise [m]; ``None`` when the onsets came from the force alone.
     impact_velocity : float, optional
         Penetration rate at the onsets [m/s] (needed with ``sigma_zeta``).
+    settings : NoiseFloorSettings, optional
+        The options below in one object; keywords override its fields.
     n_boot : int
         Replicates.
     seed : int
@@ -71,13 +85,14 @@ def noise_floor(
     dict
         ``{"mean": {I0..I4}, "q95": {I0..I4}, "n_boot": n, "seed": seed}``.
     """
+    s = NoiseFloorSettings.of("noise_floor", settings, options)
     E = reference_impulse
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(s.seed)
     W = E.duration
     K = max(int(n_cycles), 1) + 1
     lead = 0.3 * period
     samples = {n: [] for n in CRITERIA}
-    for _ in range(n_boot):
+    for _ in range(s.n_boot):
         t = rng.uniform(0.0, dt) + np.arange(int((lead + K * W + 0.5 * period) / dt)) * dt
         # the stand-in repeated: main onset of cycle c at lead + c W
         F = E.evaluate(t - lead) + rng.normal(0.0, sigma_f, t.size)
@@ -100,12 +115,12 @@ def noise_floor(
             "mean": {n: float("inf") for n in CRITERIA},
             "q95": {n: float("inf") for n in CRITERIA},
             "n_boot": 0,
-            "seed": seed,
+            "seed": s.seed,
         }
     return {
         "mean": {n: float(np.mean(v)) for n, v in samples.items()},
         "q95": {n: float(np.quantile(v, 0.95)) for n, v in samples.items()},
         "sd": {n: float(np.std(v, ddof=1)) if len(v) > 1 else 0.0 for n, v in samples.items()},
         "n_boot": len(samples["I2"]),
-        "seed": seed,
+        "seed": s.seed,
     }
