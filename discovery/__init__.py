@@ -76,6 +76,8 @@ _EXPORTS = {
     "LandscapeSettings": "vibroimpact.verify.criteria_landscape",
     "FieldRecordSettings": "vibroimpact.studies.records",
     "AdviseSettings": "vibroimpact.advise.search",
+    "IdentifySettings": "vibroimpact.fit.identification",
+    "ExplainSettings": "vibroimpact.explain.loop",
 }
 
 
@@ -145,6 +147,8 @@ __all__ = [
     "LandscapeSettings",
     "FieldRecordSettings",
     "AdviseSettings",
+    "IdentifySettings",
+    "ExplainSettings",
 ]
 
 lazy_package(__name__, _EXPORTS)

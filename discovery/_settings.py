@@ -70,11 +70,12 @@ class Settings:
         return cls()
 
     @classmethod
-    def of(cls, where, settings=None, options=None, *, rest=False):
+    def of(cls, where, settings=None, options=None, *, rest=()):
         """The settings a call of ``where`` asks for: ``settings`` (an instance or None)
-        with the keyword ``options`` over its fields.  With ``rest``, keywords that are no
-        field are returned beside the settings (``(settings, rest)``) for the function to
-        pass on; without it they are refused."""
+        with the keyword ``options`` over its fields.  With ``rest`` (the names a function
+        passes on, e.g. an estimator's parameters), keywords that are no field but one of
+        those are returned beside the settings (``(settings, rest)``); any other keyword is
+        refused."""
         if settings is not None and not isinstance(settings, cls):
             raise VidiTypeError(
                 f"{where}: settings must be a {cls.__name__} or None; got {_received(settings)}"
@@ -82,9 +83,10 @@ class Settings:
         options = dict(options or {})
         known = cls.names()
         unknown = {k: options.pop(k) for k in list(options) if k not in known}
-        if unknown and not rest:
-            name = next(iter(unknown))
-            close = difflib.get_close_matches(name, known, n=1)
+        wrong = [k for k in unknown if not rest or k not in rest]
+        if wrong:
+            name = wrong[0]
+            close = difflib.get_close_matches(name, (*known, *(rest or ())), n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise VidiTypeError(
                 f"{where}: unexpected keyword {name!r}{hint}; the options are the fields of "

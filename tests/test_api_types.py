@@ -157,8 +157,8 @@ CASES = [
     ("SynthesizeSettings fs 0", lambda: d.SynthesizeSettings(fs=0), VALUE, "fs"),
     ("LandscapeSettings workers 0", lambda: d.LandscapeSettings(workers=0), VALUE, "workers"),
     ("FieldRecordSettings seed -1", lambda: d.FieldRecordSettings(seed=-1), VALUE, "seed"),
-    ("AdviseSettings workers text", lambda: d.AdviseSettings(workers="a"), VALUE, "workers"),
-    ("IdentifySettings xtol text", lambda: d.IdentifySettings(xtol="a"), VALUE, "xtol"),
+    ("AdviseSettings workers text", lambda: d.AdviseSettings(workers="a"), TYPE, "workers"),
+    ("IdentifySettings xtol text", lambda: d.IdentifySettings(xtol="a"), TYPE, "xtol"),
     ("ExplainSettings alpha 2", lambda: d.ExplainSettings(alpha=2.0), VALUE, "alpha"),
     (
         "ueda UedaChartSettings periods 0",

@@ -17,6 +17,7 @@ _EXPORTS = {
     "ExplainResult": "loop",
     "Iteration": "loop",
     "explain": "loop",
+    "ExplainSettings": "loop",
     "start_law": "loop",
     "PHASES": "disagreement",
     "localise": "disagreement",
@@ -24,6 +25,7 @@ _EXPORTS = {
 
 __all__ = [
     "explain",
+    "ExplainSettings",
     "ExplainResult",
     "Iteration",
     "EFFECTS",

@@ -31,6 +31,7 @@ those whose simulation criterion (default I2) is within ``sim_rtol`` (relative) 
 criterion; models without a periodic steady state come last.
 """
 
+import inspect
 import time
 from dataclasses import dataclass, replace
 from warnings import warn
@@ -58,6 +59,7 @@ from .evidence import _contact_samples, _Evidence, _regression, _required_terms,
 from .intervals import INTERVAL_REFITS, bootstrap_intervals
 from .ranking import _RankingRule, rank
 from .records import pair_records
+from .regression import ConstrainedSparseRegressor
 from .shortlist import _Checker, _shortlist
 from .stepwise import _Stepwise
 
@@ -176,6 +178,10 @@ def _contact_models(scenario, measurement, n_boot, seed, progress):
     )
 
 
+#: the estimator's parameters a call of :func:`discover` may give as keywords
+_ESTIMATOR_OPTIONS = tuple(inspect.signature(ConstrainedSparseRegressor).parameters)
+
+
 @dataclass(frozen=True)
 class DiscoverSettings(Settings):
     """The options of :func:`discover` (each is also a keyword of it; see its parameters)."""
@@ -291,7 +297,7 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
         consistent model, a refinement that moved coefficients far beyond their
         uncertainty (regression bias).
     """
-    s, more = DiscoverSettings.of("discover", settings, options, rest=True)
+    s, more = DiscoverSettings.of("discover", settings, options, rest=_ESTIMATOR_OPTIONS)
     if s.library == "contact-models":  # the named contact models, fitted by name
         return _contact_models(scenario, measurement, s.n_boot_intervals, s.seed, progress)
     t0 = time.perf_counter()
