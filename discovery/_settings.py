@@ -14,6 +14,9 @@ that checks it (:func:`option`).
   raises), so an object passed around is valid.
 * ``to_dict()`` / ``from_dict()`` give a JSON-safe document and back, for records of the
   settings a result was made with.
+* ``repr()`` is what one would type to make the object (its fields not at their default);
+  ``print()`` lists every field.  A settings class is declared ``@dataclass(frozen=True,
+  repr=False)`` so that it keeps this ``repr``.
 """
 
 from __future__ import annotations
@@ -99,6 +102,22 @@ class Settings:
                 object.__setattr__(base, k, v)
             base._check(where, options)
         return (base, unknown) if rest else base
+
+    def __repr__(self):
+        """What one would type to make these settings: the fields not at their default."""
+        body = ", ".join(f"{k}={v!r}" for k, v in self.changed().items())
+        return f"{type(self).__name__}({body})"
+
+    def __str__(self):
+        changed = self.changed()
+        names = self.names()
+        width = max(len(n) for n in names)
+        head = f"{type(self).__name__}: {len(changed)} of {len(names)} options changed"
+        rows = [
+            f"  {n:<{width}} = {getattr(self, n)!r}" + ("   (changed)" if n in changed else "")
+            for n in names
+        ]
+        return "\n".join([head, *rows])
 
     def changed(self):
         """``{name: value}`` of the fields not at their default."""

@@ -100,3 +100,19 @@ def test_options_of_lists_the_signature_and_the_settings():
     opts = options_of(discovery.discover)
     assert opts["library"] == "poly:2" and opts["progress"] is None
     assert "settings" not in opts and "options" not in opts
+
+
+@pytest.mark.parametrize("cls", SETTINGS, ids=lambda c: c.__name__)
+def test_repr_is_what_one_would_type_and_print_lists_every_option(cls):
+    assert cls.__repr__ is Settings.__repr__, "declare it @dataclass(frozen=True, repr=False)"
+    assert repr(cls()) == f"{cls.__name__}()"
+    text = str(cls())
+    assert text.startswith(f"{cls.__name__}: 0 of {len(cls.names())} options changed")
+    assert len(text.splitlines()) == len(cls.names()) + 1
+
+
+def test_a_changed_settings_object_reads_back_from_its_repr():
+    s = discovery.DiscoverSettings(library="poly:3", seed=7)
+    assert repr(s) == "DiscoverSettings(library='poly:3', seed=7)"
+    assert eval(repr(s), {"DiscoverSettings": discovery.DiscoverSettings}) == s
+    assert "seed" in str(s) and "(changed)" in str(s)

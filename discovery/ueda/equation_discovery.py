@@ -195,7 +195,7 @@ def _block_bootstrap(system, sup, ols_se, boot):
     return np.array(out).std(axis=0, ddof=1), chosen / int(boot.resamples), n_blocks, True
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class UedaDiscoverSettings(Settings):
     """The options of :func:`discover` (each is also a keyword of it; see its parameters)."""
 

@@ -344,7 +344,7 @@ class _Loop:
         self.state = _State(new_terms, fit2, crit2, ver2)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class UedaExplainSettings(Settings):
     """The options of :func:`explain` (each is also a keyword of it; see its parameters)."""
 

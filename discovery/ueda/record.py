@@ -85,7 +85,7 @@ def check_record(t, x, what="the record"):
     return t, x
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class UedaRecordSettings(Settings):
     """The keyword options of :func:`simulate_record` (each is also a keyword of it)."""
 

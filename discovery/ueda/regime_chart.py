@@ -309,7 +309,7 @@ def _run_rows(system, settings, nu, B, *, workers, executor, progress):
     return grids, cpu, workers
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class UedaChartSettings(Settings):
     """The options of :func:`chart` (each is also a keyword of it; see its parameters)."""
 

@@ -137,7 +137,7 @@ def _regime_match(rec, mod, lyap):
     return mod.kind == "beat"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class UedaVerifySettings(Settings):
     """The options of :func:`verify` (each is also a keyword of it; see its docstring)."""
 

@@ -61,7 +61,7 @@ def _run(ex, context, jobs, progress, stage):
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class AdviseSettings(Settings):
     """The options of :func:`advise` (each is also a keyword of it)."""
 

@@ -335,7 +335,7 @@ class _Counted:
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ReferenceSimulateSettings(Settings):
     """The options of :func:`reference_simulate` (each is also a keyword of it)."""
 

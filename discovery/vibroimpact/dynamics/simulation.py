@@ -235,7 +235,7 @@ def _atol(scenario, tol):
     return tol.atol([x, v, x, v])
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SimulateSettings(Settings):
     """The options of :func:`simulate` (each is also a keyword of it; see its parameters)."""
 

@@ -342,7 +342,7 @@ def _orbit(pm, y, n, t0, *, tol, max_newton, attempt, evidence):
     )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SteadyStateSettings(Settings):
     """The options of :func:`steady_state` (each is also a keyword of it; see its parameters)."""
 

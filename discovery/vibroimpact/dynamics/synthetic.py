@@ -80,7 +80,7 @@ class SimulatedRecord(Result):
         return f"simulated record of {self.law} ({self.samples} samples)"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class SynthesizeSettings(Settings):
     """The options of :func:`synthesize` (each is also a keyword of it; see its parameters)."""
 

@@ -359,7 +359,7 @@ def _intervals(run, n_boot_intervals, seed, progress, refit="two-step"):
         return None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class ExplainSettings(Settings):
     """The options of :func:`explain` (each is also a keyword of it; see its parameters)."""
 

@@ -182,7 +182,7 @@ def _contact_models(scenario, measurement, n_boot, seed, progress):
 _ESTIMATOR_OPTIONS = tuple(inspect.signature(ConstrainedSparseRegressor).parameters)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class DiscoverSettings(Settings):
     """The options of :func:`discover` (each is also a keyword of it; see its parameters)."""
 

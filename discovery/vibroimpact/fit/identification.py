@@ -332,7 +332,7 @@ def _mean_criteria(evs):
     return {k: float(np.mean([e.criteria[k] for e in evs if k in e.criteria])) for k in keys}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class IdentifySettings(Settings):
     """The options of :func:`identify` (each is also a keyword of it; see its parameters)."""
 

@@ -200,7 +200,7 @@ cycles; below it (a period-four orbit over 12 periods: three cycles) the replica
 white noise of the record's level."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class BootstrapIntervalsSettings(Settings):
     """The options of :func:`bootstrap_intervals` (each is also a keyword of it; see its
     parameters)."""

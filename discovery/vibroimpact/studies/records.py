@@ -133,7 +133,7 @@ def noisy_measurement(
     return Measurement(np.array(t, dtype=float), F, channels, source=source, notes=tuple(notes))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class FieldRecordSettings(Settings):
     """The options of :func:`field_record` (each is also a keyword of it)."""
 

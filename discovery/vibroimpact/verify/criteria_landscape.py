@@ -354,7 +354,7 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
     return fl["mean"], fl["q95"], f"the measured cycle ({why})"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class LandscapeSettings(Settings):
     """The options of :func:`landscape` (each is also a keyword of it; see its parameters)."""
 

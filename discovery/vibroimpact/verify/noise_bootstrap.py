@@ -34,7 +34,7 @@ def _sawtooth(t, onsets, velocity):
     return velocity * (t - onsets[k])
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class NoiseFloorSettings(Settings):
     """The bootstrap's options of :func:`noise_floor` (each is also a keyword of it)."""
 
