@@ -296,16 +296,9 @@ def test_the_cases_cover_every_public_entry():
             "ContactModel",
             "parse_law",
             "fit_contact_models",
-            "DiscoverSettings",
-            "SimulateSettings",
-            "SteadyStateSettings",
-            "SynthesizeSettings",
-            "LandscapeSettings",
-            "FieldRecordSettings",
-            "AdviseSettings",
-            "IdentifySettings",
-            "ExplainSettings",
         }
+        # a settings class with a row of its own (rows are named after the class)
+        - {n for n in public if n.endswith("Settings") and n.lower() in covered}
     )
     assert not unlisted, f"public entries without a row: {sorted(unlisted)}"
 
