@@ -191,8 +191,11 @@ def _binder(signature):
     most of a check's cost, and the checked functions are called in inner loops."""
     kinds = inspect.Parameter
     ps = list(signature.parameters.values())
-    if any(p.kind in (kinds.VAR_POSITIONAL, kinds.VAR_KEYWORD) for p in ps):
+    if any(p.kind == kinds.VAR_POSITIONAL for p in ps):
         return lambda args, kwargs: None
+    # the ``**options`` of a function that takes settings (discovery._settings)
+    rest = next((p.name for p in ps if p.kind == kinds.VAR_KEYWORD), None)
+    ps = [p for p in ps if p.kind != kinds.VAR_KEYWORD]
     positional = [
         p.name for p in ps if p.kind in (kinds.POSITIONAL_ONLY, kinds.POSITIONAL_OR_KEYWORD)
     ]
@@ -204,9 +207,14 @@ def _binder(signature):
             return None
         given = dict(zip(positional, args, strict=False))
         for k, v in kwargs.items():
-            if k in given or k not in by_keyword:
+            if k in given:
                 return None
-            given[k] = v
+            if k in by_keyword:
+                given[k] = v
+            elif rest is not None:
+                given.setdefault(rest, {})[k] = v
+            else:
+                return None
         return given if required.issubset(given) else None
 
     return arguments

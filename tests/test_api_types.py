@@ -320,7 +320,10 @@ def test_the_checks_name_the_arguments_as_the_signature_binds_them():
     def f3(self, x=1):
         pass
 
-    for f in (f1, f2, f3):
+    def f4(a, b=1, *, settings=None, **options):
+        pass
+
+    for f in (f1, f2, f3, f4):
         sig = inspect.signature(f)
         arguments = _binder(sig)
         names = [*sig.parameters, "unknown"]
