@@ -29,6 +29,7 @@ import numpy as np
 from ..._printing import fmt
 from ..._validate import Instance, params
 from ...errors import InputError
+from ...numerics.intervals import in_widened_intervals
 
 _IMPULSE = Instance("discovery.vibroimpact.data.impulse", "Impulse")
 
@@ -124,13 +125,9 @@ def compare(measured, simulated):
 
 
 def _in_intervals(t, iv, pad, length):
-    """Whether each time lies in one of the intervals ``iv`` widened by ``pad`` (cyclic
-    over ``length``)."""
-    inside = np.zeros(t.size, dtype=bool)
-    for a, b in iv:
-        for shift in (-length, 0.0, length):
-            inside |= (t >= a - pad + shift) & (t <= b + pad + shift)
-    return inside
+    """Whether each (sorted) time lies in one of the intervals ``iv`` widened by ``pad``
+    (cyclic over ``length``)."""
+    return in_widened_intervals(t, iv, pad, length)
 
 
 def _int_abs(t, d):

@@ -22,6 +22,7 @@ sample times).  A record without positions has no I5; its verdict says so.
 
 import numpy as np
 
+from ...numerics.intervals import in_widened_intervals
 from ...numerics.memo import Memo
 
 __all__ = [
@@ -61,11 +62,7 @@ def contact_window(fold, impulses, penetrations=(), pad=WINDOW_PAD):
     for z in penetrations:
         on = fold.average(z) > 0.0
         iv.append(np.array([[fold.phase[a], fold.phase[b]] for a, b in _runs(on)]).reshape(-1, 2))
-    inside = np.zeros(fold.phase.size, dtype=bool)
-    for a, b in np.concatenate(iv):
-        for shift in (-W, 0.0, W):
-            inside |= (fold.phase >= a - pad + shift) & (fold.phase <= b + pad + shift)
-    return inside
+    return in_widened_intervals(fold.phase, np.concatenate(iv), pad, W)
 
 
 def penetration_criterion(fold, z_measured, z_simulated, window):
