@@ -19,7 +19,6 @@ def in_widened_intervals(t, iv, pad, length):
     start = np.searchsorted(t, lo, "left")
     end = np.searchsorted(t, hi, "right")
     keep = start < end
-    marks = np.zeros(t.size + 1, dtype=np.int64)
-    np.add.at(marks, start[keep], 1)
-    np.add.at(marks, end[keep], -1)
+    n = t.size + 1
+    marks = np.bincount(start[keep], minlength=n) - np.bincount(end[keep], minlength=n)
     return np.cumsum(marks[:-1]) > 0
