@@ -1,5 +1,6 @@
 """Integrator tolerances, shared by both systems' integrators."""
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,6 +53,13 @@ class Tolerances:
     hmax_fraction: float = 0.02
     free_flight: str = "closed"
     contact: str = "closed"
+
+    @classmethod
+    @functools.cache
+    def default(cls):
+        """The default settings, made and checked once (a frozen object, shared): what a
+        simulation uses when it is given none."""
+        return cls()
 
     def __post_init__(self):
         for name, spec in (

@@ -25,7 +25,7 @@ def setup(system, tolerances):
     """``(tolerances, period, atol, largest step)`` of runs of ``system``."""
     if not isinstance(system, UedaSystem):
         raise VidiTypeError("system must be a discovery.ueda.UedaSystem")
-    tol = tolerances or Tolerances()
+    tol = tolerances or Tolerances.default()
     T = system.period
     return tol, T, tol.atol(system.scales()), T * tol.hmax_fraction
 

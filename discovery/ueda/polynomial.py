@@ -174,7 +174,7 @@ def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20
     from ._runs import check
     from .exponents import Lyapunov
 
-    tol = tolerances or Tolerances()
+    tol = tolerances or Tolerances.default()
     T = model.period
     atol = tol.atol(model.scales())
     hmax = T * tol.hmax_fraction

@@ -310,7 +310,7 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
     s = SimulateSettings.of("simulate", settings, options)
     if y0 is not None and np.size(y0) != 4:
         raise InputError(f"simulate: y0 must be the 4 states (w1, v1, w2, v2); got {np.size(y0)}")
-    tol = s.tolerances or Tolerances()
+    tol = s.tolerances or Tolerances.default()
     t0, t1 = (float(v) for v in t_span)
     if not (np.isfinite(t0) and np.isfinite(t1) and t1 > t0):
         raise InputError(f"t_span must be two finite times with t1 > t0, got {t_span!r}")

@@ -54,7 +54,7 @@ class StroboscopicMap:
     def __init__(self, scenario, law, tolerances=None):
         self.scenario = scenario
         self.law = law
-        self.tol = tolerances or Tolerances()
+        self.tol = tolerances or Tolerances.default()
         self._p = kernel_params(scenario, law, self.tol)
         self._coef, self._ea, self._eb, self._br = law.kernel_arrays()
         self._atol = _atol(scenario, self.tol)
