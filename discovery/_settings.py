@@ -21,7 +21,6 @@ that checks it (:func:`option`).
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import difflib
 import functools
@@ -97,10 +96,11 @@ class Settings:
             )
         base = cls.defaults() if settings is None else settings
         if options:  # only the given values need a check (naming the function called)
-            base = copy.copy(base)
-            for k, v in options.items():
-                object.__setattr__(base, k, v)
-            base._check(where, options)
+            new = object.__new__(cls)  # a copy with the options (a frozen dataclass's fields)
+            new.__dict__.update(base.__dict__)
+            new.__dict__.update(options)
+            new._check(where, options)
+            base = new
         return (base, unknown) if rest else base
 
     def __repr__(self):
