@@ -85,10 +85,10 @@ class Settings:
         options = dict(options or {})
         known = cls.names()
         unknown = {k: options.pop(k) for k in list(options) if k not in known}
-        wrong = [k for k in unknown if not rest or k not in rest]
+        wrong = [k for k in unknown if k not in rest]
         if wrong:
             name = wrong[0]
-            close = difflib.get_close_matches(name, (*known, *(rest or ())), n=1)
+            close = difflib.get_close_matches(name, (*known, *rest), n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise VidiTypeError(
                 f"{where}: unexpected keyword {name!r}{hint}; the options are the fields of "
