@@ -6,7 +6,7 @@ import numpy as np
 
 from ..._result import Result
 from ..._settings import Settings, option, takes
-from ...errors import InputError, IntegrationError
+from ...errors import InputError, IntegrationError, NoContactError
 from ...numerics.executor import map_on
 from .optimise import _checked, _fitted
 from .problem import _Objective
@@ -164,7 +164,7 @@ def _refit_replicate(context, k):
             max(int(budget), 2 * len(records)),
         )
         x, _ = _fitted(obj, method, xtol, budget)
-    except IntegrationError:
+    except (IntegrationError, NoContactError):  # a replicate without contact in a block
         return None
     return np.array(obj.law(x).coefficients, dtype=float)
 
@@ -184,7 +184,7 @@ def _step_replicate(context, k):
             if obj.evaluations(x) is None:
                 return None
             r, J = obj.residuals(x), obj.jacobian(x)
-        except IntegrationError:
+        except (IntegrationError, NoContactError):  # a replicate without contact in a block
             return None
         if not (np.all(np.isfinite(r)) and np.all(np.isfinite(J))):
             return None

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..._printing import fmt
 from ..._validate import Instance, params
-from ...errors import InputError
+from ...errors import InputError, NoContactError
 from ...numerics.intervals import in_widened_intervals
 
 _IMPULSE = Instance("discovery.vibroimpact.data.impulse", "Impulse")
@@ -168,7 +168,7 @@ def _intersection(a, b):
 
 def _safe(num, den, name):
     if den <= 0:
-        raise InputError(f"{name} is undefined: the measured impulse is zero")
+        raise NoContactError(f"{name} is undefined: the measured impulse is zero")
     return num / den
 
 

@@ -350,3 +350,27 @@ def test_a_hopeless_fit_is_given_up_after_its_cycle_by_cycle_fit(paper, referenc
     kept = identify(paper, reference, START, method="least-squares", give_up_above=0.5)
     assert not kept.given_up
     assert kept.law.coefficients == fitted.law.coefficients
+
+
+def test_a_replicate_without_contact_in_a_block_fails_alone(monkeypatch, paper):
+    """A bootstrap replicate whose resampled block has no measured contact (a short contact
+    under its noise: its criteria are undefined) is a failed replicate, as a failed
+    simulation is, instead of stopping the intervals (a random explain draw stopped so)."""
+    from discovery.errors import NoContactError
+    from discovery.vibroimpact.fit import intervals as iv
+
+    class NoContact:
+        def __init__(self, *args, **kwargs):
+            pass
+
+        def evaluations(self, x):
+            raise NoContactError("I4 is undefined: the measured impulse is zero")
+
+    monkeypatch.setattr(iv, "_Objective", NoContact)
+    monkeypatch.setattr(iv, "_checked", lambda *args, **kwargs: [])
+    monkeypatch.setattr(iv, "_fitted", lambda obj, *args: obj.evaluations(None))
+    settings = {"criterion": "I2", "tolerances": None, "max_simulations": 10}
+    context = ([paper], [[None]], paper.law, settings)
+    assert iv._step_replicate(context, 0) is None
+    assert iv._refit_replicate(context, 0) is None
+    assert issubclass(NoContactError, InputError)
