@@ -237,6 +237,13 @@ def _dpw(x, p):
 def force_partials(mode, z, v, coef, ea, eb, br, dc):
     """``(dF/dz, dF/dv)`` of the mode's force at ``(z, v)``, and ``dc[i] = dF/dc_i`` (a law
     without a permanent set: the sensitivities are not carried for one)."""
+    return _partials(mode, z, v, coef, ea, eb, br, dc)
+
+
+@njit(cache=True, inline="always")
+def _partials(mode, z, v, coef, ea, eb, br, dc):
+    """:func:`force_partials` inlined: in the sensitivities' right-hand side, at every stage
+    of every step (as a call there, a sensitivity run took a fifth longer)."""
     fz = 0.0
     fv = 0.0
     for i in range(coef.shape[0]):
@@ -392,10 +399,10 @@ def _dforce(fz, fv, dz, dv, j, spar, dc):
     return df
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _rhs_sens(y, mode, p, coef, ea, eb, br, S, spar, dc, out):
     """``out[:, j] = (df/dy) S[:, j] + df/dq_j`` at ``y`` in ``mode``."""
-    fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
+    fz, fv = _partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
     ky = p[2] + 3.0 * p[P_K3] * y[0] * y[0]
     for j in range(S.shape[1]):
         df = _dforce(fz, fv, S[0, j] - S[2, j], S[1, j] - S[3, j], j, spar, dc)
