@@ -72,14 +72,15 @@ def _edge_params(t, period, min_samples=3):
     return max(min_samples, int(0.01 * period / dt)), max(4.0, 0.02 * period / dt)
 
 
-def _sampled_support(tau, F, thr, period, *, noise=0.0, extrapolate=True):
+def _sampled_support(tau, F, thr, period, *, noise=0.0, extrapolate=True, edges=None):
     """Support of a cycle sampled at ``tau`` (starting at the onset, ``tau[0] = 0``).
 
     When its noise is not negligible (``noise > thr / 100``) the cycle is first smoothed
     by a moving average over 1 % of a period, so noise near a flat tail does not stretch
     the support by chance crossings of the threshold (the measured and the simulated
-    cycle go through the same operator; a smoothed edge moves by up to half a window)."""
-    min_len, max_extrap = _edge_params(tau, period)
+    cycle go through the same operator; a smoothed edge moves by up to half a window).
+    ``edges``: :func:`_edge_params` of ``tau`` when the caller keeps them (a fold's)."""
+    min_len, max_extrap = _edge_params(tau, period) if edges is None else edges
     dt = tau[2] - tau[1]
     width = max(1, int(0.01 * period / dt)) | 1 if noise > thr / 100.0 else 1
     Fs = uniform_filter1d(np.asarray(F, dtype=float), width, mode="nearest")

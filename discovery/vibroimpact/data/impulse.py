@@ -104,8 +104,9 @@ class Impulse:
         ----------
         tq : array_like
             Query times since the onset [s].
-        side : {"right", "left"}
-            Which limit to take where the force jumps.
+        side : {"right", "left"} or ndarray of bool
+            Which limit to take where the force jumps; an array of ``tq``'s shape, true
+            where the left limit is wanted, takes one per query.
         """
         from ...numerics.piecewise import periodic_values  # numba: not for `vidi --help`
 

@@ -13,10 +13,11 @@ sub-sample phases give a finer phase grid instead of a smear.
 """
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
-from ..data.contact_edges import _sampled_support
+from ..data.contact_edges import _edge_params, _sampled_support
 from ..data.impulse import Impulse
 
 __all__ = ["Fold", "make_fold"]
@@ -75,6 +76,14 @@ class Fold:
             / self.counts
         )
 
+    @cached_property
+    def knots(self):
+        """The folded cycle's times ``[0, phase..., duration]`` (read-only: every impulse
+        of this fold shares them) and their edge rules (:func:`_edge_params`)."""
+        tau = np.concatenate([[0.0], self.phase, [self.duration]])
+        tau.setflags(write=False)
+        return tau, _edge_params(tau, self.period)
+
     def impulse(self, values, *, threshold, noise, onset_record_time=None):
         """The folded cycle of ``values`` as an
         :class:`~discovery.vibroimpact.data.impulse.Impulse` whose
@@ -101,14 +110,20 @@ class Fold:
         crossing moves smoothly with the noise, and the floor replicates reproduce it.
         """
         Fm = self.average(values)
-        W, p = self.duration, self.phase
+        W = self.duration
         # the cycle's ends: the first bin's value at 0 (the right limit F(0+)) and the last
         # bin's at W (the left limit F(W-) = F(0-)); a force jump at the origin stays one
-        tau = np.concatenate([[0.0], p, [W]])
+        tau, edges = self.knots
         F = np.concatenate([[Fm[0]], Fm, [Fm[-1]]])
         n_eff = max(self.n_cycles, 1)
         support = _sampled_support(
-            tau, F, threshold, self.period, noise=noise / np.sqrt(n_eff), extrapolate=False
+            tau,
+            F,
+            threshold,
+            self.period,
+            noise=noise / np.sqrt(n_eff),
+            extrapolate=False,
+            edges=edges,
         )
         onsets = support[:, 0].copy() if len(support) else np.zeros(1)
         return Impulse(
