@@ -24,6 +24,7 @@ the measured one is sensor noise.  When the two cycles differ
 import functools
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -70,6 +71,16 @@ class Comparison:
     support_n: np.ndarray
     length: float
     _values: dict = field(default_factory=dict, repr=False, compare=False)
+
+    @cached_property
+    def steps(self):
+        """The grid's steps ``diff(t)`` (every integral's)."""
+        return np.diff(self.t)
+
+    @cached_property
+    def difference(self):
+        """``fn - fe`` at ``t``."""
+        return self.fn - self.fe
 
 
 def _grid_points(imp, length):
@@ -145,9 +156,8 @@ def _in_intervals(t, iv, pad, length):
     return in_widened_intervals(t, iv, pad, length)
 
 
-def _int_abs(t, d):
-    """Exact integral of |d| for d piecewise linear on t."""
-    h = np.diff(t)
+def _int_abs(h, d):
+    """Exact integral of |d| for d piecewise linear on a grid of steps ``h``."""
     a, b = d[:-1], d[1:]
     same = a * b >= 0
     area = np.where(
@@ -158,8 +168,8 @@ def _int_abs(t, d):
     return float(np.sum(h * area))
 
 
-def _int_sq(t, d):
-    h = np.diff(t)
+def _int_sq(h, d):
+    """Exact integral of d^2 for d piecewise linear on a grid of steps ``h``."""
     a, b = d[:-1], d[1:]
     return float(np.sum(h * (a * a + a * b + b * b) / 3.0))
 
@@ -202,15 +212,15 @@ def _once(fn):
 
 @_once
 def _i1(c):
-    return _safe(float(np.max(np.abs(c.fn - c.fe))), float(np.max(np.abs(c.fe))), "I1")
+    return _safe(float(np.max(np.abs(c.difference))), float(np.max(np.abs(c.fe))), "I1")
 
 
 def _i2(c):
-    return _safe(_int_abs(c.t, c.fn - c.fe), _int_abs(c.t, c.fe), "I2")
+    return _safe(_int_abs(c.steps, c.difference), _int_abs(c.steps, c.fe), "I2")
 
 
 def _i3(c):
-    return math.sqrt(_safe(_int_sq(c.t, c.fn - c.fe), _int_sq(c.t, c.fe), "I3"))
+    return math.sqrt(_safe(_int_sq(c.steps, c.difference), _int_sq(c.steps, c.fe), "I3"))
 
 
 @_once

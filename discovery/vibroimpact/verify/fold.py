@@ -17,6 +17,7 @@ from functools import cached_property
 
 import numpy as np
 
+from ...numerics.memo import Memo
 from ..data.contact_edges import _edge_params, _sampled_support
 from ..data.impulse import Impulse
 
@@ -68,13 +69,56 @@ class Fold:
         return self.origin + self.n_cycles * self.duration
 
     def average(self, values):
-        """Bin means of ``values`` (one per folded sample), ndarray of shape (k,)."""
+        """Bin means of ``values`` (one per folded sample), ndarray of shape (k,); for a
+        read-only array, kept (:meth:`_kept_for`)."""
+        return self._kept_for("average", values, self._bin_means)
+
+    def positive_phases(self, values):
+        """The phase intervals ``(a, b)`` (first and last bin's phase) of each run of bins
+        whose mean of ``values`` is positive, ndarray of shape (r, 2) (where a folded
+        penetration says the bodies touch); for a read-only array, kept."""
+        return self._kept_for("positive", values, self._positive_phases)
+
+    def _bin_means(self, values):
         return (
             np.bincount(
                 self.bins, weights=np.asarray(values, dtype=float), minlength=self.counts.size
             )
             / self.counts
         )
+
+    def _positive_phases(self, values):
+        on = self.average(values) > 0.0
+        d = np.diff(np.concatenate([[0], on.astype(np.int8), [0]]))
+        first, last = np.flatnonzero(d == 1), np.flatnonzero(d == -1) - 1
+        return np.column_stack([self.phase[first], self.phase[last]]).reshape(-1, 2)
+
+    @cached_property
+    def _kept(self):
+        return Memo(8)
+
+    def _kept_for(self, what, values, compute):
+        """``compute(values)``; for a read-only array (a block's recorded channels, a
+        memoised simulation's) the result is kept, read-only, and the same object comes
+        back when the same array is asked for again (the fitting loops ask for the recorded
+        side at every evaluation).  The entry holds the array, so its id is not reused."""
+        if not (isinstance(values, np.ndarray) and not values.flags.writeable):
+            return compute(values)
+
+        def computed():
+            out = compute(values)
+            out.setflags(write=False)
+            return values, out
+
+        kept, out = self._kept.get((what, id(values)), computed)
+        # the entry is this very array's (a copied fold's entries could name another's id)
+        return out if kept is values else compute(values)
+
+    def __getstate__(self):
+        # what the fold keeps stays in this process (a worker's arrays have other ids)
+        state = dict(self.__dict__)
+        state.pop("_kept", None)
+        return state
 
     @cached_property
     def knots(self):

@@ -43,12 +43,6 @@ WINDOW_PAD = 0.01
 """The contact window's widening on each side, in drive periods (as the force criteria's)."""
 
 
-def _runs(mask):
-    """``(first, last)`` bin indices of each run of ``True`` in ``mask``."""
-    d = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
-    return zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1) - 1, strict=True)
-
-
 def contact_window(fold, impulses, penetrations=(), pad=WINDOW_PAD):
     """Whether each of the fold's bins lies in the contact window, ndarray of bool of shape
     (k,): where either side is in contact by its force (the ``impulses``' supports) or by
@@ -59,9 +53,7 @@ def contact_window(fold, impulses, penetrations=(), pad=WINDOW_PAD):
     W = fold.duration
     pad = pad * fold.period
     iv = [np.asarray(imp.support, dtype=float).reshape(-1, 2) for imp in impulses]
-    for z in penetrations:
-        on = fold.average(z) > 0.0
-        iv.append(np.array([[fold.phase[a], fold.phase[b]] for a, b in _runs(on)]).reshape(-1, 2))
+    iv += [fold.positive_phases(z) for z in penetrations]
     return in_widened_intervals(fold.phase, np.concatenate(iv), pad, W)
 
 

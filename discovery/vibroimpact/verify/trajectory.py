@@ -229,7 +229,10 @@ def record_span(
             td_all, o, cycle.n_periods, T, (o, o + count * W + 0.5 * (td_all[1] - td_all[0]))
         )
         state = free_flight_state(measurement, scenario, runs[j], mids[j], time_offset=time_offset)
-        Fi = F[fold.idx]
+        # the block's recorded channels, read-only: the fold keeps what it computes of them
+        Fi, Zi = F[fold.idx], zeta[fold.idx]
+        Fi.setflags(write=False)
+        Zi.setflags(write=False)
         peak = float(np.max(fold.average(Fi)))
         thr = max(5.0 * sigma / np.sqrt(fold.n_cycles), 1e-3 * peak)
         blk = Block(
@@ -237,7 +240,7 @@ def record_span(
             state=state,
             F=Fi,
             threshold=thr,
-            Z=zeta[fold.idx],
+            Z=Zi,
             impacts_before=int(np.count_nonzero(onsets + time_offset < state.t)),
         )
         if not len(fold.impulse(Fi, threshold=thr, noise=sigma).support):
