@@ -240,3 +240,28 @@ def test_compare_errors():
     zero = imp([0, 1], [0, 0], 1, np.zeros((0, 2)))
     with pytest.raises(InputError, match="undefined"):
         evaluate_criteria(zero, e, names=["I2"])
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_one_folds_two_sides_compare_as_through_the_union(seed, monkeypatch):
+    """Two impulses on the same knots (a fold's measured and simulated cycles) take the
+    grid once; the comparison and every criterion are bitwise those of the general union
+    of two grids."""
+    import discovery.vibroimpact.verify.criteria as C
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(5, 60))
+    t = np.sort(np.concatenate([[0.0, 1.0], rng.uniform(0, 1, n)]))
+    if seed % 2:  # a jump inside the cycle: a repeated knot
+        t = np.sort(np.concatenate([t, t[n // 2 : n // 2 + 1]]))
+    Fe = np.abs(rng.normal(size=t.size))
+    Fn = np.abs(Fe + 0.2 * rng.normal(size=t.size))
+    sup = np.array([[0.0, float(t[-2])]])
+    e = dataclasses.replace(imp(t, Fe, 1.0, sup), noise=0.01 * (seed % 3), threshold=0.01)
+    s = imp(t.copy() if seed % 3 else t, Fn, 1.0, sup)
+    fast, fast_v = compare(e, s), evaluate_criteria(e, s)
+    monkeypatch.setattr(C, "_same_grid", lambda a, b: False)
+    slow, slow_v = compare(e, s), evaluate_criteria(e, s)
+    for f in ("t", "fe", "fn", "support_e", "support_n"):
+        assert np.array_equal(getattr(fast, f), getattr(slow, f))
+    assert fast_v == slow_v
