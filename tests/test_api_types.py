@@ -337,3 +337,19 @@ def test_the_checks_name_the_arguments_as_the_signature_binds_them():
                 except TypeError:
                     expected = None
                 assert arguments(args, kwargs) == expected, (f.__name__, args, kwargs)
+
+
+def test_unchecked_is_the_function_past_its_checks(paper):
+    """The inner loops' way past the argument checks runs the same function (the same
+    result for a valid call), while the public name still checks every call."""
+    from discovery._validate import unchecked
+    from discovery.vibroimpact.dynamics import simulate
+
+    raw = unchecked(simulate)
+    assert raw is not simulate and unchecked(raw) is raw
+    T = paper.period
+    a = simulate(paper, paper.law, (0.0, T), t_eval=[0.5 * T])
+    b = raw(paper, paper.law, (0.0, T), t_eval=[0.5 * T])
+    assert np.array_equal(a.y, b.y) and np.array_equal(a.event_t, b.event_t)
+    with pytest.raises(VidiTypeError, match="simulate: law must be a ForceLaw"):
+        simulate(paper, "2e8*z", (0.0, T))

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._validate import unchecked
 from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
 from ..data.contact_edges import contact_onsets
@@ -264,7 +265,7 @@ def _simulate_block(scenario, law, blk, y0, tolerances, **kwargs):
     sampled at its sample times."""
     fold, st = blk.fold, blk.state
     scenario = blk.machine(scenario)
-    return simulate(
+    return unchecked(simulate)(
         scenario,
         law,
         (min(st.t, fold.td[0]), fold.end),
@@ -473,7 +474,8 @@ def block_criteria(measured, simulated, span, names=None):
     mean : dict
     per_block : list of dict
     """
-    per = [evaluate_criteria(m, s, names) for m, s in zip(measured, simulated, strict=True)]
+    criteria = unchecked(evaluate_criteria)
+    per = [criteria(m, s, names) for m, s in zip(measured, simulated, strict=True)]
     w = np.array([b.fold.n_cycles for b in span.blocks], dtype=float)
     w = w / w.sum()
     return {k: float(np.dot(w, [p[k] for p in per])) for k in per[0]}, per
