@@ -45,7 +45,7 @@ def announce_compile(kernel="vibro-impact", stream=None):
     if cached(kernel):
         return
     print(
-        f"vidi: compiling the {kernel} simulator once (about half a minute on two cores; "
+        f"vidi: compiling the {kernel} simulator once (under a minute on two cores; "
         "cached for every later run; `make install` does it ahead)",
         file=stream or sys.stderr,
         flush=True,

@@ -82,3 +82,20 @@ def test_warm_announces_the_compile_once(tmp_path, monkeypatch, capsys):
     C.announce_compile("vibro-impact")  # what the first run would print
     out, err = capsys.readouterr()
     assert out.count("compiling the simulators once") == 1 and "vidi: compiling" not in err
+
+
+def test_the_install_compiles_every_entry_of_the_oscillators_kernel(monkeypatch):
+    """`make install` (discovery.warm) leaves each compiled entry point of Ueda's kernel in
+    the cache, the chart's scan and Floquet check too: a first chart after the install
+    compiled those in its workers (4-8 s of each worker's time)."""
+    import re
+    from pathlib import Path
+
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    folder, _ = C.KERNELS["oscillator"]
+    src = (Path(folder) / "_kernel.py").read_text()
+    entries = re.findall(r"@njit\(cache=True\)\ndef (\w+)\(", src)
+    assert {"scan_run", "monodromy_run", "strobe_run"} <= set(entries)
+    cached = {p.name for p in C._cache_folder(folder).iterdir() if p.suffix == ".nbi"}
+    missing = [e for e in entries if not any(n.startswith(f"_kernel.{e}-") for n in cached)]
+    assert not missing, f"not compiled by discovery.warm: {missing}"
