@@ -24,7 +24,6 @@ the measured one is sensor noise.  When the two cycles differ
 import functools
 import math
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 
@@ -72,12 +71,12 @@ class Comparison:
     length: float
     _values: dict = field(default_factory=dict, repr=False, compare=False)
 
-    @cached_property
+    @functools.cached_property
     def steps(self):
         """The grid's steps ``diff(t)`` (every integral's)."""
         return np.diff(self.t)
 
-    @cached_property
+    @functools.cached_property
     def difference(self):
         """``fn - fe`` at ``t``."""
         return self.fn - self.fe
