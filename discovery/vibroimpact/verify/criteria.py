@@ -71,16 +71,6 @@ class Comparison:
     length: float
     _values: dict = field(default_factory=dict, repr=False, compare=False)
 
-    @functools.cached_property
-    def steps(self):
-        """The grid's steps ``diff(t)`` (every integral's)."""
-        return np.diff(self.t)
-
-    @functools.cached_property
-    def difference(self):
-        """``fn - fe`` at ``t``."""
-        return self.fn - self.fe
-
 
 def _grid_points(imp, length):
     """(times, is_right_limit) of one impulse's nodes repeated over ``length``."""
@@ -197,8 +187,9 @@ def _safe(num, den, name):
 
 
 def _once(fn):
-    """A criterion's function computed once per :class:`Comparison` (I0 is made of I1 and
-    I4, which are asked for too)."""
+    """A function of a :class:`Comparison` computed once for it: the parts several
+    criteria share (I0 is made of I1 and I4, which are asked for too; every integral takes
+    the grid's steps, three the force difference)."""
 
     @functools.wraps(fn)
     def once(c):
@@ -210,16 +201,26 @@ def _once(fn):
 
 
 @_once
+def _steps(c):
+    return np.diff(c.t)
+
+
+@_once
+def _difference(c):
+    return c.fn - c.fe
+
+
+@_once
 def _i1(c):
-    return _safe(float(np.max(np.abs(c.difference))), float(np.max(np.abs(c.fe))), "I1")
+    return _safe(float(np.max(np.abs(_difference(c)))), float(np.max(np.abs(c.fe))), "I1")
 
 
 def _i2(c):
-    return _safe(_int_abs(c.steps, c.difference), _int_abs(c.steps, c.fe), "I2")
+    return _safe(_int_abs(_steps(c), _difference(c)), _int_abs(_steps(c), c.fe), "I2")
 
 
 def _i3(c):
-    return math.sqrt(_safe(_int_sq(c.steps, c.difference), _int_sq(c.steps, c.fe), "I3"))
+    return math.sqrt(_safe(_int_sq(_steps(c), _difference(c)), _int_sq(_steps(c), c.fe), "I3"))
 
 
 @_once
