@@ -159,6 +159,8 @@ def register(sub):
     _options.add_intervals_option(s, "the final model's 95 % parameter intervals")
     _options.add_seed_option(s, "seed of the noise-floor bootstrap")
     _options.add_interval_refit_option(s)
-    _options.add_parallel_options(s, "the screening refits and the bootstrap intervals' refits")
+    _options.add_parallel_options(
+        s, "the screening refits, the bootstrap intervals' refits and the record's blocks"
+    )
     _options.add_out_option(s)
     s.set_defaults(func=run)

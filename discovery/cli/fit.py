@@ -312,7 +312,9 @@ def _add_check_options(p):
     _options.add_intervals_option(p, "the selected law's 95 % coefficient intervals")
     _options.add_interval_refit_option(p)
     _options.add_workers_option(
-        p, "the refinements of each search step and the bootstrap intervals' refits"
+        p,
+        "the refinements of each search step (a lone one: its record blocks) and the "
+        "bootstrap intervals' refits",
     )
     p.add_argument(
         "--allow-unphysical",

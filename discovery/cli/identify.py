@@ -255,7 +255,7 @@ def register(sub):
         s, "the 95 % coefficient intervals", "records with positions; 0 = none"
     )
     _options.add_interval_refit_option(s)
-    _options.add_workers_option(s, "the bootstrap intervals' refits")
+    _options.add_workers_option(s, "the fit's record blocks and the bootstrap intervals' refits")
     _options.add_seed_option(s, "seed of the noise-floor and interval bootstraps")
     _options.add_out_option(s)
     s.set_defaults(func=run)

@@ -37,7 +37,7 @@ from .._validate import Real, Text, params
 from ..errors import InputError
 from ._workers import terminate_pool, worker_initializer
 
-__all__ = ["Executor", "Serial", "Pool", "Dask", "make_executor", "map_on"]
+__all__ = ["Executor", "Serial", "Pool", "Dask", "make_executor", "map_on", "one_blas_thread"]
 
 _CONTEXT = {}  # the context of the sweep running in this (worker) process
 _THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
@@ -48,7 +48,7 @@ def _set_context(context):
     _CONTEXT["value"] = context
 
 
-def _one_blas_thread():
+def one_blas_thread():
     """A job runs with one BLAS thread wherever it runs.  A BLAS with its default threads
     gains nothing on these small jobs: its idle threads spin, using a second core's CPU
     time for one core's wall time, and in parallel workers they take the other workers'
@@ -62,7 +62,7 @@ def _one_blas_thread():
 
 
 def _job(fn, context, job):
-    with _one_blas_thread():
+    with one_blas_thread():
         return fn(context, job)
 
 

@@ -69,6 +69,13 @@ class Memo:
         self._d.move_to_end(key)
         return value
 
+    def __contains__(self, key):
+        """Whether ``key`` is stored (not counted as a hit or a miss)."""
+        try:
+            return key in self._d
+        except TypeError:
+            return False
+
     def clear(self):
         self._d.clear()
         self.hits = self.misses = 0

@@ -53,6 +53,7 @@ from ..fit.intervals import INTERVAL_REFITS, bootstrap_intervals
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from ..verify import Reference
+from ..verify.block_farm import block_workers, shared_blocks
 from ..verify.motion import MOTION_CRITERION
 from .disagreement import localise
 from .effects import EFFECTS, Model
@@ -427,8 +428,10 @@ def explain(
         the whole catalogue: a score test is local, and an effect that ranked low at a
         far start was the one that explained the record).
     workers : int, optional
-        Processes for the screening refits (default: all cores; the result does not
-        depend on it).
+        Processes for the screening refits and the bootstrap intervals' refits, and for
+        the record's blocks in the sequential fits (the start's, the winner's polish:
+        :mod:`~discovery.vibroimpact.verify.block_farm`) (default: all cores; the result
+        does not depend on it).
     executor : Executor, optional
         Where the screening refits run (:mod:`discovery.numerics.executor`); overrides ``workers``
         and is not closed here.
@@ -475,45 +478,48 @@ def explain(
         meas_first=ms[0] if not isinstance(ms[0], Reference) else None,
         stopped=f"the budget of {s.max_iterations} added effect(s) is used",
     )
-    fit = _fit_start(run, start, plain if all_plain else None, progress)
-    if not any(isinstance(m, Reference) for m in ms):
-        run.drift = _Drift(pairs, records)
-    run.model, run.uncertainties = Model(fit.law), dict(fit.standard_errors)
-    for _ in range(s.max_iterations + 1):
-        tick(progress, _ITERATIONS, len(run.iterations), s.max_iterations)
-        if not _iteration(run, s.max_iterations):
-            break
-    dropped = drop_collapsed(run)
-    evs = problem.evaluations(run.model, floor=True)
-    crit, floor = _with_drift(
-        _mean(evs, "criteria"), _mean(evs, "noise_floor"), run.drift, run.model
-    )
-    return ExplainResult(
-        intervals=_intervals(run, s.n_boot_intervals, s.seed, progress, s.interval_refit),
-        iterations=tuple(run.iterations),
-        final_model=run.model,
-        uncertainties=run.uncertainties,
-        criteria=crit,
-        noise_floor=floor,
-        limits=dict(evs[0].limits) if len(evs) == 1 else {},
-        consistent=all(e.consistent for e in evs) and run.drift_free(run.model),
-        stopped_because=run.stopped,
-        separability=tuple(run.separability),
-        dropped=tuple(dropped),
-        seconds=time.perf_counter() - t0,
-        settings={
-            "start": str(start),
-            "criterion": s.criterion,
-            "alpha": s.alpha,
-            "max_iterations": s.max_iterations,
-            "max_simulations": budget,
-            "n_boot": s.n_boot,
-            "seed": s.seed,
-            "effects": [e.id for e in catalogue],
-            "max_refits": s.max_refits,
-            "workers": s.workers,
-            "intervals": {"replicates": s.n_boot_intervals, "refit": s.interval_refit},
-            "records": len(records),
-            "simulations": problem.n_sim,
-        },
-    )
+    # the sequential fits (the start's, the winner's polish, the verifications) share out
+    # each evaluation's blocks over the workers the screening refits use
+    with shared_blocks([r for _, r in records], block_workers(s.workers, executor)):
+        fit = _fit_start(run, start, plain if all_plain else None, progress)
+        if not any(isinstance(m, Reference) for m in ms):
+            run.drift = _Drift(pairs, records)
+        run.model, run.uncertainties = Model(fit.law), dict(fit.standard_errors)
+        for _ in range(s.max_iterations + 1):
+            tick(progress, _ITERATIONS, len(run.iterations), s.max_iterations)
+            if not _iteration(run, s.max_iterations):
+                break
+        dropped = drop_collapsed(run)
+        evs = problem.evaluations(run.model, floor=True)
+        crit, floor = _with_drift(
+            _mean(evs, "criteria"), _mean(evs, "noise_floor"), run.drift, run.model
+        )
+        return ExplainResult(
+            intervals=_intervals(run, s.n_boot_intervals, s.seed, progress, s.interval_refit),
+            iterations=tuple(run.iterations),
+            final_model=run.model,
+            uncertainties=run.uncertainties,
+            criteria=crit,
+            noise_floor=floor,
+            limits=dict(evs[0].limits) if len(evs) == 1 else {},
+            consistent=all(e.consistent for e in evs) and run.drift_free(run.model),
+            stopped_because=run.stopped,
+            separability=tuple(run.separability),
+            dropped=tuple(dropped),
+            seconds=time.perf_counter() - t0,
+            settings={
+                "start": str(start),
+                "criterion": s.criterion,
+                "alpha": s.alpha,
+                "max_iterations": s.max_iterations,
+                "max_simulations": budget,
+                "n_boot": s.n_boot,
+                "seed": s.seed,
+                "effects": [e.id for e in catalogue],
+                "max_refits": s.max_refits,
+                "workers": s.workers,
+                "intervals": {"replicates": s.n_boot_intervals, "refit": s.interval_refit},
+                "records": len(records),
+                "simulations": problem.n_sim,
+            },
+        )

@@ -49,6 +49,7 @@ from ..dynamics import Tolerances
 from ..model.library import Library
 from ..model.scenario import Scenario
 from ..verify import Reference
+from ..verify.block_farm import block_workers, shared_blocks
 from ..verify.criteria import criterion as _criterion
 from .discovery_result import DiscoveryResult, RankedModel
 from .discovery_warnings import _defects_warning, _warnings
@@ -275,9 +276,10 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
         How a bootstrap replicate is refitted (``"two-step"`` or ``"full"``: see
         :func:`discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
     workers : int or None
-        Processes for the refinements of the shortlist and of each stepwise move, and for
-        the bootstrap's refits (default 1; ``None``: every core); the result does not
-        depend on it.
+        Processes for the refinements of the shortlist and of each stepwise move (a lone
+        refinement shares out its evaluations' blocks:
+        :mod:`~discovery.vibroimpact.verify.block_farm`), and for the bootstrap's refits
+        (default 1; ``None``: every core); the result does not depend on it.
     progress : callable or bool, optional
         ``progress(stage, done, total)`` as the shortlist is simulated and the stepwise
         search and the bootstrap go on; None: a bar when the session is
@@ -330,15 +332,18 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
         required=required,
         workers=s.workers,
     )
-    models = _shortlist(check, est, required, s.shortlist, progress)
-    by_score = list(models)  # the estimator's order (its scoring)
-    rule = _RankingRule(s.criterion, s.sim_rtol, s.sim_atol, s.physics)
-    search = _Stepwise(check, rule, stepwise=s.stepwise, max_terms=s.max_terms)
-    ranking = search.run(models, refs, s.refine, progress)
-    boot = _Bootstrap(
-        s.n_boot_intervals, seed, s.workers, s.interval_refit, s.criterion, s.tolerances
-    )
-    selected, ranking = boot.selected(ranking, refs, s.refine, progress)
+    # a refinement run here (a step with one trial, say) shares out its evaluations'
+    # blocks over the workers (the steps' trials run in parallel processes)
+    with shared_blocks([r for _, r in refs], block_workers(s.workers)):
+        models = _shortlist(check, est, required, s.shortlist, progress)
+        by_score = list(models)  # the estimator's order (its scoring)
+        rule = _RankingRule(s.criterion, s.sim_rtol, s.sim_atol, s.physics)
+        search = _Stepwise(check, rule, stepwise=s.stepwise, max_terms=s.max_terms)
+        ranking = search.run(models, refs, s.refine, progress)
+        boot = _Bootstrap(
+            s.n_boot_intervals, seed, s.workers, s.interval_refit, s.criterion, s.tolerances
+        )
+        selected, ranking = boot.selected(ranking, refs, s.refine, progress)
     # the certificate of the law actually selected (the ranking may prefer another
     # candidate than the estimator's best by BIC); a failure is an error
     cert = require_certificate(selected.certificate)

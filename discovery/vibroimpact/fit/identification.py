@@ -47,6 +47,7 @@ from ..dynamics import Tolerances
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
+from ..verify.block_farm import block_workers, shared_blocks
 from ..verify.criteria import criteria_lines
 from ..verify.evaluation import Evaluation
 
@@ -398,8 +399,9 @@ def identify(scenario, reference, start, *, settings=None, progress=None, **opti
     seed : int
         Seed of that bootstrap.
     workers : int or None
-        Processes for the bootstrap's refits (default 1; ``None``: every core; the
-        intervals do not depend on it).
+        Processes for the fit's evaluations (a record compared over its span is shared out
+        block by block: :mod:`~discovery.vibroimpact.verify.block_farm`) and the bootstrap's
+        refits (default 1; ``None``: every core; the result does not depend on it).
     interval_refit : str
         How a bootstrap replicate is refitted (:func:`bootstrap_intervals`: ``"two-step"``).
     interval_noise : str
@@ -439,6 +441,13 @@ def identify(scenario, reference, start, *, settings=None, progress=None, **opti
     records = _checked(
         scenario, reference, start, method=s.method, xtol=s.xtol, max_simulations=s.max_simulations
     )
+    # every evaluation's blocks shared out over ``workers`` processes (none with one)
+    with shared_blocks([r for _, r in records], block_workers(s.workers)):
+        return _identified(records, start, s, progress)
+
+
+def _identified(records, start, s, progress):
+    """:func:`identify` on checked ``records`` with its settings ``s``."""
     t0 = time.perf_counter()
     spent, short_value = 0, None
     if s.short_first:

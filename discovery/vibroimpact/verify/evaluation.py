@@ -40,7 +40,7 @@ from ..dynamics.steady_states import steady_state
 from .criteria import compare, criteria_lines, evaluate_criteria
 from .motion import MOTION_CRITERION, block_penetration
 from .notes import contacts_note, transient_notes
-from .trajectory import block_criteria, simulated_motion
+from .span_evaluation import span_run
 
 __all__ = [
     "Evaluation",
@@ -579,11 +579,14 @@ def _evaluate_span(
     reg = {"measured": reference.regime, "simulated": None}
     imp = {"measured": reference.impacts, "simulated": None}
     try:
-        hist, z_sim = simulated_motion(
-            scenario, law, span, tolerances=tolerances, observe=observe, window=smooth_onset
+        # every block run, folded and compared (shared out over a block farm when one holds
+        # the span: :mod:`~discovery.vibroimpact.verify.block_farm`)
+        blocks = span_run(
+            scenario, law, reference, tolerances=tolerances, observe=observe, window=smooth_onset
         )
     except IntegrationError as exc:
         return _failed(reg, imp, exc)
+    hist, z_sim = blocks.histories, blocks.penetrations
     if not any(np.any(h > 0) for h in hist):
         imp["simulated"] = 0
         return Evaluation(
@@ -595,10 +598,10 @@ def _evaluate_span(
             False,
             "inconsistent: the simulated bodies never come into contact over the record's span",
         )
-    sims = span.impulses(hist, onset_record_time=E.onset)
+    sims = blocks.impulses()
     sim = sims[-1]
     imp["simulated"] = int(len(sim.support))
-    crit, per_block = block_criteria(reference.blocks, sims, span)
+    crit, per_block = blocks.criteria(span)
     if span.sigma_z > 0:
         crit[MOTION_CRITERION], _ = block_penetration(
             span, reference.blocks, sims, [b.Z for b in span.blocks], z_sim

@@ -27,6 +27,7 @@ from ..data.impulse import Impulse
 from ..data.noise import estimate_noise
 from ..dynamics import _kernel as _K
 from ..dynamics.simulation import simulate
+from .block_farm import farm_for
 from .criteria import CRITERIA, evaluate_criteria
 from .fold import make_fold
 from .motion import MOTION_CRITERION, block_penetration
@@ -336,11 +337,37 @@ def _sensitivities(scenario, law, blk, tolerances):
     return MEMO.get(key, lambda: (blk, *_sensitivity_run(scenario, law, blk, tolerances)))[1:]
 
 
+def sensitivity_outcome(reference, k, scenario, law, tolerances):
+    """Block ``k``'s sensitivity run (:func:`_sensitivity_run`), or the exception it
+    raised (a block farm's job)."""
+    try:
+        return _sensitivity_run(scenario, law, reference.span.blocks[k], tolerances)
+    except Exception as exc:  # raised where the block is asked for, in block order
+        return exc
+
+
+def _shared_sensitivities(scenario, law, span, tolerances):
+    """The span's sensitivity runs made on the block farm that holds it, when one does
+    (:func:`~.block_farm.shared_blocks`), and kept in :data:`MEMO` as if made here (a block
+    whose run failed is left to be run, and to fail, here)."""
+    farm = farm_for(span)
+    if farm is None:
+        return
+    keys = [value_key("sensitivities", scenario, law, tolerances, id(b)) for b in span.blocks]
+    if all(k in MEMO for k in keys):
+        return
+    outcomes = farm.map(sensitivity_outcome, span, (scenario, law, tolerances)) or []
+    for blk, key, o in zip(span.blocks, keys, outcomes, strict=False):
+        if not isinstance(o, Exception):
+            MEMO.get(key, lambda blk=blk, o=o: (blk, *o))
+
+
 def penetration_sensitivities(scenario, law, span, *, tolerances=None):
     """The derivatives of the simulated penetration at the span's sample times along the
     law's coefficients (loading, then unloading terms), one array of shape (m, samples)
     per block, from the same runs as :func:`history_sensitivities` (a contact offset only
     shifts the penetration, so it is the model's)."""
+    _shared_sensitivities(scenario, law, span, tolerances)
     return [_sensitivities(scenario, law, blk, tolerances)[4] for blk in span.blocks]
 
 
@@ -356,6 +383,7 @@ def history_sensitivities(scenario, law, span, *, tolerances=None, observe=None)
     :class:`~discovery.errors.IntegrationError` when a run fails."""
     if observe is not None and not getattr(observe, "linear", False):
         raise InputError("the observation model is not linear in the force")
+    _shared_sensitivities(scenario, law, span, tolerances)
     out = []
     for blk in span.blocks:
         td = blk.fold.td
@@ -417,8 +445,7 @@ def _runs(scenario, law, span, tolerances, starts):
     fitting loops ask again) or from ``starts`` (a bootstrap draw: asked once)."""
     for k, blk in enumerate(span.blocks):
         if starts is None:
-            key = value_key(scenario, law, tolerances, id(blk))
-            yield MEMO.get(key, lambda b=blk: (b, *_block_run(scenario, law, b, None, tolerances)))
+            yield _memo_run(scenario, law, blk, tolerances)
         else:
             yield (blk, *_block_run(scenario, law, blk, starts[k], tolerances))
 
@@ -430,22 +457,35 @@ def simulated_motion(
     span's sample times: ``(histories, penetrations)``, one array per block each."""
     out, zs = [], []
     for blk, F, onsets, Z in _runs(scenario, law, span, tolerances, starts):
-        fold = blk.fold
-        td = fold.td
         zs.append(Z)
-        Fs = F.copy()
-        if window and td.size > 1:
-            # the sample whose interval [e_i, e_i+1) holds a contact onset at fraction u is
-            # blended towards the record's value with weight |2u - 1|: its residual is 0
-            # when the onset crosses the sample time (where the point value jumps) and
-            # whole at the interval's ends, so the residual is continuous in the law's
-            # coefficients and unbiased (at the truth it is the record's noise, weighted)
-            k, u, _, _ = _onset_weights(td, onsets)
-            if k.size:
-                w = np.abs(2.0 * u - 1.0)
-                Fs[k] = blk.F[k] + w * (Fs[k] - blk.F[k])
-        out.append(Fs if observe is None else _observed(fold, Fs, observe))
+        out.append(_history(blk, F, onsets, observe, window))
     return out, zs
+
+
+def _history(blk, F, onsets, observe, window):
+    """A block's simulated force at its sample times as the comparison sees it: with
+    ``window``, onset samples blended towards the record (:func:`simulated_history`); seen
+    through ``observe``."""
+    fold = blk.fold
+    td = fold.td
+    Fs = F.copy()
+    if window and td.size > 1:
+        # the sample whose interval [e_i, e_i+1) holds a contact onset at fraction u is
+        # blended towards the record's value with weight |2u - 1|: its residual is 0
+        # when the onset crosses the sample time (where the point value jumps) and
+        # whole at the interval's ends, so the residual is continuous in the law's
+        # coefficients and unbiased (at the truth it is the record's noise, weighted)
+        k, u, _, _ = _onset_weights(td, onsets)
+        if k.size:
+            w = np.abs(2.0 * u - 1.0)
+            Fs[k] = blk.F[k] + w * (Fs[k] - blk.F[k])
+    return Fs if observe is None else _observed(fold, Fs, observe)
+
+
+def _memo_run(scenario, law, blk, tolerances):
+    """A block's run from its measured state, memoised (:data:`MEMO`)."""
+    key = value_key(scenario, law, tolerances, id(blk))
+    return MEMO.get(key, lambda: (blk, *_block_run(scenario, law, blk, None, tolerances)))
 
 
 def _observed(fold, Fs, observe):
@@ -476,9 +516,70 @@ def block_criteria(measured, simulated, span, names=None):
     """
     criteria = unchecked(evaluate_criteria)
     per = [criteria(m, s, names) for m, s in zip(measured, simulated, strict=True)]
+    return _block_mean(per, span), per
+
+
+def _block_mean(per, span):
+    """The blocks' criteria ``per`` averaged, weighted by the blocks' cycles."""
     w = np.array([b.fold.n_cycles for b in span.blocks], dtype=float)
     w = w / w.sum()
-    return {k: float(np.dot(w, [p[k] for p in per])) for k in per[0]}, per
+    return {k: float(np.dot(w, [p[k] for p in per])) for k in per[0]}
+
+
+@dataclass(frozen=True)
+class _FloorJob:
+    """What every replicate of one noise floor is asked (:func:`_floor_replicate`): the
+    machine and law, the noise-free folded blocks, the runs from the measured states
+    (``(histories, penetrations)``, or ``None`` when they failed), the integrator's
+    settings, the observation model and the criteria's names."""
+
+    scenario: object
+    law: object
+    simulated: list
+    measured: tuple | None
+    tolerances: object
+    observe: object
+    names: list
+
+
+def _floor_replicate(span, draw, job):
+    """One replicate of :func:`span_floor` from its ``draw`` (start states, force and
+    penetration noise): ``(criteria, contacts in its last block)``, or ``None`` when its
+    record cannot be folded."""
+    starts, noise, noise_z = draw
+    measured = job.measured
+    sc, law, tol, observe = job.scenario, job.law, job.tolerances, job.observe
+    try:
+        # the truth as a record holds it: point samples
+        hist, zs = simulated_motion(sc, law, span, tolerances=tol, starts=starts, observe=observe)
+    except IntegrationError:  # a failed draw: the measured states' histories instead
+        if measured is None:
+            measured = simulated_motion(sc, law, span, tolerances=tol, observe=observe)
+        hist, zs = measured
+    try:
+        reps = span.impulses([h + e for h, e in zip(hist, noise, strict=True)])
+        crit, _ = block_criteria(reps, job.simulated, span)
+    except InputError:
+        return None
+    if MOTION_CRITERION in job.names:
+        # the noise-free penetrations from the measured states
+        z_sim = (
+            measured[1]
+            if measured is not None
+            else simulated_motion(sc, law, span, tolerances=tol)[1]
+        )
+        crit[MOTION_CRITERION] = block_penetration(
+            span, reps, job.simulated, [z + e for z, e in zip(zs, noise_z, strict=True)], z_sim
+        )[0]
+    return crit, int(len(reps[-1].support))
+
+
+def _floor_job(reference, draw, job):
+    """:func:`_floor_replicate` on a block farm (the exception it raised, returned)."""
+    try:
+        return _floor_replicate(reference.span, draw, job)
+    except Exception as exc:
+        return exc
 
 
 def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=None, observe=None):
@@ -500,37 +601,34 @@ def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=
     # the penetration noise from its own stream: the force criteria's floor is unchanged
     rng_z = np.random.default_rng((seed, 5))
     names = list(CRITERIA) + ([MOTION_CRITERION] if span.sigma_z > 0 else [])
-    samples = {n: [] for n in names}
-    impacts = []  # contacts per cycle each replicate shows (noise can split a contact)
-    base = None
-    z_sim = None
+    draws = []  # every replicate's draws first: the same streams, whoever runs them
     for _ in range(n_boot):
         starts = [b.state.draw(rng) for b in span.blocks]
         noise = [rng.normal(0.0, span.sigma_f, b.F.size) for b in span.blocks]
         noise_z = [rng_z.normal(0.0, span.sigma_z, b.F.size) for b in span.blocks]
-        try:
-            # the truth as a record holds it: point samples
-            hist, zs = simulated_motion(
-                scenario, law, span, tolerances=tolerances, starts=starts, observe=observe
-            )
-        except IntegrationError:  # a failed draw: the measured states' histories instead
-            if base is None:
-                base = simulated_motion(scenario, law, span, tolerances=tolerances, observe=observe)
-            hist, zs = base
-        try:
-            reps = span.impulses([h + e for h, e in zip(hist, noise, strict=True)])
-            crit, _ = block_criteria(reps, simulated, span)
-        except InputError:
+        draws.append((starts, noise, noise_z))
+    try:
+        # the noise-free runs from the measured states (memoised): a failed draw's stand-in
+        # and the penetrations the replicates' are compared with
+        measured = simulated_motion(scenario, law, span, tolerances=tolerances, observe=observe)
+    except IntegrationError:
+        measured = None  # a replicate that needs them runs them, and raises
+    job = _FloorJob(scenario, law, simulated, measured, tolerances, observe, names)
+    farm = farm_for(span)
+    replicates = None if farm is None else farm.map(_floor_job, span, (job,), items=draws)
+    if replicates is None:
+        replicates = [_floor_replicate(span, d, job) for d in draws]
+    samples = {n: [] for n in names}
+    impacts = []  # contacts per cycle each replicate shows (noise can split a contact)
+    for r in replicates:
+        if isinstance(r, Exception):
+            raise r
+        if r is None:  # the replicate could not be folded
             continue
-        if MOTION_CRITERION in samples:
-            if z_sim is None:  # the noise-free penetrations from the measured states
-                z_sim = simulated_motion(scenario, law, span, tolerances=tolerances)[1]
-            crit[MOTION_CRITERION] = block_penetration(
-                span, reps, simulated, [z + e for z, e in zip(zs, noise_z, strict=True)], z_sim
-            )[0]
+        crit, contacts = r
         for n, v in crit.items():
             samples[n].append(v)
-        impacts.append(int(len(reps[-1].support)))
+        impacts.append(contacts)
     if not samples["I2"]:
         inf = {n: float("inf") for n in names}
         return {

@@ -1,0 +1,149 @@
+"""A law evaluated on a record span block by block: each block's run from its measured
+state, its history, folded and compared (:func:`block_outcome`), for every block at once
+(:func:`span_run`), on the block farm that holds the span when one is open
+(:mod:`~discovery.vibroimpact.verify.block_farm`), else here in block order.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..._validate import unchecked
+from ...numerics.memo import value_key
+from .block_farm import farm_for
+from .criteria import evaluate_criteria
+from .trajectory import MEMO, _block_mean, _history, _memo_run
+
+__all__ = ["BlockJob", "BlockOutcome", "block_outcome", "SpanRun", "span_run"]
+
+
+@dataclass(frozen=True)
+class BlockOutcome:
+    """One block of an evaluation (:func:`block_outcome`): what was computed, and the first
+    exception where a stage failed.
+
+    Attributes
+    ----------
+    run : tuple or None
+        ``(F, onsets, Z)``: the run's force, contact onsets and penetration.
+    history : ndarray or None
+        The force as compared (:func:`_history`).
+    impulse : Impulse or None
+        The folded history.
+    criteria : dict or None
+        The criteria against the measured folded block.
+    error : Exception or None
+    stage : int
+        Where ``error`` came from: 0 none, 1 the run or its history, 2 the fold, 3 the
+        criteria.
+    """
+
+    run: tuple | None = None
+    history: np.ndarray | None = None
+    impulse: object = None
+    criteria: dict | None = None
+    error: Exception | None = None
+    stage: int = 0
+
+
+@dataclass(frozen=True)
+class BlockJob:
+    """What every block of one evaluation is asked (:func:`block_outcome`): the machine,
+    the law, the integrator's settings, the observation model, the onset window
+    (:func:`simulated_history`) and the record's onset time."""
+
+    scenario: object
+    law: object
+    tolerances: object = None
+    observe: object = None
+    window: bool = False
+    onset: float | None = None
+
+
+def block_outcome(reference, k, job):
+    """Block ``k`` of ``reference``'s span evaluated for ``job`` (a :class:`BlockJob`): the
+    law's run from the block's measured state, its history, folded, and its criteria (a
+    function of its arguments: the same here or in a worker of a
+    :mod:`~discovery.vibroimpact.verify.block_farm`)."""
+    span = reference.span
+    blk = span.blocks[k]
+    try:
+        _, F, onsets, Z = _memo_run(job.scenario, job.law, blk, job.tolerances)
+        H = _history(blk, F, onsets, job.observe, job.window)
+    except Exception as exc:  # raised by the caller, in block order
+        return BlockOutcome(error=exc, stage=1)
+    run = (F, onsets, Z)
+    try:
+        imp = blk.fold.impulse(
+            H, threshold=blk.threshold, noise=span.sigma_f, onset_record_time=job.onset
+        )
+    except Exception as exc:
+        return BlockOutcome(run, H, error=exc, stage=2)
+    try:
+        crit = unchecked(evaluate_criteria)(reference.blocks[k], imp, None)
+    except Exception as exc:
+        return BlockOutcome(run, H, imp, error=exc, stage=3)
+    return BlockOutcome(run, H, imp, crit)
+
+
+@dataclass(frozen=True)
+class SpanRun:
+    """Every block of a span evaluated (:func:`span_run`), in block order.  Each stage's
+    first failure in block order is raised where the stage's results are asked for, as a
+    block-by-block evaluation would raise it."""
+
+    outcomes: tuple
+
+    def _raise(self, stage):
+        for o in self.outcomes:
+            if o.stage == stage:
+                raise o.error
+
+    @property
+    def histories(self):
+        return [o.history for o in self.outcomes]
+
+    @property
+    def penetrations(self):
+        return [o.run[2] for o in self.outcomes]
+
+    def impulses(self):
+        """Each block's folded history."""
+        self._raise(2)
+        return [o.impulse for o in self.outcomes]
+
+    def criteria(self, span):
+        """``(mean, per_block)`` as :func:`block_criteria`."""
+        self._raise(2)
+        self._raise(3)
+        per = [o.criteria for o in self.outcomes]
+        return _block_mean(per, span), per
+
+
+def span_run(scenario, law, reference, *, tolerances=None, observe=None, window=False):
+    """Every block of ``reference``'s span evaluated (:func:`block_outcome`): shared out over
+    the block farm that holds the span (:func:`~.block_farm.shared_blocks`), else here in
+    block order.  Raises the first block's run failure (as :func:`simulated_motion`);
+    the runs a farm made are kept in :data:`MEMO` as if made here."""
+    span = reference.span
+    job = BlockJob(scenario, law, tolerances, observe, window, reference.impulse.onset)
+    farm = farm_for(span)
+    outcomes = None if farm is None else farm.map(block_outcome, span, (job,))
+    if outcomes is not None:
+        for blk, o in zip(span.blocks, outcomes, strict=True):
+            if o.run is not None:
+                for a in o.run:
+                    a.setflags(write=False)
+                MEMO.get(
+                    value_key(scenario, law, tolerances, id(blk)),
+                    lambda blk=blk, o=o: (blk, *o.run),
+                )
+    else:
+        outcomes = []
+        for k in range(len(span.blocks)):
+            outcomes.append(block_outcome(reference, k, job))
+            if outcomes[-1].stage == 1:
+                break
+    out = SpanRun(tuple(outcomes))
+    out._raise(1)
+    return out
