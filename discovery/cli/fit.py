@@ -180,6 +180,7 @@ def _run_contact_models(args, scs, meas, t_start):
             max_simulations=args.max_simulations or 200,
             n_boot=args.intervals,
             seed=args.seed or 0,
+            workers=args.workers,
             progress=rep,
         )
     tail = {**provenance_of(args), "seconds": time.perf_counter() - t_start}
@@ -313,8 +314,8 @@ def _add_check_options(p):
     _options.add_interval_refit_option(p)
     _options.add_workers_option(
         p,
-        "the refinements of each search step (a lone one: its record blocks) and the "
-        "bootstrap intervals' refits",
+        "the refinements of each search step (a lone one: its record blocks; with "
+        "contact-models each fit's record blocks) and the bootstrap intervals' refits",
     )
     p.add_argument(
         "--allow-unphysical",

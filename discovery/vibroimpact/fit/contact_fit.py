@@ -38,6 +38,7 @@ from ..data.measurement import Measurement
 from ..model.contact_models import MODELS, same_force
 from ..model.scenario import Scenario
 from ..verify import Reference
+from ..verify.block_farm import block_workers, shared_blocks
 from .contact_starts import from_hunt_crossley, record_samples, regression_start, start_model
 from .identification import as_records, identify
 
@@ -261,6 +262,7 @@ def _intervals(res, records, settings):
             n_boot=settings["n_boot"],
             seed=settings["seed"],
             tolerances=settings["tolerances"],
+            workers=settings["workers"],
         )
         if iv is not None:
             return {k: tuple(v) for k, v in iv.bounds.items()}, "bootstrap"
@@ -323,6 +325,7 @@ def _fit_one(name, records, settings, progress, hunt_crossley=None):
     max_simulations=Real(2, integer=True),
     n_boot=Real(0, integer=True),
     seed=Real(0, integer=True),
+    workers=(None, Real(1, integer=True)),
 )
 @reports_progress
 def fit_contact_models(
@@ -334,6 +337,7 @@ def fit_contact_models(
     n_boot=30,
     seed=0,
     tolerances=None,
+    workers=1,
     progress=None,
 ):
     """Fit every named contact model to the record(s) and select the one they support.
@@ -353,6 +357,10 @@ def fit_contact_models(
         the fit's Jacobian).
     seed : int
     tolerances : Tolerances, optional
+    workers : int or None
+        Processes for each fit's record blocks (:mod:`~discovery.vibroimpact.verify.block_farm`)
+        and the bootstrap's refits (default 1; ``None``: every core; the result does not
+        depend on it).
     progress : callable or bool, optional
         ``progress(stage, done, total)`` as each model is fitted; None: a bar when the session is
         interactive, False: none (:mod:`discovery._progress`).
@@ -375,16 +383,18 @@ def fit_contact_models(
         "n_boot": int(n_boot),
         "seed": int(seed),
         "tolerances": tolerances,
+        "workers": workers,
     }
     fits = []
     # Hunt-Crossley first: its fit starts Lankarani-Nikravesh and Flores (the same force
     # at one impact velocity)
     order = sorted(names, key=lambda m: m in ("lankarani-nikravesh", "flores"))
-    for i, name in enumerate(order):
-        if progress is not None:
-            progress("contact models", i, len(names))
-        hc = next((f for f in fits if f.model == "hunt-crossley"), None)
-        fits.append(_fit_one(name, records, settings, None, hc))
+    with shared_blocks([ref for _, ref in records], block_workers(workers)):
+        for i, name in enumerate(order):
+            if progress is not None:
+                progress("contact models", i, len(names))
+            hc = next((f for f in fits if f.model == "hunt-crossley"), None)
+            fits.append(_fit_one(name, records, settings, None, hc))
     if progress is not None:
         progress("contact models", len(names), len(names))
     fits.sort(key=lambda f: f.value)

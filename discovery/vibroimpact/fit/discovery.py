@@ -169,13 +169,19 @@ def _settings(evidence, check, search, boot, *, shortlist, stability, n_boot, av
     }
 
 
-def _contact_models(scenario, measurement, n_boot, seed, progress):
+def _contact_models(scenario, measurement, s, progress):
     """``library="contact-models"``: the named contact models fitted by name
-    (:func:`~discovery.vibroimpact.fit.contact_fit.fit_contact_models`)."""
+    (:func:`~discovery.vibroimpact.fit.contact_fit.fit_contact_models`) with the settings
+    ``s`` (:class:`DiscoverSettings`: its intervals, seed and workers)."""
     from .contact_fit import fit_contact_models
 
     return fit_contact_models(
-        scenario, measurement, n_boot=n_boot, seed=0 if seed is None else seed, progress=progress
+        scenario,
+        measurement,
+        n_boot=s.n_boot_intervals,
+        seed=0 if s.seed is None else s.seed,
+        workers=s.workers,
+        progress=progress,
     )
 
 
@@ -301,7 +307,7 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
     """
     s, more = DiscoverSettings.of("discover", settings, options, rest=_ESTIMATOR_OPTIONS)
     if s.library == "contact-models":  # the named contact models, fitted by name
-        return _contact_models(scenario, measurement, s.n_boot_intervals, s.seed, progress)
+        return _contact_models(scenario, measurement, s, progress)
     t0 = time.perf_counter()
     seed = _seed(s.random_state, s.seed)
     _check_settings(

@@ -3,6 +3,7 @@ evaluations (with their noise floor), the exact Jacobians and identify's fit; a 
 fails the same way; a model it cannot send is evaluated here; the farm answers only in the
 process that made it, and leaves no worker behind."""
 
+import dataclasses
 import multiprocessing
 import os
 
@@ -144,3 +145,17 @@ def test_an_interrupted_farm_closes(record):
             farm.map(_interrupt, ref.span, ())
         assert not farm.holds(ref.span)  # closed: its answers would be out of step
         assert BF.farm_for(ref.span) is None
+
+
+def test_the_named_contact_models_on_a_farm_are_the_same_fits():
+    """``fit_contact_models(workers=2)``: each fit's blocks and the bootstrap's refits in
+    parallel, the same fits as on one process."""
+    from discovery.vibroimpact.fit.contact_fit import fit_contact_models
+
+    sc = load_scenario("paper")
+    m = reference_record((sc, sc.law), periods=8, seed=5, check=False)
+    kw = {"models": ("kelvin-voigt", "hertz-damper"), "max_simulations": 40, "n_boot": 5}
+    one = _fresh(lambda: fit_contact_models(sc, m, workers=1, **kw))
+    two = _fresh(lambda: fit_contact_models(sc, m, workers=2, **kw))
+    assert [dataclasses.asdict(f) for f in one.fits] == [dataclasses.asdict(f) for f in two.fits]
+    assert one.selected == two.selected
