@@ -19,7 +19,9 @@ function of the same values wherever it runs, and the mean is taken here, in blo
 
 A farm answers only in the process that made it (a pool forked while it is open does
 its jobs block by block), and only for the spans of the references it was made with
-(and their cycle-by-cycle versions, :meth:`Reference.shortened`).
+(and their cycle-by-cycle versions, :meth:`Reference.shortened`).  Items a worker cannot
+answer (an answer that cannot be sent, a worker lost) are done here; a lost worker closes
+the farm, and this process does every block from then on.
 """
 
 import contextlib
@@ -54,8 +56,10 @@ def _serve(conn, references, parent):
         if msg is None:
             return
         fn, i, items, shared = msg
-        args = pickle.loads(shared)
-        conn.send([fn(references[i], item, *args) for item in items])
+        try:
+            conn.send([fn(references[i], item, *pickle.loads(shared)) for item in items])
+        except Exception:  # an answer that cannot be sent: the parent does these items
+            conn.send(None)
 
 
 class BlockFarm:
@@ -118,18 +122,32 @@ class BlockFarm:
         except (pickle.PicklingError, AttributeError, TypeError):
             return None  # a model's closure (an observation model, say): done here
         out = [None] * n
+        sent = set()
         try:
             for w in range(1, size):
-                self._conns[w - 1].send((fn, i, items[w::size], shared))
+                with contextlib.suppress(OSError):  # a worker gone: its items are done here
+                    self._conns[w - 1].send((fn, i, items[w::size], shared))
+                    sent.add(w)
             for k in range(0, n, size):
                 out[k] = fn(self._refs[i], items[k], *args)
+            lost = len(sent) < size - 1
             for w in range(1, size):
-                for k, o in zip(range(w, n, size), self._conns[w - 1].recv(), strict=True):
+                got = None
+                if w in sent:
+                    try:
+                        got = self._conns[w - 1].recv()
+                    except (EOFError, OSError):  # the worker is gone
+                        lost = True
+                if got is None:  # its items done here, as they would be without a farm
+                    got = [fn(self._refs[i], items[k], *args) for k in range(w, n, size)]
+                for k, o in zip(range(w, n, size), got, strict=True):
                     out[k] = o
         except BaseException:
-            # interrupted or a worker lost: its answers would be read as the next ones
+            # interrupted: the workers' answers would be read as the next ones
             self.close()
             raise
+        if lost:
+            self.close()  # this process does every block from now on
         return out
 
     def close(self):

@@ -159,3 +159,31 @@ def test_the_named_contact_models_on_a_farm_are_the_same_fits():
     two = _fresh(lambda: fit_contact_models(sc, m, workers=2, **kw))
     assert [dataclasses.asdict(f) for f in one.fits] == [dataclasses.asdict(f) for f in two.fits]
     assert one.selected == two.selected
+
+
+def _unsendable_in_workers(reference, k):
+    """An answer a worker cannot send (a lambda), a plain one here."""
+    if os.getpid() != _interrupt.parent:
+        return lambda: k
+    return k
+
+
+def test_answers_a_worker_cannot_send_are_made_here(record):
+    sc, ref = record
+    _interrupt.parent = os.getpid()
+    n = len(ref.span.blocks)
+    with BF.shared_blocks([ref], 2) as farm:
+        assert farm.map(_unsendable_in_workers, ref.span, ()) == list(range(n))
+        assert farm.holds(ref.span)  # still in step: it goes on sharing out
+
+
+def test_a_lost_worker_leaves_the_work_here(record):
+    sc, ref = record
+    law = ForceLaw.parse("2.1e8*z + 1.0e7*zd")
+    here = _fresh(lambda: evaluate(sc, law, ref, floor=True))
+    with BF.shared_blocks([ref], 2) as farm:
+        farm._procs[0].kill()
+        farm._procs[0].join()
+        there = _fresh(lambda: evaluate(sc, law, ref, floor=True))
+        assert not farm.holds(ref.span)  # closed: the blocks are done here
+        _same(here, there)
