@@ -25,6 +25,7 @@ the farm, and this process does every block from then on.
 """
 
 import contextlib
+import multiprocessing
 import os
 import pickle
 from multiprocessing import get_context
@@ -190,7 +191,9 @@ def shared_blocks(references, workers):
 
     with one_blas_thread():
         refs = [r for r in references if getattr(r, "span", None) is not None]
-        if not refs or not workers or int(workers) <= 1:
+        # a daemonic process (a worker of another pool) may not have children
+        alone = multiprocessing.current_process().daemon
+        if alone or not refs or not workers or int(workers) <= 1:
             yield None
             return
         farm = BlockFarm(refs, workers)

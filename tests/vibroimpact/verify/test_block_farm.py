@@ -187,3 +187,19 @@ def test_a_lost_worker_leaves_the_work_here(record):
         there = _fresh(lambda: evaluate(sc, law, ref, floor=True))
         assert not farm.holds(ref.span)  # closed: the blocks are done here
         _same(here, there)
+
+
+def _farm_in_a_daemon(ref, out):
+    with BF.shared_blocks([ref], 2) as farm:
+        out.put(farm is None)
+
+
+def test_a_daemonic_process_opens_no_farm(record):
+    """A worker of someone else's pool (daemonic: it may not have children) fits alone."""
+    sc, ref = record
+    ctx = multiprocessing.get_context("fork")
+    out = ctx.Queue()
+    p = ctx.Process(target=_farm_in_a_daemon, args=(ref, out), daemon=True)
+    p.start()
+    assert out.get(timeout=60) is True
+    p.join(timeout=10)
