@@ -78,6 +78,7 @@ _EXPORTS = {
     "AdviseSettings": "vibroimpact.advise.search",
     "IdentifySettings": "vibroimpact.fit.identification",
     "ExplainSettings": "vibroimpact.explain.loop",
+    "ContactModelsSettings": "vibroimpact.fit.contact_fit",
 }
 
 
@@ -149,6 +150,7 @@ __all__ = [
     "AdviseSettings",
     "IdentifySettings",
     "ExplainSettings",
+    "ContactModelsSettings",
 ]
 
 lazy_package(__name__, _EXPORTS)

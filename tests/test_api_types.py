@@ -161,6 +161,12 @@ CASES = [
     ("IdentifySettings xtol text", lambda: d.IdentifySettings(xtol="a"), TYPE, "xtol"),
     ("ExplainSettings alpha 2", lambda: d.ExplainSettings(alpha=2.0), VALUE, "alpha"),
     (
+        "ContactModelsSettings workers 0",
+        lambda: d.ContactModelsSettings(workers=0),
+        VALUE,
+        "workers",
+    ),
+    (
         "ueda UedaChartSettings periods 0",
         lambda: osc.UedaChartSettings(periods=0),
         VALUE,

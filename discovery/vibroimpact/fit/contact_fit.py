@@ -30,11 +30,13 @@ import numpy as np
 from ..._printing import interval_text, readable
 from ..._progress import reports_progress
 from ..._result import SCHEMA_VERSION, Result
+from ..._settings import Settings, option, takes
 from ..._validate import Real, params
 from ...errors import InputError, IntegrationError
 from ...wording import records as the_records
 from ...wording import verb
 from ..data.measurement import Measurement
+from ..dynamics import Tolerances
 from ..model.contact_models import MODELS, same_force
 from ..model.scenario import Scenario
 from ..verify import Reference
@@ -42,7 +44,7 @@ from ..verify.block_farm import block_workers, shared_blocks
 from .contact_starts import from_hunt_crossley, record_samples, regression_start, start_model
 from .identification import as_records, identify
 
-__all__ = ["ContactFit", "ContactModelsResult", "fit_contact_models"]
+__all__ = ["ContactFit", "ContactModelsResult", "ContactModelsSettings", "fit_contact_models"]
 
 _Z95 = 1.959963984540054
 
@@ -318,28 +320,25 @@ def _fit_one(name, records, settings, progress, hunt_crossley=None):
     )
 
 
+@dataclass(frozen=True, repr=False)
+class ContactModelsSettings(Settings):
+    """The options of :func:`fit_contact_models` (each is also a keyword of it)."""
+
+    models: object = option(None, (None, list, tuple))
+    max_simulations: int = option(200, Real(2, integer=True))
+    n_boot: int = option(30, Real(0, integer=True))
+    seed: int = option(0, Real(0, integer=True))
+    tolerances: object = option(None, (Tolerances, None))
+    workers: object = option(1, (None, Real(1, integer=True)))
+
+
+@takes(ContactModelsSettings)
 @params(
     scenario=(Scenario, list, tuple),
     reference=(Measurement, Reference, list, tuple),
-    models=(None, list, tuple),
-    max_simulations=Real(2, integer=True),
-    n_boot=Real(0, integer=True),
-    seed=Real(0, integer=True),
-    workers=(None, Real(1, integer=True)),
 )
 @reports_progress
-def fit_contact_models(
-    scenario,
-    reference,
-    *,
-    models=None,
-    max_simulations=200,
-    n_boot=30,
-    seed=0,
-    tolerances=None,
-    workers=1,
-    progress=None,
-):
+def fit_contact_models(scenario, reference, *, settings=None, progress=None, **options):
     """Fit every named contact model to the record(s) and select the one they support.
 
     Parameters
@@ -347,6 +346,8 @@ def fit_contact_models(
     scenario : Scenario or sequence of Scenario
         One per record (or one for all).
     reference : Measurement or Reference, or a sequence of them
+    settings : ContactModelsSettings, optional
+        The options below in one object; keywords override its fields.
     models : sequence of str, optional
         Models to fit (default all of :data:`~discovery.vibroimpact.model.contact_models.MODELS`).
     max_simulations : int
@@ -369,6 +370,8 @@ def fit_contact_models(
     -------
     ContactModelsResult
     """
+    o = ContactModelsSettings.of("fit_contact_models", settings, options)
+    models, max_simulations, n_boot, seed = o.models, o.max_simulations, o.n_boot, o.seed
     t0 = time.perf_counter()
     names = list(MODELS) if models is None else [str(m) for m in models]
     bad = [m for m in names if m not in MODELS]
@@ -382,14 +385,14 @@ def fit_contact_models(
         "max_simulations": int(max_simulations),
         "n_boot": int(n_boot),
         "seed": int(seed),
-        "tolerances": tolerances,
-        "workers": workers,
+        "tolerances": o.tolerances,
+        "workers": o.workers,
     }
     fits = []
     # Hunt-Crossley first: its fit starts Lankarani-Nikravesh and Flores (the same force
     # at one impact velocity)
     order = sorted(names, key=lambda m: m in ("lankarani-nikravesh", "flores"))
-    with shared_blocks([ref for _, ref in records], block_workers(workers)):
+    with shared_blocks([ref for _, ref in records], block_workers(o.workers)):
         for i, name in enumerate(order):
             if progress is not None:
                 progress("contact models", i, len(names))
