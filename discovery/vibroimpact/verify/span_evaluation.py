@@ -9,10 +9,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._validate import unchecked
-from ...numerics.memo import value_key
 from .block_farm import farm_for
 from .criteria import evaluate_criteria
-from .trajectory import MEMO, _block_mean, _history, _memo_run
+from .trajectory import _block_mean, _history, _memo_run
 
 __all__ = ["BlockJob", "BlockOutcome", "block_outcome", "SpanRun", "span_run"]
 
@@ -124,7 +123,7 @@ def span_run(scenario, law, reference, *, tolerances=None, observe=None, window=
     """Every block of ``reference``'s span evaluated (:func:`block_outcome`): shared out over
     the block farm that holds the span (:func:`~.block_farm.shared_blocks`), else here in
     block order.  Raises the first block's run failure (as :func:`simulated_motion`);
-    the runs a farm made are kept in :data:`MEMO` as if made here."""
+    the runs a farm made are kept in :data:`~.trajectory.MEMO` as if made here."""
     span = reference.span
     job = BlockJob(scenario, law, tolerances, observe, window, reference.impulse.onset)
     farm = farm_for(span)
@@ -134,10 +133,7 @@ def span_run(scenario, law, reference, *, tolerances=None, observe=None, window=
             if o.run is not None:
                 for a in o.run:
                     a.setflags(write=False)
-                MEMO.get(
-                    value_key(scenario, law, tolerances, id(blk)),
-                    lambda blk=blk, o=o: (blk, *o.run),
-                )
+                _memo_run(scenario, law, blk, tolerances, made=o.run)
     else:
         outcomes = []
         for k in range(len(span.blocks)):

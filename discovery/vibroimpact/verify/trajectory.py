@@ -330,11 +330,17 @@ def _sensitivity_run(scenario, law, blk, tolerances):
     )
 
 
-def _sensitivities(scenario, law, blk, tolerances):
+def _sensitivity_key(scenario, law, blk, tolerances):
+    return value_key("sensitivities", scenario, law, tolerances, id(blk))
+
+
+def _sensitivities(scenario, law, blk, tolerances, made=None):
     """A block's sensitivity run (memoised: asked by the force's and the penetration's
-    rows of one Jacobian)."""
-    key = value_key("sensitivities", scenario, law, tolerances, id(blk))
-    return MEMO.get(key, lambda: (blk, *_sensitivity_run(scenario, law, blk, tolerances)))[1:]
+    rows of one Jacobian); ``made``: that run made elsewhere (a block farm), kept as is."""
+    return MEMO.get(
+        _sensitivity_key(scenario, law, blk, tolerances),
+        lambda: (blk, *(made or _sensitivity_run(scenario, law, blk, tolerances))),
+    )[1:]
 
 
 def sensitivity_outcome(reference, k, scenario, law, tolerances):
@@ -353,13 +359,12 @@ def _shared_sensitivities(scenario, law, span, tolerances):
     farm = farm_for(span)
     if farm is None:
         return
-    keys = [value_key("sensitivities", scenario, law, tolerances, id(b)) for b in span.blocks]
-    if all(k in MEMO for k in keys):
+    if all(_sensitivity_key(scenario, law, b, tolerances) in MEMO for b in span.blocks):
         return
     outcomes = farm.map(sensitivity_outcome, span, (scenario, law, tolerances)) or []
-    for blk, key, o in zip(span.blocks, keys, outcomes, strict=False):
+    for blk, o in zip(span.blocks, outcomes, strict=False):
         if not isinstance(o, Exception):
-            MEMO.get(key, lambda blk=blk, o=o: (blk, *o))
+            _sensitivities(scenario, law, blk, tolerances, made=o)
 
 
 def penetration_sensitivities(scenario, law, span, *, tolerances=None):
@@ -482,10 +487,11 @@ def _history(blk, F, onsets, observe, window):
     return Fs if observe is None else _observed(fold, Fs, observe)
 
 
-def _memo_run(scenario, law, blk, tolerances):
-    """A block's run from its measured state, memoised (:data:`MEMO`)."""
+def _memo_run(scenario, law, blk, tolerances, made=None):
+    """A block's run from its measured state, memoised (:data:`MEMO`); ``made``: that run
+    made elsewhere (a block farm), kept as is."""
     key = value_key(scenario, law, tolerances, id(blk))
-    return MEMO.get(key, lambda: (blk, *_block_run(scenario, law, blk, None, tolerances)))
+    return MEMO.get(key, lambda: (blk, *(made or _block_run(scenario, law, blk, None, tolerances))))
 
 
 def _observed(fold, Fs, observe):
