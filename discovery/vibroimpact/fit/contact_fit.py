@@ -380,7 +380,8 @@ def fit_contact_models(scenario, reference, *, settings=None, progress=None, **o
             f"unknown contact model {bad[0] if bad else ''!r}; the models: {', '.join(MODELS)}"
         )
     records = as_records(scenario, reference)
-    settings = {
+    # what every model's fit is given (``settings`` is the caller's options object)
+    fitting = {
         "samples": record_samples(scenario, reference),
         "max_simulations": int(max_simulations),
         "n_boot": int(n_boot),
@@ -397,7 +398,7 @@ def fit_contact_models(scenario, reference, *, settings=None, progress=None, **o
             if progress is not None:
                 progress("contact models", i, len(names))
             hc = next((f for f in fits if f.model == "hunt-crossley"), None)
-            fits.append(_fit_one(name, records, settings, None, hc))
+            fits.append(_fit_one(name, records, fitting, None, hc))
     if progress is not None:
         progress("contact models", len(names), len(names))
     fits.sort(key=lambda f: f.value)
