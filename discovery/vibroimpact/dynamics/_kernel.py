@@ -74,6 +74,15 @@ from ...numerics._tableau import A as _A
 from ...numerics._tableau import B as _B
 from ...numerics._tableau import E as _E
 
+# Every function here that allocates nothing takes its arrays borrowed: compiled without
+# numba's reference counting (``_nrt=False``, as numba compiles its own helpers), a call
+# passes its arrays without an atomic increment and decrement of each one's count.  Those
+# took a third of a closed-form period's time and half of an integrated contact's; the
+# arithmetic, and so every result, is the same bit for bit.  A function that allocates
+# (``integrate``, a contact mode's set-up) keeps the counts; numba refuses to compile an
+# allocation in a borrowing function.
+_borrowed_njit = njit(cache=True, _nrt=False)
+
 # the shared Dormand-Prince blocks for this system's four states (w1, v1, w2, v2)
 _D = blocks(4)
 _stage, _combine, _dense, _error_norm = _D.stage, _D.combine, _D.dense, _D.error_norm
@@ -100,7 +109,7 @@ P_CONTACT, N_PARAMS = 14, 15
 _ZENO_EVENTS, _ZENO_GAP = 1000, 1e-3
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _zeno_run(t, t_last_ev, hmax, short_run):
     """The count of events in a row each within ``_ZENO_GAP * hmax`` of the previous one,
     after an event at ``t`` (chattering beyond ``_ZENO_EVENTS``)."""
@@ -167,7 +176,7 @@ def load_force(z, v, p, coef, ea, eb, br):
     return _reload_set(z, v, p, coef, ea, eb, br)
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _reload_set(z, v, p, coef, ea, eb, br):
     """The loading branch below ``z_max`` with a permanent set: a call, not inlined (the
     rare branch, typed once instead of at each of the step's seven stages)."""
@@ -233,7 +242,7 @@ def _dpw(x, p):
     return p * abs(x) ** (p - 1.0)
 
 
-@njit(cache=True)
+@_borrowed_njit
 def force_partials(mode, z, v, coef, ea, eb, br, dc):
     """``(dF/dz, dF/dv)`` of the mode's force at ``(z, v)``, and ``dc[i] = dF/dc_i`` (a law
     without a permanent set: the sensitivities are not carried for one)."""
@@ -263,7 +272,7 @@ def _partials(mode, z, v, coef, ea, eb, br, dc):
     return fz, fv
 
 
-@njit(cache=True)
+@_borrowed_njit
 def resolve_mode(y, p, coef, ea, eb, br):
     """The mode a state belongs to (used at the start of an integration; a start inside
     an unloading phase takes its own penetration as the contact's largest)."""
@@ -301,14 +310,14 @@ def _rhs(t, y, mode, p, coef, ea, eb, br, out):
     out[3] = f / p[1] - p[6]
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _rhs_at(t, y, mode, p, coef, ea, eb, br, out):
     """:func:`_rhs` as a call (for the once-per-event saltation: inlined there it would be
     typed again at each site, which costs compile time, not run time)."""
     _rhs(t, y, mode, p, coef, ea, eb, br, out)
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _switching(mode, y, p, coef, ea, eb, br, h):
     """Fill ``h`` with the mode's switching functions; return how many."""
     z = y[0] - y[2]
@@ -329,7 +338,7 @@ def _switching(mode, y, p, coef, ea, eb, br, h):
     return 2
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _event_kind(mode, index):
     if mode == FREE:
         return EV_ONSET
@@ -342,7 +351,7 @@ def _event_kind(mode, index):
     return EV_RESUME
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _mode_after(kind, y, p, coef, ea, eb, br):
     """The mode after an event, and the contact's state updates it brings (in ``p``): an
     onset starts a new contact (``z_max = 0``) and sheds the moulding's mass fraction
@@ -371,7 +380,7 @@ def _mode_after(kind, y, p, coef, ea, eb, br):
     return LOAD if load_force(z, max(v, 0.0), p, coef, ea, eb, br) >= 0.0 else CLIPPED
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew):
     """One DP5 step from (t, y) with K[0] = f(t, y) already set; fills K[1:7], ynew
     (the method's stages from :mod:`._dopri`, this system's right-hand side)."""
@@ -412,7 +421,7 @@ def _rhs_sens(y, mode, p, coef, ea, eb, br, S, spar, dc, out):
         out[3, j] = df / p[1]
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _rk_sens(y, h, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew):
     """The sensitivities through the step ``y -> ynew`` of length ``h`` whose stages are in
     ``K``: fills the stage derivatives ``KS`` (7, 4, m) and ``Snew``."""
@@ -435,7 +444,7 @@ def _rk_sens(y, h, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew
             Snew[r, j] = SS[r, j]
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _sens_error(S, Snew, KS, h, rtol, atol, sscale):
     """The embedded error estimate of the sensitivities, scaled as the state's is: column
     ``j`` times ``sscale[j]`` (the size of a perturbation along it) is the response of the
@@ -474,7 +483,7 @@ def _dense_diff(S, KS, h, w, r, j):
     )
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _dense_force_sens(mode, y, S, KS, h, theta, spar, coef, ea, eb, br, dc, out, k):
     """``out[j, k] = dF/dq_j`` at the dense output ``y`` (step fraction ``theta``): only the
     penetration's and its rate's sensitivities are interpolated, the two combinations of
@@ -488,7 +497,7 @@ def _dense_force_sens(mode, y, S, KS, h, theta, spar, coef, ea, eb, br, dc, out,
         out[m + j, k] = dz
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _force_sens(mode, y, S, spar, coef, ea, eb, br, dc, out, k):
     """``out[j, k] = dF/dq_j`` of the force at ``y`` (sensitivities ``S``) in ``mode``, and
     ``out[m + j, k]`` the penetration's."""
@@ -499,7 +508,7 @@ def _force_sens(mode, y, S, spar, coef, ea, eb, br, dc, out, k):
         out[m + j, k] = S[0, j] - S[2, j]
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _event_time_sens(t, y, mode, index, p, coef, ea, eb, br, S, spar, dc, fminus, tau):
     """Before an event: the vector field ``fminus`` of the mode left, and ``tau[j]``, the
     derivative of the event time along column ``j``: ``-(grad h . S_j + dh/dq_j) /
@@ -529,7 +538,7 @@ def _event_time_sens(t, y, mode, index, p, coef, ea, eb, br, S, spar, dc, fminus
         tau[j] = -num / den if den != 0.0 else np.nan
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau):
     """After an event into ``mode``: ``S_j += (f- - f+) tau_j``, and the event's time
     derivatives kept in ``ev_tau`` (if there is room)."""
@@ -541,7 +550,7 @@ def _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_
             ev_tau[n_ev, j] = tau[j]
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _locate(y, K, h, mode, p, coef, ea, eb, br, index, th_lo, th_hi, h_lo, h_hi, ybuf, hbuf):
     """Root in ``theta`` of switching function ``index`` on the dense output (Illinois)."""
     a, b, fa, fb = th_lo, th_hi, h_lo, h_hi
@@ -568,7 +577,7 @@ def _locate(y, K, h, mode, p, coef, ea, eb, br, index, th_lo, th_hi, h_lo, h_hi,
     return b
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _h_at(y, K, h, mode, p, coef, ea, eb, br, index, theta, ybuf, hbuf):
     """Switching function ``index`` on the dense output at ``theta``."""
     _dense(y, K, h, theta, ybuf)
@@ -576,7 +585,7 @@ def _h_at(y, K, h, mode, p, coef, ea, eb, br, index, theta, ybuf, hbuf):
     return hbuf[index]
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _rate_root(y, K, h, s, d0, d1, ybuf):
     """``theta`` where ``s * dzeta`` on the dense output goes from ``d0 < 0`` to ``d1 > 0``:
     the interior minimum of the switching function ``s * zeta`` (Illinois)."""
@@ -603,7 +612,7 @@ def _rate_root(y, K, h, s, d0, d1, ybuf):
     return 0.5 * (a + b)
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _first_crossing(t, y, ynew, K, h, mode, p, coef, ea, eb, br, i, h0, ha, hb, h1, ybuf, hbuf):
     """``theta`` in ``[0, 1]`` of the first crossing of switching function ``i`` over the
     step (``0``: at once), or ``2`` if it stays on its side.
@@ -680,7 +689,7 @@ def _first_crossing(t, y, ynew, K, h, mode, p, coef, ea, eb, br, i, h0, ha, hb, 
     return _locate(y, K, h, mode, p, coef, ea, eb, br, i, pos_t, neg_t, pos_f, neg_f, ybuf, hbuf)
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _record_event(t, y, mode, index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes):
     """Store event ``n_ev`` (if there is room) and return the mode after it."""
     kind = _event_kind(mode, index)
@@ -725,7 +734,7 @@ _SAMPLE_SLIP = 1e-12  # evenly spaced samples: on their grid within this many dr
 _SAMPLE_ANCHOR = 256  # samples advanced by the semigroup between two evaluated in closed form
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _flight_ok(p):
     """Whether the free flight has the closed form (requested, linear supports with ``k1 >
     0``, ``c1 >= 0``, and a periodic particular solution)."""
@@ -738,7 +747,7 @@ def _flight_ok(p):
     return a * a + b * b > 0.0 and np.isfinite(a) and np.isfinite(b)
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _flight_setup(t0, y, p, fl):
     """The flight's constants from ``(t0, y)`` into ``fl``: alpha, w0^2, w0^2 - alpha^2,
     w_s, P, Q, w, g, t0, u(t0), u'(t0), w2(t0), v2(t0), the bound's constant part
@@ -762,7 +771,7 @@ def _flight_setup(t0, y, p, fl):
     fl[15] = np.sqrt(w0sq)
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _flight_phi(s, fl):
     """The frame's transition matrix ``Phi(s)`` (four entries, row by row)."""
     al, w0sq, q = fl[0], fl[1], fl[2]
@@ -787,7 +796,7 @@ def _flight_phi(s, fl):
     return eC + al * eS, eS, -w0sq * eS, eC - al * eS
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _flight_state(s, fl, out):
     """The state ``s`` after the flight's start into ``out``; returns ``(u, u')``, the
     frame's homogeneous part."""
@@ -804,14 +813,14 @@ def _flight_state(s, fl, out):
     return u, ud
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _flight_res(fl, s):
     """The time resolution at ``s`` after the flight's start: a few units in the last place
     of the absolute time, and at least 1e-15 of the drive period."""
     return 4.0e-16 * max(abs(fl[8] + s), 2.0 * np.pi / fl[6])
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _flight_polish(a, b, fl, ybuf):
     """The first root of the penetration in ``[a, b]`` (``z(a) <= 0 < z(b)``, no root in
     ``[a, b)`` but the crossing's): safeguarded Newton to the time's resolution; the point
@@ -842,7 +851,7 @@ def _flight_polish(a, b, fl, ybuf):
     return hi
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _flight_search(z0, d0, s_end, fl, ybuf):
     """The first onset in ``(0, s_end]`` of the flight set up in ``fl`` (the start's
     penetration ``z0 <= 0``, its rate ``d0``): ``(s, code)``, ``code`` 1 for an onset at
@@ -872,7 +881,7 @@ def _flight_search(z0, d0, s_end, fl, ybuf):
     return a, 4
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _flight_samples(t, t_new, fl, S, t_eval, k_eval, out_y, out_f, out_mode, out_dF):
     """The dense output of the flight set up in ``fl`` (started at ``t``) at the samples
     ``t_eval[k_eval:]`` up to ``t_new``: the state, no force, the free mode and the
@@ -941,7 +950,7 @@ def _flight_samples(t, t_new, fl, S, t_eval, k_eval, out_y, out_f, out_mode, out
     return k_eval
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mode, out_dF):
     """One free flight from ``(t, y)`` in closed form: ``(code, t_new, k_eval)``.
 
@@ -1025,7 +1034,7 @@ _NE = 12  # a mode's complex constants per eigenvalue, :func:`_contact_setup`
 _NR = 6  # a mode's real constants, :func:`_contact_setup`
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_law(p, coef, ea, eb, br, kc):
     """Whether the contact has the closed form: requested (``p[P_CONTACT] = 1``), a linear
     law and nothing else acting during the contact (see above); fills ``kc`` with the
@@ -1053,7 +1062,7 @@ def _contact_law(p, coef, ea, eb, br, kc):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _contact_g(mode, kc, i):
     """Switching function ``i`` of a contact mode as ``(gz, gv)``: ``h = gz z + gv zd``
     (loss, unload or reload, release: as :func:`_switching`)."""
@@ -1277,12 +1286,12 @@ def _contact_setup(p, kc, mode, dsc, E, R):
 def _phi1(x, ex):
     """``(e^x - 1) / x`` (1 at 0) for a complex ``x`` with ``ex = e^x``, without cancellation
     near 0."""
-    if abs(x) < 1e-2:
+    if x.real * x.real + x.imag * x.imag < 1e-4:  # |x| < 1e-2 without a hypot
         return 1.0 + x * (1.0 + x * (1.0 + x * (1.0 + x * (1.0 + x / 6.0) / 5.0) / 4.0) / 3.0) / 2.0
     return (ex - 1.0) / x
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_start(t0, y, mi, w, E, qm):
     """The phase's modal data from ``(t0, y)``: ``qm[j] = (u_j(0), d_j)``, ``d_j = lambda_j
     u_j(0) + beta_cj`` (``u_j``'s rate at the start)."""
@@ -1296,7 +1305,7 @@ def _contact_start(t0, y, mi, w, E, qm):
         qm[j, 1] = E[mi, j, 8] * u0 + E[mi, j, 9]
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_state(s, t0, w, mi, E, qm, out, ex):
     """The state ``s`` after the phase's start (at ``t0``) into ``out`` (``ex``: a work
     array of 4 complex numbers, left holding ``e^(lambda_j s)``)."""
@@ -1305,7 +1314,7 @@ def _contact_state(s, t0, w, mi, E, qm, out, ex):
     _contact_state_at(s, np.cos(w * tt) + 1j * np.sin(w * tt), ex, mi, E, qm, out)
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_state_at(s, ew, ex, mi, E, qm, out):
     """:func:`_contact_state` from the exponentials at ``s``: ``ew = e^(i w (t0 + s))``,
     ``ex[j] = e^(lambda_j s)``."""
@@ -1321,7 +1330,7 @@ def _contact_state_at(s, ew, ex, mi, E, qm, out):
     out[0], out[1], out[2], out[3] = a0.real, a1.real, a2.real, a3.real
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_phi(ex, mi, E, out):
     """The mode's transition matrix ``Phi(s) = V diag(e^(lambda s)) V^-1`` into ``out``
     (``ex[j] = e^(lambda_j s)``)."""
@@ -1336,18 +1345,18 @@ def _contact_phi(ex, mi, E, out):
                 out[r, q] += (vr * E[mi, j, 4 + q]).real
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _eint(lj, mu, ej, emu, s):
     """``int_0^s e^(lambda (s - u)) e^(mu u) du`` from ``ej = e^(lambda s)``, ``emu = e^(mu
     s)`` (``s e^(lambda s) phi1((mu - lambda) s)`` near ``mu = lambda``)."""
     d = mu - lj
     x = d * s
-    if abs(x) < 1e-2:
+    if x.real * x.real + x.imag * x.imag < 1e-4:  # |x| < 1e-2 without a hypot
         return s * ej * _phi1(x, 0j)
     return (emu - ej) / d
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_forced(s, t0, w, mi, E, qm, m1, m2, ex, ews, W):
     """``W[0]``, ``W[1]``: the state's response at ``s`` of the phase (zero at its start) to a
     force ``z``, and to a force ``zd``, added to the contact's: ``int_0^s Phi(s - u) e_F z(u)
@@ -1380,7 +1389,7 @@ def _contact_forced(s, t0, w, mi, E, qm, m1, m2, ex, ews, W):
             W[1, r] += (E[mi, j, r] * eps * iv).real
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_sens(s, t0, mi, E, qm, p, S, spar, gcol, phi, ex, ews, W, kF, cF, y, out_dF, k):
     """Through ``s`` of the phase (``ex[j] = e^(lambda_j s)``, ``ews = e^(i w s)``): ``S <-
     Phi(s) S``, plus ``gcol[0, j] W[0] + gcol[1, j] W[1]`` for a coefficient's column ``j``
@@ -1414,7 +1423,7 @@ def _contact_sens(s, t0, mi, E, qm, p, S, spar, gcol, phi, ex, ews, W, kF, cF, y
             S[0, j], S[1, j], S[2, j], S[3, j] = b0, b1, b2, b3
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_h(i, mode, kc, t, y, p):
     """Switching function ``i`` of a contact mode and its rate at ``(t, y)``."""
     gz, gv = _contact_g(mode, kc, i)
@@ -1426,7 +1435,7 @@ def _contact_h(i, mode, kc, t, y, p):
     return gz * z + gv * zd, gz * zd + gv * (a1 - a2)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _contact_gap(f, fd, K):
     """The positive root of ``f + fd tau - K tau^2 / 2`` (``f >= 0``): how far a function at
     ``f`` with rate ``fd`` and curvature at least ``-K`` stays positive."""
@@ -1438,14 +1447,14 @@ def _contact_gap(f, fd, K):
     return (fd + disc) / K if fd > 0.0 else 2.0 * f / (disc - fd)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _time_res(t, w):
     """The time resolution at ``t``: a few units in the last place of the absolute time, and
     at least 1e-15 of the drive period."""
     return 4.0e-16 * max(abs(t), 2.0 * np.pi / w)
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_polish(i, mode, a, b, hb, hdb, t0, p, kc, mi, E, qm, ybuf, ex):
     """The first root of switching function ``i`` in ``[a, b]`` (``h(a) >= 0 > h(b) = hb``,
     rate ``hdb``; no root in ``[a, b)`` but the crossing's): safeguarded Newton to the
@@ -1479,17 +1488,28 @@ def _contact_polish(i, mode, a, b, hb, hdb, t0, p, kc, mi, E, qm, ybuf, ex):
     return lo
 
 
-@njit(cache=True)
-def _contact_bound(i, mi, a, hcap, E, R, cb):
-    """The curvature bound ``K`` of switching function ``i`` over ``[a, a + hcap]``."""
-    K = R[mi, 1 + i]
+@_borrowed_njit
+def _contact_growth(mi, a, hcap, E, cb):
+    """The largest ``|e^(lambda_j s)|`` over ``[a, a + hcap]`` of each eigenvalue into
+    ``cb[3]`` (at ``a`` for a decaying one, whose end value is the smaller), shared by the
+    three switching functions' curvature bounds."""
     for j in range(4):
         re = E[mi, j, 8].real
-        K += cb[i, j] * max(np.exp(re * a), np.exp(re * (a + hcap)))
+        e = np.exp(re * a)
+        cb[3, j] = e if re <= 0.0 else max(e, np.exp(re * (a + hcap)))
+
+
+@_borrowed_njit
+def _contact_bound(i, mi, R, cb):
+    """The curvature bound ``K`` of switching function ``i`` over the interval whose
+    exponentials' bounds :func:`_contact_growth` left in ``cb[3]``."""
+    K = R[mi, 1 + i]
+    for j in range(4):
+        K += cb[i, j] * cb[3, j]
     return K
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf, ex):
     """The first event in ``(0, s_end]`` of the contact phase set up (the switching
     functions' values ``f >= 0`` and rates ``fd`` at its start): ``(s, index)``, ``index`` the
@@ -1503,8 +1523,9 @@ def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf, ex):
         if grow > 0.0:
             hcap = min(hcap, 1.0 / grow)
         H = hcap
+        _contact_growth(mi, a, hcap, E, cb)
         for i in range(3):
-            H = min(H, _contact_gap(f[i], fd[i], _contact_bound(i, mi, a, hcap, E, R, cb)))
+            H = min(H, _contact_gap(f[i], fd[i], _contact_bound(i, mi, R, cb)))
         if a + H >= s_end:
             return s_end, -1
         b = min(a + max(H, _time_res(t0 + a, w)), s_end)
@@ -1527,7 +1548,7 @@ def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf, ex):
     return a, -2
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact(
     t,
     t1,
@@ -1573,7 +1594,7 @@ def _contact(
     mi = 0 if mode == LOAD else 1
     if R[mi, 0] == 0.0:
         return 3, t, k_eval, -1
-    gcol, phi, W, ex = sw
+    gcol, phi, W, ex, _ = sw
     m = S.shape[1]
     for j in range(m):
         if spar[j] >= 0 and not R[mi, 5] > 1e-3 * p[5]:
@@ -1637,14 +1658,14 @@ def _contact(
     return code, t_new, k_eval, index
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_exps(s, w, mi, E, ex):
     """``ex[j] = e^(lambda_j s)`` of the contact mode ``mi``."""
     for j in range(4):
         ex[j] = np.exp(E[mi, j, 8] * s)
 
 
-@njit(cache=True)
+@_borrowed_njit
 def _contact_samples(
     t,
     t_new,
@@ -1676,8 +1697,7 @@ def _contact_samples(
     (:func:`_flight_samples`)."""
     if k_eval >= t_eval.shape[0] or t_eval[k_eval] > t_new:
         return k_eval  # no sample in the phase
-    gcol, phi, W, ex = sw
-    eh = np.empty(4, dtype=np.complex128)
+    gcol, phi, W, ex, eh = sw
     want_df = out_dF.shape[1] > 0
     slip = _SAMPLE_SLIP * 2.0 * np.pi / w
     ew0 = np.cos(w * t) + 1j * np.sin(w * t)
@@ -1821,8 +1841,14 @@ def integrate(
         use_contact = R[0, 0] != 0.0 or R[1, 0] != 0.0
     qm = np.empty((4, 2), dtype=np.complex128)
     # the closed-form sensitivities' work arrays (:func:`_contact_sens`)
-    sw = (np.empty((2, m_s)), np.empty((4, 4)), np.empty((2, 4)), np.empty(4, dtype=np.complex128))
-    cb = np.empty((3, 4))
+    sw = (
+        np.empty((2, m_s)),
+        np.empty((4, 4)),
+        np.empty((2, 4)),
+        np.empty(4, dtype=np.complex128),
+        np.empty(4, dtype=np.complex128),
+    )
+    cb = np.empty((4, 4))
     fc = np.empty(3)
     fcd = np.empty(3)
     while t < t1:
