@@ -1783,29 +1783,138 @@ def integrate(
     too (shape (m, 0) for none), and with ``ev_tau`` of shape (len(ev_t), m) the events'
     time derivatives (shape (0, m) for none).  Not for a law with a permanent set.
     """
+    m_s = S.shape[1]
     y = y0.copy()
-    ynew = np.empty(4)
-    ytmp = np.empty(4)
-    ybuf = np.empty(4)
-    K = np.empty((7, 4))
-    hs0 = np.empty(3)
-    hs1 = np.empty(3)
-    hsa = np.empty(3)
-    hsb = np.empty(3)
-    hsm = np.empty(3)
+    # the work arrays of the steps, of the sensitivities and of the closed-form phases
+    steps = (
+        np.empty(4),
+        np.empty(4),
+        np.empty(4),
+        np.empty((7, 4)),
+        np.empty(3),
+        np.empty(3),
+        np.empty(3),
+        np.empty(3),
+        np.empty(3),
+    )
+    sens = (
+        np.empty((7, 4, m_s)),
+        np.empty((4, m_s)),
+        np.empty((4, m_s)),
+        np.empty(coef.shape[0]),
+        np.empty(4),
+        np.empty(4),
+        np.empty(m_s),
+    )
+    # the contact in closed form where it applies (:func:`_contact`; not with sensitivities)
+    kc = np.zeros(4)
+    use_contact = _contact_law(p, coef, ea, eb, br, kc)
+    E = np.zeros((2, 4, _NE), dtype=np.complex128)
+    R = np.zeros((2, _NR))
+    if use_contact:
+        _contact_setup(p, kc, LOAD, atol, E, R)
+        _contact_setup(p, kc, UNLOAD, atol, E, R)
+        use_contact = R[0, 0] != 0.0 or R[1, 0] != 0.0
+    phases = (
+        np.empty(_NF),
+        kc,
+        E,
+        R,
+        np.empty((4, 2), dtype=np.complex128),
+        # the closed-form sensitivities' work arrays (:func:`_contact_sens`)
+        (
+            np.empty((2, m_s)),
+            np.empty((4, 4)),
+            np.empty((2, 4)),
+            np.empty(4, dtype=np.complex128),
+            np.empty(4, dtype=np.complex128),
+        ),
+        np.empty((4, 4)),
+        np.empty(3),
+        np.empty(3),
+    )
+    status, t, mode, n_steps, n_ev, h = _integrate(
+        t0,
+        t1,
+        y,
+        mode0,
+        p,
+        coef,
+        ea,
+        eb,
+        br,
+        rtol,
+        atol,
+        h0,
+        hmax,
+        max_steps,
+        t_eval,
+        out_y,
+        out_f,
+        out_mode,
+        ev_t,
+        ev_kind,
+        ev_y,
+        ev_modes,
+        S,
+        spar,
+        sscale,
+        out_dF,
+        ev_tau,
+        use_contact,
+        steps,
+        sens,
+        phases,
+    )
+    return status, t, y, mode, n_steps, n_ev, h
+
+
+@_borrowed_njit
+def _integrate(
+    t0,
+    t1,
+    y,
+    mode0,
+    p,
+    coef,
+    ea,
+    eb,
+    br,
+    rtol,
+    atol,
+    h0,
+    hmax,
+    max_steps,
+    t_eval,
+    out_y,
+    out_f,
+    out_mode,
+    ev_t,
+    ev_kind,
+    ev_y,
+    ev_modes,
+    S,
+    spar,
+    sscale,
+    out_dF,
+    ev_tau,
+    use_contact,
+    steps,
+    sens,
+    phases,
+):
+    """:func:`integrate`'s steps, borrowing every array (``y`` the state, advanced in place;
+    ``steps``, ``sens``, ``phases``: the work arrays it allocated, ``use_contact`` whether a
+    contact mode has the closed form); returns ``(status, t, mode, n_steps, n_ev, h)``."""
+    ynew, ytmp, ybuf, K, hs0, hs1, hsa, hsb, hsm = steps
+    KS, SS, Snew, dc, fminus, fplus, tau = sens
+    fl, kc, E, R, qm, sw, cb, fc, fcd = phases
     need_h0 = True
     ns = 0
     t = t0
     m_s = S.shape[1]
     ctl_s = m_s > 0 and sscale.shape[0] > 0
     want_df = out_dF.shape[1] > 0
-    KS = np.empty((7, 4, m_s))
-    SS = np.empty((4, m_s))
-    Snew = np.empty((4, m_s))
-    dc = np.empty(coef.shape[0])
-    fminus = np.empty(4)
-    fplus = np.empty(4)
-    tau = np.empty(m_s)
     mode = mode0 if mode0 >= 0 else resolve_mode(y, p, coef, ea, eb, br)
     h = min(h0, hmax, t1 - t0)
     n_eval = t_eval.shape[0]
@@ -1828,29 +1937,7 @@ def integrate(
     # free flight in closed form where it applies (:func:`_flight`); ``hold``: the
     # integrator's steps until one is accepted (a start across the surface, not closing)
     use_flight = _flight_ok(p)
-    fl = np.empty(_NF)
     hold = False
-    # the contact in closed form where it applies (:func:`_contact`; not with sensitivities)
-    kc = np.zeros(4)
-    use_contact = _contact_law(p, coef, ea, eb, br, kc)
-    E = np.zeros((2, 4, _NE), dtype=np.complex128)
-    R = np.zeros((2, _NR))
-    if use_contact:
-        _contact_setup(p, kc, LOAD, atol, E, R)
-        _contact_setup(p, kc, UNLOAD, atol, E, R)
-        use_contact = R[0, 0] != 0.0 or R[1, 0] != 0.0
-    qm = np.empty((4, 2), dtype=np.complex128)
-    # the closed-form sensitivities' work arrays (:func:`_contact_sens`)
-    sw = (
-        np.empty((2, m_s)),
-        np.empty((4, 4)),
-        np.empty((2, 4)),
-        np.empty(4, dtype=np.complex128),
-        np.empty(4, dtype=np.complex128),
-    )
-    cb = np.empty((4, 4))
-    fc = np.empty(3)
-    fcd = np.empty(3)
     while t < t1:
         if n_steps >= max_steps:
             status = STEP_BUDGET
@@ -2135,4 +2222,4 @@ def integrate(
             for i in range(ns):
                 hs0[i] = hs1[i]
             h = h * _step_factor(err)
-    return status, t, y, mode, n_steps, n_ev, h
+    return status, t, mode, n_steps, n_ev, h
