@@ -1765,6 +1765,7 @@ def integrate(
     sscale,
     out_dF,
     ev_tau,
+    modes,
 ):
     """Integrate from ``t0`` to ``t1``; see :func:`discovery.vibroimpact.dynamics.simulate`.
 
@@ -1782,6 +1783,12 @@ def integrate(
     ``out_dF`` of shape (m, len(t_eval)) the force's derivatives at ``t_eval`` are written
     too (shape (m, 0) for none), and with ``ev_tau`` of shape (len(ev_t), m) the events'
     time derivatives (shape (0, m) for none).  Not for a law with a permanent set.
+
+    ``modes``: the contact modes' closed form ``(kc, E, R, made)``
+    (:func:`~discovery.vibroimpact.dynamics.simulation.contact_modes`), set up here when
+    ``made[0]`` is 0 (then 1 where a mode has the closed form, 2 where none has): a caller
+    that integrates the same law and scenario again passes them back, and the set-up (the
+    eigendecomposition of both modes, 4.6 us of a 7.5 us call's fixed cost) is made once.
     """
     m_s = S.shape[1]
     y = y0.copy()
@@ -1807,14 +1814,15 @@ def integrate(
         np.empty(m_s),
     )
     # the contact in closed form where it applies (:func:`_contact`; not with sensitivities)
-    kc = np.zeros(4)
-    use_contact = _contact_law(p, coef, ea, eb, br, kc)
-    E = np.zeros((2, 4, _NE), dtype=np.complex128)
-    R = np.zeros((2, _NR))
-    if use_contact:
-        _contact_setup(p, kc, LOAD, atol, E, R)
-        _contact_setup(p, kc, UNLOAD, atol, E, R)
-        use_contact = R[0, 0] != 0.0 or R[1, 0] != 0.0
+    kc, E, R, made = modes
+    if made[0] == 0.0:
+        use_contact = _contact_law(p, coef, ea, eb, br, kc)
+        if use_contact:
+            _contact_setup(p, kc, LOAD, atol, E, R)
+            _contact_setup(p, kc, UNLOAD, atol, E, R)
+            use_contact = R[0, 0] != 0.0 or R[1, 0] != 0.0
+        made[0] = 1.0 if use_contact else 2.0
+    use_contact = made[0] == 1.0
     phases = (
         np.empty(_NF),
         kc,

@@ -179,6 +179,19 @@ def no_sensitivities():
     )
 
 
+def contact_modes():
+    """Fresh storage for the contact modes' closed form (the kernel's ``modes``): the first
+    run sets it up, and a caller that runs the same law and scenario with the same
+    tolerances again (a stroboscopic map) passes the same storage back, so the
+    eigendecomposition of the two modes is made once."""
+    return (
+        np.zeros(4),
+        np.zeros((2, 4, K._NE), dtype=np.complex128),
+        np.zeros((2, K._NR)),
+        np.zeros(1),
+    )
+
+
 SENSITIVITIES = ("state", "coefficients", "all")
 _STATE_NAMES = ("w1", "v1", "w2", "v2")
 
@@ -353,6 +366,7 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
         te,
         *bufs,
         *sens,
+        contact_modes(),
     )
     message = (
         "ok"

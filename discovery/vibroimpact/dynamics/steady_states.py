@@ -36,7 +36,15 @@ from ...numerics.status import message as status_message
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from . import _kernel as K
-from .simulation import _HINTS, Tolerances, _atol, kernel_params, no_sensitivities, simulate
+from .simulation import (
+    _HINTS,
+    Tolerances,
+    _atol,
+    contact_modes,
+    kernel_params,
+    no_sensitivities,
+    simulate,
+)
 
 __all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
 
@@ -80,6 +88,8 @@ class StroboscopicMap:
         self.zeta_max = 0.0
         self.impact_v0 = 0.0
         self._no_sens = no_sensitivities()
+        # the contact modes' closed form, set up by the first run and kept for the others
+        self._modes = contact_modes()
         self._state_dirs = np.full(4, -1, dtype=np.int64)
         # exact Jacobians (one run with the variational equations) unless the law has a
         # permanent set; ``n_exact`` counts them
@@ -124,6 +134,7 @@ class StroboscopicMap:
             self._evy,
             self._evm,
             *sens,
+            self._modes,
         )
         self.n_calls += 1
         self.n_steps += steps
