@@ -38,7 +38,7 @@ from ..dynamics.law_response import impulse_from_steady_state
 from ..dynamics.simulation import simulate
 from ..dynamics.steady_states import steady_state
 from .criteria import compare, criteria_lines, evaluate_criteria
-from .motion import MOTION_CRITERION, block_penetration
+from .motion import MOTION_CRITERION
 from .notes import contacts_note, transient_notes
 from .span_evaluation import span_run
 
@@ -603,9 +603,7 @@ def _evaluate_span(
     imp["simulated"] = int(len(sim.support))
     crit, per_block = blocks.criteria(span)
     if span.sigma_z > 0:
-        crit[MOTION_CRITERION], _ = block_penetration(
-            span, reference.blocks, sims, [b.Z for b in span.blocks], z_sim
-        )
+        crit[MOTION_CRITERION], _ = blocks.penetration(span)
     last = span.blocks[-1]
     found = {
         "comparison": "record span",

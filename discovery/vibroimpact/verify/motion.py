@@ -29,6 +29,8 @@ __all__ = [
     "MOTION_CRITERION",
     "penetration_criterion",
     "block_penetration",
+    "fold_penetration",
+    "penetration_mean",
     "contact_window",
     "penetration_residuals",
     "penetration_jacobian",
@@ -101,13 +103,26 @@ def block_penetration(span, measured, simulated, z_measured, z_simulated):
     per_block : list of float
     """
     per = [
-        penetration_criterion(b.fold, zm, zs, contact_window(b.fold, (m, s), (zm, zs)))
+        fold_penetration(b.fold, m, s, zm, zs)
         for b, m, s, zm, zs in zip(
             span.blocks, measured, simulated, z_measured, z_simulated, strict=True
         )
     ]
+    return penetration_mean(span, per), per
+
+
+def fold_penetration(fold, measured, simulated, z_measured, z_simulated):
+    """I5 of one block's fold: its penetrations compared inside the contact window of its
+    folded force cycles and penetrations (a block farm's worker computes it with the
+    block's other criteria)."""
+    window = contact_window(fold, (measured, simulated), (z_measured, z_simulated))
+    return penetration_criterion(fold, z_measured, z_simulated, window)
+
+
+def penetration_mean(span, per_block):
+    """The blocks' I5 values' mean weighted by their cycles."""
     w = np.array([b.fold.n_cycles for b in span.blocks], dtype=float)
-    return float(np.dot(w / w.sum(), per)), per
+    return float(np.dot(w / w.sum(), per_block))
 
 
 RESIDUAL_PAD = 0.1

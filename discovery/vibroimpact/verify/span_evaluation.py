@@ -11,6 +11,7 @@ import numpy as np
 from ..._validate import unchecked
 from .block_farm import farm_for
 from .criteria import evaluate_criteria
+from .motion import fold_penetration, penetration_mean
 from .trajectory import _block_mean, _history, _memo_run
 
 __all__ = ["BlockJob", "BlockOutcome", "block_outcome", "SpanRun", "span_run"]
@@ -31,16 +32,19 @@ class BlockOutcome:
         The folded history.
     criteria : dict or None
         The criteria against the measured folded block.
+    penetration : float or None
+        The block's I5 (:func:`~.motion.fold_penetration`), for a span with positions.
     error : Exception or None
     stage : int
         Where ``error`` came from: 0 none, 1 the run or its history, 2 the fold, 3 the
-        criteria.
+        criteria, 4 the penetration's.
     """
 
     run: tuple | None = None
     history: np.ndarray | None = None
     impulse: object = None
     criteria: dict | None = None
+    penetration: float | None = None
     error: Exception | None = None
     stage: int = 0
 
@@ -61,9 +65,9 @@ class BlockJob:
 
 def block_outcome(reference, k, job):
     """Block ``k`` of ``reference``'s span evaluated for ``job`` (a :class:`BlockJob`): the
-    law's run from the block's measured state, its history, folded, and its criteria (a
-    function of its arguments: the same here or in a worker of a
-    :mod:`~discovery.vibroimpact.verify.block_farm`)."""
+    law's run from the block's measured state, its history, folded, its criteria and, for a
+    span with positions, its I5 (a function of its arguments: the same here or in a worker
+    of a :mod:`~discovery.vibroimpact.verify.block_farm`)."""
     span = reference.span
     blk = span.blocks[k]
     try:
@@ -82,7 +86,13 @@ def block_outcome(reference, k, job):
         crit = unchecked(evaluate_criteria)(reference.blocks[k], imp, None)
     except Exception as exc:
         return BlockOutcome(run, H, imp, error=exc, stage=3)
-    return BlockOutcome(run, H, imp, crit)
+    if not span.sigma_z > 0:
+        return BlockOutcome(run, H, imp, crit)
+    try:
+        pen = fold_penetration(blk.fold, reference.blocks[k], imp, blk.Z, Z)
+    except Exception as exc:
+        return BlockOutcome(run, H, imp, crit, error=exc, stage=4)
+    return BlockOutcome(run, H, imp, crit, pen)
 
 
 @dataclass(frozen=True)
@@ -117,6 +127,12 @@ class SpanRun:
         self._raise(3)
         per = [o.criteria for o in self.outcomes]
         return _block_mean(per, span), per
+
+    def penetration(self, span):
+        """``(mean, per_block)`` of I5 as :func:`~.motion.block_penetration`."""
+        self._raise(4)
+        per = [o.penetration for o in self.outcomes]
+        return penetration_mean(span, per), per
 
 
 def span_run(scenario, law, reference, *, tolerances=None, observe=None, window=False):
