@@ -60,6 +60,12 @@ law, the right-hand side, the shared Dormand-Prince blocks) are inlined; the ste
 switching functions, the dense-output probe and the event record are compiled once each
 and called (a call per step or per event, not per stage): a cold compile takes about 30 s
 on two cores instead of 160 s with everything inlined, at the same run time (``bench/``).
+Those calls pass their arrays borrowed: every function that allocates nothing is compiled
+without numba's reference counting (:data:`_borrowed_njit`), and :func:`integrate` only
+allocates the work arrays and the contact modes' set-up and hands them to
+:func:`_integrate`'s loop.  With the counts, their atomic increments and decrements took
+about half of a period's time (sampled); without them the arithmetic is the same, bit for
+bit.
 """
 
 import numpy as np
@@ -76,11 +82,9 @@ from ...numerics._tableau import E as _E
 
 # Every function here that allocates nothing takes its arrays borrowed: compiled without
 # numba's reference counting (``_nrt=False``, as numba compiles its own helpers), a call
-# passes its arrays without an atomic increment and decrement of each one's count.  Those
-# took a third of a closed-form period's time and half of an integrated contact's; the
-# arithmetic, and so every result, is the same bit for bit.  A function that allocates
-# (``integrate``, a contact mode's set-up) keeps the counts; numba refuses to compile an
-# allocation in a borrowing function.
+# passes its arrays without an atomic increment and decrement of each one's count.  A
+# function that allocates (``integrate``, a contact mode's set-up) keeps the counts; numba
+# refuses to compile an allocation in a borrowing function.
 _borrowed_njit = njit(cache=True, _nrt=False)
 
 # the shared Dormand-Prince blocks for this system's four states (w1, v1, w2, v2)
