@@ -468,3 +468,24 @@ def test_frames_from_undamped_to_overdamped(c1):
     assert np.sum(a.event_kind == K.EV_ONSET) >= 3
     # measured <= 2.6e-9 T, 2.9e-9 of the scales, 4.7e-9 of the force's peak
     _agree(a, b, sc, 1e-8, 1e-7, 1e-7)
+
+
+@pytest.mark.parametrize("name", list(REGIMES))
+def test_a_map_sets_the_contact_modes_up_once(name):
+    """A stroboscopic map keeps the contact modes' closed form from its first run (the
+    kernel's ``modes``): every later run gives the same bits as a run that sets them up
+    afresh, and the storage says whether a mode has the closed form."""
+    sc, text, _ = REGIMES[name]
+    law = ForceLaw.parse(text)
+    smap = StroboscopicMap(sc, law)
+    assert smap._modes[3][0] == 0.0  # nothing set up before the first run
+    y = sc.initial_state()
+    for k in range(4):
+        kept = smap.advance(y, 1, t0=k * sc.period)
+        fresh = simulate(sc, law, (k * sc.period, (k + 1) * sc.period), y0=y).y_final
+        np.testing.assert_array_equal(kept, fresh)
+        y = kept
+    assert smap._modes[3][0] == 1.0  # linear laws: a mode has the closed form
+    nonlinear = StroboscopicMap(sc, ForceLaw.parse(text + " + 1e9*z*zd"))
+    nonlinear.advance(sc.initial_state(), 1)
+    assert nonlinear._modes[3][0] == 2.0
