@@ -238,7 +238,9 @@ def sensitivity_setup(scenario, law, which, *, n_eval=0, n_events=0, controlled=
             )
         S[:] = S0
     out_dF = np.empty((2 * m, n_eval))  # the force's derivatives, then the penetration's
-    ev_tau = np.full((n_events, m), np.nan)
+    # every recorded event's row is written (the saltation after it) and the rest are cut
+    # off: no fill (10 000 rows of NaN took 4-7 us a run)
+    ev_tau = np.empty((n_events, m))
     sscale = np.array(sscale) if controlled else np.empty(0)
     return (S, np.array(spar, dtype=np.int64), sscale, out_dF, ev_tau), tuple(names)
 
