@@ -31,6 +31,7 @@ from ..._printing import fmt
 from ..._validate import Instance, params
 from ...errors import InputError, NoContactError
 from ...numerics.intervals import in_widened_intervals
+from ...numerics.memo import Memo
 
 _IMPULSE = Instance("discovery.vibroimpact.data.impulse", "Impulse")
 
@@ -97,28 +98,17 @@ def compare(measured, simulated):
     if not math.isclose(ratio, q / p, rel_tol=1e-6):
         raise InputError("the impulses come from different drive periods; use one scenario")
     length = measured.duration * (math.lcm(p, q) // p)
-    te, de = _grid_points(measured, length)
     if _same_grid(measured, simulated):
-        # one fold's two sides (a record span): the union of a grid with itself
-        jumps, base = np.unique(te[de]), np.unique(te)
+        # one fold's two sides (a record span): the measured side on its own grid, made
+        # once for every law compared with it
+        t, tq, left, fe, sup_e = _own_grid(measured, length)
     else:
+        te, de = _grid_points(measured, length)
         tn, dn = _grid_points(simulated, length)
-        jumps = np.union1d(te[de], tn[dn])
-        base = np.union1d(te, tn)
-    t = np.sort(np.concatenate([base, jumps]))
-    right = np.zeros(t.size, dtype=bool)
-    right[1:] = t[1:] == t[:-1]
-    right[0] = True
-    # the left limit at every time, the right one at a jump's second time and at 0
-    tq, left = t.copy(), ~right
-    tq[0] = 0.0
-
-    def ev(imp):
-        return imp.evaluate(tq, left)
-
-    sup_e = measured.periodic_support(length)
+        t, tq, left = _query_grid(np.union1d(te, tn), np.union1d(te[de], tn[dn]))
+        fe, sup_e = measured.evaluate(tq, left), measured.periodic_support(length)
     sup_n = simulated.periodic_support(length)
-    fe, fn = ev(measured), ev(simulated)
+    fn = simulated.evaluate(tq, left)
     if measured.noise > 0:
         # fair to both signals: outside the contact windows (either support, widened by
         # 1 % of a period) the simulated force is zero and the measured one is only
@@ -128,6 +118,46 @@ def compare(measured, simulated):
         inside = _in_intervals(t, np.concatenate([sup_e, sup_n]), pad, length)
         fe, fn = np.where(inside, fe, 0.0), np.where(inside, fn, 0.0)
     return Comparison(t=t, fe=fe, fn=fn, support_e=sup_e, support_n=sup_n, length=length)
+
+
+def _query_grid(base, jumps):
+    """The common grid ``t`` of the knots ``base`` and the jumps' times ``jumps`` (each jump's
+    time twice), and where to evaluate both sides on it: ``(t, tq, left)``, the left limit
+    at every time, the right one at a jump's second time and at 0."""
+    t = np.sort(np.concatenate([base, jumps]))
+    right = np.zeros(t.size, dtype=bool)
+    right[1:] = t[1:] == t[:-1]
+    right[0] = True
+    tq, left = t.copy(), ~right
+    tq[0] = 0.0
+    return t, tq, left
+
+
+_OWN_GRIDS = Memo(256)
+"""The measured side of :func:`compare` on its own grid, per impulse (see :func:`_own_grid`)."""
+
+
+def _own_grid(imp, length):
+    """``(t, tq, left, F, support)``: the grid of ``imp`` compared with an impulse on the same
+    knots (one fold's two sides: the union of a grid with itself), ``imp`` evaluated on it
+    and its support over ``length``; made once per impulse and kept (the fitting loops
+    compare each measured block with every law; this was half of a comparison's time).
+    What a :class:`Comparison` holds is read-only; ``tq`` and ``left`` stay writeable, as
+    the compiled evaluation's signature has them.  The entry holds the impulse, so its id
+    is not reused while kept."""
+
+    def made():
+        te, de = _grid_points(imp, length)
+        t, tq, left = _query_grid(np.unique(te), np.unique(te[de]))
+        out = (t, tq, left, imp.evaluate(tq, left), imp.periodic_support(length))
+        for a in (out[0], out[3], out[4]):
+            a.setflags(write=False)
+        return imp, length, out
+
+    kept, kept_length, out = _OWN_GRIDS.get(id(imp), made)
+    if kept is imp and kept_length == length:
+        return out
+    return made()[2]
 
 
 def _same_grid(a, b):

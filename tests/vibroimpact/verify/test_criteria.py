@@ -265,3 +265,29 @@ def test_one_folds_two_sides_compare_as_through_the_union(seed, monkeypatch):
     for f in ("t", "fe", "fn", "support_e", "support_n"):
         assert np.array_equal(getattr(fast, f), getattr(slow, f))
     assert fast_v == slow_v
+
+
+def test_a_measured_side_is_made_once_and_kept(monkeypatch):
+    """The fitting loops compare one measured block with every law: its side of a comparison
+    on its own grid is made once and kept (read-only where a comparison holds it), and each
+    later comparison is bitwise a fresh one."""
+    import discovery.vibroimpact.verify.criteria as C
+
+    rng = np.random.default_rng(5)
+    t = np.sort(np.concatenate([[0.0, 1.0], rng.uniform(0, 1, 40)]))
+    sup = np.array([[0.0, float(t[-2])]])
+    e = dataclasses.replace(imp(t, np.abs(rng.normal(size=t.size)), 1.0, sup), noise=0.01)
+    sims = [imp(t, np.abs(rng.normal(size=t.size)), 1.0, sup) for _ in range(3)]
+    made = []
+    grid_points = C._grid_points
+    monkeypatch.setattr(C, "_grid_points", lambda *a: made.append(1) or grid_points(*a))
+    kept = [(compare(e, s), evaluate_criteria(e, s)) for s in sims]
+    assert len(made) == 1
+    assert not kept[0][0].t.flags.writeable and not kept[0][0].support_e.flags.writeable
+    for s, (c, v) in zip(sims, kept, strict=True):
+        C._OWN_GRIDS.clear()
+        fresh = compare(e, s)
+        for f in ("t", "fe", "fn", "support_e", "support_n"):
+            assert np.array_equal(getattr(c, f), getattr(fresh, f))
+        C._OWN_GRIDS.clear()
+        assert evaluate_criteria(e, s) == v
