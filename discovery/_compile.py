@@ -6,7 +6,7 @@ import os
 import sys
 from pathlib import Path
 
-__all__ = ["KERNELS", "cached", "announce_compile"]
+__all__ = ["KERNELS", "cached", "announce_compile", "borrowing_options"]
 
 KERNELS = {
     "vibro-impact": (Path(__file__).parent / "vibroimpact" / "dynamics", "_kernel.integrate-"),
@@ -50,3 +50,15 @@ def announce_compile(kernel="vibro-impact", stream=None):
         file=stream or sys.stderr,
         flush=True,
     )
+
+
+def borrowing_options():
+    """The numba options of a kernel function that allocates nothing and takes its arrays
+    borrowed: ``{"_nrt": False}`` (no reference counts, as numba compiles its own helpers)
+    where this numba has that option, else none, so that a release without the private
+    option still compiles the kernels, with the counts (the same arithmetic, slower)."""
+    try:
+        from numba.core.cpu import CPUTargetOptions
+    except ImportError:  # a numba without that module: the counts stay
+        return {}
+    return {"_nrt": False} if hasattr(CPUTargetOptions, "_nrt") else {}

@@ -99,3 +99,20 @@ def test_the_install_compiles_every_entry_of_the_oscillators_kernel(monkeypatch)
     cached = {p.name for p in C._cache_folder(folder).iterdir() if p.suffix == ".nbi"}
     missing = [e for e in entries if not any(n.startswith(f"_kernel.{e}-") for n in cached)]
     assert not missing, f"not compiled by discovery.warm: {missing}"
+
+
+def test_the_kernel_borrows_its_arrays_where_numba_can(monkeypatch):
+    """The kernel's non-allocating functions are compiled without reference counts
+    (``_nrt=False``) with this numba; a numba without that private option gets no option,
+    so the kernel still compiles (with the counts)."""
+    import types
+
+    from discovery._compile import borrowing_options
+    from discovery.vibroimpact.dynamics import _kernel as K
+
+    assert borrowing_options() == {"_nrt": False}
+    assert K._contact_search.targetoptions.get("_nrt") is False
+    assert "_nrt" not in K.integrate.targetoptions  # it allocates: the counts stay
+    without = types.SimpleNamespace(CPUTargetOptions=type("CPUTargetOptions", (), {}))
+    monkeypatch.setitem(sys.modules, "numba.core.cpu", without)
+    assert borrowing_options() == {}

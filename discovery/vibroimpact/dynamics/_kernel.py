@@ -71,6 +71,7 @@ bit.
 import numpy as np
 from numba import njit
 
+from ..._compile import borrowing_options
 from ...numerics._dopri import MIN_FACTOR as _MIN_FACTOR
 from ...numerics._dopri import C as _C
 from ...numerics._dopri import blocks
@@ -81,11 +82,12 @@ from ...numerics._tableau import B as _B
 from ...numerics._tableau import E as _E
 
 # Every function here that allocates nothing takes its arrays borrowed: compiled without
-# numba's reference counting (``_nrt=False``, as numba compiles its own helpers), a call
-# passes its arrays without an atomic increment and decrement of each one's count.  A
-# function that allocates (``integrate``, a contact mode's set-up) keeps the counts; numba
-# refuses to compile an allocation in a borrowing function.
-_borrowed_njit = njit(cache=True, _nrt=False)
+# numba's reference counting (``_nrt=False``, where this numba has the option:
+# :func:`~discovery._compile.borrowing_options`), a call passes its arrays without an atomic
+# increment and decrement of each one's count.  A function that allocates (``integrate``, a
+# contact mode's set-up) keeps the counts; numba refuses to compile an allocation in a
+# borrowing function.
+_borrowed_njit = njit(cache=True, **borrowing_options())
 
 # the shared Dormand-Prince blocks for this system's four states (w1, v1, w2, v2)
 _D = blocks(4)
