@@ -101,7 +101,7 @@ def compare(measured, simulated):
     if _same_grid(measured, simulated):
         # one fold's two sides (a record span): the measured side on its own grid, made
         # once for every law compared with it
-        t, tq, left, fe, sup_e = _own_grid(measured, length)
+        t, tq, left, fe, sup_e = _own_grid(measured)
     else:
         te, de = _grid_points(measured, length)
         tn, dn = _grid_points(simulated, length)
@@ -137,27 +137,25 @@ _OWN_GRIDS = Memo(256)
 """The measured side of :func:`compare` on its own grid, per impulse (see :func:`_own_grid`)."""
 
 
-def _own_grid(imp, length):
+def _own_grid(imp):
     """``(t, tq, left, F, support)``: the grid of ``imp`` compared with an impulse on the same
-    knots (one fold's two sides: the union of a grid with itself), ``imp`` evaluated on it
-    and its support over ``length``; made once per impulse and kept (the fitting loops
+    knots (one fold's two sides: the union of a grid with itself, over one cycle), ``imp``
+    evaluated on it and its support; made once per impulse and kept (the fitting loops
     compare each measured block with every law; this was half of a comparison's time).
     What a :class:`Comparison` holds is read-only; ``tq`` and ``left`` stay writeable, as
     the compiled evaluation's signature has them.  The entry holds the impulse, so its id
     is not reused while kept."""
 
     def made():
-        te, de = _grid_points(imp, length)
+        te, de = _grid_points(imp, imp.duration)
         t, tq, left = _query_grid(np.unique(te), np.unique(te[de]))
-        out = (t, tq, left, imp.evaluate(tq, left), imp.periodic_support(length))
+        out = (t, tq, left, imp.evaluate(tq, left), imp.periodic_support(imp.duration))
         for a in (out[0], out[3], out[4]):
             a.setflags(write=False)
-        return imp, length, out
+        return imp, out
 
-    kept, kept_length, out = _OWN_GRIDS.get(id(imp), made)
-    if kept is imp and kept_length == length:
-        return out
-    return made()[2]
+    kept, out = _OWN_GRIDS.get(id(imp), made)
+    return out if kept is imp else made()[1]
 
 
 def _same_grid(a, b):
