@@ -76,10 +76,11 @@ def recurrence(strobe, scale, max_period):
     ``(k, k + n)`` ending at the last point: ``{n: distance}``.
     """
     d = {}
-    last = len(strobe) - 1
+    points = np.asarray(strobe)
+    last = len(points) - 1
     for n in range(1, max_period + 1):
-        ks = range(max(0, last - n - 2), last - n + 1)
-        d[n] = float(max(np.max(np.abs(strobe[k + n] - strobe[k]) / scale) for k in ks))
+        k = max(0, last - n - 2)
+        d[n] = float(np.max(np.abs(points[k + n :] - points[k : last - n + 1]) / scale))
     return d
 
 

@@ -1743,6 +1743,180 @@ def _contact_samples(
 
 
 @njit(cache=True)
+def work_arrays(m_s, n_coef, modes):
+    """The work arrays of :func:`_integrate`: ``(steps, sens, phases)``, those of the
+    steps, of ``m_s`` sensitivities (a law of ``n_coef`` coefficients) and of the
+    closed-form phases (with the contact ``modes``, see :func:`integrate`).  A caller that
+    runs the same law many times (:class:`~discovery.vibroimpact.dynamics.steady_states.
+    StroboscopicMap`) makes them once and calls :func:`_integrate` itself."""
+    kc, E, R, _ = modes
+    steps = (
+        np.empty(4),
+        np.empty(4),
+        np.empty(4),
+        np.empty((7, 4)),
+        np.empty(3),
+        np.empty(3),
+        np.empty(3),
+        np.empty(3),
+        np.empty(3),
+    )
+    sens = (
+        np.empty((7, 4, m_s)),
+        np.empty((4, m_s)),
+        np.empty((4, m_s)),
+        np.empty(n_coef),
+        np.empty(4),
+        np.empty(4),
+        np.empty(m_s),
+    )
+    phases = (
+        np.empty(_NF),
+        kc,
+        E,
+        R,
+        np.empty((4, 2), dtype=np.complex128),
+        # the closed-form sensitivities' work arrays (:func:`_contact_sens`)
+        (
+            np.empty((2, m_s)),
+            np.empty((4, 4)),
+            np.empty((2, 4)),
+            np.empty(4, dtype=np.complex128),
+            np.empty(4, dtype=np.complex128),
+        ),
+        np.empty((4, 4)),
+        np.empty(3),
+        np.empty(3),
+    )
+    return steps, sens, phases
+
+
+@njit(cache=True)
+def set_up_modes(p, coef, ea, eb, br, atol, modes):
+    """Whether a contact mode has the closed form (:func:`_contact`; not with
+    sensitivities), setting the ``modes`` up when ``made[0]`` is 0 (see
+    :func:`integrate`)."""
+    kc, E, R, made = modes
+    if made[0] == 0.0:
+        use_contact = _contact_law(p, coef, ea, eb, br, kc)
+        if use_contact:
+            _contact_setup(p, kc, LOAD, atol, E, R)
+            _contact_setup(p, kc, UNLOAD, atol, E, R)
+            use_contact = R[0, 0] != 0.0 or R[1, 0] != 0.0
+        made[0] = 1.0 if use_contact else 2.0
+    return made[0] == 1.0
+
+
+@_borrowed_njit
+def in_range(y, bound):
+    """Whether every ``|y[j]| < bound`` (false for a NaN)."""
+    for j in range(y.shape[0]):
+        if not abs(y[j]) < bound:
+            return False
+    return True
+
+
+@_borrowed_njit
+def strobe(
+    points,
+    y,
+    p_base,
+    p,
+    memory,
+    period,
+    coef,
+    ea,
+    eb,
+    br,
+    rtol,
+    atol,
+    hmax,
+    max_steps,
+    bound,
+    t_eval,
+    out_y,
+    out_f,
+    out_mode,
+    ev_t,
+    ev_kind,
+    ev_y,
+    ev_modes,
+    S,
+    spar,
+    sscale,
+    out_dF,
+    ev_tau,
+    use_contact,
+    steps,
+    sens,
+    phases,
+):
+    """Strobe points: ``points[k] = Phi(points[k - 1])`` for ``k >= 1`` (``points[0]`` the
+    start), each period one run of :func:`_integrate` from ``t = 0`` exactly as a separate
+    call (the mode resolved from the state, the first step ``period / 100``, ``p`` a fresh
+    copy of ``p_base``), so the points are bitwise those of one call per period.  With
+    ``memory`` (a law with a permanent set) each run starts with the contact memory
+    (``p[P_ZMAX]``, ``p[P_V0]``) the previous one ended with, the first with ``p``'s.
+    ``y`` is the run's state (work array).  Returns ``(status, k, t, n_steps, inside)``:
+    the last period run (``k``, its status and end time ``t``), the steps of all runs,
+    and whether its end state is within ``bound`` (:func:`in_range`)."""
+    n_steps = 0
+    status = OK
+    t = 0.0
+    inside = True
+    k = 0
+    while k < points.shape[0] - 1:
+        k += 1
+        zmax, v0 = p[P_ZMAX], p[P_V0]
+        for j in range(p.shape[0]):
+            p[j] = p_base[j]
+        if memory:
+            p[P_ZMAX], p[P_V0] = zmax, v0
+        for j in range(4):
+            y[j] = points[k - 1, j]
+        status, t, _, ns, _, _ = _integrate(
+            0.0,
+            period,
+            y,
+            -1,
+            p,
+            coef,
+            ea,
+            eb,
+            br,
+            rtol,
+            atol,
+            period / 100.0,
+            hmax,
+            max_steps,
+            t_eval,
+            out_y,
+            out_f,
+            out_mode,
+            ev_t,
+            ev_kind,
+            ev_y,
+            ev_modes,
+            S,
+            spar,
+            sscale,
+            out_dF,
+            ev_tau,
+            use_contact,
+            steps,
+            sens,
+            phases,
+        )
+        n_steps += ns
+        for j in range(4):
+            points[k, j] = y[j]
+        inside = in_range(y, bound)
+        if status != OK or not inside:
+            break
+    return status, k, t, n_steps, inside
+
+
+@njit(cache=True)
 def integrate(
     t0,
     t1,
@@ -1796,57 +1970,9 @@ def integrate(
     that integrates the same law and scenario again passes them back, and the set-up (the
     eigendecomposition of both modes, 4.6 us of a 7.5 us call's fixed cost) is made once.
     """
-    m_s = S.shape[1]
     y = y0.copy()
-    # the work arrays of the steps, of the sensitivities and of the closed-form phases
-    steps = (
-        np.empty(4),
-        np.empty(4),
-        np.empty(4),
-        np.empty((7, 4)),
-        np.empty(3),
-        np.empty(3),
-        np.empty(3),
-        np.empty(3),
-        np.empty(3),
-    )
-    sens = (
-        np.empty((7, 4, m_s)),
-        np.empty((4, m_s)),
-        np.empty((4, m_s)),
-        np.empty(coef.shape[0]),
-        np.empty(4),
-        np.empty(4),
-        np.empty(m_s),
-    )
-    # the contact in closed form where it applies (:func:`_contact`; not with sensitivities)
-    kc, E, R, made = modes
-    if made[0] == 0.0:
-        use_contact = _contact_law(p, coef, ea, eb, br, kc)
-        if use_contact:
-            _contact_setup(p, kc, LOAD, atol, E, R)
-            _contact_setup(p, kc, UNLOAD, atol, E, R)
-            use_contact = R[0, 0] != 0.0 or R[1, 0] != 0.0
-        made[0] = 1.0 if use_contact else 2.0
-    use_contact = made[0] == 1.0
-    phases = (
-        np.empty(_NF),
-        kc,
-        E,
-        R,
-        np.empty((4, 2), dtype=np.complex128),
-        # the closed-form sensitivities' work arrays (:func:`_contact_sens`)
-        (
-            np.empty((2, m_s)),
-            np.empty((4, 4)),
-            np.empty((2, 4)),
-            np.empty(4, dtype=np.complex128),
-            np.empty(4, dtype=np.complex128),
-        ),
-        np.empty((4, 4)),
-        np.empty(3),
-        np.empty(3),
-    )
+    use_contact = set_up_modes(p, coef, ea, eb, br, atol, modes)
+    steps, sens, phases = work_arrays(S.shape[1], coef.shape[0], modes)
     status, t, mode, n_steps, n_ev, h = _integrate(
         t0,
         t1,

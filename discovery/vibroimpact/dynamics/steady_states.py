@@ -49,6 +49,16 @@ from .simulation import (
 __all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
 
 
+def _event_arrays(room):
+    """The kernel's event arrays ``(t, kind, y, modes)`` with room for ``room`` events."""
+    return (
+        np.empty(room),
+        np.empty(room, dtype=np.int64),
+        np.empty((room, 4)),
+        np.empty((room, 2), dtype=np.int64),
+    )
+
+
 class StroboscopicMap:
     """The period map of one scenario and law (a thin, fast wrapper on the kernel).
 
@@ -72,13 +82,11 @@ class StroboscopicMap:
         self._ey = np.empty((4, 0))
         self._ef = np.empty(0)
         self._em = np.empty(0, dtype=np.int64)
-        self._evt = np.empty(0)
-        self._evk = np.empty(0, dtype=np.int64)
-        self._evy = np.empty((0, 4))
-        self._evm = np.empty((0, 2), dtype=np.int64)
+        self._no_events = _event_arrays(0)
         x, v = scenario.scales()
         self.scale = np.array([x, v, x, v])
         self.n_calls = 0
+        self.n_periods = 0
         self.n_steps = 0
         # a law with a permanent set unloads from the contact's largest penetration, which
         # the four states do not hold: the map carries it from one call's end to the next
@@ -88,8 +96,15 @@ class StroboscopicMap:
         self.zeta_max = 0.0
         self.impact_v0 = 0.0
         self._no_sens = no_sensitivities()
-        # the contact modes' closed form, set up by the first run and kept for the others
+        # the contact modes' closed form, set up here once for all the map's runs, and the
+        # kernel's work arrays, made once for the plain runs and once for the Jacobian's
+        # (the map calls the kernel's loop itself: it is 2-3 us of a 10 us period)
         self._modes = contact_modes()
+        self._use_contact = K.set_up_modes(
+            self._p, self._coef, self._ea, self._eb, self._br, self._atol, self._modes
+        )
+        self._work = {}
+        self._bound = 1e6 * self.scale.max() + 1e3
         self._state_dirs = np.full(4, -1, dtype=np.int64)
         # exact Jacobians (one run with the variational equations) unless the law has a
         # permanent set; ``n_exact`` counts them
@@ -105,15 +120,38 @@ class StroboscopicMap:
         ``remember`` this call's own end value replaces it."""
         return self._run(y, n, t0, remember, self._no_sens)
 
-    def _run(self, y, n, t0, remember, sens):
+    def onsets(self, y, n=1):
+        """The contact onsets over ``n`` periods from ``y`` (with the contact memory the
+        map holds, which the run leaves as it is): the impacts of an orbit through
+        ``y``.  Not one of the search's evaluations: :attr:`n_calls` stays as it was."""
+        calls, room = self.n_calls, 8 * n
+        while True:
+            events = _event_arrays(room)
+            n_ev = self._run(y, n, 0.0, False, self._no_sens, events=events)[1]
+            if n_ev <= room:
+                self.n_calls = calls
+                return int(np.sum(events[1][:n_ev] == K.EV_ONSET))
+            room = n_ev
+
+    def _prepared(self, m_s):
+        """A run's parameters (a copy, holding the map's contact memory) and the kernel's
+        work arrays for ``m_s`` sensitivities (made once)."""
         p = self._p.copy()
         if self._memory:
             p[K.P_ZMAX] = self.zeta_max
             p[K.P_V0] = self.impact_v0
-        status, tf, yf, _, steps, _, _ = K.integrate(
+        work = self._work.get(m_s)
+        if work is None:
+            work = self._work[m_s] = K.work_arrays(m_s, self._coef.shape[0], self._modes)
+        return p, work
+
+    def _run(self, y, n, t0, remember, sens, *, events=None):
+        p, work = self._prepared(sens[0].shape[1])
+        yf = np.array(y, dtype=float)  # advanced in place
+        status, tf, _, steps, n_ev, _ = K._integrate(
             t0,
             t0 + n * self._T,
-            np.asarray(y, dtype=float),
+            yf,
             -1,
             p,
             self._coef,
@@ -129,30 +167,74 @@ class StroboscopicMap:
             self._ey,
             self._ef,
             self._em,
-            self._evt,
-            self._evk,
-            self._evy,
-            self._evm,
+            *(self._no_events if events is None else events),
             *sens,
-            self._modes,
+            self._use_contact,
+            *work,
         )
-        self.n_calls += 1
+        self._account(1, n, steps, p if remember else None)
+        self._check(status, tf, K.in_range(yf, self._bound))
+        return yf if events is None else (yf, n_ev)
+
+    def strobe(self, y, n):
+        """The strobe points ``y, Phi(y), ..., Phi^n(y)``, ndarray of shape (n + 1, 4):
+        bitwise those of ``n`` calls of :meth:`advance`, from one call of the kernel."""
+        points = np.empty((n + 1, 4))
+        points[0] = y
+        p, work = self._prepared(0)
+        status, k, tf, steps, inside = K.strobe(
+            points,
+            np.empty(4),
+            self._p,
+            p,
+            self._memory,
+            self._T,
+            self._coef,
+            self._ea,
+            self._eb,
+            self._br,
+            self.tol.rtol,
+            self._atol,
+            self._hmax,
+            self.tol.max_steps,
+            self._bound,
+            self._empty,
+            self._ey,
+            self._ef,
+            self._em,
+            *self._no_events,
+            *self._no_sens,
+            self._use_contact,
+            *work,
+        )
+        self._account(k, k, steps, p)
+        self._check(status, tf, inside)
+        return points
+
+    def _account(self, calls, periods, steps, p):
+        """Count a run's calls, periods and steps, and keep the contact memory its end
+        holds (``p``; None to keep the map's)."""
+        self.n_calls += calls
+        self.n_periods += periods
         self.n_steps += steps
-        if self._memory and remember:
+        if self._memory and p is not None:
             self.zeta_max = float(p[K.P_ZMAX])
             self.impact_v0 = float(p[K.P_V0])
+
+    def _check(self, status, tf, inside):
+        """Raise IntegrationError for a run that failed (``status``) or left the
+        physical range (not ``inside``), at time ``tf``."""
         if status != K.OK:
             raise IntegrationError(
                 f"simulation of law '{self.law}' stopped at t = {tf:.6g} s: "
                 f"{status_message(status, _HINTS)}"
             )
-        if not np.all(np.abs(yf) < 1e6 * self.scale.max() + 1e3):
+        if not inside:
             raise IntegrationError(
                 f"simulation of law '{self.law}' left the physical range at t = {tf:.6g} s "
                 "(a displacement over 1e6 times the drive's scale); the law or the scenario "
                 "may be unphysical (negative or huge coefficients, a moulding thrown away)"
             )
-        return yf
 
     def jacobian(self, y, n=1, fy=None):
         """Jacobian of ``Phi^n`` at ``y``, ndarray of shape (4, 4): exact (the variational
@@ -287,15 +369,18 @@ def _strobe_recurrence(pm, y, max_period):
     """Strobe points from ``y`` and their recurrence distance per period ``n``: ``(last
     strobe point, periods advanced, {n: distance}, the one-period distance)``; when the
     points already recur after one period, only two periods are advanced."""
-    strobe = [y, pm.advance(y, 1), None]
-    strobe[2] = pm.advance(strobe[1], 1)
+    strobe = pm.strobe(y, 2)
     quick = max(np.max(np.abs(strobe[k + 1] - strobe[k]) / pm.scale) for k in (0, 1))
     if quick < 1e-2:
         # fast path: the strobe points already recur after one period
-        return strobe[-1], 2, {1: float(quick)}, quick
-    for _ in range(2 * max_period):
-        strobe.append(pm.advance(strobe[-1], 1))
-    return strobe[-1], 2 * max_period + 2, recurrence(strobe, pm.scale, max_period), quick
+        return strobe[-1].copy(), 2, {1: float(quick)}, quick
+    strobe = np.concatenate([strobe, pm.strobe(strobe[-1], 2 * max_period)[1:]])
+    return (
+        strobe[-1].copy(),
+        2 * max_period + 2,
+        recurrence(strobe, pm.scale, max_period),
+        quick,
+    )
 
 
 def _orbit(pm, y, n, t0, *, tol, max_newton, attempt, evidence):
@@ -337,7 +422,7 @@ def _orbit(pm, y, n, t0, *, tol, max_newton, attempt, evidence):
         # one more orbit from y0 leaves the memory y0 holds (the orbit is periodic)
         pm.advance(y_orb, n)
         zmax, v0 = pm.zeta_max, pm.impact_v0
-    impacts = _count_onsets(pm, y_orb, t0, n, zeta_max0=zmax, impact_v0=v0)
+    impacts = pm.onsets(y_orb, n)
     return SteadyState(
         regime=f"P{n}",
         n_periods=n,
@@ -505,7 +590,7 @@ def _continued(scenario, law, pm, guess, tol):
         "t_start": float(guess.t0),
         "continued_from": {"regime": guess.regime, "newton_residuals": hist},
     }
-    impacts = _count_onsets(pm, y_orb, guess.t0, n)
+    impacts = pm.onsets(y_orb, n)
     return SteadyState(
         regime=f"P{n}",
         n_periods=n,
@@ -518,19 +603,3 @@ def _continued(scenario, law, pm, guess, tol):
         evidence=evidence,
         zeta_max0=0.0,
     )
-
-
-def _count_onsets(pm, y0, t0, n, *, zeta_max0=0.0, impact_v0=0.0):
-    """Contact onsets over ``n`` drive periods from ``y0`` at ``t0`` [s], simulated with
-    the scenario, law and tolerances of the stroboscopic map ``pm`` (and the contact
-    memory ``zeta_max0``, ``impact_v0`` the start holds)."""
-    tr = simulate(
-        pm.scenario,
-        pm.law,
-        (t0, t0 + n * pm.scenario.period),
-        y0=y0,
-        tolerances=pm.tol,
-        zeta_max0=zeta_max0,
-        impact_v0=impact_v0,
-    )
-    return int(np.sum(tr.event_kind == K.EV_ONSET))

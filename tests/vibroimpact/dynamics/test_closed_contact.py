@@ -472,20 +472,24 @@ def test_frames_from_undamped_to_overdamped(c1):
 
 @pytest.mark.parametrize("name", list(REGIMES))
 def test_a_map_sets_the_contact_modes_up_once(name):
-    """A stroboscopic map keeps the contact modes' closed form from its first run (the
-    kernel's ``modes``): every later run gives the same bits as a run that sets them up
-    afresh, and the storage says whether a mode has the closed form."""
+    """A stroboscopic map sets the contact modes' closed form up when it is made (the
+    kernel's ``modes``) and keeps them: every run, one period at a time or many from one
+    call (``strobe``), gives the same bits as a run that sets them up afresh, and the
+    storage says whether a mode has the closed form."""
     sc, text, _ = REGIMES[name]
     law = ForceLaw.parse(text)
     smap = StroboscopicMap(sc, law)
-    assert smap._modes[3][0] == 0.0  # nothing set up before the first run
+    assert smap._modes[3][0] == 1.0  # linear laws: a mode has the closed form
     y = sc.initial_state()
     for k in range(4):
         kept = smap.advance(y, 1, t0=k * sc.period)
         fresh = simulate(sc, law, (k * sc.period, (k + 1) * sc.period), y0=y).y_final
         np.testing.assert_array_equal(kept, fresh)
         y = kept
-    assert smap._modes[3][0] == 1.0  # linear laws: a mode has the closed form
+    points = [sc.initial_state()]
+    for _ in range(4):  # each period from t = 0, as the map's strobe points
+        points.append(simulate(sc, law, (0.0, sc.period), y0=points[-1]).y_final)
+    np.testing.assert_array_equal(smap.strobe(points[0], 4), points)
+    assert smap.n_calls == 8 and smap.n_periods == 8
     nonlinear = StroboscopicMap(sc, ForceLaw.parse(text + " + 1e9*z*zd"))
-    nonlinear.advance(sc.initial_state(), 1)
     assert nonlinear._modes[3][0] == 2.0

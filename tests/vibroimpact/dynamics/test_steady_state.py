@@ -10,7 +10,7 @@ from discovery.vibroimpact.dynamics import _kernel as K
 from discovery.vibroimpact.dynamics.simulation import simulate
 from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state
 from discovery.vibroimpact.model.law import ForceLaw
-from discovery.vibroimpact.model.scenario import Scenario
+from discovery.vibroimpact.model.scenario import Scenario, load_scenario
 
 
 def _rel(pm, a, b):
@@ -159,6 +159,42 @@ def test_advance_raises_on_runaway(paper):
     # guard (1e6 * velocity scale + 1e3 ~ 3.2e5): it must raise rather than return it
     with pytest.raises(IntegrationError, match="left the physical range"):
         pm.advance(paper.initial_state(), 20000)
+
+
+def test_strobe_points_are_those_of_one_advance_a_period():
+    """``strobe`` runs many periods in one call of the kernel, each as its own run: the
+    points, the counters and a permanent set's contact memory are those of one
+    ``advance`` a period, bit for bit; a runaway raises as ``advance`` does."""
+    sc = Scenario(m1=4390.0, m2=3270.0, k1=21900000.0, c1=73600.0, A=142000.0, frequency=16.6)
+    for text in ("1.4e8*z + 8.24e6*zd; set: 0.3", "1e10*z^1.5 + 1e7*zd", "3.37e9*z + 8.15e6*zd"):
+        law = ForceLaw.parse(text)
+        one, many = StroboscopicMap(sc, law), StroboscopicMap(sc, law)
+        y = sc.initial_state()
+        points = [y]
+        for _ in range(12):
+            points.append(one.advance(points[-1]))
+        np.testing.assert_array_equal(many.strobe(y, 12), points)
+        assert (many.n_calls, many.n_periods, many.n_steps) == (12, 12, one.n_steps)
+        assert (many.zeta_max, many.impact_v0) == (one.zeta_max, one.impact_v0)
+    pm = StroboscopicMap(sc, ForceLaw.parse("1e-3*z"))
+    with pytest.raises(IntegrationError, match="left the physical range"):
+        pm.strobe(sc.initial_state(), 20000)
+
+
+def test_an_orbits_onsets_are_the_simulated_ones(paper, paper_ss):
+    """The map counts an orbit's contact onsets from its own run: the count a simulation
+    of the same periods gives, also where a period holds more events than the first
+    guess of room (chatter); the count is not one of the search's evaluations."""
+    light = load_scenario("light").replace(m2=1000.0)
+    # the light machine's period from there holds 13 events: the count runs twice
+    cases = [(paper, paper.law, paper_ss.y0, 1), (light, ForceLaw.parse("2e9*z + 1.41e5*zd"), 20, 2)]
+    for sc, law, start, runs in cases:
+        pm = StroboscopicMap(sc, law)
+        y = pm.advance(sc.initial_state(), start) if sc is light else start
+        calls, periods = pm.n_calls, pm.n_periods
+        tr = simulate(sc, law, (0.0, sc.period), y0=y)
+        assert pm.onsets(y) == np.sum(tr.event_kind == K.EV_ONSET) > 0
+        assert (pm.n_calls, pm.n_periods) == (calls, periods + runs)
 
 
 # --- period detection near multipliers -1 (issue: a slow P1 orbit read as P2) -------------
