@@ -187,7 +187,10 @@ def test_an_orbits_onsets_are_the_simulated_ones(paper, paper_ss):
     guess of room (chatter); the count is not one of the search's evaluations."""
     light = load_scenario("light").replace(m2=1000.0)
     # the light machine's period from there holds 13 events: the count runs twice
-    cases = [(paper, paper.law, paper_ss.y0, 1), (light, ForceLaw.parse("2e9*z + 1.41e5*zd"), 20, 2)]
+    cases = [
+        (paper, paper.law, paper_ss.y0, 1),
+        (light, ForceLaw.parse("2e9*z + 1.41e5*zd"), 20, 2),
+    ]
     for sc, law, start, runs in cases:
         pm = StroboscopicMap(sc, law)
         y = pm.advance(sc.initial_state(), start) if sc is light else start
