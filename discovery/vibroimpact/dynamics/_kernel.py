@@ -1791,6 +1791,18 @@ def work_arrays(m_s, n_coef, modes):
     return steps, sens, phases
 
 
+@_borrowed_njit
+def sorted_within(t, lo, hi):
+    """Whether ``t`` is sorted (non-decreasing) and within ``[lo, hi]`` (false for a
+    NaN)."""
+    prev = lo
+    for k in range(t.shape[0]):
+        if not t[k] >= prev:
+            return False
+        prev = t[k]
+    return prev <= hi
+
+
 @njit(cache=True)
 def set_up_modes(p, coef, ea, eb, br, atol, modes):
     """Whether a contact mode has the closed form (:func:`_contact`; not with

@@ -331,7 +331,7 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
         raise InputError(f"t_span must be two finite times with t1 > t0, got {t_span!r}")
     y0 = scenario.initial_state() if y0 is None else np.array(y0, dtype=float).reshape(4)
     te = np.zeros(0) if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
-    if te.size and (np.any(np.diff(te) < 0) or te[0] < t0 - 1e-12 or te[-1] > t1 + 1e-12):
+    if te.size and not K.sorted_within(te, t0 - 1e-12, t1 + 1e-12):
         raise InputError("t_eval must be sorted and inside t_span")
     bufs = _buffers(te.size, s.max_events)
     out_y, out_f, out_m, ev_t, ev_k, ev_y, ev_m = bufs

@@ -279,10 +279,20 @@ def test_invalid_t_span(paper, span):
         simulate(paper, paper.law, span)
 
 
-@pytest.mark.parametrize("te", [[0.02, 0.01], [-1.0, 0.01], [0.0, 0.5]])
+@pytest.mark.parametrize(
+    "te",
+    [[0.02, 0.01], [-1.0, 0.01], [0.0, 0.5], [0.0, 0.01, 0.03, 0.02], [0.0, np.nan, 0.02]],
+)
 def test_invalid_t_eval(paper, te):
     with pytest.raises(InputError, match="t_eval"):
         simulate(paper, paper.law, (0.0, 0.04), t_eval=te)
+
+
+def test_t_eval_at_the_span_ends_and_repeated(paper):
+    """Times on the span's ends (within 1e-12 s) and repeated times are valid."""
+    te = [-1e-13, 0.0, 0.01, 0.01, 0.04 + 1e-13]
+    tr = simulate(paper, paper.law, (0.0, 0.04), t_eval=te)
+    assert tr.t.size == 5 and tr.force[2] == tr.force[3]
 
 
 @pytest.mark.parametrize(
