@@ -54,6 +54,31 @@ def test_every_job_runs_with_one_blas_thread():
     assert Pool(2).map(_blas_threads, [0, 1]) == [[1], [1]]
 
 
+def test_the_blas_libraries_are_looked_for_again_only_after_an_import():
+    """The libraries one job found serve the next, until a module is imported (it may
+    bring a BLAS of its own); outside a job the BLAS has its threads back."""
+    import importlib
+    import sys
+
+    from threadpoolctl import threadpool_info
+
+    from discovery.numerics import executor as E
+
+    before = [i["num_threads"] for i in threadpool_info()]
+    with E.one_blas_thread():
+        pass
+    first = E._BLAS["controller"]
+    with E.one_blas_thread():
+        assert _blas_threads(None, 0) == [1]
+    assert E._BLAS["controller"] is first
+    sys.modules.pop("colorsys", None)
+    importlib.import_module("colorsys")
+    with E.one_blas_thread():
+        assert _blas_threads(None, 0) == [1]
+    assert E._BLAS["controller"] is not first
+    assert [i["num_threads"] for i in threadpool_info()] == before
+
+
 def test_pool_raises_the_job_error_and_leaves_no_worker():
     with pytest.raises(InputError, match="three"):
         Pool(2).map(_fail_on_three, list(range(8)))
