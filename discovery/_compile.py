@@ -9,7 +9,7 @@ from pathlib import Path
 __all__ = ["KERNELS", "cached", "announce_compile", "borrowing_options"]
 
 KERNELS = {
-    "vibro-impact": (Path(__file__).parent / "vibroimpact" / "dynamics", "_kernel.integrate-"),
+    "vibro-impact": (Path(__file__).parent / "vibroimpact" / "dynamics", "_kernel._integrate-"),
     "oscillator": (Path(__file__).parent / "ueda", "_kernel."),
 }
 _ANNOUNCED = set()

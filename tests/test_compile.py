@@ -112,7 +112,7 @@ def test_the_kernel_borrows_its_arrays_where_numba_can(monkeypatch):
 
     assert borrowing_options() == {"_nrt": False}
     assert K._contact_search.targetoptions.get("_nrt") is False
-    assert "_nrt" not in K.integrate.targetoptions  # it allocates: the counts stay
+    assert "_nrt" not in K.work_arrays.targetoptions  # it allocates: the counts stay
     without = types.SimpleNamespace(CPUTargetOptions=type("CPUTargetOptions", (), {}))
     monkeypatch.setitem(sys.modules, "numba.core.cpu", without)
     assert borrowing_options() == {}

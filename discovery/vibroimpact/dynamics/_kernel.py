@@ -61,11 +61,16 @@ switching functions, the dense-output probe and the event record are compiled on
 and called (a call per step or per event, not per stage): a cold compile takes about 30 s
 on two cores instead of 160 s with everything inlined, at the same run time (``bench/``).
 Those calls pass their arrays borrowed: every function that allocates nothing is compiled
-without numba's reference counting (:data:`_borrowed_njit`), and :func:`integrate` only
-allocates the work arrays and the contact modes' set-up and hands them to
-:func:`_integrate`'s loop.  With the counts, their atomic increments and decrements took
-about half of a period's time (sampled); without them the arithmetic is the same, bit for
-bit.
+without numba's reference counting (:data:`_borrowed_njit`), :func:`_integrate` included:
+its callers make the work arrays (:func:`work_arrays`, kept from run to run) and the
+contact modes (:func:`set_up_modes`) and pass them in.  With the counts, their atomic
+increments and decrements took about half of a period's time (sampled); without them the
+arithmetic is the same, bit for bit.
+
+The entries called from Python are :func:`_integrate`, :func:`strobe`, :func:`work_arrays`,
+:func:`set_up_modes` and the small checks; none calls :func:`_integrate` with a constant
+argument: LLVM then inlines the loop into the caller and optimises it again (:func:`strobe`
+took 12 s of the cold compile that way, 2 s with its constants passed in).
 """
 
 import numpy as np
@@ -84,8 +89,8 @@ from ...numerics._tableau import E as _E
 # Every function here that allocates nothing takes its arrays borrowed: compiled without
 # numba's reference counting (``_nrt=False``, where this numba has the option:
 # :func:`~discovery._compile.borrowing_options`), a call passes its arrays without an atomic
-# increment and decrement of each one's count.  A function that allocates (``integrate``, a
-# contact mode's set-up) keeps the counts; numba refuses to compile an allocation in a
+# increment and decrement of each one's count.  A function that allocates (the work arrays,
+# a contact mode's set-up) keeps the counts; numba refuses to compile an allocation in a
 # borrowing function.
 _borrowed_njit = njit(cache=True, **borrowing_options())
 
@@ -1743,13 +1748,13 @@ def _contact_samples(
 
 
 @njit(cache=True)
-def work_arrays(m_s, n_coef, modes):
+def work_arrays(m_s, n_coef):
     """The work arrays of :func:`_integrate`: ``(steps, sens, phases)``, those of the
     steps, of ``m_s`` sensitivities (a law of ``n_coef`` coefficients) and of the
-    closed-form phases (with the contact ``modes``, see :func:`integrate`).  A caller that
-    runs the same law many times (:class:`~discovery.vibroimpact.dynamics.steady_states.
-    StroboscopicMap`) makes them once and calls :func:`_integrate` itself."""
-    kc, E, R, _ = modes
+    closed-form phases, less the contact modes (``phases`` here is ``(fl, qm, sw, cb, fc,
+    fcd)``; :func:`_integrate` takes ``(fl, kc, E, R, qm, sw, cb, fc, fcd)``).  Scratch
+    space: a run reads nothing in them that it did not write, so its callers keep them
+    for the next run (:func:`~discovery.vibroimpact.dynamics.simulation.scratch`)."""
     steps = (
         np.empty(4),
         np.empty(4),
@@ -1772,9 +1777,6 @@ def work_arrays(m_s, n_coef, modes):
     )
     phases = (
         np.empty(_NF),
-        kc,
-        E,
-        R,
         np.empty((4, 2), dtype=np.complex128),
         # the closed-form sensitivities' work arrays (:func:`_contact_sens`)
         (
@@ -1806,8 +1808,11 @@ def sorted_within(t, lo, hi):
 @njit(cache=True)
 def set_up_modes(p, coef, ea, eb, br, atol, modes):
     """Whether a contact mode has the closed form (:func:`_contact`; not with
-    sensitivities), setting the ``modes`` up when ``made[0]`` is 0 (see
-    :func:`integrate`)."""
+    sensitivities), setting the ``modes`` ``(kc, E, R, made)``
+    (:func:`~discovery.vibroimpact.dynamics.simulation.contact_modes`) up when ``made[0]``
+    is 0 (then 1 where a mode has the closed form, 2 where none has): a caller that
+    integrates the same law and scenario again passes them back, and the set-up (the
+    eigendecomposition of both modes, 4.6 us) is made once."""
     kc, E, R, made = modes
     if made[0] == 0.0:
         use_contact = _contact_law(p, coef, ea, eb, br, kc)
@@ -1835,7 +1840,10 @@ def strobe(
     p_base,
     p,
     memory,
+    t0,
+    mode0,
     period,
+    h0,
     coef,
     ea,
     eb,
@@ -1864,9 +1872,9 @@ def strobe(
     phases,
 ):
     """Strobe points: ``points[k] = Phi(points[k - 1])`` for ``k >= 1`` (``points[0]`` the
-    start), each period one run of :func:`_integrate` from ``t = 0`` exactly as a separate
-    call (the mode resolved from the state, the first step ``period / 100``, ``p`` a fresh
-    copy of ``p_base``), so the points are bitwise those of one call per period.  With
+    start), each period one run of :func:`_integrate` from ``t0`` (mode ``mode0``, first
+    step ``h0``, ``p`` a fresh copy of ``p_base``) exactly as a separate call, so the points
+    are bitwise those of one call per period.  With
     ``memory`` (a law with a permanent set) each run starts with the contact memory
     (``p[P_ZMAX]``, ``p[P_V0]``) the previous one ended with, the first with ``p``'s.
     ``y`` is the run's state (work array).  Returns ``(status, k, t, n_steps, inside)``:
@@ -1887,10 +1895,10 @@ def strobe(
         for j in range(4):
             y[j] = points[k - 1, j]
         status, t, _, ns, _, _ = _integrate(
-            0.0,
-            period,
+            t0,
+            t0 + period,
             y,
-            -1,
+            mode0,
             p,
             coef,
             ea,
@@ -1898,7 +1906,7 @@ def strobe(
             br,
             rtol,
             atol,
-            period / 100.0,
+            h0,
             hmax,
             max_steps,
             t_eval,
@@ -1926,99 +1934,6 @@ def strobe(
         if status != OK or not inside:
             break
     return status, k, t, n_steps, inside
-
-
-@njit(cache=True)
-def integrate(
-    t0,
-    t1,
-    y0,
-    mode0,
-    p,
-    coef,
-    ea,
-    eb,
-    br,
-    rtol,
-    atol,
-    h0,
-    hmax,
-    max_steps,
-    t_eval,
-    out_y,
-    out_f,
-    out_mode,
-    ev_t,
-    ev_kind,
-    ev_y,
-    ev_modes,
-    S,
-    spar,
-    sscale,
-    out_dF,
-    ev_tau,
-    modes,
-):
-    """Integrate from ``t0`` to ``t1``; see :func:`discovery.vibroimpact.dynamics.simulate`.
-
-    Writes the state, force and mode at each ``t_eval`` (sorted, within
-    ``[t0, t1]``) and up to ``len(ev_t)`` events.  Returns
-    ``(status, t, y, mode, n_steps, n_events, h)``; ``mode0 < 0`` resolves the mode
-    from ``y0``.
-
-    Sensitivities (``S`` of shape (4, m), ``m = 0`` for none): ``S`` holds the
-    derivatives of the start along ``m`` directions and is replaced by those of the end;
-    column ``j`` also moves the law's coefficient ``spar[j]`` when ``spar[j] >= 0``;
-    ``sscale[j]`` is the size of a perturbation along it: their error is then controlled
-    as the state's, so the run takes its own steps (``sscale`` of size 0: the state's
-    steps, and the state's results bitwise those of a run without sensitivities).  With
-    ``out_dF`` of shape (m, len(t_eval)) the force's derivatives at ``t_eval`` are written
-    too (shape (m, 0) for none), and with ``ev_tau`` of shape (len(ev_t), m) the events'
-    time derivatives (shape (0, m) for none).  Not for a law with a permanent set.
-
-    ``modes``: the contact modes' closed form ``(kc, E, R, made)``
-    (:func:`~discovery.vibroimpact.dynamics.simulation.contact_modes`), set up here when
-    ``made[0]`` is 0 (then 1 where a mode has the closed form, 2 where none has): a caller
-    that integrates the same law and scenario again passes them back, and the set-up (the
-    eigendecomposition of both modes, 4.6 us of a 7.5 us call's fixed cost) is made once.
-    """
-    y = y0.copy()
-    use_contact = set_up_modes(p, coef, ea, eb, br, atol, modes)
-    steps, sens, phases = work_arrays(S.shape[1], coef.shape[0], modes)
-    status, t, mode, n_steps, n_ev, h = _integrate(
-        t0,
-        t1,
-        y,
-        mode0,
-        p,
-        coef,
-        ea,
-        eb,
-        br,
-        rtol,
-        atol,
-        h0,
-        hmax,
-        max_steps,
-        t_eval,
-        out_y,
-        out_f,
-        out_mode,
-        ev_t,
-        ev_kind,
-        ev_y,
-        ev_modes,
-        S,
-        spar,
-        sscale,
-        out_dF,
-        ev_tau,
-        use_contact,
-        steps,
-        sens,
-        phases,
-    )
-    return status, t, y, mode, n_steps, n_ev, h
 
 
 @_borrowed_njit
@@ -2055,9 +1970,27 @@ def _integrate(
     sens,
     phases,
 ):
-    """:func:`integrate`'s steps, borrowing every array (``y`` the state, advanced in place;
-    ``steps``, ``sens``, ``phases``: the work arrays it allocated, ``use_contact`` whether a
-    contact mode has the closed form); returns ``(status, t, mode, n_steps, n_ev, h)``."""
+    """Integrate from ``t0`` to ``t1``, advancing ``y`` in place; see
+    :func:`discovery.vibroimpact.dynamics.simulate`.  Returns ``(status, t, mode, n_steps,
+    n_events, h)``; ``mode0 < 0`` resolves the mode from ``y``.
+
+    Writes the state, force and mode at each ``t_eval`` (sorted, within ``[t0, t1]``) and
+    up to ``len(ev_t)`` events.
+
+    Sensitivities (``S`` of shape (4, m), ``m = 0`` for none): ``S`` holds the
+    derivatives of the start along ``m`` directions and is replaced by those of the end;
+    column ``j`` also moves the law's coefficient ``spar[j]`` when ``spar[j] >= 0``;
+    ``sscale[j]`` is the size of a perturbation along it: their error is then controlled
+    as the state's, so the run takes its own steps (``sscale`` of size 0: the state's
+    steps, and the state's results bitwise those of a run without sensitivities).  With
+    ``out_dF`` of shape (m, len(t_eval)) the force's derivatives at ``t_eval`` are written
+    too (shape (m, 0) for none), and with ``ev_tau`` of shape (len(ev_t), m) the events'
+    time derivatives (shape (0, m) for none).  Not for a law with a permanent set.
+
+    ``use_contact``: whether a contact mode has the closed form (:func:`set_up_modes`);
+    ``steps``, ``sens``: the work arrays (:func:`work_arrays`); ``phases``: those of the
+    phases with the contact modes, ``(fl, kc, E, R, qm, sw, cb, fc, fcd)``.  Every array is
+    borrowed."""
     ynew, ytmp, ybuf, K, hs0, hs1, hsa, hsb, hsm = steps
     KS, SS, Snew, dc, fminus, fplus, tau = sens
     fl, kc, E, R, qm, sw, cb, fc, fcd = phases

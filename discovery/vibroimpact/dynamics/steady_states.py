@@ -43,6 +43,7 @@ from .simulation import (
     contact_modes,
     kernel_params,
     no_sensitivities,
+    scratch,
     simulate,
 )
 
@@ -96,14 +97,11 @@ class StroboscopicMap:
         self.zeta_max = 0.0
         self.impact_v0 = 0.0
         self._no_sens = no_sensitivities()
-        # the contact modes' closed form, set up here once for all the map's runs, and the
-        # kernel's work arrays, made once for the plain runs and once for the Jacobian's
-        # (the map calls the kernel's loop itself: it is 2-3 us of a 10 us period)
+        # the contact modes' closed form, set up here once for all the map's runs
         self._modes = contact_modes()
         self._use_contact = K.set_up_modes(
             self._p, self._coef, self._ea, self._eb, self._br, self._atol, self._modes
         )
-        self._work = {}
         self._bound = 1e6 * self.scale.max() + 1e3
         self._state_dirs = np.full(4, -1, dtype=np.int64)
         # exact Jacobians (one run with the variational equations) unless the law has a
@@ -140,9 +138,7 @@ class StroboscopicMap:
         if self._memory:
             p[K.P_ZMAX] = self.zeta_max
             p[K.P_V0] = self.impact_v0
-        work = self._work.get(m_s)
-        if work is None:
-            work = self._work[m_s] = K.work_arrays(m_s, self._coef.shape[0], self._modes)
+        work = scratch(m_s, self._coef.shape[0], self._modes)
         return p, work
 
     def _run(self, y, n, t0, remember, sens, *, events=None):
@@ -188,7 +184,10 @@ class StroboscopicMap:
             self._p,
             p,
             self._memory,
+            0.0,
+            -1,
             self._T,
+            self._T / 100.0,
             self._coef,
             self._ea,
             self._eb,
