@@ -79,10 +79,22 @@ class StroboscopicMap:
         self._atol = _atol(scenario, self.tol)
         self._T = scenario.period
         self._hmax = self._T * self.tol.hmax_fraction
-        self._empty = np.zeros(0)
-        self._ey = np.empty((4, 0))
-        self._ef = np.empty(0)
-        self._em = np.empty(0, dtype=np.int64)
+        # the kernel's arguments every run takes: the law, the tolerances, no output times
+        self._fixed = (
+            self._coef,
+            self._ea,
+            self._eb,
+            self._br,
+            self.tol.rtol,
+            self._atol,
+            self._T / 100.0,
+            self._hmax,
+            self.tol.max_steps,
+            np.zeros(0),
+            np.empty((4, 0)),
+            np.empty(0),
+            np.empty(0, dtype=np.int64),
+        )
         self._no_events = _event_arrays(0)
         x, v = scenario.scales()
         self.scale = np.array([x, v, x, v])
@@ -150,19 +162,7 @@ class StroboscopicMap:
             yf,
             -1,
             p,
-            self._coef,
-            self._ea,
-            self._eb,
-            self._br,
-            self.tol.rtol,
-            self._atol,
-            self._T / 100.0,
-            self._hmax,
-            self.tol.max_steps,
-            self._empty,
-            self._ey,
-            self._ef,
-            self._em,
+            *self._fixed,
             *(self._no_events if events is None else events),
             *sens,
             self._use_contact,
@@ -187,20 +187,8 @@ class StroboscopicMap:
             0.0,
             -1,
             self._T,
-            self._T / 100.0,
-            self._coef,
-            self._ea,
-            self._eb,
-            self._br,
-            self.tol.rtol,
-            self._atol,
-            self._hmax,
-            self.tol.max_steps,
             self._bound,
-            self._empty,
-            self._ey,
-            self._ef,
-            self._em,
+            *self._fixed,
             *self._no_events,
             *self._no_sens,
             self._use_contact,
