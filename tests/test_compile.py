@@ -55,8 +55,8 @@ def test_an_empty_cache_is_announced_once(tmp_path, monkeypatch):
 def test_a_steady_state_announces_the_compile_before_its_first_period(
     tmp_path, monkeypatch, capsys
 ):
-    """The stroboscopic map is the first to call the kernel in `vidi steady`: it says so
-    before (the map is built here, nothing is compiled)."""
+    """The stroboscopic map is the first to call the kernel in `vidi steady` (its contact
+    modes' set-up, when it is built): it says so first."""
     from discovery import load_scenario
     from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap
 

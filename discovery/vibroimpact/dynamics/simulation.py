@@ -352,6 +352,7 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
         raise InputError(f"t_span must be two finite times with t1 > t0, got {t_span!r}")
     y0 = scenario.initial_state() if y0 is None else np.array(y0, dtype=float).reshape(4)
     te = np.zeros(0) if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
+    announce_compile("vibro-impact")  # the check below is the kernel's first call
     if te.size and not K.sorted_within(te, t0 - 1e-12, t1 + 1e-12):
         raise InputError("t_eval must be sorted and inside t_span")
     bufs = _buffers(te.size, s.max_events)
@@ -373,7 +374,6 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
             controlled=s.control_sensitivities,
             start=s.sensitivity_start,
         )
-    announce_compile("vibro-impact")
     coef, ea, eb, br = law.kernel_arrays()
     atol = _atol(scenario, tol)
     modes = contact_modes()

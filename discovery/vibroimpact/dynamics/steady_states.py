@@ -71,6 +71,7 @@ class StroboscopicMap:
     """
 
     def __init__(self, scenario, law, tolerances=None):
+        announce_compile("vibro-impact")  # the contact modes' set-up may compile the kernel
         self.scenario = scenario
         self.law = law
         self.tol = tolerances or Tolerances.default()
@@ -120,7 +121,6 @@ class StroboscopicMap:
         # permanent set; ``n_exact`` counts them
         self.exact = not self._memory
         self.n_exact = 0
-        announce_compile("vibro-impact")  # the map's first advance may compile the kernel
 
     def advance(self, y, n=1, t0=0.0, remember=True):
         """State after ``n`` periods from ``y`` at time ``t0`` (a multiple of ``T``).
@@ -145,7 +145,7 @@ class StroboscopicMap:
 
     def _prepared(self, m_s):
         """A run's parameters (a copy, holding the map's contact memory) and the kernel's
-        work arrays for ``m_s`` sensitivities (made once)."""
+        work arrays for ``m_s`` sensitivities (the process's scratch arrays)."""
         p = self._p.copy()
         if self._memory:
             p[K.P_ZMAX] = self.zeta_max
