@@ -101,7 +101,7 @@ def test_bad_csv_does_not_destroy_earlier_results(record, tmp_path, capsys):
         ("t,F\n0,0\n1,nan\n2,0\n3,0\n", "non-finite"),
         ("t,F\n0,0\n2,1\n1,0\n3,0\n", "not increasing"),
         ("time,F\n0,0\n", "no column t"),
-        ("t,F\n0,0\n1,0\n2,0\n3,0\n4,0\n", "no contact"),
+        ("t,F\n" + "".join(f"{k * 1e-4!r},0\n" for k in range(2000)), "no contact"),
     ],
 )
 def test_bad_csv_messages(body, needle, tmp_path, capsys):
@@ -109,6 +109,24 @@ def test_bad_csv_messages(body, needle, tmp_path, capsys):
     p.write_text(body)
     assert main(["identify", "--data", str(p), "--start", "z", "--out", str(tmp_path / "o")]) == 2
     assert needle in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "command", [["verify"], ["fit"], ["explain"], ["identify", "--start", "z"]]
+)
+def test_a_time_column_in_milliseconds_is_refused_in_one_line(command, record, tmp_path, capsys):
+    """A record whose t is in ms has under one sample per drive period: one line naming the
+    sampling and the likely cause, exit 2 (it was an internal error)."""
+    rows = record.read_text().splitlines()
+    ms = [rows[0]] + [
+        ",".join([repr(1e3 * float(r.split(",")[0]))] + r.split(",")[1:]) for r in rows[1:]
+    ]
+    p = tmp_path / "ms.csv"
+    p.write_text("\n".join(ms) + "\n")
+    assert main([*command, "--data", str(p), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "0.8 samples per drive period" in err and "t column is in seconds" in err
+    assert "\n" not in err and "Traceback" not in err
 
 
 def test_verify_command_writes_summary_and_figure(tmp_path):

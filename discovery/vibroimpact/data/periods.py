@@ -34,17 +34,32 @@ def own_period(t, F, period, max_periods=4.5):
     return k * dt, float(ac[k])
 
 
+MIN_SAMPLES_PER_PERIOD = 20
+"""The fewest samples per drive period a record may have (the field-like corpus has 192 to
+836): below it no impact is resolved, and a time column in milliseconds lands there."""
+
+
 def check_drive_period(t, F, period, source=""):
-    """Refuse a record whose force repeats at a period that is no whole number of the
-    scenario's drive periods (a record of another machine or drive frequency, or a time
-    column in other units): everything downstream would be meaningless.  A record without a
-    clear period (strength below 0.3: chaos, too short) passes."""
+    """Refuse a record sampled too coarsely to resolve a drive period (fewer than
+    :data:`MIN_SAMPLES_PER_PERIOD` samples in one, e.g. a time column in milliseconds) or
+    whose force repeats at a period that is no whole number of the scenario's drive
+    periods (a record of another machine or drive frequency, or a time column in other
+    units): everything downstream would be meaningless.  A record without a clear period
+    (strength below 0.3: chaos, too short) passes the second check."""
+    where = f" of {source}" if source else ""
+    dt = float(np.median(np.diff(np.asarray(t, dtype=float))))
+    if period / dt < MIN_SAMPLES_PER_PERIOD:
+        raise InputError(
+            f"the record{where} has {period / dt:.3g} samples per drive period (sampled at "
+            f"{1 / dt:.4g} Hz for a {1 / period:.4g} Hz drive; at least "
+            f"{MIN_SAMPLES_PER_PERIOD} are needed): check that the t column is in seconds, "
+            "and the scenario's frequency"
+        )
     lag, strength = own_period(t, F, period)
     if not (np.isfinite(lag) and strength >= 0.3):
         return
     r = lag / period
     if abs(r - round(r)) > 0.03:
-        where = f" of {source}" if source else ""
         raise InputError(
             f"the force{where} repeats every {lag:.4g} s ({r:.3g} of the scenario's drive "
             f"period {period:.4g} s, i.e. a drive of {round(r) / lag if round(r) else 1 / lag:.4g}"
