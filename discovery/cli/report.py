@@ -7,8 +7,10 @@ def run(args):
     from .._io import MANIFEST, read_manifest
     from ..reporting import report
 
-    # a malformed manifest (files not a list of names, not an object) is one line, exit 2
-    read_manifest(Path(args.run_dir) / MANIFEST, strict=True)
+    # a malformed manifest (files not a list of names, not an object) is one line, exit 2;
+    # a path that is no directory is report()'s to refuse
+    if Path(args.run_dir).is_dir():
+        read_manifest(Path(args.run_dir) / MANIFEST, strict=True)
 
     r = report(args.run_dir, snippet=args.snippet, compile=not args.no_pdf)
     print(r)

@@ -637,6 +637,16 @@ def test_a_malformed_manifest_is_one_line(runs, tmp_path, capsys, files):
     assert capsys.readouterr().err.count("\n") == 1
 
 
+def test_a_file_given_as_the_run_directory_is_one_line(tmp_path, capsys):
+    """`vidi report D.csv` (a record, not a run directory): one line saying what to give,
+    exit 2, not a remark on a manifest inside the file."""
+    f = tmp_path / "D.csv"
+    f.write_text("t,F\n0,0\n")
+    assert main(["report", str(f), "--no-pdf"]) == 2
+    err = capsys.readouterr().err
+    assert "is not a run directory" in err and "manifest" not in err and err.count("\n") == 1
+
+
 def test_the_api_checks_its_arguments(runs):
     from discovery.errors import VidiError
     from discovery.reporting import report as api_report
