@@ -25,6 +25,8 @@ Text form: ``"hunt-crossley: k=2e9, n=1.5, lambda=3e9"``, ``"flores: k=2e9, n=1.
 e=0.6"``, ``"kelvin-voigt: k=2e8, c=1e6"`` (:func:`parse_model`).
 """
 
+import difflib
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -305,4 +307,19 @@ def parse_law(text):
     (``"flores: k=2e9, n=1.5, e=0.6"``): what ``--law`` reads."""
     if is_model_text(text):
         return parse_model(text).law
+    name = text.partition(":")[0].strip().lower() if isinstance(text, str) else ""
+    if ":" in text and re.fullmatch(r"[a-z][a-z_ -]*", name) and name not in _SECTIONS:
+        # a word and a colon: a named model misspelt (a law's sections follow its terms)
+        close = [m for m in MODELS if m.startswith(name)] or difflib.get_close_matches(
+            name, MODELS, n=1
+        )
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        raise InputError(
+            f"{name!r} is no contact model; {hint}the models are {', '.join(MODELS)} (e.g. "
+            "'hunt-crossley: k=2e9, n=1.5, lambda=3e9'), or write a law's terms like "
+            "'2.06e8*z + 1.28e7*zd'"
+        )
     return ForceLaw.parse(text)
+
+
+_SECTIONS = ("unloading", "set", "scale")  # the law text's own "name:" parts (after ";")

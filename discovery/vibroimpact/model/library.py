@@ -13,6 +13,8 @@ Specifications (``Library.parse``)::
     poly:2+hc         a sum of specifications
 """
 
+import difflib
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,8 +97,10 @@ class Library:
                         terms.append(Term.parse(name.strip()))
                     except InputError as exc:
                         raise InputError(
-                            f"library {spec!r}: {name.strip()!r} is not a term{_reason(exc)}; "
-                            "use poly:N, hc or names like z, zd, z*zd, z^1.5, z^2*zd"
+                            f"library {spec!r}: {name.strip()!r} is not a term{_reason(exc)}"
+                            f"{_did_you_mean(name.strip())}; use poly:N, hc or names like z, "
+                            "zd, z*zd, z^1.5, z^2*zd (fit also takes 'contact-models': the "
+                            "named contact models)"
                         ) from None
                 lib = cls(tuple(terms))
             out = lib if out is None else out + lib
@@ -181,6 +185,16 @@ class Library:
 
     def fit_transform(self, X, y=None):
         return self.transform(X)
+
+
+def _did_you_mean(word):
+    """``" (did you mean 'poly:2'?)"`` for a library word close to one (``poly2``,
+    ``contact-model``), else ``""``."""
+    m = re.fullmatch(r"poly\s*[-_ ]?\s*(\d)", word.lower())
+    if m:
+        return f" (did you mean 'poly:{m.group(1)}'?)"
+    close = difflib.get_close_matches(word.lower(), ("contact-models", "hc"), n=1, cutoff=0.7)
+    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def _split_plus(spec):

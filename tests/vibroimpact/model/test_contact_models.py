@@ -162,6 +162,11 @@ def test_text_round_trip(name):
         ("flores: k=-2e9, n=1.5, e=0.5", "stiffness"),
         ("kelvin-voigt: k=2e8, c=abc", "number"),
         ("2e8*z; scale: v1", "scale"),
+        ("hunt-crosley: k=2e9, n=1.5, lambda=3e9", "did you mean 'hunt-crossley'"),
+        ("Kelvin Voigt: k=2e8, c=1e6", "did you mean 'kelvin-voigt'"),
+        ("hertz: k=2e9", "did you mean 'hertz-damper'"),
+        ("maxwell: k=2e9", "'maxwell' is no contact model; the models are kelvin-voigt"),
+        ("unloading: 4e6*zd", "force law"),
     ],
 )
 def test_bad_text_is_one_input_error(text, match):

@@ -2,6 +2,7 @@
 contract."""
 
 import inspect
+import re
 
 import numpy as np
 import pytest
@@ -79,6 +80,20 @@ def test_parse_returns_library_unchanged():
 )
 def test_bad_specs_raise_input_error(spec):
     with pytest.raises(InputError):
+        Library.parse(spec)
+
+
+@pytest.mark.parametrize(
+    "spec, hint",
+    [
+        ("contact-model", "did you mean 'contact-models'?"),
+        ("poly2", "did you mean 'poly:2'?"),
+        ("Poly 3", "did you mean 'poly:3'?"),
+        ("q", "fit also takes 'contact-models'"),
+    ],
+)
+def test_a_near_miss_is_named(spec, hint):
+    with pytest.raises(InputError, match=re.escape(hint)):
         Library.parse(spec)
 
 
