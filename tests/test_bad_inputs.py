@@ -10,10 +10,12 @@ mode and mtime, and no new file or directory, staging included).
 import hashlib
 import os
 import stat
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import discovery
 from discovery.cli import main
 from discovery.errors import VidiError
 from discovery.vibroimpact.dynamics.synthetic import synthesize
@@ -512,6 +514,18 @@ CASES += [
     ("landscape-data-no-contact", [*L, "--data", "zeros.csv"], "no contact found"),
     ("landscape-n-boot-zero", [*L, "--n-boot", "0"], "--n-boot: '0' is out of range"),
     ("landscape-out-is-file", [*L[:-1], "afile"], "is an existing file"),
+    ("fit-library-near-miss", [*F, "--library", "contact-model"], "did you mean 'contact-models'"),
+    (
+        "verify-law-model-misspelt",
+        [*V, "--law", "hunt-crosley: k=2e9, n=1.5, lambda=3e9"],
+        "did you mean 'hunt-crossley'",
+    ),
+    (
+        "study-config-missing",
+        ["study", "--config", "nope.toml", "--out", "stres"],
+        # the example by its full path (the package runs from its source tree here)
+        f"such as {Path(discovery.__file__).parents[1] / 'examples' / 'study_paper.toml'}",
+    ),
 ]
 
 

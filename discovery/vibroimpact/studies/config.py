@@ -523,8 +523,7 @@ def load_study(path_or_mapping):
         text = raw.decode("utf-8-sig")
     except FileNotFoundError:
         raise InputError(
-            f"study file {short(path)!r} does not exist; give a TOML file such as "
-            "examples/study_paper.toml"
+            f"study file {short(path)!r} does not exist; give a TOML file such as {_example()}"
         ) from None
     except IsADirectoryError:
         raise InputError(f"study file {short(path)!r} is a directory; give a TOML file") from None
@@ -539,3 +538,11 @@ def load_study(path_or_mapping):
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"study file {short(path)!r} is not valid TOML: {exc}") from None
     return study_from_mapping(data, str(path))
+
+
+def _example():
+    """Where the shipped example study is: the source tree's ``examples/study_paper.toml``
+    by its full path when the package runs from one (a run from another folder finds it
+    there), else its path in the repository."""
+    example = Path(__file__).resolve().parents[3] / "examples" / "study_paper.toml"
+    return str(example) if example.is_file() else "examples/study_paper.toml (in the repository)"
