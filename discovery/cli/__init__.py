@@ -276,7 +276,8 @@ def _add_quiet(parser, path=()):
 
 def _add_overwrite(parser):
     """``--overwrite`` on every (sub)command that writes ``--out``: replace the results of
-    another command (or a file vidi did not write); files the user added are kept."""
+    another command (or an ``--out`` file vidi did not write); files the user added to a
+    result directory are kept, and a directory holding no vidi result is never replaced."""
     for action in parser._actions:
         if isinstance(action, argparse._SubParsersAction):
             for sp in action.choices.values():
@@ -288,8 +289,9 @@ def _add_overwrite(parser):
         parser.add_argument(
             "--overwrite",
             action="store_true",
-            help="replace the results of another command in --out (or a "
-            "file vidi did not write); files you added are kept",
+            help="replace the results of another vidi command in --out, or an --out "
+            "file vidi did not write; files you added to a result directory are kept, and "
+            "a directory holding no vidi result is never replaced",
         )
 
 
