@@ -157,7 +157,7 @@ def register(sub):
     _options.add_max_simulations_option(s, least=10, most=100_000, default=150, of=" of each refit")
     _options.add_n_boot_option(s)
     _options.add_intervals_option(s, "the final model's 95 % parameter intervals")
-    _options.add_seed_option(s, "seed of the noise-floor bootstrap")
+    _options.add_seed_option(s, "seed of the noise-floor bootstrap and of the intervals")
     _options.add_interval_refit_option(s)
     _options.add_parallel_options(
         s, "the screening refits, the bootstrap intervals' refits and the record's blocks"
