@@ -71,7 +71,8 @@ def _add_forcing_options(s):
     s.add_argument(
         "--model",
         choices=("negres", "duffing"),
-        help="take the forcing B, nu from this model (override with --B, --nu)",
+        help="take the forcing B, nu from this model (override with --B, --nu; no "
+        "default: give --model, or --B and --nu)",
     )
     _add_forcing_values(s)
 
