@@ -471,7 +471,10 @@ class DiscoveryResult(Result):
         out = [head, *coefficient_lines(sel.law.as_dict(), sel.standard_errors, sel.intervals)]
         out += criteria_lines(sel.criteria, sel.noise_floor, sel.limits)
         out.append(f"  verdict: {sel.verdict}")
-        out.append(f"ranking ({len(self.ranking)} candidates, criterion {crit}):")
+        out.append(
+            f"ranking ({len(self.ranking)} candidates: the consistent ones first, the fewest "
+            f"terms first, then by {crit}):"
+        )
         out += ranking_lines(self.ranking, crit)
         out += [f"equivalent: {equivalent_text(e)}" for e in self.equivalent]
         cert = self.certificate
