@@ -307,9 +307,10 @@ def parse_law(text):
     (``"flores: k=2e9, n=1.5, e=0.6"``): what ``--law`` reads."""
     if is_model_text(text):
         return parse_model(text).law
-    name = text.partition(":")[0].strip().lower() if isinstance(text, str) else ""
-    if ":" in text and re.fullmatch(r"[a-z][a-z_ -]*", name) and name not in _SECTIONS:
-        # a word and a colon: a named model misspelt (a law's sections follow its terms)
+    # a word and a colon is a named model misspelt (a law's sections follow its terms)
+    colon = isinstance(text, str) and ":" in text
+    name = text.partition(":")[0].strip().lower() if colon else ""
+    if re.fullmatch(r"[a-z][a-z_ -]*", name) and name not in _SECTIONS:
         close = [m for m in MODELS if m.startswith(name)] or difflib.get_close_matches(
             name, MODELS, n=1
         )

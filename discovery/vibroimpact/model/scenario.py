@@ -189,6 +189,19 @@ class Scenario:
                 "use ForceLaw.parse(text)"
             )
 
+    def __str__(self):
+        """The machine in a few lines, with units (``repr`` stays what one would type)."""
+        lines = [f"scenario {self.name!r}" + (f" ({self.source})" if self.source else "")]
+        for key, (unit, _) in _FIELDS.items():
+            value = getattr(self, key)
+            if key in _OPTIONAL and value == _OPTIONAL[key] and key != "g":
+                continue  # an optional part left out
+            lines.append(f"  {key:<10}{value:.6g} {unit}")
+        if self.initial is not None:
+            lines.append("  initial   " + ", ".join(f"{v:.6g}" for v in self.initial))
+        lines.append(f"  law       {self.law if self.law is not None else '(none)'}")
+        return "\n".join(lines)
+
     # ------------------------------------------------------------------ derived
     @property
     def omega(self):

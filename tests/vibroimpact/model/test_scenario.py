@@ -291,3 +291,15 @@ def test_directory_non_utf8_empty_and_bom(tmp_path):
     p = tmp_path / "bom.toml"
     p.write_bytes(b"\xef\xbb\xbf" + GOOD.encode())
     assert load_scenario(p).name == "bench"
+
+
+def test_a_scenario_prints_its_machine_with_units():
+    """``print(scenario)`` is the machine in lines with units (the optional parts only when
+    set); ``repr`` stays what one would type."""
+    sc = load_scenario("paper")
+    text = str(sc)
+    assert text.splitlines()[0] == "scenario 'paper' (builtin:paper)"
+    assert "  k1        2.75e+07 N/m" in text and "  frequency 25 Hz" in text
+    assert "law       2.06e+08*z + 1.28e+07*zd" in text and "offset" not in text
+    assert "offset    0.0001 m" in str(sc.replace(offset=1e-4))
+    assert repr(sc).startswith("Scenario(m1=10000.0")
