@@ -17,8 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import chi2
 
+from ..numerics.test_functions import test_function
 from .polynomial import FORCING, MONOMIALS, TERMS, ForcedPolynomial
-from .weak_form import test_function, weak_system
+from .weak_form import weak_system
 
 __all__ = ["WeakSettings", "Fit", "WeakFits", "hac"]
 

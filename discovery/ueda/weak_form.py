@@ -13,20 +13,10 @@ the fast internal oscillation); the weak form is exact to quadrature.
 import numpy as np
 
 from ..errors import InputError
+from ..numerics.test_functions import test_function
 from .polynomial import MONOMIALS
 
-__all__ = ["test_function", "window_half_width", "weak_system", "stlsq_gram", "stlsq"]
-
-
-def test_function(hs, order):
-    """The test function ``phi = (1 - s^2)^order`` on ``2 hs + 1`` samples of ``s`` in
-    ``[-1, 1]``, and its first and second derivatives in ``s``: ``(phi, dphi, ddphi)``."""
-    s = np.linspace(-1.0, 1.0, 2 * hs + 1)
-    q = 1.0 - s * s
-    phi = q**order
-    dphi = -2.0 * order * s * q ** (order - 1)
-    ddphi = -2.0 * order * q ** (order - 1) + 4.0 * order * (order - 1) * s * s * q ** (order - 2)
-    return phi, dphi, ddphi
+__all__ = ["window_half_width", "weak_system", "stlsq_gram", "stlsq"]
 
 
 def weak_system(t, x, v, B, nu, *, half_width, order=4, stride=None):

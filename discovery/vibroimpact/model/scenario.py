@@ -305,6 +305,30 @@ class Scenario:
         d["source"] = self.source
         return d
 
+    def to_toml(self):
+        """The scenario as the text of a scenario file (:meth:`from_toml` reads it back)."""
+        lines = [f"name = {_toml_text(self.name)}", "", "[machine]"]
+        for key, (unit, _) in _FIELDS.items():
+            value = getattr(self, key)
+            if key in _OPTIONAL and value == _OPTIONAL[key] and key != "g":
+                continue
+            lines.append(f"{key} = {value!r}  # {unit}")
+        if self.law is not None:
+            lines += ["", "[law]", f"text = {_toml_text(self.law.to_text())}"]
+        if self.initial is not None:
+            lines += ["", "[initial]"]
+            lines += [f"{k} = {v!r}" for k, v in zip(_TABLES["initial"], self.initial, strict=True)]
+        return "\n".join(lines) + "\n"
+
+    @classmethod
+    def from_dict(cls, d):
+        """The scenario an :meth:`as_dict` document describes."""
+        d = dict(d)
+        law = d.pop("law", None)
+        if d.get("initial") is not None:
+            d["initial"] = tuple(d["initial"])
+        return cls(**d, law=None if law is None else ForceLaw.parse(law))
+
     # ------------------------------------------------------------------ loading
     @classmethod
     def from_toml(cls, path):
@@ -402,6 +426,12 @@ class Scenario:
                 f'scenario {source!r}: name must be non-empty text, e.g. name = "my-grid"'
             )
         return cls(**values, law=law, initial=initial, name=name, source=source)
+
+
+def _toml_text(text):
+    """``text`` as a TOML basic string."""
+    out = str(text).replace("\\", "\\\\").replace('"', '\\"')
+    return '"' + "".join(c if c.isprintable() else f"\\u{ord(c):04x}" for c in out) + '"'
 
 
 def builtin_scenarios():

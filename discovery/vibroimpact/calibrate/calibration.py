@@ -1,0 +1,245 @@
+"""``calibrate``: the machine as the record shows it (see :mod:`.equations`)."""
+
+import math
+import time
+
+import numpy as np
+
+from ..._validate import Real, params
+from ...errors import InputError
+from ..data.measurement import Measurement
+from ..model.scenario import Scenario
+from .equations import machine_rows
+from .estimate import cycle_draws, drive_phase, estimate, frame_residual, moulding_residual
+from .result import UNITS, Calibration
+from .units import check_units
+
+__all__ = ["calibrate", "CALIBRATED", "LOOSE"]
+
+#: the parameters a calibration may estimate
+CALIBRATED = ("m1", "c1", "k1", "k3", "A", "m2")
+#: a parameter whose 95 % interval reaches further than this share of its value is loose
+LOOSE = 0.25
+#: a drive phase beyond this many degrees (and its interval) is noted
+PHASE_NOTE = 3.0
+
+
+def _machine_key(sc):
+    return (sc.m1, sc.m2, sc.k1, sc.c1, sc.k3, sc.g, sc.mass_loss)
+
+
+def _listed(x):
+    return list(x) if isinstance(x, list | tuple) else [x]
+
+
+@params(
+    scenario=(Scenario, list, tuple),
+    measurement=(Measurement, list, tuple),
+    n_boot=Real(0, 10_000, integer=True),
+    seed=Real(0, integer=True),
+    keep=(tuple, list),
+)
+def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, keep=()):
+    """The machine as the record shows it: ``m1, c1, k1, A, m2`` (and ``k3`` when the
+    sheet's supports stiffen) estimated from the record's own motions and force.
+
+    Parameters
+    ----------
+    scenario : Scenario or sequence of Scenario
+        The designer's sheet: one for all records or one per record.  Records whose
+        sheets give the same machine (masses, supports) are calibrated jointly, each with
+        its own drive amplitude.
+    measurement : Measurement or sequence of Measurement
+        Records with ``t``, ``F``, ``w1``, ``w2`` (``v1``, ``v2`` used where present).  A
+        record without positions is not calibrated: its sheet is used, and a note says so.
+    time_offset : float or sequence of float
+        Drive-clock time [s] of each record's ``t = 0``.
+    n_boot : int
+        Bootstrap replicates over the records' cycles, for the intervals.
+    seed : int
+        Seed of the bootstrap.
+    keep : sequence of str
+        Parameters held at the sheet's values (of ``m1, c1, k1, k3, A, m2``).
+
+    Returns
+    -------
+    Calibration
+        ``.scenario`` (``.scenarios``) is the machine to verify, fit and explain with.
+
+    Raises
+    ------
+    InputError
+        When a record's units or signs contradict any machine (positions in mm, a force
+        in kN, motions measured downwards): one line naming the likely cause.
+    """
+    t_start = time.perf_counter()
+    meas = _listed(measurement)
+    sheets = _listed(scenario)
+    if len(sheets) == 1:
+        sheets = sheets * len(meas)
+    if len(sheets) != len(meas) or not meas:
+        raise InputError(
+            f"calibrate: {len(meas)} record(s) and {len(sheets)} scenario(s); give one "
+            "scenario for all records or one per record"
+        )
+    offsets = _listed(time_offset)
+    offsets = offsets * len(meas) if len(offsets) == 1 else offsets
+    if len(offsets) != len(meas):
+        raise InputError("calibrate: give one time_offset for all records or one per record")
+    keep = tuple(keep)
+    bad = [k for k in keep if k not in CALIBRATED]
+    if bad:
+        raise InputError(
+            f"calibrate: keep names {bad[0]!r}; the parameters are {', '.join(CALIBRATED)}"
+        )
+    rows = [machine_rows(m, s, float(o)) for m, s, o in zip(meas, sheets, offsets, strict=True)]
+    for r, m, s in zip(rows, meas, sheets, strict=True):
+        if r is not None:
+            check_units(r, s, m.source)
+    settings = {
+        "time_offset": offsets,
+        "n_boot": n_boot,
+        "seed": seed,
+        "keep": list(keep),
+        "loose": LOOSE,
+    }
+    notes, parameters, residual, phases = [], {}, {}, [(0.0, math.nan, math.nan)] * len(meas)
+    used = list(sheets)
+    groups = {}
+    for k, s in enumerate(sheets):
+        groups.setdefault(_machine_key(s), []).append(k)
+    for members in groups.values():
+        missing = [k for k in members if rows[k] is None]
+        for k in missing:
+            notes.append(_uncalibrated_note(meas[k], sheets[k]))
+        members = [k for k in members if rows[k] is not None]
+        if not members:
+            continue
+        out = _calibrate_group(
+            [rows[k] for k in members], [sheets[k] for k in members], keep, n_boot, seed
+        )
+        if out is None:
+            notes.append(
+                "the records' equations are degenerate (no contact or no motion); "
+                "the sheet's machine is used"
+            )
+            continue
+        group_params, group_scenarios, group_residual, group_notes, phase = out
+        for k, sc, ph in zip(members, group_scenarios, phase, strict=True):
+            used[k] = sc
+            phases[k] = ph
+        prefix = "" if len(groups) == 1 else f"records {', '.join(str(k + 1) for k in members)}: "
+        parameters.update({prefix + n: v for n, v in group_params.items()})
+        residual = group_residual if len(groups) == 1 else {**residual, prefix: group_residual}
+        notes += group_notes
+    for k, (p, lo, hi) in enumerate(phases):
+        if math.isfinite(lo) and abs(p) > PHASE_NOTE and not lo <= 0.0 <= hi:
+            period = sheets[k].period
+            notes.append(
+                f"{'record ' + str(k + 1) + ': ' if len(meas) > 1 else ''}the drive's phase "
+                f"at the record's t = 0 is {p:.1f} deg [{lo:.1f}, {hi:.1f}], not 0: is t on "
+                f"the drive's clock? (a time offset of {-p / 360 * period:.4g} s would put "
+                "it there)"
+            )
+    return Calibration(
+        sheet=tuple(sheets),
+        scenarios=tuple(used),
+        parameters=parameters,
+        phase=tuple(phases),
+        residual=residual,
+        calibrated=bool(parameters),
+        notes=tuple(notes),
+        settings=settings,
+        seconds=time.perf_counter() - t_start,
+    )
+
+
+def _uncalibrated_note(meas, sheet):
+    src = f"{meas.source}: " if meas.source else ""
+    return (
+        f"{src}the record has no positions w1, w2 (or is too short for the equations' "
+        f"windows): its machine is taken as the scenario gives it ({sheet.name})"
+    )
+
+
+def _calibrate_group(rows, sheets, keep, n_boot, seed):
+    """Calibrate records of one machine: ``(parameters, scenarios, residual, notes,
+    phases)`` or ``None`` when the equations are degenerate."""
+    sheet = sheets[0]
+    R = len(rows)
+    draws = cycle_draws(rows, n_boot, seed)
+    amps = ["A"] if R == 1 else [f"A[{r + 1}]" for r in range(R)]
+    sheet_values = {
+        "m1": sheet.m1,
+        "c1": sheet.c1,
+        "k1": sheet.k1,
+        "k3": sheet.k3,
+        "m2": sheet.m2,
+        **{a: s.A for a, s in zip(amps, sheets, strict=True)},
+    }
+    held = {n: sheet_values[n] for n in keep if n != "A"}
+    if "A" in keep:
+        held.update({a: sheet_values[a] for a in amps})
+    if sheet.k3 == 0:
+        held.setdefault("k3", 0.0)  # linear supports stay linear (a stiffening is an effect)
+    if sheet.mass_loss > 0:
+        held.setdefault("m2", sheet.m2)  # a shedding moulding has no one mass
+    try:
+        first = estimate(rows, held, draws)
+    except np.linalg.LinAlgError:
+        return None
+    if not np.all(np.isfinite(first.value)):
+        return None
+    loose = {}
+    for k, name in enumerate(first.names):
+        if first.fixed[k]:
+            continue
+        v, lo, hi = first.value[k], first.low[k], first.high[k]
+        if not (v > 0 and np.isfinite(lo) and lo > 0 and (hi - lo) / 2 <= LOOSE * v):
+            loose[name] = sheet_values[name]
+    final = estimate(rows, {**held, **loose}, draws) if loose else first
+    parameters, notes = {}, []
+    for k, name in enumerate(final.names):
+        if name == "k3" and name in held and sheet.k3 == 0:
+            continue
+        src = first if name in loose else final
+        rec = float(src.value[k])
+        determined = not final.fixed[k]
+        parameters[name] = {
+            "unit": UNITS[name.split("[")[0]],
+            "sheet": float(sheet_values[name]),
+            "record": rec,
+            "low": float(src.low[k]) if name not in held else None,
+            "high": float(src.high[k]) if name not in held else None,
+            "determined": bool(determined),
+            "held": name in held,
+            "used": float(final.value[k]),
+        }
+    for name in loose:
+        p = parameters.get(name)
+        if p is not None:
+            notes.append(
+                f"the record leaves {name} loose ({_fmt(p['record'])} "
+                f"[{_fmt(p['low'])}, {_fmt(p['high'])}] {p['unit']}): the sheet's "
+                f"{_fmt(p['sheet'])} is kept"
+            )
+    if sheet.mass_loss > 0:
+        notes.append(
+            "the sheet's moulding sheds mass: its m2 is kept (a mean over the record "
+            "would not be its starting mass)"
+        )
+    common = {n: final.get(n) for n in ("m1", "c1", "k1", "k3", "m2")}
+    scenarios = [s.replace(**common, A=final.get(a)) for s, a in zip(sheets, amps, strict=True)]
+    sheet_frame = [sheet.m1, sheet.c1, sheet.k1, sheet.k3, *[s.A for s in sheets]]
+    residual = {
+        "frame": {"sheet": frame_residual(rows, sheet_frame), "record": final.residual["frame"]},
+        "moulding": {
+            "sheet": moulding_residual(rows, sheet.m2),
+            "record": final.residual["moulding"],
+        },
+    }
+    return parameters, scenarios, residual, notes, drive_phase(rows, draws)
+
+
+def _fmt(x):
+    return "--" if x is None else f"{x:.4g}"

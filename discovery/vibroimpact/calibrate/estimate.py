@@ -1,0 +1,208 @@
+"""Least squares of the weak-form rows of records that share one machine, with intervals
+from a bootstrap over the records' drive cycles (the windows of one cycle overlap and share
+noise, those of different cycles hardly).
+
+Three equations hold in every window: the frame's, the moulding's and their sum, the
+momentum balance of the two bodies.  The balance holds no force: it fixes the machine's
+ratios (``m2/m1``, ``c1/m1``, ``k1/m1``, ``A/m1``) from the motions alone, far tighter than
+the equations that carry the force's noise, and those two set the one number the motions
+cannot, the machine's scale.  The blocks are weighted by the inverse RMS of their
+residuals.  ``m1, c1, k1, k3, m2`` are shared by the records; each has its own drive
+amplitude ``A``.  A parameter may be held (its column moves to the right-hand side).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .equations import FRAME_TERMS
+
+__all__ = ["Estimate", "estimate", "cycle_draws", "parameter_names", "drive_phase"]
+
+
+def parameter_names(n_records):
+    """``m1, c1, k1, k3``, one ``A`` per record (``A`` alone for one record, else ``A[1]``,
+    ``A[2]``, ...), then ``m2``."""
+    amps = ["A"] if n_records == 1 else [f"A[{r + 1}]" for r in range(n_records)]
+    return (*FRAME_TERMS[:4], *amps, "m2")
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """Estimated parameters (ndarrays over :attr:`names`; a held one has its given value
+    and a zero-width interval).
+
+    Attributes
+    ----------
+    names : tuple of str
+    value, low, high : ndarray
+        Estimates and their 95 % bootstrap intervals.
+    fixed : ndarray of bool
+    residual : dict
+        ``{"frame", "moulding"}``: RMS of the weak-form residual over the RMS of the
+        measured force term (0: the equations hold exactly).
+    """
+
+    names: tuple
+    value: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    fixed: np.ndarray
+    residual: dict
+
+    def get(self, name):
+        return float(self.value[self.names.index(name)])
+
+
+def cycle_draws(rows, n_boot, seed):
+    """``n_boot`` resamples of each record's cycles (with replacement), as row indices: a
+    list over replicates of lists over records."""
+    rng = np.random.default_rng(seed)
+    groups = []
+    for r in rows:
+        cycles = np.unique(r.cycle)
+        groups.append([np.flatnonzero(r.cycle == c) for c in cycles])
+    draws = []
+    for _ in range(n_boot):
+        one = []
+        for g in groups:
+            pick = rng.integers(0, len(g), len(g))
+            one.append(np.concatenate([g[k] for k in pick]))
+        draws.append(one)
+    return draws
+
+
+def _blocks(rows, pick=None):
+    """The three stacked blocks of the design, each ``(X, y)`` with the columns of
+    :func:`parameter_names`: the frame (``y = -int phi F``), the moulding
+    (``y = int phi F``) and their sum, the momentum balance (``y = 0``)."""
+    R = len(rows)
+    frame, mould, f = [], [], []
+    for r, row in enumerate(rows):
+        sel = slice(None) if pick is None else pick[r]
+        fr = row.frame[sel]
+        X = np.zeros((fr.shape[0], 5 + R))
+        X[:, :4] = fr[:, :4]
+        X[:, 4 + r] = fr[:, 4]
+        M = np.zeros_like(X)
+        M[:, -1] = row.moulding[sel]
+        frame.append(X)
+        mould.append(M)
+        f.append(row.force[sel])
+    frame, mould, f = np.vstack(frame), np.vstack(mould), np.concatenate(f)
+    return (frame, -f), (mould, f), (frame + mould, np.zeros_like(f))
+
+
+def _solve(X, y, held):
+    """Least squares with the columns of the non-NaN ``held`` values held at them."""
+    free = np.isnan(held)
+    theta = np.where(free, 0.0, held)
+    rhs = y - X[:, ~free] @ theta[~free]
+    A = X[:, free]
+    scale = np.sqrt((A * A).sum(axis=0))
+    scale[scale == 0] = 1.0
+    theta[free] = np.linalg.lstsq(A / scale, rhs, rcond=None)[0] / scale
+    return theta
+
+
+def _weighted_solve(blocks, weights, held):
+    X = np.vstack([w * b[0] for b, w in zip(blocks, weights, strict=True)])
+    y = np.concatenate([w * b[1] for b, w in zip(blocks, weights, strict=True)])
+    return _solve(X, y, held)
+
+
+def _block_weights(blocks, theta):
+    """Each block's weight: the inverse RMS of its residual at ``theta``."""
+    rms = [float(np.sqrt(np.mean((y - X @ theta) ** 2))) for X, y in blocks]
+    top = max(rms)
+    if top == 0:
+        return [1.0] * len(blocks)
+    return [1.0 / max(r, 1e-12 * top) for r in rms]
+
+
+def _fit(rows, held, pick=None, weights=None):
+    """The weighted least squares of :func:`_blocks`; without ``weights`` they are found
+    by three reweighting passes.  Returns ``(theta, weights)``."""
+    blocks = _blocks(rows, pick)
+    if weights is None:
+        weights = [1.0, 1.0, 1.0]
+        for _ in range(3):
+            weights = _block_weights(blocks, _weighted_solve(blocks, weights, held))
+    return _weighted_solve(blocks, weights, held), weights
+
+
+def _relative_rms(res, y):
+    ref = float(np.sqrt(np.mean(y * y)))
+    return float(np.sqrt(np.mean(res * res)) / ref) if ref > 0 else np.nan
+
+
+def estimate(rows, fixed, draws):
+    """Estimate the machine from the records' ``rows`` (:class:`MachineRows`, one machine).
+
+    Parameters
+    ----------
+    rows : list of MachineRows
+    fixed : dict
+        ``{name: value}`` of the parameters held (names of :func:`parameter_names`).
+    draws : list
+        The bootstrap's cycle resamples (:func:`cycle_draws`).
+
+    Returns
+    -------
+    Estimate
+    """
+    names = parameter_names(len(rows))
+    held = np.array([fixed.get(n, np.nan) for n in names], dtype=float)
+    value, weights = _fit(rows, held)
+    boot = np.array([_fit(rows, held, pick, weights)[0] for pick in draws])
+    if len(draws):
+        low, high = np.nanpercentile(boot, [2.5, 97.5], axis=0)
+    else:
+        low = high = np.full(len(names), np.nan)
+    fixed_mask = ~np.isnan(held)
+    low = np.where(fixed_mask, value, low)
+    high = np.where(fixed_mask, value, high)
+    residual = {
+        "frame": frame_residual(rows, value[:-1]),
+        "moulding": moulding_residual(rows, value[-1]),
+    }
+    return Estimate(names, value, low, high, fixed_mask, residual)
+
+
+def frame_residual(rows, theta_frame):
+    """The frame's relative weak-form residual with given ``m1, c1, k1, k3, A...``."""
+    X, y = _blocks(rows)[0]
+    return _relative_rms(y - X[:, :-1] @ np.asarray(theta_frame, dtype=float), y)
+
+
+def moulding_residual(rows, m2):
+    """The moulding's relative weak-form residual with the mass ``m2``."""
+    X, y = _blocks(rows)[1]
+    return _relative_rms(y - X[:, -1] * m2, y)
+
+
+def drive_phase(rows, draws):
+    """Each record's drive phase [deg] at its ``t = 0`` from a fit of the frame with a
+    ``cos`` column too, and its 95 % interval: ``[(phase, low, high), ...]`` (0 when the
+    record is on the drive's clock)."""
+    R = len(rows)
+
+    def fit(pick):
+        X, y = _blocks(rows, pick)[0]
+        X = X[:, :-1]
+        cos = np.zeros((X.shape[0], R))
+        start = 0
+        for r, row in enumerate(rows):
+            c = row.drive_cos if pick is None else row.drive_cos[pick[r]]
+            cos[start : start + c.size, r] = c
+            start += c.size
+        th = _solve(np.hstack([X, cos]), y, np.full(X.shape[1] + R, np.nan))
+        return np.degrees(np.arctan2(th[4 + R :], th[4 : 4 + R]))
+
+    phase = fit(None)
+    if not draws:
+        return [(float(p), np.nan, np.nan) for p in phase]
+    boot = np.array([fit(p) for p in draws])
+    boot = phase + (boot - phase + 180.0) % 360.0 - 180.0  # wrapped around the estimate
+    low, high = np.percentile(boot, [2.5, 97.5], axis=0)
+    return [(float(p), float(a), float(b)) for p, a, b in zip(phase, low, high, strict=True)]
