@@ -59,6 +59,8 @@ _EXPORTS = {
     "load": "_result",
     "Result": "_result",
     "verify": "vibroimpact.verify.verdict",
+    "calibrate": "vibroimpact.calibration.machine",
+    "Calibration": "vibroimpact.calibration.result",
     "VerifyResult": "vibroimpact.verify.verdict",
     "advise": "vibroimpact.advise.search",
     "AdviseResult": "vibroimpact.advise.result",
@@ -84,6 +86,8 @@ _EXPORTS = {
 
 __all__ = [
     "CRITERIA",
+    "calibrate",
+    "Calibration",
     "evaluate_criteria",
     "simulate",
     "Tolerances",

@@ -41,6 +41,7 @@ SCHEMA_VERSION = 1
 KINDS = {
     "evaluation": "discovery.vibroimpact.verify.evaluation:Evaluation",
     "verify": "discovery.vibroimpact.verify.verdict:VerifyResult",
+    "calibrate": "discovery.vibroimpact.calibration.result:Calibration",
     "landscape": "discovery.vibroimpact.verify.criteria_landscape:Landscape",
     "ranked-model": "discovery.vibroimpact.fit.discovery_result:RankedModel",
     "fit": "discovery.vibroimpact.fit.discovery_result:DiscoveryResult",

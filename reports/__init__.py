@@ -16,9 +16,11 @@ _EXPORTS = {
     "loops_figure": "vibroimpact.verify_figures",
 }
 _EXPORTS["advise_figure"] = "vibroimpact.advise_figures"
+_EXPORTS["calibration_figure"] = "vibroimpact.calibration_figures"
 
 __all__ = [
     "advise_figure",
+    "calibration_figure",
     "landscape_figure",
     "identification_figure",
     "fit_impulse_figure",

@@ -184,6 +184,7 @@ def _add_examples(parser, path=()):
 
 COMMANDS = (
     "simulate",
+    "calibrate",
     "fit",
     "verify",
     "explain",
@@ -215,6 +216,7 @@ def _parser():
     # imported here, inside main()'s handlers: a Ctrl-C while they load is an interrupt too
     from . import (
         advise,
+        calibrate,
         explain,
         fit,
         identify,
@@ -229,6 +231,7 @@ def _parser():
 
     modules = {
         "simulate": simulate,
+        "calibrate": calibrate,
         "fit": fit,
         "verify": verify,
         "explain": explain,

@@ -180,9 +180,53 @@ def executor_of(args):
     return make_executor(getattr(args, "workers", None), args.scheduler)
 
 
+MACHINE_HELP = (
+    "the machine the record is judged with: 'record' calibrates the scenario's masses, "
+    "supports and drive from the record's own motions and force (vidi calibrate; a record "
+    "without positions keeps the scenario), 'sheet' takes the scenario as given "
+    "(default: %(default)s)"
+)
+
+
 def add_record_options(parser):
-    """Add the options of reading a record (``--columns``); returns the action."""
-    return parser.add_argument("--columns", metavar="MAP", help=COLUMNS_HELP)
+    """Add the options of reading a record (``--columns``, ``--machine``); returns the
+    ``--columns`` action."""
+    columns = parser.add_argument("--columns", metavar="MAP", help=COLUMNS_HELP)
+    parser.add_argument(
+        "--machine", choices=("record", "sheet"), default="record", help=MACHINE_HELP
+    )
+    return columns
+
+
+def machine_for(args, scenarios, measurements, time_offset=0.0):
+    """The machine each record is judged with (``--machine``): the scenarios calibrated
+    from the records (``record``, the default) or as given (``sheet``).  The records' units
+    and signs are checked either way; one line is printed for the machine used and one for
+    each sheet value the records contradict.  Returns ``(scenarios, summary entry)``."""
+    from ..vibroimpact.calibration import calibrate
+
+    scs = list(scenarios)
+    cal = calibrate(
+        scs, list(measurements), time_offset=time_offset, seed=getattr(args, "seed", 0) or 0
+    )
+    use = getattr(args, "machine", "record")
+    for note in cal.notes:
+        print(f"note: {note}")
+    if use == "record" and cal.calibrated:
+        used = list(cal.scenarios)
+        print(
+            f"machine: calibrated from the record ({cal.summary_line()}); "
+            "--machine sheet keeps the scenario's"
+        )
+        for line in cal.disagreements():
+            print(f"machine: {line}")
+    else:
+        used = scs
+        if cal.calibrated:
+            print("machine: the scenario as given (--machine sheet)")
+            for line in cal.disagreements():
+                print(f"machine: {line} (not used: --machine sheet)")
+    return used, {"used": use if cal.calibrated else "sheet", **cal.as_dict()}
 
 
 def read_record(args, scenario, path=None):
@@ -276,9 +320,11 @@ def outputs_line(args, files):
     return f"outputs in {args.out}/: {', '.join(files)}"
 
 
-def read_records(args):
+def read_records(args, machine=True):
     """Every ``--data`` record with its scenario (``--scenario`` once per ``--data`` in the
-    same order, or once for all): ``(scenarios, measurements)``; notes are printed."""
+    same order, or once for all), and the machine each is judged with (:func:`machine_for`):
+    ``(scenarios, measurements, machine summary)``; notes are printed.  With ``machine``
+    false the scenarios are returned as given and the summary is ``None``."""
     from ..vibroimpact.model.scenario import load_scenario
 
     data = _listed(args.data)
@@ -295,7 +341,10 @@ def read_records(args):
         for note in m.notes:
             print(f"note: {path}: {note}" if len(data) > 1 else f"note: {note}")
         meas.append(m)
-    return scs, meas
+    if not machine:
+        return scs, meas, None
+    scs, summary = machine_for(args, scs, meas)
+    return scs, meas, summary
 
 
 def criteria_line(criteria, floor):

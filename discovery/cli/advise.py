@@ -8,6 +8,7 @@ from ._common import (
     check_out,
     executor_of,
     integer,
+    machine_for,
     number,
     outputs_line,
     parse_range,
@@ -50,15 +51,23 @@ def _noise(args, sc):
         )
     if args.data is not None:
         meas = read_record(args, sc)
-        return NoiseModel.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
-    return NoiseModel(
-        relative=args.noise,
-        dt=1.0 / args.sample_rate,
-        periods=args.periods,
-        n_boot=args.n_boot,
-        seed=args.seed,
-        source="given as a fraction of the peak force",
-        position=args.position_noise,
+        for note in meas.notes:
+            print(f"note: {note}")
+        (sc,), machine = machine_for(args, [sc], [meas])
+        noise = NoiseModel.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
+        return noise, sc, machine
+    return (
+        NoiseModel(
+            relative=args.noise,
+            dt=1.0 / args.sample_rate,
+            periods=args.periods,
+            n_boot=args.n_boot,
+            seed=args.seed,
+            source="given as a fraction of the peak force",
+            position=args.position_noise,
+        ),
+        sc,
+        None,
     )
 
 
@@ -94,13 +103,13 @@ def run(args):
             f"the fit's scenario {fit_scenario!r} cannot be loaded here ({exc}); give "
             "--scenario (a built-in name or the fit's TOML file)"
         ) from None
-    noise = _noise(args, sc)
+    noise, sc, machine = _noise(args, sc)
     with reporter(args) as rep, executor_of(args) as ex:
         res = advise(sc, laws, knobs, noise, safe, workers=args.workers, progress=rep, executor=ex)
     prov = provenance_of(args)
     prov["settings"] = {**res.settings, **prov["settings"]}
     with OutputDir(args.out) as out:
-        res.record_run(tail=prov).write_into(out)
+        res.record_run({"machine": machine} if machine else None, prov).write_into(out)
         advise_figure(res, str(out.path("advise_map")))
     print(res)
     for k, p in enumerate(res.ranked()[1:4], start=2):

@@ -46,7 +46,7 @@ def run(args):
     if args.effects:
         effects = [e.strip() for e in args.effects.split(",") if e.strip()]
         select(EFFECTS, effects, where="--effects")
-    scs, meas = read_records(args)
+    scs, meas, machine = read_records(args)
     with reporter(args) as rep, executor_of(args) as ex:
         res = explain(
             scs,
@@ -65,7 +65,12 @@ def run(args):
             progress=rep,
             executor=ex,
         )
-    head = {"command": "explain", "scenario": scs[0].as_dict(), "data": data_entry(args.data)}
+    head = {
+        "command": "explain",
+        "scenario": scs[0].as_dict(),
+        "machine": machine,
+        "data": data_entry(args.data),
+    }
     tail = {"catalogue": [e.as_dict() for e in EFFECTS], "explain_settings": res.settings}
     loops = _final_loops(res, scs[0], meas[0], args)
     with OutputDir(args.out) as out:

@@ -167,7 +167,7 @@ def _print_result(args, res, pdf, why):
     print(outputs_line(args, ["summary.json", "ranking.csv", "model.tex", *pdfs, *figures]))
 
 
-def _run_contact_models(args, scs, meas, t_start):
+def _run_contact_models(args, scs, meas, machine, t_start):
     """``--library contact-models``: every named contact model fitted, the one the record
     supports and those it cannot tell from it (``summary.json`` is the result's
     ``to_dict()`` with the provenance)."""
@@ -185,31 +185,34 @@ def _run_contact_models(args, scs, meas, t_start):
         )
     tail = {**provenance_of(args), "seconds": time.perf_counter() - t_start}
     with OutputDir(args.out) as out:
-        res.record_run(_head(args, scs), tail).write_into(out)
+        res.record_run(_head(args, scs, machine), tail).write_into(out)
     print(res)
     print(outputs_line(args, ["summary.json"]))
     return 0
 
 
-def _head(args, scs):
+def _head(args, scs, machine):
     """The command's part of ``summary.json``: the records and their scenarios."""
     return {
         "command": "fit",
         "scenario": scs[0].as_dict(),
         "scenarios": [sc.as_dict() for sc in scs] if len(scs) > 1 else None,
         "data": data_entry(args.data),
+        "machine": machine,
     }
 
 
 def run(args):
     t_start = time.perf_counter()
     check_out(args)
-    scs, meas = read_records(args)
+    scs, meas, machine = read_records(args)
     if args.library == "contact-models":
-        return _run_contact_models(args, scs, meas, t_start)
+        return _run_contact_models(args, scs, meas, machine, t_start)
     with reporter(args) as rep:
         res = _discover(args, scs, meas, rep)
-    res.record_run(_head(args, scs), provenance_of(args), names=[str(p) for p in args.data])
+    res.record_run(
+        _head(args, scs, machine), provenance_of(args), names=[str(p) for p in args.data]
+    )
     pdf, why = _write_outputs(args, res, t_start)
     _print_result(args, res, pdf, why)
     return 0

@@ -16,6 +16,7 @@ from ._common import (
     check_out,
     coefficients_line,
     criteria_line,
+    machine_for,
     number,
     outputs_line,
     provenance_of,
@@ -131,12 +132,13 @@ def _iterations_csv(res):
     return buf.getvalue()
 
 
-def _summary(args, sc, start, ref, res):
+def _summary(args, sc, start, ref, res, machine):
     """``summary.json`` of the command."""
     final = res.checks[0]  # the identified law against the record, with its noise floor
     head = {
         "command": "identify",
         "scenario": sc.as_dict(),
+        "machine": machine,
         "data": str(args.data),
         "measured": ref.measured(),
         "start": start.as_dict(),
@@ -194,6 +196,7 @@ def run(args):
     meas = read_record(args, sc)
     for note in meas.notes:
         print(f"note: {note}")
+    (sc,), machine = machine_for(args, [sc], [meas])
     ref = Reference.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
     with reporter(args) as rep:
         res = identify(
@@ -212,7 +215,7 @@ def run(args):
         )
     imps = _iterate_impulses(sc, start, ref, res)
     with OutputDir(args.out) as out:
-        _summary(args, sc, start, ref, res).write_into(out)
+        _summary(args, sc, start, ref, res, machine).write_into(out)
         out.path("iterations.csv").write_text(_iterations_csv(res))
         identification_figure(
             res, ref.impulse, imps, str(out.path("identification")), land=land, start=start

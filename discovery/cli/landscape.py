@@ -16,6 +16,7 @@ from ._common import (
     check_out,
     executor_of,
     law_or_default,
+    machine_for,
     number,
     outputs_line,
     parse_range,
@@ -89,8 +90,11 @@ def _reference(args, sc):
                 f"scenario {sc.name!r} has no reference law; pass --data D.csv "
                 "(a measured record) or add [law] text to the scenario"
             )
-        return None, {"source": "law", "law": sc.law.to_text()}, ()
+        return None, {"source": "law", "law": sc.law.to_text()}, sc
     meas = read_record(args, sc)
+    for note in meas.notes:
+        print(f"note: {note}")
+    (sc,), machine = machine_for(args, [sc], [meas], args.time_offset)
     ref = Reference.from_measurement(
         meas, sc, time_offset=args.time_offset, n_boot=args.n_boot, seed=args.seed
     )
@@ -102,8 +106,9 @@ def _reference(args, sc):
         "n_boot": ref.n_boot,
         "seed": ref.seed,
         "notes": list(meas.notes),
+        "machine": machine,
     }
-    return ref, info, meas.notes
+    return ref, info, sc
 
 
 def run(args):
@@ -122,9 +127,7 @@ def run(args):
         )
     n0, n1 = parse_grid(args.grid)
     (r0, r1), origin = _ranges(args, law)
-    ref, ref_info, notes = _reference(args, sc)
-    for note in notes:
-        print(f"note: {note}")
+    ref, ref_info, sc = _reference(args, sc)
     a0, a1 = np.linspace(*r0, n0), np.linspace(*r1, n1)
     with reporter(args) as rep, executor_of(args) as ex:
         land = landscape(

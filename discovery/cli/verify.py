@@ -8,6 +8,7 @@ from ._common import (
     check_out,
     criteria_line,
     law_or_default,
+    machine_for,
     number,
     outputs_line,
     provenance_of,
@@ -26,6 +27,7 @@ def run(args):
     meas = read_record(args, sc)
     for note in meas.notes:
         print(f"note: {note}")
+    (sc,), machine = machine_for(args, [sc], [meas], args.time_offset)
     res = verify(
         sc,
         meas,
@@ -36,7 +38,12 @@ def run(args):
         check_default_start=not args.no_default_start,
     )
     res.record_run(
-        {"command": "verify", "scenario": sc.as_dict(), "data": str(args.data)},
+        {
+            "command": "verify",
+            "scenario": sc.as_dict(),
+            "machine": machine,
+            "data": str(args.data),
+        },
         provenance_of(args),
     )
     with OutputDir(args.out) as out:

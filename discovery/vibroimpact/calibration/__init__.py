@@ -2,7 +2,7 @@
 own motions and measured force (the equations of motion in the weak form, intervals by the
 record's cycles), and the units and signs a record contradicts."""
 
-from .calibration import CALIBRATED, calibrate
+from .machine import CALIBRATED, calibrate
 from .result import Calibration
 
 __all__ = ["calibrate", "Calibration", "CALIBRATED"]

@@ -66,6 +66,11 @@ class Calibration(Result):
     notes : tuple of str
     settings : dict
     seconds : float
+    series : dict or None
+        For the figure, over the first record's test windows: ``t`` (their centres [s]),
+        ``measured`` (the measured force, averaged over each window [N]) and the force
+        each body's motion implies, ``frame`` / ``moulding``, each ``{"sheet", "record"}``.
+        Not in the document (``None`` on a loaded result).
     """
 
     sheet: tuple
@@ -77,6 +82,7 @@ class Calibration(Result):
     notes: tuple = ()
     settings: dict = field(default_factory=dict)
     seconds: float = 0.0
+    series: dict = field(default=None, repr=False)
 
     KIND = "calibrate"
     _LOAD = {
@@ -105,6 +111,10 @@ class Calibration(Result):
             "seconds": self.seconds,
         }
 
+    def summary_line(self):
+        """The machine used, in one line (``m1 9.05 t, c1 8.04e+04 N s/m, ...``)."""
+        return ", ".join(f"{n} {_quantity(p['used'], n)}" for n, p in self.parameters.items())
+
     def disagreements(self):
         """One line for each parameter the record determines whose sheet value lies
         outside its interval ("the record's moulding mass is 6.31 t +- 0.05 t; the
@@ -118,7 +128,8 @@ class Calibration(Result):
             half = (p["high"] - p["low"]) / 2
             out.append(
                 f"the record's {_what(name)} is {_quantity(p['record'], name)} +- "
-                f"{_quantity(half, name)}; the scenario says {_quantity(p['sheet'], name)}"
+                f"{_quantity(half, name, like=p['record'])}; the scenario says "
+                f"{_quantity(p['sheet'], name)}"
             )
         return out
 
@@ -126,9 +137,8 @@ class Calibration(Result):
         head = "calibration: the machine as the record shows it"
         if not self.calibrated:
             return [f"{head}: not calibrated", *[f"  note: {n}" for n in self.notes]]
-        rows = [head, f"  {'':<6}{'sheet':>13}  {'record (95 %)':<36}used"]
+        rows = [head, f"  {'parameter':<15}{'sheet':>11}   {'record [95 % interval]':<34}used"]
         for name, p in self.parameters.items():
-            unit = _unit(name)
             rec = (
                 f"{fmt(p['record'])} [{fmt(p['low'])}, {fmt(p['high'])}]"
                 if p["low"] is not None and p["low"] != p["high"]
@@ -137,7 +147,8 @@ class Calibration(Result):
             used = "record" if p["determined"] else "sheet (the record leaves it loose)"
             if p.get("held"):
                 used = "sheet (held)"
-            rows.append(f"  {name:<6}{fmt(p['sheet']):>13}  {rec + ' ' + unit:<36}{used}")
+            label = f"{name} [{_unit(name)}]"
+            rows.append(f"  {label:<15}{fmt(p['sheet']):>11}   {rec:<34}{used}")
         res = self.residual
         if res:
             rows.append(
@@ -155,9 +166,10 @@ def _pct(x):
     return "--" if x is None or not math.isfinite(x) else f"{100 * x:.2g} %"
 
 
-def _quantity(value, name):
-    """A parameter's value in readable units (a mass in t from a tonne up)."""
+def _quantity(value, name, like=None):
+    """A parameter's value in readable units (a mass in t from a tonne up, or in the unit
+    of the value ``like``)."""
     unit = _unit(name)
-    if unit == "kg" and abs(value) >= 1000:
+    if unit == "kg" and abs(value if like is None else like) >= 1000:
         return f"{value / 1000:.3g} t"
     return f"{value:.3g} {unit}"

@@ -103,7 +103,8 @@ def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, kee
         "keep": list(keep),
         "loose": LOOSE,
     }
-    notes, parameters, residual, phases = [], {}, {}, [(0.0, math.nan, math.nan)] * len(meas)
+    notes, parameters, residual, series = [], {}, {}, None
+    phases = [(0.0, math.nan, math.nan)] * len(meas)
     used = list(sheets)
     groups = {}
     for k, s in enumerate(sheets):
@@ -124,7 +125,8 @@ def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, kee
                 "the sheet's machine is used"
             )
             continue
-        group_params, group_scenarios, group_residual, group_notes, phase = out
+        group_params, group_scenarios, group_residual, group_notes, phase, group_series = out
+        series = series or group_series
         for k, sc, ph in zip(members, group_scenarios, phase, strict=True):
             used[k] = sc
             phases[k] = ph
@@ -151,6 +153,7 @@ def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, kee
         notes=tuple(notes),
         settings=settings,
         seconds=time.perf_counter() - t_start,
+        series=series,
     )
 
 
@@ -229,7 +232,10 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
             "would not be its starting mass)"
         )
     common = {n: final.get(n) for n in ("m1", "c1", "k1", "k3", "m2")}
-    scenarios = [s.replace(**common, A=final.get(a)) for s, a in zip(sheets, amps, strict=True)]
+    scenarios = [
+        s.replace(**common, A=final.get(a), name=f"{s.name}, calibrated")
+        for s, a in zip(sheets, amps, strict=True)
+    ]
     sheet_frame = [sheet.m1, sheet.c1, sheet.k1, sheet.k3, *[s.A for s in sheets]]
     residual = {
         "frame": {"sheet": frame_residual(rows, sheet_frame), "record": final.residual["frame"]},
@@ -238,7 +244,27 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
             "record": final.residual["moulding"],
         },
     }
-    return parameters, scenarios, residual, notes, drive_phase(rows, draws)
+    theta = [final.get(n) for n in final.names]
+    series = _series(rows[0], [*sheet_frame[:5], sheet.m2], [*theta[:5], theta[-1]])
+    return parameters, scenarios, residual, notes, drive_phase(rows, draws), series
+
+
+def _series(row, sheet, record):
+    """The figure's series of one record: the force its motions imply over each window,
+    with the ``sheet``'s and the ``record``'s parameters (each ``m1, c1, k1, k3, A, m2``)."""
+
+    def frame(p):
+        return -(row.frame @ np.asarray(p[:5], dtype=float)) / row.ones
+
+    return {
+        "t": row.centre,
+        "measured": row.force / row.ones,
+        "frame": {"sheet": frame(sheet), "record": frame(record)},
+        "moulding": {
+            "sheet": row.moulding * sheet[5] / row.ones,
+            "record": row.moulding * record[5] / row.ones,
+        },
+    }
 
 
 def _fmt(x):

@@ -1,0 +1,91 @@
+"""``vidi calibrate``: the machine as the record shows it."""
+
+from .._io import OutputDir
+from ..errors import InputError
+from . import _options
+from ._common import (
+    COLUMNS_HELP,
+    check_out,
+    data_entry,
+    number,
+    outputs_line,
+    provenance_of,
+    read_records,
+)
+
+
+def _keep(text):
+    from ..vibroimpact.calibration import CALIBRATED
+
+    names = [k.strip() for k in (text or "").split(",") if k.strip()]
+    bad = [k for k in names if k not in CALIBRATED]
+    if bad:
+        raise InputError(
+            f"--keep names {bad[0]!r}; give parameters of {', '.join(CALIBRATED)}, e.g. "
+            "--keep c1,k1"
+        )
+    return tuple(names)
+
+
+def run(args):
+    from reports import calibration_figure
+
+    from ..vibroimpact.calibration import calibrate
+
+    check_out(args)
+    keep = _keep(args.keep)
+    scs, meas, _ = read_records(args, machine=False)
+    res = calibrate(
+        scs, meas, time_offset=args.time_offset, n_boot=args.n_boot, seed=args.seed, keep=keep
+    )
+    res.record_run({"command": "calibrate", "data": data_entry(args.data)}, provenance_of(args))
+    files = ["summary.json"]
+    with OutputDir(args.out) as out:
+        res.write_into(out)
+        if res.calibrated:
+            for k, sc in enumerate(res.scenarios):
+                name = "scenario.toml" if len(res.scenarios) == 1 else f"scenario_{k + 1}.toml"
+                with open(out.path(name), "w", encoding="utf-8") as fh:
+                    fh.write(sc.to_toml())
+                files.append(name)
+            if calibration_figure(res, str(out.path("calibrate"))):
+                files.append("calibrate.png/.pdf")
+    print(res)
+    print(outputs_line(args, files))
+    return 0
+
+
+def register(sub):
+    s = sub.add_parser(
+        "calibrate",
+        help="the machine as the record shows it: masses, supports and drive estimated from "
+        "the record's own motions and force, against the scenario's sheet",
+    )
+    _options.add_scenario_option(s, repeat=True, help_suffix=" (the designer's sheet)")
+    _options.add_data_option(
+        s,
+        "CSV with t, F, w1, w2 (v1, v2 recommended); repeat it to calibrate one machine from "
+        "several records (each its own drive amplitude)",
+        repeat=True,
+    )
+    s.add_argument("--columns", metavar="MAP", help=COLUMNS_HELP)
+    s.add_argument(
+        "--time-offset",
+        type=number(-1e7, 1e7, unit="s"),
+        default=0.0,
+        help="drive-clock time [s] of the records' t = 0 (default: %(default)g)",
+    )
+    _options.add_n_boot_option(
+        s, of="the parameters' intervals (over the record's cycles)", help_suffix=", 1..10000"
+    )
+    s.set_defaults(n_boot=200)
+    _options.add_seed_option(s, "seed of the bootstrap, >= 0", most=None)
+    s.add_argument(
+        "--keep",
+        metavar="NAMES",
+        help="parameters held at the scenario's values, e.g. 'c1,k1' (of m1, c1, k1, k3, A, "
+        "m2; default: none)",
+    )
+    _options.add_out_option(s)
+    s.set_defaults(func=run)
+    return s
