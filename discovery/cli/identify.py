@@ -132,13 +132,12 @@ def _iterations_csv(res):
     return buf.getvalue()
 
 
-def _summary(args, sc, start, ref, res, machine):
+def _summary(args, sc, start, ref, res):
     """``summary.json`` of the command."""
     final = res.checks[0]  # the identified law against the record, with its noise floor
     head = {
         "command": "identify",
         "scenario": sc.as_dict(),
-        "machine": machine,
         "data": str(args.data),
         "measured": ref.measured(),
         "start": start.as_dict(),
@@ -215,7 +214,10 @@ def run(args):
         )
     imps = _iterate_impulses(sc, start, ref, res)
     with OutputDir(args.out) as out:
-        _summary(args, sc, start, ref, res, machine).write_into(out)
+        summary = _summary(args, sc, start, ref, res)
+        run = summary.run_record
+        summary.record_run({**run["head"], "machine": machine}, run["tail"])
+        summary.write_into(out)
         out.path("iterations.csv").write_text(_iterations_csv(res))
         identification_figure(
             res, ref.impulse, imps, str(out.path("identification")), land=land, start=start

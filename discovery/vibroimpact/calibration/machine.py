@@ -232,10 +232,7 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
             "would not be its starting mass)"
         )
     common = {n: final.get(n) for n in ("m1", "c1", "k1", "k3", "m2")}
-    scenarios = [
-        s.replace(**common, A=final.get(a), name=f"{s.name}, calibrated")
-        for s, a in zip(sheets, amps, strict=True)
-    ]
+    scenarios = [s.replace(**common, A=final.get(a)) for s, a in zip(sheets, amps, strict=True)]
     sheet_frame = [sheet.m1, sheet.c1, sheet.k1, sheet.k3, *[s.A for s in sheets]]
     residual = {
         "frame": {"sheet": frame_residual(rows, sheet_frame), "record": final.residual["frame"]},
