@@ -36,6 +36,7 @@ def run(args):
         n_boot=args.n_boot,
         seed=args.seed,
         check_default_start=not args.no_default_start,
+        machine_scale=machine.get("scale_range") if machine["used"] == "record" else None,
     )
     res.record_run(
         {

@@ -120,15 +120,42 @@ def _block_weights(blocks, theta):
     return [1.0 / max(r, 1e-12 * top) for r in rms]
 
 
+#: rounds of the alternation between the ratios and the scale
+ROUNDS = 4
+
+
 def _fit(rows, held, pick=None, weights=None):
-    """The weighted least squares of :func:`_blocks`; without ``weights`` they are found
-    by three reweighting passes.  Returns ``(theta, weights)``."""
-    blocks = _blocks(rows, pick)
+    """The machine from the three blocks of :func:`_blocks`: the ratios to ``m1`` from the
+    balance, the scale from the two equations that hold the force, in turn (a held
+    parameter enters the balance at its value over the current scale).
+
+    The balance is homogeneous: fitted in one least squares with the other two, its tight
+    residual would pull the whole machine toward zero (measured: -6 % on a record with 3 %
+    force noise), so it only ever sees the ratios.  ``weights`` (of the frame's and the
+    moulding's equations, the inverse RMS of their residuals) are found on the first call.
+    Returns ``(theta, weights)``."""
+    frame, mould, balance = _blocks(rows, pick)
+    theta = _weighted_solve((frame, mould), weights or (1.0, 1.0), held)
     if weights is None:
-        weights = [1.0, 1.0, 1.0]
-        for _ in range(3):
-            weights = _block_weights(blocks, _weighted_solve(blocks, weights, held))
-    return _weighted_solve(blocks, weights, held), weights
+        weights = _block_weights((frame, mould), theta)
+        theta = _weighted_solve((frame, mould), weights, held)
+    free = np.isnan(held)
+    X = np.vstack([w * b[0] for b, w in zip((frame, mould), weights, strict=True)])
+    y = np.concatenate([w * b[1] for b, w in zip((frame, mould), weights, strict=True)])
+    for _ in range(ROUNDS):
+        scale = theta[0]
+        if not (np.isfinite(scale) and scale != 0):
+            break
+        ratios_held = np.where(free, np.nan, held / scale)
+        ratios_held[0] = 1.0
+        rho = _solve(*balance, ratios_held)
+        if free[0]:
+            part = X[:, free] @ rho[free]
+            rest = y - X[:, ~free] @ held[~free]
+            den = float(part @ part)
+            scale = float(part @ rest) / den if den > 0 else scale
+        theta = np.where(free, scale * rho, held)
+    return theta, weights
 
 
 def _relative_rms(res, y):

@@ -11,6 +11,10 @@ __all__ = ["Calibration", "UNITS"]
 
 #: each calibrated parameter's unit
 UNITS = {"m1": "kg", "m2": "kg", "k1": "N/m", "c1": "N s/m", "k3": "N/m^3", "A": "N"}
+#: the least relative uncertainty granted the machine's scale: the force's quadrature alone
+#: put it 0.8-1.3 % off on noise-free records of stiff, heavily damped contacts, whose
+#: impulse lies in a few samples (the bootstrap over cycles does not see a bias)
+SCALE_FLOOR = 0.02
 #: what each parameter is, for the lines a command prints
 WHAT = {
     "m1": "grid frame's mass",
@@ -93,6 +97,19 @@ class Calibration(Result):
     }
 
     @property
+    def scale_range(self):
+        """``(low, high)``: the factors within which the calibrated machine's scale is
+        uncertain (``m1``'s 95 % interval, at least +-:data:`SCALE_FLOOR`), or ``None``
+        when ``m1`` was not calibrated (held, loose, or nothing calibrated).  The ratios
+        are known far better (see :mod:`~discovery.vibroimpact.calibration.estimate`);
+        ``verify(..., machine_scale=...)`` takes it."""
+        p = self.parameters.get("m1")
+        if not self.calibrated or not p or not p["determined"] or p["low"] is None:
+            return None
+        half = max((p["high"] - p["low"]) / 2 / p["used"], SCALE_FLOOR)
+        return (1.0 - half, 1.0 + half)
+
+    @property
     def scenario(self):
         """The machine of the (first) record."""
         return self.scenarios[0]
@@ -105,6 +122,7 @@ class Calibration(Result):
             "parameters": self.parameters,
             "phase": [list(p) for p in self.phase],
             "residual": self.residual,
+            "scale_range": None if self.scale_range is None else list(self.scale_range),
             "disagreements": self.disagreements(),
             "notes": list(self.notes),
             "settings": self.settings,

@@ -273,6 +273,14 @@ class Scenario:
         """A copy with some parameters changed (validated like the original)."""
         return Scenario(**{**self._fields(), **changes})
 
+    def scaled(self, factor):
+        """A copy with every force-carrying parameter (``m1, m2, k1, c1, A, k3``) times
+        ``factor``: the same machine's motion under forces ``factor`` times larger.  A
+        calibration from a record knows the machine's ratios far better than its scale
+        (:func:`~discovery.calibrate`)."""
+        keys = ("m1", "m2", "k1", "c1", "A", "k3")
+        return self.replace(**{k: getattr(self, k) * factor for k in keys})
+
     def with_law(self, law):
         """A copy with another reference law."""
         return Scenario(**{**self._fields(), "law": law})

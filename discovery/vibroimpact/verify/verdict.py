@@ -8,6 +8,7 @@ import numpy as np
 from ..._printing import readable
 from ..._result import Result, part
 from ..._validate import Real, params
+from ...errors import InputError
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
 from ..model.law import ForceLaw
@@ -194,6 +195,48 @@ def _default_start_note(ev, other):
     )
 
 
+#: the most simulations the search of the machine's scale makes
+SCALE_EVALUATIONS = 12
+
+
+def _profiled_scale(scenario, law, ref, bounds, tolerances):
+    """The scenario scaled within ``bounds`` to fit ``law`` best (I2 of the record,
+    bounded Brent), and a note saying where."""
+    from scipy.optimize import minimize_scalar
+
+    lo, hi = (float(b) for b in bounds)
+    if not (0 < lo <= 1 <= hi):
+        raise InputError(
+            f"verify: machine_scale must be (low, high) with 0 < low <= 1 <= high; got {bounds!r}"
+        )
+
+    seen = {}
+
+    def i2(factor):
+        if factor in seen:
+            return seen[factor]
+        ev = evaluate(
+            scenario.scaled(factor), law, ref, tolerances=tolerances, floor=False, smooth_onset=True
+        )
+        v = ev.criteria.get("I2") if ev.status == "ok" and ev.criteria else None
+        seen[factor] = float(v) if v is not None and np.isfinite(v) else 1e3
+        return seen[factor]
+
+    if hi - lo < 1e-9:
+        return scenario, "the machine's scale is fixed"
+    res = minimize_scalar(
+        i2,
+        bounds=(lo, hi),
+        method="bounded",
+        options={"xatol": 1e-4, "maxiter": SCALE_EVALUATIONS},
+    )
+    best = float(res.x) if i2(1.0) > res.fun else 1.0
+    return scenario.scaled(best), (
+        f"the machine's scale, known to [{lo:.4f}, {hi:.4f}] of the calibration's, fits "
+        f"this law best at {best:.4f} (I2 {min(res.fun, i2(1.0)):.3g} there)"
+    )
+
+
 @params(
     scenario=Scenario,
     measurement=(Measurement, Reference),
@@ -202,6 +245,7 @@ def _default_start_note(ev, other):
     n_boot=Real(0, integer=True),
     seed=Real(0, integer=True),
     tolerances=(Tolerances, None),
+    machine_scale=(tuple, list, None),
 )
 def verify(
     scenario,
@@ -213,6 +257,7 @@ def verify(
     seed=0,
     check_default_start=True,
     tolerances=None,
+    machine_scale=None,
 ):
     """Verify ``law`` against a record by full simulation.
 
@@ -234,6 +279,13 @@ def verify(
     check_default_start : bool
         Also simulate from the scenario's initial state and note a different attractor.
     tolerances : Tolerances, optional
+    machine_scale : (float, float), optional
+        The factors ``(low, high)`` within which the machine's scale is uncertain (a
+        calibration's :attr:`~discovery.Calibration.scale_range`).  The law is then judged
+        with the scale in that range that fits it best (a one-dimensional search on I2,
+        :data:`SCALE_EVALUATIONS` simulations at most): the record fixes the machine's
+        ratios from its motions, its scale only through the force's quadrature, and a
+        stiff machine's verdict can turn on a fraction of a percent of it.
 
     Returns
     -------
@@ -247,8 +299,12 @@ def verify(
             measurement, scenario, time_offset=time_offset, n_boot=n_boot, seed=seed
         )
     )
+    notes = []
+    if machine_scale is not None:
+        scenario, note = _profiled_scale(scenario, law, ref, machine_scale, tolerances)
+        notes.append(note)
     ev = evaluate(scenario, law, ref, tolerances=tolerances)
-    other, notes = None, []
+    other = None
     if check_default_start and ref.start is not None:
         other = evaluate(scenario, law, ref, tolerances=tolerances, from_state=False, floor=False)
         note = _default_start_note(ev, other)
@@ -260,6 +316,7 @@ def verify(
         "seed": seed,
         "check_default_start": check_default_start,
         "tolerances": None if tolerances is None else tolerances.as_dict(),
+        "machine_scale": None if machine_scale is None else list(machine_scale),
     }
     return VerifyResult(
         law=law,
