@@ -124,6 +124,8 @@ def bench_pipeline(repeat=3):
     """Wall time of the public entry points, as ratios to one steady state of the same
     scenario and law measured in the same run (the unit of every simulation they make):
 
+    * ``discovery.calibrate`` of that record, and ``verify`` with its machine and the
+      search of the machine's scale (``machine_scale``), as ratios to the plain ``verify``;
     * ``discovery.vibroimpact.verify.verify`` on a 20-period steady record (paper scenario, law
       (11), 1 % force noise, positions and velocities; best of ``repeat``): one
       steady state from the measured state, the alignment, a 16-replicate noise floor
@@ -143,12 +145,28 @@ def bench_pipeline(repeat=3):
     t_one, _ = _best(lambda: steady_state(sc, sc.law), repeat=5)
     rec = synthesize(sc, sc.law, periods=20, fs=20000, noise=0.01, seed=1)
     t_ver, res = _best(lambda: verify(sc, rec, sc.law), repeat=repeat)
+    from discovery import calibrate
+
+    t_cal, cal = _best(lambda: calibrate(sc, rec), repeat=repeat)
+    t_vcal, res_cal = _best(
+        lambda: verify(cal.scenario, rec, sc.law, machine_scale=cal.scale_range), repeat=repeat
+    )
     out = {
         "one_steady_state_seconds": t_one,
         "verify_20_periods": {
             "seconds": t_ver,
             "ratio_to_one_steady_state": t_ver / t_one,
             "consistent": res.consistent,
+        },
+        "calibrate_20_periods": {
+            "seconds": t_cal,
+            "ratio_to_verify": t_cal / t_ver,
+            "m1_error": cal.scenario.m1 / sc.m1 - 1,
+        },
+        "verify_calibrated_20_periods": {
+            "seconds": t_vcal,
+            "ratio_to_verify": t_vcal / t_ver,
+            "consistent": res_cal.consistent,
         },
     }
     law = ForceLaw.parse(TRUE)

@@ -489,6 +489,13 @@ def main():
         f"verify, 20-period record: {v['seconds']:.2f} s ({v['ratio_to_one_steady_state']:.0f}"
         f" x one steady state of {p['one_steady_state_seconds'] * 1e3:.1f} ms)"
     )
+    c_, vc = p["calibrate_20_periods"], p["verify_calibrated_20_periods"]
+    print(
+        f"calibrate, the same record: {c_['seconds']:.3f} s ({c_['ratio_to_verify']:.2f} x "
+        f"verify; m1 {c_['m1_error']:+.2%}); verify with the calibrated machine and its scale "
+        f"searched: {vc['seconds']:.2f} s ({vc['ratio_to_verify']:.2f} x, consistent "
+        f"{vc['consistent']})"
+    )
     for lib in ("poly:2", "poly:3"):
         d_ = p[f"discover_{lib}"]
         if "error" in d_:

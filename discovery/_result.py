@@ -267,6 +267,7 @@ def part(cls, d):
 
 #: the command whose report a result kind has (a saved result names no command)
 _COMMANDS = {
+    "calibrate": "calibrate",
     "verify": "verify",
     "landscape": "landscape",
     "fit": "fit",

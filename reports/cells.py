@@ -65,6 +65,10 @@ FIGURE_CAPTIONS = {
     "attractor": "Stroboscopic points and a trajectory of the attractor.",
     "basins": "Basins of the coexisting attractors.",
     "chart": "Regime chart over the forcing frequency and amplitude.",
+    "calibrate": "The force each body's motion implies through its equation of motion, "
+    "averaged over each test window: with the scenario's machine (orange circles) and the "
+    "calibrated one (blue crosses), against the measured force (black); the first drive "
+    "periods of the record.",
     "explain": "The missing effect: where the model disagrees before and after it is added.",
     "explain_loops": "The final model against the record: the force-penetration loop and both "
     "penetrations over the contacts (what I5 compares).",
@@ -251,3 +255,30 @@ def _coef_rows(coefs, errors=None, intervals=None, start=None, term=term_tex):
             + ([num((start or {}).get(k), 3)] if start is not None else [])
         )
     return rows
+
+
+def _machine_rows(machine):
+    """The calibration's table (a ``summary.json``'s ``machine``, or a ``calibrate`` run's
+    summary): parameter, the sheet's value, the record's with its 95 % interval, and which
+    one the run used; ``None`` without a calibration."""
+    if not isinstance(machine, dict) or not machine.get("calibrated"):
+        return None
+    rows = []
+    for name, p in (machine.get("parameters") or {}).items():
+        if not isinstance(p, dict):
+            continue
+        interval = (
+            Tex(f"[{num(p.get('low'))}, {num(p.get('high'))}]")
+            if p.get("low") is not None and p.get("low") != p.get("high")
+            else Tex("")
+        )
+        used = "record" if p.get("determined") else ("sheet (held)" if p.get("held") else "sheet")
+        rows.append(
+            [
+                Tex(escape(name) + r"\ " + unit_tex(p.get("unit", ""))),
+                num(p.get("sheet")),
+                Tex(num(p.get("record")) + " " + interval),
+                used,
+            ]
+        )
+    return rows or None

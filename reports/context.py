@@ -17,12 +17,14 @@ from .cells import (  # noqa: F401  (the shared cells, read by the tests from he
     FIGURE_CAPTIONS,
     _criteria_table,
     _figures,
+    _machine_rows,
     _provenance,
     _scenario_rows,
     criterion_definition,
     criterion_names,
     criterion_tex,
 )
+from .lawtex import prose
 from .run import run_document
 from .ueda.context import _ueda_attractor, _ueda_chart, _ueda_discover, _ueda_explain
 from .vibroimpact.context import (  # noqa: F401
@@ -44,7 +46,36 @@ def _advise(doc, run_dir):
     return advise_context(doc, run_dir, _figures)
 
 
+def _calibrate(doc, run_dir):
+    """A calibration's report: the machine section of the frame holds its table."""
+    s = doc.summary
+    lines = list(s.get("disagreements") or [])
+    res = s.get("residual") or {}
+    if s.get("calibrated"):
+        if not lines:
+            lines.append(
+                "The record agrees with the scenario's machine: every value the record "
+                "determines holds the scenario's within its 95 % interval."
+            )
+        fr, mo = res.get("frame") or {}, res.get("moulding") or {}
+        if fr and mo:
+            lines.append(
+                "The equations' weak-form residual, as a share of the force: frame "
+                f"{100 * fr.get('record', float('nan')):.2g} % with the calibrated machine "
+                f"({100 * fr.get('sheet', float('nan')):.2g} % with the scenario's), moulding "
+                f"{100 * mo.get('record', float('nan')):.2g} % "
+                f"({100 * mo.get('sheet', float('nan')):.2g} %)."
+            )
+    lines += list(s.get("notes") or [])
+    return {
+        "title": "The machine as the record shows it",
+        "conclusions": [prose(x) for x in lines],
+        "figures": _figures(run_dir, ["calibrate"]),
+    }
+
+
 KINDS = {
+    "calibrate": _calibrate,
     "verify": _verify,
     "advise": _advise,
     "fit": _fit,
@@ -60,6 +91,7 @@ KINDS = {
 
 
 TEMPLATES = {
+    "calibrate": "calibrate",
     "verify": "verify",
     "advise": "advise",
     "fit": "fit",
@@ -91,6 +123,10 @@ def context(doc, run_dir):
     c["template"] = ("contact_models" if named else TEMPLATES.get(kind, "ueda")) + ".tex.j2"
     c["provenance"] = _provenance(summary, run_dir)
     c["scenario"] = _scenario_rows(summary.get("scenario"))
+    machine = summary if kind == "calibrate" else summary.get("machine")
+    c["machine"] = _machine_rows(machine)
+    c["machine_used"] = (machine or {}).get("used", "record")
+    c["machine_lines"] = [prose(x) for x in (machine or {}).get("disagreements") or []]
     c["data"] = summary.get("data") or (summary.get("settings") or {}).get("data")
     c["seconds"] = summary.get("seconds")
     return c
