@@ -104,7 +104,12 @@ surveys: install
 		$(MEASURED)/corpus*.jsonl $(MEASURED)/contact-two-points*.jsonl \
 		$(MEASURED)/contact-narrow-points*.jsonl \
 		$(MEASURED)/explain-random*.jsonl $(MEASURED)/study-paper*.jsonl \
-		$(MEASURED)/contact-models-*.jsonl $(MEASURED)/explain-cases*.jsonl
+		$(MEASURED)/contact-models-*.jsonl $(MEASURED)/explain-cases*.jsonl \
+		$(MEASURED)/calibration*.jsonl
+	$(BIN)/python -m tests.survey_calibration --n 3 --first-seed 900 \
+		--out $(MEASURED)/calibration.jsonl
+	$(BIN)/python -m tests.survey_calibration --n 4 --first-seed 903 \
+		--out $(MEASURED)/calibration-903.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 272 \
 		--workers $(SURVEY_WORKERS) --out $(MEASURED)/intervals-272.jsonl
 	$(BIN)/python -m tests.survey_intervals --records 64 --first 208 \

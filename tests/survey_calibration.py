@@ -177,3 +177,32 @@ def main(argv=None):
 
 if __name__ == "__main__":
     sys.exit(main())
+
+
+# ------------------------------------------------------------- the docs' table
+def read_rows(paths):
+    """Every row of the run files ``paths``."""
+    return [r for p in paths for r in measured.read(p)[1]]
+
+
+def _rate(k, n):
+    return f"{k}/{n} ({100 * k / n:.0f} %)" if n else "--"
+
+
+def markdown_row(rows, label):
+    """docs/calibration.md's row ``label`` ("force noise 1 %", "force noise 3 %", "all")."""
+    if label != "all":
+        level = float(label.split()[-2]) / 100
+        rows = [r for r in rows if abs(r["force_noise"] - level) < 1e-9]
+    n = len(rows)
+    masses = sum(all(abs(r["params"][p]["error"]) <= 0.02 for p in ("m1", "m2")) for r in rows)
+    cells = [label, str(n), _rate(masses, n)]
+    for name in ("true", "sheet", "record"):
+        ok = sum(bool(r["verdicts"][name]["true"]["consistent"]) for r in rows)
+        cells.append(_rate(ok, n))
+    for name in ("true", "sheet", "record"):
+        wrong = [
+            v["consistent"] for r in rows for k, v in r["verdicts"][name].items() if k != "true"
+        ]
+        cells.append(_rate(sum(not c for c in wrong), len(wrong)))
+    return "| " + " | ".join(cells) + " |"

@@ -30,6 +30,7 @@ from . import (
     measured,
     realistic_survey,
     survey_advise,
+    survey_calibration,
     survey_contact_models,
     survey_corpus,
     survey_explain,
@@ -104,6 +105,20 @@ def _two_points(pattern):
 
 
 TABLES = {
+    "calibration": Table(
+        page="docs/calibration.md",
+        header=(
+            "| records | n | masses within 2 % | true law consistent: true machine | sheet | "
+            "calibrated | wrong laws rejected: true machine | sheet | calibrated |",
+            "|---|---|---|---|---|---|---|---|---|",
+        ),
+        rows=tuple(
+            (label, ("calibration*.jsonl",))
+            for label in ("force noise 1 %", "force noise 3 %", "all")
+        ),
+        row=survey_calibration.markdown_row,
+        read=survey_calibration.read_rows,
+    ),
     "intervals": Table(
         page="docs/validation.md",
         header=(

@@ -198,6 +198,14 @@ def add_record_options(parser):
     return columns
 
 
+def machine_scale(machine):
+    """The machine scale's uncertainty ``(low, high)`` of a :func:`machine_for` summary
+    when the run uses the calibrated machine, else ``None``."""
+    if machine and machine.get("used") == "record" and machine.get("scale_range"):
+        return tuple(machine["scale_range"])
+    return None
+
+
 def machine_for(args, scenarios, measurements, time_offset=0.0):
     """The machine each record is judged with (``--machine``): the scenarios calibrated
     from the records (``record``, the default) or as given (``sheet``).  The records' units

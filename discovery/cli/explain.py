@@ -11,6 +11,7 @@ from ._common import (
     criteria_line,
     data_entry,
     executor_of,
+    machine_scale,
     outputs_line,
     provenance_of,
     read_records,
@@ -62,6 +63,7 @@ def run(args):
             workers=args.workers,
             n_boot_intervals=args.intervals,
             interval_refit=args.interval_refit,
+            machine_scale=machine_scale(machine),
             progress=rep,
             executor=ex,
         )

@@ -15,6 +15,7 @@ from ._common import (
     criteria_line,
     data_entry,
     integer,
+    machine_scale,
     number,
     outputs_line,
     provenance_of,
@@ -23,13 +24,13 @@ from ._common import (
 )
 
 
-def _discover(args, scs, meas, progress):
+def _discover(args, records, progress):
     """The API call the options describe."""
     from ..errors import SolverError
     from ..vibroimpact.fit.discovery import discover
 
     try:
-        return _call(discover, args, scs, meas, progress)
+        return _call(discover, args, records, progress)
     except SolverError as exc:
         if not args.margin:
             raise
@@ -40,7 +41,10 @@ def _discover(args, scs, meas, progress):
         ) from None
 
 
-def _call(discover, args, scs, meas, progress):
+def _call(discover, args, records, progress):
+    """``discover`` on ``records`` (the scenarios, the records and the machine's summary of
+    :func:`._common.read_records`) with the options of the command line."""
+    scs, meas, machine = records
     return discover(
         scs,
         meas,
@@ -64,6 +68,7 @@ def _call(discover, args, scs, meas, progress):
         interval_refit=args.interval_refit,
         workers=args.workers,
         progress=progress,
+        machine_scale=machine_scale(machine),
         **({"signs": args.signs} if args.signs else {}),
     )
 
@@ -209,7 +214,7 @@ def run(args):
     if args.library == "contact-models":
         return _run_contact_models(args, scs, meas, machine, t_start)
     with reporter(args) as rep:
-        res = _discover(args, scs, meas, rep)
+        res = _discover(args, (scs, meas, machine), rep)
     res.record_run(
         _head(args, scs, machine), provenance_of(args), names=[str(p) for p in args.data]
     )

@@ -9,6 +9,7 @@ from ._common import (
     criteria_line,
     law_or_default,
     machine_for,
+    machine_scale,
     number,
     outputs_line,
     provenance_of,
@@ -36,7 +37,7 @@ def run(args):
         n_boot=args.n_boot,
         seed=args.seed,
         check_default_start=not args.no_default_start,
-        machine_scale=machine.get("scale_range") if machine["used"] == "record" else None,
+        machine_scale=machine_scale(machine),
     )
     res.record_run(
         {

@@ -337,24 +337,25 @@ def _check_settings(max_simulations, budget, alpha, workers, max_iterations):
 _ITERATIONS = "explain: iterations (localise, score, refit)"
 
 
-def _intervals(run, n_boot_intervals, seed, progress, refit="two-step"):
+def _intervals(run, s, progress):
     """Bootstrap intervals of the final model's parameters (``None`` when not asked for or
     when a replicate cannot be simulated)."""
-    if not n_boot_intervals:
+    if not s.n_boot_intervals:
         return None
     try:
-        tick(progress, "explain: bootstrap intervals", 0, n_boot_intervals)
+        tick(progress, "explain: bootstrap intervals", 0, s.n_boot_intervals)
         return bootstrap_intervals(
             [sc for sc, _ in run.records],
             [r for _, r in run.records],
             run.model,
-            n_boot=int(n_boot_intervals),
-            seed=seed,
+            n_boot=int(s.n_boot_intervals),
+            seed=s.seed,
             criterion=run.criterion,
             tolerances=run.tolerances,
             workers=run.workers,
             executor=run.executor,
-            refit=refit,
+            refit=s.interval_refit,
+            machine_scale=None if s.machine_scale is None else tuple(s.machine_scale),
         )
     except IntegrationError:
         return None
@@ -377,6 +378,7 @@ class ExplainSettings(Settings):
     n_boot_intervals: int = option(30, Real(0, integer=True))
     interval_refit: str = option("two-step", Choice(*INTERVAL_REFITS))
     budget: object = option(None, (None, Real(1, integer=True)))
+    machine_scale: object = option(None, (None, tuple, list))
 
 
 @takes(ExplainSettings)
@@ -443,6 +445,10 @@ def explain(
         session is interactive, False: none (:mod:`discovery._progress`).
     budget : int, optional
         Deprecated name of ``max_simulations``.
+    machine_scale : (float, float), optional
+        The factors within which the machine's scale is uncertain (a calibration's
+        :attr:`~discovery.Calibration.scale_range`): the intervals of the forces are
+        widened to it (:func:`~discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
 
     Returns
     -------
@@ -495,7 +501,7 @@ def explain(
             _mean(evs, "criteria"), _mean(evs, "noise_floor"), run.drift, run.model
         )
         return ExplainResult(
-            intervals=_intervals(run, s.n_boot_intervals, s.seed, progress, s.interval_refit),
+            intervals=_intervals(run, s, progress),
             iterations=tuple(run.iterations),
             final_model=run.model,
             uncertainties=run.uncertainties,

@@ -110,6 +110,7 @@ class _Bootstrap:
     refit: str
     criterion: str
     tolerances: Tolerances | None
+    machine_scale: tuple | None = None
 
     def selected(self, ranking, refs, refine, progress):
         """The selected (best ranked) model, with bootstrap intervals when asked for and it
@@ -133,6 +134,7 @@ class _Bootstrap:
             tolerances=self.tolerances,
             workers=self.workers,
             refit=self.refit,
+            machine_scale=self.machine_scale,
         )
         if iv is None:
             return selected, ranking
@@ -217,6 +219,7 @@ class DiscoverSettings(Settings):
     workers: object = option(1, (None, Real(1, integer=True)))
     random_state: object = option(None, (None, Real(0, integer=True)))
     estimator: object = option(None, (None, dict))
+    machine_scale: object = option(None, (None, tuple, list))
 
 
 @takes(DiscoverSettings)
@@ -295,6 +298,11 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
     estimator : dict, optional
         Further estimator parameters (``margin``, ``monotone``, ``signs``, ...); they may
         also be given as keywords.
+    machine_scale : (float, float), optional
+        The factors within which the machine's scale is uncertain (a calibration's
+        :attr:`~discovery.Calibration.scale_range`): the selected law's intervals of the
+        forces are widened to it
+        (:func:`~discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
 
     Returns
     -------
@@ -347,7 +355,13 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
         search = _Stepwise(check, rule, stepwise=s.stepwise, max_terms=s.max_terms)
         ranking = search.run(models, refs, s.refine, progress)
         boot = _Bootstrap(
-            s.n_boot_intervals, seed, s.workers, s.interval_refit, s.criterion, s.tolerances
+            s.n_boot_intervals,
+            seed,
+            s.workers,
+            s.interval_refit,
+            s.criterion,
+            s.tolerances,
+            None if s.machine_scale is None else tuple(s.machine_scale),
         )
         selected, ranking = boot.selected(ranking, refs, s.refine, progress)
     # the certificate of the law actually selected (the ranking may prefer another

@@ -85,6 +85,27 @@ class Intervals(Result):
     method: str = "parametric bootstrap through the record-span processing"
     dof: int = 0
 
+    def with_machine_scale(self, low, high, names):
+        """These intervals with the parameters ``names`` widened by a machine scale known
+        only to ``[low, high]`` (see :func:`bootstrap_intervals`)."""
+        lo_s, hi_s = float(low), float(high)
+        if not 0 < lo_s <= 1 <= hi_s:
+            raise InputError(
+                f"machine_scale must be (low, high) with 0 < low <= 1 <= high; got {(low, high)!r}"
+            )
+        bounds = {}
+        for k, (a, b) in self.bounds.items():
+            if k in names:
+                ends = (a / lo_s, a / hi_s, b / lo_s, b / hi_s)
+                a, b = min(ends), max(ends)
+            bounds[k] = (a, b)
+        return replace(
+            self,
+            bounds=bounds,
+            method=f"{self.method}; forces widened by the machine's scale, known to "
+            f"[{lo_s:.4f}, {hi_s:.4f}] (calibration)",
+        )
+
     def as_dict(self):
         return {
             "bounds": {k: list(v) for k, v in self.bounds.items()},
@@ -214,6 +235,21 @@ class BootstrapIntervalsSettings(Settings):
     workers: object = option(1)
     refit: str = option("two-step")
     noise: str = option("cycles")
+    machine_scale: object = option(None, (tuple, list, None))
+
+
+def force_names(model):
+    """The names of ``model``'s parameters that are forces per unit of motion (the law's
+    coefficients, and an effect's parameter whose unit is a force's, such as the unloading
+    damping's N s/m): they scale with the machine, an offset, a lag or a set do not."""
+    law, _, _ = model_parts(model)
+    names = set(law.names)
+    free = getattr(model, "free_effects", None)
+    for effect in free() if free is not None else ():
+        p = effect.parameters[0]
+        if str(p.unit).startswith("N"):
+            names.add(p.name)
+    return names
 
 
 @takes(BootstrapIntervalsSettings)
@@ -255,6 +291,12 @@ def bootstrap_intervals(scenario, reference, model, *, settings=None, executor=N
         record's own residuals with one random weight per cycle (white noise when the
         cycles are too few: :data:`MIN_CYCLE_DOF`); ``"white"``, white noise of the
         record's level (a parametric bootstrap).
+    machine_scale : (float, float), optional
+        The factors within which the machine's scale is uncertain (a calibration's
+        :attr:`~discovery.Calibration.scale_range`).  A machine ``s`` times the true one
+        takes a law about ``s`` times the true one to reproduce the record's motions, so
+        the intervals of the forces (:func:`force_names`) are widened to every value the
+        range allows: ``[low / s_high, high / s_low]`` for a positive coefficient.
 
     Returns
     -------
@@ -319,7 +361,10 @@ def bootstrap_intervals(scenario, reference, model, *, settings=None, executor=N
     if len(draws) < 5:
         return None
     how = _Resampling(cycles=G, noise=noise, few=few, refit=s.refit, level=s.level, seed=s.seed)
-    return _intervals(np.array(draws), model, how)
+    iv = _intervals(np.array(draws), model, how)
+    if s.machine_scale is not None:
+        iv = iv.with_machine_scale(*s.machine_scale, names=force_names(model))
+    return iv
 
 
 @dataclass(frozen=True)
