@@ -162,6 +162,7 @@ CASES = [
     ("AdviseSettings workers text", lambda: d.AdviseSettings(workers="a"), TYPE, "workers"),
     ("IdentifySettings xtol text", lambda: d.IdentifySettings(xtol="a"), TYPE, "xtol"),
     ("ExplainSettings alpha 2", lambda: d.ExplainSettings(alpha=2.0), VALUE, "alpha"),
+    ("VerifySettings n_boot -1", lambda: d.VerifySettings(n_boot=-1), VALUE, "n_boot"),
     (
         "ContactModelsSettings workers 0",
         lambda: d.ContactModelsSettings(workers=0),

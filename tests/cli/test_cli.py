@@ -50,8 +50,6 @@ def test_identify_recovers_true_law(record, tmp_path):
             "1.5e8*z + 0.9e7*zd",
             "--method",
             "least-squares",
-            "--machine",
-            "sheet",
             "--out",
             str(out),
         ]
@@ -59,9 +57,6 @@ def test_identify_recovers_true_law(record, tmp_path):
     assert rc == 0
     s = json.loads((out / "summary.json").read_text())
     c = s["coefficients"]
-    # the machine is known exactly here (--machine sheet): calibrated from this record, whose
-    # 800 samples a period cut the onset's force jump the same way every period, its scale
-    # would be 1 % off (docs/calibration.md), and the law with it
     # noise-free data sampled at 20 kHz: the onset is known to O(dt^3), 0.3 % is ample
     assert abs(c["z"] / 2.06e8 - 1) < 3e-3 and abs(c["zd"] / 1.28e7 - 1) < 3e-3
     assert s["iterations"] and s["n_simulations"] >= s["iterations"][-1]["n_simulations"]

@@ -29,6 +29,12 @@ MAX_WINDOWS = 4000
 #: the test windows' half width in drive periods, and at least this many samples
 HALF_WIDTH_PERIODS = 0.2
 MIN_HALF_WIDTH = 7
+#: a contact: the force above this share of its peak (beyond a record's noise) ...
+CONTACT_LEVEL = 0.2
+#: ... widened while it stays above this share
+EDGE_LEVEL = 0.02
+#: the fewest samples on each side of a contact window's centre
+MIN_CONTACT_HALF_WIDTH = 4
 
 
 @dataclass(frozen=True)
@@ -46,17 +52,27 @@ class MachineRows:
         ``int phi F``.
     moulding : ndarray
         ``int phi (w2'' + g)``: the coefficient of ``m2``.
-    acc2, ones : ndarray, float
+    acc2, ones : ndarray
         ``int phi w2''`` and ``int phi`` (the free-fall check fits ``g`` too).
     kinematics : dict
-        Per body (``"1"``, ``"2"``), ``(int phi v, -int phi' w)``: equal when the positions
-        and velocities are in the same units (the units check), or ``None``.
+        Per body (``"1"``, ``"2"``), ``(int phi v, -int phi' w)`` over the evenly spread
+        windows: equal when the positions and velocities are in the same units (the units
+        check), or ``None``.
     cycle : ndarray of int
         The drive period each window's centre lies in (the bootstrap's blocks).
     centre : ndarray
         The windows' centre times [s].
     half_width : int
-        Samples on each side of a window's centre.
+        Samples on each side of an evenly spread window's centre.
+    anchored : ndarray of bool
+        The windows of one contact each, from the last sample before it to the first
+        after it (the rest are spread evenly).  A stiff, damped contact's force jumps at
+        its onset, and where between two samples the jump falls is the same every period
+        when the sampling is commensurate with the drive: a window whose ``phi`` is large
+        there carries that quadrature error into ``int phi F`` (the paper's machine at
+        10 kHz: -5 % on the scale).  A contact window's ``phi`` and its first three
+        derivatives vanish at the jump, so it costs nothing there: the equations that hold
+        the force use these windows, the momentum balance the evenly spread ones.
     """
 
     frame: np.ndarray
@@ -64,11 +80,12 @@ class MachineRows:
     force: np.ndarray
     moulding: np.ndarray
     acc2: np.ndarray
-    ones: float
+    ones: np.ndarray
     kinematics: dict
     cycle: np.ndarray
     centre: np.ndarray
     half_width: int
+    anchored: np.ndarray
 
     @property
     def n_windows(self):
@@ -79,11 +96,45 @@ def _half_width(dt, period):
     return max(MIN_HALF_WIDTH, int(round(HALF_WIDTH_PERIODS * period / dt)))
 
 
+def _contacts(F, dt, period):
+    """``(start, stop)`` sample indices of each contact: a run of the force above
+    :data:`CONTACT_LEVEL` of its peak (noise does not reach it), widened while the force
+    stays above :data:`EDGE_LEVEL`, so that a window from ``start - 1`` to ``stop`` holds
+    the whole contact."""
+    top = float(np.max(np.abs(F))) if F.size else 0.0
+    if top == 0:
+        return []
+    strong = F > CONTACT_LEVEL * top
+    weak = F > EDGE_LEVEL * top
+    gap = max(2, int(0.01 * period / dt))
+    runs, k, n = [], 0, F.size
+    on = np.flatnonzero(strong)
+    while k < on.size:
+        a = b = on[k]
+        while k + 1 < on.size and on[k + 1] - b <= gap:
+            k += 1
+            b = on[k]
+        k += 1
+        while a > 0 and weak[a - 1]:
+            a -= 1
+        while b + 1 < n and weak[b + 1]:
+            b += 1
+        if runs and a <= runs[-1][1] + 1:
+            runs[-1] = (runs[-1][0], b + 1)
+        else:
+            runs.append((a, b + 1))
+    return runs
+
+
 def machine_rows(measurement, scenario, time_offset=0.0):
     """The weak-form rows of ``measurement`` (a record with ``w1`` and ``w2``; ``v1``,
     ``v2`` used where present) on the drive of ``scenario``, or ``None`` when the record
     has no positions or is too short for four test windows (the machine is then taken as
     the scenario gives it).
+
+    Two sets of windows: evenly spread ones of :data:`HALF_WIDTH_PERIODS` drive periods,
+    and one per contact, from the last sample before it to the first after it
+    (:attr:`MachineRows.anchored`).
 
     ``time_offset`` [s] is the drive-clock time of the record's ``t = 0``."""
     ch = measurement.channels
@@ -96,40 +147,95 @@ def machine_rows(measurement, scenario, time_offset=0.0):
     if 2 * hs + 1 > n // 4:
         return None
     stride = max(1, hs // 2, int(np.ceil((n - 2 * hs) / MAX_WINDOWS)))
-    centres = np.arange(hs, n - hs, stride)
+    data = _Channels.of(measurement, scenario, time_offset)
+    parts = [_rows(data, np.arange(hs, n - hs, stride), hs, dt)]
+    windows = []
+    for a, b in _contacts(data.F, dt, scenario.period)[:MAX_WINDOWS]:
+        half = max(MIN_CONTACT_HALF_WIDTH, int(np.ceil((b - a + 2) / 2)))
+        centre = a - 1 + half
+        if centre - half >= 0 and centre + half < n:
+            windows.append((half, centre))
+    for half in sorted({h for h, _ in windows}):
+        centres = np.array([c for h, c in windows if h == half])
+        parts.append(_rows(data, centres, half, dt))
+    rows = {k: np.concatenate([p[k] for p in parts]) for k in parts[0] if k != "kinematics"}
+    regular = parts[0]
+    anchored = np.arange(rows["force"].size) >= regular["force"].size
+    centre = rows.pop("centre")
+    return MachineRows(
+        **rows,
+        kinematics=regular["kinematics"],
+        cycle=np.floor((centre - t[0]) / scenario.period).astype(int),
+        centre=centre,
+        half_width=hs,
+        anchored=anchored,
+    )
+
+
+@dataclass(frozen=True)
+class _Channels:
+    """A record's channels as the windows read them (velocities ``None`` when absent)."""
+
+    t: np.ndarray
+    F: np.ndarray
+    w1: np.ndarray
+    v1: object
+    w2: np.ndarray
+    v2: object
+    sin: np.ndarray
+    cos: np.ndarray
+    g: float
+
+    @classmethod
+    def of(cls, measurement, scenario, time_offset):
+        ch = measurement.channels
+
+        def get(name):
+            return None if ch.get(name) is None else np.asarray(ch[name], dtype=float)
+
+        t = np.asarray(measurement.t, dtype=float)
+        phase = scenario.omega * (t + time_offset)
+        return cls(
+            t=t,
+            F=np.asarray(measurement.F, dtype=float),
+            w1=get("w1"),
+            v1=get("v1"),
+            w2=get("w2"),
+            v2=get("v2"),
+            sin=np.sin(phase),
+            cos=np.cos(phase),
+            g=scenario.g,
+        )
+
+
+def _rows(data, centres, hs, dt):
+    """The rows of the windows of half width ``hs`` samples centred on ``centres``."""
     idx = centres[:, None] + np.arange(-hs, hs + 1)[None, :]
     w_phi, w_dphi, w_ddphi = window_weights(hs, ORDER, dt)
-    ones = float(w_phi.sum())
-    g = scenario.g
+    ones = np.full(centres.size, float(w_phi.sum()))
 
     def integral(x):
-        return np.asarray(x, dtype=float)[idx] @ w_phi
+        return x[idx] @ w_phi
 
-    def motion(body):
-        w = np.asarray(ch[f"w{body}"], dtype=float)
-        v = ch.get(f"v{body}")
+    def motion(w, v):
         pos_rate = -(w[idx] @ w_dphi)  # int phi w' dt from the positions
         if v is None:
-            return w, pos_rate, w[idx] @ w_ddphi, None
-        v = np.asarray(v, dtype=float)
+            return pos_rate, w[idx] @ w_ddphi, None
         vel = v[idx] @ w_phi
-        return w, vel, -(v[idx] @ w_dphi), (vel, pos_rate)
+        return vel, -(v[idx] @ w_dphi), (vel, pos_rate)
 
-    w1, vel1, acc1, kin1 = motion(1)
-    _, _, acc2, kin2 = motion(2)
-    phase = scenario.omega * (t + time_offset)
+    vel1, acc1, kin1 = motion(data.w1, data.v1)
+    _, acc2, kin2 = motion(data.w2, data.v2)
     frame = np.column_stack(
-        [acc1 + g * ones, vel1, integral(w1), integral(w1**3), integral(np.sin(phase))]
+        [acc1 + data.g * ones, vel1, integral(data.w1), integral(data.w1**3), integral(data.sin)]
     )
-    return MachineRows(
-        frame=frame,
-        drive_cos=integral(np.cos(phase)),
-        force=integral(measurement.F),
-        moulding=acc2 + g * ones,
-        acc2=acc2,
-        ones=ones,
-        kinematics={"1": kin1, "2": kin2},
-        cycle=np.floor((t[centres] - t[0]) / scenario.period).astype(int),
-        centre=t[centres],
-        half_width=hs,
-    )
+    return {
+        "frame": frame,
+        "drive_cos": integral(data.cos),
+        "force": integral(data.F),
+        "moulding": acc2 + data.g * ones,
+        "acc2": acc2,
+        "ones": ones,
+        "kinematics": {"1": kin1, "2": kin2},
+        "centre": data.t[centres],
+    }

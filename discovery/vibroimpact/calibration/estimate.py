@@ -19,6 +19,9 @@ from .equations import FRAME_TERMS
 
 __all__ = ["Estimate", "estimate", "cycle_draws", "parameter_names", "drive_phase"]
 
+#: the fewest contact windows for the force's equations to use them alone
+MIN_ANCHORED = 3
+
 
 def parameter_names(n_records):
     """``m1, c1, k1, k3``, one ``A`` per record (``A`` alone for one record, else ``A[1]``,
@@ -77,9 +80,9 @@ def _blocks(rows, pick=None):
     :func:`parameter_names`: the frame (``y = -int phi F``), the moulding
     (``y = int phi F``) and their sum, the momentum balance (``y = 0``)."""
     R = len(rows)
-    frame, mould, f = [], [], []
+    frame, mould, f, anchored = [], [], [], []
     for r, row in enumerate(rows):
-        sel = slice(None) if pick is None else pick[r]
+        sel = np.arange(row.n_windows) if pick is None else pick[r]
         fr = row.frame[sel]
         X = np.zeros((fr.shape[0], 5 + R))
         X[:, :4] = fr[:, :4]
@@ -89,8 +92,18 @@ def _blocks(rows, pick=None):
         frame.append(X)
         mould.append(M)
         f.append(row.force[sel])
+        anchored.append(row.anchored[sel])
     frame, mould, f = np.vstack(frame), np.vstack(mould), np.concatenate(f)
-    return (frame, -f), (mould, f), (frame + mould, np.zeros_like(f))
+    anchored = np.concatenate(anchored)
+    # the force's equations on the contacts' own windows where there are enough (see
+    # MachineRows.anchored), the balance on the evenly spread ones
+    force = anchored if anchored.sum() >= MIN_ANCHORED else ~anchored
+    even = ~anchored
+    return (
+        (frame[force], -f[force]),
+        (mould[force], f[force]),
+        (frame[even] + mould[even], np.zeros(int(even.sum()))),
+    )
 
 
 def _solve(X, y, held):
@@ -215,15 +228,18 @@ def drive_phase(rows, draws):
     R = len(rows)
 
     def fit(pick):
-        X, y = _blocks(rows, pick)[0]
-        X = X[:, :-1]
-        cos = np.zeros((X.shape[0], R))
-        start = 0
+        blocks, ys = [], []
         for r, row in enumerate(rows):
-            c = row.drive_cos if pick is None else row.drive_cos[pick[r]]
-            cos[start : start + c.size, r] = c
-            start += c.size
-        th = _solve(np.hstack([X, cos]), y, np.full(X.shape[1] + R, np.nan))
+            sel = np.arange(row.n_windows) if pick is None else pick[r]
+            sel = sel[~row.anchored[sel]]
+            X = np.zeros((sel.size, 4 + 2 * R))
+            X[:, :4] = row.frame[sel, :4]
+            X[:, 4 + r] = row.frame[sel, 4]
+            X[:, 4 + R + r] = row.drive_cos[sel]
+            blocks.append(X)
+            ys.append(-row.force[sel])
+        X, y = np.vstack(blocks), np.concatenate(ys)
+        th = _solve(X, y, np.full(X.shape[1], np.nan))
         return np.degrees(np.arctan2(th[4 + R :], th[4 : 4 + R]))
 
     phase = fit(None)

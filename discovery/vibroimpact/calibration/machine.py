@@ -250,17 +250,18 @@ def _series(row, sheet, record):
     """The figure's series of one record: the force its motions imply over each window,
     with the ``sheet``'s and the ``record``'s parameters (each ``m1, c1, k1, k3, A, m2``)."""
 
+    even = ~row.anchored  # the evenly spread windows, in time order
+    fr, ones = row.frame[even], row.ones[even]
+    mould = row.moulding[even] / ones
+
     def frame(p):
-        return -(row.frame @ np.asarray(p[:5], dtype=float)) / row.ones
+        return -(fr @ np.asarray(p[:5], dtype=float)) / ones
 
     return {
-        "t": row.centre,
-        "measured": row.force / row.ones,
+        "t": row.centre[even],
+        "measured": row.force[even] / ones,
         "frame": {"sheet": frame(sheet), "record": frame(record)},
-        "moulding": {
-            "sheet": row.moulding * sheet[5] / row.ones,
-            "record": row.moulding * record[5] / row.ones,
-        },
+        "moulding": {"sheet": mould * sheet[5], "record": mould * record[5]},
     }
 
 

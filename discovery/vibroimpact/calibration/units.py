@@ -52,14 +52,15 @@ def kinematic_ratio(rows, body):
 def free_fall(rows):
     """``(m2, g)`` of the fit ``int phi F = m2 int phi w2'' + m2 g int phi`` over the
     windows with contact, or ``(nan, nan)`` when the record has too few contacts."""
-    f = rows.force
+    even = ~rows.anchored
+    f = rows.force[even]
     scale = float(np.max(np.abs(f))) if f.size else 0.0
     if scale == 0:
         return math.nan, math.nan
     contact = np.abs(f) > 0.05 * scale
     if contact.sum() < MIN_CONTACT_WINDOWS or contact.all():
         return math.nan, math.nan
-    X = np.column_stack([rows.acc2, np.full(f.size, rows.ones)])
+    X = np.column_stack([rows.acc2[even], rows.ones[even]])
     a, b = np.linalg.lstsq(X, f, rcond=None)[0]
     return float(a), float(b / a) if a != 0 else math.nan
 

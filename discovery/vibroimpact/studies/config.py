@@ -65,8 +65,14 @@ FACTORS = {
     "library": "poly:2",
     "selection": "best-subset",
     "refine": True,
+    "sheet_error": 0.0,
+    "machine": "sheet",
 }
-"""Every factor a study may vary, with its default."""
+"""Every factor a study may vary, with its default.  ``sheet_error`` makes the fit's
+machine a designer's sheet off the one that made the records: each of ``m1, m2, k1, A``
+off by a uniform draw within +- that share and ``c1`` within +- three times it (seeded by
+the run).  ``machine`` is what the fit takes: ``"sheet"`` (the scenario, or the sheet) or
+``"record"`` (calibrated from the records, :func:`~discovery.calibrate`)."""
 
 _FIT_KEYS = (
     "max_terms",
@@ -231,7 +237,14 @@ def _check_law(name, value, source):
     parse_law(value)
 
 
+def _check_machine(name, value, source):
+    if value not in ("record", "sheet"):
+        _fail(source, f'machine values are "record" or "sheet"; got {value!r}')
+
+
 _FACTOR_CHECKS = {
+    "sheet_error": _check_noise,
+    "machine": _check_machine,
     "force_noise": _check_noise,
     "motion_noise": _check_noise,
     "periods": _check_periods,
@@ -277,7 +290,13 @@ def _resolve(cell, fit, record, seed, cache=None):
             # a named model keeps its name (the truth a contact-models fit is scored by)
             cache[lk] = parse_law(law).to_text() if not is_model_text(law) else law
         law = cache[lk]
+    # the machine's factors are in a run's description only when set: the runs of a study
+    # that does not vary them keep their keys
+    machine = {
+        k: cell[k] for k in ("sheet_error", "machine") if cell.get(k, FACTORS[k]) != FACTORS[k]
+    }
     return {
+        **machine,
         "law": law,
         "scenarios": [dict(d) for d in scenario_dicts],
         "force_noise": float(cell["force_noise"]),

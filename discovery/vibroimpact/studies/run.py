@@ -183,10 +183,40 @@ def score_contact(result, truth_text):
     }
 
 
+#: the sheet's error of each parameter, in units of the run's ``sheet_error``
+SHEET_SPREAD = {"m1": 1.0, "m2": 1.0, "k1": 1.0, "c1": 3.0, "A": 1.0}
+
+
+def _machine(spec, scenarios, records):
+    """The machine the run's fit takes (the factors ``sheet_error`` and ``machine``), its
+    scale's range (``None`` unless calibrated) and the measures of the sheet and the
+    calibration against the machine that made the records."""
+    error = float(spec.get("sheet_error", 0.0))
+    rng = np.random.default_rng(np.random.SeedSequence([spec["seed"], 47]))
+    draws = {p: rng.uniform(-1.0, 1.0) * error * f for p, f in SHEET_SPREAD.items()}
+    sheets = [
+        sc.replace(**{p: getattr(sc, p) * (1 + d) for p, d in draws.items()}) if error else sc
+        for sc in scenarios
+    ]
+    out = {}
+    if error:
+        out["sheet"] = {p: getattr(sheets[0], p) / getattr(scenarios[0], p) - 1 for p in draws}
+    if spec.get("machine", "sheet") != "record":
+        return sheets, None, out
+    from ..calibration import calibrate
+
+    cal = calibrate(sheets, records, seed=spec["seed"])
+    out["calibrated"] = {
+        p: getattr(cal.scenarios[0], p) / getattr(scenarios[0], p) - 1 for p in draws
+    }
+    return list(cal.scenarios), cal.scale_range, out
+
+
 def _fit(spec, scenarios, records):
     """The run's fit and its measures (``discover``, or the named contact models)."""
     from ..fit.discovery import discover
 
+    scenarios, scale, machine = _machine(spec, scenarios, records)
     scs = scenarios if len(scenarios) > 1 else scenarios[0]
     recs = records if len(records) > 1 else records[0]
     if spec["library"] == "contact-models":
@@ -196,7 +226,7 @@ def _fit(spec, scenarios, records):
         result = fit_contact_models(
             scs, recs, n_boot=spec["fit"].get("n_boot_intervals", 0), seed=spec["seed"], **opts
         )
-        return score_contact(result, spec["law"])
+        return {**score_contact(result, spec["law"]), **machine}
     result = discover(
         scs,
         recs,
@@ -204,9 +234,10 @@ def _fit(spec, scenarios, records):
         selection=spec["selection"],
         refine=spec["refine"],
         seed=spec["seed"],
+        machine_scale=scale,
         **spec["fit"],
     )
-    return score(result, parse_law(spec["law"]))
+    return {**score(result, parse_law(spec["law"])), **machine}
 
 
 #: relative cost of a selection method per run (measured on the paper study: the

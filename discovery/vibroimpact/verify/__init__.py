@@ -20,6 +20,7 @@ _EXPORTS = {
     "NoiseFloorSettings": "noise_bootstrap",
     "Reference": "reference",
     "VerifyResult": "verdict",
+    "VerifySettings": "verdict",
     "verify": "verdict",
 }
 
@@ -32,6 +33,7 @@ __all__ = [
     "NoiseFloorSettings",
     "verify",
     "VerifyResult",
+    "VerifySettings",
     "CONSISTENCY_CRITERIA",
     "CONSISTENCY_FACTOR",
     "CONSISTENCY_FACTORS",

@@ -7,6 +7,7 @@ import numpy as np
 
 from ..._printing import readable
 from ..._result import Result, part
+from ..._settings import Settings, option, takes
 from ..._validate import Real, params
 from ...errors import InputError
 from ..data.measurement import Measurement
@@ -17,7 +18,7 @@ from .criteria import criteria_lines
 from .evaluation import Evaluation, evaluate
 from .reference import Reference
 
-__all__ = ["VerifyResult", "verify"]
+__all__ = ["VerifyResult", "VerifySettings", "verify"]
 
 
 def _contacts(n):
@@ -237,28 +238,21 @@ def _profiled_scale(scenario, law, ref, bounds, tolerances):
     )
 
 
-@params(
-    scenario=Scenario,
-    measurement=(Measurement, Reference),
-    law=ForceLaw,
-    time_offset=Real(),
-    n_boot=Real(0, integer=True),
-    seed=Real(0, integer=True),
-    tolerances=(Tolerances, None),
-    machine_scale=(tuple, list, None),
-)
-def verify(
-    scenario,
-    measurement,
-    law,
-    *,
-    time_offset=0.0,
-    n_boot=16,
-    seed=0,
-    check_default_start=True,
-    tolerances=None,
-    machine_scale=None,
-):
+@dataclass(frozen=True, repr=False)
+class VerifySettings(Settings):
+    """The options of :func:`verify` (each is also a keyword of it; see its parameters)."""
+
+    time_offset: float = option(0.0, Real())
+    n_boot: int = option(16, Real(0, integer=True))
+    seed: int = option(0, Real(0, integer=True))
+    check_default_start: bool = option(True, (bool, np.bool_))
+    tolerances: object = option(None, (Tolerances, None))
+    machine_scale: object = option(None, (tuple, list, None))
+
+
+@takes(VerifySettings)
+@params(scenario=Scenario, measurement=(Measurement, Reference), law=ForceLaw)
+def verify(scenario, measurement, law, *, settings=None, **options):
     """Verify ``law`` against a record by full simulation.
 
     Parameters
@@ -269,6 +263,8 @@ def verify(
         The record (``t``, ``F``; ``w1, w2`` [``v1, v2``] for the measured state and the
         exact onsets), or an already prepared :class:`Reference`.
     law : ForceLaw
+    settings : VerifySettings, optional
+        The options below in one object; keywords override its fields.
     time_offset : float
         Drive-clock time [s] of the record's ``t = 0`` (0 when the record follows the
         convention that the drive ``A sin(2 pi f t)`` has phase 0 at ``t = 0``).
@@ -291,32 +287,33 @@ def verify(
     -------
     VerifyResult
     """
+    s = VerifySettings.of("verify", settings, options)
     t0 = time.perf_counter()
     ref = (
         measurement
         if isinstance(measurement, Reference)
         else Reference.from_measurement(
-            measurement, scenario, time_offset=time_offset, n_boot=n_boot, seed=seed
+            measurement, scenario, time_offset=s.time_offset, n_boot=s.n_boot, seed=s.seed
         )
     )
     notes = []
-    if machine_scale is not None:
-        scenario, note = _profiled_scale(scenario, law, ref, machine_scale, tolerances)
+    if s.machine_scale is not None:
+        scenario, note = _profiled_scale(scenario, law, ref, s.machine_scale, s.tolerances)
         notes.append(note)
-    ev = evaluate(scenario, law, ref, tolerances=tolerances)
+    ev = evaluate(scenario, law, ref, tolerances=s.tolerances)
     other = None
-    if check_default_start and ref.start is not None:
-        other = evaluate(scenario, law, ref, tolerances=tolerances, from_state=False, floor=False)
+    if s.check_default_start and ref.start is not None:
+        other = evaluate(scenario, law, ref, tolerances=s.tolerances, from_state=False, floor=False)
         note = _default_start_note(ev, other)
         if note:
             notes.append(note)
-    settings = {
-        "time_offset": time_offset,
-        "n_boot": n_boot,
-        "seed": seed,
-        "check_default_start": check_default_start,
-        "tolerances": None if tolerances is None else tolerances.as_dict(),
-        "machine_scale": None if machine_scale is None else list(machine_scale),
+    recorded = {
+        "time_offset": s.time_offset,
+        "n_boot": s.n_boot,
+        "seed": s.seed,
+        "check_default_start": s.check_default_start,
+        "tolerances": None if s.tolerances is None else s.tolerances.as_dict(),
+        "machine_scale": None if s.machine_scale is None else list(s.machine_scale),
     }
     return VerifyResult(
         law=law,
@@ -325,5 +322,5 @@ def verify(
         default_start=other,
         notes=tuple(notes),
         seconds=time.perf_counter() - t0,
-        settings=settings,
+        settings=recorded,
     )

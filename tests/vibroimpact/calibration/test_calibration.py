@@ -38,15 +38,14 @@ def paper_record():
     return sc, _record(sc, sc.law)
 
 
-@pytest.mark.parametrize("fs, scale_tol", [(20000.0, 0.015), (19310.0, 0.005)])
-def test_an_exact_record_gives_its_machine_ratios_exactly_and_its_scale_to_quadrature(
-    fs, scale_tol
-):
+@pytest.mark.parametrize("fs", [10000.0, 20000.0, 19310.0])
+def test_an_exact_record_gives_its_machine_ratios_exactly_and_its_scale_to_quadrature(fs):
     """Noise-free, from a sheet 10-30 % off: the ratios to m1 within 1e-4 (the momentum
-    balance holds no force and the motions are smooth); the scale, which only the force's
-    quadrature sets, within 1.5 % where the samples fall at the same phase every period
-    (800 a period: the onset's force jump is cut the same way each time, measured +0.96 %)
-    and 0.5 % where they do not (measured -0.21 %)."""
+    balance holds no force and the motions are smooth); the scale within 0.1 %, also where
+    the samples fall at the same phase every period (400 and 800 a period).  The paper's
+    force jumps to 7.8 MN at the onset and decays in a few samples: evenly spread windows
+    put the scale -5 % off at 10 kHz (the jump cut the same way every period), the
+    contacts' own windows, whose test function vanishes at the jump, 0.02 %."""
     sc = load_scenario("paper")
     m = reference_record(
         (sc, sc.law), periods=20, fs=fs, force_noise=0, motion_noise=0, check=False
@@ -54,7 +53,7 @@ def test_an_exact_record_gives_its_machine_ratios_exactly_and_its_scale_to_quadr
     cal = calibrate(sc.replace(m2=0.9 * sc.m2, c1=1.3 * sc.c1, k1=1.1 * sc.k1), m)
     got = cal.scenario
     scale = got.m1 / sc.m1
-    assert scale == pytest.approx(1.0, abs=scale_tol)
+    assert scale == pytest.approx(1.0, abs=1e-3)
     for p in PARAMS:
         assert getattr(got, p) / getattr(sc, p) == pytest.approx(scale, rel=1e-4), p
     assert all(cal.parameters[p]["determined"] for p in PARAMS)
