@@ -9,6 +9,13 @@ the equations that carry the force's noise, and those two set the one number the
 cannot, the machine's scale.  The blocks are weighted by the inverse RMS of their
 residuals.  ``m1, c1, k1, k3, m2`` are shared by the records; each has its own drive
 amplitude ``A``.  A parameter may be held (its column moves to the right-hand side).
+
+The scale is fitted twice: with the force's equations on each contact's own window, whose
+test function vanishes at the onset's force jump (unbiased whatever the sampling, see
+:attr:`~.equations.MachineRows.anchored`), and on the evenly spread windows, which weigh the
+whole impulse (tighter where the force's noise dominates, biased where a jump falls between
+the same two samples every period).  Where the two agree within :data:`AGREE` combined
+standard errors the tighter one is used, else the first; the intervals span both.
 """
 
 from dataclasses import dataclass
@@ -21,6 +28,8 @@ __all__ = ["Estimate", "estimate", "cycle_draws", "parameter_names", "drive_phas
 
 #: the fewest contact windows for the force's equations to use them alone
 MIN_ANCHORED = 3
+#: the two window sets' scales agree within this many combined standard errors
+AGREE = 3.0
 
 
 def parameter_names(n_records):
@@ -75,7 +84,7 @@ def cycle_draws(rows, n_boot, seed):
     return draws
 
 
-def _blocks(rows, pick=None):
+def _blocks(rows, pick=None, force_on="contacts"):
     """The three stacked blocks of the design, each ``(X, y)`` with the columns of
     :func:`parameter_names`: the frame (``y = -int phi F``), the moulding
     (``y = int phi F``) and their sum, the momentum balance (``y = 0``)."""
@@ -97,7 +106,8 @@ def _blocks(rows, pick=None):
     anchored = np.concatenate(anchored)
     # the force's equations on the contacts' own windows where there are enough (see
     # MachineRows.anchored), the balance on the evenly spread ones
-    force = anchored if anchored.sum() >= MIN_ANCHORED else ~anchored
+    contacts = force_on == "contacts" and anchored.sum() >= MIN_ANCHORED
+    force = anchored if contacts else ~anchored
     even = ~anchored
     return (
         (frame[force], -f[force]),
@@ -137,7 +147,7 @@ def _block_weights(blocks, theta):
 ROUNDS = 4
 
 
-def _fit(rows, held, pick=None, weights=None):
+def _fit(rows, held, pick=None, weights=None, force_on="contacts"):
     """The machine from the three blocks of :func:`_blocks`: the ratios to ``m1`` from the
     balance, the scale from the two equations that hold the force, in turn (a held
     parameter enters the balance at its value over the current scale).
@@ -147,7 +157,7 @@ def _fit(rows, held, pick=None, weights=None):
     force noise), so it only ever sees the ratios.  ``weights`` (of the frame's and the
     moulding's equations, the inverse RMS of their residuals) are found on the first call.
     Returns ``(theta, weights)``."""
-    frame, mould, balance = _blocks(rows, pick)
+    frame, mould, balance = _blocks(rows, pick, force_on)
     theta = _weighted_solve((frame, mould), weights or (1.0, 1.0), held)
     if weights is None:
         weights = _block_weights((frame, mould), theta)
@@ -193,12 +203,9 @@ def estimate(rows, fixed, draws):
     """
     names = parameter_names(len(rows))
     held = np.array([fixed.get(n, np.nan) for n in names], dtype=float)
-    value, weights = _fit(rows, held)
-    boot = np.array([_fit(rows, held, pick, weights)[0] for pick in draws])
-    if len(draws):
-        low, high = np.nanpercentile(boot, [2.5, 97.5], axis=0)
-    else:
-        low = high = np.full(len(names), np.nan)
+    value, low, high = _choose(
+        _bootstrapped(rows, held, draws, "contacts"), _bootstrapped(rows, held, draws, "even")
+    )
     fixed_mask = ~np.isnan(held)
     low = np.where(fixed_mask, value, low)
     high = np.where(fixed_mask, value, high)
@@ -207,6 +214,33 @@ def estimate(rows, fixed, draws):
         "moulding": moulding_residual(rows, value[-1]),
     }
     return Estimate(names, value, low, high, fixed_mask, residual)
+
+
+def _choose(contacts, even):
+    """The estimate of the two window sets' (see the module docstring): where their scales
+    (``m1``) agree within :data:`AGREE` combined standard errors, the one with the tighter
+    interval, else the contacts' (the evenly spread windows' is biased); the intervals span
+    both, so that a bias of either is inside."""
+    v_c, lo_c, hi_c = contacts
+    v_e, lo_e, hi_e = even
+    if not (np.all(np.isfinite(lo_c[:1])) and np.all(np.isfinite(lo_e[:1]))):
+        return contacts
+    se = np.hypot(hi_c[0] - lo_c[0], hi_e[0] - lo_e[0]) / (2 * 1.96)
+    tighter = v_e if hi_e[0] - lo_e[0] <= hi_c[0] - lo_c[0] else v_c
+    value = tighter if abs(v_e[0] - v_c[0]) <= AGREE * se else v_c
+    return value, np.fmin(lo_c, lo_e), np.fmax(hi_c, hi_e)
+
+
+def _bootstrapped(rows, held, draws, force_on):
+    """``(value, low, high)``: the fit with the force's equations on ``force_on`` windows
+    and its 95 % bootstrap interval."""
+    value, weights = _fit(rows, held, force_on=force_on)
+    if not draws:
+        nan = np.full(value.size, np.nan)
+        return value, nan, nan
+    boot = np.array([_fit(rows, held, pick, weights, force_on)[0] for pick in draws])
+    low, high = np.nanpercentile(boot, [2.5, 97.5], axis=0)
+    return value, low, high
 
 
 def frame_residual(rows, theta_frame):
