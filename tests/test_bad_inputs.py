@@ -208,6 +208,12 @@ CASES = [
     ("law-never-pushes", ["steady", "--law=-1e8*z"], "never pushes the bodies apart"),
     ("law-all-zero", ["steady", "--law", "0*z"], "has no non-zero coefficient"),
     (
+        "law-negative-stiffness",
+        ["steady", "--law=-2.06e8*z + 1.28e7*zd"],
+        "has no elastic force",
+    ),
+    ("verify-law-damper-only", [*V, "--law", "1.28e7*zd"], "has no elastic force"),
+    (
         "law-not-dissipative",
         ["steady", "--law", "2.06e8*z - 1e9*zd"],
         "condition (6), dissipativity",

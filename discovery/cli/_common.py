@@ -216,7 +216,7 @@ def machine_for(args, scenarios, measurements, time_offset=0.0):
 
     scs = list(scenarios)
     for sc, m in zip(scs, measurements, strict=True):  # a time column in ms: said first
-        check_drive_period(m.t, m.F, sc.period, m.source)
+        check_drive_period(m.t, m.F, sc.period, m.source, motion=m.channels.get("w1"))
     cal = calibrate(
         scs, list(measurements), time_offset=time_offset, seed=getattr(args, "seed", 0) or 0
     )

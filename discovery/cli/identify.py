@@ -190,6 +190,11 @@ def run(args):
             "--start is empty; give the terms and start values, e.g. '1.5e8*z + 0.9e7*zd'"
         )
     start = ForceLaw.parse(args.start)
+    if any(c == 0 for c in start.coefficients):  # said before what the zero makes of the law
+        raise InputError(
+            "--start: every start coefficient must be non-zero (they set the scale of the "
+            f"search); got '{start}'"
+        )
     start.check_physical(sc, "--start")
     land = _load_landscape(args.landscape, Landscape, start, sc) if args.landscape else None
     meas = read_record(args, sc)

@@ -39,13 +39,27 @@ MIN_SAMPLES_PER_PERIOD = 20
 836): below it no impact is resolved, and a time column in milliseconds lands there."""
 
 
-def check_drive_period(t, F, period, source=""):
+def _line(t, x, frequency):
+    """The power of ``x``'s line at ``frequency`` [Hz] (its mean and trend removed)."""
+    x = np.asarray(x, dtype=float)
+    x = x - np.polyval(np.polyfit(t - t[0], x, 1), t - t[0])
+    return float(abs(np.sum(x * np.exp(-2j * np.pi * frequency * t))) ** 2)
+
+
+def check_drive_period(t, F, period, source="", motion=None):
     """Refuse a record sampled too coarsely to resolve a drive period (fewer than
     :data:`MIN_SAMPLES_PER_PERIOD` samples in one, e.g. a time column in milliseconds) or
-    whose force repeats at a period that is no whole number of the scenario's drive
-    periods (a record of another machine or drive frequency, or a time column in other
-    units): everything downstream would be meaningless.  A record without a clear period
-    (strength below 0.3: chaos, too short) passes the second check."""
+    made at another drive frequency (a record of another machine, or a time column in
+    other units): everything downstream would be meaningless.
+
+    The force's own period is the first witness: a record whose force repeats at a whole
+    number of drive periods passes, and so does one without a clear period (strength below
+    0.3: chaos, too short).  When it repeats at another period, the drive line decides:
+    the frame's motion ``motion`` (``w1``; the force without it) is driven at the drive's
+    frequency, so a record whose line at the scenario's frequency is at least as strong as
+    at the one the force's period suggests was made by that drive.  Its force does not
+    repeat over the record (a transient from rest still settling, or chaos), which the
+    verdict judges over the record's span."""
     where = f" of {source}" if source else ""
     dt = float(np.median(np.diff(np.asarray(t, dtype=float))))
     if period / dt < MIN_SAMPLES_PER_PERIOD:
@@ -60,6 +74,10 @@ def check_drive_period(t, F, period, source=""):
         return
     r = lag / period
     if abs(r - round(r)) > 0.03:
+        other = round(r) / lag if round(r) else 1 / lag
+        x = F if motion is None else motion
+        if _line(t, x, 1 / period) >= _line(t, x, other):
+            return  # the drive is the scenario's: the force has not settled
         raise InputError(
             f"the force{where} repeats every {lag:.4g} s ({r:.3g} of the scenario's drive "
             f"period {period:.4g} s, i.e. a drive of {round(r) / lag if round(r) else 1 / lag:.4g}"

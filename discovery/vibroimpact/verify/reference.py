@@ -193,7 +193,13 @@ class Reference:
         if not np.isfinite(time_offset):
             raise InputError(f"time offset must be finite, got {time_offset!r}")
         T = scenario.period
-        check_drive_period(measurement.t, measurement.F, T, measurement.source)
+        check_drive_period(
+            measurement.t,
+            measurement.F,
+            T,
+            measurement.source,
+            motion=measurement.channels.get("w1"),
+        )
         E = measurement.impulse(T)
         t = measurement.t
         dt = float(np.median(np.diff(t)))
