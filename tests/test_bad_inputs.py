@@ -210,9 +210,9 @@ CASES = [
     (
         "law-negative-stiffness",
         ["steady", "--law=-2.06e8*z + 1.28e7*zd"],
-        "has no elastic force",
+        "has a negative stiffness",
     ),
-    ("verify-law-damper-only", [*V, "--law", "1.28e7*zd"], "has no elastic force"),
+    ("verify-law-negative-stiffness", [*V, "--law=-2e8*z + 2e7*zd"], "negative stiffness"),
     (
         "law-not-dissipative",
         ["steady", "--law", "2.06e8*z - 1e9*zd"],

@@ -402,10 +402,10 @@ class ForceLaw:
 
         On the box ``0 < zeta <= x``, ``0 <= zd <= 4 v`` (``x, v`` the scenario's motion
         scales, :meth:`Scenario.scales`): the law must push the bodies apart somewhere
-        (else the moulding falls through the grid and no steady state exists), have an
-        elastic force ``P(zeta, 0) > 0`` somewhere (the unloading branch of condition (5):
-        a law of damping alone, or with a negative stiffness, holds nothing apart once the
-        bodies stop), and satisfy the paper's condition (6), dissipativity
+        (else the moulding falls through the grid and no steady state exists), have no
+        negative stiffness (``P(zeta, 0) < 0`` everywhere: the unloading branch of
+        condition (5) would pull the bodies together; damping alone, a template whose
+        stiffness a landscape varies, passes), and satisfy the paper's condition (6), dissipativity
         ``P(zeta, zd) >= P(zeta, 0)`` (damping never feeds energy into an impact).
         Conditions (3)-(5) hold by construction.
         """
@@ -427,13 +427,14 @@ class ForceLaw:
                 "would fall through the grid; a contact law needs a positive stiffness term "
                 "such as 2e8*z"
             )
-        if not np.max(self.polynomial(zz, np.zeros_like(vv))) > 0:
+        elastic = self.polynomial(zz, np.zeros_like(vv))
+        if not np.max(elastic) > 0 and np.min(elastic) < 0:
             raise InputError(
-                f"{what} '{self}' has no elastic force: F(zeta, 0) <= 0 for every "
-                f"penetration up to {Z:.3g} m, so once the bodies stop nothing pushes them "
-                "apart (the unloading follows F(zeta, 0), conditions (4)-(5)) and the "
-                "moulding sinks into the grid; a contact law needs a positive stiffness term "
-                "such as 2e8*z"
+                f"{what} '{self}' has a negative stiffness: F(zeta, 0) < 0 for every "
+                f"penetration up to {Z:.3g} m, an elastic force that pulls the bodies "
+                "together, so once they stop nothing pushes them apart (the unloading "
+                "follows F(zeta, 0), conditions (4)-(5)); make the stiffness positive, "
+                "e.g. 2.06e8*z"
             )
         if any(c < 0 for c in self.unloading_coefficients):
             raise InputError(
