@@ -57,6 +57,18 @@ def add_data_option(parser, help=MEASURED_HELP, *, repeat=False):
     return parser.add_argument("--data", required=True, help=help)
 
 
+def add_time_offset_option(parser, *, needs=None, help_prefix=""):
+    """``--time-offset``: the drive-clock time [s] of the record's ``t = 0`` (default 0)."""
+    return parser.add_argument(
+        "--time-offset",
+        type=number(-1e7, 1e7, unit="s"),
+        default=0.0,
+        needs=needs,
+        help=f"{help_prefix}drive-clock time [s] of the record's t = 0, when the record does "
+        "not start at drive phase 0 (default: %(default)g)",
+    )
+
+
 # ------------------------------------------------------------------ the checks by simulation
 def add_criterion_option(parser, what):
     """``--criterion``: one of the criteria I0..I5 (default I2); ``what`` it is used for."""

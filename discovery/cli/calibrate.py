@@ -7,7 +7,6 @@ from ._common import (
     COLUMNS_HELP,
     check_out,
     data_entry,
-    number,
     outputs_line,
     provenance_of,
     read_records,
@@ -69,12 +68,7 @@ def register(sub):
         repeat=True,
     )
     s.add_argument("--columns", metavar="MAP", help=COLUMNS_HELP)
-    s.add_argument(
-        "--time-offset",
-        type=number(-1e7, 1e7, unit="s"),
-        default=0.0,
-        help="drive-clock time [s] of the records' t = 0 (default: %(default)g)",
-    )
+    _options.add_time_offset_option(s)
     _options.add_n_boot_option(
         s, of="the parameters' intervals (over the record's cycles)", help_suffix=", 1..10000"
     )

@@ -17,7 +17,6 @@ from ._common import (
     executor_of,
     law_or_default,
     machine_for,
-    number,
     outputs_line,
     parse_range,
     provenance_of,
@@ -224,13 +223,7 @@ def register(sub):
         "--range1",
         help="LOW:HIGH of the second coefficient (default: 0.5x..1.5x the template's coefficient)",
     )
-    s.add_argument(
-        "--time-offset",
-        type=number(-1e7, 1e7, unit="s"),
-        default=0.0,
-        needs="--data",
-        help="with --data: drive-clock time [s] of the record's t = 0 (default: %(default)g)",
-    )
+    _options.add_time_offset_option(s, needs="--data", help_prefix="with --data: ")
     _options.add_n_boot_option(s, help_prefix="with --data: ", needs="--data")
     _options.add_seed_option(s, "with --data: seed of the bootstrap", needs="--data")
     s.add_argument(

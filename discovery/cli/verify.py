@@ -10,7 +10,6 @@ from ._common import (
     law_or_default,
     machine_for,
     machine_scale,
-    number,
     outputs_line,
     provenance_of,
     read_record,
@@ -72,13 +71,7 @@ def register(sub):
     _options.add_data_option(s)
     _options.add_law_option(s)
     add_record_options(s)
-    s.add_argument(
-        "--time-offset",
-        type=number(-1e7, 1e7, unit="s"),
-        default=0.0,
-        help="drive-clock time [s] of the record's t = 0, when the record does not "
-        "start at drive phase 0 (default: %(default)g)",
-    )
+    _options.add_time_offset_option(s)
     _options.add_n_boot_option(s, help_suffix=", 1..10000")
     _options.add_seed_option(s, "seed of the bootstrap, >= 0", most=None)
     s.add_argument(
