@@ -275,7 +275,7 @@ def _machine_rows(machine):
         used = "record" if p.get("determined") else ("sheet (held)" if p.get("held") else "sheet")
         rows.append(
             [
-                Tex(escape(name) + r"\ " + unit_tex(p.get("unit", ""))),
+                Tex(escape(name) + r" [" + unit_tex(p.get("unit", "")) + "]"),
                 num(p.get("sheet")),
                 Tex(num(p.get("record")) + " " + interval),
                 used,

@@ -104,3 +104,19 @@ def test_the_readme_s_scipy_record_from_rest_is_verified_not_refused(tmp_path, c
     assert main([*args, "--out", str(rec)]) == 0
     assert main(["verify", "--data", str(rec), "--law", law, "--out", str(tmp_path / "v")]) == 0
     assert ": consistent" in capsys.readouterr().out
+
+
+@needs_corpus
+def test_the_reports_show_the_machine_used(tmp_path):
+    """A calibrate run's report and a verify run's report, with the calibrated machine, both
+    hold the table sheet vs record."""
+    cal, ver = tmp_path / "cal", tmp_path / "ver"
+    assert main(["calibrate", *_args(), "--n-boot", "30", "--out", str(cal)]) == 0
+    law = ["--law", "1.5e8*z + 5e6*zd"]
+    assert main(["verify", *_args(), *law, "--n-boot", "8", "--out", str(ver)]) == 0
+    for run in (cal, ver):
+        assert main(["report", str(run), "--no-pdf"]) == 0
+        tex = (run / "report.tex").read_text()
+        assert "The machine as the record shows it" in tex and "record (95 \\% interval)" in tex
+        assert "m2 [" in tex
+    assert "the machine calibrated from" in (ver / "report.tex").read_text()
