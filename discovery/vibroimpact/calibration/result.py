@@ -11,10 +11,10 @@ __all__ = ["Calibration", "UNITS"]
 
 #: each calibrated parameter's unit
 UNITS = {"m1": "kg", "m2": "kg", "k1": "N/m", "c1": "N s/m", "k3": "N/m^3", "A": "N"}
-#: the least relative uncertainty granted the machine's scale: the force's quadrature alone
-#: put it 0.8-1.3 % off on noise-free records of stiff, heavily damped contacts, whose
-#: impulse lies in a few samples (the bootstrap over cycles does not see a bias)
-SCALE_FLOOR = 0.02
+#: the least relative uncertainty granted the machine's scale: a bias the bootstrap over
+#: cycles cannot see (the force's quadrature; noise-free, the contacts' windows leave at
+#: most 0.5 % on stiff, heavily damped contacts whose impulse lies in a few samples)
+SCALE_FLOOR = 0.01
 #: what each parameter is, for the lines a command prints
 WHAT = {
     "m1": "grid frame's mass",
