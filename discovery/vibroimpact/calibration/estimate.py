@@ -6,9 +6,10 @@ Three equations hold in every window: the frame's, the moulding's and their sum,
 momentum balance of the two bodies.  The balance holds no force: it fixes the machine's
 ratios (``m2/m1``, ``c1/m1``, ``k1/m1``, ``A/m1``) from the motions alone, far tighter than
 the equations that carry the force's noise, and those two set the one number the motions
-cannot, the machine's scale.  The blocks are weighted by the inverse RMS of their
-residuals.  ``m1, c1, k1, k3, m2`` are shared by the records; each has its own drive
-amplitude ``A``.  A parameter may be held (its column moves to the right-hand side).
+cannot, the machine's scale (the frame's and the moulding's weighted by the inverse RMS of
+their residuals).  Ratios and scale are fitted in turn: in one least squares with the others
+the balance, which is homogeneous, would pull the whole machine toward zero.
+``m1, c1, k1, k3, m2`` are shared by the records; each has its own drive amplitude ``A``.  A parameter may be held (its column moves to the right-hand side).
 
 The scale is fitted twice: with the force's equations on each contact's own window, whose
 test function vanishes at the onset's force jump (unbiased whatever the sampling, see
