@@ -216,3 +216,48 @@ def test_explain_names_both_hidden_effects_on_c12(records):
     assert res.consistent
     got = res.final_model.law.as_dict()
     assert got["z"] == pytest.approx(law.as_dict()["z"], rel=0.15)
+
+
+# ------------------------------------------- c14-c16: the scenario is a sheet a few percent off
+def _sheet_record(name):
+    """A sheet record with the machine as the record shows it and its scale's range."""
+    d = CORPUS / name
+    sheet = load_scenario(str(d / "scenario.toml"))
+    m = Measurement.from_csv(str(d / "measured.csv"))
+    cal = calibrate(sheet, m)
+    truth = json.loads((d / "truth.json").read_text())
+    return cal, m, ForceLaw.parse(truth["law"]), truth
+
+
+def _holds(intervals, law):
+    return {
+        n: intervals.bounds[n][0] <= c <= intervals.bounds[n][1] for n, c in law.as_dict().items()
+    }
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["c14-heavy-moulding", "c15-support-guess"])
+def test_fit_on_a_sheet_record_selects_the_true_support_with_intervals_that_hold(name):
+    """Issue 47: with the calibrated machine, `fit` selects the true support, and its
+    intervals of the forces (widened by the machine's scale range) hold the true law."""
+    cal, m, law, _ = _sheet_record(name)
+    res = discover(cal.scenario, m, library="poly:2", machine_scale=cal.scale_range)
+    sel = res.selected
+    assert sorted(sel.law.names) == sorted(law.names) and sel.consistent, sel.verdict
+    assert all(_holds(sel.intervals, law).values()), (sel.intervals.bounds, law)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "name, effect",
+    [("c15-support-guess", "penetration_velocity_coupling"), ("c16-all-off", "unloading_damping")],
+)
+def test_explain_on_a_sheet_record_names_the_contact_effect_not_the_machine(name, effect):
+    """Issue 47: from the linear start, with the calibrated machine, `explain` names the
+    hidden contact effect first and no machine effect (mass loss, support nonlinearity)."""
+    cal, m, _, _ = _sheet_record(name)
+    res = explain(cal.scenario, m, "linear", workers=1, n_boot_intervals=0)
+    named = _named(res)
+    assert named[:1] == [effect], [it.evidence for it in res.iterations]
+    assert not {"mass_loss", "support_nonlinearity"} & set(named)
+    assert res.consistent, res.stopped_because
