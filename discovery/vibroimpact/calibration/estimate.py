@@ -9,7 +9,8 @@ the equations that carry the force's noise, and those two set the one number the
 cannot, the machine's scale (the frame's and the moulding's weighted by the inverse RMS of
 their residuals).  Ratios and scale are fitted in turn: in one least squares with the others
 the balance, which is homogeneous, would pull the whole machine toward zero.
-``m1, c1, k1, k3, m2`` are shared by the records; each has its own drive amplitude ``A``.  A parameter may be held (its column moves to the right-hand side).
+``m1, c1, k1, k3, m2`` are shared by the records; each has its own drive amplitude ``A``.
+A parameter may be held (its column moves to the right-hand side).
 
 The scale is fitted twice: with the force's equations on each contact's own window, whose
 test function vanishes at the onset's force jump (unbiased whatever the sampling, see

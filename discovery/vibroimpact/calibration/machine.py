@@ -121,8 +121,9 @@ def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, kee
         )
         if out is None:
             notes.append(
-                "the records' equations are degenerate (no contact or no motion); "
-                "the sheet's machine is used"
+                "the record pins none of the machine's parameters (its force does not "
+                "follow its motions: no contact, or a force channel that is not the "
+                "contact's); the scenario's machine is used"
             )
             continue
         group_params, group_scenarios, group_residual, group_notes, phase, group_series = out
@@ -200,6 +201,8 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
         v, lo, hi = first.value[k], first.low[k], first.high[k]
         if not (v > 0 and np.isfinite(lo) and lo > 0 and (hi - lo) / 2 <= LOOSE * v):
             loose[name] = sheet_values[name]
+    if len(loose) == int((~first.fixed).sum()):
+        return None  # the record pins nothing: its force does not follow its motions
     final = estimate(rows, {**held, **loose}, draws) if loose else first
     parameters, notes = {}, []
     for k, name in enumerate(final.names):

@@ -26,6 +26,8 @@ RATIO_BAND = (0.5, 2.0)
 MASS_BAND = 3.0
 #: the fewest windows with contact for the free-fall and mass checks
 MIN_CONTACT_WINDOWS = 3
+#: a record's contacts stand out: its largest window force over its median one
+CONTRAST = 20.0
 
 _NAMES = {
     1e3: "mm (mm/s)",
@@ -60,8 +62,14 @@ def free_fall(rows):
     contact = np.abs(f) > 0.05 * scale
     if contact.sum() < MIN_CONTACT_WINDOWS or contact.all():
         return math.nan, math.nan
+    if scale < CONTRAST * float(np.median(np.abs(f))):
+        return math.nan, math.nan  # no flight with the force at rest: no contact to judge
     X = np.column_stack([rows.acc2[even], rows.ones[even]])
-    a, b = np.linalg.lstsq(X, f, rcond=None)[0]
+    (a, b), *_ = np.linalg.lstsq(X, f, rcond=None)
+    r = f - X @ np.array([a, b])
+    cov = np.linalg.pinv(X.T @ X) * float(r @ r) / max(1, f.size - 2)
+    if not abs(a) > 5.0 * math.sqrt(max(cov[0, 0], 0.0)):
+        return math.nan, math.nan  # the force does not follow the moulding's motion
     return float(a), float(b / a) if a != 0 else math.nan
 
 

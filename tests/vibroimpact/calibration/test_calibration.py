@@ -160,3 +160,13 @@ def test_the_sheet_turns_the_true_law_false_and_the_record_s_machine_does_not():
     law = ForceLaw.parse(truth["law"])
     assert not verify(sc, m, law, check_default_start=False).consistent
     assert verify(calibrate(sc, m).scenario, m, law, check_default_start=False).consistent
+
+
+def test_a_force_that_does_not_follow_the_motions_keeps_the_sheet(paper_record):
+    """A force channel of noise beside motions with impacts (a wrong column, a dead sensor)
+    pins nothing: the sheet is kept with one note, and no unit or sign is claimed."""
+    sc, m = paper_record
+    noise = 1e-3 * np.random.default_rng(0).standard_normal(m.F.size)
+    cal = calibrate(sc, Measurement(t=m.t, F=noise, channels=m.channels))
+    assert not cal.calibrated and cal.scenario == sc
+    assert "pins none of the machine's parameters" in cal.notes[0]
