@@ -6,6 +6,7 @@ signs a record contradicts."""
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from discovery import ForceLaw, Measurement, calibrate, load, load_scenario
