@@ -62,6 +62,11 @@ def calibration_figure(result, stem):
             )
             ax.set_ylabel("window mean force [kN]")
             ax.set_title(label, fontsize="small")
-        axes[0].legend(fontsize="x-small", loc="center")
+        fig.legend(
+            *axes[0].get_legend_handles_labels(),
+            loc="outside upper center",
+            ncols=3,
+            fontsize="x-small",
+        )
         axes[1].set_xlabel("t [s]")
         return save(fig, stem)
