@@ -62,8 +62,6 @@ class MachineRows:
         The drive period each window's centre lies in (the bootstrap's blocks).
     centre : ndarray
         The windows' centre times [s].
-    half_width : int
-        Samples on each side of an evenly spread window's centre.
     anchored : ndarray of bool
         The windows of one contact each, from the last sample before it to the first
         after it (the rest are spread evenly).  A stiff, damped contact's force jumps at
@@ -84,7 +82,6 @@ class MachineRows:
     kinematics: dict
     cycle: np.ndarray
     centre: np.ndarray
-    half_width: int
     anchored: np.ndarray
 
     @property
@@ -167,7 +164,6 @@ def machine_rows(measurement, scenario, time_offset=0.0):
         kinematics=regular["kinematics"],
         cycle=np.floor((centre - t[0]) / scenario.period).astype(int),
         centre=centre,
-        half_width=hs,
         anchored=anchored,
     )
 

@@ -2,12 +2,14 @@
 
 import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..._validate import Real, params
 from ...errors import InputError
 from ..data.measurement import Measurement
+from ..data.periods import check_drive_period
 from ..model.scenario import Scenario
 from .equations import machine_rows
 from .estimate import cycle_draws, drive_phase, estimate, frame_residual, moulding_residual
@@ -70,9 +72,70 @@ def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, kee
     ------
     InputError
         When a record's units or signs contradict any machine (positions in mm, a force
-        in kN, motions measured downwards): one line naming the likely cause.
+        in kN, motions measured downwards), or its sampling or drive frequency the sheet's
+        (:func:`~discovery.vibroimpact.data.periods.check_drive_period`): one line naming
+        the likely cause.
     """
     t_start = time.perf_counter()
+    meas, sheets, offsets, keep = _inputs(scenario, measurement, time_offset, keep)
+    for m, s in zip(meas, sheets, strict=True):  # a time column in ms is said as such first
+        check_drive_period(m.t, m.F, s.period, m.source, motion=m.channels.get("w1"))
+    rows = [machine_rows(m, s, float(o)) for m, s, o in zip(meas, sheets, offsets, strict=True)]
+    for r, m, s in zip(rows, meas, sheets, strict=True):
+        if r is not None:
+            check_units(r, s, m.source)
+    notes, parameters, residual, series = [], {}, {}, None
+    phases = [(0.0, math.nan, math.nan)] * len(meas)
+    used = list(sheets)
+    groups = {}
+    for k, s in enumerate(sheets):
+        groups.setdefault(_machine_key(s), []).append(k)
+    for members in groups.values():
+        notes += [_uncalibrated_note(meas[k], sheets[k]) for k in members if rows[k] is None]
+        members = [k for k in members if rows[k] is not None]
+        if not members:
+            continue
+        group = _calibrate_group(
+            [rows[k] for k in members], [sheets[k] for k in members], keep, n_boot, seed
+        )
+        if group is None:
+            notes.append(
+                "the record pins none of the machine's parameters (its force does not "
+                "follow its motions: no contact, or a force channel that is not the "
+                "contact's); the scenario's machine is used"
+            )
+            continue
+        series = series or group.series
+        for k, sc, ph in zip(members, group.scenarios, group.phases, strict=True):
+            used[k] = sc
+            phases[k] = ph
+        prefix = "" if len(groups) == 1 else f"records {', '.join(str(k + 1) for k in members)}: "
+        parameters.update({prefix + n: v for n, v in group.parameters.items()})
+        residual = group.residual if len(groups) == 1 else {**residual, prefix: group.residual}
+        notes += group.notes
+    return Calibration(
+        sheet=tuple(sheets),
+        scenarios=tuple(used),
+        parameters=parameters,
+        phase=tuple(phases),
+        residual=residual,
+        calibrated=bool(parameters),
+        notes=tuple(notes + _phase_notes(phases, sheets)),
+        settings={
+            "time_offset": offsets,
+            "n_boot": n_boot,
+            "seed": seed,
+            "keep": list(keep),
+            "loose": LOOSE,
+        },
+        seconds=time.perf_counter() - t_start,
+        series=series,
+    )
+
+
+def _inputs(scenario, measurement, time_offset, keep):
+    """The records, one sheet and one time offset for each, and the held parameters,
+    checked: ``(measurements, sheets, offsets, keep)``."""
     meas = _listed(measurement)
     sheets = _listed(scenario)
     if len(sheets) == 1:
@@ -92,70 +155,35 @@ def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, kee
         raise InputError(
             f"calibrate: keep names {bad[0]!r}; the parameters are {', '.join(CALIBRATED)}"
         )
-    rows = [machine_rows(m, s, float(o)) for m, s, o in zip(meas, sheets, offsets, strict=True)]
-    for r, m, s in zip(rows, meas, sheets, strict=True):
-        if r is not None:
-            check_units(r, s, m.source)
-    settings = {
-        "time_offset": offsets,
-        "n_boot": n_boot,
-        "seed": seed,
-        "keep": list(keep),
-        "loose": LOOSE,
-    }
-    notes, parameters, residual, series = [], {}, {}, None
-    phases = [(0.0, math.nan, math.nan)] * len(meas)
-    used = list(sheets)
-    groups = {}
-    for k, s in enumerate(sheets):
-        groups.setdefault(_machine_key(s), []).append(k)
-    for members in groups.values():
-        missing = [k for k in members if rows[k] is None]
-        for k in missing:
-            notes.append(_uncalibrated_note(meas[k], sheets[k]))
-        members = [k for k in members if rows[k] is not None]
-        if not members:
-            continue
-        out = _calibrate_group(
-            [rows[k] for k in members], [sheets[k] for k in members], keep, n_boot, seed
-        )
-        if out is None:
-            notes.append(
-                "the record pins none of the machine's parameters (its force does not "
-                "follow its motions: no contact, or a force channel that is not the "
-                "contact's); the scenario's machine is used"
-            )
-            continue
-        group_params, group_scenarios, group_residual, group_notes, phase, group_series = out
-        series = series or group_series
-        for k, sc, ph in zip(members, group_scenarios, phase, strict=True):
-            used[k] = sc
-            phases[k] = ph
-        prefix = "" if len(groups) == 1 else f"records {', '.join(str(k + 1) for k in members)}: "
-        parameters.update({prefix + n: v for n, v in group_params.items()})
-        residual = group_residual if len(groups) == 1 else {**residual, prefix: group_residual}
-        notes += group_notes
+    return meas, sheets, offsets, keep
+
+
+def _phase_notes(phases, sheets):
+    """A note for each record whose drive phase at ``t = 0`` is clearly not 0."""
+    notes = []
     for k, (p, lo, hi) in enumerate(phases):
         if math.isfinite(lo) and abs(p) > PHASE_NOTE and not lo <= 0.0 <= hi:
-            period = sheets[k].period
             notes.append(
-                f"{'record ' + str(k + 1) + ': ' if len(meas) > 1 else ''}the drive's phase "
+                f"{'record ' + str(k + 1) + ': ' if len(phases) > 1 else ''}the drive's phase "
                 f"at the record's t = 0 is {p:.1f} deg [{lo:.1f}, {hi:.1f}], not 0: is t on "
-                f"the drive's clock? (a time offset of {-p / 360 * period:.4g} s would put "
-                "it there)"
+                f"the drive's clock? (a time offset of {-p / 360 * sheets[k].period:.4g} s "
+                "would put it there)"
             )
-    return Calibration(
-        sheet=tuple(sheets),
-        scenarios=tuple(used),
-        parameters=parameters,
-        phase=tuple(phases),
-        residual=residual,
-        calibrated=bool(parameters),
-        notes=tuple(notes),
-        settings=settings,
-        seconds=time.perf_counter() - t_start,
-        series=series,
-    )
+    return notes
+
+
+@dataclass(frozen=True)
+class _Group:
+    """The calibration of records of one machine: the parameter table, the machine of each
+    record, the equations' residuals, notes, each record's drive phase and the figure's
+    series (see :class:`~.result.Calibration`)."""
+
+    parameters: dict
+    scenarios: list
+    residual: dict
+    notes: list
+    phases: list
+    series: dict
 
 
 def _uncalibrated_note(meas, sheet):
@@ -167,8 +195,8 @@ def _uncalibrated_note(meas, sheet):
 
 
 def _calibrate_group(rows, sheets, keep, n_boot, seed):
-    """Calibrate records of one machine: ``(parameters, scenarios, residual, notes,
-    phases)`` or ``None`` when the equations are degenerate."""
+    """Calibrate records of one machine: a :class:`_Group`, or ``None`` when the record
+    pins none of its parameters."""
     sheet = sheets[0]
     R = len(rows)
     draws = cycle_draws(rows, n_boot, seed)
@@ -204,9 +232,34 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
     if len(loose) == int((~first.fixed).sum()):
         return None  # the record pins nothing: its force does not follow its motions
     final = estimate(rows, {**held, **loose}, draws) if loose else first
+    parameters, notes = _table(first, final, held, loose, sheet_values)
+    if sheet.mass_loss > 0:
+        notes.append(
+            "the sheet's moulding sheds mass: its m2 is kept (a mean over the record "
+            "would not be its starting mass)"
+        )
+    common = {n: final.get(n) for n in ("m1", "c1", "k1", "k3", "m2")}
+    scenarios = [s.replace(**common, A=final.get(a)) for s, a in zip(sheets, amps, strict=True)]
+    sheet_frame = [sheet.m1, sheet.c1, sheet.k1, sheet.k3, *[s.A for s in sheets]]
+    residual = {
+        "frame": {"sheet": frame_residual(rows, sheet_frame), "record": final.residual["frame"]},
+        "moulding": {
+            "sheet": moulding_residual(rows, sheet.m2),
+            "record": final.residual["moulding"],
+        },
+    }
+    theta = [final.get(n) for n in final.names]
+    series = _series(rows[0], [*sheet_frame[:5], sheet.m2], [*theta[:5], theta[-1]])
+    return _Group(parameters, scenarios, residual, notes, drive_phase(rows, draws), series)
+
+
+def _table(first, final, held, loose, sheet_values):
+    """The parameter table of :class:`~.result.Calibration` and a note for each loose
+    parameter: ``first`` the estimate with only the held parameters fixed, ``final`` with the
+    loose ones kept at the sheet's values too."""
     parameters, notes = {}, []
     for k, name in enumerate(final.names):
-        if name == "k3" and name in held and sheet.k3 == 0:
+        if name == "k3" and name in held and sheet_values["k3"] == 0:
             continue
         src = first if name in loose else final
         rec = float(src.value[k])
@@ -229,24 +282,7 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
                 f"[{_fmt(p['low'])}, {_fmt(p['high'])}] {p['unit']}): the sheet's "
                 f"{_fmt(p['sheet'])} is kept"
             )
-    if sheet.mass_loss > 0:
-        notes.append(
-            "the sheet's moulding sheds mass: its m2 is kept (a mean over the record "
-            "would not be its starting mass)"
-        )
-    common = {n: final.get(n) for n in ("m1", "c1", "k1", "k3", "m2")}
-    scenarios = [s.replace(**common, A=final.get(a)) for s, a in zip(sheets, amps, strict=True)]
-    sheet_frame = [sheet.m1, sheet.c1, sheet.k1, sheet.k3, *[s.A for s in sheets]]
-    residual = {
-        "frame": {"sheet": frame_residual(rows, sheet_frame), "record": final.residual["frame"]},
-        "moulding": {
-            "sheet": moulding_residual(rows, sheet.m2),
-            "record": final.residual["moulding"],
-        },
-    }
-    theta = [final.get(n) for n in final.names]
-    series = _series(rows[0], [*sheet_frame[:5], sheet.m2], [*theta[:5], theta[-1]])
-    return parameters, scenarios, residual, notes, drive_phase(rows, draws), series
+    return parameters, notes
 
 
 def _series(row, sheet, record):

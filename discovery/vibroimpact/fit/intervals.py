@@ -8,6 +8,7 @@ from ..._result import Result
 from ..._settings import Settings, option, takes
 from ...errors import InputError, IntegrationError, NoContactError
 from ...numerics.executor import map_on
+from ..model.scenario import scale_bounds
 from .optimise import _checked, _fitted
 from .problem import _Objective
 from .records import as_records, model_parts
@@ -88,11 +89,7 @@ class Intervals(Result):
     def with_machine_scale(self, low, high, names):
         """These intervals with the parameters ``names`` widened by a machine scale known
         only to ``[low, high]`` (see :func:`bootstrap_intervals`)."""
-        lo_s, hi_s = float(low), float(high)
-        if not 0 < lo_s <= 1 <= hi_s:
-            raise InputError(
-                f"machine_scale must be (low, high) with 0 < low <= 1 <= high; got {(low, high)!r}"
-            )
+        lo_s, hi_s = scale_bounds((low, high))
         bounds = {}
         for k, (a, b) in self.bounds.items():
             if k in names:

@@ -23,7 +23,7 @@ from ..._validate import Text, check
 from ...errors import InputError
 from .law import ForceLaw
 
-__all__ = ["Scenario", "builtin_scenarios", "load_scenario"]
+__all__ = ["Scenario", "builtin_scenarios", "load_scenario", "scale_bounds"]
 
 _FIELDS = {
     "m1": ("kg", True),
@@ -434,6 +434,19 @@ class Scenario:
                 f'scenario {source!r}: name must be non-empty text, e.g. name = "my-grid"'
             )
         return cls(**values, law=law, initial=initial, name=name, source=source)
+
+
+def scale_bounds(bounds, where="machine_scale"):
+    """``(low, high)``, the factors within which a machine's scale is uncertain
+    (:meth:`Scenario.scaled`), as floats; one :class:`InputError` unless
+    ``0 < low <= 1 <= high``."""
+    try:
+        lo, hi = (float(b) for b in bounds)
+    except (TypeError, ValueError):
+        lo = hi = math.nan
+    if not 0 < lo <= 1 <= hi:
+        raise InputError(f"{where} must be (low, high) with 0 < low <= 1 <= high; got {bounds!r}")
+    return lo, hi
 
 
 def _toml_text(text):

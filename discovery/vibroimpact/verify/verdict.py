@@ -9,11 +9,10 @@ from ..._printing import readable
 from ..._result import Result, part
 from ..._settings import Settings, option, takes
 from ..._validate import Real, params
-from ...errors import InputError
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
 from ..model.law import ForceLaw
-from ..model.scenario import Scenario
+from ..model.scenario import Scenario, scale_bounds
 from .criteria import criteria_lines
 from .evaluation import Evaluation, evaluate
 from .reference import Reference
@@ -205,12 +204,7 @@ def _profiled_scale(scenario, law, ref, bounds, tolerances):
     bounded Brent), and a note saying where."""
     from scipy.optimize import minimize_scalar
 
-    lo, hi = (float(b) for b in bounds)
-    if not (0 < lo <= 1 <= hi):
-        raise InputError(
-            f"verify: machine_scale must be (low, high) with 0 < low <= 1 <= high; got {bounds!r}"
-        )
-
+    lo, hi = scale_bounds(bounds, "verify: machine_scale")
     seen = {}
 
     def i2(factor):
