@@ -190,10 +190,13 @@ def _rate(k, n):
 
 
 def markdown_row(rows, label):
-    """docs/calibration.md's row ``label`` ("force noise 1 %", "force noise 3 %", "all")."""
-    if label != "all":
+    """docs/calibration.md's row ``label``: "force noise 1 %", "force noise 3 %", a
+    generator class ("p1", "p1-slow", "subharmonic", "short-contact") or "all"."""
+    if label.startswith("force noise"):
         level = float(label.split()[-2]) / 100
         rows = [r for r in rows if abs(r["force_noise"] - level) < 1e-9]
+    elif label != "all":
+        rows = [r for r in rows if r["category"] == label]
     n = len(rows)
     masses = sum(all(abs(r["params"][p]["error"]) <= 0.02 for p in ("m1", "m2")) for r in rows)
     cells = [label, str(n), _rate(masses, n)]

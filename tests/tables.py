@@ -119,6 +119,20 @@ TABLES = {
         row=survey_calibration.markdown_row,
         read=survey_calibration.read_rows,
     ),
+    "calibration-classes": Table(
+        page="docs/calibration.md",
+        header=(
+            "| class | n | masses within 2 % | true law consistent: true machine | sheet | "
+            "calibrated | wrong laws rejected: true machine | sheet | calibrated |",
+            "|---|---|---|---|---|---|---|---|---|",
+        ),
+        rows=tuple(
+            (label, ("calibration*.jsonl",))
+            for label in ("p1", "p1-slow", "subharmonic", "short-contact")
+        ),
+        row=survey_calibration.markdown_row,
+        read=survey_calibration.read_rows,
+    ),
     "intervals": Table(
         page="docs/validation.md",
         header=(
