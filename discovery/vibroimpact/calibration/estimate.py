@@ -246,14 +246,15 @@ def _bootstrapped(rows, held, draws, force_on):
 
 
 def frame_residual(rows, theta_frame):
-    """The frame's relative weak-form residual with given ``m1, c1, k1, k3, A...``."""
-    X, y = _blocks(rows)[0]
+    """The frame's relative weak-form residual with given ``m1, c1, k1, k3, A...``, on the
+    evenly spread windows (those of the figure: the same rows for every machine)."""
+    X, y = _blocks(rows, force_on="even")[0]
     return _relative_rms(y - X[:, :-1] @ np.asarray(theta_frame, dtype=float), y)
 
 
 def moulding_residual(rows, m2):
-    """The moulding's relative weak-form residual with the mass ``m2``."""
-    X, y = _blocks(rows)[1]
+    """The moulding's relative weak-form residual with the mass ``m2`` (evenly spread windows)."""
+    X, y = _blocks(rows, force_on="even")[1]
     return _relative_rms(y - X[:, -1] * m2, y)
 
 
