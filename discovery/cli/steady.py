@@ -13,6 +13,7 @@ from ._common import check_out, law_or_default, provenance_of
 
 def run(args):
     from ..vibroimpact.dynamics.law_response import response
+    from ..vibroimpact.dynamics.steady_states import SteadyStateSettings
 
     if args.out is not None:
         check_out(args)
@@ -25,7 +26,15 @@ def run(args):
         )
     r = response(sc, law)
     ss = r.steady
-    if not (np.all(np.isfinite(ss.multipliers)) and np.isfinite(ss.residual)):
+    if not ss.periodic:
+        print(
+            f"{law}: no periodic steady state (no stable orbit of up to "
+            f"{SteadyStateSettings().max_period} drive periods that the motion from the "
+            f"scenario's state reaches, searched after {round(ss.t0 / sc.period)} periods); "
+            "the motion is nonperiodic or still in a transient: see it with vidi simulate "
+            "--from-rest --periods 400"
+        )
+    elif not (np.all(np.isfinite(ss.multipliers)) and np.isfinite(ss.residual)):
         raise IntegrationError(
             f"the steady state of {law} in scenario {sc.name!r} could not be computed "
             "(non-finite Floquet multipliers or residual: the simulation failed); check the "
@@ -34,14 +43,15 @@ def run(args):
     info = {}
     if r.impulse is not None:
         info.update(peak_force=r.impulse.peak, contact_time=r.impulse.contact_time)
-    print(
-        f"{law}: {ss.regime}, {ss.impacts} impact(s) per orbit, "
-        f"max |Floquet multiplier| {np.max(np.abs(ss.multipliers)):.4g}, "
-        f"residual {ss.residual:.2g}"
-    )
+    if ss.periodic:
+        print(
+            f"{law}: {ss.regime}, {ss.impacts} impact(s) per orbit, "
+            f"max |Floquet multiplier| {np.max(np.abs(ss.multipliers)):.4g}, "
+            f"residual {ss.residual:.2g}"
+        )
     if r.impulse is not None:
         print(f"peak force {r.impulse.peak:.4g} N, contact time {r.impulse.contact_time:.4g} s")
-    if args.sensitivities:
+    if args.sensitivities and ss.periodic:
         from ..vibroimpact.dynamics.orbit_sensitivity import orbit_sensitivity
 
         sens = orbit_sensitivity(sc, law, ss)

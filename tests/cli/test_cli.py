@@ -205,3 +205,18 @@ def test_verify_command_writes_summary_and_figure(tmp_path):
         == 2
     )
     assert not (tmp_path / "e").exists()
+
+
+def test_steady_says_nonperiodic_without_calling_it_a_failure(tmp_path, capsys):
+    """A motion without a periodic steady state is a finding, not a failed simulation."""
+    sc = tmp_path / "drawn.toml"
+    sc.write_text(
+        'name = "drawn"\n[machine]\nm1 = 3940.0\nm2 = 5610.0\nk1 = 5.23e7\nc1 = 1.35e5\n'
+        "A = 1.21e5\nfrequency = 32.4\n"
+    )
+    law = "flores: k=7.063e+09, n=1.52, e=0.878"
+    out = tmp_path / "ss"
+    assert main(["steady", "--scenario", str(sc), "--law", law, "--out", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert "no periodic steady state" in said and "failed" not in said
+    assert json.loads((out / "summary.json").read_text())["regime"] == "nonperiodic"

@@ -15,6 +15,7 @@ are :mod:`discovery.numerics.shooting` (shared with Ueda's oscillators);
 :class:`StroboscopicMap` is this system's period map for it.
 """
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -47,7 +48,7 @@ from .simulation import (
     simulate,
 )
 
-__all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
+__all__ = ["SteadyState", "steady_state", "StroboscopicMap", "MemoryMap"]
 
 
 def _event_arrays(room):
@@ -261,6 +262,63 @@ class StroboscopicMap:
         return J
 
 
+class MemoryMap:
+    """The period map of a law with contact memory, on the state that memory extends.
+
+    A law with a permanent set unloads from the contact's largest penetration, and a law
+    scaled by each impact's approach velocity (Flores, Lankarani-Nikravesh) carries that
+    velocity through the contact: where a strobe point falls inside a contact, the next
+    period depends on them as much as on the four states.  This map's state is
+    ``(w1, v1, w2, v2, zeta_max, v0)``; its Jacobian (finite differences along all six)
+    includes how the memory moves the orbit, so Newton closes the memory too and the
+    Floquet multipliers are those of the motion.  Where a strobe point is out of contact
+    the memory's columns vanish (the next onset resets it) and its multipliers are 0.
+
+    Parameters
+    ----------
+    pm : StroboscopicMap
+        The four-state map of the same scenario and law.
+    """
+
+    def __init__(self, pm):
+        self.pm = pm
+        x, v = pm.scale[0], pm.scale[1]
+        self.scale = np.concatenate([pm.scale, [x, v]])
+
+    @property
+    def n_calls(self):
+        return self.pm.n_calls
+
+    def extend(self, y):
+        """The extended state of ``y`` with the memory the four-state map now holds."""
+        return np.concatenate([np.asarray(y, dtype=float), [self.pm.zeta_max, self.pm.impact_v0]])
+
+    def advance(self, z, n=1):
+        """``Phi^n`` of the extended state ``z``."""
+        self.pm.zeta_max, self.pm.impact_v0 = float(z[4]), float(z[5])
+        y = self.pm.advance(z[:4], n)
+        return self.extend(y)
+
+    def jacobian(self, z, n=1, fz=None):
+        """Finite-difference Jacobian of ``Phi^n`` at ``z`` (forward steps of ``1e-6`` of
+        each component's scale; the memory's step only ever increases it, so a probe
+        never crosses the kernel's 'no onset known' value 0)."""
+        fz = self.advance(z, n) if fz is None else fz
+        J = np.empty((6, 6))
+        for j in range(6):
+            zp = np.array(z, dtype=float)
+            zp[j] += 1e-6 * self.scale[j]
+            J[:, j] = (self.advance(zp, n) - fz) / (1e-6 * self.scale[j])
+        return J
+
+    @staticmethod
+    def multipliers(J):
+        """The four multipliers of largest modulus of the extended map's Jacobian (the
+        memory adds at most two, which vanish where a strobe point is out of contact)."""
+        mult = floquet_multipliers(J)
+        return mult[np.argsort(-np.abs(mult))][:4]
+
+
 @readable
 @dataclass(frozen=True, eq=False)
 class SteadyState(Result):
@@ -352,13 +410,14 @@ class SteadyState(Result):
         ]
 
 
-def _strobe_recurrence(pm, y, max_period):
+def _strobe_recurrence(pm, y, max_period, full=False):
     """Strobe points from ``y`` and their recurrence distance per period ``n``: ``(last
     strobe point, periods advanced, {n: distance}, the one-period distance)``; when the
-    points already recur after one period, only two periods are advanced."""
+    points already recur after one period (and not ``full``), only two periods are
+    advanced."""
     strobe = pm.strobe(y, 2)
     quick = max(np.max(np.abs(strobe[k + 1] - strobe[k]) / pm.scale) for k in (0, 1))
-    if quick < 1e-2:
+    if quick < 1e-2 and not full:
         # fast path: the strobe points already recur after one period
         return strobe[-1].copy(), 2, {1: float(quick)}, quick
     strobe = np.concatenate([strobe, pm.strobe(strobe[-1], 2 * max_period)[1:]])
@@ -373,25 +432,38 @@ def _strobe_recurrence(pm, y, max_period):
 def _orbit(pm, y, n, t0, *, tol, max_newton, attempt, evidence):
     """Newton shooting for a period-``n`` orbit from ``y`` (at time ``t0`` [s]) on the
     stroboscopic map ``pm`` of a scenario and law: the steady state when it converges to a
-    stable orbit (reduced to its smallest period), else ``None``.  Every try is recorded in
-    ``attempt`` (one of ``evidence``'s attempts); ``tol`` and ``max_newton`` are Newton's
-    (see :func:`steady_state`)."""
+    stable orbit (reduced to its smallest period) that the motion from ``y`` reaches
+    (:func:`_reached`), else ``None``.  A law with contact memory is shot on its
+    :class:`MemoryMap` (the memory ``pm`` holds after ``y``'s run is the start's).  Every
+    try is recorded in ``attempt`` (one of ``evidence``'s attempts); ``tol`` and
+    ``max_newton`` are Newton's (see :func:`steady_state`)."""
+    shot = MemoryMap(pm) if pm.law.has_memory else pm
+    start = shot.extend(y) if shot is not pm else np.asarray(y, dtype=float)
+    found = _shoot(pm, shot, start, n, t0, tol=tol, max_newton=max_newton, attempt=attempt)
+    if found is None and shot is not pm:
+        # Newton's runs left their own memory in the map: the motion goes on with y's
+        pm.zeta_max, pm.impact_v0 = float(start[4]), float(start[5])
+    return None if found is None else dataclasses.replace(found, evidence=evidence)
+
+
+def _shoot(pm, shot, start, n, t0, *, tol, max_newton, attempt):
+    """:func:`_orbit` on the map ``shot`` (``pm`` or its :class:`MemoryMap`) from the
+    (extended) state ``start``."""
     hist = []
-    y_orb, res, J, ok = newton_orbit(pm, y, n, tol=tol, max_iter=max_newton, history=hist)
-    mult = floquet_multipliers(J, len(y))
+    y_orb, res, J, ok = newton_orbit(shot, start, n, tol=tol, max_iter=max_newton, history=hist)
+    mult = _multipliers(shot, y_orb, n, J)
     stable = bool(ok and is_stable(mult))
-    attempt["tried"].append(
-        {
-            "n": n,
-            "newton_residuals": hist,
-            "converged": ok,
-            "max_multiplier": float(np.max(np.abs(mult))),
-            "stable": stable,
-        }
-    )
+    tried = {
+        "n": n,
+        "newton_residuals": hist,
+        "converged": ok,
+        "max_multiplier": float(np.max(np.abs(mult))),
+        "stable": stable,
+    }
+    attempt["tried"].append(tried)
     if not stable:
         return None
-    reduced = smallest_period(pm, y_orb, n, tol, max_newton) if n > 1 else None
+    reduced = smallest_period(shot, y_orb, n, tol, max_newton) if n > 1 else None
     if reduced is not None:
         m, y_orb, res, J, hist_m = reduced
         attempt["tried"].append(
@@ -403,12 +475,15 @@ def _orbit(pm, y, n, t0, *, tol, max_newton, attempt, evidence):
                 "stable": True,
             }
         )
-        n, mult = m, floquet_multipliers(J)
+        n, mult = m, _multipliers(shot, y_orb, m, J)
+    tried["reached"] = _reached(shot, start, y_orb, n)
+    if not tried["reached"]:
+        return None
     zmax, v0 = 0.0, 0.0
-    if pm.law.has_memory:
-        # one more orbit from y0 leaves the memory y0 holds (the orbit is periodic)
-        pm.advance(y_orb, n)
-        zmax, v0 = pm.zeta_max, pm.impact_v0
+    if shot is not pm:
+        zmax, v0 = float(y_orb[4]), float(y_orb[5])
+        y_orb = y_orb[:4]
+        pm.zeta_max, pm.impact_v0 = zmax, v0
     impacts = pm.onsets(y_orb, n)
     return SteadyState(
         regime=f"P{n}",
@@ -419,10 +494,60 @@ def _orbit(pm, y, n, t0, *, tol, max_newton, attempt, evidence):
         multipliers=mult,
         residual=float(res),
         n_simulations=pm.n_calls,
-        evidence=evidence,
+        evidence={},
         zeta_max0=zmax,
         impact_v0=v0,
     )
+
+
+def _multipliers(shot, z, n, J):
+    """The Floquet multipliers of the period-``n`` orbit through ``z`` from its Jacobian
+    ``J`` on the map ``shot``.  On a :class:`MemoryMap`, an orbit without an onset never
+    resets its contact's memory (a contact that never ends): the memory is then a constant
+    of the motion, not a state it returns to (its multiplier is exactly 1), and the
+    multipliers are the four states' with the memory held."""
+    if J is None:
+        return floquet_multipliers(None, 4)
+    if not isinstance(shot, MemoryMap):
+        return floquet_multipliers(J)
+    mult = MemoryMap.multipliers(J)
+    if not is_stable(mult):
+        shot.pm.zeta_max, shot.pm.impact_v0 = float(z[4]), float(z[5])
+        if shot.pm.onsets(z[:4], n) == 0:
+            return floquet_multipliers(J[:4, :4])
+    return mult
+
+
+#: how close [relative to the scales] a motion must come to an orbit to have reached it,
+#: and the most periods (in runs of ``_REACH_RUN``) followed to see it come that close
+_REACH_DISTANCE, _REACH_PERIODS, _REACH_RUN = 1e-3, 600, 50
+
+
+def _reached(shot, start, z_orb, n):
+    """Whether the motion from ``start`` reaches the period-``n`` orbit through ``z_orb``
+    (Newton can converge to a stable orbit that coexists with the attractor the motion is
+    on, e.g. a chaotic one).  Near the orbit already: yes.  Otherwise the motion is
+    followed in runs of ``_REACH_RUN`` periods: it reaches the orbit when it comes within
+    ``_REACH_DISTANCE`` of one of its points, and does not when a run ends no closer than
+    it began; a motion still approaching after ``_REACH_PERIODS`` periods reaches it."""
+    points = [np.asarray(z_orb, dtype=float)]
+    for _ in range(n - 1):
+        points.append(shot.advance(points[-1], 1))
+    scale = np.asarray(shot.scale[:4])
+
+    def distance(z):
+        return min(float(np.max(np.abs(z[:4] - q[:4]) / scale)) for q in points)
+
+    d = distance(start)
+    z, periods = np.asarray(start, dtype=float), 0
+    while d >= _REACH_DISTANCE and periods < _REACH_PERIODS:
+        z = shot.advance(z, _REACH_RUN)
+        periods += _REACH_RUN
+        d_next = distance(z)
+        if d_next >= d:
+            return False
+        d = d_next
+    return True
 
 
 @dataclass(frozen=True, repr=False)
@@ -517,24 +642,19 @@ def steady_state(scenario, law, *, settings=None, **options):
         t_done += n_trans
         y, periods, dist, quick = _strobe_recurrence(pm, y, s.max_period)
         t_done += periods
-        order = sorted(dist, key=lambda n: (dist[n] > 1e-2, n if dist[n] <= 1e-2 else dist[n]))
         attempt = {"phase": phase, "recurrence": dist, "tried": []}
         evidence["attempts"].append(attempt)
-        if quick < 1e-2:
-            order = [1] + [n for n in range(2, s.max_period + 1)][:2]
-        for n in order[:3]:
-            found = _orbit(
-                pm,
-                y,
-                n,
-                t_done * T,
-                tol=s.tol,
-                max_newton=s.max_newton,
-                attempt=attempt,
-                evidence=evidence,
-            )
-            if found is not None:
-                return found
+        found = _search(pm, y, t_done * T, s, attempt, evidence, quick=quick < 1e-2)
+        if found is None and quick < 1e-2:
+            # the one-period recurrence was close, yet no orbit of period 1-3 is: the
+            # strobe points over ``max_period`` periods say which period to try
+            y, periods, dist, _ = _strobe_recurrence(pm, y, s.max_period, full=True)
+            t_done += periods
+            attempt = {"phase": phase, "recurrence": dist, "tried": []}
+            evidence["attempts"].append(attempt)
+            found = _search(pm, y, t_done * T, s, attempt, evidence)
+        if found is not None:
+            return found
     return SteadyState(
         regime="nonperiodic",
         n_periods=0,
@@ -546,6 +666,42 @@ def steady_state(scenario, law, *, settings=None, **options):
         n_simulations=pm.n_calls,
         evidence=evidence,
     )
+
+
+def _period_order(dist):
+    """The periods to try, best first, from the strobe points' recurrence ``dist`` (``{n:
+    distance}``): the periods whose points recur within 1e-2 and within 10 times the
+    closest recurrence, shortest first (a period-``n`` orbit also recurs at ``2n``, and a
+    P1 near a flip reads closer at 2; the period reduction then finds the shortest), then
+    the rest by distance."""
+    best = min(dist.values())
+
+    def key(n):
+        close = dist[n] <= 1e-2 and dist[n] <= max(10.0 * best, 1e-9)
+        return (0, n) if close else (1, dist[n])
+
+    return sorted(dist, key=key)
+
+
+def _search(pm, y, t0, s, attempt, evidence, *, quick=False):
+    """The steady state from Newton on the three most likely periods (:func:`_period_order`;
+    ``quick``: the strobe points already recur after one period, so periods 1, 2, 3) from
+    the strobe point ``y`` at time ``t0``, or None."""
+    order = [1, 2, 3] if quick else _period_order(attempt["recurrence"])
+    for n in [n for n in order if n <= s.max_period][:3]:
+        found = _orbit(
+            pm,
+            y,
+            n,
+            t0,
+            tol=s.tol,
+            max_newton=s.max_newton,
+            attempt=attempt,
+            evidence=evidence,
+        )
+        if found is not None:
+            return found
+    return None
 
 
 CONTINUATION_NEWTON = 4

@@ -501,6 +501,15 @@ def evaluate(
     )
 
 
+def _own_contacts(ss, n_periods):
+    """Contact onsets per ``n_periods`` drive periods (the record's folded cycle) of the
+    law's own periodic motion ``ss`` (its steady orbit from the record's state), or None
+    when it has none or its period does not divide into the cycle's evenly."""
+    if ss is None or not ss.periodic or (ss.impacts * n_periods) % ss.n_periods:
+        return None
+    return int(ss.impacts * n_periods // ss.n_periods)
+
+
 TRANSIENT_GAP = CONSISTENCY_SLACK
 """I2 between the law's trajectory over the record's span and its steady orbit sampled at
 the same times above which the record is taken to be still in a transient under that law."""
@@ -632,8 +641,11 @@ def _evaluate_span(
     # contacts per cycle agree, or the law's own noisy replicates show the measured count
     # (noise near the threshold can split a contact or hide a small one)
     folded = int(len(E.support))  # the record's folded cycle, same operator as the law's
-    same_impacts = imp["simulated"] in (imp["measured"], folded) or folded in (
-        fl.get("impacts") or []
+    own = _own_contacts(ss, E.n_periods)
+    same_impacts = (
+        imp["simulated"] in (imp["measured"], folded)
+        or folded in (fl.get("impacts") or [])
+        or own == imp["measured"]
     )
     regime_ok = reg["simulated"] == reg["measured"] or not settled
     within = all(np.isfinite(lim[k]) and crit[k] <= lim[k] for k in lim)
@@ -644,8 +656,10 @@ def _evaluate_span(
     found["impacts_folded"] = {"measured": folded, "simulated": imp["simulated"]}
     notes = []
     if same_impacts and imp["simulated"] != imp["measured"]:
-        notes.append(contacts_note(imp["simulated"], imp["measured"], folded))
+        notes.append(contacts_note(imp["simulated"], imp["measured"], folded, own))
         imp = {**imp, "simulated": imp["measured"]}
+    elif not same_impacts and own is not None:
+        imp = {**imp, "simulated": own}  # the count a rejection states: the law's motion's
     verdict = _verdict(
         consistent, reg, imp, crit, fl["mean"], lim=lim, transient=transient_mismatch
     )

@@ -53,10 +53,16 @@ def _contacts(n):
     return f"{n} contact" if n == 1 else f"{n} contacts"
 
 
-def contacts_note(simulated, measured, folded):
+def contacts_note(simulated, measured, folded, own=None):
     """Why the contacts per cycle are taken to agree though the law's folded cycle shows
-    ``simulated`` and the record ``measured`` (its folded cycle ``folded``)."""
-    if simulated == folded:
+    ``simulated`` and the record ``measured`` (its folded cycle ``folded``; ``own``: the
+    onsets per cycle of the law's own periodic motion, None when unknown)."""
+    if own == measured:
+        why = (
+            f"the law's own motion has {_contacts(own)} (onsets of its steady orbit from "
+            "the record's state)"
+        )
+    elif simulated == folded:
         why = (
             f"the record's folded cycle shows {_contacts(folded)} too (its cycles taken one "
             f"by one show {measured})"

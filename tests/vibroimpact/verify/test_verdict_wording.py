@@ -98,6 +98,8 @@ def test_the_contacts_note_states_one_thing():
     assert "the contact counts agree" in note and "where the record has" not in note
     note = contacts_note(2, 1, 2)
     assert "the record's folded cycle shows 2 contacts too" in note
+    note = contacts_note(2, 1, 2, own=1)
+    assert "the law's own motion has 1 contact" in note
 
 
 def test_a_compared_law_is_never_reported_as_failed(paper, quickstart):
