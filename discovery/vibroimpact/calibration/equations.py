@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...numerics.test_functions import window_weights
+from ...numerics.test_functions import test_function, window_weights
+from ..data.contact_edges import contact_onsets
 
 __all__ = ["MachineRows", "machine_rows", "FRAME_TERMS", "MAX_WINDOWS", "ORDER"]
 
@@ -181,6 +182,8 @@ class _Channels:
     sin: np.ndarray
     cos: np.ndarray
     g: float
+    share: object = None
+    onsets: object = None
 
     @classmethod
     def of(cls, measurement, scenario, time_offset):
@@ -191,9 +194,18 @@ class _Channels:
 
         t = np.asarray(measurement.t, dtype=float)
         phase = scenario.omega * (t + time_offset)
+        F = np.asarray(measurement.F, dtype=float)
+        share, onsets = None, None
+        if scenario.mass_loss > 0:
+            # the moulding sheds mass_loss of its mass at every contact's onset: its mass
+            # as a share of the record's starting mass, sample by sample
+            at = contact_onsets(t, F, scenario.period, zeta=get("w1") - get("w2"))
+            onsets = np.searchsorted(t, at, side="left")
+            before = np.searchsorted(onsets, np.arange(t.size), side="right")
+            share = (1.0 - scenario.mass_loss) ** before
         return cls(
             t=t,
-            F=np.asarray(measurement.F, dtype=float),
+            F=F,
             w1=get("w1"),
             v1=get("v1"),
             w2=get("w2"),
@@ -201,6 +213,8 @@ class _Channels:
             sin=np.sin(phase),
             cos=np.cos(phase),
             g=scenario.g,
+            share=share,
+            onsets=onsets,
         )
 
 
@@ -225,13 +239,38 @@ def _rows(data, centres, hs, dt):
     frame = np.column_stack(
         [acc1 + data.g * ones, vel1, integral(data.w1), integral(data.w1**3), integral(data.sin)]
     )
+    moulding = acc2 + data.g * ones
+    if data.share is not None:
+        moulding = _shedding_moulding(data, centres, hs, dt)
     return {
         "frame": frame,
         "drive_cos": integral(data.cos),
         "force": integral(data.F),
-        "moulding": acc2 + data.g * ones,
+        "moulding": moulding,
         "acc2": acc2,
         "ones": ones,
         "kinematics": {"1": kin1, "2": kin2},
         "centre": data.t[centres],
     }
+
+
+def _shedding_moulding(data, centres, hs, dt):
+    """The moulding's column ``int phi s (w2'' + g) dt`` of a moulding that sheds mass at
+    every onset (``s``: its mass over the record's starting mass, ``data.share``).  The
+    mass jumps while the velocity does not, so moving the derivative onto ``phi`` leaves a
+    term at each onset ``t_j`` inside a window: ``int phi s v2' dt = -int phi' s v2 dt -
+    sum_j phi(t_j) (s_j+ - s_j-) v2(t_j)`` (the rate from the positions where the record
+    has no velocities)."""
+    idx = centres[:, None] + np.arange(-hs, hs + 1)[None, :]
+    w_phi, w_dphi, _ = window_weights(hs, ORDER, dt)
+    s = data.share
+    v2 = data.v2 if data.v2 is not None else np.gradient(data.w2, dt)
+    col = -((s * v2)[idx] @ w_dphi) + data.g * (s[idx] @ w_phi)
+    phi = test_function(hs, ORDER)[0]
+    for j in data.onsets:
+        if j <= 0:
+            continue
+        near = np.abs(centres - j) <= hs
+        jump = s[j] - s[j - 1]
+        col[near] -= phi[j - centres[near] + hs] * jump * 0.5 * (v2[j] + v2[j - 1])
+    return col

@@ -214,8 +214,6 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
         held.update({a: sheet_values[a] for a in amps})
     if sheet.k3 == 0:
         held.setdefault("k3", 0.0)  # linear supports stay linear (a stiffening is an effect)
-    if sheet.mass_loss > 0:
-        held.setdefault("m2", sheet.m2)  # a shedding moulding has no one mass
     try:
         first = estimate(rows, held, draws)
     except np.linalg.LinAlgError:
@@ -235,8 +233,9 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
     parameters, notes = _table(first, final, held, loose, sheet_values)
     if sheet.mass_loss > 0:
         notes.append(
-            "the sheet's moulding sheds mass: its m2 is kept (a mean over the record "
-            "would not be its starting mass)"
+            f"the sheet's moulding sheds {sheet.mass_loss:g} of its mass at every contact: "
+            "m2 is its mass at the record's start (each window's equations hold the mass "
+            "left after the record's contacts before it)"
         )
     common = {n: final.get(n) for n in ("m1", "c1", "k1", "k3", "m2")}
     scenarios = [s.replace(**common, A=final.get(a)) for s, a in zip(sheets, amps, strict=True)]

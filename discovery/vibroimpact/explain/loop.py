@@ -38,7 +38,7 @@ One iteration (:func:`explain`):
 
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -342,12 +342,17 @@ def _intervals(run, s, progress):
     when a replicate cannot be simulated)."""
     if not s.n_boot_intervals:
         return None
+    model = run.model
+    if all(getattr(r, "span", None) is not None for _, r in run.records):
+        # every effect's parameter gets an interval: a drift's (the mass loss) too, refitted
+        # with the law on the records' spans, where each block starts with the mass left
+        model = replace(model, fit_drift=True)
     try:
         tick(progress, "explain: bootstrap intervals", 0, s.n_boot_intervals)
         return bootstrap_intervals(
             [sc for sc, _ in run.records],
             [r for _, r in run.records],
-            run.model,
+            model,
             n_boot=int(s.n_boot_intervals),
             seed=s.seed,
             criterion=run.criterion,

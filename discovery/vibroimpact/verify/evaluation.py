@@ -554,6 +554,12 @@ def _span_steady_state(scenario, law, reference, sim, reg, *, tolerances, steady
     missing."""
     span = reference.span
     last = span.blocks[-1]
+    if scenario.mass_loss > 0:
+        reg["simulated"] = "drifting"
+        return None, None, (
+            f"the machine sheds {scenario.mass_loss:g} of the moulding's mass per impact, "
+            "so the law has no steady orbit"
+        )
     steady_kwargs = _from_start(scenario, reference, steady_kwargs)
     try:
         ss = _steady(scenario, law, tolerances, steady_kwargs)

@@ -41,10 +41,10 @@ def support_case(paper, k3=5e10, law=BASE, periods=16):
     return rec, explain(paper.with_law(law), rec, "linear", n_boot_intervals=0)
 
 
-def mass_loss_case(paper, law, delta=0.005, trans=40):
-    """``(record, explain's result)`` of a moulding that sheds ``delta`` of its mass per
-    impact, in a 40-period record of the paper's machine with ``law`` (a ForceLaw), the
-    record starting at the scenario's mass after the transient's impacts."""
+def shedding_record(paper, law, delta=0.005, trans=40):
+    """A 40-period record of the paper's machine with ``law`` (a ForceLaw) whose moulding
+    sheds ``delta`` of its mass per impact, starting at the scenario's mass after the
+    transient's impacts."""
     true = paper.replace(mass_loss=delta)
     # the start mass whose transient (by the scipy path that makes the record) sheds down to
     # the scenario's: a heavier moulding makes another transient, so it is iterated
@@ -53,7 +53,13 @@ def mass_loss_case(paper, law, delta=0.005, trans=40):
         if abs(m2_end - paper.m2) <= 1e-9 * paper.m2:
             break
         true = true.replace(m2=true.m2 * paper.m2 / m2_end)
-    rec = R.reference_record((true, law), periods=40, transient=trans, seed=0, check=False)
+    return R.reference_record((true, law), periods=40, transient=trans, seed=0, check=False)
+
+
+def mass_loss_case(paper, law, delta=0.005, trans=40):
+    """``(record, explain's result)`` of a moulding that sheds ``delta`` of its mass per
+    impact (:func:`shedding_record`)."""
+    rec = shedding_record(paper, law, delta, trans)
     return rec, explain(paper, rec, "linear", n_boot_intervals=0)
 
 
