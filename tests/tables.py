@@ -36,6 +36,7 @@ from . import (
     survey_explain,
     survey_explain_cases,
     survey_intervals,
+    survey_memory_orbits,
     survey_study,
 )
 
@@ -105,6 +106,20 @@ def _two_points(pattern):
 
 
 TABLES = {
+    "memory-orbits": Table(
+        page="docs/contact-models.md",
+        header=(
+            "| draws | n | periodic | strobe point in a contact | nonperiodic | failed | "
+            "agree with the long run | periodic, agree |",
+            "|---|---|---|---|---|---|---|---|",
+        ),
+        rows=tuple(
+            (label, ("memory-orbits*.jsonl",))
+            for label in ("flores", "lankarani-nikravesh", *survey_memory_orbits.CATEGORIES, "all")
+        ),
+        row=survey_memory_orbits.markdown_row,
+        read=survey_memory_orbits.read_rows,
+    ),
     "calibration": Table(
         page="docs/calibration.md",
         header=(

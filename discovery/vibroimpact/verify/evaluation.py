@@ -556,9 +556,13 @@ def _span_steady_state(scenario, law, reference, sim, reg, *, tolerances, steady
     last = span.blocks[-1]
     if scenario.mass_loss > 0:
         reg["simulated"] = "drifting"
-        return None, None, (
-            f"the machine sheds {scenario.mass_loss:g} of the moulding's mass per impact, "
-            "so the law has no steady orbit"
+        return (
+            None,
+            None,
+            (
+                f"the machine sheds {scenario.mass_loss:g} of the moulding's mass per impact, "
+                "so the law has no steady orbit"
+            ),
         )
     steady_kwargs = _from_start(scenario, reference, steady_kwargs)
     try:
