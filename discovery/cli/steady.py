@@ -26,6 +26,14 @@ def run(args):
         )
     r = response(sc, law)
     ss = r.steady
+    if not ss.periodic and _runs_away(ss):
+        d = ss.evidence["attempts"][-1]["recurrence"][1]
+        raise IntegrationError(
+            f"the steady state of {law} in scenario {sc.name!r} could not be computed: the "
+            f"motion runs away (its strobe points move {d:.3g} of the motion's scale further "
+            "every period: the moulding is thrown off and does not come back); check the "
+            "scenario's drive amplitude, masses and the law's coefficients"
+        )
     if not ss.periodic:
         print(
             f"{law}: no periodic steady state (no stable orbit of up to "
@@ -66,6 +74,17 @@ def run(args):
             ss.write_into(out)
         print(f"wrote {Path(args.out) / 'summary.json'}")
     return 0
+
+
+def _runs_away(ss):
+    """Whether a nonperiodic search's last strobe points move steadily away: the distance
+    after ``n`` periods grows as ``n`` (within 20 %) and is beyond the motion's scale."""
+    attempts = ss.evidence.get("attempts") or []
+    rec = attempts[-1].get("recurrence", {}) if attempts else {}
+    if len(rec) < 2 or not rec.get(1, 0.0) > 1.0:
+        return False
+    n = max(rec)
+    return abs(rec[n] / (n * rec[1]) - 1.0) < 0.2
 
 
 def register(sub):

@@ -37,6 +37,7 @@ from ...numerics.status import message as status_message
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from . import _kernel as K
+from .memory_map import MemoryMap, orbit_multipliers
 from .simulation import (
     _HINTS,
     Tolerances,
@@ -48,7 +49,7 @@ from .simulation import (
     simulate,
 )
 
-__all__ = ["SteadyState", "steady_state", "StroboscopicMap", "MemoryMap"]
+__all__ = ["SteadyState", "steady_state", "StroboscopicMap"]
 
 
 def _event_arrays(room):
@@ -262,63 +263,6 @@ class StroboscopicMap:
         return J
 
 
-class MemoryMap:
-    """The period map of a law with contact memory, on the state that memory extends.
-
-    A law with a permanent set unloads from the contact's largest penetration, and a law
-    scaled by each impact's approach velocity (Flores, Lankarani-Nikravesh) carries that
-    velocity through the contact: where a strobe point falls inside a contact, the next
-    period depends on them as much as on the four states.  This map's state is
-    ``(w1, v1, w2, v2, zeta_max, v0)``; its Jacobian (finite differences along all six)
-    includes how the memory moves the orbit, so Newton closes the memory too and the
-    Floquet multipliers are those of the motion.  Where a strobe point is out of contact
-    the memory's columns vanish (the next onset resets it) and its multipliers are 0.
-
-    Parameters
-    ----------
-    pm : StroboscopicMap
-        The four-state map of the same scenario and law.
-    """
-
-    def __init__(self, pm):
-        self.pm = pm
-        x, v = pm.scale[0], pm.scale[1]
-        self.scale = np.concatenate([pm.scale, [x, v]])
-
-    @property
-    def n_calls(self):
-        return self.pm.n_calls
-
-    def extend(self, y):
-        """The extended state of ``y`` with the memory the four-state map now holds."""
-        return np.concatenate([np.asarray(y, dtype=float), [self.pm.zeta_max, self.pm.impact_v0]])
-
-    def advance(self, z, n=1):
-        """``Phi^n`` of the extended state ``z``."""
-        self.pm.zeta_max, self.pm.impact_v0 = float(z[4]), float(z[5])
-        y = self.pm.advance(z[:4], n)
-        return self.extend(y)
-
-    def jacobian(self, z, n=1, fz=None):
-        """Finite-difference Jacobian of ``Phi^n`` at ``z`` (forward steps of ``1e-6`` of
-        each component's scale; the memory's step only ever increases it, so a probe
-        never crosses the kernel's 'no onset known' value 0)."""
-        fz = self.advance(z, n) if fz is None else fz
-        J = np.empty((6, 6))
-        for j in range(6):
-            zp = np.array(z, dtype=float)
-            zp[j] += 1e-6 * self.scale[j]
-            J[:, j] = (self.advance(zp, n) - fz) / (1e-6 * self.scale[j])
-        return J
-
-    @staticmethod
-    def multipliers(J):
-        """The four multipliers of largest modulus of the extended map's Jacobian (the
-        memory adds at most two, which vanish where a strobe point is out of contact)."""
-        mult = floquet_multipliers(J)
-        return mult[np.argsort(-np.abs(mult))][:4]
-
-
 @readable
 @dataclass(frozen=True, eq=False)
 class SteadyState(Result):
@@ -429,21 +373,22 @@ def _strobe_recurrence(pm, y, max_period, full=False):
     )
 
 
-def _orbit(pm, y, n, t0, *, tol, max_newton, attempt, evidence):
+def _orbit(pm, y, n, t0, *, tol, max_newton, attempt):
     """Newton shooting for a period-``n`` orbit from ``y`` (at time ``t0`` [s]) on the
     stroboscopic map ``pm`` of a scenario and law: the steady state when it converges to a
     stable orbit (reduced to its smallest period) that the motion from ``y`` reaches
     (:func:`_reached`), else ``None``.  A law with contact memory is shot on its
     :class:`MemoryMap` (the memory ``pm`` holds after ``y``'s run is the start's).  Every
-    try is recorded in ``attempt`` (one of ``evidence``'s attempts); ``tol`` and
-    ``max_newton`` are Newton's (see :func:`steady_state`)."""
+    try is recorded in ``attempt`` (one of the evidence's attempts, which the caller puts
+    into the steady state); ``tol`` and ``max_newton`` are Newton's (see
+    :func:`steady_state`)."""
     shot = MemoryMap(pm) if pm.law.has_memory else pm
     start = shot.extend(y) if shot is not pm else np.asarray(y, dtype=float)
     found = _shoot(pm, shot, start, n, t0, tol=tol, max_newton=max_newton, attempt=attempt)
     if found is None and shot is not pm:
         # Newton's runs left their own memory in the map: the motion goes on with y's
         pm.zeta_max, pm.impact_v0 = float(start[4]), float(start[5])
-    return None if found is None else dataclasses.replace(found, evidence=evidence)
+    return found
 
 
 def _shoot(pm, shot, start, n, t0, *, tol, max_newton, attempt):
@@ -451,7 +396,7 @@ def _shoot(pm, shot, start, n, t0, *, tol, max_newton, attempt):
     (extended) state ``start``."""
     hist = []
     y_orb, res, J, ok = newton_orbit(shot, start, n, tol=tol, max_iter=max_newton, history=hist)
-    mult = _multipliers(shot, y_orb, n, J)
+    mult = orbit_multipliers(shot, y_orb, n, J)
     stable = bool(ok and is_stable(mult))
     tried = {
         "n": n,
@@ -475,8 +420,8 @@ def _shoot(pm, shot, start, n, t0, *, tol, max_newton, attempt):
                 "stable": True,
             }
         )
-        n, mult = m, _multipliers(shot, y_orb, m, J)
-    tried["reached"] = _reached(shot, start, y_orb, n)
+        n, mult = m, orbit_multipliers(shot, y_orb, m, J)
+    tried["reached"], tried["reach_runs"] = _reached(shot, start, y_orb, n)
     if not tried["reached"]:
         return None
     zmax, v0 = 0.0, 0.0
@@ -500,24 +445,6 @@ def _shoot(pm, shot, start, n, t0, *, tol, max_newton, attempt):
     )
 
 
-def _multipliers(shot, z, n, J):
-    """The Floquet multipliers of the period-``n`` orbit through ``z`` from its Jacobian
-    ``J`` on the map ``shot``.  On a :class:`MemoryMap`, an orbit without an onset never
-    resets its contact's memory (a contact that never ends): the memory is then a constant
-    of the motion, not a state it returns to (its multiplier is exactly 1), and the
-    multipliers are the four states' with the memory held."""
-    if J is None:
-        return floquet_multipliers(None, 4)
-    if not isinstance(shot, MemoryMap):
-        return floquet_multipliers(J)
-    mult = MemoryMap.multipliers(J)
-    if not is_stable(mult):
-        shot.pm.zeta_max, shot.pm.impact_v0 = float(z[4]), float(z[5])
-        if shot.pm.onsets(z[:4], n) == 0:
-            return floquet_multipliers(J[:4, :4])
-    return mult
-
-
 #: how close [relative to the scales] a motion must come to an orbit to have reached it,
 #: and the most periods (in runs of ``_REACH_RUN``) followed to see it come that close
 _REACH_DISTANCE, _REACH_PERIODS, _REACH_RUN = 1e-3, 2000, 50
@@ -526,12 +453,14 @@ _REACH_DISTANCE, _REACH_PERIODS, _REACH_RUN = 1e-3, 2000, 50
 def _reached(shot, start, z_orb, n):
     """Whether the motion from ``start`` reaches the period-``n`` orbit through ``z_orb``:
     whether it comes within ``_REACH_DISTANCE`` of one of the orbit's points within
-    ``_REACH_PERIODS`` periods.  Newton can converge to a stable orbit that coexists with
-    the attractor the motion is on (a chaotic one); a motion may also wander through a
-    chaotic transient of hundreds of periods before it settles on the orbit Newton found
-    (measured: 500 periods, then 400 more to come within 1e-3 at 0.94 per orbit), so
-    nothing short of the motion's own arrival decides (a run costs 20-50 ms per 1000
-    periods)."""
+    ``_REACH_PERIODS`` periods, or is then still closing in on it (closer after each of
+    the last four runs of ``_REACH_RUN`` periods, and less than half as far as at the
+    start).  Newton can converge to a stable orbit that coexists with the attractor the
+    motion is on (a chaotic one); a motion may also wander through a chaotic transient of
+    hundreds of periods before it settles on the orbit Newton found (measured: 500
+    periods, then 400 more to come within 1e-3 at 0.94 per orbit), so nothing short of
+    the motion's own arrival decides (a run costs 20-50 ms per 1000 periods).  Returns
+    ``(reached, runs)``, ``runs`` the runs of the motion it took."""
     points = [np.asarray(z_orb, dtype=float)]
     for _ in range(n - 1):
         points.append(shot.advance(points[-1], 1))
@@ -540,13 +469,17 @@ def _reached(shot, start, z_orb, n):
     def distance(z):
         return min(float(np.max(np.abs(z[:4] - q[:4]) / scale)) for q in points)
 
-    z, periods = np.asarray(start, dtype=float), 0
-    while distance(z) >= _REACH_DISTANCE:
-        if periods >= _REACH_PERIODS:
-            return False
+    z = np.asarray(start, dtype=float)
+    d = [distance(z)]
+    while d[-1] >= _REACH_DISTANCE:
+        if len(d) > _REACH_PERIODS // _REACH_RUN:
+            # still on its way (a multiplier near 1 in modulus): closer after each of the
+            # last runs, and well closer than at the start
+            last = d[-5:]
+            return bool(np.all(np.diff(last) < 0)) and d[-1] < 0.5 * d[0], len(d) - 1
         z = shot.advance(z, _REACH_RUN)
-        periods += _REACH_RUN
-    return True
+        d.append(distance(z))
+    return True, len(d) - 1
 
 
 @dataclass(frozen=True, repr=False)
@@ -643,7 +576,7 @@ def steady_state(scenario, law, *, settings=None, **options):
         t_done += periods
         attempt = {"phase": phase, "recurrence": dist, "tried": []}
         evidence["attempts"].append(attempt)
-        found = _search(pm, y, t_done * T, s, attempt, evidence, quick=quick < 1e-2)
+        found = _search(pm, y, t_done * T, s, attempt, quick=quick < 1e-2)
         if found is None and quick < 1e-2:
             # the one-period recurrence was close, yet no orbit of period 1-3 is: the
             # strobe points over ``max_period`` periods say which period to try
@@ -651,9 +584,9 @@ def steady_state(scenario, law, *, settings=None, **options):
             t_done += periods
             attempt = {"phase": phase, "recurrence": dist, "tried": []}
             evidence["attempts"].append(attempt)
-            found = _search(pm, y, t_done * T, s, attempt, evidence)
+            found = _search(pm, y, t_done * T, s, attempt)
         if found is not None:
-            return found
+            return dataclasses.replace(found, evidence=evidence)
     return SteadyState(
         regime="nonperiodic",
         n_periods=0,
@@ -682,7 +615,7 @@ def _period_order(dist):
     return sorted(dist, key=key)
 
 
-def _search(pm, y, t0, s, attempt, evidence, *, quick=False):
+def _search(pm, y, t0, s, attempt, *, quick=False):
     """The steady state from Newton on the three most likely periods (:func:`_period_order`;
     ``quick``: the strobe points already recur after one period, so periods 1, 2, 3) from
     the strobe point ``y`` at time ``t0``, or None."""
@@ -696,7 +629,6 @@ def _search(pm, y, t0, s, attempt, evidence, *, quick=False):
             tol=s.tol,
             max_newton=s.max_newton,
             attempt=attempt,
-            evidence=evidence,
         )
         if found is not None:
             return found

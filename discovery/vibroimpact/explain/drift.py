@@ -17,8 +17,12 @@ a wrong nominal mass only shifts the level; the drift channel sees the trend):
 ``r_w = (J_meas,w - J_pred,w) - mean``,  ``D = rms(r) / mean(J_meas)``.
 
 Its noise is estimated from the record itself, from successive differences (the median
-absolute deviation of ``diff(r)`` over ``sqrt 2``), which a smooth drift hardly changes;
-``D``'s floor is that noise over the mean impulse.
+absolute deviation of ``diff(r)`` over ``sqrt 2``), which a smooth drift hardly changes,
+and never below what the force's own sample noise puts into a window's impulse
+(``sigma_F dt sqrt(samples)``); with fewer than :data:`MIN_DIFFERENCE_WINDOWS` windows the
+differences are too few to trust (a 15-period P3 record has four windows: its three
+differences read the noise 17 times too high on one record, 4 times too low on another)
+and the sample noise alone sets it.  ``D``'s floor is that noise over the mean impulse.
 """
 
 from dataclasses import dataclass
@@ -26,6 +30,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.stats import chi2
+
+from ..data.noise import estimate_noise
 
 __all__ = [
     "DriftRecord",
@@ -44,6 +50,7 @@ class DriftRecord:
     impulses: np.ndarray
     impacts_before: np.ndarray
     window: float
+    sigma: float = 0.0
 
     @classmethod
     def from_measurement(cls, measurement, impulse):
@@ -72,7 +79,13 @@ class DriftRecord:
                 continue
             J.append(float(np.sum(F[m]) * dt))
             before.append((k - k0) * impacts_per_orbit)
-        return cls(impulses=np.array(J), impacts_before=np.array(before, dtype=float), window=W)
+        sigma = float(estimate_noise(F)) * dt * np.sqrt(W / dt)
+        return cls(
+            impulses=np.array(J),
+            impacts_before=np.array(before, dtype=float),
+            window=W,
+            sigma=sigma,
+        )
 
     @property
     def n_impacts(self):
@@ -90,18 +103,26 @@ def drift_residual(scenario, rec, loss):
     return r - r.mean()
 
 
-def noise_of(r):
-    """Robust noise scale of a residual sequence from its successive differences."""
+#: the fewest windows whose successive differences estimate the residual's noise
+MIN_DIFFERENCE_WINDOWS = 8
+
+
+def noise_of(r, floor=0.0):
+    """Robust noise scale of a residual sequence: from its successive differences, never
+    below ``floor`` (the sample noise's share of a window's impulse), which alone sets it
+    when the sequence is shorter than :data:`MIN_DIFFERENCE_WINDOWS`."""
     d = np.diff(r)
-    if d.size < 3:
-        return max(float(np.std(r)), 1e-300)
-    return max(float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0)), 1e-300)
+    if r.size < MIN_DIFFERENCE_WINDOWS:
+        est = floor if floor > 0 else (float(np.std(r)) if r.size else 0.0)
+    else:
+        est = float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2.0))
+    return max(est, floor, 1e-300)
 
 
 def drift_criterion(r, rec):
     """``D = rms(r) / mean measured impulse`` and its noise floor ``noise(r) / mean``."""
     mean = max(float(np.mean(rec.impulses)), 1e-300)
-    return float(np.sqrt(np.mean(r**2)) / mean), float(noise_of(r) / mean)
+    return float(np.sqrt(np.mean(r**2)) / mean), float(noise_of(r, rec.sigma) / mean)
 
 
 def drift_score(pairs, loss, h):
@@ -114,7 +135,7 @@ def drift_score(pairs, loss, h):
         r = drift_residual(sc, rec, loss)
         s = drift_residual(sc, rec, loss + h) - drift_residual(sc, rec, loss + 2 * h)
         s = s / h  # d(prediction)/d(loss), de-levelled
-        w = 1.0 / noise_of(r) ** 2
+        w = 1.0 / noise_of(r, rec.sigma) ** 2
         num += float(s @ r) * w
         den += float(s @ s) * w
     if den <= 0:
@@ -126,7 +147,7 @@ def drift_score(pairs, loss, h):
 def fit_drift(pairs, h, hi=0.5):
     """The mass loss per impact minimising the drift residual (bounded 1-D fit, each
     record weighted by its noise at no loss)."""
-    w = [1.0 / noise_of(drift_residual(sc, rec, 0.0)) ** 2 for sc, rec in pairs]
+    w = [1.0 / noise_of(drift_residual(sc, rec, 0.0), rec.sigma) ** 2 for sc, rec in pairs]
 
     def cost(loss):
         return sum(

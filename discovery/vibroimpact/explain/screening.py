@@ -96,6 +96,22 @@ def _jacobian(problem, model, r0):
     return np.column_stack(cols) if cols else np.zeros((r0.size, 0))
 
 
+def _score(run, model, eff, local, spans):
+    """An effect's score test: on the averaged cycle's linearisation, and a drift's (the
+    mass loss) on the drift channel; on records compared over their span, where each block
+    starts with the mass left, a drift is scored on the blocks too and the stronger test
+    kept (a motion whose impulses vary from orbit to orbit hides a trend from the drift
+    channel's few windows that the blocks' force histories show)."""
+    if "drift" not in eff.phases:
+        return local.score(eff)
+    s = run.drift.score(model, eff, _small_step(eff, run.records))
+    if spans:
+        blocks = local.score(eff)
+        if blocks.get("lm") is not None and blocks["lm"] > (s.get("lm") or 0.0):
+            return {**blocks, "channel": "blocks"}
+    return s
+
+
 @dataclass
 class _Screening:
     """The score tests of one iteration: the candidate effects, their scores, the
@@ -126,12 +142,8 @@ class _Screening:
             and (not quiet or "drift" in e.phases)
         ]
         local = _Linearisation.at(run.problem, run.records, model)
-        scores = [
-            run.drift.score(model, e, _small_step(e, run.records))
-            if "drift" in e.phases
-            else local.score(e)
-            for e in cands
-        ]
+        spans = all(getattr(ref, "span", None) is not None for _, ref in run.records)
+        scores = [_score(run, model, e, local, spans) for e in cands]
         level = run.alpha / max(len(scores), 1)
         top_phases = sorted(loc["phases"], key=lambda p: -loc["phases"][p]["share"])[:2]
         for s, e in zip(scores, cands, strict=True):

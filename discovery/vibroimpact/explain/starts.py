@@ -275,6 +275,10 @@ def _fit_start(run, start, plain, progress):
             tick(progress, "explain: fitting the start cycle by cycle", 0, None)
             fit = _output_error(short, law, criterion, budget, tolerances, polish=True)
             fit = _polish_start(records, fit, criterion, max(budget // 3, 8), tolerances)
+            if min(fit.law.coefficients) < 0:
+                why = f"the fit from {law} reached {fit.law}, with a negative coefficient"
+                fit = None
+                continue
             break
         except IntegrationError as exc:
             why = str(exc)

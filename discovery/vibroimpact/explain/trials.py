@@ -233,9 +233,11 @@ def _refit_trials(run, step, screen_budget, gap):
     trials = []
     for s in chosen:
         eff = eff_by_id[s["effect"]]
-        key = "D" if "drift" in eff.phases else gap
+        # a drift scored on the drift channel is judged there; scored on the blocks of the
+        # records' spans (:func:`~.screening._score`), by the gap it leaves on them
+        key = "D" if s.get("channel") == "drift" else gap
         try:
-            if key == "D":
+            if "drift" in eff.phases:
                 m2 = run.drift.refit(model, eff, _small_step(eff, records))
                 m2, res = _law_with_the_drift(run, m2, screen_budget, gap)
                 evs2 = run.problem.evaluations(m2, floor=True)

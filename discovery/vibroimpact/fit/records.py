@@ -58,9 +58,11 @@ def contact_scales(scenario, reference):
     a record (the scenario's period and motion scale when the record lacks them)."""
     E = reference.impulse
     tau = float(np.median(E.support[:, 1] - E.support[:, 0])) if len(E.support) else scenario.period
-    v = (reference.noise.get("impact_velocity") if reference.noise else None) or scenario.scales()[
-        1
-    ]
+    v = reference.noise.get("impact_velocity") if reference.noise else None
+    if not (v is not None and v > 0):
+        # no onset slope, or one that noise (or a contact shorter than the slope's window)
+        # turned negative: the drive's velocity scale
+        v = scenario.scales()[1]
     return tau, v, v * tau / np.pi
 
 

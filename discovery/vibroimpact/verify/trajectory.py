@@ -15,7 +15,7 @@ record's force noise added at the record's sample times, folded and compared wit
 noise-free fold.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -23,7 +23,7 @@ from ..._validate import unchecked
 from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
 from ..data.contact_edges import contact_onsets
-from ..data.impulse import Impulse
+from ..data.measurement import Measurement
 from ..data.noise import estimate_noise
 from ..dynamics import _kernel as _K
 from ..dynamics.simulation import simulate
@@ -31,6 +31,7 @@ from .block_farm import farm_for
 from .criteria import CRITERIA, evaluate_criteria
 from .fold import make_fold
 from .motion import MOTION_CRITERION, block_penetration
+from .observed import observed, observed_derivatives
 from .state import free_flight_runs, free_flight_state
 
 __all__ = [
@@ -63,6 +64,35 @@ BLOCK_CYCLES = 4
 block folded on its own and simulated from the machine's state just before it."""
 
 
+def _flight_samples(measurement, run):
+    """The samples of one free flight ``run`` (a sample range) as a record of its own."""
+    a, b = run
+    return Measurement(
+        t=measurement.t[a:b],
+        F=measurement.F[a:b],
+        channels={k: np.asarray(v)[a:b] for k, v in measurement.channels.items()},
+    )
+
+
+def _frame_key(scenario):
+    """What the frame's free motion in a flight depends on."""
+    sc = scenario
+    return (sc.m1, sc.c1, sc.k1, sc.k3, sc.A, sc.frequency, sc.g)
+
+
+@dataclass(frozen=True)
+class Flight:
+    """The free flight a block's state is estimated from: its samples (a
+    :class:`~discovery.vibroimpact.data.measurement.Measurement` of the flight alone), the
+    state's drive-clock time, the record's time offset and the machine (:func:`_frame_key`)
+    the block's :attr:`Block.state` was estimated with."""
+
+    samples: object
+    t_a: float
+    time_offset: float
+    machine: tuple
+
+
 @dataclass(frozen=True)
 class Block:
     """Consecutive cycles of a record, folded together, with the state before them.
@@ -90,6 +120,26 @@ class Block:
     threshold: float
     Z: np.ndarray
     impacts_before: int = 0
+    flight: object = None
+    states: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def state_for(self, scenario):
+        """The state before the block as a simulation on ``scenario`` starts from it: the
+        frame's free motion in the flight is fitted with the machine's own equations, so a
+        machine changed since the record's states were estimated (a stiffening of the
+        supports, a calibrated scale) re-estimates them from the same flight samples
+        (:attr:`flight`; the state of ``scenario``'s machine is kept)."""
+        if self.flight is None:
+            return self.state
+        key = _frame_key(scenario)
+        if key == self.flight.machine:
+            return self.state
+        if key not in self.states:
+            f = self.flight
+            self.states[key] = free_flight_state(
+                f.samples, scenario, (0, f.samples.t.size), f.t_a, time_offset=f.time_offset
+            )
+        return self.states[key]
 
     def machine(self, scenario):
         """``scenario`` as it is when the block starts: with a mass loss per impact, the
@@ -231,6 +281,9 @@ def record_span(
             td_all, o, cycle.n_periods, T, (o, o + count * W + 0.5 * (td_all[1] - td_all[0]))
         )
         state = free_flight_state(measurement, scenario, runs[j], mids[j], time_offset=time_offset)
+        flight = Flight(
+            _flight_samples(measurement, runs[j]), mids[j], time_offset, _frame_key(scenario)
+        )
         # the block's recorded channels, read-only: the fold keeps what it computes of them
         Fi, Zi = F[fold.idx], zeta[fold.idx]
         Fi.setflags(write=False)
@@ -244,6 +297,7 @@ def record_span(
             threshold=thr,
             Z=Zi,
             impacts_before=int(np.count_nonzero(onsets + time_offset < state.t)),
+            flight=flight,
         )
         if not len(fold.impulse(Fi, threshold=thr, noise=sigma).support):
             continue  # no contact in these cycles (a run-up's start): nothing to compare
@@ -264,7 +318,7 @@ block alive (its id is not reused while cached)."""
 def _simulate_block(scenario, law, blk, y0, tolerances, **kwargs):
     """The law simulated over a block from ``y0`` (default the block's measured state),
     sampled at its sample times."""
-    fold, st = blk.fold, blk.state
+    fold, st = blk.fold, blk.state_for(scenario)
     scenario = blk.machine(scenario)
     return unchecked(simulate)(
         scenario,
@@ -393,6 +447,10 @@ def history_sensitivities(scenario, law, span, *, tolerances=None, observe=None)
     for blk in span.blocks:
         td = blk.fold.td
         F, dF, onsets, d_on, _ = _sensitivities(scenario, law, blk, tolerances)
+        if observe is not None:
+            # no onset blend through an observation model (:func:`_history`)
+            out.append(observed_derivatives(blk, (F, dF, onsets, d_on), observe))
+            continue
         dH = dF.copy()
         if td.size > 1 and onsets.size:
             k, u, width, keep = _onset_weights(td, onsets)
@@ -403,8 +461,6 @@ def history_sensitivities(scenario, law, span, *, tolerances=None, observe=None)
                 w = abs(2.0 * u[i] - 1.0)
                 dw = 2.0 * np.sign(2.0 * u[i] - 1.0) / width[i] * d_on[i]
                 dH[:, kk] = w * dF[:, kk] + dw * (F[kk] - blk.F[kk])
-        if observe is not None:
-            dH = np.array([_observed(blk.fold, d, observe) for d in dH]).reshape(dH.shape)
         out.append(dH)
     return out
 
@@ -474,6 +530,12 @@ def _history(blk, F, onsets, observe, window):
     fold = blk.fold
     td = fold.td
     Fs = F.copy()
+    if observe is not None:
+        # through an observation model the onset's jump is placed at the run's event time
+        # (:func:`~.observed.observed`), which makes the observed history continuous in the onset: a
+        # sample blended towards the record, whose force the sensor has already filtered,
+        # would filter it twice (the lag came out 1-2 % low)
+        return observed(fold, Fs, observe, onsets)
     if window and td.size > 1:
         # the sample whose interval [e_i, e_i+1) holds a contact onset at fraction u is
         # blended towards the record's value with weight |2u - 1|: its residual is 0
@@ -484,7 +546,7 @@ def _history(blk, F, onsets, observe, window):
         if k.size:
             w = np.abs(2.0 * u - 1.0)
             Fs[k] = blk.F[k] + w * (Fs[k] - blk.F[k])
-    return Fs if observe is None else _observed(fold, Fs, observe, onsets)
+    return Fs
 
 
 def _memo_run(scenario, law, blk, tolerances, made=None):
@@ -492,52 +554,6 @@ def _memo_run(scenario, law, blk, tolerances, made=None):
     made elsewhere (a block farm), kept as is."""
     key = value_key(scenario, law, tolerances, id(blk))
     return MEMO.get(key, lambda: (blk, *(made or _block_run(scenario, law, blk, None, tolerances))))
-
-
-def _observed(fold, Fs, observe, onsets=None):
-    """A block's history at its sample times seen through the observation model (the
-    block taken as one periodic signal); ``observe.at(impulse, times)``, when the model
-    has it, gives those values without the observed impulse.
-
-    The history is piecewise linear between the samples, except at the run's contact
-    ``onsets`` (its event times): there the force jumps from 0 to its value just after
-    the onset (the next two samples' line, extrapolated back; a force that starts from 0
-    has none).  Between two samples a jump would be a ramp across the sampling interval,
-    whose response through a sensor's lag is delayed by where the onset falls in it: on
-    a sampling commensurate with the drive, the same fraction of a sample every period,
-    which biased the lag fitted by 0.4 sampling intervals."""
-    td = fold.td
-    t, F = _with_jumps(td, Fs, onsets)
-    L = fold.end - fold.origin
-    imp = Impulse(
-        t=np.concatenate([[0.0], t - fold.origin, [L]]),
-        F=np.concatenate([[Fs[-1]], F, [Fs[-1]]]),
-        duration=L,
-        support=np.zeros((0, 2)),
-        n_periods=fold.n_periods * fold.n_cycles,
-        onset=fold.origin,
-    )
-    at = getattr(observe, "at", None)
-    tq = td - fold.origin
-    return at(imp, tq) if at is not None else observe(imp).evaluate(tq)
-
-
-def _with_jumps(td, Fs, onsets):
-    """The knots ``(t, F)`` of a sampled history with a jump at each onset inside it
-    (see :func:`_observed`)."""
-    if onsets is None or td.size < 4:
-        return td, Fs
-    on = np.asarray(onsets, dtype=float)
-    on = on[(on > td[0]) & (on < td[-3])]
-    if not on.size:
-        return td, Fs
-    i = np.searchsorted(td, on, side="right") - 1  # the sample at or before each onset
-    slope = (Fs[i + 2] - Fs[i + 1]) / (td[i + 2] - td[i + 1])
-    after = np.maximum(Fs[i + 1] + slope * (on - td[i + 1]), 0.0)
-    at = np.where(on > td[i], i + 1, i)  # an onset on a sample replaces nothing
-    t = np.insert(np.insert(td, at, on), at + np.arange(on.size) + 1, on)
-    F = np.insert(np.insert(Fs, at, 0.0), at + np.arange(on.size) + 1, after)
-    return t, F
 
 
 def block_criteria(measured, simulated, span, names=None):

@@ -3,7 +3,7 @@ the Floquet multipliers agree with long runs from rest.
 
 A law scaled by each impact's approach velocity carries that velocity through a contact,
 so where a strobe point falls inside a contact the period map's state holds it too
-(:class:`~discovery.vibroimpact.dynamics.steady_states.MemoryMap`).  Each expectation here
+(:class:`~discovery.vibroimpact.dynamics.memory_map.MemoryMap`).  Each expectation here
 is measured independently of the shooting: the strobe points of a plain run from rest (the
 kernel's own period-by-period integration, which carries the memory exactly), their
 recurrence and their contraction per period onto the orbit.  The machines are random draws
@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from discovery.numerics.shooting import recurrence
-from discovery.vibroimpact.dynamics.steady_states import MemoryMap, StroboscopicMap, steady_state
+from discovery.vibroimpact.dynamics.memory_map import MemoryMap
+from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state
 from discovery.vibroimpact.model.contact_models import parse_law
 from discovery.vibroimpact.model.scenario import Scenario, load_scenario
 

@@ -18,7 +18,7 @@ from scipy.optimize import minimize_scalar
 
 from discovery.numerics.lag import lag_at, lag_at_knots
 from discovery.vibroimpact.explain.effects import first_order_lag, first_order_lag_at
-from discovery.vibroimpact.verify.trajectory import _observed
+from discovery.vibroimpact.verify.observed import observed as _observed
 
 W = 0.04  # one drive period [s]
 T_ON, DUR, JUMP = 0.0101, 0.009, 4.0e5  # a Kelvin-Voigt-like contact

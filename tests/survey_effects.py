@@ -1,0 +1,366 @@
+"""Survey of every effect class to its true value (issue 48): random machines, each
+catalogue effect hidden in turn (and two at once), each record at two noise levels, explained
+from the linear start (not a test).
+
+Usage::
+
+    python -m tests.survey_effects --draws 0 40 [--workers 2] --out docs/_measured/effects.jsonl
+
+Draw ``i`` hides class ``CLASSES[i % len(CLASSES)]`` on a machine of the generator's class
+``CATEGORIES[(i // len(CLASSES)) % 4]`` (:func:`tests.realistic.draw_case`, seed ``3000 +
+i``; a Hertz-type draw is replaced by the next seed's, a ``z*zd`` draw's law loses its
+coupling: the base law is always ``k z + c zd``).  The effect's size is drawn from the seed:
+
+========================  ===========================================================
+``none``                  nothing (the clean control)
+``unloading_damping``     an unloading damper 0.3-0.8 of the loading one
+``permanent_set``         a set 0.2-0.5
+``support_nonlinearity``  ``k3`` giving 10-50 % of ``k1``'s force at the grid's excursion
+``coupling``              ``z*zd`` carrying 20-80 % of the damping at the typical penetration
+``hertzian_stiffening``   ``z^1.5`` giving 30-100 % of the spring's force there
+``contact_offset``        an offset of 0.2-1 typical penetrations, either sign
+``sensor_lag``            a first-order sensor, ``tau`` 5-20 % of the contact time
+``mass_loss``             0.2-0.6 % of the moulding per impact (40-period transient, the
+                          record starting at the machine's mass)
+``unloading+supports``    the unloading damper and the stiffening supports together
+========================  ===========================================================
+
+Each draw's record (the independent scipy path from rest, 15 periods at 20 kHz) is made at
+two noise levels: force 2 % of its peak and motions 0.4 % of each channel's range, and a
+quarter of that.  On each: the true model verified, then ``explain`` from the linear start
+with the true machine (its sheet is another survey's), bootstrap intervals of 30 replicates.
+A row: what was named and kept, whether the final model is consistent, and whether each
+hidden parameter's 95 % interval holds its true value.
+"""
+
+import argparse
+import json
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+if not __package__:
+    sys.path[0:1] = [str(HERE.parent)]
+
+import numpy as np  # noqa: E402
+
+from tests import measured  # noqa: E402
+
+CATEGORIES = ("p1", "subharmonic", "p1-slow", "short-contact")
+CLASSES = (
+    "none",
+    "unloading_damping",
+    "permanent_set",
+    "support_nonlinearity",
+    "coupling",
+    "hertzian_stiffening",
+    "contact_offset",
+    "sensor_lag",
+    "mass_loss",
+    "unloading+supports",
+)
+#: the effect ids each class hides (``coupling`` is the catalogue's
+#: ``penetration_velocity_coupling``)
+EFFECT_IDS = {
+    "none": (),
+    "coupling": ("penetration_velocity_coupling",),
+    "unloading+supports": ("unloading_damping", "support_nonlinearity"),
+}
+#: (force, motion) noise of a draw's two records
+NOISE = {"high": (0.02, 0.004), "low": (0.005, 0.001)}
+
+
+def effect_ids(cls):
+    return EFFECT_IDS.get(cls, (cls,))
+
+
+def _base_case(category, seed):
+    """A drawn case with a linear law ``k z + c zd`` (a ``z*zd`` draw loses its coupling; a
+    Hertz-type draw is replaced by the next seed's)."""
+    from discovery import ForceLaw
+    from tests import realistic as R
+
+    for s in range(seed, seed + 50):
+        try:
+            case = R.draw_case(category, s)
+        except RuntimeError:
+            continue
+        if case.kind == "hertz":
+            continue
+        d = case.law.as_dict()
+        law = ForceLaw.parse(f"{d['z']!r}*z + {d['zd']!r}*zd")
+        return case, law
+    raise RuntimeError(f"no linear case of {category} from seed {seed}")
+
+
+def _sizes(case, law, cls, rng):
+    """The true scenario, the true law, the observation (a sensor's lag or None) and the
+    hidden parameters' true values ``{interval name: value}``."""
+    sc = case.scenario.with_law(law)
+    k, c = law.as_dict()["z"], law.as_dict()["zd"]
+    mu = sc.m1 * sc.m2 / (sc.m1 + sc.m2)
+    z0 = sc.scales()[1] / np.sqrt(k / mu)  # typical penetration
+    t_contact = np.pi * np.sqrt(mu / k)
+    true, truth, lag = law, {}, None
+    for eff in effect_ids(cls):
+        if eff == "unloading_damping":
+            d = float(f"{rng.uniform(0.3, 0.8) * c:.3g}")
+            true = true.with_unloading((true.terms[1],), (d,))
+            truth["d_zd"] = d
+        elif eff == "permanent_set":
+            s = float(np.round(rng.uniform(0.2, 0.5), 2))
+            true = true.with_unloading(permanent_set=s)
+            truth["set"] = s
+        elif eff == "support_nonlinearity":
+            x = abs(float(sc.initial_state()[0])) + sc.scales()[0]
+            k3 = float(f"{rng.uniform(0.1, 0.5) * sc.k1 / x**2:.3g}")
+            sc = sc.replace(k3=k3)
+            truth["k3"] = k3
+        elif eff == "penetration_velocity_coupling":
+            share = rng.uniform(0.2, 0.8)
+            czz = float(f"{share * c / z0:.3g}")
+            true = _loading(true, {"zd": float(f"{(1 - share) * c:.3g}"), "z*zd": czz})
+            truth["z*zd"] = czz
+        elif eff == "hertzian_stiffening":
+            kh = float(f"{rng.uniform(0.3, 1.0) * k * z0 / z0**1.5:.3g}")
+            true = _loading(true, {"z^1.5": kh})
+            truth["z^1.5"] = kh
+        elif eff == "contact_offset":
+            d0 = float(f"{rng.choice([-1, 1]) * rng.uniform(0.2, 1.0) * z0:.3g}")
+            sc = sc.replace(offset=d0)
+            truth["delta0"] = d0
+        elif eff == "sensor_lag":
+            lag = float(f"{rng.uniform(0.05, 0.2) * t_contact:.3g}")
+            truth["tau"] = lag
+        elif eff == "mass_loss":
+            loss = float(np.round(rng.uniform(0.002, 0.006), 4))
+            sc = sc.replace(mass_loss=loss)
+            truth["loss"] = loss
+    return sc.with_law(true), true, lag, truth
+
+
+def _loading(law, changes):
+    """``law`` with its loading terms' coefficients changed or added (``{name: value}``)."""
+    from discovery import ForceLaw
+
+    d = {**law.as_dict(), **changes}
+    text = " + ".join(f"{v!r}*{n}" for n, v in d.items())
+    unloading = law.to_text().split(";", 1)
+    return ForceLaw.parse(text + (";" + unloading[1] if len(unloading) > 1 else ""))
+
+
+def _record(true_sc, true, lag, noise, seed, case):
+    """The record of a draw at one noise level: the scipy path from rest; the offset shifts
+    the recorded moulding; a lag filters the recorded force (closed form on the fine
+    history); a shedding machine starts the record at its mass."""
+    from tests import realistic as R
+
+    fn, mn = noise
+    kw = dict(periods=15, seed=seed, check=False, force_noise=fn, motion_noise=mn)
+    sim_sc = true_sc.replace(offset=0.0)
+    if true_sc.mass_loss > 0:
+        sim_sc = _shedding_start(sim_sc, true, 40)
+        kw["transient"] = 40
+    else:
+        kw["transient"] = R.default_transient(case)
+    if lag:
+        rec = _lagged_record(sim_sc, true, lag, kw)
+    else:
+        rec = R.reference_record((sim_sc, true), **kw)
+    if true_sc.offset:
+        ch = dict(rec.channels)
+        ch["w2"] = ch["w2"] - true_sc.offset  # recorded penetration = model's + offset
+        rec = replace(rec, channels=ch)
+    return rec
+
+
+def _shedding_start(sc, law, trans):
+    """The starting mass whose transient sheds down to the scenario's mass."""
+    from discovery.vibroimpact.dynamics.reference import reference_simulate
+
+    true = sc
+    for _ in range(5):
+        m2_end = reference_simulate(true, law, (0, trans * sc.period))["m2_final"]
+        if abs(m2_end - sc.m2) <= 1e-9 * sc.m2:
+            break
+        true = true.replace(m2=true.m2 * sc.m2 / m2_end)
+    return true
+
+
+def _lagged_record(sc, law, tau, kw):
+    """A record whose force a first-order sensor ``tau`` filtered: the noise-free record at
+    16 times the rate, filtered in closed form (piecewise linear at that rate, from the
+    sensor at the force's value at the start), sampled at the record's rate, then the
+    noise."""
+    from discovery.numerics.lag import _pass
+    from tests import realistic as R
+
+    fine = R.reference_record(
+        (sc, law), **{**kw, "force_noise": 0.0, "motion_noise": 0.0}, fs=320_000.0
+    )
+    t, F = np.asarray(fine.t, dtype=float), np.asarray(fine.F, dtype=float)
+    G = np.empty_like(F)
+    _pass(t, F, tau, F[0], G)  # the sensor in step with the force at the record's start
+    keep = slice(None, None, 16)
+    rng = np.random.default_rng(kw["seed"] + 77)
+    fn, mn = kw["force_noise"], kw["motion_noise"]
+    Fr = G[keep] + rng.normal(0.0, fn * float(np.max(G)), G[keep].size)
+    ch = {}
+    for name, x in fine.channels.items():
+        x = np.asarray(x)[keep]
+        ch[name] = x + rng.normal(0.0, mn * float(np.ptp(x)), x.size)
+    return replace(fine, t=t[keep], F=Fr, channels=ch)
+
+
+def run_case(args):
+    """The two rows of draw ``i`` (one per noise level)."""
+    (i,) = args
+    from discovery.vibroimpact.explain import explain
+    from discovery.vibroimpact.verify import Reference, evaluate
+
+    cls = CLASSES[i % len(CLASSES)]
+    cat = CATEGORIES[(i // len(CLASSES)) % len(CATEGORIES)]
+    seed = 3000 + i
+    base = {"draw": i, "class": cls, "category": cat, "seed": seed}
+    try:
+        case, law = _base_case(cat, seed)
+    except RuntimeError as exc:
+        return [{**base, "skip": str(exc)}]
+    rng = np.random.default_rng(seed)
+    true_sc, true, lag, truth = _sizes(case, law, cls, rng)
+    base.update(truth=truth, true=true.to_text(), regime=case.regime)
+    rows = []
+    for level, noise in NOISE.items():
+        row = {**base, "noise": level}
+        try:
+            rec = _record(true_sc, true, lag, noise, seed, case)
+            start = case.scenario.with_law(law)
+            row.update(_verify_truth(true_sc, true, lag, rec, start, evaluate, Reference))
+            t0 = time.perf_counter()
+            res = explain(start, rec, "linear", workers=1)
+            row.update(_outcome(res, truth, time.perf_counter() - t0))
+        except Exception as exc:  # noqa: BLE001 (a survey row records any failure)
+            row["error"] = f"{type(exc).__name__}: {exc}"
+        rows.append(row)
+    return rows
+
+
+def _verify_truth(true_sc, true, lag, rec, start, evaluate, Reference):
+    """Whether the true model (machine, law, sensor) is consistent with its record."""
+    from discovery.vibroimpact.explain.effects import Model, effect
+
+    model = Model(true)
+    for key, eff in (("k3", "support_nonlinearity"), ("offset", "contact_offset")):
+        v = getattr(true_sc, key)
+        if v:
+            model = model.with_effect(effect(eff), v)
+    if true_sc.mass_loss:
+        model = model.with_effect(effect("mass_loss"), true_sc.mass_loss)
+    if lag:
+        model = model.with_effect(effect("sensor_lag"), lag)
+    ref = Reference.from_measurement(rec, start, n_boot=16, seed=0)
+    ev = evaluate(model.apply(start, ref), true, ref, observe=model.observe())
+    return {"true_consistent": bool(ev.consistent), "true_I2": ev.criteria.get("I2")}
+
+
+def _outcome(res, truth, seconds):
+    """What explain ended with, and each hidden parameter's interval against the truth."""
+    iv = res.intervals
+    covered = {}
+    for name, value in truth.items():
+        b = None if iv is None else iv.bounds.get(name)
+        covered[name] = None if b is None else bool(b[0] <= value <= b[1])
+    final = res.final_model
+    values = dict(zip(final.names, final.coefficients, strict=True))
+    if "loss" in truth:
+        values["loss"] = float(final.scenario.get("mass_loss", 0.0))
+    return {
+        "seconds": seconds,
+        "named": [it.effect for it in res.iterations if it.effect],
+        "kept": list(final.effects),
+        "consistent": bool(res.consistent),
+        "I2_final": res.criteria.get("I2"),
+        "final": str(final),
+        "values": {n: values.get(n) for n in truth},
+        "intervals": {n: (None if iv is None else iv.bounds.get(n)) for n in truth},
+        "covered": covered,
+    }
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--draws", nargs=2, type=int, metavar=("FIRST", "STOP"), required=True)
+    p.add_argument("--workers", type=int, default=2)
+    p.add_argument("--out", required=True, help="the run file of the rows (JSON lines)")
+    args = p.parse_args(argv)
+    from multiprocessing import get_context
+
+    out = measured.RunFile(args.out, "survey_effects", argv, append=True)
+    with get_context("spawn").Pool(args.workers) as pool:
+        for rows in pool.imap_unordered(run_case, [(i,) for i in range(*args.draws)]):
+            for row in rows:
+                out.write(row)
+                print(json.dumps(row), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
+
+
+# ------------------------------------------------------------- the docs' table
+def read_rows(paths):
+    """Every row of the run files ``paths`` (a later row of a draw and noise level replacing
+    an earlier one)."""
+    by = {(r["draw"], r.get("noise")): r for p in paths for r in measured.read(p)[1]}
+    return [by[k] for k in sorted(by, key=lambda k: (k[0], str(k[1])))]
+
+
+def named_right(r):
+    """Every hidden effect kept, and nothing else."""
+    return sorted(r.get("kept") or ()) == sorted(effect_ids(r["class"]))
+
+
+def _rate(k, n):
+    return f"{k}/{n}" if n else "--"
+
+
+def markdown_row(rows, label):
+    """docs/explain.md's row ``label`` (a class or "all")."""
+    rows = [r for r in rows if "skip" not in r and (label == "all" or r["class"] == label)]
+    ok = [r for r in rows if "error" not in r]
+    valid = [r for r in ok if r.get("true_consistent")]
+    right = sum(named_right(r) for r in valid)
+    clean = [r for r in valid if r["class"] == "none"]
+    false = sum(bool(r.get("kept")) for r in clean)
+    consistent = sum(bool(r.get("consistent")) for r in valid)
+    cov = [c for r in valid for c in (r.get("covered") or {}).values() if c is not None]
+    pairs = _pairs(rows)
+    cells = [
+        label,
+        str(len(rows)),
+        str(len(rows) - len(ok)),
+        str(len(ok) - len(valid)),
+        _rate(right, len(valid)),
+        _rate(false, len(clean)) if clean or label in ("none", "all") else "--",
+        _rate(consistent, len(valid)),
+        _rate(sum(cov), len(cov)),
+        str(pairs),
+    ]
+    return "| " + " | ".join(cells) + " |"
+
+
+def _pairs(rows):
+    """Draws where the low-noise record names a wrong effect and the high-noise one the
+    right one (better data must never give a worse answer)."""
+    by = {}
+    for r in rows:
+        by.setdefault(r["draw"], {})[r.get("noise")] = r
+    bad = 0
+    for pair in by.values():
+        hi, lo = pair.get("high"), pair.get("low")
+        if hi and lo and "error" not in hi and "error" not in lo:
+            bad += named_right(hi) and not named_right(lo)
+    return bad
