@@ -44,6 +44,12 @@ def advise_figure(result, stem):
         reg = m["regime"] & ok
         if reg.any():
             ax.scatter(A[reg], f[reg], s=220, facecolors="none", edgecolors="tab:orange", lw=1.4)
+        phys = m.get("physics", np.zeros_like(ok)) & ~m["excluded"]
+        if phys.any():
+            # separated on physics: the separation is infinite, drawn as a square of its own
+            inf = phys & ~ok
+            ax.scatter(A[inf], f[inf], s=90, marker="s", c="w", edgecolors="tab:red", lw=1.2)
+            ax.scatter(A[phys], f[phys], s=320, facecolors="none", edgecolors="tab:red", lw=1.4)
         un = m["unsafe"]
         if un.any():
             ax.scatter(A[un], f[un], marker="x", c="tab:red", s=60)
@@ -60,16 +66,18 @@ def advise_figure(result, stem):
         pa, pf = 0.04 * max(ka[1] - ka[0], abs(ka[0]) * 0.05), 0.04 * max(kf[1] - kf[0], 0.5)
         ax.set_xlim(ka[0] - pa, ka[1] + pa)
         ax.set_ylim(kf[0] - pf, kf[1] + pf)
-        ax.set_title(_legend_text(reg.any(), un.any(), ex.any(), b is not None))
+        ax.set_title(_legend_text(reg.any(), un.any(), ex.any(), b is not None, phys.any()))
         return save(fig, stem)
 
 
-def _legend_text(regime, unsafe, excluded, best):
+def _legend_text(regime, unsafe, excluded, best, physics=False):
     parts = []
     if best:
         parts.append("star: advised")
     if regime:
         parts.append("ring: a pair differs by regime")
+    if physics:
+        parts.append("red ring: a candidate breaks condition (6) there")
     if unsafe:
         parts.append("x: outside the safe region")
     if excluded:

@@ -26,6 +26,8 @@ def _f(v):
 
 def _pair_cell(q):
     tag = " (regime)" if q.regime_change else ""
+    if q.physics:
+        tag = " (physics)"
     return Tex(f"{_f(q.separation)}{tag}")
 
 

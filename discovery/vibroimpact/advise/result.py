@@ -98,7 +98,8 @@ class AdviseResult(Result):
             smallest separation over the pairs some point separates, of the best point over
             ``m2`` at each (A, f); nan where excluded),
             ``unsafe`` and ``excluded`` (bool, every m2 excluded), ``regime`` (bool, the
-            best point there separates by regime).
+            best point there separates by regime), ``physics`` (bool, a candidate's orbit
+            there leaves its dissipative domain).
         """
         ignore = frozenset(self.inseparable)
         cells = {}
@@ -110,12 +111,13 @@ class AdviseResult(Result):
             "amplitude": np.array([k[0] for k in keys]),
             "frequency": np.array([k[1] for k in keys]),
         }
-        smallest, unsafe, excl, regime = [], [], [], []
+        smallest, unsafe, excl, regime, physics = [], [], [], [], []
         for k in keys:
             ps = [p for p in cells[k] if p.usable]
             best = min(ps, key=lambda p: rank_key(p, ignore)) if ps else None
             smallest.append(best.smallest_separation(ignore) if best else np.nan)
             regime.append(bool(best and any(q.regime_change for q in best.pairs)))
+            physics.append(bool(best and any(pr.leaves_domain for pr in best.predictions)))
             unsafe.append(not ps and any(p.unsafe for p in cells[k]))
             excl.append(not ps)
         out.update(
@@ -123,6 +125,7 @@ class AdviseResult(Result):
             unsafe=np.array(unsafe),
             excluded=np.array(excl),
             regime=np.array(regime),
+            physics=np.array(physics),
         )
         return out
 
@@ -183,6 +186,7 @@ class AdviseResult(Result):
             f"{len(self.points)} point(s) evaluated, {usable} usable, {unsafe} outside the "
             f"safe region; noise {100 * self.noise.relative:.3g} % of the peak force"
         )
+        out += _domain_lines(self)
         b = self.best
         if b is None:
             out.append("no usable point: widen the bounds or the safe region")
@@ -203,6 +207,24 @@ class AdviseResult(Result):
         return out
 
 
+def _domain_lines(self):
+    """One line per candidate whose predicted orbit leaves its dissipative domain at some
+    usable point: where a record rejects it on physics."""
+    out = []
+    usable = [p for p in self.points if p.usable]
+    for k in range(len(self.laws)):
+        left = [p for p in usable if p.predictions[k].leaves_domain]
+        if left:
+            out.append(
+                f"candidate {k + 1} is dissipative (condition (6)) only up to a penetration "
+                f"rate of {left[0].predictions[k].domain:.3g} m/s; at {len(left)} of "
+                f"{len(usable)} usable point(s) the rates there go beyond (its orbit's, or "
+                "the others' where it has none), and a record rejects it on physics (ringed "
+                "in red on the map)"
+            )
+    return out
+
+
 def _where(p):
     m2 = "" if p.m2 is None else f", m2 = {p.m2:.4g} kg"
     return f"A = {p.amplitude:.4g} N, f = {p.frequency:.4g} Hz{m2}"
@@ -213,13 +235,34 @@ def point_lines(p, result):
     out = []
     for q in p.pairs:
         tag = " (regime change: separated outright)" if q.regime_change else ""
+        if q.physics:
+            tag = " (a candidate leaves its dissipative domain: separated on physics)"
         out.append(
             f"  pair {result.pair_label(q.pair)}: separation {q.separation:.3g} "
             f"(directions {q.directions[0]:.3g}, {q.directions[1]:.3g}){tag}"
         )
     for k, pr in enumerate(p.predictions):
+        if pr.status != "ok":
+            out.append(
+                f"  candidate {k + 1}: no periodic orbit ({pr.status})"
+                + (
+                    f": the other candidates' orbits reach a penetration rate of "
+                    f"{pr.max_rate:.3g} m/s, beyond the {pr.domain:.3g} m/s up to which it is "
+                    "dissipative (condition (6)): a record here rejects it on physics"
+                    if pr.leaves_domain
+                    else ""
+                )
+            )
+            continue
         out.append(
             f"  candidate {k + 1}: {pr.regime} with {pr.impacts} contact(s), peak force "
             f"{pr.peak_force:.3g} N, penetration {pr.max_penetration:.3g} m"
+            + (
+                f"; its orbit reaches a penetration rate of {pr.max_rate:.3g} m/s, beyond "
+                f"the {pr.domain:.3g} m/s up to which it is dissipative (condition (6)): a "
+                "record here rejects it on physics"
+                if pr.leaves_domain
+                else ""
+            )
         )
     return out

@@ -131,7 +131,9 @@ def advise(
     t0 = time.perf_counter()
     laws = unique_laws(laws)
     for k, law in enumerate(laws):
-        law.check_physical(scenario, f"candidate {k + 1}")
+        # a rival certified on its record's rates may break condition (6) beyond them: it is
+        # judged where its orbit stays inside, and a point where it leaves is evidence
+        law.check_physical(scenario, f"candidate {k + 1}", dissipative_below=True)
     safe = SafeRegion() if safe is None else safe
     context = _Context(scenario, laws, noise, safe, s.tolerances)
     a, f, m = knobs.axes()

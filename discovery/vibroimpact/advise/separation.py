@@ -25,7 +25,7 @@ noisy one (force and position noise seeded by ``NoiseModel.seed``; the limits co
 noise floor under ``b``).
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -65,6 +65,12 @@ class Prediction:
     max_penetration : float
         Largest penetration ``w1 - w2`` [m] on the orbit (0 unless ok).
     message : str
+    max_rate : float
+        Largest penetration rate [m/s] in contact on the orbit (0 unless ok).
+    domain : float
+        The rate up to which the candidate satisfies the paper's condition (6) at this
+        point (:meth:`~discovery.vibroimpact.model.law.ForceLaw.dissipative_rate`; ``inf``
+        when everywhere).
     """
 
     status: str
@@ -73,6 +79,17 @@ class Prediction:
     peak_force: float = 0.0
     max_penetration: float = 0.0
     message: str = ""
+    max_rate: float = 0.0
+    domain: float = float("inf")
+
+    @property
+    def leaves_domain(self):
+        """Whether the candidate breaks condition (6) at this point (a record here rejects it
+        on physics): its orbit reaches rates where it feeds energy into the impact, or it has
+        no periodic orbit while the other candidates' orbits reach rates beyond its domain
+        (``max_rate`` is then theirs: the energy its impacts would gain is what keeps it
+        from settling)."""
+        return self.status in ("ok", "nonperiodic") and self.max_rate > self.domain
 
     def to_dict(self):
         return {
@@ -82,6 +99,8 @@ class Prediction:
             "peak_force": _num(self.peak_force),
             "max_penetration": _num(self.max_penetration),
             "message": self.message,
+            "max_rate": _num(self.max_rate),
+            "domain": _num(self.domain),
         }
 
     @classmethod
@@ -93,6 +112,8 @@ class Prediction:
             peak_force=_float(d["peak_force"]),
             max_penetration=_float(d["max_penetration"]),
             message=d["message"],
+            max_rate=_float(d.get("max_rate", 0.0)),
+            domain=_float(d.get("domain", float("inf"))),
         )
 
 
@@ -115,6 +136,9 @@ class PairSeparation:
         The verdict's limits of each direction (from the noise floor).
     regime_change : bool
         The two predict different regimes or contacts per orbit: separated outright.
+    physics : bool
+        One of the two predicts an orbit that leaves its dissipative domain (condition (6)
+        broken on it): a record here rejects that one on physics, separated outright.
     """
 
     pair: tuple
@@ -123,15 +147,17 @@ class PairSeparation:
     criteria: tuple
     limits: tuple
     regime_change: bool = False
+    physics: bool = False
 
     @property
     def separated(self):
-        return bool(self.regime_change or self.separation >= 1.0)
+        return bool(self.regime_change or self.physics or self.separation >= 1.0)
 
     @property
     def score(self):
-        """For ranking: a regime change counts as infinitely separated."""
-        return float("inf") if self.regime_change else self.separation
+        """For ranking: a regime change or a break of physics counts as infinitely
+        separated."""
+        return float("inf") if self.regime_change or self.physics else self.separation
 
     def to_dict(self):
         return {
@@ -141,6 +167,7 @@ class PairSeparation:
             "criteria": [{k: _num(v) for k, v in c.items()} for c in self.criteria],
             "limits": [{k: _num(v) for k, v in c.items()} for c in self.limits],
             "regime_change": bool(self.regime_change),
+            "physics": bool(self.physics),
         }
 
     @classmethod
@@ -152,6 +179,7 @@ class PairSeparation:
             criteria=tuple({k: _float(v) for k, v in c.items()} for c in d["criteria"]),
             limits=tuple({k: _float(v) for k, v in c.items()} for c in d["limits"]),
             regime_change=bool(d["regime_change"]),
+            physics=bool(d.get("physics", False)),
         )
 
 
@@ -270,10 +298,15 @@ def _orbit(scenario, law, tolerances):
             tolerances=tolerances,
             zeta_max0=ss.zeta_max0,
         )
-        pen = float(np.max(tr.y[0] - tr.y[2]))
+        z, zd = tr.y[0] - tr.y[2], tr.y[1] - tr.y[3]
+        pen = float(np.max(z))
+        rate = float(np.max(np.abs(zd[z > 0]))) if np.any(z > 0) else 0.0
+        domain = law.dissipative_rate(scenario, up_to=max(4.0 * scenario.scales()[1], 2 * rate))
     except (IntegrationError, InputError) as exc:
         return _Orbit(Prediction("failed", message=str(exc)))
-    pred = Prediction("ok", ss.regime, int(ss.impacts), imp.peak, max(pen, 0.0))
+    pred = Prediction(
+        "ok", ss.regime, int(ss.impacts), imp.peak, max(pen, 0.0), max_rate=rate, domain=domain
+    )
     return _Orbit(pred, imp, ss)
 
 
@@ -342,6 +375,28 @@ def _direction(scenario, judged, references, tolerances):
     return float(ratio), {k: crit[k] for k in lim}, dict(lim)
 
 
+def _physics_pair(i, j):
+    """A pair one of whose candidates breaks condition (6) here (separated outright)."""
+    inf = float("inf")
+    return PairSeparation((i, j), inf, (inf, inf), ({}, {}), ({}, {}), physics=True)
+
+
+def _beyond_domain(scenario, laws, preds):
+    """The predictions with each nonperiodic candidate's dissipative domain set against
+    the largest rate the other candidates' orbits reach (:attr:`Prediction.leaves_domain`)."""
+    rates = [p.max_rate for p in preds if p.status == "ok"]
+    if not rates or all(p.status == "ok" for p in preds):
+        return preds
+    top = max(rates)
+    out = []
+    for law, p in zip(laws, preds, strict=True):
+        if p.status == "nonperiodic":
+            domain = law.dissipative_rate(scenario, up_to=max(4.0 * scenario.scales()[1], 2 * top))
+            p = replace(p, max_rate=top, domain=domain)
+        out.append(p)
+    return tuple(out)
+
+
 def evaluate_point(context, amplitude, frequency, m2=None, stage="coarse"):
     """Evaluate one operating point (see the module docstring).
 
@@ -362,10 +417,10 @@ def evaluate_point(context, amplitude, frequency, m2=None, stage="coarse"):
         changes["m2"] = float(m2)
     sc = context.scenario.replace(**changes)
     orbits = [_orbit(sc, law, context.tolerances) for law in context.laws]
-    preds = tuple(o.prediction for o in orbits)
+    preds = _beyond_domain(sc, context.laws, tuple(o.prediction for o in orbits))
     point = {"amplitude": amplitude, "frequency": frequency, "m2": m2, "stage": stage}
-    bad = [(k, p) for k, p in enumerate(preds) if p.status != "ok"]
-    if bad:
+    bad = [(k, p) for k, p in enumerate(preds) if p.status != "ok" and not p.leaves_domain]
+    if bad or all(p.status != "ok" for p in preds):
         why = "; ".join(f"candidate {k + 1}: {p.status}" for k, p in bad)
         return Point(predictions=preds, excluded=why, **point)
     unsafe = [
@@ -377,8 +432,8 @@ def evaluate_point(context, amplitude, frequency, m2=None, stage="coarse"):
         return Point(predictions=preds, excluded=f"unsafe ({why})", unsafe=True, **point)
     try:
         refs = [
-            _predicted_reference(o, sc, law, context.noise)
-            for o, law in zip(orbits, context.laws, strict=True)
+            _predicted_reference(o, sc, law, context.noise) if p.status == "ok" else None
+            for o, law, p in zip(orbits, context.laws, preds, strict=True)
         ]
     except VidiError as exc:
         why = f"a predicted record could not be prepared ({exc})"
@@ -387,6 +442,14 @@ def evaluate_point(context, amplitude, frequency, m2=None, stage="coarse"):
     n = len(orbits)
     for i in range(n):
         for j in range(i + 1, n):
+            if refs[i] is None or refs[j] is None:
+                # a candidate without an orbit here because it breaks condition (6) at the
+                # rates the others reach: separated on physics
+                inf = float("inf")
+                pairs.append(
+                    PairSeparation((i, j), inf, (inf, inf), ({}, {}), ({}, {}), physics=True)
+                )
+                continue
             r_ij, c_ij, l_ij = _direction(sc, context.laws[j], refs[i], context.tolerances)
             r_ji, c_ji, l_ji = _direction(sc, context.laws[i], refs[j], context.tolerances)
             regime = preds[i].regime != preds[j].regime or preds[i].impacts != preds[j].impacts
@@ -398,6 +461,7 @@ def evaluate_point(context, amplitude, frequency, m2=None, stage="coarse"):
                     criteria=(c_ij, c_ji),
                     limits=(l_ij, l_ji),
                     regime_change=bool(regime),
+                    physics=preds[i].leaves_domain or preds[j].leaves_domain,
                 )
             )
     return Point(predictions=preds, pairs=tuple(pairs), **point)

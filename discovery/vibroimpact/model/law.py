@@ -397,7 +397,7 @@ class ForceLaw:
             out = out + c * t(zeta, zd)
         return out
 
-    def check_physical(self, scenario, what="law"):
+    def check_physical(self, scenario, what="law", *, dissipative_below=False):
         """Refuse a law no machine could have (one clear line, :class:`InputError`).
 
         On the box ``0 < zeta <= x``, ``0 <= zd <= 4 v`` (``x, v`` the scenario's motion
@@ -407,7 +407,9 @@ class ForceLaw:
         condition (5) would pull the bodies together; damping alone, a template whose
         stiffness a landscape varies, passes), and satisfy the paper's condition (6), dissipativity
         ``P(zeta, zd) >= P(zeta, 0)`` (damping never feeds energy into an impact).
-        Conditions (3)-(5) hold by construction.
+        Conditions (3)-(5) hold by construction.  With ``dissipative_below`` condition (6)
+        is left to :meth:`dissipative_rate` (a fit's rival certified on the rates it was
+        fitted on, which an operating point may or may not leave).
         """
         if not any(self.coefficients):
             raise InputError(
@@ -415,7 +417,9 @@ class ForceLaw:
                 "as '2.06e8*z + 1.28e7*zd'"
             )
         if self.impact_scaled:  # judged as the impact at the motion's velocity scale
-            return self.at_impact(scenario.scales()[1]).check_physical(scenario, what)
+            return self.at_impact(scenario.scales()[1]).check_physical(
+                scenario, what, dissipative_below=dissipative_below
+            )
         x, v = scenario.scales()
         Z, V = x, 4.0 * v
         zz, vv = np.meshgrid(np.linspace(Z / 64, Z, 64), np.linspace(0.0, V, 65))
@@ -444,7 +448,7 @@ class ForceLaw:
             )
         D = P - self.polynomial(zz, np.zeros_like(vv))
         worst = np.unravel_index(int(np.argmin(D)), D.shape)
-        if D[worst] < -1e-9 * float(np.max(np.abs(P))):
+        if D[worst] < -1e-9 * float(np.max(np.abs(P))) and not dissipative_below:
             raise InputError(
                 f"{what} '{self}' breaks the paper's condition (6), dissipativity: F(zeta, zd) "
                 f"< F(zeta, 0) at zeta = {zz[worst]:.3g} m, zd = {vv[worst]:.3g} m/s (damping "
@@ -464,6 +468,25 @@ class ForceLaw:
                 f"under 1e-7 of the drive period {scenario.period:.3g} s, which no simulation "
                 "resolves; check the coefficients' units (N/m, N s/m) and the scenario's masses"
             )
+
+    def dissipative_rate(self, scenario, up_to=None):
+        """The largest penetration rate [m/s] up to which the paper's condition (6),
+        ``P(zeta, zd) >= P(zeta, 0)``, holds for every penetration up to the scenario's
+        motion scale (``inf`` when it holds on the whole box: rates up to ``up_to``, by
+        default 4 times the velocity scale as in :meth:`check_physical`): the domain a rival
+        certified on its record's rates is physical on.  A law scaled by each impact's
+        approach velocity is judged at the velocity scale."""
+        if self.impact_scaled:
+            return self.at_impact(scenario.scales()[1]).dissipative_rate(scenario, up_to)
+        x, v = scenario.scales()
+        top = 4.0 * v if up_to is None else float(up_to)
+        zz, vv = np.meshgrid(np.linspace(x / 64, x, 64), np.linspace(0.0, top, 257))
+        P = self.polynomial(zz, vv)
+        D = P - self.polynomial(zz, np.zeros_like(vv))
+        bad = np.any(D < -1e-9 * max(float(np.max(np.abs(P))), 1e-300), axis=1)
+        if not bad.any():
+            return float("inf")
+        return float(vv[int(np.argmax(bad)) - 1, 0]) if np.argmax(bad) > 0 else 0.0
 
     def __call__(self, zeta, dzeta, zeta_max=None, v0=None):
         """Contact force ``F(zeta, dzeta)`` [N] with conditions (3)-(5) applied (and the

@@ -315,3 +315,31 @@ def test_the_moulding_mass_is_a_third_knob_and_the_map_keeps_the_best_over_it():
     assert m["amplitude"].shape == (1,)
     assert m["smallest"][0] == pytest.approx(max(p.smallest for p in r.points if p.usable))
     assert AdviseResult.from_dict(r.to_dict()) == r
+
+
+def test_a_rival_certified_on_its_own_rates_is_advised_on_not_refused():
+    """A fit's equivalent model with a negative zd^2 is dissipative up to 0.92 m/s (its
+    record's rates) and not beyond: advise refused the run (condition (6) at 1.22 m/s).
+    It is judged where its orbit stays in that domain, and a point whose orbit leaves it
+    separates the pair on physics."""
+    rival = "2.02625e8*z + 2.18996e7*zd - 2.37176e7*zd^2"
+    assert ForceLaw.parse(rival).dissipative_rate(load_scenario("paper")) == pytest.approx(
+        2.18996e7 / 2.37176e7, rel=0.01
+    )
+    r = _one_point(["2.06e8*z + 5.12e6*zd + 6e10*z*zd", rival], noise=0.02, amplitude=3e5)
+    (p,) = r.points
+    assert p.usable and not p.predictions[1].leaves_domain
+    assert p.predictions[0].domain == float("inf")  # dissipative at every rate on its box
+    # a narrower domain that this point's orbit leaves: separated on physics, and said so
+    narrow = "2.02625e8*z + 2.18996e7*zd - 8e7*zd^2"
+    q = _one_point(["2.06e8*z + 5.12e6*zd + 6e10*z*zd", narrow], noise=0.02, amplitude=3e5)
+    (p,) = q.points
+    # its impacts gain energy at the rates the other's orbit reaches: no orbit of its own,
+    # which a record here shows (it was an excluded point)
+    assert p.usable and p.predictions[1].status == "nonperiodic"
+    assert p.predictions[1].leaves_domain and p.pairs[0].physics and p.pairs[0].separated
+    assert "rejects it on physics" in str(q)
+    assert AdviseResult.from_dict(q.to_dict()) == q
+    # a law no machine could have anywhere is still refused
+    with pytest.raises(InputError, match="negative stiffness"):
+        _one_point([BASE, "-2.06e8*z + 1.28e7*zd"])
