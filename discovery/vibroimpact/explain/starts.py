@@ -235,8 +235,9 @@ def _start_candidates(text, records, measurements):
                 )
     # softer springs: a contact that damping ends early (the paper's law unloads
     # elastically, so the contact lasts at least a quarter of the spring's period) is far
-    # shorter than the half period the contact-time stiffness assumes
-    for f in (0.25, 0.25**2, 0.25**3):
+    # shorter than the half period the contact-time stiffness assumes; stiffer ones: a
+    # noisy force's threshold (2 % of the peak) reads a short contact longer than it is
+    for f in (0.25, 0.25**2, 0.25**3, 4.0, 16.0):
         others.append(
             phys.with_coefficients(
                 [

@@ -37,7 +37,7 @@ from ...wording import records as the_records
 from ...wording import verb
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
-from ..model.contact_models import MODELS, same_force
+from ..model.contact_models import E_RANGE, MODELS, N_RANGE, same_force
 from ..model.scenario import Scenario
 from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
@@ -112,7 +112,7 @@ class ContactFit:
             parameters=dict(d["parameters"]),
             intervals={k: tuple(v) for k, v in d["intervals"].items()},
             criteria=dict(d["criteria"]),
-            value=float(d["value"]),
+            value=float("inf") if d["value"] is None else float(d["value"]),  # JSON: null
             consistent=d["consistent"],
             law=d["law"],
             message=d.get("message", ""),
@@ -228,6 +228,9 @@ class ContactModelsResult(Result):
         for f in self.fits:
             mark = "*" if f.model == self.selected else " "
             ok = {True: "consistent", False: "inconsistent", None: "failed"}[f.consistent]
+            if f.consistent is None:
+                out.append(f" {mark} {f.model:<20s} failed: {f.message}")
+                continue
             out.append(f" {mark} {f.model:<20s} I2 {f.value:.4g}  {ok}")
             for k, v in f.parameters.items():
                 lo, hi = f.intervals.get(k, (np.nan, np.nan))
@@ -276,6 +279,43 @@ def _intervals(res, records, settings):
     }, "1.96 standard errors (Jacobian)"
 
 
+#: each parameter's domain: ``(low, high, low_open)``
+_DOMAINS = {
+    "k": (0.0, np.inf, True),
+    "c": (0.0, np.inf, False),
+    "lambda": (0.0, np.inf, False),
+    "n": (*N_RANGE, False),
+    "e": (*E_RANGE, False),
+}
+
+
+def _in_domain(name, bounds):
+    """An interval clipped to its parameter's domain (a restitution below 0 or a stiffness
+    below 0 is no value the model has)."""
+    lo, hi, _ = _DOMAINS.get(name, (-np.inf, np.inf, False))
+    a, b = (float(x) for x in bounds)
+    return (min(max(a, lo), hi), max(min(b, hi), lo))
+
+
+def _degenerate(params, intervals):
+    """Why a fit is no result (``""`` when it is one): a parameter at the edge of what a fit
+    may reach (a stiffness at its floor, an exponent or a restitution at its range's end), or
+    a parameter without a finite interval, or one that spans its whole range."""
+    why = []
+    for k, v in params.items():
+        lo, hi, open_low = _DOMAINS.get(k, (-np.inf, np.inf, False))
+        if open_low and not v > 1e-200:
+            why.append(f"{k} = {v:.3g} sits at its floor")
+        elif k in ("n", "e") and (v <= lo * (1 + 1e-9) or (k == "n" and v >= hi * (1 - 1e-9))):
+            why.append(f"{k} = {v:.4g} sits at the end of its range [{lo:g}, {hi:g}]")
+        b = intervals.get(k)
+        if b is not None and not all(np.isfinite(b)):
+            why.append(f"{k} has no finite interval")
+        elif b is not None and k in ("n", "e") and b[0] <= lo and b[1] >= hi:
+            why.append(f"{k}'s interval spans its whole range")
+    return "; ".join(why)
+
+
 def _fit_one(name, records, settings, progress, hunt_crossley=None):
     sc0, ref0 = records[0]
     extra = (regression_start(name, settings["samples"]),)
@@ -305,15 +345,17 @@ def _fit_one(name, records, settings, progress, hunt_crossley=None):
     model = res.law
     iv, method = _intervals(res, records, settings)
     params = dict(zip(model.names, model.values, strict=True))
+    iv = {k: _in_domain(k, b) for k, b in iv.items()}
+    degenerate = _degenerate(params, iv)
     return ContactFit(
         model=name,
         parameters=params,
         intervals=iv,
         criteria={k: float(v) for k, v in res.criteria.items()},
-        value=float(res.criteria.get("I2", res.value)),
-        consistent=bool(res.consistent),
+        value=float(res.criteria.get("I2", res.value)) if not degenerate else float("inf"),
+        consistent=None if degenerate else bool(res.consistent),
         law=model.law.to_text(),
-        message=res.message,
+        message=f"fit degenerate: {degenerate}" if degenerate else res.message,
         n_simulations=res.n_simulations,
         interval_method=method,
         conditions=model.conditions(),
