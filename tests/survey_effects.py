@@ -367,6 +367,7 @@ def _pairs(rows):
     bad = 0
     for pair in by.values():
         hi, lo = pair.get("high"), pair.get("low")
-        if hi and lo and "error" not in hi and "error" not in lo:
+        valid = hi and lo and all("error" not in r and r.get("true_consistent") for r in (hi, lo))
+        if valid:
             bad += named_right(hi) and not named_right(lo)
     return bad
