@@ -35,15 +35,19 @@ def _received(value):
 class Real:
     """A real number (not a bool, not text) within ``[low, high]``, optionally an integer."""
 
-    def __init__(self, low=None, high=None, *, integer=False, open_low=False, unit=""):
+    def __init__(
+        self, low=None, high=None, *, integer=False, open_low=False, open_high=False, unit=""
+    ):
         self.low, self.high, self.integer, self.open_low = low, high, integer, open_low
+        self.open_high = open_high
         self.unit = f" {unit}" if unit else ""
 
     def describe(self):
         kind = "an integer" if self.integer else "a number"
         if self.low is not None and self.high is not None:
             lo = "(" if self.open_low else "["
-            return f"{kind} in {lo}{self.low:g}, {self.high:g}]{self.unit}"
+            hi = ")" if self.open_high else "]"
+            return f"{kind} in {lo}{self.low:g}, {self.high:g}{hi}{self.unit}"
         if self.low is not None:
             return f"{kind} {'>' if self.open_low else '>='} {self.low:g}{self.unit}"
         return f"a finite {kind[2:] if kind.startswith('a ') else kind[3:]}"
@@ -58,7 +62,7 @@ class Real:
         bad = (
             not np.isfinite(v)
             or (self.low is not None and (v <= self.low if self.open_low else v < self.low))
-            or (self.high is not None and v > self.high)
+            or (self.high is not None and (v >= self.high if self.open_high else v > self.high))
         )
         if bad:
             raise InputError(f"{where} must be {self.describe()}; got {value!r}")

@@ -116,3 +116,31 @@ def test_a_changed_settings_object_reads_back_from_its_repr():
     assert repr(s) == "DiscoverSettings(library='poly:3', seed=7)"
     assert eval(repr(s), {"DiscoverSettings": discovery.DiscoverSettings}) == s
     assert "seed" in str(s) and "(changed)" in str(s)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: __import__("discovery").DiscoverSettings(n_boot=0),
+        lambda: __import__("discovery").DiscoverSettings(max_simulations=1),
+        lambda: __import__("discovery").DiscoverSettings(criterion="I9"),
+        lambda: __import__("discovery").DiscoverSettings(selection="bogus"),
+        lambda: __import__("discovery").DiscoverSettings(scoring="bogus"),
+        lambda: __import__("discovery").ExplainSettings(alpha=1.0),
+        lambda: __import__("discovery").IdentifySettings(method="bogus"),
+        lambda: __import__("discovery").IdentifySettings(criterion="I9"),
+    ],
+)
+def test_settings_refused_when_used_are_refused_when_made(make):
+    """Issue 53: each of these was accepted by the settings object and refused only by the
+    function it was given to."""
+    from discovery.errors import InputError
+
+    with pytest.raises(InputError):
+        make()
+
+
+def test_explain_takes_no_added_effect_as_its_cli_does():
+    from discovery import ExplainSettings
+
+    assert ExplainSettings(max_iterations=0).max_iterations == 0

@@ -455,8 +455,8 @@ class ExplainSettings(Settings):
     """The options of :func:`explain` (each is also a keyword of it; see its parameters)."""
 
     criterion: str = option("I2", Text())
-    alpha: float = option(0.01, Real(0, 1, open_low=True))
-    max_iterations: int = option(3, Real(1, integer=True))
+    alpha: float = option(0.01, Real(0, 1, open_low=True, open_high=True))
+    max_iterations: int = option(3, Real(0, integer=True))
     max_simulations: int = option(150, Real(1, integer=True))
     n_boot: int = option(16, Real(0, integer=True))
     seed: int = option(0, Real(0, integer=True))

@@ -50,6 +50,7 @@ from ..model.library import Library
 from ..model.scenario import Scenario
 from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
+from ..verify.criteria import CRITERIA
 from ..verify.criteria import criterion as _criterion
 from .discovery_result import DiscoveryResult, RankedModel
 from .discovery_warnings import _defects_warning, _warnings
@@ -60,7 +61,7 @@ from .evidence import _contact_samples, _Evidence, _regression, _required_terms,
 from .intervals import INTERVAL_REFITS, bootstrap_intervals
 from .ranking import _RankingRule, rank
 from .records import pair_records
-from .regression import ConstrainedSparseRegressor
+from .regression import SCORES, SELECTIONS, ConstrainedSparseRegressor
 from .shortlist import _Checker, _shortlist
 from .stepwise import _Stepwise
 
@@ -196,10 +197,10 @@ class DiscoverSettings(Settings):
     """The options of :func:`discover` (each is also a keyword of it; see its parameters)."""
 
     library: object = option("poly:2", (Text(), Library, list, tuple))
-    selection: str = option("best-subset", Text())
-    scoring: str = option("bic", Text())
+    selection: str = option("best-subset", Choice(*SELECTIONS))
+    scoring: str = option("bic", Choice(*SCORES))
     max_terms: int = option(4, Real(1, 64, integer=True))
-    criterion: str = option("I2", Text())
+    criterion: str = option("I2", Choice(*CRITERIA))
     shortlist: int = option(8, Real(1, integer=True))
     refine: bool = option(True)
     stability: int = option(0, Real(0, integer=True))
@@ -209,8 +210,8 @@ class DiscoverSettings(Settings):
     sim_atol: float = option(0.005, Real(0))
     tolerances: object = option(None, (Tolerances, None))
     seed: int = option(0, Real(0, integer=True))
-    n_boot: int = option(16, Real(0, integer=True))
-    max_simulations: int = option(_REFINE_BUDGET, Real(0, integer=True))
+    n_boot: int = option(16, Real(1, integer=True))
+    max_simulations: int = option(_REFINE_BUDGET, Real(2, integer=True))
     stepwise: int = option(3, Real(0, integer=True))
     physics: bool = option(True)
     require: tuple = option((), (tuple, list))

@@ -39,7 +39,7 @@ from ..._printing import coefficient_lines, fmt, readable
 from ..._progress import reports_progress
 from ..._result import Result, part
 from ..._settings import Settings, option, takes
-from ..._validate import Choice, Real, Text, params
+from ..._validate import Choice, Real, params
 from ...errors import IntegrationError
 from ..data.impulse import Impulse
 from ..data.measurement import Measurement
@@ -48,7 +48,7 @@ from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from ..verify import Reference, evaluate
 from ..verify.block_farm import block_workers, shared_blocks
-from ..verify.criteria import criteria_lines
+from ..verify.criteria import CRITERIA, criteria_lines
 from ..verify.evaluation import Evaluation
 
 # the fit's parts (records, problem, optimise, intervals), also importable from here under the
@@ -337,8 +337,8 @@ def _mean_criteria(evs):
 class IdentifySettings(Settings):
     """The options of :func:`identify` (each is also a keyword of it; see its parameters)."""
 
-    criterion: str = option("I2", Text())
-    method: str = option("least-squares", Text())
+    criterion: str = option("I2", Choice(*CRITERIA))
+    method: str = option("least-squares", Choice(*METHODS))
     xtol: float = option(1e-5, Real(0, open_low=True))
     max_simulations: int = option(600, Real(1, integer=True))
     tolerances: object = option(None, (Tolerances, None))
