@@ -105,9 +105,12 @@ surveys: install
 		$(MEASURED)/contact-narrow-points*.jsonl \
 		$(MEASURED)/explain-random*.jsonl $(MEASURED)/study-paper*.jsonl \
 		$(MEASURED)/contact-models-*.jsonl $(MEASURED)/explain-cases*.jsonl \
-		$(MEASURED)/calibration*.jsonl $(MEASURED)/memory-orbits*.jsonl
+		$(MEASURED)/calibration*.jsonl $(MEASURED)/memory-orbits*.jsonl \
+		$(MEASURED)/effects*.jsonl
 	$(BIN)/python -m tests.survey_memory_orbits --n 160 --workers $(SURVEY_WORKERS) \
 		--out $(MEASURED)/memory-orbits.jsonl
+	$(BIN)/python -m tests.survey_effects --draws 0 40 --workers $(SURVEY_WORKERS) \
+		--out $(MEASURED)/effects.jsonl
 	$(BIN)/python -m tests.survey_calibration --n 3 --first-seed 900 \
 		--out $(MEASURED)/calibration.jsonl
 	$(BIN)/python -m tests.survey_calibration --n 4 --first-seed 903 \

@@ -33,6 +33,7 @@ from . import (
     survey_calibration,
     survey_contact_models,
     survey_corpus,
+    survey_effects,
     survey_explain,
     survey_explain_cases,
     survey_intervals,
@@ -106,6 +107,31 @@ def _two_points(pattern):
 
 
 TABLES = {
+    "effects": Table(
+        page="docs/validation.md",
+        header=(
+            "| hidden | records | explain raised an error | true model not consistent | "
+            "effect does not show (start consistent) | right effect(s) kept, where it shows | "
+            "clean: an effect kept | final model consistent | 95 % interval holds the "
+            "truth | lower noise wrong where higher right |",
+            "|---|---|---|---|---|---|---|---|---|---|",
+        ),
+        rows=tuple((label, ("effects*.jsonl",)) for label in (*survey_effects.CLASSES, "all")),
+        row=survey_effects.markdown_row,
+        read=survey_effects.read_rows,
+    ),
+    "effects-readme": Table(
+        page="README.md",
+        header=(
+            "| records | right effect(s) kept, where it shows | clean: an effect kept | final "
+            "model consistent | 95 % interval holds the truth | lower noise wrong where higher "
+            "right |",
+            "|---|---|---|---|---|---|",
+        ),
+        rows=(("all", ("effects*.jsonl",)),),
+        row=survey_effects.readme_row,
+        read=survey_effects.read_rows,
+    ),
     "memory-orbits": Table(
         page="docs/contact-models.md",
         header=(
