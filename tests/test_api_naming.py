@@ -34,16 +34,23 @@ def test_every_seed_is_called_seed():
 
 
 def test_explain_budget_is_deprecated_for_max_simulations(paper, record):
-    # the old name warns and is taken; alpha=1 then stops the call before any simulation
+    # the old name warns and is taken (a bad alpha is now refused when the settings are
+    # made, before any of this: the check that reads the old name is asked directly)
+    from discovery.vibroimpact.explain.loop import _check_settings
+
     with pytest.warns(DeprecationWarning, match="max_simulations"):
-        with pytest.raises(InputError, match="alpha"):
-            discovery.explain(paper, record, budget=20, alpha=1.0)
+        assert _check_settings(None, 20, 0.01, 1, 3) == 20
+    with pytest.raises(InputError, match="alpha"):
+        discovery.explain(paper, record, budget=20, alpha=1.0)
 
 
 def test_discover_random_state_is_deprecated_for_seed(paper, record):
+    from discovery.vibroimpact.fit.discovery import _seed
+
     with pytest.warns(DeprecationWarning, match="seed"):
-        with pytest.raises(InputError, match="criterion"):
-            discovery.discover(paper, record, random_state=3, criterion="I9")
+        assert _seed(3, 0) == 3
+    with pytest.raises(InputError, match="criterion"):
+        discovery.discover(paper, record, random_state=3, criterion="I9")
 
 
 def test_verify_from_the_package_is_the_function():

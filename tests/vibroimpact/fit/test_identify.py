@@ -183,7 +183,7 @@ def test_start_law_that_fails_is_an_error(paper, reference):
 @pytest.mark.parametrize(
     "kwargs, match",
     [
-        ({"method": "simplex"}, "unknown method"),
+        ({"method": "simplex"}, "method must be one of"),
         ({"xtol": -1.0}, "xtol"),
         ({"max_simulations": 1}, "budget"),
         ({"max_simulations": 2.5}, "max_simulations must be an integer"),

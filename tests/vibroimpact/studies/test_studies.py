@@ -110,7 +110,7 @@ def test_config_rows_and_scenario_tables():
         # every [fit] and [record] option by the API's own checks, types strict
         ({"fit": {"max_terms": "four"}}, "[fit] max_terms must be an integer"),
         ({"fit": {"max_terms": -3}}, "[fit] max_terms must be an integer in [1, 64]; got -3"),
-        ({"fit": {"criterion": "I9"}}, "unknown criterion 'I9'"),
+        ({"fit": {"criterion": "I9"}}, "criterion must be one of 'I0', 'I1', 'I2', 'I3', 'I4'"),
         ({"fit": {"max_simulations": 0}}, "max_simulations must be an integer >= 2"),
         ({"fit": {"scoring": "r2"}}, "scoring must be one of"),
         ({"fit": {"physics": "no"}}, "physics must be true or false"),
