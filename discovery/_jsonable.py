@@ -5,16 +5,28 @@ from pathlib import Path
 
 import numpy as np
 
+#: the largest JSON document read (a summary of a long study is a few MB)
+MAX_DOCUMENT_BYTES = 64 * 2**20
+
 
 def load_json(path):
     """``(data, None)`` of a JSON file, ``(None, None)`` when there is none, ``(None, why)``
-    when it cannot be read as JSON (why in a few words)."""
+    when it cannot be read as JSON (why in a few words): not a regular file (a device such
+    as ``/dev/zero`` would be read until memory runs out), over
+    :data:`MAX_DOCUMENT_BYTES`, not JSON, or nested too deeply."""
+    p = Path(path)
     try:
-        with open(path, encoding="utf-8") as fh:
+        if not p.exists():
+            return None, None
+        if not p.is_file():
+            return None, "is not a regular file"
+        if p.stat().st_size > MAX_DOCUMENT_BYTES:
+            return None, f"is over {MAX_DOCUMENT_BYTES // 2**20} MB, no summary is that large"
+        with open(p, encoding="utf-8") as fh:
             return json.load(fh), None
     except FileNotFoundError:
         return None, None
-    except (OSError, ValueError, RecursionError) as exc:
+    except (OSError, ValueError, RecursionError, MemoryError) as exc:
         return None, f"cannot be read as JSON ({type(exc).__name__})"
 
 

@@ -30,6 +30,7 @@ from importlib import import_module
 from pathlib import Path
 
 from ._io import OutputDir, short, to_jsonable
+from ._jsonable import load_json
 from .errors import InputError
 
 __all__ = ["SCHEMA_VERSION", "Result", "load", "load_summary", "part", "KINDS"]
@@ -214,18 +215,15 @@ def load_summary(path):
     ``summary.json``) or a summary file (``D.summary.json`` of ``vidi simulate``)."""
     p = Path(path)
     f = p / "summary.json" if p.is_dir() else p
-    try:
-        return json.loads(f.read_text(encoding="utf-8"))
-    except FileNotFoundError:
+    data, why = load_json(f)
+    if data is None and why is None:
         raise InputError(
             f"{short(str(path))!r} holds no summary.json: give the --out directory of a vidi "
             "command (or a .summary.json file)"
-        ) from None
-    except (OSError, ValueError) as exc:
-        raise InputError(
-            f"{short(str(f))!r} cannot be read as JSON ({type(exc).__name__}); run the "
-            "command again"
-        ) from None
+        )
+    if why is not None:
+        raise InputError(f"{short(str(f))!r} {why}; give a vidi command's summary")
+    return data
 
 
 def load(path):

@@ -1,6 +1,5 @@
 """``report``: the LaTeX report of a result or a run directory (see :mod:`reports.document`)."""
 
-import json
 from pathlib import Path
 
 from reports.document import Report, compile_tex, render
@@ -80,7 +79,6 @@ def report(run, *, out=None, snippet=None, compile=True, timeout=300):
 def _saved(run_dir):
     """The ``summary.json`` of a directory, ``None`` when there is none or it is no JSON
     (the report's own reading says why)."""
-    try:
-        return json.loads((Path(run_dir) / "summary.json").read_text(encoding="utf-8"))
-    except (OSError, ValueError, UnicodeDecodeError):
-        return None
+    from ._jsonable import load_json
+
+    return load_json(Path(run_dir) / "summary.json")[0]

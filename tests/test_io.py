@@ -493,3 +493,19 @@ def test_file_targets_that_are_not_ours_are_refused(tmp_path, kind):
         _io.set_run(None)
     if kind == "foreign":
         assert target.read_text() == "a user's file"
+
+
+def test_a_device_or_a_huge_file_is_no_summary_or_scenario(tmp_path):
+    """Issue 53: discovery.load('/dev/zero') and a scenario naming /dev/zero read until
+    memory ran out."""
+    import discovery
+    from discovery.errors import InputError
+
+    with pytest.raises(InputError, match="not a regular file"):
+        discovery.load("/dev/zero")
+    with pytest.raises(InputError, match="not a regular file"):
+        discovery.load_scenario("/dev/zero")
+    big = tmp_path / "big.toml"
+    big.write_bytes(b"#" * (2**20 + 1))
+    with pytest.raises(InputError, match="over 1 MB"):
+        discovery.load_scenario(big)

@@ -11,13 +11,13 @@ point with the same sensor has another peak force, so its noise in newtons follo
 peak.
 """
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..._jsonable import load_json
 from ...errors import InputError
 from ..model.law import ForceLaw
 
@@ -44,6 +44,14 @@ def _pair(value, what, unit, low=0.0):
             f"{what} needs {low:g} < LOW <= HIGH (finite, in {unit}), got {lo:g}:{hi:g}"
         )
     return lo, hi
+
+
+#: the most coarse grid points an advice evaluates
+MAX_POINTS = 10_000
+#: the most candidate laws (every pair is judged at every point)
+MAX_CANDIDATES = 12
+#: the most samples of one predicted record
+MAX_RECORD_SAMPLES = 20_000_000
 
 
 @dataclass(frozen=True)
@@ -90,6 +98,13 @@ class Knobs:
             v = getattr(self, name)
             if not isinstance(v, int | np.integer) or not 0 <= int(v) <= top:
                 raise InputError(f"{name} must be an integer 0..{top}, got {v!r}")
+        points = grid[0] * grid[1] * (1 if self.m2 is None else int(self.m2_points))
+        if points > MAX_POINTS:
+            raise InputError(
+                f"the grid has {points} points (each a steady state of every candidate and "
+                f"their predicted records); at most {MAX_POINTS}: make the grid coarser (the "
+                "best points are refined anyway)"
+            )
 
     def axes(self):
         """Coarse axes ``(amplitudes, frequencies, masses or (None,))``."""
@@ -226,8 +241,10 @@ class NoiseModel:
             if not (math.isfinite(v) and lo < v < hi) and not (name == "periods" and v == lo):
                 raise InputError(f"noise {name} must be {what} (in ({lo:g}, {hi:g})), got {v!r}")
             object.__setattr__(self, name, v)
-        if not 1 <= int(self.n_boot) <= 10_000:
-            raise InputError(f"n_boot must be 1..10000, got {self.n_boot!r}")
+        for name, lo, hi in (("n_boot", 1, 10_000), ("seed", 0, 2**63 - 1)):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int | np.integer) or not lo <= v <= hi:
+                raise InputError(f"noise {name} must be an integer {lo}..{hi}, got {v!r}")
         if self.position is not None:
             try:
                 v = float(self.position)
@@ -368,14 +385,11 @@ def candidates_from_fit(run_dir):
         load it when none is given).
     """
     p = Path(run_dir) / "summary.json"
-    try:
-        s = json.loads(p.read_text())
-    except FileNotFoundError:
-        raise InputError(
-            f"{str(p)!r} does not exist; give the --out directory of a vidi fit run"
-        ) from None
-    except (OSError, ValueError):
-        raise InputError(f"{str(p)!r} is not readable JSON; run vidi fit again") from None
+    s, why = load_json(p)
+    if s is None and why is None:
+        raise InputError(f"{str(p)!r} does not exist; give the --out directory of a vidi fit run")
+    if why is not None:
+        raise InputError(f"{str(p)!r} {why}; run vidi fit again")
     if not isinstance(s, dict) or s.get("command") != "fit":
         raise InputError(f"{str(p)!r} is not a vidi fit summary; give a fit's --out directory")
     if s.get("library") == "contact-models":

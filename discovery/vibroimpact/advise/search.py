@@ -13,10 +13,18 @@ from dataclasses import dataclass
 from ..._progress import reports_progress, tick
 from ..._settings import Settings, option, takes
 from ..._validate import Instance, Real, params
+from ...errors import InputError
 from ...numerics.executor import make_executor
 from ..dynamics import Tolerances
 from ..model.scenario import Scenario
-from .candidates import Knobs, NoiseModel, SafeRegion, unique_laws
+from .candidates import (
+    MAX_CANDIDATES,
+    MAX_RECORD_SAMPLES,
+    Knobs,
+    NoiseModel,
+    SafeRegion,
+    unique_laws,
+)
 from .result import AdviseResult
 from .separation import inseparable, point_job, rank_key
 
@@ -32,6 +40,24 @@ class _Context:
     noise: NoiseModel
     safe: SafeRegion
     tolerances: object = None
+
+
+def _check_size(laws, knobs, noise):
+    """Refuse work no run should start: more candidates than :data:`MAX_CANDIDATES` (every
+    pair is judged at every point) or predicted records longer than
+    :data:`MAX_RECORD_SAMPLES` samples at the lowest frequency of the bounds."""
+    if len(laws) > MAX_CANDIDATES:
+        raise InputError(
+            f"{len(laws)} candidate laws: at most {MAX_CANDIDATES} (each pair is judged at every "
+            "point); keep the fit's equivalent models that matter, or advise on a few at a time"
+        )
+    samples = noise.periods / (knobs.frequency[0] * noise.dt)
+    if samples > MAX_RECORD_SAMPLES:
+        raise InputError(
+            f"a predicted record would hold {samples:.3g} samples ({noise.periods:g} periods at "
+            f"{1 / noise.dt:.3g} Hz down to {knobs.frequency[0]:g} Hz); at most "
+            f"{MAX_RECORD_SAMPLES:.0e}: lower --sample-rate or --periods"
+        )
 
 
 def _refined(knobs, coarse, done):
@@ -130,6 +156,7 @@ def advise(
     s = AdviseSettings.of("advise", settings, options)
     t0 = time.perf_counter()
     laws = unique_laws(laws)
+    _check_size(laws, knobs, noise)
     for k, law in enumerate(laws):
         # a rival certified on its record's rates may break condition (6) beyond them: it is
         # judged where its orbit stays inside, and a point where it leaves is evidence

@@ -345,6 +345,14 @@ class Scenario:
         :meth:`_from_mapping`)."""
         path = Path(path)
         hint = f"give a TOML file or one of {', '.join(builtin_scenarios())}"
+        if path.exists() and not path.is_dir() and not path.is_file():
+            # a device (/dev/zero) would be read until memory runs out
+            raise InputError(f"scenario {str(path)!r} is not a regular file; {hint}")
+        if path.is_file() and path.stat().st_size > MAX_SCENARIO_BYTES:
+            raise InputError(
+                f"scenario file {str(path)!r} is over {MAX_SCENARIO_BYTES // 2**20} MB; a "
+                f"scenario is a few lines of TOML: {hint}"
+            )
         try:
             raw = path.read_bytes()
         except FileNotFoundError:
@@ -434,6 +442,10 @@ class Scenario:
                 f'scenario {source!r}: name must be non-empty text, e.g. name = "my-grid"'
             )
         return cls(**values, law=law, initial=initial, name=name, source=source)
+
+
+#: the largest scenario file read
+MAX_SCENARIO_BYTES = 2**20
 
 
 def scale_bounds(bounds, where="machine_scale"):

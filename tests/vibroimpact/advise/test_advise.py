@@ -343,3 +343,40 @@ def test_a_rival_certified_on_its_own_rates_is_advised_on_not_refused():
     # a law no machine could have anywhere is still refused
     with pytest.raises(InputError, match="negative stiffness"):
         _one_point([BASE, "-2.06e8*z + 1.28e7*zd"])
+
+
+@pytest.mark.parametrize(
+    "make, words",
+    [
+        (lambda: NoiseModel(0.01, n_boot=2.5), "n_boot must be an integer"),
+        (lambda: NoiseModel(0.01, seed="x"), "seed must be an integer"),
+        (lambda: NoiseModel(0.01, seed=-1), "seed must be an integer"),
+        (
+            lambda: Knobs((3e5, 6e5), (20, 30), grid=(200, 200), m2=(5e3, 1e4), m2_points=50),
+            "at most 10000",
+        ),
+        (
+            lambda: advise(
+                load_scenario("paper"),
+                [f"2.06e8*z + {1e7 + k * 1e5:g}*zd" for k in range(50)],
+                Knobs((3e5, 6e5), (20, 30), grid=(2, 2)),
+                NoiseModel(0.01),
+            ),
+            "50 candidate laws: at most 12",
+        ),
+        (
+            lambda: advise(
+                load_scenario("paper"),
+                [BASE, "2.06e8*z + 2e7*zd"],
+                Knobs((3e5, 6e5), (20, 30), grid=(2, 2)),
+                NoiseModel(0.01, dt=1e-9, periods=1000),
+            ),
+            "lower --sample-rate or --periods",
+        ),
+    ],
+)
+def test_work_no_run_should_start_is_refused_up_front(make, words):
+    """Issue 53: 50 candidates on a 2x2 grid ran for minutes, a 1 GHz record ran out of
+    memory, seeds and replicates took any value."""
+    with pytest.raises(InputError, match=words):
+        make()
