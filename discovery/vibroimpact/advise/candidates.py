@@ -397,7 +397,7 @@ def candidates_from_fit(run_dir):
             laws = contact_candidates(s)
         except InputError:
             raise
-        except (KeyError, TypeError, ValueError) as exc:
+        except (KeyError, TypeError, ValueError, AttributeError, RecursionError) as exc:
             raise InputError(
                 f"{str(p)!r} has no readable contact-models fit ({exc}); run vidi fit again"
             ) from None
@@ -408,7 +408,8 @@ def candidates_from_fit(run_dir):
             f"the fit in {str(run_dir)!r} lists no equivalent model: its record already "
             "tells the laws apart; to compare other laws give --law twice or more"
         )
-    given = (s.get("settings") or {}).get("scenario")
+    settings = s.get("settings")
+    given = settings.get("scenario") if isinstance(settings, dict) else None
     if isinstance(given, list):  # several records: the first one's
         given = given[0] if given else None
     sc = s.get("scenario") or {}
@@ -421,7 +422,7 @@ def _polynomial_candidates(s, p):
     try:
         laws = [ForceLaw.from_dict(s["selected"]["coefficients"])]
         laws += [ForceLaw.from_dict(e["coefficients"]) for e in s.get("equivalent") or []]
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, AttributeError, RecursionError) as exc:
         raise InputError(
             f"{str(p)!r} has no readable selected law or equivalent models ({exc}); "
             "run vidi fit again"

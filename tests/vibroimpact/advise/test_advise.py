@@ -380,3 +380,31 @@ def test_work_no_run_should_start_is_refused_up_front(make, words):
     memory, seeds and replicates took any value."""
     with pytest.raises(InputError, match=words):
         make()
+
+
+@pytest.mark.parametrize(
+    "tamper",
+    [
+        lambda d: d["selected"].__setitem__("coefficients", "2e8*z"),
+        lambda d: d["selected"].__setitem__("coefficients", {"z": "abc"}),
+        lambda d: d.__setitem__("settings", ["x"]),
+        lambda d: d.__setitem__("settings", "text"),
+    ],
+)
+def test_a_tampered_fit_directory_is_one_line_or_read_as_far_as_it_goes(tmp_path, tamper):
+    """Issue 53: coefficients as text and settings as a list or text were internal errors."""
+    doc = {
+        "command": "fit",
+        "library": "poly:2",
+        "selected": {"coefficients": {"z": 2e8, "zd": 1e7}},
+        "equivalent": [{"coefficients": {"z": 2e8, "zd": 1.1e7}}],
+        "settings": {"scenario": "paper"},
+    }
+    tamper(doc)
+    (tmp_path / "summary.json").write_text(json.dumps(doc))
+    try:
+        laws, scenario = candidates_from_fit(tmp_path)
+    except InputError as exc:
+        assert "run vidi fit again" in str(exc)
+    else:
+        assert len(laws) == 2 and scenario is None  # the settings unreadable: no scenario
