@@ -66,6 +66,11 @@ class RunFile:
             print(json.dumps(row, default=float), file=fh, flush=True)
 
 
+def rows(paths):
+    """Every row of the run files ``paths``, in order."""
+    return [r for p in paths for r in read(p)[1]]
+
+
 def read(path):
     """``(header, rows)`` of a run file (a file without a header: ``{}``; lines that are
     not JSON objects, such as warnings captured with the rows, are skipped)."""

@@ -368,7 +368,7 @@ def _joint_refit(run):
         ladder = _ladder(run, regressed)
         if ladder is not None:
             starts.append(ladder)
-    best, value = None, _mean(run.problem.evaluations(model), "criteria").get(run.criterion)
+    best, value = None, run.problem.value(model, run.criterion)
     for m in starts:
         try:
             res = _output_error(
@@ -382,8 +382,8 @@ def _joint_refit(run):
         except (IntegrationError, InputError):
             continue
         fitted = replace(res.law, fit_drift=False)
-        v = _mean(run.problem.evaluations(fitted), "criteria").get(run.criterion)
-        if v is not None and (value is None or v < value):
+        v = run.problem.value(fitted, run.criterion)
+        if v < value:
             best, value = (fitted, res), v
     if best is not None:
         run.model, run.uncertainties = best[0], dict(best[1].standard_errors)
@@ -401,18 +401,16 @@ def _ladder(run, model):
     """``model`` with the one effect parameter value of :data:`LADDER` times its own that
     gives the lowest gap criterion (one simulation per value), or None when none beats
     the model as it is."""
-    crit = run.criterion
-    best = _mean(run.problem.evaluations(model), "criteria").get(crit)
-    out = None
+    best, out = run.problem.value(model, run.criterion), None
     for eff in model.free_effects():
         v0 = model.value(eff)
         for f in LADDER:
             m = model.with_effect(eff, v0 * f, add=False)
             try:
-                v = _mean(run.problem.evaluations(m), "criteria").get(crit)
+                v = run.problem.value(m, run.criterion)
             except (IntegrationError, InputError):
                 continue
-            if v is not None and (best is None or v < best):
+            if v < best:
                 best, out = v, m
     return out
 

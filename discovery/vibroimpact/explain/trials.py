@@ -4,8 +4,6 @@ alone as the baseline, and the trials judged; the winner polished with the full 
 
 from dataclasses import dataclass, replace
 
-import numpy as np
-
 from ...errors import InputError, IntegrationError
 from ...numerics.executor import map_on
 from ..model.law import Term
@@ -111,15 +109,14 @@ class _Refits:
                     raise
 
     def _by_gap(self, cands):
-        """The candidate start with the lowest gap criterion (one evaluation each, shared
-        with the ranking's simulations), or None."""
+        """The candidate start with the lowest gap criterion (one evaluation each, its
+        block runs shared with the ranking's), or None."""
         best, value = None, float("inf")
         for m in cands:
             try:
-                evs = self.problem.evaluations(m)
+                v = self.problem.value(m, self.criterion)
             except (IntegrationError, InputError):
                 continue
-            v = float(np.mean([e.criteria.get(self.criterion, np.inf) for e in evs]))
             if v < value:
                 best, value = m, v
         return best

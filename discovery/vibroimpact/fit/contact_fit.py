@@ -37,7 +37,7 @@ from ...wording import records as the_records
 from ...wording import verb
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
-from ..model.contact_models import E_RANGE, MODELS, N_RANGE, same_force
+from ..model.contact_models import DOMAINS, MODELS, same_force
 from ..model.scenario import Scenario
 from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
@@ -279,20 +279,10 @@ def _intervals(res, records, settings):
     }, "1.96 standard errors (Jacobian)"
 
 
-#: each parameter's domain: ``(low, high, low_open)``
-_DOMAINS = {
-    "k": (0.0, np.inf, True),
-    "c": (0.0, np.inf, False),
-    "lambda": (0.0, np.inf, False),
-    "n": (*N_RANGE, False),
-    "e": (*E_RANGE, False),
-}
-
-
 def _in_domain(name, bounds):
     """An interval clipped to its parameter's domain (a restitution below 0 or a stiffness
     below 0 is no value the model has)."""
-    lo, hi, _ = _DOMAINS.get(name, (-np.inf, np.inf, False))
+    lo, hi, _ = DOMAINS.get(name, (-np.inf, np.inf, False))
     a, b = (float(x) for x in bounds)
     return (min(max(a, lo), hi), max(min(b, hi), lo))
 
@@ -303,8 +293,8 @@ def _degenerate(params, intervals):
     a parameter without a finite interval, or one that spans its whole range."""
     why = []
     for k, v in params.items():
-        lo, hi, open_low = _DOMAINS.get(k, (-np.inf, np.inf, False))
-        if open_low and not v > 1e-200:
+        lo, hi, open_low = DOMAINS.get(k, (-np.inf, np.inf, False))
+        if open_low and not v > 1e-200:  # at (or near) K_FLOOR
             why.append(f"{k} = {v:.3g} sits at its floor")
         elif k in ("n", "e") and (v <= lo * (1 + 1e-9) or (k == "n" and v >= hi * (1 - 1e-9))):
             why.append(f"{k} = {v:.4g} sits at the end of its range [{lo:g}, {hi:g}]")

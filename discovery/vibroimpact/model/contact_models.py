@@ -56,6 +56,17 @@ MODELS = {
 _FIXED_N = {"kelvin-voigt": 1.0, "hertz-damper": 1.5}
 N_RANGE = (0.5, 3.0)  # exponents a fit may reach
 E_RANGE = (0.02, 1.0)  # coefficients of restitution a fit may reach
+#: each parameter's domain ``(low, high, low_open)``: what a fit may reach (a stiffness stays
+#: above 0, the damping at or above it, ``n`` and ``e`` in their ranges)
+DOMAINS = {
+    "k": (0.0, np.inf, True),
+    "c": (0.0, np.inf, False),
+    "lambda": (0.0, np.inf, False),
+    "n": (*N_RANGE, False),
+    "e": (*E_RANGE, False),
+}
+#: where a stiffness is held above 0 (its open lower bound)
+K_FLOOR = 1e-300
 
 
 def restitution_ratio(name, e):
@@ -167,16 +178,8 @@ class ContactModel:
         reach, the damping to >= 0), so a fit's trial step stays a model."""
         out = []
         for key, v in zip(MODELS[self.name], values, strict=True):
-            v = float(v)
-            if key == "n":
-                v = min(max(v, N_RANGE[0]), N_RANGE[1])
-            elif key == "e":
-                v = min(max(v, E_RANGE[0]), E_RANGE[1])
-            elif key == "k":
-                v = max(v, 1e-300)
-            else:
-                v = max(v, 0.0)
-            out.append(v)
+            lo, hi, open_low = DOMAINS[key]
+            out.append(min(max(float(v), K_FLOOR if open_low else lo), hi))
         return ContactModel(self.name, tuple(out))
 
     # ----------------------------------------------------------------- law
