@@ -46,3 +46,36 @@ def to_jsonable(obj):
     if isinstance(obj, Path):
         return str(obj)
     return obj
+
+
+def reads_document(from_dict):
+    """A ``from_dict`` classmethod's function that turns a document it cannot read (a
+    missing or mistyped field, deep nesting) into one
+    :class:`~discovery.errors.InputError` naming the class, not Python's own exception.
+    Apply under ``@classmethod``."""
+    import functools
+
+    from .errors import InputError, VidiError
+
+    @functools.wraps(from_dict)
+    def read(cls, doc, *args, **kwargs):
+        try:
+            return from_dict(cls, doc, *args, **kwargs)
+        except VidiError:
+            raise
+        except (
+            KeyError,
+            TypeError,
+            ValueError,
+            AttributeError,
+            ArithmeticError,
+            RecursionError,
+        ) as exc:
+            text = str(exc)
+            text = text if len(text) <= 80 else text[:77] + "..."
+            raise InputError(
+                f"{cls.__name__}.from_dict: the document cannot be read ({type(exc).__name__}: "
+                f"{text}); give what {cls.__name__}.to_dict() wrote"
+            ) from None
+
+    return read

@@ -131,7 +131,9 @@ class Result:
                 ) as exc:
                     raise _Unreadable(cls.KIND, (f.name,), exc) from None
             elif f.name in d:
-                value = d[f.name]
+                value = _typed(cls.KIND, f, d[f.name])
+            elif _required(f):
+                raise _Unreadable(cls.KIND, (f.name,), KeyError("missing"))
             elif f.default is not dataclasses.MISSING:
                 value = f.default
             elif f.default_factory is not dataclasses.MISSING:
@@ -140,6 +142,7 @@ class Result:
                 value = None
             object.__setattr__(obj, f.name, value)
         object.__setattr__(obj, "_document", copy.deepcopy(d))
+        _prints(obj)
         return obj
 
     @staticmethod
@@ -177,6 +180,85 @@ class Result:
     def write_into(self, out):
         """Write the document as ``summary.json`` into an open :class:`OutputDir`."""
         out.write_json("summary.json", self.to_dict())
+
+
+#: the JSON types a plain field's annotation asks for (a tuple is a list in JSON; a float
+#: may be an integer, or null for a number that is not finite)
+_JSON_TYPES = {
+    "dict": (dict,),
+    "list": (list,),
+    "tuple": (list,),
+    "str": (str,),
+    "bool": (bool,),
+    "int": (int,),
+    "float": (int, float, type(None)),
+    "None": (type(None),),
+}
+
+
+def _json_types(f):
+    """The JSON types the field's annotation allows, or None when it names no plain JSON
+    type (an object the document holds in its own form)."""
+    names = [
+        n.strip()
+        for n in (f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type)))
+        .replace("NoneType", "None")
+        .split("|")
+    ]
+    if not all(n in _JSON_TYPES for n in names):
+        return None
+    allowed = tuple(t for n in names for t in _JSON_TYPES[n])
+    if f.default is None:  # an optional field the document may leave null
+        allowed += (type(None),)
+    return allowed
+
+
+def _required(f):
+    """A field the document must hold: no default, and a plain JSON type (a field without
+    a default that the document does not hold, such as a simulated history, is typed as
+    an object)."""
+    return (
+        f.default is dataclasses.MISSING
+        and f.default_factory is dataclasses.MISSING
+        and _json_types(f) is not None
+    )
+
+
+def _typed(kind, f, value):
+    """``value`` when it is of the field's JSON type (a bool is no number), else the
+    document's field is unreadable."""
+    allowed = _json_types(f)
+    if allowed is None:
+        return value
+    if isinstance(value, bool) and bool not in allowed:
+        ok = False
+    else:
+        ok = isinstance(value, allowed)
+    if not ok:
+        want = " or ".join(sorted({t.__name__.replace("NoneType", "null") for t in allowed}))
+        raise _Unreadable(kind, (f.name,), TypeError(f"{type(value).__name__}, not {want}"))
+    return value
+
+
+def _prints(obj):
+    """A loaded result prints, or its document was edited where no field's type tells
+    (a key the summary reads inside a mapping): one :class:`InputError`, not the
+    exception of the line that prints it."""
+    try:
+        str(obj)
+    except (
+        TypeError,
+        ValueError,
+        AttributeError,
+        KeyError,
+        IndexError,
+        ArithmeticError,
+        RecursionError,
+    ) as exc:
+        raise InputError(
+            f"from_dict: the {obj.KIND!r} document does not read as a result "
+            f"({type(exc).__name__}: {short(exc, 80)}); was it edited? run the command again"
+        ) from None
 
 
 def check_document(d, where, expect=None):

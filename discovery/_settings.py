@@ -25,6 +25,7 @@ import dataclasses
 import difflib
 import functools
 
+from ._jsonable import reads_document
 from ._validate import _received, check
 from .errors import VidiTypeError
 
@@ -39,6 +40,10 @@ def option(default=None, spec=None, *, factory=None):
     return dataclasses.field(default=default, metadata=metadata)
 
 
+#: the spec of a field whose annotation is one of these and that names no spec of its own
+_PLAIN = {"bool": bool, "str": str}
+
+
 @dataclasses.dataclass(frozen=True)
 class Settings:
     """Base of the settings classes: a frozen dataclass of checked options."""
@@ -51,6 +56,9 @@ class Settings:
             if names is not None and f.name not in names:
                 continue
             spec = f.metadata.get("spec")
+            if spec is None:
+                # a field without a spec of its own: a switch is a bool, a name is text
+                spec = _PLAIN.get(f.type if isinstance(f.type, str) else f.type.__name__)
             if spec is not None:
                 check(f"{where}: {f.name}", getattr(self, f.name), spec)
 
@@ -136,6 +144,7 @@ class Settings:
         return {n: to_jsonable(plain(getattr(self, n))) for n in self.names()}
 
     @classmethod
+    @reads_document
     def from_dict(cls, doc):
         """The settings a :meth:`to_dict` document holds (missing fields at their
         default; lists back as tuples where the default is a tuple; an object's fields

@@ -355,3 +355,108 @@ def test_advise_and_contact_models_are_results_like_the_others(runs, out, tmp_pa
         assert (saved / "advise.csv").read_text() == (d / out / "advise.csv").read_text()
     rep = discovery.report(r, out=saved, compile=False)
     assert "\\section" in rep.tex.read_text()
+
+
+def _paths(doc, depth=2, prefix=()):
+    """Every key path of ``doc`` down to ``depth`` levels (dicts, and a list's first item)."""
+    if depth == 0:
+        return
+    items = (
+        doc.items()
+        if isinstance(doc, dict)
+        else ([(0, doc[0])] if isinstance(doc, list) and doc else [])
+    )
+    for k, v in items:
+        if prefix == () and k in ("schema_version", "result"):
+            continue
+        yield (*prefix, k)
+        yield from _paths(v, depth - 1, (*prefix, k))
+
+
+def _mutated(doc, path, value):
+    """A deep copy of ``doc`` with the field at ``path`` replaced (or deleted: ``value`` is
+    ``_DELETE``)."""
+    d = json.loads(json.dumps(doc))
+    node = d
+    for k in path[:-1]:
+        node = node[k]
+    if value is _DELETE:
+        del node[path[-1]]
+    else:
+        node[path[-1]] = value
+    return d
+
+
+_DELETE = object()
+# what an edit or a careless tool puts in a field: nothing, text, a list, a number, a
+# mapping, deep nesting
+_VALUES = (_DELETE, None, "text", [1, "x"], -1.5, {"a": 1}, json.loads("[" * 60 + "]" * 60))
+
+
+@pytest.mark.parametrize("out", list(KIND_OF))
+def test_a_mutated_document_loads_or_is_one_project_error(runs, tmp_path, out):
+    """Issue 53: every field of every result kind's saved document, deleted or replaced by
+    a value of another type, either loads into a result that prints, or is the project's
+    own error naming what to do, never Python's own exception (a seeded sample of the
+    fields two levels deep, every top-level one)."""
+    from discovery.errors import VidiError
+
+    d, _ = runs
+    doc = json.loads((d / SUMMARY[out]).read_text())
+    paths = list(_paths(doc))
+    rng = np.random.default_rng(53)
+    top = [p for p in paths if len(p) == 1]
+    deep = [p for p in paths if len(p) > 1]
+    chosen = top + [deep[i] for i in rng.permutation(len(deep))[:40]]
+    bad = []
+    for path in chosen:
+        for value in _VALUES:
+            f = tmp_path / "m.summary.json"
+            f.write_text(json.dumps(_mutated(doc, path, value)))
+            try:
+                str(discovery.load(f))
+            except VidiError as exc:
+                assert "\n" not in str(exc).strip(), (path, str(exc))
+            except Exception as exc:  # noqa: BLE001 (what the test looks for)
+                bad.append(f"{'.'.join(map(str, path))} = {str(value)[:20]}: {exc!r}"[:200])
+    assert not bad, f"{len(bad)} mutations raised Python's own errors:\n" + "\n".join(bad[:20])
+
+
+def _documents():
+    """``(class, a document its to_dict wrote)`` of the objects results hold and the
+    settings."""
+    from discovery.vibroimpact.advise.candidates import Knobs, NoiseModel, SafeRegion
+    from discovery.vibroimpact.explain.loop import ExplainSettings
+    from discovery.vibroimpact.fit.discovery import DiscoverSettings
+
+    return [
+        (discovery.ForceLaw, discovery.ForceLaw.parse(LAW).as_dict()),
+        (Knobs, Knobs((3e5, 6e5), (20.0, 30.0)).to_dict()),
+        (NoiseModel, NoiseModel(relative=0.01).to_dict()),
+        (SafeRegion, SafeRegion(1e7, 1e-3).to_dict()),
+        (ExplainSettings, ExplainSettings().to_dict()),
+        (DiscoverSettings, DiscoverSettings().to_dict()),
+    ]
+
+
+@pytest.mark.parametrize("cls, doc", _documents(), ids=lambda x: getattr(x, "__name__", ""))
+def test_from_dict_of_a_hostile_document_is_one_project_error(cls, doc):
+    """Issue 53: the from_dict of Knobs, NoiseModel, SafeRegion, ForceLaw and the settings
+    raised KeyError, TypeError, AttributeError, RecursionError on documents that are not
+    theirs; a document of the wrong shape or with a field of another type is one
+    InputError, and the document to_dict wrote reads back."""
+    from discovery.errors import VidiError
+
+    assert cls.from_dict(doc) is not None
+    hostile = [v for v in _VALUES if v is not _DELETE]
+    cases = [*hostile, {}]
+    cases += [{**doc, k: v} for k in doc for v in hostile]
+    bad = []
+    for case in cases:
+        try:
+            cls.from_dict(case)
+        except VidiError as exc:
+            assert "\n" not in str(exc)
+        except Exception as exc:  # noqa: BLE001 (what the test looks for)
+            bad.append(f"{str(case)[:60]}: {exc!r}"[:160])
+    assert not bad, "\n".join(bad[:10])

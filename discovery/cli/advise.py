@@ -50,6 +50,21 @@ def _noise(args, sc):
             "(a fraction of the peak force, e.g. 0.01), not both and not neither"
         )
     if args.data is not None:
+        given = [
+            o
+            for o, v in (
+                ("--position-noise", args.position_noise),
+                ("--sample-rate", args.sample_rate),
+                ("--periods", args.periods),
+            )
+            if v is not None
+        ]
+        if given:
+            raise InputError(
+                f"{', '.join(given)} describe(s) a next record given by --noise; with --data "
+                "the record's own noise, sampling and length are used: drop "
+                f"{' and '.join(given)}"
+            )
         meas = read_record(args, sc)
         for note in meas.notes:
             print(f"note: {note}")
@@ -59,8 +74,8 @@ def _noise(args, sc):
     return (
         NoiseModel(
             relative=args.noise,
-            dt=1.0 / args.sample_rate,
-            periods=args.periods,
+            dt=1.0 / (args.sample_rate or 20000.0),
+            periods=args.periods or 12.0,
             n_boot=args.n_boot,
             seed=args.seed,
             source="given as a fraction of the peak force",
@@ -87,6 +102,7 @@ def run(args):
     from reports import advise_figure
 
     from ..vibroimpact.advise import SafeRegion, advise
+    from ..vibroimpact.advise.candidates import fit_scenario_changed
     from ..vibroimpact.advise.result import point_lines
     from ..vibroimpact.model.scenario import load_scenario
 
@@ -94,6 +110,11 @@ def run(args):
     knobs = _knobs(args)
     safe = SafeRegion(args.max_force, args.max_penetration)
     laws, fit_scenario = _candidates(args)
+    if args.fit is not None and not args.scenario and fit_scenario:
+        changed = fit_scenario_changed(args.fit, fit_scenario)
+        if changed:
+            raise InputError(changed)
+        args.scenario = fit_scenario  # recorded in the run's inputs, with its checksum
     try:
         sc = load_scenario(args.scenario or fit_scenario or "paper")
     except InputError as exc:
@@ -167,14 +188,12 @@ def register(sub):
     s.add_argument(
         "--sample-rate",
         type=number(1, 1e9, unit="Hz"),
-        default=20000.0,
-        help="with --noise: the next record's sampling rate [Hz] (default: %(default)g)",
+        help="with --noise: the next record's sampling rate [Hz] (default: 20000)",
     )
     s.add_argument(
         "--periods",
         type=number(1, 1e5),
-        default=12.0,
-        help="with --noise: drive periods the next record holds (default: %(default)g)",
+        help="with --noise: drive periods the next record holds (default: 12)",
     )
     s.add_argument(
         "--amplitude", required=True, help="drive amplitude bounds LOW:HIGH [N], e.g. 3e5:6e5"

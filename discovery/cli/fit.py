@@ -6,6 +6,7 @@ import io
 import time
 
 from .._io import OutputDir
+from ..errors import InputError
 from ..vibroimpact.verify.criteria import CRITERIA
 from . import _options
 from ._common import (
@@ -172,6 +173,39 @@ def _print_result(args, res, pdf, why):
     print(outputs_line(args, ["summary.json", "ranking.csv", "model.tex", *pdfs, *figures]))
 
 
+#: the options of the polynomial path (its regression, ranking and stability selection),
+#: which mean nothing to the named models' fits
+_REGRESSION = (
+    "--select",
+    "--score",
+    "--max-terms",
+    "--shortlist",
+    "--margin",
+    "--signs",
+    "--require",
+    "--allow-unphysical",
+    "--monotone",
+    "--no-refine",
+    "--stability",
+    "--derivative",
+    "--average-cycles",
+)
+
+
+def _refuse_regression_options(args, defaults):
+    """A regression option given with ``--library contact-models`` is one line, not
+    ignored (``defaults``: the parser's default of each)."""
+    given = [
+        o for o, d in defaults.items() if getattr(args, o.lstrip("-").replace("-", "_"), d) != d
+    ]
+    if given:
+        raise InputError(
+            f"{', '.join(given)} belong(s) to the polynomial library's regression; the "
+            "named contact models are fitted by simulation alone: drop "
+            f"{' and '.join(given)} or give a polynomial --library"
+        )
+
+
 def _run_contact_models(args, scs, meas, machine, t_start):
     """``--library contact-models``: every named contact model fitted, the one the record
     supports and those it cannot tell from it (``summary.json`` is the result's
@@ -210,6 +244,9 @@ def _head(args, scs, machine):
 def run(args):
     t_start = time.perf_counter()
     check_out(args)
+    defaults = vars(args).pop("regression_only", None) or {}  # not a setting of the run
+    if args.library == "contact-models":
+        _refuse_regression_options(args, defaults)
     scs, meas, machine = read_records(args)
     if args.library == "contact-models":
         return _run_contact_models(args, scs, meas, machine, t_start)
@@ -391,4 +428,7 @@ def register(sub):
     _add_regression_options(s)
     _add_check_options(s)
     _add_output_options(s)
-    s.set_defaults(func=run)
+    s.set_defaults(
+        func=run,
+        regression_only={o: s.get_default(o.lstrip("-").replace("-", "_")) for o in _REGRESSION},
+    )

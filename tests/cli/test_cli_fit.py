@@ -197,3 +197,12 @@ def test_library_of_only_plus_exit_2(record, tmp_path, capsys):
     _assert_clean_failure(
         ["fit", "--data", str(record), "--library", "+", "--out", str(out)], out, capsys
     )
+
+
+@pytest.mark.parametrize("extra", [["--require", "z"], ["--stability", "3", "--max-terms", "3"]])
+def test_regression_options_with_the_named_models_are_refused(record, tmp_path, capsys, extra):
+    """Issue 53: --require, --stability and --max-terms were ignored by the contact-models
+    fit; each option given is named, before any work."""
+    out = tmp_path / "o"
+    argv = ["fit", "--data", str(record), "--library", "contact-models", *extra, "--out", str(out)]
+    _assert_clean_failure(argv, out, capsys, extra[0])

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..._jsonable import load_json
+from ..._jsonable import load_json, reads_document
 from ...errors import InputError
 from ..model.law import ForceLaw
 
@@ -26,6 +26,7 @@ __all__ = [
     "SafeRegion",
     "NoiseModel",
     "candidates_from_fit",
+    "fit_scenario_changed",
     "contact_candidates",
     "unique_laws",
 ]
@@ -135,6 +136,7 @@ class Knobs:
         }
 
     @classmethod
+    @reads_document
     def from_dict(cls, d):
         return cls(
             amplitude=tuple(d["amplitude"]),
@@ -188,6 +190,7 @@ class SafeRegion:
         return {"max_force": self.max_force, "max_penetration": self.max_penetration}
 
     @classmethod
+    @reads_document
     def from_dict(cls, d):
         return cls(max_force=d.get("max_force"), max_penetration=d.get("max_penetration"))
 
@@ -245,6 +248,11 @@ class NoiseModel:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int | np.integer) or not lo <= v <= hi:
                 raise InputError(f"noise {name} must be an integer {lo}..{hi}, got {v!r}")
+        if not isinstance(self.source, str) or len(self.source) > 1000:
+            raise InputError(
+                "noise source must be a few words of text (where the level came from), got "
+                f"{type(self.source).__name__}"
+            )
         if self.position is not None:
             try:
                 v = float(self.position)
@@ -297,6 +305,7 @@ class NoiseModel:
         }
 
     @classmethod
+    @reads_document
     def from_dict(cls, d):
         keys = ("relative", "dt", "periods", "n_boot", "seed", "source", "position")
         return cls(**{k: d[k] for k in keys})
@@ -415,6 +424,29 @@ def candidates_from_fit(run_dir):
     sc = s.get("scenario") or {}
     name = sc.get("name") if isinstance(sc, dict) else None
     return unique_laws(laws), given if isinstance(given, str) and given else name
+
+
+def fit_scenario_changed(run_dir, scenario):
+    """Why the scenario ``scenario`` (a file or a built-in name, as the fit was given it)
+    is not the one the ``vidi fit`` run in ``run_dir`` read (its sha256 in the fit's
+    ``inputs``), or None when it is the same or the fit recorded no checksum: a scenario
+    edited after the fit would give advice for another machine."""
+    from ..._provenance import _input_record
+
+    s, _ = load_json(Path(run_dir) / "summary.json")
+    inputs = s.get("inputs") if isinstance(s, dict) else None
+    then = inputs.get("scenario") if isinstance(inputs, dict) else None
+    then = then.get("sha256") if isinstance(then, dict) else None
+    if not isinstance(then, str):
+        return None
+    now = (_input_record(scenario) or {}).get("sha256")
+    if now == then:
+        return None
+    return (
+        f"the scenario {str(scenario)!r} is not the one the fit in {str(run_dir)!r} read "
+        f"(sha256 {then[:12]}... then, {str(now)[:12]}... now): it changed after the fit; "
+        "give --scenario to advise on the machine as it is now, or run vidi fit again"
+    )
 
 
 def _polynomial_candidates(s, p):

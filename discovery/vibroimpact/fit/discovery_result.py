@@ -38,11 +38,14 @@ def _real(value):
 def _mean_over(dicts):
     """The key-wise mean of ``dicts`` over the keys every one has (empty unless every one has
     entries): a record judged on its steady orbit has no I5 where another, judged over its
-    span, has one, and a mean over the records has none."""
+    span, has one, and a mean over the records has none.  A value a document holds as null
+    (a number that was not finite) is NaN."""
     if not all(dicts):
         return {}
     return {
-        k: float(np.mean([d[k] for d in dicts])) for k in dicts[0] if all(k in d for d in dicts)
+        k: float(np.mean([np.nan if d[k] is None else d[k] for d in dicts]))
+        for k in dicts[0]
+        if all(k in d for d in dicts)
     }
 
 

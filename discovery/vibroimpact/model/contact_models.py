@@ -296,6 +296,8 @@ def parse_model(text):
                 "once each, e.g. 'hunt-crossley: k=2e9, n=1.5, lambda=3e9'"
             )
         try:
+            if not value.isascii():  # float() reads full-width digits; the law grammar not
+                raise ValueError
             got[key] = float(value)
         except ValueError:
             raise InputError(f"{text!r}: {key} needs a number, got {value.strip()!r}") from None

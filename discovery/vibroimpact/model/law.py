@@ -41,6 +41,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..._jsonable import reads_document
 from ..._validate import Real, check
 from ...errors import InputError
 from ._lawgrammar import MAX_EXPONENT, parse_law_terms
@@ -263,6 +264,7 @@ class ForceLaw:
         return tuple(merged), tuple(merged.values())
 
     @classmethod
+    @reads_document
     def from_dict(cls, coefficients):
         """Law from ``{term name: coefficient}``."""
         terms = tuple(Term.parse(k) for k in coefficients)

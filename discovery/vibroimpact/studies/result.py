@@ -61,6 +61,7 @@ class StudyResult(Result):
     _LOAD = {
         "config": _loaded_config,
         "runs": lambda d: [],  # in the study's runs/ folder, not in its summary
+        "inclusion": lambda d: {},  # the runs' inclusion counts: not in the summary either
         "n_runs": lambda d: d["runs"],
         "out": lambda d: Path(d["out"]),
         "figures": lambda d: tuple(Path(d["out"]) / f for f in d.get("figures", ())),

@@ -408,3 +408,44 @@ def test_a_tampered_fit_directory_is_one_line_or_read_as_far_as_it_goes(tmp_path
         assert "run vidi fit again" in str(exc)
     else:
         assert len(laws) == 2 and scenario is None  # the settings unreadable: no scenario
+
+
+def test_a_scenario_edited_after_the_fit_is_refused(tmp_path, capsys):
+    """Issue 53: advise --fit re-read the fit's scenario file, so a file edited after the fit
+    (m2 1e4 -> 2.5e4) gave advice for another machine without a word."""
+    from discovery._provenance import file_sha256
+
+    scenario = tmp_path / "machine.toml"
+    scenario.write_text(load_scenario("paper").to_toml())
+    doc = {
+        "command": "fit",
+        "library": "poly:2",
+        "selected": {"coefficients": {"z": 2e8, "zd": 1e7}},
+        "equivalent": [{"coefficients": {"z": 2e8, "zd": 1.1e7}}],
+        "settings": {"scenario": str(scenario)},
+        "inputs": {"scenario": {"path": str(scenario), "sha256": file_sha256(scenario)}},
+    }
+    fit = tmp_path / "fit"
+    fit.mkdir()
+    (fit / "summary.json").write_text(json.dumps(doc))
+    from discovery.vibroimpact.advise import fit_scenario_changed
+
+    assert fit_scenario_changed(fit, str(scenario)) is None
+    scenario.write_text(scenario.read_text().replace("m2 = 10000.0", "m2 = 25000.0"))
+    assert "changed after the fit" in fit_scenario_changed(fit, str(scenario))
+    out = tmp_path / "o"
+    argv = ["advise", "--fit", str(fit), "--noise", "0.01", "--amplitude", "3e5:6e5"]
+    assert main([*argv, "--frequency", "20:30", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "changed after the fit" in err and "\n" not in err and not out.exists()
+
+
+def test_record_options_with_a_record_are_refused(tmp_path, capsys):
+    """Issue 53: --position-noise (and the next record's sampling and length) were ignored
+    with --data."""
+    out = tmp_path / "o"
+    argv = ["advise", "--law", BASE, "--law", "2e8*z + 5e9*z*zd", "--data", "D.csv"]
+    argv += ["--position-noise", "0.01", "--amplitude", "3e5:6e5", "--frequency", "20:30"]
+    assert main([*argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--position-noise" in err and "\n" not in err and not out.exists()

@@ -161,6 +161,7 @@ def test_text_round_trip(name):
         ("flores: k=2e9, n=1.5, e=1.5", "restitution"),
         ("flores: k=-2e9, n=1.5, e=0.5", "stiffness"),
         ("kelvin-voigt: k=2e8, c=abc", "number"),
+        ("flores: k=\uff18e8, n=1.25, e=0.5", "k needs a number"),  # a full-width 8
         ("2e8*z; scale: v1", "scale"),
         ("hunt-crosley: k=2e9, n=1.5, lambda=3e9", "did you mean 'hunt-crossley'"),
         ("Kelvin Voigt: k=2e8, c=1e6", "did you mean 'kelvin-voigt'"),
