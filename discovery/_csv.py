@@ -4,6 +4,7 @@ one clear line for a bad file."""
 
 import csv
 import os
+import stat
 from dataclasses import dataclass
 
 import numpy as np
@@ -11,7 +12,12 @@ import numpy as np
 from ._io import short
 from .errors import InputError, VidiTypeError
 
-__all__ = ["CsvRows", "read_csv_rows", "parse_column"]
+__all__ = ["CsvRows", "read_csv_rows", "parse_column", "MAX_RECORD_BYTES"]
+
+#: the largest data file read: about two million rows of seven columns (some 2,500 drive
+#: periods of the paper's machine at 20 kHz); a record is held as text, rows and arrays at
+#: once, about ten times its size in memory
+MAX_RECORD_BYTES = 200 * 2**20
 
 
 @dataclass(frozen=True)
@@ -99,6 +105,17 @@ def _read_text(path, name):
     if not name.strip():
         raise InputError("the data file name is empty; give a CSV file such as D.csv")
     try:
+        st = os.stat(path)
+        if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode):
+            raise InputError(f"data file {name!r} is a device, not a file; give a CSV file")
+        size = st.st_size
+        if size > MAX_RECORD_BYTES:
+            raise InputError(
+                f"data file {name!r} is {size / 2**20:.0f} MB; records up to "
+                f"{MAX_RECORD_BYTES // 2**20} MB are read (about two million rows of seven "
+                "columns, held in memory about ten times over): cut it to the span the "
+                "question needs (20-50 drive periods are plenty) or downsample it"
+            )
         with open(path, "rb") as fh:
             raw = fh.read()
     except FileNotFoundError:

@@ -281,7 +281,7 @@ CASES = [
     (
         "samples-too-many",
         [*S, "--fs", "5e7", "--periods", "100"],
-        "is 2e+08 samples; the limit is 1e+07: lower --fs or --periods",
+        "is 2e+08 samples; the limit is 2e+06: lower --fs or --periods",
     ),
     ("samples-too-few", [*S, "--fs", "10", "--periods", "1"], "only 0.4 samples"),
     ("noise-negative", [*S, "--noise", "-0.1"], "--noise: '-0.1' is out of range"),
@@ -644,3 +644,17 @@ def test_a_bug_is_exit_1_not_bad_input(monkeypatch, capsys, exc):
     assert main(["steady", "--scenario", "paper"]) == 1
     err = capsys.readouterr().err.strip()
     assert err.startswith("vidi: error: internal error") and len(err.splitlines()) == 1, err
+
+
+def test_a_huge_record_is_refused_before_it_is_read(tmp_path, monkeypatch, capsys):
+    """Issue 53: a 10-million-row record (908 MB) given to verify ran for minutes with
+    nothing printed, its memory at ten times the file; a record over the stated size is one
+    line before any of it is read (a sparse file: nothing on the disk)."""
+    monkeypatch.chdir(tmp_path)
+    with open("huge.csv", "wb") as fh:
+        fh.write(b"t,F\n")
+        fh.truncate(201 * 2**20)
+    assert main(["verify", "--data", "huge.csv", "--out", "res"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "is 201 MB; records up to 200 MB" in err and "\n" not in err
+    assert not (tmp_path / "res").exists()

@@ -19,11 +19,9 @@ from ._common import (
     write_record,
 )
 
-#: largest record written (samples): 1e7 rows of 6 columns is ~1 GB of text
-MAX_SAMPLES = 10_000_000
-
 
 def run(args):
+    from ..vibroimpact.data.measurement import MAX_SAMPLES
     from ..vibroimpact.dynamics.synthetic import SimulatedRecord, synthesize
 
     paths = out, summary_path = check_record_out(args)

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..._jsonable import load_json, reads_document
 from ...errors import InputError
+from ..data.measurement import MAX_SAMPLES
 from ..model.law import ForceLaw
 
 __all__ = [
@@ -51,8 +52,8 @@ def _pair(value, what, unit, low=0.0):
 MAX_POINTS = 10_000
 #: the most candidate laws (every pair is judged at every point)
 MAX_CANDIDATES = 12
-#: the most samples of one predicted record
-MAX_RECORD_SAMPLES = 20_000_000
+#: the most samples of one predicted record (as any record a run makes)
+MAX_RECORD_SAMPLES = MAX_SAMPLES
 
 
 @dataclass(frozen=True)

@@ -40,6 +40,12 @@ from .contact_edges import _edge_params
 from .impulse import impulse_from_samples
 from .noise import estimate_noise
 
+#: the most samples of one record a run makes or predicts (``vidi simulate``, a study's
+#: records, field records, advise's predictions): a record of this length, with positions
+#: and velocities, is about the largest CSV file the reader takes
+#: (:data:`discovery._csv.MAX_RECORD_BYTES`)
+MAX_SAMPLES = 2_000_000
+
 __all__ = ["Measurement", "COLUMNS", "LIMITS", "JITTER_LIMIT", "STATE_COLUMNS"]
 
 _OPTIONAL = ("w1", "v1", "w2", "v2", "a2")

@@ -10,13 +10,11 @@ from ..._result import Result
 from ..._settings import Settings, option, takes
 from ..._validate import Choice, Real, params
 from ...errors import InputError
-from ..data.measurement import STATE_COLUMNS, Measurement
+from ..data.measurement import MAX_SAMPLES, STATE_COLUMNS, Measurement
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from .simulation import simulate
 from .steady_states import steady_state
-
-MAX_SAMPLES = 10_000_000  # samples of one record (as `vidi simulate`)
 
 __all__ = ["synthesize", "SimulatedRecord"]
 

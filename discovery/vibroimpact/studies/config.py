@@ -48,6 +48,7 @@ from pathlib import Path
 from ..._io import short
 from ..._validate import Text, params
 from ...errors import InputError, VidiError
+from ..data.measurement import MAX_SAMPLES
 from ..fit.regression import SELECTIONS
 from ..model.contact_models import is_model_text, parse_law
 from ..model.library import Library
@@ -91,7 +92,6 @@ _RECORD_KEYS = ("transient", "velocities")
 # bounds on a study's size, checked before any work (each message gives the number)
 MAX_CELLS = 10_000
 MAX_RUNS = 100_000
-MAX_SAMPLES = 10_000_000  # samples of one run's records, like `vidi simulate`
 MAX_FILE_BYTES = 1 << 20  # a study file larger than this is not read
 _FIT_BOUNDS = {
     "shortlist": 200,
@@ -379,8 +379,6 @@ def _check_fit(fit, source):
             _criterion(fit["criterion"])
         if "scoring" in fit and fit["scoring"] not in SCORES:
             raise InputError(f"scoring must be one of {', '.join(SCORES)}; got {fit['scoring']!r}")
-        if "physics" in fit and not isinstance(fit["physics"], bool):
-            raise InputError(f"physics must be true or false; got {fit['physics']!r}")
         req = fit.get("require", [])
         if not (isinstance(req, list) and all(isinstance(r, str) and r for r in req)):
             raise InputError(f'require must be a list of term names such as ["z"]; got {req!r}')

@@ -26,8 +26,8 @@ import numpy as np
 
 from ..._settings import Settings, option, takes
 from ..._validate import Real, params
-from ...errors import IntegrationError, VidiError
-from ..data.measurement import Measurement
+from ...errors import InputError, IntegrationError, VidiError
+from ..data.measurement import MAX_SAMPLES, Measurement
 from ..dynamics.reference import reference_simulate
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
@@ -177,6 +177,12 @@ def field_record(scenario, law, *, settings=None, **options):
         Times on the drive's clock; the first sample is at ``transient * T``.
     """
     s = FieldRecordSettings.of("field_record", settings, options)
+    n = s.periods * scenario.period * s.fs
+    if not n <= MAX_SAMPLES:
+        raise InputError(
+            f"field_record: periods = {s.periods} at fs = {s.fs:g} Hz is {n:.3g} samples; the "
+            f"limit is {MAX_SAMPLES:.0e}: lower fs or periods"
+        )
     transient = auto_transient(scenario, law) if s.transient is None else s.transient
     transient, periods = int(transient), int(s.periods)
     clean = clean_record(scenario, law, periods, float(s.fs), transient)

@@ -113,7 +113,7 @@ def test_config_rows_and_scenario_tables():
         ({"fit": {"criterion": "I9"}}, "criterion must be one of 'I0', 'I1', 'I2', 'I3', 'I4'"),
         ({"fit": {"max_simulations": 0}}, "max_simulations must be an integer >= 2"),
         ({"fit": {"scoring": "r2"}}, "scoring must be one of"),
-        ({"fit": {"physics": "no"}}, "physics must be true or false"),
+        ({"fit": {"physics": "no"}}, "physics must be a bool"),
         ({"fit": {"n_boot": 10**9}}, "n_boot must be at most 10000"),
         ({"fit": {"n_boot_intervals": 3}}, "cannot give an interval"),
         ({"record": {"velocities": "no"}}, "velocities is true or false; got 'no'"),
