@@ -132,8 +132,6 @@ class Result:
                     raise _Unreadable(cls.KIND, (f.name,), exc) from None
             elif f.name in d:
                 value = _typed(cls.KIND, f, d[f.name])
-            elif _required(f):
-                raise _Unreadable(cls.KIND, (f.name,), KeyError("missing"))
             elif f.default is not dataclasses.MISSING:
                 value = f.default
             elif f.default_factory is not dataclasses.MISSING:
@@ -142,7 +140,6 @@ class Result:
                 value = None
             object.__setattr__(obj, f.name, value)
         object.__setattr__(obj, "_document", copy.deepcopy(d))
-        _prints(obj)
         return obj
 
     @staticmethod
@@ -213,17 +210,6 @@ def _json_types(f):
     return allowed
 
 
-def _required(f):
-    """A field the document must hold: no default, and a plain JSON type (a field without
-    a default that the document does not hold, such as a simulated history, is typed as
-    an object)."""
-    return (
-        f.default is dataclasses.MISSING
-        and f.default_factory is dataclasses.MISSING
-        and _json_types(f) is not None
-    )
-
-
 def _typed(kind, f, value):
     """``value`` when it is of the field's JSON type (a bool is no number), else the
     document's field is unreadable."""
@@ -241,9 +227,11 @@ def _typed(kind, f, value):
 
 
 def _prints(obj):
-    """A loaded result prints, or its document was edited where no field's type tells
-    (a key the summary reads inside a mapping): one :class:`InputError`, not the
-    exception of the line that prints it."""
+    """A loaded result prints, or its document was edited where no field's type tells (a
+    field deleted, a key the summary reads inside a mapping): one :class:`InputError`, not
+    the exception of the line that prints it.  :func:`load` asks it of what it reads; a
+    report reads a document's keys as far as they go (a run directory of an older
+    vidi)."""
     try:
         str(obj)
     except (
@@ -321,7 +309,9 @@ def load(path):
         )
     d = load_summary(path)
     kind = check_document(d, f"load {short(str(path))!r}")
-    return result_class(kind).from_dict(d)
+    result = result_class(kind).from_dict(d)
+    _prints(result)
+    return result
 
 
 class _Unreadable(InputError):

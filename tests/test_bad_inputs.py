@@ -499,6 +499,18 @@ CASES += [
     ("identify-n-boot-zero", [*I, "--n-boot", "0"], "--n-boot: '0' is out of range"),
     ("landscape-range-crosses-zero", [*L, "--range0=-1e8:1e8"], "reaches zero"),
     ("landscape-range-reversed", [*L, "--range0", "3e8:1e8"], "needs LOW < HIGH"),
+    ("landscape-range-nan", [*L, "--range0", "nan:1e8"], "nan is not a finite number"),
+    (
+        "ueda-chart-B-unbounded",
+        ["ueda", "chart", "--B", "0:1e300:2", "--out", "uc"],
+        "must lie in [-1000, 1000]",
+    ),
+    (
+        "ueda-chart-nu-tiny",
+        ["ueda", "chart", "--nu", "1e-300:1.1:3", "--out", "uc"],
+        "must lie in [0.01, 100]",
+    ),
+    ("ueda-simulate-nu-tiny", ["ueda", "simulate", "--nu", "1e-300", "--out", "u.csv"], ">= 0.01"),
     ("landscape-range-text", [*L, "--range1", "abc"], "must look like LOW:HIGH"),
     (
         "landscape-grid-syntax",
@@ -585,6 +597,13 @@ def _api_cases():
             "must be a ForceLaw",
         ),
         ("scenario-dir", lambda w: load_scenario(w), "is a directory"),
+        (
+            "impulse-of-no-steady-state",
+            lambda w: discovery.impulse_from_steady_state(
+                load_scenario("paper"), ForceLaw.parse("2e8*z + 1e7*zd"), None
+            ),
+            "ss must be a SteadyState",
+        ),
         (
             "columns-not-dict",
             lambda w: Measurement.from_csv(w / "good.csv", columns=["t"]),

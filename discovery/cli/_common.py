@@ -126,7 +126,10 @@ def parse_range(text, default, name):
         lo, hi = (float(v) for v in text.split(":"))
     except ValueError:
         raise InputError(f"{name} {text!r} must look like LOW:HIGH, e.g. 1.03e8:3.09e8") from None
-    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+    bad = [v for v in (lo, hi) if not np.isfinite(v)]
+    if bad:
+        raise InputError(f"{name} {text!r}: {bad[0]!r} is not a finite number; e.g. 1.03e8:3.09e8")
+    if not lo < hi:
         raise InputError(f"{name} needs LOW < HIGH, got {text!r}")
     return lo, hi
 

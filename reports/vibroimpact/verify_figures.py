@@ -8,7 +8,7 @@ import numpy as np
 from .._mpl import PRINT_WIDTH, figure, save, subplots
 from .figure_parts import contact_view, force_unit, law_math
 
-__all__ = ["verify_figure", "loops_figure"]
+__all__ = ["verify_figure", "loops_figure", "span_view"]
 
 _save = save
 
@@ -37,6 +37,9 @@ def verify_figure(result, stem):
 
     ev = result.evaluation
     E = result.reference.impulse
+    view = span_view(result)
+    if view is not None:
+        return _span_figure(result, view, stem)
     loops = force_penetration_loops(result.reference, ev)
     if ev.simulated is None:  # nothing simulated to compare: the measured force alone
         fig, ax = subplots(1, 1, figsize=(PRINT_WIDTH, 3.4))
@@ -90,6 +93,137 @@ def verify_figure(result, stem):
         axr.set_ylabel(f"$F_N - F_E$ [{unit}]")
         axr.set_xlabel("time since the contact's start [ms] (folded)")
         axr.axhline(0.0, color="k", lw=0.5)
+    fig.tight_layout()
+    return _save(fig, stem)
+
+
+def span_view(result):
+    """The last compared block of a record-span verification, unfolded: the samples of its
+    last whole contact (onset to loss, padded by a fifth of its length each side) and every
+    contact sample of the block, measured and simulated; None for a steady-orbit
+    comparison or a loaded result (its simulations are not saved).
+
+    A record in a transient (or a shedding machine) has contacts at another phase in each
+    cycle: the fold of several cycles averages them into a staircase, so the verdict's own
+    comparison, sample by sample on the record's span, is what is shown.
+
+    Returns
+    -------
+    dict or None
+        ``t`` (times since the contact's onset [s]), ``fm``, ``fn`` (forces [N]) and, with
+        positions, ``zm``, ``zn`` (penetrations [m]) over the contact's window;
+        ``loop``: ``(zm, fm, zn, fn)`` over every contact sample of the block; ``sigma``:
+        the force's noise [N]; ``cycles``: the block's cycles.
+    """
+    ev = result.evaluation
+    span = getattr(result.reference, "span", None)
+    if ev.comparison != "record span" or not ev.histories or span is None:
+        return None
+    blk = span.blocks[-1]
+    td = np.asarray(blk.fold.td, dtype=float)
+    fm, fn = np.asarray(blk.F, dtype=float), np.asarray(ev.histories[-1], dtype=float)
+    if fn.shape != fm.shape or td.size < 8:
+        return None
+    sigma = float(span.sigma_f)
+    thr = max(3.0 * sigma, 0.02 * float(np.max(np.abs(fm))))
+    active = (fm > thr) | (fn > thr)
+    runs = _runs(active, max(3, int(0.1 * blk.fold.period / np.median(np.diff(td)))))
+    if not runs:
+        return None
+    whole = [r for r in runs if r[0] > 0 and r[1] < td.size] or runs
+    a, b = whole[-1]
+    pad = max(5, (b - a) // 5)
+    w = slice(max(a - pad, 0), min(b + pad, td.size))
+    zm = zn = None
+    if ev.penetration and span.sigma_z > 0:
+        zm, zn = np.asarray(blk.Z, dtype=float), np.asarray(ev.penetration[-1], dtype=float)
+    # the loop over the contacts' samples (a lone noise sample over the threshold is none)
+    inside = np.zeros(td.size, dtype=bool)
+    for r0, r1 in runs:
+        inside[r0:r1] = r1 - r0 >= 3
+    inside &= active
+    loop = None if zm is None else (zm[inside], fm[inside], zn[inside], fn[inside])
+    return {
+        "t": td[w] - td[a],
+        "fm": fm[w],
+        "fn": fn[w],
+        "zm": None if zm is None else zm[w],
+        "zn": None if zn is None else zn[w],
+        "loop": loop,
+        "sigma": sigma,
+        "cycles": int(blk.fold.n_cycles),
+    }
+
+
+def _runs(active, gap):
+    """``[(start, stop)]`` of the runs of ``active`` (runs closer than ``gap`` samples are
+    one: the bounces of one contact)."""
+    idx = np.flatnonzero(active)
+    if not idx.size:
+        return []
+    cut = np.flatnonzero(np.diff(idx) > gap)
+    starts = np.concatenate([[idx[0]], idx[cut + 1]])
+    stops = np.concatenate([idx[cut], [idx[-1]]]) + 1
+    return [(int(a), int(b)) for a, b in zip(starts, stops, strict=True)]
+
+
+def _span_figure(result, view, stem):
+    """The verify figure of a record-span comparison (:func:`span_view`): the last contact's
+    measured and simulated force on the record's samples with the noise band and the
+    residual; with positions, the loop over the block's contact samples and both
+    penetrations over the contact."""
+    ev = result.evaluation
+    ms = 1e3
+    x = view["t"] * ms
+    band = 2.0 * view["sigma"]
+    sc, unit = force_unit(max(float(np.max(np.abs(view["fm"]))), 1e-300))
+    if view["loop"] is None:
+        fig, (ax, axr) = subplots(
+            2, 1, figsize=(PRINT_WIDTH, 4.8), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
+        )
+    else:
+        fig = figure(figsize=(PRINT_WIDTH, 5.6))
+        grid = fig.add_gridspec(2, 2, height_ratios=[3, 2], width_ratios=[1.5, 1])
+        ax = fig.add_subplot(grid[0, 0])
+        axr = fig.add_subplot(grid[1, 0], sharex=ax)
+        axl, axz = fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, 1], sharex=ax)
+        zm, fm, zn, fn = view["loop"]
+        axl.plot(zm * ms, fm * sc, "k.", ms=1.5, label="measured")
+        axl.plot(zn * ms, fn * sc, "C3.", ms=1.5, label="simulated")
+        axl.axvline(0.0, color="0.6", lw=0.5)
+        axl.set_title(f"force-penetration loop ({view['cycles']} cycles)", fontsize=8)
+        axl.set_xlabel("penetration w1 - w2 [mm]")
+        axl.set_ylabel(f"F [{unit}]")
+        axl.legend(fontsize=7, loc="best", framealpha=0.8, markerscale=4)
+        axz.plot(x, view["zm"] * ms, "k-", lw=0.8, label="measured")
+        axz.plot(x, view["zn"] * ms, "C3-", lw=0.8, label="simulated")
+        axz.axhline(0.0, color="0.6", lw=0.5)
+        i5, lim = ev.criteria.get("I5"), (ev.limits or {}).get("I5")
+        if i5 is not None:
+            axz.set_title(
+                f"I5 {i5:.3g}" + (f" (limit {lim:.3g})" if lim is not None else ""), fontsize=8
+            )
+        axz.set_xlabel("time since the contact's onset [ms]")
+        axz.set_ylabel("w1 - w2 [mm]")
+    ax.fill_between(
+        x,
+        (view["fm"] - band) * sc,
+        (view["fm"] + band) * sc,
+        color="0.85",
+        label=r"measured $\pm 2\sigma$ noise band",
+    )
+    ax.plot(x, view["fm"] * sc, "k-", lw=1.0, label=r"measured $F_E$ (the record's samples)")
+    ax.plot(x, view["fn"] * sc, "C3-", lw=1.0, label=r"simulated $F_N$ from the measured state")
+    axr.fill_between(x, -band * sc, band * sc, color="0.85")
+    axr.plot(x, (view["fn"] - view["fm"]) * sc, "C0-", lw=0.8)
+    axr.axhline(0.0, color="k", lw=0.5)
+    axr.set_ylabel(f"$F_N - F_E$ [{unit}]")
+    axr.set_xlabel("time since the last contact's onset [ms]")
+    crit = ", ".join(_criterion_text(k, v, ev) for k, v in ev.criteria.items() if k in _JUDGED)
+    verdict = f"{'consistent' if ev.consistent else 'INCONSISTENT'}: {crit or _why_none(ev)}"
+    ax.set_title(f"{law_math(result.law)}\n" + textwrap.fill(verdict, 72), fontsize=8)
+    ax.set_ylabel(f"contact force F [{unit}]")
+    ax.legend(fontsize=7, loc="best", framealpha=0.8)
     fig.tight_layout()
     return _save(fig, stem)
 

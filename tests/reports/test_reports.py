@@ -13,6 +13,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from discovery.cli import main
@@ -1052,3 +1053,28 @@ def test_a_ueda_attractor_report_states_its_oscillator(tmp_path):
         "second exponent",
     ):
         assert words in tex, words
+
+
+def test_the_verify_figure_shows_a_transient_record_sample_by_sample(tmp_path):
+    """Issue 50: the README's from-rest record (20 periods, the scipy path) is in a
+    transient, so each cycle's onset falls at another phase: the fold of four cycles was a
+    staircase, and the loop drew force at penetrations down to -0.7 mm (eq. (1): F = 0 for
+    zeta <= 0).  The figure shows the verdict's own comparison, on the record's samples:
+    one contact's onset at time 0, and the loop where the contact carries force."""
+    from discovery import ForceLaw, load_scenario, synthesize, verify
+    from reports.vibroimpact.verify_figures import span_view, verify_figure
+
+    sc = load_scenario("paper")
+    law = ForceLaw.parse("2.06e8*z + 4e6*zd; unloading: 4e6*zd")
+    rec = synthesize(sc, law, periods=20, noise=0.01, seed=1, from_rest=True, integrator="scipy")
+    res = verify(sc, rec, law)
+    assert res.evaluation.consistent and res.evaluation.comparison == "record span"
+    view = span_view(res)
+    t, fm, fn = view["t"], view["fm"], view["fn"]
+    thr = max(3 * view["sigma"], 0.02 * fm.max())
+    assert np.all(fm[t < -1e-4] < thr) and fm[(t >= 0) & (t < 1e-3)].max() > 0.5 * fm.max()
+    assert np.max(np.abs(fn - fm)) < 6 * view["sigma"]  # the law tracks the record's samples
+    zm, f, zn, _ = view["loop"]
+    assert np.mean(zm > -3e-5) > 0.97 and np.mean(zn > -3e-5) > 0.97  # force where zeta > 0
+    png, _ = verify_figure(res, str(tmp_path / "verify"))
+    assert Path(png).stat().st_size > 10_000

@@ -61,8 +61,9 @@ def _add_forcing_values(s):
     s.add_argument("--B", type=number(-1e3, 1e3), help="forcing amplitude" + _models_default("B"))
     s.add_argument(
         "--nu",
-        type=number(0, 100, lo_open=True),
-        help="forcing angular frequency, > 0" + _models_default("nu"),
+        type=number(0.01, 100),
+        help="forcing angular frequency, 0.01-100 (a period of 2 pi / nu time units)"
+        + _models_default("nu"),
     )
 
 

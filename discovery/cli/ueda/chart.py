@@ -11,6 +11,10 @@ from .. import _options
 from .._common import check_out, executor_of, integer, reporter
 from ._system import _add_system_options, _system
 
+#: each axis's values within the bounds of its single-value option (``--nu``, ``--B`` of
+#: ``vidi ueda simulate``): ``(low, high, low excluded)``
+_AXIS_BOUNDS = {"--nu": (0.01, 100.0, False), "--B": (-1e3, 1e3, False)}
+
 
 def _grid(text, option):
     parts = text.split(":")
@@ -25,6 +29,12 @@ def _grid(text, option):
     ):
         raise argparse.ArgumentTypeError(
             f"{text!r}: need LOW < HIGH (finite) and 1 <= N <= 2000, e.g. 0.8:1.2:200"
+        )
+    low, high, open_low = _AXIS_BOUNDS.get(option, (-np.inf, np.inf, False))
+    if lo < low or (open_low and lo == low) or hi > high:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: the values must lie in {'(' if open_low else '['}{low:g}, {high:g}], "
+            f"as {option} of vidi ueda simulate"
         )
     return np.linspace(lo, hi, n)
 
@@ -46,8 +56,6 @@ def run(args):
     from ...ueda.regime_chart import chart
 
     check_out(args)
-    if args.nu[0] <= 0:
-        raise InputError("--nu: the frequencies must be > 0, e.g. --nu 0.8:1.2:200")
     system = _system(args, nu=None, B=None)
 
     if args.periods < 4 * args.max_period:

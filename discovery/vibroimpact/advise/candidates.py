@@ -104,8 +104,9 @@ class Knobs:
         if points > MAX_POINTS:
             raise InputError(
                 f"the grid has {points} points (each a steady state of every candidate and "
-                f"their predicted records); at most {MAX_POINTS}: make the grid coarser (the "
-                "best points are refined anyway)"
+                f"their predicted records); at most {MAX_POINTS}: make the grid coarser "
+                "(--grid; in the API Knobs(grid=..., m2_points=...)): the best points are "
+                "refined anyway"
             )
 
     def axes(self):

@@ -17,7 +17,7 @@ import numpy as np
 from scipy.signal import savgol_filter
 
 from ..._printing import fmt, readable
-from ..._validate import Real, Text, params
+from ..._validate import Choice, Real, Text, params
 from ...errors import InputError
 from .impulse import impulse_from_samples
 from .measurement import Measurement
@@ -184,6 +184,7 @@ def _average_steady(t, zeta, dzeta, F, period):
     k_sigma=Real(0, open_low=True),
     weights=Text(),
     period=(None, Real(0, open_low=True)),
+    contact=Choice("penetration", "force"),
 )
 def contact_samples(
     measurement,
@@ -194,6 +195,7 @@ def contact_samples(
     weights="uniform",
     average_cycles=False,
     period=None,
+    contact="penetration",
 ):
     """Contact samples of a :class:`~discovery.vibroimpact.data.measurement.Measurement`.
 
@@ -220,6 +222,11 @@ def contact_samples(
         number of samples per cycle.
     period : float, optional
         Drive period [s] (for ``average_cycles``).
+    contact : {"penetration", "force"}
+        What says a sample is in contact: ``zeta`` above ``k_sigma`` times its noise, or the
+        force above ``k_sigma`` times the force's noise.  The force tells contact where the
+        penetration, a small difference of two large noisy motions, is buried in their
+        noise (a stiff contact whose peak penetration is a few noise deviations).
 
     Returns
     -------
@@ -260,7 +267,11 @@ def contact_samples(
         t, zeta, dzeta, F, count = _average_steady(t, zeta, dzeta, F, period)
     # third differences: the smooth motion cancels, only the measurement noise remains
     floor = max(k_sigma * estimate_noise(zeta, order=3), 1e-9 * float(np.max(np.abs(zeta))))
-    contact = zeta > floor
+    contact_by_force = contact == "force"
+    if contact_by_force:
+        contact = F > max(k_sigma * sigma, 1e-9 * float(np.max(np.abs(F))))
+    else:
+        contact = zeta > floor
     if contact.sum() < 10:
         raise InputError(
             "fewer than 10 contact samples (zeta = w1 - w2 > 0 above its noise); "
@@ -272,7 +283,10 @@ def contact_samples(
     ends = np.flatnonzero(np.diff(np.concatenate([contact.astype(np.int8), [0]])) == -1)
     new = np.ones(starts.size, dtype=bool)
     for j in range(1, starts.size):
-        new[j] = bool(np.min(zeta[ends[j - 1] + 1 : starts[j]]) < -floor)
+        if contact_by_force:  # a dip of one or two samples is the force's noise
+            new[j] = starts[j] - ends[j - 1] > 3
+        else:
+            new[j] = bool(np.min(zeta[ends[j - 1] + 1 : starts[j]]) < -floor)
     impact_all = np.cumsum(np.isin(np.arange(t.size), starts[new])) - 1
     idx = np.flatnonzero(contact)
     impact = impact_all[idx]

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._printing import readable
-from ..._validate import Real, params
+from ..._validate import Instance, Real, params
 from ...errors import InputError
 from ..data.impulse import Impulse
 from ..model.law import ForceLaw
@@ -114,6 +114,13 @@ def _main_onset(tr, law, scenario, n):
     return best_j
 
 
+@params(
+    scenario=Scenario,
+    law=ForceLaw,
+    ss=Instance("discovery.vibroimpact.dynamics.steady_states", "SteadyState"),
+    tolerances=(Tolerances, None),
+    points_per_period=Real(16, integer=True),
+)
 def impulse_from_steady_state(scenario, law, ss, points_per_period=2000, tolerances=None):
     """The exact steady-state impulse of a periodic orbit.
 

@@ -141,6 +141,9 @@ class Evaluation(Result):
     penetration : list or None
         The simulated penetration at each block's samples (a record-span comparison with
         positions).
+    histories : list or None
+        The simulated force at each block's samples, unfolded (a record-span comparison;
+        not in the saved document).
     span : dict or None
         The record span compared: start time, cycles, blocks, the state fit, I2 per block.
     transient_i2 : float or None
@@ -169,6 +172,7 @@ class Evaluation(Result):
     comparison: str = "steady orbit"
     blocks: list = None
     penetration: list = None
+    histories: list = None
     span: dict = None
     transient_i2: float = None
     impacts_folded: dict = None
@@ -627,6 +631,7 @@ def _evaluate_span(
     found = {
         "comparison": "record span",
         "penetration": z_sim,
+        "histories": hist,
         "blocks": list(zip(reference.blocks, sims, strict=True)),
         "span": {
             "start_time": span.state.t,
