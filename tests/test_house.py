@@ -202,37 +202,13 @@ def test_a_lazy_package_refuses_a_name_its_module_shares(tmp_path, monkeypatch):
         importlib.import_module("vidi_shadow_pkg")
 
 
-def test_split_modules_keep_the_names_of_the_module_they_were():
-    """``fit/identification.py``, ``fit/discovery.py`` and ``explain/loop.py`` are split by job;
-    every name other modules and tests import from them is still there (the same object as
-    in its new module)."""
-    for old_mod, moved in {
-        "identification": {
-            "problem": ("_Objective", "_PENALTY", "_Budget", "_uncertainty"),
-            "intervals": ("Intervals", "bootstrap_intervals", "MIN_CYCLE_DOF", "INTERVAL_REFITS"),
-            "optimise": ("METHODS", "RESTART_FACTORS", "_optimise", "_coordinate_descent"),
-            "records": ("as_records", "pair_records", "record_start", "model_parts", "cycle_pairs"),
-        },
-        "discovery": {
-            "discovery_result": ("RankedModel", "DiscoveryResult"),
-            "ranking": ("rank",),
-            "discovery_warnings": ("_stability_warning", "_impact_warnings"),
-        },
-    }.items():
-        split = importlib.import_module(f"discovery.vibroimpact.fit.{old_mod}")
-        for mod, names in moved.items():
-            new = importlib.import_module(f"discovery.vibroimpact.fit.{mod}")
-            for n in names:
-                assert getattr(split, n) is getattr(new, n), n
-    old = importlib.import_module("discovery.vibroimpact.explain.loop")
-    pkg = importlib.import_module("discovery.vibroimpact.explain")
-    for n in ("ExplainResult", "Iteration", "start_law"):
-        assert getattr(old, n) is getattr(pkg, n), n
-    assert old.explain is pkg.explain
+def test_the_fit_and_the_loop_share_one_residual_problem():
+    """The missing-effect loop's residual problem is the fit's (one problem, not two)."""
+    loop = importlib.import_module("discovery.vibroimpact.explain.loop")
     fit_problem = importlib.import_module("discovery.vibroimpact.fit.problem")
-    assert old._Problem is fit_problem.ModelProblem  # one residual problem
-    for n in ("_within_noise", "_output_error", "_Screening", "_Trial", "_Run", "loaded_model"):
-        assert hasattr(old, n), n
+    assert loop._Problem is fit_problem.ModelProblem
+    pkg = importlib.import_module("discovery.vibroimpact.explain")
+    assert loop.explain is pkg.explain
 
 
 def test_split_study_and_impulse_modules_keep_their_public_names():

@@ -58,41 +58,24 @@ from ..verify.motion import MOTION_CRITERION
 from .disagreement import localise
 from .effects import EFFECTS, Model
 
-# the loop's parts (result, problem, starts, screening, trials, judging, separability); a
-# name imported ``as`` itself is re-exported: importable from here as before the split
+# the loop's parts (result, problem, starts, screening, trials, judging, separability)
 from .judging import _failing, _motion_within, _present, _within_noise
-from .judging import _in_bounds as _in_bounds
-from .judging import _keeps_repulsive as _keeps_repulsive
-from .judging import _motion_worse as _motion_worse
-from .judging import _repulsive as _repulsive
 from .problem import _Drift, _mean, _Problem, _with_drift
-from .problem import _drift_free as _drift_free
-from .problem import _small_step as _small_step
 from .pruning import drop_collapsed
 from .result import ExplainResult, Iteration
-from .result import _parameters as _parameters
-from .result import loaded_model as loaded_model
-from .screening import _jacobian as _jacobian
 from .screening import _Screening
-from .screening import _signature_agrees as _signature_agrees
 from .separability import _separability
-from .starts import _HAS_COEFFICIENT as _HAS_COEFFICIENT
-from .starts import _fallbacks as _fallbacks
-from .starts import _fit_start, _joined_samples, _records_of, _regression, start_law
-from .starts import _output_error as _output_error
-from .starts import _physical as _physical
-from .starts import _polish_start as _polish_start
-from .starts import _regressed as _regressed
-from .starts import _start_candidates as _start_candidates
+from .starts import (
+    _fit_start,
+    _joined_samples,
+    _output_error,
+    _records_of,
+    _regressed,
+    _regression,
+    start_law,
+)
 from .state import _Run
-from .state import _Step as _Step
-from .trials import _LADDER as _LADDER
-from .trials import _extend as _extend
 from .trials import _judged, _law_refit, _polish_winner, _refit_trials
-from .trials import _Refits as _Refits
-from .trials import _screen as _screen
-from .trials import _screen_one as _screen_one
-from .trials import _Trial as _Trial
 
 __all__ = ["ExplainResult", "Iteration", "explain", "start_law"]
 

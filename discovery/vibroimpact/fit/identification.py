@@ -51,36 +51,15 @@ from ..verify.block_farm import block_workers, shared_blocks
 from ..verify.criteria import CRITERIA, criteria_lines
 from ..verify.evaluation import Evaluation
 
-# the fit's parts (records, problem, optimise, intervals), also importable from here under the
-# names this module has always had (``x as x``: a re-export)
-from .intervals import _GN_STEPS as _GN_STEPS
-from .intervals import _WEBB as _WEBB
+# the fit's parts (records, problem, optimise, intervals)
 from .intervals import (
     INTERVAL_NOISE,
     INTERVAL_REFITS,
     Intervals,
     bootstrap_intervals,
 )
-from .intervals import MIN_CYCLE_DOF as MIN_CYCLE_DOF
-from .intervals import REFITS as REFITS
-from .intervals import _cycle_weights as _cycle_weights
-from .intervals import _intervals as _intervals
-from .intervals import _refit_replicate as _refit_replicate
-from .intervals import _replicate as _replicate
-from .intervals import _Resampling as _Resampling
-from .intervals import _step_replicate as _step_replicate
 from .optimise import METHODS, _checked, _fitted
-from .optimise import RESTART_FACTORS as RESTART_FACTORS
-from .optimise import _coordinate_descent as _coordinate_descent
-from .optimise import _optimise as _optimise
-from .optimise import _restarted as _restarted
-from .optimise import _x_bounds as _x_bounds
-from .problem import _JAC_STEP as _JAC_STEP
-from .problem import _PENALTY as _PENALTY
-from .problem import _aligned_sensitivity as _aligned_sensitivity
-from .problem import _Budget as _Budget
 from .problem import _Objective, _uncertainty
-from .records import _measured_cycles as _measured_cycles
 from .records import (
     _named,
     as_records,
@@ -88,10 +67,9 @@ from .records import (
     cycle_pairs,
     model_parts,
     pair_records,
+    record_start,
     records_verdict,
 )
-from .records import _residual_weights as _residual_weights
-from .records import record_start as record_start
 
 __all__ = [
     "IdentificationResult",

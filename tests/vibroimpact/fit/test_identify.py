@@ -322,7 +322,7 @@ def test_standard_errors_beyond_the_budget_are_left_out(paper, reference, monkey
     that, the fit is returned without them (no internal budget error escapes)."""
     import importlib
 
-    ident = importlib.import_module("discovery.vibroimpact.fit.identification")
+    ident = importlib.import_module("discovery.vibroimpact.fit.problem")
 
     def over_budget(self, x):
         raise ident._Budget
