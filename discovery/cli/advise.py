@@ -126,7 +126,17 @@ def run(args):
         ) from None
     noise, sc, machine = _noise(args, sc)
     with reporter(args) as rep, executor_of(args) as ex:
-        res = advise(sc, laws, knobs, noise, safe, workers=args.workers, progress=rep, executor=ex)
+        res = advise(
+            sc,
+            laws,
+            knobs,
+            noise,
+            safe,
+            workers=args.workers,
+            refit_simulations=args.refit_simulations,
+            progress=rep,
+            executor=ex,
+        )
     prov = provenance_of(args)
     prov["settings"] = {**res.settings, **prov["settings"]}
     with OutputDir(args.out) as out:
@@ -220,6 +230,14 @@ def register(sub):
         type=integer(0, 100),
         default=3,
         help="best coarse points refined by a 3x3 grid at half the spacing (default: 3)",
+    )
+    s.add_argument(
+        "--refit-simulations",
+        type=integer(0, 10_000),
+        default=40,
+        help="simulations of each rival's refit at the advised point, where every pair is "
+        "judged again with each rival refitted to the other's predicted record; 0: none "
+        "(default: %(default)s)",
     )
     _options.add_n_boot_option(s, of="each noise floor")
     _options.add_seed_option(s, "seed of the noise floors' bootstrap")

@@ -8,6 +8,7 @@ from ..._printing import readable
 from ..._result import Result
 from ..model.law import ForceLaw
 from .candidates import Knobs, NoiseModel, SafeRegion
+from .refit import RefitSeparation
 from .separation import Point, inseparable, rank_key
 
 __all__ = ["AdviseResult"]
@@ -32,6 +33,9 @@ class AdviseResult(Result):
     seconds : float
     settings : dict
         Versions-free settings (workers, ...); provenance is added by the CLI.
+    refit : tuple of RefitSeparation
+        The advised point's pairs with each rival refitted to the other's predicted record
+        (:mod:`~discovery.vibroimpact.advise.refit`); empty when not asked.
     """
 
     KIND = "advise"
@@ -44,6 +48,7 @@ class AdviseResult(Result):
         "points": lambda d: tuple(Point.from_dict(p) for p in d["points"]),
         "seconds": lambda d: float(d["seconds"]),
         "settings": lambda d: dict(d["settings"]),
+        "refit": lambda d: tuple(RefitSeparation.from_dict(r) for r in d.get("refit") or ()),
     }
 
     laws: tuple
@@ -54,6 +59,7 @@ class AdviseResult(Result):
     points: tuple
     seconds: float = 0.0
     settings: dict = field(default_factory=dict)
+    refit: tuple = ()
 
     # ------------------------------------------------------------------ reading
     @property
@@ -152,6 +158,7 @@ class AdviseResult(Result):
             "separates": self.separates,
             "seconds": float(self.seconds),
             "settings": dict(self.settings),
+            "refit": [r.to_dict() for r in self.refit],
         }
 
     def write_into(self, out):
@@ -193,6 +200,7 @@ class AdviseResult(Result):
             return out
         out.append(f"advised: {_where(b)}")
         out += point_lines(b, self)
+        out += refit_lines(self)
         left_out = len(self.inseparable) < len(b.pairs)
         for q in self.inseparable:
             out.append(
@@ -205,6 +213,32 @@ class AdviseResult(Result):
                 "there may still leave them equivalent; widen the bounds or record longer"
             )
         return out
+
+
+def refit_lines(result):
+    """The advised point's pairs with each rival refitted to the other's predicted record."""
+    out = []
+    for r in result.refit:
+        sep = r.separation
+        verdict = (
+            "still separated"
+            if sep > 1
+            else "the refitted rival absorbs the difference: a fit with the new record may "
+            "still leave them equivalent"
+        )
+        i, j = (k + 1 for k in r.pair)
+        nested = [
+            f"candidate {a} holds every term of {b} and reduces to it on {b}'s record (told "
+            f"apart by its extra terms' intervals, not by a rejection)"
+            for (a, b), n in zip(((j, i), (i, j)), r.nested, strict=True)
+            if n
+        ]
+        out.append(
+            f"  pair {i}-{j} with each rival refitted to the other's predicted record: "
+            f"separation {sep:.3g} (directions {r.directions[0]:.3g}, {r.directions[1]:.3g}): "
+            f"{verdict}" + "".join(f"; {t}" for t in nested)
+        )
+    return out
 
 
 def _domain_lines(self):

@@ -8,7 +8,7 @@ pair judged by the verdict's rule) -> the best points refined -> :class:`AdviseR
 
 import os
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..._progress import reports_progress, tick
 from ..._settings import Settings, option, takes
@@ -25,6 +25,7 @@ from .candidates import (
     SafeRegion,
     unique_laws,
 )
+from .refit import refitted_separations
 from .result import AdviseResult
 from .separation import inseparable, point_job, rank_key
 
@@ -93,6 +94,7 @@ class AdviseSettings(Settings):
 
     workers: object = option(None, (None, Real(1, integer=True)))
     tolerances: object = option(None, (Tolerances, None))
+    refit_simulations: int = option(40, Real(0, 10_000, integer=True))
 
 
 @takes(AdviseSettings)
@@ -137,11 +139,14 @@ def advise(
     safe : SafeRegion, optional
         Peak force and penetration the machine may not exceed (default: no bound).
     settings : AdviseSettings, optional
-        The options ``workers`` and ``tolerances`` in one object; keywords override its
-        fields.
+        The options ``workers``, ``tolerances`` and ``refit_simulations`` in one object;
+        keywords override its fields.
     workers : int, optional
         Processes (default: all cores); the result does not depend on it.
     tolerances : Tolerances, optional
+    refit_simulations : int
+        Simulations of each rival's refit at the advised point
+        (:func:`~discovery.vibroimpact.advise.refit.refitted_separations`; 0: none).
     progress : callable or bool, optional
         ``progress(stage, done, total)`` after each point; None: a bar when the session is
         interactive, False: none (:mod:`discovery._progress`).
@@ -182,7 +187,7 @@ def advise(
     finally:
         if own:
             ex.close()
-    return AdviseResult(
+    result = AdviseResult(
         laws=tuple(law.to_text() for law in laws),
         scenario=scenario.as_dict(),
         knobs=knobs,
@@ -190,5 +195,15 @@ def advise(
         noise=noise,
         points=tuple(coarse + fine),
         seconds=time.perf_counter() - t0,
-        settings={"workers": int(n_workers), "evaluated": len(jobs) + len(more)},
+        settings={
+            "workers": int(n_workers),
+            "evaluated": len(jobs) + len(more),
+            "refit_simulations": int(s.refit_simulations),
+        },
     )
+    best = result.best
+    if s.refit_simulations and best is not None and best.pairs:
+        tick(progress, "advise: refitting each rival at the advised point", 0, None)
+        refit = refitted_separations(context, best, s.refit_simulations)
+        result = replace(result, refit=refit, seconds=time.perf_counter() - t0)
+    return result

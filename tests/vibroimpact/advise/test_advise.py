@@ -449,3 +449,40 @@ def test_record_options_with_a_record_are_refused(tmp_path, capsys):
     assert main([*argv, "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert "--position-noise" in err and "\n" not in err and not out.exists()
+
+
+def test_the_advised_point_is_judged_again_with_each_rival_refitted(tmp_path):
+    """Issue 49: advise judged each rival at its fitted coefficients, where the next fit
+    refits it.  At the advised point each rival is refitted to the other's predicted record:
+    the law with a coupling term refitted to the plain law's record fits it (a nested
+    direction, told apart by the term's interval, not a rejection), while the plain law
+    refitted to the record of a strong coupling stays rejected.  (With a weak coupling,
+    1e9*z*zd, the advised point's separation 10.6 falls to 0.27 once the plain law is
+    refitted: the record there would not tell them apart.)"""
+    plain, coupled = "2.06e8*z + 1.28e7*zd", "2.06e8*z + 5e6*zd + 6e10*z*zd"
+    sc = load_scenario("paper")
+    res = advise(
+        sc,
+        [plain, coupled],
+        Knobs((3e5, 6e5), (20.0, 30.0), grid=(3, 3), refine=0),
+        NoiseModel(0.01),
+        workers=1,
+        progress=False,
+    )
+    (r,) = res.refit
+    assert r.pair == (0, 1) and r.nested == (True, False)
+    assert r.directions[0] < 1 and r.separation == r.directions[1] > 1  # absorbed; rejected
+    assert "z*zd" in r.laws[0] and "z*zd" not in r.laws[1]
+    assert "reduces to it on 1's record" in str(res)
+    back = AdviseResult.from_dict(json.loads(json.dumps(res.to_dict())))
+    assert back.refit == res.refit
+    off = advise(
+        sc,
+        [plain, coupled],
+        Knobs((3e5, 6e5), (20.0, 30.0), grid=(2, 2), refine=0),
+        NoiseModel(0.01),
+        workers=1,
+        progress=False,
+        refit_simulations=0,
+    )
+    assert off.refit == ()
