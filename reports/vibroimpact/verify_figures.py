@@ -115,6 +115,8 @@ def span_view(result):
         ``loop``: ``(zm, fm, zn, fn)`` over every contact sample of the block; ``sigma``:
         the force's noise [N]; ``cycles``: the block's cycles.
     """
+    from discovery.vibroimpact.verify.motion import contact_runs, contact_samples_of
+
     ev = result.evaluation
     span = getattr(result.reference, "span", None)
     if ev.comparison != "record span" or not ev.histories or span is None:
@@ -125,9 +127,8 @@ def span_view(result):
     if fn.shape != fm.shape or td.size < 8:
         return None
     sigma = float(span.sigma_f)
-    thr = max(3.0 * sigma, 0.02 * float(np.max(np.abs(fm))))
-    active = (fm > thr) | (fn > thr)
-    runs = _runs(active, max(3, int(0.1 * blk.fold.period / np.median(np.diff(td)))))
+    inside = contact_samples_of(blk, fn, sigma)
+    runs = contact_runs(inside, max(3, int(0.1 * blk.fold.period / np.median(np.diff(td)))))
     if not runs:
         return None
     whole = [r for r in runs if r[0] > 0 and r[1] < td.size] or runs
@@ -137,11 +138,6 @@ def span_view(result):
     zm = zn = None
     if ev.penetration and span.sigma_z > 0:
         zm, zn = np.asarray(blk.Z, dtype=float), np.asarray(ev.penetration[-1], dtype=float)
-    # the loop over the contacts' samples (a lone noise sample over the threshold is none)
-    inside = np.zeros(td.size, dtype=bool)
-    for r0, r1 in runs:
-        inside[r0:r1] = r1 - r0 >= 3
-    inside &= active
     loop = None if zm is None else (zm[inside], fm[inside], zn[inside], fn[inside])
     return {
         "t": td[w] - td[a],
@@ -153,18 +149,6 @@ def span_view(result):
         "sigma": sigma,
         "cycles": int(blk.fold.n_cycles),
     }
-
-
-def _runs(active, gap):
-    """``[(start, stop)]`` of the runs of ``active`` (runs closer than ``gap`` samples are
-    one: the bounces of one contact)."""
-    idx = np.flatnonzero(active)
-    if not idx.size:
-        return []
-    cut = np.flatnonzero(np.diff(idx) > gap)
-    starts = np.concatenate([[idx[0]], idx[cut + 1]])
-    stops = np.concatenate([idx[cut], [idx[-1]]]) + 1
-    return [(int(a), int(b)) for a, b in zip(starts, stops, strict=True)]
 
 
 def _span_figure(result, view, stem):
@@ -291,5 +275,5 @@ def _loops_panel(ax, axz, loops, ev):
         axz.set_title(
             f"I5 {i5:.3g}" + (f" (limit {lim:.3g})" if lim is not None else ""), fontsize=8
         )
-    axz.set_xlabel("time in the cycle [ms]")
+    axz.set_xlabel("time in the compared cycles [ms]")
     axz.set_ylabel("w1 - w2 [mm]")

@@ -118,14 +118,16 @@ def _physical(names, records):
     return ForceLaw(tuple(terms), tuple(record_start(*records[0], terms)))
 
 
-def _joined_samples(scenarios, measurements):
+def _joined_samples(scenarios, measurements, by_force=False):
     """The contact samples of every record joined (None without positions in every
     record): built once per run, for every regression of the force on a term list.  Contact
-    is where the penetration stands above its noise, or (where too few samples do: a stiff
-    contact's penetration a few noise deviations deep) where the force does."""
+    is where the penetration stands above its noise, or with ``by_force`` (where too few
+    samples do: a stiff contact's penetration a few noise deviations deep) where the force
+    does.  Such a regression sees a penetration mostly noise, so its spring is biased low
+    (errors in the variables): a start to try, not a law to restart the loop's refits from."""
     from ..data.samples import contact_samples, join_samples
 
-    for contact in ("penetration", "force"):
+    for contact in ("penetration", "force") if by_force else ("penetration",):
         try:
             return join_samples(
                 [
@@ -224,7 +226,8 @@ def _start_candidates(text, records, measurements):
         raise InputError("the record has no contact to start from")
     reg = None
     if measurements is not None:
-        reg = _regression(names, _joined_samples([sc for sc, _ in records], measurements))
+        samples = _joined_samples([sc for sc, _ in records], measurements, by_force=True)
+        reg = _regression(names, samples)
     phys = _physical(names, records)
     others = [phys]
     if reg is not None and len(names) <= 4 and reg.terms == phys.terms:
@@ -262,32 +265,39 @@ def _fallbacks(preferred, others, problem, criterion):
 
 
 def _without_force(fit, records):
-    """Whether the fitted law's simulated contacts carry almost no force (a peak under
-    5 % of the measured one) in some record.  Where no start reproduces the contacts' timing
-    (a short contact whose onset moves with a missing effect), a law without force is the
-    least squares' nearest point (the relative L1 distance 1, where a force at the wrong
-    time gives up to 2), and no effect's refit can leave it."""
+    """Whether the fitted law's simulated contacts carry little force (a peak under
+    :data:`WEAK_FORCE` of the measured one) in some record.  Where no start reproduces the
+    contacts' timing (a short contact whose onset moves with a missing effect), a law
+    without force is the least squares' nearest point (the relative L1 distance 1, where a
+    force at the wrong time gives up to 2), and no effect's refit leaves it: a start of
+    I2 1.18 with the record's peak led to stiffening supports, one of 0.99 at 16 % of the
+    peak to nothing."""
     for ev, (_, ref) in zip(fit.evaluations, records, strict=False):
         sim = ev.simulated
         if sim is None or not len(sim.F):
             continue
-        if float(np.max(sim.F)) < 0.05 * float(np.max(ref.impulse.F)):
+        if float(np.max(sim.F)) < WEAK_FORCE * float(np.max(ref.impulse.F)):
             return True
     return False
 
 
-#: a fitted start whose criterion is at most this is taken without trying the fallbacks
-#: (the relative L1 distance of the forces: 1 is a law with no force at all)
+#: a fitted start whose criterion is at most this is taken without fitting the other
+#: candidates (the relative L1 distance of the forces: 1 for a law with no force at all)
 GOOD_START = 0.5
+#: a fitted start whose simulated peak force is under this share of the measured one in some
+#: record has collapsed towards a law without force (the least squares' nearest point where
+#: no candidate matches the contacts' timing) and is passed over
+WEAK_FORCE = 0.25
 
 
 def _fit_start(run, start, plain, progress):
     """The start law fitted to ``run``'s records (``plain``: their measurements, for the
     regression; None when not every record has one): the first of the start candidates
-    (and their fallbacks) whose fit reaches :data:`GOOD_START`, else the best fit of them
-    all.  Where a short contact's timing is not matched, a fit can end far from the
-    record (from the regression's start, a spring 30x too soft at I2 1.5, where the
-    record's own contact time led to I2 0.07)."""
+    (and their fallbacks) whose fit reaches :data:`GOOD_START`, else the best of them, a
+    fit that collapsed towards no force (:func:`_without_force`) passed over.  Where a
+    short contact's timing is not matched, the regression's start can end in another
+    timing's basin (I2 0.90 with the record's peak, where the record's contact time led
+    to 0.10)."""
     records, criterion, budget, tolerances = run.records, run.criterion, run.budget, run.tolerances
     preferred, others = (
         ([start], []) if isinstance(start, ForceLaw) else _start_candidates(start, records, plain)

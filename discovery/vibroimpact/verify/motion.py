@@ -205,22 +205,63 @@ def penetration_size(reference):
     )
 
 
+def contact_runs(active, gap):
+    """``[(start, stop)]`` of the runs of ``active`` samples (runs closer than ``gap``
+    samples are one: the bounces of one contact)."""
+    idx = np.flatnonzero(active)
+    if not idx.size:
+        return []
+    cut = np.flatnonzero(np.diff(idx) > gap)
+    starts = np.concatenate([[idx[0]], idx[cut + 1]])
+    stops = np.concatenate([idx[cut], [idx[-1]]]) + 1
+    return [(int(a), int(b)) for a, b in zip(starts, stops, strict=True)]
+
+
+def contact_samples_of(blk, simulated, sigma):
+    """The samples of a block where the measured or the simulated force is in contact
+    (above three noise deviations and 2 % of the measured peak, in runs of three samples or
+    more: a lone noise sample is none), ndarray of bool."""
+    fm, fn = np.asarray(blk.F, dtype=float), np.asarray(simulated, dtype=float)
+    thr = max(3.0 * sigma, 0.02 * float(np.max(np.abs(fm))))
+    active = (fm > thr) | (fn > thr)
+    inside = np.zeros(fm.size, dtype=bool)
+    for a, b in contact_runs(active, 2):
+        inside[a:b] = b - a >= 3
+    return inside & active
+
+
 def force_penetration_loops(reference, evaluation):
-    """The measured and simulated force-penetration loops of a record span's latest block:
-    the folded bin means inside the contact window, in phase order.
+    """The measured and simulated force-penetration loops of a record span's latest block.
+    With the evaluation's simulated histories (a fresh evaluation): the record's own
+    samples where either force is in contact (:func:`contact_samples_of`), in time order.
+    A record in a transient has its contacts at another phase in each cycle, and a fold of
+    several cycles would pair one cycle's force with another's penetration.  Without them
+    (a loaded evaluation): the folded bin means inside the contact window.
 
     Returns
     -------
     dict or None
         ``{"measured": (zeta, F), "simulated": (zeta, F), "phase": t}`` (ndarrays [m],
-        [N], and the bins' times since the fold's origin [s]); ``None``
-        for a record without positions or an evaluation without a simulation.
+        [N], and the samples' times since the block's start, or the bins' since the fold's
+        origin [s]); ``None`` for a record without positions or an evaluation without a
+        simulation.
     """
     span = getattr(reference, "span", None)
     z_sim = evaluation.penetration if evaluation is not None else None
     blocks = evaluation.blocks if evaluation is not None else None
     if span is None or span.sigma_z <= 0 or not z_sim or not blocks:
         return None
+    hist = evaluation.histories
+    if hist and len(hist[-1]) == len(span.blocks[-1].F):
+        blk, zs, fs = span.blocks[-1], np.asarray(z_sim[-1]), np.asarray(hist[-1])
+        win = contact_samples_of(blk, fs, span.sigma_f)
+        if win.any():
+            td = np.asarray(blk.fold.td, dtype=float)
+            return {
+                "measured": (np.asarray(blk.Z)[win], np.asarray(blk.F)[win]),
+                "simulated": (zs[win], fs[win]),
+                "phase": td[win] - td[0],
+            }
     blk, (E, S), zs = span.blocks[-1], blocks[-1], z_sim[-1]
     fold = blk.fold
     zm, zn = fold.average(blk.Z), fold.average(zs)
