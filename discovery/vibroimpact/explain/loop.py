@@ -161,6 +161,21 @@ def _only_the_law_refit(run, step, best):
     return True
 
 
+def _score_rank(trials, s):
+    """``", k-th largest of n"`` of the named effect's score among the refitted effects' (the
+    refit decides, so a lower-ranked score is said, not hidden); empty when it is the
+    largest or alone."""
+    lms = sorted((t.score["lm"] for t in trials if t.score.get("lm") is not None), reverse=True)
+    if len(lms) < 2 or s["lm"] >= lms[0]:
+        return ""
+    k = 1 + sum(v > s["lm"] for v in lms)
+    return f", {k}{_ordinal(k)} largest of the {len(lms)} refitted"
+
+
+def _ordinal(k):
+    return {1: "st", 2: "nd", 3: "rd"}.get(k if k < 20 else k % 10, "th")
+
+
 def _others(trials, named, key):
     """The clause naming the other refitted effects by their criterion after the refit (the
     decision is the refit's, not the score's), best first; empty when there are none."""
@@ -191,22 +206,21 @@ def _name_effect(run, step, good, winner, trials):
         if x.key == key and x.score["criteria_after"][key] <= value + tol_eq
     ]
     score = (
-        f"score test LM = {s['lm']:.3g} (p = {s['p']:.2g} < {screening.level:.2g})"
+        f"its score test is significant (LM = {s['lm']:.3g}, p = {s['p']:.2g} < "
+        f"{screening.level:.2g}{_score_rank(trials, s)})"
         if s["lm"] is not None
-        else "no score test (a small step of it changes the regime)"
+        else "it has no score test (a small step of it changes the regime)"
     )
+    phases = ", ".join(screening.top_phases)
     evidence = (
-        f"{score}; refitted, "
-        f"{key} {before[key]:.3g} -> {value:.3g} (the noise floor of the model before: "
-        f"{floor.get(key, float('nan')):.3g}); signature "
-        f"{'agrees' if s['signature_agrees'] else 'does not agree'} with the "
-        f"localisation (largest shares: {', '.join(screening.top_phases)})"
+        f"named because its refit lowers {key} the most: {before[key]:.3g} -> {value:.3g} "
+        f"(the noise floor of the model before: {floor.get(key, float('nan')):.3g}); {score}; "
+        f"the residual is largest at the {phases}"
         + (
-            ""
+            ", where this effect acts"
             if s["signature_agrees"]
-            else "; named on the score test and the refit, which decide: the phases "
-            "where the residual is largest are a hint, and an effect that changes the "
-            "impact as a whole moves the residual everywhere"
+            else ", not where this effect acts most (the phases are a hint; an effect that "
+            "changes the whole impact moves the residual everywhere, and the refit decides)"
         )
         + _others(trials, s["effect"], key)
     )

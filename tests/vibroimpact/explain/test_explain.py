@@ -71,6 +71,10 @@ def test_hidden_coupling_is_named_and_the_gap_shrinks(hidden_coupling):
     # the evidence states the decision: the floor is the start's, and the other refits
     # (which decide over the scores) are named with their criterion
     assert "the noise floor of the model before" in it.evidence
+    # one statement, led by the decision (issue 50: "signature does not agree ... named on
+    # the score test and the refit, which decide" contradicted itself)
+    assert it.evidence.startswith("named because its refit lowers I2 the most: ")
+    assert "does not agree" not in it.evidence
     others = [x for x in refitted if x is not s and x["criteria_after"].get("I2") is not None]
     if others:
         assert "the other effects refitted reach I2 " in it.evidence
@@ -80,6 +84,8 @@ def test_hidden_coupling_is_named_and_the_gap_shrinks(hidden_coupling):
     # separation 0.40 and unloading 0.39 swap places with that 2e-4 change of the start)
     assert sum(phases[p]["share"] for p in ("onset", "loading", "peak", "unloading")) > 0.5
     assert phases["onset"]["exceeds_noise"]
+    top = ", ".join(sorted(phases, key=lambda p: -phases[p]["share"])[:2])
+    assert f"the residual is largest at the {top}" in it.evidence  # a hint, said as one
 
 
 def _clean_survey(paper, seeds):
