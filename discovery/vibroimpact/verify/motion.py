@@ -32,6 +32,8 @@ __all__ = [
     "fold_penetration",
     "penetration_mean",
     "contact_window",
+    "contact_runs",
+    "contact_samples_of",
     "penetration_residuals",
     "penetration_jacobian",
     "penetration_size",
