@@ -19,6 +19,7 @@ import inspect
 import multiprocessing
 import sys
 import threading
+import time
 
 __all__ = ["tick", "Reporter", "interactive", "resolve", "reports_progress"]
 
@@ -114,7 +115,12 @@ def reports_progress(func):
 
 
 class Reporter:
-    """The CLI's progress: a bar per stage on a terminal, a line per stage elsewhere."""
+    """The CLI's progress: a bar per stage on a terminal; elsewhere a line per stage, and a
+    line with the count every :attr:`every` seconds while a stage goes on (a log or a pipe
+    never stays silent for minutes)."""
+
+    #: seconds between two lines of one stage outside a terminal
+    every = 10.0
 
     def __init__(self, quiet=False, stream=None, bar=None):
         self.stream = sys.stderr if stream is None else stream
@@ -123,6 +129,7 @@ class Reporter:
         self.bar = bool(isatty()) if bar is None else bool(bar)
         self.stage = None
         self._bar = None
+        self._last = 0.0
 
     def __call__(self, stage, done, total=None):
         if self.quiet:
@@ -143,6 +150,11 @@ class Reporter:
                 )
             else:
                 print(f"{stage} ...", file=self.stream, flush=True)
+                self._last = time.monotonic()
+        elif not self.bar and time.monotonic() - self._last >= self.every:
+            count = f"{done}/{total}" if total else f"{done}"
+            print(f"{stage}: {count} ...", file=self.stream, flush=True)
+            self._last = time.monotonic()
         if self._bar is not None:
             if total is not None and self._bar.total != total:
                 self._bar.total = total

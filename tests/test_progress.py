@@ -23,6 +23,14 @@ def test_reporter_modes():
         r(stage, 1, 3)
     r.close()
     assert plain.getvalue() == "a ...\nb ...\n"  # one line per stage
+    # a stage that goes on prints its count every `every` seconds (issue 50: a pipe stayed
+    # silent for the 160 s of the named models' fit)
+    slow = io.StringIO()
+    r = Reporter(stream=slow, bar=False)
+    r.every = 0.0
+    for k in range(3):
+        r("fit", k, 3)
+    assert slow.getvalue() == "fit ...\nfit: 1/3 ...\nfit: 2/3 ...\n"
     bar = io.StringIO()
     with Reporter(stream=bar, bar=True) as r:
         for k in range(4):

@@ -250,7 +250,9 @@ def force_names(model):
 
 
 @takes(BootstrapIntervalsSettings)
-def bootstrap_intervals(scenario, reference, model, *, settings=None, executor=None, **options):
+def bootstrap_intervals(
+    scenario, reference, model, *, settings=None, executor=None, progress=None, **options
+):
     """Intervals of ``model``'s coefficients by a bootstrap through the record-span
     processing (the comment above).
 
@@ -280,6 +282,8 @@ def bootstrap_intervals(scenario, reference, model, *, settings=None, executor=N
     executor : Executor, optional
         Where the refits run (:mod:`discovery.numerics.executor`); overrides ``workers``
         and is not closed here.
+    progress : callable, optional
+        ``progress("bootstrap intervals", done, total)`` as the refits finish.
     refit : str
         ``"two-step"`` (default): two Gauss-Newton steps from the fitted model with the
         exact Jacobian (the comment above); ``"full"``: a least-squares refit.
@@ -352,7 +356,12 @@ def bootstrap_intervals(scenario, reference, model, *, settings=None, executor=N
         },
     )
     refits = map_on(
-        REFITS[s.refit], range(len(replicates)), context, workers=s.workers, executor=executor
+        REFITS[s.refit],
+        range(len(replicates)),
+        context,
+        workers=s.workers,
+        executor=executor,
+        done=None if progress is None else (lambda k, n: progress("bootstrap intervals", k, n)),
     )
     draws = [d for d in refits if d is not None]
     if len(draws) < 5:
