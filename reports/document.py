@@ -428,6 +428,21 @@ def _record_in_manifest(run_dir, names):
     atomic_write_text(p, json.dumps(man, indent=2) + "\n")
 
 
+def _settle_manifest(run_dir, names):
+    """Drop from the run's manifest the report's names that were claimed and not written
+    (the log of a compilation that succeeded, the PDF of one that failed): the manifest
+    lists the files that are there."""
+    from discovery.outputs import MANIFEST, atomic_write_text
+
+    d = Path(run_dir)
+    man, files = _manifest(d)
+    gone = {n for n in names if n in files and not (d / n).exists()}
+    if man is None or not gone:
+        return
+    man["files"] = sorted(files - gone)
+    atomic_write_text(d / MANIFEST, json.dumps(man, indent=2) + "\n")
+
+
 def report(run_dir, *, snippet=None, compile=True, timeout=300, summary=None):
     """Write ``run_dir/report.tex`` from the run's results and compile ``report.pdf``.
 
@@ -488,6 +503,7 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300, summary=None):
             pdf, message = dest, f"wrote {dest}"
     finally:
         shutil.rmtree(w, ignore_errors=True)
+    _settle_manifest(d, names)
     return Report(
         tex,
         pdf,

@@ -248,6 +248,8 @@ def test_a_report_of_every_kind_reads_right(runs, kind, needles, capsys):
     assert "root:" not in text and not (runs / "pwned").exists()
     listed = json.loads((run / ".vidi-manifest.json").read_text())["files"]
     assert {"report.tex", "report.pdf"} <= set(listed)
+    # the manifest lists what is there (issue 53: a report.log claimed and never written)
+    assert all((run / f).exists() for f in listed), listed
     assert not [p for p in run.iterdir() if p.name.startswith(".vidi-tex-")]
 
 
