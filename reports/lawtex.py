@@ -308,11 +308,28 @@ def value_tex(value):
     as the report's equations set it (:func:`law_inline`), a list item by item, anything
     else as :func:`prose`."""
     if isinstance(value, list | tuple):
+        span = _numeric_span(value)
+        if span is not None:
+            return prose(span)
         return Tex(", ".join(value_tex(v) for v in value))
     law = _as_law(value)
     if law is not None:
         return law_inline(law)
     return prose("" if value is None else str(value))
+
+
+def _numeric_span(values, most=6):
+    """A long list of numbers (a sweep's axis: 200 values of ``nu`` ran off the page) as its
+    range: ``"0.8 to 1.2, 200 evenly spaced values"`` (or ``"... 200 values"`` when they are
+    not evenly spaced); None for a short list or one that is not all numbers."""
+    if len(values) <= most or not all(
+        isinstance(v, int | float) and not isinstance(v, bool) for v in values
+    ):
+        return None
+    steps = [b - a for a, b in zip(values, values[1:], strict=False)]
+    even = max(steps) - min(steps) <= 1e-9 * max(abs(v) for v in values) + 1e-300
+    spaced = "evenly spaced " if even else ""
+    return f"{values[0]:.6g} to {values[-1]:.6g}, {len(values)} {spaced}values"
 
 
 def unit_tex(unit):

@@ -971,6 +971,12 @@ def test_a_law_in_the_settings_and_the_study_design_is_typeset_whole():
     assert str(value_tex("z,zd")) == r"$\zeta$,$\dot\zeta_{+}$"  # a term list is no law
     assert str(value_tex("z^2*zd")) == str(prose("z^2*zd"))  # a term, not a law of 1 z^2 zd
     assert str(value_tex("linear")) == "linear" and str(value_tex(3)) == "3"
+    # a sweep's axis as its range (issue 50: the chart's 200 values of nu ran off the page)
+    assert str(value_tex([0.8 + 0.002 * k for k in range(201)])) == (
+        "0.8 to 1.2, 201 evenly spaced values"
+    )
+    assert str(value_tex([1, 2, 4, 8, 16, 32, 64])) == "1 to 64, 7 values"
+    assert str(value_tex([1, 2, 3])) == "1, 2, 3"
 
 
 def test_identify_figure_marks_the_start_at_the_given_values():
