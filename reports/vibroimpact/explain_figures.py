@@ -107,40 +107,48 @@ def _explain_plane(fig, ax, iteration):
 
 
 def _explain_scores(ax, iteration):
-    """Every candidate effect's score test."""
-    sc = [x for x in iteration.scores if x.get("lm") is not None]
-    unscored = [x for x in iteration.scores if x.get("lm") is None and "criteria_after" in x]
-    if sc or unscored:
-        lm = [max(x["lm"], 1e-3) for x in sc]
+    """What decides the name: each refitted effect's criterion after its refit (lower is
+    better; the named one green), beside the criterion before and its noise floor; the
+    effects whose score test was not significant are not refitted and listed by name."""
+    key = next(
+        (x.get("gap") for x in iteration.scores if x.get("gap")),
+        "I2",
+    )
+    refit = [
+        x for x in iteration.scores if np.isfinite((x.get("criteria_after") or {}).get(key, np.nan))
+    ]
+    refit.sort(key=lambda x: -x["criteria_after"][key])  # the best at the top
+    if refit:
         ax.barh(
-            [x["effect"].replace("_", " ") for x in sc],
-            lm,
-            color=[
-                "tab:green"
-                if x["effect"] == iteration.effect
-                else ("tab:orange" if x["significant"] else "tab:gray")
-                for x in sc
-            ],
+            [x["effect"].replace("_", " ") for x in refit],
+            [max(x["criteria_after"][key], 1e-6) for x in refit],
+            color=["tab:green" if x["effect"] == iteration.effect else "tab:orange" for x in refit],
         )
-        # an effect whose small step changes the regime has no score, only its refit
-        for x in unscored:
-            ax.barh(
-                [x["effect"].replace("_", " ")],
-                [max(lm, default=1.0)],
-                fill=False,
-                hatch="//",
-                edgecolor="tab:green" if x["effect"] == iteration.effect else "tab:gray",
-            )
-        ax.set_xscale("log")
-    ax.set_xlabel("score-test (LM) statistic\n(hatched: no local score, refitted)")
-    ax.set_title("candidate effects\n(green: named; orange: significant;\ngray: not significant)")
+        before = (iteration.criteria_before or {}).get(key)
+        floor = (iteration.noise_floor or {}).get(key)
+        if before is not None and np.isfinite(before):
+            ax.axvline(before, color="k", lw=1.0, ls="--", label=f"{key} before")
+        if floor is not None and np.isfinite(floor):
+            ax.axvline(floor, color="0.5", lw=1.0, ls=":", label="noise floor")
+        vals = [x["criteria_after"][key] for x in refit] + [v for v in (before, floor) if v]
+        if max(vals) > 30 * max(min(vals), 1e-12):
+            ax.set_xscale("log")
+        else:
+            ax.set_xlim(0.0, 1.05 * max(vals))
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=2, frameon=False)
+    else:
+        ax.text(0.5, 0.5, "no effect refitted", ha="center", transform=ax.transAxes)
+    skipped = [x["effect"].replace("_", " ") for x in iteration.scores if x not in refit]
+    note = f"\nnot refitted (score not significant): {len(skipped)}" if skipped else ""
+    ax.set_xlabel(f"{key} after refitting the effect (lower is better){note}")
+    ax.set_title("candidate effects refitted\n(green: named; orange: refitted, not named)")
 
 
 def explain_figure(iteration, measured, stem, k=1):
     """One iteration of the missing-effect loop: the force before and after adding the
     named effect against the record, the residual's share by impact phase (and its ratio
     to the noise), the mean residual over the simulated (zeta, dzeta) plane, and every
-    candidate effect's score test."""
+    refitted candidate effect's criterion after its refit (what names the effect)."""
     with print_sizes():  # drawn at the width it is printed: its text 7 to 8 pt on paper
         fig, axes = subplots(2, 2, figsize=(PRINT_WIDTH, 6.6), layout="constrained")
         _explain_forces(axes[0, 0], iteration, measured, k)
