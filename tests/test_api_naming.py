@@ -6,7 +6,7 @@ import pytest
 import discovery
 from discovery._settings import options_of
 from discovery.cli import _parser
-from discovery.errors import InputError
+from discovery.errors import VidiError
 from discovery.vibroimpact.dynamics.synthetic import synthesize
 
 
@@ -33,24 +33,13 @@ def test_every_seed_is_called_seed():
     assert "max_simulations" in options_of(discovery.explain)
 
 
-def test_explain_budget_is_deprecated_for_max_simulations(paper, record):
-    # the old name warns and is taken (a bad alpha is now refused when the settings are
-    # made, before any of this: the check that reads the old name is asked directly)
-    from discovery.vibroimpact.explain.loop import _check_settings
-
-    with pytest.warns(DeprecationWarning, match="max_simulations"):
-        assert _check_settings(None, 20, 0.01, 1, 3) == 20
-    with pytest.raises(InputError, match="alpha"):
-        discovery.explain(paper, record, budget=20, alpha=1.0)
-
-
-def test_discover_random_state_is_deprecated_for_seed(paper, record):
-    from discovery.vibroimpact.fit.discovery import _seed
-
-    with pytest.warns(DeprecationWarning, match="seed"):
-        assert _seed(3, 0) == 3
-    with pytest.raises(InputError, match="criterion"):
-        discovery.discover(paper, record, random_state=3, criterion="I9")
+def test_the_old_names_of_seed_and_max_simulations_are_gone(paper, record):
+    """``discover(random_state=)`` and ``explain(budget=)`` were deprecated aliases kept
+    from before 0.1.0; an unknown keyword is one error naming the keyword."""
+    with pytest.raises(VidiError, match="unexpected keyword .random_state."):
+        discovery.discover(paper, record, random_state=3)
+    with pytest.raises(VidiError, match="unexpected keyword .budget."):
+        discovery.explain(paper, record, budget=20)
 
 
 def test_verify_from_the_package_is_the_function():

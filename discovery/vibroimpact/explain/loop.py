@@ -37,7 +37,6 @@ One iteration (:func:`explain`):
 """
 
 import time
-import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -325,16 +324,9 @@ def _iteration(run, max_iterations):
     return _refit_and_name(run, step)
 
 
-def _check_settings(max_simulations, budget, alpha, workers, max_iterations):
+def _check_settings(max_simulations, alpha, workers, max_iterations):
     """The settings :func:`explain` checks beyond their types; returns the simulation
-    budget of each refit (``budget=`` is the deprecated name of ``max_simulations=``)."""
-    if budget is not None:
-        warnings.warn(
-            "explain(budget=...) is renamed max_simulations=... (the CLI's --max-simulations)",
-            DeprecationWarning,
-            stacklevel=4,
-        )
-        max_simulations = budget
+    budget of each refit."""
     if not (0 < alpha < 1):
         raise InputError(f"alpha must be in (0, 1); got {alpha!r}")
     if workers is not None and not (isinstance(workers, int) and workers >= 1):
@@ -461,7 +453,6 @@ class ExplainSettings(Settings):
     workers: object = option(None, (None, Real(1, integer=True)))
     n_boot_intervals: int = option(30, Real(0, integer=True))
     interval_refit: str = option("two-step", Choice(*INTERVAL_REFITS))
-    budget: object = option(None, (None, Real(1, integer=True)))
     machine_scale: object = option(None, (None, tuple, list))
 
 
@@ -527,8 +518,6 @@ def explain(
     progress : callable or bool, optional
         ``progress(stage, done, total)`` at each stage and iteration; None: a bar when the
         session is interactive, False: none (:mod:`discovery._progress`).
-    budget : int, optional
-        Deprecated name of ``max_simulations``.
     machine_scale : (float, float), optional
         The factors within which the machine's scale is uncertain (a calibration's
         :attr:`~discovery.Calibration.scale_range`): the intervals of the forces are
@@ -540,7 +529,7 @@ def explain(
     """
     s = ExplainSettings.of("explain", settings, options)
     t0 = time.perf_counter()
-    budget = _check_settings(s.max_simulations, s.budget, s.alpha, s.workers, s.max_iterations)
+    budget = _check_settings(s.max_simulations, s.alpha, s.workers, s.max_iterations)
     pairs, records = _records_of(scenario, measurement, s.n_boot, s.seed)
     ms = [m for _, m in pairs]
     catalogue = select(EFFECTS, s.effects)

@@ -34,7 +34,6 @@ criterion; models without a periodic steady state come last.
 import inspect
 import time
 from dataclasses import dataclass, replace
-from warnings import warn
 
 import numpy as np
 
@@ -68,18 +67,6 @@ from .stepwise import _Stepwise
 __all__ = ["RankedModel", "DiscoveryResult", "discover", "rank"]
 
 _REFINE_BUDGET = 120  # simulations per shortlisted support (every record counts)
-
-
-def _seed(random_state, seed):
-    """The seed of :func:`discover` (``random_state=`` is the deprecated name of ``seed=``)."""
-    if random_state is not None:
-        warn(
-            "discover(random_state=...) is renamed seed=... (the CLI's --seed)",
-            DeprecationWarning,
-            stacklevel=4,
-        )
-        return random_state
-    return seed
 
 
 def _check_settings(*, criterion, shortlist, stability, n_boot, max_simulations, stepwise):
@@ -218,7 +205,6 @@ class DiscoverSettings(Settings):
     n_boot_intervals: int = option(30, Real(0, integer=True))
     interval_refit: str = option("two-step", Choice(*INTERVAL_REFITS))
     workers: object = option(1, (None, Real(1, integer=True)))
-    random_state: object = option(None, (None, Real(0, integer=True)))
     estimator: object = option(None, (None, dict))
     machine_scale: object = option(None, (None, tuple, list))
 
@@ -294,8 +280,6 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
         ``progress(stage, done, total)`` as the shortlist is simulated and the stepwise
         search and the bootstrap go on; None: a bar when the session is
         interactive, False: none (:mod:`discovery._progress`).
-    random_state : int, optional
-        Deprecated name of ``seed``.
     estimator : dict, optional
         Further estimator parameters (``margin``, ``monotone``, ``signs``, ...); they may
         also be given as keywords.
@@ -318,7 +302,7 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
     if s.library == "contact-models":  # the named contact models, fitted by name
         return _contact_models(scenario, measurement, s, progress)
     t0 = time.perf_counter()
-    seed = _seed(s.random_state, s.seed)
+    seed = s.seed
     _check_settings(
         criterion=s.criterion,
         shortlist=s.shortlist,
