@@ -179,16 +179,8 @@ def _span_figure(result, view, stem):
         axl.set_xlabel("penetration w1 - w2 [mm]")
         axl.set_ylabel(f"F [{unit}]")
         axl.legend(fontsize=7, loc="best", framealpha=0.8, markerscale=4)
-        axz.plot(x, view["zm"] * ms, "k-", lw=0.8, label="measured")
-        axz.plot(x, view["zn"] * ms, "C3-", lw=0.8, label="simulated")
-        axz.axhline(0.0, color="0.6", lw=0.5)
-        i5, lim = ev.criteria.get("I5"), (ev.limits or {}).get("I5")
-        if i5 is not None:
-            axz.set_title(
-                f"I5 {i5:.3g}" + (f" (limit {lim:.3g})" if lim is not None else ""), fontsize=8
-            )
+        _penetrations(axz, x, view["zm"] * ms, view["zn"] * ms, ev)
         axz.set_xlabel("time since the contact's onset [ms]")
-        axz.set_ylabel("w1 - w2 [mm]")
     ax.fill_between(
         x,
         (view["fm"] - band) * sc,
@@ -210,6 +202,19 @@ def _span_figure(result, view, stem):
     ax.legend(fontsize=7, loc="best", framealpha=0.8)
     fig.tight_layout()
     return _save(fig, stem)
+
+
+def _penetrations(axz, t, zm, zn, ev):
+    """Both penetrations [mm] over time, with I5 and its limit in the title."""
+    axz.plot(t, zm, "k-", lw=0.8)
+    axz.plot(t, zn, "C3-", lw=0.8)
+    axz.axhline(0.0, color="0.6", lw=0.5)
+    i5, lim = ev.criteria.get("I5"), (ev.limits or {}).get("I5")
+    if i5 is not None:
+        axz.set_title(
+            f"I5 {i5:.3g}" + (f" (limit {lim:.3g})" if lim is not None else ""), fontsize=8
+        )
+    axz.set_ylabel("w1 - w2 [mm]")
 
 
 def _why_none(ev):
@@ -267,13 +272,5 @@ def _loops_panel(ax, axz, loops, ev):
     ax.set_ylabel(f"F [{unit}]")
     ax.axvline(0.0, color="0.6", lw=0.5)
     ax.legend(fontsize=7, loc="best", framealpha=0.8)
-    axz.plot(t, zm * 1e3, "k-", lw=0.8)
-    axz.plot(t, zn * 1e3, "C3-", lw=0.8)
-    axz.axhline(0.0, color="0.6", lw=0.5)
-    i5, lim = ev.criteria.get("I5"), (ev.limits or {}).get("I5")
-    if i5 is not None:
-        axz.set_title(
-            f"I5 {i5:.3g}" + (f" (limit {lim:.3g})" if lim is not None else ""), fontsize=8
-        )
+    _penetrations(axz, t, zm * 1e3, zn * 1e3, ev)
     axz.set_xlabel("time in the compared cycles [ms]")
-    axz.set_ylabel("w1 - w2 [mm]")

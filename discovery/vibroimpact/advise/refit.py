@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 from ...errors import IntegrationError, VidiError
 from ..fit.identification import identify
-from .separation import _direction, _orbit, _predicted_reference
+from .separation import _direction, _orbit, _predicted_reference, at_point
 
 __all__ = ["RefitSeparation", "refitted_separations"]
 
@@ -133,10 +133,7 @@ def refitted_separations(context, point, max_simulations=40):
         One per pair whose two candidates have an orbit there (a pair separated on
         physics stays so).
     """
-    changes = {"A": float(point.amplitude), "frequency": float(point.frequency)}
-    if point.m2 is not None:
-        changes["m2"] = float(point.m2)
-    sc = context.scenario.replace(**changes)
+    sc = at_point(context.scenario, point.amplitude, point.frequency, point.m2)
     laws = context.laws
     refs = []
     for law, pred in zip(laws, point.predictions, strict=True):

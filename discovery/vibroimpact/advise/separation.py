@@ -397,6 +397,14 @@ def _beyond_domain(scenario, laws, preds):
     return tuple(out)
 
 
+def at_point(scenario, amplitude, frequency, m2=None):
+    """``scenario`` driven at an operating point (its moulding's mass too, when given)."""
+    changes = {"A": float(amplitude), "frequency": float(frequency)}
+    if m2 is not None:
+        changes["m2"] = float(m2)
+    return scenario.replace(**changes)
+
+
 def evaluate_point(context, amplitude, frequency, m2=None, stage="coarse"):
     """Evaluate one operating point (see the module docstring).
 
@@ -412,10 +420,7 @@ def evaluate_point(context, amplitude, frequency, m2=None, stage="coarse"):
     -------
     Point
     """
-    changes = {"A": float(amplitude), "frequency": float(frequency)}
-    if m2 is not None:
-        changes["m2"] = float(m2)
-    sc = context.scenario.replace(**changes)
+    sc = at_point(context.scenario, amplitude, frequency, m2)
     orbits = [_orbit(sc, law, context.tolerances) for law in context.laws]
     preds = _beyond_domain(sc, context.laws, tuple(o.prediction for o in orbits))
     point = {"amplitude": amplitude, "frequency": frequency, "m2": m2, "stage": stage}

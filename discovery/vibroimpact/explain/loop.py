@@ -59,7 +59,7 @@ from .effects import EFFECTS, Model
 
 # the loop's parts (result, problem, starts, screening, trials, judging, separability)
 from .judging import _failing, _motion_within, _present, _within_noise
-from .problem import _Drift, _mean, _Problem, _with_drift
+from .problem import _Drift, _mean, _Problem, _with_drift, best_of
 from .pruning import drop_collapsed
 from .result import ExplainResult, Iteration
 from .screening import _Screening
@@ -390,18 +390,12 @@ def _ladder(run, model):
     """``model`` with the one effect parameter value of :data:`LADDER` times its own that
     gives the lowest gap criterion (one simulation per value), or None when none beats
     the model as it is."""
-    best, out = run.problem.value(model, run.criterion), None
-    for eff in model.free_effects():
-        v0 = model.value(eff)
-        for f in LADDER:
-            m = model.with_effect(eff, v0 * f, add=False)
-            try:
-                v = run.problem.value(m, run.criterion)
-            except (IntegrationError, InputError):
-                continue
-            if v < best:
-                best, out = v, m
-    return out
+    rungs = [
+        model.with_effect(eff, model.value(eff) * f, add=False)
+        for eff in model.free_effects()
+        for f in LADDER
+    ]
+    return best_of(run.problem, rungs, run.criterion, run.problem.value(model, run.criterion))[0]
 
 
 # the progress stage of explain's iterations

@@ -86,3 +86,20 @@ def _small_step(eff, records):
     (:func:`~discovery.vibroimpact.explain.effects.small_step` at the first record's scales)."""
     tau, v, z0 = contact_scales(*records[0])
     return small_step(eff, records[0][0], records[0][1].impulse.peak, tau=tau, v=v, z0=z0)
+
+
+def best_of(problem, models, criterion, below=np.inf):
+    """``(model, value)`` of the model of ``models`` with the lowest ``criterion`` under
+    ``below`` (one evaluation each; a model that cannot be simulated or compared is passed
+    over), or ``(None, below)``."""
+    from ...errors import InputError, IntegrationError
+
+    best, value = None, below
+    for m in models:
+        try:
+            v = problem.value(m, criterion)
+        except (IntegrationError, InputError):
+            continue
+        if v < value:
+            best, value = m, v
+    return best, value

@@ -18,7 +18,7 @@ from .judging import (
     _present,
     negligible,
 )
-from .problem import _mean, _small_step, _with_drift
+from .problem import _mean, _small_step, _with_drift, best_of
 from .starts import _output_error, _regressed
 
 
@@ -111,15 +111,7 @@ class _Refits:
     def _by_gap(self, cands):
         """The candidate start with the lowest gap criterion (one evaluation each, its
         block runs shared with the ranking's), or None."""
-        best, value = None, float("inf")
-        for m in cands:
-            try:
-                v = self.problem.value(m, self.criterion)
-            except (IntegrationError, InputError):
-                continue
-            if v < value:
-                best, value = m, v
-        return best
+        return best_of(self.problem, cands, self.criterion)[0]
 
 
 def _screen_one(refits, job):
