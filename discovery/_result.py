@@ -52,6 +52,7 @@ KINDS = {
     "explain": "discovery.vibroimpact.explain.result:ExplainResult",
     "study": "discovery.vibroimpact.studies.result:StudyResult",
     "advise": "discovery.vibroimpact.advise.result:AdviseResult",
+    "campaign": "discovery.vibroimpact.advise.campaign_loop:CampaignResult",
     "contact-models": "discovery.vibroimpact.fit.contact_fit:ContactModelsResult",
     "steady": "discovery.vibroimpact.dynamics.steady_states:SteadyState",
     "simulate": "discovery.vibroimpact.dynamics.synthetic:SimulatedRecord",

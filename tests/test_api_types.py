@@ -160,6 +160,24 @@ CASES = [
     ("LandscapeSettings workers 0", lambda: d.LandscapeSettings(workers=0), VALUE, "workers"),
     ("FieldRecordSettings seed -1", lambda: d.FieldRecordSettings(seed=-1), VALUE, "seed"),
     ("AdviseSettings workers text", lambda: d.AdviseSettings(workers="a"), TYPE, "workers"),
+    (
+        "campaign scenario text",
+        lambda: d.campaign("paper", REC, print, d.Knobs((3e5, 6e5), (20, 30))),
+        TYPE,
+        "scenario",
+    ),
+    (
+        "campaign knobs text",
+        lambda: d.campaign(SC, REC, print, "3e5:6e5"),
+        TYPE,
+        "knobs",
+    ),
+    (
+        "CampaignSettings max_records 1",
+        lambda: d.CampaignSettings(max_records=1),
+        VALUE,
+        "max_records",
+    ),
     ("IdentifySettings xtol text", lambda: d.IdentifySettings(xtol="a"), TYPE, "xtol"),
     ("ExplainSettings alpha 2", lambda: d.ExplainSettings(alpha=2.0), VALUE, "alpha"),
     ("VerifySettings n_boot -1", lambda: d.VerifySettings(n_boot=-1), VALUE, "n_boot"),
@@ -259,6 +277,8 @@ def test_the_cases_cover_every_public_entry():
         "VerifyResult",
         "Calibration",
         "AdviseResult",
+        "CampaignResult",
+        "NextRecord",
         "ContactModelsResult",
         "builtin_scenarios",
         "load_scenario",
@@ -307,6 +327,7 @@ def test_the_cases_cover_every_public_entry():
             "parse_law",
             "fit_contact_models",
             "calibrate",
+            "campaign",
         }
         # a settings class with a row of its own (rows are named after the class)
         - {n for n in public if n.endswith("Settings") and n.lower() in covered}

@@ -133,6 +133,8 @@ EXAMPLES = {
         "--out out/advise",
         "vidi advise --law '2.06e8*z + 1.28e7*zd' --law '2.06e8*z + 9e6*zd + 1e9*z*zd' "
         "--noise 0.01 --amplitude 3e5:6e5 --frequency 20:30 --max-force 2e7 --out out/advise2",
+        "vidi advise --until-settled --data D.csv --amplitude 3e5:6e5 --frequency 20:30 "
+        "--acquire 'python rig.py --A {amplitude} --f {frequency} --out {out}' --out out/loop",
     ],
     "study": [
         "vidi study --config examples/study_paper.toml --out out/study",

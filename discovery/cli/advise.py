@@ -16,6 +16,7 @@ from ._common import (
     read_record,
     reporter,
 )
+from .advise_loop import add_loop_options
 
 
 def _grid(text):
@@ -98,6 +99,38 @@ def _knobs(args):
     return Knobs(amp, freq, m2, grid=_grid(args.grid), refine=args.refine)
 
 
+def _until_settled(args, knobs, safe):
+    from ..vibroimpact.model.scenario import load_scenario
+    from .advise_loop import run_loop
+
+    given = [
+        o
+        for o, v in (
+            ("--fit", args.fit),
+            ("--law", args.law),
+            ("--noise", args.noise),
+            ("--position-noise", args.position_noise),
+            ("--sample-rate", args.sample_rate),
+            ("--periods", args.periods),
+            ("--scheduler", getattr(args, "scheduler", None)),
+        )
+        if v is not None and v != []
+    ]
+    if given:
+        raise InputError(
+            f"--until-settled fits its own records, takes their noise and runs on this "
+            f"machine's processes: leave out {' and '.join(given)} (the first record is "
+            "--data, the fits' terms --library, the processes --workers)"
+        )
+    if args.data is None or args.acquire is None:
+        raise InputError(
+            "--until-settled needs the first record (--data D.csv) and the command that "
+            'takes the next ones (--acquire CMD, e.g. "python rig.py --A {amplitude} '
+            '--f {frequency} --out {out}")'
+        )
+    return run_loop(args, load_scenario(args.scenario or "paper"), knobs, safe)
+
+
 def run(args):
     from reports import advise_figure
 
@@ -109,6 +142,8 @@ def run(args):
     check_out(args)
     knobs = _knobs(args)
     safe = SafeRegion(args.max_force, args.max_penetration)
+    if args.until_settled:
+        return _until_settled(args, knobs, safe)
     laws, fit_scenario = _candidates(args)
     if args.fit is not None and not args.scenario and fit_scenario:
         changed = fit_scenario_changed(args.fit, fit_scenario)
@@ -239,6 +274,7 @@ def register(sub):
         "judged again with each rival refitted to the other's predicted record; 0: none "
         "(default: %(default)s)",
     )
+    add_loop_options(s)
     _options.add_n_boot_option(s, of="each noise floor")
     _options.add_seed_option(s, "seed of the noise floors' bootstrap")
     _options.add_parallel_options(s)

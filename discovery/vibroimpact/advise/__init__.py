@@ -2,13 +2,19 @@
 mass) where the records the candidate laws predict differ most, by the verdict's own rule.
 
 candidates (:mod:`.candidates`) -> every grid point (:mod:`.separation`) -> coarse grid and
-refinement (:mod:`.search`) -> :class:`AdviseResult` (:mod:`.result`).
+refinement (:mod:`.search`) -> :class:`AdviseResult` (:mod:`.result`); the loop of fit,
+advice and record until one law remains (:mod:`.campaign_loop`).
 """
 
 from ..._lazy import lazy_package
 
 _EXPORTS = {
     "advise": "search",
+    "campaign": "campaign_loop",
+    "CampaignSettings": "campaign_loop",
+    "CampaignResult": "campaign_loop",
+    "CampaignStep": "campaign_loop",
+    "NextRecord": "campaign_loop",
     "AdviseSettings": "search",
     "AdviseResult": "result",
     "Knobs": "candidates",
@@ -25,6 +31,11 @@ _EXPORTS = {
 
 __all__ = [
     "advise",
+    "campaign",
+    "CampaignSettings",
+    "CampaignResult",
+    "CampaignStep",
+    "NextRecord",
     "AdviseSettings",
     "AdviseResult",
     "Knobs",
