@@ -146,6 +146,38 @@ def summary(rows):
     return right, len(done)
 
 
+#: the table's rows: the noise levels, then every run
+LABELS = {"force 1 %, motions 0.2 %": (0,), "force 0.25 %, motions 0.05 %": (1,), "all": (0, 1)}
+
+
+def markdown_row(rows, label):
+    """One row of docs/advise.md's table: runs, errors, how the loop stopped, how often it
+    ends with the true law (and on the first record alone), the records it took, and the
+    draws where the quieter record ends wrong but the noisier right (all rows only)."""
+    levels = LABELS[label]
+    mine = [r for r in rows if r["level"] in levels]
+    done = [r for r in mine if "error" not in r]
+    stops = {}
+    for r in done:
+        stops[r["stopped"]] = stops.get(r["stopped"], 0) + 1
+    taken = sorted(r["records"] for r in done)
+    pairs = {}
+    for r in done:
+        pairs.setdefault(r["draw"], {})[r["level"]] = r["right"]
+    worse = sum(1 for p in pairs.values() if p.get(0) and p.get(1) is False)
+    cells = [
+        label,
+        len(mine),
+        len(mine) - len(done),
+        ", ".join(f"{k} {v}" for k, v in sorted(stops.items())) or "-",
+        f"**{sum(r['right'] for r in done)}**",
+        sum(r["right"] and r["records"] == 1 for r in done),
+        f"{taken[len(taken) // 2]} / {taken[-1]}" if taken else "-",
+        worse if label == "all" else "",
+    ]
+    return "| " + " | ".join(str(c) for c in cells) + " |"
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--draws", nargs=2, type=int, metavar=("FIRST", "STOP"))

@@ -31,6 +31,7 @@ from . import (
     realistic_survey,
     survey_advise,
     survey_calibration,
+    survey_campaign,
     survey_contact_models,
     survey_corpus,
     survey_effects,
@@ -212,6 +213,17 @@ TABLES = {
         ),
         rows=(("1 %", ("advise-1*.jsonl",)), ("3 %", ("advise-3*.jsonl",))),
         row=survey_advise.markdown_row,
+        read=_rows,
+    ),
+    "campaign": Table(
+        page="docs/advise.md",
+        header=(
+            "| noise | runs | raised an error | stopped | ends with the true law | of which on "
+            "the first record | records (median / most) | quieter wrong where noisier right |",
+            "|---|---|---|---|---|---|---|---|",
+        ),
+        rows=tuple((label, ("campaign*.jsonl",)) for label in survey_campaign.LABELS),
+        row=survey_campaign.markdown_row,
         read=_rows,
     ),
     "corpus": Table(

@@ -590,6 +590,9 @@ def _run(argv):
             x for x in (getattr(args, "command", None), getattr(args, "ueda_command", None)) if x
         )
         set_run(command or None, getattr(args, "overwrite", False))
+        from ..numerics import counts
+
+        counts.reset()  # a run's summary counts its own work
         return args.func(args)
     except (KeyboardInterrupt, Terminated) as exc:
         return _stopped(exc)

@@ -289,11 +289,12 @@ def check_out(args, kind="dir", option="--out"):
 
 
 def provenance_of(args):
-    """The ``summary.json`` provenance of a command: its options and its input files
-    (:func:`inputs_of`)."""
+    """The ``summary.json`` provenance of a command: its options, its input files
+    (:func:`inputs_of`) and the work it counted so far (:mod:`discovery.numerics.counts`)."""
     from .._io import provenance
+    from ..numerics import counts
 
-    return provenance(vars(args), inputs=inputs_of(args))
+    return {**provenance(vars(args), inputs=inputs_of(args)), "counts": counts.snapshot()}
 
 
 def data_entry(data):

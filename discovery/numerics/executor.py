@@ -36,9 +36,13 @@ from multiprocessing import get_context
 
 from .._validate import Real, Text, params
 from ..errors import InputError
+from . import counts
 from ._workers import terminate_pool, worker_initializer
 
 __all__ = ["Executor", "Serial", "Pool", "Dask", "make_executor", "map_on", "one_blas_thread"]
+
+# A worker's job returns its result with the work it counted (:mod:`.counts`), so a run's
+# counts do not depend on the executor.
 
 _CONTEXT = {}  # the context of the sweep running in this (worker) process
 _THREAD_VARS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
@@ -77,12 +81,26 @@ def _job(fn, context, job):
         return fn(context, job)
 
 
+def _counted(fn, context, job):
+    """A worker's job: its result and the work it counted (:mod:`.counts`), which the
+    parent adds to its own."""
+    before = counts.snapshot()
+    out = _job(fn, context, job)
+    return out, counts.since(before)
+
+
 def _call(fn, job):
-    return _job(fn, _CONTEXT.get("value"), job)
+    return _counted(fn, _CONTEXT.get("value"), job)
 
 
 def _call_with(fn, context, job):
-    return _job(fn, context, job)
+    return _counted(fn, context, job)
+
+
+def _received(result):
+    out, delta = result
+    counts.add(delta)
+    return out
 
 
 class Executor:
@@ -152,7 +170,7 @@ class Pool(Executor):
                 done, _ = wait(pending, return_when=FIRST_COMPLETED)
                 for fut in done:
                     i = pending.pop(fut)
-                    yield i, fut.result()
+                    yield i, _received(fut.result())
         except BaseException:
             terminate_pool(pool)  # interrupted, failed or abandoned: no waiting for the queue
             raise
@@ -236,7 +254,7 @@ class Dask(Executor):
         index = {f.key: i for i, f in enumerate(futures)}
         try:
             for fut in as_completed(futures):
-                yield index[fut.key], fut.result()
+                yield index[fut.key], _received(fut.result())
         finally:
             self.client.cancel(futures)
             with contextlib.suppress(Exception):

@@ -26,6 +26,7 @@ from ..._result import Result
 from ..._settings import Settings, option, takes
 from ..._validate import Array, Instance, Real, params
 from ...errors import InputError, IntegrationError
+from ...numerics import counts
 from ...numerics.shooting import (
     floquet_multipliers,
     is_stable,
@@ -556,6 +557,15 @@ def steady_state(scenario, law, *, settings=None, **options):
             "mass_loss = 0"
         )
     pm = StroboscopicMap(scenario, law, s.tolerances)
+    try:
+        return _steady_from(scenario, law, s, pm)
+    finally:  # the work is counted whatever the outcome (:mod:`discovery.numerics.counts`)
+        counts.count("steady_states")
+        counts.count("period_maps", pm.n_calls)
+
+
+def _steady_from(scenario, law, s, pm):
+    """:func:`steady_state`'s search with the settings ``s`` on the period map ``pm``."""
     if s.guess is not None and s.guess.periodic and not law.has_memory:
         cont = _continued(scenario, law, pm, s.guess, s.tol)
         if cont is not None:

@@ -30,6 +30,7 @@ import os
 import pickle
 from multiprocessing import get_context
 
+from ...numerics import counts
 from ...numerics._workers import die_with_parent
 
 __all__ = ["BlockFarm", "shared_blocks", "farm_for", "block_workers"]
@@ -57,8 +58,10 @@ def _serve(conn, references, parent):
         if msg is None:
             return
         fn, i, items, shared = msg
+        before = counts.snapshot()
         try:
-            conn.send([fn(references[i], item, *pickle.loads(shared)) for item in items])
+            out = [fn(references[i], item, *pickle.loads(shared)) for item in items]
+            conn.send((out, counts.since(before)))  # the work it counted goes with it
         except Exception:  # an answer that cannot be sent: the parent does these items
             conn.send(None)
 
@@ -139,6 +142,9 @@ class BlockFarm:
                         got = self._conns[w - 1].recv()
                     except (EOFError, OSError):  # the worker is gone
                         lost = True
+                    if got is not None:
+                        got, delta = got
+                        counts.add(delta)
                 if got is None:  # its items done here, as they would be without a farm
                     got = [fn(self._refs[i], items[k], *args) for k in range(w, n, size)]
                 for k, o in zip(range(w, n, size), got, strict=True):

@@ -30,6 +30,7 @@ import numpy as np
 from ..._printing import fmt
 from ..._validate import Instance, params
 from ...errors import InputError, NoContactError
+from ...numerics import counts
 from ...numerics.intervals import in_widened_intervals
 from ...numerics.memo import Memo
 
@@ -385,6 +386,7 @@ def criterion(name):
 @params(measured=(_IMPULSE, None), simulated=(_IMPULSE, None), names=(None, list, tuple))
 def evaluate_criteria(measured, simulated, names=None):
     """``{name: value}`` for the requested criteria (default all), measured vs simulated."""
+    counts.count("criteria")
     names = list(CRITERIA) if names is None else list(names)
     funcs = {n: criterion(n) for n in names}
     c = compare(measured, simulated)

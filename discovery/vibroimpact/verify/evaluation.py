@@ -33,6 +33,7 @@ import numpy as np
 from ..._printing import readable
 from ..._result import Result
 from ...errors import InputError, IntegrationError
+from ...numerics import counts
 from ...numerics.memo import Memo, value_key
 from ..dynamics.law_response import impulse_from_steady_state
 from ..dynamics.simulation import simulate
@@ -421,6 +422,7 @@ def evaluate(
     -------
     Evaluation
     """
+    counts.count("evaluations")
     if from_state and getattr(reference, "span", None) is not None:
         return _evaluate_span(
             scenario,
