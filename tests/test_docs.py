@@ -2,8 +2,10 @@
 
 - every ``from X import Y`` / ``import X`` line of a Python block resolves;
 - every backticked dotted path ``discovery.X.Y`` (also ``reports``, ``constraints``) resolves;
-- every Python block marked ``<!-- runnable ... -->`` runs as printed, in a directory holding
-  the quickstart's record (``vidi simulate`` as the README prints it);
+- every Python block marked ``<!-- runnable -->`` runs as printed, in a directory holding
+  the quickstart's record (``vidi simulate`` as the README prints it) and the ``examples/``;
+  a long one on a small input, named in its marker (``<!-- runnable: A => B; C => D -->``:
+  the text ``A`` replaced by ``B``, ...);
 - every relative link and image of the pages exists;
 - the docs' quickstart is the README's.
 """
@@ -11,6 +13,7 @@
 import importlib
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -19,15 +22,27 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
-FENCE = re.compile(r"(<!-- runnable[^>]*-->\s*)?```python\n(.*?)```", re.S)
+FENCE = re.compile(r"(<!-- runnable([^\n]*?)-->\s*)?```python\n(.*?)```", re.S)
+
+
+def _small(marker, code):
+    """``code`` on the small input its marker names (``: A => B; C => D``)."""
+    for pair in (p for p in marker.lstrip(": ").split(";") if "=>" in p):  # else a comment
+        old, new = (x.strip() for x in pair.split("=>"))
+        assert old in code, f"the marker replaces {old!r}, which the block does not hold"
+        code = code.replace(old, new)
+    return code
 
 
 def _blocks():
-    """(page, runnable, code) of every Python block."""
+    """(page, runnable, code) of every Python block (a runnable one on its small input)."""
     out = []
     for page in PAGES:
         for m in FENCE.finditer(page.read_text()):
-            out.append((page.relative_to(ROOT).as_posix(), bool(m.group(1)), m.group(2)))
+            runnable, code = bool(m.group(1)), m.group(3)
+            if runnable and m.group(2).strip():
+                code = _small(m.group(2), code)
+            out.append((page.relative_to(ROOT).as_posix(), runnable, code))
     return out
 
 
@@ -109,6 +124,7 @@ def record_dir(tmp_path_factory):
     where = tmp_path_factory.mktemp("docs")
     vidi = Path(sys.executable).with_name("vidi")
     subprocess.run([str(vidi), *argv[1:]], cwd=where, check=True, capture_output=True)
+    shutil.copytree(ROOT / "examples", where / "examples")
     return where
 
 
