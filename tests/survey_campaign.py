@@ -11,13 +11,20 @@ and the frequency in 0.8-1.2 x the first record's, a safe region of three times 
 force, four records at most.  Each next record is made by the same path at the point the
 loop advises, with the true machine.
 
+With ``--family coupled`` the draws are instead ``tests/survey_advise.py``'s laws with a
+``z*zd`` share on the paper's machine and the corpus's machine B (whose first record often
+leaves rivals), the sheet off the same way: the advised pairs of those runs, with what the
+joint fit made of each rival, are the calibration table of the predicted separation
+(:func:`calibration_row`).
+
 A run counts as *right* when the loop ends with the true law's support selected (for the
 ``hertz`` kind, fitted with ``poly:2+hc``; the others with ``poly:2``) and every model still
 listed holds the truth's terms.
 
 Run from the repository root (about a minute per run on two cores)::
 
-    python -m tests.survey_campaign --draws 0 12 --out campaign.jsonl
+    python -m tests.survey_campaign --draws 0 12 --out campaign-random.jsonl
+    python -m tests.survey_campaign --family coupled --draws 0 12 --out campaign-coupled.jsonl
     python -m tests.survey_campaign --summary campaign.jsonl
 """
 
@@ -32,7 +39,7 @@ import numpy as np
 from discovery import DiscoverSettings, ForceLaw, campaign
 from discovery._io import provenance
 from discovery.vibroimpact.advise import Knobs, SafeRegion
-from tests import measured
+from tests import measured, survey_advise
 from tests import realistic as R
 
 #: (force noise, motion noise) of the two levels
@@ -57,20 +64,29 @@ def _terms(text):
     return sorted(ForceLaw.parse(text).names)
 
 
-def run(draw, level):
-    t0 = time.time()
+def _case(draw, family):
+    """``(true machine, law, category, kind)`` of a draw of a family."""
+    if family == "coupled":
+        sc, law, _ = survey_advise.case_of(draw)
+        kind = "zzd" if "z*zd" in law.names else "linear"
+        return sc, law, "coupled", kind
     category = R.CATEGORIES[draw % len(R.CATEGORIES)]
     case = R.draw_case(category, 7000 + draw)
-    truth, law = case.scenario, case.law
+    return case.scenario, case.law, category, case.kind
+
+
+def run(draw, level, family="random"):
+    t0 = time.time()
+    truth, law, category, kind = _case(draw, family)
     sheet = sheet_of(truth, 7000 + draw)
     fnoise, mnoise = LEVELS[level]
     row = {
         "draw": draw,
         "level": level,
+        "family": family,
         "category": category,
-        "kind": case.kind,
+        "kind": kind,
         "law": law.to_text(),
-        "regime": case.regime,
         "noise": [fnoise, mnoise],
     }
 
@@ -90,7 +106,7 @@ def run(draw, level):
             (0.8 * truth.frequency, 1.2 * truth.frequency),
             grid=(4, 4),
         )
-        library = "poly:2+hc" if case.kind == "hertz" else "poly:2"
+        library = "poly:2+hc" if kind == "hertz" else "poly:2"
         res = campaign(
             sheet,
             first,
@@ -146,6 +162,54 @@ def summary(rows):
     return right, len(done)
 
 
+def predictions(rows):
+    """Every advised pair of the selected law and a rival, with what came of it: ``(predicted
+    separation or None for a regime/physics one, refitted or None, by, rejected)``, where
+    *rejected* means the rival's support is gone from the next joint fit's candidates."""
+    out = []
+    for r in rows:
+        steps = r.get("steps") or []
+        for k, step in enumerate(steps[:-1]):
+            point = step.get("point") or {}
+            after = {tuple(_terms(c)) for c in steps[k + 1]["candidates"]}
+            for q in point.get("pairs") or []:
+                i, j = q["pair"]
+                if i != 0:
+                    continue
+                rival = tuple(_terms(step["candidates"][j]))
+                out.append((q["separation"], q.get("refitted"), q["by"], rival not in after))
+    return out
+
+
+def _share(items):
+    n = len(items)
+    return f"{sum(items)} of {n}" if n else "-"
+
+
+def calibration_row(rows, label):
+    """One row of the calibration table: the advised pairs predicted in one class, and how
+    many of their rivals the joint fit with the new record rejected."""
+    preds = predictions(rows)
+    pick = {
+        "separated by criteria (> 1)": lambda p: p[2] == "criteria" and p[0] > 1,
+        "separated by regime or physics": lambda p: p[2] != "criteria",
+        "not separated (<= 1)": lambda p: p[2] == "criteria" and p[0] <= 1,
+        "refitted > 1": lambda p: p[1] is not None and p[1] > 1,
+        "refitted <= 1": lambda p: p[1] is not None and p[1] <= 1,
+    }[label]
+    chosen = [p[3] for p in preds if pick(p)]
+    return f"| {label} | {len(chosen)} | {_share(chosen)} |"
+
+
+#: the calibration table's rows
+PREDICTED = (
+    "separated by criteria (> 1)",
+    "separated by regime or physics",
+    "not separated (<= 1)",
+    "refitted > 1",
+    "refitted <= 1",
+)
+
 #: the table's rows: the noise levels, then every run
 LABELS = {"force 1 %, motions 0.2 %": (0,), "force 0.25 %, motions 0.05 %": (1,), "all": (0, 1)}
 
@@ -183,6 +247,13 @@ def main(argv=None):
     ap.add_argument("--draws", nargs=2, type=int, metavar=("FIRST", "STOP"))
     ap.add_argument("--out", help="JSON-lines file the rows are appended to")
     ap.add_argument("--summary", help="count the outcomes of a JSON-lines file")
+    ap.add_argument(
+        "--family",
+        choices=("random", "coupled"),
+        default="random",
+        help="random: tests.realistic's machines and laws; coupled: survey_advise's laws with "
+        "a z*zd share, whose first record often leaves rivals (default: random)",
+    )
     args = ap.parse_args(argv)
     if args.summary:
         summary(measured.read(args.summary)[1])
@@ -193,7 +264,7 @@ def main(argv=None):
     out = measured.RunFile(args.out, "survey_campaign", argv, append=True)
     for draw in range(*args.draws):
         for level in (0, 1):
-            row = run(draw, level)
+            row = run(draw, level, args.family)
             row["versions"] = versions
             out.write(row)
             print(json.dumps({k: row.get(k) for k in ("draw", "level", "stopped", "right", "s")}))

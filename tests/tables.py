@@ -222,8 +222,18 @@ TABLES = {
             "the first record | records (median / most) | quieter wrong where noisier right |",
             "|---|---|---|---|---|---|---|---|",
         ),
-        rows=tuple((label, ("campaign*.jsonl",)) for label in survey_campaign.LABELS),
+        rows=tuple((label, ("campaign-random*.jsonl",)) for label in survey_campaign.LABELS),
         row=survey_campaign.markdown_row,
+        read=_rows,
+    ),
+    "campaign-calibration": Table(
+        page="docs/advise.md",
+        header=(
+            "| predicted at the advised point | pairs | rival rejected by the joint fit |",
+            "|---|---|---|",
+        ),
+        rows=tuple((label, ("campaign*.jsonl",)) for label in survey_campaign.PREDICTED),
+        row=survey_campaign.calibration_row,
         read=_rows,
     ),
     "corpus": Table(

@@ -23,6 +23,8 @@ rig in the field (the CLI runs a command, ``vidi advise --until-settled --acquir
 import time
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ..._printing import readable
 from ..._progress import reports_progress, tick
 from ..._result import Result
@@ -80,7 +82,8 @@ class NextRecord:
     scenario : Scenario
         The designer's sheet at this setting (what the record's machine is said to be).
     separation : float
-        The predicted smallest separation of the candidates there (> 1: separated).
+        The predicted smallest separation of the candidates there (> 1: separated; ``inf``:
+        by a regime change or physics).
     """
 
     step: int
@@ -107,8 +110,10 @@ class CampaignStep:
         The selected law and the models the fit reports equivalent.
     point : dict or None
         The advised point: ``amplitude``, ``frequency``, ``m2``, ``separation`` (predicted,
-        smallest over the pairs some point separates), ``refitted`` (the smallest with each
-        rival refitted, ``None`` when not computed), ``regime_change``; ``None`` when the
+        smallest over the pairs some point separates; ``None``: infinite, a regime change or
+        physics), ``refitted`` (the smallest with each rival refitted, ``None`` when not
+        computed), ``regime_change``, ``pairs`` (each pair's ``separation``, ``refitted``
+        and what separates it, ``by``: criteria, regime or physics); ``None`` when the
         loop stopped at this step.
     seconds : float
     """
@@ -153,9 +158,11 @@ class CampaignStep:
             return head
         m2 = "" if p.get("m2") is None else f", m2 = {p['m2']:.4g} kg"
         refit = "" if p.get("refitted") is None else f", refitted {p['refitted']:.3g}"
+        sep = p.get("separation")
+        sep = "infinite: a regime change" if sep is None else f"{sep:.3g}"
         return (
             f"{head}; next record at A = {p['amplitude']:.4g} N, f = {p['frequency']:.4g} Hz"
-            f"{m2} (separation {p['separation']:.3g}{refit})"
+            f"{m2} (separation {sep}{refit})"
         )
 
 
@@ -305,16 +312,32 @@ def short(text):
     return law.format(4) if isinstance(law, ForceLaw) else str(law)
 
 
+def _finite(x):
+    return float(x) if np.isfinite(x) else None
+
+
 def _point_entry(adv):
     b = adv.best
-    refitted = min((r.separation for r in adv.refit), default=None)
+    refit = {tuple(r.pair): r.separation for r in adv.refit}
+    refitted = min(refit.values(), default=None)
     return {
         "amplitude": float(b.amplitude),
         "frequency": float(b.frequency),
         "m2": None if b.m2 is None else float(b.m2),
-        "separation": float(b.smallest_separation(frozenset(adv.inseparable))),
-        "refitted": None if refitted is None else float(refitted),
+        "separation": _finite(b.smallest_separation(frozenset(adv.inseparable))),
+        "refitted": None if refitted is None else _finite(refitted),
         "regime_change": any(q.regime_change for q in b.pairs),
+        # each pair's predicted separation (inf: by regime or physics: None in JSON) and
+        # with the rival refitted, to measure how often a predicted separation comes true
+        "pairs": [
+            {
+                "pair": list(q.pair),
+                "separation": _finite(q.separation),
+                "refitted": _finite(refit[tuple(q.pair)]) if tuple(q.pair) in refit else None,
+                "by": "regime" if q.regime_change else "physics" if q.physics else "criteria",
+            }
+            for q in b.pairs
+        ],
     }
 
 
@@ -438,7 +461,7 @@ def campaign(scenario, measurement, acquire, knobs, *, settings=None, progress=N
             b.frequency,
             b.m2,
             at_point(scenario, b.amplitude, b.frequency, b.m2),
-            entry["separation"],
+            float("inf") if entry["separation"] is None else entry["separation"],
         )
         tick(progress, f"campaign: acquiring record {k + 1}", k - 1, s.max_records)
         rec = _acquired(acquire, request)

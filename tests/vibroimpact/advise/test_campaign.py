@@ -70,6 +70,8 @@ def test_the_loop_settles_a_law_its_first_record_leaves_open():
     assert all(set(LAW.names) <= set(ForceLaw.parse(t).names) for t in res.remaining)
     assert len(res.records) == len(asked) + 1 == len(res.steps)
     assert res.steps[0].point is not None and res.steps[-1].point is None
+    pairs = res.steps[0].point["pairs"]  # each advised pair, for the calibration table
+    assert pairs and all(q["by"] in ("criteria", "regime", "physics") for q in pairs)
     assert res.machine == "record" and res.fit is not None
     text = str(res)
     assert text.startswith("campaign: settled after") and "step 1:" in text
@@ -107,6 +109,11 @@ def test_a_campaign_round_trips_and_prints(tmp_path):
     text = str(back)
     assert "next record at A = 5e+05 N, f = 22 Hz (separation 3.2, refitted 1.4)" in text
     assert "remaining candidates:" in text and not back.settled
+    # a regime change separates without a number: said in words, and it reads back
+    regime = CampaignStep(**{**step.__dict__, "point": {**step.point, "separation": None}})
+    res = CampaignResult(**{**res.__dict__, "steps": (regime,)})
+    back = CampaignResult.from_dict(res.to_dict())
+    assert "(separation infinite: a regime change, refitted 1.4)" in str(back)
 
 
 def test_acquire_must_be_a_callable_that_returns_a_record():
