@@ -37,6 +37,7 @@ units N m^-a (m/s)^-b.
 """
 
 from dataclasses import dataclass, replace
+from fractions import Fraction
 from functools import lru_cache
 
 import numpy as np
@@ -580,15 +581,27 @@ class ForceLaw:
         return text
 
 
-def _latex_sum(coefficients, terms, digits, latex_names, paren=False):
-    import sympy
+def _latex_power(symbol, p):
+    """``symbol^p`` in LaTeX, a fractional exponent as a fraction (``\\zeta^{\\frac{3}{2}}``)."""
+    f = Fraction(float(p)).limit_denominator(1000)
+    if f == 1:
+        return symbol
+    e = str(f.numerator) if f.denominator == 1 else rf"\frac{{{f.numerator}}}{{{f.denominator}}}"
+    return rf"{symbol}^{{{e}}}"
 
-    names = dict(zip(_symbols(), latex_names, strict=True))
+
+def _latex_term(term, latex_names):
+    """A term in LaTeX, penetration first (written here: sympy took 0.2 s a law)."""
+    powers = zip(latex_names, (term.a, term.b), strict=True)
+    return " ".join(_latex_power(n, p) for n, p in powers if p)
+
+
+def _latex_sum(coefficients, terms, digits, latex_names, paren=False):
     out = []
     for c, t in zip(coefficients, terms, strict=True):
         mant, _, exp = f"{abs(c):.{digits - 1}e}".partition("e")
         num = mant if int(exp) == 0 else rf"{mant} \cdot 10^{{{int(exp)}}}"
-        sym = sympy.latex(t.sympy(), symbol_names=names)
+        sym = _latex_term(t, latex_names)
         out.append(("-" if c < 0 else "+") + rf" {num}\,{sym}")
     text = " ".join(out)
     text = text[2:] if text.startswith("+ ") else text

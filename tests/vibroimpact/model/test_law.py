@@ -243,6 +243,9 @@ def test_latex_contains_coefficients_and_symbols():
     assert r"- 3.00 \cdot 10^{10}" in tex2
     assert r"\frac{3}{2}" in tex2
     assert "1.50" in tex2 and r"1.50 \cdot" not in tex2  # exponent 0 is not written
+    # penetration first, a fractional power as a fraction (written without sympy)
+    tex3 = ForceLaw.parse("4*z^0.5*zd^2").latex()
+    assert tex3 == r"4.000\,\zeta^{\frac{1}{2}} \dot{\zeta}_{+}^{2}"
 
 
 # --------------------------------------------------------------- property test
