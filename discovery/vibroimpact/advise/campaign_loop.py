@@ -14,7 +14,9 @@ The loop stops when
   within the bounds: wider bounds, another knob or another sensor might);
 * ``"no usable point"``: every point of the bounds is unsafe, or a candidate has no
   periodic orbit with contact there;
-* ``"budget"``: the records reached ``max_records``.
+* ``"budget"``: the records reached ``max_records``;
+* ``"none consistent"``: the joint fit's best law is not consistent with every record (no
+  law of the library explains them: a missing effect, :func:`~discovery.explain`).
 
 ``acquire`` is where the records come from: a simulator stand-in in tests and dry runs, a
 rig in the field (the CLI runs a command, ``vidi advise --until-settled --acquire CMD``).
@@ -48,7 +50,7 @@ STOPS = {
     "twins": "no point in the bounds separates the remaining candidates",
     "no usable point": "no point in the bounds is safe with an orbit of every candidate",
     "budget": "the records reached max_records",
-    "none consistent": "no named contact model is consistent with the records",
+    "none consistent": "no law the fit can form is consistent with every record",
 }
 
 
@@ -254,13 +256,18 @@ class _State:
 
 
 def _machines(state, s):
-    """The scenario each record is fitted with: calibrated from the records, or the sheets."""
+    """``(scenarios, scale)``: the scenario each record is fitted with (calibrated from the
+    records, or the sheets) and the calibrated machine's scale uncertainty (``None`` for
+    the sheets): the records pin the machine's ratios far better than its scale, and the
+    fit judges each law at the scale that suits it within that range, as ``vidi fit`` does."""
     if s.machine == "sheet":
-        return list(state.sheets)
+        return list(state.sheets), None
     from ..calibration import calibrate
 
     cal = calibrate(list(state.sheets), list(state.records), seed=s.seed)
-    return list(cal.scenarios) if cal.calibrated else list(state.sheets)
+    if not cal.calibrated:
+        return list(state.sheets), None
+    return list(cal.scenarios), cal.scale_range
 
 
 def _distinct(laws):
@@ -423,13 +430,22 @@ def campaign(scenario, measurement, acquire, knobs, *, settings=None, progress=N
         k = len(state.records)
         tick(progress, f"campaign: joint fit of {k} record(s)", k - 1, s.max_records)
         t_step = time.perf_counter()
-        machines = _machines(state, s)
-        fit = discover(machines, list(state.records), settings=fit_settings)
+        machines, scale = _machines(state, s)
+        settings = fit_settings
+        if scale is not None and fit_settings.machine_scale is None:
+            settings = DiscoverSettings.of("campaign", fit_settings, {"machine_scale": scale})
+        fit = discover(machines, list(state.records), settings=settings)
         selected, consistent, laws = _outcome(fit)
         step = CampaignStep(k, selected or "", consistent, tuple(law.to_text() for law in laws))
         stop = None
         if selected is None:
-            stop = ("none consistent", STOPS["none consistent"])
+            stop = ("none consistent", f"{STOPS['none consistent']} (no named contact model)")
+        elif not consistent:
+            stop = (
+                "none consistent",
+                f"{STOPS['none consistent']}: the best, {short(selected)}, is not; a missing "
+                "effect (vidi explain) or a machine the records do not pin",
+            )
         elif len(laws) < 2:
             stop = ("settled", f"{STOPS['settled']} ({short(selected)})")
         elif k >= s.max_records:
