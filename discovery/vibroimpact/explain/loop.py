@@ -324,18 +324,6 @@ def _iteration(run, max_iterations):
     return _refit_and_name(run, step)
 
 
-def _check_settings(max_simulations, alpha, workers, max_iterations):
-    """The settings :func:`explain` checks beyond their types; returns the simulation
-    budget of each refit."""
-    if not (0 < alpha < 1):
-        raise InputError(f"alpha must be in (0, 1); got {alpha!r}")
-    if workers is not None and not (isinstance(workers, int) and workers >= 1):
-        raise InputError(f"workers must be an integer >= 1; got {workers!r}")
-    if not (isinstance(max_iterations, int) and max_iterations >= 0):
-        raise InputError(f"max_iterations must be an integer >= 0; got {max_iterations!r}")
-    return max_simulations
-
-
 def _joint_refit(run):
     """After the loop, a model with named effects that is not consistent is refitted once
     more with all its parameters at once (the law's, each effect's, a mass loss's on the
@@ -523,7 +511,7 @@ def explain(
     """
     s = ExplainSettings.of("explain", settings, options)
     t0 = time.perf_counter()
-    budget = _check_settings(s.max_simulations, s.alpha, s.workers, s.max_iterations)
+    budget = s.max_simulations
     pairs, records = _records_of(scenario, measurement, s.n_boot, s.seed)
     ms = [m for _, m in pairs]
     catalogue = select(EFFECTS, s.effects)

@@ -35,14 +35,11 @@ import inspect
 import time
 from dataclasses import dataclass, replace
 
-import numpy as np
-
 from constraints import require as require_certificate
 
 from ..._progress import reports_progress, tick
 from ..._settings import Settings, option, takes
 from ..._validate import Choice, Real, Text, params
-from ...errors import InputError
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
 from ..model.library import Library
@@ -50,7 +47,6 @@ from ..model.scenario import Scenario
 from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
 from ..verify.criteria import CRITERIA
-from ..verify.criteria import criterion as _criterion
 from .discovery_result import DiscoveryResult, RankedModel
 from .discovery_warnings import _defects_warning, _warnings
 from .discovery_warnings import _impact_warnings as _impact_warnings
@@ -67,23 +63,6 @@ from .stepwise import _Stepwise
 __all__ = ["RankedModel", "DiscoveryResult", "discover", "rank"]
 
 _REFINE_BUDGET = 120  # simulations per shortlisted support (every record counts)
-
-
-def _check_settings(*, criterion, shortlist, stability, n_boot, max_simulations, stepwise):
-    """The settings :func:`discover` checks beyond their types."""
-    _criterion(criterion)
-    if not (isinstance(shortlist, int | np.integer) and shortlist >= 1):
-        raise InputError(
-            f"shortlist must be a positive integer (candidates simulated); got {shortlist!r}"
-        )
-    for name, v, low in (
-        ("stability", stability, 0),
-        ("n_boot", n_boot, 1),
-        ("max_simulations", max_simulations, 2),
-        ("stepwise", stepwise, 0),
-    ):
-        if not (isinstance(v, int | np.integer) and not isinstance(v, bool) and v >= low):
-            raise InputError(f"{name} must be an integer >= {low}; got {v!r}")
 
 
 @dataclass(frozen=True)
@@ -303,14 +282,6 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
         return _contact_models(scenario, measurement, s, progress)
     t0 = time.perf_counter()
     seed = s.seed
-    _check_settings(
-        criterion=s.criterion,
-        shortlist=s.shortlist,
-        stability=s.stability,
-        n_boot=s.n_boot,
-        max_simulations=s.max_simulations,
-        stepwise=s.stepwise,
-    )
     pairs = pair_records(scenario, measurement)
     parts, samples = _contact_samples(pairs, s.derivative, s.average_cycles)
     regressor = dict(

@@ -364,7 +364,7 @@ def _check_fit(fit, source):
     """Every ``[fit]`` option by the checks :func:`~discovery.vibroimpact.fit.discovery.discover`
     makes of its arguments (their types, ranges and names), so that a bad option stops the
     study up front instead of failing every run."""
-    from ..fit.discovery import DiscoverSettings, _check_settings
+    from ..fit.discovery import DiscoverSettings
     from ..fit.regression import SCORES
     from ..verify.criteria import criterion as _criterion
 
@@ -382,14 +382,6 @@ def _check_fit(fit, source):
         req = fit.get("require", [])
         if not (isinstance(req, list) and all(isinstance(r, str) and r for r in req)):
             raise InputError(f'require must be a list of term names such as ["z"]; got {req!r}')
-        _check_settings(
-            criterion=fit.get("criterion", "I2"),
-            shortlist=fit.get("shortlist", 1),
-            stability=0,
-            n_boot=fit.get("n_boot", 1),
-            max_simulations=fit.get("max_simulations", 2),
-            stepwise=fit.get("stepwise", 0),
-        )
         for k, hi in _FIT_BOUNDS.items():  # the command line's bounds (`vidi fit`)
             if k in fit and fit[k] > hi:
                 raise InputError(f"{k} must be at most {hi}; got {fit[k]}")
