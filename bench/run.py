@@ -25,6 +25,9 @@ Writes ``bench/results.json``.  Figures:
    wall time (and the 200x200 extrapolation), the duffing exponent per period against scipy.
 9. how parallel work scales (``bench/scaling_bench.py``): a 24-run study and ``explain`` on
    1, 2 and every core, with the study's parallel efficiency.
+10. old against new (``bench/paired_bench.py``): ``verify``, ``fit`` and ``explain`` run with
+    a checkout of the baseline commit and with this one, alternately, the median of the
+    pairs' ratios, beside the work each command counted (``summary.json``'s ``counts``).
 
 Each run is also saved for the documentation's tables (``make tables``): appended as a row to
 ``docs/_measured/bench-history.jsonl`` (``tests/bench_history.py``; ``python run.py kernel``
@@ -401,6 +404,7 @@ def main_kernel():
 def main():
     from discovery_bench import bench_discovery, bench_pipeline
     from explain_bench import bench_explain
+    from paired_bench import bench_paired, print_paired
     from scaling_bench import bench_scaling, print_scaling
     from sensitivity_bench import bench_sensitivities
     from ueda_bench import bench_ueda
@@ -420,6 +424,7 @@ def main():
         "explain": bench_explain(),
         "ueda": bench_ueda(),
         "scaling": bench_scaling(),
+        "paired": bench_paired(),
         "cores": os.cpu_count(),
         **provenance({"scenario": "paper"}),
     }
@@ -525,6 +530,7 @@ def main():
         f"exponent {u['lyapunov_duffing']['value']:.4f} +- {u['lyapunov_duffing']['stderr']:.4f}"
     )
     print_scaling(results["scaling"])
+    print_paired(results["paired"])
     print("wrote bench/results.json")
     save_history(results)
     prov = {k: results[k] for k in _PROVENANCE}

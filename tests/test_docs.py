@@ -137,3 +137,18 @@ def test_the_runnable_examples_run_as_printed(page, code, record_dir, monkeypatc
     monkeypatch.chdir(record_dir)
     exec(compile(code, page, "exec"), {"__name__": "__docs__"})
     assert capsys.readouterr().out.strip(), f"{page}: the example printed nothing"
+
+
+def test_every_public_name_has_one_api_page():
+    """Each name of ``discovery.__all__`` is documented on exactly one page of docs/api/
+    (``discovery.CRITERIA`` in prose: its definitions live with the criteria)."""
+    import discovery
+
+    where = {}
+    for page in sorted((ROOT / "docs" / "api").glob("*.md")):
+        for name in re.findall(r"^\.\. auto\w+:: (\w+)", page.read_text(), re.M):
+            where.setdefault(name, []).append(page.name)
+        if "`discovery.CRITERIA`" in page.read_text():
+            where.setdefault("CRITERIA", []).append(page.name)
+    assert {n: p for n, p in where.items() if len(p) > 1} == {}
+    assert sorted(where) == sorted(discovery.__all__)

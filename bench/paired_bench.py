@@ -1,0 +1,161 @@
+"""Old against new on the same machine in one run: whole commands, paired, with their counts.
+
+A shared machine's load comes and goes; a ratio of two timings taken minutes apart measures
+the load as much as the code.  Here every command runs with the baseline code (a checkout of
+:data:`BASELINE`, made once in ``bench/_work/baseline``) and with this checkout, one right
+after the other, in alternating order, ``pairs`` times; the figure is the median of the
+pairs' ratios (new / old).  Both sides run the same command line on the same inputs, made
+once by this checkout; each side runs the command once untimed first (its kernels compiled
+and cached).  Beside each ratio: the work the new code counted (``summary.json``'s
+``counts``: laws judged against a record, criterion sets, steady states, periods), numbers
+no machine changes.
+
+    python paired_bench.py                 # every command, 3 pairs
+    python paired_bench.py --quick         # verify and fit, 2 pairs
+"""
+
+import argparse
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+WORK = ROOT / "bench" / "_work"
+#: the code the ratios are measured against (issue 52's baseline)
+BASELINE = "44858e9"
+LAW = "2.06e8*z + 1.28e7*zd"
+#: name -> (the command's words after ``vidi``, in quick mode too)
+COMMANDS = {
+    "verify": (["verify", "--data", "R.csv", "--law", LAW], True),
+    "fit": (["fit", "--data", "R.csv", "--intervals", "0"], True),
+    "explain": (["explain", "--data", "R.csv", "--start", "linear"], False),
+}
+
+
+def baseline_tree():
+    """The baseline checkout (a git worktree, made once)."""
+    tree = WORK / "baseline"
+    if not (tree / "discovery").is_dir():
+        WORK.mkdir(parents=True, exist_ok=True)
+        subprocess.run(
+            ["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), BASELINE],
+            check=True,
+            capture_output=True,
+        )
+    return tree
+
+
+def _vidi(code_root, words, cwd):
+    """Run ``vidi WORDS`` with the package of ``code_root``; returns seconds."""
+    env = {**os.environ, "PYTHONPATH": str(code_root)}
+    t0 = time.perf_counter()
+    run = subprocess.run(
+        [sys.executable, "-c", "import sys; from discovery.cli import main; sys.exit(main())"]
+        + words
+        + ["--overwrite"],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    seconds = time.perf_counter() - t0
+    if run.returncode != 0:
+        raise RuntimeError(f"{code_root.name}: vidi {' '.join(words)}: {run.stderr[-800:]}")
+    return seconds
+
+
+def record(cwd):
+    """The bench record: the paper's machine from rest by the scipy path, 1 % noise (a
+    record in its transient, as the README's first record)."""
+    _vidi(
+        ROOT,
+        [
+            "simulate",
+            "--law",
+            LAW + "; unloading: 4e6*zd",
+            "--from-rest",
+            "--periods",
+            "30",
+            "--integrator",
+            "scipy",
+            "--noise",
+            "0.01",
+            "--position-noise",
+            "0.002",
+            "--out",
+            "R.csv",
+        ],  # fmt: skip
+        cwd,
+    )
+
+
+def paired(name, words, pairs, cwd, old):
+    """``{"ratio", "ratios", "new", "old", "counts"}`` of one command."""
+    out_new, out_old = ["--out", f"new_{name}"], ["--out", f"old_{name}"]
+    _vidi(ROOT, words + out_new, cwd)  # untimed: compiled and cached
+    _vidi(old, words + out_old, cwd)
+    new, base = [], []
+    for k in range(pairs):
+        order = [(ROOT, out_new, new), (old, out_old, base)]
+        for code, out, times in order if k % 2 == 0 else order[::-1]:
+            times.append(_vidi(code, words + out, cwd))
+    ratios = [n / o for n, o in zip(new, base, strict=True)]
+    summary = json.loads((cwd / f"new_{name}" / "summary.json").read_text())
+    return {
+        "ratio": statistics.median(ratios),
+        "ratios": ratios,
+        "new": new,
+        "old": base,
+        "counts": summary.get("counts"),
+    }
+
+
+def bench_paired(quick=False, pairs=None):
+    """Every command of :data:`COMMANDS` (the quick ones with ``quick``), old and new."""
+    old = baseline_tree()
+    pairs = pairs or (2 if quick else 3)
+    cwd = WORK / "paired"
+    shutil.rmtree(cwd, ignore_errors=True)
+    cwd.mkdir(parents=True)
+    record(cwd)
+    out = {"baseline": BASELINE, "pairs": pairs, "commands": {}}
+    for name, (words, in_quick) in COMMANDS.items():
+        if quick and not in_quick:
+            continue
+        out["commands"][name] = paired(name, words, pairs, cwd, old)
+        print_paired({"commands": {name: out["commands"][name]}}, head=False)
+    return out
+
+
+def print_paired(result, head=True):
+    if head:
+        print(f"old ({result['baseline']}) against new, paired ({result['pairs']} pairs):")
+    for name, r in result["commands"].items():
+        c = r.get("counts") or {}
+        counted = ", ".join(f"{k} {v}" for k, v in c.items())
+        each = ", ".join(f"{x:.2f}" for x in r["ratios"])
+        new, old = statistics.median(r["new"]), statistics.median(r["old"])
+        print(
+            f"  {name:8s} new/old {r['ratio']:.2f} (pairs {each}; new median {new:.1f} s, "
+            f"old {old:.1f} s)  counts: {counted}"
+        )
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="verify and fit only, 2 pairs")
+    ap.add_argument("--pairs", type=int, help="pairs per command (default 3; 2 with --quick)")
+    args = ap.parse_args(argv)
+    res = bench_paired(args.quick, args.pairs)
+    print_paired(res)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
