@@ -4,13 +4,18 @@ never switches the backend of a notebook or a GUI session that imported ``discov
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
-__all__ = ["subplots", "save", "colormap", "PRINT_WIDTH", "print_sizes"]
+__all__ = ["subplots", "save", "colormap", "PRINT_WIDTH", "MIN_TEXT_PT", "print_sizes"]
 
 _FIGURE_KEYS = ("figsize", "dpi", "layout")
 
-#: inches: the text width of a report page (letter paper, 2.2 cm margins) a figure is
-#: printed at; a figure drawn this wide is printed at its own size, its text as drawn
-PRINT_WIDTH = 6.7
+#: inches: the width a report figure is drawn at. The text width of a report page (letter
+#: paper, 2.2 cm margins) is 6.77 in; a figure is saved with 0.1 in of white round its
+#: artists, so one drawn this wide (nothing past its edges) is printed at its own size or
+#: larger, its text at least as large as drawn
+PRINT_WIDTH = 6.5
+
+#: points: the smallest text a figure may print (at the size the report places it)
+MIN_TEXT_PT = 7.0
 
 
 def print_sizes():

@@ -17,7 +17,7 @@ from .lawtex import (
     unit_tex,
     value_tex,
 )
-from .texenv import Tex, escape, interval, num
+from .texenv import Tex, escape, interval, num, nums, scientific
 
 
 def criterion_names(*mappings):
@@ -60,6 +60,9 @@ FIGURE_CAPTIONS = {
     "force converging to the measured one.",
     "landscape": "Criteria over the two coefficients; the noise floor and the consistent "
     "region are marked.",
+    "contact_models": "Each named contact model's criterion I2 (the fit's ranking criterion): "
+    "consistent with the record(s) (green), inconsistent (red), or failed (hatched: the fit "
+    "degenerated; the table names the parameter and why).",
     "discover": "Recovered equation: strobe points, coefficients with error bars and the "
     "verification by simulation.",
     "attractor": "Stroboscopic points and a trajectory of the attractor.",
@@ -86,8 +89,10 @@ FIGURE_CAPTIONS = {
 _DOMAIN = {"zeta_max": Tex(r"$\zeta_{\max}$"), "zd_max": Tex(r"$\dot\zeta_{+,\max}$")}
 
 
-# figures drawn a page tall at the text width (their text 7-8 pt when printed)
-_TALL = ("explain", "discover", "landscape", "identification")
+# the most of the text height a figure may take: every figure is drawn at the text width
+# and at most this tall (less the 0.1 in of white round it), so LaTeX prints it at its own
+# size or larger (its text 7-8 pt as drawn) and never shrinks it to fit
+FIGURE_HEIGHT = "0.75"
 
 
 def _model_tex(value, where):
@@ -181,12 +186,13 @@ def _criteria_table(criteria, floor, limits=None):
     rows = []
     for k in criterion_names(criteria):
         lim = (limits or {}).get(k)
+        value, fl, limit = nums(criteria[k], (floor or {}).get(k), lim)
         rows.append(
             [
                 criterion_tex(k),
-                num(criteria[k]),
-                num((floor or {}).get(k)),
-                num(lim) if lim is not None else Tex("--"),
+                value,
+                fl,
+                limit if lim is not None else Tex("--"),
                 criterion_definition(k),
             ]
         )
@@ -198,12 +204,13 @@ def _measured_rows(m, records=None):
         return []
     noise = m.get("noise")
     noise_f = noise.get("F") if isinstance(noise, dict) else noise
+    noise_tex, peak_tex = nums(noise_f, m.get("peak"))  # two forces: one form
     rows = [
         ["drive periods per cycle", m.get("n_periods", "--")],
         ["cycles averaged in the folded cycle", m.get("n_cycles", "--")],
         ["contacts per cycle", m.get("impacts", "--")],
-        ["force noise (sd)", Tex(num(noise_f) + r"\,N")],
-        ["peak force", Tex(num(m.get("peak")) + r"\,N")],
+        ["force noise (sd)", Tex(noise_tex + r"\,N")],
+        ["peak force", Tex(peak_tex + r"\,N")],
         ["contact time", Tex(num(m.get("contact_time")) + r"\,s")],
     ]
     if isinstance(noise, dict) and "dt" in noise:
@@ -222,8 +229,7 @@ def _figures(run_dir, order):
                 {
                     "file": p.name,
                     "caption": FIGURE_CAPTIONS.get(p.stem, FIGURE_CAPTIONS.get(base, p.stem)),
-                    # a figure drawn a page tall (explain's four panels) is printed so
-                    "height": Tex("0.75" if base in _TALL else "0.55"),
+                    "height": Tex(FIGURE_HEIGHT),
                 }
             )
     seen, out = set(), []
@@ -242,17 +248,22 @@ def _transient(verdict):
 
 
 def _coef_rows(coefs, errors=None, intervals=None, start=None, term=term_tex):
+    """Rows: term, coefficient, standard error, 95 % interval (and the start value): the
+    numbers of a row in one form (:func:`~reports.texenv.scientific`)."""
     rows = []
     for k, v in coefs.items():
         lo_hi = (intervals or {}).get(k)
+        err = (errors or {}).get(k)
+        first = (start or {}).get(k)
+        sci = scientific(v, err, first, *(lo_hi or ()))
         rows.append(
             [
                 term(k),
-                num(v, 4),
-                num((errors or {}).get(k), 2),
-                interval(*lo_hi) if lo_hi else Tex("--"),
+                num(v, 4, sci=sci),
+                num(err, 2, sci=sci),
+                interval(*lo_hi, sci=sci) if lo_hi else Tex("--"),
             ]
-            + ([num((start or {}).get(k), 3)] if start is not None else [])
+            + ([num(first, 3, sci=sci)] if start is not None else [])
         )
     return rows
 
@@ -267,17 +278,19 @@ def _machine_rows(machine):
     for name, p in (machine.get("parameters") or {}).items():
         if not isinstance(p, dict):
             continue
+        ranged = p.get("low") is not None and p.get("low") != p.get("high")
+        sci = scientific(p.get("sheet"), p.get("record"), *((p.get("low"), p.get("high")) * ranged))
         interval = (
-            Tex(f"[{num(p.get('low'))}, {num(p.get('high'))}]")
-            if p.get("low") is not None and p.get("low") != p.get("high")
+            Tex(f"[{num(p.get('low'), sci=sci)}, {num(p.get('high'), sci=sci)}]")
+            if ranged
             else Tex("")
         )
         used = "record" if p.get("determined") else ("sheet (held)" if p.get("held") else "sheet")
         rows.append(
             [
                 Tex(escape(name) + r" [" + unit_tex(p.get("unit", "")) + "]"),
-                num(p.get("sheet")),
-                Tex(num(p.get("record")) + " " + interval),
+                num(p.get("sheet"), sci=sci),
+                Tex(num(p.get("record"), sci=sci) + " " + interval),
                 used,
             ]
         )

@@ -443,6 +443,22 @@ def _settle_manifest(run_dir, names):
     atomic_write_text(d / MANIFEST, json.dumps(man, indent=2) + "\n")
 
 
+def _draw_report_figures(doc, d):
+    """Draw the figures a run's command did not (:func:`reports.contact_models.
+    drawn_by_report`) into the run directory, entered in its manifest first (a file of
+    those names vidi did not write is never replaced)."""
+    from .contact_models import drawn_by_report
+
+    drawn = drawn_by_report(doc)
+    names = [f"{stem}{ext}" for stem, _ in drawn for ext in (".png", ".pdf")]
+    if not names:
+        return
+    _check_ours(d, names)
+    _record_in_manifest(d, names)
+    for stem, draw in drawn:
+        draw(str(d / stem))
+
+
 def report(run_dir, *, snippet=None, compile=True, timeout=300, summary=None):
     """Write ``run_dir/report.tex`` from the run's results and compile ``report.pdf``.
 
@@ -474,9 +490,10 @@ def report(run_dir, *, snippet=None, compile=True, timeout=300, summary=None):
     from discovery.outputs import atomic_write_text
 
     doc = run_document(_load(run_dir) if summary is None else summary)
+    d = Path(run_dir)
+    _draw_report_figures(doc, d)
     skipped = []
     text = render(doc, run_dir, snippet, skipped=skipped)
-    d = Path(run_dir)
     name = "report.tex" if snippet is None else f"snippet-{snippet}.tex"
     names = [name] if snippet is not None or not compile else [name, "report.pdf", "report.log"]
     _check_ours(d, names)

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from discovery.wording import interval_digits
 
-__all__ = ["Tex", "escape", "num", "interval", "environment"]
+__all__ = ["Tex", "escape", "num", "nums", "scientific", "interval", "environment"]
 
 _SPECIAL = {
     "\\": r"\textbackslash{}",
@@ -64,8 +64,32 @@ def escape(value):
     )
 
 
-def num(value, digits=3, unit=None):
-    """A number as LaTeX math (``$2.06\\cdot 10^{8}$``); ``--`` when missing or not finite."""
+def _exponent(value):
+    """The decimal exponent of a finite non-zero number (``None`` for anything else)."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return None
+    if isinstance(value, bool) or not math.isfinite(v) or v == 0:
+        return None
+    return int(math.floor(math.log10(abs(v))))
+
+
+def scientific(*values):
+    """Whether numbers printed side by side (a table row: a value, its error and interval;
+    a criterion, its noise floor and limit) take the scientific form: all of them when any
+    one needs it (its exponent below -3, or 5 and above), so that ``46836`` is never
+    printed beside ``1.0\\cdot 10^{8}`` nor ``5.14\\cdot 10^{-4}`` beside ``0.00564``."""
+    exps = [e for e in map(_exponent, values) if e is not None]
+    return any(not -3 <= e < 5 for e in exps)
+
+
+def num(value, digits=3, unit=None, sci=None):
+    """A number as LaTeX math (``$2.06\\cdot 10^{8}$``); ``--`` when missing or not finite.
+
+    ``sci``: None chooses by the number alone (plain from 0.001 to 99999), True prints it
+    in the scientific form (a number between 1 and 10 without its ``10^0``), False plain;
+    :func:`scientific` decides it for numbers printed side by side."""
     if value is None or isinstance(value, bool):
         return Tex("--") if value is None else Tex(str(value).lower())
     try:
@@ -78,22 +102,30 @@ def num(value, digits=3, unit=None):
         body = "0"
     else:
         exp = int(math.floor(math.log10(abs(v))))
-        if -3 <= exp < 5:
+        plain = -3 <= exp < 5 if sci is None else not sci or exp == 0
+        if plain:
             body = f"{v:.{max(digits - 1 - exp, 0)}f}" if exp < digits else f"{v:.0f}"
         else:
             mant = f"{v / 10**exp:.{digits - 1}f}"
             if mant.startswith(("10.", "-10.")):  # rounding carried into the next decade
                 exp += 1
                 mant = f"{v / 10**exp:.{digits - 1}f}"
-            body = rf"{mant}\cdot 10^{{{exp}}}"
+            body = rf"{mant}\cdot 10^{{{exp}}}" if exp else mant
     return Tex(f"${body}$" + (rf"\,\mathrm{{{unit}}}" if unit else ""))
 
 
-def interval(lo, hi, digits=4):
-    """``[lo, hi]`` as LaTeX numbers (:func:`num`), with more than ``digits`` significant
-    digits where the bounds would otherwise print alike."""
+def nums(*values, digits=3):
+    """``values`` as :func:`num` prints them, in one form (:func:`scientific`)."""
+    sci = scientific(*values)
+    return [num(v, digits, sci=sci) for v in values]
+
+
+def interval(lo, hi, digits=4, sci=None):
+    """``[lo, hi]`` as LaTeX numbers (:func:`num`, both in one form), with more than
+    ``digits`` significant digits where the bounds would otherwise print alike."""
     d = interval_digits(lo, hi, digits)
-    return Tex(f"[{num(lo, d)}, {num(hi, d)}]")
+    sci = scientific(lo, hi) if sci is None else sci
+    return Tex(f"[{num(lo, d, sci=sci)}, {num(hi, d, sci=sci)}]")
 
 
 def _final(value):

@@ -9,7 +9,7 @@ import numpy as np
 from .._io import OutputDir
 from ..errors import InputError, IntegrationError
 from ..vibroimpact.model.scenario import load_scenario
-from ..vibroimpact.verify.criteria import CRITERIA
+from ..vibroimpact.verify.criteria import CRITERIA, MOTION_DEFINITIONS
 from . import _options
 from ._common import (
     add_record_options,
@@ -184,12 +184,14 @@ def run(args):
             f"  {count} simulation(s) failed, first at ({a0[at[0]]:.4g}, {a1[at[1]]:.4g}): {first}"
         )
     exact = land.reference["exact"]
-    for n in CRITERIA:
+    # the force's criteria, then the motion's (I5) when the record has positions
+    for n in [k for k in (*CRITERIA, *MOTION_DEFINITIONS) if k in minima]:
         m = minima[n]
         if m is None:
             print(f"  {n}: no point with a periodic steady state with contact")
             continue
-        beside = "" if exact else f" (noise floor {land.noise_floor[n]:.3g})"
+        fl = (land.noise_floor or {}).get(n)
+        beside = "" if exact or fl is None else f" (noise floor {fl:.3g})"
         print(f"  {n}: minimum {m['value']:.3g}{beside} at ({m['alpha1']:.4g}, {m['alpha2']:.4g})")
     if not exact:
         print(f"  noise floor under {land.floor_under}")

@@ -341,7 +341,7 @@ def _distance_panel(ax, ver):
     ax.set_xlabel("energy distance of strobe points\n(scaled by the record's sd)", fontsize=8)
     verdict = "consistent" if ver.consistent else "INCONSISTENT"
     ax.set_title(
-        f"(c) {verdict}\n(rule: median distance <= floor q95, and the same regime)", fontsize=9
+        f"(c) {verdict}\n(rule: median distance <= floor q95,\nand the same regime)", fontsize=8
     )
 
 

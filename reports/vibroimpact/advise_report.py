@@ -5,7 +5,7 @@ candidate's regime, and the map."""
 from __future__ import annotations
 
 from ..lawtex import law_inline, law_of
-from ..texenv import Tex, escape, num
+from ..texenv import Tex, escape, num, nums
 
 __all__ = ["advise_context", "CAPTION"]
 
@@ -25,10 +25,42 @@ def _f(v):
 
 
 def _pair_cell(q):
-    tag = " (regime)" if q.regime_change else ""
+    """A pair's separation; a pair separated outright (regime, physics) is marked, and
+    ranks as if its separation were infinite (the table's note says so)."""
+    tag = r" (regime$^\ast$)" if q.regime_change else ""
     if q.physics:
-        tag = " (physics)"
+        tag = r" (physics$^\ast$)"
     return Tex(f"{_f(q.separation)}{tag}")
+
+
+def _span(values, unit):
+    """Bounds ``low -- high`` with their unit (``--`` without)."""
+    if not values:
+        return Tex("--")
+    return Tex(" -- ".join(num(v) for v in values) + rf"\,{unit}")
+
+
+def _bounded(v, unit):
+    """A bound with its unit; ``none`` where the run set none."""
+    return "none" if v is None else Tex(_f(v) + rf"\,{unit}")
+
+
+def _judged_rows(adv):
+    """At the advised point, each pair in each direction: the criteria of the law judged
+    false against their limits (a criterion and its limit in one form), and their ratio."""
+    rows = []
+    for q in adv.pairs if adv is not None else ():
+        i, j = q.pair
+        for (true, judged), crit, lims in zip(((i, j), (j, i)), q.criteria, q.limits, strict=False):
+            for k in sorted(crit):
+                value, lim = crit.get(k), lims.get(k)
+                v_tex, l_tex = nums(value, lim)
+                ratio = value / lim if value is not None and lim else None
+                rows.append(
+                    [f"{i + 1}-{j + 1}", true + 1, judged + 1, Tex(f"$I_{{{k[1:]}}}$"), v_tex,
+                     l_tex, _f(ratio)]
+                )  # fmt: skip
+    return rows
 
 
 def _ranked_rows(r, limit=12):
@@ -112,14 +144,11 @@ def advise_context(doc, run_dir, figures):
         "title": "Where to take the next record",
         "candidates": [[k + 1, law_inline(law_of(t, "laws"))] for k, t in enumerate(laws)],
         "bounds": [
-            ["drive amplitude", Tex(" -- ".join(num(v) for v in knobs.amplitude or ()))],
-            ["drive frequency", Tex(" -- ".join(num(v) for v in knobs.frequency or ()))],
-            [
-                "moulding mass",
-                "scenario's" if not knobs.m2 else Tex(" -- ".join(num(v) for v in knobs.m2)),
-            ],
-            ["max peak force", _f(safe.max_force)],
-            ["max penetration", _f(safe.max_penetration)],
+            ["drive amplitude", _span(knobs.amplitude, "N")],
+            ["drive frequency", _span(knobs.frequency, "Hz")],
+            ["moulding mass", "scenario's" if not knobs.m2 else _span(knobs.m2, "kg")],
+            ["max peak force", _bounded(safe.max_force, "N")],
+            ["max penetration", _bounded(safe.max_penetration, "m")],
             ["force noise", Tex(num(100 * (noise.relative or 0.0)) + r"\,\% of the peak")],
             [
                 "position noise",
@@ -133,6 +162,7 @@ def advise_context(doc, run_dir, figures):
         ],
         "pair_heads": [f"{i + 1}-{j + 1}" for i, j in pairs],
         "ranked": _ranked_rows(r),
+        "judged": _judged_rows(adv),
         "n_points": len(r.points or ()),
         "conclusions": _conclusions(r),
         "figures": [dict(f, caption=CAPTION) for f in figures(run_dir, ["advise_map"])],

@@ -61,12 +61,11 @@ def calibration_figure(result, stem):
                 label="implied, calibrated machine",
             )
             ax.set_ylabel("window mean force [kN]")
-            ax.set_title(label, fontsize="small")
+            ax.set_title(label)
         fig.legend(
             *axes[0].get_legend_handles_labels(),
             loc="outside upper center",
             ncols=3,
-            fontsize="x-small",
         )
         axes[1].set_xlabel("t [s]")
         return save(fig, stem)

@@ -5,6 +5,7 @@ written from the numbers."""
 from __future__ import annotations
 
 import math
+import re
 
 from discovery.wording import records as the_records
 from discovery.wording import verb
@@ -27,7 +28,7 @@ from ..lawtex import (
     term_tex,
     verdict_tex,
 )
-from ..texenv import Tex, escape, num
+from ..texenv import Tex, escape, num, scientific
 
 
 # ----------------------------------------------------------------------------- kinds
@@ -189,12 +190,44 @@ def _record_checks(sel, records):
     return out
 
 
-def _certificate(cert):
-    """The certificate's cells (``--`` and "fails" without one)."""
+def _condition_tex(name, margin=0.0):
+    """A certified condition's name and its requirement as math (the quantity the
+    certificate bounds below, in the report's symbols); an unknown one's name as text."""
+    p, p0, zd = r"P(\zeta,\dot\zeta_{+})", r"P(\zeta,0)", r"\dot\zeta_{+}"
+    rhs = "0" if not margin else rf"m\,{zd}"
+    known = {
+        "non_adhesion": ("non-adhesion", rf"${p} \ge 0$"),
+        "dissipativity": ("dissipativity", rf"${p} - {p0} \ge {rhs}$"),
+        "monotone_elastic": ("monotone elastic part", r"$\zeta\,\partial_\zeta P(\zeta,0) \ge 0$"),
+    }
+    label, req = known.get(name, (str(name).replace("_", " "), None))
+    if req is not None and margin and name == "dissipativity":
+        req += r", $m = " + num(margin).strip("$") + r"\,\mathrm{N\,s/m}$"
+    return label, Tex(req) if req is not None else Tex("--")
+
+
+def _method_text(method):
+    """The certificate's method in words (``bernstein(elevation=2)+grid(1001x1001)``: a
+    Bernstein bound after degree elevation 2 and a 1001 x 1001 grid); as given otherwise."""
+    m = re.fullmatch(r"bernstein\(elevation=(\d+)\)\+grid\((\d+)x(\d+)\)", str(method))
+    if m is None:
+        return str(method)
+    return f"Bernstein bounds (degree elevation {m[1]}) and the minimum over a {m[2]} x {m[3]} grid"
+
+
+def _certificate(cert, margin=0.0):
+    """The certificate's cells (``--`` and "fails" without one): each condition's
+    requirement as math."""
     if cert is None:
         return {"method": "--", "holds": False, "worst": num(None), "domain": {}, "conditions": []}
+    rows = []
+    for k, v in cert.conditions.items():
+        label, req = _condition_tex(k, margin)
+        rows.append(
+            [label, req, "holds" if v.get("holds") else "FAILS", num(v.get("grid_min_rel"))]
+        )
     return {
-        "method": cert.method,
+        "method": _method_text(cert.method),
         "holds": bool(cert.holds),
         "worst": num(cert.worst_violation),
         "domain": {
@@ -202,16 +235,69 @@ def _certificate(cert):
             for k, v in cert.domain.items()
             if isinstance(v, int | float) and not math.isnan(v)
         },
-        "conditions": [
-            [
-                k.replace("_", " "),
-                v.get("quantity", ""),
-                "holds" if v.get("holds") else "FAILS",
-                num(v.get("grid_min_rel")),
-            ]
-            for k, v in cert.conditions.items()
-        ],
+        "conditions": rows,
     }
+
+
+_REFINED = re.compile(
+    r"refined by simulation from the (?P<origin>.+) \((?P<n>\d+) simulations, "
+    r"(?P<crit>I\d) (?P<value>[-+.\de]+)\)"
+)
+
+
+def _refinement_tex(sel, crit):
+    """The refinement's note with its criterion beside the check's: the search scores a law
+    with the force averaged over the sample that holds each contact onset (continuous in
+    the coefficients), the check by full simulation (the ranking's and the criteria table's
+    value) with point samples, so the two can differ for the same law; one value where
+    they print alike."""
+    note = sel.note or ""
+    m = _REFINED.fullmatch(note)
+    if m is None:
+        return prose(note) if note else Tex("--")
+    searched, checked = float(m["value"]), sel.criteria.get(crit)
+    name = criterion_tex(m["crit"])
+    head = prose(f"refined by simulation from the {m['origin']} ({m['n']} simulations")
+    if checked is None or num(searched) == num(checked):
+        return Tex(f"{head}; {name} = {num(searched)})")
+    return Tex(
+        f"{head}); {name} = {num(searched)} at the end of the search, which averages the "
+        "force over the sample holding each contact onset, and "
+        f"{num(checked)} in the check by full simulation (point samples: the value of the "
+        "ranking and of the criteria table)"
+    )
+
+
+def _regime_text(sel):
+    """What the check by full simulation found of the selected law's motion, true of every
+    record: its steady state, or, where the verdict says its trajectory from the measured
+    state had not settled over the record's span, that (and the regime it tends to)."""
+    evs = list(sel.evaluations or ())
+    if not evs:
+        return Tex("Steady state " + escape(sel.regime or "--") + ".")
+    regs = [escape((ev.regime or {}).get("simulated") or ev.status or "--") for ev in evs]
+    moving = [_transient(ev.verdict) for ev in evs]
+    every = f" against each of the {len(evs)} records" if len(evs) > 1 else ""
+    if not any(moving) and len(set(regs)) == 1:
+        return Tex(f"The law's steady state{every} is {regs[0]}.")
+    if all(moving) and len(set(regs)) == 1:
+        return Tex(
+            f"The law's trajectory from the measured state{every} had not settled by the "
+            f"record's end (it tends to {regs[0]}), so the record was compared with that "
+            "trajectory over its own span, block by block."
+        )
+    parts = []
+    for k, (reg, unsettled) in enumerate(zip(regs, moving, strict=True)):
+        who = f"record {k + 1}: " if len(evs) > 1 else ""
+        parts.append(
+            f"{who}the law's trajectory from the measured state had not settled by the "
+            f"record's end (it tends to {reg}), so the record was compared with that "
+            "trajectory over its own span, block by block"
+            if unsettled
+            else f"{who}the law's steady state is {reg}"
+        )
+    text = "; ".join(parts)
+    return Tex(text[0].upper() + text[1:] + ".")
 
 
 def _fit(doc, run_dir):
@@ -220,6 +306,8 @@ def _fit(doc, run_dir):
     crit = r.settings.get("criterion", "I2")
     iv = sel.intervals
     records = r.records
+    # the ranking's criterion column in one form
+    ranked_sci = scientific(*(m.criteria.get(crit) for m in r.ranking))
     c = {
         "title": "Discovery of a contact law",
         "model": _model_tex(sel.law, "selected.coefficients"),
@@ -230,8 +318,8 @@ def _fit(doc, run_dir):
         "criteria": _criteria_table(sel.criteria, sel.noise_floor, sel.limits),
         "record_checks": _record_checks(sel, records),
         "verdict": verdict_tex(sel.verdict or "--"),
-        "regime": sel.regime,
-        "refinement": sel.note,
+        "regime": _regime_text(sel),
+        "refinement": _refinement_tex(sel, crit),
         "library": r.settings.get("library", "--"),
         "selection": r.settings.get("selection", "--"),
         "scoring": r.settings.get("scoring", "--"),
@@ -242,14 +330,16 @@ def _fit(doc, run_dir):
             + [num(rec.noise.get("F")), rec.noise.get("n_cycles", "--")]
             for rec in records
         ],
-        "certificate": _certificate(r.certificate),
+        "certificate": _certificate(
+            r.certificate, (r.settings.get("estimator") or {}).get("margin") or 0.0
+        ),
         "ranking": [
             [
                 str(i + 1),
                 _terms_tex(m.law.names),
                 m.regime,
                 num(m.bic, 6),
-                num(m.criteria.get(crit)),
+                num(m.criteria.get(crit), sci=ranked_sci),
                 ("yes" if m.consistent else "no") + ("; no contact law" if m.defects else ""),
             ]
             for i, m in enumerate(r.ranking)

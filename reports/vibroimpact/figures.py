@@ -9,7 +9,7 @@ labels and views they share in :mod:`.figure_parts` (all importable from here).
 
 import numpy as np
 
-from .._mpl import PRINT_WIDTH, colormap, print_sizes, save, subplots
+from .._mpl import PRINT_WIDTH, colormap, figure, print_sizes, save
 from .explain_figures import explain_figure
 from .figure_parts import (
     coefficient_label,
@@ -41,7 +41,17 @@ __all__ = [
     "terms_math",
 ]
 
-_ORDER = ("I1", "I2", "I3", "I4", "I0")
+_ORDER = ("I1", "I2", "I3", "I4", "I5", "I0")
+
+
+def _landscape_criteria(land):
+    """The criteria the landscape computed, in the paper's order: I1..I4, the motion's I5
+    (a record with positions), I0."""
+    return [n for n in _ORDER if n in land.values and np.any(np.isfinite(land.values[n]))] or [
+        n for n in _ORDER if n in land.values
+    ]
+
+
 _save = save
 
 
@@ -66,11 +76,12 @@ def _landscape_marks(reg, ref_reg):
     return [m for m in marks if m[0].any()]
 
 
-def _landscape_contours(fig, ax, land, name):
-    """Filled contours of criterion ``name`` with its minimum starred."""
+def _landscape_contours(fig, ax, land, name, axes):
+    """Filled contours of criterion ``name`` over ``axes`` (the grid's, scaled) with its
+    minimum starred."""
     from matplotlib.ticker import MaxNLocator
 
-    a0, a1 = land.axes
+    a0, a1 = axes
     v = land.values[name]
     ok = np.isfinite(v)
     if not ok.any():
@@ -88,9 +99,24 @@ def _landscape_contours(fig, ax, land, name):
     cs = ax.contourf(a0, a1, v.T, levels=levels, cmap="viridis")
     if hi > lo:
         ax.contour(a0, a1, v.T, levels=levels[::2], colors="k", linewidths=0.4)
-    fig.colorbar(cs, ax=ax, label=f"{name} (dimensionless)")
+    # the colour bar inside the panel's own cell (a bar the layout placed took its own
+    # column's margin and stood apart from its panel)
+    fig.colorbar(cs, cax=ax.inset_axes([1.04, 0.0, 0.07, 1.0]))
     i, j = land.argmin(name)
     ax.plot(a0[i], a1[j], "w*", ms=10, mec="k")
+
+
+def _power_of_ten(values):
+    """The power of ten an axis of ``values`` is drawn in (its largest magnitude's)."""
+    big = float(np.max(np.abs(values))) if np.size(values) else 0.0
+    return int(np.floor(np.log10(big))) if big > 0 and np.isfinite(big) else 0
+
+
+def _scaled_label(name, power):
+    """``coefficient of z`` over ``[10^8 N m^-1]``: the coefficient's axis label with the
+    power of ten its values are drawn in."""
+    scale = rf"$10^{{{power}}}$ " if power else ""
+    return f"coefficient of {name}\n[{scale}{term_unit(name)}]"
 
 
 def _landscape_info_lines(land, ref_reg, *, exact, floor, cons, truth, inside):
@@ -102,13 +128,15 @@ def _landscape_info_lines(land, ref_reg, *, exact, floor, cons, truth, inside):
     src = info.get("source", "")
     src = "the scenario's law (exact)" if src in ("law", "") else src
     lines = [
-        "Criteria landscape",
+        "Criteria landscape (every criterion dimensionless)",
         f"{a0.size} x {a1.size} points, {land.seconds:.1f} s on {land.workers} processes",
         f"reference: {src}"[:70],
         f"reference regime: {ref_reg}",
     ]
     if not exact and floor:
-        lines.append("noise floor: " + ", ".join(f"{n} {floor[n]:.2g}" for n in _ORDER))
+        lines += textwrap.wrap(
+            "noise floor: " + ", ".join(f"{n} {floor[n]:.2g}" for n in _ORDER if n in floor), 72
+        )
     counts = land.regime_counts() if hasattr(land, "regime_counts") else {}
     if counts:
         lines.append("regimes: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
@@ -117,7 +145,7 @@ def _landscape_info_lines(land, ref_reg, *, exact, floor, cons, truth, inside):
     fails = getattr(land, "failures", (0, "", None))
     if fails[0]:
         lines.append(f"{fails[0]} simulation(s) failed, the first:")
-        lines += ["  " + w for w in textwrap.wrap(fails[1], 62)[:4]]
+        lines += ["  " + w for w in textwrap.wrap(fails[1], 70)[:4]]
     if truth is not None and not inside:
         lines.append("the reference law lies outside this range")
     return lines
@@ -136,14 +164,15 @@ def _landscape_legend(ax, inside, show_cons, marks):
             Line2D([], [], color="w", ls="--", lw=1.2, label="consistent region (boundary)")
         )
     handles += [Line2D([], [], label=label, **style) for _, style, label in marks]
-    leg = ax.legend(handles=handles, loc="lower left", fontsize=8, facecolor="0.85")
+    leg = ax.legend(handles=handles, loc="upper right", facecolor="0.85")
     leg.get_frame().set_edgecolor("0.5")
 
 
 def landscape_figure(land, stem, truth=None):
-    """Contours of I1..I4 and I0 (the paper's Figs. 4-5), with the points that have no
-    criteria or another regime marked, the consistent region outlined and the
-    reference's noise floor.
+    """Contours of I1..I4, I5 (when the landscape computed it) and I0 (the paper's Figs.
+    4-5), with the points that have no criteria or another regime marked, the consistent
+    region outlined and the reference's noise floor; three panels a row, the run's
+    information and the legend below them.
 
     Parameters
     ----------
@@ -155,58 +184,142 @@ def landscape_figure(land, stem, truth=None):
     """
     a0, a1 = land.axes
     reg = np.asarray(land.regime, dtype=str)
-    ref_reg = (getattr(land, "reference", None) or {}).get("regime", "P1")
-    exact = (getattr(land, "reference", None) or {}).get("exact", True)
+    ref = getattr(land, "reference", None) or {}
+    ref_reg, exact = ref.get("regime", "P1"), ref.get("exact", True)
     floor = getattr(land, "noise_floor", None)
     cons = getattr(land, "consistent", None)
     marks = _landscape_marks(reg, ref_reg)
     inside = truth is not None and a0[0] <= truth[0] <= a0[-1] and a1[0] <= truth[1] <= a1[-1]
     show_cons = cons is not None and cons.sum() >= 2  # one point: hidden by the star
+    names = _landscape_criteria(land)
+    lines = _landscape_info_lines(
+        land, ref_reg, exact=exact, floor=floor, cons=cons, truth=truth, inside=inside
+    )
+    rows = -(-len(names) // 3)
+    cells = [names[3 * r : 3 * r + 3] for r in range(rows)]
+    mosaic = [c + [f"empty{k}" for k in range(3 - len(c))] for c in cells]
+    mosaic.append(["info", "info", "legend"])
+    info_h = 0.12 * len(lines) + 0.2
+    # the coefficients drawn in powers of ten named in the labels (no offset text to
+    # collide with a label); a label where no panel is beside (y) or below (x)
+    p0, p1 = _power_of_ten(a0), _power_of_ten(a1)
+    s0, s1 = a0 / 10.0**p0, a1 / 10.0**p1
+    mark = None if not inside else (truth[0] / 10.0**p0, truth[1] / 10.0**p1)
     with print_sizes():  # drawn at the width it is printed: its text 7 to 8 pt
-        fig, axes = subplots(3, 2, figsize=(PRINT_WIDTH, 7.2))
-        for ax, name in zip(axes.flat, _ORDER, strict=False):
-            _landscape_contours(fig, ax, land, name)
+        fig = figure(figsize=(PRINT_WIDTH, 2.1 * rows + info_h), layout="constrained")
+        axd = fig.subplot_mosaic(mosaic, height_ratios=[2.1] * rows + [info_h])
+        for k, name in enumerate(names):
+            ax = axd[name]
+            _landscape_contours(fig, ax, land, name, (s0, s1))
             if show_cons:
                 ax.contour(
-                    a0,
-                    a1,
-                    cons.T.astype(float),
-                    levels=[0.5],
-                    colors="w",
-                    linestyles="--",
+                    s0, s1, cons.T.astype(float), levels=[0.5], colors="w", linestyles="--",
                     linewidths=1.2,
-                )
-            for mask, style, _ in marks:
-                ij = np.argwhere(mask)
-                ax.plot(a0[ij[:, 0]], a1[ij[:, 1]], **style)
-            if inside:
-                ax.plot(*truth, "o", mfc="none", mec="r", ms=10, mew=1.5)
-            ax.set_xlim(a0[0], a0[-1])
-            ax.set_ylim(a1[0], a1[-1])
-            ax.set_xlabel(coefficient_label(land.terms[0]))
-            ax.set_ylabel(coefficient_label(land.terms[1]))
-            ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
-            title = name if exact or not floor else f"{name} (noise floor {floor[name]:.3g})"
-            ax.set_title(title)
-        ax = axes.flat[5]
-        ax.axis("off")
-        lines = _landscape_info_lines(
-            land, ref_reg, exact=exact, floor=floor, cons=cons, truth=truth, inside=inside
-        )
-        ax.text(0.0, 1.0, "\n".join(lines), va="top", fontsize=7, transform=ax.transAxes)
-        _landscape_legend(ax, inside, show_cons, marks)
-        fig.tight_layout()
+                )  # fmt: skip
+            for where, style, _ in marks:
+                ij = np.argwhere(where)
+                ax.plot(s0[ij[:, 0]], s1[ij[:, 1]], **style)
+            if mark is not None:
+                ax.plot(*mark, "o", mfc="none", mec="r", ms=10, mew=1.5)
+            ax.set_xlim(s0[0], s0[-1])
+            ax.set_ylim(s1[0], s1[-1])
+            if k + 3 >= len(names):
+                ax.set_xlabel(_scaled_label(land.terms[0], p0))
+            if k % 3 == 0:
+                ax.set_ylabel(_scaled_label(land.terms[1], p1))
+            known = not exact and floor and name in floor
+            ax.set_title(f"{name} (noise floor {floor[name]:.3g})" if known else name)
+        for key, ax in axd.items():
+            if key not in names:
+                ax.axis("off")
+        axd["info"].text(0.0, 1.0, "\n".join(lines), va="top", transform=axd["info"].transAxes)
+        _landscape_legend(axd["legend"], inside, show_cons, marks)
         return _save(fig, stem)
 
 
-def _mark_start(ax, start, names, path):
-    """The start law given (``ForceLaw`` or dict) on the path's axes, joined dotted to the
-    path's first point when the search began elsewhere (a cycle-by-cycle refit)."""
+def _started_elsewhere(start, names, path):
+    """Whether the search's path begins away from the ``start`` given (the search first
+    fitted it cycle by cycle); False without a start."""
+    if start is None:
+        return False
     given = start if isinstance(start, dict) else start.as_dict()
-    s0 = [float(given[n]) for n in names[:2]]
-    if not np.allclose(s0, path[0, :2]):
-        ax.plot([s0[0], path[0, 0]], [s0[1], path[0, 1]], ":", color="r", lw=1)
-    ax.plot(*s0, "s", mfc="none", mec="r", ms=9, mew=1.5, label="start (given)")
+    return not np.allclose([float(given[n]) for n in names[:2]], path[0, :2])
+
+
+def _path_panel(fig, ax, result, path, *, land=None, start=None):
+    """The path of the best law so far over the first two coefficients: the path the search
+    took, from its first law. A start the search replaced (its cycle-by-cycle fit began
+    elsewhere) is named in the title, not drawn: nothing joins it to a path not taken."""
+    names = list(result.law.names)
+    crit = result.criterion
+    if land is not None and crit in land.values:
+        a0, a1 = land.axes
+        cs = ax.contourf(a0, a1, land.values[crit].T, levels=20, cmap="viridis")
+        fig.colorbar(cs, ax=ax, label=f"{crit} (dimensionless)")
+    ax.plot(
+        path[:, 0],
+        path[:, 1],
+        "o-",
+        color="w" if land is not None else "C0",
+        mec="k",
+        ms=3.5,
+        lw=1,
+        label="best law so far",
+    )
+    elsewhere = _started_elsewhere(start, names, path)
+    if start is not None and not elsewhere:
+        ax.plot(*path[0, :2], "s", mfc="none", mec="r", ms=9, mew=1.5, label="start (given)")
+    final = result.law.as_dict()
+    ax.plot(final[names[0]], final[names[1]], "r*", ms=13, mec="k", label="identified")
+    ax.set_xlabel(coefficient_label(names[0]))
+    ax.set_ylabel(coefficient_label(names[1]))
+    ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True, useOffset=True)
+    lines = [f"{result.method}: path of the best law so far"]
+    if len(names) > 2:
+        lines.append(f"(first two of {len(names)} terms)")
+    if elsewhere:
+        lines.append("from the cycle-by-cycle fit of the given start")
+    ax.set_title("\n".join(lines))
+    ax.legend(loc="best", framealpha=0.8)
+
+
+def _history_panel(ax, result, value):
+    """The best criterion so far against the simulations spent: a log axis over a decade or
+    more, else a linear one whose labels carry an offset (a search that barely moves has
+    tick labels that differ only past their sixth digit)."""
+    from matplotlib.ticker import ScalarFormatter
+
+    crit = result.criterion
+    its = list(result.iterations)
+    if its:
+        sims = np.array([it["n_simulations"] for it in its], dtype=float)
+        vals = np.array([it["value"] for it in its], dtype=float)
+        xs = np.append(sims, max(result.n_simulations, sims[-1]))
+        ax.step(
+            xs, np.append(vals, vals[-1]), where="post", color="C0", lw=1.2,
+            label=f"best {crit} so far",
+        )  # fmt: skip
+        ax.plot(sims, vals, "o", color="C0", ms=3.5, label="new best (a step or a probe)")
+        if np.all(vals > 0) and vals.max() >= 10 * vals.min():
+            ax.set_yscale("log")
+        else:
+            fmt = ScalarFormatter(useMathText=True, useOffset=True)
+            fmt.set_powerlimits((-3, 4))
+            ax.yaxis.set_major_formatter(fmt)
+        ax.legend(loc="best", framealpha=0.8)
+    ax.set_xlabel("simulations spent (steady states computed)")
+    ax.set_ylabel(f"best {crit} so far (dimensionless)")
+    # the search's value and the final check's (what the report's criteria table shows)
+    # differ by the check's own evaluation: both are named where they do
+    done = [ev.criteria[crit] for ev in result.checks if crit in (ev.criteria or {})]
+    checked = float(np.mean(done)) if done else value
+    n = f"{result.n_simulations} simulations in all"
+    ax.set_title(
+        f"identified: {crit} = {value:.3g} in the search,\n{checked:.3g} in the final check; {n}"
+        if done
+        else f"identified: {crit} = {value:.3g}\n{n}"
+    )
+    return checked
 
 
 def identification_figure(result, measured, impulses, stem, *, land=None, start=None):
@@ -231,9 +344,10 @@ def identification_figure(result, measured, impulses, stem, *, land=None, start=
     land : Landscape, optional
         Background contours of the identified criterion (two-term laws).
     start : ForceLaw or dict, optional
-        The start law the search was given (the values the report lists): marked as the
-        start.  The first best-so-far law is not it when the search first fitted the start
-        cycle by cycle; without ``start`` no start is marked.
+        The start law the search was given (the values the report lists): marked where
+        the path begins when the search began from it. When the search first fitted it
+        cycle by cycle (the path begins elsewhere), the title says so and the start is not
+        drawn: only the path searched is.
     """
     names = list(result.law.names)
     its = list(result.iterations)
@@ -241,78 +355,24 @@ def identification_figure(result, measured, impulses, stem, *, land=None, start=
     two = len(names) >= 2 and path.size > 0
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(PRINT_WIDTH, 6.6 if two else 3.4), layout="constrained")
-    if two:  # the path and the history side by side, the forces below at full width
-        axd = fig.subplot_mosaic([["a", "b"], ["c", "c"]])
-        axes = [axd["a"], axd["b"], axd["c"]]
-    else:
-        axes = list(fig.subplots(1, 2))
-    crit = result.criterion
-    # the identified law's value (result.value can belong to a standard-error probe)
-    value = result.criteria.get(crit, result.value)
-    if two:
-        ax = axes[0]
-        if land is not None and crit in land.values:
-            a0, a1 = land.axes
-            cs = ax.contourf(a0, a1, land.values[crit].T, levels=20, cmap="viridis")
-            fig.colorbar(cs, ax=ax, label=f"{crit} (dimensionless)")
-        ax.plot(
-            path[:, 0],
-            path[:, 1],
-            "o-",
-            color="w" if land is not None else "C0",
-            mec="k",
-            ms=3.5,
-            lw=1,
-            label="best law so far",
-        )
-        if start is not None:
-            _mark_start(ax, start, names, path)
-        final = result.law.as_dict()
-        ax.plot(final[names[0]], final[names[1]], "r*", ms=13, mec="k", label="identified")
-        ax.set_xlabel(coefficient_label(names[0]))
-        ax.set_ylabel(coefficient_label(names[1]))
-        ax.ticklabel_format(style="sci", scilimits=(-3, 4), useMathText=True)
-        more = f" (first two of {len(names)} terms)" if len(names) > 2 else ""
-        ax.set_title(f"{result.method}: path of the best law so far{more}", fontsize=8)
-        ax.legend(fontsize=7, loc="best")
-    ax = axes[1] if two else axes[0]
-    if its:
-        sims = np.array([it["n_simulations"] for it in its], dtype=float)
-        vals = np.array([it["value"] for it in its], dtype=float)
-        xs = np.append(sims, max(result.n_simulations, sims[-1]))
-        ax.step(
-            xs,
-            np.append(vals, vals[-1]),
-            where="post",
-            color="C0",
-            lw=1.2,
-            label=f"best {crit} so far",
-        )
-        ax.plot(
-            sims,
-            vals,
-            "o",
-            color="C0",
-            ms=3.5,
-            label="new best (an optimiser step or a finite-difference probe)",
-        )
-        if np.all(vals > 0):
-            ax.set_yscale("log")
-        # the best value only falls: the upper right is clear of the curve
-        ax.legend(fontsize=7, loc="upper right")
-    ax.set_xlabel("simulations spent (steady states computed)")
-    ax.set_ylabel(f"best {crit} so far (dimensionless)")
-    # the search's value and the final check's (what the report's criteria table shows)
-    # differ by the check's own evaluation: both are named where they do
-    done = [ev.criteria[crit] for ev in result.checks if crit in (ev.criteria or {})]
-    checked = float(np.mean(done)) if done else value
-    both = f" in the search, {checked:.3g} in the final check" if done else ""
-    ax.set_title(
-        f"identified: {crit} = {value:.3g}{both}\n{result.n_simulations} simulations in all",
-        fontsize=8,
-    )
-    ax1 = axes[-1]
+    with print_sizes():  # drawn at the width it is printed: its text 7 to 8 pt
+        fig = Figure(figsize=(PRINT_WIDTH, 6.4 if two else 3.4), layout="constrained")
+        if two:  # the path and the history side by side, the forces below at full width
+            axd = fig.subplot_mosaic([["a", "b"], ["c", "c"]])
+            axes = [axd["a"], axd["b"], axd["c"]]
+            _path_panel(fig, axes[0], result, path, land=land, start=start)
+        else:
+            axes = list(fig.subplots(1, 2))
+        crit = result.criterion
+        # the identified law's value (result.value can belong to a standard-error probe)
+        value = result.criteria.get(crit, result.value)
+        checked = _history_panel(axes[1] if two else axes[0], result, value)
+        _forces_panel(axes[-1], measured, impulses, f"{crit} = {checked:.3g}")
+        return _save(fig, stem)
+
+
+def _forces_panel(ax1, measured, impulses, checked):
+    """F_N of selected laws converging to the measured F_E."""
     ax1.plot(measured.t * 1e3, measured.F / 1e6, "k-", lw=2.5, label=r"$F_E$ (measured)")
     for k, (label, imp) in enumerate(impulses):
         if imp is not None:
@@ -328,8 +388,5 @@ def identification_figure(result, measured, impulses, stem, *, land=None, start=
     ax1.set_xlim(-0.05 * end * 1e3, min(measured.duration, 1.4 * end) * 1e3)
     ax1.set_xlabel("time since onset t - t* [ms]")
     ax1.set_ylabel("contact force [MN]")
-    ax1.set_title(
-        f"$F_N$ converging to $F_E$ ({crit} = {checked:.3g} in the final check)", fontsize=8
-    )
-    ax1.legend(fontsize=7)
-    return _save(fig, stem)
+    ax1.set_title(f"$F_N$ converging to $F_E$ ({checked} in the final check)")
+    ax1.legend(loc="best", framealpha=0.8)

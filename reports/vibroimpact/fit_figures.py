@@ -27,56 +27,64 @@ def fit_impulse_figure(result, impulses, stem, n_models=3):
     measured = [r.impulse if r is not None else result.measured for r in refs]
     models = [m for m in result.ranking if m.evaluations][:n_models]
     labels = [lab for lab, _ in impulses][: len(models)]
-    fig, axes = subplots(
-        len(measured), 1, figsize=(PRINT_WIDTH, 1.2 + 2.2 * len(measured)), squeeze=False
+    # one panel per record, two side by side; drawn no taller than the report prints a
+    # figure (0.55 of the text height), so its text is printed at the size it is drawn
+    n = len(measured)
+    ncols = 1 if n == 1 else 2
+    nrows = -(-n // ncols)
+    with print_sizes():
+        fig, axes = subplots(
+            nrows,
+            ncols,
+            figsize=(PRINT_WIDTH, min(4.8, 1.0 + 2.3 * nrows)),
+            squeeze=False,
+            layout="constrained",
+        )
+        sc, unit = force_unit(max(E.peak for E in measured))
+        for r, (E, ax) in enumerate(zip(measured, axes.flat, strict=False)):
+            _impulse_panel(ax, E, models, labels, r, sc=sc)
+            ax.set_ylabel(f"contact force [{unit}]")
+            name = getattr(refs[r], "source", None) or f"record {r + 1}"
+            ax.set_title(
+                f"record {r + 1}: {plain(name)}"
+                if n > 1
+                else "Measured and simulated contact force of the best models"
+            )
+            if r >= n - ncols:
+                ax.set_xlabel("time since the start of the contact [ms]")
+        for ax in list(axes.flat)[n:]:
+            ax.axis("off")
+        # the same models in every panel: one legend, in the first
+        axes.flat[0].legend(loc="best", framealpha=0.8)
+        return _save(fig, stem)
+
+
+def _impulse_panel(ax, E, models, labels, r, *, sc):
+    """Record ``r``'s measured impulse ``E`` and the models' simulated ones, re-based on its
+    contact."""
+    sims = [
+        (
+            labels[k] if k < len(labels) else ", ".join(m.law.names),
+            m.evaluations[r].simulated if r < len(m.evaluations) else None,
+        )
+        for k, m in enumerate(models)
+    ]
+    forces = [E.F] + [np.interp(E.t, imp.t, imp.F) for _, imp in sims if imp is not None]
+    tr, o, (lo, hi) = contact_view(
+        E.t, E.duration, *forces, threshold=max(0.02 * E.peak, 5.0 * E.noise)
     )
-    sc, unit = force_unit(max(E.peak for E in measured))
-    for r, (E, ax) in enumerate(zip(measured, axes[:, 0], strict=True)):
-        sims = [
-            (
-                labels[k] if k < len(labels) else ", ".join(m.law.names),
-                m.evaluations[r].simulated if r < len(m.evaluations) else None,
-            )
-            for k, m in enumerate(models)
-        ]
-        forces = [E.F] + [np.interp(E.t, imp.t, imp.F) for _, imp in sims if imp is not None]
-        tr, o, (lo, hi) = contact_view(
-            E.t, E.duration, *forces, threshold=max(0.02 * E.peak, 5.0 * E.noise)
-        )
+    ax.plot(
+        tr[o] * 1e3, E.F[o] * sc, "k-", lw=2.5, alpha=0.6, label=f"measured ({E.n_cycles} cycles)"
+    )
+    styles = ["-", "--", ":"]
+    for k, (label, imp) in enumerate(sims):
+        if imp is None:
+            continue
+        f = np.interp(E.t, imp.t, imp.F)
         ax.plot(
-            tr[o] * 1e3,
-            E.F[o] * sc,
-            "k-",
-            lw=2.5,
-            alpha=0.6,
-            label=f"measured ({E.n_cycles} cycles)",
+            tr[o] * 1e3, f[o] * sc, styles[k % 3], lw=1.4, color=f"C{k}", label=terms_math(label)
         )
-        styles = ["-", "--", ":"]
-        for k, (label, imp) in enumerate(sims):
-            if imp is None:
-                continue
-            f = np.interp(E.t, imp.t, imp.F)
-            ax.plot(
-                tr[o] * 1e3,
-                f[o] * sc,
-                styles[k % 3],
-                lw=1.4,
-                color=f"C{k}",
-                label=terms_math(label),
-            )
-        ax.set_xlim(lo * 1e3, hi * 1e3)
-        ax.set_ylabel(f"contact force [{unit}]")
-        name = getattr(refs[r], "source", None) or f"record {r + 1}"
-        ax.set_title(
-            f"record {r + 1}: {plain(name)}"
-            if len(measured) > 1
-            else "Measured and simulated contact force of the best models",
-            fontsize=8,
-        )
-        ax.legend(fontsize=7, loc="best", framealpha=0.8)
-    axes[-1, 0].set_xlabel("time since the start of the contact [ms]")
-    fig.tight_layout()
-    return _save(fig, stem)
+    ax.set_xlim(lo * 1e3, hi * 1e3)
 
 
 def fit_surface_figure(result, stem):

@@ -20,7 +20,7 @@ import numpy as np
 
 from discovery.vibroimpact.studies.aggregate import wilson
 
-from .._mpl import save
+from .._mpl import PRINT_WIDTH, print_sizes, save
 from .figures import terms_math
 
 __all__ = ["study_figures"]
@@ -33,6 +33,18 @@ def _figure(**kw):
     from matplotlib.figure import Figure
 
     return Figure(**kw)
+
+
+def _panels(n, row_height, extra, **kw):
+    """``(figure, its n axes)``: the panels three to a row, drawn at the width a report
+    prints them and no taller than it prints a figure (their text printed as drawn)."""
+    ncols = max(1, min(3, n))
+    nrows = -(-max(n, 1) // ncols)
+    fig = _figure(figsize=(PRINT_WIDTH, min(6.6, extra + row_height * nrows)), layout="constrained")
+    axes = list(fig.subplots(nrows, ncols, squeeze=False, **kw).flat)
+    for ax in axes[n:]:
+        ax.axis("off")
+    return fig, axes[:n]
 
 
 def _levels(runs, cells, name):
@@ -62,8 +74,7 @@ def recovery_noise_figure(runs, cells, stem):
     methods = _levels(runs, cells, "selection")
     noises = _levels(runs, cells, "force_noise")
     lengths = _levels(runs, cells, "periods")
-    fig = _figure(figsize=(4.2 * len(lengths) + 1.2, 3.6), layout="constrained")
-    axes = fig.subplots(1, len(lengths), squeeze=False, sharey=True)[0]
+    fig, axes = _panels(len(lengths), 2.5, 1.1, sharey=True)
     x = np.arange(len(noises))
     for ax, n_per in zip(axes, lengths, strict=True):
         for j, m in enumerate(methods):
@@ -76,12 +87,12 @@ def recovery_noise_figure(runs, cells, stem):
             ax.errorbar(x + dx, p, yerr=_yerr(p, lo, hi), marker="o", ms=4, capsize=2, label=m)
         ax.set_xticks(x, [_pct(s) for s in noises])
         ax.set_xlabel("force noise (of the peak force)")
-        ax.set_title(f"{n_per} periods recorded", fontsize=10)
+        ax.set_title(f"{n_per} periods recorded")
         ax.set_ylim(-0.05, 1.05)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("exact support recovered")
-    axes[-1].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
-    fig.suptitle("Recovery of the true support (Wilson 95 % intervals)", fontsize=11)
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside lower center", ncols=len(methods))
+    fig.suptitle("Recovery of the true support (Wilson 95 % intervals)")
     return _save(fig, stem)
 
 
@@ -89,8 +100,7 @@ def recovery_map_figure(runs, cells, stem):
     methods = _levels(runs, cells, "selection")
     noises = _levels(runs, cells, "force_noise")
     lengths = _levels(runs, cells, "periods")
-    fig = _figure(figsize=(2.9 * len(methods) + 0.8, 3.0))
-    axes = fig.subplots(1, len(methods), squeeze=False)[0]
+    fig, axes = _panels(len(methods), 2.4, 0.5)
     im = None
     for ax, m in zip(axes, methods, strict=True):
         grid = np.full((len(lengths), len(noises)), np.nan)
@@ -105,14 +115,13 @@ def recovery_map_figure(runs, cells, stem):
                         f"{sum(bool(r['exact']) for r in rs)}/{len(rs)}",
                         ha="center",
                         va="center",
-                        fontsize=8,
                         color="white" if grid[i, j] < 0.5 else "black",
                     )
         im = ax.imshow(grid, origin="lower", vmin=0, vmax=1, cmap="viridis", aspect="auto")
-        ax.set_xticks(range(len(noises)), [_pct(s) for s in noises], fontsize=8)
-        ax.set_yticks(range(len(lengths)), [str(n) for n in lengths], fontsize=8)
+        ax.set_xticks(range(len(noises)), [_pct(s) for s in noises])
+        ax.set_yticks(range(len(lengths)), [str(n) for n in lengths])
         ax.set_xlabel("force noise")
-        ax.set_title(m, fontsize=10)
+        ax.set_title(m)
     axes[0].set_ylabel("periods recorded")
     fig.colorbar(im, ax=list(axes), shrink=0.85, label="recovery")
     return _save(fig, stem)
@@ -121,7 +130,7 @@ def recovery_map_figure(runs, cells, stem):
 def coverage_figure(runs, cells, stem):
     methods = _levels(runs, cells, "selection")
     noises = _levels(runs, cells, "force_noise")
-    fig = _figure(figsize=(6.7, 3.6), layout="constrained")
+    fig = _figure(figsize=(PRINT_WIDTH, 3.6), layout="constrained")
     ax = fig.subplots()
     width = 0.8 / max(len(noises), 1)
     for j, s in enumerate(noises):
@@ -143,7 +152,7 @@ def coverage_figure(runs, cells, stem):
         ax.bar(xs, p, width * 0.9, yerr=_yerr(p, lo, hi), capsize=2, label=f"noise {_pct(s)}")
         for xx, n in zip(xs, lab, strict=True):
             if n:
-                ax.text(xx, 0.02, str(n), ha="center", va="bottom", fontsize=6, rotation=90)
+                ax.text(xx, 0.02, str(n), ha="center", va="bottom", fontsize=7, rotation=90)
     if not any((r.get("coverage") or {}) for r in runs):
         ax.text(
             0.5,
@@ -153,18 +162,15 @@ def coverage_figure(runs, cells, stem):
             ha="center",
             va="center",
             transform=ax.transAxes,
-            fontsize=9,
         )
     ax.set_xlim(-0.6, len(methods) - 0.4)
     ax.axhline(0.95, color="k", ls="--", lw=1, label="nominal 95 %")
-    ax.set_xticks(range(len(methods)), methods, fontsize=8)
+    ax.set_xticks(range(len(methods)), methods)
     ax.set_ylim(0, 1.05)
     ax.set_ylabel("true coefficient inside its 95 % interval")
-    ax.set_title(
-        "Coverage of the coefficient intervals (exact supports; n at the foot)", fontsize=10
-    )
+    ax.set_title("Coverage of the coefficient intervals (exact supports; n at the foot)")
     # beside the axes, not over the bars
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     return _save(fig, stem)
 
 
@@ -173,8 +179,7 @@ def inclusion_figure(runs, cells, stem, truth_terms):
     noises = _levels(runs, cells, "force_noise")
     ok = [r for r in runs if r["status"] == "ok"]
     terms = sorted({t for r in ok for t in r["selected"]} | set(truth_terms))
-    fig = _figure(figsize=(2.6 * len(methods) + 0.8, 0.45 * len(terms) + 1.6))
-    axes = fig.subplots(1, len(methods), squeeze=False, sharey=True)[0]
+    fig, axes = _panels(len(methods), 0.3 * len(terms) + 1.0, 0.4, sharey=True)
     im = None
     for ax, m in zip(axes, methods, strict=True):
         grid = np.full((len(terms), len(noises)), np.nan)
@@ -184,14 +189,13 @@ def inclusion_figure(runs, cells, stem, truth_terms):
                 if rs:
                     grid[i, j] = np.mean([t in r["selected"] for r in rs])
         im = ax.imshow(grid, origin="upper", vmin=0, vmax=1, cmap="Blues", aspect="auto")
-        ax.set_xticks(range(len(noises)), [_pct(s) for s in noises], fontsize=8)
+        ax.set_xticks(range(len(noises)), [_pct(s) for s in noises])
         ax.set_yticks(
             range(len(terms)),
             [terms_math(t) + (" (true)" if t in truth_terms else "") for t in terms],
-            fontsize=8,
         )
         ax.set_xlabel("force noise")
-        ax.set_title(m, fontsize=10)
+        ax.set_title(m)
     fig.colorbar(im, ax=list(axes), shrink=0.85, label="selected in this share of runs")
     return _save(fig, stem)
 
@@ -205,9 +209,10 @@ def study_figures(config, runs, out):
 
         truth |= set(ForceLaw.parse(r["law"]).names)
     paths = []
-    paths += recovery_noise_figure(runs, cells, str(out / "recovery_noise"))
-    paths += recovery_map_figure(runs, cells, str(out / "recovery_map"))
-    if any((r.get("coverage") or {}) for r in runs):  # no intervals: no empty chart
-        paths += coverage_figure(runs, cells, str(out / "coverage"))
-    paths += inclusion_figure(runs, cells, str(out / "inclusion"), truth)
+    with print_sizes():  # drawn at the width they are printed: their text 7 to 8 pt
+        paths += recovery_noise_figure(runs, cells, str(out / "recovery_noise"))
+        paths += recovery_map_figure(runs, cells, str(out / "recovery_map"))
+        if any((r.get("coverage") or {}) for r in runs):  # no intervals: no empty chart
+            paths += coverage_figure(runs, cells, str(out / "coverage"))
+        paths += inclusion_figure(runs, cells, str(out / "inclusion"), truth)
     return paths

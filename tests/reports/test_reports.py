@@ -122,79 +122,6 @@ def test_tex_cannot_read_outside_or_run_commands(tmp_path):
         assert "no PDF: LaTeX failed" in why
 
 
-@pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    """One small run of every kind, on a record whose name tries TeX injection."""
-    d = tmp_path_factory.mktemp("runs")
-    cwd = os.getcwd()
-    os.chdir(d)
-    try:
-        rec = "r_\\input{etc-passwd}_$x$.csv"
-        assert (
-            main(["simulate", "--periods", "12", "--noise", "0.01", "--seed", "2", "--out", rec])
-            == 0
-        )
-        scen = d / "evil.toml"
-        scen.write_text(
-            'name = "\\\\write18{touch pwned} & 100% #1"\n[machine]\nm1 = 1.0e4\n'
-            "m2 = 1.0e4\nk1 = 2.75e7\nc1 = 1.0e5\nA = 5.0e5\nfrequency = 25.0\n"
-            '[law]\ntext = "2.06e8*z + 1.28e7*zd"\n'
-        )
-        law = "2.06e8*z + 1.28e7*zd"
-        cmds = {
-            "verify": ["verify", "--scenario", str(scen), "--data", rec, "--law", law],
-            "fit": ["fit", "--data", rec, "--no-refine", "--intervals", "0"],
-            "identify": [
-                "identify",
-                "--data",
-                rec,
-                "--start",
-                "1.8e8*z + 1.1e7*zd",
-                "--max-simulations",
-                "40",
-            ],
-            "landscape": ["landscape", "--grid", "3x3", "--workers", "1"],
-        }
-        for kind, argv in cmds.items():
-            assert main([*argv, "--out", kind]) == 0, kind
-        # a fit over two scenarios (two drive amplitudes), each with its record
-        low = d / "low.toml"
-        low.write_text(scen.read_text().replace("A = 5.0e5", "A = 3.5e5").replace("100% #1", "low"))
-        assert (
-            main(
-                ["simulate", "--scenario", str(low), "--periods", "12", "--noise", "0.01"]
-                + ["--seed", "3", "--out", "low.csv"]
-            )
-            == 0
-        )
-        fit2 = ["fit", "--scenario", str(scen), "--scenario", str(low), "--data", rec]
-        fit2 += ["--data", "low.csv", "--no-refine", "--intervals", "0", "--out", "fit2"]
-        assert main(fit2) == 0
-        assert main(["ueda", "simulate", "--periods", "120", "--out", "U.csv"]) == 0
-        assert (
-            main(
-                [
-                    "ueda",
-                    "discover",
-                    "--data",
-                    "U.csv",
-                    "--model",
-                    "negres",
-                    "--model-periods",
-                    "400",
-                    "--resamples",
-                    "40",
-                    "--out",
-                    "ueda",
-                ]
-            )
-            == 0
-        )
-    finally:
-        os.chdir(cwd)
-    return d
-
-
 @pytest.mark.parametrize(
     "kind, needles",
     [
@@ -695,7 +622,8 @@ def test_an_explain_report_lists_the_effects_own_parameters():
     rows = _effect_parameter_rows(fm, errors, bounds, [e.as_dict() for e in EFFECTS])
     assert len(rows) == 1
     assert "delta0" in str(rows[0][0]) and "[m]" in str(rows[0][0])
-    assert "0.001499" in str(rows[0][3])
+    # the row's numbers in one form: its error 3e-7 is printed 3.0x10^-7, so the rest too
+    assert r"1.499\cdot 10^{-3}" in str(rows[0][3]) and r"3.0\cdot 10^{-7}" in str(rows[0][2])
     # an edited summary without a catalogue
     assert _effect_parameter_rows(fm, errors, bounds, None) == []
 
@@ -893,7 +821,7 @@ def test_identify_figure_names_the_search_value_and_the_final_check_s():
     finally:
         figures._save = figures.save
     titles = " | ".join(ax.get_title() for ax in drawn[0].axes)
-    assert "0.183 in the search, 0.189 in the final check" in titles
+    assert "0.183 in the search,\n0.189 in the final check" in titles
     assert "F_N converging" not in titles and "0.189 in the final check)" in titles
 
 
@@ -979,9 +907,11 @@ def test_a_law_in_the_settings_and_the_study_design_is_typeset_whole():
     assert str(value_tex([1, 2, 3])) == "1, 2, 3"
 
 
-def test_identify_figure_marks_the_start_at_the_given_values():
-    """The start marker sits at the start values the report lists (1.5e8, 0.9e7), not on
-    the first best-so-far law (the search may first fit the start cycle by cycle)."""
+def test_identify_figure_marks_the_start_only_where_the_search_began():
+    """The start marker sat at the start values the report lists (1.5e8, 0.9e7), joined to
+    a path that began at its cycle-by-cycle fit (4e7, 5.1e6): a path never taken. The start
+    is marked only where the search began from it; otherwise the title says where it
+    began (the path, drawn from its first law, is the one searched)."""
     import numpy as np
 
     from reports.vibroimpact import figures
@@ -1006,12 +936,17 @@ def test_identify_figure_marks_the_start_at_the_given_values():
     figures._save = lambda fig, stem: drawn.append(fig)
     try:
         figures.identification_figure(result, imp, [], "x", start={"z": 1.5e8, "zd": 0.9e7})
+        figures.identification_figure(result, imp, [], "x", start={"z": 4e7, "zd": 5.1e6})
         figures.identification_figure(result, imp, [], "x")
     finally:
         figures._save = figures.save
-    (mark,) = [ln for ln in drawn[0].axes[0].lines if ln.get_label().startswith("start")]
-    assert (mark.get_xdata()[0], mark.get_ydata()[0]) == (1.5e8, 0.9e7)
-    assert not [ln for ln in drawn[1].axes[0].lines if ln.get_label().startswith("start")]
+    away = drawn[0].axes[0]
+    assert not [ln for ln in away.lines if ln.get_label().startswith("start")]
+    assert max(max(ln.get_xdata()) for ln in away.lines) < 1e8  # nothing drawn at 1.5e8
+    assert "from the cycle-by-cycle fit of the given start" in away.get_title()
+    (mark,) = [ln for ln in drawn[1].axes[0].lines if ln.get_label().startswith("start")]
+    assert (mark.get_xdata()[0], mark.get_ydata()[0]) == (4e7, 5.1e6)
+    assert not [ln for ln in drawn[2].axes[0].lines if ln.get_label().startswith("start")]
 
 
 @pytest.mark.parametrize("kind", ["verify", "identify"])
@@ -1086,3 +1021,126 @@ def test_the_verify_figure_shows_a_transient_record_sample_by_sample(tmp_path):
     assert np.mean(zm > -3e-5) > 0.97 and np.mean(zn > -3e-5) > 0.97  # force where zeta > 0
     png, _ = verify_figure(res, str(tmp_path / "verify"))
     assert Path(png).stat().st_size > 10_000
+
+
+def test_numbers_printed_side_by_side_share_one_form():
+    """A coefficient's row printed its standard error as 46836 beside 1.0x10^8, and the
+    criteria table an I5 floor as 5.14x10^-4 beside its limit 0.00564: a row's numbers are
+    in one form now (the scientific one when any needs it)."""
+    from reports.cells import _coef_rows, _criteria_table
+
+    ((_, value, err, iv),) = _coef_rows({"z^2": 1.0e8}, {"z^2": 46836.0}, {"z^2": (9.1e7, 1.1e8)})
+    assert value == r"$1.000\cdot 10^{8}$" and err == r"$4.7\cdot 10^{4}$", (value, err)
+    assert iv == r"[$9.100\cdot 10^{7}$, $1.100\cdot 10^{8}$]", iv
+    (row,) = _criteria_table({"I5": 8.76e-6}, {"I5": 5.14e-4}, {"I5": 0.00564})
+    assert row[1:4] == [r"$8.76\cdot 10^{-6}$", r"$5.14\cdot 10^{-4}$", r"$5.64\cdot 10^{-3}$"]
+    (row,) = _criteria_table({"I2": 0.0224}, {"I2": 0.0188}, {"I2": 0.0426})
+    assert row[1:4] == ["$0.0224$", "$0.0188$", "$0.0426$"]  # none needs it: all plain
+    assert num(3.2, sci=True) == "$3.20$" and num(6941, 2, sci=True) == r"$6.9\cdot 10^{3}$"
+
+
+def test_the_refinement_names_the_search_s_criterion_apart_from_the_check_s():
+    """The refinement line said I2 0.183 where the ranking said 0.189 for the same law: the
+    search scores a law with the onset sample averaged, the check with point samples. Both
+    are named for what they are; where they print alike, one value is."""
+    from reports.vibroimpact.context import _refinement_tex
+
+    note = (
+        "refined by simulation from the backward step from z + zd + z^2 (38 simulations, I2 0.183)"
+    )
+    text = str(_refinement_tex(_ns(note=note, criteria={"I2": 0.189}), "I2"))
+    assert "$I_{2}$ = $0.183$ at the end of the search" in text, text
+    assert "$0.189$ in the check by full simulation" in text and "ranking" in text
+    assert "z^2" not in text and r"$\zeta^{2}$" in text and "(38 simulations)" in text
+    same = str(_refinement_tex(_ns(note=note, criteria={"I2": 0.1831}), "I2"))
+    assert same.count("0.183") == 1 and "search" not in same, same
+    assert str(_refinement_tex(_ns(note="not refined", criteria={}), "I2")) == "not refined"
+
+
+def test_the_check_states_what_is_true_of_the_law_s_motion():
+    """ "Steady state P1, P1" was printed beside a verdict saying the law's trajectory had
+    not settled: a record whose verdict says so is said to be compared with the trajectory
+    over its span; a settled one's steady state is named once."""
+    from discovery.vibroimpact.verify.notes import JUDGED_OVER_SPAN
+    from reports.vibroimpact.context import _regime_text
+
+    unsettled = (
+        "consistent: I2 = 0.05 <= 0.07; the law's trajectory from the measured state has not "
+        f"settled by the record's end: over its last cycles it is I2 = 0.1 from the law's "
+        f"steady orbit; {JUDGED_OVER_SPAN}"
+    )
+
+    def ev(verdict):
+        return _ns(regime={"simulated": "P1", "measured": "P1"}, status="ok", verdict=verdict)
+
+    text = str(_regime_text(_ns(evaluations=[ev(unsettled), ev("consistent")], regime="P1, P1")))
+    assert "Steady state" not in text and "P1, P1" not in text, text
+    assert text.startswith("Record 1: the law's trajectory from the measured state had not")
+    assert "record 2: the law's steady state is P1." in text
+    both = str(_regime_text(_ns(evaluations=[ev("consistent")] * 2, regime="P1, P1")))
+    assert both == "The law's steady state against each of the 2 records is P1.", both
+    one = str(_regime_text(_ns(evaluations=[ev(unsettled)], regime="P1")))
+    assert "steady state is" not in one and "(it tends to P1)" in one
+    two = str(_regime_text(_ns(evaluations=[ev(unsettled)] * 2, regime="P1, P1")))
+    assert two.startswith("The law's trajectory from the measured state against each of the 2")
+    assert "steady state is" not in two and "P1, P1" not in two
+    templates = Path(__file__).parents[2] / "reports/templates"
+    for name in ("fit.tex.j2", "model.tex.j2"):
+        assert "Steady state ((( regime )))" not in (templates / name).read_text(), name
+
+
+def test_the_certified_conditions_are_typeset_as_math():
+    """The certificate's conditions read as code ("P(zeta, zd) - P(zeta, 0) - margin * zd",
+    "bernstein(elevation=2)+grid(1001x1001)"): each is a requirement in the report's
+    symbols, the method in words."""
+    from reports.vibroimpact.context import _certificate
+
+    conditions = {
+        "non_adhesion": {"quantity": "P(zeta, zd)", "holds": True, "grid_min_rel": 0.0},
+        "dissipativity": {
+            "quantity": "P(zeta, zd) - P(zeta, 0) - margin * zd",
+            "holds": True,
+            "grid_min_rel": 0.0,
+        },
+    }
+    cert = _ns(
+        method="bernstein(elevation=2)+grid(1001x1001)",
+        holds=True,
+        worst_violation=0.0,
+        domain={"zeta_max": 3.1e-4, "zd_max": 0.757},
+        conditions=conditions,
+    )
+    c = _certificate(cert)
+    (na, diss) = c["conditions"]
+    assert na[:3] == ["non-adhesion", r"$P(\zeta,\dot\zeta_{+}) \ge 0$", "holds"]
+    assert diss[1] == r"$P(\zeta,\dot\zeta_{+}) - P(\zeta,0) \ge 0$"
+    assert "zeta" not in str(diss[1]).replace(r"\zeta", "") and "margin" not in str(diss[1])
+    assert "bernstein(" not in c["method"] and "1001 x 1001 grid" in c["method"]
+    with_margin = _certificate(cert, margin=2e3)["conditions"][1][1]
+    assert r"\ge m\,\dot\zeta_{+}$" in with_margin and r"2000\,\mathrm{N\,s/m}" in with_margin
+
+
+def test_the_advise_report_gives_units_the_ranking_rule_and_one_number_form(runs):
+    """Bounds without units, a regime change ranked above larger separations without the
+    rule said, and a floor 5.14x10^-4 beside a limit 0.00564: the bounds carry N, Hz (kg, m),
+    the note says a regime change ranks as infinite, a criterion and its limit share a form."""
+    from discovery.vibroimpact.advise.separation import PairSeparation
+    from reports.vibroimpact.advise_report import _judged_rows
+
+    tex = report(runs / "advise", compile=False).tex.read_text()
+    body = tex.split("section{Scenario}")[0]
+    assert re.search(r"\$3\.00\\cdot 10\^\{5\}\$ -- \$6\.00\\cdot 10\^\{5\}\$\\,N", body)
+    assert r"$20.0$ -- $30.0$\,Hz" in body
+    assert "ranks as if its separation were infinite" in body
+    assert "At the advised point" in body
+    q = PairSeparation(
+        (0, 1),
+        3.2,
+        (3.2, 5.0),
+        ({"I2": 0.12, "I5": 5.14e-4}, {"I2": 0.2}),
+        ({"I2": 0.05, "I5": 0.00564}, {"I2": 0.04}),
+    )
+    rows = _judged_rows(_ns(pairs=(q,)))
+    i5 = [r for r in rows if r[3] == "$I_{5}$"]
+    assert [r[4:6] for r in i5] == [[r"$5.14\cdot 10^{-4}$", r"$5.64\cdot 10^{-3}$"]], rows
+    assert [(r[1], r[2]) for r in rows] == [(1, 2), (1, 2), (2, 1)]
