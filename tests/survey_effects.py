@@ -28,7 +28,9 @@ coupling: the base law is always ``k z + c zd``).  The effect's size is drawn fr
 Each draw's record (the independent scipy path from rest, 15 periods at 20 kHz) is made at
 two noise levels: force 2 % of its peak and motions 0.4 % of each channel's range, and a
 quarter of that.  On each: the true model verified, then ``explain`` from the linear start
-with the true machine (its sheet is another survey's), bootstrap intervals of 30 replicates.
+with the true machine (with ``--sheet-error F``: with the machine calibrated from the record,
+starting from a sheet whose masses and supports are each off by up to ``F``, and the
+calibration's scale range, as ``vidi explain`` does), bootstrap intervals of 30 replicates.
 A row: what was named and kept, whether the final model is consistent, and whether each
 hidden parameter's 95 % interval holds its true value.
 """
@@ -214,16 +216,43 @@ def _lagged_record(sc, law, tau, kw):
     return replace(fine, t=t[keep], F=Fr, channels=ch)
 
 
+def _sheet(scenario, error, seed):
+    """The designer's sheet of ``scenario``: masses, support stiffness and damping each off
+    by up to ``error`` (seeded)."""
+    rng = np.random.default_rng(seed + 555)
+
+    def off():
+        return float(1.0 + error * rng.uniform(-1.0, 1.0))
+
+    return scenario.replace(
+        m1=scenario.m1 * off(),
+        m2=scenario.m2 * off(),
+        k1=scenario.k1 * off(),
+        c1=scenario.c1 * off(),
+    )
+
+
+def _machine(start, rec, error, seed):
+    """``(scenario, scale range)`` explain is given: the true machine (``error`` 0), or the
+    machine calibrated from the record from a sheet ``error`` off, as ``vidi explain`` does."""
+    if not error:
+        return start, None
+    from discovery import calibrate
+
+    cal = calibrate(_sheet(start, error, seed), rec, seed=0)
+    return cal.scenario.with_law(start.law), cal.scale_range
+
+
 def run_case(args):
     """The two rows of draw ``i`` (one per noise level)."""
-    (i,) = args
+    i, error = args
     from discovery.vibroimpact.explain import explain
     from discovery.vibroimpact.verify import Reference, evaluate
 
     cls = CLASSES[i % len(CLASSES)]
     cat = CATEGORIES[(i // len(CLASSES)) % len(CATEGORIES)]
     seed = 3000 + i
-    base = {"draw": i, "class": cls, "category": cat, "seed": seed}
+    base = {"draw": i, "class": cls, "category": cat, "seed": seed, "sheet_error": error}
     try:
         case, law = _base_case(cat, seed)
     except RuntimeError as exc:
@@ -239,7 +268,8 @@ def run_case(args):
             start = case.scenario.with_law(law)
             row.update(_verify_truth(true_sc, true, lag, rec, start, evaluate, Reference))
             t0 = time.perf_counter()
-            res = explain(start, rec, "linear", workers=1)
+            given, scale = _machine(start, rec, error, seed)
+            res = explain(given, rec, "linear", workers=1, machine_scale=scale)
             row.update(_outcome(res, truth, time.perf_counter() - t0))
         except Exception as exc:  # noqa: BLE001 (a survey row records any failure)
             row["error"] = f"{type(exc).__name__}: {exc}"
@@ -296,12 +326,20 @@ def main(argv=None):
     p.add_argument("--draws", nargs=2, type=int, metavar=("FIRST", "STOP"), required=True)
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--out", required=True, help="the run file of the rows (JSON lines)")
+    p.add_argument(
+        "--sheet-error",
+        type=float,
+        default=0.0,
+        help="give explain the machine calibrated from each record, from a sheet whose masses "
+        "and supports are each off by up to this fraction (default 0: the true machine)",
+    )
     args = p.parse_args(argv)
     from multiprocessing import get_context
 
     out = measured.RunFile(args.out, "survey_effects", argv, append=True)
     with get_context("spawn").Pool(args.workers) as pool:
-        for rows in pool.imap_unordered(run_case, [(i,) for i in range(*args.draws)]):
+        jobs = [(i, args.sheet_error) for i in range(*args.draws)]
+        for rows in pool.imap_unordered(run_case, jobs):
             for row in rows:
                 out.write(row)
                 print(json.dumps(row), flush=True)
