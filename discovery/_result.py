@@ -346,6 +346,7 @@ _COMMANDS = {
     "explain": "explain",
     "study": "study",
     "advise": "advise",
+    "campaign": "advise",
     "contact-models": "fit",
     "ueda-attractor": "ueda attractor",
     "ueda-chart": "ueda chart",

@@ -110,17 +110,24 @@ def context(doc, run_dir):
     kind = doc.command
     build = KINDS.get(kind)
     named = kind == "fit" and summary.get("library") == "contact-models"
+    loop = summary.get("result") == "campaign"  # advise --until-settled, or the API's
+    kind = "advise" if loop else kind
     if named:
         from .contact_models import contact_models_context  # the named models' fit
 
         build = contact_models_context
+    if loop:  # advise --until-settled: the experiment loop
+        from .vibroimpact.campaign_report import campaign_context
+
+        build = campaign_context
     if build is None:
         from discovery.errors import InputError
 
         raise InputError(f"no report for a {kind!r} run; reports cover {', '.join(KINDS)} runs")
     c = build(doc, run_dir)  # every kind's context reads the run's typed result
     c["kind"] = kind
-    c["template"] = ("contact_models" if named else TEMPLATES.get(kind, "ueda")) + ".tex.j2"
+    template = "campaign" if loop else TEMPLATES.get(kind, "ueda")
+    c["template"] = ("contact_models" if named else template) + ".tex.j2"
     c["provenance"] = _provenance(summary, run_dir)
     c["scenario"] = _scenario_rows(summary.get("scenario"))
     machine = summary if kind == "calibrate" else summary.get("machine")

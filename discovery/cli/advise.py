@@ -216,7 +216,11 @@ def register(sub):
             "(default: paper)", "(default: the fit's; with --law, paper)"
         ),
     )
-    s.add_argument("--data", help="the record whose noise level the next one will have")
+    s.add_argument(
+        "--data",
+        help="the record whose noise level the next one will have (with --until-settled: "
+        "the loop's first record, taken at the --scenario's drive amplitude and frequency)",
+    )
     add_record_options(s).needs = "--data"
     s.add_argument(
         "--noise",

@@ -150,7 +150,7 @@ class CampaignStep:
 
     def line(self):
         head = (
-            f"{self.records} record(s): selected {short(self.selected)} "
+            f"{_n_records(self.records)}: selected {short(self.selected)} "
             f"({'consistent' if self.consistent else 'NOT consistent'})"
         )
         if len(self.candidates) > 1:
@@ -159,7 +159,10 @@ class CampaignStep:
         if p is None:
             return head
         m2 = "" if p.get("m2") is None else f", m2 = {p['m2']:.4g} kg"
-        refit = "" if p.get("refitted") is None else f", refitted {p['refitted']:.3g}"
+        r = p.get("refitted")
+        refit = "" if r is None else f"; with each rival refitted {r:.3g}"
+        if r is not None and r <= 1:
+            refit += ": a pair may stay open"
         sep = p.get("separation")
         sep = "infinite: a regime change" if sep is None else f"{sep:.3g}"
         return (
@@ -187,7 +190,7 @@ class CampaignResult(Result):
         The candidates left (one when settled).
     records : tuple of dict
         Each record's drive setting (``amplitude``, ``frequency``, ``m2``) and source.
-    machine : str
+    machine_from : str
         ``"record"`` (each record's machine calibrated from the records) or ``"sheet"``.
     settings : dict
     seconds : float
@@ -201,7 +204,7 @@ class CampaignResult(Result):
     law: str
     remaining: tuple
     records: tuple
-    machine: str = "record"
+    machine_from: str = "record"
     settings: dict = field(default_factory=dict)
     seconds: float = 0.0
     fit: object = field(default=None, repr=False)
@@ -227,18 +230,18 @@ class CampaignResult(Result):
             "remaining": list(self.remaining),
             "steps": [s.to_dict() for s in self.steps],
             "records": [dict(r) for r in self.records],
-            "machine": self.machine,
+            "machine_from": self.machine_from,
             "settings": self.settings,
             "seconds": self.seconds,
         }
 
     def _lines(self):
-        out = [f"campaign: {self.stopped} after {len(self.records)} record(s): {self.reason}"]
+        out = [f"campaign: {self.stopped} after {_n_records(len(self.records))}: {self.reason}"]
         out += [f"  step {k}: {s.line()}" for k, s in enumerate(self.steps, start=1)]
         if not self.settled and len(self.remaining) > 1:
             out.append("  remaining candidates:")
             out += [f"    {short(t)}" for t in self.remaining]
-        used = "calibrated from the records" if self.machine == "record" else "the sheets"
+        used = "calibrated from the records" if self.machine_from == "record" else "the sheets"
         out.append(f"  machine: {used}")
         return out
 
@@ -376,17 +379,18 @@ def _stop_after_advice(adv, laws):
 
 
 @takes(CampaignSettings)
-@params(scenario=Scenario, measurement=Measurement, knobs=Knobs)
+@params(scenario=(Scenario, list, tuple), measurement=(Measurement, list, tuple), knobs=Knobs)
 @reports_progress
 def campaign(scenario, measurement, acquire, knobs, *, settings=None, progress=None, **options):
     """Run the experiment loop until one law remains (see the module docstring).
 
     Parameters
     ----------
-    scenario : Scenario
-        The designer's sheet of the machine at the first record's drive setting.
-    measurement : Measurement
-        The first record.
+    scenario : Scenario or sequence of Scenario
+        The designer's sheet of the machine at the first record's drive setting; to go on
+        from an earlier loop, the sheet at each of its records' settings.
+    measurement : Measurement or sequence of Measurement
+        The first record (or the records so far, one per sheet).
     acquire : callable
         ``acquire(NextRecord) -> Measurement``: the record of the machine at the drive
         setting asked for (:class:`NextRecord`).
@@ -424,17 +428,23 @@ def campaign(scenario, measurement, acquire, knobs, *, settings=None, progress=N
         )
     t0 = time.perf_counter()
     fit_settings = s.fit if s.fit is not None else DiscoverSettings()
-    state = _State([scenario], [measurement], s, t0)
+    state = _State(*_so_far(scenario, measurement), s, t0)
+    scenario, measurement = state.sheets[0], state.records[0]
     noise = s.noise
     while True:
         k = len(state.records)
-        tick(progress, f"campaign: joint fit of {k} record(s)", k - 1, s.max_records)
+        tick(progress, f"campaign: joint fit of {_n_records(k)}", 0, None)
         t_step = time.perf_counter()
         machines, scale = _machines(state, s)
         settings = fit_settings
         if scale is not None and fit_settings.machine_scale is None:
             settings = DiscoverSettings.of("campaign", fit_settings, {"machine_scale": scale})
-        fit = discover(machines, list(state.records), settings=settings)
+        fit = discover(
+            machines,
+            list(state.records),
+            settings=settings,
+            progress=_prefixed(progress, f"campaign, {_n_records(k)}"),
+        )
         selected, consistent, laws = _outcome(fit)
         step = CampaignStep(k, selected or "", consistent, tuple(law.to_text() for law in laws))
         stop = None
@@ -454,7 +464,7 @@ def campaign(scenario, measurement, acquire, knobs, *, settings=None, progress=N
         if stop is None:
             if noise is None:
                 noise = NoiseModel.from_measurement(measurement, machines[0], seed=s.seed)
-            tick(progress, f"campaign: advising record {k + 1}", k - 1, s.max_records)
+            tick(progress, f"campaign: advising record {k + 1}", 0, None)
             adv = advise(
                 machines[0],
                 laws,
@@ -464,6 +474,7 @@ def campaign(scenario, measurement, acquire, knobs, *, settings=None, progress=N
                 workers=s.workers,
                 tolerances=s.tolerances,
                 refit_simulations=s.refit_simulations,
+                progress=_prefixed(progress, f"campaign, record {k + 1}"),
             )
             stop = _stop_after_advice(adv, laws)
         if stop is not None:
@@ -479,11 +490,40 @@ def campaign(scenario, measurement, acquire, knobs, *, settings=None, progress=N
             at_point(scenario, b.amplitude, b.frequency, b.m2),
             float("inf") if entry["separation"] is None else entry["separation"],
         )
-        tick(progress, f"campaign: acquiring record {k + 1}", k - 1, s.max_records)
+        tick(progress, f"campaign: acquiring record {k + 1}", 0, None)
         rec = _acquired(acquire, request)
         state.steps.append(_timed(CampaignStep(**{**step.__dict__, "point": entry}), t_step))
         state.sheets.append(request.scenario)
         state.records.append(rec)
+
+
+def _so_far(scenario, measurement):
+    """``(sheets, records)``: the first record with its sheet, or the records so far."""
+    sheets = [scenario] if isinstance(scenario, Scenario) else list(scenario)
+    records = [measurement] if isinstance(measurement, Measurement) else list(measurement)
+    if not records or len(sheets) != len(records):
+        raise InputError(
+            f"campaign: give one sheet per record ({len(sheets)} sheet(s), "
+            f"{len(records)} record(s))"
+        )
+    for k, (sc, rec) in enumerate(zip(sheets, records, strict=True)):
+        if not isinstance(sc, Scenario) or not isinstance(rec, Measurement):
+            raise VidiTypeError(
+                f"campaign: record {k + 1} must be a Measurement with a Scenario as its "
+                f"sheet; got {type(rec).__name__} and {type(sc).__name__}"
+            )
+    return sheets, records
+
+
+def _n_records(k):
+    return f"{k} record" + ("" if k == 1 else "s")
+
+
+def _prefixed(progress, head):
+    """The progress of a stage of the loop, under the loop's own name."""
+    if progress is None:
+        return False
+    return lambda stage, done, total: progress(f"{head}: {stage}", done, total)
 
 
 def _timed(step, t0):
@@ -507,7 +547,7 @@ def _result(state, stop, fit, laws):
         law=state.steps[-1].selected,
         remaining=tuple(law.to_text() for law in laws),
         records=records,
-        machine=state.settings.machine,
+        machine_from=state.settings.machine,
         settings=state.settings.to_dict(),
         seconds=time.perf_counter() - state.t0,
         fit=fit,

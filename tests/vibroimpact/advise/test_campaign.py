@@ -72,7 +72,7 @@ def test_the_loop_settles_a_law_its_first_record_leaves_open():
     assert res.steps[0].point is not None and res.steps[-1].point is None
     pairs = res.steps[0].point["pairs"]  # each advised pair, for the calibration table
     assert pairs and all(q["by"] in ("criteria", "regime", "physics") for q in pairs)
-    assert res.machine == "record" and res.fit is not None
+    assert res.machine_from == "record" and res.fit is not None
     text = str(res)
     assert text.startswith("campaign: settled after") and "step 1:" in text
     back = CampaignResult.from_dict(res.to_dict())
@@ -107,13 +107,42 @@ def test_a_campaign_round_trips_and_prints(tmp_path):
     back = load(tmp_path / "c")
     assert isinstance(back, CampaignResult) and back == res
     text = str(back)
-    assert "next record at A = 5e+05 N, f = 22 Hz (separation 3.2, refitted 1.4)" in text
+    assert "next record at A = 5e+05 N, f = 22 Hz (separation 3.2; with each rival " in text
+    assert "refitted 1.4)" in text
     assert "remaining candidates:" in text and not back.settled
     # a regime change separates without a number: said in words, and it reads back
     regime = CampaignStep(**{**step.__dict__, "point": {**step.point, "separation": None}})
     res = CampaignResult(**{**res.__dict__, "steps": (regime,)})
     back = CampaignResult.from_dict(res.to_dict())
-    assert "(separation infinite: a regime change, refitted 1.4)" in str(back)
+    assert "(separation infinite: a regime change; with each rival refitted 1.4)" in str(back)
+
+
+def test_a_campaign_has_a_report(tmp_path):
+    import discovery
+
+    step = CampaignStep(
+        1,
+        "2e8*z + 1e7*zd",
+        True,
+        ("2e8*z + 1e7*zd", "2e8*z + 9e6*zd + 1e9*z*zd"),
+        {"amplitude": 5e5, "frequency": 22.0, "m2": None, "separation": None, "refitted": 0.4},
+    )
+    last = CampaignStep(2, "2e8*z + 1e7*zd", True, ("2e8*z + 1e7*zd",))
+    res = CampaignResult(
+        steps=(step, last),
+        stopped="settled",
+        reason="one law remains: the joint fit lists no equivalent model (2e8*z + 1e7*zd)",
+        law="2e8*z + 1e7*zd",
+        remaining=("2e8*z + 1e7*zd",),
+        records=(
+            {"amplitude": 5e5, "frequency": 25.0, "m2": 6000.0, "source": "D.csv"},
+            {"amplitude": 5e5, "frequency": 22.0, "m2": 6000.0, "source": "r/record_2.csv"},
+        ),
+    )
+    rep = discovery.report(res, out=tmp_path / "c", compile=False)
+    tex = (tmp_path / "c" / "report.tex").read_text()
+    assert "The experiment loop" in tex and "a regime change" in tex and "record\\_2.csv" in tex
+    assert "One law remains." in tex and rep is not None
 
 
 def test_acquire_must_be_a_callable_that_returns_a_record():
@@ -156,6 +185,14 @@ def test_the_acquire_command_is_checked_before_anything_runs(template, words):
             ["--until-settled", "--data", "D.csv", "--acquire", "rig --A {amp} {out}"],
             "placeholder {amp}",
         ),
+        (
+            ["--until-settled", "--data", "D.csv", "--acquire", "no-such-rig --out {out}"],
+            "no program 'no-such-rig' on the PATH (the command runs without a shell)",
+        ),
+        (
+            ["--until-settled", "--data", "D.csv", "--acquire", "true {out}", "--resume"],
+            "--resume: 'loop.records' holds no record_K.csv of an earlier loop",
+        ),
     ],
 )
 def test_cli_loop_options_are_checked_in_one_line(tmp_path, capsys, monkeypatch, extra, words):
@@ -184,7 +221,13 @@ def test_cli_a_failing_acquire_stops_the_loop_and_writes_nothing(tmp_path, capsy
     assert main(argv) == 2
     out = capsys.readouterr()
     assert "--acquire exited with 1 for record 2" in out.err, out.err
+    assert "the records so far are in 'loop.records' (--resume goes on from them)" in out.err
     assert not (tmp_path / "loop").exists()
+    # the sheet of the record asked for is kept; a loop there again must say what it does
+    assert (tmp_path / "loop.records" / "scenario_2.toml").is_file()
+    (tmp_path / "loop.records" / "record_2.csv").write_text("t,F\n")
+    assert main(argv) == 2
+    assert "holds 1 record(s) of an earlier loop: give --resume" in capsys.readouterr().err
 
 
 @pytest.mark.slow
