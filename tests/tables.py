@@ -119,6 +119,21 @@ TABLES = {
         row=survey_effects.markdown_row,
         read=survey_effects.read_rows,
     ),
+    "effects-sheet": Table(
+        page="docs/validation.md",
+        header=(
+            "| hidden | records | explain raised an error | true model not consistent | "
+            "effect does not show (start consistent) | right effect(s) kept, where it shows | "
+            "clean: an effect kept | final model consistent | 95 % interval holds the "
+            "truth | lower noise wrong where higher right |",
+            "|---|---|---|---|---|---|---|---|---|---|",
+        ),
+        rows=tuple(
+            (label, ("sheet-effects*.jsonl",)) for label in (*survey_effects.CLASSES, "all")
+        ),
+        row=survey_effects.markdown_row,
+        read=survey_effects.read_rows,
+    ),
     "effects-readme": Table(
         page="README.md",
         header=(
