@@ -1,6 +1,8 @@
 """Figures drawn on ``matplotlib.figure.Figure`` objects: no pyplot, so drawing a report
 never switches the backend of a notebook or a GUI session that imported ``discovery``."""
 
+import matplotlib as mpl
+import numpy as np
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
@@ -46,11 +48,88 @@ def subplots(nrows=1, ncols=1, **kwargs):
 
 
 def save(fig, stem, dpi=130):
-    """The figure as ``stem.png`` and ``stem.pdf``; returns both paths."""
+    """The figure as ``stem.png`` and ``stem.pdf``, each cropped to its artists with
+    :rc:`savefig.pad_inches` round them (``bbox_inches="tight"``); returns both paths.
+
+    Laid out once: ``savefig(..., bbox_inches="tight")`` lays a figure out and draws it
+    twice per file (once to find its extent, once to print it), each time with a new
+    renderer, so its layout engine runs twice and every text is measured and every
+    mathtext label parsed again (matplotlib caches both per renderer). Here the layout
+    engine runs once, at the PNG's ``dpi`` on an Agg canvas; the PNG is cut from that
+    canvas drawn with the same renderer (or drawn by savefig when an artist runs past the
+    figure's edge), and the PDF is printed in the same layout. The figure is left as it was
+    given (its canvas, dpi and layout engine).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
     paths = [f"{stem}.png", f"{stem}.pdf"]
-    fig.savefig(paths[0], dpi=dpi, bbox_inches="tight")
-    fig.savefig(paths[1], bbox_inches="tight")
+    own_dpi, engine, canvas = fig.dpi, fig.get_layout_engine(), fig.canvas
+    try:
+        agg = FigureCanvasAgg(fig)  # the figure's canvas until the end of the save
+        fig.set_dpi(dpi)
+        fig.draw_without_rendering()  # the layout engine, on agg's renderer at this dpi
+        tight = fig.get_tightbbox(agg.get_renderer())
+        bbox = tight.padded(mpl.rcParams["savefig.pad_inches"])
+        _set_layout_engine(fig, None)  # laid out: the PNG and the PDF are drawn in this layout
+        if _drawn_whole(fig, tight):
+            agg.draw()  # the same renderer: its texts measured and parsed in the layout
+            _write_png(paths[0], agg, bbox, dpi)
+        else:  # savefig draws it again, past the figure's edge or on the user's background
+            fig.savefig(paths[0], dpi=dpi, bbox_inches=bbox)
+        fig.set_dpi(own_dpi)  # the PDF's rasterized parts, if any, at the figure's dpi
+        # cut to its own extent: a PDF's text is measured unhinted, up to a few per cent
+        # wider than the PNG's, and a long line at the edge would lose its end
+        fig.savefig(paths[1], bbox_inches="tight")
+    finally:
+        fig.set_dpi(own_dpi)
+        _set_layout_engine(fig, engine)
+        fig.set_canvas(canvas)
     return paths
+
+
+def _set_layout_engine(fig, engine):
+    """``fig``'s layout engine set to ``engine``, None included (which
+    ``Figure.set_layout_engine`` reads as "the rcParams' default")."""
+    with mpl.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+        fig.set_layout_engine(engine)
+
+
+def _drawn_whole(fig, tight):
+    """Whether the figure's canvas holds every pixel savefig would write: its artists
+    (within ``tight``, inches) inside its edges, and the figure's own background (the
+    default rcParams) round them."""
+    rc = mpl.rcParams
+    w, h = fig.get_size_inches()
+    return (
+        tight.x0 >= 0.0
+        and tight.y0 >= 0.0
+        and tight.x1 <= w
+        and tight.y1 <= h
+        and not rc["savefig.transparent"]
+        and str(rc["savefig.facecolor"]) == "auto"
+        and str(rc["savefig.edgecolor"]) == "auto"
+    )
+
+
+def _write_png(path, agg, bbox, dpi):
+    """The pixels of ``agg`` (drawn at ``dpi``) within ``bbox`` (inches) as a PNG: what
+    ``savefig(path, dpi=dpi, bbox_inches=bbox)`` writes, to within a pixel's shift; the part
+    of ``bbox`` past the figure's edge painted in its background."""
+    from matplotlib.colors import to_rgba
+    from matplotlib.image import imsave
+
+    full = np.asarray(agg.buffer_rgba())
+    rows, cols = full.shape[:2]
+    w, h = int(bbox.width * dpi), int(bbox.height * dpi)
+    # the figure's pixel under the output's top left corner (rows count from the top)
+    i0, j0 = round(rows - bbox.y0 * dpi) - h, round(bbox.x0 * dpi)
+    out = np.empty((h, w, 4), dtype=np.uint8)
+    out[...] = np.round(np.asarray(to_rgba(agg.figure.get_facecolor())) * 255)
+    top, left = max(0, -i0), max(0, -j0)
+    bottom, right = min(h, rows - i0), min(w, cols - j0)
+    if bottom > top and right > left:
+        out[top:bottom, left:right] = full[top + i0 : bottom + i0, left + j0 : right + j0]
+    imsave(path, out, format="png", dpi=dpi)
 
 
 def colormap(name):

@@ -110,7 +110,7 @@ def fit_surface_figure(result, stem):
     ax.set_ylabel(r"loading velocity $\dot{\zeta}_{+} = \max(\dot{\zeta}, 0)$ [m/s]")
     ax.set_title(law_math(result.selected.law), fontsize=8)
     ax.legend(loc="best", fontsize=7, framealpha=0.8)
-    fig.tight_layout()
+    fig.set_layout_engine("tight")  # laid out once, by save()
     return _save(fig, stem)
 
 
@@ -151,5 +151,6 @@ def fit_loop_figure(result, stem, max_impacts=3):
         ax.set_ylabel("contact force [kN]")
         ax.set_title("Loading and unloading branches, measured and modelled")
         ax.legend(loc="best", framealpha=0.8)
-        fig.tight_layout()
-    return _save(fig, stem)
+        # laid out once, by save(), its padding in these sizes' font
+        fig.set_layout_engine("tight")
+        return _save(fig, stem)

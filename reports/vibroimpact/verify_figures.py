@@ -93,7 +93,7 @@ def verify_figure(result, stem):
         axr.set_ylabel(f"$F_N - F_E$ [{unit}]")
         axr.set_xlabel("time since the contact's start [ms] (folded)")
         axr.axhline(0.0, color="k", lw=0.5)
-    fig.tight_layout()
+    fig.set_layout_engine("tight")  # laid out once, by save()
     return _save(fig, stem)
 
 
@@ -200,7 +200,7 @@ def _span_figure(result, view, stem):
     ax.set_title(f"{law_math(result.law)}\n" + textwrap.fill(verdict, 72), fontsize=8)
     ax.set_ylabel(f"contact force F [{unit}]")
     ax.legend(fontsize=7, loc="best", framealpha=0.8)
-    fig.tight_layout()
+    fig.set_layout_engine("tight")  # laid out once, by save()
     return _save(fig, stem)
 
 
@@ -247,7 +247,7 @@ def loops_figure(loops, evaluation, stem, law, what):
     fig, (ax, axz) = subplots(1, 2, figsize=(PRINT_WIDTH, 3.0))
     _loops_panel(ax, axz, loops, evaluation)
     fig.suptitle(f"{what}: {law_math(law)}", fontsize=8)
-    fig.tight_layout()
+    fig.set_layout_engine("tight")  # laid out once, by save()
     return _save(fig, stem)
 
 
