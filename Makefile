@@ -150,10 +150,21 @@ surveys: install
 		--out $(MEASURED)/study-paper.jsonl
 	$(MAKE) tables
 
-# The demo's explain figure shown in the README and the gallery (reports/assets), made by
-# running the demo and its reports
+# The figures of the README and the gallery (reports/assets): the demo's (verify, fit,
+# explain) made by running the demo, then advise, landscape and Ueda's attractor on its machine
 gallery: demo
 	cp $(DEMO)/explain/explain_1.png reports/assets/demo_explain.png
+	cp $(DEMO)/verify/verify.png reports/assets/demo_verify.png
+	cp $(DEMO)/fit/fit_impulse.png reports/assets/demo_fit_impulse.png
+	cp $(DEMO)/fit/fit_surface.png reports/assets/demo_fit_surface.png
+	$(BIN)/vidi advise --scenario $(DEMO)/high.toml --law "$(DEMO_LAW)" --law "$(DEMO_TRUE)" \
+		--noise 0.01 --amplitude 3e5:6e5 --frequency 20:30 --grid 5x5 --out $(DEMO)/advise --overwrite
+	cp $(DEMO)/advise/advise_map.png reports/assets/demo_advise_map.png
+	$(BIN)/vidi landscape --scenario $(DEMO)/high.toml --data $(DEMO)/high.csv --grid 21x21 \
+		--out $(DEMO)/landscape --overwrite
+	cp $(DEMO)/landscape/landscape.png reports/assets/demo_landscape.png
+	$(BIN)/vidi ueda attractor --model negres --out $(DEMO)/ueda --overwrite
+	cp $(DEMO)/ueda/attractor.png reports/assets/ueda_attractor.png
 
 # The documentation site (docs/*.md, API reference from the docstrings), warnings as errors
 docs: install
