@@ -95,6 +95,13 @@ class NextRecord:
     scenario: Scenario
     separation: float
 
+    def __str__(self):
+        m2 = "" if self.m2 is None else f", m2 = {self.m2:.4g} kg"
+        return (
+            f"record {self.step} at A = {self.amplitude:.4g} N, f = {self.frequency:.4g} Hz"
+            f"{m2} (predicted separation {self.separation:.3g}; sheet {self.scenario.name!r})"
+        )
+
 
 @dataclass(frozen=True)
 class CampaignStep:
