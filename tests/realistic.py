@@ -90,6 +90,7 @@ __all__ = [
     "default_transient",
     "reference_events",
     "reference_record",
+    "sheet_of",
     "transient_periods",
     "verification_trials",
     "wrong_laws",
@@ -505,6 +506,16 @@ def reference_events(
 
 # ------------------------------------------------------ verification properties
 WRONG_FACTORS = (1.3, 0.7)
+
+
+def sheet_of(scenario, seed, errors):
+    """The designer's sheet of a machine: each parameter ``p`` of ``errors`` off by a
+    uniform draw within ``+-errors[p]`` (relative), drawn in the mapping's order from
+    ``numpy.random.default_rng(seed)``."""
+    rng = np.random.default_rng(seed)
+    return scenario.replace(
+        **{p: getattr(scenario, p) * (1 + rng.uniform(-e, e)) for p, e in errors.items()}
+    )
 
 
 def wrong_laws(law):

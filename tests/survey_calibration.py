@@ -27,7 +27,6 @@ HERE = Path(__file__).resolve().parent
 if not __package__:
     sys.path[0:1] = [str(HERE.parent)]
 
-import numpy as np  # noqa: E402
 
 from tests import measured  # noqa: E402
 from tests import realistic as R  # noqa: E402
@@ -41,10 +40,7 @@ PARAMS = ("m1", "m2", "k1", "c1", "A")
 
 def sheet_of(scenario, seed):
     """The designer's sheet of a machine: each parameter off by a uniform draw."""
-    rng = np.random.default_rng(10_000 + seed)
-    return scenario.replace(
-        **{p: getattr(scenario, p) * (1 + rng.uniform(-e, e)) for p, e in SHEET_ERRORS.items()}
-    )
+    return R.sheet_of(scenario, 10_000 + seed, SHEET_ERRORS)
 
 
 def _verdicts(machines, rec, laws, scale_range):

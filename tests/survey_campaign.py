@@ -50,14 +50,7 @@ SHEET_ERROR = 0.05
 
 def sheet_of(truth, seed):
     """The designer's sheet of the machine ``truth``: its masses and supports a few % off."""
-    rng = np.random.default_rng(seed)
-
-    def off():
-        return float(1.0 + SHEET_ERROR * rng.uniform(-1.0, 1.0))
-
-    return truth.replace(
-        m1=truth.m1 * off(), m2=truth.m2 * off(), k1=truth.k1 * off(), c1=truth.c1 * off()
-    )
+    return R.sheet_of(truth, seed, dict.fromkeys(("m1", "m2", "k1", "c1"), SHEET_ERROR))
 
 
 def _terms(text):

@@ -216,30 +216,16 @@ def _lagged_record(sc, law, tau, kw):
     return replace(fine, t=t[keep], F=Fr, channels=ch)
 
 
-def _sheet(scenario, error, seed):
-    """The designer's sheet of ``scenario``: masses, support stiffness and damping each off
-    by up to ``error`` (seeded)."""
-    rng = np.random.default_rng(seed + 555)
-
-    def off():
-        return float(1.0 + error * rng.uniform(-1.0, 1.0))
-
-    return scenario.replace(
-        m1=scenario.m1 * off(),
-        m2=scenario.m2 * off(),
-        k1=scenario.k1 * off(),
-        c1=scenario.c1 * off(),
-    )
-
-
 def _machine(start, rec, error, seed):
     """``(scenario, scale range)`` explain is given: the true machine (``error`` 0), or the
     machine calibrated from the record from a sheet ``error`` off, as ``vidi explain`` does."""
     if not error:
         return start, None
     from discovery import calibrate
+    from tests import realistic as R
 
-    cal = calibrate(_sheet(start, error, seed), rec, seed=0)
+    sheet = R.sheet_of(start, seed + 555, dict.fromkeys(("m1", "m2", "k1", "c1"), error))
+    cal = calibrate(sheet, rec, seed=0)
     return cal.scenario.with_law(start.law), cal.scale_range
 
 

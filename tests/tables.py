@@ -84,6 +84,16 @@ _EXPLAIN_RUNS = ("explain-random*.jsonl",)
 _SCALING_RUNS = ("scaling*.jsonl",)
 
 
+#: the effects survey's columns (with the true machine, and calibrated from a sheet off)
+_EFFECTS_HEADER = (
+    "| hidden | records | explain raised an error | true model not consistent | "
+    "effect does not show (start consistent) | right effect(s) kept, where it shows | "
+    "clean: an effect kept | final model consistent | 95 % interval holds the "
+    "truth | lower noise wrong where higher right |",
+    "|---|---|---|---|---|---|---|---|---|---|",
+)
+
+
 def _two_points(pattern):
     """docs/contact-models.md's table of a second operating point (the run files of
     ``pattern``): a row per truth and arm (:func:`survey_contact_models.markdown_row`)."""
@@ -108,26 +118,14 @@ def _two_points(pattern):
 TABLES = {
     "effects": Table(
         page="docs/validation.md",
-        header=(
-            "| hidden | records | explain raised an error | true model not consistent | "
-            "effect does not show (start consistent) | right effect(s) kept, where it shows | "
-            "clean: an effect kept | final model consistent | 95 % interval holds the "
-            "truth | lower noise wrong where higher right |",
-            "|---|---|---|---|---|---|---|---|---|---|",
-        ),
+        header=_EFFECTS_HEADER,
         rows=tuple((label, ("effects*.jsonl",)) for label in (*survey_effects.CLASSES, "all")),
         row=survey_effects.markdown_row,
         read=survey_effects.read_rows,
     ),
     "effects-sheet": Table(
         page="docs/validation.md",
-        header=(
-            "| hidden | records | explain raised an error | true model not consistent | "
-            "effect does not show (start consistent) | right effect(s) kept, where it shows | "
-            "clean: an effect kept | final model consistent | 95 % interval holds the "
-            "truth | lower noise wrong where higher right |",
-            "|---|---|---|---|---|---|---|---|---|---|",
-        ),
+        header=_EFFECTS_HEADER,
         rows=tuple(
             (label, ("sheet-effects*.jsonl",)) for label in (*survey_effects.CLASSES, "all")
         ),

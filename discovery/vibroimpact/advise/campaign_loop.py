@@ -38,7 +38,14 @@ from ..dynamics import Tolerances
 from ..fit.discovery import DiscoverSettings, discover
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
-from .candidates import Knobs, NoiseModel, SafeRegion, contact_candidates
+from .candidates import (
+    Knobs,
+    NoiseModel,
+    SafeRegion,
+    contact_candidates,
+    distinct_laws,
+    fitted_model,
+)
 from .search import advise
 from .separation import at_point
 
@@ -280,34 +287,23 @@ def _machines(state, s):
     return list(cal.scenarios), cal.scale_range
 
 
-def _distinct(laws):
-    out, seen = [], set()
-    for law in laws:
-        if law.to_text() not in seen:
-            seen.add(law.to_text())
-            out.append(law)
-    return out
-
-
 def _outcome(fit):
     """``(selected text or None, consistent, candidates)`` of a joint fit: a polynomial
     fit's selected law and equivalent models, or a contact-models fit's selected model and
     the models it reports equivalent (its same-force twin left out)."""
     from ..fit.contact_fit import ContactModelsResult
-    from ..model.contact_models import MODELS, ContactModel
 
     if not isinstance(fit, ContactModelsResult):
         laws = [fit.selected.law]
         laws += [ForceLaw.from_dict(e["coefficients"]) for e in fit.equivalent]
-        return fit.selected.law.to_text(), bool(fit.selected.consistent), _distinct(laws)
+        return fit.selected.law.to_text(), bool(fit.selected.consistent), distinct_laws(laws)
     if fit.selected is None:
         return None, False, []
     try:
         laws = list(contact_candidates(fit))
     except InputError:  # only the selected model's same-force twin is left: one law
-        p = fit.fit(fit.selected).parameters
-        laws = [ContactModel(fit.selected, tuple(p[k] for k in MODELS[fit.selected]))]
-    return laws[0].to_text(), True, _distinct(laws)
+        laws = [fitted_model(fit, fit.selected)]
+    return laws[0].to_text(), True, distinct_laws(laws)
 
 
 def _nested(laws):

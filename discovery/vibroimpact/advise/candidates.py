@@ -30,6 +30,8 @@ __all__ = [
     "fit_scenario_changed",
     "contact_candidates",
     "unique_laws",
+    "distinct_laws",
+    "fitted_model",
 ]
 
 
@@ -326,6 +328,24 @@ def _as_law(law):
     return parse_law(str(law))
 
 
+def distinct_laws(laws):
+    """The laws (or named models) without repeats of the same text, in order."""
+    out, seen = [], set()
+    for law in laws:
+        if law.to_text() not in seen:
+            seen.add(law.to_text())
+            out.append(law)
+    return out
+
+
+def fitted_model(result, name):
+    """The named model ``name`` of a contact-models fit with its fitted parameters."""
+    from ..model.contact_models import MODELS, ContactModel
+
+    p = result.fit(name).parameters
+    return ContactModel(name, tuple(p[k] for k in MODELS[name]))
+
+
 def unique_laws(laws):
     """The laws without repeats (same text), in order; fewer than two is an error.  Each
     may be a :class:`ForceLaw`, a named contact model or the text of either; a
@@ -335,12 +355,7 @@ def unique_laws(laws):
 
     if isinstance(laws, ContactModelsResult):
         laws = contact_candidates(laws)
-    out, seen = [], set()
-    for law in laws:
-        law = _as_law(law)
-        if law.to_text() not in seen:
-            seen.add(law.to_text())
-            out.append(law)
+    out = distinct_laws(_as_law(law) for law in laws)
     if len(out) < 2:
         raise InputError(
             f"advise separates two or more candidate laws, got {len(out)}; give --law "
@@ -358,7 +373,6 @@ def contact_candidates(result):
     (:attr:`~discovery.vibroimpact.fit.contact_fit.ContactModelsResult.same_force`) is left
     out, and a fit whose only equivalent model is that twin is refused (InputError)."""
     from ..fit.contact_fit import ContactModelsResult
-    from ..model.contact_models import MODELS, ContactModel
 
     if isinstance(result, dict):
         result = ContactModelsResult.from_dict(result)
@@ -376,11 +390,7 @@ def contact_candidates(result):
             "which makes the same force at every impact velocity: no operating point "
             "separates them, so there is nothing to advise"
         )
-    out = []
-    for name in (result.selected, *names):
-        p = result.fit(name).parameters
-        out.append(ContactModel(name, tuple(p[k] for k in MODELS[name])))
-    return tuple(out)
+    return tuple(fitted_model(result, name) for name in (result.selected, *names))
 
 
 def candidates_from_fit(run_dir):
