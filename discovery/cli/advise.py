@@ -185,20 +185,26 @@ def run(args):
     return 0
 
 
+#: ``vidi advise --help``'s description
+DESCRIPTION = (
+    "Simulate every candidate law to its steady state over a grid of the "
+    "drive amplitude and frequency (optionally the moulding mass), judge every pair by "
+    "the verdict's rule (criteria I2, I4, and I5 where positions are recorded, against "
+    "their noise-floor limits at the record's noise level), and rank the points by the "
+    "smallest pair separation (>= 1: a record there rejects the false law of every "
+    "pair). Points where a candidate exceeds --max-force or --max-penetration are "
+    "excluded. With --until-settled: the experiment loop, each next record taken by "
+    "--acquire CMD, until one law remains."
+)
+
+
 def register(sub):
     s = sub.add_parser(
         "advise",
         help="the operating point (drive amplitude, frequency) where a next record "
         "separates the laws a record cannot tell apart; --until-settled runs the whole loop "
         "of fit, advice and record",
-        description="Simulate every candidate law to its steady state over a grid of the "
-        "drive amplitude and frequency (optionally the moulding mass), judge every pair by "
-        "the verdict's rule (criteria I2, I4, and I5 where positions are recorded, against "
-        "their noise-floor limits at the record's noise level), and rank the points by the "
-        "smallest pair separation (>= 1: a record there rejects the false law of every "
-        "pair). Points where a candidate exceeds --max-force or --max-penetration are "
-        "excluded. With --until-settled: the experiment loop, each next record taken by "
-        "--acquire CMD, until one law remains.",
+        description=DESCRIPTION,
     )
     s.add_argument(
         "--fit",
