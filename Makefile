@@ -9,7 +9,7 @@ STAMP := $(VENV)/.installed
 TEX_PACKAGES := latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended \
 	lmodern poppler-utils
 
-.PHONY: install demo study test test-slow test-all bench lint clean tex docs tables surveys gallery
+.PHONY: install demo study test test-slow test-all bench lint clean tex docs tables surveys gallery readme
 
 install: $(STAMP)
 
@@ -150,13 +150,16 @@ surveys: install
 		--out $(MEASURED)/study-paper.jsonl
 	$(MAKE) tables
 
-# The figures of the README and the gallery (reports/assets): the demo's (verify, fit,
-# explain) made by running the demo, then advise, landscape and Ueda's attractor on its machine
+# The README's numbers and the demo's figures, measured as a user meets them: a fresh clone's
+# make install, make demo (its figures into reports/assets), each README command timed, make
+# test (about 20 min on two cores; the machine otherwise idle), then the pages rendered
+readme: install
+	$(BIN)/python -m tests.survey_readme --install --test --out $(MEASURED)/readme.jsonl
+	$(MAKE) tables
+
+# The gallery's other figures (reports/assets; the demo's come with `make readme`): advise,
+# landscape and Ueda's attractor on the demo's machine
 gallery: demo
-	cp $(DEMO)/explain/explain_1.png reports/assets/demo_explain.png
-	cp $(DEMO)/verify/verify.png reports/assets/demo_verify.png
-	cp $(DEMO)/fit/fit_impulse.png reports/assets/demo_fit_impulse.png
-	cp $(DEMO)/fit/fit_surface.png reports/assets/demo_fit_surface.png
 	$(BIN)/vidi advise --scenario $(DEMO)/high.toml --law "$(DEMO_LAW)" --law "$(DEMO_TRUE)" \
 		--noise 0.01 --amplitude 3e5:6e5 --frequency 20:30 --grid 5x5 --out $(DEMO)/advise --overwrite
 	cp $(DEMO)/advise/advise_map.png reports/assets/demo_advise_map.png

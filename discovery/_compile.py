@@ -45,8 +45,8 @@ def announce_compile(kernel="vibro-impact", stream=None):
     if cached(kernel):
         return
     print(
-        f"vidi: compiling the {kernel} simulator once (under a minute on two cores; "
-        "cached for every later run; `make install` does it ahead)",
+        f"vidi: compiling the {kernel} simulator once (one to a few minutes; cached for "
+        "every later run; `make install` does it ahead)",
         file=stream or sys.stderr,
         flush=True,
     )

@@ -2,20 +2,25 @@
 
 The compiled kernels (the vibro-impact integrator with its event location, and Ueda's
 oscillator) are cached by numba beside their sources (``__pycache__``).  Without a cache
-the first simulation compiles them (about a minute on two cores, most of it the
-vibro-impact integrator with its event location and sensitivities; the oscillator's
-records, scans, charts and exponents about 20 s); ``make install`` runs
-this module once so that the first command after it starts in a second, and
+the first simulation compiles them (one to a few minutes, most of it the vibro-impact
+integrator with its event location and sensitivities; the README's times table has the
+measured figure); ``make install`` runs this module once, with a line every
+:data:`HEARTBEAT` seconds while it compiles, so that the first command after it starts in a
+second, and
 `discovery._compile.announce_compile` says so in one line when a command has to compile
 anyway.
 """
 
 import sys
+import threading
 import time
 
 from ._compile import _ANNOUNCED, KERNELS, cached
 
-__all__ = ["warm", "main"]
+__all__ = ["warm", "main", "HEARTBEAT"]
+
+#: seconds between the "still compiling" lines
+HEARTBEAT = 10.0
 
 
 def warm():
@@ -44,20 +49,35 @@ def warm():
     return out
 
 
-def main():
+def _heartbeat(done, t0, every, stream):
+    """A line on ``stream`` every ``every`` seconds until ``done`` is set."""
+    while not done.wait(every):
+        print(f"  still compiling ({time.perf_counter() - t0:.0f} s)", file=stream, flush=True)
+
+
+def main(every=HEARTBEAT, stream=None):
+    stream = stream or sys.stdout
     todo = [k for k in KERNELS if not cached(k)]
+    done = threading.Event()
     if todo:
         print(
-            f"compiling the simulators once ({', '.join(todo)}; about a minute on two cores) ...",
+            f"compiling the simulators once ({', '.join(todo)}; one to a few minutes) ...",
+            file=stream,
             flush=True,
         )
+        beat = (done, time.perf_counter(), every, stream)
+        threading.Thread(target=_heartbeat, args=beat, daemon=True).start()
     # said here once: the runs below need not announce their compile again
     _ANNOUNCED.update(KERNELS)
-    seconds = warm()
+    try:
+        seconds = warm()
+    finally:
+        done.set()
     print(
         "simulators ready ("
         + ", ".join(f"{k} {v:.1f} s" for k, v in seconds.items())
-        + "); later runs load them from the cache"
+        + "); later runs load them from the cache",
+        file=stream,
     )
     return 0
 

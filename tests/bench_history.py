@@ -337,6 +337,28 @@ def markdown_row(runs, label_):
     return "| " + " | ".join([label_, *cells]) + " |"
 
 
+def readme_lines(runs):
+    """The README's bullet on speed, from the last full bench run of ``runs``."""
+    full = [r for r in runs if not r["partial"]]
+    if not full:
+        raise SystemExit("no full bench run in docs/_measured/bench-history.jsonl")
+    run = full[-1]
+    kernel = _get(run, "kernel_vs_scipy") or {}
+    fit = _get(run, "pipeline", "discover_poly:2") or {}
+    explain = _get(run, "explain") or {}
+    steady = _get(run, "pipeline", "one_steady_state_seconds")
+    return [
+        "- the shipped study (`make study`) and `make bench` (speed, and scaling over the "
+        f"cores; the last full run, {run['created'][:10]} on {run['cores']} cores):",
+        f"  the compiled kernel at equal accuracy is {_sig(kernel.get('speedup'), 3)}x the "
+        f"scipy path over one drive period, {_sig(kernel.get('long_run_40_periods_speedup'), 4)}x"
+        f" over 40 and {_sig(kernel.get('steady_state_speedup_over_scipy'), 3)}x for a cold "
+        f"steady state ({_sig(1e3 * steady)} ms); on the bench's records `fit` (`discover "
+        f"poly:2, refine`) takes {_sig(fit.get('seconds'))} s in one process and `explain` "
+        f"{_sig(explain.get('seconds'))} s on {explain.get('cores')} cores;",
+    ]
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--append", metavar="RESULTS", help="add this results file's runs")

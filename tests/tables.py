@@ -28,6 +28,7 @@ from . import (
     bench_history,
     bench_scaling,
     measured,
+    readme_text,
     realistic_survey,
     survey_advise,
     survey_calibration,
@@ -115,7 +116,39 @@ def _two_points(pattern):
     )
 
 
+def _readme(page, lines):
+    """A paragraph of ``page`` rendered by ``lines(rows)`` from the README's run
+    (:mod:`tests.survey_readme`, :mod:`tests.readme_text`)."""
+    return Table(
+        page=page,
+        header=lines,
+        rows=(("run", ("readme*.jsonl",)),),
+        row=lambda rows, label: [],
+        read=readme_text.read_rows,
+    )
+
+
+#: the README's measured paragraphs, in the README and again in the getting-started page
+_README_TEXT = {
+    f"{part}-{suffix}": _readme(page, lines)
+    for part, lines in (
+        ("setup", readme_text.setup_lines),
+        ("demo", readme_text.demo_lines),
+        ("times", readme_text.times_lines),
+    )
+    for suffix, page in (("readme", "README.md"), ("start", "docs/getting-started.md"))
+}
+
+
 TABLES = {
+    **_README_TEXT,
+    "bench-readme": Table(
+        page="README.md",
+        header=bench_history.readme_lines,
+        rows=(("runs", ("bench-history.jsonl",)),),
+        row=lambda rows, label: [],
+        read=bench_history.read_rows,
+    ),
     "effects": Table(
         page="docs/validation.md",
         header=_EFFECTS_HEADER,

@@ -84,6 +84,28 @@ def test_warm_announces_the_compile_once(tmp_path, monkeypatch, capsys):
     assert out.count("compiling the simulators once") == 1 and "vidi: compiling" not in err
 
 
+def test_warm_says_it_is_still_compiling_while_it_compiles(monkeypatch, capsys):
+    """A long compile is never silent: a line every heartbeat until it ends, none after."""
+    import time
+
+    import discovery.warm as W
+
+    monkeypatch.setattr(C, "_ANNOUNCED", set())
+    monkeypatch.setattr(W, "_ANNOUNCED", C._ANNOUNCED)
+    monkeypatch.setattr(W, "cached", lambda kernel: False)
+
+    def slow():
+        time.sleep(0.35)
+        return {k: 0.35 for k in C.KERNELS}
+
+    monkeypatch.setattr(W, "warm", slow)
+    assert W.main(every=0.1) == 0
+    time.sleep(0.3)  # a beat after the end would show here
+    lines = capsys.readouterr().out.splitlines()
+    beats = [ln for ln in lines if "still compiling" in ln]
+    assert 2 <= len(beats) <= 4 and lines[-1].startswith("simulators ready")
+
+
 def test_the_install_compiles_every_entry_of_the_oscillators_kernel(monkeypatch):
     """`make install` (discovery.warm) leaves each compiled entry point of Ueda's kernel in
     the cache, the chart's scan and Floquet check too: a first chart after the install

@@ -11,15 +11,15 @@ from pathlib import Path
 
 import pytest
 
+from . import survey_readme
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
 def _block(name="quickstart"):
-    """The lines of the bash block between ``<!-- NAME -->`` and ``<!-- /NAME -->``."""
-    text = (ROOT / "README.md").read_text()
-    block = re.search(rf"<!-- {name} -->\s*```bash\n(.*?)```\s*<!-- /{name} -->", text, re.S)
-    assert block, f"the README has no {name} block"
-    return [ln for ln in block.group(1).splitlines() if ln.strip()]
+    """The lines of the bash block between ``<!-- NAME -->`` and ``<!-- /NAME -->`` (the
+    README survey times the same lines)."""
+    return survey_readme.block(name)
 
 
 def _python_quickstart():
