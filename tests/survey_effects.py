@@ -217,16 +217,38 @@ def _lagged_record(sc, law, tau, kw):
 
 
 def _machine(start, rec, error, seed):
-    """``(scenario, scale range)`` explain is given: the true machine (``error`` 0), or the
-    machine calibrated from the record from a sheet ``error`` off, as ``vidi explain`` does."""
+    """``(scenario, scale range, found)`` explain is given: the true machine (``error`` 0),
+    or the machine calibrated from the record from a sheet ``error`` off, as ``vidi
+    explain`` does; ``found``: the machine effects the calibration found where the sheet
+    has none (``{effect: (interval name, value, low, high)}``: stiffening supports)."""
     if not error:
-        return start, None
+        return start, None, {}
     from discovery import calibrate
     from tests import realistic as R
 
     sheet = R.sheet_of(start, seed + 555, dict.fromkeys(("m1", "m2", "k1", "c1"), error))
     cal = calibrate(sheet, rec, seed=0)
-    return cal.scenario.with_law(start.law), cal.scale_range
+    found = {}
+    k3 = cal.parameters.get("k3")
+    if k3 and sheet.k3 == 0:
+        found["support_nonlinearity"] = ("k3", k3["record"], k3["low"], k3["high"])
+    return cal.scenario.with_law(start.law), cal.scale_range, found
+
+
+def _with_calibration(outcome, found, truth):
+    """explain's ``outcome`` with the machine effects the calibration found: kept (the
+    machine explain was given has them), their intervals the calibration's."""
+    if not found:
+        return outcome
+    out = {**outcome, "found_by_calibration": sorted(found)}
+    out["kept"] = [*outcome["kept"], *(e for e in found if e not in outcome["kept"])]
+    out["start_consistent"] = False  # the sheet's machine is not the record's
+    for name, value, low, high in found.values():
+        if name in truth and outcome["intervals"].get(name) is None:
+            out["values"] = {**outcome["values"], name: value}
+            out["intervals"] = {**outcome["intervals"], name: [low, high]}
+            out["covered"] = {**outcome["covered"], name: bool(low <= truth[name] <= high)}
+    return out
 
 
 def run_case(args):
@@ -254,9 +276,10 @@ def run_case(args):
             start = case.scenario.with_law(law)
             row.update(_verify_truth(true_sc, true, lag, rec, start, evaluate, Reference))
             t0 = time.perf_counter()
-            given, scale = _machine(start, rec, error, seed)
+            given, scale, found = _machine(start, rec, error, seed)
             res = explain(given, rec, "linear", workers=1, machine_scale=scale)
-            row.update(_outcome(res, truth, time.perf_counter() - t0))
+            outcome = _outcome(res, truth, time.perf_counter() - t0)
+            row.update(_with_calibration(outcome, found, truth))
         except Exception as exc:  # noqa: BLE001 (a survey row records any failure)
             row["error"] = f"{type(exc).__name__}: {exc}"
         rows.append(row)
@@ -319,12 +342,21 @@ def main(argv=None):
         help="give explain the machine calibrated from each record, from a sheet whose masses "
         "and supports are each off by up to this fraction (default 0: the true machine)",
     )
+    p.add_argument(
+        "--classes",
+        nargs="+",
+        choices=CLASSES,
+        help="only the draws of these classes (default: every class)",
+    )
     args = p.parse_args(argv)
     from multiprocessing import get_context
 
     out = measured.RunFile(args.out, "survey_effects", argv, append=True)
     with get_context("spawn").Pool(args.workers) as pool:
-        jobs = [(i, args.sheet_error) for i in range(*args.draws)]
+        draws = [
+            i for i in range(*args.draws) if CLASSES[i % len(CLASSES)] in (args.classes or CLASSES)
+        ]
+        jobs = [(i, args.sheet_error) for i in draws]
         for rows in pool.imap_unordered(run_case, jobs):
             for row in rows:
                 out.write(row)

@@ -212,25 +212,29 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
     held = {n: sheet_values[n] for n in keep if n != "A"}
     if "A" in keep:
         held.update({a: sheet_values[a] for a in amps})
-    if sheet.k3 == 0:
-        held.setdefault("k3", 0.0)  # linear supports stay linear (a stiffening is an effect)
     try:
-        first = estimate(rows, held, draws)
+        first, held = _first_estimate(rows, held, draws, sheet.k3 == 0 and "k3" not in held)
     except np.linalg.LinAlgError:
         return None
-    if not np.all(np.isfinite(first.value)):
+    if first is None:
         return None
-    loose = {}
-    for k, name in enumerate(first.names):
-        if first.fixed[k]:
-            continue
-        v, lo, hi = first.value[k], first.low[k], first.high[k]
-        if not (v > 0 and np.isfinite(lo) and lo > 0 and (hi - lo) / 2 <= LOOSE * v):
-            loose[name] = sheet_values[name]
+    loose = {
+        name: sheet_values[name]
+        for k, name in enumerate(first.names)
+        if not first.fixed[k] and not _determined(first, k)
+    }
     if len(loose) == int((~first.fixed).sum()):
         return None  # the record pins nothing: its force does not follow its motions
     final = estimate(rows, {**held, **loose}, draws) if loose else first
     parameters, notes = _table(first, final, held, loose, sheet_values)
+    if sheet.k3 == 0 and "k3" in parameters:
+        k3 = parameters["k3"]
+        notes.insert(
+            0,
+            f"the supports stiffen: k3 = {_fmt(k3['record'])} [{_fmt(k3['low'])}, "
+            f"{_fmt(k3['high'])}] N/m^3 where the sheet's are linear (the support "
+            "nonlinearity, seen in the frame's own equation; the machine used has it)",
+        )
     if sheet.mass_loss > 0:
         notes.append(
             f"the sheet's moulding sheds {sheet.mass_loss:g} of its mass at every contact: "
@@ -252,14 +256,39 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
     return _Group(parameters, scenarios, residual, notes, drive_phase(rows, draws), series)
 
 
+def _determined(est, k):
+    """Whether parameter ``k`` of ``est`` is pinned: positive, its 95 % interval above 0 and
+    its half width at most :data:`LOOSE` of its value."""
+    v, lo, hi = est.value[k], est.low[k], est.high[k]
+    return bool(v > 0 and np.isfinite(lo) and lo > 0 and (hi - lo) / 2 <= LOOSE * v)
+
+
+def _first_estimate(rows, held, draws, probe_k3):
+    """The estimate with only ``held`` fixed, and the parameters it held: ``(Estimate or
+    None, held)``.  With ``probe_k3`` (a sheet with linear supports) the supports are
+    estimated linear, and with ``k3`` free too: the record's stiffening is kept where it
+    pins ``k3`` (:func:`_determined`), else the supports stay linear, as the sheet has
+    them, and every other parameter is judged as with them."""
+    linear = {**held, "k3": 0.0} if probe_k3 else held
+    first = estimate(rows, linear, draws)
+    if not np.all(np.isfinite(first.value)):
+        return None, linear
+    if probe_k3:
+        free = estimate(rows, held, draws)
+        k = free.names.index("k3")
+        if np.all(np.isfinite(free.value)) and _determined(free, k):
+            return free, held
+    return first, linear
+
+
 def _table(first, final, held, loose, sheet_values):
     """The parameter table of :class:`~.result.Calibration` and a note for each loose
     parameter: ``first`` the estimate with only the held parameters fixed, ``final`` with the
     loose ones kept at the sheet's values too."""
     parameters, notes = {}, []
     for k, name in enumerate(final.names):
-        if name == "k3" and name in held and sheet_values["k3"] == 0:
-            continue
+        if name == "k3" and sheet_values["k3"] == 0 and (name in held or name in loose):
+            continue  # linear supports, as the sheet has them
         src = first if name in loose else final
         rec = float(src.value[k])
         determined = not final.fixed[k]
