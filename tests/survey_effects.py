@@ -220,7 +220,8 @@ def _machine(start, rec, error, seed):
     """``(scenario, scale range, found)`` explain is given: the true machine (``error`` 0),
     or the machine calibrated from the record from a sheet ``error`` off, as ``vidi
     explain`` does; ``found``: the machine effects the calibration found where the sheet
-    has none (``{effect: (interval name, value, low, high)}``: stiffening supports)."""
+    has none (``{effect: (interval name, value, low, high)}``: stiffening supports, with
+    the machine scale's range, and a mass loss)."""
     if not error:
         return start, None, {}
     from discovery import calibrate
@@ -229,9 +230,13 @@ def _machine(start, rec, error, seed):
     sheet = R.sheet_of(start, seed + 555, dict.fromkeys(("m1", "m2", "k1", "c1"), error))
     cal = calibrate(sheet, rec, seed=0)
     found = {}
+    low, high = cal.scale_range or (1.0, 1.0)  # a scaled parameter shares the scale's range
     k3 = cal.parameters.get("k3")
     if k3 and sheet.k3 == 0:
-        found["support_nonlinearity"] = ("k3", k3["record"], k3["low"], k3["high"])
+        found["support_nonlinearity"] = ("k3", k3["record"], low * k3["low"], high * k3["high"])
+    loss = cal.parameters.get("mass_loss")
+    if loss:
+        found["mass_loss"] = ("loss", loss["record"], loss["low"], loss["high"])
     return cal.scenario.with_law(start.law), cal.scale_range, found
 
 

@@ -14,6 +14,7 @@ from ..model.scenario import Scenario
 from .equations import machine_rows
 from .estimate import cycle_draws, drive_phase, estimate, frame_residual, moulding_residual
 from .result import UNITS, Calibration
+from .shedding import shedding
 from .units import check_units
 
 __all__ = ["calibrate", "CALIBRATED", "LOOSE"]
@@ -95,9 +96,11 @@ def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, kee
         members = [k for k in members if rows[k] is not None]
         if not members:
             continue
-        group = _calibrate_group(
-            [rows[k] for k in members], [sheets[k] for k in members], keep, n_boot, seed
-        )
+        shed = _shedding(members, rows, meas, sheets, offsets)
+        group_sheets = [
+            sheets[k] if shed is None else sheets[k].replace(mass_loss=shed.loss) for k in members
+        ]
+        group = _calibrate_group([rows[k] for k in members], group_sheets, keep, n_boot, seed)
         if group is None:
             notes.append(
                 "the record pins none of the machine's parameters (its force does not "
@@ -110,6 +113,9 @@ def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, kee
             used[k] = sc
             phases[k] = ph
         prefix = "" if len(groups) == 1 else f"records {', '.join(str(k + 1) for k in members)}: "
+        if shed is not None:
+            group.parameters["mass_loss"] = _shedding_row(shed)
+            group.notes.insert(0, _shedding_note(shed))
         parameters.update({prefix + n: v for n, v in group.parameters.items()})
         residual = group.residual if len(groups) == 1 else {**residual, prefix: group.residual}
         notes += group.notes
@@ -156,6 +162,45 @@ def _inputs(scenario, measurement, time_offset, keep):
             f"calibrate: keep names {bad[0]!r}; the parameters are {', '.join(CALIBRATED)}"
         )
     return meas, sheets, offsets, keep
+
+
+def _shedding(members, rows, meas, sheets, offsets):
+    """The mass loss the records ``members`` of one machine show where their sheets have
+    none (:mod:`.shedding`), or ``None``; when found, their rows are made again with it
+    (``rows`` updated in place), so that ``m2`` is the mass at each record's start."""
+    if any(sheets[k].mass_loss > 0 for k in members):
+        return None
+    found = shedding(
+        [rows[k] for k in members], [meas[k] for k in members], [sheets[k] for k in members]
+    )
+    if found is None or not found.found:
+        return None
+    for k in members:
+        rows[k] = machine_rows(meas[k], sheets[k].replace(mass_loss=found.loss), float(offsets[k]))
+    return found
+
+
+def _shedding_row(shed):
+    """The parameter table's row of a mass loss the record shows."""
+    return {
+        "unit": UNITS["mass_loss"],
+        "sheet": 0.0,
+        "record": shed.loss,
+        "low": shed.low,
+        "high": shed.high,
+        "determined": True,
+        "held": False,
+        "used": shed.loss,
+    }
+
+
+def _shedding_note(shed):
+    return (
+        f"the moulding sheds mass: {_fmt(shed.loss)} [{_fmt(shed.low)}, {_fmt(shed.high)}] "
+        f"of it at every contact (from its mass at each of {shed.contacts} contacts) where "
+        "the sheet has none; m2 is its mass at the record's start, and the machine used "
+        "sheds it"
+    )
 
 
 def _phase_notes(phases, sheets):
@@ -237,7 +282,7 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
         )
     if sheet.mass_loss > 0:
         notes.append(
-            f"the sheet's moulding sheds {sheet.mass_loss:g} of its mass at every contact: "
+            f"the moulding sheds {sheet.mass_loss:.3g} of its mass at every contact: "
             "m2 is its mass at the record's start (each window's equations hold the mass "
             "left after the record's contacts before it)"
         )

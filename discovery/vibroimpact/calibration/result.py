@@ -10,7 +10,15 @@ from ..model.scenario import Scenario
 __all__ = ["Calibration", "UNITS"]
 
 #: each calibrated parameter's unit
-UNITS = {"m1": "kg", "m2": "kg", "k1": "N/m", "c1": "N s/m", "k3": "N/m^3", "A": "N"}
+UNITS = {
+    "m1": "kg",
+    "m2": "kg",
+    "k1": "N/m",
+    "c1": "N s/m",
+    "k3": "N/m^3",
+    "A": "N",
+    "mass_loss": "1/contact",
+}
 #: the least relative uncertainty granted the machine's scale: a bias the bootstrap over
 #: cycles cannot see (the force's quadrature; noise-free, the contacts' windows leave at
 #: most 0.5 % on stiff, heavily damped contacts whose impulse lies in a few samples)
@@ -23,6 +31,7 @@ WHAT = {
     "c1": "support damping",
     "k3": "supports' cubic stiffness",
     "A": "drive amplitude",
+    "mass_loss": "moulding's mass loss per contact",
 }
 
 

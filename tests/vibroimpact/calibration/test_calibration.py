@@ -193,3 +193,22 @@ def test_stiffening_supports_under_a_linear_sheet_are_found_and_used():
     linear = calibrate(sheet, _record(sc, sc.law, noise=0.01))
     assert "k3" not in linear.parameters and linear.scenario.k3 == 0.0
     assert not any("stiffen" in n for n in linear.notes)
+
+
+def test_a_moulding_that_sheds_mass_under_a_sheet_that_keeps_it_is_found():
+    """The moulding sheds 0.5 % of its mass per contact (the paper's machine, 40 periods,
+    the sheet's mass its mass at the record's start): the calibration reads the loss from
+    its mass at each contact, the interval holds the truth, m2 is the start mass (a
+    constant-mass calibration returns the record's average, 10 % lower), the machine used
+    sheds it and a note says so; the constant-mass record shows no loss."""
+    from tests.vibroimpact.explain.test_explain_effects import shedding_record
+
+    sc = load_scenario("paper")
+    cal = calibrate(sc, shedding_record(sc, sc.law, delta=0.005))
+    q = cal.parameters["mass_loss"]
+    assert q["determined"] and q["low"] <= 0.005 <= q["high"], q
+    assert cal.scenario.mass_loss == pytest.approx(0.005, rel=0.2)
+    assert cal.scenario.m2 == pytest.approx(sc.m2, rel=0.02)
+    assert cal.notes[0].startswith("the moulding sheds mass: ")
+    steady = calibrate(sc, _record(sc, sc.law, periods=40, noise=0.01))
+    assert "mass_loss" not in steady.parameters and steady.scenario.mass_loss == 0.0
