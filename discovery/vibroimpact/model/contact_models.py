@@ -1,14 +1,7 @@
-"""The contact models engineers name, each a :class:`ForceLaw` with physical parameters.
-
-======================  =====================================  ===================
-name                    force while ``zeta > 0``               parameters
-======================  =====================================  ===================
-``kelvin-voigt``        ``k z + c dz``                         ``k, c``
-``hertz-damper``        ``k z^1.5 + c dz``                     ``k, c``
-``hunt-crossley``       ``k z^n + lambda z^n dz``              ``k, n, lambda``
-``lankarani-nikravesh`` ``k z^n (1 + 3 (1 - e^2) / 4 dz/v0)``  ``k, n, e``
-``flores``              ``k z^n (1 + 8 (1 - e) / (5 e) dz/v0)``  ``k, n, e``
-======================  =====================================  ===================
+"""The contact models engineers name, each a :class:`ForceLaw` with physical parameters:
+the entries of the registry
+(:data:`~discovery.vibroimpact.model.contact_registry.CONTACT_MODELS`, whose docstring
+lists them), read here without switching on a model's name.
 
 ``dz`` is the signed penetration rate: the damping acts in loading and in unloading (the
 law's unloading terms, :mod:`~discovery.vibroimpact.model.law`), and the force is never
@@ -23,10 +16,6 @@ rate) does not, on purpose (damping while unloading); (6) (dissipativity) holds 
 
 Text form: ``"hunt-crossley: k=2e9, n=1.5, lambda=3e9"``, ``"flores: k=2e9, n=1.5,
 e=0.6"``, ``"kelvin-voigt: k=2e8, c=1e6"`` (:func:`parse_model`).
-
-Each model is one entry of the registry
-(:data:`~discovery.vibroimpact.model.contact_registry.CONTACT_MODELS`): its parameters, its
-force, its restitution relation; this module reads it and switches on no model's name.
 """
 
 import difflib

@@ -8,6 +8,21 @@ whose fit starts its own, its force as plain text and as LaTeX, and a line that 
 it.  The models (:class:`~discovery.vibroimpact.model.contact_models.ContactModel`), their
 fit, the fit's starts, the reports and the CLI's help read the spec; adding a model is
 adding one entry to :data:`CONTACT_MODELS` here.
+
+The shipped models:
+
+======================  =====================================  ===================
+name                    force while ``zeta > 0``               parameters
+======================  =====================================  ===================
+``kelvin-voigt``        ``k z + c dz``                         ``k, c``
+``hertz-damper``        ``k z^1.5 + c dz``                     ``k, c``
+``hunt-crossley``       ``k z^n + lambda z^n dz``              ``k, n, lambda``
+``lankarani-nikravesh`` ``k z^n (1 + 3 (1 - e^2) / 4 dz/v0)``  ``k, n, e``
+``flores``              ``k z^n (1 + 8 (1 - e) / (5 e) dz/v0)``  ``k, n, e``
+======================  =====================================  ===================
+
+(``dz`` the signed penetration rate, ``v0`` each impact's approach velocity:
+:mod:`~discovery.vibroimpact.model.contact_models`.)
 """
 
 from collections.abc import Callable
