@@ -5,6 +5,7 @@ tell from it."""
 
 from __future__ import annotations
 
+from discovery.vibroimpact.model.contact_registry import CONTACT_MODELS
 from discovery.wording import records as the_records
 from discovery.wording import verb
 
@@ -16,13 +17,12 @@ from .vibroimpact.contact_figures import at_floor, failed, failure_reasons
 __all__ = ["contact_models_context", "drawn_by_report"]
 
 _PARAM_TEX = {"k": "k", "n": "n", "c": "c", "lambda": r"\lambda", "e": "e"}
-_FORMS = {
-    "kelvin-voigt": r"k\zeta + c\dot\zeta",
-    "hertz-damper": r"k\zeta^{1.5} + c\dot\zeta",
-    "hunt-crossley": r"k\zeta^n + \lambda\zeta^n\dot\zeta",
-    "lankarani-nikravesh": r"k\zeta^n\left(1 + \tfrac{3(1-e^2)}{4}\,\dot\zeta/v_0\right)",
-    "flores": r"k\zeta^n\left(1 + \tfrac{8(1-e)}{5e}\,\dot\zeta/v_0\right)",
-}
+
+
+def _form(model):
+    """A model's force in LaTeX, as its registry entry writes it ("" for no model)."""
+    spec = CONTACT_MODELS.get(model)
+    return spec.latex if spec is not None else ""
 
 
 def _parameter_cells(f):
@@ -53,7 +53,7 @@ def _rows(fits, selected):
         rows.append(
             [
                 name,
-                Tex(f"${_FORMS.get(f.model, '')}$"),
+                Tex(f"${_form(f.model)}$"),
                 num(f.value, 3),
                 escape(ok),
                 Tex("; ".join(_parameter_cells(f))),

@@ -66,13 +66,16 @@ from discovery.vibroimpact.dynamics.steady_states import steady_state  # noqa: E
 from discovery.vibroimpact.fit.contact_fit import fit_contact_models  # noqa: E402
 from discovery.vibroimpact.fit.identification import bootstrap_intervals  # noqa: E402
 from discovery.vibroimpact.model.contact_models import (  # noqa: E402
-    MODELS,
     ContactModel,
     restitution_ratio,
 )
+from discovery.vibroimpact.model.contact_registry import CONTACT_MODELS  # noqa: E402
 from discovery.vibroimpact.verify import Reference  # noqa: E402
 from tests import measured  # noqa: E402
 from tests.realistic import draw_case, reference_record  # noqa: E402
+
+#: the named models, each with its parameters in order
+MODELS = {name: spec.parameters for name, spec in CONTACT_MODELS.items()}
 
 PARAMS_CHECKED = ("k", "n", "e", "lambda", "c")
 

@@ -181,9 +181,9 @@ def test_a_draft_table_renders_from_the_run_files_given(tmp_path, capsys):
 def _contact_row(truth, seed, selected, equivalent=(), covered=None, boot=None, **kw):
     """A row of tests.survey_contact_models: the true model's fit with an interval per
     parameter (``covered``: which hold the true value), and the bootstrap's (``boot``)."""
-    from discovery.vibroimpact.model.contact_models import MODELS
+    from discovery.vibroimpact.model.contact_registry import CONTACT_MODELS
 
-    keys = MODELS.get(truth, ())
+    keys = CONTACT_MODELS[truth].parameters if truth in CONTACT_MODELS else ()
     true = {k: 1.0 for k in keys}
     inside = {k: [0.5, 1.5] if (covered or {}).get(k, True) else [2.0, 3.0] for k in keys}
     row = {

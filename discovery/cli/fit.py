@@ -7,6 +7,7 @@ import time
 
 from .._io import OutputDir
 from ..errors import InputError
+from ..vibroimpact.model.contact_registry import CONTACT_MODELS
 from ..vibroimpact.verify.criteria import CRITERIA
 from . import _options
 from ._common import (
@@ -307,8 +308,8 @@ def _add_regression_options(p):
         help="candidate terms: poly:N (every z^a zd^b with 1 <= a+b <= N), hc (the "
         "Hunt-Crossley terms z^1.5 and z^1.5*zd), a list 'z,zd,z*zd', or sums (poly:2+hc); "
         "or 'contact-models': "
-        "the named models (kelvin-voigt, hertz-damper, hunt-crossley, lankarani-nikravesh, "
-        "flores) fitted by name (default: %(default)s)",
+        f"the named models ({', '.join(CONTACT_MODELS)}) fitted by name "
+        "(default: %(default)s)",
     )
     p.add_argument(
         "--select",

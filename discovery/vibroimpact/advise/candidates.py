@@ -340,10 +340,11 @@ def distinct_laws(laws):
 
 def fitted_model(result, name):
     """The named model ``name`` of a contact-models fit with its fitted parameters."""
-    from ..model.contact_models import MODELS, ContactModel
+    from ..model.contact_models import ContactModel
+    from ..model.contact_registry import CONTACT_MODELS
 
     p = result.fit(name).parameters
-    return ContactModel(name, tuple(p[k] for k in MODELS[name]))
+    return ContactModel(name, tuple(p[k] for k in CONTACT_MODELS[name].parameters))
 
 
 def unique_laws(laws):

@@ -37,11 +37,12 @@ from ...wording import records as the_records
 from ...wording import verb
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
-from ..model.contact_models import DOMAINS, MODELS, same_force
+from ..model.contact_models import same_force
+from ..model.contact_registry import CONTACT_MODELS, DOMAINS
 from ..model.scenario import Scenario
 from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
-from .contact_starts import from_hunt_crossley, record_samples, regression_start, start_model
+from .contact_starts import from_seed, record_samples, regression_start, start_model
 from .identification import _checks, as_records, identify
 
 __all__ = ["ContactFit", "ContactModelsResult", "ContactModelsSettings", "fit_contact_models"]
@@ -316,11 +317,13 @@ def _within(progress, name, i, names):
     return lambda stage, done, total: progress(f"{head} ({stage})", done, total)
 
 
-def _fit_one(name, records, settings, progress, hunt_crossley=None):
+def _fit_one(name, records, settings, progress, seeding=None):
+    """The fit of model ``name``; ``seeding``: the fit of the model its spec is seeded by
+    (None: not fitted)."""
     sc0, ref0 = records[0]
     extra = (regression_start(name, settings["samples"]),)
-    if name in ("lankarani-nikravesh", "flores"):
-        extra += (from_hunt_crossley(name, hunt_crossley, sc0, ref0),)
+    if CONTACT_MODELS[name].seeded_by is not None:
+        extra += (from_seed(name, seeding, sc0, ref0),)
     start = start_model(name, records, settings["tolerances"], extra)
     try:
         res = identify(
@@ -398,7 +401,8 @@ def fit_contact_models(scenario, reference, *, settings=None, progress=None, **o
     settings : ContactModelsSettings, optional
         The options below in one object; keywords override its fields.
     models : sequence of str, optional
-        Models to fit (default all of :data:`~discovery.vibroimpact.model.contact_models.MODELS`).
+        Models to fit (default all of
+        :data:`~discovery.vibroimpact.model.contact_registry.CONTACT_MODELS`).
     max_simulations : int
         Budget of each model's fit.
     n_boot : int
@@ -422,11 +426,12 @@ def fit_contact_models(scenario, reference, *, settings=None, progress=None, **o
     o = ContactModelsSettings.of("fit_contact_models", settings, options)
     models, max_simulations, n_boot, seed = o.models, o.max_simulations, o.n_boot, o.seed
     t0 = time.perf_counter()
-    names = list(MODELS) if models is None else [str(m) for m in models]
-    bad = [m for m in names if m not in MODELS]
+    names = list(CONTACT_MODELS) if models is None else [str(m) for m in models]
+    bad = [m for m in names if m not in CONTACT_MODELS]
     if bad or not names:
         raise InputError(
-            f"unknown contact model {bad[0] if bad else ''!r}; the models: {', '.join(MODELS)}"
+            f"unknown contact model {bad[0] if bad else ''!r}; the models: "
+            f"{', '.join(CONTACT_MODELS)}"
         )
     records = as_records(scenario, reference)
     # what every model's fit is given (``settings`` is the caller's options object)
@@ -439,15 +444,17 @@ def fit_contact_models(scenario, reference, *, settings=None, progress=None, **o
         "workers": o.workers,
     }
     fits = []
-    # Hunt-Crossley first: its fit starts Lankarani-Nikravesh and Flores (the same force
-    # at one impact velocity)
-    order = sorted(names, key=lambda m: m in ("lankarani-nikravesh", "flores"))
+    # the seeds first: Hunt-Crossley's fit starts Lankarani-Nikravesh and Flores (the same
+    # force at one impact velocity), each model's spec naming its seed
+    order = sorted(names, key=lambda m: CONTACT_MODELS[m].seeded_by is not None)
     with shared_blocks([ref for _, ref in records], block_workers(o.workers)):
         for i, name in enumerate(order):
             if progress is not None:
                 progress("contact models", i, len(names))
-            hc = next((f for f in fits if f.model == "hunt-crossley"), None)
-            fits.append(_fit_one(name, records, fitting, _within(progress, name, i, names), hc))
+            by = CONTACT_MODELS[name].seeded_by
+            seeding = next((f for f in fits if f.model == by), None)
+            at = _within(progress, name, i, names)
+            fits.append(_fit_one(name, records, fitting, at, seeding))
     if progress is not None:
         progress("contact models", len(names), len(names))
     fits.sort(key=lambda f: f.value)

@@ -1,16 +1,19 @@
 """Where the fit of a named contact model starts (:mod:`.contact_fit`): the best by I2 of a
 linear least-squares fit to the record's contact samples, a grid of stiffness and damping
-ratios, and for Lankarani-Nikravesh and Flores the Hunt-Crossley fit read at the record's
-impact velocity."""
+ratios, and for a model its spec says is seeded by another (Lankarani-Nikravesh and Flores
+by Hunt-Crossley) that model's fit read at the record's impact velocity.  Each rule reads
+the model's spec (:mod:`~discovery.vibroimpact.model.contact_registry`): its fixed
+exponent, its damping term, its restitution relation."""
 
 import numpy as np
 
 from ...errors import VidiError
 from ..model.contact_models import ContactModel, restitution_from_ratio
+from ..model.contact_registry import CONTACT_MODELS
 from ..model.law import Term
 from .identification import contact_scales, record_start
 
-__all__ = ["start_model", "record_samples", "from_hunt_crossley", "regression_start"]
+__all__ = ["start_model", "record_samples", "from_seed", "regression_start"]
 
 _START_N = (1.0, 1.25, 1.5)
 _START_XI = (0.05, 0.2, 0.6)  # damping ratios of the start grid
@@ -20,16 +23,24 @@ _START_XI = (0.05, 0.2, 0.6)  # damping ratios of the start grid
 _START_K = (1.0, 0.3, 0.1)
 
 
+def _model(name, k, n, d, e_start):
+    """The model ``name`` of stiffness ``k``, exponent ``n`` and damping ``d``: the
+    coefficient of its damping term (``c`` of ``dz``, ``lambda`` of ``z^n dz``), or for an
+    impact-scaled model its ratio ``r``, read as a restitution clipped to ``e_start``'s
+    ``(low, high)`` (``e_start[0]`` where the ratio means none)."""
+    spec = CONTACT_MODELS[name]
+    if spec.impact_scaled:
+        e = restitution_from_ratio(name, d)
+        d = min(max(e if np.isfinite(e) else e_start[0], e_start[1]), e_start[2])
+    return ContactModel(name, spec.values(k, n, d))
+
+
 def _candidate(name, k, n, c, *, v0, z0):
     """A start model of stiffness ``k``, exponent ``n`` and a dashpot ``c`` at the typical
     penetration ``z0`` [m] and impact velocity ``v0`` [m/s]."""
-    if name in ("kelvin-voigt", "hertz-damper"):
-        return ContactModel(name, (k, c))
-    if name == "hunt-crossley":
-        return ContactModel(name, (k, n, c / z0**n))
-    e = restitution_from_ratio(name, c / z0**n * v0 / k)
-    e = e if np.isfinite(e) else 0.3
-    return ContactModel(name, (k, n, min(max(e, 0.1), 0.95)))
+    spec = CONTACT_MODELS[name]
+    d = c / z0**n if spec.damper_with_n else c
+    return _model(name, k, n, d * v0 / k if spec.impact_scaled else d, (0.3, 0.1, 0.95))
 
 
 def _start_candidates(name, scenario, ref):
@@ -38,7 +49,7 @@ def _start_candidates(name, scenario, ref):
     :data:`_START_XI`."""
     mu = scenario.m1 * scenario.m2 / (scenario.m1 + scenario.m2)
     _, v0, z0 = contact_scales(scenario, ref)
-    fixed = {"kelvin-voigt": 1.0, "hertz-damper": 1.5}.get(name)
+    fixed = CONTACT_MODELS[name].fixed_n
     out = []
     for n in (fixed,) if fixed else _START_N:
         (k,) = record_start(scenario, ref, [Term(n, 0.0)])
@@ -51,6 +62,8 @@ def _start_candidates(name, scenario, ref):
 
 
 _LS_N = np.linspace(1.0, 1.6, 13)  # exponents the regression start tries
+# a restitution read from a fit: where the ratio means none, and the range it is clipped to
+_E_FIT = (0.05, 0.05, 0.98)
 
 
 def _impact_velocities(samples):
@@ -75,44 +88,40 @@ def regression_start(name, samples):
     z = np.maximum(samples.zeta[keep], 0.0)
     dz, F = samples.dzeta[keep], samples.F[keep]
     v0 = _impact_velocities(samples)[keep]
-    fixed = {"kelvin-voigt": 1.0, "hertz-damper": 1.5}.get(name)
+    spec = CONTACT_MODELS[name]
+    fixed = spec.fixed_n
     best, best_r = None, np.inf
     for n in (fixed,) if fixed else _LS_N:
         zn = z**n
-        if fixed:
-            damp = dz  # a linear dashpot
-        elif name == "hunt-crossley":
-            damp = zn * dz
-        else:
-            damp = zn * dz / v0  # lambda = k r / v0: the second coefficient is k r
-        A = np.column_stack([zn, damp])
+        columns = [zn]
+        if spec.damper is not None:  # a dashpot, Hunt-Crossley's term, or it over each v0
+            damp = zn * dz if spec.damper_with_n else dz
+            columns.append(damp / v0 if spec.impact_scaled else damp)
+        A = np.column_stack(columns)
         coef, *_ = np.linalg.lstsq(A, F, rcond=None)
         r = float(np.sum((A @ coef - F) ** 2))
-        k, c = float(coef[0]), max(float(coef[1]), 0.0)
+        k = float(coef[0])
+        c = max(float(coef[1]), 0.0) if len(coef) > 1 else 0.0
         if not (k > 0 and r < best_r):
             continue
-        if fixed:
-            cand = (k, c)
-        elif name == "hunt-crossley":
-            cand = (k, n, c)
-        else:
-            e = restitution_from_ratio(name, c / k)
-            cand = (k, n, min(max(e if np.isfinite(e) else 0.05, 0.05), 0.98))
-        best, best_r = ContactModel(name, cand), r
+        # an impact-scaled model's second coefficient is k r (lambda = k r / v0)
+        best, best_r = _model(name, k, n, c / k if spec.impact_scaled else c, _E_FIT), r
     return best
 
 
-def from_hunt_crossley(name, fit, scenario, ref):
-    """A Lankarani-Nikravesh or Flores start from a fitted Hunt-Crossley model: the same
-    force at the record's typical impact velocity (``r = lambda v0 / k``), or None."""
+def from_seed(name, fit, scenario, ref):
+    """A start of an impact-scaled model (Lankarani-Nikravesh, Flores) from the fit of the
+    model its spec is seeded by (Hunt-Crossley): the same force at the record's typical
+    impact velocity (``r = lambda v0 / k``, ``lambda`` the seed's damping coefficient), or
+    None."""
     if fit is None or fit.consistent is None:
         return None
     p = fit.parameters
     v0 = contact_scales(scenario, ref)[1]
-    e = restitution_from_ratio(name, p["lambda"] * v0 / p["k"])
-    if not np.isfinite(e):
+    r = CONTACT_MODELS[fit.model].damping(p) * v0 / p["k"]
+    if not np.isfinite(restitution_from_ratio(name, r)):
         return None
-    return ContactModel(name, (p["k"], p["n"], min(max(e, 0.05), 0.98)))
+    return _model(name, p["k"], p["n"], r, _E_FIT)
 
 
 def start_model(name, records, tolerances, extra=()):

@@ -1,14 +1,7 @@
-"""The contact models engineers name, each a :class:`ForceLaw` with physical parameters.
-
-======================  =====================================  ===================
-name                    force while ``zeta > 0``               parameters
-======================  =====================================  ===================
-``kelvin-voigt``        ``k z + c dz``                         ``k, c``
-``hertz-damper``        ``k z^1.5 + c dz``                     ``k, c``
-``hunt-crossley``       ``k z^n + lambda z^n dz``              ``k, n, lambda``
-``lankarani-nikravesh`` ``k z^n (1 + 3 (1 - e^2) / 4 dz/v0)``  ``k, n, e``
-``flores``              ``k z^n (1 + 8 (1 - e) / (5 e) dz/v0)``  ``k, n, e``
-======================  =====================================  ===================
+"""The contact models engineers name, each a :class:`ForceLaw` with physical parameters:
+the entries of the registry
+(:data:`~discovery.vibroimpact.model.contact_registry.CONTACT_MODELS`, whose docstring
+lists them), read here without switching on a model's name.
 
 ``dz`` is the signed penetration rate: the damping acts in loading and in unloading (the
 law's unloading terms, :mod:`~discovery.vibroimpact.model.law`), and the force is never
@@ -33,10 +26,10 @@ import numpy as np
 
 from ..._validate import Real, Text, check
 from ...errors import InputError
-from .law import ForceLaw, Term
+from .contact_registry import CONTACT_MODELS, E_RANGE, K_FLOOR, N_RANGE
+from .law import ForceLaw
 
 __all__ = [
-    "MODELS",
     "ContactModel",
     "parse_model",
     "parse_law",
@@ -45,67 +38,47 @@ __all__ = [
     "same_force",
 ]
 
-#: the models, each with its parameters in order and whether ``n`` is its own
-MODELS = {
-    "kelvin-voigt": ("k", "c"),
-    "hertz-damper": ("k", "c"),
-    "hunt-crossley": ("k", "n", "lambda"),
-    "lankarani-nikravesh": ("k", "n", "e"),
-    "flores": ("k", "n", "e"),
-}
-_FIXED_N = {"kelvin-voigt": 1.0, "hertz-damper": 1.5}
-N_RANGE = (0.5, 3.0)  # exponents a fit may reach
-E_RANGE = (0.02, 1.0)  # coefficients of restitution a fit may reach
-#: each parameter's domain ``(low, high, low_open)``: what a fit may reach (a stiffness stays
-#: above 0, the damping at or above it, ``n`` and ``e`` in their ranges)
-DOMAINS = {
-    "k": (0.0, np.inf, True),
-    "c": (0.0, np.inf, False),
-    "lambda": (0.0, np.inf, False),
-    "n": (*N_RANGE, False),
-    "e": (*E_RANGE, False),
-}
-#: where a stiffness is held above 0 (its open lower bound)
-K_FLOOR = 1e-300
+
+def _restitution_spec(name):
+    """The spec of a model with a restitution relation (an impact-scaled one)."""
+    spec = CONTACT_MODELS.get(name)
+    if spec is None or spec.ratio is None:
+        raise InputError(f"{name!r} is no contact model with a coefficient of restitution")
+    return spec
 
 
 def restitution_ratio(name, e):
     """The damping ratio ``r = lambda v0 / k`` a model gives to a coefficient of
     restitution ``e``."""
-    if name == "lankarani-nikravesh":
-        return 3.0 * (1.0 - e * e) / 4.0
-    return 8.0 * (1.0 - e) / (5.0 * e)
+    return _restitution_spec(name).ratio(e)
 
 
 def restitution_from_ratio(name, r):
     """The coefficient of restitution a ratio ``r`` means for a model (``nan`` where the
     model has none: Lankarani-Nikravesh beyond ``r = 3/4``)."""
-    r = max(float(r), 0.0)
-    if name == "lankarani-nikravesh":
-        return float(np.sqrt(1.0 - 4.0 * r / 3.0)) if r <= 0.75 else float("nan")
-    return 8.0 / (8.0 + 5.0 * r)
-
-
-#: the models that are one force family ``k z^n (1 + r dz / v0)``, each reading ``e`` from ``r``
-_ONE_FAMILY = ("lankarani-nikravesh", "flores")
+    return _restitution_spec(name).restitution(max(float(r), 0.0))
 
 
 def same_force(name, parameters):
     """``(other model, its parameters)`` making exactly the same force as model ``name``
     with ``parameters`` at every impact velocity, or ``None``.
 
-    Lankarani-Nikravesh and Flores are one family: the same ``k``, ``n`` and ratio
-    ``r`` give the same force, so no record, at any operating point, can tell them apart.
-    A Flores model whose ``r`` exceeds ``3/4`` (``e < 8/11.75``) has no Lankarani-Nikravesh
-    counterpart.
+    The models with a restitution relation (Lankarani-Nikravesh and Flores) are one family
+    ``k z^n (1 + r dz / v0)``: the same ``k``, ``n`` and ratio ``r`` give the same force,
+    so no record, at any operating point, can tell them apart.  A Flores model whose ``r``
+    exceeds ``3/4`` (``e < 8/11.75``) has no Lankarani-Nikravesh counterpart.
     """
-    if name not in _ONE_FAMILY:
+    spec = CONTACT_MODELS.get(name)
+    if spec is None or not spec.impact_scaled:
         return None
-    other = _ONE_FAMILY[1 - _ONE_FAMILY.index(name)]
-    e = restitution_from_ratio(other, restitution_ratio(name, float(parameters["e"])))
-    if not np.isfinite(e):
-        return None
-    return other, {"k": float(parameters["k"]), "n": float(parameters["n"]), "e": e}
+    r = spec.ratio(float(parameters["e"]))
+    for other in CONTACT_MODELS.values():
+        if other.impact_scaled and other.name != name:
+            e = restitution_from_ratio(other.name, r)
+            if np.isfinite(e):
+                k, n = float(parameters["k"]), float(parameters["n"])
+                return other.name, {"k": k, "n": n, "e": e}
+    return None
 
 
 @dataclass(frozen=True)
@@ -128,15 +101,16 @@ class ContactModel:
         check("ContactModel: values", self.values, (tuple, list))
         for v in self.values:
             check("ContactModel: each of values", v, Real())
-        if self.name not in MODELS:
+        if self.name not in CONTACT_MODELS:
             raise InputError(
-                f"unknown contact model {self.name!r}; the models: {', '.join(MODELS)}"
+                f"unknown contact model {self.name!r}; the models: {', '.join(CONTACT_MODELS)}"
             )
+        keys = self.spec.parameters
         vals = tuple(float(v) for v in self.values)
-        if len(vals) != len(MODELS[self.name]) or not all(np.isfinite(vals)):
+        if len(vals) != len(keys) or not all(np.isfinite(vals)):
             raise InputError(
-                f"{self.name} takes {len(MODELS[self.name])} finite parameters "
-                f"({', '.join(MODELS[self.name])}); got {self.values!r}"
+                f"{self.name} takes {len(keys)} finite parameters "
+                f"({', '.join(keys)}); got {self.values!r}"
             )
         object.__setattr__(self, "values", vals)
         p = self.params
@@ -157,11 +131,15 @@ class ContactModel:
 
     # ----------------------------------------------------------- parameters
     @property
+    def spec(self):
+        """The model's entry in the registry
+        (:data:`~discovery.vibroimpact.model.contact_registry.CONTACT_MODELS`)."""
+        return CONTACT_MODELS[self.name]
+
+    @property
     def params(self):
-        """``{name: value}``, with ``n`` for every model (fixed for two of them)."""
-        out = dict(zip(MODELS[self.name], self.values, strict=True))
-        out.setdefault("n", _FIXED_N.get(self.name, 1.0))
-        return out
+        """``{name: value}``, with ``n`` for every model (fixed for some of them)."""
+        return self.spec.params(self.values)
 
     @property
     def coefficients(self):
@@ -171,14 +149,13 @@ class ContactModel:
     @property
     def names(self):
         """The parameters' names, in order."""
-        return list(MODELS[self.name])
+        return list(self.spec.parameters)
 
     def with_coefficients(self, values):
         """The model with new parameters (``n`` and ``e`` clipped to the ranges a fit may
         reach, the damping to >= 0), so a fit's trial step stays a model."""
         out = []
-        for key, v in zip(MODELS[self.name], values, strict=True):
-            lo, hi, open_low = DOMAINS[key]
+        for (lo, hi, open_low), v in zip(self.spec.domains.values(), values, strict=True):
             out.append(min(max(float(v), K_FLOOR if open_low else lo), hi))
         return ContactModel(self.name, tuple(out))
 
@@ -186,26 +163,7 @@ class ContactModel:
     @property
     def law(self):
         """The model as a :class:`ForceLaw` (damping in loading and unloading)."""
-        p = self.params
-        k, n = p["k"], p["n"]
-        if self.name in _FIXED_N:
-            el, damp, c = Term(n, 0.0), Term(0.0, 1.0), p["c"]
-        else:
-            el, damp = Term(n, 0.0), Term(n, 1.0)
-            c = (
-                p["lambda"]
-                if self.name == "hunt-crossley"
-                else k * restitution_ratio(self.name, p["e"])
-            )
-        if c == 0:
-            return ForceLaw((el,), (k,))
-        return ForceLaw(
-            (el, damp),
-            (k, c),
-            (damp,),
-            (c,),
-            impact_scaled=self.name in ("lankarani-nikravesh", "flores"),
-        )
+        return self.spec.law(self.params)
 
     def apply(self, scenario, record=None):
         """The scenario ``record`` is compared with: unchanged (a model changes no machine
@@ -222,14 +180,7 @@ class ContactModel:
     def conditions(self):
         """The paper's conditions (3)-(6) for this model: ``{"(3)": {"holds": bool, "why":
         str}, ...}`` (analytic: each follows from the model's form and its parameters)."""
-        p = self.params
-        if self.name in ("lankarani-nikravesh", "flores"):
-            damping, what = (
-                self.law.coefficients[-1] if len(self.law.coefficients) > 1 else 0.0,
-                "k r(e)",
-            )
-        else:
-            damping, what = p.get("c", p.get("lambda", 0.0)), "c" if "c" in p else "lambda"
+        damping, what = self.spec.damping(self.params), self.spec.damping_name
         return {
             "(3)": {"holds": True, "why": "no force without contact (F = 0 for zeta <= 0)"},
             "(4)": {"holds": True, "why": "never adhesive (the force is clipped at 0)"},
@@ -251,12 +202,12 @@ class ContactModel:
     def to_text(self):
         """Text that :func:`parse_model` reads back to the same model."""
         return f"{self.name}: " + ", ".join(
-            f"{k}={v!r}" for k, v in zip(MODELS[self.name], self.values, strict=True)
+            f"{k}={v!r}" for k, v in zip(self.spec.parameters, self.values, strict=True)
         )
 
     def format(self, digits=4):
         return f"{self.name}: " + ", ".join(
-            f"{k}={v:.{digits}g}" for k, v in zip(MODELS[self.name], self.values, strict=True)
+            f"{k}={v:.{digits}g}" for k, v in zip(self.spec.parameters, self.values, strict=True)
         )
 
     def __str__(self):
@@ -265,7 +216,7 @@ class ContactModel:
     def as_dict(self):
         return {
             "model": self.name,
-            "parameters": dict(zip(MODELS[self.name], self.values, strict=True)),
+            "parameters": dict(zip(self.spec.parameters, self.values, strict=True)),
             "law": self.law.to_text(),
             "text": self.to_text(),
         }
@@ -273,7 +224,7 @@ class ContactModel:
 
 def is_model_text(text):
     """True when ``text`` names a contact model (``"<model>: k=..., ..."``)."""
-    return isinstance(text, str) and text.partition(":")[0].strip().lower() in MODELS
+    return isinstance(text, str) and text.partition(":")[0].strip().lower() in CONTACT_MODELS
 
 
 def parse_model(text):
@@ -281,18 +232,19 @@ def parse_model(text):
     (every parameter of the model, once, in any order)."""
     name, sep, rest = text.partition(":")
     name = name.strip().lower()
-    if not sep or name not in MODELS:
+    if not sep or name not in CONTACT_MODELS:
         raise InputError(
             f"{text!r} names no contact model; give '<model>: k=..., ...' with a model of "
-            f"{', '.join(MODELS)}"
+            f"{', '.join(CONTACT_MODELS)}"
         )
+    keys = CONTACT_MODELS[name].parameters
     got = {}
     for part in rest.split(","):
         key, eq, value = part.partition("=")
         key = key.strip().lower()
-        if not eq or key not in MODELS[name] or key in got:
+        if not eq or key not in keys or key in got:
             raise InputError(
-                f"{text!r}: {name} takes {', '.join(f'{k}=<number>' for k in MODELS[name])} "
+                f"{text!r}: {name} takes {', '.join(f'{k}=<number>' for k in keys)} "
                 "once each, e.g. 'hunt-crossley: k=2e9, n=1.5, lambda=3e9'"
             )
         try:
@@ -301,10 +253,10 @@ def parse_model(text):
             got[key] = float(value)
         except ValueError:
             raise InputError(f"{text!r}: {key} needs a number, got {value.strip()!r}") from None
-    missing = [k for k in MODELS[name] if k not in got]
+    missing = [k for k in keys if k not in got]
     if missing:
         raise InputError(f"{text!r}: {name} needs {', '.join(missing)} too")
-    return ContactModel(name, tuple(got[k] for k in MODELS[name]))
+    return ContactModel(name, tuple(got[k] for k in keys))
 
 
 def parse_law(text):
@@ -316,12 +268,12 @@ def parse_law(text):
     colon = isinstance(text, str) and ":" in text
     name = text.partition(":")[0].strip().lower() if colon else ""
     if re.fullmatch(r"[a-z][a-z_ -]*", name) and name not in _SECTIONS:
-        close = [m for m in MODELS if m.startswith(name)] or difflib.get_close_matches(
-            name, MODELS, n=1
+        close = [m for m in CONTACT_MODELS if m.startswith(name)] or difflib.get_close_matches(
+            name, CONTACT_MODELS, n=1
         )
         hint = f"did you mean {close[0]!r}? " if close else ""
         raise InputError(
-            f"{name!r} is no contact model; {hint}the models are {', '.join(MODELS)} (e.g. "
+            f"{name!r} is no contact model; {hint}the models are {', '.join(CONTACT_MODELS)} (e.g. "
             "'hunt-crossley: k=2e9, n=1.5, lambda=3e9'), or write a law's terms like "
             "'2.06e8*z + 1.28e7*zd'"
         )

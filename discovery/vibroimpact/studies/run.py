@@ -35,7 +35,8 @@ import time
 import numpy as np
 
 from ...errors import VidiError
-from ..model.contact_models import MODELS, is_model_text, parse_law, parse_model
+from ..model.contact_models import is_model_text, parse_law, parse_model
+from ..model.contact_registry import CONTACT_MODELS
 from ..model.scenario import Scenario
 from .records import auto_transient, field_record
 
@@ -152,7 +153,7 @@ def score_contact(result, truth_text):
     coverage, coef_error = {}, None
     if name is not None:
         truth, fit = parse_model(truth_text).params, result.fit(name)
-        keys = [k for k in MODELS[name] if k in fit.parameters]
+        keys = [k for k in CONTACT_MODELS[name].parameters if k in fit.parameters]
         rel = [(fit.parameters[k] - truth[k]) / truth[k] for k in keys if truth[k]]
         coef_error = float(np.sqrt(np.mean(np.square(rel)))) if rel else None
         if exact:

@@ -19,7 +19,6 @@ from discovery.vibroimpact.fit.contact_fit import (
     fit_contact_models,
 )
 from discovery.vibroimpact.model.contact_models import (
-    MODELS,
     ContactModel,
     parse_law,
     parse_model,
@@ -27,6 +26,7 @@ from discovery.vibroimpact.model.contact_models import (
     restitution_ratio,
     same_force,
 )
+from discovery.vibroimpact.model.contact_registry import CONTACT_MODELS
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import load_scenario
 from tests.realistic import reference_record
@@ -48,7 +48,7 @@ def _paper_model(name, n=1.3, e=0.6):
     return sc, ContactModel(name, (k, n, e))
 
 
-@pytest.mark.parametrize("name", list(MODELS))
+@pytest.mark.parametrize("name", list(CONTACT_MODELS))
 def test_kernel_and_scipy_path_agree(name):
     sc, model = _paper_model(name)
     law = model.law
@@ -142,7 +142,7 @@ def test_a_resting_contact_too_stiff_to_integrate_stops_in_both_simulators():
         reference_simulate(sc, law, (0.0, T), rtol=1e-8, max_nfev=100_000)
 
 
-@pytest.mark.parametrize("name", list(MODELS))
+@pytest.mark.parametrize("name", list(CONTACT_MODELS))
 def test_text_round_trip(name):
     _, model = _paper_model(name)
     assert parse_model(model.to_text()) == model
@@ -175,7 +175,7 @@ def test_bad_text_is_one_input_error(text, match):
         parse_law(text)
 
 
-@pytest.mark.parametrize("name", list(MODELS))
+@pytest.mark.parametrize("name", list(CONTACT_MODELS))
 def test_the_papers_conditions(name):
     _, model = _paper_model(name)
     cond = model.conditions()
