@@ -218,7 +218,8 @@ def times_lines(rows):
     test = _one(rows, "test")
     if test:
         lines.append(
-            f"| `make test` | set-up | {duration(test['seconds'])} ({duration(test['cpu'])}) |"
+            "| `make test` (less the two test modules that read this run) | set-up | "
+            f"{duration(test['seconds'])} ({duration(test['cpu'])}) |"
         )
     return [
         f"**Expected times**, measured on {day} ({where}), each command as a user runs it (the",

@@ -100,7 +100,9 @@ def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, kee
         group_sheets = [
             sheets[k] if shed is None else sheets[k].replace(mass_loss=shed.loss) for k in members
         ]
-        group = _calibrate_group([rows[k] for k in members], group_sheets, keep, n_boot, seed)
+        group = _calibrate_group(
+            [rows[k] for k in members], group_sheets, keep, n_boot, seed, found=shed is not None
+        )
         if group is None:
             notes.append(
                 "the record pins none of the machine's parameters (its force does not "
@@ -239,9 +241,10 @@ def _uncalibrated_note(meas, sheet):
     )
 
 
-def _calibrate_group(rows, sheets, keep, n_boot, seed):
+def _calibrate_group(rows, sheets, keep, n_boot, seed, *, found=False):
     """Calibrate records of one machine: a :class:`_Group`, or ``None`` when the record
-    pins none of its parameters."""
+    pins none of its parameters (``found``: the sheets' mass loss is the records', noted by
+    the caller)."""
     sheet = sheets[0]
     R = len(rows)
     draws = cycle_draws(rows, n_boot, seed)
@@ -280,7 +283,7 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed):
             f"{_fmt(k3['high'])}] N/m^3 where the sheet's are linear (the support "
             "nonlinearity, seen in the frame's own equation; the machine used has it)",
         )
-    if sheet.mass_loss > 0:
+    if sheet.mass_loss > 0 and not found:  # a loss the record showed has its own note
         notes.append(
             f"the moulding sheds {sheet.mass_loss:.3g} of its mass at every contact: "
             "m2 is its mass at the record's start (each window's equations hold the mass "

@@ -17,7 +17,7 @@ UNITS = {
     "c1": "N s/m",
     "k3": "N/m^3",
     "A": "N",
-    "mass_loss": "1/contact",
+    "mass_loss": "per contact",
 }
 #: the least relative uncertainty granted the machine's scale: a bias the bootstrap over
 #: cycles cannot see (the force's quadrature; noise-free, the contacts' windows leave at
@@ -164,7 +164,11 @@ class Calibration(Result):
         head = "calibration: the machine as the record shows it"
         if not self.calibrated:
             return [f"{head}: not calibrated", *[f"  note: {n}" for n in self.notes]]
-        rows = [head, f"  {'parameter':<15}{'sheet':>11}   {'record [95 % interval]':<34}used"]
+        width = max(15, *(len(f"{n} [{_unit(n)}]") + 1 for n in self.parameters))
+        rows = [
+            head,
+            f"  {'parameter':<{width}}{'sheet':>11}   {'record [95 % interval]':<34}used",
+        ]
         for name, p in self.parameters.items():
             rec = (
                 f"{fmt(p['record'])} [{fmt(p['low'])}, {fmt(p['high'])}]"
@@ -175,7 +179,7 @@ class Calibration(Result):
             if p.get("held"):
                 used = "sheet (held)"
             label = f"{name} [{_unit(name)}]"
-            rows.append(f"  {label:<15}{fmt(p['sheet']):>11}   {rec:<34}{used}")
+            rows.append(f"  {label:<{width}}{fmt(p['sheet']):>11}   {rec:<34}{used}")
         res = self.residual
         if res:
             rows.append(
