@@ -125,6 +125,7 @@ def _item(text, indent="   "):
     """``text`` wrapped as the README's source is (a numbered item's lines indented), its
     code spans whole."""
     kept = re.sub(r"`[^`]*`", lambda m: m.group().replace(" ", "\0"), text)
+    kept = re.sub(r"(\d) (s|min|%)\b", "\\1\0\\2", kept)  # a number keeps its unit
     lines = textwrap.wrap(kept, 92, subsequent_indent=indent, break_on_hyphens=False)
     return [line.replace("\0", " ") for line in lines]
 
