@@ -43,6 +43,7 @@ from ._tableau import B as _B
 from ._tableau import C
 from ._tableau import E as _E
 from ._tableau import P as _P
+from .status import BLOW_UP, OK, STEP_BUDGET, STEP_UNDERFLOW
 
 __all__ = [
     "C",
@@ -165,9 +166,6 @@ def step_factor(err):
     if err > 1.0:
         return max(MIN_FACTOR, SAFETY * err**-0.2)
     return min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * max(err, 1e-10) ** -0.2))
-
-
-OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW = 0, 1, 2, 3
 
 
 def make_smooth_advance(rhs, n, n_out):

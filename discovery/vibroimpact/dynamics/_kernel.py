@@ -85,6 +85,7 @@ from ...numerics._dopri import step_factor as _step_factor
 from ...numerics._tableau import A as _A
 from ...numerics._tableau import B as _B
 from ...numerics._tableau import E as _E
+from ...numerics.status import BLOW_UP, CHATTER, OK, STEP_BUDGET, STEP_UNDERFLOW
 
 # Every function here that allocates nothing takes its arrays borrowed: compiled without
 # numba's reference counting (``_nrt=False``, where this numba has the option:
@@ -100,7 +101,6 @@ _stage, _combine, _dense, _error_norm = _D.stage, _D.combine, _D.dense, _D.error
 
 FREE, LOAD, UNLOAD, CLIPPED = 0, 1, 2, 3
 EV_ONSET, EV_LOSS, EV_UNLOAD, EV_RELOAD, EV_RELEASE, EV_RESUME = 1, 2, 3, 4, 5, 6
-OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW, CHATTER = 0, 1, 2, 3, 4
 
 # the parameter vector ``p``: the scenario's m1, m2, k1, c1, A, omega, g (0-6), the
 # supports' cubic stiffness, the mass fraction shed per impact, the law's permanent-set
