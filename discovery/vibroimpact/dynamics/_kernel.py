@@ -284,9 +284,10 @@ def _partials(mode, z, v, coef, ea, eb, br, dc):
 
 
 @_borrowed_njit
-def resolve_mode(y, p, coef, ea, eb, br):
+def resolve_mode(y, law):
     """The mode a state belongs to (used at the start of an integration; a start inside
     an unloading phase takes its own penetration as the contact's largest)."""
+    p, coef, ea, eb, br = law
     z = y[0] - y[2]
     v = y[1] - y[3]
     if z < 0.0 or (z == 0.0 and v <= 0.0):
@@ -322,15 +323,17 @@ def _rhs(t, y, mode, p, coef, ea, eb, br, out):
 
 
 @_borrowed_njit
-def _rhs_at(t, y, mode, p, coef, ea, eb, br, out):
+def _rhs_at(t, y, mode, law, out):
     """:func:`_rhs` as a call (for the once-per-event saltation: inlined there it would be
     typed again at each site, which costs compile time, not run time)."""
+    p, coef, ea, eb, br = law
     _rhs(t, y, mode, p, coef, ea, eb, br, out)
 
 
 @_borrowed_njit
-def _switching(mode, y, p, coef, ea, eb, br, h):
+def _switching(mode, y, law, h):
     """Fill ``h`` with the mode's switching functions; return how many."""
+    p, coef, ea, eb, br = law
     z = y[0] - y[2]
     v = y[1] - y[3]
     if mode == FREE:
@@ -363,10 +366,11 @@ def _event_kind(mode, index):
 
 
 @_borrowed_njit
-def _mode_after(kind, y, p, coef, ea, eb, br):
+def _mode_after(kind, y, law):
     """The mode after an event, and the contact's state updates it brings (in ``p``): an
     onset starts a new contact (``z_max = 0``) and sheds the moulding's mass fraction
     ``p[P_LOSS]``; entering the unloading branch records the largest penetration."""
+    p, coef, ea, eb, br = law
     z = max(y[0] - y[2], 0.0)
     v = y[1] - y[3]
     if kind == EV_LOSS:
@@ -392,9 +396,10 @@ def _mode_after(kind, y, p, coef, ea, eb, br):
 
 
 @_borrowed_njit
-def _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew):
+def _rk_step(t, y, h, mode, law, K, ytmp, ynew):
     """One DP5 step from (t, y) with K[0] = f(t, y) already set; fills K[1:7], ynew
     (the method's stages from :mod:`._dopri`, this system's right-hand side)."""
+    p, coef, ea, eb, br = law
     for s in range(1, 6):
         _stage(s, y, h, K, ytmp)
         _rhs(t + _C[s] * h, ytmp, mode, p, coef, ea, eb, br, K[s])
@@ -433,9 +438,12 @@ def _rhs_sens(y, mode, p, coef, ea, eb, br, S, spar, dc, out):
 
 
 @_borrowed_njit
-def _rk_sens(y, h, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew):
+def _rk_sens(y, h, mode, law, K, ytmp, S, spar, sw):
     """The sensitivities through the step ``y -> ynew`` of length ``h`` whose stages are in
-    ``K``: fills the stage derivatives ``KS`` (7, 4, m) and ``Snew``."""
+    ``K``: fills the stage derivatives ``KS`` (7, 4, m) and ``Snew`` (of the sensitivities'
+    work arrays ``sw``, :func:`work_arrays`)."""
+    p, coef, ea, eb, br = law
+    KS, SS, Snew, dc = sw[0], sw[1], sw[2], sw[3]
     m = S.shape[1]
     _rhs_sens(y, mode, p, coef, ea, eb, br, S, spar, dc, KS[0])
     for s in range(1, 7):
@@ -495,10 +503,13 @@ def _dense_diff(S, KS, h, w, r, j):
 
 
 @_borrowed_njit
-def _dense_force_sens(mode, y, S, KS, h, theta, spar, coef, ea, eb, br, dc, out, k):
-    """``out[j, k] = dF/dq_j`` at the dense output ``y`` (step fraction ``theta``): only the
-    penetration's and its rate's sensitivities are interpolated, the two combinations of
+def _dense_force_sens(mode, y, h, theta, law, sens, sw, k):
+    """``out_dF[j, k] = dF/dq_j`` at the dense output ``y`` (step fraction ``theta``): only
+    the penetration's and its rate's sensitivities are interpolated, the two combinations of
     rows the force needs."""
+    _, coef, ea, eb, br = law
+    S, spar, out = sens[0], sens[1], sens[3]
+    KS, dc = sw[0], sw[3]
     w = _dense_weights(theta)
     fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
     m = S.shape[1]
@@ -509,9 +520,11 @@ def _dense_force_sens(mode, y, S, KS, h, theta, spar, coef, ea, eb, br, dc, out,
 
 
 @_borrowed_njit
-def _force_sens(mode, y, S, spar, coef, ea, eb, br, dc, out, k):
-    """``out[j, k] = dF/dq_j`` of the force at ``y`` (sensitivities ``S``) in ``mode``, and
-    ``out[m + j, k]`` the penetration's."""
+def _force_sens(mode, y, law, sens, dc, k):
+    """``out_dF[j, k] = dF/dq_j`` of the force at ``y`` (sensitivities ``S``) in ``mode``,
+    and ``out_dF[m + j, k]`` the penetration's."""
+    _, coef, ea, eb, br = law
+    S, spar, out = sens[0], sens[1], sens[3]
     fz, fv = force_partials(mode, y[0] - y[2], y[1] - y[3], coef, ea, eb, br, dc)
     m = S.shape[1]
     for j in range(m):
@@ -520,11 +533,13 @@ def _force_sens(mode, y, S, spar, coef, ea, eb, br, dc, out, k):
 
 
 @_borrowed_njit
-def _event_time_sens(t, y, mode, index, p, coef, ea, eb, br, S, spar, dc, fminus, tau):
+def _event_time_sens(t, y, mode, index, law, S, spar, sw):
     """Before an event: the vector field ``fminus`` of the mode left, and ``tau[j]``, the
     derivative of the event time along column ``j``: ``-(grad h . S_j + dh/dq_j) /
     (grad h . f-)`` for the switching function ``index`` that fired."""
-    _rhs_at(t, y, mode, p, coef, ea, eb, br, fminus)
+    _, coef, ea, eb, br = law
+    dc, fminus, tau = sw[3], sw[4], sw[6]
+    _rhs_at(t, y, mode, law, fminus)
     z = y[0] - y[2]
     v = y[1] - y[3]
     cs = 0.0
@@ -550,10 +565,11 @@ def _event_time_sens(t, y, mode, index, p, coef, ea, eb, br, S, spar, dc, fminus
 
 
 @_borrowed_njit
-def _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau):
+def _saltation(t, y, mode, law, S, sw, n_ev, ev_tau):
     """After an event into ``mode``: ``S_j += (f- - f+) tau_j``, and the event's time
     derivatives kept in ``ev_tau`` (if there is room)."""
-    _rhs_at(t, y, mode, p, coef, ea, eb, br, fplus)
+    fminus, fplus, tau = sw[4], sw[5], sw[6]
+    _rhs_at(t, y, mode, law, fplus)
     for j in range(S.shape[1]):
         for r in range(4):
             S[r, j] += (fminus[r] - fplus[r]) * tau[j]
@@ -562,7 +578,7 @@ def _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_
 
 
 @_borrowed_njit
-def _locate(y, K, h, mode, p, coef, ea, eb, br, index, th_lo, th_hi, h_lo, h_hi, ybuf, hbuf):
+def _locate(y, K, h, mode, law, index, th_lo, th_hi, h_lo, h_hi, ybuf, hbuf):
     """Root in ``theta`` of switching function ``index`` on the dense output (Illinois)."""
     a, b, fa, fb = th_lo, th_hi, h_lo, h_hi
     side = 0
@@ -571,7 +587,7 @@ def _locate(y, K, h, mode, p, coef, ea, eb, br, index, th_lo, th_hi, h_lo, h_hi,
         if not (a < c < b):
             c = 0.5 * (a + b)
         _dense(y, K, h, c, ybuf)
-        _switching(mode, ybuf, p, coef, ea, eb, br, hbuf)
+        _switching(mode, ybuf, law, hbuf)
         fc = hbuf[index]
         if fc < 0.0:
             b, fb = c, fc
@@ -589,10 +605,10 @@ def _locate(y, K, h, mode, p, coef, ea, eb, br, index, th_lo, th_hi, h_lo, h_hi,
 
 
 @_borrowed_njit
-def _h_at(y, K, h, mode, p, coef, ea, eb, br, index, theta, ybuf, hbuf):
+def _h_at(y, K, h, mode, law, index, theta, ybuf, hbuf):
     """Switching function ``index`` on the dense output at ``theta``."""
     _dense(y, K, h, theta, ybuf)
-    _switching(mode, ybuf, p, coef, ea, eb, br, hbuf)
+    _switching(mode, ybuf, law, hbuf)
     return hbuf[index]
 
 
@@ -624,12 +640,12 @@ def _rate_root(y, K, h, s, d0, d1, ybuf):
 
 
 @_borrowed_njit
-def _first_crossing(t, y, ynew, K, h, mode, p, coef, ea, eb, br, i, h0, ha, hb, h1, ybuf, hbuf):
+def _first_crossing(t, y, ynew, K, h, mode, law, i, hv, ybuf, hbuf):
     """``theta`` in ``[0, 1]`` of the first crossing of switching function ``i`` over the
     step (``0``: at once), or ``2`` if it stays on its side.
 
-    ``h0, ha, hb, h1`` are its values at ``theta = 0, 1/3, 2/3, 1``.  A crossing needs a
-    value strictly on the function's side (``> 0``) before one across it (``< 0``):
+    ``hv = (h0, ha, hb, h1)`` are its values at ``theta = 0, 1/3, 2/3, 1``.  A crossing needs
+    a value strictly on the function's side (``> 0``) before one across it (``< 0``):
 
     * the start does not count as on its side unless ``h0 > 0``: right after an event
       the state sits on the surface just crossed (and on any coinciding one) with a
@@ -647,6 +663,7 @@ def _first_crossing(t, y, ynew, K, h, mode, p, coef, ea, eb, br, i, h0, ha, hb, 
       ``dzeta`` changes sign), so a graze that touches and leaves the surface between
       the probes is seen.
     """
+    h0, ha, hb, h1 = hv
     third = 1.0 / 3.0
     pos_t, pos_f = -1.0, 0.0
     if h0 > 0.0:
@@ -670,7 +687,7 @@ def _first_crossing(t, y, ynew, K, h, mode, p, coef, ea, eb, br, i, h0, ha, hb, 
         d1 = s * (ynew[1] - ynew[3])
         if d0 < 0.0 and d1 > 0.0:
             th = _rate_root(y, K, h, s, d0, d1, ybuf)
-            fm = _h_at(y, K, h, mode, p, coef, ea, eb, br, 0, th, ybuf, hbuf)
+            fm = _h_at(y, K, h, mode, law, 0, th, ybuf, hbuf)
             if fm < 0.0:
                 neg_t, neg_f = th, fm
                 pos_t = -1.0
@@ -691,20 +708,22 @@ def _first_crossing(t, y, ynew, K, h, mode, p, coef, ea, eb, br, i, h0, ha, hb, 
                 # probe: moving further across, it crosses now; coming back (a step cut
                 # to an event ends within its error of the surface, not on it), not yet
                 return 0.0 if f_first <= h0 else 2.0
-            f = _h_at(y, K, h, mode, p, coef, ea, eb, br, i, th, ybuf, hbuf)
+            f = _h_at(y, K, h, mode, law, i, th, ybuf, hbuf)
             if f > 0.0:
                 pos_t, pos_f = th, f
                 break
             if f < 0.0:
                 neg_t, neg_f = th, f
-    return _locate(y, K, h, mode, p, coef, ea, eb, br, i, pos_t, neg_t, pos_f, neg_f, ybuf, hbuf)
+    return _locate(y, K, h, mode, law, i, pos_t, neg_t, pos_f, neg_f, ybuf, hbuf)
 
 
 @_borrowed_njit
-def _record_event(t, y, mode, index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes):
-    """Store event ``n_ev`` (if there is room) and return the mode after it."""
+def _record_event(t, y, mode, index, law, n_ev, events):
+    """Store event ``n_ev`` (if there is room) in ``events`` ``(ev_t, ev_kind, ev_y,
+    ev_modes)`` and return the mode after it."""
+    ev_t, ev_kind, ev_y, ev_modes = events
     kind = _event_kind(mode, index)
-    new_mode = _mode_after(kind, y, p, coef, ea, eb, br)
+    new_mode = _mode_after(kind, y, law)
     if n_ev < ev_t.shape[0]:
         ev_t[n_ev] = t
         ev_kind[n_ev] = kind
@@ -713,6 +732,21 @@ def _record_event(t, y, mode, index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, e
         for j in range(4):
             ev_y[n_ev, j] = y[j]
     return new_mode
+
+
+@_borrowed_njit
+def _take_event(t, y, mode, index, law, n_ev, events, sens, sw):
+    """Event ``n_ev`` of switching function ``index`` at ``(t, y)``: with sensitivities its
+    time derivatives (:func:`_event_time_sens`), its record (:func:`_record_event`) and the
+    saltation into the mode after it (:func:`_saltation`); returns that mode."""
+    S, spar, ev_tau = sens[0], sens[1], sens[4]
+    m_s = S.shape[1]
+    if m_s:
+        _event_time_sens(t, y, mode, index, law, S, spar, sw)
+    mode = _record_event(t, y, mode, index, law, n_ev, events)
+    if m_s:
+        _saltation(t, y, mode, law, S, sw, n_ev, ev_tau)
+    return mode
 
 
 # ---- free flight in closed form.  Between contacts (mode FREE, no force) the two bodies
@@ -893,11 +927,11 @@ def _flight_search(z0, d0, s_end, fl, ybuf):
 
 
 @_borrowed_njit
-def _flight_samples(t, t_new, fl, S, t_eval, k_eval, out_y, out_f, out_mode, out_dF):
+def _flight_samples(t, t_new, fl, S, samples, k_eval, out_dF):
     """The dense output of the flight set up in ``fl`` (started at ``t``) at the samples
-    ``t_eval[k_eval:]`` up to ``t_new``: the state, no force, the free mode and the
-    penetration's derivatives (the transition matrix applied to ``S``); returns the next
-    sample's index.
+    ``t_eval[k_eval:]`` up to ``t_new`` (``samples``: ``(t_eval, out_y, out_f, out_mode)``):
+    the state, no force, the free mode and the penetration's derivatives (the transition
+    matrix applied to ``S``, into ``out_dF``); returns the next sample's index.
 
     Evenly spaced samples (a record's) advance by the flight's semigroup instead of
     evaluating each in closed form: ``u(s + h) = Phi(h) u(s)``, the drive's phase rotated
@@ -907,6 +941,7 @@ def _flight_samples(t, t_new, fl, S, t_eval, k_eval, out_y, out_f, out_mode, out
     every ``_SAMPLE_ANCHOR``-th sample, is an anchor again; the recurrence's rounding
     stays at a few units of 1e-14 of the state's scale (tested against the closed form at
     every sample)."""
+    t_eval, out_y, out_f, out_mode = samples
     n_eval = t_eval.shape[0]
     want_df = out_dF.shape[1] > 0
     m = S.shape[1]
@@ -962,7 +997,7 @@ def _flight_samples(t, t_new, fl, S, t_eval, k_eval, out_y, out_f, out_mode, out
 
 
 @_borrowed_njit
-def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mode, out_dF):
+def _flight(t, t1, y, p, hair, fl, ybuf, S, samples, k_eval, out_dF):
     """One free flight from ``(t, y)`` in closed form: ``(code, t_new, k_eval)``.
 
     ``code`` 0: no onset up to ``t1`` (``y`` and ``S`` advanced to it); 1: an onset at
@@ -971,7 +1006,8 @@ def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mo
     start is across the surface by more than ``hair`` and not closing: the integrator's
     steps); 4: advanced to ``t_new`` without an onset, the integrator's steps next (the
     safeguard's interval budget ran out).  Writes the dense output at ``t_eval[k_eval:]`` up
-    to ``t_new`` (free: no force, no force derivatives)."""
+    to ``t_new`` (``samples``, :func:`_flight_samples`; free: no force, no force
+    derivatives)."""
     z0 = y[0] - y[2]
     d0 = y[1] - y[3]
     if z0 >= 0.0 and d0 >= 0.0:
@@ -988,7 +1024,7 @@ def _flight(t, t1, y, p, hair, fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mo
     s_end = t1 - t
     s, code = _flight_search(min(z0, 0.0), d0, s_end, fl, ybuf)
     t_new = t1 if code == 0 else t + s
-    k_eval = _flight_samples(t, t_new, fl, S, t_eval, k_eval, out_y, out_f, out_mode, out_dF)
+    k_eval = _flight_samples(t, t_new, fl, S, samples, k_eval, out_dF)
     if s > 0.0:
         _flight_state(s, fl, ybuf)
         for j in range(4):
@@ -1046,10 +1082,11 @@ _NR = 6  # a mode's real constants, :func:`_contact_setup`
 
 
 @_borrowed_njit
-def _contact_law(p, coef, ea, eb, br, kc):
+def _contact_law(law, kc):
     """Whether the contact has the closed form: requested (``p[P_CONTACT] = 1``), a linear
     law and nothing else acting during the contact (see above); fills ``kc`` with the
     loading force's ``(k, c)``, then the unloading force's."""
+    p, coef, ea, eb, br = law
     if p[P_CONTACT] == 0.0 or p[P_K3] != 0.0 or p[P_LOSS] != 0.0:
         return False
     if p[P_SET] != 0.0 or p[P_VSCALE] != 0.0:
@@ -1401,12 +1438,16 @@ def _contact_forced(s, t0, w, mi, E, qm, m1, m2, ex, ews, W):
 
 
 @_borrowed_njit
-def _contact_sens(s, t0, mi, E, qm, p, S, spar, gcol, phi, ex, ews, W, kF, cF, y, out_dF, k):
-    """Through ``s`` of the phase (``ex[j] = e^(lambda_j s)``, ``ews = e^(i w s)``): ``S <-
-    Phi(s) S``, plus ``gcol[0, j] W[0] + gcol[1, j] W[1]`` for a coefficient's column ``j``
-    (``dF/dc = gcol[0, j] z + gcol[1, j] zd`` in this mode, :func:`_contact_forced`); with
-    ``k >= 0`` instead the force's and the penetration's derivatives at ``s`` (the state
-    ``y`` there) into ``out_dF[:, k]``, ``S`` kept."""
+def _contact_sens(s, phase, p, S, spar, sw, ews, force, y, out_dF, k):
+    """Through ``s`` of the phase ``(t0, mi, E, qm)`` (``ex[j] = e^(lambda_j s)`` in its work
+    arrays ``sw`` ``(gcol, phi, W, ex, eh)``, ``ews = e^(i w s)``): ``S <- Phi(s) S``, plus
+    ``gcol[0, j] W[0] + gcol[1, j] W[1]`` for a coefficient's column ``j`` (``dF/dc = gcol[0,
+    j] z + gcol[1, j] zd`` in this mode, :func:`_contact_forced`); with ``k >= 0`` instead
+    the force's (``force = (kF, cF)``: ``kF z + cF zd``) and the penetration's derivatives
+    at ``s`` (the state ``y`` there) into ``out_dF[:, k]``, ``S`` kept."""
+    t0, mi, E, qm = phase
+    gcol, phi, W, ex, _ = sw
+    kF, cF = force
     _contact_phi(ex, mi, E, phi)
     m = S.shape[1]
     for j in range(m):
@@ -1466,14 +1507,15 @@ def _time_res(t, w):
 
 
 @_borrowed_njit
-def _contact_polish(i, mode, a, b, hb, hdb, t0, p, kc, mi, E, qm, ybuf, ex):
+def _contact_polish(i, mode, a, b, hb, hdb, phase, p, kc, ybuf, ex):
     """The first root of switching function ``i`` in ``[a, b]`` (``h(a) >= 0 > h(b) = hb``,
     rate ``hdb``; no root in ``[a, b)`` but the crossing's): safeguarded Newton to the
     time's resolution.  The point returned is the last one on the function's side (``h >=
     0``), within that resolution of the root: a phase's event state keeps every function of
     its mode at ``>= 0`` (the penetration and the force have their signs up to the end of
     the contact, as its left limits must), and the next mode starts a hair across its own
-    surface at most, leaving it."""
+    surface at most, leaving it.  ``phase``: ``(t0, mi, E, qm)``."""
+    t0, mi, E, qm = phase
     w = p[5]
     lo, hi = a, b
     s, hs, hds = b, hb, hdb
@@ -1521,11 +1563,12 @@ def _contact_bound(i, mi, R, cb):
 
 
 @_borrowed_njit
-def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf, ex):
-    """The first event in ``(0, s_end]`` of the contact phase set up (the switching
-    functions' values ``f >= 0`` and rates ``fd`` at its start): ``(s, index)``, ``index`` the
-    function that fires at ``s``, -1 for none up to ``s = s_end``, -2 if the safeguard's
-    interval budget ran out at ``s`` (no event before it)."""
+def _contact_search(mode, phase, s_end, p, kc, R, cb, f, fd, ybuf, ex):
+    """The first event in ``(0, s_end]`` of the contact phase ``(t0, mi, E, qm)`` set up (the
+    switching functions' values ``f >= 0`` and rates ``fd`` at its start): ``(s, index)``,
+    ``index`` the function that fires at ``s``, -1 for none up to ``s = s_end``, -2 if the
+    safeguard's interval budget ran out at ``s`` (no event before it)."""
+    t0, mi, E, qm = phase
     w = p[5]
     a = 0.0
     grow = R[mi, 4]
@@ -1547,7 +1590,7 @@ def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf, ex):
             f[i], fd[i] = hb, hdb
         for i in range(3):
             if f[i] < 0.0:
-                si = _contact_polish(i, mode, a, b, f[i], fd[i], t0, p, kc, mi, E, qm, ybuf, ex)
+                si = _contact_polish(i, mode, a, b, f[i], fd[i], phase, p, kc, ybuf, ex)
                 # near-ties go to the lower index (loss before release at once)
                 if si < best_s - 2.0 * _time_res(t0 + si, w):
                     best_s, best_i = si, i
@@ -1560,36 +1603,7 @@ def _contact_search(mode, t0, s_end, p, kc, mi, E, R, qm, cb, f, fd, ybuf, ex):
 
 
 @_borrowed_njit
-def _contact(
-    t,
-    t1,
-    y,
-    mode,
-    p,
-    kc,
-    E,
-    R,
-    atol,
-    qm,
-    cb,
-    f,
-    fd,
-    ybuf,
-    S,
-    spar,
-    coef,
-    ea,
-    eb,
-    br,
-    dc,
-    sw,
-    t_eval,
-    k_eval,
-    out_y,
-    out_f,
-    out_mode,
-    out_dF,
-):
+def _contact(t, t1, y, mode, law, atol, phases, ybuf, dc, sens, samples, k_eval):
     """One contact phase (loading or unloading) from ``(t, y)`` in closed form: ``(code,
     t_new, k_eval, index)``.
 
@@ -1599,9 +1613,14 @@ def _contact(
     hair of the absolute tolerances, or not leaving it: the integrator's steps); 4: advanced
     to ``t_new`` without an event, the integrator's steps next (the safeguard's interval
     budget ran out).  Writes the state, force and mode at ``t_eval[k_eval:]`` up to
-    ``t_new`` (and the force's derivatives with ``out_dF``); ``S`` moves with the state
-    (``sw``: its work arrays, :func:`_contact_sens`).  A law coefficient's column needs the
-    mode's eigenvalues away from 0 (``|lambda| > 1e-3 w``), else the integrator's steps."""
+    ``t_new`` (``samples``: ``(t_eval, out_y, out_f, out_mode)``; and the force's
+    derivatives with ``out_dF``); ``S`` moves with the state (``sens``: ``(S, spar, sscale,
+    out_dF, ev_tau)``).  ``phases``: the closed-form phases' arrays, :func:`_integrate`'s.  A
+    law coefficient's column needs the mode's eigenvalues away from 0 (``|lambda| > 1e-3
+    w``), else the integrator's steps."""
+    p, coef, ea, eb, br = law
+    _, kc, E, R, qm, sw, cb, f, fd = phases
+    S, spar = sens[0], sens[1]
     mi = 0 if mode == LOAD else 1
     if R[mi, 0] == 0.0:
         return 3, t, k_eval, -1
@@ -1634,38 +1653,18 @@ def _contact(
         for j in range(4):
             G = gz * (E[mi, j, 0] - E[mi, j, 2]) + gv * (E[mi, j, 1] - E[mi, j, 3])
             cb[i, j] = abs(G) * abs(E[mi, j, 8]) * abs(qm[j, 1])
-    s, index = _contact_search(mode, t, t1 - t, p, kc, mi, E, R, qm, cb, f, fd, ybuf, ex)
+    phase = (t, mi, E, qm)
+    s, index = _contact_search(mode, phase, t1 - t, p, kc, R, cb, f, fd, ybuf, ex)
     code = 1 if index >= 0 else (0 if index == -1 else 4)
     t_new = t1 if code == 0 else t + s
-    k, c = kc[2 * mi], kc[2 * mi + 1]
-    k_eval = _contact_samples(
-        t,
-        t_new,
-        mode,
-        mi,
-        k,
-        c,
-        w,
-        E,
-        qm,
-        p,
-        S,
-        spar,
-        sw,
-        ybuf,
-        t_eval,
-        k_eval,
-        out_y,
-        out_f,
-        out_mode,
-        out_dF,
-    )
+    force = (kc[2 * mi], kc[2 * mi + 1])
+    k_eval = _contact_samples(t_new, phase, mode, force, p, sens, sw, ybuf, samples, k_eval)
     _contact_state(s, t, w, mi, E, qm, ybuf, ex)  # ex: e^(lambda_j s) for the sensitivities
     for j in range(4):
         y[j] = ybuf[j]
     if m:
         ews = np.cos(w * s) + 1j * np.sin(w * s)
-        _contact_sens(s, t, mi, E, qm, p, S, spar, gcol, phi, ex, ews, W, k, c, ybuf, out_dF, -1)
+        _contact_sens(s, phase, p, S, spar, sw, ews, force, ybuf, sens[3], -1)
     return code, t_new, k_eval, index
 
 
@@ -1677,38 +1676,24 @@ def _contact_exps(s, w, mi, E, ex):
 
 
 @_borrowed_njit
-def _contact_samples(
-    t,
-    t_new,
-    mode,
-    mi,
-    k,
-    c,
-    w,
-    E,
-    qm,
-    p,
-    S,
-    spar,
-    sw,
-    ybuf,
-    t_eval,
-    k_eval,
-    out_y,
-    out_f,
-    out_mode,
-    out_dF,
-):
-    """The dense output of the contact phase started at ``t`` (its modal data ``qm``, its
-    force ``k z + c zd``) at the samples ``t_eval[k_eval:]`` up to ``t_new``: the state, the
-    force, the mode and (with ``out_dF``) the force's and the penetration's derivatives;
-    returns the next sample's index.  Evenly spaced samples advance the exponentials by
-    their semigroup (``e^(lambda (s + h)) = e^(lambda s) e^(lambda h)``, the drive's phase
-    rotated by ``w h``) between anchors evaluated directly, as the free flight's samples
+def _contact_samples(t_new, phase, mode, force, p, sens, sw, ybuf, samples, k_eval):
+    """The dense output of the contact phase ``(t, mi, E, qm)`` (started at ``t``, its modal
+    data ``qm``, its force ``force = (k, c)``: ``k z + c zd``) at the samples
+    ``t_eval[k_eval:]`` up to ``t_new`` (``samples``: ``(t_eval, out_y, out_f, out_mode)``):
+    the state, the force, the mode and (with ``out_dF`` of ``sens``) the force's and the
+    penetration's derivatives; returns the next sample's index.  Evenly spaced samples
+    advance the exponentials by their semigroup (``e^(lambda (s + h)) = e^(lambda s)
+    e^(lambda h)``, the drive's phase rotated by ``w h``) between anchors evaluated
+    directly, as the free flight's samples
     (:func:`_flight_samples`)."""
+    t_eval, out_y, out_f, out_mode = samples
     if k_eval >= t_eval.shape[0] or t_eval[k_eval] > t_new:
         return k_eval  # no sample in the phase
-    gcol, phi, W, ex, eh = sw
+    t, mi, E, qm = phase
+    k, c = force
+    S, spar, out_dF = sens[0], sens[1], sens[3]
+    w = p[5]
+    ex, eh = sw[3], sw[4]
     want_df = out_dF.shape[1] > 0
     slip = _SAMPLE_SLIP * 2.0 * np.pi / w
     ew0 = np.cos(w * t) + 1j * np.sin(w * t)
@@ -1740,9 +1725,7 @@ def _contact_samples(
         out_f[k_eval] = k * (ybuf[0] - ybuf[2]) + c * (ybuf[1] - ybuf[3])
         out_mode[k_eval] = mode
         if want_df:
-            _contact_sens(
-                se, t, mi, E, qm, p, S, spar, gcol, phi, ex, ews, W, k, c, ybuf, out_dF, k_eval
-            )
+            _contact_sens(se, phase, p, S, spar, sw, ews, force, ybuf, out_dF, k_eval)
         k_eval += 1
     return k_eval
 
@@ -1806,16 +1789,18 @@ def sorted_within(t, lo, hi):
 
 
 @njit(cache=True)
-def set_up_modes(p, coef, ea, eb, br, atol, modes):
+def set_up_modes(law, atol, modes):
     """Whether a contact mode has the closed form (:func:`_contact`; not with
     sensitivities), setting the ``modes`` ``(kc, E, R, made)``
     (:func:`~discovery.vibroimpact.dynamics.simulation.contact_modes`) up when ``made[0]``
     is 0 (then 1 where a mode has the closed form, 2 where none has): a caller that
     integrates the same law and scenario again passes them back, and the set-up (the
-    eigendecomposition of both modes, 4.6 us) is made once."""
+    eigendecomposition of both modes, 4.6 us) is made once.  ``law``: ``(p, coef, ea, eb,
+    br)``, as :func:`_integrate` takes it."""
+    p = law[0]
     kc, E, R, made = modes
     if made[0] == 0.0:
-        use_contact = _contact_law(p, coef, ea, eb, br, kc)
+        use_contact = _contact_law(law, kc)
         if use_contact:
             _contact_setup(p, kc, LOAD, atol, E, R)
             _contact_setup(p, kc, UNLOAD, atol, E, R)
@@ -1834,52 +1819,19 @@ def in_range(y, bound):
 
 
 @_borrowed_njit
-def strobe(
-    points,
-    y,
-    p_base,
-    p,
-    memory,
-    t0,
-    mode0,
-    period,
-    bound,
-    coef,
-    ea,
-    eb,
-    br,
-    rtol,
-    atol,
-    h0,
-    hmax,
-    max_steps,
-    t_eval,
-    out_y,
-    out_f,
-    out_mode,
-    ev_t,
-    ev_kind,
-    ev_y,
-    ev_modes,
-    S,
-    spar,
-    sscale,
-    out_dF,
-    ev_tau,
-    use_contact,
-    steps,
-    sens,
-    phases,
-):
+def strobe(points, y, p_base, memory, bound, clock, law, ctl, out, use_contact, work):
     """Strobe points: ``points[k] = Phi(points[k - 1])`` for ``k >= 1`` (``points[0]`` the
-    start), each period one run of :func:`_integrate` from ``t0`` (mode ``mode0``, first
-    step ``h0``, ``p`` a fresh copy of ``p_base``) exactly as a separate call, so the points
-    are bitwise those of one call per period.  With
-    ``memory`` (a law with a permanent set) each run starts with the contact memory
-    (``p[P_ZMAX]``, ``p[P_V0]``) the previous one ended with, the first with ``p``'s.
-    ``y`` is the run's state (work array).  Returns ``(status, k, t, n_steps, inside)``:
-    the last period run (``k``, its status and end time ``t``), the steps of all runs,
-    and whether its end state is within ``bound`` (:func:`in_range`)."""
+    start), each period one run of :func:`_integrate` from ``t0`` (mode ``mode0``, ``clock =
+    (t0, mode0, period)``; ``law``'s ``p`` a fresh copy of ``p_base``) exactly as a separate
+    call, so the points are bitwise those of one call per period; ``ctl``, ``out``,
+    ``use_contact`` and ``work`` as :func:`_integrate` takes them.  With ``memory`` (a law
+    with a permanent set) each run starts with the contact memory (``p[P_ZMAX]``,
+    ``p[P_V0]``) the previous one ended with, the first with ``p``'s.  ``y`` is the run's
+    state (work array).  Returns ``(status, k, t, n_steps, inside)``: the last period run
+    (``k``, its status and end time ``t``), the steps of all runs, and whether its end state
+    is within ``bound`` (:func:`in_range`)."""
+    t0, mode0, period = clock
+    p = law[0]
     n_steps = 0
     status = OK
     t = 0.0
@@ -1895,37 +1847,7 @@ def strobe(
         for j in range(4):
             y[j] = points[k - 1, j]
         status, t, _, ns, _, _ = _integrate(
-            t0,
-            t0 + period,
-            y,
-            mode0,
-            p,
-            coef,
-            ea,
-            eb,
-            br,
-            rtol,
-            atol,
-            h0,
-            hmax,
-            max_steps,
-            t_eval,
-            out_y,
-            out_f,
-            out_mode,
-            ev_t,
-            ev_kind,
-            ev_y,
-            ev_modes,
-            S,
-            spar,
-            sscale,
-            out_dF,
-            ev_tau,
-            use_contact,
-            steps,
-            sens,
-            phases,
+            t0, t0 + period, y, mode0, law, ctl, out, use_contact, work
         )
         n_steps += ns
         for j in range(4):
@@ -1937,39 +1859,7 @@ def strobe(
 
 
 @_borrowed_njit
-def _integrate(
-    t0,
-    t1,
-    y,
-    mode0,
-    p,
-    coef,
-    ea,
-    eb,
-    br,
-    rtol,
-    atol,
-    h0,
-    hmax,
-    max_steps,
-    t_eval,
-    out_y,
-    out_f,
-    out_mode,
-    ev_t,
-    ev_kind,
-    ev_y,
-    ev_modes,
-    S,
-    spar,
-    sscale,
-    out_dF,
-    ev_tau,
-    use_contact,
-    steps,
-    sens,
-    phases,
-):
+def _integrate(t0, t1, y, mode0, law, ctl, out, use_contact, work):
     """Integrate from ``t0`` to ``t1``, advancing ``y`` in place; see
     :func:`discovery.vibroimpact.dynamics.simulate`.  Returns ``(status, t, mode, n_steps,
     n_events, h)``; ``mode0 < 0`` resolves the mode from ``y``.
@@ -1987,20 +1877,30 @@ def _integrate(
     too (shape (m, 0) for none), and with ``ev_tau`` of shape (len(ev_t), m) the events'
     time derivatives (shape (0, m) for none).  Not for a law with a permanent set.
 
-    ``use_contact``: whether a contact mode has the closed form (:func:`set_up_modes`);
-    ``steps``, ``sens``: the work arrays (:func:`work_arrays`); ``phases``: those of the
-    phases with the contact modes, ``(fl, kc, E, R, qm, sw, cb, fc, fcd)``.  Every array is
-    borrowed."""
+    The arguments come in bundles: ``law`` ``(p, coef, ea, eb, br)``, the parameters and
+    the law's arrays; ``ctl`` ``(rtol, atol, h0, hmax, max_steps)``, the step control;
+    ``out`` ``(samples, events, sens)``, the outputs ``(t_eval, out_y, out_f, out_mode)``,
+    ``(ev_t, ev_kind, ev_y, ev_modes)`` and the sensitivities ``(S, spar, sscale, out_dF,
+    ev_tau)``; ``use_contact``: whether a contact mode has the closed form
+    (:func:`set_up_modes`); ``work`` ``(steps, sens, phases)``: the work arrays
+    (:func:`work_arrays`), ``phases`` those of the phases with the contact modes, ``(fl, kc,
+    E, R, qm, sw, cb, fc, fcd)``.  Every array is borrowed."""
+    p, coef, ea, eb, br = law
+    rtol, atol, h0, hmax, max_steps = ctl
+    samples, events, sens = out
+    t_eval, out_y, out_f, out_mode = samples
+    S, spar, sscale, out_dF, _ = sens
+    steps, sw, phases = work
     ynew, ytmp, ybuf, K, hs0, hs1, hsa, hsb, hsm = steps
-    KS, SS, Snew, dc, fminus, fplus, tau = sens
-    fl, kc, E, R, qm, sw, cb, fc, fcd = phases
+    KS, _, Snew, dc = sw[0], sw[1], sw[2], sw[3]
+    fl = phases[0]
     need_h0 = True
     ns = 0
     t = t0
     m_s = S.shape[1]
     ctl_s = m_s > 0 and sscale.shape[0] > 0
     want_df = out_dF.shape[1] > 0
-    mode = mode0 if mode0 >= 0 else resolve_mode(y, p, coef, ea, eb, br)
+    mode = mode0 if mode0 >= 0 else resolve_mode(y, law)
     h = min(h0, hmax, t1 - t0)
     n_eval = t_eval.shape[0]
     k_eval = 0
@@ -2010,7 +1910,7 @@ def _integrate(
         out_f[k_eval] = mode_force(mode, y[0] - y[2], y[1] - y[3], p, coef, ea, eb, br)
         out_mode[k_eval] = mode
         if want_df:
-            _force_sens(mode, y, S, spar, coef, ea, eb, br, dc, out_dF, k_eval)
+            _force_sens(mode, y, law, sens, dc, k_eval)
         k_eval += 1
     n_ev = 0
     n_steps = 0
@@ -2029,7 +1929,7 @@ def _integrate(
             break
         if use_flight and mode == FREE and not hold:
             code, t_new, k_eval = _flight(
-                t, t1, y, p, atol[0], fl, ybuf, S, t_eval, k_eval, out_y, out_f, out_mode, out_dF
+                t, t1, y, p, atol[0], fl, ybuf, S, samples, k_eval, out_dF
             )
             if code == 3:
                 hold = True
@@ -2064,47 +1964,14 @@ def _integrate(
                         status = CHATTER
                         break
                     t_last_ev = t
-                if m_s:
-                    _event_time_sens(t, y, mode, 0, p, coef, ea, eb, br, S, spar, dc, fminus, tau)
-                mode = _record_event(
-                    t, y, mode, 0, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
-                )
-                if m_s:
-                    _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau)
+                mode = _take_event(t, y, mode, 0, law, n_ev, events, sens, sw)
                 n_ev += 1
                 need_f = True
                 need_h0 = True
                 continue
         if use_contact and (mode == LOAD or mode == UNLOAD) and not hold:
             code, t_new, k_eval, idx = _contact(
-                t,
-                t1,
-                y,
-                mode,
-                p,
-                kc,
-                E,
-                R,
-                atol,
-                qm,
-                cb,
-                fc,
-                fcd,
-                ybuf,
-                S,
-                spar,
-                coef,
-                ea,
-                eb,
-                br,
-                dc,
-                sw,
-                t_eval,
-                k_eval,
-                out_y,
-                out_f,
-                out_mode,
-                out_dF,
+                t, t1, y, mode, law, atol, phases, ybuf, dc, sens, samples, k_eval
             )
             if code == 3:
                 hold = True
@@ -2131,13 +1998,7 @@ def _integrate(
                     status = CHATTER
                     break
                 t_last_ev = t
-                if m_s:
-                    _event_time_sens(t, y, mode, idx, p, coef, ea, eb, br, S, spar, dc, fminus, tau)
-                mode = _record_event(
-                    t, y, mode, idx, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
-                )
-                if m_s:
-                    _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau)
+                mode = _take_event(t, y, mode, idx, law, n_ev, events, sens, sw)
                 n_ev += 1
                 continue
         if need_f:
@@ -2147,13 +2008,13 @@ def _integrate(
         if h < 1e-14 * max(1.0, abs(t)) and t1 - t > h:
             status = STEP_UNDERFLOW
             break
-        _rk_step(t, y, h, mode, p, coef, ea, eb, br, K, ytmp, ynew)
+        _rk_step(t, y, h, mode, law, K, ytmp, ynew)
         n_steps += 1
         err = _error_norm(y, ynew, K, h, rtol, atol)
         if ctl_s:
             # the sensitivities are held to the state's accuracy too (a fractional power
             # makes the variational equations stiffer than the state near an onset)
-            _rk_sens(y, h, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew)
+            _rk_sens(y, h, mode, law, K, ytmp, S, spar, sw)
             err = max(err, _sens_error(S, Snew, KS, h, rtol, atol, sscale))
         if not np.isfinite(err):
             h *= _MIN_FACTOR
@@ -2166,17 +2027,17 @@ def _integrate(
             continue
         # ---- accepted step: look for the earliest event in (t, t + h]
         if need_h0:
-            ns = _switching(mode, y, p, coef, ea, eb, br, hs0)
+            ns = _switching(mode, y, law, hs0)
             need_h0 = False
-        _switching(mode, ynew, p, coef, ea, eb, br, hs1)
+        _switching(mode, ynew, law, hs1)
         best_theta = 2.0
         best_index = -1
         # probe the dense output at 1/3 and 2/3 too, so a brief excursion across a
         # switching surface inside one step is seen (once per step, for all functions)
         _dense(y, K, h, 1.0 / 3.0, ybuf)
-        _switching(mode, ybuf, p, coef, ea, eb, br, hsa)
+        _switching(mode, ybuf, law, hsa)
         _dense(y, K, h, 2.0 / 3.0, ybuf)
-        _switching(mode, ybuf, p, coef, ea, eb, br, hsb)
+        _switching(mode, ybuf, law, hsb)
         for i in range(ns):
             if hsa[i] >= 0.0 and hsb[i] >= 0.0 and hs1[i] >= 0.0:
                 # fast path: no probe across the surface; only a graze of zeta = 0
@@ -2186,26 +2047,8 @@ def _integrate(
                 s = -1.0 if mode == FREE else 1.0
                 if not (s * (y[1] - y[3]) < 0.0 and s * (ynew[1] - ynew[3]) > 0.0):
                     continue
-            th = _first_crossing(
-                t,
-                y,
-                ynew,
-                K,
-                h,
-                mode,
-                p,
-                coef,
-                ea,
-                eb,
-                br,
-                i,
-                hs0[i],
-                hsa[i],
-                hsb[i],
-                hs1[i],
-                ybuf,
-                hsm,
-            )
+            hv = (hs0[i], hsa[i], hsb[i], hs1[i])
+            th = _first_crossing(t, y, ynew, K, h, mode, law, i, hv, ybuf, hsm)
             # near-ties go to the lower index: contact loss (index 0) wins over the
             # force reaching zero at the same instant (e.g. P(zeta, 0) = k * zeta)
             if th < best_theta - 1e-9:
@@ -2216,29 +2059,21 @@ def _integrate(
                 if zero_len > 4:
                     status = CHATTER
                     break
-                if m_s:
-                    _event_time_sens(
-                        t, y, mode, best_index, p, coef, ea, eb, br, S, spar, dc, fminus, tau
-                    )
-                mode = _record_event(
-                    t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
-                )
-                if m_s:
-                    _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau)
+                mode = _take_event(t, y, mode, best_index, law, n_ev, events, sens, sw)
                 n_ev += 1
                 need_f = True
                 need_h0 = True
                 continue
             # re-take the step so that it ends on the event
             h_ev = best_theta * h
-            _rk_step(t, y, h_ev, mode, p, coef, ea, eb, br, K, ytmp, ynew)
+            _rk_step(t, y, h_ev, mode, law, K, ytmp, ynew)
             h_used = h_ev
             if m_s:
-                _rk_sens(y, h_used, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew)
+                _rk_sens(y, h_used, mode, law, K, ytmp, S, spar, sw)
         else:
             h_used = h
             if m_s and not ctl_s:
-                _rk_sens(y, h_used, mode, p, coef, ea, eb, br, K, S, spar, dc, KS, ytmp, SS, Snew)
+                _rk_sens(y, h_used, mode, law, K, ytmp, S, spar, sw)
         zero_len = 0
         hold = False
         t_new = t + h_used if best_index >= 0 or h_used < t1 - t else t1
@@ -2253,22 +2088,7 @@ def _integrate(
             )
             out_mode[k_eval] = mode
             if want_df:
-                _dense_force_sens(
-                    mode,
-                    ybuf,
-                    S,
-                    KS,
-                    h_used,
-                    min(theta, 1.0),
-                    spar,
-                    coef,
-                    ea,
-                    eb,
-                    br,
-                    dc,
-                    out_dF,
-                    k_eval,
-                )
+                _dense_force_sens(mode, ybuf, h_used, min(theta, 1.0), law, sens, sw, k_eval)
             k_eval += 1
         for j in range(4):
             y[j] = ynew[j]
@@ -2290,15 +2110,7 @@ def _integrate(
                 status = CHATTER
                 break
             t_last_ev = t
-            if m_s:
-                _event_time_sens(
-                    t, y, mode, best_index, p, coef, ea, eb, br, S, spar, dc, fminus, tau
-                )
-            mode = _record_event(
-                t, y, mode, best_index, p, coef, ea, eb, br, n_ev, ev_t, ev_kind, ev_y, ev_modes
-            )
-            if m_s:
-                _saltation(t, y, mode, p, coef, ea, eb, br, S, fminus, tau, fplus, n_ev, ev_tau)
+            mode = _take_event(t, y, mode, best_index, law, n_ev, events, sens, sw)
             n_ev += 1
             need_f = True
             need_h0 = True

@@ -136,7 +136,7 @@ def _force_rate(scenario, law, t, y, mode):
             continue
         z, v = y[0, i] - y[2, i], y[1, i] - y[3, i]
         fz, fv = K.force_partials(mode[i], z, v, coef, ea, eb, br, dc)
-        K._rhs_at(t[i], y[:, i].copy(), mode[i], p, coef, ea, eb, br, f)
+        K._rhs_at(t[i], y[:, i].copy(), mode[i], (p, coef, ea, eb, br), f)
         out[i] = fz * v + fv * (f[1] - f[3])
     return out
 

@@ -154,18 +154,18 @@ def kernel_params(scenario, law, tolerances=None):
     return p
 
 
-def _buffers(n_eval, max_events):
-    """The kernel's output arrays: state, force and mode at the output times, and the
-    events' times, kinds, states and modes."""
-    return (
-        np.empty((4, n_eval)),
-        np.empty(n_eval),
-        np.empty(n_eval, dtype=np.int64),
+def _buffers(t_eval, max_events):
+    """The kernel's outputs ``(samples, events)``: the output times ``t_eval`` with the
+    state, force and mode there, and the events' times, kinds, states and modes."""
+    n_eval = t_eval.shape[0]
+    samples = (t_eval, np.empty((4, n_eval)), np.empty(n_eval), np.empty(n_eval, dtype=np.int64))
+    events = (
         np.empty(max_events),
         np.empty(max_events, dtype=np.int64),
         np.empty((max_events, 4)),
         np.empty((max_events, 2), dtype=np.int64),
     )
+    return samples, events
 
 
 def no_sensitivities():
@@ -355,8 +355,9 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
     announce_compile("vibro-impact")  # the check below is the kernel's first call
     if te.size and not K.sorted_within(te, t0 - 1e-12, t1 + 1e-12):
         raise InputError("t_eval must be sorted and inside t_span")
-    bufs = _buffers(te.size, s.max_events)
-    out_y, out_f, out_m, ev_t, ev_k, ev_y, ev_m = bufs
+    samples, events = _buffers(te, s.max_events)
+    _, out_y, out_f, out_m = samples
+    ev_t, ev_k, ev_y, ev_m = events
     period = scenario.period
     p = kernel_params(scenario, law, tol)
     p[K.P_ZMAX] = float(s.zeta_max0)
@@ -377,28 +378,20 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
     coef, ea, eb, br = law.kernel_arrays()
     atol = _atol(scenario, tol)
     modes = contact_modes()
-    use_contact = K.set_up_modes(p, coef, ea, eb, br, atol, modes)
+    law_arrays = (p, coef, ea, eb, br)
+    use_contact = K.set_up_modes(law_arrays, atol, modes)
+    ctl = (tol.rtol, atol, period / 100.0, period * tol.hmax_fraction, tol.max_steps)
     yf = y0.copy()  # advanced in place
     status, tf, mf, n_steps, n_ev, _ = K._integrate(
         t0,
         t1,
         yf,
         -1 if s.mode0 is None else int(s.mode0),
-        p,
-        coef,
-        ea,
-        eb,
-        br,
-        tol.rtol,
-        atol,
-        period / 100.0,
-        period * tol.hmax_fraction,
-        tol.max_steps,
-        te,
-        *bufs,
-        *sens,
+        law_arrays,
+        ctl,
+        (samples, events, sens),
         use_contact,
-        *scratch(sens[0].shape[1], coef.shape[0], modes),
+        scratch(sens[0].shape[1], coef.shape[0], modes),
     )
     message = (
         "ok"
