@@ -8,9 +8,13 @@ from pathlib import Path
 
 __all__ = ["KERNELS", "cached", "announce_compile", "borrowing_options"]
 
+_HERE = Path(__file__).parent
 KERNELS = {
-    "vibro-impact": (Path(__file__).parent / "vibroimpact" / "dynamics", "_kernel._integrate-"),
-    "oscillator": (Path(__file__).parent / "ueda", "_kernel."),
+    "vibro-impact": (
+        _HERE / "vibroimpact" / "dynamics" / "kernel",
+        "loop.integrate-",
+    ),
+    "oscillator": (_HERE / "ueda", "_kernel."),
 }
 _ANNOUNCED = set()
 

@@ -108,11 +108,12 @@ def test_the_kernel_borrows_its_arrays_where_numba_can(monkeypatch):
     import types
 
     from discovery._compile import borrowing_options
-    from discovery.vibroimpact.dynamics import _kernel as K
+    from discovery.vibroimpact.dynamics.kernel.contact import _contact_search
+    from discovery.vibroimpact.dynamics.kernel.entries import work_arrays
 
     assert borrowing_options() == {"_nrt": False}
-    assert K._contact_search.targetoptions.get("_nrt") is False
-    assert "_nrt" not in K.work_arrays.targetoptions  # it allocates: the counts stay
+    assert _contact_search.targetoptions.get("_nrt") is False
+    assert "_nrt" not in work_arrays.targetoptions  # it allocates: the counts stay
     without = types.SimpleNamespace(CPUTargetOptions=type("CPUTargetOptions", (), {}))
     monkeypatch.setitem(sys.modules, "numba.core.cpu", without)
     assert borrowing_options() == {}

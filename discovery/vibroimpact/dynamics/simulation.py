@@ -8,11 +8,16 @@ from ..._compile import announce_compile
 from ..._settings import Settings, option, takes
 from ..._validate import Array, Choice, Real, params
 from ...errors import InputError, IntegrationError
+from ...numerics.status import BLOW_UP, STEP_BUDGET, STEP_UNDERFLOW
 from ...numerics.status import message as status_message
 from ...numerics.tolerances import Tolerances
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
-from . import _kernel as K
+from .kernel import codes as K
+from .kernel.contact_modes import NE, NR
+from .kernel.entries import set_up_modes, sorted_within, work_arrays
+from .kernel.forces import mode_force
+from .kernel.loop import integrate
 
 __all__ = ["Trajectory", "simulate", "Tolerances", "MODE_NAMES", "EVENT_NAMES", "SENSITIVITIES"]
 
@@ -27,12 +32,12 @@ EVENT_NAMES = {
 }
 # what to check when the vibro-impact kernel fails (after the meaning from .status)
 _HINTS = {
-    K.STEP_BUDGET: (
+    STEP_BUDGET: (
         " (a law too stiff or too fast for the machine: check the coefficients' "
         "units; API: Tolerances(max_steps=...))"
     ),
-    K.BLOW_UP: "; check the law's coefficients and signs",
-    K.STEP_UNDERFLOW: "; the law may be too stiff for this tolerance",
+    BLOW_UP: "; check the law's coefficients and signs",
+    STEP_UNDERFLOW: "; the law may be too stiff for this tolerance",
 }
 
 
@@ -130,8 +135,8 @@ class Trajectory:
                 p[K.P_ZMAX] = 0.0
                 p[K.P_V0] = max(v, 1e-12)
             p[K.P_ZMAX] = max(p[K.P_ZMAX], z)  # the largest penetration so far (events only)
-            out[k, 0] = K.mode_force(m0, z, v, p, coef, ea, eb, br)
-            out[k, 1] = K.mode_force(m1, z, v, p, coef, ea, eb, br)
+            out[k, 0] = mode_force(m0, z, v, p, coef, ea, eb, br)
+            out[k, 1] = mode_force(m1, z, v, p, coef, ea, eb, br)
         return out
 
 
@@ -186,8 +191,8 @@ def contact_modes():
     eigendecomposition of the two modes is made once."""
     return (
         np.zeros(4),
-        np.zeros((2, 4, K._NE), dtype=np.complex128),
-        np.zeros((2, K._NR)),
+        np.zeros((2, 4, NE), dtype=np.complex128),
+        np.zeros((2, NR)),
         np.zeros(1),
     )
 
@@ -204,7 +209,7 @@ def scratch(m_s, n_coef, modes):
     if work is None:
         if len(_SCRATCH) >= 64:
             _SCRATCH.clear()
-        work = _SCRATCH[key] = K.work_arrays(m_s, n_coef)
+        work = _SCRATCH[key] = work_arrays(m_s, n_coef)
     steps, sens, (fl, qm, sw, cb, fc, fcd) = work
     kc, E, R, _ = modes
     return steps, sens, (fl, kc, E, R, qm, sw, cb, fc, fcd)
@@ -353,7 +358,7 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
     y0 = scenario.initial_state() if y0 is None else np.array(y0, dtype=float).reshape(4)
     te = np.zeros(0) if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
     announce_compile("vibro-impact")  # the check below is the kernel's first call
-    if te.size and not K.sorted_within(te, t0 - 1e-12, t1 + 1e-12):
+    if te.size and not sorted_within(te, t0 - 1e-12, t1 + 1e-12):
         raise InputError("t_eval must be sorted and inside t_span")
     samples, events = _buffers(te, s.max_events)
     _, out_y, out_f, out_m = samples
@@ -379,10 +384,10 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
     atol = _atol(scenario, tol)
     modes = contact_modes()
     law_arrays = (p, coef, ea, eb, br)
-    use_contact = K.set_up_modes(law_arrays, atol, modes)
+    use_contact = set_up_modes(law_arrays, atol, modes)
     ctl = (tol.rtol, atol, period / 100.0, period * tol.hmax_fraction, tol.max_steps)
     yf = y0.copy()  # advanced in place
-    status, tf, mf, n_steps, n_ev, _ = K._integrate(
+    status, tf, mf, n_steps, n_ev, _ = integrate(
         t0,
         t1,
         yf,

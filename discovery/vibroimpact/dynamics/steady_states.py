@@ -34,10 +34,13 @@ from ...numerics.shooting import (
     recurrence,
     smallest_period,
 )
+from ...numerics.status import OK
 from ...numerics.status import message as status_message
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
-from . import _kernel as K
+from .kernel import codes as K
+from .kernel.entries import in_range, set_up_modes, strobe
+from .kernel.loop import integrate
 from .memory_map import MemoryMap, orbit_multipliers
 from .simulation import (
     _HINTS,
@@ -108,7 +111,7 @@ class StroboscopicMap:
         self._no_sens = no_sensitivities()
         # the contact modes' closed form, set up here once for all the map's runs
         self._modes = contact_modes()
-        self._use_contact = K.set_up_modes((self._p, *self._arrays), self._atol, self._modes)
+        self._use_contact = set_up_modes((self._p, *self._arrays), self._atol, self._modes)
         self._bound = 1e6 * self.scale.max() + 1e3
         self._state_dirs = np.full(4, -1, dtype=np.int64)
         # exact Jacobians (one run with the variational equations) unless the law has a
@@ -151,7 +154,7 @@ class StroboscopicMap:
         p, work = self._prepared(sens[0].shape[1])
         yf = np.array(y, dtype=float)  # advanced in place
         out = (self._no_samples, self._no_events if events is None else events, sens)
-        status, tf, _, steps, n_ev, _ = K._integrate(
+        status, tf, _, steps, n_ev, _ = integrate(
             t0,
             t0 + n * self._T,
             yf,
@@ -163,7 +166,7 @@ class StroboscopicMap:
             work,
         )
         self._account(1, n, steps, p if remember else None)
-        self._check(status, tf, K.in_range(yf, self._bound))
+        self._check(status, tf, in_range(yf, self._bound))
         return yf if events is None else (yf, n_ev)
 
     def strobe(self, y, n):
@@ -172,7 +175,7 @@ class StroboscopicMap:
         points = np.empty((n + 1, 4))
         points[0] = y
         p, work = self._prepared(0)
-        status, k, tf, steps, inside = K.strobe(
+        status, k, tf, steps, inside = strobe(
             points,
             np.empty(4),
             self._p,
@@ -202,7 +205,7 @@ class StroboscopicMap:
     def _check(self, status, tf, inside):
         """Raise IntegrationError for a run that failed (``status``) or left the
         physical range (not ``inside``), at time ``tf``."""
-        if status != K.OK:
+        if status != OK:
             raise IntegrationError(
                 f"simulation of law '{self.law}' stopped at t = {tf:.6g} s: "
                 f"{status_message(status, _HINTS)}"
