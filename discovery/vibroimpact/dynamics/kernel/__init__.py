@@ -85,4 +85,15 @@ way, 2 s with its constants passed in).  Their arguments come in tuples (the law
 coef, ea, eb, br)``, the step control, the outputs, the work arrays: see
 :func:`~.loop.integrate`), which numba passes as their fields, at the cost of the separate
 arguments; no kernel function takes more than 12.
+
+Numba's cache: a cached function is stamped with its own source file only, and holds every
+function it calls or inlines from the other modules.  Importing the package therefore
+checks the sources of all its modules and of the shared Dormand-Prince blocks against the
+stamp their cache was made with, and drops the cache when any changed
+(:func:`discovery._compile.refresh`): an edit to one module recompiles the whole kernel, as
+it did when the kernel was one file.
 """
+
+from ...._compile import refresh
+
+refresh("vibro-impact")
