@@ -6,13 +6,22 @@ import os
 import sys
 from pathlib import Path
 
-__all__ = ["KERNELS", "cached", "announce_compile", "borrowing_options"]
+__all__ = ["KERNELS", "cached", "refresh", "announce_compile", "borrowing_options"]
 
+_HERE = Path(__file__).parent
 KERNELS = {
-    "vibro-impact": (Path(__file__).parent / "vibroimpact" / "dynamics", "_kernel._integrate-"),
-    "oscillator": (Path(__file__).parent / "ueda", "_kernel."),
+    "vibro-impact": (
+        _HERE / "vibroimpact" / "dynamics" / "kernel",
+        "loop.integrate-",
+    ),
+    "oscillator": (_HERE / "ueda", "_kernel."),
 }
 _ANNOUNCED = set()
+# the sources beyond a kernel's own folder that its compiled functions inline
+_SHARED = (_HERE / "numerics" / "_dopri.py", _HERE / "numerics" / "_tableau.py")
+_STAMP = "sources.sha1"
+# the kernels split over the modules of a package: their cache is checked against all of them
+_PACKAGES = {"vibro-impact"}
 
 
 def _cache_folder(folder):
@@ -28,12 +37,46 @@ def _cache_folder(folder):
 
 def cached(kernel="vibro-impact"):
     """Whether numba's cache holds the compiled ``kernel`` (``"vibro-impact"`` or
-    ``"oscillator"``)."""
+    ``"oscillator"``; a kernel whose sources changed since its cache was made is not, see
+    :func:`refresh`)."""
+    if kernel in _PACKAGES:
+        refresh(kernel)
     folder, prefix = KERNELS[kernel]
     cache = _cache_folder(folder)
     return cache.is_dir() and any(
         p.name.startswith(prefix) and p.suffix == ".nbi" for p in cache.iterdir()
     )
+
+
+def refresh(kernel="vibro-impact"):
+    """Drop numba's cache of ``kernel`` if any of its sources changed since it was made.
+
+    Numba stamps a cached function with the content of its own file only, while the function
+    holds everything it calls or inlines from other modules: a kernel split over several
+    modules (and built on the shared Dormand-Prince blocks) would otherwise run an edited
+    module's old code from the cache of a module left as it was.  The digest of all the
+    kernel folder's modules and the shared blocks is kept beside the cache (``sources.sha1``);
+    when it differs, the folder's cached functions are removed and the digest written.
+    Nothing happens where the cache cannot be written (numba then compiles in memory)."""
+    folder, _ = KERNELS[kernel]
+    digest = hashlib.sha1()
+    for path in sorted(folder.glob("*.py")) + list(_SHARED):
+        digest.update(path.read_bytes())
+    cache = _cache_folder(folder)
+    try:
+        if (cache / _STAMP).read_text() == digest.hexdigest():
+            return
+    except OSError:
+        pass
+    try:
+        if cache.is_dir():
+            for p in cache.iterdir():
+                if p.suffix in (".nbi", ".nbc"):
+                    p.unlink(missing_ok=True)
+        cache.mkdir(parents=True, exist_ok=True)
+        (cache / _STAMP).write_text(digest.hexdigest())
+    except OSError:  # a read-only install: numba compiles without its cache
+        pass
 
 
 def announce_compile(kernel="vibro-impact", stream=None):

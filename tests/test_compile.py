@@ -41,6 +41,22 @@ def test_the_cache_folder_is_numbas_own_with_numba_cache_dir(tmp_path, monkeypat
     assert C._cache_folder(src) == src / "__pycache__"
 
 
+def test_a_changed_source_of_the_kernel_drops_its_whole_cache(tmp_path, monkeypatch):
+    """Numba stamps a cached function with its own file only, and the function holds what it
+    calls from the kernel's other modules: the cache is kept while the digest of all the
+    kernel's sources is the one it was made with, and dropped when it is not."""
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    folder, prefix = C.KERNELS["vibro-impact"]
+    cache = C._cache_folder(folder)
+    C.refresh()
+    entry = cache / f"{prefix}1.py311.nbi"
+    entry.write_bytes(b"")
+    assert C.cached() and entry.exists()  # the same sources: kept
+    (cache / C._STAMP).write_text("the digest of an older kernel")
+    assert not C.cached() and not entry.exists()
+    assert (cache / C._STAMP).read_text() != "the digest of an older kernel"
+
+
 def test_an_empty_cache_is_announced_once(tmp_path, monkeypatch):
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
     monkeypatch.setattr(C, "_ANNOUNCED", set())
@@ -130,11 +146,12 @@ def test_the_kernel_borrows_its_arrays_where_numba_can(monkeypatch):
     import types
 
     from discovery._compile import borrowing_options
-    from discovery.vibroimpact.dynamics import _kernel as K
+    from discovery.vibroimpact.dynamics.kernel.contact import _contact_search
+    from discovery.vibroimpact.dynamics.kernel.entries import work_arrays
 
     assert borrowing_options() == {"_nrt": False}
-    assert K._contact_search.targetoptions.get("_nrt") is False
-    assert "_nrt" not in K.work_arrays.targetoptions  # it allocates: the counts stay
+    assert _contact_search.targetoptions.get("_nrt") is False
+    assert "_nrt" not in work_arrays.targetoptions  # it allocates: the counts stay
     without = types.SimpleNamespace(CPUTargetOptions=type("CPUTargetOptions", (), {}))
     monkeypatch.setitem(sys.modules, "numba.core.cpu", without)
     assert borrowing_options() == {}

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from discovery.vibroimpact.data.impulse import estimate_noise
-from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.kernel import codes as K
 from discovery.vibroimpact.dynamics.reference import reference_simulate
 from discovery.vibroimpact.dynamics.simulation import Tolerances, simulate
 from tests import realistic as R

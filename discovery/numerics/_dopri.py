@@ -2,7 +2,7 @@
 
 The method (stages, solution, error estimate, dense output and step-size control) does
 not depend on the system; only the right-hand side does.  Each system's integrator
-(:mod:`discovery.vibroimpact.dynamics._kernel` for the two-body vibro-impact machine,
+(:mod:`discovery.vibroimpact.dynamics.kernel` for the two-body vibro-impact machine,
 :mod:`discovery.ueda._kernel` for Ueda's oscillators) is a loop that calls these
 functions and its own right-hand side::
 
@@ -25,9 +25,10 @@ floating-point operations: changing it changes every result in its last bits.
 
 Caveat (numba's): a cached integrator is invalidated only when the *content* of its own
 source file changes (numba 0.68 stamps sources by a content hash; touching does not
-help).  After editing this file, delete the ``__pycache__`` directories of
-``discovery/vibroimpact/dynamics`` and ``discovery/ueda`` so that the integrators are
-recompiled with the new blocks.
+help).  The vibro-impact kernel checks this file and its own modules itself
+(:func:`discovery._compile.refresh`); after editing this file, delete the ``__pycache__``
+directory of ``discovery/ueda`` so that Ueda's integrators are recompiled with the new
+blocks.
 
 ``K`` has shape ``(7, n)``.  Coefficients are in :mod:`discovery.numerics._tableau`
 (checked against scipy's RK45 tables by the tests).
@@ -43,6 +44,7 @@ from ._tableau import B as _B
 from ._tableau import C
 from ._tableau import E as _E
 from ._tableau import P as _P
+from .status import BLOW_UP, OK, STEP_BUDGET, STEP_UNDERFLOW
 
 __all__ = [
     "C",
@@ -165,9 +167,6 @@ def step_factor(err):
     if err > 1.0:
         return max(MIN_FACTOR, SAFETY * err**-0.2)
     return min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * max(err, 1e-10) ** -0.2))
-
-
-OK, STEP_BUDGET, BLOW_UP, STEP_UNDERFLOW = 0, 1, 2, 3
 
 
 def make_smooth_advance(rhs, n, n_out):

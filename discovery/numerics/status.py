@@ -1,7 +1,8 @@
 """What the compiled integrators' status codes mean: one table for both systems.
 
-Every compiled run returns a status (:data:`OK` or one of the failures below, the codes of
-:mod:`discovery.numerics._dopri`; the vibro-impact kernel adds :data:`CHATTER`).
+Every compiled run returns a status (:data:`OK` or one of the failures below): the codes
+are defined here once, and both integrators import them (the smooth advance of
+:mod:`discovery.numerics._dopri` and the vibro-impact kernel, which adds :data:`CHATTER`).
 :func:`check` turns a failure into one :class:`~discovery.errors.IntegrationError` line.
 """
 

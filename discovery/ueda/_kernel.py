@@ -25,7 +25,8 @@ constant of the shared blocks):
 import numpy as np
 from numba import njit
 
-from ..numerics._dopri import OK, make_segments
+from ..numerics._dopri import make_segments
+from ..numerics.status import OK
 from .system import UEDA
 
 __all__ = [
@@ -34,7 +35,6 @@ __all__ = [
     "pair_run",
     "scan_run",
     "monodromy_run",
-    "OK",
 ]
 
 

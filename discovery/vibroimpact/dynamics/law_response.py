@@ -17,7 +17,7 @@ from ..data.impulse import Impulse
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from . import Tolerances
-from . import _kernel as K
+from .kernel import codes as K
 from .simulation import simulate
 from .steady_states import steady_state
 

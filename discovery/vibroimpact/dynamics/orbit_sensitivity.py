@@ -21,7 +21,8 @@ import numpy as np
 
 from ..._printing import readable
 from ...errors import InputError
-from . import _kernel as K
+from .kernel import codes as K
+from .kernel.forces import force_partials, rhs_at
 from .simulation import kernel_params, simulate
 
 __all__ = ["OrbitSensitivity", "orbit_sensitivity"]
@@ -135,8 +136,8 @@ def _force_rate(scenario, law, t, y, mode):
         if mode[i] not in (K.LOAD, K.UNLOAD):
             continue
         z, v = y[0, i] - y[2, i], y[1, i] - y[3, i]
-        fz, fv = K.force_partials(mode[i], z, v, coef, ea, eb, br, dc)
-        K._rhs_at(t[i], y[:, i].copy(), mode[i], p, coef, ea, eb, br, f)
+        fz, fv = force_partials(mode[i], z, v, coef, ea, eb, br, dc)
+        rhs_at(t[i], y[:, i].copy(), mode[i], (p, coef, ea, eb, br), f)
         out[i] = fz * v + fv * (f[1] - f[3])
     return out
 

@@ -8,11 +8,16 @@ from ..._compile import announce_compile
 from ..._settings import Settings, option, takes
 from ..._validate import Array, Choice, Real, params
 from ...errors import InputError, IntegrationError
+from ...numerics.status import BLOW_UP, STEP_BUDGET, STEP_UNDERFLOW
 from ...numerics.status import message as status_message
 from ...numerics.tolerances import Tolerances
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
-from . import _kernel as K
+from .kernel import codes as K
+from .kernel.contact_modes import NE, NR
+from .kernel.entries import set_up_modes, sorted_within, work_arrays
+from .kernel.forces import mode_force
+from .kernel.loop import integrate
 
 __all__ = ["Trajectory", "simulate", "Tolerances", "MODE_NAMES", "EVENT_NAMES", "SENSITIVITIES"]
 
@@ -27,12 +32,12 @@ EVENT_NAMES = {
 }
 # what to check when the vibro-impact kernel fails (after the meaning from .status)
 _HINTS = {
-    K.STEP_BUDGET: (
+    STEP_BUDGET: (
         " (a law too stiff or too fast for the machine: check the coefficients' "
         "units; API: Tolerances(max_steps=...))"
     ),
-    K.BLOW_UP: "; check the law's coefficients and signs",
-    K.STEP_UNDERFLOW: "; the law may be too stiff for this tolerance",
+    BLOW_UP: "; check the law's coefficients and signs",
+    STEP_UNDERFLOW: "; the law may be too stiff for this tolerance",
 }
 
 
@@ -130,8 +135,8 @@ class Trajectory:
                 p[K.P_ZMAX] = 0.0
                 p[K.P_V0] = max(v, 1e-12)
             p[K.P_ZMAX] = max(p[K.P_ZMAX], z)  # the largest penetration so far (events only)
-            out[k, 0] = K.mode_force(m0, z, v, p, coef, ea, eb, br)
-            out[k, 1] = K.mode_force(m1, z, v, p, coef, ea, eb, br)
+            out[k, 0] = mode_force(m0, z, v, p, coef, ea, eb, br)
+            out[k, 1] = mode_force(m1, z, v, p, coef, ea, eb, br)
         return out
 
 
@@ -154,18 +159,18 @@ def kernel_params(scenario, law, tolerances=None):
     return p
 
 
-def _buffers(n_eval, max_events):
-    """The kernel's output arrays: state, force and mode at the output times, and the
-    events' times, kinds, states and modes."""
-    return (
-        np.empty((4, n_eval)),
-        np.empty(n_eval),
-        np.empty(n_eval, dtype=np.int64),
+def _buffers(t_eval, max_events):
+    """The kernel's outputs ``(samples, events)``: the output times ``t_eval`` with the
+    state, force and mode there, and the events' times, kinds, states and modes."""
+    n_eval = t_eval.shape[0]
+    samples = (t_eval, np.empty((4, n_eval)), np.empty(n_eval), np.empty(n_eval, dtype=np.int64))
+    events = (
         np.empty(max_events),
         np.empty(max_events, dtype=np.int64),
         np.empty((max_events, 4)),
         np.empty((max_events, 2), dtype=np.int64),
     )
+    return samples, events
 
 
 def no_sensitivities():
@@ -186,8 +191,8 @@ def contact_modes():
     eigendecomposition of the two modes is made once."""
     return (
         np.zeros(4),
-        np.zeros((2, 4, K._NE), dtype=np.complex128),
-        np.zeros((2, K._NR)),
+        np.zeros((2, 4, NE), dtype=np.complex128),
+        np.zeros((2, NR)),
         np.zeros(1),
     )
 
@@ -204,7 +209,7 @@ def scratch(m_s, n_coef, modes):
     if work is None:
         if len(_SCRATCH) >= 64:
             _SCRATCH.clear()
-        work = _SCRATCH[key] = K.work_arrays(m_s, n_coef)
+        work = _SCRATCH[key] = work_arrays(m_s, n_coef)
     steps, sens, (fl, qm, sw, cb, fc, fcd) = work
     kc, E, R, _ = modes
     return steps, sens, (fl, kc, E, R, qm, sw, cb, fc, fcd)
@@ -353,10 +358,11 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
     y0 = scenario.initial_state() if y0 is None else np.array(y0, dtype=float).reshape(4)
     te = np.zeros(0) if t_eval is None else np.ascontiguousarray(t_eval, dtype=float)
     announce_compile("vibro-impact")  # the check below is the kernel's first call
-    if te.size and not K.sorted_within(te, t0 - 1e-12, t1 + 1e-12):
+    if te.size and not sorted_within(te, t0 - 1e-12, t1 + 1e-12):
         raise InputError("t_eval must be sorted and inside t_span")
-    bufs = _buffers(te.size, s.max_events)
-    out_y, out_f, out_m, ev_t, ev_k, ev_y, ev_m = bufs
+    samples, events = _buffers(te, s.max_events)
+    _, out_y, out_f, out_m = samples
+    ev_t, ev_k, ev_y, ev_m = events
     period = scenario.period
     p = kernel_params(scenario, law, tol)
     p[K.P_ZMAX] = float(s.zeta_max0)
@@ -377,28 +383,20 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
     coef, ea, eb, br = law.kernel_arrays()
     atol = _atol(scenario, tol)
     modes = contact_modes()
-    use_contact = K.set_up_modes(p, coef, ea, eb, br, atol, modes)
+    law_arrays = (p, coef, ea, eb, br)
+    use_contact = set_up_modes(law_arrays, atol, modes)
+    ctl = (tol.rtol, atol, period / 100.0, period * tol.hmax_fraction, tol.max_steps)
     yf = y0.copy()  # advanced in place
-    status, tf, mf, n_steps, n_ev, _ = K._integrate(
+    status, tf, mf, n_steps, n_ev, _ = integrate(
         t0,
         t1,
         yf,
         -1 if s.mode0 is None else int(s.mode0),
-        p,
-        coef,
-        ea,
-        eb,
-        br,
-        tol.rtol,
-        atol,
-        period / 100.0,
-        period * tol.hmax_fraction,
-        tol.max_steps,
-        te,
-        *bufs,
-        *sens,
+        law_arrays,
+        ctl,
+        (samples, events, sens),
         use_contact,
-        *scratch(sens[0].shape[1], coef.shape[0], modes),
+        scratch(sens[0].shape[1], coef.shape[0], modes),
     )
     message = (
         "ok"

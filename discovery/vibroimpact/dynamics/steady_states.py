@@ -34,10 +34,13 @@ from ...numerics.shooting import (
     recurrence,
     smallest_period,
 )
+from ...numerics.status import OK
 from ...numerics.status import message as status_message
 from ..model.law import ForceLaw
 from ..model.scenario import Scenario
-from . import _kernel as K
+from .kernel import codes as K
+from .kernel.entries import in_range, set_up_modes, strobe
+from .kernel.loop import integrate
 from .memory_map import MemoryMap, orbit_multipliers
 from .simulation import (
     _HINTS,
@@ -84,16 +87,9 @@ class StroboscopicMap:
         self._T = scenario.period
         self._hmax = self._T * self.tol.hmax_fraction
         # the kernel's arguments every run takes: the law, the tolerances, no output times
-        self._fixed = (
-            self._coef,
-            self._ea,
-            self._eb,
-            self._br,
-            self.tol.rtol,
-            self._atol,
-            self._T / 100.0,
-            self._hmax,
-            self.tol.max_steps,
+        self._arrays = (self._coef, self._ea, self._eb, self._br)
+        self._ctl = (self.tol.rtol, self._atol, self._T / 100.0, self._hmax, self.tol.max_steps)
+        self._no_samples = (
             np.zeros(0),
             np.empty((4, 0)),
             np.empty(0),
@@ -115,9 +111,7 @@ class StroboscopicMap:
         self._no_sens = no_sensitivities()
         # the contact modes' closed form, set up here once for all the map's runs
         self._modes = contact_modes()
-        self._use_contact = K.set_up_modes(
-            self._p, self._coef, self._ea, self._eb, self._br, self._atol, self._modes
-        )
+        self._use_contact = set_up_modes((self._p, *self._arrays), self._atol, self._modes)
         self._bound = 1e6 * self.scale.max() + 1e3
         self._state_dirs = np.full(4, -1, dtype=np.int64)
         # exact Jacobians (one run with the variational equations) unless the law has a
@@ -159,20 +153,20 @@ class StroboscopicMap:
     def _run(self, y, n, t0, remember, sens, *, events=None):
         p, work = self._prepared(sens[0].shape[1])
         yf = np.array(y, dtype=float)  # advanced in place
-        status, tf, _, steps, n_ev, _ = K._integrate(
+        out = (self._no_samples, self._no_events if events is None else events, sens)
+        status, tf, _, steps, n_ev, _ = integrate(
             t0,
             t0 + n * self._T,
             yf,
             -1,
-            p,
-            *self._fixed,
-            *(self._no_events if events is None else events),
-            *sens,
+            (p, *self._arrays),
+            self._ctl,
+            out,
             self._use_contact,
-            *work,
+            work,
         )
         self._account(1, n, steps, p if remember else None)
-        self._check(status, tf, K.in_range(yf, self._bound))
+        self._check(status, tf, in_range(yf, self._bound))
         return yf if events is None else (yf, n_ev)
 
     def strobe(self, y, n):
@@ -181,21 +175,18 @@ class StroboscopicMap:
         points = np.empty((n + 1, 4))
         points[0] = y
         p, work = self._prepared(0)
-        status, k, tf, steps, inside = K.strobe(
+        status, k, tf, steps, inside = strobe(
             points,
             np.empty(4),
             self._p,
-            p,
             self._memory,
-            0.0,
-            -1,
-            self._T,
             self._bound,
-            *self._fixed,
-            *self._no_events,
-            *self._no_sens,
+            (0.0, -1, self._T),
+            (p, *self._arrays),
+            self._ctl,
+            (self._no_samples, self._no_events, self._no_sens),
             self._use_contact,
-            *work,
+            work,
         )
         self._account(k, k, steps, p)
         self._check(status, tf, inside)
@@ -214,7 +205,7 @@ class StroboscopicMap:
     def _check(self, status, tf, inside):
         """Raise IntegrationError for a run that failed (``status``) or left the
         physical range (not ``inside``), at time ``tf``."""
-        if status != K.OK:
+        if status != OK:
             raise IntegrationError(
                 f"simulation of law '{self.law}' stopped at t = {tf:.6g} s: "
                 f"{status_message(status, _HINTS)}"

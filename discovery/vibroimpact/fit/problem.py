@@ -365,7 +365,7 @@ def _aligned_sensitivity(scenario, law, ref, ev, tolerances):
     the measured cycle, seen from the onset the alignment chose (which moves with the
     coefficients): :meth:`~discovery.vibroimpact.dynamics.orbit_sensitivity.
     OrbitSensitivity.from_onset` at the measured sample times, shape (m, samples)."""
-    from ..dynamics import _kernel as K
+    from ..dynamics.kernel import codes as K
     from ..dynamics.orbit_sensitivity import orbit_sensitivity
 
     os_ = orbit_sensitivity(scenario, law, ev.steady, impacts=False, tolerances=tolerances)

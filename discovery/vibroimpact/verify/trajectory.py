@@ -25,7 +25,7 @@ from ...numerics.memo import Memo, value_key
 from ..data.contact_edges import contact_onsets
 from ..data.measurement import Measurement
 from ..data.noise import estimate_noise
-from ..dynamics import _kernel as _K
+from ..dynamics.kernel import codes as _K
 from ..dynamics.simulation import simulate
 from .block_farm import farm_for
 from .criteria import CRITERIA, evaluate_criteria

@@ -7,7 +7,7 @@ import pytest
 
 from discovery.errors import InputError
 from discovery.vibroimpact.data.impulse import Impulse, estimate_noise, impulse_from_samples
-from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.kernel import codes as K
 from discovery.vibroimpact.dynamics.law_response import impulse_from_steady_state
 from discovery.vibroimpact.dynamics.simulation import simulate
 from discovery.vibroimpact.verify.criteria import evaluate_criteria

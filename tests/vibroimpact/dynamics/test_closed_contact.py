@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from discovery.errors import InputError
-from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.kernel import codes as K
+from discovery.vibroimpact.dynamics.kernel.contact_modes import _contact_eig_scaled, _contact_matrix
 from discovery.vibroimpact.dynamics.reference import reference_simulate
 from discovery.vibroimpact.dynamics.simulation import EVENT_NAMES, Tolerances, simulate
 from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state
@@ -271,9 +272,9 @@ def test_the_contact_modes_eigenvalues_against_lapack():
         p[:7] = m1, m2, k1, c1, 1.0, 10.0, 9.81
         dsc = np.array([1e-3, 1e-1, 1e-3, 1e-1])
         Ms = np.empty((4, 4), dtype=complex)
-        K._contact_matrix(p, k, c, dsc, Ms)
+        _contact_matrix(p, k, c, dsc, Ms)
         lam, Vs = np.empty(4, dtype=complex), np.empty((4, 4), dtype=complex)
-        assert K._contact_eig_scaled(p, k, c, dsc, Ms, lam, Vs)
+        assert _contact_eig_scaled(p, k, c, dsc, Ms, lam, Vs)
         ref, V = np.linalg.eig(Ms)
         if np.linalg.cond(V) > 1e4:
             continue  # near a defective pair: LAPACK's own error grows (the kernel integrates)

@@ -7,7 +7,7 @@ import pytest
 from scipy.optimize import brentq
 
 from discovery.errors import InputError
-from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.kernel import codes as K
 from discovery.vibroimpact.dynamics.simulation import Tolerances, simulate
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.scenario import Scenario, load_scenario

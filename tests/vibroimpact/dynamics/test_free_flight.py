@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from discovery.errors import InputError
-from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.kernel import codes as K
 from discovery.vibroimpact.dynamics.reference import reference_simulate
 from discovery.vibroimpact.dynamics.simulation import EVENT_NAMES, Tolerances, simulate
 from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state

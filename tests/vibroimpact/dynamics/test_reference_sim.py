@@ -22,8 +22,8 @@ their start states are the reference's own states at an event, to full precision
 import numpy as np
 import pytest
 
-from discovery.vibroimpact.dynamics import _kernel as K
 from discovery.vibroimpact.dynamics import reference as R
+from discovery.vibroimpact.dynamics.kernel import codes as K
 from discovery.vibroimpact.dynamics.reference import reference_simulate
 from discovery.vibroimpact.dynamics.simulation import EVENT_NAMES, Tolerances, simulate
 from discovery.vibroimpact.model.law import ForceLaw

@@ -8,7 +8,7 @@ import pytest
 from scipy.linalg import expm
 
 from discovery.errors import InputError
-from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.kernel import codes as K
 from discovery.vibroimpact.dynamics.simulation import Tolerances, simulate
 from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state
 from discovery.vibroimpact.model.law import ForceLaw

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from discovery.errors import IntegrationError
-from discovery.vibroimpact.dynamics import _kernel as K
+from discovery.vibroimpact.dynamics.kernel import codes as K
 from discovery.vibroimpact.dynamics.simulation import simulate
 from discovery.vibroimpact.dynamics.steady_states import StroboscopicMap, steady_state
 from discovery.vibroimpact.model.law import ForceLaw
