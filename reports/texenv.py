@@ -171,4 +171,7 @@ def environment():
     env.filters["spec"] = _spec
     env.filters["tex"] = lambda v: v if isinstance(v, Tex) else Tex(escape(v))
     env.filters["tt"] = lambda v: Tex(r"\texttt{" + escape(v) + "}")
+    from .rules import rule_tex
+
+    env.globals["consistency_rule"] = Tex(rule_tex())  # the rule as the verdict applies it
     return env

@@ -28,6 +28,7 @@ from ..lawtex import (
     term_tex,
     verdict_tex,
 )
+from ..rules import rule_text
 from ..texenv import Tex, escape, num, scientific
 
 
@@ -60,9 +61,7 @@ def _verify(doc, run_dir):
             f"The law is consistent with the record: every judged criterion is within "
             f"its limit (I2 {crit.get('I2', float('nan')):.3g} against "
             f"{lim.get('I2', float('nan')):.3g}), the limit being what the true law "
-            "scores on records this noisy (f times the noise floor, f = 2 for I2 and I4 "
-            "and 1.25 for I5, or the floor plus three of its standard deviations, plus "
-            "0.005)."
+            f"scores on records this noisy ({rule_text()})."
         )
     else:
         over = [k for k in lim if crit.get(k, 0) > lim[k]]
