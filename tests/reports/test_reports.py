@@ -661,11 +661,12 @@ def test_the_limit_rule_names_each_criterion_s_factor():
 def test_the_reports_state_the_rule_from_its_constants(monkeypatch):
     """The rule's words and LaTeX are rendered from the constants the verdict applies: a
     changed factor, spread or slack changes what every report says."""
+    import discovery.vibroimpact.verify as ev
     from reports import rules
 
-    monkeypatch.setattr(rules, "CONSISTENCY_FACTORS", {"I2": 3.0, "I4": 2.0, "I5": 1.5})
-    monkeypatch.setattr(rules, "CONSISTENCY_SPREAD", 4.0)
-    monkeypatch.setattr(rules, "CONSISTENCY_SLACK", 0.01)
+    monkeypatch.setattr(ev, "CONSISTENCY_FACTORS", {"I2": 3.0, "I4": 2.0, "I5": 1.5})
+    monkeypatch.setattr(ev, "CONSISTENCY_SPREAD", 4.0)
+    monkeypatch.setattr(ev, "CONSISTENCY_SLACK", 0.01)
     assert rules.rule_text() == (
         "f times the noise floor, f = 3 for I2, 2 for I4 and 1.5 for I5, or the floor plus "
         "4 of its standard deviations, plus 0.01"

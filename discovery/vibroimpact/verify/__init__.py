@@ -12,6 +12,7 @@ _EXPORTS = {
     "CONSISTENCY_FACTOR": "evaluation",
     "CONSISTENCY_FACTORS": "evaluation",
     "CONSISTENCY_SLACK": "evaluation",
+    "CONSISTENCY_SPREAD": "evaluation",
     "Evaluation": "evaluation",
     "align": "evaluation",
     "consistency_limits": "evaluation",
@@ -38,6 +39,7 @@ __all__ = [
     "CONSISTENCY_FACTOR",
     "CONSISTENCY_FACTORS",
     "CONSISTENCY_SLACK",
+    "CONSISTENCY_SPREAD",
     "consistency_limits",
 ]
 
