@@ -106,19 +106,18 @@ def _install(clone, env, log):
     as the simulators' warm-up printed them."""
     env = {**env, "PIP_NO_CACHE_DIR": "1"}
     seconds, cpu, run = _timed(["make", "install"], clone, env)
-    compiled = dict(
-        (k, float(v))
-        for k, v in re.findall(r"([\w-]+) ([\d.]+) s", _ready_line(run.stdout + run.stderr))
-    )
+    compiled = _compiled(run)
     log(f"make install {seconds:.0f} s (compile {compiled})")
     return {"kind": "install", "seconds": seconds, "cpu": cpu, "compile": compiled, "fresh": True}
 
 
-def _ready_line(text):
-    for line in text.splitlines():
+def _compiled(run):
+    """``{kernel: seconds}`` from the warm-up's "simulators ready (...)" line in ``run``'s
+    output (empty when it did not print one)."""
+    for line in (run.stdout + run.stderr).splitlines():
         if line.startswith("simulators ready"):
-            return line
-    return ""
+            return {k: float(v) for k, v in re.findall(r"([\w-]+) ([\d.]+) s", line)}
+    return {}
 
 
 def _borrow_venv(clone, env, log):
@@ -130,10 +129,7 @@ def _borrow_venv(clone, env, log):
             clone,
             {**env, "NUMBA_CACHE_DIR": cache},
         )
-    compiled = dict(
-        (k, float(v))
-        for k, v in re.findall(r"([\w-]+) ([\d.]+) s", _ready_line(run.stdout + run.stderr))
-    )
+    compiled = _compiled(run)
     log(f"compile {seconds:.0f} s {compiled}")
     return {"kind": "install", "seconds": None, "cpu": cpu, "compile": compiled, "fresh": False}
 

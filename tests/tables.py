@@ -116,16 +116,18 @@ def _two_points(pattern):
     )
 
 
-def _readme(page, lines):
-    """A paragraph of ``page`` rendered by ``lines(rows)`` from the README's run
-    (:mod:`tests.survey_readme`, :mod:`tests.readme_text`)."""
+def _paragraph(page, lines, runs, read):
+    """Text of ``page`` rendered by ``lines(rows)`` from the run files ``runs`` (read with
+    ``read``): a table without rows."""
     return Table(
-        page=page,
-        header=lines,
-        rows=(("run", ("readme*.jsonl",)),),
-        row=lambda rows, label: [],
-        read=readme_text.read_rows,
+        page=page, header=lines, rows=(("run", runs),), row=lambda rows, label: [], read=read
     )
+
+
+def _readme(page, lines):
+    """A paragraph of ``page`` from the README's run (:mod:`tests.survey_readme`,
+    :mod:`tests.readme_text`)."""
+    return _paragraph(page, lines, ("readme*.jsonl",), readme_text.read_rows)
 
 
 #: the README's measured paragraphs, in the README and again in the getting-started page
@@ -142,12 +144,8 @@ _README_TEXT = {
 
 TABLES = {
     **_README_TEXT,
-    "bench-readme": Table(
-        page="README.md",
-        header=bench_history.readme_lines,
-        rows=(("runs", ("bench-history.jsonl",)),),
-        row=lambda rows, label: [],
-        read=bench_history.read_rows,
+    "bench-readme": _paragraph(
+        "README.md", bench_history.readme_lines, ("bench-history.jsonl",), bench_history.read_rows
     ),
     "effects": Table(
         page="docs/validation.md",
