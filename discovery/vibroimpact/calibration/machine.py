@@ -14,10 +14,10 @@ from ..model.scenario import Scenario
 from .equations import machine_rows
 from .estimate import cycle_draws, drive_phase, estimate, frame_residual, moulding_residual
 from .result import UNITS, Calibration
-from .shedding import shedding
+from .shedding import MATERIAL, shedding
 from .units import check_units
 
-__all__ = ["calibrate", "CALIBRATED", "LOOSE"]
+__all__ = ["calibrate", "CALIBRATED", "LOOSE", "MATERIAL"]
 
 #: the parameters a calibration may estimate
 CALIBRATED = ("m1", "c1", "k1", "k3", "A", "m2")
@@ -311,6 +311,14 @@ def _determined(est, k):
     return bool(v > 0 and np.isfinite(lo) and lo > 0 and (hi - lo) / 2 <= LOOSE * v)
 
 
+def stiffening_share(rows, k1, k3):
+    """The stiffening's share of the supports' force as the records' equations hold it:
+    ``k3 ||int phi w1^3|| / (k1 ||int phi w1||)`` over every window of ``rows``."""
+    frame = np.concatenate([r.frame for r in rows])
+    linear = abs(k1) * np.linalg.norm(frame[:, 2])
+    return float(abs(k3) * np.linalg.norm(frame[:, 3]) / linear) if linear > 0 else math.inf
+
+
 def _first_estimate(rows, held, draws, probe_k3):
     """The estimate with only ``held`` fixed, and the parameters it held: ``(Estimate or
     None, held)``.  With ``probe_k3`` (a sheet with linear supports) the supports are
@@ -324,7 +332,12 @@ def _first_estimate(rows, held, draws, probe_k3):
     if probe_k3:
         free = estimate(rows, held, draws)
         k = free.names.index("k3")
-        if np.all(np.isfinite(free.value)) and _determined(free, k):
+        v = free.value
+        if (
+            np.all(np.isfinite(v))
+            and _determined(free, k)
+            and stiffening_share(rows, v[free.names.index("k1")], v[k]) >= MATERIAL
+        ):
             return free, held
     return first, linear
 

@@ -195,6 +195,27 @@ def test_stiffening_supports_under_a_linear_sheet_are_found_and_used():
     assert not any("stiffen" in n for n in linear.notes)
 
 
+def test_the_readme_record_claims_no_machine_effect():
+    """The README's record (the paper's machine, 1 % force noise, motions without noise):
+    the frame's equation once pinned a k3 to 4 % whose share of the supports' force was
+    1e-6 (the equations' quadrature error), and every command said "the supports stiffen".
+    An effect the sheet lacks is kept only where it moves its force by MATERIAL."""
+    from discovery.vibroimpact.calibration.machine import stiffening_share
+    from discovery.vibroimpact.calibration.shedding import MATERIAL
+    from discovery.vibroimpact.dynamics.synthetic import synthesize
+
+    sc = load_scenario("paper")
+    law = ForceLaw.parse("2.06e8*z + 1.28e7*zd")
+    m = synthesize(sc, law, periods=20, fs=20000, noise=0.01, seed=1)
+    cal = calibrate(sc, m)
+    assert "k3" not in cal.parameters and "mass_loss" not in cal.parameters, cal.notes
+    assert cal.scenario.k3 == 0.0 and cal.scenario.mass_loss == 0.0
+    rows = [machine_rows(m, sc)]
+    x = float(np.max(np.abs(m.channels["w1"])))
+    assert stiffening_share(rows, sc.k1, sc.k1 / x**2) == pytest.approx(1.0, rel=0.5)
+    assert stiffening_share(rows, sc.k1, 1.0e6) < MATERIAL / 1000
+
+
 def test_a_moulding_that_sheds_mass_under_a_sheet_that_keeps_it_is_found():
     """The moulding sheds 0.5 % of its mass per contact (the paper's machine, 40 periods,
     the sheet's mass its mass at the record's start): the calibration reads the loss from
