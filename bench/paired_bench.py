@@ -34,6 +34,8 @@ COMMANDS = {
     "verify": (["verify", "--data", "R.csv", "--law", LAW], True),
     "fit": (["fit", "--data", "R.csv", "--intervals", "0"], True),
     "explain": (["explain", "--data", "R.csv", "--start", "linear"], False),
+    # the five named models on the README's record (M.csv), intervals included
+    "contact-models": (["fit", "--data", "M.csv", "--library", "contact-models"], False),
 }
 
 
@@ -71,8 +73,9 @@ def _vidi(code_root, words, cwd):
 
 
 def record(cwd):
-    """The bench record: the paper's machine from rest by the scipy path, 1 % noise (a
-    record in its transient, as the README's first record)."""
+    """The bench records: the paper's machine from rest by the scipy path, 1 % noise (a
+    record in its transient, as the README's first record), and the README's record of the
+    named models."""
     _vidi(
         ROOT,
         [
@@ -93,6 +96,9 @@ def record(cwd):
         ],  # fmt: skip
         cwd,
     )
+    # the README's 20-period record of the paper's machine (its named-models example)
+    words = ["simulate", "--scenario", "paper", "--law", LAW, "--periods", "20", "--fs", "20000"]
+    _vidi(ROOT, words + ["--noise", "0.01", "--seed", "1", "--out", "M.csv"], cwd)
 
 
 def paired(name, words, pairs, cwd, old):
@@ -142,7 +148,7 @@ def print_paired(result, head=True):
         each = ", ".join(f"{x:.2f}" for x in r["ratios"])
         new, old = statistics.median(r["new"]), statistics.median(r["old"])
         print(
-            f"  {name:8s} new/old {r['ratio']:.2f} (pairs {each}; new median {new:.1f} s, "
+            f"  {name:14s} new/old {r['ratio']:.2f} (pairs {each}; new median {new:.1f} s, "
             f"old {old:.1f} s)  counts: {counted}"
         )
 

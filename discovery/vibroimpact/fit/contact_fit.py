@@ -38,7 +38,7 @@ from ...wording import verb
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
 from ..model.contact_models import same_force
-from ..model.contact_registry import CONTACT_MODELS, DOMAINS
+from ..model.contact_registry import CONTACT_MODELS, DOMAINS, domain_edges
 from ..model.scenario import Scenario
 from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
@@ -293,13 +293,9 @@ def _degenerate(params, intervals):
     """Why a fit is no result (``""`` when it is one): a parameter at the edge of what a fit
     may reach (a stiffness at its floor, an exponent or a restitution at its range's end), or
     a parameter without a finite interval, or one that spans its whole range."""
-    why = []
-    for k, v in params.items():
-        lo, hi, open_low = DOMAINS.get(k, (-np.inf, np.inf, False))
-        if open_low and not v > 1e-200:  # at (or near) K_FLOOR
-            why.append(f"{k} = {v:.3g} sits at its floor")
-        elif k in ("n", "e") and (v <= lo * (1 + 1e-9) or (k == "n" and v >= hi * (1 - 1e-9))):
-            why.append(f"{k} = {v:.4g} sits at the end of its range [{lo:g}, {hi:g}]")
+    why = domain_edges(params)
+    for k in params:
+        lo, hi, _ = DOMAINS.get(k, (-np.inf, np.inf, False))
         b = intervals.get(k)
         if b is not None and not all(np.isfinite(b)):
             why.append(f"{k} has no finite interval")

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..._validate import Real, Text, check
 from ...errors import InputError
-from .contact_registry import CONTACT_MODELS, E_RANGE, K_FLOOR, N_RANGE
+from .contact_registry import CONTACT_MODELS, E_RANGE, K_FLOOR, N_RANGE, domain_edges
 from .law import ForceLaw
 
 __all__ = [
@@ -158,6 +158,13 @@ class ContactModel:
         for (lo, hi, open_low), v in zip(self.spec.domains.values(), values, strict=True):
             out.append(min(max(float(v), K_FLOOR if open_low else lo), hi))
         return ContactModel(self.name, tuple(out))
+
+    def edges(self):
+        """Why the model sits at the edge of what a fit may reach: one line per parameter
+        at it (a stiffness at its floor, an exponent or a restitution at its range's end;
+        empty when none is).  A fit that ends there is no result, and one heading there is
+        not restarted (:func:`~discovery.vibroimpact.fit.optimise._restarted`)."""
+        return domain_edges(self.params)
 
     # ----------------------------------------------------------------- law
     @property

@@ -32,7 +32,15 @@ import numpy as np
 
 from .law import ForceLaw, Term
 
-__all__ = ["ContactModelSpec", "CONTACT_MODELS", "DOMAINS", "N_RANGE", "E_RANGE", "K_FLOOR"]
+__all__ = [
+    "ContactModelSpec",
+    "CONTACT_MODELS",
+    "DOMAINS",
+    "N_RANGE",
+    "E_RANGE",
+    "K_FLOOR",
+    "domain_edges",
+]
 
 N_RANGE = (0.5, 3.0)  # exponents a fit may reach
 E_RANGE = (0.02, 1.0)  # coefficients of restitution a fit may reach
@@ -47,6 +55,20 @@ DOMAINS = {
 }
 #: where a stiffness is held above 0 (its open lower bound)
 K_FLOOR = 1e-300
+
+
+def domain_edges(params):
+    """Why parameters ``{name: value}`` sit at the edge of what a fit may reach
+    (:data:`DOMAINS`): one line per parameter at it, a stiffness at its floor or an exponent
+    or a restitution at its range's end (empty when none is)."""
+    why = []
+    for k, v in params.items():
+        lo, hi, open_low = DOMAINS.get(k, (-np.inf, np.inf, False))
+        if open_low and not v > 1e-200:  # at (or near) K_FLOOR
+            why.append(f"{k} = {v:.3g} sits at its floor")
+        elif k in ("n", "e") and (v <= lo * (1 + 1e-9) or (k == "n" and v >= hi * (1 - 1e-9))):
+            why.append(f"{k} = {v:.4g} sits at the end of its range [{lo:g}, {hi:g}]")
+    return why
 
 
 @dataclass(frozen=True)
