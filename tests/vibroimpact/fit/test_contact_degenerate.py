@@ -52,3 +52,25 @@ def test_a_failed_fit_prints_its_reason_not_its_numbers():
     text = str(res)
     assert "kelvin-voigt" in text and "failed: fit degenerate: k = 1e-300 sits at its floor" in text
     assert "nan" not in text and "1e-300  95 %" not in text
+
+
+def test_a_fit_heading_to_the_edge_stops_there():
+    """The README's record (a damper-dominated contact): Hertz-damper's stiffness leaves its
+    domain on the fit's third step and is clipped to its floor, where its Jacobian column
+    is zero, so no step brings it back.  The fit stops after EDGE_ITERATIONS such
+    iterations and is not restarted there (it spent its whole budget of 200 simulations,
+    and 14 s, before: 31 now), and is listed as failed."""
+    from discovery import ForceLaw, load_scenario
+    from discovery.vibroimpact.dynamics.synthetic import synthesize
+    from discovery.vibroimpact.fit.contact_fit import fit_contact_models
+    from discovery.vibroimpact.model.contact_models import ContactModel
+
+    sc = load_scenario("paper")
+    law = ForceLaw.parse("2.06e8*z + 1.28e7*zd")
+    m = synthesize(sc, law, periods=20, fs=20000, noise=0.01, seed=1)
+    res = fit_contact_models(sc, m, models=["hertz-damper"], progress=False)
+    (fit,) = res.fits
+    assert fit.consistent is None and "k = 1e-300 sits at its floor" in fit.message
+    assert fit.n_simulations < 80, fit.n_simulations
+    assert ContactModel("hertz-damper", (1e-300, 1e6)).edges() == ["k = 1e-300 sits at its floor"]
+    assert ContactModel("hertz-damper", (1e9, 1e6)).edges() == []
