@@ -304,6 +304,20 @@ def _degenerate(params, intervals):
     return "; ".join(why)
 
 
+def _too_damped(name, params):
+    """Why an impact-scaled model's restitution at the low end of its range means: the
+    record's impacts are damped more than the model can (Lankarani-Nikravesh's ratio stays
+    below 3/4 whatever ``e``), or ``""``."""
+    spec = CONTACT_MODELS[name]
+    if not spec.impact_scaled or params.get("e", 1.0) > DOMAINS["e"][0] * (1 + 1e-9):
+        return ""
+    r = spec.ratio(DOMAINS["e"][0])
+    return (
+        f" (the record's impacts are damped more than {name} can damp them: its ratio "
+        f"r = lambda v0 / k is at most {r:.3g})"
+    )
+
+
 def _within(progress, name, i, names):
     """The progress of one model's fit and intervals, named in the models' count (the bar
     moves within a model: each fit takes tens of seconds)."""
@@ -352,7 +366,7 @@ def _fit_one(name, records, settings, progress, seeding=None):
         res = replace(res, checks=_checks(records, model, None, settings["tolerances"]))
     iv, method = _intervals(res, records, {**settings, "n_boot": 0} if edge else settings, progress)
     iv = {k: _in_domain(k, b) for k, b in iv.items()}
-    degenerate = _degenerate(params, iv)
+    degenerate = _degenerate(params, iv) + _too_damped(name, params)
     return ContactFit(
         model=name,
         parameters=params,

@@ -9,6 +9,7 @@ from discovery.vibroimpact.fit.contact_fit import (
     ContactModelsResult,
     _degenerate,
     _in_domain,
+    _too_damped,
 )
 
 
@@ -74,3 +75,12 @@ def test_a_fit_heading_to_the_edge_stops_there():
     assert fit.n_simulations < 80, fit.n_simulations
     assert ContactModel("hertz-damper", (1e-300, 1e6)).edges() == ["k = 1e-300 sits at its floor"]
     assert ContactModel("hertz-damper", (1e9, 1e6)).edges() == []
+
+
+def test_a_restitution_at_its_floor_says_the_impacts_are_damped_beyond_the_model():
+    """The docs' Flores record (e 0.45, ratio 1.96): Lankarani-Nikravesh's ratio stays below
+    3/4 whatever e, so its fit ends at e = 0.02; the reason says so."""
+    why = _too_damped("lankarani-nikravesh", {"k": 1.4e9, "n": 1.3, "e": 0.02})
+    assert "damped more than lankarani-nikravesh can" in why and "at most 0.75" in why
+    assert _too_damped("lankarani-nikravesh", {"k": 1.4e9, "n": 1.3, "e": 0.5}) == ""
+    assert _too_damped("kelvin-voigt", {"k": 1.4e9, "c": 1e6}) == ""
