@@ -51,6 +51,10 @@ class MachineRows:
         ``int phi cos(omega (t + tau))``: a drive out of phase (the phase check).
     force : ndarray
         ``int phi F``.
+    force_rate : ndarray
+        ``int phi F' = -int phi' F``: with a force sensor of first order and time constant
+        ``tau`` (``tau F' + F = F_true``), ``int phi F_true = force + tau force_rate``
+        exactly (:mod:`.sensor`).
     moulding : ndarray
         ``int phi (w2'' + g)``: the coefficient of ``m2``.
     acc2, ones : ndarray
@@ -72,11 +76,16 @@ class MachineRows:
         10 kHz: -5 % on the scale).  A contact window's ``phi`` and its first three
         derivatives vanish at the jump, so it costs nothing there: the equations that hold
         the force use these windows, the momentum balance the evenly spread ones.
+    lagged : bool
+        The force is a lagging sensor's, corrected for its lag (:mod:`.sensor`): it has no
+        jump, and on a contact's short window the machine's scale follows the lag's
+        error 4 % for 2 % of it, so the force's equations use the evenly spread windows.
     """
 
     frame: np.ndarray
     drive_cos: np.ndarray
     force: np.ndarray
+    force_rate: np.ndarray
     moulding: np.ndarray
     acc2: np.ndarray
     ones: np.ndarray
@@ -84,6 +93,7 @@ class MachineRows:
     cycle: np.ndarray
     centre: np.ndarray
     anchored: np.ndarray
+    lagged: bool = False
 
     @property
     def n_windows(self):
@@ -246,6 +256,7 @@ def _rows(data, centres, hs, dt):
         "frame": frame,
         "drive_cos": integral(data.cos),
         "force": integral(data.F),
+        "force_rate": -(data.F[idx] @ w_dphi),
         "moulding": moulding,
         "acc2": acc2,
         "ones": ones,

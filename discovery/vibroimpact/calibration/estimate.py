@@ -26,7 +26,14 @@ import numpy as np
 
 from .equations import FRAME_TERMS
 
-__all__ = ["Estimate", "estimate", "cycle_draws", "parameter_names", "drive_phase"]
+__all__ = [
+    "Estimate",
+    "estimate",
+    "cycle_draws",
+    "parameter_names",
+    "drive_phase",
+    "force_lag",
+]
 
 #: the fewest contact windows for the force's equations to use them alone
 MIN_ANCHORED = 3
@@ -91,6 +98,7 @@ def _blocks(rows, pick=None, force_on="contacts"):
     :func:`parameter_names`: the frame (``y = -int phi F``), the moulding
     (``y = int phi F``) and their sum, the momentum balance (``y = 0``)."""
     R = len(rows)
+    force_on = "even" if any(r.lagged for r in rows) else force_on
     frame, mould, f, anchored = [], [], [], []
     for r, row in enumerate(rows):
         sel = np.arange(row.n_windows) if pick is None else pick[r]
@@ -106,15 +114,41 @@ def _blocks(rows, pick=None, force_on="contacts"):
         anchored.append(row.anchored[sel])
     frame, mould, f = np.vstack(frame), np.vstack(mould), np.concatenate(f)
     anchored = np.concatenate(anchored)
-    # the force's equations on the contacts' own windows where there are enough (see
-    # MachineRows.anchored), the balance on the evenly spread ones
-    contacts = force_on == "contacts" and anchored.sum() >= MIN_ANCHORED
-    force = anchored if contacts else ~anchored
-    even = ~anchored
+    force, even = _force_windows(anchored, force_on), ~anchored
     return (
         (frame[force], -f[force]),
         (mould[force], f[force]),
         (frame[even] + mould[even], np.zeros(int(even.sum()))),
+    )
+
+
+def _force_windows(anchored, force_on):
+    """The windows of the force's equations: the contacts' own where there are enough (see
+    :attr:`~.equations.MachineRows.anchored`) and ``force_on`` is ``"contacts"``, else the
+    evenly spread ones (those of the balance)."""
+    contacts = force_on == "contacts" and anchored.sum() >= MIN_ANCHORED
+    return anchored if contacts else ~anchored
+
+
+def _force_rates(rows, pick, force_on):
+    """The force's rate column (``force_rate``) on the rows of the force's equations of
+    :func:`_blocks`, in their order."""
+    force_on = "even" if any(r.lagged for r in rows) else force_on
+    sels = [np.arange(r.n_windows) if pick is None else pick[k] for k, r in enumerate(rows)]
+    rate = np.concatenate([r.force_rate[s] for r, s in zip(rows, sels, strict=True)])
+    anchored = np.concatenate([r.anchored[s] for r, s in zip(rows, sels, strict=True)])
+    return rate[_force_windows(anchored, force_on)]
+
+
+def _with_lag_column(blocks, rate):
+    """The blocks with a last column for a force sensor's time constant ``tau``: ``+rate``
+    in the frame's equation (``X theta + tau rate = -int phi F``), ``-rate`` in the
+    moulding's, 0 in the balance (it holds no force)."""
+    (Xf, yf), (Xm, ym), (Xb, yb) = blocks
+    return (
+        (np.column_stack([Xf, rate]), yf),
+        (np.column_stack([Xm, -rate]), ym),
+        (np.column_stack([Xb, np.zeros(yb.size)]), yb),
     )
 
 
@@ -149,7 +183,7 @@ def _block_weights(blocks, theta):
 ROUNDS = 4
 
 
-def _fit(rows, held, pick=None, weights=None, force_on="contacts"):
+def _fit(rows, held, pick=None, weights=None, force_on="contacts", lag=False):
     """The machine from the three blocks of :func:`_blocks`: the ratios to ``m1`` from the
     balance, the scale from the two equations that hold the force, in turn (a held
     parameter enters the balance at its value over the current scale).
@@ -158,29 +192,55 @@ def _fit(rows, held, pick=None, weights=None, force_on="contacts"):
     residual would pull the whole machine toward zero (measured: -6 % on a record with 3 %
     force noise), so it only ever sees the ratios.  ``weights`` (of the frame's and the
     moulding's equations, the inverse RMS of their residuals) are found on the first call.
-    Returns ``(theta, weights)``."""
+    With ``lag`` a force sensor's time constant is fitted too, beside the scale (the
+    balance does not see it).  Returns ``(theta, weights, tau)`` (``tau`` 0 without
+    ``lag``)."""
     frame, mould, balance = _blocks(rows, pick, force_on)
+    if lag:
+        frame, mould, balance = _with_lag_column(
+            (frame, mould, balance), _force_rates(rows, pick, force_on)
+        )
+        held = np.append(held, np.nan)
     theta = _weighted_solve((frame, mould), weights or (1.0, 1.0), held)
     if weights is None:
         weights = _block_weights((frame, mould), theta)
         theta = _weighted_solve((frame, mould), weights, held)
     free = np.isnan(held)
+    scaled = free.copy()
+    if lag:
+        scaled[-1] = False  # tau is no ratio to m1
     X = np.vstack([w * b[0] for b, w in zip((frame, mould), weights, strict=True)])
     y = np.concatenate([w * b[1] for b, w in zip((frame, mould), weights, strict=True)])
+    tau = theta[-1] if lag else 0.0
     for _ in range(ROUNDS):
         scale = theta[0]
         if not (np.isfinite(scale) and scale != 0):
             break
         ratios_held = np.where(free, np.nan, held / scale)
         ratios_held[0] = 1.0
+        if lag:
+            ratios_held[-1] = 0.0
         rho = _solve(*balance, ratios_held)
         if free[0]:
-            part = X[:, free] @ rho[free]
+            part = X[:, scaled] @ rho[scaled]
             rest = y - X[:, ~free] @ held[~free]
-            den = float(part @ part)
-            scale = float(part @ rest) / den if den > 0 else scale
+            scale, tau = _scale_step(part, X[:, -1] if lag else None, rest, scale)
         theta = np.where(free, scale * rho, held)
-    return theta, weights
+        if lag:
+            theta[-1] = tau
+    return (theta[:-1], weights, float(tau)) if lag else (theta, weights, 0.0)
+
+
+def _scale_step(part, lag_column, rest, scale):
+    """The machine's scale (and a sensor's time constant, with its ``lag_column``) by least
+    squares of ``rest`` on ``part``: ``(scale, tau)``; the given ``scale`` where ``part``
+    is all zeros."""
+    if lag_column is None:
+        den = float(part @ part)
+        return (float(part @ rest) / den if den > 0 else scale), 0.0
+    A = np.column_stack([part, lag_column])
+    sol = np.linalg.lstsq(A, rest, rcond=None)[0]
+    return float(sol[0]), float(sol[1])
 
 
 def _relative_rms(res, y):
@@ -236,13 +296,27 @@ def _choose(contacts, even):
 def _bootstrapped(rows, held, draws, force_on):
     """``(value, low, high)``: the fit with the force's equations on ``force_on`` windows
     and its 95 % bootstrap interval."""
-    value, weights = _fit(rows, held, force_on=force_on)
+    value, weights, _ = _fit(rows, held, force_on=force_on)
     if not draws:
         nan = np.full(value.size, np.nan)
         return value, nan, nan
     boot = np.array([_fit(rows, held, pick, weights, force_on)[0] for pick in draws])
     low, high = np.nanpercentile(boot, [2.5, 97.5], axis=0)
     return value, low, high
+
+
+def force_lag(rows, fixed, draws, force_on="even"):
+    """A force sensor's time constant ``tau`` [s] fitted with the machine (:func:`_fit`
+    with ``lag``, the force's equations on ``force_on`` windows), and its 95 % bootstrap
+    interval over the draws: ``(tau, low, high)``."""
+    names = parameter_names(len(rows))
+    held = np.array([fixed.get(n, np.nan) for n in names], dtype=float)
+    _, weights, tau = _fit(rows, held, force_on=force_on, lag=True)
+    if not draws:
+        return tau, np.nan, np.nan
+    boot = np.array([_fit(rows, held, pick, weights, force_on, lag=True)[2] for pick in draws])
+    low, high = np.nanpercentile(boot, [2.5, 97.5])
+    return tau, float(low), float(high)
 
 
 def frame_residual(rows, theta_frame):

@@ -14,6 +14,7 @@ from ..model.scenario import Scenario
 from .equations import machine_rows
 from .estimate import cycle_draws, drive_phase, estimate, frame_residual, moulding_residual
 from .result import UNITS, Calibration
+from .sensor import sensor_lag, with_lag
 from .shedding import MATERIAL, shedding
 from .units import check_units
 
@@ -96,7 +97,11 @@ def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, kee
         members = [k for k in members if rows[k] is not None]
         if not members:
             continue
+        lag = _sensor(members, rows, keep, sheets[members[0]], (n_boot, seed))
         shed = _shedding(members, rows, meas, sheets, offsets)
+        if shed is not None and lag is not None:  # its rows made again: the lag again too
+            for k in members:
+                rows[k] = with_lag([rows[k]], lag.tau)[0]
         group_sheets = [
             sheets[k] if shed is None else sheets[k].replace(mass_loss=shed.loss) for k in members
         ]
@@ -116,8 +121,11 @@ def calibrate(scenario, measurement, *, time_offset=0.0, n_boot=200, seed=0, kee
             phases[k] = ph
         prefix = "" if len(groups) == 1 else f"records {', '.join(str(k + 1) for k in members)}: "
         if shed is not None:
-            group.parameters["mass_loss"] = _shedding_row(shed)
+            group.parameters["mass_loss"] = _found_row("mass_loss", shed.loss, shed.low, shed.high)
             group.notes.insert(0, _shedding_note(shed))
+        if lag is not None:
+            group.parameters["force_lag"] = _found_row("force_lag", lag.tau, lag.low, lag.high)
+            group.notes.insert(0, _lag_note(lag))
         parameters.update({prefix + n: v for n, v in group.parameters.items()})
         residual = group.residual if len(groups) == 1 else {**residual, prefix: group.residual}
         notes += group.notes
@@ -166,6 +174,29 @@ def _inputs(scenario, measurement, time_offset, keep):
     return meas, sheets, offsets, keep
 
 
+def _sensor(members, rows, keep, sheet, boot):
+    """The force sensor's lag the records ``members`` of one machine show
+    (:mod:`.sensor`), or ``None``; when found, their rows are those of the force the sensor
+    saw (``rows`` updated in place).  ``boot``: the bootstrap's ``(n_boot, seed)``."""
+    group = [rows[k] for k in members]
+    fixed = {n: getattr(sheet, n) for n in keep if n in ("m1", "c1", "k1", "k3", "m2")}
+    lag = sensor_lag(group, fixed, cycle_draws(group, *boot), loose=LOOSE, material=MATERIAL)
+    if not lag.found:
+        return None
+    for k, row in zip(members, with_lag(group, lag.tau), strict=True):
+        rows[k] = row
+    return lag
+
+
+def _lag_note(lag):
+    return (
+        f"the force lags the motions: a sensor of time constant {_fmt(lag.tau)} "
+        f"[{_fmt(lag.low)}, {_fmt(lag.high)}] s (seen in the machine's equations, "
+        f"{lag.share:.1%} of the force's); the machine is read from the force it saw, and "
+        "explain names the lag (sensor_lag) where a law is judged"
+    )
+
+
 def _shedding(members, rows, meas, sheets, offsets):
     """The mass loss the records ``members`` of one machine show where their sheets have
     none (:mod:`.shedding`), or ``None``; when found, their rows are made again with it
@@ -182,17 +213,18 @@ def _shedding(members, rows, meas, sheets, offsets):
     return found
 
 
-def _shedding_row(shed):
-    """The parameter table's row of a mass loss the record shows."""
+def _found_row(name, value, low, high):
+    """The parameter table's row of an effect the record shows where the sheet has none (a
+    mass loss, a force sensor's lag): its value, used."""
     return {
-        "unit": UNITS["mass_loss"],
+        "unit": UNITS[name],
         "sheet": 0.0,
-        "record": shed.loss,
-        "low": shed.low,
-        "high": shed.high,
+        "record": value,
+        "low": low,
+        "high": high,
         "determined": True,
         "held": False,
-        "used": shed.loss,
+        "used": value,
     }
 
 

@@ -18,6 +18,7 @@ UNITS = {
     "k3": "N/m^3",
     "A": "N",
     "mass_loss": "per contact",
+    "force_lag": "s",
 }
 #: the least relative uncertainty granted the machine's scale: a bias the bootstrap over
 #: cycles cannot see (the force's quadrature; noise-free, the contacts' windows leave at
@@ -32,6 +33,7 @@ WHAT = {
     "k3": "supports' cubic stiffness",
     "A": "drive amplitude",
     "mass_loss": "moulding's mass loss per contact",
+    "force_lag": "force sensor's time constant",
 }
 
 
