@@ -46,10 +46,15 @@ class Score:
         The refitted model is consistent with every record.
     parameters : dict or None
         ``{name: value}`` of the effect's parameters after the refit.
-    repulsive, in_bounds, negligible, motion_worse, force_worse : bool or None
+    repulsive, in_bounds, motion_worse, force_worse : bool or None
         The refit's checks (:mod:`~discovery.vibroimpact.explain.trials`).
     gap : str or None
         The criterion the refit was judged on (``"I2"``, ``"I5"`` or ``"D"``).
+    negligible : float or None
+        The largest value of the effect's parameter that is negligible.
+    beats_law_refit, present : bool or None
+        The refit beats the law refitted alone by the noise margin; the effect's parameter
+        is not within two standard errors of 0 (the trials judged).
     """
 
     effect: str
@@ -66,9 +71,11 @@ class Score:
     repulsive: bool | None = None
     in_bounds: bool | None = None
     gap: str | None = None
-    negligible: bool | None = None
+    negligible: float | None = None
     motion_worse: bool | None = None
     force_worse: bool | None = None
+    beats_law_refit: bool | None = None
+    present: bool | None = None
 
     @classmethod
     def from_dict(cls, d):

@@ -38,9 +38,11 @@ REFITTED = {
     "repulsive": True,
     "in_bounds": True,
     "gap": "I2",
-    "negligible": False,
+    "negligible": 2.1e6,
     "motion_worse": False,
     "force_worse": False,
+    "beats_law_refit": True,
+    "present": True,
 }
 DRIFT = {
     "effect": "mass_loss",
