@@ -11,7 +11,9 @@ that checks it (:func:`option`).
   line naming it, the closest field and the settings class (a ``TypeError``, as Python's own
   unexpected keyword is); a wrong value is one line naming the function and the field.
 * A settings object checks its fields when it is made (``DiscoverSettings(max_terms=0)``
-  raises), so an object passed around is valid.
+  raises), so an object passed around is valid: each field by its spec, and fields that
+  bound each other by the class's :meth:`Settings._check_together`.  The function that
+  takes the object checks nothing of it again (``tests/test_settings_bounds.py``).
 * ``to_dict()`` / ``from_dict()`` give a JSON-safe document and back, for records of the
   settings a result was made with.
 * ``repr()`` is what one would type to make the object (its fields not at their default);
@@ -61,6 +63,12 @@ class Settings:
                 spec = _PLAIN.get(f.type if isinstance(f.type, str) else f.type.__name__)
             if spec is not None:
                 check(f"{where}: {f.name}", getattr(self, f.name), spec)
+        self._check_together(where)
+
+    def _check_together(self, where):
+        """Refuse fields each within its spec but not together (``periods`` at least four
+        times ``max_period``): a class with such a rule overrides this (an InputError
+        naming ``where`` and the fields); the base has none."""
 
     @classmethod
     @functools.cache

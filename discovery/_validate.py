@@ -33,16 +33,28 @@ def _received(value):
 
 
 class Real:
-    """A real number (not a bool, not text) within ``[low, high]``, optionally an integer."""
+    """A real number (not a bool, not text) within ``[low, high]``, optionally an integer;
+    with ``zero``, also 0 (a count whose 0 means none, e.g. bootstrap replicates)."""
 
     def __init__(
-        self, low=None, high=None, *, integer=False, open_low=False, open_high=False, unit=""
+        self,
+        low=None,
+        high=None,
+        *,
+        integer=False,
+        open_low=False,
+        open_high=False,
+        unit="",
+        zero=False,
     ):
         self.low, self.high, self.integer, self.open_low = low, high, integer, open_low
-        self.open_high = open_high
+        self.open_high, self.zero = open_high, zero
         self.unit = f" {unit}" if unit else ""
 
     def describe(self):
+        return ("0 or " if self.zero else "") + self._range()
+
+    def _range(self):
         kind = "an integer" if self.integer else "a number"
         if self.low is not None and self.high is not None:
             lo = "(" if self.open_low else "["
@@ -58,9 +70,12 @@ class Real:
         )
         if isinstance(value, (bool, np.bool_)) or not ok_type:
             raise VidiTypeError(f"{where} must be {self.describe()}; got {_received(value)}")
-        v = float(value)
+        # an integer compared as itself (2**63 - 1 is no float)
+        v = int(value) if self.integer else float(value)
+        if self.zero and v == 0:
+            return
         bad = (
-            not np.isfinite(v)
+            (not self.integer and not np.isfinite(v))
             or (self.low is not None and (v <= self.low if self.open_low else v < self.low))
             or (self.high is not None and (v >= self.high if self.open_high else v > self.high))
         )

@@ -200,8 +200,8 @@ class UedaDiscoverSettings(Settings):
     """The options of :func:`discover` (each is also a keyword of it; see its parameters)."""
 
     threshold: float = option(0.02, Real(0))
-    half_width: object = option(None, (None, Real(1, integer=True)))
-    order: int = option(4, Real(1, integer=True))
+    half_width: object = option(None, (None, Real(2, integer=True)))
+    order: int = option(4, Real(2, integer=True))
     fit_forcing: bool = option(True)
     bootstrap: int = option(200, Real(0, integer=True))
     block_periods: int = option(4, Real(1, integer=True))
@@ -243,8 +243,6 @@ def discover(t, x, B, nu, *, settings=None, **options):
     t, x, spp = check_forcing(t, x, B, nu)
     T = 2 * np.pi / nu
     hs = window_half_width(t.size, spp, s.half_width)
-    if int(s.order) < 2:
-        raise InputError(f"order must be >= 2, got {s.order}")
     sm = smooth(t, x, spp)
     G, b, centres = weak_system(t, x, sm.v, B, nu, half_width=hs, order=int(s.order))
     nt = len(MONOMIALS)

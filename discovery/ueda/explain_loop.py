@@ -45,6 +45,7 @@ from .._settings import Settings, option, takes
 from .._validate import Array, Real, params
 from ..catalogue import select
 from ..errors import InputError
+from ..numerics.tolerances import Tolerances
 from .effects import EFFECTS, in_bounds
 from .explanation import Explanation, Iteration
 from .polynomial import TERMS
@@ -91,22 +92,6 @@ def parse_terms(spec):
         if name not in out:
             out.append(name)
     return tuple(sorted(out, key=TERMS.index))
-
-
-def _check_settings(alpha, max_iterations, order, noise):
-    """The settings :func:`explain` checks beyond their types."""
-    if not (0 < alpha < 1):
-        raise InputError(f"alpha must be in (0, 1); got {alpha!r}")
-    if (
-        isinstance(max_iterations, bool)
-        or not isinstance(max_iterations, int | np.integer)
-        or max_iterations < 0
-    ):
-        raise InputError(f"max_iterations must be an integer >= 0; got {max_iterations!r}")
-    if int(order) < 2:
-        raise InputError(f"order must be >= 2, got {order}")
-    if noise is not None and not (np.isfinite(noise) and noise >= 0):
-        raise InputError(f"noise must be a finite fraction >= 0, got {noise}")
 
 
 @dataclass(frozen=True)
@@ -348,19 +333,19 @@ class _Loop:
 class UedaExplainSettings(Settings):
     """The options of :func:`explain` (each is also a keyword of it; see its parameters)."""
 
-    alpha: float = option(0.01, Real(0, 1, open_low=True))
-    max_iterations: int = option(3, Real(1, integer=True))
+    alpha: float = option(0.01, Real(0, 1, open_low=True, open_high=True))
+    max_iterations: int = option(3, Real(0, integer=True))
     effects: object = option(None, (None, list, tuple))
-    half_width: object = option(None)
-    order: int = option(4)
+    half_width: object = option(None, (None, Real(2, integer=True)))
+    order: int = option(4, Real(2, integer=True))
     fit_forcing: bool = option(True)
-    noise: object = option(None)
+    noise: object = option(None, (None, Real(0)))
     simulate: bool = option(True)
-    transient: int = option(200)
-    periods: int = option(2000)
-    resamples: int = option(200)
+    transient: int = option(200, Real(0, integer=True))
+    periods: int = option(2000, Real(1, integer=True))
+    resamples: int = option(200, Real(0, integer=True))
     seed: int = option(0, Real(0, integer=True))
-    tolerances: object = option(None)
+    tolerances: object = option(None, (Tolerances, None))
 
 
 @takes(UedaExplainSettings)
@@ -405,7 +390,6 @@ def explain(t, x, B, nu, start_terms=DEFAULT_START, *, settings=None, **options)
     """
     s = UedaExplainSettings.of("explain", settings, options)
     t_start = time.perf_counter()
-    _check_settings(s.alpha, s.max_iterations, s.order, s.noise)
     start = parse_terms(start_terms)
     catalogue = select(EFFECTS, s.effects)
     t, x, spp = check_forcing(t, x, B, nu)

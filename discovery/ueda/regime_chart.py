@@ -216,39 +216,14 @@ def _axis(values, name):
     return a
 
 
-def _check_grid(system, nu, B, workers):
-    """The system, the axes and ``workers`` of :func:`chart`, checked; returns the axes."""
+def _check_grid(system, nu, B):
+    """The system and the axes of :func:`chart`, checked; returns the axes."""
     if not isinstance(system, UedaSystem):
         raise VidiTypeError("system must be a discovery.ueda.UedaSystem")
     nu, B = _axis(nu, "nu"), _axis(B, "B")
     if nu[0] <= 0:
         raise InputError("nu must be > 0")
-    if workers is not None and int(workers) < 1:
-        raise InputError(f"workers must be at least 1, got {workers!r}")
     return nu, B
-
-
-def _check_settings(settings):
-    """The settings :func:`chart` checks beyond their types (:attr:`Chart.settings`)."""
-    s = settings
-    max_period, transient, periods = s["max_period"], s["transient"], s["periods"]
-    sweeps, recheck, min_pairs = s["sweeps"], s["recheck"], s["min_pairs"]
-    if int(max_period) < 1:
-        raise InputError(f"max_period must be at least 1, got {max_period!r}")
-    if int(transient) < 0:
-        raise InputError(f"transient must be >= 0, got {transient!r}")
-    if int(periods) < 4 * int(max_period):
-        raise InputError(
-            f"periods ({int(periods)}) must be at least 4 x max_period = "
-            f"{4 * int(max_period)}: the recurrence test of period n compares "
-            "three cycles of strobe points with the cycle before"
-        )
-    if int(sweeps) not in (1, 2):
-        raise InputError(f"sweeps must be 1 or 2, got {sweeps!r}")
-    if int(recheck) < 0:
-        raise InputError(f"recheck must be >= 0, got {recheck!r}")
-    if int(min_pairs) < 1:
-        raise InputError(f"min_pairs must be at least 1, got {min_pairs!r}")
 
 
 def _run_rows(system, settings, nu, B, *, workers, executor, progress):
@@ -319,13 +294,21 @@ class UedaChartSettings(Settings):
     rtol: float = option(1e-6, Real(0, 1, open_low=True))
     hmax_fraction: float = option(0.1, Real(0, 1, open_low=True))
     max_period: int = option(16, Real(1, integer=True))
-    closure: float = option(1e-4)
-    chaos_threshold: float = option(0.015)
-    sweeps: int = option(1)
+    closure: float = option(1e-4, Real(0, open_low=True))
+    chaos_threshold: float = option(0.015, Real(0))
+    sweeps: int = option(1, Real(1, 2, integer=True))
     early_exit: bool = option(True)
-    min_pairs: int = option(12)
-    recheck: int = option(5)
+    min_pairs: int = option(12, Real(1, integer=True))
+    recheck: int = option(5, Real(0, integer=True))
     workers: object = option(None, (None, Real(1, integer=True)))
+
+    def _check_together(self, where):
+        if self.periods < 4 * self.max_period:
+            raise InputError(
+                f"{where}: periods ({self.periods}) must be at least 4 x max_period = "
+                f"{4 * self.max_period}: the recurrence test of period n compares "
+                "three cycles of strobe points with the cycle before"
+            )
 
 
 @takes(UedaChartSettings)
@@ -387,7 +370,7 @@ def chart(system, nu, B, *, settings=None, progress=None, executor=None, **optio
     Chart
     """
     s = UedaChartSettings.of("chart", settings, options)
-    nu, B = _check_grid(system, nu, B, s.workers)
+    nu, B = _check_grid(system, nu, B)
     recorded = {
         "transient": int(s.transient),
         "periods": int(s.periods),
@@ -408,7 +391,6 @@ def chart(system, nu, B, *, settings=None, progress=None, executor=None, **optio
             else ""
         ),
     }
-    _check_settings(recorded)
     t_start = time.perf_counter()
     grids, cpu, workers = _run_rows(
         system, recorded, nu, B, workers=s.workers, executor=executor, progress=progress

@@ -115,7 +115,7 @@ def floor_scheme(rs, floor, block_periods):
     if block_periods is None:
         return FloorScheme(floor, *strobe_block_length(rs))
     L = int(block_periods)
-    if not 1 <= L <= n // 4:
+    if L > n // 4:
         raise InputError(
             f"block_periods must be 1 .. {n // 4} (a quarter of the record's "
             f"{n} strobe points), got {block_periods}"

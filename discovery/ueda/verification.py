@@ -17,7 +17,7 @@ import numpy as np
 
 from .._printing import generic_lines, readable
 from .._settings import Settings, option, takes
-from .._validate import Array, Real, params
+from .._validate import Array, Choice, Real, params
 from ..errors import InputError, IntegrationError
 from ..numerics.tolerances import Tolerances
 from .polynomial import ForcedPolynomial, simulate_model
@@ -146,8 +146,8 @@ class UedaVerifySettings(Settings):
     resamples: int = option(200, Real(0, integer=True))
     seed: int = option(0, Real(0, integer=True))
     tolerances: object = option(None, (Tolerances, None))
-    floor: str = option("blocks")
-    block_periods: object = option(None)
+    floor: str = option("blocks", Choice("blocks", "halves"))
+    block_periods: object = option(None, (None, Real(1, integer=True)))
 
 
 @takes(UedaVerifySettings)
@@ -190,8 +190,6 @@ def verify(model, t, x, *, smoothed=None, settings=None, **options):
     """
     s = UedaVerifySettings.of("verify", settings, options)
     t_start = time.perf_counter()
-    if s.floor not in ("blocks", "halves"):
-        raise InputError(f"floor must be 'blocks' or 'halves', got {s.floor!r}")
     t, x, spp = check_forcing(t, x, model.B, model.nu)
     sm = smooth(t, x, spp) if smoothed is None else smoothed
     rs, ts = record_strobe_points(t, x, model.nu, sm)

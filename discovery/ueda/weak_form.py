@@ -77,7 +77,7 @@ def window_half_width(n_samples, samples_per_period, half_width=None):
     ``phi''`` biases the forcing's coefficient by -0.8 % at 20 samples per period).  A
     window must fit four times into the record's ``n_samples``."""
     hs = max(7, int(round(samples_per_period / 4))) if half_width is None else int(half_width)
-    if hs < 2 or 2 * hs + 1 > n_samples // 4:
+    if 2 * hs + 1 > n_samples // 4:
         raise InputError(
             f"the record ({n_samples} samples) is too short for test windows of "
             f"{2 * hs + 1} samples; record more periods"

@@ -111,18 +111,16 @@ def _explain_scores(ax, iteration):
     better; the named one green), beside the criterion before and its noise floor; the
     effects whose score test was not significant are not refitted and listed by name."""
     key = next(
-        (x.get("gap") for x in iteration.scores if x.get("gap")),
+        (x.gap for x in iteration.scores if x.gap),
         "I2",
     )
-    refit = [
-        x for x in iteration.scores if np.isfinite((x.get("criteria_after") or {}).get(key, np.nan))
-    ]
-    refit.sort(key=lambda x: -x["criteria_after"][key])  # the best at the top
+    refit = [x for x in iteration.scores if np.isfinite((x.criteria_after or {}).get(key, np.nan))]
+    refit.sort(key=lambda x: -x.criteria_after[key])  # the best at the top
     if refit:
         ax.barh(
-            [x["effect"].replace("_", " ") for x in refit],
-            [max(x["criteria_after"][key], 1e-6) for x in refit],
-            color=["tab:green" if x["effect"] == iteration.effect else "tab:orange" for x in refit],
+            [x.effect.replace("_", " ") for x in refit],
+            [max(x.criteria_after[key], 1e-6) for x in refit],
+            color=["tab:green" if x.effect == iteration.effect else "tab:orange" for x in refit],
         )
         before = (iteration.criteria_before or {}).get(key)
         floor = (iteration.noise_floor or {}).get(key)
@@ -130,7 +128,7 @@ def _explain_scores(ax, iteration):
             ax.axvline(before, color="k", lw=1.0, ls="--", label=f"{key} before")
         if floor is not None and np.isfinite(floor):
             ax.axvline(floor, color="0.5", lw=1.0, ls=":", label="noise floor")
-        vals = [x["criteria_after"][key] for x in refit] + [v for v in (before, floor) if v]
+        vals = [x.criteria_after[key] for x in refit] + [v for v in (before, floor) if v]
         if max(vals) > 30 * max(min(vals), 1e-12):
             ax.set_xscale("log")
         else:
@@ -138,7 +136,8 @@ def _explain_scores(ax, iteration):
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.3), ncol=2, frameon=False)
     else:
         ax.text(0.5, 0.5, "no effect refitted", ha="center", transform=ax.transAxes)
-    skipped = [x["effect"].replace("_", " ") for x in iteration.scores if x not in refit]
+    shown = {id(x) for x in refit}
+    skipped = [x.effect.replace("_", " ") for x in iteration.scores if id(x) not in shown]
     note = f"\nnot refitted (score not significant): {len(skipped)}" if skipped else ""
     ax.set_xlabel(f"{key} after refitting the effect (lower is better){note}")
     ax.set_title("candidate effects refitted\n(green: named; orange: refitted, not named)")

@@ -39,6 +39,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ..._settings import Settings, option, takes
+from ..._validate import Real
 from ...errors import IntegrationError
 from ...numerics.status import STEP_BUDGET
 from ...numerics.status import message as status_message
@@ -339,12 +340,12 @@ class _Counted:
 class ReferenceSimulateSettings(Settings):
     """The options of :func:`reference_simulate` (each is also a keyword of it)."""
 
-    rtol: float = option(1e-10)
+    rtol: float = option(1e-10, Real(0, 1, open_low=True))
     atol: object = option(None)
     method: str = option("DOP853")
-    max_events: int = option(100_000)
-    impact_v0: float = option(0.0)
-    max_nfev: int = option(MAX_NFEV)
+    max_events: int = option(100_000, Real(0, integer=True))
+    impact_v0: float = option(0.0, Real(0))
+    max_nfev: int = option(MAX_NFEV, Real(1, integer=True))
 
 
 @takes(ReferenceSimulateSettings)

@@ -133,8 +133,6 @@ def synthesize(scenario, law, *, settings=None, **options):
     Measurement
     """
     s = SynthesizeSettings.of("synthesize", settings, options)
-    if not (s.periods >= 1 and s.fs > 0 and s.noise >= 0 and s.position_noise >= 0):
-        raise InputError("periods must be >= 1, fs > 0 and the noise levels >= 0")
     if not s.periods * scenario.period * s.fs <= MAX_SAMPLES:
         raise InputError(
             f"synthesize: periods = {s.periods} at fs = {s.fs:g} Hz is "

@@ -433,7 +433,7 @@ class ExplainSettings(Settings):
     effects: object = option(None, (None, list, tuple))
     max_refits: int = option(8, Real(1, integer=True))
     workers: object = option(None, (None, Real(1, integer=True)))
-    n_boot_intervals: int = option(30, Real(0, integer=True))
+    n_boot_intervals: int = option(30, Real(5, integer=True, zero=True))
     interval_refit: str = option("two-step", Choice(*INTERVAL_REFITS))
     machine_scale: object = option(None, (None, tuple, list))
 

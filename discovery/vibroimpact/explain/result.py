@@ -11,6 +11,7 @@ from ..fit.intervals import Intervals
 from ..model.law import ForceLaw, Term
 from ..verify.criteria import criteria_lines
 from .effects import Model
+from .score import Score
 
 __all__ = ["ExplainResult", "Iteration", "loaded_model"]
 
@@ -43,9 +44,9 @@ class Iteration(Result):
     noise_floor : dict
     localisation : dict
         Of the model before (first record).
-    scores : list of dict
-        Every scored effect: ``effect``, ``lm``, ``p``, ``significant``,
-        ``signature_agrees``, and for refitted ones ``criteria_after`` and ``parameters``.
+    scores : tuple of Score
+        Every scored effect: its score test, and for refitted ones the refit's criteria
+        and parameters.
     effect : str or None
         The effect named (None when the iteration stopped the loop).
     evidence : str
@@ -61,6 +62,7 @@ class Iteration(Result):
     _LOAD = {
         "model_before": lambda d: loaded_model(d["model_before"]),
         "model_after": lambda d: loaded_model(d["model_after"]),
+        "scores": lambda d: tuple(Score.from_dict(s) for s in d["scores"]),
     }
 
     model_before: Model
@@ -69,7 +71,7 @@ class Iteration(Result):
     criteria_after: dict
     noise_floor: dict
     localisation: dict
-    scores: list
+    scores: tuple
     effect: str | None
     evidence: str
     equivalent: list = field(default_factory=list)
@@ -87,7 +89,7 @@ class Iteration(Result):
             "parameters": _parameters(self),
             "model_before": self.model_before.as_dict(),
             "model_after": self.model_after.as_dict(),
-            "scores": self.scores,
+            "scores": [s.to_dict() for s in self.scores],
             "equivalent": self.equivalent,
             "localisation": {
                 "phases": self.localisation["phases"],
@@ -103,8 +105,8 @@ def _parameters(it):
     if it.effect is None:
         return {}
     for s in it.scores:
-        if s["effect"] == it.effect:
-            return s.get("parameters", {})
+        if s.effect == it.effect:
+            return s.parameters or {}
     return {}
 
 

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from .effects import Model
 from .problem import _Drift, _drift_free, _mean, _Problem, _with_drift
 from .result import Iteration
+from .score import Score
 
 
 @dataclass
@@ -88,7 +89,7 @@ class _Step:
             criteria_after=criteria_after,
             noise_floor=self.floor,
             localisation=self.loc,
-            scores=self.screening.scores,
+            scores=tuple(Score.from_dict(s) for s in self.screening.scores),
             effect=effect,
             evidence=evidence,
             equivalent=list(equivalent),

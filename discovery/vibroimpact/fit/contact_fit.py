@@ -388,7 +388,7 @@ class ContactModelsSettings(Settings):
 
     models: object = option(None, (None, list, tuple))
     max_simulations: int = option(200, Real(2, integer=True))
-    n_boot: int = option(30, Real(0, integer=True))
+    n_boot: int = option(30, Real(5, integer=True, zero=True))
     seed: int = option(0, Real(0, integer=True))
     tolerances: object = option(None, (Tolerances, None))
     workers: object = option(1, (None, Real(1, integer=True)))

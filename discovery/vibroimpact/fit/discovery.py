@@ -181,7 +181,7 @@ class DiscoverSettings(Settings):
     stepwise: int = option(3, Real(0, integer=True))
     physics: bool = option(True)
     require: tuple = option((), (tuple, list))
-    n_boot_intervals: int = option(30, Real(0, integer=True))
+    n_boot_intervals: int = option(30, Real(5, integer=True, zero=True))
     interval_refit: str = option("two-step", Choice(*INTERVAL_REFITS))
     workers: object = option(1, (None, Real(1, integer=True)))
     estimator: object = option(None, (None, dict))

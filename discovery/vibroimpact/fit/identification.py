@@ -318,12 +318,12 @@ class IdentifySettings(Settings):
     criterion: str = option("I2", Choice(*CRITERIA))
     method: str = option("least-squares", Choice(*METHODS))
     xtol: float = option(1e-5, Real(0, open_low=True))
-    max_simulations: int = option(600, Real(1, integer=True))
+    max_simulations: int = option(600, Real(2, integer=True))
     tolerances: object = option(None, (Tolerances, None))
     uncertainty: bool = option(True)
     observe: object = option(None)
     short_first: bool = option(True)
-    n_boot_intervals: int = option(0, Real(0, integer=True))
+    n_boot_intervals: int = option(0, Real(5, integer=True, zero=True))
     seed: int = option(0, Real(0, integer=True))
     check: bool = option(True, bool)
     workers: object = option(1, (None, Real(1, integer=True)))
@@ -416,9 +416,7 @@ def identify(scenario, reference, start, *, settings=None, progress=None, **opti
         The start law has no periodic steady state with contact.
     """
     s = IdentifySettings.of("identify", settings, options)
-    records = _checked(
-        scenario, reference, start, method=s.method, xtol=s.xtol, max_simulations=s.max_simulations
-    )
+    records = _checked(scenario, reference, start, max_simulations=s.max_simulations)
     # every evaluation's blocks shared out over ``workers`` processes (none with one)
     with shared_blocks([r for _, r in records], block_workers(s.workers)):
         return _identified(records, start, s, progress)

@@ -6,9 +6,12 @@ import numpy as np
 
 from ..._result import Result
 from ..._settings import Settings, option, takes
-from ...errors import InputError, IntegrationError, NoContactError
+from ..._validate import Choice, Real
+from ...errors import IntegrationError, NoContactError
 from ...numerics.executor import map_on
+from ..dynamics import Tolerances
 from ..model.scenario import scale_bounds
+from ..verify.criteria import CRITERIA
 from .optimise import _checked, _fitted
 from .problem import _Objective
 from .records import as_records, model_parts
@@ -171,9 +174,7 @@ def _refit_replicate(context, k):
     scenarios, replicates, model, settings = context
     method, xtol, budget = "least-squares", 1e-5, settings["max_simulations"]
     try:
-        records = _checked(
-            scenarios, replicates[k], model, method=method, xtol=xtol, max_simulations=budget
-        )
+        records = _checked(scenarios, replicates[k], model, max_simulations=budget)
         obj = _Objective(
             records,
             model,
@@ -223,15 +224,15 @@ class BootstrapIntervalsSettings(Settings):
     """The options of :func:`bootstrap_intervals` (each is also a keyword of it; see its
     parameters)."""
 
-    n_boot: int = option(30)
-    seed: int = option(0)
-    level: float = option(0.95)
-    max_simulations: int = option(60)
-    criterion: str = option("I2")
-    tolerances: object = option(None)
-    workers: object = option(1)
-    refit: str = option("two-step")
-    noise: str = option("cycles")
+    n_boot: int = option(30, Real(5, integer=True))
+    seed: int = option(0, Real(0, integer=True))
+    level: float = option(0.95, Real(0, 1, open_low=True, open_high=True))
+    max_simulations: int = option(60, Real(2, integer=True))
+    criterion: str = option("I2", Choice(*CRITERIA))
+    tolerances: object = option(None, (Tolerances, None))
+    workers: object = option(1, (None, Real(1, integer=True)))
+    refit: str = option("two-step", Choice(*INTERVAL_REFITS))
+    noise: str = option("cycles", Choice(*INTERVAL_NOISE))
     machine_scale: object = option(None, (tuple, list, None))
 
 
@@ -306,14 +307,6 @@ def bootstrap_intervals(
         than 5 refits succeeded.
     """
     s = BootstrapIntervalsSettings.of("bootstrap_intervals", settings, options)
-    if not (isinstance(s.n_boot, int) and s.n_boot >= 5):
-        raise InputError(f"n_boot must be an integer >= 5; got {s.n_boot!r}")
-    if not 0 < s.level < 1:
-        raise InputError(f"level must be in (0, 1); got {s.level!r}")
-    if s.refit not in INTERVAL_REFITS:
-        raise InputError(f"unknown refit {s.refit!r}; valid: {', '.join(INTERVAL_REFITS)}")
-    if s.noise not in INTERVAL_NOISE:
-        raise InputError(f"unknown noise {s.noise!r}; valid: {', '.join(INTERVAL_NOISE)}")
     records = as_records(scenario, reference)
     if any(getattr(ref, "span", None) is None for _, ref in records):
         return None

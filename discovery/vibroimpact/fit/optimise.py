@@ -47,19 +47,16 @@ def _coordinate_descent(obj, x0, xtol, step0=0.1):
     return x
 
 
-def _checked(scenario, reference, start, *, method, xtol, max_simulations):
-    """The settings :func:`identify` checks beyond their types; returns the records."""
+def _checked(scenario, reference, start, *, max_simulations):
+    """The arguments :func:`identify` checks beyond its settings' fields (the start, and
+    the budget against the records: two simulations per record); returns the records."""
     if isinstance(start, str):
         raise VidiTypeError(
             f"identify: start must be a ForceLaw or a Model (parse text with "
             f"ForceLaw.parse({start[:30]!r})); got str"
         )
-    if method not in METHODS:
-        raise InputError(f"unknown method {method!r}; valid methods: {', '.join(METHODS)}")
     if any(c == 0 for c in start.coefficients):
         raise InputError("every start coefficient must be non-zero (they set the scale)")
-    if not (np.isfinite(xtol) and xtol > 0):
-        raise InputError(f"xtol must be a positive number, got {xtol!r}")
     records = as_records(scenario, reference)
     if not (isinstance(max_simulations, int | np.integer) and max_simulations >= 2 * len(records)):
         raise InputError(

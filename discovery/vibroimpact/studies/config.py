@@ -385,11 +385,6 @@ def _check_fit(fit, source):
         for k, hi in _FIT_BOUNDS.items():  # the command line's bounds (`vidi fit`)
             if k in fit and fit[k] > hi:
                 raise InputError(f"{k} must be at most {hi}; got {fit[k]}")
-        if 0 < fit.get("n_boot_intervals", 0) < 5:
-            raise InputError(
-                f"n_boot_intervals = {fit['n_boot_intervals']} replicates cannot give an "
-                "interval; give 0 (none) or at least 5"
-            )
     except VidiError as exc:
         bad(exc)
 

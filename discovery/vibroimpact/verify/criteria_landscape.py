@@ -431,8 +431,6 @@ def landscape(
         )
     axis0 = _axis(axis0, "axis0")
     axis1 = _axis(axis1, "axis1")
-    if s.workers is not None and int(s.workers) < 1:
-        raise InputError(f"workers must be at least 1, got {s.workers!r}")
     t_start = time.perf_counter()
     if reference is None:
         if scenario.law is None:

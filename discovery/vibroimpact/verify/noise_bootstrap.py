@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._settings import Settings, option, takes
+from ..._validate import Real
 from ...errors import InputError
 from ..data.impulse import impulse_from_samples
 from .criteria import CRITERIA, evaluate_criteria
@@ -38,8 +39,8 @@ def _sawtooth(t, onsets, velocity):
 class NoiseFloorSettings(Settings):
     """The bootstrap's options of :func:`noise_floor` (each is also a keyword of it)."""
 
-    n_boot: int = option(16)
-    seed: int = option(0)
+    n_boot: int = option(16, Real(0, integer=True))
+    seed: int = option(0, (None, Real(0, integer=True)))
 
 
 @takes(NoiseFloorSettings)
@@ -76,7 +77,7 @@ def noise_floor(
     settings : NoiseFloorSettings, optional
         The options below in one object; keywords override its fields.
     n_boot : int
-        Replicates.
+        Replicates (0: none, the floor infinite).
     seed : int
         Seed of ``numpy.random.default_rng``.
 

@@ -63,11 +63,11 @@ def test_hidden_coupling_is_named_and_the_gap_shrinks(hidden_coupling):
     # fit) moved the coupling's LM statistic from 2.7e5 (the largest) to 1.1e5, below the
     # unloading damping's 1.8e5.  The refits decide what is named: the coupling's refit
     # lowers I2 the most.
-    s = next(x for x in it.scores if x["effect"] == "penetration_velocity_coupling")
-    assert s["significant"]
-    refitted = [x for x in it.scores if x.get("criteria_after")]
-    best = min(refitted, key=lambda x: x["criteria_after"]["I2"])
-    assert best["effect"] == "penetration_velocity_coupling"
+    s = next(x for x in it.scores if x.effect == "penetration_velocity_coupling")
+    assert s.significant
+    refitted = [x for x in it.scores if x.refitted]
+    best = min(refitted, key=lambda x: x.criteria_after["I2"])
+    assert best.effect == "penetration_velocity_coupling"
     # the evidence states the decision: the floor is the start's, and the other refits
     # (which decide over the scores) are named with their criterion
     assert "the noise floor of the model before" in it.evidence
@@ -75,10 +75,10 @@ def test_hidden_coupling_is_named_and_the_gap_shrinks(hidden_coupling):
     # the score test and the refit, which decide" contradicted itself)
     assert it.evidence.startswith("named because its refit lowers I2 the most: ")
     assert "does not agree" not in it.evidence
-    others = [x for x in refitted if x is not s and x["criteria_after"].get("I2") is not None]
+    others = [x for x in refitted if x is not s and x.criteria_after.get("I2") is not None]
     if others:
         assert "the other effects refitted reach I2 " in it.evidence
-        assert min(others, key=lambda x: x["criteria_after"]["I2"])["effect"] in it.evidence
+        assert min(others, key=lambda x: x.criteria_after["I2"]).effect in it.evidence
     phases = it.localisation["phases"]
     # the contact's phases carry most of it (measured 0.57: onset 0.18, unloading 0.39; the
     # separation 0.40 and unloading 0.39 swap places with that 2e-4 change of the start)

@@ -115,7 +115,7 @@ def test_config_rows_and_scenario_tables():
         ({"fit": {"scoring": "r2"}}, "scoring must be one of"),
         ({"fit": {"physics": "no"}}, "physics must be a bool"),
         ({"fit": {"n_boot": 10**9}}, "n_boot must be at most 10000"),
-        ({"fit": {"n_boot_intervals": 3}}, "cannot give an interval"),
+        ({"fit": {"n_boot_intervals": 3}}, "n_boot_intervals must be 0 or an integer >= 5"),
         ({"record": {"velocities": "no"}}, "velocities is true or false; got 'no'"),
         ({"factors": {"law": ["-2e8*z"]}}, "never pushes the bodies apart"),
         ({"factors": {"scenario": [{"base": "paper", "m2": 1e-300}]}}, "too stiff"),
