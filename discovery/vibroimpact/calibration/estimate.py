@@ -183,7 +183,7 @@ def _block_weights(blocks, theta):
 ROUNDS = 4
 
 
-def _fit(rows, held, pick=None, weights=None, force_on="contacts", lag=False):
+def _fit(rows, held, pick=None, weights=None, force_on="contacts", *, lag=False):
     """The machine from the three blocks of :func:`_blocks`: the ratios to ``m1`` from the
     balance, the scale from the two equations that hold the force, in turn (a held
     parameter enters the balance at its value over the current scale).
