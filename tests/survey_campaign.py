@@ -157,8 +157,11 @@ def summary(rows):
 
 def predictions(rows):
     """Every advised pair of the selected law and a rival, with what came of it: ``(predicted
-    separation or None for a regime/physics one, refitted or None, by, rejected)``, where
-    *rejected* means the rival's support is gone from the next joint fit's candidates."""
+    separation or None for a regime/physics one, refitted or None, by, rejected, told
+    apart)``, where *rejected* means the rival's support is gone from the next joint fit's
+    candidates, and *told apart* that one of the two is (the selected law's, where it was
+    the wrong one: the prediction is made as if the selected law were true, and a record
+    that rejects the selected law instead settles the pair too)."""
     out = []
     for r in rows:
         steps = r.get("steps") or []
@@ -170,7 +173,17 @@ def predictions(rows):
                 if i != 0:
                     continue
                 rival = tuple(_terms(step["candidates"][j]))
-                out.append((q["separation"], q.get("refitted"), q["by"], rival not in after))
+                selected = tuple(_terms(step["candidates"][0]))
+                gone = rival not in after
+                out.append(
+                    (
+                        q["separation"],
+                        q.get("refitted"),
+                        q["by"],
+                        gone,
+                        gone or selected not in after,
+                    )
+                )
     return out
 
 
@@ -190,8 +203,9 @@ def calibration_row(rows, label):
         "refitted > 1": lambda p: p[1] is not None and p[1] > 1,
         "refitted <= 1": lambda p: p[1] is not None and p[1] <= 1,
     }[label]
-    chosen = [p[3] for p in preds if pick(p)]
-    return f"| {label} | {len(chosen)} | {_share(chosen)} |"
+    chosen = [p for p in preds if pick(p)]
+    rejected, apart = [p[3] for p in chosen], [p[4] for p in chosen]
+    return f"| {label} | {len(chosen)} | {_share(rejected)} | {_share(apart)} |"
 
 
 #: the calibration table's rows

@@ -273,8 +273,9 @@ TABLES = {
     "campaign-calibration": Table(
         page="docs/advise.md",
         header=(
-            "| predicted at the advised point | pairs | rival rejected by the joint fit |",
-            "|---|---|---|",
+            "| predicted at the advised point | pairs | rival rejected by the joint fit "
+            "| pair told apart (one of the two rejected) |",
+            "|---|---|---|---|",
         ),
         rows=tuple((label, ("campaign*.jsonl",)) for label in survey_campaign.PREDICTED),
         row=survey_campaign.calibration_row,
