@@ -188,13 +188,36 @@ def _rebuilt(spec, value):
 
 def takes(cls):
     """Decorator of a public function whose options are the fields of ``cls`` (a
-    :class:`Settings`): :func:`options_of` then lists them beside its parameters."""
+    :class:`Settings`): :func:`options_of` then lists them beside its parameters, and the
+    function's signature shows each as a keyword with its default in place of
+    ``**options`` (``help()``, an editor's hints and the API pages read it; the function
+    still takes them through ``**options``)."""
 
     def mark(func):
         func.__vidi_settings__ = cls
+        func.__signature__ = _signature_with(func, cls)
         return func
 
     return mark
+
+
+def _signature_with(func, cls):
+    """``func``'s signature with its ``**options`` written out as the keyword-only fields
+    of ``cls`` that it does not name itself, at their defaults."""
+    import inspect
+
+    sig = inspect.signature(func)
+    params = [p for p in sig.parameters.values() if p.kind is not p.VAR_KEYWORD]
+    if len(params) == len(sig.parameters):
+        return sig  # no **options: nothing to write out
+    named = {p.name for p in params}
+    defaults = cls.defaults()
+    fields = [
+        inspect.Parameter(n, inspect.Parameter.KEYWORD_ONLY, default=getattr(defaults, n))
+        for n in cls.names()
+        if n not in named
+    ]
+    return sig.replace(parameters=params + fields)
 
 
 def options_of(func):

@@ -102,6 +102,30 @@ def test_options_of_lists_the_signature_and_the_settings():
     assert "settings" not in opts and "options" not in opts
 
 
+def _taking():
+    """Every public function that takes a settings class (``@takes``)."""
+    names = sorted(n for n in discovery.__all__ if not n[0].isupper())
+    funcs = [getattr(discovery, n) for n in names]
+    return [f for f in funcs if getattr(f, "__vidi_settings__", None) is not None]
+
+
+@pytest.mark.parametrize("func", _taking(), ids=lambda f: f.__name__)
+def test_the_signature_lists_every_option_as_a_keyword(func):
+    """``help(discover)`` showed ``**options``: the signature now writes out each field of
+    the function's settings class as a keyword at its default, as an editor and the API
+    pages read it."""
+    import inspect
+
+    params = inspect.signature(func).parameters
+    assert not any(p.kind is p.VAR_KEYWORD for p in params.values())
+    defaults = func.__vidi_settings__.defaults()
+    for name in func.__vidi_settings__.names():
+        assert name in params, name
+        if params[name].kind is params[name].KEYWORD_ONLY:
+            assert params[name].default == getattr(defaults, name), name
+    assert "library='poly:2'" in str(inspect.signature(discovery.discover))
+
+
 @pytest.mark.parametrize("cls", SETTINGS, ids=lambda c: c.__name__)
 def test_repr_is_what_one_would_type_and_print_lists_every_option(cls):
     assert cls.__repr__ is Settings.__repr__, "declare it @dataclass(frozen=True, repr=False)"
