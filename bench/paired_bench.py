@@ -12,6 +12,7 @@ no machine changes.
 
     python paired_bench.py                 # every command, 3 pairs
     python paired_bench.py --quick         # verify and fit, 2 pairs
+    python paired_bench.py --commands contact-models --pairs 2
 """
 
 import argparse
@@ -122,8 +123,9 @@ def paired(name, words, pairs, cwd, old):
     }
 
 
-def bench_paired(quick=False, pairs=None):
-    """Every command of :data:`COMMANDS` (the quick ones with ``quick``), old and new."""
+def bench_paired(quick=False, pairs=None, only=None):
+    """Every command of :data:`COMMANDS` (the quick ones with ``quick``; those named in
+    ``only`` with it), old and new."""
     old = baseline_tree()
     pairs = pairs or (2 if quick else 3)
     cwd = WORK / "paired"
@@ -132,7 +134,7 @@ def bench_paired(quick=False, pairs=None):
     record(cwd)
     out = {"baseline": BASELINE, "pairs": pairs, "commands": {}}
     for name, (words, in_quick) in COMMANDS.items():
-        if quick and not in_quick:
+        if (quick and not in_quick) or (only and name not in only):
             continue
         out["commands"][name] = paired(name, words, pairs, cwd, old)
         print_paired({"commands": {name: out["commands"][name]}}, head=False)
@@ -157,8 +159,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="verify and fit only, 2 pairs")
     ap.add_argument("--pairs", type=int, help="pairs per command (default 3; 2 with --quick)")
+    ap.add_argument("--commands", nargs="+", choices=list(COMMANDS), help="only these commands")
     args = ap.parse_args(argv)
-    res = bench_paired(args.quick, args.pairs)
+    res = bench_paired(args.quick, args.pairs, args.commands)
     print_paired(res)
     return 0
 
