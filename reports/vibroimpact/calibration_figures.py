@@ -42,7 +42,10 @@ def calibration_figure(result, stem):
             (axes[0], "frame", "grid frame: -(m1 (w1'' + g) + c1 w1' + k1 w1 + A sin)"),
             (axes[1], "moulding", "moulding: m2 (w2'' + g)"),
         ):
-            ax.plot(t[keep], s["measured"][keep] / 1e3, "k.-", lw=0.8, ms=3, label="measured F")
+            measured = (
+                "measured F, its sensor's lag removed" if s.get("lag_removed") else "measured F"
+            )
+            ax.plot(t[keep], s["measured"][keep] / 1e3, "k.-", lw=0.8, ms=3, label=measured)
             ax.plot(
                 t[keep],
                 s[body]["sheet"][keep] / 1e3,

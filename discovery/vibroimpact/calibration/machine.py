@@ -419,7 +419,8 @@ def _series(row, sheet, record):
 
     return {
         "t": row.centre[even],
-        "measured": row.force[even] / ones,
+        "measured": row.force[even] / ones,  # the force the sensor saw, where it lags
+        "lag_removed": bool(row.lagged),
         "frame": {"sheet": frame(sheet), "record": frame(record)},
         "moulding": {"sheet": mould * sheet[5], "record": mould * record[5]},
     }

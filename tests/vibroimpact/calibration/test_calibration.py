@@ -274,5 +274,6 @@ def test_a_force_sensor_that_lags_is_read_and_the_machine_is_not_biased_by_it():
         assert getattr(cal.scenario, name) == pytest.approx(getattr(sc, name), rel=0.02), name
     assert cal.notes[0].startswith("the force lags the motions: a sensor of time constant")
     assert not any("drive's phase" in n for n in cal.notes)
+    assert cal.series["lag_removed"]  # the figure says its force is the sensor's, corrected
     clean = calibrate(sheet, _lagged(sc, sc.law, 1e-9))
-    assert "force_lag" not in clean.parameters
+    assert "force_lag" not in clean.parameters and not clean.series["lag_removed"]
