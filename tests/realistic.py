@@ -486,6 +486,32 @@ def reference_record(
     )
 
 
+def lagged_record(case_or_pair, tau, *, fs=20000.0, **record_kw):
+    """A record whose force a first-order sensor ``tau`` [s] filtered: the noise-free record
+    of :func:`reference_record` at 16 times ``fs``, filtered in closed form (piecewise
+    linear at that rate, from the sensor at the force's value at the start), sampled at
+    ``fs``, then each channel's noise as :func:`reference_record` draws it (the generator
+    seeded ``seed + 77``)."""
+    from dataclasses import replace
+
+    from discovery.numerics.lag import _pass
+
+    kw = {**record_kw, "force_noise": 0.0, "motion_noise": 0.0}
+    fine = reference_record(case_or_pair, **kw, fs=16 * fs)
+    t, F = np.asarray(fine.t, dtype=float), np.asarray(fine.F, dtype=float)
+    G = np.empty_like(F)
+    _pass(t, F, tau, F[0], G)  # the sensor in step with the force at the record's start
+    keep = slice(None, None, 16)
+    rng = np.random.default_rng(record_kw.get("seed", 0) + 77)
+    fn, mn = record_kw.get("force_noise", 0.01), record_kw.get("motion_noise", 0.002)
+    Fr = G[keep] + rng.normal(0.0, fn * float(np.max(G)), G[keep].size)
+    ch = {}
+    for name, x in fine.channels.items():
+        x = np.asarray(x)[keep]
+        ch[name] = x + rng.normal(0.0, mn * float(np.ptp(x)), x.size)
+    return replace(fine, t=t[keep], F=Fr, channels=ch)
+
+
 def reference_events(
     case_or_pair, *, periods=15, fs=20000.0, transient=None, record_transient=False
 ):

@@ -168,7 +168,7 @@ def _record(true_sc, true, lag, noise, seed, case):
     else:
         kw["transient"] = R.default_transient(case)
     if lag:
-        rec = _lagged_record(sim_sc, true, lag, kw)
+        rec = R.lagged_record((sim_sc, true), lag, **kw)
     else:
         rec = R.reference_record((sim_sc, true), **kw)
     if true_sc.offset:
@@ -189,31 +189,6 @@ def _shedding_start(sc, law, trans):
             break
         true = true.replace(m2=true.m2 * sc.m2 / m2_end)
     return true
-
-
-def _lagged_record(sc, law, tau, kw):
-    """A record whose force a first-order sensor ``tau`` filtered: the noise-free record at
-    16 times the rate, filtered in closed form (piecewise linear at that rate, from the
-    sensor at the force's value at the start), sampled at the record's rate, then the
-    noise."""
-    from discovery.numerics.lag import _pass
-    from tests import realistic as R
-
-    fine = R.reference_record(
-        (sc, law), **{**kw, "force_noise": 0.0, "motion_noise": 0.0}, fs=320_000.0
-    )
-    t, F = np.asarray(fine.t, dtype=float), np.asarray(fine.F, dtype=float)
-    G = np.empty_like(F)
-    _pass(t, F, tau, F[0], G)  # the sensor in step with the force at the record's start
-    keep = slice(None, None, 16)
-    rng = np.random.default_rng(kw["seed"] + 77)
-    fn, mn = kw["force_noise"], kw["motion_noise"]
-    Fr = G[keep] + rng.normal(0.0, fn * float(np.max(G)), G[keep].size)
-    ch = {}
-    for name, x in fine.channels.items():
-        x = np.asarray(x)[keep]
-        ch[name] = x + rng.normal(0.0, mn * float(np.ptp(x)), x.size)
-    return replace(fine, t=t[keep], F=Fr, channels=ch)
 
 
 def _machine(start, rec, error, seed):

@@ -98,7 +98,6 @@ def _blocks(rows, pick=None, force_on="contacts"):
     :func:`parameter_names`: the frame (``y = -int phi F``), the moulding
     (``y = int phi F``) and their sum, the momentum balance (``y = 0``)."""
     R = len(rows)
-    force_on = "even" if any(r.lagged for r in rows) else force_on
     frame, mould, f, anchored = [], [], [], []
     for r, row in enumerate(rows):
         sel = np.arange(row.n_windows) if pick is None else pick[r]
@@ -114,7 +113,7 @@ def _blocks(rows, pick=None, force_on="contacts"):
         anchored.append(row.anchored[sel])
     frame, mould, f = np.vstack(frame), np.vstack(mould), np.concatenate(f)
     anchored = np.concatenate(anchored)
-    force, even = _force_windows(anchored, force_on), ~anchored
+    force, even = _force_windows(rows, anchored, force_on), ~anchored
     return (
         (frame[force], -f[force]),
         (mould[force], f[force]),
@@ -122,22 +121,23 @@ def _blocks(rows, pick=None, force_on="contacts"):
     )
 
 
-def _force_windows(anchored, force_on):
-    """The windows of the force's equations: the contacts' own where there are enough (see
-    :attr:`~.equations.MachineRows.anchored`) and ``force_on`` is ``"contacts"``, else the
-    evenly spread ones (those of the balance)."""
-    contacts = force_on == "contacts" and anchored.sum() >= MIN_ANCHORED
+def _force_windows(rows, anchored, force_on):
+    """The windows of the force's equations (``anchored``: the rows' flags, stacked): the
+    contacts' own where there are enough (see :attr:`~.equations.MachineRows.anchored`),
+    ``force_on`` is ``"contacts"`` and no record's force is a lagging sensor's (``lagged``),
+    else the evenly spread ones (those of the balance)."""
+    lagged = any(r.lagged for r in rows)
+    contacts = force_on == "contacts" and not lagged and anchored.sum() >= MIN_ANCHORED
     return anchored if contacts else ~anchored
 
 
 def _force_rates(rows, pick, force_on):
     """The force's rate column (``force_rate``) on the rows of the force's equations of
     :func:`_blocks`, in their order."""
-    force_on = "even" if any(r.lagged for r in rows) else force_on
     sels = [np.arange(r.n_windows) if pick is None else pick[k] for k, r in enumerate(rows)]
     rate = np.concatenate([r.force_rate[s] for r, s in zip(rows, sels, strict=True)])
     anchored = np.concatenate([r.anchored[s] for r, s in zip(rows, sels, strict=True)])
-    return rate[_force_windows(anchored, force_on)]
+    return rate[_force_windows(rows, anchored, force_on)]
 
 
 def _with_lag_column(blocks, rate):

@@ -13,7 +13,7 @@ from discovery import ForceLaw, Measurement, calibrate, load, load_scenario
 from discovery.errors import InputError
 from discovery.vibroimpact.calibration.equations import machine_rows
 from discovery.vibroimpact.calibration.units import free_fall, kinematic_ratio
-from tests.realistic import reference_record
+from tests.realistic import lagged_record, reference_record
 
 CORPUS = Path(__file__).resolve().parents[4] / "shared" / "corpus"
 SHEETS = ("c14-heavy-moulding", "c15-support-guess", "c16-all-off")
@@ -235,28 +235,10 @@ def test_a_moulding_that_sheds_mass_under_a_sheet_that_keeps_it_is_found():
     assert "mass_loss" not in steady.parameters and steady.scenario.mass_loss == 0.0
 
 
-def _lagged(sc, law, tau, periods=20, fs=19310.0, noise=0.01):
-    """A scipy-path record whose force a first-order sensor ``tau`` filtered (closed form on
-    the history at 16 times the rate, from the sensor at the force's start value), sampled
-    at ``fs``, then each channel's noise."""
-    from dataclasses import replace
-
-    from discovery.numerics.lag import _pass
-
-    fine = reference_record(
-        (sc, law), periods=periods, fs=16 * fs, force_noise=0.0, motion_noise=0.0, check=False
-    )
-    t, F = np.asarray(fine.t, dtype=float), np.asarray(fine.F, dtype=float)
-    G = np.empty_like(F)
-    _pass(t, F, tau, F[0], G)
-    keep = slice(None, None, 16)
-    rng = np.random.default_rng(7)
-    Fr = G[keep] + rng.normal(0.0, noise * float(np.max(G)), G[keep].size)
-    ch = {}
-    for name, x in fine.channels.items():
-        x = np.asarray(x)[keep]
-        ch[name] = x + rng.normal(0.0, noise / 5 * float(np.ptp(x)), x.size)
-    return replace(fine, t=t[keep], F=Fr, channels=ch)
+def _lagged(sc, law, tau):
+    """A scipy-path record whose force a first-order sensor ``tau`` filtered, 1 % force
+    noise, 0.2 % motion noise (:func:`tests.realistic.lagged_record`)."""
+    return lagged_record((sc, law), tau, periods=20, fs=19310.0, check=False)
 
 
 def test_a_force_sensor_that_lags_is_read_and_the_machine_is_not_biased_by_it():
