@@ -502,8 +502,9 @@ def explain(
         session is interactive, False: none (:mod:`discovery._progress`).
     machine_scale : (float, float), optional
         The factors within which the machine's scale is uncertain (a calibration's
-        :attr:`~discovery.Calibration.scale_range`): the intervals of the forces are
-        widened to it (:func:`~discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
+        :attr:`~discovery.Calibration.scale_range`): every parameter's interval is
+        widened to it, the forces' in closed form, the others by how far their refit moves
+        at the range's ends (:func:`~discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
 
     Returns
     -------

@@ -89,21 +89,30 @@ class Intervals(Result):
     method: str = "parametric bootstrap through the record-span processing"
     dof: int = 0
 
-    def with_machine_scale(self, low, high, names):
+    def with_machine_scale(self, low, high, names, moves=None):
         """These intervals with the parameters ``names`` widened by a machine scale known
-        only to ``[low, high]`` (see :func:`bootstrap_intervals`)."""
+        only to ``[low, high]`` (see :func:`bootstrap_intervals`), and each parameter of
+        ``moves`` (``{name: (move at low, move at high)}``) by how far it moves there."""
         lo_s, hi_s = scale_bounds((low, high))
+        moves = moves or {}
         bounds = {}
         for k, (a, b) in self.bounds.items():
             if k in names:
                 ends = (a / lo_s, a / hi_s, b / lo_s, b / hi_s)
                 a, b = min(ends), max(ends)
+            elif k in moves:
+                a, b = a + min(0.0, *moves[k]), b + max(0.0, *moves[k])
             bounds[k] = (a, b)
+        others = (
+            f"; the other parameters by their refit's move at the range's ends ({', '.join(moves)})"
+            if moves
+            else ""
+        )
         return replace(
             self,
             bounds=bounds,
             method=f"{self.method}; forces widened by the machine's scale, known to "
-            f"[{lo_s:.4f}, {hi_s:.4f}] (calibration)",
+            f"[{lo_s:.4f}, {hi_s:.4f}] (calibration){others}",
         )
 
     def as_dict(self):
@@ -298,7 +307,10 @@ def bootstrap_intervals(
         :attr:`~discovery.Calibration.scale_range`).  A machine ``s`` times the true one
         takes a law about ``s`` times the true one to reproduce the record's motions, so
         the intervals of the forces (:func:`force_names`) are widened to every value the
-        range allows: ``[low / s_high, high / s_low]`` for a positive coefficient.
+        range allows: ``[low / s_high, high / s_low]`` for a positive coefficient.  Every
+        other parameter (a lag, an offset, a set, a mass loss) is widened by how far it
+        moves with the machine at the range's two ends (two Gauss-Newton steps from the
+        fit on the records themselves: four more simulations and Jacobians per record).
 
     Returns
     -------
@@ -362,8 +374,34 @@ def bootstrap_intervals(
     how = _Resampling(cycles=G, noise=noise, few=few, refit=s.refit, level=s.level, seed=s.seed)
     iv = _intervals(np.array(draws), model, how)
     if s.machine_scale is not None:
-        iv = iv.with_machine_scale(*s.machine_scale, names=force_names(model))
+        forces = force_names(model)
+        moves = _scale_moves(records, model, s.machine_scale, forces, context[3])
+        iv = iv.with_machine_scale(*s.machine_scale, names=forces, moves=moves)
     return iv
+
+
+def _scale_moves(records, model, scale, forces, settings):
+    """How far each parameter of ``model`` other than ``forces`` moves with the machine at
+    either end of its scale's range: ``{name: (move at low, move at high)}``, each by two
+    Gauss-Newton steps from the fitted model on the records themselves ({} where a step
+    fails or the scale is fixed).  A machine ``s`` times the true one with forces ``s``
+    times the true ones moves exactly as the true one, so the forces follow the scale in
+    closed form; the recorded force is not scaled, though, and what a lag, an offset or a
+    mass loss takes up of that misfit is measured here."""
+    lo, hi = scale_bounds(scale)
+    others = [k for k, n in enumerate(model.names) if n not in forces]
+    if not others or hi - lo < 1e-12:
+        return {}
+    est = np.array(model.coefficients, dtype=float)
+    refs = [[ref for _, ref in records]]
+    moved = []
+    for f in (lo, hi):
+        context = ([sc.scaled(f) for sc, _ in records], refs, model, settings)
+        theta = _step_replicate(context, 0)
+        if theta is None:
+            return {}
+        moved.append(theta - est)
+    return {model.names[k]: (float(moved[0][k]), float(moved[1][k])) for k in others}
 
 
 @dataclass(frozen=True)

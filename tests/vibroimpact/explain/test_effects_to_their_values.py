@@ -119,3 +119,37 @@ def test_better_data_never_gives_a_worse_answer_on_a_set(noise):
     res = explain(sc.with_law(law), rec, "linear", workers=1, n_boot_intervals=0)
     assert res.final_model.effects == ("permanent_set",) and res.consistent
     assert res.final_model.law.permanent_set == pytest.approx(0.3, rel=0.01)
+
+
+def test_a_lag_interval_carries_the_machine_scale_it_was_fitted_on(paper):
+    """The machine's scale known to 1 %: a lag's interval is widened by how far the lag
+    moves with the machine at the range's two ends (two Gauss-Newton steps from the fit),
+    and that move is the one a least-squares refit on the scaled machine makes (the
+    independent path; measured: 0.05 % apart, a move of 1.2 % of the lag)."""
+    from discovery.vibroimpact.explain.effects import Model, effect
+    from discovery.vibroimpact.fit.identification import bootstrap_intervals, identify
+    from discovery.vibroimpact.fit.intervals import _scale_moves
+    from tests.vibroimpact.explain.test_explain import lagged_record
+
+    tau = 2e-4
+    rec = lagged_record(paper, tau=tau)
+    ref = Reference.from_measurement(rec, paper, n_boot=8, seed=0)
+    start = Model(paper.law).with_effect(effect("sensor_lag"), tau)
+    fit = identify(paper, ref, start, check=False, uncertainty=False).law
+    moves = _scale_moves([(paper, ref)], fit, (0.99, 1.01), {"z", "zd"}, _FIT_SETTINGS)
+    assert set(moves) == {"tau"}
+    moved = identify(paper.scaled(1.01), ref, fit, check=False, uncertainty=False).law
+    refit = moved.observation["sensor_lag"] - fit.observation["sensor_lag"]
+    assert moves["tau"][1] == pytest.approx(refit, rel=0.02)
+    plain = bootstrap_intervals(paper, ref, fit, n_boot=6, seed=1)
+    wide = bootstrap_intervals(paper, ref, fit, n_boot=6, seed=1, machine_scale=(0.99, 1.01))
+    (a, b), (a2, b2) = plain.bounds["tau"], wide.bounds["tau"]
+    assert a2 == pytest.approx(a + min(0.0, *moves["tau"])) and a2 <= a
+    assert b2 == pytest.approx(b + max(0.0, *moves["tau"])) and b2 >= b
+    assert "refit's move" in wide.method
+    for name in ("z", "zd"):  # the forces: in closed form, as before
+        lo, hi = plain.bounds[name]
+        assert wide.bounds[name] == pytest.approx((lo / 1.01, hi / 0.99))
+
+
+_FIT_SETTINGS = {"criterion": "I2", "max_simulations": 60, "tolerances": None}
