@@ -6,6 +6,7 @@ import numpy as np
 
 from ..fit.records import contact_scales
 from ..verify.motion import MOTION_CRITERION
+from .effects import effect
 
 
 def _present(eff, model, res, negligible=0.0):
@@ -98,3 +99,10 @@ def _in_bounds(eff, model):
     """Whether the effect's parameter in ``model`` is within its physical bounds."""
     lo, hi = eff.parameters[0].bounds
     return bool(lo <= model.value(eff) <= hi)
+
+
+def out_of_bounds(model):
+    """The effects of ``model`` whose parameter a refit took outside its physical bounds
+    (a refit of every parameter can push an effect named earlier past its bound: a
+    penetration-velocity coupling turned negative beside stiffening supports)."""
+    return [e for e in map(effect, model.effects) if not _in_bounds(e, model)]

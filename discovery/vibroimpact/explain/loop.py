@@ -58,7 +58,14 @@ from .disagreement import localise
 from .effects import EFFECTS, Model
 
 # the loop's parts (result, problem, starts, screening, trials, judging, separability)
-from .judging import _failing, _motion_within, _present, _within_noise
+from .judging import (
+    _failing,
+    _keeps_repulsive,
+    _motion_within,
+    _present,
+    _within_noise,
+    out_of_bounds,
+)
 from .problem import _Drift, _mean, _Problem, _with_drift, best_of
 from .pruning import drop_collapsed
 from .result import ExplainResult, Iteration
@@ -333,7 +340,8 @@ def _joint_refit(run):
     the loop's refits can stop in that basin short of the truth (stiffening supports: a
     local minimum 25 % beyond the true ``k3``), so the regression's law is also tried with
     each effect's parameter on a ladder around the loop's value (:func:`_ladder`).  The
-    best refit is kept when it lowers the gap criterion."""
+    best refit is kept when it lowers the gap criterion and stays physical, as a trial
+    must (every effect within its bounds, the contact spring pushing)."""
     model = run.model
     if not model.effects or all(e.consistent for e in run.problem.evaluations(model, floor=True)):
         return
@@ -359,6 +367,8 @@ def _joint_refit(run):
         except (IntegrationError, InputError):
             continue
         fitted = replace(res.law, fit_drift=False)
+        if out_of_bounds(fitted) or not _keeps_repulsive(fitted, model, run.records):
+            continue  # not physical: an effect past its bound stands for none
         v = run.problem.value(fitted, run.criterion)
         if v < value:
             best, value = (fitted, res), v

@@ -12,11 +12,11 @@ from ..verify.motion import MOTION_CRITERION
 from .effects import effect
 from .judging import (
     _force_worse,
-    _in_bounds,
     _keeps_repulsive,
     _motion_worse,
     _present,
     negligible,
+    out_of_bounds,
 )
 from .problem import _mean, _small_step, _with_drift, best_of
 from .starts import _output_error, _regressed
@@ -200,13 +200,22 @@ class _Trial:
         )
 
 
+def _physical(refit, model, records):
+    """Whether a law refit of ``model`` stays physical: every effect named before within
+    its bounds, the contact spring still pushing.  One that is not stands for nothing."""
+    return not out_of_bounds(refit) and _keeps_repulsive(refit, model, records)
+
+
 def _law_refit(run, model, budget, *, polish=False):
     """``(result, criteria, evaluations)`` of the model refitted alone (no effect added) on
-    ``run``'s records, or None when the refit fails (e.g. a parameter at 0)."""
+    ``run``'s records, or None when the refit fails (e.g. a parameter at 0) or is not
+    physical (an effect named before pushed past its bound, the contact spring pulling)."""
     try:
         res = _output_error(
             run.records, model, run.criterion, budget, run.tolerances, polish=polish
         )
+        if not _physical(res.law, model, run.records):
+            return None
         evs = run.problem.evaluations(res.law, floor=True)
         after, _ = _with_drift(_mean(evs, "criteria"), {}, run.drift, res.law)
     except (IntegrationError, InputError):
@@ -221,7 +230,7 @@ def _refit_trials(run, step, screen_budget, gap):
     history, the law's among them, run in parallel (the law's last, so one process does
     them in the order written), the drift channel here.  Returns ``(trials, baseline)``,
     ``baseline`` is ``(fit, criteria, evaluations)`` of the law refitted alone, or three
-    Nones when that refit fails."""
+    Nones when that refit fails or is not physical (:func:`_physical`)."""
     model, records, before = run.model, run.records, step.before
     chosen = step.screening.ranked[: run.max_refits]
     eff_by_id = step.screening.by_id
@@ -249,7 +258,7 @@ def _refit_trials(run, step, screen_budget, gap):
     baseline = (None, None, None)
     if law_start is not None:
         law, res, evs, error = out.pop()
-        if error is None:
+        if error is None and _physical(law, model, records):
             after, _ = _with_drift(_mean(evs, "criteria"), {}, run.drift, law)
             baseline = (res, after, evs)
     refits = iter(out)
@@ -285,11 +294,13 @@ def _refit_trials(run, step, screen_budget, gap):
                 "the refit's elastic branch P(zeta, 0) pulls at the record's "
                 "penetration: the effect only fits by undoing the contact spring"
             )
-        s["in_bounds"] = _in_bounds(eff, m2)
-        if not s["in_bounds"]:
-            lo, hi = eff.parameters[0].bounds
+        outside = out_of_bounds(m2)  # the effect's, or one named before it
+        s["in_bounds"] = not outside
+        if outside:
+            e = outside[0]
+            lo, hi = e.parameters[0].bounds
             s["note"] = (
-                f"the refit puts {eff.parameters[0].name} = {m2.value(eff):.4g} "
+                f"the refit puts {e.parameters[0].name} = {m2.value(e):.4g} "
                 f"outside its physical bounds [{lo:g}, {hi:g}]"
             )
         s["gap"] = key
@@ -359,7 +370,7 @@ def _polish_winner(run, best, eff):
         if (
             after3
             and after3[key] <= s["criteria_after"][key]
-            and _in_bounds(eff, res2.law)
+            and not out_of_bounds(res2.law)
             and _keeps_repulsive(res2.law, run.model, run.records)
         ):
             m2, res, evs2 = res2.law, res2, evs3

@@ -153,3 +153,33 @@ def test_a_lag_interval_carries_the_machine_scale_it_was_fitted_on(paper):
 
 
 _FIT_SETTINGS = {"criterion": "I2", "max_simulations": 60, "tolerances": None}
+
+
+def test_a_refit_that_pushes_a_named_effect_past_its_bound_stands_for_nothing(paper, monkeypatch):
+    """Survey draw 33 (short contacts, stiffening supports, the quieter record): a law refit
+    after the coupling was named took its ``z*zd`` to -7.2e10 (the catalogue's bound is
+    ``c >= 0``) and the loop kept it as a consistent model.  A refit with an effect past
+    its bound (or a pulling contact spring) is no baseline, no polish and no final model."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.explain import trials
+    from discovery.vibroimpact.explain.effects import Model, effect
+    from discovery.vibroimpact.explain.judging import out_of_bounds
+
+    coupling = effect("penetration_velocity_coupling")
+    named = Model(paper.law).with_effect(coupling, 1e9)
+    negative = named.with_effect(coupling, -7.2e10)
+    assert out_of_bounds(named) == []
+    assert [e.id for e in out_of_bounds(negative)] == ["penetration_velocity_coupling"]
+    ref = Reference.from_measurement(R.reference_record((paper, paper.law), check=False), paper)
+    records = [(paper, ref)]
+    assert trials._physical(named, named, records)
+    assert not trials._physical(negative, named, records)
+    pulling = named.with_coefficients([-1e8, *named.coefficients[1:]])
+    assert not trials._physical(pulling, named, records)
+    # the law refit that leaves the bound is refused
+    monkeypatch.setattr(
+        trials, "_output_error", lambda *a, **k: SimpleNamespace(law=negative, standard_errors={})
+    )
+    run = SimpleNamespace(records=records, criterion="I2", tolerances=None)
+    assert trials._law_refit(run, named, 10) is None
