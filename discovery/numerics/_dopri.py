@@ -184,24 +184,27 @@ def make_smooth_advance(rhs, n, n_out):
     Returns
     -------
     numba function
-        ``advance(t, y, t_end, h, p, rtol, atol, hmax, max_steps, K, ytmp, ynew,
-        t_eval, k_eval, out_eval)`` -> ``(status, t, h, k_eval, n_steps)``: steps from
-        ``t`` to exactly ``t_end`` (the last step is cut to land on it; ``y`` is updated
-        in place and ``K[0]`` must hold ``f(t, y)`` on entry and holds ``f(t_end, y)`` on
-        return), writing the dense output at ``t_eval[k_eval:]`` up to ``t_end`` into
-        ``out_eval[:n_out, k]``.  ``h`` is the step size to try first (returned for the
-        next call).  Inline it (it is ``inline="always"``) into a module-level
-        ``@njit(cache=True)`` integrator: a closure over ``rhs`` inlined there is cached
-        on disk with it, while a closure that is itself the compiled entry point is
-        compiled again in every process.
+        ``advance(t, y, t_end, h, p, ctl, work, samples, k_eval)`` -> ``(status, t, h,
+        k_eval, n_steps)``: steps from ``t`` to exactly ``t_end`` (the last step is cut to
+        land on it; ``y`` is updated in place and ``K[0]`` must hold ``f(t, y)`` on entry
+        and holds ``f(t_end, y)`` on return), writing the dense output at
+        ``t_eval[k_eval:]`` up to ``t_end`` into ``out_eval[:n_out, k]``.  ``h`` is the
+        step size to try first (returned for the next call).  The arguments come in
+        bundles, as the vibro-impact kernel's: ``ctl`` ``(rtol, atol, hmax, max_steps)``,
+        the step control (``max_steps`` this call's budget); ``work`` ``(K, ytmp,
+        ynew)``, the work arrays; ``samples`` ``(t_eval, out_eval)``.  Inline it (it is
+        ``inline="always"``) into a module-level ``@njit(cache=True)`` integrator: a
+        closure over ``rhs`` inlined there is cached on disk with it, while a closure that
+        is itself the compiled entry point is compiled again in every process.
     """
     D = blocks(n)
     stage, combine, dense, error_norm = D.stage, D.combine, D.dense, D.error_norm
 
     @njit(inline="always")
-    def advance(
-        t, y, t_end, h, p, rtol, atol, hmax, max_steps, K, ytmp, ynew, t_eval, k_eval, out_eval
-    ):
+    def advance(t, y, t_end, h, p, ctl, work, samples, k_eval):
+        rtol, atol, hmax, max_steps = ctl
+        K, ytmp, ynew = work
+        t_eval, out_eval = samples
         n_steps = 0
         status = OK
         n_eval = t_eval.shape[0]
@@ -272,8 +275,8 @@ def make_segments(rhs, n, n_out):
         The advance of :func:`make_smooth_advance` (for a driver with dense output,
         ``W[:3]`` its work arrays).
     to : numba function
-        ``to(t, y, t_end, h, p, rtol, atol, hmax, max_steps, W)`` -> ``(status, t, h,
-        n_steps)``: ``advance`` to ``t_end`` without dense output.  ``W[0][0]`` must hold
+        ``to(t, y, t_end, h, p, ctl, W)`` -> ``(status, t, h, n_steps)``: ``advance`` to
+        ``t_end`` without dense output (``ctl`` as for ``advance``).  ``W[0][0]`` must hold
         ``f(t, y)`` on entry, as for ``advance``.
     """
     advance = make_smooth_advance(rhs, n, n_out)
@@ -283,10 +286,10 @@ def make_segments(rhs, n, n_out):
         return np.empty((7, n)), np.empty(n), np.empty(n), np.empty(0), np.empty((n_out, 0))
 
     @njit(inline="always")
-    def to(t, y, t_end, h, p, rtol, atol, hmax, max_steps, W):
+    def to(t, y, t_end, h, p, ctl, W):
         K, ytmp, ynew, empty_t, empty_o = W
         status, t, h, _, ns = advance(
-            t, y, t_end, h, p, rtol, atol, hmax, max_steps, K, ytmp, ynew, empty_t, 0, empty_o
+            t, y, t_end, h, p, ctl, (K, ytmp, ynew), (empty_t, empty_o), 0
         )
         return status, t, h, ns
 

@@ -20,6 +20,11 @@ constant of the shared blocks):
 * 4 states ``(x, v, x', v')``: two nearby trajectories integrated as one system (one
   step sequence, so their local errors are correlated), renormalised at every strobe
   time (the two-trajectory estimate of the largest exponent).
+
+The entries' arguments come in bundles, as the vibro-impact kernel's: ``ctl`` ``(rtol,
+atol, hmax, max_steps)``, the step control (``atol`` the state's two absolute tolerances,
+``max_steps`` the run's budget: :meth:`discovery.ueda._runs.Integration.control`), and
+the output arrays of each entry in one tuple.
 """
 
 import numpy as np
@@ -130,9 +135,18 @@ _work4, _adv4, _to4 = make_segments(_rhs4, 4, 2)
 
 
 @njit(cache=True, inline="always")
-def _tangent_start(y0, atol_state, atol_tangent):
+def _left(ctl, n_steps):
+    """The step control ``ctl`` with the ``n_steps`` already taken off its budget."""
+    rtol, atol, hmax, max_steps = ctl
+    return rtol, atol, hmax, max_steps - n_steps
+
+
+@njit(cache=True, inline="always")
+def _tangent_start(y0, ctl, atol_tangent):
     """The variational state at a segment's start (the state, the tangent vectors the
-    identity, the trace integral 0) and its absolute tolerances."""
+    identity, the trace integral 0) and its step control (the state's absolute tolerances,
+    ``atol_tangent`` the rest's)."""
+    rtol, atol_state, hmax, max_steps = ctl
     y = np.zeros(7)
     y[0] = y0[0]
     y[1] = y0[1]
@@ -143,17 +157,16 @@ def _tangent_start(y0, atol_state, atol_tangent):
     atol[1] = atol_state[1]
     for j in range(2, 7):
         atol[j] = atol_tangent
-    return y, atol
+    return y, (rtol, atol, hmax, max_steps)
 
 
 @njit(cache=True)
-def strobe_run(
-    t0, y0, p, T, n_trans, n_strobe, rtol, atol, hmax, max_steps, t_eval, out_eval, out_strobe
-):
+def strobe_run(t0, y0, p, T, n_trans, n_strobe, ctl, samples, out_strobe):
     """``n_trans`` periods of transient, then ``n_strobe`` periods, the state at each
     period's end in ``out_strobe[k]`` (steps land on strobe times exactly); dense output
-    at ``t_eval`` (absolute times) in ``out_eval``.  Returns
-    ``(status, t, y, n_steps, k_eval)``."""
+    at ``t_eval`` (absolute times) in ``out_eval``, ``samples`` ``(t_eval, out_eval)``.
+    Returns ``(status, t, y, n_steps, k_eval)``."""
+    t_eval, out_eval = samples
     y = y0.copy()
     K, ytmp, ynew, _, _ = _work2()
     _rhs2(t0, y, p, K[0])
@@ -169,21 +182,7 @@ def strobe_run(
     for k in range(n_trans + n_strobe):
         t_end = t0 + (k + 1) * T
         status, t, h, k_eval, ns = _adv2(
-            t,
-            y,
-            t_end,
-            h,
-            p,
-            rtol,
-            atol,
-            hmax,
-            max_steps - n_steps,
-            K,
-            ytmp,
-            ynew,
-            t_eval,
-            k_eval,
-            out_eval,
+            t, y, t_end, h, p, _left(ctl, n_steps), (K, ytmp, ynew), samples, k_eval
         )
         n_steps += ns
         if status != OK:
@@ -220,27 +219,15 @@ def renormalise(y, k, out_logs, out_trace, out_strobe):
 
 
 @njit(cache=True)
-def variational_run(
-    t0,
-    y0,
-    p,
-    T,
-    n_seg,
-    rtol,
-    atol_state,
-    atol_tangent,
-    hmax,
-    max_steps,
-    out_logs,
-    out_trace,
-    out_strobe,
-):
+def variational_run(t0, y0, p, T, n_seg, ctl, atol_tangent, out):
     """Benettin's method over ``n_seg`` periods: the state and two tangent vectors
-    (started orthonormal), Gram-Schmidt at every strobe time.  ``out_logs[k]`` gets
-    ``(log r11, log r22)`` of segment ``k``, ``out_trace[k]`` the integral of the
-    Jacobian's trace over it, ``out_strobe[k]`` the state at its end.  Returns
-    ``(status, t, y, n_steps)``."""
-    y, atol = _tangent_start(y0, atol_state, atol_tangent)
+    (started orthonormal), Gram-Schmidt at every strobe time; ``atol_tangent`` the
+    tangent vectors' absolute tolerance.  ``out`` ``(out_logs, out_trace, out_strobe)``:
+    ``out_logs[k]`` gets ``(log r11, log r22)`` of segment ``k``, ``out_trace[k]`` the
+    integral of the Jacobian's trace over it, ``out_strobe[k]`` the state at its end.
+    Returns ``(status, t, y, n_steps)``."""
+    out_logs, out_trace, out_strobe = out
+    y, ctl7 = _tangent_start(y0, ctl, atol_tangent)
     W = _work7()
     t = t0
     h = T / 50.0
@@ -248,9 +235,7 @@ def variational_run(
     status = OK
     _rhs7(t, y, p, W[0][0])
     for k in range(n_seg):
-        status, t, h, ns = _to7(
-            t, y, t0 + (k + 1) * T, h, p, rtol, atol, hmax, max_steps - n_steps, W
-        )
+        status, t, h, ns = _to7(t, y, t0 + (k + 1) * T, h, p, _left(ctl7, n_steps), W)
         n_steps += ns
         if status != OK:
             break
@@ -263,7 +248,7 @@ def variational_run(
 
 
 @njit(cache=True)
-def pair_run(t0, y0, p, T, n_seg, d0, rtol, atol, hmax, max_steps, out_logs):
+def pair_run(t0, y0, p, T, n_seg, d0, ctl, out_logs):
     """Two trajectories ``d0`` apart (along ``(1, 1)/sqrt 2`` in ``(x, v)``), one system;
     at every strobe time the separation ``d`` is measured, ``log(d / d0)`` stored and
     the second trajectory put back at distance ``d0`` along it.  Returns
@@ -274,11 +259,13 @@ def pair_run(t0, y0, p, T, n_seg, d0, rtol, atol, hmax, max_steps, out_logs):
     y[1] = y0[1]
     y[2] = y0[0] + s
     y[3] = y0[1] + s
+    rtol, atol, hmax, max_steps = ctl
     at = np.empty(4)
     at[0] = atol[0]
     at[1] = atol[1]
     at[2] = atol[0]
     at[3] = atol[1]
+    ctl4 = (rtol, at, hmax, max_steps)
     W = _work4()
     t = t0
     h = T / 50.0
@@ -286,9 +273,7 @@ def pair_run(t0, y0, p, T, n_seg, d0, rtol, atol, hmax, max_steps, out_logs):
     status = OK
     _rhs4(t, y, p, W[0][0])
     for k in range(n_seg):
-        status, t, h, ns = _to4(
-            t, y, t0 + (k + 1) * T, h, p, rtol, at, hmax, max_steps - n_steps, W
-        )
+        status, t, h, ns = _to4(t, y, t0 + (k + 1) * T, h, p, _left(ctl4, n_steps), W)
         n_steps += ns
         if status != OK:
             break
@@ -303,31 +288,19 @@ def pair_run(t0, y0, p, T, n_seg, d0, rtol, atol, hmax, max_steps, out_logs):
 
 
 @njit(cache=True)
-def scan_run(
-    y0,
-    p,
-    T,
-    n_max,
-    max_period,
-    min_pairs,
-    closure,
-    inv_scale,
-    rtol,
-    atol,
-    hmax,
-    max_steps,
-    out_strobe,
-    run,
-):
+def scan_run(y0, p, T, n_max, rule, ctl, out):
     """Up to ``n_max`` periods of the stroboscopic map from ``(0, y0)`` (the same steps
-    as :func:`strobe_run`), stopping early when the strobe
-    points repeat: ``run[n]`` counts the consecutive latest pairs ``|S_k - S_{k-n}| /
+    as :func:`strobe_run`), the strobe points in ``out_strobe``, stopping early when they
+    repeat by ``rule`` ``(max_period, min_pairs, closure, inv_scale)``; ``out``
+    ``(out_strobe, run)``.  ``run[n]`` counts the consecutive latest pairs ``|S_k - S_{k-n}| /
     scale < closure`` (max norm); the smallest ``n`` with ``run[n] >= max(3 n,
     min_pairs)`` ends the run unless the run may still be converging to an orbit of a
     divisor ``d`` of ``n``: ``d`` is closing too (``run[d] > 0``), or its differences
     ``|S_k - S_{k-d}|`` shrank by more than 10 % over the last ``max(3 n, min_pairs)``
     periods (e.g. a P1 orbit with a multiplier near -1 repeats after 2 periods long
     before it repeats after 1).  Returns ``(status, t, y, periods done, n or 0)``."""
+    max_period, min_pairs, closure, inv_scale = rule
+    out_strobe, run = out
     y = y0.copy()
     W = _work2()
     for n in range(max_period + 1):
@@ -340,7 +313,7 @@ def scan_run(
     found = 0
     k = 0
     while k < n_max:
-        status, t, h, ns = _to2(t, y, (k + 1) * T, h, p, rtol, atol, hmax, max_steps - n_steps, W)
+        status, t, h, ns = _to2(t, y, (k + 1) * T, h, p, _left(ctl, n_steps), W)
         n_steps += ns
         if status != OK:
             break
@@ -376,12 +349,12 @@ def _gap(s, k, n, inv_scale):
 
 
 @njit(cache=True)
-def monodromy_run(y0, p, T, n, rtol, atol_state, atol_tangent, hmax, max_steps):
+def monodromy_run(y0, p, T, n, ctl, atol_tangent):
     """The variational equations over ``n`` periods from ``(0, y0)`` without
     orthonormalisation (the tangent matrix only rescaled by its largest entry every
     period).  Returns ``(status, t, M, log of the scale factors, trace integral)``: the
     monodromy matrix is ``exp(log) M``."""
-    y, atol = _tangent_start(y0, atol_state, atol_tangent)
+    y, ctl7 = _tangent_start(y0, ctl, atol_tangent)
     W = _work7()
     t = 0.0
     h = T / 50.0
@@ -390,7 +363,7 @@ def monodromy_run(y0, p, T, n, rtol, atol_state, atol_tangent, hmax, max_steps):
     logs = 0.0
     _rhs7(t, y, p, W[0][0])
     for k in range(n):
-        status, t, h, ns = _to7(t, y, (k + 1) * T, h, p, rtol, atol, hmax, max_steps - n_steps, W)
+        status, t, h, ns = _to7(t, y, (k + 1) * T, h, p, _left(ctl7, n_steps), W)
         n_steps += ns
         if status != OK:
             break

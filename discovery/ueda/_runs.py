@@ -11,7 +11,7 @@ from ..numerics.status import check
 from ..numerics.tolerances import Tolerances
 from .system import UedaSystem
 
-__all__ = ["DEFAULT_Y0", "Integration", "budget", "check", "setup", "initial_state"]
+__all__ = ["DEFAULT_Y0", "Integration", "budget", "control", "check", "setup", "initial_state"]
 
 DEFAULT_Y0 = (0.1, 0.0)
 
@@ -19,6 +19,12 @@ DEFAULT_Y0 = (0.1, 0.0)
 def budget(tol, n_periods):
     """Step budget of a run: ``max_steps`` per 100 periods."""
     return tol.max_steps * (1 + int(n_periods) // 100)
+
+
+def control(tol, atol, hmax, n_periods):
+    """The compiled runs' step control ``(rtol, atol, hmax, max_steps)`` for a run of
+    ``n_periods`` (:func:`budget` its steps)."""
+    return float(tol.rtol), atol, float(hmax), budget(tol, n_periods)
 
 
 def setup(system, tolerances):
@@ -63,6 +69,10 @@ class Integration:
     def budget(self, n_periods):
         """Step budget of a run of ``n_periods`` (:func:`budget`)."""
         return budget(self.tol, n_periods)
+
+    def control(self, n_periods):
+        """The compiled runs' step control for a run of ``n_periods`` (:func:`control`)."""
+        return control(self.tol, self.atol, self.hmax, n_periods)
 
 
 def initial_state(y0):

@@ -183,14 +183,9 @@ def variational_run(run, y, periods, *, t0=0.0):
         run.params,
         run.period,
         n,
-        run.tol.rtol,
-        run.atol,
+        run.control(n),
         run.tol.atol_variational,
-        run.hmax,
-        run.budget(n),
-        logs,
-        trace,
-        strobe,
+        (logs, trace, strobe),
     )
     _check(status, t, "the variational equations")
     return logs, trace, strobe, yf
@@ -240,19 +235,7 @@ def lyapunov_two_trajectory(
     n = int(periods)
     logs = np.empty(n)
     d = float(d0) * float(system.scales()[0])
-    status, t, _, _ = UK.pair_run(
-        0.0,
-        y,
-        run.params,
-        T,
-        n,
-        d,
-        run.tol.rtol,
-        run.atol,
-        run.hmax,
-        run.budget(n),
-        logs,
-    )
+    status, t, _, _ = UK.pair_run(0.0, y, run.params, T, n, d, run.control(n), logs)
     _check(status, t, "the two-trajectory run")
     _, se = batch_stats(logs, T, batches)
     return float(logs.sum() / (n * T)), float(se)

@@ -30,8 +30,8 @@ from ..errors import InputError
 from ..numerics.shooting import floquet_multipliers, is_stable, newton_orbit, smallest_period
 from ..numerics.tolerances import Tolerances
 from . import _kernel as UK
-from ._runs import budget as _budget
 from ._runs import check as _check
+from ._runs import control as _control
 from ._runs import initial_state as _y0
 from ._runs import setup as _setup
 from .system import UedaSystem
@@ -97,12 +97,8 @@ class UedaMap:
             self._T,
             n - 1,
             1,
-            self.tol.rtol,
-            self._atol,
-            self._hmax,
-            _budget(self.tol, n),
-            self._te,
-            self._oe,
+            _control(self.tol, self._atol, self._hmax, n),
+            (self._te, self._oe),
             self._out,
         )
         self.n_calls += 1

@@ -170,8 +170,8 @@ def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20
     Returns ``(strobe, Lyapunov)``; raises :class:`IntegrationError` when the solution
     blows up (``|x|`` or ``|x'|`` above 1e6).
     """
-    from ._runs import budget as _budget
     from ._runs import check
+    from ._runs import control as _control
     from .exponents import Lyapunov
 
     tol = tolerances or Tolerances.default()
@@ -188,12 +188,8 @@ def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20
             T,
             int(transient),
             0,
-            tol.rtol,
-            atol,
-            hmax,
-            _budget(tol, transient),
-            np.empty(0),
-            np.empty((2, 0)),
+            _control(tol, atol, hmax, transient),
+            (np.empty(0), np.empty((2, 0))),
             np.empty((0, 2)),
         )
         check(status, t, "the discovered equation")
@@ -206,14 +202,9 @@ def simulate_model(model, y0, t0=0.0, *, transient=200, periods=2000, batches=20
         p,
         T,
         n,
-        tol.rtol,
-        atol,
+        _control(tol, atol, hmax, n),
         tol.atol_variational,
-        hmax,
-        _budget(tol, n),
-        logs,
-        trace,
-        strobe,
+        (logs, trace, strobe),
     )
     check(status, t, "the discovered equation")
     return strobe, Lyapunov.from_logs(logs, trace, T, batches=batches, rtol=tol.rtol)

@@ -58,12 +58,8 @@ def strobe_points(system, y0=None, n=200, *, transient=200, t0=0.0, tolerances=N
         run.period,
         int(transient),
         int(n),
-        run.tol.rtol,
-        run.atol,
-        run.hmax,
-        run.budget(int(n) + int(transient)),
-        np.empty(0),
-        np.empty((2, 0)),
+        run.control(int(n) + int(transient)),
+        (np.empty(0), np.empty((2, 0))),
         out,
     )
     _check(status, t, "the stroboscopic map")
@@ -108,19 +104,7 @@ def trajectory(system, y0, t_span, n_samples=4000, *, tolerances=None):
     n_per = max(1, int(np.ceil((t1 - t0) / T - 1e-9)))
     strobe = np.empty((n_per, 2))
     status, t, _, _, k = UK.strobe_run(
-        t0,
-        _y0(y0),
-        run.params,
-        T,
-        0,
-        n_per,
-        run.tol.rtol,
-        run.atol,
-        run.hmax,
-        run.budget(n_per),
-        te,
-        out,
-        strobe,
+        t0, _y0(y0), run.params, T, 0, n_per, run.control(n_per), (te, out), strobe
     )
     _check(status, t, "the trajectory")
     return te[:k], out[0, :k], out[1, :k]

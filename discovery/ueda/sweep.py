@@ -116,9 +116,9 @@ def _stable_orbit(run, y, n):
     """``log|m_1| / (n T)`` of the period-``n`` orbit through ``y`` (its monodromy over
     ``n`` periods of the :class:`~discovery.ueda._runs.Integration` ``run``); NaN when it
     is not stable (``|m_1| >= 1``)."""
-    tol, T = run.tol, run.period
+    T = run.period
     status, t, M, logs, _ = UK.monodromy_run(
-        y, run.params, T, n, tol.rtol, run.atol, tol.atol_variational, run.hmax, run.budget(n)
+        y, run.params, T, n, run.control(n), run.tol.atol_variational
     )
     _check(status, t, "the variational equations")
     log1, _ = _floquet(M, logs)
@@ -143,7 +143,7 @@ def point(system, y, s, tol, buffers=None):
     _Point
     """
     run = Integration.of(system, tol)
-    T, p, atol, hmax = run.period, run.params, run.atol, run.hmax
+    T, p = run.period, run.params
     scale = system.scales()
     inv = 1.0 / scale
     n_tr, n_obs, P, closure = s["transient"], s["periods"], s["max_period"], s["closure"]
@@ -153,21 +153,9 @@ def point(system, y, s, tol, buffers=None):
     y = np.asarray(y, dtype=float)
     cost = 0
     if n_tr > 0:
+        rule = (P if s["early_exit"] else 0, s["min_pairs"], closure, inv)
         status, t, y, done, n = UK.scan_run(
-            y,
-            p,
-            T,
-            n_tr,
-            P if s["early_exit"] else 0,
-            s["min_pairs"],
-            closure,
-            inv,
-            tol.rtol,
-            atol,
-            hmax,
-            run.budget(n_tr),
-            strobe,
-            lengths,
+            y, p, T, n_tr, rule, run.control(n_tr), (strobe, lengths)
         )
         _check(status, t, "the stroboscopic map")
         cost += done
@@ -179,20 +167,7 @@ def point(system, y, s, tol, buffers=None):
                 return _Point.periodic(n, lam, y, cost=cost, points=points)
             # an unstable orbit repeating by chance: the rest of the transient
             status, t, y, more, _ = UK.scan_run(
-                y,
-                p,
-                T,
-                n_tr - done,
-                0,
-                1,
-                closure,
-                inv,
-                tol.rtol,
-                atol,
-                hmax,
-                run.budget(n_tr),
-                strobe,
-                lengths,
+                y, p, T, n_tr - done, (0, 1, closure, inv), run.control(n_tr), (strobe, lengths)
             )
             _check(status, t, "the stroboscopic map")
             cost += more
@@ -205,14 +180,9 @@ def point(system, y, s, tol, buffers=None):
         p,
         T,
         n_obs,
-        tol.rtol,
-        atol,
+        run.control(n_obs),
         tol.atol_variational,
-        hmax,
-        run.budget(n_obs),
-        logs,
-        trace,
-        obs,
+        (logs, trace, obs),
     )
     _check(status, t, "the variational equations")
     cost += n_obs
