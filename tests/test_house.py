@@ -335,12 +335,17 @@ def test_modules_are_short():
     assert not long, long
 
 
-def test_the_vibroimpact_kernels_functions_take_bundles():
-    """No function of the compiled vibro-impact kernel takes more than 12 parameters: its
-    arrays travel in tuples (the law, the step control, the outputs, the work arrays), so
-    that no caller writes a long call out (numba passes a tuple's fields as arguments)."""
+def test_the_compiled_kernels_functions_take_bundles():
+    """No function of the compiled kernels (the vibro-impact kernel, Ueda's oscillators, the
+    shared Dormand-Prince blocks) takes more than 12 parameters: their arrays travel in
+    tuples (the law, the step control, the outputs, the work arrays), so that no caller
+    writes a long call out (numba passes a tuple's fields as arguments)."""
     wide = []
-    for path in sorted((ROOT / "discovery/vibroimpact/dynamics/kernel").glob("*.py")):
+    paths = sorted((ROOT / "discovery/vibroimpact/dynamics/kernel").glob("*.py")) + [
+        ROOT / "discovery/ueda/_kernel.py",
+        ROOT / "discovery/numerics/_dopri.py",
+    ]
+    for path in paths:
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.FunctionDef) and len(node.args.args) > 12:
                 wide.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name}")
