@@ -31,16 +31,25 @@ _ZENO_EVENTS, _ZENO_GAP = 1000, 1e-3
 
 @borrowed_njit
 def _zeno_run(t, t_last_ev, hmax, short_run):
-    """The count of events in a row each within ``_ZENO_GAP * hmax`` of the previous one,
-    after an event at ``t`` (chattering beyond ``_ZENO_EVENTS``)."""
-    return short_run + 1 if t - t_last_ev < _ZENO_GAP * hmax else 0
+    """After an event at ``t``: the count of events in a row each within ``_ZENO_GAP * hmax``
+    of the previous one, ``t`` (the last event's time) and the run's status (chattering
+    beyond ``_ZENO_EVENTS`` such events)."""
+    run = short_run + 1 if t - t_last_ev < _ZENO_GAP * hmax else 0
+    return run, t, CHATTER if run > _ZENO_EVENTS else OK
+
+
+@njit(cache=True, inline="always")
+def _finite(y):
+    """Whether the state's four components are finite."""
+    return np.isfinite(y[0]) and np.isfinite(y[1]) and np.isfinite(y[2]) and np.isfinite(y[3])
 
 
 @njit(cache=True, inline="always")
 def _take_event(t, y, mode, index, law, n_ev, events, sens, sw):
     """Event ``n_ev`` of switching function ``index`` at ``(t, y)``: with sensitivities its
     time derivatives (:func:`_event_time_sens`), its record (:func:`_record_event`) and the
-    saltation into the mode after it (:func:`_saltation`); returns that mode.  Inlined: the
+    saltation into the mode after it (:func:`_saltation`); returns that mode and the count of
+    events recorded, ``n_ev + 1``.  Inlined: the
     loop's calls pass literal indices, and a call of its own would be compiled once for each
     (five times, 3 s of the cold compile) where the three calls it makes are typed anyway."""
     S, spar, ev_tau = sens[0], sens[1], sens[4]
@@ -50,7 +59,7 @@ def _take_event(t, y, mode, index, law, n_ev, events, sens, sw):
     mode = _record_event(t, y, mode, index, law, n_ev, events)
     if m_s:
         _saltation(t, y, mode, law, S, sw, n_ev, ev_tau)
-    return mode
+    return mode, n_ev + 1
 
 
 @borrowed_njit
@@ -122,80 +131,44 @@ def integrate(t0, t1, y, mode0, law, ctl, out, use_contact, work):
         if n_steps >= max_steps:
             status = STEP_BUDGET
             break
+        # a phase in closed form: ``code`` as :func:`~.flight._flight`'s (a contact phase's
+        # has no 2), 3 where none applies
+        code, t_new, idx = 3, t, 0
         if use_flight and mode == FREE and not hold:
             code, t_new, k_eval = _flight(
                 t, t1, y, p, atol[0], fl, ybuf, S, samples, k_eval, out_dF
             )
-            if code == 3:
-                hold = True
-            else:
-                if code != 2:
-                    n_steps += 1
-                    t = t_new
-                    need_f = True
-                    need_h0 = True
-                    if not (
-                        np.isfinite(y[0])
-                        and np.isfinite(y[1])
-                        and np.isfinite(y[2])
-                        and np.isfinite(y[3])
-                    ):
-                        status = BLOW_UP
-                        break
-                if code == 0:
-                    continue
-                if code == 4:
-                    hold = True
-                    continue
-                if code == 2:
-                    zero_len += 1
-                    if zero_len > 4:
-                        status = CHATTER
-                        break
-                else:
-                    zero_len = 0
-                    short_run = _zeno_run(t, t_last_ev, hmax, short_run)
-                    if short_run > _ZENO_EVENTS:
-                        status = CHATTER
-                        break
-                    t_last_ev = t
-                mode = _take_event(t, y, mode, 0, law, n_ev, events, sens, sw)
-                n_ev += 1
-                need_f = True
-                need_h0 = True
-                continue
-        if use_contact and (mode == LOAD or mode == UNLOAD) and not hold:
+            hold = code == 3
+        elif use_contact and (mode == LOAD or mode == UNLOAD) and not hold:
             code, t_new, k_eval, idx = _contact(
                 t, t1, y, mode, law, atol, phases, ybuf, dc, sens, samples, k_eval
             )
-            if code == 3:
-                hold = True
-            else:
+            hold = code == 3
+        if code != 3:
+            if code != 2:
                 n_steps += 1
                 t = t_new
                 need_f = True
                 need_h0 = True
-                if not (
-                    np.isfinite(y[0])
-                    and np.isfinite(y[1])
-                    and np.isfinite(y[2])
-                    and np.isfinite(y[3])
-                ):
+                if not _finite(y):
                     status = BLOW_UP
                     break
-                if code == 4:
-                    hold = True
-                if code != 1:
-                    continue
-                zero_len = 0
-                short_run = _zeno_run(t, t_last_ev, hmax, short_run)
-                if short_run > _ZENO_EVENTS:
+            if code == 0 or code == 4:
+                hold = code == 4
+                continue
+            if code == 2:
+                zero_len += 1
+                if zero_len > 4:
                     status = CHATTER
                     break
-                t_last_ev = t
-                mode = _take_event(t, y, mode, idx, law, n_ev, events, sens, sw)
-                n_ev += 1
-                continue
+            else:
+                zero_len = 0
+                short_run, t_last_ev, status = _zeno_run(t, t_last_ev, hmax, short_run)
+                if status != OK:
+                    break
+            mode, n_ev = _take_event(t, y, mode, idx, law, n_ev, events, sens, sw)
+            need_f = need_h0 = True
+            continue
         if need_f:
             _rhs(t, y, mode, p, coef, ea, eb, br, K[0])
             need_f = False
@@ -254,10 +227,8 @@ def integrate(t0, t1, y, mode0, law, ctl, out, use_contact, work):
                 if zero_len > 4:
                     status = CHATTER
                     break
-                mode = _take_event(t, y, mode, best_index, law, n_ev, events, sens, sw)
-                n_ev += 1
-                need_f = True
-                need_h0 = True
+                mode, n_ev = _take_event(t, y, mode, best_index, law, n_ev, events, sens, sw)
+                need_f = need_h0 = True
                 continue
             # re-take the step so that it ends on the event
             h_ev = best_theta * h
@@ -292,23 +263,15 @@ def integrate(t0, t1, y, mode0, law, ctl, out, use_contact, work):
             for j in range(m_s):
                 S[r, j] = Snew[r, j]
         t = t_new
-        bad = False
-        for j in range(4):
-            if not np.isfinite(y[j]):
-                bad = True
-        if bad:
+        if not _finite(y):
             status = BLOW_UP
             break
         if best_index >= 0:
-            short_run = _zeno_run(t, t_last_ev, hmax, short_run)
-            if short_run > _ZENO_EVENTS:
-                status = CHATTER
+            short_run, t_last_ev, status = _zeno_run(t, t_last_ev, hmax, short_run)
+            if status != OK:
                 break
-            t_last_ev = t
-            mode = _take_event(t, y, mode, best_index, law, n_ev, events, sens, sw)
-            n_ev += 1
-            need_f = True
-            need_h0 = True
+            mode, n_ev = _take_event(t, y, mode, best_index, law, n_ev, events, sens, sw)
+            need_f = need_h0 = True
             # keep the step size that worked before the cut
         else:
             for i in range(ns):
