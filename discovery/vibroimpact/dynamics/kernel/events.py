@@ -2,6 +2,8 @@
 the first crossing of a switching function over an accepted step (on its dense output), and
 the event's record and the mode after it (see :mod:`.` for the detection's rules)."""
 
+from numba import njit
+
 from .codes import (
     CLIPPED,
     DP,
@@ -107,28 +109,41 @@ def _mode_after(kind, y, law):
     return LOAD if load_force(z, max(v, 0.0), p, coef, ea, eb, br) >= 0.0 else CLIPPED
 
 
+@njit(cache=True, inline="always")
+def _secant(a, b, fa, fb):
+    """The secant's root of the bracket ``[a, b]`` (values ``fa``, ``fb`` of opposite signs),
+    its midpoint where that root is not inside it."""
+    c = (a * fb - b * fa) / (fb - fa)
+    if not (a < c < b):
+        c = 0.5 * (a + b)
+    return c
+
+
+@njit(cache=True, inline="always")
+def _illinois(a, b, fa, fb, side, c, fc, left):
+    """The bracket ``(a, b, fa, fb, side)`` after the value ``fc`` at ``c`` inside it: ``c``
+    replaces ``a`` where ``left``, else ``b``; an end kept twice in a row has its value
+    halved (Illinois); ``side`` says which end moved last (1: ``a``, -1: ``b``)."""
+    if left:
+        if side == 1:
+            fb *= 0.5
+        return c, b, fc, fb, 1
+    if side == -1:
+        fa *= 0.5
+    return a, c, fa, fc, -1
+
+
 @borrowed_njit
 def _locate(y, K, h, mode, law, index, th_lo, th_hi, h_lo, h_hi, ybuf, hbuf):
     """Root in ``theta`` of switching function ``index`` on the dense output (Illinois)."""
     a, b, fa, fb = th_lo, th_hi, h_lo, h_hi
     side = 0
     for _ in range(100):
-        c = (a * fb - b * fa) / (fb - fa)
-        if not (a < c < b):
-            c = 0.5 * (a + b)
+        c = _secant(a, b, fa, fb)
         _dense(y, K, h, c, ybuf)
         _switching(mode, ybuf, law, hbuf)
         fc = hbuf[index]
-        if fc < 0.0:
-            b, fb = c, fc
-            if side == -1:
-                fa *= 0.5
-            side = -1
-        else:
-            a, fa = c, fc
-            if side == 1:
-                fb *= 0.5
-            side = 1
+        a, b, fa, fb, side = _illinois(a, b, fa, fb, side, c, fc, not fc < 0.0)
         if b - a <= 1e-15 * max(1.0, b):
             break
     return b
@@ -149,21 +164,10 @@ def _rate_root(y, K, h, s, d0, d1, ybuf):
     a, b, fa, fb = 0.0, 1.0, d0, d1
     side = 0
     for _ in range(60):
-        c = (a * fb - b * fa) / (fb - fa)
-        if not (a < c < b):
-            c = 0.5 * (a + b)
+        c = _secant(a, b, fa, fb)
         _dense(y, K, h, c, ybuf)
         fc = s * (ybuf[1] - ybuf[3])
-        if fc < 0.0:
-            a, fa = c, fc
-            if side == -1:
-                fb *= 0.5
-            side = -1
-        else:
-            b, fb = c, fc
-            if side == 1:
-                fa *= 0.5
-            side = 1
+        a, b, fa, fb, side = _illinois(a, b, fa, fb, side, c, fc, fc < 0.0)
         if b - a <= 1e-12:
             break
     return 0.5 * (a + b)
