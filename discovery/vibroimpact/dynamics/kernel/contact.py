@@ -26,7 +26,7 @@ from numba import njit
 
 from .codes import LOAD, borrowed_njit
 from .contact_modes import _contact_g
-from .flight import _FLIGHT_ITERS, _SAMPLE_ANCHOR, _SAMPLE_SLIP
+from .flight import _FLIGHT_ITERS, _SAMPLE_ANCHOR, _SAMPLE_SLIP, _newton_probe
 from .forces import force_partials
 
 
@@ -223,20 +223,10 @@ def _contact_polish(i, mode, a, b, hb, hdb, phase, p, kc, ybuf, ex):
         res = _time_res(t0 + hi, w)
         if hi - lo <= res:
             break
-        c = s - hs / hds if hds < 0.0 else 0.5 * (lo + hi)
-        if not (lo < c < hi):
-            c = 0.5 * (lo + hi)
-        if abs(c - s) <= res:
-            # Newton has converged from one side: probe just across to close the bracket
-            c = s - res if hs < 0.0 else s + res
-            if not (lo < c < hi):
-                c = 0.5 * (lo + hi)
+        c = _newton_probe(lo, hi, s, hs, hds, hds < 0.0, hs < 0.0, res)
         _contact_state(c, t0, w, mi, E, qm, ybuf, ex)
         hc, hdc = _contact_h(i, mode, kc, t0 + c, ybuf, p)
-        if hc < 0.0:
-            hi = c
-        else:
-            lo = c
+        lo, hi = (lo, c) if hc < 0.0 else (c, hi)
         s, hs, hds = c, hc, hdc
     return lo
 

@@ -121,6 +121,23 @@ def _flight_res(fl, s):
     return 4.0e-16 * max(abs(fl[8] + s), 2.0 * np.pi / fl[6])
 
 
+@njit(cache=True, inline="always")
+def _newton_probe(lo, hi, s, fs, dfs, heads, across, res):
+    """The next point of a safeguarded Newton iteration for a root in ``[lo, hi]`` from ``s``
+    (value ``fs``, rate ``dfs``): Newton's where the rate ``heads`` to the root and that point
+    is inside, else the midpoint; where Newton has converged from one side (it moved by
+    ``res`` or less), a probe ``res`` away towards the other side (``across``: ``s`` is across
+    the root) to close the bracket.  Shared by the flight's and the contact's polish."""
+    c = s - fs / dfs if heads else 0.5 * (lo + hi)
+    if not (lo < c < hi):
+        c = 0.5 * (lo + hi)
+    if abs(c - s) <= res:
+        c = s - res if across else s + res
+        if not (lo < c < hi):
+            c = 0.5 * (lo + hi)
+    return c
+
+
 @borrowed_njit
 def _flight_polish(a, b, fl, ybuf):
     """The first root of the penetration in ``[a, b]`` (``z(a) <= 0 < z(b)``, no root in
@@ -134,20 +151,10 @@ def _flight_polish(a, b, fl, ybuf):
         res = _flight_res(fl, hi)
         if hi - lo <= res:
             break
-        c = s - zs / ds if ds > 0.0 else 0.5 * (lo + hi)
-        if not (lo < c < hi):
-            c = 0.5 * (lo + hi)
-        if abs(c - s) <= res:
-            # Newton has converged from one side: probe just across to close the bracket
-            c = s - res if zs > 0.0 else s + res
-            if not (lo < c < hi):
-                c = 0.5 * (lo + hi)
+        c = _newton_probe(lo, hi, s, zs, ds, ds > 0.0, zs > 0.0, res)
         _flight_state(c, fl, ybuf)
         zc, dc = ybuf[0] - ybuf[2], ybuf[1] - ybuf[3]
-        if zc > 0.0:
-            hi = c
-        else:
-            lo = c
+        lo, hi = (lo, c) if zc > 0.0 else (c, hi)
         s, zs, ds = c, zc, dc
     return hi
 
