@@ -184,15 +184,16 @@ def make_smooth_advance(rhs, n, n_out):
     Returns
     -------
     numba function
-        ``advance(t, y, t_end, h, p, ctl, work, samples, k_eval)`` -> ``(status, t, h,
-        k_eval, n_steps)``: steps from ``t`` to exactly ``t_end`` (the last step is cut to
-        land on it; ``y`` is updated in place and ``K[0]`` must hold ``f(t, y)`` on entry
-        and holds ``f(t_end, y)`` on return), writing the dense output at
+        ``advance(t, y, t_end, h, p, ctl, n_steps, work, samples, k_eval)`` -> ``(status,
+        t, h, k_eval, n_steps)``: steps from ``t`` to exactly ``t_end`` (the last step is
+        cut to land on it; ``y`` is updated in place and ``K[0]`` must hold ``f(t, y)`` on
+        entry and holds ``f(t_end, y)`` on return), writing the dense output at
         ``t_eval[k_eval:]`` up to ``t_end`` into ``out_eval[:n_out, k]``.  ``h`` is the
-        step size to try first (returned for the next call).  The arguments come in
-        bundles, as the vibro-impact kernel's: ``ctl`` ``(rtol, atol, hmax, max_steps)``,
-        the step control (``max_steps`` this call's budget); ``work`` ``(K, ytmp,
-        ynew)``, the work arrays; ``samples`` ``(t_eval, out_eval)``.  Inline it (it is
+        step size to try first (returned for the next call); ``n_steps`` the steps the run
+        took before (returned with this call's added).  The arguments come in bundles, as
+        the vibro-impact kernel's: ``ctl`` ``(rtol, atol, hmax, max_steps)``, the step
+        control (``max_steps`` the run's budget, ``n_steps`` included); ``work`` ``(K,
+        ytmp, ynew)``, the work arrays; ``samples`` ``(t_eval, out_eval)``.  Inline it (it is
         ``inline="always"``) into a module-level ``@njit(cache=True)`` integrator: a
         closure over ``rhs`` inlined there is cached on disk with it, while a closure that
         is itself the compiled entry point is compiled again in every process.
@@ -201,11 +202,10 @@ def make_smooth_advance(rhs, n, n_out):
     stage, combine, dense, error_norm = D.stage, D.combine, D.dense, D.error_norm
 
     @njit(inline="always")
-    def advance(t, y, t_end, h, p, ctl, work, samples, k_eval):
+    def advance(t, y, t_end, h, p, ctl, n_steps, work, samples, k_eval):
         rtol, atol, hmax, max_steps = ctl
         K, ytmp, ynew = work
         t_eval, out_eval = samples
-        n_steps = 0
         status = OK
         n_eval = t_eval.shape[0]
         while t < t_end:
@@ -269,28 +269,31 @@ def make_segments(rhs, n, n_out):
 
     Returns
     -------
-    work : numba function
-        ``work()`` -> the work arrays ``W`` (stages, trial states, an empty dense output).
+    start : numba function
+        ``start(t, y, p)`` -> the work arrays ``W`` (stages, trial states, an empty dense
+        output) with ``f(t, y)`` in ``W[0][0]``, as ``advance`` needs on entry.
     advance : numba function
         The advance of :func:`make_smooth_advance` (for a driver with dense output,
         ``W[:3]`` its work arrays).
     to : numba function
-        ``to(t, y, t_end, h, p, ctl, W)`` -> ``(status, t, h, n_steps)``: ``advance`` to
-        ``t_end`` without dense output (``ctl`` as for ``advance``).  ``W[0][0]`` must hold
-        ``f(t, y)`` on entry, as for ``advance``.
+        ``to(t, y, t_end, h, p, ctl, n_steps, W)`` -> ``(status, t, h, n_steps)``:
+        ``advance`` to ``t_end`` without dense output (``ctl`` and ``n_steps`` as for
+        ``advance``).  ``W[0][0]`` must hold ``f(t, y)`` on entry, as for ``advance``.
     """
     advance = make_smooth_advance(rhs, n, n_out)
 
     @njit(inline="always")
-    def work():
-        return np.empty((7, n)), np.empty(n), np.empty(n), np.empty(0), np.empty((n_out, 0))
+    def start(t, y, p):
+        W = np.empty((7, n)), np.empty(n), np.empty(n), np.empty(0), np.empty((n_out, 0))
+        rhs(t, y, p, W[0][0])
+        return W
 
     @njit(inline="always")
-    def to(t, y, t_end, h, p, ctl, W):
+    def to(t, y, t_end, h, p, ctl, n_steps, W):
         K, ytmp, ynew, empty_t, empty_o = W
-        status, t, h, _, ns = advance(
-            t, y, t_end, h, p, ctl, (K, ytmp, ynew), (empty_t, empty_o), 0
+        status, t, h, _, n_steps = advance(
+            t, y, t_end, h, p, ctl, n_steps, (K, ytmp, ynew), (empty_t, empty_o), 0
         )
-        return status, t, h, ns
+        return status, t, h, n_steps
 
-    return work, advance, to
+    return start, advance, to

@@ -129,16 +129,9 @@ def _diverged(y, p):
     return abs(y[0]) > p[1] or abs(y[1]) > p[1]
 
 
-_work2, _adv2, _to2 = make_segments(_rhs2, 2, 2)
-_work7, _adv7, _to7 = make_segments(_rhs7, 7, 2)
-_work4, _adv4, _to4 = make_segments(_rhs4, 4, 2)
-
-
-@njit(cache=True, inline="always")
-def _left(ctl, n_steps):
-    """The step control ``ctl`` with the ``n_steps`` already taken off its budget."""
-    rtol, atol, hmax, max_steps = ctl
-    return rtol, atol, hmax, max_steps - n_steps
+_start2, _adv2, _to2 = make_segments(_rhs2, 2, 2)
+_start7, _adv7, _to7 = make_segments(_rhs7, 7, 2)
+_start4, _adv4, _to4 = make_segments(_rhs4, 4, 2)
 
 
 @njit(cache=True, inline="always")
@@ -168,23 +161,18 @@ def strobe_run(t0, y0, p, T, n_trans, n_strobe, ctl, samples, out_strobe):
     Returns ``(status, t, y, n_steps, k_eval)``."""
     t_eval, out_eval = samples
     y = y0.copy()
-    K, ytmp, ynew, _, _ = _work2()
-    _rhs2(t0, y, p, K[0])
-    t = t0
-    h = T / 50.0
+    K, ytmp, ynew, _, _ = _start2(t0, y, p)
+    t, h, n_steps, status = t0, T / 50.0, 0, OK
     k_eval = 0
-    n_steps = 0
-    status = OK
     while k_eval < t_eval.shape[0] and t_eval[k_eval] <= t0:
         out_eval[0, k_eval] = y[0]
         out_eval[1, k_eval] = y[1]
         k_eval += 1
     for k in range(n_trans + n_strobe):
         t_end = t0 + (k + 1) * T
-        status, t, h, k_eval, ns = _adv2(
-            t, y, t_end, h, p, _left(ctl, n_steps), (K, ytmp, ynew), samples, k_eval
+        status, t, h, k_eval, n_steps = _adv2(
+            t, y, t_end, h, p, ctl, n_steps, (K, ytmp, ynew), samples, k_eval
         )
-        n_steps += ns
         if status != OK:
             break
         if _diverged(y, p):
@@ -226,17 +214,12 @@ def variational_run(t0, y0, p, T, n_seg, ctl, atol_tangent, out):
     ``out_logs[k]`` gets ``(log r11, log r22)`` of segment ``k``, ``out_trace[k]`` the
     integral of the Jacobian's trace over it, ``out_strobe[k]`` the state at its end.
     Returns ``(status, t, y, n_steps)``."""
+    t, h, n_steps, status = t0, T / 50.0, 0, OK
     out_logs, out_trace, out_strobe = out
     y, ctl7 = _tangent_start(y0, ctl, atol_tangent)
-    W = _work7()
-    t = t0
-    h = T / 50.0
-    n_steps = 0
-    status = OK
-    _rhs7(t, y, p, W[0][0])
+    W = _start7(t0, y, p)
     for k in range(n_seg):
-        status, t, h, ns = _to7(t, y, t0 + (k + 1) * T, h, p, _left(ctl7, n_steps), W)
-        n_steps += ns
+        status, t, h, n_steps = _to7(t, y, t0 + (k + 1) * T, h, p, ctl7, n_steps, W)
         if status != OK:
             break
         if _diverged(y, p):
@@ -253,6 +236,7 @@ def pair_run(t0, y0, p, T, n_seg, d0, ctl, out_logs):
     at every strobe time the separation ``d`` is measured, ``log(d / d0)`` stored and
     the second trajectory put back at distance ``d0`` along it.  Returns
     ``(status, t, y, n_steps)``."""
+    t, h, n_steps, status = t0, T / 50.0, 0, OK
     y = np.empty(4)
     s = d0 / np.sqrt(2.0)
     y[0] = y0[0]
@@ -266,15 +250,9 @@ def pair_run(t0, y0, p, T, n_seg, d0, ctl, out_logs):
     at[2] = atol[0]
     at[3] = atol[1]
     ctl4 = (rtol, at, hmax, max_steps)
-    W = _work4()
-    t = t0
-    h = T / 50.0
-    n_steps = 0
-    status = OK
-    _rhs4(t, y, p, W[0][0])
+    W = _start4(t0, y, p)
     for k in range(n_seg):
-        status, t, h, ns = _to4(t, y, t0 + (k + 1) * T, h, p, _left(ctl4, n_steps), W)
-        n_steps += ns
+        status, t, h, n_steps = _to4(t, y, t0 + (k + 1) * T, h, p, ctl4, n_steps, W)
         if status != OK:
             break
         dx = y[2] - y[0]
@@ -302,19 +280,14 @@ def scan_run(y0, p, T, n_max, rule, ctl, out):
     max_period, min_pairs, closure, inv_scale = rule
     out_strobe, run = out
     y = y0.copy()
-    W = _work2()
     for n in range(max_period + 1):
         run[n] = 0
-    _rhs2(0.0, y, p, W[0][0])
-    t = 0.0
-    h = T / 50.0
-    n_steps = 0
-    status = OK
+    W = _start2(0.0, y, p)
+    t, h, n_steps, status = 0.0, T / 50.0, 0, OK
     found = 0
     k = 0
     while k < n_max:
-        status, t, h, ns = _to2(t, y, (k + 1) * T, h, p, _left(ctl, n_steps), W)
-        n_steps += ns
+        status, t, h, n_steps = _to2(t, y, (k + 1) * T, h, p, ctl, n_steps, W)
         if status != OK:
             break
         out_strobe[k, 0] = y[0]
@@ -354,17 +327,12 @@ def monodromy_run(y0, p, T, n, ctl, atol_tangent):
     orthonormalisation (the tangent matrix only rescaled by its largest entry every
     period).  Returns ``(status, t, M, log of the scale factors, trace integral)``: the
     monodromy matrix is ``exp(log) M``."""
-    y, ctl7 = _tangent_start(y0, ctl, atol_tangent)
-    W = _work7()
-    t = 0.0
-    h = T / 50.0
-    n_steps = 0
-    status = OK
+    t, h, n_steps, status = 0.0, T / 50.0, 0, OK
     logs = 0.0
-    _rhs7(t, y, p, W[0][0])
+    y, ctl7 = _tangent_start(y0, ctl, atol_tangent)
+    W = _start7(0.0, y, p)
     for k in range(n):
-        status, t, h, ns = _to7(t, y, (k + 1) * T, h, p, _left(ctl7, n_steps), W)
-        n_steps += ns
+        status, t, h, n_steps = _to7(t, y, (k + 1) * T, h, p, ctl7, n_steps, W)
         if status != OK:
             break
         m = max(max(abs(y[2]), abs(y[3])), max(abs(y[4]), abs(y[5])))
