@@ -192,13 +192,14 @@ def _shedding_start(sc, law, trans):
 
 
 def _machine(start, rec, error, seed):
-    """``(scenario, scale range, found)`` explain is given: the true machine (``error`` 0),
-    or the machine calibrated from the record from a sheet ``error`` off, as ``vidi
-    explain`` does; ``found``: the machine effects the calibration found where the sheet
-    has none (``{effect: (interval name, value, low, high)}``: stiffening supports, with
-    the machine scale's range, and a mass loss)."""
+    """``(scenario, scale range, found, known)`` explain is given: the true machine
+    (``error`` 0), or the machine calibrated from the record from a sheet ``error`` off, as
+    ``vidi explain`` does; ``found``: the machine effects the calibration found where the
+    sheet has none (``{effect: (interval name, value, low, high)}``: stiffening supports,
+    with the machine scale's range, and a mass loss); ``known``: the force sensor's lag it
+    found, for explain's ``known`` (as ``vidi explain`` passes it)."""
     if not error:
-        return start, None, {}
+        return start, None, {}, None
     from discovery import calibrate
     from tests import realistic as R
 
@@ -212,7 +213,9 @@ def _machine(start, rec, error, seed):
     loss = cal.parameters.get("mass_loss")
     if loss:
         found["mass_loss"] = ("loss", loss["record"], loss["low"], loss["high"])
-    return cal.scenario.with_law(start.law), cal.scale_range, found
+    lag = cal.parameters.get("force_lag")
+    known = {"sensor_lag": lag["record"]} if lag else None
+    return cal.scenario.with_law(start.law), cal.scale_range, found, known
 
 
 def _with_calibration(outcome, found, truth):
@@ -256,8 +259,8 @@ def run_case(args):
             start = case.scenario.with_law(law)
             row.update(_verify_truth(true_sc, true, lag, rec, start, evaluate, Reference))
             t0 = time.perf_counter()
-            given, scale, found = _machine(start, rec, error, seed)
-            res = explain(given, rec, "linear", workers=1, machine_scale=scale)
+            given, scale, found, known = _machine(start, rec, error, seed)
+            res = explain(given, rec, "linear", workers=1, machine_scale=scale, known=known)
             outcome = _outcome(res, truth, time.perf_counter() - t0)
             row.update(_with_calibration(outcome, found, truth))
         except Exception as exc:  # noqa: BLE001 (a survey row records any failure)

@@ -209,6 +209,17 @@ def machine_scale(machine):
     return None
 
 
+def machine_known(machine):
+    """The effects a :func:`machine_for` summary found beyond the machine when the run
+    uses the calibrated machine (a force sensor's lag): ``{effect id: value}`` for
+    :func:`~discovery.explain`'s ``known``, else ``None``."""
+    if not (machine and machine.get("used") == "record"):
+        return None
+    lag = (machine.get("parameters") or {}).get("force_lag")
+    value = lag.get("record") if isinstance(lag, dict) else None
+    return {"sensor_lag": float(value)} if value else None
+
+
 def machine_for(args, scenarios, measurements, time_offset=0.0):
     """The machine each record is judged with (``--machine``): the scenarios calibrated
     from the records (``record``, the default) or as given (``sheet``).  The records' units

@@ -11,6 +11,7 @@ from ._common import (
     criteria_line,
     data_entry,
     executor_of,
+    machine_known,
     machine_scale,
     outputs_line,
     provenance_of,
@@ -64,6 +65,7 @@ def run(args):
             n_boot_intervals=args.intervals,
             interval_refit=args.interval_refit,
             machine_scale=machine_scale(machine),
+            known=machine_known(machine),
             progress=rep,
             executor=ex,
         )

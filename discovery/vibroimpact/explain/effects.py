@@ -30,6 +30,7 @@ __all__ = [
     "EFFECTS",
     "TARGETS",
     "effect",
+    "KnownEffects",
     "first_order_lag",
     "first_order_lag_at",
     "small_step",
@@ -440,3 +441,31 @@ EFFECTS = (
 def effect(effect_id):
     """The catalogue entry ``effect_id`` (:func:`discovery.catalogue.lookup`)."""
     return lookup(EFFECTS, effect_id)
+
+
+class KnownEffects:
+    """The spec of effects found before the loop (:func:`~discovery.explain`'s ``known``):
+    ``{effect id: value}``, each a catalogue effect with its value within its parameter's
+    bounds."""
+
+    def describe(self):
+        return "a dict {effect id: value}"
+
+    def __call__(self, where, value):
+        from ...errors import InputError, VidiTypeError
+
+        if not isinstance(value, dict):
+            raise VidiTypeError(f"{where} must be {self.describe()}; got {type(value).__name__}")
+        ids = [e.id for e in EFFECTS]
+        for eid, v in value.items():
+            if eid not in ids:
+                raise InputError(
+                    f"{where}: unknown effect {eid!r}; the catalogue has {', '.join(ids)}"
+                )
+            eff = lookup(EFFECTS, eid)
+            lo, hi = eff.parameters[0].bounds
+            if not (isinstance(v, int | float) and lo <= v <= hi):
+                raise InputError(
+                    f"{where}: {eid}'s {eff.parameters[0].name} must be a number in "
+                    f"[{lo:g}, {hi:g}]; got {v!r}"
+                )

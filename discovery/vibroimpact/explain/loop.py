@@ -55,7 +55,7 @@ from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
 from ..verify.motion import MOTION_CRITERION
 from .disagreement import localise
-from .effects import EFFECTS, Model
+from .effects import EFFECTS, KnownEffects, Model, effect
 
 # the loop's parts (result, problem, starts, screening, trials, judging, separability)
 from .judging import (
@@ -331,6 +331,27 @@ def _iteration(run, max_iterations):
     return _refit_and_name(run, step)
 
 
+def _start_with_known(run, known):
+    """The start with the effects found before the loop (``known``, :func:`explain`),
+    refitted with the law on every record: kept when it stays physical and lowers the
+    criterion.  A calibration that found a force sensor's lag in the machine's equations
+    has evidence the loop's refits weigh only against the noise floor: on a noisy record
+    the lag's refit beat the law's by less than the floor and went unnamed."""
+    model = run.model
+    for eid, value in known.items():
+        model = model.with_effect(effect(eid), value)
+    try:
+        res = _output_error(
+            run.records, model, run.criterion, run.budget, run.tolerances, polish=True
+        )
+    except (IntegrationError, InputError):
+        return
+    if out_of_bounds(res.law) or not _keeps_repulsive(res.law, run.model, run.records):
+        return
+    if run.problem.value(res.law, run.criterion) < run.problem.value(run.model, run.criterion):
+        run.model, run.uncertainties = res.law, dict(res.standard_errors)
+
+
 def _joint_refit(run):
     """After the loop, a model with named effects that is not consistent is refitted once
     more with all its parameters at once (the law's, each effect's, a mass loss's on the
@@ -446,6 +467,7 @@ class ExplainSettings(Settings):
     n_boot_intervals: int = option(30, Real(5, integer=True, zero=True))
     interval_refit: str = option("two-step", Choice(*INTERVAL_REFITS))
     machine_scale: object = option(None, (None, tuple, list))
+    known: object = option(None, (None, KnownEffects()))
 
 
 @takes(ExplainSettings)
@@ -515,6 +537,11 @@ def explain(
         :attr:`~discovery.Calibration.scale_range`): every parameter's interval is
         widened to it, the forces' in closed form, the others by how far their refit moves
         at the range's ends (:func:`~discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
+    known : dict, optional
+        ``{effect id: value}`` of effects found before the loop (a calibration's force
+        sensor lag: ``{"sensor_lag": tau}``, as ``vidi explain`` passes it): the start is
+        refitted with them and the law, and kept when that lowers the criterion; the loop
+        refits them with the rest.
 
     Returns
     -------
@@ -557,6 +584,8 @@ def explain(
         if not any(isinstance(m, Reference) for m in ms):
             run.drift = _Drift(pairs, records)
         run.model, run.uncertainties = Model(fit.law), dict(fit.standard_errors)
+        if s.known:
+            _start_with_known(run, s.known)
         for _ in range(s.max_iterations + 1):
             tick(progress, _ITERATIONS, len(run.iterations), s.max_iterations)
             if not _iteration(run, s.max_iterations):
@@ -593,6 +622,7 @@ def explain(
                 "workers": s.workers,
                 "intervals": {"replicates": s.n_boot_intervals, "refit": s.interval_refit},
                 "records": len(records),
+                "known": dict(s.known or {}),
                 "simulations": problem.n_sim,
             },
         )

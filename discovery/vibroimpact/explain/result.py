@@ -196,6 +196,16 @@ class ExplainResult(Result):
             + ": "
             f"{'consistent' if self.consistent else 'NOT consistent'} with the record(s)"
         ]
+        for eid, value in (self.settings or {}).get("known", {}).items():
+            kept = eid in named
+            out.append(
+                f"  known before the loop: {eid} {value:.4g} (given: a calibration's), "
+                + (
+                    "in the start, refitted with the law"
+                    if kept
+                    else "left out: the start with it fitted the record no better"
+                )
+            )
         for k, it in enumerate(self.iterations):
             key = next((c for c in ("I2", "D") if c in it.criteria_after), None)
             gap = (
