@@ -183,3 +183,42 @@ def test_a_refit_that_pushes_a_named_effect_past_its_bound_stands_for_nothing(pa
     )
     run = SimpleNamespace(records=records, criterion="I2", tolerances=None)
     assert trials._law_refit(run, named, 10) is None
+
+
+def test_explain_starts_from_an_effect_found_before_the_loop(paper):
+    """A force sensor's lag the calibration found (``known``, as ``vidi explain`` passes
+    it) is in the start and refitted with the law: the final model has it at its true value
+    without the loop naming it (survey draw 27's noisier record named nothing: the lag's
+    refit beat the law's by less than the noise floor)."""
+    from discovery.errors import InputError, VidiTypeError
+    from discovery.vibroimpact.explain import ExplainSettings
+    from tests.vibroimpact.explain.test_explain import LAG_EFFECTS, lagged_record
+
+    tau = 1e-4
+    rec = lagged_record(paper, tau=tau)
+    res = explain(
+        paper, rec, "linear", effects=LAG_EFFECTS, n_boot_intervals=0, known={"sensor_lag": 1.2e-4}
+    )
+    assert "sensor_lag" in res.final_model.effects
+    assert all(it.effect != "sensor_lag" for it in res.iterations)
+    assert res.final_model.observation["sensor_lag"] == pytest.approx(tau, rel=0.1)
+    assert res.consistent
+    assert "known before the loop: sensor_lag 0.00012" in str(res)
+    assert res.settings["known"] == {"sensor_lag": 1.2e-4}
+    with pytest.raises(InputError, match="unknown effect 'lag'"):
+        ExplainSettings(known={"lag": 1e-4})
+    with pytest.raises(InputError, match=r"tau must be a number in \[0, 0.005\]"):
+        ExplainSettings(known={"sensor_lag": -1e-4})
+    with pytest.raises(VidiTypeError, match="must be None or a dict"):
+        ExplainSettings(known=1e-4)
+
+
+def test_vidi_explain_passes_the_calibrations_lag():
+    from discovery.cli._common import machine_known
+
+    lag = {"record": 3.9e-4, "low": 3.7e-4, "high": 4.2e-4}
+    assert machine_known({"used": "record", "parameters": {"force_lag": lag}}) == {
+        "sensor_lag": 3.9e-4
+    }
+    assert machine_known({"used": "sheet", "parameters": {"force_lag": lag}}) is None
+    assert machine_known({"used": "record", "parameters": {"m1": {"record": 1.0}}}) is None
