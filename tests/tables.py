@@ -166,12 +166,12 @@ TABLES = {
     "effects-readme": Table(
         page="README.md",
         header=(
-            "| records | right effect(s) kept, where it shows | clean: an effect kept | final "
-            "model consistent | 95 % interval holds the truth | lower noise wrong where higher "
-            "right |",
-            "|---|---|---|---|---|---|",
+            "| records | machine given | right effect(s) kept, where it shows | clean: an "
+            "effect kept | final model consistent | 95 % interval holds the truth | lower noise "
+            "wrong where higher right |",
+            "|---|---|---|---|---|---|---|",
         ),
-        rows=(("all", ("effects*.jsonl",)),),
+        rows=(("all", ("effects*.jsonl",)), ("all sheet", ("sheet-effects*.jsonl",))),
         row=survey_effects.readme_row,
         read=survey_effects.read_rows,
     ),
