@@ -106,3 +106,10 @@ def out_of_bounds(model):
     (a refit of every parameter can push an effect named earlier past its bound: a
     penetration-velocity coupling turned negative beside stiffening supports)."""
     return [e for e in map(effect, model.effects) if not _in_bounds(e, model)]
+
+
+def physical(refit, model, records):
+    """Whether a refit of ``model`` stays physical: every effect within its bounds
+    (:func:`out_of_bounds`), the contact spring still pushing (:func:`_keeps_repulsive`).
+    One that is not stands for nothing: no baseline, no winner, no start."""
+    return not out_of_bounds(refit) and _keeps_repulsive(refit, model, records)

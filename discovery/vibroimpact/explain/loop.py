@@ -58,14 +58,7 @@ from .disagreement import localise
 from .effects import EFFECTS, KnownEffects, Model, effect
 
 # the loop's parts (result, problem, starts, screening, trials, judging, separability)
-from .judging import (
-    _failing,
-    _keeps_repulsive,
-    _motion_within,
-    _present,
-    _within_noise,
-    out_of_bounds,
-)
+from .judging import _failing, _motion_within, _present, _within_noise, physical
 from .problem import _Drift, _mean, _Problem, _with_drift, best_of
 from .pruning import drop_collapsed
 from .result import ExplainResult, Iteration
@@ -346,7 +339,7 @@ def _start_with_known(run, known):
         )
     except (IntegrationError, InputError):
         return
-    if out_of_bounds(res.law) or not _keeps_repulsive(res.law, run.model, run.records):
+    if not physical(res.law, run.model, run.records):
         return
     if run.problem.value(res.law, run.criterion) < run.problem.value(run.model, run.criterion):
         run.model, run.uncertainties = res.law, dict(res.standard_errors)
@@ -388,8 +381,8 @@ def _joint_refit(run):
         except (IntegrationError, InputError):
             continue
         fitted = replace(res.law, fit_drift=False)
-        if out_of_bounds(fitted) or not _keeps_repulsive(fitted, model, run.records):
-            continue  # not physical: an effect past its bound stands for none
+        if not physical(fitted, model, run.records):
+            continue  # an effect past its bound stands for none
         v = run.problem.value(fitted, run.criterion)
         if v < value:
             best, value = (fitted, res), v

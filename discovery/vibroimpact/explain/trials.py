@@ -17,6 +17,7 @@ from .judging import (
     _present,
     negligible,
     out_of_bounds,
+    physical,
 )
 from .problem import _mean, _small_step, _with_drift, best_of
 from .starts import _output_error, _regressed
@@ -200,12 +201,6 @@ class _Trial:
         )
 
 
-def _physical(refit, model, records):
-    """Whether a law refit of ``model`` stays physical: every effect named before within
-    its bounds, the contact spring still pushing.  One that is not stands for nothing."""
-    return not out_of_bounds(refit) and _keeps_repulsive(refit, model, records)
-
-
 def _law_refit(run, model, budget, *, polish=False):
     """``(result, criteria, evaluations)`` of the model refitted alone (no effect added) on
     ``run``'s records, or None when the refit fails (e.g. a parameter at 0) or is not
@@ -214,7 +209,7 @@ def _law_refit(run, model, budget, *, polish=False):
         res = _output_error(
             run.records, model, run.criterion, budget, run.tolerances, polish=polish
         )
-        if not _physical(res.law, model, run.records):
+        if not physical(res.law, model, run.records):
             return None
         evs = run.problem.evaluations(res.law, floor=True)
         after, _ = _with_drift(_mean(evs, "criteria"), {}, run.drift, res.law)
@@ -230,7 +225,7 @@ def _refit_trials(run, step, screen_budget, gap):
     history, the law's among them, run in parallel (the law's last, so one process does
     them in the order written), the drift channel here.  Returns ``(trials, baseline)``,
     ``baseline`` is ``(fit, criteria, evaluations)`` of the law refitted alone, or three
-    Nones when that refit fails or is not physical (:func:`_physical`)."""
+    Nones when that refit fails or is not physical (:func:`~.judging.physical`)."""
     model, records, before = run.model, run.records, step.before
     chosen = step.screening.ranked[: run.max_refits]
     eff_by_id = step.screening.by_id
@@ -258,7 +253,7 @@ def _refit_trials(run, step, screen_budget, gap):
     baseline = (None, None, None)
     if law_start is not None:
         law, res, evs, error = out.pop()
-        if error is None and _physical(law, model, records):
+        if error is None and physical(law, model, records):
             after, _ = _with_drift(_mean(evs, "criteria"), {}, run.drift, law)
             baseline = (res, after, evs)
     refits = iter(out)
@@ -370,8 +365,7 @@ def _polish_winner(run, best, eff):
         if (
             after3
             and after3[key] <= s["criteria_after"][key]
-            and not out_of_bounds(res2.law)
-            and _keeps_repulsive(res2.law, run.model, run.records)
+            and physical(res2.law, run.model, run.records)
         ):
             m2, res, evs2 = res2.law, res2, evs3
             s["criteria_after"] = after3

@@ -164,7 +164,7 @@ def test_a_refit_that_pushes_a_named_effect_past_its_bound_stands_for_nothing(pa
 
     from discovery.vibroimpact.explain import trials
     from discovery.vibroimpact.explain.effects import Model, effect
-    from discovery.vibroimpact.explain.judging import out_of_bounds
+    from discovery.vibroimpact.explain.judging import out_of_bounds, physical
 
     coupling = effect("penetration_velocity_coupling")
     named = Model(paper.law).with_effect(coupling, 1e9)
@@ -173,10 +173,10 @@ def test_a_refit_that_pushes_a_named_effect_past_its_bound_stands_for_nothing(pa
     assert [e.id for e in out_of_bounds(negative)] == ["penetration_velocity_coupling"]
     ref = Reference.from_measurement(R.reference_record((paper, paper.law), check=False), paper)
     records = [(paper, ref)]
-    assert trials._physical(named, named, records)
-    assert not trials._physical(negative, named, records)
+    assert physical(named, named, records)
+    assert not physical(negative, named, records)
     pulling = named.with_coefficients([-1e8, *named.coefficients[1:]])
-    assert not trials._physical(pulling, named, records)
+    assert not physical(pulling, named, records)
     # the law refit that leaves the bound is refused
     monkeypatch.setattr(
         trials, "_output_error", lambda *a, **k: SimpleNamespace(law=negative, standard_errors={})
