@@ -196,8 +196,8 @@ def _machine(start, rec, error, seed):
     (``error`` 0), or the machine calibrated from the record from a sheet ``error`` off, as
     ``vidi explain`` does; ``found``: the machine effects the calibration found where the
     sheet has none (``{effect: (interval name, value, low, high)}``: stiffening supports,
-    with the machine scale's range, and a mass loss); ``known``: the force sensor's lag it
-    found, for explain's ``known`` (as ``vidi explain`` passes it)."""
+    with the machine scale's range, a mass loss and a force sensor's lag); ``known``: that
+    lag, for explain's ``known`` (as ``vidi explain`` passes it: explain starts from it)."""
     if not error:
         return start, None, {}, None
     from discovery import calibrate
@@ -214,17 +214,25 @@ def _machine(start, rec, error, seed):
     if loss:
         found["mass_loss"] = ("loss", loss["record"], loss["low"], loss["high"])
     lag = cal.parameters.get("force_lag")
-    known = {"sensor_lag": lag["record"]} if lag else None
+    known = None
+    if lag:  # explain starts from it: found, as the machine's effects are
+        known = {"sensor_lag": lag["record"]}
+        found["sensor_lag"] = ("tau", lag["record"], lag["low"], lag["high"])
     return cal.scenario.with_law(start.law), cal.scale_range, found, known
 
 
 def _with_calibration(outcome, found, truth):
-    """explain's ``outcome`` with the machine effects the calibration found: kept (the
-    machine explain was given has them), their intervals the calibration's."""
+    """explain's ``outcome`` with the effects the calibration found: the machine's kept (the
+    machine explain was given has them), their intervals the calibration's where explain
+    gives none; a force sensor's lag (in explain's start) kept where its final model has
+    it."""
     if not found:
         return outcome
     out = {**outcome, "found_by_calibration": sorted(found)}
-    out["kept"] = [*outcome["kept"], *(e for e in found if e not in outcome["kept"])]
+    # the machine's effects are in the machine explain was given; a lag is in its start and
+    # kept only where explain's final model has it
+    machine = [e for e in found if e != "sensor_lag" and e not in outcome["kept"]]
+    out["kept"] = [*outcome["kept"], *machine]
     out["start_consistent"] = False  # the sheet's machine is not the record's
     for name, value, low, high in found.values():
         if name in truth and outcome["intervals"].get(name) is None:
