@@ -44,7 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
-from discovery._io import provenance, to_jsonable
+from discovery._files._io import provenance, to_jsonable
 from discovery.vibroimpact.dynamics import Tolerances, simulate
 from discovery.vibroimpact.dynamics.reference import reference_simulate
 from discovery.vibroimpact.dynamics.steady_states import steady_state

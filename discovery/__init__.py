@@ -6,9 +6,9 @@ candidate :class:`Library` -> certified sparse fit (:class:`ConstrainedSparseReg
 (:func:`discover`), identification, landscapes -> figures, LaTeX and ``summary.json``.
 """
 
-from ._lazy import lazy_package
+from ._startup._lazy import lazy_package
 
-# Names are imported on first use (:mod:`discovery._lazy`): ``import discovery`` and
+# Names are imported on first use (:mod:`discovery._startup._lazy`): ``import discovery`` and
 # ``vidi --help`` do not load numba, cvxpy, sympy and matplotlib.
 _EXPORTS = {
     "CRITERIA": "vibroimpact.verify.criteria",
@@ -56,8 +56,8 @@ _EXPORTS = {
     "Executor": "numerics.executor",
     "make_executor": "parallel",
     "report": "reporting",
-    "load": "_result",
-    "Result": "_result",
+    "load": "_api._result",
+    "Result": "_api._result",
     "verify": "vibroimpact.verify.verdict",
     "calibrate": "vibroimpact.calibration.machine",
     "Calibration": "vibroimpact.calibration.result",

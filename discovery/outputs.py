@@ -2,8 +2,8 @@
 (the reports): the manifest's name, atomic writes, and whether the run that owns a staging
 directory is still alive (its PID and start time)."""
 
-from ._io import MANIFEST, atomic_write_text
-from ._staging import _alive as process_alive
-from ._staging import _proc_start as process_start
+from ._files._io import MANIFEST, atomic_write_text
+from ._files._staging import _alive as process_alive
+from ._files._staging import _proc_start as process_start
 
 __all__ = ["MANIFEST", "atomic_write_text", "process_alive", "process_start"]

@@ -2,7 +2,7 @@
 :func:`~discovery.numerics.executor.make_executor` with both systems' kernels compiled on
 a Dask cluster's workers before any job (:func:`discovery.warm.warm`)."""
 
-from ._validate import Real, Text, params
+from ._api._validate import Real, Text, params
 from .numerics.executor import make_executor as _make_executor
 from .warm import warm
 

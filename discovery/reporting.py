@@ -36,8 +36,8 @@ def report(run, *, out=None, snippet=None, compile=True, timeout=300):
     :func:`discovery.load` (its version and kind checked); one written before results had
     a schema version is reported from its keys as before.
     """
-    from ._result import Result, command_of, load
-    from ._validate import Choice, Real, check
+    from ._api._result import Result, command_of, load
+    from ._api._validate import Choice, Real, check
     from .errors import InputError, VidiTypeError
 
     check("report: snippet", snippet, (None, Choice("model", "table", "criteria", "figure")))
@@ -79,6 +79,6 @@ def report(run, *, out=None, snippet=None, compile=True, timeout=300):
 def _saved(run_dir):
     """The ``summary.json`` of a directory, ``None`` when there is none or it is no JSON
     (the report's own reading says why)."""
-    from ._jsonable import load_json
+    from ._files._jsonable import load_json
 
     return load_json(Path(run_dir) / "summary.json")[0]

@@ -7,7 +7,7 @@ integrator with its event location and sensitivities; the README's times table h
 measured figure); ``make install`` runs this module once, with a line every
 :data:`HEARTBEAT` seconds while it compiles, so that the first command after it starts in a
 second, and
-`discovery._compile.announce_compile` says so in one line when a command has to compile
+`discovery._startup._compile.announce_compile` says so in one line when a command has to compile
 anyway.
 """
 
@@ -15,7 +15,7 @@ import sys
 import threading
 import time
 
-from ._compile import _ANNOUNCED, KERNELS, cached
+from ._startup._compile import _ANNOUNCED, KERNELS, cached
 
 __all__ = ["warm", "main", "HEARTBEAT"]
 

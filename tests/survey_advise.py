@@ -33,7 +33,7 @@ import traceback
 import numpy as np
 
 from discovery import ForceLaw, discover, load_scenario
-from discovery._io import provenance
+from discovery._files._io import provenance
 from discovery.vibroimpact.advise import Knobs, NoiseModel, SafeRegion, advise
 from discovery.vibroimpact.model.scenario import Scenario
 from tests import measured

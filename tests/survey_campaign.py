@@ -37,7 +37,7 @@ import traceback
 import numpy as np
 
 from discovery import DiscoverSettings, ForceLaw, campaign
-from discovery._io import provenance
+from discovery._files._io import provenance
 from discovery.vibroimpact.advise import Knobs, SafeRegion
 from tests import measured, survey_advise
 from tests import realistic as R

@@ -59,7 +59,7 @@ if not __package__:  # run as a script: python tests/survey_contact_models.py
     # packages that would shadow the top-level ones)
     sys.path[0:1] = [str(Path(__file__).resolve().parents[1])]
 
-from discovery._io import git_state, provenance  # noqa: E402
+from discovery._files._io import git_state, provenance  # noqa: E402
 from discovery.errors import InputError, VidiError  # noqa: E402
 from discovery.vibroimpact.advise import Knobs, NoiseModel, SafeRegion, advise  # noqa: E402
 from discovery.vibroimpact.dynamics.steady_states import steady_state  # noqa: E402

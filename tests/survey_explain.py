@@ -33,7 +33,7 @@ import time
 import numpy as np
 
 from discovery import ForceLaw
-from discovery._io import provenance
+from discovery._files._io import provenance
 from discovery.vibroimpact.explain import explain
 from discovery.vibroimpact.verify import Reference, evaluate
 from tests import measured

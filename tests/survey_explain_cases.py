@@ -180,7 +180,7 @@ def run_case(name, paper=None):
     named, kept and taken out, each named step's gap, the final model's values and law,
     and the time taken (an error in the case: its message)."""
     from discovery import load_scenario
-    from discovery._io import provenance
+    from discovery._files._io import provenance
 
     label, hidden, drifting = CASES[name]
     prov = provenance()

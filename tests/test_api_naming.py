@@ -4,7 +4,7 @@ deprecated (they still work for now, with a DeprecationWarning)."""
 import pytest
 
 import discovery
-from discovery._settings import options_of
+from discovery._api._settings import options_of
 from discovery.cli import _parser
 from discovery.errors import VidiError
 from discovery.vibroimpact.dynamics.synthetic import synthesize

@@ -341,7 +341,7 @@ def test_the_checks_name_the_arguments_as_the_signature_binds_them():
     import inspect
     import itertools
 
-    from discovery._validate import _binder
+    from discovery._api._validate import _binder
 
     def f1(a, b, c=1, *, d, e=2):
         pass
@@ -374,7 +374,7 @@ def test_the_checks_name_the_arguments_as_the_signature_binds_them():
 def test_unchecked_is_the_function_past_its_checks(paper):
     """The inner loops' way past the argument checks runs the same function (the same
     result for a valid call), while the public name still checks every call."""
-    from discovery._validate import unchecked
+    from discovery._api._validate import unchecked
     from discovery.vibroimpact.dynamics import simulate
 
     raw = unchecked(simulate)

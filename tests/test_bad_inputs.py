@@ -574,7 +574,7 @@ def test_bad_input(workspace, monkeypatch, capsys, argv, needle):
 # -------------------------------------------------------------------- API-level inputs
 def _api_cases():
     from discovery import ForceLaw, Measurement, load_scenario
-    from discovery._io import check_output
+    from discovery._files._io import check_output
     from discovery.vibroimpact.model.scenario import Scenario
 
     t = np.arange(10) / 1000.0

@@ -1,5 +1,5 @@
 """Whether the compiled kernels are cached, wherever numba keeps its cache, and the one line a
-run that must compile prints (:mod:`discovery._compile`)."""
+run that must compile prints (:mod:`discovery._startup._compile`)."""
 
 import io
 import os
@@ -7,7 +7,7 @@ import subprocess
 import sys
 import textwrap
 
-import discovery._compile as C
+import discovery._startup._compile as C
 
 
 def test_the_installed_kernels_are_cached(monkeypatch):
@@ -145,7 +145,7 @@ def test_the_kernel_borrows_its_arrays_where_numba_can(monkeypatch):
     so the kernel still compiles (with the counts)."""
     import types
 
-    from discovery._compile import borrowing_options
+    from discovery._startup._compile import borrowing_options
     from discovery.vibroimpact.dynamics.kernel.contact import _contact_search
     from discovery.vibroimpact.dynamics.kernel.entries import work_arrays
 

@@ -194,7 +194,8 @@ def test_a_lazy_package_refuses_a_name_its_module_shares(tmp_path, monkeypatch):
     pkg.mkdir()
     (pkg / "thing.py").write_text("def thing():\n    return 1\n")
     (pkg / "__init__.py").write_text(
-        "from discovery._lazy import lazy_package\nlazy_package(__name__, {'thing': 'thing'})\n"
+        "from discovery._startup._lazy import lazy_package\n"
+        "lazy_package(__name__, {'thing': 'thing'})\n"
     )
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.delitem(sys.modules, "vidi_shadow_pkg", raising=False)
@@ -300,7 +301,7 @@ def test_functions_take_few_parameters():
     """No function of the package takes more than 8 parameters, nor more than 5
     positionally (``self``/``cls``, ``*args`` and ``**kwargs`` aside): a longer list is state
     that deserves a named object (a public function's options are a settings object,
-    :mod:`discovery._settings`).  Exempt: the compiled kernels, and a scikit-learn
+    :mod:`discovery._api._settings`).  Exempt: the compiled kernels, and a scikit-learn
     estimator's ``__init__``, whose contract is every hyper-parameter an explicit keyword
     of the constructor (``get_params``, ``set_params``, ``clone``)."""
     wide = []

@@ -1,5 +1,5 @@
 """Atomic output directories, output checks, stale staging, provenance, file modes and
-worker processes that die with their parent (discovery._io, discovery.numerics._workers)."""
+worker processes that die with their parent (discovery._files._io, discovery.numerics._workers)."""
 
 import hashlib
 import json
@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from discovery import _io
-from discovery._io import OutputDir, atomic_write_text, check_output, clean_stale, provenance
+from discovery._files import _io
+from discovery._files._io import OutputDir, atomic_write_text, check_output, clean_stale, provenance
 from discovery.errors import InputError
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -247,7 +247,7 @@ def test_clean_stale_restores_an_aside_result(tmp_path):
 
 _WRITER = textwrap.dedent("""
     import sys, time
-    from discovery._io import OutputDir
+    from discovery._files._io import OutputDir
     target, mode = sys.argv[1], sys.argv[2]
     print("ready", flush=True)
     i = 0
@@ -292,7 +292,7 @@ def test_sigkill_at_random_moments_never_mixes(tmp_path, exchange):
     script = (
         _WRITER
         if exchange
-        else ("import discovery._io as m; m._exchange = lambda a, b: False\n" + _WRITER)
+        else ("import discovery._files._io as m; m._exchange = lambda a, b: False\n" + _WRITER)
     )
     _write_set(target, "earlier", ("summary.json", "a.csv", "b.png", "c.pdf"))
     rng = __import__("random").Random(7)

@@ -30,7 +30,7 @@ def _restore_sigint():
 # the result is written into the open stage (``Result.write_into``)
 _CHILD = textwrap.dedent("""
     import sys, time
-    import discovery._result as R
+    import discovery._api._result as R
     real = R.Result.write_into
     def slow(*a, **k):
         print("staged", flush=True)
@@ -110,7 +110,7 @@ def test_signal_exits_with_one_line(earlier, sig, code, word):
 # went on; vidi's entry point gives it back to the main thread
 _LOST = textwrap.dedent("""
     import sys, time, weakref
-    import discovery._result as R
+    import discovery._api._result as R
     real = R.Result.write_into
     def lost(*a, **k):
         class Held: pass

@@ -185,7 +185,7 @@ def test_equivalent_models_and_the_time_read_as_text():
 
 def test_interval_bounds_print_apart():
     """A narrow interval around a large value keeps digits until its bounds differ."""
-    from discovery._printing import coefficient_lines, interval_text
+    from discovery._api._printing import coefficient_lines, interval_text
     from discovery.wording import interval_digits
 
     assert interval_text(1.9e8, 2.2e8) == "[1.9e+08, 2.2e+08]"  # wide: 4 digits, as before

@@ -9,7 +9,7 @@ import types
 import pytest
 
 from discovery import ForceLaw, landscape, load_scenario
-from discovery._progress import Reporter, interactive, reports_progress, resolve
+from discovery._api._progress import Reporter, interactive, reports_progress, resolve
 from discovery.cli import main
 from discovery.errors import VidiTypeError
 from discovery.ueda import UedaSystem

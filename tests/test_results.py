@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import discovery
-from discovery._result import KINDS, SCHEMA_VERSION, Result, part, result_class
+from discovery._api._result import KINDS, SCHEMA_VERSION, Result, part, result_class
 from discovery.cli import main
 from discovery.errors import InputError
 

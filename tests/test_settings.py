@@ -7,7 +7,7 @@ import pkgutil
 import pytest
 
 import discovery
-from discovery._settings import Settings, options_of
+from discovery._api._settings import Settings, options_of
 from discovery.errors import InputError, VidiTypeError
 
 

@@ -20,7 +20,7 @@ import textwrap
 import pytest
 
 import discovery
-from discovery._validate import Real, check
+from discovery._api._validate import Real, check
 from discovery.errors import InputError, VidiTypeError
 
 from .test_settings import SETTINGS

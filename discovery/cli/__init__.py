@@ -4,7 +4,7 @@ One module per command of :data:`COMMANDS` (``ueda`` a package with one module p
 subcommand), each with ``register(subparsers)`` and ``run(args)``.  Every command
 writes ``summary.json`` (results, versions, settings) beside its other outputs;
 outputs are staged and put in place as a whole only when the command succeeds
-(:class:`discovery._io.OutputDir`).
+(:class:`discovery._files._io.OutputDir`).
 
 Exit codes: 0 success; 2 bad input, failed numerics or an OS error such as a full disk
 (one line on stderr, ``vidi: error: ...``, naming the problem and the fix; also for
@@ -572,7 +572,7 @@ def main(argv=None):
 
 def _run(argv):
     try:
-        from .._io import set_run, short
+        from .._files._io import set_run, short
 
         parser = _parser()
         if not argv:  # plain `vidi`: the overview, not an error

@@ -8,7 +8,7 @@ For the command modules:
   header names for our columns); ``read_record(args, scenario)`` then loads
   ``args.data`` with that mapping (:meth:`discovery.Measurement.from_csv`).
 * ``check_out(args, kind="dir")`` refuses a bad ``--out`` before any work
-  (:func:`discovery._io.check_output` with the command's input files);
+  (:func:`discovery._files._io.check_output` with the command's input files);
   ``check_record_out(args)`` and ``write_record(...)`` do it for a command that writes a
   record (``D.csv`` and ``D.summary.json``).
 * ``provenance_of(args)`` is the provenance of ``summary.json`` (the options and the
@@ -22,8 +22,8 @@ import os
 
 import numpy as np
 
-from .._io import check_output
-from .._printing import interval_text
+from .._api._printing import interval_text
+from .._files._io import check_output
 from ..errors import InputError
 from ..vibroimpact.model.scenario import builtin_scenarios
 
@@ -164,7 +164,7 @@ def parse_columns(text, option="--columns"):
 def reporter(args):
     """The progress reporter of a long command (``--quiet`` silences it; ``--progress``, where
     a command has it, draws the bar even when stderr is not a terminal)."""
-    from .._progress import Reporter
+    from .._api._progress import Reporter
 
     return Reporter(
         quiet=getattr(args, "quiet", False), bar=True if getattr(args, "progress", False) else None
@@ -293,7 +293,7 @@ def check_out_inputs(args):
 
 
 def check_out(args, kind="dir", option="--out"):
-    """Refuse a bad ``--out`` before any work (see :func:`discovery._io.check_output`)."""
+    """Refuse a bad ``--out`` before any work (see :func:`discovery._files._io.check_output`)."""
     return check_output(
         getattr(args, "out", None), check_out_inputs(args), kind=kind, option=option
     )
@@ -302,7 +302,7 @@ def check_out(args, kind="dir", option="--out"):
 def provenance_of(args):
     """The ``summary.json`` provenance of a command: its options, its input files
     (:func:`inputs_of`) and the work it counted so far (:mod:`discovery.numerics.counts`)."""
-    from .._io import provenance
+    from .._files._io import provenance
     from ..numerics import counts
 
     return {**provenance(vars(args), inputs=inputs_of(args)), "counts": counts.snapshot()}
@@ -330,7 +330,7 @@ def write_record(paths, csv_text, summary):
     sha256, so a pair from two runs is detectable)."""
     import json
 
-    from .._io import atomic_write_text
+    from .._files._io import atomic_write_text
 
     out, summary_path = paths
     text = json.dumps(summary.to_dict(), indent=2) + "\n"

@@ -1,6 +1,6 @@
 """``vidi advise``: where should the next record be taken to separate the candidate laws?"""
 
-from .._io import OutputDir
+from .._files._io import OutputDir
 from ..errors import InputError
 from . import _options
 from ._common import (

@@ -13,7 +13,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
-from .._io import OutputDir
+from .._files._io import OutputDir
 from ..errors import InputError
 from ._common import integer, outputs_line, provenance_of, read_record, reporter
 

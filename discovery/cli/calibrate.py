@@ -1,6 +1,6 @@
 """``vidi calibrate``: the machine as the record shows it."""
 
-from .._io import OutputDir
+from .._files._io import OutputDir
 from ..errors import InputError
 from . import _options
 from ._common import (

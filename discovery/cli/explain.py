@@ -2,7 +2,7 @@
 
 import time
 
-from .._io import OutputDir
+from .._files._io import OutputDir
 from . import _options
 from ._common import (
     add_record_options,

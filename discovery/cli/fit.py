@@ -5,7 +5,7 @@ import csv
 import io
 import time
 
-from .._io import OutputDir
+from .._files._io import OutputDir
 from ..errors import InputError
 from ..vibroimpact.model.contact_registry import CONTACT_MODELS
 from ..vibroimpact.verify.criteria import CRITERIA

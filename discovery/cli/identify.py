@@ -5,7 +5,7 @@ import io
 
 import numpy as np
 
-from .._io import OutputDir
+from .._files._io import OutputDir
 from ..errors import InputError
 from ..vibroimpact.model.law import ForceLaw
 from ..vibroimpact.model.scenario import load_scenario
@@ -63,7 +63,7 @@ def _load_landscape(path, cls, start, scenario):
 def _read_landscape(path, cls):
     """``(Landscape, its document)`` of a saved landscape (through :func:`discovery.load`:
     a summary from before the schema version is one clear error)."""
-    from .._result import load
+    from .._api._result import load
 
     try:
         land = load(path)

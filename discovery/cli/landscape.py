@@ -6,7 +6,7 @@ import io
 
 import numpy as np
 
-from .._io import OutputDir
+from .._files._io import OutputDir
 from ..errors import InputError, IntegrationError
 from ..vibroimpact.model.scenario import load_scenario
 from ..vibroimpact.verify.criteria import CRITERIA, MOTION_DEFINITIONS

@@ -4,7 +4,7 @@
 def run(args):
     from pathlib import Path
 
-    from .._io import MANIFEST, read_manifest
+    from .._files._io import MANIFEST, read_manifest
     from ..reporting import report
 
     # a malformed manifest (files not a list of names, not an object) is one line, exit 2;

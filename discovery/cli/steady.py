@@ -4,7 +4,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._io import OutputDir
+from .._files._io import OutputDir
 from ..errors import InputError, IntegrationError
 from ..vibroimpact.model.scenario import load_scenario
 from . import _options

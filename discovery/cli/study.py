@@ -4,7 +4,7 @@
 def run(args):
     from reports.vibroimpact.study_figures import study_figures
 
-    from .._io import set_run
+    from .._files._io import set_run
     from ..vibroimpact.studies.driver import study
     from ._common import reporter
 

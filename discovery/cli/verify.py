@@ -1,6 +1,6 @@
 """``vidi verify``: is a law consistent with a record?"""
 
-from .._io import OutputDir
+from .._files._io import OutputDir
 from ..vibroimpact.model.scenario import load_scenario
 from . import _options
 from ._common import (

@@ -26,7 +26,7 @@ floating-point operations: changing it changes every result in its last bits.
 Caveat (numba's): a cached integrator is invalidated only when the *content* of its own
 source file changes (numba 0.68 stamps sources by a content hash; touching does not
 help).  The vibro-impact kernel checks this file and its own modules itself
-(:func:`discovery._compile.refresh`); after editing this file, delete the ``__pycache__``
+(:func:`discovery._startup._compile.refresh`); after editing this file, delete the ``__pycache__``
 directory of ``discovery/ueda`` so that Ueda's integrators are recompiled with the new
 blocks.
 

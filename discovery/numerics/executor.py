@@ -34,7 +34,7 @@ import sys
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from multiprocessing import get_context
 
-from .._validate import Real, Text, params
+from .._api._validate import Real, Text, params
 from ..errors import InputError
 from . import counts
 from ._workers import terminate_pool, worker_initializer

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import Real, check
+from .._api._validate import Real, check
 from ..errors import InputError
 
 __all__ = ["Tolerances", "FREE_FLIGHT", "CONTACT"]

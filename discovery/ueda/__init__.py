@@ -27,9 +27,9 @@ system (:mod:`discovery.numerics._dopri`).
   and score tests), :mod:`.explanation` (its outcome), :mod:`.effects`.
 """
 
-from .._lazy import lazy_package
+from .._startup._lazy import lazy_package
 
-# names are imported on first use (:mod:`discovery._lazy`)
+# names are imported on first use (:mod:`discovery._startup._lazy`)
 _EXPORTS = {
     "Attractor": "attractor_analysis",
     "attractor": "attractor_analysis",

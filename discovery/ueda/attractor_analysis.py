@@ -11,9 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._printing import generic_lines, readable
-from .._result import Result, part
-from .._validate import Array, Real, params
+from .._api._printing import generic_lines, readable
+from .._api._result import Result, part
+from .._api._validate import Array, Real, params
 from ..numerics.tolerances import Tolerances
 from ._runs import Integration
 from ._runs import initial_state as _y0

@@ -5,8 +5,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._printing import fmt, readable
-from .._validate import Array, Real, params
+from .._api._printing import fmt, readable
+from .._api._validate import Array, Real, params
 from ..numerics.tolerances import Tolerances
 from .exponents import Lyapunov
 from .regimes import Regime, classify

@@ -28,10 +28,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._printing import generic_lines, readable
-from .._result import Result
-from .._settings import Settings, option, takes
-from .._validate import Array, Real, params
+from .._api._printing import generic_lines, readable
+from .._api._result import Result
+from .._api._settings import Settings, option, takes
+from .._api._validate import Array, Real, params
 from ..errors import InputError
 from .polynomial import FORCING, MONOMIALS, TERMS, ForcedPolynomial
 from .record import (

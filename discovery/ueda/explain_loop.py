@@ -41,8 +41,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .._settings import Settings, option, takes
-from .._validate import Array, Real, params
+from .._api._settings import Settings, option, takes
+from .._api._validate import Array, Real, params
 from ..catalogue import select
 from ..errors import InputError
 from ..numerics.tolerances import Tolerances

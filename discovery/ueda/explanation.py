@@ -4,8 +4,8 @@
 
 from dataclasses import dataclass, field
 
-from .._printing import generic_lines, readable
-from .._result import Result, part
+from .._api._printing import generic_lines, readable
+from .._api._result import Result, part
 from .effects import EFFECTS, effect_dict
 from .polynomial import ForcedPolynomial
 

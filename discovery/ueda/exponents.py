@@ -8,9 +8,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._printing import fmt, readable
-from .._result import Result
-from .._validate import Array, Real, params
+from .._api._printing import fmt, readable
+from .._api._result import Result
+from .._api._validate import Array, Real, params
 from ..numerics.tolerances import Tolerances
 from . import _kernel as UK
 from ._runs import Integration

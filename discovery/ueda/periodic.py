@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._printing import fmt, readable
-from .._validate import Array, Real, params
+from .._api._printing import fmt, readable
+from .._api._validate import Array, Real, params
 from ..errors import InputError
 from ..numerics.shooting import floquet_multipliers, is_stable, newton_orbit, smallest_period
 from ..numerics.tolerances import Tolerances

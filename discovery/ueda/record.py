@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._settings import Settings, option, takes
-from .._validate import Array, Choice, Real, params
+from .._api._settings import Settings, option, takes
+from .._api._validate import Array, Choice, Real, params
 from ..errors import InputError, IntegrationError
 from ..numerics.tolerances import Tolerances
 from .polynomial import ForcedPolynomial
@@ -38,7 +38,7 @@ def read_record_csv(path):
     """``(t, x)`` from a CSV with a header naming columns ``t`` and ``x`` (other columns
     ignored); checked: finite, at least 64 rows, strictly increasing and uniform ``t``
     (to 1e-6 of the step)."""
-    from .._csv import parse_column, read_csv_rows
+    from .._files._csv import parse_column, read_csv_rows
 
     rows = read_csv_rows(path, "t and x")
     header = rows.header

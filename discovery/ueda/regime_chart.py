@@ -15,11 +15,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._printing import readable
-from .._progress import reports_progress, tick
-from .._result import Result
-from .._settings import Settings, option, takes
-from .._validate import Array, Instance, Real, params
+from .._api._printing import readable
+from .._api._progress import reports_progress, tick
+from .._api._result import Result
+from .._api._settings import Settings, option, takes
+from .._api._validate import Array, Instance, Real, params
 from ..errors import InputError, VidiTypeError
 from ..numerics.executor import make_executor
 from ._runs import initial_state as _y0
@@ -360,7 +360,7 @@ def chart(system, nu, B, *, settings=None, progress=None, executor=None, **optio
         Processes (default all cores, at most one per row).
     progress : callable or bool, optional
         ``progress(stage, done, total)`` after each row (stage ``"chart: rows"``); None:
-        a bar when the session is interactive, False: none (:mod:`discovery._progress`).
+        a bar when the session is interactive, False: none (:mod:`discovery._api._progress`).
     executor : Executor, optional
         Where the rows run (:mod:`discovery.numerics.executor`); overrides ``workers`` and is not
         closed here.  One task per row of ``B``.

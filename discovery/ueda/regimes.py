@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._printing import readable
+from .._api._printing import readable
 from ..errors import IntegrationError
 from ._runs import Integration
 from .exponents import Lyapunov, variational_run

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._result import Result
+from .._api._result import Result
 from .system import UedaSystem
 
 __all__ = ["SimulatedUedaRecord"]

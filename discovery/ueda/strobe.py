@@ -8,7 +8,7 @@ absolute tolerance ``rtol * atol_scale * scale``, ``max_steps``, largest step
 
 import numpy as np
 
-from .._validate import Array, Real, params
+from .._api._validate import Array, Real, params
 from ..numerics.tolerances import Tolerances
 from . import _kernel as UK
 from ._runs import Integration

@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._printing import generic_lines, readable
-from .._settings import Settings, option, takes
-from .._validate import Array, Choice, Real, params
+from .._api._printing import generic_lines, readable
+from .._api._settings import Settings, option, takes
+from .._api._validate import Array, Choice, Real, params
 from ..errors import InputError, IntegrationError
 from ..numerics.tolerances import Tolerances
 from .polynomial import ForcedPolynomial, simulate_model

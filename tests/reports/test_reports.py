@@ -69,7 +69,7 @@ def test_the_report_s_printout_names_each_file_once_with_the_right_article(tmp_p
     assert text.count(str(tex)) == 1 and "left out figure(s) x.pdf" in text, text
     text = str(Report(tex, None, "no PDF: LaTeX failed (x); the log is y", "fit"))
     assert text.splitlines()[0] == "report of a fit run" and "no PDF: LaTeX failed" in text
-    from discovery._validate import Instance
+    from discovery._api._validate import Instance
 
     assert Instance("discovery.ueda", "UedaSystem").describe() == "a UedaSystem"
 
@@ -845,7 +845,7 @@ def test_identify_figure_names_the_search_value_and_the_final_check_s():
 def test_conclusions_follow_the_number_of_records():
     """A fit of two records says the records hold an effect (not "the record holds"); one
     record keeps the singular."""
-    from discovery._result import SCHEMA_VERSION
+    from discovery._api._result import SCHEMA_VERSION
     from reports.run import run_document
     from reports.vibroimpact.context import _fit
 

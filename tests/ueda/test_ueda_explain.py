@@ -104,7 +104,7 @@ def test_missing_van_der_pol_damping_is_named_and_the_gap_shrinks(missing_vdp):
 
 
 def _jsonable(d):
-    from discovery._io import to_jsonable
+    from discovery._files._io import to_jsonable
 
     return to_jsonable(d)
 

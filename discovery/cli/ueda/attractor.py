@@ -2,7 +2,7 @@
 errors, the regime with its evidence, figures (optionally the coexisting attractors from a grid
 of initial states)."""
 
-from ..._io import OutputDir, provenance
+from ..._files._io import OutputDir, provenance
 from .. import _options
 from .._common import check_out, integer, number, outputs_line
 from . import _record

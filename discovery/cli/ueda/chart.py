@@ -5,7 +5,7 @@ import csv
 
 import numpy as np
 
-from ..._io import OutputDir, provenance
+from ..._files._io import OutputDir, provenance
 from ...errors import InputError
 from .. import _options
 from .._common import check_out, executor_of, integer, reporter

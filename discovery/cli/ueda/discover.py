@@ -6,7 +6,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..._io import OutputDir
+from ..._files._io import OutputDir
 from .. import _options
 from .._common import check_out, integer, number, outputs_line, provenance_of
 from . import _record

@@ -1,7 +1,7 @@
 """``vidi ueda explain``: the missing-effect workflow: from a start model, name the missing effect
 of this system's catalogue by score tests, add it, refit, and show the gap shrink."""
 
-from ..._io import OutputDir
+from ..._files._io import OutputDir
 from ...errors import InputError
 from .. import _options
 from .._common import check_out, outputs_line, provenance_of

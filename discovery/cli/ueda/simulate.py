@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..._io import provenance
+from ..._files._io import provenance
 from ...errors import InputError
 from .. import _options
 from .._common import check_record_out, integer, number, write_record

@@ -6,7 +6,7 @@ refinement (:mod:`.search`) -> :class:`AdviseResult` (:mod:`.result`); the loop 
 advice and record until one law remains (:mod:`.campaign_loop`).
 """
 
-from ..._lazy import lazy_package
+from ..._startup._lazy import lazy_package
 
 _EXPORTS = {
     "advise": "search",

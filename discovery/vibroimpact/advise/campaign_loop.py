@@ -27,11 +27,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._printing import readable
-from ..._progress import reports_progress, tick
-from ..._result import Result
-from ..._settings import Settings, option, takes
-from ..._validate import Choice, Real, params
+from ..._api._printing import readable
+from ..._api._progress import reports_progress, tick
+from ..._api._result import Result
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Choice, Real, params
 from ...errors import InputError, VidiTypeError
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances

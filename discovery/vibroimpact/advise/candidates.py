@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..._jsonable import load_json, reads_document
+from ..._files._jsonable import load_json, reads_document
 from ...errors import InputError
 from ..data.measurement import MAX_SAMPLES
 from ..model.law import ForceLaw
@@ -444,7 +444,7 @@ def fit_scenario_changed(run_dir, scenario):
     is not the one the ``vidi fit`` run in ``run_dir`` read (its sha256 in the fit's
     ``inputs``), or None when it is the same or the fit recorded no checksum: a scenario
     edited after the fit would give advice for another machine."""
-    from ..._provenance import _input_record
+    from ..._files._provenance import _input_record
 
     s, _ = load_json(Path(run_dir) / "summary.json")
     inputs = s.get("inputs") if isinstance(s, dict) else None

@@ -4,8 +4,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._printing import readable
-from ..._result import Result
+from ..._api._printing import readable
+from ..._api._result import Result
 from ..model.law import ForceLaw
 from .candidates import Knobs, NoiseModel, SafeRegion
 from .refit import RefitSeparation
@@ -163,7 +163,7 @@ class AdviseResult(Result):
 
     def write_into(self, out):
         """``summary.json`` (the document) and ``advise.csv`` into an open
-        :class:`~discovery._io.OutputDir` (``save(dir)`` stages both and puts them in
+        :class:`~discovery._files._io.OutputDir` (``save(dir)`` stages both and puts them in
         place together)."""
         super().write_into(out)
         out.path("advise.csv").write_text(self.csv())

@@ -10,9 +10,9 @@ import os
 import time
 from dataclasses import dataclass, replace
 
-from ..._progress import reports_progress, tick
-from ..._settings import Settings, option, takes
-from ..._validate import Instance, Real, params
+from ..._api._progress import reports_progress, tick
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Instance, Real, params
 from ...errors import InputError
 from ...numerics.executor import make_executor
 from ..dynamics import Tolerances
@@ -149,7 +149,7 @@ def advise(
         (:func:`~discovery.vibroimpact.advise.refit.refitted_separations`; 0: none).
     progress : callable or bool, optional
         ``progress(stage, done, total)`` after each point; None: a bar when the session is
-        interactive, False: none (:mod:`discovery._progress`).
+        interactive, False: none (:mod:`discovery._api._progress`).
     executor : Executor, optional
         Where the points run (:mod:`discovery.numerics.executor`); not closed here.
 

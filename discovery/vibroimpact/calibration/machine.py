@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import Real, params
+from ..._api._validate import Real, params
 from ...errors import InputError
 from ..data.measurement import Measurement
 from ..data.periods import check_drive_period

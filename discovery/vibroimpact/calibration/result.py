@@ -3,8 +3,8 @@
 import math
 from dataclasses import dataclass, field
 
-from ..._printing import fmt, readable
-from ..._result import Result
+from ..._api._printing import fmt, readable
+from ..._api._result import Result
 from ..model.scenario import Scenario
 
 __all__ = ["Calibration", "UNITS"]

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._printing import fmt, readable
-from ..._validate import Array, Real, params
+from ..._api._printing import fmt, readable
+from ..._api._validate import Array, Real, params
 from ...errors import InputError, NoContactError
 from .contact_edges import _contact_runs, _sampled_support
 from .noise import estimate_noise

@@ -31,10 +31,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._csv import parse_column, read_csv_rows
-from ..._io import atomic_write_text
-from ..._printing import fmt, readable
-from ..._validate import Array, Text, check
+from ..._api._printing import fmt, readable
+from ..._api._validate import Array, Text, check
+from ..._files._csv import parse_column, read_csv_rows
+from ..._files._io import atomic_write_text
 from ...errors import InputError, NoContactError
 from .contact_edges import _edge_params
 from .impulse import impulse_from_samples
@@ -43,7 +43,7 @@ from .noise import estimate_noise
 #: the most samples of one record a run makes or predicts (``vidi simulate``, a study's
 #: records, field records, advise's predictions): a record of this length, with positions
 #: and velocities, is about the largest CSV file the reader takes
-#: (:data:`discovery._csv.MAX_RECORD_BYTES`)
+#: (:data:`discovery._files._csv.MAX_RECORD_BYTES`)
 MAX_SAMPLES = 2_000_000
 
 __all__ = ["Measurement", "COLUMNS", "LIMITS", "JITTER_LIMIT", "STATE_COLUMNS"]

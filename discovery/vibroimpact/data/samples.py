@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.signal import savgol_filter
 
-from ..._printing import fmt, readable
-from ..._validate import Choice, Real, Text, params
+from ..._api._printing import fmt, readable
+from ..._api._validate import Choice, Real, Text, params
 from ...errors import InputError
 from .impulse import impulse_from_samples
 from .measurement import Measurement

@@ -10,8 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._printing import readable
-from ..._validate import Instance, Real, params
+from ..._api._printing import readable
+from ..._api._validate import Instance, Real, params
 from ...errors import InputError
 from ..data.impulse import Impulse
 from ..model.law import ForceLaw

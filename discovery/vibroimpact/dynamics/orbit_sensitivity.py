@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._printing import readable
+from ..._api._printing import readable
 from ...errors import InputError
 from .kernel import codes as K
 from .kernel.forces import force_partials, rhs_at

@@ -38,8 +38,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..._settings import Settings, option, takes
-from ..._validate import Real
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Real
 from ...errors import IntegrationError
 from ...numerics.status import STEP_BUDGET
 from ...numerics.status import message as status_message

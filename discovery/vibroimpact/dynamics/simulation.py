@@ -4,9 +4,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._compile import announce_compile
-from ..._settings import Settings, option, takes
-from ..._validate import Array, Choice, Real, params
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Array, Choice, Real, params
+from ..._startup._compile import announce_compile
 from ...errors import InputError, IntegrationError
 from ...numerics.status import BLOW_UP, STEP_BUDGET, STEP_UNDERFLOW
 from ...numerics.status import message as status_message

@@ -20,11 +20,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._compile import announce_compile
-from ..._printing import fmt, readable
-from ..._result import Result
-from ..._settings import Settings, option, takes
-from ..._validate import Array, Instance, Real, params
+from ..._api._printing import fmt, readable
+from ..._api._result import Result
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Array, Instance, Real, params
+from ..._startup._compile import announce_compile
 from ...errors import InputError, IntegrationError
 from ...numerics import counts
 from ...numerics.shooting import (

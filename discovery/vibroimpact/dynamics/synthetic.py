@@ -6,9 +6,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._result import Result
-from ..._settings import Settings, option, takes
-from ..._validate import Choice, Real, params
+from ..._api._result import Result
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Choice, Real, params
 from ...errors import InputError
 from ..data.measurement import MAX_SAMPLES, STATE_COLUMNS, Measurement
 from ..model.law import ForceLaw

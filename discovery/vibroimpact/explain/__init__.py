@@ -5,7 +5,7 @@ record + model -> :func:`localise` (phases, (zeta, dzeta) plane, grid motion, dr
 score tests of the catalogue's effects (:data:`EFFECTS`) -> refit -> :func:`explain`.
 """
 
-from ..._lazy import lazy_package
+from ..._startup._lazy import lazy_package
 
 _EXPORTS = {
     "EFFECTS": "effects",

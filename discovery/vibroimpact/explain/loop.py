@@ -41,9 +41,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..._progress import reports_progress, tick
-from ..._settings import Settings, option, takes
-from ..._validate import Choice, Instance, Real, Text, params
+from ..._api._progress import reports_progress, tick
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Choice, Instance, Real, Text, params
 from ...catalogue import select
 from ...errors import InputError, IntegrationError
 from ..data.measurement import Measurement
@@ -524,7 +524,7 @@ def explain(
         each is refitted (:func:`discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
     progress : callable or bool, optional
         ``progress(stage, done, total)`` at each stage and iteration; None: a bar when the
-        session is interactive, False: none (:mod:`discovery._progress`).
+        session is interactive, False: none (:mod:`discovery._api._progress`).
     machine_scale : (float, float), optional
         The factors within which the machine's scale is uncertain (a calibration's
         :attr:`~discovery.Calibration.scale_range`): every parameter's interval is

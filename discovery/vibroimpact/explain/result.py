@@ -5,8 +5,8 @@
 
 from dataclasses import dataclass, field
 
-from ..._printing import fmt, readable
-from ..._result import Result, part
+from ..._api._printing import fmt, readable
+from ..._api._result import Result, part
 from ..fit.intervals import Intervals
 from ..model.law import ForceLaw, Term
 from ..verify.criteria import criteria_lines

@@ -10,7 +10,7 @@ before the records were typed load as they are.
 
 from dataclasses import dataclass, fields
 
-from ..._printing import fmt
+from ..._api._printing import fmt
 
 __all__ = ["Score"]
 

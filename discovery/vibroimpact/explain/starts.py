@@ -8,7 +8,7 @@ import re
 
 import numpy as np
 
-from ..._progress import tick
+from ..._api._progress import tick
 from ...errors import InputError, IntegrationError
 from ..fit.identification import identify
 from ..fit.records import as_records, pair_records, record_start

@@ -27,11 +27,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..._printing import interval_text, readable
-from ..._progress import reports_progress
-from ..._result import SCHEMA_VERSION, Result
-from ..._settings import Settings, option, takes
-from ..._validate import Real, params
+from ..._api._printing import interval_text, readable
+from ..._api._progress import reports_progress
+from ..._api._result import SCHEMA_VERSION, Result
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Real, params
 from ...errors import InputError, IntegrationError
 from ...wording import records as the_records
 from ...wording import verb
@@ -427,7 +427,7 @@ def fit_contact_models(scenario, reference, *, settings=None, progress=None, **o
         depend on it).
     progress : callable or bool, optional
         ``progress(stage, done, total)`` as each model is fitted; None: a bar when the session is
-        interactive, False: none (:mod:`discovery._progress`).
+        interactive, False: none (:mod:`discovery._api._progress`).
 
     Returns
     -------

@@ -37,9 +37,9 @@ from dataclasses import dataclass, replace
 
 from constraints import require as require_certificate
 
-from ..._progress import reports_progress, tick
-from ..._settings import Settings, option, takes
-from ..._validate import Choice, Real, Text, params
+from ..._api._progress import reports_progress, tick
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Choice, Real, Text, params
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
 from ..model.library import Library
@@ -258,7 +258,7 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
     progress : callable or bool, optional
         ``progress(stage, done, total)`` as the shortlist is simulated and the stepwise
         search and the bootstrap go on; None: a bar when the session is
-        interactive, False: none (:mod:`discovery._progress`).
+        interactive, False: none (:mod:`discovery._api._progress`).
     estimator : dict, optional
         Further estimator parameters (``margin``, ``monotone``, ``signs``, ...); they may
         also be given as keywords.

@@ -19,8 +19,8 @@ import numpy as np
 
 from constraints import Certificate
 
-from ..._printing import coefficient_lines, fmt, readable
-from ..._result import Result, part
+from ..._api._printing import coefficient_lines, fmt, readable
+from ..._api._result import Result, part
 from ..model.law import ForceLaw
 from ..verify.criteria import criteria_lines
 from ..verify.evaluation import Evaluation

@@ -35,11 +35,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._printing import coefficient_lines, fmt, readable
-from ..._progress import reports_progress
-from ..._result import Result, part
-from ..._settings import Settings, option, takes
-from ..._validate import Choice, Real, params
+from ..._api._printing import coefficient_lines, fmt, readable
+from ..._api._progress import reports_progress
+from ..._api._result import Result, part
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Choice, Real, params
 from ...errors import IntegrationError
 from ..data.impulse import Impulse
 from ..data.measurement import Measurement
@@ -386,7 +386,7 @@ def identify(scenario, reference, start, *, settings=None, progress=None, **opti
         The replicates' noise (:func:`bootstrap_intervals`: ``"cycles"``).
     progress : callable or bool, optional
         ``progress(stage, done, total)`` after each simulation; None: a bar when the session is
-        interactive, False: none (:mod:`discovery._progress`).
+        interactive, False: none (:mod:`discovery._api._progress`).
     short_first : bool
         With record spans compared in blocks of several cycles: first fit the records
         cycle by cycle (:meth:`~discovery.vibroimpact.verify.Reference.shortened`, up to half the

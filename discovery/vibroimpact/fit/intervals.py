@@ -4,9 +4,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..._result import Result
-from ..._settings import Settings, option, takes
-from ..._validate import Choice, Real
+from ..._api._result import Result
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Choice, Real
 from ...errors import IntegrationError, NoContactError
 from ...numerics.executor import map_on
 from ..dynamics import Tolerances

@@ -15,7 +15,7 @@ Every evaluation is :func:`discovery.vibroimpact.verify.evaluate`.
 
 import numpy as np
 
-from ..._progress import tick
+from ..._api._progress import tick
 from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
 from ..model.law import ForceLaw, Term

@@ -38,8 +38,8 @@ from sklearn.utils.validation import check_is_fitted
 
 from constraints import Box, certify, require
 
-from ..._printing import coefficient_lines, fmt, readable
-from ..._validate import Array, check
+from ..._api._printing import coefficient_lines, fmt, readable
+from ..._api._validate import Array, check
 from ...errors import InputError, VidiError
 from ..model.library import Library
 from .constrained_lsq import _Constraints, _InfeasibleSupport, _Problem, _weights_and_groups

@@ -5,7 +5,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..._progress import tick
+from ..._api._progress import tick
 from ...errors import InputError, IntegrationError
 from ...numerics.executor import map_on
 from ..data.samples import ContactSamples

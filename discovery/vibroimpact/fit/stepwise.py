@@ -2,7 +2,7 @@
 
 from dataclasses import dataclass, field
 
-from ..._progress import tick
+from ..._api._progress import tick
 from .ranking import _best_per_support, _RankingRule
 from .shortlist import _Checker
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import Real, Text, check
+from ..._api._validate import Real, Text, check
 from ...errors import InputError
 from .contact_registry import CONTACT_MODELS, E_RANGE, K_FLOOR, N_RANGE, domain_edges
 from .law import ForceLaw

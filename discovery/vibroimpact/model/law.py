@@ -42,8 +42,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..._jsonable import reads_document
-from ..._validate import Real, check
+from ..._api._validate import Real, check
+from ..._files._jsonable import reads_document
 from ...errors import InputError
 from ._lawgrammar import MAX_EXPONENT, parse_law_terms
 

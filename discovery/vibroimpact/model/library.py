@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import check
+from ..._api._validate import check
 from ...errors import InputError
 from .law import ForceLaw, Term
 

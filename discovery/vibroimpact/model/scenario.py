@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..._validate import Text, check
+from ..._api._validate import Text, check
 from ...errors import InputError
 from .law import ForceLaw
 

@@ -7,7 +7,7 @@ scored against the truth) on an executor (:mod:`discovery.numerics.executor`) ->
 aggregates from the files (:mod:`.aggregate`) -> tables and figures (:func:`study`).
 """
 
-from ..._lazy import lazy_package
+from ..._startup._lazy import lazy_package
 
 _EXPORTS = {
     "StudyConfig": "config",

@@ -45,8 +45,8 @@ import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..._io import short
-from ..._validate import Text, params
+from ..._api._validate import Text, params
+from ..._files._io import short
 from ...errors import InputError, VidiError
 from ..data.measurement import MAX_SAMPLES
 from ..fit.regression import SELECTIONS

@@ -36,9 +36,9 @@ import sys
 import time
 from pathlib import Path
 
-from ..._io import _RUN, MANIFEST, check_output, provenance, running, short, to_jsonable
-from ..._progress import reports_progress
-from ..._validate import Instance, Real, Text, params
+from ..._api._progress import reports_progress
+from ..._api._validate import Instance, Real, Text, params
+from ..._files._io import _RUN, MANIFEST, check_output, provenance, running, short, to_jsonable
 from ...errors import InputError, VidiTypeError
 from .config import StudyConfig, load_study
 from .result import StudyResult
@@ -108,7 +108,7 @@ def study(
         Use this executor (overrides ``workers`` and ``scheduler``; not closed here).
     progress : callable or bool, optional
         ``progress(stage, done, total)`` as runs finish; None: a bar when the session is
-        interactive, False: none (:mod:`discovery._progress`). Anything else is a
+        interactive, False: none (:mod:`discovery._api._progress`). Anything else is a
         :class:`~discovery.errors.VidiTypeError`.
     max_runs : int, optional
         Do at most this many missing runs, then aggregate what the files hold (a study in

@@ -24,8 +24,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..._settings import Settings, option, takes
-from ..._validate import Real, params
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Real, params
 from ...errors import InputError, IntegrationError, VidiError
 from ..data.measurement import MAX_SAMPLES, Measurement
 from ..dynamics.reference import reference_simulate

@@ -8,8 +8,8 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..._printing import readable
-from ..._result import Result
+from ..._api._printing import readable
+from ..._api._result import Result
 from ...errors import InputError
 from .aggregate import run_rows
 from .config import StudyConfig

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..._io import load_json
+from ..._files._io import load_json
 
 __all__ = ["code_version"]
 

@@ -13,8 +13,8 @@ import shutil
 import time
 from pathlib import Path
 
-from ..._io import OutputDir, atomic_write_text, running, short, to_jsonable
-from ..._progress import tick
+from ..._api._progress import tick
+from ..._files._io import OutputDir, atomic_write_text, running, short, to_jsonable
 from ...errors import InputError
 from ...numerics.executor import make_executor
 from ..dynamics.warmup import compile_kernels

@@ -4,7 +4,7 @@ record -> :class:`Reference` (steady cycle, noise floor, measured state) ->
 :func:`evaluate` (simulate, align, criteria, consistency) -> :func:`verify`.
 """
 
-from ..._lazy import lazy_package
+from ..._startup._lazy import lazy_package
 
 # names are imported on first use: the criteria beside them stay cheap to import
 _EXPORTS = {

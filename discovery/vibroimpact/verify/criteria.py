@@ -27,8 +27,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._printing import fmt
-from ..._validate import Instance, params
+from ..._api._printing import fmt
+from ..._api._validate import Instance, params
 from ...errors import InputError, NoContactError
 from ...numerics import counts
 from ...numerics.intervals import in_widened_intervals

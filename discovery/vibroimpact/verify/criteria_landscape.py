@@ -22,11 +22,11 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from ..._printing import fmt, readable
-from ..._progress import reports_progress, tick
-from ..._result import Result
-from ..._settings import Settings, option, takes
-from ..._validate import Array, Instance, Real, params
+from ..._api._printing import fmt, readable
+from ..._api._progress import reports_progress, tick
+from ..._api._result import Result
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Array, Instance, Real, params
 from ...errors import InputError, VidiError, VidiTypeError
 from ...numerics.executor import make_executor
 from ..data.impulse import Impulse
@@ -410,7 +410,7 @@ def landscape(
         (default), else from the scenario's initial state.
     progress : callable or bool, optional
         ``progress(stage, done, total)`` after each row of the grid; None: a bar when the session is
-        interactive, False: none (:mod:`discovery._progress`).
+        interactive, False: none (:mod:`discovery._api._progress`).
     executor : Executor, optional
         Where the rows run (:mod:`discovery.numerics.executor`: serial, a process pool, a Dask
         cluster); overrides ``workers`` and is not closed here.  One task per row.

@@ -30,8 +30,8 @@ from enum import StrEnum
 
 import numpy as np
 
-from ..._printing import readable
-from ..._result import Result
+from ..._api._printing import readable
+from ..._api._result import Result
 from ...errors import InputError, IntegrationError
 from ...numerics import counts
 from ...numerics.memo import Memo, value_key

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._settings import Settings, option, takes
-from ..._validate import Real
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Real
 from ...errors import InputError
 from ..data.impulse import impulse_from_samples
 from .criteria import CRITERIA, evaluate_criteria

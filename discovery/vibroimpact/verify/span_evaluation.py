@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._validate import unchecked
+from ..._api._validate import unchecked
 from .block_farm import farm_for
 from .criteria import evaluate_criteria
 from .motion import fold_penetration, penetration_mean

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._validate import unchecked
+from ..._api._validate import unchecked
 from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
 from ..data.contact_edges import contact_onsets

@@ -5,10 +5,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..._printing import readable
-from ..._result import Result, part
-from ..._settings import Settings, option, takes
-from ..._validate import Real, params
+from ..._api._printing import readable
+from ..._api._result import Result, part
+from ..._api._settings import Settings, option, takes
+from ..._api._validate import Real, params
 from ..data.measurement import Measurement
 from ..dynamics import Tolerances
 from ..model.law import ForceLaw

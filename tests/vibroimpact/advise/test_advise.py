@@ -413,7 +413,7 @@ def test_a_tampered_fit_directory_is_one_line_or_read_as_far_as_it_goes(tmp_path
 def test_a_scenario_edited_after_the_fit_is_refused(tmp_path, capsys):
     """Issue 53: advise --fit re-read the fit's scenario file, so a file edited after the fit
     (m2 1e4 -> 2.5e4) gave advice for another machine without a word."""
-    from discovery._provenance import file_sha256
+    from discovery._files._provenance import file_sha256
 
     scenario = tmp_path / "machine.toml"
     scenario.write_text(load_scenario("paper").to_toml())

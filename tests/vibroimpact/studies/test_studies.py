@@ -350,7 +350,7 @@ def test_study_refuses_a_directory_that_is_not_a_study(tmp_path):
 def test_study_owns_its_directory_whatever_ran_before(tmp_path):
     """An earlier CLI command in the same process (here `vidi report`) does not make the API
     refuse a study directory as another command's results."""
-    from discovery._io import _RUN, set_run
+    from discovery._files._io import _RUN, set_run
 
     out = tmp_path / "s"
     study(

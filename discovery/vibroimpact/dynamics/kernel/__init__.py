@@ -90,10 +90,10 @@ Numba's cache: a cached function is stamped with its own source file only, and h
 function it calls or inlines from the other modules.  Importing the package therefore
 checks the sources of all its modules and of the shared Dormand-Prince blocks against the
 stamp their cache was made with, and drops the cache when any changed
-(:func:`discovery._compile.refresh`): an edit to one module recompiles the whole kernel, as
+(:func:`discovery._startup._compile.refresh`): an edit to one module recompiles the whole kernel, as
 it did when the kernel was one file.
 """
 
-from ...._compile import refresh
+from ...._startup._compile import refresh
 
 refresh("vibro-impact")

@@ -4,15 +4,15 @@ the parameter vector ``p``, and how the kernel's functions are compiled
 
 from numba import njit
 
-from ...._compile import borrowing_options
+from ...._startup._compile import borrowing_options
 from ....numerics._dopri import blocks
 
 # Every kernel function that allocates nothing takes its arrays borrowed: compiled without
 # numba's reference counting (``_nrt=False``, where this numba has the option:
-# :func:`~discovery._compile.borrowing_options`), a call passes its arrays without an atomic
-# increment and decrement of each one's count.  A function that allocates (the work arrays,
-# a contact mode's set-up) keeps the counts; numba refuses to compile an allocation in a
-# borrowing function.
+# :func:`~discovery._startup._compile.borrowing_options`), a call passes its arrays without an
+# atomic increment and decrement of each one's count.  A function that allocates (the work
+# arrays, a contact mode's set-up) keeps the counts; numba refuses to compile an allocation in
+# a borrowing function.
 borrowed_njit = njit(cache=True, **borrowing_options())
 
 # the shared Dormand-Prince blocks for this system's four states (w1, v1, w2, v2)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import html
 
-from .wording import interval_digits
+from ..wording import interval_digits
 
 __all__ = [
     "readable",

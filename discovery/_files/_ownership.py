@@ -7,9 +7,9 @@ import json
 import re
 from pathlib import Path
 
+from ..errors import InputError
 from ._jsonable import load_json
 from ._text import short
-from .errors import InputError
 
 MANIFEST = ".vidi-manifest.json"
 """The file in every result directory that lists what the run wrote (and which command):

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError, VidiTypeError
 from ._io import short
-from .errors import InputError, VidiTypeError
 
 __all__ = ["CsvRows", "read_csv_rows", "parse_column", "MAX_RECORD_BYTES"]
 

@@ -80,8 +80,8 @@ def resolve(progress, where="progress"):
         return None, False
     if callable(progress):
         return progress, False
+    from ..errors import VidiTypeError
     from ._validate import _received
-    from .errors import VidiTypeError
 
     raise VidiTypeError(
         f"{where}: progress must be None (automatic), True, False or a callable "

@@ -55,7 +55,7 @@ def reads_document(from_dict):
     Apply under ``@classmethod``."""
     import functools
 
-    from .errors import InputError, VidiError
+    from ..errors import InputError, VidiError
 
     @functools.wraps(from_dict)
     def read(cls, doc, *args, **kwargs):

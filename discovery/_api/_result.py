@@ -14,7 +14,7 @@ Every result the API returns (:class:`~discovery.VerifyResult`, :class:`~discove
   samples, a fitted estimator, the record itself) is ``None`` on a loaded result.  A loaded
   result keeps its document, so ``to_dict()`` gives it back unchanged.
 * Two results are equal when their documents are: ``from_dict(r.to_dict()) == r``.
-* ``r.save(dir)`` writes ``dir/summary.json`` through :class:`~discovery._io.OutputDir`
+* ``r.save(dir)`` writes ``dir/summary.json`` through :class:`~discovery._files._io.OutputDir`
   (staged, put in place whole or not at all); :func:`load` reads any saved result back as
   its own type.
 
@@ -29,9 +29,9 @@ import json
 from importlib import import_module
 from pathlib import Path
 
-from ._io import OutputDir, short, to_jsonable
-from ._jsonable import load_json
-from .errors import InputError
+from .._files._io import OutputDir, short, to_jsonable
+from .._files._jsonable import load_json
+from ..errors import InputError
 
 __all__ = ["SCHEMA_VERSION", "Result", "load", "load_summary", "part", "KINDS"]
 
@@ -170,7 +170,7 @@ class Result:
     # ---------------------------------------------------------------- files
     def save(self, directory):
         """Write ``directory/summary.json`` (the document), staged and put in place as a
-        whole (:class:`~discovery._io.OutputDir`); returns the directory's path."""
+        whole (:class:`~discovery._files._io.OutputDir`); returns the directory's path."""
         with OutputDir(directory) as out:
             self.write_into(out)
         return Path(directory)
@@ -303,7 +303,7 @@ def load(path):
     ...).  A summary written before results had a schema version is one
     :class:`~discovery.errors.InputError` saying so."""
     if not isinstance(path, str) and not hasattr(path, "__fspath__"):
-        from .errors import VidiTypeError
+        from ..errors import VidiTypeError
 
         raise VidiTypeError(
             f"load: path must be a result directory or a summary file; got {type(path).__name__}"

@@ -3,7 +3,7 @@
 Refused: a symbolic link (results never replace through a link), a file where a directory is
 expected or anything but a regular file where a file is, not writable, the current
 directory, an input file or a directory holding one, a directory holding another command's
-results (unless ``--overwrite``: :func:`~discovery._ownership.set_run`), a file that vidi
+results (unless ``--overwrite``: :func:`~discovery._files._ownership.set_run`), a file that vidi
 did not write (no ``X.summary.json`` sidecar naming the command) or another command's file,
 and a non-empty directory that is no vidi result at all."""
 
@@ -13,10 +13,10 @@ import re
 import secrets
 from pathlib import Path
 
+from ..errors import InputError
 from ._ownership import _RUN, _owner, _owner_file, _refuse_other_command
 from ._staging import _OWNED, _proc_start
 from ._text import short
-from .errors import InputError
 
 # names of the files a result directory may hold (an earlier result that may be replaced)
 _RESULT_FILE = re.compile(r"^[^/]+\.(json|csv|png|pdf|tex|txt|svg)$", re.IGNORECASE)

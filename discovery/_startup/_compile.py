@@ -8,7 +8,7 @@ from pathlib import Path
 
 __all__ = ["KERNELS", "cached", "refresh", "announce_compile", "borrowing_options"]
 
-_HERE = Path(__file__).parent
+_HERE = Path(__file__).parent.parent  # the package, discovery/
 KERNELS = {
     "vibro-impact": (
         _HERE / "vibroimpact" / "dynamics" / "kernel",

@@ -31,7 +31,7 @@ _PACKAGES = (
 
 
 def _project_root():
-    return Path(__file__).resolve().parent.parent
+    return Path(__file__).resolve().parents[2]
 
 
 def git_state(root=None, timeout=2.0):

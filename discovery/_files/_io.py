@@ -27,12 +27,13 @@ After the swap, every entry of the earlier directory that is not in its manifest
 notes, another record, a file dropped in while the run went on) is moved back into the new
 one (as ``NAME.kept`` when the new result uses its name), and only then is the earlier set
 removed.  :func:`check_output` (called by the commands before any work) refuses a target
-that is not safe to replace (:mod:`discovery._output_checks`).
+that is not safe to replace (:mod:`discovery._files._output_checks`).
 
 The other jobs live in small modules, their names re-exported here: provenance records
-(:mod:`discovery._provenance`), JSON values and files (:mod:`discovery._jsonable`), the
-command a result belongs to and its manifest (:mod:`discovery._ownership`), the names a run
-owns while it writes and atomic file writes (:mod:`discovery._staging`).
+(:mod:`discovery._files._provenance`), JSON values and files
+(:mod:`discovery._files._jsonable`), the command a result belongs to and its manifest
+(:mod:`discovery._files._ownership`), the names a run owns while it writes and atomic file
+writes (:mod:`discovery._files._staging`).
 """
 
 import contextlib
@@ -43,6 +44,7 @@ import shutil
 from importlib import metadata
 from pathlib import Path
 
+from ..errors import InputError
 from ._jsonable import load_json as load_json
 from ._jsonable import to_jsonable
 from ._output_checks import check_output
@@ -61,7 +63,6 @@ from ._staging import (
 )
 from ._staging import _proc_start as _proc_start
 from ._text import short
-from .errors import InputError
 
 __all__ = [
     "OutputDir",

@@ -4,7 +4,7 @@ A public function with more options than a signature should carry takes them as 
 (``discover(scenario, record, library="poly:3", shortlist=4)``) or as one object
 (``discover(scenario, record, settings=DiscoverSettings(library="poly:3"))``), or both: the
 keywords then override the object's fields.  The object is a frozen dataclass derived from
-:class:`Settings`; each field declares its default and the spec of :mod:`discovery._validate`
+:class:`Settings`; each field declares its default and the spec of :mod:`discovery._api._validate`
 that checks it (:func:`option`).
 
 * :meth:`Settings.of` merges an object and keywords for a function: an unknown keyword is one
@@ -27,9 +27,9 @@ import dataclasses
 import difflib
 import functools
 
-from ._jsonable import reads_document
+from .._files._jsonable import reads_document
+from ..errors import VidiTypeError
 from ._validate import _received, check
-from .errors import VidiTypeError
 
 __all__ = ["Settings", "option", "takes", "options_of"]
 
@@ -144,7 +144,7 @@ class Settings:
 
     def to_dict(self):
         """A JSON-safe ``{name: value}`` of every field."""
-        from ._io import to_jsonable
+        from .._files._io import to_jsonable
 
         def plain(v):
             return dataclasses.asdict(v) if dataclasses.is_dataclass(v) else v

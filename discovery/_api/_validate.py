@@ -20,7 +20,7 @@ import numbers
 
 import numpy as np
 
-from .errors import InputError, VidiTypeError
+from ..errors import InputError, VidiTypeError
 
 __all__ = ["Real", "Choice", "Text", "Array", "Instance", "check", "params", "unchecked"]
 
@@ -167,7 +167,7 @@ def _describe(spec):
 
 
 def _a(name):
-    from .wording import a
+    from ..wording import a
 
     return a(name)
 
@@ -212,7 +212,7 @@ def _binder(signature):
     ps = list(signature.parameters.values())
     if any(p.kind == kinds.VAR_POSITIONAL for p in ps):
         return lambda args, kwargs: None
-    # the ``**options`` of a function that takes settings (discovery._settings)
+    # the ``**options`` of a function that takes settings (discovery._api._settings)
     rest = next((p.name for p in ps if p.kind == kinds.VAR_KEYWORD), None)
     ps = [p for p in ps if p.kind != kinds.VAR_KEYWORD]
     positional = [
