@@ -425,6 +425,33 @@ def test_two_systems_on_a_shared_floor():
     )
 
 
+def test_the_package_root_holds_its_public_layer():
+    """The root of ``discovery`` shows the public layer at a glance: its modules are public
+    (no ``_`` name), and the private infrastructure lives in private packages by job
+    (``_api``: results, settings, checks, printing, progress; ``_files``: files in and out;
+    ``_startup``: lazy names, the compiled kernels' cache). Their ``__init__`` files import
+    nothing; none of them reaches a system, the shared floor or a layer above, and the file
+    and start-up layers do not reach the API's machinery."""
+    private = sorted(p.name for p in (ROOT / "discovery").glob("_*.py") if p.name != "__init__.py")
+    assert not private, private
+    graph = _graph()
+    layers = ["discovery._api", "discovery._files", "discovery._startup"]
+    assert all((ROOT.joinpath(*p.split(".")) / "__init__.py").is_file() for p in layers)
+    assert not [p for p in layers if graph[p]], "a private package's __init__ imports"
+    above = (
+        "discovery.vibroimpact",
+        "discovery.ueda",
+        "discovery.numerics",
+        "discovery.cli",
+        "discovery.warm",
+        "discovery.parallel",
+        "discovery.reporting",
+        "reports",
+    )
+    assert not _crossings(graph, layers, above)
+    assert not _crossings(graph, ["discovery._files", "discovery._startup"], ("discovery._api",))
+
+
 def test_the_package_draws_no_figures():
     """The systems (studies included) reach no report module: figures and documents are the
     report layer's, which the CLI calls (a study is handed its drawer)."""
