@@ -4,6 +4,8 @@ alone as the baseline, and the trials judged; the winner polished with the full 
 
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from ...errors import InputError, IntegrationError
 from ...numerics.executor import map_on
 from ..model.law import Term
@@ -31,6 +33,22 @@ def _extend(model, eff, value):
 _LADDER = tuple(2.0**k for k in range(13))
 
 
+def _side(guess, lo):
+    """-1 where the parameter may be negative (``lo < 0``, an offset) and its LM direction
+    ``guess`` points there, else 1."""
+    return -1.0 if lo < 0 and guess is not None and guess < 0 else 1.0
+
+
+def _usable(guess, lo):
+    """Whether an LM direction is a start: finite, non-zero and above the lower bound."""
+    return guess is not None and np.isfinite(guess) and guess != 0 and guess > lo
+
+
+def _within(value, share, lo, hi):
+    """``value`` clipped to ``share`` of the way to each bound."""
+    return min(max(value, share * lo), share * hi)
+
+
 @dataclass(frozen=True)
 class _Refits:
     """How a screening refit runs (the executor's context: the records stay in the forked
@@ -56,12 +74,15 @@ class _Refits:
         the certified regression (:func:`_regressed`) with the effect: for a term effect
         the regression on the extended term set; for any other, the regression on the
         current terms (on the loading samples alone for an effect on the unloading branch)
-        with the effect's value from a ladder (its small step times 1, 4, ... 4096, within
-        its bounds)."""
+        with the effect's value from a ladder (its small step times 1, 2, ... 4096, within
+        its bounds).  A parameter of either sign (an offset) starts, and climbs its
+        ladder, on the side of its LM direction: from the positive side a refit toward a
+        negative offset stopped short of zero on a noisy record (survey draw 26)."""
         problem, regress = self.problem, self.regress
-        h = _small_step(eff, self.records)
-        hi = eff.parameters[0].bounds[1]
-        cands = [_extend(model, eff, min(guess if guess and guess > 0 else h, 0.5 * hi))]
+        lo, hi = eff.parameters[0].bounds
+        # a two-sided parameter (an offset) starts on the side its LM direction points to
+        h = _small_step(eff, self.records) * _side(guess, lo)
+        cands = [_extend(model, eff, _within(guess if _usable(guess, lo) else h, 0.5, lo, hi))]
         if eff.target == "term":
             names = list(model.law.names) + [Term.parse(eff.key).name]
             reg = _regressed(model.with_effect(eff, 0.0), names, regress)
@@ -73,7 +94,7 @@ class _Refits:
                 model, model.law.names, regress, loading=eff.target in ("unloading", "set")
             )
             if reg is not None:
-                values = sorted({min(h * f, 0.9 * hi) for f in _LADDER})
+                values = sorted({_within(h * f, 0.9, lo, hi) for f in _LADDER})
                 cands += [_extend(reg, eff, v) for v in values]
         ranked = (
             [cands[0]]
@@ -98,7 +119,7 @@ class _Refits:
                 best = res
         if best is not None:
             return best.law, best
-        starts = ranked[1:2] + [_extend(model, eff, min(h, 0.5 * hi))]
+        starts = ranked[1:2] + [_extend(model, eff, _within(h, 0.5, lo, hi))]
         for i, start in enumerate(starts):
             try:
                 res = _output_error(

@@ -222,3 +222,38 @@ def test_vidi_explain_passes_the_calibrations_lag():
     }
     assert machine_known({"used": "sheet", "parameters": {"force_lag": lag}}) is None
     assert machine_known({"used": "record", "parameters": {"m1": {"record": 1.0}}}) is None
+
+
+def test_an_offset_refit_starts_on_the_side_its_direction_points_to(paper, monkeypatch):
+    """Survey draw 26 (slow transient, offset -46 um, the noisier record, the sheet 5 % off):
+    the offset's LM direction pointed below zero, but its refit started from a small
+    positive offset, stopped at +0.95 um and nothing was named (I2 0.61).  Started on the
+    direction's side it reaches the truth (I2 0.061, consistent).  A one-sided parameter
+    still starts above its lower bound whatever its direction."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.explain import trials
+    from discovery.vibroimpact.explain.effects import Model, effect
+
+    starts = []
+
+    def fake_fit(records, start, *a, **k):
+        starts.append(start)
+        return SimpleNamespace(law=start, value=1.0)
+
+    monkeypatch.setattr(trials, "_small_step", lambda eff, records: 1e-6)
+    monkeypatch.setattr(trials, "_output_error", fake_fit)
+    monkeypatch.setattr(trials, "best_of", lambda *a, **k: (None, np.inf))
+    refits = trials._Refits(problem=None, records=[], criterion="I2", budget=4, tolerances=None)
+    model = Model(paper.law)
+    offset, coupling = effect("contact_offset"), effect("penetration_velocity_coupling")
+    refits.refit(model, offset, -2.5e-5)
+    refits.refit(model, offset, None)
+    refits.refit(model, offset, 3e-5)
+    refits.refit(model, coupling, -4e9)
+    got = [s.value(e) for s, e in zip(starts, (offset, offset, offset, coupling), strict=True)]
+    assert got == [-2.5e-5, 1e-6, 3e-5, 1e-6]
+    # its bounds hold the start: half the way to each; a direction past them is no start
+    refits.refit(model, offset, -0.9)
+    refits.refit(model, offset, -5.0)
+    assert [s.value(offset) for s in starts[-2:]] == [-0.5, -1e-6]
