@@ -65,12 +65,11 @@ from .result import ExplainResult, Iteration
 from .screening import _Screening
 from .separability import _separability
 from .starts import (
+    Regressions,
     _fit_start,
-    _joined_samples,
     _output_error,
     _records_of,
     _regressed,
-    _regression,
     start_law,
 )
 from .state import _Run
@@ -549,7 +548,7 @@ def explain(
     problem = _Problem(records, s.tolerances)
     plain = [m for m in ms if not isinstance(m, Reference)]
     all_plain = len(plain) == len(ms)
-    samples = _joined_samples([sc for sc, _ in records], plain) if all_plain else None
+    regress = Regressions([sc for sc, _ in records], plain) if all_plain else None
     run = _Run(
         problem=problem,
         records=records,
@@ -559,11 +558,7 @@ def explain(
         budget=budget,
         tolerances=s.tolerances,
         drift=None,
-        regress=(
-            (lambda names, loading=False: _regression(names, samples, loading))
-            if samples is not None
-            else None
-        ),
+        regress=regress,
         workers=s.workers,
         executor=executor,
         max_refits=s.max_refits,
@@ -573,7 +568,7 @@ def explain(
     # the sequential fits (the start's, the winner's polish, the verifications) share out
     # each evaluation's blocks over the workers the screening refits use
     with shared_blocks([r for _, r in records], block_workers(s.workers, executor)):
-        fit = _fit_start(run, start, plain if all_plain else None, progress)
+        fit, start_note = _fit_start(run, start, plain if all_plain else None, progress)
         if not any(isinstance(m, Reference) for m in ms):
             run.drift = _Drift(pairs, records)
         run.model, run.uncertainties = Model(fit.law), dict(fit.standard_errors)
@@ -616,6 +611,7 @@ def explain(
                 "intervals": {"replicates": s.n_boot_intervals, "refit": s.interval_refit},
                 "records": len(records),
                 "known": dict(s.known or {}),
+                "start_note": start_note,
                 "simulations": problem.n_sim,
             },
         )

@@ -196,6 +196,8 @@ class ExplainResult(Result):
             + ": "
             f"{'consistent' if self.consistent else 'NOT consistent'} with the record(s)"
         ]
+        if (self.settings or {}).get("start_note"):
+            out.append(f"  start: {self.settings['start_note']}")
         for eid, value in (self.settings or {}).get("known", {}).items():
             kept = eid in named
             out.append(

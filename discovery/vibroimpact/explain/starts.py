@@ -118,16 +118,19 @@ def _physical(names, records):
     return ForceLaw(tuple(terms), tuple(record_start(*records[0], terms)))
 
 
-def _joined_samples(scenarios, measurements, by_force=False):
+def _joined_samples(scenarios, measurements, by_force=False, contacts=None):
     """The contact samples of every record joined (None without positions in every
     record): built once per run, for every regression of the force on a term list.  Contact
     is where the penetration stands above its noise, or with ``by_force`` (where too few
     samples do: a stiff contact's penetration a few noise deviations deep) where the force
     does.  Such a regression sees a penetration mostly noise, so its spring is biased low
-    (errors in the variables): a start to try, not a law to restart the loop's refits from."""
+    (errors in the variables): a start to try, not a law to restart the loop's refits from.
+    ``contacts``: the ways of telling contact tried in turn (overrides ``by_force``)."""
     from ..data.samples import contact_samples, join_samples
 
-    for contact in ("penetration", "force") if by_force else ("penetration",):
+    if contacts is None:
+        contacts = ("penetration", "force") if by_force else ("penetration",)
+    for contact in contacts:
         try:
             return join_samples(
                 [
@@ -140,22 +143,26 @@ def _joined_samples(scenarios, measurements, by_force=False):
     return None
 
 
-def _regression(names, samples, loading=False):
+def _regression(names, samples, loading=False, shift=0.0):
     """The certified regression of the force on exactly these terms over ``samples``
     (:func:`_joined_samples`; None without them, or when the regression fails); with
     ``loading``, on the loading samples (``dzeta > 0``) alone, which an unloading branch
-    or a set leaves as they are."""
+    or a set leaves as they are; with a ``shift`` (a contact offset), on the penetration
+    beyond it (the force's argument is the recorded penetration less the offset)."""
     from ..fit.regression import ConstrainedSparseRegressor
 
     if samples is None:
         return None
     try:
+        zeta = samples.zeta - shift
         keep = samples.dzeta > 0 if loading else np.ones(len(samples), dtype=bool)
+        if shift:
+            keep &= zeta > 0
         if np.count_nonzero(keep) < 10 * len(names):
             return None
         est = ConstrainedSparseRegressor(library=",".join(names), max_terms=len(names))
         est.fit(
-            samples.X[keep],
+            np.column_stack([zeta, samples.dzeta])[keep],
             samples.F[keep],
             groups=samples.impact[keep],
             sample_weight=samples.weight[keep],
@@ -172,16 +179,40 @@ def _regression(names, samples, loading=False):
     return ForceLaw(tuple(terms), tuple(float(coef[t.name]) for t in terms))
 
 
-def _regressed(model, names, regress, loading=False):
+class Regressions:
+    """The certified regressions of one run's records (:func:`_regression`), called as
+    ``regress(names, loading=False, shift=0.0)``: over the samples whose penetration
+    stands above its noise, or with a ``shift`` (a contact offset) over those the force
+    says are in contact, since an offset moves the recorded penetration's zero (a record
+    whose contacts start 0.88 mm below it has no samples by penetration; survey draw 6).
+    A call returns None where the records have no such samples."""
+
+    def __init__(self, scenarios, measurements):
+        self.scenarios, self.measurements = scenarios, measurements
+        self.samples = _joined_samples(scenarios, measurements)
+        self._by_force = None
+
+    def __call__(self, names, loading=False, shift=0.0):
+        if not shift:
+            return _regression(names, self.samples, loading)
+        if self._by_force is None:
+            self._by_force = (
+                _joined_samples(self.scenarios, self.measurements, contacts=("force",)) or False
+            )
+        return _regression(names, self._by_force or None, loading, shift)
+
+
+def _regressed(model, names, regress, loading=False, shift=0.0):
     """``model`` with every loading coefficient from the certified regression of the
     measured force on the terms ``names`` (its unloading branch and added effects kept);
     None when the records have no positions or the regression fails.  The regression sees
     the force against the measured penetration alone, so a start law that has compensated
     for a missing effect with its coefficients (a stiffer spring for a Hertz term or for
-    stiffening supports) does not hold the refit in its basin."""
+    stiffening supports) does not hold the refit in its basin.  ``shift``: the penetration
+    the force starts from (a contact offset's, :func:`_regression`)."""
     if regress is None:
         return None
-    fit = regress(list(names), loading)
+    fit = regress(list(names), loading, shift)
     if fit is None:
         return None
     law = model.law
@@ -264,13 +295,13 @@ def _fallbacks(preferred, others, problem, criterion):
     yield from sorted(others, key=lambda law: problem.value(Model(law), criterion))[:3]
 
 
-def _without_force(fit, records):
-    """Whether the fitted law's simulated contacts carry little force (a peak under
+def _without_force(evaluations, records):
+    """Whether the simulated contacts of a law's ``evaluations`` carry little force (a peak under
     :data:`WEAK_FORCE` of the measured one) in some record.  Where no start reproduces the
     contacts' timing (a short contact whose onset moves with a missing effect), a law
     without force is the least squares' nearest point (the relative L1 distance 1, where a
     force at the wrong time gives up to 2), and no effect's refit leaves it."""
-    for ev, (_, ref) in zip(fit.evaluations, records, strict=False):
+    for ev, (_, ref) in zip(evaluations, records, strict=False):
         sim = ev.simulated
         if sim is None or not len(sim.F):
             continue
@@ -292,13 +323,16 @@ def _fit_start(run, start, plain, progress):
     contacts (:func:`_without_force`).  Which of several poor starts (I2 near or above 1, a
     short contact's timing not matched) leads the loop to the missing effect is not told
     by their criterion: on the effects survey, taking the best of them instead named the
-    effect as often and lost other draws."""
+    effect as often and lost other draws.  Where no fit stays physical, the best of the
+    candidates as drawn (:func:`_unfitted`).  Returns ``(fit, note)``: the note says why
+    the start is not fitted ("" when it is)."""
     records, criterion, budget, tolerances = run.records, run.criterion, run.budget, run.tolerances
     preferred, others = (
         ([start], []) if isinstance(start, ForceLaw) else _start_candidates(start, records, plain)
     )
-    fit, why = None, ""
+    fit, why, tried = None, "", []
     for law in _fallbacks(preferred, others, run.problem, criterion):
+        tried.append(law)
         try:
             # the start is fitted cycle by cycle (each cycle from the machine's state before
             # it): over several cycles a law can trade its spring against the missing
@@ -311,17 +345,51 @@ def _fit_start(run, start, plain, progress):
             if min(got.law.coefficients) < 0:
                 why = f"the fit from {law} reached {got.law}, with a negative coefficient"
                 continue
-            if _without_force(got, records):
+            if _without_force(got.evaluations, records):
                 why = f"the fit from {law} reached {got.law}, whose contacts carry no force"
                 continue
             fit = got
             break
         except IntegrationError as exc:
             why = str(exc)
-    if fit is None:
+    if fit is not None:
+        return fit, ""
+    law = _unfitted(run, tried)
+    if law is None:
         raise IntegrationError(
             f"no start law for {start!r} has a periodic steady state with "
             f"contact for the record ({why}); give --start as a law with "
             "coefficients closer to the record"
         )
-    return fit
+    return _Drawn(law), (
+        f"no fit of a start law stayed physical ({why}); the loop began from {law}, "
+        "drawn from the record and not fitted"
+    )
+
+
+class _Drawn:
+    """A start law taken as drawn from the record (no fit, no standard errors)."""
+
+    def __init__(self, law):
+        self.law, self.standard_errors = law, {}
+
+
+def _unfitted(run, laws):
+    """The law of ``laws`` (the start candidates tried) with the lowest criterion whose
+    simulation has force in its contacts in every record, unfitted; None when none has.
+    Where every fit of a start left physics, the start is not the model to explain but
+    where the loop's refits begin: on survey draw 6 (a contact offset of -0.88 mm, the
+    recorded positions shifted by it) every fit from a law without the offset ran to a
+    negative spring, and the loop named the offset from the true law's start (I2 1.04 ->
+    0.025, consistent)."""
+    best, value = None, np.inf
+    for law in laws:
+        model = Model(law)
+        try:
+            evs = run.problem.evaluations(model)
+            v = run.problem.value(model, run.criterion)
+        except (IntegrationError, InputError):
+            continue
+        if v < value and not _without_force(evs, run.records):
+            best, value = law, v
+    return best

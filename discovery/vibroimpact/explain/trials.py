@@ -88,6 +88,12 @@ class _Refits:
             reg = _regressed(model.with_effect(eff, 0.0), names, regress)
             if reg is not None:
                 cands.append(reg)
+        elif eff.key == "offset":
+            # the force starts at the offset: the law regressed beyond each rung's
+            for v in sorted({_within(h * f, 0.9, lo, hi) for f in _LADDER}):
+                reg = _regressed(model, model.law.names, regress, shift=v)
+                if reg is not None:
+                    cands.append(_extend(reg, eff, v))
         else:
             # an effect on the unloading branch leaves the loading samples as they are
             reg = _regressed(

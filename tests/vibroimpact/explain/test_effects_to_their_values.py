@@ -257,3 +257,47 @@ def test_an_offset_refit_starts_on_the_side_its_direction_points_to(paper, monke
     refits.refit(model, offset, -0.9)
     refits.refit(model, offset, -5.0)
     assert [s.value(offset) for s in starts[-2:]] == [-0.5, -1e-6]
+
+
+@pytest.fixture(scope="module")
+def deep_offset():
+    """Survey draw 6, the noisier record (force noise 2 % of its peak, motion noise 0.4 % of
+    each channel's range): the position sensors' zeros differ by -0.88 mm, about a typical
+    penetration, so the recorded penetration never stands above its noise in contact."""
+    from tests import survey_effects as S
+
+    seed = 3006
+    case, law = S._base_case("p1", seed)
+    true_sc, true, lag, _ = S._sizes(case, law, "contact_offset", np.random.default_rng(seed))
+    rec = S._record(true_sc, true, lag, S.NOISE["high"], seed, case)
+    return case.scenario.with_law(law), true, true_sc.offset, rec
+
+
+def test_an_offset_regression_reads_the_force_beyond_the_offset(deep_offset):
+    """The certified regression beyond an offset takes the samples the force says are in
+    contact and the penetration less the offset: the true law to 8 % at the true offset,
+    where no sample's penetration stands above its noise and half the offset gives a spring
+    three times too stiff."""
+    from discovery.vibroimpact.explain.starts import Regressions
+
+    sc, true, d0, rec = deep_offset
+    regress = Regressions([sc], [rec])
+    assert regress(["z", "zd"]) is None
+    at = regress(["z", "zd"], shift=d0)
+    assert at.coefficients == pytest.approx(true.coefficients, rel=0.1)
+    assert regress(["z", "zd"], shift=d0 / 2).coefficients[0] > 2 * true.coefficients[0]
+
+
+@pytest.mark.slow
+def test_explain_names_an_offset_no_start_fits_without(deep_offset):
+    """Every fit of a start law without the offset ran to a negative spring, and explain
+    stopped with "no start law ... has a periodic steady state".  The loop now begins from
+    the best start as drawn from the record (and says so), and names the offset from its
+    regression beyond each rung of the offset's ladder: the offset and the law to 1 %."""
+    sc, true, d0, rec = deep_offset
+    res = explain(sc, rec, "linear", n_boot_intervals=0)
+    assert "drawn from the record and not fitted" in str(res)
+    assert [it.effect for it in res.iterations][:1] == ["contact_offset"]
+    assert res.consistent
+    assert res.final_model.scenario["offset"] == pytest.approx(d0, rel=0.01)
+    assert res.final_model.law.coefficients == pytest.approx(true.coefficients, rel=0.01)
