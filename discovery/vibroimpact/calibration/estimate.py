@@ -18,12 +18,17 @@ test function vanishes at the onset's force jump (unbiased whatever the sampling
 whole impulse (tighter where the force's noise dominates, biased where a jump falls between
 the same two samples every period).  Where the two agree within :data:`AGREE` combined
 standard errors the tighter one is used, else the first; the intervals span both.
+
+The bootstrap's replicates are the same fit on the drawn windows; they are fitted together,
+each window weighted by how often its replicate draws it (:mod:`.batched`: 0.52 s of
+per-replicate fits in a calibration of a 30-period record down to 0.07 s).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
+from . import batched
 from .equations import FRAME_TERMS
 
 __all__ = [
@@ -126,9 +131,14 @@ def _force_windows(rows, anchored, force_on):
     contacts' own where there are enough (see :attr:`~.equations.MachineRows.anchored`),
     ``force_on`` is ``"contacts"`` and no record's force is a lagging sensor's (``lagged``),
     else the evenly spread ones (those of the balance)."""
+    return anchored if _on_contacts(rows, anchored.sum(), force_on) else ~anchored
+
+
+def _on_contacts(rows, n_anchored, force_on):
+    """Whether the force's equations are on the contacts' own windows (:func:`_force_windows`)
+    where ``n_anchored`` of them are taken."""
     lagged = any(r.lagged for r in rows)
-    contacts = force_on == "contacts" and not lagged and anchored.sum() >= MIN_ANCHORED
-    return anchored if contacts else ~anchored
+    return force_on == "contacts" and not lagged and n_anchored >= MIN_ANCHORED
 
 
 def _force_rates(rows, pick, force_on):
@@ -300,7 +310,7 @@ def _bootstrapped(rows, held, draws, force_on):
     if not draws:
         nan = np.full(value.size, np.nan)
         return value, nan, nan
-    boot = np.array([_fit(rows, held, pick, weights, force_on)[0] for pick in draws])
+    boot = _boot_fits(rows, held, draws, weights, force_on)[0]
     low, high = np.nanpercentile(boot, [2.5, 97.5], axis=0)
     return value, low, high
 
@@ -314,9 +324,44 @@ def force_lag(rows, fixed, draws, force_on="even"):
     _, weights, tau = _fit(rows, held, force_on=force_on, lag=True)
     if not draws:
         return tau, np.nan, np.nan
-    boot = np.array([_fit(rows, held, pick, weights, force_on, lag=True)[2] for pick in draws])
+    boot = _boot_fits(rows, held, draws, weights, force_on, lag=True)[1]
     low, high = np.nanpercentile(boot, [2.5, 97.5])
     return tau, float(low), float(high)
+
+
+def _row_counts(rows, draws):
+    """How often each replicate of ``draws`` takes each window of ``rows`` (stacked in
+    their order): ``(B, windows)``."""
+    offsets = np.cumsum([0, *(r.n_windows for r in rows)])
+    n = int(offsets[-1])
+    flat = np.concatenate(
+        [b * n + offsets[k] + p for b, one in enumerate(draws) for k, p in enumerate(one)]
+    )
+    return np.bincount(flat, minlength=len(draws) * n).reshape(len(draws), n).astype(float)
+
+
+def _boot_fits(rows, held, draws, weights, force_on, *, lag=False):
+    """Each draw's :func:`_fit` with the full fit's ``weights``, all at once
+    (:func:`.batched.fits`): ``(theta, tau)``, ``(B, P)`` and ``(B,)`` (zeros without
+    ``lag``).  A draw whose force's equations fall on the other kind of windows (too few
+    contacts drawn, see :func:`_force_windows`) or whose batched fit is degenerate is
+    fitted alone by :func:`_fit`."""
+    counts = _row_counts(rows, draws)
+    anchored = np.concatenate([r.anchored for r in rows])
+    contacts = _on_contacts(rows, anchored.sum(), force_on)
+    force = anchored if contacts else ~anchored
+    blocks, h = _blocks(rows, None, force_on), held
+    if lag:
+        blocks = _with_lag_column(blocks, _force_rates(rows, None, force_on))
+        h = np.append(held, np.nan)
+    theta, ok = batched.fits(
+        blocks, (counts[:, force], counts[:, ~anchored]), h, weights, rounds=ROUNDS, lag=lag
+    )
+    ok &= np.array([_on_contacts(rows, k, force_on) == contacts for k in counts @ anchored])
+    for b in np.flatnonzero(~ok):
+        th, _, tau = _fit(rows, held, draws[b], weights, force_on, lag=lag)
+        theta[b] = np.append(th, tau) if lag else th
+    return (theta[:, :-1], theta[:, -1]) if lag else (theta, np.zeros(len(draws)))
 
 
 def frame_residual(rows, theta_frame):
