@@ -245,23 +245,26 @@ def _law_refit(run, model, budget, *, polish=False):
     return res, after, evs
 
 
-def _refit_trials(run, step, screen_budget, gap):
+def _refit_trials(run, step, screen_budget, gap, chosen=None):
     """Every chosen effect (the screening's ranked ones, at most ``run.max_refits``) refitted
     with ``screen_budget`` simulations and checked (physical, within its bounds), and the
     law refitted alone with the same budget (:func:`_law_start`): the refits of the force
     history, the law's among them, run in parallel (the law's last, so one process does
     them in the order written), the drift channel here.  Returns ``(trials, baseline)``,
     ``baseline`` is ``(fit, criteria, evaluations)`` of the law refitted alone, or three
-    Nones when that refit fails or is not physical (:func:`~.judging.physical`)."""
+    Nones when that refit fails or is not physical (:func:`~.judging.physical`).  Given
+    the score entries ``chosen``, those effects are refitted and the law is not."""
     model, records, before = run.model, run.records, step.before
-    chosen = step.screening.ranked[: run.max_refits]
+    refit_law = chosen is None
+    if refit_law:
+        chosen = step.screening.ranked[: run.max_refits]
     eff_by_id = step.screening.by_id
     jobs = [
         (model, s["effect"], s.get("direction"))
         for s in chosen
         if "drift" not in eff_by_id[s["effect"]].phases
     ]
-    law_start = _law_start(run)
+    law_start = _law_start(run) if refit_law else None
     if law_start is not None:
         jobs.append((law_start, None, None))
     out = _screen(
