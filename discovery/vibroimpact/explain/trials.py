@@ -245,25 +245,12 @@ def _law_refit(run, model, budget, *, polish=False):
     return res, after, evs
 
 
-def _refit_trials(run, step, screen_budget, gap, chosen=None):
-    """Every chosen effect (the screening's ranked ones, at most ``run.max_refits``) refitted
-    with ``screen_budget`` simulations and checked (physical, within its bounds), and the
-    law refitted alone with the same budget (:func:`_law_start`): the refits of the force
-    history, the law's among them, run in parallel (the law's last, so one process does
-    them in the order written), the drift channel here.  Returns ``(trials, baseline)``,
-    ``baseline`` is ``(fit, criteria, evaluations)`` of the law refitted alone, or three
-    Nones when that refit fails or is not physical (:func:`~.judging.physical`).  Given
-    the score entries ``chosen``, those effects are refitted and the law is not."""
-    model, records, before = run.model, run.records, step.before
-    refit_law = chosen is None
-    if refit_law:
-        chosen = step.screening.ranked[: run.max_refits]
-    eff_by_id = step.screening.by_id
-    jobs = [
-        (model, s["effect"], s.get("direction"))
-        for s in chosen
-        if "drift" not in eff_by_id[s["effect"]].phases
-    ]
+def _refits_and_baseline(run, chosen, screen_budget, refit_law):
+    """The screening refits of the ``chosen`` score entries (:func:`_screen`) and, with
+    ``refit_law``, the law refitted alone in the same batch (the last job): ``(refits,
+    baseline)``, ``baseline`` as :func:`_refit_trials` returns it."""
+    model, records = run.model, run.records
+    jobs = [(model, s["effect"], s.get("direction")) for s in chosen]
     law_start = _law_start(run) if refit_law else None
     if law_start is not None:
         jobs.append((law_start, None, None))
@@ -286,6 +273,29 @@ def _refit_trials(run, step, screen_budget, gap, chosen=None):
         if error is None and physical(law, model, records):
             after, _ = _with_drift(_mean(evs, "criteria"), {}, run.drift, law)
             baseline = (res, after, evs)
+    return out, baseline
+
+
+def _refit_trials(run, step, screen_budget, gap, chosen=None):
+    """Every chosen effect (the screening's ranked ones, at most ``run.max_refits``) refitted
+    with ``screen_budget`` simulations and checked (physical, within its bounds), and the
+    law refitted alone with the same budget (:func:`_law_start`): the refits of the force
+    history, the law's among them, run in parallel (the law's last, so one process does
+    them in the order written), the drift channel here.  Returns ``(trials, baseline)``,
+    ``baseline`` is ``(fit, criteria, evaluations)`` of the law refitted alone, or three
+    Nones when that refit fails or is not physical (:func:`~.judging.physical`).  Given
+    the score entries ``chosen``, those effects are refitted and the law is not."""
+    model, records, before = run.model, run.records, step.before
+    refit_law = chosen is None
+    if refit_law:
+        chosen = step.screening.ranked[: run.max_refits]
+    eff_by_id = step.screening.by_id
+    out, baseline = _refits_and_baseline(
+        run,
+        [s for s in chosen if "drift" not in eff_by_id[s["effect"]].phases],
+        screen_budget,
+        refit_law,
+    )
     refits = iter(out)
     trials = []
     for s in chosen:
