@@ -408,7 +408,7 @@ def evaluate(
     observe : callable, optional
         An observation model ``Impulse -> Impulse`` applied to the exact simulated force
         history before it is aligned and sampled (e.g. the force sensor's own dynamics,
-        :mod:`discovery.vibroimpact.explain.effects`).
+        :func:`~discovery.vibroimpact.verify.sensors.observation`).
     smooth_onset : bool
         For a record span: the simulated sample whose interval holds a contact onset is
         the force averaged over that interval (see

@@ -16,6 +16,7 @@ from ..model.scenario import Scenario, scale_bounds
 from .criteria import criteria_lines
 from .evaluation import Evaluation, evaluate
 from .reference import Reference
+from .sensors import observation
 
 __all__ = ["VerifyResult", "VerifySettings", "verify"]
 
@@ -225,9 +226,10 @@ SCALE_EVALUATIONS = 12
 SCALE_XTOL = 1e-4
 
 
-def _profiled_scale(scenario, law, ref, bounds, tolerances):
+def _profiled_scale(scenario, law, ref, bounds, how):
     """The scenario scaled within ``bounds`` to fit ``law`` best (I2 of the record,
-    bounded Brent), and a note saying where."""
+    bounded Brent; ``how``: :func:`evaluate`'s tolerances and observation model), and a
+    note saying where."""
     from scipy.optimize import minimize_scalar
 
     lo, hi = scale_bounds(bounds, "verify: machine_scale")
@@ -236,9 +238,7 @@ def _profiled_scale(scenario, law, ref, bounds, tolerances):
     def i2(factor):
         if factor in seen:
             return seen[factor]
-        ev = evaluate(
-            scenario.scaled(factor), law, ref, tolerances=tolerances, floor=False, smooth_onset=True
-        )
+        ev = evaluate(scenario.scaled(factor), law, ref, floor=False, smooth_onset=True, **how)
         v = ev.criteria.get("I2") if ev.status == "ok" and ev.criteria else None
         seen[factor] = float(v) if v is not None and np.isfinite(v) else 1e3
         return seen[factor]
@@ -268,6 +268,7 @@ class VerifySettings(Settings):
     check_default_start: bool = option(True, (bool, np.bool_))
     tolerances: object = option(None, (Tolerances, None))
     machine_scale: object = option(None, (tuple, list, None))
+    sensor_lag: float = option(0.0, Real(0.0, 5e-3))
 
 
 @takes(VerifySettings)
@@ -302,6 +303,11 @@ def verify(scenario, measurement, law, *, settings=None, **options):
         :data:`SCALE_EVALUATIONS` simulations at most): the record fixes the machine's
         ratios from its motions, its scale only through the force's quadrature, and a
         stiff machine's verdict can turn on a fraction of a percent of it.
+    sensor_lag : float
+        A force sensor's time constant [s] (a calibration's ``force_lag``): the simulated
+        force is compared with the record as the sensor sees it (``tau F' + F = F_true``,
+        :func:`~discovery.vibroimpact.verify.sensors.first_order_lag`); 0 (the default):
+        the record's force is the contact force.
 
     Returns
     -------
@@ -317,13 +323,20 @@ def verify(scenario, measurement, law, *, settings=None, **options):
         )
     )
     scenario, notes = _shedding(scenario, ref)
+    observe = observation({"sensor_lag": s.sensor_lag} if s.sensor_lag else None)
+    if observe is not None:
+        notes.append(
+            f"the simulated force is compared as a force sensor with a lag of "
+            f"{s.sensor_lag * 1e3:.4g} ms sees it"
+        )
+    how = {"tolerances": s.tolerances, "observe": observe}
     if s.machine_scale is not None:
-        scenario, note = _profiled_scale(scenario, law, ref, s.machine_scale, s.tolerances)
+        scenario, note = _profiled_scale(scenario, law, ref, s.machine_scale, how)
         notes.append(note)
-    ev = evaluate(scenario, law, ref, tolerances=s.tolerances)
+    ev = evaluate(scenario, law, ref, **how)
     other = None
     if s.check_default_start and ref.start is not None and scenario.mass_loss == 0:
-        other = evaluate(scenario, law, ref, tolerances=s.tolerances, from_state=False, floor=False)
+        other = evaluate(scenario, law, ref, from_state=False, floor=False, **how)
         note = _default_start_note(ev, other)
         if note:
             notes.append(note)
@@ -334,6 +347,7 @@ def verify(scenario, measurement, law, *, settings=None, **options):
         "check_default_start": s.check_default_start,
         "tolerances": None if s.tolerances is None else s.tolerances.as_dict(),
         "machine_scale": None if s.machine_scale is None else list(s.machine_scale),
+        "sensor_lag": s.sensor_lag,
     }
     return VerifyResult(
         law=law,
