@@ -31,7 +31,8 @@ One iteration (:func:`explain`):
    Where none of these refits names an effect, the effects the score test passed over
    are refitted too before the loop stops.  The
    effect is named when its refit lowers the mean I2 by at least 10 % and keeps the
-   contact spring repulsive (``P(z0, 0) > 0`` at the record's typical penetration: a
+   contact spring repulsive (``P(z, 0) > 0`` from first touch to the record's typical
+   penetration ``z0``: a
    stiffening support can mimic unloading damping only by turning the spring into a
    pull); two refits within the noise floor of each other are reported as equivalent.
    Its signature (the phases where it acts) is checked against the localisation and

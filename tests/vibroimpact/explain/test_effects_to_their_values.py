@@ -324,3 +324,22 @@ def test_an_effect_the_score_test_passed_over_is_refitted_before_the_loop_stops(
     assert res.final_model.value(effect_of("penetration_velocity_coupling")) == pytest.approx(
         truth["z*zd"], rel=0.02
     )
+
+
+def test_a_spring_that_pulls_near_first_touch_is_not_repulsive(paper):
+    """Survey draw 31 (short contacts, unloading damping, the noisier record): a Hertz
+    term's refit ended at ``-1.55e10*z + 9.41e12*z^1.5``, pushing at the typical
+    penetration ``z0`` but pulling below a tenth of it, and was named.  The elastic branch
+    must push from first touch to ``z0``."""
+    from discovery.vibroimpact.explain.judging import _repulsive
+    from discovery.vibroimpact.explain.problem import contact_scales
+
+    ref = Reference.from_measurement(R.reference_record((paper, paper.law), check=False), paper)
+    records = [(paper, ref)]
+    z0 = contact_scales(paper, ref)[2]
+    k = 2.06e8
+    pulls = ForceLaw.parse(f"{-k}*z + {k / np.sqrt(0.05 * z0)}*z^1.5")  # zero at z0 / 20
+    assert float(pulls.polynomial(z0, 0.0)) > 0 > float(pulls.polynomial(0.01 * z0, 0.0))
+    assert not _repulsive(pulls, records)
+    assert _repulsive(paper.law, records)
+    assert _repulsive(ForceLaw.parse(f"{-1e-4 * k}*z + {k / np.sqrt(z0)}*z^1.5"), records)
