@@ -611,6 +611,8 @@ def explain(
                 break
         _joint_refit(run)
         dropped = drop_collapsed(run)
+        if dropped:  # the effects left, refitted without the ones taken out
+            _joint_refit(run)
         evs = problem.evaluations(run.model, floor=True)
         crit, floor = _with_drift(
             _mean(evs, "criteria"), _mean(evs, "noise_floor"), run.drift, run.model
