@@ -80,28 +80,33 @@ class _Refits:
         negative offset stopped short of zero on a noisy record (survey draw 26)."""
         problem, regress = self.problem, self.regress
         lo, hi = eff.parameters[0].bounds
-        # a two-sided parameter (an offset) starts on the side its LM direction points to
-        h = _small_step(eff, self.records) * _side(guess, lo)
+        # a two-sided parameter (an offset) starts on the side its LM direction points to,
+        # and its ladder climbs both sides (far from the truth the direction can point
+        # away from it: corpus c11, offset +1.5 mm, direction -0.13 mm)
+        step = _small_step(eff, self.records)
+        h = step * _side(guess, lo)
+        sides = (1.0, -1.0) if lo < 0 else (1.0,)
         cands = [_extend(model, eff, _within(guess if _usable(guess, lo) else h, 0.5, lo, hi))]
         if eff.target == "term":
             names = list(model.law.names) + [Term.parse(eff.key).name]
             reg = _regressed(model.with_effect(eff, 0.0), names, regress)
             if reg is not None:
                 cands.append(reg)
-        elif eff.key == "offset":
-            # the force starts at the offset: the law regressed beyond each rung's
-            for v in sorted({_within(h * f, 0.9, lo, hi) for f in _LADDER}):
-                reg = _regressed(model, model.law.names, regress, shift=v)
-                if reg is not None:
-                    cands.append(_extend(reg, eff, v))
         else:
             # an effect on the unloading branch leaves the loading samples as they are
             reg = _regressed(
                 model, model.law.names, regress, loading=eff.target in ("unloading", "set")
             )
+            values = sorted({_within(sd * step * f, 0.9, lo, hi) for sd in sides for f in _LADDER})
             if reg is not None:
-                values = sorted({_within(h * f, 0.9, lo, hi) for f in _LADDER})
                 cands += [_extend(reg, eff, v) for v in values]
+            if eff.key == "offset":
+                # the force starts at the offset: also the law regressed beyond each rung
+                # (where no sample's penetration stands above its noise, the only ladder)
+                for v in values:
+                    beyond = _regressed(model, model.law.names, regress, shift=v)
+                    if beyond is not None:
+                        cands.append(_extend(beyond, eff, v))
         ranked = (
             [cands[0]]
             if len(cands) == 1
