@@ -27,14 +27,13 @@ One iteration (:func:`explain`):
    Hertz term with a stiffer spring otherwise holds the refit in its basin).  The
    LM statistic is local: an effect whose output is far from linear in its parameter (a
    set, an unloading damper the start law has compensated) can score below one that
-   merely correlates with the residual, so the refits, not the scores, decide.  The
-   Where none of these refits names an effect, the effects the score test passed over
-   are refitted too before the loop stops.  The
-   effect is named when its refit lowers the mean I2 by at least 10 % and keeps the
-   contact spring repulsive (``P(z, 0) > 0`` from first touch to the record's typical
-   penetration ``z0``: a
-   stiffening support can mimic unloading damping only by turning the spring into a
-   pull); two refits within the noise floor of each other are reported as equivalent.
+   merely correlates with the residual, so the refits, not the scores, decide.  Where
+   none of these refits names an effect, the effects the score test passed over are
+   refitted too before the loop stops.  The effect is named when its refit lowers the
+   mean I2 by at least 10 % and keeps the contact spring repulsive (``P(z, 0) > 0`` from
+   first touch to the record's typical penetration ``z0``: a stiffening support can mimic
+   unloading damping only by turning the spring into a pull); two refits within the noise
+   floor of each other are reported as equivalent.
    Its signature (the phases where it acts) is checked against the localisation and
    reported.
 """

@@ -296,8 +296,8 @@ def _fallbacks(preferred, others, problem, criterion):
 
 
 def _without_force(evaluations, records):
-    """Whether the simulated contacts of a law's ``evaluations`` carry little force (a peak under
-    :data:`WEAK_FORCE` of the measured one) in some record.  Where no start reproduces the
+    """Whether the simulated contacts of a law's ``evaluations`` carry little force (a peak
+    under :data:`WEAK_FORCE` of the measured one) in some record.  Where no start reproduces the
     contacts' timing (a short contact whose onset moves with a missing effect), a law
     without force is the least squares' nearest point (the relative L1 distance 1, where a
     force at the wrong time gives up to 2), and no effect's refit leaves it."""
