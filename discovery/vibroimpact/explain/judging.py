@@ -115,8 +115,26 @@ def out_of_bounds(model):
     return [e for e in map(effect, model.effects) if not _in_bounds(e, model)]
 
 
+def _keeps_signs(refit, model):
+    """Whether every loading coefficient of ``model``'s law that is not negative stays so
+    in the ``refit`` (a term an effect adds is held by the effect's bounds): a damper
+    refitted to ``-8.3e7*zd`` beside a contact offset on survey draw 33 had traded the
+    contact's damping for the offset."""
+    before = dict(zip(model.law.terms, model.law.coefficients, strict=True))
+    return all(
+        c >= 0
+        for t, c in zip(refit.law.terms, refit.law.coefficients, strict=True)
+        if before.get(t, -1.0) >= 0
+    )
+
+
 def physical(refit, model, records):
     """Whether a refit of ``model`` stays physical: every effect within its bounds
-    (:func:`out_of_bounds`), the contact spring still pushing (:func:`_keeps_repulsive`).
-    One that is not stands for nothing: no baseline, no winner, no start."""
-    return not out_of_bounds(refit) and _keeps_repulsive(refit, model, records)
+    (:func:`out_of_bounds`), the contact spring still pushing (:func:`_keeps_repulsive`),
+    no loading coefficient turned negative (:func:`_keeps_signs`).  One that is not stands
+    for nothing: no baseline, no winner, no start."""
+    return (
+        not out_of_bounds(refit)
+        and _keeps_repulsive(refit, model, records)
+        and _keeps_signs(refit, model)
+    )
