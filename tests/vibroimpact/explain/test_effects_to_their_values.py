@@ -370,3 +370,23 @@ def test_better_data_never_gives_a_worse_answer_on_stiffening_supports(noise):
     assert res.consistent
     rel = {"high": 0.15, "low": 0.02}[noise]
     assert res.final_model.law.coefficients == pytest.approx(true.coefficients, rel=rel)
+
+
+def test_a_refit_that_turns_a_coefficient_negative_is_not_physical(paper):
+    """Survey draw 33 with the machine that made the record: an offset's refit traded the
+    contact's damper for the offset (``1.9e8*z - 8.26e7*zd``) and was named.  A law's
+    coefficient that was not negative must stay so; one a user's start law gave negative
+    is not held against a refit."""
+    from discovery.vibroimpact.explain.effects import Model, effect
+    from discovery.vibroimpact.explain.judging import _keeps_signs, physical
+
+    ref = Reference.from_measurement(R.reference_record((paper, paper.law), check=False), paper)
+    records = [(paper, ref)]
+    model = Model(paper.law)
+    traded = Model(ForceLaw.parse("1.9e8*z - 8.26e7*zd")).with_effect(
+        effect("contact_offset"), -1e-5
+    )
+    assert not _keeps_signs(traded, model) and not physical(traded, model, records)
+    assert _keeps_signs(Model(ForceLaw.parse("1.9e8*z + 8.26e7*zd")), model)
+    given = Model(ForceLaw.parse("2e8*z - 1e3*zd"))  # negative in the start already
+    assert _keeps_signs(Model(ForceLaw.parse("2e8*z - 2e3*zd")), given)
