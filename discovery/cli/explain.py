@@ -93,6 +93,8 @@ def run(args):
         tail["seconds"] = time.perf_counter() - t_start
         tail.update(provenance_of(args))
         res.record_run(head, tail).write_into(out)
+    if (res.settings or {}).get("start_note"):
+        print(f"start: {res.settings['start_note']}")
     for k, it in enumerate(res.iterations, start=1):
         name = it.effect or "nothing named"
         print(f"iteration {k}: {name}: {it.evidence}")
