@@ -298,6 +298,7 @@ def test_explain_names_an_offset_no_start_fits_without(deep_offset):
     sc, true, d0, rec = deep_offset
     res = explain(sc, rec, "linear", n_boot_intervals=0)
     assert "drawn from the record and not fitted" in str(res)
+    assert "drawn from the record" in res.settings["start_note"]
     assert [it.effect for it in res.iterations][:1] == ["contact_offset"]
     assert res.consistent
     assert res.final_model.scenario["offset"] == pytest.approx(d0, rel=0.01)
@@ -390,3 +391,27 @@ def test_a_refit_that_turns_a_coefficient_negative_is_not_physical(paper):
     assert _keeps_signs(Model(ForceLaw.parse("1.9e8*z + 8.26e7*zd")), model)
     given = Model(ForceLaw.parse("2e8*z - 1e3*zd"))  # negative in the start already
     assert _keeps_signs(Model(ForceLaw.parse("2e8*z - 2e3*zd")), given)
+
+
+@pytest.mark.slow
+def test_vidi_explain_says_where_the_loop_began(deep_offset, tmp_path, capsys):
+    """The command prints the start's note (and keeps it in ``summary.json``)."""
+    import json
+
+    from discovery.cli import main
+
+    sc, _, _, rec = deep_offset
+    (tmp_path / "sc.toml").write_text(sc.to_toml())
+    rec.to_csv(tmp_path / "rec.csv")
+    words = [
+        "explain",
+        "--scenario",
+        str(tmp_path / "sc.toml"),
+        "--data",
+        str(tmp_path / "rec.csv"),
+    ]
+    assert main([*words, "--machine", "sheet", "--out", str(tmp_path / "o")]) == 0
+    out = capsys.readouterr().out
+    assert "start: no fit of a start law stayed physical" in out
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert "drawn from the record" in json.dumps(summary)
