@@ -12,7 +12,7 @@ import math
 from ...errors import InputError, IntegrationError
 from .effects import effect
 from .judging import negligible
-from .problem import _small_step
+from .problem import _mean, _small_step
 
 
 def drop_collapsed(run):
@@ -66,8 +66,9 @@ def _why_not_needed(run, eff, with_it, without):
             "in for an effect named after it"
         )
     key = run.criterion
-    a, b = _mean_of(with_it, "criteria", key), _mean_of(without, "criteria", key)
-    floor = _mean_of(with_it, "noise_floor", key)
+    a = _mean(with_it, "criteria").get(key, math.inf)
+    b = _mean(without, "criteria").get(key, math.inf)
+    floor = _mean(with_it, "noise_floor").get(key, math.inf)
     if not (math.isfinite(a + b + floor) and b <= a + floor):
         return None
     # a survey machine (stiffening supports, a local minimum of k3 at the second
@@ -78,12 +79,3 @@ def _why_not_needed(run, eff, with_it, without):
         f"records and {key} moves {a:.3g} -> {b:.3g}, within its noise floor {floor:.3g}: "
         "the refits after it left it nothing to explain"
     )
-
-
-def _mean_of(evaluations, what, key):
-    """The mean over records of ``what`` (``criteria``, ``noise_floor``) at ``key``
-    (inf where a record has none)."""
-    vals = [(getattr(e, what, None) or {}).get(key) for e in evaluations]
-    if any(v is None for v in vals):
-        return float("inf")
-    return float(sum(vals) / len(vals))

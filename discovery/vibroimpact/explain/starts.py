@@ -5,6 +5,7 @@ output-error refits (:func:`~discovery.vibroimpact.fit.identification.identify`)
 
 import itertools
 import re
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -361,17 +362,20 @@ def _fit_start(run, start, plain, progress):
             f"contact for the record ({why}); give --start as a law with "
             "coefficients closer to the record"
         )
-    return _Drawn(law), (
+    return LawOnly(law, {}), (
         f"no fit of a start law stayed physical ({why}); the loop began from {law}, "
         "drawn from the record and not fitted"
     )
 
 
-class _Drawn:
-    """A start law taken as drawn from the record (no fit, no standard errors)."""
+@dataclass(frozen=True)
+class LawOnly:
+    """A law (or model) with its standard errors, where no identification stands behind it:
+    a start taken as drawn from the record (none), a trial's refit with its collapsed
+    effect taken out (the refit's, less the effect's)."""
 
-    def __init__(self, law):
-        self.law, self.standard_errors = law, {}
+    law: object
+    standard_errors: dict
 
 
 def _unfitted(run, laws):

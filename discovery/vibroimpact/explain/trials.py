@@ -23,7 +23,7 @@ from .judging import (
     physical,
 )
 from .problem import _mean, _small_step, _with_drift, best_of
-from .starts import _output_error, _regressed
+from .starts import LawOnly, _output_error, _regressed
 
 
 def _extend(model, eff, value):
@@ -396,14 +396,6 @@ def _refit_trials(run, step, screen_budget, gap, chosen=None):
     return trials, baseline
 
 
-@dataclass(frozen=True)
-class _LawOnly:
-    """A trial's refit with its effect taken out: the law refitted from the trial's start."""
-
-    law: object
-    standard_errors: dict
-
-
 def _collapsed_baseline(run, trials, baseline, gap):
     """The law's baseline, or the best trial whose effect's refit collapsed (its parameter
     negligible) with the effect taken out, when that lowers the ``gap`` criterion and stays
@@ -437,7 +429,7 @@ def _collapsed_baseline(run, trials, baseline, gap):
         return baseline
     name = eff.parameters[0].name
     errors = {k: v for k, v in x.result.standard_errors.items() if k != name}
-    return _LawOnly(reduced, errors), after, evs
+    return LawOnly(reduced, errors), after, evs
 
 
 def _law_start(run):
