@@ -84,12 +84,23 @@ def consistency_limits(floor, sd=None):
     percentile is about 3.2 times its mean; twice the mean alone rejected the true law in
     about one record in ten."""
     sd = sd or {}
-    return {
+    lim = {
         k: max(CONSISTENCY_FACTORS[k] * floor[k], floor[k] + CONSISTENCY_SPREAD * sd.get(k, 0.0))
         + CONSISTENCY_SLACK
         for k in CONSISTENCY_CRITERIA
         if k in floor
     }
+    if lim.get("I2", 0.0) >= NO_FORCE_I2:  # a law without force would pass: no test
+        lim["I2"] = float("inf")
+    return lim
+
+
+NO_FORCE_I2 = 1.0
+"""I2 of a law without force (the relative L1 distance of the record's force from zero).
+An I2 limit this high or higher decides nothing (it is undefined, like an infinite floor):
+the law's own noisy replicates score as far from its force as a zero force does (survey
+draw 39: a short contact whose noise-free runs from the drawn block states miss each
+other's timing, floor 0.97), and every law with a contact would pass."""
 
 
 class Status(StrEnum):
@@ -308,6 +319,12 @@ def _verdict(consistent, reg, imp, crit, floor, *, lim=None, transient=False):
         )
     lim = consistency_limits(floor) if lim is None else lim
     if not all(np.isfinite(v) for v in lim.values()):
+        if np.isfinite(floor.get("I2", np.inf)):
+            return (
+                f"inconsistent: undecided: the noise floor under this law (I2 "
+                f"{floor['I2']:.3g}) would pass a law without force (I2 = 1), so this "
+                "record cannot test it"
+            )
         return (
             "inconsistent: the noise floor under this law could not be estimated (no "
             "bootstrap replicate of its force history found the contacts)"

@@ -11,7 +11,8 @@ from ..data.noise import estimate_noise
 from ..data.periods import check_drive_period
 from .criteria import CRITERIA
 from .noise_bootstrap import noise_floor
-from .trajectory import BLOCK_CYCLES, record_span, span_floor
+from .span_floor import span_floor
+from .trajectory import BLOCK_CYCLES, record_span
 
 __all__ = ["Reference"]
 
@@ -128,7 +129,7 @@ class Reference:
         """Noise floor of every criterion if ``stand_in`` (an exact impulse aligned with
         the measured cycle) were the truth: see :func:`~discovery.vibroimpact.verify.noise_floor`;
         with a record span (and ``scenario``, ``law``), through the span's own processing
-        (:func:`~discovery.vibroimpact.verify.trajectory.span_floor`)."""
+        (:func:`~discovery.vibroimpact.verify.span_floor.span_floor`)."""
         if self.span is not None and law is not None:
             return span_floor(
                 scenario,

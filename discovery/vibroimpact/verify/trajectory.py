@@ -28,9 +28,8 @@ from ..data.noise import estimate_noise
 from ..dynamics.kernel import codes as _K
 from ..dynamics.simulation import simulate
 from .block_farm import farm_for
-from .criteria import CRITERIA, evaluate_criteria
+from .criteria import evaluate_criteria
 from .fold import make_fold
-from .motion import MOTION_CRITERION, block_penetration
 from .observed import observed, observed_derivatives
 from .state import free_flight_runs, free_flight_state
 
@@ -43,7 +42,6 @@ __all__ = [
     "history_sensitivities",
     "penetration_sensitivities",
     "block_criteria",
-    "span_floor",
     "BLOCK_CYCLES",
 ]
 
@@ -574,126 +572,3 @@ def _block_mean(per, span):
     w = np.array([b.fold.n_cycles for b in span.blocks], dtype=float)
     w = w / w.sum()
     return {k: float(np.dot(w, [p[k] for p in per])) for k in per[0]}
-
-
-@dataclass(frozen=True)
-class _FloorJob:
-    """What every replicate of one noise floor is asked (:func:`_floor_replicate`): the
-    machine and law, the noise-free folded blocks, the runs from the measured states
-    (``(histories, penetrations)``, or ``None`` when they failed), the integrator's
-    settings, the observation model and the criteria's names."""
-
-    scenario: object
-    law: object
-    simulated: list
-    measured: tuple | None
-    tolerances: object
-    observe: object
-    names: list
-
-
-def _floor_replicate(span, draw, job):
-    """One replicate of :func:`span_floor` from its ``draw`` (start states, force and
-    penetration noise): ``(criteria, contacts in its last block)``, or ``None`` when its
-    record cannot be folded."""
-    starts, noise, noise_z = draw
-    measured = job.measured
-    sc, law, tol, observe = job.scenario, job.law, job.tolerances, job.observe
-    try:
-        # the truth as a record holds it: point samples
-        hist, zs = simulated_motion(sc, law, span, tolerances=tol, starts=starts, observe=observe)
-    except IntegrationError:  # a failed draw: the measured states' histories instead
-        if measured is None:
-            measured = simulated_motion(sc, law, span, tolerances=tol, observe=observe)
-        hist, zs = measured
-    try:
-        reps = span.impulses([h + e for h, e in zip(hist, noise, strict=True)])
-        crit, _ = block_criteria(reps, job.simulated, span)
-    except InputError:
-        return None
-    if MOTION_CRITERION in job.names:
-        # the noise-free penetrations from the measured states
-        z_sim = (
-            measured[1]
-            if measured is not None
-            else simulated_motion(sc, law, span, tolerances=tol)[1]
-        )
-        crit[MOTION_CRITERION] = block_penetration(
-            span, reps, job.simulated, [z + e for z, e in zip(zs, noise_z, strict=True)], z_sim
-        )[0]
-    return crit, int(len(reps[-1].support))
-
-
-def _floor_job(reference, draw, job):
-    """:func:`_floor_replicate` on a block farm (the exception it raised, returned)."""
-    try:
-        return _floor_replicate(reference.span, draw, job)
-    except Exception as exc:
-        return exc
-
-
-def span_floor(scenario, law, span, simulated, *, n_boot=16, seed=0, tolerances=None, observe=None):
-    """Noise floor of every criterion if ``law`` were the truth, through the span's own
-    processing.
-
-    Each replicate starts every block from a state drawn from that block's state-fit
-    covariance, adds the record's force noise at the record's sample times, folds, and is
-    compared block by block with ``simulated`` (the folded noise-free histories from the
-    measured states).
-
-    Returns
-    -------
-    dict
-        ``{"mean": {I0..I5}, "q95": {I0..I5}, "sd": {I0..I5}, "n_boot": n, "seed": seed,
-        "impacts": [contacts per cycle of each replicate's last block]}``.
-    """
-    rng = np.random.default_rng(seed)
-    # the penetration noise from its own stream: the force criteria's floor is unchanged
-    rng_z = np.random.default_rng((seed, 5))
-    names = list(CRITERIA) + ([MOTION_CRITERION] if span.sigma_z > 0 else [])
-    draws = []  # every replicate's draws first: the same streams, whoever runs them
-    for _ in range(n_boot):
-        starts = [b.state.draw(rng) for b in span.blocks]
-        noise = [rng.normal(0.0, span.sigma_f, b.F.size) for b in span.blocks]
-        noise_z = [rng_z.normal(0.0, span.sigma_z, b.F.size) for b in span.blocks]
-        draws.append((starts, noise, noise_z))
-    try:
-        # the noise-free runs from the measured states (memoised): a failed draw's stand-in
-        # and the penetrations the replicates' are compared with
-        measured = simulated_motion(scenario, law, span, tolerances=tolerances, observe=observe)
-    except IntegrationError:
-        measured = None  # a replicate that needs them runs them, and raises
-    job = _FloorJob(scenario, law, simulated, measured, tolerances, observe, names)
-    farm = farm_for(span)
-    replicates = None if farm is None else farm.map(_floor_job, span, (job,), items=draws)
-    if replicates is None:
-        replicates = [_floor_replicate(span, d, job) for d in draws]
-    samples = {n: [] for n in names}
-    impacts = []  # contacts per cycle each replicate shows (noise can split a contact)
-    for r in replicates:
-        if isinstance(r, Exception):
-            raise r
-        if r is None:  # the replicate could not be folded
-            continue
-        crit, contacts = r
-        for n, v in crit.items():
-            samples[n].append(v)
-        impacts.append(contacts)
-    if not samples["I2"]:
-        inf = {n: float("inf") for n in names}
-        return {
-            "mean": inf,
-            "q95": dict(inf),
-            "sd": dict(inf),
-            "n_boot": 0,
-            "seed": seed,
-            "impacts": [],
-        }
-    return {
-        "impacts": impacts,
-        "mean": {n: float(np.mean(v)) for n, v in samples.items()},
-        "q95": {n: float(np.quantile(v, 0.95)) for n, v in samples.items()},
-        "sd": {n: float(np.std(v, ddof=1)) if len(v) > 1 else 0.0 for n, v in samples.items()},
-        "n_boot": len(samples["I2"]),
-        "seed": seed,
-    }

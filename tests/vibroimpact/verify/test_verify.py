@@ -293,3 +293,60 @@ def test_a_block_of_a_record_that_sheds_mass_starts_with_the_mass_left():
     ev = evaluate(start, paper.law, ref)
     assert ev.consistent, ev.verdict
     assert not evaluate(start.replace(mass_loss=0.0), paper.law, ref).consistent
+
+
+def test_a_replicate_block_without_contact_leaves_the_floor_to_the_other_blocks(
+    light, light_record, monkeypatch
+):
+    """A short contact averaged over a transient block's few cycles can vanish from a
+    bootstrap replicate (survey draw 35: a 2-cycle block of every replicate).  That block
+    has no criteria; the replicate's floor is its other blocks' (weighted by their cycles),
+    not undefined (which made every law inconsistent); with no block left it is undefined."""
+    from discovery.vibroimpact.verify import span_floor as SF
+
+    ref = Reference.from_measurement(light_record, light, n_boot=4)
+    assert ref.span is not None and len(ref.span.blocks) > 1
+    ev = evaluate(light, light.law, ref)
+    base = ev.noise_floor
+    assert np.isfinite(base["I2"]) and ev.consistent
+    run = SF.simulated_motion
+
+    def hidden(blocks):
+        def motion(*args, starts=None, **kwargs):
+            hist, zs = run(*args, starts=starts, **kwargs)
+            if starts is not None:  # a replicate's draw: these blocks' contacts gone
+                hist = [0.0 * h if i in blocks else h for i, h in enumerate(hist)]
+            return hist, zs
+
+        return motion
+
+    stand_in = [s for _, s in ev.blocks]  # the law's folded blocks from the measured states
+    monkeypatch.setattr(SF, "simulated_motion", hidden({0}))
+    fl = ref.floor_for(stand_in, scenario=light, law=light.law)
+    assert fl["n_boot"] == 4 and np.isfinite(fl["mean"]["I2"])
+    assert fl["mean"]["I2"] != base["I2"]  # the first block's share is out
+    monkeypatch.setattr(SF, "simulated_motion", hidden(set(range(len(ref.span.blocks)))))
+    none = ref.floor_for(stand_in, scenario=light, law=light.law)
+    assert none["n_boot"] == 0 and none["mean"]["I2"] == float("inf")
+
+
+def test_a_floor_that_would_pass_a_law_without_force_decides_nothing():
+    """A law without force scores I2 = 1.  Where the law's own replicates score so far
+    from its force that the I2 limit reaches 1 (survey draw 39: floor 0.97), every law
+    with a contact would pass: the limit is undefined, the law not consistent, and the
+    verdict says why."""
+    from discovery.vibroimpact.verify.evaluation import _verdict, consistency_limits
+
+    assert np.isfinite(consistency_limits({"I2": 0.49, "I4": 0.3})["I2"])
+    lim = consistency_limits({"I2": 0.5, "I4": 0.3})
+    assert lim["I2"] == float("inf") and np.isfinite(lim["I4"])
+    same = {"measured": "P1", "simulated": "P1"}
+    text = _verdict(
+        False,
+        same,
+        {"measured": 1, "simulated": 1},
+        {"I2": 0.6, "I4": 0.1},
+        {"I2": 0.5, "I4": 0.3},
+        lim=lim,
+    )
+    assert "would pass a law without force" in text and "cannot test it" in text
