@@ -415,3 +415,57 @@ def test_vidi_explain_says_where_the_loop_began(deep_offset, tmp_path, capsys):
     assert "start: no fit of a start law stayed physical" in out
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert "drawn from the record" in json.dumps(summary)
+
+
+@pytest.mark.slow
+def test_a_start_fit_with_its_force_misplaced_is_rescued_from_the_grid_around_it():
+    """Survey draw 30, the noisier record (a 0.6 ms contact at 3 % force noise, no effect):
+    the regression's start (I2 1.8: its contacts at the wrong time) ran to a spring a
+    hundred times too soft (I2 0.93), and explain ended inconsistent with nothing to name.
+    Fitted from the best point of the grid around the regression's start, the law reaches
+    the truth."""
+    from tests import survey_effects as S
+
+    seed = 3030
+    case, law = S._base_case("short-contact", seed)
+    true_sc, true, lag, truth = S._sizes(case, law, "none", np.random.default_rng(seed))
+    rec = S._record(true_sc, true, lag, S.NOISE["high"], seed, case)
+    res = explain(case.scenario.with_law(law), rec, "linear", n_boot_intervals=0)
+    assert res.consistent and not [it.effect for it in res.iterations if it.effect]
+    assert res.final_model.law.coefficients == pytest.approx(true.coefficients, rel=0.05)
+
+
+def test_a_poor_start_fit_is_replaced_only_by_a_better_fit_from_the_grid(monkeypatch):
+    """The rescue's rule on a stand-in run: a fit at or under :data:`POOR_START` is kept;
+    a poor one is replaced by the fit from the grid's best law when that fit is lower, and
+    kept when no grid law beats it."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.explain import starts as St
+
+    start = ForceLaw.parse("1e9*z + 1e6*zd")
+    grid = St._grid(start)
+    assert len(grid) == 80 and start not in grid
+    assert {round(g.coefficients[0] / 1e9, 6) for g in grid} == {
+        round(2.0**e, 6) for e in np.arange(-2, 2.01, 0.5)
+    }
+    assert len(St._grid(ForceLaw.parse("1e9*z + 1e6*zd + 1e11*z^2"))) == 5**3 - 1
+    assert St._grid(ForceLaw.parse("1*z + 1*zd + 1*z^2 + 1*z^3")) == []
+    good = start.with_coefficients([2.0e9, 0.71e6])  # the one grid basin
+
+    def value(model, criterion):
+        law = model.law
+        if law.coefficients == pytest.approx(good.coefficients, rel=0.02):
+            return 0.1 if law is not good else 0.6
+        return 0.93 if law is FIT.law else 1.6
+
+    FIT = SimpleNamespace(law=start.with_coefficients([1e7, 7e5]))
+    run = SimpleNamespace(problem=SimpleNamespace(value=value), criterion="I2")
+    better = SimpleNamespace(law=start.with_coefficients([2.01e9, 0.7e6]))
+    monkeypatch.setattr(St, "_grid", lambda law: [good, *grid[:3]])
+    monkeypatch.setattr(St, "_fit_one", lambda run, law, progress: (better, ""))
+    assert St._rescued(run, FIT, start, None) is better
+    fine = SimpleNamespace(law=start.with_coefficients([2.0e9, 0.7e6]))
+    assert St._rescued(run, fine, start, None) is fine  # 0.1: not poor
+    monkeypatch.setattr(St, "_grid", lambda law: grid[:3])  # every grid law at 1.6
+    assert St._rescued(run, FIT, start, None) is FIT
