@@ -469,3 +469,25 @@ def test_a_poor_start_fit_is_replaced_only_by_a_better_fit_from_the_grid(monkeyp
     assert St._rescued(run, fine, start, None) is fine  # 0.1: not poor
     monkeypatch.setattr(St, "_grid", lambda law: grid[:3])  # every grid law at 1.6
     assert St._rescued(run, FIT, start, None) is FIT
+
+
+def test_the_floor_replicates_start_from_the_states_of_the_machine_they_run_on():
+    """Survey draw 9, the quieter record (stiffening supports and unloading damping, P1):
+    the floor's replicates drew their block states from the states fitted with the
+    record's linear machine while they ran on the stiff one; their contacts fell elsewhere,
+    the true model's I2 floor was 0.85 and its limit let any law with a contact pass.
+    Drawn from the states of the machine they run on, the floor is the noise's."""
+    from discovery.vibroimpact.explain.effects import Model
+    from tests import survey_effects as S
+
+    seed = 3009
+    case, law = S._base_case("p1", seed)
+    true_sc, true, lag, truth = S._sizes(
+        case, law, "unloading+supports", np.random.default_rng(seed)
+    )
+    rec = S._record(true_sc, true, lag, S.NOISE["low"], seed, case)
+    start = case.scenario.with_law(law)
+    ref = Reference.from_measurement(rec, start, n_boot=16, seed=0)
+    model = Model(true).with_effect(effect_of("support_nonlinearity"), true_sc.k3)
+    ev = evaluate(model.apply(start, ref), true, ref)
+    assert ev.noise_floor["I2"] < 0.05 and ev.consistent, ev.verdict
