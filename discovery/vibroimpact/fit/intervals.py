@@ -141,7 +141,8 @@ def _cycle_weights(fold, rng):
 def _replicate(scenario, law, observe, ref, rng, *, tolerances=None, noise="cycles"):
     """A synthetic copy of ``ref`` made by ``law`` (the same span, states and sample times).
 
-    Every block is simulated from a state drawn from its state fit's covariance; its noise
+    Every block is simulated from a state drawn from its state fit's covariance (the fit
+    with ``scenario``'s machine); its noise
     is, with ``noise="cycles"``, the record's own residual against ``law`` (force and
     penetration) with each cycle's multiplied by one random weight (a wild bootstrap by
     cycles: what repeats within a cycle, correlated noise, an onset's timing, a misfit the
@@ -150,7 +151,9 @@ def _replicate(scenario, law, observe, ref, rng, *, tolerances=None, noise="cycl
     from ..verify.trajectory import simulated_motion
 
     span = ref.span
-    starts = [b.state.draw(rng) for b in span.blocks]
+    # the states a run on this machine starts from (re-estimated where it is not the
+    # record's: stiffening supports), as the noise floor's replicates draw them
+    starts = [b.state_for(scenario).draw(rng) for b in span.blocks]
     hist, zs = simulated_motion(
         scenario, law, span, tolerances=tolerances, starts=starts, observe=observe
     )
