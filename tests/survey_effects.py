@@ -266,6 +266,8 @@ def run_case(args):
             rec = _record(true_sc, true, lag, noise, seed, case)
             start = case.scenario.with_law(law)
             row.update(_verify_truth(true_sc, true, lag, rec, start, evaluate, Reference))
+            if cls != "none":
+                row.update(_law_alone(true_sc, law, rec, evaluate, Reference))
             t0 = time.perf_counter()
             given, scale, found, known = _machine(start, rec, error, seed)
             res = explain(given, rec, "linear", workers=1, machine_scale=scale, known=known)
@@ -293,6 +295,25 @@ def _verify_truth(true_sc, true, lag, rec, start, evaluate, Reference):
     ref = Reference.from_measurement(rec, start, n_boot=16, seed=0)
     ev = evaluate(model.apply(start, ref), true, ref, observe=model.observe())
     return {"true_consistent": bool(ev.consistent), "true_I2": ev.criteria.get("I2")}
+
+
+def _law_alone(true_sc, law, rec, evaluate, Reference):
+    """Whether the record can tell the hidden effect(s) at all: the law without them,
+    refitted (output error, from the true law's own coefficients) on the machine without
+    them, is not consistent with the record.  Where it is, no method can name the effect
+    from this record, and a right answer is to name nothing (``alone_consistent``)."""
+    from discovery.vibroimpact.fit.identification import identify
+
+    bare = true_sc.replace(k3=0.0, offset=0.0, mass_loss=0.0)
+    ref = Reference.from_measurement(rec, bare, n_boot=16, seed=0)
+    try:
+        fit = identify(
+            [bare], [ref], law, method="least-squares", max_simulations=80, check=False
+        ).law
+    except Exception:  # noqa: BLE001 (no refit: the true coefficients judged as they are)
+        fit = law
+    ev = evaluate(bare, fit, ref)
+    return {"alone_consistent": bool(ev.consistent), "alone_I2": ev.criteria.get("I2")}
 
 
 def _outcome(res, truth, seconds):
@@ -384,6 +405,9 @@ def markdown_row(rows, label):
     # where the effect shows: the linear start is not consistent with the record
     shows = [r for r in valid if r["class"] != "none" and not r.get("start_consistent")]
     right = sum(named_right(r) for r in shows)
+    # where the record can tell: the law alone, refitted without the effect, is not
+    # consistent (rows run before the check was made count as telling)
+    tells = [r for r in shows if not r.get("alone_consistent")]
     clean = [r for r in valid if r["class"] == "none"]
     false = sum(bool(r.get("kept")) for r in clean)
     consistent = sum(bool(r.get("consistent")) for r in valid)
@@ -397,6 +421,7 @@ def markdown_row(rows, label):
         str(len(ok) - len(valid)),
         str(len(weak)),
         _rate(right, len(shows)),
+        _rate(sum(named_right(r) for r in tells), len(tells)),
         _rate(false, len(clean)) if clean or label in ("none", "all") else "--",
         _rate(consistent, len(valid)),
         _rate(sum(cov), len(cov)),
