@@ -403,15 +403,15 @@ def _value(run, law):
 
 def _rescued(run, fit, start, progress, tries=2):
     """``fit`` (from ``start``), or where it ends poor (criterion above
-    :data:`POOR_START`) the lowest of the fits from the ``tries`` best laws of the grid
-    around ``start`` (:func:`_grid`, one simulation each) that beat it, when that fit is
-    no longer poor.  A short contact's timing makes the criterion rugged in the
+    :data:`POOR_START`) the lowest of it and the fits from the ``tries`` best laws of the
+    grid around ``start`` (:func:`_grid`, one simulation each) that beat it with force in
+    their contacts.  A short contact's timing makes the criterion rugged in the
     coefficients: on survey draw 30 (a 0.6 ms contact at 2 % force noise) the
     regression's start (I2 1.8) ran to a law a hundred times too soft (0.93), while one
-    grid point (0.67) fitted to the truth (0.076, consistent).  A grid fit that is still
-    poor is not taken: on draw 9 (stiffening supports) it stopped at a law with nearly no
-    force (I2 1.0, below the fit's 1.7), from which no effect's refit leaves, where the
-    supports' refit from the fit itself reached 0.13."""
+    grid point (0.67) fitted to the truth (0.076, consistent).  A grid fit whose contacts
+    carry no force (:func:`_without_force`) is not taken: on draw 9 (stiffening supports)
+    one stopped at I2 1.0, its peak 4.7 % of the record's, from where no effect's refit
+    leaves, while the supports' refit from the fit itself (1.2) reached 0.13."""
     v = _value(run, fit.law)
     if v <= POOR_START:
         return fit
@@ -422,9 +422,11 @@ def _rescued(run, fit, start, progress, tries=2):
         if value >= v:
             break
         got, _ = _fit_one(run, law, progress)
-        if got is not None and (w := _value(run, got.law)) < best[0]:
+        if got is None or (w := _value(run, got.law)) >= best[0]:
+            continue
+        if not _without_force(run.problem.evaluations(Model(got.law)), run.records):
             best = (w, got)
-    return best[1] if best[0] <= POOR_START else fit
+    return best[1]
 
 
 @dataclass(frozen=True)
