@@ -8,14 +8,14 @@ from ..._startup._lazy import lazy_package
 
 # names are imported on first use: the criteria beside them stay cheap to import
 _EXPORTS = {
-    "CONSISTENCY_CRITERIA": "evaluation",
-    "CONSISTENCY_FACTOR": "evaluation",
-    "CONSISTENCY_FACTORS": "evaluation",
-    "CONSISTENCY_SLACK": "evaluation",
-    "CONSISTENCY_SPREAD": "evaluation",
+    "CONSISTENCY_CRITERIA": "consistency",
+    "CONSISTENCY_FACTOR": "consistency",
+    "CONSISTENCY_FACTORS": "consistency",
+    "CONSISTENCY_SLACK": "consistency",
+    "CONSISTENCY_SPREAD": "consistency",
     "Evaluation": "evaluation",
     "align": "evaluation",
-    "consistency_limits": "evaluation",
+    "consistency_limits": "consistency",
     "evaluate": "evaluation",
     "noise_floor": "noise_bootstrap",
     "NoiseFloorSettings": "noise_bootstrap",

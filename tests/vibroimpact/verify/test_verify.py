@@ -351,7 +351,8 @@ def test_a_floor_that_would_pass_a_law_without_force_decides_nothing():
     from its force that the I2 limit reaches 1 (survey draw 39: floor 0.97), every law
     with a contact would pass: the limit is undefined, the law not consistent, and the
     verdict says why."""
-    from discovery.vibroimpact.verify.evaluation import _verdict, consistency_limits
+    from discovery.vibroimpact.verify.consistency import consistency_limits
+    from discovery.vibroimpact.verify.evaluation import _verdict
 
     assert np.isfinite(consistency_limits({"I2": 0.49, "I4": 0.3})["I2"])
     lim = consistency_limits({"I2": 0.5, "I4": 0.3})
