@@ -39,7 +39,7 @@ import argparse
 import json
 import sys
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -277,6 +277,38 @@ def run_case(args):
             row["error"] = f"{type(exc).__name__}: {exc}"
         rows.append(row)
     return rows
+
+
+@dataclass(frozen=True)
+class Draw:
+    """One survey draw at one noise level: its case and linear start law, the machine and
+    law that made the record (with its lag), the hidden parameters' true values and the
+    record (as :func:`run_case` makes them)."""
+
+    case: object
+    law: object
+    machine: object
+    true: object
+    lag: object
+    truth: dict
+    record: object
+    seed: int
+
+    @property
+    def start(self):
+        """The case's scenario with the linear start law (the machine as drawn)."""
+        return self.case.scenario.with_law(self.law)
+
+
+def draw(i, level):
+    """Draw ``i``'s record at noise ``level`` (``"high"`` or ``"low"``), for tests and
+    single-record checks."""
+    cls = CLASSES[i % len(CLASSES)]
+    seed = 3000 + i
+    case, law = _base_case(CATEGORIES[(i // len(CLASSES)) % len(CATEGORIES)], seed)
+    true_sc, true, lag, truth = _sizes(case, law, cls, np.random.default_rng(seed))
+    rec = _record(true_sc, true, lag, NOISE[level], seed, case)
+    return Draw(case, law, true_sc, true, lag, truth, rec, seed)
 
 
 def _verify_truth(true_sc, true, lag, rec, start, evaluate, Reference):

@@ -267,11 +267,8 @@ def deep_offset():
     penetration, so the recorded penetration never stands above its noise in contact."""
     from tests import survey_effects as S
 
-    seed = 3006
-    case, law = S._base_case("p1", seed)
-    true_sc, true, lag, _ = S._sizes(case, law, "contact_offset", np.random.default_rng(seed))
-    rec = S._record(true_sc, true, lag, S.NOISE["high"], seed, case)
-    return case.scenario.with_law(law), true, true_sc.offset, rec
+    d = S.draw(6, "high")
+    return d.start, d.true, d.machine.offset, d.record
 
 
 def test_an_offset_regression_reads_the_force_beyond_the_offset(deep_offset):
@@ -314,11 +311,9 @@ def test_an_effect_the_score_test_passed_over_is_refitted_before_the_loop_stops(
     0.060).  Refitted after them, the coupling reaches the truth."""
     from tests import survey_effects as S
 
-    seed = 3014
-    case, law = S._base_case("subharmonic", seed)
-    true_sc, true, lag, truth = S._sizes(case, law, "coupling", np.random.default_rng(seed))
-    rec = S._record(true_sc, true, lag, S.NOISE["low"], seed, case)
-    res = explain(case.scenario.with_law(law), rec, "linear", n_boot_intervals=0)
+    d = S.draw(14, "low")
+    truth = d.truth
+    res = explain(d.start, d.record, "linear", n_boot_intervals=0)
     assert [it.effect for it in res.iterations] == ["penetration_velocity_coupling"]
     assert "its score test is not significant" in res.iterations[0].evidence
     assert res.consistent
@@ -358,13 +353,9 @@ def test_better_data_never_gives_a_worse_answer_on_stiffening_supports(noise):
     and to 2 % on the quieter."""
     from tests import survey_effects as S
 
-    seed = 3033
-    case, law = S._base_case("short-contact", seed)
-    true_sc, true, lag, truth = S._sizes(
-        case, law, "support_nonlinearity", np.random.default_rng(seed)
-    )
-    rec = S._record(true_sc, true, lag, S.NOISE[noise], seed, case)
-    given, scale, found, known = S._machine(case.scenario.with_law(law), rec, 0.05, seed)
+    d = S.draw(33, noise)
+    rec, true = d.record, d.true
+    given, scale, found, known = S._machine(d.start, rec, 0.05, d.seed)
     assert "support_nonlinearity" in found
     res = explain(given, rec, "linear", machine_scale=scale, known=known, n_boot_intervals=0)
     assert res.final_model.effects == ()
@@ -426,11 +417,9 @@ def test_a_start_fit_with_its_force_misplaced_is_rescued_from_the_grid_around_it
     the truth."""
     from tests import survey_effects as S
 
-    seed = 3030
-    case, law = S._base_case("short-contact", seed)
-    true_sc, true, lag, truth = S._sizes(case, law, "none", np.random.default_rng(seed))
-    rec = S._record(true_sc, true, lag, S.NOISE["high"], seed, case)
-    res = explain(case.scenario.with_law(law), rec, "linear", n_boot_intervals=0)
+    d = S.draw(30, "high")
+    true = d.true
+    res = explain(d.start, d.record, "linear", n_boot_intervals=0)
     assert res.consistent and not [it.effect for it in res.iterations if it.effect]
     assert res.final_model.law.coefficients == pytest.approx(true.coefficients, rel=0.05)
 
@@ -484,48 +473,38 @@ def test_a_poor_start_fit_is_replaced_only_by_a_better_fit_from_the_grid(monkeyp
     assert St._rescued(run, FIT, start, None) is FIT
 
 
-def test_the_floor_replicates_start_from_the_states_of_the_machine_they_run_on():
-    """Survey draw 9, the quieter record (stiffening supports and unloading damping, P1):
-    the floor's replicates drew their block states from the states fitted with the
-    record's linear machine while they ran on the stiff one; their contacts fell elsewhere,
-    the true model's I2 floor was 0.85 and its limit let any law with a contact pass.
-    Drawn from the states of the machine they run on, the floor is the noise's."""
+@pytest.fixture(scope="module")
+def draw9():
+    """Survey draw 9, the quieter record (stiffening supports and unloading damping, P1),
+    and the machine with its supports as the record's states are fitted for it."""
     from discovery.vibroimpact.explain.effects import Model
     from tests import survey_effects as S
 
-    seed = 3009
-    case, law = S._base_case("p1", seed)
-    true_sc, true, lag, truth = S._sizes(
-        case, law, "unloading+supports", np.random.default_rng(seed)
-    )
-    rec = S._record(true_sc, true, lag, S.NOISE["low"], seed, case)
-    start = case.scenario.with_law(law)
-    ref = Reference.from_measurement(rec, start, n_boot=16, seed=0)
-    model = Model(true).with_effect(effect_of("support_nonlinearity"), true_sc.k3)
-    ev = evaluate(model.apply(start, ref), true, ref)
+    d = S.draw(9, "low")
+    ref = Reference.from_measurement(d.record, d.start, n_boot=16, seed=0)
+    model = Model(d.true).with_effect(effect_of("support_nonlinearity"), d.machine.k3)
+    return d, ref, model.apply(d.start, ref)
+
+
+def test_the_floor_replicates_start_from_the_states_of_the_machine_they_run_on(draw9):
+    """Survey draw 9, the quieter record: the floor's replicates drew their block states
+    from the states fitted with the record's linear machine while they ran on the stiff
+    one; their contacts fell elsewhere, the true model's I2 floor was 0.85 and its limit
+    let any law with a contact pass.  Drawn from the states of the machine they run on,
+    the floor is the noise's."""
+    d, ref, machine = draw9
+    ev = evaluate(machine, d.true, ref)
     assert ev.noise_floor["I2"] < 0.05 and ev.consistent, ev.verdict
 
 
-def test_the_interval_replicates_start_from_the_states_of_the_machine_they_run_on():
+def test_the_interval_replicates_start_from_the_states_of_the_machine_they_run_on(draw9):
     """The same record (survey draw 9): a bootstrap replicate of the intervals is the true
     model's run from drawn block states; drawn from the linear machine's states, its
     contacts fell elsewhere (I2 about 0.9 from the model's own run)."""
-    from discovery.vibroimpact.explain.effects import Model
     from discovery.vibroimpact.fit.intervals import _replicate
     from discovery.vibroimpact.verify.criteria import evaluate_criteria
-    from tests import survey_effects as S
 
-    seed = 3009
-    case, law = S._base_case("p1", seed)
-    true_sc, true, lag, truth = S._sizes(
-        case, law, "unloading+supports", np.random.default_rng(seed)
-    )
-    rec = S._record(true_sc, true, lag, S.NOISE["low"], seed, case)
-    start = case.scenario.with_law(law)
-    ref = Reference.from_measurement(rec, start, n_boot=0, seed=0)
-    machine = (
-        Model(true).with_effect(effect_of("support_nonlinearity"), true_sc.k3).apply(start, ref)
-    )
-    rep = _replicate(machine, true, None, ref, np.random.default_rng(0), noise="white")
-    own = evaluate(machine, true, ref, floor=False)
+    d, ref, machine = draw9
+    rep = _replicate(machine, d.true, None, ref, np.random.default_rng(0), noise="white")
+    own = evaluate(machine, d.true, ref, floor=False)
     assert evaluate_criteria(rep.impulse, own.simulated)["I2"] < 0.2
