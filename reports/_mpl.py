@@ -54,11 +54,11 @@ def save(fig, stem, dpi=130):
     Laid out once: ``savefig(..., bbox_inches="tight")`` lays a figure out and draws it
     twice per file (once to find its extent, once to print it), each time with a new
     renderer, so its layout engine runs twice and every text is measured and every
-    mathtext label parsed again (matplotlib caches both per renderer). Here the layout
-    engine runs once, at the PNG's ``dpi`` on an Agg canvas; the PNG is cut from that
-    canvas drawn with the same renderer (or drawn by savefig when an artist runs past the
-    figure's edge), and the PDF is printed in the same layout. The figure is left as it was
-    given (its canvas, dpi and layout engine).
+    mathtext label parsed again (matplotlib caches both per renderer). Here the figure is
+    drawn once on an Agg canvas at the PNG's ``dpi``, its layout engine run as the draw's
+    first step; the PNG is cut from that canvas (or drawn by savefig when an artist runs
+    past the figure's edge), and the PDF is printed in the same layout. The figure is left
+    as it was given (its canvas, dpi and layout engine).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
@@ -67,12 +67,11 @@ def save(fig, stem, dpi=130):
     try:
         agg = FigureCanvasAgg(fig)  # the figure's canvas until the end of the save
         fig.set_dpi(dpi)
-        fig.draw_without_rendering()  # the layout engine, on agg's renderer at this dpi
-        tight = fig.get_tightbbox(agg.get_renderer())
+        agg.draw()  # laid out by its engine (the draw's first step) and drawn at this dpi
+        tight = fig.get_tightbbox(agg.get_renderer())  # the same renderer: texts measured
         bbox = tight.padded(mpl.rcParams["savefig.pad_inches"])
         _set_layout_engine(fig, None)  # laid out: the PNG and the PDF are drawn in this layout
         if _drawn_whole(fig, tight):
-            agg.draw()  # the same renderer: its texts measured and parsed in the layout
             _write_png(paths[0], agg, bbox, dpi)
         else:  # savefig draws it again, past the figure's edge or on the user's background
             fig.savefig(paths[0], dpi=dpi, bbox_inches=bbox)

@@ -180,7 +180,7 @@ def _span_figure(result, view, stem):
         axl.set_ylabel(f"F [{unit}]")
         axl.legend(fontsize=7, loc="best", framealpha=0.8, markerscale=4)
         _penetrations(axz, x, view["zm"] * ms, view["zn"] * ms, ev)
-        axz.set_xlabel("time since the contact's onset [ms]")
+        axz.set_xlabel("since the onset [ms]")
     ax.fill_between(
         x,
         (view["fm"] - band) * sc,

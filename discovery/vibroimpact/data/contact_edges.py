@@ -4,7 +4,6 @@ runs dropped, onsets refined on the penetration; their onsets: :func:`contact_on
 a cycle's support (:func:`_sampled_support`)."""
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
 
 from .noise import estimate_noise
 
@@ -66,6 +65,18 @@ def _bracket_onset(t, F, run, thr):
     return float(min(max(t_on, lo), hi))
 
 
+def moving_mean(x, width):
+    """The mean of ``x`` over ``width`` samples centred on each (``width`` odd), the ends
+    padded with the end values (``scipy.ndimage.uniform_filter1d(x, width, mode="nearest")``,
+    without importing ``scipy.ndimage``: a quarter of a second of every command's start)."""
+    x = np.asarray(x, dtype=float)
+    if width <= 1:
+        return x.copy()
+    h = width // 2
+    padded = np.concatenate([np.full(h, x[0]), x, np.full(h, x[-1])])
+    return np.convolve(padded, np.ones(width), mode="valid") / width
+
+
 def _edge_params(t, period, min_samples=3):
     """Debounce length and edge extrapolation bound [samples] for a sampling."""
     dt = float(np.median(np.diff(t)))
@@ -83,7 +94,7 @@ def _sampled_support(tau, F, thr, period, *, noise=0.0, extrapolate=True, edges=
     min_len, max_extrap = _edge_params(tau, period) if edges is None else edges
     dt = tau[2] - tau[1]
     width = max(1, int(0.01 * period / dt)) | 1 if noise > thr / 100.0 else 1
-    Fs = uniform_filter1d(np.asarray(F, dtype=float), width, mode="nearest")
+    Fs = moving_mean(np.asarray(F, dtype=float), width)
     Fs[0] = F[0]
     t_ext = np.concatenate([[-dt], tau, [tau[-1] + dt]])
     f_ext = np.concatenate([[0.0], Fs, [0.0]])

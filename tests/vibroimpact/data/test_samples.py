@@ -271,3 +271,17 @@ def test_csv_with_a2_without_scenario_raises(rec, tmp_path):
     _write(p, {"t": rec.t[:10], "a2": np.zeros(10)})
     with pytest.raises(InputError, match="a2 but no F"):
         Measurement.from_csv(p)
+
+
+@pytest.mark.parametrize("width", [1, 3, 7, 31])
+def test_the_edge_smoothing_is_scipys_moving_mean(width):
+    """The contact edges' smoothing (``moving_mean``) against its independent slow path,
+    scipy's ``uniform_filter1d`` with the ends held, on a noisy impulse train."""
+    from scipy.ndimage import uniform_filter1d
+
+    from discovery.vibroimpact.data.contact_edges import moving_mean
+
+    rng = np.random.default_rng(width)
+    x = np.maximum(0.0, np.sin(np.linspace(0, 20, 500))) * 1e6 + rng.normal(0, 1e4, 500)
+    want = uniform_filter1d(x, width, mode="nearest")
+    np.testing.assert_allclose(moving_mean(x, width), want, rtol=0, atol=1e-9 * np.ptp(x))
