@@ -451,7 +451,7 @@ def test_a_poor_start_fit_is_replaced_only_by_a_better_fit_from_the_grid(monkeyp
         return 0.93 if law is FIT.law else 1.6
 
     FIT = SimpleNamespace(law=start.with_coefficients([1e7, 7e5]))
-    problem = SimpleNamespace(value=value, evaluations=lambda model: [])
+    problem = SimpleNamespace(value=value, evaluations=lambda model, floor=False: [])
     run = SimpleNamespace(problem=problem, criterion="I2", records=[])
     better = SimpleNamespace(law=start.with_coefficients([2.01e9, 0.7e6]))
     monkeypatch.setattr(St, "_grid", lambda law: [good, *grid[:3]])
@@ -471,6 +471,30 @@ def test_a_poor_start_fit_is_replaced_only_by_a_better_fit_from_the_grid(monkeyp
     assert St._rescued(run, FIT, start, None) is still_poor
     monkeypatch.setattr(St, "_without_force", lambda evaluations, records: True)
     assert St._rescued(run, FIT, start, None) is FIT
+    # nor one whose own noisy records show no contact: its floor infinite, no effect can be
+    # named from it (survey draw 33h: I2 1.0, no simulated contact)
+    monkeypatch.setattr(St, "_without_force", lambda evaluations, records: False)
+    blind = SimpleNamespace(noise_floor={"I2": float("inf")})
+    problem.evaluations = lambda model, floor=False: [blind]
+    assert St._rescued(run, FIT, start, None) is FIT
+
+
+@pytest.mark.slow
+def test_supports_under_a_short_contact_are_named_from_the_machine_without_them():
+    """Survey draw 33, the noisier record (a 0.3 ms contact, supports stiffening to k3
+    9.86e13), explain given the machine without the supports: the penetration tells too
+    few contact samples for the candidates' regression, so the supports' refit had no
+    start but the current law, and the start's rescue took a grid fit with no simulated
+    contact (I2 1.0, its floor infinite) from which nothing could be named.  The
+    regression now falls back to the samples the force tells, the rescue refuses a fit
+    with an infinite floor, and the supports are named to their true value."""
+    from tests import survey_effects as S
+
+    d = S.draw(33, "high")
+    res = explain(d.start, d.record, "linear", workers=1, n_boot_intervals=0)
+    assert res.final_model.effects == ("support_nonlinearity",)
+    assert res.consistent, res.stopped_because
+    assert res.final_model.scenario["k3"] == pytest.approx(d.machine.k3, rel=0.02)
 
 
 @pytest.fixture(scope="module")
