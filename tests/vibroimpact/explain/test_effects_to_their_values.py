@@ -532,3 +532,23 @@ def test_the_interval_replicates_start_from_the_states_of_the_machine_they_run_o
     rep = _replicate(machine, d.true, None, ref, np.random.default_rng(0), noise="white")
     own = evaluate(machine, d.true, ref, floor=False)
     assert evaluate_criteria(rep.impulse, own.simulated)["I2"] < 0.2
+
+
+@pytest.mark.slow
+def test_of_refits_within_the_noise_floor_a_consistent_one_is_named():
+    """Survey draw 31, the noisier record (an unloading damper under a short contact; the
+    machine calibrated from a sheet 5 % off, as ``vidi explain`` runs): a permanent set's
+    refit reached I2 0.111 with its contact time off (I4 above its limit), the damper's
+    0.119 with every criterion within its limit (floor 0.065).  The set was named and the
+    loop ended inconsistent; now the damper is named, the evidence says why, and the loop
+    ends consistent."""
+    from tests import survey_effects as S
+
+    d = S.draw(31, "high")
+    given, scale, found, known = S._machine(d.start, d.record, 0.05, d.seed)
+    res = explain(given, d.record, "linear", machine_scale=scale, known=known, n_boot_intervals=0)
+    assert res.final_model.effects == ("unloading_damping",)
+    assert res.consistent, res.stopped_because
+    first = res.iterations[0]
+    assert "is consistent with the record(s) and the lower ones" in first.evidence
+    assert "permanent_set" in first.evidence
