@@ -67,14 +67,15 @@ def _bracket_onset(t, F, run, thr):
 
 def moving_mean(x, width):
     """The mean of ``x`` over ``width`` samples centred on each (``width`` odd), the ends
-    padded with the end values (``scipy.ndimage.uniform_filter1d(x, width, mode="nearest")``,
-    without importing ``scipy.ndimage``: a quarter of a second of every command's start)."""
+    padded with the end values: ``scipy.ndimage.uniform_filter1d(x, width, mode="nearest")``
+    to the last bit (the same running sum, in the same order: the contact edges decide
+    samples at a threshold, and a last-bit change moved a survey record's final refit),
+    without importing ``scipy.ndimage`` (a quarter of a second of every command's start)."""
     x = np.asarray(x, dtype=float)
-    if width <= 1:
-        return x.copy()
     h = width // 2
-    padded = np.concatenate([np.full(h, x[0]), x, np.full(h, x[-1])])
-    return np.convolve(padded, np.ones(width), mode="valid") / width
+    p = np.concatenate([np.full(h, x[0]), x, np.full(h, x[-1])])
+    first = np.cumsum(p[:width])[-1]  # summed in order, as the running sum goes on
+    return np.cumsum(np.concatenate([[first], p[width:] - p[: p.size - width]])) / width
 
 
 def _edge_params(t, period, min_samples=3):
