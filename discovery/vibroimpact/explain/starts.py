@@ -430,26 +430,24 @@ def _rescued(run, fit, start, progress, tries=2):
         got, _ = _fit_one(run, law, progress)
         if got is None or (w := _value(run, got.law)) >= best[0]:
             continue
-        if not _without_force(run.problem.evaluations(Model(got.law)), run.records) and _testable(
-            run, got.law
-        ):
+        try:
+            evs = run.problem.evaluations(Model(got.law), floor=True)
+        except (IntegrationError, InputError):
+            continue
+        if not _without_force(evs, run.records) and _testable(evs, run.criterion):
             best = (w, got)
     return best[1]
 
 
-def _testable(run, law):
-    """Whether ``law`` has a finite noise floor of the run's criterion on every record: a
-    law whose own noisy records show no contact (its floor infinite) is a start from which
-    no effect can be named, since every refit must beat the law's by that floor.  On survey
-    draw 33 (a 0.3 ms contact, stiffening supports) a grid fit reached I2 1.0 with no
-    simulated contact and an infinite floor; the supports' refit from it reached the
+def _testable(evaluations, criterion):
+    """Whether a law's ``evaluations`` have a finite noise floor of ``criterion`` on every
+    record: a law whose own noisy records show no contact (its floor infinite) is a start
+    from which no effect can be named, since every refit must beat the law's by that floor.
+    On survey draw 33 (a 0.3 ms contact, stiffening supports) a grid fit reached I2 1.0 with
+    no simulated contact and an infinite floor; the supports' refit from it reached the
     truth's 0.081 and went unnamed."""
-    try:
-        evs = run.problem.evaluations(Model(law), floor=True)
-    except (IntegrationError, InputError):
-        return False
     return all(
-        ev.noise_floor and np.isfinite(ev.noise_floor.get(run.criterion, np.inf)) for ev in evs
+        ev.noise_floor and np.isfinite(ev.noise_floor.get(criterion, np.inf)) for ev in evaluations
     )
 
 

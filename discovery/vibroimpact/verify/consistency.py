@@ -29,9 +29,16 @@ corpus record (0.91-1.06), with a spread over the replicates of a few per cent, 
 2 would pass a law whose penetration is off by nearly the noise itself (a spring four times
 too soft behind unloading damping: I5 1.8 times its floor)."""
 CONSISTENCY_SLACK = 0.005  # numerical agreement of two simulators, sampling effects
-
-
 CONSISTENCY_SPREAD = 3.0
+"""The spread term's factor: a limit at least the floor plus this many standard deviations
+of the criterion over the floor's replicates."""
+
+NO_FORCE_I2 = 1.0
+"""I2 of a law without force (the relative L1 distance of the record's force from zero).
+An I2 limit this high or higher decides nothing (it is undefined, like an infinite floor):
+the law's own noisy replicates score as far from its force as a zero force does (survey
+draw 39: a short contact whose noise-free runs from the drawn block states miss each
+other's timing, floor 0.97), and every law with a contact would pass."""
 
 
 def consistency_limits(floor, sd=None):
@@ -52,11 +59,3 @@ def consistency_limits(floor, sd=None):
     if lim.get("I2", 0.0) >= NO_FORCE_I2:  # a law without force would pass: no test
         lim["I2"] = float("inf")
     return lim
-
-
-NO_FORCE_I2 = 1.0
-"""I2 of a law without force (the relative L1 distance of the record's force from zero).
-An I2 limit this high or higher decides nothing (it is undefined, like an infinite floor):
-the law's own noisy replicates score as far from its force as a zero force does (survey
-draw 39: a short contact whose noise-free runs from the drawn block states miss each
-other's timing, floor 0.97), and every law with a contact would pass."""
