@@ -18,7 +18,7 @@ from .sensor import sensor_lag, with_lag
 from .shedding import MATERIAL, shedding
 from .units import check_units
 
-__all__ = ["calibrate", "CALIBRATED", "LOOSE", "MATERIAL"]
+__all__ = ["calibrate", "supports_reading", "CALIBRATED", "LOOSE", "MATERIAL"]
 
 #: the parameters a calibration may estimate
 CALIBRATED = ("m1", "c1", "k1", "k3", "A", "m2")
@@ -350,6 +350,26 @@ def stiffening_share(rows, k1, k3):
     frame = np.concatenate([r.frame for r in rows])
     linear = abs(k1) * np.linalg.norm(frame[:, 2])
     return float(abs(k3) * np.linalg.norm(frame[:, 3]) / linear) if linear > 0 else math.inf
+
+
+def supports_reading(scenarios, measurements):
+    """The supports' cubic stiffness ``k3`` [N/m^3] the frame's own equation reads from
+    records of one machine, the rest of it (``m1, c1, k1, m2`` and each record's ``A``)
+    held as ``scenarios`` give it: a start for a refit that adds stiffening supports to a
+    machine given without them (the force's regression cannot see the supports).  None
+    where a record has no positions, the records are of different machines, or the reading
+    is not a positive number."""
+    if len({_machine_key(s) for s in scenarios}) != 1:
+        return None
+    rows = [machine_rows(m, s) for s, m in zip(scenarios, measurements, strict=True)]
+    if any(r is None for r in rows):
+        return None
+    sheet = scenarios[0]
+    held = {n: getattr(sheet, n) for n in ("m1", "c1", "k1", "m2")}
+    amps = ["A"] if len(rows) == 1 else [f"A[{r + 1}]" for r in range(len(rows))]
+    held.update({a: s.A for a, s in zip(amps, scenarios, strict=True)})
+    k3 = estimate(rows, held, []).get("k3")
+    return k3 if np.isfinite(k3) and k3 > 0 else None
 
 
 def _first_estimate(rows, held, draws, probe_k3):

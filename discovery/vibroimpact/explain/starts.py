@@ -191,7 +191,7 @@ class Regressions:
     def __init__(self, scenarios, measurements):
         self.scenarios, self.measurements = scenarios, measurements
         self.samples = _joined_samples(scenarios, measurements)
-        self._by_force = None
+        self._by_force = self._supports = None
 
     def __call__(self, names, loading=False, shift=0.0):
         if not shift:
@@ -199,6 +199,17 @@ class Regressions:
             if fit is not None:
                 return fit
         return _regression(names, self.by_force(), loading, shift)
+
+    def supports(self):
+        """The supports' ``k3`` the frame's own equation reads from the records, the rest of
+        the machine as given (:func:`~discovery.vibroimpact.calibration.machine.supports_reading`;
+        None where it reads none), computed once."""
+        if self._supports is None:
+            from ..calibration.machine import supports_reading
+
+            read = supports_reading(self.scenarios, self.measurements)
+            self._supports = (read,)
+        return self._supports[0]
 
     def by_force(self):
         """The contact samples the force says are in contact (None without them)."""

@@ -34,6 +34,19 @@ def _extend(model, eff, value):
 _LADDER = tuple(2.0**k for k in range(13))
 
 
+#: the spring factors scanned around a start whose machine effect is read, not fitted (the
+#: supports' ``k3`` from the frame's equation): the regression's spring is biased low by the
+#: penetration's noise by a few percent, and a short contact's basin can be narrower
+_SPRING_SCAN = tuple(1.0 + 0.01 * k for k in range(-6, 9) if k)
+
+
+def _springs(model, factor):
+    """``model`` with its law's elastic terms (no velocity factor) scaled by ``factor``."""
+    law = model.law
+    pairs = zip(law.terms, law.coefficients, strict=True)
+    return model.with_law(law.with_coefficients([c * factor if t.b == 0 else c for t, c in pairs]))
+
+
 def _side(guess, lo):
     """-1 where the parameter may be negative (``lo < 0``, an offset) and its LM direction
     ``guess`` points there, else 1."""
@@ -80,30 +93,28 @@ class _Refits:
         parameter of either sign (an offset) starts on the side of its LM direction (from
         the positive side a refit toward a negative offset stopped short of zero on a noisy
         record, survey draw 26), its ladder climbs both sides, and each ladder's best start
-        is refitted as well; the lowest refit is kept."""
+        is refitted as well.  Stiffening supports also start from the ``k3`` the frame's
+        equation reads, with the law's spring scanned around the regression's, ranked
+        apart, their best refitted too.  The lowest refit is kept."""
         problem = self.problem
         lo, hi = eff.parameters[0].bounds
-        h, families = self._candidates(model, eff, guess)
+        h, families, own = self._candidates(model, eff, guess)
         cands = [m for family in families for m in family]
-        ranked = (
-            [cands[0]]
-            if len(cands) == 1
-            else [m for _, _, m in sorted((problem.squares(m), i, m) for i, m in enumerate(cands))]
-        )
+        # the families refitted on their own but not ranked with the rest (a read start)
+        pool = cands + [m for f in own for m in f if all(m is not c for c in cands)]
+        squares = [problem.squares(m) for m in pool] if len(pool) > 1 else [0.0]
+        order = sorted(range(len(pool)), key=lambda i: (squares[i], i))
+        ranked = [pool[i] for i in order if i < len(cands)]
         # the best start by the criterion that names the effect too, when it is another:
         # the squares and the criterion can prefer different basins (a set's ladder: the
         # squares' best start stopped at set 0.19, I2 0.127, the criterion's reached the
         # true 0.30, I2 0.0075)
         by_gap = self._by_gap(cands)
         first = [ranked[0]] + ([by_gap] if by_gap is not None and by_gap is not ranked[0] else [])
-        if lo < 0:
-            # a two-sided parameter (an offset): each ladder's best start too (from the
-            # law regressed beyond its rung, an offset of -46 um went to a basin at I2
-            # 0.32; from the plain regression's, to the truth: survey draw 26)
-            for family in families[1:]:
-                best_of_family = next(m for m in ranked if any(m is x for x in family))
-                if all(best_of_family is not m for m in first):
-                    first.append(best_of_family)
+        for family in own:
+            best_of_family = next(pool[i] for i in order if any(pool[i] is x for x in family))
+            if all(best_of_family is not m for m in first):
+                first.append(best_of_family)
         best = None
         for start in first:
             try:
@@ -128,11 +139,21 @@ class _Refits:
                     raise
 
     def _candidates(self, model, eff, guess):
-        """``(h, families)``: the effect's small step, signed to its LM direction's side,
-        and the refit's start candidates by family (see :meth:`refit`): the current law
+        """``(h, families, own)``: the effect's small step, signed to its LM direction's
+        side, the refit's start candidates by family (see :meth:`refit`): the current law
         with the effect at its LM step first, then the regression's (on the extended terms,
-        or with the effect's value on its ladder), and for an offset the ladder of laws
-        regressed beyond each rung."""
+        or with the effect's value on its ladder), for an offset the ladder of laws
+        regressed beyond each rung, and for stiffening supports the value the frame's own
+        equation reads (:meth:`Regressions.supports`); and the families whose best start
+        is refitted too (``own``).
+
+        A two-sided parameter (an offset) refits each ladder's best start: from the law
+        regressed beyond its rung, an offset of -46 um went to a basin at I2 0.32; from the
+        plain regression's, to the truth (survey draw 26).  The supports' reading is
+        refitted too: on survey draw 33's quieter record (a 0.3 ms contact) the true law's
+        basin is a few percent wide in the spring, and no refit from the ladder's rungs
+        reached it (I2 1.22-1.41, the truth 0.11), while the frame's equation reads ``k3``
+        to 0.1 %."""
         regress = self.regress
         lo, hi = eff.parameters[0].bounds
         # a two-sided parameter (an offset) starts on the side its LM direction points to,
@@ -146,7 +167,7 @@ class _Refits:
             names = list(model.law.names) + [Term.parse(eff.key).name]
             reg = _regressed(model.with_effect(eff, 0.0), names, regress)
             families.append([reg] if reg is not None else [])
-            return h, [f for f in families if f]
+            return h, [f for f in families if f], []
         # an effect on the unloading branch leaves the loading samples as they are
         reg = _regressed(
             model, model.law.names, regress, loading=eff.target in ("unloading", "set")
@@ -158,7 +179,14 @@ class _Refits:
             # (where no sample's penetration stands above its noise, the only ladder)
             beyond = [(_regressed(model, model.law.names, regress, shift=v), v) for v in values]
             families.append([_extend(b, eff, v) for b, v in beyond if b is not None])
-        return h, [f for f in families if f]
+        families = [f for f in families if f]
+        own = families[1:] if lo < 0 else []
+        read = regress.supports() if eff.key == "k3" and regress is not None else None
+        if read is not None and lo <= read <= hi:
+            family = [_extend(m, eff, read) for m in (model, reg) if m is not None]
+            base = family[-1]
+            own.append(family + [_springs(base, f) for f in _SPRING_SCAN])
+        return h, families, own
 
     def _by_gap(self, cands):
         """The candidate start with the lowest gap criterion (one evaluation each, its
