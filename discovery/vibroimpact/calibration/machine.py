@@ -358,7 +358,9 @@ def supports_reading(scenarios, measurements):
     held as ``scenarios`` give it: a start for a refit that adds stiffening supports to a
     machine given without them (the force's regression cannot see the supports).  None
     where a record has no positions, the records are of different machines, or the reading
-    is not a positive number."""
+    is not a positive number that moves the supports' force by :data:`MATERIAL` (as the
+    calibration keeps a stiffening: on records of linear supports the equations read a
+    ``k3`` whose share is 1e-6 to 1e-4, on stiffening ones 0.03 to 1.3)."""
     if len({_machine_key(s) for s in scenarios}) != 1:
         return None
     rows = [machine_rows(m, s) for s, m in zip(scenarios, measurements, strict=True)]
@@ -369,7 +371,9 @@ def supports_reading(scenarios, measurements):
     amps = ["A"] if len(rows) == 1 else [f"A[{r + 1}]" for r in range(len(rows))]
     held.update({a: s.A for a, s in zip(amps, scenarios, strict=True)})
     k3 = estimate(rows, held, []).get("k3")
-    return k3 if np.isfinite(k3) and k3 > 0 else None
+    if not (np.isfinite(k3) and k3 > 0 and stiffening_share(rows, sheet.k1, k3) >= MATERIAL):
+        return None
+    return k3
 
 
 def _first_estimate(rows, held, draws, probe_k3):

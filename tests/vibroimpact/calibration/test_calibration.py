@@ -200,7 +200,8 @@ def test_the_supports_reading_holds_the_given_machine_and_reads_k3():
     supports' start in explain, where the machine comes without them): within 1 % of the
     truth on a 1 %-noise record of the paper's machine with supports a third stiffer at
     its excursion, from one record and from two of different drives; on linear supports
-    a k3 far below that (or none); no reading without positions."""
+    none (a stiffening that moves their force by less than MATERIAL is the equations'
+    quadrature); none without positions."""
     from discovery.vibroimpact.calibration.machine import supports_reading
 
     sc = load_scenario("paper")
@@ -212,8 +213,7 @@ def test_the_supports_reading_holds_the_given_machine_and_reads_k3():
     other = sc.replace(A=0.8 * sc.A)
     m2 = _record(other.replace(k3=k3), sc.law, noise=0.01)
     assert supports_reading([sc, other], [m, m2]) == pytest.approx(k3, rel=0.01)
-    linear = supports_reading([sc], [_record(sc, sc.law, noise=0.01)])
-    assert linear is None or linear < 0.05 * k3
+    assert supports_reading([sc], [_record(sc, sc.law, noise=0.01)]) is None
     force_only = Measurement(t=m.t, F=m.F, channels={})
     assert supports_reading([sc], [force_only]) is None
     assert supports_reading([sc, sc.replace(m2=2 * sc.m2)], [m, m]) is None
