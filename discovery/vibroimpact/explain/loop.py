@@ -75,7 +75,7 @@ from .starts import (
     start_law,
 )
 from .state import _Run
-from .trials import _judged, _law_refit, _polish_winner, _refit_trials
+from .trials import _judged, _law_refit, _polish_winner, _refit_trials, by_verdict
 
 __all__ = ["ExplainResult", "Iteration", "explain", "start_law"]
 
@@ -236,6 +236,7 @@ def _name_effect(run, step, good, winner, trials):
             else ", not where this effect acts most (the phases are a hint; an effect that "
             "changes the whole impact moves the residual everywhere, and the refit decides)"
         )
+        + by_verdict(s, key)
         + _others(trials, s["effect"], key)
     )
     run.iterations.append(
@@ -330,7 +331,7 @@ def _refit_and_name(run, step):
     eff_by_id = step.screening.by_id
     gap = _gap(run, evs)
     trials, (null, null_after, null_evs) = _refit_trials(run, step, screen_budget, gap)
-    good = _judged(trials, null_after, step.floor, eff_by_id)
+    good = _judged(trials, null_after, step.floor, eff_by_id, null_evs)
     if not good and null_after and gap in null_after and null_after[gap] <= 0.9 * before[gap]:
         run.iterations.append(
             step.iteration(
@@ -349,7 +350,7 @@ def _refit_and_name(run, step):
     if not good:
         more = _unscored_trials(run, step, screen_budget, gap)
         trials += more
-        good = _judged(more, null_after, step.floor, eff_by_id)
+        good = _judged(more, null_after, step.floor, eff_by_id, null_evs)
     if not good:
         run.iterations.append(
             step.iteration(

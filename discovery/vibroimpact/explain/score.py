@@ -53,8 +53,12 @@ class Score:
     negligible : float or None
         The largest value of the effect's parameter that is negligible.
     beats_law_refit, present : bool or None
-        The refit beats the law refitted alone by the noise margin; the effect's parameter
-        is not within two standard errors of 0 (the trials judged).
+        The refit beats the law refitted alone by the noise margin (or by the verdict);
+        the effect's parameter is not within two standard errors of 0 (the trials judged).
+    law_alone_inconsistent : float or None
+        Where the refit beat the law refitted alone by the verdict (within the noise margin,
+        lower and consistent with every record where that law is not): that law's gap
+        criterion.
     """
 
     effect: str
@@ -76,6 +80,7 @@ class Score:
     force_worse: bool | None = None
     beats_law_refit: bool | None = None
     present: bool | None = None
+    law_alone_inconsistent: float | None = None
 
     @classmethod
     def from_dict(cls, d):

@@ -100,3 +100,41 @@ def test_an_iteration_saves_its_scores_as_before_and_loads_them():
     assert doc["parameters"] == {"c_zzd": 2.1e10}
     back = Iteration.from_dict(doc)
     assert back.scores == it.scores and all(isinstance(s, Score) for s in back.scores)
+
+
+@pytest.mark.parametrize(
+    ("after", "consistent", "law_consistent", "beats", "by_verdict"),
+    [
+        (0.020, False, False, True, False),  # beats the law alone by the floor (0.025)
+        (0.026, True, False, True, True),  # within the floor, consistent where the law is not
+        (0.026, False, False, False, False),  # within the floor, neither consistent
+        (0.026, True, True, False, False),  # within the floor, both consistent
+        (0.026, True, None, False, False),  # the law's verdict unknown
+        (0.051, True, False, False, False),  # not lower than the law alone
+    ],
+)
+def test_a_refit_beats_the_law_alone_by_the_floor_or_by_the_verdict(
+    after, consistent, law_consistent, beats, by_verdict
+):
+    """Survey draw 28's noisier record (a slow transient, a mass loss): the loss's refit
+    reached the truth (I2 0.026, consistent), the law refitted alone 0.050 with its
+    penetration off (not consistent), 0.024 short of the floor 0.025. Within the floor the
+    whole verdict decides; the evidence says so."""
+    from discovery.vibroimpact.explain.effects import effect
+    from discovery.vibroimpact.explain.trials import _Trial, by_verdict as clause
+
+    score = {
+        "effect": "mass_loss",
+        "criteria_after": {"I2": after},
+        "consistent_after": consistent,
+        "negligible": 1e-4,
+    }
+    trial = _Trial(0.5, score, Model(ForceLaw.parse("1e8*z + 1e6*zd")), None, [], "I2")
+    trial.judge(effect("mass_loss"), {"I2": 0.050}, {"I2": 0.025}, law_consistent)
+    assert score["beats_law_refit"] is beats
+    assert ("law_alone_inconsistent" in score) is by_verdict
+    text = clause(score, "I2")
+    assert (text != "") is by_verdict
+    if by_verdict:
+        assert "0.05, within the noise floor of this refit, but is not consistent" in text
+        assert Score.from_dict(score).law_alone_inconsistent == 0.050
