@@ -121,7 +121,8 @@ def test_a_refit_beats_the_law_alone_by_the_floor_or_by_the_verdict(
     penetration off (not consistent), 0.024 short of the floor 0.025. Within the floor the
     whole verdict decides; the evidence says so."""
     from discovery.vibroimpact.explain.effects import effect
-    from discovery.vibroimpact.explain.trials import _Trial, by_verdict as clause
+    from discovery.vibroimpact.explain.trials import _Trial
+    from discovery.vibroimpact.explain.trials import by_verdict as clause
 
     score = {
         "effect": "mass_loss",
