@@ -57,8 +57,8 @@ class Score:
         the effect's parameter is not within two standard errors of 0 (the trials judged).
     law_alone_inconsistent : float or None
         Where the refit beat the law refitted alone by the verdict (within the noise margin,
-        lower and consistent with every record where that law is not): that law's gap
-        criterion.
+        lower, at the noise floor and consistent with every record where that law is not):
+        that law's gap criterion.
     """
 
     effect: str
