@@ -501,18 +501,6 @@ def _law_start(run):
 NEAR_FLOOR = 1.25
 
 
-def by_verdict(score, key):
-    """The evidence's clause for an effect named over the law refitted alone by the verdict
-    (:meth:`_Trial.judge`), else ""."""
-    law = score.get("law_alone_inconsistent")
-    if law is None:
-        return ""
-    return (
-        f"; the law refitted alone reached {key} {law:.3g}, within the noise floor of this "
-        "refit, but is not consistent with the record(s), where this refit is"
-    )
-
-
 def _judged(trials, null_after, floor, eff_by_id, null_evs=None):
     """The trials that name an effect, each judged (:meth:`_Trial.judge`) against the law
     refitted alone (``null_after``, its evaluations ``null_evs``) and the noise ``floor``."""

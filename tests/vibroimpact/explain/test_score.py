@@ -124,8 +124,8 @@ def test_a_refit_beats_the_law_alone_by_the_floor_or_by_the_verdict(
     Hertz term took a refit to twice the floor, just under its limit, standing in for what
     a calibrated machine misses); the evidence says so."""
     from discovery.vibroimpact.explain.effects import effect
+    from discovery.vibroimpact.explain.naming import by_verdict as clause
     from discovery.vibroimpact.explain.trials import _Trial
-    from discovery.vibroimpact.explain.trials import by_verdict as clause
 
     score = {
         "effect": "mass_loss",
