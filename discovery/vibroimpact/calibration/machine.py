@@ -12,7 +12,14 @@ from ..data.measurement import Measurement
 from ..data.periods import check_drive_period
 from ..model.scenario import Scenario
 from .equations import machine_rows
-from .estimate import cycle_draws, drive_phase, estimate, frame_residual, moulding_residual
+from .estimate import (
+    cycle_draws,
+    drive_phase,
+    estimate,
+    frame_residual,
+    moulding_residual,
+    parameter_names,
+)
 from .result import UNITS, Calibration
 from .sensor import sensor_lag, with_lag
 from .shedding import MATERIAL, shedding
@@ -281,7 +288,7 @@ def _calibrate_group(rows, sheets, keep, n_boot, seed, *, found=False):
     sheet = sheets[0]
     R = len(rows)
     draws = cycle_draws(rows, n_boot, seed)
-    amps = ["A"] if R == 1 else [f"A[{r + 1}]" for r in range(R)]
+    amps = parameter_names(R)[4:-1]  # each record's drive amplitude
     sheet_values = {
         "m1": sheet.m1,
         "c1": sheet.c1,
@@ -368,7 +375,7 @@ def supports_reading(scenarios, measurements):
         return None
     sheet = scenarios[0]
     held = {n: getattr(sheet, n) for n in ("m1", "c1", "k1", "m2")}
-    amps = ["A"] if len(rows) == 1 else [f"A[{r + 1}]" for r in range(len(rows))]
+    amps = parameter_names(len(rows))[4:-1]  # each record's drive amplitude
     held.update({a: s.A for a, s in zip(amps, scenarios, strict=True)})
     k3 = estimate(rows, held, []).get("k3")
     if not (np.isfinite(k3) and k3 > 0 and stiffening_share(rows, sheet.k1, k3) >= MATERIAL):

@@ -293,15 +293,7 @@ def _start_candidates(text, records, measurements):
     # elastically, so the contact lasts at least a quarter of the spring's period) is far
     # shorter than the half period the contact-time stiffness assumes; stiffer ones: a
     # noisy force's threshold (2 % of the peak) reads a short contact longer than it is
-    for f in (0.25, 0.25**2, 0.25**3, 4.0, 16.0):
-        others.append(
-            phys.with_coefficients(
-                [
-                    c * f if t.b == 0 else c
-                    for t, c in zip(phys.terms, phys.coefficients, strict=True)
-                ]
-            )
-        )
+    others += [phys.with_springs_scaled(f) for f in (0.25, 0.25**2, 0.25**3, 4.0, 16.0)]
     return ([reg] if reg is not None else []), others
 
 

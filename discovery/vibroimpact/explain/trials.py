@@ -40,13 +40,6 @@ _LADDER = tuple(2.0**k for k in range(13))
 _SPRING_SCAN = tuple(1.0 + 0.01 * k for k in range(-6, 9) if k)
 
 
-def _springs(model, factor):
-    """``model`` with its law's elastic terms (no velocity factor) scaled by ``factor``."""
-    law = model.law
-    pairs = zip(law.terms, law.coefficients, strict=True)
-    return model.with_law(law.with_coefficients([c * factor if t.b == 0 else c for t, c in pairs]))
-
-
 def _side(guess, lo):
     """-1 where the parameter may be negative (``lo < 0``, an offset) and its LM direction
     ``guess`` points there, else 1."""
@@ -185,7 +178,9 @@ class _Refits:
         if read is not None and lo <= read <= hi:
             family = [_extend(m, eff, read) for m in (model, reg) if m is not None]
             base = family[-1]
-            own.append(family + [_springs(base, f) for f in _SPRING_SCAN])
+            own.append(
+                family + [base.with_law(base.law.with_springs_scaled(f)) for f in _SPRING_SCAN]
+            )
         return h, families, own
 
     def _by_gap(self, cands):

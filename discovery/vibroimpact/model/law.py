@@ -276,6 +276,12 @@ class ForceLaw:
         is kept."""
         return replace(self, coefficients=tuple(float(v) for v in values))
 
+    def with_springs_scaled(self, factor):
+        """The law with its loading branch's elastic terms (those without a velocity
+        factor) scaled by ``factor``; the damping terms and the unloading branch kept."""
+        pairs = zip(self.terms, self.coefficients, strict=True)
+        return self.with_coefficients([c * factor if t.b == 0 else c for t, c in pairs])
+
     def with_unloading(self, terms=None, coefficients=None, permanent_set=None):
         """The same loading branch with another unloading branch (None keeps a part)."""
         return replace(

@@ -299,3 +299,14 @@ def test_check_physical_accepts_real_laws_and_names_what_is_wrong(paper, light):
         ForceLaw.parse("0*z").check_physical(paper)
     with pytest.raises(InputError, match=r"condition \(6\)"):
         ForceLaw.parse("2e8*z + 1e7*zd - 1e10*z*zd").check_physical(paper)  # z > 1 mm
+
+
+def test_springs_scaled_leave_the_damping_and_the_unloading_branch():
+    """The elastic terms (no velocity factor) scaled; damping terms, the unloading branch and
+    the set as they were (the start laws' softer springs, explain's spring scan)."""
+    law = ForceLaw.parse("2e8*z + 1e9*z^1.5 + 1e7*zd + 3e10*z*zd; unloading: 4e6*zd; set: 0.1")
+    got = law.with_springs_scaled(0.5)
+    assert got.as_dict() == {"z": 1e8, "z^1.5": 5e8, "zd": 1e7, "z*zd": 3e10}
+    assert got.unloading == law.unloading
+    assert got.unloading_coefficients == law.unloading_coefficients
+    assert got.permanent_set == law.permanent_set
