@@ -14,7 +14,6 @@ whole impacts.
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import savgol_filter
 
 from ..._api._printing import fmt, readable
 from ..._api._validate import Choice, Real, Text, params
@@ -252,6 +251,8 @@ def contact_samples(
             raise InputError("derivative 'velocities' needs the v1 and v2 columns")
         dzeta = ch["v1"] - ch["v2"]
     elif derivative == "savgol":
+        from scipy.signal import savgol_filter  # 0.4 s to import; only this option needs it
+
         dzeta = savgol_filter(zeta, window, 3, deriv=1, delta=dt)
     else:
         from pysindy.differentiation import SmoothedFiniteDifference

@@ -107,6 +107,20 @@ class _EdgeWatch:
             raise StopIteration
 
 
+#: a least-squares fit stops when its step lowers the sum of squares by less than this share
+#: of the residual variance ``s^2 = cost / dof`` (the scale of the standard errors): the
+#: estimate then moves by a few hundredths of a standard error at most.  With scipy's fixed
+#: ``ftol`` of 1e-12 the fits of the bench record went on for as many iterations again after
+#: that point (each one a simulation and its sensitivities per record): CHANGELOG.
+FTOL_VARIANCE = 1e-3
+
+
+def _ftol(obj):
+    """scipy's relative ``ftol`` for :data:`FTOL_VARIANCE` (``dF < ftol * F`` with ``F``
+    the sum of squares, about ``s^2 * dof``)."""
+    return max(FTOL_VARIANCE / obj.dof, 1e-12)
+
+
 def _optimise(obj, x0, method, xtol, max_simulations):
     """Run ``method`` on the objective from ``x0``; returns the optimiser's message."""
     try:
@@ -139,7 +153,7 @@ def _optimise(obj, x0, method, xtol, max_simulations):
             x_scale=1.0,
             diff_step=1e-6,
             xtol=xtol * 1e-2,
-            ftol=1e-12,
+            ftol=_ftol(obj),
             gtol=1e-12,
             callback=watch,
         )

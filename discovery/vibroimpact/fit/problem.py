@@ -180,6 +180,13 @@ class _Objective:
     def law(self, x):
         return self.start.with_coefficients(self.c0 * np.asarray(x))
 
+    @property
+    def dof(self):
+        """The residuals' degrees of freedom: their count (every compared cycle's weighted
+        force but its first point, then the penetration's rows) less the parameters."""
+        m = sum(w.size - 1 for ws in self.w for w in ws) + self.n_motion
+        return max(m - len(self.c0), 1)
+
     def evaluations(self, x):
         key = tuple(np.round(np.asarray(x, dtype=float), 14))
         if key not in self.cache:
