@@ -5,7 +5,7 @@ output-error refits (:func:`~discovery.vibroimpact.fit.identification.identify`)
 
 import itertools
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -182,10 +182,12 @@ def _regression(names, samples, loading=False, shift=0.0):
 
 class Regressions:
     """The certified regressions of one run's records (:func:`_regression`), called as
-    ``regress(names, loading=False, shift=0.0)``: over the samples whose penetration
-    stands above its noise, or with a ``shift`` (a contact offset) over those the force
-    says are in contact, since an offset moves the recorded penetration's zero (a record
-    whose contacts start 0.88 mm below it has no samples by penetration; survey draw 6).
+    ``regress(names, loading=False, shift=0.0, lag=0.0)``: over the samples whose
+    penetration stands above its noise, or with a ``shift`` (a contact offset) over those
+    the force says are in contact, since an offset moves the recorded penetration's zero (a
+    record whose contacts start 0.88 mm below it has no samples by penetration; survey draw
+    6); with a ``lag`` (a sensor's time constant), of the force before the lag
+    (:meth:`unlagged`).
     A call returns None where the records have no such samples."""
 
     def __init__(self, scenarios, measurements):
@@ -193,12 +195,24 @@ class Regressions:
         self.samples = _joined_samples(scenarios, measurements)
         self._by_force = self._supports = None
 
-    def __call__(self, names, loading=False, shift=0.0):
+    def __call__(self, names, loading=False, shift=0.0, lag=0.0):
+        if lag:
+            return _regression(names, self.unlagged(lag), loading)
         if not shift:
             fit = _regression(names, self.samples, loading)
             if fit is not None:
                 return fit
         return _regression(names, self.by_force(), loading, shift)
+
+    def unlagged(self, tau):
+        """The contact samples of the force a first-order sensor lag of time constant
+        ``tau`` would have recorded as the measured one: ``F + tau dF/dt`` (the lag's
+        inverse, the derivative by central differences; noisier than the record, which
+        a regression's target may be, unbiased)."""
+        return _joined_samples(
+            self.scenarios,
+            [replace(m, F=m.F + tau * np.gradient(m.F, m.t)) for m in self.measurements],
+        )
 
     def supports(self):
         """The supports' ``k3`` the frame's own equation reads from the records, the rest of
@@ -220,17 +234,18 @@ class Regressions:
         return self._by_force or None
 
 
-def _regressed(model, names, regress, loading=False, shift=0.0):
+def _regressed(model, names, regress, *, loading=False, shift=0.0, lag=0.0):
     """``model`` with every loading coefficient from the certified regression of the
     measured force on the terms ``names`` (its unloading branch and added effects kept);
     None when the records have no positions or the regression fails.  The regression sees
     the force against the measured penetration alone, so a start law that has compensated
     for a missing effect with its coefficients (a stiffer spring for a Hertz term or for
     stiffening supports) does not hold the refit in its basin.  ``shift``: the penetration
-    the force starts from (a contact offset's, :func:`_regression`)."""
+    the force starts from (a contact offset's, :func:`_regression`); ``lag``: the time
+    constant of a sensor lag the force is read through (:meth:`Regressions.unlagged`)."""
     if regress is None:
         return None
-    fit = regress(list(names), loading, shift)
+    fit = regress(list(names), loading, shift, lag)
     if fit is None:
         return None
     law = model.law
