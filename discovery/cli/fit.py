@@ -4,6 +4,7 @@ import argparse
 import csv
 import io
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 from .._files._io import OutputDir
 from ..errors import InputError
@@ -112,18 +113,21 @@ def _write_outputs(args, res, t_start):
                     m.evaluation.simulated,
                 )
             )
-    with OutputDir(args.out) as out:
+    with OutputDir(args.out) as out, ThreadPoolExecutor(1) as latex:
         out.path("ranking.csv").write_text(_ranking_csv(res))
         fit_impulse_figure(res, imps, str(out.path("fit_impulse")))
-        fit_surface_figure(res, str(out.path("fit_surface")))
-        fit_loop_figure(res, str(out.path("fit_loop")))
         # model.tex is a template of the report system, rendered from the summary itself
         out.path("model.tex").write_text(render(res.to_dict(), out.stage, template="model"))
-        pdf, why = (
-            compile_tex(out.path("model.tex"), ["fit_impulse.pdf"])
+        # LaTeX runs while the other two figures are drawn (a subprocess: this thread only
+        # waits for it); it needs only the first figure
+        compiled = (
+            latex.submit(compile_tex, out.path("model.tex"), ["fit_impulse.pdf"])
             if not args.no_pdf
-            else (None, None)
+            else None
         )
+        fit_surface_figure(res, str(out.path("fit_surface")))
+        fit_loop_figure(res, str(out.path("fit_loop")))
+        pdf, why = compiled.result() if compiled is not None else (None, None)
         why = None if pdf is not None else why
         # the run's record, with the PDF and the whole command's wall time
         res.record_run(
