@@ -9,8 +9,10 @@ count is a number in this process's :data:`COUNTS`, raised where the work is don
 * ``evaluations``: a law judged against a record (one full simulation of the law over the
   record and its criteria, :func:`~discovery.vibroimpact.verify.evaluation.evaluate`),
   counted when asked for (a repeat answered from the cache counts too);
-* ``criteria``: criterion sets computed
+* ``criteria``: criterion sets computed, every criterion of a comparison
   (:func:`~discovery.vibroimpact.verify.criteria.evaluate_criteria`);
+* ``objectives``: comparisons of which only some criteria were computed (an optimiser's
+  objective, the other criteria of its evaluations only at its end; a transient's I2);
 * ``steady_states``: periodic steady states searched
   (:func:`~discovery.vibroimpact.dynamics.steady_states.steady_state`);
 * ``period_maps``: drive periods the steady-state searches integrated (Newton's and the
@@ -30,6 +32,7 @@ __all__ = ["COUNTS", "NAMES", "count", "snapshot", "since", "add", "reset", "cou
 NAMES = {
     "evaluations": "laws judged against a record (asked for)",
     "criteria": "criterion sets computed",
+    "objectives": "comparisons of an optimiser's criterion alone",
     "steady_states": "steady states searched",
     "period_maps": "drive periods integrated by the steady-state searches",
 }

@@ -75,13 +75,13 @@ def test_a_residual_after_a_verification_reuses_its_simulations(span_record):
     full = evaluate(sc, law, ref)
     runs = traj.MEMO.misses
     assert runs == len(ref.span.blocks)
-    smooth = evaluate(sc, law, ref, floor=False, smooth_onset=True)
+    smooth = evaluate(sc, law, ref, floor=False, objective=("I2",))
     # no new run: the floor and the residual asked the verification's runs again
     assert traj.MEMO.misses == runs and traj.MEMO.hits >= runs
     again = evaluate(sc, law, ref)
     _same(full, again)
     traj.MEMO.clear()
-    _same(smooth, evaluate(sc, law, ref, floor=False, smooth_onset=True))
+    _same(smooth, evaluate(sc, law, ref, floor=False, objective=("I2",)))
     # another law is another simulation
     other = evaluate(sc, ForceLaw.parse("2.2e8*z + 1.1e7*zd"), ref, floor=False)
     assert traj.MEMO.misses == 2 * runs and other.criteria != smooth.criteria

@@ -455,7 +455,7 @@ def _identified(records, start, s, progress):
         # before the error probes
         x_best, message = _fitted(obj, s.method, s.xtol, s.max_simulations)
     law = obj.law(x_best)
-    evs = obj.evaluations(x_best)
+    evs = obj.full_evaluations(x_best)
     if evs is None:  # a given-up start compared on the blocks before: never, short of a bug
         raise IntegrationError(f"the law {law} cannot be compared with the record")
     se, corr = {}, None

@@ -20,6 +20,7 @@ from ...errors import InputError, IntegrationError
 from ...numerics.memo import Memo, value_key
 from ..model.law import ForceLaw, Term
 from ..verify import evaluate
+from ..verify.criteria import CRITERIA
 from ..verify.criteria import criterion as _criterion
 from ..verify.motion import penetration_jacobian, penetration_residuals, penetration_size
 from .records import _measured_cycles, _named, _residual_weights, cycle_pairs, model_parts
@@ -99,6 +100,8 @@ class ModelProblem:
         return self._memo.get(key, lambda: self._evaluate(model, floor, smooth_onset))
 
     def _evaluate(self, model, floor, smooth_onset):
+        """The evaluations of :meth:`evaluations`; those with the onset smoothed are the
+        residual's (:meth:`residual`), which reads the histories and no criterion."""
         law, machine, observe = model_parts(model)
         evs = []
         for sc, ref in self.records:
@@ -111,7 +114,7 @@ class ModelProblem:
                     tolerances=self.tol,
                     floor=floor,
                     observe=observe,
-                    smooth_onset=smooth_onset,
+                    objective=() if smooth_onset else None,
                 )
             )
         return evs
@@ -188,6 +191,9 @@ class _Objective:
         return max(m - len(self.c0), 1)
 
     def evaluations(self, x):
+        """Every record's evaluation at ``x`` with the objective's criterion alone (what the
+        optimisers read; :meth:`full_evaluations` for every criterion), None where one
+        fails; cached, and counted against the budget."""
         key = tuple(np.round(np.asarray(x, dtype=float), 14))
         if key not in self.cache:
             if self.n + len(self.records) > self.max_sim:
@@ -204,7 +210,7 @@ class _Objective:
                     tolerances=self.tol,
                     floor=False,
                     observe=observe,
-                    smooth_onset=True,
+                    objective=(self.name,),
                     **self._continued(i, x),
                 )
                 if ev.status == "ok" and getattr(ref, "span", None) is None:
@@ -221,6 +227,26 @@ class _Objective:
                     break
             self.cache[key] = evs if all(e.status == "ok" for e in evs) else None
         return self.cache[key]
+
+    def full_evaluations(self, x):
+        """Every record's evaluation at ``x`` (met before: :meth:`evaluations`) with every
+        criterion: its block runs are the memo's, so only the criteria are computed."""
+        if self.evaluations(x) is None:
+            return None
+        law, machine, observe = model_parts(self.law(x), self.observe)
+        return [
+            evaluate(
+                machine(sc, ref),
+                law,
+                ref,
+                tolerances=self.tol,
+                floor=False,
+                observe=observe,
+                objective=tuple(CRITERIA),
+                **self._continued(i, x),
+            )
+            for i, (sc, ref) in enumerate(self.records)
+        ]
 
     def _continued(self, i, x):
         """``{"guess": orbit}``: the solved steady orbit of record ``i`` nearest to ``x``

@@ -47,7 +47,7 @@ from .consistency import (
 from .criteria import compare, criteria_lines, evaluate_criteria
 from .motion import MOTION_CRITERION
 from .notes import contacts_note, transient_notes
-from .span_evaluation import span_run
+from .span_evaluation import BlockJob, span_run
 
 __all__ = ["Evaluation", "evaluate"]
 
@@ -353,7 +353,7 @@ def evaluate(
     from_state=True,
     floor=True,
     observe=None,
-    smooth_onset=False,
+    objective=None,
     **steady_kwargs,
 ):
     """Simulate ``law`` and score it against ``reference`` (see the module docstring).
@@ -375,12 +375,15 @@ def evaluate(
         An observation model ``Impulse -> Impulse`` applied to the exact simulated force
         history before it is aligned and sampled (e.g. the force sensor's own dynamics,
         :func:`~discovery.vibroimpact.verify.sensors.observation`).
-    smooth_onset : bool
-        For a record span: the simulated sample whose interval holds a contact onset is
-        the force averaged over that interval (see
-        :func:`~discovery.vibroimpact.verify.trajectory.simulated_history`), so the criteria are
-        continuous in the law's coefficients (optimisers: ``identify``); the default
-        compares point samples with the record's point samples (the verdict).
+    objective : sequence of str, optional
+        An optimiser's evaluation: the criteria it reads (``()``: none, the residual reads
+        the histories), only those computed without a floor (a record with positions adds
+        its I5; the others, the contact supports of I0 and I4 most, were a quarter of an
+        evaluation's time); and for a record span the simulated sample whose interval holds
+        a contact onset is the force averaged over that interval (see
+        :func:`~discovery.vibroimpact.verify.trajectory.simulated_history`), so the criteria
+        are continuous in the law's coefficients.  The default (None) is the verdict's:
+        every criterion, point samples compared with the record's point samples.
     **steady_kwargs
         Passed to :func:`~discovery.vibroimpact.dynamics.steady_states.steady_state`.
 
@@ -389,17 +392,18 @@ def evaluate(
     Evaluation
     """
     counts.count("evaluations")
+    names = None if floor or objective is None else tuple(objective)
     if from_state and getattr(reference, "span", None) is not None:
-        return _evaluate_span(
+        job = BlockJob(
             scenario,
             law,
-            reference,
-            tolerances=tolerances,
-            floor=floor,
-            observe=observe,
-            steady_kwargs=steady_kwargs,
-            smooth_onset=smooth_onset,
+            tolerances,
+            observe,
+            objective is not None,
+            reference.impulse.onset,
+            names,
         )
+        return _evaluate_span(job, reference, floor=floor, steady_kwargs=steady_kwargs)
     reg = {"measured": reference.regime, "simulated": None}
     imp = {"measured": reference.impacts, "simulated": None}
     if from_state and reference.start is not None:
@@ -442,7 +446,7 @@ def evaluate(
     rot, sim = align(reference.impulse, exact)
     # contacts per simulated orbit, seen through the measurement's threshold rules
     imp["simulated"] = int(round(len(sim.support) * ss.n_periods / sim.n_periods))
-    crit = evaluate_criteria(reference.impulse, sim)
+    crit = evaluate_criteria(reference.impulse, sim, names)
     if not floor:
         return Evaluation(
             "ok", reg, imp, crit, {}, False, "", steady=ss, simulated=sim, aligned=rot
@@ -557,14 +561,14 @@ def _span_steady_state(scenario, law, reference, sim, reg, *, tolerances, steady
     return ss, _orbit_gap(orbit, sim), ""
 
 
-def _evaluate_span(
-    scenario, law, reference, *, tolerances, floor, observe, steady_kwargs, smooth_onset=False
-):
-    """:func:`evaluate` for a record with positions: the law simulated from the machine's
-    states across the record's span, block by block, both histories folded by the same
-    operator (:mod:`~discovery.vibroimpact.verify.trajectory`); the criteria are the blocks' mean
+def _evaluate_span(job, reference, *, floor, steady_kwargs):
+    """:func:`evaluate` for a record with positions (what each block is asked: ``job``, a
+    :class:`~.span_evaluation.BlockJob`): the law simulated from the machine's states
+    across the record's span, block by block, both histories folded by the same operator
+    (:mod:`~discovery.vibroimpact.verify.trajectory`); the criteria are the blocks' mean
     (weighted by cycles); the steady state is found only to report the law's regime and to
     tell a transient from a regime mismatch."""
+    scenario, law, tolerances, observe = job.scenario, job.law, job.tolerances, job.observe
     span = reference.span
     E = reference.impulse
     reg = {"measured": reference.regime, "simulated": None}
@@ -572,9 +576,7 @@ def _evaluate_span(
     try:
         # every block run, folded and compared (shared out over a block farm when one holds
         # the span: :mod:`~discovery.vibroimpact.verify.block_farm`)
-        blocks = span_run(
-            scenario, law, reference, tolerances=tolerances, observe=observe, window=smooth_onset
-        )
+        blocks = span_run(job, reference)
     except IntegrationError as exc:
         return _failed(reg, imp, exc)
     hist, z_sim = blocks.histories, blocks.penetrations
@@ -607,7 +609,7 @@ def _evaluate_span(
             "blocks": len(span.blocks),
             "state": last.state.method,
             "state_samples": last.state.n_samples,
-            "block_I2": [p["I2"] for p in per_block],
+            "block_I2": [p.get("I2") for p in per_block],
         },
     }
     if not floor:

@@ -53,7 +53,8 @@ class BlockOutcome:
 class BlockJob:
     """What every block of one evaluation is asked (:func:`block_outcome`): the machine,
     the law, the integrator's settings, the observation model, the onset window
-    (:func:`simulated_history`) and the record's onset time."""
+    (:func:`simulated_history`), the record's onset time and the criteria computed (None:
+    every one)."""
 
     scenario: object
     law: object
@@ -61,6 +62,7 @@ class BlockJob:
     observe: object = None
     window: bool = False
     onset: float | None = None
+    criteria: tuple | None = None
 
 
 def block_outcome(reference, k, job):
@@ -83,7 +85,7 @@ def block_outcome(reference, k, job):
     except Exception as exc:
         return BlockOutcome(run, H, error=exc, stage=2)
     try:
-        crit = unchecked(evaluate_criteria)(reference.blocks[k], imp, None)
+        crit = unchecked(evaluate_criteria)(reference.blocks[k], imp, job.criteria)
     except Exception as exc:
         return BlockOutcome(run, H, imp, error=exc, stage=3)
     if not span.sigma_z > 0:
@@ -135,13 +137,14 @@ class SpanRun:
         return penetration_mean(span, per), per
 
 
-def span_run(scenario, law, reference, *, tolerances=None, observe=None, window=False):
-    """Every block of ``reference``'s span evaluated (:func:`block_outcome`): shared out over
-    the block farm that holds the span (:func:`~.block_farm.shared_blocks`), else here in
-    block order.  Raises the first block's run failure (as :func:`simulated_motion`);
-    the runs a farm made are kept in :data:`~.trajectory.MEMO` as if made here."""
+def span_run(job, reference):
+    """Every block of ``reference``'s span evaluated for ``job`` (a :class:`BlockJob`,
+    :func:`block_outcome`): shared out over the block farm that holds the span
+    (:func:`~.block_farm.shared_blocks`), else here in block order.  Raises the first
+    block's run failure (as :func:`simulated_motion`); the runs a farm made are kept in
+    :data:`~.trajectory.MEMO` as if made here."""
     span = reference.span
-    job = BlockJob(scenario, law, tolerances, observe, window, reference.impulse.onset)
+    scenario, law, tolerances = job.scenario, job.law, job.tolerances
     farm = farm_for(span)
     outcomes = None if farm is None else farm.map(block_outcome, span, (job,))
     if outcomes is not None:

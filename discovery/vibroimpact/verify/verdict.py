@@ -270,7 +270,7 @@ def _profiled_scale(scenario, law, ref, bounds, how):
         return scenario, "the machine's scale is fixed"
 
     def i2(factor):
-        ev = evaluate(scenario.scaled(factor), law, ref, floor=False, smooth_onset=True, **how)
+        ev = evaluate(scenario.scaled(factor), law, ref, floor=False, objective=("I2",), **how)
         v = ev.criteria.get("I2") if ev.status == "ok" and ev.criteria else None
         return float(v) if v is not None and np.isfinite(v) else 1e3
 

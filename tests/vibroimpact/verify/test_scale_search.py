@@ -89,7 +89,7 @@ def test_the_scale_chosen_is_as_good_as_a_dense_grid_of_verifications(sheet_reco
     ref = Reference.from_measurement(rec, cal.scenario, n_boot=16, seed=0)
 
     def i2(f):
-        ev = evaluate(cal.scenario.scaled(f), law, ref, floor=False, smooth_onset=True)
+        ev = evaluate(cal.scenario.scaled(f), law, ref, floor=False, objective=("I2",))
         return ev.criteria["I2"]
 
     grid = min(i2(f) for f in np.linspace(lo, hi, 21))
