@@ -22,7 +22,12 @@ from ..model.law import ForceLaw, Term
 from ..verify import evaluate
 from ..verify.criteria import CRITERIA
 from ..verify.criteria import criterion as _criterion
-from ..verify.motion import penetration_jacobian, penetration_residuals, penetration_size
+from ..verify.motion import (
+    MOTION_CRITERION,
+    penetration_jacobian,
+    penetration_residuals,
+    penetration_size,
+)
 from .records import _measured_cycles, _named, _residual_weights, cycle_pairs, model_parts
 
 _PENALTY = 10.0  # criterion value of a failed simulation (criteria are O(1))
@@ -242,7 +247,7 @@ class _Objective:
                 tolerances=self.tol,
                 floor=False,
                 observe=observe,
-                objective=tuple(CRITERIA),
+                objective=(*CRITERIA, MOTION_CRITERION),
                 **self._continued(i, x),
             )
             for i, (sc, ref) in enumerate(self.records)

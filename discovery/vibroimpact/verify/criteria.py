@@ -386,8 +386,8 @@ def criterion(name):
 @params(measured=(_IMPULSE, None), simulated=(_IMPULSE, None), names=(None, list, tuple))
 def evaluate_criteria(measured, simulated, names=None):
     """``{name: value}`` for the requested criteria (default all), measured vs simulated."""
-    counts.count("criteria" if names is None else "objectives")
     names = list(CRITERIA) if names is None else list(names)
+    counts.count("criteria" if set(names) >= set(CRITERIA) else "objectives")
     funcs = {n: criterion(n) for n in names}
     c = compare(measured, simulated)
     return {n: float(f(c)) for n, f in funcs.items()}

@@ -47,7 +47,7 @@ from .consistency import (
 from .criteria import compare, criteria_lines, evaluate_criteria
 from .motion import MOTION_CRITERION
 from .notes import contacts_note, transient_notes
-from .span_evaluation import BlockJob, span_run
+from .span_evaluation import BlockJob, force_criteria, span_run, wants_motion
 
 __all__ = ["Evaluation", "evaluate"]
 
@@ -377,10 +377,10 @@ def evaluate(
         :func:`~discovery.vibroimpact.verify.sensors.observation`).
     objective : sequence of str, optional
         An optimiser's evaluation: the criteria it reads (``()``: none, the residual reads
-        the histories), only those computed without a floor (a record with positions adds
-        its I5; the others, the contact supports of I0 and I4 most, were a quarter of an
-        evaluation's time); and for a record span the simulated sample whose interval holds
-        a contact onset is the force averaged over that interval (see
+        the histories; I5 only when named), only those computed without a floor (the
+        others, the contact supports of I0 and I4 and the penetration's I5 most, were
+        about 40 % of an evaluation's time); and for a record span the simulated sample
+        whose interval holds a contact onset is the force averaged over that interval (see
         :func:`~discovery.vibroimpact.verify.trajectory.simulated_history`), so the criteria
         are continuous in the law's coefficients.  The default (None) is the verdict's:
         every criterion, point samples compared with the record's point samples.
@@ -446,7 +446,7 @@ def evaluate(
     rot, sim = align(reference.impulse, exact)
     # contacts per simulated orbit, seen through the measurement's threshold rules
     imp["simulated"] = int(round(len(sim.support) * ss.n_periods / sim.n_periods))
-    crit = evaluate_criteria(reference.impulse, sim, names)
+    crit = evaluate_criteria(reference.impulse, sim, force_criteria(names))
     if not floor:
         return Evaluation(
             "ok", reg, imp, crit, {}, False, "", steady=ss, simulated=sim, aligned=rot
@@ -595,7 +595,7 @@ def _evaluate_span(job, reference, *, floor, steady_kwargs):
     sim = sims[-1]
     imp["simulated"] = int(len(sim.support))
     crit, per_block = blocks.criteria(span)
-    if span.sigma_z > 0:
+    if span.sigma_z > 0 and wants_motion(job.criteria):
         crit[MOTION_CRITERION], _ = blocks.penetration(span)
     last = span.blocks[-1]
     found = {

@@ -11,10 +11,18 @@ import numpy as np
 from ..._api._validate import unchecked
 from .block_farm import farm_for
 from .criteria import evaluate_criteria
-from .motion import fold_penetration, penetration_mean
+from .motion import MOTION_CRITERION, fold_penetration, penetration_mean
 from .trajectory import _block_mean, _history, _memo_run
 
-__all__ = ["BlockJob", "BlockOutcome", "block_outcome", "SpanRun", "span_run"]
+__all__ = [
+    "BlockJob",
+    "BlockOutcome",
+    "block_outcome",
+    "SpanRun",
+    "span_run",
+    "force_criteria",
+    "wants_motion",
+]
 
 
 @dataclass(frozen=True)
@@ -65,6 +73,16 @@ class BlockJob:
     criteria: tuple | None = None
 
 
+def force_criteria(names):
+    """The criteria of the force histories among ``names`` (None: every one)."""
+    return None if names is None else tuple(n for n in names if n != MOTION_CRITERION)
+
+
+def wants_motion(names):
+    """Whether the penetration's criterion is among ``names`` (None: every one)."""
+    return names is None or MOTION_CRITERION in names
+
+
 def block_outcome(reference, k, job):
     """Block ``k`` of ``reference``'s span evaluated for ``job`` (a :class:`BlockJob`): the
     law's run from the block's measured state, its history, folded, its criteria and, for a
@@ -85,10 +103,10 @@ def block_outcome(reference, k, job):
     except Exception as exc:
         return BlockOutcome(run, H, error=exc, stage=2)
     try:
-        crit = unchecked(evaluate_criteria)(reference.blocks[k], imp, job.criteria)
+        crit = unchecked(evaluate_criteria)(reference.blocks[k], imp, force_criteria(job.criteria))
     except Exception as exc:
         return BlockOutcome(run, H, imp, error=exc, stage=3)
-    if not span.sigma_z > 0:
+    if not span.sigma_z > 0 or not wants_motion(job.criteria):
         return BlockOutcome(run, H, imp, crit)
     try:
         pen = fold_penetration(blk.fold, reference.blocks[k], imp, blk.Z, Z)
