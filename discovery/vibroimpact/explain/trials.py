@@ -47,6 +47,13 @@ _SPRING_SCAN = tuple(1.0 + 0.01 * k for k in range(-6, 9) if k)
 RESCAN_DROP = 0.1
 
 
+def _same_contacts(ev):
+    """Whether an evaluation's contact times agree with its record's (I4 within its
+    consistency limit)."""
+    i4, lim = (ev.criteria or {}).get("I4"), (ev.limits or {}).get("I4")
+    return i4 is not None and lim is not None and i4 <= lim
+
+
 def _side(guess, lo):
     """-1 where the parameter may be negative (``lo < 0``, an offset) and its LM direction
     ``guess`` points there, else 1."""
@@ -140,15 +147,18 @@ class _Refits:
                     raise
 
     def rescanned(self, res):
-        """A refit ``res`` not consistent with every record, refitted again from its law's
-        springs scanned (:data:`_SPRING_SCAN`) where one of them has a sum of squares
-        :data:`RESCAN_DROP` below its end; the lower of the two refits by the criterion.
+        """A refit ``res`` not consistent with every record, its contact times off (I4
+        above its limit in a record: another contact sequence's basin), refitted again from
+        its law's springs scanned (:data:`_SPRING_SCAN`) where one of them has a sum of
+        squares :data:`RESCAN_DROP` below its end; the lower of the two refits by the
+        criterion.
         Over a record's transient the contact sequence changes with the spring, so the sum
         of squares has basins a few percent wide: on survey draw 27's noisier record (a lag)
         the lag's refit stopped at I2 0.050, its spring 6 % soft, where the true model is
         at 0.025; its spring 7 % stiffer had a sum of squares 32 % lower."""
         problem = self.problem
-        if all(e.consistent for e in problem.evaluations(res.law, floor=True)):
+        evs = problem.evaluations(res.law, floor=True)
+        if all(e.consistent for e in evs) or all(_same_contacts(e) for e in evs):
             return res
         m = res.law
         scan = [

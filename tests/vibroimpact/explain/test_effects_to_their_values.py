@@ -609,3 +609,19 @@ def test_a_refit_stopped_in_a_basin_of_the_transient_is_restarted_from_its_sprin
     assert res.final_model.effects == ("sensor_lag",)
     assert res.consistent, res.stopped_because
     assert res.final_model.observation["sensor_lag"] == pytest.approx(d.truth["tau"], rel=0.02)
+
+
+def test_a_refit_is_rescanned_only_where_its_contact_times_are_off():
+    """The springs' rescan is for a refit in another contact sequence's basin: its I4 above
+    the limit in a record.  On the sheet run's draw 39 (a short contact, the unloading
+    damper and stiffening supports) a rescan of the damper's refit, whose contact times
+    agreed (I4 0.35, limit 0.37), moved it within the noise floor of a permanent set's, and
+    the set was named."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.explain.trials import _same_contacts
+
+    ev = lambda i4, lim: SimpleNamespace(criteria={"I2": 0.7, "I4": i4}, limits={"I4": lim})  # noqa: E731
+    assert _same_contacts(ev(0.348, 0.366))
+    assert not _same_contacts(ev(0.0487, 0.0238))
+    assert not _same_contacts(SimpleNamespace(criteria={"I2": 0.7}, limits={}))
