@@ -151,11 +151,11 @@ class _Refits:
         above its limit in a record: another contact sequence's basin), refitted again from
         its law's springs scanned (:data:`_SPRING_SCAN`) where one of them has a sum of
         squares :data:`RESCAN_DROP` below its end; the lower of the two refits by the
-        criterion.
-        Over a record's transient the contact sequence changes with the spring, so the sum
-        of squares has basins a few percent wide: on survey draw 27's noisier record (a lag)
-        the lag's refit stopped at I2 0.050, its spring 6 % soft, where the true model is
-        at 0.025; its spring 7 % stiffer had a sum of squares 32 % lower."""
+        criterion.  Over a record's transient the contact sequence changes with the
+        spring, so the sum of squares has basins a few percent wide: on survey draw 27's
+        noisier record (a lag) the lag's refit stopped at I2 0.050, its spring 6 % soft,
+        where the true model is at 0.025; its spring 7 % stiffer had a sum of squares 32 %
+        lower."""
         problem = self.problem
         evs = problem.evaluations(res.law, floor=True)
         if all(e.consistent for e in evs) or all(_same_contacts(e) for e in evs):
@@ -167,7 +167,7 @@ class _Refits:
             else m.with_law(m.law.with_springs_scaled(f))
             for f in _SPRING_SCAN
         ]
-        squares = [problem.squares(m) for m in scan]
+        squares = [problem.squares(x) for x in scan]
         i = int(np.argmin(squares))
         if not squares[i] < (1.0 - RESCAN_DROP) * problem.squares(res.law):
             return res
