@@ -65,6 +65,14 @@ def output_residuals(evaluations, records, weights=None):
     return np.concatenate(force + motion)
 
 
+def _evaluated(parts, sc, ref, tolerances, **how):
+    """One record's :func:`~discovery.vibroimpact.verify.evaluate` of a model split by
+    :func:`~.records.model_parts` (``parts``: its law, machine and observation model);
+    ``how``: evaluate's other keywords."""
+    law, machine, observe = parts
+    return evaluate(machine(sc, ref), law, ref, tolerances=tolerances, observe=observe, **how)
+
+
 class ModelProblem:
     """A model against every record: its evaluations (with a memo), residuals, mean criteria
     and the noise of the averaged cycles.
@@ -107,21 +115,12 @@ class ModelProblem:
     def _evaluate(self, model, floor, smooth_onset):
         """The evaluations of :meth:`evaluations`; those with the onset smoothed are the
         residual's (:meth:`residual`), which reads the histories and no criterion."""
-        law, machine, observe = model_parts(model)
+        parts = model_parts(model)
         evs = []
         for sc, ref in self.records:
             self.n_sim += 1
-            evs.append(
-                evaluate(
-                    machine(sc, ref),
-                    law,
-                    ref,
-                    tolerances=self.tol,
-                    floor=floor,
-                    observe=observe,
-                    objective=() if smooth_onset else None,
-                )
-            )
+            how = {"floor": floor, "objective": () if smooth_onset else None}
+            evs.append(_evaluated(parts, sc, ref, self.tol, **how))
         return evs
 
     def residual(self, model):
@@ -203,21 +202,13 @@ class _Objective:
         if key not in self.cache:
             if self.n + len(self.records) > self.max_sim:
                 raise _Budget
-            law, machine, observe = model_parts(self.law(x), self.observe)
+            parts = model_parts(self.law(x), self.observe)
             evs = []
             for i, (sc, ref) in enumerate(self.records):
                 self.n += 1
                 tick(self.progress, "identify: simulations", self.n, self.max_sim)
-                ev = evaluate(
-                    machine(sc, ref),
-                    law,
-                    ref,
-                    tolerances=self.tol,
-                    floor=False,
-                    observe=observe,
-                    objective=(self.name,),
-                    **self._continued(i, x),
-                )
+                how = {"floor": False, "objective": (self.name,), **self._continued(i, x)}
+                ev = _evaluated(parts, sc, ref, self.tol, **how)
                 if ev.status == "ok" and getattr(ref, "span", None) is None:
                     self.orbits[i].append((np.asarray(x, dtype=float), ev.steady))
                 evs.append(ev)
@@ -238,17 +229,11 @@ class _Objective:
         criterion: its block runs are the memo's, so only the criteria are computed."""
         if self.evaluations(x) is None:
             return None
-        law, machine, observe = model_parts(self.law(x), self.observe)
+        parts = model_parts(self.law(x), self.observe)
+        every = (*CRITERIA, MOTION_CRITERION)
         return [
-            evaluate(
-                machine(sc, ref),
-                law,
-                ref,
-                tolerances=self.tol,
-                floor=False,
-                observe=observe,
-                objective=(*CRITERIA, MOTION_CRITERION),
-                **self._continued(i, x),
+            _evaluated(
+                parts, sc, ref, self.tol, floor=False, objective=every, **self._continued(i, x)
             )
             for i, (sc, ref) in enumerate(self.records)
         ]
