@@ -220,6 +220,14 @@ def machine_known(machine):
     return {"sensor_lag": float(value)} if value else None
 
 
+def sensor_lag_of(args, machine):
+    """``--sensor-lag`` (:func:`._options.add_sensor_lag_option`), else the force sensor's
+    lag the calibration found (0 without)."""
+    if getattr(args, "sensor_lag", None) is not None:
+        return args.sensor_lag
+    return (machine_known(machine) or {}).get("sensor_lag", 0.0)
+
+
 def machine_for(args, scenarios, measurements, time_offset=0.0):
     """The machine each record is judged with (``--machine``): the scenarios calibrated
     from the records (``record``, the default) or as given (``sheet``).  The records' units

@@ -160,6 +160,19 @@ def add_effect_search_options(parser, *, alpha_most, alpha_help, max_iterations)
     )
 
 
+def add_sensor_lag_option(parser):
+    """``--sensor-lag SECONDS``: the force sensor's time constant (read with
+    :func:`._common.sensor_lag_of`)."""
+    return parser.add_argument(
+        "--sensor-lag",
+        type=float,
+        default=None,
+        metavar="SECONDS",
+        help="the force sensor's time constant: the simulated force is compared as the "
+        "sensor sees it (default: the calibration's, when it finds one; 0: none)",
+    )
+
+
 # ------------------------------------------------------------------ processes and outputs
 def add_workers_option(parser, what=None):
     """``--workers N``: processes (for ``what``; default: every core)."""

@@ -24,6 +24,7 @@ from ._common import (
     provenance_of,
     read_records,
     reporter,
+    sensor_lag_of,
 )
 
 
@@ -72,6 +73,7 @@ def _call(discover, args, records, progress):
         workers=args.workers,
         progress=progress,
         machine_scale=machine_scale(machine),
+        sensor_lag=sensor_lag_of(args, machine),
         **({"signs": args.signs} if args.signs else {}),
     )
 
@@ -145,6 +147,7 @@ def _write_outputs(args, res, t_start):
 def _print_result(args, res, pdf, why):
     """The command's printout: the selected law, its checks, the ranking's notes."""
     from ..vibroimpact.fit.discovery_result import equivalent_text
+    from ..vibroimpact.verify.sensors import lag_note
 
     sel = res.selected
     print(f"selected {sel.law}   [{sel.regime}]")
@@ -153,6 +156,8 @@ def _print_result(args, res, pdf, why):
     if sel.criteria:
         print(criteria_line(sel.criteria, sel.noise_floor))
     print(f"  {sel.verdict}")
+    if res.settings.get("sensor_lag"):
+        print(f"  note: {lag_note(res.settings['sensor_lag'])}")
     cert = res.certificate
     print(
         f"  certificate: {'holds' if cert.holds else 'FAILS'} on zeta <= "
@@ -226,6 +231,7 @@ def _run_contact_models(args, scs, meas, machine, t_start):
             seed=args.seed or 0,
             workers=args.workers,
             progress=rep,
+            sensor_lag=sensor_lag_of(args, machine),
         )
     tail = {**provenance_of(args), "seconds": time.perf_counter() - t_start}
     with OutputDir(args.out) as out:
@@ -412,6 +418,7 @@ def _add_check_options(p):
         "noise-floor bootstrap and the bootstrap coefficient intervals (with --library "
         "contact-models: the models' intervals)",
     )
+    _options.add_sensor_lag_option(p)
 
 
 def _add_output_options(p):

@@ -9,11 +9,11 @@ from ._common import (
     criteria_line,
     law_or_default,
     machine_for,
-    machine_known,
     machine_scale,
     outputs_line,
     provenance_of,
     read_record,
+    sensor_lag_of,
 )
 
 
@@ -38,7 +38,7 @@ def run(args):
         seed=args.seed,
         check_default_start=not args.no_default_start,
         machine_scale=machine_scale(machine),
-        sensor_lag=_sensor_lag(args, machine),
+        sensor_lag=sensor_lag_of(args, machine),
     )
     res.record_run(
         {
@@ -63,13 +63,6 @@ def run(args):
     return 0
 
 
-def _sensor_lag(args, machine):
-    """``--sensor-lag``, else the force sensor's lag the calibration found (0 without)."""
-    if args.sensor_lag is not None:
-        return args.sensor_lag
-    return (machine_known(machine) or {}).get("sensor_lag", 0.0)
-
-
 def register(sub):
     s = sub.add_parser(
         "verify",
@@ -88,13 +81,6 @@ def register(sub):
         action="store_true",
         help="skip the check of the attractor reached from the scenario's initial state",
     )
-    s.add_argument(
-        "--sensor-lag",
-        type=float,
-        default=None,
-        metavar="SECONDS",
-        help="the force sensor's time constant: the simulated force is compared as the "
-        "sensor sees it (default: the calibration's, when it finds one; 0: none)",
-    )
+    _options.add_sensor_lag_option(s)
     _options.add_out_option(s)
     s.set_defaults(func=run)

@@ -27,7 +27,7 @@ Files from real instruments (:meth:`Measurement.from_csv`):
 """
 
 import io
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -237,6 +237,16 @@ class Measurement:
         """Write atomically as CSV (``t, F`` then the optional channels); mode 0666 minus
         the umask."""
         atomic_write_text(path, self.to_csv_text())
+
+    def unlagged(self, tau):
+        """The record as a force sensor without its first-order lag of time constant
+        ``tau`` [s] would have read it: ``F + tau dF/dt`` (the lag's inverse, the
+        derivative by central differences; noisier than the record, unbiased), the other
+        channels as they are.  What a regression of the force on the penetration sees
+        when the lag is known (:func:`discovery.discover`'s ``sensor_lag``)."""
+        if not tau:
+            return self
+        return replace(self, F=self.F + tau * np.gradient(self.F, self.t))
 
     @property
     def zeta(self):

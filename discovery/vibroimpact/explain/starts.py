@@ -5,7 +5,7 @@ output-error refits (:func:`~discovery.vibroimpact.fit.identification.identify`)
 
 import itertools
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -206,13 +206,9 @@ class Regressions:
 
     def unlagged(self, tau):
         """The contact samples of the force a first-order sensor lag of time constant
-        ``tau`` would have recorded as the measured one: ``F + tau dF/dt`` (the lag's
-        inverse, the derivative by central differences; noisier than the record, which
-        a regression's target may be, unbiased)."""
-        return _joined_samples(
-            self.scenarios,
-            [replace(m, F=m.F + tau * np.gradient(m.F, m.t)) for m in self.measurements],
-        )
+        ``tau`` would have recorded as the measured one
+        (:meth:`~discovery.vibroimpact.data.measurement.Measurement.unlagged`)."""
+        return _joined_samples(self.scenarios, [m.unlagged(tau) for m in self.measurements])
 
     def supports(self):
         """The supports' ``k3`` the frame's own equation reads from the records, the rest of

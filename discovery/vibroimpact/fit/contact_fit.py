@@ -42,6 +42,7 @@ from ..model.contact_registry import CONTACT_MODELS, DOMAINS, domain_edges
 from ..model.scenario import Scenario
 from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
+from ..verify.sensors import lag_note, observation
 from .contact_starts import from_seed, record_samples, regression_start, start_model
 from .identification import _checks, as_records, identify
 
@@ -226,6 +227,8 @@ class ContactModelsResult(Result):
 
     def _lines(self):
         out = [self.conclusion]
+        if self.settings.get("sensor_lag"):
+            out.append(f"note: {lag_note(self.settings['sensor_lag'])}")
         for f in self.fits:
             mark = "*" if f.model == self.selected else " "
             ok = {True: "consistent", False: "inconsistent", None: "failed"}[f.consistent]
@@ -270,6 +273,7 @@ def _intervals(res, records, settings, progress=None):
             tolerances=settings["tolerances"],
             workers=settings["workers"],
             progress=progress,
+            observe=settings["observe"],
         )
         if iv is not None:
             return {k: tuple(v) for k, v in iv.bounds.items()}, "bootstrap"
@@ -334,7 +338,7 @@ def _fit_one(name, records, settings, progress, seeding=None):
     extra = (regression_start(name, settings["samples"]),)
     if CONTACT_MODELS[name].seeded_by is not None:
         extra += (from_seed(name, seeding, sc0, ref0),)
-    start = start_model(name, records, settings["tolerances"], extra)
+    start = start_model(name, records, settings["tolerances"], extra, settings["observe"])
     try:
         res = identify(
             [sc for sc, _ in records],
@@ -344,6 +348,7 @@ def _fit_one(name, records, settings, progress, seeding=None):
             tolerances=settings["tolerances"],
             progress=progress,
             check=False,
+            observe=settings["observe"],
         )
     except (IntegrationError, InputError) as exc:
         return ContactFit(
@@ -363,7 +368,9 @@ def _fit_one(name, records, settings, progress, seeding=None):
     # named models' fit)
     edge = _degenerate(params, {})
     if not edge:  # the check against the noise floors (31 s of a degenerate fit's 63 s)
-        res = replace(res, checks=_checks(records, model, None, settings["tolerances"]))
+        res = replace(
+            res, checks=_checks(records, model, settings["observe"], settings["tolerances"])
+        )
     iv, method = _intervals(res, records, {**settings, "n_boot": 0} if edge else settings, progress)
     iv = {k: _in_domain(k, b) for k, b in iv.items()}
     degenerate = _degenerate(params, iv) + _too_damped(name, params)
@@ -392,6 +399,7 @@ class ContactModelsSettings(Settings):
     seed: int = option(0, Real(0, integer=True))
     tolerances: object = option(None, (Tolerances, None))
     workers: object = option(1, (None, Real(1, integer=True)))
+    sensor_lag: float = option(0.0, Real(0.0, 5e-3))
 
 
 @takes(ContactModelsSettings)
@@ -425,6 +433,10 @@ def fit_contact_models(scenario, reference, *, settings=None, progress=None, **o
         Processes for each fit's record blocks (:mod:`~discovery.vibroimpact.verify.block_farm`)
         and the bootstrap's refits (default 1; ``None``: every core; the result does not
         depend on it).
+    sensor_lag : float
+        The force sensor's time constant [s] (0: none): each model's start regression sees
+        the force before the lag, and every simulated force is read through it (as
+        :func:`discovery.discover`'s ``sensor_lag``).
     progress : callable or bool, optional
         ``progress(stage, done, total)`` as each model is fitted; None: a bar when the session is
         interactive, False: none (:mod:`discovery._api._progress`).
@@ -446,12 +458,13 @@ def fit_contact_models(scenario, reference, *, settings=None, progress=None, **o
     records = as_records(scenario, reference)
     # what every model's fit is given (``settings`` is the caller's options object)
     fitting = {
-        "samples": record_samples(scenario, reference),
+        "samples": record_samples(scenario, reference, o.sensor_lag),
         "max_simulations": int(max_simulations),
         "n_boot": int(n_boot),
         "seed": int(seed),
         "tolerances": o.tolerances,
         "workers": o.workers,
+        "observe": observation({"sensor_lag": o.sensor_lag} if o.sensor_lag else None),
     }
     fits = []
     # the seeds first: Hunt-Crossley's fit starts Lankarani-Nikravesh and Flores (the same
@@ -480,6 +493,7 @@ def fit_contact_models(scenario, reference, *, settings=None, progress=None, **o
             "max_simulations": int(max_simulations),
             "n_boot": int(n_boot),
             "seed": int(seed),
+            "sensor_lag": float(o.sensor_lag),
             "interval_method": (
                 f"bootstrap ({int(n_boot)} replicates) where the record allows, else "
                 "1.96 standard errors (Jacobian)"

@@ -124,9 +124,10 @@ def from_seed(name, fit, scenario, ref):
     return _model(name, p["k"], p["n"], r, _E_FIT)
 
 
-def start_model(name, records, tolerances, extra=()):
+def start_model(name, records, tolerances, extra=(), observe=None):
     """The start of a model's fit: the best of its start grid (and ``extra`` starts) by
-    the mean I2 (one simulation per record and candidate)."""
+    the mean I2 (one simulation per record and candidate; the simulated force read through
+    ``observe``, a known sensor's observation model)."""
     from ..verify import evaluate
 
     sc0, ref0 = records[0]
@@ -134,7 +135,7 @@ def start_model(name, records, tolerances, extra=()):
     for cand in [*_start_candidates(name, sc0, ref0), *(m for m in extra if m is not None)]:
         vals = []
         for sc, ref in records:
-            ev = evaluate(sc, cand.law, ref, tolerances=tolerances, floor=False)
+            ev = evaluate(sc, cand.law, ref, tolerances=tolerances, floor=False, observe=observe)
             vals.append(ev.criteria["I2"] if ev.status == "ok" else np.inf)
         v = float(np.mean(vals))
         if v < best_v or best is None:
@@ -142,13 +143,15 @@ def start_model(name, records, tolerances, extra=()):
     return best
 
 
-def record_samples(scenario, reference):
+def record_samples(scenario, reference, lag=0.0):
     """The contact samples of every record that holds positions, as one set (each
     record's impacts their own groups, so each keeps its own approach velocity), or None
     when no record has them (force records, prepared
     :class:`~discovery.vibroimpact.verify.Reference` objects).  With records at several
     operating points the impacts arrive at several velocities, and the regression start
-    separates a constant ``lambda`` from one set by each impact's ``v0``."""
+    separates a constant ``lambda`` from one set by each impact's ``v0``.  ``lag``: a known
+    force sensor's time constant, the samples then of the force before it
+    (:meth:`~discovery.vibroimpact.data.measurement.Measurement.unlagged`)."""
     from ..data.measurement import Measurement
     from ..data.samples import contact_samples, join_samples
     from .records import pair_records
@@ -158,7 +161,7 @@ def record_samples(scenario, reference):
         if not isinstance(meas, Measurement):
             continue
         try:
-            part = contact_samples(meas, period=sc.period)
+            part = contact_samples(meas.unlagged(lag), period=sc.period)
         except (VidiError, ValueError):
             continue
         if len(part):

@@ -78,6 +78,7 @@ class _Bootstrap:
     criterion: str
     tolerances: Tolerances | None
     machine_scale: tuple | None = None
+    observe: object = None
 
     def selected(self, ranking, refs, refine, progress):
         """The selected (best ranked) model, with bootstrap intervals when asked for and it
@@ -102,6 +103,7 @@ class _Bootstrap:
             workers=self.workers,
             refit=self.refit,
             machine_scale=self.machine_scale,
+            observe=self.observe,
         )
         if iv is None:
             return selected, ranking
@@ -135,6 +137,7 @@ def _settings(evidence, check, search, boot, *, shortlist, stability, n_boot, av
         "require": sorted(check.required),
         "ranking_rule": {"sim_rtol": search.rank.sim_rtol, "sim_atol": search.rank.sim_atol},
         "estimator": est.get_params(),
+        "sensor_lag": check.sensor_lag,
     }
 
 
@@ -151,6 +154,7 @@ def _contact_models(scenario, measurement, s, progress):
         seed=0 if s.seed is None else s.seed,
         workers=s.workers,
         progress=progress,
+        sensor_lag=s.sensor_lag,
     )
 
 
@@ -186,6 +190,7 @@ class DiscoverSettings(Settings):
     workers: object = option(1, (None, Real(1, integer=True)))
     estimator: object = option(None, (None, dict))
     machine_scale: object = option(None, (None, tuple, list))
+    sensor_lag: float = option(0.0, Real(0.0, 5e-3))
 
 
 @takes(DiscoverSettings)
@@ -267,6 +272,12 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
         :attr:`~discovery.Calibration.scale_range`): the selected law's intervals of the
         forces are widened to it
         (:func:`~discovery.vibroimpact.fit.intervals.bootstrap_intervals`).
+    sensor_lag : float
+        The force sensor's time constant [s] (a calibration's ``force_lag``; 0: none):
+        the regression sees the force before the lag
+        (:meth:`~discovery.vibroimpact.data.measurement.Measurement.unlagged`), and every
+        simulated force is compared as the sensor would have read it (its refinement,
+        checks and bootstrap intervals, as :func:`discovery.verify`'s ``sensor_lag``).
 
     Returns
     -------
@@ -283,7 +294,11 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
     t0 = time.perf_counter()
     seed = s.seed
     pairs = pair_records(scenario, measurement)
-    parts, samples = _contact_samples(pairs, s.derivative, s.average_cycles)
+    # the regression sees the force before a known sensor lag; the records' references
+    # keep the recorded force, and every simulated force is read through the lag
+    parts, samples = _contact_samples(
+        [(sc, m.unlagged(s.sensor_lag)) for sc, m in pairs], s.derivative, s.average_cycles
+    )
     regressor = dict(
         library=s.library, selection=s.selection, scoring=s.scoring, max_terms=s.max_terms
     )
@@ -301,6 +316,7 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
         budget=s.max_simulations,
         required=required,
         workers=s.workers,
+        sensor_lag=s.sensor_lag,
     )
     # a refinement run here (a step with one trial, say) shares out its evaluations'
     # blocks over the workers (the steps' trials run in parallel processes)
@@ -318,6 +334,7 @@ def discover(scenario, measurement, *, settings=None, progress=None, **options):
             s.criterion,
             s.tolerances,
             None if s.machine_scale is None else tuple(s.machine_scale),
+            check.observe,
         )
         selected, ranking = boot.selected(ranking, refs, s.refine, progress)
     # the certificate of the law actually selected (the ranking may prefer another

@@ -24,6 +24,7 @@ from ..._api._result import Result, part
 from ..model.law import ForceLaw
 from ..verify.criteria import criteria_lines
 from ..verify.evaluation import Evaluation
+from ..verify.sensors import lag_note
 from .intervals import Intervals
 from .records import records_verdict
 
@@ -474,6 +475,8 @@ class DiscoveryResult(Result):
         out = [head, *coefficient_lines(sel.law.as_dict(), sel.standard_errors, sel.intervals)]
         out += criteria_lines(sel.criteria, sel.noise_floor, sel.limits)
         out.append(f"  verdict: {sel.verdict}")
+        if self.settings.get("sensor_lag"):
+            out.append(f"  note: {lag_note(self.settings['sensor_lag'])}")
         out.append(
             f"ranking ({len(self.ranking)} candidates: the consistent ones first, the fewest "
             f"terms first, then by {crit}):"

@@ -193,6 +193,7 @@ def _refit_replicate(context, k):
             settings["criterion"],
             settings["tolerances"],
             max(int(budget), 2 * len(records)),
+            observe=settings["observe"],
         )
         x, _ = _fitted(obj, method, xtol, budget)
     except (IntegrationError, NoContactError):  # a replicate without contact in a block
@@ -208,7 +209,14 @@ def _step_replicate(context, k):
     replicate (a task of the executor, as :func:`_refit_replicate`), None when it fails."""
     scenarios, replicates, model, settings = context
     records = list(zip(scenarios, replicates[k], strict=True))
-    obj = _Objective(records, model, settings["criterion"], settings["tolerances"], 10**9)
+    obj = _Objective(
+        records,
+        model,
+        settings["criterion"],
+        settings["tolerances"],
+        10**9,
+        observe=settings["observe"],
+    )
     x = np.ones(len(model.coefficients))
     for _ in range(_GN_STEPS):
         try:
@@ -246,6 +254,7 @@ class BootstrapIntervalsSettings(Settings):
     refit: str = option("two-step", Choice(*INTERVAL_REFITS))
     noise: str = option("cycles", Choice(*INTERVAL_NOISE))
     machine_scale: object = option(None, (tuple, list, None))
+    observe: object = option(None)
 
 
 def force_names(model):
@@ -314,6 +323,9 @@ def bootstrap_intervals(
         other parameter (a lag, an offset, a set, a mass loss) is widened by how far it
         moves with the machine at the range's two ends (two Gauss-Newton steps from the
         fit on the records themselves: four more simulations and Jacobians per record).
+    observe : callable, optional
+        The observation model every simulated force is read through (a known sensor lag:
+        :func:`~discovery.vibroimpact.verify.sensors.observation`), beside the model's own.
 
     Returns
     -------
@@ -327,7 +339,7 @@ def bootstrap_intervals(
         return None
     if any(c == 0 for c in model.coefficients):
         return None  # a parameter at 0 sets no scale for the refits
-    law, machine, observe = model_parts(model)
+    law, machine, observe = model_parts(model, s.observe)
     # the resampled cycles against the parameters (see the comment above): too few, and the
     # replicates take white noise of the record's level instead
     G = sum(b.fold.n_cycles for _, ref in records for b in ref.span.blocks)
@@ -361,6 +373,7 @@ def bootstrap_intervals(
             "criterion": s.criterion,
             "max_simulations": s.max_simulations,
             "tolerances": s.tolerances,
+            "observe": s.observe,
         },
     )
     refits = map_on(

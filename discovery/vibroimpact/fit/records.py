@@ -97,10 +97,14 @@ def model_parts(model, observe=None):
     missing-effect workflow's :class:`~discovery.vibroimpact.explain.Model`: ``coefficients``,
     ``names``, ``with_coefficients``, ``law``, ``apply(scenario, record)``, ``observe()``).
     The machine a record is simulated with may depend on how the record is compared (a
-    mass loss per impact applies to a record compared over its span only)."""
+    mass loss per impact applies to a record compared over its span only).  ``observe``:
+    the observation model of a known sensor, used where the model has none of its own (a
+    named contact model; an explained model that fits a lag reads the force through its
+    own)."""
     if isinstance(model, ForceLaw):
         return model, (lambda sc, ref=None: sc), observe
-    return model.law, model.apply, model.observe()
+    own = model.observe()
+    return model.law, model.apply, observe if own is None else own
 
 
 def _measured_cycles(ref):

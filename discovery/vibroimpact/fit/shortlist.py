@@ -11,6 +11,7 @@ from ...numerics.executor import map_on
 from ..data.samples import ContactSamples
 from ..dynamics import Tolerances
 from ..verify import evaluate
+from ..verify.sensors import observation
 from .discovery_result import RankedModel
 from .identification import identify
 from .records import record_start
@@ -60,7 +61,8 @@ class _Checker:
     ``refs`` every record's ``(Scenario, Reference)``, ``budget`` the simulations of one
     refinement, ``required`` the terms no backward step drops, ``give_up_above`` the
     criterion above which a refinement stops after its cycle-by-cycle first fit
-    (:meth:`screen_from`)."""
+    (:meth:`screen_from`), ``sensor_lag`` the force sensor's time constant every simulated
+    force is read through (:attr:`observe`)."""
 
     est: ConstrainedSparseRegressor
     samples: ContactSamples
@@ -72,9 +74,19 @@ class _Checker:
     required: frozenset = frozenset()
     workers: int | None = 1
     give_up_above: float | None = None
+    sensor_lag: float = 0.0
+
+    @property
+    def observe(self):
+        """The force sensor's observation model (None without a lag:
+        :func:`~discovery.vibroimpact.verify.sensors.observation`)."""
+        return observation({"sensor_lag": self.sensor_lag} if self.sensor_lag else None)
 
     def evaluate(self, law):
-        return tuple(evaluate(sc, law, ref, tolerances=self.tol) for sc, ref in self.refs)
+        observe = self.observe
+        return tuple(
+            evaluate(sc, law, ref, tolerances=self.tol, observe=observe) for sc, ref in self.refs
+        )
 
     def screen_from(self, laws):
         """Set :attr:`give_up_above` to :data:`GIVE_UP_FACTOR` times the records' largest
@@ -126,6 +138,7 @@ class _Checker:
                 tolerances=self.tol,
                 check=False,
                 give_up_above=self.give_up_above,
+                observe=self.observe,
             )
         except IntegrationError as exc:
             return RankedModel(

@@ -69,6 +69,15 @@ _AT = {"sensor_lag": first_order_lag_at}
 _LINEAR = {"sensor_lag"}
 
 
+def lag_note(tau):
+    """The line that says every simulated force was read through a sensor's lag ``tau``
+    [s] (:func:`discovery.verify`'s and :func:`discovery.discover`'s ``sensor_lag``)."""
+    return (
+        f"the simulated force is compared as a force sensor with a lag of "
+        f"{tau * 1e3:.4g} ms sees it"
+    )
+
+
 def observation(parameters):
     """The observation model ``Impulse -> Impulse`` of ``{name: parameter}`` (names of
     :data:`OBSERVATIONS`, e.g. ``{"sensor_lag": 2e-5}``), applied in the order of their

@@ -16,7 +16,7 @@ from ..model.scenario import Scenario, scale_bounds
 from .criteria import criteria_lines
 from .evaluation import Evaluation, evaluate
 from .reference import Reference
-from .sensors import observation
+from .sensors import lag_note, observation
 
 __all__ = ["VerifyResult", "VerifySettings", "verify"]
 
@@ -348,10 +348,7 @@ def verify(scenario, measurement, law, *, settings=None, **options):
     scenario, notes = _shedding(scenario, ref)
     observe = observation({"sensor_lag": s.sensor_lag} if s.sensor_lag else None)
     if observe is not None:
-        notes.append(
-            f"the simulated force is compared as a force sensor with a lag of "
-            f"{s.sensor_lag * 1e3:.4g} ms sees it"
-        )
+        notes.append(lag_note(s.sensor_lag))
     how = {"tolerances": s.tolerances, "observe": observe}
     if s.machine_scale is not None:
         scenario, note = _profiled_scale(scenario, law, ref, s.machine_scale, how)

@@ -153,7 +153,7 @@ def test_a_lag_interval_carries_the_machine_scale_it_was_fitted_on(paper):
         assert wide.bounds[name] == pytest.approx((lo / 1.01, hi / 0.99))
 
 
-_FIT_SETTINGS = {"criterion": "I2", "max_simulations": 60, "tolerances": None}
+_FIT_SETTINGS = {"criterion": "I2", "max_simulations": 60, "tolerances": None, "observe": None}
 
 
 def test_a_refit_that_pushes_a_named_effect_past_its_bound_stands_for_nothing(paper, monkeypatch):

@@ -132,11 +132,13 @@ def test_an_effect_too_weak_to_matter_is_not_named(paper):
 LAG_EFFECTS = ["sensor_lag", "penetration_velocity_coupling"]
 
 
-def lagged_record(paper, tau=1e-4, seed=4):
-    """The paper's record with its force channel seen through a first-order sensor (time
-    constant ``tau``): the clean record's force is filtered, then noise is added."""
-    rec = _record(paper, paper.law, seed=seed, force_noise=0.0)
-    E = response(paper, paper.law).impulse
+def lagged_record(paper, tau=1e-4, seed=4, law=None):
+    """The paper's record (of its law, or of ``law``) with its force channel seen through
+    a first-order sensor (time constant ``tau``): the clean record's force is filtered, then
+    noise is added."""
+    law = paper.law if law is None else law
+    rec = _record(paper, law, seed=seed, force_noise=0.0)
+    E = response(paper, law).impulse
     T = paper.period
     lagged = first_order_lag(E, tau)
     phase = np.mod(rec.t - (E.onset % T), T)  # P1: one cycle per period

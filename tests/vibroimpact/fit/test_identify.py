@@ -369,7 +369,7 @@ def test_a_replicate_without_contact_in_a_block_fails_alone(monkeypatch, paper):
     monkeypatch.setattr(iv, "_Objective", NoContact)
     monkeypatch.setattr(iv, "_checked", lambda *args, **kwargs: [])
     monkeypatch.setattr(iv, "_fitted", lambda obj, *args: obj.evaluations(None))
-    settings = {"criterion": "I2", "tolerances": None, "max_simulations": 10}
+    settings = {"criterion": "I2", "tolerances": None, "max_simulations": 10, "observe": None}
     context = ([paper], [[None]], paper.law, settings)
     assert iv._step_replicate(context, 0) is None
     assert iv._refit_replicate(context, 0) is None
