@@ -7,14 +7,9 @@ regime) and each window's contact impulse ``J_w = integral of F dt`` is compared
 model's.  Over a periodic orbit the contact carries the moulding's weight exactly (its
 momentum returns to its start: ``integral of (F - m2 g) dt = 0``), so whatever the law,
 the model predicts ``J_w = m2(w) g n T`` with the mass after the impacts so far,
-``m2(w) = m2 (1 - loss)^(impacts before w)``.  Over a window that is no orbit (a slow
-transient: the orbit still growing) the moulding's momentum changes too, and its own
-equation ``m2 dv2/dt = F - m2 g`` gives the impulse exactly:
-``J_w = m2(w) (g n T + v2(end) - v2(start))``.  The window's bounds lie in free flight,
-where the moulding is ballistic, so its velocity there is read from the recorded motion
-(:func:`flight_velocity`); a record without it is taken as quasi-steady.  The impulse
-weighs the moulding window by window, and where the samples fall on a force jump moves it
-far less than it would move a peak (its floor below).
+``m2(w) = m2 (1 - loss)^(impacts before w)``; a slow drift keeps the orbit quasi-steady.
+The impulse weighs the moulding window by window, and it does not depend on where the
+samples fall on a force jump (a peak would).
 
 The residual is measured minus predicted with its mean removed (a force calibration or
 a wrong nominal mass only shifts the level; the drift channel sees the trend):
@@ -24,14 +19,10 @@ a wrong nominal mass only shifts the level; the drift channel sees the trend):
 Its noise is estimated from the record itself, from successive differences (the median
 absolute deviation of ``diff(r)`` over ``sqrt 2``), which a smooth drift hardly changes,
 and never below what the force's own sample noise puts into a window's impulse
-(``sigma_F dt sqrt(samples)``) with what the sampling of each contact's force jump at its
-onset does (``F(0+) dt / sqrt 12`` a contact; on survey draw 28's quieter record 0.09 % of a
-window's impulse against the samples' 0.11 %, where the windows' sums stood up to 0.27 %
-from the moulding's momentum balance, noise-free); with fewer than
-:data:`MIN_DIFFERENCE_WINDOWS` windows the differences are too few to trust (a 15-period
-P3 record has four windows: its three differences read the noise 17 times too high on one
-record, 4 times too low on another) and the sample noise alone sets it.  ``D``'s floor
-is that noise over the mean impulse.
+(``sigma_F dt sqrt(samples)``); with fewer than :data:`MIN_DIFFERENCE_WINDOWS` windows the
+differences are too few to trust (a 15-period P3 record has four windows: its three
+differences read the noise 17 times too high on one record, 4 times too low on another)
+and the sample noise alone sets it.  ``D``'s floor is that noise over the mean impulse.
 """
 
 from dataclasses import dataclass
@@ -60,15 +51,12 @@ class DriftRecord:
     impacts_before: np.ndarray
     window: float
     sigma: float = 0.0
-    velocity_changes: np.ndarray | None = None
 
     @classmethod
-    def from_measurement(cls, measurement, impulse, g):
+    def from_measurement(cls, measurement, impulse):
         """Windows of one orbit (``impulse``: the record's averaged cycle) whose bounds lie
         in the middle of the orbit's longest free flight, so no contact is split between
-        two windows; each sample stands for one sampling interval.  The moulding's velocity
-        change over each window is read at its bounds (:func:`flight_velocity`, ``g`` the
-        gravity [m/s^2]; None without a recorded motion of the moulding)."""
+        two windows; each sample stands for one sampling interval."""
         W = impulse.duration
         sup = np.asarray(impulse.support, dtype=float).reshape(-1, 2)
         if len(sup):
@@ -76,15 +64,14 @@ class DriftRecord:
             gaps = np.mod(starts - ends, W)
             i = int(np.argmax(gaps))
             phase = impulse.onset + ends[i] + 0.5 * gaps[i]
-            flight = float(gaps[i])
         else:
-            phase, flight = impulse.onset, 0.0
+            phase = impulse.onset
         t, F = measurement.t, measurement.F
         dt = float(np.median(np.diff(t)))
         k0 = int(np.ceil((t[0] - phase) / W - 1e-9))
         k1 = int(np.floor((t[-1] - phase) / W + 1e-9))
-        impacts_per_orbit = contacts_per_cycle(impulse)
-        J, before, dv = [], [], []
+        impacts_per_orbit = len(impulse.onsets)
+        J, before = [], []
         for k in range(k0, k1):
             a = phase + k * W
             m = (t >= a) & (t < a + W)
@@ -92,26 +79,12 @@ class DriftRecord:
                 continue
             J.append(float(np.sum(F[m]) * dt))
             before.append((k - k0) * impacts_per_orbit)
-            dv.append(
-                flight_velocity(measurement, a + W, 0.5 * flight, g)
-                - flight_velocity(measurement, a, 0.5 * flight, g)
-            )
-        # the samples' noise, and where the samples fall on each contact's force jump at
-        # its onset (a left sum misses a uniform share of the jump's sampling interval)
-        jump = float(impulse.evaluate(np.zeros(1), "right")[0])
-        sigma = float(
-            np.hypot(
-                estimate_noise(F) * dt * np.sqrt(W / dt),
-                jump * dt * np.sqrt(impacts_per_orbit / 12.0),
-            )
-        )
-        dv = np.array(dv, dtype=float)
+        sigma = float(estimate_noise(F)) * dt * np.sqrt(W / dt)
         return cls(
             impulses=np.array(J),
             impacts_before=np.array(before, dtype=float),
             window=W,
             sigma=sigma,
-            velocity_changes=dv if dv.size and np.all(np.isfinite(dv)) else None,
         )
 
     @property
@@ -119,45 +92,9 @@ class DriftRecord:
         return float(self.impacts_before[-1]) if self.impacts_before.size else 0.0
 
 
-def contacts_per_cycle(impulse):
-    """The contacts in one cycle of ``impulse``: its support's intervals, a contact that runs
-    over the cycle's end into its start counted once (on survey draw 28's slow transient
-    the averaged cycle's force rose 0.7 ms before the onset, and each three-period window
-    was counted four impacts, the mass loss fitted at 60 % of the truth)."""
-    sup = np.asarray(impulse.support, dtype=float).reshape(-1, 2)
-    n = max(len(sup), 1)
-    W = impulse.duration
-    if len(sup) > 1 and sup[0, 0] <= 1e-9 * W and sup[-1, 1] >= W * (1 - 1e-9):
-        n -= 1
-    return n
-
-
-#: the share of a free flight around a window's bound read for the moulding's velocity
-FLIGHT_SHARE = 0.5
-
-
-def flight_velocity(measurement, at, flight, g):
-    """The moulding's upward velocity [m/s] at time ``at`` in a free flight of length
-    ``flight`` [s] centred on it, from the samples within ``FLIGHT_SHARE * flight / 2`` of
-    it: ballistic there, ``v2 + g (t - at)`` is constant (its mean, from a recorded
-    ``v2``) and ``w2 + g (t - at)^2 / 2`` linear (its slope, from ``w2``).  ``nan`` without
-    either channel or with fewer than four samples."""
-    ch = measurement.channels
-    half = 0.5 * FLIGHT_SHARE * flight
-    m = np.abs(measurement.t - at) <= half
-    if m.sum() < 4 or ("v2" not in ch and "w2" not in ch):
-        return np.nan
-    u = measurement.t[m] - at
-    if "v2" in ch:
-        return float(np.mean(ch["v2"][m] + g * u))
-    return float(np.polyfit(u, ch["w2"][m] + 0.5 * g * u**2, 1)[0])
-
-
 def predicted(scenario, rec, loss):
-    """The model's contact impulse of every window: ``m2 (1 - loss)^n (g W + dv)``, ``dv``
-    the moulding's velocity change over the window (0: quasi-steady)."""
-    dv = 0.0 if rec.velocity_changes is None else rec.velocity_changes
-    return scenario.mass_after(rec.impacts_before, loss) * (scenario.g * rec.window + dv)
+    """The model's contact impulse of every window: ``m2 (1 - loss)^n g W``."""
+    return scenario.mass_after(rec.impacts_before, loss) * scenario.g * rec.window
 
 
 def drift_residual(scenario, rec, loss):
