@@ -165,7 +165,7 @@ def add_sensor_lag_option(parser):
     :func:`._common.sensor_lag_of`)."""
     return parser.add_argument(
         "--sensor-lag",
-        type=float,
+        type=number(0.0, 5e-3, unit="s"),
         default=None,
         metavar="SECONDS",
         help="the force sensor's time constant: the simulated force is compared as the "

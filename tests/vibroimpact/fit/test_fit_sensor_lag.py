@@ -101,5 +101,5 @@ def test_vidi_fit_takes_the_lag_the_calibration_found(tmp_path, record, capsys):
     capsys.readouterr()
     assert main([*words, "--sensor-lag", "-1", "--out", str(tmp_path / "c")]) == 2
     err = capsys.readouterr().err.strip()
-    assert "sensor_lag must be a number in [0, 0.005]" in err and "\n" not in err
+    assert "--sensor-lag: '-1' is out of range" in err and "\n" not in err
     assert not (tmp_path / "c").exists()

@@ -58,5 +58,5 @@ def test_vidi_verify_takes_the_lag_the_calibration_found(tmp_path, capsys):
     capsys.readouterr()
     assert main([*words, "--sensor-lag", "-1", "--out", str(tmp_path / "c")]) == 2
     err = capsys.readouterr().err.strip()
-    assert "sensor_lag must be a number" in err and "\n" not in err
+    assert "--sensor-lag: '-1' is out of range" in err and "\n" not in err
     assert not (tmp_path / "c").exists()
