@@ -273,18 +273,20 @@ class _State:
 
 
 def _machines(state, s):
-    """``(scenarios, scale)``: the scenario each record is fitted with (calibrated from the
-    records, or the sheets) and the calibrated machine's scale uncertainty (``None`` for
-    the sheets): the records pin the machine's ratios far better than its scale, and the
-    fit judges each law at the scale that suits it within that range, as ``vidi fit`` does."""
+    """``(scenarios, fit options)``: the scenario each record is fitted with (calibrated
+    from the records, or the sheets) and what the calibration adds to the joint fit, as
+    ``vidi fit`` takes it: the machine's scale uncertainty (the records pin its ratios far
+    better than its scale; each law is judged at the scale that suits it within that range)
+    and the force sensor's lag the records show (``{}`` for the sheets)."""
     if s.machine == "sheet":
-        return list(state.sheets), None
+        return list(state.sheets), {}
     from ..calibration import calibrate
 
     cal = calibrate(list(state.sheets), list(state.records), seed=s.seed)
     if not cal.calibrated:
-        return list(state.sheets), None
-    return list(cal.scenarios), cal.scale_range
+        return list(state.sheets), {}
+    found = {"machine_scale": cal.scale_range, "sensor_lag": cal.sensor_lag}
+    return list(cal.scenarios), {k: v for k, v in found.items() if v}
 
 
 def _outcome(fit):
@@ -438,10 +440,11 @@ def campaign(scenario, measurement, acquire, knobs, *, settings=None, progress=N
         k = len(state.records)
         tick(progress, f"campaign: joint fit of {_n_records(k)}", 0, None)
         t_step = time.perf_counter()
-        machines, scale = _machines(state, s)
-        settings = fit_settings
-        if scale is not None and fit_settings.machine_scale is None:
-            settings = DiscoverSettings.of("campaign", fit_settings, {"machine_scale": scale})
+        machines, found = _machines(state, s)
+        # what the calibration found, where the fit's settings do not say it themselves
+        given = {"machine_scale": fit_settings.machine_scale, "sensor_lag": fit_settings.sensor_lag}
+        extra = {k: v for k, v in found.items() if not given[k]}
+        settings = DiscoverSettings.of("campaign", fit_settings, extra) if extra else fit_settings
         fit = discover(
             machines,
             list(state.records),

@@ -121,6 +121,14 @@ class Calibration(Result):
         return (1.0 - half, 1.0 + half)
 
     @property
+    def sensor_lag(self):
+        """The force sensor's time constant [s] the records show (``force_lag``), 0 where
+        none was found: what ``discover``, ``verify`` and ``explain`` read the simulated
+        force through."""
+        p = self.parameters.get("force_lag") if self.calibrated else None
+        return float(p["record"]) if p and p.get("record") else 0.0
+
+    @property
     def scenario(self):
         """The machine of the (first) record."""
         return self.scenarios[0]

@@ -16,7 +16,7 @@ from discovery.vibroimpact.fit.discovery import discover
 from discovery.vibroimpact.fit.records import model_parts
 from discovery.vibroimpact.model.contact_models import parse_law
 from discovery.vibroimpact.verify.sensors import observation
-from tests.vibroimpact.explain.test_explain import lagged_record
+from tests.vibroimpact.explain.test_explain import _record, lagged_record
 
 TAU = 3e-4  # a 0.3 ms sensor on the paper's 2.4 ms contact
 
@@ -103,3 +103,21 @@ def test_vidi_fit_takes_the_lag_the_calibration_found(tmp_path, record, capsys):
     err = capsys.readouterr().err.strip()
     assert "--sensor-lag: '-1' is out of range" in err and "\n" not in err
     assert not (tmp_path / "c").exists()
+
+
+def test_the_campaigns_joint_fit_takes_the_calibrations_lag(paper, record):
+    """``advise --until-settled`` fits its records jointly with what the calibration found:
+    the machine's scale range and the force sensor's lag (``Calibration.sensor_lag``), as
+    ``vidi fit`` does; the sheets add nothing."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.advise.campaign_loop import _machines
+    from discovery.vibroimpact.calibration import calibrate
+
+    state = SimpleNamespace(sheets=[paper], records=[record])
+    machines, found = _machines(state, SimpleNamespace(machine="record", seed=0))
+    assert found["sensor_lag"] == pytest.approx(TAU, rel=0.05)
+    assert found["machine_scale"][0] < 1.0 < found["machine_scale"][1]
+    assert _machines(state, SimpleNamespace(machine="sheet", seed=0)) == ([paper], {})
+    assert calibrate([paper], [lagged_record(paper, tau=TAU)]).sensor_lag == found["sensor_lag"]
+    assert calibrate([paper], [_record(paper, paper.law, seed=4)]).sensor_lag == 0.0
