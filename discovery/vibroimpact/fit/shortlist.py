@@ -93,7 +93,7 @@ class _Checker:
         consistency limit of the criterion, or :data:`GIVE_UP_FLOOR` when larger, read from
         the first of ``laws`` that every record can be compared with (the limits follow the
         record's noise, not the law).  None (no screen) when the criterion has no limit or
-        no law simulates."""
+        no law simulates, and when a record's limit is not finite."""
         for law in laws:
             try:
                 evs = self.evaluate(law)
@@ -102,7 +102,8 @@ class _Checker:
             if any(e.status != "ok" for e in evs):
                 continue
             lims = [e.limits.get(self.criterion) for e in evs]
-            if None not in lims:
+            # a limit that is not finite (a record whose floor the law cannot set) is none
+            if None not in lims and np.all(np.isfinite(lims)):
                 self.give_up_above = max(GIVE_UP_FACTOR * max(lims), GIVE_UP_FLOOR)
             return
 

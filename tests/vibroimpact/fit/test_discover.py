@@ -362,3 +362,25 @@ def test_rank_puts_laws_that_are_no_contact_laws_last():
     assert not spring.defects
     # asked for, the records alone decide
     assert rank([damper, neg, spring], physics=False)[0] is damper
+
+
+def test_a_record_without_a_finite_limit_sets_no_give_up_screen():
+    """A record whose consistency limit the law cannot set (infinite) gives no screen: an
+    infinite ``give_up_above`` had stopped the fit with an input error (the effects survey's
+    draw 17, noisier record: a 1.07 ms sensor lag, fitted without it on the machine
+    calibrated from a 5 % sheet)."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.fit.shortlist import _Checker
+
+    def checker(limits):
+        c = _Checker(None, None, [], "I2", True, None, 10)
+        c.evaluate = lambda law: [SimpleNamespace(status="ok", limits={"I2": v}) for v in limits]
+        return c
+
+    finite = checker([0.04, 0.05])
+    finite.screen_from(["law"])
+    assert finite.give_up_above == max(GIVE_UP_FACTOR * 0.05, GIVE_UP_FLOOR)
+    infinite = checker([0.04, math.inf])
+    infinite.screen_from(["law"])
+    assert infinite.give_up_above is None
