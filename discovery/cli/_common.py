@@ -213,11 +213,12 @@ def machine_known(machine):
     """The effects a :func:`machine_for` summary found beyond the machine when the run
     uses the calibrated machine (a force sensor's lag): ``{effect id: value}`` for
     :func:`~discovery.explain`'s ``known``, else ``None``."""
+    from ..vibroimpact.calibration.result import found_lag
+
     if not (machine and machine.get("used") == "record"):
         return None
-    lag = (machine.get("parameters") or {}).get("force_lag")
-    value = lag.get("record") if isinstance(lag, dict) else None
-    return {"sensor_lag": float(value)} if value else None
+    value = found_lag(machine.get("parameters") or {})
+    return {"sensor_lag": value} if value else None
 
 
 def sensor_lag_of(args, machine):

@@ -51,6 +51,13 @@ def _scenarios(key):
     return lambda d: tuple(Scenario.from_dict(s) for s in d[key])
 
 
+def found_lag(parameters):
+    """The force sensor's time constant [s] a calibration's ``parameters`` (its table, or
+    the same table read back from a summary) hold as ``force_lag``, 0 where none."""
+    p = parameters.get("force_lag")
+    return float(p["record"]) if isinstance(p, dict) and p.get("record") else 0.0
+
+
 @readable
 @dataclass(frozen=True, eq=False)
 class Calibration(Result):
@@ -125,8 +132,7 @@ class Calibration(Result):
         """The force sensor's time constant [s] the records show (``force_lag``), 0 where
         none was found: what ``discover``, ``verify`` and ``explain`` read the simulated
         force through."""
-        p = self.parameters.get("force_lag") if self.calibrated else None
-        return float(p["record"]) if p and p.get("record") else 0.0
+        return found_lag(self.parameters) if self.calibrated else 0.0
 
     @property
     def scenario(self):

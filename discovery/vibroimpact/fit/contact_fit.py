@@ -42,7 +42,7 @@ from ..model.contact_registry import CONTACT_MODELS, DOMAINS, domain_edges
 from ..model.scenario import Scenario
 from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
-from ..verify.sensors import lag_note, observation
+from ..verify.sensors import lag_note, lag_observation
 from .contact_starts import from_seed, record_samples, regression_start, start_model
 from .identification import _checks, as_records, identify
 
@@ -464,7 +464,7 @@ def fit_contact_models(scenario, reference, *, settings=None, progress=None, **o
         "seed": int(seed),
         "tolerances": o.tolerances,
         "workers": o.workers,
-        "observe": observation({"sensor_lag": o.sensor_lag} if o.sensor_lag else None),
+        "observe": lag_observation(o.sensor_lag),
     }
     fits = []
     # the seeds first: Hunt-Crossley's fit starts Lankarani-Nikravesh and Flores (the same

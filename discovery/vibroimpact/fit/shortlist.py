@@ -2,6 +2,7 @@
 the regression's best supports and the trials of each stepwise move."""
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -11,7 +12,7 @@ from ...numerics.executor import map_on
 from ..data.samples import ContactSamples
 from ..dynamics import Tolerances
 from ..verify import evaluate
-from ..verify.sensors import observation
+from ..verify.sensors import lag_observation
 from .discovery_result import RankedModel
 from .identification import identify
 from .records import record_start
@@ -76,11 +77,11 @@ class _Checker:
     give_up_above: float | None = None
     sensor_lag: float = 0.0
 
-    @property
+    @cached_property
     def observe(self):
         """The force sensor's observation model (None without a lag:
-        :func:`~discovery.vibroimpact.verify.sensors.observation`)."""
-        return observation({"sensor_lag": self.sensor_lag} if self.sensor_lag else None)
+        :func:`~discovery.vibroimpact.verify.sensors.lag_observation`), made once."""
+        return lag_observation(self.sensor_lag)
 
     def evaluate(self, law):
         observe = self.observe

@@ -78,6 +78,13 @@ def lag_note(tau):
     )
 
 
+def lag_observation(tau):
+    """A first-order force sensor of time constant ``tau`` [s] as an observation model
+    (:func:`observation`; None for 0): what ``verify``, ``discover`` and
+    ``fit_contact_models`` read a simulated force through."""
+    return observation({"sensor_lag": tau} if tau else None)
+
+
 def observation(parameters):
     """The observation model ``Impulse -> Impulse`` of ``{name: parameter}`` (names of
     :data:`OBSERVATIONS`, e.g. ``{"sensor_lag": 2e-5}``), applied in the order of their

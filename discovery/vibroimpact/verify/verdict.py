@@ -16,7 +16,7 @@ from ..model.scenario import Scenario, scale_bounds
 from .criteria import criteria_lines
 from .evaluation import Evaluation, evaluate
 from .reference import Reference
-from .sensors import lag_note, observation
+from .sensors import lag_note, lag_observation
 
 __all__ = ["VerifyResult", "VerifySettings", "verify"]
 
@@ -346,7 +346,7 @@ def verify(scenario, measurement, law, *, settings=None, **options):
         )
     )
     scenario, notes = _shedding(scenario, ref)
-    observe = observation({"sensor_lag": s.sensor_lag} if s.sensor_lag else None)
+    observe = lag_observation(s.sensor_lag)
     if observe is not None:
         notes.append(lag_note(s.sensor_lag))
     how = {"tolerances": s.tolerances, "observe": observe}
