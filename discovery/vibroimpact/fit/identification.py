@@ -400,9 +400,12 @@ def identify(scenario, reference, start, *, settings=None, progress=None, **opti
         blocks is above this value and that fit lowered it by less than 10 % (a support
         that cannot explain the record; a right one from a poor start moves): the better
         of the start and that fit's law is returned, without the fit on the blocks and
-        without standard errors (the result's :attr:`~IdentificationResult.given_up`).
-        ``discover`` sets it at ten times the record's consistency limit of the criterion,
-        at least 0.5 (:data:`~discovery.vibroimpact.fit.shortlist.GIVE_UP_FACTOR`).
+        without standard errors (the result's :attr:`~IdentificationResult.given_up`).  A
+        fit on the blocks above it stops after two iterations that lower its sum of squares
+        by less than 10 % each, and is not restarted (a restart leaves a wrong basin of a
+        law that can match the record).  ``discover`` sets it at ten times the record's
+        consistency limit of the criterion, at least 0.5
+        (:data:`~discovery.vibroimpact.fit.shortlist.GIVE_UP_FACTOR`).
 
     Returns
     -------
@@ -453,7 +456,9 @@ def _identified(records, start, s, progress):
         message = f"given up after the cycle-by-cycle fit: {s.criterion} {given_up}"
     else:
         # before the error probes
-        x_best, message = _fitted(obj, s.method, s.xtol, s.max_simulations)
+        x_best, message = _fitted(
+            obj, s.method, s.xtol, s.max_simulations, give_up_above=s.give_up_above
+        )
     law = obj.law(x_best)
     evs = obj.full_evaluations(x_best)
     if evs is None:  # a given-up start compared on the blocks before: never, short of a bug

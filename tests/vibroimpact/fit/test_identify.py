@@ -352,6 +352,25 @@ def test_a_hopeless_fit_is_given_up_after_its_cycle_by_cycle_fit(paper, referenc
     assert kept.law.coefficients == fitted.law.coefficients
 
 
+def test_a_fit_above_the_screen_without_progress_stops_and_is_not_restarted(paper):
+    """A damping-only law whose cycle-by-cycle fit moves it (so it is not given up there)
+    stays far above the screen on the blocks, each step lowering its sum of squares by a
+    few per cent: its fit stops after two such steps and is not restarted.  Without the
+    screen its damper walked to 300 times the start's, each simulation slower than the last
+    (a contact time constant of 30 ns): 18 s for this one law, where a right law is
+    unaffected (``test_a_hopeless_fit_is_given_up_after_its_cycle_by_cycle_fit``)."""
+    rec = synthesize(paper, paper.law, periods=12, fs=20000, noise=0.01, seed=1)
+    ref = Reference.from_measurement(rec, paper, n_boot=8, seed=0)
+    res = identify(
+        paper, ref, ForceLaw.parse("1e8*zd"), max_simulations=120, check=False, give_up_above=0.5
+    )
+    assert not res.given_up and res.value > 0.5
+    assert "stopped above the screen: I2" in res.message
+    assert "not restarted: I2" in res.message and "above the screen 0.5" in res.message
+    assert "restarted from the best point" not in res.message
+    assert res.n_simulations < 60
+
+
 def test_a_replicate_without_contact_in_a_block_fails_alone(monkeypatch, paper):
     """A bootstrap replicate whose resampled block has no measured contact (a short contact
     under its noise: its criteria are undefined) is a failed replicate, as a failed
