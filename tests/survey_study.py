@@ -7,7 +7,7 @@ recoveries, false positives per run, intervals covered) and one ``pooled`` row p
 method (the study's :meth:`~discovery.StudyResult.pooled`).  docs/validation.md's table of the
 study is rendered from it (:mod:`tests.tables`).
 
-Run from the repository root (about 18 minutes on two cores)::
+Run from the repository root (10-20 minutes on two shared cores)::
 
     python -m tests.survey_study --workers 2 --out docs/_measured/study-paper.jsonl
 """
