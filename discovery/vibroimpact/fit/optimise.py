@@ -150,7 +150,7 @@ def _ftol(obj):
     return max(FTOL_VARIANCE / obj.dof, 1e-12)
 
 
-def _optimise(obj, x0, method, xtol, max_simulations, give_up_above=None):
+def _optimise(obj, x0, method, xtol, max_simulations, *, give_up_above=None):
     """Run ``method`` on the objective from ``x0``; returns the optimiser's message.  A
     least-squares fit stops early at the edge of its model's domain, or above
     ``give_up_above`` without progress (:class:`_StopRules`)."""
@@ -204,7 +204,7 @@ record's transient); a restart from a stiffer and a softer point often leaves su
 (the rates: CHANGELOG)."""
 
 
-def _restarted(obj, method, xtol, max_simulations, message, give_up_above=None):
+def _restarted(obj, method, xtol, max_simulations, message, *, give_up_above=None):
     """:data:`RESTART_FACTORS` restarts from the best point (see there); the message says
     which improved it.  A fit whose criterion is still above ``give_up_above`` (the
     shortlist's screen of hopeless laws, :func:`~discovery.vibroimpact.fit.identify`) is
@@ -262,9 +262,11 @@ def _fitted(obj, method, xtol, max_simulations, *, restarts=True, give_up_above=
             f"{f['status']} ({f['message']}); give start values closer to "
             "the record (e.g. from vidi fit)"
         )
-    message = _optimise(obj, x0, method, xtol, max_simulations, give_up_above)
+    message = _optimise(obj, x0, method, xtol, max_simulations, give_up_above=give_up_above)
     if obj.best[1] is None:  # least squares evaluates residuals, which record the path
         obj(x0)
     if restarts:
-        message = _restarted(obj, method, xtol, max_simulations, message, give_up_above)
+        message = _restarted(
+            obj, method, xtol, max_simulations, message, give_up_above=give_up_above
+        )
     return obj.estimate(method), message
