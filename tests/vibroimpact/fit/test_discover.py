@@ -123,6 +123,20 @@ def test_supports_that_cannot_explain_the_record_are_given_up_not_polished(resul
     assert not any(m.refinement.given_up for m in result.ranking if m.consistent)
 
 
+def test_a_damping_only_law_above_the_screen_is_stopped_and_says_so(paper):
+    """The README quickstart's kind of record (12 periods on the orbit, 1 % noise): the
+    damping-only candidate's refinement stays far above the screen without progress, stops
+    there and is not restarted (it had walked its damper 300 times out, restarted there:
+    12 of the fit's 15 s), and its note says so; the true support is selected, consistent."""
+    rec = synthesize(paper, paper.law, periods=12, fs=20000, noise=0.01, seed=1)
+    res = discover(paper, rec, n_boot_intervals=0)
+    assert res.selected.law.names == ["z", "zd"] and res.selected.consistent
+    (damper,) = [m for m in res.ranking if m.law.names == ["zd"]]
+    assert "stopped above 0.5 (the screen of hopeless laws)" in damper.note
+    assert "not restarted" in damper.note and not damper.consistent
+    assert not any("stopped above" in m.note for m in res.ranking if m.consistent)
+
+
 def test_refinements_on_two_processes_are_the_serial_ones(paper):
     """The shortlist's refinements and each stepwise move's trials run on the workers; each
     refinement is deterministic and results are put back in their order, so the ranking
