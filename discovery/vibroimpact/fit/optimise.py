@@ -92,6 +92,13 @@ EDGE_ITERATIONS = 3
 #: squares by less than :data:`SCREEN_PROGRESS` before it stops
 SCREEN_ITERATIONS = 2
 SCREEN_PROGRESS = 0.1
+#: how the optimiser's message begins when a fit stopped above the screen
+SCREEN_STOP = "stopped above the screen"
+
+
+def _above_screen(obj, give_up_above):
+    """Whether ``obj``'s best criterion so far is above the screen ``give_up_above``."""
+    return give_up_above is not None and obj.best[0] > give_up_above
 
 
 class _StopRules:
@@ -125,11 +132,11 @@ class _StopRules:
         self.cost = cost
         if self.give_up_above is None or before is None:
             return
-        hopeless = self.obj.best[0] > self.give_up_above
+        hopeless = _above_screen(self.obj, self.give_up_above)
         self.slow = self.slow + 1 if hopeless and cost > (1 - SCREEN_PROGRESS) * before else 0
         if self.slow >= SCREEN_ITERATIONS:
             self.why = (
-                f"stopped above the screen: {self.obj.name} {self.obj.best[0]:.3g} above "
+                f"{SCREEN_STOP}: {self.obj.name} {self.obj.best[0]:.3g} above "
                 f"{self.give_up_above:.3g}, the sum of squares lowered by less than "
                 f"{SCREEN_PROGRESS:.0%} in {SCREEN_ITERATIONS} iterations"
             )
@@ -207,18 +214,16 @@ record's transient); a restart from a stiffer and a softer point often leaves su
 def _restarted(obj, method, xtol, max_simulations, message, *, give_up_above=None):
     """:data:`RESTART_FACTORS` restarts from the best point (see there); the message says
     which improved it.  A fit whose criterion is still above ``give_up_above`` (the
-    shortlist's screen of hopeless laws, :func:`~discovery.vibroimpact.fit.identify`) is
-    not restarted: a restart leaves a wrong basin of a law that can match the record, and
-    this one's force histories still differ by more than half the force.  On the README's
-    12-period record a damping-only law (I2 0.93 against a screen of 0.5) was restarted
-    twice with its damper 300 times the regression's, where each simulation takes a
-    quarter of a second (a contact time constant ``m / c`` of 30 ns): 9.8 s of the fit's
-    14.9 s.  A restart whose point is still at the edge of its model's domain
-    (a named contact model's stiffness clipped to its floor, scaled, stays clipped) is not
-    made: the clipped parameter's Jacobian column is zero there, so the fit would stay at
-    the edge, which is no result (such restarts were 57 % of the named models' fit time on
-    the README's record)."""
-    if give_up_above is not None and obj.best[0] > give_up_above:
+    shortlist's screen of hopeless laws, :class:`_StopRules`) is not restarted: a restart
+    leaves a wrong basin of a law that can match the record, and this one's force histories
+    still differ by more than half the force (the README's damping-only law was restarted
+    where each simulation took a quarter of a second: 9.8 s of the fit's 14.9 s).  A
+    restart whose point is still at the edge of its model's domain (a named contact model's
+    stiffness clipped to its floor, scaled, stays clipped) is not made: the clipped
+    parameter's Jacobian column is zero there, so the fit would stay at the edge, which is
+    no result (such restarts were 57 % of the named models' fit time on the README's
+    record)."""
+    if _above_screen(obj, give_up_above):
         return message + (
             f"; not restarted: {obj.name} {obj.best[0]:.3g} above the screen {give_up_above:.3g}"
         )

@@ -15,7 +15,7 @@ from ..verify import evaluate
 from ..verify.sensors import lag_observation
 from .discovery_result import RankedModel
 from .identification import identify
-from .optimise import SCREEN_PROGRESS
+from .optimise import SCREEN_PROGRESS, SCREEN_STOP
 from .records import record_start
 from .regression import ConstrainedSparseRegressor
 
@@ -181,7 +181,7 @@ class _Checker:
                 f"refined by simulation from the {origin} "
                 f"({ref.n_simulations} simulations, {self.criterion} {ref.value:.3g})"
             )
-            if "stopped above the screen" in ref.message:
+            if ref.message.startswith(SCREEN_STOP):
                 note += (
                     f"; stopped above {self.give_up_above:.3g} (the screen of hopeless laws), "
                     f"its steps lowering the squares by less than {SCREEN_PROGRESS:.0%}, and "
