@@ -8,7 +8,7 @@ from scipy.optimize import least_squares, minimize
 
 from ...errors import InputError, IntegrationError, VidiTypeError
 from ..model.law import ForceLaw
-from .problem import _Budget
+from .problem import _Budget, _NotFinite
 from .records import as_records
 
 __all__ = ["METHODS", "RESTART_FACTORS"]
@@ -200,6 +200,8 @@ def _optimise(obj, x0, method, xtol, max_simulations, *, give_up_above=None):
         return str(res.message)
     except _Budget:
         return f"simulation budget of {max_simulations} used"
+    except _NotFinite:
+        return "stopped: the optimiser's step was not finite (the best point met is kept)"
 
 
 RESTART_FACTORS = (1.25, 0.8)

@@ -393,3 +393,54 @@ def test_a_replicate_without_contact_in_a_block_fails_alone(monkeypatch, paper):
     assert iv._step_replicate(context, 0) is None
     assert iv._refit_replicate(context, 0) is None
     assert issubclass(NoContactError, InputError)
+
+
+def test_an_exact_column_beyond_any_resolvable_slope_is_taken_by_differences(
+    paper, reference, monkeypatch
+):
+    """Variational equations integrated through a contact they cannot follow gave a
+    hopeless law a Jacobian column of 2.6e97 on a random short-contact record: finite, so
+    kept, and the least-squares step overflowed to NaN.  A column steeper than
+    :data:`~discovery.vibroimpact.fit.problem.JACOBIAN_LIMIT` is taken by differences."""
+    from discovery.vibroimpact.fit import problem
+
+    obj = problem._Objective([(paper, reference)], paper.law, "I2", None, 100)
+    x = np.ones(len(paper.law.coefficients))
+    assert obj.exact_columns[1]
+    honest = obj.jacobian(x)
+    real = problem._Objective._exact_jacobian
+
+    def overflowing(self, x, cols, J):
+        exact = real(self, x, cols, J)
+        J[:, 0] *= 1e90
+        return exact
+
+    monkeypatch.setattr(problem._Objective, "_exact_jacobian", overflowing)
+    J = obj.jacobian(x)
+    assert np.all(np.isfinite(J)) and np.abs(J).max() < problem.JACOBIAN_LIMIT
+    # the differenced column is the exact one to the step's accuracy; the other is exact
+    assert np.allclose(J[:, 0], honest[:, 0], rtol=1e-2, atol=1e-3 * np.abs(honest).max())
+    assert np.array_equal(J[:, 1], honest[:, 1])
+
+
+def test_a_step_that_is_not_finite_ends_the_fit_at_its_best_point(paper, reference, monkeypatch):
+    """An optimiser's step that overflowed to NaN is no trial law (the law would refuse its
+    coefficients, and that ended a whole discovery): the fit stops there, says so, and keeps
+    the best point it met, which is still judged.  (scipy's trust-region step overflowed so
+    on a Jacobian column of 2.6e97; here the optimiser proposes NaN after its first step.)"""
+    from discovery.vibroimpact.fit import optimise
+
+    real = optimise.least_squares
+
+    def overflowing(fun, x0, **kwargs):
+        kwargs["max_nfev"] = 2
+        res = real(fun, x0, **kwargs)
+        fun(np.full_like(res.x, np.nan))
+        return res
+
+    monkeypatch.setattr(optimise, "least_squares", overflowing)
+    start = paper.law.with_coefficients([1.2 * c for c in paper.law.coefficients])
+    res = identify(paper, reference, start, max_simulations=60, check=False)
+    assert "the optimiser's step was not finite" in res.message
+    assert all(np.isfinite(res.law.coefficients)) and res.verdict
+    assert res.law.coefficients != start.coefficients  # its first step was kept
