@@ -8,7 +8,8 @@ import numpy as np
 
 from ...errors import InputError, IntegrationError
 from ...numerics.executor import map_on
-from ..model.law import ForceLaw, Term
+from ..fit.rescan import lower_basin, springs_scaled
+from ..model.law import Term
 from ..verify import CONSISTENCY_FACTORS
 from ..verify.motion import MOTION_CRITERION
 from .effects import effect
@@ -38,13 +39,6 @@ _LADDER = tuple(2.0**k for k in range(13))
 #: supports' ``k3`` from the frame's equation): the regression's spring is biased low by the
 #: penetration's noise by a few percent, and a short contact's basin can be narrower
 _SPRING_SCAN = tuple(1.0 + 0.01 * k for k in range(-6, 9) if k)
-
-
-#: the share by which a scanned spring's sum of squares must fall below a refit's end for
-#: :meth:`_Refits.rescanned` to refit from it: a lower basin (draw 27's lag, 32 % at +7 %).
-#: Nearer, the scan meets the roughness of a transient's squares (1.5-7 % at +-1-2 % of the
-#: spring on the bench record's refits, whose refits from there ended where they began)
-RESCAN_DROP = 0.1
 
 
 def _same_contacts(ev):
@@ -150,7 +144,8 @@ class _Refits:
         """A refit ``res`` not consistent with every record, its contact times off (I4
         above its limit in a record: another contact sequence's basin), refitted again from
         its law's springs scanned (:data:`_SPRING_SCAN`) where one of them has a sum of
-        squares :data:`RESCAN_DROP` below its end; the lower of the two refits by the
+        squares :data:`~discovery.vibroimpact.fit.rescan.RESCAN_DROP` below its end
+        (:func:`~discovery.vibroimpact.fit.rescan.lower_basin`); the lower of the two refits by the
         criterion.  Over a record's transient the contact sequence changes with the
         spring, so the sum of squares has basins a few percent wide: on survey draw 27's
         noisier record (a lag) the lag's refit stopped at I2 0.050, its spring 6 % soft,
@@ -160,20 +155,12 @@ class _Refits:
         evs = problem.evaluations(res.law, floor=True)
         if all(e.consistent for e in evs) or all(_same_contacts(e) for e in evs):
             return res
-        m = res.law
-        scan = [
-            m.with_springs_scaled(f)
-            if isinstance(m, ForceLaw)
-            else m.with_law(m.law.with_springs_scaled(f))
-            for f in _SPRING_SCAN
-        ]
-        squares = [problem.squares(x) for x in scan]
-        i = int(np.argmin(squares))
-        if not squares[i] < (1.0 - RESCAN_DROP) * problem.squares(res.law):
+        lower = lower_basin(res.law, _SPRING_SCAN, problem.squares)
+        if lower is None:
             return res
         try:
             again = _output_error(
-                self.records, scan[i], self.criterion, self.budget, self.tolerances
+                self.records, lower[1], self.criterion, self.budget, self.tolerances
             )
         except IntegrationError:
             return res
@@ -231,9 +218,7 @@ class _Refits:
         if read is not None and lo <= read <= hi:
             family = [_extend(m, eff, read) for m in (model, reg) if m is not None]
             base = family[-1]
-            own.append(
-                family + [base.with_law(base.law.with_springs_scaled(f)) for f in _SPRING_SCAN]
-            )
+            own.append(family + [springs_scaled(base, f) for f in _SPRING_SCAN])
         return h, families, own
 
     def _by_gap(self, cands):

@@ -99,6 +99,9 @@ class ModelProblem:
         The records (:func:`~.records.as_records`).
     tolerances : Tolerances or None
         Integrator settings of every evaluation.
+    observe : callable or None
+        A known sensor's observation model, where the model has none of its own
+        (:func:`~.records.model_parts`).
 
     Attributes
     ----------
@@ -106,8 +109,8 @@ class ModelProblem:
         Evaluations run (one per record; answers from the memo do not count).
     """
 
-    def __init__(self, records, tolerances):
-        self.records, self.tol = records, tolerances
+    def __init__(self, records, tolerances, observe=None):
+        self.records, self.tol, self.observe = records, tolerances, observe
         self.n_sim = 0
         # a model asked for again (in the missing-effect loop: verified at the start of an
         # iteration and named in the one before; its residual follows its verification) is
@@ -131,7 +134,7 @@ class ModelProblem:
     def _evaluate(self, model, floor, smooth_onset):
         """The evaluations of :meth:`evaluations`; those with the onset smoothed are the
         residual's (:meth:`residual`), which reads the histories and no criterion."""
-        parts = model_parts(model)
+        parts = model_parts(model, self.observe)
         evs = []
         for sc, ref in self.records:
             self.n_sim += 1

@@ -16,8 +16,10 @@ from ..verify.sensors import lag_observation
 from .discovery_result import RankedModel
 from .identification import identify
 from .optimise import SCREEN_PROGRESS, SCREEN_STOP
+from .problem import ModelProblem
 from .records import record_start
 from .regression import ConstrainedSparseRegressor
+from .rescan import WIDE_SPRING_SCAN, lower_basin
 
 _FORWARD_STARTS = (0.01, 0.001)  # a new term's start force at the box corner / peak force
 
@@ -131,18 +133,7 @@ class _Checker:
             return RankedModel(law, cand, self.evaluate(law), note="not refined", certificate=cert0)
         law = self._scaled_start(law)
         try:
-            ref = identify(
-                [sc for sc, _ in self.refs],
-                [r for _, r in self.refs],
-                law,
-                criterion=self.criterion,
-                method="least-squares",
-                max_simulations=self.budget,
-                tolerances=self.tol,
-                check=False,
-                give_up_above=self.give_up_above,
-                observe=self.observe,
-            )
+            ref = self._identified(law, self.budget)
         except IntegrationError as exc:
             return RankedModel(
                 law,
@@ -151,6 +142,8 @@ class _Checker:
                 note=f"not refined: the {origin} law fails ({exc})",
                 certificate=cert0,
             )
+        first = ref
+        ref, rescan = self._rescanned(ref)
         coef = _coefficients(ref.law, est.library_)
         cert = est.certify(coef)
         if not cert.holds:
@@ -179,7 +172,7 @@ class _Checker:
         else:
             note = (
                 f"refined by simulation from the {origin} "
-                f"({ref.n_simulations} simulations, {self.criterion} {ref.value:.3g})"
+                f"({first.n_simulations} simulations, {self.criterion} {first.value:.3g})"
             )
             if ref.message.startswith(SCREEN_STOP):
                 note += (
@@ -187,8 +180,53 @@ class _Checker:
                     f"its steps lowering the squares by less than {SCREEN_PROGRESS:.0%}, and "
                     "not restarted"
                 )
+            note += rescan
         return RankedModel(
             ref.law, rescored, self.evaluate(ref.law), refinement=ref, note=note, certificate=cert
+        )
+
+    def _rescanned(self, ref):
+        """``(refinement, note)``: a refinement that ends inconsistent with a record (and
+        below the screen of hopeless laws) refitted again from its springs scanned wide
+        (:data:`~.rescan.WIDE_SPRING_SCAN`) where one has a sum of squares
+        :data:`~.rescan.RESCAN_DROP` below its end; the better of the two by the criterion,
+        and a note on the rescan ("" when none was refitted)."""
+        if ref.given_up or ref.message.startswith(SCREEN_STOP):
+            return ref, ""
+        if all(e.consistent for e in self.evaluate(ref.law)):
+            return ref, ""
+        problem = ModelProblem(self.refs, self.tol, observe=self.observe)
+        lower = lower_basin(ref.law, WIDE_SPRING_SCAN, problem.squares)
+        if lower is None:
+            return ref, ""
+        factor, start, squares, base = lower
+        try:
+            again = self._identified(start, self.budget)
+        except IntegrationError:
+            return ref, ""
+        better = again.value < ref.value
+        note = (
+            f"; its springs x {factor:g} had {1 - squares / base:.0%} lower squares "
+            f"({problem.n_sim} simulations), refitted from there to {self.criterion} "
+            f"{again.value:.3g} ({again.n_simulations} simulations)"
+            + (", kept" if better else ", not kept")
+        )
+        return (again if better else ref), note
+
+    def _identified(self, law, budget):
+        """``law`` refined by simulation on every record (least squares, ``budget``
+        simulations, not checked: the shortlist evaluates its result)."""
+        return identify(
+            [sc for sc, _ in self.refs],
+            [r for _, r in self.refs],
+            law,
+            criterion=self.criterion,
+            method="least-squares",
+            max_simulations=budget,
+            tolerances=self.tol,
+            check=False,
+            give_up_above=self.give_up_above,
+            observe=self.observe,
         )
 
     def _scaled_start(self, law):

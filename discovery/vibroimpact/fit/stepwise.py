@@ -9,6 +9,15 @@ from .shortlist import _Checker
 _RESTARTS = 2  # stalled smaller supports restarted from a consistent model, per step
 
 
+def _settled(model):
+    """Whether a model's support needs no other start: it was simulated, and refined (or
+    not meant to be) rather than left at a start whose refinement broke a physical
+    condition or failed."""
+    return bool(model.criteria) and not (
+        model.refinement is not None and model.note.startswith("not refined")
+    )
+
+
 @dataclass(eq=False)
 class _Stepwise:
     """The output-error stepwise search around the best model: a consistent model loses a
@@ -40,11 +49,14 @@ class _Stepwise:
     def trials(self, top, models):
         """The models of one move from ``top``, and the move's kind."""
         check, physics = self.check, self.rank.physics
-        # supports already simulated successfully are not tried again, except that a
-        # consistent model's backward step retries a smaller support that was inconsistent
-        # from its own (biased regression) start, once, from the consistent coefficients:
-        # a refinement that stalled far from the truth must not hide the simplest model
-        done = frozenset(frozenset(m.law.names) for m in models if m.criteria)
+        # supports already refined are not tried again, except that a consistent model's
+        # backward step retries a smaller support that was inconsistent from its own
+        # (biased regression) start, once, from the consistent coefficients: a refinement
+        # that stalled far from the truth must not hide the simplest model.  A support whose
+        # refinement from a biased start broke a physical condition is tried again from a
+        # move's coefficients (on a random short-contact record the true support's
+        # regression had a negative coupling, and its refinement kept it)
+        done = frozenset(frozenset(m.law.names) for m in models if _settled(m))
         if not (top.consistent and not (physics and top.defects)):
             # both directions: a wrong term may have to go while a missing one comes in
             trials = check.forward(top, self.max_terms, done) + check.backward(top, done)
