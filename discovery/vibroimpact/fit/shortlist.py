@@ -142,8 +142,6 @@ class _Checker:
                 note=f"not refined: the {origin} law fails ({exc})",
                 certificate=cert0,
             )
-        first = ref
-        ref, rescan = self._rescanned(ref)
         coef = _coefficients(ref.law, est.library_)
         cert = est.certify(coef)
         if not cert.holds:
@@ -172,7 +170,7 @@ class _Checker:
         else:
             note = (
                 f"refined by simulation from the {origin} "
-                f"({first.n_simulations} simulations, {self.criterion} {first.value:.3g})"
+                f"({ref.n_simulations} simulations, {self.criterion} {ref.value:.3g})"
             )
             if ref.message.startswith(SCREEN_STOP):
                 note += (
@@ -180,38 +178,30 @@ class _Checker:
                     f"its steps lowering the squares by less than {SCREEN_PROGRESS:.0%}, and "
                     "not restarted"
                 )
-            note += rescan
         return RankedModel(
             ref.law, rescored, self.evaluate(ref.law), refinement=ref, note=note, certificate=cert
         )
 
-    def _rescanned(self, ref):
-        """``(refinement, note)``: a refinement that ends inconsistent with a record (and
-        below the screen of hopeless laws) refitted again from its springs scanned wide
+    def rescanned(self, model):
+        """A refined ``model`` that is not consistent with a record (and below the screen of
+        hopeless laws) refined again from its springs scanned wide
         (:data:`~.rescan.WIDE_SPRING_SCAN`) where one has a sum of squares
-        :data:`~.rescan.RESCAN_DROP` below its end; the better of the two by the criterion,
-        and a note on the rescan ("" when none was refitted)."""
-        if ref.given_up or ref.message.startswith(SCREEN_STOP):
-            return ref, ""
-        if all(e.consistent for e in self.evaluate(ref.law)):
-            return ref, ""
+        :data:`~.rescan.RESCAN_DROP` below its own; None when none has."""
+        ref = model.refinement
+        if ref is None or ref.given_up or ref.message.startswith(SCREEN_STOP):
+            return None
+        if model.consistent or model.note.startswith("not refined"):
+            return None
         problem = ModelProblem(self.refs, self.tol, observe=self.observe)
-        lower = lower_basin(ref.law, WIDE_SPRING_SCAN, problem.squares)
+        lower = lower_basin(model.law, WIDE_SPRING_SCAN, problem.squares)
         if lower is None:
-            return ref, ""
+            return None
         factor, start, squares, base = lower
-        try:
-            again = self._identified(start, self.budget)
-        except IntegrationError:
-            return ref, ""
-        better = again.value < ref.value
-        note = (
-            f"; its springs x {factor:g} had {1 - squares / base:.0%} lower squares "
-            f"({problem.n_sim} simulations), refitted from there to {self.criterion} "
-            f"{again.value:.3g} ({again.n_simulations} simulations)"
-            + (", kept" if better else ", not kept")
+        origin = (
+            f"springs of {' + '.join(model.law.names)} scaled x {factor:g}, where the squares "
+            f"were {1 - squares / base:.0%} lower"
         )
-        return (again if better else ref), note
+        return self.refined(start, model.candidate, origin)
 
     def _identified(self, law, budget):
         """``law`` refined by simulation on every record (least squares, ``budget``

@@ -23,14 +23,16 @@ class _Stepwise:
     """The output-error stepwise search around the best model: a consistent model loses a
     term (backward), an inconsistent one gains one (forward: the regression may have been
     misled, e.g. by noisy penetration), for up to ``stepwise`` moves.  ``retried``: the
-    supports already restarted from a consistent model (each once); ``steps``: the moves
-    made, each ``{"kind", "from", "trials"}``."""
+    supports already restarted from a consistent model (each once); ``scanned``: those whose
+    springs were scanned (:meth:`rescanned`, each once); ``steps``: the moves made, each
+    ``{"kind", "from", "trials"}``."""
 
     check: _Checker
     rank: _RankingRule
     stepwise: int
     max_terms: int
     retried: set = field(default_factory=set)
+    scanned: set = field(default_factory=set)
     steps: list = field(default_factory=list)
 
     def more(self, steps, ranking):
@@ -83,6 +85,24 @@ class _Stepwise:
             trials.append(check.restart(top, set(m.law.names)))
         return trials, "backward"
 
+    def rescanned(self, top, models, ranking):
+        """``(models, ranking, top)`` after the best model, when it is not consistent, is
+        refined again from its springs scanned wide (:meth:`_Checker.rescanned`; each
+        support once, as a move of its own in ``steps``).  Only the best: on a record no
+        candidate matches (the bench record, an unloading damper outside ``poly:2``) every
+        candidate's scan found no lower basin, 42 simulations for nothing."""
+        support = frozenset(top.law.names)
+        if top.consistent or support in self.scanned:
+            return models, ranking, top
+        self.scanned.add(support)
+        again = self.check.rescanned(top)
+        if again is None:
+            return models, ranking, top
+        self.steps.append({"kind": "rescan", "from": list(top.law.names), "trials": 1})
+        models = _best_per_support(models + [again], self.rank.criterion)
+        ranking = self.rank(models)
+        return models, ranking, ranking[0]
+
     def run(self, models, refs, refine, progress):
         """The ranking after the search (its moves in ``steps``)."""
         ranking = self.rank(models)
@@ -96,6 +116,7 @@ class _Stepwise:
                 ranking = self.rank(models)
         while refine and ranking[0].criteria and self.more(steps, ranking):
             top = ranking[0]
+            models, ranking, top = self.rescanned(top, models, ranking)
             trials, kind = self.trials(top, models)
             if not trials:
                 break

@@ -184,7 +184,8 @@ def test_a_refinement_stopped_in_a_soft_basin_is_rescanned_along_its_springs():
     res = discover(cal.scenario, rec, n_boot_intervals=0, machine_scale=cal.scale_range)
     sel = res.selected
     assert sel.consistent and sel.law.names == ["z", "zd"]
-    assert "its springs x 1.45 had" in sel.note and sel.note.endswith(", kept")
+    assert "from the springs of z + zd scaled x 1.45, where the squares were" in sel.note
+    assert any(s["kind"] == "rescan" for s in res.settings["steps"])
     for a, b in zip(sel.law.coefficients, case.law.coefficients, strict=True):
         assert abs(a / b - 1) < 0.02, (sel.law, case.law)
 
