@@ -133,7 +133,7 @@ class _Checker:
             return RankedModel(law, cand, self.evaluate(law), note="not refined", certificate=cert0)
         law = self._scaled_start(law)
         try:
-            ref = self._identified(law, self.budget)
+            ref = self._identified(law)
         except IntegrationError as exc:
             return RankedModel(
                 law,
@@ -203,8 +203,8 @@ class _Checker:
         )
         return self.refined(start, model.candidate, origin)
 
-    def _identified(self, law, budget):
-        """``law`` refined by simulation on every record (least squares, ``budget``
+    def _identified(self, law):
+        """``law`` refined by simulation on every record (least squares, :attr:`budget`
         simulations, not checked: the shortlist evaluates its result)."""
         return identify(
             [sc for sc, _ in self.refs],
@@ -212,7 +212,7 @@ class _Checker:
             law,
             criterion=self.criterion,
             method="least-squares",
-            max_simulations=budget,
+            max_simulations=self.budget,
             tolerances=self.tol,
             check=False,
             give_up_above=self.give_up_above,
