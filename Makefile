@@ -106,7 +106,9 @@ surveys: install
 		$(MEASURED)/explain-random*.jsonl $(MEASURED)/study-paper*.jsonl \
 		$(MEASURED)/contact-models-*.jsonl $(MEASURED)/explain-cases*.jsonl \
 		$(MEASURED)/calibration*.jsonl $(MEASURED)/memory-orbits*.jsonl \
-		$(MEASURED)/effects*.jsonl
+		$(MEASURED)/effects*.jsonl $(MEASURED)/fit-sheet*.jsonl
+	$(BIN)/python -m tests.survey_fit_sheet --draws 0 24 --workers $(SURVEY_WORKERS) \
+		--out $(MEASURED)/fit-sheet.jsonl
 	$(BIN)/python -m tests.survey_memory_orbits --n 160 --workers $(SURVEY_WORKERS) \
 		--out $(MEASURED)/memory-orbits.jsonl
 	$(BIN)/python -m tests.survey_effects --draws 0 40 --workers $(SURVEY_WORKERS) \

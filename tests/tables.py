@@ -38,6 +38,7 @@ from . import (
     survey_effects,
     survey_explain,
     survey_explain_cases,
+    survey_fit_sheet,
     survey_intervals,
     survey_memory_orbits,
     survey_study,
@@ -175,6 +176,22 @@ TABLES = {
         rows=(("all", ("effects*.jsonl",)), ("all sheet", ("sheet-effects*.jsonl",))),
         row=survey_effects.readme_row,
         read=survey_effects.read_rows,
+    ),
+    "fit-sheet": Table(
+        page="docs/validation.md",
+        header=survey_fit_sheet.HEADER,
+        rows=tuple(
+            (label, ("fit-sheet*.jsonl",)) for label in (*survey_fit_sheet.CATEGORIES, "all")
+        ),
+        row=survey_fit_sheet.markdown_row,
+        read=survey_fit_sheet.read_rows,
+    ),
+    "fit-sheet-readme": Table(
+        page="README.md",
+        header=survey_fit_sheet.HEADER,
+        rows=(("all", ("fit-sheet*.jsonl",)),),
+        row=survey_fit_sheet.markdown_row,
+        read=survey_fit_sheet.read_rows,
     ),
     "memory-orbits": Table(
         page="docs/contact-models.md",

@@ -520,3 +520,39 @@ def test_the_study_table_is_each_methods_cells_and_pooled_counts(tmp_path):
         run.write(r)
     line = survey_study.stamp([path], rows)
     assert "4 / 40 recorded periods" in line and "8 cells, 16 runs, 10.0 min on 2" in line
+
+
+def test_the_fit_sheet_table_counts_each_record_once_by_its_outcome(tmp_path):
+    """tests.survey_fit_sheet's rows: a later row of a draw and noise level replaces an
+    earlier one; refusals and errors are columns of their own; a true law outside the
+    library is counted apart (with how many of those are consistent); the rates are among
+    the fitted records the library holds; a draw whose quieter record loses the right
+    support that its noisier one has is a pair."""
+    from tests import survey_fit_sheet as s
+
+    def row(i, noise, cat="p1", inside=True, **kw):
+        return {"draw": i, "category": cat, "noise": noise, "in_library": inside, **kw}
+
+    good = dict(right_support=True, consistent=True, worst_coefficient_error=0.01)
+    rows = [
+        row(0, "high", **good),
+        row(0, "low", right_support=False, consistent=True),  # worse on better data
+        row(1, "high", refused="fewer than 10 contact samples"),
+        row(1, "low", **{**good, "worst_coefficient_error": 0.08}),  # right, 8 % off
+        row(2, "high", inside=False, right_support=False, consistent=True),
+        row(2, "low", inside=False, right_support=False, consistent=False),
+        row(3, "high", cat="subharmonic", error="TypeError: x"),
+        row(3, "low", cat="subharmonic", right_support=True, consistent=False),
+    ]
+    path = tmp_path / "fit-sheet-test.jsonl"
+    out = measured.RunFile(path, "survey_fit_sheet", ["--draws", "0", "4"])
+    for r in rows:
+        out.write(r)
+    out.write(row(3, "low", cat="subharmonic", **good))  # draw 3 again: now right
+    read = s.read_rows([path])
+    assert len(read) == 8 and read[-1]["consistent"]
+    assert s.markdown_row(read, "p1") == "| p1 | 6 | 1 | 0 | 2 (1) | 2/3 | 3/3 | 1/3 | 1 |"
+    assert s.markdown_row(read, "subharmonic") == (
+        "| subharmonic | 2 | 0 | 1 | 0 (0) | 1/1 | 1/1 | 1/1 | 0 |"
+    )
+    assert s.markdown_row(read, "all") == "| all | 8 | 1 | 1 | 2 (1) | 3/4 | 4/4 | 2/4 | 1 |"
