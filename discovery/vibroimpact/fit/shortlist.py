@@ -201,7 +201,12 @@ class _Checker:
             f"springs of {' + '.join(model.law.names)} scaled x {factor:g}, where the squares "
             f"were {1 - squares / base:.0%} lower"
         )
-        return self.refined(start, model.candidate, origin)
+        # the coefficients its refinement started from stay those the model's came from
+        cand = model.candidate
+        before = cand.extra.get("regression_coefficients")
+        return self.refined(
+            start, replace(cand, coefficients=dict(before or cand.coefficients)), origin
+        )
 
     def _identified(self, law):
         """``law`` refined by simulation on every record (least squares, :attr:`budget`
