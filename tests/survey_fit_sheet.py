@@ -1,6 +1,7 @@
-"""Survey of ``vidi fit`` on random machines known to 5 %: each record given to the tool
-with a designer's sheet off the machine that made it, calibrated from the record as ``vidi
-fit`` does, each at two noise levels (not a test).
+"""Survey of ``vidi fit`` on random machines known to 5 %, two noise levels (not a test).
+
+Each record is given to the tool with a designer's sheet off the machine that made it,
+calibrated from the record as ``vidi fit`` does.
 
 Usage::
 
@@ -103,8 +104,15 @@ def _worst(law, truth):
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--draws", nargs=2, type=int, metavar=("FIRST", "STOP"), required=True)
-    p.add_argument("--workers", type=int, default=2)
+    p.add_argument(
+        "--draws",
+        nargs=2,
+        type=int,
+        metavar=("FIRST", "STOP"),
+        required=True,
+        help="the draws FIRST .. STOP - 1 (draw i: category i %% 4, seed 8100 + i)",
+    )
+    p.add_argument("--workers", type=int, default=2, help="processes, one draw each (2)")
     p.add_argument("--out", required=True, help="the run file of the rows (JSON lines)")
     args = p.parse_args(argv)
     from multiprocessing import get_context
