@@ -66,6 +66,18 @@ class RunFile:
             print(json.dumps(row, default=float), file=fh, flush=True)
 
 
+def write_pooled(out, fn, jobs, workers):
+    """``fn(job)`` for every job on ``workers`` spawned processes, each result's rows (a
+    list) written to the run file ``out`` and printed as they come."""
+    from multiprocessing import get_context
+
+    with get_context("spawn").Pool(workers) as pool:
+        for result in pool.imap_unordered(fn, jobs):
+            for row in result:
+                out.write(row)
+                print(json.dumps(row), flush=True)
+
+
 def rows(paths):
     """Every row of the run files ``paths``, in order."""
     return [r for p in paths for r in read(p)[1]]

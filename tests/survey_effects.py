@@ -36,7 +36,6 @@ hidden parameter's 95 % interval holds its true value.
 """
 
 import argparse
-import json
 import sys
 import time
 from dataclasses import dataclass, replace
@@ -393,18 +392,11 @@ def main(argv=None):
         help="only the draws of these classes (default: every class)",
     )
     args = p.parse_args(argv)
-    from multiprocessing import get_context
-
     out = measured.RunFile(args.out, "survey_effects", argv, append=True)
-    with get_context("spawn").Pool(args.workers) as pool:
-        draws = [
-            i for i in range(*args.draws) if CLASSES[i % len(CLASSES)] in (args.classes or CLASSES)
-        ]
-        jobs = [(i, args.sheet_error) for i in draws]
-        for rows in pool.imap_unordered(run_case, jobs):
-            for row in rows:
-                out.write(row)
-                print(json.dumps(row), flush=True)
+    draws = [
+        i for i in range(*args.draws) if CLASSES[i % len(CLASSES)] in (args.classes or CLASSES)
+    ]
+    measured.write_pooled(out, run_case, [(i, args.sheet_error) for i in draws], args.workers)
     return 0
 
 

@@ -21,7 +21,6 @@ relative error of its coefficients on the true support, or the refusal or error.
 """
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
@@ -115,14 +114,8 @@ def main(argv=None):
     p.add_argument("--workers", type=int, default=2, help="processes, one draw each (2)")
     p.add_argument("--out", required=True, help="the run file of the rows (JSON lines)")
     args = p.parse_args(argv)
-    from multiprocessing import get_context
-
     out = measured.RunFile(args.out, "survey_fit_sheet", argv, append=True)
-    with get_context("spawn").Pool(args.workers) as pool:
-        for rows in pool.imap_unordered(run_draw, range(*args.draws)):
-            for row in rows:
-                out.write(row)
-                print(json.dumps(row), flush=True)
+    measured.write_pooled(out, run_draw, range(*args.draws), args.workers)
     return 0
 
 

@@ -353,8 +353,7 @@ class _Objective:
             # a column that is not finite (a graze at an onset, an infinite slope of a
             # fractional power at zero penetration) or beyond any resolvable slope
             # (JACOBIAN_LIMIT) is taken by differences
-            exact &= np.all(np.isfinite(J), axis=0)
-            exact &= np.all(np.abs(np.nan_to_num(J)) <= JACOBIAN_LIMIT, axis=0)
+            exact &= np.all(np.abs(J) <= JACOBIAN_LIMIT, axis=0)  # False for inf and NaN
         # the variational equations give the force's and the penetration's rows of the
         # exact columns; the other columns by forward differences
         for i in np.flatnonzero(~exact):
