@@ -487,6 +487,9 @@ def _stopped(exc, outer=None):
     the note it attaches to the interrupt) or that the partial outputs were removed."""
     note = getattr(outer, "vidi_note", None) or getattr(exc, "vidi_note", None)
     what = note or "partial outputs were removed, earlier results are unchanged"
+    hook = sys.unraisablehook
+    if isinstance(hook, _Unraisable):  # what the interrupt left half built is freed quietly
+        hook.stopped = True
     if isinstance(exc, Terminated):
         _error(f"terminated (SIGTERM); {what}")
         return 143
@@ -494,26 +497,37 @@ def _stopped(exc, outer=None):
     return 130
 
 
-def _redeliver(hook):
-    """An unraisable-exception hook that gives an interrupt back to the main thread.
+class _Unraisable:
+    """The unraisable-exception hook of a run: gives an interrupt back to the main thread,
+    and is quiet once the run has been stopped.
 
     A signal that arrives while Python runs a callback it cannot propagate from (an
     import lock's weakref callback, during the imports) would be printed as "Exception
     ignored" with a traceback and then lost: the run would go on.  The hook delivers the
     signal to the main thread again, from a timer thread so that it lands once the hook
-    has returned (raised inside the hook it would be lost the same way); anything else
+    has returned (raised inside the hook it would be lost the same way).
+
+    Once the run has stopped on an interrupt (``stopped``), the objects the interrupt left
+    half built are freed with the run's frames; their clean-up can fail (llvmlite's
+    ``ObjectRef.__del__`` on a compilation cut short, "no attribute '_as_parameter_'").
+    The run has said what happened in its one line, so those are dropped.  Anything else
     goes to the previous hook."""
 
-    def unraisable(u):
-        if isinstance(u.exc_value, KeyboardInterrupt | Terminated):
-            sig = signal.SIGINT if isinstance(u.exc_value, KeyboardInterrupt) else signal.SIGTERM
-            again = threading.Timer(0.01, _thread.interrupt_main, (sig,))
-            again.daemon = True
-            again.start()
-            return
-        hook(u)
+    def __init__(self, hook):
+        self.hook = hook
+        self.stopped = False
 
-    return unraisable
+    def __call__(self, u):
+        stop = u.exc_value
+        if isinstance(stop, KeyboardInterrupt | Terminated):
+            if not self.stopped:
+                sig = signal.SIGINT if isinstance(stop, KeyboardInterrupt) else signal.SIGTERM
+                again = threading.Timer(0.01, _thread.interrupt_main, (sig,))
+                again.daemon = True
+                again.start()
+            return
+        if not self.stopped:
+            self.hook(u)
 
 
 def _leave(code):
@@ -548,7 +562,7 @@ def main(argv=None):
             old_term = signal.signal(signal.SIGTERM, _terminate)
         except (ValueError, OSError):
             old_term = None
-        sys.unraisablehook = _redeliver(old_hook)
+        sys.unraisablehook = _Unraisable(old_hook)
     try:
         code = _run(argv)
     except MemoryError:  # handled out here, once the frames holding the memory are gone
@@ -560,7 +574,8 @@ def main(argv=None):
                 signal.signal(signal.SIGTERM, signal.SIG_IGN)
         elif old_term is not None:
             signal.signal(signal.SIGTERM, old_term)
-        sys.unraisablehook = old_hook
+        if not entry:  # as the entry point, the hook stays to the end (an interrupted run's)
+            sys.unraisablehook = old_hook
     if code is None:
         with contextlib.suppress(OSError):
             os.write(2, _OUT_OF_MEMORY)
