@@ -4,12 +4,18 @@ while it runs (the moulding shedding sand: ``mass_loss``).
 A drifting record has no periodic steady state, and its averaged cycle hides the drift.
 Here the record is cut into windows of one orbit (``n`` drive periods, the record's
 regime) and each window's contact impulse ``J_w = integral of F dt`` is compared with the
-model's.  Over a periodic orbit the contact carries the moulding's weight exactly (its
-momentum returns to its start: ``integral of (F - m2 g) dt = 0``), so whatever the law,
-the model predicts ``J_w = m2(w) g n T`` with the mass after the impacts so far,
-``m2(w) = m2 (1 - loss)^(impacts before w)``; a slow drift keeps the orbit quasi-steady.
-The impulse weighs the moulding window by window, and it does not depend on where the
-samples fall on a force jump (a peak would).
+model's.  Between window bounds in the middle of a free flight the moulding's momentum
+balance is exact whatever the law: ``J_w = m2(w) (g W + dv_w)``, with the mass after the
+impacts so far, ``m2(w) = m2 (1 - loss)^(impacts before w)``, and ``dv_w`` the moulding's
+change of speed over the window, read from its free flights at the two bounds
+(:func:`flight_speed`; zero on a periodic orbit, not in a slow transient, where it was
+seen to trend by 1 % of the impulse over four windows).  The impulse weighs the moulding
+window by window, and it does not depend on where the samples fall on a force jump (a
+peak would).
+
+The impacts are counted on the orbit as a circle (:func:`contacts_per_orbit`): a contact
+that the averaged cycle cuts at its ends (its onset a little before the cycle's start in
+some cycles) is one impact, not two.
 
 The residual is measured minus predicted with its mean removed (a force calibration or
 a wrong nominal mass only shifts the level; the drift channel sees the trend):
@@ -18,11 +24,13 @@ a wrong nominal mass only shifts the level; the drift channel sees the trend):
 
 Its noise is estimated from the record itself, from successive differences (the median
 absolute deviation of ``diff(r)`` over ``sqrt 2``), which a smooth drift hardly changes,
-and never below what the force's own sample noise puts into a window's impulse
-(``sigma_F dt sqrt(samples)``); with fewer than :data:`MIN_DIFFERENCE_WINDOWS` windows the
-differences are too few to trust (a 15-period P3 record has four windows: its three
-differences read the noise 17 times too high on one record, 4 times too low on another)
-and the sample noise alone sets it.  ``D``'s floor is that noise over the mean impulse.
+and never below what the samples put into a window's impulse: the force's sample noise
+(``sigma_F dt sqrt(samples)``) and the force's jumps at the contacts' edges, each known to
+a sampling interval (``h dt / sqrt 12`` for a jump ``h``).  With fewer than
+:data:`MIN_DIFFERENCE_WINDOWS` windows the differences are too few to trust (a 15-period
+P3 record has four windows: its three differences read the noise 17 times too high on one
+record, 4 times too low on another) and the samples alone set it.  ``D``'s floor is that
+noise over the mean impulse.
 """
 
 from dataclasses import dataclass
@@ -35,6 +43,9 @@ from ..data.noise import estimate_noise
 
 __all__ = [
     "DriftRecord",
+    "contacts_per_orbit",
+    "edge_jumps",
+    "flight_speed",
     "drift_residual",
     "drift_criterion",
     "drift_score",
@@ -45,33 +56,39 @@ __all__ = [
 
 @dataclass(frozen=True)
 class DriftRecord:
-    """One record's orbit windows: measured contact impulses [N s] and impacts before."""
+    """One record's orbit windows: measured contact impulses [N s], impacts before each
+    window, and the moulding's change of speed over it [m/s] (zeros without its motion)."""
 
     impulses: np.ndarray
     impacts_before: np.ndarray
     window: float
     sigma: float = 0.0
+    speed_change: np.ndarray | None = None
 
     @classmethod
-    def from_measurement(cls, measurement, impulse):
+    def from_measurement(cls, measurement, impulse, g=9.81):
         """Windows of one orbit (``impulse``: the record's averaged cycle) whose bounds lie
         in the middle of the orbit's longest free flight, so no contact is split between
-        two windows; each sample stands for one sampling interval."""
+        two windows; each sample stands for one sampling interval; ``g`` the machine's
+        gravity (the moulding's fall in flight)."""
         W = impulse.duration
         sup = np.asarray(impulse.support, dtype=float).reshape(-1, 2)
+        flight = 0.0
         if len(sup):
             ends, starts = sup[:, 1], np.roll(sup[:, 0], -1)
             gaps = np.mod(starts - ends, W)
             i = int(np.argmax(gaps))
             phase = impulse.onset + ends[i] + 0.5 * gaps[i]
+            flight = float(gaps[i])
         else:
             phase = impulse.onset
         t, F = measurement.t, measurement.F
         dt = float(np.median(np.diff(t)))
         k0 = int(np.ceil((t[0] - phase) / W - 1e-9))
         k1 = int(np.floor((t[-1] - phase) / W + 1e-9))
-        impacts_per_orbit = len(impulse.onsets)
-        J, before = [], []
+        impacts_per_orbit = contacts_per_orbit(impulse)
+        free = F <= impulse.threshold  # no contact force: the moulding in flight
+        J, before, dv = [], [], []
         for k in range(k0, k1):
             a = phase + k * W
             m = (t >= a) & (t < a + W)
@@ -79,12 +96,20 @@ class DriftRecord:
                 continue
             J.append(float(np.sum(F[m]) * dt))
             before.append((k - k0) * impacts_per_orbit)
-        sigma = float(estimate_noise(F)) * dt * np.sqrt(W / dt)
+            dv.append(
+                flight_speed(measurement, a + W, 0.4 * flight, g, free)
+                - flight_speed(measurement, a, 0.4 * flight, g, free)
+            )
+        sample = float(estimate_noise(F)) * dt * np.sqrt(W / dt)
+        # each jump known to a sampling interval, shared over the record's windows
+        per_window = W / max(float(t[-1] - t[0]), W)
+        jumps = dt * float(np.sqrt(per_window * np.sum(edge_jumps(F, impulse.threshold) ** 2) / 12))
         return cls(
             impulses=np.array(J),
             impacts_before=np.array(before, dtype=float),
             window=W,
-            sigma=sigma,
+            sigma=float(np.hypot(sample, jumps)),
+            speed_change=np.array(dv),
         )
 
     @property
@@ -92,9 +117,56 @@ class DriftRecord:
         return float(self.impacts_before[-1]) if self.impacts_before.size else 0.0
 
 
+def contacts_per_orbit(impulse):
+    """The contacts of an averaged cycle counted on the orbit as a circle: one that runs to
+    the cycle's end and one that starts at its start are one contact cut by the fold."""
+    sup = np.asarray(impulse.support, dtype=float).reshape(-1, 2)
+    n = len(sup)
+    if n < 2:
+        return n
+    step = float(np.median(np.diff(impulse.t))) if len(impulse.t) > 1 else 0.0
+    cut = sup[0, 0] <= 0.5 * step and sup[-1, 1] >= impulse.duration - 0.5 * step
+    return n - 1 if cut else n
+
+
+def edge_jumps(F, threshold):
+    """The force's jump at each contact's onset and end in a record [N]: its first and
+    last values above ``threshold`` in each run of samples above it (a run the record cuts
+    at its start or end has no edge there)."""
+    on = np.asarray(F, dtype=float) > threshold
+    if not on.any():
+        return np.zeros(0)
+    edges = np.flatnonzero(np.diff(on.astype(np.int8)))
+    first = edges[~on[edges]] + 1  # off -> on: the first sample of a run
+    last = edges[on[edges]]  # on -> off: the last sample of a run
+    return np.abs(np.concatenate([F[first], F[last]]))
+
+
+def flight_speed(measurement, at, half, g, free=None):
+    """The moulding's speed at time ``at`` inside a free flight: its motion within ``half``
+    seconds of it (at the samples ``free`` of contact force, all by default), where it
+    falls freely (``dv2/dt = -g``), fitted to the recorded speed ``v2`` (or, without it, to
+    the position ``w2`` with its fall's curvature); 0 without either channel or samples."""
+    ch = getattr(measurement, "channels", {}) or {}
+    t = measurement.t
+    m = (t >= at - half) & (t <= at + half)
+    if free is not None:
+        m &= free
+    if m.sum() < 3:
+        return 0.0
+    s = t[m] - at
+    if "v2" in ch:
+        return float(np.mean(ch["v2"][m] + g * s))
+    if "w2" in ch:  # w2 + g s^2 / 2 = w2(at) + v2(at) s
+        slope = np.polyfit(s, ch["w2"][m] + 0.5 * g * s**2, 1)[0]
+        return float(slope)
+    return 0.0
+
+
 def predicted(scenario, rec, loss):
-    """The model's contact impulse of every window: ``m2 (1 - loss)^n g W``."""
-    return scenario.mass_after(rec.impacts_before, loss) * scenario.g * rec.window
+    """The model's contact impulse of every window: ``m2 (1 - loss)^n (g W + dv)``."""
+    dv = 0.0 if rec.speed_change is None else rec.speed_change
+    return scenario.mass_after(rec.impacts_before, loss) * (scenario.g * rec.window + dv)
 
 
 def drift_residual(scenario, rec, loss):

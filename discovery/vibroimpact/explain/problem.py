@@ -21,7 +21,7 @@ class _Drift:
     def __init__(self, pairs, records):
         self.recs = []
         for (sc, m), (_, ref) in zip(pairs, records, strict=True):
-            self.recs.append((sc, D.DriftRecord.from_measurement(m, ref.impulse)))
+            self.recs.append((sc, D.DriftRecord.from_measurement(m, ref.impulse, g=sc.g)))
 
     def _pairs(self, model):
         return [(model.apply(sc), rec) for sc, rec in self.recs]

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from discovery import ForceLaw, Scenario
+from discovery.vibroimpact.data.impulse import Impulse
 from discovery.vibroimpact.explain import drift as D
 from discovery.vibroimpact.explain import explain
 from discovery.vibroimpact.explain.effects import effect as effect_of
@@ -688,3 +689,81 @@ def test_a_refit_is_rescanned_only_where_its_contact_times_are_off():
     assert _same_contacts(ev(0.348, 0.366))
     assert not _same_contacts(ev(0.0487, 0.0238))
     assert not _same_contacts(SimpleNamespace(criteria={"I2": 0.7}, limits={}))
+
+
+def _cycle(support, duration=0.1):
+    t = np.linspace(0.0, duration, 201)
+    F = np.zeros_like(t)
+    for s, e in support:
+        F[(t >= s) & (t <= e)] = 1.0
+    return Impulse(t, F, duration, np.array(support, dtype=float), 3, 0.0)
+
+
+def test_a_contact_the_averaged_cycle_cuts_at_its_ends_is_one_impact():
+    """A contact whose onset falls a little before the averaged cycle's start in some
+    cycles is cut by the fold into a piece at the cycle's end and one at its start: one
+    impact, not two (survey draw 28 had its loss fitted 25 % low for three impacts counted
+    as four)."""
+    assert D.contacts_per_orbit(_cycle([[0.0, 0.01], [0.05, 0.06], [0.098, 0.1]])) == 2
+    assert D.contacts_per_orbit(_cycle([[0.002, 0.01], [0.05, 0.06], [0.098, 0.1]])) == 3
+    assert D.contacts_per_orbit(_cycle([[0.0, 0.01], [0.05, 0.06]])) == 2
+    assert D.contacts_per_orbit(_cycle([[0.0, 0.1]])) == 1
+
+
+def test_the_moulding_speed_in_flight_is_read_from_its_fall():
+    """In flight the moulding falls freely: its speed at a window's bound is the recorded
+    speed (or position) fitted with the fall's slope (or curvature), to the noise's share."""
+    from types import SimpleNamespace
+
+    rng = np.random.default_rng(1)
+    t = np.arange(0.0, 0.2, 5e-5)
+    s = t - 0.1
+    v2, w2 = 0.37 - 9.81 * s, 0.002 + 0.37 * s - 4.905 * s**2
+    noisy = SimpleNamespace(t=t, channels={"v2": v2 + rng.normal(0, 1e-3, t.size), "w2": w2})
+    assert D.flight_speed(noisy, 0.1, 0.02, 9.81) == pytest.approx(0.37, abs=1e-4)
+    positions = SimpleNamespace(t=t, channels={"w2": w2 + rng.normal(0, 1e-6, t.size)})
+    assert D.flight_speed(positions, 0.1, 0.02, 9.81) == pytest.approx(0.37, abs=1e-3)
+    assert D.flight_speed(SimpleNamespace(t=t, channels={}), 0.1, 0.02, 9.81) == 0.0
+
+
+def test_a_force_jump_is_read_at_each_contact_edge():
+    F = np.array([5.0, 0.0, 0.0, 5.0, 3.0, 4.0, 0.0, 0.0, 2.0, 0.0, 7.0])
+    # runs cut by the record's ends have no edge there
+    assert sorted(D.edge_jumps(F, 1.0)) == [2.0, 2.0, 4.0, 5.0, 5.0, 7.0]
+
+
+def test_the_drift_channel_balances_the_moulding_momentum_in_a_slow_transient():
+    """Survey draw 28 (a slow P3 with three contacts an orbit, shedding 0.29 % an impact),
+    recorded without noise at 160 kHz: over windows between free flights the impulse is
+    ``m2(w) (g W + dv)`` exactly.  Without the moulding's change of speed, and with the
+    contact the averaged cycle cuts counted twice, the true loss left a trend of +-60 N s
+    on 6260 N s (D 0.0065): the quieter noisy record's true model was called drifting."""
+    from tests.survey_effects import draw
+
+    d = draw(28, "low")
+    sim = _shedding_start(d.machine, d.true, 40)
+    clean = R.reference_record(
+        (sim, d.true), periods=15, transient=40, seed=3028, check=False, fs=160000.0,
+        force_noise=0.0, motion_noise=0.0,
+    )  # fmt: skip
+    ref = Reference.from_measurement(d.record, d.start, n_boot=4, seed=0)
+    assert D.contacts_per_orbit(ref.impulse) == 3
+    rec = D.DriftRecord.from_measurement(clean, ref.impulse, g=d.machine.g)
+    r = D.drift_residual(d.machine, rec, 0.0029)
+    assert D.drift_criterion(r, rec)[0] < 5e-4
+    # the noisy record: the true loss is no drift, and the channel fits it
+    noisy = D.DriftRecord.from_measurement(d.record, ref.impulse, g=d.machine.g)
+    assert D.drift_score([(d.machine, noisy)], 0.0029, 1e-4)[1] > 0.05
+    assert D.fit_drift([(d.machine, noisy)], 1e-4) == pytest.approx(0.0029, rel=0.25)
+
+
+@pytest.mark.slow
+def test_a_mass_loss_named_to_its_value_in_a_slow_transient_is_not_called_drifting():
+    """Survey draw 28's quieter record: explain named the loss to 0.3 % and called the model
+    drifting (D 0.0067 against a floor of 0.0011); it ends consistent."""
+    from tests.survey_effects import draw
+
+    d = draw(28, "low")
+    res = explain(d.start, d.record, "linear", workers=1, n_boot_intervals=0)
+    assert res.final_model.effects == ("mass_loss",)
+    assert res.consistent, res.stopped_because
