@@ -267,6 +267,8 @@ def run_case(args):
             row.update(_verify_truth(true_sc, true, lag, rec, start, evaluate, Reference))
             if cls != "none":
                 row.update(_law_alone(true_sc, law, rec, evaluate, Reference))
+            if len(effect_ids(cls)) > 1:
+                row.update(_each_alone(true_sc, law, true, rec, evaluate, Reference))
             t0 = time.perf_counter()
             given, scale, found, known = _machine(start, rec, error, seed)
             res = explain(given, rec, "linear", workers=1, machine_scale=scale, known=known)
@@ -345,6 +347,32 @@ def _law_alone(true_sc, law, rec, evaluate, Reference):
         fit = law
     ev = evaluate(bare, fit, ref)
     return {"alone_consistent": bool(ev.consistent), "alone_I2": ev.criteria.get("I2")}
+
+
+def _each_alone(true_sc, law, true, rec, evaluate, Reference):
+    """Whether the record can tell each of two hidden effects (the unloading damper and the
+    stiffening supports): the model without that one, the other kept at its true value,
+    refitted as :func:`_law_alone` refits the law.  Where that model is consistent, no method
+    can name the effect left out, and naming the other alone is a right answer
+    (``without_consistent``: ``{effect: consistent}``)."""
+    from discovery.vibroimpact.fit.identification import identify
+
+    out = {}
+    bare = true_sc.replace(offset=0.0, mass_loss=0.0)
+    cases = {  # the machine and the law of the model without each effect
+        "unloading_damping": (bare, law),
+        "support_nonlinearity": (bare.replace(k3=0.0), true),
+    }
+    for eff, (machine, start) in cases.items():
+        ref = Reference.from_measurement(rec, machine, n_boot=16, seed=0)
+        try:
+            fit = identify(
+                [machine], [ref], start, method="least-squares", max_simulations=80, check=False
+            ).law
+        except Exception:  # noqa: BLE001 (no refit: judged as it is)
+            fit = start
+        out[eff] = bool(evaluate(machine, fit, ref).consistent)
+    return {"without_consistent": out}
 
 
 def _outcome(res, truth, seconds):
@@ -430,8 +458,13 @@ def markdown_row(rows, label):
     shows = [r for r in valid if r["class"] != "none" and not r.get("start_consistent")]
     right = sum(named_right(r) for r in shows)
     # where the record can tell: the law alone, refitted without the effect, is not
-    # consistent (rows run before the check was made count as telling)
-    tells = [r for r in shows if not r.get("alone_consistent")]
+    # consistent, nor (two effects) the model without either one (rows run before the
+    # checks were made count as telling)
+    tells = [
+        r
+        for r in shows
+        if not r.get("alone_consistent") and not any((r.get("without_consistent") or {}).values())
+    ]
     clean = [r for r in valid if r["class"] == "none"]
     false = sum(bool(r.get("kept")) for r in clean)
     consistent = sum(bool(r.get("consistent")) for r in valid)

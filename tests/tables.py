@@ -90,7 +90,8 @@ _SCALING_RUNS = ("scaling*.jsonl",)
 _EFFECTS_HEADER = (
     "| hidden | records | explain raised an error | true model not consistent | "
     "effect does not show (start consistent) | right effect(s) kept, where it shows | "
-    "where the record tells it (the law alone, refitted, not consistent) | "
+    "where the record tells it (the law alone, refitted, not consistent; of two effects, "
+    "neither alone) | "
     "clean: an effect kept | final model consistent | 95 % interval holds the "
     "truth | lower noise wrong where higher right |",
     "|---|---|---|---|---|---|---|---|---|---|---|",
