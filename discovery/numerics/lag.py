@@ -9,13 +9,14 @@ One pass over the knots gives ``G`` at the end of the cycle as ``P G_0 + Q`` wit
 ``P = exp(-W / tau)``; periodicity fixes ``G_0 = Q / (1 - P)``; a second pass gives every
 knot.  A zero-length interval (a jump of ``F``) leaves ``G`` continuous.  Exact for the
 signal as given (no resampling, no FFT); the response of a non-negative force is
-non-negative.
+non-negative.  :func:`lag_from` is the same pass from a given initial value (a signal that
+is not periodic: a record's block, whose sensor starts where the record says).
 """
 
 import numpy as np
 from numba import njit
 
-__all__ = ["lag_at_knots", "lag_at"]
+__all__ = ["lag_at_knots", "lag_from", "lag_at"]
 
 
 @njit(cache=True)
@@ -41,6 +42,16 @@ def lag_at_knots(t, F, tau):
     q = _pass(t, F, tau, 0.0, out)
     P = np.exp(-(t[-1] - t[0]) / tau)
     _pass(t, F, tau, q / (1.0 - P), out)
+    return out
+
+
+def lag_from(t, F, tau, g0):
+    """``G`` at the knots ``t`` of the response to ``F`` that starts from ``G(t[0]) = g0``
+    (an initial value, not a periodic signal)."""
+    t = np.ascontiguousarray(t, dtype=float)
+    F = np.ascontiguousarray(F, dtype=float)
+    out = np.empty(t.size)
+    _pass(t, F, tau, float(g0), out)
     return out
 
 

@@ -48,14 +48,20 @@ def first_order_lag(impulse, tau):
     )
 
 
-def first_order_lag_at(impulse, tau, tq):
+def first_order_lag_at(impulse, tau, tq, start=None):
     """:func:`first_order_lag` at the times ``tq`` since the onset (periodic), from the
     closed form itself: exact where the grid's interpolation is within 0.05 % of the
-    transient, and without the grid (a record's block needs only its sample times)."""
+    transient, and without the grid (a record's block needs only its sample times).
+
+    With ``start`` the signal is not periodic: the sensor's output is ``start`` at the
+    impulse's first knot and ``tq`` lie between its first and last knots."""
     if tau <= 0:
         return impulse.evaluate(tq)
-    from ...numerics.lag import lag_at, lag_at_knots  # numba: not for `vidi --help`
+    from ...numerics.lag import lag_at, lag_at_knots, lag_from  # numba: not for `vidi --help`
 
+    if start is not None:
+        G = lag_from(impulse.t, impulse.F, tau, start)
+        return lag_at(impulse.t, impulse.F, G, tau, np.asarray(tq, dtype=float))
     t0 = float(impulse.t[0])
     q = np.mod(np.asarray(tq, dtype=float) - t0, impulse.duration) + t0
     return lag_at(impulse.t, impulse.F, lag_at_knots(impulse.t, impulse.F, tau), tau, q)
@@ -90,7 +96,10 @@ def observation(parameters):
     :data:`OBSERVATIONS`, e.g. ``{"sensor_lag": 2e-5}``), applied in the order of their
     names; None when there is none.  Its ``at(impulse, times)`` gives the observed force at
     those times only, and ``linear`` says whether it is linear in the force (identify's
-    exact Jacobian applies it to the force's derivatives)."""
+    exact Jacobian applies it to the force's derivatives).  ``at(impulse, times, start)``
+    starts the sensor at ``start`` on the impulse's first knot instead of taking the
+    impulse as periodic, where ``starts`` says the model can (one observation with its own
+    closed form)."""
     if not parameters:
         return None
     items = sorted(parameters.items())
@@ -100,12 +109,15 @@ def observation(parameters):
             impulse = OBSERVATIONS[name](impulse, value)
         return impulse
 
-    def at(impulse, tq):
+    closed = len(items) == 1 and items[0][0] in _AT
+
+    def at(impulse, tq, start=None):
         # the observed force at times ``tq`` only: one observation's own closed form
-        if len(items) == 1 and items[0][0] in _AT:
-            return _AT[items[0][0]](impulse, items[0][1], tq)
+        if closed:
+            return _AT[items[0][0]](impulse, items[0][1], tq, start)
         return apply(impulse).evaluate(tq)
 
     apply.linear = all(name in _LINEAR for name, _ in items)
     apply.at = at
+    apply.starts = closed
     return apply

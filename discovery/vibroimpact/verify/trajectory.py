@@ -533,7 +533,7 @@ def _history(blk, F, onsets, observe, window):
         # (:func:`~.observed.observed`), which makes the observed history continuous in the onset: a
         # sample blended towards the record, whose force the sensor has already filtered,
         # would filter it twice (the lag came out 1-2 % low)
-        return observed(fold, Fs, observe, onsets)
+        return observed(fold, Fs, observe, onsets, record=blk.F)
     if window and td.size > 1:
         # the sample whose interval [e_i, e_i+1) holds a contact onset at fraction u is
         # blended towards the record's value with weight |2u - 1|: its residual is 0

@@ -767,3 +767,19 @@ def test_a_mass_loss_named_to_its_value_in_a_slow_transient_is_not_called_drifti
     res = explain(d.start, d.record, "linear", workers=1, n_boot_intervals=0)
     assert res.final_model.effects == ("mass_loss",)
     assert res.consistent, res.stopped_because
+
+
+def test_a_short_contact_lag_record_verifies_its_true_model_from_the_sensor_state():
+    """Survey draw 37's quieter record (a 1.5 ms contact seen through a 0.204 ms lag): its
+    blocks begin at a contact onset, and taken as periodic signals each began from the
+    sensor's state at its end; the true model read I2 0.106 (0.095 without noise) and was
+    rejected at both noise levels.  From the sensor's state the record shows it is
+    consistent, and a lag 10 % off is not."""
+    from tests.survey_effects import _verify_truth, draw
+
+    d = draw(37, "low")
+    ok = _verify_truth(d.machine, d.true, d.lag, d.record, d.start, evaluate, Reference)
+    assert ok["true_consistent"] and ok["true_I2"] < 0.03, ok
+    for tau in (0.9 * d.lag, 1.1 * d.lag):
+        off = _verify_truth(d.machine, d.true, tau, d.record, d.start, evaluate, Reference)
+        assert not off["true_consistent"], (tau, off)

@@ -16,9 +16,10 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
-from discovery.numerics.lag import lag_at, lag_at_knots
+from discovery.numerics.lag import lag_at, lag_at_knots, lag_from
 from discovery.vibroimpact.explain.effects import first_order_lag, first_order_lag_at
 from discovery.vibroimpact.verify.observed import observed as _observed
+from discovery.vibroimpact.verify.sensors import observation
 
 W = 0.04  # one drive period [s]
 T_ON, DUR, JUMP = 0.0101, 0.009, 4.0e5  # a Kelvin-Voigt-like contact
@@ -90,3 +91,58 @@ def test_a_force_that_starts_from_zero_gets_no_jump():
     with_on = _observed(fold, F, observe, np.array([0.0101]))
     without = _observed(fold, F, observe, None)
     assert np.max(np.abs(with_on - without)) < 1e-3 * F.max()
+
+
+def _block_in_contact(fs):
+    """A block whose record starts inside a contact that began before it: the true force
+    (a jump at ``-PRE``, a line down to 0 at ``DUR - PRE``, 0 after) over one period from
+    the block's start, its samples, and the sensor's response to the whole history (the
+    part before the block included) at the samples."""
+    pre = 0.002
+    t = np.arange(int(round(W * fs))) / fs
+    F = np.where(t < DUR - pre, JUMP + SLOPE * (t + pre), 0.0)
+    kt = np.array([-10 * TAU, -pre, -pre, DUR - pre, W])
+    kF = np.array([0.0, 0.0, JUMP, 0.0, 0.0])
+    G = lag_at(kt, kF, lag_from(kt, kF, TAU, 0.0), TAU, t)
+    return t, F, G
+
+
+def test_a_block_cut_inside_a_contact_starts_from_the_sensor_state_the_record_shows():
+    """The block's run starts from the machine's measured state, inside a contact: the
+    force before the block is not in its history, but the record shows the sensor's state.
+    Started from the state fitted to the record the observed history is the record's
+    (within 1e-4 of the jump); taken as a periodic signal it began from the sensor's state
+    at the block's end, unloaded (a short-contact survey record's true model read I2 0.095
+    without noise)."""
+    t, F, G = _block_in_contact(21_000.0)
+    fold = SimpleNamespace(td=t, origin=0.0, end=W, n_periods=1, n_cycles=1)
+    observe = observation({"sensor_lag": TAU})
+    assert observe.starts
+    from_record = _observed(fold, F, observe, None, record=G)
+    assert np.max(np.abs(from_record - G)) < 1e-4 * JUMP
+    periodic = _observed(fold, F, observe, None)
+    assert np.max(np.abs(periodic - G)) > 0.3 * JUMP
+
+
+def test_the_lag_from_a_start_is_the_closed_form():
+    """``G' = (F - G) / tau`` from ``G(0) = g0`` under a constant and a linear force."""
+    t = np.linspace(0.0, 5 * TAU, 11)
+    g = lag_from(t, np.full(t.size, 3.0), TAU, 1.0)
+    assert np.allclose(g, 3.0 - 2.0 * np.exp(-t / TAU), rtol=0, atol=1e-12)
+    s = 2.0e3  # F = s t: G = s (t - tau) + (g0 + s tau) exp(-t / tau)
+    g = lag_from(t, s * t, TAU, 0.5)
+    assert np.allclose(g, s * (t - TAU) + (0.5 + s * TAU) * np.exp(-t / TAU), atol=1e-12)
+
+
+def test_the_derivative_of_a_history_from_its_fitted_start_is_its_own():
+    """Given zeros for the record, the observation is the derivative of the history from
+    its fitted start (affine in the force: the start's fit moves with it)."""
+    t, F, G = _block_in_contact(10_000.0)
+    fold = SimpleNamespace(td=t, origin=0.0, end=W, n_periods=1, n_cycles=1)
+    observe = observation({"sensor_lag": TAU})
+    dF = np.sin(np.arange(t.size) * 0.37) * (F > 0) * 1e3
+    h = 10.0  # affine: any step is exact, a large one above the rounding
+    up = _observed(fold, F + h * dF, observe, None, record=G)
+    down = _observed(fold, F - h * dF, observe, None, record=G)
+    d = _observed(fold, dF, observe, None, record=np.zeros_like(G))
+    assert np.allclose((up - down) / (2 * h), d, rtol=0, atol=1e-6 * np.max(np.abs(d)))
