@@ -69,7 +69,9 @@ class DriftRecord:
     def from_measurement(cls, measurement, impulse, g=9.81):
         """Windows of one orbit (``impulse``: the record's averaged cycle) whose bounds lie
         in the middle of the orbit's longest free flight, so no contact is split between
-        two windows; each sample stands for one sampling interval; ``g`` the machine's
+        two windows (a window with a contact across a bound, where the record's orbit is
+        out of step with its averaged cycle, is left out); each sample stands for one
+        sampling interval; ``g`` the machine's
         gravity (the moulding's fall in flight)."""
         W = impulse.duration
         sup = np.asarray(impulse.support, dtype=float).reshape(-1, 2)
@@ -88,12 +90,13 @@ class DriftRecord:
         k1 = int(np.floor((t[-1] - phase) / W + 1e-9))
         impacts_per_orbit = contacts_per_orbit(impulse)
         free = F <= impulse.threshold  # no contact force: the moulding in flight
+        contact = _contact_runs(~free)
         J, before, dv = [], [], []
         for k in range(k0, k1):
             a = phase + k * W
             m = (t >= a) & (t < a + W)
-            if m.sum() < 0.9 * W / dt:
-                continue
+            if m.sum() < 0.9 * W / dt or _at(t, contact, a) or _at(t, contact, a + W):
+                continue  # cut short, or a contact across a bound (the orbit out of step)
             J.append(float(np.sum(F[m]) * dt))
             before.append((k - k0) * impacts_per_orbit)
             dv.append(
@@ -115,6 +118,24 @@ class DriftRecord:
     @property
     def n_impacts(self):
         return float(self.impacts_before[-1]) if self.impacts_before.size else 0.0
+
+
+def _contact_runs(above, shortest=3):
+    """The samples in runs of at least ``shortest`` above the threshold (a contact; a lone
+    sample above it is the noise's)."""
+    above = np.asarray(above, dtype=bool)
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], above.astype(np.int8), [0]])))
+    out = np.zeros(above.size, dtype=bool)
+    for s, e in zip(edges[::2], edges[1::2], strict=True):
+        if e - s >= shortest:
+            out[s:e] = True
+    return out
+
+
+def _at(t, flags, time):
+    """Whether the samples on either side of ``time`` are flagged."""
+    i = int(np.searchsorted(t, time))
+    return bool(flags[max(i - 1, 0)] or flags[min(i, flags.size - 1)])
 
 
 def contacts_per_orbit(impulse):

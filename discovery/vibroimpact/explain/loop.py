@@ -216,6 +216,44 @@ def _best_polished(run, step, good, screen_budget):
     return min(polished, key=lambda p: (not _consistent(p[1]), p[1].score["criteria_after"][key]))
 
 
+def _polished_contenders(run, step, trials, gap):
+    """Where no screening refit beats the law's baseline, the refits that shrink the gap by
+    10 % and are otherwise fit to name their effect (physical, within bounds, present, the
+    motion not made worse), at most :data:`POLISHED`, lowest first, polished with the full
+    budget (:func:`_polish_winner`), to be judged again.  A third of the budget had each
+    stop short: on survey draw 22's quieter record (a set 0.3, a slow transient) the set's
+    screening refit stopped at I2 0.126, a collapsed mass loss's refit of the law reached
+    0.119 and became the baseline, and nothing was named; polished, the set reaches the
+    truth (I2 0.0086)."""
+    near = sorted(
+        (
+            x
+            for x in trials
+            if x.key == gap and x.result is not None and _names_but_for_the_baseline(x)
+        ),
+        key=lambda x: x.score["criteria_after"][gap],
+    )[:POLISHED]
+    by_id, before = step.screening.by_id, step.before[gap]
+    out = []
+    for x in near:
+        p = _polish_winner(run, x, by_id[x.score["effect"]])
+        out.append(replace(p, ratio=p.score["criteria_after"][gap] / max(before, 1e-300)))
+    return out
+
+
+def _names_but_for_the_baseline(trial):
+    """Whether a trial would name its effect if it beat the law refitted alone."""
+    s = trial.score
+    return bool(
+        trial.ratio <= 0.9
+        and s.get("repulsive")
+        and s.get("in_bounds")
+        and s.get("present")
+        and not s.get("motion_worse")
+        and not s.get("force_worse")
+    )
+
+
 def _consistent(trial):
     """Whether a trial's refit is consistent with every record (all the criteria within
     their limits).  Of refits within the noise floor of each other, the gap criterion
@@ -238,6 +276,14 @@ def _refit_and_name(run, step):
     gap = _gap(run, evs)
     trials, (null, null_after, null_evs) = _refit_trials(run, step, screen_budget, gap)
     good = _judged(trials, null_after, step.floor, eff_by_id, null_evs)
+    if not good and run.budget > screen_budget:
+        good = _judged(
+            _polished_contenders(run, step, trials, gap),
+            null_after,
+            step.floor,
+            eff_by_id,
+            null_evs,
+        )
     if not good and null_after and gap in null_after and null_after[gap] <= 0.9 * before[gap]:
         run.iterations.append(
             step.iteration(
