@@ -342,7 +342,7 @@ def markdown_row(rows, label):
 
 
 def effects_row(rows, label):
-    """A row of the second corpus table (c08-c13): the true law verified (I2 and I5
+    """A row of the second corpus table (c08-c16): the true law verified (I2 and I5
     against their limits; c10's soft law too), explain."""
     r = _find(rows, label)
     if "error" in r:

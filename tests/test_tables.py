@@ -78,7 +78,7 @@ def test_a_changed_run_makes_the_check_fail(tmp_path, monkeypatch, capsys):
 
 
 def test_the_corpus_tables_have_a_row_per_record_of_their_run():
-    """tests.survey_corpus's rows: each of the thirteen records in one of the two tables,
+    """tests.survey_corpus's rows: each of the sixteen records in one of the two tables,
     and the cells say what the numbers say."""
     from tests import survey_corpus
 

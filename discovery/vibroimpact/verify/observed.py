@@ -12,7 +12,7 @@ from ..data.impulse import Impulse
 __all__ = ["observed", "observed_derivatives"]
 
 
-def observed(fold, Fs, observe, onsets=None, active=None, record=None):
+def observed(fold, Fs, observe, onsets=None, *, active=None, record=None):
     """A block's history at its sample times seen through the observation model.
 
     The history is piecewise linear between the samples, except at the run's contact
@@ -100,7 +100,7 @@ def observed_derivatives(blk, run, observe):
     fold = blk.fold
     _, _, active = _with_jumps(fold.td, F, onsets)
     none = np.zeros_like(blk.F)  # the record does not move with the coefficients
-    dH = np.array([observed(fold, d, observe, onsets, active, none) for d in dF])
+    dH = np.array([observed(fold, d, observe, onsets, active=active, record=none) for d in dF])
     dH = dH.reshape(dF.shape)
     if active is None:
         return dH
