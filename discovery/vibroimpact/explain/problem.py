@@ -26,9 +26,12 @@ class _Drift:
     def _pairs(self, model):
         return [(model.apply(sc), rec) for sc, rec in self.recs]
 
-    @staticmethod
-    def _loss(model):
-        return float(model.scenario.get("mass_loss", 0.0))
+    def _loss(self, model):
+        """The mass loss the model runs with: its own, else the machine's (a calibrated
+        machine may carry one: read as 0, the drift of a loss the machine has explained
+        was judged as unexplained)."""
+        machine = self.recs[0][0].mass_loss if self.recs else 0.0
+        return float(model.scenario.get("mass_loss", machine))
 
     def criterion(self, model):
         """Mean ``D`` over records and its noise floor."""
