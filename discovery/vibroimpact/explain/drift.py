@@ -71,8 +71,7 @@ class DriftRecord:
         in the middle of the orbit's longest free flight, so no contact is split between
         two windows (a window with a contact across a bound, where the record's orbit is
         out of step with its averaged cycle, is left out); each sample stands for one
-        sampling interval; ``g`` the machine's
-        gravity (the moulding's fall in flight)."""
+        sampling interval; ``g`` the machine's gravity (the moulding's fall in flight)."""
         W = impulse.duration
         sup = np.asarray(impulse.support, dtype=float).reshape(-1, 2)
         flight = 0.0
