@@ -330,22 +330,28 @@ def _verify_truth(true_sc, true, lag, rec, start, evaluate, Reference):
     return {"true_consistent": bool(ev.consistent), "true_I2": ev.criteria.get("I2")}
 
 
+def _refitted(machine, start, rec, evaluate, Reference):
+    """The evaluation of ``start`` refitted by output error (from its own coefficients) on
+    ``machine`` against the record (``start`` as it is where the refit fails)."""
+    from discovery.vibroimpact.fit.identification import identify
+
+    ref = Reference.from_measurement(rec, machine, n_boot=16, seed=0)
+    try:
+        fit = identify(
+            [machine], [ref], start, method="least-squares", max_simulations=80, check=False
+        ).law
+    except Exception:  # noqa: BLE001 (no refit: the coefficients judged as they are)
+        fit = start
+    return evaluate(machine, fit, ref)
+
+
 def _law_alone(true_sc, law, rec, evaluate, Reference):
     """Whether the record can tell the hidden effect(s) at all: the law without them,
     refitted (output error, from the true law's own coefficients) on the machine without
     them, is not consistent with the record.  Where it is, no method can name the effect
     from this record, and a right answer is to name nothing (``alone_consistent``)."""
-    from discovery.vibroimpact.fit.identification import identify
-
     bare = true_sc.replace(k3=0.0, offset=0.0, mass_loss=0.0)
-    ref = Reference.from_measurement(rec, bare, n_boot=16, seed=0)
-    try:
-        fit = identify(
-            [bare], [ref], law, method="least-squares", max_simulations=80, check=False
-        ).law
-    except Exception:  # noqa: BLE001 (no refit: the true coefficients judged as they are)
-        fit = law
-    ev = evaluate(bare, fit, ref)
+    ev = _refitted(bare, law, rec, evaluate, Reference)
     return {"alone_consistent": bool(ev.consistent), "alone_I2": ev.criteria.get("I2")}
 
 
@@ -355,24 +361,17 @@ def _each_alone(true_sc, law, true, rec, evaluate, Reference):
     refitted as :func:`_law_alone` refits the law.  Where that model is consistent, no method
     can name the effect left out, and naming the other alone is a right answer
     (``without_consistent``: ``{effect: consistent}``)."""
-    from discovery.vibroimpact.fit.identification import identify
-
-    out = {}
     bare = true_sc.replace(offset=0.0, mass_loss=0.0)
     cases = {  # the machine and the law of the model without each effect
         "unloading_damping": (bare, law),
         "support_nonlinearity": (bare.replace(k3=0.0), true),
     }
-    for eff, (machine, start) in cases.items():
-        ref = Reference.from_measurement(rec, machine, n_boot=16, seed=0)
-        try:
-            fit = identify(
-                [machine], [ref], start, method="least-squares", max_simulations=80, check=False
-            ).law
-        except Exception:  # noqa: BLE001 (no refit: judged as it is)
-            fit = start
-        out[eff] = bool(evaluate(machine, fit, ref).consistent)
-    return {"without_consistent": out}
+    return {
+        "without_consistent": {
+            eff: bool(_refitted(machine, start, rec, evaluate, Reference).consistent)
+            for eff, (machine, start) in cases.items()
+        }
+    }
 
 
 def _outcome(res, truth, seconds):

@@ -98,6 +98,22 @@ _EFFECTS_HEADER = (
 )
 
 
+def _by_label(page, header, survey, pattern, labels):
+    """A survey's table of one row per label (a class or a category, and "all"), each
+    rendered by the survey's ``markdown_row`` from its runs ``pattern``."""
+    return Table(
+        page=page,
+        header=header,
+        rows=tuple((label, (pattern,)) for label in labels),
+        row=survey.markdown_row,
+        read=survey.read_rows,
+    )
+
+
+#: the effects survey's rows: each class hidden, then all
+_EFFECT_ROWS = (*survey_effects.CLASSES, "all")
+
+
 def _two_points(pattern):
     """docs/contact-models.md's table of a second operating point (the run files of
     ``pattern``): a row per truth and arm (:func:`survey_contact_models.markdown_row`)."""
@@ -150,21 +166,11 @@ TABLES = {
     "bench-readme": _paragraph(
         "README.md", bench_history.readme_lines, ("bench-history.jsonl",), bench_history.read_rows
     ),
-    "effects": Table(
-        page="docs/validation.md",
-        header=_EFFECTS_HEADER,
-        rows=tuple((label, ("effects*.jsonl",)) for label in (*survey_effects.CLASSES, "all")),
-        row=survey_effects.markdown_row,
-        read=survey_effects.read_rows,
+    "effects": _by_label(
+        "docs/validation.md", _EFFECTS_HEADER, survey_effects, "effects*.jsonl", _EFFECT_ROWS
     ),
-    "effects-sheet": Table(
-        page="docs/validation.md",
-        header=_EFFECTS_HEADER,
-        rows=tuple(
-            (label, ("sheet-effects*.jsonl",)) for label in (*survey_effects.CLASSES, "all")
-        ),
-        row=survey_effects.markdown_row,
-        read=survey_effects.read_rows,
+    "effects-sheet": _by_label(
+        "docs/validation.md", _EFFECTS_HEADER, survey_effects, "sheet-effects*.jsonl", _EFFECT_ROWS
     ),
     "effects-readme": Table(
         page="README.md",
@@ -178,14 +184,12 @@ TABLES = {
         row=survey_effects.readme_row,
         read=survey_effects.read_rows,
     ),
-    "fit-sheet": Table(
-        page="docs/validation.md",
-        header=survey_fit_sheet.HEADER,
-        rows=tuple(
-            (label, ("fit-sheet*.jsonl",)) for label in (*survey_fit_sheet.CATEGORIES, "all")
-        ),
-        row=survey_fit_sheet.markdown_row,
-        read=survey_fit_sheet.read_rows,
+    "fit-sheet": _by_label(
+        "docs/validation.md",
+        survey_fit_sheet.HEADER,
+        survey_fit_sheet,
+        "fit-sheet*.jsonl",
+        (*survey_fit_sheet.CATEGORIES, "all"),
     ),
     "fit-sheet-readme": Table(
         page="README.md",

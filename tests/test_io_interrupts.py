@@ -128,9 +128,11 @@ _LOST = textwrap.dedent("""
 """)
 
 
-def test_interrupt_in_an_unraisable_callback_still_stops_the_run(earlier):
+def _stops_with_one_line(script, earlier):
+    """``script`` run as a child on ``earlier``: exit 130, the interrupt's one line, the
+    earlier results intact."""
     p = subprocess.run(
-        [sys.executable, "-c", _LOST, str(earlier)],
+        [sys.executable, "-c", script, str(earlier)],
         cwd=ROOT,
         capture_output=True,
         text=True,
@@ -143,6 +145,10 @@ def test_interrupt_in_an_unraisable_callback_still_stops_the_run(earlier):
         "are unchanged"
     ], p.stderr
     _intact(earlier)
+
+
+def test_interrupt_in_an_unraisable_callback_still_stops_the_run(earlier):
+    _stops_with_one_line(_LOST, earlier)
 
 
 # `vidi steady` interrupted while it holds an object the interrupt left half built (as
@@ -167,20 +173,7 @@ _HALF = textwrap.dedent("""
 
 
 def test_what_an_interrupt_left_half_built_is_freed_without_a_traceback(earlier):
-    p = subprocess.run(
-        [sys.executable, "-c", _HALF, str(earlier)],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-        preexec_fn=_restore_sigint,
-    )
-    assert p.returncode == 130, p.stderr
-    assert p.stderr.splitlines() == [
-        "vidi: error: interrupted (Ctrl-C); partial outputs were removed, earlier results "
-        "are unchanged"
-    ], p.stderr
-    _intact(earlier)
+    _stops_with_one_line(_HALF, earlier)
 
 
 def test_a_failing_clean_up_outside_an_interrupt_is_still_reported(monkeypatch):

@@ -90,6 +90,13 @@ class DriftRecord:
         impacts_per_orbit = contacts_per_orbit(impulse)
         free = F <= impulse.threshold  # no contact force: the moulding in flight
         contact = _contact_runs(~free)
+        speeds = {}  # the moulding's speed at bound k, each bound read once
+
+        def speed(k):
+            if k not in speeds:
+                speeds[k] = flight_speed(measurement, phase + k * W, 0.4 * flight, g, free)
+            return speeds[k]
+
         J, before, dv = [], [], []
         for k in range(k0, k1):
             a = phase + k * W
@@ -98,10 +105,7 @@ class DriftRecord:
                 continue  # cut short, or a contact across a bound (the orbit out of step)
             J.append(float(np.sum(F[m]) * dt))
             before.append((k - k0) * impacts_per_orbit)
-            dv.append(
-                flight_speed(measurement, a + W, 0.4 * flight, g, free)
-                - flight_speed(measurement, a, 0.4 * flight, g, free)
-            )
+            dv.append(speed(k + 1) - speed(k))
         sample = float(estimate_noise(F)) * dt * np.sqrt(W / dt)
         # each jump known to a sampling interval, shared over the record's windows
         per_window = W / max(float(t[-1] - t[0]), W)
