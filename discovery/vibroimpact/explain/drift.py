@@ -155,9 +155,10 @@ def contacts_per_orbit(impulse):
 
 def edge_jumps(F, threshold):
     """The force's jump at each contact's onset and end in a record [N]: its first and
-    last values above ``threshold`` in each run of samples above it (a run the record cuts
-    at its start or end has no edge there)."""
-    on = np.asarray(F, dtype=float) > threshold
+    last values above ``threshold`` in each contact (a run of three samples or more above it:
+    a lone sample above it is the noise's; a run the record cuts at its start or end has no
+    edge there)."""
+    on = _contact_runs(np.asarray(F, dtype=float) > threshold)
     if not on.any():
         return np.zeros(0)
     edges = np.flatnonzero(np.diff(on.astype(np.int8)))
