@@ -201,3 +201,43 @@ def contact_onsets(t, F, period, *, zeta=None, min_samples=3):
     thr = max(5.0 * sigma, 1e-3 * float(np.max(F)))
     runs = _contact_runs(t, F, thr, sigma, period, min_samples=min_samples, zeta=zeta)
     return np.array([r[0] for r in runs], dtype=float)
+
+
+def onset_penetrations(t, F, zeta, period, *, flight=0.05):
+    """The recorded penetration at each contact's onset [m]: where a contact offset's
+    contacts start (the force acts beyond a recorded penetration ``delta0``).
+
+    The onset time is the force's: for a force that *jumps* at its first sample above the
+    threshold (a viscous contact's ``F(0+)``: its rise over the next interval, taken back
+    one interval, leaves more than its noise) the middle of the sample interval that
+    brackets it (uniform within it, so unbiased over many contacts: the edge drawn through
+    the samples on either side of the jump reads it up to a sample early, and a sample read
+    at the first one in contact is half a sample's motion late); for a force that rises from
+    zero, that rise taken back to zero force (at most four intervals).  The penetration
+    there is a quadratic fitted by least squares to the free flight before it (up to
+    ``flight`` of a period, after the previous contact's loss, at least 6 samples),
+    extrapolated to the onset: a noisy penetration read at one sample is as noisy as the
+    offset is small (survey draw 26: 46 um under 20 um of noise)."""
+    t, F, zeta = (np.asarray(x, dtype=float) for x in (t, F, zeta))
+    sigma = estimate_noise(F)
+    thr = max(5.0 * sigma, 1e-3 * float(np.max(F)))
+    runs = _contact_runs(t, F, thr, sigma, period, min_samples=3, zeta=None)
+    dt = float(np.median(np.diff(t)))
+    longest = max(6, int(flight * period / dt))
+    out, loss = [], -np.inf
+    for t_on, t_off, s in runs:
+        if s < 1 or s + 1 >= t.size:
+            continue
+        rise = F[s + 1] - F[s]  # the force's rise over the contact's first sample interval
+        if F[s] - rise > 3.0 * sigma or rise <= 0.0:  # a jump: the onset within [s - 1, s]
+            onset = 0.5 * (t[s - 1] + t[s])
+        else:  # a rise from zero: back along it
+            onset = t[s] - min(F[s] / rise, 4.0) * (t[s + 1] - t[s])
+        k = int(np.searchsorted(t, onset, side="left"))  # the samples before the onset
+        a = max(k - longest, int(np.searchsorted(t, loss, side="right")), 0)
+        loss = t_off
+        if k - a < 6:
+            continue
+        c = np.polyfit(t[a:k] - onset, zeta[a:k], 2)
+        out.append(float(c[-1]))
+    return np.array(out, dtype=float)

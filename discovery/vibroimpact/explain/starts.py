@@ -193,7 +193,7 @@ class Regressions:
     def __init__(self, scenarios, measurements):
         self.scenarios, self.measurements = scenarios, measurements
         self.samples = _joined_samples(scenarios, measurements)
-        self._by_force = self._supports = None
+        self._by_force = self._supports = self._offset = None
 
     def __call__(self, names, loading=False, shift=0.0, lag=0.0):
         if lag:
@@ -220,6 +220,23 @@ class Regressions:
             read = supports_reading(self.scenarios, self.measurements)
             self._supports = (read,)
         return self._supports[0]
+
+    def offset(self):
+        """The contact offset the records read: the median over every contact of the
+        recorded penetration at the force's onset
+        (:func:`~discovery.vibroimpact.data.contact_edges.onset_penetrations`); None where no
+        record has positions or contacts with a free flight before them, computed once."""
+        if self._offset is None:
+            from ..data.contact_edges import onset_penetrations
+
+            reads = [
+                onset_penetrations(m.t, m.F, m.zeta, s.period)
+                for s, m in zip(self.scenarios, self.measurements, strict=True)
+                if m.zeta is not None
+            ]
+            reads = np.concatenate(reads) if reads else np.zeros(0)
+            self._offset = (float(np.median(reads)) if reads.size >= 3 else None,)
+        return self._offset[0]
 
     def by_force(self):
         """The contact samples the force says are in contact (None without them)."""

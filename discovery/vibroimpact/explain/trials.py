@@ -171,9 +171,10 @@ class _Refits:
         side, the refit's start candidates by family (see :meth:`refit`): the current law
         with the effect at its LM step first, then the regression's (on the extended terms,
         or with the effect's value on its ladder), for an offset the ladder of laws
-        regressed beyond each rung, and for stiffening supports the value the frame's own
-        equation reads (:meth:`Regressions.supports`); and the families whose best start
-        is refitted too (``own``).
+        regressed beyond each rung, for stiffening supports the value the frame's own
+        equation reads (:meth:`Regressions.supports`), for an offset the one the force's
+        onsets read (:meth:`Regressions.offset`, with the law regressed beyond it); and the
+        families whose best start is refitted too (``own``).
 
         A two-sided parameter (an offset) refits each ladder's best start: from the law
         regressed beyond its rung, an offset of -46 um went to a basin at I2 0.32; from the
@@ -181,7 +182,9 @@ class _Refits:
         refitted too: on survey draw 33's quieter record (a 0.3 ms contact) the true law's
         basin is a few percent wide in the spring, and no refit from the ladder's rungs
         reached it (I2 1.22-1.41, the truth 0.11), while the frame's equation reads ``k3``
-        to 0.1 %."""
+        to 0.1 %.  So is the offset's reading: on draw 26's noisier record every ladder's
+        start went to the basin at I2 0.32 again (the offset -66 um), and the onsets read
+        -46.4 um."""
         regress = self.regress
         lo, hi = eff.parameters[0].bounds
         # a two-sided parameter (an offset) starts on the side its LM direction points to,
@@ -219,6 +222,10 @@ class _Refits:
             family = [_extend(m, eff, read) for m in (model, reg) if m is not None]
             base = family[-1]
             own.append(family + [springs_scaled(base, f) for f in _SPRING_SCAN])
+        read = regress.offset() if eff.key == "offset" and regress is not None else None
+        if read is not None and lo <= read <= hi:
+            beyond = _regressed(model, model.law.names, regress, shift=read)
+            own.append([_extend(m, eff, read) for m in (beyond, model) if m is not None])
         return h, families, own
 
     def _by_gap(self, cands):
