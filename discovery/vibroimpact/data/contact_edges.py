@@ -225,7 +225,7 @@ def onset_penetrations(t, F, zeta, period, *, flight=0.05):
     dt = float(np.median(np.diff(t)))
     longest = max(6, int(flight * period / dt))
     out, loss = [], -np.inf
-    for t_on, t_off, s in runs:
+    for _, t_off, s in runs:
         if s < 1 or s + 1 >= t.size:
             continue
         rise = F[s + 1] - F[s]  # the force's rise over the contact's first sample interval
