@@ -197,10 +197,16 @@ def contact_onsets(t, F, period, *, zeta=None, min_samples=3):
     ``max(5 sigma, 1e-3 max F)``, noise runs dropped; with ``zeta``, contacts not separated
     by a free flight are one)."""
     t, F = np.asarray(t, dtype=float), np.asarray(F, dtype=float)
+    runs = _record_contacts(t, F, period, min_samples, zeta)[1]
+    return np.array([r[0] for r in runs], dtype=float)
+
+
+def _record_contacts(t, F, period, min_samples=3, zeta=None):
+    """``(sigma, runs)``: the force's noise and its contacts (:func:`_contact_runs`) at the
+    record's threshold ``max(5 sigma, 1e-3 max F)``."""
     sigma = estimate_noise(F)
     thr = max(5.0 * sigma, 1e-3 * float(np.max(F)))
-    runs = _contact_runs(t, F, thr, sigma, period, min_samples=min_samples, zeta=zeta)
-    return np.array([r[0] for r in runs], dtype=float)
+    return sigma, _contact_runs(t, F, thr, sigma, period, min_samples=min_samples, zeta=zeta)
 
 
 def onset_penetrations(t, F, zeta, period, *, flight=0.05):
@@ -219,9 +225,7 @@ def onset_penetrations(t, F, zeta, period, *, flight=0.05):
     extrapolated to the onset: a noisy penetration read at one sample is as noisy as the
     offset is small (survey draw 26: 46 um under 20 um of noise)."""
     t, F, zeta = (np.asarray(x, dtype=float) for x in (t, F, zeta))
-    sigma = estimate_noise(F)
-    thr = max(5.0 * sigma, 1e-3 * float(np.max(F)))
-    runs = _contact_runs(t, F, thr, sigma, period, min_samples=3, zeta=None)
+    sigma, runs = _record_contacts(t, F, period)
     dt = float(np.median(np.diff(t)))
     longest = max(6, int(flight * period / dt))
     out, loss = [], -np.inf

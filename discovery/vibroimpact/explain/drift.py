@@ -40,6 +40,7 @@ from scipy.optimize import minimize_scalar
 from scipy.stats import chi2
 
 from ..data.noise import estimate_noise
+from ..verify.motion import contact_runs
 
 __all__ = [
     "DriftRecord",
@@ -127,11 +128,9 @@ def _contact_runs(above, shortest=3):
     """The samples in runs of at least ``shortest`` above the threshold (a contact; a lone
     sample above it is the noise's)."""
     above = np.asarray(above, dtype=bool)
-    edges = np.flatnonzero(np.diff(np.concatenate([[0], above.astype(np.int8), [0]])))
     out = np.zeros(above.size, dtype=bool)
-    for s, e in zip(edges[::2], edges[1::2], strict=True):
-        if e - s >= shortest:
-            out[s:e] = True
+    for s, e in contact_runs(above, 1):
+        out[s:e] = e - s >= shortest
     return out
 
 
