@@ -50,6 +50,11 @@ class Effect:
     terms : tuple of str
         For a system whose effects are terms of its own model (the Ueda oscillator's
         catalogue): the terms it adds; ``target`` is then ``"term"`` and ``key`` the first.
+    machine : tuple of str
+        Machine parameters a record fixes only together with this effect's, refitted with
+        it where its parameter is fitted on the records' spans (a mass shed per impact and
+        the moulding's mass at the record's start: a calibration that read one a little
+        high reads the other high too, and the loss alone cannot undo it).
     """
 
     id: str
@@ -63,6 +68,7 @@ class Effect:
     key: str = ""
     departs: str = ""
     terms: tuple = ()
+    machine: tuple = ()
 
     def __post_init__(self):
         if not self.target and self.terms:
@@ -89,6 +95,7 @@ class Effect:
             "target": self.target,
             "key": self.key,
             "departs_from_paper": self.departs,
+            "refitted_with": list(self.machine),
         }
 
 

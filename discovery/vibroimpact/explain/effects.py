@@ -35,6 +35,7 @@ __all__ = [
     "first_order_lag",
     "first_order_lag_at",
     "small_step",
+    "drift_fitted",
 ]
 
 
@@ -68,7 +69,9 @@ class Model:
     fit_drift : bool
         Whether :func:`discovery.identify` fits a drift effect's parameter too (records
         compared over their span, where each block starts with the mass left); by default
-        the drift channel fits it.
+        the drift channel fits it.  The machine parameters such an effect is refitted with
+        (:attr:`~discovery.catalogue.Effect.machine`) are fitted too where ``scenario``
+        holds them (:func:`drift_fitted` puts them there).
     """
 
     law: ForceLaw
@@ -113,7 +116,7 @@ class Model:
         else:
             obs[eff.key] = float(value)
         ids = self.effects + ((eff.id,) if add and eff.id not in self.effects else ())
-        return Model(law, obs, ids, scen, fit_drift=self.fit_drift)
+        return replace(self, law=law, observation=obs, effects=ids, scenario=scen)
 
     def without_effect(self, eff):
         """The model with the effect taken out (its term, unloading term, set, machine
@@ -138,9 +141,8 @@ class Model:
             scen.pop(eff.key, None)
         else:
             obs.pop(eff.key, None)
-        return Model(
-            law, obs, tuple(i for i in self.effects if i != eff.id), scen, fit_drift=self.fit_drift
-        )
+        ids = tuple(i for i in self.effects if i != eff.id)
+        return replace(self, law=law, observation=obs, effects=ids, scenario=scen)
 
     def with_law(self, law):
         return replace(self, law=law)
@@ -154,25 +156,38 @@ class Model:
             if e.target != "term" and (self.fit_drift or "drift" not in e.phases)
         ]
 
+    def free_machine(self):
+        """The machine parameters fitted with a drift's (:attr:`fit_drift`): those its
+        effects are refitted with that :attr:`scenario` holds."""
+        keys = [k for e in self.free_effects() for k in e.machine if k in self.scenario]
+        return tuple(dict.fromkeys(keys))
+
     @property
     def coefficients(self):
-        """The law's coefficients, then the added effects' other parameters."""
-        return self.law.coefficients + tuple(self.value(e) for e in self.free_effects())
+        """The law's coefficients, then the added effects' other parameters, then the
+        machine parameters fitted with them (:meth:`free_machine`)."""
+        own = tuple(self.value(e) for e in self.free_effects())
+        return self.law.coefficients + own + tuple(self.scenario[k] for k in self.free_machine())
 
     @property
     def names(self):
-        return list(self.law.names) + [e.parameters[0].name for e in self.free_effects()]
+        own = [e.parameters[0].name for e in self.free_effects()]
+        return list(self.law.names) + own + list(self.free_machine())
 
     def with_coefficients(self, values):
         """The model with new :attr:`coefficients` (each effect parameter clipped to its
-        physical bounds), so :func:`discovery.identify` fits them jointly."""
+        physical bounds, a machine parameter kept positive), so :func:`discovery.identify`
+        fits them jointly."""
         values = [float(v) for v in values]
-        n = len(self.law.coefficients)
+        n, effects, machine = len(self.law.coefficients), self.free_effects(), self.free_machine()
         m = self.with_law(self.law.with_coefficients(values[:n]))
-        for e, v in zip(self.free_effects(), values[n:], strict=True):
+        for e, v in zip(effects, values[n : n + len(effects)], strict=True):
             lo, hi = e.parameters[0].bounds
             m = m.with_effect(e, min(max(v, lo), hi), add=False)
-        return m
+        scen = dict(m.scenario)
+        for k, v in zip(machine, values[n + len(effects) :], strict=True):
+            scen[k] = max(v, 1e-12 * abs(self.scenario[k]))
+        return replace(m, scenario=scen)
 
     def apply(self, scenario, record=None):
         """The scenario ``record`` (a :class:`~discovery.vibroimpact.verify.Reference`) is
@@ -211,6 +226,21 @@ class Model:
         extra = [f"{k} = {v:.4g}" for k, v in sorted(self.scenario.items())]
         extra += [f"observed through {k} = {v:.4g}" for k, v in sorted(self.observation.items())]
         return str(self.law) + (f"  ({'; '.join(extra)})" if extra else "")
+
+
+def drift_fitted(model, scenarios):
+    """``model`` with its drift effects' parameters fitted (:attr:`Model.fit_drift`), each
+    with the machine parameters it is refitted with (:attr:`~discovery.catalogue.Effect.machine`)
+    starting from the records' machine (``scenarios``) where the model has not changed them
+    and the records' machines agree on them."""
+    m = replace(model, fit_drift=True)
+    scen = dict(m.scenario)
+    for e in m.free_effects():
+        for k in e.machine:
+            values = {float(getattr(sc, k)) for sc in scenarios}
+            if k not in scen and len(values) == 1:
+                scen[k] = values.pop()
+    return replace(m, scenario=scen)
 
 
 def small_step(eff, scenario, peak, *, tau, v, z0):
@@ -329,6 +359,7 @@ EFFECTS = (
         phases=("drift",),
         target="scenario",
         key="mass_loss",
+        machine=("m2",),
     ),
     Effect(
         id="contact_offset",

@@ -55,7 +55,7 @@ from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
 from ..verify.motion import MOTION_CRITERION
 from .disagreement import localise
-from .effects import EFFECTS, KnownEffects, Model, effect
+from .effects import EFFECTS, KnownEffects, Model, drift_fitted, effect
 
 # the loop's parts (result, problem, starts, screening, trials, judging, separability)
 from .judging import _failing, _motion_within, _present, _within_noise, physical
@@ -403,7 +403,7 @@ def _joint_refit(run):
         try:
             res = _output_error(
                 run.records,
-                replace(m, fit_drift=spans),
+                drift_fitted(m, [sc for sc, _ in run.records]) if spans else m,
                 run.criterion,
                 run.budget,
                 run.tolerances,
@@ -454,7 +454,7 @@ def _intervals(run, s, progress):
     if all(getattr(r, "span", None) is not None for _, r in run.records):
         # every effect's parameter gets an interval: a drift's (the mass loss) too, refitted
         # with the law on the records' spans, where each block starts with the mass left
-        model = replace(model, fit_drift=True)
+        model = drift_fitted(model, [sc for sc, _ in run.records])
     try:
         tick(progress, "explain: bootstrap intervals", 0, s.n_boot_intervals)
         return bootstrap_intervals(

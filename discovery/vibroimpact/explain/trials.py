@@ -12,7 +12,7 @@ from ..fit.rescan import lower_basin, springs_scaled
 from ..model.law import Term
 from ..verify import CONSISTENCY_FACTORS
 from ..verify.motion import MOTION_CRITERION
-from .effects import effect
+from .effects import drift_fitted, effect
 from .judging import (
     _force_worse,
     _keeps_repulsive,
@@ -581,14 +581,21 @@ def _law_with_the_drift(run, model, budget, gap):
     without the drift: this brings it into the record's basin), then, on records compared
     over their span, where each block starts with the mass left, jointly with the drift
     parameter (the blocks fix it far more tightly than the drift channel; a record without
-    positions keeps the drift channel's value).  ``(model, fit)``: the refit where it
+    positions keeps the drift channel's value), and then with the machine parameters the
+    drift is refitted with too (:func:`~.effects.drift_fitted`: the moulding's mass, which
+    a calibration reads together with the loss; freed only once the loss is near its
+    value, the fit reaches it within the same budget).  ``(model, fit)``: the refit where it
     lowers the gap criterion, else ``model`` and ``None``."""
     spans = all(getattr(ref, "span", None) is not None for _, ref in run.records)
     try:
         res = _output_error(run.records, model, run.criterion, budget, run.tolerances)
         if spans:
-            start = replace(res.law, fit_drift=True)
-            res = _output_error(run.records, start, run.criterion, budget, run.tolerances)
+            res = _output_error(
+                run.records, replace(res.law, fit_drift=True), run.criterion, budget, run.tolerances
+            )
+            start = drift_fitted(res.law, [sc for sc, _ in run.records])
+            if start.free_machine():
+                res = _output_error(run.records, start, run.criterion, budget, run.tolerances)
         fitted = replace(res.law, fit_drift=False)
         old = _mean(run.problem.evaluations(model, floor=False), "criteria")
         new = _mean(run.problem.evaluations(fitted, floor=False), "criteria")

@@ -322,6 +322,7 @@ class _Objective:
             for e in model.free_effects():
                 t = Term.parse(e.key) if e.target == "unloading" else None
                 cols.append(n + law.unloading.index(t) if t in law.unloading else None)
+            cols += [None] * len(getattr(model, "free_machine", tuple)())
         # a record compared over its span takes an observation linear in the force; one
         # compared with its steady orbit (a force-only record) takes none
         linear = observe is None or getattr(observe, "linear", False)

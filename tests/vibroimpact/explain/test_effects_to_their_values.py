@@ -845,3 +845,30 @@ def test_the_drift_channel_runs_with_the_machines_own_mass_loss():
     model = Model(ForceLaw.parse("1.19e8*z + 9.82e5*zd"))
     assert drift.criterion(model)[0] < 1e-12
     assert drift.criterion(model.with_effect(effect_of("mass_loss"), 0.0))[0] > 1e-3
+
+
+def test_a_mass_loss_is_refitted_with_the_moulding_mass_the_calibration_read():
+    """Survey draw 38's quieter record, explained on the machine calibrated from a sheet 5 %
+    off: the calibration read the moulding 0.5 % heavy and its mass loss 9 % high (0.0061 for
+    0.0056), a point on the ridge along which the two trade.  The loss refitted alone
+    stopped at I2 0.050 against a limit of 0.044, inconsistent, though the true law is
+    consistent on the true machine.  Refitted with the moulding's mass, once the loss is
+    near its value, the model reaches the truth: the law within 0.2 %, the loss within 1 %,
+    consistent, and the loss's interval holds the truth."""
+    from discovery.vibroimpact.explain import explain
+    from tests import survey_effects as S
+
+    d = S.draw(38, "low")
+    given, scale, _, known = S._machine(d.start, d.record, 0.05, d.seed)
+    assert given.m2 == pytest.approx(6793, rel=1e-3)  # the calibration's, 0.5 % heavy
+    res = explain(given, d.record, "linear", workers=1, machine_scale=scale, known=known)
+    assert res.consistent, res
+    model = res.final_model
+    assert model.effects == ("mass_loss",)
+    assert model.scenario["mass_loss"] == pytest.approx(0.0056, rel=0.01)
+    # the moulding's mass, in the calibration's scale (its other masses 0.1 % heavy)
+    assert model.scenario["m2"] / d.machine.m2 == pytest.approx(given.m1 / d.machine.m1, abs=5e-4)
+    for got, true in zip(model.law.coefficients, d.true.coefficients, strict=True):
+        assert got == pytest.approx(true, rel=0.005)
+    lo, hi = res.intervals.bounds["loss"]
+    assert lo <= d.machine.mass_loss <= hi

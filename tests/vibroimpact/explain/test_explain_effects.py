@@ -187,3 +187,30 @@ def test_hidden_hertzian_stiffening_is_named(paper):
     assert _shrinks(res.iterations[0])
     assert 7e9 < res.final_model.law.as_dict()["z^1.5"] < 1.3e10
     assert res.consistent
+
+
+def test_a_drift_fit_frees_the_machine_parameters_it_trades_against(paper):
+    """A mass loss fitted on the records' spans carries the moulding's mass with it: the
+    model's parameter vector ends with ``m2`` (from the records' machine), a new vector sets
+    it, the fitted model applies it, and without the drift fit it is held."""
+    from dataclasses import replace
+
+    from discovery.vibroimpact.explain.effects import Model, drift_fitted, effect
+
+    law = ForceLaw.parse("2e8*z + 1.3e7*zd")
+    m = Model(law).with_effect(effect("mass_loss"), 0.004)
+    assert m.names == ["z", "zd"] and m.free_machine() == ()
+    fit = drift_fitted(m, [paper, paper])
+    assert fit.names == ["z", "zd", "loss", "m2"]
+    assert fit.coefficients == (2e8, 1.3e7, 0.004, paper.m2)
+    moved = fit.with_coefficients([2.1e8, 1.2e7, 0.005, 1.01 * paper.m2])
+    assert moved.scenario == {"mass_loss": 0.005, "m2": 1.01 * paper.m2}
+
+    class _Span:
+        span = object()
+
+    assert moved.apply(paper, _Span()).m2 == pytest.approx(1.01 * paper.m2)
+    held = replace(moved, fit_drift=False)
+    assert held.names == ["z", "zd"] and held.free_machine() == ()
+    # machines that disagree on the moulding leave it alone
+    assert drift_fitted(m, [paper, paper.replace(m2=2 * paper.m2)]).names == ["z", "zd", "loss"]
