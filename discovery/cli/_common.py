@@ -386,12 +386,17 @@ def criteria_line(criteria, floor):
     )
 
 
+def _error_text(error):
+    """A standard error as the printout shows it ("--" where the fit gave none)."""
+    return f"{error:.2g}" if error is not None and np.isfinite(error) else "--"
+
+
 def coefficients_line(coefficients, errors, intervals=None):
     """``  coefficients (standard error): z c (se), ...`` for the command's printout, and
     with ``intervals`` (:class:`discovery.vibroimpact.fit.intervals.Intervals`) a second line with
     them and what the standard errors do not cover."""
     line = "  coefficients (standard error): " + ", ".join(
-        f"{t} {c:.4g} ({errors.get(t, float('nan')):.2g})" for t, c in coefficients.items()
+        f"{t} {c:.4g} ({_error_text(errors.get(t))})" for t, c in coefficients.items()
     )
     if intervals is None:
         if errors:

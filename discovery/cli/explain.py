@@ -103,11 +103,7 @@ def run(args):
     fm = res.final_model
     print(f"final model: {fm}")
     if res.uncertainties:
-        print(
-            coefficients_line(
-                dict(zip(fm.names, fm.coefficients, strict=True)), res.uncertainties, res.intervals
-            )
-        )
+        print(coefficients_line(_parameters(res, scs), res.uncertainties, res.intervals))
     if res.criteria:
         print(criteria_line(res.criteria, res.noise_floor))
     print(
@@ -125,6 +121,22 @@ def run(args):
         )
     print(outputs_line(args, ["summary.json", *files]))
     return 0
+
+
+def _parameters(res, scenarios):
+    """``{name: value}`` of the final model's parameters the printout shows: the law's, then
+    every other one with a standard error or an interval (a mass loss, and the moulding's
+    mass refitted with it)."""
+    from ..vibroimpact.explain.effects import drift_fitted
+
+    fm = res.final_model
+    full = drift_fitted(fm, scenarios)
+    known = set(res.uncertainties or {}) | set(getattr(res.intervals, "bounds", None) or {})
+    return {
+        n: c
+        for n, c in zip(full.names, full.coefficients, strict=True)
+        if n in fm.names or n in known
+    }
 
 
 def _catalogue():
