@@ -207,3 +207,38 @@ def test_the_command_s_interval_line_prints_the_bounds_apart():
     )
     line = coefficients_line({"z": 2.06e8}, {"z": 7.7e3}, iv)
     assert "z [2.06000e+08, 2.06001e+08]" in line, line
+
+
+def test_the_explain_printout_shows_a_loss_and_the_moulding_s_mass_beside_the_law(paper):
+    """A final model with a mass loss: the law's coefficients, then the loss and the
+    moulding's mass refitted with it, each with its interval; a parameter the fit gave no
+    standard error reads "--", not "nan"."""
+    from types import SimpleNamespace
+
+    from discovery import ForceLaw
+    from discovery.cli._common import coefficients_line
+    from discovery.cli.explain import _parameters
+    from discovery.vibroimpact.explain.effects import Model, effect
+
+    fm = Model(ForceLaw.parse("2e8*z + 1.3e7*zd")).with_effect(effect("mass_loss"), 0.0056)
+    fm = fm.__class__(fm.law, {}, fm.effects, {**fm.scenario, "m2": 6767.0})
+    iv = SimpleNamespace(
+        bounds={
+            "z": (1.9e8, 2.1e8),
+            "zd": (1.2e7, 1.4e7),
+            "loss": (0.005, 0.006),
+            "m2": (6e3, 7e3),
+        },
+        level=0.95,
+        method="bootstrap",
+        n_boot=30,
+    )
+    res = SimpleNamespace(final_model=fm, uncertainties={"z": 1e6, "zd": 1e5}, intervals=iv)
+    shown = _parameters(res, [paper])
+    assert shown == {"z": 2e8, "zd": 1.3e7, "loss": 0.0056, "m2": 6767.0}
+    line = coefficients_line(shown, res.uncertainties, iv)
+    assert "loss 0.0056 (--)" in line and "m2 6767 (--)" in line and "nan" not in line
+    assert "loss [" in line.split("intervals")[1] and "m2 [" in line.split("intervals")[1]
+    # without intervals or errors for them, only the law's
+    bare = SimpleNamespace(final_model=fm, uncertainties={"z": 1e6}, intervals=None)
+    assert list(_parameters(bare, [paper])) == ["z", "zd"]
