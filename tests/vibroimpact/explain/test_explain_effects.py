@@ -145,17 +145,23 @@ def test_a_clean_record_shows_no_drift(paper):
 def test_two_hidden_effects_are_both_found(paper):
     """A penetration-velocity coupling in the law and a moulding that sheds 0.5 % of its
     mass per impact, hidden together in a 40-period record: the drift is explained first,
-    with the law refitted on blocks that start with the mass left (I2 0.998 -> 0.114, loss
-    0.00515), then the coupling (1.79e10 for 2e10; I2 0.114 -> 0.046)."""
+    with the law refitted on blocks that start with the mass left, and the moulding's mass
+    with the loss (I2 0.999 -> 0.109, loss 0.0052, the mass 0.5 % heavy: it stands in for
+    the coupling not yet named), then the coupling (1.6e10; I2 0.109 -> 0.055), and the
+    refit of every parameter after the loop reaches the truth: the coupling 2.03e10 for
+    2e10, the loss 0.00500, the mass within 0.01 %, I2 0.017, consistent."""
     _, res = mass_loss_case(paper, ForceLaw.parse(COUPLED))
     named = _named(res)
     assert named[:2] == ["mass_loss", "penetration_velocity_coupling"], [
         it.evidence for it in res.iterations
     ]
-    assert 0.0025 < res.final_model.scenario["mass_loss"] < 0.01
-    assert 1e10 < res.final_model.law.as_dict()["z*zd"] < 3e10
     coupling = res.iterations[1]
-    assert coupling.criteria_after["I2"] <= coupling.criteria_before["I2"] / 2
+    assert coupling.criteria_after["I2"] <= 0.6 * coupling.criteria_before["I2"]
+    assert res.consistent, res
+    final = res.final_model
+    assert final.scenario["mass_loss"] == pytest.approx(0.005, rel=0.02)
+    assert final.scenario["m2"] == pytest.approx(paper.m2, rel=0.002)
+    assert final.law.as_dict()["z*zd"] == pytest.approx(2e10, rel=0.05)
 
 
 def test_explain_cli_reports_the_unloading_branch(paper, tmp_path):
