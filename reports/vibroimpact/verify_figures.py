@@ -228,7 +228,7 @@ def _why_none(ev):
     return str(ev.status)
 
 
-def loops_figure(loops, evaluation, stem, law, what):
+def loops_figure(loops, evaluation, stem, law, what, note=""):
     """The force-penetration loop and both penetrations over the contacts of a model
     against a record (:func:`discovery.vibroimpact.verify.motion.force_penetration_loops`),
     e.g. explain's final model.
@@ -243,10 +243,13 @@ def loops_figure(loops, evaluation, stem, law, what):
     law : ForceLaw
     what : str
         What the law is, for the title (e.g. "final model").
+    note : str
+        A second title line: what the model adds beside its law (a machine change, an
+        observation model).
     """
     fig, (ax, axz) = subplots(1, 2, figsize=(PRINT_WIDTH, 3.0))
     _loops_panel(ax, axz, loops, evaluation)
-    fig.suptitle(f"{what}: {law_math(law)}", fontsize=8)
+    fig.suptitle(f"{what}: {law_math(law)}" + (f"\n{note}" if note else ""), fontsize=8)
     fig.set_layout_engine("tight")  # laid out once, by save()
     return _save(fig, stem)
 

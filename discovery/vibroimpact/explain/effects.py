@@ -222,10 +222,16 @@ class Model:
             "text": law.to_text(),
         }
 
-    def __str__(self):
+    def changes(self):
+        """What the model adds beside its law, as text: its machine changes and observation
+        models (``"m2 = 6767; mass_loss = 0.0056"``; "" for none)."""
         extra = [f"{k} = {v:.4g}" for k, v in sorted(self.scenario.items())]
         extra += [f"observed through {k} = {v:.4g}" for k, v in sorted(self.observation.items())]
-        return str(self.law) + (f"  ({'; '.join(extra)})" if extra else "")
+        return "; ".join(extra)
+
+    def __str__(self):
+        extra = self.changes()
+        return str(self.law) + (f"  ({extra})" if extra else "")
 
 
 def drift_fitted(model, scenarios):

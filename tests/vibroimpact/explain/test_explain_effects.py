@@ -211,6 +211,10 @@ def test_a_drift_fit_frees_the_machine_parameters_it_trades_against(paper):
     assert fit.coefficients == (2e8, 1.3e7, 0.004, paper.m2)
     moved = fit.with_coefficients([2.1e8, 1.2e7, 0.005, 1.01 * paper.m2])
     assert moved.scenario == {"mass_loss": 0.005, "m2": 1.01 * paper.m2}
+    # what the model adds beside its law, as its printout and the loops figure state it
+    assert moved.changes() == "m2 = 1.01e+04; mass_loss = 0.005"
+    assert str(moved).endswith("(m2 = 1.01e+04; mass_loss = 0.005)")
+    assert Model(law).changes() == ""
 
     class _Span:
         span = object()
