@@ -88,7 +88,7 @@ def run(args):
                 str(out.path("explain_loops")),
                 res.final_model.law,
                 "final model against the first record",
-                res.final_model.changes(),
+                note=res.final_model.changes(),
             )
             files.append("explain_loops.png/.pdf")
         tail["seconds"] = time.perf_counter() - t_start

@@ -228,7 +228,7 @@ def _why_none(ev):
     return str(ev.status)
 
 
-def loops_figure(loops, evaluation, stem, law, what, note=""):
+def loops_figure(loops, evaluation, stem, law, what, *, note=""):
     """The force-penetration loop and both penetrations over the contacts of a model
     against a record (:func:`discovery.vibroimpact.verify.motion.force_penetration_loops`),
     e.g. explain's final model.
