@@ -136,7 +136,7 @@ def _edges(t, F, thr, min_len, *, max_extrap=4.0, noise=0.0):
         # whether a contact is one or two)
         if merged and (
             r[0] - merged[-1][1] < min_len
-            or (noise > 0 and np.min(F[merged[-1][1] : r[0]]) > thr - 3.0 * noise)
+            or (noise > 0 and F[merged[-1][1] : r[0]].min() > thr - 3.0 * noise)
         ):
             merged[-1][1] = r[1]
         else:
@@ -146,7 +146,7 @@ def _edges(t, F, thr, min_len, *, max_extrap=4.0, noise=0.0):
     runs = [
         r
         for r in merged
-        if r[1] - r[0] >= min_len or (r[1] - r[0] >= 3 and np.max(F[r[0] : r[1]]) >= 3.0 * thr)
+        if r[1] - r[0] >= min_len or (r[1] - r[0] >= 3 and F[r[0] : r[1]].max() >= 3.0 * thr)
     ]
     out = []
     for s, e in runs:
@@ -156,12 +156,12 @@ def _edges(t, F, thr, min_len, *, max_extrap=4.0, noise=0.0):
         steep = max_extrap is not None and f1 - f0 > 3.0 * noise
         lo = -max_extrap if steep else 0.0
         frac = ((0.0 if steep else thr) - f0) / (f1 - f0) if f1 > f0 else 1.0
-        t_on = t[s - 1] + float(np.clip(frac, lo, 1.0)) * (t[s] - t[s - 1])
+        t_on = t[s - 1] + min(max(float(frac), lo), 1.0) * (t[s] - t[s - 1])
         g0, g1 = F[e - 1], F[e]
         steep = max_extrap is not None and g0 - g1 > 3.0 * noise
         hi = 1.0 + max_extrap if steep else 1.0
         frac = ((0.0 if steep else thr) - g0) / (g1 - g0) if g1 < g0 else 0.0
-        t_off = t[e - 1] + float(np.clip(frac, 0.0, hi)) * (t[e] - t[e - 1])
+        t_off = t[e - 1] + min(max(float(frac), 0.0), hi) * (t[e] - t[e - 1])
         if out and t_on <= out[-1][1]:  # extrapolated edges met: one contact
             out[-1] = (out[-1][0], max(out[-1][1], t_off), out[-1][2])
         else:
