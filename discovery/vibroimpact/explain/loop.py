@@ -55,7 +55,7 @@ from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
 from ..verify.motion import MOTION_CRITERION
 from .disagreement import localise
-from .effects import EFFECTS, KnownEffects, Model, drift_fitted, effect
+from .effects import EFFECTS, KnownEffects, Model, effect
 
 # the loop's parts (result, problem, starts, screening, trials, judging, separability)
 from .judging import _failing, _motion_within, _present, _within_noise, physical
@@ -390,7 +390,6 @@ def _joint_refit(run):
     model = run.model
     if not model.effects or all(e.consistent for e in run.problem.evaluations(model, floor=True)):
         return
-    spans = all(getattr(ref, "span", None) is not None for _, ref in run.records)
     starts = [model]
     regressed = _regressed(model, model.law.names, run.regress)
     if regressed is not None:
@@ -403,7 +402,7 @@ def _joint_refit(run):
         try:
             res = _output_error(
                 run.records,
-                drift_fitted(m, [sc for sc, _ in run.records]) if spans else m,
+                run.drift_fitted(m) if run.spans else m,
                 run.criterion,
                 run.budget,
                 run.tolerances,
@@ -451,14 +450,14 @@ def _intervals(run, s, progress):
     if not s.n_boot_intervals:
         return None
     model = run.model
-    if all(getattr(r, "span", None) is not None for _, r in run.records):
+    if run.spans:
         # every effect's parameter gets an interval: a drift's (the mass loss) too, refitted
         # with the law on the records' spans, where each block starts with the mass left
-        model = drift_fitted(model, [sc for sc, _ in run.records])
+        model = run.drift_fitted(model)
     try:
         tick(progress, "explain: bootstrap intervals", 0, s.n_boot_intervals)
         return bootstrap_intervals(
-            [sc for sc, _ in run.records],
+            run.scenarios,
             [r for _, r in run.records],
             model,
             n_boot=int(s.n_boot_intervals),

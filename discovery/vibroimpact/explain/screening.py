@@ -142,8 +142,7 @@ class _Screening:
             and (not quiet or "drift" in e.phases)
         ]
         local = _Linearisation.at(run.problem, run.records, model)
-        spans = all(getattr(ref, "span", None) is not None for _, ref in run.records)
-        scores = [_score(run, model, e, local, spans) for e in cands]
+        scores = [_score(run, model, e, local, run.spans) for e in cands]
         level = run.alpha / max(len(scores), 1)
         top_phases = sorted(loc["phases"], key=lambda p: -loc["phases"][p]["share"])[:2]
         for s, e in zip(scores, cands, strict=True):

@@ -4,7 +4,7 @@ its loop (:class:`_Run`), and one iteration's view of the current model (:class:
 
 from dataclasses import dataclass, field
 
-from .effects import Model
+from .effects import Model, drift_fitted
 from .problem import _Drift, _drift_free, _mean, _Problem, _with_drift
 from .result import Iteration
 from .score import Score
@@ -32,6 +32,22 @@ class _Run:
     iterations: list = field(default_factory=list)
     separability: tuple = ()
     stopped: str = ""
+
+    @property
+    def scenarios(self):
+        """Each record's machine."""
+        return [sc for sc, _ in self.records]
+
+    @property
+    def spans(self):
+        """Whether every record is compared over its span (each block starting with the
+        mass left after the record's impacts before it)."""
+        return all(getattr(ref, "span", None) is not None for _, ref in self.records)
+
+    def drift_fitted(self, model):
+        """``model`` with its drift fitted, with the machine parameters it trades against
+        from the records' machines (:func:`~.effects.drift_fitted`)."""
+        return drift_fitted(model, self.scenarios)
 
     def drift_free(self, model):
         return _drift_free(

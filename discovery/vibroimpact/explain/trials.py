@@ -12,7 +12,7 @@ from ..fit.rescan import lower_basin, springs_scaled
 from ..model.law import Term
 from ..verify import CONSISTENCY_FACTORS
 from ..verify.motion import MOTION_CRITERION
-from .effects import drift_fitted, effect
+from .effects import effect
 from .judging import (
     _force_worse,
     _keeps_repulsive,
@@ -586,14 +586,13 @@ def _law_with_the_drift(run, model, budget, gap):
     a calibration reads together with the loss; freed only once the loss is near its
     value, the fit reaches it within the same budget).  ``(model, fit)``: the refit where it
     lowers the gap criterion, else ``model`` and ``None``."""
-    spans = all(getattr(ref, "span", None) is not None for _, ref in run.records)
     try:
         res = _output_error(run.records, model, run.criterion, budget, run.tolerances)
-        if spans:
+        if run.spans:
             res = _output_error(
                 run.records, replace(res.law, fit_drift=True), run.criterion, budget, run.tolerances
             )
-            start = drift_fitted(res.law, [sc for sc, _ in run.records])
+            start = run.drift_fitted(res.law)
             if start.free_machine():
                 res = _output_error(run.records, start, run.criterion, budget, run.tolerances)
         fitted = replace(res.law, fit_drift=False)
