@@ -242,3 +242,30 @@ def test_the_explain_printout_shows_a_loss_and_the_moulding_s_mass_beside_the_la
     # without intervals or errors for them, only the law's
     bare = SimpleNamespace(final_model=fm, uncertainties={"z": 1e6}, intervals=None)
     assert list(_parameters(bare, [paper])) == ["z", "zd"]
+
+
+def test_print_of_an_explain_result_states_the_machine_changes_beside_the_law():
+    """``print(result)`` of explain: the final model with what it adds beside its law (a
+    mass loss and the moulding's mass refitted with it)."""
+    from types import SimpleNamespace
+
+    from discovery import ForceLaw
+    from discovery.vibroimpact.explain.effects import Model, effect
+    from discovery.vibroimpact.explain.result import ExplainResult
+
+    fm = Model(ForceLaw.parse("2e8*z + 1.3e7*zd")).with_effect(effect("mass_loss"), 0.0056)
+    fm = fm.__class__(fm.law, {}, fm.effects, {**fm.scenario, "m2": 6767.0})
+    res = SimpleNamespace(
+        final_model=fm,
+        consistent=True,
+        settings={},
+        iterations=(),
+        dropped=(),
+        criteria={},
+        noise_floor={},
+        limits={},
+        stopped_because="the model is consistent",
+        seconds=1.0,
+    )
+    first = ExplainResult._lines(res)[0]
+    assert "(m2 = 6767; mass_loss = 0.0056) with mass_loss: consistent" in first, first

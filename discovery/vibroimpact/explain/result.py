@@ -191,7 +191,7 @@ class ExplainResult(Result):
     def _lines(self):
         named = list(self.final_model.effects)
         out = [
-            f"final model {self.final_model.law}"
+            f"final model {self.final_model}"
             + (f" with {', '.join(named)}" if named else " (nothing named)")
             + ": "
             f"{'consistent' if self.consistent else 'NOT consistent'} with the record(s)"
