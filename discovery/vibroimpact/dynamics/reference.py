@@ -28,9 +28,10 @@ A run of more than ``_MAX_ZERO_LENGTH`` zero-length segments at one instant rais
 :class:`~discovery.errors.IntegrationError` (chattering between modes), and so does a run
 whose right-hand side is evaluated more than its budget (``max_nfev``, per 100 drive
 periods of the span): the compiled kernel's step budget, so that a law made stiff
-beyond what the machine's time scales need (e.g. a Lankarani-Nikravesh contact that
-starts at rest: its damping over an approach velocity of ``1e-12`` m/s) stops with a
-clear message instead of taking steps of ``1e-8`` s for hours.
+beyond what the machine's time scales need (e.g. a Lankarani-Nikravesh contact with a
+tiny approach velocity: its damping is divided by it, though never by less than the
+machine's floor, :meth:`~discovery.vibroimpact.model.scenario.Scenario.impact_v0_floor`)
+stops with a clear message instead of taking steps of ``1e-8`` s for hours.
 """
 
 from dataclasses import dataclass
@@ -117,7 +118,7 @@ def _mode_of(law, y, state):
         return "free"
     if law.impact_scaled and state.get("law") is None:
         # a start inside a contact whose onset is not known: its own penetration rate
-        state["law"] = law.at_impact(max(abs(v), 1e-12))
+        state["law"] = law.at_impact(max(abs(v), state["v0_floor"]))
     law = state.get("law") or law
     if v > 0:
         return "load" if _load(law, max(z, 0.0), v, state["zmax"]) >= 0 else "clipped"
@@ -163,7 +164,7 @@ def _after(law, kind, y, state, loss):
         state["zmax"] = 0.0
         state["m2"] *= 1.0 - loss
         if law.impact_scaled:  # this impact's own law: velocity terms over its v0
-            state["law"] = law.at_impact(max(v, 1e-12))
+            state["law"] = law.at_impact(max(v, state["v0_floor"]))
     law = state.get("law") or law
     if kind == "loss":
         return "free"
@@ -388,9 +389,11 @@ def reference_simulate(scenario, law, t_span, *, y0=None, t_eval=None, settings=
         than the scenario's after impacts with a ``mass_loss``); ``nfev``.
     """
     s = ReferenceSimulateSettings.of("reference_simulate", settings, options)
-    state = {"m2": scenario.m2, "zmax": 0.0, "law": law}
+    # an impact-scaled law divides by no approach velocity below the machine's floor
+    floor = scenario.impact_v0_floor()
+    state = {"m2": scenario.m2, "zmax": 0.0, "law": law, "v0_floor": floor}
     if law.impact_scaled:
-        state["law"] = law.at_impact(s.impact_v0) if s.impact_v0 > 0 else None
+        state["law"] = law.at_impact(max(s.impact_v0, floor)) if s.impact_v0 > 0 else None
     T = scenario.period
     y = scenario.initial_state() if y0 is None else np.array(y0, dtype=float)
     atol = s.atol

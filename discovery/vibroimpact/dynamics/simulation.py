@@ -70,6 +70,11 @@ class Trajectory:
     status : int
         0 on success; see ``message``.
     message : str
+    zeta_max0, impact_v0 : float
+        The contact memory at the start (see :func:`simulate`).
+    impact_v0_floor : float
+        The smallest approach velocity an impact-scaled law's velocity terms are divided by
+        (:meth:`Scenario.impact_v0_floor`).
     sensitivity : ndarray of shape (4, m) or None
         With ``simulate(..., sensitivities=...)``: the derivatives of the final state along
         each of ``m`` directions, named in ``sensitivity_names``: ``"w1", "v1", "w2", "v2"``
@@ -100,6 +105,7 @@ class Trajectory:
     message: str
     zeta_max0: float = 0.0
     impact_v0: float = 0.0
+    impact_v0_floor: float = 0.0
     sensitivity: np.ndarray | None = None
     force_sensitivity: np.ndarray | None = None
     penetration_sensitivity: np.ndarray | None = None
@@ -129,6 +135,7 @@ class Trajectory:
         p[K.P_ZMAX] = self.zeta_max0
         p[K.P_VSCALE] = 1.0 if law.impact_scaled else 0.0
         p[K.P_V0] = self.impact_v0
+        p[K.P_V0MIN] = self.impact_v0_floor
         for k, (yk, (m0, m1)) in enumerate(zip(self.event_y, self.event_modes, strict=True)):
             z, v = yk[0] - yk[2], yk[1] - yk[3]
             if m0 == K.FREE:
@@ -156,6 +163,7 @@ def kernel_params(scenario, law, tolerances=None):
     p[K.P_FLIGHT] = 1.0 if closed else 0.0
     contact = tolerances is None or tolerances.contact == "closed"
     p[K.P_CONTACT] = 1.0 if closed and contact else 0.0
+    p[K.P_V0MIN] = scenario.impact_v0_floor()
     return p
 
 
@@ -424,6 +432,7 @@ def simulate(scenario, law, t_span, y0=None, t_eval=None, *, settings=None, **op
         message=message,
         zeta_max0=float(s.zeta_max0),
         impact_v0=v0_start,
+        impact_v0_floor=float(p[K.P_V0MIN]),
         sensitivity=sens[0] if names else None,
         force_sensitivity=sens[3][: len(names), ok_out] if names else None,
         penetration_sensitivity=sens[3][len(names) :, ok_out] if names else None,

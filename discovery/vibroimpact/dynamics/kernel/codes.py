@@ -32,4 +32,7 @@ EV_ONSET, EV_LOSS, EV_UNLOAD, EV_RELOAD, EV_RELEASE, EV_RESUME = 1, 2, 3, 4, 5, 
 # second contact state, set at every onset).  ``p[P_CONTACT] = 1`` advances the contact in closed
 # form where it applies (0: the integrator's steps).
 P_K3, P_LOSS, P_SET, P_ZMAX, P_FLIGHT, P_V0, P_VSCALE = 7, 8, 9, 10, 11, 12, 13
-P_CONTACT, N_PARAMS = 14, 15
+# ``p[P_V0MIN]``: the smallest approach velocity the velocity terms are divided by
+# (:meth:`~discovery.vibroimpact.model.scenario.Scenario.impact_v0_floor`; a contact that begins
+# at rest has none).
+P_CONTACT, P_V0MIN, N_PARAMS = 14, 15, 16

@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 from ....numerics._dopri import C as _C
-from .codes import DP, LOAD, P_K3, P_SET, P_V0, P_VSCALE, P_ZMAX, UNLOAD, borrowed_njit
+from .codes import DP, LOAD, P_K3, P_SET, P_V0, P_V0MIN, P_VSCALE, P_ZMAX, UNLOAD, borrowed_njit
 
 _stage, _combine = DP.stage, DP.combine
 
@@ -34,10 +34,11 @@ def _pw(x, p):
 @njit(cache=True, inline="always")
 def _vscale(p):
     """The factor of the velocity terms' coefficients: ``1 / v0`` for a law scaled by each
-    impact's approach velocity (``p[P_VSCALE] = 1``), else 1."""
+    impact's approach velocity (``p[P_VSCALE] = 1``), not below the floor ``p[P_V0MIN]``,
+    else 1."""
     if p[P_VSCALE] == 0.0:
         return 1.0
-    return 1.0 / max(p[P_V0], 1e-12)
+    return 1.0 / max(p[P_V0], p[P_V0MIN], 1e-12)
 
 
 @njit(cache=True, inline="always")
