@@ -9,7 +9,7 @@ import numpy as np
 from ..fit.problem import ModelProblem
 from ..fit.records import contact_scales
 from . import drift as D
-from .effects import EFFECTS, small_step
+from .effects import EFFECTS, drift_fitted, small_step
 
 #: the loop's residual problem: the fit's :class:`~discovery.vibroimpact.fit.problem.ModelProblem`
 _Problem = ModelProblem
@@ -76,6 +76,18 @@ def _drift_free(drift, model, records, alpha):
         return True
     eff = next(e for e in EFFECTS if "drift" in e.phases)
     return drift.score(model, eff, _small_step(eff, records))["p"] >= alpha
+
+
+def spans_of(records):
+    """Whether every record is compared over its span (each block starting with the mass
+    left after the record's impacts before it)."""
+    return all(getattr(ref, "span", None) is not None for _, ref in records)
+
+
+def drift_fitted_on(model, records):
+    """``model`` with its drift fitted, with the machine parameters it trades against from
+    the ``records``' machines (:func:`~.effects.drift_fitted`)."""
+    return drift_fitted(model, [sc for sc, _ in records])
 
 
 def _mean(evs, key):

@@ -4,8 +4,8 @@ its loop (:class:`_Run`), and one iteration's view of the current model (:class:
 
 from dataclasses import dataclass, field
 
-from .effects import Model, drift_fitted
-from .problem import _Drift, _drift_free, _mean, _Problem, _with_drift
+from .effects import Model
+from .problem import _Drift, _drift_free, _mean, _Problem, _with_drift, drift_fitted_on, spans_of
 from .result import Iteration
 from .score import Score
 
@@ -40,14 +40,12 @@ class _Run:
 
     @property
     def spans(self):
-        """Whether every record is compared over its span (each block starting with the
-        mass left after the record's impacts before it)."""
-        return all(getattr(ref, "span", None) is not None for _, ref in self.records)
+        """Whether every record is compared over its span (:func:`~.problem.spans_of`)."""
+        return spans_of(self.records)
 
     def drift_fitted(self, model):
-        """``model`` with its drift fitted, with the machine parameters it trades against
-        from the records' machines (:func:`~.effects.drift_fitted`)."""
-        return drift_fitted(model, self.scenarios)
+        """``model`` with its drift fitted (:func:`~.problem.drift_fitted_on`)."""
+        return drift_fitted_on(model, self.records)
 
     def drift_free(self, model):
         return _drift_free(

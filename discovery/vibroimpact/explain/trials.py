@@ -23,7 +23,7 @@ from .judging import (
     out_of_bounds,
     physical,
 )
-from .problem import _mean, _small_step, _with_drift, best_of
+from .problem import _mean, _small_step, _with_drift, best_of, drift_fitted_on, spans_of
 from .starts import LawOnly, _output_error, _regressed
 
 
@@ -68,8 +68,9 @@ def _within(value, share, lo, hi):
 class _Refits:
     """How a screening refit runs (the executor's context: the records stay in the forked
     processes): the residual problem, the records, the criterion, the simulations of each
-    refit, the integrator's tolerances and the regression of the force on a term list
-    (``None`` without positions)."""
+    refit, the integrator's tolerances, the regression of the force on a term list
+    (``None`` without positions), the records' drift channel (``None`` without one) and the
+    criterion a drift effect's refit must lower (:func:`_law_with_the_drift`)."""
 
     problem: object
     records: list
@@ -77,6 +78,15 @@ class _Refits:
     budget: int
     tolerances: object
     regress: object = None
+    drift: object = None
+    gap: str | None = None
+
+    @property
+    def spans(self):
+        return spans_of(self.records)
+
+    def drift_fitted(self, model):
+        return drift_fitted_on(model, self.records)
 
     def refit(self, model, eff, guess):
         """Add ``eff`` and refit the extended model by output error: the law's coefficients
@@ -236,8 +246,11 @@ class _Refits:
 
 def _screen_one(refits, job):
     """One screening refit (:meth:`_Refits.refit`, a task of the executor), or with no
-    effect (``eff_id`` None) the law refitted alone from ``model``: ``(model,
-    identification, evaluations, error, simulations)``."""
+    effect (``eff_id`` None) the law refitted alone from ``model``, or a drift effect's
+    parameter fitted to the drift channel and the law refitted with it
+    (:func:`_law_with_the_drift`; with the others, it had run in the calling process after
+    them, 1.4 s of the bench record's 11 s on two workers): ``(model, identification,
+    evaluations, error, simulations)``."""
     problem = refits.problem
     model, eff_id, direction = job
     n0 = problem.n_sim
@@ -249,6 +262,10 @@ def _screen_one(refits, job):
                 )
             )
             m2 = res.law
+        elif "drift" in effect(eff_id).phases:
+            eff = effect(eff_id)
+            m2 = refits.drift.refit(model, eff, _small_step(eff, refits.records))
+            m2, res = _law_with_the_drift(refits, m2, refits.budget, refits.gap)
         else:
             m2, res = refits.refit(model, effect(eff_id), direction)
         evs = problem.evaluations(m2, floor=True)
@@ -358,7 +375,7 @@ def _law_refit(run, model, budget, *, polish=False):
     return res, after, evs
 
 
-def _refits_and_baseline(run, chosen, screen_budget, refit_law):
+def _refits_and_baseline(run, chosen, screen_budget, refit_law, gap):
     """The screening refits of the ``chosen`` score entries (:func:`_screen`) and, with
     ``refit_law``, the law refitted alone in the same batch (the last job): ``(refits,
     baseline)``, ``baseline`` as :func:`_refit_trials` returns it."""
@@ -376,6 +393,8 @@ def _refits_and_baseline(run, chosen, screen_budget, refit_law):
             budget=screen_budget,
             tolerances=run.tolerances,
             regress=run.regress,
+            drift=run.drift,
+            gap=gap,
         ),
         run.workers,
         run.executor,
@@ -390,25 +409,20 @@ def _refits_and_baseline(run, chosen, screen_budget, refit_law):
 
 
 def _refit_trials(run, step, screen_budget, gap, chosen=None):
-    """Every chosen effect (the screening's ranked ones, at most ``run.max_refits``) refitted
-    with ``screen_budget`` simulations and checked (physical, within its bounds), and the
-    law refitted alone with the same budget (:func:`_law_start`): the refits of the force
-    history, the law's among them, run in parallel (the law's last, so one process does
-    them in the order written), the drift channel here.  Returns ``(trials, baseline)``,
-    ``baseline`` is ``(fit, criteria, evaluations)`` of the law refitted alone, or three
-    Nones when that refit fails or is not physical (:func:`~.judging.physical`).  Given
-    the score entries ``chosen``, those effects are refitted and the law is not."""
+    """Every chosen effect (the screening's ranked ones, at most ``run.max_refits``) refitted with
+    ``screen_budget`` simulations and checked (physical, within its bounds), and the law refitted
+    alone with the same budget (:func:`_law_start`): the refits of the force history, the law's
+    among them, run in parallel (the law's last, so one process does them in the order written), a
+    drift effect's with them (:func:`_screen_one`). Returns ``(trials, baseline)``, ``baseline`` is
+    ``(fit, criteria, evaluations)`` of the law refitted alone, or three Nones when that refit fails
+    or is not physical (:func:`~.judging.physical`). Given the score entries ``chosen``, those
+    effects are refitted and the law is not."""
     model, records, before = run.model, run.records, step.before
     refit_law = chosen is None
     if refit_law:
         chosen = step.screening.ranked[: run.max_refits]
     eff_by_id = step.screening.by_id
-    out, baseline = _refits_and_baseline(
-        run,
-        [s for s in chosen if "drift" not in eff_by_id[s["effect"]].phases],
-        screen_budget,
-        refit_law,
-    )
+    out, baseline = _refits_and_baseline(run, chosen, screen_budget, refit_law, gap)
     refits = iter(out)
     trials = []
     for s in chosen:
@@ -417,14 +431,9 @@ def _refit_trials(run, step, screen_budget, gap, chosen=None):
         # records' spans (:func:`~.screening._score`), by the gap it leaves on them
         key = "D" if s.get("channel") == "drift" else gap
         try:
-            if "drift" in eff.phases:
-                m2 = run.drift.refit(model, eff, _small_step(eff, records))
-                m2, res = _law_with_the_drift(run, m2, screen_budget, gap)
-                evs2 = run.problem.evaluations(m2, floor=True)
-            else:
-                m2, res, evs2, error = next(refits)
-                if error is not None:
-                    raise IntegrationError(error)
+            m2, res, evs2, error = next(refits)
+            if error is not None:
+                raise IntegrationError(error)
         except IntegrationError as exc:
             s["note"] = f"refit failed: {exc}"
             continue
@@ -576,16 +585,17 @@ def _polish_winner(run, best, eff):
 
 
 def _law_with_the_drift(run, model, budget, gap):
-    """A drift effect's model (its parameter fitted to the drift channel) with the law
-    refitted by output error, first with the drift parameter held (the law was fitted
-    without the drift: this brings it into the record's basin), then, on records compared
-    over their span, where each block starts with the mass left, jointly with the drift
-    parameter (the blocks fix it far more tightly than the drift channel; a record without
-    positions keeps the drift channel's value), and then with the machine parameters the
-    drift is refitted with too (:func:`~.effects.drift_fitted`: the moulding's mass, which
-    a calibration reads together with the loss; freed only once the loss is near its
-    value, the fit reaches it within the same budget).  ``(model, fit)``: the refit where it
-    lowers the gap criterion, else ``model`` and ``None``."""
+    """``run`` (a screening job's :class:`_Refits`, or anything with its records, criterion,
+    tolerances, problem, ``spans`` and ``drift_fitted``): a drift effect's model (its parameter
+    fitted to the drift channel) with the law refitted by output error, first with the drift
+    parameter held (the law was fitted without the drift: this brings it into the record's basin),
+    then, on records compared over their span, where each block starts with the mass left, jointly
+    with the drift parameter (the blocks fix it far more tightly than the drift channel; a record
+    without positions keeps the drift channel's value), and then with the machine parameters the
+    drift is refitted with too (:func:`~.effects.drift_fitted`: the moulding's mass, which a
+    calibration reads together with the loss; freed only once the loss is near its value, the fit
+    reaches it within the same budget). ``(model, fit)``: the refit where it lowers the gap
+    criterion, else ``model`` and ``None``."""
     try:
         res = _output_error(run.records, model, run.criterion, budget, run.tolerances)
         if run.spans:
