@@ -409,14 +409,14 @@ def _refits_and_baseline(run, chosen, screen_budget, refit_law, gap):
 
 
 def _refit_trials(run, step, screen_budget, gap, chosen=None):
-    """Every chosen effect (the screening's ranked ones, at most ``run.max_refits``) refitted with
-    ``screen_budget`` simulations and checked (physical, within its bounds), and the law refitted
-    alone with the same budget (:func:`_law_start`): the refits of the force history, the law's
-    among them, run in parallel (the law's last, so one process does them in the order written), a
-    drift effect's with them (:func:`_screen_one`). Returns ``(trials, baseline)``, ``baseline`` is
-    ``(fit, criteria, evaluations)`` of the law refitted alone, or three Nones when that refit fails
-    or is not physical (:func:`~.judging.physical`). Given the score entries ``chosen``, those
-    effects are refitted and the law is not."""
+    """Every chosen effect (the screening's ranked ones, at most ``run.max_refits``) refitted
+    with ``screen_budget`` simulations and checked (physical, within its bounds), and the
+    law refitted alone with the same budget (:func:`_law_start`): the refits run in
+    parallel, a drift effect's among them (:func:`_screen_one`), the law's last (so one
+    process does them in the order written).  Returns ``(trials, baseline)``,
+    ``baseline`` is ``(fit, criteria, evaluations)`` of the law refitted alone, or three
+    Nones when that refit fails or is not physical (:func:`~.judging.physical`).  Given
+    the score entries ``chosen``, those effects are refitted and the law is not."""
     model, records, before = run.model, run.records, step.before
     refit_law = chosen is None
     if refit_law:
@@ -585,17 +585,18 @@ def _polish_winner(run, best, eff):
 
 
 def _law_with_the_drift(run, model, budget, gap):
-    """``run`` (a screening job's :class:`_Refits`, or anything with its records, criterion,
-    tolerances, problem, ``spans`` and ``drift_fitted``): a drift effect's model (its parameter
-    fitted to the drift channel) with the law refitted by output error, first with the drift
-    parameter held (the law was fitted without the drift: this brings it into the record's basin),
-    then, on records compared over their span, where each block starts with the mass left, jointly
-    with the drift parameter (the blocks fix it far more tightly than the drift channel; a record
-    without positions keeps the drift channel's value), and then with the machine parameters the
-    drift is refitted with too (:func:`~.effects.drift_fitted`: the moulding's mass, which a
-    calibration reads together with the loss; freed only once the loss is near its value, the fit
-    reaches it within the same budget). ``(model, fit)``: the refit where it lowers the gap
-    criterion, else ``model`` and ``None``."""
+    """A drift effect's model (its parameter fitted to the drift channel) with the law
+    refitted by output error, first with the drift parameter held (the law was fitted
+    without the drift: this brings it into the record's basin), then, on records compared
+    over their span, where each block starts with the mass left, jointly with the drift
+    parameter (the blocks fix it far more tightly than the drift channel; a record without
+    positions keeps the drift channel's value), and then with the machine parameters the
+    drift is refitted with too (:func:`~.effects.drift_fitted`: the moulding's mass, which
+    a calibration reads together with the loss; freed only once the loss is near its
+    value, the fit reaches it within the same budget).  ``run`` is a screening job's
+    :class:`_Refits` (its records, criterion, tolerances, problem, ``spans`` and
+    ``drift_fitted``).  ``(model, fit)``: the refit where it lowers the gap criterion, else
+    ``model`` and ``None``."""
     try:
         res = _output_error(run.records, model, run.criterion, budget, run.tolerances)
         if run.spans:
