@@ -69,6 +69,14 @@ class Memo:
         self._d.move_to_end(key)
         return value
 
+    def of(self, obj, compute):
+        """``compute()`` for the object ``obj`` itself, kept under its identity (a measured
+        block's arrays, asked for by every evaluation): the entry holds ``obj``, so its id is
+        not reused while kept; an object that took the id of one no longer kept is computed
+        afresh."""
+        kept, value = self.get(id(obj), lambda: (obj, compute()))
+        return value if kept is obj else compute()
+
     def __contains__(self, key):
         """Whether ``key`` is stored (not counted as a hit or a miss)."""
         try:

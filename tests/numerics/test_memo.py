@@ -107,3 +107,19 @@ def _steady_record(sc):
     r = reference_simulate(sc, sc.law, (0.0, t[-1]), t_eval=t, rtol=1e-9)
     rng = np.random.default_rng(2)
     return t, r["force"] + rng.normal(0.0, 0.01 * np.max(np.abs(r["force"])), t.size)
+
+
+def test_of_keeps_a_result_per_object_and_never_answers_another():
+    """``Memo.of``: one computation per object while it is kept; an object whose id is that of
+    one no longer alive is computed afresh, never given the other's result."""
+    memo, calls = Memo(4), []
+
+    def for_(a):
+        return lambda: calls.append(id(a)) or float(a.sum())
+
+    a = np.arange(3.0)
+    assert memo.of(a, for_(a)) == 3.0 and memo.of(a, for_(a)) == 3.0
+    assert len(calls) == 1
+    b = np.arange(4.0)
+    memo._d[id(b)] = (a, 3.0)  # a stale entry under b's id (as after a's id was reused)
+    assert memo.of(b, for_(b)) == 6.0 and len(calls) == 2

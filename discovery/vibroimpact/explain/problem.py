@@ -78,16 +78,25 @@ def _drift_free(drift, model, records, alpha):
     return drift.score(model, eff, _small_step(eff, records))["p"] >= alpha
 
 
-def spans_of(records):
-    """Whether every record is compared over its span (each block starting with the mass
-    left after the record's impacts before it)."""
-    return all(getattr(ref, "span", None) is not None for _, ref in records)
+class OnRecords:
+    """What an explain run and its screening jobs read off their ``records`` (``[(scenario,
+    reference)]``, an attribute of the class this is mixed into)."""
 
+    @property
+    def scenarios(self):
+        """Each record's machine."""
+        return [sc for sc, _ in self.records]
 
-def drift_fitted_on(model, records):
-    """``model`` with its drift fitted, with the machine parameters it trades against from
-    the ``records``' machines (:func:`~.effects.drift_fitted`)."""
-    return drift_fitted(model, [sc for sc, _ in records])
+    @property
+    def spans(self):
+        """Whether every record is compared over its span (each block starting with the mass
+        left after the record's impacts before it)."""
+        return all(getattr(ref, "span", None) is not None for _, ref in self.records)
+
+    def drift_fitted(self, model):
+        """``model`` with its drift fitted, with the machine parameters it trades against
+        from the records' machines (:func:`~.effects.drift_fitted`)."""
+        return drift_fitted(model, self.scenarios)
 
 
 def _mean(evs, key):

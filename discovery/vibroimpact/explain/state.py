@@ -5,13 +5,13 @@ its loop (:class:`_Run`), and one iteration's view of the current model (:class:
 from dataclasses import dataclass, field
 
 from .effects import Model
-from .problem import _Drift, _drift_free, _mean, _Problem, _with_drift, drift_fitted_on, spans_of
+from .problem import OnRecords, _Drift, _drift_free, _mean, _Problem, _with_drift
 from .result import Iteration
 from .score import Score
 
 
 @dataclass
-class _Run:
+class _Run(OnRecords):
     """One :func:`explain` call: its fixed inputs and the state of its loop."""
 
     problem: _Problem
@@ -32,20 +32,6 @@ class _Run:
     iterations: list = field(default_factory=list)
     separability: tuple = ()
     stopped: str = ""
-
-    @property
-    def scenarios(self):
-        """Each record's machine."""
-        return [sc for sc, _ in self.records]
-
-    @property
-    def spans(self):
-        """Whether every record is compared over its span (:func:`~.problem.spans_of`)."""
-        return spans_of(self.records)
-
-    def drift_fitted(self, model):
-        """``model`` with its drift fitted (:func:`~.problem.drift_fitted_on`)."""
-        return drift_fitted_on(model, self.records)
 
     def drift_free(self, model):
         return _drift_free(

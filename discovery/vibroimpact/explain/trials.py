@@ -23,7 +23,7 @@ from .judging import (
     out_of_bounds,
     physical,
 )
-from .problem import _mean, _small_step, _with_drift, best_of, drift_fitted_on, spans_of
+from .problem import OnRecords, _mean, _small_step, _with_drift, best_of
 from .starts import LawOnly, _output_error, _regressed
 
 
@@ -65,7 +65,7 @@ def _within(value, share, lo, hi):
 
 
 @dataclass(frozen=True)
-class _Refits:
+class _Refits(OnRecords):
     """How a screening refit runs (the executor's context: the records stay in the forked
     processes): the residual problem, the records, the criterion, the simulations of each
     refit, the integrator's tolerances, the regression of the force on a term list
@@ -80,13 +80,6 @@ class _Refits:
     regress: object = None
     drift: object = None
     gap: str | None = None
-
-    @property
-    def spans(self):
-        return spans_of(self.records)
-
-    def drift_fitted(self, model):
-        return drift_fitted_on(model, self.records)
 
     def refit(self, model, eff, guess):
         """Add ``eff`` and refit the extended model by output error: the law's coefficients
@@ -253,21 +246,21 @@ def _screen_one(refits, job):
     evaluations, error, simulations)``."""
     problem = refits.problem
     model, eff_id, direction = job
+    eff = None if eff_id is None else effect(eff_id)
     n0 = problem.n_sim
     try:
-        if eff_id is None:
+        if eff is None:
             res = refits.rescanned(
                 _output_error(
                     refits.records, model, refits.criterion, refits.budget, refits.tolerances
                 )
             )
             m2 = res.law
-        elif "drift" in effect(eff_id).phases:
-            eff = effect(eff_id)
+        elif "drift" in eff.phases:
             m2 = refits.drift.refit(model, eff, _small_step(eff, refits.records))
             m2, res = _law_with_the_drift(refits, m2, refits.budget, refits.gap)
         else:
-            m2, res = refits.refit(model, effect(eff_id), direction)
+            m2, res = refits.refit(model, eff, direction)
         evs = problem.evaluations(m2, floor=True)
     except (IntegrationError, InputError) as exc:
         return None, None, None, str(exc), problem.n_sim - n0

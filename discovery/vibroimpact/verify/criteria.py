@@ -144,8 +144,7 @@ def _own_grid(imp):
     evaluated on it and its support; made once per impulse and kept (the fitting loops
     compare each measured block with every law; this was half of a comparison's time).
     What a :class:`Comparison` holds is read-only; ``tq`` and ``left`` stay writeable, as
-    the compiled evaluation's signature has them.  The entry holds the impulse, so its id
-    is not reused while kept."""
+    the compiled evaluation's signature has them (:meth:`~discovery.numerics.memo.Memo.of`)."""
 
     def made():
         te, de = _grid_points(imp, imp.duration)
@@ -153,10 +152,9 @@ def _own_grid(imp):
         out = (t, tq, left, imp.evaluate(tq, left), imp.periodic_support(imp.duration))
         for a in (out[0], out[3], out[4]):
             a.setflags(write=False)
-        return imp, out
+        return out
 
-    kept, out = _OWN_GRIDS.get(id(imp), made)
-    return out if kept is imp else made()[1]
+    return _OWN_GRIDS.of(imp, made)
 
 
 def _same_grid(a, b):

@@ -351,21 +351,20 @@ def _block_run(scenario, law, blk, y0, tolerances):
 def _sample_edges(td):
     """The edges of the intervals around the sample times ``td`` (midway between samples,
     half a spacing beyond the ends), made once per block's sample times and kept
-    (:data:`_EDGES`; every evaluation of every block asked for them)."""
+    (:data:`_EDGES`, :meth:`~discovery.numerics.memo.Memo.of`; every evaluation of every
+    block asked for them)."""
 
     def made():
         mid = 0.5 * (td[1:] + td[:-1])
         edges = np.concatenate([[td[0] - (mid[0] - td[0])], mid, [td[-1] + (td[-1] - mid[-1])]])
         edges.setflags(write=False)
-        return td, edges
+        return edges
 
-    kept, edges = _EDGES.get(id(td), made)
-    return edges if kept is td else made()[1]
+    return _EDGES.of(td, made)
 
 
 _EDGES = Memo(256)
-"""The sample intervals' edges of each block's sample times (:func:`_sample_edges`); the
-entry holds the times, so their id is not reused while kept."""
+"""The sample intervals' edges of each block's sample times (:func:`_sample_edges`)."""
 
 
 def _onset_weights(td, onsets):
