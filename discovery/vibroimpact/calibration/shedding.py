@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...numerics.student_t import t_quantile
+from ...numerics.distributions import t_quantile
 from ..data.contact_edges import contact_onsets
 
 __all__ = ["Shedding", "shedding", "MIN_CONTACTS", "SIGNIFICANCE", "MATERIAL"]

@@ -37,8 +37,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import minimize_scalar
-from scipy.stats import chi2
 
+from ...numerics.distributions import chi2_sf_one
 from ..data.noise import estimate_noise
 from ..verify.motion import contact_runs
 
@@ -237,7 +237,7 @@ def drift_score(pairs, loss, h):
     if den <= 0:
         return 0.0, 1.0, 0.0
     lm = num**2 / den
-    return float(lm), float(chi2.sf(lm, 1)), float(num / den)
+    return float(lm), chi2_sf_one(lm), float(num / den)
 
 
 def fit_drift(pairs, h, hi=0.5):

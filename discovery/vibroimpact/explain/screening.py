@@ -5,8 +5,8 @@ the current model, and the significant effects ranked.
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import chi2
 
+from ...numerics.distributions import chi2_sf_one
 from .judging import _motion_within, _within_noise
 from .problem import _small_step
 
@@ -76,7 +76,7 @@ class _Linearisation:
         return {
             "effect": eff.id,
             "lm": lm,
-            "p": float(chi2.sf(lm, 1)),
+            "p": chi2_sf_one(lm),
             "significant": False,
             "direction": float(-(s_perp @ r_perp) / den) if den > 0 else 0.0,
         }

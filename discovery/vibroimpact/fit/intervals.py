@@ -8,6 +8,7 @@ from ..._api._result import Result
 from ..._api._settings import Settings, option, takes
 from ..._api._validate import Choice, Real
 from ...errors import IntegrationError, NoContactError
+from ...numerics.distributions import normal_quantile, t_quantile
 from ...numerics.executor import map_on
 from ..dynamics import Tolerances
 from ..model.scenario import scale_bounds
@@ -438,18 +439,15 @@ def _intervals(D, model, how):
     around ``model``'s: normal quantiles on the spread for white noise; for the cycles, the
     spread scaled by ``sqrt(G / (G - p))`` and Student's t with ``G - p`` degrees of freedom
     (the comment above)."""
-    from scipy.stats import norm
-    from scipy.stats import t as student_t
-
     names = list(model.names)
     est = np.array(model.coefficients, dtype=float)
     sd = D.std(axis=0, ddof=1)
     dof, G = 0, how.cycles
-    z = float(norm.ppf(0.5 + how.level / 2))
+    z = normal_quantile(0.5 + how.level / 2)
     if how.noise == "cycles":
         dof = G - len(names)
         sd = sd * np.sqrt(G / dof)
-        z = float(student_t.ppf(0.5 + how.level / 2, dof))
+        z = t_quantile(dof, 0.5 + how.level / 2)
     method = (
         f"wild bootstrap by cycles (the record's residuals, one weight per cycle; Student t "
         f"with {dof} degrees of freedom)"

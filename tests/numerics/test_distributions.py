@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.special import stdtr, stdtrit
 
-from discovery.numerics.student_t import t_cdf, t_quantile
+from discovery.numerics.distributions import t_cdf, t_quantile
 
 DOFS = [1, 2, 3, 4, 5, 7, 10, 17, 30, 63, 100, 250, 499, 500, 501, 1000, 1e4, 1e5, 1e6]
 PS = [0.6, 0.9, 0.95, 0.975, 0.99, 0.995, 0.9995, 0.025, 0.1, 1e-6]
@@ -45,3 +45,25 @@ def test_closed_forms():
 def test_bad_arguments_are_refused(dof, p):
     with pytest.raises(ValueError, match="t_quantile needs"):
         t_quantile(dof, p)
+
+
+def test_the_normal_quantile_is_scipys():
+    from scipy.special import ndtri
+
+    from discovery.numerics.distributions import normal_quantile
+
+    for p in [1e-12, 1e-6, 0.025, 0.16, 0.5, 0.84, 0.975, 0.995, 1 - 1e-9]:
+        assert normal_quantile(p) == pytest.approx(float(ndtri(p)), rel=1e-14, abs=1e-15)
+
+
+def test_chi2_of_one_degree_is_scipys_and_the_squared_normal():
+    from scipy.special import chdtrc
+
+    from discovery.numerics.distributions import chi2_sf_one
+
+    for x in [1e-10, 0.01, 0.5, 1.0, 3.841458820694124, 10.0, 50.0, 300.0]:
+        assert chi2_sf_one(x) == pytest.approx(float(chdtrc(1, x)), rel=1e-12)
+    # P(Z^2 > 1.96^2) = 2 P(Z > 1.96) = 0.05 at the normal's 97.5 % quantile
+    assert chi2_sf_one(1.959963984540054**2) == pytest.approx(0.05, rel=1e-12)
+    assert chi2_sf_one(0.0) == 1.0 and chi2_sf_one(-1.0) == 1.0
+    assert math.isnan(chi2_sf_one(float("nan")))

@@ -1,8 +1,10 @@
-"""Student's t distribution's quantile without scipy: a calibrated command reads one
-(:mod:`~discovery.vibroimpact.calibration.shedding`), and ``scipy.special`` took 0.16 s of
-every such command's start (``scipy.stats`` about 1 s).
+"""The few distribution functions the package reads, without scipy: Student's t quantile
+(a calibrated command's mass-loss interval, the bootstrap intervals of a fit by cycles), the
+normal quantile and the chi-square survival function of one degree of freedom (the score
+tests of ``explain``).  ``scipy.special`` took 0.16 s of a command's start and
+``scipy.stats`` about 0.5 s (the named contact models' fit imports nothing else of it).
 
-The distribution function is the regularised incomplete beta function,
+Student's t distribution function is the regularised incomplete beta function,
 
     P(T <= t) = 1 - I_x(nu / 2, 1 / 2) / 2,    x = nu / (nu + t^2),   t >= 0,
 
@@ -10,13 +12,18 @@ evaluated by its continued fraction (modified Lentz), on the side of ``x`` where
 fraction converges fast (``I_x(a, b) = 1 - I_{1-x}(b, a)``).  The quantile is Newton's root
 of ``P(T <= t) = p`` from the Cornish-Fisher expansion about the normal quantile.  Checked
 against ``scipy.special.stdtrit`` to 1e-11 (relative) over 1-10^6 degrees of freedom and
-against the closed forms of one and two (``tests/numerics/test_student_t.py``).
+against the closed forms of one and two (``tests/numerics/test_distributions.py``).
+
+The chi-square variable of one degree of freedom is the square of a standard normal one, so
+its survival function is ``P(X > x) = erfc(sqrt(x / 2))`` (``math.erfc``, to the last
+digits, also far in the tail).  The normal quantile is the standard library's
+(:class:`statistics.NormalDist`, Wichura's algorithm AS 241, within 2e-15 of scipy's).
 """
 
 import math
 from statistics import NormalDist
 
-__all__ = ["t_quantile", "t_cdf"]
+__all__ = ["t_quantile", "t_cdf", "normal_quantile", "chi2_sf_one"]
 
 _EPS = 1e-16
 _TINY = 1e-300
@@ -125,3 +132,18 @@ def t_quantile(dof, p):
             return t_new
         t = t_new
     return t
+
+
+def normal_quantile(p):
+    """The ``p`` quantile of the standard normal distribution (as ``scipy.stats.norm.ppf``),
+    ``0 < p < 1``."""
+    return NormalDist().inv_cdf(float(p))
+
+
+def chi2_sf_one(x):
+    """``P(X > x)`` for a chi-square variable ``X`` of one degree of freedom (as
+    ``scipy.stats.chi2.sf(x, 1)``): ``erfc(sqrt(x / 2))``; 1 for ``x <= 0``, nan for nan."""
+    x = float(x)
+    if math.isnan(x):
+        return math.nan
+    return 1.0 if x <= 0 else math.erfc(math.sqrt(0.5 * x))
