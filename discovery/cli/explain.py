@@ -41,6 +41,7 @@ def run(args):
 
     from ..catalogue import select
     from ..vibroimpact.explain import EFFECTS, explain
+    from ..vibroimpact.explain.result import read_text
 
     t_start = time.perf_counter()
     check_out(args)
@@ -96,6 +97,8 @@ def run(args):
         res.record_run(head, tail).write_into(out)
     if (res.settings or {}).get("start_note"):
         print(f"start: {res.settings['start_note']}")
+    for eid, r in (res.settings or {}).get("read", {}).items():
+        print(f"read before the loop: {read_text(eid, r)}")
     for k, it in enumerate(res.iterations, start=1):
         name = it.effect or "nothing named"
         print(f"iteration {k}: {name}: {it.evidence}")

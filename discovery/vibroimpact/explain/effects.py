@@ -66,6 +66,10 @@ class Model:
         Machine parameters changed from the record's scenario, e.g. ``{"k3": 3e12}``.
     effects : tuple of str
         Ids of the effects added so far.
+    held : tuple of str
+        Ids of added effects whose parameter another channel of the record reads, held
+        where it reads it and not refitted with the law (stiffening supports the frame's own
+        equation reads: :func:`~discovery.vibroimpact.calibration.machine.supports_reading`).
     fit_drift : bool
         Whether :func:`discovery.identify` fits a drift effect's parameter too (records
         compared over their span, where each block starts with the mass left); by default
@@ -78,6 +82,7 @@ class Model:
     observation: dict = field(default_factory=dict)
     effects: tuple = ()
     scenario: dict = field(default_factory=dict)
+    held: tuple = ()
     fit_drift: bool = field(default=False, compare=False)
 
     # ------------------------------------------------------------- one mechanism
@@ -142,18 +147,22 @@ class Model:
         else:
             obs.pop(eff.key, None)
         ids = tuple(i for i in self.effects if i != eff.id)
-        return replace(self, law=law, observation=obs, effects=ids, scenario=scen)
+        held = tuple(i for i in self.held if i != eff.id)
+        return replace(self, law=law, observation=obs, effects=ids, scenario=scen, held=held)
 
     def with_law(self, law):
         return replace(self, law=law)
 
     # ------------------------------------------- the parameters identify() fits
     def free_effects(self):
-        """Added effects whose parameter is not a coefficient of the loading law."""
+        """Added effects whose parameter is not a coefficient of the loading law, nor held
+        where another channel reads it (:attr:`held`)."""
         return [
             e
             for e in (effect(i) for i in self.effects)
-            if e.target != "term" and (self.fit_drift or "drift" not in e.phases)
+            if e.target != "term"
+            and e.id not in self.held
+            and (self.fit_drift or "drift" not in e.phases)
         ]
 
     def free_machine(self):
@@ -218,6 +227,7 @@ class Model:
             "scenario": dict(self.scenario),
             "observation": dict(self.observation),
             "effects": list(self.effects),
+            "held": list(self.held),
             "latex": law.latex(),
             "text": law.to_text(),
         }

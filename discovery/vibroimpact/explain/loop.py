@@ -66,12 +66,17 @@ from .result import ExplainResult, Iteration
 from .screening import _Screening
 from .separability import _separability
 from .starts import (
+    SUPPORTS,
     Regressions,
     _fit_start,
     _output_error,
     _records_of,
     _regressed,
+    read_entry,
     start_law,
+    supports_read,
+    with_read,
+    with_supports,
 )
 from .state import _Run
 from .trials import _judged, _law_refit, _polish_winner, _refit_trials
@@ -573,9 +578,14 @@ def explain(
     s = ExplainSettings.of("explain", settings, options)
     t0 = time.perf_counter()
     budget = s.max_simulations
+    catalogue = select(EFFECTS, s.effects)
+    # the machine as its frame's own equation shows it: stiffening supports read there are
+    # in every simulation from the start on, and held where they are read
+    read = supports_read(scenario, measurement, catalogue, s.seed)
+    if read is not None:
+        scenario, measurement = with_supports(scenario, measurement, read[0])
     pairs, records = _records_of(scenario, measurement, s.n_boot, s.seed)
     ms = [m for _, m in pairs]
-    catalogue = select(EFFECTS, s.effects)
     problem = _Problem(records, s.tolerances)
     plain = [m for m in ms if not isinstance(m, Reference)]
     all_plain = len(plain) == len(ms)
@@ -603,6 +613,8 @@ def explain(
         if not any(isinstance(m, Reference) for m in ms):
             run.drift = _Drift(pairs, records)
         run.model, run.uncertainties = Model(fit.law), dict(fit.standard_errors)
+        if read is not None:
+            run.model = replace(run.model.with_effect(effect(SUPPORTS), read[0]), held=(SUPPORTS,))
         if s.known:
             _start_with_known(run, s.known)
         for _ in range(s.max_iterations + 1):
@@ -618,7 +630,7 @@ def explain(
             _mean(evs, "criteria"), _mean(evs, "noise_floor"), run.drift, run.model
         )
         return ExplainResult(
-            intervals=_intervals(run, s, progress),
+            intervals=with_read(_intervals(run, s, progress), read),
             iterations=tuple(run.iterations),
             final_model=run.model,
             uncertainties=run.uncertainties,
@@ -644,6 +656,7 @@ def explain(
                 "intervals": {"replicates": s.n_boot_intervals, "refit": s.interval_refit},
                 "records": len(records),
                 "known": dict(s.known or {}),
+                "read": {} if read is None else {SUPPORTS: read_entry(read)},
                 "start_note": start_note,
                 "simulations": problem.n_sim,
             },

@@ -24,8 +24,8 @@ def drop_collapsed(run):
     dropped = []
     for eid in list(run.model.effects):
         eff = effect(eid)
-        if "drift" in eff.phases:
-            continue
+        if "drift" in eff.phases or eid in run.model.held:
+            continue  # a drift's, or held where another channel reads it
         reduced = run.model.without_effect(eff)
         try:
             with_it = run.problem.evaluations(run.model, floor=True)

@@ -29,6 +29,17 @@ def loaded_model(d):
         observation=dict(d.get("observation") or {}),
         effects=tuple(d.get("effects") or ()),
         scenario=dict(d.get("scenario") or {}),
+        held=tuple(d.get("held") or ()),
+    )
+
+
+def read_text(eid, read):
+    """What the loop read before it began (``read``: ``{"k3", "low", "high"}`` of the
+    supports the frame's own equation reads), as one phrase."""
+    return (
+        f"{eid} k3 = {read['k3']:.4g} [{read['low']:.4g}, {read['high']:.4g}] N/m^3 (the "
+        "frame's own equation, the machine given with linear supports; held there in every "
+        "refit)"
     )
 
 
@@ -208,6 +219,8 @@ class ExplainResult(Result):
                     else "left out: the start with it fitted the record no better"
                 )
             )
+        for eid, r in (self.settings or {}).get("read", {}).items():
+            out.append(f"  read before the loop: {read_text(eid, r)}")
         for k, it in enumerate(self.iterations):
             key = next((c for c in ("I2", "D") if c in it.criteria_after), None)
             gap = (

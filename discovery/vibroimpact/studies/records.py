@@ -76,6 +76,22 @@ def auto_transient(scenario, law):
     return int(min(TRANSIENT_MAX, max(ss.n_periods, 1) * transient_periods(mult)))
 
 
+def after_transient(scenario, law, transient):
+    """``(state, scenario)`` after ``transient`` periods from rest by the scipy path, as
+    :func:`clean_record` integrates a record's transient (in chunks at
+    :data:`RTOL_TRANSIENT`): a machine that sheds mass at each impact goes on from each
+    chunk with the mass it ended with, and the scenario returned has the mass left."""
+    T = scenario.period
+    y0 = scenario.initial_state()
+    for k in range(0, transient, TRANSIENT_CHUNK):
+        k1 = min(transient, k + TRANSIENT_CHUNK)
+        run = reference_simulate(scenario, law, (k * T, k1 * T), y0=y0, rtol=RTOL_TRANSIENT)
+        y0 = run["y_final"]
+        if run["m2_final"] != scenario.m2:
+            scenario = scenario.replace(m2=run["m2_final"])
+    return y0, scenario
+
+
 @lru_cache(maxsize=32)
 def clean_record(scenario, law, periods, fs, transient, *, record_transient=False):
     """Noise-free scipy-path record ``(t, y (4, n), F, events, m2)`` (read-only arrays; ``m2``
@@ -93,12 +109,7 @@ def clean_record(scenario, law, periods, fs, transient, *, record_transient=Fals
         t = np.arange(n) / fs
         out = reference_simulate(scenario, law, (0.0, t_end), y0=y0, t_eval=t, rtol=RTOL_RECORD)
     else:
-        for k in range(0, transient, TRANSIENT_CHUNK):
-            k1 = min(transient, k + TRANSIENT_CHUNK)
-            run = reference_simulate(scenario, law, (k * T, k1 * T), y0=y0, rtol=RTOL_TRANSIENT)
-            y0 = run["y_final"]
-            if run["m2_final"] != scenario.m2:
-                scenario = scenario.replace(m2=run["m2_final"])
+        y0, scenario = after_transient(scenario, law, transient)
         n = int(round(periods * T * fs))
         t = t_rec + np.arange(n) / fs
         out = reference_simulate(scenario, law, (t_rec, t_end), y0=y0, t_eval=t, rtol=RTOL_RECORD)

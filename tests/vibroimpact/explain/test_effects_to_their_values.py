@@ -68,7 +68,7 @@ def shedding_draw():
     0.53 % of the moulding per impact."""
     sc = _machine(m1=3110.0, m2=2220.0, k1=2.05e7, c1=2.09e4, A=7.75e4, frequency=27.3)
     law = ForceLaw.parse("1.19e8*z + 9.82e5*zd")
-    true = _shedding_start(sc.replace(mass_loss=0.0053).with_law(law), law, 40)
+    true = _shedding_start(sc.replace(mass_loss=0.0053).with_law(law), law, 40)[0]
     rec = R.reference_record((true, law), periods=15, transient=40, seed=3008, check=False, **LOW)
     return sc.with_law(law), rec
 
