@@ -394,10 +394,13 @@ def _outcome(res, truth, seconds):
     values = dict(zip(final.names, final.coefficients, strict=True))
     if "loss" in truth:
         values["loss"] = float(final.scenario.get("mass_loss", 0.0))
+    read = sorted((res.settings or {}).get("read") or {})
     return {
         "seconds": seconds,
         # the linear start already consistent: the effect does not show in this record
-        "start_consistent": bool(res.consistent and not res.iterations),
+        # (stiffening supports the frame's equation read before the loop show there)
+        "start_consistent": bool(res.consistent and not res.iterations and not read),
+        "read": read,
         "named": [it.effect for it in res.iterations if it.effect],
         "kept": list(final.effects),
         "consistent": bool(res.consistent),

@@ -359,19 +359,15 @@ def stiffening_share(rows, k1, k3):
     return float(abs(k3) * np.linalg.norm(frame[:, 3]) / linear) if linear > 0 else math.inf
 
 
-def supports_reading(scenarios, measurements, n_boot=200, seed=0):
-    """The supports' cubic stiffness the frame's own equation reads from records of one
-    machine, the rest of it (``m1, c1, k1, m2`` and each record's ``A``) held as
-    ``scenarios`` give it: ``(k3, low, high)`` [N/m^3], the value and its 95 % interval over
-    ``n_boot`` resamples of the records' cycles, as :func:`calibrate` reads it.  The force's
-    regression cannot see the supports, and the contact force's refits trade them against
-    the contact law, so :func:`~discovery.vibroimpact.explain.explain` takes them into a
-    machine given without them from here.  None where a record has no positions, the
-    records are of different machines, or the reading is not pinned (:func:`_determined`)
-    or does not move the supports' force by :data:`MATERIAL` (as the calibration keeps a
-    stiffening: on records of linear supports the equations read a ``k3`` whose share is
-    1e-6 to 1e-4, on stiffening ones 0.03 to 1.8; on the effect survey's 160 records every
-    stiffening was read within 0.6 % of its truth and no linear support read as one)."""
+def supports_reading(scenarios, measurements):
+    """The supports' cubic stiffness ``k3`` [N/m^3] the frame's own equation reads from
+    records of one machine, the rest of it (``m1, c1, k1, m2`` and each record's ``A``)
+    held as ``scenarios`` give it: a start for a refit that adds stiffening supports to a
+    machine given without them (the force's regression cannot see the supports).  None
+    where a record has no positions, the records are of different machines, or the reading
+    is not a positive number that moves the supports' force by :data:`MATERIAL` (as the
+    calibration keeps a stiffening: on records of linear supports the equations read a
+    ``k3`` whose share is 1e-6 to 1e-4, on stiffening ones 0.03 to 1.3)."""
     if len({_machine_key(s) for s in scenarios}) != 1:
         return None
     rows = [machine_rows(m, s) for s, m in zip(scenarios, measurements, strict=True)]
@@ -381,17 +377,10 @@ def supports_reading(scenarios, measurements, n_boot=200, seed=0):
     held = {n: getattr(sheet, n) for n in ("m1", "c1", "k1", "m2")}
     amps = parameter_names(len(rows))[4:-1]  # each record's drive amplitude
     held.update({a: s.A for a, s in zip(amps, scenarios, strict=True)})
-    est = estimate(rows, held, cycle_draws(rows, n_boot, seed))
-    k = est.names.index("k3")
-    k3 = float(est.value[k])
-    if not (
-        np.isfinite(k3)
-        and k3 > 0
-        and _determined(est, k)
-        and stiffening_share(rows, sheet.k1, k3) >= MATERIAL
-    ):
+    k3 = estimate(rows, held, []).get("k3")
+    if not (np.isfinite(k3) and k3 > 0 and stiffening_share(rows, sheet.k1, k3) >= MATERIAL):
         return None
-    return k3, float(est.low[k]), float(est.high[k])
+    return k3
 
 
 def _first_estimate(rows, held, draws, probe_k3):

@@ -221,7 +221,6 @@ class _Refits(OnRecords):
         families = [f for f in families if f]
         own = families[1:] if lo < 0 else []
         read = regress.supports() if eff.key == "k3" and regress is not None else None
-        read = None if read is None else read[0]
         if read is not None and lo <= read <= hi:
             family = [_extend(m, eff, read) for m in (model, reg) if m is not None]
             base = family[-1]

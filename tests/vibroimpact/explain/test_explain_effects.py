@@ -100,18 +100,19 @@ def test_hidden_permanent_set_is_named(paper):
 
 def test_hidden_support_nonlinearity_is_named_in_a_subharmonic_regime(paper):
     """Stiffening grid supports (k3 = 5e10 N/m^3) turn the paper's machine with a lighter
-    damper into a P4 orbit with three impacts.  The linear start compensates with a spring
-    2.4x too soft and has no local score for k3 (a small step of it changes the regime);
-    its refit starts from the certified regression with k3 from a ladder.  Measured: named,
-    k3 = 4.99e10, law 2.067e8*z + 3.98e6*zd, I2 0.933 -> 0.033 (floor 0.034).  (It failed
-    from the base commit db3b64e, k3 named but its refit stopped at I2 0.10, floor 0.04,
-    until the record's block states were fitted with the model's own supports and all the
-    parameters refitted together after the loop.)"""
+    damper into a P4 orbit with three impacts.  The linear start compensated with a spring
+    2.4x too soft and had no local score for k3 (a small step of it changes the regime);
+    the supports' refit started from the certified regression with k3 from a ladder
+    (measured: named, k3 = 4.99e10, I2 0.933 -> 0.033, floor 0.034).  Now the machine's own
+    equations read k3 before the loop, and the start is fitted with it."""
     rec, res = support_case(paper)
-    it = res.iterations[0]
-    assert _named(res)[0] == "support_nonlinearity", [it.evidence for it in res.iterations]
-    assert _shrinks(it)
+    # read by the machine's own equations before the loop, and held there
+    assert res.final_model.effects[0] == "support_nonlinearity", str(res)
+    assert res.final_model.held == ("support_nonlinearity",)
+    read = res.settings["read"]["support_nonlinearity"]
+    assert read["low"] <= read["k3"] == res.final_model.scenario["k3"] <= read["high"]
     assert 3e10 < res.final_model.scenario["k3"] < 8e10
+    assert res.consistent, res.stopped_because
     from discovery.vibroimpact.verify import Reference, evaluate
 
     ev = evaluate(
