@@ -350,6 +350,16 @@ def _nonuniform_message(where, jit, med, lo, hi):
     )
 
 
+def _recurring(starts, period):
+    """Whether runs starting at ``starts`` [s] recur with the drive: at least three, each
+    a whole number of periods (one or more) after the one before, within a tenth of one."""
+    if starts.size < 3:
+        return False
+    gaps = np.diff(starts) / period
+    whole = np.round(gaps)
+    return bool(np.all(whole >= 1) and np.all(np.abs(gaps - whole) <= 0.1))
+
+
 def no_contact_message(t, F, period, source="", threshold=None):
     """Why a record yields no complete contact: no sample above the threshold, samples
     above it only in runs cut off at the record's start or end, or only noise spikes."""
@@ -385,11 +395,21 @@ def no_contact_message(t, F, period, source="", threshold=None):
             "record; record a few drive periods more (whole contacts)"
         )
     if not long_runs:
+        longest = max(b - a for a, b in runs)
+        if _recurring(t[[a for a, _ in runs]], period):
+            rate = (1.0 / float(np.median(np.diff(t)))) * min_len / longest
+            return (
+                f"no contact found in the force record{where}: {len(runs)} runs above the "
+                f"threshold {thr:.3g} N recur with the drive period, but the longest lasts "
+                f"{longest} sample(s) and a contact needs {min_len} (1 % of a drive "
+                "period): the contacts are too short for this sampling rate; record at "
+                f"{rate:.3g} Hz or more"
+            )
         return (
             f"no contact found in the force record{where}: {n_above} samples exceed the "
             f"threshold {thr:.3g} N but no run lasts {min_len} samples (1 % of a drive "
-            "period): they look like noise spikes; check the F column, its units and the "
-            "sampling rate"
+            "period) and they do not recur with the drive period: they look like noise "
+            "spikes; check the F column, its units and the sampling rate"
         )
     return (
         f"no contact found in the force record{where}: the runs above the threshold "
