@@ -879,8 +879,8 @@ def test_the_machine_reads_the_supports_it_is_given_without(stiff_supports, shed
     from the record to 0.2 % with a narrow interval (this draw's is one of the misses, 0.2
     standard errors short: a bias that grows with the noise); a machine given with supports
     of its own, a force-only record, a catalogue without the effect and linear supports
-    read nothing, and neither does survey draw 8's moulding that sheds 0.53 % of its mass
-    at every impact."""
+    read nothing, and neither do a sheet whose linear supports are 8 % too soft nor survey
+    draw 8's moulding that sheds 0.53 % of its mass at every impact."""
     from dataclasses import replace
 
     from discovery.catalogue import select
@@ -896,6 +896,9 @@ def test_the_machine_reads_the_supports_it_is_given_without(stiff_supports, shed
     assert supports_read(sc, replace(rec, channels={}), EFFECTS) is None
     linear = R.reference_record((sc, law), periods=15, transient=30, seed=3003, check=False, **LOW)
     assert supports_read(sc, linear, EFFECTS) is None
+    # linear supports 8 % stiffer than the sheet's (corpus c15): the sheet's k1 is off, no
+    # stiffening
+    assert supports_read(sc.replace(k1=sc.k1 / 1.08), linear, EFFECTS) is None
     assert supports_read(*shedding_draw, EFFECTS) is None
 
 
