@@ -72,11 +72,8 @@ from .starts import (
     _output_error,
     _records_of,
     _regressed,
-    read_entry,
     start_law,
     supports_read,
-    with_read,
-    with_supports,
 )
 from .state import _Run
 from .trials import _judged, _law_refit, _polish_winner, _refit_trials
@@ -579,11 +576,11 @@ def explain(
     t0 = time.perf_counter()
     budget = s.max_simulations
     catalogue = select(EFFECTS, s.effects)
-    # the machine as its frame's own equation shows it: stiffening supports read there are
-    # in every simulation from the start on, and held where they are read
+    # the machine as its own equations show it: stiffening supports read there are in
+    # every simulation from the start on, and held where they are read
     read = supports_read(scenario, measurement, catalogue, s.seed)
     if read is not None:
-        scenario, measurement = with_supports(scenario, measurement, read[0])
+        scenario, measurement = read.machine(scenario, measurement)
     pairs, records = _records_of(scenario, measurement, s.n_boot, s.seed)
     ms = [m for _, m in pairs]
     problem = _Problem(records, s.tolerances)
@@ -614,7 +611,7 @@ def explain(
             run.drift = _Drift(pairs, records)
         run.model, run.uncertainties = Model(fit.law), dict(fit.standard_errors)
         if read is not None:
-            run.model = replace(run.model.with_effect(effect(SUPPORTS), read[0]), held=(SUPPORTS,))
+            run.model = replace(run.model.with_effect(effect(SUPPORTS), read.k3), held=(SUPPORTS,))
         if s.known:
             _start_with_known(run, s.known)
         for _ in range(s.max_iterations + 1):
@@ -629,8 +626,9 @@ def explain(
         crit, floor = _with_drift(
             _mean(evs, "criteria"), _mean(evs, "noise_floor"), run.drift, run.model
         )
+        intervals = _intervals(run, s, progress)
         return ExplainResult(
-            intervals=with_read(_intervals(run, s, progress), read),
+            intervals=intervals if read is None else read.beside(intervals),
             iterations=tuple(run.iterations),
             final_model=run.model,
             uncertainties=run.uncertainties,
@@ -656,7 +654,7 @@ def explain(
                 "intervals": {"replicates": s.n_boot_intervals, "refit": s.interval_refit},
                 "records": len(records),
                 "known": dict(s.known or {}),
-                "read": {} if read is None else {SUPPORTS: read_entry(read)},
+                "read": {} if read is None else {SUPPORTS: read.entry()},
                 "start_note": start_note,
                 "simulations": problem.n_sim,
             },

@@ -41,8 +41,35 @@ def _records_of(scenario, measurement, n_boot, seed):
 SUPPORTS = "support_nonlinearity"
 
 
+@dataclass(frozen=True)
+class SupportsReading:
+    """Stiffening supports the machine's own equations read (:func:`supports_read`): ``k3``
+    [N/m^3] and its 95 % interval."""
+
+    k3: float
+    low: float
+    high: float
+
+    def machine(self, scenario, measurement):
+        """The records' scenarios (one per record, in order) with these supports, and their
+        measurements."""
+        pairs = pair_records(scenario, measurement)
+        return [sc.replace(k3=self.k3) for sc, _ in pairs], [m for _, m in pairs]
+
+    def entry(self):
+        """The reading as the result's settings keep it."""
+        return {"k3": self.k3, "low": self.low, "high": self.high}
+
+    def beside(self, intervals):
+        """``intervals`` with the supports' read interval beside the bootstrap's (None stays
+        None)."""
+        if intervals is None:
+            return None
+        return replace(intervals, bounds={**intervals.bounds, "k3": (self.low, self.high)})
+
+
 def supports_read(scenario, measurement, catalogue, seed=0):
-    """``(k3, low, high)``: the stiffening supports the machine's own equations read from the
+    """A :class:`SupportsReading`: the stiffening supports the machine's own equations read from the
     records, the rest of the machine held as given (:func:`~discovery.calibrate` with every
     other parameter kept: it reads ``k3`` where it is pinned and moves the supports' force
     by 1 %, with its 95 % interval over resamples of the records' cycles, and weighs a
@@ -78,27 +105,7 @@ def supports_read(scenario, measurement, catalogue, seed=0):
     except (InputError, np.linalg.LinAlgError):
         return None  # a record the machine's equations cannot read: the loop's refits decide
     k3 = cal.parameters.get("k3")
-    return None if not k3 else (k3["record"], k3["low"], k3["high"])
-
-
-def with_supports(scenario, measurement, k3):
-    """The records' scenarios (one per record, in order) with stiffening supports ``k3``,
-    and their measurements."""
-    pairs = pair_records(scenario, measurement)
-    return [sc.replace(k3=k3) for sc, _ in pairs], [m for _, m in pairs]
-
-
-def read_entry(read):
-    """A reading ``(k3, low, high)`` as the result's settings keep it."""
-    return {"k3": read[0], "low": read[1], "high": read[2]}
-
-
-def with_read(intervals, read):
-    """``intervals`` with the supports' read interval beside the bootstrap's (None stays
-    None)."""
-    if intervals is None or read is None:
-        return intervals
-    return replace(intervals, bounds={**intervals.bounds, "k3": (read[1], read[2])})
+    return None if not k3 else SupportsReading(k3["record"], k3["low"], k3["high"])
 
 
 def _output_error(records, start, criterion, budget, tol, *, polish=False):

@@ -888,7 +888,8 @@ def test_the_machine_reads_the_supports_it_is_given_without(stiff_supports, shed
     from discovery.vibroimpact.explain.starts import supports_read
 
     sc, true, law, rec = stiff_supports
-    k3, lo, hi = supports_read(sc, rec, EFFECTS)
+    read = supports_read(sc, rec, EFFECTS)
+    k3, lo, hi = read.k3, read.low, read.high
     assert k3 == pytest.approx(2.09e15, rel=0.002) and lo < k3 < hi
     assert (hi - lo) < 0.005 * k3
     assert supports_read(true, rec, EFFECTS) is None  # the machine has its supports
