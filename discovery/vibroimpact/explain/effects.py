@@ -68,8 +68,9 @@ class Model:
         Ids of the effects added so far.
     held : tuple of str
         Ids of added effects whose parameter another channel of the record reads, held
-        where it reads it and not refitted with the law (stiffening supports the frame's own
-        equation reads: :func:`~discovery.vibroimpact.calibration.machine.supports_reading`).
+        where it reads it and not refitted with the law (stiffening supports the machine's
+        own equations read before the loop:
+        :func:`~discovery.vibroimpact.explain.starts.supports_read`).
     fit_drift : bool
         Whether :func:`discovery.identify` fits a drift effect's parameter too (records
         compared over their span, where each block starts with the mass left); by default

@@ -519,7 +519,11 @@ def explain(
     Parameters
     ----------
     scenario : Scenario or sequence of Scenario
-        One per record (or one for all).
+        One per record (or one for all).  Given with linear supports, records with
+        positions whose machine's own equations read a stiffening
+        (:func:`~discovery.vibroimpact.explain.starts.supports_read`) are explained with it:
+        the final model holds ``support_nonlinearity`` at the reading, not refitted
+        (``settings["read"]``, its interval beside the bootstrap's).
     measurement : Measurement, Reference, or a sequence of them
     start : str or ForceLaw
         ``"linear"`` (z, zd), a term list (``"z,zd"``) or a law with coefficients; the
