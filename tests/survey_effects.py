@@ -394,6 +394,8 @@ def _outcome(res, truth, seconds):
     values = dict(zip(final.names, final.coefficients, strict=True))
     if "loss" in truth:
         values["loss"] = float(final.scenario.get("mass_loss", 0.0))
+    if "k3" in truth and "k3" not in values and "k3" in final.scenario:
+        values["k3"] = float(final.scenario["k3"])  # held where the machine's equations read it
     read = sorted((res.settings or {}).get("read") or {})
     return {
         "seconds": seconds,
