@@ -37,9 +37,9 @@ def read_text(eid, read):
     """What the loop read before it began (``read``: ``{"k3", "low", "high"}`` of the
     supports the frame's own equation reads), as one phrase."""
     return (
-        f"{eid} k3 = {read['k3']:.4g} [{read['low']:.4g}, {read['high']:.4g}] N/m^3 (the "
-        "frame's own equation, the machine given with linear supports; held there in every "
-        "refit)"
+        f"{eid} k3 = {read['k3']:.5g} [{read['low']:.5g}, {read['high']:.5g}] N/m^3 (the "
+        "machine's own equations, the machine given with linear supports; held there in "
+        "every refit)"
     )
 
 
