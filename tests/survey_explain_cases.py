@@ -201,6 +201,7 @@ def run_case(name, paper=None):
     row.update(
         regime=ref.regime,
         impacts=ref.impacts,
+        read=sorted((res.settings or {}).get("read") or {}),
         named=[it.effect for it in res.iterations if it.effect],
         kept=list(res.final_model.effects),
         dropped=[d["effect"] for d in res.dropped],
@@ -244,12 +245,15 @@ def _regime(r):
 
 
 def _named(r):
+    """The effects read before the loop (the supports the machine's own equations read),
+    then those named, in order."""
     gone = r.get("dropped") or ()
+    read = [f"`{e}` (read before the loop)" for e in r.get("read") or ()]
     names = [f"`{e}`" + (" (taken out)" if e in gone else "") for e in r["named"]]
     if not names:
-        return "nothing"
-    wrong = r["named"][0] not in r["hidden_effects"]
-    return ", ".join(names) + (" (not the hidden effect first)" if wrong else "")
+        return ", ".join(read) or "nothing"
+    wrong = not read and r["named"][0] not in r["hidden_effects"]
+    return ", ".join(read + names) + (" (not the hidden effect first)" if wrong else "")
 
 
 def _recovered(r):
@@ -257,7 +261,7 @@ def _recovered(r):
     the fit gives them); a stiffening support's with the law's coefficients, which it
     trades against."""
     parts = []
-    for eid in r["named"]:
+    for eid in [*(r.get("read") or ()), *r["named"]]:
         if eid not in r["values"]:
             continue
         se = r["errors"].get(eid)
@@ -273,7 +277,8 @@ def _gap(r):
     model's I2 and its floor."""
     if not r["steps"]:
         floor = r["noise_floor"].get("I2")
-        return f"I2 {_num(r['criteria'].get('I2'))} (floor {_num(floor)}), nothing named"
+        what = "read before the loop, nothing named" if r.get("read") else "nothing named"
+        return f"I2 {_num(r['criteria'].get('I2'))} (floor {_num(floor)}), {what}"
     parts = []
     for s in r["steps"]:
         before, after, floor = s["before"], s["after"], s["floor"]
