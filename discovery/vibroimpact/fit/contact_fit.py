@@ -274,6 +274,7 @@ def _intervals(res, records, settings, progress=None):
             workers=settings["workers"],
             progress=progress,
             observe=settings["observe"],
+            domains=_BOUNDED,
         )
         if iv is not None:
             return {k: tuple(v) for k, v in iv.bounds.items()}, "bootstrap"
@@ -283,6 +284,11 @@ def _intervals(res, records, settings, progress=None):
         for k, v in zip(model.names, model.values, strict=True)
         if k in se and np.isfinite(se[k])
     }, "1.96 standard errors (Jacobian)"
+
+
+#: the named models' parameters bounded on both sides: a bootstrap whose first third spans
+#: one of them ends there (the fit is degenerate, :func:`_degenerate`; 1.5 s of a model)
+_BOUNDED = {k: DOMAINS[k][:2] for k in ("n", "e")}
 
 
 def _in_domain(name, bounds):

@@ -256,6 +256,7 @@ class BootstrapIntervalsSettings(Settings):
     noise: str = option("cycles", Choice(*INTERVAL_NOISE))
     machine_scale: object = option(None, (tuple, list, None))
     observe: object = option(None)
+    domains: object = option(None, (dict, None))
 
 
 def force_names(model):
@@ -327,6 +328,13 @@ def bootstrap_intervals(
     observe : callable, optional
         The observation model every simulated force is read through (a known sensor lag:
         :func:`~discovery.vibroimpact.verify.sensors.observation`), beside the model's own.
+    domains : dict, optional
+        ``{name: (low, high)}``: parameters bounded on both sides (an exponent, a
+        restitution).  The refits then run in two passes, a third of the replicates first:
+        where their interval of one of these already covers its whole domain with a
+        domain's width to spare on each side, the record does not tell that parameter, no
+        later replicate can narrow it into its domain, and the intervals are the first
+        pass's (their ``n_boot`` says how many).
 
     Returns
     -------
@@ -377,18 +385,23 @@ def bootstrap_intervals(
             "observe": s.observe,
         },
     )
-    refits = map_on(
-        REFITS[s.refit],
-        range(len(replicates)),
-        context,
-        workers=s.workers,
-        executor=executor,
-        done=None if progress is None else (lambda k, n: progress("bootstrap intervals", k, n)),
-    )
-    draws = [d for d in refits if d is not None]
+    how = _Resampling(cycles=G, noise=noise, few=few, refit=s.refit, level=s.level, seed=s.seed)
+    passes = _Passes(len(replicates), s.domains, progress)
+    draws = []
+    for jobs in passes.jobs():
+        refits = map_on(
+            REFITS[s.refit],
+            jobs,
+            context,
+            workers=s.workers,
+            executor=executor,
+            done=passes.done(jobs),
+        )
+        draws += [d for d in refits if d is not None]
+        if len(draws) >= 5 and passes.spanned(_intervals(np.array(draws), model, how)):
+            break
     if len(draws) < 5:
         return None
-    how = _Resampling(cycles=G, noise=noise, few=few, refit=s.refit, level=s.level, seed=s.seed)
     iv = _intervals(np.array(draws), model, how)
     if s.machine_scale is not None:
         forces = force_names(model)
@@ -419,6 +432,37 @@ def _scale_moves(records, model, scale, forces, settings):
             return {}
         moved.append(theta - est)
     return {model.names[k]: (float(moved[0][k]), float(moved[1][k])) for k in others}
+
+
+@dataclass(frozen=True)
+class _Passes:
+    """The refits' passes over ``n`` replicates: all at once, or (with ``domains``, see
+    :func:`bootstrap_intervals`) a third first and the rest after it unless the first
+    pass's intervals already span a bounded parameter's domain."""
+
+    n: int
+    domains: object
+    progress: object
+
+    def jobs(self):
+        """The passes' replicate indices, in order."""
+        first = max(5, self.n // 3) if self.domains else self.n
+        return [range(first), range(first, self.n)] if first < self.n else [range(self.n)]
+
+    def done(self, jobs):
+        """The progress callback of the pass ``jobs`` (counted among all replicates)."""
+        if self.progress is None:
+            return None
+        return lambda k, _n: self.progress("bootstrap intervals", jobs.start + k, self.n)
+
+    def spanned(self, iv):
+        """Whether intervals ``iv`` cover a bounded parameter's whole domain with its width
+        to spare on each side (never without ``domains``)."""
+        for name, (lo, hi) in (self.domains or {}).items():
+            b = iv.bounds.get(name)
+            if b is not None and b[0] <= lo - (hi - lo) and b[1] >= hi + (hi - lo):
+                return True
+        return False
 
 
 @dataclass(frozen=True)

@@ -71,6 +71,29 @@ def test_bootstrap_intervals_do_not_depend_on_workers(paper, reference, fitted):
     assert lo < fitted.law.as_dict()["z"] < hi
 
 
+def test_a_bootstrap_that_spans_a_bounded_domain_ends_after_its_first_pass(
+    paper, reference, fitted
+):
+    """With ``domains``, a third of the replicates are refitted first: where their interval
+    of a bounded parameter covers its whole domain with a domain's width to spare on each
+    side, no later replicate can bring it inside, and the bootstrap ends there.  Where it
+    does not, the passes give the single pass's intervals to the last bit."""
+    full = bootstrap_intervals(paper, reference, fitted.law, n_boot=15, seed=2)
+    c = fitted.law.as_dict()["zd"]
+    wide = bootstrap_intervals(
+        paper, reference, fitted.law, n_boot=15, seed=2, domains={"zd": (0.0, 10 * c)}
+    )
+    assert wide == full and full.n_boot == 15
+    lo, hi = full.bounds["zd"]
+    narrow = (c - (hi - lo) / 10, c + (hi - lo) / 10)  # a domain a tenth of the interval
+    short = bootstrap_intervals(
+        paper, reference, fitted.law, n_boot=15, seed=2, domains={"zd": narrow}
+    )
+    assert short.n_boot == 5
+    first = bootstrap_intervals(paper, reference, fitted.law, n_boot=5, seed=2)
+    assert short.bounds == first.bounds
+
+
 def test_force_only_identification_continues_its_steady_states(paper, record, monkeypatch):
     """On a record compared with its steady orbit, each trial law's orbit is continued from
     the nearest solved one (Newton from it; the cold search only when that fails): the
