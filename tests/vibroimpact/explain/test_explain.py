@@ -333,6 +333,62 @@ def test_localisation_of_a_law_with_no_periodic_orbit(paper, hidden_coupling):
     assert out["plane"] is None and out["grid"] is None
 
 
+def _refit_as_is(run, model, budget):
+    """A stand-in for ``pruning._law_refit``: the model "refitted" is the model itself."""
+    from types import SimpleNamespace
+
+    evs = run.problem.evaluations(model)
+    return SimpleNamespace(law=model, standard_errors={}), dict(evs[0].criteria), evs
+
+
+def test_an_effect_named_for_the_other_parameters_refit_is_taken_out(monkeypatch):
+    """Survey draw 74's quieter record: a coupling's refit stopped at I2 0.743, and the next
+    iteration's refits of a set, a Hertz term and an offset all reached 0.058-0.059, so a
+    set was named beside the coupling.  Unrefitted, the model without the set is far off
+    (its law had moved with it); refitted without it, the model is consistent at 0.0589,
+    within the floor of the model with it: the set is taken out.  Without the coupling the
+    refit stays inconsistent, and the coupling is kept."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.explain import pruning
+    from discovery.vibroimpact.explain.effects import Model
+
+    sets, coupling = effect("permanent_set"), effect("penetration_velocity_coupling")
+    law = ForceLaw.parse("4.05e9*z + 1.88e7*zd")
+    model = Model(law).with_effect(coupling, 6.73e10).with_effect(sets, 0.0021)
+    monkeypatch.setattr(pruning, "_small_step", lambda eff, records: 1e-9)
+
+    def evaluations(mod, floor=True):
+        i2 = 0.0581 if len(mod.effects) == 2 else 0.3  # unrefitted: far off
+        return [
+            SimpleNamespace(consistent=i2 < 0.127, criteria={"I2": i2}, noise_floor={"I2": 0.0622})
+        ]
+
+    def refit(run, mod, budget):
+        i2 = 0.0589 if "penetration_velocity_coupling" in mod.effects else 0.74
+        evs = [SimpleNamespace(consistent=i2 < 0.127, criteria={"I2": i2}, noise_floor={})]
+        refitted = mod.with_effect(coupling, 6.76e10, add=False) if mod.effects else mod
+        return SimpleNamespace(law=refitted, standard_errors={"zd": 1.0}), {"I2": i2}, evs
+
+    monkeypatch.setattr(pruning, "_law_refit", refit)
+    run = SimpleNamespace(
+        model=model,
+        records=[None],
+        criterion="I2",
+        budget=100,
+        regress=None,
+        problem=SimpleNamespace(evaluations=evaluations),
+        uncertainties={"set": 1e-4},
+    )
+    dropped = pruning.drop_collapsed(run)
+    assert [d["effect"] for d in dropped] == ["permanent_set"]
+    assert "refitted without it" in dropped[0]["reason"]
+    assert "0.0581 -> 0.0589, within its noise floor 0.0622" in dropped[0]["reason"]
+    assert run.model.effects == ("penetration_velocity_coupling",)
+    assert run.model.value(coupling) == 6.76e10  # the refitted model, not the reduced one
+    assert run.uncertainties == {"zd": 1.0}
+
+
 def test_an_effect_a_later_refit_made_negligible_is_taken_out(monkeypatch):
     """``without_effect`` takes each kind of effect out; the pruning step takes out a named
     effect whose parameter is below a tenth of its small step when the model without it is
@@ -371,10 +427,13 @@ def test_an_effect_a_later_refit_made_negligible_is_taken_out(monkeypatch):
             model=model,
             records=[None],
             criterion="I2",
+            budget=100,
+            regress=None,
             problem=SimpleNamespace(evaluations=evaluations),
             uncertainties={"tau": 1e-11, "z": 1.0},
         )
 
+    monkeypatch.setattr(pruning, "_law_refit", _refit_as_is)
     run = run_with(True)
     dropped = pruning.drop_collapsed(run)
     assert [d["effect"] for d in dropped] == ["sensor_lag"]
@@ -412,9 +471,12 @@ def test_an_effect_that_explains_less_than_the_floor_is_taken_out(monkeypatch):
         model=model,
         records=[None],
         criterion="I2",
+        budget=100,
+        regress=None,
         problem=SimpleNamespace(evaluations=evaluations),
         uncertainties={"delta0": 1e-8, "k3": 1e13},
     )
+    monkeypatch.setattr(pruning, "_law_refit", _refit_as_is)
     dropped = pruning.drop_collapsed(run)
     assert [d["effect"] for d in dropped] == ["contact_offset"]
     assert "0.0087 -> 0.0094, within its noise floor 0.0075" in dropped[0]["reason"]
