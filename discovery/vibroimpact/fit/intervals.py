@@ -387,7 +387,7 @@ def bootstrap_intervals(
     )
     how = _Resampling(cycles=G, noise=noise, few=few, refit=s.refit, level=s.level, seed=s.seed)
     passes = _Passes(len(replicates), s.domains, progress)
-    draws = []
+    draws, iv = [], None
     for jobs in passes.jobs():
         refits = map_on(
             REFITS[s.refit],
@@ -398,11 +398,11 @@ def bootstrap_intervals(
             done=passes.done(jobs),
         )
         draws += [d for d in refits if d is not None]
-        if len(draws) >= 5 and passes.spanned(_intervals(np.array(draws), model, how)):
+        iv = _intervals(np.array(draws), model, how) if len(draws) >= 5 else None
+        if iv is not None and passes.spanned(iv):
             break
-    if len(draws) < 5:
+    if iv is None:
         return None
-    iv = _intervals(np.array(draws), model, how)
     if s.machine_scale is not None:
         forces = force_names(model)
         moves = _scale_moves(records, model, s.machine_scale, forces, context[3])

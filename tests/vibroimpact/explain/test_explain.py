@@ -333,6 +333,22 @@ def test_localisation_of_a_law_with_no_periodic_orbit(paper, hidden_coupling):
     assert out["plane"] is None and out["grid"] is None
 
 
+def _pruning_run(model, evaluations, uncertainties):
+    """A stand-in for explain's run as pruning reads it: one record, I2, the model's
+    evaluations by ``evaluations``."""
+    from types import SimpleNamespace
+
+    return SimpleNamespace(
+        model=model,
+        records=[None],
+        criterion="I2",
+        budget=100,
+        regress=None,
+        problem=SimpleNamespace(evaluations=evaluations),
+        uncertainties=uncertainties,
+    )
+
+
 def _refit_as_is(run, model, budget):
     """A stand-in for ``pruning._law_refit``: the model "refitted" is the model itself."""
     from types import SimpleNamespace
@@ -371,15 +387,7 @@ def test_an_effect_named_for_the_other_parameters_refit_is_taken_out(monkeypatch
         return SimpleNamespace(law=refitted, standard_errors={"zd": 1.0}), {"I2": i2}, evs
 
     monkeypatch.setattr(pruning, "_law_refit", refit)
-    run = SimpleNamespace(
-        model=model,
-        records=[None],
-        criterion="I2",
-        budget=100,
-        regress=None,
-        problem=SimpleNamespace(evaluations=evaluations),
-        uncertainties={"set": 1e-4},
-    )
+    run = _pruning_run(model, evaluations, {"set": 1e-4})
     dropped = pruning.drop_collapsed(run)
     assert [d["effect"] for d in dropped] == ["permanent_set"]
     assert "refitted without it" in dropped[0]["reason"]
@@ -423,15 +431,7 @@ def test_an_effect_a_later_refit_made_negligible_is_taken_out(monkeypatch):
             i2 = 0.02 if "penetration_velocity_coupling" in mod.effects else 0.5
             return [SimpleNamespace(consistent=ok, criteria={"I2": i2}, noise_floor={"I2": 0.01})]
 
-        return SimpleNamespace(
-            model=model,
-            records=[None],
-            criterion="I2",
-            budget=100,
-            regress=None,
-            problem=SimpleNamespace(evaluations=evaluations),
-            uncertainties={"tau": 1e-11, "z": 1.0},
-        )
+        return _pruning_run(model, evaluations, {"tau": 1e-11, "z": 1.0})
 
     monkeypatch.setattr(pruning, "_law_refit", _refit_as_is)
     run = run_with(True)
@@ -467,15 +467,7 @@ def test_an_effect_that_explains_less_than_the_floor_is_taken_out(monkeypatch):
             SimpleNamespace(consistent=i2 < 0.02, criteria={"I2": i2}, noise_floor={"I2": 0.0075})
         ]
 
-    run = SimpleNamespace(
-        model=model,
-        records=[None],
-        criterion="I2",
-        budget=100,
-        regress=None,
-        problem=SimpleNamespace(evaluations=evaluations),
-        uncertainties={"delta0": 1e-8, "k3": 1e13},
-    )
+    run = _pruning_run(model, evaluations, {"delta0": 1e-8, "k3": 1e13})
     monkeypatch.setattr(pruning, "_law_refit", _refit_as_is)
     dropped = pruning.drop_collapsed(run)
     assert [d["effect"] for d in dropped] == ["contact_offset"]
