@@ -476,6 +476,60 @@ def test_an_effect_that_explains_less_than_the_floor_is_taken_out(monkeypatch):
     assert run.uncertainties == {"k3": 1e13}
 
 
+def test_an_effect_is_taken_out_by_continuation_where_its_drop_lands_in_another_basin(
+    monkeypatch,
+):
+    """Survey draw 75's quieter record: a Hertz law under a 20 um contact, a 3.2 um offset
+    named beside the Hertz term (I2 0.0379, floor 0.108).  Refitted with the offset simply
+    dropped, the law stops at I2 0.178, not consistent; refitted with the offset held at half
+    its value and then without it, each from the last, it reaches 0.0881, consistent: the
+    offset is taken out.  A term of the law (the Hertz term) is not held halfway."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.explain import pruning
+    from discovery.vibroimpact.explain.effects import Model
+
+    offset, hertz = effect("contact_offset"), effect("hertzian_stiffening")
+    law = ForceLaw.parse("2.82e10*z + 2.26e7*zd")
+    model = Model(law).with_effect(hertz, 1.80e12).with_effect(offset, 3.22e-6)
+    monkeypatch.setattr(pruning, "_small_step", lambda eff, records: 1e-12)
+    basin = 1.7537e12  # the Hertz coefficient the continuation carries the law to
+
+    def evaluations(mod, floor=True):
+        i2 = 0.0379 if len(mod.effects) == 2 else 0.5
+        return [
+            SimpleNamespace(consistent=i2 < 0.245, criteria={"I2": i2}, noise_floor={"I2": 0.108})
+        ]
+
+    starts = []
+
+    def refit(run, mod, budget):
+        starts.append(mod)
+        if "hertzian_stiffening" not in mod.effects:
+            i2, out = 0.5, mod  # the record needs the Hertz term
+        elif "contact_offset" in mod.held:  # halfway: the law moves toward the other basin
+            i2, out = 0.067, mod.with_effect(hertz, basin, add=False)
+        else:
+            i2, out = (0.0881 if mod.value(hertz) == basin else 0.178), mod
+        evs = [SimpleNamespace(consistent=i2 < 0.12, criteria={"I2": i2}, noise_floor={})]
+        return SimpleNamespace(law=out, standard_errors={"z^1.5": 1.0}), {"I2": i2}, evs
+
+    monkeypatch.setattr(pruning, "_law_refit", refit)
+    run = _pruning_run(model, evaluations, {"delta0": 1e-6})
+    dropped = pruning.drop_collapsed(run)
+    assert [d["effect"] for d in dropped] == ["contact_offset"]
+    assert "0.0379 -> 0.0881, within its noise floor 0.108" in dropped[0]["reason"]
+    assert run.model.effects == ("hertzian_stiffening",)
+    assert run.model.value(hertz) == basin
+    halfway = [m for m in starts if "contact_offset" in m.held]
+    assert len(halfway) == 1 and halfway[0].value(offset) == pytest.approx(1.61e-6)
+    assert not any("hertzian_stiffening" in m.held for m in starts)  # a term: not held
+    # without the continuation's start the offset stays (the drop alone stops at 0.178)
+    monkeypatch.setattr(pruning, "_halfway", lambda run, eff: None)
+    run = _pruning_run(model, evaluations, {"delta0": 1e-6})
+    assert pruning.drop_collapsed(run) == [] and "contact_offset" in run.model.effects
+
+
 def test_a_refit_judged_by_the_motion_that_breaks_the_force_names_nothing():
     """With the gap measured on the penetration (I5; the force within its limit), a refit
     that takes the force's I2 further away and beyond its limit is a fit of the motion by
