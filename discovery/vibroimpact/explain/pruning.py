@@ -12,7 +12,8 @@ its basin every effect's refit reaches the record (survey draw 74's quieter reco
 coupling's first refit stopped at I2 0.743; the next iteration's refits of a set, a Hertz
 term and an offset all reached 0.058-0.059, and the set was named).  So each effect is also
 judged as it was named, the other way round: the model without it, refitted from the final
-model, is as consistent with every record and within the noise floor of the model with it.
+model (and by continuation, :func:`_halfway`), is as consistent with every record and
+within the noise floor of the model with it.
 Of several such effects the one whose removal costs least goes first, and the rest are
 judged again without it.  A model's only effect is not judged so: it was named over the law
 refitted alone in its own iteration (the baseline every effect must beat).
