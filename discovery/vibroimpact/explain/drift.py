@@ -7,7 +7,7 @@ regime) and each window's contact impulse ``J_w = integral of F dt`` is compared
 model's.  Between window bounds in the middle of a free flight the moulding's momentum
 balance is exact whatever the law: ``J_w = m2(w) (g W + dv_w)``, with the mass after the
 impacts so far, ``m2(w) = m2 (1 - loss)^(impacts before w)``, and ``dv_w`` the moulding's
-change of speed over the window, read from its free flights at the two bounds
+change of speed over the window, read in the free flight that holds each bound
 (:func:`flight_speed`; zero on a periodic orbit, not in a slow transient, where it was
 seen to trend by 1 % of the impulse over four windows).  The impulse weighs the moulding
 window by window, and it does not depend on where the samples fall on a force jump (a
@@ -95,7 +95,7 @@ class DriftRecord:
 
         def speed(k):
             if k not in speeds:
-                speeds[k] = flight_speed(measurement, phase + k * W, 0.4 * flight, g, free)
+                speeds[k] = flight_speed(measurement, phase + k * W, 0.4 * flight, g, ~contact)
             return speeds[k]
 
         J, before, dv = [], [], []
@@ -168,14 +168,18 @@ def edge_jumps(F, threshold):
 
 def flight_speed(measurement, at, half, g, free=None):
     """The moulding's speed at time ``at`` inside a free flight: its motion within ``half``
-    seconds of it (at the samples ``free`` of contact force, all by default), where it
-    falls freely (``dv2/dt = -g``), fitted to the recorded speed ``v2`` (or, without it, to
-    the position ``w2`` with its fall's curvature); 0 without either channel or samples."""
+    seconds of it in the flight around it (the run of samples ``free`` of contact that
+    holds ``at``, all by default), where it falls freely (``dv2/dt = -g``), fitted to the
+    recorded speed ``v2`` (or, without it, to the position ``w2`` with its fall's
+    curvature); 0 without either channel or samples.  The samples past a contact within
+    ``half`` belong to another flight: survey draw 55's noisier record (a P4 transient) had
+    a contact 2 ms after a window bound, and a reading across it put the window's impulse
+    2 % off its momentum balance (the true model called drifting, D 3.5 times its floor)."""
     ch = getattr(measurement, "channels", {}) or {}
     t = measurement.t
     m = (t >= at - half) & (t <= at + half)
     if free is not None:
-        m &= free
+        m &= _run_around(np.asarray(free, dtype=bool), int(np.searchsorted(t, at)))
     if m.sum() < 3:
         return 0.0
     s = t[m] - at
@@ -185,6 +189,22 @@ def flight_speed(measurement, at, half, g, free=None):
         slope = np.polyfit(s, ch["w2"][m] + 0.5 * g * s**2, 1)[0]
         return float(slope)
     return 0.0
+
+
+def _run_around(flags, i):
+    """The run of ``flags`` that holds sample ``i`` (or the one before it), as a mask; none
+    where neither is flagged."""
+    out = np.zeros(flags.size, dtype=bool)
+    i = min(i, flags.size - 1)
+    if not flags[i]:
+        i -= 1
+    if i < 0 or not flags[i]:
+        return out
+    off = np.flatnonzero(~flags)
+    a = off[off < i]
+    b = off[off > i]
+    out[(a[-1] + 1 if a.size else 0) : (b[0] if b.size else flags.size)] = True
+    return out
 
 
 def predicted(scenario, rec, loss):
