@@ -17,7 +17,14 @@ from .optimise import _checked, _fitted
 from .problem import _Objective
 from .records import as_records, model_parts
 
-__all__ = ["Intervals", "bootstrap_intervals", "INTERVAL_REFITS", "INTERVAL_NOISE"]
+__all__ = [
+    "Intervals",
+    "bootstrap_intervals",
+    "cycle_spread",
+    "cycle_widening",
+    "INTERVAL_REFITS",
+    "INTERVAL_NOISE",
+]
 
 # how a bootstrap replicate of the intervals is refitted (see bootstrap_intervals)
 INTERVAL_REFITS = ("two-step", "full")
@@ -478,6 +485,25 @@ class _Resampling:
     seed: int
 
 
+def cycle_spread(G, p, level=0.95):
+    """``(scale, quantile)`` of a bootstrap over ``G`` resampled cycles fitting ``p``
+    parameters (the comment above): its spread scaled by ``sqrt(G / (G - p))`` and the
+    ``level`` interval's quantile of Student's t with ``G - p`` degrees of freedom."""
+    dof = G - p
+    return float(np.sqrt(G / dof)), t_quantile(dof, 0.5 + level / 2)
+
+
+def cycle_widening(G, p, level=0.95):
+    """The factor that turns a percentile interval of a bootstrap over ``G`` resampled
+    cycles fitting ``p`` parameters into one with :func:`cycle_spread`'s rule: each side's
+    distance from the estimate times ``scale * quantile / z``, ``z`` the normal's quantile
+    (the percentile interval's, for a normal spread); 1 where ``G <= p``."""
+    if G <= p:
+        return 1.0
+    scale, q = cycle_spread(G, p, level)
+    return scale * q / normal_quantile(0.5 + level / 2)
+
+
 def _intervals(D, model, how):
     """The :class:`Intervals` of the refitted coefficients ``D`` (replicates x parameters)
     around ``model``'s: normal quantiles on the spread for white noise; for the cycles, the
@@ -490,8 +516,8 @@ def _intervals(D, model, how):
     z = normal_quantile(0.5 + how.level / 2)
     if how.noise == "cycles":
         dof = G - len(names)
-        sd = sd * np.sqrt(G / dof)
-        z = t_quantile(dof, 0.5 + how.level / 2)
+        scale, z = cycle_spread(G, len(names), how.level)
+        sd = sd * scale
     method = (
         f"wild bootstrap by cycles (the record's residuals, one weight per cycle; Student t "
         f"with {dof} degrees of freedom)"

@@ -930,8 +930,10 @@ def test_a_mass_loss_is_refitted_with_the_moulding_mass_the_calibration_read():
 
 def test_the_machine_reads_the_supports_it_is_given_without(stiff_supports, shedding_draw):
     """Survey draw 3: the calibration, the rest of the machine held as given, reads ``k3``
-    from the record to 0.2 % with a narrow interval (this draw's is one of the misses, 0.2
-    standard errors short: a bias that grows with the noise); a machine given with supports
+    from the record to 0.2 % with a narrow interval (the calibration's percentile interval
+    missed the truth by 1.04 of its half width; widened by the rule of the bootstrap
+    intervals it stands beside, 1.13 for one parameter on 15 cycles, it holds it); a
+    machine given with supports
     of its own, a force-only record, a catalogue without the effect and linear supports
     read nothing, and neither do a sheet whose linear supports are 8 % too soft nor survey
     draw 8's moulding that sheds 0.53 % of its mass at every impact."""
@@ -945,7 +947,7 @@ def test_the_machine_reads_the_supports_it_is_given_without(stiff_supports, shed
     read = supports_read(sc, rec, EFFECTS)
     k3, lo, hi = read.k3, read.low, read.high
     assert k3 == pytest.approx(2.09e15, rel=0.002) and lo < k3 < hi
-    assert (hi - lo) < 0.005 * k3
+    assert (hi - lo) < 0.005 * k3 and lo <= 2.09e15 <= hi
     assert supports_read(true, rec, EFFECTS) is None  # the machine has its supports
     assert supports_read(sc, rec, select(EFFECTS, ["unloading_damping"])) is None
     assert supports_read(sc, replace(rec, channels={}), EFFECTS) is None

@@ -467,3 +467,17 @@ def test_a_step_that_is_not_finite_ends_the_fit_at_its_best_point(paper, referen
     assert "the optimiser's step was not finite" in res.message
     assert all(np.isfinite(res.law.coefficients)) and res.verdict
     assert res.law.coefficients != start.coefficients  # its first step was kept
+
+
+def test_a_percentile_interval_over_few_cycles_is_widened_by_the_bootstraps_rule():
+    """``cycle_widening``: ``sqrt(G / (G - p))`` times Student's t quantile with ``G - p``
+    degrees of freedom over the normal's (closed form: 15 cycles, one parameter,
+    ``sqrt(15/14) * 2.1448 / 1.9600``); 1 where the cycles are no more than the parameters;
+    it tends to 1 with many cycles, and :func:`cycle_spread` gives its two parts."""
+    from discovery.vibroimpact.fit.intervals import cycle_spread, cycle_widening
+
+    assert cycle_widening(15, 1) == pytest.approx(np.sqrt(15 / 14) * 2.144787 / 1.959964, rel=1e-5)
+    assert cycle_widening(3, 3) == 1.0 and cycle_widening(2, 5) == 1.0
+    assert 1.0 < cycle_widening(10000, 1) < 1.001
+    scale, q = cycle_spread(12, 3)
+    assert scale == pytest.approx(np.sqrt(12 / 9)) and q == pytest.approx(2.262157, rel=1e-5)
