@@ -40,6 +40,22 @@ def _within_noise(evs, criterion):
     return all(e.same_regime and e.noise_floor and e.within(criterion) for e in evs)
 
 
+#: the contact-time criterion (the symmetric difference of the contact supports): where the
+#: force and the penetration are within their limits and it alone fails, it is the gap, and
+#: an effect is named only where its refit makes the model consistent (:func:`supports_gap`)
+SUPPORTS_CRITERION = "I4"
+
+
+def supports_gap(evs, criterion):
+    """Whether ``criterion`` and the penetration are within their limits on every record
+    and the contact time (:data:`SUPPORTS_CRITERION`) alone fails: the contact supports of
+    a noisy record, or an effect that moves the onsets and losses more than the force."""
+    if not (_within_noise(evs, criterion) and _motion_within(evs)):
+        return False
+    failing = _failing(evs)
+    return failing == [SUPPORTS_CRITERION]
+
+
 def _motion_within(evs):
     """The recorded penetration (I5) within its consistency limit on every record that has
     it: a law that trades spring for damping matches the force, not the motion, and is

@@ -58,7 +58,14 @@ from .disagreement import localise
 from .effects import EFFECTS, KnownEffects, Model, effect
 
 # the loop's parts (result, problem, starts, screening, trials, judging, separability)
-from .judging import _failing, _motion_within, _present, _within_noise, physical
+from .judging import (
+    SUPPORTS_CRITERION,
+    _motion_within,
+    _present,
+    _within_noise,
+    physical,
+    supports_gap,
+)
 from .naming import name_effect
 from .problem import _Drift, _mean, _Problem, _with_drift, best_of
 from .pruning import drop_collapsed
@@ -114,20 +121,9 @@ def _stop_not_compared(run, step):
 
 def _stop_nothing_significant(run, step):
     """No effect is significant: the iteration is recorded and the loop stops."""
-    criterion, evs = run.criterion, step.evaluations
+    evs = step.evaluations
     why = f"no catalogue effect is significant (score tests at family-wise level {run.alpha:g})"
     run.stopped = "no catalogue effect explains the remaining disagreement significantly"
-    if step.screening.quiet and not step.cycle_ok:
-        why = (
-            f"{criterion} is within its noise limit and the model fails "
-            f"{', '.join(_failing(evs))} alone, which no effect is fitted to (the "
-            "contact supports of a noisy record); " + why
-        )
-        run.stopped = (
-            f"{criterion} is within its noise limit; the model fails "
-            f"{', '.join(_failing(evs))} alone, which is not explained by an "
-            "effect"
-        )
     run.iterations.append(
         step.iteration(
             model_after=run.model,
@@ -165,9 +161,12 @@ def _only_the_law_refit(run, step, best):
 def _gap(run, evs):
     """The criterion the gap is measured on: the refits' criterion, or the penetration's
     (I5) when the model is within its limit on the force and fails by the motion alone (a
-    spring too soft behind a missing effect matches the force)."""
+    spring too soft behind a missing effect matches the force), or the contact time's (I4)
+    when it alone fails (:func:`~.judging.supports_gap`)."""
     if _within_noise(evs, run.criterion) and not _motion_within(evs):
         return MOTION_CRITERION
+    if supports_gap(evs, run.criterion):
+        return SUPPORTS_CRITERION
     return run.criterion
 
 
@@ -316,6 +315,12 @@ def _refit_and_name(run, step):
             )
         )
         run.stopped = "the candidate effects do not shrink the gap when refitted"
+        if gap == SUPPORTS_CRITERION:
+            run.stopped = (
+                f"{run.criterion} and the penetration are within their limits and the model "
+                f"fails the contact time ({gap}) alone; no effect's refit makes it consistent "
+                "(the contact supports of a noisy record)"
+            )
         return False
     good.sort(key=lambda x: x.ratio)
     best, winner = _best_polished(run, step, good, screen_budget)
@@ -351,7 +356,8 @@ def _iteration(run, max_iterations):
         tolerances=run.tolerances,
     )
     step.screening = _Screening.of(run, step)
-    if not step.screening.ranked:
+    # (failing the contact time alone, the effects the score test passed over are refitted)
+    if not step.screening.ranked and not supports_gap(step.evaluations, run.criterion):
         _stop_nothing_significant(run, step)
         return False
     return _refit_and_name(run, step)

@@ -7,7 +7,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...numerics.distributions import chi2_sf_one
-from .judging import _motion_within, _within_noise
 from .problem import _small_step
 
 
@@ -129,11 +128,11 @@ class _Screening:
     def of(cls, run, step):
         """Score tests of the applicable effects at the current model (``step``); the
         significant ones ranked by their statistic."""
-        model, evs, loc = run.model, step.evaluations, step.loc
-        # a cycle within its noise leaves only the drift to explain: consistent, or failing
-        # I4 alone (the supports of a noisy record) while the criterion the refits lower is
-        # within its limit (lowering it further would fit the noise)
-        quiet = step.cycle_ok or (_within_noise(evs, run.criterion) and _motion_within(evs))
+        model, loc = run.model, step.loc
+        # a consistent cycle leaves only the drift to explain; one that fails the contact
+        # time alone (:func:`~.judging.supports_gap`) is screened in full, and its refits
+        # name an effect only where they make the model consistent
+        quiet = step.cycle_ok
         cands = [
             e
             for e in run.catalogue

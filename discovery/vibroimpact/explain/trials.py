@@ -15,6 +15,7 @@ from ..verify import CONSISTENCY_FACTORS
 from ..verify.motion import MOTION_CRITERION
 from .effects import effect
 from .judging import (
+    SUPPORTS_CRITERION,
     _force_worse,
     _keeps_repulsive,
     _keeps_signs,
@@ -323,7 +324,7 @@ class _Trial:
             and null_consistent is False
             and s.get("consistent_after")
             and after < null_after[k]
-            and after <= NEAR_FLOOR * floor.get(k, 0.0)
+            and (k == SUPPORTS_CRITERION or after <= NEAR_FLOOR * floor.get(k, 0.0))
         ):
             s["beats_law_refit"] = True
             s["law_alone_inconsistent"] = null_after[k]
@@ -343,6 +344,7 @@ class _Trial:
         s = self.score
         return bool(
             self.ratio <= 0.9
+            and (self.key != SUPPORTS_CRITERION or s.get("consistent_after"))
             and s["repulsive"]
             and s["in_bounds"]
             and s["beats_law_refit"]
