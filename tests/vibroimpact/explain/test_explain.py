@@ -546,3 +546,40 @@ def test_a_refit_judged_by_the_motion_that_breaks_the_force_names_nothing():
     assert not _motion_worse(before, after, evs)
     within = [SimpleNamespace(limits={"I2": 0.2, "I5": 0.088}, criteria=after)]
     assert not _force_worse("I2", "I5", before, after, within)  # worse, but within its limit
+
+
+class _Scored:
+    """An evaluation's verdict parts (regime, floor, criteria, limits) with the real rules of
+    :class:`~discovery.vibroimpact.verify.evaluation.Evaluation` for within and failing."""
+
+    def __init__(self, criteria, limits, same_regime=True):
+        from discovery.vibroimpact.verify.evaluation import Evaluation
+
+        self.criteria, self.limits = criteria, limits
+        self.same_regime, self.noise_floor = same_regime, dict(limits)
+        self.within = lambda k, absent=False: Evaluation.within(self, k, absent=absent)
+        self.failing = lambda: Evaluation.failing(self)
+
+
+def test_the_contact_time_is_the_gap_only_where_it_alone_fails():
+    """``supports_gap``: the force (I2) and the penetration (I5) within their limits and the
+    contact time (I4) alone beyond its own, on every record, makes I4 the gap that refits
+    are judged by (survey draw 45's noisier Hertz record); any other failure, a regime
+    mismatch, or a consistent model does not."""
+    from discovery.vibroimpact.explain.judging import SUPPORTS_CRITERION, supports_gap
+
+    limits = {"I2": 0.03, "I4": 0.04, "I5": 0.1}
+    alone = _Scored({"I2": 0.02, "I4": 0.07, "I5": 0.05}, limits)
+    consistent = _Scored({"I2": 0.02, "I4": 0.03, "I5": 0.05}, limits)
+    assert SUPPORTS_CRITERION == "I4"
+    assert supports_gap([alone], "I2")
+    assert supports_gap([alone, consistent], "I2")  # failing I4 alone on one record
+    assert not supports_gap([consistent], "I2")  # nothing fails
+    force = _Scored({"I2": 0.05, "I4": 0.07, "I5": 0.05}, limits)
+    motion = _Scored({"I2": 0.02, "I4": 0.07, "I5": 0.2}, limits)
+    assert not supports_gap([force], "I2") and not supports_gap([alone, force], "I2")
+    assert not supports_gap([motion], "I2")  # the penetration's gap comes first
+    other = _Scored({"I2": 0.02, "I4": 0.07, "I5": 0.05}, limits, same_regime=False)
+    assert not supports_gap([other], "I2")
+    no_motion = _Scored({"I2": 0.02, "I4": 0.07}, {"I2": 0.03, "I4": 0.04})
+    assert supports_gap([no_motion], "I2")  # a record without positions
