@@ -428,7 +428,6 @@ def test_better_data_never_gives_a_worse_answer(i, eid, term, rel, noise):
     assert res.final_model.value(effect_of(eid)) == pytest.approx(d.truth[term], rel=rel)
 
 
-
 @pytest.mark.slow
 @pytest.mark.parametrize("noise", ["high", "low"])
 def test_a_model_failing_the_contact_time_alone_names_the_effect_that_makes_it_consistent(
@@ -453,6 +452,7 @@ def test_a_model_failing_the_contact_time_alone_names_the_effect_that_makes_it_c
         assert got == pytest.approx(d.truth["z^1.5"], rel=0.25)
     else:
         assert res.final_model.effects == ()
+
 
 def test_a_refit_that_turns_a_coefficient_negative_is_not_physical(paper):
     """Survey draw 33 with the machine that made the record: an offset's refit traded the
