@@ -29,7 +29,7 @@ def _explain_forces(ax, iteration, measured, k):
             iteration.simulated_after.F / 1e3,
             "-",
             color="tab:blue",
-            label=f"after (+ {iteration.effect.replace('_', ' ')})",
+            label=f"+ {iteration.effect.replace('_', ' ')}",
         )
     if len(E.support):
         a, b = E.support[0]
@@ -45,7 +45,8 @@ def _explain_forces(ax, iteration, measured, k):
     # room above the curves for the legend, which then covers none of them
     lo, hi = ax.get_ylim()
     ax.set_ylim(lo, hi + 0.55 * (hi - lo))
-    ax.legend(loc="upper right", framealpha=0.8)
+    # narrow enough for the panel (a wider legend runs over the force's tick labels)
+    ax.legend(loc="upper right", framealpha=0.8, handlelength=1.5)
 
 
 def _explain_phases(ax, iteration):
