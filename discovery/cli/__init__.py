@@ -18,6 +18,7 @@ it is not itself an option; ``--law=-1e8*z`` always works.
 
 import _thread
 import argparse
+import atexit
 import contextlib
 import os
 import re
@@ -582,7 +583,25 @@ def main(argv=None):
         return 2
     if entry and code in (130, 143):
         _leave(code)
+    if entry:
+        _finish(code)
     return code
+
+
+def _finish(code):
+    """End the process that ran ``vidi`` without the interpreter's teardown.
+
+    Tearing the interpreter down takes longer than many commands' own work: freeing
+    numba's loaded kernels took 0.37 s and matplotlib's modules 0.19 s (of ``vidi verify``'s
+    2.7 s on a 30-period record).  When the run is over, its files are closed (every
+    output is written in ``with`` blocks), so the exit handlers (``atexit``: logging's,
+    multiprocessing's) are run, the streams flushed, and the process leaves with its code.
+    Where a thread the interpreter would wait for still runs, it ends as usual."""
+    main_thread = threading.main_thread()
+    if any(t is not main_thread and not t.daemon for t in threading.enumerate()):
+        return
+    atexit._run_exitfuncs()
+    _leave(code)
 
 
 def _run(argv):
