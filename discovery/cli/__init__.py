@@ -596,9 +596,13 @@ def _finish(code):
     2.7 s on a 30-period record).  When the run is over, its files are closed (every
     output is written in ``with`` blocks), so the exit handlers (``atexit``: logging's,
     multiprocessing's) are run, the streams flushed, and the process leaves with its code.
-    Where a thread the interpreter would wait for still runs, it ends as usual."""
+    It ends as usual where a thread the interpreter would wait for still runs, or where a
+    profiler, tracer or debugger watches the run (``python -m cProfile -o`` writes its file
+    after the script returns)."""
     main_thread = threading.main_thread()
     if any(t is not main_thread and not t.daemon for t in threading.enumerate()):
+        return
+    if sys.getprofile() is not None or sys.gettrace() is not None:
         return
     atexit._run_exitfuncs()
     _leave(code)

@@ -64,3 +64,23 @@ def test_a_thread_still_running_is_waited_for(tmp_path):
     assert run.returncode == 0, run.stderr
     assert (tmp_path / "thread.txt").read_text() == "done"
     assert (tmp_path / "atexit.txt").read_text() == "ran"
+
+
+def test_a_profiled_run_leaves_its_profile(tmp_path):
+    """``python -m cProfile -o`` writes its file after the script returns: a watched run
+    ends as usual."""
+    script = tmp_path / "entry.py"
+    script.write_text(_ENTRY)
+    words = ["simulate", "--scenario", "paper", "--periods", "2", "--out", str(tmp_path / "r.csv")]
+    prof = tmp_path / "run.prof"
+    run = subprocess.run(
+        [sys.executable, "-m", "cProfile", "-o", str(prof), str(script), str(tmp_path), "none"]
+        + words,
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert run.returncode == 0, run.stderr
+    assert prof.stat().st_size > 0
