@@ -6,6 +6,14 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
+# The BLAS kernels: OpenBLAS picks them by the CPU, and they round sums in different orders,
+# enough for a record of a long transient from rest to settle on another orbit.  The stored
+# survey runs and the tests of named survey draws use the SkylakeX kernels, which every CPU
+# with AVX-512 runs: pinned here for every target (a value you set is kept; tests/kernels.py)
+ifeq ($(shell grep -qsw avx512f /proc/cpuinfo && echo y),y)
+export OPENBLAS_CORETYPE ?= SkylakeX
+endif
+
 TEX_PACKAGES := latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended \
 	lmodern poppler-utils
 

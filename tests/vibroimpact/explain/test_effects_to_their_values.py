@@ -15,10 +15,19 @@ from discovery.vibroimpact.explain import drift as D
 from discovery.vibroimpact.explain import explain
 from discovery.vibroimpact.explain.effects import effect as effect_of
 from discovery.vibroimpact.verify import Reference, evaluate
+from tests import kernels as K
 from tests import realistic as R
 from tests.survey_effects import _shedding_start
 
 LOW = {"force_noise": 0.005, "motion_noise": 0.001}
+
+
+def _draw(i, level):
+    """The effects survey's draw i at a noise level (its stored record: tests/kernels.py)."""
+    from tests import survey_effects as S
+
+    K.require_stored()
+    return S.draw(i, level)
 
 
 def _machine(**kw):
@@ -277,9 +286,8 @@ def test_an_offset_refit_starts_from_the_offset_the_onsets_read():
     force's onsets reads -46.4 um; the refit from it and the law regressed beyond it reaches
     the truth, consistent, its interval holding it."""
     from discovery.vibroimpact.explain import explain
-    from tests import survey_effects as S
 
-    d = S.draw(26, "high")
+    d = _draw(26, "high")
     res = explain(d.start, d.record, "linear", workers=1, effects=["contact_offset"])
     assert res.consistent, res
     lo, hi = res.intervals.bounds["delta0"]
@@ -292,9 +300,8 @@ def deep_offset():
     """Survey draw 6, the noisier record (force noise 2 % of its peak, motion noise 0.4 % of
     each channel's range): the position sensors' zeros differ by -0.88 mm, about a typical
     penetration, so the recorded penetration never stands above its noise in contact."""
-    from tests import survey_effects as S
 
-    d = S.draw(6, "high")
+    d = _draw(6, "high")
     return d.start, d.true, d.machine.offset, d.record
 
 
@@ -339,9 +346,8 @@ def test_an_effect_the_score_test_passed_over_is_refitted_before_the_loop_stops(
     squares stop at the noise, the start fit ends where the coupling's score test is
     significant, and it is named in the first pass; the late pass's rule is held by
     :func:`test_the_effects_the_score_test_passed_over_are_refitted_largest_first`.)"""
-    from tests import survey_effects as S
 
-    d = S.draw(14, "low")
+    d = _draw(14, "low")
     truth = d.truth
     res = explain(d.start, d.record, "linear", n_boot_intervals=0)
     assert [it.effect for it in res.iterations] == ["penetration_velocity_coupling"]
@@ -382,7 +388,7 @@ def test_better_data_never_gives_a_worse_answer_on_stiffening_supports(noise):
     and to 2 % on the quieter."""
     from tests import survey_effects as S
 
-    d = S.draw(33, noise)
+    d = _draw(33, noise)
     rec, true = d.record, d.true
     given, scale, found, known = S._machine(d.start, rec, 0.05, d.seed)
     assert "support_nonlinearity" in found
@@ -419,9 +425,8 @@ def test_better_data_never_gives_a_worse_answer(i, eid, term, rel, noise):
     stopped in another basin (I2 0.178, not consistent); by continuation (the offset held at
     half its value, then taken out) it reaches 0.088, consistent, and pruning takes the
     offset out; the Hertz term within 4 %."""
-    from tests import survey_effects as S
 
-    d = S.draw(i, noise)
+    d = _draw(i, noise)
     res = explain(d.start, d.record, "linear", n_boot_intervals=0)
     assert res.final_model.effects == (eid,)
     assert res.consistent
@@ -441,9 +446,8 @@ def test_a_model_failing_the_contact_time_alone_names_the_effect_that_makes_it_c
     consistent (I2 0.020, the truth 0.012): the effect does not show there, nothing is named
     and the model stays consistent, which is the survey's one pair counted as quieter
     silent where noisier right; it names no wrong effect."""
-    from tests import survey_effects as S
 
-    d = S.draw(45, noise)
+    d = _draw(45, noise)
     res = explain(d.start, d.record, "linear", n_boot_intervals=0)
     assert res.consistent
     if noise == "high":
@@ -505,9 +509,8 @@ def test_a_start_fit_with_its_force_misplaced_is_rescued_from_the_grid_around_it
     hundred times too soft (I2 0.93), and explain ended inconsistent with nothing to name.
     Fitted from the best point of the grid around the regression's start, the law reaches
     the truth."""
-    from tests import survey_effects as S
 
-    d = S.draw(30, "high")
+    d = _draw(30, "high")
     true = d.true
     res = explain(d.start, d.record, "linear", n_boot_intervals=0)
     assert res.consistent and not [it.effect for it in res.iterations if it.effect]
@@ -583,9 +586,8 @@ def test_supports_under_a_short_contact_are_named_from_the_machine_without_them(
     supports' refit now also starts from the ``k3`` the frame's equation reads, the
     spring scanned around the regression's.  Both name the supports to their true value,
     so better data no longer gives the worse answer."""
-    from tests import survey_effects as S
 
-    d = S.draw(33, noise)
+    d = _draw(33, noise)
     res = explain(d.start, d.record, "linear", workers=1, n_boot_intervals=0)
     assert res.final_model.effects == ("support_nonlinearity",)
     assert res.consistent, res.stopped_because
@@ -597,9 +599,8 @@ def draw9():
     """Survey draw 9, the quieter record (stiffening supports and unloading damping, P1),
     and the machine with its supports as the record's states are fitted for it."""
     from discovery.vibroimpact.explain.effects import Model
-    from tests import survey_effects as S
 
-    d = S.draw(9, "low")
+    d = _draw(9, "low")
     ref = Reference.from_measurement(d.record, d.start, n_boot=16, seed=0)
     model = Model(d.true).with_effect(effect_of("support_nonlinearity"), d.machine.k3)
     return d, ref, model.apply(d.start, ref)
@@ -641,7 +642,7 @@ def test_of_refits_within_the_noise_floor_a_consistent_one_is_named():
     :func:`test_of_polished_refits_within_the_floor_a_consistent_one_comes_first`.)"""
     from tests import survey_effects as S
 
-    d = S.draw(31, "high")
+    d = _draw(31, "high")
     given, scale, found, known = S._machine(d.start, d.record, 0.05, d.seed)
     res = explain(given, d.record, "linear", machine_scale=scale, known=known, n_boot_intervals=0)
     assert res.final_model.effects == ("unloading_damping",)
@@ -717,9 +718,8 @@ def test_a_mass_loss_within_the_floor_of_the_law_alone_is_named_by_the_verdict()
     truth (I2 0.054 -> 0.026, consistent), the law refitted alone 0.050 with its
     penetration off (I5 above its limit); 0.024 short of the noise floor (0.026), nothing
     had been named. Within the floor the whole verdict decides, and the evidence says so."""
-    from tests import survey_effects as S
 
-    d = S.draw(28, "high")
+    d = _draw(28, "high")
     res = explain(d.start, d.record, "linear", workers=1, n_boot_intervals=0)
     assert res.final_model.effects == ("mass_loss",)
     assert res.consistent, res.stopped_because
@@ -733,9 +733,8 @@ def test_the_force_before_a_sensor_lag_regresses_to_the_true_law():
     the force the lag's inverse gives at the true time constant (``F + tau dF/dt``), both
     within 1 %; at twice the lag the spring is 10 % soft."""
     from discovery.vibroimpact.explain.starts import Regressions
-    from tests import survey_effects as S
 
-    d = S.draw(27, "low")
+    d = _draw(27, "low")
     tau, true = d.truth["tau"], np.array(d.true.coefficients)
     regress = Regressions([d.start], [d.record])
     plain = np.array(regress(["z", "zd"]).coefficients)
@@ -752,9 +751,8 @@ def test_a_refit_stopped_in_a_basin_of_the_transient_is_restarted_from_its_sprin
     four times its limit), where the true model is at 0.025; nothing was named.  A refit
     that is not consistent is restarted from its law's springs scanned a few percent: the
     lag is named, consistent, its time constant to 2 %."""
-    from tests import survey_effects as S
 
-    d = S.draw(27, "high")
+    d = _draw(27, "high")
     res = explain(d.start, d.record, "linear", workers=1, n_boot_intervals=0)
     assert res.final_model.effects == ("sensor_lag",)
     assert res.consistent, res.stopped_because
@@ -1003,7 +1001,7 @@ def test_a_mass_loss_is_refitted_with_the_moulding_mass_the_calibration_read():
     from discovery.vibroimpact.explain import explain
     from tests import survey_effects as S
 
-    d = S.draw(38, "low")
+    d = _draw(38, "low")
     given, scale, _, known = S._machine(d.start, d.record, 0.05, d.seed)
     assert given.m2 == pytest.approx(6793, rel=1e-3)  # the calibration's, 0.5 % heavy
     res = explain(given, d.record, "linear", workers=1, machine_scale=scale, known=known)

@@ -1,0 +1,36 @@
+"""The BLAS kernels the suite runs on: the stored survey runs' kernels wherever the CPU has
+them, and on them a named draw is the stored record (tests/kernels.py)."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from tests import kernels as K
+
+EFFECTS_RUNS = Path(__file__).parent.parent / "docs" / "_measured" / "effects.jsonl"
+
+
+def test_the_suite_runs_the_stored_kernels_where_the_cpu_has_them():
+    if not K.has_avx512():
+        pytest.skip("this CPU has no AVX-512: OpenBLAS runs its own kernels here")
+    assert K.as_stored(), (
+        f"OpenBLAS runs {K.in_use()} on a CPU with AVX-512: the pin to {K.STORED} "
+        "(Makefile, tests/__init__.py) did not reach this process"
+    )
+
+
+def test_a_named_draw_is_its_stored_record_on_the_stored_kernels():
+    """Draw 30 (a short contact, P2 after a long transient from rest) is the draw the Haswell
+    kernels turn into an irregular motion (the true law's I2 0.50): on the stored kernels its
+    true model's I2 is the stored run's to the last digits."""
+    from discovery.vibroimpact.verify import Reference, evaluate
+    from tests import survey_effects as S
+
+    K.require_stored()
+    d = S.draw(30, "high")
+    row = S._verify_truth(d.machine, d.true, d.lag, d.record, d.start, evaluate, Reference)
+    with open(EFFECTS_RUNS, encoding="utf-8") as f:
+        rows = [json.loads(line) for line in f]
+    stored = next(r for r in rows if r.get("draw") == 30 and r.get("noise") == "high")
+    assert row["true_I2"] == pytest.approx(stored["true_I2"], rel=1e-9)
