@@ -12,6 +12,8 @@ reproduces the runs bit for bit on an AMD EPYC).  On a CPU without AVX-512 the n
 not the stored records and their tests skip, saying so.
 """
 
+import functools
+
 STORED = "SkylakeX"
 
 
@@ -27,20 +29,28 @@ def has_avx512():
     return False
 
 
+@functools.cache
 def in_use():
-    """The architectures of the OpenBLAS libraries numpy and scipy.linalg loaded here."""
+    """The architectures of the OpenBLAS libraries numpy and scipy.linalg loaded here (a
+    process's kernels are chosen once, when the libraries load)."""
     import numpy  # noqa: F401
     import scipy.linalg  # noqa: F401
     from threadpoolctl import threadpool_info
 
-    return sorted(
-        {i.get("architecture", "?") for i in threadpool_info() if i["internal_api"] == "openblas"}
+    return tuple(
+        sorted(
+            {
+                i.get("architecture", "?")
+                for i in threadpool_info()
+                if i["internal_api"] == "openblas"
+            }
+        )
     )
 
 
 def as_stored():
     """Whether every OpenBLAS library here runs the stored runs' kernels."""
-    return in_use() == [STORED]
+    return in_use() == (STORED,)
 
 
 def require_stored():

@@ -1,14 +1,10 @@
 """The BLAS kernels the suite runs on: the stored survey runs' kernels wherever the CPU has
 them, and on them a named draw is the stored record (tests/kernels.py)."""
 
-import json
-from pathlib import Path
-
 import pytest
 
 from tests import kernels as K
-
-EFFECTS_RUNS = Path(__file__).parent.parent / "docs" / "_measured" / "effects.jsonl"
+from tests.measured import MEASURED, read
 
 
 def test_the_suite_runs_the_stored_kernels_where_the_cpu_has_them():
@@ -30,7 +26,6 @@ def test_a_named_draw_is_its_stored_record_on_the_stored_kernels():
     K.require_stored()
     d = S.draw(30, "high")
     row = S._verify_truth(d.machine, d.true, d.lag, d.record, d.start, evaluate, Reference)
-    with open(EFFECTS_RUNS, encoding="utf-8") as f:
-        rows = [json.loads(line) for line in f]
+    _, rows = read(MEASURED / "effects.jsonl")
     stored = next(r for r in rows if r.get("draw") == 30 and r.get("noise") == "high")
     assert row["true_I2"] == pytest.approx(stored["true_I2"], rel=1e-9)

@@ -300,7 +300,6 @@ def deep_offset():
     """Survey draw 6, the noisier record (force noise 2 % of its peak, motion noise 0.4 % of
     each channel's range): the position sensors' zeros differ by -0.88 mm, about a typical
     penetration, so the recorded penetration never stands above its noise in contact."""
-
     d = _draw(6, "high")
     return d.start, d.true, d.machine.offset, d.record
 
@@ -346,7 +345,6 @@ def test_an_effect_the_score_test_passed_over_is_refitted_before_the_loop_stops(
     squares stop at the noise, the start fit ends where the coupling's score test is
     significant, and it is named in the first pass; the late pass's rule is held by
     :func:`test_the_effects_the_score_test_passed_over_are_refitted_largest_first`.)"""
-
     d = _draw(14, "low")
     truth = d.truth
     res = explain(d.start, d.record, "linear", n_boot_intervals=0)
@@ -425,7 +423,6 @@ def test_better_data_never_gives_a_worse_answer(i, eid, term, rel, noise):
     stopped in another basin (I2 0.178, not consistent); by continuation (the offset held at
     half its value, then taken out) it reaches 0.088, consistent, and pruning takes the
     offset out; the Hertz term within 4 %."""
-
     d = _draw(i, noise)
     res = explain(d.start, d.record, "linear", n_boot_intervals=0)
     assert res.final_model.effects == (eid,)
@@ -446,7 +443,6 @@ def test_a_model_failing_the_contact_time_alone_names_the_effect_that_makes_it_c
     consistent (I2 0.020, the truth 0.012): the effect does not show there, nothing is named
     and the model stays consistent, which is the survey's one pair counted as quieter
     silent where noisier right; it names no wrong effect."""
-
     d = _draw(45, noise)
     res = explain(d.start, d.record, "linear", n_boot_intervals=0)
     assert res.consistent
@@ -509,7 +505,6 @@ def test_a_start_fit_with_its_force_misplaced_is_rescued_from_the_grid_around_it
     hundred times too soft (I2 0.93), and explain ended inconsistent with nothing to name.
     Fitted from the best point of the grid around the regression's start, the law reaches
     the truth."""
-
     d = _draw(30, "high")
     true = d.true
     res = explain(d.start, d.record, "linear", n_boot_intervals=0)
@@ -586,7 +581,6 @@ def test_supports_under_a_short_contact_are_named_from_the_machine_without_them(
     supports' refit now also starts from the ``k3`` the frame's equation reads, the
     spring scanned around the regression's.  Both name the supports to their true value,
     so better data no longer gives the worse answer."""
-
     d = _draw(33, noise)
     res = explain(d.start, d.record, "linear", workers=1, n_boot_intervals=0)
     assert res.final_model.effects == ("support_nonlinearity",)
@@ -718,7 +712,6 @@ def test_a_mass_loss_within_the_floor_of_the_law_alone_is_named_by_the_verdict()
     truth (I2 0.054 -> 0.026, consistent), the law refitted alone 0.050 with its
     penetration off (I5 above its limit); 0.024 short of the noise floor (0.026), nothing
     had been named. Within the floor the whole verdict decides, and the evidence says so."""
-
     d = _draw(28, "high")
     res = explain(d.start, d.record, "linear", workers=1, n_boot_intervals=0)
     assert res.final_model.effects == ("mass_loss",)
@@ -751,7 +744,6 @@ def test_a_refit_stopped_in_a_basin_of_the_transient_is_restarted_from_its_sprin
     four times its limit), where the true model is at 0.025; nothing was named.  A refit
     that is not consistent is restarted from its law's springs scanned a few percent: the
     lag is named, consistent, its time constant to 2 %."""
-
     d = _draw(27, "high")
     res = explain(d.start, d.record, "linear", workers=1, n_boot_intervals=0)
     assert res.final_model.effects == ("sensor_lag",)
