@@ -39,7 +39,7 @@ _EXPORTS = {
     "Library": "vibroimpact.model.library",
     "Measurement": "vibroimpact.data.measurement",
     "synthesize": "vibroimpact.dynamics.synthetic",
-    "Candidate": "vibroimpact.fit.regression",
+    "Candidate": "vibroimpact.fit.certified_fit",
     "ConstrainedSparseRegressor": "vibroimpact.fit.regression",
     "Response": "vibroimpact.dynamics.law_response",
     "response": "vibroimpact.dynamics.law_response",

@@ -234,7 +234,7 @@ def _regression(names, samples, loading=False, shift=0.0):
     ``loading``, on the loading samples (``dzeta > 0``) alone, which an unloading branch
     or a set leaves as they are; with a ``shift`` (a contact offset), on the penetration
     beyond it (the force's argument is the recorded penetration less the offset)."""
-    from ..fit.regression import ConstrainedSparseRegressor
+    from ..fit.certified_fit import CertifiedSparseFit, RegressionSettings
 
     if samples is None:
         return None
@@ -245,7 +245,7 @@ def _regression(names, samples, loading=False, shift=0.0):
             keep &= zeta > 0
         if np.count_nonzero(keep) < 10 * len(names):
             return None
-        est = ConstrainedSparseRegressor(library=",".join(names), max_terms=len(names))
+        est = CertifiedSparseFit(RegressionSettings(library=",".join(names), max_terms=len(names)))
         est.fit(
             np.column_stack([zeta, samples.dzeta])[keep],
             samples.F[keep],

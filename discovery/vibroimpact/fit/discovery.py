@@ -31,9 +31,8 @@ those whose simulation criterion (default I2) is within ``sim_rtol`` (relative) 
 criterion; models without a periodic steady state come last.
 """
 
-import inspect
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 from constraints import require as require_certificate
 
@@ -47,6 +46,7 @@ from ..model.scenario import Scenario
 from ..verify import Reference
 from ..verify.block_farm import block_workers, shared_blocks
 from ..verify.criteria import CRITERIA
+from .certified_fit import SCORES, SELECTIONS, RegressionSettings
 from .discovery_result import DiscoveryResult, RankedModel
 from .discovery_warnings import _defects_warning, _warnings
 from .discovery_warnings import _impact_warnings as _impact_warnings
@@ -56,7 +56,6 @@ from .evidence import _contact_samples, _Evidence, _regression, _required_terms,
 from .intervals import INTERVAL_REFITS, bootstrap_intervals
 from .ranking import _RankingRule, rank
 from .records import pair_records
-from .regression import SCORES, SELECTIONS, ConstrainedSparseRegressor
 from .shortlist import _Checker, _shortlist
 from .stepwise import _Stepwise
 
@@ -113,7 +112,7 @@ class _Bootstrap:
 
 def _settings(evidence, check, search, boot, *, shortlist, stability, n_boot, average_cycles):
     """The settings a discovery reports, read from the objects that ran it."""
-    est = evidence.est
+    est = evidence.est.settings
     return {
         "library": str(est.library),
         "selection": est.selection,
@@ -136,7 +135,7 @@ def _settings(evidence, check, search, boot, *, shortlist, stability, n_boot, av
         "interval_refit": boot.refit,
         "require": sorted(check.required),
         "ranking_rule": {"sim_rtol": search.rank.sim_rtol, "sim_atol": search.rank.sim_atol},
-        "estimator": est.get_params(),
+        "estimator": evidence.est.get_params(),
         "sensor_lag": check.sensor_lag,
     }
 
@@ -159,7 +158,7 @@ def _contact_models(scenario, measurement, s, progress):
 
 
 #: the estimator's parameters a call of :func:`discover` may give as keywords
-_ESTIMATOR_OPTIONS = tuple(inspect.signature(ConstrainedSparseRegressor).parameters)
+_ESTIMATOR_OPTIONS = tuple(f.name for f in fields(RegressionSettings))
 
 
 @dataclass(frozen=True, repr=False)

@@ -62,7 +62,7 @@ def _loaded_evaluations(d):
 def _loaded_candidate(d):
     """A loaded ranked model's regression statistics: the law's terms and coefficients, the
     regression's own coefficients in ``extra`` (as a refined candidate keeps them)."""
-    from .regression import Candidate
+    from .certified_fit import Candidate
 
     return Candidate(
         terms=tuple(d["terms"]),
@@ -346,8 +346,10 @@ class DiscoveryResult(Result):
         Every shortlisted candidate, best first.
     certificate : constraints.Certificate
         Of the selected law on the data's box.
-    estimator : ConstrainedSparseRegressor
-        The fitted estimator.
+    estimator : CertifiedSparseFit
+        The fitted certified regression (the fitted attributes of
+        :class:`~discovery.vibroimpact.fit.regression.ConstrainedSparseRegressor`:
+        ``candidates_``, ``library_``, ``box_``, ``coef_``...; without scikit-learn).
     samples : ContactSamples
         The contact samples of all records, joined.
     measured : Impulse

@@ -10,7 +10,7 @@ from ...errors import InputError, VidiError
 from ..data.samples import ContactSamples, contact_samples, join_samples
 from ..model.law import Term
 from ..model.library import Library
-from .regression import ConstrainedSparseRegressor
+from .certified_fit import CertifiedSparseFit, RegressionSettings
 
 
 def _sign_vector(signs, library):
@@ -63,7 +63,7 @@ class _Evidence:
         Every record's contact samples.
     samples : ContactSamples
         Their join (what the regression is fitted to).
-    est : ConstrainedSparseRegressor
+    est : CertifiedSparseFit
         The certified sparse regression fitted to ``samples``.
     refs : list of (Scenario, Reference)
         Every record's reference (what each law is simulated against).
@@ -72,7 +72,7 @@ class _Evidence:
     pairs: list
     parts: list
     samples: ContactSamples
-    est: ConstrainedSparseRegressor
+    est: CertifiedSparseFit
     refs: list
 
 
@@ -86,11 +86,11 @@ def _contact_samples(pairs, derivative, average_cycles):
 
 
 def _regression(samples, settings):
-    """The certified sparse regression ``ConstrainedSparseRegressor(**settings)`` fitted to
+    """The certified sparse regression ``CertifiedSparseFit`` with ``settings`` fitted to
     ``samples`` (``settings["signs"]`` may be ``{term: sign}``)."""
     if isinstance(settings.get("signs"), dict):
         settings = {**settings, "signs": _sign_vector(settings["signs"], settings["library"])}
-    est = ConstrainedSparseRegressor(**settings)
+    est = CertifiedSparseFit(RegressionSettings(**settings))
     est.fit(samples.X, samples.F, groups=samples.impact, sample_weight=samples.weight)
     return est
 

@@ -13,12 +13,12 @@ from ..data.samples import ContactSamples
 from ..dynamics import Tolerances
 from ..verify import evaluate
 from ..verify.sensors import lag_observation
+from .certified_fit import CertifiedSparseFit
 from .discovery_result import RankedModel
 from .identification import identify
 from .optimise import SCREEN_PROGRESS, SCREEN_STOP
 from .problem import ModelProblem
 from .records import record_start
-from .regression import ConstrainedSparseRegressor
 from .rescan import WIDE_SPRING_SCAN, lower_basin
 
 _FORWARD_STARTS = (0.01, 0.001)  # a new term's start force at the box corner / peak force
@@ -68,7 +68,7 @@ class _Checker:
     (:meth:`screen_from`), ``sensor_lag`` the force sensor's time constant every simulated
     force is read through (:attr:`observe`)."""
 
-    est: ConstrainedSparseRegressor
+    est: CertifiedSparseFit
     samples: ContactSamples
     refs: list
     criterion: str

@@ -49,7 +49,7 @@ from ..._api._validate import Text, params
 from ..._files._io import short
 from ...errors import InputError, VidiError
 from ..data.measurement import MAX_SAMPLES
-from ..fit.regression import SELECTIONS
+from ..fit.certified_fit import SELECTIONS
 from ..model.contact_models import is_model_text, parse_law
 from ..model.library import Library
 from ..model.scenario import load_scenario
@@ -364,8 +364,8 @@ def _check_fit(fit, source):
     """Every ``[fit]`` option by the checks :func:`~discovery.vibroimpact.fit.discovery.discover`
     makes of its arguments (their types, ranges and names), so that a bad option stops the
     study up front instead of failing every run."""
+    from ..fit.certified_fit import SCORES
     from ..fit.discovery import DiscoverSettings
-    from ..fit.regression import SCORES
     from ..verify.criteria import criterion as _criterion
 
     def bad(exc):

@@ -18,6 +18,7 @@ from constraints.errors import SolverError
 from discovery.errors import InputError
 from discovery.vibroimpact.data.samples import contact_samples
 from discovery.vibroimpact.dynamics.synthetic import synthesize
+from discovery.vibroimpact.fit.certified_fit import CertifiedSparseFit, RegressionSettings
 from discovery.vibroimpact.fit.regression import SELECTIONS, ConstrainedSparseRegressor
 from discovery.vibroimpact.model.law import ForceLaw
 from discovery.vibroimpact.model.library import Library
@@ -237,7 +238,7 @@ def test_best_subset_is_exact_against_brute_force(source, light):
         cs = _runup(light, HC, 30, 0.01, 3)
         X, y, groups = cs.X, cs.F, cs.impact
     est = ConstrainedSparseRegressor(library="poly:2", max_terms=3).fit(X, y, groups=groups)
-    prob = est._problem(X, y, np.ones(len(y)))
+    prob = est.certified_fit_._problem(X, y, np.ones(len(y)))
     n = len(est.library_)
     n_active = 0
     for k in (1, 2, 3):
@@ -256,7 +257,7 @@ def test_best_subset_is_exact_against_brute_force(source, light):
 def test_constrained_solve_on_support_with_vanishing_rows():
     X, y = _unphysical_data(0)
     est = ConstrainedSparseRegressor(library="poly:2", max_terms=3).fit(X, y)
-    prob = est._problem(X, y, np.ones(len(y)))
+    prob = est.certified_fit_._problem(X, y, np.ones(len(y)))
     idx = [est.library_.names.index(n) for n in ("z", "z^2", "zd^2")]
     x, rss, active, solver = prob.fit_support(idx)
     assert active and solver == "CLARABEL"
@@ -457,7 +458,7 @@ def test_problem_rows_are_the_constraints_package_rows():
     est = ConstrainedSparseRegressor(
         library="poly:2", margin=1e3, monotone=True, signs=[1, 1, 0, 0, 0]
     ).fit(X, y)
-    prob = est._problem(X, y, np.ones(len(y)))
+    prob = est.certified_fit_._problem(X, y, np.ones(len(y)))
     rows, rhs = constraint_rows(
         est.library_.exponents,
         est.box_,
@@ -477,13 +478,13 @@ def test_problem_rows_are_the_constraints_package_rows():
 def test_cross_validation_only_when_scored_by_it_or_asked(monkeypatch):
     X, y, g = _law11_data()
     made = []
-    real = ConstrainedSparseRegressor._problem
+    real = CertifiedSparseFit._problem
 
     def spy(self, *args):
         made.append(len(args[1]))
         return real(self, *args)
 
-    monkeypatch.setattr(ConstrainedSparseRegressor, "_problem", spy)
+    monkeypatch.setattr(CertifiedSparseFit, "_problem", spy)
     kw = dict(library="poly:2", max_terms=3, cv=4, grid=101)
     bic = ConstrainedSparseRegressor(**kw).fit(X, y, groups=g)
     assert made == [len(y)]  # one problem: the fit, no fold
@@ -511,13 +512,13 @@ def test_stability_refits_with_the_weights_and_one_group_per_drawn_impact(monkey
     X, y, g = _law11_data(n=300, groups_of=30)
     w = np.random.default_rng(1).uniform(0.5, 2.0, y.size)
     seen = []
-    real = ConstrainedSparseRegressor.fit
+    real = CertifiedSparseFit.fit
 
     def spy(self, X, y, groups=None, sample_weight=None):
         seen.append((y.copy(), np.asarray(groups).copy(), np.asarray(sample_weight).copy()))
         return real(self, X, y, groups=groups, sample_weight=sample_weight)
 
-    monkeypatch.setattr(ConstrainedSparseRegressor, "fit", spy)
+    monkeypatch.setattr(CertifiedSparseFit, "fit", spy)
     est = ConstrainedSparseRegressor(library="z,zd", max_terms=2)
     est.stability(X, y, g, n_resamples=4, random_state=0, sample_weight=w)
     assert len(seen) == 4
@@ -649,3 +650,53 @@ def test_contact_by_force_where_the_penetration_is_buried_in_its_noise():
     by_force = contact_samples(noisy, contact="force")
     assert abs(len(by_force.F) - len(clean_f.F)) <= 0.05 * len(clean_f.F)
     assert np.all(by_force.F > 0)
+
+
+# ------------------------------------------------- the core without sklearn
+
+
+def test_the_estimator_and_its_sklearn_free_core_fit_alike():
+    """The estimator is its core's fit: the same candidates, coefficients and certificate."""
+    X, y, g = _law11_data()
+    kw = dict(library="poly:2", max_terms=3, margin=1e3, grid=101)
+    est = ConstrainedSparseRegressor(**kw).fit(X, y, groups=g)
+    core = CertifiedSparseFit(RegressionSettings(**kw)).fit(X, y, groups=g)
+    assert [(c.terms, c.coefficients, c.bic) for c in est.candidates_] == [
+        (c.terms, c.coefficients, c.bic) for c in core.candidates_
+    ]
+    np.testing.assert_array_equal(est.coef_, core.coef_)
+    np.testing.assert_array_equal(est.predict(X), core.predict(X))
+    assert est.score(X, y) == pytest.approx(core.score(X, y), rel=1e-12)
+    assert core.get_params() == {**RegressionSettings().__dict__, **kw}
+    assert est.certified_fit_.get_params() == est.get_params()
+    assert str(core).startswith("CertifiedSparseFit(max_terms=3, margin=1000.0")
+    assert "support z + zd" in str(core)
+    assert "not fitted" in str(CertifiedSparseFit())
+
+
+def test_an_unfitted_core_raises_the_estimators_not_fitted_error():
+    with pytest.raises(NotFittedError, match="CertifiedSparseFit"):
+        CertifiedSparseFit().predict(np.zeros((3, 2)))
+
+
+def test_a_fit_and_an_explain_import_no_scikit_learn():
+    """The commands' regression is the sklearn-free core: a discovery's modules and a core
+    fit load neither scikit-learn nor pandas (0.8 s of import; make bench times it)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, numpy as np\n"
+        "import discovery.vibroimpact.fit.discovery, discovery.vibroimpact.explain\n"
+        "import discovery.cli.fit, discovery.cli.explain\n"
+        "from discovery.vibroimpact.fit.certified_fit import CertifiedSparseFit\n"
+        "rng = np.random.default_rng(0)\n"
+        "X = np.column_stack([rng.uniform(0, 1e-3, 200), rng.uniform(-0.5, 0.5, 200)])\n"
+        "y = 2e8 * X[:, 0] + 1e5 * np.maximum(X[:, 1], 0)\n"
+        "CertifiedSparseFit().fit(X, y)\n"
+        "print(','.join(m for m in ('sklearn', 'pandas') if m in sys.modules))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=300
+    ).stdout.strip()
+    assert out == "", f"a fit imports {out}"
