@@ -157,18 +157,11 @@ def test_every_example_in_the_help_parses():
 def test_help_loads_no_heavy_library():
     """``vidi --help`` builds every parser without numba, cvxpy, sympy, scipy, matplotlib,
     pysindy or jinja2 (their import took 2-3 s; the timing itself is in make bench)."""
-    import subprocess
-    import sys
+    from tests.interpreter import loaded_after
 
-    code = (
-        "import sys; from discovery.cli import _parser; _parser(); "
-        "print(','.join(m for m in ('numba', 'cvxpy', 'sympy', 'scipy', 'matplotlib', "
-        "'pysindy', 'jinja2', 'sklearn') if m in sys.modules))"
-    )
-    out = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
-    ).stdout.strip()
-    assert out == "", f"vidi --help imports {out}"
+    heavy = ("numba", "cvxpy", "sympy", "scipy", "matplotlib", "pysindy", "jinja2", "sklearn")
+    out = loaded_after("from discovery.cli import _parser; _parser()", heavy, timeout=120)
+    assert out == [], f"vidi --help imports {','.join(out)}"
 
 
 def test_a_mistyped_command_or_option_gets_a_did_you_mean(capsys, tmp_path):

@@ -157,21 +157,8 @@ class CertifiedSparseFit:
 
     # ------------------------------------------------------------------ fit
     def fit(self, X, y, groups=None, sample_weight=None):
-        """Fit on ``X[:, 0] = zeta`` [m], ``X[:, 1] = dzeta`` [m/s], ``y = F`` [N].
-
-        Parameters
-        ----------
-        X : array_like of shape (n_samples, 2)
-        y : array_like of shape (n_samples,)
-        groups : array_like of shape (n_samples,), optional
-            Impact index of each sample (cross-validation folds keep impacts whole);
-            default: every sample its own group.
-        sample_weight : array_like of shape (n_samples,), optional
-
-        Returns
-        -------
-        self
-        """
+        """Fit on ``X[:, 0] = zeta`` [m], ``X[:, 1] = dzeta`` [m/s], ``y = F`` [N]; the
+        parameters are those of :meth:`ConstrainedSparseRegressor.fit`. Returns self."""
         check(f"{self._name}.fit: X", X, Array(2))
         check(f"{self._name}.fit: y", y, Array())
         t0 = time.perf_counter()

@@ -682,21 +682,17 @@ def test_an_unfitted_core_raises_the_estimators_not_fitted_error():
 def test_a_fit_and_an_explain_import_no_scikit_learn():
     """The commands' regression is the sklearn-free core: a discovery's modules and a core
     fit load neither scikit-learn nor pandas (0.8 s of import; make bench times it)."""
-    import subprocess
-    import sys
+    from tests.interpreter import loaded_after
 
     code = (
-        "import sys, numpy as np\n"
+        "import numpy as np\n"
         "import discovery.vibroimpact.fit.discovery, discovery.vibroimpact.explain\n"
         "import discovery.cli.fit, discovery.cli.explain\n"
         "from discovery.vibroimpact.fit.certified_fit import CertifiedSparseFit\n"
         "rng = np.random.default_rng(0)\n"
         "X = np.column_stack([rng.uniform(0, 1e-3, 200), rng.uniform(-0.5, 0.5, 200)])\n"
         "y = 2e8 * X[:, 0] + 1e5 * np.maximum(X[:, 1], 0)\n"
-        "CertifiedSparseFit().fit(X, y)\n"
-        "print(','.join(m for m in ('sklearn', 'pandas') if m in sys.modules))"
+        "CertifiedSparseFit().fit(X, y)"
     )
-    out = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=300
-    ).stdout.strip()
-    assert out == "", f"a fit imports {out}"
+    out = loaded_after(code, ("sklearn", "pandas"))
+    assert out == [], f"a fit imports {','.join(out)}"
