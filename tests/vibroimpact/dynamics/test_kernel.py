@@ -247,6 +247,38 @@ def test_split_integration_matches_single_run(paper):
     assert np.max(np.abs(b.y_final - whole.y_final) / scale) < 1e-7
 
 
+def _runs_alike(a, b):
+    for name in ("t", "y", "force", "mode", "event_t", "event_kind", "event_y", "y_final"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+
+
+def test_runs_sharing_a_set_up_are_bitwise_those_set_up_alone(paper):
+    """Runs of one law on one machine with one set of tolerances share the kernel's set-up
+    (the contact modes' closed form made by the first): each is bitwise the run made with
+    its own, from any start and in any order; another law, machine or tolerances object
+    gets its own set-up."""
+    from discovery.vibroimpact.dynamics import simulation as S
+
+    T, law = paper.period, ForceLaw.parse("2e8*z + 1.2e7*zd")
+    starts = [(0.0, None), (0.3 * T, simulate(paper, law, (0.0, 0.3 * T)).y_final)]
+    te = np.linspace(0.3 * T, 2.3 * T, 50)
+    tol = Tolerances.default()  # what a run without tolerances is set up with
+    shared = [simulate(paper, law, (t0, 2.3 * T), y0=y0, t_eval=te) for t0, y0 in starts]
+    assert S._RunSetup.of(paper, law, tol) is S._RunSetup.of(paper, law, tol)
+    for (t0, y0), run in zip(starts, shared, strict=True):
+        S._SETUPS.clear()  # a set-up of its own
+        _runs_alike(simulate(paper, law, (t0, 2.3 * T), y0=y0, t_eval=te), run)
+    other = ForceLaw.parse("2e8*z + 1.2e7*zd")  # equal, another object: its own set-up
+    assert S._RunSetup.of(paper, other, tol) is not S._RunSetup.of(paper, law, tol)
+    assert S._RunSetup.of(paper.scaled(1.01), law, tol) is not S._RunSetup.of(paper, law, tol)
+    # the modes' closed form is set up once and then only read
+    setup = S._RunSetup.of(paper, law, tol)
+    made = [m.copy() for m in setup.modes]
+    simulate(paper, law, (0.0, 2 * T))
+    for a, b in zip(made, setup.modes, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
 # ---------------------------------------------------------------- (e) failures
 
 
