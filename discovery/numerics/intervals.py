@@ -11,14 +11,8 @@ def in_widened_intervals(t, iv, pad, length):
     ``+length`` (a cyclic signal): ``a - pad + s <= t <= b + pad + s`` for a shift ``s`` in
     ``(-length, 0, length)``, by two binary searches an interval instead of a pass over
     ``t`` each."""
-    t = np.asarray(t, dtype=float)
-    iv = np.asarray(iv, dtype=float).reshape(-1, 2)
-    shifts = np.array([-length, 0.0, length])
-    lo = ((iv[:, :1] - pad) + shifts).ravel()  # the same arithmetic as the inequalities
-    hi = ((iv[:, 1:] + pad) + shifts).ravel()
-    start = np.searchsorted(t, lo, "left")
-    end = np.searchsorted(t, hi, "right")
-    keep = start < end
-    n = t.size + 1
-    marks = np.bincount(start[keep], minlength=n) - np.bincount(end[keep], minlength=n)
-    return np.cumsum(marks[:-1]) > 0
+    from .sampled import in_widened  # (numba: not at import, the --help path reads this)
+
+    t = np.ascontiguousarray(t, dtype=float)
+    iv = np.ascontiguousarray(np.reshape(iv, (-1, 2)), dtype=float)
+    return in_widened(t, iv, float(pad), float(length))

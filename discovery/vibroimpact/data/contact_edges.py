@@ -71,11 +71,9 @@ def moving_mean(x, width):
     to the last bit (the same running sum, in the same order: the contact edges decide
     samples at a threshold, and a last-bit change moved a survey record's final refit),
     without importing ``scipy.ndimage`` (a quarter of a second of every command's start)."""
-    x = np.asarray(x, dtype=float)
-    h = width // 2
-    p = np.concatenate([np.full(h, x[0]), x, np.full(h, x[-1])])
-    first = np.cumsum(p[:width])[-1]  # summed in order, as the running sum goes on
-    return np.cumsum(np.concatenate([[first], p[width:] - p[: p.size - width]])) / width
+    from ...numerics.sampled import running_mean  # (numba: not at import)
+
+    return running_mean(np.ascontiguousarray(x, dtype=float), int(width))
 
 
 def _edge_params(t, period, min_samples=3):
@@ -120,53 +118,17 @@ def _edges(t, F, thr, min_len, *, max_extrap=4.0, noise=0.0):
     extrapolated along its slope to zero force, by at most ``max_extrap`` samples, so
     the part of a smooth rise or fall below the threshold is not cut off; a flat,
     noisy edge has no meaningful slope and ends at its threshold crossing."""
-    above = F > thr
-    idx = np.flatnonzero(np.diff(above.astype(np.int8)))
-    starts = list(idx[~above[idx]] + 1)
-    ends = list(idx[above[idx]] + 1)
-    if above[0]:
-        starts.insert(0, 0)
-    if above[-1]:
-        ends.append(len(F))
-    runs = [[s, e] for s, e in zip(starts, ends, strict=True)]
-    merged = []
-    for r in runs:
-        # a gap is closed when it is short, or when it never goes clearly below the
-        # threshold (a dip of the force within the noise of it: noise must not decide
-        # whether a contact is one or two)
-        if merged and (
-            r[0] - merged[-1][1] < min_len
-            or (noise > 0 and F[merged[-1][1] : r[0]].min() > thr - 3.0 * noise)
-        ):
-            merged[-1][1] = r[1]
-        else:
-            merged.append(r)
-    # short runs are threshold flicker, unless the force clearly stands out: a contact
-    # shorter than the debounce length (< 1 % of a period) is still a contact
-    runs = [
-        r
-        for r in merged
-        if r[1] - r[0] >= min_len or (r[1] - r[0] >= 3 and F[r[0] : r[1]].max() >= 3.0 * thr)
-    ]
-    out = []
-    for s, e in runs:
-        if s == 0 or e >= len(F):
-            continue  # incomplete at the record's ends
-        f0, f1 = F[s - 1], F[s]
-        steep = max_extrap is not None and f1 - f0 > 3.0 * noise
-        lo = -max_extrap if steep else 0.0
-        frac = ((0.0 if steep else thr) - f0) / (f1 - f0) if f1 > f0 else 1.0
-        t_on = t[s - 1] + min(max(float(frac), lo), 1.0) * (t[s] - t[s - 1])
-        g0, g1 = F[e - 1], F[e]
-        steep = max_extrap is not None and g0 - g1 > 3.0 * noise
-        hi = 1.0 + max_extrap if steep else 1.0
-        frac = ((0.0 if steep else thr) - g0) / (g1 - g0) if g1 < g0 else 0.0
-        t_off = t[e - 1] + min(max(float(frac), 0.0), hi) * (t[e] - t[e - 1])
-        if out and t_on <= out[-1][1]:  # extrapolated edges met: one contact
-            out[-1] = (out[-1][0], max(out[-1][1], t_off), out[-1][2])
-        else:
-            out.append((t_on, t_off, s))
-    return out
+    from ...numerics.sampled import threshold_runs  # (numba: not at import)
+
+    runs = threshold_runs(
+        np.ascontiguousarray(t, dtype=float),
+        np.ascontiguousarray(F, dtype=float),
+        float(thr),
+        int(min_len),
+        -1.0 if max_extrap is None else float(max_extrap),
+        float(noise),
+    )
+    return [(float(a), float(b), int(k)) for a, b, k in runs]
 
 
 def _contact_runs(t, F, thr, sigma, period, *, min_samples, zeta):

@@ -174,12 +174,9 @@ def _in_intervals(t, iv, pad, length):
 
 def _int_abs(h, d):
     """Exact integral of |d| for d piecewise linear on a grid of steps ``h``."""
-    a, b = d[:-1], d[1:]
-    same = a * b >= 0
-    m = np.abs(d)  # once for both ends (the same values as |a| + |b|)
-    total = m[:-1] + m[1:]
-    area = np.where(same, 0.5 * total, 0.5 * (a * a + b * b) / np.where(same, 1.0, total))
-    return float(np.sum(h * area))
+    from ...numerics.sampled import abs_areas  # (numba: not at import, see --help)
+
+    return float(np.sum(abs_areas(h, np.ascontiguousarray(d, dtype=float))))
 
 
 def _int_sq(h, d):

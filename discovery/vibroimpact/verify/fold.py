@@ -80,12 +80,9 @@ class Fold:
         return self._kept_for("positive", values, self._positive_phases)
 
     def _bin_means(self, values):
-        return (
-            np.bincount(
-                self.bins, weights=np.asarray(values, dtype=float), minlength=self.counts.size
-            )
-            / self.counts
-        )
+        from ...numerics.sampled import bin_means  # (numba: not at import)
+
+        return bin_means(self.bins, np.ascontiguousarray(values, dtype=float), self.counts)
 
     def _positive_phases(self, values):
         on = self.average(values) > 0.0
