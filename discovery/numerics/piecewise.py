@@ -7,12 +7,17 @@ impulses of every comparison this way, thousands of times in a fit.
 """
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+
+# compiled once, its inputs taken read-only (a writeable array is one too): a memoised
+# (read-only) signal or query compiled another version at a user's first command
+_F1 = types.Array(types.float64, 1, "C", readonly=True)
+_B1 = types.Array(types.boolean, 1, "C", readonly=True)
 
 __all__ = ["periodic_values"]
 
 
-@njit(cache=True)
+@njit(types.void(_F1, _F1, types.float64, _F1, _B1, types.float64[::1]), cache=True)
 def _values(t, F, W, tq, lefts, out):
     """``out[k]``: the signal at ``tq[k]``, the left limit where ``lefts[k]`` (one flag for
     every query, or one for all)."""

@@ -164,3 +164,37 @@ def test_the_bin_means_are_numpys_to_the_bit(seed):
     values = rng.standard_normal(n) * 10.0 ** rng.integers(-3, 6)
     want = np.bincount(bins, weights=values, minlength=counts.size) / counts
     np.testing.assert_array_equal(bin_means(bins, values, counts), want)
+
+
+def test_each_loop_is_compiled_once_for_read_only_and_writeable_arrays():
+    """A memoised (read-only) array and a fresh one take the same compiled version: a
+    user's first command compiles nothing that `make install` did not."""
+    from discovery.numerics import sampled
+
+    x = np.linspace(0.0, 1.0, 20)
+    ro = x.copy()
+    ro.setflags(write=False)
+    bins, counts = np.zeros(20, dtype=np.int64), np.array([20])
+    for a in (x, ro):
+        sampled.running_mean(a, 3)
+        sampled.threshold_runs(a, a, 0.5, 3, -1.0, 0.0)
+        sampled.abs_areas(np.diff(a), a)
+        sampled.in_widened(a, np.array([[0.1, 0.2]]), 0.0, 1.0)
+        sampled.bin_means(bins, a, counts)
+    for name in sampled.__all__:
+        assert len(getattr(sampled, name).signatures) == 1, name
+
+
+def test_the_criteria_interpolation_is_compiled_once():
+    """The compiled interpolation takes read-only and writeable signals and queries alike
+    (a memoised signal compiled a second and third version at a user's first command)."""
+    from discovery.numerics.piecewise import _values, periodic_values
+
+    t, F = np.array([0.0, 0.5, 0.5, 1.0]), np.array([0.0, 1.0, 2.0, 0.0])
+    ro_t, ro_q = t.copy(), np.linspace(0.0, 2.0, 9)
+    ro_t.setflags(write=False)
+    ro_q.setflags(write=False)
+    a = periodic_values(t, F, 1.0, np.linspace(0.0, 2.0, 9), "left")
+    b = periodic_values(ro_t, F, 1.0, ro_q, np.ones(9, dtype=bool))
+    np.testing.assert_array_equal(a, b)
+    assert len(_values.signatures) == 1

@@ -176,7 +176,8 @@ def _int_abs(h, d):
     """Exact integral of |d| for d piecewise linear on a grid of steps ``h``."""
     from ...numerics.sampled import abs_areas  # (numba: not at import, see --help)
 
-    return float(np.sum(abs_areas(h, np.ascontiguousarray(d, dtype=float))))
+    h, d = (np.ascontiguousarray(a, dtype=float) for a in (h, d))
+    return float(np.sum(abs_areas(h, d)))
 
 
 def _int_sq(h, d):

@@ -82,7 +82,11 @@ class Fold:
     def _bin_means(self, values):
         from ...numerics.sampled import bin_means  # (numba: not at import)
 
-        return bin_means(self.bins, np.ascontiguousarray(values, dtype=float), self.counts)
+        return bin_means(
+            np.ascontiguousarray(self.bins, dtype=np.int64),
+            np.ascontiguousarray(values, dtype=float),
+            np.ascontiguousarray(self.counts, dtype=np.int64),
+        )
 
     def _positive_phases(self, values):
         on = self.average(values) > 0.0
