@@ -9,10 +9,11 @@ impulses of every comparison this way, thousands of times in a fit.
 import numpy as np
 from numba import njit, types
 
-# compiled once, its inputs taken read-only (a writeable array is one too): a memoised
-# (read-only) signal or query compiled another version at a user's first command
-_F1 = types.Array(types.float64, 1, "C", readonly=True)
-_B1 = types.Array(types.boolean, 1, "C", readonly=True)
+from ._compiled_types import readonly
+
+# compiled once, for read-only C arrays (:func:`._compiled_types.readonly`)
+_F1 = readonly(types.float64)
+_B1 = readonly(types.boolean)
 
 __all__ = ["periodic_values"]
 

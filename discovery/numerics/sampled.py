@@ -14,13 +14,13 @@ summation), the callers' part.
 import numpy as np
 from numba import njit, types
 
-# Each loop is compiled once, for read-only arrays (C order): a writeable array is taken as
-# one too, so neither a memoised (read-only) nor a fresh array compiles another version at
-# a user's first command (a loop first compiled by a command took 0.7 s of the demo's
-# ``verify``); callers pass contiguous arrays of these types.
-_F1 = types.Array(types.float64, 1, "C", readonly=True)
-_F2 = types.Array(types.float64, 2, "C", readonly=True)
-_I1 = types.Array(types.int64, 1, "C", readonly=True)
+from ._compiled_types import readonly
+
+# each loop compiled once, for read-only C arrays (:func:`._compiled_types.readonly`);
+# callers pass contiguous arrays of these types
+_F1 = readonly(types.float64)
+_F2 = readonly(types.float64, 2)
+_I1 = readonly(types.int64)
 
 __all__ = ["running_mean", "threshold_runs", "abs_areas", "in_widened", "bin_means"]
 
