@@ -1,10 +1,15 @@
 """Figures drawn on ``matplotlib.figure.Figure`` objects: no pyplot, so drawing a report
 never switches the backend of a notebook or a GUI session that imported ``discovery``."""
 
+import contextlib
+import functools
+
 import matplotlib as mpl
 import numpy as np
 from matplotlib import colormaps
 from matplotlib.figure import Figure
+
+from discovery.outputs import hand_off
 
 __all__ = ["subplots", "save", "colormap", "PRINT_WIDTH", "MIN_TEXT_PT", "print_sizes"]
 
@@ -55,9 +60,11 @@ def save(fig, stem, dpi=130):
     twice per file (once to find its extent, once to print it), each time with a new
     renderer, so its layout engine runs twice and every text is measured and every
     mathtext label parsed again (matplotlib caches both per renderer). Here the figure is
-    drawn once on an Agg canvas at the PNG's ``dpi``, its layout engine run as the draw's
-    first step; the PNG is cut from that canvas (or drawn by savefig when an artist runs
-    past the figure's edge), and the PDF is printed in the same layout. The figure is left
+    laid out once by its layout engine on an Agg canvas at the PNG's ``dpi`` and drawn
+    there; the PNG is cut from that canvas (or drawn by savefig when an artist runs
+    past the figure's edge), and the PDF is printed in the same layout: within a command's
+    output directory by a forked child while the command goes on (the directory waits for
+    it: :mod:`discovery._files._handoff`), else before this returns. The figure is left
     as it was given (its canvas, dpi and layout engine).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -67,23 +74,48 @@ def save(fig, stem, dpi=130):
     try:
         agg = FigureCanvasAgg(fig)  # the figure's canvas until the end of the save
         fig.set_dpi(dpi)
-        agg.draw()  # laid out by its engine (the draw's first step) and drawn at this dpi
+        _lay_out(fig)  # as the canvas's draw would, with its renderer's text metrics
+        _set_layout_engine(fig, None)  # laid out: the PNG and the PDF are drawn in this layout
+        # the PDF printed by a forked child while the PNG is drawn here, where it may
+        # (discovery._files._handoff), else here and now: the same file either way
+        hand_off(paths[1], functools.partial(_print_pdf, fig, paths[1], own_dpi))
+        agg.draw()
         tight = fig.get_tightbbox(agg.get_renderer())  # the same renderer: texts measured
         bbox = tight.padded(mpl.rcParams["savefig.pad_inches"])
-        _set_layout_engine(fig, None)  # laid out: the PNG and the PDF are drawn in this layout
         if _drawn_whole(fig, tight):
             _write_png(paths[0], agg, bbox, dpi)
         else:  # savefig draws it again, past the figure's edge or on the user's background
             fig.savefig(paths[0], dpi=dpi, bbox_inches=bbox)
-        fig.set_dpi(own_dpi)  # the PDF's rasterized parts, if any, at the figure's dpi
-        # cut to its own extent: a PDF's text is measured unhinted, up to a few per cent
-        # wider than the PNG's, and a long line at the edge would lose its end
-        fig.savefig(paths[1], bbox_inches="tight")
     finally:
         fig.set_dpi(own_dpi)
         _set_layout_engine(fig, engine)
         fig.set_canvas(canvas)
     return paths
+
+
+def _lay_out(fig):
+    """Run ``fig``'s layout engine on its canvas's renderer: the first step of
+    ``Figure.draw`` (which, as there, lets a ValueError of a layout that cannot be met
+    pass), taken apart so that the PNG and the PDF are drawn in the one layout."""
+    engine = fig.get_layout_engine()
+    if fig.axes and engine is not None:
+        with contextlib.suppress(ValueError):
+            engine.execute(fig)
+
+
+def _print_pdf(fig, path, dpi):
+    """``fig`` as the PDF ``path`` in the layout it has (no layout engine run), at ``dpi``
+    (its rasterized parts, if any), cut to its own extent: a PDF's text is measured
+    unhinted, up to a few per cent wider than the PNG's, and a long line at the edge would
+    lose its end.  The figure is left as it was given."""
+    own_dpi, engine = fig.dpi, fig.get_layout_engine()
+    try:
+        fig.set_dpi(dpi)
+        _set_layout_engine(fig, None)
+        fig.savefig(path, bbox_inches="tight")
+    finally:
+        fig.set_dpi(own_dpi)
+        _set_layout_engine(fig, engine)
 
 
 def _set_layout_engine(fig, engine):

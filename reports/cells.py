@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from discovery.outputs import finish_handed_off
 from discovery.vibroimpact.verify.criteria import CRITERIA as _REGISTRY
 from discovery.vibroimpact.verify.criteria import MOTION_DEFINITIONS, definition
 
@@ -219,6 +220,7 @@ def _measured_rows(m, records=None):
 
 
 def _figures(run_dir, order):
+    finish_handed_off(under=run_dir)  # the PDFs forked children print, all there
     figs = []
     for stem in order:
         for p in sorted(Path(run_dir).glob(f"{stem}*.pdf")):

@@ -23,6 +23,8 @@ import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from discovery.outputs import finish_handed_off
+
 from .context import context
 from .run import RunDocument, run_document
 from .texenv import Tex, environment
@@ -236,6 +238,7 @@ def _safe_figure(parent, name):
     if not _SAFE_FILE.match(name):
         return None
     src = Path(parent) / name
+    finish_handed_off([src])  # a PDF a forked child prints is there first
     try:
         st = os.lstat(src)
     except OSError:

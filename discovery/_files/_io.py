@@ -45,6 +45,7 @@ from importlib import metadata
 from pathlib import Path
 
 from ..errors import InputError
+from . import _handoff
 from ._jsonable import load_json as load_json
 from ._jsonable import to_jsonable
 from ._output_checks import check_output
@@ -127,6 +128,7 @@ class OutputDir:
             ) from None
         _chmod_default(self.stage, directory=True)
         self._abs = target
+        _handoff.open_stage(self.stage)
         return self
 
     def path(self, name):
@@ -225,8 +227,11 @@ class OutputDir:
     def __exit__(self, exc_type, exc, tb):
         try:
             if exc_type is None:
+                _handoff.finish(under=self.stage)  # the figures printed by children
                 self._commit()
         finally:
+            if self.stage is not None:
+                _handoff.close_stage(self.stage)  # a failed run's children killed
             if self.stage is not None and self.stage.exists():
                 shutil.rmtree(self.stage, ignore_errors=True)
             if exc_type is not None or not self._abs.exists():

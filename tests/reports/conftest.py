@@ -111,6 +111,8 @@ def runs_and_figures(tmp_path_factory):
     commands saved (the same object, before and after it was written)."""
     from matplotlib.figure import Figure
 
+    from discovery._files import _handoff
+
     d = tmp_path_factory.mktemp("runs")
     drawn = {}
     save = Figure.savefig
@@ -125,6 +127,8 @@ def runs_and_figures(tmp_path_factory):
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(Figure, "savefig", keep)
+        # every PDF printed here, not by a forked child: the figures are kept in this process
+        mp.setattr(_handoff, "in_parallel", lambda: False)
         _make_runs(d)
     return d, drawn
 

@@ -1,0 +1,114 @@
+"""Files of a staged result written by a forked process while the command goes on.
+
+A figure is saved twice, as a PNG and as a PDF; the PDF's print (a layout pass of its own
+and the fonts' subsetting, about half of a figure's time) needs nothing the command does
+after it.  :func:`write` hands such a write to a forked child when the file lies in the
+staging directory of an open :class:`~discovery._files._io.OutputDir` of this process, on
+Linux with a second core, and returns at once; the output directory waits for its
+children before it puts the result in place (:func:`finish`) and kills them when the run
+fails (:func:`abandon`).  A reader of such a file within the run (LaTeX reading a figure)
+waits for it first (:func:`finish` with its paths).
+
+A child that fails or is killed leaves its file to the parent, which writes it itself:
+the result does not depend on the hand-off.  Elsewhere (a figure an API user saves, one
+core, no ``fork``) the write is done at once, in this process.
+"""
+
+import contextlib
+import os
+import signal
+import sys
+from pathlib import Path
+
+__all__ = ["write", "finish", "abandon", "open_stage", "close_stage", "in_parallel"]
+
+_STAGES = []  # the staging directories of this process's open output directories
+_PENDING = {}  # path -> (pid of the child writing it, the write itself)
+
+
+def in_parallel():
+    """Whether a write may be handed to a forked child here: Linux (``fork`` is safe with
+    the libraries loaded; elsewhere it is not promised) and a second core to run it on."""
+    if not (sys.platform.startswith("linux") and hasattr(os, "fork")):
+        return False
+    try:
+        return len(os.sched_getaffinity(0)) > 1
+    except (AttributeError, OSError):  # pragma: no cover - Linux has it
+        return (os.cpu_count() or 1) > 1
+
+
+def open_stage(stage):
+    """``stage`` (an output directory's staging directory) takes handed-off writes."""
+    _STAGES.append(Path(os.path.abspath(stage)))
+
+
+def close_stage(stage):
+    """``stage`` takes no more; its pending children are killed (:func:`abandon`)."""
+    stage = Path(os.path.abspath(stage))
+    abandon(stage)
+    with contextlib.suppress(ValueError):
+        _STAGES.remove(stage)
+
+
+def _stage_of(path):
+    return next((s for s in _STAGES if s == path.parent or s in path.parents), None)
+
+
+def write(path, fn):
+    """Write the file ``path`` by calling ``fn()`` (which writes it and may be called again):
+    in a forked child when ``path`` lies in an open stage and :func:`in_parallel`, else at
+    once.  A second write of one path waits for the first."""
+    path = Path(os.path.abspath(path))
+    if _stage_of(path) is None or not in_parallel():
+        fn()
+        return
+    finish([path])
+    pid = os.fork()
+    if pid == 0:  # the child: write, then leave without the parent's exit handlers
+        code = 1
+        try:
+            # Ctrl-C reaches the whole process group: the parent alone decides (it kills
+            # this child); and not the parent's SIGTERM handler (it raises its exception)
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+            fn()
+            code = 0
+        except BaseException:  # noqa: BLE001 - the parent writes the file again
+            code = 1
+        finally:
+            os._exit(code)
+    _PENDING[path] = (pid, fn)
+
+
+def finish(paths=None, under=None):
+    """Wait for the children writing ``paths`` (default: every pending one, or those in
+    the directory ``under``); a file whose child failed is written here."""
+    for path in _selected(paths, under):
+        pid, fn = _PENDING.pop(path)
+        try:
+            _, status = os.waitpid(pid, 0)
+        except ChildProcessError:  # reaped elsewhere: its outcome is unknown
+            status = None
+        if status is None or not (os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0):
+            fn()
+
+
+def abandon(under=None):
+    """Kill and reap the children writing into ``under`` (default: all), their files left
+    unwritten (a failed run's staging directory is removed)."""
+    for path in _selected(None, under):
+        pid, _ = _PENDING.pop(path)
+        with contextlib.suppress(OSError):
+            os.kill(pid, signal.SIGKILL)
+        with contextlib.suppress(OSError):
+            os.waitpid(pid, 0)
+
+
+def _selected(paths, under):
+    if paths is not None:
+        wanted = {Path(os.path.abspath(p)) for p in paths}
+        return [p for p in list(_PENDING) if p in wanted]
+    if under is None:
+        return list(_PENDING)
+    under = Path(os.path.abspath(under))
+    return [p for p in list(_PENDING) if under in p.parents]
