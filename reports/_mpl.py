@@ -77,7 +77,11 @@ def save(fig, stem, dpi=130):
         _lay_out(fig)  # as the canvas's draw would, with its renderer's text metrics
         _set_layout_engine(fig, None)  # laid out: the PNG and the PDF are drawn in this layout
         # the PDF printed by a forked child while the PNG is drawn here, where it may
-        # (discovery._files._handoff), else here and now: the same file either way
+        # (discovery._files._handoff), else here and now: the same file either way. The
+        # PDF backend is loaded here first (0.1-0.5 s, its fonts' subsetting), once for
+        # every child, not by each
+        import matplotlib.backends.backend_pdf  # noqa: F401
+
         hand_off(paths[1], functools.partial(_print_pdf, fig, paths[1], own_dpi))
         agg.draw()
         tight = fig.get_tightbbox(agg.get_renderer())  # the same renderer: texts measured
