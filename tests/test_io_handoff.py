@@ -60,6 +60,30 @@ def test_finish_waits_for_the_files_a_reader_needs(tmp_path):
         assert out.path("a.txt").exists() and not _handoff._PENDING
 
 
+def test_a_reader_in_another_thread_finds_the_file_there(tmp_path):
+    """LaTeX's thread (``vidi fit``) waits for the figure it reads while this thread hands
+    off the next ones."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    with OutputDir(tmp_path / "out") as out, ThreadPoolExecutor(1) as reader:
+        _handoff.write(out.path("a.txt"), _writer(out.path("a.txt"), sleep=0.3))
+
+        def read():
+            _handoff.finish([out.path("a.txt")])
+            return out.path("a.txt").read_text()
+
+        seen = reader.submit(read)
+        for k in range(3):
+            _handoff.write(out.path(f"b{k}.txt"), _writer(out.path(f"b{k}.txt")))
+        assert int(seen.result()) != os.getpid()
+    assert sorted(p.name for p in (tmp_path / "out").glob("*.txt")) == [
+        "a.txt",
+        "b0.txt",
+        "b1.txt",
+        "b2.txt",
+    ]
+
+
 def test_a_failed_run_kills_its_children_and_leaves_the_target(tmp_path):
     (tmp_path / "out").mkdir()
     with pytest.raises(KeyError), OutputDir(tmp_path / "out") as out:

@@ -18,12 +18,16 @@ import contextlib
 import os
 import signal
 import sys
+import threading
 from pathlib import Path
 
 __all__ = ["write", "finish", "abandon", "open_stage", "close_stage", "in_parallel"]
 
 _STAGES = []  # the staging directories of this process's open output directories
 _PENDING = {}  # path -> (pid of the child writing it, the write itself)
+# held while the registry changes and while its children are waited for: a reader in another
+# thread (LaTeX's, in ``vidi fit``) returns once the file it waits for is there
+_LOCK = threading.RLock()
 
 
 def in_parallel():
@@ -62,7 +66,14 @@ def write(path, fn):
     if _stage_of(path) is None or not in_parallel():
         fn()
         return
-    finish([path])
+    with _LOCK:
+        finish([path])
+        pid = _forked(fn)
+        _PENDING[path] = (pid, fn)
+
+
+def _forked(fn):
+    """The pid of a forked child that calls ``fn()`` and exits: 0 when it wrote, else 1."""
     pid = os.fork()
     if pid == 0:  # the child: write, then leave without the parent's exit handlers
         code = 1
@@ -77,31 +88,33 @@ def write(path, fn):
             code = 1
         finally:
             os._exit(code)
-    _PENDING[path] = (pid, fn)
+    return pid
 
 
 def finish(paths=None, under=None):
     """Wait for the children writing ``paths`` (default: every pending one, or those in
     the directory ``under``); a file whose child failed is written here."""
-    for path in _selected(paths, under):
-        pid, fn = _PENDING.pop(path)
-        try:
-            _, status = os.waitpid(pid, 0)
-        except ChildProcessError:  # reaped elsewhere: its outcome is unknown
-            status = None
-        if status is None or not (os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0):
-            fn()
+    with _LOCK:
+        for path in _selected(paths, under):
+            pid, fn = _PENDING.pop(path)
+            try:
+                _, status = os.waitpid(pid, 0)
+            except ChildProcessError:  # reaped elsewhere: its outcome is unknown
+                status = None
+            if status is None or not (os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0):
+                fn()
 
 
 def abandon(under=None):
     """Kill and reap the children writing into ``under`` (default: all), their files left
     unwritten (a failed run's staging directory is removed)."""
-    for path in _selected(None, under):
-        pid, _ = _PENDING.pop(path)
-        with contextlib.suppress(OSError):
-            os.kill(pid, signal.SIGKILL)
-        with contextlib.suppress(OSError):
-            os.waitpid(pid, 0)
+    with _LOCK:
+        for path in _selected(None, under):
+            pid, _ = _PENDING.pop(path)
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
+            with contextlib.suppress(OSError):
+                os.waitpid(pid, 0)
 
 
 def _selected(paths, under):
