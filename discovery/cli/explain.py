@@ -77,12 +77,13 @@ def run(args):
         "data": data_entry(args.data),
     }
     tail = {"catalogue": [e.as_dict() for e in EFFECTS], "explain_settings": res.settings}
-    loops = _final_loops(res, scs[0], meas[0], args)
     with OutputDir(args.out) as out:
         files = []
         for k, it in enumerate(res.iterations, start=1):
             explain_figure(it, it.measured, str(out.path(f"explain_{k}")), k)
             files.append(f"explain_{k}.png/.pdf")
+        # the final model's loops, simulated while a child prints the figures' PDFs
+        loops = _final_loops(res, scs[0], meas[0], args)
         if loops is not None:
             loops_figure(
                 *loops,
