@@ -4,7 +4,7 @@ before and after, phases, the coefficient plane and the effects' scores."""
 import numpy as np
 
 from .._mpl import PRINT_WIDTH, print_sizes, save, subplots
-from .figure_parts import terms_math
+from .figure_parts import contact_view, terms_math
 
 __all__ = ["explain_figure"]
 
@@ -12,28 +12,24 @@ _save = save
 
 
 def _explain_forces(ax, iteration, measured, k):
-    """The force before and after the named effect, against the record."""
+    """The force before and after the named effect, against the record, over the contact:
+    its times re-based on the contact's start, so a contact that crosses the fold's end is
+    shown whole (:func:`~.figure_parts.contact_view`), not its tail alone."""
     E = measured
-    ax.plot(E.t * 1e3, E.F / 1e3, "k-", lw=2, label="measured")
+    curves = [(E.F, {"color": "k", "lw": 2, "label": "measured"})]
     if iteration.simulated_before is not None:
-        ax.plot(
-            E.t * 1e3,
-            iteration.simulated_before.F / 1e3,
-            "-",
-            color="tab:red",
-            label=terms_math(f"before ({' + '.join(iteration.model_before.law.names)})"),
-        )
+        names = " + ".join(iteration.model_before.law.names)
+        label = terms_math(f"before ({names})")
+        curves.append((iteration.simulated_before.F, {"color": "tab:red", "label": label}))
     if iteration.effect and iteration.simulated_after is not None:
-        ax.plot(
-            E.t * 1e3,
-            iteration.simulated_after.F / 1e3,
-            "-",
-            color="tab:blue",
-            label=f"+ {iteration.effect.replace('_', ' ')}",
-        )
-    if len(E.support):
-        a, b = E.support[0]
-        ax.set_xlim(max(a - 0.1 * (b - a), 0) * 1e3, (b + 0.3 * (b - a)) * 1e3)
+        label = f"+ {iteration.effect.replace('_', ' ')}"
+        curves.append((iteration.simulated_after.F, {"color": "tab:blue", "label": label}))
+    tr, o, (lo, hi) = contact_view(
+        E.t, E.duration, *(F for F, _ in curves), threshold=max(0.02 * E.peak, 5.0 * E.noise)
+    )
+    for F, style in curves:
+        ax.plot(tr[o] * 1e3, np.asarray(F)[o] / 1e3, "-", **style)
+    ax.set_xlim(lo * 1e3, hi * 1e3)
     ax.set_xlabel("time since onset [ms]")
     ax.set_ylabel("contact force [kN]")
     i2b = iteration.criteria_before.get("I2", float("nan"))

@@ -788,7 +788,7 @@ def test_explain_forces_legend_covers_no_curve():
 
     t = np.linspace(0, 6e-3, 300)
     F = 2e6 * np.exp(-t / 1.5e-3) * (t > 2e-4)
-    imp = _ns(t=t, F=F, support=np.array([[2e-4, 5e-3]]))
+    imp = _ns(t=t, F=F, support=np.array([[2e-4, 5e-3]]), duration=6e-3, peak=F.max(), noise=0.0)
     it = _ns(
         simulated_before=_ns(F=0.9 * F),
         simulated_after=_ns(F=F),
@@ -806,6 +806,47 @@ def test_explain_forces_legend_covers_no_curve():
     top = max(ax.transData.transform(np.c_[ln.get_xdata(), ln.get_ydata()])[:, 1].max()
               for ln in ax.lines)  # fmt: skip
     assert box.y0 > top
+
+
+def test_explain_forces_show_a_contact_that_crosses_the_folds_end_whole():
+    """A contact that begins late in the folded cycle and ends after its start: the panel
+    shows it from its onset through its peak (it showed the tail after the fold's start,
+    the peak out of view), on times since the onset."""
+    import numpy as np
+
+    from reports._mpl import print_sizes, subplots
+    from reports.vibroimpact.explain_figures import _explain_forces
+
+    period = 8e-3
+    t = np.linspace(0.0, period, 400, endpoint=False)
+    since = np.mod(t - 6.5e-3, period)  # the onset at 6.5 ms, the contact 2.5 ms long
+    F = np.where(since < 2.5e-3, 5e6 * np.sin(np.pi * since / 2.5e-3), 0.0)
+    imp = _ns(
+        t=t,
+        F=F,
+        support=np.array([[0.0, 1e-3], [6.5e-3, period]]),
+        duration=period,
+        peak=F.max(),
+        noise=0.0,
+    )
+    it = _ns(
+        simulated_before=_ns(F=0.9 * F),
+        simulated_after=_ns(F=F),
+        model_before=_ns(law=_ns(names=["z", "zd"])),
+        effect="unloading_damping",
+        criteria_before={"I2": 0.136},
+        criteria_after={"I2": 0.0245},
+        noise_floor={"I2": 0.026},
+    )
+    with print_sizes():
+        fig, ax = subplots(figsize=(3.3, 3.0))
+        _explain_forces(ax, it, imp, 1)
+    lo, hi = ax.get_xlim()
+    x, y = ax.lines[0].get_xdata(), ax.lines[0].get_ydata()
+    shown = (x >= lo) & (x <= hi)
+    assert lo < 0.0 < 2.5 < hi  # [ms]: the onset and the end in view
+    assert y[shown].max() == y.max() > 4.99e3  # the peak [kN]
+    assert np.all(np.diff(x) > 0)  # one run, not the cycle's two pieces
 
 
 def test_identify_figure_names_the_search_value_and_the_final_check_s():
