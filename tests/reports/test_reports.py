@@ -779,6 +779,20 @@ def test_fit_loop_draws_the_model_above_every_impact_s_samples(tmp_path):
     assert "model, impact 0" in labels and "model unloading (dashed)" in labels
 
 
+def _explain_iteration(F):
+    """An explain iteration whose model before reads 0.9 of the force ``F`` and whose
+    unloading damping reads it exactly (the force panel's inputs)."""
+    return _ns(
+        simulated_before=_ns(F=0.9 * F),
+        simulated_after=_ns(F=F),
+        model_before=_ns(law=_ns(names=["z", "zd"])),
+        effect="unloading_damping",
+        criteria_before={"I2": 0.136},
+        criteria_after={"I2": 0.0245},
+        noise_floor={"I2": 0.026},
+    )
+
+
 def test_explain_forces_legend_covers_no_curve():
     """The legend of explain's force panel sits above every curve (it hid the peak)."""
     import numpy as np
@@ -789,15 +803,7 @@ def test_explain_forces_legend_covers_no_curve():
     t = np.linspace(0, 6e-3, 300)
     F = 2e6 * np.exp(-t / 1.5e-3) * (t > 2e-4)
     imp = _ns(t=t, F=F, support=np.array([[2e-4, 5e-3]]), duration=6e-3, peak=F.max(), noise=0.0)
-    it = _ns(
-        simulated_before=_ns(F=0.9 * F),
-        simulated_after=_ns(F=F),
-        model_before=_ns(law=_ns(names=["z", "zd"])),
-        effect="unloading_damping",
-        criteria_before={"I2": 0.136},
-        criteria_after={"I2": 0.0245},
-        noise_floor={"I2": 0.026},
-    )
+    it = _explain_iteration(F)
     with print_sizes():  # as explain_figure draws it: one of four panels of the page
         fig, ax = subplots(figsize=(3.3, 3.0))
         _explain_forces(ax, it, imp, 1)
@@ -829,15 +835,7 @@ def test_explain_forces_show_a_contact_that_crosses_the_folds_end_whole():
         peak=F.max(),
         noise=0.0,
     )
-    it = _ns(
-        simulated_before=_ns(F=0.9 * F),
-        simulated_after=_ns(F=F),
-        model_before=_ns(law=_ns(names=["z", "zd"])),
-        effect="unloading_damping",
-        criteria_before={"I2": 0.136},
-        criteria_after={"I2": 0.0245},
-        noise_floor={"I2": 0.026},
-    )
+    it = _explain_iteration(F)
     with print_sizes():
         fig, ax = subplots(figsize=(3.3, 3.0))
         _explain_forces(ax, it, imp, 1)
