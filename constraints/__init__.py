@@ -20,6 +20,8 @@ builders
     cvxpy constraints on the **scaled** coefficients ``x_i = c_i Z**a_i V**b_i`` [N].
 verify
     :func:`certify` (Bernstein + dense grid), :class:`Certificate`, :func:`require`.
+_cvxpy
+    ``cvxpy``, imported without ``scipy.stats`` (for one name it never uses here).
 solver
     :func:`solve`, a cvxpy wrapper that raises on any non-optimal status.
 errors
@@ -46,6 +48,7 @@ _EXPORTS = {
     "normalized_rows": "builders",
     "physical": "builders",
     "sign_rows": "builders",
+    "cvxpy": "_cvxpy",
     "Box": "domain",
     "CertificateError": "errors",
     "InputError": "errors",

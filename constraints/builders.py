@@ -27,9 +27,9 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-import cvxpy as cp
 import numpy as np
 
+from ._cvxpy import cvxpy as cp
 from .bernstein import bernstein_map, check_margin
 from .domain import Box
 from .errors import InputError

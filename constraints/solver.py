@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-import cvxpy as cp
-
+from ._cvxpy import cvxpy as cp
 from .errors import SolverError
 
 __all__ = ["solve"]

@@ -4,10 +4,10 @@ unconstrained, precise and constrained fits (with the solver fallback), and its 
 import math
 from dataclasses import dataclass
 
-import cvxpy as cp
 import numpy as np
 
 from constraints import constraint_rows, normalized_rows, scale_factors, solve
+from constraints import cvxpy as cp
 from constraints.errors import SolverError
 
 from ...errors import InputError

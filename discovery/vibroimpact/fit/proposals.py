@@ -5,9 +5,9 @@ path."""
 import itertools
 import math
 
-import cvxpy as cp
 import numpy as np
 
+from constraints import cvxpy as cp
 from constraints import solve
 
 from ...errors import InputError
