@@ -330,6 +330,7 @@ class IdentifySettings(Settings):
     interval_refit: str = option("two-step", Choice(*INTERVAL_REFITS))
     interval_noise: str = option("cycles", Choice(*INTERVAL_NOISE))
     give_up_above: object = option(None, (None, Real(0, open_low=True)))
+    restart_above: object = option(None, (None, Real(0)))
 
 
 @takes(IdentifySettings)
@@ -406,6 +407,12 @@ def identify(scenario, reference, start, *, settings=None, progress=None, **opti
         law that can match the record).  ``discover`` sets it at ten times the record's
         consistency limit of the criterion, at least 0.5
         (:data:`~discovery.vibroimpact.fit.shortlist.GIVE_UP_FACTOR`).
+    restart_above : float, optional
+        A fit on the blocks whose criterion is at or below this value is not started again
+        from its best point scaled (:data:`~discovery.vibroimpact.fit.optimise.RESTART_FACTORS`):
+        it already matches the records to within their noise.  ``discover`` sets it at the
+        smallest consistency limit of the criterion over the records; None (the default)
+        restarts every fit below ``give_up_above``.
 
     Returns
     -------
@@ -456,9 +463,8 @@ def _identified(records, start, s, progress):
         message = f"given up after the cycle-by-cycle fit: {s.criterion} {given_up}"
     else:
         # before the error probes
-        x_best, message = _fitted(
-            obj, s.method, s.xtol, s.max_simulations, give_up_above=s.give_up_above
-        )
+        screens = (s.give_up_above, s.restart_above)
+        x_best, message = _fitted(obj, s.method, s.xtol, s.max_simulations, screens=screens)
     law = obj.law(x_best)
     evs = obj.full_evaluations(x_best)
     if evs is None:  # a given-up start compared on the blocks before: never, short of a bug

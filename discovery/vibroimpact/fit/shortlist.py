@@ -65,7 +65,8 @@ class _Checker:
     ``refs`` every record's ``(Scenario, Reference)``, ``budget`` the simulations of one
     refinement, ``required`` the terms no backward step drops, ``give_up_above`` the
     criterion above which a refinement stops after its cycle-by-cycle first fit
-    (:meth:`screen_from`), ``sensor_lag`` the force sensor's time constant every simulated
+    (:meth:`screen_from`), ``restart_above`` the criterion at or below which a refinement
+    is not restarted (the same), ``sensor_lag`` the force sensor's time constant every simulated
     force is read through (:attr:`observe`)."""
 
     est: CertifiedSparseFit
@@ -78,6 +79,7 @@ class _Checker:
     required: frozenset = frozenset()
     workers: int | None = 1
     give_up_above: float | None = None
+    restart_above: float | None = None
     sensor_lag: float = 0.0
 
     @cached_property
@@ -94,7 +96,9 @@ class _Checker:
 
     def screen_from(self, laws):
         """Set :attr:`give_up_above` to :data:`GIVE_UP_FACTOR` times the records' largest
-        consistency limit of the criterion, or :data:`GIVE_UP_FLOOR` when larger, read from
+        consistency limit of the criterion, or :data:`GIVE_UP_FLOOR` when larger, and
+        :attr:`restart_above` to their smallest limit (a refinement that ends within it
+        matches every record to its noise and is not restarted: :func:`identify`), read from
         the first of ``laws`` that every record can be compared with (the limits follow the
         record's noise, not the law).  None (no screen) when the criterion has no limit or
         no law simulates, and when a record's limit is not finite."""
@@ -109,6 +113,7 @@ class _Checker:
             # a limit that is not finite (a record whose floor the law cannot set) is none
             if None not in lims and np.all(np.isfinite(lims)):
                 self.give_up_above = max(GIVE_UP_FACTOR * max(lims), GIVE_UP_FLOOR)
+                self.restart_above = float(min(lims))
             return
 
     def run(self, jobs, stage=None, progress=None):
@@ -221,6 +226,7 @@ class _Checker:
             tolerances=self.tol,
             check=False,
             give_up_above=self.give_up_above,
+            restart_above=self.restart_above,
             observe=self.observe,
         )
 

@@ -434,7 +434,8 @@ def test_rank_puts_laws_that_are_no_contact_laws_last():
 
 
 def test_a_record_without_a_finite_limit_sets_no_give_up_screen():
-    """A record whose consistency limit the law cannot set (infinite) gives no screen: an
+    """The screens are read from the records' limits; a record whose consistency limit the
+    law cannot set (infinite) gives none: an
     infinite ``give_up_above`` had stopped the fit with an input error (the effects survey's
     draw 17, noisier record: a 1.07 ms sensor lag, fitted without it on the machine
     calibrated from a 5 % sheet)."""
@@ -450,6 +451,8 @@ def test_a_record_without_a_finite_limit_sets_no_give_up_screen():
     finite = checker([0.04, 0.05])
     finite.screen_from(["law"])
     assert finite.give_up_above == max(GIVE_UP_FACTOR * 0.05, GIVE_UP_FLOOR)
+    # a refinement within the smallest limit is not restarted (identify's restart_above)
+    assert finite.restart_above == 0.04
     infinite = checker([0.04, math.inf])
     infinite.screen_from(["law"])
-    assert infinite.give_up_above is None
+    assert infinite.give_up_above is None and infinite.restart_above is None
