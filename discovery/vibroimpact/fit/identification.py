@@ -410,8 +410,8 @@ def identify(scenario, reference, start, *, settings=None, progress=None, **opti
     restart_above : float, optional
         A fit on the blocks whose criterion is at or below this value is not started again
         from its best point scaled (:data:`~discovery.vibroimpact.fit.optimise.RESTART_FACTORS`):
-        it already matches the records to within their noise.  ``discover`` sets it at the
-        smallest consistency limit of the criterion over the records; None (the default)
+        it already matches the records as well as the true law would.  ``discover`` sets it
+        at the smallest noise floor of the criterion over the records; None (the default)
         restarts every fit below ``give_up_above``.
 
     Returns

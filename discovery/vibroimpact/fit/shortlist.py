@@ -97,11 +97,12 @@ class _Checker:
     def screen_from(self, laws):
         """Set :attr:`give_up_above` to :data:`GIVE_UP_FACTOR` times the records' largest
         consistency limit of the criterion, or :data:`GIVE_UP_FLOOR` when larger, and
-        :attr:`restart_above` to their smallest limit (a refinement that ends within it
-        matches every record to its noise and is not restarted: :func:`identify`), read from
-        the first of ``laws`` that every record can be compared with (the limits follow the
-        record's noise, not the law).  None (no screen) when the criterion has no limit or
-        no law simulates, and when a record's limit is not finite."""
+        :attr:`restart_above` to their smallest noise floor of it (a refinement that ends
+        there matches every record as the true law would and is not restarted:
+        :func:`identify`), read from the first of ``laws`` that every record can be compared
+        with (the limits and floors follow the record's noise, not the law).  None (no
+        screen) when the criterion has no limit or no law simulates, and when a record's
+        limit (or, for :attr:`restart_above`, its floor) is not finite."""
         for law in laws:
             try:
                 evs = self.evaluate(law)
@@ -113,7 +114,9 @@ class _Checker:
             # a limit that is not finite (a record whose floor the law cannot set) is none
             if None not in lims and np.all(np.isfinite(lims)):
                 self.give_up_above = max(GIVE_UP_FACTOR * max(lims), GIVE_UP_FLOOR)
-                self.restart_above = float(min(lims))
+                floors = [(e.noise_floor or {}).get(self.criterion, np.nan) for e in evs]
+                if np.all(np.isfinite(floors)):
+                    self.restart_above = float(min(floors))
             return
 
     def run(self, jobs, stage=None, progress=None):

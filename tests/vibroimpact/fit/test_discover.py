@@ -445,14 +445,17 @@ def test_a_record_without_a_finite_limit_sets_no_give_up_screen():
 
     def checker(limits):
         c = _Checker(None, None, [], "I2", True, None, 10)
-        c.evaluate = lambda law: [SimpleNamespace(status="ok", limits={"I2": v}) for v in limits]
+        c.evaluate = lambda law: [
+            SimpleNamespace(status="ok", limits={"I2": v}, noise_floor={"I2": v / 2})
+            for v in limits
+        ]
         return c
 
     finite = checker([0.04, 0.05])
     finite.screen_from(["law"])
     assert finite.give_up_above == max(GIVE_UP_FACTOR * 0.05, GIVE_UP_FLOOR)
-    # a refinement within the smallest limit is not restarted (identify's restart_above)
-    assert finite.restart_above == 0.04
+    # a refinement at the smallest floor is not restarted (identify's restart_above)
+    assert finite.restart_above == 0.02
     infinite = checker([0.04, math.inf])
     infinite.screen_from(["law"])
     assert infinite.give_up_above is None and infinite.restart_above is None

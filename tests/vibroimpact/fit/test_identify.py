@@ -395,17 +395,17 @@ def test_a_fit_above_the_screen_without_progress_stops_and_is_not_restarted(pape
 
 
 def test_a_fit_within_the_consistency_limit_is_not_restarted(paper, reference, fitted):
-    """``restart_above``: a right law's fit that ends within the records' consistency limit
-    is not started again from its best point scaled (the restarts only leave a wrong
-    basin); it ends where the restarted fit ends and needs fewer simulations.  Below the
-    fit's criterion the restarts run as before."""
+    """``restart_above``: a right law's fit that ends at or below it (``discover``: the
+    records' noise floor) is not started again from its best point scaled (the restarts
+    only leave a wrong basin); it ends where the restarted fit ends and needs fewer
+    simulations.  Below the fit's criterion the restarts run as before."""
     kept = identify(paper, reference, START, method="least-squares", restart_above=1.0)
-    assert "not restarted: I2" in kept.message and "consistency limit" in kept.message
+    assert "not restarted: I2" in kept.message and "noise floor" in kept.message
     assert "restarted from the best point" not in kept.message
     assert kept.n_simulations < fitted.n_simulations
     np.testing.assert_allclose(kept.law.coefficients, fitted.law.coefficients, rtol=1e-3)
     low = identify(paper, reference, START, method="least-squares", restart_above=1e-12)
-    assert "consistency limit" not in low.message
+    assert "noise floor" not in low.message
     assert low.law.coefficients == fitted.law.coefficients
     assert low.n_simulations == fitted.n_simulations
 
