@@ -61,7 +61,7 @@ demo: install
 	$(BIN)/vidi report $(DEMO)/explain
 	@echo "demo done: read $(DEMO)/explain/report.pdf (or report.tex without TeX: make tex)"
 
-# The shipped model-term selection study (120 runs, 10-20 min on two cores; resumable: run it
+# The shipped model-term selection study (120 runs, 4-10 min on two cores; resumable: run it
 # again after an interruption), then its report
 study: install
 	$(BIN)/vidi study --config examples/study_paper.toml --out out/study
