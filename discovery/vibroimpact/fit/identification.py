@@ -58,7 +58,7 @@ from .intervals import (
     Intervals,
     bootstrap_intervals,
 )
-from .optimise import METHODS, _checked, _fitted
+from .optimise import METHODS, Screens, _checked, _fitted
 from .problem import _Objective, _uncertainty
 from .records import (
     _named,
@@ -463,7 +463,7 @@ def _identified(records, start, s, progress):
         message = f"given up after the cycle-by-cycle fit: {s.criterion} {given_up}"
     else:
         # before the error probes
-        screens = (s.give_up_above, s.restart_above)
+        screens = Screens(s.give_up_above, s.restart_above)
         x_best, message = _fitted(obj, s.method, s.xtol, s.max_simulations, screens=screens)
     law = obj.law(x_best)
     evs = obj.full_evaluations(x_best)

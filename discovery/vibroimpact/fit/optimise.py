@@ -3,6 +3,8 @@ coordinate descent, scipy's Nelder-Mead and trust-region least squares, restarts
 point, and the settings they check.
 """
 
+from typing import NamedTuple
+
 import numpy as np
 from scipy.optimize import least_squares, minimize
 
@@ -204,6 +206,18 @@ def _optimise(obj, x0, method, xtol, max_simulations, *, give_up_above=None):
         return "stopped: the optimiser's step was not finite (the best point met is kept)"
 
 
+class Screens(NamedTuple):
+    """The criterion values that cut a fit short (either None: no such cut):
+    ``give_up_above``, the shortlist's screen of hopeless laws (:class:`_StopRules`; no
+    restart above it), and ``restart_above``, the records' noise floor (no restart at or
+    below it): :func:`_restarted`."""
+
+    give_up_above: float | None = None
+    restart_above: float | None = None
+
+
+_NO_SCREENS = Screens()
+
 RESTART_FACTORS = (1.25, 0.8)
 """After the first optimisation, it is started again from its best point with every
 parameter scaled by each factor, while the budget allows, and the best point is kept (by the
@@ -213,7 +227,7 @@ record's transient); a restart from a stiffer and a softer point often leaves su
 (the rates: CHANGELOG)."""
 
 
-def _restarted(obj, method, xtol, max_simulations, message, *, screens=(None, None)):
+def _restarted(obj, method, xtol, max_simulations, message, *, screens=_NO_SCREENS):
     """:data:`RESTART_FACTORS` restarts from the best point (see there); the message says
     which improved it.  A fit whose criterion is still above ``give_up_above`` (the
     shortlist's screen of hopeless laws, :class:`_StopRules`) is not restarted: a restart
@@ -230,9 +244,8 @@ def _restarted(obj, method, xtol, max_simulations, message, *, screens=(None, No
     a lower sum of squares elsewhere would be fitted noise.  Within the consistency limit
     (about twice the floor) is not enough: on the fit-sheet survey's draw 6 a first fit
     stopped at I2 0.054, within its limit 0.075, its spring 3 % stiff, and the restart from
-    0.8 times it reached the floor, 0.035, and the spring within 0.5 %.
-
-    ``screens`` is ``(give_up_above, restart_above)``, either None."""
+    0.8 times it reached the floor, 0.035, and the spring within 0.5 % (``screens``:
+    :class:`Screens`)."""
     give_up_above, restart_above = screens
     if _above_screen(obj, give_up_above):
         return message + (
@@ -265,10 +278,10 @@ def _restarted(obj, method, xtol, max_simulations, message, *, screens=(None, No
     return message
 
 
-def _fitted(obj, method, xtol, max_simulations, *, restarts=True, screens=(None, None)):
+def _fitted(obj, method, xtol, max_simulations, *, restarts=True, screens=_NO_SCREENS):
     """Optimise ``obj`` from its start (``x = 1``), then restart from the best point
     (:func:`_restarted`; not with ``restarts=False``, nor when the criterion is still above
-    ``screens[0]`` (``give_up_above``) or at most ``screens[1]`` (``restart_above``)):
+    ``screens.give_up_above`` or at most ``screens.restart_above``: :class:`Screens`):
     ``(the fitted x, the optimiser's message)``.
 
     Raises
@@ -284,7 +297,7 @@ def _fitted(obj, method, xtol, max_simulations, *, restarts=True, screens=(None,
             f"{f['status']} ({f['message']}); give start values closer to "
             "the record (e.g. from vidi fit)"
         )
-    message = _optimise(obj, x0, method, xtol, max_simulations, give_up_above=screens[0])
+    message = _optimise(obj, x0, method, xtol, max_simulations, give_up_above=screens.give_up_above)
     if obj.best[1] is None:  # least squares evaluates residuals, which record the path
         obj(x0)
     if restarts:
