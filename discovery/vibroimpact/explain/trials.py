@@ -632,9 +632,7 @@ def _met(law, met):
     """Whether ``law``'s parameters agree with one of ``met``'s to :data:`SAME_POINT`."""
     x = np.asarray(law.coefficients, dtype=float)
     return any(
-        m.coefficients is not None
-        and len(m.coefficients) == x.size
-        and np.allclose(m.coefficients, x, rtol=SAME_POINT, atol=0.0)
+        len(m.coefficients) == x.size and np.allclose(m.coefficients, x, rtol=SAME_POINT, atol=0)
         for m in met
     )
 

@@ -862,7 +862,7 @@ def test_a_drift_refit_also_starts_from_the_regressions_law(monkeypatch):
     reached = {stiff: 0.147, regressed: 0.076}
     starts = []
 
-    def refit(run, start, budget, gap):
+    def refit(run, start, budget, gap, met=None):
         starts.append(start.law)
         return start, SimpleNamespace(start=start.law), reached[start.law]
 
