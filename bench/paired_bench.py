@@ -39,7 +39,20 @@ COMMANDS = {
     "contact-models": (["fit", "--data", "M.csv", "--library", "contact-models"], False),
     # the README's quickstart, as a newcomer types it (Q.csv: 12 periods on the orbit)
     "fit-readme": (["fit", "--data", "Q.csv"], True),
+    # the demo's fit (make demo): its two 30-period records at two drive amplitudes, jointly
+    "fit-demo": (
+        "fit --scenario high.toml --scenario low.toml --data high.csv --data low.csv".split(),
+        False,
+    ),
 }
+#: the field-like corpus (records of a simulator not ours, ``../shared/corpus``): explain on
+#: the records issue 52 names, each with its own scenario
+CORPUS = ROOT.parent / "shared" / "corpus"
+for _name in ("c02-steep-onset", "c06-unloading-damping", "c12-coupling-unloading"):
+    if (CORPUS / _name / "measured.csv").is_file():
+        _files = ["--data", str(CORPUS / _name / "measured.csv")]
+        _files += ["--scenario", str(CORPUS / _name / "scenario.toml")]
+        COMMANDS[f"explain-{_name[:3]}"] = (["explain", *_files], False)
 
 
 def baseline_tree():
@@ -91,7 +104,7 @@ def _vidi(code_root, words, cwd):
 def record(cwd):
     """The bench records: the paper's machine from rest by the scipy path, 1 % noise (a
     record in its transient, as the README's first record), the README's record of the
-    named models, and the README quickstart's record."""
+    named models, the README quickstart's record and the demo's two records."""
     _vidi(
         ROOT,
         [
@@ -119,6 +132,17 @@ def record(cwd):
     # above (a damping-only law restarted where each simulation takes 0.25 s: CHANGELOG)
     words = ["simulate", "--scenario", "paper", "--periods", "12", "--noise", "0.01"]
     _vidi(ROOT, words + ["--seed", "1", "--out", "Q.csv"], cwd)
+    # the demo's records (the Makefile's demo target): its machine at two drive amplitudes,
+    # from rest by the scipy path, the contact damping while unloading
+    machine = "m1 = 1.0e4\nm2 = 1.0e4\nk1 = 2.75e7\nc1 = 1.0e5\nfrequency = 25.0\n"
+    law = "2.06e8*z + 4e6*zd"
+    for name, amplitude, seed in (("high", "5.0e5", "1"), ("low", "3.5e5", "2")):
+        (cwd / f"{name}.toml").write_text(
+            f'name = "grid-{name}"\n[machine]\n{machine}A = {amplitude}\n[law]\ntext = "{law}"\n'
+        )
+        words = ["simulate", "--scenario", f"{name}.toml", "--law", f"{law}; unloading: 4e6*zd"]
+        words += ["--from-rest", "--integrator", "scipy", "--periods", "30", "--noise", "0.01"]
+        _vidi(ROOT, words + ["--seed", seed, "--out", f"{name}.csv"], cwd)
 
 
 def paired(name, words, pairs, cwd, old):

@@ -26,8 +26,9 @@ Writes ``bench/results.json``.  Figures:
 9. how parallel work scales (``bench/scaling_bench.py``): a 24-run study and ``explain`` on
    1, 2 and every core, with the study's parallel efficiency.
 10. old against new (``bench/paired_bench.py``): ``verify``, ``fit``, ``explain``, the
-    five named contact models and the README quickstart's ``fit`` run with a checkout of
-    the baseline commit and with this one,
+    five named contact models, the README quickstart's and the demo's ``fit`` and
+    ``explain`` on the corpus records c02, c06 and c12 run with a checkout of the baseline
+    commit and with this one,
     alternately, the median of the pairs' ratios, beside the work each command counted
     (``summary.json``'s ``counts``).
 

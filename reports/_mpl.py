@@ -60,12 +60,13 @@ def save(fig, stem, dpi=130):
     twice per file (once to find its extent, once to print it), each time with a new
     renderer, so its layout engine runs twice and every text is measured and every
     mathtext label parsed again (matplotlib caches both per renderer). Here the figure is
-    laid out once by its layout engine on an Agg canvas at the PNG's ``dpi`` and drawn
-    there; the PNG is cut from that canvas (or drawn by savefig when an artist runs
-    past the figure's edge), and the PDF is printed in the same layout: within a command's
-    output directory by a forked child while the command goes on (the directory waits for
-    it: :mod:`discovery._files._handoff`), else before this returns. The figure is left
-    as it was given (its canvas, dpi and layout engine).
+    laid out once by its layout engine on an Agg canvas at the PNG's ``dpi``, its extent
+    read from that layout's text metrics, and drawn once: on that canvas, the PNG cut
+    from it, or, when an artist runs past the figure's edge, by savefig within the extent
+    (the explain figure's legend; it was drawn twice so). The PDF is printed in the same
+    layout: within a command's output directory by a forked child while the command goes
+    on (the directory waits for it: :mod:`discovery._files._handoff`), else before this
+    returns. The figure is left as it was given (its canvas, dpi and layout engine).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
@@ -83,12 +84,13 @@ def save(fig, stem, dpi=130):
         import matplotlib.backends.backend_pdf  # noqa: F401
 
         hand_off(paths[1], functools.partial(_print_pdf, fig, paths[1], own_dpi))
-        agg.draw()
-        tight = fig.get_tightbbox(agg.get_renderer())  # the same renderer: texts measured
+        # the extent before any draw: the layout measured every text on this renderer
+        tight = fig.get_tightbbox(agg.get_renderer())
         bbox = tight.padded(mpl.rcParams["savefig.pad_inches"])
         if _drawn_whole(fig, tight):
+            agg.draw()
             _write_png(paths[0], agg, bbox, dpi)
-        else:  # savefig draws it again, past the figure's edge or on the user's background
+        else:  # savefig draws it once, past the figure's edge or on the user's background
             fig.savefig(paths[0], dpi=dpi, bbox_inches=bbox)
     finally:
         fig.set_dpi(own_dpi)

@@ -57,7 +57,7 @@ def test_the_png_cut_from_the_canvas_is_what_savefig_writes(tmp_path, bounds):
 
 @pytest.mark.parametrize("past_the_edge", [False, True])
 def test_save_writes_what_a_tight_savefig_writes(tmp_path, past_the_edge):
-    """The PNG (cut from the one drawing, or drawn again when a text runs past the edge) is
+    """The PNG (cut from the one drawing, or drawn by savefig when a text runs past the edge) is
     savefig's tight PNG to within a pixel's shift, the PDF's page is savefig's, and the
     figure is left as it was given (canvas, dpi, layout engine)."""
     from matplotlib.image import imread
@@ -80,3 +80,25 @@ def test_save_writes_what_a_tight_savefig_writes(tmp_path, past_the_edge):
         # begins at most savefig.pad_inches left of the figure's)
         edge = int((fig.get_figwidth() + 0.1) * 130) + 1
         assert np.any(got[:, edge:, :3] < 0.5)
+
+
+@pytest.mark.parametrize("past_the_edge", [False, True])
+def test_the_png_is_drawn_once(tmp_path, monkeypatch, past_the_edge):
+    """One drawing on an Agg renderer per PNG, whether cut from the canvas or written by
+    savefig past the figure's edge: its extent is read from the layout's text metrics
+    before anything is drawn (it was drawn twice past the edge, 0.1 s of explain's figure)."""
+    from matplotlib.backends.backend_agg import RendererAgg
+    from matplotlib.figure import Figure
+
+    from reports._mpl import save
+
+    draws = []
+    draw = Figure.draw
+
+    def counted(fig, renderer):
+        draws.append(isinstance(renderer, RendererAgg))
+        return draw(fig, renderer)
+
+    monkeypatch.setattr(Figure, "draw", counted)
+    save(_figure(past_the_edge), str(tmp_path / "saved"))
+    assert sum(draws) == 1
