@@ -88,7 +88,7 @@ def test_a_failed_run_kills_its_children_and_leaves_the_target(tmp_path):
     (tmp_path / "out").mkdir()
     with pytest.raises(KeyError), OutputDir(tmp_path / "out") as out:
         _handoff.write(out.path("late.txt"), _writer(out.path("late.txt"), sleep=30.0))
-        (pid,) = [p for p, _ in _handoff._PENDING.values()]
+        (pid,) = [child.pid for child, _ in _handoff._PENDING.values()]
         raise KeyError("the run failed")
     assert not _handoff._PENDING
     with pytest.raises(ChildProcessError):  # reaped, not a zombie left behind

@@ -10,8 +10,10 @@ fails (:func:`abandon`).  A reader of such a file within the run (LaTeX reading 
 waits for it first (:func:`finish` with its paths).
 
 A child that fails or is killed leaves its file to the parent, which writes it itself:
-the result does not depend on the hand-off.  Elsewhere (a figure an API user saves, one
-core, no ``fork``) the write is done at once, in this process.
+the result does not depend on the hand-off.  Files another process writes (a command's
+figure drawer, :mod:`._drawer`) are waited for the same way (:func:`pend`).  Elsewhere (a
+figure an API user saves, one core, no ``fork``) the write is done at once, in this
+process.
 """
 
 import contextlib
@@ -21,10 +23,10 @@ import sys
 import threading
 from pathlib import Path
 
-__all__ = ["write", "finish", "abandon", "open_stage", "close_stage", "in_parallel"]
+__all__ = ["write", "pend", "finish", "abandon", "open_stage", "close_stage", "in_parallel"]
 
 _STAGES = []  # the staging directories of this process's open output directories
-_PENDING = {}  # path -> (pid of the child writing it, the write itself)
+_PENDING = {}  # path -> (what writes it: a _Child or a drawer's job, the write itself)
 # held while the registry changes and while its children are waited for: a reader in another
 # thread (LaTeX's, in ``vidi fit``) returns once the file it waits for is there
 _LOCK = threading.RLock()
@@ -58,6 +60,53 @@ def _stage_of(path):
     return next((s for s in _STAGES if s == path.parent or s in path.parents), None)
 
 
+def stage_of(path):
+    """The open stage that holds ``path`` (None outside every one)."""
+    return _stage_of(Path(os.path.abspath(path)))
+
+
+class _Child:
+    """A forked child writing a file: ``wait()`` is whether it wrote it, ``kill()`` ends it."""
+
+    def __init__(self, pid):
+        self.pid = pid
+
+    def wait(self):
+        try:
+            _, status = os.waitpid(self.pid, 0)
+        except ChildProcessError:  # reaped elsewhere: its outcome is unknown
+            return False
+        return os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0
+
+    def kill(self):
+        with contextlib.suppress(OSError):
+            os.kill(self.pid, signal.SIGKILL)
+        with contextlib.suppress(OSError):
+            os.waitpid(self.pid, 0)
+
+
+class _Once:
+    """A write shared by several paths (a figure's PNG and PDF): done at most once here."""
+
+    def __init__(self, fn):
+        self.fn, self.done = fn, False
+
+    def __call__(self):
+        if not self.done:
+            self.done = True
+            self.fn()
+
+
+def pend(paths, writer, fn):
+    """The files ``paths`` are being written by ``writer`` (an object with ``wait()``, whether
+    it wrote them, and ``kill()``); where it did not, :func:`finish` writes them by calling
+    ``fn()`` once."""
+    once = _Once(fn)
+    with _LOCK:
+        for path in paths:
+            _PENDING[Path(os.path.abspath(path))] = (writer, once)
+
+
 def write(path, fn):
     """Write the file ``path`` by calling ``fn()`` (which writes it and may be called again):
     in a forked child when ``path`` lies in an open stage and :func:`in_parallel`, else at
@@ -68,8 +117,7 @@ def write(path, fn):
         return
     with _LOCK:
         finish([path])
-        pid = _forked(fn)
-        _PENDING[path] = (pid, fn)
+        _PENDING[path] = (_Child(_forked(fn)), fn)
 
 
 def _forked(fn):
@@ -96,12 +144,8 @@ def finish(paths=None, under=None):
     the directory ``under``); a file whose child failed is written here."""
     with _LOCK:
         for path in _selected(paths, under):
-            pid, fn = _PENDING.pop(path)
-            try:
-                _, status = os.waitpid(pid, 0)
-            except ChildProcessError:  # reaped elsewhere: its outcome is unknown
-                status = None
-            if status is None or not (os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0):
+            writer, fn = _PENDING.pop(path)
+            if not writer.wait():
                 fn()
 
 
@@ -110,11 +154,8 @@ def abandon(under=None):
     unwritten (a failed run's staging directory is removed)."""
     with _LOCK:
         for path in _selected(None, under):
-            pid, _ = _PENDING.pop(path)
-            with contextlib.suppress(OSError):
-                os.kill(pid, signal.SIGKILL)
-            with contextlib.suppress(OSError):
-                os.waitpid(pid, 0)
+            writer, _ = _PENDING.pop(path)
+            writer.kill()
 
 
 def _selected(paths, under):

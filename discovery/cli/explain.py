@@ -2,6 +2,7 @@
 
 import time
 
+from .._files._drawer import drawing
 from .._files._io import OutputDir
 from . import _options
 from ._common import (
@@ -36,15 +37,26 @@ def _final_loops(res, scenario, measurement, args):
     return None if loops is None else (loops, ev)
 
 
-def run(args):
-    from reports import explain_figure, loops_figure
+#: what the drawer loads while the command computes (:mod:`discovery._files._drawer`)
+_DRAWN = (
+    "reports.vibroimpact.explain_figures",
+    "reports.vibroimpact.verify_figures",
+    "discovery.vibroimpact.explain.result",
+)
 
+
+def run(args):
+    check_out(args)
+    with drawing(_DRAWN) as drawer:
+        return _run(args, drawer)
+
+
+def _run(args, drawer):
     from ..catalogue import select
     from ..vibroimpact.explain import EFFECTS, explain
     from ..vibroimpact.explain.result import read_text
 
     t_start = time.perf_counter()
-    check_out(args)
     effects = None
     if args.effects:
         effects = [e.strip() for e in args.effects.split(",") if e.strip()]
@@ -80,14 +92,19 @@ def run(args):
     with OutputDir(args.out) as out:
         files = []
         for k, it in enumerate(res.iterations, start=1):
-            explain_figure(it, it.measured, str(out.path(f"explain_{k}")), k)
+            stem = str(out.path(f"explain_{k}"))
+            figure = "reports.vibroimpact.explain_figures:explain_figure"
+            drawer.draw(stem, figure, it, it.measured, stem, k)
             files.append(f"explain_{k}.png/.pdf")
         # the final model's loops, simulated while a child prints the figures' PDFs
         loops = _final_loops(res, scs[0], meas[0], args)
         if loops is not None:
-            loops_figure(
+            stem = str(out.path("explain_loops"))
+            drawer.draw(
+                stem,
+                "reports.vibroimpact.verify_figures:loops_figure",
                 *loops,
-                str(out.path("explain_loops")),
+                stem,
                 res.final_model.law,
                 "final model against the first record",
                 note=res.final_model.changes(),

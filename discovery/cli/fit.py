@@ -6,6 +6,7 @@ import io
 import time
 from concurrent.futures import ThreadPoolExecutor
 
+from .._files._drawer import drawing
 from .._files._io import OutputDir
 from ..errors import InputError
 from ..vibroimpact.model.contact_registry import CONTACT_MODELS
@@ -99,10 +100,14 @@ def _ranking_csv(res):
     return buf.getvalue()
 
 
-def _write_outputs(args, res, t_start):
-    """The output directory: ranking, figures, model.tex (and its PDF), summary.json.
-    Returns ``(pdf, why)`` (``why``: the reason there is no PDF)."""
-    from reports import fit_impulse_figure, fit_loop_figure, fit_surface_figure
+#: what the drawer loads while the command computes (:mod:`discovery._files._drawer`)
+_DRAWN = ("reports.vibroimpact.fit_figures", "discovery.vibroimpact.fit.discovery_result")
+_FIGURES = "reports.vibroimpact.fit_figures"
+
+
+def _write_outputs(args, res, t_start, drawer):
+    """The output directory: ranking, figures (drawn by ``drawer``), model.tex (and its
+    PDF), summary.json.  Returns ``(pdf, why)`` (``why``: the reason there is no PDF)."""
     from reports.document import compile_tex, render
 
     imps = []
@@ -117,7 +122,8 @@ def _write_outputs(args, res, t_start):
             )
     with OutputDir(args.out) as out, ThreadPoolExecutor(1) as latex:
         out.path("ranking.csv").write_text(_ranking_csv(res))
-        fit_impulse_figure(res, imps, str(out.path("fit_impulse")))
+        stem = str(out.path("fit_impulse"))
+        drawer.draw(stem, f"{_FIGURES}:fit_impulse_figure", res, imps, stem)
         # model.tex is a template of the report system, rendered from the summary itself
         out.path("model.tex").write_text(render(res.to_dict(), out.stage, template="model"))
         # LaTeX runs while the other two figures are drawn (a subprocess: this thread only
@@ -127,8 +133,9 @@ def _write_outputs(args, res, t_start):
             if not args.no_pdf
             else None
         )
-        fit_surface_figure(res, str(out.path("fit_surface")))
-        fit_loop_figure(res, str(out.path("fit_loop")))
+        for name in ("fit_surface", "fit_loop"):
+            stem = str(out.path(name))
+            drawer.draw(stem, f"{_FIGURES}:{name}_figure", res, stem)
         pdf, why = compiled.result() if compiled is not None else (None, None)
         why = None if pdf is not None else why
         # the run's record, with the PDF and the whole command's wall time
@@ -258,15 +265,17 @@ def run(args):
     defaults = vars(args).pop("regression_only", None) or {}  # not a setting of the run
     if args.library == "contact-models":
         _refuse_regression_options(args, defaults)
-    scs, meas, machine = read_records(args)
     if args.library == "contact-models":
+        scs, meas, machine = read_records(args)
         return _run_contact_models(args, scs, meas, machine, t_start)
-    with reporter(args) as rep:
-        res = _discover(args, (scs, meas, machine), rep)
-    res.record_run(
-        _head(args, scs, machine), provenance_of(args), names=[str(p) for p in args.data]
-    )
-    pdf, why = _write_outputs(args, res, t_start)
+    with drawing(_DRAWN) as drawer:
+        scs, meas, machine = read_records(args)
+        with reporter(args) as rep:
+            res = _discover(args, (scs, meas, machine), rep)
+        res.record_run(
+            _head(args, scs, machine), provenance_of(args), names=[str(p) for p in args.data]
+        )
+        pdf, why = _write_outputs(args, res, t_start, drawer)
     _print_result(args, res, pdf, why)
     return 0
 

@@ -1,5 +1,6 @@
 """``vidi verify``: is a law consistent with a record?"""
 
+from .._files._drawer import drawing
 from .._files._io import OutputDir
 from ..vibroimpact.model.scenario import load_scenario
 from . import _options
@@ -16,13 +17,19 @@ from ._common import (
     sensor_lag_of,
 )
 
+#: what the drawer loads while the command computes (:mod:`discovery._files._drawer`)
+_DRAWN = ("reports.vibroimpact.verify_figures", "discovery.vibroimpact.verify.verdict")
+
 
 def run(args):
-    from reports import verify_figure
+    check_out(args)
+    with drawing(_DRAWN) as drawer:
+        return _run(args, drawer)
 
+
+def _run(args, drawer):
     from ..vibroimpact.verify import verify
 
-    check_out(args)
     sc = load_scenario(args.scenario)
     law = law_or_default(args.law, sc)
     meas = read_record(args, sc)
@@ -51,7 +58,8 @@ def run(args):
     )
     with OutputDir(args.out) as out:
         res.write_into(out)
-        verify_figure(res, str(out.path("verify")))
+        stem = str(out.path("verify"))
+        drawer.draw(stem, "reports.vibroimpact.verify_figures:verify_figure", res, stem)
     ev = res.evaluation
     print(f"{law}: {res.verdict}")
     print(f"  {res.regime_line()}")

@@ -1,0 +1,177 @@
+"""Figures drawn by a process forked when a command starts.
+
+Loading matplotlib and a figure module takes a third of a second, and a figure's drawing as
+long again: in a command that draws one figure at its end (``vidi verify``), that is a
+third of its time, all of it after the work.  A :class:`Drawer` is forked before the command
+loads its numerics, loads matplotlib, the figure modules and the modules of the results it
+will draw (``preload``) on the second core while the command computes, then draws each
+figure it is sent (:meth:`Drawer.draw`: the figure function's name and its arguments,
+pickled), its PDF printed by a child of its own (:mod:`._handoff`), and answers when both
+files are written.  The command's output directory waits for them as for any handed-off
+file; a figure the drawer did not write (its drawing raised, the drawer died, its arguments
+do not pickle) is drawn by the command itself, so the result does not depend on the drawer.
+Elsewhere (one core, no ``fork``, a figure outside an output directory) a figure is drawn at
+once, in this process.
+"""
+
+import contextlib
+import importlib
+import os
+import pickle
+import signal
+import threading
+
+from . import _handoff
+
+__all__ = ["Drawer", "drawing"]
+
+
+def _function(name):
+    """The figure function ``"module:function"``."""
+    module, _, attr = name.partition(":")
+    return getattr(importlib.import_module(module), attr)
+
+
+def _draw_here(name, args, kwargs):
+    _function(name)(*args, **kwargs)
+
+
+class Drawer:
+    """The drawing process of one command (see the module docstring); ``None`` of
+    :meth:`start` stands for drawing here."""
+
+    def __init__(self, pid, conn):
+        self.pid, self.conn = pid, conn
+        self.answers, self.sent, self.dead = {}, 0, False
+        self.lock = threading.Lock()
+
+    @classmethod
+    def start(cls, preload=()):
+        """A drawer that has begun loading the modules ``preload`` (names), or None where
+        writes are not handed off (:func:`._handoff.in_parallel`)."""
+        if not _handoff.in_parallel():
+            return None
+        from multiprocessing import Pipe
+
+        mine, its = Pipe()
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child (its work is checked by its files)
+            mine.close()
+            _serve(its, preload)
+        its.close()
+        return cls(pid, mine)
+
+    def draw(self, stem, name, *args, **kwargs):
+        """``stem.png`` and ``stem.pdf`` written by the figure function ``name``
+        (``"module:function"``) called with ``args`` and ``kwargs`` (among them ``stem``):
+        by the drawer when the files lie in an open output directory, else here and now."""
+        stage = _handoff.stage_of(f"{stem}.png")
+        job = self.sent
+        payload = None
+        if stage is not None and not self.dead:
+            with contextlib.suppress(Exception):  # arguments that do not pickle: drawn here
+                payload = pickle.dumps((job, name, args, kwargs, str(stage)), protocol=5)
+        if payload is None:
+            _draw_here(name, args, kwargs)
+            return
+        paths = [f"{stem}.png", f"{stem}.pdf"]
+        _handoff.finish(paths)  # a second drawing of one file waits for the first
+        try:
+            self.conn.send_bytes(payload)
+        except OSError:  # the drawer is gone
+            self.dead = True
+            _draw_here(name, args, kwargs)
+            return
+        self.sent += 1
+        _handoff.pend(paths, _Job(self, job), lambda: _draw_here(name, args, kwargs))
+
+    def answered(self, job):
+        """Whether the drawer wrote job ``job``'s files (waits for its answer)."""
+        with self.lock:
+            while job not in self.answers and not self.dead:
+                try:
+                    done, ok = self.conn.recv()
+                except (EOFError, OSError):
+                    self.dead = True
+                    break
+                self.answers[done] = ok
+            return bool(self.answers.get(job, False))
+
+    def kill(self):
+        """End the drawer at once (a failed run: its files are not wanted)."""
+        self.dead = True
+        with contextlib.suppress(OSError):
+            os.kill(self.pid, signal.SIGKILL)
+
+    def close(self):
+        """Let the drawer end (it is idle once every file is waited for) and reap it."""
+        self.dead = True
+        with contextlib.suppress(OSError):
+            self.conn.close()
+        with contextlib.suppress(OSError):
+            os.waitpid(self.pid, 0)
+
+
+class _Job:
+    """One figure sent to a drawer, as :func:`._handoff.pend` waits for it."""
+
+    def __init__(self, drawer, job):
+        self.drawer, self.job = drawer, job
+
+    def wait(self):
+        return self.drawer.answered(self.job)
+
+    def kill(self):
+        self.drawer.kill()
+
+
+class _Here:
+    """Drawing in this process (one core, no ``fork``): :meth:`Drawer.draw`'s signature."""
+
+    def draw(self, stem, name, *args, **kwargs):
+        _draw_here(name, args, kwargs)
+
+
+@contextlib.contextmanager
+def drawing(preload=()):
+    """``with drawing([...]) as d:`` a :class:`Drawer` started now (or one drawing here),
+    closed when the block ends (its output directories closed within it)."""
+    drawer = Drawer.start(preload)
+    try:
+        yield drawer if drawer is not None else _Here()
+    finally:
+        if drawer is not None:
+            drawer.close()
+
+
+def _serve(conn, preload):  # pragma: no cover - runs in the forked drawer
+    """The drawer's life: load ``preload``, then draw each job it is sent, answering
+    ``(job, wrote)``; it ends when the command closes its end (or dies)."""
+    code = 0
+    try:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # the command decides (it kills this)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        backends = ("matplotlib.backends.backend_agg", "matplotlib.backends.backend_pdf")
+        for name in ("matplotlib.figure", *backends, *preload):
+            with contextlib.suppress(Exception):
+                importlib.import_module(name)
+        while True:
+            try:
+                job, name, args, kwargs, stage = pickle.loads(conn.recv_bytes())
+            except (EOFError, OSError):
+                break
+            ok = False
+            _handoff.open_stage(stage)
+            try:
+                _draw_here(name, args, kwargs)
+                _handoff.finish(under=stage)  # its PDF, printed by a child of this process
+                ok = True
+            except BaseException:  # noqa: BLE001 - the command draws it again
+                ok = False
+            finally:
+                _handoff.close_stage(stage)
+            conn.send((job, ok))
+    except BaseException:  # noqa: BLE001
+        code = 1
+    finally:
+        os._exit(code)

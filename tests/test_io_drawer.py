@@ -1,0 +1,98 @@
+"""Figures drawn by a process forked when a command starts (``discovery._files._drawer``):
+the same files as drawn in the command, waited for by the output directory, drawn again by
+the command where the drawer did not write them, at once outside an output directory."""
+
+import os
+import re
+import signal
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from discovery._files import _handoff
+from discovery._files._drawer import Drawer, drawing
+from discovery._files._io import OutputDir
+
+pytestmark = pytest.mark.skipif(not _handoff.in_parallel(), reason="one core or no fork here")
+
+SQUARE = "tests.test_io_drawer:_square"
+
+
+def _square(stem, here=None, *, fail=False, slow=False, extra=None):
+    """A small figure with mathtext as ``stem.png``/``.pdf``; in a process other than
+    ``here`` (a pid) it raises (``fail``) or first sleeps 5 s (``slow``)."""
+    from reports._mpl import save, subplots
+
+    if here is not None and os.getpid() != here:
+        if slow:
+            time.sleep(5.0)
+        if fail:
+            raise RuntimeError("drawn in the wrong process")
+    fig, ax = subplots(figsize=(3.0, 2.0), layout="constrained")
+    x = np.linspace(0.0, 1.0, 40)
+    ax.plot(x, x**2, label=r"$\dot{\zeta}_{+}$")
+    ax.set_xlabel(r"penetration $\zeta$ [mm]")
+    ax.legend()
+    save(fig, stem)
+
+
+def _pdf_body(path):
+    return re.sub(rb"/CreationDate \(.*?\)", b"", Path(path).read_bytes())
+
+
+def test_a_figure_the_drawer_draws_is_the_figure_drawn_here(tmp_path):
+    _square(str(tmp_path / "here"))
+    with drawing(["reports._mpl"]) as drawer, OutputDir(tmp_path / "out") as out:
+        assert isinstance(drawer, Drawer)
+        stem = str(out.path("fig"))
+        drawer.draw(stem, SQUARE, stem)
+        assert {out.path("fig.png"), out.path("fig.pdf")} <= set(_handoff._PENDING)
+    assert drawer.answers == {0: True}  # the drawer wrote both files
+    out_dir = tmp_path / "out"
+    assert (out_dir / "fig.png").read_bytes() == (tmp_path / "here.png").read_bytes()
+    assert _pdf_body(out_dir / "fig.pdf") == _pdf_body(tmp_path / "here.pdf")
+    assert "fig.pdf" in (out_dir / ".vidi-manifest.json").read_text()
+    assert not _handoff._PENDING
+
+
+def test_a_figure_the_drawer_fails_is_drawn_by_the_command(tmp_path):
+    with drawing() as drawer, OutputDir(tmp_path / "out") as out:
+        stem = str(out.path("fig"))
+        drawer.draw(stem, SQUARE, stem, os.getpid(), fail=True)
+    assert drawer.answers == {0: False}
+    assert (tmp_path / "out" / "fig.png").stat().st_size > 0
+    assert (tmp_path / "out" / "fig.pdf").stat().st_size > 0
+
+
+def test_a_dead_drawers_figures_are_drawn_by_the_command(tmp_path):
+    with drawing() as drawer, OutputDir(tmp_path / "out") as out:
+        first, second = str(out.path("a")), str(out.path("b"))
+        drawer.draw(first, SQUARE, first, os.getpid(), slow=True)
+        os.kill(drawer.pid, signal.SIGKILL)
+        drawer.draw(second, SQUARE, second)  # sent to a dead drawer, or drawn here at once
+    for name in ("a.png", "a.pdf", "b.png", "b.pdf"):
+        assert (tmp_path / "out" / name).stat().st_size > 0
+
+
+def test_outside_an_output_directory_or_unpicklable_a_figure_is_drawn_at_once(tmp_path):
+    with drawing() as drawer:
+        stem = str(tmp_path / "loose")
+        drawer.draw(stem, SQUARE, stem)
+        assert Path(f"{stem}.png").exists() and not _handoff._PENDING
+        with OutputDir(tmp_path / "out") as out:
+            stem = str(out.path("fig"))
+            drawer.draw(stem, SQUARE, stem, extra=lambda: None)  # a lambda: no pickle
+            assert out.path("fig.png").exists()  # (its PDF a child's of this process)
+    assert drawer.sent == 0 and (tmp_path / "out" / "fig.pdf").exists()
+
+
+def test_a_failed_run_stops_the_drawer_and_leaves_the_target(tmp_path):
+    target = tmp_path / "out"
+    with pytest.raises(RuntimeError), drawing() as drawer, OutputDir(target) as out:
+        stem = str(out.path("fig"))
+        drawer.draw(stem, SQUARE, stem, os.getpid(), slow=True)
+        raise RuntimeError("the run failed")
+    assert drawer.dead and not target.exists() and not _handoff._PENDING
+    assert not list(tmp_path.iterdir())  # no staging directory left
