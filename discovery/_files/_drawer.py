@@ -104,10 +104,13 @@ class Drawer:
             os.kill(self.pid, signal.SIGKILL)
 
     def close(self):
-        """Let the drawer end (it is idle once every file is waited for) and reap it."""
+        """End the drawer and reap it: every file it was sent is waited for by now (its
+        output directory closed), so it is idle, or still loading when the command stopped
+        early (an interrupt: the command does not wait for its imports)."""
         self.dead = True
         with contextlib.suppress(OSError):
             self.conn.close()
+        self.kill()
         with contextlib.suppress(OSError):
             os.waitpid(self.pid, 0)
 
