@@ -17,7 +17,7 @@ from discovery._files._io import OutputDir
 
 pytestmark = pytest.mark.skipif(not _handoff.in_parallel(), reason="one core or no fork here")
 
-SQUARE = "tests.test_io_drawer:_square"
+SQUARE = "_test_square"  # a name of `reports`, as the commands' figures are (fixture below)
 
 
 def _square(stem, here=None, *, fail=False, slow=False, extra=None):
@@ -38,13 +38,21 @@ def _square(stem, here=None, *, fail=False, slow=False, extra=None):
     save(fig, stem)
 
 
+@pytest.fixture(autouse=True)
+def _square_in_reports(monkeypatch):
+    """``reports._test_square``: set before each drawer is forked, so it has it too."""
+    import reports
+
+    monkeypatch.setattr(reports, SQUARE, _square, raising=False)
+
+
 def _pdf_body(path):
     return re.sub(rb"/CreationDate \(.*?\)", b"", Path(path).read_bytes())
 
 
 def test_a_figure_the_drawer_draws_is_the_figure_drawn_here(tmp_path):
     _square(str(tmp_path / "here"))
-    with drawing(["reports._mpl"]) as drawer, OutputDir(tmp_path / "out") as out:
+    with drawing([SQUARE], ["reports._mpl"]) as drawer, OutputDir(tmp_path / "out") as out:
         assert isinstance(drawer, Drawer)
         stem = str(out.path("fig"))
         drawer.draw(stem, SQUARE, stem)

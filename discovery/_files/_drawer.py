@@ -27,9 +27,9 @@ __all__ = ["Drawer", "drawing"]
 
 
 def _function(name):
-    """The figure function ``"module:function"``."""
-    module, _, attr = name.partition(":")
-    return getattr(importlib.import_module(module), attr)
+    """The figure function ``name`` of :mod:`reports` (its names load their module on first
+    use, matplotlib with it)."""
+    return getattr(importlib.import_module("reports"), name)
 
 
 def _draw_here(name, args, kwargs):
@@ -46,9 +46,10 @@ class Drawer:
         self.lock = threading.Lock()
 
     @classmethod
-    def start(cls, preload=()):
-        """A drawer that has begun loading the modules ``preload`` (names), or None where
-        writes are not handed off (:func:`._handoff.in_parallel`)."""
+    def start(cls, figures=(), preload=()):
+        """A drawer that has begun loading the figure functions ``figures`` (names in
+        :mod:`reports`) and the modules ``preload`` (the results' it will be sent), or None
+        where writes are not handed off (:func:`._handoff.in_parallel`)."""
         if not _handoff.in_parallel():
             return None
         from multiprocessing import Pipe
@@ -57,13 +58,13 @@ class Drawer:
         pid = os.fork()
         if pid == 0:  # pragma: no cover - the child (its work is checked by its files)
             mine.close()
-            _serve(its, preload)
+            _serve(its, figures, preload)
         its.close()
         return cls(pid, mine)
 
     def draw(self, stem, name, *args, **kwargs):
-        """``stem.png`` and ``stem.pdf`` written by the figure function ``name``
-        (``"module:function"``) called with ``args`` and ``kwargs`` (among them ``stem``):
+        """``stem.png`` and ``stem.pdf`` written by the figure function ``name`` of
+        :mod:`reports` called with ``args`` and ``kwargs`` (among them ``stem``):
         by the drawer when the files lie in an open output directory, else here and now."""
         stage = _handoff.stage_of(f"{stem}.png")
         job = self.sent
@@ -136,10 +137,10 @@ class _Here:
 
 
 @contextlib.contextmanager
-def drawing(preload=()):
-    """``with drawing([...]) as d:`` a :class:`Drawer` started now (or one drawing here),
-    closed when the block ends (its output directories closed within it)."""
-    drawer = Drawer.start(preload)
+def drawing(figures=(), preload=()):
+    """``with drawing([...]) as d:`` a :class:`Drawer` started now (:meth:`Drawer.start`; or
+    one drawing here), closed when the block ends (its output directories closed within it)."""
+    drawer = Drawer.start(figures, preload)
     try:
         yield drawer if drawer is not None else _Here()
     finally:
@@ -147,17 +148,20 @@ def drawing(preload=()):
             drawer.close()
 
 
-def _serve(conn, preload):  # pragma: no cover - runs in the forked drawer
-    """The drawer's life: load ``preload``, then draw each job it is sent, answering
+def _serve(conn, figures, preload):  # pragma: no cover - runs in the forked drawer
+    """The drawer's life: load ``figures`` and ``preload``, then draw each job, answering
     ``(job, wrote)``; it ends when the command closes its end (or dies)."""
     code = 0
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # the command decides (it kills this)
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         backends = ("matplotlib.backends.backend_agg", "matplotlib.backends.backend_pdf")
-        for name in ("matplotlib.figure", *backends, *preload):
+        for name in (*backends, *preload):
             with contextlib.suppress(Exception):
                 importlib.import_module(name)
+        for name in figures:
+            with contextlib.suppress(Exception):
+                _function(name)
         while True:
             try:
                 job, name, args, kwargs, stage = pickle.loads(conn.recv_bytes())

@@ -37,17 +37,15 @@ def _final_loops(res, scenario, measurement, args):
     return None if loops is None else (loops, ev)
 
 
-#: what the drawer loads while the command computes (:mod:`discovery._files._drawer`)
-_DRAWN = (
-    "reports.vibroimpact.explain_figures",
-    "reports.vibroimpact.verify_figures",
-    "discovery.vibroimpact.explain.result",
-)
+#: what the drawer loads while the command computes: the figures and the results' modules
+#: (:mod:`discovery._files._drawer`)
+_FIGURES = ("explain_figure", "loops_figure")
+_RESULTS = ("discovery.vibroimpact.explain.result",)
 
 
 def run(args):
     check_out(args)
-    with drawing(_DRAWN) as drawer:
+    with drawing(_FIGURES, _RESULTS) as drawer:
         return _run(args, drawer)
 
 
@@ -93,8 +91,7 @@ def _run(args, drawer):
         files = []
         for k, it in enumerate(res.iterations, start=1):
             stem = str(out.path(f"explain_{k}"))
-            figure = "reports.vibroimpact.explain_figures:explain_figure"
-            drawer.draw(stem, figure, it, it.measured, stem, k)
+            drawer.draw(stem, "explain_figure", it, it.measured, stem, k)
             files.append(f"explain_{k}.png/.pdf")
         # the final model's loops, simulated while a child prints the figures' PDFs
         loops = _final_loops(res, scs[0], meas[0], args)
@@ -102,7 +99,7 @@ def _run(args, drawer):
             stem = str(out.path("explain_loops"))
             drawer.draw(
                 stem,
-                "reports.vibroimpact.verify_figures:loops_figure",
+                "loops_figure",
                 *loops,
                 stem,
                 res.final_model.law,

@@ -100,9 +100,10 @@ def _ranking_csv(res):
     return buf.getvalue()
 
 
-#: what the drawer loads while the command computes (:mod:`discovery._files._drawer`)
-_DRAWN = ("reports.vibroimpact.fit_figures", "discovery.vibroimpact.fit.discovery_result")
-_FIGURES = "reports.vibroimpact.fit_figures"
+#: what the drawer loads while the command computes: the figures and the results' modules
+#: (:mod:`discovery._files._drawer`)
+_RESULTS = ("discovery.vibroimpact.fit.discovery_result",)
+_FIGURES = ("fit_impulse_figure", "fit_surface_figure", "fit_loop_figure")
 
 
 def _write_outputs(args, res, t_start, drawer):
@@ -123,7 +124,7 @@ def _write_outputs(args, res, t_start, drawer):
     with OutputDir(args.out) as out, ThreadPoolExecutor(1) as latex:
         out.path("ranking.csv").write_text(_ranking_csv(res))
         stem = str(out.path("fit_impulse"))
-        drawer.draw(stem, f"{_FIGURES}:fit_impulse_figure", res, imps, stem)
+        drawer.draw(stem, "fit_impulse_figure", res, imps, stem)
         # model.tex is a template of the report system, rendered from the summary itself
         out.path("model.tex").write_text(render(res.to_dict(), out.stage, template="model"))
         # LaTeX runs while the other two figures are drawn (a subprocess: this thread only
@@ -135,7 +136,7 @@ def _write_outputs(args, res, t_start, drawer):
         )
         for name in ("fit_surface", "fit_loop"):
             stem = str(out.path(name))
-            drawer.draw(stem, f"{_FIGURES}:{name}_figure", res, stem)
+            drawer.draw(stem, f"{name}_figure", res, stem)
         pdf, why = compiled.result() if compiled is not None else (None, None)
         why = None if pdf is not None else why
         # the run's record, with the PDF and the whole command's wall time
@@ -268,7 +269,7 @@ def run(args):
     if args.library == "contact-models":
         scs, meas, machine = read_records(args)
         return _run_contact_models(args, scs, meas, machine, t_start)
-    with drawing(_DRAWN) as drawer:
+    with drawing(_FIGURES, _RESULTS) as drawer:
         scs, meas, machine = read_records(args)
         with reporter(args) as rep:
             res = _discover(args, (scs, meas, machine), rep)

@@ -17,13 +17,14 @@ from ._common import (
     sensor_lag_of,
 )
 
-#: what the drawer loads while the command computes (:mod:`discovery._files._drawer`)
-_DRAWN = ("reports.vibroimpact.verify_figures", "discovery.vibroimpact.verify.verdict")
+#: the results' modules the drawer loads while the command computes
+#: (:mod:`discovery._files._drawer`)
+_RESULTS = ("discovery.vibroimpact.verify.verdict",)
 
 
 def run(args):
     check_out(args)
-    with drawing(_DRAWN) as drawer:
+    with drawing(["verify_figure"], _RESULTS) as drawer:
         return _run(args, drawer)
 
 
@@ -59,7 +60,7 @@ def _run(args, drawer):
     with OutputDir(args.out) as out:
         res.write_into(out)
         stem = str(out.path("verify"))
-        drawer.draw(stem, "reports.vibroimpact.verify_figures:verify_figure", res, stem)
+        drawer.draw(stem, "verify_figure", res, stem)
     ev = res.evaluation
     print(f"{law}: {res.verdict}")
     print(f"  {res.regime_line()}")
