@@ -104,3 +104,70 @@ def test_a_failed_run_stops_the_drawer_and_leaves_the_target(tmp_path):
         raise RuntimeError("the run failed")
     assert drawer.dead and not target.exists() and not _handoff._PENDING
     assert not list(tmp_path.iterdir())  # no staging directory left
+
+
+@pytest.fixture(scope="module")
+def records(tmp_path_factory):
+    """``{"vibro": the README quickstart's kind of record (12 periods of the paper's machine,
+    1 % noise), "ueda": a record of the negative-resistance oscillator}``."""
+    from discovery.cli import main
+
+    d = tmp_path_factory.mktemp("rec")
+    words = ["simulate", "--scenario", "paper", "--periods", "12", "--noise", "0.01"]
+    assert main([*words, "--seed", "1", "--out", str(d / "d.csv")]) == 0
+    assert main(["ueda", "simulate", "--periods", "60", "--out", str(d / "u.csv")]) == 0
+    return {"vibro": d / "d.csv", "ueda": d / "u.csv"}
+
+
+#: the commands that draw their figures at their end: their words ("{vibro}", "{ueda}": a
+#: record of the fixture) and the figures' stems
+FIGURES_AT_THE_END = {
+    "calibrate": (["calibrate", "--data", "{vibro}"], ["calibrate"]),
+    "identify": (
+        ["identify", "--data", "{vibro}", "--start", "1.5e8*z + 1e7*zd", "--intervals", "0"],
+        ["identification"],
+    ),
+    "landscape": (["landscape", "--data", "{vibro}", "--grid", "5x5"], ["landscape"]),
+    "advise": (
+        ["advise", "--data", "{vibro}", "--law", "2.06e8*z + 1.28e7*zd"]
+        + ["--law", "2.0e8*z + 1.28e7*zd + 1e10*z*zd", "--amplitude", "4e5:5e5"]
+        + ["--frequency", "24:26", "--grid", "2x2"],
+        ["advise_map"],
+    ),
+    "ueda-attractor": (
+        ["ueda", "attractor", "--periods", "200", "--basins", "4"],
+        ["attractor", "basins"],
+    ),
+    "ueda-discover": (["ueda", "discover", "--data", "{ueda}", "--model", "negres"], ["discover"]),
+}
+
+
+@pytest.mark.parametrize("command", sorted(FIGURES_AT_THE_END))
+def test_a_command_s_figures_are_drawn_by_its_drawer(records, tmp_path, monkeypatch, command):
+    """calibrate, identify, landscape, advise and the Ueda commands send their figures to
+    the drawer forked when they start (as verify, fit and explain do), which writes both
+    files of each."""
+    from discovery.cli import main
+
+    sent, answered = [], []
+    draw, wait = Drawer.draw, Drawer.answered
+
+    def spy_draw(self, stem, name, *args, **kwargs):
+        sent.append(name)
+        return draw(self, stem, name, *args, **kwargs)
+
+    def spy_wait(self, job):
+        answered.append(wait(self, job))
+        return answered[-1]
+
+    monkeypatch.setattr(Drawer, "draw", spy_draw)
+    monkeypatch.setattr(Drawer, "answered", spy_wait)
+    words, stems = FIGURES_AT_THE_END[command]
+    words = [w.format(**records) for w in words]
+    out = tmp_path / "out"
+    assert main([*words, "--out", str(out)]) == 0
+    assert len(sent) == len(stems) and all(n.endswith("_figure") for n in sent)
+    assert answered and all(answered)
+    for stem in stems:
+        for suffix in (".png", ".pdf"):
+            assert (out / f"{stem}{suffix}").stat().st_size > 0

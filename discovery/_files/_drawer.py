@@ -28,8 +28,9 @@ __all__ = ["Drawer", "drawing"]
 
 def _function(name):
     """The figure function ``name`` of :mod:`reports` (its names load their module on first
-    use, matplotlib with it)."""
-    return getattr(importlib.import_module("reports"), name)
+    use, matplotlib with it), or of a module below it: ``"ueda.figures.chart_figure"``."""
+    module, _, function = f"reports.{name}".rpartition(".")
+    return getattr(importlib.import_module(module), function)
 
 
 def _draw_here(name, args, kwargs):

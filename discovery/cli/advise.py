@@ -1,5 +1,6 @@
 """``vidi advise``: where should the next record be taken to separate the candidate laws?"""
 
+from .._files._drawer import drawing
 from .._files._io import OutputDir
 from ..errors import InputError
 from . import _options
@@ -131,19 +132,32 @@ def _until_settled(args, knobs, safe):
     return run_loop(args, load_scenario(args.scenario or "paper"), knobs, safe)
 
 
-def run(args):
-    from reports import advise_figure
+#: the results' module the drawer loads while the command computes
+#: (:mod:`discovery._files._drawer`)
+_RESULTS = ("discovery.vibroimpact.advise.result",)
 
-    from ..vibroimpact.advise import SafeRegion, advise
+
+def run(args):
+    check_out(args)
+    if args.until_settled:
+        return _until_settled(args, _knobs(args), _safe(args))
+    with drawing(["advise_figure"], _RESULTS) as drawer:
+        return _run(args, drawer)
+
+
+def _safe(args):
+    from ..vibroimpact.advise import SafeRegion
+
+    return SafeRegion(args.max_force, args.max_penetration)
+
+
+def _run(args, drawer):
+    from ..vibroimpact.advise import advise
     from ..vibroimpact.advise.candidates import fit_scenario_changed
     from ..vibroimpact.advise.result import point_lines
     from ..vibroimpact.model.scenario import load_scenario
 
-    check_out(args)
-    knobs = _knobs(args)
-    safe = SafeRegion(args.max_force, args.max_penetration)
-    if args.until_settled:
-        return _until_settled(args, knobs, safe)
+    knobs, safe = _knobs(args), _safe(args)
     laws, fit_scenario = _candidates(args)
     if args.fit is not None and not args.scenario and fit_scenario:
         changed = fit_scenario_changed(args.fit, fit_scenario)
@@ -176,7 +190,8 @@ def run(args):
     prov["settings"] = {**res.settings, **prov["settings"]}
     with OutputDir(args.out) as out:
         res.record_run({"machine": machine} if machine else None, prov).write_into(out)
-        advise_figure(res, str(out.path("advise_map")))
+        stem = str(out.path("advise_map"))
+        drawer.draw(stem, "advise_figure", res, stem)
     print(res)
     for k, p in enumerate(res.ranked()[1:4], start=2):
         print(f"rank {k}: A = {p.amplitude:.4g} N, f = {p.frequency:.4g} Hz")

@@ -1,5 +1,6 @@
 """``vidi calibrate``: the machine as the record shows it."""
 
+from .._files._drawer import drawing
 from .._files._io import OutputDir
 from ..errors import InputError
 from . import _options
@@ -26,12 +27,20 @@ def _keep(text):
     return tuple(names)
 
 
-def run(args):
-    from reports import calibration_figure
+#: the figure and the result's module the drawer loads while the command computes
+#: (:mod:`discovery._files._drawer`)
+_RESULTS = ("discovery.vibroimpact.calibration.result",)
 
+
+def run(args):
+    check_out(args)
+    with drawing(["calibration_figure"], _RESULTS) as drawer:
+        return _run(args, drawer)
+
+
+def _run(args, drawer):
     from ..vibroimpact.calibration import calibrate
 
-    check_out(args)
     keep = _keep(args.keep)
     scs, meas, _ = read_records(args, machine=False)
     res = calibrate(
@@ -47,7 +56,9 @@ def run(args):
                 with open(out.path(name), "w", encoding="utf-8") as fh:
                     fh.write(sc.to_toml())
                 files.append(name)
-            if calibration_figure(res, str(out.path("calibrate"))):
+            if res.series is not None:  # a result made here has them (a loaded one not)
+                stem = str(out.path("calibrate"))
+                drawer.draw(stem, "calibration_figure", res, stem)
                 files.append("calibrate.png/.pdf")
     print(res)
     print(outputs_line(args, files))

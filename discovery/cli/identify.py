@@ -5,6 +5,7 @@ import io
 
 import numpy as np
 
+from .._files._drawer import drawing
 from .._files._io import OutputDir
 from ..errors import InputError
 from ..vibroimpact.model.law import ForceLaw
@@ -176,14 +177,22 @@ def _print_result(args, res):
     print(outputs_line(args, files))
 
 
-def run(args):
-    from reports import identification_figure
+#: the results' module the drawer loads while the command computes
+#: (:mod:`discovery._files._drawer`)
+_RESULTS = ("discovery.vibroimpact.fit.identification",)
 
+
+def run(args):
+    check_out(args)
+    with drawing(["identification_figure"], _RESULTS) as drawer:
+        return _run(args, drawer)
+
+
+def _run(args, drawer):
     from ..vibroimpact.fit.identification import identify
     from ..vibroimpact.verify import Reference
     from ..vibroimpact.verify.criteria_landscape import Landscape
 
-    check_out(args)
     sc = load_scenario(args.scenario)
     if not args.start.strip():
         raise InputError(
@@ -224,8 +233,9 @@ def run(args):
         summary.record_run({**run["head"], "machine": machine}, run["tail"])
         summary.write_into(out)
         out.path("iterations.csv").write_text(_iterations_csv(res))
-        identification_figure(
-            res, ref.impulse, imps, str(out.path("identification")), land=land, start=start
+        stem = str(out.path("identification"))
+        drawer.draw(
+            stem, "identification_figure", res, ref.impulse, imps, stem, land=land, start=start
         )
     _print_result(args, res)
     return 0

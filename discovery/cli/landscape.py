@@ -6,6 +6,7 @@ import io
 
 import numpy as np
 
+from .._files._drawer import drawing
 from .._files._io import OutputDir
 from ..errors import InputError, IntegrationError
 from ..vibroimpact.model.scenario import load_scenario
@@ -110,12 +111,20 @@ def _reference(args, sc):
     return ref, info, sc
 
 
-def run(args):
-    from reports import landscape_figure
+#: the results' module the drawer loads while the command computes
+#: (:mod:`discovery._files._drawer`)
+_RESULTS = ("discovery.vibroimpact.verify.criteria_landscape",)
 
+
+def run(args):
+    check_out(args)
+    with drawing(["landscape_figure"], _RESULTS) as drawer:
+        return _run(args, drawer)
+
+
+def _run(args, drawer):
     from ..vibroimpact.verify.criteria_landscape import landscape, parse_grid
 
-    check_out(args)
     sc = load_scenario(args.scenario)
     law = law_or_default(args.law, sc)
     if len(law.terms) < 2:
@@ -169,7 +178,8 @@ def run(args):
         src = land.reference.get("source") if isinstance(land.reference, dict) else None
         if isinstance(src, str) and "$" in src:  # a file name is text, never mathtext
             land.reference["source"] = src.replace("$", r"\$")
-        landscape_figure(land, str(out.path("landscape")), truth=truth)
+        stem = str(out.path("landscape"))
+        drawer.draw(stem, "landscape_figure", land, stem, truth=truth)
     src = "the scenario's law" if ref is None else f"{args.data}"
     count, first, at = land.failures
     minima = summary["minima"]

@@ -2,19 +2,28 @@
 errors, the regime with its evidence, figures (optionally the coexisting attractors from a grid
 of initial states)."""
 
+from ..._files._drawer import drawing
 from ..._files._io import OutputDir, provenance
 from .. import _options
 from .._common import check_out, integer, number, outputs_line
 from . import _record
 from ._system import _add_start_options, _add_system_options, _system, _tolerances
 
+#: the figures and the results' module the drawer loads while the command computes
+#: (:mod:`discovery._files._drawer`)
+_FIGURES = ("ueda.figures.attractor_figure", "ueda.figures.basins_figure")
+_RESULTS = ("discovery.ueda.attractor_analysis", "discovery.ueda.coexisting")
+
 
 def run(args):
-    from reports.ueda.figures import attractor_figure, basins_figure
+    check_out(args)
+    with drawing(_FIGURES, _RESULTS) as drawer:
+        return _run(args, drawer)
 
+
+def _run(args, drawer):
     from ...ueda import attractor, basins
 
-    check_out(args)
     system = _system(args)
     tol = _tolerances(args)
     att = attractor(
@@ -50,11 +59,13 @@ def run(args):
     att.record_run({"command": "ueda attractor"}, {**tail, **provenance(vars(args))})
     files = ["summary.json", "attractor.png", "attractor.pdf"]
     with OutputDir(args.out) as out:
-        attractor_figure(att, str(out.path("attractor")))
+        stem = str(out.path("attractor"))
+        drawer.draw(stem, _FIGURES[0], att, stem)
         _record.write_strobe(out.path("strobe.csv"), att.strobe)
         files.append("strobe.csv")
         if bas is not None:
-            basins_figure(bas, str(out.path("basins")))
+            stem = str(out.path("basins"))
+            drawer.draw(stem, _FIGURES[1], bas, stem)
             files += ["basins.png", "basins.pdf"]
         att.write_into(out)
     print(f"{system.model}: {att.regime.regime} ({att.regime.evidence['rule']})")

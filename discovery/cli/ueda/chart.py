@@ -5,6 +5,7 @@ import csv
 
 import numpy as np
 
+from ..._files._drawer import drawing
 from ..._files._io import OutputDir, provenance
 from ...errors import InputError
 from .. import _options
@@ -50,12 +51,21 @@ def _add_grid_option(c, option, default, what):
     )
 
 
-def run(args):
-    from reports.ueda.figures import chart_figure
+#: the figures and the results' module the drawer loads while the command computes
+#: (:mod:`discovery._files._drawer`)
+_FIGURES = ("ueda.figures.chart_figure",)
+_RESULTS = ("discovery.ueda.regime_chart",)
 
+
+def run(args):
+    check_out(args)
+    with drawing(_FIGURES, _RESULTS) as drawer:
+        return _run(args, drawer)
+
+
+def _run(args, drawer):
     from ...ueda.regime_chart import chart
 
-    check_out(args)
     system = _system(args, nu=None, B=None)
 
     if args.periods < 4 * args.max_period:
@@ -91,7 +101,8 @@ def run(args):
             w.writerow(ch.columns)
             for r in ch.rows():
                 w.writerow([cell(v, c) for v, c in zip(r, ch.columns, strict=True)])
-        chart_figure(ch, str(out.path("chart")))
+        stem = str(out.path("chart"))
+        drawer.draw(stem, _FIGURES[0], ch, stem)
         ch.write_into(out)
     fr = ch.fractions()
     print(

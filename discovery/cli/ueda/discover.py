@@ -6,21 +6,30 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..._files._drawer import drawing
 from ..._files._io import OutputDir
 from .. import _options
 from .._common import check_out, integer, number, outputs_line, provenance_of
 from . import _record
 from ._system import _add_forcing_options, _forcing
 
+#: the figures and the results' module the drawer loads while the command computes
+#: (:mod:`discovery._files._drawer`)
+_FIGURES = ("ueda.figures.discover_figure",)
+_RESULTS = ("discovery.ueda.equation_discovery", "discovery.ueda.verification")
+
 
 def run(args):
-    from reports.ueda.figures import discover_figure
+    check_out(args)
+    with drawing(_FIGURES, _RESULTS) as drawer:
+        return _run(args, drawer)
 
+
+def _run(args, drawer):
     from ...ueda.equation_discovery import discover
     from ...ueda.record import read_record_csv
     from ...ueda.verification import verify
 
-    check_out(args)
     B, nu = _forcing(args)
     t, x = read_record_csv(args.data)
     d = discover(
@@ -58,7 +67,8 @@ def run(args):
         settings_key="discovery_settings",
     )
     with OutputDir(args.out, inputs=[args.data]) as out:
-        discover_figure(d, ver, str(out.path("discover")))
+        stem = str(out.path("discover"))
+        drawer.draw(stem, _FIGURES[0], d, ver, stem)
         _record.write_strobe(out.path("strobe_record.csv"), ver.record_strobe)
         _record.write_strobe(out.path("strobe_model.csv"), ver.model_strobe)
         d.write_into(out)

@@ -1,6 +1,7 @@
 """``vidi ueda explain``: the missing-effect workflow: from a start model, name the missing effect
 of this system's catalogue by score tests, add it, refit, and show the gap shrink."""
 
+from ..._files._drawer import drawing
 from ..._files._io import OutputDir
 from ...errors import InputError
 from .. import _options
@@ -8,14 +9,22 @@ from .._common import check_out, outputs_line, provenance_of
 from . import _record
 from ._system import _add_forcing_options, _forcing
 
+#: the figures and the results' module the drawer loads while the command computes
+#: (:mod:`discovery._files._drawer`)
+_FIGURES = ("ueda.explain_figure.explain_figure",)
+_RESULTS = ("discovery.ueda.explanation",)
+
 
 def run(args):
-    from reports.ueda.explain_figure import explain_figure
+    check_out(args)
+    with drawing(_FIGURES, _RESULTS) as drawer:
+        return _run(args, drawer)
 
+
+def _run(args, drawer):
     from ...ueda.explain_loop import explain, parse_terms
     from ...ueda.record import read_record_csv
 
-    check_out(args)
     B, nu = _forcing(args)
     start = parse_terms(args.start)
     effects = None
@@ -50,7 +59,8 @@ def run(args):
         settings_key="method",
     )
     with OutputDir(args.out, inputs=[args.data]) as out:
-        explain_figure(ex, str(out.path("explain")))
+        stem = str(out.path("explain"))
+        drawer.draw(stem, _FIGURES[0], ex, stem)
         for name, ver in (("start", ex.start_verification), ("final", ex.final_verification)):
             _record.write_strobe(out.path(f"strobe_{name}.csv"), ver.model_strobe)
         _record.write_strobe(out.path("strobe_record.csv"), ex.final_verification.record_strobe)
