@@ -465,9 +465,10 @@ def main():
         )
     )
     for m in METHODS:
+        fewer = idf[m]["fewer_than_coordinate_descent"]
         print(
             f"identify {m}: {idf[m]['simulations_to_0.1%']} simulations to 0.1 % "
-            f"({idf[m]['fewer_than_coordinate_descent']} x fewer than coordinate descent)"
+            + (f"({fewer:.2g} x fewer than coordinate descent)" if fewer else "(not reached)")
         )
     se = results["sensitivities"]
     print(

@@ -356,7 +356,46 @@ def readme_lines(runs):
         f"steady state ({_sig(1e3 * steady)} ms); on the bench's records `fit` (`discover "
         f"poly:2, refine`) takes {_sig(fit.get('seconds'))} s in one process and `explain` "
         f"{_sig(explain.get('seconds'))} s on {explain.get('cores')} cores;",
+        *_paired_lines(_get(run, "paired")),
     ]
+
+
+#: the paired commands the README names, and how
+_PAIRED_NAMES = {
+    "verify": "`verify`",
+    "fit": "`fit`",
+    "fit-readme": "the quickstart's `fit`",
+    "fit-demo": "the demo's `fit`",
+    "contact-models": "the named contact models",
+    "explain": "`explain`",
+    "explain-c02": "`explain` on corpus c02",
+    "explain-c06": "c06",
+    "explain-c12": "c12",
+}
+
+
+def _paired_lines(paired):
+    """The README's line on the paired commands of a run (none when it paired none): each
+    command's time as a fraction of the baseline's, on the same machine in the same run."""
+    commands = (paired or {}).get("commands") or {}
+    named = [(text, commands[k]["ratio"]) for k, text in _PAIRED_NAMES.items() if k in commands]
+    if not named:
+        return []
+    ratios = ", ".join(f"{text} {ratio:.2f}" for text, ratio in named)
+    return [
+        f"  each command's time over the same command's with {paired['baseline']}, run in turn "
+        f"on the same machine (medians of {paired['pairs']} pairs): {ratios};"
+    ]
+
+
+def readme_stamp(files, runs):
+    """The line under the README's paragraph: the run it is made from, its commit and date."""
+    run = [r for r in runs if not r["partial"]][-1]
+    names = ", ".join(f"`{p.name}`" for p in files)
+    return (
+        f"*Rendered by `make tables` from {names} in `docs/_measured/`: the last full "
+        f"`make bench` run, at {label(run)} ({str(run['created'])[:10]}).*"
+    )
 
 
 def main(argv=None):

@@ -135,11 +135,16 @@ def _two_points(pattern):
     )
 
 
-def _paragraph(page, lines, runs, read):
+def _paragraph(page, lines, runs, read, stamp=None):
     """Text of ``page`` rendered by ``lines(rows)`` from the run files ``runs`` (read with
-    ``read``): a table without rows."""
+    ``read``): a table without rows (``stamp``: its line under it, default the run files')."""
     return Table(
-        page=page, header=lines, rows=(("run", runs),), row=lambda rows, label: [], read=read
+        page=page,
+        header=lines,
+        rows=(("run", runs),),
+        row=lambda rows, label: [],
+        read=read,
+        stamp=stamp,
     )
 
 
@@ -164,7 +169,11 @@ _README_TEXT = {
 TABLES = {
     **_README_TEXT,
     "bench-readme": _paragraph(
-        "README.md", bench_history.readme_lines, ("bench-history.jsonl",), bench_history.read_rows
+        "README.md",
+        bench_history.readme_lines,
+        ("bench-history.jsonl",),
+        bench_history.read_rows,
+        bench_history.readme_stamp,
     ),
     "effects": _by_label(
         "docs/validation.md", _EFFECTS_HEADER, survey_effects, "effects*.jsonl", _EFFECT_ROWS
