@@ -308,13 +308,16 @@ def check_out(args, kind="dir", option="--out"):
     )
 
 
-def provenance_of(args):
+def provenance_of(args, counted=True):
     """The ``summary.json`` provenance of a command: its options, its input files
-    (:func:`inputs_of`) and the work it counted so far (:mod:`discovery.numerics.counts`)."""
+    (:func:`inputs_of`) and, with ``counted``, the work it counted so far
+    (:mod:`discovery.numerics.counts`: the vibro-impact system's units; not for the Ueda
+    commands, whose work they do not count)."""
     from .._files._io import provenance
     from ..numerics import counts
 
-    return {**provenance(vars(args), inputs=inputs_of(args)), "counts": counts.snapshot()}
+    prov = provenance(vars(args), inputs=inputs_of(args))
+    return {**prov, "counts": counts.snapshot()} if counted else prov
 
 
 def data_entry(data):

@@ -39,3 +39,12 @@ def test_a_command_s_summary_counts_its_own_work_on_any_worker_count(tmp_path, m
     assert [{k: g[k] for k in asked} for g in got] == [{k: got[0][k] for k in asked}] * 2
     assert got[0]["evaluations"] >= 9 and got[0]["criteria"] >= 9
     assert got[0]["steady_states"] >= 1 and got[0]["period_maps"] >= got[0]["steady_states"]
+
+
+def test_the_ueda_commands_record_no_counts_of_the_other_system(tmp_path, monkeypatch):
+    """The counts are the vibro-impact system's units: a Ueda command, which does none of
+    that work, records none (it had recorded zeros, as if it had judged no law)."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["ueda", "simulate", "--periods", "60", "--out", "u.csv"]) == 0
+    assert main(["ueda", "discover", "--data", "u.csv", "--model", "negres", "--out", "d"]) == 0
+    assert "counts" not in json.loads((tmp_path / "d" / "summary.json").read_text())

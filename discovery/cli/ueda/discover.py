@@ -62,7 +62,7 @@ def _run(args, drawer):
         {"command": "ueda discover", "forcing": {"B": B, "nu": nu}},
         {
             "verification": ver.as_dict(),
-            **provenance_of(args),
+            **provenance_of(args, counted=False),
         },
         settings_key="discovery_settings",
     )

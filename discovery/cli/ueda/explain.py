@@ -55,7 +55,7 @@ def _run(args, drawer):
     )
     ex.record_run(  # "settings" is provenance's (the options): the method's is "method"
         {"command": "ueda explain", "forcing": {"B": B, "nu": nu}},
-        provenance_of(args),
+        provenance_of(args, counted=False),
         settings_key="method",
     )
     with OutputDir(args.out, inputs=[args.data]) as out:
