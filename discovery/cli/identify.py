@@ -18,6 +18,7 @@ from ._common import (
     coefficients_line,
     criteria_line,
     machine_for,
+    machine_scale,
     number,
     outputs_line,
     provenance_of,
@@ -224,6 +225,7 @@ def _run(args, drawer):
             interval_refit=args.interval_refit,
             seed=args.seed,
             workers=args.workers,
+            machine_scale=machine_scale(machine),
             progress=rep,
         )
     imps = _iterate_impulses(sc, start, ref, res)

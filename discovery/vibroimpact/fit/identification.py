@@ -331,6 +331,7 @@ class IdentifySettings(Settings):
     interval_noise: str = option("cycles", Choice(*INTERVAL_NOISE))
     give_up_above: object = option(None, (None, Real(0, open_low=True)))
     restart_above: object = option(None, (None, Real(0)))
+    machine_scale: object = option(None, (None, tuple, list))
 
 
 @takes(IdentifySettings)
@@ -385,6 +386,11 @@ def identify(scenario, reference, start, *, settings=None, progress=None, **opti
         How a bootstrap replicate is refitted (:func:`bootstrap_intervals`: ``"two-step"``).
     interval_noise : str
         The replicates' noise (:func:`bootstrap_intervals`: ``"cycles"``).
+    machine_scale : (float, float), optional
+        The factors within which the machine's scale is uncertain (a calibration's
+        :attr:`~discovery.Calibration.scale_range`): the bootstrap intervals are widened to
+        it (:func:`bootstrap_intervals`), as ``verify``, ``discover`` and ``explain`` widen
+        theirs; a law fitted on a calibrated machine carries the scale's error.
     progress : callable or bool, optional
         ``progress(stage, done, total)`` after each simulation; None: a bar when the session is
         interactive, False: none (:mod:`discovery._api._progress`).
@@ -491,6 +497,8 @@ def _identified(records, start, s, progress):
             workers=s.workers,
             refit=s.interval_refit,
             noise=s.interval_noise,
+            machine_scale=None if s.machine_scale is None else tuple(s.machine_scale),
+            observe=s.observe,
         )
     return IdentificationResult(
         checks=_checks(records, law, s.observe, s.tolerances) if s.check else (),
