@@ -24,6 +24,7 @@ from ._common import (
     provenance_of,
     read_record,
     reporter,
+    sensor_lag_of,
 )
 
 
@@ -155,7 +156,7 @@ def _summary(args, sc, start, ref, res):
     return res.record_run(head, tail)
 
 
-def _print_result(args, res):
+def _print_result(args, res, tau=0.0):
     final = res.checks[0]
     print(f"identified {res.law}")
     # the criterion of the identified law (res.value can be that of a standard-error probe)
@@ -169,6 +170,10 @@ def _print_result(args, res):
     if final.criteria:
         print(criteria_line(final.criteria, final.noise_floor))
     print(f"  {final.verdict}")
+    if tau:
+        from ..vibroimpact.verify.sensors import lag_note
+
+        print(f"  note: {lag_note(tau)}")
     if res.failures:
         print(
             f"  note: {len(res.failures)} trial law(s) had no periodic steady state with "
@@ -193,6 +198,7 @@ def _run(args, drawer):
     from ..vibroimpact.fit.identification import identify
     from ..vibroimpact.verify import Reference
     from ..vibroimpact.verify.criteria_landscape import Landscape
+    from ..vibroimpact.verify.sensors import lag_observation
 
     sc = load_scenario(args.scenario)
     if not args.start.strip():
@@ -211,6 +217,7 @@ def _run(args, drawer):
     for note in meas.notes:
         print(f"note: {note}")
     (sc,), machine = machine_for(args, [sc], [meas])
+    tau = sensor_lag_of(args, machine)  # the force sensor's, read through as verify and fit do
     ref = Reference.from_measurement(meas, sc, n_boot=args.n_boot, seed=args.seed)
     with reporter(args) as rep:
         res = identify(
@@ -226,20 +233,21 @@ def _run(args, drawer):
             seed=args.seed,
             workers=args.workers,
             machine_scale=machine_scale(machine),
+            observe=lag_observation(tau),
             progress=rep,
         )
     imps = _iterate_impulses(sc, start, ref, res)
     with OutputDir(args.out) as out:
         summary = _summary(args, sc, start, ref, res)
         run = summary.run_record
-        summary.record_run({**run["head"], "machine": machine}, run["tail"])
+        summary.record_run({**run["head"], "machine": machine, "sensor_lag": tau}, run["tail"])
         summary.write_into(out)
         out.path("iterations.csv").write_text(_iterations_csv(res))
         stem = str(out.path("identification"))
         drawer.draw(
             stem, "identification_figure", res, ref.impulse, imps, stem, land=land, start=start
         )
-    _print_result(args, res)
+    _print_result(args, res, tau)
     return 0
 
 
@@ -277,6 +285,7 @@ def register(sub):
         s, "the 95 % coefficient intervals", "records with positions; 0 = none"
     )
     _options.add_interval_refit_option(s)
+    _options.add_sensor_lag_option(s)
     _options.add_workers_option(s, "the fit's record blocks and the bootstrap intervals' refits")
     _options.add_seed_option(s, "seed of the noise-floor and interval bootstraps")
     _options.add_out_option(s)
