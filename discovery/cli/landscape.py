@@ -23,6 +23,7 @@ from ._common import (
     provenance_of,
     read_record,
     reporter,
+    sensor_lag_of,
 )
 
 
@@ -136,6 +137,8 @@ def _run(args, drawer):
     n0, n1 = parse_grid(args.grid)
     (r0, r1), origin = _ranges(args, law)
     ref, ref_info, sc = _reference(args, sc)
+    # the force sensor the calibration found (or --sensor-lag): read through, as verify does
+    tau = sensor_lag_of(args, ref_info.get("machine"))
     a0, a1 = np.linspace(*r0, n0), np.linspace(*r1, n1)
     with reporter(args) as rep, executor_of(args) as ex:
         land = landscape(
@@ -148,6 +151,7 @@ def _run(args, drawer):
             progress=rep,
             executor=ex,
             continuation=not args.no_continuation,
+            sensor_lag=tau,
         )
     count, first, at = land.failures
     if count and count >= n0 * n1:  # nothing to show: one line and no output
@@ -161,7 +165,12 @@ def _run(args, drawer):
         ref_info["impacts"] = land.reference["impacts"]
     with OutputDir(args.out) as out:
         land.record_run(
-            {"command": "landscape", "scenario": sc.as_dict(), "law": law.to_text()},
+            {
+                "command": "landscape",
+                "scenario": sc.as_dict(),
+                "law": law.to_text(),
+                "sensor_lag": tau,
+            },
             {
                 "reference": ref_info,
                 "grid": [n0, n1],
@@ -238,6 +247,7 @@ def register(sub):
     _options.add_time_offset_option(s, needs="--data", help_prefix="with --data: ")
     _options.add_n_boot_option(s, help_prefix="with --data: ", needs="--data")
     _options.add_seed_option(s, "with --data: seed of the bootstrap", needs="--data")
+    _options.add_sensor_lag_option(s).needs = "--data"
     s.add_argument(
         "--no-continuation",
         action="store_true",

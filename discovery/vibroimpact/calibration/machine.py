@@ -200,8 +200,8 @@ def _lag_note(lag):
         f"the force lags the motions: a sensor of time constant {_fmt(lag.tau)} "
         f"[{_fmt(lag.low)}, {_fmt(lag.high)}] s (seen in the machine's equations, "
         f"{lag.share:.1%} of the force's); the machine is read from the force it saw, "
-        "vidi fit, vidi verify and vidi identify compare a law's force as this sensor sees "
-        "it, and vidi explain starts from it (sensor_lag)"
+        "vidi fit, verify, identify and landscape compare a law's force as this sensor "
+        "sees it, and vidi explain starts from it (sensor_lag)"
     )
 
 

@@ -36,6 +36,7 @@ from ..model.law import ForceLaw
 from ..model.scenario import Scenario
 from . import Reference, evaluate
 from .criteria import CRITERIA
+from .sensors import lag_observation
 
 __all__ = ["Landscape", "landscape", "parse_grid", "default_range", "DEFAULT_SPREAD"]
 
@@ -267,20 +268,36 @@ class _FixedFloor(Reference):
         return self.fixed_floor
 
 
+@dataclass(frozen=True)
+class _Grid:
+    """What every point of a landscape is evaluated with (a row's task carries it): the
+    machine, the template law, the reference (its floor fixed), the integrator's
+    tolerances, whether to start from the measured state, continuation along a row, and the
+    observation model of the simulated force (a force sensor's lag; None: none)."""
+
+    scenario: object
+    law: object
+    reference: object
+    tolerances: object
+    from_state: bool
+    continuation: bool
+    observe: object = None
+
+
 def _point(ctx, law, guess=None):
     """``((regime, impacts, criteria or None, consistent, message), steady state or None)``
-    of one law; ``ctx`` is ``(scenario, law, reference, tolerances, from_state,
-    continuation)``; ``guess`` the previous point's steady state (continuation)."""
-    scenario, _, reference, tolerances, from_state, _ = ctx
+    of one law; ``ctx`` a :class:`_Grid`; ``guess`` the previous point's steady state
+    (continuation)."""
     try:
         ev = evaluate(
-            scenario,
+            ctx.scenario,
             law,
-            reference,
-            tolerances=tolerances,
-            from_state=from_state,
+            ctx.reference,
+            tolerances=ctx.tolerances,
+            from_state=ctx.from_state,
             floor=True,
             guess=guess,
+            observe=ctx.observe,
         )
     except VidiError:
         raise  # bad input (e.g. a zero reference impulse) concerns every point: stop
@@ -302,7 +319,7 @@ def _row(ctx, job):
     from its neighbours' orbit (:func:`~discovery.vibroimpact.dynamics.steady_states.steady_state`'s
     ``guess``, see :func:`_predicted`), and from the cold search when that fails."""
     v0, axis1 = job
-    law, continuation = ctx[1], ctx[5]
+    law, continuation = ctx.law, ctx.continuation
     out, solved = [], []
     for v1 in axis1:
         coefs = list(law.coefficients)
@@ -329,11 +346,12 @@ def _predicted(solved, v):
     return replace(last, y0=last.y0 + r * (last.y0 - before.y0))
 
 
-def _floor_once(scenario, law, reference, tolerances, from_state):
+def _floor_once(ctx):
     """The reference's noise floor, ``(mean, q95, what it was computed under)``: under
-    the template ``law``; if that law has no periodic orbit with contact, under the
+    the template law; if that law has no periodic orbit with contact, under the
     scenario's law; else under the measured cycle itself (a noisy stand-in, which
-    smooths force jumps and so gives a lower floor)."""
+    smooths force jumps and so gives a lower floor).  ``ctx``: a :class:`_Grid`."""
+    scenario, law, reference = ctx.scenario, ctx.law, ctx.reference
     if not reference.noise:
         fl = reference.floor_for(reference.impulse)
         return fl["mean"], fl["q95"], "exact reference (no noise)"
@@ -341,7 +359,14 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
     for cand in (law, scenario.law):
         if cand is None or cand.to_text() in (t for t, _ in tried):
             continue
-        ev = evaluate(scenario, cand, reference, tolerances=tolerances, from_state=from_state)
+        ev = evaluate(
+            scenario,
+            cand,
+            reference,
+            tolerances=ctx.tolerances,
+            from_state=ctx.from_state,
+            observe=ctx.observe,
+        )
         if ev.status == "ok":
             return (
                 dict(ev.noise_floor),
@@ -354,6 +379,30 @@ def _floor_once(scenario, law, reference, tolerances, from_state):
     return fl["mean"], fl["q95"], f"the measured cycle ({why})"
 
 
+def _reference_of(scenario, reference, tolerances):
+    """What a landscape compares with: ``reference`` (a :class:`Reference`), or by default
+    the exact impulse of the scenario's law."""
+    if reference is None:
+        if scenario.law is None:
+            raise InputError(
+                f"scenario {scenario.name!r} has no reference law; add [law] text "
+                "or compare with a measured record"
+            )
+        imp = response(scenario, scenario.law, tolerances=tolerances).impulse
+        if imp is None:
+            raise InputError(
+                f"the reference law '{scenario.law}' has no periodic steady state with contact"
+            )
+        return Reference.exact(imp, source="law")
+    if not isinstance(reference, Reference):
+        raise VidiTypeError(
+            "reference must be a discovery.vibroimpact.verify.Reference; wrap an exact impulse "
+            "with Reference.exact(impulse) or prepare a record with "
+            "Reference.from_measurement(measurement, scenario)"
+        )
+    return reference
+
+
 @dataclass(frozen=True, repr=False)
 class LandscapeSettings(Settings):
     """The options of :func:`landscape` (each is also a keyword of it; see its parameters)."""
@@ -362,6 +411,7 @@ class LandscapeSettings(Settings):
     tolerances: object = option(None, (Tolerances, None))
     from_state: bool = option(True)
     continuation: bool = option(True)
+    sensor_lag: float = option(0.0, Real(0.0, 5e-3))
 
 
 @takes(LandscapeSettings)
@@ -417,6 +467,10 @@ def landscape(
     continuation : bool
         Start each point's steady state from its neighbours' orbit along a row (default),
         falling back on the cold search; False: every point from the cold search.
+    sensor_lag : float
+        The force sensor's time constant [s] (a calibration's
+        :attr:`~discovery.Calibration.sensor_lag`): every point's force is compared as the
+        sensor sees it, as :func:`~discovery.verify` compares it (0: as simulated).
 
     Returns
     -------
@@ -432,25 +486,17 @@ def landscape(
     axis0 = _axis(axis0, "axis0")
     axis1 = _axis(axis1, "axis1")
     t_start = time.perf_counter()
-    if reference is None:
-        if scenario.law is None:
-            raise InputError(
-                f"scenario {scenario.name!r} has no reference law; add [law] text "
-                "or compare with a measured record"
-            )
-        imp = response(scenario, scenario.law, tolerances=s.tolerances).impulse
-        if imp is None:
-            raise InputError(
-                f"the reference law '{scenario.law}' has no periodic steady state with contact"
-            )
-        reference = Reference.exact(imp, source="law")
-    elif not isinstance(reference, Reference):
-        raise VidiTypeError(
-            "reference must be a discovery.vibroimpact.verify.Reference; wrap an exact impulse "
-            "with Reference.exact(impulse) or prepare a record with "
-            "Reference.from_measurement(measurement, scenario)"
-        )
-    floor, q95, under = _floor_once(scenario, law, reference, s.tolerances, s.from_state)
+    reference = _reference_of(scenario, reference, s.tolerances)
+    grid = _Grid(
+        scenario,
+        law,
+        reference,
+        s.tolerances,
+        s.from_state,
+        bool(s.continuation),
+        lag_observation(s.sensor_lag),
+    )
+    floor, q95, under = _floor_once(grid)
     ref = _FixedFloor(
         **{f.name: getattr(reference, f.name) for f in fields(Reference)},
         fixed_floor={"mean": floor, "q95": q95, "n_boot": reference.n_boot, "seed": reference.seed},
@@ -463,7 +509,7 @@ def landscape(
     messages = np.full(shape, "", dtype=object)
     values = {n: np.full(shape, np.nan) for n in CRITERIA}
     jobs = [(v0, axis1) for v0 in axis0]
-    context = (scenario, law, ref, s.tolerances, s.from_state, bool(s.continuation))
+    context = replace(grid, reference=ref)
     own = executor is None
     ex = make_executor(workers) if own else executor
     try:

@@ -143,3 +143,23 @@ def test_vidi_identify_takes_the_lag_the_calibration_found(tmp_path, record, cap
     plain = json.loads((tmp_path / "b" / "summary.json").read_text())
     assert plain["sensor_lag"] == 0.0 and plain["consistent"] is False
     assert plain["coefficients"]["z"] < 0.95 * 2.06e8
+
+
+def test_vidi_landscape_reads_the_force_through_the_calibration_s_sensor(tmp_path, record):
+    """``vidi landscape`` against a lagged record compares every point's force as the sensor
+    the calibration found sees it: its lowest I2 at the true law, consistent there; with
+    ``--sensor-lag 0`` (what it did before) no point is consistent and the lowest lies at
+    the grid's edge, a damping 16 % low."""
+    record.to_csv(tmp_path / "rec.csv")
+    words = ["landscape", "--data", str(tmp_path / "rec.csv"), "--grid", "5x5", "--quiet"]
+    words += ["--range0", "1.86e8:2.26e8", "--range1", "1.08e7:1.48e7", "--workers", "1"]
+    found = {}
+    for name, extra in (("a", []), ("b", ["--sensor-lag", "0"])):
+        assert main([*words, *extra, "--out", str(tmp_path / name)]) == 0
+        s = json.loads((tmp_path / name / "summary.json").read_text())
+        i, j = np.unravel_index(np.nanargmin(np.array(s["I2"], dtype=float)), (5, 5))
+        found[name] = (s["sensor_lag"], s["alpha1"][i], s["alpha2"][j], np.sum(s["consistent"]))
+    lag, z, zd, n_consistent = found["a"]
+    assert lag > 0 and (z, zd) == (2.06e8, 1.28e7) and n_consistent >= 1
+    lag, z, zd, n_consistent = found["b"]
+    assert lag == 0.0 and zd == 1.08e7 and n_consistent == 0
