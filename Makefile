@@ -17,7 +17,7 @@ endif
 TEX_PACKAGES := latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended \
 	lmodern poppler-utils
 
-.PHONY: install demo study test test-slow test-all bench lint clean tex docs tables surveys gallery readme
+.PHONY: install demo study test test-slow test-all bench bench-study lint clean tex docs tables surveys gallery readme
 
 install: $(STAMP)
 
@@ -95,6 +95,12 @@ test-all: install
 # section to docs/_measured/scaling-bench.jsonl, then renders the tables made from them.
 bench: install
 	cd bench && ../$(BIN)/python run.py
+	$(BIN)/python -m tests.tables
+
+# The shipped paper study (examples/study_paper.toml) old against new, 3 pairs (about 25
+# minutes on two cores): its own run in the bench history, its tables compared cell by cell.
+bench-study: install
+	cd bench && ../$(BIN)/python run.py paper-study
 	$(BIN)/python -m tests.tables
 
 # The measured tables of docs/validation.md and the README, rendered between their

@@ -16,6 +16,7 @@ no machine changes.
 """
 
 import argparse
+import csv
 import json
 import os
 import shutil
@@ -53,6 +54,14 @@ for _name in ("c02-steep-onset", "c06-unloading-damping", "c12-coupling-unloadin
         _files = ["--data", str(CORPUS / _name / "measured.csv")]
         _files += ["--scenario", str(CORPUS / _name / "scenario.toml")]
         COMMANDS[f"explain-{_name[:3]}"] = (["explain", *_files], False)
+
+
+#: the shipped paper study (``examples/study_paper.toml``: 120 runs on every core, tables only),
+#: paired on its own (``python run.py paper-study``; 8 minutes a pair on two cores)
+STUDY = ["study", "--config", str(ROOT / "examples" / "study_paper.toml"), "--no-figures"]
+#: the study table's columns compared cell by cell, old against new (what a run found, not
+#: how long it took)
+STUDY_COLUMNS = ("recovered", "equivalent", "fp_per_run", "fn_per_run", "covered", "consistent")
 
 
 def baseline_tree():
@@ -145,15 +154,21 @@ def record(cwd):
         _vidi(ROOT, words + ["--seed", seed, "--out", f"{name}.csv"], cwd)
 
 
-def paired(name, words, pairs, cwd, old):
-    """``{"ratio", "ratios", "new", "old", "counts"}`` of one command."""
+def paired(name, words, pairs, cwd, old, *, fresh=False):
+    """``{"ratio", "ratios", "new", "old", "counts"}`` of one command; with ``fresh`` (a
+    study, which reuses the runs it finds in ``--out``) each timed run starts from an empty
+    ``--out`` and the untimed first runs do two of its runs only."""
     out_new, out_old = ["--out", f"new_{name}"], ["--out", f"old_{name}"]
-    _vidi(ROOT, words + out_new, cwd)  # untimed: compiled and cached
-    _vidi(old, words + out_old, cwd)
+    warm = ["--max-runs", "2"] if fresh else []
+    _vidi(ROOT, words + out_new + warm, cwd)  # untimed: compiled and cached
+    _vidi(old, words + out_old + warm, cwd)
     new, base = [], []
     for k in range(pairs):
         order = [(ROOT, out_new, new), (old, out_old, base)]
         for code, out, times in order if k % 2 == 0 else order[::-1]:
+            if fresh:  # the study's results and its work directory beside them
+                for d in (out[1], f".{out[1]}.vidi-study"):
+                    shutil.rmtree(cwd / d, ignore_errors=True)
             times.append(_vidi(code, words + out, cwd))
     ratios = [n / o for n, o in zip(new, base, strict=True)]
     summary = json.loads((cwd / f"new_{name}" / "summary.json").read_text())
@@ -183,6 +198,64 @@ def bench_paired(quick=False, pairs=None, only=None):
         out["commands"][name] = paired(name, words, pairs, cwd, old)
         print_paired({"commands": {name: out["commands"][name]}}, head=False)
     return out
+
+
+def _cells(path):
+    with open(path, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    return {tuple(r[k] for k in ("force_noise", "periods", "selection")): r for r in rows}
+
+
+def _simulations(path):
+    with open(path, newline="") as fh:
+        return sum(int(float(r["simulations"] or 0)) for r in csv.DictReader(fh))
+
+
+def study_tables(cwd, name):
+    """The two sides' study tables compared: ``{"cells", "same_cells", "differ",
+    "simulations_new", "simulations_old"}`` (``differ``: each cell whose
+    :data:`STUDY_COLUMNS` differ, with both sides' values)."""
+    new, old = _cells(cwd / f"new_{name}" / "cells.csv"), _cells(cwd / f"old_{name}" / "cells.csv")
+    differ = []
+    for key, row in new.items():
+        a = {c: row.get(c) for c in STUDY_COLUMNS}
+        b = {c: old.get(key, {}).get(c) for c in STUDY_COLUMNS}
+        if a != b:
+            differ.append({"cell": list(key), "new": a, "old": b})
+    return {
+        "cells": len(new),
+        "same_cells": len(new) - len(differ),
+        "differ": differ,
+        "simulations_new": _simulations(cwd / f"new_{name}" / "runs.csv"),
+        "simulations_old": _simulations(cwd / f"old_{name}" / "runs.csv"),
+    }
+
+
+def bench_paper_study(pairs=3):
+    """The shipped paper study (:data:`STUDY`), old and new in turn, ``pairs`` times, with
+    its tables compared cell by cell (:func:`study_tables`)."""
+    old = baseline_tree()
+    compiled(old, ROOT)
+    cwd = WORK / "paired-study"
+    shutil.rmtree(cwd, ignore_errors=True)
+    cwd.mkdir(parents=True)
+    out = paired("paper-study", STUDY, pairs, cwd, old, fresh=True)
+    out.update(study_tables(cwd, "paper-study"))
+    out["counts"] = {"simulations": out["simulations_new"]}
+    return {"baseline": BASELINE, "pairs": pairs, "commands": {"paper-study": out}}
+
+
+def print_study(result):
+    """The paired study's line and its tables' agreement."""
+    print_paired(result)
+    r = result["commands"]["paper-study"]
+    print(
+        f"  paper study: {r['same_cells']}/{r['cells']} cells the same ({', '.join(STUDY_COLUMNS)}"
+        f"); simulations {r['simulations_new']} against {r['simulations_old']} "
+        f"({r['simulations_new'] / r['simulations_old']:.2f})"
+    )
+    for d in r["differ"]:
+        print(f"    differs: {d['cell']}: new {d['new']}, old {d['old']}")
 
 
 def print_paired(result, head=True):

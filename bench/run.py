@@ -30,7 +30,9 @@ Writes ``bench/results.json``.  Figures:
     ``explain`` on the corpus records c02, c06 and c12 run with a checkout of the baseline
     commit and with this one,
     alternately, the median of the pairs' ratios, beside the work each command counted
-    (``summary.json``'s ``counts``).
+    (``summary.json``'s ``counts``).  The shipped paper study (120 runs, 8 minutes a pair
+    on two cores) is paired on its own: ``python run.py paper-study`` (``make
+    bench-study``), with its tables compared cell by cell.
 
 Each run is also saved for the documentation's tables (``make tables``): appended as a row to
 ``docs/_measured/bench-history.jsonl`` (``tests/bench_history.py``; ``python run.py kernel``
@@ -404,6 +406,31 @@ def main_kernel():
     return 0
 
 
+def main_paper_study(argv):
+    """``python run.py paper-study [--pairs N]``: the shipped paper study old against new
+    (:func:`paired_bench.bench_paper_study`, about 8 minutes a pair on two cores), merged
+    into the results file as a section of its own with its own provenance (a run of its own
+    in the bench history, as ``kernel``'s)."""
+    import argparse
+
+    from paired_bench import bench_paper_study, print_study
+
+    ap = argparse.ArgumentParser(prog="run.py paper-study")
+    ap.add_argument("--pairs", type=int, default=3, help="pairs (default %(default)s)")
+    a = ap.parse_args(argv)
+    if a.pairs < 1:
+        ap.error("--pairs must be at least 1")
+    res = bench_paper_study(a.pairs)
+    path = Path(__file__).with_name("results.json")
+    results = json.loads(path.read_text()) if path.exists() else {}
+    results["paired_study"] = res
+    results["paired_study_provenance"] = provenance({"config": "examples/study_paper.toml"})
+    path.write_text(json.dumps(to_jsonable(results), indent=2) + "\n")
+    print_study(res)
+    save_history(results)
+    return 0
+
+
 def main():
     from discovery_bench import bench_discovery, bench_pipeline
     from explain_bench import bench_explain
@@ -583,4 +610,6 @@ def main_scaling(argv):
 if __name__ == "__main__":
     if sys.argv[1:2] == ["scaling"]:
         sys.exit(main_scaling(sys.argv[2:]))
+    if sys.argv[1:2] == ["paper-study"]:
+        sys.exit(main_paper_study(sys.argv[2:]))
     sys.exit(main_kernel() if sys.argv[1:] == ["kernel"] else main())

@@ -10,7 +10,8 @@ that were never committed.
 
 A results file holds one run, or two when ``python run.py kernel`` measured the kernel again
 afterwards: that section then has its own ``kernel_vs_scipy_provenance`` and is a run of its
-own (a *partial* run: the kernel's figures only).  :func:`columns` picks the table's runs (the
+own (a *partial* run: the kernel's figures only; ``python run.py paper-study``'s paired
+paper study likewise).  :func:`columns` picks the table's runs (the
 last :data:`COLUMNS`; a partial run measured again by the next partial run before any full
 one is left out) and :func:`markdown_row` makes each row of the table from the numbers (keys
 missing from older runs are blank cells).
@@ -184,13 +185,21 @@ def header(runs):
     )
 
 
+#: what a partial run measured, by its section
+PARTIAL = {"kernel_vs_scipy": "the kernel's figures only", "paired_study": "the paper study only"}
+
+
+def _partial(run):
+    return "; ".join(PARTIAL.get(s, s) for s in run["sections"])
+
+
 def stamp(files, runs):
     """The line under the table: the run file, and each column's commit and date."""
     cols = columns(runs)
     shown = ", ".join(
         f"{label(r)} ({str(r['created'])[:10]}"
         + (f", saved in {r['saved_in']}" if r.get("saved_in") and r["commit"] else "")
-        + (", the kernel's figures only" if r["partial"] else "")
+        + (f", {_partial(r)}" if r["partial"] else "")
         + ")"
         for r in cols
     )
@@ -328,7 +337,13 @@ ROWS = {
     "`explain`, full catalogue": lambda r: _wall_ratio(_get(r, "explain")),
     "`explain` on 2 processes over 1": lambda r: _parallel(_get(r, "explain")),
     "Ueda chart 60x60": lambda r: _seconds(_get(r, "ueda", "chart", "seconds"), ".1f"),
+    "the paper study over the baseline's, paired (`make bench-study`)": lambda r: _study(r),
 }
+
+
+def _study(run):
+    r = _get(run, "paired_study", "commands", "paper-study")
+    return "" if r is None else f"{r['ratio']:.2f} ({r['same_cells']}/{r['cells']} cells same)"
 
 
 def markdown_row(runs, label_):
@@ -357,6 +372,24 @@ def readme_lines(runs):
         f"poly:2, refine`) takes {_sig(fit.get('seconds'))} s in one process and `explain` "
         f"{_sig(explain.get('seconds'))} s on {explain.get('cores')} cores;",
         *_paired_lines(_get(run, "paired")),
+        *_study_lines(runs),
+    ]
+
+
+def _study_lines(runs):
+    """The README's line on the paired paper study: the last run that measured it (``make
+    bench-study``, a run of its own), none before one has."""
+    done = [r for r in runs if _get(r, "paired_study", "commands", "paper-study")]
+    if not done:
+        return []
+    run = done[-1]
+    r = run["results"]["paired_study"]["commands"]["paper-study"]
+    pairs = run["results"]["paired_study"]["pairs"]
+    return [
+        f"  the shipped paper study (`make bench-study`, 120 runs, tables only; at "
+        f"{label(run)}, {str(run['created'])[:10]}, medians of {pairs} pairs) "
+        f"{r['ratio']:.2f}, with {r['simulations_new'] / r['simulations_old']:.2f} of the "
+        f"simulations and the same table in {r['same_cells']} of its {r['cells']} cells;"
     ]
 
 
@@ -392,9 +425,16 @@ def readme_stamp(files, runs):
     """The line under the README's paragraph: the run it is made from, its commit and date."""
     run = [r for r in runs if not r["partial"]][-1]
     names = ", ".join(f"`{p.name}`" for p in files)
+    study = [r for r in runs if _get(r, "paired_study", "commands", "paper-study")]
+    also = (
+        f", and the last `make bench-study` run, at {label(study[-1])} "
+        f"({str(study[-1]['created'])[:10]})"
+        if study
+        else ""
+    )
     return (
         f"*Rendered by `make tables` from {names} in `docs/_measured/`: the last full "
-        f"`make bench` run, at {label(run)} ({str(run['created'])[:10]}).*"
+        f"`make bench` run, at {label(run)} ({str(run['created'])[:10]}){also}.*"
     )
 
 

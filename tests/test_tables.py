@@ -445,6 +445,53 @@ def test_a_kernel_run_after_the_bench_is_a_run_of_its_own(tmp_path):
     assert h.markdown_row(runs, "Ueda chart 60x60") == "| Ueda chart 60x60 |  |  |"
 
 
+def test_a_paired_study_run_is_a_run_of_its_own_the_readme_names(tmp_path):
+    """python run.py paper-study's section (with its own provenance) is a partial run: a
+    column of the speed history with its ratio, and a line of the README's paragraph with
+    its run named under it; before any such run the README has no line on it."""
+    from tests import bench_history as h
+
+    full = _results(
+        "a",
+        "2026-01-01T00:00:00+00:00",
+        kernel_vs_scipy={"speedup": 44.4, "long_run_40_periods_speedup": 60.5},
+        pipeline={"one_steady_state_seconds": 1e-3},
+        explain={"seconds": 6.1, "cores": 2},
+    )
+    path = tmp_path / "history.jsonl"
+    h.append(full, path)
+    assert not any("paper study" in line for line in h.readme_lines(h.read_rows([path])))
+    study = {
+        "ratio": 0.571,
+        "simulations_new": 62049,
+        "simulations_old": 104436,
+        "same_cells": 59,
+        "cells": 60,
+    }
+    again = {
+        **full,
+        "paired_study": {"baseline": "44858e9", "pairs": 3, "commands": {"paper-study": study}},
+        "paired_study_provenance": _results("b", "2026-01-02T00:00:00+00:00"),
+    }
+    new = h.append(again, path)
+    assert [(r["commit"], r["partial"], r["sections"]) for r in new] == [
+        ("bbbbbbb", True, ["paired_study"])
+    ]
+    runs = h.read_rows([path])
+    label = "the paper study over the baseline's, paired (`make bench-study`)"
+    assert h.markdown_row(runs, label) == f"| {label} |  | 0.57 (59/60 cells same) |"
+    lines = h.readme_lines(runs)
+    assert "2026-01-01 on" in lines[0]  # the paragraph is the last full run's
+    assert lines[-1] == (
+        "  the shipped paper study (`make bench-study`, 120 runs, tables only; at bbbbbbb, "
+        "2026-01-02, medians of 3 pairs) 0.57, with 0.59 of the simulations and the same "
+        "table in 59 of its 60 cells;"
+    )
+    assert h.readme_stamp([path], runs).endswith(
+        "at aaaaaaa (2026-01-01), and the last `make bench-study` run, at bbbbbbb (2026-01-02).*"
+    )
+
+
 def test_a_scaling_run_adds_its_machines_rows(tmp_path):
     """A scaling run file (as run.py scaling --out FILE.jsonl writes it) is headed by its
     command, commit and machine; the table has a row per machine and work, a later run on as
