@@ -6,7 +6,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from discovery.outputs import finish_handed_off
+from discovery.outputs import handed_off
 from discovery.vibroimpact.verify.criteria import CRITERIA as _REGISTRY
 from discovery.vibroimpact.verify.criteria import MOTION_DEFINITIONS, definition
 
@@ -220,10 +220,15 @@ def _measured_rows(m, records=None):
 
 
 def _figures(run_dir, order):
-    finish_handed_off(under=run_dir)  # the PDFs forked children print, all there
+    """The run's PDF figures whose names begin with each of ``order``, in that order: those
+    written and those a forked process is writing (not waited for here: the report waits
+    for each figure it shows, :func:`reports.document.render`)."""
+    printing = {p.name for p in handed_off(run_dir) if p.suffix == ".pdf"}
     figs = []
     for stem in order:
-        for p in sorted(Path(run_dir).glob(f"{stem}*.pdf")):
+        found = {p.name for p in Path(run_dir).glob(f"{stem}*.pdf")}
+        found |= {n for n in printing if n.startswith(stem)}
+        for p in (Path(run_dir) / n for n in sorted(found)):
             if p.stem in ("report", "model"):
                 continue
             base = p.stem.split("_")[0] if p.stem not in FIGURE_CAPTIONS else p.stem

@@ -84,6 +84,37 @@ def test_a_dead_drawers_figures_are_drawn_by_the_command(tmp_path):
         assert (tmp_path / "out" / name).stat().st_size > 0
 
 
+def _slow_print(stem):
+    """A figure whose PDF takes its printing child a second and a half."""
+    from discovery.outputs import hand_off
+
+    def pdf():
+        time.sleep(1.5)
+        Path(f"{stem}.pdf").write_bytes(b"%PDF-1.4 slow\n")
+
+    Path(f"{stem}.png").write_bytes(b"png")
+    hand_off(f"{stem}.pdf", pdf)
+
+
+def test_the_drawer_draws_the_next_figure_while_a_pdf_is_printing(tmp_path, monkeypatch):
+    """The drawer does not wait for a figure's PDF before it draws the next figure: the
+    second figure, sent right after a figure whose print takes 1.5 s, is drawn and answered
+    first; both figures' files are in place when the output directory closes."""
+    import reports
+
+    monkeypatch.setattr(reports, "_test_slow_print", _slow_print, raising=False)
+    with drawing() as drawer, OutputDir(tmp_path / "out") as out:
+        slow, fast = str(out.path("slow")), str(out.path("fast"))
+        drawer.draw(slow, "_test_slow_print", slow)
+        drawer.draw(fast, SQUARE, fast)
+        assert drawer.answered(1)
+        assert 0 not in drawer.answers  # the slow figure's PDF still printing
+    assert list(drawer.answers) == [1, 0] and all(drawer.answers.values())
+    assert (tmp_path / "out" / "slow.pdf").read_bytes() == b"%PDF-1.4 slow\n"
+    for name in ("slow.png", "fast.png", "fast.pdf"):
+        assert (tmp_path / "out" / name).stat().st_size > 0
+
+
 def test_outside_an_output_directory_or_unpicklable_a_figure_is_drawn_at_once(tmp_path):
     with drawing() as drawer:
         stem = str(tmp_path / "loose")

@@ -6,10 +6,11 @@ third of its time, all of it after the work.  A :class:`Drawer` is forked before
 loads its numerics, loads matplotlib, the figure modules and the modules of the results it
 will draw (``preload``) on the second core while the command computes, then draws each
 figure it is sent (:meth:`Drawer.draw`: the figure function's name and its arguments,
-pickled), its PDF printed by a child of its own (:mod:`._handoff`), and answers when both
-files are written.  The command's output directory waits for them as for any handed-off
-file; a figure the drawer did not write (its drawing raised, the drawer died, its arguments
-do not pickle) is drawn by the command itself, so the result does not depend on the drawer.
+pickled), its PDF printed by a child of its own (:mod:`._handoff`) while it draws the next,
+and answers when both files are written.  The command's output directory waits for them as
+for any handed-off file; a figure the drawer did not write (its drawing raised, the drawer
+died, its arguments do not pickle) is drawn by the command itself, so the result does not
+depend on the drawer.
 Elsewhere (one core, no ``fork``, a figure outside an output directory) a figure is drawn at
 once, in this process.
 """
@@ -18,6 +19,7 @@ import contextlib
 import importlib
 import os
 import pickle
+import queue
 import signal
 import threading
 
@@ -45,6 +47,7 @@ class Drawer:
         self.pid, self.conn = pid, conn
         self.answers, self.sent, self.dead = {}, 0, False
         self.lock = threading.Lock()
+        self.queue = None  # the sending thread's jobs (:meth:`_send`)
 
     @classmethod
     def start(cls, figures=(), preload=()):
@@ -78,14 +81,27 @@ class Drawer:
             return
         paths = [f"{stem}.png", f"{stem}.pdf"]
         _handoff.finish(paths)  # a second drawing of one file waits for the first
-        try:
-            self.conn.send_bytes(payload)
-        except OSError:  # the drawer is gone
-            self.dead = True
-            _draw_here(name, args, kwargs)
-            return
+        self._send(payload)
         self.sent += 1
         _handoff.pend(paths, _Job(self, job), lambda: _draw_here(name, args, kwargs))
+
+    def _send(self, payload):
+        """Send a job by the sending thread, in order: the command goes on while a job of
+        megabytes waits in the pipe for the drawer to take it (it takes the next job when
+        it has drawn the last).  A job that cannot be sent (the drawer is gone) is drawn by
+        the command where it waits for it."""
+        if self.queue is None:
+            self.queue = queue.SimpleQueue()
+            threading.Thread(target=self._sending, daemon=True).start()
+        self.queue.put(payload)
+
+    def _sending(self):
+        while (payload := self.queue.get()) is not None:
+            try:
+                self.conn.send_bytes(payload)
+            except OSError:  # the drawer is gone: answered() reads no answer
+                self.dead = True
+                return
 
     def answered(self, job):
         """Whether the drawer wrote job ``job``'s files (waits for its answer)."""
@@ -110,6 +126,8 @@ class Drawer:
         output directory closed), so it is idle, or still loading when the command stopped
         early (an interrupt: the command does not wait for its imports)."""
         self.dead = True
+        if self.queue is not None:
+            self.queue.put(None)  # the sending thread ends
         with contextlib.suppress(OSError):
             self.conn.close()
         self.kill()
@@ -151,7 +169,9 @@ def drawing(figures=(), preload=()):
 
 def _serve(conn, figures, preload):  # pragma: no cover - runs in the forked drawer
     """The drawer's life: load ``figures`` and ``preload``, then draw each job, answering
-    ``(job, wrote)``; it ends when the command closes its end (or dies)."""
+    ``(job, wrote)`` once its PDF is printed too; it ends when the command closes its end
+    (or dies).  A figure's PDF is printed by a child of this process while the next figure
+    is drawn (:class:`_Printing`)."""
     code = 0
     try:
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # the command decides (it kills this)
@@ -163,23 +183,57 @@ def _serve(conn, figures, preload):  # pragma: no cover - runs in the forked dra
         for name in figures:
             with contextlib.suppress(Exception):
                 _function(name)
+        printing = _Printing(conn)
         while True:
             try:
                 job, name, args, kwargs, stage = pickle.loads(conn.recv_bytes())
             except (EOFError, OSError):
                 break
-            ok = False
-            _handoff.open_stage(stage)
-            try:
-                _draw_here(name, args, kwargs)
-                _handoff.finish(under=stage)  # its PDF, printed by a child of this process
-                ok = True
-            except BaseException:  # noqa: BLE001 - the command draws it again
-                ok = False
-            finally:
-                _handoff.close_stage(stage)
-            conn.send((job, ok))
+            printing.draw(job, name, args, kwargs, stage)
     except BaseException:  # noqa: BLE001
         code = 1
     finally:
         os._exit(code)
+
+
+class _Printing:  # pragma: no cover - runs in the forked drawer
+    """The drawer's answers: each figure's answered by a thread of its own once its PDF is
+    printed too, while the drawer draws the next figure (a figure's PNG and its PDF's print
+    take about as long: the drawer no longer waits for each print before the next drawing,
+    and the command hears of each figure as soon as both its files are written)."""
+
+    def __init__(self, conn):
+        self.conn, self.stages, self.lock = conn, set(), threading.Lock()
+
+    def draw(self, job, name, args, kwargs, stage):
+        """Draw job ``job`` into the output directory's staging directory ``stage``; a job
+        that raised is answered at once, not drawn (the command draws it again), and the
+        prints it began are killed."""
+        if stage not in self.stages:  # open while the drawer lives: its prints go on
+            _handoff.open_stage(stage)
+            self.stages.add(stage)
+        before = set(_handoff.pending(stage))
+        try:
+            _draw_here(name, args, kwargs)
+        except BaseException:  # noqa: BLE001
+            _handoff.abandon(paths=[p for p in _handoff.pending(stage) if p not in before])
+            self._answer(job, False)
+            return
+        printing = [p for p in _handoff.pending(stage) if p not in before]
+        threading.Thread(target=self._printed, args=(job, printing), daemon=True).start()
+
+    def _printed(self, job, paths):
+        """Answer ``job`` once the prints of ``paths`` have ended (a print that failed is
+        made again here, as :func:`._handoff.finish` does)."""
+        ok = True
+        try:
+            for writer in _handoff.writers(paths):
+                writer.wait()  # not holding the registry: the next figure's prints start
+            _handoff.finish(paths)
+        except BaseException:  # noqa: BLE001 - the command draws it again
+            ok = False
+        self._answer(job, ok)
+
+    def _answer(self, job, ok):
+        with self.lock, contextlib.suppress(OSError):
+            self.conn.send((job, ok))

@@ -23,7 +23,17 @@ import sys
 import threading
 from pathlib import Path
 
-__all__ = ["write", "pend", "finish", "abandon", "open_stage", "close_stage", "in_parallel"]
+__all__ = [
+    "write",
+    "pend",
+    "finish",
+    "pending",
+    "writers",
+    "abandon",
+    "open_stage",
+    "close_stage",
+    "in_parallel",
+]
 
 _STAGES = []  # the staging directories of this process's open output directories
 _PENDING = {}  # path -> (what writes it: a _Child or a drawer's job, the write itself)
@@ -66,17 +76,19 @@ def stage_of(path):
 
 
 class _Child:
-    """A forked child writing a file: ``wait()`` is whether it wrote it, ``kill()`` ends it."""
+    """A forked child writing a file: ``wait()`` is whether it wrote it (its outcome kept:
+    asked again, it answers again), ``kill()`` ends it."""
 
     def __init__(self, pid):
-        self.pid = pid
+        self.pid, self.status = pid, None
 
     def wait(self):
-        try:
-            _, status = os.waitpid(self.pid, 0)
-        except ChildProcessError:  # reaped elsewhere: its outcome is unknown
-            return False
-        return os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0
+        if self.status is None:
+            try:
+                _, self.status = os.waitpid(self.pid, 0)
+            except ChildProcessError:  # reaped elsewhere: its outcome is unknown
+                self.status = -1
+        return os.WIFEXITED(self.status) and os.WEXITSTATUS(self.status) == 0
 
     def kill(self):
         with contextlib.suppress(OSError):
@@ -149,11 +161,24 @@ def finish(paths=None, under=None):
                 fn()
 
 
-def abandon(under=None):
-    """Kill and reap the children writing into ``under`` (default: all), their files left
-    unwritten (a failed run's staging directory is removed)."""
+def pending(under):
+    """The files being written into the directory ``under`` now."""
     with _LOCK:
-        for path in _selected(None, under):
+        return _selected(None, under)
+
+
+def writers(paths):
+    """What writes each of ``paths`` that is pending (each with ``wait()``): a thread may wait
+    for them without holding the registry, then :func:`finish` them at once."""
+    with _LOCK:
+        return [_PENDING[p][0] for p in _selected(paths, None)]
+
+
+def abandon(under=None, paths=None):
+    """Kill and reap the children writing into ``under`` (default: all) or writing
+    ``paths``, their files left unwritten (a failed run's staging directory is removed)."""
+    with _LOCK:
+        for path in _selected(paths, under):
             writer, _ = _PENDING.pop(path)
             writer.kill()
 

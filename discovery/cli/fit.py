@@ -123,20 +123,22 @@ def _write_outputs(args, res, t_start, drawer):
             )
     with OutputDir(args.out) as out, ThreadPoolExecutor(1) as latex:
         out.path("ranking.csv").write_text(_ranking_csv(res))
+        # every figure sent at once: the drawer draws the next while the last's PDF prints
         stem = str(out.path("fit_impulse"))
         drawer.draw(stem, "fit_impulse_figure", res, imps, stem)
+        for name in ("fit_surface", "fit_loop"):
+            stem = str(out.path(name))
+            drawer.draw(stem, f"{name}_figure", res, stem)
         # model.tex is a template of the report system, rendered from the summary itself
+        # (it shows the first figure: it waits for that one alone)
         out.path("model.tex").write_text(render(res.to_dict(), out.stage, template="model"))
         # LaTeX runs while the other two figures are drawn (a subprocess: this thread only
         # waits for it); it needs only the first figure
         compiled = (
-            latex.submit(compile_tex, out.path("model.tex"), ["fit_impulse.pdf"])
+            latex.submit(compile_tex, out.path("model.tex"), ["fit_impulse.pdf"], once=True)
             if not args.no_pdf
             else None
         )
-        for name in ("fit_surface", "fit_loop"):
-            stem = str(out.path(name))
-            drawer.draw(stem, f"{name}_figure", res, stem)
         pdf, why = compiled.result() if compiled is not None else (None, None)
         why = None if pdf is not None else why
         # the run's record, with the PDF and the whole command's wall time

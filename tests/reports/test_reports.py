@@ -233,6 +233,44 @@ def test_fit_writes_model_tex_from_the_template(runs):
     assert "r\\_\\textbackslash{}input\\{etc-passwd\\}\\_\\$x\\$.csv" in tex
 
 
+def _pages_png(pdf, tmp_path, name):
+    """The PDF's pages as PNG bytes (pdftoppm at 50 dpi)."""
+    subprocess.run(["pdftoppm", "-r", "50", "-png", str(pdf), str(tmp_path / name)], check=True)
+    return [p.read_bytes() for p in sorted(tmp_path.glob(f"{name}*.png"))]
+
+
+@pytest.mark.skipif(not HAVE_TEX or shutil.which("pdftoppm") is None, reason="TeX not installed")
+def test_the_fit_s_model_tex_compiled_once_has_latexmk_s_pages(runs, tmp_path):
+    """``vidi fit`` compiles model.tex by one pdflatex pass (``compile_tex(once=True)``):
+    the same pages as latexmk's two passes."""
+
+    for way in ("once", "latexmk"):
+        d = tmp_path / way
+        d.mkdir()
+        for name in ("model.tex", "fit_impulse.pdf"):
+            shutil.copyfile(runs / "fit" / name, d / name)
+        pdf, _ = compile_tex(d / "model.tex", ["fit_impulse.pdf"], once=way == "once")
+        assert pdf is not None
+    once = _pages_png(tmp_path / "once" / "model.pdf", tmp_path, "once")
+    assert len(once) >= 1
+    assert once == _pages_png(tmp_path / "latexmk" / "model.pdf", tmp_path, "twice")
+
+
+@pytest.mark.skipif(not HAVE_TEX, reason="TeX not installed")
+def test_a_document_compiled_once_gets_the_passes_its_log_asks_for(tmp_path):
+    """A forward reference is resolved: the first pass's log asks for another, and latexmk
+    makes it."""
+
+    tex = tmp_path / "doc.tex"
+    tex.write_text(
+        "\\documentclass{article}\\begin{document}See section~\\ref{s}."
+        "\\section{Later}\\label{s}\\end{document}\n"
+    )
+    pdf, _ = compile_tex(tex, once=True)
+    text = subprocess.run(["pdftotext", str(pdf), "-"], capture_output=True, text=True).stdout
+    assert "See section 1." in text and "??" not in text
+
+
 def test_user_text_in_figures_is_not_read_as_mathtext(tmp_path):
     """A record name holding '$...$' is drawn as it is: matplotlib's mathtext would fail on
     a broken formula and end the run."""
