@@ -17,7 +17,7 @@ endif
 TEX_PACKAGES := latexmk texlive-latex-recommended texlive-latex-extra texlive-fonts-recommended \
 	lmodern poppler-utils
 
-.PHONY: install demo study test test-slow test-all bench bench-study lint clean tex docs tables surveys gallery readme
+.PHONY: install demo study test test-slow test-all bench bench-study bench-corpus lint clean tex docs tables surveys gallery readme
 
 install: $(STAMP)
 
@@ -101,6 +101,13 @@ bench: install
 # minutes on two cores): its own run in the bench history, its tables compared cell by cell.
 bench-study: install
 	cd bench && ../$(BIN)/python run.py paper-study
+	$(BIN)/python -m tests.tables
+
+# The corpus (../shared/corpus) old against new: every record verified with its true law,
+# fitted and explained by both codes in turn (about 12 minutes on two cores), what each
+# found compared with the other's and the truth; its own run in the bench history.
+bench-corpus: install
+	cd bench && ../$(BIN)/python run.py corpus
 	$(BIN)/python -m tests.tables
 
 # The measured tables of docs/validation.md and the README, rendered between their

@@ -32,7 +32,9 @@ Writes ``bench/results.json``.  Figures:
     alternately, the median of the pairs' ratios, beside the work each command counted
     (``summary.json``'s ``counts``).  The shipped paper study (120 runs, 8 minutes a pair
     on two cores) is paired on its own: ``python run.py paper-study`` (``make
-    bench-study``), with its tables compared cell by cell.
+    bench-study``), with its tables compared cell by cell; so is the corpus (every record
+    verified with its true law, fitted and explained, 12 minutes): ``python run.py corpus``
+    (``make bench-corpus``), what each side found compared with the other's and the truth.
 
 Each run is also saved for the documentation's tables (``make tables``): appended as a row to
 ``docs/_measured/bench-history.jsonl`` (``tests/bench_history.py``; ``python run.py kernel``
@@ -421,14 +423,35 @@ def main_paper_study(argv):
     if a.pairs < 1:
         ap.error("--pairs must be at least 1")
     res = bench_paper_study(a.pairs)
+    _save_section("paired_study", res, {"config": "examples/study_paper.toml"})
+    print_study(res)
+    return 0
+
+
+def main_corpus(argv):
+    """``python run.py corpus [--records c02 ...] [--commands explain ...]``: the corpus's
+    records verified, fitted and explained old against new (:mod:`corpus_bench`, about 12
+    minutes on two cores), what each side found compared with the other's and with the
+    truth; a section of its own in the results file and a run of its own in the history."""
+    from corpus_bench import bench_corpus, print_corpus
+    from corpus_bench import main as parse
+
+    a = parse(argv, parse_only=True)
+    res = bench_corpus(a.records, a.commands)
+    _save_section("paired_corpus", res, {"records": a.records, "commands": a.commands})
+    print_corpus(res)
+    return 0
+
+
+def _save_section(name, section, settings):
+    """``section`` merged into the results file as ``name`` with its own provenance (a
+    partial run of the bench history), and the history appended."""
     path = Path(__file__).with_name("results.json")
     results = json.loads(path.read_text()) if path.exists() else {}
-    results["paired_study"] = res
-    results["paired_study_provenance"] = provenance({"config": "examples/study_paper.toml"})
+    results[name] = section
+    results[f"{name}_provenance"] = provenance(settings)
     path.write_text(json.dumps(to_jsonable(results), indent=2) + "\n")
-    print_study(res)
     save_history(results)
-    return 0
 
 
 def main():
@@ -612,4 +635,6 @@ if __name__ == "__main__":
         sys.exit(main_scaling(sys.argv[2:]))
     if sys.argv[1:2] == ["paper-study"]:
         sys.exit(main_paper_study(sys.argv[2:]))
+    if sys.argv[1:2] == ["corpus"]:
+        sys.exit(main_corpus(sys.argv[2:]))
     sys.exit(main_kernel() if sys.argv[1:] == ["kernel"] else main())

@@ -186,7 +186,11 @@ def header(runs):
 
 
 #: what a partial run measured, by its section
-PARTIAL = {"kernel_vs_scipy": "the kernel's figures only", "paired_study": "the paper study only"}
+PARTIAL = {
+    "kernel_vs_scipy": "the kernel's figures only",
+    "paired_study": "the paper study only",
+    "paired_corpus": "the corpus only",
+}
 
 
 def _partial(run):
@@ -338,12 +342,22 @@ ROWS = {
     "`explain` on 2 processes over 1": lambda r: _parallel(_get(r, "explain")),
     "Ueda chart 60x60": lambda r: _seconds(_get(r, "ueda", "chart", "seconds"), ".1f"),
     "the paper study over the baseline's, paired (`make bench-study`)": lambda r: _study(r),
+    "`explain` on the corpus over the baseline's, paired (`make bench-corpus`)": lambda r: _corpus(
+        r
+    ),
 }
 
 
 def _study(run):
     r = _get(run, "paired_study", "commands", "paper-study")
     return "" if r is None else f"{r['ratio']:.2f} ({r['same_cells']}/{r['cells']} cells same)"
+
+
+def _corpus(run):
+    r = _get(run, "paired_corpus", "commands", "explain")
+    if r is None or r["ratio"] is None:
+        return ""
+    return f"{r['ratio']:.2f} ({r['same']}/{r['records']} records same)"
 
 
 def markdown_row(runs, label_):
@@ -373,6 +387,7 @@ def readme_lines(runs):
         f"{_sig(explain.get('seconds'))} s on {explain.get('cores')} cores;",
         *_paired_lines(_get(run, "paired")),
         *_study_lines(runs),
+        *_corpus_lines(runs),
     ]
 
 
@@ -390,6 +405,34 @@ def _study_lines(runs):
         f"{label(run)}, {str(run['created'])[:10]}, medians of {pairs} pairs) "
         f"{r['ratio']:.2f}, with {r['simulations_new'] / r['simulations_old']:.2f} of the "
         f"simulations and the same table in {r['same_cells']} of its {r['cells']} cells;"
+    ]
+
+
+#: the corpus's commands the README names, and what their findings are
+_CORPUS_NAMES = {
+    "verify": ("`verify` with the true law", "verdicts"),
+    "fit": ("`fit`", "selected laws and verdicts"),
+    "explain": ("`explain`", "named effects and verdicts"),
+}
+
+
+def _corpus_lines(runs):
+    """The README's line on the paired corpus: the last run that measured it (``make
+    bench-corpus``, a run of its own), none before one has."""
+    done = [r for r in runs if _get(r, "paired_corpus", "commands")]
+    if not done:
+        return []
+    run = done[-1]
+    commands = run["results"]["paired_corpus"]["commands"]
+    parts = [
+        f"{text} {c['ratio']:.2f} (the same {what} on {c['same']} of {c['records']} records; "
+        f"right {c['right_new']}/{c['judged']} against {c['right_old']}/{c['judged']})"
+        for k, (text, what) in _CORPUS_NAMES.items()
+        if (c := commands.get(k)) and c["ratio"] is not None
+    ]
+    return [
+        f"  on the corpus (`make bench-corpus`, every record once a side; at {label(run)}, "
+        f"{str(run['created'])[:10]}, medians over the records): {'; '.join(parts)};"
     ]
 
 
@@ -425,13 +468,14 @@ def readme_stamp(files, runs):
     """The line under the README's paragraph: the run it is made from, its commit and date."""
     run = [r for r in runs if not r["partial"]][-1]
     names = ", ".join(f"`{p.name}`" for p in files)
-    study = [r for r in runs if _get(r, "paired_study", "commands", "paper-study")]
-    also = (
-        f", and the last `make bench-study` run, at {label(study[-1])} "
-        f"({str(study[-1]['created'])[:10]})"
-        if study
-        else ""
-    )
+    also = ""
+    for target, section in (("bench-study", "paired_study"), ("bench-corpus", "paired_corpus")):
+        done = [r for r in runs if _get(r, section, "commands")]
+        if done:
+            also += (
+                f", and the last `make {target}` run, at {label(done[-1])} "
+                f"({str(done[-1]['created'])[:10]})"
+            )
     return (
         f"*Rendered by `make tables` from {names} in `docs/_measured/`: the last full "
         f"`make bench` run, at {label(run)} ({str(run['created'])[:10]}){also}.*"

@@ -492,6 +492,63 @@ def test_a_paired_study_run_is_a_run_of_its_own_the_readme_names(tmp_path):
     )
 
 
+def test_a_paired_corpus_run_is_a_run_of_its_own_the_readme_names(tmp_path):
+    """python run.py corpus's section (with its own provenance) is a partial run: a column
+    of the speed history with explain's ratio and agreement, and a line of the README's
+    paragraph with each command's ratio, agreement and rightness, its run named under it."""
+    from tests import bench_history as h
+
+    full = _results(
+        "a",
+        "2026-01-01T00:00:00+00:00",
+        kernel_vs_scipy={"speedup": 44.4, "long_run_40_periods_speedup": 60.5},
+        pipeline={"one_steady_state_seconds": 1e-3},
+        explain={"seconds": 6.1, "cores": 2},
+    )
+    path = tmp_path / "history.jsonl"
+    h.append(full, path)
+    assert not any("corpus" in line for line in h.readme_lines(h.read_rows([path])))
+
+    def command(ratio, same, right_new, right_old):
+        return {
+            "ratio": ratio,
+            "records": 16,
+            "same": same,
+            "judged": 15,
+            "right_new": right_new,
+            "right_old": right_old,
+        }
+
+    corpus = {
+        "baseline": "44858e9",
+        "commands": {
+            "verify": command(0.612, 15, 15, 12),
+            "explain": command(0.789, 13, 14, 11),
+        },
+    }
+    again = {
+        **full,
+        "paired_corpus": corpus,
+        "paired_corpus_provenance": _results("c", "2026-01-03T00:00:00+00:00"),
+    }
+    new = h.append(again, path)
+    assert [(r["commit"], r["partial"], r["sections"]) for r in new] == [
+        ("ccccccc", True, ["paired_corpus"])
+    ]
+    runs = h.read_rows([path])
+    label = "`explain` on the corpus over the baseline's, paired (`make bench-corpus`)"
+    assert h.markdown_row(runs, label) == f"| {label} |  | 0.79 (13/16 records same) |"
+    assert h.readme_lines(runs)[-1] == (
+        "  on the corpus (`make bench-corpus`, every record once a side; at ccccccc, "
+        "2026-01-03, medians over the records): `verify` with the true law 0.61 (the same "
+        "verdicts on 15 of 16 records; right 15/15 against 12/15); `explain` 0.79 (the same "
+        "named effects and verdicts on 13 of 16 records; right 14/15 against 11/15);"
+    )
+    assert h.readme_stamp([path], runs).endswith(
+        "at aaaaaaa (2026-01-01), and the last `make bench-corpus` run, at ccccccc (2026-01-03).*"
+    )
+
+
 def test_a_scaling_run_adds_its_machines_rows(tmp_path):
     """A scaling run file (as run.py scaling --out FILE.jsonl writes it) is headed by its
     command, commit and machine; the table has a row per machine and work, a later run on as
