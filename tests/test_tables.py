@@ -445,12 +445,8 @@ def test_a_kernel_run_after_the_bench_is_a_run_of_its_own(tmp_path):
     assert h.markdown_row(runs, "Ueda chart 60x60") == "| Ueda chart 60x60 |  |  |"
 
 
-def test_a_paired_study_run_is_a_run_of_its_own_the_readme_names(tmp_path):
-    """python run.py paper-study's section (with its own provenance) is a partial run: a
-    column of the speed history with its ratio, and a line of the README's paragraph with
-    its run named under it; before any such run the README has no line on it."""
-    from tests import bench_history as h
-
+def _full_run(h, tmp_path):
+    """A full bench run's results, appended to a fresh history file: ``(results, path)``."""
     full = _results(
         "a",
         "2026-01-01T00:00:00+00:00",
@@ -460,6 +456,16 @@ def test_a_paired_study_run_is_a_run_of_its_own_the_readme_names(tmp_path):
     )
     path = tmp_path / "history.jsonl"
     h.append(full, path)
+    return full, path
+
+
+def test_a_paired_study_run_is_a_run_of_its_own_the_readme_names(tmp_path):
+    """python run.py paper-study's section (with its own provenance) is a partial run: a
+    column of the speed history with its ratio, and a line of the README's paragraph with
+    its run named under it; before any such run the README has no line on it."""
+    from tests import bench_history as h
+
+    full, path = _full_run(h, tmp_path)
     assert not any("paper study" in line for line in h.readme_lines(h.read_rows([path])))
     study = {
         "ratio": 0.571,
@@ -498,15 +504,7 @@ def test_a_paired_corpus_run_is_a_run_of_its_own_the_readme_names(tmp_path):
     paragraph with each command's ratio, agreement and rightness, its run named under it."""
     from tests import bench_history as h
 
-    full = _results(
-        "a",
-        "2026-01-01T00:00:00+00:00",
-        kernel_vs_scipy={"speedup": 44.4, "long_run_40_periods_speedup": 60.5},
-        pipeline={"one_steady_state_seconds": 1e-3},
-        explain={"seconds": 6.1, "cores": 2},
-    )
-    path = tmp_path / "history.jsonl"
-    h.append(full, path)
+    full, path = _full_run(h, tmp_path)
     assert not any("corpus" in line for line in h.readme_lines(h.read_rows([path])))
 
     def command(ratio, same, right_new, right_old):
