@@ -468,18 +468,16 @@ def readme_stamp(files, runs):
     """The line under the README's paragraph: the run it is made from, its commit and date."""
     run = [r for r in runs if not r["partial"]][-1]
     names = ", ".join(f"`{p.name}`" for p in files)
-    also = ""
+    parts = [f"the last full `make bench` run, at {label(run)} ({str(run['created'])[:10]})"]
     for target, section in (("bench-study", "paired_study"), ("bench-corpus", "paired_corpus")):
         done = [r for r in runs if _get(r, section, "commands")]
         if done:
-            also += (
-                f", and the last `make {target}` run, at {label(done[-1])} "
+            parts.append(
+                f"the last `make {target}` run, at {label(done[-1])} "
                 f"({str(done[-1]['created'])[:10]})"
             )
-    return (
-        f"*Rendered by `make tables` from {names} in `docs/_measured/`: the last full "
-        f"`make bench` run, at {label(run)} ({str(run['created'])[:10]}){also}.*"
-    )
+    runs_text = parts[0] if len(parts) == 1 else ", ".join(parts[:-1]) + " and " + parts[-1]
+    return f"*Rendered by `make tables` from {names} in `docs/_measured/`: {runs_text}.*"
 
 
 def main(argv=None):

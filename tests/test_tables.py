@@ -494,7 +494,7 @@ def test_a_paired_study_run_is_a_run_of_its_own_the_readme_names(tmp_path):
         "table in 59 of its 60 cells;"
     )
     assert h.readme_stamp([path], runs).endswith(
-        "at aaaaaaa (2026-01-01), and the last `make bench-study` run, at bbbbbbb (2026-01-02).*"
+        "at aaaaaaa (2026-01-01) and the last `make bench-study` run, at bbbbbbb (2026-01-02).*"
     )
 
 
@@ -543,7 +543,7 @@ def test_a_paired_corpus_run_is_a_run_of_its_own_the_readme_names(tmp_path):
         "named effects and verdicts on 13 of 16 records; right 14/15 against 11/15);"
     )
     assert h.readme_stamp([path], runs).endswith(
-        "at aaaaaaa (2026-01-01), and the last `make bench-corpus` run, at ccccccc (2026-01-03).*"
+        "at aaaaaaa (2026-01-01) and the last `make bench-corpus` run, at ccccccc (2026-01-03).*"
     )
 
 
