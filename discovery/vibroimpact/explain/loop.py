@@ -517,6 +517,7 @@ def explain(
     settings=None,
     progress=None,
     executor=None,
+    on_loop_end=None,
     **options,
 ):
     """Explain the disagreement of a start model with one or several records by named
@@ -567,6 +568,11 @@ def explain(
     progress : callable or bool, optional
         ``progress(stage, done, total)`` at each stage and iteration; None: a bar when the
         session is interactive, False: none (:mod:`discovery._api._progress`).
+    on_loop_end : callable, optional
+        ``on_loop_end(iterations, model)`` once the loop is over and its final model
+        refitted, before the bootstrap intervals: the result's
+        :attr:`~ExplainResult.iterations` and :attr:`~ExplainResult.final_model` as they
+        will be returned (``vidi explain`` draws their figures while the intervals run).
     machine_scale : (float, float), optional
         The factors within which the machine's scale is uncertain (a calibration's
         :attr:`~discovery.Calibration.scale_range`): every parameter's interval is
@@ -636,6 +642,8 @@ def explain(
         crit, floor = _with_drift(
             _mean(evs, "criteria"), _mean(evs, "noise_floor"), run.drift, run.model
         )
+        if on_loop_end is not None:
+            on_loop_end(tuple(run.iterations), run.model)
         intervals = _intervals(run, s, progress)
         return ExplainResult(
             intervals=intervals if read is None else read.beside(intervals),

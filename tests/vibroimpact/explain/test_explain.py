@@ -583,3 +583,53 @@ def test_the_contact_time_is_the_gap_only_where_it_alone_fails():
     assert not supports_gap([other], "I2")
     no_motion = _Scored({"I2": 0.02, "I4": 0.07}, {"I2": 0.03, "I4": 0.04})
     assert supports_gap([no_motion], "I2")  # a record without positions
+
+
+def test_the_loops_end_is_reported_before_the_intervals(paper, hidden_coupling):
+    """``on_loop_end`` gets the result's iterations and final model, once, before the
+    bootstrap intervals start (``vidi explain`` draws their figures meanwhile)."""
+    rec, _ = hidden_coupling
+    events = []
+    res = explain(
+        paper,
+        rec,
+        "linear",
+        max_iterations=0,
+        n_boot_intervals=5,
+        workers=1,
+        progress=lambda stage, done, total: events.append(stage),
+        on_loop_end=lambda iterations, model: events.append((iterations, model)),
+    )
+    ends = [e for e in events if isinstance(e, tuple)]
+    assert len(ends) == 1
+    iterations, model = ends[0]
+    assert iterations == res.iterations and model is res.final_model
+    at = events.index(ends[0])
+    assert "explain: bootstrap intervals" in events[at + 1 :]
+    assert "explain: bootstrap intervals" not in events[:at]
+    assert res.intervals is not None
+
+
+def test_a_failed_explain_leaves_the_earlier_result(hidden_coupling, tmp_path, monkeypatch, capsys):
+    """The output directory is staged before explain runs (its figures are drawn while the
+    intervals run): a run that fails removes the staging and leaves the earlier result."""
+    import discovery.vibroimpact.explain as package
+    from discovery.errors import IntegrationError
+
+    rec, _ = hidden_coupling
+    data = tmp_path / "hc.csv"
+    rec.to_csv(data)
+    out = tmp_path / "ex"
+    out.mkdir()
+    earlier = {"command": "explain", "earlier": True}  # an earlier run's result
+    (out / "summary.json").write_text(json.dumps(earlier))
+
+    def fails(*args, **kwargs):
+        raise IntegrationError("the law has no orbit")
+
+    monkeypatch.setattr(package, "explain", fails)
+    argv = ["explain", "--data", str(data), "--out", str(out), "--overwrite", "--intervals", "0"]
+    assert main(argv) == 2
+    assert "the law has no orbit" in capsys.readouterr().err
+    assert json.loads((out / "summary.json").read_text()) == earlier
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ex", "hc.csv"]
