@@ -1,6 +1,8 @@
 """The figure of one iteration of the missing-effect workflow (``vidi explain``): forces
 before and after, phases, the coefficient plane and the effects' scores."""
 
+import textwrap
+
 import numpy as np
 
 from .._mpl import PRINT_WIDTH, print_sizes, save, subplots
@@ -115,7 +117,8 @@ def _explain_scores(ax, iteration):
     refit.sort(key=lambda x: -x.criteria_after[key])  # the best at the top
     if refit:
         ax.barh(
-            [x.effect.replace("_", " ") for x in refit],
+            # long names on two lines: the column's width goes to the plots, not the labels
+            [textwrap.fill(x.effect.replace("_", " "), 20) for x in refit],
             [max(x.criteria_after[key], 1e-6) for x in refit],
             color=["tab:green" if x.effect == iteration.effect else "tab:orange" for x in refit],
         )

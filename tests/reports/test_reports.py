@@ -1238,3 +1238,27 @@ def test_the_advise_report_gives_units_the_ranking_rule_and_one_number_form(runs
     i5 = [r for r in rows if r[3] == "$I_{5}$"]
     assert [r[4:6] for r in i5] == [[r"$5.14\cdot 10^{-4}$", r"$5.64\cdot 10^{-3}$"]], rows
     assert [(r[1], r[2]) for r in rows] == [(1, 2), (1, 2), (2, 1)]
+
+
+def test_explain_scores_wrap_long_effect_names():
+    """The scores panel writes a long effect name on two lines (its labels had taken a third
+    of the page's width from the plots), in the order best at the top, the named one green."""
+    from reports._mpl import print_sizes, subplots
+    from reports.vibroimpact.explain_figures import _explain_scores
+
+    def score(effect, after):
+        return _ns(effect=effect, gap="I2", criteria_after={"I2": after})
+
+    it = _ns(
+        effect="unloading_damping",
+        scores=[score("penetration_velocity_coupling", 0.19), score("unloading_damping", 0.02)],
+        criteria_before={"I2": 0.136},
+        noise_floor={"I2": 0.026},
+    )
+    with print_sizes():
+        fig, ax = subplots(figsize=(3.3, 3.0))
+        _explain_scores(ax, it)
+    labels = [t.get_text() for t in ax.get_yticklabels()]
+    assert labels == ["penetration velocity\ncoupling", "unloading damping"]
+    colors = [p.get_facecolor()[:3] for p in ax.patches]
+    assert colors[1][1] > colors[1][0]  # the named one (at the top) green
