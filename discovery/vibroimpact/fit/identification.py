@@ -12,7 +12,8 @@ well-scaled problem.  Methods:
     try a step, double it while it keeps improving, else try the other direction,
     else halve it; stop when every step is below ``xtol``.
 ``nelder-mead``
-    scipy's Nelder–Mead simplex (derivative-free).
+    scipy's Nelder–Mead simplex (derivative-free); it stops once its best criterion has
+    fallen by less than 0.01 % of itself in 10 iterations (:class:`.optimise._Plateau`).
 ``least-squares``
     scipy's trust-region least squares on the residual vector ``(F_N - F_E)`` of every
     record, weighted so that each record's squared norm is its ``I3^2`` (a smooth

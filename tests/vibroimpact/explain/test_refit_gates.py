@@ -35,17 +35,30 @@ def unloading_fits():
     return records, start, plain, polished
 
 
-def test_a_fit_at_its_noise_floor_is_neither_restarted_nor_polished(unloading_fits):
+def test_a_fit_at_its_noise_floor_is_neither_restarted_nor_polished(unloading_fits, monkeypatch):
     """Where least squares ends at or below the gate, the result is the first least-squares
     fit's own: no restart from its best point scaled, no simplex (fewer simulations).
     Below every value the fit runs as before, bit for bit.  Nelder-Mead minimises the
     criterion alone (the force), least squares the force's and the penetration's
     residuals: at the floor the simplex trades the penetration for noise in the force."""
+    from discovery.vibroimpact.explain import starts
+
     records, start, plain, polished = unloading_fits
-    assert polished.n_simulations > plain.n_simulations  # the simplex ran
+    methods, identify = [], starts.identify
+
+    def spied(*args, **kwargs):
+        methods.append(kwargs["method"])
+        return identify(*args, **kwargs)
+
+    monkeypatch.setattr(starts, "identify", spied)
+    again = _output_error(records, start, "I2", 150, None, polish=True)
+    assert methods == ["least-squares", "nelder-mead"]  # the simplex ran
+    assert again.law.coefficients == polished.law.coefficients
+    methods.clear()
     high = 10.0 * polished.value
     first = _output_error(records, start, "I2", 150, None, floor=high)
     gated = _output_error(records, start, "I2", 150, None, polish=True, floor=high)
+    assert methods == ["least-squares", "least-squares"]  # no simplex at the floor
     assert gated.law.coefficients == first.law.coefficients
     assert gated.n_simulations == first.n_simulations < plain.n_simulations
     assert f"at every record's noise floor ({high:.3g} or more)" in first.message

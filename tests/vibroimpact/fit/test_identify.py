@@ -176,6 +176,9 @@ def test_derivative_free_methods_agree(paper, reference, fitted, method):
         # comparison: after 300 simulations it is still far (measured z 1.70e8, I2 0.145
         # against least squares' 0.018 in 77); the baseline the bench compares with
         return
+    # the simplex stops where its criterion no longer falls, well within its budget
+    assert "fell by less than 0.01% of itself in 10 iterations" in res.message
+    assert res.n_simulations < 300
     # the simplex minimises I2 itself (an L1 norm), least squares its L2 surrogate: two
     # estimators of the same law, a few standard errors apart (measured: z 2.0586e8 by the
     # simplex vs 2.0593e8 +- 4e5 by least squares)
@@ -497,3 +500,32 @@ def test_a_percentile_interval_over_few_cycles_is_widened_by_the_bootstraps_rule
     assert 1.0 < cycle_widening(10000, 1) < 1.001
     scale, q = cycle_spread(12, 3)
     assert scale == pytest.approx(np.sqrt(12 / 9)) and q == pytest.approx(2.262157, rel=1e-5)
+
+
+def test_the_simplex_stops_on_its_plateau():
+    """:class:`_Plateau`: the simplex goes on while its best criterion falls by 0.01 % of
+    itself or more over 10 iterations, and stops at the first iteration where it has not."""
+    from types import SimpleNamespace
+
+    from discovery.vibroimpact.fit.optimise import PLATEAU_ITERATIONS, _Plateau
+
+    steady = _Plateau()
+    for k in range(200):  # 0.002 % an iteration: 0.02 % in 10
+        steady(SimpleNamespace(fun=1.0 - 2e-5 * k))
+    assert steady.why == ""
+    flat, values = _Plateau(), [1.0, 0.5, 0.4] + [0.4 - 1e-7 * k for k in range(30)]
+    stopped = None
+    for k, v in enumerate(values):
+        try:
+            flat(SimpleNamespace(fun=v))
+        except StopIteration:
+            stopped = k
+            break
+    assert stopped == 2 + PLATEAU_ITERATIONS and "10 iterations" in flat.why
+    # the best so far counts, not the simplex's last value
+    worse = _Plateau()
+    worse(SimpleNamespace(fun=1.0))
+    for _ in range(PLATEAU_ITERATIONS - 1):
+        worse(SimpleNamespace(fun=2.0))
+    with pytest.raises(StopIteration):
+        worse(SimpleNamespace(fun=3.0))
