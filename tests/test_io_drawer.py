@@ -115,6 +115,36 @@ def test_the_drawer_draws_the_next_figure_while_a_pdf_is_printing(tmp_path, monk
         assert (tmp_path / "out" / name).stat().st_size > 0
 
 
+def _meet(stem, mine, theirs):
+    """A figure drawn only while the figure that marks ``theirs`` is drawn too: it marks
+    ``mine`` (its pid and its parent's) and waits for ``theirs`` (10 s at most)."""
+    Path(mine).write_text(f"{os.getpid()} {os.getppid()}")
+    deadline = time.monotonic() + 10.0
+    while not Path(theirs).exists():
+        if time.monotonic() > deadline:
+            raise RuntimeError("drawn alone")
+        time.sleep(0.01)
+    _square(stem)
+
+
+def test_the_drawer_draws_figures_side_by_side(tmp_path, monkeypatch):
+    """Two figures, each of which is drawn only while the other is: the drawer draws them
+    at once, each in a child of its own, and both are answered as written."""
+    import reports
+
+    monkeypatch.setattr(reports, "_test_meet", _meet, raising=False)
+    marks = [tmp_path / "a.mark", tmp_path / "b.mark"]
+    with drawing() as drawer, OutputDir(tmp_path / "out") as out:
+        for name, mine, theirs in (("a", *marks), ("b", *marks[::-1])):
+            stem = str(out.path(name))
+            drawer.draw(stem, "_test_meet", stem, str(mine), str(theirs))
+    assert drawer.answers == {0: True, 1: True}
+    (a, pa), (b, pb) = (map(int, m.read_text().split()) for m in marks)
+    assert a != b and pa == pb == drawer.pid
+    for name in ("a.png", "a.pdf", "b.png", "b.pdf"):
+        assert (tmp_path / "out" / name).stat().st_size > 0
+
+
 def test_outside_an_output_directory_or_unpicklable_a_figure_is_drawn_at_once(tmp_path):
     with drawing() as drawer:
         stem = str(tmp_path / "loose")

@@ -33,6 +33,7 @@ __all__ = [
     "open_stage",
     "close_stage",
     "in_parallel",
+    "child_wrote",
 ]
 
 _STAGES = []  # the staging directories of this process's open output directories
@@ -95,6 +96,11 @@ class _Child:
             os.kill(self.pid, signal.SIGKILL)
         with contextlib.suppress(OSError):
             os.waitpid(self.pid, 0)
+
+
+def child_wrote(pid):
+    """Whether the forked child ``pid`` exited 0 (waits for it)."""
+    return _Child(pid).wait()
 
 
 class _Once:
