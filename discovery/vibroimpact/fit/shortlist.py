@@ -148,7 +148,7 @@ class _Checker:
         cert0 = est.certify(_coefficients(law, est.library_))
         if not self.refine:
             return RankedModel(law, cand, self.evaluate(law), note="not refined", certificate=cert0)
-        if not any(t.b == 0 for t in law.terms):  # every term carries the rate
+        if not law.has_elastic_term:
             return RankedModel(law, cand, self.evaluate(law), note=NO_ELASTIC, certificate=cert0)
         law = self._scaled_start(law)
         try:

@@ -368,6 +368,12 @@ class ForceLaw:
         return self.format()
 
     @property
+    def has_elastic_term(self):
+        """True when a term is the penetration's alone (``zeta^a``, ``b = 0``): without one
+        every term carries the rate and the law has no force at rest in contact."""
+        return any(t.b == 0 for t in self.terms)
+
+    @property
     def has_jump(self):
         """True when the force jumps at contact onset (a term ``zd^b`` with ``a = 0``)."""
         return any(t.a == 0 for t in self.terms)
